@@ -1,0 +1,22 @@
+#pragma once
+// One registration function per subcommand; each lives in its own cmd_<name>.cpp with its
+// options struct, its setup (flags, validators, --help text) and its run function.
+#include <CLI/CLI.hpp>
+
+namespace whirl::cli {
+
+void RegisterTrain(CLI::App& app);       // cmd_train.cpp
+void RegisterPredict(CLI::App& app);     // cmd_predict.cpp
+void RegisterSimulate(CLI::App& app);    // cmd_simulate.cpp
+void RegisterDataset(CLI::App& app);     // cmd_dataset.cpp
+void RegisterCurve(CLI::App& app);       // cmd_curve.cpp
+void RegisterFit(CLI::App& app);         // cmd_fit.cpp
+void RegisterPlan(CLI::App& app);        // cmd_plan.cpp
+void RegisterCompare(CLI::App& app);     // cmd_compare.cpp
+void RegisterLeadReport(CLI::App& app);  // cmd_lead_report.cpp
+void RegisterEvaluate(CLI::App& app);    // cmd_evaluate.cpp
+void RegisterCrosscheck(CLI::App& app);  // cmd_crosscheck.cpp (LibTorch)
+void RegisterExport(CLI::App& app);      // cmd_export.cpp (LibTorch)
+void RegisterDemo(CLI::App& app);        // cmd_demo.cpp
+
+}  // namespace whirl::cli

@@ -1,0 +1,52 @@
+#include "cli/common.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+namespace whirl::cli {
+
+void PrintJson(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+
+void Warn(const std::string& text) { std::cerr << "warning: " << text << std::endl; }
+
+Progress::Progress(std::string label, std::size_t total)
+    : label_(std::move(label)), total_(total == 0 ? 1 : total), tty_(::isatty(2) != 0) {}
+
+void Progress::Update(std::size_t done, const std::string& detail) {
+  const double frac = static_cast<double>(done) / static_cast<double>(total_);
+  if (tty_) {
+    const int width = 30;
+    const int filled = static_cast<int>(frac * width + 0.5);
+    std::fprintf(stderr, "\r%s [%s%s] %zu/%zu %s", label_.c_str(), std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), done, total_, detail.c_str());
+    std::fflush(stderr);
+  } else {
+    const int decile = static_cast<int>(frac * 10);
+    if (decile != last_decile_) {
+      last_decile_ = decile;
+      std::fprintf(stderr, "%s: %zu/%zu %s\n", label_.c_str(), done, total_, detail.c_str());
+    }
+  }
+}
+
+void Progress::Finish(const std::string& detail) {
+  if (finished_) return;
+  finished_ = true;
+  if (tty_) {
+    Update(total_, detail);
+    std::fprintf(stderr, "\n");
+  } else {
+    std::fprintf(stderr, "%s: done %s\n", label_.c_str(), detail.c_str());
+  }
+}
+
+std::string ProjectPath(const std::string& relative) {
+  const char* home = std::getenv("WHIRL_HOME");
+  const std::string root = home != nullptr ? home : WHIRL_SOURCE_DIR;
+  return root + "/" + relative;
+}
+
+}  // namespace whirl::cli

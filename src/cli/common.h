@@ -1,0 +1,44 @@
+#pragma once
+// Small helpers shared by the subcommands. The library never includes CLI11; this folder does.
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace whirl::cli {
+
+/// A command that ran but whose result is a failure (e.g. a cross-check that disagrees):
+/// main prints the message and exits with `exit_code` (never 0).
+struct CommandFailure : std::runtime_error {
+  int exit_code;
+  CommandFailure(const std::string& message, int code = 2)
+      : std::runtime_error(message), exit_code(code) {}
+};
+
+/// Machine output: JSON on stdout, pretty-printed, newline-terminated.
+void PrintJson(const nlohmann::json& j);
+
+/// Warning line on stderr: "warning: <text>".
+void Warn(const std::string& text);
+
+/// Progress bar on stderr. On a terminal it redraws one line; otherwise it prints a line at every
+/// 10 % so logs stay short. Finish() ends the line.
+class Progress {
+ public:
+  Progress(std::string label, std::size_t total);
+  void Update(std::size_t done, const std::string& detail = "");
+  void Finish(const std::string& detail = "");
+
+ private:
+  std::string label_;
+  std::size_t total_;
+  bool tty_;
+  int last_decile_ = -1;
+  bool finished_ = false;
+};
+
+/// Where the shipped files live: $WHIRL_HOME if set, else the source tree this binary was built
+/// from. Used by `whirl demo` and defaults such as datasets/whirling_train.csv.
+std::string ProjectPath(const std::string& relative);
+
+}  // namespace whirl::cli

@@ -1,0 +1,50 @@
+// whirl: predicts the thermal elongation of the unmachined section of a ball screw during hard
+// whirling and turns it into SINUMERIK 840D temperature-compensation setting data.
+#include <cstdio>
+#include <exception>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "core/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "whirl: thermal-elongation compensation for hard whirling of ball screws on SINUMERIK 840D.\n"
+      "Train a Bayesian-regularized 5-6-2 network on process tables, predict the elongation curve\n"
+      "of the unmachined section, plan 840D temperature-compensation setting data (SD43900/\n"
+      "SD43910/SD43920) and compare the lead error against traditional compensation.\n"
+      "Run 'whirl <command> --help' for each command. Exit code 0 only on success; 1 on bad\n"
+      "input or failure; 2 when a check ran and failed."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "whirl 0.1.0");
+  using namespace whirl::cli;
+  RegisterDemo(app);
+  RegisterDataset(app);
+  RegisterSimulate(app);
+  RegisterTrain(app);
+  RegisterPredict(app);
+  RegisterCurve(app);
+  RegisterFit(app);
+  RegisterPlan(app);
+  RegisterCompare(app);
+  RegisterLeadReport(app);
+  RegisterEvaluate(app);
+  RegisterCrosscheck(app);
+  RegisterExport(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 1;
+  } catch (const CommandFailure& e) {
+    std::fprintf(stderr, "failed: %s\n", e.what());
+    return e.exit_code;
+  } catch (const whirl::InputError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

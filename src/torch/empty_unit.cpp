@@ -1,0 +1,1 @@
+// Temporary empty unit so the target configures; the torch owner replaces it.

@@ -1,0 +1,60 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/process.h"
+
+namespace whirl {
+namespace {
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    ParseCsv(text, "t.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Csv, ParsesHeaderRowsAndComments) {
+  const CsvTable t = ParseCsv("# made by test\na,b\n1,2.5\n\n-3e-2, 4\n", "t.csv");
+  ASSERT_EQ(t.header.size(), 2u);
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.rows[1][0], -3e-2);
+  EXPECT_EQ(t.rows[1][1], 4.0);
+  EXPECT_EQ(t.line_numbers[1], 5);
+  EXPECT_EQ(t.comments.at(0), "made by test");
+}
+
+TEST(Csv, ErrorsNameFileLineAndColumn) {
+  EXPECT_NE(ErrorOf("a,b\n1,x\n").find("t.csv:2: column 2 ('b')"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,b\n1,nan\n").find("not finite"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,b\n1,inf\n").find("not finite"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,b\n1,2\n3\n").find("t.csv:3: expected 2 cells"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,a\n1,2\n").find("duplicated column 'a'"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,b\n").find("no data rows"), std::string::npos);
+  EXPECT_NE(ErrorOf("").find("empty file"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,b\n1,2x\n").find("'2x' is not a number"), std::string::npos);
+  EXPECT_NE(ErrorOf("a,b\n1,\n").find("empty cell"), std::string::npos);
+}
+
+TEST(Csv, FormatNumberRoundTripsRandomDoubles) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_int_distribution<int> e(-30, 30);
+  for (int i = 0; i < 10000; ++i) {
+    const double x = std::ldexp(u(rng), e(rng));
+    EXPECT_EQ(std::strtod(FormatNumber(x).c_str(), nullptr), x);
+  }
+}
+
+TEST(Csv, FormatThenParseIsIdentity) {
+  std::vector<std::vector<double>> rows = {{1.0 / 3, 2e-300}, {-7, 1e10}};
+  const CsvTable t = ParseCsv(FormatCsv({"x", "y"}, rows, {"c"}), "m");
+  EXPECT_EQ(t.rows, rows);
+}
+
+}  // namespace
+}  // namespace whirl

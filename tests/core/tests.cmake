@@ -1,0 +1,4 @@
+whirl_add_gtest(test_core SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/test_csv.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_files.cpp
+  LABELS core)
