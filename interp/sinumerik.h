@@ -1,0 +1,150 @@
+#pragma once
+// SINUMERIK 840D temperature-compensation setting data for one axis (REFERENCE.md section 3;
+// Function Manual Extended Functions K3):
+//
+//   dK = K0 + tan(beta) * (P - P0)                   dK in mm, P actual axis position (MCS), mm
+//   SD43900 $SA_TEMP_COMP_ABS_VALUE[axis]   = K0       mm
+//   SD43910 $SA_TEMP_COMP_SLOPE[axis]       = tan(beta) dimensionless (mm/mm)
+//   SD43920 $SA_TEMP_COMP_REF_POSITION[axis]= P0       mm
+//   MD32750 $MA_TEMP_COMP_TYPE = 3 (bit 0: SD43900, bit 1: SD43910/SD43920) must be set (power on).
+//   MD32760 $MA_COMP_ADD_VELO_FACTOR caps |tan(beta)| (default 0.01, range 0..0.10).
+//
+// Time to position (constant axial feed, time origin = start of the cut at the thread start):
+//   P(t) = machine_offset_mm + start_position_mm + direction * axial_feed_mm_s * t     (MCS, mm)
+// Segment A->B of the breakpoints (interp/breakpoints.h) becomes, with s = +1 (add) or -1 (subtract),
+//   SD43900 = s * l_A / 1000,  SD43910 = s * (l_B - l_A) / 1000 / (P_B - P_A),  SD43920 = P_A
+// so that dK(P) = s * l(t(P)) / 1000 on the chord. The segment is active while the axis is between
+// P_A and P_B; the plan covers the whole thread: after the curve's last change a final segment with
+// slope 0 holds the plateau to the end of the thread.
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fit/arctan_curve.h"
+#include "interp/breakpoints.h"
+
+namespace whirl::interp {
+
+/// How the control's dK relates to the predicted elongation l (um, positive = the unmachined
+/// section grows, i.e. the cut point moves away from the chuck).
+///  kSubtract: dK = -l/1000 mm (default).  kAdd: dK = +l/1000 mm.
+/// Why subtract is the default: cutting runs from the free end towards the chuck, so the growth of
+/// the unmachined section points against the direction of travel. With the default direction +1
+/// (travel towards +MCS), following the grown material means shifting the axis by -l; assuming the
+/// control adds dK to the position setpoint (K3 does not state it plainly, REFERENCE.md 3), that is
+/// dK = -l. With direction -1 the same reasoning gives kAdd: check the sign on the machine once
+/// (e.g. with a constant SD43900 test value) and set it explicitly.
+enum class SignConvention { kSubtract, kAdd };
+std::string ToString(SignConvention s);                 ///< "subtract" / "add"
+SignConvention ParseSignConvention(const std::string&);  ///< InputError for other strings
+/// +1 for kAdd, -1 for kSubtract.
+double SignFactor(SignConvention s);
+
+/// MD32760 bounds from K3.
+inline constexpr double kMd32760Default = 0.01;
+inline constexpr double kMd32760Max = 0.10;
+
+struct PlanOptions {
+  /// Largest |applied compensation - predicted curve| along the thread, um (> 0).
+  double tolerance_um = 0.5;
+  /// Axis name used in $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (letters, digits, '_').
+  std::string axis = "Z";
+  /// Axis position at the thread start (time 0), in the coordinate system of the part program, mm.
+  double start_position_mm = 0;
+  /// Direction of travel along the axis while cutting: +1 or -1.
+  int direction = 1;
+  /// Machine coordinate of the program's zero for this axis, mm (SD43920 and $AA_IM are MCS).
+  double machine_offset_mm = 0;
+  /// dK = s * l / 1000 (see SignConvention).
+  SignConvention sign = SignConvention::kSubtract;
+  /// MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910| (0 < cap <= 0.10). A larger slope is an
+  /// InputError naming the segment, its slope and the cap.
+  double md32760 = kMd32760Default;
+  /// Check-grid step for the tolerance, s (BreakpointOptions::check_step_s).
+  double check_step_s = 0.25;
+
+  /// InputError naming the field, value and rule for any option out of range.
+  void Validate() const;
+};
+
+struct CompensationSegment {
+  double t_a_s = 0, t_b_s = 0;    ///< segment start/end time from the start of the cut, s
+  double p_a_mm = 0, p_b_mm = 0;  ///< axis positions (MCS) at t_a and t_b, mm
+  double l_a_um = 0, l_b_um = 0;  ///< predicted elongation at t_a and t_b, um
+  double sd43900_mm = 0;          ///< $SA_TEMP_COMP_ABS_VALUE = s * l_a / 1000, mm
+  double sd43910 = 0;             ///< $SA_TEMP_COMP_SLOPE = s (l_b - l_a)/1000/(p_b - p_a), -
+  double sd43920_mm = 0;          ///< $SA_TEMP_COMP_REF_POSITION = p_a, mm
+};
+
+struct CompensationPlan {
+  PlanOptions options;
+  double axial_feed_mm_s = 0;    ///< constant axial feed, mm/s
+  double thread_length_mm = 0;   ///< threaded length, mm
+  double cutting_time_s = 0;     ///< thread_length / feed, s
+  std::vector<CompensationSegment> segments;  ///< in order of travel, contiguous
+  std::size_t point_count = 0;   ///< breakpoints = segments + 1
+  std::size_t uniform_point_count = 0;  ///< uniform points needed for the same bound (0: > 1e6)
+  double max_deviation_um = 0;   ///< largest |chord - curve| on the check grid, um
+  double effective_tolerance_um = 0;  ///< tolerance minus the curvature margin, um
+  double max_abs_slope = 0;      ///< max |SD43910|
+};
+
+/// Axis position (MCS, mm) at time t_s under the plan's options and feed.
+double AxisPositionMm(const PlanOptions& options, double axial_feed_mm_s, double t_s);
+
+/// Builds the plan for a curve l(t) (um) over the cutting time thread_length_mm / axial_feed_mm_s.
+/// `forced_times_s` are kinks that must be breakpoints. Throws InputError for invalid options,
+/// non-positive or non-finite feed or length, and any |SD43910| > md32760.
+CompensationPlan BuildPlan(const CurveFunction& curve_um, double axial_feed_mm_s,
+                           double thread_length_mm, const PlanOptions& options,
+                           const std::vector<double>& forced_times_s = {});
+/// The arctan curve: its settle time is a forced breakpoint, so the plateau is one segment with
+/// slope 0 to the end of the thread.
+CompensationPlan BuildPlan(const fit::ArctanCurve& curve, double axial_feed_mm_s,
+                           double thread_length_mm, const PlanOptions& options);
+
+/// The elongation (um) the control compensates with the axis at `axis_position_mm` (MCS),
+/// reconstructed from SD43900/SD43910/SD43920 and the sign convention only: the active segment is
+/// the last one whose SD43920 the axis has passed in the direction of travel (the first one before
+/// the start); value = (SD43900 + SD43910 (P - SD43920)) * 1000 / s. Positive = the same direction
+/// as the elongation it cancels.
+double AppliedCompensationUm(const CompensationPlan& plan, double axis_position_mm);
+
+/// Checks a plan read back or built elsewhere: contiguous segments, finite values, slopes within
+/// the cap. InputError naming the segment and the rule.
+void ValidatePlan(const CompensationPlan& plan);
+
+// --- Writers -------------------------------------------------------------------------------
+
+/// JSON of the plan (schema "whirl.plan", version 1): settings, segments with units, counts.
+/// Callers add "curve" and "prediction" objects beside it.
+void to_json(nlohmann::json& j, const CompensationPlan& plan);
+void from_json(const nlohmann::json& j, CompensationPlan& plan);
+void to_json(nlohmann::json& j, const PlanOptions& options);
+void from_json(const nlohmann::json& j, PlanOptions& options);
+
+/// CSV table for a PLC that writes the setting data (one row per segment, in order):
+/// segment,trigger_position_mm,t_a_s,t_b_s,p_a_mm,p_b_mm,sd43900_mm,sd43910,sd43920_mm
+/// with '#' comment lines (axis, sign, direction, MD32760, tolerance, provenance).
+std::string FormatPlcCsv(const CompensationPlan& plan,
+                         const std::vector<std::string>& provenance = {});
+
+/// Text facts for the NC program header.
+struct NcProgramInfo {
+  std::string program_name = "WHIRL_TEMP_COMP";  ///< used in the header comment
+  std::string curve_source;  ///< e.g. "model m.json, screw s.json (L=..., t_s=..., k=...)"
+};
+
+/// SINUMERIK part-program text: a header comment (MD32750 = 3, MD32760 cap vs the largest slope,
+/// sign convention, axis, assumptions, curve source), a main-run write of the first segment's
+/// setting data (STOPRE first), then one modal synchronized action per later segment:
+///   ID=<n> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=... 
+///        $$SA_TEMP_COMP_SLOPE[<axis>]=... $$SA_TEMP_COMP_REF_POSITION[<axis>]=...
+/// ('<=' when travelling in -direction; '$$' = write in the main run, Programming Manual Job
+/// Planning 10.3.8). ID numbers 1..255: more segments is an InputError (raise the tolerance).
+/// Numbers are printed with fixed decimals (positions 4, SD43900 6, SD43910 8). Ends with M17
+/// (subprogram end): call it before the cutting block; modal ID= actions stay active in the program.
+std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info = {});
+
+}  // namespace whirl::interp
