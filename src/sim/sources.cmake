@@ -1,1 +1,4 @@
-# Sources of src/sim (owned by the sim module). Add files with target_sources(whirl_core PRIVATE ...).
+# Sources of src/sim (owned by the sim module).
+target_sources(whirl_core PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/screw.cpp
+)
