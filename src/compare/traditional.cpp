@@ -1,0 +1,90 @@
+#include "compare/traditional.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/csv.h"
+#include "core/error.h"
+
+namespace whirl::compare {
+
+const ExperienceClass& ExperienceRule::ClassFor(double diameter_mm) const {
+  if (classes.empty()) throw InputError("experience rule has no diameter classes");
+  for (const auto& c : classes)
+    if (diameter_mm <= c.upper_mm) return c;
+  return classes.back();
+}
+
+double ExperienceRule::CompensationUm(double diameter_mm, double t_s) const {
+  if (t_s <= 0) return 0.0;
+  const double ramp = ramp_time_s > 0 ? std::min(1.0, t_s / ramp_time_s) : 1.0;
+  return ClassFor(diameter_mm).plateau_um * ramp;
+}
+
+ExperienceRule BuildExperienceRule(const ProcessTable& history,
+                                   const ExperienceRuleOptions& options) {
+  if (history.inputs.empty())
+    throw InputError(history.source +
+                     ": the experience rule needs past screws, the table is empty");
+  if (history.targets.size() != history.inputs.size())
+    throw InputError(history.source +
+                     ": the experience rule needs the measured targets (max_elongation_um, "
+                     "settle_time_s) of the past screws");
+  const auto& d = options.class_diameters_mm;
+  if (d.empty()) throw InputError("class_diameters_mm: needs at least one diameter");
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (!(d[i] > 0) || !std::isfinite(d[i]))
+      throw InputError("class_diameters_mm[" + std::to_string(i) + "] = " + FormatNumber(d[i]) +
+                       ": must be finite and > 0");
+    if (i > 0 && !(d[i] > d[i - 1]))
+      throw InputError("class_diameters_mm[" + std::to_string(i) + "] = " + FormatNumber(d[i]) +
+                       ": must be greater than the previous " + FormatNumber(d[i - 1]));
+  }
+  ExperienceRule rule;
+  rule.source = history.source;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    ExperienceClass c;
+    c.nominal_diameter_mm = d[i];
+    c.lower_mm = i == 0 ? 0.0 : std::sqrt(d[i - 1] * d[i]);
+    c.upper_mm = i + 1 == d.size() ? 1e9 : std::sqrt(d[i] * d[i + 1]);
+    rule.classes.push_back(c);
+  }
+  std::vector<double> sum(d.size(), 0.0);
+  double all_plateau = 0, all_settle = 0;
+  for (std::size_t r = 0; r < history.inputs.size(); ++r) {
+    const double dia = history.inputs[r].diameter_mm;
+    for (std::size_t i = 0; i < rule.classes.size(); ++i) {
+      if (dia <= rule.classes[i].upper_mm || i + 1 == rule.classes.size()) {
+        sum[i] += history.targets[r].max_elongation_um;
+        rule.classes[i].screws += 1;
+        break;
+      }
+    }
+    all_plateau += history.targets[r].max_elongation_um;
+    all_settle += history.targets[r].settle_time_s;
+  }
+  const double n = static_cast<double>(history.inputs.size());
+  rule.machine_plateau_um = all_plateau / n;
+  rule.ramp_time_s = all_settle / n;
+  for (std::size_t i = 0; i < rule.classes.size(); ++i)
+    rule.classes[i].plateau_um =
+        rule.classes[i].screws > 0 ? sum[i] / rule.classes[i].screws : rule.machine_plateau_um;
+  return rule;
+}
+
+void to_json(nlohmann::json& j, const ExperienceRule& rule) {
+  nlohmann::json classes = nlohmann::json::array();
+  for (const auto& c : rule.classes)
+    classes.push_back({{"nominal_diameter_mm", c.nominal_diameter_mm},
+                       {"lower_mm", c.lower_mm},
+                       {"upper_mm", c.upper_mm},
+                       {"plateau_um", c.plateau_um},
+                       {"screws", c.screws}});
+  j = nlohmann::json{{"rule", "c(t) = P_class * min(1, t / T)"},
+                     {"ramp_time_s", rule.ramp_time_s},
+                     {"machine_plateau_um", rule.machine_plateau_um},
+                     {"classes", classes},
+                     {"source", rule.source}};
+}
+
+}  // namespace whirl::compare
