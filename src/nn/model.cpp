@@ -1,0 +1,444 @@
+#include "nn/model.h"
+
+#include <cmath>
+#include <set>
+
+#include "core/error.h"
+#include "core/json_file.h"
+
+namespace whirl::nn {
+namespace {
+
+using nlohmann::json;
+
+const json& Require(const json& j, const std::string& key, const std::string& where) {
+  if (!j.is_object()) throw InputError(where + ": expected a JSON object");
+  if (!j.contains(key)) throw InputError(where + ": missing required key '" + key + "'");
+  return j.at(key);
+}
+
+double RequireFinite(const json& v, const std::string& where) {
+  if (!v.is_number()) throw InputError(where + " must be a number, got " + v.dump());
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) throw InputError(where + " must be finite, got " + v.dump());
+  return x;
+}
+
+Eigen::VectorXd ReadVector(const json& v, const std::string& where, Eigen::Index expected) {
+  if (!v.is_array()) throw InputError(where + " must be an array of numbers, got " + v.dump());
+  if (expected >= 0 && static_cast<Eigen::Index>(v.size()) != expected)
+    throw InputError(where + " has " + std::to_string(v.size()) + " entries, expected " +
+                     std::to_string(expected));
+  Eigen::VectorXd out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out(i) = RequireFinite(v[i], where + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+Eigen::MatrixXd ReadMatrix(const json& v, const std::string& where, Eigen::Index rows,
+                           Eigen::Index cols) {
+  if (!v.is_array()) throw InputError(where + " must be an array of rows, got " + v.dump());
+  if (static_cast<Eigen::Index>(v.size()) != rows)
+    throw InputError(where + " has " + std::to_string(v.size()) + " rows, expected " +
+                     std::to_string(rows));
+  Eigen::MatrixXd m(rows, cols);
+  for (Eigen::Index r = 0; r < rows; ++r)
+    m.row(r) = ReadVector(v[r], where + "[" + std::to_string(r) + "]", cols).transpose();
+  return m;
+}
+
+json VectorJson(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+json MatrixJson(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(VectorJson(m.row(r).transpose()));
+  return rows;
+}
+
+json ScalingJson(const MapMinMax& s) {
+  return json{{"min", VectorJson(s.xmin)}, {"max", VectorJson(s.xmax)}};
+}
+
+MapMinMax ReadScaling(const json& j, const std::string& key, Eigen::Index size) {
+  const json& s = Require(j, key, "model");
+  RejectUnknownKeys(s, {"min", "max"}, "model '" + key + "'");
+  MapMinMax m;
+  m.xmin = ReadVector(Require(s, "min", "model '" + key + "'"), "model '" + key + ".min'", size);
+  m.xmax = ReadVector(Require(s, "max", "model '" + key + "'"), "model '" + key + ".max'", size);
+  m.Validate(("model '" + key + "'").c_str());
+  return m;
+}
+
+std::vector<VariableInfo> ExpectedInputs() {
+  std::vector<VariableInfo> v;
+  for (int i = 0; i < ProcessInputs::kCount; ++i) v.push_back({kInputColumns[i], kInputUnits[i]});
+  return v;
+}
+
+std::vector<VariableInfo> ExpectedOutputs() {
+  std::vector<VariableInfo> v;
+  for (int k = 0; k < Features::kCount; ++k) v.push_back({kTargetColumns[k], kTargetUnits[k]});
+  return v;
+}
+
+std::vector<VariableInfo> ReadVariables(const json& j, const std::string& key,
+                                        const std::vector<VariableInfo>& expected) {
+  const json& v = Require(j, key, "model");
+  if (!v.is_array() || v.size() != expected.size())
+    throw InputError("model '" + key + "': expected an array of " +
+                     std::to_string(expected.size()) + " {name, unit} objects");
+  std::vector<VariableInfo> out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string where = "model '" + key + "[" + std::to_string(i) + "]'";
+    RejectUnknownKeys(v[i], {"name", "unit"}, where);
+    const json& name = Require(v[i], "name", where);
+    const json& unit = Require(v[i], "unit", where);
+    if (!name.is_string() || !unit.is_string())
+      throw InputError(where + ": 'name' and 'unit' must be strings");
+    out.push_back({name.get<std::string>(), unit.get<std::string>()});
+    if (out.back().name != expected[i].name || out.back().unit != expected[i].unit)
+      throw InputError(where + " is '" + out.back().name + "' [" + out.back().unit +
+                       "], expected '" + expected[i].name + "' [" + expected[i].unit + "]");
+  }
+  return out;
+}
+
+json OptionsJson(const TrainOptions& o) {
+  return json{{"epochs", o.epochs},     {"goal", o.goal},         {"mu", o.mu},
+              {"mu_dec", o.mu_dec},     {"mu_inc", o.mu_inc},     {"mu_max", o.mu_max},
+              {"min_grad", o.min_grad}, {"regularization", ToString(o.regularization)}};
+}
+
+TrainOptions ReadOptions(const json& j) {
+  const std::string where = "model 'training.options'";
+  RejectUnknownKeys(j, {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad",
+                        "regularization"},
+                    where);
+  TrainOptions o;
+  o.epochs = static_cast<int>(RequireFinite(Require(j, "epochs", where), where + " 'epochs'"));
+  o.goal = RequireFinite(Require(j, "goal", where), where + " 'goal'");
+  o.mu = RequireFinite(Require(j, "mu", where), where + " 'mu'");
+  o.mu_dec = RequireFinite(Require(j, "mu_dec", where), where + " 'mu_dec'");
+  o.mu_inc = RequireFinite(Require(j, "mu_inc", where), where + " 'mu_inc'");
+  o.mu_max = RequireFinite(Require(j, "mu_max", where), where + " 'mu_max'");
+  o.min_grad = RequireFinite(Require(j, "min_grad", where), where + " 'min_grad'");
+  o.regularization = ParseRegularization(Require(j, "regularization", where).get<std::string>());
+  return o;
+}
+
+std::uint64_t ReadSeed(const json& v, const std::string& where) {
+  if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
+    throw InputError(where + " must be a non-negative integer, got " + v.dump());
+  return v.get<std::uint64_t>();
+}
+
+}  // namespace
+
+void Model::Validate() const {
+  network.Validate("model 'layers'");
+  if (network.InputCount() != ProcessInputs::kCount)
+    throw InputError("model 'layer_sizes': " + std::to_string(network.InputCount()) +
+                     " inputs, expected " + std::to_string(ProcessInputs::kCount));
+  if (network.OutputCount() != Features::kCount)
+    throw InputError("model 'layer_sizes': " + std::to_string(network.OutputCount()) +
+                     " outputs, expected " + std::to_string(Features::kCount));
+  input_scaling.Validate("model 'input_scaling'");
+  target_scaling.Validate("model 'target_scaling'");
+  if (input_scaling.size() != network.InputCount())
+    throw InputError("model 'input_scaling' has " + std::to_string(input_scaling.size()) +
+                     " entries, the network " + std::to_string(network.InputCount()) + " inputs");
+  if (target_scaling.size() != network.OutputCount())
+    throw InputError("model 'target_scaling' has " + std::to_string(target_scaling.size()) +
+                     " entries, the network " + std::to_string(network.OutputCount()) + " outputs");
+  if (domain_min.size() != network.InputCount() || domain_max.size() != network.InputCount())
+    throw InputError("model 'training_domain': needs min and max of every input");
+  for (int i = 0; i < network.InputCount(); ++i)
+    if (!std::isfinite(domain_min(i)) || !std::isfinite(domain_max(i)) ||
+        domain_min(i) > domain_max(i))
+      throw InputError("model 'training_domain." + std::string(kInputColumns[i]) +
+                       "': min and max must be finite with min <= max");
+  if (error_space != "normalized")
+    throw InputError("model 'error_space' is '" + error_space +
+                     "', this version only knows 'normalized'");
+  if (!(noise_variance > 0) || !std::isfinite(noise_variance))
+    throw InputError("model 'uncertainty.noise_variance_normalized' must be finite and > 0");
+  const int N = network.ParameterCount();
+  if (posterior_covariance.rows() != N || posterior_covariance.cols() != N)
+    throw InputError("model 'uncertainty.posterior_covariance' must be " + std::to_string(N) + "x" +
+                     std::to_string(N) + " (N of layer_sizes)");
+  if (!posterior_covariance.allFinite())
+    throw InputError("model 'uncertainty.posterior_covariance' is not finite");
+  for (int i = 0; i < N; ++i) {
+    if (!(posterior_covariance(i, i) >= 0))
+      throw InputError("model 'uncertainty.posterior_covariance' has a negative diagonal entry " +
+                       std::to_string(i));
+    for (int k = 0; k < i; ++k)
+      if (posterior_covariance(i, k) != posterior_covariance(k, i))
+        throw InputError("model 'uncertainty.posterior_covariance' is not symmetric at (" +
+                         std::to_string(i) + ", " + std::to_string(k) + ")");
+  }
+  if (training_summary.parameter_count != N)
+    throw InputError("model 'training_summary.parameter_count' = " +
+                     std::to_string(training_summary.parameter_count) + ", layer_sizes give " +
+                     std::to_string(N));
+}
+
+void to_json(nlohmann::json& j, const Model& m) {
+  json layers = json::array();
+  for (int l = 0; l < m.network.LayerCount(); ++l)
+    layers.push_back(json{{"weights", MatrixJson(m.network.weights[l])},
+                          {"biases", VectorJson(m.network.biases[l])},
+                          {"transfer", l + 1 < m.network.LayerCount() ? "tansig" : "purelin"}});
+  json inputs = json::array(), outputs = json::array(), domain = json::object();
+  for (std::size_t i = 0; i < m.inputs.size(); ++i) {
+    inputs.push_back(json{{"name", m.inputs[i].name}, {"unit", m.inputs[i].unit}});
+    domain[m.inputs[i].name] = json{{"min", m.domain_min(i)}, {"max", m.domain_max(i)}};
+  }
+  for (const auto& o : m.outputs) outputs.push_back(json{{"name", o.name}, {"unit", o.unit}});
+  j = json{{"format", Model::kFormat},
+           {"schema_version", Model::kSchemaVersion},
+           {"layer_sizes", m.network.layer_sizes},
+           {"layers", layers},
+           {"input_scaling", ScalingJson(m.input_scaling)},
+           {"target_scaling", ScalingJson(m.target_scaling)},
+           {"inputs", inputs},
+           {"outputs", outputs},
+           {"training_domain", domain},
+           {"training_summary", m.training_summary},
+           {"training",
+            json{{"data", m.training_data},
+                 {"samples", m.training_samples},
+                 {"restarts", m.restarts},
+                 {"init_seed", m.init_seed},
+                 {"restart_runs", m.restart_runs},
+                 {"options", OptionsJson(m.train_options)}}},
+           {"seed", m.seed},
+           {"error_space", m.error_space},
+           {"uncertainty",
+            json{{"method", "laplace"},
+                 {"noise_variance_normalized", m.noise_variance},
+                 {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
+}
+
+void from_json(const nlohmann::json& j, Model& m) {
+  RejectUnknownKeys(j, {"format", "schema_version", "layer_sizes", "layers", "input_scaling",
+                        "target_scaling", "inputs", "outputs", "training_domain",
+                        "training_summary", "training", "seed", "error_space", "uncertainty"},
+                    "model");
+  const json& format = Require(j, "format", "model");
+  if (!format.is_string() || format.get<std::string>() != Model::kFormat)
+    throw InputError("model 'format' is " + format.dump() + ", expected \"" + Model::kFormat + "\"");
+  const json& version = Require(j, "schema_version", "model");
+  if (!version.is_number_integer() || version.get<int>() != Model::kSchemaVersion)
+    throw InputError("model 'schema_version' is " + version.dump() + ", this whirl reads " +
+                     std::to_string(Model::kSchemaVersion));
+
+  const json& sizes = Require(j, "layer_sizes", "model");
+  if (!sizes.is_array() || sizes.size() < 2)
+    throw InputError("model 'layer_sizes' must be an array of at least 2 sizes, got " + sizes.dump());
+  std::vector<int> layer_sizes;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    if (!sizes[i].is_number_integer() || sizes[i].get<int>() < 1)
+      throw InputError("model 'layer_sizes[" + std::to_string(i) + "]' must be an integer >= 1, got " +
+                       sizes[i].dump());
+    layer_sizes.push_back(sizes[i].get<int>());
+  }
+  m.network = Network::Zeros(layer_sizes);
+  const json& layers = Require(j, "layers", "model");
+  if (!layers.is_array() || layers.size() + 1 != layer_sizes.size())
+    throw InputError("model 'layers' must be an array of " + std::to_string(layer_sizes.size() - 1) +
+                     " layers (one fewer than layer_sizes)");
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    const std::string where = "model 'layers[" + std::to_string(l) + "]'";
+    RejectUnknownKeys(layers[l], {"weights", "biases", "transfer"}, where);
+    const std::string transfer = l + 1 < layers.size() ? "tansig" : "purelin";
+    const json& t = Require(layers[l], "transfer", where);
+    if (!t.is_string() || t.get<std::string>() != transfer)
+      throw InputError(where + ".transfer is " + t.dump() + ", expected \"" + transfer + "\"");
+    m.network.weights[l] = ReadMatrix(Require(layers[l], "weights", where), where + ".weights",
+                                      layer_sizes[l + 1], layer_sizes[l]);
+    m.network.biases[l] =
+        ReadVector(Require(layers[l], "biases", where), where + ".biases", layer_sizes[l + 1]);
+  }
+  m.input_scaling = ReadScaling(j, "input_scaling", layer_sizes.front());
+  m.target_scaling = ReadScaling(j, "target_scaling", layer_sizes.back());
+  m.inputs = ReadVariables(j, "inputs", ExpectedInputs());
+  m.outputs = ReadVariables(j, "outputs", ExpectedOutputs());
+
+  const json& domain = Require(j, "training_domain", "model");
+  if (!domain.is_object() || domain.size() != m.inputs.size())
+    throw InputError("model 'training_domain' must have one {min, max} per input (" +
+                     std::to_string(m.inputs.size()) + ")");
+  m.domain_min.resize(m.inputs.size());
+  m.domain_max.resize(m.inputs.size());
+  for (std::size_t i = 0; i < m.inputs.size(); ++i) {
+    const std::string where = "model 'training_domain." + m.inputs[i].name + "'";
+    const json& d = Require(domain, m.inputs[i].name, "model 'training_domain'");
+    RejectUnknownKeys(d, {"min", "max"}, where);
+    m.domain_min(i) = RequireFinite(Require(d, "min", where), where + ".min");
+    m.domain_max(i) = RequireFinite(Require(d, "max", where), where + ".max");
+  }
+
+  try {
+    m.training_summary = Require(j, "training_summary", "model").get<TrainSummary>();
+  } catch (const json::exception& e) {
+    throw InputError(std::string("model 'training_summary': ") + e.what());
+  }
+  const json& training = Require(j, "training", "model");
+  RejectUnknownKeys(training, {"data", "samples", "restarts", "init_seed", "restart_runs", "options"},
+                    "model 'training'");
+  const json& data = Require(training, "data", "model 'training'");
+  if (!data.is_string()) throw InputError("model 'training.data' must be a string");
+  m.training_data = data.get<std::string>();
+  m.training_samples = static_cast<int>(
+      RequireFinite(Require(training, "samples", "model 'training'"), "model 'training.samples'"));
+  m.restarts = static_cast<int>(
+      RequireFinite(Require(training, "restarts", "model 'training'"), "model 'training.restarts'"));
+  m.init_seed = ReadSeed(Require(training, "init_seed", "model 'training'"), "model 'training.init_seed'");
+  try {
+    m.restart_runs =
+        Require(training, "restart_runs", "model 'training'").get<std::vector<RestartRecord>>();
+  } catch (const json::exception& e) {
+    throw InputError(std::string("model 'training.restart_runs': ") + e.what());
+  }
+  m.train_options = ReadOptions(Require(training, "options", "model 'training'"));
+  m.seed = ReadSeed(Require(j, "seed", "model"), "model 'seed'");
+  const json& space = Require(j, "error_space", "model");
+  if (!space.is_string()) throw InputError("model 'error_space' must be a string");
+  m.error_space = space.get<std::string>();
+
+  const json& u = Require(j, "uncertainty", "model");
+  RejectUnknownKeys(u, {"method", "noise_variance_normalized", "posterior_covariance"},
+                    "model 'uncertainty'");
+  const json& method = Require(u, "method", "model 'uncertainty'");
+  if (!method.is_string() || method.get<std::string>() != "laplace")
+    throw InputError("model 'uncertainty.method' is " + method.dump() + ", expected \"laplace\"");
+  m.noise_variance = RequireFinite(Require(u, "noise_variance_normalized", "model 'uncertainty'"),
+                                   "model 'uncertainty.noise_variance_normalized'");
+  const int N = m.network.ParameterCount();
+  m.posterior_covariance =
+      ReadMatrix(Require(u, "posterior_covariance", "model 'uncertainty'"),
+                 "model 'uncertainty.posterior_covariance'", N, N);
+  m.Validate();
+}
+
+Model LoadModel(const std::filesystem::path& path) {
+  const json j = ReadJsonFile(path);
+  try {
+    return j.get<Model>();
+  } catch (const InputError& e) {
+    throw InputError("model file '" + path.string() + "': " + e.what());
+  } catch (const json::exception& e) {
+    throw InputError("model file '" + path.string() + "': " + e.what());
+  }
+}
+
+void SaveModel(const std::filesystem::path& path, const Model& model) {
+  model.Validate();
+  WriteJsonFile(path, json(model));
+}
+
+Eigen::MatrixXd InputMatrix(const std::vector<ProcessInputs>& inputs) {
+  Eigen::MatrixXd x(ProcessInputs::kCount, inputs.size());
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    const auto a = inputs[q].ToArray();
+    for (int i = 0; i < ProcessInputs::kCount; ++i) x(i, q) = a[i];
+  }
+  return x;
+}
+
+Eigen::MatrixXd TargetMatrix(const std::vector<Features>& targets) {
+  Eigen::MatrixXd t(Features::kCount, targets.size());
+  for (std::size_t q = 0; q < targets.size(); ++q) {
+    const auto a = targets[q].ToArray();
+    for (int k = 0; k < Features::kCount; ++k) t(k, q) = a[k];
+  }
+  return t;
+}
+
+std::vector<Prediction> PredictBatch(const Model& model, const std::vector<ProcessInputs>& inputs) {
+  std::vector<Prediction> out(inputs.size());
+  if (inputs.empty()) return out;
+  const Eigen::MatrixXd x_raw = InputMatrix(inputs);
+  if (!x_raw.allFinite()) throw InputError("predict: an input is NaN or infinite");
+  const Eigen::MatrixXd x = model.input_scaling.Apply(x_raw);
+  ForwardCache cache;
+  model.network.Forward(x, &cache);
+  const Eigen::MatrixXd y = model.target_scaling.Reverse(cache.output());
+  Eigen::MatrixXd J;
+  ErrorJacobian(model.network, cache, &J);  // rows q * S + k, = -dy/dw
+  const Eigen::VectorXd half = model.target_scaling.HalfRange();
+  const int S = model.network.OutputCount();
+  Eigen::VectorXd Sg;
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    std::array<double, Features::kCount> mean{}, sd{}, noise{};
+    for (int k = 0; k < S; ++k) {
+      const auto g = J.row(static_cast<Eigen::Index>(q) * S + k).transpose();
+      Sg.noalias() = model.posterior_covariance * g;
+      const double var = model.noise_variance + g.dot(Sg);
+      mean[k] = y(k, q);
+      sd[k] = std::sqrt(std::max(var, 0.0)) * half(k);
+      noise[k] = std::sqrt(model.noise_variance) * half(k);
+    }
+    Prediction& p = out[q];
+    p.mean = Features::FromArray(mean);
+    p.stddev = Features::FromArray(sd);
+    p.noise_stddev = Features::FromArray(noise);
+    for (int i = 0; i < ProcessInputs::kCount; ++i) {
+      if (x_raw(i, q) < model.domain_min(i) || x_raw(i, q) > model.domain_max(i)) {
+        p.outside_domain = true;
+        p.outside_domain_fields.push_back(model.inputs[i].name);
+      }
+    }
+  }
+  return out;
+}
+
+Prediction Predict(const Model& model, const ProcessInputs& inputs) {
+  return PredictBatch(model, {inputs}).front();
+}
+
+Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
+                 const std::string& data_name, const ModelProgress& progress) {
+  if (table.targets.size() != table.inputs.size())
+    throw InputError(table.source + ": the training table needs the target columns " +
+                     kTargetColumns[0] + " and " + kTargetColumns[1]);
+  if (table.inputs.size() < 2)
+    throw InputError(table.source + ": " + std::to_string(table.inputs.size()) +
+                     " training rows; at least 2 are needed");
+  for (std::size_t h = 0; h < options.hidden_sizes.size(); ++h)
+    if (options.hidden_sizes[h] < 1)
+      throw InputError("hidden size " + std::to_string(options.hidden_sizes[h]) + ": must be >= 1");
+  const Eigen::MatrixXd x_raw = InputMatrix(table.inputs);
+  const Eigen::MatrixXd t_raw = TargetMatrix(table.targets);
+  Model m;
+  m.input_scaling = MapMinMax::Fit(x_raw);
+  m.target_scaling = MapMinMax::Fit(t_raw);
+  TrainingData data{m.input_scaling.Apply(x_raw), m.target_scaling.Apply(t_raw), m.target_scaling};
+  std::vector<int> sizes = {ProcessInputs::kCount};
+  sizes.insert(sizes.end(), options.hidden_sizes.begin(), options.hidden_sizes.end());
+  sizes.push_back(Features::kCount);
+  if (options.train.regularization != Regularization::kBayesian)
+    throw InputError("a model file needs Bayesian regularization (its Laplace uncertainty)");
+  RestartResult r = TrainBrRestarts(data, sizes, options.seed, options.restarts, options.train,
+                                    progress);
+  m.network = std::move(r.best.network);
+  m.inputs = ExpectedInputs();
+  m.outputs = ExpectedOutputs();
+  m.domain_min = x_raw.rowwise().minCoeff();
+  m.domain_max = x_raw.rowwise().maxCoeff();
+  m.training_summary = r.best.summary;
+  m.seed = options.seed;
+  m.init_seed = r.best.init_seed;
+  m.restarts = options.restarts;
+  m.restart_runs = r.runs;
+  m.train_options = options.train;
+  m.training_data = data_name;
+  m.training_samples = static_cast<int>(table.inputs.size());
+  m.noise_variance = r.best.summary.noise_variance;
+  m.posterior_covariance = std::move(r.best.posterior_covariance);
+  m.Validate();
+  return m;
+}
+
+}  // namespace whirl::nn

@@ -1,0 +1,106 @@
+#pragma once
+// A trained elongation-feature model: the network of nn/network.h with its mapminmax scalings,
+// names and units, training domain, training summary and Laplace posterior; JSON file I/O; and
+// prediction with a standard deviation.
+//
+// Predictive uncertainty (MacKay 1992 section 4 "error bars"; Bishop 1995 section 10.3), per
+// output k at input x, in the normalized target space:
+//   var_k(x) = sigma_nu^2 + g_k(x)' A^-1 g_k(x),
+//   sigma_nu^2 = 1 / (2 beta)               (noise variance; = ssE / (n - gamma) after training),
+//   A^-1 = (2 (beta J'J + alpha I))^-1        (posterior covariance of w, J at the final weights),
+//   g_k(x) = d y_k / d w at x (flat order, nn/network.h),
+// with MATLAB's alpha, beta (F = beta ssE + alpha ssX, see nn/trainbr.h for why the factors 2).
+// In original units: stddev_k = sqrt(var_k) * (xmax_k - xmin_k) / 2 (mapminmax half range; 1 for
+// a constant target). The mean is the network output mapped back by mapminmax.
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/process.h"
+#include "nn/network.h"
+#include "nn/trainbr.h"
+
+namespace whirl::nn {
+
+/// A named network input or output.
+struct VariableInfo {
+  std::string name;  ///< column name, e.g. "hardness_hrc"
+  std::string unit;  ///< e.g. "HRC"
+};
+
+struct Model {
+  static constexpr int kSchemaVersion = 1;
+  static constexpr const char* kFormat = "whirl-nn-model";
+
+  Network network;                 ///< weights in the normalized space
+  MapMinMax input_scaling;         ///< mapminmax of the five inputs (training ranges)
+  MapMinMax target_scaling;        ///< mapminmax of the two targets
+  std::vector<VariableInfo> inputs;   ///< kInputColumns with kInputUnits, in order
+  std::vector<VariableInfo> outputs;  ///< kTargetColumns with kTargetUnits, in order
+  Eigen::VectorXd domain_min;      ///< per input: smallest training value, original units
+  Eigen::VectorXd domain_max;      ///< per input: largest training value, original units
+  TrainSummary training_summary;   ///< of the chosen restart
+  std::uint64_t seed = 0;          ///< base seed of the restart series (--seed)
+  std::uint64_t init_seed = 0;     ///< seed of the chosen restart (seed + its index)
+  int restarts = 1;                ///< number of restarts trained
+  std::vector<RestartRecord> restart_runs;  ///< every restart (seed, log evidence, ...)
+  TrainOptions train_options;      ///< the trainbr options used
+  std::string training_data;       ///< provenance: file name of the training table
+  int training_samples = 0;        ///< Q
+  std::string error_space = "normalized";  ///< errors measured in the mapminmax target space
+  double noise_variance = 0;       ///< sigma_nu^2 = 1 / (2 beta), normalized target units
+  Eigen::MatrixXd posterior_covariance;  ///< A^-1, N x N, flat order (see header comment)
+
+  /// Throws InputError naming the key and the rule if anything is missing or inconsistent.
+  void Validate() const;
+};
+void to_json(nlohmann::json& j, const Model& m);
+/// Validates everything (schema version, sizes, finiteness, names); InputError names the key.
+void from_json(const nlohmann::json& j, Model& m);
+
+/// Reads and validates a model file. A wrong, truncated or inconsistent file is an InputError
+/// whose message names the file and the offending key.
+Model LoadModel(const std::filesystem::path& path);
+/// Writes the model as JSON atomically (round-trip double formatting, so reloading predicts
+/// bit-identically).
+void SaveModel(const std::filesystem::path& path, const Model& model);
+
+struct Prediction {
+  Features mean;    ///< network output, original units
+  Features stddev;  ///< predictive standard deviation (noise + weight uncertainty), original units
+  bool outside_domain = false;  ///< some input lies outside the training domain
+  std::vector<std::string> outside_domain_fields;  ///< names of those inputs, in input order
+  Features noise_stddev;  ///< the noise part alone, sqrt(sigma_nu^2) * half range
+};
+
+/// Prediction for one process (see the header comment for the formula).
+Prediction Predict(const Model& model, const ProcessInputs& inputs);
+/// Predictions for many processes (one forward pass for the means).
+std::vector<Prediction> PredictBatch(const Model& model, const std::vector<ProcessInputs>& inputs);
+
+/// How `whirl train` builds a model.
+struct ModelTrainOptions {
+  std::vector<int> hidden_sizes = {6};  ///< tansig hidden layers (paper: one layer of 6)
+  std::uint64_t seed = 1;               ///< restart k initializes with seed + k
+  int restarts = 1;                     ///< keep the highest log evidence of this many runs
+  TrainOptions train;                   ///< trainbr options (MATLAB defaults)
+};
+
+/// Progress of TrainModel: restart index (0-based) and the epoch just finished.
+using ModelProgress = std::function<void(int restart, const EpochInfo& info)>;
+
+/// Fits mapminmax on the table, trains `restarts` networks and returns the chosen model.
+/// `data_name` goes into the model's provenance. Throws InputError if the table has no targets,
+/// fewer than 2 rows or inconsistent lengths.
+Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
+                 const std::string& data_name, const ModelProgress& progress = {});
+
+/// Inputs (5 x Q) and targets (2 x Q) of a table, original units.
+Eigen::MatrixXd InputMatrix(const std::vector<ProcessInputs>& inputs);
+Eigen::MatrixXd TargetMatrix(const std::vector<Features>& targets);
+
+}  // namespace whirl::nn

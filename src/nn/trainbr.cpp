@@ -1,0 +1,408 @@
+#include "nn/trainbr.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/csv.h"
+#include "core/error.h"
+
+namespace whirl::nn {
+namespace {
+
+constexpr double kMuFloor = 1e-20;  // trainbr: mu = max(mu * mu_dec, 1e-20)
+
+std::string Num(double x) { return FormatNumber(x); }
+
+double SumSquares(const Eigen::MatrixXd& e) { return e.squaredNorm(); }
+
+}  // namespace
+
+std::string ToString(TrainTermination t) {
+  switch (t) {
+    case TrainTermination::kGoalMet: return "goal_met";
+    case TrainTermination::kMaxEpochs: return "max_epochs";
+    case TrainTermination::kMinGradient: return "min_gradient";
+    case TrainTermination::kMaxMu: return "max_mu";
+  }
+  return "unknown";
+}
+
+TrainTermination ParseTermination(const std::string& s) {
+  for (auto t : {TrainTermination::kGoalMet, TrainTermination::kMaxEpochs,
+                 TrainTermination::kMinGradient, TrainTermination::kMaxMu})
+    if (ToString(t) == s) return t;
+  throw InputError("termination '" + s +
+                   "' is not one of goal_met, max_epochs, min_gradient, max_mu");
+}
+
+std::string ToString(Regularization r) {
+  return r == Regularization::kBayesian ? "bayesian" : "none";
+}
+
+Regularization ParseRegularization(const std::string& s) {
+  if (s == "bayesian") return Regularization::kBayesian;
+  if (s == "none") return Regularization::kNone;
+  throw InputError("regularization '" + s + "' is not one of bayesian, none");
+}
+
+void TrainOptions::Validate() const {
+  auto fail = [](const std::string& name, double v, const std::string& rule) {
+    throw InputError("train option '" + name + "' = " + Num(v) + ": " + rule);
+  };
+  if (epochs < 0) fail("epochs", epochs, "must be >= 0");
+  if (!(goal >= 0) || !std::isfinite(goal)) fail("goal", goal, "must be finite and >= 0");
+  if (!(mu > 0) || !std::isfinite(mu)) fail("mu", mu, "must be finite and > 0");
+  if (!(mu_dec > 0 && mu_dec < 1)) fail("mu_dec", mu_dec, "must be in (0, 1)");
+  if (!(mu_inc > 1) || !std::isfinite(mu_inc)) fail("mu_inc", mu_inc, "must be finite and > 1");
+  if (!(mu_max > mu)) fail("mu_max", mu_max, "must be > mu");
+  if (!(min_grad >= 0) || !std::isfinite(min_grad))
+    fail("min_grad", min_grad, "must be finite and >= 0");
+}
+
+std::string TrainSummary::BriefReport() const {
+  std::ostringstream s;
+  s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": F "
+    << Num(initial_cost) << " -> " << Num(final_cost) << ", ssE " << Num(initial_sse) << " -> "
+    << Num(sse) << " in " << epochs << " epochs, gamma " << Num(gamma) << " of "
+    << parameter_count << ", " << ToString(termination) << " (" << message << ")";
+  return s.str();
+}
+
+namespace {
+nlohmann::json VecJson(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+Eigen::VectorXd VecFromJson(const nlohmann::json& j, const char* key) {
+  if (!j.contains(key) || !j.at(key).is_array())
+    throw InputError(std::string("training_summary: '") + key + "' must be an array of numbers");
+  const auto& a = j.at(key);
+  Eigen::VectorXd v(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!a[i].is_number())
+      throw InputError(std::string("training_summary: '") + key + "'[" + std::to_string(i) +
+                       "] must be a number, got " + a[i].dump());
+    v(i) = a[i].get<double>();
+  }
+  return v;
+}
+// NaN (no regularization) is stored as null.
+nlohmann::json MaybeNumber(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+double NumberOrNan(const nlohmann::json& j, const char* key) {
+  if (!j.contains(key)) throw InputError(std::string("training_summary: missing key '") + key + "'");
+  const auto& v = j.at(key);
+  if (v.is_null()) return std::numeric_limits<double>::quiet_NaN();
+  if (!v.is_number())
+    throw InputError(std::string("training_summary: '") + key + "' must be a number, got " + v.dump());
+  return v.get<double>();
+}
+}  // namespace
+
+void to_json(nlohmann::json& j, const TrainSummary& s) {
+  j = nlohmann::json{{"epochs", s.epochs},
+                     {"parameter_count", s.parameter_count},
+                     {"error_count", s.error_count},
+                     {"initial_cost", s.initial_cost},
+                     {"final_cost", s.final_cost},
+                     {"initial_sse_normalized", s.initial_sse},
+                     {"sse_normalized", s.sse},
+                     {"rms_error", VecJson(s.rms_error)},
+                     {"rms_error_normalized", VecJson(s.rms_error_normalized)},
+                     {"sum_squared_weights", s.sum_squared_weights},
+                     {"gamma", s.gamma},
+                     {"alpha", s.alpha},
+                     {"beta", s.beta},
+                     {"mu", s.mu},
+                     {"gradient", s.gradient},
+                     {"log_evidence", MaybeNumber(s.log_evidence)},
+                     {"noise_variance_normalized", MaybeNumber(s.noise_variance)},
+                     {"regularization", ToString(s.regularization)},
+                     {"termination", ToString(s.termination)},
+                     {"message", s.message}};
+}
+
+void from_json(const nlohmann::json& j, TrainSummary& s) {
+  if (!j.is_object()) throw InputError("training_summary: expected a JSON object");
+  auto num = [&](const char* key) {
+    if (!j.contains(key)) throw InputError(std::string("training_summary: missing key '") + key + "'");
+    const auto& v = j.at(key);
+    if (!v.is_number())
+      throw InputError(std::string("training_summary: '") + key + "' must be a number, got " + v.dump());
+    return v.get<double>();
+  };
+  s.epochs = static_cast<int>(num("epochs"));
+  s.parameter_count = static_cast<int>(num("parameter_count"));
+  s.error_count = static_cast<int>(num("error_count"));
+  s.initial_cost = num("initial_cost");
+  s.final_cost = num("final_cost");
+  s.initial_sse = num("initial_sse_normalized");
+  s.sse = num("sse_normalized");
+  s.rms_error = VecFromJson(j, "rms_error");
+  s.rms_error_normalized = VecFromJson(j, "rms_error_normalized");
+  s.sum_squared_weights = num("sum_squared_weights");
+  s.gamma = num("gamma");
+  s.alpha = num("alpha");
+  s.beta = num("beta");
+  s.mu = num("mu");
+  s.gradient = num("gradient");
+  s.log_evidence = NumberOrNan(j, "log_evidence");
+  s.noise_variance = NumberOrNan(j, "noise_variance_normalized");
+  s.regularization = ParseRegularization(j.at("regularization").get<std::string>());
+  s.termination = ParseTermination(j.at("termination").get<std::string>());
+  s.message = j.at("message").get<std::string>();
+}
+
+void to_json(nlohmann::json& j, const RestartRecord& r) {
+  j = nlohmann::json{{"seed", r.seed},       {"log_evidence", MaybeNumber(r.log_evidence)},
+                     {"sse_normalized", r.sse}, {"gamma", r.gamma},
+                     {"epochs", r.epochs},   {"termination", ToString(r.termination)}};
+}
+
+void from_json(const nlohmann::json& j, RestartRecord& r) {
+  r.seed = j.at("seed").get<std::uint64_t>();
+  r.log_evidence = NumberOrNan(j, "log_evidence");
+  r.sse = j.at("sse_normalized").get<double>();
+  r.gamma = j.at("gamma").get<double>();
+  r.epochs = j.at("epochs").get<int>();
+  r.termination = ParseTermination(j.at("termination").get<std::string>());
+}
+
+double LogEvidence(double sse, double ssx, double alpha, double beta, double log_det_h,
+                   int parameter_count, int error_count, const std::vector<int>& layer_sizes) {
+  const double N = parameter_count;
+  const double n = error_count;
+  double symmetry = 0;
+  for (std::size_t l = 1; l + 1 < layer_sizes.size(); ++l)
+    symmetry += std::lgamma(layer_sizes[l] + 1.0) + layer_sizes[l] * std::log(2.0);
+  const double F = beta * sse + alpha * ssx;
+  return -F - 0.5 * log_det_h + 0.5 * N * std::log(alpha) + 0.5 * n * std::log(beta) -
+         0.5 * n * std::log(M_PI) + symmetry;
+}
+
+TrainResult TrainBr(const TrainingData& data, const Network& initial, const TrainOptions& options,
+                    const EpochCallback& callback) {
+  options.Validate();
+  initial.Validate("initial network");
+  const int S = initial.OutputCount();
+  const Eigen::Index Q = data.inputs.cols();
+  if (Q < 1) throw InputError("training data: no samples");
+  if (data.inputs.rows() != initial.InputCount())
+    throw InputError("training data: " + std::to_string(data.inputs.rows()) +
+                     " input rows, the network has " + std::to_string(initial.InputCount()) +
+                     " inputs");
+  if (data.targets.rows() != S || data.targets.cols() != Q)
+    throw InputError("training data: targets are " + std::to_string(data.targets.rows()) + "x" +
+                     std::to_string(data.targets.cols()) + ", expected " + std::to_string(S) +
+                     "x" + std::to_string(Q));
+  if (!data.inputs.allFinite() || !data.targets.allFinite())
+    throw InputError("training data: NaN or infinity in the inputs or targets");
+  if (data.target_scaling.size() != S)
+    throw InputError("training data: target scaling has " +
+                     std::to_string(data.target_scaling.size()) + " variables, expected " +
+                     std::to_string(S));
+
+  const bool bayes = options.regularization == Regularization::kBayesian;
+  TrainResult result;
+  result.network = initial;
+  Network& net = result.network;
+  Network trial_net = initial;
+  const int N = net.ParameterCount();
+  const double n = static_cast<double>(S) * static_cast<double>(Q);
+
+  // Work arrays, allocated once.
+  Eigen::VectorXd w = net.GetParameters();
+  Eigen::VectorXd w2(N), dw(N), rhs(N), je(N);
+  Eigen::MatrixXd J, jj(N, N), A(N, N), e(S, Q), e2(S, Q);
+  Eigen::LLT<Eigen::MatrixXd> llt(N);
+  Eigen::MatrixXd L_inv(N, N);
+  ForwardCache cache, trial_cache;
+
+  net.Forward(data.inputs, &cache);
+  e = data.targets - cache.output();
+  double sse = SumSquares(e);
+  double ssx = w.squaredNorm();
+  double gamma = N, alpha = 0, beta = 1;
+  if (bayes) {
+    beta = sse == 0 ? 1.0 : (n - N) / (2 * sse);
+    if (!(beta > 0)) beta = 1.0;
+    alpha = ssx == 0 ? 1.0 : N / (2 * ssx);
+  }
+  double F = beta * sse + alpha * ssx;
+  TrainSummary& sum = result.summary;
+  sum.parameter_count = N;
+  sum.error_count = static_cast<int>(n);
+  sum.initial_cost = F;
+  sum.initial_sse = sse;
+  sum.regularization = options.regularization;
+  double mu = options.mu;
+  double gradient = 0;
+
+  for (int epoch = 0;; ++epoch) {
+    ErrorJacobian(net, cache, &J);
+    Eigen::Map<const Eigen::VectorXd> e_flat(e.data(), e.size());
+    je.noalias() = J.transpose() * e_flat;
+    jj.setZero();
+    jj.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+    jj.triangularView<Eigen::StrictlyUpper>() = jj.transpose();
+    gradient = 2 * je.norm();
+
+    sum.epochs = epoch;
+    if (sse <= options.goal) {
+      sum.termination = TrainTermination::kGoalMet;
+      sum.message = "ssE = " + Num(sse) + " <= goal = " + Num(options.goal);
+      break;
+    }
+    if (epoch == options.epochs) {
+      sum.termination = TrainTermination::kMaxEpochs;
+      sum.message = "epoch = " + std::to_string(epoch) + " == epochs = " +
+                    std::to_string(options.epochs);
+      break;
+    }
+    if (gradient <= options.min_grad) {
+      sum.termination = TrainTermination::kMinGradient;
+      sum.message = "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " +
+                    Num(options.min_grad);
+      break;
+    }
+    if (mu >= options.mu_max) {
+      sum.termination = TrainTermination::kMaxMu;
+      sum.message = "mu = " + Num(mu) + " >= mu_max = " + Num(options.mu_max);
+      break;
+    }
+
+    EpochInfo info;
+    info.epoch = epoch + 1;
+    info.max_epochs = options.epochs;
+    info.objective_before = F;
+    info.gradient = gradient;
+    rhs = beta * je + alpha * w;
+    bool accepted = false;
+    while (mu <= options.mu_max) {
+      A = beta * jj;
+      A.diagonal().array() += mu + alpha;
+      llt.compute(A);
+      if (llt.info() == Eigen::Success) {
+        dw = -llt.solve(rhs);
+        if (dw.allFinite()) {
+          w2 = w + dw;
+          trial_net.SetParameters(w2);
+          trial_net.Forward(data.inputs, &trial_cache);
+          e2 = data.targets - trial_cache.output();
+          const double sse2 = SumSquares(e2);
+          const double ssx2 = w2.squaredNorm();
+          const double F2 = beta * sse2 + alpha * ssx2;
+          if (F2 < F) {
+            std::swap(w, w2);
+            std::swap(net, trial_net);
+            std::swap(cache, trial_cache);
+            std::swap(e, e2);
+            sse = sse2;
+            ssx = ssx2;
+            F = F2;
+            mu = std::max(mu * options.mu_dec, kMuFloor);
+            accepted = true;
+            break;
+          }
+        }
+      }
+      mu *= options.mu_inc;
+    }
+    info.step_accepted = accepted;
+    info.objective_after_step = F;
+    if (accepted && bayes) {
+      // gamma from the jj of this epoch and the old alpha, beta (REFERENCE.md section 2):
+      // trace(H^-1) = ||L^-1||_F^2 for H = L L'.
+      A = beta * jj;
+      A.diagonal().array() += alpha;
+      llt.compute(A);
+      L_inv.setIdentity();
+      llt.matrixL().solveInPlace(L_inv);
+      gamma = N - alpha * L_inv.squaredNorm();
+      alpha = ssx == 0 ? 1.0 : gamma / (2 * ssx);
+      beta = sse == 0 ? 1.0 : (n - gamma) / (2 * sse);
+      F = beta * sse + alpha * ssx;
+    }
+    info.objective = F;
+    info.sse = sse;
+    info.ssx = ssx;
+    info.gamma = gamma;
+    info.alpha = alpha;
+    info.beta = beta;
+    info.mu = mu;
+    if (callback) callback(info);
+  }
+
+  sum.final_cost = F;
+  sum.sse = sse;
+  sum.sum_squared_weights = ssx;
+  sum.gamma = gamma;
+  sum.alpha = alpha;
+  sum.beta = beta;
+  sum.mu = mu;
+  sum.gradient = gradient;
+  sum.rms_error_normalized = (e.array().square().rowwise().sum() / static_cast<double>(Q)).sqrt();
+  sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
+  if (bayes) {
+    // Laplace approximation at the final weights (jj is at the final w: the loop ended right
+    // after computing it).
+    A = beta * jj;
+    A.diagonal().array() += alpha;
+    llt.compute(A);
+    const double log_det_h = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+    sum.log_evidence = LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n),
+                                   net.layer_sizes);
+    sum.noise_variance = 1.0 / (2.0 * beta);
+    result.posterior_covariance = 0.5 * llt.solve(Eigen::MatrixXd::Identity(N, N));
+    // Exact symmetry (the solve leaves rounding-level asymmetry).
+    result.posterior_covariance =
+        0.5 * (result.posterior_covariance + result.posterior_covariance.transpose()).eval();
+  } else {
+    sum.log_evidence = std::numeric_limits<double>::quiet_NaN();
+    sum.noise_variance = std::numeric_limits<double>::quiet_NaN();
+  }
+  return result;
+}
+
+RestartResult TrainBrRestarts(const TrainingData& data, const std::vector<int>& layer_sizes,
+                              std::uint64_t seed, int restarts, const TrainOptions& options,
+                              const std::function<void(int, const EpochInfo&)>& callback) {
+  if (restarts < 1)
+    throw InputError("restarts = " + std::to_string(restarts) + ": must be >= 1");
+  RestartResult out;
+  const bool bayes = options.regularization == Regularization::kBayesian;
+  for (int k = 0; k < restarts; ++k) {
+    Network net = Network::Zeros(layer_sizes);
+    const std::uint64_t s = seed + static_cast<std::uint64_t>(k);
+    InitNguyenWidrow(s, &net);
+    EpochCallback cb;
+    if (callback) cb = [&callback, k](const EpochInfo& info) { callback(k, info); };
+    TrainResult r = TrainBr(data, net, options, cb);
+    r.init_seed = s;
+    RestartRecord rec;
+    rec.seed = s;
+    rec.log_evidence = r.summary.log_evidence;
+    rec.sse = r.summary.sse;
+    rec.gamma = r.summary.gamma;
+    rec.epochs = r.summary.epochs;
+    rec.termination = r.summary.termination;
+    out.runs.push_back(rec);
+    bool better = k == 0;
+    if (!better) {
+      if (bayes) {
+        // A NaN evidence (should not happen with alpha, beta > 0) never wins.
+        better = rec.log_evidence > out.best.summary.log_evidence ||
+                 (std::isnan(out.best.summary.log_evidence) && !std::isnan(rec.log_evidence));
+      } else {
+        better = rec.sse < out.best.summary.sse;
+      }
+    }
+    if (better) {
+      out.best = std::move(r);
+      out.best_index = k;
+    }
+  }
+  return out;
+}
+
+}  // namespace whirl::nn

@@ -1,0 +1,175 @@
+#pragma once
+// Bayesian-regularized Levenberg-Marquardt training, MATLAB `trainbr` (REFERENCE.md section 2;
+// MacKay, "Bayesian interpolation", Neural Computation 4(3) 1992; Foresee & Hagan, "Gauss-Newton
+// approximation to Bayesian learning", ICNN 1997).
+//
+// Notation (MATLAB's, used in every field below):
+//   N = number of weights and biases (50 for 5-6-2), n = number of target elements (S outputs x
+//   Q samples), e = t - y in the NORMALIZED target space (mapminmax), J = de/dw,
+//   ssE = e'e, ssX = w'w, objective F(w) = beta * ssE + alpha * ssX.
+// MATLAB's alpha and beta are half of MacKay's: F = beta ssE + alpha ssX equals MacKay's
+// M(w) = beta_M E_D + alpha_M E_W with E_D = ssE / 2, E_W = ssX / 2, beta_M = 2 beta,
+// alpha_M = 2 alpha. So the noise variance (normalized units) is sigma_nu^2 = 1 / beta_M =
+// 1 / (2 beta) = ssE / (n - gamma) at the re-estimated beta, and the Gauss-Newton posterior
+// covariance of w is A^-1 = (beta_M J'J + alpha_M I)^-1 = (2 H)^-1 with H = beta J'J + alpha I
+// (MacKay 1992 eqs. 2.8-2.10 and 4.3; Foresee & Hagan eqs. 11-13).
+//
+// Algorithm, per epoch (REFERENCE.md section 2, to the letter):
+//   1. at the current w: ssE, J, je = J'e, jj = J'J, gradient = 2 ||J'e||.
+//   2. stop if ssE <= goal (kGoalMet), epoch == epochs (kMaxEpochs), gradient <= min_grad
+//      (kMinGradient), mu >= mu_max (kMaxMu), tested in that order.
+//   3. while mu <= mu_max: dw = -(beta jj + (mu + alpha) I)^-1 (beta je + alpha w);
+//      accept if dw is finite and beta ssE(w + dw) + alpha ||w + dw||^2 < F(w), then
+//      mu = max(mu * mu_dec, 1e-20); otherwise mu = mu * mu_inc.
+//   4. after an accepted step, with the OLD alpha, beta and the jj of step 1:
+//      gamma = N - alpha trace((beta jj + alpha I)^-1); alpha = gamma / (2 ssX);
+//      beta = (n - gamma) / (2 ssE) (each set to 1 when its denominator is 0); F recomputed.
+// Initialization: gamma = N; beta = (n - N) / (2 ssE), set to 1 when ssE = 0 or the value is not
+// positive (with 20 samples and 2 outputs, n - N = 40 - 50 < 0, so beta starts at 1);
+// alpha = N / (2 ssX) (1 when ssX = 0).
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "nn/network.h"
+
+namespace whirl::nn {
+
+enum class Regularization {
+  kBayesian,  ///< trainbr: alpha, beta re-estimated by the evidence framework (default)
+  kNone,      ///< plain Levenberg-Marquardt (trainlm): alpha = 0, beta = 1 fixed, F = ssE
+};
+
+enum class TrainTermination {
+  kGoalMet,      ///< ssE <= goal
+  kMaxEpochs,    ///< epoch == epochs
+  kMinGradient,  ///< gradient = 2 ||J'e|| <= min_grad
+  kMaxMu,        ///< mu >= mu_max: no step decreased F any more (trainbr's usual ending)
+};
+std::string ToString(TrainTermination t);        ///< "goal_met", "max_epochs", ...
+TrainTermination ParseTermination(const std::string& s);  ///< inverse; InputError otherwise
+std::string ToString(Regularization r);          ///< "bayesian", "none"
+Regularization ParseRegularization(const std::string& s);
+
+/// MATLAB trainbr defaults (net.trainParam).
+struct TrainOptions {
+  int epochs = 1000;        ///< maximum number of epochs (accepted or failed LM loops)
+  double goal = 0.0;        ///< stop when ssE (normalized) <= goal
+  double mu = 0.005;        ///< initial Marquardt damping mu
+  double mu_dec = 0.1;      ///< mu factor after an accepted step (in (0, 1))
+  double mu_inc = 10.0;     ///< mu factor after a rejected step (> 1)
+  double mu_max = 1e10;     ///< stop when mu reaches this
+  double min_grad = 1e-7;   ///< stop when 2 ||J'e|| <= min_grad
+  Regularization regularization = Regularization::kBayesian;
+
+  /// Throws InputError naming the option, its value and the rule.
+  void Validate() const;
+};
+
+/// What the per-epoch callback sees after each epoch's LM loop.
+struct EpochInfo {
+  int epoch = 0;                   ///< 1-based number of the epoch just finished
+  int max_epochs = 0;              ///< options.epochs
+  bool step_accepted = false;      ///< false when mu passed mu_max without a decrease
+  double objective_before = 0;     ///< F(w) at the start of the epoch
+  double objective_after_step = 0; ///< F(w + dw) with the SAME alpha, beta (< objective_before)
+  double objective = 0;            ///< F after the alpha/beta update
+  double sse = 0;                  ///< ssE after the step (normalized)
+  double ssx = 0;                  ///< ssX after the step
+  double gamma = 0, alpha = 0, beta = 0;  ///< after the update
+  double mu = 0;                   ///< after the LM loop
+  double gradient = 0;             ///< 2 ||J'e|| at the start of the epoch
+};
+using EpochCallback = std::function<void(const EpochInfo&)>;
+
+/// Training set in the normalized space, one sample per column.
+struct TrainingData {
+  Eigen::MatrixXd inputs;     ///< R x Q, mapminmax-normalized
+  Eigen::MatrixXd targets;    ///< S x Q, mapminmax-normalized
+  MapMinMax target_scaling;   ///< only to report RMS errors in original units
+};
+
+struct TrainSummary {
+  int epochs = 0;               ///< completed epochs
+  int parameter_count = 0;      ///< N
+  int error_count = 0;          ///< n = S * Q
+  double initial_cost = 0;      ///< F at the initial weights with the initial alpha, beta
+  double final_cost = 0;        ///< F at the final weights with the final alpha, beta
+  double initial_sse = 0;       ///< ssE at the initial weights (normalized)
+  double sse = 0;               ///< ssE at the final weights (normalized)
+  Eigen::VectorXd rms_error;             ///< per output sqrt(mean e^2), original units
+  Eigen::VectorXd rms_error_normalized;  ///< per output, normalized units
+  double sum_squared_weights = 0;        ///< ssX = w'w at the final weights
+  double gamma = 0;             ///< effective number of parameters, in (0, N]
+  double alpha = 0;             ///< weight-decay coefficient of F (MATLAB convention)
+  double beta = 0;              ///< data coefficient of F (MATLAB convention)
+  double mu = 0;                ///< final Marquardt damping
+  double gradient = 0;          ///< 2 ||J'e|| at the final weights
+  /// ln P(D | alpha, beta) of the final network (see LogEvidence); NaN without regularization.
+  double log_evidence = 0;
+  /// sigma_nu^2 = 1 / (2 beta), normalized units; NaN without regularization.
+  double noise_variance = 0;
+  Regularization regularization = Regularization::kBayesian;
+  TrainTermination termination = TrainTermination::kMaxEpochs;
+  std::string message;          ///< the reason with the numbers it compared
+
+  /// "trainbr: F 12.3 -> 0.45, ssE 3.1 -> 0.02 in 212 epochs, gamma 17.2 of 50, max_mu (...)".
+  std::string BriefReport() const;
+};
+void to_json(nlohmann::json& j, const TrainSummary& s);
+void from_json(const nlohmann::json& j, TrainSummary& s);
+
+struct TrainResult {
+  Network network;                      ///< final weights
+  TrainSummary summary;
+  /// A^-1 = (2 (beta J'J + alpha I))^-1 at the final weights, final alpha, beta: the Laplace
+  /// (Gauss-Newton) posterior covariance of w, N x N, flat order. Empty without regularization.
+  Eigen::MatrixXd posterior_covariance;
+  std::uint64_t init_seed = 0;          ///< seed of InitNguyenWidrow (0 if the caller initialized)
+};
+
+/// Trains `initial` with trainbr (or plain LM) on `data`. Throws InputError on inconsistent sizes,
+/// non-finite data or bad options; a run that stops on mu or epochs is a Summary, not a throw.
+TrainResult TrainBr(const TrainingData& data, const Network& initial, const TrainOptions& options,
+                    const EpochCallback& callback = {});
+
+/// MacKay's log evidence in MATLAB's alpha/beta convention (derived from MacKay 1992 eq. 4.9
+/// with alpha_M = 2 alpha, beta_M = 2 beta, A = 2 H):
+///   ln P(D | alpha, beta) = -F - 1/2 ln det H + (N/2) ln alpha + (n/2) ln beta - (n/2) ln pi
+///                           + sum over hidden layers of (ln S_h! + S_h ln 2),
+/// F = beta ssE + alpha ssX, H = beta J'J + alpha I. The last term counts the 2^S S! equivalent
+/// weight vectors of a tansig layer of S neurons (MacKay, "A practical Bayesian framework for
+/// backprop networks", 1992, section 6); it matters only when comparing hidden sizes.
+double LogEvidence(double sse, double ssx, double alpha, double beta, double log_det_h,
+                   int parameter_count, int error_count, const std::vector<int>& layer_sizes);
+
+/// One training run of a restart series.
+struct RestartRecord {
+  std::uint64_t seed = 0;
+  double log_evidence = 0;
+  double sse = 0;
+  double gamma = 0;
+  int epochs = 0;
+  TrainTermination termination = TrainTermination::kMaxEpochs;
+};
+void to_json(nlohmann::json& j, const RestartRecord& r);
+void from_json(const nlohmann::json& j, RestartRecord& r);
+
+struct RestartResult {
+  TrainResult best;
+  int best_index = 0;                ///< index into runs
+  std::vector<RestartRecord> runs;   ///< in seed order
+};
+
+/// Trains `restarts` networks of `layer_sizes`, initialized by InitNguyenWidrow with seeds
+/// seed, seed + 1, ..., seed + restarts - 1, and keeps the one with the HIGHEST log evidence
+/// (lowest ssE under Regularization::kNone); ties keep the earlier seed. The callback receives
+/// the restart index (0-based) with each epoch.
+RestartResult TrainBrRestarts(const TrainingData& data, const std::vector<int>& layer_sizes,
+                              std::uint64_t seed, int restarts, const TrainOptions& options,
+                              const std::function<void(int, const EpochInfo&)>& callback = {});
+
+}  // namespace whirl::nn
