@@ -43,12 +43,12 @@ struct BreakpointOptions {
 };
 
 struct Breakpoints {
-  std::vector<double> time_s;       ///< strictly increasing; first = t_begin, last = t_end
-  std::vector<double> value_um;     ///< curve value at each breakpoint, um
-  double tolerance_um = 0;          ///< requested bound
+  std::vector<double> time_s;         ///< strictly increasing; first = t_begin, last = t_end
+  std::vector<double> value_um;       ///< curve value at each breakpoint, um
+  double tolerance_um = 0;            ///< requested bound
   double effective_tolerance_um = 0;  ///< tolerance_um minus the curvature margin (step 2)
-  double max_deviation_um = 0;      ///< largest |interpolant - curve| over the check grid, um
-  double check_step_s = 0;          ///< grid step actually used, s
+  double max_deviation_um = 0;        ///< largest |interpolant - curve| over the check grid, um
+  double check_step_s = 0;            ///< grid step actually used, s
   std::size_t grid_samples = 0;
 
   std::size_t size() const { return time_s.size(); }
@@ -64,9 +64,10 @@ Breakpoints ChooseBreakpoints(const CurveFunction& curve, double t_begin_s, doub
                               const BreakpointOptions& options = {});
 
 /// Smallest number N >= 2 of uniformly spaced points on [t_begin, t_end] (including both ends,
-/// points on the curve) whose piecewise-linear interpolant stays within the same effective tolerance
-/// on the same check grid (forced times are not given to the uniform rule). Found by doubling then
-/// bisection on N, then verified; returns 0 when even `max_points` points do not reach the bound.
+/// points on the curve) whose piecewise-linear interpolant stays within the same effective
+/// tolerance on the same check grid (forced times are not given to the uniform rule). Found by
+/// doubling then bisection on N, then verified; returns 0 when even `max_points` points do not
+/// reach the bound.
 std::size_t UniformPointCount(const CurveFunction& curve, double t_begin_s, double t_end_s,
                               const BreakpointOptions& options = {},
                               std::size_t max_points = 1'000'000);

@@ -11,7 +11,8 @@
 //
 // Time to position (constant axial feed, time origin = start of the cut at the thread start):
 //   P(t) = machine_offset_mm + start_position_mm + direction * axial_feed_mm_s * t     (MCS, mm)
-// Segment A->B of the breakpoints (interp/breakpoints.h) becomes, with s = +1 (add) or -1 (subtract),
+// Segment A->B of the breakpoints (interp/breakpoints.h) becomes, with s = +1 (add) or -1
+// (subtract),
 //   SD43900 = s * l_A / 1000,  SD43910 = s * (l_B - l_A) / 1000 / (P_B - P_A),  SD43920 = P_A
 // so that dK(P) = s * l(t(P)) / 1000 on the chord. The segment is active while the axis is between
 // P_A and P_B; the plan covers the whole thread: after the curve's last change a final segment with
@@ -36,7 +37,7 @@ namespace whirl::interp {
 /// dK = -l. With direction -1 the same reasoning gives kAdd: check the sign on the machine once
 /// (e.g. with a constant SD43900 test value) and set it explicitly.
 enum class SignConvention { kSubtract, kAdd };
-std::string ToString(SignConvention s);                 ///< "subtract" / "add"
+std::string ToString(SignConvention s);                  ///< "subtract" / "add"
 SignConvention ParseSignConvention(const std::string&);  ///< InputError for other strings
 /// +1 for kAdd, -1 for kSubtract.
 double SignFactor(SignConvention s);
@@ -79,15 +80,15 @@ struct CompensationSegment {
 
 struct CompensationPlan {
   PlanOptions options;
-  double axial_feed_mm_s = 0;    ///< constant axial feed, mm/s
-  double thread_length_mm = 0;   ///< threaded length, mm
-  double cutting_time_s = 0;     ///< thread_length / feed, s
+  double axial_feed_mm_s = 0;                 ///< constant axial feed, mm/s
+  double thread_length_mm = 0;                ///< threaded length, mm
+  double cutting_time_s = 0;                  ///< thread_length / feed, s
   std::vector<CompensationSegment> segments;  ///< in order of travel, contiguous
-  std::size_t point_count = 0;   ///< breakpoints = segments + 1
+  std::size_t point_count = 0;                ///< breakpoints = segments + 1
   std::size_t uniform_point_count = 0;  ///< uniform points needed for the same bound (0: > 1e6)
-  double max_deviation_um = 0;   ///< largest |chord - curve| on the check grid, um
-  double effective_tolerance_um = 0;  ///< tolerance minus the curvature margin, um
-  double max_abs_slope = 0;      ///< max |SD43910|
+  double max_deviation_um = 0;          ///< largest |chord - curve| on the check grid, um
+  double effective_tolerance_um = 0;    ///< tolerance minus the curvature margin, um
+  double max_abs_slope = 0;             ///< max |SD43910|
 };
 
 /// Axis position (MCS, mm) at time t_s under the plan's options and feed.
@@ -139,12 +140,13 @@ struct NcProgramInfo {
 /// SINUMERIK part-program text: a header comment (MD32750 = 3, MD32760 cap vs the largest slope,
 /// sign convention, axis, assumptions, curve source), a main-run write of the first segment's
 /// setting data (STOPRE first), then one modal synchronized action per later segment:
-///   ID=<n> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=... 
+///   ID=<n> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=...
 ///        $$SA_TEMP_COMP_SLOPE[<axis>]=... $$SA_TEMP_COMP_REF_POSITION[<axis>]=...
 /// ('<=' when travelling in -direction; '$$' = write in the main run, Programming Manual Job
 /// Planning 10.3.8). ID numbers 1..255: more segments is an InputError (raise the tolerance).
 /// Numbers are printed with fixed decimals (positions 4, SD43900 6, SD43910 8). Ends with M17
-/// (subprogram end): call it before the cutting block; modal ID= actions stay active in the program.
+/// (subprogram end): call it before the cutting block; modal ID= actions stay active in the
+/// program.
 std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info = {});
 
 }  // namespace whirl::interp

@@ -1,2 +1,5 @@
-# Sources of interp/. Add files with target_sources(whirl_interp PRIVATE ...).
-target_sources(whirl_interp PRIVATE ${CMAKE_CURRENT_LIST_DIR}/empty_unit.cpp)
+# Sources of interp/ (compensation points and SINUMERIK 840D setting data).
+target_sources(whirl_interp PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/breakpoints.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/sinumerik.cpp
+)

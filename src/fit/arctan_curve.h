@@ -1,13 +1,15 @@
 #pragma once
 // The arctangent elongation curve of the unmachined section (REFERENCE.md section 1; paper seed
-// 002, section 3: "the dynamic part is fitted with an arctangent function, the plateau with a line").
+// 002, section 3: "the dynamic part is fitted with an arctangent function, the plateau with a
+// line").
 //
 //   l(t) = L * atan(k t / t_s) / atan(k)     for 0 <= t < t_s
 //   l(t) = L                                 for t >= t_s          (and l(t) = 0 for t < 0)
 //
 //   L   = max_elongation_um  (plateau, um)         t_s = settle_time_s (s)
 //   k   = shape_k (dimensionless, > 0): how sharply the curve bends. The slope at the start is
-//         l'(0) = L k / (t_s atan k); just before t_s it is l'(t_s-) = L k / (t_s atan(k) (1 + k^2)).
+//         l'(0) = L k / (t_s atan k); just before t_s it is l'(t_s-) = L k / (t_s atan(k) (1 +
+//         k^2)).
 //
 // The two network features fix L and t_s; k is a property of the process family, fitted once from
 // simulated curves (kDefaultShapeK). The curve is continuous at t_s (l(t_s-) = L) but its slope
@@ -31,8 +33,8 @@ inline constexpr double kMinShapeK = 1e-3;
 inline constexpr double kMaxShapeK = 1e3;
 
 struct ArctanCurve {
-  double max_elongation_um = 0;  ///< L, plateau elongation, um (>= 0)
-  double settle_time_s = 0;      ///< t_s, time at which the plateau is reached, s (> 0)
+  double max_elongation_um = 0;     ///< L, plateau elongation, um (>= 0)
+  double settle_time_s = 0;         ///< t_s, time at which the plateau is reached, s (> 0)
   double shape_k = kDefaultShapeK;  ///< k, dimensionless, in [kMinShapeK, kMaxShapeK]
 
   /// l(t) in um; t in s from the start of the cut. 0 for t <= 0, L for t >= t_s.

@@ -11,11 +11,11 @@
 // section 3.2; Nielsen's damping update as in tiny_solver):
 //   g = J' r,  A = J'J,  D = diag(max(diag(A), kMinDiagonal))
 //   step  h = -(A + mu D)^-1 g;  x_new = Project(x + h)  (Project clamps each entry into its box)
-//   gain  rho = (cost(x) - cost(x_new)) / (L(0) - L(h_p)),  L(h) = cost + g'h + h'Ah/2, h_p = x_new - x
-//   rho > 0: accept, mu *= max(1/3, 1 - (2 rho - 1)^3), nu = 2;   else mu *= nu, nu *= 2.
+//   gain  rho = (cost(x) - cost(x_new)) / (L(0) - L(h_p)),  L(h) = cost + g'h + h'Ah/2, h_p = x_new
+//   - x rho > 0: accept, mu *= max(1/3, 1 - (2 rho - 1)^3), nu = 2;   else mu *= nu, nu *= 2.
 // Positivity (or any box) is kept by projection onto the bounds: set lower_bounds to a small
-// positive number for parameters that must stay positive. Convergence with bounds is measured on the
-// projected gradient ||Project(x - g) - x||_inf, which is zero at a constrained optimum.
+// positive number for parameters that must stay positive. Convergence with bounds is measured on
+// the projected gradient ||Project(x - g) - x||_inf, which is zero at a constrained optimum.
 #include <Eigen/Core>
 #include <functional>
 #include <string>
@@ -25,16 +25,16 @@ namespace whirl::fit {
 /// Residuals r(x) (size m) and, when `jacobian` is not null, J_r_x (m x n, J(i,j) = d r_i / d x_j).
 /// A functor that never fills the Jacobian must be passed with `analytic_jacobian = false`; the
 /// solver then uses central finite differences.
-using ResidualFunction =
-    std::function<void(const Eigen::VectorXd& x, Eigen::VectorXd* residuals,
-                       Eigen::MatrixXd* jacobian)>;
+using ResidualFunction = std::function<void(const Eigen::VectorXd& x, Eigen::VectorXd* residuals,
+                                            Eigen::MatrixXd* jacobian)>;
 
 struct LmOptions {
   /// Maximum number of outer iterations (Jacobian evaluations). Reaching it is an outcome.
   int max_iterations = 200;
   /// Stop when the (projected) gradient ||Project(x - J'r) - x||_inf <= gradient_tolerance.
   double gradient_tolerance = 1e-12;
-  /// Stop when an accepted step satisfies ||h||_2 <= parameter_tolerance * (||x||_2 + parameter_tolerance).
+  /// Stop when an accepted step satisfies ||h||_2 <= parameter_tolerance * (||x||_2 +
+  /// parameter_tolerance).
   double parameter_tolerance = 1e-10;
   /// Stop when an accepted step lowers the cost by less than cost_tolerance * cost (relative).
   double cost_tolerance = 1e-14;
@@ -71,7 +71,8 @@ struct LmSummary {
   double final_gradient_norm = 0;  ///< projected gradient, inf-norm
   double final_mu = 0;
   LmTermination termination = LmTermination::kMaxIterations;
-  std::string message;  ///< the numbers compared for the termination, e.g. "gradient 3e-13 <= 1e-12"
+  std::string
+      message;  ///< the numbers compared for the termination, e.g. "gradient 3e-13 <= 1e-12"
 
   /// True for the four converged reasons.
   bool Converged() const;
@@ -80,8 +81,9 @@ struct LmSummary {
 };
 
 /// Minimises 1/2 ||r(x)||^2 from the start point in *x (projected onto the bounds first) and leaves
-/// the best point found in *x. `num_residuals` is m. Bad options (non-positive tolerances, bounds of
-/// the wrong size or lower > upper, m < 1) throw InputError; non-convergence is a Summary outcome.
+/// the best point found in *x. `num_residuals` is m. Bad options (non-positive tolerances, bounds
+/// of the wrong size or lower > upper, m < 1) throw InputError; non-convergence is a Summary
+/// outcome.
 LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
                             bool analytic_jacobian, Eigen::VectorXd* x,
                             const LmOptions& options = {});

@@ -1,0 +1,257 @@
+#include "fit/levenberg_marquardt.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace whirl::fit {
+namespace {
+
+// Floor for the Marquardt scaling diag(J'J) so a parameter the residuals ignore still gets damped.
+constexpr double kMinDiagonal = 1e-12;
+
+std::string Num(double x) {
+  std::ostringstream ss;
+  ss.precision(6);
+  ss << x;
+  return ss.str();
+}
+
+bool HasBounds(const LmOptions& o) {
+  return o.lower_bounds.size() > 0 || o.upper_bounds.size() > 0;
+}
+
+double Lower(const LmOptions& o, Eigen::Index j) {
+  return o.lower_bounds.size() > 0 ? o.lower_bounds[j] : -std::numeric_limits<double>::infinity();
+}
+double Upper(const LmOptions& o, Eigen::Index j) {
+  return o.upper_bounds.size() > 0 ? o.upper_bounds[j] : std::numeric_limits<double>::infinity();
+}
+
+Eigen::VectorXd Project(const LmOptions& o, Eigen::VectorXd x) {
+  if (!HasBounds(o)) return x;
+  for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j], Lower(o, j), Upper(o, j));
+  return x;
+}
+
+void ValidateOptions(const LmOptions& o, Eigen::Index n, int m) {
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v))
+      throw InputError(std::string("LM option ") + name + " = " + Num(v) +
+                       ": must be a positive finite number");
+  };
+  if (o.max_iterations < 0)
+    throw InputError("LM option max_iterations = " + std::to_string(o.max_iterations) +
+                     ": must be >= 0");
+  positive(o.parameter_tolerance, "parameter_tolerance");
+  positive(o.initial_mu, "initial_mu");
+  positive(o.max_mu, "max_mu");
+  positive(o.fd_relative_step, "fd_relative_step");
+  if (!(o.gradient_tolerance >= 0))
+    throw InputError("LM option gradient_tolerance = " + Num(o.gradient_tolerance) +
+                     ": must be >= 0");
+  if (!(o.cost_tolerance >= 0))
+    throw InputError("LM option cost_tolerance = " + Num(o.cost_tolerance) + ": must be >= 0");
+  if (m < 1) throw InputError("LM: num_residuals = " + std::to_string(m) + ": must be >= 1");
+  if (n < 1) throw InputError("LM: no parameters: x must have at least one entry");
+  for (const auto* b : {&o.lower_bounds, &o.upper_bounds})
+    if (b->size() != 0 && b->size() != n)
+      throw InputError("LM: bounds have " + std::to_string(b->size()) + " entries for " +
+                       std::to_string(n) + " parameters");
+  if (HasBounds(o))
+    for (Eigen::Index j = 0; j < n; ++j)
+      if (!(Lower(o, j) <= Upper(o, j)))
+        throw InputError("LM: lower bound " + Num(Lower(o, j)) + " > upper bound " +
+                         Num(Upper(o, j)) + " for parameter " + std::to_string(j));
+}
+
+double ProjectedGradientNorm(const LmOptions& o, const Eigen::VectorXd& x,
+                             const Eigen::VectorXd& g) {
+  return (Project(o, x - g) - x).lpNorm<Eigen::Infinity>();
+}
+
+}  // namespace
+
+std::string ToString(LmTermination t) {
+  switch (t) {
+    case LmTermination::kGradientTolerance:
+      return "gradient_tolerance";
+    case LmTermination::kParameterTolerance:
+      return "parameter_tolerance";
+    case LmTermination::kCostTolerance:
+      return "cost_tolerance";
+    case LmTermination::kZeroCost:
+      return "zero_cost";
+    case LmTermination::kMaxIterations:
+      return "max_iterations";
+    case LmTermination::kMuTooLarge:
+      return "mu_too_large";
+    case LmTermination::kNonFinite:
+      return "non_finite";
+  }
+  return "unknown";
+}
+
+bool LmSummary::Converged() const {
+  return termination == LmTermination::kGradientTolerance ||
+         termination == LmTermination::kParameterTolerance ||
+         termination == LmTermination::kCostTolerance || termination == LmTermination::kZeroCost;
+}
+
+std::string LmSummary::BriefReport() const {
+  std::ostringstream ss;
+  ss.precision(6);
+  ss << "LM: cost " << initial_cost << " -> " << final_cost << " in " << iterations
+     << " iterations (" << accepted_steps << " accepted), " << ToString(termination) << " ("
+     << message << ")";
+  return ss.str();
+}
+
+Eigen::MatrixXd FiniteDifferenceJacobian(const ResidualFunction& residual, int num_residuals,
+                                         const Eigen::VectorXd& x, const LmOptions& options) {
+  const Eigen::Index n = x.size();
+  Eigen::MatrixXd jac(num_residuals, n);
+  Eigen::VectorXd r_plus(num_residuals), r_minus(num_residuals);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double h = options.fd_relative_step * std::max(std::abs(x[j]), 1.0);
+    // Keep the stencil inside the box: one-sided differences at a bound.
+    double up = h, down = h;
+    if (HasBounds(options)) {
+      up = std::min(h, Upper(options, j) - x[j]);
+      down = std::min(h, x[j] - Lower(options, j));
+      if (up <= 0 && down <= 0) up = down = h;  // degenerate box: ignore it for the stencil
+      if (up <= 0) up = 0;
+      if (down <= 0) down = 0;
+    }
+    Eigen::VectorXd xp = x, xm = x;
+    xp[j] += up;
+    xm[j] -= down;
+    residual(xp, &r_plus, nullptr);
+    residual(xm, &r_minus, nullptr);
+    jac.col(j) = (r_plus - r_minus) / (up + down);
+  }
+  return jac;
+}
+
+LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
+                            bool analytic_jacobian, Eigen::VectorXd* x_ptr,
+                            const LmOptions& options) {
+  if (x_ptr == nullptr) throw InputError("LM: x must not be null");
+  Eigen::VectorXd& x = *x_ptr;
+  const Eigen::Index n = x.size();
+  ValidateOptions(options, n, num_residuals);
+  x = Project(options, x);
+
+  LmSummary summary;
+  Eigen::VectorXd r(num_residuals);
+  Eigen::MatrixXd jac(num_residuals, n);
+  auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* res, Eigen::MatrixXd* j) {
+    res->resize(num_residuals);
+    if (j != nullptr && analytic_jacobian) {
+      j->resize(num_residuals, n);
+      residual(at, res, j);
+    } else {
+      residual(at, res, nullptr);
+      if (j != nullptr) *j = FiniteDifferenceJacobian(residual, num_residuals, at, options);
+    }
+    if (res->size() != num_residuals)
+      throw InputError("LM: residual function returned " + std::to_string(res->size()) +
+                       " residuals, expected " + std::to_string(num_residuals));
+  };
+
+  evaluate(x, &r, &jac);
+  double cost = 0.5 * r.squaredNorm();
+  summary.initial_cost = summary.final_cost = cost;
+  if (!std::isfinite(cost) || !jac.allFinite()) {
+    summary.termination = LmTermination::kNonFinite;
+    summary.message =
+        "residuals or Jacobian not finite at the start point (cost " + Num(cost) + ")";
+    return summary;
+  }
+
+  Eigen::MatrixXd jtj = jac.transpose() * jac;
+  Eigen::VectorXd g = jac.transpose() * r;
+  double mu = options.initial_mu * std::max(jtj.diagonal().maxCoeff(), kMinDiagonal);
+  double nu = 2.0;
+  Eigen::VectorXd r_new(num_residuals);
+  Eigen::MatrixXd jac_new(num_residuals, n);
+
+  summary.termination = LmTermination::kMaxIterations;
+  summary.message = "reached max_iterations " + std::to_string(options.max_iterations);
+  for (int iter = 0;; ++iter) {
+    const double grad_norm = ProjectedGradientNorm(options, x, g);
+    summary.final_gradient_norm = grad_norm;
+    if (cost == 0) {
+      summary.termination = LmTermination::kZeroCost;
+      summary.message = "cost is exactly 0";
+      break;
+    }
+    if (grad_norm <= options.gradient_tolerance) {
+      summary.termination = LmTermination::kGradientTolerance;
+      summary.message = "projected gradient " + Num(grad_norm) + " <= gradient_tolerance " +
+                        Num(options.gradient_tolerance);
+      break;
+    }
+    if (iter >= options.max_iterations) break;
+    summary.iterations = iter + 1;
+
+    Eigen::VectorXd diag = jtj.diagonal().cwiseMax(kMinDiagonal);
+    Eigen::MatrixXd a = jtj;
+    a.diagonal() += mu * diag;
+    const Eigen::VectorXd step = a.ldlt().solve(-g);
+    const Eigen::VectorXd x_new = Project(options, x + step);
+    const Eigen::VectorXd h = x_new - x;
+    const double step_norm = h.norm();
+    if (step_norm <= options.parameter_tolerance * (x.norm() + options.parameter_tolerance)) {
+      summary.termination = LmTermination::kParameterTolerance;
+      summary.message = "step " + Num(step_norm) + " <= parameter_tolerance " +
+                        Num(options.parameter_tolerance) + " * (|x| " + Num(x.norm()) + " + tol)";
+      break;
+    }
+    // The residual function is evaluated once here; the Jacobian only after acceptance.
+    r_new.resize(num_residuals);
+    residual(x_new, &r_new, nullptr);
+    const double cost_new = 0.5 * r_new.squaredNorm();
+    // cost - cost_new as 1/2 (r - r_new).(r + r_new): no cancellation near the optimum, where the
+    // plain difference of two nearly equal costs is rounding noise.
+    const double decrease = 0.5 * (r - r_new).dot(r + r_new);
+    const double model_decrease = -(g.dot(h) + 0.5 * h.dot(jtj * h));
+    const double rho =
+        (std::isfinite(cost_new) && model_decrease > 0) ? decrease / model_decrease : -1.0;
+    if (rho > 0 && std::isfinite(cost_new)) {
+      x = x_new;
+      evaluate(x, &r, &jac);
+      cost = cost_new;
+      jtj = jac.transpose() * jac;
+      g = jac.transpose() * r;
+      ++summary.accepted_steps;
+      mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+      nu = 2.0;
+      if (decrease <= options.cost_tolerance * (cost + decrease)) {
+        summary.termination = LmTermination::kCostTolerance;
+        summary.message = "relative cost decrease " + Num(decrease / (cost + decrease)) +
+                          " <= cost_tolerance " + Num(options.cost_tolerance);
+        summary.final_gradient_norm = ProjectedGradientNorm(options, x, g);
+        break;
+      }
+    } else {
+      mu *= nu;
+      nu *= 2.0;
+      if (!(mu <= options.max_mu)) {
+        summary.termination = LmTermination::kMuTooLarge;
+        summary.message = "damping mu " + Num(mu) + " > max_mu " + Num(options.max_mu) +
+                          " without a cost decrease (cost " + Num(cost) + ")";
+        break;
+      }
+    }
+  }
+  summary.final_cost = cost;
+  summary.final_mu = mu;
+  return summary;
+}
+
+}  // namespace whirl::fit

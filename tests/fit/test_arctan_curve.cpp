@@ -1,0 +1,202 @@
+// The arctan curve (closed-form properties, derivatives against finite differences) and the curve
+// fitter (recovers known parameters from poor starts, compares the three models).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/error.h"
+#include "fit/arctan_curve.h"
+#include "fit/curve_fit.h"
+
+namespace whirl::fit {
+namespace {
+
+ArctanCurve RandomCurve(std::mt19937& rng) {
+  std::uniform_real_distribution<double> ul(5.0, 120.0), uts(60.0, 600.0), uk(0.5, 12.0);
+  return ArctanCurve{ul(rng), uts(rng), uk(rng)};
+}
+
+ElongationCurve Sample(const std::function<double(double)>& f, double t_end, int n) {
+  ElongationCurve c;
+  for (int i = 0; i < n; ++i) {
+    const double t = t_end * i / (n - 1);
+    c.time_s.push_back(t);
+    c.elongation_um.push_back(f(t));
+  }
+  return c;
+}
+
+TEST(ArctanCurve, ClosedFormProperties) {
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 200; ++trial) {
+    const ArctanCurve c = RandomCurve(rng);
+    EXPECT_EQ(c.ElongationUm(0.0), 0.0);
+    EXPECT_EQ(c.ElongationUm(-5.0), 0.0);
+    EXPECT_NEAR(c.ElongationUm(c.settle_time_s * (1 - 1e-12)), c.max_elongation_um,
+                1e-9 * c.max_elongation_um);  // continuous at t_s
+    EXPECT_EQ(c.ElongationUm(2 * c.settle_time_s), c.max_elongation_um);
+    // Slope at 0 and just before t_s: L k/(t_s atan k) and that over (1 + k^2).
+    const double s0 = c.max_elongation_um * c.shape_k / (c.settle_time_s * std::atan(c.shape_k));
+    EXPECT_NEAR(c.SlopeUmPerS(0.0), s0, 1e-12 * s0);
+    EXPECT_NEAR(c.SlopeUmPerS(c.settle_time_s), s0 / (1 + c.shape_k * c.shape_k), 1e-12 * s0);
+    EXPECT_EQ(c.SlopeUmPerS(1.5 * c.settle_time_s), 0.0);
+    double prev = -1;
+    for (int i = 0; i <= 100; ++i) {  // monotone non-decreasing, within [0, L]
+      const double v = c.ElongationUm(1.2 * c.settle_time_s * i / 100);
+      EXPECT_GE(v, prev);
+      EXPECT_LE(v, c.max_elongation_um * (1 + 1e-12));
+      prev = v;
+    }
+  }
+}
+
+TEST(ArctanCurve, DerivativesMatchFiniteDifferences) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> frac(0.01, 0.99);
+  for (int trial = 0; trial < 200; ++trial) {
+    const ArctanCurve c = RandomCurve(rng);
+    const double t = frac(rng) * c.settle_time_s;
+    const double h = 1e-5 * c.settle_time_s;
+    const double fd_t = (c.ElongationUm(t + h) - c.ElongationUm(t - h)) / (2 * h);
+    EXPECT_NEAR(c.SlopeUmPerS(t), fd_t, 1e-6 * std::abs(fd_t) + 1e-10);
+    double dl, dts, dk;
+    c.ParameterGradient(t, &dl, &dts, &dk);
+    auto at = [&](double big_l, double ts, double k) {
+      return ArctanCurve{big_l, ts, k}.ElongationUm(t);
+    };
+    const double hl = 1e-6 * c.max_elongation_um, hts = 1e-6 * c.settle_time_s,
+                 hk = 1e-6 * c.shape_k;
+    const double L = c.max_elongation_um, ts = c.settle_time_s, k = c.shape_k;
+    EXPECT_NEAR(dl, (at(L + hl, ts, k) - at(L - hl, ts, k)) / (2 * hl), 1e-7);
+    const double fd_ts = (at(L, ts + hts, k) - at(L, ts - hts, k)) / (2 * hts);
+    EXPECT_NEAR(dts, fd_ts, 1e-6 * std::abs(fd_ts) + 1e-9);
+    const double fd_k = (at(L, ts, k + hk) - at(L, ts, k - hk)) / (2 * hk);
+    EXPECT_NEAR(dk, fd_k, 1e-6 * std::abs(fd_k) + 1e-9);
+  }
+}
+
+TEST(CurveModels, AnalyticGradientsMatchFiniteDifferences) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> frac(0.02, 0.98);
+  for (CurveModel model : kAllCurveModels) {
+    for (int trial = 0; trial < 100; ++trial) {
+      const ArctanCurve c = RandomCurve(rng);
+      Eigen::VectorXd p(model == CurveModel::kSine ? 2 : 3);
+      p[0] = c.max_elongation_um;
+      p[1] = c.settle_time_s;
+      if (model == CurveModel::kArctan) p[2] = c.shape_k;
+      if (model == CurveModel::kParabola) p[2] = 1.3 * c.max_elongation_um / c.settle_time_s;
+      const double t = frac(rng) * c.settle_time_s;
+      Eigen::VectorXd g;
+      EvaluateModel(model, p, t, &g);
+      for (Eigen::Index j = 0; j < p.size(); ++j) {
+        Eigen::VectorXd pp = p, pm = p;
+        const double h = 1e-6 * std::abs(p[j]);
+        pp[j] += h;
+        pm[j] -= h;
+        const double fd = (EvaluateModel(model, pp, t) - EvaluateModel(model, pm, t)) / (2 * h);
+        EXPECT_NEAR(g[j], fd, 1e-6 * std::abs(fd) + 1e-8) << ToString(model) << " param " << j;
+      }
+    }
+  }
+}
+
+TEST(CurveFit, ArctanFitRecoversParametersFromTheDataStart) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 30; ++trial) {
+    const ArctanCurve truth = RandomCurve(rng);
+    const ElongationCurve data =
+        Sample([&](double t) { return truth.ElongationUm(t); }, 2.5 * truth.settle_time_s, 301);
+    CurveFitOptions o;
+    o.initial_shape_k = 1.0;  // a poor start for k as well
+    const CurveFit fit = FitCurveModel(data, CurveModel::kArctan, o);
+    EXPECT_TRUE(fit.summary.Converged()) << fit.summary.BriefReport();
+    EXPECT_NEAR(fit.parameters[0], truth.max_elongation_um, 1e-4 * truth.max_elongation_um)
+        << fit.summary.BriefReport();
+    // t_s is only pinned to within a sample step by data on a grid (the kink sits between samples).
+    EXPECT_NEAR(fit.parameters[1], truth.settle_time_s, 2.5 * truth.settle_time_s / 300);
+    EXPECT_NEAR(fit.parameters[2], truth.shape_k, 0.05 * truth.shape_k);
+    EXPECT_GT(fit.r_squared, 0.99999);
+    EXPECT_LT(fit.rms_residual_um, 1e-3 * truth.max_elongation_um);
+  }
+}
+
+TEST(CurveFit, NoisyCurveGivesRmsNearTheNoiseAndArctanWins) {
+  std::mt19937 rng(6);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  for (int trial = 0; trial < 10; ++trial) {
+    ArctanCurve truth = RandomCurve(rng);
+    truth.shape_k = 3.0 + trial;  // sharply bending curves, where the models differ clearly
+    ElongationCurve data =
+        Sample([&](double t) { return truth.ElongationUm(t); }, 2 * truth.settle_time_s, 400);
+    for (double& v : data.elongation_um) v += noise(rng);
+    const std::vector<CurveFit> fits = FitAllModels(data);
+    ASSERT_EQ(fits.size(), 3u);
+    EXPECT_NEAR(fits[0].rms_residual_um, 0.3, 0.06) << fits[0].summary.BriefReport();
+    EXPECT_LT(fits[0].rms_residual_um, fits[1].rms_residual_um);
+    EXPECT_LT(fits[0].rms_residual_um, fits[2].rms_residual_um);
+    EXPECT_GT(fits[0].r_squared, fits[1].r_squared);
+    EXPECT_GT(fits[0].r_squared, fits[2].r_squared);
+  }
+}
+
+TEST(CurveFit, SineAndParabolaRecoverTheirOwnCurves) {
+  // Each alternative model fits data generated by itself exactly: checks their formulas and fits.
+  Eigen::VectorXd sine(2), parabola(3);
+  sine << 40.0, 200.0;
+  parabola << 40.0, 200.0, 0.35;  // b between L/t_s and 2L/t_s keeps the curve monotone
+  const ElongationCurve ds =
+      Sample([&](double t) { return EvaluateModel(CurveModel::kSine, sine, t); }, 500, 251);
+  const ElongationCurve dp =
+      Sample([&](double t) { return EvaluateModel(CurveModel::kParabola, parabola, t); }, 500, 251);
+  const CurveFit fs = FitCurveModel(ds, CurveModel::kSine);
+  const CurveFit fp = FitCurveModel(dp, CurveModel::kParabola);
+  EXPECT_NEAR(fs.parameters[0], 40.0, 1e-3) << fs.summary.BriefReport();
+  EXPECT_NEAR(fs.parameters[1], 200.0, 2.0);
+  EXPECT_NEAR(fp.parameters[0], 40.0, 1e-3) << fp.summary.BriefReport();
+  EXPECT_NEAR(fp.parameters[2], 0.35, 0.01);
+  EXPECT_GT(fs.r_squared, 0.9999);
+  EXPECT_GT(fp.r_squared, 0.9999);
+}
+
+TEST(CurveFit, ShapeFitWithFixedFeaturesRecoversK) {
+  std::mt19937 rng(8);
+  std::vector<ElongationCurve> curves;
+  std::vector<Features> features;
+  std::vector<double> ks;
+  for (int trial = 0; trial < 15; ++trial) {
+    const ArctanCurve truth = RandomCurve(rng);
+    curves.push_back(
+        Sample([&](double t) { return truth.ElongationUm(t); }, 2 * truth.settle_time_s, 200));
+    features.push_back(truth.ToFeatures());
+    ks.push_back(truth.shape_k);
+    const ShapeFit fit = FitShapeK(curves.back(), features.back());
+    EXPECT_NEAR(fit.shape_k, truth.shape_k, 1e-5 * truth.shape_k) << fit.summary.BriefReport();
+  }
+  const ShapeCalibration cal = CalibrateShapeK(curves, features);
+  std::sort(ks.begin(), ks.end());
+  EXPECT_NEAR(cal.median_shape_k, ks[ks.size() / 2], 1e-4 * ks[ks.size() / 2]);
+  EXPECT_NEAR(cal.min_shape_k, ks.front(), 1e-4 * ks.front());
+  EXPECT_THROW(CalibrateShapeK(curves, {}), InputError);
+}
+
+TEST(ArctanCurve, ValidationNamesTheField) {
+  try {
+    ArctanCurve::FromFeatures({10.0, -3.0});
+    FAIL() << "negative settle time accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("settle_time_s"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((ArctanCurve{10.0, 100.0, 0.0}.Validate()), InputError);
+  EXPECT_THROW((ArctanCurve{std::nan(""), 100.0, 3.0}.Validate()), InputError);
+  EXPECT_NO_THROW((ArctanCurve{0.0, 100.0, 3.0}.Validate()));
+  ElongationCurve tiny;
+  tiny.time_s = {0, 1};
+  tiny.elongation_um = {0, 1};
+  EXPECT_THROW(FitCurveModel(tiny, CurveModel::kArctan), InputError);
+  EXPECT_THROW(ParseCurveModel("cubic"), InputError);
+}
+
+}  // namespace
+}  // namespace whirl::fit

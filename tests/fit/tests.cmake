@@ -1,0 +1,6 @@
+# Tests of src/fit (LM solver, curve models) and the fit/curve command line.
+whirl_add_gtest(test_fit
+  SOURCES
+    ${CMAKE_CURRENT_LIST_DIR}/test_levenberg_marquardt.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_arctan_curve.cpp
+  LABELS fit)
