@@ -1,0 +1,256 @@
+// trainbr invariants (REFERENCE.md section 2): acceptance rule, gamma range, the first epoch's
+// updates recomputed independently, stopping reasons, regularization helps on small noisy data,
+// the noise estimate, the log-evidence convention, restarts.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "core/error.h"
+#include "nn/trainbr.h"
+#include "support/eigen_near.h"
+#include "synthetic.h"
+
+namespace whirl::nn {
+namespace {
+
+Network Initial(const std::vector<int>& sizes, std::uint64_t seed) {
+  Network net = Network::Zeros(sizes);
+  InitNguyenWidrow(seed, &net);
+  return net;
+}
+
+TEST(TrainBr, AcceptedStepNeverIncreasesFAndGammaStaysInRange) {
+  int accepted = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    const TrainingData data = synth::SmoothProblem(20, 0.05, seed);
+    const Network net = Initial({5, 6, 2}, 100 + seed);
+    const int N = net.ParameterCount();
+    const TrainResult r = TrainBr(data, net, TrainOptions{}, [&](const EpochInfo& info) {
+      if (info.step_accepted) {
+        ++accepted;
+        EXPECT_LT(info.objective_after_step, info.objective_before) << "epoch " << info.epoch;
+      } else {
+        EXPECT_EQ(info.objective_after_step, info.objective_before);
+      }
+      EXPECT_GT(info.gamma, 0.0);
+      EXPECT_LE(info.gamma, N);
+      EXPECT_GT(info.alpha, 0.0);
+      EXPECT_GT(info.beta, 0.0);
+    });
+    EXPECT_GT(r.summary.gamma, 0.0);
+    EXPECT_LE(r.summary.gamma, N);
+    EXPECT_LT(r.summary.sse, r.summary.initial_sse);
+    EXPECT_TRUE(std::isfinite(r.summary.log_evidence));
+  }
+  EXPECT_GT(accepted, 0);
+}
+
+// One epoch by hand from the rules of REFERENCE.md section 2, with gamma from the eigenvalues of
+// J'J rather than a matrix inverse.
+TEST(TrainBr, FirstEpochFollowsTheReferenceRules) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const TrainingData data = synth::SmoothProblem(20, 0.1, 50 + seed);
+    const Network net = Initial({5, 6, 2}, seed);
+    const int N = net.ParameterCount();
+    const double n = 40;
+    ForwardCache cache;
+    net.Forward(data.inputs, &cache);
+    Eigen::MatrixXd J;
+    ErrorJacobian(net, cache, &J);
+    const Eigen::MatrixXd E = data.targets - cache.output();
+    const Eigen::VectorXd e = Eigen::Map<const Eigen::VectorXd>(E.data(), E.size());
+    const Eigen::VectorXd w = net.GetParameters();
+    const double sse = e.squaredNorm(), ssx = w.squaredNorm();
+    double beta = (n - N) / (2 * sse);
+    if (!(beta > 0)) beta = 1;
+    ASSERT_EQ(beta, 1.0);  // 20 samples, 2 outputs: n - N < 0
+    const double alpha = N / (2 * ssx);
+    const double F = beta * sse + alpha * ssx;
+    const Eigen::MatrixXd jj = J.transpose() * J;
+    const Eigen::VectorXd je = J.transpose() * e;
+    double mu = 0.005;
+    Eigen::VectorXd w1;
+    double sse1 = 0, ssx1 = 0;
+    for (;; mu *= 10) {
+      ASSERT_LE(mu, 1e10);
+      Eigen::MatrixXd A = beta * jj + (mu + alpha) * Eigen::MatrixXd::Identity(N, N);
+      const Eigen::VectorXd dw = -A.ldlt().solve(beta * je + alpha * w);
+      Network n1 = net;
+      n1.SetParameters(w + dw);
+      const Eigen::MatrixXd E1 = data.targets - n1.Forward(data.inputs);
+      sse1 = E1.squaredNorm();
+      ssx1 = (w + dw).squaredNorm();
+      if (beta * sse1 + alpha * ssx1 < F) {
+        w1 = w + dw;
+        mu = std::max(mu * 0.1, 1e-20);
+        break;
+      }
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jj);
+    double gamma = 0;
+    for (int i = 0; i < N; ++i) {
+      const double lambda = std::max(eig.eigenvalues()(i), 0.0);
+      gamma += beta * lambda / (beta * lambda + alpha);
+    }
+    const double alpha1 = gamma / (2 * ssx1);
+    const double beta1 = (n - gamma) / (2 * sse1);
+
+    TrainOptions one;
+    one.epochs = 1;
+    const TrainResult r = TrainBr(data, net, one);
+    EXPECT_EQ(r.summary.termination, TrainTermination::kMaxEpochs);
+    EXPECT_EQ(r.summary.epochs, 1);
+    EXPECT_NEAR(r.summary.initial_cost, F, 1e-12 * F);
+    EXPECT_TRUE(whirl::test::AllNear(r.network.GetParameters(), w1, 1e-9, 1e-12));
+    EXPECT_NEAR(r.summary.gamma, gamma, 1e-8 * N);
+    EXPECT_NEAR(r.summary.alpha, alpha1, 1e-8 * alpha1);
+    EXPECT_NEAR(r.summary.beta, beta1, 1e-8 * beta1);
+    EXPECT_NEAR(r.summary.mu, mu, 1e-12 * mu);
+    EXPECT_NEAR(r.summary.final_cost, beta1 * sse1 + alpha1 * ssx1, 1e-9 * r.summary.final_cost);
+  }
+}
+
+TEST(TrainBr, StopsForEachDocumentedReason) {
+  const TrainingData data = synth::SmoothProblem(20, 0.05, 3);
+  const Network net = Initial({5, 6, 2}, 3);
+  TrainOptions o;
+  o.epochs = 0;
+  TrainResult r = TrainBr(data, net, o);
+  EXPECT_EQ(r.summary.termination, TrainTermination::kMaxEpochs);
+  EXPECT_EQ(r.summary.epochs, 0);
+  EXPECT_EQ(r.network.GetParameters(), net.GetParameters());
+
+  o = TrainOptions{};
+  o.goal = 1e9;
+  r = TrainBr(data, net, o);
+  EXPECT_EQ(r.summary.termination, TrainTermination::kGoalMet);
+  EXPECT_NE(r.summary.message.find("goal"), std::string::npos) << r.summary.message;
+
+  o = TrainOptions{};
+  o.min_grad = 1e9;
+  r = TrainBr(data, net, o);
+  EXPECT_EQ(r.summary.termination, TrainTermination::kMinGradient);
+  EXPECT_NE(r.summary.message.find("min_grad = 1e+09"), std::string::npos) << r.summary.message;
+
+  o = TrainOptions{};
+  o.mu_max = 1e-2;  // one rejection pushes mu past it
+  r = TrainBr(data, net, o);
+  EXPECT_TRUE(r.summary.termination == TrainTermination::kMaxMu ||
+              r.summary.termination == TrainTermination::kMaxEpochs)
+      << r.summary.BriefReport();
+
+  // Default options end for one of the four reasons, and the report names it with numbers.
+  r = TrainBr(data, net, TrainOptions{});
+  EXPECT_NE(r.summary.BriefReport().find(ToString(r.summary.termination)), std::string::npos);
+  EXPECT_EQ(ParseTermination(ToString(r.summary.termination)), r.summary.termination);
+}
+
+TEST(TrainBr, RegularizationBeatsPlainLmOnTwentyNoisySamples) {
+  const TrainingData test_set = synth::SmoothProblem(400, 0.0, 999);
+  double mse_br = 0, mse_lm = 0;
+  const int runs = 8;
+  for (int s = 1; s <= runs; ++s) {
+    const TrainingData data = synth::SmoothProblem(20, 0.1, 200 + s);
+    const Network net = Initial({5, 6, 2}, 300 + s);
+    TrainOptions lm;
+    lm.regularization = Regularization::kNone;
+    const TrainResult br = TrainBr(data, net, TrainOptions{});
+    const TrainResult plain = TrainBr(data, net, lm);
+    EXPECT_LE(plain.summary.sse, br.summary.sse * 1.0001 + 1e-12);  // LM fits training data closer
+    mse_br += (test_set.targets - br.network.Forward(test_set.inputs)).squaredNorm() / 800.0;
+    mse_lm += (test_set.targets - plain.network.Forward(test_set.inputs)).squaredNorm() / 800.0;
+  }
+  mse_br /= runs;
+  mse_lm /= runs;
+  EXPECT_LT(mse_br, mse_lm) << "trainbr test MSE " << mse_br << " vs plain LM " << mse_lm;
+}
+
+// The noise estimate 1/(2 beta) = ssE/(n - gamma) matches the true noise when the model can
+// represent the function (teacher network of the same size).
+TEST(TrainBr, NoiseVarianceMatchesTrueNoise) {
+  const double sigma = 0.1;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Network teacher = Initial({5, 6, 2}, 900 + seed);
+    Rng rng(seed);
+    const int Q = 300;
+    TrainingData d;
+    d.inputs.resize(5, Q);
+    for (int q = 0; q < Q; ++q)
+      for (int i = 0; i < 5; ++i) d.inputs(i, q) = rng.Uniform(-1, 1);
+    d.targets = teacher.Forward(d.inputs);
+    for (int q = 0; q < Q; ++q)
+      for (int k = 0; k < 2; ++k) d.targets(k, q) += sigma * synth::Gaussian(&rng);
+    d.target_scaling = MapMinMax::Identity(2);
+    const TrainResult r = TrainBr(d, Initial({5, 6, 2}, seed), TrainOptions{});
+    EXPECT_NEAR(r.summary.noise_variance, r.summary.sse / (600 - r.summary.gamma),
+                1e-6 * r.summary.noise_variance);
+    EXPECT_GT(r.summary.noise_variance, 0.7 * sigma * sigma) << r.summary.BriefReport();
+    EXPECT_LT(r.summary.noise_variance, 1.3 * sigma * sigma) << r.summary.BriefReport();
+  }
+}
+
+// Our closed form (MATLAB alpha, beta) equals MacKay's evidence with alpha_M = 2 alpha,
+// beta_M = 2 beta, E_D = ssE/2, E_W = ssX/2, A = 2 H, computed from the eigenvalues of J'J.
+TEST(TrainBr, LogEvidenceEqualsMacKaysFormInHisConvention) {
+  const TrainingData data = synth::SmoothProblem(20, 0.1, 11);
+  const TrainResult r = TrainBr(data, Initial({5, 6, 2}, 11), TrainOptions{});
+  ForwardCache cache;
+  r.network.Forward(data.inputs, &cache);
+  Eigen::MatrixXd J;
+  ErrorJacobian(r.network, cache, &J);
+  const auto& s = r.summary;
+  const double aM = 2 * s.alpha, bM = 2 * s.beta, N = 50, n = 40;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(J.transpose() * J);
+  double log_det_A = 0;
+  for (int i = 0; i < 50; ++i) log_det_A += std::log(bM * std::max(eig.eigenvalues()(i), 0.0) + aM);
+  const double mackay = -bM * s.sse / 2 - aM * s.sum_squared_weights / 2 - 0.5 * log_det_A +
+                        N / 2 * std::log(aM) + n / 2 * std::log(bM) - n / 2 * std::log(2 * M_PI) +
+                        std::lgamma(7.0) + 6 * std::log(2.0);
+  EXPECT_NEAR(s.log_evidence, mackay, 1e-8 * std::abs(mackay));
+  // Posterior covariance = A^-1.
+  const Eigen::MatrixXd A =
+      bM * J.transpose() * J + aM * Eigen::MatrixXd::Identity(50, 50);
+  EXPECT_TRUE(whirl::test::AllNear(Eigen::MatrixXd(A * r.posterior_covariance),
+                            Eigen::MatrixXd::Identity(50, 50), 0, 1e-8));
+}
+
+TEST(TrainBr, RestartsKeepTheHighestEvidenceAndAreReproducible) {
+  const TrainingData data = synth::SmoothProblem(20, 0.1, 21);
+  const RestartResult r = TrainBrRestarts(data, {5, 6, 2}, 40, 4, TrainOptions{});
+  ASSERT_EQ(r.runs.size(), 4u);
+  for (std::size_t k = 0; k < r.runs.size(); ++k) {
+    EXPECT_EQ(r.runs[k].seed, 40 + k);
+    EXPECT_LE(r.runs[k].log_evidence, r.best.summary.log_evidence);
+    const TrainResult single = TrainBr(data, Initial({5, 6, 2}, 40 + k), TrainOptions{});
+    EXPECT_EQ(single.summary.log_evidence, r.runs[k].log_evidence);  // bit-identical rerun
+  }
+  EXPECT_EQ(r.best.init_seed, r.runs[r.best_index].seed);
+  EXPECT_THROW(TrainBrRestarts(data, {5, 6, 2}, 1, 0, TrainOptions{}), InputError);
+}
+
+TEST(TrainBr, RejectsInconsistentDataAndBadOptions) {
+  TrainingData data = synth::SmoothProblem(10, 0.1, 1);
+  const Network net = Initial({5, 6, 2}, 1);
+  TrainingData bad = data;
+  bad.targets = data.targets.topRows(1);
+  EXPECT_THROW(TrainBr(bad, net, TrainOptions{}), InputError);
+  bad = data;
+  bad.inputs(2, 3) = std::nan("");
+  EXPECT_THROW(TrainBr(bad, net, TrainOptions{}), InputError);
+  TrainOptions o;
+  o.mu_dec = 2;
+  try {
+    TrainBr(data, net, o);
+    FAIL() << "mu_dec = 2 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("mu_dec"), std::string::npos) << e.what();
+  }
+  o = TrainOptions{};
+  o.epochs = -1;
+  EXPECT_THROW(TrainBr(data, net, o), InputError);
+}
+
+}  // namespace
+}  // namespace whirl::nn
