@@ -91,14 +91,24 @@ Grid MakeGrid(const CurveFunction& curve, double t0, double t1, const Breakpoint
   return g;
 }
 
-double EffectiveTolerance(const Grid& g, double tolerance_um) {
-  const double eff = tolerance_um - g.margin_um;
-  if (!(eff > 0.5 * tolerance_um))
-    throw InputError(
-        "tolerance_um = " + Num(tolerance_um) +
-        " um is too small for the check grid: the curvature margin between samples is " +
-        Num(g.margin_um) + " um (must stay below half the tolerance): lower check_step_s");
-  return eff;
+// The grid, refined (step halved) until the curvature margin is below half the tolerance.
+Grid MakeRefinedGrid(const CurveFunction& curve, double t0, double t1, BreakpointOptions o,
+                     double* effective_tolerance_um) {
+  for (;;) {
+    Grid g = MakeGrid(curve, t0, t1, o);
+    const double eff = o.tolerance_um - g.margin_um;
+    if (eff > 0.5 * o.tolerance_um) {
+      *effective_tolerance_um = eff;
+      return g;
+    }
+    if (2.0 * static_cast<double>(g.t.size()) > static_cast<double>(o.max_grid_samples))
+      throw InputError(
+          "tolerance_um = " + Num(o.tolerance_um) +
+          " um is too small for a check grid of at most " + std::to_string(o.max_grid_samples) +
+          " samples: the curvature margin between samples is " + Num(g.margin_um) + " um at step " +
+          Num(g.max_step) + " s (must stay below half the tolerance)");
+    o.check_step_s = 0.5 * g.max_step;
+  }
 }
 
 // Is the chord from sample a to sample b within tol at every sample strictly between?
@@ -150,8 +160,8 @@ double Breakpoints::InterpolateUm(double t) const {
 
 Breakpoints ChooseBreakpoints(const CurveFunction& curve, double t_begin_s, double t_end_s,
                               const BreakpointOptions& options) {
-  const Grid g = MakeGrid(curve, t_begin_s, t_end_s, options);
-  const double tol = EffectiveTolerance(g, options.tolerance_um);
+  double tol = 0;
+  const Grid g = MakeRefinedGrid(curve, t_begin_s, t_end_s, options, &tol);
   const std::size_t last = g.t.size() - 1;
   Breakpoints bp;
   bp.tolerance_um = options.tolerance_um;
@@ -197,8 +207,8 @@ std::size_t UniformPointCount(const CurveFunction& curve, double t_begin_s, doub
                               const BreakpointOptions& options, std::size_t max_points) {
   // The same grid and effective tolerance as ChooseBreakpoints; the forced times stay grid samples
   // (so no check interval spans a kink) but the uniform points ignore them.
-  const Grid g = MakeGrid(curve, t_begin_s, t_end_s, options);
-  const double tol = EffectiveTolerance(g, options.tolerance_um);
+  double tol = 0;
+  const Grid g = MakeRefinedGrid(curve, t_begin_s, t_end_s, options, &tol);
   std::vector<double> bt, bv;
   std::size_t ok = 0, fail = 1;
   max_points = std::max<std::size_t>(max_points, 2);

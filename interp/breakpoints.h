@@ -33,7 +33,8 @@ using CurveFunction = std::function<double(double t_s)>;
 struct BreakpointOptions {
   /// Largest allowed |piecewise-linear interpolant - curve|, um (> 0). Default from the issue.
   double tolerance_um = 0.5;
-  /// Largest check-grid step, s (> 0). The grid has ceil((t_end - t_begin)/check_step_s) steps.
+  /// Largest check-grid step, s (> 0). The grid starts with ceil((t_end - t_begin)/check_step_s)
+  /// steps and is refined (step halved) until the curvature margin is below tolerance_um / 2.
   double check_step_s = 0.25;
   /// Guard against absurd grids: more samples than this is an InputError (raise check_step_s).
   std::size_t max_grid_samples = 20'000'000;
@@ -58,8 +59,8 @@ struct Breakpoints {
 
 /// Chooses breakpoints on [t_begin_s, t_end_s] (see the algorithm above). Throws InputError for
 /// t_end <= t_begin, non-finite bounds, tolerance_um <= 0 or non-finite, check_step_s <= 0, a grid
-/// above max_grid_samples, a non-finite curve value (naming the time), or a tolerance so small that
-/// the curvature margin consumes it.
+/// above max_grid_samples (also when refining it for a tiny tolerance), or a non-finite curve value
+/// (naming the time).
 Breakpoints ChooseBreakpoints(const CurveFunction& curve, double t_begin_s, double t_end_s,
                               const BreakpointOptions& options = {});
 

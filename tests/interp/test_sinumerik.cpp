@@ -1,0 +1,242 @@
+// 840D setting data: the invariant (compensation reconstructed from SD43900/43910/43920 follows the
+// curve within the tolerance), the SD definitions, the slope cap, writers and the NC golden file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <regex>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "fit/arctan_curve.h"
+#include "interp/sinumerik.h"
+
+namespace whirl::interp {
+namespace {
+
+struct Case {
+  fit::ArctanCurve curve;
+  double feed_mm_s;
+  double thread_mm;
+  PlanOptions options;
+};
+
+Case RandomCase(std::mt19937& rng) {
+  std::uniform_real_distribution<double> ul(5.0, 120.0), uts(80.0, 600.0), uk(0.5, 10.0),
+      ufeed(0.3, 1.5), uthread(800.0, 6000.0), upos(-3000.0, 3000.0), utol(0.1, 2.0);
+  Case c;
+  c.curve = fit::ArctanCurve{ul(rng), uts(rng), uk(rng)};
+  c.feed_mm_s = ufeed(rng);
+  c.thread_mm = uthread(rng);
+  c.options.tolerance_um = utol(rng);
+  c.options.start_position_mm = upos(rng);
+  c.options.machine_offset_mm = upos(rng);
+  c.options.direction = rng() % 2 == 0 ? 1 : -1;
+  c.options.sign = rng() % 2 == 0 ? SignConvention::kAdd : SignConvention::kSubtract;
+  c.options.check_step_s = 0.5;
+  c.options.md32760 = kMd32760Max;  // random feeds and curves reach slopes up to ~0.04
+  return c;
+}
+
+TEST(Sinumerik, ReconstructedCompensationFollowsTheCurveWithinTolerance) {
+  std::mt19937 rng(31);
+  int seen[2][2] = {{0, 0}, {0, 0}};
+  for (int trial = 0; trial < 120; ++trial) {
+    const Case c = RandomCase(rng);
+    const CompensationPlan plan = BuildPlan(c.curve, c.feed_mm_s, c.thread_mm, c.options);
+    ++seen[c.options.direction > 0][c.options.sign == SignConvention::kAdd];
+    const double t_end = c.thread_mm / c.feed_mm_s;
+    const int dense = 30000;
+    double worst = 0;
+    for (int i = 0; i <= dense; ++i) {
+      const double t = t_end * (i + 0.5) / (dense + 1);
+      const double p = AxisPositionMm(c.options, c.feed_mm_s, t);
+      worst = std::max(worst, std::abs(AppliedCompensationUm(plan, p) - c.curve.ElongationUm(t)));
+    }
+    EXPECT_LE(worst, c.options.tolerance_um) << "trial " << trial << " dir " << c.options.direction
+                                             << " sign " << ToString(c.options.sign);
+    // Beyond the thread end the plateau is held.
+    const double p_after = AxisPositionMm(c.options, c.feed_mm_s, t_end * 1.1);
+    EXPECT_NEAR(AppliedCompensationUm(plan, p_after), c.curve.max_elongation_um, 1e-9);
+  }
+  for (auto& row : seen)
+    for (int n : row) EXPECT_GT(n, 10) << "every direction/sign combination is exercised";
+}
+
+TEST(Sinumerik, SettingDataFollowTheDocumentedFormulas) {
+  std::mt19937 rng(32);
+  for (int trial = 0; trial < 40; ++trial) {
+    const Case c = RandomCase(rng);
+    const CompensationPlan plan = BuildPlan(c.curve, c.feed_mm_s, c.thread_mm, c.options);
+    const double s = c.options.sign == SignConvention::kAdd ? 1.0 : -1.0;
+    ASSERT_GE(plan.segments.size(), 2u);
+    EXPECT_EQ(plan.point_count, plan.segments.size() + 1);
+    EXPECT_GE(plan.uniform_point_count, plan.point_count);
+    const double p0 = c.options.machine_offset_mm + c.options.start_position_mm;
+    EXPECT_NEAR(plan.segments.front().p_a_mm, p0, 1e-9);
+    EXPECT_NEAR(plan.segments.back().p_b_mm, p0 + c.options.direction * c.thread_mm, 1e-6);
+    for (std::size_t i = 0; i < plan.segments.size(); ++i) {
+      const CompensationSegment& g = plan.segments[i];
+      EXPECT_NEAR(g.p_a_mm, p0 + c.options.direction * c.feed_mm_s * g.t_a_s, 1e-9);
+      EXPECT_DOUBLE_EQ(g.l_a_um, c.curve.ElongationUm(g.t_a_s));
+      EXPECT_DOUBLE_EQ(g.sd43900_mm, s * g.l_a_um / 1000.0);
+      EXPECT_DOUBLE_EQ(g.sd43920_mm, g.p_a_mm);
+      EXPECT_NEAR(g.sd43910, s * (g.l_b_um - g.l_a_um) / 1000.0 / (g.p_b_mm - g.p_a_mm), 1e-15);
+      EXPECT_LE(std::abs(g.sd43910), c.options.md32760);
+      if (i > 0) {
+        EXPECT_EQ(g.t_a_s, plan.segments[i - 1].t_b_s);
+      }
+    }
+    EXPECT_EQ(plan.segments.back().sd43910, 0.0) << "the plateau segment is flat";
+  }
+}
+
+TEST(Sinumerik, SlopeBeyondMd32760IsAnErrorNamingSegmentSlopeAndCap) {
+  // 100 um in 10 s at 0.05 mm/s feed: slope ~0.2 mm/mm at the start, far above 0.01.
+  const fit::ArctanCurve steep{100.0, 10.0, 3.0};
+  PlanOptions o;
+  try {
+    BuildPlan(steep, 0.05, 100.0, o);
+    FAIL() << "steep slope accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("segment 1"), std::string::npos) << m;
+    EXPECT_NE(m.find("SD43910"), std::string::npos) << m;
+    EXPECT_NE(m.find("0.01"), std::string::npos) << m;
+  }
+  // The same curve with a generous cap and a fast feed passes, and every slope respects the cap.
+  o.md32760 = 0.1;
+  const CompensationPlan plan = BuildPlan(steep, 2.0, 100.0, o);
+  EXPECT_LE(plan.max_abs_slope, 0.1);
+}
+
+TEST(Sinumerik, BadOptionsThrow) {
+  const fit::ArctanCurve c{30.0, 200.0, 3.0};
+  PlanOptions o;
+  o.tolerance_um = -0.5;
+  EXPECT_THROW(BuildPlan(c, 0.5, 1000, o), InputError);
+  o = PlanOptions{};
+  o.direction = 0;
+  EXPECT_THROW(BuildPlan(c, 0.5, 1000, o), InputError);
+  o = PlanOptions{};
+  o.md32760 = 0.2;
+  EXPECT_THROW(BuildPlan(c, 0.5, 1000, o), InputError);
+  o = PlanOptions{};
+  o.axis = "Z;M30";
+  EXPECT_THROW(BuildPlan(c, 0.5, 1000, o), InputError);
+  EXPECT_THROW(BuildPlan(c, -0.5, 1000, PlanOptions{}), InputError);
+  EXPECT_THROW(BuildPlan(c, 0.5, 0, PlanOptions{}), InputError);
+  EXPECT_THROW(ParseSignConvention("plus"), InputError);
+}
+
+TEST(Sinumerik, JsonRoundTripReproducesThePlan) {
+  std::mt19937 rng(33);
+  const Case c = RandomCase(rng);
+  const CompensationPlan plan = BuildPlan(c.curve, c.feed_mm_s, c.thread_mm, c.options);
+  const nlohmann::json j = plan;
+  const CompensationPlan back = nlohmann::json::parse(j.dump()).get<CompensationPlan>();
+  ASSERT_EQ(back.segments.size(), plan.segments.size());
+  for (double p = -4000; p <= 4000; p += 7.3)
+    EXPECT_EQ(AppliedCompensationUm(back, p), AppliedCompensationUm(plan, p));
+  EXPECT_EQ(back.options.sign, plan.options.sign);
+  EXPECT_EQ(back.uniform_point_count, plan.uniform_point_count);
+  nlohmann::json bad = j;
+  bad["settings"]["tolerance"] = 1;  // typo'd key
+  EXPECT_THROW(bad.get<CompensationPlan>(), InputError);
+}
+
+TEST(Sinumerik, PlcCsvCarriesTheSettingDataExactly) {
+  std::mt19937 rng(34);
+  const Case c = RandomCase(rng);
+  const CompensationPlan plan = BuildPlan(c.curve, c.feed_mm_s, c.thread_mm, c.options);
+  const CsvTable t = ParseCsv(FormatPlcCsv(plan, {" made by the test"}), "plc.csv");
+  ASSERT_EQ(t.rows.size(), plan.segments.size());
+  const auto k0 = t.Column("sd43900_mm"), slope = t.Column("sd43910"), p0 = t.Column("sd43920_mm"),
+             trig = t.Column("trigger_position_mm");
+  for (std::size_t i = 0; i < plan.segments.size(); ++i) {
+    EXPECT_EQ(k0[i], plan.segments[i].sd43900_mm);
+    EXPECT_EQ(slope[i], plan.segments[i].sd43910);
+    EXPECT_EQ(p0[i], plan.segments[i].sd43920_mm);
+    EXPECT_EQ(trig[i], plan.segments[i].p_a_mm);
+  }
+  EXPECT_EQ(t.comments.front(), "made by the test");
+}
+
+// A fixed small plan (hand-made values) for the format of the NC program.
+CompensationPlan SmallPlan() {
+  CompensationPlan plan;
+  plan.options.axis = "Z";
+  plan.options.start_position_mm = 100.0;
+  plan.options.machine_offset_mm = -500.0;
+  plan.options.direction = 1;
+  plan.options.sign = SignConvention::kSubtract;
+  plan.axial_feed_mm_s = 0.5;
+  plan.thread_length_mm = 100.0;
+  plan.cutting_time_s = 200.0;
+  const double t[] = {0.0, 20.0, 60.0, 200.0};
+  const double l[] = {0.0, 12.5, 25.0, 30.0};
+  for (int i = 0; i < 3; ++i) {
+    CompensationSegment s;
+    s.t_a_s = t[i];
+    s.t_b_s = t[i + 1];
+    s.p_a_mm = -400.0 + 0.5 * t[i];
+    s.p_b_mm = -400.0 + 0.5 * t[i + 1];
+    s.l_a_um = l[i];
+    s.l_b_um = l[i + 1];
+    s.sd43900_mm = -l[i] / 1000.0;
+    s.sd43910 = -(l[i + 1] - l[i]) / 1000.0 / (s.p_b_mm - s.p_a_mm);
+    s.sd43920_mm = s.p_a_mm;
+    plan.segments.push_back(s);
+    plan.max_abs_slope = std::max(plan.max_abs_slope, std::abs(s.sd43910));
+  }
+  plan.point_count = 4;
+  plan.max_deviation_um = 0.4321;
+  return plan;
+}
+
+TEST(Sinumerik, NcProgramMatchesGoldenFile) {
+  NcProgramInfo info;
+  info.curve_source = "golden test plan";
+  const std::string nc = FormatNcProgram(SmallPlan(), info);
+  const std::string golden_path =
+      std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/small_plan.mpf";
+  if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(golden_path, nc);
+  EXPECT_EQ(nc, ReadTextFile(golden_path)) << "regenerate with WHIRL_UPDATE_GOLDEN=1 after a "
+                                              "deliberate format change; actual:\n"
+                                           << nc;
+}
+
+TEST(Sinumerik, NcProgramValuesReconstructTheCompensation) {
+  // Parse the synchronized actions back: the printed values reproduce the plan within the printed
+  // precision, in both directions of travel.
+  std::mt19937 rng(35);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Case c = RandomCase(rng);
+    const CompensationPlan plan = BuildPlan(c.curve, c.feed_mm_s, c.thread_mm, c.options);
+    const std::string nc = FormatNcProgram(plan);
+    const std::regex action(
+        R"(ID=(\d+) WHEN \$AA_IM\[Z\](>=|<=)(-?[0-9.]+) DO \$\$SA_TEMP_COMP_ABS_VALUE\[Z\]=(-?[0-9.]+) \$\$SA_TEMP_COMP_SLOPE\[Z\]=(-?[0-9.]+) \$\$SA_TEMP_COMP_REF_POSITION\[Z\]=(-?[0-9.]+))");
+    std::size_t count = 0;
+    for (auto it = std::sregex_iterator(nc.begin(), nc.end(), action); it != std::sregex_iterator();
+         ++it) {
+      const auto& m = *it;
+      const std::size_t id = std::stoul(m[1]);
+      ASSERT_LT(id, plan.segments.size());
+      const CompensationSegment& s = plan.segments[id];
+      EXPECT_EQ(m[2].str(), c.options.direction > 0 ? ">=" : "<=");
+      EXPECT_NEAR(std::stod(m[3]), s.p_a_mm, 0.5e-4);
+      EXPECT_NEAR(std::stod(m[4]), s.sd43900_mm, 0.5e-6);
+      EXPECT_NEAR(std::stod(m[5]), s.sd43910, 0.5e-8);
+      EXPECT_NEAR(std::stod(m[6]), s.sd43920_mm, 0.5e-4);
+      ++count;
+    }
+    EXPECT_EQ(count, plan.segments.size() - 1);
+    EXPECT_NE(nc.find("MD32750 $MA_TEMP_COMP_TYPE = 3"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace whirl::interp

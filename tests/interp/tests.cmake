@@ -1,0 +1,7 @@
+# Tests of interp/ (breakpoints, 840D setting data, writers) and the plan command line.
+whirl_add_gtest(test_interp
+  SOURCES
+    ${CMAKE_CURRENT_LIST_DIR}/test_breakpoints.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_sinumerik.cpp
+  LIBS whirl::interp
+  LABELS interp)
