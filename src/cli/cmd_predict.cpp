@@ -1,9 +1,191 @@
-// Placeholder until its owner writes it; replaced before anything lands.
+// whirl predict: elongation features with Laplace standard deviations from a trained model
+// (src/nn/model.h).
+#include <array>
+#include <cmath>
+#include <memory>
+#include <cstdio>
+#include <iostream>
+
 #include "cli/commands.h"
+#include "cli/common.h"
+#include "core/atomic_file.h"
+#include "core/csv.h"
 #include "core/error.h"
+#include "core/process.h"
+#include "nn/model.h"
+
 namespace whirl::cli {
-void RegisterPredict(CLI::App& app) {
-  auto* sub = app.add_subcommand("predict", "(being built)");
-  sub->callback([] { throw InputError("'predict' is not built yet"); });
+namespace {
+
+struct PredictOptions {
+  std::string model_path;
+  std::string input_path;
+  std::string out_path;
+  bool json = false;
+  // Single process: all five or none.
+  double hardness_hrc = NAN;
+  double diameter_mm = NAN;
+  double pitch_mm = NAN;
+  double raceway_radius_mm = NAN;
+  double cutting_speed_m_min = NAN;
+};
+
+void Run(const PredictOptions& o) {
+  const std::array<double, ProcessInputs::kCount> single = {
+      o.hardness_hrc, o.diameter_mm, o.pitch_mm, o.raceway_radius_mm, o.cutting_speed_m_min};
+  const std::array<const char*, ProcessInputs::kCount> flags = {
+      "--hardness", "--diameter", "--pitch", "--raceway-radius", "--cutting-speed"};
+  std::string given, missing;
+  for (int i = 0; i < ProcessInputs::kCount; ++i)
+    (std::isnan(single[i]) ? missing : given) += std::string(" ") + flags[i];
+
+  ProcessTable table;
+  if (!o.input_path.empty()) {
+    if (!given.empty())
+      throw InputError("predict: use either --input CSV or the five process flags, not both (got" +
+                       given + ")");
+    table = ReadProcessTable(o.input_path, /*require_targets=*/false);
+  } else {
+    if (!missing.empty())
+      throw InputError("predict: give --input CSV or all five of --hardness --diameter --pitch "
+                       "--raceway-radius --cutting-speed (missing:" + missing + ")");
+    table.source = "command line";
+    table.inputs.push_back(ProcessInputs::FromArray(single));
+  }
+  const nn::Model model = nn::LoadModel(o.model_path);
+  const std::vector<nn::Prediction> pred = nn::PredictBatch(model, table.inputs);
+  const bool have_targets = table.targets.size() == table.inputs.size() && !table.targets.empty();
+
+  int outside = 0;
+  for (std::size_t q = 0; q < pred.size(); ++q) {
+    if (!pred[q].outside_domain) continue;
+    ++outside;
+    std::string fields;
+    for (const auto& f : pred[q].outside_domain_fields) fields += (fields.empty() ? "" : ", ") + f;
+    const std::string where = o.input_path.empty()
+                                  ? std::string("the process")
+                                  : o.input_path + " line " + std::to_string(table.line_numbers[q]);
+    Warn(where + " lies outside the training domain in " + fields +
+         " (the prediction extrapolates; its standard deviation may understate the error)");
+  }
+
+  if (!o.out_path.empty()) {
+    std::vector<std::string> header(kInputColumns.begin(), kInputColumns.end());
+    for (const char* c : {"max_elongation_um", "max_elongation_std_um", "settle_time_s",
+                          "settle_time_std_s", "outside_domain"})
+      header.push_back(c);
+    std::vector<std::vector<double>> rows;
+    for (std::size_t q = 0; q < pred.size(); ++q) {
+      const auto a = table.inputs[q].ToArray();
+      std::vector<double> row(a.begin(), a.end());
+      row.insert(row.end(), {pred[q].mean.max_elongation_um, pred[q].stddev.max_elongation_um,
+                             pred[q].mean.settle_time_s, pred[q].stddev.settle_time_s,
+                             pred[q].outside_domain ? 1.0 : 0.0});
+      rows.push_back(std::move(row));
+    }
+    WriteFileAtomic(o.out_path,
+                    FormatCsv(header, rows,
+                              {"whirl predict --model " + o.model_path +
+                                   (o.input_path.empty() ? "" : " --input " + o.input_path),
+                               "std = Laplace predictive standard deviation (noise + weights), "
+                               "outside_domain = 1 if an input is outside the training domain"}));
+  }
+
+  if (o.json) {
+    nlohmann::json rows = nlohmann::json::array();
+    double sq_e = 0, sq_t = 0;
+    for (std::size_t q = 0; q < pred.size(); ++q) {
+      nlohmann::json inputs;
+      const auto a = table.inputs[q].ToArray();
+      for (int i = 0; i < ProcessInputs::kCount; ++i) inputs[kInputColumns[i]] = a[i];
+      nlohmann::json r = {{"inputs", inputs},
+                          {"max_elongation_um", pred[q].mean.max_elongation_um},
+                          {"max_elongation_std_um", pred[q].stddev.max_elongation_um},
+                          {"settle_time_s", pred[q].mean.settle_time_s},
+                          {"settle_time_std_s", pred[q].stddev.settle_time_s},
+                          {"outside_domain", pred[q].outside_domain},
+                          {"outside_domain_fields", pred[q].outside_domain_fields}};
+      if (have_targets) {
+        const double de = pred[q].mean.max_elongation_um - table.targets[q].max_elongation_um;
+        const double dt = pred[q].mean.settle_time_s - table.targets[q].settle_time_s;
+        r["error"] = {{"max_elongation_um", de}, {"settle_time_s", dt}};
+        sq_e += de * de;
+        sq_t += dt * dt;
+      }
+      rows.push_back(r);
+    }
+    nlohmann::json j = {{"model", o.model_path}, {"predictions", rows}, {"outside_domain_count", outside}};
+    if (have_targets) {
+      const double n = static_cast<double>(pred.size());
+      j["rms_error"] = {{"max_elongation_um", std::sqrt(sq_e / n)},
+                        {"settle_time_s", std::sqrt(sq_t / n)}};
+    }
+    PrintJson(j);
+    return;
+  }
+
+  std::printf("%4s %8s %8s %7s %8s %9s | %22s | %18s | %s\n", "row", "HRC", "D [mm]", "P [mm]",
+              "R [mm]", "v [m/min]", "max elongation [um]", "settle time [s]", "domain");
+  double ape_e = 0, ape_t = 0;
+  for (std::size_t q = 0; q < pred.size(); ++q) {
+    const auto& in = table.inputs[q];
+    const auto& p = pred[q];
+    std::printf("%4zu %8.4g %8.4g %7.4g %8.4g %9.4g | %10.5g +- %-8.3g | %8.5g +- %-6.3g | %s\n",
+                q + 1, in.hardness_hrc, in.diameter_mm, in.pitch_mm, in.raceway_radius_mm,
+                in.cutting_speed_m_min, p.mean.max_elongation_um, p.stddev.max_elongation_um,
+                p.mean.settle_time_s, p.stddev.settle_time_s, p.outside_domain ? "OUTSIDE" : "in");
+    if (have_targets) {
+      ape_e += std::abs(p.mean.max_elongation_um - table.targets[q].max_elongation_um) /
+               std::abs(table.targets[q].max_elongation_um);
+      ape_t += std::abs(p.mean.settle_time_s - table.targets[q].settle_time_s) /
+               std::abs(table.targets[q].settle_time_s);
+    }
+  }
+  std::printf("(+- one predictive standard deviation, Laplace approximation)\n");
+  if (have_targets) {
+    const double n = static_cast<double>(pred.size());
+    std::printf("targets in %s: mean absolute error %.3g %% (max elongation), %.3g %% (settle time)\n",
+                o.input_path.c_str(), 100 * ape_e / n, 100 * ape_t / n);
+  }
+  if (!o.out_path.empty()) std::printf("written: %s\n", o.out_path.c_str());
 }
+
+}  // namespace
+
+void RegisterPredict(CLI::App& app) {
+  auto o = std::make_shared<PredictOptions>();
+  o->model_path = ProjectPath("models/default.json");
+  auto* sub = app.add_subcommand(
+      "predict",
+      "Predict the two elongation features of hard whirling - maximum elongation of the\n"
+      "unmachined section [um] and settle time [s] - each with a standard deviation from the\n"
+      "Laplace approximation of the Bayesian network (noise plus weight uncertainty).\n"
+      "Inputs outside the training domain get a warning on stderr and a flag in the output.\n"
+      "Give either --input CSV (columns hardness_hrc, diameter_mm, pitch_mm,\n"
+      "raceway_radius_mm, cutting_speed_m_min; if max_elongation_um and settle_time_s are\n"
+      "present too they are used to report the prediction error) or all five process flags.");
+  sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  auto* input = sub->add_option("--input", o->input_path, "table of processes (CSV)")
+                    ->check(CLI::ExistingFile);
+  auto* h = sub->add_option("--hardness", o->hardness_hrc, "workpiece hardness [HRC]");
+  auto* d = sub->add_option("--diameter", o->diameter_mm, "screw diameter [mm]")
+                ->check(CLI::PositiveNumber);
+  auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm]")
+                ->check(CLI::PositiveNumber);
+  auto* r = sub->add_option("--raceway-radius", o->raceway_radius_mm,
+                            "raceway (ball-groove) radius [mm]")
+                ->check(CLI::PositiveNumber);
+  auto* v = sub->add_option("--cutting-speed", o->cutting_speed_m_min,
+                            "cutting speed of the whirling tools [m/min]")
+                ->check(CLI::PositiveNumber);
+  for (auto* flag : {h, d, p, r, v}) input->excludes(flag);
+  sub->add_option("--out", o->out_path,
+                  "write a CSV: the inputs, max_elongation_um, max_elongation_std_um,\n"
+                  "settle_time_s, settle_time_std_s, outside_domain (0/1)");
+  sub->add_flag("--json", o->json, "machine output: JSON on stdout");
+  sub->callback([o] { Run(*o); });
+}
+
 }  // namespace whirl::cli

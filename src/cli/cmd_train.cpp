@@ -1,9 +1,193 @@
-// Placeholder until its owner writes it; replaced before anything lands.
+// whirl train: fit the Bayesian-regularized network (src/nn/trainbr.h) to a process table, or
+// sweep the hidden size with k-fold cross-validation (src/nn/selection.h).
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <iostream>
+#include <sstream>
+
 #include "cli/commands.h"
+#include "cli/common.h"
+#include "core/csv.h"
 #include "core/error.h"
+#include "core/process.h"
+#include "nn/model.h"
+#include "nn/selection.h"
+
 namespace whirl::cli {
-void RegisterTrain(CLI::App& app) {
-  auto* sub = app.add_subcommand("train", "(being built)");
-  sub->callback([] { throw InputError("'train' is not built yet"); });
+namespace {
+
+struct TrainCliOptions {
+  std::string data_path;
+  std::string out_path;
+  int hidden = 6;
+  std::uint64_t seed = 1;
+  int restarts = 1;
+  int epochs = nn::TrainOptions{}.epochs;
+  std::string hidden_sweep;  // "A..B"
+  int folds = 5;
+  bool json = false;
+};
+
+std::pair<int, int> ParseSweep(const std::string& s) {
+  const auto dots = s.find("..");
+  int a = 0, b = 0;
+  char tail = 0;
+  if (dots == std::string::npos ||
+      std::sscanf(s.substr(0, dots).c_str(), "%d%c", &a, &tail) != 1 ||
+      std::sscanf(s.substr(dots + 2).c_str(), "%d%c", &b, &tail) != 1)
+    throw InputError("--hidden-sweep '" + s + "': expected A..B with integers, e.g. 4..10");
+  if (a < 1 || b < a)
+    throw InputError("--hidden-sweep '" + s + "': need 1 <= A <= B");
+  return {a, b};
 }
+
+std::string Fmt(double x, int digits = 4) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
+}
+
+void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
+  nn::SweepOptions s;
+  std::tie(s.hidden_min, s.hidden_max) = ParseSweep(o.hidden_sweep);
+  s.folds = o.folds;
+  s.seed = o.seed;
+  s.restarts = o.restarts;
+  s.train.epochs = o.epochs;
+  s.Validate(static_cast<int>(table.inputs.size()));
+  Progress progress("hidden sweep", static_cast<std::size_t>((s.hidden_max - s.hidden_min + 1) *
+                                                             (s.folds + 1)));
+  const auto rows = nn::HiddenSweep(table, s, [&](int done, int total) {
+    progress.Update(static_cast<std::size_t>(done), std::to_string(done) + "/" +
+                                                        std::to_string(total) + " fits");
+  });
+  progress.Finish();
+  if (o.json) {
+    PrintJson({{"data", o.data_path},
+               {"samples", table.inputs.size()},
+               {"folds", s.folds},
+               {"seed", s.seed},
+               {"restarts", s.restarts},
+               {"error_space", "normalized"},
+               {"rows", rows}});
+    return;
+  }
+  std::cout << "hidden-size sweep on " << o.data_path << " (" << table.inputs.size()
+            << " rows, " << s.folds << "-fold CV, seed " << s.seed << ", " << s.restarts
+            << " restart(s) per fit)\n";
+  std::cout << "hidden  N   gamma   train_rms_um  train_rms_s  cv_rms_um  cv_rms_s  "
+               "cv_rms_norm  log_evidence\n";
+  for (const auto& r : rows) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%6d %3d %7.2f %13.4g %12.4g %10.4g %9.4g %12.4g %13.5g\n",
+                  r.hidden, r.parameter_count, r.gamma, r.train_rms(0), r.train_rms(1),
+                  r.cv_rms(0), r.cv_rms(1), r.cv_rms_normalized, r.log_evidence);
+    std::cout << line;
+  }
+  std::cout << "Pick the smallest size after which cv_rms_norm stops improving (the paper grew\n"
+               "the hidden layer from 4 until the error stopped improving), then run 'whirl\n"
+               "train --hidden N --out MODEL.json'.\n";
+}
+
+void Run(const TrainCliOptions& o) {
+  const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
+  if (!o.hidden_sweep.empty()) {
+    RunSweep(o, table);
+    return;
+  }
+  if (o.out_path.empty()) throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
+  nn::ModelTrainOptions opt;
+  opt.hidden_sizes = {o.hidden};
+  opt.seed = o.seed;
+  opt.restarts = o.restarts;
+  opt.train.epochs = o.epochs;
+  const std::size_t total = static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
+  Progress progress("train", total);
+  const nn::Model model = nn::TrainModel(
+      table, opt, std::filesystem::path(o.data_path).filename().string(),
+      [&](int restart, const nn::EpochInfo& info) {
+        progress.Update(static_cast<std::size_t>(restart) * std::max(o.epochs, 1) + info.epoch,
+                        "restart " + std::to_string(restart + 1) + "/" +
+                            std::to_string(o.restarts) + " epoch " + std::to_string(info.epoch) +
+                            " F " + Fmt(info.objective) + " gamma " + Fmt(info.gamma));
+      });
+  progress.Finish();
+  nn::SaveModel(o.out_path, model);
+  const auto& s = model.training_summary;
+  if (o.json) {
+    PrintJson({{"model", o.out_path},
+               {"layer_sizes", model.network.layer_sizes},
+               {"seed", model.seed},
+               {"init_seed", model.init_seed},
+               {"restarts", model.restarts},
+               {"restart_runs", model.restart_runs},
+               {"training_summary", s}});
+    return;
+  }
+  std::cout << "model " << o.out_path << ": network 5-" << o.hidden << "-2 (N = "
+            << s.parameter_count << " weights and biases), " << table.inputs.size()
+            << " samples from " << o.data_path << "\n";
+  std::cout << "  " << s.BriefReport() << "\n";
+  std::cout << "  RMS training error: max_elongation " << Fmt(s.rms_error(0)) << " um, settle_time "
+            << Fmt(s.rms_error(1)) << " s (normalized ssE " << Fmt(s.sse) << ")\n";
+  std::cout << "  gamma " << Fmt(s.gamma) << " of " << s.parameter_count << ", alpha "
+            << Fmt(s.alpha) << ", beta " << Fmt(s.beta) << ", sum of squared weights "
+            << Fmt(s.sum_squared_weights) << ", log evidence " << Fmt(s.log_evidence, 6) << "\n";
+  if (model.restarts > 1) {
+    std::cout << "  restarts (best log evidence kept):\n";
+    for (const auto& r : model.restart_runs)
+      std::cout << "    seed " << r.seed << ": log evidence " << Fmt(r.log_evidence, 6)
+                << ", ssE " << Fmt(r.sse) << ", gamma " << Fmt(r.gamma) << ", " << r.epochs
+                << " epochs, " << nn::ToString(r.termination)
+                << (r.seed == model.init_seed ? "  <- kept" : "") << "\n";
+  }
+}
+
+}  // namespace
+
+void RegisterTrain(CLI::App& app) {
+  auto o = std::make_shared<TrainCliOptions>();
+  auto* sub = app.add_subcommand(
+      "train",
+      "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
+      "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
+      "on a process table and write a model file (JSON), or sweep the hidden size.\n"
+      "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
+      "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
+      "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
+      "Progress goes to stderr, results to stdout. Exit code 0 only on success.");
+  sub->add_option("--data", o->data_path, "training table (CSV, see above)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  auto* out = sub->add_option("--out", o->out_path,
+                              "model file to write (JSON, atomically); required unless "
+                              "--hidden-sweep");
+  sub->add_option("--hidden", o->hidden, "tansig neurons in the hidden layer (paper: 6)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 200));
+  sub->add_option("--seed", o->seed,
+                  "seed of the Nguyen-Widrow initialization; restart k uses seed + k")
+      ->capture_default_str();
+  sub->add_option("--restarts", o->restarts,
+                  "train this many networks (seeds seed..seed+K-1) and keep the one with the\n"
+                  "highest log evidence ln P(D|alpha,beta) (MacKay 1992)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  sub->add_option("--epochs", o->epochs, "trainbr epoch limit (MATLAB default 1000)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
+  auto* sweep = sub->add_option(
+      "--hidden-sweep", o->hidden_sweep,
+      "A..B: instead of writing a model, report for each hidden size A..B the training RMS\n"
+      "error (um, s), gamma (effective number of parameters), log evidence and k-fold\n"
+      "cross-validation RMS error, so the size can be picked as in the paper");
+  sub->add_option("--folds", o->folds, "k of k-fold cross-validation for --hidden-sweep")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 1000));
+  sub->add_flag("--json", o->json, "machine output: JSON summary on stdout");
+  out->excludes(sweep);
+  sub->callback([o] { Run(*o); });
+}
+
 }  // namespace whirl::cli

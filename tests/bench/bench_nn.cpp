@@ -1,0 +1,68 @@
+// nn hot paths: one full trainbr fit of 5-6-2 on 20 samples x 2 outputs to the default stopping
+// rule, one epoch, and batch prediction with Laplace standard deviations.
+// Reference point: R's brnn needs 20-35 ms for one single-output fit of this size.
+#include <benchmark/benchmark.h>
+
+#include "../nn/synthetic.h"
+#include "nn/model.h"
+#include "nn/trainbr.h"
+
+namespace {
+
+using namespace whirl::nn;
+
+Network Initial(std::uint64_t seed) {
+  Network net = Network::Zeros({5, 6, 2});
+  InitNguyenWidrow(seed, &net);
+  return net;
+}
+
+// Full fit; the data and initial weights vary with the iteration so the median covers typical
+// runs, not one lucky one. Counter "epochs" = mean epochs per fit.
+void BM_FullFit_5_6_2_20Samples(benchmark::State& state) {
+  std::vector<TrainingData> data;
+  std::vector<Network> nets;
+  for (int s = 0; s < 16; ++s) {
+    data.push_back(synth::SmoothProblem(20, 0.05, 1 + s));
+    nets.push_back(Initial(100 + s));
+  }
+  std::size_t i = 0;
+  double epochs = 0;
+  for (auto _ : state) {
+    const TrainResult r = TrainBr(data[i % 16], nets[i % 16], TrainOptions{});
+    benchmark::DoNotOptimize(r.summary.sse);
+    epochs += r.summary.epochs;
+    ++i;
+  }
+  state.counters["epochs"] = benchmark::Counter(epochs / static_cast<double>(i));
+}
+BENCHMARK(BM_FullFit_5_6_2_20Samples)->Unit(benchmark::kMillisecond);
+
+void BM_OneEpoch_5_6_2_20Samples(benchmark::State& state) {
+  const TrainingData data = synth::SmoothProblem(20, 0.05, 1);
+  const Network net = Initial(1);
+  TrainOptions one;
+  one.epochs = 1;
+  for (auto _ : state) {
+    const TrainResult r = TrainBr(data, net, one);
+    benchmark::DoNotOptimize(r.summary.sse);
+  }
+}
+BENCHMARK(BM_OneEpoch_5_6_2_20Samples)->Unit(benchmark::kMicrosecond);
+
+void BM_PredictBatch(benchmark::State& state) {
+  const whirl::ProcessTable table = synth::SyntheticProcessTable(20, 0.05, 5);
+  const Model model = TrainModel(table, ModelTrainOptions{}, "synthetic");
+  const whirl::ProcessTable queries =
+      synth::SyntheticProcessTable(static_cast<int>(state.range(0)), 0.0, 6);
+  for (auto _ : state) {
+    const auto p = PredictBatch(model, queries.inputs);
+    benchmark::DoNotOptimize(p.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_PredictBatch)->Arg(1)->Arg(100)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
