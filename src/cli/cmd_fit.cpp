@@ -1,9 +1,204 @@
-// Placeholder until its owner writes it; replaced before anything lands.
+// whirl fit: features and fitted curve parameters of a measured (or simulated) elongation curve,
+// and the model comparison / shape calibration over simulated curves (src/fit/curve_fit.h,
+// src/fit/simulated_fits.h).
+#include <cstdio>
+#include <memory>
+#include <string>
+
 #include "cli/commands.h"
+#include "cli/common.h"
+#include "core/curve.h"
 #include "core/error.h"
+#include "fit/curve_fit.h"
+#include "fit/simulated_fits.h"
+#include "sim/features.h"
+
 namespace whirl::cli {
-void RegisterFit(CLI::App& app) {
-  auto* sub = app.add_subcommand("fit", "(being built)");
-  sub->callback([] { throw InputError("'fit' is not built yet"); });
+namespace {
+
+struct FitOptions {
+  std::string curve_path;
+  int simulated = 0;
+  std::uint64_t seed = 1;
+  double window_s = 1800.0;
+  bool disturbances = false;
+  double max_gap_factor = 5.0;
+  bool json = false;
+};
+
+nlohmann::json FitJson(const fit::CurveFit& f) {
+  nlohmann::json params;
+  for (std::size_t i = 0; i < f.parameter_names.size(); ++i)
+    params[f.parameter_names[i]] = f.parameters[static_cast<Eigen::Index>(i)];
+  return {{"model", fit::ToString(f.model)},
+          {"parameters", params},
+          {"r_squared", f.r_squared},
+          {"rms_residual_um", f.rms_residual_um},
+          {"max_abs_residual_um", f.max_abs_residual_um},
+          {"samples", f.samples},
+          {"converged", f.summary.Converged()},
+          {"termination", fit::ToString(f.summary.termination)},
+          {"lm", f.summary.BriefReport()}};
 }
+
+void RunCurve(const FitOptions& o) {
+  const ElongationCurve curve = ReadElongationCurve(o.curve_path, o.max_gap_factor);
+  const sim::SettleAnalysis settle = sim::AnalyzeSettle(curve);
+  const std::vector<fit::CurveFit> fits = fit::FitAllModels(curve);
+  const fit::ShapeFit shape = fit::FitShapeK(curve, settle.features);
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < fits.size(); ++i)
+    if (fits[i].rms_residual_um < fits[best].rms_residual_um) best = i;
+  for (const auto& f : fits)
+    if (!f.summary.Converged())
+      Warn(fit::ToString(f.model) + " fit did not converge: " + f.summary.BriefReport());
+  if (!settle.settled_before_tail)
+    Warn("the curve does not settle before its tail window: the settle time is unreliable (" +
+         settle.message + ")");
+
+  if (o.json) {
+    nlohmann::json models = nlohmann::json::array();
+    for (const auto& f : fits) models.push_back(FitJson(f));
+    PrintJson({{"schema", "whirl.fit"},
+               {"schema_version", 1},
+               {"curve", o.curve_path},
+               {"samples", curve.size()},
+               {"features",
+                {{"max_elongation_um", settle.features.max_elongation_um},
+                 {"settle_time_s", settle.features.settle_time_s},
+                 {"settled_before_tail", settle.settled_before_tail},
+                 {"noise_std_um", settle.noise_std_um},
+                 {"criterion", settle.message}}},
+               {"shape_k_with_features_fixed",
+                {{"shape_k", shape.shape_k},
+                 {"r_squared", shape.r_squared},
+                 {"rms_residual_um", shape.rms_residual_um}}},
+               {"models", models},
+               {"best_model", fit::ToString(fits[best].model)}});
+    return;
+  }
+  std::printf("curve %s: %zu samples, %.6g to %.6g s\n", o.curve_path.c_str(), curve.size(),
+              curve.time_s.front(), curve.time_s.back());
+  std::printf("features: max elongation %.4f um, settle time %.2f s (sim::AnalyzeSettle)\n",
+              settle.features.max_elongation_um, settle.features.settle_time_s);
+  std::printf("arctan shape with these features fixed: k = %.4f (R^2 %.6f, RMS %.4f um)\n",
+              shape.shape_k, shape.r_squared, shape.rms_residual_um);
+  std::printf("%-9s %-58s %10s %12s\n", "model", "parameters (all free)", "R^2", "RMS [um]");
+  for (const auto& f : fits) {
+    std::string params;
+    for (std::size_t i = 0; i < f.parameter_names.size(); ++i) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s=%.5g", i ? " " : "", f.parameter_names[i].c_str(),
+                    f.parameters[static_cast<Eigen::Index>(i)]);
+      params += buf;
+    }
+    std::printf("%-9s %-58s %10.6f %12.4f%s\n", fit::ToString(f.model).c_str(), params.c_str(),
+                f.r_squared, f.rms_residual_um, f.summary.Converged() ? "" : " (not converged)");
+  }
+  std::printf("best fit (smallest RMS residual): %s\n", fit::ToString(fits[best].model).c_str());
+}
+
+void RunSimulated(const FitOptions& o) {
+  fit::SimulatedFitOptions so;
+  so.count = o.simulated;
+  so.seed = o.seed;
+  so.window_s = o.window_s;
+  so.disturbances = o.disturbances;
+  Progress progress("simulating and fitting", static_cast<std::size_t>(o.simulated));
+  const fit::SimulatedFitReport r =
+      fit::FitSimulatedCurves(so, [&](std::size_t d, std::size_t) { progress.Update(d); });
+  progress.Finish();
+  if (o.json) {
+    nlohmann::json models = nlohmann::json::array();
+    for (const auto& m : r.models)
+      models.push_back({{"model", fit::ToString(m.model)},
+                        {"median_r_squared", m.median_r_squared},
+                        {"median_rms_residual_um", m.median_rms_residual_um},
+                        {"worst_rms_residual_um", m.worst_rms_residual_um},
+                        {"best_count", m.best_count},
+                        {"converged_count", m.converged_count}});
+    nlohmann::json ks = nlohmann::json::array();
+    for (const auto& f : r.shape.fits) ks.push_back(f.shape_k);
+    PrintJson({{"schema", "whirl.fit_simulated"},
+               {"schema_version", 1},
+               {"curves", o.simulated},
+               {"seed", o.seed},
+               {"window_s", o.window_s},
+               {"disturbances", o.disturbances},
+               {"shape_k",
+                {{"median", r.shape.median_shape_k},
+                 {"min", r.shape.min_shape_k},
+                 {"max", r.shape.max_shape_k},
+                 {"median_r_squared", r.shape.median_r_squared},
+                 {"per_curve", ks},
+                 {"default_in_library", fit::kDefaultShapeK}}},
+               {"models", models},
+               {"best_model", fit::ToString(r.best_model)}});
+    return;
+  }
+  std::printf("%d simulated curves (seed %llu, %.0f s each, disturbances %s)\n", o.simulated,
+              static_cast<unsigned long long>(o.seed), o.window_s, o.disturbances ? "on" : "off");
+  std::printf(
+      "arctan shape k with the simulator's features fixed: median %.4f (min %.4f, max "
+      "%.4f, median R^2 %.6f); library default kDefaultShapeK = %.4f\n",
+      r.shape.median_shape_k, r.shape.min_shape_k, r.shape.max_shape_k, r.shape.median_r_squared,
+      fit::kDefaultShapeK);
+  std::printf("%-9s %14s %20s %18s %6s %10s\n", "model", "median R^2", "median RMS [um]",
+              "worst RMS [um]", "best", "converged");
+  for (const auto& m : r.models)
+    std::printf("%-9s %14.6f %20.4f %18.4f %6d %10d\n", fit::ToString(m.model).c_str(),
+                m.median_r_squared, m.median_rms_residual_um, m.worst_rms_residual_um, m.best_count,
+                m.converged_count);
+  std::printf("best model (smallest median RMS residual): %s\n",
+              fit::ToString(r.best_model).c_str());
+}
+
+}  // namespace
+
+void RegisterFit(CLI::App& app) {
+  auto o = std::make_shared<FitOptions>();
+  auto* sub = app.add_subcommand(
+      "fit",
+      "Fit elongation-curve models to a measured or simulated curve and report its features.\n"
+      "  --curve C.csv   columns time_s [s], elongation_um [um] ('#' comments allowed; gaps and\n"
+      "                  non-increasing time are errors). Reports the features (max elongation\n"
+      "                  [um], settle time [s]; sim::AnalyzeSettle criterion), the arctan shape k\n"
+      "                  with those features fixed, and three models with all parameters free:\n"
+      "                    arctan   l = L atan(k t/t_s)/atan(k) up to t_s, L after\n"
+      "                    parabola l = b t + (L - b t_s)(t/t_s)^2 up to t_s, L after\n"
+      "                    sine     l = L sin(pi t/(2 t_s)) up to t_s, L after\n"
+      "                  each with R^2 and RMS residual [um] (LM least squares).\n"
+      "  --simulated N   simulate N curves over the paper's training ranges, fit k with the\n"
+      "                  simulator's features fixed (median = how kDefaultShapeK is derived) and\n"
+      "                  compare the three models (median R^2 / RMS, how often each is best).");
+  auto* curve =
+      sub->add_option("--curve", o->curve_path, "measured curve (CSV)")->check(CLI::ExistingFile);
+  auto* simulated = sub->add_option("--simulated", o->simulated,
+                                    "number of simulated curves to fit (model comparison and "
+                                    "shape calibration)")
+                        ->check(CLI::Range(1, 1000));
+  curve->excludes(simulated);
+  sub->add_option("--seed", o->seed, "seed of the design points and disturbances (--simulated)")
+      ->capture_default_str();
+  sub->add_option("--window-s", o->window_s, "simulated time per curve [s] (--simulated)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--disturbances", o->disturbances,
+                "add the simulator's disturbances: noise, drift, per-workpiece variation "
+                "(--simulated)");
+  sub->add_option("--max-gap-factor", o->max_gap_factor,
+                  "a time step larger than this times the median step is a gap (error) [-]")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e6));
+  sub->add_flag("--json", o->json, "machine output: JSON on stdout");
+  sub->callback([o] {
+    if (o->curve_path.empty() && o->simulated == 0)
+      throw InputError("fit: give --curve C.csv or --simulated N");
+    if (!o->curve_path.empty())
+      RunCurve(*o);
+    else
+      RunSimulated(*o);
+  });
+}
+
 }  // namespace whirl::cli

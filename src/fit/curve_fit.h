@@ -31,12 +31,14 @@ inline constexpr CurveModel kAllCurveModels[] = {CurveModel::kArctan, CurveModel
 struct CurveFitOptions {
   /// LM settings; bounds are set by the fitter (L in [0, 10 max|l| + 1], t_s within the recorded
   /// time span, k in [kMinShapeK, kMaxShapeK], b >= 0).
-  /// The iteration limit is raised to 2000: the settle time is a kink of every model, so the cost
-  /// is only piecewise smooth in t_s (a kink wherever t_s crosses a sample) and LM can need many
-  /// short steps to cross them (each iteration costs O(samples)).
+  /// The iteration limit is raised to 2000 and the relative cost-decrease tolerance to 1e-9: the
+  /// settle time is a kink of every model, so the cost is only piecewise smooth in t_s (a kink
+  /// wherever t_s crosses a sample); a model whose best t_s sits on a kink (the parabola, often)
+  /// otherwise creeps along it with ever smaller accepted steps.
   LmOptions lm = [] {
     LmOptions o;
     o.max_iterations = 2000;
+    o.cost_tolerance = 1e-9;
     return o;
   }();
   /// Start value of k for the arctan fit (the start of L and t_s comes from the data: L0 = largest
