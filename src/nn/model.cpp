@@ -24,26 +24,29 @@ double RequireFinite(const json& v, const std::string& where) {
   return x;
 }
 
-Eigen::VectorXd ReadVector(const json& v, const std::string& where, Eigen::Index expected) {
+// `path` is the key path inside the model file, e.g. "layers[0].weights"; messages quote it.
+Eigen::VectorXd ReadVector(const json& v, const std::string& path, Eigen::Index expected) {
+  const std::string where = "model '" + path + "'";
   if (!v.is_array()) throw InputError(where + " must be an array of numbers, got " + v.dump());
   if (expected >= 0 && static_cast<Eigen::Index>(v.size()) != expected)
     throw InputError(where + " has " + std::to_string(v.size()) + " entries, expected " +
                      std::to_string(expected));
   Eigen::VectorXd out(v.size());
   for (std::size_t i = 0; i < v.size(); ++i)
-    out(i) = RequireFinite(v[i], where + "[" + std::to_string(i) + "]");
+    out(i) = RequireFinite(v[i], "model '" + path + "[" + std::to_string(i) + "]'");
   return out;
 }
 
-Eigen::MatrixXd ReadMatrix(const json& v, const std::string& where, Eigen::Index rows,
+Eigen::MatrixXd ReadMatrix(const json& v, const std::string& path, Eigen::Index rows,
                            Eigen::Index cols) {
+  const std::string where = "model '" + path + "'";
   if (!v.is_array()) throw InputError(where + " must be an array of rows, got " + v.dump());
   if (static_cast<Eigen::Index>(v.size()) != rows)
     throw InputError(where + " has " + std::to_string(v.size()) + " rows, expected " +
                      std::to_string(rows));
   Eigen::MatrixXd m(rows, cols);
   for (Eigen::Index r = 0; r < rows; ++r)
-    m.row(r) = ReadVector(v[r], where + "[" + std::to_string(r) + "]", cols).transpose();
+    m.row(r) = ReadVector(v[r], path + "[" + std::to_string(r) + "]", cols).transpose();
   return m;
 }
 
@@ -63,8 +66,8 @@ MapMinMax ReadScaling(const json& j, const std::string& key, Eigen::Index size) 
   const json& s = Require(j, key, "model");
   RejectUnknownKeys(s, {"min", "max"}, "model '" + key + "'");
   MapMinMax m;
-  m.xmin = ReadVector(Require(s, "min", "model '" + key + "'"), "model '" + key + ".min'", size);
-  m.xmax = ReadVector(Require(s, "max", "model '" + key + "'"), "model '" + key + ".max'", size);
+  m.xmin = ReadVector(Require(s, "min", "model '" + key + "'"), key + ".min", size);
+  m.xmax = ReadVector(Require(s, "max", "model '" + key + "'"), key + ".max", size);
   m.Validate(("model '" + key + "'").c_str());
   return m;
 }
@@ -249,16 +252,17 @@ void from_json(const nlohmann::json& j, Model& m) {
     throw InputError("model 'layers' must be an array of " + std::to_string(layer_sizes.size() - 1) +
                      " layers (one fewer than layer_sizes)");
   for (std::size_t l = 0; l < layers.size(); ++l) {
-    const std::string where = "model 'layers[" + std::to_string(l) + "]'";
+    const std::string prefix = "model 'layers[" + std::to_string(l) + "]";
+    const std::string where = prefix + "'";
     RejectUnknownKeys(layers[l], {"weights", "biases", "transfer"}, where);
     const std::string transfer = l + 1 < layers.size() ? "tansig" : "purelin";
     const json& t = Require(layers[l], "transfer", where);
     if (!t.is_string() || t.get<std::string>() != transfer)
-      throw InputError(where + ".transfer is " + t.dump() + ", expected \"" + transfer + "\"");
-    m.network.weights[l] = ReadMatrix(Require(layers[l], "weights", where), where + ".weights",
+      throw InputError(prefix + ".transfer' is " + t.dump() + ", expected \"" + transfer + "\"");
+    m.network.weights[l] = ReadMatrix(Require(layers[l], "weights", where), "layers[" + std::to_string(l) + "].weights",
                                       layer_sizes[l + 1], layer_sizes[l]);
     m.network.biases[l] =
-        ReadVector(Require(layers[l], "biases", where), where + ".biases", layer_sizes[l + 1]);
+        ReadVector(Require(layers[l], "biases", where), "layers[" + std::to_string(l) + "].biases", layer_sizes[l + 1]);
   }
   m.input_scaling = ReadScaling(j, "input_scaling", layer_sizes.front());
   m.target_scaling = ReadScaling(j, "target_scaling", layer_sizes.back());
@@ -318,7 +322,7 @@ void from_json(const nlohmann::json& j, Model& m) {
   const int N = m.network.ParameterCount();
   m.posterior_covariance =
       ReadMatrix(Require(u, "posterior_covariance", "model 'uncertainty'"),
-                 "model 'uncertainty.posterior_covariance'", N, N);
+                 "uncertainty.posterior_covariance", N, N);
   m.Validate();
 }
 

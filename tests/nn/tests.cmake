@@ -2,4 +2,5 @@
 whirl_add_gtest(test_nn SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_network.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_trainbr.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_model.cpp
   LABELS nn)

@@ -1,0 +1,241 @@
+// Model file and prediction: determinism, round trip, Laplace standard deviation against an
+// independent finite-difference computation, domain flags, every kind of bad model file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/json_file.h"
+#include "nn/model.h"
+#include "nn/selection.h"
+#include "support/eigen_near.h"
+#include "synthetic.h"
+
+namespace whirl::nn {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path Scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("whirl_nn_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+const Model& SharedModel() {
+  static const Model m = [] {
+    ModelTrainOptions o;
+    o.restarts = 2;
+    o.seed = 5;
+    return TrainModel(synth::SyntheticProcessTable(20, 0.05, 1), o, "synthetic.csv");
+  }();
+  return m;
+}
+
+TEST(Model, SameSeedGivesByteIdenticalFileAndDifferentSeedDoesNot) {
+  const ProcessTable table = synth::SyntheticProcessTable(20, 0.05, 2);
+  ModelTrainOptions o;
+  o.restarts = 3;
+  o.seed = 7;
+  SaveModel(Scratch("a.json"), TrainModel(table, o, "t.csv"));
+  SaveModel(Scratch("b.json"), TrainModel(table, o, "t.csv"));
+  o.seed = 8;
+  SaveModel(Scratch("c.json"), TrainModel(table, o, "t.csv"));
+  const std::string a = ReadTextFile(Scratch("a.json"));
+  EXPECT_EQ(a, ReadTextFile(Scratch("b.json")));
+  EXPECT_NE(a, ReadTextFile(Scratch("c.json")));
+}
+
+TEST(Model, SaveLoadRoundTripPredictsBitIdentically) {
+  const Model& m = SharedModel();
+  SaveModel(Scratch("rt.json"), m);
+  const Model back = LoadModel(Scratch("rt.json"));
+  const ProcessTable queries = synth::SyntheticProcessTable(50, 0.0, 77);
+  const auto p1 = PredictBatch(m, queries.inputs);
+  const auto p2 = PredictBatch(back, queries.inputs);
+  for (std::size_t q = 0; q < p1.size(); ++q) {
+    EXPECT_EQ(p1[q].mean.max_elongation_um, p2[q].mean.max_elongation_um);
+    EXPECT_EQ(p1[q].mean.settle_time_s, p2[q].mean.settle_time_s);
+    EXPECT_EQ(p1[q].stddev.max_elongation_um, p2[q].stddev.max_elongation_um);
+    EXPECT_EQ(p1[q].stddev.settle_time_s, p2[q].stddev.settle_time_s);
+  }
+  SaveModel(Scratch("rt2.json"), back);
+  EXPECT_EQ(ReadTextFile(Scratch("rt.json")), ReadTextFile(Scratch("rt2.json")));
+  const auto j = ReadJsonFile(Scratch("rt.json"));
+  EXPECT_EQ(j.at("error_space"), "normalized");
+  EXPECT_EQ(j.at("layer_sizes"), nlohmann::json({5, 6, 2}));
+  EXPECT_EQ(j.at("schema_version"), Model::kSchemaVersion);
+}
+
+TEST(Model, PredictMatchesScalingAndLaplaceFormulaByFiniteDifferences) {
+  const Model& m = SharedModel();
+  const ProcessTable queries = synth::SyntheticProcessTable(10, 0.0, 5);
+  const auto preds = PredictBatch(m, queries.inputs);
+  const Eigen::VectorXd half = m.target_scaling.HalfRange();
+  for (std::size_t q = 0; q < preds.size(); ++q) {
+    const Eigen::VectorXd x = m.input_scaling.Apply(InputMatrix({queries.inputs[q]}));
+    const Eigen::VectorXd y = m.network.Forward(x);
+    // mean: network output mapped back by mapminmax
+    const Eigen::VectorXd mean = m.target_scaling.Reverse(y);
+    EXPECT_NEAR(preds[q].mean.max_elongation_um, mean(0), 1e-12 * std::abs(mean(0)));
+    EXPECT_NEAR(preds[q].mean.settle_time_s, mean(1), 1e-12 * std::abs(mean(1)));
+    // g = dy/dw by central differences, var = sigma^2 + g' A^-1 g, std scaled by half range
+    const Eigen::VectorXd w = m.network.GetParameters();
+    Eigen::MatrixXd g(2, w.size());
+    for (int i = 0; i < w.size(); ++i) {
+      Network plus = m.network, minus = m.network;
+      Eigen::VectorXd wp = w, wm = w;
+      const double h = 1e-6 * std::max(1.0, std::abs(w(i)));
+      wp(i) += h;
+      wm(i) -= h;
+      plus.SetParameters(wp);
+      minus.SetParameters(wm);
+      g.col(i) = (plus.Forward(x) - minus.Forward(x)) / (2 * h);
+    }
+    for (int k = 0; k < 2; ++k) {
+      const double var = m.noise_variance + g.row(k) * m.posterior_covariance * g.row(k).transpose();
+      const double sd = std::sqrt(var) * half(k);
+      const double got = k == 0 ? preds[q].stddev.max_elongation_um : preds[q].stddev.settle_time_s;
+      EXPECT_NEAR(got, sd, 1e-6 * sd);
+      const double noise = k == 0 ? preds[q].noise_stddev.max_elongation_um
+                                  : preds[q].noise_stddev.settle_time_s;
+      EXPECT_GE(got, noise);  // weight uncertainty only adds
+      EXPECT_NEAR(noise, std::sqrt(m.noise_variance) * half(k), 1e-12 * noise);
+    }
+  }
+}
+
+TEST(Model, UncertaintyGrowsFarOutsideTheTrainingDomainAndIsFlagged) {
+  const Model& m = SharedModel();
+  ProcessInputs inside;
+  inside.hardness_hrc = 0.5 * (m.domain_min(0) + m.domain_max(0));
+  inside.diameter_mm = 0.5 * (m.domain_min(1) + m.domain_max(1));
+  inside.pitch_mm = 0.5 * (m.domain_min(2) + m.domain_max(2));
+  inside.raceway_radius_mm = 0.5 * (m.domain_min(3) + m.domain_max(3));
+  inside.cutting_speed_m_min = 0.5 * (m.domain_min(4) + m.domain_max(4));
+  const Prediction pin = Predict(m, inside);
+  EXPECT_FALSE(pin.outside_domain);
+  EXPECT_TRUE(pin.outside_domain_fields.empty());
+  ProcessInputs far = inside;
+  far.diameter_mm = m.domain_max(1) + 10 * (m.domain_max(1) - m.domain_min(1));
+  far.cutting_speed_m_min = m.domain_min(4) - 1;
+  const Prediction pfar = Predict(m, far);
+  EXPECT_TRUE(pfar.outside_domain);
+  EXPECT_EQ(pfar.outside_domain_fields,
+            (std::vector<std::string>{"diameter_mm", "cutting_speed_m_min"}));
+  EXPECT_GT(pfar.stddev.max_elongation_um, pin.stddev.max_elongation_um);
+  // Training-domain bounds are inclusive.
+  ProcessInputs edge = inside;
+  edge.pitch_mm = m.domain_max(2);
+  EXPECT_FALSE(Predict(m, edge).outside_domain);
+}
+
+TEST(Model, TrainModelRejectsTablesWithoutTargetsOrRows) {
+  ProcessTable t = synth::SyntheticProcessTable(20, 0.05, 1);
+  t.targets.clear();
+  EXPECT_THROW(TrainModel(t, ModelTrainOptions{}, "x"), InputError);
+  t = synth::SyntheticProcessTable(1, 0.05, 1);
+  EXPECT_THROW(TrainModel(t, ModelTrainOptions{}, "x"), InputError);
+  t = synth::SyntheticProcessTable(20, 0.05, 1);
+  ModelTrainOptions o;
+  o.restarts = 0;
+  EXPECT_THROW(TrainModel(t, o, "x"), InputError);
+}
+
+// Each corruption must be rejected with a message that names the key.
+TEST(Model, LoadRejectsWrongTruncatedOrInconsistentFiles) {
+  SaveModel(Scratch("good.json"), SharedModel());
+  const std::string text = ReadTextFile(Scratch("good.json"));
+  const nlohmann::json good = nlohmann::json::parse(text);
+  struct Case {
+    std::string name;
+    std::function<void(nlohmann::json&)> corrupt;
+    std::string expect;  // substring of the message
+  };
+  const std::vector<Case> cases = {
+      {"schema version", [](auto& j) { j["schema_version"] = 99; }, "schema_version"},
+      {"format", [](auto& j) { j["format"] = "other"; }, "format"},
+      {"missing layers", [](auto& j) { j.erase("layers"); }, "layers"},
+      {"layer sizes", [](auto& j) { j["layer_sizes"] = {5, 7, 2}; }, "layers[0].weights"},
+      {"wrong input count", [](auto& j) { j["layer_sizes"][0] = 4; }, "layers[0].weights"},
+      {"bias count", [](auto& j) { j["layers"][1]["biases"].push_back(1.0); }, "layers[1].biases"},
+      {"non-number weight", [](auto& j) { j["layers"][0]["weights"][2][1] = "nan"; },
+       "layers[0].weights[2][1]"},
+      {"null weight", [](auto& j) { j["layers"][0]["biases"][0] = nullptr; }, "layers[0].biases[0]"},
+      {"scaling size", [](auto& j) { j["input_scaling"]["min"].erase(0); }, "input_scaling.min"},
+      {"scaling order", [](auto& j) { j["target_scaling"]["min"][0] = 1e9; }, "target_scaling"},
+      {"input name", [](auto& j) { j["inputs"][1]["name"] = "diameter_in"; }, "inputs[1]"},
+      {"output unit", [](auto& j) { j["outputs"][1]["unit"] = "min"; }, "outputs[1]"},
+      {"domain", [](auto& j) { j["training_domain"].erase("pitch_mm"); }, "training_domain"},
+      {"unknown key", [](auto& j) { j["extra"] = 1; }, "extra"},
+      {"error space", [](auto& j) { j["error_space"] = "original"; }, "error_space"},
+      {"covariance size", [](auto& j) { j["uncertainty"]["posterior_covariance"].erase(0); },
+       "posterior_covariance"},
+      {"covariance symmetry",
+       [](auto& j) { j["uncertainty"]["posterior_covariance"][0][1] = 12345.0; },
+       "posterior_covariance"},
+      {"noise", [](auto& j) { j["uncertainty"]["noise_variance_normalized"] = -1.0; },
+       "noise_variance"},
+      {"summary", [](auto& j) { j["training_summary"].erase("gamma"); }, "gamma"},
+      {"seed", [](auto& j) { j["seed"] = -3; }, "seed"},
+  };
+  for (const auto& c : cases) {
+    nlohmann::json j = good;
+    c.corrupt(j);
+    WriteFileAtomic(Scratch("bad.json"), j.dump(1));
+    try {
+      LoadModel(Scratch("bad.json"));
+      ADD_FAILURE() << c.name << ": accepted";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(c.expect), std::string::npos) << c.name << ": " << msg;
+      EXPECT_NE(msg.find("bad.json"), std::string::npos) << c.name << ": " << msg;
+    }
+  }
+  // Truncated file (a partial write): a JSON error naming the file.
+  WriteFileAtomic(Scratch("trunc.json"), text.substr(0, text.size() / 2));
+  try {
+    LoadModel(Scratch("trunc.json"));
+    ADD_FAILURE() << "truncated file accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("trunc.json"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(LoadModel(Scratch("does_not_exist.json")), InputError);
+}
+
+TEST(HiddenSweep, ReportsEveryHiddenSizeWithConsistentNumbers) {
+  const ProcessTable t = synth::SyntheticProcessTable(20, 0.05, 3);
+  SweepOptions o;
+  o.hidden_min = 2;
+  o.hidden_max = 4;
+  o.folds = 4;
+  int last = 0;
+  const auto rows = HiddenSweep(t, o, [&](int done, int total) {
+    EXPECT_EQ(done, last + 1);
+    EXPECT_EQ(total, 3 * 5);
+    last = done;
+  });
+  ASSERT_EQ(rows.size(), 3u);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const int h = 2 + static_cast<int>(i);
+    EXPECT_EQ(rows[i].hidden, h);
+    EXPECT_EQ(rows[i].parameter_count, h * 6 + 2 * (h + 1));
+    EXPECT_GT(rows[i].gamma, 0);
+    EXPECT_LE(rows[i].gamma, rows[i].parameter_count);
+    EXPECT_TRUE(rows[i].cv_rms.allFinite());
+    EXPECT_TRUE(std::isfinite(rows[i].log_evidence));
+    // Held-out error is not below the training error of the same size on average.
+    EXPECT_GT(rows[i].cv_rms.sum(), 0.0);
+  }
+  EXPECT_EQ(last, 15);
+  o.folds = 1;
+  EXPECT_THROW(HiddenSweep(t, o), InputError);
+  o.folds = 21;
+  EXPECT_THROW(HiddenSweep(t, o), InputError);
+}
+
+}  // namespace
+}  // namespace whirl::nn
