@@ -1,1 +1,0 @@
-// Temporary empty unit so the target configures; the torch owner replaces it.
