@@ -1,0 +1,227 @@
+#include "compare/compare.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+#include "sim/dataset.h"
+#include "sim/features.h"
+
+namespace whirl::compare {
+
+std::string ToString(Strategy s) {
+  switch (s) {
+    case Strategy::kNone:
+      return "none";
+    case Strategy::kTraditional:
+      return "traditional";
+    case Strategy::kModel:
+      return "model";
+  }
+  return "none";
+}
+
+namespace {
+
+std::optional<double> Reduce(double value, double baseline) {
+  if (std::abs(baseline) == 0) return std::nullopt;
+  return 100.0 * (1.0 - std::abs(value) / std::abs(baseline));
+}
+
+nlohmann::json Optional(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json();
+}
+
+std::string Fixed(double x, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+  return buf;
+}
+
+}  // namespace
+
+MetricReductions Reductions(const LeadMetrics& s, const LeadMetrics& b) {
+  MetricReductions r;
+  r.e_a_pct = Reduce(s.e_a_um, b.e_a_um);
+  r.v_u_pct = Reduce(s.v_u_um, b.v_u_um);
+  r.v_300_pct = Reduce(s.v_300_um, b.v_300_um);
+  if (s.v_2pi_um && b.v_2pi_um) r.v_2pi_pct = Reduce(*s.v_2pi_um, *b.v_2pi_um);
+  r.accumulated_1000_pct = Reduce(s.accumulated_1000_um, b.accumulated_1000_um);
+  r.accumulated_total_pct = Reduce(s.accumulated_total_um, b.accumulated_total_um);
+  return r;
+}
+
+const StrategyOutcome& ScrewComparison::Outcome(Strategy s) const {
+  return outcomes[static_cast<std::size_t>(s)];
+}
+
+std::string ScrewComparison::BriefReport() const {
+  const auto& n = Outcome(Strategy::kNone).metrics;
+  const auto& t = Outcome(Strategy::kTraditional).metrics;
+  const auto& m = Outcome(Strategy::kModel).metrics;
+  std::string s = screw.name + ": accumulated within 1000 mm none " +
+                  Fixed(n.accumulated_1000_um, 1) + " / traditional " +
+                  Fixed(t.accumulated_1000_um, 1) + " / model " + Fixed(m.accumulated_1000_um, 1) +
+                  " um";
+  if (model_vs_traditional.accumulated_1000_pct)
+    s += " (" + Fixed(*model_vs_traditional.accumulated_1000_pct, 1) + " % less than traditional)";
+  s += ", whole thread " + Fixed(n.accumulated_total_um, 1) + " / " +
+       Fixed(t.accumulated_total_um, 1) + " / " + Fixed(m.accumulated_total_um, 1) + " um";
+  s += ", ISO class " + ToString(Outcome(Strategy::kNone).iso.reached) + " / " +
+       ToString(Outcome(Strategy::kTraditional).iso.reached) + " / " +
+       ToString(Outcome(Strategy::kModel).iso.reached);
+  return s;
+}
+
+sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
+                           const std::string& name) {
+  sim::Screw s = base;
+  s.process = inputs;
+  s.name = name;
+  return s;
+}
+
+ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
+                             const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+                             const CompareOptions& options) {
+  ScrewComparison c;
+  c.screw = screw;
+  c.kinematics = sim::ComputeKinematics(screw);  // validates; InputError if infeasible
+  c.seed = options.seed;
+  c.disturbances_on = options.disturbances_on;
+
+  // Truth: the whole thread, disturbances on.
+  sim::SimOptions sim_options = options.sim;
+  sim_options.duration_s = 0.0;
+  sim::DisturbanceOptions disturbance = options.disturbance;
+  disturbance.enabled = options.disturbances_on;
+  disturbance.seed = options.seed;
+  const sim::SimulationResult sim = sim::Simulate(screw, sim_options, disturbance);
+  c.disturbances = sim.disturbances;
+  c.truth.time_s = sim.curve.time_s;
+  c.truth.elongation_um = sim.elongation_noise_free_um.size() == sim.curve.size()
+                              ? sim.elongation_noise_free_um
+                              : sim.curve.elongation_um;
+  // Features as the training table measures them: the recorded curve over the dataset's window
+  // (sim::DatasetOptions::window_s), not over the whole thread, whose tail is no plateau.
+  const double window_s = sim::DatasetOptions{}.window_s;
+  ElongationCurve recorded;
+  for (std::size_t i = 0; i < sim.curve.size() && sim.curve.time_s[i] <= window_s; ++i) {
+    recorded.time_s.push_back(sim.curve.time_s[i]);
+    recorded.elongation_um.push_back(sim.curve.elongation_um[i]);
+  }
+  c.truth_features = recorded.size() >= 10 && sim.curve.time_s.back() >= window_s
+                         ? sim::ExtractFeatures(recorded, sim_options.settle)
+                         : sim.features;
+
+  // Model: prediction -> arctangent curve -> 840D plan.
+  c.prediction = nn::Predict(model, screw.process);
+  c.predicted_curve = fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k);
+  c.predicted_curve.Validate("predicted curve of screw '" + screw.name + "'");
+  const double feed = c.kinematics.axial_feed_mm_s;
+  c.plan = interp::BuildPlan(c.predicted_curve, feed, screw.thread_length_mm, options.plan);
+  const interp::CompensationPlan& plan = c.plan;
+  const CompensationFunction model_c = [&plan, feed](double t_s) {
+    return interp::AppliedCompensationUm(plan, interp::AxisPositionMm(plan.options, feed, t_s));
+  };
+
+  // Traditional: the experience rule of the screw's diameter class.
+  c.experience_class = rule.ClassFor(screw.process.diameter_mm);
+  c.experience_ramp_time_s = rule.ramp_time_s;
+  const double diameter = screw.process.diameter_mm;
+  const CompensationFunction traditional_c = [&rule, diameter](double t_s) {
+    return rule.CompensationUm(diameter, t_s);
+  };
+
+  for (double t : c.truth.time_s) {
+    c.traditional_compensation_um.push_back(traditional_c(t));
+    c.model_compensation_um.push_back(model_c(t));
+  }
+
+  LeadMetricOptions metric_options = options.metrics;
+  metric_options.lead_mm = screw.process.pitch_mm;
+  for (Strategy s : kStrategies) {
+    StrategyOutcome& o = c.outcomes[static_cast<std::size_t>(s)];
+    o.strategy = s;
+    const CompensationFunction& comp = s == Strategy::kNone          ? NoCompensation()
+                                       : s == Strategy::kTraditional ? traditional_c
+                                                                     : model_c;
+    o.lead = CutLeadDeviation(c.truth, comp, feed, screw.thread_length_mm, screw.process.pitch_mm,
+                              options.cut);
+    o.metrics = ComputeLeadMetrics(o.lead, metric_options);
+    o.iso = EvaluateIsoClass(o.metrics, iso_table);
+  }
+  c.model_vs_traditional =
+      Reductions(c.Outcome(Strategy::kModel).metrics, c.Outcome(Strategy::kTraditional).metrics);
+  c.model_vs_none =
+      Reductions(c.Outcome(Strategy::kModel).metrics, c.Outcome(Strategy::kNone).metrics);
+  c.traditional_vs_none =
+      Reductions(c.Outcome(Strategy::kTraditional).metrics, c.Outcome(Strategy::kNone).metrics);
+  return c;
+}
+
+void to_json(nlohmann::json& j, const MetricReductions& r) {
+  j = nlohmann::json{{"e_a_pct", Optional(r.e_a_pct)},
+                     {"v_u_pct", Optional(r.v_u_pct)},
+                     {"v_300_pct", Optional(r.v_300_pct)},
+                     {"v_2pi_pct", Optional(r.v_2pi_pct)},
+                     {"accumulated_1000_pct", Optional(r.accumulated_1000_pct)},
+                     {"accumulated_total_pct", Optional(r.accumulated_total_pct)}};
+}
+
+void to_json(nlohmann::json& j, const ScrewComparison& c) {
+  nlohmann::json strategies = nlohmann::json::object();
+  for (const auto& o : c.outcomes)
+    strategies[ToString(o.strategy)] = {{"metrics", o.metrics}, {"iso", o.iso}};
+  nlohmann::json plan_summary = {{"segments", c.plan.segments.size()},
+                                 {"points", c.plan.point_count},
+                                 {"uniform_points_for_same_bound", c.plan.uniform_point_count},
+                                 {"max_deviation_um", c.plan.max_deviation_um},
+                                 {"max_abs_sd43910", c.plan.max_abs_slope},
+                                 {"md32760", c.plan.options.md32760},
+                                 {"axis", c.plan.options.axis},
+                                 {"sign", interp::ToString(c.plan.options.sign)},
+                                 {"tolerance_um", c.plan.options.tolerance_um}};
+  j = nlohmann::json{{"schema", "whirl.compare"},
+                     {"schema_version", kCompareSchemaVersion},
+                     {"screw", c.screw},
+                     {"kinematics",
+                      {{"axial_feed_mm_s", c.kinematics.axial_feed_mm_s},
+                       {"axial_feed_mm_min", c.kinematics.axial_feed_mm_min},
+                       {"cutting_time_s", c.kinematics.cutting_time_s},
+                       {"ring_speed_rpm", c.kinematics.ring_speed_rpm},
+                       {"workpiece_speed_rpm", c.kinematics.workpiece_speed_rpm}}},
+                     {"truth",
+                      {{"seed", c.seed},
+                       {"disturbances_on", c.disturbances_on},
+                       {"heat_partition_factor", c.disturbances.heat_partition_factor},
+                       {"expansion_factor", c.disturbances.expansion_factor},
+                       {"ambient_drift_k_per_h", c.disturbances.ambient_drift_k_per_h},
+                       {"max_elongation_um", c.truth_features.max_elongation_um},
+                       {"settle_time_s", c.truth_features.settle_time_s}}},
+                     {"prediction",
+                      {{"max_elongation_um", c.prediction.mean.max_elongation_um},
+                       {"settle_time_s", c.prediction.mean.settle_time_s},
+                       {"max_elongation_stddev_um", c.prediction.stddev.max_elongation_um},
+                       {"settle_time_stddev_s", c.prediction.stddev.settle_time_s},
+                       {"outside_domain", c.prediction.outside_domain},
+                       {"outside_domain_fields", c.prediction.outside_domain_fields},
+                       {"shape_k", c.predicted_curve.shape_k}}},
+                     {"plan", plan_summary},
+                     {"traditional",
+                      {{"rule", "c(t) = P_class * min(1, t / T)"},
+                       {"class_nominal_diameter_mm", c.experience_class.nominal_diameter_mm},
+                       {"plateau_um", c.experience_class.plateau_um},
+                       {"class_screws", c.experience_class.screws},
+                       {"ramp_time_s", c.experience_ramp_time_s}}},
+                     {"strategies", strategies},
+                     {"reductions",
+                      {{"model_vs_traditional", c.model_vs_traditional},
+                       {"model_vs_none", c.model_vs_none},
+                       {"traditional_vs_none", c.traditional_vs_none}}},
+                     {"sign_convention",
+                      "travel deviation = actual minus specified travel from the thread start, um; "
+                      "d(x) = [e(t) - c(t)] - [e(0) - c(0)], x = axial_feed * t"}};
+}
+
+}  // namespace whirl::compare

@@ -1,0 +1,116 @@
+#pragma once
+// The lead error a real-size screw gets with three compensation strategies, cut in the simulator
+// (REFERENCE.md sections 1 and 4; issue 5):
+//
+//   none         c(t) = 0
+//   traditional  c(t) = the shop's experience rule (compare/traditional.h)
+//   model        nn::Predict -> fit::ArctanCurve::FromFeatures -> interp::BuildPlan with the
+//                screw's kinematics -> c(t) = interp::AppliedCompensationUm(plan, P(t)), i.e. the
+//                value the 840D reconstructs from SD43900/SD43910/SD43920 at the axis position
+//                P(t) = interp::AxisPositionMm(plan options, feed, t).
+//
+// Truth: sim::Simulate over the whole thread with the seeded disturbances ON (per-workpiece heat
+// partition and expansion coefficient, ambient drift) that the model never saw. The groove is
+// displaced by the true (noise-free) elongation: the sensor noise of the simulated recording is a
+// property of the recording, not of the screw. Lead deviation per strategy: compare/cut.h.
+// Metrics: compare/metrics.h with lead_mm = the screw's lead; ISO class: compare/iso3408.h.
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compare/cut.h"
+#include "compare/iso3408.h"
+#include "compare/metrics.h"
+#include "compare/traditional.h"
+#include "fit/arctan_curve.h"
+#include "interp/sinumerik.h"
+#include "nn/model.h"
+#include "sim/screw.h"
+#include "sim/simulator.h"
+
+namespace whirl::compare {
+
+enum class Strategy { kNone, kTraditional, kModel };
+inline constexpr std::array<Strategy, 3> kStrategies = {Strategy::kNone, Strategy::kTraditional,
+                                                        Strategy::kModel};
+std::string ToString(Strategy s);  ///< "none", "traditional", "model"
+
+struct CompareOptions {
+  /// Seed of the truth's disturbances (sim::DisturbanceOptions::seed).
+  std::uint64_t seed = 1;
+  /// Disturbances of the truth; `enabled` and `seed` are set from `disturbances_on` and `seed`.
+  sim::DisturbanceOptions disturbance;
+  bool disturbances_on = true;
+  /// Simulator numerics; duration_s is forced to 0 (the whole thread).
+  sim::SimOptions sim;
+  /// 840D plan options (tolerance, axis, sign, MD32760 cap, ...).
+  interp::PlanOptions plan;
+  /// Shape k of the predicted arctangent curve (fit::kDefaultShapeK).
+  double shape_k = fit::kDefaultShapeK;
+  /// Metric options; lead_mm is set to the screw's lead.
+  LeadMetricOptions metrics;
+  CutOptions cut;
+};
+
+struct StrategyOutcome {
+  Strategy strategy = Strategy::kNone;
+  LeadDeviation lead;  ///< travel deviation along the thread, um (sign: compare/lead.h)
+  LeadMetrics metrics;
+  IsoVerdict iso;
+};
+
+/// Reduction of each metric by one strategy against a baseline, percent:
+/// 100 (1 - |metric| / |baseline metric|); nullopt when the baseline metric is 0.
+struct MetricReductions {
+  std::optional<double> e_a_pct, v_u_pct, v_300_pct, v_2pi_pct, accumulated_1000_pct,
+      accumulated_total_pct;
+};
+MetricReductions Reductions(const LeadMetrics& strategy, const LeadMetrics& baseline);
+
+struct ScrewComparison {
+  sim::Screw screw;
+  sim::Kinematics kinematics;
+  std::uint64_t seed = 0;
+  bool disturbances_on = true;
+  sim::AppliedDisturbances disturbances;
+  ElongationCurve truth;  ///< noise-free truth elongation of the unmachined section, um
+  /// Features of the recorded (noisy) truth over the training table's window
+  /// (sim::DatasetOptions::window_s, 1800 s) or the whole cut if shorter: what the model learns.
+  Features truth_features;
+  nn::Prediction prediction;  ///< model prediction for the screw's five inputs
+  fit::ArctanCurve predicted_curve;
+  interp::CompensationPlan plan;
+  ExperienceClass experience_class;  ///< the traditional rule's class of this screw
+  double experience_ramp_time_s = 0;
+  /// Compensation applied at the truth's sample times, um (for plots and checks).
+  std::vector<double> traditional_compensation_um, model_compensation_um;
+  std::array<StrategyOutcome, 3> outcomes;  ///< in kStrategies order
+  MetricReductions model_vs_traditional, model_vs_none, traditional_vs_none;
+
+  const StrategyOutcome& Outcome(Strategy s) const;
+  /// "reference: accumulated 1000 mm none 85.1 / traditional 31.0 / model 3.2 um (-89.7 % vs
+  /// traditional), classes none/T7/P3".
+  std::string BriefReport() const;
+};
+
+/// Runs the comparison for one screw. InputError for an infeasible screw, invalid options, or a
+/// plan the control cannot run (slope beyond MD32760).
+ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
+                             const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+                             const CompareOptions& options = {});
+
+/// A screw like `base` (length, thread length, machine settings) with other process inputs.
+sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
+                           const std::string& name);
+
+void to_json(nlohmann::json& j, const MetricReductions& r);
+/// Summary JSON (schema "whirl.compare", version 1): screw, kinematics, disturbances, features
+/// (truth, predicted, stddev), plan summary, experience class, per strategy metrics + ISO verdict,
+/// reductions. Curves are not included (the report writes them as CSV).
+void to_json(nlohmann::json& j, const ScrewComparison& c);
+inline constexpr int kCompareSchemaVersion = 1;
+
+}  // namespace whirl::compare

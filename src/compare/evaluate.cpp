@@ -1,0 +1,210 @@
+#include "compare/evaluate.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "core/csv.h"
+#include "core/error.h"
+#include "sim/random.h"
+
+namespace whirl::compare {
+
+std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, std::uint64_t seed,
+                                             const InputRanges& ranges) {
+  if (count < 0)
+    throw InputError("random screw count = " + std::to_string(count) + ": must be >= 0");
+  sim::Rng rng(seed);
+  const auto lo = ranges.min.ToArray(), hi = ranges.max.ToArray();
+  for (int i = 0; i < ProcessInputs::kCount; ++i)
+    if (!(hi[i] >= lo[i]))
+      throw InputError(std::string("input range of ") + kInputColumns[i] + ": max " +
+                       FormatNumber(hi[i]) + " < min " + FormatNumber(lo[i]));
+  std::vector<sim::Screw> screws;
+  for (int k = 0; k < count; ++k) {
+    for (int attempt = 0;; ++attempt) {
+      if (attempt == 1000)
+        throw InputError("1000 random draws in a row gave infeasible screws: check the ranges");
+      std::array<double, ProcessInputs::kCount> a{};
+      for (int i = 0; i < ProcessInputs::kCount; ++i)
+        a[i] = lo[i] + (hi[i] - lo[i]) * rng.Uniform();
+      sim::Screw s =
+          ScrewWithInputs(base, ProcessInputs::FromArray(a), "random-" + std::to_string(k + 1));
+      try {
+        sim::ValidateScrew(s, s.name);
+      } catch (const InputError&) {
+        continue;
+      }
+      screws.push_back(s);
+      break;
+    }
+  }
+  return screws;
+}
+
+std::vector<sim::Screw> ScrewsFromTable(const sim::Screw& base, const ProcessTable& table,
+                                        const std::string& prefix) {
+  std::vector<sim::Screw> screws;
+  for (std::size_t r = 0; r < table.inputs.size(); ++r) {
+    sim::Screw s = ScrewWithInputs(base, table.inputs[r], prefix + "-" + std::to_string(r + 1));
+    const std::string line =
+        r < table.line_numbers.size() ? ":" + std::to_string(table.line_numbers[r]) : "";
+    sim::ValidateScrew(s, table.source + line);
+    screws.push_back(s);
+  }
+  return screws;
+}
+
+ReductionStats Stats(std::vector<double> values) {
+  ReductionStats s;
+  s.count = values.size();
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  s.median_pct = n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  s.worst_pct = values.front();
+  s.best_pct = values.back();
+  return s;
+}
+
+Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model& model,
+                          const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+                          const EvaluateOptions& options, const EvaluateProgress& progress) {
+  if (options.threads < 1)
+    throw InputError("threads = " + std::to_string(options.threads) + ": must be >= 1");
+  Evaluation e;
+  e.screws.resize(screws.size());
+  std::atomic<std::size_t> next{0}, done{0};
+  std::mutex progress_mutex;
+  auto worker = [&]() {
+    for (std::size_t i = next++; i < screws.size(); i = next++) {
+      EvaluatedScrew& out = e.screws[i];
+      out.screw = screws[i];
+      out.seed = sim::MixSeed(options.seed, i);
+      CompareOptions co = options.compare;
+      co.seed = out.seed;
+      try {
+        const ScrewComparison c = CompareScrew(screws[i], model, rule, iso_table, co);
+        out.ok = true;
+        out.outside_domain = c.prediction.outside_domain;
+        for (std::size_t k = 0; k < 3; ++k) {
+          out.metrics[k] = c.outcomes[k].metrics;
+          out.iso[k] = c.outcomes[k].iso.reached;
+        }
+        out.model_vs_traditional = c.model_vs_traditional;
+        out.model_vs_none = c.model_vs_none;
+      } catch (const InputError& err) {
+        out.ok = false;
+        out.error = err.what();
+      }
+      const std::size_t d = ++done;
+      if (progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        progress(d, screws.size());
+      }
+    }
+  };
+  const int threads = std::min<int>(options.threads, std::max<std::size_t>(1, screws.size()));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+
+  EvaluationSummary& s = e.summary;
+  s.screws = screws.size();
+  std::vector<double> acc_t, total_t, acc_n;
+  std::array<std::size_t, 3> p3{}, p5{};
+  std::size_t ok = 0;
+  for (const auto& r : e.screws) {
+    if (!r.ok) {
+      ++s.failed;
+      continue;
+    }
+    ++ok;
+    if (r.model_vs_traditional.accumulated_1000_pct)
+      acc_t.push_back(*r.model_vs_traditional.accumulated_1000_pct);
+    if (r.model_vs_traditional.accumulated_total_pct)
+      total_t.push_back(*r.model_vs_traditional.accumulated_total_pct);
+    if (r.model_vs_none.accumulated_1000_pct)
+      acc_n.push_back(*r.model_vs_none.accumulated_1000_pct);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const IsoClass c = r.iso[k];
+      if (c == IsoClass::kP1 || c == IsoClass::kP3) ++p3[k];
+      if (c == IsoClass::kP1 || c == IsoClass::kP3 || c == IsoClass::kP5) ++p5[k];
+    }
+  }
+  s.acc1000_vs_traditional = Stats(acc_t);
+  s.total_vs_traditional = Stats(total_t);
+  s.acc1000_vs_none = Stats(acc_n);
+  for (std::size_t k = 0; k < 3; ++k) {
+    s.share_p3[k] = ok > 0 ? static_cast<double>(p3[k]) / ok : 0.0;
+    s.share_p5[k] = ok > 0 ? static_cast<double>(p5[k]) / ok : 0.0;
+  }
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%zu screws (%zu failed): accumulated error within 1000 mm, model vs traditional: "
+                "median reduction %.1f %%, worst %.1f %%; whole thread: median %.1f %%, worst "
+                "%.1f %%; vs none: median %.1f %%; share reaching P3 none/traditional/model "
+                "%.0f/%.0f/%.0f %%, P5 %.0f/%.0f/%.0f %%",
+                s.screws, s.failed, s.acc1000_vs_traditional.median_pct,
+                s.acc1000_vs_traditional.worst_pct, s.total_vs_traditional.median_pct,
+                s.total_vs_traditional.worst_pct, s.acc1000_vs_none.median_pct, 100 * s.share_p3[0],
+                100 * s.share_p3[1], 100 * s.share_p3[2], 100 * s.share_p5[0], 100 * s.share_p5[1],
+                100 * s.share_p5[2]);
+  s.message = buf;
+  return e;
+}
+
+namespace {
+nlohmann::json StatsJson(const ReductionStats& r) {
+  return {{"count", r.count},
+          {"median_pct", r.median_pct},
+          {"worst_pct", r.worst_pct},
+          {"best_pct", r.best_pct}};
+}
+}  // namespace
+
+void to_json(nlohmann::json& j, const EvaluatedScrew& s) {
+  j = nlohmann::json{{"name", s.screw.name}, {"seed", s.seed}, {"ok", s.ok}};
+  const auto in = s.screw.process.ToArray();
+  for (int i = 0; i < ProcessInputs::kCount; ++i) j[kInputColumns[i]] = in[i];
+  if (!s.ok) {
+    j["error"] = s.error;
+    return;
+  }
+  j["outside_domain"] = s.outside_domain;
+  nlohmann::json strategies = nlohmann::json::object();
+  for (std::size_t k = 0; k < 3; ++k)
+    strategies[ToString(kStrategies[k])] = {{"metrics", s.metrics[k]},
+                                            {"iso_class", ToString(s.iso[k])}};
+  j["strategies"] = strategies;
+  j["model_vs_traditional"] = s.model_vs_traditional;
+  j["model_vs_none"] = s.model_vs_none;
+}
+
+void to_json(nlohmann::json& j, const EvaluationSummary& s) {
+  nlohmann::json p3 = nlohmann::json::object(), p5 = nlohmann::json::object();
+  for (std::size_t k = 0; k < 3; ++k) {
+    p3[ToString(kStrategies[k])] = s.share_p3[k];
+    p5[ToString(kStrategies[k])] = s.share_p5[k];
+  }
+  j = nlohmann::json{{"screws", s.screws},
+                     {"failed", s.failed},
+                     {"accumulated_1000_model_vs_traditional", StatsJson(s.acc1000_vs_traditional)},
+                     {"accumulated_total_model_vs_traditional", StatsJson(s.total_vs_traditional)},
+                     {"accumulated_1000_model_vs_none", StatsJson(s.acc1000_vs_none)},
+                     {"share_reaching_p3", p3},
+                     {"share_reaching_p5", p5},
+                     {"message", s.message}};
+}
+
+void to_json(nlohmann::json& j, const Evaluation& e) {
+  j = nlohmann::json{{"schema", "whirl.evaluate"},
+                     {"schema_version", 1},
+                     {"summary", e.summary},
+                     {"screws", e.screws}};
+}
+
+}  // namespace whirl::compare

@@ -1,0 +1,416 @@
+#include "compare/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/json_file.h"
+
+namespace whirl::compare {
+namespace {
+
+std::string Fixed(double x, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+  return buf;
+}
+
+std::string Html(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    switch (ch) {
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += ch;
+    }
+  }
+  return out;
+}
+
+std::string ShellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return out + "'";
+}
+
+std::string Pct(const std::optional<double>& v) { return v ? Fixed(*v, 1) + " %" : "-"; }
+
+std::vector<std::string> Comments(const ReportOptions& o, const std::string& what) {
+  std::vector<std::string> c{" " + what};
+  for (const auto& p : o.provenance) c.push_back(" " + p);
+  return c;
+}
+
+bool HaveGnuplot(const std::string& command) {
+  return std::system((command + " --version > /dev/null 2>&1").c_str()) == 0;
+}
+
+std::string Terminal(const std::string& command) {
+  const bool cairo =
+      std::system((command + " -e \"set terminal pngcairo\" > /dev/null 2>&1").c_str()) == 0;
+  return cairo ? "pngcairo size 1000,560 font 'Sans,11' noenhanced"
+               : "png size 1000,560 noenhanced";
+}
+
+struct PlotFiles {
+  std::string elongation, lead, lead_start;
+};
+
+// The gnuplot script for one screw; outputs go to "<png>.tmp" and are renamed after success.
+std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, const PlotFiles& f,
+                          const std::string& terminal) {
+  const double t_end = c.truth.time_s.back();
+  const double settle = std::max(c.predicted_curve.settle_time_s, c.experience_ramp_time_s);
+  const double t_zoom = std::min(t_end, std::max(60.0, 3.0 * settle));
+  const double l = c.screw.thread_length_mm;
+  std::ostringstream s;
+  s << "# gnuplot script written by whirl; re-run with: gnuplot " << slug << ".gp\n"
+    << "set datafile separator ','\nset datafile commentschars '#'\n"
+    << "set terminal " << terminal << "\nset grid\nset key right bottom box opaque\n"
+    << "set style line 1 lc rgb '#1f77b4' lw 2\nset style line 2 lc rgb '#d62728' lw 2 dt 2\n"
+    << "set style line 3 lc rgb '#2ca02c' lw 2\nset style line 4 lc rgb '#ff7f0e' lw 2 dt 4\n"
+    << "set style line 5 lc rgb '#000000' pt 7 ps 0.8\n";
+  // Elongation: truth vs prediction, compensation points, traditional ramp.
+  s << "set output '" << f.elongation << ".tmp'\n"
+    << "set title '" << c.screw.name << ": elongation of the unmachined section (first "
+    << Fixed(t_zoom, 0) << " s of " << Fixed(t_end, 0) << " s cutting time)'\n"
+    << "set xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
+    << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
+    << "plot '" << slug << "_elongation.csv' using 1:2 with lines ls 1 title 'simulated truth "
+    << "(disturbed)', \\\n"
+    << "  '' using 1:3 with lines ls 2 title 'predicted arctan curve (model)', \\\n"
+    << "  '' using 1:5 with lines ls 3 title '840D compensation applied (model plan)', \\\n"
+    << "  '' using 1:4 with lines ls 4 title 'traditional compensation (experience ramp)', \\\n"
+    << "  '" << slug << "_points.csv' using 1:3 with points ls 5 title 'compensation points "
+    << "(SD43900/10/20 breakpoints)'\n"
+    << "set output\n";
+  // Lead deviation along the whole thread.
+  s << "set key right top box opaque\n"
+    << "set output '" << f.lead << ".tmp'\n"
+    << "set title '" << c.screw.name
+    << ": travel deviation along the thread after cooling (actual - specified)'\n"
+    << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
+    << "set xrange [0:" << l << "]\nset yrange [*:*]\n"
+    << "plot '" << slug << "_lead.csv' using 1:2 with lines ls 2 title 'no compensation', \\\n"
+    << "  '' using 1:3 with lines ls 4 title 'traditional (experience rule)', \\\n"
+    << "  '' using 1:4 with lines ls 3 title 'model-based (840D plan)'\n"
+    << "set output\n";
+  s << "set output '" << f.lead_start << ".tmp'\n"
+    << "set title '" << c.screw.name << ": travel deviation, first "
+    << Fixed(std::min(l, 1000.0), 0) << " mm of the thread'\n"
+    << "set xrange [0:" << std::min(l, 1000.0) << "]\n"
+    << "replot\nset output\n";
+  return s.str();
+}
+
+std::string MetricsTable(const ScrewComparison& c) {
+  const auto& n = c.Outcome(Strategy::kNone);
+  const auto& t = c.Outcome(Strategy::kTraditional);
+  const auto& m = c.Outcome(Strategy::kModel);
+  std::ostringstream h;
+  h << "<table><tr><th>metric [um]</th><th>no compensation</th><th>traditional</th>"
+       "<th>model-based</th><th>model vs traditional</th><th>model vs none</th></tr>\n";
+  auto row = [&](const std::string& name, double a, double b, double d,
+                 const std::optional<double>& r1, const std::optional<double>& r2) {
+    h << "<tr><td>" << name << "</td><td>" << Fixed(a, 1) << "</td><td>" << Fixed(b, 1)
+      << "</td><td>" << Fixed(d, 1) << "</td><td>" << Pct(r1) << "</td><td>" << Pct(r2)
+      << "</td></tr>\n";
+  };
+  row("accumulated error within any 1000 mm", n.metrics.accumulated_1000_um,
+      t.metrics.accumulated_1000_um, m.metrics.accumulated_1000_um,
+      c.model_vs_traditional.accumulated_1000_pct, c.model_vs_none.accumulated_1000_pct);
+  row("accumulated error over the whole thread", n.metrics.accumulated_total_um,
+      t.metrics.accumulated_total_um, m.metrics.accumulated_total_um,
+      c.model_vs_traditional.accumulated_total_pct, c.model_vs_none.accumulated_total_pct);
+  row("e_a (mean travel deviation over l_u)", n.metrics.e_a_um, t.metrics.e_a_um, m.metrics.e_a_um,
+      c.model_vs_traditional.e_a_pct, c.model_vs_none.e_a_pct);
+  row("v_u (band over l_u)", n.metrics.v_u_um, t.metrics.v_u_um, m.metrics.v_u_um,
+      c.model_vs_traditional.v_u_pct, c.model_vs_none.v_u_pct);
+  row("v_300 (band within 300 mm)", n.metrics.v_300_um, t.metrics.v_300_um, m.metrics.v_300_um,
+      c.model_vs_traditional.v_300_pct, c.model_vs_none.v_300_pct);
+  if (n.metrics.v_2pi_um && t.metrics.v_2pi_um && m.metrics.v_2pi_um)
+    row("v_2pi (band within one revolution)", *n.metrics.v_2pi_um, *t.metrics.v_2pi_um,
+        *m.metrics.v_2pi_um, c.model_vs_traditional.v_2pi_pct, c.model_vs_none.v_2pi_pct);
+  h << "<tr class='cls'><td>ISO 3408-3 class reached</td><td>" << ToString(n.iso.reached)
+    << "</td><td>" << ToString(t.iso.reached) << "</td><td>" << ToString(m.iso.reached)
+    << "</td><td colspan='2'></td></tr>\n</table>\n<ul class='small'>\n";
+  for (const auto* o : {&n, &t, &m})
+    h << "<li><b>" << ToString(o->strategy) << "</b>: " << Html(o->iso.message) << "</li>\n";
+  h << "</ul>\n";
+  return h.str();
+}
+
+}  // namespace
+
+std::string FormatComparisonTable(const ScrewComparison& c) {
+  const auto& n = c.Outcome(Strategy::kNone);
+  const auto& t = c.Outcome(Strategy::kTraditional);
+  const auto& m = c.Outcome(Strategy::kModel);
+  std::ostringstream s;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "  %-34s %10s %12s %10s %12s %10s\n", "metric [um]", "none",
+                "traditional", "model", "vs trad.", "vs none");
+  s << buf;
+  auto row = [&](const char* name, double a, double b, double d, const std::optional<double>& r1,
+                 const std::optional<double>& r2) {
+    std::snprintf(buf, sizeof buf, "  %-34s %10.2f %12.2f %10.2f %12s %10s\n", name, a, b, d,
+                  Pct(r1).c_str(), Pct(r2).c_str());
+    s << buf;
+  };
+  row("accumulated within any 1000 mm", n.metrics.accumulated_1000_um,
+      t.metrics.accumulated_1000_um, m.metrics.accumulated_1000_um,
+      c.model_vs_traditional.accumulated_1000_pct, c.model_vs_none.accumulated_1000_pct);
+  row("accumulated over the thread", n.metrics.accumulated_total_um, t.metrics.accumulated_total_um,
+      m.metrics.accumulated_total_um, c.model_vs_traditional.accumulated_total_pct,
+      c.model_vs_none.accumulated_total_pct);
+  row("e_a", n.metrics.e_a_um, t.metrics.e_a_um, m.metrics.e_a_um, c.model_vs_traditional.e_a_pct,
+      c.model_vs_none.e_a_pct);
+  row("v_u", n.metrics.v_u_um, t.metrics.v_u_um, m.metrics.v_u_um, c.model_vs_traditional.v_u_pct,
+      c.model_vs_none.v_u_pct);
+  row("v_300", n.metrics.v_300_um, t.metrics.v_300_um, m.metrics.v_300_um,
+      c.model_vs_traditional.v_300_pct, c.model_vs_none.v_300_pct);
+  if (n.metrics.v_2pi_um && t.metrics.v_2pi_um && m.metrics.v_2pi_um)
+    row("v_2pi", *n.metrics.v_2pi_um, *t.metrics.v_2pi_um, *m.metrics.v_2pi_um,
+        c.model_vs_traditional.v_2pi_pct, c.model_vs_none.v_2pi_pct);
+  std::snprintf(buf, sizeof buf, "  %-34s %10s %12s %10s\n", "ISO 3408-3 class reached",
+                ToString(n.iso.reached).c_str(), ToString(t.iso.reached).c_str(),
+                ToString(m.iso.reached).c_str());
+  s << buf;
+  return s.str();
+}
+
+std::string Slug(const std::string& name) {
+  std::string s;
+  for (char ch : name) {
+    const unsigned char u = static_cast<unsigned char>(ch);
+    if (std::isalnum(u))
+      s += static_cast<char>(std::tolower(u));
+    else if (ch == '-' || ch == '_')
+      s += ch;
+    else if (!s.empty() && s.back() != '-')
+      s += '-';
+  }
+  while (!s.empty() && s.back() == '-') s.pop_back();
+  return s.empty() ? "screw" : s;
+}
+
+ReportResult WriteReport(const std::filesystem::path& dir,
+                         const std::vector<ScrewComparison>& comparisons,
+                         const ReportOptions& options) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError("report directory '" + dir.string() + "': cannot create it (" + ec.message() +
+                     ")");
+  ReportResult result;
+  const bool gnuplot = options.plots && HaveGnuplot(options.gnuplot_command);
+  if (options.plots && !gnuplot)
+    result.warnings.push_back("'" + options.gnuplot_command +
+                              "' not found: plots skipped (install gnuplot-nox, e.g. "
+                              "scripts/setup.sh); the HTML, CSV data and .gp scripts are written");
+  const std::string terminal = gnuplot ? Terminal(options.gnuplot_command) : "pngcairo";
+  bool all_rendered = gnuplot;
+
+  std::vector<std::string> slugs;
+  nlohmann::json report_json = nlohmann::json::array();
+  std::ostringstream body;
+  for (const ScrewComparison& c : comparisons) {
+    std::string slug = Slug(c.screw.name);
+    while (std::find(slugs.begin(), slugs.end(), slug) != slugs.end()) slug += "_";
+    slugs.push_back(slug);
+    const double feed = c.kinematics.axial_feed_mm_s;
+
+    // Data files.
+    std::vector<std::vector<double>> rows;
+    for (std::size_t i = 0; i < c.truth.size(); ++i) {
+      const double t = c.truth.time_s[i];
+      rows.push_back({t, c.truth.elongation_um[i], c.predicted_curve.ElongationUm(t),
+                      c.traditional_compensation_um[i], c.model_compensation_um[i]});
+    }
+    auto write = [&](const std::string& name, const std::string& text) {
+      WriteFileAtomic(dir / name, text);
+      result.files.push_back(dir / name);
+    };
+    write(slug + "_elongation.csv",
+          FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
+                     "traditional_compensation_um", "model_compensation_um"},
+                    rows,
+                    Comments(options, "elongation of the unmachined section of screw '" +
+                                          c.screw.name + "' and the compensation applied")));
+    rows.clear();
+    if (!c.plan.segments.empty()) {
+      for (const auto& seg : c.plan.segments)
+        rows.push_back(
+            {seg.t_a_s, seg.t_a_s * feed, seg.l_a_um, seg.sd43900_mm, seg.sd43910, seg.sd43920_mm});
+      const auto& last = c.plan.segments.back();
+      rows.push_back(
+          {last.t_b_s, last.t_b_s * feed, last.l_b_um, std::nan(""), std::nan(""), last.p_b_mm});
+      rows.back()[3] = 0;  // CSV cells must be finite: the end point carries no setting data
+      rows.back()[4] = 0;
+    }
+    write(slug + "_points.csv",
+          FormatCsv({"time_s", "thread_position_mm", "elongation_um", "sd43900_mm", "sd43910",
+                     "sd43920_mm"},
+                    rows,
+                    Comments(options,
+                             "compensation points of the 840D plan (the last row is "
+                             "the end of the last segment: no setting data)")));
+    rows.clear();
+    const auto& ln = c.Outcome(Strategy::kNone).lead;
+    const auto& lt = c.Outcome(Strategy::kTraditional).lead;
+    const auto& lm = c.Outcome(Strategy::kModel).lead;
+    for (std::size_t i = 0; i < ln.size(); ++i)
+      rows.push_back(
+          {ln.position_mm[i], ln.deviation_um[i], lt.deviation_um[i], lm.deviation_um[i]});
+    write(slug + "_lead.csv", FormatCsv({"position_mm", "none_deviation_um",
+                                         "traditional_deviation_um", "model_deviation_um"},
+                                        rows,
+                                        Comments(options,
+                                                 "travel deviation (actual - specified travel from "
+                                                 "the thread start) of screw '" +
+                                                     c.screw.name + "'")));
+
+    // Plots.
+    const PlotFiles files{slug + "_elongation.png", slug + "_lead.png", slug + "_lead_start.png"};
+    write(slug + ".gp", GnuplotScript(c, slug, files, terminal));
+    if (gnuplot) {
+      const std::string cmd = "cd " + ShellQuote(dir.string()) + " && " + options.gnuplot_command +
+                              " " + ShellQuote(slug + ".gp") + " > " +
+                              ShellQuote(slug + ".gp.log") + " 2>&1";
+      const int rc = std::system(cmd.c_str());
+      bool ok = rc == 0;
+      for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+        const auto tmp = dir / (png + ".tmp");
+        if (ok && std::filesystem::exists(tmp) && std::filesystem::file_size(tmp) > 0) {
+          std::filesystem::rename(tmp, dir / png);
+          result.files.push_back(dir / png);
+        } else {
+          ok = false;
+          std::filesystem::remove(tmp, ec);
+        }
+      }
+      if (ok) {
+        std::filesystem::remove(dir / (slug + ".gp.log"), ec);
+      } else {
+        all_rendered = false;
+        result.warnings.push_back("gnuplot failed on " + (dir / (slug + ".gp")).string() +
+                                  " (see " + (dir / (slug + ".gp.log")).string() + "): plots of '" +
+                                  c.screw.name + "' skipped");
+      }
+    }
+
+    // HTML section.
+    const auto in = c.screw.process;
+    body << "<h2>" << Html(c.screw.name) << "</h2>\n<p>Inputs: hardness "
+         << Fixed(in.hardness_hrc, 1) << " HRC, diameter " << Fixed(in.diameter_mm, 1)
+         << " mm, lead " << Fixed(in.pitch_mm, 2) << " mm, raceway radius "
+         << Fixed(in.raceway_radius_mm, 2) << " mm, cutting speed "
+         << Fixed(in.cutting_speed_m_min, 0) << " m/min; blank " << Fixed(c.screw.length_mm, 0)
+         << " mm, thread " << Fixed(c.screw.thread_length_mm, 0) << " mm; axial feed "
+         << Fixed(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
+         << Fixed(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
+    if (c.prediction.outside_domain) {
+      std::string fields;
+      for (const auto& f : c.prediction.outside_domain_fields)
+        fields += (fields.empty() ? "" : ", ") + f;
+      body << "<p class='warn'>The model extrapolates: outside its training domain in "
+           << Html(fields) << ".</p>\n";
+    }
+    body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n"
+         << "<tr><td>simulated truth (seed " << c.seed << ", disturbances "
+         << (c.disturbances_on ? "on" : "off") << ")</td><td>"
+         << Fixed(c.truth_features.max_elongation_um, 1) << "</td><td>"
+         << Fixed(c.truth_features.settle_time_s, 0) << "</td></tr>\n"
+         << "<tr><td>model prediction (+- 1 std)</td><td>"
+         << Fixed(c.prediction.mean.max_elongation_um, 1) << " +- "
+         << Fixed(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
+         << Fixed(c.prediction.mean.settle_time_s, 0) << " +- "
+         << Fixed(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
+         << "<tr><td>traditional rule (class " << Fixed(c.experience_class.nominal_diameter_mm, 0)
+         << " mm, " << c.experience_class.screws << " past screws)</td><td>"
+         << Fixed(c.experience_class.plateau_um, 1) << "</td><td>"
+         << Fixed(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n"
+         << "<p class='small'>Disturbances of the truth (unknown to the model): heat partition x"
+         << Fixed(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
+         << Fixed(c.disturbances.expansion_factor, 3) << ", ambient drift "
+         << Fixed(c.disturbances.ambient_drift_k_per_h, 3)
+         << " K/h. 840D plan: " << c.plan.segments.size() << " segments (" << c.plan.point_count
+         << " points; uniform spacing would need " << c.plan.uniform_point_count
+         << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
+         << FormatNumber(c.plan.max_abs_slope) << " (MD32760 cap "
+         << FormatNumber(c.plan.options.md32760) << "), axis " << Html(c.plan.options.axis)
+         << ", sign " << interp::ToString(c.plan.options.sign) << ".</p>\n"
+         << MetricsTable(c);
+    for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+      if (gnuplot && std::filesystem::exists(dir / png))
+        body << "<p><img src='" << png << "' alt='" << png << "'></p>\n";
+      else
+        body << "<p class='warn'>Plot " << png << " not rendered (see warnings).</p>\n";
+    }
+    body << "<p class='small'>Data: <a href='" << slug << "_elongation.csv'>" << slug
+         << "_elongation.csv</a>, <a href='" << slug << "_points.csv'>" << slug
+         << "_points.csv</a>, <a href='" << slug << "_lead.csv'>" << slug
+         << "_lead.csv</a>, gnuplot script <a href='" << slug << ".gp'>" << slug
+         << ".gp</a>.</p>\n";
+    report_json.push_back(c);
+  }
+  result.plots_rendered = all_rendered && !comparisons.empty();
+
+  WriteJsonFile(dir / "report.json", {{"schema", "whirl.report"},
+                                      {"schema_version", 1},
+                                      {"provenance", options.provenance},
+                                      {"comparisons", report_json}});
+  result.files.push_back(dir / "report.json");
+
+  std::ostringstream html;
+  html
+      << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>"
+      << Html(options.title)
+      << "</title>\n<style>body{font-family:sans-serif;max-width:1060px;margin:2em auto;color:#222}"
+         "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #bbb;padding:3px "
+         "8px;"
+         "text-align:right}td:first-child,th:first-child{text-align:left}th{background:#eee}"
+         "tr.cls td{font-weight:bold}.small{font-size:0.85em;color:#555}.warn{color:#a00}"
+         "img{max-width:100%;border:1px solid #ddd}</style></head><body>\n<h1>"
+      << Html(options.title) << "</h1>\n";
+  for (const auto& p : options.provenance) html << "<p class='small'>" << Html(p) << "</p>\n";
+  for (const auto& n : options.notes) html << "<p>" << Html(n) << "</p>\n";
+  for (const auto& w : result.warnings) html << "<p class='warn'>warning: " << Html(w) << "</p>\n";
+  html << "<p>How to read this page. Each screw is cut in the simulator (the ground truth, with "
+          "seeded disturbances the model never saw) three times: without compensation, with the "
+          "traditional experience rule (one correction per diameter class, ramped in linearly over "
+          "the machine's mean settle time, from the same past screws the model was trained on), "
+          "and with the model-based 840D plan (prediction, arctangent curve, "
+          "SD43900/SD43910/SD43920 "
+          "segments). Travel deviation = actual minus specified travel from the thread start after "
+          "cooling; accumulated error within 1000 mm = the largest max - min of the deviation "
+          "within any 1000 mm of thread (the paper's figure), over the whole thread = max - min "
+          "over the thread. e_a, v_u, v_300, v_2pi as ISO 3408-3 (about the least-squares mean "
+          "travel line). Reductions are 100 (1 - model / baseline).</p>\n"
+          "<p class='small'>ISO 3408-3 caveat: only some tolerance cells are confirmed by a source "
+          "(Steinmeyer, HIWIN catalogue); the others are recalled values "
+          "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
+       << body.str() << "</body></html>\n";
+  WriteFileAtomic(dir / "index.html", html.str());
+  result.files.push_back(dir / "index.html");
+  result.index_html = dir / "index.html";
+  return result;
+}
+
+}  // namespace whirl::compare

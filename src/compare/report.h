@@ -1,0 +1,56 @@
+#pragma once
+// The report a process engineer opens after a comparison: one HTML page (index.html) with, per
+// screw, the elongation curve (simulated truth against the prediction, with the compensation points
+// of the 840D plan and the traditional ramp), the lead deviation along the thread for the three
+// strategies (whole thread, and the first 1000 mm where the transient lives), the metrics table
+// with the ISO 3408-3 class reached and the reductions, plus the CSV files every plot comes from
+// and report.json.
+//
+// Plots: gnuplot (Debian package gnuplot-nox, pngcairo terminal, falling back to png). Why gnuplot:
+// it is a well-kept Debian package already installed by scripts/setup.sh, it needs no library
+// linked into whirl (the library stays free of plotting code paths at link time), the generated
+// .gp scripts stay in the report folder so anyone can re-plot or restyle from the CSVs, and PNG
+// embeds in any browser or mail. If gnuplot is missing at run time, the HTML, CSVs and scripts are
+// still written and ReportResult::warnings says the plots were skipped.
+// Every file is written atomically (PNGs are rendered to a temporary name and renamed), and
+// index.html last, so an interrupted run never leaves a page pointing at half-written plots.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "compare/compare.h"
+
+namespace whirl::compare {
+
+struct ReportOptions {
+  std::string title = "whirl: lead error with and without thermal-elongation compensation";
+  /// Lines shown under the title and written as '#' comments into every CSV (command, seed, model).
+  std::vector<std::string> provenance;
+  /// Render PNGs with gnuplot (false: data, scripts and HTML only).
+  bool plots = true;
+  std::string gnuplot_command = "gnuplot";
+  /// Extra notes shown at the top of the page (e.g. how the new-type screw was defined).
+  std::vector<std::string> notes;
+};
+
+struct ReportResult {
+  std::filesystem::path index_html;
+  std::vector<std::filesystem::path> files;  ///< every file written
+  bool plots_rendered = false;
+  std::vector<std::string> warnings;  ///< e.g. "gnuplot not found: plots skipped"
+};
+
+/// Writes the report for one or more screws into `dir` (created if missing). InputError if the
+/// directory cannot be created or a file cannot be written; a failing gnuplot is a warning.
+ReportResult WriteReport(const std::filesystem::path& dir,
+                         const std::vector<ScrewComparison>& comparisons,
+                         const ReportOptions& options = {});
+
+/// Plain-text metrics table of one comparison (for the terminal): the metrics of the three
+/// strategies, the ISO class reached and the reductions of the model against both baselines.
+std::string FormatComparisonTable(const ScrewComparison& c);
+
+/// File-name stem for a screw name: lower case letters, digits, '-' and '_' only.
+std::string Slug(const std::string& name);
+
+}  // namespace whirl::compare
