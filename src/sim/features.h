@@ -32,12 +32,16 @@ struct SettleOptions {
   double smoothing_window_s = 20.0;  ///< centred moving-average window, s
   double tail_fraction = 0.35;       ///< part of the record (by time) used for the plateau line, -
   double noise_sigma_multiplier = 3.0;  ///< band floor in smoothed-noise standard deviations, -
+  /// Degree of the tail polynomial p(t): 1 (default, a line: follows a slow drift); 0 = constant
+  /// plateau; 2 follows a curving drift but extrapolates noise back to the settle region badly
+  /// (tested: settle times of noisy table rows scatter by > 100 %).
+  int tail_degree = 1;
 };
 
 /// Full result of the settle analysis.
 struct SettleAnalysis {
   Features features;
-  double plateau_slope_um_per_s = 0;  ///< b1 of the tail line, um/s (drift)
+  double plateau_slope_um_per_s = 0;  ///< mean slope of p(t) over the tail, um/s (drift)
   double noise_std_um = 0;            ///< robust std of the raw tail residuals, um
   double band_um = 0;                 ///< band half-width used, um
   /// False when the smoothed curve never enters the band before the tail window starts (the record

@@ -45,7 +45,7 @@ struct SimOptions {
   /// the cutting time are clamped to it (the heat stops at the thread end).
   double duration_s = 0.0;
   double cell_size_mm = 2.0;       ///< uniform finite-volume cell size, mm
-  double time_step_s = 0.5;        ///< BDF2 time step, s
+  double time_step_s = 1.0;        ///< BDF2 time step, s
   double sample_interval_s = 1.0;  ///< spacing of the recorded curve, s (a multiple of the step)
   PhysicsConstants physics;        ///< material, heat transfer and cutting constants
   /// Verification hook: if >= 0, use this heat input (W) instead of the process model's.
