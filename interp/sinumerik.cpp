@@ -48,8 +48,9 @@ CompensationSegment MakeSegment(const PlanOptions& o, double feed, double t_a, d
   s.p_b_mm = AxisPositionMm(o, feed, t_b);
   s.l_a_um = l_a;
   s.l_b_um = l_b;
-  s.sd43900_mm = sign * l_a / 1000.0;
-  s.sd43910 = sign * (l_b - l_a) / 1000.0 / (s.p_b_mm - s.p_a_mm);
+  // "+ 0.0" turns -0.0 (subtract of a zero elongation) into 0 for the writers.
+  s.sd43900_mm = sign * l_a / 1000.0 + 0.0;
+  s.sd43910 = sign * (l_b - l_a) / 1000.0 / (s.p_b_mm - s.p_a_mm) + 0.0;
   s.sd43920_mm = s.p_a_mm;
   return s;
 }

@@ -1,9 +1,165 @@
-// Placeholder until its owner writes it; replaced before anything lands.
+// whirl curve: the arctan elongation curve (src/fit/arctan_curve.h) from a model's prediction for a
+// screw, or from given features, sampled as CSV time_s,elongation_um.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
 #include "cli/commands.h"
+#include "cli/common.h"
+#include "core/csv.h"
+#include "core/curve.h"
 #include "core/error.h"
+#include "fit/arctan_curve.h"
+#include "nn/model.h"
+#include "sim/screw.h"
+
 namespace whirl::cli {
-void RegisterCurve(CLI::App& app) {
-  auto* sub = app.add_subcommand("curve", "(being built)");
-  sub->callback([] { throw InputError("'curve' is not built yet"); });
+namespace {
+
+struct CurveOptions {
+  std::string model_path;
+  std::string screw_path;
+  double max_elongation_um = NAN;
+  double settle_time_s = NAN;
+  double shape_k = fit::kDefaultShapeK;
+  double duration_s = 0;
+  double step_s = 1.0;
+  std::string out_path;
+  bool allow_extrapolation = false;
+  bool json = false;
+};
+
+void Run(const CurveOptions& o) {
+  const bool by_model = !o.model_path.empty() || !o.screw_path.empty();
+  const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
+  if (by_model == by_features)
+    throw InputError(
+        "curve: give either --model M --screw S.json or --max-elongation L --settle-time T");
+  Features features;
+  Features stddev{NAN, NAN};
+  double duration_s = o.duration_s;
+  std::string source;
+  if (by_model) {
+    if (o.model_path.empty() || o.screw_path.empty())
+      throw InputError("curve: --model and --screw go together (got only " +
+                       std::string(o.model_path.empty() ? "--screw" : "--model") + ")");
+    const sim::Screw screw = sim::ReadScrew(o.screw_path);
+    const sim::Kinematics kin = sim::ComputeKinematics(screw);
+    const nn::Model model = nn::LoadModel(o.model_path);
+    const nn::Prediction pred = nn::Predict(model, screw.process);
+    if (pred.outside_domain) {
+      std::string fields;
+      for (const auto& f : pred.outside_domain_fields) fields += (fields.empty() ? "" : ", ") + f;
+      if (!o.allow_extrapolation)
+        throw InputError("screw " + o.screw_path + " lies outside the model's training domain in " +
+                         fields + ": pass --allow-extrapolation to use the prediction anyway");
+      Warn("screw " + o.screw_path + " lies outside the training domain in " + fields +
+           " (extrapolating)");
+    }
+    features = pred.mean;
+    stddev = pred.stddev;
+    if (duration_s == 0) duration_s = kin.cutting_time_s;
+    source = "model " + o.model_path + ", screw " + o.screw_path;
+  } else {
+    if (std::isnan(o.max_elongation_um) || std::isnan(o.settle_time_s))
+      throw InputError("curve: --max-elongation and --settle-time go together");
+    features = {o.max_elongation_um, o.settle_time_s};
+    source = "given features";
+  }
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures(features, o.shape_k);
+  if (duration_s == 0) duration_s = 3.0 * curve.settle_time_s;
+  const double samples = std::floor(duration_s / o.step_s) + 1;
+  if (samples > 1e7)
+    throw InputError("curve: " + FormatNumber(samples) + " samples (duration " +
+                     FormatNumber(duration_s) + " s / step " + FormatNumber(o.step_s) +
+                     " s): at most 1e7, raise --step-s");
+  ElongationCurve c;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(samples); ++i) {
+    const double t = o.step_s * static_cast<double>(i);
+    c.time_s.push_back(t);
+    c.elongation_um.push_back(curve.ElongationUm(t));
+  }
+  if (c.time_s.back() < duration_s) {
+    c.time_s.push_back(duration_s);
+    c.elongation_um.push_back(curve.ElongationUm(duration_s));
+  }
+  const std::vector<std::string> comments = {
+      "whirl curve (" + source + ")", "l(t) = L atan(k t/t_s)/atan(k) for t < t_s, L after; L = " +
+                                          FormatNumber(curve.max_elongation_um) +
+                                          " um, t_s = " + FormatNumber(curve.settle_time_s) +
+                                          " s, k = " + FormatNumber(curve.shape_k)};
+  if (!o.out_path.empty()) WriteElongationCurve(o.out_path, c, comments);
+
+  if (o.json) {
+    nlohmann::json j = {{"schema", "whirl.curve"},
+                        {"schema_version", 1},
+                        {"source", source},
+                        {"curve",
+                         {{"model", "arctan"},
+                          {"max_elongation_um", curve.max_elongation_um},
+                          {"settle_time_s", curve.settle_time_s},
+                          {"shape_k", curve.shape_k}}},
+                        {"duration_s", duration_s},
+                        {"samples", c.size()}};
+    if (by_model)
+      j["prediction_stddev"] = {{"max_elongation_um", stddev.max_elongation_um},
+                                {"settle_time_s", stddev.settle_time_s}};
+    if (!o.out_path.empty()) j["out"] = o.out_path;
+    PrintJson(j);
+    return;
+  }
+  if (o.out_path.empty()) {
+    std::vector<std::vector<double>> rows;
+    for (std::size_t i = 0; i < c.size(); ++i) rows.push_back({c.time_s[i], c.elongation_um[i]});
+    std::cout << FormatCsv({"time_s", "elongation_um"}, rows, comments);
+    return;
+  }
+  std::printf("arctan curve: L = %.4f um, t_s = %.2f s, k = %.4f (%s)\n", curve.max_elongation_um,
+              curve.settle_time_s, curve.shape_k, source.c_str());
+  if (by_model)
+    std::printf("prediction std: %.3g um, %.3g s\n", stddev.max_elongation_um,
+                stddev.settle_time_s);
+  std::printf("written: %s (%zu samples over %.1f s)\n", o.out_path.c_str(), c.size(), duration_s);
 }
+
+}  // namespace
+
+void RegisterCurve(CLI::App& app) {
+  auto o = std::make_shared<CurveOptions>();
+  auto* sub = app.add_subcommand(
+      "curve",
+      "The elongation curve of the unmachined section as the arctan model\n"
+      "  l(t) = L atan(k t/t_s)/atan(k) for t < t_s, L after   [l in um, t in s]\n"
+      "from a model's prediction for a screw (--model M --screw S.json; L and t_s are the\n"
+      "predicted max elongation and settle time) or from given features\n"
+      "(--max-elongation L --settle-time T). Writes CSV time_s,elongation_um (--out, atomically;\n"
+      "else CSV on stdout). A screw outside the training domain is an error unless\n"
+      "--allow-extrapolation.");
+  sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--screw", o->screw_path, "screw file (JSON, see 'whirl simulate --help')")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--max-elongation", o->max_elongation_um, "plateau elongation L [um]")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--settle-time", o->settle_time_s, "settle time t_s [s]")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--shape-k", o->shape_k,
+                  "arctan shape k [-] (default: kDefaultShapeK, fitted on simulated curves)")
+      ->capture_default_str()
+      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+  sub->add_option("--duration-s", o->duration_s,
+                  "sampled time span [s] (default: the screw's cutting time, else 3 t_s)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--step-s", o->step_s, "sample spacing [s]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--out", o->out_path, "write the curve CSV here (atomically)");
+  sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
+                "use the prediction even if the screw is outside the training domain");
+  sub->add_flag("--json", o->json, "machine output: curve parameters as JSON on stdout");
+  sub->callback([o] { Run(*o); });
+}
+
 }  // namespace whirl::cli

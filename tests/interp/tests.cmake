@@ -5,3 +5,4 @@ whirl_add_gtest(test_interp
     ${CMAKE_CURRENT_LIST_DIR}/test_sinumerik.cpp
   LIBS whirl::interp
   LABELS interp)
+whirl_add_cli_test(cli_plan ${CMAKE_CURRENT_LIST_DIR}/cli_plan.sh)

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Smoke test of 'whirl curve' and 'whirl fit': args <whirl> <scratch dir> <source dir>.
+set -u
+W="$1"; D="$2"; SRC="$3"
+rm -rf "$D"; mkdir -p "$D"
+fail() { echo "FAIL: $*"; exit 1; }
+expect_fail() {  # expect_fail <pattern> <command...>: exit code 1 and 'error:' + pattern on stderr
+  local pattern="$1"; shift
+  "$@" > "$D/out.txt" 2> "$D/err.txt"; local rc=$?
+  [ $rc -eq 1 ] || fail "expected exit 1, got $rc: $*"
+  grep -q "error" "$D/err.txt" || fail "no error message: $*"
+  grep -qi -- "$pattern" "$D/err.txt" || fail "message lacks '$pattern': $(cat "$D/err.txt")"
+}
+
+"$W" fit --help > "$D/help.txt" || fail "fit --help"
+grep -q "elongation_um" "$D/help.txt" || fail "fit --help does not explain the columns"
+"$W" curve --help | grep -q "um" || fail "curve --help has no units"
+
+# A curve from given features, then its fit: the arctan model recovers L, t_s and k.
+"$W" curve --max-elongation 30 --settle-time 250 --shape-k 4 --duration-s 900 --out "$D/c.csv" \
+  || fail "curve --out"
+head -1 "$D/c.csv" | grep -q "^#" || fail "curve CSV has no provenance comment"
+grep -q "^time_s,elongation_um" "$D/c.csv" || fail "curve CSV header"
+"$W" fit --curve "$D/c.csv" > "$D/fit.txt" || fail "fit --curve"
+grep -q "best fit (smallest RMS residual): arctan" "$D/fit.txt" || fail "arctan is not best: $(cat "$D/fit.txt")"
+"$W" fit --curve "$D/c.csv" --json > "$D/fit.json" || fail "fit --json"
+grep -q '"best_model": "arctan"' "$D/fit.json" || fail "fit --json best model"
+# k fitted with all parameters free is 4 within 1 %: read it from the JSON.
+k=$(tr -d ' \n' < "$D/fit.json" | grep -o '"shape_k":[0-9.e+-]*' | head -1 | cut -d: -f2)
+awk -v k="$k" 'BEGIN { exit !(k > 3.96 && k < 4.04) }' || fail "fitted k = $k, expected 4"
+
+# Bad curves: a gap, non-increasing time, a missing file.
+printf 'time_s,elongation_um\n0,0\n1,1\n2,2\n3,3\n4,4\n5,5\n100,6\n' > "$D/gap.csv"
+expect_fail "gap" "$W" fit --curve "$D/gap.csv"
+printf 'time_s,elongation_um\n0,0\n1,1\n1,2\n2,3\n' > "$D/dup.csv"
+expect_fail "increas" "$W" fit --curve "$D/dup.csv"
+"$W" fit --curve "$D/none.csv" > /dev/null 2>&1 && fail "missing file accepted"
+expect_fail "--curve" "$W" fit
+# curve: negative elongation and half-given features are rejected.
+"$W" curve --max-elongation -3 --settle-time 100 > /dev/null 2>&1 && fail "negative L accepted"
+expect_fail "together" "$W" curve --max-elongation 3
+echo "ok"
