@@ -81,6 +81,16 @@ sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
   return s;
 }
 
+sim::Screw NewTypeScrew(const sim::Screw& reference) {
+  ProcessInputs in;
+  in.hardness_hrc = 61.0;
+  in.diameter_mm = 63.0;
+  in.pitch_mm = 12.0;
+  in.raceway_radius_mm = 4.0;
+  in.cutting_speed_m_min = 200.0;
+  return ScrewWithInputs(reference, in, "new-type_63x12x6000");
+}
+
 ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
                              const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                              const CompareOptions& options) {

@@ -106,6 +106,13 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
 sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
                            const std::string& name);
 
+/// The demo's "new type" screw, outside the training rows (the paper's new workpiece type I):
+/// the reference blank and machine settings (`reference`: length, thread, tools, feed per tooth)
+/// with new process inputs inside the training ranges but unlike any training row:
+/// hardness 61 HRC, diameter 63 mm, lead 12 mm, raceway radius 4.0 mm, cutting speed 200 m/min.
+/// Name "new-type_63x12x6000".
+sim::Screw NewTypeScrew(const sim::Screw& reference);
+
 void to_json(nlohmann::json& j, const MetricReductions& r);
 /// Summary JSON (schema "whirl.compare", version 1): screw, kinematics, disturbances, features
 /// (truth, predicted, stddev), plan summary, experience class, per strategy metrics + ISO verdict,

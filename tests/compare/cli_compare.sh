@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Smoke test of `whirl compare` (reference screw, shipped model) with a report, and of
+# `whirl evaluate` on a few random screws.
+set -euo pipefail
+whirl="$1"; scratch="$2"; src="$3"
+rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
+model="$src/models/default.json"; screw="$src/datasets/screws/reference_80x10x6000.json"
+if [[ ! -f "$model" || ! -f "$screw" ]]; then echo "shipped model or screw missing"; exit 1; fi
+"$whirl" compare --model "$model" --screw "$screw" --seed 2 --json --report rep > cmp.json
+python3 - <<'PY'
+import json
+j = json.load(open("cmp.json"))
+assert j["schema"] == "whirl.compare"
+s = j["strategies"]
+n, m = s["none"]["metrics"], s["model"]["metrics"]
+assert m["accumulated_1000_um"] < n["accumulated_1000_um"], (m, n)
+r = j["reductions"]["model_vs_none"]["accumulated_1000_pct"]
+assert abs(r - 100 * (1 - m["accumulated_1000_um"] / n["accumulated_1000_um"])) < 1e-6
+for k in ("none", "traditional", "model"):
+    assert s[k]["iso"]["reached"] in ("P1", "P3", "P5", "T7", "T10", "none")
+PY
+test -s rep/index.html && test -s rep/report.json && test -s rep/reference_80x10x6000_lead.csv
+if command -v gnuplot > /dev/null; then test -s rep/reference_80x10x6000_lead.png; fi
+"$whirl" compare --model "$model" --screw "$screw" | grep -q "ISO 3408-3 class reached"
+# Bad screw file -> exit 1 naming the file.
+echo '{"schema_version": 1, "name": "x"}' > bad.json
+if "$whirl" compare --model "$model" --screw bad.json 2> err.txt; then exit 1; fi
+grep -q "bad.json" err.txt
+"$whirl" evaluate --no-validation --random 4 --seed 5 --json > eval.json
+python3 - <<'PY'
+import json
+j = json.load(open("eval.json"))
+assert j["summary"]["screws"] == 4 and len(j["screws"]) == 4
+PY
+echo OK

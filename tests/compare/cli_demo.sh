@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Smoke test of `whirl demo` in a scratch directory: plan files, report, summary with reductions.
+set -euo pipefail
+whirl="$1"; scratch="$2"
+rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
+"$whirl" demo --out-dir out > demo.txt
+grep -q "summary:" demo.txt
+grep -q "% less" demo.txt
+for f in reference_80x10x6000_plan.json reference_80x10x6000_plan.csv reference_80x10x6000_temp_comp.spf \
+         new-type_63x12x6000_plan.json report/index.html report/report.json; do
+  test -s "out/$f" || { echo "missing out/$f"; exit 1; }
+done
+grep -q "SA_TEMP_COMP" out/reference_80x10x6000_temp_comp.spf
+echo OK
