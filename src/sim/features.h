@@ -29,7 +29,7 @@ namespace whirl::sim {
 
 struct SettleOptions {
   double tolerance_rel = 0.02;       ///< band half-width relative to the plateau, -
-  double smoothing_window_s = 20.0;  ///< centred moving-average window, s
+  double smoothing_window_s = 60.0;  ///< centred moving-average window, s
   double tail_fraction = 0.35;       ///< part of the record (by time) used for the plateau line, -
   double noise_sigma_multiplier = 3.0;  ///< band floor in smoothed-noise standard deviations, -
   /// Degree of the tail polynomial p(t): 1 (default, a line: follows a slow drift); 0 = constant
