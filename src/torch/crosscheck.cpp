@@ -28,9 +28,10 @@ void RequireFinite(const Eigen::MatrixXd& m, const std::string& what) {
 /// F, J'e and ssE of nn's network at w (J = nn::ErrorJacobian).
 struct EigenObjective {
   double objective = 0, sse = 0, ssx = 0;
-  Eigen::VectorXd je;        ///< J'e
-  Eigen::MatrixXd jacobian;  ///< J_e_w
-  Eigen::VectorXd e;         ///< errors, sample-major
+  Eigen::VectorXd je;                ///< J'e
+  Eigen::MatrixXd jacobian;          ///< J_e_w
+  Eigen::VectorXd e;                 ///< errors, sample-major
+  Eigen::VectorXd t_abs_plus_y_abs;  ///< |t| + |y|, sample-major
 };
 
 EigenObjective EvaluateEigen(nn::Network net, const Eigen::VectorXd& w, const Eigen::MatrixXd& x,
@@ -41,6 +42,8 @@ EigenObjective EvaluateEigen(nn::Network net, const Eigen::VectorXd& w, const Ei
   EigenObjective out;
   const Eigen::MatrixXd e = t - cache.output();
   out.e = Eigen::Map<const Eigen::VectorXd>(e.data(), e.size());  // column-major = sample-major
+  const Eigen::MatrixXd ty = t.cwiseAbs() + cache.output().cwiseAbs();
+  out.t_abs_plus_y_abs = Eigen::Map<const Eigen::VectorXd>(ty.data(), ty.size());
   nn::ErrorJacobian(net, cache, &out.jacobian);
   out.sse = out.e.squaredNorm();
   out.ssx = w.squaredNorm();
@@ -311,7 +314,10 @@ void to_json(nlohmann::json& j, const CrosscheckReport& r) {
         {"termination", ToString(r.eigen_training.termination)},
         {"message", r.eigen_training.message}}},
       {"torch_training",
-       {{"method", "torch::optim::LBFGS, strong Wolfe line search, autograd gradient"},
+       {{"method", r.torch_training.preconditioned
+                       ? "torch::optim::LBFGS, strong Wolfe line search, autograd gradient, "
+                         "Gauss-Newton preconditioner (autograd Jacobian) per step"
+                       : "torch::optim::LBFGS, strong Wolfe line search, autograd gradient"},
         {"initial_objective", finite(r.torch_training.initial_objective)},
         {"final_objective", finite(r.torch_training.final_objective)},
         {"final_gradient_inf", finite(r.torch_training.final_gradient_inf)},
@@ -387,8 +393,11 @@ CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& in
     const TorchObjective tt = TorchEvaluate(layout, *w, x, t, alpha, beta);
     obj = std::max(obj, std::abs(tt.objective - e.objective) / std::abs(e.objective));
     const Eigen::VectorXd g_eigen = 2.0 * (beta * e.je + alpha * *w);
+    // e = t - y cancels when the fit is close: two correct implementations differ by ~eps |y|
+    // in each e, so the scale counts the magnitudes entering e, |t| + |y| (>= |e|).
+    const Eigen::VectorXd ty = e.t_abs_plus_y_abs;
     const Eigen::VectorXd scale =
-        2.0 * (beta * e.jacobian.cwiseAbs().transpose() * e.e.cwiseAbs() + alpha * w->cwiseAbs());
+        2.0 * (beta * e.jacobian.cwiseAbs().transpose() * ty + alpha * w->cwiseAbs());
     grad = std::max(grad, (tt.gradient - g_eigen).cwiseAbs().maxCoeff() / scale.maxCoeff());
     if (!std::isfinite(tt.objective) || !tt.gradient.allFinite()) {
       obj = grad = std::numeric_limits<double>::quiet_NaN();
@@ -397,7 +406,7 @@ CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& in
   report.figures.push_back({"objective", obj, options.objective_tolerance,
                             "|F_T - F_E| / |F_E|, F = beta ssE + alpha ssX, at w_model and w0"});
   report.figures.push_back({"gradient", grad, options.gradient_tolerance,
-                            "max |g_T - g_E| / max(2 beta |J|'|e| + 2 alpha |w|), g = dF/dw, "
+                            "max |g_T - g_E| / max(2 beta |J|'(|t|+|y|) + 2 alpha |w|), g = dF/dw, "
                             "autograd vs 2(beta J'e + alpha w)"});
 
   // 5. Training with alpha, beta fixed from the same start.

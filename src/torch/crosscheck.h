@@ -11,15 +11,18 @@
 //   jacobian    max_ij |J_T - J_E| / max(1, max_ij |J_E|), J = de/dw (n x N), autograd versus nn's
 //               analytic back-propagation (nn::ErrorJacobian);
 //   objective   |F_T - F_E| / |F_E|, F = beta ssE + alpha ssX (MacKay 1992; trainbr.h);
-//   gradient    max_i |g_T - g_E|_i / max_i (2 beta |J|'|e| + 2 alpha |w|)_i, g = dF/dw; the
-//               Eigen side is g_E = 2 (beta J'e + alpha w) from nn's Jacobian; the scale is the
-//               sum of magnitudes of the terms (it stays meaningful at a minimum where g ~ 0);
+//   gradient    max_i |g_T - g_E|_i / max_i (2 beta |J|'(|t| + |y|) + 2 alpha |w|)_i, g = dF/dw;
+//               the Eigen side is g_E = 2 (beta J'e + alpha w) from nn's Jacobian; the scale is the
+//               sum of magnitudes of the terms (meaningful at a minimum where g ~ 0) with |t| + |y|
+//               for |e| because e = t - y cancels on a close fit: there two correct codes differ
+//               by ~eps |y| per error, and with beta ~ 1e8 that alone is ~1e-9 of 2 beta |J|'|e|;
 //   training    from the same start w0 with alpha, beta fixed, F minimised (a) in Eigen by the
 //               damped Gauss-Newton (Levenberg-Marquardt) iteration of trainbr on nn's Jacobian,
 //               (b) in LibTorch by torch::optim::LBFGS with strong-Wolfe line search on autograd
-//               gradients. Agreement: |F_a - F_b| / |F_a| and the largest difference of the two
-//               trained networks' predictions on the data, normalized target units (a range of the
-//               training targets is 2 units, so 1e-6 units is 5e-7 of the range).
+//               gradients (Gauss-Newton preconditioned by default, see TorchMinimize). Agreement:
+//               |F_a - F_b| / |F_a| and the largest difference of the two trained networks'
+//               predictions on the data, normalized target units (a range of the training targets
+//               is 2 units, so 1e-6 units is 5e-7 of the range).
 // The objective and gradient are evaluated at the model's weights and at w0; the worse is reported.
 #include <Eigen/Core>
 #include <cstdint>

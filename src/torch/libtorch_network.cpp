@@ -87,11 +87,16 @@ class WhirlNetImpl : public ::torch::nn::Module {
     add("target", out_min, out_max);
   }
 
-  Tensor ForwardNormalized(const Tensor& x) const {
+  Tensor ForwardNormalized(const Tensor& x) const { return ForwardWith(x, LayerParameters()); }
+
+  /// The same network with other parameter values {W_0, b_0, W_1, b_1, ...} (may carry autograd
+  /// history, e.g. functions of a preconditioned variable).
+  static Tensor ForwardWith(const Tensor& x, const std::vector<Tensor>& p) {
     Tensor h = x;
-    for (std::size_t l = 0; l < weights_.size(); ++l) {
-      h = ::torch::matmul(h, weights_[l].t()) + biases_[l];
-      if (l + 1 < weights_.size()) h = ::torch::tanh(h);
+    const std::size_t layers = p.size() / 2;
+    for (std::size_t l = 0; l < layers; ++l) {
+      h = ::torch::matmul(h, p[2 * l].t()) + p[2 * l + 1];
+      if (l + 1 < layers) h = ::torch::tanh(h);
     }
     return h;
   }
@@ -143,15 +148,67 @@ Tensor SamplesToTensor(const Eigen::MatrixXd& x) {
   return ToTensor(Eigen::MatrixXd(x.transpose()));
 }
 
-Tensor Objective(const WhirlNet& net, const Tensor& x, const Tensor& t, double alpha, double beta,
-                 Tensor* sse, Tensor* ssx) {
-  const Tensor e = t - net->ForwardNormalized(x);
+Tensor ObjectiveWith(const std::vector<Tensor>& p, const Tensor& x, const Tensor& t, double alpha,
+                     double beta, Tensor* sse, Tensor* ssx) {
+  const Tensor e = t - WhirlNetImpl::ForwardWith(x, p);
   Tensor sum_e = e.pow(2).sum();
   Tensor sum_x = ::torch::zeros({}, kF64);
-  for (const Tensor& p : net->LayerParameters()) sum_x = sum_x + p.pow(2).sum();
+  for (const Tensor& q : p) sum_x = sum_x + q.pow(2).sum();
   if (sse != nullptr) *sse = sum_e;
   if (ssx != nullptr) *ssx = sum_x;
   return beta * sum_e + alpha * sum_x;
+}
+
+Tensor Objective(const WhirlNet& net, const Tensor& x, const Tensor& t, double alpha, double beta,
+                 Tensor* sse, Tensor* ssx) {
+  return ObjectiveWith(net->LayerParameters(), x, t, alpha, beta, sse, ssx);
+}
+
+/// Parameters as one vector in torch's own order (each tensor row-major, in LayerParameters order)
+/// and back; used only inside the preconditioned LBFGS, never compared with nn's order.
+Tensor CatParameters(const std::vector<Tensor>& p) {
+  std::vector<Tensor> flat;
+  for (const Tensor& q : p) flat.push_back(q.detach().reshape({-1}));
+  return ::torch::cat(flat);
+}
+
+std::vector<Tensor> SplitParameters(const Tensor& v, const std::vector<Tensor>& like) {
+  std::vector<Tensor> out;
+  int64_t offset = 0;
+  for (const Tensor& q : like) {
+    out.push_back(v.narrow(0, offset, q.numel()).view(q.sizes()));
+    offset += q.numel();
+  }
+  return out;
+}
+
+/// Gauss-Newton preconditioner M = L^-T with L L' = beta J'J + alpha I, J = dy/dw by autograd at
+/// the current parameters (torch order). Undefined tensor if H is not positive definite.
+Tensor GaussNewtonPreconditioner(const std::vector<Tensor>& params, const Tensor& x, double alpha,
+                                 double beta) {
+  const Tensor y = WhirlNetImpl::ForwardWith(x, params).reshape({-1});
+  const int64_t n = y.size(0);
+  int64_t count = 0;
+  for (const Tensor& q : params) count += q.numel();
+  Tensor jacobian = ::torch::zeros({n, count}, kF64);
+  for (int64_t i = 0; i < n; ++i) {
+    const std::vector<Tensor> g = ::torch::autograd::grad({y[i]}, params, {}, /*retain_graph=*/true,
+                                                          /*create_graph=*/false,
+                                                          /*allow_unused=*/true);
+    std::vector<Tensor> filled;
+    for (std::size_t k = 0; k < g.size(); ++k)
+      filled.push_back(g[k].defined() ? g[k] : ::torch::zeros_like(params[k]));
+    jacobian[i] = CatParameters(filled);
+  }
+  const Tensor eye = ::torch::eye(count, kF64);
+  const Tensor h = beta * jacobian.t().mm(jacobian) + alpha * eye;
+  try {
+    const Tensor l = ::torch::linalg::cholesky(h);
+    return ::torch::linalg::solve_triangular(l.t(), eye, /*upper=*/true, /*left=*/true,
+                                             /*unitriangular=*/false);
+  } catch (const c10::Error&) {
+    return Tensor();
+  }
 }
 
 void CheckData(const whirl::torch::FlatLayout& layout, const Eigen::MatrixXd& x,
@@ -334,10 +391,12 @@ std::string ToString(LbfgsTermination t) {
 }
 
 std::string LbfgsSummary::BriefReport() const {
-  return "LBFGS (LibTorch, strong Wolfe): F " + FormatDouble(initial_objective) + " -> " +
-         FormatDouble(final_objective) + " in " + std::to_string(iterations) + " iterations (" +
-         std::to_string(steps) + " steps, " + std::to_string(function_evaluations) +
-         " evaluations), " + ToString(termination) + " (" + message + ")";
+  return "LBFGS (LibTorch, strong Wolfe" +
+         std::string(preconditioned ? ", Gauss-Newton preconditioner" : "") + "): F " +
+         FormatDouble(initial_objective) + " -> " + FormatDouble(final_objective) + " in " +
+         std::to_string(iterations) + " iterations (" + std::to_string(steps) + " steps, " +
+         std::to_string(function_evaluations) + " evaluations), " + ToString(termination) + " (" +
+         message + ")";
 }
 
 LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
@@ -354,27 +413,41 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
   WhirlNet net(layout, w0);
   const Tensor x = SamplesToTensor(x_norm), t = SamplesToTensor(t_norm);
   const std::vector<Tensor> params = net->LayerParameters();
-  ::torch::optim::LBFGS optimizer(params, ::torch::optim::LBFGSOptions(1.0)
-                                              .max_iter(options.iterations_per_step)
-                                              .history_size(options.history_size)
-                                              .tolerance_grad(options.gradient_tolerance)
-                                              .tolerance_change(options.change_tolerance)
-                                              .line_search_fn("strong_wolfe"));
+  const auto lbfgs_options = [&] {
+    return ::torch::optim::LBFGSOptions(1.0)
+        .max_iter(options.iterations_per_step)
+        .history_size(options.history_size)
+        .tolerance_grad(options.gradient_tolerance)
+        .tolerance_change(options.change_tolerance)
+        .line_search_fn("strong_wolfe");
+  };
   int evaluations = 0;
-  auto closure = [&]() -> Tensor {
-    optimizer.zero_grad();
-    Tensor f = Objective(net, x, t, alpha, beta, nullptr, nullptr);
+  // Objective and inf-norm of dF/dw at the current parameters.
+  const auto evaluate = [&](double* f, double* g_inf) {
+    const Tensor value = ObjectiveWith(params, x, t, alpha, beta, nullptr, nullptr);
+    const std::vector<Tensor> grads = ::torch::autograd::grad({value}, params);
+    double worst = 0;
+    for (const Tensor& g : grads) worst = std::max(worst, g.abs().max().item<double>());
+    ++evaluations;
+    *f = value.item<double>();
+    *g_inf = worst;
+  };
+  const auto iterations_of = [](const ::torch::optim::LBFGS& optimizer) {
+    int64_t n = 0;
+    for (const auto& kv : optimizer.state()) {
+      n = static_cast<const ::torch::optim::LBFGSParamState&>(*kv.second).n_iter();
+    }
+    return static_cast<int>(n);
+  };
+
+  // Plain LBFGS keeps one optimizer (and its history) over all steps.
+  ::torch::optim::LBFGS plain(params, lbfgs_options());
+  auto plain_closure = [&]() -> Tensor {
+    plain.zero_grad();
+    Tensor f = ObjectiveWith(params, x, t, alpha, beta, nullptr, nullptr);
     f.backward();
     ++evaluations;
     return f;
-  };
-  // Objective and inf-norm of the gradient at the current parameters.
-  const auto evaluate = [&](double* f, double* g_inf) {
-    const Tensor value = closure();
-    double worst = 0;
-    for (const Tensor& p : params) worst = std::max(worst, p.grad().abs().max().item<double>());
-    *f = value.item<double>();
-    *g_inf = worst;
   };
 
   LbfgsSummary summary;
@@ -382,20 +455,38 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
   evaluate(&f, &g_inf);
   summary.initial_objective = f;
   summary.termination = LbfgsTermination::kMaxSteps;
+  int preconditioned_iterations = 0;
   for (int step = 0; step < options.max_steps; ++step) {
     if (!std::isfinite(f) || !std::isfinite(g_inf)) {
       summary.termination = LbfgsTermination::kNonFinite;
       summary.message = "F = " + FormatDouble(f) + ", ||g||_inf = " + FormatDouble(g_inf);
       break;
     }
-    if (g_inf <= options.gradient_tolerance) {
-      summary.termination = LbfgsTermination::kGradientTolerance;
-      summary.message = "||dF/dw||_inf " + FormatDouble(g_inf) +
-                        " <= " + FormatDouble(options.gradient_tolerance);
-      break;
-    }
+    if (g_inf <= options.gradient_tolerance) break;
     const double f_before = f;
-    optimizer.step(closure);
+    Tensor m;
+    if (options.gauss_newton_preconditioner) m = GaussNewtonPreconditioner(params, x, alpha, beta);
+    if (m.defined()) {
+      // LBFGS on z with w = w_c + M z: the same F, Hessian ~ 2 I near w_c.
+      const Tensor w_c = CatParameters(params);
+      Tensor z = ::torch::zeros({w_c.size(0)}, kF64).requires_grad_(true);
+      ::torch::optim::LBFGS optimizer({z}, lbfgs_options());
+      auto closure = [&]() -> Tensor {
+        optimizer.zero_grad();
+        Tensor value = ObjectiveWith(SplitParameters(w_c + m.mv(z), params), x, t, alpha, beta,
+                                     nullptr, nullptr);
+        value.backward();
+        ++evaluations;
+        return value;
+      };
+      optimizer.step(closure);
+      preconditioned_iterations += iterations_of(optimizer);
+      ::torch::NoGradGuard no_grad;
+      const std::vector<Tensor> w_new = SplitParameters(w_c + m.mv(z.detach()), params);
+      for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(w_new[k]);
+    } else {
+      plain.step(plain_closure);
+    }
     ++summary.steps;
     evaluate(&f, &g_inf);
     if (std::isfinite(f) && f >= f_before && g_inf > options.gradient_tolerance) {
@@ -416,11 +507,8 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
                         FormatDouble(g_inf) + " > " + FormatDouble(options.gradient_tolerance);
     }
   }
-  const auto& state = optimizer.state();
-  for (const auto& kv : state) {
-    const auto& s = static_cast<const ::torch::optim::LBFGSParamState&>(*kv.second);
-    summary.iterations = static_cast<int>(s.n_iter());
-  }
+  summary.iterations = preconditioned_iterations + iterations_of(plain);
+  summary.preconditioned = options.gauss_newton_preconditioner;
   summary.final_objective = f;
   summary.final_gradient_inf = g_inf;
   summary.function_evaluations = evaluations;
@@ -476,6 +564,8 @@ namespace {
   } catch (const c10::Error& e) {
     throw InputError("cannot load TorchScript file '" + path.string() +
                      "': " + e.what_without_backtrace());
+  } catch (const std::exception& e) {
+    throw InputError("cannot load TorchScript file '" + path.string() + "': " + e.what());
   }
 }
 }  // namespace
@@ -487,9 +577,33 @@ Eigen::MatrixXd RunTorchScript(const std::filesystem::path& path, const Eigen::M
   try {
     const Tensor y = module.forward({SamplesToTensor(x_raw)}).toTensor();
     return ToEigenMatrix(y.t());
+  } catch (const InputError&) {
+    throw;
   } catch (const c10::Error& e) {
     throw InputError("TorchScript file '" + path.string() +
                      "' failed to run: " + e.what_without_backtrace());
+  } catch (const std::exception& e) {  // torch::jit::JITException (a failed assert in forward)
+    throw InputError("TorchScript file '" + path.string() + "' failed to run: " + e.what());
+  }
+}
+
+Eigen::VectorXd RunTorchScriptOne(const std::filesystem::path& path, const Eigen::VectorXd& x_raw) {
+  Prepare();
+  ::torch::jit::Module module = LoadScript(path);
+  ::torch::NoGradGuard no_grad;
+  try {
+    const Tensor y = module.forward({ToTensor(x_raw)}).toTensor();
+    if (y.dim() != 1)
+      throw InputError("TorchScript file '" + path.string() + "': a 1-D input gave a " +
+                       std::to_string(y.dim()) + "-D result");
+    return ToEigenMatrix(y.reshape({-1, 1})).col(0);
+  } catch (const InputError&) {
+    throw;
+  } catch (const c10::Error& e) {
+    throw InputError("TorchScript file '" + path.string() +
+                     "' failed to run: " + e.what_without_backtrace());
+  } catch (const std::exception& e) {  // torch::jit::JITException (a failed assert in forward)
+    throw InputError("TorchScript file '" + path.string() + "' failed to run: " + e.what());
   }
 }
 

@@ -62,6 +62,13 @@ TorchObjective TorchEvaluate(const FlatLayout& layout, const Eigen::VectorXd& w,
                              double alpha, double beta);
 
 /// LibTorch torch::optim::LBFGS with strong-Wolfe line search on F(w), alpha and beta fixed.
+/// With beta ~ 1e8 (near noise-free data) F is so ill-conditioned that plain LBFGS stalls far from
+/// the minimum; the default therefore runs each step in preconditioned variables
+/// w = w_c + M z, M = L^-T, L L' = beta J'J + alpha I (J = dy/dw by autograd at the step's start
+/// w_c, Cholesky by torch::linalg): the same F and minima, Hessian ~ 2 I near w_c (Nocedal &
+/// Wright, Numerical Optimization, 2nd ed., section 7.2 on preconditioned quasi-Newton). A fresh
+/// LBFGS (history cleared) runs in each step; if H is not positive definite (alpha = 0 and rank
+/// deficient J) that step falls back to plain LBFGS.
 struct LbfgsOptions {
   /// Outer calls of LBFGS::step; each runs up to `iterations_per_step` LBFGS iterations.
   int max_steps = 100;
@@ -73,6 +80,9 @@ struct LbfgsOptions {
   double gradient_tolerance = 1e-10;
   /// torch's tolerance_change: stop inside a step when F or the step changes less than this.
   double change_tolerance = 1e-16;
+  /// Gauss-Newton preconditioner refreshed at every step (see above); false = plain LBFGS with
+  /// one history over all steps.
+  bool gauss_newton_preconditioner = true;
 };
 
 enum class LbfgsTermination {
@@ -93,6 +103,7 @@ struct LbfgsSummary {
   int steps = 0;                  ///< LBFGS::step calls
   int iterations = 0;             ///< LBFGS iterations over all steps (torch's n_iter)
   int function_evaluations = 0;   ///< objective+gradient evaluations (closure calls)
+  bool preconditioned = false;    ///< LbfgsOptions::gauss_newton_preconditioner was on
   LbfgsTermination termination = LbfgsTermination::kMaxSteps;
   std::string message;  ///< the compared numbers
   Eigen::VectorXd w;    ///< final weights, flat order
@@ -136,6 +147,9 @@ Eigen::MatrixXd TorchPredictRaw(const ModelSpec& spec, const Eigen::MatrixXd& x_
 /// Loads a TorchScript file and runs forward on raw inputs (inputs x Q, original units); returns
 /// outputs x Q in original units. Throws InputError if the file cannot be loaded or run.
 Eigen::MatrixXd RunTorchScript(const std::filesystem::path& path, const Eigen::MatrixXd& x_raw);
+
+/// Same for one sample passed as a 1-D tensor of size `inputs` (the script returns a 1-D result).
+Eigen::VectorXd RunTorchScriptOne(const std::filesystem::path& path, const Eigen::VectorXd& x_raw);
 
 /// The names stored by SaveTorchScript (input_names(), target_names()).
 std::vector<std::string> TorchScriptNames(const std::filesystem::path& path, bool inputs);

@@ -198,6 +198,25 @@ TEST(TorchCrosscheck, TrainedModelPassesEveryFigure) {
   EXPECT_EQ(j.at("figures").size(), 7u);
 }
 
+TEST(TorchCrosscheck, TrainingAgreesFromSeveralStartsAndSizes) {
+  // Property over starts and architectures: both minimisers reach the same minimum.
+  const ProcessTable table = test::SyntheticTable(20, 7);
+  for (const std::vector<int>& hidden : {std::vector<int>{4}, std::vector<int>{3, 3}}) {
+    nn::ModelTrainOptions train;
+    train.hidden_sizes = hidden;
+    train.seed = 5;
+    train.train.epochs = 300;
+    const nn::Model model = nn::TrainModel(table, train, "synthetic");
+    for (std::uint64_t seed : {2u, 3u}) {
+      CrosscheckOptions options;
+      options.seed = seed;
+      const CrosscheckReport report = RunCrosscheck(model, table, options);
+      EXPECT_TRUE(report.Passed()) << "hidden layers " << hidden.size() << ", seed " << seed << "\n"
+                                   << report.Table();
+    }
+  }
+}
+
 TEST(TorchCrosscheck, RejectsBadOptionsAndData) {
   const nn::Model model = test::SmallTrainedModel();
   CrosscheckOptions bad;
@@ -231,6 +250,11 @@ TEST(TorchExport, LoadedTorchScriptPredictsLikeTheEigenModel) {
   std::vector<Features> means;
   for (const auto& p : nn::PredictBatch(model, inputs)) means.push_back(p.mean);
   EXPECT_TRUE(AllNear(y_script, nn::TargetMatrix(means), 1e-12));
+
+  // One sample as a 1-D tensor gives a 1-D result; a wrong input width is refused.
+  const Eigen::VectorXd one = RunTorchScriptOne(file, nn::InputMatrix({inputs[3]}).col(0));
+  EXPECT_TRUE(AllNear(one, nn::TargetMatrix({means[3]}).col(0), 1e-12));
+  EXPECT_THROW(RunTorchScript(file, Eigen::MatrixXd::Ones(4, 2)), InputError);
 
   const auto in_names = TorchScriptNames(file, true);
   const auto out_names = TorchScriptNames(file, false);
