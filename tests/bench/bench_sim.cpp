@@ -26,3 +26,4 @@ void BM_Table500Rows(benchmark::State& state) {
 BENCHMARK(BM_Table500Rows)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 }  // namespace
+BENCHMARK_MAIN();
