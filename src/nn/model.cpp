@@ -163,8 +163,8 @@ void Model::Validate() const {
   if (error_space != "normalized")
     throw InputError("model 'error_space' is '" + error_space +
                      "', this version only knows 'normalized'");
-  if (!(noise_variance > 0) || !std::isfinite(noise_variance))
-    throw InputError("model 'uncertainty.noise_variance_normalized' must be finite and > 0");
+  if (!(noise_variance >= 0) || !std::isfinite(noise_variance))
+    throw InputError("model 'uncertainty.noise_variance_normalized' must be finite and >= 0");
   const int N = network.ParameterCount();
   if (posterior_covariance.rows() != N || posterior_covariance.cols() != N)
     throw InputError("model 'uncertainty.posterior_covariance' must be " + std::to_string(N) + "x" +

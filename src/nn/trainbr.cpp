@@ -1,6 +1,7 @@
 #include "nn/trainbr.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -25,16 +26,18 @@ std::string ToString(TrainTermination t) {
     case TrainTermination::kMaxEpochs: return "max_epochs";
     case TrainTermination::kMinGradient: return "min_gradient";
     case TrainTermination::kMaxMu: return "max_mu";
+    case TrainTermination::kInterpolation: return "interpolation";
   }
   return "unknown";
 }
 
 TrainTermination ParseTermination(const std::string& s) {
   for (auto t : {TrainTermination::kGoalMet, TrainTermination::kMaxEpochs,
-                 TrainTermination::kMinGradient, TrainTermination::kMaxMu})
+                 TrainTermination::kMinGradient, TrainTermination::kMaxMu,
+                 TrainTermination::kInterpolation})
     if (ToString(t) == s) return t;
   throw InputError("termination '" + s +
-                   "' is not one of goal_met, max_epochs, min_gradient, max_mu");
+                   "' is not one of goal_met, max_epochs, min_gradient, max_mu, interpolation");
 }
 
 std::string ToString(Regularization r) {
@@ -237,6 +240,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   sum.regularization = options.regularization;
   double mu = options.mu;
   double gradient = 0;
+  std::string degenerate_message;  // set when the alpha/beta update stops being finite
 
   for (int epoch = 0;; ++epoch) {
     ErrorJacobian(net, cache, &J);
@@ -248,6 +252,11 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     gradient = 2 * je.norm();
 
     sum.epochs = epoch;
+    if (!degenerate_message.empty()) {
+      sum.termination = TrainTermination::kInterpolation;
+      sum.message = degenerate_message;
+      break;
+    }
     if (sse <= options.goal) {
       sum.termination = TrainTermination::kGoalMet;
       sum.message = "ssE = " + Num(sse) + " <= goal = " + Num(options.goal);
@@ -318,9 +327,18 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
       llt.compute(A);
       L_inv.setIdentity();
       llt.matrixL().solveInPlace(L_inv);
-      gamma = N - alpha * L_inv.squaredNorm();
-      alpha = ssx == 0 ? 1.0 : gamma / (2 * ssx);
-      beta = sse == 0 ? 1.0 : (n - gamma) / (2 * sse);
+      const double gamma_new = N - alpha * L_inv.squaredNorm();
+      const double alpha_new = ssx == 0 ? 1.0 : gamma_new / (2 * ssx);
+      const double beta_new = sse == 0 ? 1.0 : (n - gamma_new) / (2 * sse);
+      if (std::isfinite(alpha_new) && alpha_new > 0 && std::isfinite(beta_new) && beta_new > 0) {
+        gamma = gamma_new;
+        alpha = alpha_new;
+        beta = beta_new;
+      } else {
+        degenerate_message = "gamma = " + Num(gamma_new) + ", alpha = " + Num(alpha_new) +
+                             ", beta = (n - gamma)/(2 ssE) = " + Num(beta_new) + " at ssE = " +
+                             Num(sse) + " (kept the last finite alpha, beta)";
+      }
       F = beta * sse + alpha * ssx;
     }
     info.objective = F;
@@ -345,16 +363,20 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
   if (bayes) {
     // Laplace approximation at the final weights (jj is at the final w: the loop ended right
-    // after computing it).
-    A = beta * jj;
-    A.diagonal().array() += alpha;
-    llt.compute(A);
-    const double log_det_h = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+    // after computing it). Through the eigenvalues of jj (clamped at 0) rather than a Cholesky
+    // factor, so that a near-interpolating fit (beta ~ 1e8 or more, H badly conditioned) still
+    // gives a finite log det and a positive semi-definite covariance.
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jj);
+    const Eigen::VectorXd h_eig =
+        (beta * eig.eigenvalues().cwiseMax(0.0)).array() + alpha;  // eigenvalues of H
+    const double log_det_h = h_eig.array().log().sum();
     sum.log_evidence = LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n),
                                    net.layer_sizes);
     sum.noise_variance = 1.0 / (2.0 * beta);
-    result.posterior_covariance = 0.5 * llt.solve(Eigen::MatrixXd::Identity(N, N));
-    // Exact symmetry (the solve leaves rounding-level asymmetry).
+    const Eigen::MatrixXd& V = eig.eigenvectors();
+    result.posterior_covariance =
+        V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
+    // Exact symmetry (the product leaves rounding-level asymmetry).
     result.posterior_covariance =
         0.5 * (result.posterior_covariance + result.posterior_covariance.transpose()).eval();
   } else {

@@ -48,6 +48,10 @@ enum class TrainTermination {
   kMaxEpochs,    ///< epoch == epochs
   kMinGradient,  ///< gradient = 2 ||J'e|| <= min_grad
   kMaxMu,        ///< mu >= mu_max: no step decreased F any more (trainbr's usual ending)
+  /// Not in MATLAB: the alpha/beta update gave a non-finite or non-positive value (ssE
+  /// underflowed because the network interpolates the data, gamma -> n; possible when N > n).
+  /// Training stops with the last finite alpha, beta. Tested first, at the next epoch.
+  kInterpolation,
 };
 std::string ToString(TrainTermination t);        ///< "goal_met", "max_epochs", ...
 TrainTermination ParseTermination(const std::string& s);  ///< inverse; InputError otherwise

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Smoke test of 'whirl train' and 'whirl predict': help, results, determinism, exit codes and the
+# messages for bad input. Usage (CTest): cli_nn.sh <whirl> <scratch dir> <source dir>
+set -uo pipefail
+whirl="$1"; scratch="$2"; src="$3"
+rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+# expect <code> <stderr substring> -- command...: runs, checks exit code and stderr text.
+expect() {
+  local code="$1" text="$2"; shift 3
+  "$@" > out.txt 2> err.txt; local rc=$?
+  [ "$rc" -eq "$code" ] || fail "exit $rc (want $code): $* ; stderr: $(cat err.txt)"
+  [ -z "$text" ] || grep -qF -- "$text" err.txt || fail "stderr lacks '$text': $* ; got: $(cat err.txt)"
+}
+data="$src/datasets/whirling_train.csv"
+H="hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min,max_elongation_um,settle_time_s"
+
+# --help explains, with units
+expect 0 "" -- "$whirl" train --help
+grep -q "max_elongation_um \[um\]" out.txt || fail "train --help lacks target units"
+expect 0 "" -- "$whirl" predict --help
+grep -q "\[HRC\]" out.txt || fail "predict --help lacks units"
+
+# train: writes a model, human summary on stdout, progress on stderr
+expect 0 "" -- "$whirl" train --data "$data" --out m1.json --seed 3 --restarts 2
+[ -s m1.json ] || fail "no model written"
+grep -q "gamma" out.txt || fail "train summary lacks gamma"
+grep -q "train: done" err.txt || fail "no progress on stderr"
+grep -q '"error_space": "normalized"' m1.json || fail "model lacks error_space"
+grep -q '"schema_version": 1' m1.json || fail "model lacks schema_version"
+# same seed => byte-identical file; --json summary
+expect 0 "" -- "$whirl" train --data "$data" --out m2.json --seed 3 --restarts 2 --json
+cmp -s m1.json m2.json || fail "same seed gave different model files"
+grep -q '"termination"' out.txt || fail "train --json lacks termination"
+grep -q '"log_evidence"' out.txt || fail "train --json lacks log_evidence"
+
+# hidden sweep
+expect 0 "" -- "$whirl" train --data "$data" --hidden-sweep 3..4 --folds 4
+grep -q "cv_rms" out.txt || fail "sweep lacks cv columns"
+[ "$(grep -cE '^ +[34] ' out.txt)" -eq 2 ] || fail "sweep should print 2 rows: $(cat out.txt)"
+expect 1 "" -- "$whirl" train --data "$data" --hidden-sweep 3..4 --out x.json
+expect 1 "hidden-sweep" -- "$whirl" train --data "$data" --hidden-sweep 5..2
+expect 1 "--out" -- "$whirl" train --data "$data"
+
+# predict one process (flags), a table, JSON, CSV output
+expect 0 "" -- "$whirl" predict --model m1.json --hardness 62 --diameter 80 --pitch 10 \
+  --raceway-radius 5 --cutting-speed 180
+grep -q "+-" out.txt || fail "predict table lacks +- std"
+grep -q "max elongation \[um\]" out.txt || fail "predict table lacks units"
+expect 0 "" -- "$whirl" predict --model m1.json --input "$src/datasets/whirling_validation.csv" \
+  --out pred.csv
+head -n 5 pred.csv | grep -q "^hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min,max_elongation_um,max_elongation_std_um,settle_time_s,settle_time_std_s,outside_domain$" \
+  || fail "predict --out header wrong: $(head -n 5 pred.csv)"
+[ "$(grep -cvE '^(#|hardness)' pred.csv)" -eq "$(grep -cvE '^(#|hardness)' "$src/datasets/whirling_validation.csv")" ] \
+  || fail "predict --out row count"
+grep -q "mean absolute error" out.txt || fail "targets in --input not used for an error report"
+# outside the domain: warning + JSON flag, still exit 0
+expect 0 "outside the training domain" -- "$whirl" predict --model m1.json --hardness 62 \
+  --diameter 300 --pitch 10 --raceway-radius 5 --cutting-speed 180 --json
+grep -q '"outside_domain": true' out.txt || fail "JSON lacks outside_domain flag"
+grep -q '"diameter_mm"' out.txt || fail "JSON lacks the outside field name"
+grep -q '"max_elongation_std_um"' out.txt || fail "JSON lacks std"
+
+# bad training tables: exit 1, message names file, line and column
+printf "$H\n62,80,10,5,180,20,300\n62,80,x10,5,180,20,300\n" > cell.csv
+printf "$H\n62,80,10,5,180,20,300\n62,nan,10,5,180,20,300\n" > nan.csv
+printf "$H\n62,80,10,5,180,20,300\n62,80,10,5,inf,20,300\n" > inf.csv
+printf "hardness_hrc,diameter_mm,pitch_mm,cutting_speed_m_min,max_elongation_um,settle_time_s\n62,80,10,180,20,300\n" > missing.csv
+printf "$H,pitch_mm\n62,80,10,5,180,20,300,10\n" > dup.csv
+printf "# only a comment\n$H\n" > empty.csv
+printf "hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min\n62,80,10,5,180\n63,81,11,6,190\n" > notarget.csv
+expect 1 "cell.csv:3: column 3 ('pitch_mm'): 'x10'" -- "$whirl" train --data cell.csv --out bad.json
+expect 1 "nan.csv:3: column 2 ('diameter_mm')" -- "$whirl" train --data nan.csv --out bad.json
+expect 1 "inf.csv:3: column 5 ('cutting_speed_m_min')" -- "$whirl" train --data inf.csv --out bad.json
+expect 1 "missing column 'raceway_radius_mm'" -- "$whirl" train --data missing.csv --out bad.json
+expect 1 "dup.csv:1: duplicated column 'pitch_mm'" -- "$whirl" train --data dup.csv --out bad.json
+expect 1 "empty.csv: table has no data rows" -- "$whirl" train --data empty.csv --out bad.json
+expect 1 "missing column 'max_elongation_um'" -- "$whirl" train --data notarget.csv --out bad.json
+expect 1 "" -- "$whirl" train --data does_not_exist.csv --out bad.json
+expect 1 "does not exist" -- "$whirl" train --data "$data" --out no_such_dir/m.json
+[ ! -e bad.json ] || fail "a failed train left bad.json behind"
+expect 1 "" -- "$whirl" train --data "$data" --out bad.json --hidden 0
+[ ! -e bad.json ] || fail "a failed train left bad.json behind"
+
+# bad predict input
+expect 1 "missing: --pitch --raceway-radius --cutting-speed" -- "$whirl" predict --model m1.json \
+  --hardness 62 --diameter 80
+expect 1 "" -- "$whirl" predict --model m1.json --input "$src/datasets/whirling_validation.csv" --hardness 62
+expect 1 "nan.csv:3" -- "$whirl" predict --model m1.json --input nan.csv
+head -c 3000 m1.json > trunc.json
+expect 1 "trunc.json" -- "$whirl" predict --model trunc.json --hardness 62 --diameter 80 \
+  --pitch 10 --raceway-radius 5 --cutting-speed 180
+sed 's/"schema_version": 1/"schema_version": 7/' m1.json > v7.json
+expect 1 "schema_version" -- "$whirl" predict --model v7.json --hardness 62 --diameter 80 \
+  --pitch 10 --raceway-radius 5 --cutting-speed 180
+expect 1 "" -- "$whirl" predict --model m1.json --hardness 62 --diameter -80 --pitch 10 \
+  --raceway-radius 5 --cutting-speed 180
+
+if [ "$fails" -ne 0 ]; then echo "$fails failure(s)" >&2; exit 1; fi
+echo "ok: whirl train/predict smoke test"
