@@ -101,7 +101,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "(SD43900/10/20 breakpoints)'\n"
     << "set output\n";
   // Lead deviation along the whole thread.
-  s << "set key right top box opaque\n"
+  s << "set key below horizontal box\nset bmargin 6\n"
     << "set output '" << f.lead << ".tmp'\n"
     << "set title '" << c.screw.name
     << ": travel deviation along the thread after cooling (actual - specified)'\n"
