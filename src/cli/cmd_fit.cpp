@@ -23,6 +23,7 @@ struct FitOptions {
   double window_s = 1800.0;
   bool disturbances = false;
   double max_gap_factor = 5.0;
+  double fit_window_factor = 2.0;
   bool json = false;
 };
 
@@ -42,8 +43,18 @@ nlohmann::json FitJson(const fit::CurveFit& f) {
 }
 
 void RunCurve(const FitOptions& o) {
-  const ElongationCurve curve = ReadElongationCurve(o.curve_path, o.max_gap_factor);
-  const sim::SettleAnalysis settle = sim::AnalyzeSettle(curve);
+  const ElongationCurve record = ReadElongationCurve(o.curve_path, o.max_gap_factor);
+  const sim::SettleAnalysis settle = sim::AnalyzeSettle(record);
+  // The models describe the rise and the plateau it settles on; a long record's slow drift
+  // (ambient, sensor) is not part of them, so they are fitted on [0, factor * t_s].
+  ElongationCurve curve;
+  const double t_max = o.fit_window_factor > 0 ? o.fit_window_factor * settle.features.settle_time_s
+                                               : record.time_s.back();
+  for (std::size_t i = 0; i < record.size() && record.time_s[i] <= t_max; ++i) {
+    curve.time_s.push_back(record.time_s[i]);
+    curve.elongation_um.push_back(record.elongation_um[i]);
+  }
+  if (curve.size() < 10) curve = record;
   const std::vector<fit::CurveFit> fits = fit::FitAllModels(curve);
   const fit::ShapeFit shape = fit::FitShapeK(curve, settle.features);
   std::size_t best = 0;
@@ -62,7 +73,8 @@ void RunCurve(const FitOptions& o) {
     PrintJson({{"schema", "whirl.fit"},
                {"schema_version", 1},
                {"curve", o.curve_path},
-               {"samples", curve.size()},
+               {"samples", record.size()},
+               {"fit_window_s", {curve.time_s.front(), curve.time_s.back()}},
                {"features",
                 {{"max_elongation_um", settle.features.max_elongation_um},
                  {"settle_time_s", settle.features.settle_time_s},
@@ -77,7 +89,8 @@ void RunCurve(const FitOptions& o) {
                {"best_model", fit::ToString(fits[best].model)}});
     return;
   }
-  std::printf("curve %s: %zu samples, %.6g to %.6g s\n", o.curve_path.c_str(), curve.size(),
+  std::printf("curve %s: %zu samples, %.6g to %.6g s; models fitted on %.6g to %.6g s\n",
+              o.curve_path.c_str(), record.size(), record.time_s.front(), record.time_s.back(),
               curve.time_s.front(), curve.time_s.back());
   std::printf("features: max elongation %.4f um, settle time %.2f s (sim::AnalyzeSettle)\n",
               settle.features.max_elongation_um, settle.features.settle_time_s);
@@ -190,6 +203,11 @@ void RegisterFit(CLI::App& app) {
                   "a time step larger than this times the median step is a gap (error) [-]")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1e6));
+  sub->add_option("--fit-window-factor", o->fit_window_factor,
+                  "fit the models on [0, factor * settle time] (the rise and its plateau, not a "
+                  "long record's drift); 0 = the whole record [-]")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] {
     if (o->curve_path.empty() && o->simulated == 0)

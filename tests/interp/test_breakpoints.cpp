@@ -25,7 +25,7 @@ TEST(Breakpoints, BoundHoldsBetweenCheckSamplesOnRandomCurves) {
     BreakpointOptions o;
     o.tolerance_um = utol(rng);
     o.check_step_s = ustep(rng);
-    o.forced_times_s = {c.settle_time_s};
+    o.forced_times_s.assign(1, c.settle_time_s);
     const double t_end = c.settle_time_s * 3.0;
     auto f = [&](double t) { return c.ElongationUm(t); };
     const Breakpoints bp = ChooseBreakpoints(f, 0.0, t_end, o);
@@ -52,7 +52,7 @@ TEST(Breakpoints, BoundHoldsBetweenCheckSamplesOnRandomCurves) {
 TEST(Breakpoints, DenseWhileMovingSparseOnPlateau) {
   const fit::ArctanCurve c{50.0, 250.0, 5.0};
   BreakpointOptions o;
-  o.forced_times_s = {c.settle_time_s};
+  o.forced_times_s.assign(1, c.settle_time_s);
   const Breakpoints bp = ChooseBreakpoints([&](double t) { return c.ElongationUm(t); }, 0, 7000, o);
   // Segment lengths grow while the slope falls: the first is shorter than the last one before t_s.
   const double first = bp.time_s[1] - bp.time_s[0];
@@ -105,7 +105,7 @@ TEST(Breakpoints, UniformCountIsTheSmallestUniformSpacingThatMeetsTheBound) {
     BreakpointOptions o;
     o.tolerance_um = 0.5;
     o.check_step_s = 0.5;
-    o.forced_times_s = {c.settle_time_s};
+    o.forced_times_s.assign(1, c.settle_time_s);
     auto f = [&](double t) { return c.ElongationUm(t); };
     const Breakpoints bp = ChooseBreakpoints(f, 0.0, t_end, o);
     const std::size_t n = UniformPointCount(f, 0.0, t_end, o);
