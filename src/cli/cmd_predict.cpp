@@ -2,9 +2,9 @@
 // (src/nn/model.h).
 #include <array>
 #include <cmath>
-#include <memory>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -47,8 +47,10 @@ void Run(const PredictOptions& o) {
     table = ReadProcessTable(o.input_path, /*require_targets=*/false);
   } else {
     if (!missing.empty())
-      throw InputError("predict: give --input CSV or all five of --hardness --diameter --pitch "
-                       "--raceway-radius --cutting-speed (missing:" + missing + ")");
+      throw InputError(
+          "predict: give --input CSV or all five of --hardness --diameter --pitch "
+          "--raceway-radius --cutting-speed (missing:" +
+          missing + ")");
     table.source = "command line";
     table.inputs.push_back(ProcessInputs::FromArray(single));
   }
@@ -114,7 +116,8 @@ void Run(const PredictOptions& o) {
       }
       rows.push_back(r);
     }
-    nlohmann::json j = {{"model", o.model_path}, {"predictions", rows}, {"outside_domain_count", outside}};
+    nlohmann::json j = {
+        {"model", o.model_path}, {"predictions", rows}, {"outside_domain_count", outside}};
     if (have_targets) {
       const double n = static_cast<double>(pred.size());
       j["rms_error"] = {{"max_elongation_um", std::sqrt(sq_e / n)},
@@ -144,8 +147,9 @@ void Run(const PredictOptions& o) {
   std::printf("(+- one predictive standard deviation, Laplace approximation)\n");
   if (have_targets) {
     const double n = static_cast<double>(pred.size());
-    std::printf("targets in %s: mean absolute error %.3g %% (max elongation), %.3g %% (settle time)\n",
-                o.input_path.c_str(), 100 * ape_e / n, 100 * ape_t / n);
+    std::printf(
+        "targets in %s: mean absolute error %.3g %% (max elongation), %.3g %% (settle time)\n",
+        o.input_path.c_str(), 100 * ape_e / n, 100 * ape_t / n);
   }
   if (!o.out_path.empty()) std::printf("written: %s\n", o.out_path.c_str());
 }
@@ -174,9 +178,9 @@ void RegisterPredict(CLI::App& app) {
                 ->check(CLI::PositiveNumber);
   auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm]")
                 ->check(CLI::PositiveNumber);
-  auto* r = sub->add_option("--raceway-radius", o->raceway_radius_mm,
-                            "raceway (ball-groove) radius [mm]")
-                ->check(CLI::PositiveNumber);
+  auto* r =
+      sub->add_option("--raceway-radius", o->raceway_radius_mm, "raceway (ball-groove) radius [mm]")
+          ->check(CLI::PositiveNumber);
   auto* v = sub->add_option("--cutting-speed", o->cutting_speed_m_min,
                             "cutting speed of the whirling tools [m/min]")
                 ->check(CLI::PositiveNumber);

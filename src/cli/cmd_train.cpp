@@ -2,8 +2,8 @@
 // sweep the hidden size with k-fold cross-validation (src/nn/selection.h).
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "cli/commands.h"
@@ -33,12 +33,10 @@ std::pair<int, int> ParseSweep(const std::string& s) {
   const auto dots = s.find("..");
   int a = 0, b = 0;
   char tail = 0;
-  if (dots == std::string::npos ||
-      std::sscanf(s.substr(0, dots).c_str(), "%d%c", &a, &tail) != 1 ||
+  if (dots == std::string::npos || std::sscanf(s.substr(0, dots).c_str(), "%d%c", &a, &tail) != 1 ||
       std::sscanf(s.substr(dots + 2).c_str(), "%d%c", &b, &tail) != 1)
     throw InputError("--hidden-sweep '" + s + "': expected A..B with integers, e.g. 4..10");
-  if (a < 1 || b < a)
-    throw InputError("--hidden-sweep '" + s + "': need 1 <= A <= B");
+  if (a < 1 || b < a) throw InputError("--hidden-sweep '" + s + "': need 1 <= A <= B");
   return {a, b};
 }
 
@@ -56,11 +54,11 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
   s.restarts = o.restarts;
   s.train.epochs = o.epochs;
   s.Validate(static_cast<int>(table.inputs.size()));
-  Progress progress("hidden sweep", static_cast<std::size_t>((s.hidden_max - s.hidden_min + 1) *
-                                                             (s.folds + 1)));
+  Progress progress("hidden sweep",
+                    static_cast<std::size_t>((s.hidden_max - s.hidden_min + 1) * (s.folds + 1)));
   const auto rows = nn::HiddenSweep(table, s, [&](int done, int total) {
-    progress.Update(static_cast<std::size_t>(done), std::to_string(done) + "/" +
-                                                        std::to_string(total) + " fits");
+    progress.Update(static_cast<std::size_t>(done),
+                    std::to_string(done) + "/" + std::to_string(total) + " fits");
   });
   progress.Finish();
   if (o.json) {
@@ -73,16 +71,16 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
                {"rows", rows}});
     return;
   }
-  std::cout << "hidden-size sweep on " << o.data_path << " (" << table.inputs.size()
-            << " rows, " << s.folds << "-fold CV, seed " << s.seed << ", " << s.restarts
+  std::cout << "hidden-size sweep on " << o.data_path << " (" << table.inputs.size() << " rows, "
+            << s.folds << "-fold CV, seed " << s.seed << ", " << s.restarts
             << " restart(s) per fit)\n";
   std::cout << "hidden  N   gamma   train_rms_um  train_rms_s  cv_rms_um  cv_rms_s  "
                "cv_rms_norm  log_evidence\n";
   for (const auto& r : rows) {
     char line[256];
     std::snprintf(line, sizeof line, "%6d %3d %7.2f %13.4g %12.4g %10.4g %9.4g %12.4g %13.5g\n",
-                  r.hidden, r.parameter_count, r.gamma, r.train_rms(0), r.train_rms(1),
-                  r.cv_rms(0), r.cv_rms(1), r.cv_rms_normalized, r.log_evidence);
+                  r.hidden, r.parameter_count, r.gamma, r.train_rms(0), r.train_rms(1), r.cv_rms(0),
+                  r.cv_rms(1), r.cv_rms_normalized, r.log_evidence);
     std::cout << line;
   }
   std::cout << "Pick the smallest size after which cv_rms_norm stops improving (the paper grew\n"
@@ -96,13 +94,15 @@ void Run(const TrainCliOptions& o) {
     RunSweep(o, table);
     return;
   }
-  if (o.out_path.empty()) throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
+  if (o.out_path.empty())
+    throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
   nn::ModelTrainOptions opt;
   opt.hidden_sizes = {o.hidden};
   opt.seed = o.seed;
   opt.restarts = o.restarts;
   opt.train.epochs = o.epochs;
-  const std::size_t total = static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
+  const std::size_t total =
+      static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
   Progress progress("train", total);
   const nn::Model model = nn::TrainModel(
       table, opt, std::filesystem::path(o.data_path).filename().string(),
@@ -125,8 +125,8 @@ void Run(const TrainCliOptions& o) {
                {"training_summary", s}});
     return;
   }
-  std::cout << "model " << o.out_path << ": network 5-" << o.hidden << "-2 (N = "
-            << s.parameter_count << " weights and biases), " << table.inputs.size()
+  std::cout << "model " << o.out_path << ": network 5-" << o.hidden
+            << "-2 (N = " << s.parameter_count << " weights and biases), " << table.inputs.size()
             << " samples from " << o.data_path << "\n";
   std::cout << "  " << s.BriefReport() << "\n";
   std::cout << "  RMS training error: max_elongation " << Fmt(s.rms_error(0)) << " um, settle_time "
@@ -137,10 +137,10 @@ void Run(const TrainCliOptions& o) {
   if (model.restarts > 1) {
     std::cout << "  restarts (best log evidence kept):\n";
     for (const auto& r : model.restart_runs)
-      std::cout << "    seed " << r.seed << ": log evidence " << Fmt(r.log_evidence, 6)
-                << ", ssE " << Fmt(r.sse) << ", gamma " << Fmt(r.gamma) << ", " << r.epochs
-                << " epochs, " << nn::ToString(r.termination)
-                << (r.seed == model.init_seed ? "  <- kept" : "") << "\n";
+      std::cout << "    seed " << r.seed << ": log evidence " << Fmt(r.log_evidence, 6) << ", ssE "
+                << Fmt(r.sse) << ", gamma " << Fmt(r.gamma) << ", " << r.epochs << " epochs, "
+                << nn::ToString(r.termination) << (r.seed == model.init_seed ? "  <- kept" : "")
+                << "\n";
   }
 }
 

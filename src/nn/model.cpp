@@ -50,7 +50,9 @@ Eigen::MatrixXd ReadMatrix(const json& v, const std::string& path, Eigen::Index 
   return m;
 }
 
-json VectorJson(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+json VectorJson(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
 
 json MatrixJson(const Eigen::MatrixXd& m) {
   json rows = json::array();
@@ -107,16 +109,21 @@ std::vector<VariableInfo> ReadVariables(const json& j, const std::string& key,
 }
 
 json OptionsJson(const TrainOptions& o) {
-  return json{{"epochs", o.epochs},     {"goal", o.goal},         {"mu", o.mu},
-              {"mu_dec", o.mu_dec},     {"mu_inc", o.mu_inc},     {"mu_max", o.mu_max},
-              {"min_grad", o.min_grad}, {"regularization", ToString(o.regularization)}};
+  return json{{"epochs", o.epochs},
+              {"goal", o.goal},
+              {"mu", o.mu},
+              {"mu_dec", o.mu_dec},
+              {"mu_inc", o.mu_inc},
+              {"mu_max", o.mu_max},
+              {"min_grad", o.min_grad},
+              {"regularization", ToString(o.regularization)}};
 }
 
 TrainOptions ReadOptions(const json& j) {
   const std::string where = "model 'training.options'";
-  RejectUnknownKeys(j, {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad",
-                        "regularization"},
-                    where);
+  RejectUnknownKeys(
+      j, {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad", "regularization"},
+      where);
   TrainOptions o;
   o.epochs = static_cast<int>(RequireFinite(Require(j, "epochs", where), where + " 'epochs'"));
   o.goal = RequireFinite(Require(j, "goal", where), where + " 'goal'");
@@ -208,29 +215,29 @@ void to_json(nlohmann::json& j, const Model& m) {
            {"outputs", outputs},
            {"training_domain", domain},
            {"training_summary", m.training_summary},
-           {"training",
-            json{{"data", m.training_data},
-                 {"samples", m.training_samples},
-                 {"restarts", m.restarts},
-                 {"init_seed", m.init_seed},
-                 {"restart_runs", m.restart_runs},
-                 {"options", OptionsJson(m.train_options)}}},
+           {"training", json{{"data", m.training_data},
+                             {"samples", m.training_samples},
+                             {"restarts", m.restarts},
+                             {"init_seed", m.init_seed},
+                             {"restart_runs", m.restart_runs},
+                             {"options", OptionsJson(m.train_options)}}},
            {"seed", m.seed},
            {"error_space", m.error_space},
-           {"uncertainty",
-            json{{"method", "laplace"},
-                 {"noise_variance_normalized", m.noise_variance},
-                 {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
+           {"uncertainty", json{{"method", "laplace"},
+                                {"noise_variance_normalized", m.noise_variance},
+                                {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
 }
 
 void from_json(const nlohmann::json& j, Model& m) {
-  RejectUnknownKeys(j, {"format", "schema_version", "layer_sizes", "layers", "input_scaling",
-                        "target_scaling", "inputs", "outputs", "training_domain",
-                        "training_summary", "training", "seed", "error_space", "uncertainty"},
+  RejectUnknownKeys(j,
+                    {"format", "schema_version", "layer_sizes", "layers", "input_scaling",
+                     "target_scaling", "inputs", "outputs", "training_domain", "training_summary",
+                     "training", "seed", "error_space", "uncertainty"},
                     "model");
   const json& format = Require(j, "format", "model");
   if (!format.is_string() || format.get<std::string>() != Model::kFormat)
-    throw InputError("model 'format' is " + format.dump() + ", expected \"" + Model::kFormat + "\"");
+    throw InputError("model 'format' is " + format.dump() + ", expected \"" + Model::kFormat +
+                     "\"");
   const json& version = Require(j, "schema_version", "model");
   if (!version.is_number_integer() || version.get<int>() != Model::kSchemaVersion)
     throw InputError("model 'schema_version' is " + version.dump() + ", this whirl reads " +
@@ -238,18 +245,20 @@ void from_json(const nlohmann::json& j, Model& m) {
 
   const json& sizes = Require(j, "layer_sizes", "model");
   if (!sizes.is_array() || sizes.size() < 2)
-    throw InputError("model 'layer_sizes' must be an array of at least 2 sizes, got " + sizes.dump());
+    throw InputError("model 'layer_sizes' must be an array of at least 2 sizes, got " +
+                     sizes.dump());
   std::vector<int> layer_sizes;
   for (std::size_t i = 0; i < sizes.size(); ++i) {
     if (!sizes[i].is_number_integer() || sizes[i].get<int>() < 1)
-      throw InputError("model 'layer_sizes[" + std::to_string(i) + "]' must be an integer >= 1, got " +
-                       sizes[i].dump());
+      throw InputError("model 'layer_sizes[" + std::to_string(i) +
+                       "]' must be an integer >= 1, got " + sizes[i].dump());
     layer_sizes.push_back(sizes[i].get<int>());
   }
   m.network = Network::Zeros(layer_sizes);
   const json& layers = Require(j, "layers", "model");
   if (!layers.is_array() || layers.size() + 1 != layer_sizes.size())
-    throw InputError("model 'layers' must be an array of " + std::to_string(layer_sizes.size() - 1) +
+    throw InputError("model 'layers' must be an array of " +
+                     std::to_string(layer_sizes.size() - 1) +
                      " layers (one fewer than layer_sizes)");
   for (std::size_t l = 0; l < layers.size(); ++l) {
     const std::string prefix = "model 'layers[" + std::to_string(l) + "]";
@@ -259,10 +268,12 @@ void from_json(const nlohmann::json& j, Model& m) {
     const json& t = Require(layers[l], "transfer", where);
     if (!t.is_string() || t.get<std::string>() != transfer)
       throw InputError(prefix + ".transfer' is " + t.dump() + ", expected \"" + transfer + "\"");
-    m.network.weights[l] = ReadMatrix(Require(layers[l], "weights", where), "layers[" + std::to_string(l) + "].weights",
-                                      layer_sizes[l + 1], layer_sizes[l]);
+    m.network.weights[l] =
+        ReadMatrix(Require(layers[l], "weights", where),
+                   "layers[" + std::to_string(l) + "].weights", layer_sizes[l + 1], layer_sizes[l]);
     m.network.biases[l] =
-        ReadVector(Require(layers[l], "biases", where), "layers[" + std::to_string(l) + "].biases", layer_sizes[l + 1]);
+        ReadVector(Require(layers[l], "biases", where), "layers[" + std::to_string(l) + "].biases",
+                   layer_sizes[l + 1]);
   }
   m.input_scaling = ReadScaling(j, "input_scaling", layer_sizes.front());
   m.target_scaling = ReadScaling(j, "target_scaling", layer_sizes.back());
@@ -289,16 +300,18 @@ void from_json(const nlohmann::json& j, Model& m) {
     throw InputError(std::string("model 'training_summary': ") + e.what());
   }
   const json& training = Require(j, "training", "model");
-  RejectUnknownKeys(training, {"data", "samples", "restarts", "init_seed", "restart_runs", "options"},
+  RejectUnknownKeys(training,
+                    {"data", "samples", "restarts", "init_seed", "restart_runs", "options"},
                     "model 'training'");
   const json& data = Require(training, "data", "model 'training'");
   if (!data.is_string()) throw InputError("model 'training.data' must be a string");
   m.training_data = data.get<std::string>();
   m.training_samples = static_cast<int>(
       RequireFinite(Require(training, "samples", "model 'training'"), "model 'training.samples'"));
-  m.restarts = static_cast<int>(
-      RequireFinite(Require(training, "restarts", "model 'training'"), "model 'training.restarts'"));
-  m.init_seed = ReadSeed(Require(training, "init_seed", "model 'training'"), "model 'training.init_seed'");
+  m.restarts = static_cast<int>(RequireFinite(Require(training, "restarts", "model 'training'"),
+                                              "model 'training.restarts'"));
+  m.init_seed =
+      ReadSeed(Require(training, "init_seed", "model 'training'"), "model 'training.init_seed'");
   try {
     m.restart_runs =
         Require(training, "restart_runs", "model 'training'").get<std::vector<RestartRecord>>();
@@ -320,9 +333,8 @@ void from_json(const nlohmann::json& j, Model& m) {
   m.noise_variance = RequireFinite(Require(u, "noise_variance_normalized", "model 'uncertainty'"),
                                    "model 'uncertainty.noise_variance_normalized'");
   const int N = m.network.ParameterCount();
-  m.posterior_covariance =
-      ReadMatrix(Require(u, "posterior_covariance", "model 'uncertainty'"),
-                 "uncertainty.posterior_covariance", N, N);
+  m.posterior_covariance = ReadMatrix(Require(u, "posterior_covariance", "model 'uncertainty'"),
+                                      "uncertainty.posterior_covariance", N, N);
   m.Validate();
 }
 
@@ -424,8 +436,8 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   sizes.push_back(Features::kCount);
   if (options.train.regularization != Regularization::kBayesian)
     throw InputError("a model file needs Bayesian regularization (its Laplace uncertainty)");
-  RestartResult r = TrainBrRestarts(data, sizes, options.seed, options.restarts, options.train,
-                                    progress);
+  RestartResult r =
+      TrainBrRestarts(data, sizes, options.seed, options.restarts, options.train, progress);
   m.network = std::move(r.best.network);
   m.inputs = ExpectedInputs();
   m.outputs = ExpectedOutputs();

@@ -36,24 +36,24 @@ struct Model {
   static constexpr int kSchemaVersion = 1;
   static constexpr const char* kFormat = "whirl-nn-model";
 
-  Network network;                 ///< weights in the normalized space
-  MapMinMax input_scaling;         ///< mapminmax of the five inputs (training ranges)
-  MapMinMax target_scaling;        ///< mapminmax of the two targets
-  std::vector<VariableInfo> inputs;   ///< kInputColumns with kInputUnits, in order
-  std::vector<VariableInfo> outputs;  ///< kTargetColumns with kTargetUnits, in order
-  Eigen::VectorXd domain_min;      ///< per input: smallest training value, original units
-  Eigen::VectorXd domain_max;      ///< per input: largest training value, original units
-  TrainSummary training_summary;   ///< of the chosen restart
-  std::uint64_t seed = 0;          ///< base seed of the restart series (--seed)
-  std::uint64_t init_seed = 0;     ///< seed of the chosen restart (seed + its index)
-  int restarts = 1;                ///< number of restarts trained
+  Network network;                          ///< weights in the normalized space
+  MapMinMax input_scaling;                  ///< mapminmax of the five inputs (training ranges)
+  MapMinMax target_scaling;                 ///< mapminmax of the two targets
+  std::vector<VariableInfo> inputs;         ///< kInputColumns with kInputUnits, in order
+  std::vector<VariableInfo> outputs;        ///< kTargetColumns with kTargetUnits, in order
+  Eigen::VectorXd domain_min;               ///< per input: smallest training value, original units
+  Eigen::VectorXd domain_max;               ///< per input: largest training value, original units
+  TrainSummary training_summary;            ///< of the chosen restart
+  std::uint64_t seed = 0;                   ///< base seed of the restart series (--seed)
+  std::uint64_t init_seed = 0;              ///< seed of the chosen restart (seed + its index)
+  int restarts = 1;                         ///< number of restarts trained
   std::vector<RestartRecord> restart_runs;  ///< every restart (seed, log evidence, ...)
-  TrainOptions train_options;      ///< the trainbr options used
-  std::string training_data;       ///< provenance: file name of the training table
-  int training_samples = 0;        ///< Q
-  std::string error_space = "normalized";  ///< errors measured in the mapminmax target space
-  double noise_variance = 0;       ///< sigma_nu^2 = 1 / (2 beta), normalized target units
-  Eigen::MatrixXd posterior_covariance;  ///< A^-1, N x N, flat order (see header comment)
+  TrainOptions train_options;               ///< the trainbr options used
+  std::string training_data;                ///< provenance: file name of the training table
+  int training_samples = 0;                 ///< Q
+  std::string error_space = "normalized";   ///< errors measured in the mapminmax target space
+  double noise_variance = 0;                ///< sigma_nu^2 = 1 / (2 beta), normalized target units
+  Eigen::MatrixXd posterior_covariance;     ///< A^-1, N x N, flat order (see header comment)
 
   /// Throws InputError naming the key and the rule if anything is missing or inconsistent.
   void Validate() const;
@@ -72,7 +72,7 @@ void SaveModel(const std::filesystem::path& path, const Model& model);
 struct Prediction {
   Features mean;    ///< network output, original units
   Features stddev;  ///< predictive standard deviation (noise + weight uncertainty), original units
-  bool outside_domain = false;  ///< some input lies outside the training domain
+  bool outside_domain = false;                     ///< some input lies outside the training domain
   std::vector<std::string> outside_domain_fields;  ///< names of those inputs, in input order
   Features noise_stddev;  ///< the noise part alone, sqrt(sigma_nu^2) * half range
 };

@@ -80,8 +80,8 @@ Network Network::Zeros(const std::vector<int>& layer_sizes) {
                      std::to_string(layer_sizes.size()) + " entries");
   for (std::size_t l = 0; l < layer_sizes.size(); ++l)
     if (layer_sizes[l] < 1)
-      throw InputError("network: layer_sizes[" + std::to_string(l) + "] = " +
-                       std::to_string(layer_sizes[l]) + " must be >= 1");
+      throw InputError("network: layer_sizes[" + std::to_string(l) +
+                       "] = " + std::to_string(layer_sizes[l]) + " must be >= 1");
   Network net;
   net.layer_sizes = layer_sizes;
   for (std::size_t l = 0; l + 1 < layer_sizes.size(); ++l) {
@@ -114,7 +114,8 @@ Eigen::VectorXd Network::GetParameters() const {
   for (int l = 0; l < LayerCount(); ++l) {
     w.segment(k, biases[l].size()) = biases[l];
     k += static_cast<int>(biases[l].size());
-    w.segment(k, weights[l].size()) = Eigen::Map<const Eigen::VectorXd>(weights[l].data(), weights[l].size());
+    w.segment(k, weights[l].size()) =
+        Eigen::Map<const Eigen::VectorXd>(weights[l].data(), weights[l].size());
     k += static_cast<int>(weights[l].size());
   }
   return w;
@@ -128,7 +129,8 @@ void Network::SetParameters(const Eigen::VectorXd& w) {
   for (int l = 0; l < LayerCount(); ++l) {
     biases[l] = w.segment(k, biases[l].size());
     k += static_cast<int>(biases[l].size());
-    Eigen::Map<Eigen::VectorXd>(weights[l].data(), weights[l].size()) = w.segment(k, weights[l].size());
+    Eigen::Map<Eigen::VectorXd>(weights[l].data(), weights[l].size()) =
+        w.segment(k, weights[l].size());
     k += static_cast<int>(weights[l].size());
   }
 }

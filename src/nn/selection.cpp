@@ -15,14 +15,16 @@ void SweepOptions::Validate(int rows) const {
     throw InputError("hidden sweep: last size " + std::to_string(hidden_max) +
                      " must be >= first size " + std::to_string(hidden_min));
   if (folds < 2 || folds > rows)
-    throw InputError("folds = " + std::to_string(folds) + ": must be in [2, rows = " +
-                     std::to_string(rows) + "]");
+    throw InputError("folds = " + std::to_string(folds) +
+                     ": must be in [2, rows = " + std::to_string(rows) + "]");
   if (restarts < 1) throw InputError("restarts = " + std::to_string(restarts) + ": must be >= 1");
   train.Validate();
 }
 
 void to_json(nlohmann::json& j, const SweepRow& r) {
-  auto vec = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
+  auto vec = [](const Eigen::VectorXd& v) {
+    return std::vector<double>(v.data(), v.data() + v.size());
+  };
   j = nlohmann::json{{"hidden", r.hidden},
                      {"parameter_count", r.parameter_count},
                      {"train_sse_normalized", r.train_sse_normalized},
@@ -86,8 +88,8 @@ std::vector<SweepRow> HiddenSweep(const ProcessTable& table, const SweepOptions&
       if (progress) progress(++done, total);
     }
     row.cv_rms = (sq / Q).cwiseSqrt();
-    row.cv_rms_normalized =
-        std::sqrt((sq.array() / half.array().square()).sum() / (static_cast<double>(Q) * Features::kCount));
+    row.cv_rms_normalized = std::sqrt((sq.array() / half.array().square()).sum() /
+                                      (static_cast<double>(Q) * Features::kCount));
     rows.push_back(row);
   }
   return rows;

@@ -14,24 +14,24 @@
 namespace whirl::nn {
 
 struct SweepOptions {
-  int hidden_min = 4;         ///< first hidden size (one tansig layer)
-  int hidden_max = 8;         ///< last hidden size, inclusive
-  int folds = 5;              ///< k of k-fold cross-validation, 2 <= k <= rows
-  std::uint64_t seed = 1;     ///< restart r of every fit initializes with seed + r
-  int restarts = 1;           ///< restarts per fit (best log evidence kept)
-  TrainOptions train;         ///< trainbr options
+  int hidden_min = 4;             ///< first hidden size (one tansig layer)
+  int hidden_max = 8;             ///< last hidden size, inclusive
+  int folds = 5;                  ///< k of k-fold cross-validation, 2 <= k <= rows
+  std::uint64_t seed = 1;         ///< restart r of every fit initializes with seed + r
+  int restarts = 1;               ///< restarts per fit (best log evidence kept)
+  TrainOptions train;             ///< trainbr options
   void Validate(int rows) const;  ///< InputError naming the option, value and rule
 };
 
 /// One hidden size. Errors in original units per output (max_elongation_um, settle_time_s).
 struct SweepRow {
   int hidden = 0;
-  int parameter_count = 0;           ///< N
-  double train_sse_normalized = 0;   ///< ssE of the fit on all rows
-  Eigen::VectorXd train_rms;         ///< per output, original units
-  double gamma = 0;                  ///< effective number of parameters of the full fit
-  double log_evidence = 0;           ///< of the full fit (nn/trainbr.h LogEvidence)
-  Eigen::VectorXd cv_rms;            ///< k-fold CV RMS error per output, original units
+  int parameter_count = 0;          ///< N
+  double train_sse_normalized = 0;  ///< ssE of the fit on all rows
+  Eigen::VectorXd train_rms;        ///< per output, original units
+  double gamma = 0;                 ///< effective number of parameters of the full fit
+  double log_evidence = 0;          ///< of the full fit (nn/trainbr.h LogEvidence)
+  Eigen::VectorXd cv_rms;           ///< k-fold CV RMS error per output, original units
   /// sqrt(mean over outputs and rows of (CV error / full-data half range)^2): both outputs count
   /// equally, as in training (error_space "normalized").
   double cv_rms_normalized = 0;

@@ -22,19 +22,24 @@ double SumSquares(const Eigen::MatrixXd& e) { return e.squaredNorm(); }
 
 std::string ToString(TrainTermination t) {
   switch (t) {
-    case TrainTermination::kGoalMet: return "goal_met";
-    case TrainTermination::kMaxEpochs: return "max_epochs";
-    case TrainTermination::kMinGradient: return "min_gradient";
-    case TrainTermination::kMaxMu: return "max_mu";
-    case TrainTermination::kInterpolation: return "interpolation";
+    case TrainTermination::kGoalMet:
+      return "goal_met";
+    case TrainTermination::kMaxEpochs:
+      return "max_epochs";
+    case TrainTermination::kMinGradient:
+      return "min_gradient";
+    case TrainTermination::kMaxMu:
+      return "max_mu";
+    case TrainTermination::kInterpolation:
+      return "interpolation";
   }
   return "unknown";
 }
 
 TrainTermination ParseTermination(const std::string& s) {
-  for (auto t : {TrainTermination::kGoalMet, TrainTermination::kMaxEpochs,
-                 TrainTermination::kMinGradient, TrainTermination::kMaxMu,
-                 TrainTermination::kInterpolation})
+  for (auto t :
+       {TrainTermination::kGoalMet, TrainTermination::kMaxEpochs, TrainTermination::kMinGradient,
+        TrainTermination::kMaxMu, TrainTermination::kInterpolation})
     if (ToString(t) == s) return t;
   throw InputError("termination '" + s +
                    "' is not one of goal_met, max_epochs, min_gradient, max_mu, interpolation");
@@ -68,8 +73,8 @@ std::string TrainSummary::BriefReport() const {
   std::ostringstream s;
   s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": F "
     << Num(initial_cost) << " -> " << Num(final_cost) << ", ssE " << Num(initial_sse) << " -> "
-    << Num(sse) << " in " << epochs << " epochs, gamma " << Num(gamma) << " of "
-    << parameter_count << ", " << ToString(termination) << " (" << message << ")";
+    << Num(sse) << " in " << epochs << " epochs, gamma " << Num(gamma) << " of " << parameter_count
+    << ", " << ToString(termination) << " (" << message << ")";
   return s.str();
 }
 
@@ -91,13 +96,17 @@ Eigen::VectorXd VecFromJson(const nlohmann::json& j, const char* key) {
   return v;
 }
 // NaN (no regularization) is stored as null.
-nlohmann::json MaybeNumber(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+nlohmann::json MaybeNumber(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
+}
 double NumberOrNan(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key)) throw InputError(std::string("training_summary: missing key '") + key + "'");
+  if (!j.contains(key))
+    throw InputError(std::string("training_summary: missing key '") + key + "'");
   const auto& v = j.at(key);
   if (v.is_null()) return std::numeric_limits<double>::quiet_NaN();
   if (!v.is_number())
-    throw InputError(std::string("training_summary: '") + key + "' must be a number, got " + v.dump());
+    throw InputError(std::string("training_summary: '") + key + "' must be a number, got " +
+                     v.dump());
   return v.get<double>();
 }
 }  // namespace
@@ -128,10 +137,12 @@ void to_json(nlohmann::json& j, const TrainSummary& s) {
 void from_json(const nlohmann::json& j, TrainSummary& s) {
   if (!j.is_object()) throw InputError("training_summary: expected a JSON object");
   auto num = [&](const char* key) {
-    if (!j.contains(key)) throw InputError(std::string("training_summary: missing key '") + key + "'");
+    if (!j.contains(key))
+      throw InputError(std::string("training_summary: missing key '") + key + "'");
     const auto& v = j.at(key);
     if (!v.is_number())
-      throw InputError(std::string("training_summary: '") + key + "' must be a number, got " + v.dump());
+      throw InputError(std::string("training_summary: '") + key + "' must be a number, got " +
+                       v.dump());
     return v.get<double>();
   };
   s.epochs = static_cast<int>(num("epochs"));
@@ -157,9 +168,9 @@ void from_json(const nlohmann::json& j, TrainSummary& s) {
 }
 
 void to_json(nlohmann::json& j, const RestartRecord& r) {
-  j = nlohmann::json{{"seed", r.seed},       {"log_evidence", MaybeNumber(r.log_evidence)},
+  j = nlohmann::json{{"seed", r.seed},          {"log_evidence", MaybeNumber(r.log_evidence)},
                      {"sse_normalized", r.sse}, {"gamma", r.gamma},
-                     {"epochs", r.epochs},   {"termination", ToString(r.termination)}};
+                     {"epochs", r.epochs},      {"termination", ToString(r.termination)}};
 }
 
 void from_json(const nlohmann::json& j, RestartRecord& r) {
@@ -196,8 +207,8 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
                      " inputs");
   if (data.targets.rows() != S || data.targets.cols() != Q)
     throw InputError("training data: targets are " + std::to_string(data.targets.rows()) + "x" +
-                     std::to_string(data.targets.cols()) + ", expected " + std::to_string(S) +
-                     "x" + std::to_string(Q));
+                     std::to_string(data.targets.cols()) + ", expected " + std::to_string(S) + "x" +
+                     std::to_string(Q));
   if (!data.inputs.allFinite() || !data.targets.allFinite())
     throw InputError("training data: NaN or infinity in the inputs or targets");
   if (data.target_scaling.size() != S)
@@ -264,14 +275,14 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     }
     if (epoch == options.epochs) {
       sum.termination = TrainTermination::kMaxEpochs;
-      sum.message = "epoch = " + std::to_string(epoch) + " == epochs = " +
-                    std::to_string(options.epochs);
+      sum.message =
+          "epoch = " + std::to_string(epoch) + " == epochs = " + std::to_string(options.epochs);
       break;
     }
     if (gradient <= options.min_grad) {
       sum.termination = TrainTermination::kMinGradient;
-      sum.message = "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " +
-                    Num(options.min_grad);
+      sum.message =
+          "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " + Num(options.min_grad);
       break;
     }
     if (mu >= options.mu_max) {
@@ -336,8 +347,8 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
         beta = beta_new;
       } else {
         degenerate_message = "gamma = " + Num(gamma_new) + ", alpha = " + Num(alpha_new) +
-                             ", beta = (n - gamma)/(2 ssE) = " + Num(beta_new) + " at ssE = " +
-                             Num(sse) + " (kept the last finite alpha, beta)";
+                             ", beta = (n - gamma)/(2 ssE) = " + Num(beta_new) +
+                             " at ssE = " + Num(sse) + " (kept the last finite alpha, beta)";
       }
       F = beta * sse + alpha * ssx;
     }
@@ -370,12 +381,11 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     const Eigen::VectorXd h_eig =
         (beta * eig.eigenvalues().cwiseMax(0.0)).array() + alpha;  // eigenvalues of H
     const double log_det_h = h_eig.array().log().sum();
-    sum.log_evidence = LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n),
-                                   net.layer_sizes);
+    sum.log_evidence =
+        LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n), net.layer_sizes);
     sum.noise_variance = 1.0 / (2.0 * beta);
     const Eigen::MatrixXd& V = eig.eigenvectors();
-    result.posterior_covariance =
-        V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
+    result.posterior_covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
     // Exact symmetry (the product leaves rounding-level asymmetry).
     result.posterior_covariance =
         0.5 * (result.posterior_covariance + result.posterior_covariance.transpose()).eval();
@@ -389,8 +399,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
 RestartResult TrainBrRestarts(const TrainingData& data, const std::vector<int>& layer_sizes,
                               std::uint64_t seed, int restarts, const TrainOptions& options,
                               const std::function<void(int, const EpochInfo&)>& callback) {
-  if (restarts < 1)
-    throw InputError("restarts = " + std::to_string(restarts) + ": must be >= 1");
+  if (restarts < 1) throw InputError("restarts = " + std::to_string(restarts) + ": must be >= 1");
   RestartResult out;
   const bool bayes = options.regularization == Regularization::kBayesian;
   for (int k = 0; k < restarts; ++k) {

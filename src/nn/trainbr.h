@@ -53,20 +53,20 @@ enum class TrainTermination {
   /// Training stops with the last finite alpha, beta. Tested first, at the next epoch.
   kInterpolation,
 };
-std::string ToString(TrainTermination t);        ///< "goal_met", "max_epochs", ...
+std::string ToString(TrainTermination t);                 ///< "goal_met", "max_epochs", ...
 TrainTermination ParseTermination(const std::string& s);  ///< inverse; InputError otherwise
-std::string ToString(Regularization r);          ///< "bayesian", "none"
+std::string ToString(Regularization r);                   ///< "bayesian", "none"
 Regularization ParseRegularization(const std::string& s);
 
 /// MATLAB trainbr defaults (net.trainParam).
 struct TrainOptions {
-  int epochs = 1000;        ///< maximum number of epochs (accepted or failed LM loops)
-  double goal = 0.0;        ///< stop when ssE (normalized) <= goal
-  double mu = 0.005;        ///< initial Marquardt damping mu
-  double mu_dec = 0.1;      ///< mu factor after an accepted step (in (0, 1))
-  double mu_inc = 10.0;     ///< mu factor after a rejected step (> 1)
-  double mu_max = 1e10;     ///< stop when mu reaches this
-  double min_grad = 1e-7;   ///< stop when 2 ||J'e|| <= min_grad
+  int epochs = 1000;       ///< maximum number of epochs (accepted or failed LM loops)
+  double goal = 0.0;       ///< stop when ssE (normalized) <= goal
+  double mu = 0.005;       ///< initial Marquardt damping mu
+  double mu_dec = 0.1;     ///< mu factor after an accepted step (in (0, 1))
+  double mu_inc = 10.0;    ///< mu factor after a rejected step (> 1)
+  double mu_max = 1e10;    ///< stop when mu reaches this
+  double min_grad = 1e-7;  ///< stop when 2 ||J'e|| <= min_grad
   Regularization regularization = Regularization::kBayesian;
 
   /// Throws InputError naming the option, its value and the rule.
@@ -75,50 +75,50 @@ struct TrainOptions {
 
 /// What the per-epoch callback sees after each epoch's LM loop.
 struct EpochInfo {
-  int epoch = 0;                   ///< 1-based number of the epoch just finished
-  int max_epochs = 0;              ///< options.epochs
-  bool step_accepted = false;      ///< false when mu passed mu_max without a decrease
-  double objective_before = 0;     ///< F(w) at the start of the epoch
-  double objective_after_step = 0; ///< F(w + dw) with the SAME alpha, beta (< objective_before)
-  double objective = 0;            ///< F after the alpha/beta update
-  double sse = 0;                  ///< ssE after the step (normalized)
-  double ssx = 0;                  ///< ssX after the step
+  int epoch = 0;                    ///< 1-based number of the epoch just finished
+  int max_epochs = 0;               ///< options.epochs
+  bool step_accepted = false;       ///< false when mu passed mu_max without a decrease
+  double objective_before = 0;      ///< F(w) at the start of the epoch
+  double objective_after_step = 0;  ///< F(w + dw) with the SAME alpha, beta (< objective_before)
+  double objective = 0;             ///< F after the alpha/beta update
+  double sse = 0;                   ///< ssE after the step (normalized)
+  double ssx = 0;                   ///< ssX after the step
   double gamma = 0, alpha = 0, beta = 0;  ///< after the update
-  double mu = 0;                   ///< after the LM loop
-  double gradient = 0;             ///< 2 ||J'e|| at the start of the epoch
+  double mu = 0;                          ///< after the LM loop
+  double gradient = 0;                    ///< 2 ||J'e|| at the start of the epoch
 };
 using EpochCallback = std::function<void(const EpochInfo&)>;
 
 /// Training set in the normalized space, one sample per column.
 struct TrainingData {
-  Eigen::MatrixXd inputs;     ///< R x Q, mapminmax-normalized
-  Eigen::MatrixXd targets;    ///< S x Q, mapminmax-normalized
-  MapMinMax target_scaling;   ///< only to report RMS errors in original units
+  Eigen::MatrixXd inputs;    ///< R x Q, mapminmax-normalized
+  Eigen::MatrixXd targets;   ///< S x Q, mapminmax-normalized
+  MapMinMax target_scaling;  ///< only to report RMS errors in original units
 };
 
 struct TrainSummary {
-  int epochs = 0;               ///< completed epochs
-  int parameter_count = 0;      ///< N
-  int error_count = 0;          ///< n = S * Q
-  double initial_cost = 0;      ///< F at the initial weights with the initial alpha, beta
-  double final_cost = 0;        ///< F at the final weights with the final alpha, beta
-  double initial_sse = 0;       ///< ssE at the initial weights (normalized)
-  double sse = 0;               ///< ssE at the final weights (normalized)
+  int epochs = 0;                        ///< completed epochs
+  int parameter_count = 0;               ///< N
+  int error_count = 0;                   ///< n = S * Q
+  double initial_cost = 0;               ///< F at the initial weights with the initial alpha, beta
+  double final_cost = 0;                 ///< F at the final weights with the final alpha, beta
+  double initial_sse = 0;                ///< ssE at the initial weights (normalized)
+  double sse = 0;                        ///< ssE at the final weights (normalized)
   Eigen::VectorXd rms_error;             ///< per output sqrt(mean e^2), original units
   Eigen::VectorXd rms_error_normalized;  ///< per output, normalized units
   double sum_squared_weights = 0;        ///< ssX = w'w at the final weights
-  double gamma = 0;             ///< effective number of parameters, in (0, N]
-  double alpha = 0;             ///< weight-decay coefficient of F (MATLAB convention)
-  double beta = 0;              ///< data coefficient of F (MATLAB convention)
-  double mu = 0;                ///< final Marquardt damping
-  double gradient = 0;          ///< 2 ||J'e|| at the final weights
+  double gamma = 0;                      ///< effective number of parameters, in (0, N]
+  double alpha = 0;                      ///< weight-decay coefficient of F (MATLAB convention)
+  double beta = 0;                       ///< data coefficient of F (MATLAB convention)
+  double mu = 0;                         ///< final Marquardt damping
+  double gradient = 0;                   ///< 2 ||J'e|| at the final weights
   /// ln P(D | alpha, beta) of the final network (see LogEvidence); NaN without regularization.
   double log_evidence = 0;
   /// sigma_nu^2 = 1 / (2 beta), normalized units; NaN without regularization.
   double noise_variance = 0;
   Regularization regularization = Regularization::kBayesian;
   TrainTermination termination = TrainTermination::kMaxEpochs;
-  std::string message;          ///< the reason with the numbers it compared
+  std::string message;  ///< the reason with the numbers it compared
 
   /// "trainbr: F 12.3 -> 0.45, ssE 3.1 -> 0.02 in 212 epochs, gamma 17.2 of 50, max_mu (...)".
   std::string BriefReport() const;
@@ -127,12 +127,12 @@ void to_json(nlohmann::json& j, const TrainSummary& s);
 void from_json(const nlohmann::json& j, TrainSummary& s);
 
 struct TrainResult {
-  Network network;                      ///< final weights
+  Network network;  ///< final weights
   TrainSummary summary;
   /// A^-1 = (2 (beta J'J + alpha I))^-1 at the final weights, final alpha, beta: the Laplace
   /// (Gauss-Newton) posterior covariance of w, N x N, flat order. Empty without regularization.
   Eigen::MatrixXd posterior_covariance;
-  std::uint64_t init_seed = 0;          ///< seed of InitNguyenWidrow (0 if the caller initialized)
+  std::uint64_t init_seed = 0;  ///< seed of InitNguyenWidrow (0 if the caller initialized)
 };
 
 /// Trains `initial` with trainbr (or plain LM) on `data`. Throws InputError on inconsistent sizes,
@@ -164,8 +164,8 @@ void from_json(const nlohmann::json& j, RestartRecord& r);
 
 struct RestartResult {
   TrainResult best;
-  int best_index = 0;                ///< index into runs
-  std::vector<RestartRecord> runs;   ///< in seed order
+  int best_index = 0;               ///< index into runs
+  std::vector<RestartRecord> runs;  ///< in seed order
 };
 
 /// Trains `restarts` networks of `layer_sizes`, initialized by InitNguyenWidrow with seeds

@@ -96,12 +96,13 @@ TEST(Model, PredictMatchesScalingAndLaplaceFormulaByFiniteDifferences) {
       g.col(i) = (plus.Forward(x) - minus.Forward(x)) / (2 * h);
     }
     for (int k = 0; k < 2; ++k) {
-      const double var = m.noise_variance + g.row(k) * m.posterior_covariance * g.row(k).transpose();
+      const double var =
+          m.noise_variance + g.row(k) * m.posterior_covariance * g.row(k).transpose();
       const double sd = std::sqrt(var) * half(k);
       const double got = k == 0 ? preds[q].stddev.max_elongation_um : preds[q].stddev.settle_time_s;
       EXPECT_NEAR(got, sd, 1e-6 * sd);
-      const double noise = k == 0 ? preds[q].noise_stddev.max_elongation_um
-                                  : preds[q].noise_stddev.settle_time_s;
+      const double noise =
+          k == 0 ? preds[q].noise_stddev.max_elongation_um : preds[q].noise_stddev.settle_time_s;
       EXPECT_GE(got, noise);  // weight uncertainty only adds
       EXPECT_NEAR(noise, std::sqrt(m.noise_variance) * half(k), 1e-12 * noise);
     }
@@ -159,12 +160,17 @@ TEST(Model, LoadRejectsWrongTruncatedOrInconsistentFiles) {
       {"schema version", [](auto& j) { j["schema_version"] = 99; }, "schema_version"},
       {"format", [](auto& j) { j["format"] = "other"; }, "format"},
       {"missing layers", [](auto& j) { j.erase("layers"); }, "layers"},
-      {"layer sizes", [](auto& j) { j["layer_sizes"] = {5, 7, 2}; }, "layers[0].weights"},
+      {"layer sizes",
+       [](auto& j) {
+         j["layer_sizes"] = {5, 7, 2};
+       },
+       "layers[0].weights"},
       {"wrong input count", [](auto& j) { j["layer_sizes"][0] = 4; }, "layers[0].weights"},
       {"bias count", [](auto& j) { j["layers"][1]["biases"].push_back(1.0); }, "layers[1].biases"},
       {"non-number weight", [](auto& j) { j["layers"][0]["weights"][2][1] = "nan"; },
        "layers[0].weights[2][1]"},
-      {"null weight", [](auto& j) { j["layers"][0]["biases"][0] = nullptr; }, "layers[0].biases[0]"},
+      {"null weight", [](auto& j) { j["layers"][0]["biases"][0] = nullptr; },
+       "layers[0].biases[0]"},
       {"scaling size", [](auto& j) { j["input_scaling"]["min"].erase(0); }, "input_scaling.min"},
       {"scaling order", [](auto& j) { j["target_scaling"]["min"][0] = 1e9; }, "target_scaling"},
       {"input name", [](auto& j) { j["inputs"][1]["name"] = "diameter_in"; }, "inputs[1]"},

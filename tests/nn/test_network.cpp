@@ -33,8 +33,8 @@ Eigen::VectorXd Errors(const Network& net, const Eigen::MatrixXd& x) {
 }
 
 TEST(Network, JacobianMatchesCentralDifferencesOnRandomNetworks) {
-  const std::vector<std::vector<int>> shapes = {{5, 6, 2}, {5, 6, 2}, {5, 4, 2}, {3, 1, 1},
-                                                {5, 8, 3, 2}, {2, 2}, {5, 10, 2}};
+  const std::vector<std::vector<int>> shapes = {{5, 6, 2},    {5, 6, 2}, {5, 4, 2}, {3, 1, 1},
+                                                {5, 8, 3, 2}, {2, 2},    {5, 10, 2}};
   int cases = 0;
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
     const auto& sizes = shapes[seed % shapes.size()];
@@ -59,7 +59,8 @@ TEST(Network, JacobianMatchesCentralDifferencesOnRandomNetworks) {
     }
     const double rel = (J - J_fd).norm() / J_fd.norm();
     EXPECT_LT(rel, 1e-6) << "seed " << seed;
-    EXPECT_TRUE(whirl::test::AllNear(J, J_fd, 1e-6, 1e-9 * J_fd.cwiseAbs().maxCoeff())) << "seed " << seed;
+    EXPECT_TRUE(whirl::test::AllNear(J, J_fd, 1e-6, 1e-9 * J_fd.cwiseAbs().maxCoeff()))
+        << "seed " << seed;
     ++cases;
   }
   EXPECT_EQ(cases, 40);

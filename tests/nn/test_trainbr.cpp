@@ -210,10 +210,9 @@ TEST(TrainBr, LogEvidenceEqualsMacKaysFormInHisConvention) {
                         std::lgamma(7.0) + 6 * std::log(2.0);
   EXPECT_NEAR(s.log_evidence, mackay, 1e-8 * std::abs(mackay));
   // Posterior covariance = A^-1.
-  const Eigen::MatrixXd A =
-      bM * J.transpose() * J + aM * Eigen::MatrixXd::Identity(50, 50);
+  const Eigen::MatrixXd A = bM * J.transpose() * J + aM * Eigen::MatrixXd::Identity(50, 50);
   EXPECT_TRUE(whirl::test::AllNear(Eigen::MatrixXd(A * r.posterior_covariance),
-                            Eigen::MatrixXd::Identity(50, 50), 0, 1e-8));
+                                   Eigen::MatrixXd::Identity(50, 50), 0, 1e-8));
 }
 
 TEST(TrainBr, RestartsKeepTheHighestEvidenceAndAreReproducible) {
