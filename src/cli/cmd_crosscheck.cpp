@@ -73,8 +73,10 @@ void RegisterCrosscheck(CLI::App& app) {
       "its gradient (1e-10), and training: from the same start (model weights perturbed by\n"
       "--perturbation) with alpha, beta fixed, the Eigen damped Gauss-Newton (trainbr LM loop on "
       "nn's\n"
-      "Jacobian) and LibTorch LBFGS (strong Wolfe) must reach the same minimum (F within 1e-6\n"
-      "relative, predictions within --prediction-tolerance normalized target units).\n"
+      "Jacobian) and LibTorch LBFGS (strong Wolfe, Gauss-Newton preconditioned with an autograd\n"
+      "Jacobian) must reach the same minimum (F within 1e-6 relative, predictions within\n"
+      "--prediction-tolerance normalized target units). Use the model's training table: on other\n"
+      "data, with the model's alpha, beta, the two may legitimately find different local minima.\n"
       "Errors are measured in the model's normalized (mapminmax) target space.\n"
       "Exit code 0 when every figure is within tolerance, 2 when one is not, 1 on bad input.");
   sub->add_option("--model", o->model_path, "Model file (JSON, written by 'whirl train')")
