@@ -1,4 +1,6 @@
 // whirl crosscheck: the Eigen network against an independent LibTorch implementation (issue 6).
+// Compiled into build/whirl-torch only (the one whirl executable that links LibTorch);
+// build/whirl forwards "whirl crosscheck ..." to it (cli/torch_forward.cpp).
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -6,12 +8,9 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/error.h"
-
-#ifdef WHIRL_HAVE_TORCH
 #include "core/process.h"
 #include "nn/model.h"
 #include "torch/crosscheck.h"
-#endif
 
 namespace whirl::cli {
 namespace {
@@ -28,7 +27,6 @@ struct CrosscheckCliOptions {
 };
 
 void RunCrosscheck(const CrosscheckCliOptions& o) {
-#ifdef WHIRL_HAVE_TORCH
   const nn::Model model = nn::LoadModel(o.model_path);
   const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
   torch::CrosscheckOptions options;
@@ -48,13 +46,6 @@ void RunCrosscheck(const CrosscheckCliOptions& o) {
                 report.Table().c_str(), report.BriefReport().c_str());
   }
   if (!report.Passed()) throw CommandFailure(report.BriefReport(), 2);
-#else
-  (void)o;
-  throw InputError(
-      "'whirl crosscheck' is not available: whirl was built without LibTorch (install "
-      "libtorch-dev, "
-      "e.g. scripts/setup.sh, and rebuild with -DWHIRL_WITH_TORCH=ON)");
-#endif
 }
 
 }  // namespace

@@ -1,4 +1,6 @@
 // whirl export: a trained model as a TorchScript module for the PyTorch world (issue 6).
+// Compiled into build/whirl-torch only (the one whirl executable that links LibTorch);
+// build/whirl forwards "whirl export ..." to it (cli/torch_forward.cpp).
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -6,11 +8,8 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/error.h"
-
-#ifdef WHIRL_HAVE_TORCH
 #include "nn/model.h"
 #include "torch/crosscheck.h"
-#endif
 
 namespace whirl::cli {
 namespace {
@@ -22,7 +21,6 @@ struct ExportCliOptions {
 };
 
 void RunExport(const ExportCliOptions& o) {
-#ifdef WHIRL_HAVE_TORCH
   const nn::Model model = nn::LoadModel(o.model_path);
   torch::ExportOptions options;
   options.description = "whirl elongation-feature model exported by 'whirl export --model " +
@@ -55,12 +53,6 @@ void RunExport(const ExportCliOptions& o) {
                   report.max_relative_difference, report.tolerance);
     throw CommandFailure(buf, 2);
   }
-#else
-  (void)o;
-  throw InputError(
-      "'whirl export' is not available: whirl was built without LibTorch (install libtorch-dev, "
-      "e.g. scripts/setup.sh, and rebuild with -DWHIRL_WITH_TORCH=ON)");
-#endif
 }
 
 }  // namespace

@@ -15,8 +15,10 @@ void RegisterPlan(CLI::App& app);        // cmd_plan.cpp
 void RegisterCompare(CLI::App& app);     // cmd_compare.cpp
 void RegisterLeadReport(CLI::App& app);  // cmd_lead_report.cpp
 void RegisterEvaluate(CLI::App& app);    // cmd_evaluate.cpp
-void RegisterCrosscheck(CLI::App& app);  // cmd_crosscheck.cpp (LibTorch)
-void RegisterExport(CLI::App& app);      // cmd_export.cpp (LibTorch)
+void RegisterCrosscheck(CLI::App& app);  // cmd_crosscheck.cpp (in whirl-torch only)
+void RegisterExport(CLI::App& app);      // cmd_export.cpp (in whirl-torch only)
+/// In whirl: 'crosscheck' and 'export' hand their arguments to whirl-torch (torch_forward.cpp).
+void RegisterTorchForwarders(CLI::App& app);
 void RegisterDemo(CLI::App& app);        // cmd_demo.cpp
 
 }  // namespace whirl::cli

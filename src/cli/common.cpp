@@ -2,11 +2,30 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 
+#include "core/error.h"
+
 namespace whirl::cli {
+
+int RunApp(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 1;
+  } catch (const CommandFailure& e) {
+    std::fprintf(stderr, "failed: %s\n", e.what());
+    return e.exit_code;
+  } catch (const std::exception& e) {  // InputError and anything else: bad input or failure
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
 
 void PrintJson(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
 

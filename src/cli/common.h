@@ -5,7 +5,16 @@
 #include <stdexcept>
 #include <string>
 
+namespace CLI {
+class App;
+}
+
 namespace whirl::cli {
+
+/// Parses the command line and runs the chosen subcommand's callback. Exit code: 0 on success
+/// (and for --help/--version), 1 on a parse error or bad input ("error: <message>" on stderr),
+/// CommandFailure::exit_code when a check ran and failed. Shared by whirl and whirl-torch.
+int RunApp(CLI::App& app, int argc, char** argv);
 
 /// A command that ran but whose result is a failure (e.g. a cross-check that disagrees):
 /// main prints the message and exits with `exit_code` (never 0).

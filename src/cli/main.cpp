@@ -1,11 +1,7 @@
 // whirl: predicts the thermal elongation of the unmachined section of a ball screw during hard
 // whirling and turns it into SINUMERIK 840D temperature-compensation setting data.
-#include <cstdio>
-#include <exception>
-
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "core/error.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -29,22 +25,6 @@ int main(int argc, char** argv) {
   RegisterCompare(app);
   RegisterLeadReport(app);
   RegisterEvaluate(app);
-  RegisterCrosscheck(app);
-  RegisterExport(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 1;
-  } catch (const CommandFailure& e) {
-    std::fprintf(stderr, "failed: %s\n", e.what());
-    return e.exit_code;
-  } catch (const whirl::InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  RegisterTorchForwarders(app);
+  return RunApp(app, argc, argv);
 }
