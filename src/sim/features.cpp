@@ -30,9 +30,54 @@ void CheckOptions(const SettleOptions& o) {
     fail("smoothing_window_s", o.smoothing_window_s, "must be >= 0");
   if (!(o.tail_fraction > 0 && o.tail_fraction < 1))
     fail("tail_fraction", o.tail_fraction, "0 < x < 1");
-  if (o.tail_degree < 0 || o.tail_degree > 2) fail("tail_degree", o.tail_degree, "0, 1 or 2");
+  if (o.drift_degree < 0 || o.drift_degree > 3) fail("drift_degree", o.drift_degree, "0 to 3");
   if (!(o.noise_sigma_multiplier >= 0))
     fail("noise_sigma_multiplier", o.noise_sigma_multiplier, "must be >= 0");
+  if (!(o.fit_start_factor >= 1)) fail("fit_start_factor", o.fit_start_factor, "must be >= 1");
+  if (o.max_iterations < 1) fail("max_iterations", o.max_iterations, "must be >= 1");
+}
+
+// Plateau + drift fitted to samples [begin, n): coef(0) = P, coef(k) = c_k of u^k.
+struct DriftFit {
+  Eigen::VectorXd coef;
+  double sigma = 0;
+  double Drift(double u) const {
+    double v = 0.0, p = u;
+    for (Eigen::Index k = 1; k < coef.size(); ++k, p *= u) v += coef(k) * p;
+    return v;
+  }
+};
+
+DriftFit FitPlateauAndDrift(const std::vector<double>& u, const std::vector<double>& y,
+                            std::size_t begin, int degree) {
+  const std::size_t n = u.size(), m = n - begin;
+  Eigen::MatrixXd design(m, degree + 1);
+  Eigen::VectorXd rhs(m), w = Eigen::VectorXd::Ones(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    double p = 1.0;
+    for (int d = 0; d <= degree; ++d, p *= u[begin + i])
+      design(static_cast<Eigen::Index>(i), d) = p;
+    rhs(static_cast<Eigen::Index>(i)) = y[begin + i];
+  }
+  DriftFit f;
+  std::vector<double> resid(m);
+  // Huber IRLS: Gaussian noise gives plain least squares; spikes of a real sensor lose weight.
+  for (int pass = 0; pass < 4; ++pass) {
+    const Eigen::MatrixXd wd = w.asDiagonal() * design;
+    f.coef = wd.colPivHouseholderQr().solve(w.asDiagonal() * rhs);
+    const Eigen::VectorXd r = rhs - design * f.coef;
+    for (std::size_t i = 0; i < m; ++i) resid[i] = r(static_cast<Eigen::Index>(i));
+    const double med = Median(resid);
+    std::vector<double> dev(m);
+    for (std::size_t i = 0; i < m; ++i) dev[i] = std::abs(resid[i] - med);
+    f.sigma = 1.4826 * Median(dev);
+    const double c = 1.345 * f.sigma;
+    for (std::size_t i = 0; i < m; ++i) {
+      const double a = std::abs(resid[i]);
+      w(static_cast<Eigen::Index>(i)) = (c > 0 && a > c) ? std::sqrt(c / a) : 1.0;
+    }
+  }
+  return f;
 }
 
 }  // namespace
@@ -56,86 +101,93 @@ SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& 
   }
   const std::vector<double>& t = curve.time_s;
   const std::vector<double>& y = curve.elongation_um;
+  const double t0 = t.front(), span = t.back() - t.front();
+  std::vector<double> u(n);
+  for (std::size_t i = 0; i < n; ++i) u[i] = (t[i] - t0) / span;
+  auto index_at = [&](double tt) {
+    std::size_t i = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), tt) - t.begin());
+    return std::min(i, n - 3);
+  };
 
-  // 1. Centred moving average (two pointers over prefix sums).
-  std::vector<double> prefix(n + 1, 0.0);
-  for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + y[i];
-  std::vector<double> smooth(n);
-  std::vector<double> window_count(n);
+  // Centred moving-average windows [lo_i, hi_i] (two pointers); counts n_i.
+  std::vector<std::size_t> win_lo(n), win_hi(n);
   const double half = 0.5 * options.smoothing_window_s;
-  std::size_t lo = 0, hi = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0, lo = 0, hi = 0; i < n; ++i) {
     while (t[lo] < t[i] - half) ++lo;
     if (hi < i) hi = i;
     while (hi + 1 < n && t[hi + 1] <= t[i] + half) ++hi;
-    const double count = static_cast<double>(hi - lo + 1);
-    smooth[i] = (prefix[hi + 1] - prefix[lo]) / count;
-    window_count[i] = count;
+    win_lo[i] = lo;
+    win_hi[i] = hi;
   }
+  std::vector<double> prefix(n + 1), smooth(n);
 
-  // 2. Tail line by least squares on the raw samples.
-  const double t_tail = t.back() - options.tail_fraction * (t.back() - t.front());
-  std::size_t tail_begin = 0;
-  while (tail_begin < n && t[tail_begin] < t_tail) ++tail_begin;
-  tail_begin = std::min(tail_begin, n - 3);
-  const std::size_t m = n - tail_begin;
-  // Polynomial in the scaled time u = (t - t_mid) / t_half for conditioning.
-  const double t_mid = 0.5 * (t[tail_begin] + t.back());
-  const double t_half = std::max(1e-12, 0.5 * (t.back() - t[tail_begin]));
-  const int degree = options.tail_degree;
-  Eigen::MatrixXd design(m, degree + 1);
-  Eigen::VectorXd rhs(m);
-  for (std::size_t i = 0; i < m; ++i) {
-    const double u = (t[tail_begin + i] - t_mid) / t_half;
-    double p = 1.0;
-    for (int d = 0; d <= degree; ++d, p *= u) design(static_cast<Eigen::Index>(i), d) = p;
-    rhs(static_cast<Eigen::Index>(i)) = y[tail_begin + i];
-  }
-  const Eigen::VectorXd coef = design.colPivHouseholderQr().solve(rhs);
-  auto plateau = [&](double tt) {
-    const double u = (tt - t_mid) / t_half;
-    double v = 0.0, p = 1.0;
-    for (int d = 0; d <= degree; ++d, p *= u) v += coef(d) * p;
-    return v;
-  };
-  const double slope = (plateau(t.back()) - plateau(t[tail_begin])) / (2.0 * t_half);
-
-  // 3. Robust noise level of the raw tail.
-  std::vector<double> resid;
-  resid.reserve(m);
-  for (std::size_t i = tail_begin; i < n; ++i) resid.push_back(y[i] - plateau(t[i]));
-  const double med = Median(resid);
-  for (double& r : resid) r = std::abs(r - med);
-  const double sigma = 1.4826 * Median(resid);
-  std::vector<double> counts(window_count.begin() + static_cast<std::ptrdiff_t>(tail_begin),
-                             window_count.end());
-  const double n_win = std::max(1.0, Median(counts));
-  const double noise_floor = options.noise_sigma_multiplier * sigma / std::sqrt(n_win);
-
-  // 4./5. Last excursion of the smoothed curve outside the band.
-  auto band = [&](double tt) {
-    return std::max(options.tolerance_rel * std::abs(plateau(tt)), noise_floor);
-  };
+  const double t_tail = t0 + (1.0 - options.tail_fraction) * span;
+  const std::size_t tail_begin = index_at(t_tail);
+  std::size_t fit_begin = tail_begin;
+  int degree = std::min(1, options.drift_degree);
+  DriftFit fit;
   std::size_t settle_index = 0;
-  for (std::size_t i = n; i-- > 0;) {
-    if (std::abs(smooth[i] - plateau(t[i])) > band(t[i])) {
-      settle_index = std::min(i + 1, n - 1);
-      break;
+  double band_at_settle = 0;
+  int iterations = 0;
+  std::vector<std::size_t> visited;
+  for (int pass = 0; pass < options.max_iterations; ++pass) {
+    ++iterations;
+    fit = FitPlateauAndDrift(u, y, fit_begin, degree);
+    const double plateau = fit.coef(0);
+    for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (y[i] - fit.Drift(u[i]));
+    for (std::size_t i = 0; i < n; ++i)
+      smooth[i] = (prefix[win_hi[i] + 1] - prefix[win_lo[i]]) /
+                  static_cast<double>(win_hi[i] - win_lo[i] + 1);
+    auto band = [&](std::size_t i) {
+      const double count = static_cast<double>(win_hi[i] - win_lo[i] + 1);
+      return std::max(options.tolerance_rel * std::abs(plateau),
+                      options.noise_sigma_multiplier * fit.sigma / std::sqrt(count));
+    };
+    std::size_t s = 0;
+    for (std::size_t i = n; i-- > 0;) {
+      if (std::abs(smooth[i] - plateau) > band(i)) {
+        s = std::min(i + 1, n - 1);
+        break;
+      }
     }
+    band_at_settle = band(s);
+    const std::size_t next_begin =
+        std::min(tail_begin, index_at(t0 + options.fit_start_factor * (t[s] - t0)));
+    // Stop at a fixed point, or when the window start comes back to an earlier value (a cycle
+    // of two windows one sample apart: either answer is as good).
+    const bool converged =
+        degree == options.drift_degree &&
+        std::find(visited.begin(), visited.end(), next_begin) != visited.end();
+    settle_index = s;
+    if (converged) break;
+    if (degree == options.drift_degree) visited.push_back(fit_begin);
+    fit_begin = next_begin;
+    degree = options.drift_degree;
   }
+
   SettleAnalysis a;
-  a.features.settle_time_s = t[settle_index] - t.front();
-  a.features.max_elongation_um = plateau(t[settle_index]);
-  a.plateau_slope_um_per_s = slope;
-  a.noise_std_um = sigma;
-  a.band_um = band(t[settle_index]);
-  a.settled_before_tail = t[settle_index] < t_tail;
+  const double ts = t[settle_index];
+  a.features.settle_time_s = ts - t0;
+  // The level where the plateau is reached, P + d(t_s): the fit determines it from samples just
+  // after t_s, whereas P alone is a quadratic extrapolated back to t0 (several times noisier).
+  a.features.max_elongation_um = fit.coef(0) + fit.Drift(u[settle_index]);
+  a.drift_at_settle_um = fit.Drift(u[settle_index]);
+  a.drift_at_end_um = fit.Drift(1.0);
+  a.plateau_slope_um_per_s = (fit.Drift(1.0) - fit.Drift(u[fit_begin])) / (t.back() - t[fit_begin]);
+  a.noise_std_um = fit.sigma;
+  a.band_um = band_at_settle;
+  a.fit_start_s = t[fit_begin];
+  a.iterations = iterations;
+  a.settled_before_tail = ts < t_tail;
   std::ostringstream msg;
-  msg << "plateau " << FormatNumber(a.features.max_elongation_um) << " um (tail fit from "
-      << FormatNumber(t_tail) << " s, slope " << FormatNumber(slope * 3600.0)
-      << " um/h mean), band +-" << FormatNumber(a.band_um) << " um = max(" << options.tolerance_rel
-      << " x plateau, " << options.noise_sigma_multiplier << " x noise " << FormatNumber(sigma)
-      << " um / sqrt(" << FormatNumber(n_win) << ")); smoothed curve stays in the band from "
+  msg << "plateau " << FormatNumber(a.features.max_elongation_um) << " um at the settle time (fit of"
+      << " plateau + degree-" << options.drift_degree << " drift from " << FormatNumber(a.fit_start_s)
+      << " s, " << iterations << " passes; drift " << FormatNumber(a.drift_at_settle_um)
+      << " um at the settle time, " << FormatNumber(a.drift_at_end_um)
+      << " um at the end), band +-" << FormatNumber(a.band_um) << " um = max("
+      << options.tolerance_rel << " x plateau, " << options.noise_sigma_multiplier << " x noise "
+      << FormatNumber(a.noise_std_um) << " um / sqrt(samples in " << options.smoothing_window_s
+      << " s)); detrended smoothed curve stays in the band from "
       << FormatNumber(a.features.settle_time_s) << " s"
       << (a.settled_before_tail ? "" : " (NOT before the tail window: record too short)");
   a.message = msg.str();
