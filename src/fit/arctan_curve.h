@@ -23,11 +23,11 @@ namespace whirl::fit {
 
 /// Default shape parameter k: the median of k fitted with L and t_s fixed to the simulator's
 /// features (sim::ExtractFeatures) over 25 undisturbed simulated curves spread over the paper's
-/// training ranges: 5.70 (range 5.55 to 5.91, median R^2 0.998). Reproduce with
+/// training ranges: 5.62 (range 5.10 to 5.91, median R^2 0.998). Reproduce with
 ///   whirl fit --simulated 25          (src/fit/simulated_fits.h)
 /// tests/fit/test_simulated_fits.cpp checks it is near the median of a freshly simulated set.
-/// With k = 5.7 the slope just before t_s is 1/(1 + k^2) = 3 % of the initial slope.
-inline constexpr double kDefaultShapeK = 5.70;
+/// With k = 5.62 the slope just before t_s is 1/(1 + k^2) = 3 % of the initial slope.
+inline constexpr double kDefaultShapeK = 5.62;
 
 /// Bounds accepted for the shape parameter (validation and fitting).
 inline constexpr double kMinShapeK = 1e-3;
