@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Retrains the shipped model models/default.json from datasets/whirling_train.csv with the
+# Retrains the shipped model models/default.json from datasets/whirling_500.csv (the shop history,
+# also the traditional rule's default history in compare/evaluate/demo) with the
 # documented settings (5-6-2 network, seed 1, 10 restarts, best log evidence kept; trainbr
 # defaults otherwise). Setup-free: it only runs an already built whirl.
 # Usage: scripts/train_default.sh [OUT]   (OUT defaults to models/default.json)
@@ -13,4 +14,4 @@ if [ ! -x "$WHIRL" ]; then
   echo "train_default: '$WHIRL' not found; build first (scripts/build.sh) or set WHIRL" >&2
   exit 1
 fi
-"$WHIRL" train --data datasets/whirling_train.csv --out "$OUT" --hidden 6 --seed 1 --restarts 10
+"$WHIRL" train --data datasets/whirling_500.csv --out "$OUT" --hidden 6 --seed 1 --restarts 10

@@ -23,7 +23,7 @@ struct CompareCliOptions {
   std::string report_dir;
   bool no_plots = false;
   bool no_disturbances = false;
-  std::string history = ProjectPath("datasets/whirling_train.csv");
+  std::string history = ProjectPath(kHistoryTable);
   std::string iso_table = ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv");
   double tolerance_um = interp::PlanOptions{}.tolerance_um;
   double md32760 = interp::kMd32760Default;
@@ -110,7 +110,8 @@ void RegisterCompare(CLI::App& app) {
   sub->add_flag("--no-plots", o->no_plots, "with --report: skip gnuplot (data and HTML only)");
   sub->add_option("--history", o->history,
                   "past screws for the traditional rule: process table with targets "
-                  "(default: the training table datasets/whirling_train.csv)")
+                  "(default: " +
+                      std::string(kHistoryTable) + ", the table models/default.json is trained on)")
       ->check(CLI::ExistingFile);
   sub->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV (default: shipped)")
       ->check(CLI::ExistingFile);

@@ -36,7 +36,7 @@ void RunDemo(const DemoOptions& o) {
     throw InputError("--out-dir '" + o.out_dir + "': cannot create it (" + ec.message() + ")");
 
   const std::string model_path = ProjectPath("models/default.json");
-  const std::string train_path = ProjectPath("datasets/whirling_train.csv");
+  const std::string train_path = ProjectPath(kHistoryTable);
   const ProcessTable history = ReadProcessTable(train_path, /*require_targets=*/true);
   nn::Model model;
   std::string model_source;
@@ -154,7 +154,9 @@ void RegisterDemo(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "demo",
       "Run the whole mission on the shipped defaults in seconds: load models/default.json (or\n"
-      "train from datasets/whirling_train.csv if it is missing or with --retrain), predict the\n"
+      "train from datasets/whirling_500.csv, the shop history, if it is missing or with "
+      "--retrain;\n"
+      "the traditional rule learns from the same table), predict the\n"
       "elongation of the reference screw (datasets/screws/reference_80x10x6000.json) and of a\n"
       "new-type screw outside the training rows (reference blank; 61 HRC, 63 mm, lead 12 mm,\n"
       "raceway radius 4.0 mm, 200 m/min), build the arctangent curve, plan the 840D setting data\n"

@@ -18,7 +18,7 @@ namespace {
 struct EvaluateCliOptions {
   std::string model_path = ProjectPath("models/default.json");
   std::string validation = ProjectPath("datasets/whirling_validation.csv");
-  std::string history = ProjectPath("datasets/whirling_train.csv");
+  std::string history = ProjectPath(kHistoryTable);
   std::string base_screw = ProjectPath("datasets/screws/reference_80x10x6000.json");
   std::string iso_table = ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv");
   bool no_validation = false;
@@ -131,7 +131,8 @@ void RegisterEvaluate(CLI::App& app) {
   sub->add_option("--seed", o->seed, "seed of the random screws and the disturbances (default 1)");
   sub->add_option("--threads", o->threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
   sub->add_option("--history", o->history,
-                  "past screws for the traditional rule (default datasets/whirling_train.csv)")
+                  std::string("past screws for the traditional rule (default ") + kHistoryTable +
+                      ", the table models/default.json is trained on)")
       ->check(CLI::ExistingFile);
   sub->add_option("--base-screw", o->base_screw,
                   "screw whose blank and settings every evaluated screw shares (default the "

@@ -46,8 +46,14 @@ class Progress {
   bool finished_ = false;
 };
 
+/// The shop's history of past screws (process table with targets), relative to the project: the
+/// table the shipped model is trained on (scripts/train_default.sh) and the default history of the
+/// traditional experience rule in compare/evaluate/demo, so both strategies learn from the same
+/// past screws.
+inline constexpr const char* kHistoryTable = "datasets/whirling_500.csv";
+
 /// Where the shipped files live: $WHIRL_HOME if set, else the source tree this binary was built
-/// from. Used by `whirl demo` and defaults such as datasets/whirling_train.csv.
+/// from. Used by `whirl demo` and defaults such as kHistoryTable.
 std::string ProjectPath(const std::string& relative);
 
 }  // namespace whirl::cli
