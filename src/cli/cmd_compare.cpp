@@ -43,13 +43,9 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
   co.plan.md32760 = o.md32760;
   co.shape_k = o.shape_k;
   const compare::ScrewComparison c = compare::CompareScrew(screw, model, rule, iso, co);
-  if (c.prediction.outside_domain) {
-    std::string fields;
-    for (const auto& f : c.prediction.outside_domain_fields)
-      fields += (fields.empty() ? "" : ", ") + f;
-    Warn("screw '" + screw.name + "' lies outside the model's training domain (" + fields +
-         "): the prediction extrapolates");
-  }
+  if (c.prediction.outside_domain)
+    Warn("screw '" + screw.name + "' lies outside the model's training domain (" +
+         JoinFields(c.prediction.outside_domain_fields) + "): the prediction extrapolates");
   if (!o.report_dir.empty()) {
     compare::ReportOptions ro;
     ro.plots = !o.no_plots;

@@ -49,15 +49,8 @@ void Run(const CurveOptions& o) {
     const sim::Kinematics kin = sim::ComputeKinematics(screw);
     const nn::Model model = nn::LoadModel(o.model_path);
     const nn::Prediction pred = nn::Predict(model, screw.process);
-    if (pred.outside_domain) {
-      std::string fields;
-      for (const auto& f : pred.outside_domain_fields) fields += (fields.empty() ? "" : ", ") + f;
-      if (!o.allow_extrapolation)
-        throw InputError("screw " + o.screw_path + " lies outside the model's training domain in " +
-                         fields + ": pass --allow-extrapolation to use the prediction anyway");
-      Warn("screw " + o.screw_path + " lies outside the training domain in " + fields +
-           " (extrapolating)");
-    }
+    GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.screw_path,
+                        o.allow_extrapolation);
     features = pred.mean;
     stddev = pred.stddev;
     if (duration_s == 0) duration_s = kin.cutting_time_s;

@@ -27,6 +27,23 @@ int RunApp(CLI::App& app, int argc, char** argv) {
   return 0;
 }
 
+std::string JoinFields(const std::vector<std::string>& fields) {
+  std::string out;
+  for (const auto& f : fields) out += (out.empty() ? "" : ", ") + f;
+  return out;
+}
+
+void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fields,
+                         const std::string& screw_path, bool allow_extrapolation) {
+  if (!outside_domain) return;
+  if (!allow_extrapolation)
+    throw InputError("screw " + screw_path + " lies outside the model's training domain in " +
+                     JoinFields(fields) +
+                     ": pass --allow-extrapolation to use the prediction anyway");
+  Warn("screw " + screw_path + " lies outside the training domain in " + JoinFields(fields) +
+       " (extrapolating)");
+}
+
 void PrintJson(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
 
 void Warn(const std::string& text) { std::cerr << "warning: " << text << std::endl; }

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -23,6 +24,15 @@ struct CommandFailure : std::runtime_error {
   CommandFailure(const std::string& message, int code = 2)
       : std::runtime_error(message), exit_code(code) {}
 };
+
+/// "a, b, c": the fields of a prediction outside the model's training domain, for messages.
+std::string JoinFields(const std::vector<std::string>& fields);
+
+/// The training-domain guard of commands that act on one screw's prediction (curve, plan): if
+/// `outside_domain`, an InputError naming the screw file and the fields unless
+/// `allow_extrapolation`, which turns it into a warning.
+void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fields,
+                         const std::string& screw_path, bool allow_extrapolation);
 
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.
 void PrintJson(const nlohmann::json& j);
