@@ -11,18 +11,11 @@ namespace whirl::compare {
 LeadDeviation ReadLeadDeviation(const std::filesystem::path& path) {
   const CsvTable csv = ReadCsv(path);
   LeadDeviation lead;
-  lead.position_mm = csv.Column("position_mm");
+  lead.position_mm = csv.IncreasingColumn("position_mm");
   lead.deviation_um = csv.Column("deviation_um");
   if (lead.size() < 2)
     throw InputError(csv.source + ": a lead-deviation curve needs at least 2 rows, found " +
                      std::to_string(lead.size()));
-  for (std::size_t i = 1; i < lead.size(); ++i) {
-    if (!(lead.position_mm[i] > lead.position_mm[i - 1]))
-      throw InputError(csv.source + ":" + std::to_string(csv.line_numbers[i]) +
-                       ": position_mm must increase strictly (" +
-                       FormatNumber(lead.position_mm[i]) + " after " +
-                       FormatNumber(lead.position_mm[i - 1]) + ")");
-  }
   return lead;
 }
 

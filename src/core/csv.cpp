@@ -53,6 +53,17 @@ std::vector<double> CsvTable::Column(const std::string& name) const {
   return out;
 }
 
+std::vector<double> CsvTable::IncreasingColumn(const std::string& name) const {
+  std::vector<double> v = Column(name);
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    if (!(v[i] > v[i - 1]))
+      throw InputError(source + ":" + std::to_string(line_numbers[i]) + ": " + name +
+                       " must increase strictly (" + FormatNumber(v[i]) + " after " +
+                       FormatNumber(v[i - 1]) + ")");
+  }
+  return v;
+}
+
 CsvTable ParseCsv(const std::string& text, const std::string& source, bool allow_empty) {
   CsvTable t;
   t.source = source;
@@ -84,8 +95,8 @@ CsvTable ParseCsv(const std::string& text, const std::string& source, bool allow
       continue;
     }
     if (cells.size() != t.header.size()) {
-      throw InputError(where + ": expected " + std::to_string(t.header.size()) +
-                       " cells, found " + std::to_string(cells.size()));
+      throw InputError(where + ": expected " + std::to_string(t.header.size()) + " cells, found " +
+                       std::to_string(cells.size()));
     }
     std::vector<double> row(cells.size());
     for (std::size_t c = 0; c < cells.size(); ++c) {

@@ -20,6 +20,9 @@ struct CsvTable {
   bool HasColumn(const std::string& name) const;
   /// All values of one column.
   std::vector<double> Column(const std::string& name) const;
+  /// All values of one column, which must increase strictly from row to row (a time or position
+  /// axis); InputError "file:line: name must increase strictly (b after a)" otherwise.
+  std::vector<double> IncreasingColumn(const std::string& name) const;
 };
 
 /// Parses CSV text. Rejects: no header, an empty or duplicated column name, a row with the wrong

@@ -11,19 +11,14 @@ namespace whirl {
 ElongationCurve ReadElongationCurve(const std::filesystem::path& path, double max_gap_factor) {
   const CsvTable csv = ReadCsv(path);
   ElongationCurve c;
-  c.time_s = csv.Column("time_s");
+  c.time_s = csv.IncreasingColumn("time_s");
   c.elongation_um = csv.Column("elongation_um");
   if (c.size() < 3)
     throw InputError(csv.source + ": a curve needs at least 3 samples, found " +
                      std::to_string(c.size()));
   std::vector<double> steps;
   for (std::size_t i = 1; i < c.size(); ++i) {
-    const double dt = c.time_s[i] - c.time_s[i - 1];
-    if (!(dt > 0))
-      throw InputError(csv.source + ":" + std::to_string(csv.line_numbers[i]) +
-                       ": time_s must increase strictly (" + FormatNumber(c.time_s[i]) +
-                       " after " + FormatNumber(c.time_s[i - 1]) + ")");
-    steps.push_back(dt);
+    steps.push_back(c.time_s[i] - c.time_s[i - 1]);
   }
   std::vector<double> sorted = steps;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
@@ -32,8 +27,8 @@ ElongationCurve ReadElongationCurve(const std::filesystem::path& path, double ma
     if (steps[i] > max_gap_factor * median)
       throw InputError(csv.source + ":" + std::to_string(csv.line_numbers[i + 1]) +
                        ": gap in the recording: time step " + FormatNumber(steps[i]) +
-                       " s is more than " + FormatNumber(max_gap_factor) +
-                       " x the median step " + FormatNumber(median) + " s");
+                       " s is more than " + FormatNumber(max_gap_factor) + " x the median step " +
+                       FormatNumber(median) + " s");
   }
   return c;
 }
