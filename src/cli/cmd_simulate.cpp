@@ -1,4 +1,5 @@
 // whirl simulate: the hard-whirling thermal simulator for one screw (src/sim/simulator.h).
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 
@@ -94,21 +95,25 @@ void Run(const SimulateOptions& o) {
     PrintJson(ResultJson(screw, r, settle, o));
     return;
   }
+  // Human output rounds to what a process engineer reads (4 significant digits); --json and the
+  // curve file keep full precision.
+  const auto g = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", x);
+    return std::string(buf);
+  };
   const auto& k = r.kinematics;
-  std::cout << "screw " << screw.name << ": " << screw.process.diameter_mm << " mm x "
-            << screw.process.pitch_mm << " mm lead, thread " << screw.thread_length_mm << " mm\n"
-            << "  ring " << FormatNumber(k.ring_speed_rpm) << " r/min on a "
-            << k.tool_circle_diameter_mm << " mm tool circle, workpiece "
-            << FormatNumber(k.workpiece_speed_rpm) << " r/min, axial feed "
-            << FormatNumber(k.axial_feed_mm_min) << " mm/min, whole thread "
-            << FormatNumber(k.cutting_time_s / 3600.0) << " h\n"
-            << "  cutting power " << FormatNumber(r.heat.cutting_power_w)
-            << " W, into the workpiece "
-            << FormatNumber(r.heat.heat_to_workpiece_w * r.disturbances.heat_partition_factor)
-            << " W\n"
-            << "  max_elongation_um " << FormatNumber(r.features.max_elongation_um)
-            << "\n  settle_time_s " << FormatNumber(r.features.settle_time_s) << "\n  "
-            << r.summary.BriefReport() << "\n";
+  std::cout << "screw " << screw.name << ": " << g(screw.process.diameter_mm) << " mm x "
+            << g(screw.process.pitch_mm) << " mm lead, thread " << g(screw.thread_length_mm)
+            << " mm\n"
+            << "  ring " << g(k.ring_speed_rpm) << " r/min on a " << g(k.tool_circle_diameter_mm)
+            << " mm tool circle, workpiece " << g(k.workpiece_speed_rpm) << " r/min, axial feed "
+            << g(k.axial_feed_mm_min) << " mm/min, whole thread " << g(k.cutting_time_s / 3600.0)
+            << " h\n"
+            << "  cutting power " << g(r.heat.cutting_power_w) << " W, into the workpiece "
+            << g(r.heat.heat_to_workpiece_w * r.disturbances.heat_partition_factor) << " W\n"
+            << "  max_elongation_um " << g(r.features.max_elongation_um) << "\n  settle_time_s "
+            << g(r.features.settle_time_s) << "\n  " << r.summary.BriefReport() << "\n";
   if (!o.out_path.empty()) std::cout << "  curve written to " << o.out_path << "\n";
 }
 
