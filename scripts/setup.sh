@@ -7,7 +7,7 @@ packages=(
   libeigen3-dev nlohmann-json3-dev libcli11-dev
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libtorch-dev
-  gnuplot-nox
+  gnuplot-nox fonts-liberation   # report plots (pngcairo needs a font; a Recommends of gnuplot-nox)
 )
 missing=()
 for p in "${packages[@]}"; do
