@@ -1,5 +1,11 @@
-# Sources of src/compare (owned by the compare module). Add files with target_sources(whirl_core PRIVATE ...).
-target_sources(whirl_core PRIVATE
+# src/compare: lead deviation, ISO 3408-3 metrics, traditional rule, comparison, evaluation, report.
+# Its own library on top of the core (nn, sim, fit) and interp (the 840D plan it applies), so the
+# dependencies run one way: core <- interp <- compare <- whirl.
+add_library(whirl_compare STATIC)
+add_library(whirl::compare ALIAS whirl_compare)
+target_link_libraries(whirl_compare PUBLIC whirl::core whirl_interp)
+whirl_set_warnings(whirl_compare)
+target_sources(whirl_compare PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/lead.cpp
   ${CMAKE_CURRENT_LIST_DIR}/metrics.cpp
   ${CMAKE_CURRENT_LIST_DIR}/iso3408.cpp
@@ -8,6 +14,3 @@ target_sources(whirl_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/compare.cpp
   ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp
   ${CMAKE_CURRENT_LIST_DIR}/report.cpp)
-# compare drives the 840D plan (interp/), which is its own library linked to whirl_core: link it
-# back (CMake resolves the cycle of the two static libraries) and see its headers ("interp/x.h").
-target_link_libraries(whirl_core PUBLIC whirl_interp)
