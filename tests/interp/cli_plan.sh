@@ -3,14 +3,7 @@
 set -u
 W="$1"; D="$2"; SRC="$3"
 rm -rf "$D"; mkdir -p "$D"
-fail() { echo "FAIL: $*"; exit 1; }
-expect_fail() {  # expect_fail <pattern> <command...>: exit code 1 and 'error:' + pattern on stderr
-  local pattern="$1"; shift
-  "$@" > "$D/out.txt" 2> "$D/err.txt"; local rc=$?
-  [ $rc -eq 1 ] || fail "expected exit 1, got $rc: $*"
-  grep -q "error" "$D/err.txt" || fail "no error message: $*"
-  grep -qi -- "$pattern" "$D/err.txt" || fail "message lacks '$pattern': $(cat "$D/err.txt")"
-}
+source "$SRC/tests/support/cli_common.sh"
 S="$SRC/datasets/screws/reference_80x10x6000.json"
 
 "$W" plan --help | grep -q "SD43910" || fail "plan --help"
