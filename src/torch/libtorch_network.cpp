@@ -568,15 +568,14 @@ namespace {
     throw InputError("cannot load TorchScript file '" + path.string() + "': " + e.what());
   }
 }
-}  // namespace
 
-Eigen::MatrixXd RunTorchScript(const std::filesystem::path& path, const Eigen::MatrixXd& x_raw) {
-  Prepare();
-  ::torch::jit::Module module = LoadScript(path);
+// Runs `forward` (a call of a loaded script) without autograd and turns LibTorch's errors into
+// InputError naming the file.
+template <typename Forward>
+auto RunScript(const std::filesystem::path& path, Forward forward) -> decltype(forward()) {
   ::torch::NoGradGuard no_grad;
   try {
-    const Tensor y = module.forward({SamplesToTensor(x_raw)}).toTensor();
-    return ToEigenMatrix(y.t());
+    return forward();
   } catch (const InputError&) {
     throw;
   } catch (const c10::Error& e) {
@@ -586,25 +585,27 @@ Eigen::MatrixXd RunTorchScript(const std::filesystem::path& path, const Eigen::M
     throw InputError("TorchScript file '" + path.string() + "' failed to run: " + e.what());
   }
 }
+}  // namespace
+
+Eigen::MatrixXd RunTorchScript(const std::filesystem::path& path, const Eigen::MatrixXd& x_raw) {
+  Prepare();
+  ::torch::jit::Module module = LoadScript(path);
+  return RunScript(path, [&] {
+    const Tensor y = module.forward({SamplesToTensor(x_raw)}).toTensor();
+    return ToEigenMatrix(y.t());
+  });
+}
 
 Eigen::VectorXd RunTorchScriptOne(const std::filesystem::path& path, const Eigen::VectorXd& x_raw) {
   Prepare();
   ::torch::jit::Module module = LoadScript(path);
-  ::torch::NoGradGuard no_grad;
-  try {
+  return RunScript(path, [&]() -> Eigen::VectorXd {
     const Tensor y = module.forward({ToTensor(x_raw)}).toTensor();
     if (y.dim() != 1)
       throw InputError("TorchScript file '" + path.string() + "': a 1-D input gave a " +
                        std::to_string(y.dim()) + "-D result");
     return ToEigenMatrix(y.reshape({-1, 1})).col(0);
-  } catch (const InputError&) {
-    throw;
-  } catch (const c10::Error& e) {
-    throw InputError("TorchScript file '" + path.string() +
-                     "' failed to run: " + e.what_without_backtrace());
-  } catch (const std::exception& e) {  // torch::jit::JITException (a failed assert in forward)
-    throw InputError("TorchScript file '" + path.string() + "' failed to run: " + e.what());
-  }
+  });
 }
 
 std::vector<std::string> TorchScriptNames(const std::filesystem::path& path, bool inputs) {
