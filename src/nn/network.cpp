@@ -217,6 +217,48 @@ void ErrorJacobian(const Network& net, const ForwardCache& cache, Eigen::MatrixX
   }
 }
 
+void ErrorGram(const Network& net, const ForwardCache& cache, const Eigen::MatrixXd& J_e_w,
+               Eigen::MatrixXd* G) {
+  const Eigen::Index n = J_e_w.rows();
+  if (net.LayerCount() != 2) {
+    G->resize(n, n);
+    G->noalias() = J_e_w * J_e_w.transpose();
+    G->triangularView<Eigen::StrictlyUpper>() = G->transpose();  // exactly symmetric
+    return;
+  }
+  const int S = net.OutputCount();
+  const int H = net.layer_sizes[1];
+  const Eigen::MatrixXd& x = cache.a[0];  // R x Q
+  const Eigen::MatrixXd& a = cache.a[1];  // H x Q
+  const Eigen::Index Q = x.cols();
+  if (n != S * Q)
+    throw InputError("network: Jacobian has " + std::to_string(n) + " rows, the cache " +
+                     std::to_string(S * Q) + " errors");
+  const Eigen::MatrixXd& W1 = net.weights[1];
+  // ut.col(q * S + k) = u_qk; the dot products below run over contiguous columns of length H.
+  thread_local Eigen::MatrixXd ut, px, pa;
+  ut.resize(H, n);
+  for (Eigen::Index q = 0; q < Q; ++q)
+    for (int k = 0; k < S; ++k)
+      ut.col(q * S + k) =
+          W1.row(k).transpose().cwiseProduct((1.0 - a.col(q).array().square()).matrix());
+  px.resize(Q, Q);
+  pa.resize(Q, Q);
+  px.noalias() = x.transpose() * x;
+  pa.noalias() = a.transpose() * a;
+  G->resize(n, n);
+  for (Eigen::Index c = 0; c < n; ++c) {
+    const Eigen::Index qc = c / S, kc = c % S;
+    for (Eigen::Index r = c; r < n; ++r) {
+      const Eigen::Index qr = r / S, kr = r % S;
+      double g = ut.col(r).dot(ut.col(c)) * (1.0 + px(qr, qc));
+      if (kr == kc) g += 1.0 + pa(qr, qc);
+      (*G)(r, c) = g;
+      (*G)(c, r) = g;
+    }
+  }
+}
+
 Eigen::MatrixXd OutputJacobian(const Network& net, const Eigen::VectorXd& x) {
   ForwardCache cache;
   net.Forward(x, &cache);

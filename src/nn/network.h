@@ -96,6 +96,16 @@ struct Network {
 /// `J_e_w` is resized to (S * Q) x N if needed.
 void ErrorJacobian(const Network& net, const ForwardCache& cache, Eigen::MatrixXd* J_e_w);
 
+/// G = J_e_w J_e_w' (n x n, n = S * Q, symmetric), the Gram matrix of the error Jacobian
+/// `J_e_w` = ErrorJacobian(net, cache) of the last Forward(x, cache) call. With one hidden layer
+/// (H tansig neurons) the rows of J_e_w have a product structure, so with x_q = a_0(:, q),
+/// a_q = a_1(:, q) and u_qk = W_1(k, :)' .* (1 - a_q.^2) (row q * S + k):
+///   G[(q,k), (q',k')] = (u_qk . u_q'k') (1 + x_q . x_q') + [k == k'] (1 + a_q . a_q'),
+/// which costs O(n^2 (H + R)) instead of O(n^2 N) and does not read J_e_w. Other depths:
+/// J_e_w J_e_w'. The two agree to rounding (tested).
+void ErrorGram(const Network& net, const ForwardCache& cache, const Eigen::MatrixXd& J_e_w,
+               Eigen::MatrixXd* G);
+
 /// dy/dw for one input (normalized): S x N, row k = gradient of output k (= -J_e_w rows).
 Eigen::MatrixXd OutputJacobian(const Network& net, const Eigen::VectorXd& x);
 

@@ -18,10 +18,11 @@ std::string Num(double x) { return FormatNumber(x); }
 
 double SumSquares(const Eigen::MatrixXd& e) { return e.squaredNorm(); }
 
-// Small dense kernels for the N x N (N = 50 for 5-6-2) systems of the epoch loop. Eigen's blocked
-// LLT, triangular-matrix solve and rankUpdate pack their operands for GEMM kernels, which at this
-// size costs more than the arithmetic; these plain loops over contiguous column segments (all in
-// L1) do the same operations in a different order, so results agree to rounding.
+// Small dense kernels for the N x N (N = 50 for 5-6-2) or n x n (LinearSystem::kErrors) systems
+// of the epoch loop. Eigen's blocked LLT, triangular-matrix solve and rankUpdate pack their
+// operands for GEMM kernels, which at this size costs more than the arithmetic; these plain loops
+// over contiguous column segments (all in L1) do the same operations in a different order, so
+// results agree to rounding.
 using ConstSeg = Eigen::Map<const Eigen::VectorXd>;
 using Seg = Eigen::Map<Eigen::VectorXd>;
 
@@ -359,11 +360,17 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   const int N = net.ParameterCount();
   const double n = static_cast<double>(S) * static_cast<double>(Q);
 
-  // Work arrays, allocated once.
+  // The systems of the epoch: N x N (beta J'J + c I) or n x n (beta J J' + c I); see LinearSystem.
+  const bool errors_form =
+      options.linear_system == LinearSystem::kErrors ||
+      (options.linear_system == LinearSystem::kAuto && static_cast<double>(S) * Q < N);
+  const Eigen::Index M = errors_form ? S * Q : N;
+
+  // Work arrays, allocated once. gram is jj = J'J (kWeights) or J J' (kErrors).
   Eigen::VectorXd w = net.GetParameters();
-  Eigen::VectorXd w2(N), dw(N), rhs(N), je(N);
-  Eigen::MatrixXd J, jj(N, N), A(N, N), e(S, Q), e2(S, Q);
-  Eigen::VectorXd work(N), inv_diag(N);
+  Eigen::VectorXd w2(N), dw(N), rhs(M), je(N), jw(S * Q), y(M);
+  Eigen::MatrixXd J, gram(M, M), A(M, M), e(S, Q), e2(S, Q);
+  Eigen::VectorXd work(M), inv_diag(M);
   Eigen::MatrixXd Jt(N, S * Q);
   ForwardCache cache, trial_cache;
 
@@ -392,7 +399,12 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     ErrorJacobian(net, cache, &J);
     Eigen::Map<const Eigen::VectorXd> e_flat(e.data(), e.size());
     je.noalias() = J.transpose() * e_flat;
-    GramLower(J, &Jt, &jj);  // lower triangle only; mirrored after the loop for the eigensolver
+    if (errors_form) {
+      ErrorGram(net, cache, J, &gram);
+      jw.noalias() = J * w;
+    } else {
+      GramLower(J, &Jt, &gram);  // lower triangle only
+    }
     gradient = 2 * je.norm();
 
     sum.epochs = epoch;
@@ -429,13 +441,23 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     info.max_epochs = options.epochs;
     info.objective_before = F;
     info.gradient = gradient;
-    rhs = beta * je + alpha * w;
+    if (!errors_form) rhs = beta * je + alpha * w;
     bool accepted = false;
     double shift_accepted = 0;  // mu + alpha of the accepted step; A holds its factor
     while (mu <= options.mu_max) {
-      if (FactorShifted(jj, beta, mu + alpha, &A, &inv_diag)) {
-        SolveFactored(A, inv_diag, rhs, &dw);
-        dw = -dw;
+      const double c = mu + alpha;
+      if (FactorShifted(gram, beta, c, &A, &inv_diag)) {
+        if (errors_form) {
+          // dw = -(alpha/c) w - beta J' K_c^-1 (e - (alpha/c) J w) (LinearSystem::kErrors).
+          const double r = alpha / c;
+          rhs = e_flat - r * jw;
+          SolveFactored(A, inv_diag, rhs, &y);
+          dw.noalias() = -beta * (J.transpose() * y);
+          dw -= r * w;
+        } else {
+          SolveFactored(A, inv_diag, rhs, &dw);
+          dw = -dw;
+        }
         if (dw.allFinite()) {
           w2 = w + dw;
           trial_net.SetParameters(w2);
@@ -452,7 +474,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
             sse = sse2;
             ssx = ssx2;
             F = F2;
-            shift_accepted = mu + alpha;
+            shift_accepted = c;
             mu = std::max(mu * options.mu_dec, kMuFloor);
             accepted = true;
             break;
@@ -464,15 +486,17 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     info.step_accepted = accepted;
     info.objective_after_step = F;
     if (accepted && bayes) {
-      // gamma from the jj of this epoch and the old alpha, beta (REFERENCE.md section 2):
-      // trace(H^-1) = ||L^-1||_F^2 for H = L L'.
+      // gamma from the Gram matrix of this epoch and the old alpha, beta (REFERENCE.md
+      // section 2): trace(H^-1) = ||L^-1||_F^2 for H = L L'; in the errors form
+      // gamma = n - alpha trace(K_alpha^-1) (LinearSystem), so M - alpha trace covers both.
       // Once mu has fallen below rounding of alpha, mu + alpha == alpha and the accepted step's
       // factor is bit for bit the factor of this H: reuse it. An H that is not numerically
       // positive definite gives gamma = NaN, which ends the fit on the degenerate path below.
       bool factored = shift_accepted == alpha;
-      if (!factored) factored = FactorShifted(jj, beta, alpha, &A, &inv_diag);
-      const double gamma_new = factored ? N - alpha * TraceOfInverse(A, inv_diag, &work)
-                                        : std::numeric_limits<double>::quiet_NaN();
+      if (!factored) factored = FactorShifted(gram, beta, alpha, &A, &inv_diag);
+      const double gamma_new =
+          factored ? static_cast<double>(M) - alpha * TraceOfInverse(A, inv_diag, &work)
+                   : std::numeric_limits<double>::quiet_NaN();
       const double alpha_new = ssx == 0 ? 1.0 : gamma_new / (2 * ssx);
       const double beta_new = sse == 0 ? 1.0 : (n - gamma_new) / (2 * sse);
       if (std::isfinite(alpha_new) && alpha_new > 0 && std::isfinite(beta_new) && beta_new > 0) {
@@ -507,10 +531,17 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   sum.rms_error_normalized = (e.array().square().rowwise().sum() / static_cast<double>(Q)).sqrt();
   sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
   if (bayes) {
-    // Laplace approximation at the final weights (jj is at the final w: the loop ended right
-    // after computing it). Through the eigenvalues of jj (clamped at 0) rather than a Cholesky
-    // factor, so that a near-interpolating fit (beta ~ 1e8 or more, H badly conditioned) still
-    // gives a finite log det and a positive semi-definite covariance.
+    // Laplace approximation at the final weights (J is at the final w: the loop ended right
+    // after computing it; in the weights form gram holds the lower triangle of its jj).
+    // Through the eigenvalues of jj (clamped at 0) rather than a Cholesky factor, so that a
+    // near-interpolating fit (beta ~ 1e8 or more, H badly conditioned) still gives a finite
+    // log det and a positive semi-definite covariance.
+    Eigen::MatrixXd jj(N, N);
+    if (errors_form) {
+      GramLower(J, &Jt, &jj);
+    } else {
+      jj = gram;
+    }
     jj.triangularView<Eigen::StrictlyUpper>() = jj.transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jj);
     const Eigen::VectorXd h_eig =

@@ -58,6 +58,19 @@ TrainTermination ParseTermination(const std::string& s);  ///< inverse; InputErr
 std::string ToString(Regularization r);                   ///< "bayesian", "none"
 Regularization ParseRegularization(const std::string& s);
 
+/// Which n x n or N x N systems carry the LM steps and gamma. Both give the same step and gamma
+/// (exact algebra, results agree to rounding):
+///   kWeights: H_c = beta J'J + c I (N x N, c = mu + alpha) by Cholesky; dw = -H_c^-1 (beta je +
+///             alpha w); gamma = N - alpha trace(H_alpha^-1). MATLAB's form.
+///   kErrors:  K_c = beta J J' + c I (n x n) by Cholesky, through the push-through identity
+///             H_c^-1 J' = J' K_c^-1 and Woodbury: dw = -(alpha/c) w - beta J' K_c^-1 (e -
+///             (alpha/c) J w), and, since H_alpha has the eigenvalues of K_alpha plus N - n times
+///             alpha, gamma = n - alpha trace(K_alpha^-1).
+///   kAuto:    kErrors when n < N (few samples: 20 samples x 2 outputs = 40 < 50 weights, about
+///             half the work per factorization), otherwise kWeights.
+/// With one hidden layer J J' is assembled from its structure (nn::ErrorGram), not from J.
+enum class LinearSystem { kAuto, kWeights, kErrors };
+
 /// MATLAB trainbr defaults (net.trainParam).
 struct TrainOptions {
   int epochs = 1000;       ///< maximum number of epochs (accepted or failed LM loops)
@@ -68,6 +81,9 @@ struct TrainOptions {
   double mu_max = 1e10;    ///< stop when mu reaches this
   double min_grad = 1e-7;  ///< stop when 2 ||J'e|| <= min_grad
   Regularization regularization = Regularization::kBayesian;
+  /// How the epoch's linear systems are solved (same algorithm, results agree to rounding; not
+  /// stored in model files). See LinearSystem.
+  LinearSystem linear_system = LinearSystem::kAuto;
 
   /// Throws InputError naming the option, its value and the rule.
   void Validate() const;

@@ -18,8 +18,11 @@ Network Initial(std::uint64_t seed) {
 }
 
 // Full fit; the data and initial weights vary with the iteration so the median covers typical
-// runs, not one lucky one. Counter "epochs" = mean epochs per fit.
+// runs, not one lucky one. Counter "epochs" = mean epochs per fit. Argument: the LinearSystem
+// (0 = kAuto, which is kErrors here: 40 errors < 50 weights; 1 = kWeights, MATLAB's N x N form).
 void BM_FullFit_5_6_2_20Samples(benchmark::State& state) {
+  TrainOptions options;
+  options.linear_system = state.range(0) == 0 ? LinearSystem::kAuto : LinearSystem::kWeights;
   std::vector<TrainingData> data;
   std::vector<Network> nets;
   for (int s = 0; s < 16; ++s) {
@@ -29,14 +32,18 @@ void BM_FullFit_5_6_2_20Samples(benchmark::State& state) {
   std::size_t i = 0;
   double epochs = 0;
   for (auto _ : state) {
-    const TrainResult r = TrainBr(data[i % 16], nets[i % 16], TrainOptions{});
+    const TrainResult r = TrainBr(data[i % 16], nets[i % 16], options);
     benchmark::DoNotOptimize(r.summary.sse);
     epochs += r.summary.epochs;
     ++i;
   }
   state.counters["epochs"] = benchmark::Counter(epochs / static_cast<double>(i));
 }
-BENCHMARK(BM_FullFit_5_6_2_20Samples)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FullFit_5_6_2_20Samples)
+    ->ArgName("weights_form")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_OneEpoch_5_6_2_20Samples(benchmark::State& state) {
   const TrainingData data = synth::SmoothProblem(20, 0.05, 1);

@@ -66,6 +66,27 @@ TEST(Network, JacobianMatchesCentralDifferencesOnRandomNetworks) {
   EXPECT_EQ(cases, 40);
 }
 
+// The structured Gram matrix (one hidden layer) and the fallback (other depths) against J J'.
+TEST(Network, ErrorGramEqualsJacobianTimesItsTranspose) {
+  const std::vector<std::vector<int>> shapes = {{5, 6, 2}, {5, 4, 2},    {3, 1, 1}, {5, 10, 3},
+                                                {2, 7, 1}, {5, 8, 3, 2}, {2, 2}};
+  for (std::uint64_t seed = 1; seed <= 35; ++seed) {
+    const auto& sizes = shapes[seed % shapes.size()];
+    const Network net = RandomNetwork(sizes, seed, 1.5);
+    Rng rng(1000 + seed);
+    const Eigen::MatrixXd x = RandomMatrix(sizes.front(), 1 + static_cast<int>(seed % 23), &rng);
+    ForwardCache cache;
+    net.Forward(x, &cache);
+    Eigen::MatrixXd J, G;
+    ErrorJacobian(net, cache, &J);
+    ErrorGram(net, cache, J, &G);
+    const Eigen::MatrixXd reference = J * J.transpose();
+    EXPECT_TRUE(whirl::test::AllNear(G, reference, 1e-12, 1e-12 * reference.norm()))
+        << "seed " << seed;
+    EXPECT_EQ(G, G.transpose()) << "seed " << seed;
+  }
+}
+
 TEST(Network, FlatOrderIsBiasThenColumnMajorWeightsPerLayer) {
   Network net = Network::Zeros({5, 6, 2});
   EXPECT_EQ(net.ParameterCount(), 50);

@@ -112,6 +112,59 @@ TEST(TrainBr, FirstEpochFollowsTheReferenceRules) {
   }
 }
 
+TrainOptions WithSystem(LinearSystem system, int epochs = 1000) {
+  TrainOptions o;
+  o.linear_system = system;
+  o.epochs = epochs;
+  return o;
+}
+
+// LinearSystem::kErrors (n x n, push-through and Woodbury) and kWeights (N x N, MATLAB's form)
+// are the same algorithm: epoch by epoch they agree to rounding, on both sides of n = N.
+TEST(TrainBr, ErrorsAndWeightsFormsTakeTheSameSteps) {
+  for (int Q : {8, 20, 30}) {  // n = 16, 40 < N = 50; n = 60 > N
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+      const TrainingData data = synth::SmoothProblem(Q, 0.05, 10 * Q + seed);
+      const Network net = Initial({5, 6, 2}, seed);
+      std::vector<EpochInfo> by_weights, by_errors;
+      const TrainResult w = TrainBr(data, net, WithSystem(LinearSystem::kWeights, 12),
+                                    [&](const EpochInfo& i) { by_weights.push_back(i); });
+      const TrainResult e = TrainBr(data, net, WithSystem(LinearSystem::kErrors, 12),
+                                    [&](const EpochInfo& i) { by_errors.push_back(i); });
+      ASSERT_EQ(by_weights.size(), by_errors.size()) << "Q " << Q << " seed " << seed;
+      for (std::size_t k = 0; k < by_weights.size(); ++k) {
+        const EpochInfo &a = by_weights[k], &b = by_errors[k];
+        EXPECT_EQ(a.step_accepted, b.step_accepted) << "epoch " << a.epoch;
+        EXPECT_EQ(a.mu, b.mu) << "epoch " << a.epoch;  // same accept/reject sequence
+        EXPECT_NEAR(a.objective, b.objective, 1e-8 * a.objective) << "epoch " << a.epoch;
+        EXPECT_NEAR(a.gamma, b.gamma, 1e-8 * 50) << "epoch " << a.epoch;
+        EXPECT_NEAR(a.alpha, b.alpha, 1e-8 * a.alpha) << "epoch " << a.epoch;
+        EXPECT_NEAR(a.beta, b.beta, 1e-8 * a.beta) << "epoch " << a.epoch;
+      }
+      EXPECT_TRUE(
+          whirl::test::AllNear(w.network.GetParameters(), e.network.GetParameters(), 1e-7, 1e-9))
+          << "Q " << Q << " seed " << seed;
+      EXPECT_NEAR(w.summary.log_evidence, e.summary.log_evidence,
+                  1e-8 * std::abs(w.summary.log_evidence));
+      EXPECT_TRUE(whirl::test::AllNear(w.posterior_covariance, e.posterior_covariance, 1e-6,
+                                       1e-9 * w.posterior_covariance.norm()));
+    }
+  }
+}
+
+// kAuto is kErrors below n = N and kWeights from there (bit for bit).
+TEST(TrainBr, AutoPicksTheSmallerSystem) {
+  for (int Q : {20, 25, 30}) {  // n = 40, 50, 60 against N = 50
+    const TrainingData data = synth::SmoothProblem(Q, 0.05, Q);
+    const Network net = Initial({5, 6, 2}, 7);
+    const Eigen::VectorXd automatic =
+        TrainBr(data, net, WithSystem(LinearSystem::kAuto, 30)).network.GetParameters();
+    const LinearSystem expected = 2 * Q < 50 ? LinearSystem::kErrors : LinearSystem::kWeights;
+    EXPECT_EQ(automatic, TrainBr(data, net, WithSystem(expected, 30)).network.GetParameters())
+        << "Q " << Q;
+  }
+}
+
 TEST(TrainBr, StopsForEachDocumentedReason) {
   const TrainingData data = synth::SmoothProblem(20, 0.05, 3);
   const Network net = Initial({5, 6, 2}, 3);
