@@ -22,7 +22,8 @@ struct Grid {
   std::vector<double> l;
   std::vector<char> forced;
   double max_step = 0;
-  double margin_um = 0;  // h^2/8 * 2 max|l''| (estimated), see breakpoints.h step 2
+  double margin_um = 0;  // h^2/8 * 2 max|l''| (estimated) or the first-interval bound, see
+                         // breakpoints.h step 2
 };
 
 void ValidateRange(double t_begin, double t_end, const BreakpointOptions& o) {
@@ -88,6 +89,16 @@ Grid MakeGrid(const CurveFunction& curve, double t0, double t1, const Breakpoint
   }
   // Twice the estimated curvature: a second difference averages l'' over two steps.
   g.margin_um = g.max_step * g.max_step / 8.0 * 2.0 * max_curv;
+  // The first interval: a curve may start with an unbounded slope and curvature (the arctan
+  // curve with p < 1 grows like t^p), where second differences underestimate the bulge. If the
+  // curve is concave or convex on the first two intervals, it lies between the first chord and
+  // the line through (t_1, l_1) with the second chord's slope, so its distance from the first
+  // chord is at most h_0 |s_0 - s_1| (s_i = slope of chord i), whatever its curvature.
+  if (g.t.size() >= 3 && !g.forced[1]) {
+    const double h0 = g.t[1] - g.t[0], h1 = g.t[2] - g.t[1];
+    const double s0 = (g.l[1] - g.l[0]) / h0, s1 = (g.l[2] - g.l[1]) / h1;
+    g.margin_um = std::max(g.margin_um, h0 * std::abs(s0 - s1));
+  }
   return g;
 }
 

@@ -28,6 +28,7 @@ struct CompareCliOptions {
   double tolerance_um = interp::PlanOptions{}.tolerance_um;
   double md32760 = interp::kMd32760Default;
   double shape_k = fit::kDefaultShapeK;
+  double time_exponent = fit::kDefaultTimeExponent;
 };
 
 void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
@@ -42,6 +43,7 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
   co.plan.tolerance_um = o.tolerance_um;
   co.plan.md32760 = o.md32760;
   co.shape_k = o.shape_k;
+  co.time_exponent = o.time_exponent;
   const compare::ScrewComparison c = compare::CompareScrew(screw, model, rule, iso, co);
   if (c.prediction.outside_domain)
     Warn("screw '" + screw.name + "' lies outside the model's training domain (" +
@@ -117,9 +119,7 @@ void RegisterCompare(CLI::App& app) {
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910|, - (default 0.01, max 0.10)")
       ->check(CLI::Range(1e-9, interp::kMd32760Max));
-  sub->add_option("--shape-k", o->shape_k,
-                  "shape k of the predicted arctangent curve, - (default: fit::kDefaultShapeK)")
-      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+  AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_flag("--json", o->json, "machine output: the comparison as JSON on stdout");
   sub->callback([o, sub] {
     std::string cmd = "whirl compare";

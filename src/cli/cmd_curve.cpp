@@ -24,6 +24,7 @@ struct CurveOptions {
   double max_elongation_um = NAN;
   double settle_time_s = NAN;
   double shape_k = fit::kDefaultShapeK;
+  double time_exponent = fit::kDefaultTimeExponent;
   double duration_s = 0;
   double step_s = 1.0;
   std::string out_path;
@@ -61,7 +62,8 @@ void Run(const CurveOptions& o) {
     features = {o.max_elongation_um, o.settle_time_s};
     source = "given features";
   }
-  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures(features, o.shape_k);
+  const fit::ArctanCurve curve =
+      fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
   if (duration_s == 0) duration_s = 3.0 * curve.settle_time_s;
   const double samples = std::floor(duration_s / o.step_s) + 1;
   if (samples > 1e7)
@@ -79,21 +81,17 @@ void Run(const CurveOptions& o) {
     c.elongation_um.push_back(curve.ElongationUm(duration_s));
   }
   const std::vector<std::string> comments = {
-      "whirl curve (" + source + ")", "l(t) = L atan(k t/t_s)/atan(k) for t < t_s, L after; L = " +
-                                          FormatNumber(curve.max_elongation_um) +
-                                          " um, t_s = " + FormatNumber(curve.settle_time_s) +
-                                          " s, k = " + FormatNumber(curve.shape_k)};
+      "whirl curve (" + source + ")",
+      std::string(fit::kArctanFormula) + "; L = " + FormatNumber(curve.max_elongation_um) +
+          " um, t_s = " + FormatNumber(curve.settle_time_s) +
+          " s, k = " + FormatNumber(curve.shape_k) + ", p = " + FormatNumber(curve.time_exponent)};
   if (!o.out_path.empty()) WriteElongationCurve(o.out_path, c, comments);
 
   if (o.json) {
     nlohmann::json j = {{"schema", "whirl.curve"},
                         {"schema_version", 1},
                         {"source", source},
-                        {"curve",
-                         {{"model", "arctan"},
-                          {"max_elongation_um", curve.max_elongation_um},
-                          {"settle_time_s", curve.settle_time_s},
-                          {"shape_k", curve.shape_k}}},
+                        {"curve", curve},
                         {"duration_s", duration_s},
                         {"samples", c.size()}};
     if (by_model)
@@ -109,8 +107,7 @@ void Run(const CurveOptions& o) {
     std::cout << FormatCsv({"time_s", "elongation_um"}, rows, comments);
     return;
   }
-  std::printf("arctan curve: L = %.4f um, t_s = %.2f s, k = %.4f (%s)\n", curve.max_elongation_um,
-              curve.settle_time_s, curve.shape_k, source.c_str());
+  std::printf("%s (%s)\n", curve.Describe().c_str(), source.c_str());
   if (by_model)
     std::printf("prediction std: %.3g um, %.3g s\n", stddev.max_elongation_um,
                 stddev.settle_time_s);
@@ -124,7 +121,7 @@ void RegisterCurve(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "curve",
       "The elongation curve of the unmachined section as the arctan model\n"
-      "  l(t) = L atan(k t/t_s)/atan(k) for t < t_s, L after   [l in um, t in s]\n"
+      "  l(t) = L atan(k (t/t_s)^p)/atan(k) for t < t_s, L after   [l in um, t in s]\n"
       "from a model's prediction for a screw (--model M --screw S.json; L and t_s are the\n"
       "predicted max elongation and settle time) or from given features\n"
       "(--max-elongation L --settle-time T). Writes CSV time_s,elongation_um (--out, atomically;\n"
@@ -138,10 +135,7 @@ void RegisterCurve(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--settle-time", o->settle_time_s, "settle time t_s [s]")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--shape-k", o->shape_k,
-                  "arctan shape k [-] (default: kDefaultShapeK, fitted on simulated curves)")
-      ->capture_default_str()
-      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+  AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--duration-s", o->duration_s,
                   "sampled time span [s] (default: the screw's cutting time, else 3 t_s)")
       ->check(CLI::NonNegativeNumber);

@@ -85,15 +85,13 @@ void RunDemo(const DemoOptions& o) {
     const auto& p = c.prediction;
     std::printf(
         "3. %s: predicted max elongation %.1f +- %.1f um, settle time %.0f +- %.0f s%s; "
-        "arctan curve k = %.2f\n",
+        "arctan curve k = %.2f, p = %.3f\n",
         screw->name.c_str(), p.mean.max_elongation_um, p.stddev.max_elongation_um,
         p.mean.settle_time_s, p.stddev.settle_time_s,
-        p.outside_domain ? " (outside the training domain)" : "", c.predicted_curve.shape_k);
+        p.outside_domain ? " (outside the training domain)" : "", c.predicted_curve.shape_k,
+        c.predicted_curve.time_exponent);
     nlohmann::json plan_json = c.plan;
-    plan_json["curve"] = {{"form", "l(t) = L atan(k t/t_s)/atan(k), t < t_s; L after"},
-                          {"max_elongation_um", c.predicted_curve.max_elongation_um},
-                          {"settle_time_s", c.predicted_curve.settle_time_s},
-                          {"shape_k", c.predicted_curve.shape_k}};
+    plan_json["curve"] = c.predicted_curve;
     plan_json["prediction"] = {{"model", model_source},
                                {"screw", screw->name},
                                {"max_elongation_stddev_um", p.stddev.max_elongation_um},

@@ -56,7 +56,7 @@ void RunCurve(const FitOptions& o) {
   }
   if (curve.size() < 10) curve = record;
   const std::vector<fit::CurveFit> fits = fit::FitAllModels(curve);
-  const fit::ShapeFit shape = fit::FitShapeK(curve, settle.features);
+  const fit::ShapeFit shape = fit::FitShape(curve, settle.features);
   std::size_t best = 0;
   for (std::size_t i = 1; i < fits.size(); ++i)
     if (fits[i].rms_residual_um < fits[best].rms_residual_um) best = i;
@@ -81,8 +81,9 @@ void RunCurve(const FitOptions& o) {
                  {"settled_before_tail", settle.settled_before_tail},
                  {"noise_std_um", settle.noise_std_um},
                  {"criterion", settle.message}}},
-               {"shape_k_with_features_fixed",
+               {"shape_with_features_fixed",
                 {{"shape_k", shape.shape_k},
+                 {"time_exponent", shape.time_exponent},
                  {"r_squared", shape.r_squared},
                  {"rms_residual_um", shape.rms_residual_um}}},
                {"models", models},
@@ -94,8 +95,9 @@ void RunCurve(const FitOptions& o) {
               curve.time_s.front(), curve.time_s.back());
   std::printf("features: max elongation %.4f um, settle time %.2f s (sim::AnalyzeSettle)\n",
               settle.features.max_elongation_um, settle.features.settle_time_s);
-  std::printf("arctan shape with these features fixed: k = %.4f (R^2 %.6f, RMS %.4f um)\n",
-              shape.shape_k, shape.r_squared, shape.rms_residual_um);
+  std::printf(
+      "arctan shape with these features fixed: k = %.4f, p = %.4f (R^2 %.6f, RMS %.4f um)\n",
+      shape.shape_k, shape.time_exponent, shape.r_squared, shape.rms_residual_um);
   std::printf("%-9s %-58s %10s %12s\n", "model", "parameters (all free)", "R^2", "RMS [um]");
   for (const auto& f : fits) {
     std::string params;
@@ -130,21 +132,31 @@ void RunSimulated(const FitOptions& o) {
                         {"worst_rms_residual_um", m.worst_rms_residual_um},
                         {"best_count", m.best_count},
                         {"converged_count", m.converged_count}});
-    nlohmann::json ks = nlohmann::json::array();
-    for (const auto& f : r.shape.fits) ks.push_back(f.shape_k);
+    nlohmann::json per_curve = nlohmann::json::array();
+    for (const auto& f : r.shape.fits)
+      per_curve.push_back({{"shape_k", f.shape_k}, {"time_exponent", f.time_exponent}});
     PrintJson({{"schema", "whirl.fit_simulated"},
                {"schema_version", 1},
                {"curves", o.simulated},
                {"seed", o.seed},
                {"window_s", o.window_s},
                {"disturbances", o.disturbances},
-               {"shape_k",
-                {{"median", r.shape.median_shape_k},
-                 {"min", r.shape.min_shape_k},
-                 {"max", r.shape.max_shape_k},
+               {"shape",
+                {{"shape_k", r.shape.shape_k},
+                 {"time_exponent", r.shape.time_exponent},
+                 {"converged", r.shape.summary.Converged()},
+                 {"shape_k_range", {r.shape.min_shape_k, r.shape.max_shape_k}},
+                 {"time_exponent_range", {r.shape.min_time_exponent, r.shape.max_time_exponent}},
                  {"median_r_squared", r.shape.median_r_squared},
-                 {"per_curve", ks},
-                 {"default_in_library", fit::kDefaultShapeK}}},
+                 {"median_rms_residual_um", r.shape.median_rms_residual_um},
+                 {"plain_arctan",
+                  {{"shape_k", r.shape.plain_shape_k},
+                   {"time_exponent", 1.0},
+                   {"median_rms_residual_um", r.shape.plain_median_rms_residual_um}}},
+                 {"per_curve", per_curve},
+                 {"default_in_library",
+                  {{"shape_k", fit::kDefaultShapeK},
+                   {"time_exponent", fit::kDefaultTimeExponent}}}}},
                {"models", models},
                {"best_model", fit::ToString(r.best_model)}});
     return;
@@ -152,10 +164,17 @@ void RunSimulated(const FitOptions& o) {
   std::printf("%d simulated curves (seed %llu, %.0f s each, disturbances %s)\n", o.simulated,
               static_cast<unsigned long long>(o.seed), o.window_s, o.disturbances ? "on" : "off");
   std::printf(
-      "arctan shape k with the simulator's features fixed: median %.4f (min %.4f, max "
-      "%.4f, median R^2 %.6f); library default kDefaultShapeK = %.4f\n",
-      r.shape.median_shape_k, r.shape.min_shape_k, r.shape.max_shape_k, r.shape.median_r_squared,
-      fit::kDefaultShapeK);
+      "arctan shape with the simulator's features fixed, pooled fit: k = %.4f, p = %.4f%s\n"
+      "  per curve: k %.4f to %.4f, p %.4f to %.4f; pooled shape on each curve: median R^2 "
+      "%.6f, median RMS %.4f um\n"
+      "  plain arctangent (p = 1), pooled: k = %.4f, median RMS %.4f um\n"
+      "  library defaults: kDefaultShapeK = %.4f, kDefaultTimeExponent = %.4f\n",
+      r.shape.shape_k, r.shape.time_exponent,
+      r.shape.summary.Converged() ? "" : " (pooled fit not converged)", r.shape.min_shape_k,
+      r.shape.max_shape_k, r.shape.min_time_exponent, r.shape.max_time_exponent,
+      r.shape.median_r_squared, r.shape.median_rms_residual_um, r.shape.plain_shape_k,
+      r.shape.plain_median_rms_residual_um, fit::kDefaultShapeK,
+      fit::kDefaultTimeExponent);
   std::printf("%-9s %14s %20s %18s %6s %10s\n", "model", "median R^2", "median RMS [um]",
               "worst RMS [um]", "best", "converged");
   for (const auto& m : r.models)
@@ -175,15 +194,17 @@ void RegisterFit(CLI::App& app) {
       "Fit elongation-curve models to a measured or simulated curve and report its features.\n"
       "  --curve C.csv   columns time_s [s], elongation_um [um] ('#' comments allowed; gaps and\n"
       "                  non-increasing time are errors). Reports the features (max elongation\n"
-      "                  [um], settle time [s]; sim::AnalyzeSettle criterion), the arctan shape k\n"
-      "                  with those features fixed, and three models with all parameters free:\n"
-      "                    arctan   l = L atan(k t/t_s)/atan(k) up to t_s, L after\n"
+      "                  [um], settle time [s]; sim::AnalyzeSettle criterion), the arctan shape\n"
+      "                  (k, p) with those features fixed, and three models with all parameters\n"
+      "                  free:\n"
+      "                    arctan   l = L atan(k (t/t_s)^p)/atan(k) up to t_s, L after\n"
       "                    parabola l = b t + (L - b t_s)(t/t_s)^2 up to t_s, L after\n"
       "                    sine     l = L sin(pi t/(2 t_s)) up to t_s, L after\n"
       "                  each with R^2 and RMS residual [um] (LM least squares).\n"
-      "  --simulated N   simulate N curves over the paper's training ranges, fit k with the\n"
-      "                  simulator's features fixed (median = how kDefaultShapeK is derived) and\n"
-      "                  compare the three models (median R^2 / RMS, how often each is best).");
+      "  --simulated N   simulate N curves over the paper's training ranges, fit (k, p) with the\n"
+      "                  simulator's features fixed (the pooled fit over the N curves = how\n"
+      "                  kDefaultShapeK and kDefaultTimeExponent are derived) and compare the three\n"
+      "                  models (median R^2 / RMS, how often each is best).");
   auto* curve =
       sub->add_option("--curve", o->curve_path, "measured curve (CSV)")->check(CLI::ExistingFile);
   auto* simulated = sub->add_option("--simulated", o->simulated,

@@ -25,6 +25,7 @@ struct PlanCliOptions {
   double max_elongation_um = NAN;
   double settle_time_s = NAN;
   double shape_k = fit::kDefaultShapeK;
+  double time_exponent = fit::kDefaultTimeExponent;
   interp::PlanOptions plan;
   std::string sign = "subtract";
   std::string out_path;
@@ -76,24 +77,18 @@ void Run(const PlanCliOptions& o) {
         "points along +axis, so 'add' is the consistent choice if the control adds dK to the "
         "setpoint (see 'whirl plan --help'); keeping 'subtract' as asked");
 
-  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures(features, o.shape_k);
+  const fit::ArctanCurve curve =
+      fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
 
-  char curve_text[160];
-  std::snprintf(curve_text, sizeof curve_text, "arctan L=%.4f um, t_s=%.2f s, k=%.4f",
-                curve.max_elongation_um, curve.settle_time_s, curve.shape_k);
-  const std::string provenance = "whirl plan (" + source + "), " + curve_text;
+  const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();
 
   nlohmann::json j = plan;
   j["provenance"] = provenance;
   j["screw"] = screw;
   j["prediction"] = prediction;
-  j["curve"] = {{"model", "arctan"},
-                {"formula", "l(t) = L atan(k t/t_s)/atan(k) for t < t_s, L after"},
-                {"max_elongation_um", curve.max_elongation_um},
-                {"settle_time_s", curve.settle_time_s},
-                {"shape_k", curve.shape_k}};
+  j["curve"] = curve;
   j["kinematics"] = {{"axial_feed_mm_min", kin.axial_feed_mm_min},
                      {"cutting_time_s", kin.cutting_time_s},
                      {"workpiece_speed_rpm", kin.workpiece_speed_rpm},
@@ -101,7 +96,7 @@ void Run(const PlanCliOptions& o) {
   // Render everything first, then write: a failure leaves no partial set of files.
   const std::string csv_text = o.csv_path.empty() ? "" : interp::FormatPlcCsv(plan, {provenance});
   interp::NcProgramInfo info;
-  info.curve_source = std::string(curve_text) + " (" + source + ")";
+  info.curve_source = curve.Describe() + " (" + source + ")";
   const std::string nc_text = o.nc_path.empty() ? "" : interp::FormatNcProgram(plan, info);
   if (!o.out_path.empty()) WriteJsonFile(o.out_path, j);
   if (!o.csv_path.empty()) WriteFileAtomic(o.csv_path, csv_text);
@@ -162,9 +157,7 @@ void RegisterPlan(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--settle-time", o->settle_time_s, "instead of --model: settle time t_s [s]")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--shape-k", o->shape_k, "arctan shape k [-]")
-      ->capture_default_str()
-      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+  AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--tolerance-um", o->plan.tolerance_um,
                   "largest |compensation - curve| along the thread [um], > 0")
       ->capture_default_str()

@@ -8,8 +8,22 @@
 #include <iostream>
 
 #include "core/error.h"
+#include "fit/arctan_curve.h"
 
 namespace whirl::cli {
+
+void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent) {
+  sub->add_option("--shape-k", *shape_k,
+                  "shape k of the arctangent curve l(t) = L atan(k (t/t_s)^p)/atan(k) [-] "
+                  "(default: fitted on simulated curves, 'whirl fit --simulated 25')")
+      ->capture_default_str()
+      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+  sub->add_option("--time-exponent", *time_exponent,
+                  "time exponent p of that curve, in [0.5, 1]; 1 = the plain arctangent in time "
+                  "[-] (default: fitted with k)")
+      ->capture_default_str()
+      ->check(CLI::Range(fit::kMinTimeExponent, fit::kMaxTimeExponent));
+}
 
 int RunApp(CLI::App& app, int argc, char** argv) {
   try {

@@ -34,6 +34,10 @@ std::string JoinFields(const std::vector<std::string>& fields);
 void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fields,
                          const std::string& screw_path, bool allow_extrapolation);
 
+/// The shape options of the arctangent curve, shared by curve, plan, compare and evaluate:
+/// --shape-k K and --time-exponent P, with their ranges and defaults (fit/arctan_curve.h).
+void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent);
+
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.
 void PrintJson(const nlohmann::json& j);
 

@@ -126,7 +126,8 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
 
   // Model: prediction -> arctangent curve -> 840D plan.
   c.prediction = nn::Predict(model, screw.process);
-  c.predicted_curve = fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k);
+  c.predicted_curve = fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k,
+                                                      options.time_exponent);
   c.predicted_curve.Validate("predicted curve of screw '" + screw.name + "'");
   const double feed = c.kinematics.axial_feed_mm_s;
   c.plan = interp::BuildPlan(c.predicted_curve, feed, screw.thread_length_mm, options.plan);
@@ -216,7 +217,8 @@ void to_json(nlohmann::json& j, const ScrewComparison& c) {
                        {"settle_time_stddev_s", c.prediction.stddev.settle_time_s},
                        {"outside_domain", c.prediction.outside_domain},
                        {"outside_domain_fields", c.prediction.outside_domain_fields},
-                       {"shape_k", c.predicted_curve.shape_k}}},
+                       {"shape_k", c.predicted_curve.shape_k},
+                       {"time_exponent", c.predicted_curve.time_exponent}}},
                      {"plan", plan_summary},
                      {"traditional",
                       {{"rule", "c(t) = P_class * min(1, t / T)"},

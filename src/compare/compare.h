@@ -48,8 +48,9 @@ struct CompareOptions {
   sim::SimOptions sim;
   /// 840D plan options (tolerance, axis, sign, MD32760 cap, ...).
   interp::PlanOptions plan;
-  /// Shape k of the predicted arctangent curve (fit::kDefaultShapeK).
+  /// Shape k and time exponent p of the predicted arctangent curve (fit/arctan_curve.h).
   double shape_k = fit::kDefaultShapeK;
+  double time_exponent = fit::kDefaultTimeExponent;
   /// Metric options; lead_mm is set to the screw's lead.
   LeadMetricOptions metrics;
   CutOptions cut;

@@ -64,7 +64,7 @@ DataStart StartFromData(const ElongationCurve& curve) {
 std::vector<std::string> Names(CurveModel m) {
   switch (m) {
     case CurveModel::kArctan:
-      return {"max_elongation_um", "settle_time_s", "shape_k"};
+      return {"max_elongation_um", "settle_time_s", "shape_k", "time_exponent"};
     case CurveModel::kParabola:
       return {"max_elongation_um", "settle_time_s", "initial_slope_um_per_s"};
     case CurveModel::kSine:
@@ -99,8 +99,9 @@ double EvaluateModel(CurveModel model, const Eigen::VectorXd& p, double t, Eigen
   if (t <= 0) return 0.0;
   switch (model) {
     case CurveModel::kArctan: {
-      const ArctanCurve c{big_l, ts, p[2]};
-      if (grad != nullptr) c.ParameterGradient(t, &(*grad)[0], &(*grad)[1], &(*grad)[2]);
+      const ArctanCurve c{big_l, ts, p[2], p[3]};
+      if (grad != nullptr)
+        c.ParameterGradient(t, &(*grad)[0], &(*grad)[1], &(*grad)[2], &(*grad)[3]);
       return c.ElongationUm(t);
     }
     case CurveModel::kParabola: {
@@ -141,7 +142,7 @@ Features CurveFit::FittedFeatures() const { return {parameters[0], parameters[1]
 ArctanCurve CurveFit::AsArctan() const {
   if (model != CurveModel::kArctan)
     throw InputError("curve fit of model '" + ToString(model) + "' is not an arctan curve");
-  return ArctanCurve{parameters[0], parameters[1], parameters[2]};
+  return ArctanCurve{parameters[0], parameters[1], parameters[2], parameters[3]};
 }
 
 void GoodnessOfFit(const ElongationCurve& curve, const std::function<double(double)>& model_um,
@@ -183,6 +184,9 @@ CurveFit FitCurveModel(const ElongationCurve& curve, CurveModel model,
     p[2] = std::clamp(options.initial_shape_k, kMinShapeK, kMaxShapeK);
     lower[2] = kMinShapeK;
     upper[2] = kMaxShapeK;
+    p[3] = std::clamp(options.initial_time_exponent, kMinTimeExponent, kMaxTimeExponent);
+    lower[3] = kMinTimeExponent;
+    upper[3] = kMaxTimeExponent;
   } else if (model == CurveModel::kParabola) {
     p[2] = 2.0 * start.max_um / start.settle_s;
     lower[2] = 0.0;
@@ -215,63 +219,141 @@ std::vector<CurveFit> FitAllModels(const ElongationCurve& curve, const CurveFitO
   return fits;
 }
 
-ShapeFit FitShapeK(const ElongationCurve& curve, const Features& features,
-                   const CurveFitOptions& options) {
-  CheckCurve(curve);
-  ArctanCurve base{features.max_elongation_um, features.settle_time_s, options.initial_shape_k};
-  base.Validate("features for the shape fit");
-  Eigen::VectorXd k(1);
-  k[0] = std::clamp(options.initial_shape_k, kMinShapeK, kMaxShapeK);
+namespace {
+
+double MedianOf(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// LM setup shared by the single and the pooled shape fits: x = (k, p) within the bounds, or x = (k)
+// when p is held at `fixed_p` (> 0).
+LmOptions ShapeLmOptions(const CurveFitOptions& options, double fixed_p, Eigen::VectorXd* x) {
+  const bool free_p = !(fixed_p > 0);
+  x->resize(free_p ? 2 : 1);
+  (*x)[0] = std::clamp(options.initial_shape_k, kMinShapeK, kMaxShapeK);
   LmOptions lm = options.lm;
-  lm.lower_bounds = Eigen::VectorXd::Constant(1, kMinShapeK);
-  lm.upper_bounds = Eigen::VectorXd::Constant(1, kMaxShapeK);
-  const int m = static_cast<int>(curve.size());
+  lm.lower_bounds = Eigen::VectorXd::Constant(x->size(), kMinShapeK);
+  lm.upper_bounds = Eigen::VectorXd::Constant(x->size(), kMaxShapeK);
+  if (free_p) {
+    (*x)[1] = std::clamp(options.initial_time_exponent, kMinTimeExponent, kMaxTimeExponent);
+    lm.lower_bounds[1] = kMinTimeExponent;
+    lm.upper_bounds[1] = kMaxTimeExponent;
+  }
+  return lm;
+}
+
+// Residuals (model - data) * weight of one curve for shape x (see ShapeLmOptions), written from
+// row `row` on.
+void ShapeResiduals(const ElongationCurve& curve, const ArctanCurve& base, double weight,
+                    double fixed_p, const Eigen::VectorXd& x, Eigen::Index row, Eigen::VectorXd* r,
+                    Eigen::MatrixXd* jac) {
+  ArctanCurve c = base;
+  c.shape_k = x[0];
+  c.time_exponent = x.size() > 1 ? x[1] : fixed_p;
+  for (std::size_t i = 0; i < curve.size(); ++i, ++row) {
+    (*r)[row] = weight * (c.ElongationUm(curve.time_s[i]) - curve.elongation_um[i]);
+    if (jac != nullptr) {
+      double dl, dt, dk, dp;
+      c.ParameterGradient(curve.time_s[i], &dl, &dt, &dk, &dp);
+      (*jac)(row, 0) = weight * dk;
+      if (x.size() > 1) (*jac)(row, 1) = weight * dp;
+    }
+  }
+}
+
+// The pooled fit (see ShapeCalibration) with p free (fixed_p <= 0) or held; returns (k, p).
+Eigen::Vector2d PooledShape(const std::vector<ElongationCurve>& curves,
+                            const std::vector<ArctanCurve>& bases,
+                            const std::vector<double>& weights, const CurveFitOptions& options,
+                            double fixed_p, LmSummary* summary) {
+  Eigen::Index rows = 0;
+  for (const auto& c : curves) rows += static_cast<Eigen::Index>(c.size());
   auto residual = [&](const Eigen::VectorXd& x, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
-    ArctanCurve c = base;
-    c.shape_k = x[0];
-    for (int i = 0; i < m; ++i) {
-      (*r)[i] = c.ElongationUm(curve.time_s[i]) - curve.elongation_um[i];
-      if (jac != nullptr) {
-        double dl, dt, dk;
-        c.ParameterGradient(curve.time_s[i], &dl, &dt, &dk);
-        (*jac)(i, 0) = dk;
-      }
+    Eigen::Index row = 0;
+    for (std::size_t i = 0; i < curves.size(); ++i) {
+      ShapeResiduals(curves[i], bases[i], weights[i], fixed_p, x, row, r, jac);
+      row += static_cast<Eigen::Index>(curves[i].size());
     }
   };
+  Eigen::VectorXd x;
+  const LmOptions lm = ShapeLmOptions(options, fixed_p, &x);
+  *summary = SolveLeastSquares(residual, static_cast<int>(rows), true, &x, lm);
+  return {x[0], x.size() > 1 ? x[1] : fixed_p};
+}
+
+}  // namespace
+
+ShapeFit FitShape(const ElongationCurve& curve, const Features& features,
+                  const CurveFitOptions& options) {
+  CheckCurve(curve);
+  const ArctanCurve base = ArctanCurve::FromFeatures(features, kDefaultShapeK, kDefaultTimeExponent);
+  Eigen::VectorXd x;
+  const LmOptions lm = ShapeLmOptions(options, 0.0, &x);
+  const int m = static_cast<int>(curve.size());
+  auto residual = [&](const Eigen::VectorXd& xx, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
+    ShapeResiduals(curve, base, 1.0, 0.0, xx, 0, r, jac);
+  };
   ShapeFit fit;
-  fit.summary = SolveLeastSquares(residual, m, true, &k, lm);
-  fit.shape_k = k[0];
-  ArctanCurve c = base;
-  c.shape_k = k[0];
+  fit.summary = SolveLeastSquares(residual, m, true, &x, lm);
+  fit.shape_k = x[0];
+  fit.time_exponent = x[1];
+  const ArctanCurve c = ArctanCurve::FromFeatures(features, x[0], x[1]);
   GoodnessOfFit(
       curve, [&](double t) { return c.ElongationUm(t); }, &fit.r_squared, &fit.rms_residual_um,
       nullptr);
   return fit;
 }
 
-ShapeCalibration CalibrateShapeK(const std::vector<ElongationCurve>& curves,
-                                 const std::vector<Features>& features,
-                                 const CurveFitOptions& options) {
+ShapeCalibration CalibrateShape(const std::vector<ElongationCurve>& curves,
+                                const std::vector<Features>& features,
+                                const CurveFitOptions& options) {
   if (curves.empty()) throw InputError("shape calibration: no curves");
   if (curves.size() != features.size())
     throw InputError("shape calibration: " + std::to_string(curves.size()) + " curves but " +
                      std::to_string(features.size()) + " feature pairs");
   ShapeCalibration cal;
-  std::vector<double> ks, r2s;
+  std::vector<ArctanCurve> bases;
+  std::vector<double> weights;
   for (std::size_t i = 0; i < curves.size(); ++i) {
-    cal.fits.push_back(FitShapeK(curves[i], features[i], options));
-    ks.push_back(cal.fits.back().shape_k);
-    r2s.push_back(cal.fits.back().r_squared);
+    CheckCurve(curves[i]);
+    if (!(features[i].max_elongation_um > 0))
+      throw InputError("shape calibration: curve " + std::to_string(i) +
+                       " has max_elongation_um = " + std::to_string(features[i].max_elongation_um) +
+                       ": must be > 0 (curves are normalized by it)");
+    bases.push_back(ArctanCurve::FromFeatures(features[i], kDefaultShapeK, kDefaultTimeExponent));
+    weights.push_back(1.0 / (features[i].max_elongation_um *
+                             std::sqrt(static_cast<double>(curves[i].size()))));
+    cal.fits.push_back(FitShape(curves[i], features[i], options));
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  };
-  cal.median_shape_k = median(ks);
+  const Eigen::Vector2d x = PooledShape(curves, bases, weights, options, 0.0, &cal.summary);
+  cal.shape_k = x[0];
+  cal.time_exponent = x[1];
+  LmSummary plain_summary;
+  cal.plain_shape_k = PooledShape(curves, bases, weights, options, 1.0, &plain_summary)[0];
+  std::vector<double> ks, ps, r2s, rms, plain_rms;
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    ks.push_back(cal.fits[i].shape_k);
+    ps.push_back(cal.fits[i].time_exponent);
+    const ArctanCurve c = ArctanCurve::FromFeatures(features[i], x[0], x[1]);
+    const ArctanCurve plain = ArctanCurve::FromFeatures(features[i], cal.plain_shape_k, 1.0);
+    double r2 = 0, e = 0, e_plain = 0;
+    GoodnessOfFit(
+        curves[i], [&](double t) { return c.ElongationUm(t); }, &r2, &e, nullptr);
+    GoodnessOfFit(
+        curves[i], [&](double t) { return plain.ElongationUm(t); }, nullptr, &e_plain, nullptr);
+    r2s.push_back(r2);
+    rms.push_back(e);
+    plain_rms.push_back(e_plain);
+  }
   cal.min_shape_k = *std::min_element(ks.begin(), ks.end());
   cal.max_shape_k = *std::max_element(ks.begin(), ks.end());
-  cal.median_r_squared = median(r2s);
+  cal.min_time_exponent = *std::min_element(ps.begin(), ps.end());
+  cal.max_time_exponent = *std::max_element(ps.begin(), ps.end());
+  cal.median_r_squared = MedianOf(r2s);
+  cal.median_rms_residual_um = MedianOf(rms);
+  cal.plain_median_rms_residual_um = MedianOf(plain_rms);
   return cal;
 }
 

@@ -4,7 +4,7 @@
 // fits of the dynamic part (plateau: a line) and finds the arctangent best; this module repeats
 // that comparison. Every model is 0 at t = 0, reaches its plateau L at t_s and stays there:
 //
-//   arctan   (L, t_s, k):  l = L atan(k t/t_s)/atan(k)                 (fit/arctan_curve.h)
+//   arctan   (L, t_s, k, p): l = L atan(k (t/t_s)^p)/atan(k)           (fit/arctan_curve.h)
 //   parabola (L, t_s, b):  l = b t + (L - b t_s)(t/t_s)^2   (general parabola through the origin
 //                          reaching L at t_s; b = initial slope, um/s; b = 2L/t_s is the vertex
 //                          form)
@@ -41,9 +41,10 @@ struct CurveFitOptions {
     o.cost_tolerance = 1e-9;
     return o;
   }();
-  /// Start value of k for the arctan fit (the start of L and t_s comes from the data: L0 = largest
-  /// value, t_s0 = first time the curve reaches 98 % of L0).
+  /// Start values of k and p for the arctan fits (the start of L and t_s comes from the data:
+  /// L0 = largest value, t_s0 = first time the curve reaches 98 % of L0).
   double initial_shape_k = kDefaultShapeK;
+  double initial_time_exponent = kDefaultTimeExponent;
 };
 
 struct CurveFit {
@@ -77,28 +78,42 @@ CurveFit FitCurveModel(const ElongationCurve& curve, CurveModel model,
 std::vector<CurveFit> FitAllModels(const ElongationCurve& curve,
                                    const CurveFitOptions& options = {});
 
-/// Fit of the shape k only, with L and t_s fixed (the features as the simulator or the network
-/// defines them) so that ArctanCurve::FromFeatures(features, k) follows the curve best.
+/// Fit of the shape (k, p) only, with L and t_s fixed (the features as the simulator or the
+/// network defines them) so that ArctanCurve::FromFeatures(features, k, p) follows the curve best
+/// (least squares on l, bounds of arctan_curve.h).
 struct ShapeFit {
   double shape_k = 0;
+  double time_exponent = 0;
   double r_squared = 0;
   double rms_residual_um = 0;
   LmSummary summary;
 };
-ShapeFit FitShapeK(const ElongationCurve& curve, const Features& features,
-                   const CurveFitOptions& options = {});
+ShapeFit FitShape(const ElongationCurve& curve, const Features& features,
+                  const CurveFitOptions& options = {});
 
-/// Median of the fitted k over several curves (each with its features): how kDefaultShapeK is
-/// derived. Throws InputError for empty input or size mismatch.
+/// One (k, p) for a family of curves: how kDefaultShapeK and kDefaultTimeExponent are derived.
+/// The pooled fit minimizes sum_i (1/m_i) sum_j ((l_i(t_j) - ArctanCurve(L_i, t_s,i, k, p)(t_j)) /
+/// L_i)^2 over all curves i (m_i samples, features L_i, t_s,i fixed): every curve counts the same
+/// whatever its size and sample count. The per-curve fits (FitShape) give the spread.
+/// Throws InputError for empty input, size mismatch or a curve with L <= 0.
 struct ShapeCalibration {
-  double median_shape_k = 0;
-  double min_shape_k = 0, max_shape_k = 0;
+  double shape_k = 0;        ///< pooled k
+  double time_exponent = 0;  ///< pooled p
+  LmSummary summary;         ///< of the pooled fit
+  double min_shape_k = 0, max_shape_k = 0;  ///< range of the per-curve k
+  double min_time_exponent = 0, max_time_exponent = 0;  ///< range of the per-curve p
+  /// Median over the curves of R^2 and RMS residual (um) of the pooled (k, p) on each curve.
   double median_r_squared = 0;
-  std::vector<ShapeFit> fits;
+  double median_rms_residual_um = 0;
+  /// The same pooled fit with p held at 1 (the plain arctangent in time): its k and the median
+  /// RMS residual (um) it leaves on the curves, for comparison.
+  double plain_shape_k = 0;
+  double plain_median_rms_residual_um = 0;
+  std::vector<ShapeFit> fits;  ///< per curve
 };
-ShapeCalibration CalibrateShapeK(const std::vector<ElongationCurve>& curves,
-                                 const std::vector<Features>& features,
-                                 const CurveFitOptions& options = {});
+ShapeCalibration CalibrateShape(const std::vector<ElongationCurve>& curves,
+                                const std::vector<Features>& features,
+                                const CurveFitOptions& options = {});
 
 /// Goodness of fit of any predictor on a curve: R^2 and RMS as defined above.
 void GoodnessOfFit(const ElongationCurve& curve, const std::function<double(double)>& model_um,

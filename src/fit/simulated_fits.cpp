@@ -58,7 +58,7 @@ SimulatedFitReport FitSimulatedCurves(
                                 options.fit));
     if (progress) progress(i + 1, report.inputs.size());
   }
-  report.shape = CalibrateShapeK(curves, report.features, options.fit);
+  report.shape = CalibrateShape(curves, report.features, options.fit);
   double best_median = INFINITY;
   for (std::size_t m = 0; m < std::size(kAllCurveModels); ++m) {
     ModelComparison mc;

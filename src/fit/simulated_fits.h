@@ -1,12 +1,13 @@
 #pragma once
-// Fits over simulated curves of the training domain (src/sim): derives the default shape k of the
-// arctan curve (kDefaultShapeK) and repeats the paper's model comparison (arctan vs parabola vs
+// Fits over simulated curves of the training domain (src/sim): derives the default shape k and
+// time exponent p of the arctan curve (kDefaultShapeK, kDefaultTimeExponent) and repeats the paper's model comparison (arctan vs parabola vs
 // sine, paper seed 002 section 3) on them. Driven by `whirl fit --simulated N`.
 //
 // For each design point (sim::DesignPoints: space-filling over the paper's ranges) the reference
 // blank is simulated for window_s, features are extracted by sim::ExtractFeatures, and
-//   * the shape k is fitted with L and t_s fixed to those features (FitShapeK), so that
-//     ArctanCurve::FromFeatures(features, median k) reproduces the simulator best;
+//   * the shape (k, p) is fitted with L and t_s fixed to those features, per curve (FitShape)
+//     and pooled over all curves (CalibrateShape), so that
+//     ArctanCurve::FromFeatures(features, k, p) reproduces the simulator best;
 //   * each model is fitted with all its parameters free (FitCurveModel) on the part of the record
 //     up to fit_window_factor * t_s (the dynamic part and enough plateau to anchor it).
 #include <cstdint>
@@ -40,7 +41,7 @@ struct ModelComparison {
 struct SimulatedFitReport {
   std::vector<ProcessInputs> inputs;            ///< the design points
   std::vector<Features> features;               ///< sim::ExtractFeatures of each curve
-  ShapeCalibration shape;                       ///< k with L, t_s fixed
+  ShapeCalibration shape;                       ///< (k, p) with L, t_s fixed
   std::vector<ModelComparison> models;          ///< in kAllCurveModels order
   CurveModel best_model = CurveModel::kArctan;  ///< smallest median RMS residual
 };

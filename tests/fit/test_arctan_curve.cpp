@@ -2,7 +2,9 @@
 // fitter (recovers known parameters from poor starts, compares the three models).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "core/error.h"
@@ -12,9 +14,13 @@
 namespace whirl::fit {
 namespace {
 
+// Random curve; every fourth has p = 1 exactly (the plain arctangent in time).
 ArctanCurve RandomCurve(std::mt19937& rng) {
-  std::uniform_real_distribution<double> ul(5.0, 120.0), uts(60.0, 600.0), uk(0.5, 12.0);
-  return ArctanCurve{ul(rng), uts(rng), uk(rng)};
+  std::uniform_real_distribution<double> ul(5.0, 120.0), uts(60.0, 600.0), uk(0.5, 12.0),
+      up(0.5, 1.0);
+  std::uniform_int_distribution<int> plain(0, 3);
+  const ArctanCurve c{ul(rng), uts(rng), uk(rng), up(rng)};
+  return plain(rng) == 0 ? ArctanCurve{c.max_elongation_um, c.settle_time_s, c.shape_k, 1.0} : c;
 }
 
 ElongationCurve Sample(const std::function<double(double)>& f, double t_end, int n) {
@@ -36,17 +42,40 @@ TEST(ArctanCurve, ClosedFormProperties) {
     EXPECT_NEAR(c.ElongationUm(c.settle_time_s * (1 - 1e-12)), c.max_elongation_um,
                 1e-9 * c.max_elongation_um);  // continuous at t_s
     EXPECT_EQ(c.ElongationUm(2 * c.settle_time_s), c.max_elongation_um);
-    // Slope at 0 and just before t_s: L k/(t_s atan k) and that over (1 + k^2).
+    // Slope at 0: L k/(t_s atan k) for p = 1, infinite for p < 1; just before t_s: L k p/(t_s
+    // atan(k) (1 + k^2)).
     const double s0 = c.max_elongation_um * c.shape_k / (c.settle_time_s * std::atan(c.shape_k));
-    EXPECT_NEAR(c.SlopeUmPerS(0.0), s0, 1e-12 * s0);
-    EXPECT_NEAR(c.SlopeUmPerS(c.settle_time_s), s0 / (1 + c.shape_k * c.shape_k), 1e-12 * s0);
+    if (c.time_exponent == 1.0)
+      EXPECT_NEAR(c.SlopeUmPerS(0.0), s0, 1e-12 * s0);
+    else
+      EXPECT_EQ(c.SlopeUmPerS(0.0), std::numeric_limits<double>::infinity());
+    EXPECT_NEAR(c.SlopeUmPerS(c.settle_time_s),
+                s0 * c.time_exponent / (1 + c.shape_k * c.shape_k), 1e-12 * s0);
     EXPECT_EQ(c.SlopeUmPerS(1.5 * c.settle_time_s), 0.0);
+    // At the same fraction of t_s, atan(k r^p) is atan(k r) at r^p: the exponent only remaps time.
+    const double r = 0.37;
+    const ArctanCurve plain{c.max_elongation_um, c.settle_time_s, c.shape_k, 1.0};
+    EXPECT_NEAR(c.ElongationUm(r * c.settle_time_s),
+                plain.ElongationUm(std::pow(r, c.time_exponent) * c.settle_time_s),
+                1e-12 * c.max_elongation_um);
+    EXPECT_NEAR(plain.ElongationUm(r * c.settle_time_s),
+                c.max_elongation_um * std::atan(c.shape_k * r) / std::atan(c.shape_k),
+                1e-12 * c.max_elongation_um);
+    // Monotone non-decreasing, within [0, L], and concave on [0, t_s] (second differences <= 0):
+    // what the compensation-point placement relies on.
     double prev = -1;
-    for (int i = 0; i <= 100; ++i) {  // monotone non-decreasing, within [0, L]
-      const double v = c.ElongationUm(1.2 * c.settle_time_s * i / 100);
+    for (int i = 0; i <= 100; ++i) {
+      const double t = 1.2 * c.settle_time_s * i / 100;
+      const double v = c.ElongationUm(t);
       EXPECT_GE(v, prev);
       EXPECT_LE(v, c.max_elongation_um * (1 + 1e-12));
       prev = v;
+      const double h = c.settle_time_s / 200;
+      if (t >= h && t + h <= c.settle_time_s) {
+        EXPECT_LE(c.ElongationUm(t + h) - 2 * v + c.ElongationUm(t - h),
+                  1e-12 * c.max_elongation_um)
+            << "not concave at t = " << t << " with p = " << c.time_exponent;
+      }
     }
   }
 }
@@ -60,19 +89,27 @@ TEST(ArctanCurve, DerivativesMatchFiniteDifferences) {
     const double h = 1e-5 * c.settle_time_s;
     const double fd_t = (c.ElongationUm(t + h) - c.ElongationUm(t - h)) / (2 * h);
     EXPECT_NEAR(c.SlopeUmPerS(t), fd_t, 1e-6 * std::abs(fd_t) + 1e-10);
-    double dl, dts, dk;
-    c.ParameterGradient(t, &dl, &dts, &dk);
-    auto at = [&](double big_l, double ts, double k) {
-      return ArctanCurve{big_l, ts, k}.ElongationUm(t);
+    double dl, dts, dk, dp;
+    c.ParameterGradient(t, &dl, &dts, &dk, &dp);
+    const double p = c.time_exponent;
+    auto at = [&](double big_l, double ts, double k, double pp) {
+      return ArctanCurve{big_l, ts, k, pp}.ElongationUm(t);
     };
     const double hl = 1e-6 * c.max_elongation_um, hts = 1e-6 * c.settle_time_s,
-                 hk = 1e-6 * c.shape_k;
+                 hk = 1e-6 * c.shape_k, hp = 1e-6;
     const double L = c.max_elongation_um, ts = c.settle_time_s, k = c.shape_k;
-    EXPECT_NEAR(dl, (at(L + hl, ts, k) - at(L - hl, ts, k)) / (2 * hl), 1e-7);
-    const double fd_ts = (at(L, ts + hts, k) - at(L, ts - hts, k)) / (2 * hts);
+    EXPECT_NEAR(dl, (at(L + hl, ts, k, p) - at(L - hl, ts, k, p)) / (2 * hl), 1e-7);
+    const double fd_ts = (at(L, ts + hts, k, p) - at(L, ts - hts, k, p)) / (2 * hts);
     EXPECT_NEAR(dts, fd_ts, 1e-6 * std::abs(fd_ts) + 1e-9);
-    const double fd_k = (at(L, ts, k + hk) - at(L, ts, k - hk)) / (2 * hk);
+    const double fd_k = (at(L, ts, k + hk, p) - at(L, ts, k - hk, p)) / (2 * hk);
     EXPECT_NEAR(dk, fd_k, 1e-6 * std::abs(fd_k) + 1e-9);
+    const double fd_p = (at(L, ts, k, p + hp) - at(L, ts, k, p - hp)) / (2 * hp);
+    EXPECT_NEAR(dp, fd_p, 1e-6 * std::abs(fd_p) + 1e-8);
+    double dl3, dts3, dk3;  // the 3-parameter overload gives the same first three
+    c.ParameterGradient(t, &dl3, &dts3, &dk3);
+    EXPECT_EQ(dl3, dl);
+    EXPECT_EQ(dts3, dts);
+    EXPECT_EQ(dk3, dk);
   }
 }
 
@@ -82,10 +119,13 @@ TEST(CurveModels, AnalyticGradientsMatchFiniteDifferences) {
   for (CurveModel model : kAllCurveModels) {
     for (int trial = 0; trial < 100; ++trial) {
       const ArctanCurve c = RandomCurve(rng);
-      Eigen::VectorXd p(model == CurveModel::kSine ? 2 : 3);
+      Eigen::VectorXd p(model == CurveModel::kSine ? 2 : model == CurveModel::kArctan ? 4 : 3);
       p[0] = c.max_elongation_um;
       p[1] = c.settle_time_s;
-      if (model == CurveModel::kArctan) p[2] = c.shape_k;
+      if (model == CurveModel::kArctan) {
+        p[2] = c.shape_k;
+        p[3] = std::min(c.time_exponent, 0.999);  // central differences stay inside (0, 1]
+      }
       if (model == CurveModel::kParabola) p[2] = 1.3 * c.max_elongation_um / c.settle_time_s;
       const double t = frac(rng) * c.settle_time_s;
       Eigen::VectorXd g;
@@ -109,7 +149,8 @@ TEST(CurveFit, ArctanFitRecoversParametersFromTheDataStart) {
     const ElongationCurve data =
         Sample([&](double t) { return truth.ElongationUm(t); }, 2.5 * truth.settle_time_s, 301);
     CurveFitOptions o;
-    o.initial_shape_k = 1.0;  // a poor start for k as well
+    o.initial_shape_k = 1.0;  // a poor start for k and p as well
+    o.initial_time_exponent = 0.6;
     const CurveFit fit = FitCurveModel(data, CurveModel::kArctan, o);
     EXPECT_TRUE(fit.summary.Converged()) << fit.summary.BriefReport();
     EXPECT_NEAR(fit.parameters[0], truth.max_elongation_um, 1e-4 * truth.max_elongation_um)
@@ -117,6 +158,7 @@ TEST(CurveFit, ArctanFitRecoversParametersFromTheDataStart) {
     // t_s is only pinned to within a sample step by data on a grid (the kink sits between samples).
     EXPECT_NEAR(fit.parameters[1], truth.settle_time_s, 2.5 * truth.settle_time_s / 300);
     EXPECT_NEAR(fit.parameters[2], truth.shape_k, 0.05 * truth.shape_k);
+    EXPECT_NEAR(fit.parameters[3], truth.time_exponent, 0.02);
     EXPECT_GT(fit.r_squared, 0.99999);
     EXPECT_LT(fit.rms_residual_um, 1e-3 * truth.max_elongation_um);
   }
@@ -164,25 +206,81 @@ TEST(CurveFit, SineAndParabolaRecoverTheirOwnCurves) {
   EXPECT_GT(fp.r_squared, 0.9999);
 }
 
-TEST(CurveFit, ShapeFitWithFixedFeaturesRecoversK) {
+TEST(CurveFit, ShapeFitWithFixedFeaturesRecoversKAndP) {
   std::mt19937 rng(8);
   std::vector<ElongationCurve> curves;
   std::vector<Features> features;
-  std::vector<double> ks;
+  std::vector<double> ks, ps;
   for (int trial = 0; trial < 15; ++trial) {
     const ArctanCurve truth = RandomCurve(rng);
     curves.push_back(
         Sample([&](double t) { return truth.ElongationUm(t); }, 2 * truth.settle_time_s, 200));
     features.push_back(truth.ToFeatures());
     ks.push_back(truth.shape_k);
-    const ShapeFit fit = FitShapeK(curves.back(), features.back());
+    ps.push_back(truth.time_exponent);
+    const ShapeFit fit = FitShape(curves.back(), features.back());
     EXPECT_NEAR(fit.shape_k, truth.shape_k, 1e-5 * truth.shape_k) << fit.summary.BriefReport();
+    EXPECT_NEAR(fit.time_exponent, truth.time_exponent, 1e-5) << fit.summary.BriefReport();
   }
-  const ShapeCalibration cal = CalibrateShapeK(curves, features);
-  std::sort(ks.begin(), ks.end());
-  EXPECT_NEAR(cal.median_shape_k, ks[ks.size() / 2], 1e-4 * ks[ks.size() / 2]);
-  EXPECT_NEAR(cal.min_shape_k, ks.front(), 1e-4 * ks.front());
-  EXPECT_THROW(CalibrateShapeK(curves, {}), InputError);
+  // Mixed shapes: the pooled (k, p) is a compromise inside the per-curve ranges.
+  const ShapeCalibration cal = CalibrateShape(curves, features);
+  EXPECT_NEAR(cal.min_shape_k, *std::min_element(ks.begin(), ks.end()), 1e-4);
+  EXPECT_NEAR(cal.max_time_exponent, *std::max_element(ps.begin(), ps.end()), 1e-5);
+  EXPECT_GT(cal.shape_k, cal.min_shape_k);
+  EXPECT_LT(cal.shape_k, cal.max_shape_k);
+  EXPECT_GT(cal.time_exponent, cal.min_time_exponent);
+  EXPECT_LT(cal.time_exponent, cal.max_time_exponent);
+  EXPECT_THROW(CalibrateShape(curves, {}), InputError);
+  EXPECT_THROW(CalibrateShape({}, {}), InputError);
+}
+
+TEST(CurveFit, PooledShapeRecoversACommonShapeAndIgnoresScale) {
+  // Curves of one family (common k, p; different L, t_s, lengths and sample counts): the pooled
+  // fit recovers (k, p). Then scaling one curve and its L by 1000 and sampling it 5 times more
+  // densely must not move the pooled result (each curve is normalized by L and sample count).
+  std::mt19937 rng(9);
+  const double k = 4.1, p = 0.83;
+  std::uniform_real_distribution<double> ul(5.0, 120.0), uts(60.0, 600.0), uend(1.5, 4.0);
+  std::vector<ElongationCurve> curves;
+  std::vector<Features> features;
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (int i = 0; i < 8; ++i) {
+    const ArctanCurve c{ul(rng), uts(rng), k, p};
+    curves.push_back(Sample([&](double t) { return c.ElongationUm(t); },
+                            uend(rng) * c.settle_time_s, 100 + 37 * i));
+    features.push_back(c.ToFeatures());
+  }
+  const ShapeCalibration exact = CalibrateShape(curves, features);
+  EXPECT_NEAR(exact.shape_k, k, 1e-5) << exact.summary.BriefReport();
+  EXPECT_NEAR(exact.time_exponent, p, 1e-6);
+  EXPECT_GT(exact.median_r_squared, 0.999999);
+  // Now noisy data (so curves disagree) and the rescaling.
+  for (auto& c : curves)
+    for (double& v : c.elongation_um) v += noise(rng);
+  const ShapeCalibration noisy = CalibrateShape(curves, features);
+  const ArctanCurve c0{features[0].max_elongation_um, features[0].settle_time_s, k, p};
+  std::vector<ElongationCurve> scaled = curves;
+  std::vector<Features> scaled_features = features;
+  ElongationCurve dense;
+  const double t_end = curves[0].time_s.back();
+  const int n0 = static_cast<int>(curves[0].size());
+  for (int i = 0; i < 5 * (n0 - 1) + 1; ++i) {  // the original samples and 4 between each pair
+    const double t = t_end * i / (5.0 * (n0 - 1));
+    dense.time_s.push_back(t);
+    // Same residual pattern: noise of the original sample on its own points, the exact curve
+    // between them would change the residual set, so repeat each original residual 5 times.
+    const int src = std::min(i / 5, n0 - 1);
+    const double resid = curves[0].elongation_um[src] - c0.ElongationUm(curves[0].time_s[src]);
+    dense.elongation_um.push_back(1000.0 * (c0.ElongationUm(t) + resid));
+  }
+  scaled[0] = dense;
+  scaled_features[0].max_elongation_um *= 1000.0;
+  const ShapeCalibration rescaled = CalibrateShape(scaled, scaled_features);
+  EXPECT_NEAR(rescaled.shape_k, noisy.shape_k, 0.02 * noisy.shape_k);
+  EXPECT_NEAR(rescaled.time_exponent, noisy.time_exponent, 0.01);
+  // Without the normalization the 1000x curve would dominate: its own fit is far from the pool.
+  EXPECT_NEAR(noisy.shape_k, k, 0.05 * k);
+  EXPECT_NEAR(noisy.time_exponent, p, 0.02);
 }
 
 TEST(ArctanCurve, ValidationNamesTheField) {
@@ -193,6 +291,14 @@ TEST(ArctanCurve, ValidationNamesTheField) {
     EXPECT_NE(std::string(e.what()).find("settle_time_s"), std::string::npos) << e.what();
   }
   EXPECT_THROW((ArctanCurve{10.0, 100.0, 0.0}.Validate()), InputError);
+  for (double bad_p : {0.0, 0.45, 1.01, std::nan("")}) {
+    try {
+      ArctanCurve{10.0, 100.0, 3.0, bad_p}.Validate();
+      FAIL() << "time exponent " << bad_p << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("time_exponent"), std::string::npos) << e.what();
+    }
+  }
   EXPECT_THROW((ArctanCurve{std::nan(""), 100.0, 3.0}.Validate()), InputError);
   EXPECT_NO_THROW((ArctanCurve{0.0, 100.0, 3.0}.Validate()));
   ElongationCurve tiny;
