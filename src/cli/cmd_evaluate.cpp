@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "fit/arctan_curve.h"
+#include "interp/sinumerik.h"
 #include "cli/common.h"
 #include "compare/evaluate.h"
 #include "core/csv.h"
@@ -24,10 +26,98 @@ struct EvaluateCliOptions {
   bool no_validation = false;
   int random = 40;
   std::uint64_t seed = 1;
+  int seeds = 1;
   int threads = 2;
+  double tolerance_um = interp::PlanOptions{}.tolerance_um;
+  double shape_k = fit::kDefaultShapeK;
+  double time_exponent = fit::kDefaultTimeExponent;
   bool json = false;
   double require_median_pct = -1e300;
 };
+
+// The summary lines of one evaluation or of several pooled.
+void PrintSummary(const compare::EvaluationSummary& m) {
+  std::printf(
+      "accumulated error within 1000 mm, model vs traditional: median %.1f %%, worst "
+      "%.1f %%, best %.1f %%\n",
+      m.acc1000_vs_traditional.median_pct, m.acc1000_vs_traditional.worst_pct,
+      m.acc1000_vs_traditional.best_pct);
+  std::printf(
+      "accumulated error over the thread, model vs traditional: median %.1f %%, worst "
+      "%.1f %%\n",
+      m.total_vs_traditional.median_pct, m.total_vs_traditional.worst_pct);
+  std::printf("accumulated error within 1000 mm, model vs none: median %.1f %%, worst %.1f %%\n",
+              m.acc1000_vs_none.median_pct, m.acc1000_vs_none.worst_pct);
+  std::printf("share reaching P3: none %.0f %%, traditional %.0f %%, model %.0f %%\n",
+              100 * m.share_p3[0], 100 * m.share_p3[1], 100 * m.share_p3[2]);
+  std::printf("share reaching P5: none %.0f %%, traditional %.0f %%, model %.0f %%\n",
+              100 * m.share_p5[0], 100 * m.share_p5[1], 100 * m.share_p5[2]);
+}
+
+void ReportOne(const EvaluateCliOptions& o, const compare::Evaluation& e) {
+  if (o.json) {
+    PrintJson(e);
+    return;
+  }
+  std::printf("%-14s %6s %6s %6s %6s %6s | %-28s | %-24s | %9s\n", "screw", "HRC", "D mm", "lead",
+              "r mm", "m/min", "acc. 1000 mm none/trad/model", "ISO none/trad/model", "vs trad.");
+  for (const auto& s : e.screws) {
+    const auto& p = s.screw.process;
+    std::printf("%-14s %6.1f %6.1f %6.2f %6.2f %6.0f | ", s.screw.name.c_str(), p.hardness_hrc,
+                p.diameter_mm, p.pitch_mm, p.raceway_radius_mm, p.cutting_speed_m_min);
+    if (!s.ok) {
+      std::printf("FAILED: %s\n", s.error.c_str());
+      continue;
+    }
+    char acc[64], cls[64];
+    std::snprintf(acc, sizeof acc, "%.1f / %.1f / %.1f um", s.metrics[0].accumulated_1000_um,
+                  s.metrics[1].accumulated_1000_um, s.metrics[2].accumulated_1000_um);
+    std::snprintf(cls, sizeof cls, "%s / %s / %s", compare::ToString(s.iso[0]).c_str(),
+                  compare::ToString(s.iso[1]).c_str(), compare::ToString(s.iso[2]).c_str());
+    const auto& r = s.model_vs_traditional.accumulated_1000_pct;
+    std::printf("%-28s | %-24s | %7.1f %%%s\n", acc, cls, r ? *r : 0.0,
+                s.outside_domain ? "  (outside training domain)" : "");
+  }
+  const auto& m = e.summary;
+  std::printf("\n%zu screws (%zu failed), truth seeds MixSeed(%llu, index)\n", m.screws, m.failed,
+              static_cast<unsigned long long>(o.seed));
+  PrintSummary(m);
+}
+
+// --seeds N > 1: one line per seed, then the figures over all screws of all seeds.
+void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluation>& runs,
+                 const compare::EvaluationSummary& pooled) {
+  if (o.json) {
+    nlohmann::json per_seed = nlohmann::json::array();
+    for (std::size_t k = 0; k < runs.size(); ++k)
+      per_seed.push_back({{"seed", o.seed + k}, {"summary", runs[k].summary}});
+    PrintJson({{"schema", "whirl.evaluate_seeds"},
+               {"schema_version", 1},
+               {"seeds", per_seed},
+               {"pooled", pooled}});
+    return;
+  }
+  std::printf("%6s %8s %8s | %-40s | %s\n", "seed", "screws", "failed",
+              "acc. 1000 mm model vs trad.: median/worst", "P3 trad./model");
+  std::vector<double> medians;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const auto& m = runs[k].summary;
+    medians.push_back(m.acc1000_vs_traditional.median_pct);
+    char red[64];
+    std::snprintf(red, sizeof red, "%.1f %% / %.1f %%", m.acc1000_vs_traditional.median_pct,
+                  m.acc1000_vs_traditional.worst_pct);
+    std::printf("%6llu %8zu %8zu | %-40s | %.0f %% / %.0f %%\n",
+                static_cast<unsigned long long>(o.seed + k), m.screws, m.failed, red,
+                100 * m.share_p3[1], 100 * m.share_p3[2]);
+  }
+  const compare::ReductionStats across = compare::Stats(medians);
+  std::printf(
+      "\nper-seed medians within 1000 mm: lowest %.1f %%, median %.1f %%, highest %.1f %% (%zu "
+      "seeds)\n",
+      across.worst_pct, across.median_pct, across.best_pct, runs.size());
+  std::printf("pooled over all %zu screws (%zu failed):\n", pooled.screws, pooled.failed);
+  PrintSummary(pooled);
+}
 
 void RunEvaluate(const EvaluateCliOptions& o) {
   const nn::Model model = nn::LoadModel(o.model_path);
@@ -36,72 +126,50 @@ void RunEvaluate(const EvaluateCliOptions& o) {
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
   const sim::Screw base =
       std::filesystem::exists(o.base_screw) ? sim::ReadScrew(o.base_screw) : sim::ReferenceScrew();
-  std::vector<sim::Screw> screws;
-  if (!o.no_validation) {
-    screws = compare::ScrewsFromTable(base, ReadProcessTable(o.validation, false), "validation");
-  }
-  // The random screws draw from their own stream so adding validation rows does not change them.
-  for (auto& s : compare::RandomFeasibleScrews(base, o.random, o.seed + 1000003))
-    screws.push_back(s);
-  if (screws.empty()) throw InputError("nothing to evaluate: --no-validation and --random 0");
-
+  const ProcessTable validation =
+      o.no_validation ? ProcessTable{} : ReadProcessTable(o.validation, false);
+  if (o.no_validation && o.random == 0)
+    throw InputError("nothing to evaluate: --no-validation and --random 0");
   compare::EvaluateOptions eo;
-  eo.seed = o.seed;
   eo.threads = o.threads;
-  Progress progress("evaluate", screws.size());
-  const compare::Evaluation e = compare::EvaluateScrews(
-      screws, model, rule, iso, eo, [&](std::size_t done, std::size_t) { progress.Update(done); });
-  progress.Finish();
+  eo.compare.plan.tolerance_um = o.tolerance_um;
+  eo.compare.shape_k = o.shape_k;
+  eo.compare.time_exponent = o.time_exponent;
 
-  if (o.json) {
-    PrintJson(e);
-  } else {
-    std::printf("%-14s %6s %6s %6s %6s %6s | %-28s | %-24s | %9s\n", "screw", "HRC", "D mm", "lead",
-                "r mm", "m/min", "acc. 1000 mm none/trad/model", "ISO none/trad/model", "vs trad.");
-    for (const auto& s : e.screws) {
-      const auto& p = s.screw.process;
-      std::printf("%-14s %6.1f %6.1f %6.2f %6.2f %6.0f | ", s.screw.name.c_str(), p.hardness_hrc,
-                  p.diameter_mm, p.pitch_mm, p.raceway_radius_mm, p.cutting_speed_m_min);
-      if (!s.ok) {
-        std::printf("FAILED: %s\n", s.error.c_str());
-        continue;
-      }
-      char acc[64], cls[64];
-      std::snprintf(acc, sizeof acc, "%.1f / %.1f / %.1f um", s.metrics[0].accumulated_1000_um,
-                    s.metrics[1].accumulated_1000_um, s.metrics[2].accumulated_1000_um);
-      std::snprintf(cls, sizeof cls, "%s / %s / %s", compare::ToString(s.iso[0]).c_str(),
-                    compare::ToString(s.iso[1]).c_str(), compare::ToString(s.iso[2]).c_str());
-      const auto& r = s.model_vs_traditional.accumulated_1000_pct;
-      std::printf("%-28s | %-24s | %7.1f %%%s\n", acc, cls, r ? *r : 0.0,
-                  s.outside_domain ? "  (outside training domain)" : "");
-    }
-    const auto& m = e.summary;
-    std::printf("\n%zu screws (%zu failed), truth seeds MixSeed(%llu, index)\n", m.screws, m.failed,
-                static_cast<unsigned long long>(o.seed));
-    std::printf(
-        "accumulated error within 1000 mm, model vs traditional: median %.1f %%, worst "
-        "%.1f %%, best %.1f %%\n",
-        m.acc1000_vs_traditional.median_pct, m.acc1000_vs_traditional.worst_pct,
-        m.acc1000_vs_traditional.best_pct);
-    std::printf(
-        "accumulated error over the thread, model vs traditional: median %.1f %%, worst "
-        "%.1f %%\n",
-        m.total_vs_traditional.median_pct, m.total_vs_traditional.worst_pct);
-    std::printf("accumulated error within 1000 mm, model vs none: median %.1f %%, worst %.1f %%\n",
-                m.acc1000_vs_none.median_pct, m.acc1000_vs_none.worst_pct);
-    std::printf("share reaching P3: none %.0f %%, traditional %.0f %%, model %.0f %%\n",
-                100 * m.share_p3[0], 100 * m.share_p3[1], 100 * m.share_p3[2]);
-    std::printf("share reaching P5: none %.0f %%, traditional %.0f %%, model %.0f %%\n",
-                100 * m.share_p5[0], 100 * m.share_p5[1], 100 * m.share_p5[2]);
+  // One evaluation per seed: its own random screws and disturbances.
+  std::vector<compare::Evaluation> runs;
+  std::vector<compare::EvaluatedScrew> pooled;
+  for (int k = 0; k < o.seeds; ++k) {
+    const std::uint64_t seed = o.seed + static_cast<std::uint64_t>(k);
+    std::vector<sim::Screw> screws;
+    if (!o.no_validation) screws = compare::ScrewsFromTable(base, validation, "validation");
+    // The random screws draw from their own stream so adding validation rows does not change
+    // them.
+    for (auto& s : compare::RandomFeasibleScrews(base, o.random, seed + 1000003))
+      screws.push_back(s);
+    eo.seed = seed;
+    Progress progress(o.seeds > 1 ? "evaluate seed " + std::to_string(seed) : "evaluate",
+                      screws.size());
+    runs.push_back(compare::EvaluateScrews(screws, model, rule, iso, eo,
+                                           [&](std::size_t d, std::size_t) { progress.Update(d); }));
+    progress.Finish();
+    pooled.insert(pooled.end(), runs.back().screws.begin(), runs.back().screws.end());
   }
-  if (e.summary.failed == e.summary.screws)
+  const compare::EvaluationSummary pooled_summary =
+      o.seeds > 1 ? compare::Summarize(pooled) : runs.front().summary;
+  if (o.seeds > 1)
+    ReportSeeds(o, runs, pooled_summary);
+  else
+    ReportOne(o, runs.front());
+  if (pooled_summary.failed == pooled_summary.screws)
     throw CommandFailure("every comparison failed (see the per-screw lines)", 1);
-  if (e.summary.acc1000_vs_traditional.median_pct < o.require_median_pct) {
-    char buf[160];
+  if (pooled_summary.acc1000_vs_traditional.median_pct < o.require_median_pct) {
+    char buf[200];
     std::snprintf(buf, sizeof buf,
                   "median reduction of the accumulated error within 1000 mm vs traditional %.1f %% "
-                  "< required %.1f %%",
-                  e.summary.acc1000_vs_traditional.median_pct, o.require_median_pct);
+                  "< required %.1f %%%s",
+                  pooled_summary.acc1000_vs_traditional.median_pct, o.require_median_pct,
+                  o.seeds > 1 ? " (pooled over the seeds)" : "");
     throw CommandFailure(buf, 2);
   }
 }
@@ -129,6 +197,15 @@ void RegisterEvaluate(CLI::App& app) {
   sub->add_option("--random", o->random, "number of random feasible screws (default 40)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--seed", o->seed, "seed of the random screws and the disturbances (default 1)");
+  sub->add_option("--seeds", o->seeds,
+                  "repeat the evaluation for seeds --seed .. --seed + N - 1 (each with its own "
+                  "random screws and disturbances); prints one line per seed and the figures "
+                  "pooled over all screws, which --require-median-pct then checks (default 1)")
+      ->check(CLI::Range(1, 1000));
+  sub->add_option("--tolerance-um", o->tolerance_um,
+                  "largest |840D chord - predicted curve| of each plan [um] (default 0.5)")
+      ->check(CLI::PositiveNumber);
+  AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--threads", o->threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
   sub->add_option("--history", o->history,
                   std::string("past screws for the traditional rule (default ") + kHistoryTable +

@@ -112,12 +112,17 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model
   worker();
   for (auto& t : pool) t.join();
 
-  EvaluationSummary& s = e.summary;
+  e.summary = Summarize(e.screws);
+  return e;
+}
+
+EvaluationSummary Summarize(const std::vector<EvaluatedScrew>& screws) {
+  EvaluationSummary s;
   s.screws = screws.size();
   std::vector<double> acc_t, total_t, acc_n;
   std::array<std::size_t, 3> p3{}, p5{};
   std::size_t ok = 0;
-  for (const auto& r : e.screws) {
+  for (const auto& r : screws) {
     if (!r.ok) {
       ++s.failed;
       continue;
@@ -154,7 +159,7 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model
                 100 * s.share_p3[1], 100 * s.share_p3[2], 100 * s.share_p5[0], 100 * s.share_p5[1],
                 100 * s.share_p5[2]);
   s.message = buf;
-  return e;
+  return s;
 }
 
 namespace {

@@ -78,6 +78,9 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model
                           const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                           const EvaluateOptions& options, const EvaluateProgress& progress = {});
 
+/// The summary of evaluated screws (those of one run, or pooled over several seeds).
+EvaluationSummary Summarize(const std::vector<EvaluatedScrew>& screws);
+
 /// Median (mean of the two middle values for an even count), worst (min) and best (max).
 ReductionStats Stats(std::vector<double> values);
 

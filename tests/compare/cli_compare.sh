@@ -32,4 +32,26 @@ import json
 j = json.load(open("eval.json"))
 assert j["summary"]["screws"] == 4 and len(j["screws"]) == 4
 PY
+# --seeds: each seed's summary equals a run with that seed alone, and the pooled median is the
+# median over the union of the per-screw reductions.
+"$whirl" evaluate --no-validation --random 3 --seed 6 --json > eval6.json
+"$whirl" evaluate --no-validation --random 3 --seed 5 --seeds 2 --json > evals.json
+"$whirl" evaluate --no-validation --random 3 --seed 5 --json > eval5.json
+python3 - <<'PY'
+import json, statistics
+j = json.load(open("evals.json"))
+assert j["schema"] == "whirl.evaluate_seeds"
+runs = [json.load(open("eval5.json")), json.load(open("eval6.json"))]
+for k, run in enumerate(runs):
+    assert j["seeds"][k]["seed"] == 5 + k
+    assert j["seeds"][k]["summary"] == run["summary"], (j["seeds"][k], run["summary"])
+red = [s["model_vs_traditional"]["accumulated_1000_pct"] for r in runs for s in r["screws"]]
+p = j["pooled"]
+assert p["screws"] == 6
+assert abs(p["accumulated_1000_model_vs_traditional"]["median_pct"] - statistics.median(red)) < 1e-9, p
+PY
+# A required median above what is reached exits 2 and says so.
+if "$whirl" evaluate --no-validation --random 2 --seed 5 --seeds 2 --require-median-pct 101 \
+     > /dev/null 2> req.txt; then exit 1; else test $? -eq 2; fi
+grep -q "pooled over the seeds" req.txt
 echo OK
