@@ -98,7 +98,7 @@ void RunCurve(const FitOptions& o) {
   std::printf(
       "arctan shape with these features fixed: k = %.4f, p = %.4f (R^2 %.6f, RMS %.4f um)\n",
       shape.shape_k, shape.time_exponent, shape.r_squared, shape.rms_residual_um);
-  std::printf("%-9s %-58s %10s %12s\n", "model", "parameters (all free)", "R^2", "RMS [um]");
+  std::printf("%-9s %-84s %10s %12s\n", "model", "parameters (all free)", "R^2", "RMS [um]");
   for (const auto& f : fits) {
     std::string params;
     for (std::size_t i = 0; i < f.parameter_names.size(); ++i) {
@@ -107,7 +107,7 @@ void RunCurve(const FitOptions& o) {
                     f.parameters[static_cast<Eigen::Index>(i)]);
       params += buf;
     }
-    std::printf("%-9s %-58s %10.6f %12.4f%s\n", fit::ToString(f.model).c_str(), params.c_str(),
+    std::printf("%-9s %-84s %10.6f %12.4f%s\n", fit::ToString(f.model).c_str(), params.c_str(),
                 f.r_squared, f.rms_residual_um, f.summary.Converged() ? "" : " (not converged)");
   }
   std::printf("best fit (smallest RMS residual): %s\n", fit::ToString(fits[best].model).c_str());
