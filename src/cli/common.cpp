@@ -29,8 +29,10 @@ int RunApp(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 1;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A bad option or value: the same "error: " prefix as every other failure.
+    std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
+    return 1;
   } catch (const CommandFailure& e) {
     std::fprintf(stderr, "failed: %s\n", e.what());
     return e.exit_code;

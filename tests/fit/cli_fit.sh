@@ -9,8 +9,9 @@ source "$SRC/tests/support/cli_common.sh"
 grep -q "elongation_um" "$D/help.txt" || fail "fit --help does not explain the columns"
 "$W" curve --help | grep -q "um" || fail "curve --help has no units"
 
-# A curve from given features, then its fit: the arctan model recovers L, t_s and k.
-"$W" curve --max-elongation 30 --settle-time 250 --shape-k 4 --duration-s 900 --out "$D/c.csv" \
+# A curve from given features, then its fit: the arctan model recovers L, t_s, k and p.
+"$W" curve --max-elongation 30 --settle-time 250 --shape-k 4 --time-exponent 0.8 --duration-s 900 \
+  --out "$D/c.csv" \
   || fail "curve --out"
 head -1 "$D/c.csv" | grep -q "^#" || fail "curve CSV has no provenance comment"
 grep -q "^time_s,elongation_um" "$D/c.csv" || fail "curve CSV header"
@@ -21,6 +22,10 @@ grep -q '"best_model": "arctan"' "$D/fit.json" || fail "fit --json best model"
 # k fitted with all parameters free is 4 within 1 %: read it from the JSON.
 k=$(tr -d ' \n' < "$D/fit.json" | grep -o '"shape_k":[0-9.e+-]*' | head -1 | cut -d: -f2)
 awk -v k="$k" 'BEGIN { exit !(k > 3.96 && k < 4.04) }' || fail "fitted k = $k, expected 4"
+p=$(tr -d ' \n' < "$D/fit.json" | grep -o '"time_exponent":[0-9.e+-]*' | head -1 | cut -d: -f2)
+awk -v p="$p" 'BEGIN { exit !(p > 0.79 && p < 0.81) }' || fail "fitted p = $p, expected 0.8"
+grep -q "p = 0.8" "$D/c.csv" || fail "curve CSV comment does not give p"
+expect_fail "time-exponent" "$W" curve --max-elongation 3 --settle-time 100 --time-exponent 1.2
 
 # Bad curves: a gap, non-increasing time, a missing file.
 printf 'time_s,elongation_um\n0,0\n1,1\n2,2\n3,3\n4,4\n5,5\n100,6\n' > "$D/gap.csv"
