@@ -22,7 +22,7 @@ struct Grid {
   std::vector<double> l;
   std::vector<char> forced;
   double max_step = 0;
-  double margin_um = 0;  // h^2/8 * 2 max|l''| (estimated) or the first-interval bound, see
+  double margin_um = 0;  // h^2/8 * 2 max|l''| (estimated) or the start's bound, see
                          // breakpoints.h step 2
 };
 
@@ -89,17 +89,54 @@ Grid MakeGrid(const CurveFunction& curve, double t0, double t1, const Breakpoint
   }
   // Twice the estimated curvature: a second difference averages l'' over two steps.
   g.margin_um = g.max_step * g.max_step / 8.0 * 2.0 * max_curv;
-  // The first interval: a curve may start with an unbounded slope and curvature (the arctan
-  // curve with p < 1 grows like t^p), where second differences underestimate the bulge. If the
-  // curve is concave or convex on the first two intervals, it lies between the first chord and
-  // the line through (t_1, l_1) with the second chord's slope, so its distance from the first
-  // chord is at most h_0 |s_0 - s_1| (s_i = slope of chord i), whatever its curvature.
-  if (g.t.size() >= 3 && !g.forced[1]) {
-    const double h0 = g.t[1] - g.t[0], h1 = g.t[2] - g.t[1];
-    const double s0 = (g.l[1] - g.l[0]) / h0, s1 = (g.l[2] - g.l[1]) / h1;
-    g.margin_um = std::max(g.margin_um, h0 * std::abs(s0 - s1));
-  }
   return g;
+}
+
+// Bulge bound of grid interval i (between samples i and i + 1) that needs no curvature: if the
+// curve is concave or convex over intervals i and i + 1, it lies between chord i and the line
+// through sample i + 1 with the slope of chord i + 1, so it leaves chord i by at most
+// h_i |s_i - s_{i+1}|. Without a usable next interval (the end, or a kink at sample i + 1) the
+// bound of a monotone stretch, |l_{i+1} - l_i|.
+double IntervalBound(const Grid& g, std::size_t i) {
+  const double hi = g.t[i + 1] - g.t[i];
+  const double si = (g.l[i + 1] - g.l[i]) / hi;
+  if (i + 2 >= g.t.size() || g.forced[i + 1]) return std::abs(g.l[i + 1] - g.l[i]);
+  const double sn = (g.l[i + 2] - g.l[i + 1]) / (g.t[i + 2] - g.t[i + 1]);
+  return hi * std::abs(si - sn);
+}
+
+// The start of the curve. A curve may start with an unbounded slope and curvature (the arctan
+// curve with p < 1 grows like t^p), where second differences underestimate the bulge of the first
+// interval. Its bulge is bounded by IntervalBound instead; while that exceeds `target_um`, the
+// worst interval of the start is halved (a fan of samples towards t_0, at most 200 of them).
+// Returns the largest bound left on the start (the first uniform interval, now subdivided).
+double RefineStart(const CurveFunction& curve, Grid* g, double target_um) {
+  if (g->t.size() < 2) return 0.0;
+  const double start_end = g->t[1];  // the first interval of the uniform grid
+  std::size_t fan = 1;               // intervals 0 .. fan-1 lie in [t_0, start_end]
+  for (int split = 0;; ++split) {
+    std::size_t worst = 0;
+    double worst_bound = -1;
+    for (std::size_t i = 0; i < fan; ++i) {
+      const double b = IntervalBound(*g, i);
+      if (b > worst_bound) {
+        worst_bound = b;
+        worst = i;
+      }
+    }
+    const double h = g->t[worst + 1] - g->t[worst];
+    if (worst_bound <= target_um || split >= 200 || h <= 1e-12 * (start_end - g->t[0]))
+      return worst_bound;
+    const double tm = g->t[worst] + 0.5 * h;
+    const double lm = curve(tm);
+    if (!std::isfinite(lm))
+      throw InputError("breakpoints: curve value at t = " + Num(tm) + " s is " + Num(lm) +
+                       ": must be finite");
+    g->t.insert(g->t.begin() + static_cast<std::ptrdiff_t>(worst) + 1, tm);
+    g->l.insert(g->l.begin() + static_cast<std::ptrdiff_t>(worst) + 1, lm);
+    g->forced.insert(g->forced.begin() + static_cast<std::ptrdiff_t>(worst) + 1, 0);
+    ++fan;
+  }
 }
 
 // The grid, refined (step halved) until the curvature margin is below half the tolerance.
@@ -107,6 +144,12 @@ Grid MakeRefinedGrid(const CurveFunction& curve, double t0, double t1, Breakpoin
                      double* effective_tolerance_um) {
   for (;;) {
     Grid g = MakeGrid(curve, t0, t1, o);
+    // The start is refined until its bound is no worse than the rest of the grid's margin (or
+    // 5 % of the tolerance, whichever is larger), so a steep start costs samples near t_0, not
+    // tolerance everywhere.
+    const double start_um =
+        RefineStart(curve, &g, std::max(g.margin_um, 0.05 * o.tolerance_um));
+    g.margin_um = std::max(g.margin_um, start_um);
     const double eff = o.tolerance_um - g.margin_um;
     if (eff > 0.5 * o.tolerance_um) {
       *effective_tolerance_um = eff;
@@ -116,8 +159,9 @@ Grid MakeRefinedGrid(const CurveFunction& curve, double t0, double t1, Breakpoin
       throw InputError(
           "tolerance_um = " + Num(o.tolerance_um) +
           " um is too small for a check grid of at most " + std::to_string(o.max_grid_samples) +
-          " samples: the curvature margin between samples is " + Num(g.margin_um) + " um at step " +
-          Num(g.max_step) + " s (must stay below half the tolerance)");
+          " samples: the margin between samples (curvature, or the bulge of a steep start) is " +
+          Num(g.margin_um) + " um at step " + Num(g.max_step) +
+          " s (must stay below half the tolerance)");
     o.check_step_s = 0.5 * g.max_step;
   }
 }

@@ -11,10 +11,12 @@
 //   2. Effective tolerance tol_eff = tolerance_um - margin, margin = h^2/8 * max|l''| with l''
 //      estimated from second differences of the grid (the error of a chord between two grid samples
 //      can exceed its value at the samples by at most h^2 max|l''|/8). So the bound holds between
-//      the samples too, for curves whose curvature the grid resolves. The first interval gets
-//      a bound that needs no curvature: h_0 |s_0 - s_1| (s_i the slope of the i-th grid chord),
-//      valid when the curve is concave or convex over the first two intervals; it covers curves
-//      that start with an infinite slope (the arctan curve with time exponent p < 1).
+//      the samples too, for curves whose curvature the grid resolves. The first interval of the
+//      grid is treated apart, because a curve may start with an infinite slope (the arctan curve
+//      with time exponent p < 1): there a bound that needs no curvature is used,
+//      h_i |s_i - s_{i+1}| (s_i the slope of grid chord i), valid when the curve is concave or
+//      convex over the two intervals, and the first interval is subdivided towards t_begin until
+//      that bound is no larger than the rest of the grid's margin (or 5 % of the tolerance).
 //   3. From breakpoint A (a grid sample), B is pushed as far as possible while the chord A-B stays
 //      within tol_eff of every grid sample between them: doubling then bisection over the grid
 //      index (a forced time is never skipped). The found B becomes the next A.

@@ -13,11 +13,11 @@
 namespace whirl::interp {
 namespace {
 
-// Random curves over the admissible time-exponent range, down to 0.6 (the infinitely steep start
+// Random curves over the whole admissible time-exponent range (the infinitely steep start
 // of p < 1 is the hard case for the margin of the check grid), and p = 1 exactly.
 fit::ArctanCurve RandomCurve(std::mt19937& rng) {
   std::uniform_real_distribution<double> ul(2.0, 150.0), uts(40.0, 800.0), uk(0.3, 15.0),
-      up(0.6, 1.0);
+      up(0.5, 1.0);
   std::uniform_int_distribution<int> plain(0, 3);
   const double p = plain(rng) == 0 ? 1.0 : up(rng);
   return fit::ArctanCurve{ul(rng), uts(rng), uk(rng), p};
@@ -56,6 +56,48 @@ TEST(Breakpoints, BoundHoldsBetweenCheckSamplesOnRandomCurves) {
   }
 }
 
+TEST(Breakpoints, SteepStartStaysWithinTheBoundInsideTheFirstSegment) {
+  // l = A t^p starts with an infinite slope and curvature: second differences underestimate the
+  // bulge of the first check interval. The start is subdivided with a curvature-free bound, so the
+  // tolerance holds everywhere inside the first (shortest) segments too, which a dense check of
+  // the whole range would step over.
+  for (double p : {0.5, 0.6, 0.75, 0.882}) {
+    for (double a : {0.3, 2.0, 8.0}) {
+      for (double tol : {0.05, 0.2, 0.5}) {
+        auto f = [&](double t) { return t <= 0 ? 0.0 : a * std::pow(t, p); };
+        BreakpointOptions o;
+        o.tolerance_um = tol;
+        o.check_step_s = 0.5;
+        const double t_end = 400.0;
+        const Breakpoints bp = ChooseBreakpoints(f, 0.0, t_end, o);
+        double worst = 0;
+        for (std::size_t seg = 0; seg + 1 < bp.size() && seg < 4; ++seg) {
+          const double t0 = bp.time_s[seg], t1 = bp.time_s[seg + 1];
+          for (int i = 1; i < 20000; ++i) {
+            const double t = t0 + (t1 - t0) * i / 20000.0;
+            worst = std::max(worst, std::abs(bp.InterpolateUm(t) - f(t)));
+          }
+        }
+        EXPECT_LE(worst, tol) << "p " << p << " A " << a << " tol " << tol;
+        EXPECT_GT(bp.effective_tolerance_um, 0.5 * tol);
+      }
+    }
+  }
+}
+
+TEST(Breakpoints, SteepStartCostsSamplesNotTolerance) {
+  // The start's bound is met by subdividing the start, not by lowering the tolerance of every
+  // chord: a 30 um / 250 s arctan curve with p = 0.882 over the reference screw's 7655 s keeps
+  // almost the whole tolerance (a bound applied to the whole grid left 0.466 of 0.5 um).
+  const fit::ArctanCurve c{30.0, 250.0, fit::kDefaultShapeK, 0.882};
+  BreakpointOptions o;
+  o.forced_times_s.assign(1, c.settle_time_s);
+  const Breakpoints bp =
+      ChooseBreakpoints([&](double t) { return c.ElongationUm(t); }, 0.0, 7655.0, o);
+  EXPECT_GT(bp.effective_tolerance_um, 0.48);
+  EXPECT_LE(bp.max_deviation_um, bp.effective_tolerance_um);
+}
+
 TEST(Breakpoints, DenseWhileMovingSparseOnPlateau) {
   const fit::ArctanCurve c{50.0, 250.0, 5.0};
   BreakpointOptions o;
@@ -70,27 +112,28 @@ TEST(Breakpoints, DenseWhileMovingSparseOnPlateau) {
 
 TEST(Breakpoints, GreedyCountEqualsExhaustiveMinimumOnSmallGrids) {
   // Reference: the fewest chords through grid samples covering the grid within the same effective
-  // tolerance, by dynamic programming over all (a, b) pairs.
+  // tolerance, by dynamic programming over all (a, b) pairs. Plain arctangents (p = 1) with
+  // k up to 6, whose check grid mostly stays the uniform one the reference rebuilds; a start that
+  // needs extra samples towards t = 0 (a sharp bend within the first step) is left out, and most
+  // trials must remain.
   std::mt19937 rng(22);
+  std::uniform_real_distribution<double> uk(0.3, 6.0);
   int checked = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    const fit::ArctanCurve c = RandomCurve(rng);
+    fit::ArctanCurve c = RandomCurve(rng);
+    c.time_exponent = 1.0;
+    c.shape_k = uk(rng);
     const double t_end = 1.2 * c.settle_time_s;
-    const int coarse_steps = 80;
+    const int steps = 80;
     BreakpointOptions o;
-    o.check_step_s = t_end / coarse_steps;
+    o.check_step_s = t_end / steps;
     o.tolerance_um = 0.02 * c.max_elongation_um;
     o.forced_times_s.clear();
     auto f = [&](double t) { return c.ElongationUm(t); };
     const Breakpoints bp = ChooseBreakpoints(f, 0.0, t_end, o);
-    // The grid may have been refined (step halved) for the curvature margin; it stays uniform.
-    // The reference costs O(grid^3): curves whose steep start needs a grid above 8x the coarse
-    // one (small p) are left out, and most trials must remain.
-    ASSERT_GE(bp.grid_samples, static_cast<std::size_t>(coarse_steps + 1));
-    if (bp.grid_samples > static_cast<std::size_t>(8 * coarse_steps + 1)) continue;
+    ASSERT_GE(bp.grid_samples, static_cast<std::size_t>(steps + 1));
+    if (bp.grid_samples != static_cast<std::size_t>(steps + 1)) continue;
     ++checked;
-    const int steps = static_cast<int>(bp.grid_samples) - 1;
-    ASSERT_NEAR(bp.check_step_s, t_end / steps, 1e-9 * t_end);
     std::vector<double> t(steps + 1), l(steps + 1);
     for (int i = 0; i <= steps; ++i) {
       t[i] = i == steps ? t_end : t_end * i / steps;
@@ -110,11 +153,12 @@ TEST(Breakpoints, GreedyCountEqualsExhaustiveMinimumOnSmallGrids) {
         if (best[a] + 1 < best[b] && fits(a, b)) best[b] = best[a] + 1;
     EXPECT_EQ(static_cast<int>(bp.size()) - 1, best[steps]) << "trial " << trial;
   }
-  EXPECT_GE(checked, 25);
+  EXPECT_GE(checked, 30);
 }
 
 TEST(Breakpoints, UniformCountIsTheSmallestUniformSpacingThatMeetsTheBound) {
   std::mt19937 rng(23);
+  int unreachable = 0;
   for (int trial = 0; trial < 30; ++trial) {
     const fit::ArctanCurve c = RandomCurve(rng);
     const double t_end = 4.0 * c.settle_time_s;
@@ -125,6 +169,11 @@ TEST(Breakpoints, UniformCountIsTheSmallestUniformSpacingThatMeetsTheBound) {
     auto f = [&](double t) { return c.ElongationUm(t); };
     const Breakpoints bp = ChooseBreakpoints(f, 0.0, t_end, o);
     const std::size_t n = UniformPointCount(f, 0.0, t_end, o);
+    if (n == 0) {  // a steep start (small p) that 1e6 uniform points cannot follow
+      ++unreachable;
+      EXPECT_LT(c.time_exponent, 0.7);
+      continue;
+    }
     ASSERT_GE(n, 2u);
     EXPECT_GE(n, bp.size()) << "uniform spacing cannot beat the adaptive points";
     auto uniform_error = [&](std::size_t count) {
@@ -153,6 +202,7 @@ TEST(Breakpoints, UniformCountIsTheSmallestUniformSpacingThatMeetsTheBound) {
       EXPECT_GT(uniform_error(n - 1), bp.effective_tolerance_um);
     }
   }
+  EXPECT_LE(unreachable, 5);
 }
 
 TEST(Breakpoints, StraightLineNeedsTwoPoints) {
