@@ -90,7 +90,8 @@ void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluat
   if (o.json) {
     nlohmann::json per_seed = nlohmann::json::array();
     for (std::size_t k = 0; k < runs.size(); ++k)
-      per_seed.push_back({{"seed", o.seed + k}, {"summary", runs[k].summary}});
+      per_seed.push_back(
+          {{"seed", o.seed + k}, {"summary", runs[k].summary}, {"screws", runs[k].screws}});
     PrintJson({{"schema", "whirl.evaluate_seeds"},
                {"schema_version", 1},
                {"seeds", per_seed},
@@ -102,14 +103,21 @@ void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluat
   std::vector<double> medians;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const auto& m = runs[k].summary;
-    medians.push_back(m.acc1000_vs_traditional.median_pct);
     char red[64];
-    std::snprintf(red, sizeof red, "%.1f %% / %.1f %%", m.acc1000_vs_traditional.median_pct,
-                  m.acc1000_vs_traditional.worst_pct);
+    if (m.acc1000_vs_traditional.count > 0) {
+      medians.push_back(m.acc1000_vs_traditional.median_pct);
+      std::snprintf(red, sizeof red, "%.1f %% / %.1f %%", m.acc1000_vs_traditional.median_pct,
+                    m.acc1000_vs_traditional.worst_pct);
+    } else {
+      std::snprintf(red, sizeof red, "no screw compared");
+    }
     std::printf("%6llu %8zu %8zu | %-40s | %.0f %% / %.0f %%\n",
                 static_cast<unsigned long long>(o.seed + k), m.screws, m.failed, red,
                 100 * m.share_p3[1], 100 * m.share_p3[2]);
+    for (const auto& s : runs[k].screws)
+      if (!s.ok) std::printf("       FAILED %s: %s\n", s.screw.name.c_str(), s.error.c_str());
   }
+  if (medians.empty()) return;
   const compare::ReductionStats across = compare::Stats(medians);
   std::printf(
       "\nper-seed medians within 1000 mm: lowest %.1f %%, median %.1f %%, highest %.1f %% (%zu "
@@ -162,7 +170,14 @@ void RunEvaluate(const EvaluateCliOptions& o) {
   else
     ReportOne(o, runs.front());
   if (pooled_summary.failed == pooled_summary.screws)
-    throw CommandFailure("every comparison failed (see the per-screw lines)", 1);
+    throw CommandFailure("every comparison failed (see the FAILED lines)", 1);
+  const bool required = o.require_median_pct > -1e299;
+  if (required && pooled_summary.failed > 0)
+    throw CommandFailure(std::to_string(pooled_summary.failed) + " of " +
+                             std::to_string(pooled_summary.screws) +
+                             " comparisons failed (see the FAILED lines): a median over the "
+                             "others is not checked against --require-median-pct",
+                         2);
   if (pooled_summary.acc1000_vs_traditional.median_pct < o.require_median_pct) {
     char buf[200];
     std::snprintf(buf, sizeof buf,
@@ -218,7 +233,8 @@ void RegisterEvaluate(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sub->add_option("--require-median-pct", o->require_median_pct,
                   "fail (exit 2) if the median reduction of the accumulated error within 1000 mm "
-                  "against traditional is below this, percent (target: 85)");
+                  "against traditional is below this, or if any screw's comparison failed, "
+                  "percent (target: 85)");
   sub->add_flag("--json", o->json, "machine output: per-screw figures and the summary as JSON");
   sub->callback([o] { RunEvaluate(*o); });
 }

@@ -71,7 +71,7 @@ void RunCurve(const FitOptions& o) {
     nlohmann::json models = nlohmann::json::array();
     for (const auto& f : fits) models.push_back(FitJson(f));
     PrintJson({{"schema", "whirl.fit"},
-               {"schema_version", 1},
+               {"schema_version", 2},
                {"curve", o.curve_path},
                {"samples", record.size()},
                {"fit_window_s", {curve.time_s.front(), curve.time_s.back()}},
@@ -136,7 +136,7 @@ void RunSimulated(const FitOptions& o) {
     for (const auto& f : r.shape.fits)
       per_curve.push_back({{"shape_k", f.shape_k}, {"time_exponent", f.time_exponent}});
     PrintJson({{"schema", "whirl.fit_simulated"},
-               {"schema_version", 1},
+               {"schema_version", 2},
                {"curves", o.simulated},
                {"seed", o.seed},
                {"window_s", o.window_s},
@@ -200,7 +200,9 @@ void RegisterFit(CLI::App& app) {
       "                    arctan   l = L atan(k (t/t_s)^p)/atan(k) up to t_s, L after\n"
       "                    parabola l = b t + (L - b t_s)(t/t_s)^2 up to t_s, L after\n"
       "                    sine     l = L sin(pi t/(2 t_s)) up to t_s, L after\n"
-      "                  each with R^2 and RMS residual [um] (LM least squares).\n"
+      "                  each with R^2 and RMS residual [um] (LM least squares). The arctan has\n"
+      "                  one parameter more than the parabola (p); with p held at 1 it fitted\n"
+      "                  best as well (README, Results).\n"
       "  --simulated N   simulate N curves over the paper's training ranges, fit (k, p) with the\n"
       "                  simulator's features fixed (the pooled fit over the N curves = how\n"
       "                  kDefaultShapeK and kDefaultTimeExponent are derived) and compare the three\n"

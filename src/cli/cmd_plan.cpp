@@ -109,10 +109,13 @@ void Run(const PlanCliOptions& o) {
   std::printf("%s\n", provenance.c_str());
   std::printf("axial feed %.4f mm/min, cutting time %.1f s over %.1f mm of thread\n",
               kin.axial_feed_mm_min, plan.cutting_time_s, plan.thread_length_mm);
+  const std::string uniform = plan.uniform_point_count > 0
+                                  ? std::to_string(plan.uniform_point_count)
+                                  : std::string("more than 1000000");
   std::printf(
-      "compensation points: %zu (%zu segments), uniform spacing needs %zu for the same "
+      "compensation points: %zu (%zu segments), uniform spacing needs %s for the same "
       "%.3g um bound\n",
-      plan.point_count, plan.segments.size(), plan.uniform_point_count, options.tolerance_um);
+      plan.point_count, plan.segments.size(), uniform.c_str(), options.tolerance_um);
   std::printf("largest |curve - compensation| on the check grid: %.4f um (tolerance %.4g um)\n",
               plan.max_deviation_um, options.tolerance_um);
   std::printf("largest |SD43910| %.3e (MD32760 cap %.3g), axis %s, sign %s, direction %+d\n",

@@ -20,7 +20,8 @@ void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent)
       ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
   sub->add_option("--time-exponent", *time_exponent,
                   "time exponent p of that curve, in [0.5, 1]; 1 = the plain arctangent in time "
-                  "[-] (default: fitted with k)")
+                  "[-] (default: fitted with k). Below about 0.7 the curve starts so steeply that "
+                  "the first segment's SD43910 can exceed the MD32760 cap (an error)")
       ->capture_default_str()
       ->check(CLI::Range(fit::kMinTimeExponent, fit::kMaxTimeExponent));
 }

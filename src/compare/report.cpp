@@ -351,7 +351,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
          << Fixed(c.disturbances.expansion_factor, 3) << ", ambient drift "
          << Fixed(c.disturbances.ambient_drift_k_per_h, 3)
          << " K/h. 840D plan: " << c.plan.segments.size() << " segments (" << c.plan.point_count
-         << " points; uniform spacing would need " << c.plan.uniform_point_count
+         << " points; uniform spacing would need "
+         << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
+                                            : std::string("more than 1000000"))
          << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
          << FormatNumber(c.plan.max_abs_slope) << " (MD32760 cap "
          << FormatNumber(c.plan.options.md32760) << "), axis " << Html(c.plan.options.axis)

@@ -28,7 +28,7 @@ double ArctanCurve::SlopeUmPerS(double t_s) const {
   const double r = t_s / settle_time_s;
   const double rp = std::pow(r, time_exponent);
   const double u = shape_k * rp;
-  return scale * rp / r / (1.0 + u * u);
+  return scale * std::pow(r, time_exponent - 1.0) / (1.0 + u * u);
 }
 
 void ArctanCurve::ParameterGradient(double t_s, double* d_l_d_max, double* d_l_d_settle,

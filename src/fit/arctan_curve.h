@@ -18,8 +18,8 @@
 // simulated curves (whirl fit --simulated 25) the pooled least-squares fit gives p = 0.882 and
 // a median RMS residual of 0.059 um against 0.083 um for the best plain arctangent (k = 5.54);
 // the gain sits in the first minutes, the part of the curve that drives the accumulated lead
-// error: over 10 evaluation seeds (whirl evaluate --seed S, README) the median reduction within
-// 1000 mm rises by 0.2 to 3.7 points. The network still only predicts L and t_s; k and p are
+// error: over 10 evaluation seeds (whirl evaluate --seeds 10, README) the median reduction within
+// 1000 mm rises by 0.2 to 3.7 points per seed against the previous plain curve (k = 5.62). The network still only predicts L and t_s; k and p are
 // properties of the process family, fitted once (kDefaultShapeK, kDefaultTimeExponent).
 //
 // Slope: l'(t) = L k p (t/t_s)^(p-1) / (t_s atan(k) (1 + k^2 (t/t_s)^(2p))). At t = 0 it is
@@ -50,7 +50,9 @@ inline constexpr double kMaxShapeK = 1e3;
 /// Bounds accepted for the time exponent: above 1 the curve would start convex (S-shaped), which
 /// neither the physics (heat input from t = 0) nor the compensation-point placement expects.
 /// Below 0.5 the start is so steep that checking a compensation plan against the curve needs
-/// impractically fine grids (interp/breakpoints.h); measured curves give about 0.88.
+/// impractically fine grids (interp/breakpoints.h), and already below about 0.7 the first
+/// compensation segment can be steeper than MD32760 allows (the plan then fails with an error
+/// naming the segment); the simulated curves give 0.87 to 0.89.
 inline constexpr double kMinTimeExponent = 0.5;
 inline constexpr double kMaxTimeExponent = 1.0;
 
