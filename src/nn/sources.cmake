@@ -2,5 +2,6 @@
 target_sources(whirl_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/network.cpp
   ${CMAKE_CURRENT_LIST_DIR}/trainbr.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/dense_kernels.cpp
   ${CMAKE_CURRENT_LIST_DIR}/model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/selection.cpp)

@@ -1,9 +1,13 @@
 // nn hot paths: one full trainbr fit of 5-6-2 on 20 samples x 2 outputs to the default stopping
-// rule, one epoch, and batch prediction with Laplace standard deviations.
+// rule, one epoch, the linear-algebra floor of one epoch, and batch prediction with Laplace
+// standard deviations.
 // Reference point: R's brnn needs 20-35 ms for one single-output fit of this size.
 #include <benchmark/benchmark.h>
 
+#include <random>
+
 #include "../nn/synthetic.h"
+#include "nn/dense_kernels.h"
 #include "nn/model.h"
 #include "nn/trainbr.h"
 
@@ -56,6 +60,37 @@ void BM_OneEpoch_5_6_2_20Samples(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_OneEpoch_5_6_2_20Samples)->Unit(benchmark::kMicrosecond);
+
+// The linear algebra of one epoch of the errors form at n = 40 (20 samples x 2 outputs), alone:
+// two factorizations of beta G + c I with a solve each (one LM trial, and the gamma update's
+// factor, whose solve stands for the step's), and one trace of the inverse. G = J J' of a random
+// 40 x 50 J. Counter "per_138_epochs": the time of 138 such epochs (a typical full fit), the
+// floor the rest of the epoch (Jacobian, J J', tanh) comes on top of.
+void BM_EpochLinearAlgebra_n40(benchmark::State& state) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::MatrixXd J(40, 50);
+  for (Eigen::Index i = 0; i < J.size(); ++i) J.data()[i] = normal(rng);
+  const Eigen::MatrixXd gram = J * J.transpose();
+  Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(40, [&] { return normal(rng); });
+  Eigen::MatrixXd A(40, 40);
+  Eigen::VectorXd inv_diag, x, work;
+  const double beta = 3.0, alpha = 0.8, mu = 0.05;
+  for (auto _ : state) {
+    detail::FactorShifted(gram, beta, alpha + mu, &A, &inv_diag);
+    detail::SolveFactored(A, inv_diag, b, &x);
+    benchmark::DoNotOptimize(x.data());
+    detail::FactorShifted(gram, beta, alpha, &A, &inv_diag);
+    detail::SolveFactored(A, inv_diag, b, &x);
+    benchmark::DoNotOptimize(x.data());
+    benchmark::DoNotOptimize(detail::TraceOfInverse(A, inv_diag, &work));
+  }
+  // Inverted rate of iterations / 138: seconds per 138 epochs (printed with its unit).
+  state.counters["per_138_epochs"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) / 138.0,
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_EpochLinearAlgebra_n40)->Unit(benchmark::kMicrosecond);
 
 void BM_PredictBatch(benchmark::State& state) {
   const whirl::ProcessTable table = synth::SyntheticProcessTable(20, 0.05, 5);
