@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/stats.h"
 
 namespace whirl::fit {
 namespace {
@@ -221,12 +222,6 @@ std::vector<CurveFit> FitAllModels(const ElongationCurve& curve, const CurveFitO
 
 namespace {
 
-double MedianOf(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // LM setup shared by the single and the pooled shape fits: x = (k, p) within the bounds, or x = (k)
 // when p is held at `fixed_p` (> 0).
 LmOptions ShapeLmOptions(const CurveFitOptions& options, double fixed_p, Eigen::VectorXd* x) {
@@ -289,14 +284,8 @@ ShapeFit FitShape(const ElongationCurve& curve, const Features& features,
                   const CurveFitOptions& options) {
   CheckCurve(curve);
   const ArctanCurve base = ArctanCurve::FromFeatures(features, kDefaultShapeK, kDefaultTimeExponent);
-  Eigen::VectorXd x;
-  const LmOptions lm = ShapeLmOptions(options, 0.0, &x);
-  const int m = static_cast<int>(curve.size());
-  auto residual = [&](const Eigen::VectorXd& xx, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
-    ShapeResiduals(curve, base, 1.0, 0.0, xx, 0, r, jac);
-  };
   ShapeFit fit;
-  fit.summary = SolveLeastSquares(residual, m, true, &x, lm);
+  const Eigen::Vector2d x = PooledShape({curve}, {base}, {1.0}, options, 0.0, &fit.summary);
   fit.shape_k = x[0];
   fit.time_exponent = x[1];
   const ArctanCurve c = ArctanCurve::FromFeatures(features, x[0], x[1]);
@@ -351,9 +340,9 @@ ShapeCalibration CalibrateShape(const std::vector<ElongationCurve>& curves,
   cal.max_shape_k = *std::max_element(ks.begin(), ks.end());
   cal.min_time_exponent = *std::min_element(ps.begin(), ps.end());
   cal.max_time_exponent = *std::max_element(ps.begin(), ps.end());
-  cal.median_r_squared = MedianOf(r2s);
-  cal.median_rms_residual_um = MedianOf(rms);
-  cal.plain_median_rms_residual_um = MedianOf(plain_rms);
+  cal.median_r_squared = Median(r2s);
+  cal.median_rms_residual_um = Median(rms);
+  cal.plain_median_rms_residual_um = Median(plain_rms);
   return cal;
 }
 

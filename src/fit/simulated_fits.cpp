@@ -5,18 +5,13 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/stats.h"
 #include "sim/dataset.h"
 #include "sim/features.h"
 #include "sim/simulator.h"
 
 namespace whirl::fit {
 namespace {
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 ElongationCurve Head(const ElongationCurve& c, double t_max) {
   ElongationCurve h;

@@ -7,17 +7,10 @@
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/stats.h"
 
 namespace whirl::sim {
 namespace {
-
-double Median(std::vector<double> v) {
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  double m = v[mid];
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
-  return m;
-}
 
 void CheckOptions(const SettleOptions& o) {
   auto fail = [](const char* field, double value, const char* rule) {
