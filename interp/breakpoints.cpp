@@ -147,8 +147,7 @@ Grid MakeRefinedGrid(const CurveFunction& curve, double t0, double t1, Breakpoin
     // The start is refined until its bound is no worse than the rest of the grid's margin (or
     // 5 % of the tolerance, whichever is larger), so a steep start costs samples near t_0, not
     // tolerance everywhere.
-    const double start_um =
-        RefineStart(curve, &g, std::max(g.margin_um, 0.05 * o.tolerance_um));
+    const double start_um = RefineStart(curve, &g, std::max(g.margin_um, 0.05 * o.tolerance_um));
     g.margin_um = std::max(g.margin_um, start_um);
     const double eff = o.tolerance_um - g.margin_um;
     if (eff > 0.5 * o.tolerance_um) {

@@ -88,12 +88,9 @@ void Run(const CurveOptions& o) {
   if (!o.out_path.empty()) WriteElongationCurve(o.out_path, c, comments);
 
   if (o.json) {
-    nlohmann::json j = {{"schema", "whirl.curve"},
-                        {"schema_version", 1},
-                        {"source", source},
-                        {"curve", curve},
-                        {"duration_s", duration_s},
-                        {"samples", c.size()}};
+    nlohmann::json j = {{"schema", "whirl.curve"},  {"schema_version", 1},
+                        {"source", source},         {"curve", curve},
+                        {"duration_s", duration_s}, {"samples", c.size()}};
     if (by_model)
       j["prediction_stddev"] = {{"max_elongation_um", stddev.max_elongation_um},
                                 {"settle_time_s", stddev.settle_time_s}};

@@ -5,12 +5,12 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "fit/arctan_curve.h"
-#include "interp/sinumerik.h"
 #include "cli/common.h"
 #include "compare/evaluate.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "fit/arctan_curve.h"
+#include "interp/sinumerik.h"
 #include "nn/model.h"
 #include "sim/screw.h"
 
@@ -158,8 +158,8 @@ void RunEvaluate(const EvaluateCliOptions& o) {
     eo.seed = seed;
     Progress progress(o.seeds > 1 ? "evaluate seed " + std::to_string(seed) : "evaluate",
                       screws.size());
-    runs.push_back(compare::EvaluateScrews(screws, model, rule, iso, eo,
-                                           [&](std::size_t d, std::size_t) { progress.Update(d); }));
+    runs.push_back(compare::EvaluateScrews(
+        screws, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); }));
     progress.Finish();
     pooled.insert(pooled.end(), runs.back().screws.begin(), runs.back().screws.end());
   }

@@ -135,30 +135,30 @@ void RunSimulated(const FitOptions& o) {
     nlohmann::json per_curve = nlohmann::json::array();
     for (const auto& f : r.shape.fits)
       per_curve.push_back({{"shape_k", f.shape_k}, {"time_exponent", f.time_exponent}});
-    PrintJson({{"schema", "whirl.fit_simulated"},
-               {"schema_version", 2},
-               {"curves", o.simulated},
-               {"seed", o.seed},
-               {"window_s", o.window_s},
-               {"disturbances", o.disturbances},
-               {"shape",
-                {{"shape_k", r.shape.shape_k},
-                 {"time_exponent", r.shape.time_exponent},
-                 {"converged", r.shape.summary.Converged()},
-                 {"shape_k_range", {r.shape.min_shape_k, r.shape.max_shape_k}},
-                 {"time_exponent_range", {r.shape.min_time_exponent, r.shape.max_time_exponent}},
-                 {"median_r_squared", r.shape.median_r_squared},
-                 {"median_rms_residual_um", r.shape.median_rms_residual_um},
-                 {"plain_arctan",
-                  {{"shape_k", r.shape.plain_shape_k},
-                   {"time_exponent", 1.0},
-                   {"median_rms_residual_um", r.shape.plain_median_rms_residual_um}}},
-                 {"per_curve", per_curve},
-                 {"default_in_library",
-                  {{"shape_k", fit::kDefaultShapeK},
-                   {"time_exponent", fit::kDefaultTimeExponent}}}}},
-               {"models", models},
-               {"best_model", fit::ToString(r.best_model)}});
+    PrintJson(
+        {{"schema", "whirl.fit_simulated"},
+         {"schema_version", 2},
+         {"curves", o.simulated},
+         {"seed", o.seed},
+         {"window_s", o.window_s},
+         {"disturbances", o.disturbances},
+         {"shape",
+          {{"shape_k", r.shape.shape_k},
+           {"time_exponent", r.shape.time_exponent},
+           {"converged", r.shape.summary.Converged()},
+           {"shape_k_range", {r.shape.min_shape_k, r.shape.max_shape_k}},
+           {"time_exponent_range", {r.shape.min_time_exponent, r.shape.max_time_exponent}},
+           {"median_r_squared", r.shape.median_r_squared},
+           {"median_rms_residual_um", r.shape.median_rms_residual_um},
+           {"plain_arctan",
+            {{"shape_k", r.shape.plain_shape_k},
+             {"time_exponent", 1.0},
+             {"median_rms_residual_um", r.shape.plain_median_rms_residual_um}}},
+           {"per_curve", per_curve},
+           {"default_in_library",
+            {{"shape_k", fit::kDefaultShapeK}, {"time_exponent", fit::kDefaultTimeExponent}}}}},
+         {"models", models},
+         {"best_model", fit::ToString(r.best_model)}});
     return;
   }
   std::printf("%d simulated curves (seed %llu, %.0f s each, disturbances %s)\n", o.simulated,
@@ -173,8 +173,7 @@ void RunSimulated(const FitOptions& o) {
       r.shape.summary.Converged() ? "" : " (pooled fit not converged)", r.shape.min_shape_k,
       r.shape.max_shape_k, r.shape.min_time_exponent, r.shape.max_time_exponent,
       r.shape.median_r_squared, r.shape.median_rms_residual_um, r.shape.plain_shape_k,
-      r.shape.plain_median_rms_residual_um, fit::kDefaultShapeK,
-      fit::kDefaultTimeExponent);
+      r.shape.plain_median_rms_residual_um, fit::kDefaultShapeK, fit::kDefaultTimeExponent);
   std::printf("%-9s %14s %20s %18s %6s %10s\n", "model", "median R^2", "median RMS [um]",
               "worst RMS [um]", "best", "converged");
   for (const auto& m : r.models)
@@ -205,7 +204,8 @@ void RegisterFit(CLI::App& app) {
       "                  best as well (README, Results).\n"
       "  --simulated N   simulate N curves over the paper's training ranges, fit (k, p) with the\n"
       "                  simulator's features fixed (the pooled fit over the N curves = how\n"
-      "                  kDefaultShapeK and kDefaultTimeExponent are derived) and compare the three\n"
+      "                  kDefaultShapeK and kDefaultTimeExponent are derived) and compare the "
+      "three\n"
       "                  models (median R^2 / RMS, how often each is best).");
   auto* curve =
       sub->add_option("--curve", o->curve_path, "measured curve (CSV)")->check(CLI::ExistingFile);

@@ -126,8 +126,8 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
 
   // Model: prediction -> arctangent curve -> 840D plan.
   c.prediction = nn::Predict(model, screw.process);
-  c.predicted_curve = fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k,
-                                                      options.time_exponent);
+  c.predicted_curve =
+      fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k, options.time_exponent);
   c.predicted_curve.Validate("predicted curve of screw '" + screw.name + "'");
   const double feed = c.kinematics.axial_feed_mm_s;
   c.plan = interp::BuildPlan(c.predicted_curve, feed, screw.thread_length_mm, options.plan);

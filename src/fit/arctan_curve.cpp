@@ -19,7 +19,8 @@ double ArctanCurve::ElongationUm(double t_s) const {
 
 double ArctanCurve::SlopeUmPerS(double t_s) const {
   if (t_s < 0 || t_s > settle_time_s) return 0.0;
-  const double scale = max_elongation_um * shape_k * time_exponent / (settle_time_s * std::atan(shape_k));
+  const double scale =
+      max_elongation_um * shape_k * time_exponent / (settle_time_s * std::atan(shape_k));
   if (time_exponent == 1.0) {
     const double u = shape_k * t_s / settle_time_s;
     return scale / (1.0 + u * u);
@@ -66,8 +67,8 @@ ArctanCurve ArctanCurve::FromFeatures(const Features& features, double shape_k,
 
 std::string ArctanCurve::Describe() const {
   char buf[160];
-  std::snprintf(buf, sizeof buf, "arctan L=%.4f um, t_s=%.2f s, k=%.4f, p=%.4f",
-                max_elongation_um, settle_time_s, shape_k, time_exponent);
+  std::snprintf(buf, sizeof buf, "arctan L=%.4f um, t_s=%.2f s, k=%.4f, p=%.4f", max_elongation_um,
+                settle_time_s, shape_k, time_exponent);
   return buf;
 }
 

@@ -19,8 +19,9 @@
 // a median RMS residual of 0.059 um against 0.083 um for the best plain arctangent (k = 5.54);
 // the gain sits in the first minutes, the part of the curve that drives the accumulated lead
 // error: over 10 evaluation seeds (whirl evaluate --seeds 10, README) the median reduction within
-// 1000 mm rises by 0.2 to 3.7 points per seed against the previous plain curve (k = 5.62). The network still only predicts L and t_s; k and p are
-// properties of the process family, fitted once (kDefaultShapeK, kDefaultTimeExponent).
+// 1000 mm rises by 0.2 to 3.7 points per seed against the previous plain curve (k = 5.62). The
+// network still only predicts L and t_s; k and p are properties of the process family, fitted once
+// (kDefaultShapeK, kDefaultTimeExponent).
 //
 // Slope: l'(t) = L k p (t/t_s)^(p-1) / (t_s atan(k) (1 + k^2 (t/t_s)^(2p))). At t = 0 it is
 // L k/(t_s atan k) for p = 1 and infinite for p < 1; just before t_s it is

@@ -283,7 +283,8 @@ Eigen::Vector2d PooledShape(const std::vector<ElongationCurve>& curves,
 ShapeFit FitShape(const ElongationCurve& curve, const Features& features,
                   const CurveFitOptions& options) {
   CheckCurve(curve);
-  const ArctanCurve base = ArctanCurve::FromFeatures(features, kDefaultShapeK, kDefaultTimeExponent);
+  const ArctanCurve base =
+      ArctanCurve::FromFeatures(features, kDefaultShapeK, kDefaultTimeExponent);
   ShapeFit fit;
   const Eigen::Vector2d x = PooledShape({curve}, {base}, {1.0}, options, 0.0, &fit.summary);
   fit.shape_k = x[0];
@@ -312,8 +313,8 @@ ShapeCalibration CalibrateShape(const std::vector<ElongationCurve>& curves,
                        " has max_elongation_um = " + std::to_string(features[i].max_elongation_um) +
                        ": must be > 0 (curves are normalized by it)");
     bases.push_back(ArctanCurve::FromFeatures(features[i], kDefaultShapeK, kDefaultTimeExponent));
-    weights.push_back(1.0 / (features[i].max_elongation_um *
-                             std::sqrt(static_cast<double>(curves[i].size()))));
+    weights.push_back(
+        1.0 / (features[i].max_elongation_um * std::sqrt(static_cast<double>(curves[i].size()))));
     cal.fits.push_back(FitShape(curves[i], features[i], options));
   }
   const Eigen::Vector2d x = PooledShape(curves, bases, weights, options, 0.0, &cal.summary);

@@ -97,10 +97,10 @@ ShapeFit FitShape(const ElongationCurve& curve, const Features& features,
 /// whatever its size and sample count. The per-curve fits (FitShape) give the spread.
 /// Throws InputError for empty input, size mismatch or a curve with L <= 0.
 struct ShapeCalibration {
-  double shape_k = 0;        ///< pooled k
-  double time_exponent = 0;  ///< pooled p
-  LmSummary summary;         ///< of the pooled fit
-  double min_shape_k = 0, max_shape_k = 0;  ///< range of the per-curve k
+  double shape_k = 0;                                   ///< pooled k
+  double time_exponent = 0;                             ///< pooled p
+  LmSummary summary;                                    ///< of the pooled fit
+  double min_shape_k = 0, max_shape_k = 0;              ///< range of the per-curve k
   double min_time_exponent = 0, max_time_exponent = 0;  ///< range of the per-curve p
   /// Median over the curves of R^2 and RMS residual (um) of the pooled (k, p) on each curve.
   double median_r_squared = 0;

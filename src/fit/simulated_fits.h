@@ -1,7 +1,8 @@
 #pragma once
 // Fits over simulated curves of the training domain (src/sim): derives the default shape k and
-// time exponent p of the arctan curve (kDefaultShapeK, kDefaultTimeExponent) and repeats the paper's model comparison (arctan vs parabola vs
-// sine, paper seed 002 section 3) on them. Driven by `whirl fit --simulated N`.
+// time exponent p of the arctan curve (kDefaultShapeK, kDefaultTimeExponent) and repeats the
+// paper's model comparison (arctan vs parabola vs sine, paper seed 002 section 3) on them. Driven
+// by `whirl fit --simulated N`.
 //
 // For each design point (sim::DesignPoints: space-filling over the paper's ranges) the reference
 // blank is simulated for window_s, features are extracted by sim::ExtractFeatures, and

@@ -86,9 +86,9 @@ void BM_EpochLinearAlgebra_n40(benchmark::State& state) {
     benchmark::DoNotOptimize(detail::TraceOfInverse(A, inv_diag, &work));
   }
   // Inverted rate of iterations / 138: seconds per 138 epochs (printed with its unit).
-  state.counters["per_138_epochs"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) / 138.0,
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["per_138_epochs"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) / 138.0,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_EpochLinearAlgebra_n40)->Unit(benchmark::kMicrosecond);
 

@@ -49,8 +49,8 @@ TEST(ArctanCurve, ClosedFormProperties) {
       EXPECT_NEAR(c.SlopeUmPerS(0.0), s0, 1e-12 * s0);
     else
       EXPECT_EQ(c.SlopeUmPerS(0.0), std::numeric_limits<double>::infinity());
-    EXPECT_NEAR(c.SlopeUmPerS(c.settle_time_s),
-                s0 * c.time_exponent / (1 + c.shape_k * c.shape_k), 1e-12 * s0);
+    EXPECT_NEAR(c.SlopeUmPerS(c.settle_time_s), s0 * c.time_exponent / (1 + c.shape_k * c.shape_k),
+                1e-12 * s0);
     EXPECT_EQ(c.SlopeUmPerS(1.5 * c.settle_time_s), 0.0);
     // At the same fraction of t_s, atan(k r^p) is atan(k r) at r^p: the exponent only remaps time.
     const double r = 0.37;
@@ -246,7 +246,8 @@ TEST(CurveFit, PooledShapeRecoversACommonShapeAndIgnoresScale) {
   for (int i = 0; i < 8; ++i) {
     const ArctanCurve c{ul(rng), uts(rng), k, p};
     ends.push_back(uend(rng) * c.settle_time_s);
-    curves.push_back(Sample([&](double t) { return c.ElongationUm(t); }, ends.back(), 100 + 37 * i));
+    curves.push_back(
+        Sample([&](double t) { return c.ElongationUm(t); }, ends.back(), 100 + 37 * i));
     features.push_back(c.ToFeatures());
   }
   const ShapeCalibration exact = CalibrateShape(curves, features);
@@ -277,8 +278,7 @@ TEST(CurveFit, PooledShapeRecoversACommonShapeAndIgnoresScale) {
   const ShapeCalibration dense = CalibrateShape(curves, features);
   // The per-sample mean changes slightly with the sampling; the weight of the curve does not.
   EXPECT_NEAR(dense.shape_k, mixed.shape_k, 0.25 * std::abs(mixed.shape_k - k));
-  EXPECT_NEAR(dense.time_exponent, mixed.time_exponent,
-              0.25 * std::abs(mixed.time_exponent - p));
+  EXPECT_NEAR(dense.time_exponent, mixed.time_exponent, 0.25 * std::abs(mixed.time_exponent - p));
 }
 
 TEST(ArctanCurve, ValidationNamesTheField) {

@@ -44,9 +44,9 @@ TEST(Breakpoints, BoundHoldsBetweenCheckSamplesOnRandomCurves) {
       const double t = t_end * (i + 0.37) / dense;
       worst = std::max(worst, std::abs(bp.InterpolateUm(t) - f(t)));
     }
-    EXPECT_LE(worst, o.tolerance_um) << "trial " << trial << " L " << c.max_elongation_um << " ts "
-                                     << c.settle_time_s << " k " << c.shape_k << " p "
-                                     << c.time_exponent;
+    EXPECT_LE(worst, o.tolerance_um)
+        << "trial " << trial << " L " << c.max_elongation_um << " ts " << c.settle_time_s << " k "
+        << c.shape_k << " p " << c.time_exponent;
     EXPECT_LE(bp.max_deviation_um, bp.effective_tolerance_um);
     for (std::size_t i = 0; i < bp.size(); ++i) EXPECT_DOUBLE_EQ(bp.value_um[i], f(bp.time_s[i]));
     // The settle time is a breakpoint and the plateau is a single flat segment to the end.
