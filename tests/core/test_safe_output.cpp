@@ -1,0 +1,115 @@
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/atomic_file.h"
+#include "core/parallel.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
+
+namespace whirl {
+namespace {
+namespace fs = std::filesystem;
+
+TEST(SafeText, HtmlEscapeLeavesNoMarkup) {
+  EXPECT_EQ(HtmlEscape("<script>alert('x')&\"</script>"),
+            "&lt;script&gt;alert(&#39;x&#39;)&amp;&quot;&lt;/script&gt;");
+  EXPECT_EQ(HtmlEscape("a\x01"
+                       "b"),
+            "a\xEF\xBF\xBD"
+            "b");
+  EXPECT_EQ(HtmlEscape("plain 80x10"), "plain 80x10");
+}
+
+TEST(SafeText, GnuplotStringHasNoLineBreakAndBalancedQuotes) {
+  EXPECT_EQ(GnuplotString("O'Brien"), "'O''Brien'");
+  const std::string hostile = "x'; system \"touch /tmp/PWNED\"; set title '\n! rm -rf /\r\\";
+  const std::string q = GnuplotString(hostile);
+  EXPECT_EQ(q.find('\n'), std::string::npos);
+  EXPECT_EQ(q.find('\r'), std::string::npos);
+  // Inside the outer quotes every ' is doubled, so the literal never closes early.
+  const std::string inner = q.substr(1, q.size() - 2);
+  for (std::size_t i = 0; i < inner.size(); ++i) {
+    if (inner[i] != '\'') continue;
+    ASSERT_LT(i + 1, inner.size());
+    EXPECT_EQ(inner[i + 1], '\'');
+    ++i;
+  }
+}
+
+TEST(SafeText, SlugIsAFileName) {
+  EXPECT_EQ(Slug("../../etc/passwd"), "_._.._etc_passwd");
+  EXPECT_EQ(Slug(".."), "_.");
+  EXPECT_EQ(Slug(""), "x");
+  EXPECT_EQ(Slug("-rf"), "_rf");
+  EXPECT_EQ(Slug(std::string(200, 'a')).size(), 64u);
+}
+
+// Gnuplot itself parses the quoted string back to the original text (control characters aside):
+// the reference is gnuplot's own reader, not our encoder.
+TEST(SafeText, GnuplotReadsTheStringBack) {
+  if (!ProgramSucceeds({"gnuplot", "--version"})) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path d = fs::temp_directory_path() / "whirl_test_gnuplot_string";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string name = "x'; system \"touch PWNED\"; print 'y\\ \"<b>\"";
+  WriteFileAtomic(d / "t.gp", "set print 'out.txt'\nprint " + GnuplotString(name) + "\n");
+  ASSERT_EQ(RunProgram({"gnuplot", "t.gp"}, d, d / "log.txt"), 0);
+  EXPECT_FALSE(fs::exists(d / "PWNED"));
+  EXPECT_EQ(ReadTextFile(d / "out.txt"), name + "\n");
+}
+
+TEST(RunProgram, PassesArgumentsWithoutAShell) {
+  const fs::path d = fs::temp_directory_path() / "whirl_test_run_program";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string arg = "a b; touch PWNED $(touch PWNED2) 'c'";
+  ASSERT_EQ(RunProgram({"printf", "%s", arg}, d, d / "log.txt"), 0);
+  EXPECT_EQ(ReadTextFile(d / "log.txt"), arg);
+  EXPECT_FALSE(fs::exists(d / "PWNED"));
+  EXPECT_FALSE(fs::exists(d / "PWNED2"));
+  EXPECT_EQ(RunProgram({"false"}), 1);
+  EXPECT_EQ(RunProgram({"whirl-no-such-program-xyz"}), 127);
+  EXPECT_EQ(RunProgram({"true"}, d / "missing"), 127);
+  EXPECT_THROW(RunProgram({}), std::invalid_argument);
+}
+
+TEST(ParallelFor, SameResultForAnyThreadCount) {
+  for (int threads : {1, 2, 3, 8}) {
+    std::vector<double> out(1000, 0.0);
+    std::atomic<std::size_t> calls{0};
+    ParallelFor(out.size(), threads, [&](std::size_t i) {
+      out[i] = static_cast<double>(i) * 0.5;
+      ++calls;
+    });
+    EXPECT_EQ(calls.load(), out.size());
+    for (std::size_t i = 0; i < out.size(); ++i) ASSERT_EQ(out[i], 0.5 * static_cast<double>(i));
+  }
+}
+
+TEST(ParallelFor, AnyExceptionReachesTheCaller) {
+  for (int threads : {1, 2, 4}) {
+    EXPECT_THROW(ParallelFor(100, threads,
+                             [](std::size_t i) {
+                               if (i == 37) throw std::logic_error("not an InputError");
+                             }),
+                 std::logic_error);
+    EXPECT_THROW(ParallelFor(10, threads, [](std::size_t) { throw 42; }), int);
+  }
+  std::size_t last = 0;
+  ParallelFor(
+      5, 2, [](std::size_t) {},
+      [&](std::size_t done, std::size_t n) {
+        EXPECT_EQ(n, 5u);
+        last = std::max(last, done);
+      });
+  EXPECT_EQ(last, 5u);
+}
+
+}  // namespace
+}  // namespace whirl
