@@ -24,7 +24,8 @@ std::string Num(double x) {
 CircleTrace FromTable(const CsvTable& t) {
   for (const auto& name : t.header)
     if (name != "angle_deg" && name != "deviation_um")
-      throw InputError(t.source + ": unknown column '" + name + "' (allowed: angle_deg, deviation_um)");
+      throw InputError(t.source + ": unknown column '" + name +
+                       "' (allowed: angle_deg, deviation_um)");
   CircleTrace c;
   c.source = t.source;
   c.comments = t.comments;
@@ -45,9 +46,12 @@ CircleTrace FromTable(const CsvTable& t) {
 
 std::string ToString(Plane p) {
   switch (p) {
-    case Plane::kXY: return "XY";
-    case Plane::kXZ: return "XZ";
-    case Plane::kYZ: return "YZ";
+    case Plane::kXY:
+      return "XY";
+    case Plane::kXZ:
+      return "XZ";
+    case Plane::kYZ:
+      return "YZ";
   }
   return "?";
 }
@@ -69,7 +73,8 @@ CircleTrace ReadCircleTrace(const std::filesystem::path& path) { return FromTabl
 
 std::string FormatCircleTrace(const CircleTrace& c) {
   std::vector<std::vector<double>> rows;
-  for (std::size_t i = 0; i < c.angle_deg.size(); ++i) rows.push_back({c.angle_deg[i], c.deviation_um[i]});
+  for (std::size_t i = 0; i < c.angle_deg.size(); ++i)
+    rows.push_back({c.angle_deg[i], c.deviation_um[i]});
   return FormatCsv({"angle_deg", "deviation_um"}, rows, c.comments);
 }
 
@@ -78,11 +83,14 @@ void CircleOptions::Validate() const {
     throw InputError("radius_mm = " + Num(radius_mm) + ": must be in [1, 2000] mm");
   for (double p : {cyclic_period_1_mm, cyclic_period_2_mm})
     if (!(p == 0 || (p >= 0.1 && p <= 1000)))
-      throw InputError("cyclic period = " + Num(p) + " mm: must be 0 (not fitted) or in [0.1, 1000] mm");
+      throw InputError("cyclic period = " + Num(p) +
+                       " mm: must be 0 (not fitted) or in [0.1, 1000] mm");
   if (!(std::abs(spindle_tram_urad) <= 1e5))
-    throw InputError("spindle_tram_urad = " + Num(spindle_tram_urad) + ": must be within +-1e5 urad");
+    throw InputError("spindle_tram_urad = " + Num(spindle_tram_urad) +
+                     ": must be within +-1e5 urad");
   if (spindle_tram_urad != 0 && plane != Plane::kXZ)
-    throw InputError("spindle_tram_urad applies to the XZ plane only (plane " + ToString(plane) + ")");
+    throw InputError("spindle_tram_urad applies to the XZ plane only (plane " + ToString(plane) +
+                     ")");
 }
 
 namespace {
@@ -124,8 +132,11 @@ void CheckSeparable(const Design& d, const std::string& source) {
   const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(scaled).singularValues();
   const double ratio = sv(sv.size() - 1) / sv(0);
   if (!(ratio > 1e-4))
-    throw InputError(source + ": the trace cannot separate the fitted terms (smallest/largest "
-                     "singular value " + Num(ratio) + ", rule: above 1e-4); a cyclic period far "
+    throw InputError(source +
+                     ": the trace cannot separate the fitted terms (smallest/largest "
+                     "singular value " +
+                     Num(ratio) +
+                     ", rule: above 1e-4); a cyclic period far "
                      "longer than the radius mimics the centre offset: check --cyclic-period-1-mm "
                      "and --cyclic-period-2-mm");
 }
@@ -146,7 +157,8 @@ void Cyclic(const Eigen::VectorXd& x, const Eigen::MatrixXd& cov, int j, double*
 CircleDiagnostics FitCircle(const CircleTrace& c, const CircleOptions& o) {
   o.Validate();
   const int n = static_cast<int>(c.angle_deg.size());
-  if (n < 16) throw InputError(c.source + ": " + std::to_string(n) + " samples (rule: at least 16)");
+  if (n < 16)
+    throw InputError(c.source + ": " + std::to_string(n) + " samples (rule: at least 16)");
   const double span = c.angle_deg.back() - c.angle_deg.front();
   if (span < 180 - 1e-9 || span > 360 + 1e-9)
     throw InputError(c.source + ": the trace spans " + Num(span) +
@@ -173,14 +185,16 @@ CircleDiagnostics FitCircle(const CircleTrace& c, const CircleOptions& o) {
   out.centre_offset_2_um = x(2);
   out.scale_mismatch_um_per_m = per_m * x(3);
   out.squareness_urad = per_m * x(4);
-  out.terms = {{"radius offset", x(0), sd(0), "um"},
-               {"centre offset " + a1, x(1), sd(1), "um"},
-               {"centre offset " + a2, x(2), sd(2), "um"},
-               {"scale mismatch " + a1 + "-" + a2, out.scale_mismatch_um_per_m, per_m * sd(3), "um/m"},
-               {"squareness " + a1 + a2, out.squareness_urad, per_m * sd(4), "urad"}};
+  out.terms = {
+      {"radius offset", x(0), sd(0), "um"},
+      {"centre offset " + a1, x(1), sd(1), "um"},
+      {"centre offset " + a2, x(2), sd(2), "um"},
+      {"scale mismatch " + a1 + "-" + a2, out.scale_mismatch_um_per_m, per_m * sd(3), "um/m"},
+      {"squareness " + a1 + a2, out.squareness_urad, per_m * sd(4), "urad"}};
   if (o.plane == Plane::kXZ) {
     out.parallelism_urad = out.squareness_urad - o.spindle_tram_urad;
-    out.terms.push_back({"parallelism Z travel / spindle", out.parallelism_urad, per_m * sd(4), "urad"});
+    out.terms.push_back(
+        {"parallelism Z travel / spindle", out.parallelism_urad, per_m * sd(4), "urad"});
   }
   double asd = 0;
   if (d.cyclic1 >= 0) {

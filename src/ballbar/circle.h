@@ -11,8 +11,8 @@
 // kMaxTraceSamples.
 //
 // Model (first order in the errors, R the nominal radius; u = axis-1 and v = axis-2 offsets from
-// the circle's centre, u = R cos theta, v = R sin theta; a point moves by (du, dv) and the radius by
-// du cos theta + dv sin theta). Linear least squares in the coefficients:
+// the circle's centre, u = R cos theta, v = R sin theta; a point moves by (du, dv) and the radius
+// by du cos theta + dv sin theta). Linear least squares in the coefficients:
 //   dr(theta) = r0                                   radius offset (bar length, mean scale), um
 //             + e1 cos theta + e2 sin theta          centre offset of axis 1 / axis 2, um
 //             + c2 cos 2 theta                       scale mismatch: du = s1 u, dv = s2 v gives
@@ -31,17 +31,16 @@
 // the Z travel against the X travel only; with the spindle axis square to the X travel (or its
 // measured tram angle t given, urad), the parallelism of the Z travel to the spindle axis is
 //   beta = alpha_XZ - t   (urad; a Z travel leaning towards +X as Z rises is positive).
-// It is the same coefficient as the XZ squareness (the trace cannot tell them apart); it is reported
-// under both names in the XZ plane.
-// Each coefficient comes with its standard error from the residual (sigma^2 (A'A)^-1). Also:
-// residual RMS and max (um) and the circular deviation G = max - min of the trace after removing the
-// least-squares centre (ISO 230-4, with the LSC centre instead of the minimum zone, um).
-// Semicircles (XZ, YZ): over 0..180 degrees the radius offset, the axis-2 centre offset and the
-// scale mismatch are correlated, so their standard errors are 5-7 times those of a full circle
-// (R 125 mm, 0.1 um noise, 1441 samples: scale mismatch sd 0.29 um/m against 0.045 um/m on a full
-// circle of 2880 samples); the squareness / parallelism is 3 times worse. Read the sd column.
-// Not modelled: backlash, reversal spikes, servo mismatch (direction-dependent terms; fit each
-// direction's trace separately).
+// It is the same coefficient as the XZ squareness (the trace cannot tell them apart); it is
+// reported under both names in the XZ plane. Each coefficient comes with its standard error from
+// the residual (sigma^2 (A'A)^-1). Also: residual RMS and max (um) and the circular deviation G =
+// max - min of the trace after removing the least-squares centre (ISO 230-4, with the LSC centre
+// instead of the minimum zone, um). Semicircles (XZ, YZ): over 0..180 degrees the radius offset,
+// the axis-2 centre offset and the scale mismatch are correlated, so their standard errors are 5-7
+// times those of a full circle (R 125 mm, 0.1 um noise, 1441 samples: scale mismatch sd 0.29 um/m
+// against 0.045 um/m on a full circle of 2880 samples); the squareness / parallelism is 3 times
+// worse. Read the sd column. Not modelled: backlash, reversal spikes, servo mismatch
+// (direction-dependent terms; fit each direction's trace separately).
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -68,10 +67,10 @@ std::string FormatCircleTrace(const CircleTrace& trace);
 
 struct CircleOptions {
   Plane plane = Plane::kXY;
-  double radius_mm = 100;                ///< nominal radius (bar length), mm (1..2000)
-  double cyclic_period_1_mm = 0;         ///< period of axis 1's cyclic error, mm (0: not fitted)
-  double cyclic_period_2_mm = 0;         ///< period of axis 2's cyclic error, mm (0: not fitted)
-  double spindle_tram_urad = 0;          ///< XZ only: spindle axis tilt from square to X, urad
+  double radius_mm = 100;         ///< nominal radius (bar length), mm (1..2000)
+  double cyclic_period_1_mm = 0;  ///< period of axis 1's cyclic error, mm (0: not fitted)
+  double cyclic_period_2_mm = 0;  ///< period of axis 2's cyclic error, mm (0: not fitted)
+  double spindle_tram_urad = 0;   ///< XZ only: spindle axis tilt from square to X, urad
   void Validate() const;
 };
 
@@ -94,10 +93,10 @@ struct CircleDiagnostics {
   double squareness_urad = 0;          ///< alpha
   double cyclic_amplitude_1_um = 0, cyclic_phase_1_deg = 0;
   double cyclic_amplitude_2_um = 0, cyclic_phase_2_deg = 0;
-  double parallelism_urad = 0;         ///< XZ only: alpha - tram
-  std::vector<Term> terms;             ///< every reported quantity with its sd, in order
+  double parallelism_urad = 0;  ///< XZ only: alpha - tram
+  std::vector<Term> terms;      ///< every reported quantity with its sd, in order
   double residual_rms_um = 0, residual_max_um = 0;
-  double circular_deviation_um = 0;    ///< G about the least-squares centre
+  double circular_deviation_um = 0;  ///< G about the least-squares centre
 };
 
 /// Least-squares fit of the model above. InputError for too few samples, a span under 180

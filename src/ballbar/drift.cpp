@@ -32,8 +32,8 @@ Reading ParseRow(const CsvTable& t, std::size_t r, bool has_t) {
   x.pivot = static_cast<int>(pivot);
   x.length_mm = v[t.ColumnIndex("length_mm")];
   if (!(x.length_mm > 0 && x.length_mm <= kMaxBarLengthMm))
-    throw InputError(Where(t, r, "length_mm") + ": " + Num(x.length_mm) +
-                     " mm is outside (0, " + Num(kMaxBarLengthMm) + "] mm");
+    throw InputError(Where(t, r, "length_mm") + ": " + Num(x.length_mm) + " mm is outside (0, " +
+                     Num(kMaxBarLengthMm) + "] mm");
   if (has_t) {
     const double c = v[t.ColumnIndex("bar_temperature_C")];
     if (!(c >= kMinBarTemperatureC && c <= kMaxBarTemperatureC))
@@ -62,9 +62,8 @@ Readings FromTable(const CsvTable& t) {
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     out.rows.push_back(ParseRow(t, r, has_t));
     if (r > 0 && out.rows[r].time_min < out.rows[r - 1].time_min)
-      throw InputError(Where(t, r, "time_min") + ": " + Num(out.rows[r].time_min) +
-                       " min after " + Num(out.rows[r - 1].time_min) +
-                       " min (rule: time must not decrease)");
+      throw InputError(Where(t, r, "time_min") + ": " + Num(out.rows[r].time_min) + " min after " +
+                       Num(out.rows[r - 1].time_min) + " min (rule: time must not decrease)");
   }
   return out;
 }
@@ -126,7 +125,8 @@ void DriftOptions::Validate() const {
   auto bad = [](const std::string& field, double v, const std::string& rule) {
     throw InputError(field + " = " + Num(v) + ": " + rule);
   };
-  if (!(block_gap_min > 0 && block_gap_min <= 1440)) bad("block_gap_min", block_gap_min, "must be in (0, 1440] min");
+  if (!(block_gap_min > 0 && block_gap_min <= 1440))
+    bad("block_gap_min", block_gap_min, "must be in (0, 1440] min");
   if (!(bar_sd_um >= 0 && bar_sd_um <= 100)) bad("bar_sd_um", bar_sd_um, "must be in [0, 100] um");
   if (!(bar_alpha_per_K >= 0 && bar_alpha_per_K <= 50e-6))
     bad("bar_alpha_per_K", bar_alpha_per_K, "must be in [0, 50e-6] 1/K");
@@ -158,7 +158,8 @@ std::vector<Block> SplitBlocks(const Readings& r, double gap_min) {
                          Num(r.rows[b.begin].time_min) + " min has no reading of pivot " +
                          std::to_string(p + 1) +
                          " (rule: every block reads all three pivots; blocks are split where "
-                         "readings are more than " + Num(gap_min) + " min apart)");
+                         "readings are more than " +
+                         Num(gap_min) + " min apart)");
   }
   return blocks;
 }
@@ -169,8 +170,8 @@ struct Corrected {
 };
 Corrected Correct(const Reading& x, const DriftOptions& o, bool correct) {
   const double t = x.bar_temperature_C.value_or(o.bar_reference_C);
-  const double l = correct ? x.length_mm * (1 + o.bar_alpha_per_K * (t - o.bar_reference_C))
-                           : x.length_mm;
+  const double l =
+      correct ? x.length_mm * (1 + o.bar_alpha_per_K * (t - o.bar_reference_C)) : x.length_mm;
   return {l, t, x.time_min};
 }
 
@@ -209,8 +210,8 @@ DriftBlock Measure(const Readings& r, const Block& b, const PivotFrame& frame,
       d.averaging = "positions";
       d.position_mm.setZero();
       for (int k = 0; k < d.readings[0]; ++k)
-        d.position_mm += Trilaterate(
-            frame, {s[0][k].length_mm, s[1][k].length_mm, s[2][k].length_mm});
+        d.position_mm +=
+            Trilaterate(frame, {s[0][k].length_mm, s[1][k].length_mm, s[2][k].length_mm});
       d.position_mm /= d.readings[0];
     } else {
       d.averaging = "lengths";
@@ -260,10 +261,10 @@ Sensitivity Sense(const PivotFrame& frame, const DriftBlock& d, double sd_mm, co
   for (int p = 0; p < 3; ++p) var(p) = sd_mm * sd_mm / d.readings[p];
   Sensitivity s;
   s.cov_mm2 = j * var.asDiagonal() * j.transpose();
-  const Eigen::Vector3d dl = corrected
-      ? Eigen::Vector3d(d.mean_length_mm.array() *
-                        (d.mean_bar_temperature_C.array() - o.bar_reference_C))
-      : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d dl =
+      corrected ? Eigen::Vector3d(d.mean_length_mm.array() *
+                                  (d.mean_bar_temperature_C.array() - o.bar_reference_C))
+                : Eigen::Vector3d::Zero();
   s.dp_dalpha_mm = j * dl;
   return s;
 }
@@ -312,8 +313,8 @@ DriftResult ComputeDrift(const Readings& readings, const PivotCentres& pivots_mm
     }
     const Sensitivity s = Sense(frame, d, res.bar_sd_um / 1000, o, res.bar_temperature_corrected);
     const Eigen::Vector3d g = s.dp_dalpha_mm - s0.dp_dalpha_mm;
-    const Eigen::Matrix3d cov = s.cov_mm2 + s0.cov_mm2 +
-                                o.bar_alpha_sd_per_K * o.bar_alpha_sd_per_K * g * g.transpose();
+    const Eigen::Matrix3d cov =
+        s.cov_mm2 + s0.cov_mm2 + o.bar_alpha_sd_per_K * o.bar_alpha_sd_per_K * g * g.transpose();
     d.drift_sd_um = 1000 * cov.diagonal().cwiseSqrt();
   }
   res.placement = AdvisePlacement(frame, cold.position_mm);
@@ -372,7 +373,8 @@ nlohmann::json ToJson(const DriftResult& r) {
        {{"sign", interp::ToString(r.options.sign)},
         {"rule", "SD43900[axis] = s * drift_um / 1000 with s = -1 (subtract) or +1 (add)"},
         {"time_min", r.blocks.back().time_min},
-        {"sd43900_mm", {{"X", r.sd43900_mm.x()}, {"Y", r.sd43900_mm.y()}, {"Z", r.sd43900_mm.z()}}}}}};
+        {"sd43900_mm",
+         {{"X", r.sd43900_mm.x()}, {"Y", r.sd43900_mm.y()}, {"Z", r.sd43900_mm.z()}}}}}};
   return j;
 }
 

@@ -31,7 +31,12 @@
 //   g = dD/dalpha = J_b (L_b (T_b - T_ref)) - J_0 (L_0 (T_0 - T_ref))   (per-pivot means),
 // sigma the sd of one reading (given, or pooled from the scatter of repeated readings of a pivot
 // within blocks after removing the tool ball's motion during the block: L_i changes at u_i . v,
-// v the ball's velocity from the neighbouring blocks' positions), u_alpha the sd of alpha. Pivot-centre errors cancel to first order in D.
+// v the ball's velocity from the neighbouring blocks' positions), u_alpha the sd of alpha.
+// Pivot-centre errors cancel to first order in D.
+//
+// What D is: the tool ball relative to the pivots, i.e. spindle drift relative to the table at the
+// pivots. Growth of the table between the pivots is not separated (it changes LB1..LB3 and is read
+// as a small drift); measure the pivots' centres cold and keep the pivots close together.
 //
 // 840D (README "840D setting data: conventions", REFERENCE.md section 3): the position-independent
 // compensation of axis a is SD43900 $SA_TEMP_COMP_ABS_VALUE[a] = s * D_a / 1000 mm with s = -1
@@ -100,28 +105,28 @@ struct DriftOptions {
 };
 
 struct DriftBlock {
-  double time_min = 0;        ///< mean time of the block's readings, min
+  double time_min = 0;  ///< mean time of the block's readings, min
   int first_line = 0, last_line = 0;
-  std::array<int, 3> readings{};             ///< count per pivot
-  std::string averaging;                     ///< "positions" (eq. 18 triplets) or "lengths"
-  Eigen::Vector3d mean_length_mm;            ///< corrected, per pivot
-  Eigen::Vector3d mean_bar_temperature_C;    ///< per pivot (T_ref without the column)
-  Eigen::Vector3d position_mm;               ///< tool ball, MCS
-  Eigen::Vector3d drift_um;                  ///< eq. 18, MCS
-  Eigen::Vector3d drift_sd_um;               ///< sqrt(diag Cov(D))
+  std::array<int, 3> readings{};           ///< count per pivot
+  std::string averaging;                   ///< "positions" (eq. 18 triplets) or "lengths"
+  Eigen::Vector3d mean_length_mm;          ///< corrected, per pivot
+  Eigen::Vector3d mean_bar_temperature_C;  ///< per pivot (T_ref without the column)
+  Eigen::Vector3d position_mm;             ///< tool ball, MCS
+  Eigen::Vector3d drift_um;                ///< eq. 18, MCS
+  Eigen::Vector3d drift_sd_um;             ///< sqrt(diag Cov(D))
 };
 
 struct DriftResult {
   std::string source;
-  std::vector<DriftBlock> blocks;           ///< the first one is the cold reference (drift 0)
-  double bar_sd_um = 0;                     ///< sd used for the uncertainty
-  std::string bar_sd_source;                ///< "given" or "pooled from N repeated readings"
-  std::optional<double> pooled_bar_sd_um;   ///< estimate from the scatter, when available
+  std::vector<DriftBlock> blocks;          ///< the first one is the cold reference (drift 0)
+  double bar_sd_um = 0;                    ///< sd used for the uncertainty
+  std::string bar_sd_source;               ///< "given" or "pooled from N repeated readings"
+  std::optional<double> pooled_bar_sd_um;  ///< estimate from the scatter, when available
   int pooled_dof = 0;
   bool bar_temperature_corrected = false;
   DriftOptions options;
-  PlacementAdvice placement;                ///< at the cold block's position
-  Eigen::Vector3d sd43900_mm;               ///< s * D_last / 1000 per axis, mm
+  PlacementAdvice placement;   ///< at the cold block's position
+  Eigen::Vector3d sd43900_mm;  ///< s * D_last / 1000 per axis, mm
 };
 
 /// Blocks, trilateration, drift and its uncertainty, placement advice, SD43900.

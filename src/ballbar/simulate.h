@@ -13,9 +13,9 @@
 //   Bar temperature T(t) = bar_start_C + bar_rise_K (1 - exp(-t / bar_tau_min)), recorded to
 //   0.01 K. A reading is |P - B_i| / (1 + alpha (T - 20 degC)) (the warm bar reads short, drift.h)
 //   plus N(0, bar_noise_sd_um^2), rounded to resolution_um.
-//   Blocks every interval_min from 0 to duration_min; in a block, `repeats` passes over the pivots in
-//   palindromic order (1 2 3 3 2 1 ...), one reading every reading_step_min.
-//   Truth of block b: drift(tbar_b) - drift(tbar_0), tbar the block's mean reading time.
+//   Blocks every interval_min from 0 to duration_min; in a block, `repeats` passes over the pivots
+//   in palindromic order (1 2 3 3 2 1 ...), one reading every reading_step_min. Truth of block b:
+//   drift(tbar_b) - drift(tbar_0), tbar the block's mean reading time.
 // Circle traces: exact geometry (not the linear model of circle.h). Commanded point (u, v) =
 // R (cos theta, sin theta) about the circle's centre; actual
 //   u' = e1 + u (1 + s1) + alpha v + A1 sin(2 pi u / p1 + phi1)
@@ -54,8 +54,8 @@ struct WarmupOptions {
 struct WarmupSimulation {
   PivotCentres pivots_mm{};
   Readings readings;
-  Eigen::Vector3d final_drift_um;   ///< D per axis
-  Eigen::Vector3d tau_min;          ///< tau per axis
+  Eigen::Vector3d final_drift_um;  ///< D per axis
+  Eigen::Vector3d tau_min;         ///< tau per axis
   std::vector<double> block_time_min;
   std::vector<Eigen::Vector3d> truth_um;  ///< per block, relative to the cold block
 };

@@ -74,24 +74,27 @@ Eigen::Vector3d TrilaterateLocal(const PivotFrame& f, const Eigen::Vector3d& l) 
   const double x = (l(0) * l(0) - l(1) * l(1) + lb1 * lb1) / (2 * lb1);  // (11)
   const double c1_sq = l(0) * l(0) - x * x;
   if (!(c1_sq > 0))
-    throw InputError("inconsistent bar lengths " + Lengths(l) + ": eq. 12 needs L1^2 - x^2 > 0 but it is " +
-                     Num(c1_sq) + " mm^2 (|L1 - L2| must be less than |B1B2| = " + Num(lb1) +
+    throw InputError("inconsistent bar lengths " + Lengths(l) +
+                     ": eq. 12 needs L1^2 - x^2 > 0 but it is " + Num(c1_sq) +
+                     " mm^2 (|L1 - L2| must be less than |B1B2| = " + Num(lb1) +
                      " mm): a wrong pivot number, pivot centre or bar length");
   const double xb = f.xb_mm, cb = f.cb_mm;                      // (13), (14)
   const double d1_sq = c1_sq + (xb - x) * (xb - x);             // (15)
   const double y = (d1_sq - l(2) * l(2) + cb * cb) / (2 * cb);  // (16)
   const double z_sq = c1_sq - y * y;
   if (!(z_sq > 0))
-    throw InputError("inconsistent bar lengths " + Lengths(l) + ": eq. 17 needs c1^2 - y^2 > 0 but it is " +
-                     Num(z_sq) + " mm^2 (the three spheres do not meet, or the tool ball lies in the " +
+    throw InputError("inconsistent bar lengths " + Lengths(l) +
+                     ": eq. 17 needs c1^2 - y^2 > 0 but it is " + Num(z_sq) +
+                     " mm^2 (the three spheres do not meet, or the tool ball lies in the " +
                      "pivots' plane): a wrong pivot number, pivot centre or bar length");
   const double z = std::sqrt(z_sq);  // (17)
   const double ratio = z / l.maxCoeff();
   if (ratio < f.limits.min_height_ratio)
-    throw InputError("tool ball only " + Num(z) + " mm above the pivots' plane (" + Lengths(l) +
-                     "): height / longest bar = " + Num(ratio) + " (rule: at least " +
-                     Num(f.limits.min_height_ratio) +
-                     "); z is ill-conditioned there: raise the tool ball or bring the pivots closer");
+    throw InputError(
+        "tool ball only " + Num(z) + " mm above the pivots' plane (" + Lengths(l) +
+        "): height / longest bar = " + Num(ratio) + " (rule: at least " +
+        Num(f.limits.min_height_ratio) +
+        "); z is ill-conditioned there: raise the tool ball or bring the pivots closer");
   return {x, y, z};
 }
 

@@ -58,13 +58,13 @@ struct GeometryLimits {
 
 /// The paper's local frame of three pivots (Fig. 7).
 struct PivotFrame {
-  PivotCentres pivots_mm{};      ///< B1, B2, B3 in MCS, mm
-  Eigen::Matrix3d axes;          ///< columns: local x, y, z axes as unit vectors in MCS
-  double lb1_mm = 0;             ///< LB1 = |B1B2|, mm
-  double lb2_mm = 0;             ///< LB2 = |B2B3|, mm
-  double lb3_mm = 0;             ///< LB3 = |B1B3|, mm
-  double xb_mm = 0;              ///< eq. 13: x of B3 in the local frame, mm
-  double cb_mm = 0;              ///< eq. 14: y of B3 in the local frame, mm
+  PivotCentres pivots_mm{};  ///< B1, B2, B3 in MCS, mm
+  Eigen::Matrix3d axes;      ///< columns: local x, y, z axes as unit vectors in MCS
+  double lb1_mm = 0;         ///< LB1 = |B1B2|, mm
+  double lb2_mm = 0;         ///< LB2 = |B2B3|, mm
+  double lb3_mm = 0;         ///< LB3 = |B1B3|, mm
+  double xb_mm = 0;          ///< eq. 13: x of B3 in the local frame, mm
+  double cb_mm = 0;          ///< eq. 14: y of B3 in the local frame, mm
   GeometryLimits limits;
 
   /// Local coordinates (x, y, z) of eqs. 11-17 to MCS: B1 + axes * local.
@@ -92,15 +92,15 @@ Eigen::Matrix3d PositionJacobian(const PivotCentres& pivots_mm, const Eigen::Vec
 
 /// How well a layout turns bar noise into position noise.
 struct PlacementAdvice {
-  double condition_number = 0;      ///< kappa(U) = sigma_max / sigma_min, >= 1 (1 is ideal)
-  Eigen::Vector3d noise_gain;       ///< per MCS axis: sqrt(sum_i J_ki^2), the position sd per
-                                    ///< unit sd of each reading (1 in the ideal layout)
-  double height_mm = 0;             ///< tool ball above the pivots' plane, mm
-  double mean_radius_mm = 0;        ///< mean horizontal distance of the pivots from its foot, mm
-  double ideal_height_mm = 0;       ///< L / sqrt(3) for the mean bar length L, mm
-  double ideal_radius_mm = 0;       ///< L sqrt(2/3), mm
-  std::string rating;               ///< "good" (kappa <= 2), "fair" (<= 5), "poor" (> 5)
-  std::string advice;               ///< one sentence: what to move, with the ideal numbers
+  double condition_number = 0;  ///< kappa(U) = sigma_max / sigma_min, >= 1 (1 is ideal)
+  Eigen::Vector3d noise_gain;   ///< per MCS axis: sqrt(sum_i J_ki^2), the position sd per
+                                ///< unit sd of each reading (1 in the ideal layout)
+  double height_mm = 0;         ///< tool ball above the pivots' plane, mm
+  double mean_radius_mm = 0;    ///< mean horizontal distance of the pivots from its foot, mm
+  double ideal_height_mm = 0;   ///< L / sqrt(3) for the mean bar length L, mm
+  double ideal_radius_mm = 0;   ///< L sqrt(2/3), mm
+  std::string rating;           ///< "good" (kappa <= 2), "fair" (<= 5), "poor" (> 5)
+  std::string advice;           ///< one sentence: what to move, with the ideal numbers
 };
 
 /// Condition number, noise gains and advice for the tool ball at `position_mm` (MCS).

@@ -44,10 +44,11 @@ void RunDrift(DriftCmd c) {
   const ballbar::DriftResult r =
       ballbar::ComputeDrift(ballbar::ReadReadings(c.readings), ballbar::ReadPivots(c.pivots), c.o);
   if (!c.out.empty()) {
-    WriteFileAtomic(c.out, ballbar::FormatDriftCsv(
-                               r, {"spindle thermal drift from ball-bar readings (seed 001, eq. 18)",
-                                   "readings: " + c.readings + ", pivots: " + c.pivots,
-                                   "drift = tool-ball position now - cold block, MCS, um"}));
+    WriteFileAtomic(c.out,
+                    ballbar::FormatDriftCsv(
+                        r, {"spindle thermal drift from ball-bar readings (seed 001, eq. 18)",
+                            "readings: " + c.readings + ", pivots: " + c.pivots,
+                            "drift = tool-ball position now - cold block, MCS, um"}));
     std::fprintf(stderr, "wrote %s\n", c.out.c_str());
   }
   if (c.json)
@@ -61,16 +62,20 @@ void AddDrift(CLI::App& parent) {
   auto* sub = parent.add_subcommand(
       "drift",
       "Spindle thermal drift from ball-bar readings to three table pivots (seed 001 eqs. 11-18).\n"
-      "Readings CSV: time_min (min, non-decreasing), pivot (1, 2, 3), length_mm (centre-to-centre,\n"
+      "Readings CSV: time_min (min, non-decreasing), pivot (1, 2, 3), length_mm "
+      "(centre-to-centre,\n"
       "mm, at most 2000), optional bar_temperature_C (degC, -20..60); at most 1e6 rows. Readings\n"
       "closer than --block-gap-min form one block (one position); the first block is the cold\n"
       "reference. Pivots JSON: {\"schema\": \"whirl.ballbar.pivots\", \"schema_version\": 1,\n"
       "\"pivots_mm\": [[x,y,z],[x,y,z],[x,y,z]]} in machine coordinates (mm).\n"
-      "Prints the drift per block and axis (um) with its sd (bar noise through the trilateration's\n"
+      "Prints the drift per block and axis (um) with its sd (bar noise through the "
+      "trilateration's\n"
       "Jacobian, plus the bar-expansion coefficient's sd), the pivot layout's condition number\n"
       "with advice, and the current SD43900 per axis (mm): -drift/1000 with --sign subtract.");
   sub->add_option("--readings", c->readings, "readings CSV")->required()->check(CLI::ExistingFile);
-  sub->add_option("--pivots", c->pivots, "pivots JSON (MCS, mm)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--pivots", c->pivots, "pivots JSON (MCS, mm)")
+      ->required()
+      ->check(CLI::ExistingFile);
   sub->add_option("--out", c->out,
                   "write the run file time_min,drift_x_um,drift_y_um,drift_z_um (drift commands "
                   "read it as error columns)");
@@ -130,8 +135,10 @@ void AddCircle(CLI::App& parent) {
       "Circle-test diagnostics of a ball-bar trace (ISO 230-4 style), least squares.\n"
       "Trace CSV: angle_deg (from axis 1 towards axis 2, strictly increasing, span 180..360 deg),\n"
       "deviation_um (measured minus nominal radius, um). Prints, each with its sd: radius offset\n"
-      "(um), centre offset per axis (um), scale mismatch axis1-axis2 (um/m), squareness (urad; the\n"
-      "axes enclose 90 deg - alpha), cyclic amplitude per axis at the given period (um), in XZ the\n"
+      "(um), centre offset per axis (um), scale mismatch axis1-axis2 (um/m), squareness (urad; "
+      "the\n"
+      "axes enclose 90 deg - alpha), cyclic amplitude per axis at the given period (um), in XZ "
+      "the\n"
       "parallelism of the Z travel to the spindle (urad), the fit residual (um) and G (um).");
   sub->add_option("--trace", c->trace, "trace CSV")->required()->check(CLI::ExistingFile);
   sub->add_option("--plane", c->plane, "XY, XZ or YZ (default XY)")

@@ -1,11 +1,10 @@
 // Circle-test diagnostics: each planted error (exact geometry, noise 0.1 um) is recovered within
 // 2 % and leaves the other terms near zero; standard errors match the scatter; bad traces fail.
-#include "ballbar/circle.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "ballbar/circle.h"
 #include "ballbar/simulate.h"
 #include "core/error.h"
 
@@ -17,8 +16,8 @@ struct Values {
 };
 
 Values Planted(const CirclePlant& p) {
-  return {p.centre_1_um, p.centre_2_um, p.scale_1_um_per_m - p.scale_2_um_per_m, p.squareness_urad,
-          p.cyclic_1_um, p.cyclic_2_um};
+  return {p.centre_1_um,     p.centre_2_um, p.scale_1_um_per_m - p.scale_2_um_per_m,
+          p.squareness_urad, p.cyclic_1_um, p.cyclic_2_um};
 }
 
 CircleOptions OptionsFor(const CirclePlant& p) {
@@ -36,17 +35,17 @@ CircleOptions OptionsFor(const CirclePlant& p) {
 void ExpectRecovered(const CirclePlant& p, const std::string& label) {
   const CircleDiagnostics d = FitCircle(SimulateCircle(p), OptionsFor(p));
   const Values want = Planted(p);
-  const Values got{d.centre_offset_1_um, d.centre_offset_2_um, d.scale_mismatch_um_per_m,
-                   d.squareness_urad, d.cyclic_amplitude_1_um, d.cyclic_amplitude_2_um};
+  const Values got{d.centre_offset_1_um, d.centre_offset_2_um,    d.scale_mismatch_um_per_m,
+                   d.squareness_urad,    d.cyclic_amplitude_1_um, d.cyclic_amplitude_2_um};
   // terms: radius, centre 1, centre 2, scale, squareness, [parallelism], cyclic 1, cyclic 2.
   const int c1 = p.plane == Plane::kXZ ? 6 : 5;
-  const double sd[6] = {d.terms[1].sd, d.terms[2].sd, d.terms[3].sd,
+  const double sd[6] = {d.terms[1].sd, d.terms[2].sd,  d.terms[3].sd,
                         d.terms[4].sd, d.terms[c1].sd, d.terms[c1 + 1].sd};
   const double cap[6] = {0.06, 0.06, 1.5, 1.5, 0.06, 0.06};
   const double w[6] = {want.centre1, want.centre2, want.scale, want.square, want.cyc1, want.cyc2};
   const double g[6] = {got.centre1, got.centre2, got.scale, got.square, got.cyc1, got.cyc2};
-  const char* names[6] = {"centre 1", "centre 2", "scale mismatch", "squareness", "cyclic 1",
-                          "cyclic 2"};
+  const char* names[6] = {"centre 1",   "centre 2", "scale mismatch",
+                          "squareness", "cyclic 1", "cyclic 2"};
   for (int i = 0; i < 6; ++i) {
     if (w[i] != 0) {
       EXPECT_NEAR(g[i], w[i], 0.02 * std::abs(w[i])) << label << ": " << names[i];
@@ -74,18 +73,30 @@ TEST(Circle, EachPlantedErrorIsRecoveredWithin2PercentAndOthersStayNearZero) {
         p.cyclic_period_1_mm = 10;
         p.cyclic_period_2_mm = 16;
         switch (term) {
-          case 0: p.centre_1_um = 8; break;
+          case 0:
+            p.centre_1_um = 8;
+            break;
           // On a semicircle the axis-2 centre, the radius offset and the scale mismatch are
           // correlated (circle.h): their standard errors are 5-7 times larger, so the planted
           // values are larger there to keep 2 % above 4 standard errors.
-          case 1: p.centre_2_um = semi ? -15 : -6; break;
-          case 2: p.scale_1_um_per_m = semi ? 60 : 30; break;  // thermal growth of one scale
-          case 3: p.squareness_urad = 40; break;   // in XZ: the spindle / Z-guide parallelism
-          case 4: p.cyclic_1_um = 1.5, p.cyclic_phase_1_deg = 30; break;
-          case 5: p.cyclic_2_um = 2.0, p.cyclic_phase_2_deg = -70; break;
+          case 1:
+            p.centre_2_um = semi ? -15 : -6;
+            break;
+          case 2:
+            p.scale_1_um_per_m = semi ? 60 : 30;
+            break;  // thermal growth of one scale
+          case 3:
+            p.squareness_urad = 40;
+            break;  // in XZ: the spindle / Z-guide parallelism
+          case 4:
+            p.cyclic_1_um = 1.5, p.cyclic_phase_1_deg = 30;
+            break;
+          case 5:
+            p.cyclic_2_um = 2.0, p.cyclic_phase_2_deg = -70;
+            break;
         }
-        ExpectRecovered(p, ToString(plane) + " term " + std::to_string(term) + " seed " +
-                               std::to_string(seed));
+        ExpectRecovered(
+            p, ToString(plane) + " term " + std::to_string(term) + " seed " + std::to_string(seed));
       }
 }
 
@@ -160,11 +171,15 @@ TEST(Circle, BadTracesAreClearErrors) {
   std::string quarter = "angle_deg,deviation_um\n";
   for (int i = 0; i <= 90; ++i) quarter += std::to_string(i) + ",0\n";
   ExpectInputError([&] { FitCircle(ParseCircleTrace(quarter, "q.csv"), o); }, "spans 90");
-  ExpectInputError([&] { FitCircle(ParseCircleTrace("angle_deg,deviation_um\n0,0\n180,0\n", "s.csv"), o); },
-                   "at least 16");
-  ExpectInputError([&] { ParseCircleTrace("angle_deg,deviation_um\n0,0\n0,1\n", "d.csv"); }, "d.csv:3");
-  ExpectInputError([&] { ParseCircleTrace("angle_deg,radius_mm\n0,0\n", "r.csv"); }, "unknown column");
-  ExpectInputError([&] { ParseCircleTrace("angle_deg,deviation_um\n0,100000\n", "b.csv"); }, "b.csv:2");
+  ExpectInputError(
+      [&] { FitCircle(ParseCircleTrace("angle_deg,deviation_um\n0,0\n180,0\n", "s.csv"), o); },
+      "at least 16");
+  ExpectInputError([&] { ParseCircleTrace("angle_deg,deviation_um\n0,0\n0,1\n", "d.csv"); },
+                   "d.csv:3");
+  ExpectInputError([&] { ParseCircleTrace("angle_deg,radius_mm\n0,0\n", "r.csv"); },
+                   "unknown column");
+  ExpectInputError([&] { ParseCircleTrace("angle_deg,deviation_um\n0,100000\n", "b.csv"); },
+                   "b.csv:2");
   CircleOptions longp;
   longp.radius_mm = 10;
   longp.cyclic_period_1_mm = 1000;  // mimics the centre offset over a 10 mm circle

@@ -1,11 +1,10 @@
 // Drift from ball-bar readings (eq. 18) against the simulated warm-up's planted truth, its
 // uncertainty, the bar-expansion correction, averaging, files and SD43900.
-#include "ballbar/drift.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "ballbar/drift.h"
 #include "ballbar/simulate.h"
 #include "core/error.h"
 #include "support/eigen_near.h"
@@ -74,7 +73,8 @@ TEST(Drift, DefaultOptionsAreConservativeOnTheDemo) {
   EXPECT_GE(*r.pooled_bar_sd_um, 0.5 * kReadingSdUm);
   for (std::size_t b = 1; b < r.blocks.size(); ++b)
     for (int a = 0; a < 3; ++a)
-      EXPECT_LE(std::abs(r.blocks[b].drift_um(a) - s.truth_um[b](a)), 3 * r.blocks[b].drift_sd_um(a))
+      EXPECT_LE(std::abs(r.blocks[b].drift_um(a) - s.truth_um[b](a)),
+                3 * r.blocks[b].drift_sd_um(a))
           << "block " << b << " axis " << a;
   EXPECT_EQ(r.placement.rating, "good");
 }

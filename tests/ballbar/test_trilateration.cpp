@@ -1,12 +1,11 @@
 // Trilateration (seed 001 eqs. 11-17): hand example, round trips, Jacobian against finite
 // differences, degenerate geometry, placement advice.
-#include "ballbar/trilateration.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "ballbar/trilateration.h"
 #include "core/error.h"
 #include "sim/random.h"
 #include "support/eigen_near.h"
@@ -46,7 +45,7 @@ TEST(Trilateration, HandComputedExampleFollowsEachEquation) {
   EXPECT_DOUBLE_EQ(f.lb1_mm, 100);
   EXPECT_NEAR(f.lb2_mm, std::sqrt(20000.0), 1e-12);
   EXPECT_DOUBLE_EQ(f.lb3_mm, 100);
-  EXPECT_NEAR(f.xb_mm, 0, 1e-12);   // (13): (10000 - 20000 + 10000) / 200
+  EXPECT_NEAR(f.xb_mm, 0, 1e-12);    // (13): (10000 - 20000 + 10000) / 200
   EXPECT_NEAR(f.cb_mm, 100, 1e-12);  // (14)
   const Vector3d l(std::sqrt(5000.0), std::sqrt(9000.0), std::sqrt(7000.0));
   // (11) x = (5000 - 9000 + 10000)/200 = 30; (12) c1^2 = 4100; (15) d1^2 = 5000;
@@ -64,6 +63,7 @@ TEST(Trilateration, RoundTripPositionLengthsPositionTo1e9mm) {
     const Vector3d back = Trilaterate(f, BarLengths(c.pivots, c.ball));
     worst = std::max(worst, (back - c.ball).cwiseAbs().maxCoeff());
   }
+  RecordProperty("worst_round_trip_mm", testing::PrintToString(worst));
   EXPECT_LT(worst, 1e-9) << "worst round-trip error " << worst << " mm";
 }
 
@@ -119,7 +119,8 @@ TEST(Trilateration, DegenerateGeometryIsAClearErrorNotNaN) {
   // L3 far too long for the other two: eq. 17's radicand is negative.
   ExpectInputError([&] { TrilaterateLocal(f, Vector3d(100, 100, 400)); }, "eq. 17");
   // Tool ball 2 mm above the pivots' plane.
-  ExpectInputError([&] { TrilaterateLocal(f, BarLengths(b, Vector3d(50, 30, 2))); }, "above the pivots' plane");
+  ExpectInputError([&] { TrilaterateLocal(f, BarLengths(b, Vector3d(50, 30, 2))); },
+                   "above the pivots' plane");
   ExpectInputError([&] { TrilaterateLocal(f, Vector3d(-1, 100, 100)); }, "positive");
   // Just above the limit it works.
   EXPECT_NO_THROW(TrilaterateLocal(f, BarLengths(b, Vector3d(50, 30, 10))));
@@ -170,7 +171,8 @@ TEST(Placement, NoiseGainIsTheSdPerUnitReadingSd) {
     ss += (Trilaterate(f, noisy) - c.ball).cwiseAbs2();
   }
   const Vector3d mc = (ss / n).cwiseSqrt() / sd;
-  EXPECT_TRUE(test::AllNear(mc, a.noise_gain, 0.03)) << mc.transpose() << " vs " << a.noise_gain.transpose();
+  EXPECT_TRUE(test::AllNear(mc, a.noise_gain, 0.03))
+      << mc.transpose() << " vs " << a.noise_gain.transpose();
 }
 
 }  // namespace
