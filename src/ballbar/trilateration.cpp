@@ -10,6 +10,8 @@
 namespace whirl::ballbar {
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 std::string Num(double x) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.6g", x);
@@ -54,9 +56,9 @@ PivotFrame MakePivotFrame(const PivotCentres& pivots_mm, const GeometryLimits& l
   const Eigen::Vector3d ey = (b13 - b13.dot(ex) * ex).normalized();
   Eigen::Vector3d ez = ex.cross(ey);
   if (std::abs(ez.z()) < limits.min_normal_z)
-    throw InputError("pivots' plane is tilted " + Num(std::acos(std::abs(ez.z())) * 180 / M_PI) +
+    throw InputError("pivots' plane is tilted " + Num(std::acos(std::abs(ez.z())) * 180 / kPi) +
                      " degrees from the table (rule: its normal within " +
-                     Num(std::acos(limits.min_normal_z) * 180 / M_PI) +
+                     Num(std::acos(limits.min_normal_z) * 180 / kPi) +
                      " degrees of machine Z, so that the tool ball's side of it is +Z)");
   if (ez.z() < 0) ez = -ez;  // the root of eq. 17 is taken on the spindle's side (+Z)
   f.axes.col(0) = ex;

@@ -144,6 +144,17 @@ TEST(Circle, StandardErrorsMatchTheScatterOverSeeds) {
   EXPECT_NEAR(sd(square) / reported_square, 1, 0.15);
 }
 
+TEST(Circle, TraceFileRoundTrip) {
+  CirclePlant p;
+  p.samples = 64;
+  CircleTrace c = SimulateCircle(p);
+  c.comments = {"made by a test"};
+  const CircleTrace back = ParseCircleTrace(FormatCircleTrace(c), "t.csv");
+  EXPECT_EQ(back.angle_deg, c.angle_deg);
+  EXPECT_EQ(back.deviation_um, c.deviation_um);
+  EXPECT_EQ(back.comments, c.comments);
+}
+
 TEST(Circle, TramCorrectsTheXzParallelism) {
   CirclePlant p;
   p.plane = Plane::kXZ;

@@ -178,6 +178,23 @@ TEST(Drift, RunFileHasTheDriftModulesFormat) {
   EXPECT_EQ(back.rows[5].length_mm, s.readings.rows[5].length_mm);
 }
 
+TEST(Drift, BlocksSplitWhereReadingsAreMoreThanTheGapApart) {
+  // Same readings, stamped either per reading (0.25 min apart) or all at the block's time: the
+  // same blocks and drift; a gap below the within-block spacing splits them (and then fails).
+  const WarmupSimulation s = SimulateWarmup({});
+  Readings same_time = s.readings;
+  for (std::size_t i = 0; i < same_time.rows.size(); ++i)
+    same_time.rows[i].time_min = s.readings.rows[i - i % 6].time_min;
+  const DriftResult a = ComputeDrift(s.readings, s.pivots_mm);
+  const DriftResult b = ComputeDrift(same_time, s.pivots_mm);
+  ASSERT_EQ(a.blocks.size(), b.blocks.size());
+  EXPECT_TRUE(test::AllNear(a.blocks.back().drift_um, b.blocks.back().drift_um, 0, 1e-12));
+  EXPECT_NEAR(b.blocks[2].time_min, 30, 1e-12);
+  DriftOptions o;
+  o.block_gap_min = 0.2;
+  EXPECT_THROW(ComputeDrift(s.readings, s.pivots_mm, o), InputError);
+}
+
 template <typename F>
 void ExpectInputError(F f, const std::string& fragment) {
   try {

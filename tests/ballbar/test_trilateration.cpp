@@ -14,6 +14,7 @@ namespace whirl::ballbar {
 namespace {
 
 using Eigen::Vector3d;
+constexpr double kPi = 3.14159265358979323846;
 
 double U(sim::Rng& r, double lo, double hi) { return lo + (hi - lo) * r.Uniform(); }
 
@@ -130,7 +131,7 @@ TEST(Placement, IdealLayoutHasConditionOneAndUnitGain) {
   const double bar = 150, h = bar / std::sqrt(3.0), rad = bar * std::sqrt(2.0 / 3.0);
   PivotCentres b;
   for (int i = 0; i < 3; ++i) {
-    const double a = (210 + 120 * i) * M_PI / 180;
+    const double a = (210 + 120 * i) * kPi / 180;
     b[i] = Vector3d(rad * std::cos(a), rad * std::sin(a), -h);
   }
   const PlacementAdvice a = AdvisePlacement(MakePivotFrame(b), Vector3d::Zero());
