@@ -134,12 +134,11 @@ void AddCircle(CLI::App& parent) {
       "circle",
       "Circle-test diagnostics of a ball-bar trace (ISO 230-4 style), least squares.\n"
       "Trace CSV: angle_deg (from axis 1 towards axis 2, strictly increasing, span 180..360 deg),\n"
-      "deviation_um (measured minus nominal radius, um). Prints, each with its sd: radius offset\n"
-      "(um), centre offset per axis (um), scale mismatch axis1-axis2 (um/m), squareness (urad; "
-      "the\n"
-      "axes enclose 90 deg - alpha), cyclic amplitude per axis at the given period (um), in XZ "
-      "the\n"
-      "parallelism of the Z travel to the spindle (urad), the fit residual (um) and G (um).");
+      "deviation_um (measured minus nominal radius, um, within +-10000); 16 to 1e6 samples.\n"
+      "Prints, each with its sd: radius offset (um), centre offset per axis (um), scale mismatch\n"
+      "axis1-axis2 (um/m), squareness (urad; the axes enclose 90 deg - alpha), cyclic amplitude\n"
+      "per axis at the given period (um), in XZ the parallelism of the Z travel to the spindle\n"
+      "(urad), the fit residual (um) and the circular deviation G (um).");
   sub->add_option("--trace", c->trace, "trace CSV")->required()->check(CLI::ExistingFile);
   sub->add_option("--plane", c->plane, "XY, XZ or YZ (default XY)")
       ->check(CLI::IsMember({"XY", "XZ", "YZ", "xy", "xz", "yz"}));
