@@ -64,16 +64,25 @@ void AnalyzeCubic(MethodComparison& c, const std::vector<SurfacePoint>& points) 
   for (const auto& p : points) lo = std::min(lo, p.error_um), hi = std::max(hi, p.error_um);
   c.measured_range_um = hi - lo;
   c.cubic_overshoot_um = Overshoot(fit.surface, b, lo, hi, c.options.map_samples);
+  const double excess = c.options.min_excess_um;
   const bool edge_worse =
       c.cubic_loo_edge.count && c.cubic_loo_interior.count &&
-      c.cubic_loo_edge.rms_um > c.options.edge_ratio * c.cubic_loo_interior.rms_um;
-  const bool overshoots = c.cubic_overshoot_um > c.options.overshoot_fraction * c.measured_range_um;
+      c.cubic_loo_edge.rms_um > c.options.edge_ratio * c.cubic_loo_interior.rms_um &&
+      c.cubic_loo_edge.rms_um - c.cubic_loo_interior.rms_um > excess;
+  const bool overshoots =
+      c.cubic_overshoot_um > c.options.overshoot_fraction * c.measured_range_um &&
+      c.cubic_overshoot_um > excess;
   c.cubic_oscillates = edge_worse || overshoots;
+  if (edge_worse)
+    c.note = "edge LOO RMS " + Um(c.cubic_loo_edge.rms_um) + " > " +
+             FormatNumber(c.options.edge_ratio) + " x interior " + Um(c.cubic_loo_interior.rms_um);
+  if (overshoots)
+    c.note += std::string(c.note.empty() ? "" : "; ") + "it leaves the measured range by " +
+              Um(c.cubic_overshoot_um) + " (> " + FormatNumber(c.options.overshoot_fraction) +
+              " x range " + Um(c.measured_range_um) + ")";
   if (c.cubic_oscillates)
-    c.note = "the cubic polynomial oscillates at the edges: edge LOO RMS " +
-             Um(c.cubic_loo_edge.rms_um) + " vs interior " + Um(c.cubic_loo_interior.rms_um) +
-             ", and it leaves the measured range by " + Um(c.cubic_overshoot_um) + " (range " +
-             Um(c.measured_range_um) + "); a low-order fit does not describe this field";
+    c.note = "the cubic polynomial oscillates at the edges (Runge): " + c.note +
+             "; a low-order fit does not describe this field, prefer the B-spline on a grid";
 }
 
 void Recommend(MethodComparison& c) {
@@ -97,7 +106,8 @@ void Recommend(MethodComparison& c) {
     c.reason = "no point has a leave-one-out error under both methods; the cubic is the simpler";
     return;
   }
-  const bool spline_better = c.bspline_loo_common.rms_um < c.cubic_loo_common.rms_um;
+  // A tie (within 1e-6 um, e.g. both exact on a cubic field) goes to the simpler cubic.
+  const bool spline_better = c.bspline_loo_common.rms_um < c.cubic_loo_common.rms_um - 1e-6;
   c.recommended = spline_better ? Method::kBspline : Method::kCubic;
   c.reason = std::string(spline_better ? "bspline" : "cubic") +
              ": lower leave-one-out RMS on the " + std::to_string(c.cubic_loo_common.count) +
@@ -115,6 +125,8 @@ void ChoiceOptions::Validate() const {
     throw InputError("edge_ratio " + FormatNumber(edge_ratio) + " must be > 1");
   if (!(overshoot_fraction > 0))
     throw InputError("overshoot_fraction " + FormatNumber(overshoot_fraction) + " must be > 0");
+  if (!(min_excess_um >= 0))
+    throw InputError("min_excess_um " + FormatNumber(min_excess_um) + " must be >= 0");
   if (map_samples < 2 || map_samples > 1001)
     throw InputError("map_samples " + std::to_string(map_samples) + " is outside 2..1001");
 }

@@ -12,7 +12,9 @@
 //   - the oscillation note for the cubic, raised when either
 //       edge LOO RMS > edge_ratio x interior LOO RMS (edge points: on the bounding box), or
 //       the cubic leaves the measured range [min, max] on a samples x samples map of the box by
-//       more than overshoot_fraction x (max - min) (overshoot_um below).
+//       more than overshoot_fraction x (max - min) (overshoot_um below; a cubic overshoots where
+//       it swings between points, mostly at the edges),
+//     and in either case by more than min_excess_um (so noise-free fits are never flagged).
 #include <string>
 #include <vector>
 
@@ -25,6 +27,7 @@ struct ChoiceOptions {
   double edge_ratio = 1.5;          ///< edge/interior LOO RMS ratio that flags oscillation (> 1)
   double overshoot_fraction = 0.1;  ///< overshoot / measured range that flags it (> 0)
   int map_samples = 101;            ///< map points per direction for the overshoot (2..1001)
+  double min_excess_um = 0.5;       ///< smallest excess that flags oscillation, um (>= 0)
   void Validate() const;
 };
 

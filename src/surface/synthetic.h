@@ -6,9 +6,9 @@
 //   smooth(x, y) = 10 + 10 s + 6 t + 4 s^2 + 3 s t - 2 t^2 + 5 s^3 + 2 s t^2   um
 //                  (linear, quadratic and cubic parts; 10 um at (0, 0), 38 um at (1, 1))
 //   bump(x, y)   = smooth(x, y) + A exp(-((x - x0)^2 + (y - y0)^2) / (2 sigma^2))
-//                  A = bump_um (default 12 um), (x0, y0) = (0.7 length_x, 0.35 length_y),
+//                  A = bump_um (default 15 um), (x0, y0) = (0.7 length_x, 0.35 length_y),
 //                  sigma = bump_sigma_fraction * length_x (default 0.1): a local hot spot
-//   measured     = field + noise, noise ~ Normal(0, noise_um^2) (default 1.5 um), drawn with
+//   measured     = field + noise, noise ~ Normal(0, noise_um^2) (default 1 um), drawn with
 //                  sim::Rng(seed) (deterministic across standard libraries), row by row.
 // Points: an nx x ny grid from (0, 0) to (length_x, length_y), evenly spaced, row by row (y outer).
 #include <cstdint>
@@ -30,8 +30,8 @@ struct SyntheticOptions {
   double length_y_mm = 500;          ///< table travel in Y, mm (> 0)
   int nx = 9;                        ///< grid columns (2..kMaxGridLines)
   int ny = 7;                        ///< grid rows (2..kMaxGridLines)
-  double noise_um = 1.5;             ///< standard deviation of the noise, um (0..10)
-  double bump_um = 12;               ///< bump amplitude, um (0..100)
+  double noise_um = 1.0;             ///< standard deviation of the noise, um (0..10)
+  double bump_um = 15;               ///< bump amplitude, um (0..100)
   double bump_sigma_fraction = 0.1;  ///< bump width / length_x (0.01..1)
   std::uint64_t seed = 1;
   void Validate() const;  ///< InputError naming the field

@@ -230,7 +230,9 @@ TEST(Bspline, ReproducesPolynomialsUpToItsDegree) {
       }
       // The leave-line-out prediction reproduces it too (where defined).
       for (double e : fit.loo_error_um) {
-        if (!std::isnan(e)) EXPECT_NEAR(e, 0, 1e-8);
+        if (!std::isnan(e)) {
+          EXPECT_NEAR(e, 0, 1e-8);
+        }
       }
     }
 }
