@@ -21,6 +21,12 @@ std::string Fixed(double x, int decimals) {
   return buf;
 }
 
+std::string Sci(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
 std::string GridData(const SurfaceFit& fit, int n) {
   const Bounds& b = fit.surface.bounds;
   std::ostringstream s;
@@ -52,16 +58,16 @@ std::string MapScript(const SurfaceReportOptions& o, const std::string& terminal
   s << "# gnuplot script written by whirl surface; re-run with: gnuplot map.gp\n"
     << "set terminal " << terminal << "\n"
     << "set output 'map.png.tmp'\n"
-    << "set title " << GnuplotString(o.title + "\n" + subtitle) << " noenhanced\n"
+    << "set title " << GnuplotString(o.title + ": " + subtitle) << " noenhanced\n"
     << "set xlabel 'X [mm]'\nset ylabel 'Y [mm]'\nset cblabel 'thermal error [um]'\n"
     << "set view map\nset size ratio -1\nset palette rgbformulae 33,13,10\n"
     << "set contour base\nset cntrparam levels auto 12\nunset clabel\n"
-    << "set key outside bottom center horizontal noenhanced\n"
+    << "unset key\n"
     << "set datafile separator whitespace\n"
     << "splot 'surface_grid.dat' using 1:2:3 with pm3d nocontours notitle, \\\n"
     << "  '' using 1:2:3 nosurface with lines lc rgb '#202020' notitle, \\\n"
     << "  'points.dat' using 1:2:3 nocontours with points pt 7 ps 1.3 "
-       "lc rgb 'black' title 'measured points'\n"
+       "lc rgb 'black' notitle\n"
     << "set output\n";
   return s.str();
 }
@@ -77,7 +83,7 @@ bool Render(const fs::path& dir, const SurfaceReportOptions& o, SurfaceReportRes
     r.warnings.push_back("gnuplot ('" + o.gnuplot_command + "') not found: map skipped");
     return false;
   }
-  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, dir, dir / "gnuplot.log");
+  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, dir, fs::absolute(dir / "gnuplot.log"));
   std::error_code ec;
   if (rc != 0 || !fs::exists(dir / "map.png.tmp")) {
     fs::remove(dir / "map.png.tmp", ec);
@@ -99,8 +105,7 @@ std::string SummaryHtml(const SurfaceFit& f) {
   h << "</td></tr>\n<tr><th>points</th><td>" << f.points.size() << "</td></tr>\n"
     << "<tr><th>condition number</th><td>" << Fixed(f.condition_number, 1);
   if (f.surface.method == Method::kCubic)
-    h << " (normalized coordinates; " << HtmlEscape(FormatNumber(f.condition_number_mm))
-      << " in raw mm)";
+    h << " (normalized coordinates; " << Sci(f.condition_number_mm) << " in raw mm)";
   h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << Fixed(res.rms_um, 3) << " / "
     << Fixed(res.max_abs_um, 3) << " um</td></tr>\n"
     << "<tr><th>leave-one-out RMS / max</th><td>" << Fixed(loo.rms_um, 3) << " / "
@@ -194,7 +199,7 @@ SurfaceReportResult WriteSurfaceReport(const fs::path& dir, const SurfaceFit& fi
   SurfaceReportResult r;
   const Bounds& b = fit.surface.bounds;
   const std::string subtitle = ToString(fit.surface.method) + " surface, " +
-                               std::to_string(fit.points.size()) + " measured points";
+                               std::to_string(fit.points.size()) + " measured points (black dots)";
   const bool flat = b.x_max_mm <= b.x_min_mm || b.y_max_mm <= b.y_min_mm;
   WriteFileAtomic(dir / "surface_grid.dat", GridData(fit, o.map_samples));
   std::vector<std::string> comments;

@@ -26,7 +26,7 @@ struct SurfaceReportOptions {
   std::vector<std::string> provenance;  ///< lines under the title (command, input files)
   bool plots = true;
   std::string gnuplot_command = "gnuplot";
-  int map_samples = 81;  ///< map grid points per direction (2..401)
+  int map_samples = 121;  ///< map grid points per direction (2..401)
 };
 
 struct SurfaceReportResult {

@@ -278,8 +278,10 @@ std::string FormatFitText(const SurfaceFit& f) {
       std::snprintf(buf, sizeof buf, "  a%d = %.6e\n", k, a[k]);
       s << buf;
     }
-    s << "  condition number " << Fixed(f.condition_number, 1) << " (normalized u, v), "
-      << FormatNumber(f.condition_number_mm) << " (raw mm)\n";
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%.1f (normalized u, v), %.3g (raw mm)", f.condition_number,
+                  f.condition_number_mm);
+    s << "  condition number " << buf << "\n";
   } else {
     const BsplineSurface& bs = f.surface.bspline;
     s << "  degree " << bs.degree << ", grid " << bs.grid_y.size() << " rows x " << bs.grid_x.size()
