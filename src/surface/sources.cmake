@@ -13,4 +13,12 @@ target_sources(whirl_surface PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/choice.cpp
   ${CMAKE_CURRENT_LIST_DIR}/line840d.cpp
   ${CMAKE_CURRENT_LIST_DIR}/synthetic.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/report.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/report.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/per_point.cpp)
+# Per-point models from the drift module (issue 13), once src/drift is in the tree.
+if(EXISTS ${CMAKE_CURRENT_LIST_DIR}/../drift/model.h)
+  target_sources(whirl_surface PRIVATE ${CMAKE_CURRENT_LIST_DIR}/drift_adapter.cpp)
+  target_compile_definitions(whirl_surface PUBLIC WHIRL_HAVE_DRIFT=1)
+else()
+  message(STATUS "whirl: src/drift not in the tree: surface per-point models from drift disabled")
+endif()
