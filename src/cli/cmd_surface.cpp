@@ -15,6 +15,10 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "surface/choice.h"
+#ifdef WHIRL_HAVE_DRIFT
+#include "drift/run_file.h"
+#include "surface/drift_adapter.h"
+#endif
 #include "surface/line840d.h"
 #include "surface/report.h"
 #include "surface/surface.h"
@@ -307,6 +311,106 @@ void SetupLine(CLI::App& parent) {
   sub->callback([o] { RunLine(*o); });
 }
 
+// --- points (per-point models, seed 003's first step) -----------------------------------------
+
+struct PointsCli {
+  std::string run, manifest, method = "cubic", out, predictions, state = "cutting";
+  std::vector<std::string> train, sensors;
+  double time_min = NAN;
+  int degree = 3;
+  bool json = false;
+};
+
+#ifdef WHIRL_HAVE_DRIFT
+void RunPoints(const PointsCli& o) {
+  const drift::RunState state = drift::ParseRunState(o.state);
+  const drift::Run target = drift::ReadRun(o.run, state);
+  std::vector<drift::Run> training;
+  for (const auto& t : o.train) training.push_back(drift::ReadRun(t, state));
+  if (training.empty()) training.push_back(target);
+  const auto points = o.manifest.empty() ? PointColumnsFromHeader(target.error_names, o.run)
+                                         : ReadPointManifest(o.manifest, target.error_names);
+  drift::FitOptions fo;
+  fo.sensors = o.sensors;
+  DriftPointNotes notes;
+  std::cerr << "fitting " << points.size() << " per-point models\n";
+  const PointPredictions p =
+      PredictAllPoints(points, DriftPointModel(training, target, fo, &notes), 0);
+  const std::size_t k = NearestSample(target.time_min, o.time_min);
+  SurfaceFit fit = FitSurface(PointsAtSample(p, k), {ParseMethod(o.method), o.degree});
+  fit.provenance = {
+      "whirl surface points --run " + o.run + " at time " + FormatNumber(target.time_min[k]) +
+          (target.time_from_index ? " (sample index)" : " min"),
+      "per-point models: " +
+          std::string(o.sensors.empty() ? "seed 000 selection + " : "given sensors, ") +
+          "MLR (src/drift), trained on " +
+          (o.train.empty() ? o.run : std::to_string(o.train.size()) + " run(s)")};
+  for (const auto& pc : points)
+    fit.provenance.push_back(pc.column + ": " + notes.by_column[pc.column]);
+  if (!o.predictions.empty()) {
+    std::vector<std::string> header{target.time_from_index ? "sample" : "time_min"};
+    for (const auto& pc : points) header.push_back(pc.column);
+    std::vector<std::vector<double>> rows;
+    for (Eigen::Index r = 0; r < p.predicted_um.rows(); ++r) {
+      rows.push_back({target.time_min[static_cast<std::size_t>(r)]});
+      for (Eigen::Index c = 0; c < p.predicted_um.cols(); ++c)
+        rows.back().push_back(p.predicted_um(r, c));
+    }
+    WriteFileAtomic(o.predictions,
+                    FormatCsv(header, rows, {" per-point predictions, whirl surface points"}));
+  }
+  if (!o.out.empty()) WriteJsonFile(o.out, SurfaceFitToJson(fit));
+  if (o.json) {
+    PrintJson(SurfaceFitToJson(fit));
+    return;
+  }
+  for (const auto& line : fit.provenance) std::printf("%s\n", line.c_str());
+  std::printf("%s", FormatFitText(fit).c_str());
+}
+#else
+void RunPoints(const PointsCli&) {
+  throw InputError(
+      "surface points: per-point models need the drift module (src/drift, issue 13), which is "
+      "not in this build");
+}
+#endif
+
+void SetupPoints(CLI::App& parent) {
+  auto o = std::make_shared<PointsCli>();
+  auto* sub = parent.add_subcommand(
+      "points",
+      "Per-point models, then a surface (seed 003): each error column of a position-tagged run\n"
+      "file (drift run format: time_s|time_min, *_C temperatures, *_um errors, each error\n"
+      "column named <name>_x<X>_y<Y>_um with X, Y in mm, or placed by --manifest) gets its own\n"
+      "model from its sensitive temperatures (seed 000 selection + MLR, src/drift) fitted on\n"
+      "--train runs (default: the run itself); the P predictions at --time-min become the points\n"
+      "of a cubic or B-spline surface (as 'surface fit').");
+  sub->add_option("--run", o->run, "run file to predict (CSV)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--train", o->train, "training run file(s) (default: --run itself)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--manifest", o->manifest, "JSON placing error columns (surface/per_point.h)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--state", o->state,
+                  "idle | cutting | unknown: state of the runs (default cutting)")
+      ->check(CLI::IsMember({"idle", "cutting", "unknown"}));
+  sub->add_option("--sensors", o->sensors,
+                  "temperature columns to use (default: seed 000 selection)")
+      ->delimiter(',');
+  sub->add_option("--time-min", o->time_min, "moment of the surface, min (nearest sample)")
+      ->required();
+  sub->add_option("--method", o->method, "cubic | bspline (default cubic)")
+      ->check(CLI::IsMember({"cubic", "bspline"}));
+  sub->add_option("--degree", o->degree, "B-spline degree (1..5, default 3)")
+      ->check(CLI::Range(1, kMaxDegree));
+  sub->add_option("--out", o->out, "surface JSON to write");
+  sub->add_option("--predictions", o->predictions,
+                  "CSV of every point's prediction per sample, um");
+  sub->add_flag("--json", o->json, "machine output: the surface JSON on stdout");
+  sub->callback([o] { RunPoints(*o); });
+}
+
 }  // namespace
 
 void RegisterSurface(CLI::App& app) {
@@ -321,6 +425,7 @@ void RegisterSurface(CLI::App& app) {
   SetupPredict(*sub);
   SetupCompare(*sub);
   SetupLine(*sub);
+  SetupPoints(*sub);
 }
 
 }  // namespace whirl::cli
