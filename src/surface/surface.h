@@ -3,8 +3,9 @@
 // src/surface.
 //
 // Seed 003 measures the thermal error at P points of the table, builds a model per point from its
-// sensitive temperatures (surface/per_point.h), and at any moment turns the P predicted errors into
-// a surface over the table, so the error is known at every position:
+// sensitive temperatures (surface/per_point.h; the models themselves come from src/drift through
+// surface/drift_adapter.h), and at any moment turns the P predicted errors into a surface over
+// the table, so the error is known at every position:
 //   - a cubic polynomial in X and Y, 10 coefficients by least squares (surface/cubic.h), for a
 //     smooth, low-order field (scattered points allowed);
 //   - a tensor-product B-spline interpolating a rectangular M x N grid (surface/bspline.h), where
@@ -17,10 +18,11 @@
 // Units everywhere: positions in mm (x_mm, y_mm), errors in um (error_um).
 // Surface file (JSON, schema "whirl.surface", schema_version 1):
 //   method "cubic" | "bspline"; bounds {x_min_mm, x_max_mm, y_min_mm, y_max_mm} of the points;
-//   cubic: {x_center_mm, y_center_mm, x_half_range_mm, y_half_range_mm, b (10, normalized),
-//           a_mm (10, the seed's form in mm), condition_number, condition_number_mm};
+//   cubic: {terms (text), x_center_mm, y_center_mm, x_half_range_mm, y_half_range_mm, b_um (10,
+//           in the normalized u, v), a_mm (10, the seed's form in mm), condition_number,
+//           condition_number_mm};
 //   bspline: {degree, grid_x_mm (N), grid_y_mm (M), knots_x_mm, knots_y_mm, weights_um (M rows
-//           of N)};
+//           of N), condition_number};
 //   points [{x_mm, y_mm, error_um, fitted_um, residual_um, loo_error_um (null: undefined)}];
 //   summary {rms_residual_um, max_abs_residual_um, loo_rms_um, loo_max_abs_um, loo_count};
 //   provenance [strings].
