@@ -180,14 +180,13 @@ void RunPredict(const PredictCli& o) {
       single ? std::vector<std::pair<double, double>>{{o.x, o.y}} : ReadPositions(o.input);
   const auto p = Predict(s, xy);
   std::size_t outside = 0;
-  std::vector<std::vector<double>> rows;
-  for (const auto& q : p) outside += q.inside ? 0 : 1, rows.push_back({q.x_mm, q.y_mm, q.error_um});
+  for (const auto& q : p) outside += q.inside ? 0 : 1;
   if (outside)
     Warn(std::to_string(outside) + " of " + std::to_string(p.size()) +
          " positions lie outside the measured rectangle: the cubic extrapolates there");
   if (!o.out.empty())
-    WriteFileAtomic(o.out, FormatCsv({"x_mm", "y_mm", "error_um"}, rows,
-                                     {" predicted by whirl surface predict from " + o.surface}));
+    WriteFileAtomic(
+        o.out, FormatPredictionsCsv(p, {" predicted by whirl surface predict from " + o.surface}));
   if (o.json) {
     PrintJson(PredictionsToJson(s, p));
     return;
@@ -347,18 +346,11 @@ void RunPoints(const PointsCli& o) {
           (o.train.empty() ? o.run : std::to_string(o.train.size()) + " run(s)")};
   for (const auto& pc : points)
     fit.provenance.push_back(pc.column + ": " + notes.by_column[pc.column]);
-  if (!o.predictions.empty()) {
-    std::vector<std::string> header{target.time_from_index ? "sample" : "time_min"};
-    for (const auto& pc : points) header.push_back(pc.column);
-    std::vector<std::vector<double>> rows;
-    for (Eigen::Index r = 0; r < p.predicted_um.rows(); ++r) {
-      rows.push_back({target.time_min[static_cast<std::size_t>(r)]});
-      for (Eigen::Index c = 0; c < p.predicted_um.cols(); ++c)
-        rows.back().push_back(p.predicted_um(r, c));
-    }
+  if (!o.predictions.empty())
     WriteFileAtomic(o.predictions,
-                    FormatCsv(header, rows, {" per-point predictions, whirl surface points"}));
-  }
+                    FormatPointPredictionsCsv(
+                        p, target.time_min, target.time_from_index ? "sample" : "time_min",
+                        {" per-point predictions, whirl surface points --run " + o.run}));
   if (!o.out.empty()) WriteJsonFile(o.out, SurfaceFitToJson(fit));
   if (o.json) {
     PrintJson(SurfaceFitToJson(fit));

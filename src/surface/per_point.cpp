@@ -113,6 +113,25 @@ std::vector<SurfacePoint> PointsAtSample(const PointPredictions& p, std::size_t 
   return out;
 }
 
+std::string FormatPointPredictionsCsv(const PointPredictions& p, const std::vector<double>& times,
+                                      const std::string& time_header,
+                                      const std::vector<std::string>& comments) {
+  if (times.size() != static_cast<std::size_t>(p.predicted_um.rows()))
+    throw InputError("per-point predictions: " + std::to_string(times.size()) + " times for " +
+                     std::to_string(p.predicted_um.rows()) + " samples");
+  std::vector<std::string> header{time_header};
+  for (const auto& pc : p.points) header.push_back(pc.column);
+  std::vector<std::vector<double>> rows;
+  for (Eigen::Index r = 0; r < p.predicted_um.rows(); ++r) {
+    rows.push_back({times[static_cast<std::size_t>(r)]});
+    for (Eigen::Index c = 0; c < p.predicted_um.cols(); ++c)
+      rows.back().push_back(p.predicted_um(r, c));
+  }
+  std::vector<std::string> lines;
+  for (const auto& c : comments) lines.push_back(OneLine(c));
+  return FormatCsv(header, rows, lines);
+}
+
 std::size_t NearestSample(const std::vector<double>& times, double time) {
   if (times.empty()) throw InputError("no samples to pick a time from");
   std::size_t best = 0;

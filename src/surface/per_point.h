@@ -64,6 +64,11 @@ PointPredictions PredictAllPoints(const std::vector<PointColumn>& points, const 
 /// The surface's input at one target sample: the P predicted errors at their positions.
 std::vector<SurfacePoint> PointsAtSample(const PointPredictions& p, std::size_t sample);
 
+/// CSV of every point's prediction per sample: <time_header>,<column 1>,... (um), with '#' lines.
+std::string FormatPointPredictionsCsv(const PointPredictions& p, const std::vector<double>& times,
+                                      const std::string& time_header,
+                                      const std::vector<std::string>& comments);
+
 /// Index of the sample whose time is nearest to `time` (ties: the earlier); InputError if empty.
 std::size_t NearestSample(const std::vector<double>& times, double time);
 

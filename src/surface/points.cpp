@@ -92,11 +92,19 @@ std::size_t CountDistinctPositions(const std::vector<SurfacePoint>& points) {
   return distinct;
 }
 
+std::string OneLine(std::string text) {
+  for (char& ch : text)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
+  return text;
+}
+
 std::string FormatPointsCsv(const std::vector<SurfacePoint>& points,
                             const std::vector<std::string>& comments) {
   std::vector<std::vector<double>> rows;
   for (const auto& p : points) rows.push_back({p.x_mm, p.y_mm, p.error_um});
-  return FormatCsv({"x_mm", "y_mm", "error_um"}, rows, comments);
+  std::vector<std::string> lines;
+  for (const auto& c : comments) lines.push_back(OneLine(c));
+  return FormatCsv({"x_mm", "y_mm", "error_um"}, rows, lines);
 }
 
 }  // namespace whirl::surface

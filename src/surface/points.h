@@ -53,7 +53,11 @@ void CheckPosition(double x_mm, double y_mm, const std::string& where);
 /// Number of distinct positions (coordinates equal within kSamePositionMm are one position).
 std::size_t CountDistinctPositions(const std::vector<SurfacePoint>& points);
 
-/// CSV text x_mm,y_mm,error_um with '#' comment lines.
+/// `text` on one line: every control character (newline, CR, tab, ...) becomes a space, so a user
+/// string (a path) cannot end a '#' comment line of a CSV and start a data row.
+std::string OneLine(std::string text);
+
+/// CSV text x_mm,y_mm,error_um with '#' comment lines (each through OneLine).
 std::string FormatPointsCsv(const std::vector<SurfacePoint>& points,
                             const std::vector<std::string>& comments = {});
 

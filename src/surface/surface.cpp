@@ -263,6 +263,13 @@ nlohmann::json PredictionsToJson(const Surface& surface, const std::vector<Predi
           {"extrapolated_count", outside},        {"predictions", rows}};
 }
 
+std::string FormatPredictionsCsv(const std::vector<PredictedPoint>& p,
+                                 const std::vector<std::string>& comments) {
+  std::vector<SurfacePoint> points;
+  for (const auto& q : p) points.push_back({q.x_mm, q.y_mm, q.error_um});
+  return FormatPointsCsv(points, comments);
+}
+
 std::string FormatFitText(const SurfaceFit& f) {
   std::ostringstream s;
   const Bounds& b = f.surface.bounds;

@@ -98,6 +98,9 @@ struct PredictedPoint {
 std::vector<PredictedPoint> Predict(const Surface& surface,
                                     const std::vector<std::pair<double, double>>& xy);
 nlohmann::json PredictionsToJson(const Surface& surface, const std::vector<PredictedPoint>& p);
+/// CSV x_mm,y_mm,error_um of predictions with '#' comment lines (each through OneLine).
+std::string FormatPredictionsCsv(const std::vector<PredictedPoint>& p,
+                                 const std::vector<std::string>& comments);
 
 /// Terminal text of a fit: method, coefficients or grid, condition, residual and LOO per point.
 std::string FormatFitText(const SurfaceFit& fit);

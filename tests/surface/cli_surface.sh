@@ -69,6 +69,23 @@ assert l['uncorrected_max_abs_um'] < 1e-9 and not l['slope_capped'], l
 [ -s rep/index.html ] && [ -s rep/map.gp ] || fail "report files"
 if command -v gnuplot > /dev/null; then [ -s rep/map.png ] || fail "no map.png"; fi
 
+# Hostile file names (quote, backslash, newline, markup) stay text in the page, the CSVs and gnuplot.
+evil=$'ev\'il\\ "x"\n<script>alert(1).csv'
+cp bump.csv "$evil"
+"$whirl" surface fit --points "$evil" --method cubic --out "$evil.json" --report rep2 > /dev/null \
+  2> rep2.err || fail "report with a hostile name: $(cat rep2.err)"
+! grep -q "<script>" rep2/index.html || fail "markup reached the page"
+grep -q "&lt;script&gt;" rep2/index.html || fail "name not shown escaped"
+"$whirl" surface predict --surface "$evil.json" --input xy.csv --out evil_pred.csv > /dev/null \
+  || fail "predict with a hostile name"
+python3 - <<'PY' || fail "hostile name broke a CSV"
+for name in ("rep2/points.csv", "evil_pred.csv"):
+    rows = [l for l in open(name) if not l.startswith("#")]
+    assert rows[0].strip() == "x_mm,y_mm,error_um", (name, rows[0])
+    assert all(len(r.split(",")) == 3 for r in rows), name
+PY
+if command -v gnuplot > /dev/null; then [ -s rep2/map.png ] || fail "no map with a hostile name"; fi
+
 # Bad input: exit 1, the message names the rule; nothing written.
 expect_fail "distinct positions" "$whirl" surface fit --points <(head -12 smooth.csv) \
   --method cubic --out none.json
