@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "core/csv.h"
 #include "core/error.h"
 #include "surface/per_point.h"
 #include "surface/surface.h"
@@ -94,6 +95,27 @@ TEST(PerPoint, ModelsThatDisagreeOnLengthOrGiveNanAreRefused) {
                                   throw InputError("model failed");
                                 }),
                InputError);  // a model's exception reaches the caller
+}
+
+}  // namespace
+}  // namespace whirl::surface
+
+namespace whirl::surface {
+namespace {
+
+TEST(PointsFile, LimitsAndMissingColumnsNameTheFileLineAndRule) {
+  try {
+    PointsFromTable(ParseCsv("x_mm,y_mm,error_um\n0,0,1\n0,200000,1\n", "p.csv"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.csv:3: column 'y_mm'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("beyond +-100000"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(PointsFromTable(ParseCsv("x_mm,error_um\n0,1\n", "p.csv")), InputError);
+  std::string big = "x_mm,y_mm,error_um\n";
+  for (std::size_t k = 0; k <= kMaxPoints; ++k) big += "0,0,0\n";
+  EXPECT_THROW(PointsFromTable(ParseCsv(big, "big.csv")), InputError);
+  EXPECT_EQ(OneLine("a\nb\rc\td"), "a b c d");
 }
 
 }  // namespace
