@@ -324,3 +324,41 @@ TEST(SurfaceFile, RoundTripsBothMethodsAndRejectsTamperedKnots) {
 
 }  // namespace
 }  // namespace whirl::surface
+
+namespace whirl::surface {
+namespace {
+
+// The B-spline LOO of an interior node, rebuilt from the public API: the mean of the surfaces
+// fitted without the node's row and without its column, evaluated at the node.
+TEST(Bspline, LeaveOneOutIsTheMeanOfTheRowAndColumnRefits) {
+  std::mt19937_64 rng(41);
+  std::normal_distribution<double> n01;
+  const std::vector<double> xs{0, 90, 200, 330, 400, 520}, ys{0, 70, 150, 260, 300};
+  std::vector<SurfacePoint> pts;
+  for (double y : ys)
+    for (double x : xs) pts.push_back({x, y, 20 + 5 * n01(rng)});
+  const BsplineFit fit = FitBsplinePoints(pts, 2);
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const auto& p = pts[k];
+    std::vector<double> preds;
+    for (int drop_row = 0; drop_row < 2; ++drop_row) {
+      const auto& lines = drop_row ? ys : xs;
+      const double c = drop_row ? p.y_mm : p.x_mm;
+      if (c == lines.front() || c == lines.back()) continue;  // would extrapolate
+      std::vector<SurfacePoint> rest;
+      for (const auto& q : pts)
+        if ((drop_row ? q.y_mm : q.x_mm) != c) rest.push_back(q);
+      preds.push_back(FitBsplinePoints(rest, 2).surface.Evaluate(p.x_mm, p.y_mm));
+    }
+    if (preds.empty()) {
+      EXPECT_TRUE(std::isnan(fit.loo_error_um[k])) << k;
+    } else {
+      double mean = 0;
+      for (double v : preds) mean += v / static_cast<double>(preds.size());
+      EXPECT_NEAR(fit.loo_error_um[k], p.error_um - mean, 1e-9) << k;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace whirl::surface
