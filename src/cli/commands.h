@@ -21,5 +21,6 @@ void RegisterExport(CLI::App& app);      // cmd_export.cpp (in whirl-torch only)
 void RegisterTorchForwarders(CLI::App& app);
 void RegisterDemo(CLI::App& app);        // cmd_demo.cpp
 void RegisterBallbar(CLI::App& app);     // cmd_ballbar.cpp
+void RegisterSurface(CLI::App& app);     // cmd_surface.cpp
 
 }  // namespace whirl::cli

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   RegisterLeadReport(app);
   RegisterEvaluate(app);
   RegisterBallbar(app);
+  RegisterSurface(app);
   RegisterTorchForwarders(app);
   return RunApp(app, argc, argv);
 }

@@ -1,0 +1,219 @@
+#include "surface/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
+
+namespace whirl::surface {
+namespace fs = std::filesystem;
+namespace {
+
+std::string Fixed(double x, int decimals) {
+  if (std::isnan(x)) return "-";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+  return buf;
+}
+
+std::string Sci(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+std::string GridData(const SurfaceFit& fit, int n) {
+  const Bounds& b = fit.surface.bounds;
+  std::ostringstream s;
+  s.precision(10);
+  s << "# x_mm y_mm error_um: the " << ToString(fit.surface.method) << " surface on a " << n
+    << " x " << n << " map\n";
+  for (int i = 0; i < n; ++i) {
+    const double y = b.y_min_mm + (b.y_max_mm - b.y_min_mm) * i / (n - 1);
+    for (int j = 0; j < n; ++j) {
+      const double x = b.x_min_mm + (b.x_max_mm - b.x_min_mm) * j / (n - 1);
+      s << x << ' ' << y << ' ' << fit.surface.Evaluate(x, y) << '\n';
+    }
+    s << '\n';
+  }
+  return s.str();
+}
+
+std::string PointsData(const SurfaceFit& fit) {
+  std::ostringstream s;
+  s.precision(10);
+  s << "# x_mm y_mm error_um: the measured points\n";
+  for (const auto& p : fit.points) s << p.x_mm << ' ' << p.y_mm << ' ' << p.error_um << '\n';
+  return s.str();
+}
+
+std::string MapScript(const SurfaceReportOptions& o, const std::string& terminal,
+                      const std::string& subtitle) {
+  std::ostringstream s;
+  s << "# gnuplot script written by whirl surface; re-run with: gnuplot map.gp\n"
+    << "set terminal " << terminal << "\n"
+    << "set output 'map.png.tmp'\n"
+    << "set title " << GnuplotString(o.title + ": " + subtitle) << " noenhanced\n"
+    << "set xlabel 'X [mm]'\nset ylabel 'Y [mm]'\nset cblabel 'thermal error [um]'\n"
+    << "set view map\nset size ratio -1\nset palette rgbformulae 33,13,10\n"
+    << "set contour base\nset cntrparam levels auto 12\nunset clabel\n"
+    << "unset key\n"
+    << "set datafile separator whitespace\n"
+    << "splot 'surface_grid.dat' using 1:2:3 with pm3d nocontours notitle, \\\n"
+    << "  '' using 1:2:3 nosurface with lines lc rgb '#202020' notitle, \\\n"
+    << "  'points.dat' using 1:2:3 nocontours with points pt 7 ps 1.3 "
+       "lc rgb 'black' notitle\n"
+    << "set output\n";
+  return s.str();
+}
+
+std::string Terminal(const std::string& gnuplot) {
+  const bool cairo = ProgramSucceeds({gnuplot, "-e", "set terminal pngcairo"});
+  return cairo ? "pngcairo size 1000,700 font 'Sans,10' noenhanced"
+               : "png size 1000,700 noenhanced";
+}
+
+bool Render(const fs::path& dir, const SurfaceReportOptions& o, SurfaceReportResult& r) {
+  if (!ProgramSucceeds({o.gnuplot_command, "--version"})) {
+    r.warnings.push_back("gnuplot ('" + o.gnuplot_command + "') not found: map skipped");
+    return false;
+  }
+  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, dir, fs::absolute(dir / "gnuplot.log"));
+  std::error_code ec;
+  if (rc != 0 || !fs::exists(dir / "map.png.tmp")) {
+    fs::remove(dir / "map.png.tmp", ec);
+    r.warnings.push_back("gnuplot failed (exit " + std::to_string(rc) +
+                         "), see gnuplot.log: map skipped");
+    return false;
+  }
+  fs::rename(dir / "map.png.tmp", dir / "map.png", ec);
+  if (ec) throw InputError("cannot rename the map into '" + (dir / "map.png").string() + "'");
+  r.files.push_back(dir / "map.png");
+  return true;
+}
+
+std::string SummaryHtml(const SurfaceFit& f) {
+  const ErrorStats res = StatsOf(f.residual_um), loo = StatsOf(f.loo_error_um);
+  std::ostringstream h;
+  h << "<table><tr><th>method</th><td>" << ToString(f.surface.method);
+  if (f.surface.method == Method::kBspline) h << ", degree " << f.surface.bspline.degree;
+  h << "</td></tr>\n<tr><th>points</th><td>" << f.points.size() << "</td></tr>\n"
+    << "<tr><th>condition number</th><td>" << Fixed(f.condition_number, 1);
+  if (f.surface.method == Method::kCubic)
+    h << " (normalized coordinates; " << Sci(f.condition_number_mm) << " in raw mm)";
+  h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << Fixed(res.rms_um, 3) << " / "
+    << Fixed(res.max_abs_um, 3) << " um</td></tr>\n"
+    << "<tr><th>leave-one-out RMS / max</th><td>" << Fixed(loo.rms_um, 3) << " / "
+    << Fixed(loo.max_abs_um, 3) << " um over " << loo.count << " points</td></tr>\n</table>\n";
+  if (f.surface.method == Method::kCubic) {
+    const auto a = f.surface.cubic.CoefficientsMm();
+    h << "<p>dE = a0 + a1 X + a2 Y + a3 X&sup2; + a4 XY + a5 Y&sup2; + a6 X&sup3; + a7 X&sup2;Y + "
+         "a8 XY&sup2; + a9 Y&sup3; (um, X and Y in mm)</p>\n<table><tr>";
+    for (int k = 0; k < kCubicTerms; ++k) h << "<th>a" << k << "</th>";
+    h << "</tr><tr>";
+    for (int k = 0; k < kCubicTerms; ++k) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.4e", a[k]);
+      h << "<td>" << buf << "</td>";
+    }
+    h << "</tr></table>\n";
+  }
+  return h.str();
+}
+
+std::string LinesHtml(const std::vector<AxisLine>& lines) {
+  if (lines.empty()) return "";
+  std::ostringstream h;
+  h << "<h2>840D: the least-squares line per axis (what temperature compensation can apply)</h2>\n"
+       "<table><tr><th>axis</th><th>along</th><th>SD43900 [mm]</th><th>SD43910</th>"
+       "<th>SD43920 [mm]</th><th>error max / RMS [um]</th><th>left by the line max / RMS "
+       "[um]</th></tr>\n";
+  for (const auto& l : lines)
+    h << "<tr><td>" << HtmlEscape(l.options.axis) << "</td><td>" << l.options.along << "</td><td>"
+      << Fixed(l.sd43900_mm, 6) << "</td><td>" << Fixed(l.sd43910, 8)
+      << (l.slope_capped ? " (capped)" : "") << "</td><td>" << Fixed(l.sd43920_mm, 4) << "</td><td>"
+      << Fixed(l.error_max_abs_um, 2) << " / " << Fixed(l.error_rms_um, 2) << "</td><td>"
+      << Fixed(l.uncorrected_max_abs_um, 2) << " / " << Fixed(l.uncorrected_rms_um, 2)
+      << "</td></tr>\n";
+  h << "</table>\n<p class='small'>sign " << interp::ToString(lines[0].options.sign)
+    << " (dK = s &middot; line / 1000, interp/sinumerik.h); check it on the machine.</p>\n";
+  return h.str();
+}
+
+std::string PointsHtml(const SurfaceFit& f) {
+  std::ostringstream h;
+  h << "<h2>Measured points</h2>\n<table><tr><th>#</th><th>x [mm]</th><th>y [mm]</th>"
+       "<th>error [um]</th><th>fitted [um]</th><th>residual [um]</th><th>leave-one-out "
+       "error [um]</th></tr>\n";
+  for (std::size_t k = 0; k < f.points.size(); ++k)
+    h << "<tr><td>" << k + 1 << "</td><td>" << Fixed(f.points[k].x_mm, 2) << "</td><td>"
+      << Fixed(f.points[k].y_mm, 2) << "</td><td>" << Fixed(f.points[k].error_um, 3) << "</td><td>"
+      << Fixed(f.fitted_um[k], 3) << "</td><td>" << Fixed(f.residual_um[k], 3) << "</td><td>"
+      << Fixed(f.loo_error_um[k], 3) << "</td></tr>\n";
+  h << "</table>\n";
+  return h.str();
+}
+
+std::string PageHtml(const SurfaceFit& f, const MethodComparison* choice,
+                     const std::vector<AxisLine>& lines, const SurfaceReportOptions& o,
+                     bool have_map, const std::vector<std::string>& warnings) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << HtmlEscape(o.title)
+    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
+       "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+       "text-align:right}th{background:#eee}.small{font-size:90%;color:#444}pre{background:#f6f6f6;"
+       "padding:8px;white-space:pre-wrap}</style></head><body>\n<h1>"
+    << HtmlEscape(o.title) << "</h1>\n";
+  for (const auto& p : o.provenance) h << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
+  for (const auto& w : warnings) h << "<p><b>warning:</b> " << HtmlEscape(w) << "</p>\n";
+  if (have_map)
+    h << "<p><img src='map.png' alt='map of the thermal error over the table' width='1000'></p>\n";
+  h << "<h2>Fit</h2>\n" << SummaryHtml(f);
+  if (choice)
+    h << "<h2>Cubic polynomial or B-spline</h2>\n<pre>" << HtmlEscape(FormatComparisonText(*choice))
+      << "</pre>\n";
+  h << LinesHtml(lines) << PointsHtml(f)
+    << "<p class='small'>Files: surface_grid.dat, points.csv, points.dat, map.gp (re-plot with "
+       "gnuplot "
+       "map.gp).</p>\n</body></html>\n";
+  return h.str();
+}
+
+}  // namespace
+
+SurfaceReportResult WriteSurfaceReport(const fs::path& dir, const SurfaceFit& fit,
+                                       const MethodComparison* choice,
+                                       const std::vector<AxisLine>& lines,
+                                       const SurfaceReportOptions& o) {
+  if (o.map_samples < 2 || o.map_samples > 401)
+    throw InputError("map samples " + std::to_string(o.map_samples) + " is outside 2..401");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw InputError("cannot create the report directory '" + dir.string() + "'");
+  SurfaceReportResult r;
+  const Bounds& b = fit.surface.bounds;
+  const std::string subtitle = ToString(fit.surface.method) + " surface, " +
+                               std::to_string(fit.points.size()) + " measured points (black dots)";
+  const bool flat = b.x_max_mm <= b.x_min_mm || b.y_max_mm <= b.y_min_mm;
+  WriteFileAtomic(dir / "surface_grid.dat", GridData(fit, o.map_samples));
+  std::vector<std::string> comments;
+  for (const auto& p : o.provenance) comments.push_back(" " + p);
+  WriteFileAtomic(dir / "points.csv", FormatPointsCsv(fit.points, comments));
+  WriteFileAtomic(dir / "points.dat", PointsData(fit));
+  WriteFileAtomic(dir / "map.gp", MapScript(o, Terminal(o.gnuplot_command), subtitle));
+  r.files = {dir / "surface_grid.dat", dir / "points.csv", dir / "points.dat", dir / "map.gp"};
+  if (o.plots && !flat) r.plot_rendered = Render(dir, o, r);
+  if (flat) r.warnings.push_back("the points span no rectangle: map skipped");
+  r.index_html = dir / "index.html";
+  WriteFileAtomic(r.index_html, PageHtml(fit, choice, lines, o, r.plot_rendered, r.warnings));
+  r.files.push_back(r.index_html);
+  return r;
+}
+
+}  // namespace whirl::surface
