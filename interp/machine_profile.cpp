@@ -43,8 +43,8 @@ MachineProfile LoadMachineProfile(const std::filesystem::path& path) {
   if (!j.is_object()) throw InputError(what + ": must be a JSON object");
   RejectUnknownKeys(j,
                     {"schema", "schema_version", "name", "axis", "direction", "machine_offset_mm",
-                     "start_position_mm", "control_dk", "md32760", "sync_id_first",
-                     "sync_id_last", "save_r_first"},
+                     "start_position_mm", "control_dk", "md32760", "sync_id_first", "sync_id_last",
+                     "save_r_first"},
                     what);
   if (RequireString(j, "schema", what) != MachineProfile::kSchema)
     throw InputError(what + ": 'schema' must be \"" + std::string(MachineProfile::kSchema) + "\"");

@@ -127,7 +127,8 @@ void PlanOptions::Validate() const {
     throw InputError("md32760 = " + Num(md32760) + ": must be within (0, 0.10] (MD32760 range)");
   if (sign != ExpectedSign(direction, control_dk))
     throw InputError("sign '" + ToString(sign) + "' with direction " + std::to_string(direction) +
-                     " and control_dk '" + ToString(control_dk) + "': inconsistent; the growth "
+                     " and control_dk '" + ToString(control_dk) +
+                     "': inconsistent; the growth "
                      "points against the travel, so dK = -direction * l if the control adds dK "
                      "to the setpoint and +direction * l if it subtracts it (sign '" +
                      ToString(ExpectedSign(direction, control_dk)) + "' here)");
@@ -158,8 +159,10 @@ CompensationPlan BuildPlan(const CurveFunction& curve_um, double axial_feed_mm_s
   const double budget_um = RoundingBudgetUm(thread_length_mm, options.md32760);
   if (!(options.tolerance_um > 2.0 * budget_um))
     throw InputError("tolerance_um = " + Num(options.tolerance_um) + ": must exceed " +
-                     Num(2.0 * budget_um) + " um, twice what rounding the written setting data "
-                     "can cost over a " + Num(thread_length_mm) + " mm thread");
+                     Num(2.0 * budget_um) +
+                     " um, twice what rounding the written setting data "
+                     "can cost over a " +
+                     Num(thread_length_mm) + " mm thread");
   BreakpointOptions bo;
   bo.tolerance_um = options.tolerance_um - budget_um;
   bo.check_step_s = options.check_step_s;
@@ -221,26 +224,20 @@ void ValidatePlan(const CompensationPlan& plan) {
 // --- JSON ----------------------------------------------------------------------------------
 
 void to_json(nlohmann::json& j, const PlanOptions& o) {
-  j = nlohmann::json{{"tolerance_um", o.tolerance_um},
-                     {"axis", o.axis},
-                     {"start_position_mm", o.start_position_mm},
-                     {"direction", o.direction},
-                     {"machine_offset_mm", o.machine_offset_mm},
-                     {"sign", ToString(o.sign)},
-                     {"control_dk", ToString(o.control_dk)},
-                     {"md32760", o.md32760},
-                     {"check_step_s", o.check_step_s},
-                     {"sync_id_first", o.sync_id_first},
-                     {"sync_id_last", o.sync_id_last},
-                     {"save_r_first", o.save_r_first}};
+  j = nlohmann::json{{"tolerance_um", o.tolerance_um},           {"axis", o.axis},
+                     {"start_position_mm", o.start_position_mm}, {"direction", o.direction},
+                     {"machine_offset_mm", o.machine_offset_mm}, {"sign", ToString(o.sign)},
+                     {"control_dk", ToString(o.control_dk)},     {"md32760", o.md32760},
+                     {"check_step_s", o.check_step_s},           {"sync_id_first", o.sync_id_first},
+                     {"sync_id_last", o.sync_id_last},           {"save_r_first", o.save_r_first}};
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
-  RejectUnknownKeys(j,
-                    {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm",
-                     "sign", "control_dk", "md32760", "check_step_s", "sync_id_first",
-                     "sync_id_last", "save_r_first"},
-                    "plan settings");
+  RejectUnknownKeys(
+      j,
+      {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
+       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first"},
+      "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
   o.start_position_mm = j.at("start_position_mm").get<double>();
@@ -373,8 +370,8 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
                     FormatFixed(s.sd43900_mm, kDecimalsSd43900Mm),
                     FormatFixed(s.sd43910, kDecimalsSd43910), pos(s.sd43920_mm)});
   }
-  out += CsvLine({"restore", pos(ThreadEndMm(plan)), time(plan.cutting_time_s), "", pos(ThreadEndMm(plan)),
-                  "", "", "", "saved", "saved", "saved"});
+  out += CsvLine({"restore", pos(ThreadEndMm(plan)), time(plan.cutting_time_s), "",
+                  pos(ThreadEndMm(plan)), "", "", "", "saved", "saved", "saved"});
   return out;
 }
 
@@ -425,8 +422,8 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
      << FormatFixed(plan.max_abs_slope, kDecimalsSd43910)
      << " (largest |SD43910| here); plan checked against " << FormatFixed(o.md32760, 4) << "\n";
   nc << "; sign: " << ToString(o.sign) << " (dK = " << (o.sign == SignConvention::kAdd ? "+" : "-")
-     << "elongation/1000 mm; travel " << (o.direction > 0 ? "+" : "-") << ax
-     << ", control_dk " << ToString(o.control_dk) << ")\n";
+     << "elongation/1000 mm; travel " << (o.direction > 0 ? "+" : "-") << ax << ", control_dk "
+     << ToString(o.control_dk) << ")\n";
   nc << "; assumptions: constant axial feed " << FormatFixed(plan.axial_feed_mm_s * 60.0, 4)
      << " mm/min; time 0 = start of the cut at " << ax << " = "
      << FormatFixed(plan.segments.front().p_a_mm, kDecimalsPositionMm) << " mm (MCS); thread end "
@@ -476,8 +473,8 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   }
   const int m = o.save_r_first;
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
-        " DO " + SdWrites("$$", ax, "$" + R(m), "$" + R(m + 1), "$" + R(m + 2)) + " $" +
-        R(m + 3) + "=0\n";
+        " DO " + SdWrites("$$", ax, "$" + R(m), "$" + R(m + 1), "$" + R(m + 2)) + " $" + R(m + 3) +
+        "=0\n";
   nc += "M17\n";
   return nc;
 }
@@ -486,13 +483,14 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
   o.Validate();
   const std::string& ax = o.axis;
   const int m = o.save_r_first;
-  std::string nc = "; " + info.reset_program_name + ": restores the SINUMERIK 840D temperature "
-                   "compensation of axis " + ax + " after an aborted " + info.program_name +
-                   " run\n";
+  std::string nc = "; " + info.reset_program_name +
+                   ": restores the SINUMERIK 840D temperature "
+                   "compensation of axis " +
+                   ax + " after an aborted " + info.program_name + " run\n";
   nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + ", then, if " + R(m + 3) +
-        " = 1 (whirl's compensation active), writes back the setting data saved in " + R(m) +
-        ".." + R(m + 2) + "\n";
+        " = 1 (whirl's compensation active), writes back the setting data saved in " + R(m) + ".." +
+        R(m + 2) + "\n";
   nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n";
   nc += "$SA_TEMP_COMP_ABS_VALUE[" + ax + "]=" + R(m) + "\n";
   nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + R(m + 1) + "\n";

@@ -45,7 +45,7 @@ double SignFactor(SignConvention s);
 
 /// How the control applies the compensation value dK to the axis (a fact of the machine).
 enum class ControlDk { kAdded, kSubtracted };
-std::string ToString(ControlDk c);                   ///< "added" / "subtracted"
+std::string ToString(ControlDk c);                  ///< "added" / "subtracted"
 ControlDk ParseControlDk(const std::string& text);  ///< InputError for other strings
 /// The only consistent sign: s = -direction if dK is added to the setpoint, +direction otherwise.
 SignConvention ExpectedSign(int direction, ControlDk control_dk);
@@ -53,10 +53,10 @@ SignConvention ExpectedSign(int direction, ControlDk control_dk);
 /// Printed resolution of each quantity, identical in the NC program, the PLC table, the plan's
 /// HTML and the plan JSON (the plan's values are rounded to it when they are built, so what the
 /// files say is exactly what the plan applies): fixed decimals, never an exponent, never "-0".
-inline constexpr int kDecimalsPositionMm = 4;  ///< positions, SD43920: 0.1 um
-inline constexpr int kDecimalsSd43900Mm = 6;   ///< SD43900: 1 nm (below any control's resolution)
-inline constexpr int kDecimalsSd43910 = 8;     ///< SD43910: 1e-8 = 0.01 um per metre of travel
-inline constexpr int kDecimalsTimeS = 3;       ///< times: 1 ms
+inline constexpr int kDecimalsPositionMm = 4;    ///< positions, SD43920: 0.1 um
+inline constexpr int kDecimalsSd43900Mm = 6;     ///< SD43900: 1 nm (below any control's resolution)
+inline constexpr int kDecimalsSd43910 = 8;       ///< SD43910: 1e-8 = 0.01 um per metre of travel
+inline constexpr int kDecimalsTimeS = 3;         ///< times: 1 ms
 inline constexpr int kDecimalsElongationUm = 3;  ///< predicted elongation: 1 nm
 /// Fixed-decimal text of x (no exponent; "-0.000" printed as "0.000"). x must be finite.
 std::string FormatFixed(double x, int decimals);

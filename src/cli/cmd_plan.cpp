@@ -69,8 +69,10 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
   if (o.sync_id_first >= 0) p.sync_id_first = o.sync_id_first;
   if (o.sync_id_last >= 0) p.sync_id_last = o.sync_id_last;
   if (o.save_r_first >= 0) p.save_r_first = o.save_r_first;
-  if (!std::isnan(o.start_position_mm)) p.start_position_mm = o.start_position_mm, have_start = true;
-  if (!std::isnan(o.machine_offset_mm)) p.machine_offset_mm = o.machine_offset_mm, have_offset = true;
+  if (!std::isnan(o.start_position_mm))
+    p.start_position_mm = o.start_position_mm, have_start = true;
+  if (!std::isnan(o.machine_offset_mm))
+    p.machine_offset_mm = o.machine_offset_mm, have_offset = true;
   if (!have_start || !have_offset)
     throw InputError(std::string("plan: ") + (have_start ? "" : "--start-position-mm ") +
                      (have_start || have_offset ? "" : "and ") +
@@ -165,9 +167,10 @@ void Run(const PlanCliOptions& o) {
               interp::FormatFixed(plan.max_abs_slope, interp::kDecimalsSd43910).c_str(),
               interp::FormatFixed(options.md32760, 4).c_str(), options.axis.c_str(),
               interp::ToString(options.sign).c_str(), options.direction);
-  for (const auto& [path, what] :
-       {std::pair{o.out_path, "plan JSON"}, {o.csv_path, "PLC table"}, {o.nc_path, "NC program"},
-        {o.reset_nc_path, "NC reset program"}})
+  for (const auto& [path, what] : {std::pair{o.out_path, "plan JSON"},
+                                   {o.csv_path, "PLC table"},
+                                   {o.nc_path, "NC program"},
+                                   {o.reset_nc_path, "NC reset program"}})
     if (!path.empty()) std::printf("written: %s (%s)\n", path.c_str(), what);
 }
 
@@ -194,7 +197,8 @@ void RegisterPlan(CLI::App& app) {
       "once on the machine (constant SD43900 test value, dial gauge).\n"
       "Machine facts come from --machine M.json (schema whirl.machine, see\n"
       "datasets/machines/example_840d.json; each overridable by its flag): axis, direction,\n"
-      "machine offset, control_dk, MD32760, the synchronized-action IDs and R parameters whirl may\n"
+      "machine offset, control_dk, MD32760, the synchronized-action IDs and R parameters whirl "
+      "may\n"
       "use. --start-position-mm and --machine-offset-mm have no default: give them or a profile.\n"
       "The NC program (--nc, a subprogram ending in M17: save it as .SPF) cancels its ID range,\n"
       "saves the setting data it finds in R parameters, writes the segments through synchronized\n"
@@ -262,8 +266,9 @@ void RegisterPlan(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   sub->add_option("--out", o->out_path, "write the plan JSON here");
   sub->add_option("--csv", o->csv_path, "write the PLC table (CSV) here");
-  sub->add_option("--nc", o->nc_path,
-                  "write the NC subprogram here (ends in M17: name it .SPF, e.g. WHIRL_TEMP_COMP.SPF)");
+  sub->add_option(
+      "--nc", o->nc_path,
+      "write the NC subprogram here (ends in M17: name it .SPF, e.g. WHIRL_TEMP_COMP.SPF)");
   sub->add_option("--reset-nc", o->reset_nc_path,
                   "write the reset subprogram for an aborted cut here (.SPF)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,

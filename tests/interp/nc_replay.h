@@ -43,7 +43,8 @@ struct Replay {
   std::string axis = "Z";
 
   double Value(const std::string& v) const {
-    if (v[0] == 'R') return control.r.count(std::stoi(v.substr(1))) ? control.r.at(std::stoi(v.substr(1))) : 0.0;
+    if (v[0] == 'R')
+      return control.r.count(std::stoi(v.substr(1))) ? control.r.at(std::stoi(v.substr(1))) : 0.0;
     return std::stod(v);
   }
 
@@ -72,10 +73,13 @@ struct Replay {
     static const std::regex kComment(R"(^;.*$)");
     static const std::regex kCancel(R"(^CANCEL\((\d+)\)$)");
     static const std::regex kIf(R"(^IF R(\d+)(<>|==)([-0-9.]+)$)");
-    static const std::regex kAssignR(R"(^R(\d+)=(\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]|[-0-9.]+)$)");
-    static const std::regex kAssignSd(R"(^\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]=(R\d+|[-0-9.]+)$)");
+    static const std::regex kAssignR(
+        R"(^R(\d+)=(\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]|[-0-9.]+)$)");
+    static const std::regex kAssignSd(
+        R"(^\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]=(R\d+|[-0-9.]+)$)");
     static const std::regex kSync(R"(^ID=(\d+) WHEN \$AA_IM\[(\w+)\](>=|<=)([-0-9.]+) DO (.*)$)");
-    static const std::regex kSyncWrite(R"(\$\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]=(\$R\d+|[-0-9.]+)|\$R(\d+)=([-0-9.]+))");
+    static const std::regex kSyncWrite(
+        R"(\$\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]=(\$R\d+|[-0-9.]+)|\$R(\d+)=([-0-9.]+))");
     std::istringstream in(text);
     std::string line;
     std::vector<bool> skipping;
@@ -102,7 +106,7 @@ struct Replay {
         if (m[3].matched) {
           ASSERT_EQ(m[4].str(), axis);
           const std::string t = SdTarget(m[3]);
-          control.r[n] = t == "ABS" ? control.abs_value_mm
+          control.r[n] = t == "ABS"     ? control.abs_value_mm
                          : t == "SLOPE" ? control.slope
                                         : control.ref_position_mm;
         } else {

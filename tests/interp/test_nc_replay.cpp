@@ -5,8 +5,8 @@
 
 #include <random>
 
-#include "fit/arctan_curve.h"
 #include "core/error.h"
+#include "fit/arctan_curve.h"
 #include "interp/nc_replay.h"
 #include "interp/sinumerik.h"
 
@@ -52,7 +52,7 @@ replay::Replay FoundState(const PlanOptions& o, std::mt19937& rng) {
   r.control.ref_position_mm = 500 * u(rng);
   for (int k = 0; k < 4; ++k) r.control.r[o.save_r_first + k] = 123.0 + k;  // stale values
   r.control.r[o.save_r_first + 3] = 0;  // no whirl compensation active
-  replay::SyncAction builders;  // the machine builder's own action, outside whirl's range
+  replay::SyncAction builders;          // the machine builder's own action, outside whirl's range
   builders.id = o.sync_id_first - 1;
   builders.threshold_mm = 1e9;
   r.actions[builders.id] = builders;
@@ -90,8 +90,8 @@ TEST(NcReplay, CompensationFollowsTheCurveAndTheControlEndsAsFound) {
       const double p = AxisPositionMm(s.options, s.feed_mm_s, t);
       r.Cycle(p);
       if (i == cycles) break;
-      worst_um = std::max(worst_um, std::abs(r.control.DkMm(p) * 1000.0 / sgn -
-                                             s.curve.ElongationUm(t)));
+      worst_um =
+          std::max(worst_um, std::abs(r.control.DkMm(p) * 1000.0 / sgn - s.curve.ElongationUm(t)));
     }
     EXPECT_LE(worst_um, s.options.tolerance_um) << "trial " << trial;
     r.Cycle(AxisPositionMm(s.options, s.feed_mm_s, t_end) + s.options.direction * 0.5);  // run-out
@@ -112,7 +112,8 @@ TEST(NcReplay, AbortThenResetAndRerunWithoutResetRestoreTheFoundValues) {
     auto cut_to = [&](double fraction) {
       for (int i = 0; i <= 2000; ++i)
         r.Cycle(AxisPositionMm(s.options, s.feed_mm_s, t_end * fraction * i / 2000));
-      if (fraction >= 1) r.Cycle(AxisPositionMm(s.options, s.feed_mm_s, t_end) + s.options.direction);
+      if (fraction >= 1)
+        r.Cycle(AxisPositionMm(s.options, s.feed_mm_s, t_end) + s.options.direction);
     };
     // Aborted halfway, then a rerun of the whole program without the reset program.
     r.RunProgram(nc);

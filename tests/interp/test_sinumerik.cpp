@@ -84,7 +84,8 @@ TEST(Sinumerik, SettingDataFollowTheDocumentedFormulas) {
     const double p0 = c.options.machine_offset_mm + c.options.start_position_mm;
     const double half_pos = 0.5e-4 + 1e-9;
     EXPECT_NEAR(plan.segments.front().p_a_mm, p0, half_pos);
-    EXPECT_NEAR(plan.segments.back().p_b_mm, p0 + c.options.direction * c.thread_mm, 1e-6 + half_pos);
+    EXPECT_NEAR(plan.segments.back().p_b_mm, p0 + c.options.direction * c.thread_mm,
+                1e-6 + half_pos);
     for (std::size_t i = 0; i < plan.segments.size(); ++i) {
       const CompensationSegment& g = plan.segments[i];
       const double p_a = p0 + c.options.direction * c.feed_mm_s * g.t_a_s;
@@ -186,7 +187,8 @@ TEST(Sinumerik, PlcCsvCarriesTheSettingDataExactlyWithFixedDecimals) {
   for (std::size_t i = 0; i < plan.segments.size(); ++i) {
     const auto& r = rows[i + 1];
     const CompensationSegment& g = plan.segments[i];
-    for (const std::string& cell : r) EXPECT_EQ(cell.find_first_of("eE"), std::string::npos) << cell;
+    for (const std::string& cell : r)
+      EXPECT_EQ(cell.find_first_of("eE"), std::string::npos) << cell;
     EXPECT_EQ(r[1], FormatFixed(g.p_a_mm, kDecimalsPositionMm));
     EXPECT_EQ(std::stod(r[8]), g.sd43900_mm);  // the plan holds exactly the printed values
     EXPECT_EQ(r[8], FormatFixed(g.sd43900_mm, kDecimalsSd43900Mm));
@@ -198,7 +200,8 @@ TEST(Sinumerik, PlcCsvCarriesTheSettingDataExactlyWithFixedDecimals) {
   ASSERT_EQ(last.size(), 11u);
   EXPECT_EQ(last[0], "restore");
   EXPECT_EQ(last[1], FormatFixed(plan.segments.back().p_b_mm, kDecimalsPositionMm));
-  for (int k = 8; k <= 10; ++k) EXPECT_EQ(last[k], "saved") << "no SD value 0 that reads as 'set 0'";
+  for (int k = 8; k <= 10; ++k)
+    EXPECT_EQ(last[k], "saved") << "no SD value 0 that reads as 'set 0'";
 }
 
 TEST(Sinumerik, FormatFixedHasNoExponentAndNoNegativeZero) {
