@@ -8,4 +8,6 @@ target_sources(whirl_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/regression.cpp
   ${CMAKE_CURRENT_LIST_DIR}/model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/fit.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/evaluation.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/evaluation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/documents.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/report.cpp)
