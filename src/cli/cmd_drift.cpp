@@ -245,7 +245,7 @@ void RegisterPredictDrift(CLI::App* drift_app) {
     const drift::RunPrediction p = drift::PredictRun(m, run, drift::ParseReferenceMode(o->reference));
     for (const auto& w : p.warnings) Warn(w);
     if (!o->out.empty())
-      WriteFileAtomic(o->out, drift::PredictionCsv(p, {" whirl drift predict --model " + o->model +
+      WriteFileAtomic(o->out, drift::PredictionCsv(p, {"whirl drift predict --model " + o->model +
                                                       " --run " + o->run + " --reference " + o->reference}));
     if (o->json) {
       PrintJson({{"schema", "whirl.drift_predict"}, {"schema_version", 1}, {"model", o->model},
@@ -272,7 +272,7 @@ void RegisterCrossval(CLI::App* drift_app) {
     SelectionArgs sel;
     ModelArgs model;
     std::string error;
-    bool json = false;
+    bool from_start = false, json = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -286,9 +286,14 @@ void RegisterCrossval(CLI::App* drift_app) {
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
   sub->add_option("--error", o->error, "error column (<name>_um)")->required();
+  sub->add_flag("--errors-from-start", o->from_start,
+                "take each run's errors relative to its first row [um] (runs cut from one log "
+                "do not start from a zeroed machine)");
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
-    const auto runs = LoadRuns(o->runs);
+    auto runs = LoadRuns(o->runs);
+    if (o->from_start)
+      for (Run& r : runs) r = drift::ErrorsFromStart(r);
     std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
     const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
     if (o->json) PrintJson(drift::CrossRunJson(r));
@@ -375,9 +380,9 @@ void RegisterSplit(CLI::App* drift_app) {
     std::vector<std::pair<std::filesystem::path, std::string>> files;
     for (const Run& r : runs)
       files.emplace_back(std::filesystem::path(o->out_dir) / (Slug(r.name) + ".csv"),
-                         drift::FormatRun(r, {" " + r.name + ": rows " + std::to_string(r.line_numbers.front()) +
+                         drift::FormatRun(r, {r.name + ": rows " + std::to_string(r.line_numbers.front()) +
                                                  " to " + std::to_string(r.line_numbers.back()) + " of " + o->log,
-                                             " whirl drift split --log " + o->log + " --at " + o->column}));
+                                             "whirl drift split --log " + o->log + " --at " + o->column}));
     std::filesystem::create_directories(o->out_dir);
     for (const auto& [path, text] : files) WriteFileAtomic(path, text);
     nlohmann::json list = nlohmann::json::array();

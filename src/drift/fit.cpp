@@ -71,9 +71,13 @@ double CrossValidatedRmse(const Stacked& s, bool forward) {
     }
     if (test.empty()) continue;
     count += static_cast<Eigen::Index>(test.size());
-    const LinearFit fit = FitLinear(Rows(s.x, train), Rows(s.y, train));
-    sse += (Rows(s.y, test) - EvaluateLinear(fit.coefficients, Rows(s.x, test))).squaredNorm();
+    if (train.size() <= static_cast<std::size_t>(s.x.cols()) + 1) continue;  // too few to fit
+    const Eigen::VectorXd b = LeastSquaresCoefficients(Rows(s.x, train), Rows(s.y, train));
+    sse += (Rows(s.y, test) - EvaluateLinear(b, Rows(s.x, test))).squaredNorm();
   }
+  if (count == 0)
+    throw InputError("cross-validation: no fold has enough training samples for " +
+                     std::to_string(s.x.cols()) + " features");
   return std::sqrt(sse / static_cast<double>(count));
 }
 

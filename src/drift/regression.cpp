@@ -79,6 +79,16 @@ LinearFit FitLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
   return f;
 }
 
+Eigen::VectorXd LeastSquaresCoefficients(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+  const Eigen::MatrixXd x1 = WithIntercept(x);
+  Eigen::VectorXd scale = x1.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < scale.size(); ++j)
+    if (!(scale(j) > 0)) scale(j) = 1;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(x1 * scale.cwiseInverse().asDiagonal());
+  cod.setThreshold(1e-12);
+  return scale.cwiseInverse().asDiagonal() * cod.solve(y);
+}
+
 Eigen::VectorXd EvaluateLinear(const Eigen::VectorXd& coefficients, const Eigen::MatrixXd& x) {
   return (x * coefficients.tail(coefficients.size() - 1)).array() + coefficients(0);
 }

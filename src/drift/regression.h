@@ -32,6 +32,12 @@ struct LinearFit {
 /// is not finite or [1 X] is rank deficient (names the rank: collinear regressors).
 LinearFit FitLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
 
+/// The minimum-norm least-squares coefficients (b0 first) of y on [1 x], also for a rank-deficient
+/// [1 x] (complete orthogonal decomposition of the unit-norm-scaled columns). For
+/// cross-validation folds, where one block may leave two regressors collinear; never throws on
+/// rank. FitLinear is the fit a model is built from.
+Eigen::VectorXd LeastSquaresCoefficients(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
+
 /// b0 + x b for every row of x.
 Eigen::VectorXd EvaluateLinear(const Eigen::VectorXd& coefficients, const Eigen::MatrixXd& x);
 

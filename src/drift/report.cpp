@@ -85,8 +85,8 @@ std::string Head(const std::string& title, const std::vector<std::string>& prove
 }
 
 std::vector<std::string> Comments(const std::vector<std::string>& provenance, const std::string& what) {
-  std::vector<std::string> c{" " + what};
-  for (const auto& p : provenance) c.push_back(" " + p);
+  std::vector<std::string> c{what};
+  for (const auto& p : provenance) c.push_back(p);
   return c;
 }
 

@@ -151,6 +151,12 @@ Run Run::Slice(int begin, int end, const std::string& new_name) const {
   return r;
 }
 
+Run ErrorsFromStart(const Run& run) {
+  Run r = run;
+  if (r.error_um.rows() > 0) r.error_um.rowwise() -= run.error_um.row(0);
+  return r;
+}
+
 Run ParseRun(const std::string& text, const std::string& source, RunState state) {
   const TimePrepass prep = PrepareTime(text, source);
   const CsvTable t = ParseCsv(prep.text, source);

@@ -61,6 +61,11 @@ struct Run {
   Run Slice(int begin, int end, const std::string& name) const;
 };
 
+/// The run with every error channel taken relative to its first row, e(k) - e(0): the error
+/// gained since the run started, the counterpart of the rises, for logs whose runs do not start
+/// from a cold, zeroed machine (a run cut from a longer log).
+Run ErrorsFromStart(const Run& run);
+
 /// Parses run-file text; `source` names it in messages. InputError (file:line: column 'x': value
 /// 'v': rule) on any broken rule.
 Run ParseRun(const std::string& text, const std::string& source, RunState state);
