@@ -194,13 +194,14 @@ void to_json(json& j, const DriftModel& m) {
 }
 
 void from_json(const json& j, DriftModel& m) {
+  if (!j.is_object() || !j.contains("format") || j["format"] != DriftModel::kFormat)
+    throw InputError(std::string("not a drift model (its 'format' is not '") +
+                     DriftModel::kFormat + "'; write one with whirl drift fit)");
   RejectUnknownKeys(j, {"format", "schema_version", "kind", "error_column", "error_unit",
                         "sensors", "reference_C", "extra_inputs", "time_unit", "time_constants",
                         "features", "residual_std_um", "r_squared", "training", "linear",
                         "network"},
                     "drift model");
-  if (j.at("format").get<std::string>() != DriftModel::kFormat)
-    throw InputError("not a drift model (format '" + j.at("format").get<std::string>() + "')");
   if (j.at("schema_version").get<int>() != DriftModel::kSchemaVersion)
     throw InputError("drift model schema_version " + j.at("schema_version").dump() +
                      ": this whirl reads version " + std::to_string(DriftModel::kSchemaVersion));
