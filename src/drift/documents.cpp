@@ -147,7 +147,7 @@ std::string FormatModel(const DriftModel& m) {
       char name[64];
       std::snprintf(name, sizeof name, "%-30s", (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
       o << "  " << name << F("%12.4f", m.linear.coefficients(k + 1))
-        << F("%12.4f", m.linear.standard_errors(k + 1)) << F("%11.2f", m.linear.vif(k)) << "\n";
+        << F("%12.4f", m.linear.standard_errors(k + 1)) << F("%11.4g", m.linear.vif(k)) << "\n";
     }
   } else {
     o << "  network " << m.network.layer_sizes[0] << "-" << m.network.layer_sizes[1] << "-1\n";

@@ -136,7 +136,7 @@ std::string SimilarityPlot(ReportWriter* w, const Selection& s) {
             std::to_string(i);
   std::ostringstream gp;
   gp << "set multiplot layout 1,2\nset size ratio -1\nset cbrange [0:1]\nset xtics (" << tics
-     << ") rotate by 90\nset ytics (" << tics << ")\nset yrange [] reverse\n"
+     << ") rotate by 90 right\nset bmargin 6\nset ytics (" << tics << ")\nset yrange [] reverse\n"
      << "set title 'similarity |Pearson r| of the rises'\nplot 'similarity.dat' using 1:2:3 with image notitle\n"
      << "set title 'fuzzy equivalence (lambda levels)'\nplot 'similarity.dat' using 1:2:4 with image notitle\n"
      << "unset multiplot\n";

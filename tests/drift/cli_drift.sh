@@ -13,7 +13,7 @@ make_run() {  # make_run <file> <gain> <phase>
     print "# synthetic drift run for the CLI smoke test (tests/drift/cli_drift.sh), gain " g;
     print "time_min,a1_C,a2_C,b1_C,b2_C,c1_C,err_um,spindle_rpm";
     for (k = 0; k < 240; k++) {
-      t = k; A = g * 8 * (1 - exp(-t / 20)); B = g * t / 40; C = 2 * sin(t / 15 + p);
+      t = k; A = g * 8 * (1 - exp(-t / 13)); B = g * t / 40; C = 2 * sin(t / 15 + p);
       n = 0.01 * sin(7 * k + p);
       printf "%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", t, 20 + A + n, 21 + 0.7 * A - n, 20 + B + n,
         22 + 1.3 * B, 20 + C, 2 * A - 1.5 * B + 0.05 * sin(3 * k), (k < 200 ? 1000 : 0);
