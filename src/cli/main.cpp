@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   RegisterCompare(app);
   RegisterLeadReport(app);
   RegisterEvaluate(app);
+  RegisterDrift(app);
   RegisterTorchForwarders(app);
   return RunApp(app, argc, argv);
 }
