@@ -135,6 +135,15 @@ void PlanOptions::Validate() const {
   if (!(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= kMaxSyncActionId))
     throw InputError("synchronized-action IDs " + std::to_string(sync_id_first) + ".." +
                      std::to_string(sync_id_last) + ": must satisfy 1 <= first <= last <= 255");
+  if (workpiece_k0_param >= 0 &&
+      !(workpiece_k0_param <= 9999 && drift_marker_r >= 0 && drift_marker_r <= 9999 &&
+        (drift_marker_r < save_r_first || drift_marker_r > save_r_first + 3) &&
+        drift_missing_alarm >= 60000 && drift_missing_alarm <= 69999))
+    throw InputError("combined with the drift action: workpiece_k0_param " +
+                     std::to_string(workpiece_k0_param) + " must be 0..9999, the drift marker R" +
+                     std::to_string(drift_marker_r) + " 0..9999 outside R" +
+                     std::to_string(save_r_first) + "..R" + std::to_string(save_r_first + 3) +
+                     ", and the alarm " + std::to_string(drift_missing_alarm) + " 60000..69999");
   if (!(save_r_first >= 0 && save_r_first <= 9996))
     throw InputError("save_r_first = " + std::to_string(save_r_first) +
                      ": must be within 0..9996 (R<n>..R<n+3> are used)");
@@ -224,19 +233,29 @@ void ValidatePlan(const CompensationPlan& plan) {
 // --- JSON ----------------------------------------------------------------------------------
 
 void to_json(nlohmann::json& j, const PlanOptions& o) {
-  j = nlohmann::json{{"tolerance_um", o.tolerance_um},           {"axis", o.axis},
-                     {"start_position_mm", o.start_position_mm}, {"direction", o.direction},
-                     {"machine_offset_mm", o.machine_offset_mm}, {"sign", ToString(o.sign)},
-                     {"control_dk", ToString(o.control_dk)},     {"md32760", o.md32760},
-                     {"check_step_s", o.check_step_s},           {"sync_id_first", o.sync_id_first},
-                     {"sync_id_last", o.sync_id_last},           {"save_r_first", o.save_r_first}};
+  j = nlohmann::json{{"tolerance_um", o.tolerance_um},
+                     {"axis", o.axis},
+                     {"start_position_mm", o.start_position_mm},
+                     {"direction", o.direction},
+                     {"machine_offset_mm", o.machine_offset_mm},
+                     {"sign", ToString(o.sign)},
+                     {"control_dk", ToString(o.control_dk)},
+                     {"md32760", o.md32760},
+                     {"check_step_s", o.check_step_s},
+                     {"sync_id_first", o.sync_id_first},
+                     {"sync_id_last", o.sync_id_last},
+                     {"save_r_first", o.save_r_first},
+                     {"workpiece_k0_param", o.workpiece_k0_param},
+                     {"drift_marker_r", o.drift_marker_r},
+                     {"drift_missing_alarm", o.drift_missing_alarm}};
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
   RejectUnknownKeys(
       j,
       {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
-       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first"},
+       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
+       "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm"},
       "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
@@ -250,6 +269,9 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
   o.sync_id_first = j.at("sync_id_first").get<int>();
   o.sync_id_last = j.at("sync_id_last").get<int>();
   o.save_r_first = j.at("save_r_first").get<int>();
+  o.workpiece_k0_param = j.at("workpiece_k0_param").get<int>();
+  o.drift_marker_r = j.at("drift_marker_r").get<int>();
+  o.drift_missing_alarm = j.at("drift_missing_alarm").get<int>();
   o.Validate();
 }
 
@@ -379,11 +401,20 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
 
 namespace {
 
-std::string SdWrites(const std::string& prefix, const std::string& ax, const std::string& k0,
+bool Combined(const PlanOptions& o) { return o.workpiece_k0_param >= 0; }
+
+// Where K0 goes: SD43900 itself, or (combined with the drift action) the $AC_PARAM the drift
+// action adds. prefix "$$" in a synchronized action (main run), "$" in the part program.
+std::string K0Target(const PlanOptions& o, const std::string& prefix) {
+  if (Combined(o)) return "$AC_PARAM[" + std::to_string(o.workpiece_k0_param) + "]";
+  return prefix + "SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]";
+}
+
+std::string SdWrites(const PlanOptions& o, const std::string& prefix, const std::string& k0,
                      const std::string& slope, const std::string& p0) {
-  return prefix + "SA_TEMP_COMP_ABS_VALUE[" + ax + "]=" + k0 + " " + prefix +
-         "SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope + " " + prefix + "SA_TEMP_COMP_REF_POSITION[" +
-         ax + "]=" + p0;
+  const std::string& ax = o.axis;
+  return K0Target(o, prefix) + "=" + k0 + " " + prefix + "SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope +
+         " " + prefix + "SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + p0;
 }
 
 std::string CancelIds(const PlanOptions& o) {
@@ -395,13 +426,27 @@ std::string CancelIds(const PlanOptions& o) {
 
 std::string R(int n) { return "R" + std::to_string(n); }
 
-// Part-program lines (preprocessing) that save the found setting data once.
+// Part-program lines (preprocessing) that save the found setting data once (combined: not
+// SD43900, which the drift action owns).
 std::string SaveFoundValues(const PlanOptions& o) {
   const std::string& ax = o.axis;
   const int m = o.save_r_first;
-  return "IF " + R(m + 3) + "<>1\n" + R(m) + "=$SA_TEMP_COMP_ABS_VALUE[" + ax + "]\n" + R(m + 1) +
-         "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" + R(m + 2) + "=$SA_TEMP_COMP_REF_POSITION[" + ax +
-         "]\n" + R(m + 3) + "=1\nENDIF\n";
+  const std::string k0 =
+      Combined(o) ? std::string() : R(m) + "=$SA_TEMP_COMP_ABS_VALUE[" + ax + "]\n";
+  return "IF " + R(m + 3) + "<>1\n" + k0 + R(m + 1) + "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" +
+         R(m + 2) + "=$SA_TEMP_COMP_REF_POSITION[" + ax + "]\n" + R(m + 3) + "=1\nENDIF\n";
+}
+
+// The value K0 returns to: the saved SD43900, or 0 for the plan's part of the combined K0.
+std::string RestoredK0(const PlanOptions& o, const std::string& r_prefix) {
+  return Combined(o) ? "0" : r_prefix + R(o.save_r_first);
+}
+
+// Combined: refuse to start unless the drift action says it is active (else K0 would be lost).
+std::string RequireDriftAction(const PlanOptions& o) {
+  if (!Combined(o)) return "";
+  return "IF " + R(o.drift_marker_r) + "<>1\nSETAL(" + std::to_string(o.drift_missing_alarm) +
+         ")\nENDIF\n";
 }
 
 std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
@@ -437,6 +482,11 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
      << "short) and after an aborted cut\n";
   nc << "; $AA_IM = actual position in machine coordinates; $$SA_ = write in the main run\n";
   nc << "; call before the cutting block; the ID= actions stay active until the program ends\n";
+  if (Combined(o))
+    nc << "; combined with WHIRL_DRIFT_COMP: K0 goes to $AC_PARAM[" << o.workpiece_k0_param
+       << "], which the drift action adds into SD43900 (its only writer); alarm "
+       << o.drift_missing_alarm << " if the drift action is not active (" << R(o.drift_marker_r)
+       << " <> 1)\n";
   return nc.str();
 }
 
@@ -459,9 +509,10 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   auto pos = [](double v) { return FormatFixed(v, kDecimalsPositionMm); };
   auto k0 = [](double v) { return FormatFixed(v, kDecimalsSd43900Mm); };
   auto slope = [](double v) { return FormatFixed(v, kDecimalsSd43910); };
-  std::string nc = Header(plan, info) + CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
+  std::string nc =
+      Header(plan, info) + RequireDriftAction(o) + CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
   const CompensationSegment& first = plan.segments.front();
-  nc += "$SA_TEMP_COMP_ABS_VALUE[" + ax + "]=" + k0(first.sd43900_mm) + "\n";
+  nc += K0Target(o, "$") + "=" + k0(first.sd43900_mm) + "\n";
   nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope(first.sd43910) + "\n";
   nc += "$SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + pos(first.sd43920_mm) + "\n";
   nc += "STOPRE\n";
@@ -469,12 +520,12 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   for (std::size_t i = 1; i < plan.segments.size(); ++i, ++id) {
     const CompensationSegment& s = plan.segments[i];
     nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(s.sd43920_mm) +
-          " DO " + SdWrites("$$", ax, k0(s.sd43900_mm), slope(s.sd43910), pos(s.sd43920_mm)) + "\n";
+          " DO " + SdWrites(o, "$$", k0(s.sd43900_mm), slope(s.sd43910), pos(s.sd43920_mm)) + "\n";
   }
   const int m = o.save_r_first;
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
-        " DO " + SdWrites("$$", ax, "$" + R(m), "$" + R(m + 1), "$" + R(m + 2)) + " $" + R(m + 3) +
-        "=0\n";
+        " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), "$" + R(m + 1), "$" + R(m + 2)) + " $" +
+        R(m + 3) + "=0\n";
   nc += "M17\n";
   return nc;
 }
@@ -492,7 +543,7 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
         " = 1 (whirl's compensation active), writes back the setting data saved in " + R(m) + ".." +
         R(m + 2) + "\n";
   nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n";
-  nc += "$SA_TEMP_COMP_ABS_VALUE[" + ax + "]=" + R(m) + "\n";
+  nc += K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
   nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + R(m + 1) + "\n";
   nc += "$SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + R(m + 2) + "\n";
   nc += R(m + 3) + "=0\nENDIF\nSTOPRE\nM17\n";

@@ -97,6 +97,13 @@ struct PlanOptions {
   /// and the reset program restore exactly what was there before. 0..9996; the machine must
   /// have them (MD28050 $MC_MM_NUM_R_PARAM).
   int save_r_first = 90;
+  /// -1: the plan writes SD43900 itself. >= 0: combined with the live drift action
+  /// (interp/drift_action.h): the plan writes its K0 into $AC_PARAM[workpiece_k0_param], which the
+  /// drift action adds to the machine's K0, so SD43900 has one writer; the program raises alarm
+  /// `drift_missing_alarm` (SETAL) unless the drift action's marker R<drift_marker_r> is 1.
+  int workpiece_k0_param = -1;
+  int drift_marker_r = -1;
+  int drift_missing_alarm = 65000;
 
   /// InputError naming the field, value and rule for any option out of range, and for a sign
   /// that is not ExpectedSign(direction, control_dk).

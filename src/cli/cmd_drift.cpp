@@ -450,6 +450,7 @@ void RegisterDrift(CLI::App& app) {
   RegisterHoldout(sub);
   RegisterSplit(sub);
   RegisterReport(sub);
+  RegisterDriftNc(sub);  // cmd_drift_nc.cpp
 }
 
 }  // namespace whirl::cli

@@ -45,6 +45,7 @@ struct PlanCliOptions {
   std::string csv_path;
   std::string nc_path;
   std::string reset_nc_path;
+  bool with_drift_action = false;
   bool allow_extrapolation = false;
   bool json = false;
 };
@@ -58,7 +59,10 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
   bool have_start = false, have_offset = false;
   if (!o.machine_path.empty()) {
     const interp::MachineProfile m = interp::LoadMachineProfile(o.machine_path);
-    m.ApplyTo(p);
+    if (o.with_drift_action)
+      m.ApplyCombinedTo(p);
+    else
+      m.ApplyTo(p);
     have_start = m.start_position_mm.has_value();
     have_offset = true;
   }
@@ -73,6 +77,8 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
     p.start_position_mm = o.start_position_mm, have_start = true;
   if (!std::isnan(o.machine_offset_mm))
     p.machine_offset_mm = o.machine_offset_mm, have_offset = true;
+  if (o.with_drift_action && o.machine_path.empty())
+    throw InputError("plan: --with-drift-action needs --machine (its 'drift' object)");
   if (!have_start || !have_offset)
     throw InputError(std::string("plan: ") + (have_start ? "" : "--start-position-mm ") +
                      (have_start || have_offset ? "" : "and ") +
@@ -269,6 +275,11 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option(
       "--nc", o->nc_path,
       "write the NC subprogram here (ends in M17: name it .SPF, e.g. WHIRL_TEMP_COMP.SPF)");
+  sub->add_flag("--with-drift-action", o->with_drift_action,
+                "combined with the live drift action (whirl drift nc) on the same axis: the plan "
+                "writes its K0 into the profile's drift.workpiece_k0_param and the drift action "
+                "adds it into SD43900, its only writer; the program raises the profile's alarm if "
+                "the drift action is not active");
   sub->add_option("--reset-nc", o->reset_nc_path,
                   "write the reset subprogram for an aborted cut here (.SPF)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,

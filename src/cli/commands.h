@@ -20,6 +20,7 @@ void RegisterExport(CLI::App& app);      // cmd_export.cpp (in whirl-torch only)
 /// In whirl: 'crosscheck' and 'export' hand their arguments to whirl-torch (torch_forward.cpp).
 void RegisterTorchForwarders(CLI::App& app);
 void RegisterDemo(CLI::App& app);        // cmd_demo.cpp
-void RegisterDrift(CLI::App& app);       // cmd_drift.cpp
+void RegisterDrift(CLI::App& app);
+void RegisterDriftNc(CLI::App* drift);  // cmd_drift_nc.cpp: whirl drift nc       // cmd_drift.cpp
 
 }  // namespace whirl::cli

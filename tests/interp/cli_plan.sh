@@ -21,9 +21,9 @@ segments=$(grep -v '^#' "$D/plan.csv" | tail -n +2 | grep -vc '^restore')
 actions=$(grep -c '^ID=' "$D/plan.spf")
 # One action per later segment plus the restore at the thread end, IDs from the profile's range.
 [ "$actions" -eq "$segments" ] || fail "$segments segments but $actions synchronized actions"
-grep -q '^ID=200 ' "$D/plan.spf" || fail "IDs do not start at the profile's sync_id_first"
-[ "$(grep -c '^CANCEL(' "$D/plan.spf")" -eq 56 ] || fail "the ID range 200..255 is not cancelled"
-grep -q '^CANCEL(255)' "$D/reset.spf" || fail "reset program does not cancel the range"
+grep -q "^ID=100 " "$D/plan.spf" || fail "IDs do not start at the profile's sync_id_first"
+[ "$(grep -c '^CANCEL(' "$D/plan.spf")" -eq 50 ] || fail "the ID range 100..149 is not cancelled"
+grep -q '^CANCEL(149)' "$D/reset.spf" || fail "reset program does not cancel the range"
 grep -q "R90=\$SA_TEMP_COMP_ABS_VALUE" "$D/plan.spf" || fail "found values not saved"
 grep -q "^M17" "$D/plan.spf" || fail "no M17"
 grep -Eq '[0-9]e-?[0-9]' "$D/plan.csv" "$D/plan.spf" && fail "exponent in a control file"

@@ -54,12 +54,14 @@ replay::Replay FoundState(const PlanOptions& o, std::mt19937& rng) {
   r.control.r[o.save_r_first + 3] = 0;  // no whirl compensation active
   replay::SyncAction builders;          // the machine builder's own action, outside whirl's range
   builders.id = o.sync_id_first - 1;
-  builders.threshold_mm = 1e9;
+  builders.mode = replay::SyncAction::Mode::kWhen;
+  builders.lhs = "$AA_IM[" + o.axis + "]";
+  builders.op = ">=";
+  builders.rhs = "1000000000";
   r.actions[builders.id] = builders;
   replay::SyncAction stale;  // a leftover inside whirl's range
   stale.id = o.sync_id_last;
-  stale.threshold_mm = -1e9;
-  stale.greater_equal = true;
+  stale.mode = replay::SyncAction::Mode::kEveryCycle;
   stale.writes = {{"ABS", "0.5"}};
   r.actions[stale.id] = stale;
   return r;
@@ -78,8 +80,8 @@ TEST(NcReplay, CompensationFollowsTheCurveAndTheControlEndsAsFound) {
     const CompensationPlan plan = BuildPlan(s.curve, s.feed_mm_s, s.thread_mm, s.options);
     replay::Replay r = FoundState(s.options, rng);
     const replay::Control before = r.control;
-    r.RunProgram(FormatNcProgram(plan));
-    ASSERT_FALSE(HasFatalFailure());
+    ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));
+    ASSERT_FALSE(HasFailure());
     EXPECT_EQ(r.actions.count(s.options.sync_id_first - 1), 1u) << "builder's action kept";
     const double sgn = SignFactor(s.options.sign);
     const double t_end = s.thread_mm / s.feed_mm_s;
