@@ -14,7 +14,7 @@ namespace whirl::interp {
 namespace {
 
 constexpr const char* kPlanSchema = "whirl.plan";
-constexpr int kPlanSchemaVersion = 1;
+constexpr int kPlanSchemaVersion = 2;
 constexpr int kMaxSyncActionId = 255;
 
 std::string Num(double x) {
@@ -22,15 +22,6 @@ std::string Num(double x) {
   ss.precision(10);
   ss << x;
   return ss.str();
-}
-
-// Fixed decimals without "-0.000".
-std::string Fixed(double x, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  std::string s = buf;
-  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
 }
 
 void CheckFinitePositive(double v, const std::string& field) {
@@ -48,9 +39,11 @@ CompensationSegment MakeSegment(const PlanOptions& o, double feed, double t_a, d
   s.p_b_mm = AxisPositionMm(o, feed, t_b);
   s.l_a_um = l_a;
   s.l_b_um = l_b;
-  // "+ 0.0" turns -0.0 (subtract of a zero elongation) into 0 for the writers.
-  s.sd43900_mm = sign * l_a / 1000.0 + 0.0;
-  s.sd43910 = sign * (l_b - l_a) / 1000.0 / (s.p_b_mm - s.p_a_mm) + 0.0;
+  // The values the writers print (RoundTo); the chord's slope uses the unrounded positions.
+  s.sd43900_mm = RoundTo(sign * l_a / 1000.0, kDecimalsSd43900Mm);
+  s.sd43910 = RoundTo(sign * (l_b - l_a) / 1000.0 / (s.p_b_mm - s.p_a_mm), kDecimalsSd43910);
+  s.p_a_mm = RoundTo(s.p_a_mm, kDecimalsPositionMm);
+  s.p_b_mm = RoundTo(s.p_b_mm, kDecimalsPositionMm);
   s.sd43920_mm = s.p_a_mm;
   return s;
 }
@@ -65,7 +58,46 @@ void CheckSlope(const CompensationSegment& s, std::size_t index, double cap) {
                      "allows, or lower the feed");
 }
 
+// Largest |applied - chord| the rounding of the written values can cause, um: half a unit of
+// SD43900, half a unit of SD43910 over the whole thread, and the shift of the reference and
+// trigger positions by half a unit times the steepest allowed slope (twice: both ends).
+double RoundingBudgetUm(double thread_length_mm, double md32760) {
+  const double k0 = 0.5 * std::pow(10.0, -kDecimalsSd43900Mm);
+  const double slope = 0.5 * std::pow(10.0, -kDecimalsSd43910) * thread_length_mm;
+  const double p0 = 2.0 * md32760 * 0.5 * std::pow(10.0, -kDecimalsPositionMm);
+  return 1000.0 * (k0 + slope + p0);
+}
+
+std::size_t SyncIdsNeeded(const CompensationPlan& plan) { return plan.segments.size(); }
+
 }  // namespace
+
+std::string FormatFixed(double x, int decimals) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+  std::string s = buf;
+  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
+  return s;
+}
+
+double RoundTo(double x, int decimals) {
+  return std::stod(FormatFixed(x, decimals));  // exactly what is printed, read back
+}
+
+std::string ToString(ControlDk c) { return c == ControlDk::kAdded ? "added" : "subtracted"; }
+
+ControlDk ParseControlDk(const std::string& text) {
+  if (text == "added") return ControlDk::kAdded;
+  if (text == "subtracted") return ControlDk::kSubtracted;
+  throw InputError("control_dk '" + text +
+                   "': must be 'added' (the control adds dK to the position setpoint) or "
+                   "'subtracted'");
+}
+
+SignConvention ExpectedSign(int direction, ControlDk control_dk) {
+  const int s = (control_dk == ControlDk::kAdded ? -1 : 1) * direction;
+  return s > 0 ? SignConvention::kAdd : SignConvention::kSubtract;
+}
 
 std::string ToString(SignConvention s) { return s == SignConvention::kAdd ? "add" : "subtract"; }
 
@@ -93,6 +125,28 @@ void PlanOptions::Validate() const {
     throw InputError("direction = " + std::to_string(direction) + ": must be +1 or -1");
   if (!(md32760 > 0 && md32760 <= kMd32760Max))
     throw InputError("md32760 = " + Num(md32760) + ": must be within (0, 0.10] (MD32760 range)");
+  if (sign != ExpectedSign(direction, control_dk))
+    throw InputError("sign '" + ToString(sign) + "' with direction " + std::to_string(direction) +
+                     " and control_dk '" + ToString(control_dk) +
+                     "': inconsistent; the growth "
+                     "points against the travel, so dK = -direction * l if the control adds dK "
+                     "to the setpoint and +direction * l if it subtracts it (sign '" +
+                     ToString(ExpectedSign(direction, control_dk)) + "' here)");
+  if (!(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= kMaxSyncActionId))
+    throw InputError("synchronized-action IDs " + std::to_string(sync_id_first) + ".." +
+                     std::to_string(sync_id_last) + ": must satisfy 1 <= first <= last <= 255");
+  if (workpiece_k0_param >= 0 &&
+      !(workpiece_k0_param <= 9999 && drift_marker_r >= 0 && drift_marker_r <= 9999 &&
+        (drift_marker_r < save_r_first || drift_marker_r > save_r_first + 3) &&
+        drift_missing_alarm >= 60000 && drift_missing_alarm <= 69999))
+    throw InputError("combined with the drift action: workpiece_k0_param " +
+                     std::to_string(workpiece_k0_param) + " must be 0..9999, the drift marker R" +
+                     std::to_string(drift_marker_r) + " 0..9999 outside R" +
+                     std::to_string(save_r_first) + "..R" + std::to_string(save_r_first + 3) +
+                     ", and the alarm " + std::to_string(drift_missing_alarm) + " 60000..69999");
+  if (!(save_r_first >= 0 && save_r_first <= 9996))
+    throw InputError("save_r_first = " + std::to_string(save_r_first) +
+                     ": must be within 0..9996 (R<n>..R<n+3> are used)");
 }
 
 double AxisPositionMm(const PlanOptions& o, double axial_feed_mm_s, double t_s) {
@@ -111,8 +165,15 @@ CompensationPlan BuildPlan(const CurveFunction& curve_um, double axial_feed_mm_s
   plan.axial_feed_mm_s = axial_feed_mm_s;
   plan.thread_length_mm = thread_length_mm;
   plan.cutting_time_s = thread_length_mm / axial_feed_mm_s;
+  const double budget_um = RoundingBudgetUm(thread_length_mm, options.md32760);
+  if (!(options.tolerance_um > 2.0 * budget_um))
+    throw InputError("tolerance_um = " + Num(options.tolerance_um) + ": must exceed " +
+                     Num(2.0 * budget_um) +
+                     " um, twice what rounding the written setting data "
+                     "can cost over a " +
+                     Num(thread_length_mm) + " mm thread");
   BreakpointOptions bo;
-  bo.tolerance_um = options.tolerance_um;
+  bo.tolerance_um = options.tolerance_um - budget_um;
   bo.check_step_s = options.check_step_s;
   bo.forced_times_s = forced_times_s;
   const Breakpoints bp = ChooseBreakpoints(curve_um, 0.0, plan.cutting_time_s, bo);
@@ -178,23 +239,39 @@ void to_json(nlohmann::json& j, const PlanOptions& o) {
                      {"direction", o.direction},
                      {"machine_offset_mm", o.machine_offset_mm},
                      {"sign", ToString(o.sign)},
+                     {"control_dk", ToString(o.control_dk)},
                      {"md32760", o.md32760},
-                     {"check_step_s", o.check_step_s}};
+                     {"check_step_s", o.check_step_s},
+                     {"sync_id_first", o.sync_id_first},
+                     {"sync_id_last", o.sync_id_last},
+                     {"save_r_first", o.save_r_first},
+                     {"workpiece_k0_param", o.workpiece_k0_param},
+                     {"drift_marker_r", o.drift_marker_r},
+                     {"drift_missing_alarm", o.drift_missing_alarm}};
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
-  RejectUnknownKeys(j,
-                    {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm",
-                     "sign", "md32760", "check_step_s"},
-                    "plan settings");
+  RejectUnknownKeys(
+      j,
+      {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
+       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
+       "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm"},
+      "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
   o.start_position_mm = j.at("start_position_mm").get<double>();
   o.direction = j.at("direction").get<int>();
   o.machine_offset_mm = j.at("machine_offset_mm").get<double>();
   o.sign = ParseSignConvention(j.at("sign").get<std::string>());
+  o.control_dk = ParseControlDk(j.at("control_dk").get<std::string>());
   o.md32760 = j.at("md32760").get<double>();
   o.check_step_s = j.at("check_step_s").get<double>();
+  o.sync_id_first = j.at("sync_id_first").get<int>();
+  o.sync_id_last = j.at("sync_id_last").get<int>();
+  o.save_r_first = j.at("save_r_first").get<int>();
+  o.workpiece_k0_param = j.at("workpiece_k0_param").get<int>();
+  o.drift_marker_r = j.at("drift_marker_r").get<int>();
+  o.drift_missing_alarm = j.at("drift_missing_alarm").get<int>();
   o.Validate();
 }
 
@@ -266,81 +343,211 @@ void from_json(const nlohmann::json& j, CompensationPlan& plan) {
 
 // --- PLC table -----------------------------------------------------------------------------
 
-std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::string>& provenance) {
-  std::vector<std::string> comments = provenance;
-  const PlanOptions& o = plan.options;
-  comments.push_back(
-      " SINUMERIK 840D temperature compensation, axis " + o.axis +
-      ": when the axis (MCS) passes trigger_position_mm in the direction of travel (" +
-      (o.direction > 0 ? "+" : "-") +
-      "), write SD43900 $SA_TEMP_COMP_ABS_VALUE, SD43910 $SA_TEMP_COMP_SLOPE, "
-      "SD43920 $SA_TEMP_COMP_REF_POSITION of that row");
-  comments.push_back(" sign " + ToString(o.sign) +
-                     " (dK = " + (o.sign == SignConvention::kAdd ? "+" : "-") +
-                     "elongation), MD32760 cap " + Num(o.md32760) + ", largest |SD43910| " +
-                     Num(plan.max_abs_slope) + ", tolerance " + Num(o.tolerance_um) +
-                     " um, MD32750 $MA_TEMP_COMP_TYPE = 3 required");
-  comments.push_back(
-      " units: t s, positions mm (MCS), elongation um, SD43900 mm, SD43910 -, SD43920 mm");
-  std::vector<std::vector<double>> rows;
-  for (std::size_t i = 0; i < plan.segments.size(); ++i) {
-    const CompensationSegment& s = plan.segments[i];
-    rows.push_back({static_cast<double>(i + 1), s.p_a_mm, s.t_a_s, s.t_b_s, s.p_a_mm, s.p_b_mm,
-                    s.l_a_um, s.l_b_um, s.sd43900_mm, s.sd43910, s.sd43920_mm});
-  }
-  return FormatCsv({"segment", "trigger_position_mm", "t_a_s", "t_b_s", "p_a_mm", "p_b_mm",
-                    "l_a_um", "l_b_um", "sd43900_mm", "sd43910", "sd43920_mm"},
-                   rows, comments);
+namespace {
+
+// One line of a CSV whose cells are already text (fixed decimals per quantity).
+std::string CsvLine(const std::vector<std::string>& cells) {
+  std::string line;
+  for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+  return line + "\n";
 }
 
-// --- NC program ----------------------------------------------------------------------------
+std::string OneLine(std::string text) {
+  for (char& ch : text)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
+  return text;
+}
+
+double ThreadEndMm(const CompensationPlan& plan) { return plan.segments.back().p_b_mm; }
+
+}  // namespace
+
+std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::string>& provenance) {
+  ValidatePlan(plan);
+  const PlanOptions& o = plan.options;
+  std::string out;
+  for (const std::string& p : provenance) out += "#" + OneLine(p) + "\n";
+  out += "# SINUMERIK 840D temperature compensation, axis " + o.axis +
+         ": when the axis (MCS) passes trigger_position_mm in the direction of travel (" +
+         (o.direction > 0 ? "+" : "-") +
+         "), write SD43900 $SA_TEMP_COMP_ABS_VALUE, SD43910 $SA_TEMP_COMP_SLOPE, SD43920 "
+         "$SA_TEMP_COMP_REF_POSITION of that row; before the first row save the three values "
+         "found, and at the row 'restore' (thread end) write the saved values back\n";
+  out += "# sign " + ToString(o.sign) + " (dK = " + (o.sign == SignConvention::kAdd ? "+" : "-") +
+         "elongation; control_dk " + ToString(o.control_dk) + ", direction " +
+         std::to_string(o.direction) + "), MD32760 cap " + FormatFixed(o.md32760, 4) +
+         ", largest |SD43910| " + FormatFixed(plan.max_abs_slope, kDecimalsSd43910) +
+         ", tolerance " + FormatFixed(o.tolerance_um, 3) +
+         " um, MD32750 $MA_TEMP_COMP_TYPE = 3 required\n";
+  out += "# units: t s, positions mm (MCS), elongation um, SD43900 mm, SD43910 -, SD43920 mm\n";
+  out += CsvLine({"segment", "trigger_position_mm", "t_a_s", "t_b_s", "p_a_mm", "p_b_mm", "l_a_um",
+                  "l_b_um", "sd43900_mm", "sd43910", "sd43920_mm"});
+  auto pos = [](double v) { return FormatFixed(v, kDecimalsPositionMm); };
+  auto time = [](double v) { return FormatFixed(v, kDecimalsTimeS); };
+  auto um = [](double v) { return FormatFixed(v, kDecimalsElongationUm); };
+  for (std::size_t i = 0; i < plan.segments.size(); ++i) {
+    const CompensationSegment& s = plan.segments[i];
+    out += CsvLine({std::to_string(i + 1), pos(s.sd43920_mm), time(s.t_a_s), time(s.t_b_s),
+                    pos(s.p_a_mm), pos(s.p_b_mm), um(s.l_a_um), um(s.l_b_um),
+                    FormatFixed(s.sd43900_mm, kDecimalsSd43900Mm),
+                    FormatFixed(s.sd43910, kDecimalsSd43910), pos(s.sd43920_mm)});
+  }
+  out += CsvLine({"restore", pos(ThreadEndMm(plan)), time(plan.cutting_time_s), "",
+                  pos(ThreadEndMm(plan)), "", "", "", "saved", "saved", "saved"});
+  return out;
+}
+
+// --- NC programs ---------------------------------------------------------------------------
+
+namespace {
+
+bool Combined(const PlanOptions& o) { return o.workpiece_k0_param >= 0; }
+
+// Where K0 goes: SD43900 itself, or (combined with the drift action) the $AC_PARAM the drift
+// action adds. prefix "$$" in a synchronized action (main run), "$" in the part program.
+std::string K0Target(const PlanOptions& o, const std::string& prefix) {
+  if (Combined(o)) return "$AC_PARAM[" + std::to_string(o.workpiece_k0_param) + "]";
+  return prefix + "SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]";
+}
+
+std::string SdWrites(const PlanOptions& o, const std::string& prefix, const std::string& k0,
+                     const std::string& slope, const std::string& p0) {
+  const std::string& ax = o.axis;
+  return K0Target(o, prefix) + "=" + k0 + " " + prefix + "SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope +
+         " " + prefix + "SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + p0;
+}
+
+std::string CancelIds(const PlanOptions& o) {
+  std::string out;
+  for (int id = o.sync_id_first; id <= o.sync_id_last; ++id)
+    out += "CANCEL(" + std::to_string(id) + ")\n";
+  return out;
+}
+
+std::string R(int n) { return "R" + std::to_string(n); }
+
+// Part-program lines (preprocessing) that save the found setting data once (combined: not
+// SD43900, which the drift action owns).
+std::string SaveFoundValues(const PlanOptions& o) {
+  const std::string& ax = o.axis;
+  const int m = o.save_r_first;
+  const std::string k0 =
+      Combined(o) ? std::string() : R(m) + "=$SA_TEMP_COMP_ABS_VALUE[" + ax + "]\n";
+  return "IF " + R(m + 3) + "<>1\n" + k0 + R(m + 1) + "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" +
+         R(m + 2) + "=$SA_TEMP_COMP_REF_POSITION[" + ax + "]\n" + R(m + 3) + "=1\nENDIF\n";
+}
+
+// The value K0 returns to: the saved SD43900, or 0 for the plan's part of the combined K0.
+std::string RestoredK0(const PlanOptions& o, const std::string& r_prefix) {
+  return Combined(o) ? "0" : r_prefix + R(o.save_r_first);
+}
+
+// Combined: refuse to start unless the drift action says it is active (else K0 would be lost).
+std::string RequireDriftAction(const PlanOptions& o) {
+  if (!Combined(o)) return "";
+  return "IF " + R(o.drift_marker_r) + "<>1\nSETAL(" + std::to_string(o.drift_missing_alarm) +
+         ")\nENDIF\n";
+}
+
+std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
+  const PlanOptions& o = plan.options;
+  const std::string& ax = o.axis;
+  const int m = o.save_r_first;
+  std::ostringstream nc;
+  nc << "; " << info.program_name
+     << ": SINUMERIK 840D temperature compensation of the thermal elongation while whirling\n";
+  nc << "; generated by whirl plan; curve: "
+     << (info.curve_source.empty() ? "(not stated)" : OneLine(info.curve_source)) << "\n";
+  nc << "; axis " << ax << ", " << plan.segments.size() << " segments, tolerance "
+     << FormatFixed(o.tolerance_um, 3) << " um (largest deviation on the check grid "
+     << FormatFixed(plan.max_deviation_um, 3) << " um)\n";
+  nc << "; requires MD32750 $MA_TEMP_COMP_TYPE = 3 for axis " << ax
+     << " (bit 0 SD43900, bit 1 SD43910/SD43920; power on)\n";
+  nc << "; requires MD32760 $MA_COMP_ADD_VELO_FACTOR >= "
+     << FormatFixed(plan.max_abs_slope, kDecimalsSd43910)
+     << " (largest |SD43910| here); plan checked against " << FormatFixed(o.md32760, 4) << "\n";
+  nc << "; sign: " << ToString(o.sign) << " (dK = " << (o.sign == SignConvention::kAdd ? "+" : "-")
+     << "elongation/1000 mm; travel " << (o.direction > 0 ? "+" : "-") << ax << ", control_dk "
+     << ToString(o.control_dk) << ")\n";
+  nc << "; assumptions: constant axial feed " << FormatFixed(plan.axial_feed_mm_s * 60.0, 4)
+     << " mm/min; time 0 = start of the cut at " << ax << " = "
+     << FormatFixed(plan.segments.front().p_a_mm, kDecimalsPositionMm) << " mm (MCS); thread end "
+     << ax << " = " << FormatFixed(ThreadEndMm(plan), kDecimalsPositionMm) << " mm (MCS), "
+     << FormatFixed(plan.thread_length_mm, 4) << " mm of travel\n";
+  nc << "; uses synchronized-action IDs " << o.sync_id_first << ".." << o.sync_id_last
+     << " (cancelled first) and " << R(m) << ".." << R(m + 3)
+     << " (setting data found before the cut, marker)\n";
+  nc << "; restores the found setting data when the axis passes the thread end; call "
+     << info.reset_program_name << " after the cutting block (it restores if the axis stopped "
+     << "short) and after an aborted cut\n";
+  nc << "; $AA_IM = actual position in machine coordinates; $$SA_ = write in the main run\n";
+  nc << "; call before the cutting block; the ID= actions stay active until the program ends\n";
+  if (Combined(o))
+    nc << "; combined with WHIRL_DRIFT_COMP: K0 goes to $AC_PARAM[" << o.workpiece_k0_param
+       << "], which the drift action adds into SD43900 (its only writer); alarm "
+       << o.drift_missing_alarm << " if the drift action is not active (" << R(o.drift_marker_r)
+       << " <> 1)\n";
+  return nc.str();
+}
+
+}  // namespace
 
 std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info) {
   ValidatePlan(plan);
   const PlanOptions& o = plan.options;
   const std::string& ax = o.axis;
-  if (plan.segments.size() - 1 > static_cast<std::size_t>(kMaxSyncActionId))
+  const std::size_t available = static_cast<std::size_t>(o.sync_id_last - o.sync_id_first + 1);
+  if (SyncIdsNeeded(plan) > available)
     throw InputError("plan has " + std::to_string(plan.segments.size()) +
-                     " segments: the NC program needs one synchronized action ID per segment after "
-                     "the first and IDs end at " +
-                     std::to_string(kMaxSyncActionId) + ": raise the tolerance");
+                     " segments: the NC program needs one synchronized-action ID per segment after "
+                     "the first and one for the restore at the thread end (" +
+                     std::to_string(SyncIdsNeeded(plan)) + "), but the range " +
+                     std::to_string(o.sync_id_first) + ".." + std::to_string(o.sync_id_last) +
+                     " has " + std::to_string(available) +
+                     ": raise the tolerance or widen the ID range");
   const std::string cmp = o.direction > 0 ? ">=" : "<=";
-  std::ostringstream nc;
-  nc << "; " << info.program_name
-     << ": SINUMERIK 840D temperature compensation of the thermal elongation while whirling\n";
-  nc << "; generated by whirl plan; curve: "
-     << (info.curve_source.empty() ? "(not stated)" : info.curve_source) << "\n";
-  nc << "; axis " << ax << ", " << plan.segments.size() << " segments, tolerance "
-     << Fixed(o.tolerance_um, 3) << " um (largest deviation on the check grid "
-     << Fixed(plan.max_deviation_um, 3) << " um)\n";
-  nc << "; requires MD32750 $MA_TEMP_COMP_TYPE = 3 for axis " << ax
-     << " (bit 0 SD43900, bit 1 SD43910/SD43920; power on)\n";
-  nc << "; requires MD32760 $MA_COMP_ADD_VELO_FACTOR >= " << Fixed(plan.max_abs_slope, 8)
-     << " (largest |SD43910| here); plan checked against " << Fixed(o.md32760, 4) << "\n";
-  nc << "; sign convention: " << ToString(o.sign)
-     << " (dK = " << (o.sign == SignConvention::kAdd ? "+" : "-") << "elongation/1000 mm)\n";
-  nc << "; assumptions: constant axial feed " << Fixed(plan.axial_feed_mm_s * 60.0, 4)
-     << " mm/min; time 0 = start of the cut at " << ax << " = "
-     << Fixed(AxisPositionMm(o, plan.axial_feed_mm_s, 0.0), 4) << " mm (MCS); travel "
-     << (o.direction > 0 ? "+" : "-") << ax << " over " << Fixed(plan.thread_length_mm, 4)
-     << " mm\n";
-  nc << "; $AA_IM = actual position in machine coordinates; $$SA_ = write in the main run\n";
-  nc << "; call before the cutting block; the ID= actions stay active until the program ends\n";
+  auto pos = [](double v) { return FormatFixed(v, kDecimalsPositionMm); };
+  auto k0 = [](double v) { return FormatFixed(v, kDecimalsSd43900Mm); };
+  auto slope = [](double v) { return FormatFixed(v, kDecimalsSd43910); };
+  std::string nc =
+      Header(plan, info) + RequireDriftAction(o) + CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
   const CompensationSegment& first = plan.segments.front();
-  nc << "STOPRE\n";
-  nc << "$SA_TEMP_COMP_ABS_VALUE[" << ax << "]=" << Fixed(first.sd43900_mm, 6) << "\n";
-  nc << "$SA_TEMP_COMP_SLOPE[" << ax << "]=" << Fixed(first.sd43910, 8) << "\n";
-  nc << "$SA_TEMP_COMP_REF_POSITION[" << ax << "]=" << Fixed(first.sd43920_mm, 4) << "\n";
-  nc << "STOPRE\n";
-  for (std::size_t i = 1; i < plan.segments.size(); ++i) {
+  nc += K0Target(o, "$") + "=" + k0(first.sd43900_mm) + "\n";
+  nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope(first.sd43910) + "\n";
+  nc += "$SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + pos(first.sd43920_mm) + "\n";
+  nc += "STOPRE\n";
+  int id = o.sync_id_first;
+  for (std::size_t i = 1; i < plan.segments.size(); ++i, ++id) {
     const CompensationSegment& s = plan.segments[i];
-    nc << "ID=" << i << " WHEN $AA_IM[" << ax << "]" << cmp << Fixed(s.sd43920_mm, 4)
-       << " DO $$SA_TEMP_COMP_ABS_VALUE[" << ax << "]=" << Fixed(s.sd43900_mm, 6)
-       << " $$SA_TEMP_COMP_SLOPE[" << ax << "]=" << Fixed(s.sd43910, 8)
-       << " $$SA_TEMP_COMP_REF_POSITION[" << ax << "]=" << Fixed(s.sd43920_mm, 4) << "\n";
+    nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(s.sd43920_mm) +
+          " DO " + SdWrites(o, "$$", k0(s.sd43900_mm), slope(s.sd43910), pos(s.sd43920_mm)) + "\n";
   }
-  nc << "M17\n";
-  return nc.str();
+  const int m = o.save_r_first;
+  nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
+        " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), "$" + R(m + 1), "$" + R(m + 2)) + " $" +
+        R(m + 3) + "=0\n";
+  nc += "M17\n";
+  return nc;
+}
+
+std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info) {
+  o.Validate();
+  const std::string& ax = o.axis;
+  const int m = o.save_r_first;
+  std::string nc = "; " + info.reset_program_name +
+                   ": restores the SINUMERIK 840D temperature "
+                   "compensation of axis " +
+                   ax + " after an aborted " + info.program_name + " run\n";
+  nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
+        std::to_string(o.sync_id_last) + ", then, if " + R(m + 3) +
+        " = 1 (whirl's compensation active), writes back the setting data saved in " + R(m) + ".." +
+        R(m + 2) + "\n";
+  nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n";
+  nc += K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+  nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + R(m + 1) + "\n";
+  nc += "$SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + R(m + 2) + "\n";
+  nc += R(m + 3) + "=0\nENDIF\nSTOPRE\nM17\n";
+  return nc;
 }
 
 }  // namespace whirl::interp

@@ -29,18 +29,39 @@ namespace whirl::interp {
 
 /// How the control's dK relates to the predicted elongation l (um, positive = the unmachined
 /// section grows, i.e. the cut point moves away from the chuck).
-///  kSubtract: dK = -l/1000 mm (default).  kAdd: dK = +l/1000 mm.
-/// Why subtract is the default: cutting runs from the free end towards the chuck, so the growth of
-/// the unmachined section points against the direction of travel. With the default direction +1
-/// (travel towards +MCS), following the grown material means shifting the axis by -l; assuming the
-/// control adds dK to the position setpoint (K3 does not state it plainly, REFERENCE.md 3), that is
-/// dK = -l. With direction -1 the same reasoning gives kAdd: check the sign on the machine once
-/// (e.g. with a constant SD43900 test value) and set it explicitly.
+///  kSubtract: dK = -l/1000 mm.  kAdd: dK = +l/1000 mm.
+/// The sign is not a free choice: it follows the direction of travel and how the control applies
+/// dK (ControlDk). Cutting runs from the free end towards the chuck, so the growth of the
+/// unmachined section points against the direction of travel; following the grown material means
+/// shifting the axis by -direction * l. If the control adds dK to the position setpoint
+/// (ControlDk::kAdded, assumed by default: K3 does not state it plainly, REFERENCE.md 3), that is
+/// s = -direction; if it subtracts dK, s = +direction (ExpectedSign). Check it once on the
+/// machine (a constant SD43900 test value and a dial gauge) and record it in the machine profile.
 enum class SignConvention { kSubtract, kAdd };
 std::string ToString(SignConvention s);                  ///< "subtract" / "add"
 SignConvention ParseSignConvention(const std::string&);  ///< InputError for other strings
 /// +1 for kAdd, -1 for kSubtract.
 double SignFactor(SignConvention s);
+
+/// How the control applies the compensation value dK to the axis (a fact of the machine).
+enum class ControlDk { kAdded, kSubtracted };
+std::string ToString(ControlDk c);                  ///< "added" / "subtracted"
+ControlDk ParseControlDk(const std::string& text);  ///< InputError for other strings
+/// The only consistent sign: s = -direction if dK is added to the setpoint, +direction otherwise.
+SignConvention ExpectedSign(int direction, ControlDk control_dk);
+
+/// Printed resolution of each quantity, identical in the NC program, the PLC table, the plan's
+/// HTML and the plan JSON (the plan's values are rounded to it when they are built, so what the
+/// files say is exactly what the plan applies): fixed decimals, never an exponent, never "-0".
+inline constexpr int kDecimalsPositionMm = 4;    ///< positions, SD43920: 0.1 um
+inline constexpr int kDecimalsSd43900Mm = 6;     ///< SD43900: 1 nm (below any control's resolution)
+inline constexpr int kDecimalsSd43910 = 8;       ///< SD43910: 1e-8 = 0.01 um per metre of travel
+inline constexpr int kDecimalsTimeS = 3;         ///< times: 1 ms
+inline constexpr int kDecimalsElongationUm = 3;  ///< predicted elongation: 1 nm
+/// Fixed-decimal text of x (no exponent; "-0.000" printed as "0.000"). x must be finite.
+std::string FormatFixed(double x, int decimals);
+/// x rounded to `decimals` decimals (the value FormatFixed prints).
+double RoundTo(double x, int decimals);
 
 /// MD32760 bounds from K3.
 inline constexpr double kMd32760Default = 0.01;
@@ -57,15 +78,35 @@ struct PlanOptions {
   int direction = 1;
   /// Machine coordinate of the program's zero for this axis, mm (SD43920 and $AA_IM are MCS).
   double machine_offset_mm = 0;
-  /// dK = s * l / 1000 (see SignConvention).
+  /// dK = s * l / 1000 (see SignConvention); must equal ExpectedSign(direction, control_dk).
   SignConvention sign = SignConvention::kSubtract;
+  /// How the control applies dK (machine profile field "control_dk").
+  ControlDk control_dk = ControlDk::kAdded;
   /// MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910| (0 < cap <= 0.10). A larger slope is an
   /// InputError naming the segment, its slope and the cap.
   double md32760 = kMd32760Default;
   /// Check-grid step for the tolerance, s (BreakpointOptions::check_step_s).
   double check_step_s = 0.25;
+  /// Synchronized-action IDs whirl may use, [sync_id_first, sync_id_last] within 1..255: one per
+  /// segment after the first plus one for the restore at the thread end. The NC program cancels
+  /// exactly these IDs before it starts, so choose a range the machine builder does not use.
+  int sync_id_first = 1;
+  int sync_id_last = 255;
+  /// R parameters R<n>..R<n+3> the NC program uses to save the setting data it found (SD43900,
+  /// SD43910, SD43920) and a marker (1 while whirl's compensation is active), so the thread end
+  /// and the reset program restore exactly what was there before. 0..9996; the machine must
+  /// have them (MD28050 $MC_MM_NUM_R_PARAM).
+  int save_r_first = 90;
+  /// -1: the plan writes SD43900 itself. >= 0: combined with the live drift action
+  /// (interp/drift_action.h): the plan writes its K0 into $AC_PARAM[workpiece_k0_param], which the
+  /// drift action adds to the machine's K0, so SD43900 has one writer; the program raises alarm
+  /// `drift_missing_alarm` (SETAL) unless the drift action's marker R<drift_marker_r> is 1.
+  int workpiece_k0_param = -1;
+  int drift_marker_r = -1;
+  int drift_missing_alarm = 65000;
 
-  /// InputError naming the field, value and rule for any option out of range.
+  /// InputError naming the field, value and rule for any option out of range, and for a sign
+  /// that is not ExpectedSign(direction, control_dk).
   void Validate() const;
 };
 
@@ -118,7 +159,8 @@ void ValidatePlan(const CompensationPlan& plan);
 
 // --- Writers -------------------------------------------------------------------------------
 
-/// JSON of the plan (schema "whirl.plan", version 1): settings, segments with units, counts.
+/// JSON of the plan (schema "whirl.plan", version 2: settings gained control_dk, the
+/// synchronized-action ID range and the R parameters): settings, segments with units, counts.
 /// Callers add "curve" and "prediction" objects beside it.
 void to_json(nlohmann::json& j, const CompensationPlan& plan);
 void from_json(const nlohmann::json& j, CompensationPlan& plan);
@@ -126,27 +168,40 @@ void to_json(nlohmann::json& j, const PlanOptions& options);
 void from_json(const nlohmann::json& j, PlanOptions& options);
 
 /// CSV table for a PLC that writes the setting data (one row per segment, in order):
-/// segment,trigger_position_mm,t_a_s,t_b_s,p_a_mm,p_b_mm,sd43900_mm,sd43910,sd43920_mm
+/// segment,trigger_position_mm,t_a_s,t_b_s,p_a_mm,p_b_mm,l_a_um,l_b_um,sd43900_mm,sd43910,
+/// sd43920_mm, fixed decimals per quantity (kDecimals*), then one final row "restore" at the
+/// thread end whose setting-data cells say "saved" (write back the values found before the cut),
 /// with '#' comment lines (axis, sign, direction, MD32760, tolerance, provenance).
 std::string FormatPlcCsv(const CompensationPlan& plan,
                          const std::vector<std::string>& provenance = {});
 
 /// Text facts for the NC program header.
 struct NcProgramInfo {
-  std::string program_name = "WHIRL_TEMP_COMP";  ///< used in the header comment
-  std::string curve_source;  ///< e.g. "model m.json, screw s.json (L=..., t_s=..., k=...)"
+  std::string program_name = "WHIRL_TEMP_COMP";  ///< header comment; letters, digits, '_'
+  std::string reset_program_name = "WHIRL_TEMP_COMP_RESET";  ///< named in the header
+  std::string curve_source;  ///< e.g. "model m.json, screw s.json (L=..., t_s=..., k=...)";
+                             ///< control characters become spaces (one comment line)
 };
 
-/// SINUMERIK part-program text: a header comment (MD32750 = 3, MD32760 cap vs the largest slope,
-/// sign convention, axis, assumptions, curve source), a main-run write of the first segment's
-/// setting data (STOPRE first), then one modal synchronized action per later segment:
-///   ID=<n> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=...
+/// SINUMERIK subprogram (.SPF) that leaves the control as it found it:
+///   CANCEL(n) for every ID of [sync_id_first, sync_id_last] (stale actions of an aborted run);
+///   STOPRE; IF R<m+3><>1: save SD43900/43910/43920 into R<m>..R<m+2> (m = save_r_first), set
+///   the marker R<m+3>=1 (a rerun after an abort does not save whirl's own values); write the
+///   first segment's setting data; STOPRE;
+///   ID=<id> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=...
 ///        $$SA_TEMP_COMP_SLOPE[<axis>]=... $$SA_TEMP_COMP_REF_POSITION[<axis>]=...
-/// ('<=' when travelling in -direction; '$$' = write in the main run, Programming Manual Job
-/// Planning 10.3.8). ID numbers 1..255: more segments is an InputError (raise the tolerance).
-/// Numbers are printed with fixed decimals (positions 4, SD43900 6, SD43910 8). Ends with M17
-/// (subprogram end): call it before the cutting block; modal ID= actions stay active in the
-/// program.
+///     one modal action per later segment ('<=' when travelling in -direction), IDs counting
+///     up from sync_id_first;
+///   ID=<last> WHEN $AA_IM[<axis>]>=<thread end> DO <restore from R<m>..R<m+2>> $R<m+3>=0;
+///   M17 (subprogram end). Call it before the cutting block. IDs beyond sync_id_last are an
+///   InputError (raise the tolerance or widen the range). Header comments state MD32750 = 3,
+///   the MD32760 cap against the largest slope, the sign rule, the axis, IDs and R parameters.
+/// Not verified on a control here (REFERENCE.md 7): the access level for main-run writes of
+/// SD43900-43920 on a given machine.
 std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info = {});
+
+/// The reset subprogram for an aborted cut: CANCEL(n) over the ID range, then, if the marker
+/// R<m+3> is 1, write back the saved SD43900/43910/43920 and clear the marker; M17.
+std::string FormatNcResetProgram(const PlanOptions& options, const NcProgramInfo& info = {});
 
 }  // namespace whirl::interp

@@ -2,4 +2,6 @@
 target_sources(whirl_interp PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/breakpoints.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sinumerik.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/machine_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/drift_action.cpp
 )

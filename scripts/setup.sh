@@ -8,6 +8,7 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libtorch-dev
   gnuplot-nox fonts-liberation   # report plots (pngcairo needs a font; a Recommends of gnuplot-nox)
+  libboost-dev                   # Boost.Math (header-only): F-distribution quantile of the drift selection
 )
 missing=()
 for p in "${packages[@]}"; do

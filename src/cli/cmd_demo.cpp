@@ -13,11 +13,15 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "interp/machine_profile.h"
 #include "nn/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
 namespace {
+
+/// The machine profile the demo plans for (illustrative values).
+constexpr const char* kDemoMachineProfile = "datasets/machines/example_840d.json";
 
 struct DemoOptions {
   std::string out_dir = "whirl-demo-out";
@@ -78,6 +82,8 @@ void RunDemo(const DemoOptions& o) {
       ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv"));
   compare::CompareOptions co;
   co.seed = o.seed;
+  // The example machine's facts (ID range, R parameters, offset): a real run names its own.
+  interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile)).ApplyTo(co.plan);
   std::vector<compare::ScrewComparison> results;
   for (const sim::Screw* screw : std::vector<const sim::Screw*>{&reference, &new_type}) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
@@ -103,11 +109,13 @@ void RunDemo(const DemoOptions& o) {
     interp::NcProgramInfo info;
     info.curve_source = "whirl demo: model " + model_source + ", screw " + screw->name;
     WriteFileAtomic(out / (slug + "_temp_comp.spf"), interp::FormatNcProgram(c.plan, info));
+    WriteFileAtomic(out / (slug + "_temp_comp_reset.spf"),
+                    interp::FormatNcResetProgram(c.plan.options, info));
     std::printf(
         "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
-        "%s_plan.json/.csv and %s_temp_comp.spf\n",
+        "%s_plan.json/.csv and %s_temp_comp.spf (reset: %s_temp_comp_reset.spf)\n",
         screw->name.c_str(), c.plan.segments.size(), c.plan.max_abs_slope, c.plan.options.md32760,
-        (out / slug).string().c_str(), slug.c_str());
+        (out / slug).string().c_str(), slug.c_str(), slug.c_str());
     results.push_back(std::move(c));
   }
 

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "fit/arctan_curve.h"
+#include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
 #include "nn/model.h"
 #include "sim/screw.h"
@@ -26,22 +27,75 @@ struct PlanCliOptions {
   double settle_time_s = NAN;
   double shape_k = fit::kDefaultShapeK;
   double time_exponent = fit::kDefaultTimeExponent;
-  interp::PlanOptions plan;
-  std::string sign = "subtract";
+  double tolerance_um = interp::PlanOptions{}.tolerance_um;
+  double check_step_s = interp::PlanOptions{}.check_step_s;
+  // Machine facts: from --machine, each overridable; NAN / 0 / -1 / "" = not given.
+  std::string machine_path;
+  std::string axis;
+  double start_position_mm = NAN;
+  int direction = 0;
+  double machine_offset_mm = NAN;
+  std::string sign;
+  std::string control_dk;
+  double md32760 = NAN;
+  int sync_id_first = -1;
+  int sync_id_last = -1;
+  int save_r_first = -1;
   std::string out_path;
   std::string csv_path;
   std::string nc_path;
+  std::string reset_nc_path;
+  bool with_drift_action = false;
   bool allow_extrapolation = false;
   bool json = false;
 };
+
+// The plan options from the machine profile and the explicit flags; the machine-specific
+// positions have no default (a wrong zero would put every trigger at the wrong place).
+interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
+  interp::PlanOptions p;
+  p.tolerance_um = o.tolerance_um;
+  p.check_step_s = o.check_step_s;
+  bool have_start = false, have_offset = false;
+  if (!o.machine_path.empty()) {
+    const interp::MachineProfile m = interp::LoadMachineProfile(o.machine_path);
+    if (o.with_drift_action)
+      m.ApplyCombinedTo(p);
+    else
+      m.ApplyTo(p);
+    have_start = m.start_position_mm.has_value();
+    have_offset = true;
+  }
+  if (!o.axis.empty()) p.axis = o.axis;
+  if (o.direction != 0) p.direction = o.direction;
+  if (!o.control_dk.empty()) p.control_dk = interp::ParseControlDk(o.control_dk);
+  if (!std::isnan(o.md32760)) p.md32760 = o.md32760;
+  if (o.sync_id_first >= 0) p.sync_id_first = o.sync_id_first;
+  if (o.sync_id_last >= 0) p.sync_id_last = o.sync_id_last;
+  if (o.save_r_first >= 0) p.save_r_first = o.save_r_first;
+  if (!std::isnan(o.start_position_mm))
+    p.start_position_mm = o.start_position_mm, have_start = true;
+  if (!std::isnan(o.machine_offset_mm))
+    p.machine_offset_mm = o.machine_offset_mm, have_offset = true;
+  if (o.with_drift_action && o.machine_path.empty())
+    throw InputError("plan: --with-drift-action needs --machine (its 'drift' object)");
+  if (!have_start || !have_offset)
+    throw InputError(std::string("plan: ") + (have_start ? "" : "--start-position-mm ") +
+                     (have_start || have_offset ? "" : "and ") +
+                     (have_offset ? "" : "--machine-offset-mm ") +
+                     "required (or a --machine profile that holds them): there is no safe default "
+                     "for where the thread starts on the machine");
+  p.sign = o.sign.empty() ? interp::ExpectedSign(p.direction, p.control_dk)
+                          : interp::ParseSignConvention(o.sign);
+  p.Validate();
+  return p;
+}
 
 void Run(const PlanCliOptions& o) {
   const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
   if (by_features == !o.model_path.empty())
     throw InputError("plan: give either --model M or --max-elongation L --settle-time T");
-  interp::PlanOptions options = o.plan;
-  options.sign = interp::ParseSignConvention(o.sign);
-  options.Validate();
+  const interp::PlanOptions options = ResolvePlanOptions(o);
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   const sim::Kinematics kin = sim::ComputeKinematics(screw);
 
@@ -71,12 +125,6 @@ void Run(const PlanCliOptions& o) {
                   {"settle_time_s", features.settle_time_s}};
     source = "given features, screw " + o.screw_path;
   }
-  if (options.direction < 0 && options.sign == interp::SignConvention::kSubtract)
-    Warn(
-        "direction -1 with sign 'subtract': with the cut running towards the chuck the growth "
-        "points along +axis, so 'add' is the consistent choice if the control adds dK to the "
-        "setpoint (see 'whirl plan --help'); keeping 'subtract' as asked");
-
   const fit::ArctanCurve curve =
       fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
   const interp::CompensationPlan plan =
@@ -98,9 +146,12 @@ void Run(const PlanCliOptions& o) {
   interp::NcProgramInfo info;
   info.curve_source = curve.Describe() + " (" + source + ")";
   const std::string nc_text = o.nc_path.empty() ? "" : interp::FormatNcProgram(plan, info);
+  const std::string reset_text =
+      o.reset_nc_path.empty() ? "" : interp::FormatNcResetProgram(plan.options, info);
   if (!o.out_path.empty()) WriteJsonFile(o.out_path, j);
   if (!o.csv_path.empty()) WriteFileAtomic(o.csv_path, csv_text);
   if (!o.nc_path.empty()) WriteFileAtomic(o.nc_path, nc_text);
+  if (!o.reset_nc_path.empty()) WriteFileAtomic(o.reset_nc_path, reset_text);
 
   if (o.json) {
     PrintJson(j);
@@ -118,11 +169,14 @@ void Run(const PlanCliOptions& o) {
       plan.point_count, plan.segments.size(), uniform.c_str(), options.tolerance_um);
   std::printf("largest |curve - compensation| on the check grid: %.4f um (tolerance %.4g um)\n",
               plan.max_deviation_um, options.tolerance_um);
-  std::printf("largest |SD43910| %.3e (MD32760 cap %.3g), axis %s, sign %s, direction %+d\n",
-              plan.max_abs_slope, options.md32760, options.axis.c_str(),
+  std::printf("largest |SD43910| %s (MD32760 cap %s), axis %s, sign %s, direction %+d\n",
+              interp::FormatFixed(plan.max_abs_slope, interp::kDecimalsSd43910).c_str(),
+              interp::FormatFixed(options.md32760, 4).c_str(), options.axis.c_str(),
               interp::ToString(options.sign).c_str(), options.direction);
-  for (const auto& [path, what] :
-       {std::pair{o.out_path, "plan JSON"}, {o.csv_path, "PLC table"}, {o.nc_path, "NC program"}})
+  for (const auto& [path, what] : {std::pair{o.out_path, "plan JSON"},
+                                   {o.csv_path, "PLC table"},
+                                   {o.nc_path, "NC program"},
+                                   {o.reset_nc_path, "NC reset program"}})
     if (!path.empty()) std::printf("written: %s (%s)\n", path.c_str(), what);
 }
 
@@ -142,12 +196,23 @@ void RegisterPlan(CLI::App& app) {
       "  SD43900 $SA_TEMP_COMP_ABS_VALUE   = s l_A / 1000            [mm]\n"
       "  SD43910 $SA_TEMP_COMP_SLOPE       = s (l_B - l_A)/1000/(P_B - P_A) [-]\n"
       "  SD43920 $SA_TEMP_COMP_REF_POSITION = P_A                    [mm]\n"
-      "with s = -1 (--sign subtract, default) or +1 (add). Default 'subtract': the cut runs\n"
-      "towards the chuck, so the growth of the unmachined section points against the travel;\n"
-      "with --direction +1 following it means dK = -l, assuming the control adds dK to the\n"
-      "setpoint (the manual does not say plainly: verify once on the machine). A slope above\n"
-      "MD32760 is an error. Outputs: plan JSON (--out), PLC table CSV (--csv), NC program with\n"
-      "synchronized actions (--nc); all written atomically. Requires MD32750 = 3.");
+      "The sign s follows the direction of travel: the cut runs towards the chuck, so the growth\n"
+      "of the unmachined section points against the travel and s = -direction if the control\n"
+      "adds dK to the setpoint (control_dk 'added', Siemens' K3 description), +direction if it\n"
+      "subtracts it; --sign is optional and an inconsistent one is refused. Verify control_dk\n"
+      "once on the machine (constant SD43900 test value, dial gauge).\n"
+      "Machine facts come from --machine M.json (schema whirl.machine, see\n"
+      "datasets/machines/example_840d.json; each overridable by its flag): axis, direction,\n"
+      "machine offset, control_dk, MD32760, the synchronized-action IDs and R parameters whirl "
+      "may\n"
+      "use. --start-position-mm and --machine-offset-mm have no default: give them or a profile.\n"
+      "The NC program (--nc, a subprogram ending in M17: save it as .SPF) cancels its ID range,\n"
+      "saves the setting data it finds in R parameters, writes the segments through synchronized\n"
+      "actions and restores the saved values at the thread end; --reset-nc writes the program\n"
+      "to run after an aborted cut. Numbers: positions and SD43920 4 decimals [mm], SD43900 6\n"
+      "[mm], SD43910 8 [-], identical in NC, PLC table and JSON. A slope above MD32760 is an\n"
+      "error. Outputs: plan JSON (--out), PLC table CSV (--csv), NC programs; all written\n"
+      "atomically, none if any fails. Requires MD32750 = 3.");
   sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
       ->check(CLI::ExistingFile);
   sub->add_option("--screw", o->screw_path,
@@ -161,37 +226,62 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--settle-time", o->settle_time_s, "instead of --model: settle time t_s [s]")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
-  sub->add_option("--tolerance-um", o->plan.tolerance_um,
+  sub->add_option("--tolerance-um", o->tolerance_um,
                   "largest |compensation - curve| along the thread [um], > 0")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  sub->add_option("--axis", o->plan.axis, "axis name for $SA_TEMP_COMP_*[axis] and $AA_IM[axis]")
-      ->capture_default_str();
-  sub->add_option("--start-position-mm", o->plan.start_position_mm,
-                  "axis position at the thread start (time 0), program coordinates [mm]")
-      ->capture_default_str();
-  sub->add_option("--direction", o->plan.direction,
-                  "direction of travel along the axis while cutting: 1 or -1")
-      ->capture_default_str()
+  sub->add_option("--machine", o->machine_path,
+                  "machine profile JSON (schema whirl.machine): axis, direction, machine offset, "
+                  "control_dk, MD32760, ID range, R parameters")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--axis", o->axis,
+                  "axis name for $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (default Z)");
+  sub->add_option("--start-position-mm", o->start_position_mm,
+                  "axis position at the thread start (time 0), program coordinates [mm]; "
+                  "required unless the profile has it");
+  sub->add_option("--direction", o->direction,
+                  "direction of travel along the axis while cutting: 1 or -1 (default 1)")
       ->check(CLI::IsMember({1, -1}));
-  sub->add_option("--machine-offset-mm", o->plan.machine_offset_mm,
+  sub->add_option("--machine-offset-mm", o->machine_offset_mm,
                   "machine coordinate of the program zero on this axis [mm] (SD43920 and "
-                  "$AA_IM are machine coordinates)")
-      ->capture_default_str();
-  sub->add_option("--sign", o->sign, "dK = -l (subtract) or +l (add), see above")
-      ->capture_default_str()
+                  "$AA_IM are machine coordinates); required unless --machine");
+  sub->add_option("--control-dk", o->control_dk,
+                  "how the control applies dK: added (default) or subtracted")
+      ->check(CLI::IsMember({"added", "subtracted"}));
+  sub->add_option("--sign", o->sign,
+                  "optional check: subtract (dK = -l) or add (dK = +l); must match the rule above")
       ->check(CLI::IsMember({"subtract", "add"}));
-  sub->add_option("--md32760", o->plan.md32760,
-                  "MD32760 $MA_COMP_ADD_VELO_FACTOR of the axis: cap on |SD43910| (0-0.10]")
-      ->capture_default_str()
+  sub->add_option("--md32760", o->md32760,
+                  "MD32760 $MA_COMP_ADD_VELO_FACTOR of the axis: cap on |SD43910| (0-0.10], "
+                  "default 0.01")
       ->check(CLI::Range(1e-12, interp::kMd32760Max));
-  sub->add_option("--check-step-s", o->plan.check_step_s,
+  sub->add_option("--sync-id-first", o->sync_id_first,
+                  "first synchronized-action ID whirl may use (1-255, default 1)")
+      ->check(CLI::Range(1, 255));
+  sub->add_option("--sync-id-last", o->sync_id_last,
+                  "last synchronized-action ID whirl may use (1-255, default 255); the programs "
+                  "CANCEL the whole range first")
+      ->check(CLI::Range(1, 255));
+  sub->add_option("--save-r", o->save_r_first,
+                  "R<n>..R<n+3> keep the setting data found before the cut and a marker "
+                  "(0-9996, default 90)")
+      ->check(CLI::Range(0, 9996));
+  sub->add_option("--check-step-s", o->check_step_s,
                   "largest step of the grid the tolerance is checked on [s] (refined as needed)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sub->add_option("--out", o->out_path, "write the plan JSON here");
   sub->add_option("--csv", o->csv_path, "write the PLC table (CSV) here");
-  sub->add_option("--nc", o->nc_path, "write the NC program (text, e.g. .mpf/.spf) here");
+  sub->add_option(
+      "--nc", o->nc_path,
+      "write the NC subprogram here (ends in M17: name it .SPF, e.g. WHIRL_TEMP_COMP.SPF)");
+  sub->add_flag("--with-drift-action", o->with_drift_action,
+                "combined with the live drift action (whirl drift nc) on the same axis: the plan "
+                "writes its K0 into the profile's drift.workpiece_k0_param and the drift action "
+                "adds it into SD43900, its only writer; the program raises the profile's alarm if "
+                "the drift action is not active");
+  sub->add_option("--reset-nc", o->reset_nc_path,
+                  "write the reset subprogram for an aborted cut here (.SPF)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
                 "plan even if the screw is outside the model's training domain");
   sub->add_flag("--json", o->json, "machine output: the plan JSON on stdout");

@@ -22,5 +22,7 @@ void RegisterTorchForwarders(CLI::App& app);
 void RegisterDemo(CLI::App& app);        // cmd_demo.cpp
 void RegisterBallbar(CLI::App& app);     // cmd_ballbar.cpp
 void RegisterSurface(CLI::App& app);     // cmd_surface.cpp
+void RegisterDrift(CLI::App& app);       // cmd_drift.cpp
+void RegisterDriftNc(CLI::App* drift);   // cmd_drift_nc.cpp: whirl drift nc
 
 }  // namespace whirl::cli

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   RegisterEvaluate(app);
   RegisterBallbar(app);
   RegisterSurface(app);
+  RegisterDrift(app);
   RegisterTorchForwarders(app);
   return RunApp(app, argc, argv);
 }

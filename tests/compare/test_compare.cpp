@@ -45,14 +45,16 @@ TEST(ComparePlan, PlanOfTheTruthLeavesOnlyThePlanTolerance) {
   // Truth = the arctan curve itself, for either sign convention and direction: the lead error left
   // is the chord error of the plan, bounded by its tolerance (twice: d is a difference of two
   // residuals), far below the uncompensated error.
-  for (auto sign : {interp::SignConvention::kSubtract, interp::SignConvention::kAdd})
+  for (auto control : {interp::ControlDk::kAdded, interp::ControlDk::kSubtracted})
     for (int direction : {1, -1}) {
+      const interp::SignConvention sign = interp::ExpectedSign(direction, control);
       fit::ArctanCurve curve;
       curve.max_elongation_um = 40;
       curve.settle_time_s = 300;
       curve.shape_k = 4;
       interp::PlanOptions po;
       po.sign = sign;
+      po.control_dk = control;
       po.direction = direction;
       po.start_position_mm = 100;
       po.tolerance_um = 0.5;

@@ -5,35 +5,64 @@ W="$1"; D="$2"; SRC="$3"
 rm -rf "$D"; mkdir -p "$D"
 source "$SRC/tests/support/cli_common.sh"
 S="$SRC/datasets/screws/reference_80x10x6000.json"
+M="$SRC/datasets/machines/example_840d.json"
+POS=(--start-position-mm 0 --machine-offset-mm -850)
 
 "$W" plan --help | grep -q "SD43910" || fail "plan --help"
 
 # From given features: all three outputs, consistent with each other.
-"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --out "$D/plan.json" \
-  --csv "$D/plan.csv" --nc "$D/plan.mpf" > "$D/plan.txt" || fail "plan"
-for f in plan.json plan.csv plan.mpf; do [ -s "$D/$f" ] || fail "$f not written"; done
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --out "$D/plan.json" \
+  --csv "$D/plan.csv" --nc "$D/plan.spf" --reset-nc "$D/reset.spf" > "$D/plan.txt" || fail "plan"
+for f in plan.json plan.csv plan.spf reset.spf; do [ -s "$D/$f" ] || fail "$f not written"; done
 grep -q '"schema": "whirl.plan"' "$D/plan.json" || fail "plan JSON schema"
 grep -q '"uniform_point_count"' "$D/plan.json" || fail "plan JSON uniform count"
-grep -q "MD32750 \$MA_TEMP_COMP_TYPE = 3" "$D/plan.mpf" || fail "NC header"
-segments=$(grep -v '^#' "$D/plan.csv" | tail -n +2 | wc -l)
-actions=$(grep -c '^ID=' "$D/plan.mpf")
-[ "$actions" -eq $((segments - 1)) ] || fail "$segments segments but $actions synchronized actions"
-grep -q ">=" "$D/plan.mpf" || fail "direction +1 must compare with >="
-"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --direction -1 --sign add \
-  --nc "$D/minus.mpf" > /dev/null || fail "plan direction -1"
-grep -q "<=" "$D/minus.mpf" || fail "direction -1 must compare with <="
+grep -q "MD32750 \$MA_TEMP_COMP_TYPE = 3" "$D/plan.spf" || fail "NC header"
+segments=$(grep -v '^#' "$D/plan.csv" | tail -n +2 | grep -vc '^restore')
+actions=$(grep -c '^ID=' "$D/plan.spf")
+# One action per later segment plus the restore at the thread end, IDs from the profile's range.
+[ "$actions" -eq "$segments" ] || fail "$segments segments but $actions synchronized actions"
+grep -q "^ID=100 " "$D/plan.spf" || fail "IDs do not start at the profile's sync_id_first"
+[ "$(grep -c '^CANCEL(' "$D/plan.spf")" -eq 50 ] || fail "the ID range 100..149 is not cancelled"
+grep -q '^CANCEL(149)' "$D/reset.spf" || fail "reset program does not cancel the range"
+grep -q "R90=\$SA_TEMP_COMP_ABS_VALUE" "$D/plan.spf" || fail "found values not saved"
+grep -q "^M17" "$D/plan.spf" || fail "no M17"
+grep -Eq '[0-9]e-?[0-9]' "$D/plan.csv" "$D/plan.spf" && fail "exponent in a control file"
+grep -q '^restore,.*,saved,saved,saved$' "$D/plan.csv" || fail "PLC table lacks the restore row"
+grep -q ">=" "$D/plan.spf" || fail "direction +1 must compare with >="
+# The sign follows the direction: -1 gives 'add' by itself; an inconsistent --sign is refused.
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --direction -1 \
+  --nc "$D/minus.spf" > /dev/null || fail "plan direction -1"
+grep -q "<=" "$D/minus.spf" || fail "direction -1 must compare with <="
+grep -q "sign: add" "$D/minus.spf" || fail "direction -1 must give sign add"
+expect_fail "inconsistent" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --direction -1 --sign subtract
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --direction -1 \
+  --control-dk subtracted --sign subtract > /dev/null || fail "consistent explicit sign refused"
+# No machine positions, no plan.
+expect_fail "start-position-mm" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250
+expect_fail "machine-offset-mm" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --start-position-mm 0
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 "${POS[@]}" > /dev/null \
+  || fail "plan with explicit positions"
+# Bad machine profile: the message names the file and the key.
+sed 's/"direction": 1/"direction": 2/' "$M" > "$D/bad_machine.json"
+expect_fail "bad_machine.json" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$D/bad_machine.json"
+sed 's/"sync_id_first": 200/"sync_id_frist": 200/' "$M" > "$D/typo_machine.json"
+expect_fail "sync_id_frist" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$D/typo_machine.json"
 # A tighter tolerance needs more points.
-"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --tolerance-um 0.1 --csv "$D/tight.csv" \
-  > /dev/null || fail "plan tight"
-tight=$(grep -v '^#' "$D/tight.csv" | tail -n +2 | wc -l)
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --tolerance-um 0.1 \
+  --csv "$D/tight.csv" > /dev/null || fail "plan tight"
+tight=$(grep -v '^#' "$D/tight.csv" | tail -n +2 | grep -vc '^restore')
 [ "$tight" -gt "$segments" ] || fail "tolerance 0.1 gave $tight segments, 0.5 gave $segments"
 
 # Bad input: negative tolerance, a slope cap below the plan's slopes (nothing overwritten).
 cp "$D/plan.json" "$D/plan.before"
-"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --tolerance-um -1 > /dev/null 2>&1 \
-  && fail "negative tolerance accepted"
-expect_fail "MD32760" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --md32760 1e-6 \
-  --out "$D/plan.json"
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --tolerance-um -1 \
+  > /dev/null 2>&1 && fail "negative tolerance accepted"
+expect_fail "MD32760" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" \
+  --md32760 1e-6 --out "$D/plan.json"
 cmp -s "$D/plan.json" "$D/plan.before" || fail "failed plan overwrote the previous file"
 expect_fail "either" "$W" plan --screw "$S"
 
@@ -41,11 +70,13 @@ expect_fail "either" "$W" plan --screw "$S"
 if [ -f "$SRC/datasets/whirling_train.csv" ]; then
   "$W" train --data "$SRC/datasets/whirling_train.csv" --out "$D/m.json" --epochs 200 \
     > /dev/null 2>&1 || fail "train"
-  "$W" plan --model "$D/m.json" --screw "$S" --json > "$D/model_plan.json" || fail "plan --model"
+  "$W" plan --model "$D/m.json" --screw "$S" --machine "$M" --json > "$D/model_plan.json" \
+    || fail "plan --model"
   grep -q '"max_elongation_std_um"' "$D/model_plan.json" || fail "plan JSON lacks the std"
   sed 's/"diameter_mm": 80.0/"diameter_mm": 130.0/' "$S" > "$D/big.json"
-  expect_fail "allow-extrapolation" "$W" plan --model "$D/m.json" --screw "$D/big.json"
-  "$W" plan --model "$D/m.json" --screw "$D/big.json" --allow-extrapolation > /dev/null 2> "$D/warn.txt" \
+  expect_fail "allow-extrapolation" "$W" plan --model "$D/m.json" --screw "$D/big.json" --machine "$M"
+  "$W" plan --model "$D/m.json" --screw "$D/big.json" --machine "$M" --allow-extrapolation \
+    > /dev/null 2> "$D/warn.txt" \
     || fail "plan --allow-extrapolation: $(cat "$D/warn.txt")"
   grep -q "warning" "$D/warn.txt" || fail "no extrapolation warning"
   "$W" curve --model "$D/m.json" --screw "$S" --out "$D/model_curve.csv" > /dev/null || fail "curve --model"

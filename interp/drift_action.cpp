@@ -1,0 +1,286 @@
+#include "interp/drift_action.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace whirl::interp {
+namespace {
+
+constexpr std::size_t kMaxNcLine = 512;
+
+std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
+std::string R(int n) { return "R" + std::to_string(n); }
+std::string Num(double v, int decimals) { return FormatFixed(v, decimals); }
+// "+x" or "-x": a term appended to an expression (never "+-x", which a control may refuse).
+std::string Term(double v, int decimals) {
+  const std::string text = Num(v, decimals);
+  return text[0] == '-' ? text : "+" + text;
+}
+
+// The sign s of dK = s * e / 1000 (see the header comment).
+double DriftSign(const DriftActionOptions& o) {
+  return (o.control_dk == ControlDk::kAdded ? -1.0 : 1.0) * o.error_direction;
+}
+
+void CheckModel(const drift::DriftModel& m) {
+  if (m.kind == drift::ModelKind::kNetwork)
+    throw InputError(
+        "drift action: a network model cannot be evaluated by synchronized actions "
+        "here; fit the channel with --kind mlr or --kind dynamic");
+  if (!m.time_constants.empty() && m.time_unit != "min")
+    throw InputError("drift action: the model's lag time constants are in '" + m.time_unit +
+                     "' (its training runs had no time column): refit on runs with time_s or "
+                     "time_min so the lags can be run per interpolation cycle");
+}
+
+std::vector<std::string> Inputs(const drift::DriftModel& m) {
+  std::vector<std::string> in = m.sensors;
+  in.insert(in.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+  return in;
+}
+
+const AnalogInput& Input(const DriftActionOptions& o, const std::string& name) {
+  const auto it = o.inputs.find(name);
+  if (it == o.inputs.end())
+    throw InputError("drift action: no analog input mapped for the model's input '" + name +
+                     "' (give --input " + name +
+                     "=INDEX:SCALE:OFFSET or the profile's "
+                     "drift.analog_inputs)");
+  return it->second;
+}
+
+std::string Reading(const AnalogInput& a) {
+  return Num(a.scale, kDecimalsDriftCoefficient) + "*$A_INA[" + std::to_string(a.index) + "]" +
+         Term(a.offset, 4);
+}
+
+struct Layout {
+  int per = 1;  // slots per input: value + lags
+  int features = 0, ref = 0, flag = 0;
+};
+
+Layout MakeLayout(const drift::DriftModel& m, const DriftActionOptions& o) {
+  Layout l;
+  l.per = 1 + static_cast<int>(m.time_constants.size());
+  l.features = o.param_first;
+  l.ref = l.features + static_cast<int>(m.features.size());
+  l.flag = l.ref + static_cast<int>(m.sensors.size());
+  return l;
+}
+
+std::string Line(const std::string& text) {
+  if (text.size() > kMaxNcLine)
+    throw InputError("drift action: an NC line would be " + std::to_string(text.size()) +
+                     " characters, above the control's " + std::to_string(kMaxNcLine) +
+                     ": use fewer sensors or lags");
+  return text + "\n";
+}
+
+// The static actions, in execution order.
+std::vector<std::string> ActionBodies(const drift::DriftModel& m, const DriftActionOptions& o) {
+  const Layout l = MakeLayout(m, o);
+  const std::vector<std::string> in = Inputs(m);
+  const int ns = static_cast<int>(m.sensors.size());
+  std::vector<std::string> bodies;
+  std::string init_ref;
+  if (o.reference == DriftReference::kStart) {
+    for (int i = 0; i < ns; ++i) init_ref += " " + P(l.ref + i) + "=" + Reading(Input(o, in[i]));
+    bodies.push_back("WHENEVER " + P(l.flag) + "==0 DO" + init_ref);
+  }
+  for (int i = 0; i < static_cast<int>(in.size()); ++i) {
+    std::string ref;
+    if (i < ns)
+      ref = o.reference == DriftReference::kStart ? "-" + P(l.ref + i) : Term(-m.reference_C(i), 4);
+    bodies.push_back("DO " + P(l.features + i * l.per) + "=" + Reading(Input(o, in[i])) + ref);
+  }
+  if (l.per > 1) {
+    std::string init = "WHENEVER " + P(l.flag) + "==0 DO";
+    for (int i = 0; i < static_cast<int>(in.size()); ++i)
+      for (int k = 1; k < l.per; ++k)
+        init += " " + P(l.features + i * l.per + k) + "=" + P(l.features + i * l.per);
+    bodies.push_back(init + " " + P(l.flag) + "=1");
+    for (int i = 0; i < static_cast<int>(in.size()); ++i) {
+      std::string upd = "DO";
+      const std::string u = P(l.features + i * l.per);
+      for (int k = 1; k < l.per; ++k) {
+        const double a = 1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / m.time_constants[k - 1]);
+        const std::string y = P(l.features + i * l.per + k);
+        upd += " " + y + "=" + y + Term(a, kDecimalsLagFactor) + "*(" + u + "-" + y + ")";
+      }
+      bodies.push_back(upd);
+    }
+  } else {
+    bodies.push_back("WHENEVER " + P(l.flag) + "==0 DO " + P(l.flag) + "=1");
+  }
+  const Eigen::VectorXd c = DriftControlCoefficients(m, o);
+  std::string out =
+      "DO $$SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]=" + Num(c(0), kDecimalsDriftCoefficient);
+  for (Eigen::Index f = 1; f < c.size(); ++f)
+    out += Term(c(f), kDecimalsDriftCoefficient) + "*" + P(l.features + static_cast<int>(f) - 1);
+  if (o.workpiece_k0_param >= 0) out += "+" + P(o.workpiece_k0_param);
+  bodies.push_back(out);
+  return bodies;
+}
+
+std::string CancelRange(int first, int last) {
+  std::string out;
+  for (int id = first; id <= last; ++id) out += "CANCEL(" + std::to_string(id) + ")\n";
+  return out;
+}
+
+bool Overlap(int a0, int a1, int b0, int b1) { return a0 <= b1 && b0 <= a1; }
+
+}  // namespace
+
+std::string ToString(DriftReference r) { return r == DriftReference::kStart ? "start" : "model"; }
+
+DriftReference ParseDriftReference(const std::string& s) {
+  if (s == "model") return DriftReference::kModel;
+  if (s == "start") return DriftReference::kStart;
+  throw InputError("drift reference '" + s +
+                   "': must be 'model' (the model's reference "
+                   "temperatures) or 'start' (the temperatures when the action starts)");
+}
+
+void DriftActionOptions::Validate() const {
+  PlanOptions axis_check;
+  axis_check.axis = axis;
+  axis_check.sign = ExpectedSign(axis_check.direction, axis_check.control_dk);
+  axis_check.Validate();
+  if (error_direction != 1 && error_direction != -1)
+    throw InputError("drift error_direction " + std::to_string(error_direction) +
+                     ": must be +1 or -1");
+  if (!(ipo_cycle_ms > 0 && ipo_cycle_ms <= 100))
+    throw InputError("drift ipo_cycle_ms " + FormatFixed(ipo_cycle_ms, 3) +
+                     ": must be within (0, 100] ms");
+  if (!(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= 255))
+    throw InputError("drift synchronized-action IDs " + std::to_string(sync_id_first) + ".." +
+                     std::to_string(sync_id_last) + ": must satisfy 1 <= first <= last <= 255");
+  if (!(param_first >= 0 && param_first <= 9999))
+    throw InputError("drift param_first " + std::to_string(param_first) +
+                     ": must be within 0..9999");
+  if (!(save_r_first >= 0 && save_r_first <= 9998))
+    throw InputError("drift save_r_first " + std::to_string(save_r_first) +
+                     ": must be within 0..9998");
+  if (workpiece_k0_param > 9999)
+    throw InputError("drift workpiece_k0_param " + std::to_string(workpiece_k0_param) +
+                     ": must be within 0..9999");
+  for (const auto& [name, a] : inputs)
+    if (!(a.index >= 1 && a.index <= 999) || !std::isfinite(a.scale) || a.scale == 0 ||
+        !std::isfinite(a.offset))
+      throw InputError("analog input for '" + name +
+                       "': index must be 1..999, scale finite and "
+                       "non-zero, offset finite");
+}
+
+int DriftParamCount(const drift::DriftModel& m) {
+  return static_cast<int>(m.features.size() + m.sensors.size()) + 1;
+}
+
+Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& m, const DriftActionOptions& o) {
+  CheckModel(m);
+  const double s = DriftSign(o);
+  Eigen::VectorXd c = m.linear.coefficients;
+  for (Eigen::Index i = 0; i < c.size(); ++i)
+    c(i) = RoundTo(s * c(i) / 1000.0, kDecimalsDriftCoefficient);
+  return c;
+}
+
+std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOptions& o,
+                                 const std::string& model_source) {
+  o.Validate();
+  CheckModel(m);
+  const Layout l = MakeLayout(m, o);
+  const int used_params_last = l.flag;
+  if (o.workpiece_k0_param >= 0 &&
+      Overlap(o.workpiece_k0_param, o.workpiece_k0_param, o.param_first, used_params_last))
+    throw InputError("drift action: workpiece_k0_param " + std::to_string(o.workpiece_k0_param) +
+                     " lies in the action's own $AC_PARAM slots " + std::to_string(o.param_first) +
+                     ".." + std::to_string(used_params_last));
+  const std::vector<std::string> bodies = ActionBodies(m, o);
+  const int available = o.sync_id_last - o.sync_id_first + 1;
+  if (static_cast<int>(bodies.size()) > available)
+    throw InputError("drift action needs " + std::to_string(bodies.size()) +
+                     " synchronized-action IDs, the range " + std::to_string(o.sync_id_first) +
+                     ".." + std::to_string(o.sync_id_last) + " has " + std::to_string(available));
+  const int r = o.save_r_first;
+  std::string nc;
+  nc +=
+      "; WHIRL_DRIFT_COMP: SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
+  nc += Line("; model: " + drift::ToString(m.kind) + " of " + m.error_column + " from " +
+             std::to_string(m.sensors.size()) + " sensors" +
+             (model_source.empty() ? std::string() : ", file " + model_source));
+  nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + Num(DriftSign(o), 0) +
+        " (control_dk " + ToString(o.control_dk) + ", error_direction " +
+        std::to_string(o.error_direction) + "); reference " + ToString(o.reference) +
+        "; interpolation cycle " + Num(o.ipo_cycle_ms, 3) + " ms\n";
+  nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
+        std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
+        std::to_string(o.param_first) + ".." + std::to_string(used_params_last) + "], " + R(r) +
+        " (SD43900 found) and " + R(r + 1) + " (1 while active)\n";
+  if (o.workpiece_k0_param >= 0)
+    nc += "; adds the whirling plan's K0 from $AC_PARAM[" + std::to_string(o.workpiece_k0_param) +
+          "]: this action is the only writer of SD43900 on axis " + o.axis + "\n";
+  nc += "; requires MD32750 $MA_TEMP_COMP_TYPE bit 0 for axis " + o.axis +
+        "; stop it with WHIRL_DRIFT_COMP_RESET (restores the SD43900 found)\n";
+  nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
+  nc += "IF " + R(r + 1) + "<>1\n" + R(r) + "=$SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]\n" +
+        R(r + 1) + "=1\nENDIF\n";
+  nc += P(l.flag) + "=0\n";
+  if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
+  nc += "STOPRE\n";
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    nc += Line("IDS=" + std::to_string(o.sync_id_first + static_cast<int>(k)) + " " + bodies[k]);
+  nc += "M17\n";
+  return nc;
+}
+
+std::string FormatDriftNcResetProgram(const DriftActionOptions& o) {
+  o.Validate();
+  const int r = o.save_r_first;
+  std::string nc = "; WHIRL_DRIFT_COMP_RESET: stops the live drift compensation of axis " + o.axis +
+                   " and restores the SD43900 found before it started\n";
+  nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
+  nc += "IF " + R(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]=" + R(r) + "\n" +
+        R(r + 1) + "=0\nENDIF\nSTOPRE\nM17\n";
+  return nc;
+}
+
+std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptions& o) {
+  o.Validate();
+  const Eigen::VectorXd c = DriftControlCoefficients(m, o);
+  const std::vector<std::string> in = Inputs(m);
+  const int ns = static_cast<int>(m.sensors.size());
+  std::string out;
+  out +=
+      "# whirl drift action as a PLC table: every cycle T = scale * AIN[ain_index] + offset; "
+      "u = T - reference_C (sensors; extra inputs: u = T);\n";
+  out += "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); SD43900[" + o.axis +
+         "] = sum of coefficient_mm_per_unit * feature value, intercept included (mm)\n";
+  out += "# model " + drift::ToString(m.kind) + " of " + m.error_column +
+         "; sign applied (s = " + Num(DriftSign(o), 0) + "); interpolation cycle " +
+         Num(o.ipo_cycle_ms, 3) + " ms\n";
+  out +=
+      "feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,coefficient_mm_per_"
+      "unit\n";
+  out += "intercept,,,,,,,," + Num(c(0), kDecimalsDriftCoefficient) + "\n";
+  for (std::size_t f = 0; f < m.features.size(); ++f) {
+    const drift::Feature& feat = m.features[f];
+    int input = 0;
+    while (in[static_cast<std::size_t>(input)] != feat.input) ++input;
+    const AnalogInput& a = Input(o, feat.input);
+    const std::string ref = input < ns ? Num(m.reference_C(input), 4) : "";
+    const std::string tau = feat.tau > 0 ? Num(feat.tau, 3) : "";
+    const std::string af =
+        feat.tau > 0 ? Num(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
+                     : "";
+    out += feat.Name(m.time_unit) + "," + feat.input + "," + std::to_string(a.index) + "," +
+           Num(a.scale, kDecimalsDriftCoefficient) + "," + Num(a.offset, 4) + "," + ref + "," +
+           tau + "," + af + "," +
+           Num(c(static_cast<Eigen::Index>(f) + 1), kDecimalsDriftCoefficient) + "\n";
+  }
+  return out;
+}
+
+}  // namespace whirl::interp

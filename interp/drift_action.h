@@ -1,0 +1,99 @@
+#pragma once
+// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/drift, kinds mlr and
+// dynamic) evaluated every interpolation cycle by static synchronized actions from the machine's
+// analog inputs, written into SD43900 $SA_TEMP_COMP_ABS_VALUE (the position-independent K0 that
+// Siemens designed for exactly this, REFERENCE.md 7), plus the same model as a PLC table.
+//
+// Inputs. Sensor i of the model reads T_i = scale_i * $A_INA[index_i] + offset_i [degC]; an extra
+// input (e.g. spindle_rpm) reads scale * $A_INA[index] + offset in its own unit. The mapping is a
+// machine fact (profile "drift.analog_inputs", or --input on the command line).
+// Rises. u_i = T_i - T_ref,i: T_ref is the model's reference_C (reference "model", for a control
+// that runs all day) or the temperatures when the action starts (reference "start", seed 000's
+// convention of rises from the run's first row).
+// Lags. Each lagged feature runs the recursion of drift/regression.h FirstOrderLag once per
+// interpolation cycle T_ipo: L <- L + a (u - L), a = 1 - exp(-T_ipo / tau), L_0 = u_0.
+// Output. dK = s * e / 1000 mm with e = b0 + sum_f b_f x_f [um] (drift/model.h), where
+// s = -error_direction if the control adds dK to the setpoint and +error_direction if it
+// subtracts it; error_direction = +1 means the model's error is the tool's displacement along
+// +axis relative to the workpiece (what a dial gauge on the table reads along +axis).
+//
+// $AC_PARAM layout from param_first: one slot per model feature (input-major, as DriftModel::
+// features), then one reference slot per sensor (reference "start"), then an init flag.
+// Action order (IDs count up from sync_id_first; actions run in ID order every cycle):
+//   [start: capture T_ref once] -> rises u -> [lags: L = u once] -> [lag updates] -> SD43900.
+//
+// One writer per setting datum. With a whirling plan on the same axis (whirl plan
+// --with-drift-action), the plan's actions write their K0 into $AC_PARAM[workpiece_k0_param]
+// instead of SD43900 (they still own SD43910/SD43920), and this action writes
+//   SD43900 = machine K0 + $AC_PARAM[workpiece_k0_param],
+// so the two never fight over SD43900; the plan program refuses to start (alarm) unless this
+// action's marker says it is active. The drift action's IDs must lie above the plan's: actions
+// run in ID order each cycle, so the plan's K0 is written before it is added (no cycle of lag).
+//
+// The programs save the SD43900 they find (R<save_r_first>, marker R<save_r_first + 1>) and the
+// reset program cancels the actions and restores it, so the control ends as it was found.
+// Not verified on a control here: the access level of main-run writes and whether IDS actions
+// survive a reset on every software version (REFERENCE.md 7).
+#include <map>
+#include <string>
+#include <vector>
+
+#include "drift/model.h"
+#include "interp/sinumerik.h"
+
+namespace whirl::interp {
+
+/// One analog input: value = scale * $A_INA[index] + offset (degC for a sensor).
+struct AnalogInput {
+  int index = 1;        ///< $A_INA[index], 1..999
+  double scale = 1.0;   ///< per input unit (e.g. 0.1 degC per unit), finite, non-zero
+  double offset = 0.0;  ///< degC (or the input's unit)
+};
+
+enum class DriftReference { kModel, kStart };
+std::string ToString(DriftReference r);                    ///< "model" / "start"
+DriftReference ParseDriftReference(const std::string& s);  ///< InputError otherwise
+
+struct DriftActionOptions {
+  std::string axis = "Z";
+  ControlDk control_dk = ControlDk::kAdded;
+  int error_direction = 1;    ///< +1 / -1, see the header comment
+  double ipo_cycle_ms = 4.0;  ///< interpolation cycle of the control [ms], (0, 100]
+  int sync_id_first = 1;      ///< IDS range of the drift action, within 1..255
+  int sync_id_last = 255;
+  int param_first = 0;          ///< first $AC_PARAM slot used (0..9999)
+  int save_r_first = 80;        ///< R<n> saved SD43900, R<n+1> marker (1 while active)
+  int workpiece_k0_param = -1;  ///< >= 0: add $AC_PARAM[n] (the whirling plan's K0)
+  int missing_alarm = 65000;    ///< SETAL number the combined plan raises if this is not active
+  DriftReference reference = DriftReference::kModel;
+  std::map<std::string, AnalogInput> inputs;  ///< by column name (sensors and extra inputs)
+
+  void Validate() const;  ///< InputError naming the field and the rule
+};
+
+/// How many $AC_PARAM slots the action uses for `model` (features, references, flag).
+int DriftParamCount(const drift::DriftModel& model);
+
+/// The NC program (subprogram, .SPF, ends in M17) that installs the static actions. InputError for
+/// a network model, a dynamic model without a time unit of minutes, a missing analog input, an ID
+/// range too small, or a line longer than the control's 512 characters.
+std::string FormatDriftNcProgram(const drift::DriftModel& model, const DriftActionOptions& options,
+                                 const std::string& model_source = "");
+
+/// The program that cancels the drift action's IDs and restores the saved SD43900.
+std::string FormatDriftNcResetProgram(const DriftActionOptions& options);
+
+/// The same model for a PLC: '#' comments with the formula, then one row per feature:
+/// feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,coefficient_mm_per_unit
+/// and a first row "intercept" with coefficient b0 (mm, sign applied). Fixed decimals.
+std::string FormatDriftPlcCsv(const drift::DriftModel& model, const DriftActionOptions& options);
+
+/// The coefficients the control applies: c_0 = s * b0 / 1000 [mm], c_f = s * b_f / 1000
+/// [mm per unit], rounded to kDecimalsDriftCoefficient as printed.
+Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& model,
+                                         const DriftActionOptions& options);
+
+inline constexpr int kDecimalsDriftCoefficient = 10;  ///< mm per K (or per input unit)
+inline constexpr int kDecimalsLagFactor = 15;         ///< a = 1 - exp(-T_ipo / tau)
+
+}  // namespace whirl::interp

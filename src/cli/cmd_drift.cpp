@@ -1,0 +1,456 @@
+// whirl drift: machine thermal drift from temperature sensors (seed 000): sensitive points,
+// drift models, prediction, cross-run and hold-out evaluation, report (src/drift/).
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/safe_text.h"
+#include "drift/documents.h"
+#include "drift/evaluation.h"
+#include "drift/model.h"
+#include "drift/report.h"
+#include "drift/run_file.h"
+
+namespace whirl::cli {
+namespace {
+
+using drift::Run;
+using drift::RunState;
+
+const char* kRunFilesHelp =
+    "Run files: CSV, header row; time_s [s] or time_min [min] (empty/nan cells: the sample\n"
+    "index is used and said so); temperatures <name>_C [degC]; errors <name>_um [um]; other\n"
+    "columns (e.g. spindle_rpm) are optional inputs. At most 2,000,000 rows, 512 columns.\n";
+
+struct RunInputs {
+  std::vector<std::string> runs, idle, cutting;
+};
+
+void AddRunOptions(CLI::App* sub, RunInputs* r, bool required = true) {
+  auto* a = sub->add_option("--run", r->runs, "run file(s) of unstated state")->check(CLI::ExistingFile);
+  auto* b = sub->add_option("--idle", r->idle, "run file(s) recorded in idle running")
+                ->check(CLI::ExistingFile);
+  auto* c = sub->add_option("--cutting", r->cutting, "run file(s) recorded while cutting")
+                ->check(CLI::ExistingFile);
+  if (required) {
+    a->group("Runs (at least one)");
+    b->group("Runs (at least one)");
+    c->group("Runs (at least one)");
+  }
+}
+
+std::vector<Run> LoadRuns(const RunInputs& in) {
+  std::vector<Run> runs;
+  for (const auto& p : in.idle) runs.push_back(drift::ReadRun(p, RunState::kIdle));
+  for (const auto& p : in.cutting) runs.push_back(drift::ReadRun(p, RunState::kCutting));
+  for (const auto& p : in.runs) runs.push_back(drift::ReadRun(p, RunState::kUnknown));
+  if (runs.empty()) throw InputError("give at least one run file (--run, --idle or --cutting)");
+  for (const Run& r : runs)
+    if (r.time_from_index)
+      Warn(r.source + ": no complete time column: the sample index is used as time");
+  return runs;
+}
+
+struct SelectionArgs {
+  double alpha = 0.05;
+  std::string classes = "fewest";
+  int max_sensors = 0;
+};
+
+void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
+  sub->add_option("--alpha", s->alpha, "significance level of the F test (default 0.05)")
+      ->check(CLI::Range(1e-6, 0.5));
+  sub->add_option("--classes", s->classes,
+                  "class count: 'fewest' (seed 000: fewest classes with a significant F, "
+                  "default), 'margin' (largest (F - F_crit)/F_crit) or a number");
+  sub->add_option("--max-sensors", s->max_sensors,
+                  "at most this many classes = chosen sensors (0: no limit)")
+      ->check(CLI::Range(0, 64));
+}
+
+drift::SelectionOptions ToSelection(const SelectionArgs& a) {
+  drift::SelectionOptions o;
+  o.alpha = a.alpha;
+  o.max_classes = a.max_sensors;
+  if (a.classes == "fewest" || a.classes == "margin") {
+    o.rule = drift::ParseClassCountRule(a.classes);
+  } else {
+    o.rule = drift::ClassCountRule::kFixed;
+    try {
+      o.fixed_classes = std::stoi(a.classes);
+    } catch (const std::exception&) {
+      throw InputError("--classes '" + a.classes + "': must be fewest, margin or a number");
+    }
+  }
+  return o;
+}
+
+struct ModelArgs {
+  std::string kind = "mlr";
+  std::vector<std::string> sensors, inputs;
+  std::vector<double> lags;
+  int max_lags = 2, folds = 5, hidden = 3, restarts = 3, epochs = 1000;
+  bool shuffle_cv = false;
+  std::uint64_t seed = 1;
+  int threads = 0;
+};
+
+void AddModelOptions(CLI::App* sub, ModelArgs* m) {
+  sub->add_option("--model", m->kind,
+                  "mlr (seed 000's regression on the rises), dynamic (rises plus first-order "
+                  "lagged copies, time constants by cross-validation) or network (Bayesian-"
+                  "regularized k-h-1)")
+      ->check(CLI::IsMember({"mlr", "dynamic", "network"}));
+  sub->add_option("--sensors", m->sensors, "use these _C columns instead of the selection")
+      ->delimiter(',');
+  sub->add_option("--inputs", m->inputs,
+                  "other columns used as inputs as logged, e.g. spindle_rpm")
+      ->delimiter(',');
+  sub->add_option("--lag-grid", m->lags,
+                  "dynamic: candidate lag time constants [min] (default 5,10,20,40,80,160,320)")
+      ->delimiter(',');
+  sub->add_option("--max-lags", m->max_lags, "dynamic: at most this many time constants (1..4)")
+      ->check(CLI::Range(1, 4));
+  sub->add_option("--folds", m->folds, "dynamic: blocks of a single training run (2..20)")
+      ->check(CLI::Range(2, 20));
+  sub->add_flag("--leave-block-out", m->shuffle_cv,
+                "dynamic: leave-one-block-out instead of forward-chaining blocks");
+  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")->check(CLI::Range(1, 20));
+  sub->add_option("--restarts", m->restarts, "network: trainbr restarts (1..50)")
+      ->check(CLI::Range(1, 50));
+  sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000)")
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--seed", m->seed, "network: initialization seed");
+  sub->add_option("--threads", m->threads, "threads (0: all cores)")->check(CLI::Range(0, 256));
+}
+
+drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s) {
+  drift::FitOptions o;
+  o.kind = drift::ParseModelKind(m.kind);
+  o.sensors = m.sensors;
+  o.extra_inputs = m.inputs;
+  if (!m.lags.empty()) o.tau_grid = m.lags;
+  o.max_lags = m.max_lags;
+  o.folds = m.folds;
+  o.forward_cv = !m.shuffle_cv;
+  o.hidden = m.hidden;
+  o.restarts = m.restarts;
+  o.train.epochs = m.epochs;
+  o.seed = m.seed;
+  o.threads = m.threads;
+  o.selection = ToSelection(s);
+  return o;
+}
+
+void RegisterSelect(CLI::App* drift_app) {
+  struct Opts {
+    RunInputs runs;
+    SelectionArgs sel;
+    std::string error;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "select",
+      std::string("Temperature-sensitive points as seed 000: similarity |Pearson r| of the rises,\n"
+                  "fuzzy equivalence by max-min squaring, lambda-cuts, F test for the class count,\n"
+                  "Deng's grey grade (rho 0.5) against the error to pick one sensor per class.\n"
+                  "Prints the lambda levels with partitions and F values, the grades, the choice.\n") +
+          kRunFilesHelp);
+  AddRunOptions(sub, &o->runs);
+  AddSelectionOptions(sub, &o->sel);
+  sub->add_option("--error", o->error, "error column (<name>_um) the sensors must explain")->required();
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] {
+    const auto runs = LoadRuns(o->runs);
+    const drift::Selection s = drift::SelectSensors(runs, o->error, ToSelection(o->sel));
+    if (o->json) PrintJson({{"schema", "whirl.drift_select"}, {"schema_version", 1},
+                            {"error_column", o->error}, {"selection", drift::SelectionJson(s)}});
+    else std::fputs(drift::FormatSelection(s).c_str(), stdout);
+  });
+}
+
+void RegisterFitModel(CLI::App* drift_app) {
+  struct Opts {
+    RunInputs runs;
+    SelectionArgs sel;
+    ModelArgs model;
+    std::string error, out;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "fit",
+      std::string("Fit a drift model of one error channel [um] on the training runs and write it\n"
+                  "as a versioned JSON file (sensors, reference temperatures [degC], coefficients\n"
+                  "[um/K] with standard errors, VIF, residual std [um], lag time constants [min],\n"
+                  "training runs, state and ranges).\n") +
+          kRunFilesHelp);
+  AddRunOptions(sub, &o->runs);
+  AddSelectionOptions(sub, &o->sel);
+  AddModelOptions(sub, &o->model);
+  sub->add_option("--error", o->error, "error column to model (<name>_um)")->required();
+  sub->add_option("--out", o->out, "model file to write (JSON)")->required();
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] {
+    const auto runs = LoadRuns(o->runs);
+    std::fprintf(stderr, "fitting %s model of %s on %zu run(s)...\n", o->model.kind.c_str(),
+                 o->error.c_str(), runs.size());
+    drift::FitReport rep = drift::FitDriftModel(runs, o->error, ToFit(o->model, o->sel));
+    rep.model.notes.push_back("whirl drift fit --model " + o->model.kind + " --error " + o->error);
+    drift::WriteDriftModel(o->out, rep.model);
+    if (o->json) {
+      nlohmann::json j = {{"schema", "whirl.drift_fit"}, {"schema_version", 1},
+                          {"model_file", o->out}, {"model", drift::ModelSummaryJson(rep.model)}};
+      if (rep.selected) j["selection"] = drift::SelectionJson(rep.selection);
+      if (!rep.train_report.empty()) j["trainbr"] = rep.train_report;
+      PrintJson(j);
+      return;
+    }
+    if (rep.selected) std::fputs(drift::FormatSelection(rep.selection).c_str(), stdout);
+    std::fputs(drift::FormatModel(rep.model).c_str(), stdout);
+    if (!rep.train_report.empty()) std::printf("  %s\n", rep.train_report.c_str());
+    std::printf("model written to %s\n", o->out.c_str());
+  });
+}
+
+void RegisterPredictDrift(CLI::App* drift_app) {
+  struct Opts {
+    std::string model, run, out, reference = "run-start";
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "predict",
+      "Evaluate a drift model on a run sample by sample (as the control would) and write the\n"
+      "compensation value per sample: CSV columns time_min [min], predicted_um, compensation_um\n"
+      "(= -predicted) [um], std_um [um], and measured_um, residual_um [um] when the run has the\n"
+      "model's error column. Warns when inputs leave the training range.");
+  sub->add_option("--model", o->model, "drift model file (whirl drift fit)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--run", o->run, "run file")->required()->check(CLI::ExistingFile);
+  sub->add_option("--out", o->out, "prediction CSV to write");
+  sub->add_option("--reference", o->reference,
+                  "temperature reference: run-start (the run's first row, default, as training) "
+                  "or model (the model's reference_C [degC])")
+      ->check(CLI::IsMember({"run-start", "model"}));
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] {
+    const drift::DriftModel m = drift::ReadDriftModel(o->model);
+    const Run run = drift::ReadRun(o->run, RunState::kUnknown);
+    const drift::RunPrediction p = drift::PredictRun(m, run, drift::ParseReferenceMode(o->reference));
+    for (const auto& w : p.warnings) Warn(w);
+    if (!o->out.empty())
+      WriteFileAtomic(o->out, drift::PredictionCsv(p, {"whirl drift predict --model " + o->model +
+                                                      " --run " + o->run + " --reference " + o->reference}));
+    if (o->json) {
+      PrintJson({{"schema", "whirl.drift_predict"}, {"schema_version", 1}, {"model", o->model},
+                 {"out", o->out}, {"prediction", drift::PredictionJson(p)}});
+      return;
+    }
+    std::printf("%s: %lld samples, predicted %s from %.3f to %.3f um\n", run.name.c_str(),
+                static_cast<long long>(p.predicted_um.size()), m.error_column.c_str(),
+                p.predicted_um.minCoeff(), p.predicted_um.maxCoeff());
+    if (p.has_measured) {
+      const auto r = drift::ComputeErrorStats(p.measured_um - p.predicted_um);
+      const auto n = drift::ComputeErrorStats(p.measured_um);
+      std::printf("residual: MAE %.3f, RMSE %.3f, max %.3f um (no compensation: MAE %.3f, RMSE "
+                  "%.3f, max %.3f um)\n", r.mae_um, r.rmse_um, r.max_abs_um, n.mae_um, n.rmse_um,
+                  n.max_abs_um);
+    }
+    if (!o->out.empty()) std::printf("written to %s\n", o->out.c_str());
+  });
+}
+
+void RegisterCrossval(CLI::App* drift_app) {
+  struct Opts {
+    RunInputs runs;
+    SelectionArgs sel;
+    ModelArgs model;
+    std::string error;
+    bool from_start = false, json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "crossval",
+      std::string("Cross-run evaluation as seed 000's tables 6-8: a model built on each run (own\n"
+                  "sensor selection) predicts every run; RMSE, std and max |error| [um] per pair,\n"
+                  "group means (idle on idle, idle on cutting, cutting on cutting, ...) beside no\n"
+                  "compensation and MLR on all sensors.\n") +
+          kRunFilesHelp);
+  AddRunOptions(sub, &o->runs);
+  AddSelectionOptions(sub, &o->sel);
+  AddModelOptions(sub, &o->model);
+  sub->add_option("--error", o->error, "error column (<name>_um)")->required();
+  sub->add_flag("--errors-from-start", o->from_start,
+                "take each run's errors relative to its first row [um] (runs cut from one log "
+                "do not start from a zeroed machine)");
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] {
+    auto runs = LoadRuns(o->runs);
+    if (o->from_start)
+      for (Run& r : runs) r = drift::ErrorsFromStart(r);
+    std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
+    const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
+    if (o->json) PrintJson(drift::CrossRunJson(r));
+    else std::fputs(drift::FormatCrossRun(r).c_str(), stdout);
+  });
+}
+
+void RegisterHoldout(CLI::App* drift_app) {
+  struct Opts {
+    std::string log;
+    drift::HoldoutOptions h;
+    ModelArgs model;
+    SelectionArgs sel;
+    std::vector<std::string> channels;
+    std::string report;
+    bool no_network = false, json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "holdout",
+      std::string("Chronological hold-out on one long log (FL_THERMAL's split): train on the first\n"
+                  "--train share of the rows, test on the next --test share; the models run from\n"
+                  "the log's first row. Per channel: none, mlr_all (all sensors), mlr, dynamic and\n"
+                  "network on the selected sensors (at most --max-sensors), dynamic_extra with\n"
+                  "--inputs. Test and train MAE, RMSE, max [um].\n") +
+          kRunFilesHelp);
+  sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--train", o->h.train_fraction, "training share of the rows (default 0.6)")
+      ->check(CLI::Range(0.01, 0.99));
+  sub->add_option("--test", o->h.test_fraction, "test share after it (default 0.2)")
+      ->check(CLI::Range(0.01, 0.99));
+  sub->add_option("--channels", o->channels, "error columns (default: every _um column)")->delimiter(',');
+  sub->add_option("--max-sensors", o->h.max_sensors, "at most this many selected sensors (default 4)")
+      ->check(CLI::Range(1, 64));
+  sub->add_flag("--no-network", o->no_network, "skip the network model");
+  sub->add_option("--inputs", o->model.inputs, "extra inputs of dynamic_extra, e.g. spindle_rpm")
+      ->delimiter(',');
+  sub->add_option("--lag-grid", o->model.lags, "candidate lag time constants [min]")->delimiter(',');
+  sub->add_option("--max-lags", o->model.max_lags, "at most this many lags (1..4)")->check(CLI::Range(1, 4));
+  sub->add_option("--folds", o->model.folds, "cross-validation blocks (2..20)")->check(CLI::Range(2, 20));
+  sub->add_flag("--leave-block-out", o->model.shuffle_cv, "leave-one-block-out instead of forward-chaining");
+  sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")->check(CLI::Range(1, 10000));
+  sub->add_option("--report", o->report, "also write an HTML report into this directory");
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] {
+    const Run log = drift::ReadRun(o->log, RunState::kUnknown);
+    drift::HoldoutOptions h = o->h;
+    h.channels = o->channels;
+    h.network = !o->no_network;
+    h.fit = ToFit(o->model, o->sel);
+    const auto r = drift::Holdout(log, h, [](const std::string& s) {
+      std::fprintf(stderr, "fitting %s\n", s.c_str());
+    });
+    if (!o->report.empty()) {
+      const auto rep = drift::WriteHoldoutReport(o->report, log, r, {"whirl drift holdout --log " + o->log});
+      for (const auto& w : rep.warnings) Warn(w);
+      std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
+    }
+    if (o->json) PrintJson(drift::HoldoutJson(r));
+    else std::fputs(drift::FormatHoldout(r).c_str(), stdout);
+  });
+}
+
+void RegisterSplit(CLI::App* drift_app) {
+  struct Opts {
+    std::string log, column = "spindle_rpm", out_dir, state = "unknown";
+    double threshold = 0;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "split",
+      "Cut one long log into run files, a new run at every machine start: where --at (default\n"
+      "spindle_rpm) rises from <= --threshold to above it. Writes <out-dir>/<log>_<k>.csv in the\n"
+      "run-file format (time_min [min]); all or nothing.");
+  sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--at", o->column, "column whose rise starts a run (default spindle_rpm)");
+  sub->add_option("--threshold", o->threshold, "start threshold in the column's unit (default 0)");
+  sub->add_option("--out-dir", o->out_dir, "directory for the run files")->required();
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] {
+    const Run log = drift::ReadRun(o->log, RunState::kUnknown);
+    const auto runs = drift::SplitAtStarts(log, o->column, o->threshold);
+    std::vector<std::pair<std::filesystem::path, std::string>> files;
+    for (const Run& r : runs)
+      files.emplace_back(std::filesystem::path(o->out_dir) / (Slug(r.name) + ".csv"),
+                         drift::FormatRun(r, {r.name + ": rows " + std::to_string(r.line_numbers.front()) +
+                                                 " to " + std::to_string(r.line_numbers.back()) + " of " + o->log,
+                                             "whirl drift split --log " + o->log + " --at " + o->column}));
+    std::filesystem::create_directories(o->out_dir);
+    for (const auto& [path, text] : files) WriteFileAtomic(path, text);
+    nlohmann::json list = nlohmann::json::array();
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      list.push_back({{"file", files[i].first.string()}, {"samples", runs[i].samples()},
+                      {"start_min", runs[i].time_min.front()}, {"end_min", runs[i].time_min.back()}});
+    if (o->json) {
+      PrintJson({{"schema", "whirl.drift_split"}, {"schema_version", 1}, {"runs", list}});
+      return;
+    }
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      std::printf("%s: %d samples, %.1f to %.1f h\n", files[i].first.string().c_str(), runs[i].samples(),
+                  runs[i].time_min.front() / 60, runs[i].time_min.back() / 60);
+  });
+}
+
+void RegisterReport(CLI::App* drift_app) {
+  struct Opts {
+    RunInputs train, runs;
+    SelectionArgs sel;
+    ModelArgs model;
+    std::string error, out;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* sub = drift_app->add_subcommand(
+      "report",
+      std::string("HTML report for a process engineer: fit a model on the training runs (--train-*)\n"
+                  "and show, per run, measured and predicted error over time [um], the residuals,\n"
+                  "the similarity matrix and lambda levels of the selection, the chosen sensors and\n"
+                  "the coefficients. Plots by gnuplot (skipped with a warning if absent).\n") +
+          kRunFilesHelp);
+  sub->add_option("--train-run", o->train.runs, "training run file(s)")->check(CLI::ExistingFile);
+  sub->add_option("--train-idle", o->train.idle, "training run file(s), idle")->check(CLI::ExistingFile);
+  sub->add_option("--train-cutting", o->train.cutting, "training run file(s), cutting")
+      ->check(CLI::ExistingFile);
+  AddRunOptions(sub, &o->runs, false);
+  AddSelectionOptions(sub, &o->sel);
+  AddModelOptions(sub, &o->model);
+  sub->add_option("--error", o->error, "error column (<name>_um)")->required();
+  sub->add_option("--out", o->out, "report directory (created)")->required();
+  sub->callback([o] {
+    const auto train = LoadRuns(o->train);
+    std::vector<Run> runs = train;
+    if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty()) runs = LoadRuns(o->runs);
+    const drift::FitReport rep = drift::FitDriftModel(train, o->error, ToFit(o->model, o->sel));
+    const auto r = drift::WriteModelReport(o->out, rep, runs, {"whirl drift report --error " + o->error});
+    for (const auto& w : r.warnings) Warn(w);
+    std::printf("report written to %s\n", r.index_html.string().c_str());
+  });
+}
+
+}  // namespace
+
+void RegisterDrift(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "drift",
+      "Machine thermal drift from temperature sensors (seed 000): select sensitive points, fit\n"
+      "MLR / dynamic / network drift models, predict the compensation per sample, cross-run and\n"
+      "hold-out evaluation, HTML report.");
+  sub->require_subcommand(1);
+  RegisterSelect(sub);
+  RegisterFitModel(sub);
+  RegisterPredictDrift(sub);
+  RegisterCrossval(sub);
+  RegisterHoldout(sub);
+  RegisterSplit(sub);
+  RegisterReport(sub);
+  RegisterDriftNc(sub);  // cmd_drift_nc.cpp
+}
+
+}  // namespace whirl::cli

@@ -1,0 +1,116 @@
+// whirl drift nc: the live machine-drift compensation on the control (interp/drift_action.h):
+// an NC program of static synchronized actions that evaluates a drift model from the analog
+// inputs every interpolation cycle into SD43900, its reset program and the same model as a PLC
+// table.
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "drift/model.h"
+#include "interp/drift_action.h"
+#include "interp/machine_profile.h"
+
+namespace whirl::cli {
+namespace {
+
+struct DriftNcOptions {
+  std::string model_path, machine_path, reference = "model";
+  std::vector<std::string> inputs;  // NAME=INDEX:SCALE:OFFSET
+  std::string nc_path, reset_path, csv_path;
+  bool json = false;
+};
+
+// "t3_C=3:0.1:-20" -> {t3_C, {3, 0.1, -20}}; InputError naming the text and the rule.
+std::pair<std::string, interp::AnalogInput> ParseInput(const std::string& text) {
+  const auto eq = text.find('=');
+  const std::string rule = "--input '" + text +
+                           "': must be NAME=INDEX:SCALE:OFFSET (value = SCALE "
+                           "* $A_INA[INDEX] + OFFSET, e.g. t3_C=3:0.1:0)";
+  if (eq == std::string::npos || eq == 0) throw InputError(rule);
+  interp::AnalogInput a;
+  char tail = 0;
+  if (std::sscanf(text.c_str() + eq + 1, "%d:%lf:%lf%c", &a.index, &a.scale, &a.offset, &tail) != 3)
+    throw InputError(rule);
+  return {text.substr(0, eq), a};
+}
+
+void Run(const DriftNcOptions& o) {
+  const drift::DriftModel model = drift::ReadDriftModel(o.model_path);
+  const interp::MachineProfile machine = interp::LoadMachineProfile(o.machine_path);
+  interp::DriftActionOptions options = machine.DriftOptions();
+  options.reference = interp::ParseDriftReference(o.reference);
+  for (const std::string& text : o.inputs) {
+    const auto [name, a] = ParseInput(text);
+    options.inputs[name] = a;
+  }
+  // Render everything first: a failure writes nothing.
+  const std::string nc = interp::FormatDriftNcProgram(model, options, o.model_path);
+  const std::string reset = interp::FormatDriftNcResetProgram(options);
+  const std::string csv = interp::FormatDriftPlcCsv(model, options);
+  if (!o.nc_path.empty()) WriteFileAtomic(o.nc_path, nc);
+  if (!o.reset_path.empty()) WriteFileAtomic(o.reset_path, reset);
+  if (!o.csv_path.empty()) WriteFileAtomic(o.csv_path, csv);
+  if (o.json) {
+    const Eigen::VectorXd c = interp::DriftControlCoefficients(model, options);
+    PrintJson({{"model", o.model_path},
+               {"axis", options.axis},
+               {"coefficients_mm", std::vector<double>(c.data(), c.data() + c.size())},
+               {"nc", o.nc_path},
+               {"reset_nc", o.reset_path},
+               {"csv", o.csv_path}});
+    return;
+  }
+  std::printf("drift action for axis %s: %s model of %s from %zu sensors, reference %s\n",
+              options.axis.c_str(), drift::ToString(model.kind).c_str(), model.error_column.c_str(),
+              model.sensors.size(), o.reference.c_str());
+  for (const auto& [path, what] : {std::pair{o.nc_path, "NC program"},
+                                   {o.reset_path, "NC reset program"},
+                                   {o.csv_path, "PLC table"}})
+    if (!path.empty()) std::printf("written: %s (%s)\n", path.c_str(), what);
+}
+
+}  // namespace
+
+void RegisterDriftNc(CLI::App* drift_app) {
+  auto o = std::make_shared<DriftNcOptions>();
+  auto* sub = drift_app->add_subcommand(
+      "nc",
+      "The live machine-drift compensation on a SINUMERIK 840D: static synchronized actions\n"
+      "(IDS) that read the model's sensors from analog inputs, T = scale * $A_INA[index] +\n"
+      "offset [degC], form the rises against the model's reference temperatures (or those at\n"
+      "the start), run the lag filters every interpolation cycle (L += a (u - L), a = 1 -\n"
+      "exp(-T_ipo / tau)) and write SD43900 = s * (b0 + sum b_f x_f) / 1000 [mm]; s = -1 when\n"
+      "the control adds dK and the model's error is the tool's displacement along +axis. The\n"
+      "machine profile (--machine, its 'drift' object) gives the ID range, $AC_PARAM slots, R\n"
+      "parameters, interpolation cycle and analog inputs. With a whirling plan on the same axis\n"
+      "(whirl plan --with-drift-action) this action is the only writer of SD43900 and adds the\n"
+      "plan's K0. Models of kind mlr or dynamic (a network is refused). The reset program\n"
+      "(--reset-nc) cancels the actions and restores the SD43900 found. Files are .SPF\n"
+      "subprograms (M17). Not verified on a control: main-run write access to SD43900.");
+  sub->add_option("--model", o->model_path, "drift model JSON (whirl drift fit)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--machine", o->machine_path, "machine profile JSON with a 'drift' object")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--input", o->inputs,
+                  "NAME=INDEX:SCALE:OFFSET: analog input of a model input, overriding the "
+                  "profile (value = SCALE * $A_INA[INDEX] + OFFSET, degC for a sensor)");
+  sub->add_option("--reference", o->reference,
+                  "rises against the model's reference temperatures (model) or those when the "
+                  "action starts (start)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"model", "start"}));
+  sub->add_option("--nc", o->nc_path, "write the NC program here (.SPF)");
+  sub->add_option("--reset-nc", o->reset_path, "write the reset program here (.SPF)");
+  sub->add_option("--csv", o->csv_path, "write the PLC table here (CSV)");
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] { Run(*o); });
+}
+
+}  // namespace whirl::cli

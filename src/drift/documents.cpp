@@ -1,0 +1,303 @@
+#include "drift/documents.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "core/csv.h"
+
+namespace whirl::drift {
+namespace {
+
+using nlohmann::json;
+
+std::string F(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+std::string JoinNumbers(const std::vector<double>& v) {
+  std::string out;
+  for (double x : v) out += (out.empty() ? "" : ", ") + F("%g", x);
+  return out;
+}
+
+std::vector<double> Vec(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+
+// F values may be +inf (a partition into tight classes); JSON has no infinity.
+json Finite(double v) { return std::isfinite(v) ? json(v) : json("inf"); }
+
+std::string Classes(const Selection& s, const Partition& p) {
+  std::vector<std::string> groups(static_cast<std::size_t>(p.classes));
+  for (std::size_t i = 0; i < p.labels.size(); ++i) {
+    std::string& g = groups[static_cast<std::size_t>(p.labels[i])];
+    g += (g.empty() ? "" : " ") + s.sensor_names[i];
+  }
+  std::string out;
+  for (const auto& g : groups) out += "{" + g + "}";
+  return out;
+}
+
+}  // namespace
+
+json SelectionJson(const Selection& s) {
+  json parts = json::array();
+  for (const Partition& p : s.partitions) {
+    json classes = json::array();
+    for (int k = 0; k < p.classes; ++k) {
+      std::vector<std::string> members;
+      for (std::size_t i = 0; i < p.labels.size(); ++i)
+        if (p.labels[i] == k) members.push_back(s.sensor_names[i]);
+      classes.push_back(members);
+    }
+    json jp = {{"lambda", p.lambda}, {"classes", p.classes}, {"members", classes}};
+    if (p.has_f) {
+      jp["f"] = Finite(p.f);
+      jp["f_critical"] = p.f_critical;
+      jp["significant"] = p.significant();
+    }
+    parts.push_back(jp);
+  }
+  json grades = json::object();
+  for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
+    grades[s.sensor_names[i]] = s.grades(static_cast<Eigen::Index>(i));
+  return {{"sensors", s.sensor_names},
+          {"squarings", s.squarings},
+          {"partitions", parts},
+          {"chosen_partition", s.chosen_partition},
+          {"grey_grades", grades},
+          {"chosen_sensors", s.ChosenNames()},
+          {"rule", s.message}};
+}
+
+std::string FormatSelection(const Selection& s) {
+  std::ostringstream o;
+  o << "fuzzy equivalence matrix after " << s.squarings << " max-min squarings; lambda-cuts:\n";
+  o << "  lambda    r          F     F_crit  sig  classes\n";
+  for (std::size_t i = 0; i < s.partitions.size(); ++i) {
+    const Partition& p = s.partitions[i];
+    o << (static_cast<int>(i) == s.chosen_partition ? "* " : "  ") << F("%.4f", p.lambda)
+      << F("%5.0f", p.classes) << "  "
+      << (p.has_f ? F("%9.3f", p.f) + "  " + F("%9.3f", p.f_critical) +
+                        (p.significant() ? "  yes" : "   no")
+                  : std::string(25, ' ') + "-")
+      << "  " << Classes(s, p) << "\n";
+  }
+  o << "grey relational grades (rho 0.5):";
+  for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
+    o << " " << s.sensor_names[i] << " " << F("%.4f", s.grades(static_cast<Eigen::Index>(i)));
+  o << "\nclass count: " << s.message << "\nchosen sensors: " << Join(s.ChosenNames()) << "\n";
+  return o.str();
+}
+
+json ModelSummaryJson(const DriftModel& m) {
+  json coeffs = json::array();
+  const bool linear = m.kind != ModelKind::kNetwork;
+  if (linear) {
+    coeffs.push_back({{"feature", "intercept"},
+                      {"value", m.linear.coefficients(0)},
+                      {"standard_error", m.linear.standard_errors(0)}});
+    for (std::size_t i = 0; i < m.features.size(); ++i) {
+      const auto k = static_cast<Eigen::Index>(i);
+      coeffs.push_back({{"feature", m.features[i].Name(m.time_unit)},
+                        {"value", m.linear.coefficients(k + 1)},
+                        {"standard_error", m.linear.standard_errors(k + 1)},
+                        {"vif", Finite(m.linear.vif(k))}});
+    }
+  }
+  json j = {{"kind", ToString(m.kind)},
+            {"error_column", m.error_column},
+            {"sensors", m.sensors},
+            {"reference_C", Vec(m.reference_C)},
+            {"extra_inputs", m.extra_inputs},
+            {"time_unit", m.time_unit},
+            {"time_constants", m.time_constants},
+            {"r_squared", m.r_squared},
+            {"residual_std_um", m.residual_std_um},
+            {"training_runs", m.training_runs},
+            {"state", ToString(m.state)},
+            {"training_samples", m.training_samples},
+            {"selection", m.selection},
+            {"notes", m.notes}};
+  if (linear) j["coefficients"] = coeffs;
+  else j["layer_sizes"] = m.network.layer_sizes;
+  return j;
+}
+
+std::string FormatModel(const DriftModel& m) {
+  std::ostringstream o;
+  o << ToString(m.kind) << " model of " << m.error_column << " on " << Join(m.sensors)
+    << (m.extra_inputs.empty() ? "" : " + " + Join(m.extra_inputs)) << "\n";
+  o << "  sensors: " << m.selection << "\n";
+  if (!m.time_constants.empty())
+    o << "  lag time constants: " << JoinNumbers(m.time_constants) << " " << m.time_unit << "\n";
+  for (const auto& n : m.notes) o << "  " << n << "\n";
+  if (m.kind != ModelKind::kNetwork) {
+    o << "  feature                        coefficient   std error        VIF\n";
+    o << "  intercept [um]                " << F("%12.4f", m.linear.coefficients(0))
+      << F("%12.4f", m.linear.standard_errors(0)) << "\n";
+    for (std::size_t i = 0; i < m.features.size(); ++i) {
+      const auto k = static_cast<Eigen::Index>(i);
+      char name[64];
+      std::snprintf(name, sizeof name, "%-30s", (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
+      o << "  " << name << F("%12.4f", m.linear.coefficients(k + 1))
+        << F("%12.4f", m.linear.standard_errors(k + 1)) << F("%11.4g", m.linear.vif(k)) << "\n";
+    }
+  } else {
+    o << "  network " << m.network.layer_sizes[0] << "-" << m.network.layer_sizes[1] << "-1\n";
+  }
+  o << "  training: R^2 " << F("%.4f", m.r_squared) << ", residual std "
+    << F("%.3f", m.residual_std_um) << " um, " << m.training_samples << " samples of "
+    << Join(m.training_runs) << " (state " << ToString(m.state) << ")\n";
+  return o.str();
+}
+
+std::string PredictionCsv(const RunPrediction& p, const std::vector<std::string>& comments) {
+  std::vector<std::string> header{p.time_from_index ? "sample" : "time_min", "predicted_um",
+                                  "compensation_um", "std_um"};
+  if (p.has_measured) {
+    header.push_back("measured_um");
+    header.push_back("residual_um");
+  }
+  std::vector<std::vector<double>> rows;
+  for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k) {
+    std::vector<double> r{p.time[static_cast<std::size_t>(k)], p.predicted_um(k),
+                          -p.predicted_um(k), p.std_um(k)};
+    if (p.has_measured) {
+      r.push_back(p.measured_um(k));
+      r.push_back(p.measured_um(k) - p.predicted_um(k));
+    }
+    rows.push_back(std::move(r));
+  }
+  return FormatCsv(header, rows, comments);
+}
+
+json ErrorStatsJson(const ErrorStats& s) {
+  return {{"samples", s.samples},
+          {"mae_um", s.mae_um},
+          {"rmse_um", s.rmse_um},
+          {"std_um", s.std_um},
+          {"max_abs_um", s.max_abs_um}};
+}
+
+json PredictionJson(const RunPrediction& p) {
+  json j = {{"run", p.run},
+            {"samples", p.predicted_um.size()},
+            {"time_axis", p.time_from_index ? "sample index (no recorded time)" : "time_min"},
+            {"predicted_um_range", {p.predicted_um.minCoeff(), p.predicted_um.maxCoeff()}},
+            {"outside_training_range_samples", p.outside_range_samples},
+            {"warnings", p.warnings}};
+  if (p.has_measured) {
+    j["residual"] = ErrorStatsJson(ComputeErrorStats(p.measured_um - p.predicted_um));
+    j["no_compensation"] = ErrorStatsJson(ComputeErrorStats(p.measured_um));
+  }
+  return j;
+}
+
+json CrossRunJson(const CrossRunResult& r) {
+  json runs = json::array();
+  for (std::size_t i = 0; i < r.runs.size(); ++i)
+    runs.push_back({{"name", r.runs[i]}, {"state", ToString(r.states[i])}, {"chosen_sensors", r.chosen[i]}});
+  json cells = json::array();
+  for (std::size_t i = 0; i < r.runs.size(); ++i)
+    for (std::size_t j = 0; j < r.runs.size(); ++j)
+      cells.push_back({{"train", r.runs[i]},
+                       {"test", r.runs[j]},
+                       {"model", ErrorStatsJson(r.cells[i][j].model)},
+                       {"mlr_all_sensors", ErrorStatsJson(r.cells[i][j].all_sensors)},
+                       {"no_compensation", ErrorStatsJson(r.cells[i][j].none)}});
+  json groups = json::array();
+  for (const auto& g : r.groups)
+    groups.push_back({{"group", g.name},
+                      {"pairs", g.pairs},
+                      {"model", ErrorStatsJson(g.model)},
+                      {"mlr_all_sensors", ErrorStatsJson(g.all_sensors)},
+                      {"no_compensation", ErrorStatsJson(g.none)}});
+  return {{"schema", "whirl.drift_crossval"},
+          {"schema_version", 1},
+          {"error_column", r.error_column},
+          {"model", ToString(r.kind)},
+          {"runs", runs},
+          {"pairs", cells},
+          {"groups", groups}};
+}
+
+std::string FormatCrossRun(const CrossRunResult& r) {
+  std::ostringstream o;
+  o << "cross-run evaluation of " << r.error_column << " (" << ToString(r.kind)
+    << " model on each run's chosen sensors; statistics of measured - predicted [um])\n";
+  for (std::size_t i = 0; i < r.runs.size(); ++i)
+    o << "  " << r.runs[i] << " (" << ToString(r.states[i]) << "): " << Join(r.chosen[i]) << "\n";
+  o << "RMSE [um], rows = model built on, columns = run predicted:\n" << std::string(16, ' ');
+  for (const auto& n : r.runs) {
+    char cell[32];
+    std::snprintf(cell, sizeof cell, "%12.12s", n.c_str());
+    o << cell;
+  }
+  o << "\n";
+  for (std::size_t i = 0; i < r.runs.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%-16.16s", r.runs[i].c_str());
+    o << name;
+    for (std::size_t j = 0; j < r.runs.size(); ++j) o << F("%12.2f", r.cells[i][j].model.rmse_um);
+    o << "\n";
+  }
+  o << "group means (seed 000 tables 6-8)   pairs |  model: RMSE    std    max | all sensors: "
+       "RMSE    std    max | none: RMSE    std    max\n";
+  for (const auto& g : r.groups) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "  %-32s %5d | %12.2f %6.2f %6.2f | %18.2f %6.2f %6.2f | %10.2f %6.2f %6.2f\n",
+                  g.name.c_str(), g.pairs, g.model.rmse_um, g.model.std_um, g.model.max_abs_um,
+                  g.all_sensors.rmse_um, g.all_sensors.std_um, g.all_sensors.max_abs_um,
+                  g.none.rmse_um, g.none.std_um, g.none.max_abs_um);
+    o << line;
+  }
+  return o.str();
+}
+
+json HoldoutJson(const HoldoutResult& r) {
+  json rows = json::array();
+  for (const auto& row : r.rows_out)
+    rows.push_back({{"channel", row.channel},
+                    {"method", row.method},
+                    {"inputs", row.inputs},
+                    {"time_constants_min", row.time_constants},
+                    {"train", ErrorStatsJson(row.train)},
+                    {"test", ErrorStatsJson(row.test)}});
+  return {{"schema", "whirl.drift_holdout"},
+          {"schema_version", 1},
+          {"log", r.log},
+          {"rows", r.rows},
+          {"train_rows", {0, r.train_end}},
+          {"test_rows", {r.train_end, r.test_end}},
+          {"train_end_min", r.train_end_min},
+          {"test_end_min", r.test_end_min},
+          {"results", rows}};
+}
+
+std::string FormatHoldout(const HoldoutResult& r) {
+  std::ostringstream o;
+  o << "chronological hold-out on " << r.log << ": train rows [0, " << r.train_end
+    << ") (to " << F("%.1f", r.train_end_min / 60) << " h), test rows [" << r.train_end << ", "
+    << r.test_end << ") (to " << F("%.1f", r.test_end_min / 60) << " h)\n";
+  o << "channel  method         test MAE  test RMSE  test max | train MAE | inputs (lags)\n";
+  for (const auto& row : r.rows_out) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%-8s %-13s %9.2f %10.2f %9.2f | %9.2f | ", row.channel.c_str(),
+                  row.method.c_str(), row.test.mae_um, row.test.rmse_um, row.test.max_abs_um,
+                  row.train.mae_um);
+    o << line << (row.inputs.size() > 6 ? std::to_string(row.inputs.size()) + " sensors" : Join(row.inputs));
+    if (!row.time_constants.empty()) o << " (" << JoinNumbers(row.time_constants) << " min)";
+    o << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace whirl::drift

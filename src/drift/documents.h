@@ -1,0 +1,36 @@
+#pragma once
+// The output documents of the drift commands, built once here: JSON for --json, text tables for
+// the terminal, and the per-sample prediction CSV. The command line only prints or writes them.
+// Units are in every name (_um, _C, _min).
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "drift/evaluation.h"
+#include "drift/model.h"
+#include "drift/selection.h"
+
+namespace whirl::drift {
+
+/// Lambda levels with partitions and F values, grades and the chosen sensors.
+nlohmann::json SelectionJson(const Selection& s);
+std::string FormatSelection(const Selection& s);
+
+/// A model's summary: kind, sensors, time constants, coefficients with standard errors and VIF,
+/// R^2, residual std, training runs, lag search.
+nlohmann::json ModelSummaryJson(const DriftModel& m);
+std::string FormatModel(const DriftModel& m);
+
+/// Per sample: time_min (or sample), predicted_um, compensation_um (= -predicted), std_um, and
+/// measured_um, residual_um when the run has the error column.
+std::string PredictionCsv(const RunPrediction& p, const std::vector<std::string>& comments);
+/// Summary of a prediction (statistics of the residual when measured, warnings).
+nlohmann::json PredictionJson(const RunPrediction& p);
+
+nlohmann::json ErrorStatsJson(const ErrorStats& s);
+nlohmann::json CrossRunJson(const CrossRunResult& r);
+std::string FormatCrossRun(const CrossRunResult& r);
+nlohmann::json HoldoutJson(const HoldoutResult& r);
+std::string FormatHoldout(const HoldoutResult& r);
+
+}  // namespace whirl::drift

@@ -1,0 +1,92 @@
+#pragma once
+// Evaluation of drift models:
+//  - cross-run evaluation as seed 000's tables 6-8: a model built on each run (its own sensor
+//    selection) predicts every run; RMSE, std and max |.| of the prediction error e - e_hat [um]
+//    per pair, beside "no compensation" (e_hat = 0: the statistics of the error itself) and "MLR
+//    on all sensors". Group means over ordered pairs of different runs (train != test) by state:
+//    "idle on idle", "idle on cutting", "cutting on cutting", "cutting on idle" (and "unknown"
+//    pairs); the diagonal (a model on its own training run) is reported apart as "own run" (a fit,
+//    not a prediction). Predictions use each test run's first row as reference (ReferenceMode::
+//    kRunStart), as training does.
+//  - chronological hold-out on one long log (FL_THERMAL's split): train on rows [0, a Q), test on
+//    [a Q, (a + b) Q); the model runs from row 0 (lags and reference start at the log's start, as
+//    on a machine that is never reset) and is scored on the test rows only.
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "drift/model.h"
+
+namespace whirl::drift {
+
+struct ErrorStats {
+  int samples = 0;
+  double mae_um = 0;      ///< mean |r|
+  double rmse_um = 0;     ///< sqrt(mean r^2)
+  double std_um = 0;      ///< population std of r (seed 000's "prediction std")
+  double max_abs_um = 0;  ///< max |r|
+};
+ErrorStats ComputeErrorStats(const Eigen::VectorXd& residual_um);
+
+struct CrossRunCell {
+  ErrorStats model;        ///< the selected-sensor model of the training run
+  ErrorStats all_sensors;  ///< MLR on every sensor of the training run
+  ErrorStats none;         ///< no compensation (the test run's error)
+};
+
+struct CrossRunGroup {
+  std::string name;  ///< "idle on cutting" = trained idle, tested cutting; "own run"
+  int pairs = 0;
+  ErrorStats model, all_sensors, none;  ///< means of each statistic over the pairs
+};
+
+struct CrossRunResult {
+  std::string error_column;
+  ModelKind kind = ModelKind::kMlr;
+  std::vector<std::string> runs;
+  std::vector<RunState> states;
+  std::vector<std::vector<std::string>> chosen;    ///< sensors of each run's model
+  std::vector<std::vector<CrossRunCell>> cells;    ///< [train][test]
+  std::vector<CrossRunGroup> groups;
+  std::vector<DriftModel> models;                  ///< each run's model
+};
+
+/// Builds one model per run (options.kind, seed 000 selection unless options.sensors is set) and
+/// predicts every run. Runs need at least 2 entries and the error column. Parallel over runs.
+CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_column,
+                        const FitOptions& options);
+
+struct HoldoutOptions {
+  double train_fraction = 0.6;  ///< first part of the rows for training, in (0, 1)
+  double test_fraction = 0.2;   ///< next part for testing; train + test <= 1
+  int max_sensors = 4;          ///< the selection's class count is capped here
+  std::vector<std::string> channels;  ///< error columns (empty: every _um column)
+  /// Methods: none, mlr_all (MLR on every sensor), mlr (selected), dynamic (selected, lags),
+  /// network (selected, k-h-1), and dynamic_extra (selected + the extra inputs, lags) when
+  /// fit.extra_inputs is not empty.
+  bool network = true;
+  FitOptions fit;  ///< lag grid, network settings, selection options, extra inputs
+};
+
+struct HoldoutRow {
+  std::string channel;
+  std::string method;
+  std::vector<std::string> inputs;  ///< sensors (and extra inputs) used
+  std::vector<double> time_constants;
+  ErrorStats train, test;
+};
+
+struct HoldoutResult {
+  std::string log;
+  int rows = 0, train_end = 0, test_end = 0;
+  double train_end_min = 0, test_end_min = 0;
+  std::vector<HoldoutRow> rows_out;
+  std::vector<DriftModel> models;  ///< same order as rows_out (none: an empty model)
+  std::vector<RunPrediction> predictions;  ///< on rows [0, test_end), same order
+};
+
+HoldoutResult Holdout(const Run& log, const HoldoutOptions& options,
+                      const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace whirl::drift

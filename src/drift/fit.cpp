@@ -1,0 +1,235 @@
+// FitDriftModel: sensor selection, the lag search of the dynamic model by cross-validation, and
+// the final least-squares or trainbr fit (drift/model.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "drift/model.h"
+
+namespace whirl::drift {
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(4);
+  s << v;
+  return s.str();
+}
+
+struct Stacked {
+  Eigen::MatrixXd x;
+  Eigen::VectorXd y;
+  std::vector<int> fold;  // fold of each sample
+};
+
+Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
+              const std::vector<std::string>& sensors, const std::vector<std::string>& extras,
+              const std::vector<double>& taus, int folds) {
+  std::vector<Eigen::MatrixXd> parts;
+  Eigen::Index total = 0, cols = 0;
+  for (const Run& r : runs) {
+    parts.push_back(BuildFeatures(r, sensors, extras, taus));
+    total += r.samples();
+    cols = parts.back().cols();
+  }
+  Stacked s;
+  s.x.resize(total, cols);
+  s.y.resize(total);
+  s.fold.resize(static_cast<std::size_t>(total));
+  Eigen::Index at = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const Run& r = runs[i];
+    s.x.middleRows(at, r.samples()) = parts[i];
+    s.y.segment(at, r.samples()) = r.error_um.col(r.ErrorIndex(error_column));
+    for (int k = 0; k < r.samples(); ++k)
+      s.fold[static_cast<std::size_t>(at + k)] =
+          runs.size() > 1 ? static_cast<int>(i) : static_cast<int>(k * static_cast<long>(folds) / r.samples());
+    at += r.samples();
+  }
+  return s;
+}
+
+Eigen::MatrixXd Rows(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& idx) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(idx.size()), m.cols());
+  for (std::size_t i = 0; i < idx.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(idx[i]);
+  return out;
+}
+
+// Pooled RMSE of predicting each fold from a fit on the others.
+double CrossValidatedRmse(const Stacked& s, bool forward) {
+  const int nf = *std::max_element(s.fold.begin(), s.fold.end()) + 1;
+  double sse = 0;
+  Eigen::Index count = 0;
+  for (int f = forward ? 1 : 0; f < nf; ++f) {
+    std::vector<Eigen::Index> train, test;
+    for (std::size_t i = 0; i < s.fold.size(); ++i) {
+      if (s.fold[i] == f) test.push_back(static_cast<Eigen::Index>(i));
+      else if (!forward || s.fold[i] < f) train.push_back(static_cast<Eigen::Index>(i));
+    }
+    if (test.empty()) continue;
+    count += static_cast<Eigen::Index>(test.size());
+    if (train.size() <= static_cast<std::size_t>(s.x.cols()) + 1) continue;  // too few to fit
+    const Eigen::VectorXd b = LeastSquaresCoefficients(Rows(s.x, train), Rows(s.y, train));
+    sse += (Rows(s.y, test) - EvaluateLinear(b, Rows(s.x, test))).squaredNorm();
+  }
+  if (count == 0)
+    throw InputError("cross-validation: no fold has enough training samples for " +
+                     std::to_string(s.x.cols()) + " features");
+  return std::sqrt(sse / static_cast<double>(count));
+}
+
+// Greedy forward choice of lag time constants (drift/model.h, kind dynamic).
+std::vector<LagSearchStep> SearchLags(const std::vector<Run>& runs, const std::string& error_column,
+                                      const std::vector<std::string>& sensors,
+                                      const FitOptions& o) {
+  auto score = [&](const std::vector<double>& taus) {
+    return CrossValidatedRmse(Stack(runs, error_column, sensors, o.extra_inputs, taus, o.folds),
+                              o.forward_cv && runs.size() == 1);
+  };
+  std::vector<LagSearchStep> steps{{{}, score({})}};
+  while (static_cast<int>(steps.back().time_constants.size()) < o.max_lags) {
+    const std::vector<double>& cur = steps.back().time_constants;
+    std::vector<double> cand;
+    for (double t : o.tau_grid)
+      if (std::find(cur.begin(), cur.end(), t) == cur.end()) cand.push_back(t);
+    if (cand.empty()) break;
+    std::vector<double> rmse(cand.size(), std::numeric_limits<double>::infinity());
+    ParallelFor(cand.size(), o.threads, [&](std::size_t i) {
+      std::vector<double> taus = cur;
+      taus.push_back(cand[i]);
+      std::sort(taus.begin(), taus.end());
+      try {
+        rmse[i] = score(taus);
+      } catch (const InputError&) {
+        // collinear lag set (e.g. two nearly equal long lags): not a candidate
+      }
+    });
+    const auto best = static_cast<std::size_t>(std::min_element(rmse.begin(), rmse.end()) - rmse.begin());
+    if (!(rmse[best] < steps.back().cv_rmse_um)) break;
+    std::vector<double> taus = cur;
+    taus.push_back(cand[best]);
+    std::sort(taus.begin(), taus.end());
+    steps.push_back({taus, rmse[best]});
+  }
+  return steps;
+}
+
+void FitNetwork(const Stacked& s, const FitOptions& o, DriftModel* m, std::string* report) {
+  const Eigen::Index q = s.x.rows();
+  const Eigen::Index stride = std::max<Eigen::Index>(1, (q + o.max_train_samples - 1) / o.max_train_samples);
+  std::vector<Eigen::Index> idx;
+  for (Eigen::Index i = 0; i < q; i += stride) idx.push_back(i);
+  const Eigen::MatrixXd x = Rows(s.x, idx).transpose();
+  const Eigen::MatrixXd y = Rows(s.y, idx).transpose();
+  nn::TrainingData data;
+  m->input_scaling = nn::MapMinMax::Fit(x);
+  m->target_scaling = nn::MapMinMax::Fit(y);
+  data.inputs = m->input_scaling.Apply(x);
+  data.targets = m->target_scaling.Apply(y);
+  data.target_scaling = m->target_scaling;
+  const std::vector<int> sizes{static_cast<int>(x.rows()), o.hidden, 1};
+  const nn::RestartResult r = nn::TrainBrRestarts(data, sizes, o.seed, o.restarts, o.train);
+  m->network = r.best.network;
+  m->posterior_covariance = r.best.posterior_covariance;
+  m->noise_variance = r.best.summary.noise_variance;
+  *report = r.best.summary.BriefReport() + " (" + std::to_string(idx.size()) + " of " +
+            std::to_string(q) + " samples, best of " + std::to_string(o.restarts) + " restarts)";
+}
+
+}  // namespace
+
+void FitOptions::Validate() const {
+  selection.Validate();
+  if (max_lags < 1 || max_lags > 4)
+    throw InputError("max lags " + std::to_string(max_lags) + ": must be 1..4");
+  if (folds < 2 || folds > 20) throw InputError("folds " + std::to_string(folds) + ": must be 2..20");
+  if (tau_grid.empty() || tau_grid.size() > 32)
+    throw InputError("lag grid: give 1 to 32 time constants");
+  for (double t : tau_grid)
+    if (!(t > 0 && t <= 1e6)) throw InputError("lag time constant " + Num(t) + ": must be in (0, 1e6]");
+  if (hidden < 1 || hidden > 20) throw InputError("hidden " + std::to_string(hidden) + ": must be 1..20");
+  if (restarts < 1 || restarts > 50)
+    throw InputError("restarts " + std::to_string(restarts) + ": must be 1..50");
+  if (max_train_samples < 20 || max_train_samples > 20000)
+    throw InputError("max train samples " + std::to_string(max_train_samples) + ": must be 20..20000");
+  train.Validate();
+}
+
+FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
+                        const FitOptions& o) {
+  o.Validate();
+  if (runs.empty()) throw InputError("fit: no training run");
+  for (const Run& r : runs) {
+    r.ErrorIndex(error_column);
+    if (r.time_from_index != runs.front().time_from_index)
+      throw InputError(r.source + ": some training runs record time and others do not");
+  }
+  FitReport rep;
+  DriftModel& m = rep.model;
+  m.kind = o.kind;
+  m.error_column = error_column;
+  m.extra_inputs = o.extra_inputs;
+  m.time_unit = runs.front().time_from_index ? "sample" : "min";
+  if (o.sensors.empty()) {
+    rep.selected = true;
+    rep.selection = SelectSensors(runs, error_column, o.selection);
+    m.sensors = rep.selection.ChosenNames();
+    m.selection = "seed 000 selection: " + rep.selection.message;
+  } else {
+    m.sensors = o.sensors;
+    m.selection = "given";
+  }
+  m.reference_C = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.sensors.size()));
+  for (const Run& r : runs) {
+    for (std::size_t i = 0; i < m.sensors.size(); ++i)
+      m.reference_C(static_cast<Eigen::Index>(i)) += r.temperature_C(0, r.SensorIndex(m.sensors[i]));
+    for (const auto& e : m.extra_inputs) r.OtherIndex(e);
+    m.training_runs.push_back(r.name);
+    m.training_samples += r.samples();
+  }
+  m.reference_C /= static_cast<double>(runs.size());
+  m.state = runs.front().state;
+  for (const Run& r : runs)
+    if (r.state != m.state) m.state = RunState::kUnknown;
+  if (o.kind == ModelKind::kDynamic) {
+    rep.lag_search = SearchLags(runs, error_column, m.sensors, o);
+    m.time_constants = rep.lag_search.back().time_constants;
+    for (const auto& st : rep.lag_search) {
+      std::string t;
+      for (double v : st.time_constants) t += (t.empty() ? "" : ", ") + Num(v);
+      m.notes.push_back("lag search: time constants [" + t + "] " + m.time_unit +
+                        ": cross-validated RMSE " + Num(st.cv_rmse_um) + " um");
+    }
+  }
+  std::vector<std::string> inputs = m.sensors;
+  inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+  for (const auto& in : inputs) {
+    m.features.push_back({in, 0.0});
+    for (double t : m.time_constants) m.features.push_back({in, t});
+  }
+  const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
+  m.feature_min = s.x.colwise().minCoeff().transpose();
+  m.feature_max = s.x.colwise().maxCoeff().transpose();
+  Eigen::VectorXd fitted;
+  if (o.kind == ModelKind::kNetwork) {
+    FitNetwork(s, o, &m, &rep.train_report);
+    fitted = m.target_scaling.Reverse(m.network.Forward(m.input_scaling.Apply(s.x.transpose())))
+                 .row(0)
+                 .transpose();
+  } else {
+    m.linear = FitLinear(s.x, s.y);
+    fitted = EvaluateLinear(m.linear.coefficients, s.x);
+  }
+  const Eigen::VectorXd res = s.y - fitted;
+  const double dof = o.kind == ModelKind::kNetwork ? static_cast<double>(res.size())
+                                                   : m.linear.degrees_of_freedom;
+  m.residual_std_um = std::sqrt(res.squaredNorm() / dof);
+  const double tss = (s.y.array() - s.y.mean()).square().sum();
+  m.r_squared = tss > 0 ? 1.0 - res.squaredNorm() / tss : 1.0;
+  return rep;
+}
+
+}  // namespace whirl::drift

@@ -1,0 +1,385 @@
+#include "drift/model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/json_file.h"
+#include "core/parallel.h"
+
+namespace whirl::drift {
+namespace {
+
+using nlohmann::json;
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+json VectorJson(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+Eigen::VectorXd ReadVector(const json& j, const char* key, Eigen::Index size) {
+  const auto v = j.at(key).get<std::vector<double>>();
+  if (size >= 0 && static_cast<Eigen::Index>(v.size()) != size)
+    throw InputError(std::string("drift model '") + key + "': " + std::to_string(v.size()) +
+                     " values, expected " + std::to_string(size));
+  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  if (!out.allFinite()) throw InputError(std::string("drift model '") + key + "' is not finite");
+  return out;
+}
+
+json MatrixJson(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) rows.push_back(VectorJson(m.row(i).transpose()));
+  return rows;
+}
+
+Eigen::MatrixXd ReadMatrix(const json& j, const char* key, Eigen::Index n) {
+  const auto rows = j.at(key).get<std::vector<std::vector<double>>>();
+  if (static_cast<Eigen::Index>(rows.size()) != n)
+    throw InputError(std::string("drift model '") + key + "' must be " + std::to_string(n) + "x" +
+                     std::to_string(n));
+  Eigen::MatrixXd m(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (static_cast<Eigen::Index>(rows[static_cast<std::size_t>(i)].size()) != n)
+      throw InputError(std::string("drift model '") + key + "' row " + std::to_string(i) +
+                       " must have " + std::to_string(n) + " values");
+    for (Eigen::Index k = 0; k < n; ++k) m(i, k) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
+  }
+  if (!m.allFinite()) throw InputError(std::string("drift model '") + key + "' is not finite");
+  return m;
+}
+
+bool IsLinear(ModelKind k) { return k != ModelKind::kNetwork; }
+
+std::vector<Feature> MakeFeatures(const std::vector<std::string>& inputs,
+                                  const std::vector<double>& taus) {
+  std::vector<Feature> f;
+  for (const auto& in : inputs) {
+    f.push_back({in, 0.0});
+    for (double t : taus) f.push_back({in, t});
+  }
+  return f;
+}
+
+std::vector<std::string> Inputs(const std::vector<std::string>& sensors,
+                                const std::vector<std::string>& extras) {
+  std::vector<std::string> all = sensors;
+  all.insert(all.end(), extras.begin(), extras.end());
+  return all;
+}
+
+// Raw inputs minus reference, then lags, for one run: the batch form of DriftEvaluator::Step.
+Eigen::MatrixXd FeaturesFromInputs(const Eigen::MatrixXd& u, const std::vector<double>& t,
+                                   const std::vector<double>& taus) {
+  const Eigen::Index per = 1 + static_cast<Eigen::Index>(taus.size());
+  Eigen::MatrixXd f(u.rows(), u.cols() * per);
+  for (Eigen::Index i = 0; i < u.cols(); ++i) {
+    f.col(i * per) = u.col(i);
+    for (std::size_t l = 0; l < taus.size(); ++l)
+      f.col(i * per + 1 + static_cast<Eigen::Index>(l)) = FirstOrderLag(u.col(i), t, taus[l]);
+  }
+  return f;
+}
+
+}  // namespace
+
+std::string ToString(ModelKind k) {
+  switch (k) {
+    case ModelKind::kDynamic: return "dynamic";
+    case ModelKind::kNetwork: return "network";
+    case ModelKind::kMlr: break;
+  }
+  return "mlr";
+}
+
+ModelKind ParseModelKind(const std::string& text) {
+  if (text == "mlr") return ModelKind::kMlr;
+  if (text == "dynamic") return ModelKind::kDynamic;
+  if (text == "network") return ModelKind::kNetwork;
+  throw InputError("model kind '" + text + "': must be mlr, dynamic or network");
+}
+
+std::string ToString(ReferenceMode m) {
+  return m == ReferenceMode::kModel ? "model" : "run-start";
+}
+
+ReferenceMode ParseReferenceMode(const std::string& text) {
+  if (text == "run-start") return ReferenceMode::kRunStart;
+  if (text == "model") return ReferenceMode::kModel;
+  throw InputError("reference '" + text + "': must be run-start or model");
+}
+
+std::string Feature::Name(const std::string& time_unit) const {
+  if (tau == 0) return input;
+  return input + "_lag" + Num(tau) + time_unit;
+}
+
+void DriftModel::Validate() const {
+  const auto nf = static_cast<Eigen::Index>(features.size());
+  if (sensors.empty() && extra_inputs.empty()) throw InputError("drift model has no input");
+  if (reference_C.size() != static_cast<Eigen::Index>(sensors.size()))
+    throw InputError("drift model 'reference_C' must have one value per sensor");
+  if (nf != InputCount() * (1 + static_cast<Eigen::Index>(time_constants.size())))
+    throw InputError("drift model 'features' must be inputs x (1 + time constants)");
+  for (double t : time_constants)
+    if (!(t > 0)) throw InputError("drift model time constant " + Num(t) + ": must be > 0");
+  if (feature_min.size() != nf || feature_max.size() != nf)
+    throw InputError("drift model training ranges must have one value per feature");
+  if (time_unit != "min" && time_unit != "sample")
+    throw InputError("drift model 'time_unit' '" + time_unit + "': must be min or sample");
+  if (IsLinear(kind)) {
+    if (linear.coefficients.size() != nf + 1 || linear.covariance.rows() != nf + 1)
+      throw InputError("drift model coefficients must be 1 + " + std::to_string(nf));
+  } else {
+    network.Validate("drift model network");
+    if (network.InputCount() != nf || network.OutputCount() != 1)
+      throw InputError("drift model network must have one input per feature and one output");
+    if (posterior_covariance.rows() != network.ParameterCount())
+      throw InputError("drift model network posterior covariance has the wrong size");
+  }
+}
+
+void to_json(json& j, const DriftModel& m) {
+  json features = json::array();
+  for (std::size_t i = 0; i < m.features.size(); ++i)
+    features.push_back({{"name", m.features[i].Name(m.time_unit)},
+                        {"input", m.features[i].input},
+                        {"tau", m.features[i].tau},
+                        {"train_min", m.feature_min(static_cast<Eigen::Index>(i))},
+                        {"train_max", m.feature_max(static_cast<Eigen::Index>(i))}});
+  j = {{"format", DriftModel::kFormat},
+       {"schema_version", DriftModel::kSchemaVersion},
+       {"kind", ToString(m.kind)},
+       {"error_column", m.error_column},
+       {"error_unit", "um"},
+       {"sensors", m.sensors},
+       {"reference_C", VectorJson(m.reference_C)},
+       {"extra_inputs", m.extra_inputs},
+       {"time_unit", m.time_unit},
+       {"time_constants", m.time_constants},
+       {"features", features},
+       {"residual_std_um", m.residual_std_um},
+       {"r_squared", m.r_squared},
+       {"training",
+        {{"runs", m.training_runs},
+         {"state", ToString(m.state)},
+         {"samples", m.training_samples},
+         {"selection", m.selection},
+         {"notes", m.notes}}}};
+  if (IsLinear(m.kind)) {
+    j["linear"] = {{"coefficients", VectorJson(m.linear.coefficients)},
+                   {"coefficient_units", "b0 in um, then um per feature unit (K, or the input's)"},
+                   {"standard_errors", VectorJson(m.linear.standard_errors)},
+                   {"covariance", MatrixJson(m.linear.covariance)},
+                   {"xtx_inverse", MatrixJson(m.linear.xtx_inverse)},
+                   {"vif", VectorJson(m.linear.vif)},
+                   {"samples", m.linear.samples},
+                   {"degrees_of_freedom", m.linear.degrees_of_freedom}};
+  } else {
+    j["network"] = {{"layer_sizes", m.network.layer_sizes},
+                    {"parameters", VectorJson(m.network.GetParameters())},
+                    {"input_min", VectorJson(m.input_scaling.xmin)},
+                    {"input_max", VectorJson(m.input_scaling.xmax)},
+                    {"target_min", VectorJson(m.target_scaling.xmin)},
+                    {"target_max", VectorJson(m.target_scaling.xmax)},
+                    {"noise_variance_normalized", m.noise_variance},
+                    {"posterior_covariance", MatrixJson(m.posterior_covariance)}};
+  }
+}
+
+void from_json(const json& j, DriftModel& m) {
+  if (!j.is_object() || !j.contains("format") || j["format"] != DriftModel::kFormat)
+    throw InputError(std::string("not a drift model (its 'format' is not '") +
+                     DriftModel::kFormat + "'; write one with whirl drift fit)");
+  RejectUnknownKeys(j, {"format", "schema_version", "kind", "error_column", "error_unit",
+                        "sensors", "reference_C", "extra_inputs", "time_unit", "time_constants",
+                        "features", "residual_std_um", "r_squared", "training", "linear",
+                        "network"},
+                    "drift model");
+  if (j.at("schema_version").get<int>() != DriftModel::kSchemaVersion)
+    throw InputError("drift model schema_version " + j.at("schema_version").dump() +
+                     ": this whirl reads version " + std::to_string(DriftModel::kSchemaVersion));
+  m = DriftModel{};
+  m.kind = ParseModelKind(j.at("kind").get<std::string>());
+  m.error_column = j.at("error_column").get<std::string>();
+  m.sensors = j.at("sensors").get<std::vector<std::string>>();
+  m.reference_C = ReadVector(j, "reference_C", static_cast<Eigen::Index>(m.sensors.size()));
+  m.extra_inputs = j.at("extra_inputs").get<std::vector<std::string>>();
+  m.time_unit = j.at("time_unit").get<std::string>();
+  m.time_constants = j.at("time_constants").get<std::vector<double>>();
+  m.features = MakeFeatures(Inputs(m.sensors, m.extra_inputs), m.time_constants);
+  const auto nf = static_cast<Eigen::Index>(m.features.size());
+  const json& fj = j.at("features");
+  if (fj.size() != m.features.size())
+    throw InputError("drift model 'features' must list " + std::to_string(nf) + " features");
+  m.feature_min.resize(nf);
+  m.feature_max.resize(nf);
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    const json& f = fj[static_cast<std::size_t>(i)];
+    m.feature_min(i) = RequireNumber(f, "train_min", "drift model feature");
+    m.feature_max(i) = RequireNumber(f, "train_max", "drift model feature");
+  }
+  m.residual_std_um = RequireNumber(j, "residual_std_um", "drift model");
+  m.r_squared = RequireNumber(j, "r_squared", "drift model");
+  const json& t = j.at("training");
+  m.training_runs = t.at("runs").get<std::vector<std::string>>();
+  m.state = ParseRunState(t.at("state").get<std::string>());
+  m.training_samples = t.at("samples").get<int>();
+  m.selection = t.at("selection").get<std::string>();
+  m.notes = t.at("notes").get<std::vector<std::string>>();
+  if (IsLinear(m.kind)) {
+    const json& l = j.at("linear");
+    m.linear.coefficients = ReadVector(l, "coefficients", nf + 1);
+    m.linear.standard_errors = ReadVector(l, "standard_errors", nf + 1);
+    m.linear.covariance = ReadMatrix(l, "covariance", nf + 1);
+    m.linear.xtx_inverse = ReadMatrix(l, "xtx_inverse", nf + 1);
+    m.linear.vif = ReadVector(l, "vif", nf);
+    m.linear.samples = l.at("samples").get<int>();
+    m.linear.degrees_of_freedom = l.at("degrees_of_freedom").get<int>();
+    m.linear.residual_std_um = m.residual_std_um;
+    m.linear.r_squared = m.r_squared;
+  } else {
+    const json& n = j.at("network");
+    m.network = nn::Network::Zeros(n.at("layer_sizes").get<std::vector<int>>());
+    m.network.SetParameters(ReadVector(n, "parameters", m.network.ParameterCount()));
+    m.input_scaling.xmin = ReadVector(n, "input_min", nf);
+    m.input_scaling.xmax = ReadVector(n, "input_max", nf);
+    m.target_scaling.xmin = ReadVector(n, "target_min", 1);
+    m.target_scaling.xmax = ReadVector(n, "target_max", 1);
+    m.noise_variance = RequireNumber(n, "noise_variance_normalized", "drift model network");
+    m.posterior_covariance =
+        ReadMatrix(n, "posterior_covariance", m.network.ParameterCount());
+  }
+  m.Validate();
+}
+
+DriftModel ReadDriftModel(const std::filesystem::path& path) {
+  const json j = ReadJsonFile(path);
+  try {
+    return j.get<DriftModel>();
+  } catch (const json::exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
+}
+
+void WriteDriftModel(const std::filesystem::path& path, const DriftModel& m) {
+  m.Validate();
+  WriteJsonFile(path, json(m));
+}
+
+DriftEvaluator::DriftEvaluator(const DriftModel& model, const Eigen::VectorXd& reference_C)
+    : model_(&model), reference_(reference_C) {
+  if (reference_.size() != static_cast<Eigen::Index>(model.sensors.size()))
+    throw InputError("drift evaluator: one reference temperature per sensor is needed");
+  features_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.features.size()));
+}
+
+double DriftEvaluator::Step(double time, const Eigen::VectorXd& raw) {
+  const DriftModel& m = *model_;
+  const Eigen::Index ns = reference_.size();
+  const Eigen::Index per = 1 + static_cast<Eigen::Index>(m.time_constants.size());
+  for (Eigen::Index i = 0; i < m.InputCount(); ++i) {
+    const double u = i < ns ? raw(i) - reference_(i) : raw(i);
+    features_(i * per) = u;
+    for (std::size_t l = 0; l < m.time_constants.size(); ++l) {
+      double& y = features_(i * per + 1 + static_cast<Eigen::Index>(l));
+      if (!started_) {
+        y = u;
+      } else {
+        y += (1.0 - std::exp(-(time - last_time_) / m.time_constants[l])) * (u - y);
+      }
+    }
+  }
+  started_ = true;
+  last_time_ = time;
+  if (IsLinear(m.kind))
+    return m.linear.coefficients(0) + features_.dot(m.linear.coefficients.tail(features_.size()));
+  const Eigen::MatrixXd x = m.input_scaling.Apply(features_);
+  return m.target_scaling.Reverse(m.network.Forward(x))(0, 0);
+}
+
+double DriftEvaluator::StdDev() const {
+  const DriftModel& m = *model_;
+  if (IsLinear(m.kind)) {
+    Eigen::VectorXd x1(features_.size() + 1);
+    x1 << 1.0, features_;
+    return std::sqrt(m.residual_std_um * m.residual_std_um + x1.dot(m.linear.covariance * x1));
+  }
+  const Eigen::VectorXd x = m.input_scaling.Apply(features_);
+  const Eigen::VectorXd g = nn::OutputJacobian(m.network, x).row(0).transpose();
+  const double var = m.noise_variance + g.dot(m.posterior_covariance * g);
+  return std::sqrt(std::max(var, 0.0)) * m.target_scaling.HalfRange()(0);
+}
+
+Eigen::MatrixXd RawInputs(const DriftModel& model, const Run& run) {
+  Eigen::MatrixXd u(run.samples(), model.InputCount());
+  Eigen::Index c = 0;
+  for (const auto& s : model.sensors) u.col(c++) = run.temperature_C.col(run.SensorIndex(s));
+  for (const auto& e : model.extra_inputs) u.col(c++) = run.other.col(run.OtherIndex(e));
+  return u;
+}
+
+Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& sensors,
+                              const std::vector<std::string>& extra_inputs,
+                              const std::vector<double>& time_constants) {
+  Eigen::MatrixXd u(run.samples(), static_cast<Eigen::Index>(sensors.size() + extra_inputs.size()));
+  Eigen::Index c = 0;
+  for (const auto& s : sensors) {
+    const int i = run.SensorIndex(s);
+    u.col(c++) = run.temperature_C.col(i).array() - run.temperature_C(0, i);
+  }
+  for (const auto& e : extra_inputs) u.col(c++) = run.other.col(run.OtherIndex(e));
+  return FeaturesFromInputs(u, run.time_min, time_constants);
+}
+
+RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode reference) {
+  model.Validate();
+  if (run.time_from_index != (model.time_unit == "sample"))
+    throw InputError(run.source + ": " +
+                     (run.time_from_index ? "has no recorded time" : "has a recorded time") +
+                     " but the model's time unit is '" + model.time_unit +
+                     "': its lag time constants would be misread");
+  const Eigen::MatrixXd u = RawInputs(model, run);
+  Eigen::VectorXd ref = model.reference_C;
+  if (reference == ReferenceMode::kRunStart)
+    ref = u.row(0).head(static_cast<Eigen::Index>(model.sensors.size())).transpose();
+  DriftEvaluator ev(model, ref);
+  RunPrediction p;
+  p.run = run.name;
+  p.time = run.time_min;
+  p.time_from_index = run.time_from_index;
+  p.predicted_um.resize(run.samples());
+  p.std_um.resize(run.samples());
+  for (int k = 0; k < run.samples(); ++k) {
+    p.predicted_um(k) = ev.Step(run.time_min[static_cast<std::size_t>(k)], u.row(k).transpose());
+    p.std_um(k) = ev.StdDev();
+    const Eigen::VectorXd& f = ev.features();
+    const double span = 1e-9;
+    if (((f - model.feature_max).array() > span).any() ||
+        ((model.feature_min - f).array() > span).any())
+      ++p.outside_range_samples;
+  }
+  const auto& names = run.error_names;
+  if (std::find(names.begin(), names.end(), model.error_column) != names.end()) {
+    p.has_measured = true;
+    p.measured_um = run.error_um.col(run.ErrorIndex(model.error_column));
+  }
+  if (p.outside_range_samples > 0)
+    p.warnings.push_back(run.name + ": " + std::to_string(p.outside_range_samples) + " of " +
+                         std::to_string(run.samples()) +
+                         " samples have an input outside the model's training range "
+                         "(extrapolation)");
+  if (run.time_from_index)
+    p.warnings.push_back(run.name + ": no recorded time: the sample index is the time axis");
+  return p;
+}
+
+}  // namespace whirl::drift

@@ -1,0 +1,175 @@
+#pragma once
+// Drift models: the thermal error of one channel [um] from temperature rises on chosen sensors.
+//
+// Inputs u_i (in this order): the rises of `sensors`, dT_s = T_s - T_ref,s [K], then the
+// `extra_inputs` as logged (e.g. spindle_rpm, their own unit). T_ref is the run's first row
+// (ReferenceMode::kRunStart, seed 000's convention and the default; training always uses it) or
+// the model's reference_C (kModel: the mean first row of the training runs, for a control that
+// cannot know when a run started).
+// Features (regressors), input-major: for each input its value and its first-order-lagged copies
+//   L_tau(u)_k = L_{k-1} + (1 - exp(-(t_k - t_{k-1}) / tau)) (u_k - L_{k-1}),  L_0 = u_0,
+// one per time constant in `time_constants` (shared by all inputs; unit: min, or samples when the
+// training runs had no time column). Deformation lags temperature; a control evaluates the same
+// recursion every interpolation cycle with a = 1 - exp(-T_cycle / tau) (issue 18).
+// Kinds:
+//   mlr      seed 000's multiple linear regression, no lags: e = b0 + sum_s b_s dT_s.
+//   dynamic  the same regression on the features with lags; the time constants are picked from
+//            FitOptions::tau_grid by greedy forward selection on the cross-validated RMSE (folds:
+//            leave one run out with several runs, else `folds` contiguous blocks of the one run,
+//            forward-chaining by default); a lag is added only while it lowers that RMSE.
+//   network  the project's Bayesian-regularized k-h-1 network (nn/trainbr.h, mapminmax scaling)
+//            on the same inputs without lags; its standard deviation is MacKay's error bar
+//            sigma^2 = 1 / (2 beta) + g' A^-1 g (nn/model.h), in um.
+// Linear kinds give a standard deviation sqrt(s^2 + x1' Cov(b) x1), x1 = [1 features].
+// The training range of every feature is stored; the predictor counts samples outside it and
+// warns (a linear model extrapolates linearly, a network saturates).
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "drift/regression.h"
+#include "drift/run_file.h"
+#include "drift/selection.h"
+#include "nn/network.h"
+#include "nn/trainbr.h"
+
+namespace whirl::drift {
+
+enum class ModelKind { kMlr, kDynamic, kNetwork };
+std::string ToString(ModelKind k);                 ///< "mlr", "dynamic", "network"
+ModelKind ParseModelKind(const std::string& text);  ///< inverse; InputError otherwise
+
+enum class ReferenceMode { kRunStart, kModel };
+std::string ToString(ReferenceMode m);                  ///< "run-start", "model"
+ReferenceMode ParseReferenceMode(const std::string& text);
+
+/// One regressor: an input or its lagged copy.
+struct Feature {
+  std::string input;  ///< the column, e.g. "t3_C" or "spindle_rpm"
+  double tau = 0;     ///< lag time constant (model time unit); 0: the input itself
+  std::string Name(const std::string& time_unit) const;  ///< "t3_C" or "t3_C_lag40min"
+};
+
+struct DriftModel {
+  static constexpr int kSchemaVersion = 1;
+  static constexpr const char* kFormat = "whirl-drift-model";
+
+  ModelKind kind = ModelKind::kMlr;
+  std::string error_column;               ///< predicted channel, e.g. "ch1_um" [um]
+  std::vector<std::string> sensors;       ///< temperature columns used (rises) [degC -> K]
+  Eigen::VectorXd reference_C;            ///< per sensor: mean first row of the training runs
+  std::vector<std::string> extra_inputs;  ///< other columns used as logged
+  std::string time_unit = "min";          ///< "min", or "sample" (training runs had no time)
+  std::vector<double> time_constants;     ///< lag time constants [time_unit], ascending
+  std::vector<Feature> features;          ///< input-major, see the header comment
+  Eigen::VectorXd feature_min, feature_max;  ///< training range per feature
+
+  LinearFit linear;  ///< mlr, dynamic: coefficients b0 [um], then um per feature unit
+
+  nn::Network network;             ///< network: k-h-1 in the normalized space
+  nn::MapMinMax input_scaling;     ///< network: mapminmax of the features
+  nn::MapMinMax target_scaling;    ///< network: mapminmax of the error
+  Eigen::MatrixXd posterior_covariance;  ///< network: A^-1 (nn/trainbr.h)
+  double noise_variance = 0;       ///< network: 1 / (2 beta), normalized units
+
+  double residual_std_um = 0;  ///< training residual std (all kinds)
+  double r_squared = 0;        ///< training R^2 (all kinds)
+  std::vector<std::string> training_runs;
+  RunState state = RunState::kUnknown;  ///< common state of the training runs, else unknown
+  int training_samples = 0;
+  std::string selection;          ///< how the sensors were chosen (selection message or "given")
+  std::vector<std::string> notes;  ///< provenance (command line, lag search)
+
+  int InputCount() const { return static_cast<int>(sensors.size() + extra_inputs.size()); }
+  /// Throws InputError naming the field when sizes or values are inconsistent.
+  void Validate() const;
+};
+void to_json(nlohmann::json& j, const DriftModel& m);
+void from_json(const nlohmann::json& j, DriftModel& m);
+DriftModel ReadDriftModel(const std::filesystem::path& path);
+void WriteDriftModel(const std::filesystem::path& path, const DriftModel& m);
+
+/// The model evaluated sample by sample, as a control would: Step() takes one sample's raw
+/// temperatures of model.sensors [degC] followed by the extra inputs, updates the lag states and
+/// returns the predicted error [um]. The first Step initializes the lags (L_0 = u_0).
+class DriftEvaluator {
+ public:
+  DriftEvaluator(const DriftModel& model, const Eigen::VectorXd& reference_C);
+  double Step(double time, const Eigen::VectorXd& raw_inputs);
+  const Eigen::VectorXd& features() const { return features_; }  ///< of the last Step
+  /// Standard deviation of the last prediction [um] (see the header comment).
+  double StdDev() const;
+
+ private:
+  const DriftModel* model_;
+  Eigen::VectorXd reference_;
+  Eigen::VectorXd features_;
+  double last_time_ = 0;
+  bool started_ = false;
+};
+
+/// Raw inputs (sensors' temperatures, extras) of every sample of a run: samples x inputs.
+/// InputError if the run lacks a column the model needs.
+Eigen::MatrixXd RawInputs(const DriftModel& model, const Run& run);
+/// Feature matrix (samples x features) of a run with the run's first row as reference.
+Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& sensors,
+                              const std::vector<std::string>& extra_inputs,
+                              const std::vector<double>& time_constants);
+
+struct RunPrediction {
+  std::string run;
+  std::vector<double> time;       ///< run.time_min (samples when time_from_index)
+  bool time_from_index = false;
+  Eigen::VectorXd predicted_um;   ///< the compensation value is its negative
+  Eigen::VectorXd std_um;         ///< standard deviation of each prediction
+  bool has_measured = false;      ///< the run has the model's error column
+  Eigen::VectorXd measured_um;
+  int outside_range_samples = 0;  ///< samples with a feature outside its training range
+  std::vector<std::string> warnings;
+};
+RunPrediction PredictRun(const DriftModel& model, const Run& run,
+                         ReferenceMode reference = ReferenceMode::kRunStart);
+
+struct FitOptions {
+  ModelKind kind = ModelKind::kMlr;
+  std::vector<std::string> sensors;  ///< empty: seed 000's selection (selection.h)
+  SelectionOptions selection;
+  std::vector<std::string> extra_inputs;  ///< other columns used as inputs
+  /// dynamic: candidate lag time constants [min, or samples without time]
+  std::vector<double> tau_grid = {5, 10, 20, 40, 80, 160, 320};
+  int max_lags = 2;  ///< dynamic: at most this many time constants (1..4)
+  int folds = 5;     ///< dynamic: contiguous blocks when there is one training run (2..20)
+  /// dynamic, one training run: forward-chaining folds (block k is predicted from blocks < k
+  /// only, as a model is used on a machine: always forward in time) instead of leave-one-block-
+  /// out. Several runs: always leave one run out.
+  bool forward_cv = true;
+  int hidden = 3;    ///< network: hidden tansig neurons h (1..20)
+  int restarts = 3;  ///< network: trainbr restarts, the highest evidence kept (1..50)
+  std::uint64_t seed = 1;      ///< network: Nguyen-Widrow seed of the first restart
+  int max_train_samples = 3000;  ///< network: evenly thinned to at most this many samples
+  nn::TrainOptions train;      ///< network: trainbr options (epochs default 1000)
+  int threads = 0;             ///< cross-validation and restarts (0: all cores)
+  void Validate() const;
+};
+
+struct LagSearchStep {
+  std::vector<double> time_constants;
+  double cv_rmse_um = 0;
+};
+
+struct FitReport {
+  DriftModel model;
+  bool selected = false;   ///< sensors came from the selection
+  Selection selection;     ///< when selected
+  std::vector<LagSearchStep> lag_search;  ///< dynamic: accepted steps, static first
+  std::string train_report;  ///< network: trainbr BriefReport
+};
+
+/// Fits a model of `error_column` on `runs` (InputError on missing columns or bad options).
+FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
+                        const FitOptions& options);
+
+}  // namespace whirl::drift

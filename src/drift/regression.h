@@ -1,0 +1,53 @@
+#pragma once
+// Least squares for the drift models: seed 000's multiple linear regression
+//   error = b0 + sum_j b_j x_j  (x_j = a temperature rise [K] or a lagged copy of it)
+// solved with Eigen (column-pivoting QR of the design matrix [1 X]), with the classical
+// statistics of ordinary least squares (any regression text, e.g. Montgomery, Peck & Vining,
+// "Introduction to Linear Regression Analysis", chapters 3 and 9):
+//   residual std  s = sqrt(RSS / (n - p - 1))                    [um]
+//   covariance    Cov(b) = s^2 (X1' X1)^-1, X1 = [1 X]           [um^2 / K^2 ...]
+//   standard error of b_j = sqrt(Cov_jj)
+//   R^2 = 1 - RSS / TSS  (TSS about the mean; 1 when TSS = 0 and RSS = 0)
+//   VIF_j = 1 / (1 - R_j^2), R_j^2 of regressing x_j on the other regressors (with intercept);
+//           1 for a single regressor, +inf for an exactly collinear one.
+// The posterior of b under a flat prior and Gaussian noise is N(b, Cov(b)), which the on-line
+// recalibration (issue 14) uses as its prior; xtx_inverse is kept for it unscaled.
+#include <Eigen/Core>
+
+namespace whirl::drift {
+
+struct LinearFit {
+  Eigen::VectorXd coefficients;     ///< b0 (intercept, um), then one per regressor
+  Eigen::VectorXd standard_errors;  ///< sqrt(diag Cov), same order
+  Eigen::MatrixXd covariance;       ///< s^2 (X1'X1)^-1, (p + 1) x (p + 1)
+  Eigen::MatrixXd xtx_inverse;      ///< (X1'X1)^-1
+  double residual_std_um = 0;       ///< s
+  double r_squared = 0;
+  int samples = 0;              ///< n
+  int degrees_of_freedom = 0;   ///< n - p - 1
+  Eigen::VectorXd vif;          ///< per regressor
+};
+
+/// OLS of y (n) on the columns of x (n x p) with an intercept. InputError if n <= p + 1, a value
+/// is not finite or [1 X] is rank deficient (names the rank: collinear regressors).
+LinearFit FitLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
+
+/// The minimum-norm least-squares coefficients (b0 first) of y on [1 x], also for a rank-deficient
+/// [1 x] (complete orthogonal decomposition of the unit-norm-scaled columns). For
+/// cross-validation folds, where one block may leave two regressors collinear; never throws on
+/// rank. FitLinear is the fit a model is built from.
+Eigen::VectorXd LeastSquaresCoefficients(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
+
+/// b0 + x b for every row of x.
+Eigen::VectorXd EvaluateLinear(const Eigen::VectorXd& coefficients, const Eigen::MatrixXd& x);
+
+/// Variance inflation factors of the columns of x (see the header comment).
+Eigen::VectorXd VarianceInflation(const Eigen::MatrixXd& x);
+
+/// First-order lag of a series sampled at times t [min], exact for a piecewise-constant input
+/// (zero-order hold), the recursion a control runs every cycle:
+///   y_0 = x_0,  y_k = y_{k-1} + a_k (x_k - y_{k-1}),  a_k = 1 - exp(-(t_k - t_{k-1}) / tau).
+/// tau in the unit of t (> 0).
+Eigen::VectorXd FirstOrderLag(const Eigen::VectorXd& x, const std::vector<double>& t, double tau);
+
+}  // namespace whirl::drift

@@ -1,0 +1,252 @@
+#include "drift/report.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
+#include "drift/documents.h"
+
+namespace whirl::drift {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string F(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
+
+// Writes files, renders the gnuplot scripts, writes index.html last.
+class ReportWriter {
+ public:
+  ReportWriter(fs::path dir, std::string gnuplot) : dir_(std::move(dir)), gnuplot_(std::move(gnuplot)) {
+    std::error_code ec;
+    fs::create_directories(dir_, ec);
+    if (ec) throw InputError("report directory '" + dir_.string() + "': " + ec.message());
+    have_gnuplot_ = ProgramSucceeds({gnuplot_, "--version"});
+    if (!have_gnuplot_)
+      result_.warnings.push_back("'" + gnuplot_ + "' not found: plots skipped (install gnuplot-nox)");
+  }
+  void File(const std::string& name, const std::string& text) {
+    WriteFileAtomic(dir_ / name, text);
+    result_.files.push_back(dir_ / name);
+  }
+  // Script `stem`.gp renders `stem`.png; returns the <img> tag (or a note when not rendered).
+  std::string Plot(const std::string& stem, const std::string& body, const std::string& alt) {
+    const std::string png = stem + ".png", tmp = stem + ".png.tmp";
+    File(stem + ".gp", "# gnuplot script written by whirl; re-run with: gnuplot " + stem + ".gp\n" +
+                           kTerminal + "set output " + GnuplotString(png) + "\n" + body);
+    if (have_gnuplot_) {
+      const std::string script = std::string(kTerminal) + "set output " + GnuplotString(tmp) + "\n" + body;
+      WriteFileAtomic(dir_ / (stem + ".tmp.gp"), script);
+      const int rc = RunProgram({gnuplot_, stem + ".tmp.gp"}, dir_, dir_ / "gnuplot.log");
+      fs::remove(dir_ / (stem + ".tmp.gp"));
+      if (rc == 0 && fs::exists(dir_ / tmp)) {
+        fs::rename(dir_ / tmp, dir_ / png);
+        result_.files.push_back(dir_ / png);
+        return "<img src='" + HtmlEscape(png) + "' alt='" + HtmlEscape(alt) + "'>";
+      }
+      result_.warnings.push_back("gnuplot failed on " + (dir_ / (stem + ".gp")).string() +
+                                 " (see gnuplot.log)");
+    }
+    return "<p>(plot not rendered: " + HtmlEscape(stem) + ".gp)</p>";
+  }
+  const std::vector<std::string>& warnings() const { return result_.warnings; }
+  DriftReportResult Finish(const std::string& html) {
+    File("index.html", html);
+    result_.index_html = dir_ / "index.html";
+    return result_;
+  }
+
+ private:
+  fs::path dir_;
+  std::string gnuplot_;
+  bool have_gnuplot_ = false;
+  DriftReportResult result_;
+};
+
+std::string Head(const std::string& title, const std::vector<std::string>& provenance) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << HtmlEscape(title)
+    << "</title><style>body{font-family:sans-serif;max-width:1100px;margin:1em auto}"
+       "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;"
+       "text-align:right}th{background:#eee}pre{background:#f6f6f6;padding:6px}"
+       "img{max-width:100%}</style></head><body>\n<h1>"
+    << HtmlEscape(title) << "</h1>\n";
+  for (const auto& p : provenance) h << "<p><code>" << HtmlEscape(p) << "</code></p>\n";
+  return h.str();
+}
+
+std::vector<std::string> Comments(const std::vector<std::string>& provenance, const std::string& what) {
+  std::vector<std::string> c{what};
+  for (const auto& p : provenance) c.push_back(p);
+  return c;
+}
+
+std::string SelectionHtml(const Selection& s) {
+  std::ostringstream h;
+  h << "<h2>Sensitive points (seed 000)</h2>\n<p>" << HtmlEscape(s.message)
+    << ". Chosen sensors: <b>";
+  for (const auto& n : s.ChosenNames()) h << HtmlEscape(n) << " ";
+  h << "</b></p>\n<table><tr><th>lambda</th><th>classes</th><th>F</th><th>F crit</th>"
+       "<th>significant</th><th style='text-align:left'>partition</th></tr>\n";
+  for (std::size_t i = 0; i < s.partitions.size(); ++i) {
+    const Partition& p = s.partitions[i];
+    std::string classes;
+    for (int k = 0; k < p.classes; ++k) {
+      classes += "{";
+      for (std::size_t j = 0; j < p.labels.size(); ++j)
+        if (p.labels[j] == k) classes += s.sensor_names[j] + " ";
+      classes += "} ";
+    }
+    const bool chosen = static_cast<int>(i) == s.chosen_partition;
+    h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>" << F("%.4f", p.lambda)
+      << "</td><td>" << p.classes << "</td><td>" << (p.has_f ? F("%.3f", p.f) : "-") << "</td><td>"
+      << (p.has_f ? F("%.3f", p.f_critical) : "-") << "</td><td>"
+      << (p.has_f ? (p.significant() ? "yes" : "no") : "-")
+      << "</td><td style='text-align:left'>" << HtmlEscape(classes) << "</td></tr>\n";
+  }
+  h << "</table>\n<p>Grey relational grades against the error (rho 0.5):</p><table><tr>";
+  for (const auto& n : s.sensor_names) h << "<th>" << HtmlEscape(n) << "</th>";
+  h << "</tr><tr>";
+  for (Eigen::Index i = 0; i < s.grades.size(); ++i) h << "<td>" << F("%.4f", s.grades(i)) << "</td>";
+  h << "</tr></table>\n";
+  return h.str();
+}
+
+// Similarity matrix and fuzzy equivalence as heat maps, with sensor names on the axes.
+std::string SimilarityPlot(ReportWriter* w, const Selection& s) {
+  std::ostringstream data;
+  const Eigen::Index m = s.similarity.rows();
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index j = 0; j < m; ++j)
+      data << i << " " << j << " " << FormatNumber(s.similarity(i, j)) << " "
+           << FormatNumber(s.equivalence(i, j)) << "\n";
+  w->File("similarity.dat", "# i j similarity equivalence (sensor indices as in the tics)\n" + data.str());
+  std::string tics;
+  for (Eigen::Index i = 0; i < m; ++i)
+    tics += (i ? ", " : "") + GnuplotString(s.sensor_names[static_cast<std::size_t>(i)]) + " " +
+            std::to_string(i);
+  std::ostringstream gp;
+  gp << "set multiplot layout 1,2\nset size ratio -1\nset cbrange [0:1]\nset xtics (" << tics
+     << ") rotate by 90 right\nset bmargin 6\nset ytics (" << tics << ")\nset yrange [] reverse\n"
+     << "set title 'similarity |Pearson r| of the rises'\nplot 'similarity.dat' using 1:2:3 with image notitle\n"
+     << "set title 'fuzzy equivalence (lambda levels)'\nplot 'similarity.dat' using 1:2:4 with image notitle\n"
+     << "unset multiplot\n";
+  return w->Plot("similarity", gp.str(), "similarity and fuzzy equivalence matrices");
+}
+
+std::string StatsRow(const std::string& name, const ErrorStats& s) {
+  return "<tr><td style='text-align:left'>" + HtmlEscape(name) + "</td><td>" + F("%.2f", s.mae_um) +
+         "</td><td>" + F("%.2f", s.rmse_um) + "</td><td>" + F("%.2f", s.std_um) + "</td><td>" +
+         F("%.2f", s.max_abs_um) + "</td></tr>\n";
+}
+
+}  // namespace
+
+DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
+                                   const std::vector<Run>& runs,
+                                   const std::vector<std::string>& provenance,
+                                   const std::string& gnuplot) {
+  std::vector<RunPrediction> preds;
+  for (const Run& r : runs) preds.push_back(PredictRun(fit.model, r));  // all inputs checked first
+  ReportWriter w(dir, gnuplot);
+  const DriftModel& m = fit.model;
+  std::ostringstream h;
+  h << Head("whirl: machine thermal drift of " + m.error_column, provenance);
+  h << "<h2>Model</h2>\n<pre>" << HtmlEscape(FormatModel(m)) << "</pre>\n";
+  if (fit.selected) h << SelectionHtml(fit.selection) << SimilarityPlot(&w, fit.selection) << "\n";
+  h << "<h2>Runs</h2>\n<table><tr><th style='text-align:left'>run</th><th>MAE um</th><th>RMSE um</th>"
+       "<th>std um</th><th>max um</th></tr>\n";
+  std::ostringstream plots;
+  for (const RunPrediction& p : preds) {
+    const std::string slug = Slug(p.run);
+    w.File(slug + "_prediction.csv", PredictionCsv(p, Comments(provenance, "prediction of " + p.run)));
+    if (p.has_measured) {
+      h << StatsRow(p.run + " (model)", ComputeErrorStats(p.measured_um - p.predicted_um))
+        << StatsRow(p.run + " (no compensation)", ComputeErrorStats(p.measured_um));
+    }
+    const std::string x = p.time_from_index ? "sample" : "time [h]";
+    const std::string xcol = p.time_from_index ? "1" : "($1/60)";
+    std::ostringstream gp;
+    gp << "set datafile separator ','\nset key top left\nset grid\nset xlabel " << GnuplotString(x)
+       << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\nset title "
+       << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column) << "\nplot "
+       << GnuplotString(slug + "_prediction.csv") << " using " << xcol
+       << ":2 with lines lw 2 title 'predicted'";
+    if (p.has_measured)
+      gp << ", '' using " << xcol << ":5 with lines lc rgb 'black' title 'measured'";
+    gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
+    if (p.has_measured) gp << "plot " << GnuplotString(slug + "_prediction.csv") << " using " << xcol
+                           << ":6 with lines lc rgb 'red' title 'residual'\n";
+    else gp << "plot 0 notitle\n";
+    gp << "unset multiplot\n";
+    plots << "<h3>" << HtmlEscape(p.run) << "</h3>\n";
+    for (const auto& warn : p.warnings) plots << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
+    plots << w.Plot(slug + "_prediction", gp.str(), "measured and predicted error of " + p.run) << "\n";
+  }
+  h << "</table>\n" << plots.str();
+  for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
+  h << "</body></html>\n";
+  return w.Finish(h.str());
+}
+
+DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log,
+                                     const HoldoutResult& r,
+                                     const std::vector<std::string>& provenance,
+                                     const std::string& gnuplot) {
+  ReportWriter w(dir, gnuplot);
+  std::ostringstream h;
+  h << Head("whirl: chronological hold-out on " + log.name, provenance);
+  h << "<p>Train rows [0, " << r.train_end << ") to " << F("%.1f", r.train_end_min / 60)
+    << " h; test rows [" << r.train_end << ", " << r.test_end << ") to "
+    << F("%.1f", r.test_end_min / 60) << " h. Models run from the log's first row.</p>\n";
+  h << "<pre>" << HtmlEscape(FormatHoldout(r)) << "</pre>\n";
+  std::vector<std::string> channels;
+  for (const auto& row : r.rows_out)
+    if (channels.empty() || channels.back() != row.channel) channels.push_back(row.channel);
+  for (const std::string& ch : channels) {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < r.rows_out.size(); ++i)
+      if (r.rows_out[i].channel == ch) idx.push_back(i);
+    std::vector<std::string> header{"time_min", "measured_um"};
+    for (std::size_t i : idx) header.push_back(r.rows_out[i].method + "_um");
+    std::vector<std::vector<double>> rows;
+    const RunPrediction& first = r.predictions[idx.front()];
+    for (Eigen::Index k = 0; k < first.measured_um.size(); ++k) {
+      std::vector<double> row{first.time[static_cast<std::size_t>(k)], first.measured_um(k)};
+      for (std::size_t i : idx) row.push_back(r.predictions[i].predicted_um(k));
+      rows.push_back(std::move(row));
+    }
+    const std::string slug = Slug(ch);
+    w.File(slug + "_holdout.csv", FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
+    std::ostringstream gp;
+    gp << "set datafile separator ','\nset key outside right\nset grid\nset xlabel 'time [h]'\n"
+       << "set arrow from " << r.train_end_min / 60 << ", graph 0 to " << r.train_end_min / 60
+       << ", graph 1 nohead dt 2\nset multiplot layout 2,1\nset ylabel 'error [um]'\nset title "
+       << GnuplotString(ch + ": measured and predicted (dashed line: end of training)") << "\nplot "
+       << GnuplotString(slug + "_holdout.csv") << " using ($1/60):2 with lines lc rgb 'black' lw 2 title 'measured'";
+    for (std::size_t c = 1; c < idx.size(); ++c)
+      gp << ", '' using ($1/60):" << c + 3 << " with lines lc " << c << " title "
+         << GnuplotString(r.rows_out[idx[c]].method);
+    gp << ", '' using ($1/60):2 with lines lc rgb 'black' lw 2 notitle";
+    gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\nplot ";
+    for (std::size_t c = 1; c < idx.size(); ++c)
+      gp << (c > 1 ? ", " : "") << GnuplotString(slug + "_holdout.csv") << " using ($1/60):($2-$" << c + 3
+         << ") with lines lc " << c << " title " << GnuplotString(r.rows_out[idx[c]].method);
+    gp << "\nunset multiplot\n";
+    h << "<h2>" << HtmlEscape(ch) << "</h2>\n" << w.Plot(slug + "_holdout", gp.str(), "hold-out of " + ch) << "\n";
+  }
+  for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
+  h << "</body></html>\n";
+  return w.Finish(h.str());
+}
+
+}  // namespace whirl::drift

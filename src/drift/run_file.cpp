@@ -1,0 +1,260 @@
+#include "drift/run_file.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+
+namespace whirl::drift {
+namespace {
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string Join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out.empty() ? "none" : out;
+}
+
+// The time column may hold empty or nan cells, which core's strict CSV rejects: such cells are
+// replaced by 0 before parsing (same line numbers) and remembered, so every other cell keeps the
+// strict rules and their messages.
+struct TimePrepass {
+  std::string text;
+  std::string time_column;  // "" if none
+  int missing = 0;
+};
+
+TimePrepass PrepareTime(const std::string& text, const std::string& source) {
+  TimePrepass p;
+  std::istringstream in(text);
+  std::string line, out;
+  int time_index = -1, line_no = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string trimmed = Trim(line);
+    if (!trimmed.empty() && trimmed[0] != '#') {
+      std::vector<std::string> cells;
+      std::string cell;
+      std::istringstream ss(line);
+      while (std::getline(ss, cell, ',')) cells.push_back(cell);
+      if (!line.empty() && line.back() == ',') cells.push_back("");
+      if (!header) {
+        header = true;
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+          const std::string name = Trim(cells[i]);
+          if (name != "time_s" && name != "time_min") continue;
+          if (time_index >= 0)
+            throw InputError(source + ":" + std::to_string(line_no) +
+                             ": two time columns ('" + p.time_column + "' and '" + name +
+                             "'): give time_s or time_min, not both");
+          time_index = static_cast<int>(i);
+          p.time_column = name;
+        }
+      } else if (time_index >= 0 && static_cast<int>(cells.size()) > time_index) {
+        const std::string v = Lower(Trim(cells[static_cast<std::size_t>(time_index)]));
+        if (v.empty() || v == "nan") {
+          ++p.missing;
+          cells[static_cast<std::size_t>(time_index)] = "0";
+          line.clear();
+          for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+        }
+      }
+    }
+    out += line;
+    out += '\n';
+  }
+  p.text = std::move(out);
+  return p;
+}
+
+void CheckRange(const CsvTable& t, std::size_t row, std::size_t col, double lo, double hi,
+                const std::string& rule) {
+  const double v = t.rows[row][col];
+  if (v >= lo && v <= hi) return;
+  throw InputError(t.source + ":" + std::to_string(t.line_numbers[row]) + ": column '" +
+                   t.header[col] + "': value " + FormatNumber(v) + " " + rule);
+}
+
+int FindIndex(const std::vector<std::string>& names, const std::string& name,
+              const std::string& run, const char* kind) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it != names.end()) return static_cast<int>(it - names.begin());
+  throw InputError(run + ": no " + kind + " column '" + name + "' (have: " + Join(names) + ")");
+}
+
+}  // namespace
+
+std::string ToString(RunState s) {
+  switch (s) {
+    case RunState::kIdle: return "idle";
+    case RunState::kCutting: return "cutting";
+    case RunState::kUnknown: break;
+  }
+  return "unknown";
+}
+
+RunState ParseRunState(const std::string& text) {
+  if (text == "idle") return RunState::kIdle;
+  if (text == "cutting") return RunState::kCutting;
+  if (text == "unknown") return RunState::kUnknown;
+  throw InputError("run state '" + text + "': must be idle, cutting or unknown");
+}
+
+Eigen::MatrixXd Run::Rises() const {
+  Eigen::MatrixXd r = temperature_C;
+  if (r.rows() > 0) r.rowwise() -= temperature_C.row(0);
+  return r;
+}
+
+int Run::SensorIndex(const std::string& name) const {
+  return FindIndex(sensor_names, name, source, "temperature (_C)");
+}
+int Run::ErrorIndex(const std::string& name) const {
+  return FindIndex(error_names, name, source, "thermal-error (_um)");
+}
+int Run::OtherIndex(const std::string& name) const {
+  return FindIndex(other_names, name, source, "input");
+}
+
+Run Run::Slice(int begin, int end, const std::string& new_name) const {
+  if (begin < 0 || end > samples() || end - begin < 1)
+    throw InputError(source + ": rows [" + std::to_string(begin) + ", " + std::to_string(end) +
+                     ") are not a non-empty part of its " + std::to_string(samples()) + " rows");
+  Run r = *this;
+  r.name = new_name;
+  const int n = end - begin;
+  r.time_min.assign(time_min.begin() + begin, time_min.begin() + end);
+  r.line_numbers.assign(line_numbers.begin() + begin, line_numbers.begin() + end);
+  r.temperature_C = temperature_C.middleRows(begin, n);
+  r.error_um = error_um.middleRows(begin, n);
+  r.other = other.middleRows(begin, n);
+  return r;
+}
+
+Run ErrorsFromStart(const Run& run) {
+  Run r = run;
+  if (r.error_um.rows() > 0) r.error_um.rowwise() -= run.error_um.row(0);
+  return r;
+}
+
+Run ParseRun(const std::string& text, const std::string& source, RunState state) {
+  const TimePrepass prep = PrepareTime(text, source);
+  const CsvTable t = ParseCsv(prep.text, source);
+  if (t.rows.size() > static_cast<std::size_t>(kMaxRunSamples))
+    throw InputError(source + ": " + std::to_string(t.rows.size()) + " rows: a run file holds at most " +
+                     std::to_string(kMaxRunSamples) + " (split the log into runs)");
+  if (t.header.size() > static_cast<std::size_t>(kMaxRunColumns))
+    throw InputError(source + ": " + std::to_string(t.header.size()) +
+                     " columns: a run file holds at most " + std::to_string(kMaxRunColumns));
+  Run r;
+  r.source = source;
+  r.name = std::filesystem::path(source).stem().string();
+  r.state = state;
+  r.line_numbers = t.line_numbers;
+  std::vector<std::size_t> s_cols, e_cols, o_cols;
+  for (std::size_t c = 0; c < t.header.size(); ++c) {
+    const std::string& h = t.header[c];
+    if (h == prep.time_column) continue;
+    if (EndsWith(h, "_C")) {
+      s_cols.push_back(c);
+      r.sensor_names.push_back(h);
+    } else if (EndsWith(h, "_um")) {
+      e_cols.push_back(c);
+      r.error_names.push_back(h);
+    } else {
+      o_cols.push_back(c);
+      r.other_names.push_back(h);
+    }
+  }
+  if (s_cols.empty())
+    throw InputError(source + ": no temperature column (a name ending in _C, degC) in the header (" +
+                     Join(t.header) + ")");
+  const std::size_t q = t.rows.size();
+  const auto n = static_cast<Eigen::Index>(q);
+  r.temperature_C.resize(n, static_cast<Eigen::Index>(s_cols.size()));
+  r.error_um.resize(n, static_cast<Eigen::Index>(e_cols.size()));
+  r.other.resize(n, static_cast<Eigen::Index>(o_cols.size()));
+  for (std::size_t i = 0; i < q; ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    for (std::size_t j = 0; j < s_cols.size(); ++j) {
+      CheckRange(t, i, s_cols[j], kMinTemperatureC, kMaxTemperatureC,
+                 "is outside the plausible temperature range [-60, 400] degC");
+      r.temperature_C(k, static_cast<Eigen::Index>(j)) = t.rows[i][s_cols[j]];
+    }
+    for (std::size_t j = 0; j < e_cols.size(); ++j) {
+      CheckRange(t, i, e_cols[j], -kMaxAbsErrorUm, kMaxAbsErrorUm,
+                 "is outside the plausible thermal-error range +-100000 um");
+      r.error_um(k, static_cast<Eigen::Index>(j)) = t.rows[i][e_cols[j]];
+    }
+    for (std::size_t j = 0; j < o_cols.size(); ++j)
+      r.other(k, static_cast<Eigen::Index>(j)) = t.rows[i][o_cols[j]];
+  }
+  if (prep.time_column.empty() || prep.missing > 0) {
+    r.time_from_index = true;
+    r.time_min.resize(q);
+    for (std::size_t i = 0; i < q; ++i) r.time_min[i] = static_cast<double>(i);
+  } else {
+    r.time_min = t.IncreasingColumn(prep.time_column);
+    if (prep.time_column == "time_s")
+      for (double& v : r.time_min) v /= 60.0;
+  }
+  return r;
+}
+
+Run ReadRun(const std::filesystem::path& path, RunState state) {
+  return ParseRun(ReadTextFile(path), path.string(), state);
+}
+
+std::string FormatRun(const Run& run, const std::vector<std::string>& comments) {
+  std::vector<std::string> header;
+  if (!run.time_from_index) header.push_back("time_min");
+  for (const auto& v : {run.sensor_names, run.error_names, run.other_names})
+    header.insert(header.end(), v.begin(), v.end());
+  std::vector<std::vector<double>> rows(static_cast<std::size_t>(run.samples()));
+  for (int k = 0; k < run.samples(); ++k) {
+    auto& row = rows[static_cast<std::size_t>(k)];
+    if (!run.time_from_index) row.push_back(run.time_min[static_cast<std::size_t>(k)]);
+    for (const Eigen::MatrixXd* m : {&run.temperature_C, &run.error_um, &run.other})
+      for (Eigen::Index j = 0; j < m->cols(); ++j) row.push_back((*m)(k, j));
+  }
+  return FormatCsv(header, rows, comments);
+}
+
+std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold) {
+  const int c = run.OtherIndex(column);
+  std::vector<int> starts{0};
+  for (int k = 1; k < run.samples(); ++k)
+    if (run.other(k - 1, c) <= threshold && run.other(k, c) > threshold && k > starts.back())
+      starts.push_back(k);
+  if (starts.size() > 1 && run.other(0, c) <= threshold) {
+    // rows before the first start belong to the first run
+    starts.erase(starts.begin() + 1);
+  }
+  starts.push_back(run.samples());
+  std::vector<Run> runs;
+  for (std::size_t i = 0; i + 1 < starts.size(); ++i)
+    runs.push_back(run.Slice(starts[i], starts[i + 1], run.name + "_" + std::to_string(i + 1)));
+  return runs;
+}
+
+}  // namespace whirl::drift

@@ -1,0 +1,319 @@
+#include "drift/selection.h"
+
+#include <algorithm>
+#include <boost/math/distributions/fisher_f.hpp>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace whirl::drift {
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(4);
+  s << v;
+  return s.str();
+}
+
+Eigen::VectorXd MinMaxNormalize(const Eigen::VectorXd& x) {
+  const double lo = x.minCoeff(), hi = x.maxCoeff();
+  if (!(hi > lo)) return Eigen::VectorXd::Zero(x.size());
+  return (x.array() - lo) / (hi - lo);
+}
+
+// Relative margin (F - F_crit) / F_crit; +inf for an infinite F.
+double Margin(const Partition& p) { return (p.f - p.f_critical) / p.f_critical; }
+
+// Each class's sensor with the highest grade (ties: the first), in file order.
+std::vector<int> BestPerClass(const std::vector<int>& labels, const Eigen::VectorXd& grades) {
+  const int r = *std::max_element(labels.begin(), labels.end()) + 1;
+  std::vector<int> best(static_cast<std::size_t>(r), -1);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    int& b = best[static_cast<std::size_t>(labels[i])];
+    if (b < 0 || grades(static_cast<Eigen::Index>(i)) > grades(b)) b = static_cast<int>(i);
+  }
+  std::sort(best.begin(), best.end());
+  return best;
+}
+
+// Picks the partition by the options' rule; returns -1 (every sensor a class) if none qualifies.
+int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions& o,
+                    std::string* message) {
+  auto eligible = [&](const Partition& p) { return o.max_classes <= 0 || p.classes <= o.max_classes; };
+  auto best_margin = [&]() {
+    int best = -1;
+    for (std::size_t i = 0; i < parts.size(); ++i)
+      if (parts[i].has_f && eligible(parts[i]) &&
+          (best < 0 || Margin(parts[i]) > Margin(parts[static_cast<std::size_t>(best)])))
+        best = static_cast<int>(i);
+    return best;
+  };
+  if (o.rule == ClassCountRule::kFixed) {
+    for (std::size_t i = 0; i < parts.size(); ++i)
+      if (parts[i].classes == o.fixed_classes) {
+        *message = "fixed class count " + std::to_string(o.fixed_classes) + " (lambda " +
+                   Num(parts[i].lambda) + ")";
+        return static_cast<int>(i);
+      }
+    std::string have;
+    for (const auto& p : parts) have += (have.empty() ? "" : ", ") + std::to_string(p.classes);
+    throw InputError("--classes " + std::to_string(o.fixed_classes) +
+                     ": no lambda-cut has that many classes (the cuts have " + have + ")");
+  }
+  if (o.rule == ClassCountRule::kFewestSignificant) {
+    int best = -1;
+    for (std::size_t i = 0; i < parts.size(); ++i)
+      if (parts[i].significant() && eligible(parts[i]) &&
+          (best < 0 || parts[i].classes < parts[static_cast<std::size_t>(best)].classes))
+        best = static_cast<int>(i);
+    if (best >= 0) {
+      const Partition& p = parts[static_cast<std::size_t>(best)];
+      *message = "fewest classes with a significant F: r = " + std::to_string(p.classes) +
+                 " at lambda " + Num(p.lambda) + " (F " + Num(p.f) + " > F_crit " +
+                 Num(p.f_critical) + ")";
+      return best;
+    }
+  }
+  const int best = best_margin();
+  if (best >= 0) {
+    const Partition& p = parts[static_cast<std::size_t>(best)];
+    *message = std::string(o.rule == ClassCountRule::kLargestMargin
+                               ? "largest (F - F_crit) / F_crit"
+                               : "no eligible partition has a significant F; fallback: largest "
+                                 "(F - F_crit) / F_crit") +
+               ": r = " + std::to_string(p.classes) + " at lambda " + Num(p.lambda) + " (F " +
+               Num(p.f) + ", F_crit " + Num(p.f_critical) + ")";
+    return best;
+  }
+  *message = "no partition with 1 < r < m (and r <= max classes): every sensor is its own class";
+  return -1;
+}
+
+}  // namespace
+
+std::string ToString(ClassCountRule r) {
+  switch (r) {
+    case ClassCountRule::kLargestMargin: return "margin";
+    case ClassCountRule::kFixed: return "fixed";
+    case ClassCountRule::kFewestSignificant: break;
+  }
+  return "fewest";
+}
+
+ClassCountRule ParseClassCountRule(const std::string& s) {
+  if (s == "fewest") return ClassCountRule::kFewestSignificant;
+  if (s == "margin") return ClassCountRule::kLargestMargin;
+  if (s == "fixed") return ClassCountRule::kFixed;
+  throw InputError("class-count rule '" + s + "': must be fewest, margin or fixed");
+}
+
+void SelectionOptions::Validate() const {
+  if (!(alpha > 0 && alpha < 1))
+    throw InputError("alpha " + Num(alpha) + ": must be in (0, 1)");
+  if (!(rho > 0 && rho <= 1)) throw InputError("rho " + Num(rho) + ": must be in (0, 1]");
+  if (rule == ClassCountRule::kFixed && fixed_classes < 1)
+    throw InputError("fixed class count " + std::to_string(fixed_classes) + ": must be >= 1");
+  if (max_classes < 0)
+    throw InputError("max classes " + std::to_string(max_classes) + ": must be >= 0");
+}
+
+std::vector<std::string> Selection::ChosenNames() const {
+  std::vector<std::string> out;
+  for (int i : chosen) out.push_back(sensor_names[static_cast<std::size_t>(i)]);
+  return out;
+}
+
+Eigen::MatrixXd SimilarityMatrix(const Eigen::MatrixXd& series) {
+  const Eigen::Index m = series.cols();
+  Eigen::MatrixXd c = series.rowwise() - series.colwise().mean();
+  const Eigen::VectorXd norm = c.colwise().norm();
+  Eigen::MatrixXd r = Eigen::MatrixXd::Identity(m, m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index j = i + 1; j < m; ++j) {
+      double v = 0;
+      if (norm(i) > 0 && norm(j) > 0)
+        v = std::min(1.0, std::abs(c.col(i).dot(c.col(j))) / (norm(i) * norm(j)));
+      r(i, j) = r(j, i) = v;
+    }
+  return r;
+}
+
+Eigen::MatrixXd MaxMinCompose(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  Eigen::MatrixXd c(a.rows(), b.cols());
+  for (Eigen::Index i = 0; i < a.rows(); ++i)
+    for (Eigen::Index j = 0; j < b.cols(); ++j) {
+      double v = 0;
+      for (Eigen::Index k = 0; k < a.cols(); ++k) v = std::max(v, std::min(a(i, k), b(k, j)));
+      c(i, j) = v;
+    }
+  return c;
+}
+
+Eigen::MatrixXd FuzzyEquivalence(const Eigen::MatrixXd& similarity, int* squarings) {
+  Eigen::MatrixXd r = similarity;
+  int n = 0;
+  for (;;) {
+    Eigen::MatrixXd next = MaxMinCompose(r, r);
+    ++n;
+    if (next == r) break;  // max and min only copy entries: exact comparison is safe
+    r = std::move(next);
+  }
+  if (squarings) *squarings = n;
+  return r;
+}
+
+std::vector<double> LambdaLevels(const Eigen::MatrixXd& r) {
+  std::vector<double> levels;
+  for (Eigen::Index i = 0; i < r.rows(); ++i)
+    for (Eigen::Index j = i + 1; j < r.cols(); ++j) levels.push_back(r(i, j));
+  std::sort(levels.begin(), levels.end(), std::greater<double>());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  return levels;
+}
+
+std::vector<int> LambdaCut(const Eigen::MatrixXd& r, double lambda) {
+  const auto m = static_cast<int>(r.rows());
+  std::vector<int> labels(static_cast<std::size_t>(m), -1);
+  int next = 0;
+  for (int i = 0; i < m; ++i) {
+    if (labels[static_cast<std::size_t>(i)] >= 0) continue;
+    for (int j = i; j < m; ++j)
+      if (labels[static_cast<std::size_t>(j)] < 0 && (j == i || r(i, j) >= lambda))
+        labels[static_cast<std::size_t>(j)] = next;
+    ++next;
+  }
+  return labels;
+}
+
+Eigen::MatrixXd ZScore(const Eigen::MatrixXd& series) {
+  Eigen::MatrixXd z = series.rowwise() - series.colwise().mean();
+  for (Eigen::Index j = 0; j < z.cols(); ++j) {
+    const double sd = std::sqrt(z.col(j).squaredNorm() / static_cast<double>(z.rows()));
+    if (sd > 0) z.col(j) /= sd;
+    else z.col(j).setZero();
+  }
+  return z;
+}
+
+double FStatistic(const Eigen::MatrixXd& z, const std::vector<int>& labels) {
+  const auto m = static_cast<int>(z.cols());
+  const int r = *std::max_element(labels.begin(), labels.end()) + 1;
+  if (!(r > 1 && r < m))
+    throw InputError("F statistic needs 1 < r < m (r = " + std::to_string(r) +
+                     ", m = " + std::to_string(m) + ")");
+  const Eigen::VectorXd mean = z.rowwise().mean();
+  Eigen::MatrixXd class_sum = Eigen::MatrixXd::Zero(z.rows(), r);
+  std::vector<int> n(static_cast<std::size_t>(r), 0);
+  for (int i = 0; i < m; ++i) {
+    class_sum.col(labels[static_cast<std::size_t>(i)]) += z.col(i);
+    ++n[static_cast<std::size_t>(labels[static_cast<std::size_t>(i)])];
+  }
+  double between = 0, within = 0;
+  for (int k = 0; k < r; ++k) {
+    class_sum.col(k) /= n[static_cast<std::size_t>(k)];
+    between += n[static_cast<std::size_t>(k)] * (class_sum.col(k) - mean).squaredNorm();
+  }
+  for (int i = 0; i < m; ++i)
+    within += (z.col(i) - class_sum.col(labels[static_cast<std::size_t>(i)])).squaredNorm();
+  const double num = between / (r - 1), den = within / (m - r);
+  if (den <= 0) return std::numeric_limits<double>::infinity();
+  return num / den;
+}
+
+double FCritical(int d1, int d2, double alpha) {
+  if (d1 < 1 || d2 < 1 || !(alpha > 0 && alpha < 1))
+    throw InputError("F critical value needs d1, d2 >= 1 and alpha in (0, 1)");
+  const boost::math::fisher_f dist(d1, d2);
+  return boost::math::quantile(boost::math::complement(dist, alpha));
+}
+
+Eigen::VectorXd GreyGrades(const Eigen::MatrixXd& series, const Eigen::VectorXd& error,
+                           double rho) {
+  const Eigen::VectorXd x0 = MinMaxNormalize(error);
+  Eigen::MatrixXd d(series.rows(), series.cols());
+  for (Eigen::Index i = 0; i < series.cols(); ++i)
+    d.col(i) = (x0 - MinMaxNormalize(series.col(i))).cwiseAbs();
+  const double dmin = d.minCoeff(), dmax = d.maxCoeff();
+  if (!(dmax > 0)) return Eigen::VectorXd::Ones(series.cols());
+  const Eigen::MatrixXd xi = (dmin + rho * dmax) / (d.array() + rho * dmax);
+  return xi.colwise().mean().transpose();
+}
+
+Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& error,
+                        const std::vector<std::string>& sensor_names,
+                        const SelectionOptions& options) {
+  options.Validate();
+  const auto m = static_cast<int>(rises.cols());
+  if (m < 1 || rises.rows() < 3 || error.size() != rises.rows() ||
+      static_cast<int>(sensor_names.size()) != m)
+    throw InputError("sensor selection needs at least 1 sensor and 3 samples (have " +
+                     std::to_string(m) + " sensors, " + std::to_string(rises.rows()) +
+                     " samples)");
+  Selection s;
+  s.sensor_names = sensor_names;
+  s.similarity = SimilarityMatrix(rises);
+  s.equivalence = FuzzyEquivalence(s.similarity, &s.squarings);
+  const Eigen::MatrixXd z = ZScore(rises);
+  for (double lambda : LambdaLevels(s.equivalence)) {
+    Partition p;
+    p.lambda = lambda;
+    p.labels = LambdaCut(s.equivalence, lambda);
+    p.classes = *std::max_element(p.labels.begin(), p.labels.end()) + 1;
+    p.has_f = p.classes > 1 && p.classes < m;
+    if (p.has_f) {
+      p.f = FStatistic(z, p.labels);
+      p.f_critical = FCritical(p.classes - 1, m - p.classes, options.alpha);
+    }
+    s.partitions.push_back(std::move(p));
+  }
+  s.grades = GreyGrades(rises, error, options.rho);
+  s.chosen_partition = ChoosePartition(s.partitions, options, &s.message);
+  if (s.chosen_partition >= 0) {
+    s.chosen = BestPerClass(s.partitions[static_cast<std::size_t>(s.chosen_partition)].labels,
+                            s.grades);
+  } else {
+    std::vector<int> order(static_cast<std::size_t>(m));
+    for (int i = 0; i < m; ++i) order[static_cast<std::size_t>(i)] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return s.grades(a) > s.grades(b); });
+    if (options.max_classes > 0 && options.max_classes < m)
+      order.resize(static_cast<std::size_t>(options.max_classes));
+    std::sort(order.begin(), order.end());
+    s.chosen = order;
+  }
+  return s;
+}
+
+void StackRuns(const std::vector<Run>& runs, const std::string& error_column,
+               Eigen::MatrixXd* rises, Eigen::VectorXd* error) {
+  if (runs.empty()) throw InputError("no run given");
+  Eigen::Index total = 0;
+  for (const Run& r : runs) {
+    if (r.sensor_names != runs.front().sensor_names)
+      throw InputError(r.source + ": its temperature columns differ from " +
+                       runs.front().source + "'s (runs must log the same sensors)");
+    r.ErrorIndex(error_column);
+    total += r.samples();
+  }
+  rises->resize(total, runs.front().temperature_C.cols());
+  error->resize(total);
+  Eigen::Index at = 0;
+  for (const Run& r : runs) {
+    rises->middleRows(at, r.samples()) = r.Rises();
+    error->segment(at, r.samples()) = r.error_um.col(r.ErrorIndex(error_column));
+    at += r.samples();
+  }
+}
+
+Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
+                        const SelectionOptions& options) {
+  Eigen::MatrixXd rises;
+  Eigen::VectorXd error;
+  StackRuns(runs, error_column, &rises, &error);
+  return SelectSensors(rises, error, runs.front().sensor_names, options);
+}
+
+}  // namespace whirl::drift

@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Smoke test of 'whirl drift': args <whirl> <scratch dir> <source dir>.
+set -u
+W="$1"; D="$2"; SRC="$3"
+rm -rf "$D"; mkdir -p "$D"
+source "$SRC/tests/support/cli_common.sh"
+
+# Synthetic runs (awk, deterministic): two latent temperatures A (fast rise) and B (slow ramp),
+# sensors a1,a2 follow A, b1,b2 follow B, c1 is a third shape; error = 2 A - 1.5 B (+ idle/cut
+# offset scale). Written with a provenance comment.
+make_run() {  # make_run <file> <gain> <phase>
+  awk -v g="$2" -v p="$3" 'BEGIN {
+    print "# synthetic drift run for the CLI smoke test (tests/drift/cli_drift.sh), gain " g;
+    print "time_min,a1_C,a2_C,b1_C,b2_C,c1_C,err_um,spindle_rpm";
+    for (k = 0; k < 240; k++) {
+      t = k; A = g * 8 * (1 - exp(-t / 13)); B = g * t / 40; C = 2 * sin(t / 15 + p);
+      n = 0.01 * sin(7 * k + p);
+      printf "%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", t, 20 + A + n, 21 + 0.7 * A - n, 20 + B + n,
+        22 + 1.3 * B, 20 + C, 2 * A - 1.5 * B + 0.05 * sin(3 * k), (k < 200 ? 1000 : 0);
+    }
+  }' > "$1"
+}
+make_run "$D/idle1.csv" 1.0 0.0
+make_run "$D/idle2.csv" 0.8 1.0
+make_run "$D/cut1.csv" 1.4 2.0
+make_run "$D/it's \"<script>x.csv" 1.1 0.5
+
+"$W" drift --help > "$D/help.txt" || fail "drift --help"
+for c in select fit predict crossval holdout split report; do
+  "$W" drift $c --help > "$D/help_$c.txt" || fail "drift $c --help"
+done
+grep -q "degC" "$D/help_fit.txt" || fail "fit --help has no units"
+grep -q "\[um\]" "$D/help_predict.txt" || fail "predict --help has no units"
+grep -q "min" "$D/help_fit.txt" || fail "fit --help does not give the lag unit"
+
+# select: the two sensor groups (and c1) are found; JSON too.
+"$W" drift select --idle "$D/idle1.csv" --error err_um --classes margin > "$D/select.txt" || fail "select"
+grep -q "chosen sensors" "$D/select.txt" || fail "select prints no choice"
+grep -q "lambda" "$D/select.txt" || fail "select prints no lambda levels"
+"$W" drift select --idle "$D/idle1.csv" --error err_um --classes margin --json > "$D/select.json" || fail "select --json"
+grep -q '"chosen_sensors"' "$D/select.json" || fail "select --json"
+grep -q '"grey_grades"' "$D/select.json" || fail "select --json grades"
+
+# fit (mlr, dynamic, network) and predict: the per-sample compensation CSV.
+for m in mlr dynamic network; do
+  "$W" drift fit --idle "$D/idle1.csv" --idle "$D/idle2.csv" --error err_um --model $m --epochs 100 \
+    --out "$D/$m.json" > "$D/fit_$m.txt" || fail "fit --model $m: $(cat "$D/fit_$m.txt")"
+  grep -q '"format": "whirl-drift-model"' "$D/$m.json" || fail "$m model file"
+  grep -q '"reference_C"' "$D/$m.json" || fail "$m model has no reference temperatures"
+done
+"$W" drift fit --idle "$D/idle1.csv" --error err_um --json --out "$D/m.json" > "$D/fit.json" || fail "fit --json"
+grep -q '"coefficients"' "$D/fit.json" || fail "fit --json has no coefficients"
+"$W" drift predict --model "$D/mlr.json" --run "$D/cut1.csv" --out "$D/pred.csv" > "$D/pred.txt" \
+  2> "$D/pred_err.txt" || fail "predict"
+grep -q "^time_min,predicted_um,compensation_um,std_um,measured_um,residual_um" "$D/pred.csv" \
+  || fail "prediction CSV header: $(grep -v '^#' "$D/pred.csv" | head -1)"
+[ "$(grep -vc '^#' "$D/pred.csv")" -eq 241 ] || fail "prediction CSV row count"
+grep -q "training range" "$D/pred_err.txt" || fail "no extrapolation warning for a hotter run"
+"$W" drift predict --model "$D/dynamic.json" --run "$D/idle2.csv" --json > "$D/pred.json" || fail "predict --json"
+grep -q '"residual"' "$D/pred.json" || fail "predict --json residual"
+
+# crossval with states, split, holdout.
+"$W" drift crossval --idle "$D/idle1.csv" "$D/idle2.csv" --cutting "$D/cut1.csv" --error err_um \
+  > "$D/cv.txt" || fail "crossval"
+grep -q "idle on cutting" "$D/cv.txt" || fail "crossval groups: $(cat "$D/cv.txt")"
+"$W" drift crossval --idle "$D/idle1.csv" "$D/idle2.csv" --error err_um --json > "$D/cv.json" || fail "crossval --json"
+grep -q '"mlr_all_sensors"' "$D/cv.json" || fail "crossval --json baseline"
+"$W" drift split --log "$D/idle1.csv" --out-dir "$D/split" > /dev/null || fail "split"
+[ -f "$D/split/idle1_1.csv" ] || fail "split wrote no run file"
+"$W" drift holdout --log "$D/idle1.csv" --no-network --json > "$D/ho.json" || fail "holdout"
+grep -q '"method": "dynamic"' "$D/ho.json" || fail "holdout methods"
+
+# report with a hostile run name: escaped in HTML, never markup.
+"$W" drift report --train-idle "$D/idle1.csv" --run "$D/it's \"<script>x.csv" --error err_um \
+  --classes margin --out "$D/report" > /dev/null 2> "$D/rep_err.txt" || fail "report: $(cat "$D/rep_err.txt")"
+[ -f "$D/report/index.html" ] || fail "report has no index.html"
+grep -q "<script>" "$D/report/index.html" && fail "run name reached the HTML unescaped"
+grep -q "&lt;script&gt;x" "$D/report/index.html" || fail "escaped run name missing"
+
+# Bad input: clear errors, nothing written.
+printf 'time_min,a_C,err_um\n0,20,0\n1,abc,1\n' > "$D/bad.csv"
+expect_fail "bad.csv:3" "$W" drift fit --run "$D/bad.csv" --error err_um --out "$D/never.json"
+[ -e "$D/never.json" ] && fail "a model was written on failure"
+expect_fail "no thermal-error" "$W" drift select --run "$D/idle1.csv" --error ch9_um
+expect_fail "not a drift model" "$W" drift predict --model "$D/select.json" --run "$D/idle1.csv"
+expect_fail "classes" "$W" drift select --run "$D/idle1.csv" --error err_um --classes 99
+echo "ok"

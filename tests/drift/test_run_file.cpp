@@ -1,0 +1,87 @@
+// drift::Run files: columns by suffix, time in s or min or missing, and clear errors for bad files.
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "drift/run_file.h"
+
+namespace whirl::drift {
+namespace {
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    ParseRun(text, "r.csv", RunState::kIdle);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RunFile, ColumnsBySuffixAndTimeInMinutes) {
+  const drift::Run r = ParseRun("# test\ntime_s,a_C,b_C,x_um,spindle_rpm\n0,20,21,0,0\n60,21,22,1.5,1000\n"
+                         "120,22,22.5,2,1000\n",
+                         "dir/r.csv", RunState::kCutting);
+  EXPECT_EQ(r.name, "r");
+  EXPECT_EQ(r.state, RunState::kCutting);
+  EXPECT_EQ(r.sensor_names, (std::vector<std::string>{"a_C", "b_C"}));
+  EXPECT_EQ(r.error_names, (std::vector<std::string>{"x_um"}));
+  EXPECT_EQ(r.other_names, (std::vector<std::string>{"spindle_rpm"}));
+  EXPECT_EQ(r.time_min, (std::vector<double>{0, 1, 2}));
+  EXPECT_FALSE(r.time_from_index);
+  EXPECT_EQ(r.Rises()(2, 1), 1.5);
+  EXPECT_EQ(r.line_numbers[0], 3);
+}
+
+TEST(RunFile, MissingTimeUsesTheSampleIndex) {
+  const drift::Run r = ParseRun("time_min,a_C,e_um\n0,20,0\nnan,21,1\n,22,2\n", "r.csv", RunState::kIdle);
+  EXPECT_TRUE(r.time_from_index);
+  EXPECT_EQ(r.time_min, (std::vector<double>{0, 1, 2}));
+  const drift::Run none = ParseRun("a_C,e_um\n20,0\n21,1\n", "r.csv", RunState::kIdle);
+  EXPECT_TRUE(none.time_from_index);
+}
+
+TEST(RunFile, BadFilesGetClearErrors) {
+  EXPECT_NE(ErrorOf("time_s,e_um\n0,1\n").find("no temperature column"), std::string::npos);
+  const std::string cell = ErrorOf("time_s,a_C,e_um\n0,20,1\n1,abc,2\n");
+  EXPECT_NE(cell.find("r.csv:3"), std::string::npos) << cell;
+  EXPECT_NE(cell.find("a_C"), std::string::npos) << cell;
+  const std::string nan_temp = ErrorOf("time_s,a_C,e_um\n0,nan,1\n");
+  EXPECT_NE(nan_temp.find("r.csv:2"), std::string::npos) << nan_temp;
+  const std::string order = ErrorOf("time_s,a_C\n0,20\n5,21\n5,22\n");
+  EXPECT_NE(order.find("r.csv:4"), std::string::npos) << order;
+  EXPECT_NE(order.find("increase"), std::string::npos) << order;
+  EXPECT_NE(ErrorOf("time_s,time_min,a_C\n0,0,1\n").find("two time columns"), std::string::npos);
+  const std::string hot = ErrorOf("time_s,a_C\n0,20\n1,2000\n");
+  EXPECT_NE(hot.find("r.csv:3: column 'a_C': value 2000"), std::string::npos) << hot;
+  EXPECT_NE(ErrorOf("time_s,a_C,b_C\n0,20\n").find("r.csv:2"), std::string::npos);
+  EXPECT_NE(ErrorOf("time_s,a_C\n").find("r.csv"), std::string::npos);
+  const drift::Run r = ParseRun("time_s,a_C\n0,20\n", "r.csv", RunState::kIdle);
+  try {
+    r.ErrorIndex("ch9_um");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ch9_um"), std::string::npos);
+  }
+}
+
+TEST(RunFile, SplitAtStartsAndFormatRoundTrip) {
+  std::string text = "time_s,a_C,e_um,spindle_rpm\n";
+  const double rpm[] = {0, 0, 500, 500, 0, 0, 800, 800, 0};
+  for (int k = 0; k < 9; ++k)
+    text += std::to_string(k * 60) + "," + std::to_string(20 + k) + "," + std::to_string(k) + "," +
+            std::to_string(rpm[k]) + "\n";
+  const drift::Run log = ParseRun(text, "log.csv", RunState::kIdle);
+  const auto runs = SplitAtStarts(log, "spindle_rpm");
+  ASSERT_EQ(runs.size(), 2u);  // the idle rows before the first start belong to run 1
+  EXPECT_EQ(runs[0].samples(), 6);
+  EXPECT_EQ(runs[1].samples(), 3);
+  EXPECT_EQ(runs[1].Rises()(0, 0), 0.0);
+  EXPECT_EQ(runs[1].name, "log_2");
+  const drift::Run back = ParseRun(FormatRun(runs[1], {"provenance"}), "b.csv", RunState::kIdle);
+  EXPECT_EQ(back.temperature_C, runs[1].temperature_C);
+  EXPECT_EQ(back.error_um, runs[1].error_um);
+  EXPECT_EQ(back.time_min, runs[1].time_min);
+  EXPECT_EQ(ErrorsFromStart(back).error_um(0, 0), 0.0);
+}
+
+}  // namespace
+}  // namespace whirl::drift

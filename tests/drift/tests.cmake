@@ -1,0 +1,8 @@
+# Tests of src/drift (run files, seed 000 selection, drift models, evaluation) and its CLI.
+whirl_add_gtest(test_drift
+  SOURCES
+    ${CMAKE_CURRENT_LIST_DIR}/test_selection.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_models.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_run_file.cpp
+  LABELS drift)
+whirl_add_cli_test(cli_drift ${CMAKE_CURRENT_LIST_DIR}/cli_drift.sh)

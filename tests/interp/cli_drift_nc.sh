@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Smoke test of 'whirl drift nc' and 'whirl plan --with-drift-action': args <whirl> <scratch> <src>.
+set -u
+W="$1"; D="$2"; SRC="$3"
+rm -rf "$D"; mkdir -p "$D"
+source "$SRC/tests/support/cli_common.sh"
+M="$SRC/datasets/machines/example_840d.json"
+S="$SRC/datasets/screws/reference_80x10x6000.json"
+
+"$W" drift nc --help | grep -q 'A_INA' || fail "drift nc --help"
+# A small run: two sensors warming, an error driven by both (2 um/K and -1 um/K) plus a wiggle.
+awk 'BEGIN { print "# synthetic run for the smoke test"; print "time_min,t1_C,t2_C,ch1_um";
+  for (k = 0; k < 200; k++) { t1 = 20 + 8 * (1 - exp(-k / 50)); t2 = 21 + 0.02 * k;
+    printf "%d,%.4f,%.4f,%.4f\n", k, t1, t2, 2 * (t1 - 20) - (t2 - 21) + 0.05 * sin(k) } }' \
+  > "$D/run.csv"
+"$W" drift fit --run "$D/run.csv" --error ch1_um --sensors t1_C t2_C --out "$D/model.json" \
+  > /dev/null || fail "drift fit"
+"$W" drift nc --model "$D/model.json" --machine "$M" --nc "$D/drift.spf" \
+  --reset-nc "$D/drift_reset.spf" --csv "$D/drift.csv" > "$D/out.txt" || fail "drift nc"
+for f in drift.spf drift_reset.spf drift.csv; do [ -s "$D/$f" ] || fail "$f not written"; done
+grep -q '^IDS=200 ' "$D/drift.spf" || fail "IDS range from the profile"
+grep -q 'A_INA\[1\]' "$D/drift.spf" || fail "analog input of t1_C"
+grep -q 'SA_TEMP_COMP_ABS_VALUE\[Z\]=.*\$AC_PARAM\[99\]' "$D/drift.spf" \
+  || fail "the drift action must add the plan's K0 (workpiece_k0_param 99)"
+grep -q '^M17' "$D/drift_reset.spf" || fail "reset program"
+grep -Eq '[0-9]e-?[0-9]' "$D/drift.spf" "$D/drift.csv" && fail "exponent in a control file"
+# Bad input: an unmapped sensor, a malformed --input; nothing written.
+rm -f "$D/none.spf"
+sed 's/"t2_C"/"t2_X"/' "$M" > "$D/machine_no_t2.json"
+expect_fail "t2_C" "$W" drift nc --model "$D/model.json" --machine "$D/machine_no_t2.json" \
+  --nc "$D/none.spf"
+[ -e "$D/none.spf" ] && fail "a failed drift nc wrote a file"
+expect_fail "INDEX:SCALE:OFFSET" "$W" drift nc --model "$D/model.json" --machine "$M" \
+  --input "t1_C=3;rm" --nc "$D/none.spf"
+# The plan combined with it: K0 into $AC_PARAM[99], an alarm if the drift action is not active.
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --with-drift-action \
+  --nc "$D/plan.spf" > /dev/null || fail "plan --with-drift-action"
+grep -q '^\$AC_PARAM\[99\]=' "$D/plan.spf" || fail "combined plan must write K0 into AC_PARAM[99]"
+grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/plan.spf" | grep -v '^;' && fail "combined plan writes SD43900"
+grep -q '^SETAL(65000)' "$D/plan.spf" || fail "combined plan lacks the alarm"
+grep -v '"drift"' "$M" > /dev/null
+python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); del j["drift"]; json.dump(j, open(sys.argv[2], "w"))' \
+  "$M" "$D/machine_nodrift.json" 2>/dev/null || cp "$M" "$D/machine_nodrift.json"
+if ! grep -q '"drift"' "$D/machine_nodrift.json"; then
+  expect_fail "drift" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+    --machine "$D/machine_nodrift.json" --with-drift-action
+fi
+echo "ok"

@@ -1,0 +1,284 @@
+#pragma once
+// An independent, deliberately strict replay of the NC programs whirl writes: it parses the text
+// (not the plan or model behind it), executes the part-program lines as the control's
+// preprocessing would, and then runs the synchronized actions interpolation cycle by cycle, in ID
+// order: WHEN fires once, WHENEVER every cycle while its condition holds, no condition every
+// cycle; ID= actions end with the program, IDS= actions stay until CANCEL. Expressions: numbers,
+// + - * / and parentheses over $AC_PARAM[n], $A_INA[n], R parameters and the setting data. A line
+// it does not understand fails the test, so the writer cannot emit something the replay ignores.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace whirl::interp::replay {
+
+struct Control {
+  double abs_value_mm = 0;         // SD43900
+  double slope = 0;                // SD43910
+  double ref_position_mm = 0;      // SD43920
+  std::map<int, double> r;         // R parameters
+  std::map<int, double> ac_param;  // $AC_PARAM
+  std::map<int, double> ain;       // $A_INA (set by the test)
+  int alarm = 0;                   // last SETAL
+
+  double DkMm(double p_mm) const { return abs_value_mm + slope * (p_mm - ref_position_mm); }
+};
+
+struct Write {
+  std::string target;  // "ABS", "SLOPE", "REF", "R<n>" or "P<n>" ($AC_PARAM)
+  std::string expr;
+};
+
+struct SyncAction {
+  int id = 0;
+  bool is_static = false;  // IDS
+  enum class Mode { kEveryCycle, kWhen, kWhenever } mode = Mode::kEveryCycle;
+  std::string lhs, op, rhs;  // condition
+  std::vector<Write> writes;
+  bool fired = false;
+};
+
+// Recursive-descent evaluation of the expressions the writers emit.
+class Expr {
+ public:
+  Expr(const std::string& text, const Control& c, const std::string& axis)
+      : s_(text), c_(c), axis_(axis) {}
+  double Eval() {
+    const double v = Sum();
+    if (i_ != s_.size()) ADD_FAILURE() << "trailing text in expression '" << s_ << "'";
+    return v;
+  }
+
+ private:
+  double Sum() {
+    double v = Product();
+    while (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) {
+      const char op = s_[i_++];
+      const double w = Product();
+      v = op == '+' ? v + w : v - w;
+    }
+    return v;
+  }
+  double Product() {
+    double v = Factor();
+    while (i_ < s_.size() && (s_[i_] == '*' || s_[i_] == '/')) {
+      const char op = s_[i_++];
+      const double w = Factor();
+      v = op == '*' ? v * w : v / w;
+    }
+    return v;
+  }
+  int Index(const std::string& prefix) {  // "<prefix>[n]" at i_, returns n
+    i_ += prefix.size();
+    const std::size_t close = s_.find(']', i_);
+    const int n = std::stoi(s_.substr(i_, close - i_));
+    i_ = close + 1;
+    return n;
+  }
+  bool Take(const std::string& word) {
+    if (s_.compare(i_, word.size(), word) != 0) return false;
+    return true;
+  }
+  static double Get(const std::map<int, double>& m, int n) {
+    const auto it = m.find(n);
+    return it == m.end() ? 0.0 : it->second;
+  }
+  double Factor() {
+    if (i_ < s_.size() && s_[i_] == '-') {
+      ++i_;
+      return -Factor();
+    }
+    if (i_ < s_.size() && s_[i_] == '(') {
+      ++i_;
+      const double v = Sum();
+      if (i_ >= s_.size() || s_[i_] != ')') ADD_FAILURE() << "missing ) in '" << s_ << "'";
+      ++i_;
+      return v;
+    }
+    if (Take("$AC_PARAM[")) return Get(c_.ac_param, Index("$AC_PARAM["));
+    if (Take("$A_INA[")) return Get(c_.ain, Index("$A_INA["));
+    const std::string sd = "$SA_TEMP_COMP_";
+    if (Take(sd)) {
+      i_ += sd.size();
+      const std::size_t open = s_.find('[', i_);
+      const std::string name = s_.substr(i_, open - i_);
+      i_ = open;
+      const std::size_t close = s_.find(']', i_);
+      if (s_.substr(i_ + 1, close - i_ - 1) != axis_) ADD_FAILURE() << "axis in '" << s_ << "'";
+      i_ = close + 1;
+      if (name == "ABS_VALUE") return c_.abs_value_mm;
+      if (name == "SLOPE") return c_.slope;
+      if (name == "REF_POSITION") return c_.ref_position_mm;
+      ADD_FAILURE() << "unknown setting datum " << name;
+      return 0;
+    }
+    if (i_ < s_.size() &&
+        (s_[i_] == 'R' || (s_[i_] == '$' && i_ + 1 < s_.size() && s_[i_ + 1] == 'R'))) {
+      i_ += s_[i_] == '$' ? 2 : 1;
+      std::size_t end = i_;
+      while (end < s_.size() && std::isdigit(static_cast<unsigned char>(s_[end]))) ++end;
+      const int n = std::stoi(s_.substr(i_, end - i_));
+      i_ = end;
+      return Get(c_.r, n);
+    }
+    std::size_t end = i_;
+    while (end < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[end])) || s_[end] == '.'))
+      ++end;
+    if (end == i_) {
+      ADD_FAILURE() << "cannot read '" << s_.substr(i_) << "' in '" << s_ << "'";
+      i_ = s_.size();
+      return 0;
+    }
+    const double v = std::stod(s_.substr(i_, end - i_));
+    i_ = end;
+    return v;
+  }
+
+  std::string s_;
+  std::size_t i_ = 0;
+  const Control& c_;
+  std::string axis_;
+};
+
+struct Replay {
+  Control control;
+  std::map<int, SyncAction> actions;  // by ID: executed in ID order
+  std::string axis = "Z";
+
+  double Value(const std::string& expr) const { return Expr(expr, control, axis).Eval(); }
+
+  // "$$SA_TEMP_COMP_ABS_VALUE[Z]" / "$SA_..." / "$AC_PARAM[3]" / "$R93" / "R93" -> target code.
+  std::string Target(const std::string& lhs) const {
+    static const std::regex kSd(R"(^\$?\$SA_TEMP_COMP_(ABS_VALUE|SLOPE|REF_POSITION)\[(\w+)\]$)");
+    static const std::regex kParam(R"(^\$AC_PARAM\[(\d+)\]$)");
+    static const std::regex kR(R"(^\$?R(\d+)$)");
+    std::smatch m;
+    if (std::regex_match(lhs, m, kSd)) {
+      EXPECT_EQ(m[2].str(), axis);
+      return m[1] == "ABS_VALUE" ? "ABS" : m[1] == "SLOPE" ? "SLOPE" : "REF";
+    }
+    if (std::regex_match(lhs, m, kParam)) return "P" + m[1].str();
+    if (std::regex_match(lhs, m, kR)) return "R" + m[1].str();
+    ADD_FAILURE() << "unknown assignment target '" << lhs << "'";
+    return "?";
+  }
+
+  void Assign(const std::string& target, double v) {
+    if (target == "ABS")
+      control.abs_value_mm = v;
+    else if (target == "SLOPE")
+      control.slope = v;
+    else if (target == "REF")
+      control.ref_position_mm = v;
+    else if (target[0] == 'R')
+      control.r[std::stoi(target.substr(1))] = v;
+    else if (target[0] == 'P')
+      control.ac_param[std::stoi(target.substr(1))] = v;
+  }
+
+  // "a=b c=d ..." (no spaces inside an expression, as the writers emit).
+  std::vector<Write> ParseWrites(const std::string& body) const {
+    std::vector<Write> out;
+    std::istringstream in(body);
+    std::string item;
+    while (in >> item) {
+      const std::size_t eq = item.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        ADD_FAILURE() << "not an assignment: '" << item << "'";
+        continue;
+      }
+      out.push_back({Target(item.substr(0, eq)), item.substr(eq + 1)});
+    }
+    return out;
+  }
+
+  bool Holds(const SyncAction& a, double p_mm) const {
+    if (a.mode == SyncAction::Mode::kEveryCycle) return true;
+    const double l = a.lhs == "$AA_IM[" + axis + "]" ? p_mm : Value(a.lhs);
+    const double r = Value(a.rhs);
+    if (a.op == ">=") return l >= r;
+    if (a.op == "<=") return l <= r;
+    if (a.op == "==") return l == r;
+    ADD_FAILURE() << "operator " << a.op;
+    return false;
+  }
+
+  // Runs the part program's preprocessing; fails the test on any unknown line. Returns false if
+  // the program stopped with an alarm (SETAL).
+  bool RunProgram(const std::string& text) {
+    static const std::regex kCancel(R"(^CANCEL\((\d+)\)$)");
+    static const std::regex kIf(R"(^IF (R\d+)(<>|==)([-0-9.]+)$)");
+    static const std::regex kSetal(R"(^SETAL\((\d+)\)$)");
+    static const std::regex kAssign(R"(^(\$?\$?[A-Z_]+(\[\w+\])?|R\d+)=(\S+)$)");
+    static const std::regex kSync(
+        R"(^(ID|IDS)=(\d+) (?:(WHEN|WHENEVER) (\S+?)(>=|<=|==)(\S+) )?DO (.*)$)");
+    std::istringstream in(text);
+    std::string line;
+    std::vector<bool> skipping;
+    bool ended = false;
+    while (std::getline(in, line)) {
+      EXPECT_FALSE(ended) << "text after M17: " << line;
+      std::smatch m;
+      const bool skip = !skipping.empty() && skipping.back();
+      if (line == "ENDIF") {
+        EXPECT_FALSE(skipping.empty()) << "ENDIF without IF";
+        if (!skipping.empty()) skipping.pop_back();
+      } else if (std::regex_match(line, m, kIf)) {
+        const double r = Value(m[1]);
+        const double c = std::stod(m[3]);
+        skipping.push_back(skip || !(m[2] == "==" ? r == c : r != c));
+      } else if (skip || (!line.empty() && line[0] == ';') || line == "STOPRE") {
+      } else if (line == "M17") {
+        ended = true;
+      } else if (std::regex_match(line, m, kSetal)) {
+        control.alarm = std::stoi(m[1]);
+        return false;  // a cycle alarm stops the program
+      } else if (std::regex_match(line, m, kCancel)) {
+        actions.erase(std::stoi(m[1]));
+      } else if (std::regex_match(line, m, kSync)) {
+        SyncAction a;
+        a.is_static = m[1] == "IDS";
+        a.id = std::stoi(m[2]);
+        if (m[3].matched) {
+          a.mode = m[3] == "WHEN" ? SyncAction::Mode::kWhen : SyncAction::Mode::kWhenever;
+          a.lhs = m[4];
+          a.op = m[5];
+          a.rhs = m[6];
+        }
+        a.writes = ParseWrites(m[7]);
+        actions[a.id] = a;
+      } else if (std::regex_match(line, m, kAssign)) {
+        Assign(Target(m[1]), Value(m[3]));
+      } else {
+        ADD_FAILURE() << "line the replay does not understand: '" << line << "'";
+      }
+    }
+    EXPECT_TRUE(ended) << "no M17";
+    EXPECT_TRUE(skipping.empty()) << "IF without ENDIF";
+    return true;
+  }
+
+  // One interpolation cycle with the axis at p_mm: every action in ID order.
+  void Cycle(double p_mm) {
+    for (auto& [id, a] : actions) {
+      if (a.mode == SyncAction::Mode::kWhen && a.fired) continue;
+      if (!Holds(a, p_mm)) continue;
+      for (const Write& w : a.writes) Assign(w.target, Value(w.expr));
+      a.fired = true;
+    }
+  }
+
+  // Program end or reset: modal (ID=) actions are gone, static (IDS=) ones stay.
+  void EndProgram() {
+    for (auto it = actions.begin(); it != actions.end();)
+      it = it->second.is_static ? std::next(it) : actions.erase(it);
+  }
+};
+
+}  // namespace whirl::interp::replay

@@ -1,0 +1,205 @@
+// The live drift action replayed as the control runs it (tests/interp/nc_replay.h): SD43900
+// follows the drift model evaluated sample by sample (drift::DriftEvaluator, the reference), for
+// static and lagged models and both temperature references; combined with a whirling plan, one
+// writer owns SD43900 and it equals machine part + workpiece part; the reset programs restore.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "drift/model.h"
+#include "fit/arctan_curve.h"
+#include "interp/drift_action.h"
+#include "interp/nc_replay.h"
+#include "interp/sinumerik.h"
+
+namespace whirl::interp {
+namespace {
+
+constexpr double kCycleMs = 50.0;
+
+// A hand-made model: two sensors, lags of 0.02 and 0.1 min (a few hundred cycles of 50 ms, so
+// the lag recursion is exercised), coefficients of a typical size (um per K).
+drift::DriftModel HandModel(bool lags, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-8.0, 8.0);
+  drift::DriftModel m;
+  m.kind = lags ? drift::ModelKind::kDynamic : drift::ModelKind::kMlr;
+  m.error_column = "ch1_um";
+  m.sensors = {"t1_C", "t2_C"};
+  m.reference_C = Eigen::Vector2d(24.5, 26.25);
+  if (lags) m.time_constants = {0.02, 0.1};
+  for (const auto& s : m.sensors) {
+    m.features.push_back({s, 0.0});
+    for (double t : m.time_constants) m.features.push_back({s, t});
+  }
+  const auto nf = static_cast<Eigen::Index>(m.features.size());
+  m.feature_min = Eigen::VectorXd::Constant(nf, -5);
+  m.feature_max = Eigen::VectorXd::Constant(nf, 5);
+  m.linear.coefficients = Eigen::VectorXd(nf + 1);
+  for (Eigen::Index i = 0; i <= nf; ++i) m.linear.coefficients(i) = u(rng);
+  m.linear.covariance = Eigen::MatrixXd::Identity(nf + 1, nf + 1) * 0.01;
+  m.Validate();
+  return m;
+}
+
+DriftActionOptions Options(ControlDk control, int error_direction, DriftReference ref) {
+  DriftActionOptions o;
+  o.axis = "Z";
+  o.control_dk = control;
+  o.error_direction = error_direction;
+  o.ipo_cycle_ms = kCycleMs;
+  o.sync_id_first = 150;
+  o.sync_id_last = 190;
+  o.param_first = 100;
+  o.save_r_first = 80;
+  o.reference = ref;
+  o.inputs["t1_C"] = {3, 0.1, -20.0};  // T = 0.1 * AIN + (-20)
+  o.inputs["t2_C"] = {7, 0.05, 0.0};
+  return o;
+}
+
+// Temperatures at cycle k: smooth warm-ups with different rates.
+Eigen::Vector2d Temperatures(int k) {
+  const double t_s = k * kCycleMs / 1000.0;
+  return Eigen::Vector2d(25.0 + 6.0 * (1 - std::exp(-t_s / 20.0)), 26.0 + 0.08 * t_s);
+}
+
+void SetInputs(replay::Replay& r, const DriftActionOptions& o, const Eigen::Vector2d& t) {
+  r.control.ain[o.inputs.at("t1_C").index] =
+      (t(0) - o.inputs.at("t1_C").offset) / o.inputs.at("t1_C").scale;
+  r.control.ain[o.inputs.at("t2_C").index] =
+      (t(1) - o.inputs.at("t2_C").offset) / o.inputs.at("t2_C").scale;
+}
+
+double Sign(const DriftActionOptions& o) {
+  return (o.control_dk == ControlDk::kAdded ? -1.0 : 1.0) * o.error_direction;
+}
+
+TEST(DriftAction, Sd43900FollowsTheModelEvaluatedSampleBySample) {
+  std::mt19937 rng(1804);
+  for (bool lags : {false, true})
+    for (auto control : {ControlDk::kAdded, ControlDk::kSubtracted})
+      for (int dir : {1, -1})
+        for (auto ref : {DriftReference::kModel, DriftReference::kStart}) {
+          const drift::DriftModel m = HandModel(lags, rng);
+          const DriftActionOptions o = Options(control, dir, ref);
+          replay::Replay r;
+          r.control.abs_value_mm = 0.0021;
+          SetInputs(r, o, Temperatures(0));
+          ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, o)));
+          const Eigen::VectorXd reference =
+              ref == DriftReference::kModel ? m.reference_C : Eigen::VectorXd(Temperatures(0));
+          drift::DriftEvaluator ev(m, reference);
+          double worst_mm = 0;
+          for (int k = 0; k < 1500; ++k) {
+            SetInputs(r, o, Temperatures(k));
+            r.Cycle(0.0);
+            const double e_um = ev.Step(k * kCycleMs / 60000.0, Temperatures(k));
+            worst_mm =
+                std::max(worst_mm, std::abs(r.control.abs_value_mm - Sign(o) * e_um / 1000.0));
+          }
+          EXPECT_LT(worst_mm, 1e-8) << "lags " << lags << " ref " << ToString(ref);
+          ASSERT_FALSE(HasFailure());
+          // Static actions survive the program's end; the reset program restores SD43900.
+          r.EndProgram();
+          EXPECT_FALSE(r.actions.empty());
+          ASSERT_TRUE(r.RunProgram(FormatDriftNcResetProgram(o)));
+          EXPECT_TRUE(r.actions.empty());
+          EXPECT_EQ(r.control.abs_value_mm, 0.0021);
+        }
+}
+
+TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
+  std::mt19937 rng(1805);
+  const drift::DriftModel m = HandModel(true, rng);
+  DriftActionOptions d = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  d.workpiece_k0_param = 99;
+  PlanOptions p;
+  p.start_position_mm = 0;
+  p.machine_offset_mm = -600;
+  p.sync_id_first = 100;  // below the drift action's 150..190: written before it is added
+  p.sync_id_last = 140;
+  p.save_r_first = 90;
+  p.workpiece_k0_param = 99;
+  p.drift_marker_r = d.save_r_first + 1;
+  p.md32760 = kMd32760Max;
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({20.0, 40.0}, 4.0, 1.0);
+  const double feed = 2.0, thread = 300.0;  // 150 s of cutting
+  const CompensationPlan plan = BuildPlan(curve, feed, thread, p);
+
+  replay::Replay r;
+  r.control.abs_value_mm = 0.0007;  // found values
+  r.control.slope = 3e-6;
+  r.control.ref_position_mm = 12.0;
+  // Without the drift action the plan refuses to start, and changes nothing.
+  EXPECT_FALSE(r.RunProgram(FormatNcProgram(plan)));
+  EXPECT_EQ(r.control.alarm, p.drift_missing_alarm);
+  EXPECT_EQ(r.control.slope, 3e-6);
+  EXPECT_TRUE(r.actions.empty());
+
+  SetInputs(r, d, Temperatures(0));
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, d)));
+  ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));
+  drift::DriftEvaluator ev(m, m.reference_C);
+  const int cycles = static_cast<int>(thread / feed * 1000.0 / kCycleMs);
+  double worst_um = 0;
+  for (int k = 0; k <= cycles + 40; ++k) {
+    const double t_s = k * kCycleMs / 1000.0;
+    const double pos = AxisPositionMm(p, feed, std::min(t_s, thread / feed)) +
+                       (t_s > thread / feed ? 1.0 : 0.0);  // run-out past the thread end
+    SetInputs(r, d, Temperatures(k));
+    r.Cycle(pos);
+    const double machine_mm = -ev.Step(t_s / 60.0, Temperatures(k)) / 1000.0;
+    if (t_s >= thread / feed) {  // restored: machine part only, the found slope and reference
+      EXPECT_NEAR(r.control.abs_value_mm, machine_mm, 1e-8);
+      continue;
+    }
+    const double workpiece_um = (r.control.DkMm(pos) - machine_mm) * 1000.0 / SignFactor(p.sign);
+    worst_um = std::max(worst_um, std::abs(workpiece_um - curve.ElongationUm(t_s)));
+  }
+  EXPECT_LE(worst_um, p.tolerance_um + 1e-6);
+  EXPECT_EQ(r.control.slope, 3e-6);
+  EXPECT_EQ(r.control.ref_position_mm, 12.0);
+  r.EndProgram();
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcResetProgram(d)));
+  EXPECT_EQ(r.control.abs_value_mm, 0.0007);
+  EXPECT_TRUE(r.actions.empty());
+}
+
+TEST(DriftAction, RefusesWhatTheControlCannotRun) {
+  std::mt19937 rng(1806);
+  drift::DriftModel m = HandModel(true, rng);
+  DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  o.inputs.erase("t2_C");
+  EXPECT_THROW(FormatDriftNcProgram(m, o), InputError);  // unmapped sensor
+  o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  o.sync_id_last = o.sync_id_first + 2;
+  EXPECT_THROW(FormatDriftNcProgram(m, o), InputError);  // too few IDs
+  o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  o.workpiece_k0_param = o.param_first + 1;
+  EXPECT_THROW(FormatDriftNcProgram(m, o), InputError);  // slot collision
+  m.time_unit = "sample";
+  EXPECT_THROW(FormatDriftNcProgram(m, Options(ControlDk::kAdded, 1, DriftReference::kModel)),
+               InputError);  // lags in samples
+  m = HandModel(false, rng);
+  m.kind = drift::ModelKind::kNetwork;
+  EXPECT_THROW(FormatDriftNcProgram(m, Options(ControlDk::kAdded, 1, DriftReference::kModel)),
+               InputError);
+}
+
+TEST(DriftAction, GoldenProgramAndPlcTable) {
+  std::mt19937 rng(1807);
+  const drift::DriftModel m = HandModel(true, rng);
+  DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kStart);
+  o.workpiece_k0_param = 99;
+  const std::string nc = FormatDriftNcProgram(m, o, "golden model") + FormatDriftNcResetProgram(o) +
+                         FormatDriftPlcCsv(m, o);
+  const std::string path = std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action.spf";
+  if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path, nc);
+  EXPECT_EQ(nc, ReadTextFile(path)) << "actual:\n" << nc;
+}
+
+}  // namespace
+}  // namespace whirl::interp
