@@ -436,6 +436,7 @@ void RegisterReport(CLI::App* drift_app) {
 
 }  // namespace
 
+void RegisterDriftMonitor(CLI::App* drift_app);  // cmd_drift_monitor.cpp (issue 14)
 void RegisterDrift(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "drift",
@@ -450,6 +451,7 @@ void RegisterDrift(CLI::App& app) {
   RegisterHoldout(sub);
   RegisterSplit(sub);
   RegisterReport(sub);
+  RegisterDriftMonitor(sub);
 }
 
 }  // namespace whirl::cli
