@@ -236,12 +236,15 @@ Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) 
 
 Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                             const Eigen::VectorXd& b, Eigen::MatrixXd* p, double noise_variance) {
-  const Eigen::MatrixXd xp = x * (*p);  // n x q
-  Eigen::MatrixXd s = xp * x.transpose();
-  s.diagonal().array() += noise_variance;
-  const Eigen::MatrixXd k = s.ldlt().solve(xp).transpose();  // q x n (P, S symmetric)
-  const Eigen::VectorXd updated = b + k * (y - x * b);
-  Eigen::MatrixXd next = *p - k * xp;
+  // Information form: the gain form K = P X' (X P X' + r I)^-1 loses the digits of the data
+  // when the prior is weak and n > q (X P X' is then a huge matrix of rank q).
+  const Eigen::Index q = b.size();
+  const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(q, q);
+  Eigen::MatrixXd precision = p->ldlt().solve(identity);
+  precision.noalias() += x.transpose() * x / noise_variance;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(precision);
+  const Eigen::VectorXd updated = b + ldlt.solve(x.transpose() * (y - x * b) / noise_variance);
+  const Eigen::MatrixXd next = ldlt.solve(identity);
   *p = 0.5 * (next + next.transpose());
   return updated;
 }

@@ -31,9 +31,10 @@
 //   bayes    recursive least squares = Gaussian posterior with the current coefficients as the
 //            prior mean and prior covariance P (first P0 = prior_scale * Cov(b) of the training
 //            fit, regression.h), observation variance r = s^2 + noise_um^2:
-//              K = P X' (X P X' + r I)^-1,  b+ = b + K (y - X b),  P+ = (I - K X) P,
-//            and P+ is the prior of the next update (Bishop, PRML eqs. 3.50-3.51; Kalman with no
-//            process noise). A very weak prior (prior_scale -> inf) gives the patent's refit when
+//              P+ = (P^-1 + X'X / r)^-1,  b+ = b + P+ X' (y - X b) / r
+//            (Bishop, PRML eqs. 3.50-3.51; the same as the gain form K = P X' (X P X' + r I)^-1,
+//            b+ = b + K (y - X b), P+ = (I - K X) P of Kalman with no process noise, computed in
+//            this information form for accuracy), and P+ is the prior of the next update. A very weak prior (prior_scale -> inf) gives the patent's refit when
 //            X has full column rank (tests/drift/test_monitor.cpp).
 //   offset   only the intercept: b0 += mean_j (y_j - x_j' b).
 //   static   (reference) the model as fitted, never checked.

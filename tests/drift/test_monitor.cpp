@@ -11,12 +11,21 @@
 
 #include "core/error.h"
 #include "drift/monitor.h"
-#include "synthetic.h"
 
 namespace whirl::drift {
 namespace {
 
-// Three sensors with the synthetic latent shapes (rises exactly Latent(k, t), no sensor noise),
+// Latent rises [K] at minute t, far from collinear with each other and with a constant over any
+// window of an hour or more (a slow first-order rise, a rise and cool-down, an oscillation).
+double Latent(int k, double t) {
+  switch (k) {
+    case 0: return 8.0 * (1.0 - std::exp(-t / 200.0));
+    case 1: return t < 300 ? t / 50.0 : 6.0 - (t - 300) / 60.0;
+    default: return 3.0 * std::sin(t / 40.0) + 0.01 * t;
+  }
+}
+
+// Three sensors with these latent shapes (rises exactly Latent(k, t), no sensor noise),
 // one sample per minute; error = c + w . Latent + N(0, sigma), with w -> w_after and c -> c_after
 // from minute change_min on.
 struct Planted {
@@ -42,8 +51,8 @@ Run MakeRun(const Planted& p, unsigned seed) {
     const bool after = t >= p.change_min;
     double e = after ? p.c_after : p.c;
     for (int k = 0; k < 3; ++k) {
-      r.temperature_C(q, k) = 20.0 + synth::Latent(k, t);
-      e += (after ? p.w_after : p.w)(k) * synth::Latent(k, t);
+      r.temperature_C(q, k) = 20.0 + Latent(k, t);
+      e += (after ? p.w_after : p.w)(k) * Latent(k, t);
     }
     r.error_um(q, 0) = e + p.sigma * n01(rng);
   }
@@ -64,7 +73,7 @@ const StrategyResult& Rule(const MonitorResult& r, UpdateRule u) {
 
 TEST(Monitor, StaticReplayEqualsBatchPrediction) {
   Planted p;
-  const Run run = MakeRun(p, 1);
+  const drift::Run run = MakeRun(p, 1);
   const DriftModel m = FitOn(run.Slice(0, 300, "train"));
   const MonitorResult r = MonitorRun(m, run, {});
   const RunPrediction batch = PredictRun(m, run);
@@ -91,13 +100,16 @@ TEST(Monitor, PlantedChangeIsFlaggedByTheNextCheckAndRecovered) {
   p.change_min = 200;
   p.w_after = {1.6, 0.1, -0.4};
   p.c_after = -1.0;
-  const Run run = MakeRun(p, 7);
+  const drift::Run run = MakeRun(p, 7);
   const DriftModel m = FitOn(run.Slice(0, 200, "train"));
   MonitorOptions o;
   o.check_every = 60;
   o.refit_samples = 12;
   o.refit_every = 20;
   o.threshold_sigma = 3;
+  // Bayes with the training posterior itself as the prior (scale 1) stays near the old
+  // coefficients by design; with a weak prior it must recover the new ones like the refit.
+  o.prior_scale = 1e4;
   const MonitorResult r = MonitorRun(m, run, o);
   Eigen::Vector4d truth;
   truth << p.c_after, p.w_after;
@@ -141,17 +153,19 @@ TEST(Monitor, FalseAlarmRateOfAStationaryRunMatchesTheNormalTail) {
   int checks3 = 0, alarms3 = 0, checks1 = 0, alarms1 = 0;
   for (unsigned seed = 0; seed < 120; ++seed) {
     const DriftModel m = FitOn(MakeRun(p, 10000 + seed));
-    const Run run = MakeRun(p, seed);
+    const drift::Run run = MakeRun(p, seed);
     MonitorOptions o;
     o.check_every = 20;
     o.rules = {UpdateRule::kOffset};
     o.threshold_sigma = 3;
-    const auto& s3 = Rule(MonitorRun(m, run, o), UpdateRule::kOffset);
+    const MonitorResult r3 = MonitorRun(m, run, o);
+    const auto& s3 = Rule(r3, UpdateRule::kOffset);
     o.threshold_sigma = 1;
     o.refit_samples = 1;
     // At 1 sigma the rule recalibrates often; count only the first check of each replay and the
     // checks before the first recalibration, whose residuals are those of the trained model.
-    const auto& s1 = Rule(MonitorRun(m, run, o), UpdateRule::kOffset);
+    const MonitorResult r1 = MonitorRun(m, run, o);
+    const auto& s1 = Rule(r1, UpdateRule::kOffset);
     checks3 += s3.checks;
     alarms3 += s3.invalid_checks;
     for (const auto& e : s1.events) {
@@ -198,7 +212,7 @@ TEST(Monitor, BayesWithAVeryWeakPriorEqualsThePatentRefit) {
   Planted p;
   p.change_min = 200;
   p.w_after = {1.6, 0.1, -0.4};
-  const Run run = MakeRun(p, 3);
+  const drift::Run run = MakeRun(p, 3);
   MonitorOptions o;
   o.refit_samples = 8;
   o.refit_every = 20;
@@ -232,13 +246,14 @@ TEST(Monitor, OffsetRuleRecoversAPlantedOffset) {
   Planted p;
   p.change_min = 200;
   p.c_after = p.c + 4.0;
-  const Run run = MakeRun(p, 11);
+  const drift::Run run = MakeRun(p, 11);
   MonitorOptions o;
   o.rules = {UpdateRule::kOffset};
   o.refit_samples = 15;
   o.refit_every = 2;
   const DriftModel m = FitOn(run.Slice(0, 200, "train"));
-  const auto& s = Rule(MonitorRun(m, run, o), UpdateRule::kOffset);
+  const MonitorResult r = MonitorRun(m, run, o);
+  const auto& s = Rule(r, UpdateRule::kOffset);
   ASSERT_GE(s.recalibrations, 1);
   const double shift = s.final_coefficients(0) - m.linear.coefficients(0);
   // 16 measurements: the mean's std is sigma / 4 = 0.05 um; add the fit's own intercept error.
@@ -248,7 +263,7 @@ TEST(Monitor, OffsetRuleRecoversAPlantedOffset) {
 
 TEST(Monitor, RefusesBadInput) {
   Planted p;
-  const Run run = MakeRun(p, 1);
+  const drift::Run run = MakeRun(p, 1);
   const DriftModel m = FitOn(run.Slice(0, 300, "train"));
   MonitorOptions o;
   o.check_every = -1;
@@ -268,7 +283,7 @@ TEST(Monitor, RefusesBadInput) {
   DriftModel net = m;
   net.kind = ModelKind::kNetwork;
   EXPECT_THROW(MonitorDesign(net, run, ReferenceMode::kRunStart), InputError);
-  Run no_error = run;
+  drift::Run no_error = run;
   no_error.error_names = {"other_um"};
   EXPECT_THROW(MonitorRun(m, no_error, {}), InputError);
   EXPECT_THROW(ParseUpdateRule("kalman"), InputError);
