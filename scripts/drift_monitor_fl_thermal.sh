@@ -8,7 +8,7 @@
 # Environment: WHIRL_FL_THERMAL (data.csv), WHIRL_BIN (build/whirl), MODEL (mlr|dynamic, default
 # mlr), STOP_MIN (machine stop per measurement [min], default 1), THRESHOLD (--threshold-sigma,
 # default 3), REFIT (--refit-samples, default 3), REFIT_EVERY ([min], default 5), PRIOR (--prior-scale,
-# default 1), NOISE_UM (default 0).
+# default 1), NOISE_UM (default 0), INPUTS (extra model inputs, e.g. spindle_rpm; default none).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA="${WHIRL_FL_THERMAL:-../shared/data/fl_thermal/data.csv}"
@@ -29,8 +29,8 @@ echo "== training: rows 0..$((rows - 1)) of $DATA (to $end_min min, first 1250 r
 echo "== source's seq2seq test MAE (rows 60-80 %, no measurement after training): ch1 3.56, ch3 3.70, ch5 4.28 um"
 for ch in ch1_um ch3_um ch5_um; do
   "$W" drift fit --run "$OUT/train.csv" --error "$ch" --max-sensors 4 --model "$MODEL" \
-    --out "$OUT/model_$ch.json" > "$OUT/fit_$ch.txt" 2> /dev/null
-  echo "-- $ch: $(grep -m1 -i 'sensors' "$OUT/fit_$ch.txt" || true)"
+    ${INPUTS:+--inputs "$INPUTS"} --out "$OUT/model_$ch.json" > "$OUT/fit_$ch.txt" 2> /dev/null
+  echo "-- $ch: $(grep -m1 -i 'sensors' "$OUT/fit_$ch.txt" || true); $(grep -m1 -i 'time constants\|lag' "$OUT/fit_$ch.txt" || true)"
   for every in 60 120 240; do
     args=(--model "$OUT/model_$ch.json" --run "$DATA" --start "$end_min" --check-every "$every"
           --threshold-sigma "${THRESHOLD:-3}" --refit-samples "${REFIT:-3}"

@@ -26,9 +26,11 @@ struct MonitorArgs {
 void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   drift::MonitorOptions& o = a->o;
   sub->add_option("--model", a->model, "drift model file (whirl drift fit; mlr or dynamic)")
-      ->required()->check(CLI::ExistingFile);
+      ->required()
+      ->check(CLI::ExistingFile);
   sub->add_option("--run", a->run, "run file with the model's error column (the check-bar values)")
-      ->required()->check(CLI::ExistingFile);
+      ->required()
+      ->check(CLI::ExistingFile);
   sub->add_option("--check-every", o.check_every,
                   "interval between checks [min; samples if the run has no time] (default 60)")
       ->check(CLI::PositiveNumber);
@@ -40,9 +42,11 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
                   "threshold as a multiple of sqrt(s^2 + noise^2), s the model's training residual "
                   "std [um] (default 3)")
       ->check(CLI::Range(0.01, 100.0));
-  sub->add_option("--refit-samples", o.refit_samples,
-                  "m: further measurements after an invalid check (1..100, default 3)")
-      ->check(CLI::Range(1, drift::kMaxRefitSamples));
+  sub->add_option(
+         "--refit-samples", o.refit_samples,
+         "m: further measurements after an invalid check (0..100, default 3; 0: update from the "
+         "check alone)")
+      ->check(CLI::Range(0, drift::kMaxRefitSamples));
   sub->add_option("--refit-every", o.refit_every,
                   "interval between the refit measurements [min; samples] (default 5)")
       ->check(CLI::PositiveNumber);
@@ -53,12 +57,14 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
                   "update rules replayed beside the static model: patent (least-squares refit on "
                   "the new measurements), bayes (recursive least squares, the training fit as "
                   "prior), offset (intercept only); default all three")
-      ->delimiter(',')->check(CLI::IsMember({"patent", "bayes", "offset"}));
+      ->delimiter(',')
+      ->check(CLI::IsMember({"patent", "bayes", "offset"}));
   sub->add_option("--prior-scale", o.prior_scale,
                   "bayes: prior covariance = this x the training fit's Cov(b) (default 1)")
       ->check(CLI::Range(1e-6, 1e12));
-  sub->add_option("--noise-um", o.noise_um,
-                  "std of the check-bar measurement noise added to the logged error [um] (default 0)")
+  sub->add_option(
+         "--noise-um", o.noise_um,
+         "std of the check-bar measurement noise added to the logged error [um] (default 0)")
       ->check(CLI::Range(0.0, 1000.0));
   sub->add_option("--seed", o.seed, "seed of the measurement noise (default 1)");
   sub->add_option("--start", o.start,
@@ -67,7 +73,8 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   sub->add_option("--score-rows", a->score_rows,
                   "scored share of the run's rows FROM,TO (default 0,1; FL_THERMAL's test "
                   "window: 0.6,0.8)")
-      ->delimiter(',')->expected(2);
+      ->delimiter(',')
+      ->expected(2);
   sub->add_option("--reference", a->reference,
                   "temperature reference: run-start (default, as training) or model")
       ->check(CLI::IsMember({"run-start", "model"}));
@@ -100,8 +107,10 @@ void RunMonitor(MonitorArgs& a) {
   }
   if (!a.timeline.empty()) WriteFileAtomic(a.timeline, timeline);
   if (!a.events.empty()) WriteFileAtomic(a.events, events);
-  if (a.json) PrintJson(drift::MonitorJson(r, a.o));
-  else std::fputs(drift::FormatMonitor(r, a.o).c_str(), stdout);
+  if (a.json)
+    PrintJson(drift::MonitorJson(r, a.o));
+  else
+    std::fputs(drift::FormatMonitor(r, a.o).c_str(), stdout);
 }
 
 }  // namespace

@@ -37,12 +37,12 @@ int SampleAt(const std::vector<double>& t, double time, int min_sample) {
 
 // The inputs of one rule's replay.
 struct Replay {
-  const Eigen::MatrixXd& x;       // samples x (1 + features)
-  const Eigen::VectorXd& y;       // measured with noise
+  const Eigen::MatrixXd& x;  // samples x (1 + features)
+  const Eigen::VectorXd& y;  // measured with noise
   const std::vector<double>& t;
   const MonitorOptions& o;
-  Eigen::VectorXd b0;             // the model's coefficients
-  Eigen::MatrixXd p0;             // bayes prior
+  Eigen::VectorXd b0;  // the model's coefficients
+  Eigen::MatrixXd p0;  // bayes prior
   double threshold_um, noise_variance;
   int start_sample;
 };
@@ -61,10 +61,14 @@ std::string CheckMessage(double t, double y, double p, double thr, bool valid) {
 Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
                           const Eigen::VectorXd& b, Eigen::MatrixXd* p, double r) {
   switch (rule) {
-    case UpdateRule::kPatent: return PatentRefit(xs, ys);
-    case UpdateRule::kBayes: return BayesUpdate(xs, ys, b, p, r);
-    case UpdateRule::kOffset: return OffsetUpdate(xs, ys, b);
-    case UpdateRule::kStatic: break;
+    case UpdateRule::kPatent:
+      return PatentRefit(xs, ys);
+    case UpdateRule::kBayes:
+      return BayesUpdate(xs, ys, b, p, r);
+    case UpdateRule::kOffset:
+      return OffsetUpdate(xs, ys, b);
+    case UpdateRule::kStatic:
+      break;
   }
   return b;
 }
@@ -112,7 +116,8 @@ StrategyResult RunRule(UpdateRule rule, const Replay& in) {
       ++s.invalid_checks;
       std::vector<int> rows{k};
       for (int j = 0; j < in.o.refit_samples; ++j) {
-        const int q = SampleAt(in.t, in.t[static_cast<std::size_t>(last)] + in.o.refit_every, last + 1);
+        const int q =
+            SampleAt(in.t, in.t[static_cast<std::size_t>(last)] + in.o.refit_every, last + 1);
         if (q < 0) break;
         MonitorEvent e = measure(q, MonitorEvent::Kind::kRefitMeasurement);
         e.message = "refit measurement " + std::to_string(j + 1) + " of " +
@@ -165,26 +170,35 @@ StrategyResult RunRule(UpdateRule rule, const Replay& in) {
 
 std::string ToString(UpdateRule r) {
   switch (r) {
-    case UpdateRule::kStatic: return "static";
-    case UpdateRule::kPatent: return "patent";
-    case UpdateRule::kBayes: return "bayes";
-    case UpdateRule::kOffset: return "offset";
+    case UpdateRule::kStatic:
+      return "static";
+    case UpdateRule::kPatent:
+      return "patent";
+    case UpdateRule::kBayes:
+      return "bayes";
+    case UpdateRule::kOffset:
+      return "offset";
   }
   return "?";
 }
 
 UpdateRule ParseUpdateRule(const std::string& text) {
-  for (UpdateRule r : {UpdateRule::kStatic, UpdateRule::kPatent, UpdateRule::kBayes, UpdateRule::kOffset})
+  for (UpdateRule r :
+       {UpdateRule::kStatic, UpdateRule::kPatent, UpdateRule::kBayes, UpdateRule::kOffset})
     if (ToString(r) == text) return r;
   throw InputError("update rule '" + text + "': must be patent, bayes or offset");
 }
 
 std::string ToString(MonitorEvent::Kind k) {
   switch (k) {
-    case MonitorEvent::Kind::kCheck: return "check";
-    case MonitorEvent::Kind::kRefitMeasurement: return "refit-measurement";
-    case MonitorEvent::Kind::kUpdate: return "update";
-    case MonitorEvent::Kind::kSkipped: return "skipped";
+    case MonitorEvent::Kind::kCheck:
+      return "check";
+    case MonitorEvent::Kind::kRefitMeasurement:
+      return "refit-measurement";
+    case MonitorEvent::Kind::kUpdate:
+      return "update";
+    case MonitorEvent::Kind::kSkipped:
+      return "skipped";
   }
   return "?";
 }
@@ -198,8 +212,8 @@ void MonitorOptions::Validate() const {
           "must be >= 0 um (0: use threshold_sigma)");
   Require(std::isfinite(threshold_sigma) && threshold_sigma > 0, "threshold_sigma", threshold_sigma,
           "must be > 0");
-  Require(refit_samples >= 1 && refit_samples <= kMaxRefitSamples, "refit_samples", refit_samples,
-          "must be 1.." + std::to_string(kMaxRefitSamples));
+  Require(refit_samples >= 0 && refit_samples <= kMaxRefitSamples, "refit_samples", refit_samples,
+          "must be 0.." + std::to_string(kMaxRefitSamples));
   Require(std::isfinite(noise_um) && noise_um >= 0, "noise_um", noise_um, "must be >= 0 um");
   Require(std::isfinite(prior_scale) && prior_scale > 0, "prior_scale", prior_scale, "must be > 0");
   Require(std::isfinite(start), "start", start, "must be finite");
@@ -214,7 +228,8 @@ Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, Reference
                      "dynamic)");
   model.Validate();
   if (run.time_from_index != (model.time_unit == "sample"))
-    throw InputError(run.source + ": " + (run.time_from_index ? "has no recorded time" : "has a recorded time") +
+    throw InputError(run.source + ": " +
+                     (run.time_from_index ? "has no recorded time" : "has a recorded time") +
                      " but the model's time unit is '" + model.time_unit + "'");
   const Eigen::MatrixXd u = RawInputs(model, run);
   Eigen::VectorXd ref = model.reference_C;
@@ -274,8 +289,8 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
   r.monitored_min = r.time.back() - r.time[static_cast<std::size_t>(start)];
   if (r.monitored_min / o.check_every > kMaxMonitorChecks)
     throw InputError("monitor option check_every = " + Num(o.check_every, "%g") + ": over " +
-                     std::to_string(kMaxMonitorChecks) + " checks in " + Num(r.monitored_min, "%g") +
-                     " (limit)");
+                     std::to_string(kMaxMonitorChecks) + " checks in " +
+                     Num(r.monitored_min, "%g") + " (limit)");
   r.score_begin = std::max(start, static_cast<int>(o.score_from * n));
   r.score_end = std::min(n, static_cast<int>(o.score_to * n));
   if (r.score_end <= r.score_begin)
@@ -288,13 +303,21 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
   const Eigen::VectorXd y = r.measured_um + r.measurement_noise_um;
   const double s = model.residual_std_um;
   const double noise_variance = s * s + o.noise_um * o.noise_um;
-  r.threshold_um = o.threshold_um > 0 ? o.threshold_um : o.threshold_sigma * std::sqrt(noise_variance);
+  r.threshold_um =
+      o.threshold_um > 0 ? o.threshold_um : o.threshold_sigma * std::sqrt(noise_variance);
   if (!(r.threshold_um > 0))
-    throw InputError("monitor: threshold is 0 um (the model's residual std is 0 and no noise): "
-                     "give an absolute threshold");
-  const Replay in{x, y, r.time, o, model.linear.coefficients,
-                  o.prior_scale * model.linear.covariance, r.threshold_um,
-                  std::max(noise_variance, 1e-12), start};
+    throw InputError(
+        "monitor: threshold is 0 um (the model's residual std is 0 and no noise): "
+        "give an absolute threshold");
+  const Replay in{x,
+                  y,
+                  r.time,
+                  o,
+                  model.linear.coefficients,
+                  o.prior_scale * model.linear.covariance,
+                  r.threshold_um,
+                  std::max(noise_variance, 1e-12),
+                  start};
   const int m = r.score_end - r.score_begin;
   r.none = ComputeErrorStats(r.measured_um.segment(r.score_begin, m));
   std::vector<UpdateRule> rules{UpdateRule::kStatic};

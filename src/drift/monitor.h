@@ -34,8 +34,9 @@
 //              P+ = (P^-1 + X'X / r)^-1,  b+ = b + P+ X' (y - X b) / r
 //            (Bishop, PRML eqs. 3.50-3.51; the same as the gain form K = P X' (X P X' + r I)^-1,
 //            b+ = b + K (y - X b), P+ = (I - K X) P of Kalman with no process noise, computed in
-//            this information form for accuracy), and P+ is the prior of the next update. A very weak prior (prior_scale -> inf) gives the patent's refit when
-//            X has full column rank (tests/drift/test_monitor.cpp).
+//            this information form for accuracy), and P+ is the prior of the next update. A very
+//            weak prior (prior_scale -> inf) gives the patent's refit when X has full column rank
+//            (tests/drift/test_monitor.cpp).
 //   offset   only the intercept: b0 += mean_j (y_j - x_j' b).
 //   static   (reference) the model as fitted, never checked.
 // Every check and update is logged (MonitorEvent) with the numbers it compared.
@@ -73,7 +74,8 @@ struct MonitorOptions {
   double threshold_um = 0;
   /// Threshold as a multiple of sqrt(s^2 + noise_um^2) when threshold_um is 0 (> 0).
   double threshold_sigma = 3;
-  /// m: further measurements after an invalid check (1..kMaxRefitSamples).
+  /// m: further measurements after an invalid check (0..kMaxRefitSamples; 0: the update uses
+  /// the invalid check alone, no extra stop).
   int refit_samples = 3;
   /// Interval between the refit measurements [min; samples without time] (> 0).
   double refit_every = 5;
@@ -95,13 +97,13 @@ struct MonitorEvent {
   enum class Kind { kCheck, kRefitMeasurement, kUpdate, kSkipped };
   Kind kind = Kind::kCheck;
   int sample = 0;
-  double time = 0;            ///< [min; samples]
-  double measured_um = 0;     ///< measurement (checks, refit measurements)
-  double predicted_um = 0;    ///< by the coefficients in force
-  double threshold_um = 0;    ///< checks
-  bool valid = true;          ///< checks: |measured - predicted| <= threshold
+  double time = 0;               ///< [min; samples]
+  double measured_um = 0;        ///< measurement (checks, refit measurements)
+  double predicted_um = 0;       ///< by the coefficients in force
+  double threshold_um = 0;       ///< checks
+  bool valid = true;             ///< checks: |measured - predicted| <= threshold
   Eigen::VectorXd coefficients;  ///< updates: after
-  std::string message;        ///< reason and the numbers compared
+  std::string message;           ///< reason and the numbers compared
 };
 std::string ToString(MonitorEvent::Kind k);  ///< "check", "refit-measurement", "update", "skipped"
 
@@ -119,12 +121,12 @@ struct MonitorResult {
   std::string run, error_column, model_kind;
   std::vector<double> time;
   bool time_from_index = false;
-  Eigen::VectorXd measured_um;   ///< the logged error (without the added noise)
-  Eigen::VectorXd measurement_noise_um;  ///< the draw added at each sample if measured
-  int score_begin = 0, score_end = 0;  ///< scored rows [begin, end)
-  double monitored_min = 0;     ///< t_end - start [min; samples]
-  double threshold_um = 0;      ///< the threshold in force
-  ErrorStats none;              ///< no compensation over the scored rows
+  Eigen::VectorXd measured_um;             ///< the logged error (without the added noise)
+  Eigen::VectorXd measurement_noise_um;    ///< the draw added at each sample if measured
+  int score_begin = 0, score_end = 0;      ///< scored rows [begin, end)
+  double monitored_min = 0;                ///< t_end - start [min; samples]
+  double threshold_um = 0;                 ///< the threshold in force
+  ErrorStats none;                         ///< no compensation over the scored rows
   std::vector<StrategyResult> strategies;  ///< static first, then options.rules
   std::vector<std::string> warnings;
 };

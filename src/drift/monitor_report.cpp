@@ -30,8 +30,8 @@ std::vector<std::string> WithComments(const std::vector<std::string>& c, const s
 }
 
 nlohmann::json EventJson(const MonitorEvent& e) {
-  nlohmann::json j = {{"kind", ToString(e.kind)}, {"sample", e.sample}, {"time", e.time},
-                      {"message", e.message}};
+  nlohmann::json j = {
+      {"kind", ToString(e.kind)}, {"sample", e.sample}, {"time", e.time}, {"message", e.message}};
   if (e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement) {
     j["measured_um"] = e.measured_um;
     j["predicted_um"] = e.predicted_um;
@@ -41,8 +41,8 @@ nlohmann::json EventJson(const MonitorEvent& e) {
     j["valid"] = e.valid;
   }
   if (e.kind == MonitorEvent::Kind::kUpdate)
-    j["coefficients"] = std::vector<double>(e.coefficients.data(),
-                                            e.coefficients.data() + e.coefficients.size());
+    j["coefficients"] =
+        std::vector<double>(e.coefficients.data(), e.coefficients.data() + e.coefficients.size());
   return j;
 }
 
@@ -72,8 +72,8 @@ std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::stri
       std::string msg = e.message;
       for (char& ch : msg)
         if (ch == '"' || ch == '\n' || ch == ',') ch = ch == ',' ? ';' : '\'';
-      const bool measured = e.kind == MonitorEvent::Kind::kCheck ||
-                            e.kind == MonitorEvent::Kind::kRefitMeasurement;
+      const bool measured =
+          e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement;
       o << ToString(s.rule) << "," << ToString(e.kind) << "," << e.sample << ","
         << FormatNumber(e.time) << "," << (measured ? FormatNumber(e.measured_um) : "") << ","
         << FormatNumber(e.predicted_um) << ","
@@ -90,13 +90,17 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
     nlohmann::json events = nlohmann::json::array();
     for (const auto& e : s.events) events.push_back(EventJson(e));
     strategies.push_back(
-        {{"rule", ToString(s.rule)}, {"score", ErrorStatsJson(s.score)}, {"checks", s.checks},
-         {"invalid_checks", s.invalid_checks}, {"measurements", s.measurements},
-         {"recalibrations", s.recalibrations}, {"stop_min", s.stop_min},
+        {{"rule", ToString(s.rule)},
+         {"score", ErrorStatsJson(s.score)},
+         {"checks", s.checks},
+         {"invalid_checks", s.invalid_checks},
+         {"measurements", s.measurements},
+         {"recalibrations", s.recalibrations},
+         {"stop_min", s.stop_min},
          {"stop_share", s.stop_share},
-         {"final_coefficients", std::vector<double>(s.final_coefficients.data(),
-                                                    s.final_coefficients.data() +
-                                                        s.final_coefficients.size())},
+         {"final_coefficients",
+          std::vector<double>(s.final_coefficients.data(),
+                              s.final_coefficients.data() + s.final_coefficients.size())},
          {"events", events}});
   }
   std::vector<std::string> rules;
@@ -108,12 +112,20 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
           {"model_kind", r.model_kind},
           {"time_unit", r.time_from_index ? "sample" : "min"},
           {"options",
-           {{"check_every", o.check_every}, {"refit_every", o.refit_every},
-            {"refit_samples", o.refit_samples}, {"stop_min_per_measurement", o.stop_min_per_measurement},
-            {"threshold_um", o.threshold_um}, {"threshold_sigma", o.threshold_sigma},
-            {"noise_um", o.noise_um}, {"seed", o.seed}, {"prior_scale", o.prior_scale},
-            {"start", o.start}, {"score_from", o.score_from}, {"score_to", o.score_to},
-            {"reference", ToString(o.reference)}, {"rules", rules}}},
+           {{"check_every", o.check_every},
+            {"refit_every", o.refit_every},
+            {"refit_samples", o.refit_samples},
+            {"stop_min_per_measurement", o.stop_min_per_measurement},
+            {"threshold_um", o.threshold_um},
+            {"threshold_sigma", o.threshold_sigma},
+            {"noise_um", o.noise_um},
+            {"seed", o.seed},
+            {"prior_scale", o.prior_scale},
+            {"start", o.start},
+            {"score_from", o.score_from},
+            {"score_to", o.score_to},
+            {"reference", ToString(o.reference)},
+            {"rules", rules}}},
           {"threshold_um", r.threshold_um},
           {"monitored", r.monitored_min},
           {"scored_rows", {r.score_begin, r.score_end}},
@@ -132,18 +144,19 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
     << F("%.2f", r.threshold_um) << " um, " << o.refit_samples << " refit measurements every "
     << F("%g", o.refit_every) << (idx ? " samples" : " min") << ", "
     << F("%g", o.stop_min_per_measurement) << " min stop each\n";
-  s << "scored rows [" << r.score_begin << ", " << r.score_end << "): "
-    << F("%.2f", r.time[static_cast<std::size_t>(r.score_begin)] * to_h) << " to "
+  s << "scored rows [" << r.score_begin << ", " << r.score_end
+    << "): " << F("%.2f", r.time[static_cast<std::size_t>(r.score_begin)] * to_h) << " to "
     << F("%.2f", r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h) << " " << unit << "\n";
   s << "rule      MAE um  RMSE um  max um  checks  invalid  recal  stop min  stop %\n";
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%-8s %7.2f %8.2f %7.2f       -        -      -         -       -\n",
-                "none", r.none.mae_um, r.none.rmse_um, r.none.max_abs_um);
+  std::snprintf(buf, sizeof buf,
+                "%-8s %7.2f %8.2f %7.2f       -        -      -         -       -\n", "none",
+                r.none.mae_um, r.none.rmse_um, r.none.max_abs_um);
   s << buf;
   for (const auto& st : r.strategies) {
     std::snprintf(buf, sizeof buf, "%-8s %7.2f %8.2f %7.2f %7d %8d %6d %9.1f %7.2f\n",
-                  ToString(st.rule).c_str(), st.score.mae_um, st.score.rmse_um,
-                  st.score.max_abs_um, st.checks, st.invalid_checks, st.recalibrations, st.stop_min,
+                  ToString(st.rule).c_str(), st.score.mae_um, st.score.rmse_um, st.score.max_abs_um,
+                  st.checks, st.invalid_checks, st.recalibrations, st.stop_min,
                   100.0 * st.stop_share);
     s << buf;
   }
@@ -186,10 +199,16 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1100,700 font 'Sans,10' noenhanced\nset output 'monitor.png'\n"
      << "set datafile separator ','\nset key outside right\nset grid\nset xlabel "
-     << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset multiplot layout 2,1\n"
+     << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset arrow from "
+     << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
+     << ", graph 0 to "
+     << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
+     << ", graph 1 nohead dt 2\nset multiplot layout 2,1\n"
      << "set ylabel 'thermal error [um]'\nset title "
-     << GnuplotString("run " + r.run + ": measured " + r.error_column +
-                      " and the models (open: valid checks, filled: invalid checks and refits)")
+     << GnuplotString(
+            "run " + r.run + ": measured " + r.error_column +
+            " and the models (dashed: monitoring starts; open: valid checks, filled: invalid "
+            "checks and refit measurements)")
      << "\nplot 'timeline.csv' using " << x << ":2 with lines lc rgb 'black' lw 2 title 'measured'";
   for (std::size_t i = 0; i < q; ++i)
     gp << ", '' using " << x << ":" << i + 3 << " with lines lc " << i + 1 << " title "
@@ -213,7 +232,8 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
              fs::exists(dir / "monitor.png")) {
     img = "<img src='monitor.png' alt='monitor timeline'>";
   } else {
-    out.warnings.push_back("gnuplot failed on " + (dir / "monitor.gp").string() + " (see gnuplot.log)");
+    out.warnings.push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
+                           " (see gnuplot.log)");
   }
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>"
@@ -223,7 +243,8 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
     << HtmlEscape("whirl: on-line check and recalibration of " + r.error_column + " on " + r.run)
     << "</h1>\n";
   for (const auto& p : provenance) h << "<p><code>" << HtmlEscape(p) << "</code></p>\n";
-  h << "<pre>" << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n" << img << "\n"
+  h << "<pre>" << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n"
+    << img << "\n"
     << "<p>Data: <a href='timeline.csv'>timeline.csv</a>, <a href='events.csv'>events.csv</a> "
        "(every check and update with its reason), <a href='monitor.gp'>monitor.gp</a>.</p>\n";
   for (const auto& w : out.warnings) h << "<p><i>" << HtmlEscape(w) << "</i></p>\n";

@@ -19,9 +19,12 @@ namespace {
 // window of an hour or more (a slow first-order rise, a rise and cool-down, an oscillation).
 double Latent(int k, double t) {
   switch (k) {
-    case 0: return 8.0 * (1.0 - std::exp(-t / 200.0));
-    case 1: return t < 300 ? t / 50.0 : 6.0 - (t - 300) / 60.0;
-    default: return 3.0 * std::sin(t / 40.0) + 0.01 * t;
+    case 0:
+      return 8.0 * (1.0 - std::exp(-t / 200.0));
+    case 1:
+      return t < 300 ? t / 50.0 : 6.0 - (t - 300) / 60.0;
+    default:
+      return 3.0 * std::sin(t / 40.0) + 0.01 * t;
   }
 }
 
@@ -52,7 +55,7 @@ Run MakeRun(const Planted& p, unsigned seed) {
     double e = after ? p.c_after : p.c;
     for (int k = 0; k < 3; ++k) {
       r.temperature_C(q, k) = 20.0 + Latent(k, t);
-      e += (after ? p.w_after : p.w)(k) * Latent(k, t);
+      e += (after ? p.w_after : p.w)(k)*Latent(k, t);
     }
     r.error_um(q, 0) = e + p.sigma * n01(rng);
   }
@@ -129,7 +132,8 @@ TEST(Monitor, PlantedChangeIsFlaggedByTheNextCheckAndRecovered) {
     std::vector<int> rows;
     const MonitorEvent* update = nullptr;
     for (const auto& e : s.events) {
-      if (e.sample >= 240 && e.kind != MonitorEvent::Kind::kUpdate && !update) rows.push_back(e.sample);
+      if (e.sample >= 240 && e.kind != MonitorEvent::Kind::kUpdate && !update)
+        rows.push_back(e.sample);
       if (e.kind == MonitorEvent::Kind::kUpdate && !update) update = &e;
     }
     ASSERT_NE(update, nullptr);
@@ -236,8 +240,9 @@ TEST(Monitor, BayesWithAStrongPriorKeepsTheCoefficientsAndShrinksItsCovariance) 
   EXPECT_LT((BayesUpdate(x, y, b, &p, 1.0) - b).cwiseAbs().maxCoeff(), 1e-8);
   // One observation, scalar case by hand: P = 1, r = 1, x = 1: b+ = b + (y - b) / 2, P+ = 1/2.
   Eigen::MatrixXd p1 = Eigen::MatrixXd::Ones(1, 1);
-  const Eigen::VectorXd b1 = BayesUpdate(Eigen::MatrixXd::Ones(1, 1), Eigen::VectorXd::Constant(1, 4.0),
-                                         Eigen::VectorXd::Constant(1, 2.0), &p1, 1.0);
+  const Eigen::VectorXd b1 =
+      BayesUpdate(Eigen::MatrixXd::Ones(1, 1), Eigen::VectorXd::Constant(1, 4.0),
+                  Eigen::VectorXd::Constant(1, 2.0), &p1, 1.0);
   EXPECT_NEAR(b1(0), 3.0, 1e-12);
   EXPECT_NEAR(p1(0, 0), 0.5, 1e-12);
 }
