@@ -31,8 +31,10 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   sub->add_option("--run", a->run, "run file with the model's error column (the check-bar values)")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--check-every", o.check_every,
-                  "interval between checks [min; samples if the run has no time] (default 60)")
+  sub->add_option(
+         "--check-every", o.check_every,
+         "interval between checks [min; samples if the run has no time] (default 60; at most "
+         "100,000 checks per run)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--threshold-um", o.threshold_um,
                   "validity threshold on |measured - predicted| [um] (default 0: use "

@@ -127,7 +127,7 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
             {"reference", ToString(o.reference)},
             {"rules", rules}}},
           {"threshold_um", r.threshold_um},
-          {"monitored", r.monitored_min},
+          {"monitored_time", r.monitored_min},
           {"scored_rows", {r.score_begin, r.score_end}},
           {"none", ErrorStatsJson(r.none)},
           {"strategies", strategies},
