@@ -436,6 +436,7 @@ void RegisterReport(CLI::App* drift_app) {
 
 }  // namespace
 
+void RegisterDriftMonitor(CLI::App* drift_app);  // cmd_drift_monitor.cpp (issue 14)
 void RegisterDrift(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "drift",
@@ -451,6 +452,7 @@ void RegisterDrift(CLI::App& app) {
   RegisterSplit(sub);
   RegisterReport(sub);
   RegisterDriftNc(sub);  // cmd_drift_nc.cpp
+  RegisterDriftMonitor(sub);
 }
 
 }  // namespace whirl::cli

@@ -11,3 +11,4 @@ target_sources(whirl_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/evaluation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/documents.cpp
   ${CMAKE_CURRENT_LIST_DIR}/report.cpp)
+target_sources(whirl_core PRIVATE ${CMAKE_CURRENT_LIST_DIR}/monitor.cpp ${CMAKE_CURRENT_LIST_DIR}/monitor_report.cpp)  # issue 14

@@ -1,0 +1,173 @@
+#pragma once
+// On-line check of a drift model with a check bar, and recalibration when it has gone stale
+// (issue 14, seed 004: patent of Xi'an Univ. of Posts and Telecommunications, digest in
+// REFERENCE.md section 6). A model fitted once goes stale (ambient, ageing, process); the patent
+// stops the machine at set intervals, measures a check bar at a fixed position, and when the
+// measured error disagrees with the model E = sum k_i dT_i it re-fits the coefficients by least
+// squares from a few new measurements. MonitorRun replays this on a logged run, so a shop can
+// choose the interval and the threshold from its own data before touching the machine.
+//
+// Replay (what the control sees):
+//   * temperatures arrive every sample; the model (mlr or dynamic: linear in its features
+//     x = [1 f], model.h) predicts e_k = x_k' b every sample from the run's first row on (the lag
+//     states and the reference run from there, as in PredictRun);
+//   * the thermal error is known only at measurements: the run's error column at that sample plus
+//     optional Gaussian noise N(0, noise_um^2) (one draw per sample from `seed`, so every rule sees
+//     the same value at the same sample);
+//   * checks: the first at start + check_every, the next check_every after the last measurement
+//     (the patent: "when the machining time reaches the set time"); each measurement (check or
+//     refit) stops the machine stop_min_per_measurement [min]. The log cannot be paused: the stop
+//     is counted as machine time, the samples go on as logged.
+// Validity test (the patent's): the model is invalid at a check when
+//   |measured - predicted| > threshold,
+//   threshold = threshold_um when > 0, else threshold_sigma * sqrt(s^2 + noise_um^2),
+//   s = model.residual_std_um (training residual std).
+// Recalibration on an invalid check: m = refit_samples further measurements every refit_every,
+// then the update from the n = m + 1 measurements (the invalid check and the m) with design rows
+// x_j = [1 f_j] and values y_j; the new coefficients apply from the last measurement on. Rules:
+//   patent   least squares of all coefficients on the n measurements alone (the patent's rule;
+//            its model has no intercept, ours fits b0 too). n < p + 1 (p features) or collinear
+//            rows: the minimum-norm solution of the unit-scaled columns (regression.h).
+//   bayes    recursive least squares = Gaussian posterior with the current coefficients as the
+//            prior mean and prior covariance P (first P0 = prior_scale * Cov(b) of the training
+//            fit, regression.h), observation variance r = s^2 + noise_um^2:
+//              P+ = (P^-1 + X'X / r)^-1,  b+ = b + P+ X' (y - X b) / r
+//            (Bishop, PRML eqs. 3.50-3.51; the same as the gain form K = P X' (X P X' + r I)^-1,
+//            b+ = b + K (y - X b), P+ = (I - K X) P of Kalman with no process noise, computed in
+//            this information form for accuracy), and P+ is the prior of the next update. A very
+//            weak prior (prior_scale -> inf) gives the patent's refit when X has full column rank
+//            (tests/drift/test_monitor.cpp).
+//   offset   only the intercept: b0 += mean_j (y_j - x_j' b).
+//   static   (reference) the model as fitted, never checked.
+// Every check and update is logged (MonitorEvent) with the numbers it compared.
+// Scores: MAE, RMSE, max of measured - predicted [um] over the scored rows: samples at or after
+// `start` whose row index lies in [score_from, score_to) * samples; "none" is the measured error
+// itself (no compensation). Machine time: stop_min = measurements * stop_min_per_measurement,
+// stop share = stop_min / (monitored time + stop_min), monitored time = t_end - start.
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "drift/evaluation.h"
+#include "drift/model.h"
+#include "drift/run_file.h"
+
+namespace whirl::drift {
+
+enum class UpdateRule { kStatic, kPatent, kBayes, kOffset };
+std::string ToString(UpdateRule r);                   ///< "static", "patent", "bayes", "offset"
+UpdateRule ParseUpdateRule(const std::string& text);  ///< inverse; InputError otherwise
+
+// Limits (resource and plausibility, stated in the messages).
+inline constexpr int kMaxRefitSamples = 100;
+inline constexpr int kMaxMonitorChecks = 100000;
+
+struct MonitorOptions {
+  /// Interval between checks [min; samples when the run has no time column] (> 0).
+  double check_every = 60;
+  /// Machine stop per check-bar measurement (a check or a refit measurement) [min] (>= 0).
+  double stop_min_per_measurement = 1.0;
+  /// Absolute validity threshold [um]; 0: use threshold_sigma.
+  double threshold_um = 0;
+  /// Threshold as a multiple of sqrt(s^2 + noise_um^2) when threshold_um is 0 (> 0).
+  double threshold_sigma = 3;
+  /// m: further measurements after an invalid check (0..kMaxRefitSamples; 0: the update uses
+  /// the invalid check alone, no extra stop).
+  int refit_samples = 3;
+  /// Interval between the refit measurements [min; samples without time] (> 0).
+  double refit_every = 5;
+  /// Std of the check-bar measurement noise added to the logged error [um] (>= 0).
+  double noise_um = 0;
+  std::uint64_t seed = 1;  ///< noise draws
+  /// bayes: prior covariance = prior_scale * the training fit's Cov(b) (> 0).
+  double prior_scale = 1;
+  /// Monitoring starts here [min; samples]: no check before it, scores from it.
+  double start = 0;
+  double score_from = 0, score_to = 1;  ///< scored share of the run's rows, [from, to)
+  ReferenceMode reference = ReferenceMode::kRunStart;
+  /// Rules replayed besides static (always replayed).
+  std::vector<UpdateRule> rules = {UpdateRule::kPatent, UpdateRule::kBayes, UpdateRule::kOffset};
+  void Validate() const;  ///< InputError naming the option, value and rule
+};
+
+struct MonitorEvent {
+  enum class Kind { kCheck, kRefitMeasurement, kUpdate, kSkipped };
+  Kind kind = Kind::kCheck;
+  int sample = 0;
+  double time = 0;               ///< [min; samples]
+  double measured_um = 0;        ///< measurement (checks, refit measurements)
+  double predicted_um = 0;       ///< by the coefficients in force
+  double threshold_um = 0;       ///< checks
+  bool valid = true;             ///< checks: |measured - predicted| <= threshold
+  Eigen::VectorXd coefficients;  ///< updates: after
+  std::string message;           ///< reason and the numbers compared
+};
+std::string ToString(MonitorEvent::Kind k);  ///< "check", "refit-measurement", "update", "skipped"
+
+struct StrategyResult {
+  UpdateRule rule = UpdateRule::kStatic;
+  Eigen::VectorXd predicted_um;  ///< per sample
+  std::vector<MonitorEvent> events;
+  int checks = 0, invalid_checks = 0, measurements = 0, recalibrations = 0;
+  double stop_min = 0, stop_share = 0;
+  ErrorStats score;  ///< measured - predicted over the scored rows
+  Eigen::VectorXd final_coefficients;
+};
+
+struct MonitorResult {
+  std::string run, error_column, model_kind;
+  std::vector<double> time;
+  bool time_from_index = false;
+  Eigen::VectorXd measured_um;             ///< the logged error (without the added noise)
+  Eigen::VectorXd measurement_noise_um;    ///< the draw added at each sample if measured
+  int score_begin = 0, score_end = 0;      ///< scored rows [begin, end)
+  double monitored_min = 0;                ///< t_end - start [min; samples]
+  double threshold_um = 0;                 ///< the threshold in force
+  ErrorStats none;                         ///< no compensation over the scored rows
+  std::vector<StrategyResult> strategies;  ///< static first, then options.rules
+  std::vector<std::string> warnings;
+};
+
+/// Replays `options` on `run` (which must have model.error_column). InputError for a network
+/// model (not linear in coefficients), a missing column, a time-unit mismatch or bad options.
+MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorOptions& options);
+
+/// Features of every sample as the control computes them: samples x (1 + features), first
+/// column 1 (the design rows of the updates).
+Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, ReferenceMode reference);
+
+/// The update rules on n measurements (rows of x: [1 f], y: measured [um]); b: current
+/// coefficients; prior_covariance (bayes, updated in place); noise_variance r [um^2].
+Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
+Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                            const Eigen::VectorXd& b, Eigen::MatrixXd* prior_covariance,
+                            double noise_variance);
+Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& b);
+
+// Output documents (built here once; the command line only writes or prints them).
+/// Per sample: time_min (or sample), measured_um, none_um (0), <rule>_um predictions, and
+/// <rule>_residual_um.
+std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::string>& comments);
+/// Every event of every rule: rule, kind, sample, time, measured_um, predicted_um,
+/// threshold_um, valid, message.
+std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments);
+nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o);
+std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o);
+
+struct MonitorReportResult {
+  std::filesystem::path index_html;
+  std::vector<std::string> warnings;
+};
+/// HTML page with the table and a plot of measured and predicted error per rule with the checks
+/// and recalibrations marked, and the residuals (gnuplot via RunProgram; skipped with a warning
+/// when absent), beside the timeline and events CSV it is drawn from.
+MonitorReportResult WriteMonitorReport(const std::filesystem::path& dir, const MonitorResult& r,
+                                       const MonitorOptions& o,
+                                       const std::vector<std::string>& provenance,
+                                       const std::string& gnuplot = "gnuplot");
+
+}  // namespace whirl::drift

@@ -1,0 +1,257 @@
+// Output documents of the monitor (issue 14): timeline and events CSV, JSON, text table, HTML page.
+#include <cstdio>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
+#include "drift/documents.h"
+#include "drift/monitor.h"
+
+namespace whirl::drift {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string F(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+std::string TimeName(const MonitorResult& r) { return r.time_from_index ? "sample" : "time_min"; }
+
+std::vector<std::string> WithComments(const std::vector<std::string>& c, const std::string& what) {
+  std::vector<std::string> out{what};
+  out.insert(out.end(), c.begin(), c.end());
+  return out;
+}
+
+nlohmann::json EventJson(const MonitorEvent& e) {
+  nlohmann::json j = {
+      {"kind", ToString(e.kind)}, {"sample", e.sample}, {"time", e.time}, {"message", e.message}};
+  if (e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement) {
+    j["measured_um"] = e.measured_um;
+    j["predicted_um"] = e.predicted_um;
+  }
+  if (e.kind == MonitorEvent::Kind::kCheck) {
+    j["threshold_um"] = e.threshold_um;
+    j["valid"] = e.valid;
+  }
+  if (e.kind == MonitorEvent::Kind::kUpdate)
+    j["coefficients"] =
+        std::vector<double>(e.coefficients.data(), e.coefficients.data() + e.coefficients.size());
+  return j;
+}
+
+}  // namespace
+
+std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
+  std::vector<std::string> header{TimeName(r), "measured_um"};
+  for (const auto& s : r.strategies) header.push_back(ToString(s.rule) + "_um");
+  for (const auto& s : r.strategies) header.push_back(ToString(s.rule) + "_residual_um");
+  std::vector<std::vector<double>> rows;
+  for (Eigen::Index k = 0; k < r.measured_um.size(); ++k) {
+    std::vector<double> row{r.time[static_cast<std::size_t>(k)], r.measured_um(k)};
+    for (const auto& s : r.strategies) row.push_back(s.predicted_um(k));
+    for (const auto& s : r.strategies) row.push_back(r.measured_um(k) - s.predicted_um(k));
+    rows.push_back(std::move(row));
+  }
+  return FormatCsv(header, rows, WithComments(comments, "monitor timeline of " + r.run));
+}
+
+std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
+  std::ostringstream o;
+  for (const auto& c : WithComments(comments, "monitor events of " + r.run)) o << "# " << c << "\n";
+  o << "rule,kind,sample," << TimeName(r)
+    << ",measured_um,predicted_um,threshold_um,valid,message\n";
+  for (const auto& s : r.strategies)
+    for (const auto& e : s.events) {
+      std::string msg = e.message;
+      for (char& ch : msg)
+        if (ch == '"' || ch == '\n' || ch == ',') ch = ch == ',' ? ';' : '\'';
+      const bool measured =
+          e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement;
+      o << ToString(s.rule) << "," << ToString(e.kind) << "," << e.sample << ","
+        << FormatNumber(e.time) << "," << (measured ? FormatNumber(e.measured_um) : "") << ","
+        << FormatNumber(e.predicted_um) << ","
+        << (e.kind == MonitorEvent::Kind::kCheck ? FormatNumber(e.threshold_um) : "") << ","
+        << (e.kind == MonitorEvent::Kind::kCheck ? (e.valid ? "1" : "0") : "") << "," << msg
+        << "\n";
+    }
+  return o.str();
+}
+
+nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
+  nlohmann::json strategies = nlohmann::json::array();
+  for (const auto& s : r.strategies) {
+    nlohmann::json events = nlohmann::json::array();
+    for (const auto& e : s.events) events.push_back(EventJson(e));
+    strategies.push_back(
+        {{"rule", ToString(s.rule)},
+         {"score", ErrorStatsJson(s.score)},
+         {"checks", s.checks},
+         {"invalid_checks", s.invalid_checks},
+         {"measurements", s.measurements},
+         {"recalibrations", s.recalibrations},
+         {"stop_min", s.stop_min},
+         {"stop_share", s.stop_share},
+         {"final_coefficients",
+          std::vector<double>(s.final_coefficients.data(),
+                              s.final_coefficients.data() + s.final_coefficients.size())},
+         {"events", events}});
+  }
+  std::vector<std::string> rules;
+  for (UpdateRule u : o.rules) rules.push_back(ToString(u));
+  return {{"schema", "whirl.drift_monitor"},
+          {"schema_version", 1},
+          {"run", r.run},
+          {"error_column", r.error_column},
+          {"model_kind", r.model_kind},
+          {"time_unit", r.time_from_index ? "sample" : "min"},
+          {"options",
+           {{"check_every", o.check_every},
+            {"refit_every", o.refit_every},
+            {"refit_samples", o.refit_samples},
+            {"stop_min_per_measurement", o.stop_min_per_measurement},
+            {"threshold_um", o.threshold_um},
+            {"threshold_sigma", o.threshold_sigma},
+            {"noise_um", o.noise_um},
+            {"seed", o.seed},
+            {"prior_scale", o.prior_scale},
+            {"start", o.start},
+            {"score_from", o.score_from},
+            {"score_to", o.score_to},
+            {"reference", ToString(o.reference)},
+            {"rules", rules}}},
+          {"threshold_um", r.threshold_um},
+          {"monitored_time", r.monitored_min},
+          {"scored_rows", {r.score_begin, r.score_end}},
+          {"none", ErrorStatsJson(r.none)},
+          {"strategies", strategies},
+          {"warnings", r.warnings}};
+}
+
+std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
+  const bool idx = r.time_from_index;
+  const double to_h = idx ? 1.0 : 1.0 / 60.0;
+  const std::string unit = idx ? "samples" : "h";
+  std::ostringstream s;
+  s << "run " << r.run << ", " << r.error_column << ", " << r.model_kind << " model; checks every "
+    << F("%g", o.check_every) << (idx ? " samples" : " min") << ", threshold "
+    << F("%.2f", r.threshold_um) << " um, " << o.refit_samples << " refit measurements every "
+    << F("%g", o.refit_every) << (idx ? " samples" : " min") << ", "
+    << F("%g", o.stop_min_per_measurement) << " min stop each\n";
+  s << "scored rows [" << r.score_begin << ", " << r.score_end
+    << "): " << F("%.2f", r.time[static_cast<std::size_t>(r.score_begin)] * to_h) << " to "
+    << F("%.2f", r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h) << " " << unit << "\n";
+  s << "rule      MAE um  RMSE um  max um  checks  invalid  recal  stop min  stop %\n";
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "%-8s %7.2f %8.2f %7.2f       -        -      -         -       -\n", "none",
+                r.none.mae_um, r.none.rmse_um, r.none.max_abs_um);
+  s << buf;
+  for (const auto& st : r.strategies) {
+    std::snprintf(buf, sizeof buf, "%-8s %7.2f %8.2f %7.2f %7d %8d %6d %9.1f %7.2f\n",
+                  ToString(st.rule).c_str(), st.score.mae_um, st.score.rmse_um, st.score.max_abs_um,
+                  st.checks, st.invalid_checks, st.recalibrations, st.stop_min,
+                  100.0 * st.stop_share);
+    s << buf;
+  }
+  for (const auto& st : r.strategies) {
+    if (st.recalibrations == 0) continue;
+    s << ToString(st.rule) << " updates:\n";
+    for (const auto& e : st.events)
+      if (e.kind == MonitorEvent::Kind::kUpdate || e.kind == MonitorEvent::Kind::kSkipped)
+        s << "  " << F("%.2f", e.time * to_h) << " " << unit << ": " << e.message << "\n";
+  }
+  for (const auto& w : r.warnings) s << "warning: " << w << "\n";
+  return s.str();
+}
+
+MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult& r,
+                                       const MonitorOptions& o,
+                                       const std::vector<std::string>& provenance,
+                                       const std::string& gnuplot) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError("report directory '" + dir.string() + "': " + ec.message());
+  MonitorReportResult out;
+  WriteFileAtomic(dir / "timeline.csv", MonitorTimelineCsv(r, provenance));
+  WriteFileAtomic(dir / "events.csv", MonitorEventsCsv(r, provenance));
+  // Marker data per rule (gnuplot index blocks, CSV like the timeline): time, measured, 1 for
+  // an invalid check or a refit measurement, 0 for a valid check.
+  std::ostringstream marks;
+  marks << "# one block per rule in the order of timeline.csv: time,measured_um,invalid\n";
+  for (const auto& st : r.strategies) {
+    marks << "# " << ToString(st.rule) << "\n";
+    for (const auto& e : st.events)
+      if (e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement)
+        marks << FormatNumber(e.time) << "," << FormatNumber(e.measured_um) << ","
+              << (e.kind == MonitorEvent::Kind::kCheck && e.valid ? 0 : 1) << "\n";
+    marks << FormatNumber(r.time.front()) << ",0,-1\n\n\n";  // sentinel: no block is empty
+  }
+  WriteFileAtomic(dir / "checks.csv", marks.str());
+  const std::string x = r.time_from_index ? "1" : "($1/60)";
+  const std::size_t q = r.strategies.size();
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 1100,700 font 'Sans,10' noenhanced\nset output 'monitor.png'\n"
+     << "set datafile separator ','\nset key outside right\nset grid\nset xlabel "
+     << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset arrow from "
+     << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
+     << ", graph 0 to "
+     << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
+     << ", graph 1 nohead dt 2\nset multiplot layout 2,1\n"
+     << "set ylabel 'thermal error [um]'\nset title "
+     << GnuplotString(
+            "run " + r.run + ": measured " + r.error_column +
+            " and the models (dashed: monitoring starts; open: valid checks, filled: invalid "
+            "checks and refit measurements)")
+     << "\nplot 'timeline.csv' using " << x << ":2 with lines lc rgb 'black' lw 2 title 'measured'";
+  for (std::size_t i = 0; i < q; ++i)
+    gp << ", '' using " << x << ":" << i + 3 << " with lines lc " << i + 1 << " title "
+       << GnuplotString(ToString(r.strategies[i].rule));
+  for (std::size_t i = 1; i < q; ++i)
+    gp << ", 'checks.csv' index " << i << " using " << x << ":($3==0?$2:1/0) with points pt 6 lc "
+       << i + 1 << " notitle, '' index " << i << " using " << x
+       << ":($3==1?$2:1/0) with points pt 7 lc " << i + 1 << " notitle";
+  gp << "\nset title 'residual (measured - model)'\nset ylabel 'residual [um]'\nplot ";
+  for (std::size_t i = 0; i < q; ++i)
+    gp << (i ? ", " : "") << "'timeline.csv' using " << x << ":" << i + 3 + q << " with lines lc "
+       << i + 1 << " title " << GnuplotString(ToString(r.strategies[i].rule));
+  gp << "\nunset multiplot\n";
+  WriteFileAtomic(dir / "monitor.gp",
+                  "# gnuplot script written by whirl; re-run: gnuplot monitor.gp\n" + gp.str());
+  std::string img = "<p>(plot not rendered: monitor.gp)</p>";
+  fs::remove(dir / "monitor.png", ec);
+  if (!ProgramSucceeds({gnuplot, "--version"})) {
+    out.warnings.push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
+  } else if (RunProgram({gnuplot, "monitor.gp"}, dir, dir / "gnuplot.log") == 0 &&
+             fs::exists(dir / "monitor.png")) {
+    img = "<img src='monitor.png' alt='monitor timeline'>";
+  } else {
+    out.warnings.push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
+                           " (see gnuplot.log)");
+  }
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>"
+    << HtmlEscape("whirl: drift monitor of " + r.run)
+    << "</title><style>body{font-family:sans-serif;max-width:1200px;margin:1em auto}"
+       "pre{background:#f6f6f6;padding:6px}img{max-width:100%}</style></head><body>\n<h1>"
+    << HtmlEscape("whirl: on-line check and recalibration of " + r.error_column + " on " + r.run)
+    << "</h1>\n";
+  for (const auto& p : provenance) h << "<p><code>" << HtmlEscape(p) << "</code></p>\n";
+  h << "<pre>" << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n"
+    << img << "\n"
+    << "<p>Data: <a href='timeline.csv'>timeline.csv</a>, <a href='events.csv'>events.csv</a> "
+       "(every check and update with its reason), <a href='monitor.gp'>monitor.gp</a>.</p>\n";
+  for (const auto& w : out.warnings) h << "<p><i>" << HtmlEscape(w) << "</i></p>\n";
+  h << "</body></html>\n";
+  WriteFileAtomic(dir / "index.html", h.str());
+  out.index_html = dir / "index.html";
+  return out;
+}
+
+}  // namespace whirl::drift
