@@ -14,7 +14,8 @@ namespace whirl::drift {
 namespace {
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() > suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 std::string Trim(const std::string& s) {
@@ -64,8 +65,8 @@ TimePrepass PrepareTime(const std::string& text, const std::string& source) {
           const std::string name = Trim(cells[i]);
           if (name != "time_s" && name != "time_min") continue;
           if (time_index >= 0)
-            throw InputError(source + ":" + std::to_string(line_no) +
-                             ": two time columns ('" + p.time_column + "' and '" + name +
+            throw InputError(source + ":" + std::to_string(line_no) + ": two time columns ('" +
+                             p.time_column + "' and '" + name +
                              "'): give time_s or time_min, not both");
           time_index = static_cast<int>(i);
           p.time_column = name;
@@ -106,9 +107,12 @@ int FindIndex(const std::vector<std::string>& names, const std::string& name,
 
 std::string ToString(RunState s) {
   switch (s) {
-    case RunState::kIdle: return "idle";
-    case RunState::kCutting: return "cutting";
-    case RunState::kUnknown: break;
+    case RunState::kIdle:
+      return "idle";
+    case RunState::kCutting:
+      return "cutting";
+    case RunState::kUnknown:
+      break;
   }
   return "unknown";
 }
@@ -161,8 +165,9 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
   const TimePrepass prep = PrepareTime(text, source);
   const CsvTable t = ParseCsv(prep.text, source);
   if (t.rows.size() > static_cast<std::size_t>(kMaxRunSamples))
-    throw InputError(source + ": " + std::to_string(t.rows.size()) + " rows: a run file holds at most " +
-                     std::to_string(kMaxRunSamples) + " (split the log into runs)");
+    throw InputError(source + ": " + std::to_string(t.rows.size()) +
+                     " rows: a run file holds at most " + std::to_string(kMaxRunSamples) +
+                     " (split the log into runs)");
   if (t.header.size() > static_cast<std::size_t>(kMaxRunColumns))
     throw InputError(source + ": " + std::to_string(t.header.size()) +
                      " columns: a run file holds at most " + std::to_string(kMaxRunColumns));
@@ -187,7 +192,8 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
     }
   }
   if (s_cols.empty())
-    throw InputError(source + ": no temperature column (a name ending in _C, degC) in the header (" +
+    throw InputError(source +
+                     ": no temperature column (a name ending in _C, degC) in the header (" +
                      Join(t.header) + ")");
   const std::size_t q = t.rows.size();
   const auto n = static_cast<Eigen::Index>(q);

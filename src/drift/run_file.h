@@ -40,7 +40,7 @@ struct Run {
   RunState state = RunState::kUnknown;
   /// Time of each sample [min]; the sample index when time_from_index.
   std::vector<double> time_min;
-  bool time_from_index = false;  ///< true: the file recorded no (complete) time column
+  bool time_from_index = false;   ///< true: the file recorded no (complete) time column
   std::vector<int> line_numbers;  ///< 1-based file line of each sample
 
   std::vector<std::string> sensor_names;  ///< the `_C` columns, in file order

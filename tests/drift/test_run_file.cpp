@@ -17,9 +17,10 @@ std::string ErrorOf(const std::string& text) {
 }
 
 TEST(RunFile, ColumnsBySuffixAndTimeInMinutes) {
-  const drift::Run r = ParseRun("# test\ntime_s,a_C,b_C,x_um,spindle_rpm\n0,20,21,0,0\n60,21,22,1.5,1000\n"
-                         "120,22,22.5,2,1000\n",
-                         "dir/r.csv", RunState::kCutting);
+  const drift::Run r = ParseRun(
+      "# test\ntime_s,a_C,b_C,x_um,spindle_rpm\n0,20,21,0,0\n60,21,22,1.5,1000\n"
+      "120,22,22.5,2,1000\n",
+      "dir/r.csv", RunState::kCutting);
   EXPECT_EQ(r.name, "r");
   EXPECT_EQ(r.state, RunState::kCutting);
   EXPECT_EQ(r.sensor_names, (std::vector<std::string>{"a_C", "b_C"}));
@@ -32,7 +33,8 @@ TEST(RunFile, ColumnsBySuffixAndTimeInMinutes) {
 }
 
 TEST(RunFile, MissingTimeUsesTheSampleIndex) {
-  const drift::Run r = ParseRun("time_min,a_C,e_um\n0,20,0\nnan,21,1\n,22,2\n", "r.csv", RunState::kIdle);
+  const drift::Run r =
+      ParseRun("time_min,a_C,e_um\n0,20,0\nnan,21,1\n,22,2\n", "r.csv", RunState::kIdle);
   EXPECT_TRUE(r.time_from_index);
   EXPECT_EQ(r.time_min, (std::vector<double>{0, 1, 2}));
   const drift::Run none = ParseRun("a_C,e_um\n20,0\n21,1\n", "r.csv", RunState::kIdle);
