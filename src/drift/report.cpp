@@ -31,6 +31,7 @@ class ReportWriter {
       : dir_(std::move(dir)), gnuplot_(std::move(gnuplot)) {
     std::error_code ec;
     fs::create_directories(dir_, ec);
+    if (!ec) dir_ = fs::absolute(dir_, ec);  // gnuplot runs inside dir_: paths must not be relative
     if (ec) throw InputError("report directory '" + dir_.string() + "': " + ec.message());
     have_gnuplot_ = ProgramSucceeds({gnuplot_, "--version"});
     if (!have_gnuplot_)
