@@ -9,7 +9,6 @@
 #include "cli/common.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/safe_text.h"
 #include "drift/documents.h"
 #include "drift/evaluation.h"
 #include "drift/model.h"
@@ -83,7 +82,9 @@ drift::SelectionOptions ToSelection(const SelectionArgs& a) {
   } else {
     o.rule = drift::ClassCountRule::kFixed;
     try {
-      o.fixed_classes = std::stoi(a.classes);
+      std::size_t used = 0;
+      o.fixed_classes = std::stoi(a.classes, &used);
+      if (used != a.classes.size()) throw std::invalid_argument(a.classes);
     } catch (const std::exception&) {
       throw InputError("--classes '" + a.classes + "': must be fewest, margin or a number");
     }
@@ -406,18 +407,11 @@ void RegisterSplit(CLI::App* drift_app) {
   sub->callback([o] {
     const Run log = drift::ReadRun(o->log, RunState::kUnknown);
     const auto runs = drift::SplitAtStarts(log, o->column, o->threshold);
-    std::vector<std::pair<std::filesystem::path, std::string>> files;
-    for (const Run& r : runs)
-      files.emplace_back(
-          std::filesystem::path(o->out_dir) / (Slug(r.name) + ".csv"),
-          drift::FormatRun(r, {r.name + ": rows " + std::to_string(r.line_numbers.front()) +
-                                   " to " + std::to_string(r.line_numbers.back()) + " of " + o->log,
-                               "whirl drift split --log " + o->log + " --at " + o->column}));
-    std::filesystem::create_directories(o->out_dir);
-    for (const auto& [path, text] : files) WriteFileAtomic(path, text);
+    const auto paths = drift::WriteRuns(
+        o->out_dir, runs, {"whirl drift split --log " + o->log + " --at " + o->column});
     nlohmann::json list = nlohmann::json::array();
     for (std::size_t i = 0; i < runs.size(); ++i)
-      list.push_back({{"file", files[i].first.string()},
+      list.push_back({{"file", paths[i].string()},
                       {"samples", runs[i].samples()},
                       {"start_min", runs[i].time_min.front()},
                       {"end_min", runs[i].time_min.back()}});
@@ -426,8 +420,8 @@ void RegisterSplit(CLI::App* drift_app) {
       return;
     }
     for (std::size_t i = 0; i < runs.size(); ++i)
-      std::printf("%s: %d samples, %.1f to %.1f h\n", files[i].first.string().c_str(),
-                  runs[i].samples(), runs[i].time_min.front() / 60, runs[i].time_min.back() / 60);
+      std::printf("%s: %d samples, %.1f to %.1f h\n", paths[i].string().c_str(), runs[i].samples(),
+                  runs[i].time_min.front() / 60, runs[i].time_min.back() / 60);
   });
 }
 

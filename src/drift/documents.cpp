@@ -278,6 +278,7 @@ json HoldoutJson(const HoldoutResult& r) {
           {"rows", r.rows},
           {"train_rows", {0, r.train_end}},
           {"test_rows", {r.train_end, r.test_end}},
+          {"time_axis", r.time_from_index ? "sample index (no recorded time)" : "time_min"},
           {"train_end_min", r.train_end_min},
           {"test_end_min", r.test_end_min},
           {"results", rows}};
@@ -285,9 +286,13 @@ json HoldoutJson(const HoldoutResult& r) {
 
 std::string FormatHoldout(const HoldoutResult& r) {
   std::ostringstream o;
+  auto when = [&](double t) {
+    return r.time_from_index ? "sample " + F("%.0f", t) + " (no recorded time)"
+                             : F("%.1f", t / 60) + " h";
+  };
   o << "chronological hold-out on " << r.log << ": train rows [0, " << r.train_end << ") (to "
-    << F("%.1f", r.train_end_min / 60) << " h), test rows [" << r.train_end << ", " << r.test_end
-    << ") (to " << F("%.1f", r.test_end_min / 60) << " h)\n";
+    << when(r.train_end_min) << "), test rows [" << r.train_end << ", " << r.test_end << ") (to "
+    << when(r.test_end_min) << ")\n";
   o << "channel  method         test MAE  test RMSE  test max | train MAE | inputs (lags)\n";
   for (const auto& row : r.rows_out) {
     char line[160];
@@ -297,7 +302,8 @@ std::string FormatHoldout(const HoldoutResult& r) {
     o << line
       << (row.inputs.size() > 6 ? std::to_string(row.inputs.size()) + " sensors"
                                 : Join(row.inputs));
-    if (!row.time_constants.empty()) o << " (" << JoinNumbers(row.time_constants) << " min)";
+    if (!row.time_constants.empty())
+      o << " (" << JoinNumbers(row.time_constants) << (r.time_from_index ? " samples)" : " min)");
     o << "\n";
   }
   return o.str();

@@ -80,7 +80,8 @@ struct HoldoutRow {
 struct HoldoutResult {
   std::string log;
   int rows = 0, train_end = 0, test_end = 0;
-  double train_end_min = 0, test_end_min = 0;
+  double train_end_min = 0, test_end_min = 0;  ///< sample indices when time_from_index
+  bool time_from_index = false;                ///< the log recorded no time
   std::vector<HoldoutRow> rows_out;
   std::vector<DriftModel> models;          ///< same order as rows_out (none: an empty model)
   std::vector<RunPrediction> predictions;  ///< on rows [0, test_end), same order

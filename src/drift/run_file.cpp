@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/safe_text.h"
 
 namespace whirl::drift {
 namespace {
@@ -244,6 +245,31 @@ std::string FormatRun(const Run& run, const std::vector<std::string>& comments) 
       for (Eigen::Index j = 0; j < m->cols(); ++j) row.push_back((*m)(k, j));
   }
   return FormatCsv(header, rows, comments);
+}
+
+std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
+                                             const std::vector<Run>& runs,
+                                             const std::vector<std::string>& comments) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError("run directory '" + dir.string() + "': " + ec.message());
+  std::vector<std::filesystem::path> paths, temps;
+  try {
+    for (const Run& r : runs) {
+      paths.push_back(dir / (Slug(r.name) + ".csv"));
+      temps.push_back(dir / (Slug(r.name) + ".csv.partial"));
+      std::vector<std::string> c{r.name + ": lines " + std::to_string(r.line_numbers.front()) +
+                                 " to " + std::to_string(r.line_numbers.back()) + " of " +
+                                 r.source};
+      c.insert(c.end(), comments.begin(), comments.end());
+      WriteFileAtomic(temps.back(), FormatRun(r, c));
+    }
+    for (std::size_t i = 0; i < paths.size(); ++i) std::filesystem::rename(temps[i], paths[i]);
+  } catch (...) {
+    for (const auto& t : temps) std::filesystem::remove(t, ec);
+    throw;
+  }
+  return paths;
 }
 
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold) {
