@@ -9,7 +9,6 @@
 #include "cli/common.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/safe_text.h"
 #include "drift/documents.h"
 #include "drift/evaluation.h"
 #include "drift/model.h"
@@ -32,7 +31,8 @@ struct RunInputs {
 };
 
 void AddRunOptions(CLI::App* sub, RunInputs* r, bool required = true) {
-  auto* a = sub->add_option("--run", r->runs, "run file(s) of unstated state")->check(CLI::ExistingFile);
+  auto* a =
+      sub->add_option("--run", r->runs, "run file(s) of unstated state")->check(CLI::ExistingFile);
   auto* b = sub->add_option("--idle", r->idle, "run file(s) recorded in idle running")
                 ->check(CLI::ExistingFile);
   auto* c = sub->add_option("--cutting", r->cutting, "run file(s) recorded while cutting")
@@ -82,7 +82,9 @@ drift::SelectionOptions ToSelection(const SelectionArgs& a) {
   } else {
     o.rule = drift::ClassCountRule::kFixed;
     try {
-      o.fixed_classes = std::stoi(a.classes);
+      std::size_t used = 0;
+      o.fixed_classes = std::stoi(a.classes, &used);
+      if (used != a.classes.size()) throw std::invalid_argument(a.classes);
     } catch (const std::exception&) {
       throw InputError("--classes '" + a.classes + "': must be fewest, margin or a number");
     }
@@ -108,8 +110,7 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
       ->check(CLI::IsMember({"mlr", "dynamic", "network"}));
   sub->add_option("--sensors", m->sensors, "use these _C columns instead of the selection")
       ->delimiter(',');
-  sub->add_option("--inputs", m->inputs,
-                  "other columns used as inputs as logged, e.g. spindle_rpm")
+  sub->add_option("--inputs", m->inputs, "other columns used as inputs as logged, e.g. spindle_rpm")
       ->delimiter(',');
   sub->add_option("--lag-grid", m->lags,
                   "dynamic: candidate lag time constants [min] (default 5,10,20,40,80,160,320)")
@@ -120,7 +121,8 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
       ->check(CLI::Range(2, 20));
   sub->add_flag("--leave-block-out", m->shuffle_cv,
                 "dynamic: leave-one-block-out instead of forward-chaining blocks");
-  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")->check(CLI::Range(1, 20));
+  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")
+      ->check(CLI::Range(1, 20));
   sub->add_option("--restarts", m->restarts, "network: trainbr restarts (1..50)")
       ->check(CLI::Range(1, 50));
   sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000)")
@@ -157,21 +159,27 @@ void RegisterSelect(CLI::App* drift_app) {
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
       "select",
-      std::string("Temperature-sensitive points as seed 000: similarity |Pearson r| of the rises,\n"
-                  "fuzzy equivalence by max-min squaring, lambda-cuts, F test for the class count,\n"
-                  "Deng's grey grade (rho 0.5) against the error to pick one sensor per class.\n"
-                  "Prints the lambda levels with partitions and F values, the grades, the choice.\n") +
+      std::string(
+          "Temperature-sensitive points as seed 000: similarity |Pearson r| of the rises,\n"
+          "fuzzy equivalence by max-min squaring, lambda-cuts, F test for the class count,\n"
+          "Deng's grey grade (rho 0.5) against the error to pick one sensor per class.\n"
+          "Prints the lambda levels with partitions and F values, the grades, the choice.\n") +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
-  sub->add_option("--error", o->error, "error column (<name>_um) the sensors must explain")->required();
+  sub->add_option("--error", o->error, "error column (<name>_um) the sensors must explain")
+      ->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
     const auto runs = LoadRuns(o->runs);
     const drift::Selection s = drift::SelectSensors(runs, o->error, ToSelection(o->sel));
-    if (o->json) PrintJson({{"schema", "whirl.drift_select"}, {"schema_version", 1},
-                            {"error_column", o->error}, {"selection", drift::SelectionJson(s)}});
-    else std::fputs(drift::FormatSelection(s).c_str(), stdout);
+    if (o->json)
+      PrintJson({{"schema", "whirl.drift_select"},
+                 {"schema_version", 1},
+                 {"error_column", o->error},
+                 {"selection", drift::SelectionJson(s)}});
+    else
+      std::fputs(drift::FormatSelection(s).c_str(), stdout);
   });
 }
 
@@ -205,8 +213,10 @@ void RegisterFitModel(CLI::App* drift_app) {
     rep.model.notes.push_back("whirl drift fit --model " + o->model.kind + " --error " + o->error);
     drift::WriteDriftModel(o->out, rep.model);
     if (o->json) {
-      nlohmann::json j = {{"schema", "whirl.drift_fit"}, {"schema_version", 1},
-                          {"model_file", o->out}, {"model", drift::ModelSummaryJson(rep.model)}};
+      nlohmann::json j = {{"schema", "whirl.drift_fit"},
+                          {"schema_version", 1},
+                          {"model_file", o->out},
+                          {"model", drift::ModelSummaryJson(rep.model)}};
       if (rep.selected) j["selection"] = drift::SelectionJson(rep.selection);
       if (!rep.train_report.empty()) j["trainbr"] = rep.train_report;
       PrintJson(j);
@@ -231,7 +241,9 @@ void RegisterPredictDrift(CLI::App* drift_app) {
       "compensation value per sample: CSV columns time_min [min], predicted_um, compensation_um\n"
       "(= -predicted) [um], std_um [um], and measured_um, residual_um [um] when the run has the\n"
       "model's error column. Warns when inputs leave the training range.");
-  sub->add_option("--model", o->model, "drift model file (whirl drift fit)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--model", o->model, "drift model file (whirl drift fit)")
+      ->required()
+      ->check(CLI::ExistingFile);
   sub->add_option("--run", o->run, "run file")->required()->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "prediction CSV to write");
   sub->add_option("--reference", o->reference,
@@ -242,14 +254,19 @@ void RegisterPredictDrift(CLI::App* drift_app) {
   sub->callback([o] {
     const drift::DriftModel m = drift::ReadDriftModel(o->model);
     const Run run = drift::ReadRun(o->run, RunState::kUnknown);
-    const drift::RunPrediction p = drift::PredictRun(m, run, drift::ParseReferenceMode(o->reference));
+    const drift::RunPrediction p =
+        drift::PredictRun(m, run, drift::ParseReferenceMode(o->reference));
     for (const auto& w : p.warnings) Warn(w);
     if (!o->out.empty())
-      WriteFileAtomic(o->out, drift::PredictionCsv(p, {"whirl drift predict --model " + o->model +
-                                                      " --run " + o->run + " --reference " + o->reference}));
+      WriteFileAtomic(
+          o->out, drift::PredictionCsv(p, {"whirl drift predict --model " + o->model + " --run " +
+                                           o->run + " --reference " + o->reference}));
     if (o->json) {
-      PrintJson({{"schema", "whirl.drift_predict"}, {"schema_version", 1}, {"model", o->model},
-                 {"out", o->out}, {"prediction", drift::PredictionJson(p)}});
+      PrintJson({{"schema", "whirl.drift_predict"},
+                 {"schema_version", 1},
+                 {"model", o->model},
+                 {"out", o->out},
+                 {"prediction", drift::PredictionJson(p)}});
       return;
     }
     std::printf("%s: %lld samples, predicted %s from %.3f to %.3f um\n", run.name.c_str(),
@@ -258,9 +275,10 @@ void RegisterPredictDrift(CLI::App* drift_app) {
     if (p.has_measured) {
       const auto r = drift::ComputeErrorStats(p.measured_um - p.predicted_um);
       const auto n = drift::ComputeErrorStats(p.measured_um);
-      std::printf("residual: MAE %.3f, RMSE %.3f, max %.3f um (no compensation: MAE %.3f, RMSE "
-                  "%.3f, max %.3f um)\n", r.mae_um, r.rmse_um, r.max_abs_um, n.mae_um, n.rmse_um,
-                  n.max_abs_um);
+      std::printf(
+          "residual: MAE %.3f, RMSE %.3f, max %.3f um (no compensation: MAE %.3f, RMSE "
+          "%.3f, max %.3f um)\n",
+          r.mae_um, r.rmse_um, r.max_abs_um, n.mae_um, n.rmse_um, n.max_abs_um);
     }
     if (!o->out.empty()) std::printf("written to %s\n", o->out.c_str());
   });
@@ -296,8 +314,10 @@ void RegisterCrossval(CLI::App* drift_app) {
       for (Run& r : runs) r = drift::ErrorsFromStart(r);
     std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
     const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
-    if (o->json) PrintJson(drift::CrossRunJson(r));
-    else std::fputs(drift::FormatCrossRun(r).c_str(), stdout);
+    if (o->json)
+      PrintJson(drift::CrossRunJson(r));
+    else
+      std::fputs(drift::FormatCrossRun(r).c_str(), stdout);
   });
 }
 
@@ -314,28 +334,36 @@ void RegisterHoldout(CLI::App* drift_app) {
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
       "holdout",
-      std::string("Chronological hold-out on one long log (FL_THERMAL's split): train on the first\n"
-                  "--train share of the rows, test on the next --test share; the models run from\n"
-                  "the log's first row. Per channel: none, mlr_all (all sensors), mlr, dynamic and\n"
-                  "network on the selected sensors (at most --max-sensors), dynamic_extra with\n"
-                  "--inputs. Test and train MAE, RMSE, max [um].\n") +
+      std::string(
+          "Chronological hold-out on one long log (FL_THERMAL's split): train on the first\n"
+          "--train share of the rows, test on the next --test share; the models run from\n"
+          "the log's first row. Per channel: none, mlr_all (all sensors), mlr, dynamic and\n"
+          "network on the selected sensors (at most --max-sensors), dynamic_extra with\n"
+          "--inputs. Test and train MAE, RMSE, max [um].\n") +
           kRunFilesHelp);
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--train", o->h.train_fraction, "training share of the rows (default 0.6)")
       ->check(CLI::Range(0.01, 0.99));
   sub->add_option("--test", o->h.test_fraction, "test share after it (default 0.2)")
       ->check(CLI::Range(0.01, 0.99));
-  sub->add_option("--channels", o->channels, "error columns (default: every _um column)")->delimiter(',');
-  sub->add_option("--max-sensors", o->h.max_sensors, "at most this many selected sensors (default 4)")
+  sub->add_option("--channels", o->channels, "error columns (default: every _um column)")
+      ->delimiter(',');
+  sub->add_option("--max-sensors", o->h.max_sensors,
+                  "at most this many selected sensors (default 4)")
       ->check(CLI::Range(1, 64));
   sub->add_flag("--no-network", o->no_network, "skip the network model");
   sub->add_option("--inputs", o->model.inputs, "extra inputs of dynamic_extra, e.g. spindle_rpm")
       ->delimiter(',');
-  sub->add_option("--lag-grid", o->model.lags, "candidate lag time constants [min]")->delimiter(',');
-  sub->add_option("--max-lags", o->model.max_lags, "at most this many lags (1..4)")->check(CLI::Range(1, 4));
-  sub->add_option("--folds", o->model.folds, "cross-validation blocks (2..20)")->check(CLI::Range(2, 20));
-  sub->add_flag("--leave-block-out", o->model.shuffle_cv, "leave-one-block-out instead of forward-chaining");
-  sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")->check(CLI::Range(1, 10000));
+  sub->add_option("--lag-grid", o->model.lags, "candidate lag time constants [min]")
+      ->delimiter(',');
+  sub->add_option("--max-lags", o->model.max_lags, "at most this many lags (1..4)")
+      ->check(CLI::Range(1, 4));
+  sub->add_option("--folds", o->model.folds, "cross-validation blocks (2..20)")
+      ->check(CLI::Range(2, 20));
+  sub->add_flag("--leave-block-out", o->model.shuffle_cv,
+                "leave-one-block-out instead of forward-chaining");
+  sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")
+      ->check(CLI::Range(1, 10000));
   sub->add_option("--report", o->report, "also write an HTML report into this directory");
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
@@ -344,16 +372,18 @@ void RegisterHoldout(CLI::App* drift_app) {
     h.channels = o->channels;
     h.network = !o->no_network;
     h.fit = ToFit(o->model, o->sel);
-    const auto r = drift::Holdout(log, h, [](const std::string& s) {
-      std::fprintf(stderr, "fitting %s\n", s.c_str());
-    });
+    const auto r = drift::Holdout(
+        log, h, [](const std::string& s) { std::fprintf(stderr, "fitting %s\n", s.c_str()); });
     if (!o->report.empty()) {
-      const auto rep = drift::WriteHoldoutReport(o->report, log, r, {"whirl drift holdout --log " + o->log});
+      const auto rep =
+          drift::WriteHoldoutReport(o->report, log, r, {"whirl drift holdout --log " + o->log});
       for (const auto& w : rep.warnings) Warn(w);
       std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
     }
-    if (o->json) PrintJson(drift::HoldoutJson(r));
-    else std::fputs(drift::FormatHoldout(r).c_str(), stdout);
+    if (o->json)
+      PrintJson(drift::HoldoutJson(r));
+    else
+      std::fputs(drift::FormatHoldout(r).c_str(), stdout);
   });
 }
 
@@ -377,24 +407,20 @@ void RegisterSplit(CLI::App* drift_app) {
   sub->callback([o] {
     const Run log = drift::ReadRun(o->log, RunState::kUnknown);
     const auto runs = drift::SplitAtStarts(log, o->column, o->threshold);
-    std::vector<std::pair<std::filesystem::path, std::string>> files;
-    for (const Run& r : runs)
-      files.emplace_back(std::filesystem::path(o->out_dir) / (Slug(r.name) + ".csv"),
-                         drift::FormatRun(r, {r.name + ": rows " + std::to_string(r.line_numbers.front()) +
-                                                 " to " + std::to_string(r.line_numbers.back()) + " of " + o->log,
-                                             "whirl drift split --log " + o->log + " --at " + o->column}));
-    std::filesystem::create_directories(o->out_dir);
-    for (const auto& [path, text] : files) WriteFileAtomic(path, text);
+    const auto paths = drift::WriteRuns(
+        o->out_dir, runs, {"whirl drift split --log " + o->log + " --at " + o->column});
     nlohmann::json list = nlohmann::json::array();
     for (std::size_t i = 0; i < runs.size(); ++i)
-      list.push_back({{"file", files[i].first.string()}, {"samples", runs[i].samples()},
-                      {"start_min", runs[i].time_min.front()}, {"end_min", runs[i].time_min.back()}});
+      list.push_back({{"file", paths[i].string()},
+                      {"samples", runs[i].samples()},
+                      {"start_min", runs[i].time_min.front()},
+                      {"end_min", runs[i].time_min.back()}});
     if (o->json) {
       PrintJson({{"schema", "whirl.drift_split"}, {"schema_version", 1}, {"runs", list}});
       return;
     }
     for (std::size_t i = 0; i < runs.size(); ++i)
-      std::printf("%s: %d samples, %.1f to %.1f h\n", files[i].first.string().c_str(), runs[i].samples(),
+      std::printf("%s: %d samples, %.1f to %.1f h\n", paths[i].string().c_str(), runs[i].samples(),
                   runs[i].time_min.front() / 60, runs[i].time_min.back() / 60);
   });
 }
@@ -409,13 +435,15 @@ void RegisterReport(CLI::App* drift_app) {
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
       "report",
-      std::string("HTML report for a process engineer: fit a model on the training runs (--train-*)\n"
-                  "and show, per run, measured and predicted error over time [um], the residuals,\n"
-                  "the similarity matrix and lambda levels of the selection, the chosen sensors and\n"
-                  "the coefficients. Plots by gnuplot (skipped with a warning if absent).\n") +
+      std::string(
+          "HTML report for a process engineer: fit a model on the training runs (--train-*)\n"
+          "and show, per run, measured and predicted error over time [um], the residuals,\n"
+          "the similarity matrix and lambda levels of the selection, the chosen sensors and\n"
+          "the coefficients. Plots by gnuplot (skipped with a warning if absent).\n") +
           kRunFilesHelp);
   sub->add_option("--train-run", o->train.runs, "training run file(s)")->check(CLI::ExistingFile);
-  sub->add_option("--train-idle", o->train.idle, "training run file(s), idle")->check(CLI::ExistingFile);
+  sub->add_option("--train-idle", o->train.idle, "training run file(s), idle")
+      ->check(CLI::ExistingFile);
   sub->add_option("--train-cutting", o->train.cutting, "training run file(s), cutting")
       ->check(CLI::ExistingFile);
   AddRunOptions(sub, &o->runs, false);
@@ -426,9 +454,11 @@ void RegisterReport(CLI::App* drift_app) {
   sub->callback([o] {
     const auto train = LoadRuns(o->train);
     std::vector<Run> runs = train;
-    if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty()) runs = LoadRuns(o->runs);
+    if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
+      runs = LoadRuns(o->runs);
     const drift::FitReport rep = drift::FitDriftModel(train, o->error, ToFit(o->model, o->sel));
-    const auto r = drift::WriteModelReport(o->out, rep, runs, {"whirl drift report --error " + o->error});
+    const auto r =
+        drift::WriteModelReport(o->out, rep, runs, {"whirl drift report --error " + o->error});
     for (const auto& w : r.warnings) Warn(w);
     std::printf("report written to %s\n", r.index_html.string().c_str());
   });

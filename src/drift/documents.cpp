@@ -67,12 +67,9 @@ json SelectionJson(const Selection& s) {
   json grades = json::object();
   for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
     grades[s.sensor_names[i]] = s.grades(static_cast<Eigen::Index>(i));
-  return {{"sensors", s.sensor_names},
-          {"squarings", s.squarings},
-          {"partitions", parts},
-          {"chosen_partition", s.chosen_partition},
-          {"grey_grades", grades},
-          {"chosen_sensors", s.ChosenNames()},
+  return {{"sensors", s.sensor_names}, {"squarings", s.squarings},
+          {"partitions", parts},       {"chosen_partition", s.chosen_partition},
+          {"grey_grades", grades},     {"chosen_sensors", s.ChosenNames()},
           {"rule", s.message}};
 }
 
@@ -125,8 +122,10 @@ json ModelSummaryJson(const DriftModel& m) {
             {"training_samples", m.training_samples},
             {"selection", m.selection},
             {"notes", m.notes}};
-  if (linear) j["coefficients"] = coeffs;
-  else j["layer_sizes"] = m.network.layer_sizes;
+  if (linear)
+    j["coefficients"] = coeffs;
+  else
+    j["layer_sizes"] = m.network.layer_sizes;
   return j;
 }
 
@@ -145,7 +144,8 @@ std::string FormatModel(const DriftModel& m) {
     for (std::size_t i = 0; i < m.features.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
       char name[64];
-      std::snprintf(name, sizeof name, "%-30s", (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
+      std::snprintf(name, sizeof name, "%-30s",
+                    (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
       o << "  " << name << F("%12.4f", m.linear.coefficients(k + 1))
         << F("%12.4f", m.linear.standard_errors(k + 1)) << F("%11.4g", m.linear.vif(k)) << "\n";
     }
@@ -203,7 +203,8 @@ json PredictionJson(const RunPrediction& p) {
 json CrossRunJson(const CrossRunResult& r) {
   json runs = json::array();
   for (std::size_t i = 0; i < r.runs.size(); ++i)
-    runs.push_back({{"name", r.runs[i]}, {"state", ToString(r.states[i])}, {"chosen_sensors", r.chosen[i]}});
+    runs.push_back(
+        {{"name", r.runs[i]}, {"state", ToString(r.states[i])}, {"chosen_sensors", r.chosen[i]}});
   json cells = json::array();
   for (std::size_t i = 0; i < r.runs.size(); ++i)
     for (std::size_t j = 0; j < r.runs.size(); ++j)
@@ -277,6 +278,7 @@ json HoldoutJson(const HoldoutResult& r) {
           {"rows", r.rows},
           {"train_rows", {0, r.train_end}},
           {"test_rows", {r.train_end, r.test_end}},
+          {"time_axis", r.time_from_index ? "sample index (no recorded time)" : "time_min"},
           {"train_end_min", r.train_end_min},
           {"test_end_min", r.test_end_min},
           {"results", rows}};
@@ -284,17 +286,24 @@ json HoldoutJson(const HoldoutResult& r) {
 
 std::string FormatHoldout(const HoldoutResult& r) {
   std::ostringstream o;
-  o << "chronological hold-out on " << r.log << ": train rows [0, " << r.train_end
-    << ") (to " << F("%.1f", r.train_end_min / 60) << " h), test rows [" << r.train_end << ", "
-    << r.test_end << ") (to " << F("%.1f", r.test_end_min / 60) << " h)\n";
+  auto when = [&](double t) {
+    return r.time_from_index ? "sample " + F("%.0f", t) + " (no recorded time)"
+                             : F("%.1f", t / 60) + " h";
+  };
+  o << "chronological hold-out on " << r.log << ": train rows [0, " << r.train_end << ") (to "
+    << when(r.train_end_min) << "), test rows [" << r.train_end << ", " << r.test_end << ") (to "
+    << when(r.test_end_min) << ")\n";
   o << "channel  method         test MAE  test RMSE  test max | train MAE | inputs (lags)\n";
   for (const auto& row : r.rows_out) {
     char line[160];
-    std::snprintf(line, sizeof line, "%-8s %-13s %9.2f %10.2f %9.2f | %9.2f | ", row.channel.c_str(),
-                  row.method.c_str(), row.test.mae_um, row.test.rmse_um, row.test.max_abs_um,
-                  row.train.mae_um);
-    o << line << (row.inputs.size() > 6 ? std::to_string(row.inputs.size()) + " sensors" : Join(row.inputs));
-    if (!row.time_constants.empty()) o << " (" << JoinNumbers(row.time_constants) << " min)";
+    std::snprintf(line, sizeof line, "%-8s %-13s %9.2f %10.2f %9.2f | %9.2f | ",
+                  row.channel.c_str(), row.method.c_str(), row.test.mae_um, row.test.rmse_um,
+                  row.test.max_abs_um, row.train.mae_um);
+    o << line
+      << (row.inputs.size() > 6 ? std::to_string(row.inputs.size()) + " sensors"
+                                : Join(row.inputs));
+    if (!row.time_constants.empty())
+      o << " (" << JoinNumbers(row.time_constants) << (r.time_from_index ? " samples)" : " min)");
     o << "\n";
   }
   return o.str();

@@ -128,6 +128,7 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
   if (o.max_sensors < 1) throw InputError("holdout: max sensors must be >= 1");
   HoldoutResult res;
   res.log = log.name;
+  res.time_from_index = log.time_from_index;
   res.rows = log.samples();
   res.train_end = static_cast<int>(std::floor(o.train_fraction * res.rows));
   res.test_end = static_cast<int>(std::floor((o.train_fraction + o.test_fraction) * res.rows));

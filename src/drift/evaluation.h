@@ -46,10 +46,10 @@ struct CrossRunResult {
   ModelKind kind = ModelKind::kMlr;
   std::vector<std::string> runs;
   std::vector<RunState> states;
-  std::vector<std::vector<std::string>> chosen;    ///< sensors of each run's model
-  std::vector<std::vector<CrossRunCell>> cells;    ///< [train][test]
+  std::vector<std::vector<std::string>> chosen;  ///< sensors of each run's model
+  std::vector<std::vector<CrossRunCell>> cells;  ///< [train][test]
   std::vector<CrossRunGroup> groups;
-  std::vector<DriftModel> models;                  ///< each run's model
+  std::vector<DriftModel> models;  ///< each run's model
 };
 
 /// Builds one model per run (options.kind, seed 000 selection unless options.sensors is set) and
@@ -58,9 +58,9 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
                         const FitOptions& options);
 
 struct HoldoutOptions {
-  double train_fraction = 0.6;  ///< first part of the rows for training, in (0, 1)
-  double test_fraction = 0.2;   ///< next part for testing; train + test <= 1
-  int max_sensors = 4;          ///< the selection's class count is capped here
+  double train_fraction = 0.6;        ///< first part of the rows for training, in (0, 1)
+  double test_fraction = 0.2;         ///< next part for testing; train + test <= 1
+  int max_sensors = 4;                ///< the selection's class count is capped here
   std::vector<std::string> channels;  ///< error columns (empty: every _um column)
   /// Methods: none, mlr_all (MLR on every sensor), mlr (selected), dynamic (selected, lags),
   /// network (selected, k-h-1), and dynamic_extra (selected + the extra inputs, lags) when
@@ -80,9 +80,10 @@ struct HoldoutRow {
 struct HoldoutResult {
   std::string log;
   int rows = 0, train_end = 0, test_end = 0;
-  double train_end_min = 0, test_end_min = 0;
+  double train_end_min = 0, test_end_min = 0;  ///< sample indices when time_from_index
+  bool time_from_index = false;                ///< the log recorded no time
   std::vector<HoldoutRow> rows_out;
-  std::vector<DriftModel> models;  ///< same order as rows_out (none: an empty model)
+  std::vector<DriftModel> models;          ///< same order as rows_out (none: an empty model)
   std::vector<RunPrediction> predictions;  ///< on rows [0, test_end), same order
 };
 

@@ -46,7 +46,8 @@ Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
     s.y.segment(at, r.samples()) = r.error_um.col(r.ErrorIndex(error_column));
     for (int k = 0; k < r.samples(); ++k)
       s.fold[static_cast<std::size_t>(at + k)] =
-          runs.size() > 1 ? static_cast<int>(i) : static_cast<int>(k * static_cast<long>(folds) / r.samples());
+          runs.size() > 1 ? static_cast<int>(i)
+                          : static_cast<int>(k * static_cast<long>(folds) / r.samples());
     at += r.samples();
   }
   return s;
@@ -54,7 +55,8 @@ Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
 
 Eigen::MatrixXd Rows(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& idx) {
   Eigen::MatrixXd out(static_cast<Eigen::Index>(idx.size()), m.cols());
-  for (std::size_t i = 0; i < idx.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(idx[i]);
+  for (std::size_t i = 0; i < idx.size(); ++i)
+    out.row(static_cast<Eigen::Index>(i)) = m.row(idx[i]);
   return out;
 }
 
@@ -66,8 +68,10 @@ double CrossValidatedRmse(const Stacked& s, bool forward) {
   for (int f = forward ? 1 : 0; f < nf; ++f) {
     std::vector<Eigen::Index> train, test;
     for (std::size_t i = 0; i < s.fold.size(); ++i) {
-      if (s.fold[i] == f) test.push_back(static_cast<Eigen::Index>(i));
-      else if (!forward || s.fold[i] < f) train.push_back(static_cast<Eigen::Index>(i));
+      if (s.fold[i] == f)
+        test.push_back(static_cast<Eigen::Index>(i));
+      else if (!forward || s.fold[i] < f)
+        train.push_back(static_cast<Eigen::Index>(i));
     }
     if (test.empty()) continue;
     count += static_cast<Eigen::Index>(test.size());
@@ -107,7 +111,8 @@ std::vector<LagSearchStep> SearchLags(const std::vector<Run>& runs, const std::s
         // collinear lag set (e.g. two nearly equal long lags): not a candidate
       }
     });
-    const auto best = static_cast<std::size_t>(std::min_element(rmse.begin(), rmse.end()) - rmse.begin());
+    const auto best =
+        static_cast<std::size_t>(std::min_element(rmse.begin(), rmse.end()) - rmse.begin());
     if (!(rmse[best] < steps.back().cv_rmse_um)) break;
     std::vector<double> taus = cur;
     taus.push_back(cand[best]);
@@ -119,7 +124,8 @@ std::vector<LagSearchStep> SearchLags(const std::vector<Run>& runs, const std::s
 
 void FitNetwork(const Stacked& s, const FitOptions& o, DriftModel* m, std::string* report) {
   const Eigen::Index q = s.x.rows();
-  const Eigen::Index stride = std::max<Eigen::Index>(1, (q + o.max_train_samples - 1) / o.max_train_samples);
+  const Eigen::Index stride =
+      std::max<Eigen::Index>(1, (q + o.max_train_samples - 1) / o.max_train_samples);
   std::vector<Eigen::Index> idx;
   for (Eigen::Index i = 0; i < q; i += stride) idx.push_back(i);
   const Eigen::MatrixXd x = Rows(s.x, idx).transpose();
@@ -145,16 +151,20 @@ void FitOptions::Validate() const {
   selection.Validate();
   if (max_lags < 1 || max_lags > 4)
     throw InputError("max lags " + std::to_string(max_lags) + ": must be 1..4");
-  if (folds < 2 || folds > 20) throw InputError("folds " + std::to_string(folds) + ": must be 2..20");
+  if (folds < 2 || folds > 20)
+    throw InputError("folds " + std::to_string(folds) + ": must be 2..20");
   if (tau_grid.empty() || tau_grid.size() > 32)
     throw InputError("lag grid: give 1 to 32 time constants");
   for (double t : tau_grid)
-    if (!(t > 0 && t <= 1e6)) throw InputError("lag time constant " + Num(t) + ": must be in (0, 1e6]");
-  if (hidden < 1 || hidden > 20) throw InputError("hidden " + std::to_string(hidden) + ": must be 1..20");
+    if (!(t > 0 && t <= 1e6))
+      throw InputError("lag time constant " + Num(t) + ": must be in (0, 1e6]");
+  if (hidden < 1 || hidden > 20)
+    throw InputError("hidden " + std::to_string(hidden) + ": must be 1..20");
   if (restarts < 1 || restarts > 50)
     throw InputError("restarts " + std::to_string(restarts) + ": must be 1..50");
   if (max_train_samples < 20 || max_train_samples > 20000)
-    throw InputError("max train samples " + std::to_string(max_train_samples) + ": must be 20..20000");
+    throw InputError("max train samples " + std::to_string(max_train_samples) +
+                     ": must be 20..20000");
   train.Validate();
 }
 
@@ -185,7 +195,8 @@ FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_c
   m.reference_C = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.sensors.size()));
   for (const Run& r : runs) {
     for (std::size_t i = 0; i < m.sensors.size(); ++i)
-      m.reference_C(static_cast<Eigen::Index>(i)) += r.temperature_C(0, r.SensorIndex(m.sensors[i]));
+      m.reference_C(static_cast<Eigen::Index>(i)) +=
+          r.temperature_C(0, r.SensorIndex(m.sensors[i]));
     for (const auto& e : m.extra_inputs) r.OtherIndex(e);
     m.training_runs.push_back(r.name);
     m.training_samples += r.samples();
@@ -224,8 +235,8 @@ FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_c
     fitted = EvaluateLinear(m.linear.coefficients, s.x);
   }
   const Eigen::VectorXd res = s.y - fitted;
-  const double dof = o.kind == ModelKind::kNetwork ? static_cast<double>(res.size())
-                                                   : m.linear.degrees_of_freedom;
+  const double dof =
+      o.kind == ModelKind::kNetwork ? static_cast<double>(res.size()) : m.linear.degrees_of_freedom;
   m.residual_std_um = std::sqrt(res.squaredNorm() / dof);
   const double tss = (s.y.array() - s.y.mean()).square().sum();
   m.r_squared = tss > 0 ? 1.0 - res.squaredNorm() / tss : 1.0;

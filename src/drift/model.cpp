@@ -21,14 +21,17 @@ std::string Num(double v) {
   return s.str();
 }
 
-json VectorJson(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+json VectorJson(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
 
 Eigen::VectorXd ReadVector(const json& j, const char* key, Eigen::Index size) {
   const auto v = j.at(key).get<std::vector<double>>();
   if (size >= 0 && static_cast<Eigen::Index>(v.size()) != size)
     throw InputError(std::string("drift model '") + key + "': " + std::to_string(v.size()) +
                      " values, expected " + std::to_string(size));
-  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  Eigen::VectorXd out =
+      Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
   if (!out.allFinite()) throw InputError(std::string("drift model '") + key + "' is not finite");
   return out;
 }
@@ -49,7 +52,8 @@ Eigen::MatrixXd ReadMatrix(const json& j, const char* key, Eigen::Index n) {
     if (static_cast<Eigen::Index>(rows[static_cast<std::size_t>(i)].size()) != n)
       throw InputError(std::string("drift model '") + key + "' row " + std::to_string(i) +
                        " must have " + std::to_string(n) + " values");
-    for (Eigen::Index k = 0; k < n; ++k) m(i, k) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
+    for (Eigen::Index k = 0; k < n; ++k)
+      m(i, k) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
   }
   if (!m.allFinite()) throw InputError(std::string("drift model '") + key + "' is not finite");
   return m;
@@ -91,9 +95,12 @@ Eigen::MatrixXd FeaturesFromInputs(const Eigen::MatrixXd& u, const std::vector<d
 
 std::string ToString(ModelKind k) {
   switch (k) {
-    case ModelKind::kDynamic: return "dynamic";
-    case ModelKind::kNetwork: return "network";
-    case ModelKind::kMlr: break;
+    case ModelKind::kDynamic:
+      return "dynamic";
+    case ModelKind::kNetwork:
+      return "network";
+    case ModelKind::kMlr:
+      break;
   }
   return "mlr";
 }
@@ -105,9 +112,7 @@ ModelKind ParseModelKind(const std::string& text) {
   throw InputError("model kind '" + text + "': must be mlr, dynamic or network");
 }
 
-std::string ToString(ReferenceMode m) {
-  return m == ReferenceMode::kModel ? "model" : "run-start";
-}
+std::string ToString(ReferenceMode m) { return m == ReferenceMode::kModel ? "model" : "run-start"; }
 
 ReferenceMode ParseReferenceMode(const std::string& text) {
   if (text == "run-start") return ReferenceMode::kRunStart;
@@ -195,12 +200,12 @@ void to_json(json& j, const DriftModel& m) {
 
 void from_json(const json& j, DriftModel& m) {
   if (!j.is_object() || !j.contains("format") || j["format"] != DriftModel::kFormat)
-    throw InputError(std::string("not a drift model (its 'format' is not '") +
-                     DriftModel::kFormat + "'; write one with whirl drift fit)");
-  RejectUnknownKeys(j, {"format", "schema_version", "kind", "error_column", "error_unit",
-                        "sensors", "reference_C", "extra_inputs", "time_unit", "time_constants",
-                        "features", "residual_std_um", "r_squared", "training", "linear",
-                        "network"},
+    throw InputError(std::string("not a drift model (its 'format' is not '") + DriftModel::kFormat +
+                     "'; write one with whirl drift fit)");
+  RejectUnknownKeys(j,
+                    {"format", "schema_version", "kind", "error_column", "error_unit", "sensors",
+                     "reference_C", "extra_inputs", "time_unit", "time_constants", "features",
+                     "residual_std_um", "r_squared", "training", "linear", "network"},
                     "drift model");
   if (j.at("schema_version").get<int>() != DriftModel::kSchemaVersion)
     throw InputError("drift model schema_version " + j.at("schema_version").dump() +
@@ -253,8 +258,7 @@ void from_json(const json& j, DriftModel& m) {
     m.target_scaling.xmin = ReadVector(n, "target_min", 1);
     m.target_scaling.xmax = ReadVector(n, "target_max", 1);
     m.noise_variance = RequireNumber(n, "noise_variance_normalized", "drift model network");
-    m.posterior_covariance =
-        ReadMatrix(n, "posterior_covariance", m.network.ParameterCount());
+    m.posterior_covariance = ReadMatrix(n, "posterior_covariance", m.network.ParameterCount());
   }
   m.Validate();
 }

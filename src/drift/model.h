@@ -39,11 +39,11 @@
 namespace whirl::drift {
 
 enum class ModelKind { kMlr, kDynamic, kNetwork };
-std::string ToString(ModelKind k);                 ///< "mlr", "dynamic", "network"
+std::string ToString(ModelKind k);                  ///< "mlr", "dynamic", "network"
 ModelKind ParseModelKind(const std::string& text);  ///< inverse; InputError otherwise
 
 enum class ReferenceMode { kRunStart, kModel };
-std::string ToString(ReferenceMode m);                  ///< "run-start", "model"
+std::string ToString(ReferenceMode m);  ///< "run-start", "model"
 ReferenceMode ParseReferenceMode(const std::string& text);
 
 /// One regressor: an input or its lagged copy.
@@ -58,29 +58,29 @@ struct DriftModel {
   static constexpr const char* kFormat = "whirl-drift-model";
 
   ModelKind kind = ModelKind::kMlr;
-  std::string error_column;               ///< predicted channel, e.g. "ch1_um" [um]
-  std::vector<std::string> sensors;       ///< temperature columns used (rises) [degC -> K]
-  Eigen::VectorXd reference_C;            ///< per sensor: mean first row of the training runs
-  std::vector<std::string> extra_inputs;  ///< other columns used as logged
-  std::string time_unit = "min";          ///< "min", or "sample" (training runs had no time)
-  std::vector<double> time_constants;     ///< lag time constants [time_unit], ascending
-  std::vector<Feature> features;          ///< input-major, see the header comment
+  std::string error_column;                  ///< predicted channel, e.g. "ch1_um" [um]
+  std::vector<std::string> sensors;          ///< temperature columns used (rises) [degC -> K]
+  Eigen::VectorXd reference_C;               ///< per sensor: mean first row of the training runs
+  std::vector<std::string> extra_inputs;     ///< other columns used as logged
+  std::string time_unit = "min";             ///< "min", or "sample" (training runs had no time)
+  std::vector<double> time_constants;        ///< lag time constants [time_unit], ascending
+  std::vector<Feature> features;             ///< input-major, see the header comment
   Eigen::VectorXd feature_min, feature_max;  ///< training range per feature
 
   LinearFit linear;  ///< mlr, dynamic: coefficients b0 [um], then um per feature unit
 
-  nn::Network network;             ///< network: k-h-1 in the normalized space
-  nn::MapMinMax input_scaling;     ///< network: mapminmax of the features
-  nn::MapMinMax target_scaling;    ///< network: mapminmax of the error
+  nn::Network network;                   ///< network: k-h-1 in the normalized space
+  nn::MapMinMax input_scaling;           ///< network: mapminmax of the features
+  nn::MapMinMax target_scaling;          ///< network: mapminmax of the error
   Eigen::MatrixXd posterior_covariance;  ///< network: A^-1 (nn/trainbr.h)
-  double noise_variance = 0;       ///< network: 1 / (2 beta), normalized units
+  double noise_variance = 0;             ///< network: 1 / (2 beta), normalized units
 
   double residual_std_um = 0;  ///< training residual std (all kinds)
   double r_squared = 0;        ///< training R^2 (all kinds)
   std::vector<std::string> training_runs;
   RunState state = RunState::kUnknown;  ///< common state of the training runs, else unknown
   int training_samples = 0;
-  std::string selection;          ///< how the sensors were chosen (selection message or "given")
+  std::string selection;           ///< how the sensors were chosen (selection message or "given")
   std::vector<std::string> notes;  ///< provenance (command line, lag search)
 
   int InputCount() const { return static_cast<int>(sensors.size() + extra_inputs.size()); }
@@ -121,11 +121,11 @@ Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& se
 
 struct RunPrediction {
   std::string run;
-  std::vector<double> time;       ///< run.time_min (samples when time_from_index)
+  std::vector<double> time;  ///< run.time_min (samples when time_from_index)
   bool time_from_index = false;
-  Eigen::VectorXd predicted_um;   ///< the compensation value is its negative
-  Eigen::VectorXd std_um;         ///< standard deviation of each prediction
-  bool has_measured = false;      ///< the run has the model's error column
+  Eigen::VectorXd predicted_um;  ///< the compensation value is its negative
+  Eigen::VectorXd std_um;        ///< standard deviation of each prediction
+  bool has_measured = false;     ///< the run has the model's error column
   Eigen::VectorXd measured_um;
   int outside_range_samples = 0;  ///< samples with a feature outside its training range
   std::vector<std::string> warnings;
@@ -146,12 +146,12 @@ struct FitOptions {
   /// only, as a model is used on a machine: always forward in time) instead of leave-one-block-
   /// out. Several runs: always leave one run out.
   bool forward_cv = true;
-  int hidden = 3;    ///< network: hidden tansig neurons h (1..20)
-  int restarts = 3;  ///< network: trainbr restarts, the highest evidence kept (1..50)
-  std::uint64_t seed = 1;      ///< network: Nguyen-Widrow seed of the first restart
+  int hidden = 3;                ///< network: hidden tansig neurons h (1..20)
+  int restarts = 3;              ///< network: trainbr restarts, the highest evidence kept (1..50)
+  std::uint64_t seed = 1;        ///< network: Nguyen-Widrow seed of the first restart
   int max_train_samples = 3000;  ///< network: evenly thinned to at most this many samples
-  nn::TrainOptions train;      ///< network: trainbr options (epochs default 1000)
-  int threads = 0;             ///< cross-validation and restarts (0: all cores)
+  nn::TrainOptions train;        ///< network: trainbr options (epochs default 1000)
+  int threads = 0;               ///< cross-validation and restarts (0: all cores)
   void Validate() const;
 };
 
@@ -162,10 +162,10 @@ struct LagSearchStep {
 
 struct FitReport {
   DriftModel model;
-  bool selected = false;   ///< sensors came from the selection
-  Selection selection;     ///< when selected
+  bool selected = false;                  ///< sensors came from the selection
+  Selection selection;                    ///< when selected
   std::vector<LagSearchStep> lag_search;  ///< dynamic: accepted steps, static first
-  std::string train_report;  ///< network: trainbr BriefReport
+  std::string train_report;               ///< network: trainbr BriefReport
 };
 
 /// Fits a model of `error_column` on `runs` (InputError on missing columns or bad options).

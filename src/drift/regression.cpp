@@ -41,8 +41,8 @@ Solved Solve(const Eigen::MatrixXd& x1, const Eigen::VectorXd& y) {
   const Eigen::MatrixXd r = qr.matrixR().topLeftCorner(p, p).triangularView<Eigen::Upper>();
   const Eigen::MatrixXd r_inv =
       r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
-  const Eigen::MatrixXd inner = qr.colsPermutation() * (r_inv * r_inv.transpose()) *
-                                qr.colsPermutation().transpose();
+  const Eigen::MatrixXd inner =
+      qr.colsPermutation() * (r_inv * r_inv.transpose()) * qr.colsPermutation().transpose();
   s.xtx_inverse = scale.cwiseInverse().asDiagonal() * inner * scale.cwiseInverse().asDiagonal();
   return s;
 }
@@ -84,7 +84,8 @@ Eigen::VectorXd LeastSquaresCoefficients(const Eigen::MatrixXd& x, const Eigen::
   Eigen::VectorXd scale = x1.colwise().norm().transpose();
   for (Eigen::Index j = 0; j < scale.size(); ++j)
     if (!(scale(j) > 0)) scale(j) = 1;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(x1 * scale.cwiseInverse().asDiagonal());
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(x1 *
+                                                              scale.cwiseInverse().asDiagonal());
   cod.setThreshold(1e-12);
   return scale.cwiseInverse().asDiagonal() * cod.solve(y);
 }
@@ -116,8 +117,9 @@ Eigen::VectorXd FirstOrderLag(const Eigen::VectorXd& x, const std::vector<double
   if (x.size() == 0) return y;
   y(0) = x(0);
   for (Eigen::Index k = 1; k < x.size(); ++k) {
-    const double a = 1.0 - std::exp(-(t[static_cast<std::size_t>(k)] -
-                                       t[static_cast<std::size_t>(k - 1)]) / tau);
+    const double a =
+        1.0 -
+        std::exp(-(t[static_cast<std::size_t>(k)] - t[static_cast<std::size_t>(k - 1)]) / tau);
     y(k) = y(k - 1) + a * (x(k) - y(k - 1));
   }
   return y;

@@ -23,9 +23,9 @@ struct LinearFit {
   Eigen::MatrixXd xtx_inverse;      ///< (X1'X1)^-1
   double residual_std_um = 0;       ///< s
   double r_squared = 0;
-  int samples = 0;              ///< n
-  int degrees_of_freedom = 0;   ///< n - p - 1
-  Eigen::VectorXd vif;          ///< per regressor
+  int samples = 0;             ///< n
+  int degrees_of_freedom = 0;  ///< n - p - 1
+  Eigen::VectorXd vif;         ///< per regressor
 };
 
 /// OLS of y (n) on the columns of x (n x p) with an intercept. InputError if n <= p + 1, a value

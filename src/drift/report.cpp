@@ -1,5 +1,6 @@
 #include "drift/report.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -26,13 +27,16 @@ const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noen
 // Writes files, renders the gnuplot scripts, writes index.html last.
 class ReportWriter {
  public:
-  ReportWriter(fs::path dir, std::string gnuplot) : dir_(std::move(dir)), gnuplot_(std::move(gnuplot)) {
+  ReportWriter(fs::path dir, std::string gnuplot)
+      : dir_(std::move(dir)), gnuplot_(std::move(gnuplot)) {
     std::error_code ec;
     fs::create_directories(dir_, ec);
+    if (!ec) dir_ = fs::absolute(dir_, ec);  // gnuplot runs inside dir_: paths must not be relative
     if (ec) throw InputError("report directory '" + dir_.string() + "': " + ec.message());
     have_gnuplot_ = ProgramSucceeds({gnuplot_, "--version"});
     if (!have_gnuplot_)
-      result_.warnings.push_back("'" + gnuplot_ + "' not found: plots skipped (install gnuplot-nox)");
+      result_.warnings.push_back("'" + gnuplot_ +
+                                 "' not found: plots skipped (install gnuplot-nox)");
   }
   void File(const std::string& name, const std::string& text) {
     WriteFileAtomic(dir_ / name, text);
@@ -44,7 +48,8 @@ class ReportWriter {
     File(stem + ".gp", "# gnuplot script written by whirl; re-run with: gnuplot " + stem + ".gp\n" +
                            kTerminal + "set output " + GnuplotString(png) + "\n" + body);
     if (have_gnuplot_) {
-      const std::string script = std::string(kTerminal) + "set output " + GnuplotString(tmp) + "\n" + body;
+      const std::string script =
+          std::string(kTerminal) + "set output " + GnuplotString(tmp) + "\n" + body;
       WriteFileAtomic(dir_ / (stem + ".tmp.gp"), script);
       const int rc = RunProgram({gnuplot_, stem + ".tmp.gp"}, dir_, dir_ / "gnuplot.log");
       fs::remove(dir_ / (stem + ".tmp.gp"));
@@ -84,7 +89,8 @@ std::string Head(const std::string& title, const std::vector<std::string>& prove
   return h.str();
 }
 
-std::vector<std::string> Comments(const std::vector<std::string>& provenance, const std::string& what) {
+std::vector<std::string> Comments(const std::vector<std::string>& provenance,
+                                  const std::string& what) {
   std::vector<std::string> c{what};
   for (const auto& p : provenance) c.push_back(p);
   return c;
@@ -110,13 +116,14 @@ std::string SelectionHtml(const Selection& s) {
     h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>" << F("%.4f", p.lambda)
       << "</td><td>" << p.classes << "</td><td>" << (p.has_f ? F("%.3f", p.f) : "-") << "</td><td>"
       << (p.has_f ? F("%.3f", p.f_critical) : "-") << "</td><td>"
-      << (p.has_f ? (p.significant() ? "yes" : "no") : "-")
-      << "</td><td style='text-align:left'>" << HtmlEscape(classes) << "</td></tr>\n";
+      << (p.has_f ? (p.significant() ? "yes" : "no") : "-") << "</td><td style='text-align:left'>"
+      << HtmlEscape(classes) << "</td></tr>\n";
   }
   h << "</table>\n<p>Grey relational grades against the error (rho 0.5):</p><table><tr>";
   for (const auto& n : s.sensor_names) h << "<th>" << HtmlEscape(n) << "</th>";
   h << "</tr><tr>";
-  for (Eigen::Index i = 0; i < s.grades.size(); ++i) h << "<td>" << F("%.4f", s.grades(i)) << "</td>";
+  for (Eigen::Index i = 0; i < s.grades.size(); ++i)
+    h << "<td>" << F("%.4f", s.grades(i)) << "</td>";
   h << "</tr></table>\n";
   return h.str();
 }
@@ -129,7 +136,8 @@ std::string SimilarityPlot(ReportWriter* w, const Selection& s) {
     for (Eigen::Index j = 0; j < m; ++j)
       data << i << " " << j << " " << FormatNumber(s.similarity(i, j)) << " "
            << FormatNumber(s.equivalence(i, j)) << "\n";
-  w->File("similarity.dat", "# i j similarity equivalence (sensor indices as in the tics)\n" + data.str());
+  w->File("similarity.dat",
+          "# i j similarity equivalence (sensor indices as in the tics)\n" + data.str());
   std::string tics;
   for (Eigen::Index i = 0; i < m; ++i)
     tics += (i ? ", " : "") + GnuplotString(s.sensor_names[static_cast<std::size_t>(i)]) + " " +
@@ -137,10 +145,33 @@ std::string SimilarityPlot(ReportWriter* w, const Selection& s) {
   std::ostringstream gp;
   gp << "set multiplot layout 1,2\nset size ratio -1\nset cbrange [0:1]\nset xtics (" << tics
      << ") rotate by 90 right\nset bmargin 6\nset ytics (" << tics << ")\nset yrange [] reverse\n"
-     << "set title 'similarity |Pearson r| of the rises'\nplot 'similarity.dat' using 1:2:3 with image notitle\n"
-     << "set title 'fuzzy equivalence (lambda levels)'\nplot 'similarity.dat' using 1:2:4 with image notitle\n"
+     << "set title 'similarity |Pearson r| of the rises'\nplot 'similarity.dat' using 1:2:3 with "
+        "image notitle\n"
+     << "set title 'fuzzy equivalence (lambda levels)'\nplot 'similarity.dat' using 1:2:4 with "
+        "image notitle\n"
      << "unset multiplot\n";
   return w->Plot("similarity", gp.str(), "similarity and fuzzy equivalence matrices");
+}
+
+// The lambda-cuts as a step plot: class count against lambda, with F / F_crit where defined.
+std::string LevelsPlot(ReportWriter* w, const Selection& s) {
+  std::vector<std::vector<double>> rows;
+  for (const Partition& p : s.partitions)
+    rows.push_back({p.lambda, static_cast<double>(p.classes),
+                    p.has_f && std::isfinite(p.f) ? p.f / p.f_critical : -1.0});
+  w->File(
+      "lambda_levels.csv",
+      FormatCsv(
+          {"lambda", "classes", "f_over_f_critical"}, rows,
+          {"lambda-cuts of the fuzzy equivalence matrix; -1: no F (r = 1 or m, or F infinite)"}));
+  std::ostringstream gp;
+  gp << "set datafile separator ','\nset grid\nset key top left\nset xlabel 'lambda'\n"
+     << "set ylabel 'classes r'\nset y2label 'F / F_crit'\nset y2tics\nset logscale y2\n"
+     << "set title 'lambda levels: classes and F test (F / F_crit > 1: significant)'\n"
+     << "plot 'lambda_levels.csv' using 1:2 with linespoints pt 5 lw 2 title 'classes at the cut', "
+     << "'' using 1:($3 > 0 ? $3 : 1/0) axes x1y2 with points pt 7 title 'F / F_crit', "
+     << "1 axes x1y2 with lines dt 2 lc rgb 'gray' notitle\n";
+  return w->Plot("lambda_levels", gp.str(), "class count and F test per lambda level");
 }
 
 std::string StatsRow(const std::string& name, const ErrorStats& s) {
@@ -162,13 +193,17 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   std::ostringstream h;
   h << Head("whirl: machine thermal drift of " + m.error_column, provenance);
   h << "<h2>Model</h2>\n<pre>" << HtmlEscape(FormatModel(m)) << "</pre>\n";
-  if (fit.selected) h << SelectionHtml(fit.selection) << SimilarityPlot(&w, fit.selection) << "\n";
-  h << "<h2>Runs</h2>\n<table><tr><th style='text-align:left'>run</th><th>MAE um</th><th>RMSE um</th>"
+  if (fit.selected)
+    h << SelectionHtml(fit.selection) << SimilarityPlot(&w, fit.selection) << "\n"
+      << LevelsPlot(&w, fit.selection) << "\n";
+  h << "<h2>Runs</h2>\n<table><tr><th style='text-align:left'>run</th><th>MAE um</th><th>RMSE "
+       "um</th>"
        "<th>std um</th><th>max um</th></tr>\n";
   std::ostringstream plots;
   for (const RunPrediction& p : preds) {
     const std::string slug = Slug(p.run);
-    w.File(slug + "_prediction.csv", PredictionCsv(p, Comments(provenance, "prediction of " + p.run)));
+    w.File(slug + "_prediction.csv",
+           PredictionCsv(p, Comments(provenance, "prediction of " + p.run)));
     if (p.has_measured) {
       h << StatsRow(p.run + " (model)", ComputeErrorStats(p.measured_um - p.predicted_um))
         << StatsRow(p.run + " (no compensation)", ComputeErrorStats(p.measured_um));
@@ -184,13 +219,16 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
     if (p.has_measured)
       gp << ", '' using " << xcol << ":5 with lines lc rgb 'black' title 'measured'";
     gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
-    if (p.has_measured) gp << "plot " << GnuplotString(slug + "_prediction.csv") << " using " << xcol
-                           << ":6 with lines lc rgb 'red' title 'residual'\n";
-    else gp << "plot 0 notitle\n";
+    if (p.has_measured)
+      gp << "plot " << GnuplotString(slug + "_prediction.csv") << " using " << xcol
+         << ":6 with lines lc rgb 'red' title 'residual'\n";
+    else
+      gp << "plot 0 notitle\n";
     gp << "unset multiplot\n";
     plots << "<h3>" << HtmlEscape(p.run) << "</h3>\n";
     for (const auto& warn : p.warnings) plots << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
-    plots << w.Plot(slug + "_prediction", gp.str(), "measured and predicted error of " + p.run) << "\n";
+    plots << w.Plot(slug + "_prediction", gp.str(), "measured and predicted error of " + p.run)
+          << "\n";
   }
   h << "</table>\n" << plots.str();
   for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
@@ -198,8 +236,7 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   return w.Finish(h.str());
 }
 
-DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log,
-                                     const HoldoutResult& r,
+DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const HoldoutResult& r,
                                      const std::vector<std::string>& provenance,
                                      const std::string& gnuplot) {
   ReportWriter w(dir, gnuplot);
@@ -226,23 +263,27 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log,
       rows.push_back(std::move(row));
     }
     const std::string slug = Slug(ch);
-    w.File(slug + "_holdout.csv", FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
+    w.File(slug + "_holdout.csv",
+           FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
     std::ostringstream gp;
     gp << "set datafile separator ','\nset key outside right\nset grid\nset xlabel 'time [h]'\n"
        << "set arrow from " << r.train_end_min / 60 << ", graph 0 to " << r.train_end_min / 60
        << ", graph 1 nohead dt 2\nset multiplot layout 2,1\nset ylabel 'error [um]'\nset title "
        << GnuplotString(ch + ": measured and predicted (dashed line: end of training)") << "\nplot "
-       << GnuplotString(slug + "_holdout.csv") << " using ($1/60):2 with lines lc rgb 'black' lw 2 title 'measured'";
+       << GnuplotString(slug + "_holdout.csv")
+       << " using ($1/60):2 with lines lc rgb 'black' lw 2 title 'measured'";
     for (std::size_t c = 1; c < idx.size(); ++c)
       gp << ", '' using ($1/60):" << c + 3 << " with lines lc " << c << " title "
          << GnuplotString(r.rows_out[idx[c]].method);
     gp << ", '' using ($1/60):2 with lines lc rgb 'black' lw 2 notitle";
     gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\nplot ";
     for (std::size_t c = 1; c < idx.size(); ++c)
-      gp << (c > 1 ? ", " : "") << GnuplotString(slug + "_holdout.csv") << " using ($1/60):($2-$" << c + 3
-         << ") with lines lc " << c << " title " << GnuplotString(r.rows_out[idx[c]].method);
+      gp << (c > 1 ? ", " : "") << GnuplotString(slug + "_holdout.csv") << " using ($1/60):($2-$"
+         << c + 3 << ") with lines lc " << c << " title "
+         << GnuplotString(r.rows_out[idx[c]].method);
     gp << "\nunset multiplot\n";
-    h << "<h2>" << HtmlEscape(ch) << "</h2>\n" << w.Plot(slug + "_holdout", gp.str(), "hold-out of " + ch) << "\n";
+    h << "<h2>" << HtmlEscape(ch) << "</h2>\n"
+      << w.Plot(slug + "_holdout", gp.str(), "hold-out of " + ch) << "\n";
   }
   for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
   h << "</body></html>\n";

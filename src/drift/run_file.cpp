@@ -9,12 +9,14 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/safe_text.h"
 
 namespace whirl::drift {
 namespace {
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() > suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 std::string Trim(const std::string& s) {
@@ -64,8 +66,8 @@ TimePrepass PrepareTime(const std::string& text, const std::string& source) {
           const std::string name = Trim(cells[i]);
           if (name != "time_s" && name != "time_min") continue;
           if (time_index >= 0)
-            throw InputError(source + ":" + std::to_string(line_no) +
-                             ": two time columns ('" + p.time_column + "' and '" + name +
+            throw InputError(source + ":" + std::to_string(line_no) + ": two time columns ('" +
+                             p.time_column + "' and '" + name +
                              "'): give time_s or time_min, not both");
           time_index = static_cast<int>(i);
           p.time_column = name;
@@ -106,9 +108,12 @@ int FindIndex(const std::vector<std::string>& names, const std::string& name,
 
 std::string ToString(RunState s) {
   switch (s) {
-    case RunState::kIdle: return "idle";
-    case RunState::kCutting: return "cutting";
-    case RunState::kUnknown: break;
+    case RunState::kIdle:
+      return "idle";
+    case RunState::kCutting:
+      return "cutting";
+    case RunState::kUnknown:
+      break;
   }
   return "unknown";
 }
@@ -161,8 +166,9 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
   const TimePrepass prep = PrepareTime(text, source);
   const CsvTable t = ParseCsv(prep.text, source);
   if (t.rows.size() > static_cast<std::size_t>(kMaxRunSamples))
-    throw InputError(source + ": " + std::to_string(t.rows.size()) + " rows: a run file holds at most " +
-                     std::to_string(kMaxRunSamples) + " (split the log into runs)");
+    throw InputError(source + ": " + std::to_string(t.rows.size()) +
+                     " rows: a run file holds at most " + std::to_string(kMaxRunSamples) +
+                     " (split the log into runs)");
   if (t.header.size() > static_cast<std::size_t>(kMaxRunColumns))
     throw InputError(source + ": " + std::to_string(t.header.size()) +
                      " columns: a run file holds at most " + std::to_string(kMaxRunColumns));
@@ -187,7 +193,8 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
     }
   }
   if (s_cols.empty())
-    throw InputError(source + ": no temperature column (a name ending in _C, degC) in the header (" +
+    throw InputError(source +
+                     ": no temperature column (a name ending in _C, degC) in the header (" +
                      Join(t.header) + ")");
   const std::size_t q = t.rows.size();
   const auto n = static_cast<Eigen::Index>(q);
@@ -238,6 +245,31 @@ std::string FormatRun(const Run& run, const std::vector<std::string>& comments) 
       for (Eigen::Index j = 0; j < m->cols(); ++j) row.push_back((*m)(k, j));
   }
   return FormatCsv(header, rows, comments);
+}
+
+std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
+                                             const std::vector<Run>& runs,
+                                             const std::vector<std::string>& comments) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError("run directory '" + dir.string() + "': " + ec.message());
+  std::vector<std::filesystem::path> paths, temps;
+  try {
+    for (const Run& r : runs) {
+      paths.push_back(dir / (Slug(r.name) + ".csv"));
+      temps.push_back(dir / (Slug(r.name) + ".csv.partial"));
+      std::vector<std::string> c{r.name + ": lines " + std::to_string(r.line_numbers.front()) +
+                                 " to " + std::to_string(r.line_numbers.back()) + " of " +
+                                 r.source};
+      c.insert(c.end(), comments.begin(), comments.end());
+      WriteFileAtomic(temps.back(), FormatRun(r, c));
+    }
+    for (std::size_t i = 0; i < paths.size(); ++i) std::filesystem::rename(temps[i], paths[i]);
+  } catch (...) {
+    for (const auto& t : temps) std::filesystem::remove(t, ec);
+    throw;
+  }
+  return paths;
 }
 
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold) {

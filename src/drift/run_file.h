@@ -40,7 +40,7 @@ struct Run {
   RunState state = RunState::kUnknown;
   /// Time of each sample [min]; the sample index when time_from_index.
   std::vector<double> time_min;
-  bool time_from_index = false;  ///< true: the file recorded no (complete) time column
+  bool time_from_index = false;   ///< true: the file recorded no (complete) time column
   std::vector<int> line_numbers;  ///< 1-based file line of each sample
 
   std::vector<std::string> sensor_names;  ///< the `_C` columns, in file order
@@ -75,6 +75,14 @@ Run ReadRun(const std::filesystem::path& path, RunState state);
 /// Writes a run back in the same format (time_min column, or none when time_from_index) with
 /// optional comment lines (the caller writes it with WriteFileAtomic).
 std::string FormatRun(const Run& run, const std::vector<std::string>& comments = {});
+
+/// Writes each run as <dir>/<Slug(name)>.csv (FormatRun with `comments` plus the run's own
+/// source lines), creating `dir`. All or nothing: every file is first written to a temporary
+/// name; only when all succeeded are they renamed, otherwise the temporaries are removed and the
+/// InputError is rethrown. Returns the paths in run order.
+std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
+                                             const std::vector<Run>& runs,
+                                             const std::vector<std::string>& comments);
 
 /// Cuts one long log into runs, a new run starting at every sample where `column` (an `other`
 /// column such as spindle_rpm) changes from <= threshold to > threshold (a machine start). The

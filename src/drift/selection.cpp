@@ -42,7 +42,9 @@ std::vector<int> BestPerClass(const std::vector<int>& labels, const Eigen::Vecto
 // Picks the partition by the options' rule; returns -1 (every sensor a class) if none qualifies.
 int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions& o,
                     std::string* message) {
-  auto eligible = [&](const Partition& p) { return o.max_classes <= 0 || p.classes <= o.max_classes; };
+  auto eligible = [&](const Partition& p) {
+    return o.max_classes <= 0 || p.classes <= o.max_classes;
+  };
   auto best_margin = [&]() {
     int best = -1;
     for (std::size_t i = 0; i < parts.size(); ++i)
@@ -96,9 +98,12 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
 
 std::string ToString(ClassCountRule r) {
   switch (r) {
-    case ClassCountRule::kLargestMargin: return "margin";
-    case ClassCountRule::kFixed: return "fixed";
-    case ClassCountRule::kFewestSignificant: break;
+    case ClassCountRule::kLargestMargin:
+      return "margin";
+    case ClassCountRule::kFixed:
+      return "fixed";
+    case ClassCountRule::kFewestSignificant:
+      break;
   }
   return "fewest";
 }
@@ -111,8 +116,7 @@ ClassCountRule ParseClassCountRule(const std::string& s) {
 }
 
 void SelectionOptions::Validate() const {
-  if (!(alpha > 0 && alpha < 1))
-    throw InputError("alpha " + Num(alpha) + ": must be in (0, 1)");
+  if (!(alpha > 0 && alpha < 1)) throw InputError("alpha " + Num(alpha) + ": must be in (0, 1)");
   if (!(rho > 0 && rho <= 1)) throw InputError("rho " + Num(rho) + ": must be in (0, 1]");
   if (rule == ClassCountRule::kFixed && fixed_classes < 1)
     throw InputError("fixed class count " + std::to_string(fixed_classes) + ": must be >= 1");
@@ -192,8 +196,10 @@ Eigen::MatrixXd ZScore(const Eigen::MatrixXd& series) {
   Eigen::MatrixXd z = series.rowwise() - series.colwise().mean();
   for (Eigen::Index j = 0; j < z.cols(); ++j) {
     const double sd = std::sqrt(z.col(j).squaredNorm() / static_cast<double>(z.rows()));
-    if (sd > 0) z.col(j) /= sd;
-    else z.col(j).setZero();
+    if (sd > 0)
+      z.col(j) /= sd;
+    else
+      z.col(j).setZero();
   }
   return z;
 }
@@ -250,8 +256,7 @@ Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& err
   if (m < 1 || rises.rows() < 3 || error.size() != rises.rows() ||
       static_cast<int>(sensor_names.size()) != m)
     throw InputError("sensor selection needs at least 1 sensor and 3 samples (have " +
-                     std::to_string(m) + " sensors, " + std::to_string(rises.rows()) +
-                     " samples)");
+                     std::to_string(m) + " sensors, " + std::to_string(rises.rows()) + " samples)");
   Selection s;
   s.sensor_names = sensor_names;
   s.similarity = SimilarityMatrix(rises);
@@ -272,8 +277,8 @@ Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& err
   s.grades = GreyGrades(rises, error, options.rho);
   s.chosen_partition = ChoosePartition(s.partitions, options, &s.message);
   if (s.chosen_partition >= 0) {
-    s.chosen = BestPerClass(s.partitions[static_cast<std::size_t>(s.chosen_partition)].labels,
-                            s.grades);
+    s.chosen =
+        BestPerClass(s.partitions[static_cast<std::size_t>(s.chosen_partition)].labels, s.grades);
   } else {
     std::vector<int> order(static_cast<std::size_t>(m));
     for (int i = 0; i < m; ++i) order[static_cast<std::size_t>(i)] = i;
@@ -293,8 +298,8 @@ void StackRuns(const std::vector<Run>& runs, const std::string& error_column,
   Eigen::Index total = 0;
   for (const Run& r : runs) {
     if (r.sensor_names != runs.front().sensor_names)
-      throw InputError(r.source + ": its temperature columns differ from " +
-                       runs.front().source + "'s (runs must log the same sensors)");
+      throw InputError(r.source + ": its temperature columns differ from " + runs.front().source +
+                       "'s (runs must log the same sensors)");
     r.ErrorIndex(error_column);
     total += r.samples();
   }

@@ -44,7 +44,7 @@
 namespace whirl::drift {
 
 enum class ClassCountRule { kFewestSignificant, kLargestMargin, kFixed };
-std::string ToString(ClassCountRule r);                  ///< "fewest", "margin", "fixed"
+std::string ToString(ClassCountRule r);                    ///< "fewest", "margin", "fixed"
 ClassCountRule ParseClassCountRule(const std::string& s);  ///< inverse; InputError otherwise
 
 struct SelectionOptions {

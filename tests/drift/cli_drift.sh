@@ -76,6 +76,13 @@ grep -q '"method": "dynamic"' "$D/ho.json" || fail "holdout methods"
 [ -f "$D/report/index.html" ] || fail "report has no index.html"
 grep -q "<script>" "$D/report/index.html" && fail "run name reached the HTML unescaped"
 grep -q "&lt;script&gt;x" "$D/report/index.html" || fail "escaped run name missing"
+if command -v gnuplot > /dev/null; then  # the hostile name reached gnuplot's titles safely
+  ls "$D/report/"*script*_prediction.png > /dev/null 2>&1 || fail "no plot for the hostile run name"
+  # a relative --out (gnuplot runs inside the report directory)
+  (cd "$D" && "$W" drift report --train-idle idle1.csv --error err_um --out rel > /dev/null 2>&1) \
+    || fail "report with a relative --out"
+  [ -f "$D/rel/idle1_prediction.png" ] || fail "relative --out: plot not rendered"
+fi
 
 # Bad input: clear errors, nothing written.
 printf 'time_min,a_C,err_um\n0,20,0\n1,abc,1\n' > "$D/bad.csv"

@@ -14,9 +14,12 @@ namespace whirl::drift::synth {
 /// (a fast first-order rise, a slow ramp with a cool-down, an oscillation).
 inline double Latent(int k, double t) {
   switch (k % 3) {
-    case 0: return 8.0 * (1.0 - std::exp(-t / 20.0));
-    case 1: return t < 150 ? t / 25.0 : 6.0 - (t - 150) / 30.0;
-    default: return 3.0 * std::sin(t / 25.0) + 0.01 * t;
+    case 0:
+      return 8.0 * (1.0 - std::exp(-t / 20.0));
+    case 1:
+      return t < 150 ? t / 25.0 : 6.0 - (t - 150) / 30.0;
+    default:
+      return 3.0 * std::sin(t / 25.0) + 0.01 * t;
   }
 }
 
@@ -43,7 +46,8 @@ inline Run PlantedRun(unsigned seed, int groups, int per_group, const std::vecto
     double e = 0;
     for (int k = 0; k < groups; ++k) {
       for (int j = 0; j < per_group; ++j)
-        r.temperature_C(q, k * per_group + j) = 20.0 + (0.6 + 0.4 * j) * Latent(k, t) + noise * n01(rng);
+        r.temperature_C(q, k * per_group + j) =
+            20.0 + (0.6 + 0.4 * j) * Latent(k, t) + noise * n01(rng);
       e += weights[static_cast<std::size_t>(k)] * Latent(k, t);
     }
     r.error_um(q, 0) = e + error_noise * n01(rng);

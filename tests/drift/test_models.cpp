@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
-#include <set>
 #include <random>
+#include <set>
 
 #include "core/error.h"
 #include "drift/evaluation.h"
@@ -74,7 +74,8 @@ TEST(FirstOrderLag, StepResponseIsTheClosedForm) {
   Eigen::VectorXd x = Eigen::VectorXd::Ones(6);
   x(0) = 0;
   const Eigen::VectorXd y = FirstOrderLag(x, t, 4.0);
-  for (int k = 1; k < 6; ++k) EXPECT_NEAR(y(k), 1 - std::exp(-t[static_cast<std::size_t>(k)] / 4.0), 1e-15);
+  for (int k = 1; k < 6; ++k)
+    EXPECT_NEAR(y(k), 1 - std::exp(-t[static_cast<std::size_t>(k)] / 4.0), 1e-15);
 }
 
 TEST(DriftModel, EvaluatorEqualsBatchFeaturesAndFileRoundTrips) {
@@ -162,7 +163,10 @@ TEST(CrossRun, GroupsByStateAndNoCompensationIsTheErrorItself) {
   EXPECT_EQ(names, (std::set<std::string>{"own run", "idle on idle", "idle on cutting",
                                           "cutting on idle", "cutting on cutting"}));
   for (const auto& g : r.groups)
-    EXPECT_EQ(g.pairs, g.name == "own run" ? 4 : g.name == "idle on idle" || g.name == "cutting on cutting" ? 2 : 4) << g.name;
+    EXPECT_EQ(g.pairs, g.name == "own run"                                          ? 4
+                       : g.name == "idle on idle" || g.name == "cutting on cutting" ? 2
+                                                                                    : 4)
+        << g.name;
   const ErrorStats e = ComputeErrorStats(runs[2].error_um.col(0));
   EXPECT_EQ(r.cells[0][2].none.rmse_um, e.rmse_um);
   // The same physics in every run: every model predicts the others to the noise level.
@@ -173,9 +177,9 @@ TEST(CrossRun, GroupsByStateAndNoCompensationIsTheErrorItself) {
 TEST(Holdout, FlThermalBeatsXgboostWithAtMostFourSensorsAndACycleModel) {
   // ${WHIRL_SOURCE_DIR}/../shared as in CI; WHIRL_FL_THERMAL overrides (e.g. a git worktree).
   const char* env = std::getenv("WHIRL_FL_THERMAL");
-  const std::filesystem::path data =
-      env ? std::filesystem::path(env)
-          : std::filesystem::path(WHIRL_SOURCE_DIR) / ".." / "shared" / "data" / "fl_thermal" / "data.csv";
+  const std::filesystem::path data = env ? std::filesystem::path(env)
+                                         : std::filesystem::path(WHIRL_SOURCE_DIR) / ".." /
+                                               "shared" / "data" / "fl_thermal" / "data.csv";
   if (!std::filesystem::exists(data)) GTEST_SKIP() << "FL_THERMAL data absent: " << data;
   const drift::Run log = ReadRun(data, RunState::kUnknown);
   HoldoutOptions o;
@@ -183,7 +187,8 @@ TEST(Holdout, FlThermalBeatsXgboostWithAtMostFourSensorsAndACycleModel) {
   o.network = false;
   const HoldoutResult r = Holdout(log, o);
   // The source's XGBoost test MAE (its README): ch1 5.611, ch3 6.039, ch5 9.535 um.
-  const std::map<std::string, double> xgboost{{"ch1_um", 5.611}, {"ch3_um", 6.039}, {"ch5_um", 9.535}};
+  const std::map<std::string, double> xgboost{
+      {"ch1_um", 5.611}, {"ch3_um", 6.039}, {"ch5_um", 9.535}};
   for (const auto& row : r.rows_out) {
     if (row.method != "dynamic") continue;
     EXPECT_LE(row.inputs.size(), 4u);

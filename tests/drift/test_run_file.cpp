@@ -1,5 +1,7 @@
-// drift::Run files: columns by suffix, time in s or min or missing, and clear errors for bad files.
+// Run files: columns by suffix, time in s or min or missing, and clear errors for bad files.
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "core/error.h"
 #include "drift/run_file.h"
@@ -17,9 +19,10 @@ std::string ErrorOf(const std::string& text) {
 }
 
 TEST(RunFile, ColumnsBySuffixAndTimeInMinutes) {
-  const drift::Run r = ParseRun("# test\ntime_s,a_C,b_C,x_um,spindle_rpm\n0,20,21,0,0\n60,21,22,1.5,1000\n"
-                         "120,22,22.5,2,1000\n",
-                         "dir/r.csv", RunState::kCutting);
+  const drift::Run r = ParseRun(
+      "# test\ntime_s,a_C,b_C,x_um,spindle_rpm\n0,20,21,0,0\n60,21,22,1.5,1000\n"
+      "120,22,22.5,2,1000\n",
+      "dir/r.csv", RunState::kCutting);
   EXPECT_EQ(r.name, "r");
   EXPECT_EQ(r.state, RunState::kCutting);
   EXPECT_EQ(r.sensor_names, (std::vector<std::string>{"a_C", "b_C"}));
@@ -32,7 +35,8 @@ TEST(RunFile, ColumnsBySuffixAndTimeInMinutes) {
 }
 
 TEST(RunFile, MissingTimeUsesTheSampleIndex) {
-  const drift::Run r = ParseRun("time_min,a_C,e_um\n0,20,0\nnan,21,1\n,22,2\n", "r.csv", RunState::kIdle);
+  const drift::Run r =
+      ParseRun("time_min,a_C,e_um\n0,20,0\nnan,21,1\n,22,2\n", "r.csv", RunState::kIdle);
   EXPECT_TRUE(r.time_from_index);
   EXPECT_EQ(r.time_min, (std::vector<double>{0, 1, 2}));
   const drift::Run none = ParseRun("a_C,e_um\n20,0\n21,1\n", "r.csv", RunState::kIdle);
@@ -81,6 +85,30 @@ TEST(RunFile, SplitAtStartsAndFormatRoundTrip) {
   EXPECT_EQ(back.error_um, runs[1].error_um);
   EXPECT_EQ(back.time_min, runs[1].time_min);
   EXPECT_EQ(ErrorsFromStart(back).error_um(0, 0), 0.0);
+}
+
+}  // namespace
+}  // namespace whirl::drift
+
+namespace whirl::drift {
+namespace {
+
+TEST(RunFile, WriteRunsIsAllOrNothing) {
+  const auto dir = std::filesystem::temp_directory_path() / "whirl_test_write_runs";
+  std::filesystem::remove_all(dir);
+  const drift::Run log =
+      ParseRun("time_s,a_C,e_um\n0,20,0\n60,21,1\n120,22,2\n", "log.csv", RunState::kIdle);
+  std::vector<drift::Run> runs{log.Slice(0, 2, "a"), log.Slice(2, 3, "b")};
+  // The second file cannot be written (a directory sits at its temporary name).
+  std::filesystem::create_directories(dir / "b.csv.partial");
+  EXPECT_THROW(WriteRuns(dir, runs, {}), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.csv.partial"));
+  std::filesystem::remove_all(dir / "b.csv.partial");
+  const auto paths = WriteRuns(dir, runs, {"test"});
+  ASSERT_EQ(paths.size(), 2u);
+  EXPECT_EQ(ReadRun(paths[1], RunState::kIdle).temperature_C(0, 0), 22.0);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
