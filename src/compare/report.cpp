@@ -190,6 +190,9 @@ std::string FormatComparisonTable(const ScrewComparison& c) {
                   o.strategy == Strategy::kModel ? "" : Pct(r).c_str());
     s << buf;
   }
+  s << "  ISO 3408-3 class reached:";
+  for (const auto& o : c.outcomes) s << " " << ToString(o.strategy) << " " << ToString(o.iso.reached);
+  s << "\n";
   return s.str();
 }
 
