@@ -134,9 +134,7 @@ void RunDemo(const DemoOptions& o) {
               report.plots_rendered ? "with plots" : "plots skipped");
   std::printf("summary:");
   for (const auto& c : results) {
-    const auto um = [&c](compare::Strategy s) {
-      return c.Outcome(s).metrics.accumulated_1000_um;
-    };
+    const auto um = [&c](compare::Strategy s) { return c.Outcome(s).metrics.accumulated_1000_um; };
     const auto& r = c.model_vs_traditional;
     std::printf(
         " %s: accumulated lead error within 1000 mm %.1f um (model), %.1f um (regression), "

@@ -246,14 +246,15 @@ void RegisterEvaluate(CLI::App& app) {
   auto o = std::make_shared<EvaluateCliOptions>();
   auto* sub = app.add_subcommand(
       "evaluate",
-      "Run 'whirl compare' (strategies none, ramp, traditional, regression, model) over many "
-      "screws: the rows of the validation table and N random\n"
-      "feasible screws (inputs uniform in the paper's training ranges; blank, thread and machine\n"
-      "settings of the base screw), each truth with its own seeded disturbances\n"
-      "(MixSeed(--seed, index)). Prints one line per screw and the median and worst reduction of\n"
-      "the accumulated lead error (within 1000 mm and over the thread) per strategy in um, the\n"
-      "reductions of the model against each baseline, and the share of screws reaching ISO 3408-3 P3 and P5 per\n"
-      "strategy. Uses --threads worker threads; results do not depend on the thread count.");
+      "Run 'whirl compare' (strategies none, ramp, traditional, regression, model) over many\n"
+      "screws: the rows of the validation table and N random feasible screws (inputs uniform in\n"
+      "the paper's training ranges; blank, thread and machine settings of the base screw), each\n"
+      "truth with its own seeded disturbances (MixSeed(--seed, index)). Prints one line per screw,\n"
+      "then per strategy the median and worst accumulated lead error [um] within 1000 mm and over\n"
+      "the thread and the share reaching ISO 3408-3 P3 and P5, the gain breakdown (curve shape,\n"
+      "five inputs, network) and the model's reductions against each baseline. --scenarios runs\n"
+      "named truth scenarios instead. Uses --threads worker threads; results do not depend on the\n"
+      "thread count.");
   sub->add_option("--model", o->model_path, "model file (default models/default.json)")
       ->check(CLI::ExistingFile);
   sub->add_option(

@@ -159,10 +159,10 @@ std::string MetricsTable(const ScrewComparison& c) {
        "<th>ISO class</th><th>model vs it, 1000 mm</th></tr>\n";
   for (const auto& o : c.outcomes) {
     const auto r = Reductions(m.metrics, o.metrics).accumulated_1000_pct;
-    h << "<tr><td>" << ToString(o.strategy) << "</td><td>" << Fixed(o.metrics.accumulated_1000_um, 2)
-      << "</td><td>" << Fixed(o.metrics.accumulated_total_um, 2) << "</td><td>"
-      << ToString(o.iso.reached) << "</td><td>" << (o.strategy == Strategy::kModel ? "" : Pct(r))
-      << "</td></tr>\n";
+    h << "<tr><td>" << ToString(o.strategy) << "</td><td>"
+      << Fixed(o.metrics.accumulated_1000_um, 2) << "</td><td>"
+      << Fixed(o.metrics.accumulated_total_um, 2) << "</td><td>" << ToString(o.iso.reached)
+      << "</td><td>" << (o.strategy == Strategy::kModel ? "" : Pct(r)) << "</td></tr>\n";
   }
   h << "</table>\n<p class='small'>ramp: class plateau ramped in linearly (the previous rule); "
        "traditional: class mean plateau and settle time with the model's curve shape and plan; "
@@ -178,8 +178,7 @@ std::string FormatComparisonTable(const ScrewComparison& c) {
   std::ostringstream s;
   char buf[256];
   std::snprintf(buf, sizeof buf, "  %-12s %14s %14s %8s %8s %8s %10s %14s\n", "strategy",
-                "1000 mm [um]", "thread [um]", "e_a", "v_u", "v_300", "ISO class",
-                "model vs it");
+                "1000 mm [um]", "thread [um]", "e_a", "v_u", "v_300", "ISO class", "model vs it");
   s << buf;
   for (const auto& o : c.outcomes) {
     const auto r = Reductions(m.metrics, o.metrics).accumulated_1000_pct;
@@ -191,7 +190,8 @@ std::string FormatComparisonTable(const ScrewComparison& c) {
     s << buf;
   }
   s << "  ISO 3408-3 class reached:";
-  for (const auto& o : c.outcomes) s << " " << ToString(o.strategy) << " " << ToString(o.iso.reached);
+  for (const auto& o : c.outcomes)
+    s << " " << ToString(o.strategy) << " " << ToString(o.iso.reached);
   s << "\n";
   return s.str();
 }

@@ -11,8 +11,11 @@ namespace whirl::compare {
 std::vector<Scenario> NamedScenarios() {
   const sim::DisturbanceOptions today;  // the library defaults (header of sim/simulator.h)
   std::vector<Scenario> s;
-  s.push_back({"today", "heat partition std 3 %, alpha std 2 %, drift std 0.2 K/h, noise 0.25 um",
-               today, {}, false});
+  s.push_back({"today",
+               "heat partition std 3 %, alpha std 2 %, drift std 0.2 K/h, noise 0.25 um",
+               today,
+               {},
+               false});
   Scenario heat{"heat-spread", "heat partition std 12.5 % (10-15 %), rest as today", today, {}};
   heat.disturbance.heat_partition_rel_std = 0.125;
   s.push_back(heat);
@@ -22,8 +25,8 @@ std::vector<Scenario> NamedScenarios() {
   Scenario wear{"tool-wear", "heat input +20 % linearly over the cut, rest as today", today, {}};
   wear.disturbance.tool_wear_heat_rise_rel = 0.20;
   s.push_back(wear);
-  Scenario rest{"steady-rest", "60 W rest friction 300 mm ahead of the cut, rest as today", today,
-                {}};
+  Scenario rest{
+      "steady-rest", "60 W rest friction 300 mm ahead of the cut, rest as today", today, {}};
   rest.disturbance.steady_rest_heat_w = 60.0;
   s.push_back(rest);
   Scenario out{"out-of-range",
@@ -82,8 +85,8 @@ std::vector<sim::Screw> ScenarioScrews(const Scenario& scenario, const sim::Scre
   }
   if (static_cast<int>(screws.size()) < count)
     throw InputError("scenario " + scenario.name + ": fewer than " + std::to_string(count) +
-                     " screws outside the training ranges among " +
-                     std::to_string(draws.size()) + " draws");
+                     " screws outside the training ranges among " + std::to_string(draws.size()) +
+                     " draws");
   return screws;
 }
 
@@ -120,8 +123,9 @@ std::string FormatScenarioTable(const std::vector<ScenarioResult>& results, bool
   std::string out;
   char buf[256];
   if (markdown) {
-    out += "| scenario | strategy | 1000 mm median um | 1000 mm worst um | thread median um | "
-           "thread worst um |\n|---|---|---|---|---|---|\n";
+    out +=
+        "| scenario | strategy | 1000 mm median um | 1000 mm worst um | thread median um | "
+        "thread worst um |\n|---|---|---|---|---|---|\n";
   } else {
     std::snprintf(buf, sizeof buf, "%-14s %-12s %18s %18s %18s %18s\n", "scenario", "strategy",
                   "1000 mm median um", "1000 mm worst um", "thread median um", "thread worst um");
@@ -132,9 +136,8 @@ std::string FormatScenarioTable(const std::vector<ScenarioResult>& results, bool
       const AbsoluteStats& a = r.summary.absolute[k];
       const char* fmt = markdown ? "| %s | %s | %.2f | %.1f | %.2f | %.1f |\n"
                                  : "%-14s %-12s %18.2f %18.1f %18.2f %18.1f\n";
-      std::snprintf(buf, sizeof buf, fmt, r.scenario.name.c_str(),
-                    ToString(kStrategies[k]).c_str(), a.acc1000_median_um, a.acc1000_worst_um,
-                    a.total_median_um, a.total_worst_um);
+      std::snprintf(buf, sizeof buf, fmt, r.scenario.name.c_str(), ToString(kStrategies[k]).c_str(),
+                    a.acc1000_median_um, a.acc1000_worst_um, a.total_median_um, a.total_worst_um);
       out += buf;
     }
   }

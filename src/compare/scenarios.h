@@ -32,7 +32,7 @@ struct Scenario {
   std::string name;
   std::string description;  ///< the levels, one line
   sim::DisturbanceOptions disturbance;
-  InputRanges ranges;        ///< random screws are drawn here
+  InputRanges ranges;         ///< random screws are drawn here
   bool out_of_range = false;  ///< keep only screws outside the training ranges (extrapolates)
 };
 

@@ -174,11 +174,12 @@ void Model::Validate() const {
                      "', this version only knows 'normalized'");
   if (!(noise_variance >= 0) || !std::isfinite(noise_variance))
     throw InputError("model 'uncertainty.noise_variance_normalized' must be finite and >= 0");
-  if (output_noise_variance.size() != network.OutputCount() ||
-      !output_noise_variance.allFinite() || output_noise_variance.minCoeff() < 0)
-    throw InputError("model 'uncertainty.output_noise_variance_normalized' needs one finite value "
-                     ">= 0 per output (" +
-                     std::to_string(network.OutputCount()) + ")");
+  if (output_noise_variance.size() != network.OutputCount() || !output_noise_variance.allFinite() ||
+      output_noise_variance.minCoeff() < 0)
+    throw InputError(
+        "model 'uncertainty.output_noise_variance_normalized' needs one finite value "
+        ">= 0 per output (" +
+        std::to_string(network.OutputCount()) + ")");
   const int N = network.ParameterCount();
   if (posterior_covariance.rows() != N || posterior_covariance.cols() != N)
     throw InputError("model 'uncertainty.posterior_covariance' must be " + std::to_string(N) + "x" +
@@ -230,12 +231,12 @@ void to_json(nlohmann::json& j, const Model& m) {
                              {"options", OptionsJson(m.train_options)}}},
            {"seed", m.seed},
            {"error_space", m.error_space},
-           {"uncertainty", json{{"method", "laplace"},
-                                {"noise_variance_normalized", m.noise_variance},
-                                {"output_noise_variance_normalized",
-                                 VectorJson(m.output_noise_variance)},
-                                {"noise_calibration", m.noise_calibration},
-                                {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
+           {"uncertainty",
+            json{{"method", "laplace"},
+                 {"noise_variance_normalized", m.noise_variance},
+                 {"output_noise_variance_normalized", VectorJson(m.output_noise_variance)},
+                 {"noise_calibration", m.noise_calibration},
+                 {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
 }
 
 void from_json(const nlohmann::json& j, Model& m) {
@@ -361,9 +362,8 @@ void from_json(const nlohmann::json& j, Model& m) {
                        std::to_string(S) + " numbers, got " + v.dump());
     m.output_noise_variance.resize(S);
     for (int k = 0; k < S; ++k)
-      m.output_noise_variance(k) =
-          RequireFinite(v[k], "model 'uncertainty.output_noise_variance_normalized[" +
-                                  std::to_string(k) + "]'");
+      m.output_noise_variance(k) = RequireFinite(
+          v[k], "model 'uncertainty.output_noise_variance_normalized[" + std::to_string(k) + "]'");
     const json& c = Require(u, "noise_calibration", "model 'uncertainty'");
     if (!c.is_string()) throw InputError("model 'uncertainty.noise_calibration' must be a string");
     m.noise_calibration = c.get<std::string>();
@@ -527,8 +527,9 @@ void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& op
       for (int k = 0; k < S; ++k) {
         const double r = (truth[k] - mean[k]) / half(k);
         // Weight part of the fold model's variance, in the full model's normalized units.
-        const double v = (sd[k] * sd[k] - fm.output_noise_variance(k) * fold_half(k) * fold_half(k)) /
-                         (half(k) * half(k));
+        const double v =
+            (sd[k] * sd[k] - fm.output_noise_variance(k) * fold_half(k) * fold_half(k)) /
+            (half(k) * half(k));
         r2[k].push_back(r * r);
         var_w[k].push_back(std::max(v, 0.0));
       }
@@ -553,7 +554,8 @@ void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& op
     model->output_noise_variance(k) = hi;
   }
   model->noise_calibration =
-      std::to_string(folds) + "-fold cross-validation on the training table: per output the "
+      std::to_string(folds) +
+      "-fold cross-validation on the training table: per output the "
       "smallest noise variance at which +-1 sigma (noise + weight variance of the fold model) "
       "covers 68.27 % of the held-out errors";
 }

@@ -251,7 +251,10 @@ ShapeFit FitShape(const ElongationCurve& c, const SettleOptions& o) {
   for (int it = 0; it < 40; ++it) {
     const double x1 = b - g * (b - a), x2 = a + g * (b - a);
     const ShapeFit f1 = FitShapeAt(c, std::exp(x1), o), f2 = FitShapeAt(c, std::exp(x2), o);
-    if (f1.rms < f2.rms) b = x2; else a = x1;
+    if (f1.rms < f2.rms)
+      b = x2;
+    else
+      a = x1;
     if (f1.rms < best.rms) best = f1;
     if (f2.rms < best.rms) best = f2;
   }

@@ -77,8 +77,8 @@ enum class SettleMethod { kShapeFit, kBand };
 
 struct SettleOptions {
   SettleMethod method = SettleMethod::kShapeFit;  ///< see the header comment
-  double shape_k = 4.33;         ///< k of the fitted shape (= fit::kDefaultShapeK), -
-  double time_exponent = 0.882;  ///< p of the fitted shape (= fit::kDefaultTimeExponent), -
+  double shape_k = 4.33;             ///< k of the fitted shape (= fit::kDefaultShapeK), -
+  double time_exponent = 0.882;      ///< p of the fitted shape (= fit::kDefaultTimeExponent), -
   double tolerance_rel = 0.02;       ///< band half-width relative to the plateau, -
   double smoothing_window_s = 60.0;  ///< centred moving-average window, s
   /// Shortest fit window, as a part of the record (by time); also the first pass's window, -

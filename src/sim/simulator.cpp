@@ -255,8 +255,7 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
     const double w0 = std::max(0.0, t - 0.5 * dt), w1 = std::min(t_heat_end, t + 0.5 * dt);
     if (w1 > w0) {
       const double wear_rel = extra ? disturbances.tool_wear_heat_rise_rel : 0.0;
-      const double wear = 1.0 + wear_rel * 0.5 * (w0 + w1) /
-                                    std::max(t_heat_end, 1e-9);
+      const double wear = 1.0 + wear_rel * 0.5 * (w0 + w1) / std::max(t_heat_end, 1e-9);
       heat_in += deposit(q_w * wear, 0.0, w_m, w0, w1);
       heat_in += deposit(rest_w, rest_offset_m, rest_width_m, w0, w1);
     }

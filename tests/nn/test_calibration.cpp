@@ -58,10 +58,11 @@ void ExpectCalibrated(const char* name, const Model& m) {
     EXPECT_GE(c.two[k], 0.90) << name << " " << kTargetColumns[k];
     EXPECT_LE(c.two[k], 0.98) << name << " " << kTargetColumns[k];
   }
-  std::printf("[ figures  ] %s, %zu hold-out rows: +-1 sigma covers %.1f %% (max elongation) / "
-              "%.1f %% (settle time), +-2 sigma %.1f %% / %.1f %%\n",
-              name, HoldOut().inputs.size(), 100 * c.one[0], 100 * c.one[1], 100 * c.two[0],
-              100 * c.two[1]);
+  std::printf(
+      "[ figures  ] %s, %zu hold-out rows: +-1 sigma covers %.1f %% (max elongation) / "
+      "%.1f %% (settle time), +-2 sigma %.1f %% / %.1f %%\n",
+      name, HoldOut().inputs.size(), 100 * c.one[0], 100 * c.one[1], 100 * c.two[0],
+      100 * c.two[1]);
 }
 
 // As `whirl train --data datasets/whirling_train.csv --seed 1 --restarts 10`.

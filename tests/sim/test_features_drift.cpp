@@ -51,12 +51,13 @@ TEST(FeaturesDrift, ReferenceScrewWholeThreadSeeds1To20) {
     const double e = r.features.settle_time_s / undisturbed.settle_time_s - 1;
     worst = std::max(worst, std::abs(e));
     EXPECT_LT(std::abs(e), 0.10) << "seed " << seed << ", drift "
-                                 << r.disturbances.ambient_drift_k_per_h << " K/h: "
-                                 << AnalyzeSettle(r.curve).message;
+                                 << r.disturbances.ambient_drift_k_per_h
+                                 << " K/h: " << AnalyzeSettle(r.curve).message;
   }
-  std::printf("[ figures  ] reference screw, whole thread, seeds 1-20: undisturbed t_s %.0f s, "
-              "worst settle-time deviation %.1f %%\n",
-              undisturbed.settle_time_s, 100 * worst);
+  std::printf(
+      "[ figures  ] reference screw, whole thread, seeds 1-20: undisturbed t_s %.0f s, "
+      "worst settle-time deviation %.1f %%\n",
+      undisturbed.settle_time_s, 100 * worst);
 }
 
 // Property over screws inside and beyond the training ranges (diameter 32-125 mm, lead 5-20 mm,
@@ -100,10 +101,11 @@ TEST(FeaturesDrift, DisturbedCurvesGiveTheUndriftedFeatures) {
   EXPECT_GT(max_drift, 0.8);
   std::sort(settle_err.begin(), settle_err.end());
   std::sort(max_err.begin(), max_err.end());
-  std::printf("[ figures  ] %d cases, drift up to %.2f K/h: settle time |rel. error| median %.1f "
-              "%%, worst %.1f %%; max elongation median %.2f %%, worst %.2f %%\n",
-              kCases, max_drift, 100 * settle_err[kCases / 2], 100 * settle_err.back(),
-              100 * max_err[kCases / 2], 100 * max_err.back());
+  std::printf(
+      "[ figures  ] %d cases, drift up to %.2f K/h: settle time |rel. error| median %.1f "
+      "%%, worst %.1f %%; max elongation median %.2f %%, worst %.2f %%\n",
+      kCases, max_drift, 100 * settle_err[kCases / 2], 100 * settle_err.back(),
+      100 * max_err[kCases / 2], 100 * max_err.back());
 }
 
 }  // namespace
