@@ -17,7 +17,8 @@
 // 0.21 um/s within 10 s, as the heat spreads ahead of the cut), while a plain arctangent through the
 // same L and t_s starts at only 0.21 um/s and bends later; p < 1 makes the start steep and the bend
 // early (its infinite slope at t = 0 matters only in the first seconds). Over 25
-// simulated curves (whirl fit --simulated 25) the pooled least-squares fit gave p = 0.882 and
+// simulated curves (whirl fit --simulated 25, with the 2 % settle times used before issue 11) the
+// pooled least-squares fit gave p = 0.882 and
 // a median RMS residual of 0.059 um against 0.083 um for the best plain arctangent (k = 5.54);
 // the gain sits in the first minutes, the part of the curve that drives the accumulated lead
 // error: over 10 evaluation seeds (whirl evaluate --seeds 10, README) the median reduction within
