@@ -1,5 +1,5 @@
 // whirl compare: the lead error of one screw cut in the simulator without compensation, with the
-// traditional experience rule, and with the model-based 840D plan; optional HTML report.
+// history baselines (ramp, traditional, regression), and with the model-based 840D plan; report.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -73,9 +73,13 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
       "840D plan: %zu segments\n",
       c.prediction.mean.max_elongation_um, c.prediction.stddev.max_elongation_um,
       c.prediction.mean.settle_time_s, c.prediction.stddev.settle_time_s, c.plan.segments.size());
-  std::printf("traditional rule: %.1f um (class %.0f mm, %d past screws) ramped in over %.0f s\n",
+  std::printf("ramp rule: %.1f um (class %.0f mm, %d past screws) ramped in over %.0f s\n",
               c.experience_class.plateau_um, c.experience_class.nominal_diameter_mm,
               c.experience_class.screws, c.experience_ramp_time_s);
+  std::printf(
+      "traditional (class-mean curve): %.1f um, %.0f s; regression (log-linear): %.1f um, %.0f s\n",
+      c.traditional_features.max_elongation_um, c.traditional_features.settle_time_s,
+      c.regression_features.max_elongation_um, c.regression_features.settle_time_s);
   std::printf("%s", compare::FormatComparisonTable(c).c_str());
 }
 
@@ -85,14 +89,16 @@ void RegisterCompare(CLI::App& app) {
   auto o = std::make_shared<CompareCliOptions>();
   auto* sub = app.add_subcommand(
       "compare",
-      "Cut a screw in the simulator three times and compare the lead error: no compensation,\n"
-      "the traditional experience rule (per diameter class: the mean plateau elongation of the\n"
-      "past screws in --history, ramped in linearly over their mean settle time), and the\n"
-      "model-based 840D plan (predict -> arctangent curve -> SD43900/SD43910/SD43920).\n"
+      "Cut a screw in the simulator five times and compare the lead error: none (no\n"
+      "compensation); ramp (the old rule: the class's mean plateau of the past screws in\n"
+      "--history ramped in linearly over their mean settle time); traditional (the class's mean\n"
+      "plateau and settle time as an arctangent curve); regression (log-linear least squares of\n"
+      "both features on the five inputs of --history); model (the network's prediction). The\n"
+      "last three go through the same 840D plan (curve -> SD43900/SD43910/SD43920).\n"
       "The truth is the whole-thread simulation with seeded disturbances (--seed) the model\n"
       "never saw. Prints, in um, the accumulated lead error within any 1000 mm and over the\n"
       "thread, e_a, v_u, v_300, v_2pi, the ISO 3408-3 class reached and the reductions of the\n"
-      "model against traditional and none (100 (1 - model/baseline) %).");
+      "model against each strategy (100 (1 - model/baseline) %).");
   sub->add_option("--model", o->model_path, "model file (JSON, e.g. models/default.json)")
       ->required()
       ->check(CLI::ExistingFile);

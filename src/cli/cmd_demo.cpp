@@ -142,13 +142,15 @@ void RunDemo(const DemoOptions& o) {
               report.plots_rendered ? "with plots" : "plots skipped");
   std::printf("summary:");
   for (const auto& c : results) {
+    const auto um = [&c](compare::Strategy s) { return c.Outcome(s).metrics.accumulated_1000_um; };
     const auto& r = c.model_vs_traditional;
     std::printf(
-        " %s: accumulated lead error within 1000 mm %.1f um (model) vs %.1f um "
-        "(traditional), %.0f %% less;",
-        c.screw.name.c_str(), c.Outcome(compare::Strategy::kModel).metrics.accumulated_1000_um,
-        c.Outcome(compare::Strategy::kTraditional).metrics.accumulated_1000_um,
-        r.accumulated_1000_pct ? *r.accumulated_1000_pct : 0.0);
+        " %s: accumulated lead error within 1000 mm %.1f um (model), %.1f um (regression), "
+        "%.1f um (traditional), %.1f um (ramp), %.1f um (none); model %.0f %% less than "
+        "traditional;",
+        c.screw.name.c_str(), um(compare::Strategy::kModel), um(compare::Strategy::kRegression),
+        um(compare::Strategy::kTraditional), um(compare::Strategy::kRamp),
+        um(compare::Strategy::kNone), r.accumulated_1000_pct ? *r.accumulated_1000_pct : 0.0);
   }
   std::printf(" done in %.1f s\n", seconds);
 }

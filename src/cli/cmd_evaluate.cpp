@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/evaluate.h"
+#include "compare/scenarios.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "fit/arctan_curve.h"
@@ -33,25 +34,36 @@ struct EvaluateCliOptions {
   double time_exponent = fit::kDefaultTimeExponent;
   bool json = false;
   double require_median_pct = -1e300;
+  std::string scenarios;  ///< named scenarios (compare/scenarios.h), empty = the plain evaluation
+  bool allow_extrapolation = false;
+  bool markdown = false;
 };
 
-// The summary lines of one evaluation or of several pooled.
+// The summary lines of one evaluation or of several pooled: absolute micrometres first.
 void PrintSummary(const compare::EvaluationSummary& m) {
+  std::printf("%-12s %18s %18s %18s %18s %6s %6s\n", "strategy", "1000 mm median um",
+              "1000 mm worst um", "thread median um", "thread worst um", "P3", "P5");
+  for (std::size_t k = 0; k < compare::kStrategyCount; ++k) {
+    const auto& a = m.absolute[k];
+    std::printf("%-12s %18.2f %18.1f %18.2f %18.1f %5.0f%% %5.0f%%\n",
+                compare::ToString(compare::kStrategies[k]).c_str(), a.acc1000_median_um,
+                a.acc1000_worst_um, a.total_median_um, a.total_worst_um, 100 * m.share_p3[k],
+                100 * m.share_p5[k]);
+  }
+  const auto& abs = m.absolute;
   std::printf(
-      "accumulated error within 1000 mm, model vs traditional: median %.1f %%, worst "
-      "%.1f %%, best %.1f %%\n",
-      m.acc1000_vs_traditional.median_pct, m.acc1000_vs_traditional.worst_pct,
-      m.acc1000_vs_traditional.best_pct);
+      "gain breakdown, medians within 1000 mm: curve shape (ramp -> traditional) %.2f um, five "
+      "inputs (traditional -> regression) %.2f um, network over regression %.2f um\n",
+      abs[1].acc1000_median_um - abs[2].acc1000_median_um,
+      abs[2].acc1000_median_um - abs[3].acc1000_median_um,
+      abs[3].acc1000_median_um - abs[4].acc1000_median_um);
   std::printf(
-      "accumulated error over the thread, model vs traditional: median %.1f %%, worst "
+      "per-screw reduction within 1000 mm, model vs traditional: median %.1f %%, worst %.1f %%; "
+      "vs regression: median %.1f %%, worst %.1f %%; vs ramp: median %.1f %%; vs none: median "
       "%.1f %%\n",
-      m.total_vs_traditional.median_pct, m.total_vs_traditional.worst_pct);
-  std::printf("accumulated error within 1000 mm, model vs none: median %.1f %%, worst %.1f %%\n",
-              m.acc1000_vs_none.median_pct, m.acc1000_vs_none.worst_pct);
-  std::printf("share reaching P3: none %.0f %%, traditional %.0f %%, model %.0f %%\n",
-              100 * m.share_p3[0], 100 * m.share_p3[1], 100 * m.share_p3[2]);
-  std::printf("share reaching P5: none %.0f %%, traditional %.0f %%, model %.0f %%\n",
-              100 * m.share_p5[0], 100 * m.share_p5[1], 100 * m.share_p5[2]);
+      m.acc1000_vs_traditional.median_pct, m.acc1000_vs_traditional.worst_pct,
+      m.acc1000_vs_regression.median_pct, m.acc1000_vs_regression.worst_pct,
+      m.acc1000_vs_ramp.median_pct, m.acc1000_vs_none.median_pct);
 }
 
 void ReportOne(const EvaluateCliOptions& o, const compare::Evaluation& e) {
@@ -59,8 +71,9 @@ void ReportOne(const EvaluateCliOptions& o, const compare::Evaluation& e) {
     PrintJson(e);
     return;
   }
-  std::printf("%-14s %6s %6s %6s %6s %6s | %-28s | %-24s | %9s\n", "screw", "HRC", "D mm", "lead",
-              "r mm", "m/min", "acc. 1000 mm none/trad/model", "ISO none/trad/model", "vs trad.");
+  std::printf("%-14s %6s %6s %6s %6s %6s | %-40s | %-24s | %9s\n", "screw", "HRC", "D mm", "lead",
+              "r mm", "m/min", "acc. 1000 mm none/ramp/trad/regr/model", "ISO none/trad/model",
+              "vs trad.");
   for (const auto& s : e.screws) {
     const auto& p = s.screw.process;
     std::printf("%-14s %6.1f %6.1f %6.2f %6.2f %6.0f | ", s.screw.name.c_str(), p.hardness_hrc,
@@ -69,13 +82,15 @@ void ReportOne(const EvaluateCliOptions& o, const compare::Evaluation& e) {
       std::printf("FAILED: %s\n", s.error.c_str());
       continue;
     }
-    char acc[64], cls[64];
-    std::snprintf(acc, sizeof acc, "%.1f / %.1f / %.1f um", s.metrics[0].accumulated_1000_um,
-                  s.metrics[1].accumulated_1000_um, s.metrics[2].accumulated_1000_um);
+    char acc[96], cls[64];
+    std::snprintf(acc, sizeof acc, "%.1f / %.1f / %.1f / %.1f / %.1f um",
+                  s.metrics[0].accumulated_1000_um, s.metrics[1].accumulated_1000_um,
+                  s.metrics[2].accumulated_1000_um, s.metrics[3].accumulated_1000_um,
+                  s.metrics[4].accumulated_1000_um);
     std::snprintf(cls, sizeof cls, "%s / %s / %s", compare::ToString(s.iso[0]).c_str(),
-                  compare::ToString(s.iso[1]).c_str(), compare::ToString(s.iso[2]).c_str());
+                  compare::ToString(s.iso[2]).c_str(), compare::ToString(s.iso[4]).c_str());
     const auto& r = s.model_vs_traditional.accumulated_1000_pct;
-    std::printf("%-28s | %-24s | %7.1f %%%s\n", acc, cls, r ? *r : 0.0,
+    std::printf("%-40s | %-24s | %7.1f %%%s\n", acc, cls, r ? *r : 0.0,
                 s.outside_domain ? "  (outside training domain)" : "");
   }
   const auto& m = e.summary;
@@ -113,7 +128,7 @@ void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluat
     }
     std::printf("%6llu %8zu %8zu | %-40s | %.0f %% / %.0f %%\n",
                 static_cast<unsigned long long>(o.seed + k), m.screws, m.failed, red,
-                100 * m.share_p3[1], 100 * m.share_p3[2]);
+                100 * m.share_p3[2], 100 * m.share_p3[4]);
     for (const auto& s : runs[k].screws)
       if (!s.ok) std::printf("       FAILED %s: %s\n", s.screw.name.c_str(), s.error.c_str());
   }
@@ -125,6 +140,40 @@ void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluat
       across.worst_pct, across.median_pct, across.best_pct, runs.size());
   std::printf("pooled over all %zu screws (%zu failed):\n", pooled.screws, pooled.failed);
   PrintSummary(pooled);
+}
+
+// --scenarios: the sensitivity table (compare/scenarios.h).
+void RunScenarioTable(const EvaluateCliOptions& o, const nn::Model& model,
+                      const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
+                      const sim::Screw& base, const compare::EvaluateOptions& eo) {
+  compare::ScenarioOptions so;
+  so.evaluate = eo;
+  so.evaluate.seed = o.seed;
+  so.random = o.random;
+  so.seeds = o.seeds;
+  so.allow_extrapolation = o.allow_extrapolation;
+  const auto scenarios = compare::SelectScenarios(o.scenarios);
+  std::vector<compare::ScenarioResult> results;
+  for (const auto& sc : scenarios) {
+    Progress progress("scenario " + sc.name, static_cast<std::size_t>(o.random));
+    const auto r = compare::RunScenarios({sc}, base, model, rule, iso, so,
+                                         [&](std::size_t d, std::size_t) { progress.Update(d); });
+    progress.Finish();
+    results.push_back(r.front());
+  }
+  if (o.json) {
+    PrintJson({{"schema", "whirl.evaluate_scenarios"},
+               {"schema_version", 1},
+               {"random_per_seed", o.random},
+               {"seeds", o.seeds},
+               {"first_seed", o.seed},
+               {"scenarios", results}});
+    return;
+  }
+  for (const auto& r : results)
+    std::printf("%-14s %s; %zu screws, %zu failed\n", r.scenario.name.c_str(),
+                r.scenario.description.c_str(), r.summary.screws, r.summary.failed);
+  std::printf("\n%s", compare::FormatScenarioTable(results, o.markdown).c_str());
 }
 
 void RunEvaluate(const EvaluateCliOptions& o) {
@@ -143,6 +192,8 @@ void RunEvaluate(const EvaluateCliOptions& o) {
   eo.compare.plan.tolerance_um = o.tolerance_um;
   eo.compare.shape_k = o.shape_k;
   eo.compare.time_exponent = o.time_exponent;
+
+  if (!o.scenarios.empty()) return RunScenarioTable(o, model, rule, iso, base, eo);
 
   // One evaluation per seed: its own random screws and disturbances.
   std::vector<compare::Evaluation> runs;
@@ -195,13 +246,15 @@ void RegisterEvaluate(CLI::App& app) {
   auto o = std::make_shared<EvaluateCliOptions>();
   auto* sub = app.add_subcommand(
       "evaluate",
-      "Run 'whirl compare' over many screws: the rows of the validation table and N random\n"
-      "feasible screws (inputs uniform in the paper's training ranges; blank, thread and machine\n"
-      "settings of the base screw), each truth with its own seeded disturbances\n"
-      "(MixSeed(--seed, index)). Prints one line per screw and the median and worst reduction of\n"
-      "the accumulated lead error (within 1000 mm and over the thread) of the model-based plan\n"
-      "against the traditional rule, and the share of screws reaching ISO 3408-3 P3 and P5 per\n"
-      "strategy. Uses --threads worker threads; results do not depend on the thread count.");
+      "Run 'whirl compare' (strategies none, ramp, traditional, regression, model) over many\n"
+      "screws: the rows of the validation table and N random feasible screws (inputs uniform in\n"
+      "the paper's training ranges; blank, thread and machine settings of the base screw), each\n"
+      "truth with its own seeded disturbances (MixSeed(--seed, index)). Prints one line per screw,\n"
+      "then per strategy the median and worst accumulated lead error [um] within 1000 mm and over\n"
+      "the thread and the share reaching ISO 3408-3 P3 and P5, the gain breakdown (curve shape,\n"
+      "five inputs, network) and the model's reductions against each baseline. --scenarios runs\n"
+      "named truth scenarios instead. Uses --threads worker threads; results do not depend on the\n"
+      "thread count.");
   sub->add_option("--model", o->model_path, "model file (default models/default.json)")
       ->check(CLI::ExistingFile);
   sub->add_option(
@@ -235,6 +288,16 @@ void RegisterEvaluate(CLI::App& app) {
                   "fail (exit 2) if the median reduction of the accumulated error within 1000 mm "
                   "against traditional is below this, or if any screw's comparison failed, "
                   "percent (target: 85)");
+  sub->add_option("--scenarios", o->scenarios,
+                  "named truth scenarios, comma-separated or 'all': today, heat-spread (heat "
+                  "partition std 12.5 %), ambient-drift (std 0.5 K/h), tool-wear (+20 % heat over "
+                  "the cut), steady-rest (60 W), out-of-range (D 40-125 mm, lead 5-20 mm, "
+                  "120-250 m/min; needs --allow-extrapolation). --random screws per scenario and "
+                  "seed; prints the scenario x strategy table of median and worst accumulated "
+                  "error [um] within 1000 mm and over the thread (src/compare/scenarios.h)");
+  sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
+                "evaluate the out-of-range scenario although the network extrapolates there");
+  sub->add_flag("--markdown", o->markdown, "--scenarios: print the table as Markdown");
   sub->add_flag("--json", o->json, "machine output: per-screw figures and the summary as JSON");
   sub->callback([o] { RunEvaluate(*o); });
 }

@@ -13,6 +13,10 @@ std::string ToString(Strategy s) {
   switch (s) {
     case Strategy::kNone:
       return "none";
+    case Strategy::kRamp:
+      return "ramp";
+    case Strategy::kRegression:
+      return "regression";
     case Strategy::kTraditional:
       return "traditional";
     case Strategy::kModel:
@@ -56,20 +60,18 @@ const StrategyOutcome& ScrewComparison::Outcome(Strategy s) const {
 }
 
 std::string ScrewComparison::BriefReport() const {
-  const auto& n = Outcome(Strategy::kNone).metrics;
-  const auto& t = Outcome(Strategy::kTraditional).metrics;
-  const auto& m = Outcome(Strategy::kModel).metrics;
-  std::string s = screw.name + ": accumulated within 1000 mm none " +
-                  Fixed(n.accumulated_1000_um, 1) + " / traditional " +
-                  Fixed(t.accumulated_1000_um, 1) + " / model " + Fixed(m.accumulated_1000_um, 1) +
-                  " um";
+  std::string s = screw.name + ": accumulated within 1000 mm";
+  for (const auto& o : outcomes)
+    s += " " + ToString(o.strategy) + " " + Fixed(o.metrics.accumulated_1000_um, 1);
+  s += " um; whole thread";
+  for (const auto& o : outcomes)
+    s += " " + ToString(o.strategy) + " " + Fixed(o.metrics.accumulated_total_um, 1);
+  s += " um";
   if (model_vs_traditional.accumulated_1000_pct)
-    s += " (" + Fixed(*model_vs_traditional.accumulated_1000_pct, 1) + " % less than traditional)";
-  s += ", whole thread " + Fixed(n.accumulated_total_um, 1) + " / " +
-       Fixed(t.accumulated_total_um, 1) + " / " + Fixed(m.accumulated_total_um, 1) + " um";
-  s += ", ISO class " + ToString(Outcome(Strategy::kNone).iso.reached) + " / " +
-       ToString(Outcome(Strategy::kTraditional).iso.reached) + " / " +
-       ToString(Outcome(Strategy::kModel).iso.reached);
+    s += " (model " + Fixed(*model_vs_traditional.accumulated_1000_pct, 1) +
+         " % less than traditional within 1000 mm)";
+  s += ", ISO class";
+  for (const auto& o : outcomes) s += " " + ToString(o.strategy) + " " + ToString(o.iso.reached);
   return s;
 }
 
@@ -131,43 +133,52 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
   c.predicted_curve.Validate("predicted curve of screw '" + screw.name + "'");
   const double feed = c.kinematics.axial_feed_mm_s;
   c.plan = interp::BuildPlan(c.predicted_curve, feed, screw.thread_length_mm, options.plan);
-  const interp::CompensationPlan& plan = c.plan;
-  const CompensationFunction model_c = [&plan, feed](double t_s) {
-    return interp::AppliedCompensationUm(plan, interp::AxisPositionMm(plan.options, feed, t_s));
-  };
 
-  // Traditional: the experience rule of the screw's diameter class.
+  // Curve baselines: the same shape and the same 840D planning as the model.
   c.experience_class = rule.ClassFor(screw.process.diameter_mm);
   c.experience_ramp_time_s = rule.ramp_time_s;
-  const double diameter = screw.process.diameter_mm;
-  const CompensationFunction traditional_c = [&rule, diameter](double t_s) {
-    return rule.CompensationUm(diameter, t_s);
+  c.traditional_features = rule.ClassFeatures(screw.process.diameter_mm);
+  if (rule.has_regression) c.regression_features = rule.regression.Predict(screw.process);
+  auto plan_of = [&](const Features& f, const std::string& what) {
+    if (!(f.max_elongation_um > 0) || !(f.settle_time_s > 0)) return interp::CompensationPlan{};
+    const fit::ArctanCurve curve =
+        fit::ArctanCurve::FromFeatures(f, options.shape_k, options.time_exponent);
+    curve.Validate(what + " curve of screw '" + screw.name + "'");
+    return interp::BuildPlan(curve, feed, screw.thread_length_mm, options.plan);
   };
-
-  for (double t : c.truth.time_s) {
-    c.traditional_compensation_um.push_back(traditional_c(t));
-    c.model_compensation_um.push_back(model_c(t));
-  }
+  const interp::CompensationPlan traditional_plan = plan_of(c.traditional_features, "traditional");
+  const interp::CompensationPlan regression_plan = plan_of(c.regression_features, "regression");
+  auto planned = [feed](const interp::CompensationPlan& plan) -> CompensationFunction {
+    if (plan.segments.empty()) return NoCompensation();
+    return [&plan, feed](double t_s) {
+      return interp::AppliedCompensationUm(plan, interp::AxisPositionMm(plan.options, feed, t_s));
+    };
+  };
+  const double diameter = screw.process.diameter_mm;
+  const std::array<CompensationFunction, kStrategyCount> comp = {
+      NoCompensation(),
+      [&rule, diameter](double t_s) { return rule.CompensationUm(diameter, t_s); },
+      planned(traditional_plan), planned(regression_plan), planned(c.plan)};
 
   LeadMetricOptions metric_options = options.metrics;
   metric_options.lead_mm = screw.process.pitch_mm;
-  for (Strategy s : kStrategies) {
-    StrategyOutcome& o = c.outcomes[static_cast<std::size_t>(s)];
-    o.strategy = s;
-    const CompensationFunction& comp = s == Strategy::kNone          ? NoCompensation()
-                                       : s == Strategy::kTraditional ? traditional_c
-                                                                     : model_c;
-    o.lead = CutLeadDeviation(c.truth, comp, feed, screw.thread_length_mm, screw.process.pitch_mm,
-                              options.cut);
+  for (std::size_t k = 0; k < kStrategyCount; ++k) {
+    for (double t : c.truth.time_s) c.compensation_um[k].push_back(comp[k](t));
+    StrategyOutcome& o = c.outcomes[k];
+    o.strategy = kStrategies[k];
+    o.lead = CutLeadDeviation(c.truth, comp[k], feed, screw.thread_length_mm,
+                              screw.process.pitch_mm, options.cut);
     o.metrics = ComputeLeadMetrics(o.lead, metric_options);
     o.iso = EvaluateIsoClass(o.metrics, iso_table);
   }
-  c.model_vs_traditional =
-      Reductions(c.Outcome(Strategy::kModel).metrics, c.Outcome(Strategy::kTraditional).metrics);
-  c.model_vs_none =
-      Reductions(c.Outcome(Strategy::kModel).metrics, c.Outcome(Strategy::kNone).metrics);
-  c.traditional_vs_none =
-      Reductions(c.Outcome(Strategy::kTraditional).metrics, c.Outcome(Strategy::kNone).metrics);
+  auto vs = [&c](Strategy a, Strategy b) {
+    return Reductions(c.Outcome(a).metrics, c.Outcome(b).metrics);
+  };
+  c.model_vs_traditional = vs(Strategy::kModel, Strategy::kTraditional);
+  c.model_vs_none = vs(Strategy::kModel, Strategy::kNone);
+  c.traditional_vs_none = vs(Strategy::kTraditional, Strategy::kNone);
+  c.model_vs_regression = vs(Strategy::kModel, Strategy::kRegression);
+  c.model_vs_ramp = vs(Strategy::kModel, Strategy::kRamp);
   return c;
 }
 
@@ -220,17 +231,27 @@ void to_json(nlohmann::json& j, const ScrewComparison& c) {
                        {"shape_k", c.predicted_curve.shape_k},
                        {"time_exponent", c.predicted_curve.time_exponent}}},
                      {"plan", plan_summary},
-                     {"traditional",
+                     {"ramp",
                       {{"rule", "c(t) = P_class * min(1, t / T)"},
                        {"class_nominal_diameter_mm", c.experience_class.nominal_diameter_mm},
                        {"plateau_um", c.experience_class.plateau_um},
                        {"class_screws", c.experience_class.screws},
                        {"ramp_time_s", c.experience_ramp_time_s}}},
+                     {"traditional",
+                      {{"rule", "class means (P_class, T_class), arctangent curve, 840D plan"},
+                       {"max_elongation_um", c.traditional_features.max_elongation_um},
+                       {"settle_time_s", c.traditional_features.settle_time_s}}},
+                     {"regression",
+                      {{"rule", "log-linear least squares on the 5 inputs, arctangent, 840D plan"},
+                       {"max_elongation_um", c.regression_features.max_elongation_um},
+                       {"settle_time_s", c.regression_features.settle_time_s}}},
                      {"strategies", strategies},
                      {"reductions",
                       {{"model_vs_traditional", c.model_vs_traditional},
                        {"model_vs_none", c.model_vs_none},
-                       {"traditional_vs_none", c.traditional_vs_none}}},
+                       {"traditional_vs_none", c.traditional_vs_none},
+                       {"model_vs_regression", c.model_vs_regression},
+                       {"model_vs_ramp", c.model_vs_ramp}}},
                      {"sign_convention",
                       "travel deviation = actual minus specified travel from the thread start, um; "
                       "d(x) = [e(t) - c(t)] - [e(0) - c(0)], x = axial_feed * t"}};

@@ -3,7 +3,9 @@
 // (REFERENCE.md sections 1 and 4; issue 5):
 //
 //   none         c(t) = 0
-//   traditional  c(t) = the shop's experience rule (compare/traditional.h)
+//   ramp         c(t) = P_class min(1, t / T), the previous experience rule (compare/traditional.h)
+//   traditional  the class means (P_class, T_class) -> arctangent curve -> 840D plan (as model)
+//   regression   log-linear least squares on the history -> arctangent curve -> 840D plan
 //   model        nn::Predict -> fit::ArctanCurve::FromFeatures -> interp::BuildPlan with the
 //                screw's kinematics -> c(t) = interp::AppliedCompensationUm(plan, P(t)), i.e. the
 //                value the 840D reconstructs from SD43900/SD43910/SD43920 at the axis position
@@ -33,10 +35,12 @@
 
 namespace whirl::compare {
 
-enum class Strategy { kNone, kTraditional, kModel };
-inline constexpr std::array<Strategy, 3> kStrategies = {Strategy::kNone, Strategy::kTraditional,
-                                                        Strategy::kModel};
-std::string ToString(Strategy s);  ///< "none", "traditional", "model"
+enum class Strategy { kNone, kRamp, kTraditional, kRegression, kModel };
+inline constexpr std::size_t kStrategyCount = 5;
+inline constexpr std::array<Strategy, kStrategyCount> kStrategies = {
+    Strategy::kNone, Strategy::kRamp, Strategy::kTraditional, Strategy::kRegression,
+    Strategy::kModel};
+std::string ToString(Strategy s);  ///< "none", "ramp", "traditional", "regression", "model"
 
 struct CompareOptions {
   /// Seed of the truth's disturbances (sim::DisturbanceOptions::seed).
@@ -86,10 +90,14 @@ struct ScrewComparison {
   interp::CompensationPlan plan;
   ExperienceClass experience_class;  ///< the traditional rule's class of this screw
   double experience_ramp_time_s = 0;
-  /// Compensation applied at the truth's sample times, um (for plots and checks).
-  std::vector<double> traditional_compensation_um, model_compensation_um;
-  std::array<StrategyOutcome, 3> outcomes;  ///< in kStrategies order
-  MetricReductions model_vs_traditional, model_vs_none, traditional_vs_none;
+  /// Features the curve-based baselines use: class means (traditional), regression (zero when
+  /// the history has no regression baseline: the strategy then equals none).
+  Features traditional_features, regression_features;
+  /// Compensation applied at the truth's sample times, um, per strategy (kStrategies order).
+  std::array<std::vector<double>, kStrategyCount> compensation_um;
+  std::array<StrategyOutcome, kStrategyCount> outcomes;  ///< in kStrategies order
+  MetricReductions model_vs_traditional, model_vs_none, traditional_vs_none, model_vs_regression,
+      model_vs_ramp;
 
   const StrategyOutcome& Outcome(Strategy s) const;
   /// "reference: accumulated 1000 mm none 85.1 / traditional 31.0 / model 3.2 um (-89.7 % vs

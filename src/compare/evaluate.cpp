@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <thread>
@@ -89,12 +90,14 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model
         const ScrewComparison c = CompareScrew(screws[i], model, rule, iso_table, co);
         out.ok = true;
         out.outside_domain = c.prediction.outside_domain;
-        for (std::size_t k = 0; k < 3; ++k) {
+        for (std::size_t k = 0; k < kStrategyCount; ++k) {
           out.metrics[k] = c.outcomes[k].metrics;
           out.iso[k] = c.outcomes[k].iso.reached;
         }
         out.model_vs_traditional = c.model_vs_traditional;
         out.model_vs_none = c.model_vs_none;
+        out.model_vs_regression = c.model_vs_regression;
+        out.model_vs_ramp = c.model_vs_ramp;
       } catch (const InputError& err) {
         out.ok = false;
         out.error = err.what();
@@ -116,25 +119,39 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model
   return e;
 }
 
+namespace {
+
+double MedianOf(std::vector<double> v) { return v.empty() ? 0.0 : Stats(std::move(v)).median_pct; }
+double WorstOf(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+}
+
+}  // namespace
+
 EvaluationSummary Summarize(const std::vector<EvaluatedScrew>& screws) {
   EvaluationSummary s;
   s.screws = screws.size();
-  std::vector<double> acc_t, total_t, acc_n;
-  std::array<std::size_t, 3> p3{}, p5{};
+  std::vector<double> acc_t, total_t, acc_n, acc_r, acc_ramp;
+  std::array<std::vector<double>, kStrategyCount> acc, total;
+  std::array<std::size_t, kStrategyCount> p3{}, p5{};
   std::size_t ok = 0;
+  auto push = [](std::vector<double>& v, const std::optional<double>& x) {
+    if (x) v.push_back(*x);
+  };
   for (const auto& r : screws) {
     if (!r.ok) {
       ++s.failed;
       continue;
     }
     ++ok;
-    if (r.model_vs_traditional.accumulated_1000_pct)
-      acc_t.push_back(*r.model_vs_traditional.accumulated_1000_pct);
-    if (r.model_vs_traditional.accumulated_total_pct)
-      total_t.push_back(*r.model_vs_traditional.accumulated_total_pct);
-    if (r.model_vs_none.accumulated_1000_pct)
-      acc_n.push_back(*r.model_vs_none.accumulated_1000_pct);
-    for (std::size_t k = 0; k < 3; ++k) {
+    push(acc_t, r.model_vs_traditional.accumulated_1000_pct);
+    push(total_t, r.model_vs_traditional.accumulated_total_pct);
+    push(acc_n, r.model_vs_none.accumulated_1000_pct);
+    push(acc_r, r.model_vs_regression.accumulated_1000_pct);
+    push(acc_ramp, r.model_vs_ramp.accumulated_1000_pct);
+    for (std::size_t k = 0; k < kStrategyCount; ++k) {
+      acc[k].push_back(std::abs(r.metrics[k].accumulated_1000_um));
+      total[k].push_back(std::abs(r.metrics[k].accumulated_total_um));
       const IsoClass c = r.iso[k];
       if (c == IsoClass::kP1 || c == IsoClass::kP3) ++p3[k];
       if (c == IsoClass::kP1 || c == IsoClass::kP3 || c == IsoClass::kP5) ++p5[k];
@@ -143,22 +160,25 @@ EvaluationSummary Summarize(const std::vector<EvaluatedScrew>& screws) {
   s.acc1000_vs_traditional = Stats(acc_t);
   s.total_vs_traditional = Stats(total_t);
   s.acc1000_vs_none = Stats(acc_n);
-  for (std::size_t k = 0; k < 3; ++k) {
+  s.acc1000_vs_regression = Stats(acc_r);
+  s.acc1000_vs_ramp = Stats(acc_ramp);
+  for (std::size_t k = 0; k < kStrategyCount; ++k) {
+    s.absolute[k] = {MedianOf(acc[k]), WorstOf(acc[k]), MedianOf(total[k]), WorstOf(total[k])};
     s.share_p3[k] = ok > 0 ? static_cast<double>(p3[k]) / ok : 0.0;
     s.share_p5[k] = ok > 0 ? static_cast<double>(p5[k]) / ok : 0.0;
   }
-  char buf[512];
+  std::string m = std::to_string(s.screws) + " screws (" + std::to_string(s.failed) +
+                  " failed): accumulated error within 1000 mm, median (worst) um:";
+  char buf[160];
+  for (std::size_t k = 0; k < kStrategyCount; ++k) {
+    std::snprintf(buf, sizeof buf, " %s %.2f (%.1f)", ToString(kStrategies[k]).c_str(),
+                  s.absolute[k].acc1000_median_um, s.absolute[k].acc1000_worst_um);
+    m += buf;
+  }
   std::snprintf(buf, sizeof buf,
-                "%zu screws (%zu failed): accumulated error within 1000 mm, model vs traditional: "
-                "median reduction %.1f %%, worst %.1f %%; whole thread: median %.1f %%, worst "
-                "%.1f %%; vs none: median %.1f %%; share reaching P3 none/traditional/model "
-                "%.0f/%.0f/%.0f %%, P5 %.0f/%.0f/%.0f %%",
-                s.screws, s.failed, s.acc1000_vs_traditional.median_pct,
-                s.acc1000_vs_traditional.worst_pct, s.total_vs_traditional.median_pct,
-                s.total_vs_traditional.worst_pct, s.acc1000_vs_none.median_pct, 100 * s.share_p3[0],
-                100 * s.share_p3[1], 100 * s.share_p3[2], 100 * s.share_p5[0], 100 * s.share_p5[1],
-                100 * s.share_p5[2]);
-  s.message = buf;
+                "; model vs traditional: median reduction %.1f %%, vs regression %.1f %%",
+                s.acc1000_vs_traditional.median_pct, s.acc1000_vs_regression.median_pct);
+  s.message = m + buf;
   return s;
 }
 
@@ -181,22 +201,33 @@ void to_json(nlohmann::json& j, const EvaluatedScrew& s) {
   }
   j["outside_domain"] = s.outside_domain;
   nlohmann::json strategies = nlohmann::json::object();
-  for (std::size_t k = 0; k < 3; ++k)
+  for (std::size_t k = 0; k < kStrategyCount; ++k)
     strategies[ToString(kStrategies[k])] = {{"metrics", s.metrics[k]},
                                             {"iso_class", ToString(s.iso[k])}};
   j["strategies"] = strategies;
   j["model_vs_traditional"] = s.model_vs_traditional;
   j["model_vs_none"] = s.model_vs_none;
+  j["model_vs_regression"] = s.model_vs_regression;
+  j["model_vs_ramp"] = s.model_vs_ramp;
 }
 
 void to_json(nlohmann::json& j, const EvaluationSummary& s) {
-  nlohmann::json p3 = nlohmann::json::object(), p5 = nlohmann::json::object();
-  for (std::size_t k = 0; k < 3; ++k) {
-    p3[ToString(kStrategies[k])] = s.share_p3[k];
-    p5[ToString(kStrategies[k])] = s.share_p5[k];
+  nlohmann::json p3 = nlohmann::json::object(), p5 = nlohmann::json::object(),
+                 absolute = nlohmann::json::object();
+  for (std::size_t k = 0; k < kStrategyCount; ++k) {
+    const std::string name = ToString(kStrategies[k]);
+    p3[name] = s.share_p3[k];
+    p5[name] = s.share_p5[k];
+    absolute[name] = {{"accumulated_1000_median_um", s.absolute[k].acc1000_median_um},
+                      {"accumulated_1000_worst_um", s.absolute[k].acc1000_worst_um},
+                      {"accumulated_total_median_um", s.absolute[k].total_median_um},
+                      {"accumulated_total_worst_um", s.absolute[k].total_worst_um}};
   }
   j = nlohmann::json{{"screws", s.screws},
                      {"failed", s.failed},
+                     {"absolute_um", absolute},
+                     {"accumulated_1000_model_vs_regression", StatsJson(s.acc1000_vs_regression)},
+                     {"accumulated_1000_model_vs_ramp", StatsJson(s.acc1000_vs_ramp)},
                      {"accumulated_1000_model_vs_traditional", StatsJson(s.acc1000_vs_traditional)},
                      {"accumulated_total_model_vs_traditional", StatsJson(s.total_vs_traditional)},
                      {"accumulated_1000_model_vs_none", StatsJson(s.acc1000_vs_none)},
@@ -207,7 +238,7 @@ void to_json(nlohmann::json& j, const EvaluationSummary& s) {
 
 void to_json(nlohmann::json& j, const Evaluation& e) {
   j = nlohmann::json{{"schema", "whirl.evaluate"},
-                     {"schema_version", 1},
+                     {"schema_version", 2},
                      {"summary", e.summary},
                      {"screws", e.screws}};
 }

@@ -45,9 +45,10 @@ struct EvaluatedScrew {
   bool ok = false;
   std::string error;            ///< the InputError message when !ok (e.g. a slope beyond MD32760)
   bool outside_domain = false;  ///< the model extrapolated
-  std::array<LeadMetrics, 3> metrics;  ///< kStrategies order
-  std::array<IsoClass, 3> iso{IsoClass::kNone, IsoClass::kNone, IsoClass::kNone};
-  MetricReductions model_vs_traditional, model_vs_none;
+  std::array<LeadMetrics, kStrategyCount> metrics;  ///< kStrategies order
+  std::array<IsoClass, kStrategyCount> iso{IsoClass::kNone, IsoClass::kNone, IsoClass::kNone,
+                                           IsoClass::kNone, IsoClass::kNone};
+  MetricReductions model_vs_traditional, model_vs_none, model_vs_regression, model_vs_ramp;
 };
 
 struct ReductionStats {
@@ -55,12 +56,20 @@ struct ReductionStats {
   double median_pct = 0, worst_pct = 0, best_pct = 0;  ///< worst = smallest reduction
 };
 
+/// Absolute accumulated lead error of one strategy over the screws, um (median and worst =
+/// largest), within 1000 mm and over the thread.
+struct AbsoluteStats {
+  double acc1000_median_um = 0, acc1000_worst_um = 0, total_median_um = 0, total_worst_um = 0;
+};
+
 struct EvaluationSummary {
   std::size_t screws = 0, failed = 0;
-  ReductionStats acc1000_vs_traditional, total_vs_traditional, acc1000_vs_none;
+  std::array<AbsoluteStats, kStrategyCount> absolute;  ///< kStrategies order: the lead figures
+  ReductionStats acc1000_vs_traditional, total_vs_traditional, acc1000_vs_none,
+      acc1000_vs_regression, acc1000_vs_ramp;
   /// Share (0..1) of the evaluated screws reaching P3 (P1 or P3) and P5 (P1, P3 or P5), by
   /// strategy.
-  std::array<double, 3> share_p3{}, share_p5{};
+  std::array<double, kStrategyCount> share_p3{}, share_p5{};
   std::string message;  ///< one line with the headline numbers
 };
 

@@ -1,5 +1,6 @@
 #include "compare/traditional.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
@@ -19,6 +20,61 @@ double ExperienceRule::CompensationUm(double diameter_mm, double t_s) const {
   if (t_s <= 0) return 0.0;
   const double ramp = ramp_time_s > 0 ? std::min(1.0, t_s / ramp_time_s) : 1.0;
   return ClassFor(diameter_mm).plateau_um * ramp;
+}
+
+Features ExperienceRule::ClassFeatures(double diameter_mm) const {
+  const ExperienceClass& c = ClassFor(diameter_mm);
+  return {c.plateau_um, c.settle_time_s};
+}
+
+Features LogLinearFeatures::Predict(const ProcessInputs& inputs) const {
+  const auto x = inputs.ToArray();
+  std::array<double, 2> y{};
+  for (int k = 0; k < 2; ++k) {
+    double v = coef[k][0];
+    for (int i = 0; i < ProcessInputs::kCount; ++i) v += coef[k][i + 1] * std::log(x[i]);
+    y[k] = std::exp(v);
+  }
+  return {y[0], y[1]};
+}
+
+LogLinearFeatures FitLogLinear(const ProcessTable& history) {
+  const int n = static_cast<int>(history.inputs.size()), p = ProcessInputs::kCount + 1;
+  if (n < p || history.targets.size() != history.inputs.size())
+    throw InputError(history.source + ": the regression baseline needs at least " +
+                     std::to_string(p) + " past screws with targets, the table has " +
+                     std::to_string(n));
+  Eigen::MatrixXd a(n, p);
+  Eigen::MatrixXd y(n, 2);
+  for (int r = 0; r < n; ++r) {
+    const auto x = history.inputs[r].ToArray();
+    const double t[2] = {history.targets[r].max_elongation_um, history.targets[r].settle_time_s};
+    a(r, 0) = 1.0;
+    for (int i = 0; i < ProcessInputs::kCount; ++i) {
+      if (!(x[i] > 0))
+        throw InputError(history.source + " row " + std::to_string(r + 1) + ": " +
+                         kInputColumns[i] + " = " + FormatNumber(x[i]) +
+                         " must be > 0 for the log-linear regression baseline");
+      a(r, i + 1) = std::log(x[i]);
+    }
+    for (int k = 0; k < 2; ++k) {
+      if (!(t[k] > 0))
+        throw InputError(history.source + " row " + std::to_string(r + 1) + ": " +
+                         kTargetColumns[k] + " = " + FormatNumber(t[k]) +
+                         " must be > 0 for the log-linear regression baseline");
+      y(r, k) = std::log(t[k]);
+    }
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+  if (qr.rank() < p)
+    throw InputError(history.source + ": the regression baseline's design has rank " +
+                     std::to_string(qr.rank()) + " < " + std::to_string(p) +
+                     " (a constant input column?)");
+  const Eigen::MatrixXd b = qr.solve(y);
+  LogLinearFeatures f;
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < p; ++i) f.coef[k][i] = b(i, k);
+  return f;
 }
 
 ExperienceRule BuildExperienceRule(const ProcessTable& history,
@@ -49,13 +105,14 @@ ExperienceRule BuildExperienceRule(const ProcessTable& history,
     c.upper_mm = i + 1 == d.size() ? 1e9 : std::sqrt(d[i] * d[i + 1]);
     rule.classes.push_back(c);
   }
-  std::vector<double> sum(d.size(), 0.0);
+  std::vector<double> sum(d.size(), 0.0), sum_settle(d.size(), 0.0);
   double all_plateau = 0, all_settle = 0;
   for (std::size_t r = 0; r < history.inputs.size(); ++r) {
     const double dia = history.inputs[r].diameter_mm;
     for (std::size_t i = 0; i < rule.classes.size(); ++i) {
       if (dia <= rule.classes[i].upper_mm || i + 1 == rule.classes.size()) {
         sum[i] += history.targets[r].max_elongation_um;
+        sum_settle[i] += history.targets[r].settle_time_s;
         rule.classes[i].screws += 1;
         break;
       }
@@ -66,9 +123,17 @@ ExperienceRule BuildExperienceRule(const ProcessTable& history,
   const double n = static_cast<double>(history.inputs.size());
   rule.machine_plateau_um = all_plateau / n;
   rule.ramp_time_s = all_settle / n;
-  for (std::size_t i = 0; i < rule.classes.size(); ++i)
-    rule.classes[i].plateau_um =
-        rule.classes[i].screws > 0 ? sum[i] / rule.classes[i].screws : rule.machine_plateau_um;
+  for (std::size_t i = 0; i < rule.classes.size(); ++i) {
+    ExperienceClass& c = rule.classes[i];
+    c.plateau_um = c.screws > 0 ? sum[i] / c.screws : rule.machine_plateau_um;
+    c.settle_time_s = c.screws > 0 ? sum_settle[i] / c.screws : rule.ramp_time_s;
+  }
+  try {
+    rule.regression = FitLogLinear(history);
+    rule.has_regression = true;
+  } catch (const InputError& e) {
+    rule.regression_error = e.what();
+  }
   return rule;
 }
 
@@ -79,12 +144,19 @@ void to_json(nlohmann::json& j, const ExperienceRule& rule) {
                        {"lower_mm", c.lower_mm},
                        {"upper_mm", c.upper_mm},
                        {"plateau_um", c.plateau_um},
+                       {"settle_time_s", c.settle_time_s},
                        {"screws", c.screws}});
   j = nlohmann::json{{"rule", "c(t) = P_class * min(1, t / T)"},
                      {"ramp_time_s", rule.ramp_time_s},
                      {"machine_plateau_um", rule.machine_plateau_um},
                      {"classes", classes},
                      {"source", rule.source}};
+  if (rule.has_regression) {
+    nlohmann::json reg = nlohmann::json::object();
+    for (int k = 0; k < 2; ++k) reg[kTargetColumns[k]] = rule.regression.coef[k];
+    j["regression"] = {{"form", "ln y = b0 + sum_i b_i ln x_i (inputs in kInputColumns order)"},
+                       {"coefficients", reg}};
+  }
 }
 
 }  // namespace whirl::compare

@@ -24,6 +24,19 @@
 // (3) It is right on average for its class: it captures the dominant diameter effect and the mean
 // time scale; what it cannot know is what the model adds: the effect of hardness, lead, raceway
 // radius and cutting speed on the plateau and the settle time, and the curved (arctangent) rise.
+// Issue 11: the history gives three baselines besides `none`, all from the same table:
+//   ramp         the rule above (kept for continuity with earlier figures);
+//   traditional  per class the mean past CURVE: class plateau P_class and class settle time
+//                T_class (mean settle_time_s of the class) with the same arctangent shape the model
+//                uses, planned like the model: the best experience rule a shop can keep without a
+//                model. Fair: it uses only what the shop has measured and the curve shape anybody
+//                can fit to one recorded curve; it lacks only the four inputs besides diameter.
+//   regression   a least-squares log-linear model of each feature on the five inputs:
+//                ln y = b0 + sum_i b_i ln x_i (6 coefficients per output), same history, same
+//                curve and plan. Fair: the strongest cheap statistical baseline (power law, the
+//                form the physics suggests: L ~ q / v_f, t_s ~ a / v_f^2); it is what a process
+//                engineer with a spreadsheet would fit before training a network.
+#include <array>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -43,14 +56,32 @@ struct ExperienceClass {
   double lower_mm = 0;    ///< class covers (lower_mm, upper_mm]; 0 for the first class
   double upper_mm = 0;    ///< 1e9 for the last class
   double plateau_um = 0;  ///< P_class, um
+  double settle_time_s = 0;  ///< T_class: mean settle time of the class, s (traditional)
   int screws = 0;         ///< past screws behind P_class (0 = fell back to the machine mean)
 };
+
+/// ln y_k = coef_k(0) + sum_i coef_k(i + 1) ln x_i, k = max elongation, settle time.
+struct LogLinearFeatures {
+  std::array<std::array<double, ProcessInputs::kCount + 1>, 2> coef{};
+  Features Predict(const ProcessInputs& inputs) const;
+};
+
+/// Least squares on the logs of a history table (InputError: fewer than 6 rows, a non-positive
+/// input or target, or a singular design, e.g. a constant column).
+LogLinearFeatures FitLogLinear(const ProcessTable& history);
 
 struct ExperienceRule {
   std::vector<ExperienceClass> classes;
   double ramp_time_s = 0;         ///< T, s
   double machine_plateau_um = 0;  ///< mean plateau over all past screws, um
   std::string source;             ///< where the history came from (file name)
+  /// The regression baseline from the same history; `has_regression` false when the history is
+  /// too small for it (fewer than 6 rows).
+  LogLinearFeatures regression;
+  bool has_regression = false;
+  std::string regression_error;  ///< why there is no regression baseline
+  /// traditional: (P_class, T_class) of the screw's class.
+  Features ClassFeatures(double diameter_mm) const;
 
   /// The class of a screw of that diameter.
   const ExperienceClass& ClassFor(double diameter_mm) const;

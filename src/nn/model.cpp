@@ -1,7 +1,9 @@
 #include "nn/model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "core/error.h"
 #include "core/json_file.h"
@@ -172,6 +174,12 @@ void Model::Validate() const {
                      "', this version only knows 'normalized'");
   if (!(noise_variance >= 0) || !std::isfinite(noise_variance))
     throw InputError("model 'uncertainty.noise_variance_normalized' must be finite and >= 0");
+  if (output_noise_variance.size() != network.OutputCount() || !output_noise_variance.allFinite() ||
+      output_noise_variance.minCoeff() < 0)
+    throw InputError(
+        "model 'uncertainty.output_noise_variance_normalized' needs one finite value "
+        ">= 0 per output (" +
+        std::to_string(network.OutputCount()) + ")");
   const int N = network.ParameterCount();
   if (posterior_covariance.rows() != N || posterior_covariance.cols() != N)
     throw InputError("model 'uncertainty.posterior_covariance' must be " + std::to_string(N) + "x" +
@@ -223,9 +231,12 @@ void to_json(nlohmann::json& j, const Model& m) {
                              {"options", OptionsJson(m.train_options)}}},
            {"seed", m.seed},
            {"error_space", m.error_space},
-           {"uncertainty", json{{"method", "laplace"},
-                                {"noise_variance_normalized", m.noise_variance},
-                                {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
+           {"uncertainty",
+            json{{"method", "laplace"},
+                 {"noise_variance_normalized", m.noise_variance},
+                 {"output_noise_variance_normalized", VectorJson(m.output_noise_variance)},
+                 {"noise_calibration", m.noise_calibration},
+                 {"posterior_covariance", MatrixJson(m.posterior_covariance)}}}};
 }
 
 void from_json(const nlohmann::json& j, Model& m) {
@@ -239,9 +250,11 @@ void from_json(const nlohmann::json& j, Model& m) {
     throw InputError("model 'format' is " + format.dump() + ", expected \"" + Model::kFormat +
                      "\"");
   const json& version = Require(j, "schema_version", "model");
-  if (!version.is_number_integer() || version.get<int>() != Model::kSchemaVersion)
-    throw InputError("model 'schema_version' is " + version.dump() + ", this whirl reads " +
+  if (!version.is_number_integer() || version.get<int>() < 1 ||
+      version.get<int>() > Model::kSchemaVersion)
+    throw InputError("model 'schema_version' is " + version.dump() + ", this whirl reads 1 to " +
                      std::to_string(Model::kSchemaVersion));
+  const int schema = version.get<int>();
 
   const json& sizes = Require(j, "layer_sizes", "model");
   if (!sizes.is_array() || sizes.size() < 2)
@@ -325,13 +338,36 @@ void from_json(const nlohmann::json& j, Model& m) {
   m.error_space = space.get<std::string>();
 
   const json& u = Require(j, "uncertainty", "model");
-  RejectUnknownKeys(u, {"method", "noise_variance_normalized", "posterior_covariance"},
-                    "model 'uncertainty'");
+  if (schema == 1)
+    RejectUnknownKeys(u, {"method", "noise_variance_normalized", "posterior_covariance"},
+                      "model 'uncertainty'");
+  else
+    RejectUnknownKeys(u,
+                      {"method", "noise_variance_normalized", "output_noise_variance_normalized",
+                       "noise_calibration", "posterior_covariance"},
+                      "model 'uncertainty'");
   const json& method = Require(u, "method", "model 'uncertainty'");
   if (!method.is_string() || method.get<std::string>() != "laplace")
     throw InputError("model 'uncertainty.method' is " + method.dump() + ", expected \"laplace\"");
   m.noise_variance = RequireFinite(Require(u, "noise_variance_normalized", "model 'uncertainty'"),
                                    "model 'uncertainty.noise_variance_normalized'");
+  const int S = m.network.OutputCount();
+  if (schema == 1) {
+    m.output_noise_variance = Eigen::VectorXd::Constant(S, m.noise_variance);
+    m.noise_calibration = "schema 1 file: trainbr's one noise level for every output";
+  } else {
+    const json& v = Require(u, "output_noise_variance_normalized", "model 'uncertainty'");
+    if (!v.is_array() || static_cast<int>(v.size()) != S)
+      throw InputError("model 'uncertainty.output_noise_variance_normalized' must be an array of " +
+                       std::to_string(S) + " numbers, got " + v.dump());
+    m.output_noise_variance.resize(S);
+    for (int k = 0; k < S; ++k)
+      m.output_noise_variance(k) = RequireFinite(
+          v[k], "model 'uncertainty.output_noise_variance_normalized[" + std::to_string(k) + "]'");
+    const json& c = Require(u, "noise_calibration", "model 'uncertainty'");
+    if (!c.is_string()) throw InputError("model 'uncertainty.noise_calibration' must be a string");
+    m.noise_calibration = c.get<std::string>();
+  }
   const int N = m.network.ParameterCount();
   m.posterior_covariance = ReadMatrix(Require(u, "posterior_covariance", "model 'uncertainty'"),
                                       "uncertainty.posterior_covariance", N, N);
@@ -391,10 +427,10 @@ std::vector<Prediction> PredictBatch(const Model& model, const std::vector<Proce
     for (int k = 0; k < S; ++k) {
       const auto g = J.row(static_cast<Eigen::Index>(q) * S + k).transpose();
       Sg.noalias() = model.posterior_covariance * g;
-      const double var = model.noise_variance + g.dot(Sg);
+      const double var = model.output_noise_variance(k) + g.dot(Sg);
       mean[k] = y(k, q);
       sd[k] = std::sqrt(std::max(var, 0.0)) * half(k);
-      noise[k] = std::sqrt(model.noise_variance) * half(k);
+      noise[k] = std::sqrt(model.output_noise_variance(k)) * half(k);
     }
     Prediction& p = out[q];
     p.mean = Features::FromArray(mean);
@@ -452,9 +488,76 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   m.training_data = data_name;
   m.training_samples = static_cast<int>(table.inputs.size());
   m.noise_variance = r.best.summary.noise_variance;
+  m.output_noise_variance = Eigen::VectorXd::Constant(Features::kCount, m.noise_variance);
+  m.noise_calibration = "trainbr: one noise level 1/(2 beta) for every output";
   m.posterior_covariance = std::move(r.best.posterior_covariance);
   m.Validate();
+  const int rows = static_cast<int>(table.inputs.size());
+  if (options.noise_folds > 0 && rows >= 4)
+    CalibrateOutputNoise(table, options, std::min(options.noise_folds, rows), &m);
   return m;
+}
+
+void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& options, int folds,
+                          Model* model) {
+  const int rows = static_cast<int>(table.inputs.size());
+  if (folds < 2 || rows < folds)
+    throw InputError("noise calibration: " + std::to_string(folds) + " folds for " +
+                     std::to_string(rows) + " rows; needs 2 <= folds <= rows");
+  ModelTrainOptions fold_options = options;
+  fold_options.noise_folds = 0;
+  fold_options.restarts = std::min(options.restarts, 3);
+  const Eigen::VectorXd half = model->target_scaling.HalfRange();
+  const int S = Features::kCount;
+  std::vector<std::vector<double>> r2(S), var_w(S);
+  for (int f = 0; f < folds; ++f) {
+    ProcessTable train, held;
+    train.source = held.source = table.source;
+    for (int i = 0; i < rows; ++i) {
+      ProcessTable& t = i % folds == f ? held : train;
+      t.inputs.push_back(table.inputs[i]);
+      t.targets.push_back(table.targets[i]);
+    }
+    const Model fm = TrainModel(train, fold_options, "fold");
+    const std::vector<Prediction> p = PredictBatch(fm, held.inputs);
+    const Eigen::VectorXd fold_half = fm.target_scaling.HalfRange();
+    for (std::size_t i = 0; i < held.inputs.size(); ++i) {
+      const auto mean = p[i].mean.ToArray(), sd = p[i].stddev.ToArray();
+      const auto truth = held.targets[i].ToArray();
+      for (int k = 0; k < S; ++k) {
+        const double r = (truth[k] - mean[k]) / half(k);
+        // Weight part of the fold model's variance, in the full model's normalized units.
+        const double v =
+            (sd[k] * sd[k] - fm.output_noise_variance(k) * fold_half(k) * fold_half(k)) /
+            (half(k) * half(k));
+        r2[k].push_back(r * r);
+        var_w[k].push_back(std::max(v, 0.0));
+      }
+    }
+  }
+  // sigma_k^2: the smallest level at which +-1 predictive sigma covers kOneSigma of the held-out
+  // errors (bisection; the coverage is monotone in sigma_k^2).
+  constexpr double kOneSigma = 0.6827;
+  model->output_noise_variance.resize(S);
+  for (int k = 0; k < S; ++k) {
+    auto coverage = [&](double s2) {
+      int in = 0;
+      for (std::size_t i = 0; i < r2[k].size(); ++i) in += r2[k][i] <= s2 + var_w[k][i] ? 1 : 0;
+      return static_cast<double>(in) / static_cast<double>(r2[k].size());
+    };
+    double lo = 0.0, hi = *std::max_element(r2[k].begin(), r2[k].end()) + 1e-300;
+    if (coverage(lo) >= kOneSigma) hi = 0.0;
+    for (int it = 0; it < 200 && hi > lo; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (coverage(mid) >= kOneSigma ? hi : lo) = mid;
+    }
+    model->output_noise_variance(k) = hi;
+  }
+  model->noise_calibration =
+      std::to_string(folds) +
+      "-fold cross-validation on the training table: per output the "
+      "smallest noise variance at which +-1 sigma (noise + weight variance of the fold model) "
+      "covers 68.27 % of the held-out errors";
 }
 
 }  // namespace whirl::nn

@@ -5,8 +5,18 @@
 //
 // Predictive uncertainty (MacKay 1992 section 4 "error bars"; Bishop 1995 section 10.3), per
 // output k at input x, in the normalized target space:
-//   var_k(x) = sigma_nu^2 + g_k(x)' A^-1 g_k(x),
-//   sigma_nu^2 = 1 / (2 beta)               (noise variance; = ssE / (n - gamma) after training),
+//   var_k(x) = sigma_k^2 + g_k(x)' A^-1 g_k(x),
+//   sigma_k^2 = the noise variance of output k (schema 2, issue 11): calibrated by K-fold cross-
+//               validation when the model is trained (CalibrateOutputNoise below):
+//               sigma_k^2 = max(0, mean_i r_ik^2 - mean_i v_ik), r_ik the held-out error of
+//               the fold model at row i and v_ik its weight-uncertainty term g' A^-1 g there
+//               (normalized units of the full model), so that the predictive variance matches the
+//               out-of-sample squared error on average, per output.
+//               Schema 1 files (one level for both outputs, trainbr's sigma_nu^2 = 1 / (2 beta) =
+//               ssE / (n - gamma)) still load, with sigma_k^2 = sigma_nu^2 for both outputs.
+//               Why: trainbr's one level is ssE / (n - gamma) over both outputs; with 20 rows
+//               gamma nears n and it shrinks (+-1 sigma covered 47-60 % of hold-out errors), with
+//               500 rows one output's noise inflates the other's (96 %).
 //   A^-1 = (2 (beta J'J + alpha I))^-1        (posterior covariance of w, J at the final weights),
 //   g_k(x) = d y_k / d w at x (flat order, nn/network.h),
 // with MATLAB's alpha, beta (F = beta ssE + alpha ssX, see nn/trainbr.h for why the factors 2).
@@ -33,7 +43,7 @@ struct VariableInfo {
 };
 
 struct Model {
-  static constexpr int kSchemaVersion = 1;
+  static constexpr int kSchemaVersion = 2;  ///< 1 still loads (one noise level)
   static constexpr const char* kFormat = "whirl-nn-model";
 
   Network network;                          ///< weights in the normalized space
@@ -52,7 +62,9 @@ struct Model {
   std::string training_data;                ///< provenance: file name of the training table
   int training_samples = 0;                 ///< Q
   std::string error_space = "normalized";   ///< errors measured in the mapminmax target space
-  double noise_variance = 0;                ///< sigma_nu^2 = 1 / (2 beta), normalized target units
+  double noise_variance = 0;                ///< trainbr's sigma_nu^2 = 1 / (2 beta), normalized
+  Eigen::VectorXd output_noise_variance;    ///< sigma_k^2 per output, normalized target units
+  std::string noise_calibration;            ///< how sigma_k^2 was obtained (provenance)
   Eigen::MatrixXd posterior_covariance;     ///< A^-1, N x N, flat order (see header comment)
 
   /// Throws InputError naming the key and the rule if anything is missing or inconsistent.
@@ -88,6 +100,9 @@ struct ModelTrainOptions {
   std::uint64_t seed = 1;               ///< restart k initializes with seed + k
   int restarts = 1;                     ///< keep the highest log evidence of this many runs
   TrainOptions train;                   ///< trainbr options (MATLAB defaults)
+  /// Per-output noise by K-fold cross-validation (0 = keep trainbr's one level for both outputs;
+  /// else min(noise_folds, rows) folds, each trained with min(restarts, 3) restarts).
+  int noise_folds = 5;
 };
 
 /// Progress of TrainModel: restart index (0-based) and the epoch just finished.
@@ -98,6 +113,12 @@ using ModelProgress = std::function<void(int restart, const EpochInfo& info)>;
 /// fewer than 2 rows or inconsistent lengths.
 Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  const std::string& data_name, const ModelProgress& progress = {});
+
+/// Sets model->output_noise_variance and noise_calibration by K-fold cross-validation on the
+/// table the model was trained on (see the header comment). InputError if folds < 2 or the table
+/// has fewer rows than folds.
+void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& options, int folds,
+                          Model* model);
 
 /// Inputs (5 x Q) and targets (2 x Q) of a table, original units.
 Eigen::MatrixXd InputMatrix(const std::vector<ProcessInputs>& inputs);

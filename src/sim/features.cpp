@@ -28,6 +28,10 @@ void CheckOptions(const SettleOptions& o) {
     fail("noise_sigma_multiplier", o.noise_sigma_multiplier, "must be >= 0");
   if (!(o.fit_start_factor >= 1)) fail("fit_start_factor", o.fit_start_factor, "must be >= 1");
   if (o.max_iterations < 1) fail("max_iterations", o.max_iterations, "must be >= 1");
+  if (!(o.min_window_s > 0)) fail("min_window_s", o.min_window_s, "must be > 0");
+  if (!(o.window_growth > 1)) fail("window_growth", o.window_growth, "must be > 1");
+  if (!(o.window_to_settle_ratio >= 1))
+    fail("window_to_settle_ratio", o.window_to_settle_ratio, "must be >= 1");
 }
 
 // Plateau + drift fitted to samples [begin, n): coef(0) = P, coef(k) = c_k of u^k.
@@ -75,8 +79,9 @@ DriftFit FitPlateauAndDrift(const std::vector<double>& u, const std::vector<doub
 
 }  // namespace
 
-SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& options) {
-  CheckOptions(options);
+namespace {
+
+void CheckCurve(const ElongationCurve& curve) {
   const std::size_t n = curve.size();
   if (n < 10 || curve.elongation_um.size() != n)
     throw InputError("elongation curve: " + std::to_string(n) +
@@ -92,6 +97,11 @@ SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& 
                        " at sample " + std::to_string(i + 1) +
                        " breaks the rule: time must increase strictly");
   }
+}
+
+// Steps 1-6 of the header on the whole of `curve`.
+SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& options) {
+  const std::size_t n = curve.size();
   const std::vector<double>& t = curve.time_s;
   const std::vector<double>& y = curve.elongation_um;
   const double t0 = t.front(), span = t.back() - t.front();
@@ -184,6 +194,135 @@ SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& 
       << FormatNumber(a.features.settle_time_s) << " s"
       << (a.settled_before_tail ? "" : " (NOT before the tail window: record too short)");
   a.message = msg.str();
+  return a;
+}
+
+// Step S: transient shape + drift, y = L f(t; t_s) + c2 u^2 + c3 u^3, fitted to the whole record
+// (u = (t - t0) / span). For a fixed t_s the model is linear in (L, c2, c3).
+struct ShapeFit {
+  double settle_s = 0, plateau = 0, c2 = 0, c3 = 0, rms = 0;
+  double Drift(double u) const { return u * u * (c2 + c3 * u); }
+};
+
+double Shape(double t, double settle_s, const SettleOptions& o) {
+  if (t >= settle_s) return 1.0;
+  if (t <= 0) return 0.0;
+  return std::atan(o.shape_k * std::pow(t / settle_s, o.time_exponent)) / std::atan(o.shape_k);
+}
+
+ShapeFit FitShapeAt(const ElongationCurve& c, double settle_s, const SettleOptions& o) {
+  const double t0 = c.time_s.front(), span = c.time_s.back() - t0;
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d aty = Eigen::Vector3d::Zero();
+  double yy = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const double u = (c.time_s[i] - t0) / span;
+    const Eigen::Vector3d a(Shape(c.time_s[i] - t0, settle_s, o), u * u, u * u * u);
+    ata += a * a.transpose();
+    aty += a * c.elongation_um[i];
+    yy += c.elongation_um[i] * c.elongation_um[i];
+  }
+  const Eigen::Vector3d x = ata.ldlt().solve(aty);
+  ShapeFit f;
+  f.settle_s = settle_s;
+  f.plateau = x(0);
+  f.c2 = x(1);
+  f.c3 = x(2);
+  const double sse = std::max(0.0, yy - 2 * x.dot(aty) + x.dot(ata * x));
+  f.rms = std::sqrt(sse / static_cast<double>(c.size()));
+  return f;
+}
+
+// Least squares over t_s: a log-spaced grid over (span / 500, span], then golden-section search
+// between the neighbours of the best grid point.
+ShapeFit FitShape(const ElongationCurve& c, const SettleOptions& o) {
+  const double span = c.time_s.back() - c.time_s.front();
+  const double lo = std::log(span / 500.0), hi = std::log(span);
+  constexpr int kGrid = 80;
+  ShapeFit best;
+  int best_k = 0;
+  for (int k = 0; k <= kGrid; ++k) {
+    const ShapeFit f = FitShapeAt(c, std::exp(lo + (hi - lo) * k / kGrid), o);
+    if (k == 0 || f.rms < best.rms) best = f, best_k = k;
+  }
+  double a = lo + (hi - lo) * std::max(0, best_k - 1) / kGrid;
+  double b = lo + (hi - lo) * std::min(kGrid, best_k + 1) / kGrid;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int it = 0; it < 40; ++it) {
+    const double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    const ShapeFit f1 = FitShapeAt(c, std::exp(x1), o), f2 = FitShapeAt(c, std::exp(x2), o);
+    if (f1.rms < f2.rms)
+      b = x2;
+    else
+      a = x1;
+    if (f1.rms < best.rms) best = f1;
+    if (f2.rms < best.rms) best = f2;
+  }
+  return best;
+}
+
+SettleAnalysis AnalyzeByShape(const ElongationCurve& c, const SettleOptions& o) {
+  const ShapeFit f = FitShape(c, o);
+  const double t0 = c.time_s.front(), span = c.time_s.back() - t0;
+  SettleAnalysis a;
+  const double u_s = f.settle_s / span;
+  a.features.settle_time_s = f.settle_s;
+  a.features.max_elongation_um = f.plateau;
+  a.drift_at_settle_um = f.Drift(u_s);
+  a.drift_at_end_um = f.Drift(1.0);
+  a.plateau_slope_um_per_s = (f.Drift(1.0) - f.Drift(u_s)) / std::max(1e-9, span - f.settle_s);
+  a.noise_std_um = f.rms;
+  a.fit_start_s = t0;
+  a.iterations = 1;
+  a.settled_before_tail = f.settle_s < (1.0 - o.tail_fraction) * span;
+  std::ostringstream msg;
+  msg << "least-squares fit over " << FormatNumber(span) << " s of L atan(" << o.shape_k
+      << " (t/t_s)^" << o.time_exponent << ")/atan(" << o.shape_k
+      << ") + drift c2 u^2 + c3 u^3: L = " << FormatNumber(f.plateau)
+      << " um, t_s = " << FormatNumber(f.settle_s) << " s, drift "
+      << FormatNumber(a.drift_at_settle_um) << " um at t_s, " << FormatNumber(a.drift_at_end_um)
+      << " um at the end, residual rms " << FormatNumber(f.rms) << " um"
+      << (a.settled_before_tail ? "" : " (t_s NOT before the last part of the record: too short)");
+  a.message = msg.str();
+  return a;
+}
+
+SettleAnalysis AnalyzeWindow(const ElongationCurve& c, const SettleOptions& o) {
+  return o.method == SettleMethod::kShapeFit ? AnalyzeByShape(c, o) : AnalyzeRecord(c, o);
+}
+
+// The first samples of `curve` up to time t0 + window_s.
+ElongationCurve Head(const ElongationCurve& curve, double window_s) {
+  ElongationCurve h;
+  const double t_end = curve.time_s.front() + window_s;
+  for (std::size_t i = 0; i < curve.size() && curve.time_s[i] <= t_end; ++i) {
+    h.time_s.push_back(curve.time_s[i]);
+    h.elongation_um.push_back(curve.elongation_um[i]);
+  }
+  return h;
+}
+
+}  // namespace
+
+SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& options) {
+  CheckOptions(options);
+  CheckCurve(curve);
+  const double record_s = curve.time_s.back() - curve.time_s.front();
+  int windows = 0;
+  for (double w = options.min_window_s; w < record_s; w *= options.window_growth) {
+    const ElongationCurve head = Head(curve, w);
+    if (head.size() < 10) continue;
+    ++windows;
+    SettleAnalysis a = AnalyzeWindow(head, options);
+    if (a.features.settle_time_s * options.window_to_settle_ratio <= w) {
+      a.windows = windows;
+      a.window_s = w;
+      return a;
+    }
+  }
+  SettleAnalysis a = AnalyzeWindow(curve, options);
+  a.windows = windows + 1;
+  a.window_s = record_s;
   return a;
 }
 

@@ -210,7 +210,33 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
   record(0.0);
 
   double heat_in = 0.0, heat_lost = 0.0, loss_prev = loss_rate_w(0.0), peak = 0.0;
-  std::vector<double> theta_new(n);
+  std::vector<double> theta_new(n), share(n);
+  const bool extra = disturbances.enabled;
+  const double rest_w = extra ? std::max(0.0, disturbances.steady_rest_heat_w) : 0.0;
+  const double rest_offset_m = disturbances.steady_rest_offset_mm * 1e-3;
+  const double rest_width_m = std::max(disturbances.steady_rest_width_mm * 1e-3, 1e-9);
+  // Deposits power (W) of a box of `width` centred `offset` towards the chuck from the cut,
+  // averaged over [w0, w1], into rhs; returns the energy deposited, J.
+  auto deposit = [&](double power, double offset, double width, double w0, double w1) {
+    if (!(power > 0)) return 0.0;
+    const double energy = power * (w1 - w0);
+    const double s0 = x_start_m - offset - v_m_s * w1, s1 = x_start_m - offset - v_m_s * w0;
+    const double lo = s0 - 0.5 * width, hi = s1 + 0.5 * width;
+    const int i0 = std::max(0, static_cast<int>(std::floor(lo / dx)));
+    const int i1 = std::min(n - 1, static_cast<int>(std::floor(hi / dx)));
+    double total = 0.0;
+    for (int i = i0; i <= i1; ++i) {
+      const double ov = s1 > s0 ? SweptOverlap(s0, s1, width, i * dx, (i + 1) * dx)
+                                : std::max(0.0, std::min((i + 1) * dx, s0 + 0.5 * width) -
+                                                    std::max(i * dx, s0 - 0.5 * width));
+      share[i] = ov;
+      total += ov;
+    }
+    // Normalised over the cells inside the blank: all heat enters the workpiece.
+    if (!(total > 0)) return 0.0;
+    for (int i = i0; i <= i1; ++i) rhs[i] += energy / dt * share[i] / total;
+    return energy;
+  };
   for (long step = 1; step <= n_steps; ++step) {
     const double t = step * dt;
     const double amb = drift_k_per_s * t;
@@ -223,30 +249,15 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
     }
     rhs[0] += g_chuck * amb;
     rhs[n - 1] += g_end * amb;
-    // Heat source: the box's overlap averaged over the window [t - dt/2, t + dt/2] (clipped to the
-    // heating period), so the deposit is centred on t (second-order consistent with BDF2) and
-    // moves continuously.
+    // Heat sources: the box's overlap averaged over the window [t - dt/2, t + dt/2] (clipped to
+    // the heating period), so the deposit is centred on t (second-order consistent with BDF2) and
+    // moves continuously. The cut (tool wear scales it) and, if any, the steady rest.
     const double w0 = std::max(0.0, t - 0.5 * dt), w1 = std::min(t_heat_end, t + 0.5 * dt);
-    if (q_w > 0 && w1 > w0) {
-      const double energy = q_w * (w1 - w0);  // J deposited this step
-      const double s0 = x_start_m - v_m_s * w1, s1 = x_start_m - v_m_s * w0;  // s0 <= s1
-      const double lo = s0 - 0.5 * w_m, hi = s1 + 0.5 * w_m;
-      const int i0 = std::max(0, static_cast<int>(std::floor(lo / dx)));
-      const int i1 = std::min(n - 1, static_cast<int>(std::floor(hi / dx)));
-      double total = 0.0;
-      for (int i = i0; i <= i1; ++i) {
-        const double ov = s1 > s0 ? SweptOverlap(s0, s1, w_m, i * dx, (i + 1) * dx)
-                                  : std::max(0.0, std::min((i + 1) * dx, s0 + 0.5 * w_m) -
-                                                      std::max(i * dx, s0 - 0.5 * w_m)) *
-                                        1.0;
-        theta_new[i] = ov;
-        total += ov;
-      }
-      // Normalised over the cells inside the blank: all heat enters the workpiece.
-      if (total > 0) {
-        for (int i = i0; i <= i1; ++i) rhs[i] += energy / dt * theta_new[i] / total;
-        heat_in += energy;
-      }
+    if (w1 > w0) {
+      const double wear_rel = extra ? disturbances.tool_wear_heat_rise_rel : 0.0;
+      const double wear = 1.0 + wear_rel * 0.5 * (w0 + w1) / std::max(t_heat_end, 1e-9);
+      heat_in += deposit(q_w * wear, 0.0, w_m, w0, w1);
+      heat_in += deposit(rest_w, rest_offset_m, rest_width_m, w0, w1);
     }
     theta_new.assign(rhs.begin(), rhs.end());
     if (step == 1)

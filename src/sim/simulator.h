@@ -78,6 +78,17 @@ struct DisturbanceOptions {
   /// +-0.5 um (95 %).
   bool measurement_noise = true;
   double measurement_noise_std_um = 0.25;
+  /// Tool wear (issue 11 scenario): the heat input rises linearly over the cut, from 1 at t = 0 to
+  /// 1 + tool_wear_heat_rise_rel at the end of the thread (flank wear raises the cutting force and
+  /// the rubbing; assumption: +20 % over a 2 h tool life), -. Deterministic; 0 = off.
+  double tool_wear_heat_rise_rel = 0.0;
+  /// Friction heat of a steady rest riding on the blank (issue 11 scenario): this power, W, spread
+  /// over steady_rest_width_mm, steady_rest_offset_mm from the cut on the unmachined (chuck) side,
+  /// moving with the whirling head. Deterministic; 0 = off (assumption: tens of W for a loaded
+  /// rest pad).
+  double steady_rest_heat_w = 0.0;
+  double steady_rest_offset_mm = 300.0;  ///< distance from the cut towards the chuck, mm
+  double steady_rest_width_mm = 20.0;    ///< axial contact width of the rest, mm
 };
 
 /// The disturbance values actually applied (1, 1, 0 when disabled).

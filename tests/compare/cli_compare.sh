@@ -16,7 +16,7 @@ n, m = s["none"]["metrics"], s["model"]["metrics"]
 assert m["accumulated_1000_um"] < n["accumulated_1000_um"], (m, n)
 r = j["reductions"]["model_vs_none"]["accumulated_1000_pct"]
 assert abs(r - 100 * (1 - m["accumulated_1000_um"] / n["accumulated_1000_um"])) < 1e-6
-for k in ("none", "traditional", "model"):
+for k in ("none", "ramp", "traditional", "regression", "model"):
     assert s[k]["iso"]["reached"] in ("P1", "P3", "P5", "T7", "T10", "none")
 PY
 test -s rep/index.html && test -s rep/report.json && test -s rep/reference_80x10x6000_lead.csv
@@ -65,4 +65,22 @@ j = json.load(open("evals.json"))
 # the per-seed screws are in the output, so the pooled figure can be recomputed from it
 assert [len(s["screws"]) for s in j["seeds"]] == [3, 3]
 PY
+# Named scenarios (issue 11): the table has a row per scenario and strategy; the out-of-range
+# scenario needs the explicit override.
+"$whirl" evaluate --scenarios today,steady-rest --random 2 --seed 3 --json > scen.json
+python3 - <<'PY'
+import json
+j = json.load(open("scen.json"))
+assert j["schema"] == "whirl.evaluate_scenarios"
+assert [s["scenario"] for s in j["scenarios"]] == ["today", "steady-rest"]
+for s in j["scenarios"]:
+    a = s["summary"]["absolute_um"]
+    assert set(a) == {"none", "ramp", "traditional", "regression", "model"}, a
+    for v in a.values():
+        assert v["accumulated_1000_worst_um"] >= v["accumulated_1000_median_um"] >= 0
+PY
+if "$whirl" evaluate --scenarios out-of-range --random 1 > /dev/null 2> oor.txt; then exit 1; fi
+grep -q -- "--allow-extrapolation" oor.txt
+if "$whirl" evaluate --scenarios nonsense --random 1 > /dev/null 2> bad_scen.txt; then exit 1; fi
+grep -q "unknown scenario 'nonsense'" bad_scen.txt
 echo OK

@@ -140,7 +140,8 @@ TEST_F(ShippedModel, ReferenceScrewComparisonIsConsistent) {
               1e-9);
   // The applied plan compensation stays within the plan tolerance of the predicted curve.
   for (std::size_t i = 0; i < c.truth.size(); ++i)
-    ASSERT_NEAR(c.model_compensation_um[i], c.predicted_curve.ElongationUm(c.truth.time_s[i]),
+    ASSERT_NEAR(c.compensation_um[static_cast<std::size_t>(Strategy::kModel)][i],
+                c.predicted_curve.ElongationUm(c.truth.time_s[i]),
                 c.plan.options.tolerance_um + 1e-6)
         << "t = " << c.truth.time_s[i];
   // Every strategy's lead starts at 0 and covers the thread.

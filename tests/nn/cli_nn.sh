@@ -28,7 +28,7 @@ expect 0 "" -- "$whirl" train --data "$data" --out m1.json --seed 3 --restarts 2
 grep -q "gamma" out.txt || fail "train summary lacks gamma"
 grep -q "train: done" err.txt || fail "no progress on stderr"
 grep -q '"error_space": "normalized"' m1.json || fail "model lacks error_space"
-grep -q '"schema_version": 1' m1.json || fail "model lacks schema_version"
+grep -q '"schema_version": 2' m1.json || fail "model lacks schema_version"
 # same seed => byte-identical file; --json summary
 expect 0 "" -- "$whirl" train --data "$data" --out m2.json --seed 3 --restarts 2 --json
 cmp -s m1.json m2.json || fail "same seed gave different model files"
@@ -91,7 +91,7 @@ expect 1 "nan.csv:3" -- "$whirl" predict --model m1.json --input nan.csv
 head -c 3000 m1.json > trunc.json
 expect 1 "trunc.json" -- "$whirl" predict --model trunc.json --hardness 62 --diameter 80 \
   --pitch 10 --raceway-radius 5 --cutting-speed 180
-sed 's/"schema_version": 1/"schema_version": 7/' m1.json > v7.json
+sed 's/"schema_version": 2/"schema_version": 7/' m1.json > v7.json
 expect 1 "schema_version" -- "$whirl" predict --model v7.json --hardness 62 --diameter 80 \
   --pitch 10 --raceway-radius 5 --cutting-speed 180
 expect 1 "" -- "$whirl" predict --model m1.json --hardness 62 --diameter -80 --pitch 10 \

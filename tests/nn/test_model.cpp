@@ -70,6 +70,21 @@ TEST(Model, SaveLoadRoundTripPredictsBitIdentically) {
   EXPECT_EQ(j.at("schema_version"), Model::kSchemaVersion);
 }
 
+// Schema 1 files (one noise level, before issue 11) still load: both outputs get that level.
+TEST(Model, SchemaOneFileLoadsWithOneNoiseLevelForBothOutputs) {
+  const Model& m = SharedModel();
+  nlohmann::json j = m;
+  j["schema_version"] = 1;
+  j["uncertainty"].erase("output_noise_variance_normalized");
+  j["uncertainty"].erase("noise_calibration");
+  WriteFileAtomic(Scratch("v1.json"), j.dump(1));
+  const Model old = LoadModel(Scratch("v1.json"));
+  EXPECT_EQ(old.output_noise_variance(0), m.noise_variance);
+  EXPECT_EQ(old.output_noise_variance(1), m.noise_variance);
+  const auto p = Predict(old, synth::SyntheticProcessTable(1, 0.0, 3).inputs[0]);
+  EXPECT_GT(p.stddev.settle_time_s, 0);
+}
+
 TEST(Model, PredictMatchesScalingAndLaplaceFormulaByFiniteDifferences) {
   const Model& m = SharedModel();
   const ProcessTable queries = synth::SyntheticProcessTable(10, 0.0, 5);
@@ -97,14 +112,14 @@ TEST(Model, PredictMatchesScalingAndLaplaceFormulaByFiniteDifferences) {
     }
     for (int k = 0; k < 2; ++k) {
       const double var =
-          m.noise_variance + g.row(k) * m.posterior_covariance * g.row(k).transpose();
+          m.output_noise_variance(k) + g.row(k) * m.posterior_covariance * g.row(k).transpose();
       const double sd = std::sqrt(var) * half(k);
       const double got = k == 0 ? preds[q].stddev.max_elongation_um : preds[q].stddev.settle_time_s;
       EXPECT_NEAR(got, sd, 1e-6 * sd);
       const double noise =
           k == 0 ? preds[q].noise_stddev.max_elongation_um : preds[q].noise_stddev.settle_time_s;
       EXPECT_GE(got, noise);  // weight uncertainty only adds
-      EXPECT_NEAR(noise, std::sqrt(m.noise_variance) * half(k), 1e-12 * noise);
+      EXPECT_NEAR(noise, std::sqrt(m.output_noise_variance(k)) * half(k), 1e-12 * noise);
     }
   }
 }
@@ -185,6 +200,10 @@ TEST(Model, LoadRejectsWrongTruncatedOrInconsistentFiles) {
        "posterior_covariance"},
       {"noise", [](auto& j) { j["uncertainty"]["noise_variance_normalized"] = -1.0; },
        "noise_variance"},
+      {"per-output noise",
+       [](auto& j) { j["uncertainty"]["output_noise_variance_normalized"].erase(1); },
+       "output_noise_variance"},
+      {"schema", [](auto& j) { j["schema_version"] = 3; }, "schema_version"},
       {"summary", [](auto& j) { j["training_summary"].erase("gamma"); }, "gamma"},
       {"seed", [](auto& j) { j["seed"] = -3; }, "seed"},
   };

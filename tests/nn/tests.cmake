@@ -7,3 +7,5 @@ whirl_add_gtest(test_nn SOURCES
 whirl_add_cli_test(cli_nn ${CMAKE_CURRENT_LIST_DIR}/cli_nn.sh)
 # Retrains models/default.json with scripts/train_default.sh and compares bytes (~2 s).
 whirl_add_cli_test(nn_default_model ${CMAKE_CURRENT_LIST_DIR}/default_model.sh)
+# Issue 11: coverage of the predictive intervals on a generated 200-row hold-out (~10 s).
+whirl_add_gtest(test_calibration SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_calibration.cpp LABELS nn)

@@ -270,7 +270,9 @@ TEST(Features, SettleTimeOfSyntheticCurvesWithNoiseAndDrift) {
       c.elongation_um.push_back(plateau * (1 - std::exp(-t / tau)) + drift_um_per_s * t +
                                 0.25 * rng.Normal());
     }
-    const SettleAnalysis a = AnalyzeSettle(c);
+    SettleOptions band;  // a first-order rise: the 2 % band criterion, not the arctan shape
+    band.method = SettleMethod::kBand;
+    const SettleAnalysis a = AnalyzeSettle(c, band);
     const double expected = tau * std::log(50.0);
     EXPECT_NEAR(a.features.settle_time_s, expected, 0.15 * expected + 15) << a.message;
     // The plateau where it is reached: the drift accumulated by then is included.

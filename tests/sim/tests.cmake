@@ -1,4 +1,5 @@
 whirl_add_gtest(test_sim SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_sim.cpp LABELS sim)
+whirl_add_gtest(test_features_drift SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_features_drift.cpp LABELS sim)
 whirl_add_cli_test(sim_cli_simulate ${CMAKE_CURRENT_LIST_DIR}/cli_simulate.sh)
 whirl_add_cli_test(sim_cli_shipped_tables ${CMAKE_CURRENT_LIST_DIR}/cli_shipped_tables.sh small)
 whirl_add_cli_test(sim_cli_shipped_500 ${CMAKE_CURRENT_LIST_DIR}/cli_shipped_tables.sh 500)
