@@ -1,14 +1,12 @@
 #include "sim/dataset.h"
 
-#include <atomic>
+#include <algorithm>
 #include <cmath>
-#include <exception>
-#include <mutex>
 #include <sstream>
-#include <thread>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "sim/random.h"
 
 namespace whirl::sim {
@@ -87,38 +85,17 @@ Dataset GenerateDataset(const DatasetOptions& options,
 
   SimOptions sim = options.sim;
   sim.duration_s = options.window_s;
-  std::atomic<std::size_t> next{0};
-  std::size_t done = 0;
-  std::mutex mutex;
-  std::exception_ptr error;
-  auto worker = [&]() {
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= n) return;
-      try {
+  ParallelFor(
+      n, std::max(1, options.threads),
+      [&](std::size_t i) {
         DisturbanceOptions dist = options.disturbance;
         dist.seed = MixSeed(options.seed, i);
         SimulationResult r = Simulate(RowScrew(points[i]), sim, dist);
         out.settle[i] = AnalyzeSettle(r.curve, sim.settle);
         out.table.targets[i] = out.settle[i].features;
         out.curves[i] = std::move(r.curve);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!error) error = std::current_exception();
-        next = n;
-        return;
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      ++done;
-      if (progress) progress(done, n);
-    }
-  };
-  const int threads = std::max(1, std::min<int>(options.threads, static_cast<int>(n)));
-  std::vector<std::thread> pool;
-  for (int k = 1; k < threads; ++k) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
+      },
+      progress);
 
   const DisturbanceOptions& d = options.disturbance;
   std::ostringstream s;
