@@ -7,10 +7,8 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "core/atomic_file.h"
-#include "core/csv.h"
+#include "compare/plan_document.h"
 #include "core/error.h"
-#include "core/json_file.h"
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
 #include "nn/model.h"
@@ -45,30 +43,19 @@ void Run(const PlanCliOptions& o) {
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   const sim::Kinematics kin = sim::ComputeKinematics(screw);
 
-  nlohmann::json prediction;
-  Features features;
+  compare::PlanSource plan_source;
   std::string source;
   if (!by_features) {
     const nn::Model model = nn::LoadModel(o.model_path);
     const nn::Prediction pred = nn::Predict(model, screw.process);
     GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.screw_path,
                         o.allow_extrapolation);
-    features = pred.mean;
-    prediction = {{"model", o.model_path},
-                  {"max_elongation_um", pred.mean.max_elongation_um},
-                  {"max_elongation_std_um", pred.stddev.max_elongation_um},
-                  {"settle_time_s", pred.mean.settle_time_s},
-                  {"settle_time_std_s", pred.stddev.settle_time_s},
-                  {"outside_domain", pred.outside_domain},
-                  {"outside_domain_fields", pred.outside_domain_fields}};
+    plan_source = {o.model_path, pred, pred.mean};
     source = "model " + o.model_path + ", screw " + o.screw_path;
   } else {
     if (std::isnan(o.max_elongation_um) || std::isnan(o.settle_time_s))
       throw InputError("plan: --max-elongation and --settle-time go together");
-    features = {o.max_elongation_um, o.settle_time_s};
-    prediction = {{"model", nullptr},
-                  {"max_elongation_um", features.max_elongation_um},
-                  {"settle_time_s", features.settle_time_s}};
+    plan_source.features = {o.max_elongation_um, o.settle_time_s};
     source = "given features, screw " + o.screw_path;
   }
   if (options.direction < 0 && options.sign == interp::SignConvention::kSubtract)
@@ -78,29 +65,14 @@ void Run(const PlanCliOptions& o) {
         "setpoint (see 'whirl plan --help'); keeping 'subtract' as asked");
 
   const fit::ArctanCurve curve =
-      fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
+      fit::ArctanCurve::FromFeatures(plan_source.features, o.shape_k, o.time_exponent);
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
-
   const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();
-
-  nlohmann::json j = plan;
-  j["provenance"] = provenance;
-  j["screw"] = screw;
-  j["prediction"] = prediction;
-  j["curve"] = curve;
-  j["kinematics"] = {{"axial_feed_mm_min", kin.axial_feed_mm_min},
-                     {"cutting_time_s", kin.cutting_time_s},
-                     {"workpiece_speed_rpm", kin.workpiece_speed_rpm},
-                     {"ring_speed_rpm", kin.ring_speed_rpm}};
-  // Render everything first, then write: a failure leaves no partial set of files.
-  const std::string csv_text = o.csv_path.empty() ? "" : interp::FormatPlcCsv(plan, {provenance});
-  interp::NcProgramInfo info;
-  info.curve_source = curve.Describe() + " (" + source + ")";
-  const std::string nc_text = o.nc_path.empty() ? "" : interp::FormatNcProgram(plan, info);
-  if (!o.out_path.empty()) WriteJsonFile(o.out_path, j);
-  if (!o.csv_path.empty()) WriteFileAtomic(o.csv_path, csv_text);
-  if (!o.nc_path.empty()) WriteFileAtomic(o.nc_path, nc_text);
+  const nlohmann::json j =
+      compare::PlanDocument(plan, curve, screw, kin, plan_source, provenance);
+  compare::WritePlanFiles({o.out_path, o.csv_path, o.nc_path}, j, plan, provenance,
+                          curve.Describe() + " (" + source + ")");
 
   if (o.json) {
     PrintJson(j);
@@ -146,8 +118,10 @@ void RegisterPlan(CLI::App& app) {
       "towards the chuck, so the growth of the unmachined section points against the travel;\n"
       "with --direction +1 following it means dK = -l, assuming the control adds dK to the\n"
       "setpoint (the manual does not say plainly: verify once on the machine). A slope above\n"
-      "MD32760 is an error. Outputs: plan JSON (--out), PLC table CSV (--csv), NC program with\n"
-      "synchronized actions (--nc); all written atomically. Requires MD32750 = 3.");
+      "MD32760 is an error. Outputs: plan JSON (--out, schema whirl.plan v1, the same document\n"
+      "as 'whirl demo'), PLC table CSV (--csv), NC program with synchronized actions (--nc);\n"
+      "all-or-nothing: if one cannot be written (missing directory, a directory, symlink, FIFO or\n"
+      "device at the path) none is and previous files stay. Requires MD32750 = 3.");
   sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
       ->check(CLI::ExistingFile);
   sub->add_option("--screw", o->screw_path,
