@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers shared by the subcommands. The library never includes CLI11; this folder does.
 #include <cstddef>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -66,8 +67,16 @@ class Progress {
 /// past screws.
 inline constexpr const char* kHistoryTable = "datasets/whirling_500.csv";
 
-/// Where the shipped files live: $WHIRL_HOME if set, else the source tree this binary was built
-/// from. Used by `whirl demo` and defaults such as kHistoryTable.
+/// Where the shipped files (models/, datasets/ with screws/ and standards/) live, in this order:
+/// $WHIRL_HOME if set and not empty; <dir of the executable>/../share/whirl when it holds
+/// models/ (an installed whirl: cmake --install build --prefix P puts them in P/share/whirl);
+/// else the source tree this binary was built from (running build/whirl). Used by `whirl demo`
+/// and defaults such as kHistoryTable. Described to users in `whirl --help` (kShippedFilesHelp).
+std::filesystem::path ShippedFilesRoot();
+inline constexpr const char* kShippedFilesHelp =
+    "Shipped files (models/default.json, datasets/...) are looked up in $WHIRL_HOME if set, else\n"
+    "in <prefix>/share/whirl next to an installed <prefix>/bin/whirl, else in the source tree\n"
+    "the binary was built from.";
 std::string ProjectPath(const std::string& relative);
 
 }  // namespace whirl::cli
