@@ -100,7 +100,7 @@ void RegisterCompare(CLI::App& app) {
                   "screw file (JSON, e.g. datasets/screws/reference_80x10x6000.json)")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--seed", o->seed, "seed of the truth's disturbances (default 1)");
+  AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-disturbances", o->no_disturbances,
                 "simulate the truth without disturbances (the model's own world)");
   sub->add_option("--report", o->report_dir,

@@ -152,7 +152,7 @@ void RegisterDemo(CLI::App& app) {
       "the lead-error reductions (um and %).");
   sub->add_option("--out-dir", o->out_dir, "output directory (default whirl-demo-out)");
   sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists");
-  sub->add_option("--seed", o->seed, "seed of the truth's disturbances (default 1)");
+  AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");
   sub->callback([o] { RunDemo(*o); });
 }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +26,19 @@ void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent)
                   "the first segment's SD43910 can exceed the MD32760 cap (an error)")
       ->capture_default_str()
       ->check(CLI::Range(fit::kMinTimeExponent, fit::kMaxTimeExponent));
+}
+
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help) {
+  const auto rule = [](std::string& text) -> std::string {
+    const bool digits = !text.empty() && text.size() <= 20 &&
+                        text.find_first_not_of("0123456789") == std::string::npos;
+    errno = 0;
+    if (digits) (void)std::strtoull(text.c_str(), nullptr, 10);
+    if (digits && errno == 0) return "";
+    return "seed '" + text + "' breaks the rule: a whole number in [0, 18446744073709551615]";
+  };
+  return sub->add_option("--seed", *seed, help + " [0 .. 2^64-1]")
+      ->check(CLI::Validator(rule, "UINT64"));
 }
 
 int RunApp(CLI::App& app, int argc, char** argv) {

@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers shared by the subcommands. The library never includes CLI11; this folder does.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace whirl::cli {
@@ -38,6 +40,10 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
 /// The shape options of the arctangent curve, shared by curve, plan, compare and evaluate:
 /// --shape-k K and --time-exponent P, with their ranges and defaults (fit/arctan_curve.h).
 void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent);
+
+/// A --seed option: a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5" or a larger
+/// number is a parse error naming the rule, never wrapped. Returns the option for chaining.
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help);
 
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.
 void PrintJson(const nlohmann::json& j);

@@ -1,8 +1,12 @@
 #include "compare/report.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <set>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -39,11 +43,30 @@ std::string Terminal(const std::string& command) {
                : "png size 1000,560 noenhanced";
 }
 
+// A fresh folder inside the report directory, removed with everything in it on destruction.
+struct StagingDir {
+  std::filesystem::path path;
+  explicit StagingDir(const std::filesystem::path& dir) {
+    std::random_device rd;
+    path = dir / (".whirl-report-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    std::error_code ec;
+    if (!std::filesystem::create_directory(path, ec))
+      throw InputError("report directory '" + dir.string() + "': cannot create a staging folder (" +
+                       ec.message() + ")");
+  }
+  ~StagingDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  StagingDir(const StagingDir&) = delete;
+  StagingDir& operator=(const StagingDir&) = delete;
+};
+
 struct PlotFiles {
   std::string elongation, lead, lead_start;
 };
 
-// The gnuplot script for one screw; outputs go to "<png>.tmp" and are renamed after success.
+// The gnuplot script for one screw: reads the CSVs and writes the PNGs beside it.
 std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, const PlotFiles& f,
                           const std::string& terminal) {
   const double t_end = c.truth.time_s.back();
@@ -59,7 +82,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "set style line 3 lc rgb '#2ca02c' lw 2\nset style line 4 lc rgb '#ff7f0e' lw 2 dt 4\n"
     << "set style line 5 lc rgb '#000000' pt 7 ps 0.8\n";
   // Elongation: truth vs prediction, compensation points, traditional ramp.
-  s << "set output " << GnuplotString(f.elongation + ".tmp") << "\n"
+  s << "set output " << GnuplotString(f.elongation) << "\n"
     << "set title " << GnuplotString(name + ": elongation of the unmachined section (first " +
                                      Fixed(t_zoom, 0) + " s of " + Fixed(t_end, 0) +
                                      " s cutting time)")
@@ -76,7 +99,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "set output\n";
   // Lead deviation along the whole thread.
   s << "set key below horizontal box\nset bmargin 6\n"
-    << "set output " << GnuplotString(f.lead + ".tmp") << "\n"
+    << "set output " << GnuplotString(f.lead) << "\n"
     << "set title "
     << GnuplotString(name + ": travel deviation along the thread after cooling (actual - specified)")
     << " noenhanced\n"
@@ -86,7 +109,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "  '' using 1:3 with lines ls 4 title 'traditional (experience rule)', \\\n"
     << "  '' using 1:4 with lines ls 3 title 'model-based (840D plan)'\n"
     << "set output\n";
-  s << "set output " << GnuplotString(f.lead_start + ".tmp") << "\n"
+  s << "set output " << GnuplotString(f.lead_start) << "\n"
     << "set title "
     << GnuplotString(name + ": travel deviation, first " + Fixed(std::min(l, 1000.0), 0) +
                      " mm of the thread")
@@ -205,6 +228,11 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                               "scripts/setup.sh); the HTML, CSV data and .gp scripts are written");
   const std::string terminal = gnuplot ? Terminal(options.gnuplot_command) : "pngcairo";
   bool all_rendered = gnuplot;
+  // Everything is first written into a staging folder inside `dir` (gnuplot renders there), then
+  // committed all-or-nothing (WriteFilesAtomic); the staging folder is removed in any case.
+  const StagingDir stage(dir);
+  std::vector<std::pair<std::filesystem::path, std::string>> outputs;
+  std::set<std::string> rendered;
 
   std::vector<std::string> slugs;
   nlohmann::json report_json = nlohmann::json::array();
@@ -223,8 +251,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                       c.traditional_compensation_um[i], c.model_compensation_um[i]});
     }
     auto write = [&](const std::string& name, const std::string& text) {
-      WriteFileAtomic(dir / name, text);
-      result.files.push_back(dir / name);
+      WriteFileAtomic(stage.path / name, text);
+      outputs.emplace_back(dir / name, text);
     };
     write(slug + "_elongation.csv",
           FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
@@ -270,24 +298,24 @@ ReportResult WriteReport(const std::filesystem::path& dir,
     write(slug + ".gp", GnuplotScript(c, slug, files, terminal));
     if (gnuplot) {
       // An argument vector, no shell: neither the directory nor the names are ever parsed.
-      std::filesystem::remove(dir / (slug + ".gp.log"), ec);
-      const int rc = RunProgram({options.gnuplot_command, slug + ".gp"}, dir,
-                                dir / (slug + ".gp.log"));
+      const std::string log = slug + ".gp.log";
+      const int rc =
+          RunProgram({options.gnuplot_command, slug + ".gp"}, stage.path, stage.path / log);
       bool ok = rc == 0;
       for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-        const auto tmp = dir / (png + ".tmp");
-        if (ok && std::filesystem::is_regular_file(tmp, ec) &&
-            std::filesystem::file_size(tmp, ec) > 0 &&
-            (std::filesystem::rename(tmp, dir / png, ec), !ec)) {
-          result.files.push_back(dir / png);
-        } else {
-          ok = false;
-          std::filesystem::remove(tmp, ec);
-        }
+        std::error_code ec;
+        ok = ok && std::filesystem::is_regular_file(stage.path / png, ec) &&
+             std::filesystem::file_size(stage.path / png, ec) > 0;
       }
       if (ok) {
-        std::filesystem::remove(dir / (slug + ".gp.log"), ec);
+        for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+          outputs.emplace_back(dir / png, ReadTextFile(stage.path / png));
+          rendered.insert(png);
+        }
       } else {
+        std::error_code ec;
+        if (std::filesystem::exists(stage.path / log, ec))
+          outputs.emplace_back(dir / log, ReadTextFile(stage.path / log));
         all_rendered = false;
         result.warnings.push_back("gnuplot failed on " + (dir / (slug + ".gp")).string() +
                                   " (see " + (dir / (slug + ".gp.log")).string() + "): plots of '" +
@@ -340,7 +368,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
          << ", sign " << interp::ToString(c.plan.options.sign) << ".</p>\n"
          << MetricsTable(c);
     for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-      if (gnuplot && std::filesystem::exists(dir / png))
+      if (rendered.count(png) > 0)
         body << "<p><img src='" << png << "' alt='" << png << "'></p>\n";
       else
         body << "<p class='warn'>Plot " << png << " not rendered (see warnings).</p>\n";
@@ -354,11 +382,11 @@ ReportResult WriteReport(const std::filesystem::path& dir,
   }
   result.plots_rendered = all_rendered && !comparisons.empty();
 
-  WriteJsonFile(dir / "report.json", {{"schema", "whirl.report"},
-                                      {"schema_version", 1},
-                                      {"provenance", options.provenance},
-                                      {"comparisons", report_json}});
-  result.files.push_back(dir / "report.json");
+  const nlohmann::json report = {{"schema", "whirl.report"},
+                                 {"schema_version", 1},
+                                 {"provenance", options.provenance},
+                                 {"comparisons", report_json}};
+  outputs.emplace_back(dir / "report.json", report.dump(2) + "\n");
 
   std::ostringstream html;
   html
@@ -389,8 +417,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
           "(Steinmeyer, HIWIN catalogue); the others are recalled values "
           "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
        << body.str() << "</body></html>\n";
-  WriteFileAtomic(dir / "index.html", html.str());
-  result.files.push_back(dir / "index.html");
+  outputs.emplace_back(dir / "index.html", html.str());  // last: the page of a complete set
+  WriteFilesAtomic(outputs);
+  for (const auto& [path, text] : outputs) result.files.push_back(path);
   result.index_html = dir / "index.html";
   return result;
 }

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -121,6 +123,39 @@ Dataset GenerateDataset(const DatasetOptions& options,
   c.push_back(s.str());
   c.push_back(" features: ExtractFeatures (plateau + quadratic drift fitted after the settle time, detrended 60 s moving average within a noise-aware 2 % band; src/sim/features.h)");
   return out;
+}
+
+void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_path,
+                  const std::filesystem::path& curves_dir, const std::string& regenerate) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<fs::path, std::string>> files;
+  files.emplace_back(table_path, FormatProcessTable(dataset.table));
+  const std::string table_name = table_path.filename().string();
+  for (std::size_t i = 0; !curves_dir.empty() && i < dataset.curves.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "row_%04zu.csv", i + 1);
+    const ElongationCurve& c = dataset.curves[i];
+    std::vector<std::vector<double>> rows;
+    rows.reserve(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) rows.push_back({c.time_s[k], c.elongation_um[k]});
+    files.emplace_back(
+        curves_dir / name,
+        FormatCsv({"time_s", "elongation_um"}, rows,
+                  {" SIMULATED curve of row " + std::to_string(i + 1) + " of " + table_name,
+                   regenerate}));
+  }
+  std::error_code ec;
+  const bool created = !curves_dir.empty() && !fs::exists(curves_dir, ec) &&
+                       fs::create_directories(curves_dir, ec);
+  if (ec)
+    throw InputError("--curves-dir '" + curves_dir.string() + "': cannot create it (" +
+                     ec.message() + ")");
+  try {
+    WriteFilesAtomic(files);
+  } catch (...) {
+    if (created) fs::remove(curves_dir, ec);  // empty: nothing was written into it
+    throw;
+  }
 }
 
 }  // namespace whirl::sim

@@ -12,6 +12,7 @@
 #include "compare/evaluate.h"
 #include "compare/report.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/run_program.h"
 
 namespace whirl::compare {
@@ -72,6 +73,27 @@ TEST_F(ShippedModelReport, HostileScrewNamesRenderPlotsAndRunNothing) {
     const std::string name = f.filename().string();
     EXPECT_EQ(name.find_first_of("'\"\\\n\r$`<> "), std::string::npos) << name;
   }
+  fs::remove_all(dir);
+}
+
+TEST_F(ShippedModelReport, AFailingReportLeavesNoFileBehind) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "whirl_report_all_or_nothing";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "index.html");  // the last file cannot be written
+  CompareOptions options;
+  options.seed = 2;
+  const ScrewComparison c = CompareScrew(sim::ReferenceScrew(), model_, rule_, iso_, options);
+  ReportOptions ro;
+  ro.plots = ProgramSucceeds({"gnuplot", "--version"});
+  EXPECT_THROW(WriteReport(dir, {c}, ro), InputError);
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir)) left.push_back(e.path().filename().string());
+  ASSERT_EQ(left.size(), 1u) << left.back();  // no CSV, script, PNG, JSON or staging folder
+  EXPECT_EQ(left[0], "index.html");
+  fs::remove_all(dir / "index.html");
+  const ReportResult r = WriteReport(dir, {c}, ro);
+  EXPECT_EQ(r.files.back(), dir / "index.html");
+  for (const auto& f : r.files) EXPECT_TRUE(fs::is_regular_file(f)) << f;
   fs::remove_all(dir);
 }
 
