@@ -114,7 +114,7 @@ void RegisterCompare(CLI::App& app) {
   sub->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV (default: shipped)")
       ->check(CLI::ExistingFile);
   sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |840D chord - predicted curve| of the plan, um (default 0.5)")
+                  "largest |840D chord - predicted curve| of the plan, um (default 0.5, >= 0.001)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910|, - (default 0.01, max 0.10)")

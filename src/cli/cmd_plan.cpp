@@ -9,6 +9,7 @@
 #include "cli/common.h"
 #include "compare/plan_document.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
 #include "nn/model.h"
@@ -64,6 +65,8 @@ void Run(const PlanCliOptions& o) {
         "points along +axis, so 'add' is the consistent choice if the control adds dK to the "
         "setpoint (see 'whirl plan --help'); keeping 'subtract' as asked");
 
+  CheckPlanFeatures(plan_source.features, by_features ? "--max-elongation/--settle-time"
+                                                      : "prediction of " + o.model_path);
   const fit::ArctanCurve curve =
       fit::ArctanCurve::FromFeatures(plan_source.features, o.shape_k, o.time_exponent);
   const interp::CompensationPlan plan =
@@ -130,13 +133,13 @@ void RegisterPlan(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--max-elongation", o->max_elongation_um,
-                  "instead of --model: plateau elongation L [um]")
+                  "instead of --model: plateau elongation L [um], 0..10000")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--settle-time", o->settle_time_s, "instead of --model: settle time t_s [s]")
+  sub->add_option("--settle-time", o->settle_time_s, "instead of --model: settle time t_s [s], 1..1e6")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--tolerance-um", o->plan.tolerance_um,
-                  "largest |compensation - curve| along the thread [um], > 0")
+                  "largest |compensation - curve| along the thread [um], >= 0.001 (1 nm)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sub->add_option("--axis", o->plan.axis, "axis name for $SA_TEMP_COMP_*[axis] and $AA_IM[axis]")

@@ -49,6 +49,13 @@ void CheckFeatures(const Features& features, const std::string& what) {
     Check(a[k], kTargetLimits[k], kTargetColumns[k], what);
 }
 
+void CheckPlanFeatures(const Features& features, const std::string& what) {
+  CheckFeatures(features, what);
+  if (!(features.settle_time_s >= kMinPlanSettleTimeS))
+    throw InputError(what + ": settle_time_s = " + FormatNumber(features.settle_time_s) +
+                     " breaks the rule: at least " + FormatNumber(kMinPlanSettleTimeS) + " s");
+}
+
 std::string ProcessLimitsHelp() {
   std::string s = "Physical limits (an error outside):";
   for (int i = 0; i < ProcessInputs::kCount; ++i)

@@ -29,6 +29,11 @@ inline constexpr double kMaxCuttingSpeedMMin = 1000;
 inline constexpr double kMaxElongationUm = 10000;
 inline constexpr double kMaxSettleTimeS = 1e6;
 inline constexpr double kMaxBlankLengthMm = 20000;
+/// Shortest settle time of a curve a plan is built from, s (CheckPlanFeatures).
+inline constexpr double kMinPlanSettleTimeS = 1;
+/// Smallest plan tolerance, um: 1 nm, the resolution of SD43900 written with 6 decimals of mm
+/// (interp::PlanOptions::Validate).
+inline constexpr double kMinPlanToleranceUm = 1e-3;
 
 /// Checks the five inputs against the ranges above; InputError "<what>: <field> = <value> breaks
 /// the rule: <range with unit>" otherwise (`what` names the file and line, or the flag set).
@@ -36,6 +41,10 @@ void CheckProcessInputs(const ProcessInputs& inputs, const std::string& what);
 
 /// Checks the two targets against the ranges above (same message shape).
 void CheckFeatures(const Features& features, const std::string& what);
+
+/// The features a curve and a plan are built from (`plan`, `curve`): CheckFeatures and a settle
+/// time of at least kMinPlanSettleTimeS, so the planner's check grid stays bounded.
+void CheckPlanFeatures(const Features& features, const std::string& what);
 
 /// One line per limit above, for --help texts.
 std::string ProcessLimitsHelp();

@@ -65,6 +65,14 @@ t "$W" lead-report --lead lead_tiny.csv --json > tiny.json || fail "subnormal de
 # nlohmann::json writes NaN and infinity as null; only v_2pi may be null (no --lead-mm given).
 grep -v '"v_2pi_um": null' tiny.json | grep -Eiq 'null|nan|inf' && fail "non-finite metric: $(cat tiny.json)"
 
+# plan and curve: absurd features and tolerances are refused at once (no long grid search).
+expect_fail "1 nm" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --tolerance-um 1e-300
+expect_fail "max_elongation_um" t "$W" plan --screw "$S" --max-elongation 1e300 --settle-time 250
+expect_fail "at least 1 s" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 1e-300
+expect_fail "settle_time_s" t "$W" curve --max-elongation 30 --settle-time 1e300
+expect_fail "32 characters" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --axis "$(printf 'X%.0s' $(seq 1 40))"
+
 # plan: one unwritable output leaves the others unwritten (and previous files intact).
 echo previous > keep.json
 mkdir adir

@@ -10,6 +10,7 @@
 #include <random>
 #include <string>
 
+#include "compare/compare.h"
 #include "compare/lead.h"
 #include "compare/metrics.h"
 #include "core/atomic_file.h"
@@ -175,6 +176,18 @@ TEST(Limits, LeadMetricsStayFiniteWithinTheLimits) {
   compare::LeadDeviation far{{0, 1e307}, {0, 1}};
   EXPECT_NE(ErrorOf([&] { compare::ComputeLeadMetrics(far); }).find("position_mm"),
             std::string::npos);
+}
+
+TEST(Limits, ReductionAgainstAVanishingBaselineIsAbsentNotInfinite) {
+  compare::LeadMetrics model, baseline;
+  model.accumulated_1000_um = 1;
+  baseline.accumulated_1000_um = 1e-310;  // subnormal: 1 / 1e-310 overflows
+  baseline.e_a_um = 2;
+  model.e_a_um = 1;
+  const compare::MetricReductions r = compare::Reductions(model, baseline);
+  EXPECT_FALSE(r.accumulated_1000_pct.has_value());
+  ASSERT_TRUE(r.e_a_pct.has_value());
+  EXPECT_DOUBLE_EQ(*r.e_a_pct, 50.0);
 }
 
 TEST(Limits, DatasetWithCurvesIsAllOrNothing) {
