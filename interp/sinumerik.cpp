@@ -8,8 +8,8 @@
 
 #include "core/csv.h"
 #include "core/error.h"
-#include "core/limits.h"
 #include "core/json_file.h"
+#include "core/limits.h"
 
 namespace whirl::interp {
 namespace {

@@ -84,13 +84,13 @@ void RunDemo(const DemoOptions& o) {
         p.outside_domain ? " (outside the training domain)" : "", c.predicted_curve.shape_k,
         c.predicted_curve.time_exponent);
     const std::string provenance = "whirl demo, model " + model_source;
-    const nlohmann::json plan_json = compare::PlanDocument(
-        c.plan, c.predicted_curve, c.screw, c.kinematics,
-        {model_source, c.prediction, c.prediction.mean}, provenance);
-    compare::WritePlanFiles({out / (slug + "_plan.json"), out / (slug + "_plan.csv"),
-                             out / (slug + "_temp_comp.spf")},
-                            plan_json, c.plan, provenance,
-                            "whirl demo: model " + model_source + ", screw " + screw->name);
+    const nlohmann::json plan_json =
+        compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
+                              {model_source, c.prediction, c.prediction.mean}, provenance);
+    compare::WritePlanFiles(
+        {out / (slug + "_plan.json"), out / (slug + "_plan.csv"), out / (slug + "_temp_comp.spf")},
+        plan_json, c.plan, provenance,
+        "whirl demo: model " + model_source + ", screw " + screw->name);
     std::printf(
         "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
         "%s_plan.json/.csv and %s_temp_comp.spf\n",

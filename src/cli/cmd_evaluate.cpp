@@ -225,8 +225,9 @@ void RegisterEvaluate(CLI::App& app) {
                   "random screws and disturbances); prints one line per seed and the figures "
                   "pooled over all screws, which --require-median-pct then checks (default 1)")
       ->check(CLI::Range(1, 1000));
-  sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |840D chord - predicted curve| of each plan [um] (default 0.5, >= 0.001)")
+  sub->add_option(
+         "--tolerance-um", o->tolerance_um,
+         "largest |840D chord - predicted curve| of each plan [um] (default 0.5, >= 0.001)")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--threads", o->threads, "worker threads (default 2)")->check(CLI::Range(1, 64));

@@ -72,8 +72,7 @@ void Run(const PlanCliOptions& o) {
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
   const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();
-  const nlohmann::json j =
-      compare::PlanDocument(plan, curve, screw, kin, plan_source, provenance);
+  const nlohmann::json j = compare::PlanDocument(plan, curve, screw, kin, plan_source, provenance);
   compare::WritePlanFiles({o.out_path, o.csv_path, o.nc_path}, j, plan, provenance,
                           curve.Describe() + " (" + source + ")");
 
@@ -135,7 +134,8 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--max-elongation", o->max_elongation_um,
                   "instead of --model: plateau elongation L [um], 0..10000")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--settle-time", o->settle_time_s, "instead of --model: settle time t_s [s], 1..1e6")
+  sub->add_option("--settle-time", o->settle_time_s,
+                  "instead of --model: settle time t_s [s], 1..1e6")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--tolerance-um", o->plan.tolerance_um,

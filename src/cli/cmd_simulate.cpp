@@ -5,9 +5,9 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "core/limits.h"
 #include "core/csv.h"
 #include "core/curve.h"
+#include "core/limits.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
 
@@ -131,7 +131,8 @@ void RegisterSimulate(CLI::App& app) {
       "--no-disturbances; they are seeded by --seed.\n"
       "Resource limits (an error beyond them): cells = length_mm / --cell-size-mm in [3, 200000],\n"
       "time steps = simulated time / --time-step-s <= 2e6 and cells x steps <= 2e9; a blank is at\n"
-      "most 20000 mm long.\n" + ProcessLimitsHelp());
+      "most 20000 mm long.\n" +
+          ProcessLimitsHelp());
   sub->add_option("--screw", opts->screw_path,
                   "screw JSON (schema_version 1: the five inputs hardness_hrc, diameter_mm, "
                   "pitch_mm, raceway_radius_mm, cutting_speed_m_min; length_mm, thread_length_mm; "

@@ -40,13 +40,15 @@ void ValidateLeadDeviation(const LeadDeviation& lead, const std::string& what) {
     // Physical limits: the metrics stay finite (no overflow in squares and sums, no division by
     // a vanishing span).
     if (std::fabs(lead.position_mm[i]) > kMaxLeadPositionMm)
-      throw InputError(what + ": point " + std::to_string(i) + ": position_mm = " +
-                       FormatNumber(lead.position_mm[i]) + " breaks the rule: |position| <= " +
-                       FormatNumber(kMaxLeadPositionMm) + " mm");
+      throw InputError(what + ": point " + std::to_string(i) +
+                       ": position_mm = " + FormatNumber(lead.position_mm[i]) +
+                       " breaks the rule: |position| <= " + FormatNumber(kMaxLeadPositionMm) +
+                       " mm");
     if (std::fabs(lead.deviation_um[i]) > kMaxLeadDeviationUm)
-      throw InputError(what + ": point " + std::to_string(i) + ": deviation_um = " +
-                       FormatNumber(lead.deviation_um[i]) + " breaks the rule: |deviation| <= " +
-                       FormatNumber(kMaxLeadDeviationUm) + " um");
+      throw InputError(what + ": point " + std::to_string(i) +
+                       ": deviation_um = " + FormatNumber(lead.deviation_um[i]) +
+                       " breaks the rule: |deviation| <= " + FormatNumber(kMaxLeadDeviationUm) +
+                       " um");
     if (i > 0 && lead.position_mm[i] - lead.position_mm[i - 1] < kMinLeadSpacingMm)
       throw InputError(what + ": point " + std::to_string(i) + ": position_mm " +
                        FormatNumber(lead.position_mm[i]) + " is closer than " +

@@ -83,29 +83,33 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "set style line 5 lc rgb '#000000' pt 7 ps 0.8\n";
   // Elongation: truth vs prediction, compensation points, traditional ramp.
   s << "set output " << GnuplotString(f.elongation) << "\n"
-    << "set title " << GnuplotString(name + ": elongation of the unmachined section (first " +
-                                     Fixed(t_zoom, 0) + " s of " + Fixed(t_end, 0) +
-                                     " s cutting time)")
+    << "set title "
+    << GnuplotString(name + ": elongation of the unmachined section (first " + Fixed(t_zoom, 0) +
+                     " s of " + Fixed(t_end, 0) + " s cutting time)")
     << " noenhanced\n"
     << "set xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
     << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
-    << "plot " << GnuplotString(slug + "_elongation.csv") << " using 1:2 with lines ls 1 title 'simulated truth "
+    << "plot " << GnuplotString(slug + "_elongation.csv")
+    << " using 1:2 with lines ls 1 title 'simulated truth "
     << "(disturbed)', \\\n"
     << "  '' using 1:3 with lines ls 2 title 'predicted arctan curve (model)', \\\n"
     << "  '' using 1:5 with lines ls 3 title '840D compensation applied (model plan)', \\\n"
     << "  '' using 1:4 with lines ls 4 title 'traditional compensation (experience ramp)', \\\n"
-    << "  " << GnuplotString(slug + "_points.csv") << " using 1:3 with points ls 5 title 'compensation points "
+    << "  " << GnuplotString(slug + "_points.csv")
+    << " using 1:3 with points ls 5 title 'compensation points "
     << "(SD43900/10/20 breakpoints)'\n"
     << "set output\n";
   // Lead deviation along the whole thread.
   s << "set key below horizontal box\nset bmargin 6\n"
     << "set output " << GnuplotString(f.lead) << "\n"
     << "set title "
-    << GnuplotString(name + ": travel deviation along the thread after cooling (actual - specified)")
+    << GnuplotString(name +
+                     ": travel deviation along the thread after cooling (actual - specified)")
     << " noenhanced\n"
     << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
     << "set xrange [0:" << l << "]\nset yrange [*:*]\n"
-    << "plot " << GnuplotString(slug + "_lead.csv") << " using 1:2 with lines ls 2 title 'no compensation', \\\n"
+    << "plot " << GnuplotString(slug + "_lead.csv")
+    << " using 1:2 with lines ls 2 title 'no compensation', \\\n"
     << "  '' using 1:3 with lines ls 4 title 'traditional (experience rule)', \\\n"
     << "  '' using 1:4 with lines ls 3 title 'model-based (840D plan)'\n"
     << "set output\n";
@@ -401,7 +405,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
       << HtmlEscape(options.title) << "</h1>\n";
   for (const auto& p : options.provenance) html << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
   for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
-  for (const auto& w : result.warnings) html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
+  for (const auto& w : result.warnings)
+    html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
   html << "<p>How to read this page. Each screw is cut in the simulator (the ground truth, with "
           "seeded disturbances the model never saw) three times: without compensation, with the "
           "traditional experience rule (one correction per diameter class, ramped in linearly over "

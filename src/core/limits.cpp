@@ -45,8 +45,7 @@ void CheckProcessInputs(const ProcessInputs& inputs, const std::string& what) {
 
 void CheckFeatures(const Features& features, const std::string& what) {
   const auto a = features.ToArray();
-  for (int k = 0; k < Features::kCount; ++k)
-    Check(a[k], kTargetLimits[k], kTargetColumns[k], what);
+  for (int k = 0; k < Features::kCount; ++k) Check(a[k], kTargetLimits[k], kTargetColumns[k], what);
 }
 
 void CheckPlanFeatures(const Features& features, const std::string& what) {

@@ -263,8 +263,8 @@ void from_json(const nlohmann::json& j, Model& m) {
                      " entries; the limit is " + std::to_string(kMaxLayers));
   double parameters = 0;
   for (std::size_t i = 0; i < sizes.size(); ++i) {
-    layer_sizes.push_back(RequireInt(sizes[i], "model 'layer_sizes[" + std::to_string(i) + "]'",
-                                     1, kMaxLayerSize));
+    layer_sizes.push_back(
+        RequireInt(sizes[i], "model 'layer_sizes[" + std::to_string(i) + "]'", 1, kMaxLayerSize));
     if (i > 0) parameters += (layer_sizes[i - 1] + 1.0) * layer_sizes[i];
   }
   if (parameters > kMaxParameters)

@@ -145,8 +145,8 @@ void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_pat
                    regenerate}));
   }
   std::error_code ec;
-  const bool created = !curves_dir.empty() && !fs::exists(curves_dir, ec) &&
-                       fs::create_directories(curves_dir, ec);
+  const bool created =
+      !curves_dir.empty() && !fs::exists(curves_dir, ec) && fs::create_directories(curves_dir, ec);
   if (ec)
     throw InputError("--curves-dir '" + curves_dir.string() + "': cannot create it (" +
                      ec.message() + ")");

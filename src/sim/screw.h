@@ -82,9 +82,10 @@ struct Kinematics {
 
 /// Throws InputError (naming the field, value and rule) for impossible values: process inputs
 /// outside the physical limits of core/limits.h (hardness 20-70 HRC, diameter (0, 500] mm, ...),
-/// a blank longer than kMaxBlankLengthMm (20 m), non-positive sizes, tool count outside 1-24, thread longer than the blank minus the
-/// offset, a groove wider than lead - kMinLandMm ("ball too large for the lead"), or deeper than
-/// kMaxGrooveDepthFraction * D. `what` prefixes messages (e.g. the file name).
+/// a blank longer than kMaxBlankLengthMm (20 m), non-positive sizes, tool count outside 1-24,
+/// thread longer than the blank minus the offset, a groove wider than lead - kMinLandMm ("ball too
+/// large for the lead"), or deeper than kMaxGrooveDepthFraction * D. `what` prefixes messages (e.g.
+/// the file name).
 void ValidateScrew(const Screw& screw, const std::string& what = "screw");
 
 /// Groove geometry for raceway radius r and lead (no validation).

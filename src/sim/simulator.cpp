@@ -163,10 +163,11 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
   }
   const double steps = std::max(1.0, std::floor(t_end / dt + 1e-9));
   if (!(steps <= kMaxTimeSteps && steps * n <= kMaxCellSteps))
-    throw InputError("simulation options: " + FormatNumber(t_end) + " s of cutting at time_step_s = " +
-                     FormatNumber(dt) + " is " + FormatNumber(steps) + " steps x " +
-                     std::to_string(n) + " cells; the rule (resource limit): at most " +
-                     FormatNumber(kMaxTimeSteps) + " steps and " + FormatNumber(kMaxCellSteps) +
+    throw InputError("simulation options: " + FormatNumber(t_end) +
+                     " s of cutting at time_step_s = " + FormatNumber(dt) + " is " +
+                     FormatNumber(steps) + " steps x " + std::to_string(n) +
+                     " cells; the rule (resource limit): at most " + FormatNumber(kMaxTimeSteps) +
+                     " steps and " + FormatNumber(kMaxCellSteps) +
                      " cell-steps (raise time_step_s or cell_size_mm, or shorten duration_s)");
   const long n_steps = static_cast<long>(steps);
   const long steps_per_sample =

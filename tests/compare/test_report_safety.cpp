@@ -44,11 +44,9 @@ TEST_F(ShippedModelReport, HostileScrewNamesRenderPlotsAndRunNothing) {
   const fs::path pwned = fs::path(::testing::TempDir()) / "whirl_PWNED";
   fs::remove(pwned);
   const std::vector<std::string> names = {
-      "x'; system \"touch " + pwned.string() + "\"; set title '",
-      "O'Brien",
+      "x'; system \"touch " + pwned.string() + "\"; set title '", "O'Brien",
       "back\\slash\nnew line\r\"double\" `touch " + pwned.string() + "`",
-      "<script>alert('x')</script>",
-      "$(touch " + pwned.string() + ") ^_@{}"};
+      "<script>alert('x')</script>", "$(touch " + pwned.string() + ") ^_@{}"};
   CompareOptions options;
   options.seed = 5;
   const ScrewComparison base = CompareScrew(sim::ReferenceScrew(), model_, rule_, iso_, options);

@@ -71,7 +71,8 @@ TEST(AtomicFile, RefusesADirectoryWithAClearMessage) {
   EXPECT_NE(e.find("is a directory"), std::string::npos) << e;
   EXPECT_EQ(e.find("Success"), std::string::npos) << e;
   EXPECT_TRUE(fs::is_directory(d / "existing_dir"));
-  EXPECT_NE(ErrorOf([&] { ReadTextFile(d / "existing_dir"); }).find("directory"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ReadTextFile(d / "existing_dir"); }).find("directory"),
+            std::string::npos);
   EXPECT_EQ(CountEntries(d), 1);
 }
 

@@ -1,7 +1,8 @@
-// libFuzzer harness: elongation curves (core/curve.h ReadElongationCurve). Bad input must be an InputError; any other exception, crash, hang,
-// leak or sanitizer report is a bug (tests/fuzz/README.md).
-#include "core/error.h"
+// libFuzzer harness: elongation curves (core/curve.h ReadElongationCurve). Bad input must be an
+// InputError; any other exception, crash, hang, leak or sanitizer report is a bug
+// (tests/fuzz/README.md).
 #include "core/curve.h"
+#include "core/error.h"
 #include "fuzz_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

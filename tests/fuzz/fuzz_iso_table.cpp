@@ -1,7 +1,8 @@
-// libFuzzer harness: ISO 3408-3 tolerance tables (compare/iso3408.h). Bad input must be an InputError; any other exception, crash, hang,
-// leak or sanitizer report is a bug (tests/fuzz/README.md).
-#include "core/error.h"
+// libFuzzer harness: ISO 3408-3 tolerance tables (compare/iso3408.h). Bad input must be an
+// InputError; any other exception, crash, hang, leak or sanitizer report is a bug
+// (tests/fuzz/README.md).
 #include "compare/iso3408.h"
+#include "core/error.h"
 #include "fuzz_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

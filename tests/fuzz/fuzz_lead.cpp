@@ -1,8 +1,9 @@
-// libFuzzer harness: lead-deviation curves (compare/lead.h ReadLeadDeviation, then the metrics). Bad input must be an InputError; any other exception, crash, hang,
-// leak or sanitizer report is a bug (tests/fuzz/README.md).
-#include "core/error.h"
+// libFuzzer harness: lead-deviation curves (compare/lead.h ReadLeadDeviation, then the metrics).
+// Bad input must be an InputError; any other exception, crash, hang, leak or sanitizer report is a
+// bug (tests/fuzz/README.md).
 #include "compare/lead.h"
 #include "compare/metrics.h"
+#include "core/error.h"
 #include "fuzz_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,5 +1,6 @@
-// libFuzzer harness: process tables (core/process.h ReadProcessTable). Bad input must be an InputError; any other exception, crash, hang,
-// leak or sanitizer report is a bug (tests/fuzz/README.md).
+// libFuzzer harness: process tables (core/process.h ReadProcessTable). Bad input must be an
+// InputError; any other exception, crash, hang, leak or sanitizer report is a bug
+// (tests/fuzz/README.md).
 #include "core/error.h"
 #include "core/process.h"
 #include "fuzz_file.h"

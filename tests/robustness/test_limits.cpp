@@ -60,9 +60,13 @@ TEST(Limits, ProcessInputsAtTheEdgesAndBeyond) {
   p.diameter_mm = 80;
   p.hardness_hrc = 70.5;
   EXPECT_NE(ErrorOf([&] { CheckProcessInputs(p, "x"); }).find("hardness_hrc"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { CheckFeatures({-1, 250}, "x"); }).find("max_elongation_um"),
+  EXPECT_NE(ErrorOf([&] {
+              CheckFeatures({-1, 250}, "x");
+            }).find("max_elongation_um"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { CheckFeatures({10, 1e7}, "x"); }).find("settle_time_s"),
+  EXPECT_NE(ErrorOf([&] {
+              CheckFeatures({10, 1e7}, "x");
+            }).find("settle_time_s"),
             std::string::npos);
 }
 
@@ -169,8 +173,8 @@ TEST(Limits, LeadMetricsStayFiniteWithinTheLimits) {
     compare::LeadMetricOptions o;
     o.lead_mm = u(rng) < 0.5 ? 10 : 0;
     const compare::LeadMetrics m = compare::ComputeLeadMetrics(lead, o);
-    for (double v : {m.e_a_um, m.v_u_um, m.v_300_um, m.accumulated_1000_um,
-                     m.accumulated_total_um, m.mean_line_slope_um_per_m, m.mean_line_offset_um})
+    for (double v : {m.e_a_um, m.v_u_um, m.v_300_um, m.accumulated_1000_um, m.accumulated_total_um,
+                     m.mean_line_slope_um_per_m, m.mean_line_offset_um})
       ASSERT_TRUE(std::isfinite(v)) << "trial " << trial << " spacing " << spacing;
   }
   compare::LeadDeviation far{{0, 1e307}, {0, 1}};

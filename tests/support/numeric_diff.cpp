@@ -33,8 +33,8 @@ std::size_t NumberAt(const std::string& s, std::size_t i, double* value) {
   std::size_t j = i;
   if (j < s.size() && (s[j] == '-' || s[j] == '+')) ++j;
   const bool digit = j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]));
-  const bool dot_digit = j + 1 < s.size() && s[j] == '.' &&
-                         std::isdigit(static_cast<unsigned char>(s[j + 1]));
+  const bool dot_digit =
+      j + 1 < s.size() && s[j] == '.' && std::isdigit(static_cast<unsigned char>(s[j + 1]));
   if (!digit && !dot_digit) return 0;
   // A number glued to a word (e.g. "x86", "sd43900") is text, not a value.
   if (i > 0 && (std::isalpha(static_cast<unsigned char>(s[i - 1])) || s[i - 1] == '_')) return 0;
@@ -70,7 +70,8 @@ int main(int argc, char** argv) {
     }
   }
   if (n_files != 2) {
-    std::fprintf(stderr, "usage: numeric_diff [--rel R] [--abs A] [--skip-comments] expected actual\n");
+    std::fprintf(stderr,
+                 "usage: numeric_diff [--rel R] [--abs A] [--skip-comments] expected actual\n");
     return 2;
   }
   const std::string a = Read(files[0], skip_comments), b = Read(files[1], skip_comments);
@@ -83,7 +84,8 @@ int main(int argc, char** argv) {
     if (la > 0 && lb > 0) {
       const double scale = std::max(std::fabs(x), std::fabs(y));
       if (!(std::fabs(x - y) <= abs_tol + rel * scale)) {
-        std::fprintf(stderr, "numeric_diff: line %d of %s: %s vs %s (|diff| %.3g > %.3g + %.3g * %.3g)\n",
+        std::fprintf(stderr,
+                     "numeric_diff: line %d of %s: %s vs %s (|diff| %.3g > %.3g + %.3g * %.3g)\n",
                      LineOf(a, i), files[1], a.substr(i, la).c_str(), b.substr(j, lb).c_str(),
                      std::fabs(x - y), abs_tol, rel, scale);
         return 1;
@@ -101,7 +103,9 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::printf("numeric_diff: %zu numbers equal within rel %.3g, abs %.3g (largest relative "
-              "difference %.3g)\n", numbers, rel, abs_tol, worst_rel);
+  std::printf(
+      "numeric_diff: %zu numbers equal within rel %.3g, abs %.3g (largest relative "
+      "difference %.3g)\n",
+      numbers, rel, abs_tol, worst_rel);
   return 0;
 }
