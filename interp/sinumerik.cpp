@@ -9,6 +9,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
 
 namespace whirl::interp {
 namespace {
@@ -111,7 +112,12 @@ double SignFactor(SignConvention s) { return s == SignConvention::kAdd ? 1.0 : -
 
 void PlanOptions::Validate() const {
   CheckFinitePositive(tolerance_um, "tolerance_um");
+  if (tolerance_um < kMinPlanToleranceUm)
+    throw InputError("tolerance_um = " + Num(tolerance_um) + ": must be at least " +
+                     Num(kMinPlanToleranceUm) + " um (1 nm, the resolution of SD43900)");
   CheckFinitePositive(check_step_s, "check_step_s");
+  if (axis.size() > 32)
+    throw InputError("axis = '" + axis.substr(0, 32) + "...': at most 32 characters");
   if (axis.empty() || !std::isalpha(static_cast<unsigned char>(axis[0])) ||
       !std::all_of(axis.begin(), axis.end(),
                    [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))

@@ -68,7 +68,8 @@ inline constexpr double kMd32760Default = 0.01;
 inline constexpr double kMd32760Max = 0.10;
 
 struct PlanOptions {
-  /// Largest |applied compensation - predicted curve| along the thread, um (> 0).
+  /// Largest |applied compensation - predicted curve| along the thread, um (>= 0.001 um = 1 nm,
+  /// kMinPlanToleranceUm of core/limits.h).
   double tolerance_um = 0.5;
   /// Axis name used in $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (letters, digits, '_').
   std::string axis = "Z";

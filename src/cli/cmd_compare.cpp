@@ -106,7 +106,7 @@ void RegisterCompare(CLI::App& app) {
                   "screw file (JSON, e.g. datasets/screws/reference_80x10x6000.json)")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--seed", o->seed, "seed of the truth's disturbances (default 1)");
+  AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-disturbances", o->no_disturbances,
                 "simulate the truth without disturbances (the model's own world)");
   sub->add_option("--report", o->report_dir,
@@ -120,7 +120,7 @@ void RegisterCompare(CLI::App& app) {
   sub->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV (default: shipped)")
       ->check(CLI::ExistingFile);
   sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |840D chord - predicted curve| of the plan, um (default 0.5)")
+                  "largest |840D chord - predicted curve| of the plan, um (default 0.5, >= 0.001)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910|, - (default 0.01, max 0.10)")

@@ -93,7 +93,7 @@ void RegisterCrosscheck(CLI::App& app) {
                   "w0 = w .* (1 + p*u), u ~ U(-1, 1)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  sub->add_option("--seed", o->seed, "Seed of the start perturbation")->capture_default_str();
+  AddSeedOption(sub, &o->seed, "Seed of the start perturbation")->capture_default_str();
   sub->add_option("--prediction-tolerance", o->prediction_tolerance,
                   "Tolerance of the trained-prediction difference, normalized target units (the "
                   "training range of a target spans 2 units)")

@@ -11,6 +11,7 @@
 #include "core/csv.h"
 #include "core/curve.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "fit/arctan_curve.h"
 #include "nn/model.h"
 #include "sim/screw.h"
@@ -62,6 +63,7 @@ void Run(const CurveOptions& o) {
     features = {o.max_elongation_um, o.settle_time_s};
     source = "given features";
   }
+  CheckPlanFeatures(features, by_features ? "--max-elongation/--settle-time" : "the prediction");
   const fit::ArctanCurve curve =
       fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
   if (duration_s == 0) duration_s = 3.0 * curve.settle_time_s;
@@ -128,9 +130,9 @@ void RegisterCurve(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sub->add_option("--screw", o->screw_path, "screw file (JSON, see 'whirl simulate --help')")
       ->check(CLI::ExistingFile);
-  sub->add_option("--max-elongation", o->max_elongation_um, "plateau elongation L [um]")
+  sub->add_option("--max-elongation", o->max_elongation_um, "plateau elongation L [um], 0..10000")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--settle-time", o->settle_time_s, "settle time t_s [s]")
+  sub->add_option("--settle-time", o->settle_time_s, "settle time t_s [s], 1..1e6")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--duration-s", o->duration_s,

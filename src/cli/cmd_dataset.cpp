@@ -38,18 +38,7 @@ void Run(const DatasetCliOptions& o) {
   if (o.no_disturbances) cmd << " --no-disturbances";
   cmd << " --out " << std::filesystem::path(o.out_path).filename().string();
   d.table.comments.insert(d.table.comments.begin(), cmd.str());
-  if (!o.curves_dir.empty()) {
-    std::filesystem::create_directories(o.curves_dir);
-    for (std::size_t i = 0; i < d.curves.size(); ++i) {
-      char name[32];
-      std::snprintf(name, sizeof name, "row_%04zu.csv", i + 1);
-      WriteElongationCurve(std::filesystem::path(o.curves_dir) / name, d.curves[i],
-                           {" SIMULATED curve of row " + std::to_string(i + 1) + " of " +
-                                std::filesystem::path(o.out_path).filename().string(),
-                            cmd.str()});
-    }
-  }
-  WriteProcessTable(o.out_path, d.table);
+  sim::WriteDataset(d, o.out_path, o.curves_dir, cmd.str());
   int unsettled = 0;
   for (const auto& s : d.settle) unsettled += s.settled_before_tail ? 0 : 1;
   if (unsettled > 0)
@@ -73,7 +62,7 @@ void RegisterDataset(CLI::App& app) {
       "reduced to max_elongation_um (um) and settle_time_s (s). Disturbances ON unless\n"
       "--no-disturbances. Progress on stderr.");
   sub->add_option("--count", opts->count, "number of rows")->check(CLI::Range(1, 100000));
-  sub->add_option("--seed", opts->seed, "seed of the design shift and of the disturbances");
+  AddSeedOption(sub, &opts->seed, "seed of the design shift and of the disturbances");
   sub->add_option("--out", opts->out_path, "output CSV (inputs, then targets), written atomically")
       ->required();
   sub->add_option("--curves-dir", opts->curves_dir,

@@ -9,10 +9,9 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/compare.h"
+#include "compare/plan_document.h"
 #include "compare/report.h"
-#include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/json_file.h"
 #include "interp/machine_profile.h"
 #include "nn/model.h"
 #include "sim/screw.h"
@@ -61,13 +60,7 @@ void RunDemo(const DemoOptions& o) {
   }
 
   const std::string ref_path = ProjectPath("datasets/screws/reference_80x10x6000.json");
-  sim::Screw reference;  // assigned once below
-  if (fs::exists(ref_path)) {
-    reference = sim::ReadScrew(ref_path);
-  } else {
-    Warn(ref_path + " not found: using the built-in reference screw (sim::ReferenceScrew)");
-    reference = sim::ReferenceScrew();
-  }
+  const sim::Screw reference = sim::ReadScrew(ref_path);  // a missing shipped file is an error
   const sim::Screw new_type = compare::NewTypeScrew(reference);
   const auto& n = new_type.process;
   std::printf(
@@ -96,21 +89,15 @@ void RunDemo(const DemoOptions& o) {
         p.mean.settle_time_s, p.stddev.settle_time_s,
         p.outside_domain ? " (outside the training domain)" : "", c.predicted_curve.shape_k,
         c.predicted_curve.time_exponent);
-    nlohmann::json plan_json = c.plan;
-    plan_json["curve"] = c.predicted_curve;
-    plan_json["prediction"] = {{"model", model_source},
-                               {"screw", screw->name},
-                               {"max_elongation_stddev_um", p.stddev.max_elongation_um},
-                               {"settle_time_stddev_s", p.stddev.settle_time_s},
-                               {"outside_domain", p.outside_domain}};
-    WriteJsonFile(out / (slug + "_plan.json"), plan_json);
-    WriteFileAtomic(out / (slug + "_plan.csv"),
-                    interp::FormatPlcCsv(c.plan, {"whirl demo, model " + model_source}));
-    interp::NcProgramInfo info;
-    info.curve_source = "whirl demo: model " + model_source + ", screw " + screw->name;
-    WriteFileAtomic(out / (slug + "_temp_comp.spf"), interp::FormatNcProgram(c.plan, info));
-    WriteFileAtomic(out / (slug + "_temp_comp_reset.spf"),
-                    interp::FormatNcResetProgram(c.plan.options, info));
+    const std::string provenance = "whirl demo, model " + model_source;
+    const nlohmann::json plan_json =
+        compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
+                              {model_source, c.prediction, c.prediction.mean}, provenance);
+    compare::WritePlanFiles(
+        {out / (slug + "_plan.json"), out / (slug + "_plan.csv"), out / (slug + "_temp_comp.spf"),
+         out / (slug + "_temp_comp_reset.spf")},
+        plan_json, c.plan, provenance,
+        "whirl demo: model " + model_source + ", screw " + screw->name);
     std::printf(
         "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
         "%s_plan.json/.csv and %s_temp_comp.spf (reset: %s_temp_comp_reset.spf)\n",
@@ -174,7 +161,7 @@ void RegisterDemo(CLI::App& app) {
       "the lead-error reductions (um and %).");
   sub->add_option("--out-dir", o->out_dir, "output directory (default whirl-demo-out)");
   sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists");
-  sub->add_option("--seed", o->seed, "seed of the truth's disturbances (default 1)");
+  AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");
   sub->callback([o] { RunDemo(*o); });
 }

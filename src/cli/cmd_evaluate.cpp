@@ -18,6 +18,9 @@
 namespace whirl::cli {
 namespace {
 
+// Resource limit on the random screws of one run (--random x --seeds).
+constexpr int kMaxRandomScrews = 10000;
+
 struct EvaluateCliOptions {
   std::string model_path = ProjectPath("models/default.json");
   std::string validation = ProjectPath("datasets/whirling_validation.csv");
@@ -181,12 +184,15 @@ void RunEvaluate(const EvaluateCliOptions& o) {
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
-  const sim::Screw base =
-      std::filesystem::exists(o.base_screw) ? sim::ReadScrew(o.base_screw) : sim::ReferenceScrew();
+  const sim::Screw base = sim::ReadScrew(o.base_screw);  // a missing file is an error
   const ProcessTable validation =
       o.no_validation ? ProcessTable{} : ReadProcessTable(o.validation, false);
   if (o.no_validation && o.random == 0)
     throw InputError("nothing to evaluate: --no-validation and --random 0");
+  if (static_cast<double>(o.random) * o.seeds > kMaxRandomScrews)
+    throw InputError("--random " + std::to_string(o.random) + " x --seeds " +
+                     std::to_string(o.seeds) + " random screws: the limit is " +
+                     std::to_string(kMaxRandomScrews) + " (about 0.5 s each per thread)");
   compare::EvaluateOptions eo;
   eo.threads = o.threads;
   eo.compare.plan.tolerance_um = o.tolerance_um;
@@ -262,16 +268,19 @@ void RegisterEvaluate(CLI::App& app) {
          "validation process table, inputs used (default datasets/whirling_validation.csv)")
       ->check(CLI::ExistingFile);
   sub->add_flag("--no-validation", o->no_validation, "random screws only");
-  sub->add_option("--random", o->random, "number of random feasible screws (default 40)")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--seed", o->seed, "seed of the random screws and the disturbances (default 1)");
+  sub->add_option("--random", o->random,
+                  "number of random feasible screws (default 40; 0 to 10000, and --random x "
+                  "--seeds at most 10000)")
+      ->check(CLI::Range(0, kMaxRandomScrews));
+  AddSeedOption(sub, &o->seed, "seed of the random screws and the disturbances (default 1)");
   sub->add_option("--seeds", o->seeds,
                   "repeat the evaluation for seeds --seed .. --seed + N - 1 (each with its own "
                   "random screws and disturbances); prints one line per seed and the figures "
                   "pooled over all screws, which --require-median-pct then checks (default 1)")
       ->check(CLI::Range(1, 1000));
-  sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |840D chord - predicted curve| of each plan [um] (default 0.5)")
+  sub->add_option(
+         "--tolerance-um", o->tolerance_um,
+         "largest |840D chord - predicted curve| of each plan [um] (default 0.5, >= 0.001)")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--threads", o->threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
@@ -281,7 +290,7 @@ void RegisterEvaluate(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sub->add_option("--base-screw", o->base_screw,
                   "screw whose blank and settings every evaluated screw shares (default the "
-                  "reference screw file, or the built-in reference if it is missing)");
+                  "shipped reference screw file; a missing file is an error)");
   sub->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV (default: shipped)")
       ->check(CLI::ExistingFile);
   sub->add_option("--require-median-pct", o->require_median_pct,

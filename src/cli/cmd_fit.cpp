@@ -214,7 +214,7 @@ void RegisterFit(CLI::App& app) {
                                     "shape calibration)")
                         ->check(CLI::Range(1, 1000));
   curve->excludes(simulated);
-  sub->add_option("--seed", o->seed, "seed of the design points and disturbances (--simulated)")
+  AddSeedOption(sub, &o->seed, "seed of the design points and disturbances (--simulated)")
       ->capture_default_str();
   sub->add_option("--window-s", o->window_s, "simulated time per curve [s] (--simulated)")
       ->capture_default_str()

@@ -72,7 +72,9 @@ void RegisterLeadReport(CLI::App& app) {
       "Prints (um): accumulated error within any 1000 mm and over the useful travel (max - min of\n"
       "the deviation), e_a (mean travel deviation from the least-squares mean travel line), v_u,\n"
       "v_300 and v_2pi (band widths about that line over l_u, any 300 mm, one revolution), and\n"
-      "the tightest class of P1, P3, P5, T7, T10 whose every tolerance holds.");
+      "the tightest class of P1, P3, P5, T7, T10 whose every tolerance holds.\n"
+      "Limits (an error beyond them): |position_mm| <= 1e6 mm, positions >= 1e-6 mm apart,\n"
+      "|deviation_um| <= 1e6 um.");
   sub->add_option("--lead", o->lead_csv, "measured lead-deviation CSV (position_mm,deviation_um)")
       ->required()
       ->check(CLI::ExistingFile);

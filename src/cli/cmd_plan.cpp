@@ -7,10 +7,9 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "core/atomic_file.h"
-#include "core/csv.h"
+#include "compare/plan_document.h"
 #include "core/error.h"
-#include "core/json_file.h"
+#include "core/limits.h"
 #include "fit/arctan_curve.h"
 #include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
@@ -99,59 +98,31 @@ void Run(const PlanCliOptions& o) {
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   const sim::Kinematics kin = sim::ComputeKinematics(screw);
 
-  nlohmann::json prediction;
-  Features features;
+  compare::PlanSource plan_source;
   std::string source;
   if (!by_features) {
     const nn::Model model = nn::LoadModel(o.model_path);
     const nn::Prediction pred = nn::Predict(model, screw.process);
     GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.screw_path,
                         o.allow_extrapolation);
-    features = pred.mean;
-    prediction = {{"model", o.model_path},
-                  {"max_elongation_um", pred.mean.max_elongation_um},
-                  {"max_elongation_std_um", pred.stddev.max_elongation_um},
-                  {"settle_time_s", pred.mean.settle_time_s},
-                  {"settle_time_std_s", pred.stddev.settle_time_s},
-                  {"outside_domain", pred.outside_domain},
-                  {"outside_domain_fields", pred.outside_domain_fields}};
+    plan_source = {o.model_path, pred, pred.mean};
     source = "model " + o.model_path + ", screw " + o.screw_path;
   } else {
     if (std::isnan(o.max_elongation_um) || std::isnan(o.settle_time_s))
       throw InputError("plan: --max-elongation and --settle-time go together");
-    features = {o.max_elongation_um, o.settle_time_s};
-    prediction = {{"model", nullptr},
-                  {"max_elongation_um", features.max_elongation_um},
-                  {"settle_time_s", features.settle_time_s}};
+    plan_source.features = {o.max_elongation_um, o.settle_time_s};
     source = "given features, screw " + o.screw_path;
   }
+  CheckPlanFeatures(plan_source.features, by_features ? "--max-elongation/--settle-time"
+                                                      : "prediction of " + o.model_path);
   const fit::ArctanCurve curve =
-      fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
+      fit::ArctanCurve::FromFeatures(plan_source.features, o.shape_k, o.time_exponent);
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
-
   const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();
-
-  nlohmann::json j = plan;
-  j["provenance"] = provenance;
-  j["screw"] = screw;
-  j["prediction"] = prediction;
-  j["curve"] = curve;
-  j["kinematics"] = {{"axial_feed_mm_min", kin.axial_feed_mm_min},
-                     {"cutting_time_s", kin.cutting_time_s},
-                     {"workpiece_speed_rpm", kin.workpiece_speed_rpm},
-                     {"ring_speed_rpm", kin.ring_speed_rpm}};
-  // Render everything first, then write: a failure leaves no partial set of files.
-  const std::string csv_text = o.csv_path.empty() ? "" : interp::FormatPlcCsv(plan, {provenance});
-  interp::NcProgramInfo info;
-  info.curve_source = curve.Describe() + " (" + source + ")";
-  const std::string nc_text = o.nc_path.empty() ? "" : interp::FormatNcProgram(plan, info);
-  const std::string reset_text =
-      o.reset_nc_path.empty() ? "" : interp::FormatNcResetProgram(plan.options, info);
-  if (!o.out_path.empty()) WriteJsonFile(o.out_path, j);
-  if (!o.csv_path.empty()) WriteFileAtomic(o.csv_path, csv_text);
-  if (!o.nc_path.empty()) WriteFileAtomic(o.nc_path, nc_text);
-  if (!o.reset_nc_path.empty()) WriteFileAtomic(o.reset_nc_path, reset_text);
+  const nlohmann::json j = compare::PlanDocument(plan, curve, screw, kin, plan_source, provenance);
+  compare::WritePlanFiles({o.out_path, o.csv_path, o.nc_path, o.reset_nc_path}, j, plan, provenance,
+                          curve.Describe() + " (" + source + ")");
 
   if (o.json) {
     PrintJson(j);
@@ -211,8 +182,10 @@ void RegisterPlan(CLI::App& app) {
       "actions and restores the saved values at the thread end; --reset-nc writes the program\n"
       "to run after an aborted cut. Numbers: positions and SD43920 4 decimals [mm], SD43900 6\n"
       "[mm], SD43910 8 [-], identical in NC, PLC table and JSON. A slope above MD32760 is an\n"
-      "error. Outputs: plan JSON (--out), PLC table CSV (--csv), NC programs; all written\n"
-      "atomically, none if any fails. Requires MD32750 = 3.");
+      "error. Outputs: plan JSON (--out, schema whirl.plan, the same document as 'whirl demo'),\n"
+      "PLC table CSV (--csv), NC programs (--nc, --reset-nc);\n"
+      "all-or-nothing: if one cannot be written (missing directory, a directory, symlink, FIFO or\n"
+      "device at the path) none is and previous files stay. Requires MD32750 = 3.");
   sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
       ->check(CLI::ExistingFile);
   sub->add_option("--screw", o->screw_path,
@@ -221,13 +194,14 @@ void RegisterPlan(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--max-elongation", o->max_elongation_um,
-                  "instead of --model: plateau elongation L [um]")
+                  "instead of --model: plateau elongation L [um], 0..10000")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--settle-time", o->settle_time_s, "instead of --model: settle time t_s [s]")
+  sub->add_option("--settle-time", o->settle_time_s,
+                  "instead of --model: settle time t_s [s], 1..1e6")
       ->check(CLI::PositiveNumber);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |compensation - curve| along the thread [um], > 0")
+                  "largest |compensation - curve| along the thread [um], >= 0.001 (1 nm)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sub->add_option("--machine", o->machine_path,

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/process.h"
 #include "nn/model.h"
 
@@ -53,6 +54,7 @@ void Run(const PredictOptions& o) {
           missing + ")");
     table.source = "command line";
     table.inputs.push_back(ProcessInputs::FromArray(single));
+    CheckProcessInputs(table.inputs.back(), "predict flags");
   }
   const nn::Model model = nn::LoadModel(o.model_path);
   const std::vector<nn::Prediction> pred = nn::PredictBatch(model, table.inputs);
@@ -130,6 +132,7 @@ void Run(const PredictOptions& o) {
   std::printf("%4s %8s %8s %7s %8s %9s | %22s | %18s | %s\n", "row", "HRC", "D [mm]", "P [mm]",
               "R [mm]", "v [m/min]", "max elongation [um]", "settle time [s]", "domain");
   double ape_e = 0, ape_t = 0;
+  int n_e = 0, n_t = 0;  // a zero target has no percentage error: left out, never a division by 0
   for (std::size_t q = 0; q < pred.size(); ++q) {
     const auto& in = table.inputs[q];
     const auto& p = pred[q];
@@ -138,18 +141,24 @@ void Run(const PredictOptions& o) {
                 in.cutting_speed_m_min, p.mean.max_elongation_um, p.stddev.max_elongation_um,
                 p.mean.settle_time_s, p.stddev.settle_time_s, p.outside_domain ? "OUTSIDE" : "in");
     if (have_targets) {
-      ape_e += std::abs(p.mean.max_elongation_um - table.targets[q].max_elongation_um) /
-               std::abs(table.targets[q].max_elongation_um);
-      ape_t += std::abs(p.mean.settle_time_s - table.targets[q].settle_time_s) /
-               std::abs(table.targets[q].settle_time_s);
+      const Features& t = table.targets[q];
+      if (t.max_elongation_um > 0) {
+        ape_e += std::abs(p.mean.max_elongation_um - t.max_elongation_um) / t.max_elongation_um;
+        ++n_e;
+      }
+      if (t.settle_time_s > 0) {
+        ape_t += std::abs(p.mean.settle_time_s - t.settle_time_s) / t.settle_time_s;
+        ++n_t;
+      }
     }
   }
   std::printf("(+- one predictive standard deviation, Laplace approximation)\n");
   if (have_targets) {
-    const double n = static_cast<double>(pred.size());
     std::printf(
-        "targets in %s: mean absolute error %.3g %% (max elongation), %.3g %% (settle time)\n",
-        o.input_path.c_str(), 100 * ape_e / n, 100 * ape_t / n);
+        "targets in %s: mean absolute error %.3g %% (max elongation, %d rows with a target > 0), "
+        "%.3g %% (settle time, %d rows)\n",
+        o.input_path.c_str(), n_e > 0 ? 100 * ape_e / n_e : 0.0, n_e,
+        n_t > 0 ? 100 * ape_t / n_t : 0.0, n_t);
   }
   if (!o.out_path.empty()) std::printf("written: %s\n", o.out_path.c_str());
 }
@@ -167,23 +176,21 @@ void RegisterPredict(CLI::App& app) {
       "Inputs outside the training domain get a warning on stderr and a flag in the output.\n"
       "Give either --input CSV (columns hardness_hrc, diameter_mm, pitch_mm,\n"
       "raceway_radius_mm, cutting_speed_m_min; if max_elongation_um and settle_time_s are\n"
-      "present too they are used to report the prediction error) or all five process flags.");
+      "present too they are used to report the prediction error) or all five process flags.\n" +
+          ProcessLimitsHelp());
   sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
   auto* input = sub->add_option("--input", o->input_path, "table of processes (CSV)")
                     ->check(CLI::ExistingFile);
-  auto* h = sub->add_option("--hardness", o->hardness_hrc, "workpiece hardness [HRC]");
-  auto* d = sub->add_option("--diameter", o->diameter_mm, "screw diameter [mm]")
-                ->check(CLI::PositiveNumber);
-  auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm]")
-                ->check(CLI::PositiveNumber);
-  auto* r =
-      sub->add_option("--raceway-radius", o->raceway_radius_mm, "raceway (ball-groove) radius [mm]")
-          ->check(CLI::PositiveNumber);
+  // Ranges: the physical limits (core/limits.h), checked with one clear message after parsing.
+  auto* h = sub->add_option("--hardness", o->hardness_hrc, "workpiece hardness [HRC], 20..70");
+  auto* d = sub->add_option("--diameter", o->diameter_mm, "screw diameter [mm], (0, 500]");
+  auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm], (0, 100]");
+  auto* r = sub->add_option("--raceway-radius", o->raceway_radius_mm,
+                            "raceway (ball-groove) radius [mm], (0, 50]");
   auto* v = sub->add_option("--cutting-speed", o->cutting_speed_m_min,
-                            "cutting speed of the whirling tools [m/min]")
-                ->check(CLI::PositiveNumber);
+                            "cutting speed of the whirling tools [m/min], (0, 1000]");
   for (auto* flag : {h, d, p, r, v}) input->excludes(flag);
   sub->add_option("--out", o->out_path,
                   "write a CSV: the inputs, max_elongation_um, max_elongation_std_um,\n"

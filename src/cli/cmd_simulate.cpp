@@ -7,6 +7,7 @@
 #include "cli/common.h"
 #include "core/csv.h"
 #include "core/curve.h"
+#include "core/limits.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
 
@@ -127,7 +128,11 @@ void RegisterSimulate(CLI::App& app) {
       "whirling (1D transient heat conduction with a moving source, src/sim/simulator.h) and\n"
       "print its features: max_elongation_um (plateau) and settle_time_s.\n"
       "Disturbances (workpiece variation, ambient drift, +-0.5 um sensor noise) are ON unless\n"
-      "--no-disturbances; they are seeded by --seed.");
+      "--no-disturbances; they are seeded by --seed.\n"
+      "Resource limits (an error beyond them): cells = length_mm / --cell-size-mm in [3, 200000],\n"
+      "time steps = simulated time / --time-step-s <= 2e6 and cells x steps <= 2e9; a blank is at\n"
+      "most 20000 mm long.\n" +
+          ProcessLimitsHelp());
   sub->add_option("--screw", opts->screw_path,
                   "screw JSON (schema_version 1: the five inputs hardness_hrc, diameter_mm, "
                   "pitch_mm, raceway_radius_mm, cutting_speed_m_min; length_mm, thread_length_mm; "
@@ -143,7 +148,7 @@ void RegisterSimulate(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_flag("--no-disturbances", opts->no_disturbances,
                 "pure physics: no workpiece variation, ambient drift or measurement noise");
-  sub->add_option("--seed", opts->seed, "seed of the disturbances (default 1)");
+  AddSeedOption(sub, &opts->seed, "seed of the disturbances (default 1)");
   sub->add_option("--cell-size-mm", opts->cell_size_mm, "finite-volume cell size in mm")
       ->check(CLI::PositiveNumber);
   sub->add_option("--time-step-s", opts->time_step_s, "BDF2 time step in s")

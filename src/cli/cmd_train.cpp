@@ -1,6 +1,8 @@
 // whirl train: fit the Bayesian-regularized network (src/nn/trainbr.h) to a process table, or
 // sweep the hidden size with k-fold cross-validation (src/nn/selection.h).
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -10,6 +12,7 @@
 #include "cli/common.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/process.h"
 #include "nn/model.h"
 #include "nn/selection.h"
@@ -29,15 +32,23 @@ struct TrainCliOptions {
   bool json = false;
 };
 
+constexpr int kMaxHidden = 200;  // neurons in the hidden layer (--hidden, --hidden-sweep)
+
 std::pair<int, int> ParseSweep(const std::string& s) {
   const auto dots = s.find("..");
-  int a = 0, b = 0;
-  char tail = 0;
-  if (dots == std::string::npos || std::sscanf(s.substr(0, dots).c_str(), "%d%c", &a, &tail) != 1 ||
-      std::sscanf(s.substr(dots + 2).c_str(), "%d%c", &b, &tail) != 1)
+  const auto whole = [](const std::string& t, long* v) {
+    char* end = nullptr;
+    errno = 0;
+    *v = std::strtol(t.c_str(), &end, 10);
+    return !t.empty() && errno == 0 && *end == '\0';
+  };
+  long a = 0, b = 0;
+  if (dots == std::string::npos || !whole(s.substr(0, dots), &a) || !whole(s.substr(dots + 2), &b))
     throw InputError("--hidden-sweep '" + s + "': expected A..B with integers, e.g. 4..10");
-  if (a < 1 || b < a) throw InputError("--hidden-sweep '" + s + "': need 1 <= A <= B");
-  return {a, b};
+  if (a < 1 || b < a || b > kMaxHidden)
+    throw InputError("--hidden-sweep '" + s + "': need 1 <= A <= B <= " +
+                     std::to_string(kMaxHidden) + " (hidden neurons, as --hidden)");
+  return {static_cast<int>(a), static_cast<int>(b)};
 }
 
 std::string Fmt(double x, int digits = 4) {
@@ -156,7 +167,8 @@ void RegisterTrain(CLI::App& app) {
       "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
       "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
       "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
-      "Progress goes to stderr, results to stdout. Exit code 0 only on success.");
+      "Progress goes to stderr, results to stdout. Exit code 0 only on success.\n" +
+          ProcessLimitsHelp());
   sub->add_option("--data", o->data_path, "training table (CSV, see above)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -165,9 +177,8 @@ void RegisterTrain(CLI::App& app) {
                               "--hidden-sweep");
   sub->add_option("--hidden", o->hidden, "tansig neurons in the hidden layer (paper: 6)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 200));
-  sub->add_option("--seed", o->seed,
-                  "seed of the Nguyen-Widrow initialization; restart k uses seed + k")
+      ->check(CLI::Range(1, kMaxHidden));
+  AddSeedOption(sub, &o->seed, "seed of the Nguyen-Widrow initialization; restart k uses seed + k")
       ->capture_default_str();
   sub->add_option("--restarts", o->restarts,
                   "train this many networks (seeds seed..seed+K-1) and keep the one with the\n"
@@ -181,7 +192,7 @@ void RegisterTrain(CLI::App& app) {
       "--hidden-sweep", o->hidden_sweep,
       "A..B: instead of writing a model, report for each hidden size A..B the training RMS\n"
       "error (um, s), gamma (effective number of parameters), log evidence and k-fold\n"
-      "cross-validation RMS error, so the size can be picked as in the paper");
+      "cross-validation RMS error, so the size can be picked as in the paper; 1 <= A <= B <= 200");
   sub->add_option("--folds", o->folds, "k of k-fold cross-validation for --hidden-sweep")
       ->capture_default_str()
       ->check(CLI::Range(2, 1000));

@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
 #include "core/error.h"
@@ -26,7 +28,24 @@ void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent)
       ->check(CLI::Range(fit::kMinTimeExponent, fit::kMaxTimeExponent));
 }
 
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help) {
+  const auto rule = [](std::string& text) -> std::string {
+    const bool digits = !text.empty() && text.size() <= 20 &&
+                        text.find_first_not_of("0123456789") == std::string::npos;
+    errno = 0;
+    if (digits) (void)std::strtoull(text.c_str(), nullptr, 10);
+    if (digits && errno == 0) return "";
+    return "seed '" + text + "' breaks the rule: a whole number in [0, 18446744073709551615]";
+  };
+  return sub->add_option("--seed", *seed, help + " [0 .. 2^64-1]")
+      ->check(CLI::Validator(rule, "UINT64"));
+}
+
 int RunApp(CLI::App& app, int argc, char** argv) {
+  // Every --help says where the shipped files come from (and how to point at them).
+  if (app.get_footer().empty()) app.footer(kShippedFilesHelp);
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    if (sub->get_footer().empty()) sub->footer(kShippedFilesHelp);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -96,10 +115,21 @@ void Progress::Finish(const std::string& detail) {
   }
 }
 
-std::string ProjectPath(const std::string& relative) {
+std::filesystem::path ShippedFilesRoot() {
+  namespace fs = std::filesystem;
   const char* home = std::getenv("WHIRL_HOME");
-  const std::string root = home != nullptr ? home : WHIRL_SOURCE_DIR;
-  return root + "/" + relative;
+  if (home != nullptr && *home != '\0') return home;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {  // installed: <prefix>/bin/whirl finds <prefix>/share/whirl
+    const fs::path installed = exe.parent_path() / WHIRL_DATA_FROM_BIN;
+    if (fs::is_directory(installed / "models", ec)) return installed.lexically_normal();
+  }
+  return WHIRL_SOURCE_DIR;  // run from the build tree
+}
+
+std::string ProjectPath(const std::string& relative) {
+  return (ShippedFilesRoot() / relative).string();
 }
 
 }  // namespace whirl::cli

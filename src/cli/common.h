@@ -1,6 +1,8 @@
 #pragma once
 // Small helpers shared by the subcommands. The library never includes CLI11; this folder does.
 #include <cstddef>
+#include <cstdint>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -8,6 +10,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace whirl::cli {
@@ -38,6 +41,10 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
 /// --shape-k K and --time-exponent P, with their ranges and defaults (fit/arctan_curve.h).
 void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent);
 
+/// A --seed option: a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5" or a larger
+/// number is a parse error naming the rule, never wrapped. Returns the option for chaining.
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help);
+
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.
 void PrintJson(const nlohmann::json& j);
 
@@ -66,8 +73,16 @@ class Progress {
 /// past screws.
 inline constexpr const char* kHistoryTable = "datasets/whirling_500.csv";
 
-/// Where the shipped files live: $WHIRL_HOME if set, else the source tree this binary was built
-/// from. Used by `whirl demo` and defaults such as kHistoryTable.
+/// Where the shipped files (models/, datasets/ with screws/ and standards/) live, in this order:
+/// $WHIRL_HOME if set and not empty; <dir of the executable>/../share/whirl when it holds
+/// models/ (an installed whirl: cmake --install build --prefix P puts them in P/share/whirl);
+/// else the source tree this binary was built from (running build/whirl). Used by `whirl demo`
+/// and defaults such as kHistoryTable. Described to users in `whirl --help` (kShippedFilesHelp).
+std::filesystem::path ShippedFilesRoot();
+inline constexpr const char* kShippedFilesHelp =
+    "Shipped files (models/default.json, datasets/...) are looked up in $WHIRL_HOME if set, else\n"
+    "in <prefix>/share/whirl next to an installed <prefix>/bin/whirl, else in the source tree\n"
+    "the binary was built from.";
 std::string ProjectPath(const std::string& relative);
 
 }  // namespace whirl::cli

@@ -28,7 +28,8 @@ std::string ToString(Strategy s) {
 namespace {
 
 std::optional<double> Reduce(double value, double baseline) {
-  if (std::abs(baseline) == 0) return std::nullopt;
+  // Below 1e-9 um (a femtometre) the ratio means nothing and could overflow: no reduction.
+  if (!(std::abs(baseline) >= 1e-9)) return std::nullopt;
   return 100.0 * (1.0 - std::abs(value) / std::abs(baseline));
 }
 

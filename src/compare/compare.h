@@ -68,7 +68,8 @@ struct StrategyOutcome {
 };
 
 /// Reduction of each metric by one strategy against a baseline, percent:
-/// 100 (1 - |metric| / |baseline metric|); nullopt when the baseline metric is 0.
+/// 100 (1 - |metric| / |baseline metric|); nullopt when the baseline metric is below 1e-9 um
+/// (the ratio would be meaningless and could overflow to infinity).
 struct MetricReductions {
   std::optional<double> e_a_pct, v_u_pct, v_300_pct, v_2pi_pct, accumulated_1000_pct,
       accumulated_total_pct;

@@ -1,14 +1,12 @@
 #include "compare/evaluate.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <mutex>
-#include <thread>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "sim/random.h"
 
 namespace whirl::compare {
@@ -77,43 +75,34 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model
     throw InputError("threads = " + std::to_string(options.threads) + ": must be >= 1");
   Evaluation e;
   e.screws.resize(screws.size());
-  std::atomic<std::size_t> next{0}, done{0};
-  std::mutex progress_mutex;
-  auto worker = [&]() {
-    for (std::size_t i = next++; i < screws.size(); i = next++) {
-      EvaluatedScrew& out = e.screws[i];
-      out.screw = screws[i];
-      out.seed = sim::MixSeed(options.seed, i);
-      CompareOptions co = options.compare;
-      co.seed = out.seed;
-      try {
-        const ScrewComparison c = CompareScrew(screws[i], model, rule, iso_table, co);
-        out.ok = true;
-        out.outside_domain = c.prediction.outside_domain;
-        for (std::size_t k = 0; k < kStrategyCount; ++k) {
-          out.metrics[k] = c.outcomes[k].metrics;
-          out.iso[k] = c.outcomes[k].iso.reached;
+  // A screw with bad input (InputError) is recorded as a failed screw; any other exception (a bug,
+  // bad_alloc) stops the run and reaches the caller through ParallelFor.
+  ParallelFor(
+      screws.size(), options.threads,
+      [&](std::size_t i) {
+        EvaluatedScrew& out = e.screws[i];
+        out.screw = screws[i];
+        out.seed = sim::MixSeed(options.seed, i);
+        CompareOptions co = options.compare;
+        co.seed = out.seed;
+        try {
+          const ScrewComparison c = CompareScrew(screws[i], model, rule, iso_table, co);
+          out.ok = true;
+          out.outside_domain = c.prediction.outside_domain;
+          for (std::size_t k = 0; k < kStrategyCount; ++k) {
+            out.metrics[k] = c.outcomes[k].metrics;
+            out.iso[k] = c.outcomes[k].iso.reached;
+          }
+          out.model_vs_traditional = c.model_vs_traditional;
+          out.model_vs_none = c.model_vs_none;
+          out.model_vs_regression = c.model_vs_regression;
+          out.model_vs_ramp = c.model_vs_ramp;
+        } catch (const InputError& err) {
+          out.ok = false;
+          out.error = err.what();
         }
-        out.model_vs_traditional = c.model_vs_traditional;
-        out.model_vs_none = c.model_vs_none;
-        out.model_vs_regression = c.model_vs_regression;
-        out.model_vs_ramp = c.model_vs_ramp;
-      } catch (const InputError& err) {
-        out.ok = false;
-        out.error = err.what();
-      }
-      const std::size_t d = ++done;
-      if (progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        progress(d, screws.size());
-      }
-    }
-  };
-  const int threads = std::min<int>(options.threads, std::max<std::size_t>(1, screws.size()));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+      },
+      progress);
 
   e.summary = Summarize(e.screws);
   return e;

@@ -82,7 +82,9 @@ struct Evaluation {
 using EvaluateProgress = std::function<void(std::size_t done, std::size_t total)>;
 
 /// Compares every screw (in parallel on `threads` threads; results in input order and identical
-/// for any thread count). A screw whose comparison throws InputError is recorded as failed.
+/// for any thread count). A screw whose comparison throws InputError is recorded as failed; any
+/// other exception (in a comparison or in `progress`) stops the run and is rethrown here after all
+/// threads have joined (core/parallel.h), never std::terminate.
 Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model& model,
                           const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                           const EvaluateOptions& options, const EvaluateProgress& progress = {});

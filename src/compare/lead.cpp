@@ -16,6 +16,7 @@ LeadDeviation ReadLeadDeviation(const std::filesystem::path& path) {
   if (lead.size() < 2)
     throw InputError(csv.source + ": a lead-deviation curve needs at least 2 rows, found " +
                      std::to_string(lead.size()));
+  ValidateLeadDeviation(lead, csv.source);
   return lead;
 }
 
@@ -36,6 +37,23 @@ void ValidateLeadDeviation(const LeadDeviation& lead, const std::string& what) {
                        FormatNumber(lead.position_mm[i]) + " after " +
                        FormatNumber(lead.position_mm[i - 1]) + " at point " + std::to_string(i) +
                        ")");
+    // Physical limits: the metrics stay finite (no overflow in squares and sums, no division by
+    // a vanishing span).
+    if (std::fabs(lead.position_mm[i]) > kMaxLeadPositionMm)
+      throw InputError(what + ": point " + std::to_string(i) +
+                       ": position_mm = " + FormatNumber(lead.position_mm[i]) +
+                       " breaks the rule: |position| <= " + FormatNumber(kMaxLeadPositionMm) +
+                       " mm");
+    if (std::fabs(lead.deviation_um[i]) > kMaxLeadDeviationUm)
+      throw InputError(what + ": point " + std::to_string(i) +
+                       ": deviation_um = " + FormatNumber(lead.deviation_um[i]) +
+                       " breaks the rule: |deviation| <= " + FormatNumber(kMaxLeadDeviationUm) +
+                       " um");
+    if (i > 0 && lead.position_mm[i] - lead.position_mm[i - 1] < kMinLeadSpacingMm)
+      throw InputError(what + ": point " + std::to_string(i) + ": position_mm " +
+                       FormatNumber(lead.position_mm[i]) + " is closer than " +
+                       FormatNumber(kMinLeadSpacingMm) + " mm to the previous " +
+                       FormatNumber(lead.position_mm[i - 1]) + " (rule: spacing >= 1 nm)");
   }
 }
 

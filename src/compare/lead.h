@@ -18,13 +18,20 @@ struct LeadDeviation {
   std::size_t size() const { return position_mm.size(); }
 };
 
+/// Physical limits of a lead-deviation curve (so every metric stays finite): |position| at most
+/// 1e6 mm (1 km), positions at least 1e-6 mm (1 nm) apart, |deviation| at most 1e6 um (1 m).
+inline constexpr double kMaxLeadPositionMm = 1e6;
+inline constexpr double kMinLeadSpacingMm = 1e-6;
+inline constexpr double kMaxLeadDeviationUm = 1e6;
+
 /// Reads a measured lead CSV: header with `position_mm` and `deviation_um` (other columns are
 /// ignored), '#' comment lines allowed. Rejects (InputError naming file and line): fewer than 2
-/// rows, positions not strictly increasing, non-finite cells, missing columns.
+/// rows, positions not strictly increasing, non-finite cells, missing columns, values beyond the
+/// limits above (ValidateLeadDeviation).
 LeadDeviation ReadLeadDeviation(const std::filesystem::path& path);
 
 /// Checks the invariants above (same sizes, >= 2 points, strictly increasing finite positions,
-/// finite deviations); `what` names the curve in the InputError.
+/// finite deviations, the limits above); `what` names the curve in the InputError.
 void ValidateLeadDeviation(const LeadDeviation& lead, const std::string& what);
 
 /// Writes `position_mm,deviation_um` with '#' provenance comments, atomically.

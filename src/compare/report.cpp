@@ -1,15 +1,20 @@
 #include "compare/report.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
+#include <random>
+#include <set>
 #include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
 
 namespace whirl::compare {
 namespace {
@@ -18,35 +23,6 @@ std::string Fixed(double x, int decimals) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
   return buf;
-}
-
-std::string Html(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    switch (ch) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += ch;
-    }
-  }
-  return out;
-}
-
-std::string ShellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return out + "'";
 }
 
 std::string Pct(const std::optional<double>& v) { return v ? Fixed(*v, 1) + " %" : "-"; }
@@ -58,27 +34,46 @@ std::vector<std::string> Comments(const ReportOptions& o, const std::string& wha
 }
 
 bool HaveGnuplot(const std::string& command) {
-  return std::system((command + " --version > /dev/null 2>&1").c_str()) == 0;
+  return !command.empty() && ProgramSucceeds({command, "--version"});
 }
 
 std::string Terminal(const std::string& command) {
-  const bool cairo =
-      std::system((command + " -e \"set terminal pngcairo\" > /dev/null 2>&1").c_str()) == 0;
+  const bool cairo = ProgramSucceeds({command, "-e", "set terminal pngcairo"});
   return cairo ? "pngcairo size 1000,560 font 'Sans,11' noenhanced"
                : "png size 1000,560 noenhanced";
 }
+
+// A fresh folder inside the report directory, removed with everything in it on destruction.
+struct StagingDir {
+  std::filesystem::path path;
+  explicit StagingDir(const std::filesystem::path& dir) {
+    std::random_device rd;
+    path = dir / (".whirl-report-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    std::error_code ec;
+    if (!std::filesystem::create_directory(path, ec))
+      throw InputError("report directory '" + dir.string() + "': cannot create a staging folder (" +
+                       ec.message() + ")");
+  }
+  ~StagingDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  StagingDir(const StagingDir&) = delete;
+  StagingDir& operator=(const StagingDir&) = delete;
+};
 
 struct PlotFiles {
   std::string elongation, lead, lead_start;
 };
 
-// The gnuplot script for one screw; outputs go to "<png>.tmp" and are renamed after success.
+// The gnuplot script for one screw: reads the CSVs and writes the PNGs beside it.
 std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, const PlotFiles& f,
                           const std::string& terminal) {
   const double t_end = c.truth.time_s.back();
   const double settle = std::max(c.predicted_curve.settle_time_s, c.experience_ramp_time_s);
   const double t_zoom = std::min(t_end, std::max(60.0, 3.0 * settle));
   const double l = c.screw.thread_length_mm;
+  const std::string& name = c.screw.name;  // user-supplied: only ever inside GnuplotString
   std::ostringstream s;
   s << "# gnuplot script written by whirl; re-run with: gnuplot " << slug << ".gp\n"
     << "set datafile separator ','\nset datafile commentschars '#'\n"
@@ -87,33 +82,42 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "set style line 3 lc rgb '#2ca02c' lw 2\nset style line 4 lc rgb '#ff7f0e' lw 2 dt 4\n"
     << "set style line 5 lc rgb '#000000' pt 7 ps 0.8\n";
   // Elongation: truth vs prediction, compensation points, traditional ramp.
-  s << "set output '" << f.elongation << ".tmp'\n"
-    << "set title '" << c.screw.name << ": elongation of the unmachined section (first "
-    << Fixed(t_zoom, 0) << " s of " << Fixed(t_end, 0) << " s cutting time)'\n"
+  s << "set output " << GnuplotString(f.elongation) << "\n"
+    << "set title "
+    << GnuplotString(name + ": elongation of the unmachined section (first " + Fixed(t_zoom, 0) +
+                     " s of " + Fixed(t_end, 0) + " s cutting time)")
+    << " noenhanced\n"
     << "set xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
     << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
-    << "plot '" << slug << "_elongation.csv' using 1:2 with lines ls 1 title 'simulated truth "
+    << "plot " << GnuplotString(slug + "_elongation.csv")
+    << " using 1:2 with lines ls 1 title 'simulated truth "
     << "(disturbed)', \\\n"
     << "  '' using 1:3 with lines ls 2 title 'predicted arctan curve (model)', \\\n"
     << "  '' using 1:5 with lines ls 3 title '840D compensation applied (model plan)', \\\n"
     << "  '' using 1:4 with lines ls 4 title 'traditional compensation (experience ramp)', \\\n"
-    << "  '" << slug << "_points.csv' using 1:3 with points ls 5 title 'compensation points "
+    << "  " << GnuplotString(slug + "_points.csv")
+    << " using 1:3 with points ls 5 title 'compensation points "
     << "(SD43900/10/20 breakpoints)'\n"
     << "set output\n";
   // Lead deviation along the whole thread.
   s << "set key below horizontal box\nset bmargin 6\n"
-    << "set output '" << f.lead << ".tmp'\n"
-    << "set title '" << c.screw.name
-    << ": travel deviation along the thread after cooling (actual - specified)'\n"
+    << "set output " << GnuplotString(f.lead) << "\n"
+    << "set title "
+    << GnuplotString(name +
+                     ": travel deviation along the thread after cooling (actual - specified)")
+    << " noenhanced\n"
     << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
     << "set xrange [0:" << l << "]\nset yrange [*:*]\n"
-    << "plot '" << slug << "_lead.csv' using 1:2 with lines ls 2 title 'no compensation', \\\n"
+    << "plot " << GnuplotString(slug + "_lead.csv")
+    << " using 1:2 with lines ls 2 title 'no compensation', \\\n"
     << "  '' using 1:3 with lines ls 4 title 'traditional (experience rule)', \\\n"
     << "  '' using 1:4 with lines ls 3 title 'model-based (840D plan)'\n"
     << "set output\n";
-  s << "set output '" << f.lead_start << ".tmp'\n"
-    << "set title '" << c.screw.name << ": travel deviation, first "
-    << Fixed(std::min(l, 1000.0), 0) << " mm of the thread'\n"
+  s << "set output " << GnuplotString(f.lead_start) << "\n"
+    << "set title "
+    << GnuplotString(name + ": travel deviation, first " + Fixed(std::min(l, 1000.0), 0) +
+                     " mm of the thread")
+    << " noenhanced\n"
     << "set xrange [0:" << std::min(l, 1000.0) << "]\n"
     << "replot\nset output\n";
   return s.str();
@@ -151,7 +155,7 @@ std::string MetricsTable(const ScrewComparison& c) {
     << "</td><td>" << ToString(t.iso.reached) << "</td><td>" << ToString(m.iso.reached)
     << "</td><td colspan='2'></td></tr>\n</table>\n<ul class='small'>\n";
   for (const auto* o : {&n, &t, &m})
-    h << "<li><b>" << ToString(o->strategy) << "</b>: " << Html(o->iso.message) << "</li>\n";
+    h << "<li><b>" << ToString(o->strategy) << "</b>: " << HtmlEscape(o->iso.message) << "</li>\n";
   h << "</ul>\n";
   // Issue 11: every baseline, absolute micrometres first (compare/traditional.h says why each is
   // a fair stand-in).
@@ -197,8 +201,10 @@ std::string FormatComparisonTable(const ScrewComparison& c) {
 }
 
 std::string Slug(const std::string& name) {
+  constexpr std::size_t kMaxLength = 64;  // file names stay far below NAME_MAX (255)
   std::string s;
   for (char ch : name) {
+    if (s.size() >= kMaxLength) break;
     const unsigned char u = static_cast<unsigned char>(ch);
     if (std::isalnum(u))
       s += static_cast<char>(std::tolower(u));
@@ -227,6 +233,11 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                               "scripts/setup.sh); the HTML, CSV data and .gp scripts are written");
   const std::string terminal = gnuplot ? Terminal(options.gnuplot_command) : "pngcairo";
   bool all_rendered = gnuplot;
+  // Everything is first written into a staging folder inside `dir` (gnuplot renders there), then
+  // committed all-or-nothing (WriteFilesAtomic); the staging folder is removed in any case.
+  const StagingDir stage(dir);
+  std::vector<std::pair<std::filesystem::path, std::string>> outputs;
+  std::set<std::string> rendered;
 
   std::vector<std::string> slugs;
   nlohmann::json report_json = nlohmann::json::array();
@@ -246,8 +257,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                       c.compensation_um[static_cast<std::size_t>(Strategy::kModel)][i]});
     }
     auto write = [&](const std::string& name, const std::string& text) {
-      WriteFileAtomic(dir / name, text);
-      result.files.push_back(dir / name);
+      WriteFileAtomic(stage.path / name, text);
+      outputs.emplace_back(dir / name, text);
     };
     write(slug + "_elongation.csv",
           FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
@@ -292,24 +303,25 @@ ReportResult WriteReport(const std::filesystem::path& dir,
     const PlotFiles files{slug + "_elongation.png", slug + "_lead.png", slug + "_lead_start.png"};
     write(slug + ".gp", GnuplotScript(c, slug, files, terminal));
     if (gnuplot) {
-      const std::string cmd = "cd " + ShellQuote(dir.string()) + " && " + options.gnuplot_command +
-                              " " + ShellQuote(slug + ".gp") + " > " +
-                              ShellQuote(slug + ".gp.log") + " 2>&1";
-      const int rc = std::system(cmd.c_str());
+      // An argument vector, no shell: neither the directory nor the names are ever parsed.
+      const std::string log = slug + ".gp.log";
+      const int rc =
+          RunProgram({options.gnuplot_command, slug + ".gp"}, stage.path, stage.path / log);
       bool ok = rc == 0;
       for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-        const auto tmp = dir / (png + ".tmp");
-        if (ok && std::filesystem::exists(tmp) && std::filesystem::file_size(tmp) > 0) {
-          std::filesystem::rename(tmp, dir / png);
-          result.files.push_back(dir / png);
-        } else {
-          ok = false;
-          std::filesystem::remove(tmp, ec);
-        }
+        std::error_code ec;
+        ok = ok && std::filesystem::is_regular_file(stage.path / png, ec) &&
+             std::filesystem::file_size(stage.path / png, ec) > 0;
       }
       if (ok) {
-        std::filesystem::remove(dir / (slug + ".gp.log"), ec);
+        for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+          outputs.emplace_back(dir / png, ReadTextFile(stage.path / png));
+          rendered.insert(png);
+        }
       } else {
+        std::error_code ec;
+        if (std::filesystem::exists(stage.path / log, ec))
+          outputs.emplace_back(dir / log, ReadTextFile(stage.path / log));
         all_rendered = false;
         result.warnings.push_back("gnuplot failed on " + (dir / (slug + ".gp")).string() +
                                   " (see " + (dir / (slug + ".gp.log")).string() + "): plots of '" +
@@ -319,7 +331,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
 
     // HTML section.
     const auto in = c.screw.process;
-    body << "<h2>" << Html(c.screw.name) << "</h2>\n<p>Inputs: hardness "
+    body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
          << Fixed(in.hardness_hrc, 1) << " HRC, diameter " << Fixed(in.diameter_mm, 1)
          << " mm, lead " << Fixed(in.pitch_mm, 2) << " mm, raceway radius "
          << Fixed(in.raceway_radius_mm, 2) << " mm, cutting speed "
@@ -332,7 +344,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
       for (const auto& f : c.prediction.outside_domain_fields)
         fields += (fields.empty() ? "" : ", ") + f;
       body << "<p class='warn'>The model extrapolates: outside its training domain in "
-           << Html(fields) << ".</p>\n";
+           << HtmlEscape(fields) << ".</p>\n";
     }
     body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n"
          << "<tr><td>simulated truth (seed " << c.seed << ", disturbances "
@@ -358,11 +370,11 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                             : std::string("more than 1000000"))
          << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
          << FormatNumber(c.plan.max_abs_slope) << " (MD32760 cap "
-         << FormatNumber(c.plan.options.md32760) << "), axis " << Html(c.plan.options.axis)
+         << FormatNumber(c.plan.options.md32760) << "), axis " << HtmlEscape(c.plan.options.axis)
          << ", sign " << interp::ToString(c.plan.options.sign) << ".</p>\n"
          << MetricsTable(c);
     for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-      if (gnuplot && std::filesystem::exists(dir / png))
+      if (rendered.count(png) > 0)
         body << "<p><img src='" << png << "' alt='" << png << "'></p>\n";
       else
         body << "<p class='warn'>Plot " << png << " not rendered (see warnings).</p>\n";
@@ -376,26 +388,27 @@ ReportResult WriteReport(const std::filesystem::path& dir,
   }
   result.plots_rendered = all_rendered && !comparisons.empty();
 
-  WriteJsonFile(dir / "report.json", {{"schema", "whirl.report"},
-                                      {"schema_version", 1},
-                                      {"provenance", options.provenance},
-                                      {"comparisons", report_json}});
-  result.files.push_back(dir / "report.json");
+  const nlohmann::json report = {{"schema", "whirl.report"},
+                                 {"schema_version", 1},
+                                 {"provenance", options.provenance},
+                                 {"comparisons", report_json}};
+  outputs.emplace_back(dir / "report.json", report.dump(2) + "\n");
 
   std::ostringstream html;
   html
       << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>"
-      << Html(options.title)
+      << HtmlEscape(options.title)
       << "</title>\n<style>body{font-family:sans-serif;max-width:1060px;margin:2em auto;color:#222}"
          "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #bbb;padding:3px "
          "8px;"
          "text-align:right}td:first-child,th:first-child{text-align:left}th{background:#eee}"
          "tr.cls td{font-weight:bold}.small{font-size:0.85em;color:#555}.warn{color:#a00}"
          "img{max-width:100%;border:1px solid #ddd}</style></head><body>\n<h1>"
-      << Html(options.title) << "</h1>\n";
-  for (const auto& p : options.provenance) html << "<p class='small'>" << Html(p) << "</p>\n";
-  for (const auto& n : options.notes) html << "<p>" << Html(n) << "</p>\n";
-  for (const auto& w : result.warnings) html << "<p class='warn'>warning: " << Html(w) << "</p>\n";
+      << HtmlEscape(options.title) << "</h1>\n";
+  for (const auto& p : options.provenance) html << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
+  for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
+  for (const auto& w : result.warnings)
+    html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
   html << "<p>How to read this page. Each screw is cut in the simulator (the ground truth, with "
           "seeded disturbances the model never saw) three times: without compensation, with the "
           "traditional experience rule (one correction per diameter class, ramped in linearly over "
@@ -411,8 +424,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
           "(Steinmeyer, HIWIN catalogue); the others are recalled values "
           "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
        << body.str() << "</body></html>\n";
-  WriteFileAtomic(dir / "index.html", html.str());
-  result.files.push_back(dir / "index.html");
+  outputs.emplace_back(dir / "index.html", html.str());  // last: the page of a complete set
+  WriteFilesAtomic(outputs);
+  for (const auto& [path, text] : outputs) result.files.push_back(path);
   result.index_html = dir / "index.html";
   return result;
 }

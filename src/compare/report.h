@@ -12,8 +12,12 @@
 // .gp scripts stay in the report folder so anyone can re-plot or restyle from the CSVs, and PNG
 // embeds in any browser or mail. If gnuplot is missing at run time, the HTML, CSVs and scripts are
 // still written and ReportResult::warnings says the plots were skipped.
-// Every file is written atomically (PNGs are rendered to a temporary name and renamed), and
-// index.html last, so an interrupted run never leaves a page pointing at half-written plots.
+// All-or-nothing: every file (CSVs, .gp scripts, PNGs rendered by gnuplot, report.json,
+// index.html) is first made in a staging folder inside the report directory, then committed with
+// core/atomic_file.h WriteFilesAtomic; a failure leaves no new file and the previous report intact.
+// Safe with any screw name: names reach gnuplot only as GnuplotString literals (titles
+// `noenhanced`), the page only through HtmlEscape, file names only as Slug; gnuplot runs through
+// RunProgram (an argument vector, no shell), in the staging folder.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -50,7 +54,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
 /// strategies, the ISO class reached and the reductions of the model against both baselines.
 std::string FormatComparisonTable(const ScrewComparison& c);
 
-/// File-name stem for a screw name: lower case letters, digits, '-' and '_' only.
+/// File-name stem for a screw name: lower case letters, digits, '-' and '_' only, at most 64
+/// characters, never empty ("screw").
 std::string Slug(const std::string& name);
 
 }  // namespace whirl::compare

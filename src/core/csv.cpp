@@ -137,7 +137,12 @@ std::string FormatCsv(const std::vector<std::string>& header,
                       const std::vector<std::vector<double>>& rows,
                       const std::vector<std::string>& comments) {
   std::string out;
-  for (const auto& c : comments) out += "# " + c + "\n";
+  for (const auto& c : comments) {
+    out += "# ";
+    // A comment is one line: a newline in a user-supplied name must not start a data row.
+    for (const char ch : c) out += (ch == '\n' || ch == '\r') ? ' ' : ch;
+    out += "\n";
+  }
   for (std::size_t i = 0; i < header.size(); ++i) out += (i ? "," : "") + header[i];
   out += "\n";
   for (const auto& r : rows) {

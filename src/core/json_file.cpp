@@ -15,6 +15,9 @@ nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError("'" + path.string() + "' is not valid JSON (byte " + std::to_string(e.byte) +
                      "): " + e.what());
+  } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range: a number beyond double
+    throw InputError("'" + path.string() + "': " + e.what() +
+                     " (rule: numbers must lie within the double range, |x| < 1.8e308)");
   }
 }
 

@@ -5,7 +5,8 @@
 
 namespace whirl {
 
-/// Parses a JSON file; a syntax error or truncation is an InputError naming the file and byte.
+/// Parses a JSON file; a syntax error, a truncation or a number beyond the double range is an
+/// InputError naming the file (and byte). Size limit: kMaxInputFileBytes (core/atomic_file.h).
 nlohmann::json ReadJsonFile(const std::filesystem::path& path);
 
 /// Writes pretty-printed JSON (2-space indent, trailing newline) atomically.

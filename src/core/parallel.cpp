@@ -26,15 +26,15 @@ void ParallelFor(std::size_t n, int threads, const std::function<void(std::size_
       if (i >= n) return;
       try {
         body(i);
+        std::lock_guard<std::mutex> lock(mutex);
+        ++done;
+        if (progress) progress(done, n);  // a throwing callback is reported like a throwing body
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
         if (!error) error = std::current_exception();
         stop.store(true);
         return;
       }
-      std::lock_guard<std::mutex> lock(mutex);
-      ++done;
-      if (progress) progress(done, n);
     }
   };
   std::vector<std::thread> pool;

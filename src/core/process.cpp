@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace whirl {
 
@@ -40,20 +41,28 @@ ProcessTable ReadProcessTable(const std::filesystem::path& path, bool require_ta
   std::array<std::size_t, Features::kCount> out_idx{};
   if (read_targets)
     for (int k = 0; k < Features::kCount; ++k) out_idx[k] = csv.ColumnIndex(kTargetColumns[k]);
-  for (const auto& row : csv.rows) {
+  for (std::size_t r = 0; r < csv.rows.size(); ++r) {
+    const auto& row = csv.rows[r];
+    const std::string where = csv.source + ":" + std::to_string(csv.line_numbers[r]);
     std::array<double, ProcessInputs::kCount> a{};
     for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = row[in_idx[i]];
     t.inputs.push_back(ProcessInputs::FromArray(a));
+    CheckProcessInputs(t.inputs.back(), where);
     if (read_targets) {
       std::array<double, Features::kCount> b{};
       for (int k = 0; k < Features::kCount; ++k) b[k] = row[out_idx[k]];
       t.targets.push_back(Features::FromArray(b));
+      CheckFeatures(t.targets.back(), where);
     }
   }
   return t;
 }
 
 void WriteProcessTable(const std::filesystem::path& path, const ProcessTable& table) {
+  WriteFileAtomic(path, FormatProcessTable(table));
+}
+
+std::string FormatProcessTable(const ProcessTable& table) {
   std::vector<std::string> header(kInputColumns.begin(), kInputColumns.end());
   const bool with_targets = !table.targets.empty();
   if (with_targets) {
@@ -71,7 +80,7 @@ void WriteProcessTable(const std::filesystem::path& path, const ProcessTable& ta
     }
     rows.push_back(std::move(row));
   }
-  WriteFileAtomic(path, FormatCsv(header, rows, table.comments));
+  return FormatCsv(header, rows, table.comments);
 }
 
 }  // namespace whirl

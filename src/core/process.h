@@ -52,10 +52,13 @@ struct ProcessTable {
 
 /// Reads a table with header row. The five input columns are required; target columns are
 /// required when `require_targets`, otherwise read when both are present. Other columns are
-/// ignored. Errors (InputError) name the file, line and column.
+/// ignored. Every row is checked against the physical limits of core/limits.h. Errors
+/// (InputError) name the file, line and column.
 ProcessTable ReadProcessTable(const std::filesystem::path& path, bool require_targets);
 
 /// Writes inputs (and targets, if non-empty) as CSV with '#' provenance comments, atomically.
 void WriteProcessTable(const std::filesystem::path& path, const ProcessTable& table);
+/// The CSV text WriteProcessTable writes (for multi-file outputs written all-or-nothing).
+std::string FormatProcessTable(const ProcessTable& table);
 
 }  // namespace whirl

@@ -23,9 +23,10 @@ int RunProgram(const std::vector<std::string>& argv, const std::filesystem::path
   if (pid == 0) {  // child: only async-signal-safe calls until exec
     const int in = open("/dev/null", O_RDONLY);
     if (in >= 0) dup2(in, STDIN_FILENO);
-    if (!cwd_s.empty() && chdir(cwd_s.c_str()) != 0) _exit(127);
+    // The log first: a relative log_path is relative to the caller's directory, not to cwd.
     const int out = open(log_s.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
     if (out < 0) _exit(127);
+    if (!cwd_s.empty() && chdir(cwd_s.c_str()) != 0) _exit(127);
     dup2(out, STDOUT_FILENO);
     dup2(out, STDERR_FILENO);
     execvp(args[0], args.data());

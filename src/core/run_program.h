@@ -9,7 +9,8 @@ namespace whirl {
 
 /// Runs `argv[0]` (looked up on PATH when it has no '/') with the arguments `argv[1..]`, in the
 /// working directory `cwd` (empty: the current one), with stdin from /dev/null and stdout plus
-/// stderr appended to `log_path` (empty: discarded). Waits for it. Returns its exit status, or
+/// stderr appended to `log_path` (empty: discarded; a relative path is relative to the caller's
+/// working directory, not to `cwd`). Waits for it. Returns its exit status, or
 /// 128 + signal if it was killed, or 127 if it could not be started (not found, cwd missing).
 /// Never throws for a failing program; throws std::invalid_argument for an empty argv.
 int RunProgram(const std::vector<std::string>& argv, const std::filesystem::path& cwd = {},

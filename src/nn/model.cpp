@@ -26,6 +26,16 @@ double RequireFinite(const json& v, const std::string& where) {
   return x;
 }
 
+// A whole number within [lo, hi], checked before any cast (a float-to-int cast out of range is
+// undefined behaviour): epochs of 1e30 or a layer of 2e9 neurons are errors, not allocations.
+int RequireInt(const json& v, const std::string& where, double lo, double hi) {
+  const double x = RequireFinite(v, where);
+  if (x != std::floor(x) || x < lo || x > hi)
+    throw InputError(where + " must be a whole number in [" + FormatNumber(lo) + ", " +
+                     FormatNumber(hi) + "], got " + v.dump());
+  return static_cast<int>(x);
+}
+
 // `path` is the key path inside the model file, e.g. "layers[0].weights"; messages quote it.
 Eigen::VectorXd ReadVector(const json& v, const std::string& path, Eigen::Index expected) {
   const std::string where = "model '" + path + "'";
@@ -127,7 +137,7 @@ TrainOptions ReadOptions(const json& j) {
       j, {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad", "regularization"},
       where);
   TrainOptions o;
-  o.epochs = static_cast<int>(RequireFinite(Require(j, "epochs", where), where + " 'epochs'"));
+  o.epochs = RequireInt(Require(j, "epochs", where), where + " 'epochs'", 0, kMaxEpochs);
   o.goal = RequireFinite(Require(j, "goal", where), where + " 'goal'");
   o.mu = RequireFinite(Require(j, "mu", where), where + " 'mu'");
   o.mu_dec = RequireFinite(Require(j, "mu_dec", where), where + " 'mu_dec'");
@@ -261,12 +271,18 @@ void from_json(const nlohmann::json& j, Model& m) {
     throw InputError("model 'layer_sizes' must be an array of at least 2 sizes, got " +
                      sizes.dump());
   std::vector<int> layer_sizes;
+  if (sizes.size() > kMaxLayers)
+    throw InputError("model 'layer_sizes' has " + std::to_string(sizes.size()) +
+                     " entries; the limit is " + std::to_string(kMaxLayers));
+  double parameters = 0;
   for (std::size_t i = 0; i < sizes.size(); ++i) {
-    if (!sizes[i].is_number_integer() || sizes[i].get<int>() < 1)
-      throw InputError("model 'layer_sizes[" + std::to_string(i) +
-                       "]' must be an integer >= 1, got " + sizes[i].dump());
-    layer_sizes.push_back(sizes[i].get<int>());
+    layer_sizes.push_back(
+        RequireInt(sizes[i], "model 'layer_sizes[" + std::to_string(i) + "]'", 1, kMaxLayerSize));
+    if (i > 0) parameters += (layer_sizes[i - 1] + 1.0) * layer_sizes[i];
   }
+  if (parameters > kMaxParameters)
+    throw InputError("model 'layer_sizes' " + sizes.dump() + " give " + FormatNumber(parameters) +
+                     " weights and biases; the limit is " + FormatNumber(kMaxParameters));
   m.network = Network::Zeros(layer_sizes);
   const json& layers = Require(j, "layers", "model");
   if (!layers.is_array() || layers.size() + 1 != layer_sizes.size())
@@ -319,10 +335,10 @@ void from_json(const nlohmann::json& j, Model& m) {
   const json& data = Require(training, "data", "model 'training'");
   if (!data.is_string()) throw InputError("model 'training.data' must be a string");
   m.training_data = data.get<std::string>();
-  m.training_samples = static_cast<int>(
-      RequireFinite(Require(training, "samples", "model 'training'"), "model 'training.samples'"));
-  m.restarts = static_cast<int>(RequireFinite(Require(training, "restarts", "model 'training'"),
-                                              "model 'training.restarts'"));
+  m.training_samples = RequireInt(Require(training, "samples", "model 'training'"),
+                                  "model 'training.samples'", 0, 1e9);
+  m.restarts = RequireInt(Require(training, "restarts", "model 'training'"),
+                          "model 'training.restarts'", 0, 1e6);
   m.init_seed =
       ReadSeed(Require(training, "init_seed", "model 'training'"), "model 'training.init_seed'");
   try {

@@ -74,6 +74,14 @@ void to_json(nlohmann::json& j, const Model& m);
 /// Validates everything (schema version, sizes, finiteness, names); InputError names the key.
 void from_json(const nlohmann::json& j, Model& m);
 
+/// Limits of a model file (LoadModel), checked before anything is allocated: at most kMaxLayers
+/// layer sizes, each in [1, kMaxLayerSize] neurons, at most kMaxParameters weights and biases
+/// (8 MB), training epochs in [0, kMaxEpochs] (as `whirl train --epochs`).
+inline constexpr std::size_t kMaxLayers = 8;
+inline constexpr double kMaxLayerSize = 1000;
+inline constexpr double kMaxParameters = 1e6;
+inline constexpr double kMaxEpochs = 1e6;
+
 /// Reads and validates a model file. A wrong, truncated or inconsistent file is an InputError
 /// whose message names the file and the offending key.
 Model LoadModel(const std::filesystem::path& path);

@@ -184,7 +184,11 @@ void from_json(const nlohmann::json& j, RestartRecord& r) {
   r.log_evidence = NumberOrNan(j, "log_evidence");
   r.sse = j.at("sse_normalized").get<double>();
   r.gamma = j.at("gamma").get<double>();
-  r.epochs = j.at("epochs").get<int>();
+  const double epochs = j.at("epochs").get<double>();  // checked before the cast (1e30 is UB)
+  if (!(epochs >= 0 && epochs <= 1e9 && epochs == std::floor(epochs)))
+    throw InputError("restart record: 'epochs' must be a whole number in [0, 1e9], got " +
+                     j.at("epochs").dump());
+  r.epochs = static_cast<int>(epochs);
   r.termination = ParseTermination(j.at("termination").get<std::string>());
 }
 

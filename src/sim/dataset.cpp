@@ -1,14 +1,14 @@
 #include "sim/dataset.h"
 
-#include <atomic>
+#include <algorithm>
 #include <cmath>
-#include <exception>
-#include <mutex>
+#include <cstdio>
 #include <sstream>
-#include <thread>
 
+#include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "sim/random.h"
 
 namespace whirl::sim {
@@ -87,38 +87,17 @@ Dataset GenerateDataset(const DatasetOptions& options,
 
   SimOptions sim = options.sim;
   sim.duration_s = options.window_s;
-  std::atomic<std::size_t> next{0};
-  std::size_t done = 0;
-  std::mutex mutex;
-  std::exception_ptr error;
-  auto worker = [&]() {
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= n) return;
-      try {
+  ParallelFor(
+      n, std::max(1, options.threads),
+      [&](std::size_t i) {
         DisturbanceOptions dist = options.disturbance;
         dist.seed = MixSeed(options.seed, i);
         SimulationResult r = Simulate(RowScrew(points[i]), sim, dist);
         out.settle[i] = AnalyzeSettle(r.curve, sim.settle);
         out.table.targets[i] = out.settle[i].features;
         out.curves[i] = std::move(r.curve);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!error) error = std::current_exception();
-        next = n;
-        return;
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      ++done;
-      if (progress) progress(done, n);
-    }
-  };
-  const int threads = std::max(1, std::min<int>(options.threads, static_cast<int>(n)));
-  std::vector<std::thread> pool;
-  for (int k = 1; k < threads; ++k) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
+      },
+      progress);
 
   const DisturbanceOptions& d = options.disturbance;
   std::ostringstream s;
@@ -144,6 +123,39 @@ Dataset GenerateDataset(const DatasetOptions& options,
   c.push_back(s.str());
   c.push_back(" features: ExtractFeatures (plateau + quadratic drift fitted after the settle time, detrended 60 s moving average within a noise-aware 2 % band; src/sim/features.h)");
   return out;
+}
+
+void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_path,
+                  const std::filesystem::path& curves_dir, const std::string& regenerate) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<fs::path, std::string>> files;
+  files.emplace_back(table_path, FormatProcessTable(dataset.table));
+  const std::string table_name = table_path.filename().string();
+  for (std::size_t i = 0; !curves_dir.empty() && i < dataset.curves.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "row_%04zu.csv", i + 1);
+    const ElongationCurve& c = dataset.curves[i];
+    std::vector<std::vector<double>> rows;
+    rows.reserve(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) rows.push_back({c.time_s[k], c.elongation_um[k]});
+    files.emplace_back(
+        curves_dir / name,
+        FormatCsv({"time_s", "elongation_um"}, rows,
+                  {" SIMULATED curve of row " + std::to_string(i + 1) + " of " + table_name,
+                   regenerate}));
+  }
+  std::error_code ec;
+  const bool created =
+      !curves_dir.empty() && !fs::exists(curves_dir, ec) && fs::create_directories(curves_dir, ec);
+  if (ec)
+    throw InputError("--curves-dir '" + curves_dir.string() + "': cannot create it (" +
+                     ec.message() + ")");
+  try {
+    WriteFilesAtomic(files);
+  } catch (...) {
+    if (created) fs::remove(curves_dir, ec);  // empty: nothing was written into it
+    throw;
+  }
 }
 
 }  // namespace whirl::sim

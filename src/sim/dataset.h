@@ -63,6 +63,14 @@ std::vector<ProcessInputs> DesignPoints(
 Dataset GenerateDataset(const DatasetOptions& options,
                         const std::function<void(std::size_t, std::size_t)>& progress = {});
 
+/// Writes the table (CSV, `table_path`) and, unless `curves_dir` is empty, each row's recorded
+/// curve as `curves_dir/row_0001.csv`, ... (time_s,elongation_um; the directory is created),
+/// all-or-nothing (core/atomic_file.h WriteFilesAtomic): one file that cannot be written leaves
+/// none written and previous files intact. `regenerate` (the command line) goes into every
+/// curve's '#' comments.
+void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_path,
+                  const std::filesystem::path& curves_dir, const std::string& regenerate);
+
 /// The reference blank with the given inputs (the screw of a table row).
 Screw RowScrew(const ProcessInputs& inputs);
 

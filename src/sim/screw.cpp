@@ -7,6 +7,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
 
 namespace whirl::sim {
 namespace {
@@ -45,13 +46,12 @@ GrooveGeometry ComputeGroove(double raceway_radius_mm, double pitch_mm, double d
 
 void ValidateScrew(const Screw& s, const std::string& what) {
   const ProcessInputs& p = s.process;
-  if (!(p.hardness_hrc >= 20 && p.hardness_hrc <= 70))
-    Fail(what, "hardness_hrc", p.hardness_hrc, "Rockwell C hardness must be within 20-70 HRC");
-  RequirePositive(what, "diameter_mm", p.diameter_mm);
-  RequirePositive(what, "pitch_mm", p.pitch_mm);
-  RequirePositive(what, "raceway_radius_mm", p.raceway_radius_mm);
-  RequirePositive(what, "cutting_speed_m_min", p.cutting_speed_m_min);
+  CheckProcessInputs(p, what);  // physical limits of the five inputs (core/limits.h)
   RequirePositive(what, "length_mm", s.length_mm);
+  if (s.length_mm > kMaxBlankLengthMm)
+    Fail(what, "length_mm", s.length_mm,
+         "a blank is at most " + FormatNumber(kMaxBlankLengthMm) +
+             " mm long (physical limit, core/limits.h)");
   RequirePositive(what, "thread_length_mm", s.thread_length_mm);
   const ProcessSettings& st = s.settings;
   if (st.tool_count < 1 || st.tool_count > 24)
@@ -152,6 +152,9 @@ void FromJsonChecked(const nlohmann::json& j, Screw& s, const std::string& what)
     if (!j.at("name").is_string())
       throw InputError(what + ": 'name' must be a string, got " + j.at("name").dump());
     s.name = j.at("name").get<std::string>();
+    if (s.name.size() > kMaxScrewNameLength)
+      throw InputError(what + ": 'name' has " + std::to_string(s.name.size()) +
+                       " characters; the limit is " + std::to_string(kMaxScrewNameLength));
   }
   std::array<double, ProcessInputs::kCount> values{};
   for (int i = 0; i < ProcessInputs::kCount; ++i)

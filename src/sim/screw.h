@@ -80,10 +80,12 @@ struct Kinematics {
   double CutPositionMm(double t_s) const;
 };
 
-/// Throws InputError (naming the field, value and rule) for impossible values: non-positive sizes,
-/// hardness outside 20-70 HRC, tool count outside 1-24, thread longer than the blank minus the
-/// offset, a groove wider than lead - kMinLandMm ("ball too large for the lead"), or deeper than
-/// kMaxGrooveDepthFraction * D. `what` prefixes messages (e.g. the file name).
+/// Throws InputError (naming the field, value and rule) for impossible values: process inputs
+/// outside the physical limits of core/limits.h (hardness 20-70 HRC, diameter (0, 500] mm, ...),
+/// a blank longer than kMaxBlankLengthMm (20 m), non-positive sizes, tool count outside 1-24,
+/// thread longer than the blank minus the offset, a groove wider than lead - kMinLandMm ("ball too
+/// large for the lead"), or deeper than kMaxGrooveDepthFraction * D. `what` prefixes messages (e.g.
+/// the file name).
 void ValidateScrew(const Screw& screw, const std::string& what = "screw");
 
 /// Groove geometry for raceway radius r and lead (no validation).
@@ -105,6 +107,9 @@ Screw ReferenceScrew();
 void to_json(nlohmann::json& j, const Screw& screw);
 void from_json(const nlohmann::json& j, Screw& screw);
 inline constexpr int kScrewSchemaVersion = 1;
+
+/// Longest screw name in a screw file, characters (it becomes titles, file names and messages).
+inline constexpr std::size_t kMaxScrewNameLength = 200;
 
 /// Reads and validates a screw file; InputError names the file, the key, the value and the rule.
 Screw ReadScrew(const std::filesystem::path& path);

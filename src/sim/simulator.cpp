@@ -130,7 +130,15 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
 
   // Geometry in SI units.
   const double length_m = screw.length_mm * 1e-3;
-  const int n = std::max(3, static_cast<int>(std::lround(screw.length_mm / options.cell_size_mm)));
+  const double cells = std::round(screw.length_mm / options.cell_size_mm);
+  if (!(cells >= 3 && cells <= kMaxCells))
+    throw InputError("simulation options: cell_size_mm = " + FormatNumber(options.cell_size_mm) +
+                     " gives " + FormatNumber(cells) + " cells on the " +
+                     FormatNumber(screw.length_mm) + " mm blank; the rule (resource limit): 3 to " +
+                     FormatNumber(kMaxCells) + " cells, i.e. cell_size_mm within [" +
+                     FormatNumber(screw.length_mm / kMaxCells) + ", " +
+                     FormatNumber(screw.length_mm / 3) + "] mm");
+  const int n = static_cast<int>(cells);
   const double dx = length_m / n;
   const double d_m = screw.process.diameter_mm * 1e-3;
   const double area = kPi * d_m * d_m / 4.0;
@@ -153,7 +161,15 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
     t_end = options.duration_s;
     result.summary.termination = SimTermination::kReachedDuration;
   }
-  const long n_steps = std::max(1L, static_cast<long>(std::floor(t_end / dt + 1e-9)));
+  const double steps = std::max(1.0, std::floor(t_end / dt + 1e-9));
+  if (!(steps <= kMaxTimeSteps && steps * n <= kMaxCellSteps))
+    throw InputError("simulation options: " + FormatNumber(t_end) +
+                     " s of cutting at time_step_s = " + FormatNumber(dt) + " is " +
+                     FormatNumber(steps) + " steps x " + std::to_string(n) +
+                     " cells; the rule (resource limit): at most " + FormatNumber(kMaxTimeSteps) +
+                     " steps and " + FormatNumber(kMaxCellSteps) +
+                     " cell-steps (raise time_step_s or cell_size_mm, or shorten duration_s)");
+  const long n_steps = static_cast<long>(steps);
   const long steps_per_sample =
       std::max(1L, static_cast<long>(std::lround(options.sample_interval_s / dt)));
 

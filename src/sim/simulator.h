@@ -39,6 +39,14 @@
 
 namespace whirl::sim {
 
+/// Resource limits of one simulation (InputError beyond them, with the numbers): cells =
+/// length_mm / cell_size_mm within [3, kMaxCells]; time steps = simulated time / time_step_s at
+/// most kMaxTimeSteps; cells x steps at most kMaxCellSteps (about a minute of one core). The
+/// defaults (2 mm, 1 s) on the 6000 mm reference screw: 3000 cells x 7655 steps = 2.3e7.
+inline constexpr double kMaxCells = 200000;
+inline constexpr double kMaxTimeSteps = 2e6;
+inline constexpr double kMaxCellSteps = 2e9;
+
 /// Numerics of the simulation.
 struct SimOptions {
   /// Simulated cutting time, s; 0 = the whole thread (Kinematics::cutting_time_s). Values beyond

@@ -2,4 +2,5 @@ whirl_add_gtest(test_core SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_csv.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_files.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_safe_output.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_file_safety.cpp
   LABELS core)

@@ -1,0 +1,50 @@
+#include "compare/plan_document.h"
+
+#include <utility>
+#include <vector>
+
+#include "core/atomic_file.h"
+
+namespace whirl::compare {
+
+nlohmann::json PlanDocument(const interp::CompensationPlan& plan, const fit::ArctanCurve& curve,
+                            const sim::Screw& screw, const sim::Kinematics& kinematics,
+                            const PlanSource& source, const std::string& provenance) {
+  nlohmann::json prediction = {
+      {"model", source.model.empty() ? nlohmann::json(nullptr) : nlohmann::json(source.model)},
+      {"max_elongation_um", source.features.max_elongation_um},
+      {"settle_time_s", source.features.settle_time_s}};
+  if (source.prediction) {
+    const nn::Prediction& p = *source.prediction;
+    prediction["max_elongation_std_um"] = p.stddev.max_elongation_um;
+    prediction["settle_time_std_s"] = p.stddev.settle_time_s;
+    prediction["outside_domain"] = p.outside_domain;
+    prediction["outside_domain_fields"] = p.outside_domain_fields;
+  }
+  nlohmann::json j = plan;
+  j["provenance"] = provenance;
+  j["screw"] = screw;
+  j["kinematics"] = {{"axial_feed_mm_min", kinematics.axial_feed_mm_min},
+                     {"cutting_time_s", kinematics.cutting_time_s},
+                     {"workpiece_speed_rpm", kinematics.workpiece_speed_rpm},
+                     {"ring_speed_rpm", kinematics.ring_speed_rpm}};
+  j["curve"] = curve;
+  j["prediction"] = prediction;
+  return j;
+}
+
+void WritePlanFiles(const PlanOutputPaths& paths, const nlohmann::json& document,
+                    const interp::CompensationPlan& plan, const std::string& provenance,
+                    const std::string& curve_source) {
+  std::vector<std::pair<std::filesystem::path, std::string>> files;
+  if (!paths.json.empty()) files.emplace_back(paths.json, document.dump(2) + "\n");
+  if (!paths.csv.empty()) files.emplace_back(paths.csv, interp::FormatPlcCsv(plan, {provenance}));
+  interp::NcProgramInfo info;
+  info.curve_source = curve_source;
+  if (!paths.nc.empty()) files.emplace_back(paths.nc, interp::FormatNcProgram(plan, info));
+  if (!paths.reset_nc.empty())
+    files.emplace_back(paths.reset_nc, interp::FormatNcResetProgram(plan.options, info));
+  if (!files.empty()) WriteFilesAtomic(files);
+}
+
+}  // namespace whirl::compare

@@ -1,0 +1,24 @@
+#pragma once
+// The fuzz input as a file: the loaders take paths, so each input is written to one scratch file
+// per process (overwritten every run) and the loader reads it like a user's file.
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace whirl::fuzz {
+
+inline std::filesystem::path FuzzFile(const std::uint8_t* data, std::size_t size,
+                                      const std::string& extension) {
+  static const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("whirl_fuzz_" + std::to_string(::getpid()) + extension);
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  return path;
+}
+
+}  // namespace whirl::fuzz

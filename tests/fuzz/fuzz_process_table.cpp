@@ -1,0 +1,15 @@
+// libFuzzer harness: process tables (core/process.h ReadProcessTable). Bad input must be an
+// InputError; any other exception, crash, hang, leak or sanitizer report is a bug
+// (tests/fuzz/README.md).
+#include "core/error.h"
+#include "core/process.h"
+#include "fuzz_file.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::filesystem::path path = whirl::fuzz::FuzzFile(data, size, ".csv");
+  try {
+    (void)whirl::ReadProcessTable(path, size % 2 == 0);
+  } catch (const whirl::InputError&) {
+  }
+  return 0;
+}
