@@ -403,6 +403,25 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
   return out;
 }
 
+std::string FormatPointsCsv(const CompensationPlan& plan, const std::vector<std::string>& comments) {
+  std::string out;
+  for (const std::string& c : comments) out += "#" + OneLine(c) + "\n";
+  out += "time_s,thread_position_mm,elongation_um,sd43900_mm,sd43910,sd43920_mm\n";
+  auto travel = [&](double t) { return FormatFixed(t * plan.axial_feed_mm_s, kDecimalsPositionMm); };
+  for (const CompensationSegment& s : plan.segments)
+    out += CsvLine({FormatFixed(s.t_a_s, kDecimalsTimeS), travel(s.t_a_s),
+                    FormatFixed(s.l_a_um, kDecimalsElongationUm),
+                    FormatFixed(s.sd43900_mm, kDecimalsSd43900Mm),
+                    FormatFixed(s.sd43910, kDecimalsSd43910),
+                    FormatFixed(s.sd43920_mm, kDecimalsPositionMm)});
+  if (!plan.segments.empty()) {
+    const CompensationSegment& last = plan.segments.back();
+    out += CsvLine({FormatFixed(last.t_b_s, kDecimalsTimeS), travel(last.t_b_s),
+                    FormatFixed(last.l_b_um, kDecimalsElongationUm), "saved", "saved", "saved"});
+  }
+  return out;
+}
+
 // --- NC programs ---------------------------------------------------------------------------
 
 namespace {

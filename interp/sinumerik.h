@@ -176,6 +176,13 @@ void from_json(const nlohmann::json& j, PlanOptions& options);
 std::string FormatPlcCsv(const CompensationPlan& plan,
                          const std::vector<std::string>& provenance = {});
 
+/// The compensation points for a report: time_s,thread_position_mm,elongation_um,sd43900_mm,
+/// sd43910,sd43920_mm, one row per breakpoint with the setting data of the segment that starts
+/// there, fixed decimals per quantity (kDecimals*); the last breakpoint (thread end) restores the
+/// values found before the cut, so its setting-data cells read "saved", never a 0 that reads as
+/// "set it to 0". Comment lines ('#') first.
+std::string FormatPointsCsv(const CompensationPlan& plan, const std::vector<std::string>& comments);
+
 /// Text facts for the NC program header.
 struct NcProgramInfo {
   std::string program_name = "WHIRL_TEMP_COMP";  ///< header comment; letters, digits, '_'

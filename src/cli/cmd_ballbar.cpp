@@ -173,7 +173,7 @@ void AddSimulate(CLI::App& parent) {
       "0.1 um resolution and a warming bar (readings.csv, pivots.json, truth_drift.csv), circle\n"
       "traces with a planted scale mismatch, cyclic error and XZ parallelism, and a README.md.");
   sub->add_option("--out-dir", c->out_dir, "output directory")->required();
-  sub->add_option("--seed", c->o.seed, "random seed (default 1)");
+  AddSeedOption(sub, &c->o.seed, "random seed (default 1)");
   sub->add_option("--duration-min", c->o.duration_min, "warm-up length, min (default 240)")
       ->check(CLI::Range(60.0, 720.0));
   sub->add_option("--interval-min", c->o.interval_min, "time between blocks, min (default 15)")

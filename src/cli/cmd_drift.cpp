@@ -127,7 +127,7 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
       ->check(CLI::Range(1, 50));
   sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000)")
       ->check(CLI::Range(1, 10000));
-  sub->add_option("--seed", m->seed, "network: initialization seed");
+  AddSeedOption(sub, &m->seed, "network: initialization seed");
   sub->add_option("--threads", m->threads, "threads (0: all cores)")->check(CLI::Range(0, 256));
 }
 

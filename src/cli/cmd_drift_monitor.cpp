@@ -68,7 +68,7 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
          "--noise-um", o.noise_um,
          "std of the check-bar measurement noise added to the logged error [um] (default 0)")
       ->check(CLI::Range(0.0, 1000.0));
-  sub->add_option("--seed", o.seed, "seed of the measurement noise (default 1)");
+  AddSeedOption(sub, &o.seed, "seed of the measurement noise (default 1)");
   sub->add_option("--start", o.start,
                   "monitoring starts here [min; samples]: no check before, scores from here "
                   "(default 0)");

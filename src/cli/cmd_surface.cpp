@@ -82,7 +82,7 @@ void SetupSynth(CLI::App& parent) {
   sub->add_option("--bump-sigma-fraction", o->synth.bump_sigma_fraction,
                   "bump width sigma / Lx (0.01..1, default 0.1)")
       ->check(CLI::Range(0.01, 1.0));
-  sub->add_option("--seed", o->synth.seed, "noise seed (default 1)");
+  AddSeedOption(sub, &o->synth.seed, "noise seed (default 1)");
   sub->add_option("--out", o->out, "points CSV to write")->required();
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] { RunSynth(*o); });

@@ -266,24 +266,11 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                     rows,
                     Comments(options, "elongation of the unmachined section of screw '" +
                                           c.screw.name + "' and the compensation applied")));
-    rows.clear();
-    if (!c.plan.segments.empty()) {
-      for (const auto& seg : c.plan.segments)
-        rows.push_back(
-            {seg.t_a_s, seg.t_a_s * feed, seg.l_a_um, seg.sd43900_mm, seg.sd43910, seg.sd43920_mm});
-      const auto& last = c.plan.segments.back();
-      rows.push_back(
-          {last.t_b_s, last.t_b_s * feed, last.l_b_um, std::nan(""), std::nan(""), last.p_b_mm});
-      rows.back()[3] = 0;  // CSV cells must be finite: the end point carries no setting data
-      rows.back()[4] = 0;
-    }
     write(slug + "_points.csv",
-          FormatCsv({"time_s", "thread_position_mm", "elongation_um", "sd43900_mm", "sd43910",
-                     "sd43920_mm"},
-                    rows,
-                    Comments(options,
-                             "compensation points of the 840D plan (the last row is "
-                             "the end of the last segment: no setting data)")));
+          interp::FormatPointsCsv(
+              c.plan, Comments(options, "compensation points of the 840D plan (the last row is the "
+                                        "thread end, where the values found before the cut are "
+                                        "restored)")));
     rows.clear();
     const auto& ln = c.Outcome(Strategy::kNone).lead;
     const auto& lt = c.Outcome(Strategy::kTraditional).lead;
@@ -369,8 +356,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
          << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
                                             : std::string("more than 1000000"))
          << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
-         << FormatNumber(c.plan.max_abs_slope) << " (MD32760 cap "
-         << FormatNumber(c.plan.options.md32760) << "), axis " << HtmlEscape(c.plan.options.axis)
+         << interp::FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910) << " (MD32760 cap "
+         << interp::FormatFixed(c.plan.options.md32760, 4) << "), axis " << HtmlEscape(c.plan.options.axis)
          << ", sign " << interp::ToString(c.plan.options.sign) << ".</p>\n"
          << MetricsTable(c);
     for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {

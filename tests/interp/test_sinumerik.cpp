@@ -204,6 +204,26 @@ TEST(Sinumerik, PlcCsvCarriesTheSettingDataExactlyWithFixedDecimals) {
     EXPECT_EQ(last[k], "saved") << "no SD value 0 that reads as 'set 0'";
 }
 
+TEST(Sinumerik, PointsCsvEndsWithTheRestoreNotWithZeros) {
+  std::mt19937 rng(36);
+  const Case c = RandomCase(rng);
+  const CompensationPlan plan = BuildPlan(c.curve, c.feed_mm_s, c.thread_mm, c.options);
+  std::istringstream in(FormatPointsCsv(plan, {" report points"}));
+  std::string line;
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line))
+    if (line[0] != '#') rows.push_back(SplitCells(line));
+  ASSERT_EQ(rows.size(), plan.segments.size() + 2);  // header, one per breakpoint
+  for (std::size_t i = 0; i < plan.segments.size(); ++i) {
+    EXPECT_EQ(std::stod(rows[i + 1][3]), plan.segments[i].sd43900_mm);
+    EXPECT_EQ(rows[i + 1][4], FormatFixed(plan.segments[i].sd43910, kDecimalsSd43910));
+    for (const std::string& cell : rows[i + 1]) EXPECT_EQ(cell.find_first_of("eE"), std::string::npos);
+  }
+  const auto& last = rows.back();
+  EXPECT_EQ(std::stod(last[0]), RoundTo(plan.segments.back().t_b_s, kDecimalsTimeS));
+  for (int k = 3; k <= 5; ++k) EXPECT_EQ(last[k], "saved");
+}
+
 TEST(Sinumerik, FormatFixedHasNoExponentAndNoNegativeZero) {
   EXPECT_EQ(FormatFixed(-4.8228920410787164e-05, kDecimalsSd43910), "-0.00004823");
   EXPECT_EQ(FormatFixed(0.00029224836244359006, kDecimalsSd43900Mm), "0.000292");

@@ -66,31 +66,31 @@ t "$W" lead-report --lead lead_tiny.csv --json > tiny.json || fail "subnormal de
 grep -v '"v_2pi_um": null' tiny.json | grep -Eiq 'null|nan|inf' && fail "non-finite metric: $(cat tiny.json)"
 
 # plan and curve: absurd features and tolerances are refused at once (no long grid search).
-expect_fail "1 nm" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --tolerance-um 1e-300
-expect_fail "max_elongation_um" t "$W" plan --screw "$S" --max-elongation 1e300 --settle-time 250
-expect_fail "at least 1 s" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 1e-300
+expect_fail "1 nm" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --tolerance-um 1e-300
+expect_fail "max_elongation_um" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 1e300 --settle-time 250
+expect_fail "at least 1 s" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 1e-300
 expect_fail "settle_time_s" t "$W" curve --max-elongation 30 --settle-time 1e300
-expect_fail "32 characters" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+expect_fail "32 characters" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
   --axis "$(printf 'X%.0s' $(seq 1 40))"
 
 # plan: one unwritable output leaves the others unwritten (and previous files intact).
 echo previous > keep.json
 mkdir adir
-expect_fail "adir.*directory" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+expect_fail "adir.*directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
   --out keep.json --csv new.csv --nc adir
 [ "$(cat keep.json)" = previous ] || fail "plan replaced keep.json although --nc failed"
 [ -e new.csv ] && fail "plan wrote new.csv although --nc failed"
-expect_fail "nodir" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+expect_fail "nodir" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
   --out keep.json --nc nodir/x.mpf
 [ "$(cat keep.json)" = previous ] || fail "plan replaced keep.json although --nc failed"
 # The atomic writer respects what sits at the path: a symlink, a FIFO, a directory.
 ln -s keep.json link.json
-expect_fail "symbolic link" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --out link.json
+expect_fail "symbolic link" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --out link.json
 [ -L link.json ] || fail "the symlink was replaced"
 mkfifo pipe
-expect_fail "FIFO" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --out pipe
+expect_fail "FIFO" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --out pipe
 [ -p pipe ] || fail "the FIFO was replaced"
-expect_fail "is a directory" t "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --out adir
+expect_fail "is a directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --out adir
 grep -q "Success" err.txt && fail "message says Success: $(cat err.txt)"
 # Reading a FIFO would block: refused.
 expect_fail "FIFO" t "$W" simulate --screw pipe

@@ -38,8 +38,11 @@ std::string ErrorOf(const std::function<void()>& f) {
   return "";
 }
 
+// One folder per test (CTest runs the tests of this file in parallel processes).
 fs::path Scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("whirl_test_limits_" + name);
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string test = info ? std::string(info->test_suite_name()) + "_" + info->name() : "";
+  const fs::path d = fs::temp_directory_path() / ("whirl_test_limits_" + name + "_" + test);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
