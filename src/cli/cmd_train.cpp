@@ -1,5 +1,6 @@
 // whirl train: fit the Bayesian-regularized network (src/nn/trainbr.h) to a process table, or
 // sweep the hidden size with k-fold cross-validation (src/nn/selection.h).
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -26,6 +27,8 @@ struct TrainCliOptions {
   int epochs = nn::TrainOptions{}.epochs;
   std::string hidden_sweep;  // "A..B"
   int folds = 5;
+  bool trainbr_matlab = false;
+  int threads = 0;
   bool json = false;
 };
 
@@ -53,6 +56,7 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
   s.seed = o.seed;
   s.restarts = o.restarts;
   s.train.epochs = o.epochs;
+  s.threads = o.threads;
   s.Validate(static_cast<int>(table.inputs.size()));
   Progress progress("hidden sweep",
                     static_cast<std::size_t>((s.hidden_max - s.hidden_min + 1) * (s.folds + 1)));
@@ -101,6 +105,9 @@ void Run(const TrainCliOptions& o) {
   opt.seed = o.seed;
   opt.restarts = o.restarts;
   opt.train.epochs = o.epochs;
+  opt.threads = o.threads;
+  if (o.trainbr_matlab) opt.stopping = nn::Stopping::kTrainbrMatlab;
+  const auto start = std::chrono::steady_clock::now();
   const std::size_t total =
       static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
   Progress progress("train", total);
@@ -113,6 +120,8 @@ void Run(const TrainCliOptions& o) {
                             " F " + Fmt(info.objective) + " gamma " + Fmt(info.gamma));
       });
   progress.Finish();
+  const double fit_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   nn::SaveModel(o.out_path, model);
   const auto& s = model.training_summary;
   if (o.json) {
@@ -122,6 +131,8 @@ void Run(const TrainCliOptions& o) {
                {"init_seed", model.init_seed},
                {"restarts", model.restarts},
                {"restart_runs", model.restart_runs},
+               {"stopping", model.stopping},
+               {"fit_time_ms", fit_ms},
                {"training_summary", s}});
     return;
   }
@@ -129,6 +140,9 @@ void Run(const TrainCliOptions& o) {
             << "-2 (N = " << s.parameter_count << " weights and biases), " << table.inputs.size()
             << " samples from " << o.data_path << "\n";
   std::cout << "  " << s.BriefReport() << "\n";
+  std::cout << "  stopping: " << model.stopping << "\n";
+  std::cout << "  fit time " << Fmt(fit_ms)
+            << " ms (training, stopping CV and noise calibration)\n";
   std::cout << "  RMS training error: max_elongation " << Fmt(s.rms_error(0)) << " um, settle_time "
             << Fmt(s.rms_error(1)) << " s (normalized ssE " << Fmt(s.sse) << ")\n";
   std::cout << "  gamma " << Fmt(s.gamma) << " of " << s.parameter_count << ", alpha "
@@ -185,6 +199,16 @@ void RegisterTrain(CLI::App& app) {
   sub->add_option("--folds", o->folds, "k of k-fold cross-validation for --hidden-sweep")
       ->capture_default_str()
       ->check(CLI::Range(2, 1000));
+  sub->add_flag("--trainbr-matlab", o->trainbr_matlab,
+                "MATLAB trainbr to the letter: run to its own stopping criteria (mu_max,\n"
+                "min_grad, --epochs). Default: the epoch limit is chosen by 5-fold\n"
+                "cross-validation (held-out error per epoch), which stops before trainbr\n"
+                "overfits small tables (src/nn/model.h Stopping)");
+  sub->add_option("--threads", o->threads,
+                  "threads for restarts, stopping/noise folds and sweep fits (0 = all cores);\n"
+                  "the result is identical for any count")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 256));
   sub->add_flag("--json", o->json, "machine output: JSON summary on stdout");
   out->excludes(sweep);
   sub->callback([o] { Run(*o); });

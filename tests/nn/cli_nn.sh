@@ -61,6 +61,19 @@ expect 0 "outside the training domain" -- "$whirl" predict --model m1.json --har
 grep -q '"outside_domain": true' out.txt || fail "JSON lacks outside_domain flag"
 grep -q '"diameter_mm"' out.txt || fail "JSON lacks the outside field name"
 grep -q '"max_elongation_std_um"' out.txt || fail "JSON lacks std"
+# many rows outside the domain: ONE summary warning line, the per-row list in --json (issue 12)
+printf "hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min\n" > far.csv
+for d in 300 310 320 330 340; do printf "62,$d,10,5,180\n" >> far.csv; done
+printf "62,80,10,5,999\n" >> far.csv
+expect 0 "6 of 6 rows lie outside the training domain" -- "$whirl" predict --model m1.json \
+  --input far.csv
+[ "$(grep -c "outside the training domain" err.txt)" -eq 1 ] \
+  || fail "predict should print one outside-domain line: $(cat err.txt)"
+grep -q "diameter_mm in 5 rows, cutting_speed_m_min in 1 row" err.txt \
+  || fail "summary lacks the per-input counts: $(cat err.txt)"
+expect 0 "" -- "$whirl" predict --model m1.json --input far.csv --json
+[ "$(grep -c '"outside_domain": true' out.txt)" -eq 6 ] || fail "JSON lacks per-row flags"
+grep -q '"outside_domain_count": 6' out.txt || fail "JSON lacks outside_domain_count"
 
 # bad training tables: exit 1, message names file, line and column
 printf "$H\n62,80,10,5,180,20,300\n62,80,x10,5,180,20,300\n" > cell.csv
