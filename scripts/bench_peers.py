@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Peer benchmark of whirl's network (issue 12): whirl train against scikit-learn MLPRegressor.
 
 Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regression splines"):

@@ -16,7 +16,8 @@ if [ ! -x "$WHIRL" ]; then
   echo "bench_peers: '$WHIRL' not found; build first (scripts/build.sh) or set WHIRL" >&2
   exit 1
 fi
-if ! python3 -c "import sklearn, numpy" 2>/dev/null; then
+PYTHON="${PYTHON:-/usr/bin/python3}"  # Debian's interpreter: python3-sklearn installs there
+if ! "$PYTHON" -c "import sklearn, numpy" 2>/dev/null; then
   WHIRL_SETUP_BENCH_PEERS=1 scripts/setup.sh
 fi
-exec python3 scripts/bench_peers.py --whirl "$WHIRL" --seeds "$SEEDS" "$@"
+exec "$PYTHON" scripts/bench_peers.py --whirl "$WHIRL" --seeds "$SEEDS" "$@"

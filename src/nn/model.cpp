@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "core/parallel.h"
+#include "nn/selection.h"
 
 namespace whirl::nn {
 namespace {
@@ -231,6 +233,7 @@ void to_json(nlohmann::json& j, const Model& m) {
                              {"init_seed", m.init_seed},
                              {"restart_runs", m.restart_runs},
                              {"stopping", m.stopping},
+                             {"hidden_selection", m.hidden_selection},
                              {"options", OptionsJson(m.train_options)}}},
            {"seed", m.seed},
            {"error_space", m.error_space},
@@ -316,13 +319,19 @@ void from_json(const nlohmann::json& j, Model& m) {
     throw InputError(std::string("model 'training_summary': ") + e.what());
   }
   const json& training = Require(j, "training", "model");
-  RejectUnknownKeys(
-      training, {"data", "samples", "restarts", "init_seed", "restart_runs", "stopping", "options"},
-      "model 'training'");
+  RejectUnknownKeys(training,
+                    {"data", "samples", "restarts", "init_seed", "restart_runs", "stopping",
+                     "hidden_selection", "options"},
+                    "model 'training'");
   if (training.contains("stopping")) {
     const json& st = training.at("stopping");
     if (!st.is_string()) throw InputError("model 'training.stopping' must be a string");
     m.stopping = st.get<std::string>();
+  }
+  if (training.contains("hidden_selection")) {
+    const json& hs = training.at("hidden_selection");
+    if (!hs.is_string()) throw InputError("model 'training.hidden_selection' must be a string");
+    m.hidden_selection = hs.get<std::string>();
   }
   const json& data = Require(training, "data", "model 'training'");
   if (!data.is_string()) throw InputError("model 'training.data' must be a string");
@@ -484,6 +493,48 @@ Prediction Predict(const Model& model, const ProcessInputs& inputs) {
   return PredictBatch(model, {inputs}).front();
 }
 
+namespace {
+
+// ModelTrainOptions::hidden_candidates: one tansig layer, size by k-fold CV (nn/selection.h).
+Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& options,
+                           const std::string& data_name, const ModelProgress& progress) {
+  const int rows = static_cast<int>(table.inputs.size());
+  ModelTrainOptions fixed = options;
+  fixed.hidden_candidates.clear();
+  if (rows < 4) {
+    fixed.hidden_sizes = {options.hidden_candidates.front()};
+    return TrainModel(table, fixed, data_name, progress);
+  }
+  SweepOptions sweep;
+  sweep.folds = std::min(options.stopping_folds, rows);
+  sweep.seed = options.seed;
+  sweep.train = options.train;
+  sweep.threads = options.threads;
+  std::string tried;
+  double best_cv = std::numeric_limits<double>::infinity();
+  int best = options.hidden_candidates.front();
+  for (int h : options.hidden_candidates) {
+    sweep.hidden_min = sweep.hidden_max = h;
+    const SweepRow row = HiddenSweep(table, sweep).front();
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s%d: %.4g", tried.empty() ? "" : ", ", h,
+                  row.cv_rms_normalized);
+    tried += buf;
+    if (row.cv_rms_normalized < best_cv) {
+      best_cv = row.cv_rms_normalized;
+      best = h;
+    }
+  }
+  fixed.hidden_sizes = {best};
+  Model m = TrainModel(table, fixed, data_name, progress);
+  m.hidden_selection = "hidden size " + std::to_string(best) + " chosen by " +
+                       std::to_string(sweep.folds) +
+                       "-fold cross-validation (lowest cv_rms_normalized; " + tried + ")";
+  return m;
+}
+
+}  // namespace
+
 Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  const std::string& data_name, const ModelProgress& progress) {
   if (table.targets.size() != table.inputs.size())
@@ -495,9 +546,13 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   for (std::size_t h = 0; h < options.hidden_sizes.size(); ++h)
     if (options.hidden_sizes[h] < 1)
       throw InputError("hidden size " + std::to_string(options.hidden_sizes[h]) + ": must be >= 1");
+  if (!options.hidden_candidates.empty())
+    return TrainModelAutoHidden(table, options, data_name, progress);
   const Eigen::MatrixXd x_raw = InputMatrix(table.inputs);
   const Eigen::MatrixXd t_raw = TargetMatrix(table.targets);
   Model m;
+  m.hidden_selection =
+      "fixed: " + std::to_string(options.hidden_sizes.size()) + " hidden layer(s) as given";
   m.input_scaling = MapMinMax::Fit(x_raw);
   m.target_scaling = MapMinMax::Fit(t_raw);
   TrainingData data{m.input_scaling.Apply(x_raw), m.target_scaling.Apply(t_raw), m.target_scaling};

@@ -67,6 +67,7 @@ TEST(CrossValidatedStopping, EpochLimitIsTheArgminOfTheHeldOutCurveAndIsUsed) {
   const ProcessTable table = synth::SyntheticProcessTable(20, 0.05, 6);
   ModelTrainOptions o;
   o.train.epochs = 200;
+  o.stopping = Stopping::kCrossValidated;
   std::vector<double> curve;
   const int e = ChooseEpochsByCrossValidation(table, o, 5, &curve);
   ASSERT_EQ(curve.size(), 200u);
@@ -84,6 +85,33 @@ TEST(CrossValidatedStopping, EpochLimitIsTheArgminOfTheHeldOutCurveAndIsUsed) {
   EXPECT_NE(matlab.stopping.find("MATLAB"), std::string::npos) << matlab.stopping;
   EXPECT_THROW(ChooseEpochsByCrossValidation(table, o, 1), InputError);
   EXPECT_THROW(ChooseEpochsByCrossValidation(table, o, 21), InputError);
+}
+
+}  // namespace
+}  // namespace whirl::nn
+
+namespace whirl::nn {
+namespace {
+
+TEST(HiddenAuto, ChoosesTheCandidateWithTheLowestCrossValidationError) {
+  const ProcessTable table = synth::SyntheticProcessTable(24, 0.05, 7);
+  ModelTrainOptions o;
+  o.train.epochs = 100;
+  o.hidden_candidates = {2, 5};
+  const Model m = TrainModel(table, o, "t.csv");
+  SweepOptions s;
+  s.folds = 5;
+  s.train = o.train;
+  s.hidden_min = 2;
+  s.hidden_max = 5;
+  const std::vector<SweepRow> rows = HiddenSweep(table, s);
+  const int expect = rows[0].cv_rms_normalized <= rows[3].cv_rms_normalized ? 2 : 5;
+  EXPECT_EQ(m.network.layer_sizes, (std::vector<int>{5, expect, 2}));
+  EXPECT_NE(m.hidden_selection.find("chosen by 5-fold"), std::string::npos) << m.hidden_selection;
+  // The fixed-size model of the chosen size is the same network.
+  o.hidden_candidates.clear();
+  o.hidden_sizes = {expect};
+  EXPECT_EQ(TrainModel(table, o, "t.csv").network.GetParameters(), m.network.GetParameters());
 }
 
 }  // namespace
