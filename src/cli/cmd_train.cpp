@@ -159,7 +159,7 @@ void Run(const TrainCliOptions& o) {
   std::cout << "  hidden layer: " << model.hidden_selection << "\n";
   std::cout << "  stopping: " << model.stopping << "\n";
   std::cout << "  fit time " << Fmt(fit_ms)
-            << " ms (training, stopping CV and noise calibration)\n";
+            << " ms (hidden-size choice, training, noise calibration)\n";
   std::cout << "  RMS training error: max_elongation " << Fmt(s.rms_error(0)) << " um, settle_time "
             << Fmt(s.rms_error(1)) << " s (normalized ssE " << Fmt(s.sse) << ")\n";
   std::cout << "  gamma " << Fmt(s.gamma) << " of " << s.parameter_count << ", alpha "
