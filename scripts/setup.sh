@@ -10,6 +10,8 @@ packages=(
   gnuplot-nox fonts-liberation   # report plots (pngcairo needs a font; a Recommends of gnuplot-nox)
   libboost-dev                   # Boost.Math (header-only): F-distribution quantile of the drift selection
 )
+# Only for scripts/bench_peers.sh (issue 12's peer benchmark), never for the default build or tests.
+if [ "${WHIRL_SETUP_BENCH_PEERS:-0}" = 1 ]; then packages+=(python3-sklearn); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -60,17 +60,16 @@ void Run(const PredictOptions& o) {
   const std::vector<nn::Prediction> pred = nn::PredictBatch(model, table.inputs);
   const bool have_targets = table.targets.size() == table.inputs.size() && !table.targets.empty();
 
-  int outside = 0;
-  for (std::size_t q = 0; q < pred.size(); ++q) {
-    if (!pred[q].outside_domain) continue;
-    ++outside;
-    std::string fields;
-    for (const auto& f : pred[q].outside_domain_fields) fields += (fields.empty() ? "" : ", ") + f;
-    const std::string where = o.input_path.empty()
-                                  ? std::string("the process")
-                                  : o.input_path + " line " + std::to_string(table.line_numbers[q]);
-    Warn(where + " lies outside the training domain in " + fields +
-         " (the prediction extrapolates; its standard deviation may understate the error)");
+  const nn::OutsideDomainSummary outside_summary = nn::SummarizeOutsideDomain(model, pred);
+  const int outside = outside_summary.rows;
+  if (outside > 0) {
+    const std::string first =
+        o.input_path.empty() ? std::string("the process")
+                             : o.input_path + " line " +
+                                   std::to_string(table.line_numbers[outside_summary.first_row]);
+    Warn(outside_summary.Describe(static_cast<int>(pred.size()), first) +
+         " (the predictions extrapolate; their standard deviations may understate the error; "
+         "--json lists the inputs of every row)");
   }
 
   if (!o.out_path.empty()) {

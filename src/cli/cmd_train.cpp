@@ -1,6 +1,7 @@
 // whirl train: fit the Bayesian-regularized network (src/nn/trainbr.h) to a process table, or
 // sweep the hidden size with k-fold cross-validation (src/nn/selection.h).
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -23,12 +24,15 @@ namespace {
 struct TrainCliOptions {
   std::string data_path;
   std::string out_path;
-  int hidden = 6;
+  std::string hidden = "auto";
   std::uint64_t seed = 1;
   int restarts = 1;
   int epochs = nn::TrainOptions{}.epochs;
   std::string hidden_sweep;  // "A..B"
   int folds = 5;
+  bool trainbr_matlab = false;
+  bool stop_by_cv = false;
+  int threads = 0;
   bool json = false;
 };
 
@@ -51,6 +55,14 @@ std::pair<int, int> ParseSweep(const std::string& s) {
   return {static_cast<int>(a), static_cast<int>(b)};
 }
 
+int ParseHidden(const std::string& s) {
+  int h = 0;
+  char tail = 0;
+  if (std::sscanf(s.c_str(), "%d%c", &h, &tail) != 1 || h < 1 || h > 200)
+    throw InputError("--hidden '" + s + "': expected 'auto' or an integer in [1, 200]");
+  return h;
+}
+
 std::string Fmt(double x, int digits = 4) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", digits, x);
@@ -64,6 +76,7 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
   s.seed = o.seed;
   s.restarts = o.restarts;
   s.train.epochs = o.epochs;
+  s.threads = o.threads;
   s.Validate(static_cast<int>(table.inputs.size()));
   Progress progress("hidden sweep",
                     static_cast<std::size_t>((s.hidden_max - s.hidden_min + 1) * (s.folds + 1)));
@@ -108,10 +121,19 @@ void Run(const TrainCliOptions& o) {
   if (o.out_path.empty())
     throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
   nn::ModelTrainOptions opt;
-  opt.hidden_sizes = {o.hidden};
+  if (o.hidden == "auto" && !o.trainbr_matlab) {
+    opt.hidden_candidates = {4, 6, 8, 10, 12};
+  } else {
+    opt.hidden_sizes = {o.hidden == "auto" ? 6 : ParseHidden(o.hidden)};
+  }
   opt.seed = o.seed;
   opt.restarts = o.restarts;
   opt.train.epochs = o.epochs;
+  opt.threads = o.threads;
+  if (o.stop_by_cv) opt.stopping = nn::Stopping::kCrossValidated;
+  if (o.trainbr_matlab && o.stop_by_cv)
+    throw InputError("train: --trainbr-matlab and --stop-by-cv exclude each other");
+  const auto start = std::chrono::steady_clock::now();
   const std::size_t total =
       static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
   Progress progress("train", total);
@@ -124,6 +146,8 @@ void Run(const TrainCliOptions& o) {
                             " F " + Fmt(info.objective) + " gamma " + Fmt(info.gamma));
       });
   progress.Finish();
+  const double fit_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   nn::SaveModel(o.out_path, model);
   const auto& s = model.training_summary;
   if (o.json) {
@@ -133,13 +157,20 @@ void Run(const TrainCliOptions& o) {
                {"init_seed", model.init_seed},
                {"restarts", model.restarts},
                {"restart_runs", model.restart_runs},
+               {"stopping", model.stopping},
+               {"hidden_selection", model.hidden_selection},
+               {"fit_time_ms", fit_ms},
                {"training_summary", s}});
     return;
   }
-  std::cout << "model " << o.out_path << ": network 5-" << o.hidden
+  std::cout << "model " << o.out_path << ": network 5-" << model.network.layer_sizes[1]
             << "-2 (N = " << s.parameter_count << " weights and biases), " << table.inputs.size()
             << " samples from " << o.data_path << "\n";
   std::cout << "  " << s.BriefReport() << "\n";
+  std::cout << "  hidden layer: " << model.hidden_selection << "\n";
+  std::cout << "  stopping: " << model.stopping << "\n";
+  std::cout << "  fit time " << Fmt(fit_ms)
+            << " ms (hidden-size choice, training, noise calibration)\n";
   std::cout << "  RMS training error: max_elongation " << Fmt(s.rms_error(0)) << " um, settle_time "
             << Fmt(s.rms_error(1)) << " s (normalized ssE " << Fmt(s.sse) << ")\n";
   std::cout << "  gamma " << Fmt(s.gamma) << " of " << s.parameter_count << ", alpha "
@@ -175,9 +206,11 @@ void RegisterTrain(CLI::App& app) {
   auto* out = sub->add_option("--out", o->out_path,
                               "model file to write (JSON, atomically); required unless "
                               "--hidden-sweep");
-  sub->add_option("--hidden", o->hidden, "tansig neurons in the hidden layer (paper: 6)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, kMaxHidden));
+  sub->add_option("--hidden", o->hidden,
+                  "tansig neurons in the hidden layer (1-200), or 'auto': the size in\n"
+                  "{4, 6, 8, 10, 12} with the lowest 5-fold cross-validation error\n"
+                  "(normalized RMS, both outputs equally; paper: 6)")
+      ->capture_default_str();
   AddSeedOption(sub, &o->seed, "seed of the Nguyen-Widrow initialization; restart k uses seed + k")
       ->capture_default_str();
   sub->add_option("--restarts", o->restarts,
@@ -196,6 +229,18 @@ void RegisterTrain(CLI::App& app) {
   sub->add_option("--folds", o->folds, "k of k-fold cross-validation for --hidden-sweep")
       ->capture_default_str()
       ->check(CLI::Range(2, 1000));
+  sub->add_flag("--trainbr-matlab", o->trainbr_matlab,
+                "the paper's MATLAB trainbr setting: 5-6-2 (or --hidden N) trained to\n"
+                "trainbr's own stopping criteria (mu_max, min_grad, --epochs); no size search");
+  sub->add_flag("--stop-by-cv", o->stop_by_cv,
+                "stop at the epoch count with the lowest 5-fold cross-validation error\n"
+                "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"
+                "src/nn/model.h Stopping)");
+  sub->add_option("--threads", o->threads,
+                  "threads for restarts, stopping/noise folds and sweep fits (0 = all cores);\n"
+                  "the result is identical for any count")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 256));
   sub->add_flag("--json", o->json, "machine output: JSON summary on stdout");
   out->excludes(sweep);
   sub->callback([o] { Run(*o); });

@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <set>
 #include <vector>
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/parallel.h"
+#include "nn/selection.h"
 
 namespace whirl::nn {
 namespace {
@@ -238,6 +242,8 @@ void to_json(nlohmann::json& j, const Model& m) {
                              {"restarts", m.restarts},
                              {"init_seed", m.init_seed},
                              {"restart_runs", m.restart_runs},
+                             {"stopping", m.stopping},
+                             {"hidden_selection", m.hidden_selection},
                              {"options", OptionsJson(m.train_options)}}},
            {"seed", m.seed},
            {"error_space", m.error_space},
@@ -330,8 +336,19 @@ void from_json(const nlohmann::json& j, Model& m) {
   }
   const json& training = Require(j, "training", "model");
   RejectUnknownKeys(training,
-                    {"data", "samples", "restarts", "init_seed", "restart_runs", "options"},
+                    {"data", "samples", "restarts", "init_seed", "restart_runs", "stopping",
+                     "hidden_selection", "options"},
                     "model 'training'");
+  if (training.contains("stopping")) {
+    const json& st = training.at("stopping");
+    if (!st.is_string()) throw InputError("model 'training.stopping' must be a string");
+    m.stopping = st.get<std::string>();
+  }
+  if (training.contains("hidden_selection")) {
+    const json& hs = training.at("hidden_selection");
+    if (!hs.is_string()) throw InputError("model 'training.hidden_selection' must be a string");
+    m.hidden_selection = hs.get<std::string>();
+  }
   const json& data = Require(training, "data", "model 'training'");
   if (!data.is_string()) throw InputError("model 'training.data' must be a string");
   m.training_data = data.get<std::string>();
@@ -462,9 +479,77 @@ std::vector<Prediction> PredictBatch(const Model& model, const std::vector<Proce
   return out;
 }
 
+OutsideDomainSummary SummarizeOutsideDomain(const Model& model,
+                                            const std::vector<Prediction>& predictions) {
+  OutsideDomainSummary s;
+  for (const auto& v : model.inputs) s.input_names.push_back(v.name);
+  s.per_input.assign(s.input_names.size(), 0);
+  for (std::size_t q = 0; q < predictions.size(); ++q) {
+    if (!predictions[q].outside_domain) continue;
+    if (s.rows++ == 0) s.first_row = q;
+    for (const auto& f : predictions[q].outside_domain_fields)
+      for (std::size_t i = 0; i < s.input_names.size(); ++i)
+        if (s.input_names[i] == f) ++s.per_input[i];
+  }
+  return s;
+}
+
+std::string OutsideDomainSummary::Describe(int total_rows, const std::string& first) const {
+  std::string inputs;
+  for (std::size_t i = 0; i < per_input.size(); ++i)
+    if (per_input[i] > 0)
+      inputs += (inputs.empty() ? "" : ", ") + input_names[i] + " in " +
+                std::to_string(per_input[i]) + (per_input[i] == 1 ? " row" : " rows");
+  if (total_rows == 1) return first + " lies outside the training domain in " + inputs;
+  return std::to_string(rows) + " of " + std::to_string(total_rows) +
+         " rows lie outside the training domain (" + inputs + "; first: " + first + ")";
+}
+
 Prediction Predict(const Model& model, const ProcessInputs& inputs) {
   return PredictBatch(model, {inputs}).front();
 }
+
+namespace {
+
+// ModelTrainOptions::hidden_candidates: one tansig layer, size by k-fold CV (nn/selection.h).
+Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& options,
+                           const std::string& data_name, const ModelProgress& progress) {
+  const int rows = static_cast<int>(table.inputs.size());
+  ModelTrainOptions fixed = options;
+  fixed.hidden_candidates.clear();
+  if (rows < 4) {
+    fixed.hidden_sizes = {options.hidden_candidates.front()};
+    return TrainModel(table, fixed, data_name, progress);
+  }
+  SweepOptions sweep;
+  sweep.folds = std::min(options.stopping_folds, rows);
+  sweep.seed = options.seed;
+  sweep.train = options.train;
+  sweep.threads = options.threads;
+  std::string tried;
+  double best_cv = std::numeric_limits<double>::infinity();
+  int best = options.hidden_candidates.front();
+  for (int h : options.hidden_candidates) {
+    sweep.hidden_min = sweep.hidden_max = h;
+    const SweepRow row = HiddenSweep(table, sweep).front();
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s%d: %.4g", tried.empty() ? "" : ", ", h,
+                  row.cv_rms_normalized);
+    tried += buf;
+    if (row.cv_rms_normalized < best_cv) {
+      best_cv = row.cv_rms_normalized;
+      best = h;
+    }
+  }
+  fixed.hidden_sizes = {best};
+  Model m = TrainModel(table, fixed, data_name, progress);
+  m.hidden_selection = "hidden size " + std::to_string(best) + " chosen by " +
+                       std::to_string(sweep.folds) +
+                       "-fold cross-validation (lowest cv_rms_normalized; " + tried + ")";
+  return m;
+}
+
+}  // namespace
 
 Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  const std::string& data_name, const ModelProgress& progress) {
@@ -477,9 +562,13 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   for (std::size_t h = 0; h < options.hidden_sizes.size(); ++h)
     if (options.hidden_sizes[h] < 1)
       throw InputError("hidden size " + std::to_string(options.hidden_sizes[h]) + ": must be >= 1");
+  if (!options.hidden_candidates.empty())
+    return TrainModelAutoHidden(table, options, data_name, progress);
   const Eigen::MatrixXd x_raw = InputMatrix(table.inputs);
   const Eigen::MatrixXd t_raw = TargetMatrix(table.targets);
   Model m;
+  m.hidden_selection =
+      "fixed: " + std::to_string(options.hidden_sizes.size()) + " hidden layer(s) as given";
   m.input_scaling = MapMinMax::Fit(x_raw);
   m.target_scaling = MapMinMax::Fit(t_raw);
   TrainingData data{m.input_scaling.Apply(x_raw), m.target_scaling.Apply(t_raw), m.target_scaling};
@@ -488,8 +577,20 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   sizes.push_back(Features::kCount);
   if (options.train.regularization != Regularization::kBayesian)
     throw InputError("a model file needs Bayesian regularization (its Laplace uncertainty)");
-  RestartResult r =
-      TrainBrRestarts(data, sizes, options.seed, options.restarts, options.train, progress);
+  const int rows = static_cast<int>(table.inputs.size());
+  TrainOptions train = options.train;
+  m.stopping = "trainbr (MATLAB): run to its own stopping criteria, at most " +
+               std::to_string(train.epochs) + " epochs";
+  if (options.stopping == Stopping::kCrossValidated && rows >= 4) {
+    const int folds = std::min(options.stopping_folds, rows);
+    train.epochs = ChooseEpochsByCrossValidation(table, options, folds);
+    m.stopping = "epochs chosen by " + std::to_string(folds) +
+                 "-fold cross-validation: " + std::to_string(train.epochs) + " of at most " +
+                 std::to_string(options.train.epochs) +
+                 " (the epoch count with the lowest summed held-out squared error, normalized)";
+  }
+  RestartResult r = TrainBrRestarts(data, sizes, options.seed, options.restarts, train, progress,
+                                    options.threads);
   m.network = std::move(r.best.network);
   m.inputs = ExpectedInputs();
   m.outputs = ExpectedOutputs();
@@ -500,7 +601,7 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   m.init_seed = r.best.init_seed;
   m.restarts = options.restarts;
   m.restart_runs = r.runs;
-  m.train_options = options.train;
+  m.train_options = train;
   m.training_data = data_name;
   m.training_samples = static_cast<int>(table.inputs.size());
   m.noise_variance = r.best.summary.noise_variance;
@@ -508,10 +609,61 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   m.noise_calibration = "trainbr: one noise level 1/(2 beta) for every output";
   m.posterior_covariance = std::move(r.best.posterior_covariance);
   m.Validate();
-  const int rows = static_cast<int>(table.inputs.size());
   if (options.noise_folds > 0 && rows >= 4)
     CalibrateOutputNoise(table, options, std::min(options.noise_folds, rows), &m);
   return m;
+}
+
+int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOptions& options,
+                                  int folds, std::vector<double>* curve) {
+  const int rows = static_cast<int>(table.inputs.size());
+  if (folds < 2 || rows < folds)
+    throw InputError("stopping by cross-validation: " + std::to_string(folds) + " folds for " +
+                     std::to_string(rows) + " rows; needs 2 <= folds <= rows");
+  const int max_epochs = options.train.epochs;
+  if (max_epochs < 1) return max_epochs;
+  const Eigen::MatrixXd x_raw = InputMatrix(table.inputs);
+  const Eigen::MatrixXd t_raw = TargetMatrix(table.targets);
+  const Eigen::VectorXd half = MapMinMax::Fit(t_raw).HalfRange();
+  std::vector<int> sizes = {ProcessInputs::kCount};
+  sizes.insert(sizes.end(), options.hidden_sizes.begin(), options.hidden_sizes.end());
+  sizes.push_back(Features::kCount);
+  // fold_sse[f][e-1]: held-out squared error (normalized by the full table's half ranges) of
+  // fold f's network after e epochs; a run that stops early keeps its last value.
+  std::vector<std::vector<double>> fold_sse(static_cast<std::size_t>(folds));
+  ParallelFor(static_cast<std::size_t>(folds), options.threads, [&](std::size_t fi) {
+    std::vector<int> tr, te;
+    for (int q = 0; q < rows; ++q) (q % folds == static_cast<int>(fi) ? te : tr).push_back(q);
+    Eigen::MatrixXd xt(x_raw.rows(), tr.size()), tt(t_raw.rows(), tr.size());
+    Eigen::MatrixXd xv(x_raw.rows(), te.size()), tv(t_raw.rows(), te.size());
+    for (std::size_t c = 0; c < tr.size(); ++c) {
+      xt.col(c) = x_raw.col(tr[c]);
+      tt.col(c) = t_raw.col(tr[c]);
+    }
+    for (std::size_t c = 0; c < te.size(); ++c) {
+      xv.col(c) = x_raw.col(te[c]);
+      tv.col(c) = t_raw.col(te[c]);
+    }
+    const MapMinMax xs = MapMinMax::Fit(xt), ts = MapMinMax::Fit(tt);
+    const TrainingData data{xs.Apply(xt), ts.Apply(tt), ts};
+    const Eigen::MatrixXd xv_n = xs.Apply(xv);
+    std::vector<double>& out = fold_sse[fi];
+    out.reserve(static_cast<std::size_t>(max_epochs));
+    Network net = Network::Zeros(sizes);
+    InitNguyenWidrow(options.seed, &net);
+    TrainBr(data, net, options.train, [&](const EpochInfo& info) {
+      const Eigen::MatrixXd y = ts.Reverse(info.network->Forward(xv_n));
+      out.push_back(((tv - y).array().colwise() / half.array()).square().sum());
+    });
+    if (out.empty()) out.push_back(std::numeric_limits<double>::infinity());
+    out.resize(static_cast<std::size_t>(max_epochs), out.back());
+  });
+  std::vector<double> total(static_cast<std::size_t>(max_epochs), 0.0);
+  for (const auto& f : fold_sse)
+    for (int e = 0; e < max_epochs; ++e) total[e] += f[e];
+  const int best = static_cast<int>(std::min_element(total.begin(), total.end()) - total.begin());
+  if (curve) *curve = total;
+  return best + 1;
 }
 
 void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& options, int folds,
@@ -523,10 +675,16 @@ void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& op
   ModelTrainOptions fold_options = options;
   fold_options.noise_folds = 0;
   fold_options.restarts = std::min(options.restarts, 3);
+  fold_options.stopping = Stopping::kTrainbrMatlab;  // the epochs the model was trained with
+  fold_options.train = model->train_options;
+  fold_options.threads = 1;
   const Eigen::VectorXd half = model->target_scaling.HalfRange();
   const int S = Features::kCount;
-  std::vector<std::vector<double>> r2(S), var_w(S);
-  for (int f = 0; f < folds; ++f) {
+  // Per fold: (r^2, weight variance) per output and held-out row; gathered in fold order below.
+  std::vector<std::vector<std::vector<std::pair<double, double>>>> per_fold(
+      static_cast<std::size_t>(folds), std::vector<std::vector<std::pair<double, double>>>(S));
+  ParallelFor(static_cast<std::size_t>(folds), options.threads, [&](std::size_t fi) {
+    const int f = static_cast<int>(fi);
     ProcessTable train, held;
     train.source = held.source = table.source;
     for (int i = 0; i < rows; ++i) {
@@ -546,11 +704,17 @@ void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& op
         const double v =
             (sd[k] * sd[k] - fm.output_noise_variance(k) * fold_half(k) * fold_half(k)) /
             (half(k) * half(k));
-        r2[k].push_back(r * r);
-        var_w[k].push_back(std::max(v, 0.0));
+        per_fold[fi][k].emplace_back(r * r, std::max(v, 0.0));
       }
     }
-  }
+  });
+  std::vector<std::vector<double>> r2(S), var_w(S);
+  for (const auto& fold : per_fold)
+    for (int k = 0; k < S; ++k)
+      for (const auto& [a, b] : fold[k]) {
+        r2[k].push_back(a);
+        var_w[k].push_back(b);
+      }
   // sigma_k^2: the smallest level at which +-1 predictive sigma covers kOneSigma of the held-out
   // errors (bisection; the coverage is monotone in sigma_k^2).
   constexpr double kOneSigma = 0.6827;

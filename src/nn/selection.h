@@ -14,12 +14,15 @@
 namespace whirl::nn {
 
 struct SweepOptions {
-  int hidden_min = 4;             ///< first hidden size (one tansig layer)
-  int hidden_max = 8;             ///< last hidden size, inclusive
-  int folds = 5;                  ///< k of k-fold cross-validation, 2 <= k <= rows
-  std::uint64_t seed = 1;         ///< restart r of every fit initializes with seed + r
-  int restarts = 1;               ///< restarts per fit (best log evidence kept)
-  TrainOptions train;             ///< trainbr options
+  int hidden_min = 4;      ///< first hidden size (one tansig layer)
+  int hidden_max = 8;      ///< last hidden size, inclusive
+  int folds = 5;           ///< k of k-fold cross-validation, 2 <= k <= rows
+  std::uint64_t seed = 1;  ///< restart r of every fit initializes with seed + r
+  int restarts = 1;        ///< restarts per fit (best log evidence kept)
+  TrainOptions train;      ///< trainbr options
+  /// Fits (sizes x (folds + 1)) run on this many threads (core/parallel.h; <= 0: all cores);
+  /// the rows are identical for any thread count.
+  int threads = 0;
   void Validate(int rows) const;  ///< InputError naming the option, value and rule
 };
 
@@ -40,7 +43,7 @@ void to_json(nlohmann::json& j, const SweepRow& r);
 
 /// Row q is held out in fold q % folds (deterministic). Each fold fits mapminmax on its own
 /// training rows (no information from the held-out rows) and trains with the same seed/restarts.
-/// `progress(done, total)` counts finished fits (sizes x (folds + 1)).
+/// `progress(done, total)` counts finished fits (sizes x (folds + 1)), called under a lock.
 std::vector<SweepRow> HiddenSweep(const ProcessTable& table, const SweepOptions& options,
                                   const std::function<void(int, int)>& progress = {});
 

@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <sstream>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "nn/dense_kernels.h"
 
 namespace whirl::nn {
@@ -391,6 +393,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     info.alpha = alpha;
     info.beta = beta;
     info.mu = mu;
+    info.network = &net;
     if (callback) callback(info);
   }
 
@@ -438,20 +441,31 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
 
 RestartResult TrainBrRestarts(const TrainingData& data, const std::vector<int>& layer_sizes,
                               std::uint64_t seed, int restarts, const TrainOptions& options,
-                              const std::function<void(int, const EpochInfo&)>& callback) {
+                              const std::function<void(int, const EpochInfo&)>& callback,
+                              int threads) {
   if (restarts < 1) throw InputError("restarts = " + std::to_string(restarts) + ": must be >= 1");
-  RestartResult out;
-  const bool bayes = options.regularization == Regularization::kBayesian;
-  for (int k = 0; k < restarts; ++k) {
+  std::vector<TrainResult> results(static_cast<std::size_t>(restarts));
+  std::mutex callback_mutex;
+  ParallelFor(results.size(), threads, [&](std::size_t k) {
     Network net = Network::Zeros(layer_sizes);
     const std::uint64_t s = seed + static_cast<std::uint64_t>(k);
     InitNguyenWidrow(s, &net);
     EpochCallback cb;
-    if (callback) cb = [&callback, k](const EpochInfo& info) { callback(k, info); };
-    TrainResult r = TrainBr(data, net, options, cb);
-    r.init_seed = s;
+    if (callback)
+      cb = [&callback, &callback_mutex, k](const EpochInfo& info) {
+        std::lock_guard<std::mutex> lock(callback_mutex);
+        callback(static_cast<int>(k), info);
+      };
+    results[k] = TrainBr(data, net, options, cb);
+    results[k].init_seed = s;
+  });
+  // Selection in seed order after all runs: the same result for any thread count.
+  RestartResult out;
+  const bool bayes = options.regularization == Regularization::kBayesian;
+  for (int k = 0; k < restarts; ++k) {
+    const TrainResult& r = results[static_cast<std::size_t>(k)];
     RestartRecord rec;
-    rec.seed = s;
+    rec.seed = r.init_seed;
     rec.log_evidence = r.summary.log_evidence;
     rec.sse = r.summary.sse;
     rec.gamma = r.summary.gamma;
@@ -460,19 +474,18 @@ RestartResult TrainBrRestarts(const TrainingData& data, const std::vector<int>& 
     out.runs.push_back(rec);
     bool better = k == 0;
     if (!better) {
+      const TrainSummary& best = results[static_cast<std::size_t>(out.best_index)].summary;
       if (bayes) {
         // A NaN evidence (should not happen with alpha, beta > 0) never wins.
-        better = rec.log_evidence > out.best.summary.log_evidence ||
-                 (std::isnan(out.best.summary.log_evidence) && !std::isnan(rec.log_evidence));
+        better = rec.log_evidence > best.log_evidence ||
+                 (std::isnan(best.log_evidence) && !std::isnan(rec.log_evidence));
       } else {
-        better = rec.sse < out.best.summary.sse;
+        better = rec.sse < best.sse;
       }
     }
-    if (better) {
-      out.best = std::move(r);
-      out.best_index = k;
-    }
+    if (better) out.best_index = k;
   }
+  out.best = std::move(results[static_cast<std::size_t>(out.best_index)]);
   return out;
 }
 

@@ -102,6 +102,7 @@ struct EpochInfo {
   double gamma = 0, alpha = 0, beta = 0;  ///< after the update
   double mu = 0;                          ///< after the LM loop
   double gradient = 0;                    ///< 2 ||J'e|| at the start of the epoch
+  const Network* network = nullptr;       ///< the weights after the epoch (valid in the call)
 };
 using EpochCallback = std::function<void(const EpochInfo&)>;
 
@@ -187,9 +188,12 @@ struct RestartResult {
 /// Trains `restarts` networks of `layer_sizes`, initialized by InitNguyenWidrow with seeds
 /// seed, seed + 1, ..., seed + restarts - 1, and keeps the one with the HIGHEST log evidence
 /// (lowest ssE under Regularization::kNone); ties keep the earlier seed. The callback receives
-/// the restart index (0-based) with each epoch.
+/// the restart index (0-based) with each epoch (serialized by a lock; epochs of different restarts
+/// interleave). The restarts run on `threads` threads (core/parallel.h; <= 0: all cores); the
+/// result is identical for any thread count (selection happens after all runs, in seed order).
 RestartResult TrainBrRestarts(const TrainingData& data, const std::vector<int>& layer_sizes,
                               std::uint64_t seed, int restarts, const TrainOptions& options,
-                              const std::function<void(int, const EpochInfo&)>& callback = {});
+                              const std::function<void(int, const EpochInfo&)>& callback = {},
+                              int threads = 0);
 
 }  // namespace whirl::nn

@@ -35,6 +35,19 @@ cmp -s m1.json m2.json || fail "same seed gave different model files"
 grep -q '"termination"' out.txt || fail "train --json lacks termination"
 grep -q '"log_evidence"' out.txt || fail "train --json lacks log_evidence"
 
+# issue 12: hidden size by CV by default, --trainbr-matlab = fixed 5-6-2, same file for any thread count
+grep -q '"hidden_selection": "hidden size [0-9]* chosen by 5-fold' m1.json \
+  || fail "default train lacks the CV hidden-size choice"
+expect 0 "" -- "$whirl" train --data "$data" --out t1.json --seed 3 --restarts 2 --threads 1
+expect 0 "" -- "$whirl" train --data "$data" --out t2.json --seed 3 --restarts 2 --threads 2
+cmp -s t1.json t2.json || fail "--threads 1 and 2 gave different models"
+expect 0 "" -- "$whirl" train --data "$data" --out mm.json --trainbr-matlab --json
+grep -q '"layer_sizes": \[5, 6, 2\]\|"layer_sizes":\[5,6,2\]' out.txt \
+  || grep -A4 '"layer_sizes"' out.txt | tr -d ' \n' | grep -q '\[5,6,2\]' || fail "--trainbr-matlab is not 5-6-2"
+grep -q '"fit_time_ms"' out.txt || fail "train --json lacks fit_time_ms"
+expect 1 "expected 'auto' or an integer" -- "$whirl" train --data "$data" --out x.json --hidden 6x
+expect 1 "exclude each other" -- "$whirl" train --data "$data" --out x.json --trainbr-matlab --stop-by-cv
+
 # hidden sweep
 expect 0 "" -- "$whirl" train --data "$data" --hidden-sweep 3..4 --folds 4
 grep -q "cv_rms" out.txt || fail "sweep lacks cv columns"
@@ -61,6 +74,19 @@ expect 0 "outside the training domain" -- "$whirl" predict --model m1.json --har
 grep -q '"outside_domain": true' out.txt || fail "JSON lacks outside_domain flag"
 grep -q '"diameter_mm"' out.txt || fail "JSON lacks the outside field name"
 grep -q '"max_elongation_std_um"' out.txt || fail "JSON lacks std"
+# many rows outside the domain: ONE summary warning line, the per-row list in --json (issue 12)
+printf "hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min\n" > far.csv
+for d in 300 310 320 330 340; do printf "62,$d,10,5,180\n" >> far.csv; done
+printf "62,80,10,5,999\n" >> far.csv
+expect 0 "6 of 6 rows lie outside the training domain" -- "$whirl" predict --model m1.json \
+  --input far.csv
+[ "$(grep -c "outside the training domain" err.txt)" -eq 1 ] \
+  || fail "predict should print one outside-domain line: $(cat err.txt)"
+grep -q "diameter_mm in 5 rows, cutting_speed_m_min in 1 row" err.txt \
+  || fail "summary lacks the per-input counts: $(cat err.txt)"
+expect 0 "" -- "$whirl" predict --model m1.json --input far.csv --json
+[ "$(grep -c '"outside_domain": true' out.txt)" -eq 6 ] || fail "JSON lacks per-row flags"
+grep -q '"outside_domain_count": 6' out.txt || fail "JSON lacks outside_domain_count"
 
 # bad training tables: exit 1, message names file, line and column
 printf "$H\n62,80,10,5,180,20,300\n62,80,x10,5,180,20,300\n" > cell.csv

@@ -206,6 +206,7 @@ TEST(TorchCrosscheck, TrainingAgreesFromSeveralStartsAndSizes) {
     train.hidden_sizes = hidden;
     train.seed = 5;
     train.train.epochs = 300;
+    train.stopping = nn::Stopping::kTrainbrMatlab;  // cross-checked against MATLAB trainbr
     const nn::Model model = nn::TrainModel(table, train, "synthetic");
     for (std::uint64_t seed : {2u, 3u}) {
       CrosscheckOptions options;

@@ -47,6 +47,7 @@ inline nn::Model SmallTrainedModel() {
   options.seed = 3;
   options.restarts = 1;
   options.train.epochs = 300;
+  options.stopping = nn::Stopping::kTrainbrMatlab;  // the cross-check is against MATLAB trainbr
   return nn::TrainModel(SyntheticTable(20, 7), options, "synthetic table (seed 7)");
 }
 

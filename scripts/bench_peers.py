@@ -1,0 +1,191 @@
+#!/usr/bin/python3
+"""Peer benchmark of whirl's network (issue 12): whirl train against scikit-learn MLPRegressor.
+
+Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regression splines"):
+  x ~ U[0, 1]^5 (written into whirl's five input columns, in order),
+  out1 = 10 sin(pi x1 x2) + 20 (x3 - 0.5)^2 + 10 x4 + 5 x5 + N(0, 1^2)          (Friedman #1)
+  out2 = 50 exp(-2 ((x1 - 0.5)^2 + (x3 - 0.5)^2)) + 30 x2 x5 + 20 sin(pi x4) + N(0, 3^2)
+  (out1 -> max_elongation_um, out2 -> settle_time_s; the names only satisfy whirl's table format).
+  Training: N rows (20, 100); test: 1000 rows from the same seed's generator.
+  Test RMSE is against the NOISE-FREE function; interval coverage is reported against the noisy
+  test targets (a predictive interval is for a new observation) and against the noise-free truth.
+Problem 2, "simulator": datasets/whirling_train.csv (20 simulated rows) for training and
+  datasets/whirling_500.csv for testing (whirl's simulator, not measurements); the seed only
+  changes the initializations; RMSE and coverage against the table's (noisy) targets.
+
+Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
+both outputs as whirl):
+  mlp_default: MLPRegressor() as a new user would call it (100 relu units, adam, 200 iterations);
+  mlp_cv:      MLPRegressor(solver="lbfgs", tanh, max_iter=2000) with hidden size in {6, 10} and
+               L2 penalty alpha in {1e-3, 1e-2, 1e-1, 1, 10} chosen by 5-fold GridSearchCV
+               (the strongest simple baseline a careful user would pick).
+Fit times: whirl's in-process time (whirl train --json fit_time_ms, one thread); sklearn's wall
+time of fit() (mlp_cv includes its grid search).
+
+Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--sizes 20,100] [--problems friedman,simulator]
+       [--variant NAME=ARGS ...] [--json out.json]
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from sklearn.compose import TransformedTargetRegressor
+from sklearn.exceptions import ConvergenceWarning
+from sklearn.model_selection import GridSearchCV, KFold
+from sklearn.neural_network import MLPRegressor
+from sklearn.pipeline import make_pipeline
+from sklearn.preprocessing import StandardScaler
+import warnings
+
+INPUTS = ["hardness_hrc", "diameter_mm", "pitch_mm", "raceway_radius_mm", "cutting_speed_m_min"]
+TARGETS = ["max_elongation_um", "settle_time_s"]
+NOISE_SD = np.array([1.0, 3.0])
+TEST_ROWS = 1000
+
+
+def friedman(rng, n):
+    x = rng.uniform(0.0, 1.0, size=(n, 5))
+    x1, x2, x3, x4, x5 = x.T
+    f1 = 10 * np.sin(np.pi * x1 * x2) + 20 * (x3 - 0.5) ** 2 + 10 * x4 + 5 * x5
+    f2 = 50 * np.exp(-2 * ((x1 - 0.5) ** 2 + (x3 - 0.5) ** 2)) + 30 * x2 * x5 + 20 * np.sin(np.pi * x4)
+    f = np.column_stack([f1, f2])
+    return x, f, f + rng.normal(size=f.shape) * NOISE_SD
+
+
+def read_table(path):
+    rows = [l for l in open(path) if l.strip() and not l.startswith("#")]
+    header = rows[0].strip().split(",")
+    data = np.array([[float(v) for v in l.strip().split(",")] for l in rows[1:]])
+    return data[:, [header.index(c) for c in INPUTS]], data[:, [header.index(c) for c in TARGETS]]
+
+
+def write_table(path, x, y=None):
+    with open(path, "w") as f:
+        f.write(",".join(INPUTS + (TARGETS if y is not None else [])) + "\n")
+        for i in range(len(x)):
+            vals = list(x[i]) + (list(y[i]) if y is not None else [])
+            f.write(",".join(repr(float(v)) for v in vals) + "\n")
+
+
+def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp):
+    train, test, model = (os.path.join(tmp, n) for n in ("train.csv", "test.csv", "m.json"))
+    write_table(train, xtr, ytr)
+    write_table(test, xte)
+    cmd = [whirl, "train", "--data", train, "--out", model, "--seed", str(seed), "--threads", "1",
+           "--json"] + args
+    t = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+    p = json.loads(subprocess.run([whirl, "predict", "--model", model, "--input", test, "--json"],
+                                  check=True, capture_output=True, text=True).stdout)
+    mean = np.array([[r["max_elongation_um"], r["settle_time_s"]] for r in p["predictions"]])
+    sd = np.array([[r["max_elongation_std_um"], r["settle_time_std_s"]] for r in p["predictions"]])
+    s = t["training_summary"]
+    return mean, sd, t["fit_time_ms"], {"gamma": s["gamma"], "epochs": s["epochs"]}
+
+
+def fit_sklearn(kind, xtr, ytr, xte, seed):
+    warnings.simplefilter("ignore", ConvergenceWarning)
+    if kind == "mlp_default":
+        net = MLPRegressor(random_state=seed)
+    else:
+        net = MLPRegressor(solver="lbfgs", activation="tanh", max_iter=2000, random_state=seed)
+    model = TransformedTargetRegressor(regressor=make_pipeline(StandardScaler(), net),
+                                       transformer=StandardScaler())
+    if kind == "mlp_cv":
+        grid = {"regressor__mlpregressor__hidden_layer_sizes": [(6,), (10,)],
+                "regressor__mlpregressor__alpha": [1e-3, 1e-2, 1e-1, 1.0, 10.0]}
+        model = GridSearchCV(model, grid, cv=KFold(5, shuffle=True, random_state=seed),
+                             scoring="neg_mean_squared_error")
+    start = time.perf_counter()
+    model.fit(xtr, ytr)
+    return model.predict(xte), 1000 * (time.perf_counter() - start)
+
+
+def rmse(pred, truth):
+    return np.sqrt(np.mean((pred - truth) ** 2, axis=0))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--whirl", required=True)
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--sizes", default="20,100")
+    ap.add_argument("--problems", default="friedman,simulator")
+    ap.add_argument("--variant", action="append", default=[],
+                    help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
+    ap.add_argument("--peers", default="mlp_default,mlp_cv")
+    ap.add_argument("--json", help="write all per-seed results here")
+    ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
+    a = ap.parse_args()
+    variants = [("whirl", [])] + [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.variant]
+    peers = [p for p in a.peers.split(",") if p]
+    cases = []
+    for prob in a.problems.split(","):
+        sizes = [int(s) for s in a.sizes.split(",")] if prob == "friedman" else [20]
+        cases += [(prob, n) for n in sizes]
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for prob, n in cases:
+            for seed in range(1, a.seeds + 1):
+                if prob == "friedman":
+                    rng = np.random.default_rng(1000 * n + seed)
+                    xtr, _, ytr = friedman(rng, n)
+                    xte, fte, yte = friedman(rng, TEST_ROWS)
+                else:
+                    xtr, ytr = read_table(os.path.join(a.datasets, "whirling_train.csv"))
+                    xte, yte = read_table(os.path.join(a.datasets, "whirling_500.csv"))
+                    fte = yte
+                rec = {"problem": prob, "rows": n, "seed": seed, "methods": {}}
+                for name, args in variants:
+                    mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp)
+                    rec["methods"][name] = {
+                        "rmse": rmse(mean, fte).tolist(), "time_ms": ms, **info,
+                        "cover1": np.mean(np.abs(yte - mean) <= sd, axis=0).tolist(),
+                        "cover2": np.mean(np.abs(yte - mean) <= 2 * sd, axis=0).tolist(),
+                        "cover1_truth": np.mean(np.abs(fte - mean) <= sd, axis=0).tolist(),
+                        "cover2_truth": np.mean(np.abs(fte - mean) <= 2 * sd, axis=0).tolist()}
+                for p in peers:
+                    pred, ms = fit_sklearn(p, xtr, ytr, xte, seed)
+                    rec["methods"][p] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
+                results.append(rec)
+                print(f"{prob} {n} rows seed {seed}: " + ", ".join(
+                    f"{k} {v['rmse'][0]:.3g}/{v['rmse'][1]:.3g}" for k, v in rec["methods"].items()),
+                    file=sys.stderr)
+            report(results, prob, n, variants, peers)
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(results, f, indent=1)
+
+
+def report(results, prob, n, variants, peers):
+    rs = [r for r in results if r["problem"] == prob and r["rows"] == n]
+    med = lambda key, m, k: float(np.median([r["methods"][m][key][k] for r in rs]))
+    print(f"\n{prob}, {n} training rows, {len(rs)} seeds (median test RMSE, out1 / out2)")
+    print(f"{'method':<14} {'rmse_out1':>9} {'rmse_out2':>9} {'wins1':>6} {'wins2':>6} "
+          f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8}")
+    for m in [v[0] for v in variants] + peers:
+        line = f"{m:<14} {med('rmse', m, 0):9.3f} {med('rmse', m, 1):9.3f}"
+        if m in peers:
+            line += f" {'':>6} {'':>6} {'':>11} {'':>11} {'':>11}"
+        else:
+            wins = [sum(r["methods"][m]["rmse"][k] < min(r["methods"][p]["rmse"][k] for p in peers)
+                        for r in rs) for k in (0, 1)]
+            cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
+                                       for k in (0, 1))
+            line += f" {wins[0]:>6} {wins[1]:>6} {cov('cover1'):>11} {cov('cover2'):>11} " \
+                    f"{cov('cover1_truth'):>11}"
+        line += f" {float(np.median([r['methods'][m]['time_ms'] for r in rs])):8.1f}"
+        print(line)
+    print("wins = seeds on which the method beats the best peer of that seed; cov = mean % of test "
+          "targets within +-1/2 sd (noisy), cov1sd_f = +-1 sd against the noise-free function; "
+          "time = median fit time")
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Peer benchmark of whirl's network (issue 12): Friedman #1 plus a second smooth output (20 and 100
+# training rows, 1000 test rows) and the simulator's tables (train 20, test 500), whirl train against
+# scikit-learn's MLPRegressor; prints median test RMSE per output, wins, interval coverage and fit
+# time. The functions, noise and peers are documented in scripts/bench_peers.py.
+# Installs Debian's python3-sklearn on first use (only here: the default setup and tests never need it).
+# Usage: scripts/bench_peers.sh [SEEDS (default 20)] [extra bench_peers.py arguments, e.g.
+#        --variant matlab=--trainbr-matlab --json bench.json]
+#   WHIRL=<path to whirl> overrides the binary (default: ${WHIRL_BUILD_DIR:-build}/whirl).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+WHIRL="${WHIRL:-${WHIRL_BUILD_DIR:-build}/whirl}"
+SEEDS="${1:-20}"
+shift || true
+if [ ! -x "$WHIRL" ]; then
+  echo "bench_peers: '$WHIRL' not found; build first (scripts/build.sh) or set WHIRL" >&2
+  exit 1
+fi
+PYTHON="${PYTHON:-/usr/bin/python3}"  # Debian's interpreter: python3-sklearn installs there
+if ! "$PYTHON" -c "import sklearn, numpy" 2>/dev/null; then
+  WHIRL_SETUP_BENCH_PEERS=1 scripts/setup.sh
+fi
+exec "$PYTHON" scripts/bench_peers.py --whirl "$WHIRL" --seeds "$SEEDS" "$@"
