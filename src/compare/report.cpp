@@ -246,7 +246,6 @@ ReportResult WriteReport(const std::filesystem::path& dir,
     std::string slug = Slug(c.screw.name);
     while (std::find(slugs.begin(), slugs.end(), slug) != slugs.end()) slug += "_";
     slugs.push_back(slug);
-    const double feed = c.kinematics.axial_feed_mm_s;
 
     // Data files.
     std::vector<std::vector<double>> rows;
