@@ -1,0 +1,3 @@
+# Sources of src/machine (issue 19): machine thermal errors of the whirling machine and its virtual
+# temperature sensors (run files in the drift format).
+target_sources(whirl_core PRIVATE ${CMAKE_CURRENT_LIST_DIR}/machine.cpp)
