@@ -11,6 +11,7 @@
 #include "core/csv.h"
 #include "core/process.h"
 #include "core/error.h"
+#include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"
 #include "nn/model.h"
@@ -21,7 +22,7 @@ namespace whirl::cli {
 namespace {
 
 struct MachineCliOptions {
-  std::string machine_path = ProjectPath("datasets/machines/whirling_machine.json");
+  std::string machine_path = ProjectPath("datasets/machines/whirling_thermal.json");
   std::uint64_t machine_seed = 1, seed = 1;
   // sensors
   std::string out;
@@ -33,12 +34,15 @@ struct MachineCliOptions {
   std::string iso_table = ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv");
   int machines = 2, screws = 3, train_runs = 2, threads = 2;
   bool machine_off = false, markdown = false, json = false;
+  std::string drift_model = "mlr";
 };
 
 machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
-  machine::MachineConfig m = std::filesystem::exists(o.machine_path)
-                                 ? machine::ReadMachine(o.machine_path)
-                                 : machine::DefaultMachine();
+  // Only the shipped default may be missing (a clone without datasets/): a named file must exist.
+  const bool shipped = o.machine_path == ProjectPath("datasets/machines/whirling_thermal.json");
+  machine::MachineConfig m = shipped && !std::filesystem::exists(o.machine_path)
+                                 ? machine::DefaultMachine()
+                                 : machine::ReadMachine(o.machine_path);
   if (o.machine_off) m.DisableAll();
   return m;
 }
@@ -83,6 +87,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.train_runs = o.train_runs;
   eo.seed = o.seed;
   eo.threads = o.threads;
+  eo.fit.kind = drift::ParseModelKind(o.drift_model);
   Progress progress("machine evaluate", static_cast<std::size_t>(o.machines * o.screws));
   const compare::MachineEvaluation e = compare::EvaluateWithMachines(
       base, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); });
@@ -106,8 +111,8 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
 
 void CommonOptions(CLI::App* sub, MachineCliOptions* o) {
   sub->add_option("--machine", o->machine_path,
-                  "machine JSON (schema whirl.machine; default "
-                  "datasets/machines/whirling_machine.json, built-in default if missing)");
+                  "machine thermal JSON (schema whirl.machine_thermal; default "
+                  "datasets/machines/whirling_thermal.json, built-in default if missing)");
   sub->add_flag("--machine-off", o->machine_off,
                 "switch every machine component off (m = 0: the workpiece-only truth)");
   sub->add_flag("--json", o->json, "machine output on stdout");
@@ -162,6 +167,10 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--base-screw", o->base_screw, "screw whose blank and settings are shared");
   e->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV")
       ->check(CLI::ExistingFile);
+  e->add_option("--drift-model", o->drift_model,
+                "machine drift model kind: mlr (seed 000's regression, default) or dynamic (with "
+                "first-order lags [min] chosen by cross-validation)")
+      ->check(CLI::IsMember({"mlr", "dynamic"}));
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
 }

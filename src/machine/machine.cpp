@@ -110,7 +110,7 @@ void to_json(nlohmann::json& j, const MachineConfig& m) {
   const auto& h = m.head;
   const auto& z = m.z_screw;
   const auto& a = m.ambient;
-  j = {{"schema", "whirl.machine"},
+  j = {{"schema", "whirl.machine_thermal"},
        {"schema_version", kMachineSchemaVersion},
        {"name", m.name},
        {"head",
@@ -149,8 +149,8 @@ void from_json(const nlohmann::json& j, MachineConfig& m) {
                      "machine_spread", "power_spread", "noise_std_k", "quantum_k", "sample_min",
                      "sensors", "sources"},
                     w);
-  if (j.contains("schema") && j.at("schema") != "whirl.machine")
-    throw InputError(w + ": schema must be \"whirl.machine\"");
+  if (j.contains("schema") && j.at("schema") != "whirl.machine_thermal")
+    throw InputError(w + ": schema must be \"whirl.machine_thermal\"");
   if (j.contains("name")) m.name = j.at("name").get<std::string>();
   if (j.contains("head")) {
     const auto& h = j.at("head");

@@ -4,8 +4,8 @@
 // this module adds the machine's own drift m(t, z) of the tool relative to the chuck, in the same
 // sign convention (um, positive = the groove lands further towards the chuck, compare/cut.h), so
 // the lead deviation of a cut is d(x) = [e + m - c](t) - [e + m - c](0). The parameters are in a
-// machine JSON (schema "whirl.machine", version 1; shipped default
-// datasets/machines/whirling_machine.json, its README states the source or reasoning of every
+// machine JSON (schema "whirl.machine_thermal", version 1; shipped default
+// datasets/machines/whirling_thermal.json, its README states the source or reasoning of every
 // magnitude). Axis coordinate z = distance of the tool from the chuck face, mm (the cut runs from
 // Kinematics::thread_start_position_mm towards the chuck: z(t) = z_start - v_f t).
 //

@@ -96,7 +96,7 @@ TEST(MachineDraw, SameSeedSameMachine) {
 }
 
 TEST(MachineConfigFile, ShippedJsonEqualsDefaultAndRejectsTypos) {
-  const std::string path = std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_machine.json";
+  const std::string path = std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_thermal.json";
   const MachineConfig shipped = ReadMachine(path);
   nlohmann::json a = shipped, b = DefaultMachine();
   EXPECT_EQ(a, b);
