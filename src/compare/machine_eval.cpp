@@ -31,14 +31,19 @@ std::uint64_t DaySeed(std::uint64_t machine_seed, std::uint64_t day) {
   return sim::MixSeed(machine_seed, 0x1000 + day);
 }
 
-// Model predictions on a run, held per sample: value at time t_s.
+// Model predictions on a run, linearly interpolated between the samples (the control evaluates
+// the model every interpolation cycle from analog inputs read continuously; the run's samples are
+// the log's resolution), held after the last sample: value at time t_s.
 struct HeldSeries {
   double step_min = 1;
   std::vector<double> values;
   double At(double t_s) const {
     if (values.empty()) return 0.0;
-    const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(t_s / 60.0 / step_min)));
-    return values[std::min(k, values.size() - 1)];
+    const double u = std::max(0.0, t_s / 60.0 / step_min);
+    const auto k = static_cast<std::size_t>(std::floor(u));
+    if (k + 1 >= values.size()) return values.back();
+    const double f = u - static_cast<double>(k);
+    return (1 - f) * values[k] + f * values[k + 1];
   }
 };
 

@@ -11,9 +11,10 @@
 //   traditional     the class-mean curve's 840D plan (as in compare.h)
 //   workpiece       the network's 840D plan (compare.h "model")
 //   machine         the machine model (trained on cutting runs) only:
-//                   c_m(t) = K0(k) + G(k) (z_fixed - z(t)) / 1000, K0 and G the drift models of
+//                   c_m(t) = K0(t) + G(t) (z_fixed - z(t)) / 1000, K0 and G the drift models of
 //                   offset_um and zscrew_per_1000_um evaluated on the screw's own sensor log,
-//                   held over each sample (k = floor(t / sample step)), as the control writes them
+//                   linearly interpolated between its samples (the control evaluates the model
+//                   every interpolation cycle from inputs read continuously)
 //   both            workpiece + machine (cutting-trained)
 //   both_idle       workpiece + machine trained on idle warm-ups (seed 000's comparison)
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
