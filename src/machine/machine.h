@@ -69,7 +69,7 @@ struct HeadComponent {
   bool enabled = true;
   int sign = 1;                    ///< +1: head growth moves the tool towards the chuck
   double idle_power_kw = 1.5;      ///< P_idle, ring turning, kW
-  double cutting_power_kw = 4.0;   ///< P_cut at 180 m/min, kW; scales with v_c / 180 m/min
+  double cutting_power_kw = 1.5;   ///< P_cut at 180 m/min, kW; scales with v_c / 180 m/min
   double motor_gain_um_per_kw = 6; ///< g_motor, um per kW at steady state
   double motor_tau_min = 35;       ///< tau_motor, min
   double process_gain_um_per_kw = 3;  ///< g_process, um per kW
