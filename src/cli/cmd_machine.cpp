@@ -35,6 +35,7 @@ struct MachineCliOptions {
   int machines = 2, screws = 3, train_runs = 2, threads = 2;
   bool machine_off = false, markdown = false, json = false;
   std::string drift_model = "mlr";
+  double monitor_every_min = 30;
 };
 
 machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
@@ -88,6 +89,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.seed = o.seed;
   eo.threads = o.threads;
   eo.fit.kind = drift::ParseModelKind(o.drift_model);
+  eo.monitor_every_min = o.monitor_every_min;
   Progress progress("machine evaluate", static_cast<std::size_t>(o.machines * o.screws));
   const compare::MachineEvaluation e = compare::EvaluateWithMachines(
       base, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); });
@@ -147,7 +149,8 @@ void RegisterMachine(CLI::App& app) {
       "Random screws cut on drifting machines (each machine: its own seeded parameters, idle and\n"
       "cutting training runs, its MLR drift models on seed 000's sensitive points). Strategies:\n"
       "none, traditional (class means), workpiece (network plan), machine (cutting-trained drift\n"
-      "models), both, both_idle (machine model trained on idle warm-ups). Prints median and worst\n"
+      "models), both, both_idle (machine model trained on idle warm-ups), both_monitor (offset\n"
+      "model kept valid by a check bar, seed 004). Prints median and worst\n"
       "accumulated lead error [um] within 1000 mm and over the thread, P3/P5 shares, the\n"
       "uncompensated error of each source alone and which part dominates what is left.");
   CommonOptions(e, o.get());
@@ -171,6 +174,9 @@ void RegisterMachine(CLI::App& app) {
                 "machine drift model kind: mlr (seed 000's regression, default) or dynamic (with "
                 "first-order lags [min] chosen by cross-validation)")
       ->check(CLI::IsMember({"mlr", "dynamic"}));
+  e->add_option("--monitor-every-min", o->monitor_every_min,
+                "both_monitor: check-bar interval of seed 004's monitor [min] (1..600, default 30)")
+      ->check(CLI::Range(1.0, 600.0));
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
 }

@@ -6,13 +6,14 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "drift/monitor.h"
 #include "sim/random.h"
 
 namespace whirl::compare {
 
 std::string ToString(MachineStrategy s) {
-  static const char* kNames[] = {"none", "traditional", "workpiece", "machine", "both",
-                                 "both_idle"};
+  static const char* kNames[] = {"none", "traditional", "workpiece", "machine",
+                                 "both", "both_idle", "both_monitor"};
   return kNames[static_cast<int>(s)];
 }
 
@@ -107,7 +108,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
                                         const ExperienceRule& rule,
                                         const IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
-                                        const CompareOptions& options) {
+                                        const CompareOptions& options, double monitor_every_min) {
   MachineEvalScrew out;
   out.screw = screw;
   out.seed = options.seed;
@@ -151,7 +152,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     };
   };
   const CompensationFunction wp = planned(c.plan), trad = planned(traditional_plan);
-  CompensationFunction mach_cut = NoCompensation(), mach_idle = NoCompensation();
+  CompensationFunction mach_cut = NoCompensation(), mach_idle = NoCompensation(),
+                       mach_monitor = NoCompensation();
   if (models.fitted) {
     machine::RunSpec spec;
     spec.name = screw.name + "_log";
@@ -167,12 +169,26 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     };
     mach_cut = held(models.offset_cutting, models.slope_cutting);
     mach_idle = held(models.offset_idle, models.slope_idle);
+    drift::MonitorOptions mo;
+    mo.check_every = monitor_every_min;
+    mo.refit_samples = 0;
+    mo.noise_um = 0.5;
+    mo.seed = options.seed;
+    mo.rules = {drift::UpdateRule::kOffset};
+    const drift::MonitorResult monitored = drift::MonitorRun(models.offset_cutting, log, mo);
+    const Eigen::VectorXd& k0 = monitored.strategies.back().predicted_um;
+    HeldSeries a{step, std::vector<double>(k0.data(), k0.data() + k0.size())};
+    const HeldSeries b = Predict(models.slope_cutting, log, step);
+    mach_monitor = [a, b, z_of, z_fixed](double t) {
+      return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3;
+    };
   }
   auto sum = [](CompensationFunction a, CompensationFunction b) -> CompensationFunction {
     return [a, b](double t) { return a(t) + b(t); };
   };
   const std::array<CompensationFunction, kMachineStrategyCount> comp = {
-      NoCompensation(), trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle)};
+      NoCompensation(),   trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle),
+      sum(wp, mach_monitor)};
 
   LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
@@ -232,7 +248,8 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
         CompareOptions co = options.compare;
         co.seed = sim::MixSeed(options.seed, k);
         try {
-          e.screws[k] = EvaluateScrewOnMachine(screws[k], model, rule, iso_table, day, models[i], co);
+          e.screws[k] = EvaluateScrewOnMachine(screws[k], model, rule, iso_table, day, models[i],
+                                               co, options.monitor_every_min);
         } catch (const InputError& err) {
           e.screws[k].screw = screws[k];
           e.screws[k].ok = false;
@@ -282,15 +299,15 @@ MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& scr
     s.share_p5[k] = ok ? static_cast<double>(p5[k]) / ok : 0.0;
   }
   for (std::size_t q = 0; q < kErrorSourceCount; ++q) s.source_median_um[q] = median(sources[q]);
-  char buf[256];
+  char buf[512];
   std::snprintf(buf, sizeof buf,
                 "%zu screws (%zu failed): within 1000 mm median none %.1f, traditional %.1f, "
-                "workpiece %.1f, machine %.1f, both %.1f, both_idle %.1f um; what is left after "
-                "both is dominated by the %s part in %zu of %zu screws",
+                "workpiece %.1f, machine %.1f, both %.1f, both_idle %.1f, both_monitor %.1f um; "
+                "what is left after both is dominated by the %s part in %zu of %zu screws",
                 s.screws, s.failed, s.absolute[0].acc1000_median_um,
                 s.absolute[1].acc1000_median_um, s.absolute[2].acc1000_median_um,
                 s.absolute[3].acc1000_median_um, s.absolute[4].acc1000_median_um,
-                s.absolute[5].acc1000_median_um,
+                s.absolute[5].acc1000_median_um, s.absolute[6].acc1000_median_um,
                 s.residual_machine_dominates > s.residual_workpiece_dominates ? "machine"
                                                                               : "workpiece",
                 std::max(s.residual_machine_dominates, s.residual_workpiece_dominates), ok);

@@ -17,6 +17,11 @@
 //                   every interpolation cycle from inputs read continuously)
 //   both            workpiece + machine (cutting-trained)
 //   both_idle       workpiece + machine trained on idle warm-ups (seed 000's comparison)
+//   both_monitor    both, with the offset model kept valid by seed 004's check bar
+//                   (drift/monitor.h MonitorRun on the screw's log: a check every
+//                   `monitor_every_min`, measured at the fixed end (offset_um) with N(0, 0.5 um)
+//                   noise, 3-sigma threshold, rule `offset` from the invalid check alone; the
+//                   stops are not simulated: the log goes on as if the cut never paused)
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
 // `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
 // drift::FitDriftModel (kind and sensor selection from `fit`, default seed 000's MLR on the
@@ -37,9 +42,11 @@
 
 namespace whirl::compare {
 
-enum class MachineStrategy { kNone, kTraditional, kWorkpiece, kMachine, kBoth, kBothIdle };
-inline constexpr std::size_t kMachineStrategyCount = 6;
-std::string ToString(MachineStrategy s);  ///< none, traditional, workpiece, machine, both, both_idle
+enum class MachineStrategy {
+  kNone, kTraditional, kWorkpiece, kMachine, kBoth, kBothIdle, kBothMonitor };
+inline constexpr std::size_t kMachineStrategyCount = 7;
+/// none, traditional, workpiece, machine, both, both_idle, both_monitor
+std::string ToString(MachineStrategy s);
 
 /// Sources of the uncompensated lead error (accumulated over the thread, um, each alone).
 enum class ErrorSource { kWorkpiece, kHead, kZScrew, kBed };
@@ -55,6 +62,7 @@ struct MachineEvalOptions {
   CompareOptions compare;
   drift::FitOptions fit;  ///< threads are forced to 1 (the screws run in parallel)
   int threads = 2;
+  double monitor_every_min = 30;  ///< both_monitor: check interval, min (> 0)
 };
 
 /// The machine models of one machine.
@@ -103,7 +111,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
                                         const ExperienceRule& rule,
                                         const IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
-                                        const CompareOptions& options);
+                                        const CompareOptions& options,
+                                        double monitor_every_min = 30);
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
                                        const ExperienceRule& rule,
