@@ -9,8 +9,8 @@
 #include "cli/common.h"
 #include "compare/machine_eval.h"
 #include "core/csv.h"
-#include "core/process.h"
 #include "core/error.h"
+#include "core/process.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"
@@ -52,9 +52,8 @@ void RunSensors(const MachineCliOptions& o) {
   const machine::MachineConfig config = LoadMachine(o);
   std::vector<drift::Run> runs;
   for (auto state : {drift::RunState::kIdle, drift::RunState::kCutting})
-    for (auto& r : compare::TrainingRuns(config, o.machine_seed,
-                                         state == drift::RunState::kIdle ? o.idle : o.cutting,
-                                         state))
+    for (auto& r : compare::TrainingRuns(
+             config, o.machine_seed, state == drift::RunState::kIdle ? o.idle : o.cutting, state))
       runs.push_back(r);
   const std::vector<std::string> comments = {
       "simulated by: whirl machine sensors --machine-seed " + std::to_string(o.machine_seed) +
@@ -107,8 +106,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
     std::printf("%s\n%s", e.summary.message.c_str(),
                 compare::FormatMachineEvalTable(e, o.markdown).c_str());
   }
-  if (e.summary.failed == e.summary.screws)
-    throw CommandFailure("every comparison failed", 1);
+  if (e.summary.failed == e.summary.screws) throw CommandFailure("every comparison failed", 1);
 }
 
 void CommonOptions(CLI::App* sub, MachineCliOptions* o) {
@@ -139,7 +137,8 @@ void RegisterMachine(CLI::App& app) {
   CommonOptions(s, o.get());
   s->add_option("--out", o->out, "output folder (created; all files or none)")->required();
   s->add_option("--machine-seed", o->machine_seed, "seed of the machine (default 1)");
-  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")->check(CLI::Range(0, 20));
+  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")
+      ->check(CLI::Range(0, 20));
   s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")
       ->check(CLI::Range(0, 20));
   s->callback([o] { RunSensors(*o); });

@@ -12,8 +12,8 @@
 namespace whirl::compare {
 
 std::string ToString(MachineStrategy s) {
-  static const char* kNames[] = {"none", "traditional", "workpiece", "machine",
-                                 "both", "both_idle", "both_monitor"};
+  static const char* kNames[] = {"none", "traditional", "workpiece",   "machine",
+                                 "both", "both_idle",   "both_monitor"};
   return kNames[static_cast<int>(s)];
 }
 
@@ -60,17 +60,15 @@ double TotalOf(const ElongationCurve& truth, const CompensationFunction& comp, d
                const sim::Screw& screw, const CompareOptions& options) {
   LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
-  const LeadDeviation lead =
-      CutLeadDeviation(truth, comp, feed, screw.thread_length_mm, screw.process.pitch_mm,
-                       options.cut);
+  const LeadDeviation lead = CutLeadDeviation(truth, comp, feed, screw.thread_length_mm,
+                                              screw.process.pitch_mm, options.cut);
   return ComputeLeadMetrics(lead, mo).accumulated_total_um;
 }
 
 }  // namespace
 
 std::vector<drift::Run> TrainingRuns(const machine::MachineConfig& config,
-                                     std::uint64_t machine_seed, int runs,
-                                     drift::RunState state) {
+                                     std::uint64_t machine_seed, int runs, drift::RunState state) {
   std::vector<drift::Run> out;
   const bool cutting = state == drift::RunState::kCutting;
   for (int r = 0; r < runs; ++r) {
@@ -164,8 +162,9 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     const double step = day.config.sample_min;
     auto held = [&](const drift::DriftModel& k0, const drift::DriftModel& g) {
       const HeldSeries a = Predict(k0, log, step), b = Predict(g, log, step);
-      return CompensationFunction(
-          [a, b, z_of, z_fixed](double t) { return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3; });
+      return CompensationFunction([a, b, z_of, z_fixed](double t) {
+        return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3;
+      });
     };
     mach_cut = held(models.offset_cutting, models.slope_cutting);
     mach_idle = held(models.offset_idle, models.slope_idle);
@@ -187,7 +186,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     return [a, b](double t) { return a(t) + b(t); };
   };
   const std::array<CompensationFunction, kMachineStrategyCount> comp = {
-      NoCompensation(),   trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle),
+      NoCompensation(),     trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle),
       sum(wp, mach_monitor)};
 
   LeadMetricOptions mo = options.metrics;
@@ -227,7 +226,8 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
   for (std::size_t i = 0; i < n_machines; ++i)
     machine_seeds[i] = sim::MixSeed(options.seed, 0x4d00 + i);
   ParallelFor(n_machines, options.threads, [&](std::size_t i) {
-    models[i] = FitMachineModels(options.machine, machine_seeds[i], options.train_runs, options.fit);
+    models[i] =
+        FitMachineModels(options.machine, machine_seeds[i], options.train_runs, options.fit);
   });
   MachineEvaluation e;
   for (const auto& m : models) {
@@ -289,7 +289,9 @@ MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& scr
     else
       ++s.residual_machine_dominates;
   }
-  auto median = [](std::vector<double> v) { return v.empty() ? 0.0 : Stats(std::move(v)).median_pct; };
+  auto median = [](std::vector<double> v) {
+    return v.empty() ? 0.0 : Stats(std::move(v)).median_pct;
+  };
   auto worst = [](const std::vector<double>& v) {
     return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
   };
@@ -300,17 +302,17 @@ MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& scr
   }
   for (std::size_t q = 0; q < kErrorSourceCount; ++q) s.source_median_um[q] = median(sources[q]);
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "%zu screws (%zu failed): within 1000 mm median none %.1f, traditional %.1f, "
-                "workpiece %.1f, machine %.1f, both %.1f, both_idle %.1f, both_monitor %.1f um; "
-                "what is left after both is dominated by the %s part in %zu of %zu screws",
-                s.screws, s.failed, s.absolute[0].acc1000_median_um,
-                s.absolute[1].acc1000_median_um, s.absolute[2].acc1000_median_um,
-                s.absolute[3].acc1000_median_um, s.absolute[4].acc1000_median_um,
-                s.absolute[5].acc1000_median_um, s.absolute[6].acc1000_median_um,
-                s.residual_machine_dominates > s.residual_workpiece_dominates ? "machine"
-                                                                              : "workpiece",
-                std::max(s.residual_machine_dominates, s.residual_workpiece_dominates), ok);
+  std::snprintf(
+      buf, sizeof buf,
+      "%zu screws (%zu failed): within 1000 mm median none %.1f, traditional %.1f, "
+      "workpiece %.1f, machine %.1f, both %.1f, both_idle %.1f, both_monitor %.1f um; "
+      "what is left after both is dominated by the %s part in %zu of %zu screws",
+      s.screws, s.failed, s.absolute[0].acc1000_median_um, s.absolute[1].acc1000_median_um,
+      s.absolute[2].acc1000_median_um, s.absolute[3].acc1000_median_um,
+      s.absolute[4].acc1000_median_um, s.absolute[5].acc1000_median_um,
+      s.absolute[6].acc1000_median_um,
+      s.residual_machine_dominates > s.residual_workpiece_dominates ? "machine" : "workpiece",
+      std::max(s.residual_machine_dominates, s.residual_workpiece_dominates), ok);
   s.message = buf;
   return s;
 }
@@ -320,18 +322,18 @@ std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown) {
   std::string out;
   char buf[256];
   if (markdown)
-    out += "| strategy | 1000 mm median um | 1000 mm worst um | thread median um | thread worst um "
-           "| P3 share | P5 share |\n|---|---|---|---|---|---|---|\n";
+    out +=
+        "| strategy | 1000 mm median um | 1000 mm worst um | thread median um | thread worst um "
+        "| P3 share | P5 share |\n|---|---|---|---|---|---|---|\n";
   else
     out += "strategy      1000mm med  worst  thread med  worst   P3    P5\n";
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
     const AbsoluteStats& a = s.absolute[k];
     const char* fmt = markdown ? "| %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f |\n"
                                : "%-12s %9.1f %6.1f %11.1f %6.1f %5.2f %5.2f\n";
-    std::snprintf(buf, sizeof buf, fmt,
-                  ToString(static_cast<MachineStrategy>(k)).c_str(), a.acc1000_median_um,
-                  a.acc1000_worst_um, a.total_median_um, a.total_worst_um, s.share_p3[k],
-                  s.share_p5[k]);
+    std::snprintf(buf, sizeof buf, fmt, ToString(static_cast<MachineStrategy>(k)).c_str(),
+                  a.acc1000_median_um, a.acc1000_worst_um, a.total_median_um, a.total_worst_um,
+                  s.share_p3[k], s.share_p5[k]);
     out += buf;
   }
   out += markdown ? "\nUncompensated error over the thread by source alone, median um:"
@@ -360,8 +362,11 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
     sources[ToString(static_cast<ErrorSource>(q))] = s.source_median_um[q];
   nlohmann::json screws = nlohmann::json::array();
   for (const auto& r : e.screws) {
-    nlohmann::json x = {{"name", r.screw.name}, {"machine", r.machine}, {"seed", r.seed},
-                        {"day_seed", r.day_seed}, {"ok", r.ok}};
+    nlohmann::json x = {{"name", r.screw.name},
+                        {"machine", r.machine},
+                        {"seed", r.seed},
+                        {"day_seed", r.day_seed},
+                        {"ok", r.ok}};
     if (!r.ok) {
       x["error"] = r.error;
     } else {

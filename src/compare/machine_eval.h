@@ -43,7 +43,14 @@
 namespace whirl::compare {
 
 enum class MachineStrategy {
-  kNone, kTraditional, kWorkpiece, kMachine, kBoth, kBothIdle, kBothMonitor };
+  kNone,
+  kTraditional,
+  kWorkpiece,
+  kMachine,
+  kBoth,
+  kBothIdle,
+  kBothMonitor
+};
 inline constexpr std::size_t kMachineStrategyCount = 7;
 /// none, traditional, workpiece, machine, both, both_idle, both_monitor
 std::string ToString(MachineStrategy s);

@@ -144,22 +144,22 @@ void to_json(nlohmann::json& j, const MachineConfig& m) {
 
 void from_json(const nlohmann::json& j, MachineConfig& m) {
   const std::string w = "machine";
-  RejectUnknownKeys(j,
-                    {"schema", "schema_version", "name", "head", "z_screw", "ambient",
-                     "machine_spread", "power_spread", "noise_std_k", "quantum_k", "sample_min",
-                     "sensors", "sources"},
-                    w);
+  RejectUnknownKeys(
+      j,
+      {"schema", "schema_version", "name", "head", "z_screw", "ambient", "machine_spread",
+       "power_spread", "noise_std_k", "quantum_k", "sample_min", "sensors", "sources"},
+      w);
   if (j.contains("schema") && j.at("schema") != "whirl.machine_thermal")
     throw InputError(w + ": schema must be \"whirl.machine_thermal\"");
   if (j.contains("name")) m.name = j.at("name").get<std::string>();
   if (j.contains("head")) {
     const auto& h = j.at("head");
     const std::string hw = w + " head";
-    RejectUnknownKeys(h,
-                      {"enabled", "sign", "idle_power_kw", "cutting_power_kw",
-                       "motor_gain_um_per_kw", "motor_tau_min", "process_gain_um_per_kw",
-                       "process_tau_min"},
-                      hw);
+    RejectUnknownKeys(
+        h,
+        {"enabled", "sign", "idle_power_kw", "cutting_power_kw", "motor_gain_um_per_kw",
+         "motor_tau_min", "process_gain_um_per_kw", "process_tau_min"},
+        hw);
     OptionalBool(h, "enabled", m.head.enabled, hw);
     double sign = m.head.sign;
     Optional(h, "sign", sign, hw);
@@ -185,8 +185,8 @@ void from_json(const nlohmann::json& j, MachineConfig& m) {
   if (j.contains("ambient")) {
     const auto& a = j.at("ambient");
     const std::string aw = w + " ambient";
-    RejectUnknownKeys(a, {"enabled", "expansion_per_k", "bed_tau_min", "rate_std_k_per_h", "start_c"},
-                      aw);
+    RejectUnknownKeys(
+        a, {"enabled", "expansion_per_k", "bed_tau_min", "rate_std_k_per_h", "start_c"}, aw);
     OptionalBool(a, "enabled", m.ambient.enabled, aw);
     Optional(a, "expansion_per_k", m.ambient.expansion_per_k, aw);
     Optional(a, "bed_tau_min", m.ambient.bed_tau_min, aw);
@@ -240,9 +240,7 @@ MachineDay MachineDay::Draw(const MachineConfig& config, std::uint64_t machine_s
   MachineDay d;
   d.config = config;
   sim::Rng machine_rng(sim::MixSeed(machine_seed, 0x6d616368));
-  auto factor = [&](double spread) {
-    return std::max(0.2, 1.0 + spread * machine_rng.Normal());
-  };
+  auto factor = [&](double spread) { return std::max(0.2, 1.0 + spread * machine_rng.Normal()); };
   HeadComponent& h = d.config.head;
   h.motor_gain_um_per_kw *= factor(config.machine_spread);
   h.process_gain_um_per_kw *= factor(config.machine_spread);
@@ -347,7 +345,8 @@ drift::Run SimulateRun(const MachineDay& day, const RunSpec& spec) {
     for (std::size_t i = 0; i < m; ++i) {
       const SensorSpec& s = c.sensors[i];
       double temp = c.ambient.start_c + s.ambient_weight * lag[i][3] + s.gains[0] * lag[i][0] +
-                    s.gains[1] * lag[i][1] + s.gains[2] * lag[i][2] + c.noise_std_k * noise.Normal();
+                    s.gains[1] * lag[i][1] + s.gains[2] * lag[i][2] +
+                    c.noise_std_k * noise.Normal();
       if (c.quantum_k > 0) temp = c.quantum_k * std::round(temp / c.quantum_k);
       run.temperature_C(k, static_cast<Eigen::Index>(i)) = temp;
     }
@@ -361,9 +360,8 @@ drift::Run SimulateRun(const MachineDay& day, const RunSpec& spec) {
 std::vector<std::string> RunComments(const MachineDay& day, std::uint64_t machine_seed,
                                      std::uint64_t day_seed, const RunSpec& spec) {
   return {"simulated by whirl machine sensors (src/machine/machine.h), machine '" +
-              day.config.name + "', machine seed " + std::to_string(machine_seed) +
-              ", day seed " + std::to_string(day_seed) + ", noise seed " +
-              std::to_string(spec.noise_seed),
+              day.config.name + "', machine seed " + std::to_string(machine_seed) + ", day seed " +
+              std::to_string(day_seed) + ", noise seed " + std::to_string(spec.noise_seed),
           "state " + drift::ToString(spec.state) + ", cutting speed " +
               FormatNumber(spec.cutting_speed_m_min) + " m/min, ambient rate " +
               FormatNumber(day.ambient_rate_k_per_h) + " K/h, power factor " +

@@ -67,11 +67,11 @@ inline constexpr int kSourceCount = 4;
 
 struct HeadComponent {
   bool enabled = true;
-  int sign = 1;                    ///< +1: head growth moves the tool towards the chuck
-  double idle_power_kw = 1.5;      ///< P_idle, ring turning, kW
-  double cutting_power_kw = 1.5;   ///< P_cut at 180 m/min, kW; scales with v_c / 180 m/min
-  double motor_gain_um_per_kw = 6; ///< g_motor, um per kW at steady state
-  double motor_tau_min = 35;       ///< tau_motor, min
+  int sign = 1;                       ///< +1: head growth moves the tool towards the chuck
+  double idle_power_kw = 1.5;         ///< P_idle, ring turning, kW
+  double cutting_power_kw = 1.5;      ///< P_cut at 180 m/min, kW; scales with v_c / 180 m/min
+  double motor_gain_um_per_kw = 6;    ///< g_motor, um per kW at steady state
+  double motor_tau_min = 35;          ///< tau_motor, min
   double process_gain_um_per_kw = 3;  ///< g_process, um per kW
   double process_tau_min = 12;        ///< tau_process, min
 };
@@ -93,10 +93,10 @@ struct AmbientComponent {
 };
 
 struct SensorSpec {
-  std::string name;             ///< column name without the _C suffix
-  double ambient_weight = 1.0;  ///< a_i: 1 follows the hall, 0 insulated
+  std::string name;               ///< column name without the _C suffix
+  double ambient_weight = 1.0;    ///< a_i: 1 follows the hall, 0 insulated
   std::array<double, 3> gains{};  ///< g_i for motor [K/kW], process [K/kW], z_screw [K/K]
-  double tau_min = 5;           ///< tau_i, min (> 0)
+  double tau_min = 5;             ///< tau_i, min (> 0)
 };
 
 struct MachineConfig {
@@ -119,11 +119,11 @@ struct MachineConfig {
 MachineConfig DefaultMachine();
 void to_json(nlohmann::json& j, const MachineConfig& m);
 void from_json(const nlohmann::json& j, MachineConfig& m);  ///< unknown keys rejected
-MachineConfig ReadMachine(const std::string& path);          ///< InputError names file and key
+MachineConfig ReadMachine(const std::string& path);         ///< InputError names file and key
 
 /// One machine on one day: the drawn parameters (seeded), closed forms of m.
 struct MachineDay {
-  MachineConfig config;       ///< with the per-machine factors applied
+  MachineConfig config;  ///< with the per-machine factors applied
   double ambient_rate_k_per_h = 0;
   double power_factor = 1;
   /// Draws the machine (machine_seed) and the day (day_seed).
@@ -132,10 +132,10 @@ struct MachineDay {
   /// Source states at time t_min of a run: cutting = the process and the Z axis are on;
   /// cutting_speed scales P_cut (v_c / 180).
   double Source(Source s, double t_min, bool cutting, double cutting_speed_m_min) const;
-  double BedRiseK(double t_min) const;        ///< dT_bed
-  double HeadUm(double t_min, bool cutting, double v_c) const;    ///< m_head
-  double ZScrewPer1000Um(double t_min, bool cutting) const;      ///< 1e6 alpha_s dT_s
-  double BedUm(double t_min) const;                              ///< m_bed
+  double BedRiseK(double t_min) const;                          ///< dT_bed
+  double HeadUm(double t_min, bool cutting, double v_c) const;  ///< m_head
+  double ZScrewPer1000Um(double t_min, bool cutting) const;     ///< 1e6 alpha_s dT_s
+  double BedUm(double t_min) const;                             ///< m_bed
   /// m(t, z) = m_head + m_z + m_bed at the tool position z_mm.
   double DriftUm(double t_min, double z_mm, bool cutting, double v_c) const;
 };

@@ -8,8 +8,8 @@
 #include "compare/machine_eval.h"
 #include "core/csv.h"
 #include "core/error.h"
-#include "core/process.h"
 #include "core/json_file.h"
+#include "core/process.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"
@@ -77,10 +77,10 @@ TEST(MachineAmbient, BedFollowsTheRampWithItsLag) {
     EXPECT_NEAR(tau * deriv + d.BedRiseK(t), r * t, 1e-7);
   }
   // Bed growth over the chuck-to-fixed-bearing distance moves the tool away from the chuck.
-  EXPECT_NEAR(d.BedUm(100),
-              -1000 * d.config.ambient.expansion_per_k * d.BedRiseK(100) *
-                  d.config.z_screw.fixed_end_mm,
-              1e-12);
+  EXPECT_NEAR(
+      d.BedUm(100),
+      -1000 * d.config.ambient.expansion_per_k * d.BedRiseK(100) * d.config.z_screw.fixed_end_mm,
+      1e-12);
 }
 
 TEST(MachineDraw, SameSeedSameMachine) {
@@ -96,7 +96,8 @@ TEST(MachineDraw, SameSeedSameMachine) {
 }
 
 TEST(MachineConfigFile, ShippedJsonEqualsDefaultAndRejectsTypos) {
-  const std::string path = std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_thermal.json";
+  const std::string path =
+      std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_thermal.json";
   const MachineConfig shipped = ReadMachine(path);
   nlohmann::json a = shipped, b = DefaultMachine();
   EXPECT_EQ(a, b);
@@ -129,8 +130,8 @@ TEST(MachineSensors, RunRoundTripsThroughTheDriftFormatAndFits) {
   EXPECT_NEAR(run.error_um(60, 0), day.HeadUm(60, true, 190) + day.BedUm(60), 1e-12);
   EXPECT_NEAR(run.error_um(60, 1), day.ZScrewPer1000Um(60, true), 1e-12);
   // Round trip: format -> parse gives the same numbers (to the printed precision).
-  const drift::Run back = drift::ParseRun(drift::FormatRun(run, {"test"}), "cut.csv",
-                                          drift::RunState::kCutting);
+  const drift::Run back =
+      drift::ParseRun(drift::FormatRun(run, {"test"}), "cut.csv", drift::RunState::kCutting);
   ASSERT_EQ(back.sensor_names, run.sensor_names);
   ASSERT_EQ(back.error_names, run.error_names);
   EXPECT_LT((back.temperature_C - run.temperature_C).cwiseAbs().maxCoeff(), 1e-6);
