@@ -36,6 +36,7 @@ struct MachineCliOptions {
   bool machine_off = false, markdown = false, json = false;
   std::string drift_model = "mlr";
   double monitor_every_min = 30;
+  std::string report;
 };
 
 machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
@@ -89,6 +90,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.threads = o.threads;
   eo.fit.kind = drift::ParseModelKind(o.drift_model);
   eo.monitor_every_min = o.monitor_every_min;
+  eo.report_dir = o.report;
   Progress progress("machine evaluate", static_cast<std::size_t>(o.machines * o.screws));
   const compare::MachineEvaluation e = compare::EvaluateWithMachines(
       base, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); });
@@ -106,6 +108,8 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
     std::printf("%s\n%s", e.summary.message.c_str(),
                 compare::FormatMachineEvalTable(e, o.markdown).c_str());
   }
+  if (!e.report_index.empty())
+    std::fprintf(stderr, "report written to %s\n", e.report_index.c_str());
   if (e.summary.failed == e.summary.screws) throw CommandFailure("every comparison failed", 1);
 }
 
@@ -176,6 +180,10 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--monitor-every-min", o->monitor_every_min,
                 "both_monitor: check-bar interval of seed 004's monitor [min] (1..600, default 30)")
       ->check(CLI::Range(1.0, 600.0));
+  e->add_option("--report", o->report,
+                "write the first screw's report here: sensor plot [degC over min], chosen "
+                "sensors, lead deviation per strategy [um over mm] (folder must not exist or be "
+                "empty)");
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
 }

@@ -106,7 +106,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
                                         const ExperienceRule& rule,
                                         const IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
-                                        const CompareOptions& options, double monitor_every_min) {
+                                        const CompareOptions& options, double monitor_every_min,
+                                        MachineScrewDetail* detail) {
   MachineEvalScrew out;
   out.screw = screw;
   out.seed = options.seed;
@@ -159,6 +160,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     spec.cutting_speed_m_min = v_c;
     spec.noise_seed = sim::MixSeed(options.seed, 77);
     const drift::Run log = machine::SimulateRun(day, spec);
+    if (detail) detail->log = log;
     const double step = day.config.sample_min;
     auto held = [&](const drift::DriftModel& k0, const drift::DriftModel& g) {
       const HeldSeries a = Predict(k0, log, step), b = Predict(g, log, step);
@@ -195,6 +197,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     const LeadDeviation lead = CutLeadDeviation(truth, comp[k], feed, screw.thread_length_mm,
                                                 screw.process.pitch_mm, options.cut);
     out.metrics[k] = ComputeLeadMetrics(lead, mo);
+    if (detail) detail->leads[k] = lead;
     out.iso[k] = EvaluateIsoClass(out.metrics[k], iso_table).reached;
   }
   for (std::size_t s = 0; s < kErrorSourceCount; ++s)
@@ -260,6 +263,19 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
       },
       progress);
   e.summary = SummarizeMachineEval(e.screws);
+  if (!options.report_dir.empty() && e.screws.front().ok) {
+    // The first screw again, keeping its curves (same seeds: the same figures).
+    const machine::MachineDay day =
+        machine::MachineDay::Draw(options.machine, machine_seeds[0], e.screws.front().day_seed);
+    CompareOptions co = options.compare;
+    co.seed = e.screws.front().seed;
+    MachineScrewDetail detail;
+    const MachineEvalScrew first =
+        EvaluateScrewOnMachine(screws.front(), model, rule, iso_table, day, models[0], co,
+                               options.monitor_every_min, &detail);
+    e.report_index = WriteMachineScrewReport(options.report_dir, first, detail,
+                                             e.sensors_cutting[0], e.sensors_idle[0]);
+  }
   return e;
 }
 

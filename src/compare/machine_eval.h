@@ -70,6 +70,8 @@ struct MachineEvalOptions {
   drift::FitOptions fit;  ///< threads are forced to 1 (the screws run in parallel)
   int threads = 2;
   double monitor_every_min = 30;  ///< both_monitor: check interval, min (> 0)
+  /// Non-empty: WriteMachineScrewReport of the first screw (machine 0) into this folder.
+  std::string report_dir;
 };
 
 /// The machine models of one machine.
@@ -105,6 +107,7 @@ struct MachineEvaluation {
   std::vector<std::vector<std::string>> sensors_cutting, sensors_idle;  ///< per machine
   std::vector<MachineEvalScrew> screws;
   MachineEvalSummary summary;
+  std::string report_index;  ///< index.html of the report, when written
 };
 
 /// Training runs of machine `machine_seed` (idle warm-ups then cutting runs).
@@ -113,13 +116,30 @@ std::vector<drift::Run> TrainingRuns(const machine::MachineConfig& config,
 MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64_t machine_seed,
                                int runs, const drift::FitOptions& fit);
 
-/// One screw on one machine day (see the header comment).
+/// Curves of one screw, for the report: its sensor log and the lead deviation per strategy.
+struct MachineScrewDetail {
+  drift::Run log;  ///< empty when no machine model was fitted
+  std::array<LeadDeviation, kMachineStrategyCount> leads;
+};
+
+/// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
                                         const ExperienceRule& rule,
                                         const IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
                                         const CompareOptions& options,
-                                        double monitor_every_min = 30);
+                                        double monitor_every_min = 30,
+                                        MachineScrewDetail* detail = nullptr);
+
+/// Report of one screw in `dir` (must not exist or be empty; written as <dir>.partial, renamed
+/// when complete, so nothing half-written remains): sensors.csv/.png (the screw's sensor log,
+/// degC over min), lead.csv/.png (lead deviation per strategy, um over mm), index.html with the
+/// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
+/// Returns the index path.
+std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
+                                    const MachineScrewDetail& detail,
+                                    const std::vector<std::string>& sensors_cutting,
+                                    const std::vector<std::string>& sensors_idle);
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
                                        const ExperienceRule& rule,

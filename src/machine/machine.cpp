@@ -1,6 +1,7 @@
 #include "machine/machine.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "core/csv.h"
@@ -74,7 +75,13 @@ void MachineConfig::Validate(const std::string& where) const {
     throw InputError(where + ": sensors: " + std::to_string(sensors.size()) +
                      " given, must be 1..64");
   for (const auto& s : sensors) {
-    if (s.name.empty()) throw InputError(where + ": a sensor has an empty name");
+    const bool plain = !s.name.empty() && s.name.size() <= 64 &&
+                       std::all_of(s.name.begin(), s.name.end(), [](char ch) {
+                         return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                       });
+    if (!plain)
+      throw InputError(where + ": sensor name '" + s.name +
+                       "': must be 1..64 letters, digits or '_' (it becomes a CSV column)");
     Positive(s.tau_min, where + ": sensor '" + s.name + "' tau_min [min]");
   }
 }

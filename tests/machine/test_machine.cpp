@@ -1,15 +1,19 @@
 // Machine thermal errors (issue 19): each component against its closed form, the sensor run files
 // against the drift format, and "machine off = workpiece only" exactly.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "compare/machine_eval.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
 #include "core/process.h"
+#include "core/safe_text.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"
@@ -191,6 +195,46 @@ TEST(MachineEvaluation, EveryComponentOffEqualsTheWorkpieceOnlyComparisonExactly
   const machine::MachineDay on = machine::MachineDay::Draw(machine::DefaultMachine(), 2, 3);
   const MachineEvalScrew w = EvaluateScrewOnMachine(screw, f.model, f.rule, f.iso, on, none, co);
   EXPECT_GT(std::abs(w.metrics[0].accumulated_total_um - m.metrics[0].accumulated_total_um), 1.0);
+}
+
+}  // namespace
+}  // namespace whirl::compare
+
+namespace whirl::compare {
+namespace {
+
+TEST(MachineReport, HostileNamesStayText) {
+  const std::string hostile = "a'b\"c\\d\n<script>alert(1)</script>";
+  MachineEvalScrew r;
+  r.ok = true;
+  r.screw.name = hostile;
+  MachineScrewDetail d;
+  machine::MachineConfig c = machine::DefaultMachine();
+  d.log = machine::SimulateRun(machine::MachineDay::Draw(c, 1, 1),
+                               {"log", drift::RunState::kCutting, 20, 180, 1});
+  d.log.sensor_names.front() = hostile;  // past the machine file's name rule, to test escaping
+  c.sensors.front().name = hostile;
+  EXPECT_THROW(c.Validate("test"), InputError);
+  for (auto& l : d.leads) {
+    l.position_mm = {0, 1, 2};
+    l.deviation_um = {0, 0.5, 1};
+  }
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("whirl_machine_report_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const std::string index = WriteMachineScrewReport(dir.string(), r, d, {hostile}, {});
+  std::ifstream in(index);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(html.find("<script>"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;"), std::string::npos);
+  std::ifstream gp(dir / "sensors.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  EXPECT_NE(script.find(GnuplotString(hostile)), std::string::npos);
+  EXPECT_NE(script.find("noenhanced"), std::string::npos);
+  // A second report into the same (now non-empty) folder is refused; nothing partial remains.
+  EXPECT_THROW(WriteMachineScrewReport(dir.string(), r, d, {}, {}), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir.string() + ".partial"));
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
