@@ -14,6 +14,4 @@ target_sources(whirl_compare PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/compare.cpp
   ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp
   ${CMAKE_CURRENT_LIST_DIR}/scenarios.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/report.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/machine_eval.cpp  # issue 19
-  ${CMAKE_CURRENT_LIST_DIR}/machine_report.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/report.cpp)
