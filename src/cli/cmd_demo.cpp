@@ -9,7 +9,6 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/compare.h"
-#include "compare/machine_eval.h"
 #include "compare/report.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -17,6 +16,8 @@
 #include "interp/machine_profile.h"
 #include "nn/model.h"
 #include "sim/screw.h"
+
+#include "compare/machine_eval.h"  // step 7 (issue 19)
 
 namespace whirl::cli {
 namespace {
