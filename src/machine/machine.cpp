@@ -47,6 +47,12 @@ void MachineConfig::DisableAll() {
 }
 
 void MachineConfig::Validate(const std::string& where) const {
+  if (name.empty() || name.size() > 100 || std::any_of(name.begin(), name.end(), [](char ch) {
+        return std::iscntrl(static_cast<unsigned char>(ch)) != 0;
+      }))
+    throw InputError(where +
+                     ": name must be 1..100 characters without control characters (it "
+                     "goes into file comments)");
   if (head.sign != 1 && head.sign != -1) throw InputError(where + ": head.sign must be +1 or -1");
   NonNegative(head.idle_power_kw, where + ": head.idle_power_kw [kW]");
   NonNegative(head.cutting_power_kw, where + ": head.cutting_power_kw [kW]");
@@ -320,7 +326,7 @@ drift::Run SimulateRun(const MachineDay& day, const RunSpec& spec) {
   const double v_c = spec.cutting_speed_m_min;
   drift::Run run;
   run.name = spec.name;
-  run.source = spec.name;
+  run.source = "the simulated log of machine '" + c.name + "'";
   run.state = spec.state;
   const std::size_t m = c.sensors.size();
   for (const auto& s : c.sensors) run.sensor_names.push_back(s.name + "_C");

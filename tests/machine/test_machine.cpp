@@ -114,6 +114,9 @@ TEST(MachineConfigFile, ShippedJsonEqualsDefaultAndRejectsTypos) {
   MachineConfig n = DefaultMachine();
   from_json(neg, n);
   EXPECT_THROW(n.Validate("test"), InputError);
+  MachineConfig named = DefaultMachine();
+  named.name = "a\n# injected";
+  EXPECT_THROW(named.Validate("test"), InputError);
 }
 
 TEST(MachineSensors, RunRoundTripsThroughTheDriftFormatAndFits) {
