@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   RegisterBallbar(app);
   RegisterSurface(app);
   RegisterDrift(app);
+  RegisterMachine(app);
   RegisterTorchForwarders(app);
   return RunApp(app, argc, argv);
 }

@@ -11,4 +11,7 @@ for f in reference_80x10x6000_plan.json reference_80x10x6000_plan.csv reference_
   test -s "out/$f" || { echo "missing out/$f"; exit 1; }
 done
 grep -q "SA_TEMP_COMP" out/reference_80x10x6000_temp_comp.spf
+test -s out/machine_report/index.html || { echo "missing machine report"; exit 1; }
+grep -q "both halves on a drifting machine" demo.txt
+
 echo OK

@@ -1,0 +1,156 @@
+#pragma once
+// Both halves in one cut (issue 19, point 4): the comparison of compare/compare.h on a whirling
+// machine that drifts (machine/machine.h), compensated by the workpiece plan, by a machine drift
+// model, or by both.
+//
+// Truth of one screw on machine i, day d: e_tot(t) = e(t) + m(t, z(t)), e the workpiece truth of
+// CompareScrew (same seed, disturbances on), m the machine drift at the tool position
+// z(t) = thread_start_position - v_f t. Lead deviation: compare/cut.h with e_tot.
+// Strategies (compensation c(t), um):
+//   none            0
+//   traditional     the class-mean curve's 840D plan (as in compare.h)
+//   workpiece       the network's 840D plan (compare.h "model")
+//   machine         the machine model (trained on cutting runs) only:
+//                   c_m(t) = K0(t) + G(t) (z_fixed - z(t)) / 1000, K0 and G the drift models of
+//                   offset_um and zscrew_per_1000_um evaluated on the screw's own sensor log,
+//                   linearly interpolated between its samples (the control evaluates the model
+//                   every interpolation cycle from inputs read continuously)
+//   both            workpiece + machine (cutting-trained)
+//   both_idle       workpiece + machine trained on idle warm-ups (seed 000's comparison)
+//   both_monitor    both, with the offset model kept valid by seed 004's check bar
+//                   (drift/monitor.h MonitorRun on the screw's log: a check every
+//                   `monitor_every_min`, measured at the fixed end (offset_um) with N(0, 0.5 um)
+//                   noise, 3-sigma threshold, rule `offset` from the invalid check alone; the
+//                   stops are not simulated: the log goes on as if the cut never paused)
+// Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
+// `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
+// drift::FitDriftModel (kind and sensor selection from `fit`, default seed 000's MLR on the
+// selected points) for each channel. With every machine component off, m = 0 and no machine
+// model is fitted (c_m = 0): every strategy then equals its workpiece-only counterpart exactly.
+// What is left (both): the residual lead error of the workpiece part (e - c_wp) and of the machine
+// part (m - c_m) are measured separately; the larger accumulated error over the thread dominates.
+// The uncompensated pattern is split the same way into workpiece, head, Z screw and bed.
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "compare/evaluate.h"
+#include "drift/model.h"
+#include "machine/machine.h"
+
+namespace whirl::compare {
+
+enum class MachineStrategy {
+  kNone,
+  kTraditional,
+  kWorkpiece,
+  kMachine,
+  kBoth,
+  kBothIdle,
+  kBothMonitor
+};
+inline constexpr std::size_t kMachineStrategyCount = 7;
+/// none, traditional, workpiece, machine, both, both_idle, both_monitor
+std::string ToString(MachineStrategy s);
+
+/// Sources of the uncompensated lead error (accumulated over the thread, um, each alone).
+enum class ErrorSource { kWorkpiece, kHead, kZScrew, kBed };
+inline constexpr std::size_t kErrorSourceCount = 4;
+std::string ToString(ErrorSource s);  ///< workpiece, head, z_screw, bed
+
+struct MachineEvalOptions {
+  machine::MachineConfig machine = machine::DefaultMachine();
+  int machines = 2;            ///< machines drawn (1..50)
+  int screws_per_machine = 3;  ///< random screws per machine (1..200)
+  int train_runs = 2;          ///< idle and cutting training runs per machine (1..20)
+  std::uint64_t seed = 1;
+  CompareOptions compare;
+  drift::FitOptions fit;  ///< threads are forced to 1 (the screws run in parallel)
+  int threads = 2;
+  double monitor_every_min = 30;  ///< both_monitor: check interval, min (> 0)
+  /// Non-empty: WriteMachineScrewReport of the first screw (machine 0) into this folder.
+  std::string report_dir;
+};
+
+/// The machine models of one machine.
+struct MachineModels {
+  bool fitted = false;  ///< false when every machine component is off
+  drift::DriftModel offset_cutting, slope_cutting, offset_idle, slope_idle;
+};
+
+struct MachineEvalScrew {
+  int machine = 0;
+  sim::Screw screw;
+  std::uint64_t seed = 0, day_seed = 0;
+  bool ok = false;
+  std::string error;
+  std::array<LeadMetrics, kMachineStrategyCount> metrics;
+  std::array<IsoClass, kMachineStrategyCount> iso{};
+  /// Uncompensated accumulated error over the thread of each source alone, um.
+  std::array<double, kErrorSourceCount> source_total_um{};
+  /// "both": accumulated error over the thread of the workpiece and machine residuals, um.
+  double residual_workpiece_total_um = 0, residual_machine_total_um = 0;
+};
+
+struct MachineEvalSummary {
+  std::size_t screws = 0, failed = 0;
+  std::array<AbsoluteStats, kMachineStrategyCount> absolute;
+  std::array<double, kMachineStrategyCount> share_p3{}, share_p5{};
+  std::array<double, kErrorSourceCount> source_median_um{};  ///< uncompensated, per source
+  std::size_t residual_workpiece_dominates = 0, residual_machine_dominates = 0;
+  std::string message;
+};
+
+struct MachineEvaluation {
+  std::vector<std::vector<std::string>> sensors_cutting, sensors_idle;  ///< per machine
+  std::vector<MachineEvalScrew> screws;
+  MachineEvalSummary summary;
+  std::string report_index;  ///< index.html of the report, when written
+};
+
+/// Training runs of machine `machine_seed` (idle warm-ups then cutting runs).
+std::vector<drift::Run> TrainingRuns(const machine::MachineConfig& config,
+                                     std::uint64_t machine_seed, int runs, drift::RunState state);
+MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64_t machine_seed,
+                               int runs, const drift::FitOptions& fit);
+
+/// Curves of one screw, for the report: its sensor log and the lead deviation per strategy.
+struct MachineScrewDetail {
+  drift::Run log;  ///< empty when no machine model was fitted
+  std::array<LeadDeviation, kMachineStrategyCount> leads;
+};
+
+/// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
+MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
+                                        const ExperienceRule& rule,
+                                        const IsoToleranceTable& iso_table,
+                                        const machine::MachineDay& day, const MachineModels& models,
+                                        const CompareOptions& options,
+                                        double monitor_every_min = 30,
+                                        MachineScrewDetail* detail = nullptr);
+
+/// Report of one screw in `dir` (must not exist or be empty; written as <dir>.partial, renamed
+/// when complete, so nothing half-written remains): sensors.csv/.png (the screw's sensor log,
+/// degC over min), lead.csv/.png (lead deviation per strategy, um over mm), index.html with the
+/// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
+/// Returns the index path.
+std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
+                                    const MachineScrewDetail& detail,
+                                    const std::vector<std::string>& sensors_cutting,
+                                    const std::vector<std::string>& sensors_idle);
+
+MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
+                                       const ExperienceRule& rule,
+                                       const IsoToleranceTable& iso_table,
+                                       const MachineEvalOptions& options,
+                                       const EvaluateProgress& progress = {});
+
+MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& screws);
+/// Fixed-width text table (strategy: median/worst um within 1000 mm and over the thread, P3/P5).
+std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown);
+
+void to_json(nlohmann::json& j, const MachineEvaluation& e);
+
+}  // namespace whirl::compare

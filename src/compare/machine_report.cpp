@@ -1,0 +1,156 @@
+// Report of one screw cut on a drifting machine (issue 19, point 5): sensor plot, chosen
+// sensors, lead deviation per strategy. User strings (sensor and screw names) reach gnuplot only
+// through GnuplotString (terminal noenhanced) and HTML only through HtmlEscape; gnuplot runs
+// through RunProgram with an argument vector.
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "compare/machine_eval.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
+
+namespace whirl::compare {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
+
+std::string SensorCsv(const drift::Run& log) {
+  std::ostringstream out;
+  out << "time_min";
+  for (const auto& n : log.sensor_names) out << ',' << n;
+  out << '\n';
+  for (int k = 0; k < log.samples(); ++k) {
+    out << log.time_min[static_cast<std::size_t>(k)];
+    for (Eigen::Index s = 0; s < log.temperature_C.cols(); ++s)
+      out << ',' << log.temperature_C(k, s);
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::string LeadCsv(const MachineScrewDetail& d) {
+  std::ostringstream out;
+  out << "position_mm";
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
+    out << ',' << ToString(static_cast<MachineStrategy>(k)) << "_um";
+  out << '\n';
+  const std::size_t n = d.leads[0].size();
+  for (std::size_t i = 0; i < n; i += 10) {  // every 10th sample: the curves are smooth
+    out << d.leads[0].position_mm[i];
+    for (const auto& l : d.leads) out << ',' << l.deviation_um[i];
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::string SensorScript(const drift::Run& log, const std::string& title) {
+  std::string gp =
+      "set datafile separator ','\nset key outside right\nset grid\n"
+      "set xlabel 'time [min]'\nset ylabel 'temperature [degC]'\nset title " +
+      GnuplotString(title) + "\nplot ";
+  for (std::size_t s = 0; s < log.sensor_names.size(); ++s)
+    gp += (s ? ", " : "") + std::string("'sensors.csv' using 1:") + std::to_string(s + 2) +
+          " with lines dt " + std::to_string(s / 8 + 1) + " title " +
+          GnuplotString(log.sensor_names[s]);  // 8 colours, then dashes
+  return gp + "\n";
+}
+
+std::string LeadScript(const std::string& title) {
+  std::string gp =
+      "set datafile separator ','\nset key outside right\nset grid\n"
+      "set xlabel 'position along the thread [mm]'\n"
+      "set ylabel 'travel deviation [um]'\nset title " +
+      GnuplotString(title) + "\nplot ";
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
+    gp += (k ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(k + 2) +
+          " with lines lw 2 title " + GnuplotString(ToString(static_cast<MachineStrategy>(k)));
+  return gp + "\n";
+}
+
+// Renders <stem>.gp into <stem>.png inside dir; returns the <img> tag or a note.
+std::string Render(const fs::path& dir, const std::string& stem, const std::string& body) {
+  WriteFileAtomic(dir / (stem + ".gp"), std::string(kTerminal) + "set output " +
+                                            GnuplotString(stem + ".png") + "\n" + body);
+  if (!ProgramSucceeds({"gnuplot", "--version"}))
+    return "<p>(gnuplot not found: " + HtmlEscape(stem) + ".gp not rendered)</p>";
+  const int rc = RunProgram({"gnuplot", stem + ".gp"}, dir, dir / "gnuplot.log");
+  if (rc != 0 || !fs::exists(dir / (stem + ".png")))
+    return "<p>(gnuplot failed on " + HtmlEscape(stem) + ".gp, see gnuplot.log)</p>";
+  return "<img src='" + HtmlEscape(stem + ".png") + "' alt='" + HtmlEscape(stem) + "'>";
+}
+
+std::string List(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + HtmlEscape(n);
+  return s.empty() ? "(none: no machine model)" : s;
+}
+
+std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
+                 const std::vector<std::string>& idle, const std::string& sensor_img,
+                 const std::string& lead_img) {
+  std::string h = "<!doctype html><html><head><meta charset='utf-8'><title>" +
+                  HtmlEscape(r.screw.name) + ": both halves</title></head><body><h1>" +
+                  HtmlEscape(r.screw.name) +
+                  ": workpiece and machine drift in one cut (simulated)</h1>"
+                  "<p>Chosen sensors of the machine's offset model, trained cutting: " +
+                  List(cutting) + "; trained idle: " + List(idle) + ".</p><h2>Sensors</h2>" +
+                  sensor_img + "<h2>Lead deviation per strategy</h2>" + lead_img +
+                  "<table border='1' cellpadding='4'><tr><th>strategy</th><th>within 1000 mm "
+                  "[um]</th><th>over the thread [um]</th><th>ISO class</th></tr>";
+  char buf[256];
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+    std::snprintf(buf, sizeof buf, "<tr><td>%s</td><td>%.1f</td><td>%.1f</td><td>%s</td></tr>",
+                  ToString(static_cast<MachineStrategy>(k)).c_str(),
+                  r.metrics[k].accumulated_1000_um, r.metrics[k].accumulated_total_um,
+                  HtmlEscape(ToString(r.iso[k])).c_str());
+    h += buf;
+  }
+  std::snprintf(buf, sizeof buf,
+                "</table><p>Left after both, over the thread: workpiece part %.1f um, machine "
+                "part %.1f um.</p></body></html>\n",
+                r.residual_workpiece_total_um, r.residual_machine_total_um);
+  return h + buf;
+}
+
+}  // namespace
+
+std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
+                                    const MachineScrewDetail& detail,
+                                    const std::vector<std::string>& sensors_cutting,
+                                    const std::vector<std::string>& sensors_idle) {
+  if (!screw.ok) throw InputError("report of screw '" + screw.screw.name + "': " + screw.error);
+  const fs::path target = fs::absolute(dir);
+  std::error_code ec;
+  if (fs::exists(target) && !fs::is_empty(target, ec))
+    throw InputError("report directory '" + dir + "': exists and is not empty");
+  const fs::path partial = target.string() + ".partial";
+  fs::remove_all(partial, ec);
+  fs::create_directories(partial, ec);
+  if (ec) throw InputError("report directory '" + partial.string() + "': " + ec.message());
+  try {
+    std::string sensor_img = "<p>(no sensor log: the machine does not drift)</p>";
+    if (detail.log.samples() > 0) {
+      WriteFileAtomic(partial / "sensors.csv", SensorCsv(detail.log));
+      sensor_img = Render(partial, "sensors",
+                          SensorScript(detail.log, screw.screw.name + ": virtual sensors"));
+    }
+    WriteFileAtomic(partial / "lead.csv", LeadCsv(detail));
+    const std::string lead_img =
+        Render(partial, "lead", LeadScript(screw.screw.name + ": lead deviation"));
+    WriteFileAtomic(partial / "index.html",
+                    Html(screw, sensors_cutting, sensors_idle, sensor_img, lead_img));
+    fs::remove(target, ec);  // an empty directory only
+    fs::rename(partial, target);
+  } catch (...) {
+    fs::remove_all(partial, ec);
+    throw;
+  }
+  return (target / "index.html").string();
+}
+
+}  // namespace whirl::compare

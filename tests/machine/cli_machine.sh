@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Smoke test of 'whirl machine' (issue 19): sensor files round-trip through 'whirl drift fit /
+# predict', the evaluation runs and its machine-off figures equal the workpiece-only truth,
+# bad input is refused with exit 1 and nothing written, the combined 840D programs are written by
+# the existing combined mode.
+set -u
+W="$1"; D="$2"; S="$3"
+rm -rf "$D"; mkdir -p "$D"
+source "$S/tests/support/cli_common.sh"
+
+"$W" machine --help > "$D/help.txt" || fail "machine --help"
+"$W" machine evaluate --help | grep -q "um" || fail "evaluate --help names no unit"
+"$W" machine sensors --out "$D/runs" --idle 1 --cutting 2 > "$D/sensors.txt" || fail "sensors"
+[ -f "$D/runs/idle_1.csv" ] && [ -f "$D/runs/cutting_2.csv" ] || fail "run files missing"
+n=$(grep -v '^#' "$D/runs/cutting_1.csv" | head -n 1 | tr ',' '\n' | grep -c '_C$')
+[ "$n" -ge 10 ] && [ "$n" -le 16 ] || fail "expected 10-16 sensors, got $n"
+"$W" drift fit --cutting "$D/runs/cutting_1.csv" --error offset_um --out "$D/offset.json" \
+  > /dev/null 2>&1 || fail "drift fit on a sensor file"
+"$W" drift predict --model "$D/offset.json" --run "$D/runs/cutting_2.csv" --json > "$D/pred.json" \
+  2>/dev/null || fail "drift predict on a sensor file"
+grep -q '"residual"' "$D/pred.json" || fail "prediction has no residual"
+
+# Evaluation: JSON output, and with the machine off the machine strategy equals none.
+"$W" machine evaluate --machines 1 --screws 2 --json > "$D/eval.json" 2>/dev/null || fail "evaluate"
+"$W" machine evaluate --machines 1 --screws 2 --machine-off --json > "$D/off.json" 2>/dev/null \
+  || fail "evaluate --machine-off"
+python3 - "$D/off.json" "$D/eval.json" <<'PY' || fail "machine off: machine != none or both != workpiece"
+import json, sys
+s = json.load(open(sys.argv[1]))["summary"]["strategies"]
+assert s["machine"] == s["none"], (s["machine"], s["none"])
+assert s["both"] == s["workpiece"], (s["both"], s["workpiece"])
+on = json.load(open(sys.argv[2]))["summary"]["strategies"]
+assert on["none"] != s["none"]
+PY
+
+# Bad input: a typo in the machine file, a missing named file; nothing written.
+sed 's/"motor_tau_min"/"motor_tau_mn"/' "$S/datasets/machines/whirling_thermal.json" > "$D/bad.json"
+expect_fail "motor_tau_mn" "$W" machine sensors --machine "$D/bad.json" --out "$D/none"
+[ ! -e "$D/none" ] || fail "files written on bad input"
+expect_fail "missing.json" "$W" machine sensors --machine "$D/missing.json" --out "$D/none"
+
+# Combined 840D programs with the existing combined mode: the plan writes its K0 into
+# $AC_PARAM, the machine drift action (the offset model) is the single writer of SD43900.
+P="$S/datasets/machines/example_840d.json"
+inputs=()
+k=1
+for s in $(python3 -c "import json,sys; print(' '.join(json.load(open(sys.argv[1]))['sensors']))" "$D/offset.json"); do
+  inputs+=(--input "$s=$k:0.1:0"); k=$((k + 1))
+done
+"$W" plan --screw "$S/datasets/screws/reference_80x10x6000.json" --machine "$P" \
+  --model "$S/models/default.json" --with-drift-action --nc "$D/PLAN.SPF" > "$D/plan.txt" 2>&1 || fail "plan --with-drift-action: $(cat "$D/plan.txt")"
+"$W" drift nc --model "$D/offset.json" --machine "$P" "${inputs[@]}" --nc "$D/DRIFT.SPF" \
+  > "$D/nc.txt" 2>&1 || fail "drift nc with the machine model: $(cat "$D/nc.txt")"
+grep -q 'AC_PARAM' "$D/PLAN.SPF" || fail "plan does not hand its K0 over"
+grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/DRIFT.SPF" || fail "drift action does not write SD43900"
+echo "cli_machine: ok"

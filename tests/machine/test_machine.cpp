@@ -1,0 +1,244 @@
+// Machine thermal errors (issue 19): each component against its closed form, the sensor run files
+// against the drift format, and "machine off = workpiece only" exactly.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "compare/machine_eval.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/json_file.h"
+#include "core/process.h"
+#include "core/safe_text.h"
+#include "drift/model.h"
+#include "drift/run_file.h"
+#include "machine/machine.h"
+#include "nn/model.h"
+#include "sim/random.h"
+#include "sim/screw.h"
+
+namespace whirl::machine {
+namespace {
+
+MachineDay Nominal() {  // no spread: parameters exactly as configured
+  MachineConfig c = DefaultMachine();
+  c.machine_spread = 0;
+  c.power_spread = 0;
+  MachineDay d = MachineDay::Draw(c, 1, 1);
+  d.ambient_rate_k_per_h = 0.6;
+  return d;
+}
+
+TEST(MachineHead, FirstOrderStepResponse) {
+  MachineDay d = Nominal();
+  d.config.head.process_gain_um_per_kw = 0;
+  const HeadComponent& h = d.config.head;
+  const double tau = h.motor_tau_min, steady = h.motor_gain_um_per_kw * h.idle_power_kw;
+  EXPECT_EQ(d.HeadUm(0, false, 180), 0.0);
+  // 63.2 % of the steady value after one time constant, 95.0 % after three, then steady.
+  EXPECT_NEAR(d.HeadUm(tau, false, 180), steady * (1 - std::exp(-1.0)), 1e-12);
+  EXPECT_NEAR(d.HeadUm(3 * tau, false, 180) / steady, 0.950213, 1e-6);
+  EXPECT_NEAR(d.HeadUm(50 * tau, false, 180), steady, 1e-9);
+  // Slope at t = 0 is steady / tau (finite difference).
+  const double dt = 1e-6;
+  EXPECT_NEAR(d.HeadUm(dt, false, 180) / dt, steady / tau, 1e-4 * steady / tau);
+  // Cutting adds the process source, proportional to the cutting speed.
+  MachineDay p = Nominal();
+  p.config.head.motor_gain_um_per_kw = 0;
+  const double t = 17;
+  EXPECT_NEAR(p.HeadUm(t, true, 200) / p.HeadUm(t, true, 100), 2.0, 1e-12);
+  EXPECT_EQ(p.HeadUm(t, false, 200), 0.0);
+}
+
+TEST(MachineZScrew, LinearGrowthFromTheFixedEnd) {
+  MachineDay d = Nominal();
+  d.config.ambient.enabled = false;  // own heating only
+  const double t = 60, z_fixed = d.config.z_screw.fixed_end_mm;
+  const auto& z = d.config.z_screw;
+  const double dT = z.steady_rise_k * (1 - std::exp(-t / z.tau_min));
+  // Zero at the fixed end, linear in the distance from it: alpha dT (z_fixed - z) [um].
+  d.config.head.enabled = false;
+  EXPECT_NEAR(d.DriftUm(t, z_fixed, true, 180), 0.0, 1e-12);
+  for (double zz : {0.0, 1000.0, 2500.0, 6000.0})
+    EXPECT_NEAR(d.DriftUm(t, zz, true, 180), 1000.0 * z.expansion_per_k * dT * (z_fixed - zz),
+                1e-9);
+  // No Z heating while idle (the axis stands).
+  EXPECT_EQ(d.ZScrewPer1000Um(t, false), 0.0);
+}
+
+TEST(MachineAmbient, BedFollowsTheRampWithItsLag) {
+  MachineDay d = Nominal();
+  const double tau = d.config.ambient.bed_tau_min, r = d.ambient_rate_k_per_h / 60.0;
+  // Closed form of a first-order lag of a ramp; check its ODE by finite differences:
+  // tau dT/dt + T = r t.
+  for (double t : {5.0, 30.0, 200.0}) {
+    const double h = 1e-4;
+    const double deriv = (d.BedRiseK(t + h) - d.BedRiseK(t - h)) / (2 * h);
+    EXPECT_NEAR(tau * deriv + d.BedRiseK(t), r * t, 1e-7);
+  }
+  // Bed growth over the chuck-to-fixed-bearing distance moves the tool away from the chuck.
+  EXPECT_NEAR(
+      d.BedUm(100),
+      -1000 * d.config.ambient.expansion_per_k * d.BedRiseK(100) * d.config.z_screw.fixed_end_mm,
+      1e-12);
+}
+
+TEST(MachineDraw, SameSeedSameMachine) {
+  const MachineConfig c = DefaultMachine();
+  const MachineDay a = MachineDay::Draw(c, 7, 3), b = MachineDay::Draw(c, 7, 3);
+  const MachineDay other = MachineDay::Draw(c, 8, 3), day = MachineDay::Draw(c, 7, 4);
+  EXPECT_EQ(a.config.head.motor_gain_um_per_kw, b.config.head.motor_gain_um_per_kw);
+  EXPECT_EQ(a.ambient_rate_k_per_h, b.ambient_rate_k_per_h);
+  EXPECT_NE(a.config.head.motor_gain_um_per_kw, other.config.head.motor_gain_um_per_kw);
+  // Another day on the same machine: same machine factors, another ambient rate.
+  EXPECT_EQ(a.config.head.motor_gain_um_per_kw, day.config.head.motor_gain_um_per_kw);
+  EXPECT_NE(a.ambient_rate_k_per_h, day.ambient_rate_k_per_h);
+}
+
+TEST(MachineConfigFile, ShippedJsonEqualsDefaultAndRejectsTypos) {
+  const std::string path =
+      std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_thermal.json";
+  const MachineConfig shipped = ReadMachine(path);
+  nlohmann::json a = shipped, b = DefaultMachine();
+  EXPECT_EQ(a, b);
+  nlohmann::json bad = b;
+  bad["head"]["motor_tau_mn"] = 3;
+  MachineConfig m;
+  EXPECT_THROW(from_json(bad, m), InputError);
+  nlohmann::json neg = b;
+  neg["z_screw"]["tau_min"] = -1;
+  MachineConfig n = DefaultMachine();
+  from_json(neg, n);
+  EXPECT_THROW(n.Validate("test"), InputError);
+  MachineConfig named = DefaultMachine();
+  named.name = "a\n# injected";
+  EXPECT_THROW(named.Validate("test"), InputError);
+}
+
+TEST(MachineSensors, RunRoundTripsThroughTheDriftFormatAndFits) {
+  MachineConfig c = DefaultMachine();
+  const MachineDay day = MachineDay::Draw(c, 3, 5);
+  RunSpec spec{"cut", drift::RunState::kCutting, 150, 190, 11};
+  const drift::Run run = SimulateRun(day, spec);
+  ASSERT_EQ(run.sensor_names.size(), c.sensors.size());
+  EXPECT_GE(run.sensor_names.size(), 10u);
+  EXPECT_LE(run.sensor_names.size(), 16u);
+  EXPECT_EQ(run.samples(), 151);
+  // Quantized to the sensor's 1/16 K.
+  for (Eigen::Index k = 0; k < run.temperature_C.size(); ++k) {
+    const double q = run.temperature_C.data()[k] / c.quantum_k;
+    EXPECT_NEAR(q, std::round(q), 1e-9);
+  }
+  // Error channels are the closed forms at the sample times.
+  EXPECT_NEAR(run.error_um(60, 0), day.HeadUm(60, true, 190) + day.BedUm(60), 1e-12);
+  EXPECT_NEAR(run.error_um(60, 1), day.ZScrewPer1000Um(60, true), 1e-12);
+  // Round trip: format -> parse gives the same numbers (to the printed precision).
+  const drift::Run back =
+      drift::ParseRun(drift::FormatRun(run, {"test"}), "cut.csv", drift::RunState::kCutting);
+  ASSERT_EQ(back.sensor_names, run.sensor_names);
+  ASSERT_EQ(back.error_names, run.error_names);
+  EXPECT_LT((back.temperature_C - run.temperature_C).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT((back.error_um - run.error_um).cwiseAbs().maxCoeff(), 1e-6);
+  // A regression on two cutting runs predicts a third run of the same machine well.
+  std::vector<drift::Run> train = {
+      SimulateRun(MachineDay::Draw(c, 3, 6), {"a", drift::RunState::kCutting, 150, 160, 12}),
+      SimulateRun(MachineDay::Draw(c, 3, 7), {"b", drift::RunState::kCutting, 150, 205, 13})};
+  drift::FitOptions fo;
+  fo.threads = 1;
+  const drift::DriftModel model = drift::FitDriftModel(train, "offset_um", fo).model;
+  const drift::RunPrediction p = drift::PredictRun(model, back);
+  const double range = back.error_um.col(0).maxCoeff() - back.error_um.col(0).minCoeff();
+  EXPECT_LT((p.predicted_um - back.error_um.col(0)).cwiseAbs().maxCoeff(), 0.25 * range);
+}
+
+}  // namespace
+}  // namespace whirl::machine
+
+namespace whirl::compare {
+namespace {
+
+struct Fixture {
+  nn::Model model = nn::LoadModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
+  ExperienceRule rule = BuildExperienceRule(
+      ReadProcessTable(std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_500.csv", true));
+  IsoToleranceTable iso = ReadIsoToleranceTable(
+      std::string(WHIRL_SOURCE_DIR) + "/datasets/standards/iso3408_3_lead_tolerances.csv");
+};
+
+TEST(MachineEvaluation, EveryComponentOffEqualsTheWorkpieceOnlyComparisonExactly) {
+  Fixture f;
+  machine::MachineConfig off = machine::DefaultMachine();
+  off.DisableAll();
+  const machine::MachineDay day = machine::MachineDay::Draw(off, 2, 3);
+  const MachineModels none;  // nothing fitted when the machine does not drift
+  const sim::Screw screw = RandomFeasibleScrews(sim::ReferenceScrew(), 1, 5).front();
+  CompareOptions co;
+  co.seed = 9;
+  const MachineEvalScrew m = EvaluateScrewOnMachine(screw, f.model, f.rule, f.iso, day, none, co);
+  const ScrewComparison c = CompareScrew(screw, f.model, f.rule, f.iso, co);
+  auto same = [](const LeadMetrics& a, const LeadMetrics& b) {
+    EXPECT_EQ(a.accumulated_1000_um, b.accumulated_1000_um);
+    EXPECT_EQ(a.accumulated_total_um, b.accumulated_total_um);
+    EXPECT_EQ(a.e_a_um, b.e_a_um);
+    EXPECT_EQ(a.v_300_um, b.v_300_um);
+  };
+  same(m.metrics[0], c.Outcome(Strategy::kNone).metrics);
+  same(m.metrics[1], c.Outcome(Strategy::kTraditional).metrics);
+  same(m.metrics[2], c.Outcome(Strategy::kModel).metrics);
+  same(m.metrics[3], c.Outcome(Strategy::kNone).metrics);
+  same(m.metrics[4], c.Outcome(Strategy::kModel).metrics);
+  EXPECT_EQ(m.source_total_um[1], 0.0);
+  EXPECT_EQ(m.source_total_um[2], 0.0);
+  EXPECT_EQ(m.source_total_um[3], 0.0);
+  // And with the machine on, the truth differs (the test above can fail).
+  const machine::MachineDay on = machine::MachineDay::Draw(machine::DefaultMachine(), 2, 3);
+  const MachineEvalScrew w = EvaluateScrewOnMachine(screw, f.model, f.rule, f.iso, on, none, co);
+  EXPECT_GT(std::abs(w.metrics[0].accumulated_total_um - m.metrics[0].accumulated_total_um), 1.0);
+}
+
+}  // namespace
+}  // namespace whirl::compare
+
+namespace whirl::compare {
+namespace {
+
+TEST(MachineReport, HostileNamesStayText) {
+  const std::string hostile = "a'b\"c\\d\n<script>alert(1)</script>";
+  MachineEvalScrew r;
+  r.ok = true;
+  r.screw.name = hostile;
+  MachineScrewDetail d;
+  machine::MachineConfig c = machine::DefaultMachine();
+  d.log = machine::SimulateRun(machine::MachineDay::Draw(c, 1, 1),
+                               {"log", drift::RunState::kCutting, 20, 180, 1});
+  d.log.sensor_names.front() = hostile;  // past the machine file's name rule, to test escaping
+  c.sensors.front().name = hostile;
+  EXPECT_THROW(c.Validate("test"), InputError);
+  for (auto& l : d.leads) {
+    l.position_mm = {0, 1, 2};
+    l.deviation_um = {0, 0.5, 1};
+  }
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("whirl_machine_report_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const std::string index = WriteMachineScrewReport(dir.string(), r, d, {hostile}, {});
+  std::ifstream in(index);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(html.find("<script>"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;"), std::string::npos);
+  std::ifstream gp(dir / "sensors.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  EXPECT_NE(script.find(GnuplotString(hostile)), std::string::npos);
+  EXPECT_NE(script.find("noenhanced"), std::string::npos);
+  // A second report into the same (now non-empty) folder is refused; nothing partial remains.
+  EXPECT_THROW(WriteMachineScrewReport(dir.string(), r, d, {}, {}), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir.string() + ".partial"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace whirl::compare
