@@ -94,7 +94,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "(disturbed)', \\\n"
     << "  '' using 1:3 with lines ls 2 title 'predicted arctan curve (model)', \\\n"
     << "  '' using 1:5 with lines ls 3 title '840D compensation applied (model plan)', \\\n"
-    << "  '' using 1:4 with lines ls 4 title 'traditional compensation (experience ramp)', \\\n"
+    << "  '' using 1:4 with lines ls 4 title 'traditional compensation (class-mean curve, 840D plan)', \\\n"
     << "  " << GnuplotString(slug + "_points.csv")
     << " using 1:3 with points ls 5 title 'compensation points "
     << "(SD43900/10/20 breakpoints)'\n"
@@ -110,7 +110,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "set xrange [0:" << l << "]\nset yrange [*:*]\n"
     << "plot " << GnuplotString(slug + "_lead.csv")
     << " using 1:2 with lines ls 2 title 'no compensation', \\\n"
-    << "  '' using 1:3 with lines ls 4 title 'traditional (experience rule)', \\\n"
+    << "  '' using 1:3 with lines ls 4 title 'traditional (class-mean curve)', \\\n"
     << "  '' using 1:4 with lines ls 3 title 'model-based (840D plan)'\n"
     << "set output\n";
   s << "set output " << GnuplotString(f.lead_start) << "\n"
