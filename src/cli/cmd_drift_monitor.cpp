@@ -107,8 +107,10 @@ void RunMonitor(MonitorArgs& a) {
     for (const auto& w : rep.warnings) Warn(w);
     std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
   }
-  if (!a.timeline.empty()) WriteFileAtomic(a.timeline, timeline);
-  if (!a.events.empty()) WriteFileAtomic(a.events, events);
+  std::vector<std::pair<std::filesystem::path, std::string>> files;
+  if (!a.timeline.empty()) files.emplace_back(a.timeline, timeline);
+  if (!a.events.empty()) files.emplace_back(a.events, events);
+  WriteFilesAtomic(files);  // both or neither
   if (a.json)
     PrintJson(drift::MonitorJson(r, a.o));
   else

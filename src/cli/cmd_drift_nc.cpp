@@ -48,13 +48,15 @@ void Run(const DriftNcOptions& o) {
     const auto [name, a] = ParseInput(text);
     options.inputs[name] = a;
   }
-  // Render everything first: a failure writes nothing.
+  // Render everything first (a model the control cannot run fails here), then write all or none.
   const std::string nc = interp::FormatDriftNcProgram(model, options, o.model_path);
   const std::string reset = interp::FormatDriftNcResetProgram(options);
   const std::string csv = interp::FormatDriftPlcCsv(model, options);
-  if (!o.nc_path.empty()) WriteFileAtomic(o.nc_path, nc);
-  if (!o.reset_path.empty()) WriteFileAtomic(o.reset_path, reset);
-  if (!o.csv_path.empty()) WriteFileAtomic(o.csv_path, csv);
+  std::vector<std::pair<std::filesystem::path, std::string>> files;
+  if (!o.nc_path.empty()) files.emplace_back(o.nc_path, nc);
+  if (!o.reset_path.empty()) files.emplace_back(o.reset_path, reset);
+  if (!o.csv_path.empty()) files.emplace_back(o.csv_path, csv);
+  WriteFilesAtomic(files);
   if (o.json) {
     const Eigen::VectorXd c = interp::DriftControlCoefficients(model, options);
     PrintJson({{"model", o.model_path},

@@ -2,6 +2,8 @@
 // 2 % and leaves the other terms near zero; standard errors match the scatter; bad traces fail.
 #include <gtest/gtest.h>
 
+#include "support/expect_error.h"
+
 #include <cmath>
 
 #include "ballbar/circle.h"
@@ -165,16 +167,6 @@ TEST(Circle, TramCorrectsTheXzParallelism) {
   EXPECT_NEAR(d.parallelism_urad, d.squareness_urad - 15, 1e-12);
   o.plane = Plane::kXY;
   EXPECT_THROW(FitCircle(SimulateCircle(p), o), InputError);
-}
-
-template <typename F>
-void ExpectInputError(F f, const std::string& fragment) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError (expected '" << fragment << "')";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
 }
 
 TEST(Circle, BadTracesAreClearErrors) {

@@ -2,6 +2,8 @@
 // uncertainty, the bar-expansion correction, averaging, files and SD43900.
 #include <gtest/gtest.h>
 
+#include "support/expect_error.h"
+
 #include <cmath>
 
 #include "ballbar/drift.h"
@@ -193,16 +195,6 @@ TEST(Drift, BlocksSplitWhereReadingsAreMoreThanTheGapApart) {
   DriftOptions o;
   o.block_gap_min = 0.2;
   EXPECT_THROW(ComputeDrift(s.readings, s.pivots_mm, o), InputError);
-}
-
-template <typename F>
-void ExpectInputError(F f, const std::string& fragment) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError (expected '" << fragment << "')";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
 }
 
 TEST(Drift, BadReadingsNameFileLineAndRule) {

@@ -2,6 +2,8 @@
 // differences, degenerate geometry, placement advice.
 #include <gtest/gtest.h>
 
+#include "support/expect_error.h"
+
 #include <Eigen/Geometry>
 #include <cmath>
 
@@ -92,16 +94,6 @@ TEST(Trilateration, JacobianMatchesFiniteDifferencesOfEquations11To17) {
       fd.col(k) = (Trilaterate(f, lp) - Trilaterate(f, lm)) / (2 * h);
     }
     ASSERT_TRUE(test::AllNear(PositionJacobian(c.pivots, c.ball), fd, 1e-6, 1e-7)) << "case " << i;
-  }
-}
-
-template <typename F>
-void ExpectInputError(F f, const std::string& fragment) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError (expected '" << fragment << "')";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
   }
 }
 
