@@ -9,6 +9,14 @@ namespace {
 
 constexpr std::size_t kMaxNcLine = 512;
 
+// Text from files the user supplies (a model's column names, a path) in a comment line or a CSV
+// cell: control characters (a newline would start a new NC block) and ',' become spaces.
+std::string Text(std::string t) {
+  for (char& ch : t)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f || ch == ',') ch = ' ';
+  return t;
+}
+
 std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
 std::string R(int n) { return "R" + std::to_string(n); }
 std::string Num(double v, int decimals) { return FormatFixed(v, decimals); }
@@ -208,9 +216,9 @@ std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOp
   std::string nc;
   nc +=
       "; WHIRL_DRIFT_COMP: SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
-  nc += Line("; model: " + drift::ToString(m.kind) + " of " + m.error_column + " from " +
+  nc += Line("; model: " + drift::ToString(m.kind) + " of " + Text(m.error_column) + " from " +
              std::to_string(m.sensors.size()) + " sensors" +
-             (model_source.empty() ? std::string() : ", file " + model_source));
+             (model_source.empty() ? std::string() : ", file " + Text(model_source)));
   nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + Num(DriftSign(o), 0) +
         " (control_dk " + ToString(o.control_dk) + ", error_direction " +
         std::to_string(o.error_direction) + "); reference " + ToString(o.reference) +
@@ -258,7 +266,7 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
       "u = T - reference_C (sensors; extra inputs: u = T);\n";
   out += "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); SD43900[" + o.axis +
          "] = sum of coefficient_mm_per_unit * feature value, intercept included (mm)\n";
-  out += "# model " + drift::ToString(m.kind) + " of " + m.error_column +
+  out += "# model " + drift::ToString(m.kind) + " of " + Text(m.error_column) +
          "; sign applied (s = " + Num(DriftSign(o), 0) + "); interpolation cycle " +
          Num(o.ipo_cycle_ms, 3) + " ms\n";
   out +=
@@ -275,9 +283,9 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
     const std::string af =
         feat.tau > 0 ? Num(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
                      : "";
-    out += feat.Name(m.time_unit) + "," + feat.input + "," + std::to_string(a.index) + "," +
-           Num(a.scale, kDecimalsDriftCoefficient) + "," + Num(a.offset, 4) + "," + ref + "," +
-           tau + "," + af + "," +
+    out += Text(feat.Name(m.time_unit)) + "," + Text(feat.input) + "," + std::to_string(a.index) +
+           "," + Num(a.scale, kDecimalsDriftCoefficient) + "," + Num(a.offset, 4) + "," + ref +
+           "," + tau + "," + af + "," +
            Num(c(static_cast<Eigen::Index>(f) + 1), kDecimalsDriftCoefficient) + "\n";
   }
   return out;

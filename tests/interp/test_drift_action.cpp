@@ -4,8 +4,10 @@
 // writer owns SD43900 and it equals machine part + workpiece part; the reset programs restore.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -187,6 +189,22 @@ TEST(DriftAction, RefusesWhatTheControlCannotRun) {
   m.kind = drift::ModelKind::kNetwork;
   EXPECT_THROW(FormatDriftNcProgram(m, Options(ControlDk::kAdded, 1, DriftReference::kModel)),
                InputError);
+}
+
+TEST(DriftAction, HostileNamesStayInsideCommentsAndCells) {
+  std::mt19937 rng(1808);
+  drift::DriftModel m = HandModel(true, rng);
+  m.error_column = "ch1_um\nM30\r\n$$SA_TEMP_COMP_SLOPE[Z]=1,x";
+  const DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  replay::Replay r;
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, o, "model\nM30\n.json")));  // no unknown line
+  EXPECT_EQ(r.control.slope, 0.0);
+  std::istringstream csv(FormatDriftPlcCsv(m, o));
+  std::string line;
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 8) << line;
+  }
 }
 
 TEST(DriftAction, GoldenProgramAndPlcTable) {
