@@ -8,7 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"; shift || true
 HARNESSES=("$@")
-[ ${#HARNESSES[@]} -eq 0 ] && HARNESSES=(csv process_table curve screw model lead iso_table)
+[ ${#HARNESSES[@]} -eq 0 ] && HARNESSES=(csv process_table curve screw model lead iso_table drift_run \
+  drift_model machine_profile)
 command -v clang++ > /dev/null || { echo "fuzz: clang++ not found (apt-get install clang)" >&2; exit 1; }
 BUILD="${WHIRL_FUZZ_BUILD_DIR:-build-fuzz}"
 CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHIRL_WITH_TORCH=OFF \
@@ -20,7 +21,8 @@ seeds_of() {  # the shipped files of the harness's kind (read only; new inputs g
     screw) echo datasets/screws ;;
     model) echo models ;;
     iso_table) echo datasets/standards ;;
-    curve|lead) echo "tests/fuzz/seeds/$1" ;;
+    curve|lead|drift_run|drift_model) echo "tests/fuzz/seeds/$1" ;;
+    machine_profile) echo datasets/machines ;;
   esac
 }
 for h in "${HARNESSES[@]}"; do
