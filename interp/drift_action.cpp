@@ -66,15 +66,35 @@ std::string Reading(const AnalogInput& a) {
 struct Layout {
   int per = 1;  // slots per input: value + lags
   int features = 0, ref = 0, flag = 0;
+  int Last() const { return flag; }
 };
 
-Layout MakeLayout(const drift::DriftModel& m, const DriftActionOptions& o) {
+Layout MakeLayout(const drift::DriftModel& m, int first) {
   Layout l;
   l.per = 1 + static_cast<int>(m.time_constants.size());
-  l.features = o.param_first;
+  l.features = first;
   l.ref = l.features + static_cast<int>(m.features.size());
   l.flag = l.ref + static_cast<int>(m.sensors.size());
   return l;
+}
+
+// Slots of one program: the offset model's, then the slope model's and S_m (slope mode).
+struct Slots {
+  Layout offset, slope;
+  int s_m = -1;  // $AC_PARAM holding S_m, -1 without a slope model
+  int last = 0;
+};
+
+Slots MakeSlots(const drift::DriftModel& m, const drift::DriftModel* g, int first) {
+  Slots s;
+  s.offset = MakeLayout(m, first);
+  s.last = s.offset.Last();
+  if (g) {
+    s.slope = MakeLayout(*g, s.last + 1);
+    s.s_m = s.slope.Last() + 1;
+    s.last = s.s_m;
+  }
+  return s;
 }
 
 std::string Line(const std::string& text) {
@@ -85,9 +105,9 @@ std::string Line(const std::string& text) {
   return text + "\n";
 }
 
-// The static actions, in execution order.
-std::vector<std::string> ActionBodies(const drift::DriftModel& m, const DriftActionOptions& o) {
-  const Layout l = MakeLayout(m, o);
+// The actions that turn one model's inputs into its features (rises, lags), in execution order.
+std::vector<std::string> FeatureBodies(const drift::DriftModel& m, const DriftActionOptions& o,
+                                       const Layout& l) {
   const std::vector<std::string> in = Inputs(m);
   const int ns = static_cast<int>(m.sensors.size());
   std::vector<std::string> bodies;
@@ -121,13 +141,57 @@ std::vector<std::string> ActionBodies(const drift::DriftModel& m, const DriftAct
   } else {
     bodies.push_back("WHENEVER " + P(l.flag) + "==0 DO " + P(l.flag) + "=1");
   }
-  const Eigen::VectorXd c = DriftControlCoefficients(m, o);
-  std::string out =
-      "DO $$SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]=" + Num(c(0), kDecimalsDriftCoefficient);
+  return bodies;
+}
+
+// c_0 + sum c_f x_f over the layout's feature slots.
+std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals) {
+  std::string out = Num(c(0), decimals);
   for (Eigen::Index f = 1; f < c.size(); ++f)
-    out += Term(c(f), kDecimalsDriftCoefficient) + "*" + P(l.features + static_cast<int>(f) - 1);
-  if (o.workpiece_k0_param >= 0) out += "+" + P(o.workpiece_k0_param);
-  bodies.push_back(out);
+    out += Term(c(f), decimals) + "*" + P(l.features + static_cast<int>(f) - 1);
+  return out;
+}
+
+bool SlopeMode(const DriftActionOptions& o, const drift::DriftModel* g) {
+  return g != nullptr || o.workpiece_slope_param >= 0;
+}
+
+// The setting-data writes (see the header comment for the composition).
+std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
+                       const DriftActionOptions& o, const Slots& s) {
+  const std::string ax = "[" + o.axis + "]";
+  std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient);
+  if (o.workpiece_k0_param >= 0) k0 += "+" + P(o.workpiece_k0_param);
+  if (!SlopeMode(o, g)) return "DO $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0;
+  std::string slope, ref;
+  if (o.workpiece_slope_param >= 0) {
+    const std::string p_w = P(o.workpiece_slope_param + 1);
+    slope = P(o.workpiece_slope_param);
+    ref = p_w;
+    if (g) {
+      slope = P(s.s_m) + "+" + slope;
+      k0 += "+" + P(s.s_m) + "*(" + p_w + Term(-o.slope_fixed_end_mm, kDecimalsPositionMm) + ")";
+    }
+  } else {
+    slope = P(s.s_m);
+    ref = Num(o.slope_fixed_end_mm, kDecimalsPositionMm);
+  }
+  return "DO $$SA_TEMP_COMP_SLOPE" + ax + "=" + slope + " $$SA_TEMP_COMP_REF_POSITION" + ax + "=" +
+         ref + " $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0;
+}
+
+// The static actions, in execution order.
+std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::DriftModel* g,
+                                      const DriftActionOptions& o, const Slots& s) {
+  std::vector<std::string> bodies = FeatureBodies(m, o, s.offset);
+  if (g) {
+    const std::vector<std::string> more = FeatureBodies(*g, o, s.slope);
+    bodies.insert(bodies.end(), more.begin(), more.end());
+    bodies.push_back(
+        "DO " + P(s.s_m) + "=" +
+        Linear(DriftSlopeCoefficients(*g, o), s.slope, kDecimalsDriftSlopeCoefficient));
+  }
+  bodies.push_back(OutputBody(m, g, o, s));
   return bodies;
 }
 
@@ -174,6 +238,20 @@ void DriftActionOptions::Validate() const {
   if (workpiece_k0_param > 9999)
     throw InputError("drift workpiece_k0_param " + std::to_string(workpiece_k0_param) +
                      ": must be within 0..9999");
+  if (workpiece_slope_param >= 0 && !(workpiece_k0_param >= 0 && workpiece_slope_param <= 9998 &&
+                                      (workpiece_k0_param < workpiece_slope_param ||
+                                       workpiece_k0_param > workpiece_slope_param + 1)))
+    throw InputError("drift workpiece_slope_param " + std::to_string(workpiece_slope_param) +
+                     ": needs workpiece_k0_param (the plan hands over K0 and slope together), "
+                     "must be within 0..9998, and its two slots must not hold workpiece_k0_param");
+  if (save_r_first > 9995)
+    throw InputError("drift save_r_first " + std::to_string(save_r_first) +
+                     ": must be within 0..9995 (R<n>..R<n+4> are used)");
+  if (has_slope && (!std::isfinite(slope_fixed_end_mm) || std::abs(slope_fixed_end_mm) > 1e6 ||
+                    (slope_growth_direction != 1 && slope_growth_direction != -1)))
+    throw InputError(
+        "drift slope: fixed_end_position_mm must be finite within +-1e6 mm and "
+        "growth_direction +1 or -1");
   for (const auto& [name, a] : inputs)
     if (!(a.index >= 1 && a.index <= 999) || !std::isfinite(a.scale) || a.scale == 0 ||
         !std::isfinite(a.offset))
@@ -182,8 +260,8 @@ void DriftActionOptions::Validate() const {
                        "non-zero, offset finite");
 }
 
-int DriftParamCount(const drift::DriftModel& m) {
-  return static_cast<int>(m.features.size() + m.sensors.size()) + 1;
+int DriftParamCount(const drift::DriftModel& m, const drift::DriftModel* g) {
+  return MakeSlots(m, g, 0).last + 1;
 }
 
 Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& m, const DriftActionOptions& o) {
@@ -195,49 +273,119 @@ Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& m, const Drift
   return c;
 }
 
+Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& g, const DriftActionOptions& o) {
+  CheckModel(g);
+  const double s = DriftSign(o) * o.slope_growth_direction;
+  Eigen::VectorXd c = g.linear.coefficients;
+  for (Eigen::Index i = 0; i < c.size(); ++i)
+    c(i) = RoundTo(s * c(i) / 1e6, kDecimalsDriftSlopeCoefficient);
+  return c;
+}
+
+namespace {
+
+void CheckSlope(const drift::DriftModel* g, const DriftActionOptions& o, const Slots& s) {
+  if (g && !o.has_slope)
+    throw InputError(
+        "drift action: a slope model needs the profile's drift.slope object "
+        "(fixed_end_position_mm, growth_direction)");
+  if (g && o.workpiece_k0_param >= 0 && o.workpiece_slope_param < 0)
+    throw InputError(
+        "drift action: a slope model combined with a plan needs the profile's "
+        "drift.workpiece_slope_param, so the plan hands its SD43910/SD43920 over "
+        "(else two writers would fight over SD43910)");
+  for (const auto& [name, slot] :
+       {std::pair{"workpiece_k0_param", o.workpiece_k0_param},
+        {"workpiece_slope_param", o.workpiece_slope_param},
+        {"workpiece_slope_param + 1",
+         o.workpiece_slope_param < 0 ? -1 : o.workpiece_slope_param + 1}})
+    if (slot >= 0 && Overlap(slot, slot, o.param_first, s.last))
+      throw InputError("drift action: " + std::string(name) + " " + std::to_string(slot) +
+                       " lies in the action's own $AC_PARAM slots " +
+                       std::to_string(o.param_first) + ".." + std::to_string(s.last));
+}
+
+// Part-program lines: save what is found once, reset the flags and the plan's slots.
+std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& s) {
+  const int r = o.save_r_first;
+  const std::string ax = "[" + o.axis + "]";
+  std::string nc = "IF " + R(r + 1) + "<>1\n" + R(r) + "=$SA_TEMP_COMP_ABS_VALUE" + ax + "\n" +
+                   R(r + 1) + "=1\nENDIF\n";
+  if (slope_mode)
+    nc += "IF " + R(r + 4) + "<>1\n" + R(r + 2) + "=$SA_TEMP_COMP_SLOPE" + ax + "\n" + R(r + 3) +
+          "=$SA_TEMP_COMP_REF_POSITION" + ax + "\n" + R(r + 4) + "=1\nENDIF\n";
+  else  // an aborted slope run left its slope behind: give the found one back
+    nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
+          "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";
+  nc += P(s.offset.flag) + "=0\n";
+  if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
+  if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
+  if (o.workpiece_slope_param >= 0)
+    nc += P(o.workpiece_slope_param) + "=0\n" + P(o.workpiece_slope_param + 1) + "=0\n";
+  return nc;
+}
+
+std::string ModelLine(const std::string& what, const drift::DriftModel& m) {
+  return what + drift::ToString(m.kind) + " of " + Text(m.error_column) + " from " +
+         std::to_string(m.sensors.size()) + " sensors";
+}
+
+std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
+                   const DriftActionOptions& o, const std::string& model_source, const Slots& s) {
+  const int r = o.save_r_first;
+  const bool slope_mode = SlopeMode(o, g);
+  std::string nc =
+      "; WHIRL_DRIFT_COMP: SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
+  nc += Line(ModelLine("; model: ", m) +
+             (model_source.empty() ? std::string() : ", file " + Text(model_source)));
+  if (g) nc += Line(ModelLine("; slope model: ", *g));
+  nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + Num(DriftSign(o), 0) +
+        " (control_dk " + ToString(o.control_dk) + ", error_direction " +
+        std::to_string(o.error_direction) + "); reference " + ToString(o.reference) +
+        "; interpolation cycle " + Num(o.ipo_cycle_ms, 3) + " ms\n";
+  if (g)
+    nc += "; slope S_m = s * sigma * (g0 + sum g_f x_f) / 1e6 (sigma = " +
+          std::to_string(o.slope_growth_direction) + ") about the fixed end " +
+          Num(o.slope_fixed_end_mm, kDecimalsPositionMm) + " mm (MCS)\n";
+  const std::string saved = slope_mode ? R(r) + ".." + R(r + 4) + " (SD43900-43920 found, markers)"
+                                       : R(r) + " (SD43900 found), " + R(r + 1) +
+                                             " (1 while active), " + R(r + 2) + ".." + R(r + 4) +
+                                             " (a slope left by an earlier run)";
+  nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
+        std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
+        std::to_string(o.param_first) + ".." + std::to_string(s.last) + "], " + saved + "\n";
+  if (o.workpiece_k0_param >= 0)
+    nc += "; adds the whirling plan's K0 from $AC_PARAM[" + std::to_string(o.workpiece_k0_param) +
+          "]: this action is the only writer of SD43900 on axis " + o.axis + "\n";
+  if (o.workpiece_slope_param >= 0)
+    nc += "; and the plan's SD43910/SD43920 from $AC_PARAM[" +
+          std::to_string(o.workpiece_slope_param) + "], [" +
+          std::to_string(o.workpiece_slope_param + 1) +
+          "]: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b)\n";
+  nc += "; requires MD32750 $MA_TEMP_COMP_TYPE bit 0" +
+        std::string(slope_mode ? " and bit 1" : "") + " for axis " + o.axis +
+        "; stop it with WHIRL_DRIFT_COMP_RESET (restores what it found)\n";
+  return nc;
+}
+
+}  // namespace
+
 std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOptions& o,
-                                 const std::string& model_source) {
+                                 const std::string& model_source, const drift::DriftModel* g) {
   o.Validate();
   CheckModel(m);
-  const Layout l = MakeLayout(m, o);
-  const int used_params_last = l.flag;
-  if (o.workpiece_k0_param >= 0 &&
-      Overlap(o.workpiece_k0_param, o.workpiece_k0_param, o.param_first, used_params_last))
-    throw InputError("drift action: workpiece_k0_param " + std::to_string(o.workpiece_k0_param) +
-                     " lies in the action's own $AC_PARAM slots " + std::to_string(o.param_first) +
-                     ".." + std::to_string(used_params_last));
-  const std::vector<std::string> bodies = ActionBodies(m, o);
+  if (g) CheckModel(*g);
+  const Slots s = MakeSlots(m, g, o.param_first);
+  CheckSlope(g, o, s);
+  const std::vector<std::string> bodies = ActionBodies(m, g, o, s);
   const int available = o.sync_id_last - o.sync_id_first + 1;
   if (static_cast<int>(bodies.size()) > available)
     throw InputError("drift action needs " + std::to_string(bodies.size()) +
                      " synchronized-action IDs, the range " + std::to_string(o.sync_id_first) +
                      ".." + std::to_string(o.sync_id_last) + " has " + std::to_string(available));
-  const int r = o.save_r_first;
-  std::string nc;
-  nc +=
-      "; WHIRL_DRIFT_COMP: SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
-  nc += Line("; model: " + drift::ToString(m.kind) + " of " + Text(m.error_column) + " from " +
-             std::to_string(m.sensors.size()) + " sensors" +
-             (model_source.empty() ? std::string() : ", file " + Text(model_source)));
-  nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + Num(DriftSign(o), 0) +
-        " (control_dk " + ToString(o.control_dk) + ", error_direction " +
-        std::to_string(o.error_direction) + "); reference " + ToString(o.reference) +
-        "; interpolation cycle " + Num(o.ipo_cycle_ms, 3) + " ms\n";
-  nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
-        std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
-        std::to_string(o.param_first) + ".." + std::to_string(used_params_last) + "], " + R(r) +
-        " (SD43900 found) and " + R(r + 1) + " (1 while active)\n";
-  if (o.workpiece_k0_param >= 0)
-    nc += "; adds the whirling plan's K0 from $AC_PARAM[" + std::to_string(o.workpiece_k0_param) +
-          "]: this action is the only writer of SD43900 on axis " + o.axis + "\n";
-  nc += "; requires MD32750 $MA_TEMP_COMP_TYPE bit 0 for axis " + o.axis +
-        "; stop it with WHIRL_DRIFT_COMP_RESET (restores the SD43900 found)\n";
+  std::string nc = Header(m, g, o, model_source, s);
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
-  nc += "IF " + R(r + 1) + "<>1\n" + R(r) + "=$SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]\n" +
-        R(r + 1) + "=1\nENDIF\n";
-  nc += P(l.flag) + "=0\n";
-  if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
-  nc += "STOPRE\n";
+  nc += Preamble(o, SlopeMode(o, g), s) + "STOPRE\n";
   for (std::size_t k = 0; k < bodies.size(); ++k)
     nc += Line("IDS=" + std::to_string(o.sync_id_first + static_cast<int>(k)) + " " + bodies[k]);
   nc += "M17\n";
@@ -247,32 +395,27 @@ std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOp
 std::string FormatDriftNcResetProgram(const DriftActionOptions& o) {
   o.Validate();
   const int r = o.save_r_first;
+  const std::string ax = "[" + o.axis + "]";
   std::string nc = "; WHIRL_DRIFT_COMP_RESET: stops the live drift compensation of axis " + o.axis +
-                   " and restores the SD43900 found before it started\n";
+                   " and restores the setting data found before it started (SD43900 if " +
+                   R(r + 1) + " = 1, SD43910/SD43920 if " + R(r + 4) + " = 1)\n";
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
-  nc += "IF " + R(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]=" + R(r) + "\n" +
-        R(r + 1) + "=0\nENDIF\nSTOPRE\nM17\n";
+  nc += "IF " + R(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + R(r) + "\n" + R(r + 1) +
+        "=0\nENDIF\n";
+  nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
+        "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";
+  nc += "STOPRE\nM17\n";
   return nc;
 }
 
-std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptions& o) {
-  o.Validate();
-  const Eigen::VectorXd c = DriftControlCoefficients(m, o);
+namespace {
+
+// Rows of one model's PLC table: intercept, then one row per feature.
+std::string PlcRows(const std::string& output, const drift::DriftModel& m,
+                    const DriftActionOptions& o, const Eigen::VectorXd& c, int decimals) {
   const std::vector<std::string> in = Inputs(m);
   const int ns = static_cast<int>(m.sensors.size());
-  std::string out;
-  out +=
-      "# whirl drift action as a PLC table: every cycle T = scale * AIN[ain_index] + offset; "
-      "u = T - reference_C (sensors; extra inputs: u = T);\n";
-  out += "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); SD43900[" + o.axis +
-         "] = sum of coefficient_mm_per_unit * feature value, intercept included (mm)\n";
-  out += "# model " + drift::ToString(m.kind) + " of " + Text(m.error_column) +
-         "; sign applied (s = " + Num(DriftSign(o), 0) + "); interpolation cycle " +
-         Num(o.ipo_cycle_ms, 3) + " ms\n";
-  out +=
-      "feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,coefficient_mm_per_"
-      "unit\n";
-  out += "intercept,,,,,,,," + Num(c(0), kDecimalsDriftCoefficient) + "\n";
+  std::string out = output + ",intercept,,,,,,,," + Num(c(0), decimals) + "\n";
   for (std::size_t f = 0; f < m.features.size(); ++f) {
     const drift::Feature& feat = m.features[f];
     int input = 0;
@@ -283,11 +426,45 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
     const std::string af =
         feat.tau > 0 ? Num(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
                      : "";
-    out += Text(feat.Name(m.time_unit)) + "," + Text(feat.input) + "," + std::to_string(a.index) +
-           "," + Num(a.scale, kDecimalsDriftCoefficient) + "," + Num(a.offset, 4) + "," + ref +
-           "," + tau + "," + af + "," +
-           Num(c(static_cast<Eigen::Index>(f) + 1), kDecimalsDriftCoefficient) + "\n";
+    out += output + "," + Text(feat.Name(m.time_unit)) + "," + Text(feat.input) + "," +
+           std::to_string(a.index) + "," + Num(a.scale, kDecimalsDriftCoefficient) + "," +
+           Num(a.offset, 4) + "," + ref + "," + tau + "," + af + "," +
+           Num(c(static_cast<Eigen::Index>(f) + 1), decimals) + "\n";
   }
+  return out;
+}
+
+}  // namespace
+
+std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptions& o,
+                              const drift::DriftModel* g) {
+  o.Validate();
+  if (g && !o.has_slope)
+    throw InputError("drift PLC table: a slope model needs the profile's drift.slope object");
+  std::string out;
+  out +=
+      "# whirl drift action as a PLC table: every cycle T = scale * AIN[ain_index] + offset; "
+      "u = T - reference_C (sensors; extra inputs: u = T);\n";
+  out +=
+      "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); K_m (mm) = sum of "
+      "the k0_mm rows' coefficient_per_unit * feature value, intercept included\n";
+  out += "# model " + drift::ToString(m.kind) + " of " + Text(m.error_column) +
+         "; sign applied (s = " + Num(DriftSign(o), 0) + "); interpolation cycle " +
+         Num(o.ipo_cycle_ms, 3) + " ms\n";
+  if (g)
+    out += "# slope model " + drift::ToString(g->kind) + " of " + Text(g->error_column) +
+           ": S_m (mm/mm) = sum of the slope rows likewise; SD43910[" + o.axis +
+           "] = S_m, SD43920 = " + Num(o.slope_fixed_end_mm, kDecimalsPositionMm) +
+           " mm, SD43900 = K_m (with a plan: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + "
+           "K_m + S_m (P_w - fixed end))\n";
+  else
+    out += "# SD43900[" + o.axis + "] = K_m\n";
+  out +=
+      "output,feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,"
+      "coefficient_per_unit\n";
+  out += PlcRows("k0_mm", m, o, DriftControlCoefficients(m, o), kDecimalsDriftCoefficient);
+  if (g)
+    out += PlcRows("slope", *g, o, DriftSlopeCoefficients(*g, o), kDecimalsDriftSlopeCoefficient);
   return out;
 }
 

@@ -30,8 +30,24 @@
 // action's marker says it is active. The drift action's IDs must lie above the plan's: actions
 // run in ID order each cycle, so the plan's K0 is written before it is added (no cycle of lag).
 //
-// The programs save the SD43900 they find (R<save_r_first>, marker R<save_r_first + 1>) and the
-// reset program cancels the actions and restores it, so the control ends as it was found.
+// The machine's slope (optional second model, e.g. the Z feed screw growing from its fixed
+// bearing; machine/machine.h channel zscrew_per_1000_um). Its output g [um per 1000 mm] is the
+// growth of the error with the distance from the fixed end P_b (profile drift.slope):
+//   e(P) = e_K + g * sigma * (P - P_b) / 1000   [um along error_direction],
+// sigma = growth_direction (+1: the distance from the fixed end grows towards +axis). So the
+// machine alone is dK_m(P) = K_m + S_m (P - P_b) with K_m = s e_K / 1000 mm and
+// S_m = s sigma g / 1e6 (mm/mm), written as SD43900 = K_m, SD43910 = S_m, SD43920 = P_b.
+// Combined with a plan that hands its slope over too (workpiece_slope_param: the plan writes its
+// K0_w, S_w, P_w into $AC_PARAM[workpiece_k0_param], [workpiece_slope_param], [.. + 1]), the sum
+//   dK(P) = K0_w + S_w (P - P_w) + K_m + S_m (P - P_b)
+// is written with the plan's reference as the common one:
+//   SD43920 = P_w,  SD43910 = S_w + S_m,  SD43900 = K0_w + K_m + S_m (P_w - P_b),
+// which equals the sum at every P; this action is then the only writer of all three.
+//
+// The programs save what they find (R<n> SD43900, marker R<n+1>; with a slope R<n+2> SD43910,
+// R<n+3> SD43920, slope marker R<n+4>; n = save_r_first, R<n>..R<n+4> reserved) and the reset
+// program cancels the actions and restores them, so the control ends as it was found. A program
+// without a slope gives back a slope an aborted slope run left behind (R<n+4> = 1).
 // Not verified on a control here: the access level of main-run writes and whether IDS actions
 // survive a reset on every software version (REFERENCE.md 7).
 #include <map>
@@ -64,36 +80,56 @@ struct DriftActionOptions {
   int param_first = 0;          ///< first $AC_PARAM slot used (0..9999)
   int save_r_first = 80;        ///< R<n> saved SD43900, R<n+1> marker (1 while active)
   int workpiece_k0_param = -1;  ///< >= 0: add $AC_PARAM[n] (the whirling plan's K0)
-  int missing_alarm = 65000;    ///< SETAL number the combined plan raises if this is not active
+  /// >= 0: the plan's SD43910 in $AC_PARAM[n], its SD43920 in $AC_PARAM[n + 1] (this action owns
+  /// SD43910/SD43920 too); needs workpiece_k0_param.
+  int workpiece_slope_param = -1;
+  bool has_slope = false;          ///< the profile's drift.slope object is present
+  double slope_fixed_end_mm = 0;   ///< P_b: axis position (MCS) of the zero of the growth, mm
+  int slope_growth_direction = 1;  ///< sigma: +1 distance from P_b grows towards +axis, or -1
+  int missing_alarm = 65000;       ///< SETAL number the combined plan raises if this is not active
   DriftReference reference = DriftReference::kModel;
   std::map<std::string, AnalogInput> inputs;  ///< by column name (sensors and extra inputs)
 
   void Validate() const;  ///< InputError naming the field and the rule
 };
 
-/// How many $AC_PARAM slots the action uses for `model` (features, references, flag).
-int DriftParamCount(const drift::DriftModel& model);
+/// How many $AC_PARAM slots the action uses for `model` (features, references, flag) and the
+/// optional slope model (its features, references, flag, and one slot for S_m).
+int DriftParamCount(const drift::DriftModel& model, const drift::DriftModel* slope = nullptr);
 
-/// The NC program (subprogram, .SPF, ends in M17) that installs the static actions. InputError for
-/// a network model, a dynamic model without a time unit of minutes, a missing analog input, an ID
-/// range too small, or a line longer than the control's 512 characters.
+/// The NC program (subprogram, .SPF, ends in M17) that installs the static actions. `slope`
+/// (optional) is the machine's slope model (see the header comment). InputError for a network
+/// model, a dynamic model without a time unit of minutes, a missing analog input, an ID range too
+/// small, a line longer than the control's 512 characters, a slope model without the profile's
+/// slope object, or a slope model with a plan that writes SD43910 itself (two writers).
 std::string FormatDriftNcProgram(const drift::DriftModel& model, const DriftActionOptions& options,
-                                 const std::string& model_source = "");
+                                 const std::string& model_source = "",
+                                 const drift::DriftModel* slope = nullptr);
 
-/// The program that cancels the drift action's IDs and restores the saved SD43900.
+/// The program that cancels the drift action's IDs and restores the saved setting data (SD43900
+/// if R<n+1> = 1, SD43910/SD43920 if R<n+4> = 1).
 std::string FormatDriftNcResetProgram(const DriftActionOptions& options);
 
-/// The same model for a PLC: '#' comments with the formula, then one row per feature:
-/// feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,coefficient_mm_per_unit
-/// and a first row "intercept" with coefficient b0 (mm, sign applied). Fixed decimals.
-std::string FormatDriftPlcCsv(const drift::DriftModel& model, const DriftActionOptions& options);
+/// The same model(s) for a PLC: '#' comments with the formulas, then one row per feature:
+/// output,feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,coefficient_per_unit
+/// where output is "k0_mm" (the offset model; coefficient in mm per unit) or "slope" (the slope
+/// model: S_m, coefficient in mm/mm per unit), each beginning with a row "intercept". Fixed
+/// decimals.
+std::string FormatDriftPlcCsv(const drift::DriftModel& model, const DriftActionOptions& options,
+                              const drift::DriftModel* slope = nullptr);
 
 /// The coefficients the control applies: c_0 = s * b0 / 1000 [mm], c_f = s * b_f / 1000
 /// [mm per unit], rounded to kDecimalsDriftCoefficient as printed.
 Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& model,
                                          const DriftActionOptions& options);
 
-inline constexpr int kDecimalsDriftCoefficient = 10;  ///< mm per K (or per input unit)
-inline constexpr int kDecimalsLagFactor = 15;         ///< a = 1 - exp(-T_ipo / tau)
+/// The slope model's coefficients the control applies: S_m = c_0 + sum c_f x_f with
+/// c = s * sigma * b / 1e6 (mm/mm per unit), rounded to kDecimalsDriftSlopeCoefficient.
+Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
+                                       const DriftActionOptions& options);
+
+inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)
+inline constexpr int kDecimalsDriftSlopeCoefficient = 14;  ///< mm/mm per K: 1e-14 per K
+inline constexpr int kDecimalsLagFactor = 15;              ///< a = 1 - exp(-T_ipo / tau)
 
 }  // namespace whirl::interp

@@ -27,7 +27,8 @@ DriftActionOptions ReadDriftSection(const nlohmann::json& j, const std::string& 
   if (!j.is_object()) throw InputError(w + ": must be a JSON object");
   RejectUnknownKeys(j,
                     {"sync_id_first", "sync_id_last", "param_first", "save_r_first", "ipo_cycle_ms",
-                     "error_direction", "workpiece_k0_param", "missing_alarm", "analog_inputs"},
+                     "error_direction", "workpiece_k0_param", "workpiece_slope_param",
+                     "missing_alarm", "slope", "analog_inputs"},
                     w);
   DriftActionOptions d;
   d.sync_id_first = RequireInt(j, "sync_id_first", w);
@@ -38,7 +39,19 @@ DriftActionOptions ReadDriftSection(const nlohmann::json& j, const std::string& 
   d.error_direction = RequireInt(j, "error_direction", w);
   if (j.contains("workpiece_k0_param"))
     d.workpiece_k0_param = RequireInt(j, "workpiece_k0_param", w);
+  if (j.contains("workpiece_slope_param"))
+    d.workpiece_slope_param = RequireInt(j, "workpiece_slope_param", w);
   if (j.contains("missing_alarm")) d.missing_alarm = RequireInt(j, "missing_alarm", w);
+  if (j.contains("slope")) {
+    const nlohmann::json& g = j.at("slope");
+    const std::string wg = w + ", object 'slope'";
+    if (!g.is_object())
+      throw InputError(wg + ": must be an object {fixed_end_position_mm, growth_direction}");
+    RejectUnknownKeys(g, {"fixed_end_position_mm", "growth_direction"}, wg);
+    d.has_slope = true;
+    d.slope_fixed_end_mm = RequireNumber(g, "fixed_end_position_mm", wg);
+    d.slope_growth_direction = RequireInt(g, "growth_direction", wg);
+  }
   if (!j.contains("analog_inputs") || !j.at("analog_inputs").is_object())
     throw InputError(w + ": 'analog_inputs' must be an object {column: {index, scale, offset}}");
   for (const auto& [name, a] : j.at("analog_inputs").items()) {
@@ -62,9 +75,9 @@ void CheckDisjoint(const MachineProfile& m, const std::string& what) {
                      ": disjoint, so the plan never cancels the drift action, and higher, because "
                      "actions run in ID order and the plan's K0 must be written before the drift "
                      "action adds it in the same cycle");
-  if (Overlap(d.save_r_first, d.save_r_first + 1, m.save_r_first, m.save_r_first + 3))
+  if (Overlap(d.save_r_first, d.save_r_first + 4, m.save_r_first, m.save_r_first + 3))
     throw InputError(what + ": the drift action's R" + std::to_string(d.save_r_first) + "..R" +
-                     std::to_string(d.save_r_first + 1) + " overlap the plan's R" +
+                     std::to_string(d.save_r_first + 4) + " overlap the plan's R" +
                      std::to_string(m.save_r_first) + "..R" + std::to_string(m.save_r_first + 3));
 }
 
@@ -79,6 +92,8 @@ void MachineProfile::ApplyCombinedTo(PlanOptions& o) const {
   o.workpiece_k0_param = drift->workpiece_k0_param;
   o.drift_marker_r = drift->save_r_first + 1;
   o.drift_missing_alarm = drift->missing_alarm;
+  o.workpiece_slope_param = drift->workpiece_slope_param;
+  o.drift_slope_marker_r = drift->workpiece_slope_param >= 0 ? drift->save_r_first + 4 : -1;
 }
 
 DriftActionOptions MachineProfile::DriftOptions() const {

@@ -21,10 +21,17 @@
 //    "drift": {                   optional: the live machine-drift action (interp/drift_action.h)
 //      "sync_id_first": 150, "sync_id_last": 190,  its IDS range, disjoint from the plan's
 //      "param_first": 100,        first $AC_PARAM slot it uses
-//      "save_r_first": 80,        R<n> SD43900 found, R<n+1> marker; disjoint from the plan's R
+//      "save_r_first": 80,        R<n>..R<n+4>: setting data found, markers; disjoint from the
+//                                 plan's R
 //      "ipo_cycle_ms": 4.0,       interpolation cycle [ms]
 //      "error_direction": 1,      +1: the model's error is the tool's displacement along +axis
 //      "workpiece_k0_param": 99,  $AC_PARAM the whirling plan writes its K0 into when combined
+//      "workpiece_slope_param": 97, optional: the plan also hands its SD43910 (97) and SD43920
+//                                 (98) to the drift action, which then owns all three
+//      "slope": {"fixed_end_position_mm": 5587.5, "growth_direction": -1},
+//                                 optional: the machine's slope model (drift nc --slope-model):
+//                                 MCS position of the zero of the growth (a feed screw's fixed
+//                                 bearing) and +1/-1 if the distance from it grows towards +/-axis
 //      "missing_alarm": 65000,    SETAL number of a combined plan started without the action
 //      "analog_inputs": {"t3_C": {"index": 3, "scale": 0.1, "offset": 0.0}, ...}}}
 //                                 T = scale * $A_INA[index] + offset [degC] per model input
@@ -57,8 +64,9 @@ struct MachineProfile {
   /// Copies the machine's facts into plan options (tolerance and check step are left alone) and
   /// sets the sign to ExpectedSign(direction, control_dk).
   void ApplyTo(PlanOptions& options) const;
-  /// The plan combined with the drift action: its K0 goes to drift.workpiece_k0_param and it
-  /// requires the drift action's marker. InputError naming the file if "drift" is missing.
+  /// The plan combined with the drift action: its K0 goes to drift.workpiece_k0_param (and its
+  /// slope and reference to drift.workpiece_slope_param, +1, when the profile has it) and it
+  /// requires the drift action's marker(s). InputError naming the file if "drift" is missing.
   void ApplyCombinedTo(PlanOptions& options) const;
   /// The drift action's options (axis and control_dk from the profile). InputError if absent.
   DriftActionOptions DriftOptions() const;

@@ -150,6 +150,22 @@ void PlanOptions::Validate() const {
                      std::to_string(drift_marker_r) + " 0..9999 outside R" +
                      std::to_string(save_r_first) + "..R" + std::to_string(save_r_first + 3) +
                      ", and the alarm " + std::to_string(drift_missing_alarm) + " 60000..69999");
+  if (workpiece_slope_param >= 0 &&
+      !(workpiece_k0_param >= 0 && workpiece_slope_param <= 9998 &&
+        (workpiece_k0_param < workpiece_slope_param ||
+         workpiece_k0_param > workpiece_slope_param + 1) &&
+        drift_slope_marker_r >= 0 && drift_slope_marker_r <= 9999 &&
+        drift_slope_marker_r != drift_marker_r &&
+        (drift_slope_marker_r < save_r_first || drift_slope_marker_r > save_r_first + 3)))
+    throw InputError("slope handed to the drift action: workpiece_slope_param " +
+                     std::to_string(workpiece_slope_param) +
+                     " needs workpiece_k0_param >= 0 outside its two slots (" +
+                     std::to_string(workpiece_k0_param) +
+                     "), must be 0..9998, and the drift "
+                     "slope marker R" +
+                     std::to_string(drift_slope_marker_r) +
+                     " 0..9999, not the drift marker, outside R" + std::to_string(save_r_first) +
+                     "..R" + std::to_string(save_r_first + 3));
   if (!(save_r_first >= 0 && save_r_first <= 9996))
     throw InputError("save_r_first = " + std::to_string(save_r_first) +
                      ": must be within 0..9996 (R<n>..R<n+3> are used)");
@@ -253,16 +269,18 @@ void to_json(nlohmann::json& j, const PlanOptions& o) {
                      {"save_r_first", o.save_r_first},
                      {"workpiece_k0_param", o.workpiece_k0_param},
                      {"drift_marker_r", o.drift_marker_r},
-                     {"drift_missing_alarm", o.drift_missing_alarm}};
+                     {"drift_missing_alarm", o.drift_missing_alarm},
+                     {"workpiece_slope_param", o.workpiece_slope_param},
+                     {"drift_slope_marker_r", o.drift_slope_marker_r}};
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
-  RejectUnknownKeys(
-      j,
-      {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
-       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
-       "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm"},
-      "plan settings");
+  RejectUnknownKeys(j,
+                    {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm",
+                     "sign", "control_dk", "md32760", "check_step_s", "sync_id_first",
+                     "sync_id_last", "save_r_first", "workpiece_k0_param", "drift_marker_r",
+                     "drift_missing_alarm", "workpiece_slope_param", "drift_slope_marker_r"},
+                    "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
   o.start_position_mm = j.at("start_position_mm").get<double>();
@@ -278,6 +296,8 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
   o.workpiece_k0_param = j.at("workpiece_k0_param").get<int>();
   o.drift_marker_r = j.at("drift_marker_r").get<int>();
   o.drift_missing_alarm = j.at("drift_missing_alarm").get<int>();
+  o.workpiece_slope_param = j.value("workpiece_slope_param", -1);  // absent before the slope mode
+  o.drift_slope_marker_r = j.value("drift_slope_marker_r", -1);
   o.Validate();
 }
 
@@ -403,11 +423,14 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
   return out;
 }
 
-std::string FormatPointsCsv(const CompensationPlan& plan, const std::vector<std::string>& comments) {
+std::string FormatPointsCsv(const CompensationPlan& plan,
+                            const std::vector<std::string>& comments) {
   std::string out;
   for (const std::string& c : comments) out += "#" + OneLine(c) + "\n";
   out += "time_s,thread_position_mm,elongation_um,sd43900_mm,sd43910,sd43920_mm\n";
-  auto travel = [&](double t) { return FormatFixed(t * plan.axial_feed_mm_s, kDecimalsPositionMm); };
+  auto travel = [&](double t) {
+    return FormatFixed(t * plan.axial_feed_mm_s, kDecimalsPositionMm);
+  };
   for (const CompensationSegment& s : plan.segments)
     out += CsvLine({FormatFixed(s.t_a_s, kDecimalsTimeS), travel(s.t_a_s),
                     FormatFixed(s.l_a_um, kDecimalsElongationUm),
@@ -427,6 +450,9 @@ std::string FormatPointsCsv(const CompensationPlan& plan, const std::vector<std:
 namespace {
 
 bool Combined(const PlanOptions& o) { return o.workpiece_k0_param >= 0; }
+// The drift action owns SD43910/SD43920 too; the plan hands its slope and reference over.
+bool SlopeHandedOver(const PlanOptions& o) { return o.workpiece_slope_param >= 0; }
+std::string Param(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
 
 // Where K0 goes: SD43900 itself, or (combined with the drift action) the $AC_PARAM the drift
 // action adds. prefix "$$" in a synchronized action (main run), "$" in the part program.
@@ -435,11 +461,20 @@ std::string K0Target(const PlanOptions& o, const std::string& prefix) {
   return prefix + "SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]";
 }
 
+std::string SlopeTarget(const PlanOptions& o, const std::string& prefix) {
+  if (SlopeHandedOver(o)) return Param(o.workpiece_slope_param);
+  return prefix + "SA_TEMP_COMP_SLOPE[" + o.axis + "]";
+}
+
+std::string RefTarget(const PlanOptions& o, const std::string& prefix) {
+  if (SlopeHandedOver(o)) return Param(o.workpiece_slope_param + 1);
+  return prefix + "SA_TEMP_COMP_REF_POSITION[" + o.axis + "]";
+}
+
 std::string SdWrites(const PlanOptions& o, const std::string& prefix, const std::string& k0,
                      const std::string& slope, const std::string& p0) {
-  const std::string& ax = o.axis;
-  return K0Target(o, prefix) + "=" + k0 + " " + prefix + "SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope +
-         " " + prefix + "SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + p0;
+  return K0Target(o, prefix) + "=" + k0 + " " + SlopeTarget(o, prefix) + "=" + slope + " " +
+         RefTarget(o, prefix) + "=" + p0;
 }
 
 std::string CancelIds(const PlanOptions& o) {
@@ -458,20 +493,32 @@ std::string SaveFoundValues(const PlanOptions& o) {
   const int m = o.save_r_first;
   const std::string k0 =
       Combined(o) ? std::string() : R(m) + "=$SA_TEMP_COMP_ABS_VALUE[" + ax + "]\n";
-  return "IF " + R(m + 3) + "<>1\n" + k0 + R(m + 1) + "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" +
-         R(m + 2) + "=$SA_TEMP_COMP_REF_POSITION[" + ax + "]\n" + R(m + 3) + "=1\nENDIF\n";
+  const std::string slope = SlopeHandedOver(o)
+                                ? std::string()
+                                : R(m + 1) + "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" + R(m + 2) +
+                                      "=$SA_TEMP_COMP_REF_POSITION[" + ax + "]\n";
+  return "IF " + R(m + 3) + "<>1\n" + k0 + slope + R(m + 3) + "=1\nENDIF\n";
 }
 
 // The value K0 returns to: the saved SD43900, or 0 for the plan's part of the combined K0.
 std::string RestoredK0(const PlanOptions& o, const std::string& r_prefix) {
   return Combined(o) ? "0" : r_prefix + R(o.save_r_first);
 }
+// Slope and reference return to the saved values, or 0 for the plan's handed-over part.
+std::string RestoredSlope(const PlanOptions& o, const std::string& r_prefix) {
+  return SlopeHandedOver(o) ? "0" : r_prefix + R(o.save_r_first + 1);
+}
+std::string RestoredRef(const PlanOptions& o, const std::string& r_prefix) {
+  return SlopeHandedOver(o) ? "0" : r_prefix + R(o.save_r_first + 2);
+}
 
 // Combined: refuse to start unless the drift action says it is active (else K0 would be lost).
 std::string RequireDriftAction(const PlanOptions& o) {
   if (!Combined(o)) return "";
-  return "IF " + R(o.drift_marker_r) + "<>1\nSETAL(" + std::to_string(o.drift_missing_alarm) +
-         ")\nENDIF\n";
+  const std::string alarm = "SETAL(" + std::to_string(o.drift_missing_alarm) + ")\nENDIF\n";
+  std::string out = "IF " + R(o.drift_marker_r) + "<>1\n" + alarm;
+  if (SlopeHandedOver(o)) out += "IF " + R(o.drift_slope_marker_r) + "<>1\n" + alarm;
+  return out;
 }
 
 std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
@@ -512,6 +559,11 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
        << "], which the drift action adds into SD43900 (its only writer); alarm "
        << o.drift_missing_alarm << " if the drift action is not active (" << R(o.drift_marker_r)
        << " <> 1)\n";
+  if (SlopeHandedOver(o))
+    nc << "; slope handed over too: SD43910 goes to $AC_PARAM[" << o.workpiece_slope_param
+       << "] and SD43920 to $AC_PARAM[" << o.workpiece_slope_param + 1
+       << "]; the drift action adds the machine's slope and is the only writer of SD43900-43920 ("
+       << R(o.drift_slope_marker_r) << " <> 1: alarm)\n";
   return nc.str();
 }
 
@@ -538,8 +590,8 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
       Header(plan, info) + RequireDriftAction(o) + CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
   const CompensationSegment& first = plan.segments.front();
   nc += K0Target(o, "$") + "=" + k0(first.sd43900_mm) + "\n";
-  nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + slope(first.sd43910) + "\n";
-  nc += "$SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + pos(first.sd43920_mm) + "\n";
+  nc += SlopeTarget(o, "$") + "=" + slope(first.sd43910) + "\n";
+  nc += RefTarget(o, "$") + "=" + pos(first.sd43920_mm) + "\n";
   nc += "STOPRE\n";
   int id = o.sync_id_first;
   for (std::size_t i = 1; i < plan.segments.size(); ++i, ++id) {
@@ -549,8 +601,8 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   }
   const int m = o.save_r_first;
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
-        " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), "$" + R(m + 1), "$" + R(m + 2)) + " $" +
-        R(m + 3) + "=0\n";
+        " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), RestoredSlope(o, "$"), RestoredRef(o, "$")) +
+        " $" + R(m + 3) + "=0\n";
   nc += "M17\n";
   return nc;
 }
@@ -569,8 +621,8 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
         R(m + 2) + "\n";
   nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n";
   nc += K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
-  nc += "$SA_TEMP_COMP_SLOPE[" + ax + "]=" + R(m + 1) + "\n";
-  nc += "$SA_TEMP_COMP_REF_POSITION[" + ax + "]=" + R(m + 2) + "\n";
+  nc += SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n";
+  nc += RefTarget(o, "$") + "=" + RestoredRef(o, "") + "\n";
   nc += R(m + 3) + "=0\nENDIF\nSTOPRE\nM17\n";
   return nc;
 }

@@ -105,6 +105,14 @@ struct PlanOptions {
   int workpiece_k0_param = -1;
   int drift_marker_r = -1;
   int drift_missing_alarm = 65000;
+  /// -1: the plan writes SD43910/SD43920 itself. >= 0 (only with workpiece_k0_param): the drift
+  /// action also owns the slope (it adds the machine's Z-screw slope, drift_action.h): the plan
+  /// writes its SD43910 into $AC_PARAM[workpiece_slope_param] and its SD43920 into
+  /// $AC_PARAM[workpiece_slope_param + 1], saves nothing and resets the three slots to 0 at the
+  /// thread end; it raises the alarm unless R<drift_slope_marker_r> (the drift action's slope
+  /// marker) is 1 as well.
+  int workpiece_slope_param = -1;
+  int drift_slope_marker_r = -1;
 
   /// InputError naming the field, value and rule for any option out of range, and for a sign
   /// that is not ExpectedSign(direction, control_dk).

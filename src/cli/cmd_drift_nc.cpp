@@ -4,6 +4,7 @@
 // table.
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,7 @@ namespace whirl::cli {
 namespace {
 
 struct DriftNcOptions {
-  std::string model_path, machine_path, reference = "model";
+  std::string model_path, slope_model_path, machine_path, reference = "model";
   std::vector<std::string> inputs;  // NAME=INDEX:SCALE:OFFSET
   std::string nc_path, reset_path, csv_path;
   bool json = false;
@@ -41,6 +42,9 @@ std::pair<std::string, interp::AnalogInput> ParseInput(const std::string& text) 
 
 void Run(const DriftNcOptions& o) {
   const drift::DriftModel model = drift::ReadDriftModel(o.model_path);
+  std::optional<drift::DriftModel> slope;
+  if (!o.slope_model_path.empty()) slope = drift::ReadDriftModel(o.slope_model_path);
+  const drift::DriftModel* g = slope ? &*slope : nullptr;
   const interp::MachineProfile machine = interp::LoadMachineProfile(o.machine_path);
   interp::DriftActionOptions options = machine.DriftOptions();
   options.reference = interp::ParseDriftReference(o.reference);
@@ -49,9 +53,9 @@ void Run(const DriftNcOptions& o) {
     options.inputs[name] = a;
   }
   // Render everything first (a model the control cannot run fails here), then write all or none.
-  const std::string nc = interp::FormatDriftNcProgram(model, options, o.model_path);
+  const std::string nc = interp::FormatDriftNcProgram(model, options, o.model_path, g);
   const std::string reset = interp::FormatDriftNcResetProgram(options);
-  const std::string csv = interp::FormatDriftPlcCsv(model, options);
+  const std::string csv = interp::FormatDriftPlcCsv(model, options, g);
   std::vector<std::pair<std::filesystem::path, std::string>> files;
   if (!o.nc_path.empty()) files.emplace_back(o.nc_path, nc);
   if (!o.reset_path.empty()) files.emplace_back(o.reset_path, reset);
@@ -59,9 +63,18 @@ void Run(const DriftNcOptions& o) {
   WriteFilesAtomic(files);
   if (o.json) {
     const Eigen::VectorXd c = interp::DriftControlCoefficients(model, options);
+    nlohmann::json slope_json = nullptr;
+    if (g) {
+      const Eigen::VectorXd cg = interp::DriftSlopeCoefficients(*g, options);
+      slope_json = {{"model", o.slope_model_path},
+                    {"fixed_end_position_mm", options.slope_fixed_end_mm},
+                    {"growth_direction", options.slope_growth_direction},
+                    {"coefficients", std::vector<double>(cg.data(), cg.data() + cg.size())}};
+    }
     PrintJson({{"model", o.model_path},
                {"axis", options.axis},
                {"coefficients_mm", std::vector<double>(c.data(), c.data() + c.size())},
+               {"slope", slope_json},
                {"nc", o.nc_path},
                {"reset_nc", o.reset_path},
                {"csv", o.csv_path}});
@@ -70,6 +83,11 @@ void Run(const DriftNcOptions& o) {
   std::printf("drift action for axis %s: %s model of %s from %zu sensors, reference %s\n",
               options.axis.c_str(), drift::ToString(model.kind).c_str(), model.error_column.c_str(),
               model.sensors.size(), o.reference.c_str());
+  if (g)
+    std::printf("  slope (SD43910) from the %s model of %s, fixed end %.4f mm (MCS)%s\n",
+                drift::ToString(g->kind).c_str(), g->error_column.c_str(),
+                options.slope_fixed_end_mm,
+                options.workpiece_slope_param >= 0 ? ", plus the plan's slope" : "");
   for (const auto& [path, what] : {std::pair{o.nc_path, "NC program"},
                                    {o.reset_path, "NC reset program"},
                                    {o.csv_path, "PLC table"}})
@@ -91,11 +109,20 @@ void RegisterDriftNc(CLI::App* drift_app) {
       "machine profile (--machine, its 'drift' object) gives the ID range, $AC_PARAM slots, R\n"
       "parameters, interpolation cycle and analog inputs. With a whirling plan on the same axis\n"
       "(whirl plan --with-drift-action) this action is the only writer of SD43900 and adds the\n"
-      "plan's K0. Models of kind mlr or dynamic (a network is refused). The reset program\n"
-      "(--reset-nc) cancels the actions and restores the SD43900 found. Files are .SPF\n"
-      "subprograms (M17). Not verified on a control: main-run write access to SD43900.");
+      "plan's K0. With --slope-model (e.g. the Z feed screw's growth, um per 1000 mm from the\n"
+      "fixed bearing; profile 'drift.slope') it also writes SD43910 = S_m = s * sigma * g / 1e6\n"
+      "[mm/mm] about SD43920 = the fixed end [mm]; combined with a plan that hands its slope\n"
+      "over (profile 'drift.workpiece_slope_param') it owns SD43900-43920: SD43920 = P_w,\n"
+      "SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b). Models of kind mlr or\n"
+      "dynamic (a network is refused). The reset program (--reset-nc) cancels the actions and\n"
+      "restores the setting data found. Files are .SPF subprograms (M17). Not verified on a\n"
+      "control: main-run write access to SD43900-43920.");
   sub->add_option("--model", o->model_path, "drift model JSON (whirl drift fit)")
       ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--slope-model", o->slope_model_path,
+                  "drift model JSON of the machine's slope, um per 1000 mm of distance from the "
+                  "profile's drift.slope fixed end (e.g. channel zscrew_per_1000_um)")
       ->check(CLI::ExistingFile);
   sub->add_option("--machine", o->machine_path, "machine profile JSON with a 'drift' object")
       ->required()

@@ -170,6 +170,148 @@ TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
   EXPECT_TRUE(r.actions.empty());
 }
 
+// The slope channel of a screw growing from its fixed end: um per 1000 mm, from two sensors.
+drift::DriftModel SlopeModel(std::mt19937& rng) {
+  drift::DriftModel g = HandModel(false, rng);
+  g.error_column = "zscrew_per_1000_um";
+  g.linear.coefficients = Eigen::Vector3d(0.8, 11.5, -3.0);  // ~ 11.5 um per metre per K
+  return g;
+}
+
+DriftActionOptions SlopeOptions(ControlDk control, int error_direction, int sigma) {
+  DriftActionOptions o = Options(control, error_direction, DriftReference::kModel);
+  o.has_slope = true;
+  o.slope_fixed_end_mm = 5587.5;
+  o.slope_growth_direction = sigma;
+  return o;
+}
+
+// Machine alone: dK(P) = s/1000 (e_K + sigma g (P - P_b) / 1000) at every position, every cycle.
+TEST(DriftAction, SlopeModeWritesTheMachineLineAboutTheFixedEnd) {
+  std::mt19937 rng(1810);
+  for (auto control : {ControlDk::kAdded, ControlDk::kSubtracted})
+    for (int dir : {1, -1})
+      for (int sigma : {1, -1}) {
+        const drift::DriftModel m = HandModel(true, rng), g = SlopeModel(rng);
+        const DriftActionOptions o = SlopeOptions(control, dir, sigma);
+        replay::Replay r;
+        r.control.abs_value_mm = 0.0021;  // found values
+        r.control.slope = -4e-6;
+        r.control.ref_position_mm = 33.0;
+        SetInputs(r, o, Temperatures(0));
+        ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, o, "", &g)));
+        drift::DriftEvaluator ev_k(m, m.reference_C), ev_g(g, g.reference_C);
+        double worst_mm = 0;
+        for (int k = 0; k < 1200; ++k) {
+          SetInputs(r, o, Temperatures(k));
+          r.Cycle(0.0);
+          const double t_min = k * kCycleMs / 60000.0;
+          const double e_k = ev_k.Step(t_min, Temperatures(k)),
+                       e_g = ev_g.Step(t_min, Temperatures(k));
+          for (double p : {-812.5, 0.0, 2500.0, 5587.5, 6400.0}) {
+            const double expected = Sign(o) / 1000.0 * (e_k + sigma * e_g * (p - 5587.5) / 1000.0);
+            worst_mm = std::max(worst_mm, std::abs(r.control.DkMm(p) - expected));
+          }
+        }
+        EXPECT_LT(worst_mm, 1e-8) << "sigma " << sigma << " dir " << dir;
+        EXPECT_EQ(r.control.ref_position_mm, 5587.5);
+        r.EndProgram();
+        ASSERT_TRUE(r.RunProgram(FormatDriftNcResetProgram(o)));
+        EXPECT_TRUE(r.actions.empty());
+        EXPECT_EQ(r.control.abs_value_mm, 0.0021);
+        EXPECT_EQ(r.control.slope, -4e-6);
+        EXPECT_EQ(r.control.ref_position_mm, 33.0);
+        ASSERT_FALSE(HasFailure());
+      }
+}
+
+// Plan and machine both with slopes: the drift action is the only writer of SD43900-43920 and the
+// control applies workpiece plan + machine line at every position of the cut.
+TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
+  std::mt19937 rng(1811);
+  const drift::DriftModel m = HandModel(true, rng), g = SlopeModel(rng);
+  DriftActionOptions d = SlopeOptions(ControlDk::kAdded, -1, -1);
+  d.workpiece_k0_param = 99;
+  d.workpiece_slope_param = 97;
+  PlanOptions p;
+  p.direction = -1;
+  p.sign = ExpectedSign(p.direction, p.control_dk);
+  p.start_position_mm = 6200;  // thread start 6200 mm from the chuck face, travelling -Z
+  p.machine_offset_mm = -812.5;
+  p.sync_id_first = 100;
+  p.sync_id_last = 140;
+  p.save_r_first = 90;
+  p.workpiece_k0_param = 99;
+  p.drift_marker_r = d.save_r_first + 1;
+  p.workpiece_slope_param = 97;
+  p.drift_slope_marker_r = d.save_r_first + 4;
+  p.md32760 = kMd32760Max;
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({20.0, 40.0}, 4.0, 1.0);
+  const double feed = 2.0, thread = 300.0;
+  const CompensationPlan plan = BuildPlan(curve, feed, thread, p);
+
+  replay::Replay r;
+  r.control.abs_value_mm = 0.0007;
+  r.control.slope = 3e-6;
+  r.control.ref_position_mm = 12.0;
+  // An offset-only drift action does not own the slope: the plan refuses to start.
+  SetInputs(r, d, Temperatures(0));
+  DriftActionOptions offset_only = d;
+  offset_only.workpiece_slope_param = -1;
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, offset_only)));
+  EXPECT_FALSE(r.RunProgram(FormatNcProgram(plan)));
+  EXPECT_EQ(r.control.alarm, p.drift_missing_alarm);
+
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, d, "", &g)));
+  ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));
+  drift::DriftEvaluator ev_k(m, m.reference_C), ev_g(g, g.reference_C);
+  const double t_end = thread / feed;
+  const double sign = Sign(d);
+  double worst_um = 0;
+  for (int k = 0; k * kCycleMs / 1000.0 <= t_end + 2.0; ++k) {
+    const double t_s = k * kCycleMs / 1000.0;
+    const double pos = AxisPositionMm(p, feed, std::min(t_s, t_end)) - (t_s > t_end ? 1.0 : 0.0);
+    SetInputs(r, d, Temperatures(k));
+    r.Cycle(pos);
+    const double e_k = ev_k.Step(t_s / 60.0, Temperatures(k));
+    const double e_g = ev_g.Step(t_s / 60.0, Temperatures(k));
+    const double machine_mm = sign / 1000.0 * (e_k - e_g * (pos - 5587.5) / 1000.0);
+    if (t_s >= t_end) {  // the plan's part is back to 0: the machine line alone
+      EXPECT_NEAR(r.control.DkMm(pos), machine_mm, 1e-8);
+      continue;
+    }
+    const double workpiece_um = (r.control.DkMm(pos) - machine_mm) * 1000.0 / SignFactor(p.sign);
+    worst_um = std::max(worst_um, std::abs(workpiece_um - curve.ElongationUm(t_s)));
+  }
+  EXPECT_LE(worst_um, p.tolerance_um + 1e-6);
+  r.EndProgram();
+  ASSERT_TRUE(r.RunProgram(FormatNcResetProgram(p)));  // nothing to restore for the plan
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcResetProgram(d)));
+  EXPECT_EQ(r.control.abs_value_mm, 0.0007);
+  EXPECT_EQ(r.control.slope, 3e-6);
+  EXPECT_EQ(r.control.ref_position_mm, 12.0);
+  EXPECT_TRUE(r.actions.empty());
+}
+
+// A program without a slope gives back the slope an aborted slope run left behind.
+TEST(DriftAction, OffsetOnlyProgramGivesBackAnAbandonedSlope) {
+  std::mt19937 rng(1812);
+  const drift::DriftModel m = HandModel(false, rng), g = SlopeModel(rng);
+  const DriftActionOptions o = SlopeOptions(ControlDk::kAdded, 1, 1);
+  replay::Replay r;
+  r.control.slope = 2e-6;
+  r.control.ref_position_mm = -5.0;
+  SetInputs(r, o, Temperatures(0));
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, o, "", &g)));
+  r.Cycle(0.0);
+  EXPECT_NE(r.control.slope, 2e-6);
+  r.EndProgram();  // aborted: no reset program
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, o)));
+  r.Cycle(0.0);
+  EXPECT_EQ(r.control.slope, 2e-6);
+  EXPECT_EQ(r.control.ref_position_mm, -5.0);
+}
+
 TEST(DriftAction, RefusesWhatTheControlCannotRun) {
   std::mt19937 rng(1806);
   drift::DriftModel m = HandModel(true, rng);
@@ -185,7 +327,21 @@ TEST(DriftAction, RefusesWhatTheControlCannotRun) {
   m.time_unit = "sample";
   EXPECT_THROW(FormatDriftNcProgram(m, Options(ControlDk::kAdded, 1, DriftReference::kModel)),
                InputError);  // lags in samples
+  // Slope models: without the profile's slope object; with a plan that keeps SD43910 itself;
+  // the plan's slope slots inside the action's own.
+  const drift::DriftModel g = SlopeModel(rng);
   m = HandModel(false, rng);
+  o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  EXPECT_THROW(FormatDriftNcProgram(m, o, "", &g), InputError);
+  o = SlopeOptions(ControlDk::kAdded, 1, 1);
+  o.workpiece_k0_param = 99;
+  EXPECT_THROW(FormatDriftNcProgram(m, o, "", &g), InputError);
+  o.workpiece_slope_param = o.param_first + 3;
+  EXPECT_THROW(FormatDriftNcProgram(m, o, "", &g), InputError);
+  o.workpiece_slope_param = 98;  // its second slot is workpiece_k0_param
+  EXPECT_THROW(FormatDriftNcProgram(m, o, "", &g), InputError);
+  o.workpiece_slope_param = 97;
+  EXPECT_NO_THROW(FormatDriftNcProgram(m, o, "", &g));
   m.kind = drift::ModelKind::kNetwork;
   EXPECT_THROW(FormatDriftNcProgram(m, Options(ControlDk::kAdded, 1, DriftReference::kModel)),
                InputError);
@@ -203,7 +359,7 @@ TEST(DriftAction, HostileNamesStayInsideCommentsAndCells) {
   std::string line;
   while (std::getline(csv, line)) {
     if (line.empty() || line[0] == '#') continue;
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 8) << line;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 9) << line;
   }
 }
 
@@ -217,6 +373,17 @@ TEST(DriftAction, GoldenProgramAndPlcTable) {
   const std::string path = std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action.spf";
   if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path, nc);
   EXPECT_EQ(nc, ReadTextFile(path)) << "actual:\n" << nc;
+  // With the machine's slope, handed over by the plan.
+  const drift::DriftModel g = SlopeModel(rng);
+  DriftActionOptions os = SlopeOptions(ControlDk::kAdded, -1, -1);
+  os.workpiece_k0_param = 99;
+  os.workpiece_slope_param = 97;
+  const std::string nc_slope =
+      FormatDriftNcProgram(m, os, "golden model", &g) + FormatDriftPlcCsv(m, os, &g);
+  const std::string path_slope =
+      std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action_slope.spf";
+  if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path_slope, nc_slope);
+  EXPECT_EQ(nc_slope, ReadTextFile(path_slope)) << "actual:\n" << nc_slope;
 }
 
 }  // namespace

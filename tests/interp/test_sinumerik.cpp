@@ -217,7 +217,8 @@ TEST(Sinumerik, PointsCsvEndsWithTheRestoreNotWithZeros) {
   for (std::size_t i = 0; i < plan.segments.size(); ++i) {
     EXPECT_EQ(std::stod(rows[i + 1][3]), plan.segments[i].sd43900_mm);
     EXPECT_EQ(rows[i + 1][4], FormatFixed(plan.segments[i].sd43910, kDecimalsSd43910));
-    for (const std::string& cell : rows[i + 1]) EXPECT_EQ(cell.find_first_of("eE"), std::string::npos);
+    for (const std::string& cell : rows[i + 1])
+      EXPECT_EQ(cell.find_first_of("eE"), std::string::npos);
   }
   const auto& last = rows.back();
   EXPECT_EQ(std::stod(last[0]), RoundTo(plan.segments.back().t_b_s, kDecimalsTimeS));
@@ -300,6 +301,24 @@ TEST(Sinumerik, NcProgramMatchesGoldenFile) {
       std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/small_plan_reset.spf";
   if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(reset_path, reset);
   EXPECT_EQ(reset, ReadTextFile(reset_path)) << "actual:\n" << reset;
+}
+
+// The plan that hands K0, slope and reference to the drift action (interp/drift_action.h).
+TEST(Sinumerik, HandedOverNcProgramMatchesGoldenFile) {
+  CompensationPlan plan = SmallPlan();
+  plan.options.workpiece_k0_param = 99;
+  plan.options.drift_marker_r = 81;
+  plan.options.workpiece_slope_param = 97;
+  plan.options.drift_slope_marker_r = 84;
+  NcProgramInfo info;
+  info.curve_source = "golden test plan";
+  const std::string nc = FormatNcProgram(plan, info) + FormatNcResetProgram(plan.options, info);
+  const std::string path =
+      std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/small_plan_handover.spf";
+  if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path, nc);
+  EXPECT_EQ(nc, ReadTextFile(path)) << "actual:\n" << nc;
+  EXPECT_EQ(nc.find("SA_TEMP_COMP_SLOPE"), std::string::npos) << "the plan must not write SD43910";
+  EXPECT_EQ(nc.find("SA_TEMP_COMP_ABS_VALUE"), std::string::npos);
 }
 
 TEST(Sinumerik, NcProgramValuesReconstructTheCompensation) {
