@@ -9,14 +9,13 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/compare.h"
+#include "compare/machine_eval.h"  // step 7 (issue 19)
 #include "compare/plan_document.h"
 #include "compare/report.h"
 #include "core/error.h"
 #include "interp/machine_profile.h"
 #include "nn/model.h"
 #include "sim/screw.h"
-
-#include "compare/machine_eval.h"  // step 7 (issue 19)
 
 namespace whirl::cli {
 namespace {
@@ -39,6 +38,8 @@ void RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model
   mo.screws_per_machine = 2;
   mo.seed = seed;
   mo.report_dir = (out / "machine_report").string();
+  // The combined 840D programs of the report's screw, for the simulated machine's profile.
+  mo.profile = interp::LoadMachineProfile(ProjectPath("datasets/machines/whirling_840d.json"));
   std::filesystem::remove_all(mo.report_dir);  // the demo's own output of an earlier run
   const compare::MachineEvaluation e = compare::EvaluateWithMachines(
       sim::ReferenceScrew(), model,
@@ -47,9 +48,11 @@ void RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model
           ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv")),
       mo);
   std::printf(
-      "7. both halves on a drifting machine (whirl machine evaluate): %s\n%s   report: %s\n",
+      "7. both halves on a drifting machine (whirl machine evaluate): %s\n%s   report: %s\n"
+      "   combined 840D programs (the drift action owns SD43900-43920; the plan hands its K0,\n"
+      "   slope and reference over): %s/WHIRL_DRIFT_COMP.SPF, WHIRL_TEMP_COMP.SPF, resets\n",
       e.summary.message.c_str(), compare::FormatMachineEvalTable(e, false).c_str(),
-      e.report_index.c_str());
+      e.report_index.c_str(), mo.report_dir.c_str());
 }
 
 void RunDemo(const DemoOptions& o) {

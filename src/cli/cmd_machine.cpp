@@ -13,6 +13,7 @@
 #include "core/process.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
+#include "interp/machine_profile.h"
 #include "machine/machine.h"
 #include "nn/model.h"
 #include "sim/random.h"
@@ -37,6 +38,7 @@ struct MachineCliOptions {
   std::string drift_model = "mlr";
   double monitor_every_min = 30;
   std::string report;
+  std::string profile = ProjectPath("datasets/machines/whirling_840d.json");
 };
 
 machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
@@ -91,6 +93,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.fit.kind = drift::ParseModelKind(o.drift_model);
   eo.monitor_every_min = o.monitor_every_min;
   eo.report_dir = o.report;
+  if (!o.report.empty()) eo.profile = interp::LoadMachineProfile(o.profile);
   Progress progress("machine evaluate", static_cast<std::size_t>(o.machines * o.screws));
   const compare::MachineEvaluation e = compare::EvaluateWithMachines(
       base, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); });
@@ -182,8 +185,13 @@ void RegisterMachine(CLI::App& app) {
       ->check(CLI::Range(1.0, 600.0));
   e->add_option("--report", o->report,
                 "write the first screw's report here: sensor plot [degC over min], chosen "
-                "sensors, lead deviation per strategy [um over mm] (folder must not exist or be "
-                "empty)");
+                "sensors, lead deviation per strategy [um over mm] and the screw's combined 840D "
+                "programs for --profile (folder must not exist or be empty)");
+  e->add_option("--profile", o->profile,
+                "840D machine profile of the combined programs in the report (schema "
+                "whirl.machine with drift.slope and drift.workpiece_slope_param; default "
+                "datasets/machines/whirling_840d.json, which matches the simulated machine)")
+      ->check(CLI::ExistingFile);
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
 }

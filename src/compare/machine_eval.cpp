@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "compare/machine_nc.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "drift/monitor.h"
@@ -112,6 +113,10 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
   out.screw = screw;
   out.seed = options.seed;
   const ScrewComparison c = CompareScrew(screw, model, rule, iso_table, options);
+  if (detail) {
+    detail->predicted_curve = c.predicted_curve;
+    detail->kinematics = c.kinematics;
+  }
   const double feed = c.kinematics.axial_feed_mm_s;
   const double z0 = c.kinematics.thread_start_position_mm;
   const double v_c = screw.process.cutting_speed_m_min;
@@ -273,8 +278,14 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
     const MachineEvalScrew first =
         EvaluateScrewOnMachine(screws.front(), model, rule, iso_table, day, models[0], co,
                                options.monitor_every_min, &detail);
-    e.report_index = WriteMachineScrewReport(options.report_dir, first, detail,
-                                             e.sensors_cutting[0], e.sensors_idle[0]);
+    std::optional<CombinedPrograms> programs;
+    if (options.profile && models[0].fitted)
+      programs = BuildCombinedPrograms(
+          detail.predicted_curve, detail.kinematics, screws.front().thread_length_mm, co.plan,
+          models[0], day.config, *options.profile, "network curve of screw " + screws.front().name);
+    e.report_index =
+        WriteMachineScrewReport(options.report_dir, first, detail, e.sensors_cutting[0],
+                                e.sensors_idle[0], programs ? &*programs : nullptr);
   }
   return e;
 }

@@ -33,11 +33,13 @@
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "compare/evaluate.h"
 #include "drift/model.h"
+#include "interp/machine_profile.h"
 #include "machine/machine.h"
 
 namespace whirl::compare {
@@ -72,6 +74,9 @@ struct MachineEvalOptions {
   double monitor_every_min = 30;  ///< both_monitor: check interval, min (> 0)
   /// Non-empty: WriteMachineScrewReport of the first screw (machine 0) into this folder.
   std::string report_dir;
+  /// With report_dir: the report also holds the combined 840D programs of that screw for this
+  /// profile (compare/machine_nc.h; shipped: datasets/machines/whirling_840d.json).
+  std::optional<interp::MachineProfile> profile;
 };
 
 /// The machine models of one machine.
@@ -120,7 +125,11 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
 struct MachineScrewDetail {
   drift::Run log;  ///< empty when no machine model was fitted
   std::array<LeadDeviation, kMachineStrategyCount> leads;
+  fit::ArctanCurve predicted_curve;  ///< the network's curve (the workpiece plan's)
+  sim::Kinematics kinematics;
 };
+
+struct CombinedPrograms;  // compare/machine_nc.h
 
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
@@ -136,10 +145,13 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
 /// degC over min), lead.csv/.png (lead deviation per strategy, um over mm), index.html with the
 /// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
 /// Returns the index path.
+/// `programs` (optional): the screw's combined 840D programs, written beside the figures
+/// (compare/machine_nc.h CombinedProgramFiles) and shown in index.html.
 std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
                                     const MachineScrewDetail& detail,
                                     const std::vector<std::string>& sensors_cutting,
-                                    const std::vector<std::string>& sensors_idle);
+                                    const std::vector<std::string>& sensors_idle,
+                                    const CombinedPrograms* programs = nullptr);
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
                                        const ExperienceRule& rule,

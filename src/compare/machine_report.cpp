@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "compare/machine_eval.h"
+#include "compare/machine_nc.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/run_program.h"
@@ -90,9 +91,40 @@ std::string List(const std::vector<std::string>& names) {
   return s.empty() ? "(none: no machine model)" : s;
 }
 
+// The last static action of the drift program: the one that writes the setting data.
+std::string OutputAction(const std::string& drift_nc) {
+  const std::size_t end = drift_nc.rfind("\nM17");
+  const std::size_t begin = drift_nc.rfind("\nIDS=", end);
+  if (end == std::string::npos || begin == std::string::npos) return "";
+  return drift_nc.substr(begin + 1, end - begin - 1);
+}
+
+std::string ProgramsHtml(const CombinedPrograms* p) {
+  if (!p) return "";
+  const interp::DriftActionOptions& d = p->drift;
+  std::string h =
+      "<h2>Combined 840D programs (one writer per setting datum)</h2><p>The workpiece plan (" +
+      std::to_string(p->plan.segments.size()) +
+      " segments of the network's curve) writes its K0, SD43910 and SD43920 into $AC_PARAM[" +
+      std::to_string(d.workpiece_k0_param) + "], [" + std::to_string(d.workpiece_slope_param) +
+      "], [" + std::to_string(d.workpiece_slope_param + 1) +
+      "]; the machine drift action (offset model and Z-screw slope model, evaluated every "
+      "interpolation cycle from the analog inputs) is the only writer of SD43900-43920: "
+      "SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b), the fixed "
+      "bearing at P_b = " +
+      interp::FormatFixed(d.slope_fixed_end_mm, 4) +
+      " mm (MCS). Call WHIRL_DRIFT_COMP first, then WHIRL_TEMP_COMP before the cutting block, "
+      "the reset programs after the cut or an abort.</p><ul>";
+  for (const char* f : {"WHIRL_TEMP_COMP.SPF", "WHIRL_TEMP_COMP_RESET.SPF", "WHIRL_DRIFT_COMP.SPF",
+                        "WHIRL_DRIFT_COMP_RESET.SPF", "WHIRL_DRIFT_COMP_PLC.csv"})
+    h += std::string("<li><a href='") + f + "'>" + f + "</a></li>";
+  return h + "</ul><p>The drift action's output:</p><pre>" + HtmlEscape(OutputAction(p->drift_nc)) +
+         "</pre>";
+}
+
 std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
                  const std::vector<std::string>& idle, const std::string& sensor_img,
-                 const std::string& lead_img) {
+                 const std::string& lead_img, const CombinedPrograms* programs) {
   std::string h = "<!doctype html><html><head><meta charset='utf-8'><title>" +
                   HtmlEscape(r.screw.name) + ": both halves</title></head><body><h1>" +
                   HtmlEscape(r.screw.name) +
@@ -112,9 +144,9 @@ std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutt
   }
   std::snprintf(buf, sizeof buf,
                 "</table><p>Left after both, over the thread: workpiece part %.1f um, machine "
-                "part %.1f um.</p></body></html>\n",
+                "part %.1f um.</p>",
                 r.residual_workpiece_total_um, r.residual_machine_total_um);
-  return h + buf;
+  return h + buf + ProgramsHtml(programs) + "</body></html>\n";
 }
 
 }  // namespace
@@ -122,7 +154,8 @@ std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutt
 std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
                                     const MachineScrewDetail& detail,
                                     const std::vector<std::string>& sensors_cutting,
-                                    const std::vector<std::string>& sensors_idle) {
+                                    const std::vector<std::string>& sensors_idle,
+                                    const CombinedPrograms* programs) {
   if (!screw.ok) throw InputError("report of screw '" + screw.screw.name + "': " + screw.error);
   const fs::path target = fs::absolute(dir);
   std::error_code ec;
@@ -142,8 +175,9 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
     WriteFileAtomic(partial / "lead.csv", LeadCsv(detail));
     const std::string lead_img =
         Render(partial, "lead", LeadScript(screw.screw.name + ": lead deviation"));
+    if (programs) WriteFilesAtomic(CombinedProgramFiles(partial, *programs));
     WriteFileAtomic(partial / "index.html",
-                    Html(screw, sensors_cutting, sensors_idle, sensor_img, lead_img));
+                    Html(screw, sensors_cutting, sensors_idle, sensor_img, lead_img, programs));
     fs::remove(target, ec);  // an empty directory only
     fs::rename(partial, target);
   } catch (...) {

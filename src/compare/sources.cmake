@@ -15,4 +15,7 @@ target_sources(whirl_compare PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp
   ${CMAKE_CURRENT_LIST_DIR}/scenarios.cpp
   ${CMAKE_CURRENT_LIST_DIR}/report.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/plan_document.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/plan_document.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/machine_eval.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/machine_report.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/machine_nc.cpp)

@@ -53,4 +53,28 @@ done
   > "$D/nc.txt" 2>&1 || fail "drift nc with the machine model: $(cat "$D/nc.txt")"
 grep -q 'AC_PARAM' "$D/PLAN.SPF" || fail "plan does not hand its K0 over"
 grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/DRIFT.SPF" || fail "drift action does not write SD43900"
+
+# The machine's Z-screw slope on the control: with the simulated machine's profile the plan hands
+# K0, slope and reference over and the drift action (offset + slope model) owns SD43900-43920.
+W840="$S/datasets/machines/whirling_840d.json"
+"$W" drift fit --cutting "$D/runs/cutting_1.csv" --error zscrew_per_1000_um \
+  --out "$D/zscrew.json" > /dev/null 2>&1 || fail "drift fit of the slope channel"
+"$W" plan --screw "$S/datasets/screws/reference_80x10x6000.json" --machine "$W840" \
+  --start-position-mm 5600 --model "$S/models/default.json" --with-drift-action \
+  --nc "$D/PLAN2.SPF" > "$D/plan2.txt" 2>&1 || fail "plan with the slope handed over: $(cat "$D/plan2.txt")"
+"$W" drift nc --model "$D/offset.json" --slope-model "$D/zscrew.json" --machine "$W840" \
+  --reference start --nc "$D/DRIFT2.SPF" --reset-nc "$D/DRIFT2_RESET.SPF" --csv "$D/DRIFT2.csv" \
+  > "$D/nc2.txt" 2>&1 || fail "drift nc --slope-model: $(cat "$D/nc2.txt")"
+! grep -q 'SA_TEMP_COMP' "$D/PLAN2.SPF" || fail "the handed-over plan writes a setting datum itself"
+grep -q 'SA_TEMP_COMP_SLOPE\[Z\]=\$AC_PARAM' "$D/DRIFT2.SPF" || fail "drift action does not own SD43910"
+grep -q '^slope,' "$D/DRIFT2.csv" || fail "PLC table has no slope rows"
+# A profile without drift.slope cannot take a slope model; nothing is written.
+expect_fail "drift.slope" "$W" drift nc --model "$D/offset.json" --slope-model "$D/zscrew.json" \
+  --machine "$P" "${inputs[@]}" --nc "$D/none.SPF"
+[ ! -e "$D/none.SPF" ] || fail "program written on bad input"
+# The report holds the combined programs of its screw.
+"$W" machine evaluate --machines 1 --screws 1 --report "$D/report" > /dev/null 2>&1 || fail "evaluate --report"
+for f in WHIRL_TEMP_COMP.SPF WHIRL_DRIFT_COMP.SPF WHIRL_DRIFT_COMP_RESET.SPF index.html; do
+  [ -f "$D/report/$f" ] || fail "report lacks $f"
+done
 echo "cli_machine: ok"

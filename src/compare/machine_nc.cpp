@@ -1,0 +1,77 @@
+#include "compare/machine_nc.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace whirl::compare {
+namespace {
+
+void Require(bool ok, const interp::MachineProfile& p, const std::string& field,
+             const std::string& rule) {
+  if (!ok) throw InputError("machine profile '" + p.source + "', " + field + ": " + rule);
+}
+
+// The profile against the simulated machine's geometry (see the header).
+void CheckAgainstMachine(const interp::MachineProfile& p, const interp::DriftActionOptions& d,
+                         double fixed_end_mm) {
+  Require(d.has_slope, p, "drift.slope", "missing (the Z feed screw's fixed end)");
+  Require(d.workpiece_slope_param >= 0, p, "drift.workpiece_slope_param",
+          "missing: the plan must hand its SD43910/SD43920 to the drift action");
+  const std::string dir = std::to_string(p.direction);
+  Require(d.error_direction == p.direction, p, "drift.error_direction",
+          std::to_string(d.error_direction) + " must equal direction " + dir +
+              " (the machine error is positive towards the chuck, the direction of travel)");
+  Require(d.slope_growth_direction == p.direction, p, "drift.slope.growth_direction",
+          std::to_string(d.slope_growth_direction) + " must equal direction " + dir +
+              " (the distance from the fixed bearing grows towards the chuck)");
+  Require(std::abs(d.slope_fixed_end_mm - fixed_end_mm) < 1e-3, p,
+          "drift.slope.fixed_end_position_mm",
+          interp::FormatFixed(d.slope_fixed_end_mm, 4) + " mm, but the machine's fixed bearing " +
+              "(z_fixed) sits at " + interp::FormatFixed(fixed_end_mm, 4) + " mm (MCS)");
+}
+
+}  // namespace
+
+CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
+                                       const sim::Kinematics& kinematics, double thread_length_mm,
+                                       const interp::PlanOptions& plan_options,
+                                       const MachineModels& models,
+                                       const machine::MachineConfig& machine,
+                                       const interp::MachineProfile& profile,
+                                       const std::string& curve_source) {
+  if (!models.fitted)
+    throw InputError("combined programs: no machine model (every machine component is off)");
+  CombinedPrograms out;
+  interp::PlanOptions po = plan_options;
+  profile.ApplyCombinedTo(po);
+  po.start_position_mm = kinematics.thread_start_position_mm;  // program zero: the chuck face
+  out.drift = profile.DriftOptions();
+  out.drift.reference = interp::DriftReference::kStart;
+  const double z0 = kinematics.thread_start_position_mm;
+  CheckAgainstMachine(profile, out.drift,
+                      po.machine_offset_mm + po.start_position_mm +
+                          po.direction * (z0 - machine.z_screw.fixed_end_mm));
+  out.plan = interp::BuildPlan(curve, kinematics.axial_feed_mm_s, thread_length_mm, po);
+  interp::NcProgramInfo info;
+  info.curve_source = curve_source;
+  out.plan_nc = interp::FormatNcProgram(out.plan, info);
+  out.plan_reset_nc = interp::FormatNcResetProgram(po, info);
+  const drift::DriftModel& g = models.slope_cutting;
+  out.drift_nc = interp::FormatDriftNcProgram(models.offset_cutting, out.drift,
+                                              "machine model trained on cutting runs", &g);
+  out.drift_reset_nc = interp::FormatDriftNcResetProgram(out.drift);
+  out.drift_plc_csv = interp::FormatDriftPlcCsv(models.offset_cutting, out.drift, &g);
+  return out;
+}
+
+std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
+    const std::filesystem::path& dir, const CombinedPrograms& p) {
+  return {{dir / "WHIRL_TEMP_COMP.SPF", p.plan_nc},
+          {dir / "WHIRL_TEMP_COMP_RESET.SPF", p.plan_reset_nc},
+          {dir / "WHIRL_DRIFT_COMP.SPF", p.drift_nc},
+          {dir / "WHIRL_DRIFT_COMP_RESET.SPF", p.drift_reset_nc},
+          {dir / "WHIRL_DRIFT_COMP_PLC.csv", p.drift_plc_csv}};
+}
+
+}  // namespace whirl::compare

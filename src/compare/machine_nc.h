@@ -1,0 +1,56 @@
+#pragma once
+// The combined 840D programs of one screw on a drifting whirling machine (issue 19, point 3):
+// the workpiece plan (the network's curve, interp/sinumerik.h) and the live machine-drift action
+// (the offset model and the Z feed screw's slope model, interp/drift_action.h) in one pair of
+// programs in which each setting datum has one writer:
+//   the plan writes its K0_w, SD43910 S_w and SD43920 P_w into $AC_PARAM (profile
+//   drift.workpiece_k0_param, drift.workpiece_slope_param and + 1);
+//   the drift action writes SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m +
+//   S_m (P_w - P_b), K_m from the offset model (offset_um), S_m from the slope model
+//   (zscrew_per_1000_um) about the screw's fixed bearing P_b.
+// Coordinates (machine/machine.h): the tool is z mm from the chuck face, the cut runs towards
+// the chuck, z(t) = z_0 - v_f t. The plan's program zero is taken at the chuck face, so the
+// thread start is start_position_mm = z_0 and the axis reads P = machine_offset_mm + start +
+// direction (z_0 - z). The profile must agree with the simulated machine: error_direction =
+// growth_direction = direction (the machine error m is positive towards the chuck, which is the
+// direction of travel), and drift.slope.fixed_end_position_mm = P at z = z_fixed; a profile that
+// does not is an InputError naming the field, its value and the value the machine implies.
+// Shipped profile for the simulated machine: datasets/machines/whirling_840d.json.
+// The drift action's rises are taken from the temperatures when it starts (reference "start"),
+// the convention of drift::PredictRun the evaluation uses (the machine starts cold with the cut).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "compare/machine_eval.h"
+#include "interp/drift_action.h"
+#include "interp/machine_profile.h"
+
+namespace whirl::compare {
+
+struct CombinedPrograms {
+  interp::CompensationPlan plan;       ///< the workpiece plan, handing K0 and slope over
+  interp::DriftActionOptions drift;    ///< the drift action's options (from the profile)
+  std::string plan_nc, plan_reset_nc;  ///< .SPF subprograms
+  std::string drift_nc, drift_reset_nc, drift_plc_csv;
+};
+
+/// Builds both programs. `plan_options` gives the tolerance and check step (the profile sets
+/// everything else); `models` must be fitted (machine components on). InputError when the
+/// profile lacks the drift object, its slope object or workpiece_slope_param, disagrees with the
+/// machine (see above), or when a program cannot be written (IDs, MD32760, analog inputs).
+CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
+                                       const sim::Kinematics& kinematics, double thread_length_mm,
+                                       const interp::PlanOptions& plan_options,
+                                       const MachineModels& models,
+                                       const machine::MachineConfig& machine,
+                                       const interp::MachineProfile& profile,
+                                       const std::string& curve_source);
+
+/// The files of the programs in `dir` (created if needed): WHIRL_TEMP_COMP.SPF,
+/// WHIRL_TEMP_COMP_RESET.SPF, WHIRL_DRIFT_COMP.SPF, WHIRL_DRIFT_COMP_RESET.SPF,
+/// WHIRL_DRIFT_COMP_PLC.csv, as (path, text) pairs for core's WriteFilesAtomic.
+std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
+    const std::filesystem::path& dir, const CombinedPrograms& programs);
+
+}  // namespace whirl::compare
