@@ -20,20 +20,6 @@ namespace fs = std::filesystem;
 
 const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
 
-std::string SensorCsv(const drift::Run& log) {
-  std::ostringstream out;
-  out << "time_min";
-  for (const auto& n : log.sensor_names) out << ',' << n;
-  out << '\n';
-  for (int k = 0; k < log.samples(); ++k) {
-    out << log.time_min[static_cast<std::size_t>(k)];
-    for (Eigen::Index s = 0; s < log.temperature_C.cols(); ++s)
-      out << ',' << log.temperature_C(k, s);
-    out << '\n';
-  }
-  return out.str();
-}
-
 std::string LeadCsv(const MachineScrewDetail& d) {
   std::ostringstream out;
   out << "position_mm";
@@ -168,7 +154,16 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
   try {
     std::string sensor_img = "<p>(no sensor log: the machine does not drift)</p>";
     if (detail.log.samples() > 0) {
-      WriteFileAtomic(partial / "sensors.csv", SensorCsv(detail.log));
+      // The screw's log in the drift run format (temperatures and the two error channels), so
+      // `whirl drift predict --run sensors.csv` evaluates a machine model on it.
+      WriteFileAtomic(
+          partial / "sensors.csv",
+          drift::FormatRun(detail.log, {"virtual sensor log of screw " + screw.screw.name +
+                                            " during its cut (simulated, src/machine/machine.h; "
+                                            "machine day seed " +
+                                            std::to_string(screw.day_seed) + ")",
+                                        "offset_um: machine drift at the Z screw's fixed end; "
+                                        "zscrew_per_1000_um: its growth per 1000 mm (um)"}));
       sensor_img = Render(partial, "sensors",
                           SensorScript(detail.log, screw.screw.name + ": virtual sensors"));
     }

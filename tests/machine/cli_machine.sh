@@ -77,4 +77,8 @@ expect_fail "drift.slope" "$W" drift nc --model "$D/offset.json" --slope-model "
 for f in WHIRL_TEMP_COMP.SPF WHIRL_DRIFT_COMP.SPF WHIRL_DRIFT_COMP_RESET.SPF index.html; do
   [ -f "$D/report/$f" ] || fail "report lacks $f"
 done
+# The screw's own sensor log is a drift run file: a machine model evaluates on it.
+"$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \
+  2>/dev/null || fail "drift predict on the screw's log"
+grep -q '"residual"' "$D/pred2.json" || fail "the screw's log has no offset_um channel"
 echo "cli_machine: ok"
