@@ -112,7 +112,11 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
   MachineEvalScrew out;
   out.screw = screw;
   out.seed = options.seed;
-  const ScrewComparison c = CompareScrew(screw, model, rule, iso_table, options);
+  // One hall: the workpiece follows the same ambient ramp as the machine's bed.
+  CompareOptions co = options;
+  if (day.config.ambient.enabled)
+    co.disturbance.ambient_drift_fixed_k_per_h = day.ambient_rate_k_per_h;
+  const ScrewComparison c = CompareScrew(screw, model, rule, iso_table, co);
   if (detail) {
     detail->predicted_curve = c.predicted_curve;
     detail->kinematics = c.kinematics;

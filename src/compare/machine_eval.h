@@ -4,7 +4,9 @@
 // model, or by both.
 //
 // Truth of one screw on machine i, day d: e_tot(t) = e(t) + m(t, z(t)), e the workpiece truth of
-// CompareScrew (same seed, disturbances on), m the machine drift at the tool position
+// CompareScrew (same seed, disturbances on; with the machine's ambient component on, the blank
+// follows the day's hall rate r, the same ramp the bed follows: one hall, not two independent
+// draws), m the machine drift at the tool position
 // z(t) = thread_start_position - v_f t. Lead deviation: compare/cut.h with e_tot.
 // Strategies (compensation c(t), um):
 //   none            0

@@ -32,8 +32,9 @@
 //             the fixed bearing (and so the tool) away from the chuck:
 //             m_bed = -1000 alpha_b dT_bed(t) z_fixed.
 // The workpiece's own response to the ambient drift stays in the workpiece simulator
-// (sim::DisturbanceOptions::ambient_drift): with every machine component off, m = 0 and every
-// result equals the workpiece-only one exactly.
+// (sim::DisturbanceOptions::ambient_drift; the evaluation gives it the day's rate r, so blank and
+// bed share one hall): with every machine component off, m = 0 and every result equals the
+// workpiece-only one exactly.
 //
 // Variation: a machine seed scales g_motor, g_process, R_z and the three time constants each by
 // (1 + machine_spread N(0,1)) (clamped to >= 0.2); a day seed draws the ambient rate

@@ -117,7 +117,9 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
       dist.expansion_factor = std::max(0.0, 1.0 + disturbances.expansion_rel_std * n_alpha);
     }
     if (disturbances.ambient_drift)
-      dist.ambient_drift_k_per_h = disturbances.ambient_drift_std_k_per_h * n_drift;
+      dist.ambient_drift_k_per_h = std::isfinite(disturbances.ambient_drift_fixed_k_per_h)
+                                       ? disturbances.ambient_drift_fixed_k_per_h
+                                       : disturbances.ambient_drift_std_k_per_h * n_drift;
     if (disturbances.measurement_noise)
       dist.measurement_noise_std_um = disturbances.measurement_noise_std_um;
   }

@@ -28,6 +28,7 @@
 // tridiagonal LU (Thomas) factors are computed once; each step costs O(cells). The elongation
 // integral uses the piecewise-linear reconstruction between cell centres up to x_c.
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,9 @@ struct DisturbanceOptions {
   /// chuck.
   bool ambient_drift = true;
   double ambient_drift_std_k_per_h = 0.2;
+  /// When finite: the hall's rate r is given instead of drawn (the same hall as the machine's
+  /// bed, compare/machine_eval.h); the draw is still made, so every later draw is unchanged.
+  double ambient_drift_fixed_k_per_h = std::numeric_limits<double>::quiet_NaN();
   /// Inductive-sensor noise on the recorded curve: N(0, std) per sample, std 0.25 um, i.e. about
   /// +-0.5 um (95 %).
   bool measurement_noise = true;

@@ -165,6 +165,26 @@ TEST(Simulator, DisturbancesAreSeededAndSwitchable) {
   EXPECT_EQ(off.curve.elongation_um, off.elongation_noise_free_um);
 }
 
+// The hall's rate given (the machine's day, compare/machine_eval.h): applied exactly, every other
+// draw unchanged, and a warming hall lengthens the screw more than a cooling one.
+TEST(Simulator, GivenAmbientRateReplacesOnlyTheDrawnOne) {
+  SimOptions o;
+  o.duration_s = 1200;
+  DisturbanceOptions d;
+  d.enabled = true;
+  d.seed = 11;
+  d.measurement_noise = false;
+  const SimulationResult drawn = Simulate(ReferenceScrew(), o, d);
+  d.ambient_drift_fixed_k_per_h = 0.8;
+  const SimulationResult warm = Simulate(ReferenceScrew(), o, d);
+  d.ambient_drift_fixed_k_per_h = -0.8;
+  const SimulationResult cool = Simulate(ReferenceScrew(), o, d);
+  EXPECT_EQ(warm.disturbances.ambient_drift_k_per_h, 0.8);
+  EXPECT_EQ(warm.disturbances.heat_partition_factor, drawn.disturbances.heat_partition_factor);
+  EXPECT_EQ(warm.disturbances.expansion_factor, drawn.disturbances.expansion_factor);
+  EXPECT_GT(warm.curve.elongation_um.back(), cool.curve.elongation_um.back());
+}
+
 TEST(ProcessModel, KinematicsClosedFormsForTheReferenceScrew) {
   const Kinematics k = ComputeKinematics(ReferenceScrew());
   EXPECT_NEAR(k.ring_speed_rpm, 180000.0 / (kPi * 86.0), 1e-9);
@@ -314,19 +334,20 @@ TEST(Features, DisturbedCurvesGiveTheUndriftedFeatures) {
     settle_err.push_back(e_s);
     max_err.push_back(e_m);
     if (e_s > kSettleTol) ++settle_outside;
-    EXPECT_LT(e_s, 2 * kSettleTol) << "case " << c << ", drift "
-                                   << r.disturbances.ambient_drift_k_per_h << " K/h:\n  disturbed: "
-                                   << a.message << "\n  reference: " << b.message;
+    EXPECT_LT(e_s, 2 * kSettleTol)
+        << "case " << c << ", drift " << r.disturbances.ambient_drift_k_per_h
+        << " K/h:\n  disturbed: " << a.message << "\n  reference: " << b.message;
     EXPECT_LT(e_m, kMaxTol) << "case " << c << ": " << a.message << " vs " << b.message;
     EXPECT_TRUE(b.settled_before_tail) << b.message;
   }
   EXPECT_LE(settle_outside, 1) << "settle times outside +-" << kSettleTol * 100 << " %";
   std::sort(settle_err.begin(), settle_err.end());
   std::sort(max_err.begin(), max_err.end());
-  std::printf("[ figures  ] %d cases: settle time |rel. error| median %.1f %%, worst %.1f %%; "
-              "max elongation median %.2f %%, worst %.2f %%\n",
-              kCases, 100 * settle_err[kCases / 2], 100 * settle_err.back(),
-              100 * max_err[kCases / 2], 100 * max_err.back());
+  std::printf(
+      "[ figures  ] %d cases: settle time |rel. error| median %.1f %%, worst %.1f %%; "
+      "max elongation median %.2f %%, worst %.2f %%\n",
+      kCases, 100 * settle_err[kCases / 2], 100 * settle_err.back(), 100 * max_err[kCases / 2],
+      100 * max_err.back());
 }
 
 TEST(Features, RejectsBadCurves) {
