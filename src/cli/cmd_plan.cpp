@@ -252,8 +252,10 @@ void RegisterPlan(CLI::App& app) {
   sub->add_flag("--with-drift-action", o->with_drift_action,
                 "combined with the live drift action (whirl drift nc) on the same axis: the plan "
                 "writes its K0 into the profile's drift.workpiece_k0_param and the drift action "
-                "adds it into SD43900, its only writer; the program raises the profile's alarm if "
-                "the drift action is not active");
+                "adds it into SD43900, its only writer; with the profile's "
+                "drift.workpiece_slope_param the plan also hands its SD43910/SD43920 over and the "
+                "drift action (with --slope-model) owns all three; the program raises the "
+                "profile's alarm if the drift action is not active");
   sub->add_option("--reset-nc", o->reset_nc_path,
                   "write the reset subprogram for an aborted cut here (.SPF)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
