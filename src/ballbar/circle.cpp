@@ -8,18 +8,12 @@
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::ballbar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180;
-
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 CircleTrace FromTable(const CsvTable& t) {
   for (const auto& name : t.header)
@@ -37,7 +31,7 @@ CircleTrace FromTable(const CsvTable& t) {
   for (std::size_t i = 0; i < c.deviation_um.size(); ++i)
     if (std::abs(c.deviation_um[i]) > 10000)
       throw InputError(t.source + ":" + std::to_string(t.line_numbers[i]) +
-                       ": column 'deviation_um': " + Num(c.deviation_um[i]) +
+                       ": column 'deviation_um': " + MessageNumber(c.deviation_um[i]) +
                        " um is beyond +-10000 um (a deviation, not a radius?)");
   return c;
 }
@@ -80,13 +74,13 @@ std::string FormatCircleTrace(const CircleTrace& c) {
 
 void CircleOptions::Validate() const {
   if (!(radius_mm >= 1 && radius_mm <= 2000))
-    throw InputError("radius_mm = " + Num(radius_mm) + ": must be in [1, 2000] mm");
+    throw InputError("radius_mm = " + MessageNumber(radius_mm) + ": must be in [1, 2000] mm");
   for (double p : {cyclic_period_1_mm, cyclic_period_2_mm})
     if (!(p == 0 || (p >= 0.1 && p <= 1000)))
-      throw InputError("cyclic period = " + Num(p) +
+      throw InputError("cyclic period = " + MessageNumber(p) +
                        " mm: must be 0 (not fitted) or in [0.1, 1000] mm");
   if (!(std::abs(spindle_tram_urad) <= 1e5))
-    throw InputError("spindle_tram_urad = " + Num(spindle_tram_urad) +
+    throw InputError("spindle_tram_urad = " + MessageNumber(spindle_tram_urad) +
                      ": must be within +-1e5 urad");
   if (spindle_tram_urad != 0 && plane != Plane::kXZ)
     throw InputError("spindle_tram_urad applies to the XZ plane only (plane " + ToString(plane) +
@@ -135,7 +129,7 @@ void CheckSeparable(const Design& d, const std::string& source) {
     throw InputError(source +
                      ": the trace cannot separate the fitted terms (smallest/largest "
                      "singular value " +
-                     Num(ratio) +
+                     MessageNumber(ratio) +
                      ", rule: above 1e-4); a cyclic period far "
                      "longer than the radius mimics the centre offset: check --cyclic-period-1-mm "
                      "and --cyclic-period-2-mm");
@@ -161,7 +155,7 @@ CircleDiagnostics FitCircle(const CircleTrace& c, const CircleOptions& o) {
     throw InputError(c.source + ": " + std::to_string(n) + " samples (rule: at least 16)");
   const double span = c.angle_deg.back() - c.angle_deg.front();
   if (span < 180 - 1e-9 || span > 360 + 1e-9)
-    throw InputError(c.source + ": the trace spans " + Num(span) +
+    throw InputError(c.source + ": the trace spans " + MessageNumber(span) +
                      " degrees (rule: 180 to 360 degrees, a semicircle or a full circle)");
   const Design d = BuildDesign(c, o);
   CheckSeparable(d, c.source);

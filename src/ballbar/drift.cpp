@@ -7,15 +7,10 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 
 namespace whirl::ballbar {
 namespace {
-
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 std::string Where(const CsvTable& t, std::size_t row, const std::string& column) {
   return t.source + ":" + std::to_string(t.line_numbers[row]) + ": column '" + column + "'";
@@ -28,17 +23,18 @@ Reading ParseRow(const CsvTable& t, std::size_t r, bool has_t) {
   x.time_min = v[t.ColumnIndex("time_min")];
   const double pivot = v[t.ColumnIndex("pivot")];
   if (pivot != 1 && pivot != 2 && pivot != 3)
-    throw InputError(Where(t, r, "pivot") + ": " + Num(pivot) + " is not 1, 2 or 3");
+    throw InputError(Where(t, r, "pivot") + ": " + MessageNumber(pivot) + " is not 1, 2 or 3");
   x.pivot = static_cast<int>(pivot);
   x.length_mm = v[t.ColumnIndex("length_mm")];
   if (!(x.length_mm > 0 && x.length_mm <= kMaxBarLengthMm))
-    throw InputError(Where(t, r, "length_mm") + ": " + Num(x.length_mm) + " mm is outside (0, " +
-                     Num(kMaxBarLengthMm) + "] mm");
+    throw InputError(Where(t, r, "length_mm") + ": " + MessageNumber(x.length_mm) +
+                     " mm is outside (0, " + MessageNumber(kMaxBarLengthMm) + "] mm");
   if (has_t) {
     const double c = v[t.ColumnIndex("bar_temperature_C")];
     if (!(c >= kMinBarTemperatureC && c <= kMaxBarTemperatureC))
-      throw InputError(Where(t, r, "bar_temperature_C") + ": " + Num(c) + " degC is outside [" +
-                       Num(kMinBarTemperatureC) + ", " + Num(kMaxBarTemperatureC) + "] degC");
+      throw InputError(Where(t, r, "bar_temperature_C") + ": " + MessageNumber(c) +
+                       " degC is outside [" + MessageNumber(kMinBarTemperatureC) + ", " +
+                       MessageNumber(kMaxBarTemperatureC) + "] degC");
     x.bar_temperature_C = c;
   }
   return x;
@@ -62,8 +58,9 @@ Readings FromTable(const CsvTable& t) {
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     out.rows.push_back(ParseRow(t, r, has_t));
     if (r > 0 && out.rows[r].time_min < out.rows[r - 1].time_min)
-      throw InputError(Where(t, r, "time_min") + ": " + Num(out.rows[r].time_min) + " min after " +
-                       Num(out.rows[r - 1].time_min) + " min (rule: time must not decrease)");
+      throw InputError(Where(t, r, "time_min") + ": " + MessageNumber(out.rows[r].time_min) +
+                       " min after " + MessageNumber(out.rows[r - 1].time_min) +
+                       " min (rule: time must not decrease)");
   }
   return out;
 }
@@ -123,7 +120,7 @@ nlohmann::json PivotsToJson(const PivotCentres& p) {
 
 void DriftOptions::Validate() const {
   auto bad = [](const std::string& field, double v, const std::string& rule) {
-    throw InputError(field + " = " + Num(v) + ": " + rule);
+    throw InputError(field + " = " + MessageNumber(v) + ": " + rule);
   };
   if (!(block_gap_min > 0 && block_gap_min <= 1440))
     bad("block_gap_min", block_gap_min, "must be in (0, 1440] min");
@@ -155,11 +152,11 @@ std::vector<Block> SplitBlocks(const Readings& r, double gap_min) {
       if (n[p] == 0)
         throw InputError(r.source + ":" + std::to_string(r.rows[b.begin].line) + "-" +
                          std::to_string(r.rows[b.end - 1].line) + ": the block at " +
-                         Num(r.rows[b.begin].time_min) + " min has no reading of pivot " +
+                         MessageNumber(r.rows[b.begin].time_min) + " min has no reading of pivot " +
                          std::to_string(p + 1) +
                          " (rule: every block reads all three pivots; blocks are split where "
                          "readings are more than " +
-                         Num(gap_min) + " min apart)");
+                         MessageNumber(gap_min) + " min apart)");
   }
   return blocks;
 }
@@ -187,8 +184,8 @@ PivotSeries Gather(const Readings& r, const Block& b, const DriftOptions& o, boo
 
 std::string BlockWhere(const Readings& r, const Block& b) {
   return r.source + ":" + std::to_string(r.rows[b.begin].line) + "-" +
-         std::to_string(r.rows[b.end - 1].line) + " (block at " + Num(r.rows[b.begin].time_min) +
-         " min)";
+         std::to_string(r.rows[b.end - 1].line) + " (block at " +
+         MessageNumber(r.rows[b.begin].time_min) + " min)";
 }
 
 DriftBlock Measure(const Readings& r, const Block& b, const PivotFrame& frame,

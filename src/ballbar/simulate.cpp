@@ -6,18 +6,11 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "sim/random.h"
 
 namespace whirl::ballbar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 double Uniform(sim::Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.Uniform(); }
 
@@ -49,7 +42,7 @@ double BarTemperature(const WarmupOptions& o, double t) {
 
 void WarmupOptions::Validate() const {
   auto bad = [](const std::string& f, double v, const std::string& rule) {
-    throw InputError(f + " = " + Num(v) + ": " + rule);
+    throw InputError(f + " = " + MessageNumber(v) + ": " + rule);
   };
   if (!(duration_min >= 60 && duration_min <= 720))
     bad("duration_min", duration_min, "must be in [60, 720] min");
@@ -59,7 +52,7 @@ void WarmupOptions::Validate() const {
   const double block = 3 * repeats * reading_step_min;
   if (!(interval_min >= block + 2.5 && interval_min <= duration_min))
     bad("interval_min", interval_min,
-        "must leave more than the 2 min block gap after a block of " + Num(block) +
+        "must leave more than the 2 min block gap after a block of " + MessageNumber(block) +
             " min and be at most the duration");
   if (!(bar_noise_sd_um >= 0 && bar_noise_sd_um <= 10))
     bad("bar_noise_sd_um", bar_noise_sd_um, "must be in [0, 10] um");
@@ -171,12 +164,13 @@ std::vector<DemoTrace> DemoTraces(std::uint64_t seed) {
 
 std::string Command(const WarmupOptions& o, const std::filesystem::path& dir) {
   return "whirl ballbar simulate --seed " + std::to_string(o.seed) + " --duration-min " +
-         Num(o.duration_min) + " --interval-min " + Num(o.interval_min) + " --out-dir " +
-         dir.string();
+         MessageNumber(o.duration_min) + " --interval-min " + MessageNumber(o.interval_min) +
+         " --out-dir " + dir.string();
 }
 
 std::string Xyz(const Eigen::Vector3d& v) {
-  return "X " + Num(v.x()) + ", Y " + Num(v.y()) + ", Z " + Num(v.z());
+  return "X " + MessageNumber(v.x()) + ", Y " + MessageNumber(v.y()) + ", Z " +
+         MessageNumber(v.z());
 }
 
 std::string Readme(const WarmupSimulation& s, const WarmupOptions& o, const std::string& command,
@@ -187,11 +181,12 @@ std::string Readme(const WarmupSimulation& s, const WarmupOptions& o, const std:
       command +
       "` (model: `src/ballbar/simulate.h`).\n\n"
       "- `readings.csv`, `pivots.json`: a " +
-      Num(o.duration_min) + " min spindle warm-up read every " + Num(o.interval_min) + " min, " +
-      std::to_string(o.repeats) +
-      " passes over the pivots per block (order 1 2 3 3 2 1), bar noise " + Num(o.bar_noise_sd_um) +
-      " um, resolution " + Num(o.resolution_um) + " um, bar alpha " + Num(o.bar_alpha_per_K) +
-      " /K warming " + Num(o.bar_rise_K) + " K from " + Num(o.bar_start_C) +
+      MessageNumber(o.duration_min) + " min spindle warm-up read every " +
+      MessageNumber(o.interval_min) + " min, " + std::to_string(o.repeats) +
+      " passes over the pivots per block (order 1 2 3 3 2 1), bar noise " +
+      MessageNumber(o.bar_noise_sd_um) + " um, resolution " + MessageNumber(o.resolution_um) +
+      " um, bar alpha " + MessageNumber(o.bar_alpha_per_K) + " /K warming " +
+      MessageNumber(o.bar_rise_K) + " K from " + MessageNumber(o.bar_start_C) +
       " degC.\n"
       "- planted drift D (1 - exp(-t/tau)): D = " +
       Xyz(s.final_drift_um) + " um; tau = " + Xyz(s.tau_min) +

@@ -6,20 +6,14 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::ballbar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
-
 std::string Lengths(const Eigen::Vector3d& l) {
-  return "L1 = " + Num(l(0)) + " mm, L2 = " + Num(l(1)) + " mm, L3 = " + Num(l(2)) + " mm";
+  return "L1 = " + MessageNumber(l(0)) + " mm, L2 = " + MessageNumber(l(1)) +
+         " mm, L3 = " + MessageNumber(l(2)) + " mm";
 }
 
 void CheckTriangle(const PivotCentres& b, const GeometryLimits& limits) {
@@ -28,10 +22,11 @@ void CheckTriangle(const PivotCentres& b, const GeometryLimits& limits) {
   const double area2 = (b[1] - b[0]).cross(b[2] - b[0]).norm();  // twice the area
   const double ratio = longest > 0 ? area2 / (longest * longest) : 0.0;
   if (!(ratio >= limits.min_triangle_ratio))
-    throw InputError("pivots nearly collinear or coincident: |B1B2| = " + Num(s12) +
-                     " mm, |B2B3| = " + Num(s23) + " mm, |B1B3| = " + Num(s13) +
-                     " mm; the triangle's smallest height over its longest side is " + Num(ratio) +
-                     " (rule: at least " + Num(limits.min_triangle_ratio) +
+    throw InputError("pivots nearly collinear or coincident: |B1B2| = " + MessageNumber(s12) +
+                     " mm, |B2B3| = " + MessageNumber(s23) + " mm, |B1B3| = " + MessageNumber(s13) +
+                     " mm; the triangle's smallest height over its longest side is " +
+                     MessageNumber(ratio) + " (rule: at least " +
+                     MessageNumber(limits.min_triangle_ratio) +
                      "); spread the pivots into a triangle around the tool ball");
 }
 
@@ -56,9 +51,10 @@ PivotFrame MakePivotFrame(const PivotCentres& pivots_mm, const GeometryLimits& l
   const Eigen::Vector3d ey = (b13 - b13.dot(ex) * ex).normalized();
   Eigen::Vector3d ez = ex.cross(ey);
   if (std::abs(ez.z()) < limits.min_normal_z)
-    throw InputError("pivots' plane is tilted " + Num(std::acos(std::abs(ez.z())) * 180 / kPi) +
+    throw InputError("pivots' plane is tilted " +
+                     MessageNumber(std::acos(std::abs(ez.z())) * 180 / kPi) +
                      " degrees from the table (rule: its normal within " +
-                     Num(std::acos(limits.min_normal_z) * 180 / kPi) +
+                     MessageNumber(std::acos(limits.min_normal_z) * 180 / kPi) +
                      " degrees of machine Z, so that the tool ball's side of it is +Z)");
   if (ez.z() < 0) ez = -ez;  // the root of eq. 17 is taken on the spindle's side (+Z)
   f.axes.col(0) = ex;
@@ -77,8 +73,8 @@ Eigen::Vector3d TrilaterateLocal(const PivotFrame& f, const Eigen::Vector3d& l) 
   const double c1_sq = l(0) * l(0) - x * x;
   if (!(c1_sq > 0))
     throw InputError("inconsistent bar lengths " + Lengths(l) +
-                     ": eq. 12 needs L1^2 - x^2 > 0 but it is " + Num(c1_sq) +
-                     " mm^2 (|L1 - L2| must be less than |B1B2| = " + Num(lb1) +
+                     ": eq. 12 needs L1^2 - x^2 > 0 but it is " + MessageNumber(c1_sq) +
+                     " mm^2 (|L1 - L2| must be less than |B1B2| = " + MessageNumber(lb1) +
                      " mm): a wrong pivot number, pivot centre or bar length");
   const double xb = f.xb_mm, cb = f.cb_mm;                      // (13), (14)
   const double d1_sq = c1_sq + (xb - x) * (xb - x);             // (15)
@@ -86,16 +82,16 @@ Eigen::Vector3d TrilaterateLocal(const PivotFrame& f, const Eigen::Vector3d& l) 
   const double z_sq = c1_sq - y * y;
   if (!(z_sq > 0))
     throw InputError("inconsistent bar lengths " + Lengths(l) +
-                     ": eq. 17 needs c1^2 - y^2 > 0 but it is " + Num(z_sq) +
+                     ": eq. 17 needs c1^2 - y^2 > 0 but it is " + MessageNumber(z_sq) +
                      " mm^2 (the three spheres do not meet, or the tool ball lies in the " +
                      "pivots' plane): a wrong pivot number, pivot centre or bar length");
   const double z = std::sqrt(z_sq);  // (17)
   const double ratio = z / l.maxCoeff();
   if (ratio < f.limits.min_height_ratio)
     throw InputError(
-        "tool ball only " + Num(z) + " mm above the pivots' plane (" + Lengths(l) +
-        "): height / longest bar = " + Num(ratio) + " (rule: at least " +
-        Num(f.limits.min_height_ratio) +
+        "tool ball only " + MessageNumber(z) + " mm above the pivots' plane (" + Lengths(l) +
+        "): height / longest bar = " + MessageNumber(ratio) + " (rule: at least " +
+        MessageNumber(f.limits.min_height_ratio) +
         "); z is ill-conditioned there: raise the tool ball or bring the pivots closer");
   return {x, y, z};
 }
@@ -138,8 +134,9 @@ PlacementAdvice AdvisePlacement(const PivotFrame& f, const Eigen::Vector3d& p) {
   a.ideal_height_mm = bar / std::sqrt(3.0);
   a.ideal_radius_mm = bar * std::sqrt(2.0 / 3.0);
   a.rating = a.condition_number <= 2 ? "good" : a.condition_number <= 5 ? "fair" : "poor";
-  const std::string ideal = "for bars of " + Num(bar) + " mm the ideal is a height of " +
-                            Num(a.ideal_height_mm) + " mm and pivots " + Num(a.ideal_radius_mm) +
+  const std::string ideal = "for bars of " + MessageNumber(bar) + " mm the ideal is a height of " +
+                            MessageNumber(a.ideal_height_mm) + " mm and pivots " +
+                            MessageNumber(a.ideal_radius_mm) +
                             " mm from the tool ball's foot, 120 degrees apart (condition 1)";
   const double shape = a.mean_radius_mm / std::max(a.height_mm, 1e-12);  // ideal sqrt(2)
   std::string what;

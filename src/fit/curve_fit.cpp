@@ -7,12 +7,12 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/stats.h"
 
 namespace whirl::fit {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 void CheckCurve(const ElongationCurve& curve) {

@@ -121,7 +121,9 @@ Dataset GenerateDataset(const DatasetOptions& options,
   else
     s << " disturbances OFF";
   c.push_back(s.str());
-  c.push_back(" features: ExtractFeatures (plateau + quadratic drift fitted after the settle time, detrended 60 s moving average within a noise-aware 2 % band; src/sim/features.h)");
+  c.push_back(
+      " features: ExtractFeatures (plateau + quadratic drift fitted after the settle time, "
+      "detrended 60 s moving average within a noise-aware 2 % band; src/sim/features.h)");
   return out;
 }
 

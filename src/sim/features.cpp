@@ -158,9 +158,8 @@ SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& 
         std::min(tail_begin, index_at(t0 + options.fit_start_factor * (t[s] - t0)));
     // Stop at a fixed point, or when the window start comes back to an earlier value (a cycle
     // of two windows one sample apart: either answer is as good).
-    const bool converged =
-        degree == options.drift_degree &&
-        std::find(visited.begin(), visited.end(), next_begin) != visited.end();
+    const bool converged = degree == options.drift_degree &&
+                           std::find(visited.begin(), visited.end(), next_begin) != visited.end();
     settle_index = s;
     if (converged) break;
     if (degree == options.drift_degree) visited.push_back(fit_begin);
@@ -183,14 +182,15 @@ SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& 
   a.iterations = iterations;
   a.settled_before_tail = ts < t_tail;
   std::ostringstream msg;
-  msg << "plateau " << FormatNumber(a.features.max_elongation_um) << " um at the settle time (fit of"
-      << " plateau + degree-" << options.drift_degree << " drift from " << FormatNumber(a.fit_start_s)
-      << " s, " << iterations << " passes; drift " << FormatNumber(a.drift_at_settle_um)
-      << " um at the settle time, " << FormatNumber(a.drift_at_end_um)
-      << " um at the end), band +-" << FormatNumber(a.band_um) << " um = max("
-      << options.tolerance_rel << " x plateau, " << options.noise_sigma_multiplier << " x noise "
-      << FormatNumber(a.noise_std_um) << " um / sqrt(samples in " << options.smoothing_window_s
-      << " s)); detrended smoothed curve stays in the band from "
+  msg << "plateau " << FormatNumber(a.features.max_elongation_um)
+      << " um at the settle time (fit of"
+      << " plateau + degree-" << options.drift_degree << " drift from "
+      << FormatNumber(a.fit_start_s) << " s, " << iterations << " passes; drift "
+      << FormatNumber(a.drift_at_settle_um) << " um at the settle time, "
+      << FormatNumber(a.drift_at_end_um) << " um at the end), band +-" << FormatNumber(a.band_um)
+      << " um = max(" << options.tolerance_rel << " x plateau, " << options.noise_sigma_multiplier
+      << " x noise " << FormatNumber(a.noise_std_um) << " um / sqrt(samples in "
+      << options.smoothing_window_s << " s)); detrended smoothed curve stays in the band from "
       << FormatNumber(a.features.settle_time_s) << " s"
       << (a.settled_before_tail ? "" : " (NOT before the tail window: record too short)");
   a.message = msg.str();

@@ -8,11 +8,10 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 
 namespace whirl::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 [[noreturn]] void Fail(const std::string& what, const std::string& field, double value,
                        const std::string& rule) {

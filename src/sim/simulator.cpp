@@ -6,12 +6,11 @@
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "sim/random.h"
 
 namespace whirl::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Double antiderivative of the indicator of (lo, hi): R'' = 1(lo < u < hi), R(u) = 0 for u <= lo.
 double BoxR(double u, double lo, double hi) {
