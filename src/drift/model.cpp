@@ -7,19 +7,13 @@
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 #include "core/parallel.h"
 
 namespace whirl::drift {
 namespace {
 
 using nlohmann::json;
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 
 json VectorJson(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
@@ -122,7 +116,7 @@ ReferenceMode ParseReferenceMode(const std::string& text) {
 
 std::string Feature::Name(const std::string& time_unit) const {
   if (tau == 0) return input;
-  return input + "_lag" + Num(tau) + time_unit;
+  return input + "_lag" + MessageNumber(tau) + time_unit;
 }
 
 void DriftModel::Validate() const {
@@ -133,7 +127,8 @@ void DriftModel::Validate() const {
   if (nf != InputCount() * (1 + static_cast<Eigen::Index>(time_constants.size())))
     throw InputError("drift model 'features' must be inputs x (1 + time constants)");
   for (double t : time_constants)
-    if (!(t > 0)) throw InputError("drift model time constant " + Num(t) + ": must be > 0");
+    if (!(t > 0))
+      throw InputError("drift model time constant " + MessageNumber(t) + ": must be > 0");
   if (feature_min.size() != nf || feature_max.size() != nf)
     throw InputError("drift model training ranges must have one value per feature");
   if (time_unit != "min" && time_unit != "sample")

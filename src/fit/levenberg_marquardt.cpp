@@ -7,19 +7,13 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::fit {
 namespace {
 
 // Floor for the Marquardt scaling diag(J'J) so a parameter the residuals ignore still gets damped.
 constexpr double kMinDiagonal = 1e-12;
-
-std::string Num(double x) {
-  std::ostringstream ss;
-  ss.precision(6);
-  ss << x;
-  return ss.str();
-}
 
 bool HasBounds(const LmOptions& o) {
   return o.lower_bounds.size() > 0 || o.upper_bounds.size() > 0;
@@ -41,7 +35,7 @@ Eigen::VectorXd Project(const LmOptions& o, Eigen::VectorXd x) {
 void ValidateOptions(const LmOptions& o, Eigen::Index n, int m) {
   auto positive = [](double v, const char* name) {
     if (!(v > 0) || !std::isfinite(v))
-      throw InputError(std::string("LM option ") + name + " = " + Num(v) +
+      throw InputError(std::string("LM option ") + name + " = " + MessageNumber(v) +
                        ": must be a positive finite number");
   };
   if (o.max_iterations < 0)
@@ -52,10 +46,11 @@ void ValidateOptions(const LmOptions& o, Eigen::Index n, int m) {
   positive(o.max_mu, "max_mu");
   positive(o.fd_relative_step, "fd_relative_step");
   if (!(o.gradient_tolerance >= 0))
-    throw InputError("LM option gradient_tolerance = " + Num(o.gradient_tolerance) +
+    throw InputError("LM option gradient_tolerance = " + MessageNumber(o.gradient_tolerance) +
                      ": must be >= 0");
   if (!(o.cost_tolerance >= 0))
-    throw InputError("LM option cost_tolerance = " + Num(o.cost_tolerance) + ": must be >= 0");
+    throw InputError("LM option cost_tolerance = " + MessageNumber(o.cost_tolerance) +
+                     ": must be >= 0");
   if (m < 1) throw InputError("LM: num_residuals = " + std::to_string(m) + ": must be >= 1");
   if (n < 1) throw InputError("LM: no parameters: x must have at least one entry");
   for (const auto* b : {&o.lower_bounds, &o.upper_bounds})
@@ -65,8 +60,8 @@ void ValidateOptions(const LmOptions& o, Eigen::Index n, int m) {
   if (HasBounds(o))
     for (Eigen::Index j = 0; j < n; ++j)
       if (!(Lower(o, j) <= Upper(o, j)))
-        throw InputError("LM: lower bound " + Num(Lower(o, j)) + " > upper bound " +
-                         Num(Upper(o, j)) + " for parameter " + std::to_string(j));
+        throw InputError("LM: lower bound " + MessageNumber(Lower(o, j)) + " > upper bound " +
+                         MessageNumber(Upper(o, j)) + " for parameter " + std::to_string(j));
 }
 
 double ProjectedGradientNorm(const LmOptions& o, const Eigen::VectorXd& x,
@@ -169,7 +164,7 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
   if (!std::isfinite(cost) || !jac.allFinite()) {
     summary.termination = LmTermination::kNonFinite;
     summary.message =
-        "residuals or Jacobian not finite at the start point (cost " + Num(cost) + ")";
+        "residuals or Jacobian not finite at the start point (cost " + MessageNumber(cost) + ")";
     return summary;
   }
 
@@ -192,8 +187,8 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
     }
     if (grad_norm <= options.gradient_tolerance) {
       summary.termination = LmTermination::kGradientTolerance;
-      summary.message = "projected gradient " + Num(grad_norm) + " <= gradient_tolerance " +
-                        Num(options.gradient_tolerance);
+      summary.message = "projected gradient " + MessageNumber(grad_norm) +
+                        " <= gradient_tolerance " + MessageNumber(options.gradient_tolerance);
       break;
     }
     if (iter >= options.max_iterations) break;
@@ -208,8 +203,9 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
     const double step_norm = h.norm();
     if (step_norm <= options.parameter_tolerance * (x.norm() + options.parameter_tolerance)) {
       summary.termination = LmTermination::kParameterTolerance;
-      summary.message = "step " + Num(step_norm) + " <= parameter_tolerance " +
-                        Num(options.parameter_tolerance) + " * (|x| " + Num(x.norm()) + " + tol)";
+      summary.message = "step " + MessageNumber(step_norm) + " <= parameter_tolerance " +
+                        MessageNumber(options.parameter_tolerance) + " * (|x| " +
+                        MessageNumber(x.norm()) + " + tol)";
       break;
     }
     // The residual function is evaluated once here; the Jacobian only after acceptance.
@@ -233,8 +229,8 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
       nu = 2.0;
       if (decrease <= options.cost_tolerance * (cost + decrease)) {
         summary.termination = LmTermination::kCostTolerance;
-        summary.message = "relative cost decrease " + Num(decrease / (cost + decrease)) +
-                          " <= cost_tolerance " + Num(options.cost_tolerance);
+        summary.message = "relative cost decrease " + MessageNumber(decrease / (cost + decrease)) +
+                          " <= cost_tolerance " + MessageNumber(options.cost_tolerance);
         summary.final_gradient_norm = ProjectedGradientNorm(options, x, g);
         break;
       }
@@ -243,8 +239,9 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
       nu *= 2.0;
       if (!(mu <= options.max_mu)) {
         summary.termination = LmTermination::kMuTooLarge;
-        summary.message = "damping mu " + Num(mu) + " > max_mu " + Num(options.max_mu) +
-                          " without a cost decrease (cost " + Num(cost) + ")";
+        summary.message = "damping mu " + MessageNumber(mu) + " > max_mu " +
+                          MessageNumber(options.max_mu) + " without a cost decrease (cost " +
+                          MessageNumber(cost) + ")";
         break;
       }
     }
