@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"; shift || true
 HARNESSES=("$@")
 [ ${#HARNESSES[@]} -eq 0 ] && HARNESSES=(csv process_table curve screw model lead iso_table drift_run \
-  drift_model machine_profile)
+  drift_model machine_profile ballbar surface)
 command -v clang++ > /dev/null || { echo "fuzz: clang++ not found (apt-get install clang)" >&2; exit 1; }
 BUILD="${WHIRL_FUZZ_BUILD_DIR:-build-fuzz}"
 CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHIRL_WITH_TORCH=OFF \
@@ -21,7 +21,7 @@ seeds_of() {  # the shipped files of the harness's kind (read only; new inputs g
     screw) echo datasets/screws ;;
     model) echo models ;;
     iso_table) echo datasets/standards ;;
-    curve|lead|drift_run|drift_model) echo "tests/fuzz/seeds/$1" ;;
+    curve|lead|drift_run|drift_model|ballbar|surface) echo "tests/fuzz/seeds/$1" ;;
     machine_profile) echo datasets/machines ;;
   esac
 }
