@@ -94,7 +94,8 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "(disturbed)', \\\n"
     << "  '' using 1:3 with lines ls 2 title 'predicted arctan curve (model)', \\\n"
     << "  '' using 1:5 with lines ls 3 title '840D compensation applied (model plan)', \\\n"
-    << "  '' using 1:4 with lines ls 4 title 'traditional compensation (class-mean curve, 840D plan)', \\\n"
+    << "  '' using 1:4 with lines ls 4 title 'traditional compensation (class-mean curve, 840D "
+       "plan)', \\\n"
     << "  " << GnuplotString(slug + "_points.csv")
     << " using 1:3 with points ls 5 title 'compensation points "
     << "(SD43900/10/20 breakpoints)'\n"
@@ -238,6 +239,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
   const StagingDir stage(dir);
   std::vector<std::pair<std::filesystem::path, std::string>> outputs;
   std::set<std::string> rendered;
+  std::vector<std::filesystem::path> not_rendered;  // a PNG an earlier run left there is removed
 
   std::vector<std::string> slugs;
   nlohmann::json report_json = nlohmann::json::array();
@@ -267,9 +269,10 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                           c.screw.name + "' and the compensation applied")));
     write(slug + "_points.csv",
           interp::FormatPointsCsv(
-              c.plan, Comments(options, "compensation points of the 840D plan (the last row is the "
-                                        "thread end, where the values found before the cut are "
-                                        "restored)")));
+              c.plan, Comments(options,
+                               "compensation points of the 840D plan (the last row is the "
+                               "thread end, where the values found before the cut are "
+                               "restored)")));
     rows.clear();
     const auto& ln = c.Outcome(Strategy::kNone).lead;
     const auto& lt = c.Outcome(Strategy::kTraditional).lead;
@@ -315,6 +318,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
       }
     }
 
+    for (const std::string& png : {files.elongation, files.lead, files.lead_start})
+      if (rendered.count(png) == 0) not_rendered.push_back(dir / png);
+
     // HTML section.
     const auto in = c.screw.process;
     body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
@@ -356,8 +362,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                             : std::string("more than 1000000"))
          << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
          << interp::FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910) << " (MD32760 cap "
-         << interp::FormatFixed(c.plan.options.md32760, 4) << "), axis " << HtmlEscape(c.plan.options.axis)
-         << ", sign " << interp::ToString(c.plan.options.sign) << ".</p>\n"
+         << interp::FormatFixed(c.plan.options.md32760, 4) << "), axis "
+         << HtmlEscape(c.plan.options.axis) << ", sign " << interp::ToString(c.plan.options.sign)
+         << ".</p>\n"
          << MetricsTable(c);
     for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
       if (rendered.count(png) > 0)
@@ -412,6 +419,11 @@ ReportResult WriteReport(const std::filesystem::path& dir,
        << body.str() << "</body></html>\n";
   outputs.emplace_back(dir / "index.html", html.str());  // last: the page of a complete set
   WriteFilesAtomic(outputs);
+  for (const auto& png :
+       not_rendered) {  // never an old figure beside a page that says "not rendered"
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(png, ec)) std::filesystem::remove(png, ec);
+  }
   for (const auto& [path, text] : outputs) result.files.push_back(path);
   result.index_html = dir / "index.html";
   return result;

@@ -95,6 +95,28 @@ TEST_F(ShippedModelReport, AFailingReportLeavesNoFileBehind) {
   fs::remove_all(dir);
 }
 
+// A rerun whose plots are not rendered removes the figures an earlier run left: the page that
+// says "not rendered" never sits beside an old figure of the same screw.
+TEST_F(ShippedModelReport, UnrenderedPlotLeavesNoOldFigure) {
+  if (!ProgramSucceeds({"gnuplot", "--version"})) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path dir = fs::path(::testing::TempDir()) / "whirl_report_stale_png";
+  fs::remove_all(dir);
+  CompareOptions options;
+  options.seed = 3;
+  const ScrewComparison c = CompareScrew(sim::ReferenceScrew(), model_, rule_, iso_, options);
+  ASSERT_TRUE(WriteReport(dir, {c}, {}).plots_rendered);
+  std::size_t pngs = 0;
+  for (const auto& e : fs::directory_iterator(dir)) pngs += e.path().extension() == ".png";
+  ASSERT_EQ(pngs, 3u);
+  ReportOptions ro;
+  ro.gnuplot_command = "false";  // runs, fails, renders nothing
+  const ReportResult r = WriteReport(dir, {c}, ro);
+  EXPECT_FALSE(r.plots_rendered);
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_NE(e.path().extension(), ".png") << e.path();
+  fs::remove_all(dir);
+}
+
 TEST_F(ShippedModelReport, EvaluateHandsAnyWorkerExceptionToTheCaller) {
   const std::vector<sim::Screw> screws(4, sim::ReferenceScrew());
   EvaluateOptions options;
