@@ -647,6 +647,14 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   TrainOptions train = options.train;
   m.stopping = "trainbr (MATLAB): run to its own stopping criteria, at most " +
                std::to_string(train.epochs) + " epochs";
+  if (train.change > 0)
+    m.stopping =
+        "trainbr with R brnn's rule: stop when F = beta ssE + alpha ssX changed by less "
+        "than " +
+        FormatNumber(train.change) +
+        " over the last 4 epochs, else MATLAB's "
+        "criteria, at most " +
+        std::to_string(train.epochs) + " epochs";
   if (options.stopping == Stopping::kCrossValidated && rows >= 4) {
     const int folds = std::min(options.stopping_folds, rows);
     train.epochs = ChooseEpochsByCrossValidation(table, options, folds);

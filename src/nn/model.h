@@ -130,8 +130,9 @@ std::vector<Prediction> PredictBatch(const Model& model, const std::vector<Proce
 ///     (issue 12 reported --epochs 30 closing the gap). In scripts/bench_peers.sh it did NOT
 ///     beat kTrainbrMatlab (Friedman 20 rows, 6 seeds: 3.09 / 10.9 against 2.91 / 11.1;
 ///     simulator: settle time 10.1 s against 8.65 s), so it stays an option (--stop-by-cv).
-///   kTrainbrMatlab (default): MATLAB's trainbr to the letter (runs to its own criteria, at
-///     most train.epochs epochs); what the LibTorch cross-check compares against.
+///   kTrainbrMatlab (default): trainbr's own stopping (MATLAB's criteria, at most train.epochs
+///     epochs, plus R brnn's rule when train.change > 0, as in DefaultTrainingOptions); with
+///     change = 0 what the LibTorch cross-check compares against.
 enum class Stopping { kTrainbrMatlab, kCrossValidated };
 
 /// How `whirl train` builds a model.
@@ -139,8 +140,9 @@ struct ModelTrainOptions {
   /// Non-empty: one tansig hidden layer whose size is the candidate with the lowest k-fold
   /// cross-validation error (SweepRow::cv_rms_normalized of nn/selection.h, stopping_folds
   /// folds, one start per fit; ties: the earlier candidate); hidden_sizes is then ignored.
-  /// `whirl train --hidden auto` (its default) uses {4, 6, 8, 10, 12}. Why (issue 12,
-  /// scripts/bench_peers.sh): at 100 rows six neurons shared by two outputs are too few.
+  /// `whirl train --hidden auto` uses {4, 6, 8, 10, 12}; its default (`--hidden evidence`,
+  /// hidden_by_evidence below) uses {4, 6, 8}. Why (issue 12, scripts/bench_peers.sh): at 100
+  /// rows six neurons shared by two outputs are too few.
   std::vector<int> hidden_candidates;
   /// How a size among hidden_candidates is chosen: false = k-fold cross-validation (above);
   /// true = the highest log evidence ln P(D | alpha, beta) of the fit on all rows (MacKay 1992,
