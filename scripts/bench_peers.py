@@ -6,6 +6,10 @@ Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regressi
   out1 = 10 sin(pi x1 x2) + 20 (x3 - 0.5)^2 + 10 x4 + 5 x5 + N(0, 1^2)          (Friedman #1)
   out2 = 50 exp(-2 ((x1 - 0.5)^2 + (x3 - 0.5)^2)) + 30 x2 x5 + 20 sin(pi x4) + N(0, 3^2)
   (out1 -> max_elongation_um, out2 -> settle_time_s; the names only satisfy whirl's table format).
+  whirl's tables must hold physically plausible values (src/core/limits.h), so every method sees
+  the inputs mapped affinely to INPUT_LO + INPUT_SPAN * x and the targets (and the noise-free
+  truth) shifted by +TARGET_OFFSET; whirl and the peers rescale inputs and targets affinely, so
+  this changes neither the RMSE nor the coverage.
   Training: N rows (20, 100); test: 1000 rows from the same seed's generator.
   Test RMSE is against the NOISE-FREE function; interval coverage is reported against the noisy
   test targets (a predictive interval is for a new observation) and against the noise-free truth.
@@ -22,8 +26,11 @@ both outputs as whirl):
 Fit times: whirl's in-process time (whirl train --json fit_time_ms, one thread); sklearn's wall
 time of fit() (mlp_cv includes its grid search).
 
+Peer cache (--peer-cache FILE): the peers' results per (problem, rows, seed, peer, sklearn
+version) are read from and added to FILE (JSON), so exploring whirl settings does not refit them.
+
 Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--sizes 20,100] [--problems friedman,simulator]
-       [--variant NAME=ARGS ...] [--json out.json]
+       [--variant NAME=ARGS ...] [--no-default] [--peer-cache FILE] [--json out.json]
 """
 import argparse
 import json
@@ -35,6 +42,7 @@ import tempfile
 import time
 
 import numpy as np
+import sklearn
 from sklearn.compose import TransformedTargetRegressor
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.model_selection import GridSearchCV, KFold
@@ -46,6 +54,9 @@ import warnings
 INPUTS = ["hardness_hrc", "diameter_mm", "pitch_mm", "raceway_radius_mm", "cutting_speed_m_min"]
 TARGETS = ["max_elongation_um", "settle_time_s"]
 NOISE_SD = np.array([1.0, 3.0])
+INPUT_LO = np.array([40.0, 20.0, 5.0, 2.0, 100.0])    # HRC, mm, mm, mm, m/min
+INPUT_SPAN = np.array([20.0, 40.0, 10.0, 4.0, 200.0])
+TARGET_OFFSET = 10.0
 TEST_ROWS = 1000
 
 
@@ -55,7 +66,8 @@ def friedman(rng, n):
     f1 = 10 * np.sin(np.pi * x1 * x2) + 20 * (x3 - 0.5) ** 2 + 10 * x4 + 5 * x5
     f2 = 50 * np.exp(-2 * ((x1 - 0.5) ** 2 + (x3 - 0.5) ** 2)) + 30 * x2 * x5 + 20 * np.sin(np.pi * x4)
     f = np.column_stack([f1, f2])
-    return x, f, f + rng.normal(size=f.shape) * NOISE_SD
+    y = f + rng.normal(size=f.shape) * NOISE_SD
+    return INPUT_LO + INPUT_SPAN * x, f + TARGET_OFFSET, y + TARGET_OFFSET
 
 
 def read_table(path):
@@ -120,14 +132,21 @@ def main():
                     help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
     ap.add_argument("--peers", default="mlp_default,mlp_cv")
     ap.add_argument("--json", help="write all per-seed results here")
+    ap.add_argument("--peer-cache", help="read/extend the peers' results in this JSON file")
+    ap.add_argument("--no-default", action="store_true",
+                    help="do not run whirl with default options (only the --variant settings)")
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     a = ap.parse_args()
-    variants = [("whirl", [])] + [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.variant]
+    variants = ([] if a.no_default else [("whirl", [])]) + [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.variant]
     peers = [p for p in a.peers.split(",") if p]
     cases = []
     for prob in a.problems.split(","):
         sizes = [int(s) for s in a.sizes.split(",")] if prob == "friedman" else [20]
         cases += [(prob, n) for n in sizes]
+    cache = {}
+    if a.peer_cache and os.path.exists(a.peer_cache):
+        with open(a.peer_cache) as f:
+            cache = json.load(f)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         for prob, n in cases:
@@ -150,8 +169,14 @@ def main():
                         "cover1_truth": np.mean(np.abs(fte - mean) <= sd, axis=0).tolist(),
                         "cover2_truth": np.mean(np.abs(fte - mean) <= 2 * sd, axis=0).tolist()}
                 for p in peers:
-                    pred, ms = fit_sklearn(p, xtr, ytr, xte, seed)
-                    rec["methods"][p] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
+                    key = f"{prob}/{n}/{seed}/{p}/sklearn-{sklearn.__version__}"
+                    if key not in cache:
+                        pred, ms = fit_sklearn(p, xtr, ytr, xte, seed)
+                        cache[key] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
+                        if a.peer_cache:
+                            with open(a.peer_cache, "w") as f:
+                                json.dump(cache, f, indent=1)
+                    rec["methods"][p] = cache[key]
                 results.append(rec)
                 print(f"{prob} {n} rows seed {seed}: " + ", ".join(
                     f"{k} {v['rmse'][0]:.3g}/{v['rmse'][1]:.3g}" for k, v in rec["methods"].items()),

@@ -5,7 +5,7 @@
 # time. The functions, noise and peers are documented in scripts/bench_peers.py.
 # Installs Debian's python3-sklearn on first use (only here: the default setup and tests never need it).
 # Usage: scripts/bench_peers.sh [SEEDS (default 20)] [extra bench_peers.py arguments, e.g.
-#        --variant matlab=--trainbr-matlab --json bench.json]
+#        --variant matlab=--trainbr-matlab --peer-cache peers.json --json bench.json]
 #   WHIRL=<path to whirl> overrides the binary (default: ${WHIRL_BUILD_DIR:-build}/whirl).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -125,21 +125,24 @@ std::vector<VariableInfo> ReadVariables(const json& j, const std::string& key,
 }
 
 json OptionsJson(const TrainOptions& o) {
-  return json{{"epochs", o.epochs},
-              {"goal", o.goal},
-              {"mu", o.mu},
-              {"mu_dec", o.mu_dec},
-              {"mu_inc", o.mu_inc},
-              {"mu_max", o.mu_max},
-              {"min_grad", o.min_grad},
-              {"regularization", ToString(o.regularization)}};
+  json j{{"epochs", o.epochs},
+         {"goal", o.goal},
+         {"mu", o.mu},
+         {"mu_dec", o.mu_dec},
+         {"mu_inc", o.mu_inc},
+         {"mu_max", o.mu_max},
+         {"min_grad", o.min_grad},
+         {"regularization", ToString(o.regularization)}};
+  if (o.change > 0) j["change"] = o.change;  // optional key: MATLAB-trainbr files stay as they were
+  return j;
 }
 
 TrainOptions ReadOptions(const json& j) {
   const std::string where = "model 'training.options'";
-  RejectUnknownKeys(
-      j, {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad", "regularization"},
-      where);
+  RejectUnknownKeys(j,
+                    {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad",
+                     "regularization", "change"},
+                    where);
   TrainOptions o;
   o.epochs = RequireInt(Require(j, "epochs", where), where + " 'epochs'", 0, kMaxEpochs);
   o.goal = RequireFinite(Require(j, "goal", where), where + " 'goal'");
@@ -149,6 +152,7 @@ TrainOptions ReadOptions(const json& j) {
   o.mu_max = RequireFinite(Require(j, "mu_max", where), where + " 'mu_max'");
   o.min_grad = RequireFinite(Require(j, "min_grad", where), where + " 'min_grad'");
   o.regularization = ParseRegularization(Require(j, "regularization", where).get<std::string>());
+  if (j.contains("change")) o.change = RequireFinite(j.at("change"), where + " 'change'");
   return o;
 }
 
@@ -511,6 +515,59 @@ Prediction Predict(const Model& model, const ProcessInputs& inputs) {
 
 namespace {
 
+// sigma^2: the smallest level at which +-1 predictive sigma (sqrt(sigma^2 + var_w[i])) covers
+// 68.27 % of the held-out squared errors r2 (bisection; the coverage is monotone in sigma^2).
+double NoiseForCoverage(const std::vector<double>& r2, const std::vector<double>& var_w) {
+  constexpr double kOneSigma = 0.6827;
+  auto coverage = [&](double s2) {
+    int in = 0;
+    for (std::size_t i = 0; i < r2.size(); ++i) in += r2[i] <= s2 + var_w[i] ? 1 : 0;
+    return static_cast<double>(in) / static_cast<double>(r2.size());
+  };
+  double lo = 0.0, hi = *std::max_element(r2.begin(), r2.end()) + 1e-300;
+  if (coverage(lo) >= kOneSigma) hi = 0.0;
+  for (int it = 0; it < 200 && hi > lo; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (coverage(mid) >= kOneSigma ? hi : lo) = mid;
+  }
+  return hi;
+}
+
+// ModelTrainOptions::hidden_by_evidence: one fit per candidate size (in parallel, each on one
+// thread; the choice happens after all fits, in candidate order: the same for any thread count).
+Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOptions& options,
+                                 const std::string& data_name) {
+  const int rows = static_cast<int>(table.inputs.size());
+  std::vector<Model> fits(options.hidden_candidates.size());
+  ParallelFor(fits.size(), options.threads, [&](std::size_t i) {
+    ModelTrainOptions one = options;
+    one.hidden_candidates.clear();
+    one.hidden_sizes = {options.hidden_candidates[i]};
+    one.noise_folds = 0;  // calibrated below, for the chosen size only
+    one.threads = 1;
+    fits[i] = TrainModel(table, one, data_name);
+  });
+  std::size_t best = 0;
+  std::string tried;
+  for (std::size_t i = 0; i < fits.size(); ++i) {
+    const double ev = fits[i].training_summary.log_evidence;
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s%d: %.6g", tried.empty() ? "" : ", ",
+                  options.hidden_candidates[i], ev);
+    tried += buf;
+    if (ev > fits[best].training_summary.log_evidence) best = i;
+  }
+  Model m = std::move(fits[best]);
+  m.hidden_selection = "hidden size " + std::to_string(options.hidden_candidates[best]) +
+                       " of the highest log evidence (" + tried + ")";
+  ModelTrainOptions chosen = options;
+  chosen.hidden_candidates.clear();
+  chosen.hidden_sizes = {options.hidden_candidates[best]};
+  if (options.noise_folds > 0 && rows >= 4)
+    CalibrateOutputNoise(table, chosen, std::min(options.noise_folds, rows), &m);
+  return m;
+}
+
 // ModelTrainOptions::hidden_candidates: one tansig layer, size by k-fold CV (nn/selection.h).
 Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& options,
                            const std::string& data_name, const ModelProgress& progress) {
@@ -521,6 +578,7 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
     fixed.hidden_sizes = {options.hidden_candidates.front()};
     return TrainModel(table, fixed, data_name, progress);
   }
+  if (options.hidden_by_evidence) return TrainModelHiddenByEvidence(table, options, data_name);
   SweepOptions sweep;
   sweep.folds = std::min(options.stopping_folds, rows);
   sweep.seed = options.seed;
@@ -550,6 +608,14 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
 }
 
 }  // namespace
+
+ModelTrainOptions DefaultTrainingOptions() {
+  ModelTrainOptions o;
+  o.hidden_candidates = {4, 6, 8};
+  o.hidden_by_evidence = true;
+  o.train.change = kBrnnChange;
+  return o;
+}
 
 Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  const std::string& data_name, const ModelProgress& progress) {
@@ -581,6 +647,14 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   TrainOptions train = options.train;
   m.stopping = "trainbr (MATLAB): run to its own stopping criteria, at most " +
                std::to_string(train.epochs) + " epochs";
+  if (train.change > 0)
+    m.stopping =
+        "trainbr with R brnn's rule: stop when F = beta ssE + alpha ssX changed by less "
+        "than " +
+        FormatNumber(train.change) +
+        " over the last 4 epochs, else MATLAB's "
+        "criteria, at most " +
+        std::to_string(train.epochs) + " epochs";
   if (options.stopping == Stopping::kCrossValidated && rows >= 4) {
     const int folds = std::min(options.stopping_folds, rows);
     train.epochs = ChooseEpochsByCrossValidation(table, options, folds);
@@ -715,24 +789,8 @@ void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& op
         r2[k].push_back(a);
         var_w[k].push_back(b);
       }
-  // sigma_k^2: the smallest level at which +-1 predictive sigma covers kOneSigma of the held-out
-  // errors (bisection; the coverage is monotone in sigma_k^2).
-  constexpr double kOneSigma = 0.6827;
   model->output_noise_variance.resize(S);
-  for (int k = 0; k < S; ++k) {
-    auto coverage = [&](double s2) {
-      int in = 0;
-      for (std::size_t i = 0; i < r2[k].size(); ++i) in += r2[k][i] <= s2 + var_w[k][i] ? 1 : 0;
-      return static_cast<double>(in) / static_cast<double>(r2[k].size());
-    };
-    double lo = 0.0, hi = *std::max_element(r2[k].begin(), r2[k].end()) + 1e-300;
-    if (coverage(lo) >= kOneSigma) hi = 0.0;
-    for (int it = 0; it < 200 && hi > lo; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (coverage(mid) >= kOneSigma ? hi : lo) = mid;
-    }
-    model->output_noise_variance(k) = hi;
-  }
+  for (int k = 0; k < S; ++k) model->output_noise_variance(k) = NoiseForCoverage(r2[k], var_w[k]);
   model->noise_calibration =
       std::to_string(folds) +
       "-fold cross-validation on the training table: per output the "

@@ -40,17 +40,20 @@ std::string ToString(TrainTermination t) {
       return "max_mu";
     case TrainTermination::kInterpolation:
       return "interpolation";
+    case TrainTermination::kObjectiveStalled:
+      return "objective_stalled";
   }
   return "unknown";
 }
 
 TrainTermination ParseTermination(const std::string& s) {
-  for (auto t :
-       {TrainTermination::kGoalMet, TrainTermination::kMaxEpochs, TrainTermination::kMinGradient,
-        TrainTermination::kMaxMu, TrainTermination::kInterpolation})
+  for (auto t : {TrainTermination::kGoalMet, TrainTermination::kMaxEpochs,
+                 TrainTermination::kMinGradient, TrainTermination::kMaxMu,
+                 TrainTermination::kInterpolation, TrainTermination::kObjectiveStalled})
     if (ToString(t) == s) return t;
   throw InputError("termination '" + s +
-                   "' is not one of goal_met, max_epochs, min_gradient, max_mu, interpolation");
+                   "' is not one of goal_met, max_epochs, min_gradient, max_mu, interpolation, "
+                   "objective_stalled");
 }
 
 std::string ToString(Regularization r) {
@@ -75,6 +78,52 @@ void TrainOptions::Validate() const {
   if (!(mu_max > mu)) fail("mu_max", mu_max, "must be > mu");
   if (!(min_grad >= 0) || !std::isfinite(min_grad))
     fail("min_grad", min_grad, "must be finite and >= 0");
+  if (!(change >= 0) || !std::isfinite(change)) fail("change", change, "must be finite and >= 0");
+}
+
+namespace {
+
+// The stopping tests of an epoch in the documented order (nn/trainbr.h, step 2): sets the
+// termination and message of `sum` and returns true when one holds.
+bool StopReached(const TrainOptions& options, int epoch, double sse, double gradient, double mu,
+                 const std::vector<double>& after_step, const std::string& degenerate_message,
+                 TrainSummary* sum) {
+  if (!degenerate_message.empty()) {
+    sum->termination = TrainTermination::kInterpolation;
+    sum->message = degenerate_message;
+  } else if (sse <= options.goal) {
+    sum->termination = TrainTermination::kGoalMet;
+    sum->message = "ssE = " + Num(sse) + " <= goal = " + Num(options.goal);
+  } else if (epoch == options.epochs) {
+    sum->termination = TrainTermination::kMaxEpochs;
+    sum->message =
+        "epoch = " + std::to_string(epoch) + " == epochs = " + std::to_string(options.epochs);
+  } else if (gradient <= options.min_grad) {
+    sum->termination = TrainTermination::kMinGradient;
+    sum->message =
+        "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " + Num(options.min_grad);
+  } else if (mu >= options.mu_max) {
+    sum->termination = TrainTermination::kMaxMu;
+    sum->message = "mu = " + Num(mu) + " >= mu_max = " + Num(options.mu_max);
+  } else if (options.change > 0 && ObjectiveSpread(after_step) < options.change) {
+    sum->termination = TrainTermination::kObjectiveStalled;
+    sum->message = "F after the step changed by at most " + Num(ObjectiveSpread(after_step)) +
+                   " < change = " + Num(options.change) + " over the last 4 epochs";
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+double ObjectiveSpread(const std::vector<double>& after_step) {
+  constexpr std::size_t kWindow = 4;  // brnn: 4 values, 3 consecutive differences
+  if (after_step.size() < kWindow) return std::numeric_limits<double>::infinity();
+  double spread = 0;
+  for (std::size_t i = after_step.size() - kWindow + 1; i < after_step.size(); ++i)
+    spread = std::max(spread, std::abs(after_step[i] - after_step[i - 1]));
+  return spread;
 }
 
 std::string TrainSummary::BriefReport() const {
@@ -206,11 +255,13 @@ double LogEvidence(double sse, double ssx, double alpha, double beta, double log
          0.5 * n * std::log(M_PI) + symmetry;
 }
 
-TrainResult TrainBr(const TrainingData& data, const Network& initial, const TrainOptions& options,
-                    const EpochCallback& callback) {
+namespace {
+
+void CheckTrainingData(const TrainingData& data, const Network& initial,
+                       const TrainOptions& options) {
   options.Validate();
   initial.Validate("initial network");
-  const int S = initial.OutputCount();
+  const Eigen::Index S = initial.OutputCount();
   const Eigen::Index Q = data.inputs.cols();
   if (Q < 1) throw InputError("training data: no samples");
   if (data.inputs.rows() != initial.InputCount())
@@ -227,7 +278,15 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     throw InputError("training data: target scaling has " +
                      std::to_string(data.target_scaling.size()) + " variables, expected " +
                      std::to_string(S));
+}
 
+}  // namespace
+
+TrainResult TrainBr(const TrainingData& data, const Network& initial, const TrainOptions& options,
+                    const EpochCallback& callback) {
+  CheckTrainingData(data, initial, options);
+  const int S = initial.OutputCount();
+  const Eigen::Index Q = data.inputs.cols();
   const bool bayes = options.regularization == Regularization::kBayesian;
   TrainResult result;
   result.network = initial;
@@ -270,6 +329,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   double mu = options.mu;
   double gradient = 0;
   std::string degenerate_message;  // set when the alpha/beta update stops being finite
+  std::vector<double> after_step;  // F right after each epoch's LM step (TrainOptions::change)
 
   for (int epoch = 0;; ++epoch) {
     ErrorJacobian(net, cache, &J);
@@ -284,33 +344,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     gradient = 2 * je.norm();
 
     sum.epochs = epoch;
-    if (!degenerate_message.empty()) {
-      sum.termination = TrainTermination::kInterpolation;
-      sum.message = degenerate_message;
-      break;
-    }
-    if (sse <= options.goal) {
-      sum.termination = TrainTermination::kGoalMet;
-      sum.message = "ssE = " + Num(sse) + " <= goal = " + Num(options.goal);
-      break;
-    }
-    if (epoch == options.epochs) {
-      sum.termination = TrainTermination::kMaxEpochs;
-      sum.message =
-          "epoch = " + std::to_string(epoch) + " == epochs = " + std::to_string(options.epochs);
-      break;
-    }
-    if (gradient <= options.min_grad) {
-      sum.termination = TrainTermination::kMinGradient;
-      sum.message =
-          "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " + Num(options.min_grad);
-      break;
-    }
-    if (mu >= options.mu_max) {
-      sum.termination = TrainTermination::kMaxMu;
-      sum.message = "mu = " + Num(mu) + " >= mu_max = " + Num(options.mu_max);
-      break;
-    }
+    if (StopReached(options, epoch, sse, gradient, mu, after_step, degenerate_message, &sum)) break;
 
     EpochInfo info;
     info.epoch = epoch + 1;
@@ -361,6 +395,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     }
     info.step_accepted = accepted;
     info.objective_after_step = F;
+    if (options.change > 0) after_step.push_back(F);
     if (accepted && bayes) {
       // gamma from the Gram matrix of this epoch and the old alpha, beta (REFERENCE.md
       // section 2): trace(H^-1) = ||L^-1||_F^2 for H = L L'; in the errors form

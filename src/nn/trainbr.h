@@ -17,7 +17,9 @@
 // Algorithm, per epoch (REFERENCE.md section 2, to the letter):
 //   1. at the current w: ssE, J, je = J'e, jj = J'J, gradient = 2 ||J'e||.
 //   2. stop if ssE <= goal (kGoalMet), epoch == epochs (kMaxEpochs), gradient <= min_grad
-//      (kMinGradient), mu >= mu_max (kMaxMu), tested in that order.
+//      (kMinGradient), mu >= mu_max (kMaxMu), tested in that order; then, only when
+//      options.change > 0 (R brnn's rule, not MATLAB's), the objective stalled
+//      (kObjectiveStalled, see TrainOptions::change).
 //   3. while mu <= mu_max: dw = -(beta jj + (mu + alpha) I)^-1 (beta je + alpha w);
 //      accept if dw is finite and beta ssE(w + dw) + alpha ||w + dw||^2 < F(w), then
 //      mu = max(mu * mu_dec, 1e-20); otherwise mu = mu * mu_inc.
@@ -52,6 +54,9 @@ enum class TrainTermination {
   /// underflowed because the network interpolates the data, gamma -> n; possible when N > n).
   /// Training stops with the last finite alpha, beta. Tested first, at the next epoch.
   kInterpolation,
+  /// Not in MATLAB; R brnn's rule (TrainOptions::change): the objective after the LM step changed
+  /// by less than `change` between each of the last 4 epochs. Tested last.
+  kObjectiveStalled,
 };
 std::string ToString(TrainTermination t);                 ///< "goal_met", "max_epochs", ...
 TrainTermination ParseTermination(const std::string& s);  ///< inverse; InputError otherwise
@@ -80,6 +85,13 @@ struct TrainOptions {
   double mu_inc = 10.0;    ///< mu factor after a rejected step (> 1)
   double mu_max = 1e10;    ///< stop when mu reaches this
   double min_grad = 1e-7;  ///< stop when 2 ||J'e|| <= min_grad
+  /// R brnn's stopping rule (Perez-Rodriguez et al. 2013, brnn's `change`, default there 0.001;
+  /// not in MATLAB, 0 = off, MATLAB's trainbr). With F_e the objective beta ssE + alpha ssX right
+  /// after epoch e's LM step (EpochInfo::objective_after_step, the alpha, beta of that epoch):
+  /// stop before epoch e + 1 when e >= 4 and max(|F_e - F_e-1|, |F_e-1 - F_e-2|, |F_e-2 - F_e-3|)
+  /// < change (kObjectiveStalled). F is dimensionless (normalized targets), about n / 2 near
+  /// the evidence optimum (beta ssE + alpha ssX -> (n - gamma) / 2 + gamma / 2).
+  double change = 0.0;
   Regularization regularization = Regularization::kBayesian;
   /// How the epoch's linear systems are solved (same algorithm, results agree to rounding; not
   /// stored in model files). See LinearSystem.
@@ -88,6 +100,11 @@ struct TrainOptions {
   /// Throws InputError naming the option, its value and the rule.
   void Validate() const;
 };
+
+/// The measure of TrainOptions::change: max |F_i - F_i-1| over the last 3 consecutive
+/// differences of `after_step` (objectives after each epoch's step, oldest first); +infinity with
+/// fewer than 4 values.
+double ObjectiveSpread(const std::vector<double>& after_step);
 
 /// What the per-epoch callback sees after each epoch's LM loop.
 struct EpochInfo {

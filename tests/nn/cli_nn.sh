@@ -35,9 +35,15 @@ cmp -s m1.json m2.json || fail "same seed gave different model files"
 grep -q '"termination"' out.txt || fail "train --json lacks termination"
 grep -q '"log_evidence"' out.txt || fail "train --json lacks log_evidence"
 
-# issue 12: hidden size by CV by default, --trainbr-matlab = fixed 5-6-2, same file for any thread count
-grep -q '"hidden_selection": "hidden size [0-9]* chosen by 5-fold' m1.json \
-  || fail "default train lacks the CV hidden-size choice"
+# issue 12: hidden size by evidence and brnn's stopping rule by default, --trainbr-matlab = fixed
+# 5-6-2 trained to MATLAB's criteria, same file for any thread count
+grep -q '"hidden_selection": "hidden size [0-9]* of the highest log evidence' m1.json \
+  || fail "default train lacks the evidence hidden-size choice"
+grep -q '"change": 0.001' m1.json || fail "default train lacks brnn's change = 0.001"
+expect 0 "" -- "$whirl" train --data "$data" --out ma.json --hidden auto
+grep -q '"hidden_selection": "hidden size [0-9]* chosen by 5-fold' ma.json \
+  || fail "--hidden auto lacks the CV hidden-size choice"
+expect 1 "excludes --change" -- "$whirl" train --data "$data" --out x.json --trainbr-matlab --change 0.01
 expect 0 "" -- "$whirl" train --data "$data" --out t1.json --seed 3 --restarts 2 --threads 1
 expect 0 "" -- "$whirl" train --data "$data" --out t2.json --seed 3 --restarts 2 --threads 2
 cmp -s t1.json t2.json || fail "--threads 1 and 2 gave different models"
@@ -45,7 +51,7 @@ expect 0 "" -- "$whirl" train --data "$data" --out mm.json --trainbr-matlab --js
 grep -q '"layer_sizes": \[5, 6, 2\]\|"layer_sizes":\[5,6,2\]' out.txt \
   || grep -A4 '"layer_sizes"' out.txt | tr -d ' \n' | grep -q '\[5,6,2\]' || fail "--trainbr-matlab is not 5-6-2"
 grep -q '"fit_time_ms"' out.txt || fail "train --json lacks fit_time_ms"
-expect 1 "expected 'auto' or an integer" -- "$whirl" train --data "$data" --out x.json --hidden 6x
+expect 1 "expected 'evidence', 'auto' or an integer" -- "$whirl" train --data "$data" --out x.json --hidden 6x
 expect 1 "exclude each other" -- "$whirl" train --data "$data" --out x.json --trainbr-matlab --stop-by-cv
 
 # hidden sweep

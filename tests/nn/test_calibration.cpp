@@ -74,6 +74,25 @@ TEST(Calibration, TwentyRowModelCoversTheHoldOut) {
   ExpectCalibrated("20-row model", m);
 }
 
+// As `whirl train --data datasets/whirling_train.csv` (the default training, issue 12). On this
+// one hold-out its +-2 sigma intervals are too wide (99.5 % / 99 %; +-1 sigma 76 % / 71.5 %), so
+// only a loose band is asserted here; the issue's band is measured over 20 seeds by
+// scripts/bench_peers.sh (README, network section), where the default meets it.
+TEST(Calibration, DefaultTrainingRoughlyCoversTheHoldOut) {
+  const Model m = TrainModel(ReadProcessTable(kData / "whirling_train.csv", true),
+                             DefaultTrainingOptions(), "whirling_train.csv");
+  const Coverage c = Measure(m, HoldOut());
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_GE(c.one[k], 0.55) << kTargetColumns[k];
+    EXPECT_LE(c.one[k], 0.85) << kTargetColumns[k];
+    EXPECT_GE(c.two[k], 0.85) << kTargetColumns[k];
+  }
+  std::printf(
+      "[ figures  ] 20-row default model: +-1 sigma %.1f %% / %.1f %%, +-2 sigma %.1f %% / "
+      "%.1f %%\n",
+      100 * c.one[0], 100 * c.one[1], 100 * c.two[0], 100 * c.two[1]);
+}
+
 // As scripts/train_default.sh (the shipped models/default.json).
 TEST(Calibration, FiveHundredRowModelCoversTheHoldOut) {
   ModelTrainOptions o;

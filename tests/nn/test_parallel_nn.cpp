@@ -116,3 +116,42 @@ TEST(HiddenAuto, ChoosesTheCandidateWithTheLowestCrossValidationError) {
 
 }  // namespace
 }  // namespace whirl::nn
+
+namespace whirl::nn {
+namespace {
+
+// The default training (issue 12): the size of the highest log evidence among the candidates,
+// each fit with brnn's rule; the chosen model is the fixed-size fit of that size (before the
+// noise calibration, which uses the same folds), and any thread count gives the same file.
+TEST(HiddenByEvidence, ChoosesTheHighestEvidenceAndIsIdenticalForAnyThreadCount) {
+  const ProcessTable table = synth::SyntheticProcessTable(24, 0.05, 9);
+  ModelTrainOptions o = DefaultTrainingOptions();
+  ASSERT_TRUE(o.hidden_by_evidence);
+  EXPECT_EQ(o.train.change, kBrnnChange);
+  o.threads = 1;
+  const Model one = TrainModel(table, o, "t.csv");
+  std::vector<Model> fits;
+  std::size_t best = 0;
+  for (int h : o.hidden_candidates) {
+    ModelTrainOptions fixed = o;
+    fixed.hidden_candidates.clear();
+    fixed.hidden_sizes = {h};
+    fits.push_back(TrainModel(table, fixed, "t.csv"));
+    const TrainSummary& s = fits.back().training_summary;
+    EXPECT_NE(s.termination, TrainTermination::kMaxEpochs) << s.BriefReport();
+    if (s.log_evidence > fits[best].training_summary.log_evidence) best = fits.size() - 1;
+  }
+  EXPECT_EQ(fits[best].network.GetParameters(), one.network.GetParameters());
+  EXPECT_EQ(fits[best].output_noise_variance, one.output_noise_variance);
+  EXPECT_EQ(one.network.layer_sizes, (std::vector<int>{5, o.hidden_candidates[best], 2}));
+  EXPECT_NE(one.hidden_selection.find("highest log evidence"), std::string::npos)
+      << one.hidden_selection;
+  const nlohmann::json reference = one;
+  for (int threads : {2, 4}) {
+    o.threads = threads;
+    EXPECT_EQ(nlohmann::json(TrainModel(table, o, "t.csv")).dump(), reference.dump()) << threads;
+  }
+}
+
+}  // namespace
+}  // namespace whirl::nn

@@ -200,6 +200,57 @@ TEST(TrainBr, StopsForEachDocumentedReason) {
   EXPECT_EQ(ParseTermination(ToString(r.summary.termination)), r.summary.termination);
 }
 
+// brnn's rule on hand-made sequences: the spread is the largest of the LAST three consecutive
+// differences; fewer than four values never stop.
+TEST(TrainBr, ObjectiveSpreadFollowsHandMadeSequences) {
+  EXPECT_TRUE(std::isinf(ObjectiveSpread({})));
+  EXPECT_TRUE(std::isinf(ObjectiveSpread({5.0, 5.0, 5.0})));
+  EXPECT_DOUBLE_EQ(ObjectiveSpread({5.0, 5.0, 5.0, 5.0}), 0.0);
+  // Differences 10, 1, 0.5, 0.25: only the last three count.
+  EXPECT_DOUBLE_EQ(ObjectiveSpread({30.0, 20.0, 19.0, 18.5, 18.25}), 1.0);
+  // An increase counts by its absolute value.
+  EXPECT_DOUBLE_EQ(ObjectiveSpread({1.0, 1.0005, 1.0, 1.002}), 0.002);
+  // Where a hand-made F sequence crosses change = 0.001: 10 + 2^-k is stalled once the last three
+  // differences 2^-(k-1) - 2^-k = 2^-k ... are all below 0.001, i.e. the oldest 2^-(k-2) < 0.001.
+  std::vector<double> f;
+  int stop_at = -1;
+  for (int k = 0; k < 30 && stop_at < 0; ++k) {
+    f.push_back(10.0 + std::ldexp(1.0, -k));
+    if (ObjectiveSpread(f) < 0.001) stop_at = k;
+  }
+  EXPECT_EQ(stop_at, 12);  // differences 2^-10, 2^-11, 2^-12 (2^-10 = 0.00098 < 0.001 > 2^-9)
+}
+
+// In TrainBr the rule stops exactly at the first epoch whose last four after-step objectives
+// (seen through the callback) have consecutive changes below `change`; change = 0 is MATLAB's run.
+TEST(TrainBr, ChangeRuleStopsWhereTheObjectivesSay) {
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const TrainingData data = synth::SmoothProblem(20, 0.1, 70 + seed);
+    const Network net = Initial({5, 6, 2}, seed);
+    TrainOptions o;
+    o.change = 0.001;
+    std::vector<double> after;
+    int expected_stop = -1;
+    const TrainResult r = TrainBr(data, net, o, [&](const EpochInfo& info) {
+      after.push_back(info.objective_after_step);
+      if (expected_stop < 0 && ObjectiveSpread(after) < o.change) expected_stop = info.epoch;
+    });
+    if (r.summary.termination == TrainTermination::kObjectiveStalled) {
+      EXPECT_EQ(r.summary.epochs, expected_stop) << "seed " << seed;
+    } else {  // a MATLAB criterion (tested first) ended the run at or before that epoch
+      EXPECT_TRUE(expected_stop == -1 || expected_stop == r.summary.epochs)
+          << "seed " << seed << ": " << r.summary.BriefReport();
+    }
+    // Off: the same start runs to MATLAB's own criteria and is never stalled.
+    const TrainResult m = TrainBr(data, net, TrainOptions{});
+    EXPECT_NE(m.summary.termination, TrainTermination::kObjectiveStalled);
+    EXPECT_GE(m.summary.epochs, r.summary.epochs);
+  }
+  TrainOptions bad;
+  bad.change = -1;
+  EXPECT_THROW(bad.Validate(), InputError);
+}
+
 TEST(TrainBr, RegularizationBeatsPlainLmOnTwentyNoisySamples) {
   const TrainingData test_set = synth::SmoothProblem(400, 0.0, 999);
   double mse_br = 0, mse_lm = 0;
