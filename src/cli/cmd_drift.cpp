@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/drift_args.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "drift/documents.h"
@@ -54,42 +55,6 @@ std::vector<Run> LoadRuns(const RunInputs& in) {
     if (r.time_from_index)
       Warn(r.source + ": no complete time column: the sample index is used as time");
   return runs;
-}
-
-struct SelectionArgs {
-  double alpha = 0.05;
-  std::string classes = "fewest";
-  int max_sensors = 0;
-};
-
-void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
-  sub->add_option("--alpha", s->alpha, "significance level of the F test (default 0.05)")
-      ->check(CLI::Range(1e-6, 0.5));
-  sub->add_option("--classes", s->classes,
-                  "class count: 'fewest' (seed 000: fewest classes with a significant F, "
-                  "default), 'margin' (largest (F - F_crit)/F_crit) or a number");
-  sub->add_option("--max-sensors", s->max_sensors,
-                  "at most this many classes = chosen sensors (0: no limit)")
-      ->check(CLI::Range(0, 64));
-}
-
-drift::SelectionOptions ToSelection(const SelectionArgs& a) {
-  drift::SelectionOptions o;
-  o.alpha = a.alpha;
-  o.max_classes = a.max_sensors;
-  if (a.classes == "fewest" || a.classes == "margin") {
-    o.rule = drift::ParseClassCountRule(a.classes);
-  } else {
-    o.rule = drift::ClassCountRule::kFixed;
-    try {
-      std::size_t used = 0;
-      o.fixed_classes = std::stoi(a.classes, &used);
-      if (used != a.classes.size()) throw std::invalid_argument(a.classes);
-    } catch (const std::exception&) {
-      throw InputError("--classes '" + a.classes + "': must be fewest, margin or a number");
-    }
-  }
-  return o;
 }
 
 struct ModelArgs {

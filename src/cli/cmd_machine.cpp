@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/drift_args.h"
 #include "compare/machine_eval.h"
 #include "core/csv.h"
 #include "core/error.h"
@@ -35,6 +36,7 @@ struct MachineCliOptions {
   std::string iso_table = ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv");
   int machines = 2, screws = 3, train_runs = 2, threads = 2;
   bool machine_off = false, markdown = false, json = false;
+  SelectionArgs selection;
   std::string drift_model = "mlr";
   double monitor_every_min = 30;
   std::string report;
@@ -91,6 +93,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.seed = o.seed;
   eo.threads = o.threads;
   eo.fit.kind = drift::ParseModelKind(o.drift_model);
+  eo.fit.selection = ToSelection(o.selection);
   eo.monitor_every_min = o.monitor_every_min;
   eo.report_dir = o.report;
   if (!o.report.empty()) eo.profile = interp::LoadMachineProfile(o.profile);
@@ -180,6 +183,7 @@ void RegisterMachine(CLI::App& app) {
                 "machine drift model kind: mlr (seed 000's regression, default) or dynamic (with "
                 "first-order lags [min] chosen by cross-validation)")
       ->check(CLI::IsMember({"mlr", "dynamic"}));
+  AddSelectionOptions(e, &o->selection);  // seed 000's sensor selection of the machine models
   e->add_option("--monitor-every-min", o->monitor_every_min,
                 "both_monitor: check-bar interval of seed 004's monitor [min] (1..600, default 30)")
       ->check(CLI::Range(1.0, 600.0));

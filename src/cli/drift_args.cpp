@@ -1,0 +1,39 @@
+#include "cli/drift_args.h"
+
+#include <stdexcept>
+
+#include "core/error.h"
+
+namespace whirl::cli {
+
+void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
+  sub->add_option("--alpha", s->alpha, "significance level of the F test (default 0.05)")
+      ->check(CLI::Range(1e-6, 0.5));
+  sub->add_option("--classes", s->classes,
+                  "class count: 'fewest' (seed 000: fewest classes with a significant F, "
+                  "default), 'margin' (largest (F - F_crit)/F_crit) or a number");
+  sub->add_option("--max-sensors", s->max_sensors,
+                  "at most this many classes = chosen sensors (0: no limit)")
+      ->check(CLI::Range(0, 64));
+}
+
+drift::SelectionOptions ToSelection(const SelectionArgs& a) {
+  drift::SelectionOptions o;
+  o.alpha = a.alpha;
+  o.max_classes = a.max_sensors;
+  if (a.classes == "fewest" || a.classes == "margin") {
+    o.rule = drift::ParseClassCountRule(a.classes);
+  } else {
+    o.rule = drift::ClassCountRule::kFixed;
+    try {
+      std::size_t used = 0;
+      o.fixed_classes = std::stoi(a.classes, &used);
+      if (used != a.classes.size()) throw std::invalid_argument(a.classes);
+    } catch (const std::exception&) {
+      throw InputError("--classes '" + a.classes + "': must be fewest, margin or a number");
+    }
+  }
+  return o;
+}
+
+}  // namespace whirl::cli
