@@ -1,5 +1,6 @@
 #include "interp/drift_action.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -282,6 +283,15 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& g, const DriftAc
   return c;
 }
 
+double DriftSlopeBound(const drift::DriftModel& g, const DriftActionOptions& o) {
+  const Eigen::VectorXd c = DriftSlopeCoefficients(g, o);
+  double bound = std::abs(c(0));
+  for (Eigen::Index f = 1; f < c.size(); ++f)
+    bound +=
+        std::abs(c(f)) * std::max(std::abs(g.feature_min(f - 1)), std::abs(g.feature_max(f - 1)));
+  return bound;
+}
+
 namespace {
 
 void CheckSlope(const drift::DriftModel* g, const DriftActionOptions& o, const Slots& s) {
@@ -320,8 +330,9 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
   nc += P(s.offset.flag) + "=0\n";
   if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
   if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
-  if (o.workpiece_slope_param >= 0)
-    nc += P(o.workpiece_slope_param) + "=0\n" + P(o.workpiece_slope_param + 1) + "=0\n";
+  if (o.workpiece_slope_param >= 0)  // no plan yet: slope 0 about the fixed end
+    nc += P(o.workpiece_slope_param) + "=0\n" + P(o.workpiece_slope_param + 1) + "=" +
+          Num(o.has_slope ? o.slope_fixed_end_mm : 0.0, kDecimalsPositionMm) + "\n";
   return nc;
 }
 
@@ -346,7 +357,9 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
   if (g)
     nc += "; slope S_m = s * sigma * (g0 + sum g_f x_f) / 1e6 (sigma = " +
           std::to_string(o.slope_growth_direction) + ") about the fixed end " +
-          Num(o.slope_fixed_end_mm, kDecimalsPositionMm) + " mm (MCS)\n";
+          Num(o.slope_fixed_end_mm, kDecimalsPositionMm) +
+          " mm (MCS); |S_m| <= " + Num(DriftSlopeBound(*g, o), kDecimalsSd43910) +
+          " over the training ranges: the plan's slopes plus this must stay within MD32760\n";
   const std::string saved = slope_mode ? R(r) + ".." + R(r + 4) + " (SD43900-43920 found, markers)"
                                        : R(r) + " (SD43900 found), " + R(r + 1) +
                                              " (1 while active), " + R(r + 2) + ".." + R(r + 4) +
@@ -400,10 +413,11 @@ std::string FormatDriftNcResetProgram(const DriftActionOptions& o) {
                    " and restores the setting data found before it started (SD43900 if " +
                    R(r + 1) + " = 1, SD43910/SD43920 if " + R(r + 4) + " = 1)\n";
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
-  nc += "IF " + R(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + R(r) + "\n" + R(r + 1) +
-        "=0\nENDIF\n";
+  // The slope first: every intermediate state is then a constant offset (sinumerik.h).
   nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
         "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";
+  nc += "IF " + R(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + R(r) + "\n" + R(r + 1) +
+        "=0\nENDIF\n";
   nc += "STOPRE\nM17\n";
   return nc;
 }

@@ -128,6 +128,11 @@ Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& model,
 Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
                                        const DriftActionOptions& options);
 
+/// The largest |S_m| the slope model gives over its training ranges (a box bound: |c_0| +
+/// sum |c_f| max(|min_f|, |max_f|)), mm/mm. The plan's slopes plus this must stay within MD32760
+/// (compare/machine_nc.h checks it for the combined programs).
+double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options);
+
 inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)
 inline constexpr int kDecimalsDriftSlopeCoefficient = 14;  ///< mm/mm per K: 1e-14 per K
 inline constexpr int kDecimalsLagFactor = 15;              ///< a = 1 - exp(-T_ipo / tau)

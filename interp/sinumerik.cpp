@@ -589,9 +589,12 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   std::string nc =
       Header(plan, info) + RequireDriftAction(o) + CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
   const CompensationSegment& first = plan.segments.front();
+  // One datum per block, the slope last: between the blocks the control applies a mix of found
+  // and new values, and with the slope written last (found slope 0, or the hand-over's 0) every
+  // mix is a constant offset, never slope * (P - a stale reference), which can be millimetres.
   nc += K0Target(o, "$") + "=" + k0(first.sd43900_mm) + "\n";
-  nc += SlopeTarget(o, "$") + "=" + slope(first.sd43910) + "\n";
   nc += RefTarget(o, "$") + "=" + pos(first.sd43920_mm) + "\n";
+  nc += SlopeTarget(o, "$") + "=" + slope(first.sd43910) + "\n";
   nc += "STOPRE\n";
   int id = o.sync_id_first;
   for (std::size_t i = 1; i < plan.segments.size(); ++i, ++id) {
@@ -620,9 +623,10 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
         " = 1 (whirl's compensation active), writes back the setting data saved in " + R(m) + ".." +
         R(m + 2) + "\n";
   nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n";
-  nc += K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+  // The slope first (see FormatNcProgram): every intermediate state is then a constant offset.
   nc += SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n";
   nc += RefTarget(o, "$") + "=" + RestoredRef(o, "") + "\n";
+  nc += K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
   nc += R(m + 3) + "=0\nENDIF\nSTOPRE\nM17\n";
   return nc;
 }

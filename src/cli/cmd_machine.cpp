@@ -114,6 +114,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
     std::printf("%s\n%s", e.summary.message.c_str(),
                 compare::FormatMachineEvalTable(e, o.markdown).c_str());
   }
+  if (!e.programs_note.empty()) Warn(e.programs_note);
   if (!e.report_index.empty())
     std::fprintf(stderr, "report written to %s\n", e.report_index.c_str());
   if (e.summary.failed == e.summary.screws) throw CommandFailure("every comparison failed", 1);
@@ -194,7 +195,8 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--profile", o->profile,
                 "840D machine profile of the combined programs in the report (schema "
                 "whirl.machine with drift.slope and drift.workpiece_slope_param; default "
-                "datasets/machines/whirling_840d.json, which matches the simulated machine)")
+                "datasets/machines/whirling_840d.json, which matches the shipped machine file; a "
+                "profile that does not fit the machine leaves the programs out with a warning)")
       ->check(CLI::ExistingFile);
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });

@@ -283,13 +283,19 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
         EvaluateScrewOnMachine(screws.front(), model, rule, iso_table, day, models[0], co,
                                options.monitor_every_min, &detail);
     std::optional<CombinedPrograms> programs;
-    if (options.profile && models[0].fitted)
-      programs = BuildCombinedPrograms(
-          detail.predicted_curve, detail.kinematics, screws.front().thread_length_mm, co.plan,
-          models[0], day.config, *options.profile, "network curve of screw " + screws.front().name);
-    e.report_index =
-        WriteMachineScrewReport(options.report_dir, first, detail, e.sensors_cutting[0],
-                                e.sensors_idle[0], programs ? &*programs : nullptr);
+    if (options.profile && models[0].fitted) {
+      try {
+        programs = BuildCombinedPrograms(detail.predicted_curve, detail.kinematics,
+                                         screws.front().thread_length_mm, co.plan, models[0],
+                                         day.config, *options.profile,
+                                         "network curve of screw " + screws.front().name);
+      } catch (const InputError& err) {  // the evaluation stands; the page says why
+        e.programs_note = std::string("combined 840D programs not written: ") + err.what();
+      }
+    }
+    e.report_index = WriteMachineScrewReport(options.report_dir, first, detail,
+                                             e.sensors_cutting[0], e.sensors_idle[0],
+                                             programs ? &*programs : nullptr, e.programs_note);
   }
   return e;
 }

@@ -115,6 +115,8 @@ struct MachineEvaluation {
   std::vector<MachineEvalScrew> screws;
   MachineEvalSummary summary;
   std::string report_index;  ///< index.html of the report, when written
+  /// Why the report holds no combined programs (a profile that does not fit the machine), or "".
+  std::string programs_note;
 };
 
 /// Training runs of machine `machine_seed` (idle warm-ups then cutting runs).
@@ -153,7 +155,8 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                                     const MachineScrewDetail& detail,
                                     const std::vector<std::string>& sensors_cutting,
                                     const std::vector<std::string>& sensors_idle,
-                                    const CombinedPrograms* programs = nullptr);
+                                    const CombinedPrograms* programs = nullptr,
+                                    const std::string& programs_note = "");
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
                                        const ExperienceRule& rule,

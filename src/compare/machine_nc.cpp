@@ -45,7 +45,9 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
   CombinedPrograms out;
   interp::PlanOptions po = plan_options;
   profile.ApplyCombinedTo(po);
-  po.start_position_mm = kinematics.thread_start_position_mm;  // program zero: the chuck face
+  // Program zero at the chuck face, the program coordinate -direction * z: the cut runs towards
+  // the chuck (z falls) in the direction of travel.
+  po.start_position_mm = -po.direction * kinematics.thread_start_position_mm;
   out.drift = profile.DriftOptions();
   out.drift.reference = interp::DriftReference::kStart;
   const double z0 = kinematics.thread_start_position_mm;
@@ -58,6 +60,14 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
   out.plan_nc = interp::FormatNcProgram(out.plan, info);
   out.plan_reset_nc = interp::FormatNcResetProgram(po, info);
   const drift::DriftModel& g = models.slope_cutting;
+  const double bound = interp::DriftSlopeBound(g, out.drift);
+  if (out.plan.max_abs_slope + bound > po.md32760)
+    throw InputError("combined programs: the plan's largest slope " +
+                     interp::FormatFixed(out.plan.max_abs_slope, interp::kDecimalsSd43910) +
+                     " plus the machine slope's bound " +
+                     interp::FormatFixed(bound, interp::kDecimalsSd43910) +
+                     " exceed MD32760 = " + interp::FormatFixed(po.md32760, 4) + " (profile '" +
+                     profile.source + "'): SD43910 could be capped mid-cut");
   out.drift_nc = interp::FormatDriftNcProgram(models.offset_cutting, out.drift,
                                               "machine model trained on cutting runs", &g);
   out.drift_reset_nc = interp::FormatDriftNcResetProgram(out.drift);

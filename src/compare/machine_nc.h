@@ -9,12 +9,14 @@
 //   S_m (P_w - P_b), K_m from the offset model (offset_um), S_m from the slope model
 //   (zscrew_per_1000_um) about the screw's fixed bearing P_b.
 // Coordinates (machine/machine.h): the tool is z mm from the chuck face, the cut runs towards
-// the chuck, z(t) = z_0 - v_f t. The plan's program zero is taken at the chuck face, so the
-// thread start is start_position_mm = z_0 and the axis reads P = machine_offset_mm + start +
-// direction (z_0 - z). The profile must agree with the simulated machine: error_direction =
-// growth_direction = direction (the machine error m is positive towards the chuck, which is the
-// direction of travel), and drift.slope.fixed_end_position_mm = P at z = z_fixed; a profile that
-// does not is an InputError naming the field, its value and the value the machine implies.
+// the chuck, z(t) = z_0 - v_f t. The plan's program zero is taken at the chuck face with the
+// program coordinate -direction * z (the travel runs towards the chuck), so the thread start is
+// start_position_mm = -direction z_0 and the axis reads P = machine_offset_mm - direction z. The
+// profile must agree with the simulated machine: error_direction = growth_direction = direction
+// (the machine error m is positive towards the chuck, the direction of travel), and
+// drift.slope.fixed_end_position_mm = P at z = z_fixed = machine_offset_mm - direction z_fixed; a
+// profile that does not is an InputError naming the field, its value and the value the machine
+// implies.
 // Shipped profile for the simulated machine: datasets/machines/whirling_840d.json.
 // The drift action's rises are taken from the temperatures when it starts (reference "start"),
 // the convention of drift::PredictRun the evaluation uses (the machine starts cold with the cut).

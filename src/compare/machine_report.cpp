@@ -85,8 +85,8 @@ std::string OutputAction(const std::string& drift_nc) {
   return drift_nc.substr(begin + 1, end - begin - 1);
 }
 
-std::string ProgramsHtml(const CombinedPrograms* p) {
-  if (!p) return "";
+std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
+  if (!p) return note.empty() ? "" : "<p>" + HtmlEscape(note) + "</p>";
   const interp::DriftActionOptions& d = p->drift;
   std::string h =
       "<h2>Combined 840D programs (one writer per setting datum)</h2><p>The workpiece plan (" +
@@ -110,7 +110,8 @@ std::string ProgramsHtml(const CombinedPrograms* p) {
 
 std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
                  const std::vector<std::string>& idle, const std::string& sensor_img,
-                 const std::string& lead_img, const CombinedPrograms* programs) {
+                 const std::string& lead_img, const CombinedPrograms* programs,
+                 const std::string& programs_note) {
   std::string h = "<!doctype html><html><head><meta charset='utf-8'><title>" +
                   HtmlEscape(r.screw.name) + ": both halves</title></head><body><h1>" +
                   HtmlEscape(r.screw.name) +
@@ -132,7 +133,7 @@ std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutt
                 "</table><p>Left after both, over the thread: workpiece part %.1f um, machine "
                 "part %.1f um.</p>",
                 r.residual_workpiece_total_um, r.residual_machine_total_um);
-  return h + buf + ProgramsHtml(programs) + "</body></html>\n";
+  return h + buf + ProgramsHtml(programs, programs_note) + "</body></html>\n";
 }
 
 }  // namespace
@@ -141,7 +142,8 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                                     const MachineScrewDetail& detail,
                                     const std::vector<std::string>& sensors_cutting,
                                     const std::vector<std::string>& sensors_idle,
-                                    const CombinedPrograms* programs) {
+                                    const CombinedPrograms* programs,
+                                    const std::string& programs_note) {
   if (!screw.ok) throw InputError("report of screw '" + screw.screw.name + "': " + screw.error);
   const fs::path target = fs::absolute(dir);
   std::error_code ec;
@@ -171,8 +173,8 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
     const std::string lead_img =
         Render(partial, "lead", LeadScript(screw.screw.name + ": lead deviation"));
     if (programs) WriteFilesAtomic(CombinedProgramFiles(partial, *programs));
-    WriteFileAtomic(partial / "index.html",
-                    Html(screw, sensors_cutting, sensors_idle, sensor_img, lead_img, programs));
+    WriteFileAtomic(partial / "index.html", Html(screw, sensors_cutting, sensors_idle, sensor_img,
+                                                 lead_img, programs, programs_note));
     fs::remove(target, ec);  // an empty directory only
     fs::rename(partial, target);
   } catch (...) {

@@ -10,6 +10,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -150,6 +151,9 @@ struct Replay {
   Control control;
   std::map<int, SyncAction> actions;  // by ID: executed in ID order
   std::string axis = "Z";
+  // Called after each part-program assignment: the main run goes on between blocks, so a test can
+  // run interpolation cycles there and see the states a program passes through.
+  std::function<void()> between_blocks;
 
   double Value(const std::string& expr) const { return Expr(expr, control, axis).Eval(); }
 
@@ -255,6 +259,7 @@ struct Replay {
         actions[a.id] = a;
       } else if (std::regex_match(line, m, kAssign)) {
         Assign(Target(m[1]), Value(m[3]));
+        if (between_blocks) between_blocks();
       } else {
         ADD_FAILURE() << "line the replay does not understand: '" << line << "'";
       }
