@@ -79,8 +79,9 @@ Layout MakeLayout(const drift::DriftModel& m, int first) {
   return l;
 }
 
-// Slots of one program: the offset model's, then the slope model's and S_m (slope mode).
+// Slots of one program: liveness, the offset model's, then the slope model's and S_m.
 struct Slots {
+  int alive = 0;
   Layout offset, slope;
   int s_m = -1;  // $AC_PARAM holding S_m, -1 without a slope model
   int last = 0;
@@ -88,7 +89,8 @@ struct Slots {
 
 Slots MakeSlots(const drift::DriftModel& m, const drift::DriftModel* g, int first) {
   Slots s;
-  s.offset = MakeLayout(m, first);
+  s.alive = first;
+  s.offset = MakeLayout(m, first + 1);
   s.last = s.offset.Last();
   if (g) {
     s.slope = MakeLayout(*g, s.last + 1);
@@ -163,7 +165,8 @@ std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
   const std::string ax = "[" + o.axis + "]";
   std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient);
   if (o.workpiece_k0_param >= 0) k0 += "+" + P(o.workpiece_k0_param);
-  if (!SlopeMode(o, g)) return "DO $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0;
+  if (!SlopeMode(o, g))
+    return "DO $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=1";
   std::string slope, ref;
   if (o.workpiece_slope_param >= 0) {
     const std::string p_w = P(o.workpiece_slope_param + 1);
@@ -178,7 +181,7 @@ std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
     ref = Num(o.slope_fixed_end_mm, kDecimalsPositionMm);
   }
   return "DO $$SA_TEMP_COMP_SLOPE" + ax + "=" + slope + " $$SA_TEMP_COMP_REF_POSITION" + ax + "=" +
-         ref + " $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0;
+         ref + " $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=2";
 }
 
 // The static actions, in execution order.
@@ -236,6 +239,9 @@ void DriftActionOptions::Validate() const {
   if (!(save_r_first >= 0 && save_r_first <= 9998))
     throw InputError("drift save_r_first " + std::to_string(save_r_first) +
                      ": must be within 0..9998");
+  if (!(missing_alarm >= 60000 && missing_alarm <= 69996))
+    throw InputError("drift missing_alarm " + std::to_string(missing_alarm) +
+                     ": must be within 60000..69996 (it and the next three numbers are used)");
   if (workpiece_k0_param > 9999)
     throw InputError("drift workpiece_k0_param " + std::to_string(workpiece_k0_param) +
                      ": must be within 0..9999");
@@ -327,7 +333,7 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
   else  // an aborted slope run left its slope behind: give the found one back
     nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
           "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";
-  nc += P(s.offset.flag) + "=0\n";
+  nc += P(s.alive) + "=0\n" + P(s.offset.flag) + "=0\n";
   if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
   if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
   if (o.workpiece_slope_param >= 0)  // no plan yet: slope 0 about the fixed end
@@ -366,7 +372,9 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
                                              " (a slope left by an earlier run)";
   nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
-        std::to_string(o.param_first) + ".." + std::to_string(s.last) + "], " + saved + "\n";
+        std::to_string(o.param_first) + ".." + std::to_string(s.last) + "] (liveness $AC_PARAM[" +
+        std::to_string(s.alive) + "] = " + (SlopeMode(o, g) ? "2" : "1") + " while running), " +
+        saved + "\n";
   if (o.workpiece_k0_param >= 0)
     nc += "; adds the whirling plan's K0 from $AC_PARAM[" + std::to_string(o.workpiece_k0_param) +
           "]: this action is the only writer of SD43900 on axis " + o.axis + "\n";
@@ -397,6 +405,9 @@ std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOp
                      " synchronized-action IDs, the range " + std::to_string(o.sync_id_first) +
                      ".." + std::to_string(o.sync_id_last) + " has " + std::to_string(available));
   std::string nc = Header(m, g, o, model_source, s);
+  if (o.plan_marker_r >= 0)  // a plan's own compensation is still on the control: reset it first
+    nc += "IF " + R(o.plan_marker_r) + "==1\nSETAL(" + std::to_string(o.missing_alarm + 3) +
+          ")\nENDIF\n";
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
   nc += Preamble(o, SlopeMode(o, g), s) + "STOPRE\n";
   for (std::size_t k = 0; k < bodies.size(); ++k)
@@ -413,6 +424,7 @@ std::string FormatDriftNcResetProgram(const DriftActionOptions& o) {
                    " and restores the setting data found before it started (SD43900 if " +
                    R(r + 1) + " = 1, SD43910/SD43920 if " + R(r + 4) + " = 1)\n";
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
+  nc += P(o.param_first) + "=0\n";  // liveness: no action runs any more
   // The slope first: every intermediate state is then a constant offset (sinumerik.h).
   nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
         "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";

@@ -17,8 +17,11 @@
 // subtracts it; error_direction = +1 means the model's error is the tool's displacement along
 // +axis relative to the workpiece (what a dial gauge on the table reads along +axis).
 //
-// $AC_PARAM layout from param_first: one slot per model feature (input-major, as DriftModel::
-// features), then one reference slot per sensor (reference "start"), then an init flag.
+// $AC_PARAM layout from param_first: the liveness slot (the last action writes the mode there
+// every cycle: 1 owns SD43900, 2 owns SD43900-43920; the plans clear it, dwell and read it back,
+// sinumerik.h), then one slot per model feature (input-major, as DriftModel::features), one
+// reference slot per sensor (reference "start") and an init flag; with a slope model its slots
+// follow likewise, then S_m. The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
 // Action order (IDs count up from sync_id_first; actions run in ID order every cycle):
 //   [start: capture T_ref once] -> rises u -> [lags: L = u once] -> [lag updates] -> SD43900.
 //
@@ -27,7 +30,9 @@
 // instead of SD43900 (they still own SD43910/SD43920), and this action writes
 //   SD43900 = machine K0 + $AC_PARAM[workpiece_k0_param],
 // so the two never fight over SD43900; the plan program refuses to start (alarm) unless this
-// action's marker says it is active. The drift action's IDs must lie above the plan's: actions
+// action is running now (the liveness slot, see the $AC_PARAM layout below), and a plan that
+// writes the setting data itself refuses while it runs. The drift action's IDs must lie above the
+// plan's: actions
 // run in ID order each cycle, so the plan's K0 is written before it is added (no cycle of lag).
 //
 // The machine's slope (optional second model, e.g. the Z feed screw growing from its fixed
@@ -86,7 +91,11 @@ struct DriftActionOptions {
   bool has_slope = false;          ///< the profile's drift.slope object is present
   double slope_fixed_end_mm = 0;   ///< P_b: axis position (MCS) of the zero of the growth, mm
   int slope_growth_direction = 1;  ///< sigma: +1 distance from P_b grows towards +axis, or -1
-  int missing_alarm = 65000;       ///< SETAL number the combined plan raises if this is not active
+  /// First of four SETAL numbers (60000..69996): + 0..2 the plans' liveness check
+  /// (sinumerik.h PlanOptions::drift_alive_param), + 3 this program finds a plan's compensation
+  /// still active (R<plan_marker_r> = 1: run the plan's reset program first).
+  int missing_alarm = 65000;
+  int plan_marker_r = -1;  ///< the plans' marker R (profile save_r_first + 3); -1: not checked
   DriftReference reference = DriftReference::kModel;
   std::map<std::string, AnalogInput> inputs;  ///< by column name (sensors and extra inputs)
 

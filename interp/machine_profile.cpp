@@ -90,10 +90,7 @@ void MachineProfile::ApplyCombinedTo(PlanOptions& o) const {
                      "needs a 'drift' object with 'workpiece_k0_param'");
   ApplyTo(o);
   o.workpiece_k0_param = drift->workpiece_k0_param;
-  o.drift_marker_r = drift->save_r_first + 1;
-  o.drift_missing_alarm = drift->missing_alarm;
   o.workpiece_slope_param = drift->workpiece_slope_param;
-  o.drift_slope_marker_r = drift->workpiece_slope_param >= 0 ? drift->save_r_first + 4 : -1;
 }
 
 DriftActionOptions MachineProfile::DriftOptions() const {
@@ -104,6 +101,7 @@ DriftActionOptions MachineProfile::DriftOptions() const {
   DriftActionOptions d = *drift;
   d.axis = axis;
   d.control_dk = control_dk;
+  d.plan_marker_r = save_r_first + 3;  // a plan's compensation left active: the preamble alarms
   return d;
 }
 
@@ -118,6 +116,10 @@ void MachineProfile::ApplyTo(PlanOptions& o) const {
   o.sync_id_last = sync_id_last;
   o.save_r_first = save_r_first;
   o.sign = ExpectedSign(direction, control_dk);
+  // A machine with a drift action: every plan checks it (a plan that writes the setting data
+  // itself must not run beside it).
+  o.drift_alive_param = drift ? drift->param_first : -1;
+  if (drift) o.drift_missing_alarm = drift->missing_alarm;
 }
 
 MachineProfile LoadMachineProfile(const std::filesystem::path& path) {

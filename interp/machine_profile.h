@@ -32,7 +32,9 @@
 //                                 optional: the machine's slope model (drift nc --slope-model):
 //                                 MCS position of the zero of the growth (a feed screw's fixed
 //                                 bearing) and +1/-1 if the distance from it grows towards +/-axis
-//      "missing_alarm": 65000,    SETAL number of a combined plan started without the action
+//      "missing_alarm": 65000,    first of four SETAL numbers: a combined plan without the action
+//                                 running, a plan writing the data itself beside it, a mode
+//                                 mismatch, a drift program finding a plan's compensation active
 //      "analog_inputs": {"t3_C": {"index": 3, "scale": 0.1, "offset": 0.0}, ...}}}
 //                                 T = scale * $A_INA[index] + offset [degC] per model input
 //
@@ -61,12 +63,14 @@ struct MachineProfile {
   int save_r_first = 90;
   std::optional<DriftActionOptions> drift;  ///< the "drift" object, when present
 
-  /// Copies the machine's facts into plan options (tolerance and check step are left alone) and
-  /// sets the sign to ExpectedSign(direction, control_dk).
+  /// Copies the machine's facts into plan options (tolerance and check step are left alone), sets
+  /// the sign to ExpectedSign(direction, control_dk) and, when the profile has a drift action, its
+  /// liveness slot and alarm (a plan that writes the setting data itself refuses beside it).
   void ApplyTo(PlanOptions& options) const;
   /// The plan combined with the drift action: its K0 goes to drift.workpiece_k0_param (and its
   /// slope and reference to drift.workpiece_slope_param, +1, when the profile has it) and it
-  /// requires the drift action's marker(s). InputError naming the file if "drift" is missing.
+  /// requires the drift action to run in the matching mode. InputError naming the file if
+  /// "drift" is missing.
   void ApplyCombinedTo(PlanOptions& options) const;
   /// The drift action's options (axis and control_dk from the profile). InputError if absent.
   DriftActionOptions DriftOptions() const;

@@ -141,31 +141,22 @@ void PlanOptions::Validate() const {
   if (!(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= kMaxSyncActionId))
     throw InputError("synchronized-action IDs " + std::to_string(sync_id_first) + ".." +
                      std::to_string(sync_id_last) + ": must satisfy 1 <= first <= last <= 255");
-  if (workpiece_k0_param >= 0 &&
-      !(workpiece_k0_param <= 9999 && drift_marker_r >= 0 && drift_marker_r <= 9999 &&
-        (drift_marker_r < save_r_first || drift_marker_r > save_r_first + 3) &&
-        drift_missing_alarm >= 60000 && drift_missing_alarm <= 69999))
+  if (workpiece_k0_param > 9999 || (workpiece_k0_param >= 0 && drift_alive_param < 0))
     throw InputError("combined with the drift action: workpiece_k0_param " +
-                     std::to_string(workpiece_k0_param) + " must be 0..9999, the drift marker R" +
-                     std::to_string(drift_marker_r) + " 0..9999 outside R" +
-                     std::to_string(save_r_first) + "..R" + std::to_string(save_r_first + 3) +
-                     ", and the alarm " + std::to_string(drift_missing_alarm) + " 60000..69999");
-  if (workpiece_slope_param >= 0 &&
-      !(workpiece_k0_param >= 0 && workpiece_slope_param <= 9998 &&
-        (workpiece_k0_param < workpiece_slope_param ||
-         workpiece_k0_param > workpiece_slope_param + 1) &&
-        drift_slope_marker_r >= 0 && drift_slope_marker_r <= 9999 &&
-        drift_slope_marker_r != drift_marker_r &&
-        (drift_slope_marker_r < save_r_first || drift_slope_marker_r > save_r_first + 3)))
+                     std::to_string(workpiece_k0_param) +
+                     " must be 0..9999 and needs the drift action's liveness slot "
+                     "(drift_alive_param, the profile's drift.param_first)");
+  if (drift_alive_param > 9999 || !(drift_missing_alarm >= 60000 && drift_missing_alarm <= 69997))
+    throw InputError("drift_alive_param " + std::to_string(drift_alive_param) +
+                     " must be at most 9999 and the alarm " + std::to_string(drift_missing_alarm) +
+                     " within 60000..69997 (it and the next two numbers are used)");
+  if (workpiece_slope_param >= 0 && !(workpiece_k0_param >= 0 && workpiece_slope_param <= 9998 &&
+                                      (workpiece_k0_param < workpiece_slope_param ||
+                                       workpiece_k0_param > workpiece_slope_param + 1)))
     throw InputError("slope handed to the drift action: workpiece_slope_param " +
                      std::to_string(workpiece_slope_param) +
                      " needs workpiece_k0_param >= 0 outside its two slots (" +
-                     std::to_string(workpiece_k0_param) +
-                     "), must be 0..9998, and the drift "
-                     "slope marker R" +
-                     std::to_string(drift_slope_marker_r) +
-                     " 0..9999, not the drift marker, outside R" + std::to_string(save_r_first) +
-                     "..R" + std::to_string(save_r_first + 3));
+                     std::to_string(workpiece_k0_param) + ") and must be 0..9998");
   if (!(save_r_first >= 0 && save_r_first <= 9996))
     throw InputError("save_r_first = " + std::to_string(save_r_first) +
                      ": must be within 0..9996 (R<n>..R<n+3> are used)");
@@ -268,19 +259,19 @@ void to_json(nlohmann::json& j, const PlanOptions& o) {
                      {"sync_id_last", o.sync_id_last},
                      {"save_r_first", o.save_r_first},
                      {"workpiece_k0_param", o.workpiece_k0_param},
-                     {"drift_marker_r", o.drift_marker_r},
+                     {"drift_alive_param", o.drift_alive_param},
                      {"drift_missing_alarm", o.drift_missing_alarm},
-                     {"workpiece_slope_param", o.workpiece_slope_param},
-                     {"drift_slope_marker_r", o.drift_slope_marker_r}};
+                     {"workpiece_slope_param", o.workpiece_slope_param}};
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
-  RejectUnknownKeys(j,
-                    {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm",
-                     "sign", "control_dk", "md32760", "check_step_s", "sync_id_first",
-                     "sync_id_last", "save_r_first", "workpiece_k0_param", "drift_marker_r",
-                     "drift_missing_alarm", "workpiece_slope_param", "drift_slope_marker_r"},
-                    "plan settings");
+  RejectUnknownKeys(
+      j,
+      {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
+       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
+       "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm", "workpiece_slope_param",
+       "drift_slope_marker_r", "drift_alive_param"},
+      "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
   o.start_position_mm = j.at("start_position_mm").get<double>();
@@ -294,10 +285,11 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
   o.sync_id_last = j.at("sync_id_last").get<int>();
   o.save_r_first = j.at("save_r_first").get<int>();
   o.workpiece_k0_param = j.at("workpiece_k0_param").get<int>();
-  o.drift_marker_r = j.at("drift_marker_r").get<int>();
   o.drift_missing_alarm = j.at("drift_missing_alarm").get<int>();
-  o.workpiece_slope_param = j.value("workpiece_slope_param", -1);  // absent before the slope mode
-  o.drift_slope_marker_r = j.value("drift_slope_marker_r", -1);
+  // Absent in plans written before the slope hand-over and the liveness check (their
+  // drift_marker_r is read over: the check now looks at the running action, not an R marker).
+  o.workpiece_slope_param = j.value("workpiece_slope_param", -1);
+  o.drift_alive_param = j.value("drift_alive_param", -1);
   o.Validate();
 }
 
@@ -493,10 +485,9 @@ std::string SaveFoundValues(const PlanOptions& o) {
   const int m = o.save_r_first;
   const std::string k0 =
       Combined(o) ? std::string() : R(m) + "=$SA_TEMP_COMP_ABS_VALUE[" + ax + "]\n";
-  const std::string slope = SlopeHandedOver(o)
-                                ? std::string()
-                                : R(m + 1) + "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" + R(m + 2) +
-                                      "=$SA_TEMP_COMP_REF_POSITION[" + ax + "]\n";
+  if (SlopeHandedOver(o)) return "";  // nothing of the control's is written: nothing to save
+  const std::string slope = R(m + 1) + "=$SA_TEMP_COMP_SLOPE[" + ax + "]\n" + R(m + 2) +
+                            "=$SA_TEMP_COMP_REF_POSITION[" + ax + "]\n";
   return "IF " + R(m + 3) + "<>1\n" + k0 + slope + R(m + 3) + "=1\nENDIF\n";
 }
 
@@ -514,11 +505,15 @@ std::string RestoredRef(const PlanOptions& o, const std::string& r_prefix) {
 
 // Combined: refuse to start unless the drift action says it is active (else K0 would be lost).
 std::string RequireDriftAction(const PlanOptions& o) {
-  if (!Combined(o)) return "";
-  const std::string alarm = "SETAL(" + std::to_string(o.drift_missing_alarm) + ")\nENDIF\n";
-  std::string out = "IF " + R(o.drift_marker_r) + "<>1\n" + alarm;
-  if (SlopeHandedOver(o)) out += "IF " + R(o.drift_slope_marker_r) + "<>1\n" + alarm;
-  return out;
+  if (o.drift_alive_param < 0) return "";
+  const std::string alive = Param(o.drift_alive_param);
+  auto alarm = [&](int k) {
+    return "SETAL(" + std::to_string(o.drift_missing_alarm + k) + ")\nENDIF\n";
+  };
+  std::string out = alive + "=0\nG4 F0.1\nSTOPRE\n";  // a running action writes it again
+  if (!Combined(o)) return out + "IF " + alive + "<>0\n" + alarm(1);
+  const std::string mode = SlopeHandedOver(o) ? "2" : "1";
+  return out + "IF " + alive + "==0\n" + alarm(0) + "IF " + alive + "<>" + mode + "\n" + alarm(2);
 }
 
 std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
@@ -546,24 +541,36 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
      << FormatFixed(plan.segments.front().p_a_mm, kDecimalsPositionMm) << " mm (MCS); thread end "
      << ax << " = " << FormatFixed(ThreadEndMm(plan), kDecimalsPositionMm) << " mm (MCS), "
      << FormatFixed(plan.thread_length_mm, 4) << " mm of travel\n";
-  nc << "; uses synchronized-action IDs " << o.sync_id_first << ".." << o.sync_id_last
-     << " (cancelled first) and " << R(m) << ".." << R(m + 3)
-     << " (setting data found before the cut, marker)\n";
-  nc << "; restores the found setting data when the axis passes the thread end; call "
-     << info.reset_program_name << " after the cutting block (it restores if the axis stopped "
-     << "short) and after an aborted cut\n";
+  nc << "; uses synchronized-action IDs " << o.sync_id_first << ".." << o.sync_id_last;
+  if (SlopeHandedOver(o))
+    nc << " (cancelled first); no R parameter (nothing of the control's is written)\n";
+  else
+    nc << " (cancelled first) and " << R(m) << ".." << R(m + 3)
+       << " (setting data found before the cut, marker)\n";
+  nc << "; restores "
+     << (SlopeHandedOver(o) ? "its $AC_PARAM slots to 0" : "the found setting data")
+     << " when the axis passes the thread end; call " << info.reset_program_name
+     << " after the cutting block (it restores if the axis stopped short) and after an aborted "
+        "cut\n";
   nc << "; $AA_IM = actual position in machine coordinates; $$SA_ = write in the main run\n";
   nc << "; call before the cutting block; the ID= actions stay active until the program ends\n";
+  if (o.drift_alive_param >= 0)
+    nc << "; checks the drift action (WHIRL_DRIFT_COMP) by its liveness slot $AC_PARAM["
+       << o.drift_alive_param << "] (cleared, 0.1 s dwell, read back): expects "
+       << (SlopeHandedOver(o) ? "2"
+           : Combined(o)      ? "1"
+                              : "0")
+       << "; alarm " << o.drift_missing_alarm << " action not running, "
+       << o.drift_missing_alarm + 1
+       << " action running although this plan writes the setting data itself, "
+       << o.drift_missing_alarm + 2 << " action in the other mode\n";
   if (Combined(o))
     nc << "; combined with WHIRL_DRIFT_COMP: K0 goes to $AC_PARAM[" << o.workpiece_k0_param
-       << "], which the drift action adds into SD43900 (its only writer); alarm "
-       << o.drift_missing_alarm << " if the drift action is not active (" << R(o.drift_marker_r)
-       << " <> 1)\n";
+       << "], which the drift action adds into SD43900 (its only writer)\n";
   if (SlopeHandedOver(o))
     nc << "; slope handed over too: SD43910 goes to $AC_PARAM[" << o.workpiece_slope_param
        << "] and SD43920 to $AC_PARAM[" << o.workpiece_slope_param + 1
-       << "]; the drift action adds the machine's slope and is the only writer of SD43900-43920 ("
-       << R(o.drift_slope_marker_r) << " <> 1: alarm)\n";
+       << "]; the drift action adds the machine's slope and is the only writer of SD43900-43920\n";
   return nc.str();
 }
 
@@ -605,7 +612,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   const int m = o.save_r_first;
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
         " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), RestoredSlope(o, "$"), RestoredRef(o, "$")) +
-        " $" + R(m + 3) + "=0\n";
+        (SlopeHandedOver(o) ? std::string() : " $" + R(m + 3) + "=0") + "\n";
   nc += "M17\n";
   return nc;
 }
@@ -618,15 +625,21 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
                    ": restores the SINUMERIK 840D temperature "
                    "compensation of axis " +
                    ax + " after an aborted " + info.program_name + " run\n";
+  // The slope first (see FormatNcProgram): every intermediate state is then a constant offset.
+  const std::string writes = SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n" +
+                             RefTarget(o, "$") + "=" + RestoredRef(o, "") + "\n" +
+                             K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+  if (SlopeHandedOver(o)) {  // only the plan's own $AC_PARAM slots: cleared unconditionally
+    nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
+          std::to_string(o.sync_id_last) + ", then sets the plan's K0, slope and reference in " +
+          "$AC_PARAM to 0 (the drift action owns SD43900-43920)\n";
+    return nc + CancelIds(o) + "STOPRE\n" + writes + "STOPRE\nM17\n";
+  }
   nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + ", then, if " + R(m + 3) +
         " = 1 (whirl's compensation active), writes back the setting data saved in " + R(m) + ".." +
         R(m + 2) + "\n";
-  nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n";
-  // The slope first (see FormatNcProgram): every intermediate state is then a constant offset.
-  nc += SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n";
-  nc += RefTarget(o, "$") + "=" + RestoredRef(o, "") + "\n";
-  nc += K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+  nc += CancelIds(o) + "STOPRE\nIF " + R(m + 3) + "==1\n" + writes;
   nc += R(m + 3) + "=0\nENDIF\nSTOPRE\nM17\n";
   return nc;
 }

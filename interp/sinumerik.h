@@ -100,19 +100,24 @@ struct PlanOptions {
   int save_r_first = 90;
   /// -1: the plan writes SD43900 itself. >= 0: combined with the live drift action
   /// (interp/drift_action.h): the plan writes its K0 into $AC_PARAM[workpiece_k0_param], which the
-  /// drift action adds to the machine's K0, so SD43900 has one writer; the program raises alarm
-  /// `drift_missing_alarm` (SETAL) unless the drift action's marker R<drift_marker_r> is 1.
+  /// drift action adds to the machine's K0, so SD43900 has one writer.
   int workpiece_k0_param = -1;
-  int drift_marker_r = -1;
-  int drift_missing_alarm = 65000;
   /// -1: the plan writes SD43910/SD43920 itself. >= 0 (only with workpiece_k0_param): the drift
   /// action also owns the slope (it adds the machine's Z-screw slope, drift_action.h): the plan
   /// writes its SD43910 into $AC_PARAM[workpiece_slope_param] and its SD43920 into
-  /// $AC_PARAM[workpiece_slope_param + 1], saves nothing and resets the three slots to 0 at the
-  /// thread end; it raises the alarm unless R<drift_slope_marker_r> (the drift action's slope
-  /// marker) is 1 as well.
+  /// $AC_PARAM[workpiece_slope_param + 1], saves nothing, uses no R marker and resets its slots
+  /// to 0 at the thread end.
   int workpiece_slope_param = -1;
-  int drift_slope_marker_r = -1;
+  /// The drift action's liveness slot (the profile's drift.param_first; -1: the machine has no
+  /// drift action): the running action writes its mode there every interpolation cycle (1 owns
+  /// SD43900, 2 owns SD43900-43920). The plan clears the slot, dwells 0.1 s and reads it back, so
+  /// the check sees the action run now (a marker in a retentive R parameter would outlive the
+  /// actions at power on). It expects 0 when the plan writes the setting data itself, 1 when only
+  /// K0 is handed over and 2 when the slope is handed over too, and otherwise raises
+  /// drift_missing_alarm (expected 1 or 2, found 0: the action is not running), + 1 (expected 0:
+  /// a running drift action would be a second writer) or + 2 (the action's mode does not match).
+  int drift_alive_param = -1;
+  int drift_missing_alarm = 65000;
 
   /// InputError naming the field, value and rule for any option out of range, and for a sign
   /// that is not ExpectedSign(direction, control_dk).

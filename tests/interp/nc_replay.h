@@ -3,7 +3,8 @@
 // (not the plan or model behind it), executes the part-program lines as the control's
 // preprocessing would, and then runs the synchronized actions interpolation cycle by cycle, in ID
 // order: WHEN fires once, WHENEVER every cycle while its condition holds, no condition every
-// cycle; ID= actions end with the program, IDS= actions stay until CANCEL. Expressions: numbers,
+// cycle; ID= actions end with the program, IDS= actions stay until CANCEL; a dwell (G4) runs one
+// cycle at standstill_mm; PowerOn() drops actions and $AC_PARAM. Expressions: numbers,
 // + - * / and parentheses over $AC_PARAM[n], $A_INA[n], R parameters and the setting data. A line
 // it does not understand fails the test, so the writer cannot emit something the replay ignores.
 #include <gtest/gtest.h>
@@ -154,6 +155,7 @@ struct Replay {
   // Called after each part-program assignment: the main run goes on between blocks, so a test can
   // run interpolation cycles there and see the states a program passes through.
   std::function<void()> between_blocks;
+  double standstill_mm = 0;  // axis position during a dwell (G4) in a part program
 
   double Value(const std::string& expr) const { return Expr(expr, control, axis).Eval(); }
 
@@ -217,7 +219,8 @@ struct Replay {
   // the program stopped with an alarm (SETAL).
   bool RunProgram(const std::string& text) {
     static const std::regex kCancel(R"(^CANCEL\((\d+)\)$)");
-    static const std::regex kIf(R"(^IF (R\d+)(<>|==)([-0-9.]+)$)");
+    static const std::regex kIf(R"(^IF (R\d+|\$AC_PARAM\[\d+\])(<>|==)([-0-9.]+)$)");
+    static const std::regex kDwell(R"(^G4 F[0-9.]+$)");
     static const std::regex kSetal(R"(^SETAL\((\d+)\)$)");
     static const std::regex kAssign(R"(^(\$?\$?[A-Z_]+(\[\w+\])?|R\d+)=(\S+)$)");
     static const std::regex kSync(
@@ -238,6 +241,9 @@ struct Replay {
         const double c = std::stod(m[3]);
         skipping.push_back(skip || !(m[2] == "==" ? r == c : r != c));
       } else if (skip || (!line.empty() && line[0] == ';') || line == "STOPRE") {
+      } else if (std::regex_match(line, m, kDwell)) {  // the main run goes on: one cycle
+        Cycle(standstill_mm);
+        if (between_blocks) between_blocks();
       } else if (line == "M17") {
         ended = true;
       } else if (std::regex_match(line, m, kSetal)) {
@@ -277,6 +283,13 @@ struct Replay {
       for (const Write& w : a.writes) Assign(w.target, Value(w.expr));
       a.fired = true;
     }
+  }
+
+  // Power off and on: every synchronized action and $AC_PARAM is gone; R parameters and setting
+  // data are retentive.
+  void PowerOn() {
+    actions.clear();
+    control.ac_param.clear();
   }
 
   // Program end or reset: modal (ID=) actions are gone, static (IDS=) ones stay.

@@ -125,7 +125,7 @@ TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
   p.sync_id_last = 140;
   p.save_r_first = 90;
   p.workpiece_k0_param = 99;
-  p.drift_marker_r = d.save_r_first + 1;
+  p.drift_alive_param = d.param_first;
   p.md32760 = kMd32760Max;
   const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({20.0, 40.0}, 4.0, 1.0);
   const double feed = 2.0, thread = 300.0;  // 150 s of cutting
@@ -242,9 +242,8 @@ TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
   p.sync_id_last = 140;
   p.save_r_first = 90;
   p.workpiece_k0_param = 99;
-  p.drift_marker_r = d.save_r_first + 1;
+  p.drift_alive_param = d.param_first;
   p.workpiece_slope_param = 97;
-  p.drift_slope_marker_r = d.save_r_first + 4;
   p.md32760 = kMd32760Max;
   const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({20.0, 40.0}, 4.0, 1.0);
   const double feed = 2.0, thread = 300.0;
@@ -254,13 +253,13 @@ TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
   r.control.abs_value_mm = 0.0007;
   r.control.slope = 3e-6;
   r.control.ref_position_mm = 12.0;
-  // An offset-only drift action does not own the slope: the plan refuses to start.
+  // An offset-only drift action does not own the slope: the plan refuses to start (mode alarm).
   SetInputs(r, d, Temperatures(0));
   DriftActionOptions offset_only = d;
   offset_only.workpiece_slope_param = -1;
   ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, offset_only)));
   EXPECT_FALSE(r.RunProgram(FormatNcProgram(plan)));
-  EXPECT_EQ(r.control.alarm, p.drift_missing_alarm);
+  EXPECT_EQ(r.control.alarm, p.drift_missing_alarm + 2);
 
   ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, d, "", &g)));
   ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));
@@ -291,6 +290,57 @@ TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
   EXPECT_EQ(r.control.slope, 3e-6);
   EXPECT_EQ(r.control.ref_position_mm, 12.0);
   EXPECT_TRUE(r.actions.empty());
+}
+
+// The plans check the running action, not a retentive marker: after a power cycle (actions and
+// $AC_PARAM gone, R parameters kept) a combined plan refuses to start; a plan that writes the
+// setting data itself refuses while a drift action runs; a drift program refuses while a plan's
+// own compensation is still on the control.
+TEST(DriftAction, LivenessNotMarkersDecideWhoMayWrite) {
+  std::mt19937 rng(1813);
+  const drift::DriftModel m = HandModel(false, rng);
+  DriftActionOptions d = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  d.workpiece_k0_param = 99;
+  d.plan_marker_r = 93;
+  PlanOptions p;
+  p.sync_id_first = 100;
+  p.sync_id_last = 140;
+  p.save_r_first = 90;
+  p.drift_alive_param = d.param_first;
+  p.md32760 = kMd32760Max;
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({20.0, 40.0}, 4.0, 1.0);
+  PlanOptions combined = p;
+  combined.workpiece_k0_param = 99;
+  const CompensationPlan plan = BuildPlan(curve, 2.0, 300.0, combined);
+  const CompensationPlan standalone = BuildPlan(curve, 2.0, 300.0, p);
+
+  replay::Replay r;
+  SetInputs(r, d, Temperatures(0));
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, d)));
+  ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));  // running: accepted
+  r.EndProgram();
+  // A plan that writes SD43900 itself beside the running action: refused, nothing written.
+  const double k0 = r.control.abs_value_mm;
+  EXPECT_FALSE(r.RunProgram(FormatNcProgram(standalone)));
+  EXPECT_EQ(r.control.alarm, p.drift_missing_alarm + 1);
+  r.Cycle(0.0);
+  EXPECT_EQ(r.control.abs_value_mm, k0);
+  // Power cycle: the markers R81 survive, the action does not: the combined plan refuses.
+  r.PowerOn();
+  EXPECT_EQ(r.control.r[d.save_r_first + 1], 1.0);
+  r.control.alarm = 0;
+  EXPECT_FALSE(r.RunProgram(FormatNcProgram(plan)));
+  EXPECT_EQ(r.control.alarm, p.drift_missing_alarm);
+  // A standalone plan aborted mid-cut leaves R93 = 1: the drift program refuses to start (it
+  // would save the plan's values as the control's own).
+  replay::Replay q;
+  ASSERT_TRUE(q.RunProgram(FormatNcProgram(standalone)));
+  q.EndProgram();
+  EXPECT_FALSE(q.RunProgram(FormatDriftNcProgram(m, d)));
+  EXPECT_EQ(q.control.alarm, d.missing_alarm + 3);
+  EXPECT_TRUE(q.actions.empty());
+  ASSERT_TRUE(q.RunProgram(FormatNcResetProgram(p)));
+  EXPECT_TRUE(q.RunProgram(FormatDriftNcProgram(m, d)));
 }
 
 // A program without a slope gives back the slope an aborted slope run left behind.

@@ -307,9 +307,8 @@ TEST(Sinumerik, NcProgramMatchesGoldenFile) {
 TEST(Sinumerik, HandedOverNcProgramMatchesGoldenFile) {
   CompensationPlan plan = SmallPlan();
   plan.options.workpiece_k0_param = 99;
-  plan.options.drift_marker_r = 81;
+  plan.options.drift_alive_param = 100;
   plan.options.workpiece_slope_param = 97;
-  plan.options.drift_slope_marker_r = 84;
   NcProgramInfo info;
   info.curve_source = "golden test plan";
   const std::string nc = FormatNcProgram(plan, info) + FormatNcResetProgram(plan.options, info);
