@@ -370,9 +370,12 @@ std::string CsvLine(const std::vector<std::string>& cells) {
   return line + "\n";
 }
 
+// A comment line from user text: control characters become spaces, and at most 200 characters
+// (an NC line has at most 512).
 std::string OneLine(std::string text) {
   for (char& ch : text)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
+  if (text.size() > 200) text = text.substr(0, 197) + "...";
   return text;
 }
 
