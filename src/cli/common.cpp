@@ -9,7 +9,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "cli/terminal.h"
 #include "core/error.h"
+#include "core/safe_text.h"
 #include "fit/arctan_curve.h"
 
 namespace whirl::cli {
@@ -42,6 +44,7 @@ CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string
 }
 
 int RunApp(CLI::App& app, int argc, char** argv) {
+  GuardTerminalOutput();  // user text in messages never reaches the terminal as a control
   // Every --help says where the shipped files come from (and how to point at them).
   if (app.get_footer().empty()) app.footer(kShippedFilesHelp);
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
@@ -92,9 +95,11 @@ void Progress::Update(std::size_t done, const std::string& detail) {
   if (tty_) {
     const int width = 30;
     const int filled = static_cast<int>(frac * width + 0.5);
-    std::fprintf(stderr, "\r%s [%s%s] %zu/%zu %s", label_.c_str(), std::string(filled, '#').c_str(),
-                 std::string(width - filled, ' ').c_str(), done, total_, detail.c_str());
-    std::fflush(stderr);
+    // Raw stderr for the carriage return; the label and detail are made inert here.
+    std::fprintf(RawStderr(), "\r%s [%s%s] %zu/%zu %s", TerminalText(label_).c_str(),
+                 std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(), done,
+                 total_, TerminalText(detail).c_str());
+    std::fflush(RawStderr());
   } else {
     const int decile = static_cast<int>(frac * 10);
     if (decile != last_decile_) {
@@ -109,7 +114,7 @@ void Progress::Finish(const std::string& detail) {
   finished_ = true;
   if (tty_) {
     Update(total_, detail);
-    std::fprintf(stderr, "\n");
+    std::fprintf(RawStderr(), "\n");
   } else {
     std::fprintf(stderr, "%s: done %s\n", label_.c_str(), detail.c_str());
   }

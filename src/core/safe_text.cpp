@@ -1,6 +1,33 @@
 #include "core/safe_text.h"
 
+#include <cstdio>
+
 namespace whirl {
+namespace {
+
+std::string HexEscape(const char* prefix, unsigned value) {
+  char buffer[16];
+  std::snprintf(buffer, sizeof buffer, "%s%02X", prefix, value);
+  return buffer;
+}
+
+// Length of the valid UTF-8 sequence starting at text[i] (2-4), or 0 if none starts there
+// (overlong forms, surrogates and code points above U+10FFFF are invalid).
+std::size_t Utf8Length(std::string_view text, std::size_t i) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(text[i + k]); };
+  const unsigned lead = b(0);
+  const std::size_t n = lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 ? 2 : 0;
+  if (n == 0 || lead > 0xF4 || i + n > text.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((b(k) & 0xC0) != 0x80) return 0;
+  if (lead == 0xE0 && b(1) < 0xA0) return 0;  // overlong
+  if (lead == 0xED && b(1) >= 0xA0) return 0;  // surrogate
+  if (lead == 0xF0 && b(1) < 0x90) return 0;  // overlong
+  if (lead == 0xF4 && b(1) >= 0x90) return 0;  // above U+10FFFF
+  return n;
+}
+
+}  // namespace
 
 std::string HtmlEscape(std::string_view text) {
   std::string out;
@@ -57,6 +84,32 @@ std::string Slug(std::string_view text, std::size_t max_length) {
   }
   if (out.empty()) return "x";
   if (out.front() == '.' || out.front() == '-') out.front() = '_';
+  return out;
+}
+
+std::string TerminalText(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const auto u = static_cast<unsigned char>(text[i]);
+    if (u < 0x80) {
+      const bool control = (u < 0x20 && u != '\t' && u != '\n') || u == 0x7f;
+      out += control ? HexEscape("\\x", u) : std::string(1, text[i]);
+      ++i;
+      continue;
+    }
+    const std::size_t n = Utf8Length(text, i);
+    if (n == 0) {
+      out += HexEscape("\\x", u);
+      ++i;
+    } else if (u == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0) {
+      out += HexEscape("\\u00", static_cast<unsigned char>(text[i + 1]));  // C1 control
+      i += 2;
+    } else {
+      out.append(text.substr(i, n));
+      i += n;
+    }
+  }
   return out;
 }
 

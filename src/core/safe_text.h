@@ -1,7 +1,8 @@
 #pragma once
-// Text that leaves whirl for another interpreter: HTML pages and gnuplot scripts. Anything a user
-// supplies (a screw name, a run file's name, a column header, a path) passes through one of these
-// before it is written into such a file, so it can never become markup or a gnuplot command.
+// Text that leaves whirl for another interpreter: HTML pages, gnuplot scripts and the user's
+// terminal. Anything a user supplies (a screw name, a run file's name, a column header, a path)
+// passes through one of these before it is written into such a file or printed, so it can never
+// become markup, a gnuplot command or a terminal control sequence.
 #include <string>
 #include <string_view>
 
@@ -22,5 +23,13 @@ std::string GnuplotString(std::string_view text);
 /// A file-name-safe slug: ASCII letters, digits, '-', '_' and '.' kept, every other byte '_',
 /// at most `max_length` characters, never empty (then "x"), never starting with '.' or '-'.
 std::string Slug(std::string_view text, std::size_t max_length = 64);
+
+/// Text for a terminal (messages, warnings, tables on stdout/stderr): every byte that a terminal
+/// could take as a control (C0 controls other than tab and newline, DEL, the C1 controls U+0080 to
+/// U+009F, e.g. CSI, and bytes that are not valid UTF-8) is shown as the visible escape \xNN
+/// (for C1: \u00NN); a backslash stays as it is. Valid UTF-8 text (e.g. "°C", "µm") is unchanged.
+/// Why: a hostile column header or screw name holding ESC sequences could otherwise retitle the
+/// window, rewrite what is on screen or, on some terminals, reach the clipboard.
+std::string TerminalText(std::string_view text);
 
 }  // namespace whirl

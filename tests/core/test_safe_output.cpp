@@ -3,6 +3,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -48,6 +49,66 @@ TEST(SafeText, SlugIsAFileName) {
   EXPECT_EQ(Slug(""), "x");
   EXPECT_EQ(Slug("-rf"), "_rf");
   EXPECT_EQ(Slug(std::string(200, 'a')).size(), 64u);
+}
+
+// A strict UTF-8 reader, independent of TerminalText's own: true if `text` is valid UTF-8 and
+// holds no code point a terminal takes as a control (C0 but tab/newline, DEL, C1).
+bool IsInertTerminalText(const std::string& text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const auto u = static_cast<unsigned char>(text[i]);
+    std::size_t n = 0;
+    unsigned cp = 0;
+    if (u < 0x80) {
+      n = 1, cp = u;
+    } else if ((u & 0xE0) == 0xC0) {
+      n = 2, cp = u & 0x1F;
+    } else if ((u & 0xF0) == 0xE0) {
+      n = 3, cp = u & 0x0F;
+    } else if ((u & 0xF8) == 0xF0) {
+      n = 4, cp = u & 0x07;
+    } else {
+      return false;
+    }
+    if (i + n > text.size()) return false;
+    for (std::size_t k = 1; k < n; ++k) {
+      const auto c = static_cast<unsigned char>(text[i + k]);
+      if ((c & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (c & 0x3F);
+    }
+    const unsigned min_cp[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (cp < min_cp[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    if ((cp < 0x20 && cp != '\t' && cp != '\n') || (cp >= 0x7F && cp <= 0x9F)) return false;
+    i += n;
+  }
+  return true;
+}
+
+TEST(SafeText, TerminalTextShowsControlsAsVisibleEscapes) {
+  EXPECT_EQ(TerminalText("sensor\x1b]0;pwned\x07 T1"), "sensor\\x1B]0;pwned\\x07 T1");
+  EXPECT_EQ(TerminalText("a\rb\x7f"), "a\\x0Db\\x7F");
+  EXPECT_EQ(TerminalText("csi \xc2\x9b" "2J"), "csi \\u009B2J");  // U+009B, the C1 CSI
+  EXPECT_EQ(TerminalText("lone \x9b byte"), "lone \\x9B byte");      // not UTF-8
+  EXPECT_EQ(TerminalText("overlong \xc0\x9b"), "overlong \\xC0\\x9B");
+  EXPECT_EQ(TerminalText("cut \xe2\x82"), "cut \\xE2\\x82");       // truncated sequence
+  // Ordinary text, tab, newline, backslash and valid UTF-8 (degree sign, micro, CJK) unchanged.
+  const std::string plain = "T_bed [\xc2\xb0" "C]\t12.5 \xc2\xb5m\n\xe4\xb8\x9d\xe6\x9d\xa0 C:\\x";
+  EXPECT_EQ(TerminalText(plain), plain);
+}
+
+// Property over random byte strings: the output is always inert terminal text, and text that
+// already is inert is returned unchanged.
+TEST(SafeText, TerminalTextIsAlwaysInertAndKeepsInertText) {
+  std::mt19937_64 rng(20261125);
+  std::uniform_int_distribution<int> byte(0, 255), length(0, 24);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::string text(static_cast<std::size_t>(length(rng)), '\0');
+    for (char& c : text) c = static_cast<char>(byte(rng));
+    const std::string shown = TerminalText(text);
+    ASSERT_TRUE(IsInertTerminalText(shown)) << "trial " << trial;
+    if (IsInertTerminalText(text)) {
+      ASSERT_EQ(shown, text) << "trial " << trial;
+    }
+  }
 }
 
 // Gnuplot itself parses the quoted string back to the original text (control characters aside):
