@@ -4,3 +4,5 @@ whirl_add_gtest(test_core SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_safe_output.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_file_safety.cpp
   LABELS core)
+
+whirl_add_cli_test(cli_terminal ${CMAKE_CURRENT_LIST_DIR}/cli_terminal.sh)
