@@ -137,7 +137,9 @@ void RegisterSelect(CLI::App* drift_app) {
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
     const auto runs = LoadRuns(o->runs);
-    const drift::Selection s = drift::SelectSensors(runs, o->error, ToSelection(o->sel));
+    drift::FitOptions fit;  // --classes cv scores each count with the fit's cross-validation
+    fit.selection = ToSelection(o->sel);
+    const drift::Selection s = drift::SelectSensorsForFit(runs, o->error, fit);
     if (o->json)
       PrintJson({{"schema", "whirl.drift_select"},
                  {"schema_version", 1},
@@ -316,6 +318,9 @@ void RegisterHoldout(CLI::App* drift_app) {
   sub->add_option("--max-sensors", o->h.max_sensors,
                   "at most this many selected sensors (default 4)")
       ->check(CLI::Range(1, 64));
+  sub->add_option("--classes", o->sel.classes,
+                  "class count of the selection: fewest (default), margin, cv or a number "
+                  "(as in 'whirl drift fit --help')");
   sub->add_flag("--no-network", o->no_network, "skip the network model");
   sub->add_option("--inputs", o->model.inputs, "extra inputs of dynamic_extra, e.g. spindle_rpm")
       ->delimiter(',');

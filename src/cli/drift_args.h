@@ -17,7 +17,7 @@ struct SelectionArgs {
 /// --alpha, --classes, --max-sensors.
 void AddSelectionOptions(CLI::App* sub, SelectionArgs* s);
 
-/// The library's options; InputError for a --classes that is not fewest, margin or a number.
+/// The library's options; InputError for a --classes that is not fewest, margin, cv or a number.
 drift::SelectionOptions ToSelection(const SelectionArgs& a);
 
 }  // namespace whirl::cli

@@ -67,10 +67,17 @@ json SelectionJson(const Selection& s) {
   json grades = json::object();
   for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
     grades[s.sensor_names[i]] = s.grades(static_cast<Eigen::Index>(i));
-  return {{"sensors", s.sensor_names}, {"squarings", s.squarings},
-          {"partitions", parts},       {"chosen_partition", s.chosen_partition},
-          {"grey_grades", grades},     {"chosen_sensors", s.ChosenNames()},
-          {"rule", s.message}};
+  json out = {{"sensors", s.sensor_names}, {"squarings", s.squarings},
+              {"partitions", parts},       {"chosen_partition", s.chosen_partition},
+              {"grey_grades", grades},     {"chosen_sensors", s.ChosenNames()},
+              {"rule", s.message}};
+  if (!s.class_count_scores.empty()) {
+    json scores = json::array();
+    for (const auto& c : s.class_count_scores)
+      scores.push_back({{"classes", c.classes}, {"cv_rmse_um", Finite(c.cv_rmse_um)}});
+    out["class_count_scores"] = scores;
+  }
+  return out;
 }
 
 std::string FormatSelection(const Selection& s) {

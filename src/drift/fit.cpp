@@ -168,6 +168,56 @@ void FitOptions::Validate() const {
   train.Validate();
 }
 
+Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& error_column,
+                              const FitOptions& o) {
+  if (o.selection.rule != ClassCountRule::kCrossValidated)
+    return SelectSensors(runs, error_column, o.selection);
+  SelectionOptions by_count = o.selection;
+  by_count.rule = ClassCountRule::kLargestMargin;  // any rule that never throws: only the cuts
+  const Selection cuts = SelectSensors(runs, error_column, by_count);  // the partitions on offer
+  by_count.rule = ClassCountRule::kFixed;
+  std::vector<int> counts;
+  for (const Partition& p : cuts.partitions)
+    if ((o.selection.max_classes <= 0 || p.classes <= o.selection.max_classes) &&
+        std::find(counts.begin(), counts.end(), p.classes) == counts.end())
+      counts.push_back(p.classes);
+  std::sort(counts.begin(), counts.end());
+  std::vector<Selection> candidates(counts.size());
+  std::vector<double> rmse(counts.size(), std::numeric_limits<double>::infinity());
+  const bool forward = o.forward_cv && runs.size() == 1;
+  ParallelFor(counts.size(), o.threads, [&](std::size_t i) {
+    SelectionOptions fixed = by_count;
+    fixed.fixed_classes = counts[i];
+    candidates[i] = SelectSensors(runs, error_column, fixed);
+    try {
+      rmse[i] = CrossValidatedRmse(
+          Stack(runs, error_column, candidates[i].ChosenNames(), o.extra_inputs, {}, o.folds),
+          forward);
+    } catch (const InputError&) {
+      // too few samples per fold for this many sensors: not a candidate
+    }
+  });
+  if (counts.empty() || !std::isfinite(*std::min_element(rmse.begin(), rmse.end())))
+    throw InputError("--classes cv: no class count can be cross-validated on " +
+                     std::to_string(runs.size()) + " run(s) (too few samples per fold)");
+  const auto best =
+      static_cast<std::size_t>(std::min_element(rmse.begin(), rmse.end()) - rmse.begin());
+  Selection chosen = candidates[best];
+  std::string scores;
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    chosen.class_count_scores.push_back({counts[i], rmse[i]});
+    scores += (scores.empty() ? "" : ", ") + std::string("r = ") + std::to_string(counts[i]) +
+              ": " + (std::isfinite(rmse[i]) ? Num(rmse[i]) + " um" : "-");
+  }
+  chosen.message = "class count by cross-validated MLR RMSE (" +
+                   (runs.size() > 1 ? std::string("leave one run out")
+                                    : std::to_string(o.folds) + (forward ? " forward-chaining" : "") +
+                                          " blocks") +
+                   "): r = " + std::to_string(counts[best]) + " (" + scores + "); " +
+                   chosen.message;
+  return chosen;
+}
+
 FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& o) {
   o.Validate();
@@ -185,7 +235,7 @@ FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_c
   m.time_unit = runs.front().time_from_index ? "sample" : "min";
   if (o.sensors.empty()) {
     rep.selected = true;
-    rep.selection = SelectSensors(runs, error_column, o.selection);
+    rep.selection = SelectSensorsForFit(runs, error_column, o);
     m.sensors = rep.selection.ChosenNames();
     m.selection = "seed 000 selection: " + rep.selection.message;
   } else {

@@ -168,6 +168,20 @@ struct FitReport {
   std::string train_report;               ///< network: trainbr BriefReport
 };
 
+/// Seed 000's selection for a fit: SelectSensors (drift/selection.h) with options.selection, or,
+/// for ClassCountRule::kCrossValidated, the class count chosen by cross-validation: for each
+/// class count r the lambda-cuts offer (r <= max_classes when set), the sensors of SelectSensors
+/// with kFixed r; their static MLR (no lags, plus the extra inputs) is scored by the pooled
+/// out-of-sample RMSE over the folds of the dynamic kind's lag search (leave one run out with
+/// several runs, else `folds` contiguous blocks, forward-chaining by default); the lowest RMSE
+/// wins (ties: fewer classes). Selection::class_count_scores lists every candidate. The sensors
+/// of each r are chosen on all runs (the clustering is unsupervised; the grey grades also see the
+/// held-out run's error), so every candidate's RMSE is slightly optimistic alike. Why (issue 19):
+/// on the simulated whirling machine the fewest-significant rule keeps fewer sensors as training
+/// runs are added and the combined compensation gets worse.
+Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& error_column,
+                              const FitOptions& options);
+
 /// Fits a model of `error_column` on `runs` (InputError on missing columns or bad options).
 FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);

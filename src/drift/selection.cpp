@@ -53,6 +53,8 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
         best = static_cast<int>(i);
     return best;
   };
+  if (o.rule == ClassCountRule::kCrossValidated)
+    throw InputError("class count 'cv' is chosen by fitting the model (drift::SelectSensorsForFit)");
   if (o.rule == ClassCountRule::kFixed) {
     for (std::size_t i = 0; i < parts.size(); ++i)
       if (parts[i].classes == o.fixed_classes) {
@@ -102,6 +104,8 @@ std::string ToString(ClassCountRule r) {
       return "margin";
     case ClassCountRule::kFixed:
       return "fixed";
+    case ClassCountRule::kCrossValidated:
+      return "cv";
     case ClassCountRule::kFewestSignificant:
       break;
   }
@@ -112,7 +116,8 @@ ClassCountRule ParseClassCountRule(const std::string& s) {
   if (s == "fewest") return ClassCountRule::kFewestSignificant;
   if (s == "margin") return ClassCountRule::kLargestMargin;
   if (s == "fixed") return ClassCountRule::kFixed;
-  throw InputError("class-count rule '" + s + "': must be fewest, margin or fixed");
+  if (s == "cv") return ClassCountRule::kCrossValidated;
+  throw InputError("class-count rule '" + s + "': must be fewest, margin, fixed or cv");
 }
 
 void SelectionOptions::Validate() const {

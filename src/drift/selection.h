@@ -24,7 +24,10 @@
 //     (Boost.Math fisher_f quantile at 1 - alpha). Partitions with r = 1 or r = m get no F.
 //  6. Class count (SelectionOptions::rule): kFewestSignificant (the paper's choice, default): the
 //     fewest classes whose F > F_crit; kLargestMargin: the largest (F - F_crit) / F_crit;
-//     kFixed: the lambda-cut with exactly `fixed_classes` classes (InputError if none has it).
+//     kFixed: the lambda-cut with exactly `fixed_classes` classes (InputError if none has it);
+//     kCrossValidated: the class count whose chosen sensors predict the error best out of sample
+//     (a static MLR, cross-validated over runs; decided by SelectSensorsForFit in drift/model.h,
+//     which needs the regression; SelectSensors itself refuses this rule).
 //     Only partitions with r <= max_classes (when > 0) are eligible. If no partition qualifies
 //     (no F significant, or m < 3), the fallback is the eligible partition with the largest
 //     margin, or, when there is none, every sensor is its own class (capped at max_classes by
@@ -43,8 +46,8 @@
 
 namespace whirl::drift {
 
-enum class ClassCountRule { kFewestSignificant, kLargestMargin, kFixed };
-std::string ToString(ClassCountRule r);                    ///< "fewest", "margin", "fixed"
+enum class ClassCountRule { kFewestSignificant, kLargestMargin, kFixed, kCrossValidated };
+std::string ToString(ClassCountRule r);                    ///< "fewest", "margin", "fixed", "cv"
 ClassCountRule ParseClassCountRule(const std::string& s);  ///< inverse; InputError otherwise
 
 struct SelectionOptions {
@@ -77,6 +80,12 @@ struct Selection {
   Eigen::VectorXd grades;                 ///< grey relational grade per sensor (convention 7)
   std::vector<int> chosen;                ///< indices of the chosen sensors, file order
   std::string message;                    ///< how the class count was decided, with the numbers
+  /// kCrossValidated: the cross-validated RMSE [um] of each candidate class count, ascending r.
+  struct ClassCountScore {
+    int classes = 0;
+    double cv_rmse_um = 0;
+  };
+  std::vector<ClassCountScore> class_count_scores;
 
   std::vector<std::string> ChosenNames() const;
 };

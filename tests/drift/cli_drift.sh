@@ -40,6 +40,11 @@ grep -q "lambda" "$D/select.txt" || fail "select prints no lambda levels"
 "$W" drift select --idle "$D/idle1.csv" --error err_um --classes margin --json > "$D/select.json" || fail "select --json"
 grep -q '"chosen_sensors"' "$D/select.json" || fail "select --json"
 grep -q '"grey_grades"' "$D/select.json" || fail "select --json grades"
+# --classes cv: the count by cross-validation, every candidate's score in the JSON.
+"$W" drift select --idle "$D/idle1.csv" "$D/idle2.csv" --error err_um --classes cv --json \
+  > "$D/select_cv.json" || fail "select --classes cv"
+grep -q '"class_count_scores"' "$D/select_cv.json" || fail "select --classes cv lists no scores"
+grep -q 'leave one run out' "$D/select_cv.json" || fail "select --classes cv: no rule in the JSON"
 
 # fit (mlr, dynamic, network) and predict: the per-sample compensation CSV.
 for m in mlr dynamic network; do

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -148,6 +149,57 @@ TEST(DriftModel, WarnsOutsideTheTrainingRange) {
   EXPECT_GT(p.outside_range_samples, 0);
   EXPECT_FALSE(p.warnings.empty());
   EXPECT_EQ(PredictRun(m, run.Slice(0, 100, "early")).outside_range_samples, 0);
+}
+
+// --classes cv: every candidate's score is the pooled leave-one-run-out RMSE, recomputed here
+// through the public fit and predictor (FitDriftModel with the candidate's sensors given, then
+// PredictRun on the held-out run); the chosen count has the lowest score; every group that drives
+// the error is represented. The runs differ in their own latent speeds, so sensors matter.
+TEST(ClassCountByCrossValidation, ScoresAreLeaveOneRunOutAndTheBestIsChosen) {
+  std::vector<drift::Run> runs;
+  for (unsigned s = 0; s < 4; ++s) {
+    drift::Run r = synth::PlantedRun(40 + s, 3, 3, {1.0, -0.6, 0.8}, 200, 0.05, 0.2);
+    r.name = "run" + std::to_string(s);
+    runs.push_back(r);
+  }
+  FitOptions o;
+  o.selection.rule = ClassCountRule::kCrossValidated;
+  const Selection sel = SelectSensorsForFit(runs, "e_um", o);
+  ASSERT_GE(sel.class_count_scores.size(), 3u);
+  double best = std::numeric_limits<double>::infinity();
+  int best_classes = 0;
+  for (const auto& c : sel.class_count_scores) {
+    SelectionOptions fixed;
+    fixed.rule = ClassCountRule::kFixed;
+    fixed.fixed_classes = c.classes;
+    FitOptions given;
+    given.sensors = SelectSensors(runs, "e_um", fixed).ChosenNames();
+    double sse = 0;
+    long count = 0;
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      std::vector<drift::Run> train;
+      for (std::size_t j = 0; j < runs.size(); ++j)
+        if (j != k) train.push_back(runs[j]);
+      const RunPrediction p = PredictRun(FitDriftModel(train, "e_um", given).model, runs[k]);
+      sse += (p.measured_um - p.predicted_um).squaredNorm();
+      count += p.measured_um.size();
+    }
+    const double rmse = std::sqrt(sse / static_cast<double>(count));
+    EXPECT_NEAR(c.cv_rmse_um, rmse, 1e-9 * (1 + rmse)) << c.classes << " classes";
+    if (rmse < best) best = rmse, best_classes = c.classes;
+  }
+  EXPECT_EQ(static_cast<int>(sel.ChosenNames().size()), best_classes) << sel.message;
+  std::set<char> groups;
+  for (const auto& name : sel.ChosenNames()) groups.insert(name[1]);
+  EXPECT_EQ(groups, (std::set<char>{'0', '1', '2'})) << sel.message;
+  // The rule needs the regression: SelectSensors alone refuses it; the name round-trips.
+  EXPECT_THROW(SelectSensors(runs, "e_um", o.selection), InputError);
+  EXPECT_EQ(ParseClassCountRule(ToString(ClassCountRule::kCrossValidated)),
+            ClassCountRule::kCrossValidated);
+  // One run: forward-chaining blocks; still a choice among the cuts, with a finite score.
+  const Selection one = SelectSensorsForFit(std::vector<drift::Run>{runs[0]}, "e_um", o);
+  EXPECT_FALSE(one.ChosenNames().empty());
+  EXPECT_NE(one.message.find("forward-chaining"), std::string::npos) << one.message;
 }
 
 TEST(CrossRun, GroupsByStateAndNoCompensationIsTheErrorItself) {
