@@ -107,16 +107,17 @@ void GuardTerminalOutput() {
   std::fflush(stderr);
   g_raw_stderr = stderr;
   if (std::FILE* err = OpenFilter(&g_stderr_filter, _IONBF)) {
-    static StdioBuf err_buf(err);
+    // Never destroyed: std::cerr is flushed after static destructors have run.
+    auto* err_buf = new StdioBuf(err);
     stderr = err;
-    std::cerr.rdbuf(&err_buf);
-    std::clog.rdbuf(&err_buf);
+    std::cerr.rdbuf(err_buf);
+    std::clog.rdbuf(err_buf);
   }
   // Line-buffered on a terminal, fully buffered otherwise, as stdio's own stdout.
   if (std::FILE* out = OpenFilter(&g_stdout_filter, ::isatty(1) != 0 ? _IOLBF : _IOFBF)) {
-    static StdioBuf out_buf(out);
+    auto* out_buf = new StdioBuf(out);  // never destroyed, as err_buf
     stdout = out;
-    std::cout.rdbuf(&out_buf);
+    std::cout.rdbuf(out_buf);
   }
   std::atexit(FinishTerminalOutput);
 }
