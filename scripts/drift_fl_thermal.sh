@@ -22,6 +22,9 @@ echo "== whirl: hold-out, at most 4 sensors from seed 000's selection on the tra
   --inputs spindle_rpm --report "$OUT/holdout" | tee "$OUT/holdout.txt"
 "$W" drift holdout --log "$DATA" --channels ch1_um,ch3_um,ch5_um --max-sensors 4 \
   --inputs spindle_rpm --json > "$OUT/holdout.json" 2> /dev/null
+echo "== the same with the class count by cross-validation (--classes cv, training rows only)"
+"$W" drift holdout --log "$DATA" --channels ch1_um,ch3_um,ch5_um --max-sensors 4 \
+  --inputs spindle_rpm --no-network --classes cv 2> /dev/null | tee "$OUT/holdout_cv.txt"
 echo "== sensitivity of the dynamic model to the lag search's cross-validation (test MAE um)"
 for cv in "" "--leave-block-out" "--folds 10" "--leave-block-out --folds 10" "--max-lags 1"; do
   printf '%-30s' "${cv:-forward, 5 folds (default)}"
