@@ -23,8 +23,15 @@ both outputs as whirl):
   mlp_cv:      MLPRegressor(solver="lbfgs", tanh, max_iter=2000) with hidden size in {6, 10} and
                L2 penalty alpha in {1e-3, 1e-2, 1e-1, 1, 10} chosen by 5-fold GridSearchCV
                (the strongest simple baseline a careful user would pick).
-Fit times: whirl's in-process time (whirl train --json fit_time_ms, one thread); sklearn's wall
-time of fit() (mlp_cv includes its grid search).
+  ols:         LinearRegression() on the inputs (ordinary least squares, the first thing an
+               engineer tries on a small table).
+  ridge_gcv:   RidgeCV(alphas=logspace(-4, 4, 41), alpha_per_target=True) on standardized
+               inputs: the ridge penalty of each output chosen by generalized (efficient
+               leave-one-out) cross-validation.
+The "best peer" of a seed (wins) is the best of all peers run on that seed, per output.
+Fit times: whirl's in-process time (whirl train --json fit_time_ms), on one thread (time_ms) and
+with --threads 2 (time2_ms; the 2-thread run must predict identically, else the script stops);
+sklearn's wall time of fit() (mlp_cv includes its grid search).
 
 Peer cache (--peer-cache FILE): the peers' results per (problem, rows, seed, peer, sklearn
 version) are read from and added to FILE (JSON), so exploring whirl settings does not refit them.
@@ -44,6 +51,7 @@ import time
 import numpy as np
 import sklearn
 from sklearn.compose import TransformedTargetRegressor
+from sklearn.linear_model import LinearRegression, RidgeCV
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.model_selection import GridSearchCV, KFold
 from sklearn.neural_network import MLPRegressor
@@ -85,23 +93,42 @@ def write_table(path, x, y=None):
             f.write(",".join(repr(float(v)) for v in vals) + "\n")
 
 
-def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp):
-    train, test, model = (os.path.join(tmp, n) for n in ("train.csv", "test.csv", "m.json"))
-    write_table(train, xtr, ytr)
-    write_table(test, xte)
-    cmd = [whirl, "train", "--data", train, "--out", model, "--seed", str(seed), "--threads", "1",
-           "--json"] + args
+def run_whirl_once(whirl, args, train, test, model, seed, threads):
+    cmd = [whirl, "train", "--data", train, "--out", model, "--seed", str(seed), "--threads",
+           str(threads), "--json"] + args
     t = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
     p = json.loads(subprocess.run([whirl, "predict", "--model", model, "--input", test, "--json"],
                                   check=True, capture_output=True, text=True).stdout)
     mean = np.array([[r["max_elongation_um"], r["settle_time_s"]] for r in p["predictions"]])
     sd = np.array([[r["max_elongation_std_um"], r["settle_time_std_s"]] for r in p["predictions"]])
+    return t, mean, sd
+
+
+def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
+    train, test, model = (os.path.join(tmp, n) for n in ("train.csv", "test.csv", "m.json"))
+    write_table(train, xtr, ytr)
+    write_table(test, xte)
+    t, mean, sd = run_whirl_once(whirl, args, train, test, model, seed, 1)
     s = t["training_summary"]
-    return mean, sd, t["fit_time_ms"], {"gamma": s["gamma"], "epochs": s["epochs"]}
+    info = {"gamma": s["gamma"], "epochs": s["epochs"],
+            "hidden": t["layer_sizes"][1]}
+    if threads2:
+        t2, mean2, sd2 = run_whirl_once(whirl, args, train, test, model, seed, 2)
+        if not (np.array_equal(mean, mean2) and np.array_equal(sd, sd2)):
+            sys.exit(f"bench_peers: whirl {' '.join(args)} seed {seed}: --threads 2 predicts "
+                     "differently from --threads 1")
+        info["time2_ms"] = t2["fit_time_ms"]
+    return mean, sd, t["fit_time_ms"], info
 
 
 def fit_sklearn(kind, xtr, ytr, xte, seed):
     warnings.simplefilter("ignore", ConvergenceWarning)
+    if kind in ("ols", "ridge_gcv"):
+        model = LinearRegression() if kind == "ols" else make_pipeline(
+            StandardScaler(), RidgeCV(alphas=np.logspace(-4, 4, 41), alpha_per_target=True))
+        start = time.perf_counter()
+        model.fit(xtr, ytr)
+        return model.predict(xte), 1000 * (time.perf_counter() - start)
     if kind == "mlp_default":
         net = MLPRegressor(random_state=seed)
     else:
@@ -130,7 +157,9 @@ def main():
     ap.add_argument("--problems", default="friedman,simulator")
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
-    ap.add_argument("--peers", default="mlp_default,mlp_cv")
+    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv")
+    ap.add_argument("--no-threads2", action="store_true",
+                    help="skip the second whirl run with --threads 2 (time2_ms)")
     ap.add_argument("--json", help="write all per-seed results here")
     ap.add_argument("--peer-cache", help="read/extend the peers' results in this JSON file")
     ap.add_argument("--no-default", action="store_true",
@@ -161,7 +190,8 @@ def main():
                     fte = yte
                 rec = {"problem": prob, "rows": n, "seed": seed, "methods": {}}
                 for name, args in variants:
-                    mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp)
+                    mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp,
+                                                 not a.no_threads2)
                     rec["methods"][name] = {
                         "rmse": rmse(mean, fte).tolist(), "time_ms": ms, **info,
                         "cover1": np.mean(np.abs(yte - mean) <= sd, axis=0).tolist(),
@@ -192,7 +222,7 @@ def report(results, prob, n, variants, peers):
     med = lambda key, m, k: float(np.median([r["methods"][m][key][k] for r in rs]))
     print(f"\n{prob}, {n} training rows, {len(rs)} seeds (median test RMSE, out1 / out2)")
     print(f"{'method':<14} {'rmse_out1':>9} {'rmse_out2':>9} {'wins1':>6} {'wins2':>6} "
-          f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8}")
+          f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8} {'time2_ms':>8}")
     for m in [v[0] for v in variants] + peers:
         line = f"{m:<14} {med('rmse', m, 0):9.3f} {med('rmse', m, 1):9.3f}"
         if m in peers:
@@ -205,10 +235,13 @@ def report(results, prob, n, variants, peers):
             line += f" {wins[0]:>6} {wins[1]:>6} {cov('cover1'):>11} {cov('cover2'):>11} " \
                     f"{cov('cover1_truth'):>11}"
         line += f" {float(np.median([r['methods'][m]['time_ms'] for r in rs])):8.1f}"
+        t2 = [r["methods"][m]["time2_ms"] for r in rs if "time2_ms" in r["methods"][m]]
+        if t2:
+            line += f" {float(np.median(t2)):8.1f}"
         print(line)
     print("wins = seeds on which the method beats the best peer of that seed; cov = mean % of test "
           "targets within +-1/2 sd (noisy), cov1sd_f = +-1 sd against the noise-free function; "
-          "time = median fit time")
+          "time = median fit time (time2: whirl --threads 2)")
     sys.stdout.flush()
 
 

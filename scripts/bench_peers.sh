@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Peer benchmark of whirl's network (issue 12): Friedman #1 plus a second smooth output (20 and 100
 # training rows, 1000 test rows) and the simulator's tables (train 20, test 500), whirl train against
-# scikit-learn's MLPRegressor; prints median test RMSE per output, wins, interval coverage and fit
-# time. The functions, noise and peers are documented in scripts/bench_peers.py.
+# scikit-learn's MLPRegressor (default and grid-searched), LinearRegression and RidgeCV; prints
+# median test RMSE per output, wins, interval coverage and fit time. The functions, noise and
+# peers are documented in scripts/bench_peers.py.
 # Installs Debian's python3-sklearn on first use (only here: the default setup and tests never need it).
 # Usage: scripts/bench_peers.sh [SEEDS (default 20)] [extra bench_peers.py arguments, e.g.
 #        --variant matlab=--trainbr-matlab --peer-cache peers.json --json bench.json]

@@ -76,8 +76,7 @@ void RunDemo(const DemoOptions& o) {
                 model.training_samples, model.training_data.c_str());
   } else {
     if (!o.retrain) Warn(model_path + " not found: training a model from " + train_path);
-    nn::ModelTrainOptions mo;
-    model = nn::TrainModel(history, mo, train_path);
+    model = nn::TrainModel(history, nn::DefaultTrainingOptions(), train_path);
     model_source = "trained now from " + train_path;
     nn::SaveModel(out / "model.json", model);
     std::printf("1. model: trained on %zu rows of %s (%s), saved to %s\n", history.inputs.size(),
@@ -187,7 +186,9 @@ void RegisterDemo(CLI::App& app) {
       "traditional experience rule and the plan, write the report (report/index.html) and print\n"
       "the lead-error reductions (um and %).");
   sub->add_option("--out-dir", o->out_dir, "output directory (default whirl-demo-out)");
-  sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists");
+  sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists, with `whirl train`'s\n"
+                "default (hidden size 4/6/8 by log evidence, brnn's stopping rule,\n"
+                "5-fold CV noise)");
   AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");
   sub->callback([o] { RunDemo(*o); });

@@ -8,10 +8,11 @@
 //   var_k(x) = sigma_k^2 + g_k(x)' A^-1 g_k(x),
 //   sigma_k^2 = the noise variance of output k (schema 2, issue 11): calibrated by K-fold cross-
 //               validation when the model is trained (CalibrateOutputNoise below):
-//               sigma_k^2 = max(0, mean_i r_ik^2 - mean_i v_ik), r_ik the held-out error of
-//               the fold model at row i and v_ik its weight-uncertainty term g' A^-1 g there
-//               (normalized units of the full model), so that the predictive variance matches the
-//               out-of-sample squared error on average, per output.
+//               sigma_k^2 = the smallest level at which +-1 predictive sigma,
+//               sqrt(sigma_k^2 + v_ik), covers 68.27 % of the held-out errors r_ik (bisection;
+//               coverage is monotone in sigma_k^2), r_ik the held-out error of the fold model at
+//               row i and v_ik its weight-uncertainty term g' A^-1 g there (normalized units of
+//               the full model).
 //               Schema 1 files (one level for both outputs, trainbr's sigma_nu^2 = 1 / (2 beta) =
 //               ssE / (n - gamma)) still load, with sigma_k^2 = sigma_nu^2 for both outputs.
 //               Why: trainbr's one level is ssE / (n - gamma) over both outputs; with 20 rows
