@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Peer benchmark of whirl's network (issue 12): whirl train against scikit-learn MLPRegressor.
+"""Peer benchmark of whirl's network (issue 12): whirl train against scikit-learn's regressors.
 
 Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regression splines"):
   x ~ U[0, 1]^5 (written into whirl's five input columns, in order),
@@ -28,6 +28,11 @@ both outputs as whirl):
   ridge_gcv:   RidgeCV(alphas=logspace(-4, 4, 41), alpha_per_target=True) on standardized
                inputs: the ridge penalty of each output chosen by generalized (efficient
                leave-one-out) cross-validation.
+  gp_ard:      GaussianProcessRegressor per output on standardized inputs, kernel
+               ConstantKernel * RBF(one length scale per input, "ARD") + WhiteKernel, normalize_y,
+               hyperparameters by maximum marginal likelihood (L-BFGS, 3 extra random starts);
+               the textbook choice for a smooth function from a few dozen noisy rows. Its
+               predictive sd (return_std, noise included) gives it coverage columns too.
 The "best peer" of a seed (wins) is the best of all peers run on that seed, per output.
 Fit times: whirl's in-process time (whirl train --json fit_time_ms), on one thread (time_ms) and
 with --threads 2 (time2_ms; the 2-thread run must predict identically, else the script stops);
@@ -53,6 +58,8 @@ import sklearn
 from sklearn.compose import TransformedTargetRegressor
 from sklearn.linear_model import LinearRegression, RidgeCV
 from sklearn.exceptions import ConvergenceWarning
+from sklearn.gaussian_process import GaussianProcessRegressor
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.model_selection import GridSearchCV, KFold
 from sklearn.neural_network import MLPRegressor
 from sklearn.pipeline import make_pipeline
@@ -121,14 +128,33 @@ def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
     return mean, sd, t["fit_time_ms"], info
 
 
+def fit_gp_ard(xtr, ytr, xte, seed):
+    """gp_ard (see the module doc): predictive mean and sd per output."""
+    scale = StandardScaler().fit(xtr)
+    a, b = scale.transform(xtr), scale.transform(xte)
+    mean, sd = np.empty((len(xte), ytr.shape[1])), np.empty((len(xte), ytr.shape[1]))
+    for k in range(ytr.shape[1]):
+        kernel = ConstantKernel(1.0) * RBF(np.ones(a.shape[1]), (1e-2, 1e3)) + \
+            WhiteKernel(0.1, (1e-6, 10.0))
+        gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=3,
+                                      random_state=seed).fit(a, ytr[:, k])
+        mean[:, k], sd[:, k] = gp.predict(b, return_std=True)
+    return mean, sd
+
+
 def fit_sklearn(kind, xtr, ytr, xte, seed):
+    """(prediction, fit ms, predictive sd or None)."""
     warnings.simplefilter("ignore", ConvergenceWarning)
+    if kind == "gp_ard":
+        start = time.perf_counter()
+        mean, sd = fit_gp_ard(xtr, ytr, xte, seed)
+        return mean, 1000 * (time.perf_counter() - start), sd
     if kind in ("ols", "ridge_gcv"):
         model = LinearRegression() if kind == "ols" else make_pipeline(
             StandardScaler(), RidgeCV(alphas=np.logspace(-4, 4, 41), alpha_per_target=True))
         start = time.perf_counter()
         model.fit(xtr, ytr)
-        return model.predict(xte), 1000 * (time.perf_counter() - start)
+        return model.predict(xte), 1000 * (time.perf_counter() - start), None
     if kind == "mlp_default":
         net = MLPRegressor(random_state=seed)
     else:
@@ -142,7 +168,15 @@ def fit_sklearn(kind, xtr, ytr, xte, seed):
                              scoring="neg_mean_squared_error")
     start = time.perf_counter()
     model.fit(xtr, ytr)
-    return model.predict(xte), 1000 * (time.perf_counter() - start)
+    return model.predict(xte), 1000 * (time.perf_counter() - start), None
+
+
+def coverage(mean, sd, yte, fte):
+    """Shares of noisy targets within +-1/+-2 sd and of the noise-free truth within +-1/+-2 sd."""
+    return {"cover1": np.mean(np.abs(yte - mean) <= sd, axis=0).tolist(),
+            "cover2": np.mean(np.abs(yte - mean) <= 2 * sd, axis=0).tolist(),
+            "cover1_truth": np.mean(np.abs(fte - mean) <= sd, axis=0).tolist(),
+            "cover2_truth": np.mean(np.abs(fte - mean) <= 2 * sd, axis=0).tolist()}
 
 
 def rmse(pred, truth):
@@ -157,7 +191,7 @@ def main():
     ap.add_argument("--problems", default="friedman,simulator")
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
-    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv")
+    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv,gp_ard")
     ap.add_argument("--no-threads2", action="store_true",
                     help="skip the second whirl run with --threads 2 (time2_ms)")
     ap.add_argument("--json", help="write all per-seed results here")
@@ -192,17 +226,15 @@ def main():
                 for name, args in variants:
                     mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp,
                                                  not a.no_threads2)
-                    rec["methods"][name] = {
-                        "rmse": rmse(mean, fte).tolist(), "time_ms": ms, **info,
-                        "cover1": np.mean(np.abs(yte - mean) <= sd, axis=0).tolist(),
-                        "cover2": np.mean(np.abs(yte - mean) <= 2 * sd, axis=0).tolist(),
-                        "cover1_truth": np.mean(np.abs(fte - mean) <= sd, axis=0).tolist(),
-                        "cover2_truth": np.mean(np.abs(fte - mean) <= 2 * sd, axis=0).tolist()}
+                    rec["methods"][name] = {"rmse": rmse(mean, fte).tolist(), "time_ms": ms,
+                                            **info, **coverage(mean, sd, yte, fte)}
                 for p in peers:
                     key = f"{prob}/{n}/{seed}/{p}/sklearn-{sklearn.__version__}"
                     if key not in cache:
-                        pred, ms = fit_sklearn(p, xtr, ytr, xte, seed)
+                        pred, ms, sd = fit_sklearn(p, xtr, ytr, xte, seed)
                         cache[key] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
+                        if sd is not None:
+                            cache[key].update(coverage(pred, sd, yte, fte))
                         if a.peer_cache:
                             with open(a.peer_cache, "w") as f:
                                 json.dump(cache, f, indent=1)
@@ -225,15 +257,18 @@ def report(results, prob, n, variants, peers):
           f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8} {'time2_ms':>8}")
     for m in [v[0] for v in variants] + peers:
         line = f"{m:<14} {med('rmse', m, 0):9.3f} {med('rmse', m, 1):9.3f}"
+        cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
+                                   for k in (0, 1))
         if m in peers:
-            line += f" {'':>6} {'':>6} {'':>11} {'':>11} {'':>11}"
+            line += f" {'':>6} {'':>6}"
         else:
             wins = [sum(r["methods"][m]["rmse"][k] < min(r["methods"][p]["rmse"][k] for p in peers)
                         for r in rs) for k in (0, 1)]
-            cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
-                                       for k in (0, 1))
-            line += f" {wins[0]:>6} {wins[1]:>6} {cov('cover1'):>11} {cov('cover2'):>11} " \
-                    f"{cov('cover1_truth'):>11}"
+            line += f" {wins[0]:>6} {wins[1]:>6}"
+        if all("cover1" in r["methods"][m] for r in rs):
+            line += f" {cov('cover1'):>11} {cov('cover2'):>11} {cov('cover1_truth'):>11}"
+        else:
+            line += f" {'':>11} {'':>11} {'':>11}"
         line += f" {float(np.median([r['methods'][m]['time_ms'] for r in rs])):8.1f}"
         t2 = [r["methods"][m]["time2_ms"] for r in rs if "time2_ms" in r["methods"][m]]
         if t2:
