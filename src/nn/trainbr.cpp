@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -127,10 +128,17 @@ double ObjectiveSpread(const std::vector<double>& after_step) {
 }
 
 std::string TrainSummary::BriefReport() const {
+  // Four significant digits for a person to read; the model file keeps the exact values.
+  auto brief = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", x);
+    return std::string(buf);
+  };
   std::ostringstream s;
   s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": F "
-    << Num(initial_cost) << " -> " << Num(final_cost) << ", ssE " << Num(initial_sse) << " -> "
-    << Num(sse) << " in " << epochs << " epochs, gamma " << Num(gamma) << " of " << parameter_count
+    << brief(initial_cost) << " -> " << brief(final_cost) << ", ssE " << brief(initial_sse)
+    << " -> " << brief(sse) << " in " << epochs << " epochs, gamma " << brief(gamma) << " of "
+    << parameter_count
     << ", " << ToString(termination) << " (" << message << ")";
   return s.str();
 }
