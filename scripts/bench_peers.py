@@ -33,6 +33,7 @@ both outputs as whirl):
                hyperparameters by maximum marginal likelihood (L-BFGS, 3 extra random starts);
                the textbook choice for a smooth function from a few dozen noisy rows. Its
                predictive sd (return_std, noise included) gives it coverage columns too.
+  gp_rbf:      the same with one length scale for all inputs (isotropic RBF).
 The "best peer" of a seed (wins) is the best of all peers run on that seed, per output.
 Fit times: whirl's in-process time (whirl train --json fit_time_ms), on one thread (time_ms) and
 with --threads 2 (time2_ms; the 2-thread run must predict identically, else the script stops);
@@ -128,13 +129,13 @@ def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
     return mean, sd, t["fit_time_ms"], info
 
 
-def fit_gp_ard(xtr, ytr, xte, seed):
-    """gp_ard (see the module doc): predictive mean and sd per output."""
+def fit_gp(xtr, ytr, xte, seed, ard):
+    """gp_ard / gp_rbf (see the module doc): predictive mean and sd per output."""
     scale = StandardScaler().fit(xtr)
     a, b = scale.transform(xtr), scale.transform(xte)
     mean, sd = np.empty((len(xte), ytr.shape[1])), np.empty((len(xte), ytr.shape[1]))
     for k in range(ytr.shape[1]):
-        kernel = ConstantKernel(1.0) * RBF(np.ones(a.shape[1]), (1e-2, 1e3)) + \
+        kernel = ConstantKernel(1.0) * RBF(np.ones(a.shape[1]) if ard else 1.0, (1e-2, 1e3)) + \
             WhiteKernel(0.1, (1e-6, 10.0))
         gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=3,
                                       random_state=seed).fit(a, ytr[:, k])
@@ -145,9 +146,9 @@ def fit_gp_ard(xtr, ytr, xte, seed):
 def fit_sklearn(kind, xtr, ytr, xte, seed):
     """(prediction, fit ms, predictive sd or None)."""
     warnings.simplefilter("ignore", ConvergenceWarning)
-    if kind == "gp_ard":
+    if kind in ("gp_ard", "gp_rbf"):
         start = time.perf_counter()
-        mean, sd = fit_gp_ard(xtr, ytr, xte, seed)
+        mean, sd = fit_gp(xtr, ytr, xte, seed, kind == "gp_ard")
         return mean, 1000 * (time.perf_counter() - start), sd
     if kind in ("ols", "ridge_gcv"):
         model = LinearRegression() if kind == "ols" else make_pipeline(
@@ -191,7 +192,7 @@ def main():
     ap.add_argument("--problems", default="friedman,simulator")
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
-    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv,gp_ard")
+    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv,gp_ard,gp_rbf")
     ap.add_argument("--no-threads2", action="store_true",
                     help="skip the second whirl run with --threads 2 (time2_ms)")
     ap.add_argument("--json", help="write all per-seed results here")
