@@ -31,6 +31,7 @@ struct TrainCliOptions {
   std::string hidden_sweep;  // "A..B"
   int folds = 5;
   bool trainbr_matlab = false;
+  bool ard = false;
   bool stop_by_cv = false;
   double change = -1;  // < 0: the default of the chosen setting
   int noise_folds = 5;
@@ -142,6 +143,9 @@ void Run(const TrainCliOptions& o) {
   opt.noise_folds = o.noise_folds;
   if (o.trainbr_matlab && o.stop_by_cv)
     throw InputError("train: --trainbr-matlab and --stop-by-cv exclude each other");
+  if (o.trainbr_matlab && o.ard)
+    throw InputError("train: --trainbr-matlab is MATLAB's trainbr as it is; it excludes --ard");
+  opt.train.ard = o.ard;
   const auto start = std::chrono::steady_clock::now();
   const std::size_t total =
       static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
@@ -185,6 +189,12 @@ void Run(const TrainCliOptions& o) {
   std::cout << "  gamma " << Fmt(s.gamma) << " of " << s.parameter_count << ", alpha "
             << Fmt(s.alpha) << ", beta " << Fmt(s.beta) << ", sum of squared weights "
             << Fmt(s.sum_squared_weights) << ", log evidence " << Fmt(s.log_evidence, 6) << "\n";
+  if (s.ard_alpha.size() == ProcessInputs::kCount + 1) {
+    std::cout << "  ARD alpha per input (larger = less relevant; normalized units):";
+    for (int i = 0; i < ProcessInputs::kCount; ++i)
+      std::cout << (i ? ", " : " ") << kInputColumns[i] << " " << Fmt(s.ard_alpha(i));
+    std::cout << "; other weights " << Fmt(s.ard_alpha(ProcessInputs::kCount)) << "\n";
+  }
   if (model.restarts > 1) {
     std::cout << "  restarts (best log evidence kept):\n";
     for (const auto& r : model.restart_runs)
@@ -247,6 +257,13 @@ void RegisterTrain(CLI::App& app) {
   sub->add_flag("--trainbr-matlab", o->trainbr_matlab,
                 "the paper's MATLAB trainbr setting: 5-6-2 (or --hidden N) trained to\n"
                 "trainbr's own stopping criteria (mu_max, min_grad, --epochs); no size search");
+  sub->add_flag("--ard", o->ard,
+                "after each trainbr fit, continue with one weight-decay alpha per\n"
+                "input's first-layer weights and one for all other weights (MacKay's\n"
+                "automatic relevance determination: inputs the data do not support are\n"
+                "shrunk), kept only if its log evidence is higher; every size fit,\n"
+                "restart and noise fold (src/nn/trainbr.h TrainOptions::ard). Better\n"
+                "from about 100 rows and for settle time; README 'Against its peers'");
   sub->add_flag("--stop-by-cv", o->stop_by_cv,
                 "stop at the epoch count with the lowest 5-fold cross-validation error\n"
                 "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"

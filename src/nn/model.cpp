@@ -134,6 +134,7 @@ json OptionsJson(const TrainOptions& o) {
          {"min_grad", o.min_grad},
          {"regularization", ToString(o.regularization)}};
   if (o.change > 0) j["change"] = o.change;  // optional key: MATLAB-trainbr files stay as they were
+  if (o.ard) j["ard"] = true;                 // optional key, likewise
   return j;
 }
 
@@ -141,7 +142,7 @@ TrainOptions ReadOptions(const json& j) {
   const std::string where = "model 'training.options'";
   RejectUnknownKeys(j,
                     {"epochs", "goal", "mu", "mu_dec", "mu_inc", "mu_max", "min_grad",
-                     "regularization", "change"},
+                     "regularization", "change", "ard"},
                     where);
   TrainOptions o;
   o.epochs = RequireInt(Require(j, "epochs", where), where + " 'epochs'", 0, kMaxEpochs);
@@ -153,6 +154,10 @@ TrainOptions ReadOptions(const json& j) {
   o.min_grad = RequireFinite(Require(j, "min_grad", where), where + " 'min_grad'");
   o.regularization = ParseRegularization(Require(j, "regularization", where).get<std::string>());
   if (j.contains("change")) o.change = RequireFinite(j.at("change"), where + " 'change'");
+  if (j.contains("ard")) {
+    if (!j.at("ard").is_boolean()) throw InputError(where + " 'ard': must be true or false");
+    o.ard = j.at("ard").get<bool>();
+  }
   return o;
 }
 
@@ -663,6 +668,9 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  std::to_string(options.train.epochs) +
                  " (the epoch count with the lowest summed held-out squared error, normalized)";
   }
+  if (train.ard)
+    m.stopping += "; then the ARD stage (one alpha per input's weights, the same stopping rule), "
+                  "kept if its log evidence is higher";
   RestartResult r = TrainBrRestarts(data, sizes, options.seed, options.restarts, train, progress,
                                     options.threads);
   m.network = std::move(r.best.network);

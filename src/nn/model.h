@@ -179,7 +179,9 @@ inline constexpr double kBrnnChange = 0.001;
 /// of 5 starts averaged (20 rows 2.98 / 11.7 against 2.83 / 11.3 for one); noise by the evidence
 /// (ssE_k / (Q - gamma/2)) or by closed-form leave-one-out from the Laplace posterior (both
 /// cost nothing but covered only 35-55 % on the simulator and at 20 rows); 3 noise folds
-/// instead of 5 (simulator: 35 % at +-1 sigma).
+/// instead of 5 (simulator: 35 % at +-1 sigma); noise folds warm-started from the full fit
+/// (simulator: 42 %). Available, not the default: TrainOptions::ard (`--ard`: better at 100 rows
+/// and on the simulator's settle time, worse on its elongation, 2-7x slower).
 ModelTrainOptions DefaultTrainingOptions();
 
 /// Progress of TrainModel: restart index (0-based) and the epoch just finished.

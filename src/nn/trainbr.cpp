@@ -1,5 +1,6 @@
 #include "nn/trainbr.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -80,6 +81,8 @@ void TrainOptions::Validate() const {
   if (!(min_grad >= 0) || !std::isfinite(min_grad))
     fail("min_grad", min_grad, "must be finite and >= 0");
   if (!(change >= 0) || !std::isfinite(change)) fail("change", change, "must be finite and >= 0");
+  if (ard && regularization != Regularization::kBayesian)
+    throw InputError("train option 'ard': needs Bayesian regularization");
 }
 
 namespace {
@@ -197,6 +200,7 @@ void to_json(nlohmann::json& j, const TrainSummary& s) {
                      {"regularization", ToString(s.regularization)},
                      {"termination", ToString(s.termination)},
                      {"message", s.message}};
+  if (s.ard_alpha.size() > 0) j["ard_alpha"] = VecJson(s.ard_alpha);  // optional key
 }
 
 void from_json(const nlohmann::json& j, TrainSummary& s) {
@@ -230,6 +234,8 @@ void from_json(const nlohmann::json& j, TrainSummary& s) {
   s.regularization = ParseRegularization(j.at("regularization").get<std::string>());
   s.termination = ParseTermination(j.at("termination").get<std::string>());
   s.message = j.at("message").get<std::string>();
+  s.ard_alpha.resize(0);
+  if (j.contains("ard_alpha")) s.ard_alpha = VecFromJson(j, "ard_alpha");
 }
 
 void to_json(nlohmann::json& j, const RestartRecord& r) {
@@ -263,6 +269,16 @@ double LogEvidence(double sse, double ssx, double alpha, double beta, double log
          0.5 * n * std::log(M_PI) + symmetry;
 }
 
+double LogEvidenceGroups(double sse, const Eigen::VectorXd& group_ssx,
+                         const Eigen::VectorXd& group_alpha, const Eigen::VectorXd& group_size,
+                         double beta, double log_det_h, int error_count,
+                         const std::vector<int>& layer_sizes) {
+  // LogEvidence with alpha = 1 and ssX = 0 leaves out the prior's terms; they are added per group.
+  const double rest = LogEvidence(sse, 0.0, 1.0, beta, log_det_h, 0, error_count, layer_sizes);
+  return rest - group_alpha.dot(group_ssx) +
+         0.5 * group_size.dot(group_alpha.array().log().matrix());
+}
+
 namespace {
 
 void CheckTrainingData(const TrainingData& data, const Network& initial,
@@ -286,6 +302,141 @@ void CheckTrainingData(const TrainingData& data, const Network& initial,
     throw InputError("training data: target scaling has " +
                      std::to_string(data.target_scaling.size()) + " variables, expected " +
                      std::to_string(S));
+}
+
+}  // namespace
+
+namespace {
+
+// TrainOptions::ard: the weight groups (first-layer weights of input i -> i, all else -> R).
+Eigen::VectorXi ArdGroups(const Network& net) {
+  const int R = net.InputCount();
+  Eigen::VectorXi group = Eigen::VectorXi::Constant(net.ParameterCount(), R);
+  for (int r = 0; r < net.layer_sizes[1]; ++r)
+    for (int i = 0; i < R; ++i) group(net.WeightIndex(0, r, i)) = i;
+  return group;
+}
+
+Eigen::VectorXd GroupSums(const Eigen::VectorXi& group, int groups, const Eigen::VectorXd& v) {
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(groups);
+  for (Eigen::Index i = 0; i < v.size(); ++i) sum(group(i)) += v(i);
+  return sum;
+}
+
+// H = beta J'J + diag(a) from the full J'J.
+Eigen::MatrixXd ArdHessian(const Eigen::MatrixXd& jj, double beta, const Eigen::VectorXd& a) {
+  Eigen::MatrixXd h = beta * jj;
+  h.diagonal() += a;
+  return h;
+}
+
+// The second stage of TrainOptions::ard, from trainbr's result `first` (nn/trainbr.h).
+TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOptions& options) {
+  Network& net = first.network;
+  TrainSummary& sum = first.summary;
+  const Eigen::VectorXi group = ArdGroups(net);
+  const int G = net.InputCount() + 1;
+  const Eigen::VectorXd group_size = GroupSums(group, G, Eigen::VectorXd::Ones(group.size()));
+  const double n = static_cast<double>(data.targets.size());
+  Eigen::VectorXd alpha = Eigen::VectorXd::Constant(G, sum.alpha);
+  double beta = sum.beta;
+  auto per_weight = [&] { return Eigen::VectorXd(alpha(group)); };
+  Eigen::VectorXd a = per_weight();
+  Eigen::VectorXd w = net.GetParameters();
+  Network trial = net;
+  ForwardCache cache, trial_cache;
+  net.Forward(data.inputs, &cache);
+  Eigen::MatrixXd e = data.targets - cache.output(), J;
+  double sse = SumSquares(e);
+  double F = beta * sse + a.dot(w.cwiseAbs2());
+  double mu = options.mu, gradient = 0;
+  std::vector<double> after_step;
+  std::string degenerate;
+  const int first_epochs = sum.epochs;
+  for (int epoch = 0;; ++epoch) {
+    ErrorJacobian(net, cache, &J);
+    const Eigen::Map<const Eigen::VectorXd> e_flat(e.data(), e.size());
+    const Eigen::MatrixXd jj = J.transpose() * J;
+    const Eigen::VectorXd je = J.transpose() * e_flat;
+    gradient = 2 * je.norm();
+    sum.epochs = first_epochs + epoch;
+    if (StopReached(options, epoch, sse, gradient, mu, after_step, degenerate, &sum)) break;
+    const Eigen::VectorXd rhs = beta * je + a.cwiseProduct(w);
+    bool accepted = false;
+    for (; mu <= options.mu_max; mu *= options.mu_inc) {
+      Eigen::MatrixXd shifted = ArdHessian(jj, beta, a);
+      shifted.diagonal().array() += mu;
+      const Eigen::LLT<Eigen::MatrixXd> llt(shifted);
+      if (llt.info() != Eigen::Success) continue;
+      const Eigen::VectorXd w2 = w - llt.solve(rhs);
+      if (!w2.allFinite()) continue;
+      trial.SetParameters(w2);
+      trial.Forward(data.inputs, &trial_cache);
+      const Eigen::MatrixXd e2 = data.targets - trial_cache.output();
+      const double sse2 = SumSquares(e2), F2 = beta * sse2 + a.dot(w2.cwiseAbs2());
+      if (F2 < F) {
+        w = w2;
+        std::swap(net, trial);
+        std::swap(cache, trial_cache);
+        e = e2;
+        sse = sse2;
+        F = F2;
+        mu = std::max(mu * options.mu_dec, kMuFloor);
+        accepted = true;
+        break;
+      }
+    }
+    if (options.change > 0) after_step.push_back(F);
+    if (!accepted) continue;  // mu > mu_max: StopReached ends the fit next epoch
+    const Eigen::LLT<Eigen::MatrixXd> h(ArdHessian(jj, beta, a));
+    Eigen::VectorXd gamma = Eigen::VectorXd::Constant(G, std::numeric_limits<double>::quiet_NaN());
+    if (h.info() == Eigen::Success) {
+      const Eigen::MatrixXd h_inv = h.solve(Eigen::MatrixXd::Identity(a.size(), a.size()));
+      gamma = group_size - alpha.cwiseProduct(GroupSums(group, G, h_inv.diagonal()));
+    }
+    const Eigen::VectorXd ssx = GroupSums(group, G, w.cwiseAbs2());
+    Eigen::VectorXd alpha_new(G);
+    for (int g = 0; g < G; ++g)
+      alpha_new(g) = ssx(g) == 0 ? kArdAlphaMax : std::min(gamma(g) / (2 * ssx(g)), kArdAlphaMax);
+    const double beta_new = sse == 0 ? 1.0 : (n - gamma.sum()) / (2 * sse);
+    if (alpha_new.allFinite() && (alpha_new.array() > 0).all() && std::isfinite(beta_new) &&
+        beta_new > 0) {
+      alpha = alpha_new;
+      beta = beta_new;
+      a = per_weight();
+      sum.gamma = gamma.sum();
+    } else {
+      degenerate = "ARD stage: gamma = " + Num(gamma.sum()) + ", beta = " + Num(beta_new) +
+                   " (kept the last finite alpha_g, beta)";
+    }
+    F = beta * sse + a.dot(w.cwiseAbs2());
+  }
+  sum.message = "ARD stage: " + sum.message;
+  sum.final_cost = F;
+  sum.sse = sse;
+  sum.sum_squared_weights = w.squaredNorm();
+  sum.alpha = alpha(G - 1);
+  sum.ard_alpha = alpha;
+  sum.beta = beta;
+  sum.mu = mu;
+  sum.gradient = gradient;
+  sum.rms_error_normalized =
+      (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
+  sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
+  // Laplace approximation at the final weights, through the eigenvalues of H (as TrainBr).
+  ErrorJacobian(net, cache, &J);
+  const Eigen::MatrixXd jj = J.transpose() * J;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ArdHessian(jj, beta, a));
+  const Eigen::VectorXd h_eig = eig.eigenvalues().cwiseMax(a.minCoeff());
+  sum.log_evidence = LogEvidenceGroups(sse, GroupSums(group, G, w.cwiseAbs2()), alpha, group_size,
+                                       beta, h_eig.array().log().sum(),
+                                       static_cast<int>(n), net.layer_sizes);
+  sum.noise_variance = 1.0 / (2.0 * beta);
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+  first.posterior_covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
+  first.posterior_covariance =
+      0.5 * (first.posterior_covariance + first.posterior_covariance.transpose()).eval();
+  return first;
 }
 
 }  // namespace
@@ -478,6 +629,13 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   } else {
     sum.log_evidence = std::numeric_limits<double>::quiet_NaN();
     sum.noise_variance = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (options.ard && bayes) {
+    // MacKay's model comparison: the ARD stage is kept only when the data support it.
+    TrainResult ard = RefineArd(data, result, options);
+    if (ard.summary.log_evidence > sum.log_evidence) return ard;
+    sum.message += "; ARD stage not kept (log evidence " + Num(ard.summary.log_evidence) +
+                   " <= " + Num(sum.log_evidence) + ")";
   }
   return result;
 }

@@ -53,6 +53,17 @@ grep -q '"layer_sizes": \[5, 6, 2\]\|"layer_sizes":\[5,6,2\]' out.txt \
 grep -q '"fit_time_ms"' out.txt || fail "train --json lacks fit_time_ms"
 expect 1 "expected 'evidence', 'auto' or an integer" -- "$whirl" train --data "$data" --out x.json --hidden 6x
 expect 1 "exclude each other" -- "$whirl" train --data "$data" --out x.json --trainbr-matlab --stop-by-cv
+# --ard: one alpha per input's weights; the model file says so and keeps the 6 group alphas, or
+# says why the evidence did not keep the ARD stage
+expect 0 "" -- "$whirl" train --data "$data" --out ard.json --ard --threads 1
+grep -q '"ard": true' ard.json || fail "--ard model lacks training.options.ard"
+python3 -c '
+import json, sys
+s = json.load(open("ard.json"))["training_summary"]
+sys.exit(not (len(s.get("ard_alpha", [])) == 6 or "ARD stage not kept" in s["message"]))' \
+  || fail "--ard model has neither 6 ard_alpha values nor the reason"
+expect 0 "" -- "$whirl" predict --model ard.json --input "$data"
+expect 1 "excludes --ard" -- "$whirl" train --data "$data" --out x.json --trainbr-matlab --ard
 
 # hidden sweep
 expect 0 "" -- "$whirl" train --data "$data" --hidden-sweep 3..4 --folds 4

@@ -4,6 +4,7 @@ whirl_add_gtest(test_nn SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_trainbr.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_parallel_nn.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_ard.cpp
   LABELS nn)
 whirl_add_cli_test(cli_nn ${CMAKE_CURRENT_LIST_DIR}/cli_nn.sh)
 # Retrains models/default.json with scripts/train_default.sh (~2 s) and compares its predictions
