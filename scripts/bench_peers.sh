@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Peer benchmark of whirl's network (issue 12): Friedman #1 plus a second smooth output (20 and 100
 # training rows, 1000 test rows) and the simulator's tables (train 20, test 500), whirl train against
-# scikit-learn's MLPRegressor (default and grid-searched), LinearRegression and RidgeCV; prints
+# scikit-learn's MLPRegressor (default and grid-searched), LinearRegression, RidgeCV and Gaussian
+# processes (ARD and isotropic RBF kernels); prints
 # median test RMSE per output, wins, interval coverage and fit time. The functions, noise and
 # peers are documented in scripts/bench_peers.py.
 # Installs Debian's python3-sklearn on first use (only here: the default setup and tests never need it).

@@ -79,6 +79,7 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
   s.seed = o.seed;
   s.restarts = o.restarts;
   s.train.epochs = o.epochs;
+  s.train.ard = o.ard;
   s.threads = o.threads;
   s.Validate(static_cast<int>(table.inputs.size()));
   Progress progress("hidden sweep",
@@ -153,10 +154,11 @@ void Run(const TrainCliOptions& o) {
   const nn::Model model = nn::TrainModel(
       table, opt, std::filesystem::path(o.data_path).filename().string(),
       [&](int restart, const nn::EpochInfo& info) {
-        progress.Update(static_cast<std::size_t>(restart) * std::max(o.epochs, 1) + info.epoch,
-                        "restart " + std::to_string(restart + 1) + "/" +
-                            std::to_string(o.restarts) + " epoch " + std::to_string(info.epoch) +
-                            " F " + Fmt(info.objective) + " gamma " + Fmt(info.gamma));
+        progress.Update(
+            static_cast<std::size_t>(restart) * std::max(o.epochs, 1) + info.epoch,
+            "restart " + std::to_string(restart + 1) + "/" + std::to_string(o.restarts) +
+                (info.ard_stage ? " ARD epoch " : " epoch ") + std::to_string(info.epoch) + " F " +
+                Fmt(info.objective) + " gamma " + Fmt(info.gamma));
       });
   progress.Finish();
   const double fit_ms =
@@ -261,9 +263,11 @@ void RegisterTrain(CLI::App& app) {
                 "after each trainbr fit, continue with one weight-decay alpha per\n"
                 "input's first-layer weights and one for all other weights (MacKay's\n"
                 "automatic relevance determination: inputs the data do not support are\n"
-                "shrunk), kept only if its log evidence is higher; every size fit,\n"
-                "restart and noise fold (src/nn/trainbr.h TrainOptions::ard). Better\n"
-                "from about 100 rows and for settle time; README 'Against its peers'");
+                "shrunk), kept only if it took a step and its log evidence is higher;\n"
+                "every size fit, restart and noise fold, and every fit of --hidden-sweep\n"
+                "(src/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
+                "choose trainbr's epochs without ARD. Better from about 100 rows and for\n"
+                "settle time; README 'Against its peers'");
   sub->add_flag("--stop-by-cv", o->stop_by_cv,
                 "stop at the epoch count with the lowest 5-fold cross-validation error\n"
                 "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"

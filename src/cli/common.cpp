@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -91,7 +92,7 @@ Progress::Progress(std::string label, std::size_t total)
     : label_(std::move(label)), total_(total == 0 ? 1 : total), tty_(::isatty(2) != 0) {}
 
 void Progress::Update(std::size_t done, const std::string& detail) {
-  const double frac = static_cast<double>(done) / static_cast<double>(total_);
+  const double frac = std::min(1.0, static_cast<double>(done) / static_cast<double>(total_));
   if (tty_) {
     const int width = 30;
     const int filled = static_cast<int>(frac * width + 0.5);

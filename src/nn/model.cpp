@@ -134,7 +134,7 @@ json OptionsJson(const TrainOptions& o) {
          {"min_grad", o.min_grad},
          {"regularization", ToString(o.regularization)}};
   if (o.change > 0) j["change"] = o.change;  // optional key: MATLAB-trainbr files stay as they were
-  if (o.ard) j["ard"] = true;                 // optional key, likewise
+  if (o.ard) j["ard"] = true;                // optional key, likewise
   return j;
 }
 
@@ -165,6 +165,19 @@ std::uint64_t ReadSeed(const json& v, const std::string& where) {
   if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
     throw InputError(where + " must be a non-negative integer, got " + v.dump());
   return v.get<std::uint64_t>();
+}
+
+// TrainSummary::ard_alpha: only with options.ard, one finite alpha > 0 per input and the rest.
+void ValidateArdAlpha(const Model& m) {
+  const Eigen::VectorXd& a = m.training_summary.ard_alpha;
+  if (a.size() == 0) return;
+  if (!m.train_options.ard)
+    throw InputError(
+        "model 'training_summary.ard_alpha' is present but 'training.options.ard' is not true");
+  if (a.size() != m.network.InputCount() + 1 || !a.allFinite() || !(a.array() > 0).all())
+    throw InputError(
+        "model 'training_summary.ard_alpha' needs " + std::to_string(m.network.InputCount() + 1) +
+        " finite values > 0 (one per input, then the rest), has " + std::to_string(a.size()));
 }
 
 }  // namespace
@@ -222,6 +235,7 @@ void Model::Validate() const {
     throw InputError("model 'training_summary.parameter_count' = " +
                      std::to_string(training_summary.parameter_count) + ", layer_sizes give " +
                      std::to_string(N));
+  ValidateArdAlpha(*this);
 }
 
 void to_json(nlohmann::json& j, const Model& m) {
@@ -669,8 +683,10 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  " (the epoch count with the lowest summed held-out squared error, normalized)";
   }
   if (train.ard)
-    m.stopping += "; then the ARD stage (one alpha per input's weights, the same stopping rule), "
-                  "kept if its log evidence is higher";
+    m.stopping +=
+        "; then the ARD stage (one alpha per input's weights, the same stopping rule "
+        "and epoch limit, counted again), kept if it took a step and its log evidence "
+        "is higher";
   RestartResult r = TrainBrRestarts(data, sizes, options.seed, options.restarts, train, progress,
                                     options.threads);
   m.network = std::move(r.best.network);
@@ -733,7 +749,9 @@ int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOpt
     out.reserve(static_cast<std::size_t>(max_epochs));
     Network net = Network::Zeros(sizes);
     InitNguyenWidrow(options.seed, &net);
-    TrainBr(data, net, options.train, [&](const EpochInfo& info) {
+    TrainOptions fold_train = options.train;
+    fold_train.ard = false;  // the folds choose trainbr's epochs; the ARD stage follows them
+    TrainBr(data, net, fold_train, [&](const EpochInfo& info) {
       const Eigen::MatrixXd y = ts.Reverse(info.network->Forward(xv_n));
       out.push_back(((tv - y).array().colwise() / half.array()).square().sum());
     });

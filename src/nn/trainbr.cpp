@@ -141,8 +141,7 @@ std::string TrainSummary::BriefReport() const {
   s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": F "
     << brief(initial_cost) << " -> " << brief(final_cost) << ", ssE " << brief(initial_sse)
     << " -> " << brief(sse) << " in " << epochs << " epochs, gamma " << brief(gamma) << " of "
-    << parameter_count
-    << ", " << ToString(termination) << " (" << message << ")";
+    << parameter_count << ", " << ToString(termination) << " (" << message << ")";
   return s.str();
 }
 
@@ -330,41 +329,103 @@ Eigen::MatrixXd ArdHessian(const Eigen::MatrixXd& jj, double beta, const Eigen::
   return h;
 }
 
-// The second stage of TrainOptions::ard, from trainbr's result `first` (nn/trainbr.h).
-TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOptions& options) {
+// alpha_g and beta of TrainOptions::ard after a step (MacKay 1992, one alpha per group).
+struct ArdHyper {
+  Eigen::VectorXd alpha;  ///< per group
+  double beta = 0;
+  double gamma = 0;  ///< sum of gamma_g
+};
+
+// One re-estimation at weights w: gamma_g = N_g - alpha_g trace_g(H^-1), alpha_g = gamma_g /
+// (2 ssX_g), beta = (n - sum gamma_g) / (2 ssE). A group whose ssX_g is 0 or whose gamma_g is
+// not positive (only by rounding: H >= diag(alpha) makes gamma_g >= 0) goes to kArdAlphaMax, as
+// does any alpha_g above it. Returns "" and updates `h`, or a reason and leaves `h` as it was.
+std::string ReestimateArd(const Eigen::MatrixXd& jj, double sse, const Eigen::VectorXd& w,
+                          const Eigen::VectorXi& group, const Eigen::VectorXd& group_size, double n,
+                          ArdHyper* h) {
+  const auto G = h->alpha.size();
+  const Eigen::LLT<Eigen::MatrixXd> llt(ArdHessian(jj, h->beta, h->alpha(group)));
+  if (llt.info() != Eigen::Success) return "H = beta J'J + diag(alpha_g) not positive definite";
+  const Eigen::MatrixXd h_inv = llt.solve(Eigen::MatrixXd::Identity(w.size(), w.size()));
+  const Eigen::VectorXd gamma =
+      (group_size - h->alpha.cwiseProduct(GroupSums(group, G, h_inv.diagonal()))).cwiseMax(0.0);
+  const Eigen::VectorXd ssx = GroupSums(group, G, w.cwiseAbs2());
+  Eigen::VectorXd alpha(G);
+  for (Eigen::Index g = 0; g < G; ++g)
+    alpha(g) = ssx(g) == 0 || !(gamma(g) > 0) ? kArdAlphaMax
+                                              : std::min(gamma(g) / (2 * ssx(g)), kArdAlphaMax);
+  const double beta = sse == 0 ? 1.0 : (n - gamma.sum()) / (2 * sse);
+  if (!alpha.allFinite() || !std::isfinite(beta) || !(beta > 0))
+    return "gamma = " + Num(gamma.sum()) + ", beta = " + Num(beta) +
+           " (kept the last finite alpha_g, beta)";
+  *h = {alpha, beta, gamma.sum()};
+  return "";
+}
+
+// The Laplace approximation of the ARD stage at its final weights: ln det H and (2 H)^-1 from a
+// Cholesky factor of H = beta J'J + diag(alpha_g(i)) (accurate also with alpha_g at
+// kArdAlphaMax); through eigenvalues clamped at min alpha only if the factor fails.
+double ArdLaplace(const Eigen::MatrixXd& h, Eigen::MatrixXd* covariance) {
+  const Eigen::Index N = h.rows();
+  const Eigen::LLT<Eigen::MatrixXd> llt(h);
+  if (llt.info() == Eigen::Success) {
+    *covariance = 0.5 * llt.solve(Eigen::MatrixXd::Identity(N, N));
+    *covariance = 0.5 * (*covariance + covariance->transpose()).eval();
+    return 2 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
+  const Eigen::VectorXd h_eig = eig.eigenvalues().cwiseMax(h.diagonal().minCoeff());
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+  *covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
+  *covariance = 0.5 * (*covariance + covariance->transpose()).eval();
+  return h_eig.array().log().sum();
+}
+
+// The second stage of TrainOptions::ard, from trainbr's result `first` (nn/trainbr.h): one
+// grouped re-estimation at trainbr's weights, then LM epochs in the weights form, each accepted
+// step followed by a re-estimation. `steps` counts the accepted steps.
+TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOptions& options,
+                      const EpochCallback& callback, int* steps) {
   Network& net = first.network;
   TrainSummary& sum = first.summary;
   const Eigen::VectorXi group = ArdGroups(net);
   const int G = net.InputCount() + 1;
   const Eigen::VectorXd group_size = GroupSums(group, G, Eigen::VectorXd::Ones(group.size()));
   const double n = static_cast<double>(data.targets.size());
-  Eigen::VectorXd alpha = Eigen::VectorXd::Constant(G, sum.alpha);
-  double beta = sum.beta;
-  auto per_weight = [&] { return Eigen::VectorXd(alpha(group)); };
-  Eigen::VectorXd a = per_weight();
+  ArdHyper hyper{Eigen::VectorXd::Constant(G, sum.alpha), sum.beta, sum.gamma};
   Eigen::VectorXd w = net.GetParameters();
   Network trial = net;
   ForwardCache cache, trial_cache;
   net.Forward(data.inputs, &cache);
   Eigen::MatrixXd e = data.targets - cache.output(), J;
   double sse = SumSquares(e);
-  double F = beta * sse + a.dot(w.cwiseAbs2());
+  ErrorJacobian(net, cache, &J);
+  std::string degenerate = ReestimateArd(J.transpose() * J, sse, w, group, group_size, n, &hyper);
+  Eigen::VectorXd a = hyper.alpha(group);
+  double F = hyper.beta * sse + a.dot(w.cwiseAbs2());
   double mu = options.mu, gradient = 0;
   std::vector<double> after_step;
-  std::string degenerate;
+  const std::string first_message = sum.message;
   const int first_epochs = sum.epochs;
+  *steps = 0;
   for (int epoch = 0;; ++epoch) {
-    ErrorJacobian(net, cache, &J);
+    if (epoch > 0) ErrorJacobian(net, cache, &J);
     const Eigen::Map<const Eigen::VectorXd> e_flat(e.data(), e.size());
     const Eigen::MatrixXd jj = J.transpose() * J;
     const Eigen::VectorXd je = J.transpose() * e_flat;
     gradient = 2 * je.norm();
     sum.epochs = first_epochs + epoch;
     if (StopReached(options, epoch, sse, gradient, mu, after_step, degenerate, &sum)) break;
-    const Eigen::VectorXd rhs = beta * je + a.cwiseProduct(w);
+    EpochInfo info;
+    info.epoch = epoch + 1;
+    info.ard_stage = true;
+    info.max_epochs = options.epochs;
+    info.gradient = gradient;
+    info.objective_before = F;
+    const Eigen::VectorXd rhs = hyper.beta * je + a.cwiseProduct(w);
     bool accepted = false;
     for (; mu <= options.mu_max; mu *= options.mu_inc) {
-      Eigen::MatrixXd shifted = ArdHessian(jj, beta, a);
+      Eigen::MatrixXd shifted = ArdHessian(jj, hyper.beta, a);
       shifted.diagonal().array() += mu;
       const Eigen::LLT<Eigen::MatrixXd> llt(shifted);
       if (llt.info() != Eigen::Success) continue;
@@ -373,7 +434,7 @@ TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOp
       trial.SetParameters(w2);
       trial.Forward(data.inputs, &trial_cache);
       const Eigen::MatrixXd e2 = data.targets - trial_cache.output();
-      const double sse2 = SumSquares(e2), F2 = beta * sse2 + a.dot(w2.cwiseAbs2());
+      const double sse2 = SumSquares(e2), F2 = hyper.beta * sse2 + a.dot(w2.cwiseAbs2());
       if (F2 < F) {
         w = w2;
         std::swap(net, trial);
@@ -383,59 +444,48 @@ TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOp
         F = F2;
         mu = std::max(mu * options.mu_dec, kMuFloor);
         accepted = true;
+        ++*steps;
         break;
       }
     }
+    info.step_accepted = accepted;
+    info.objective_after_step = F;
     if (options.change > 0) after_step.push_back(F);
-    if (!accepted) continue;  // mu > mu_max: StopReached ends the fit next epoch
-    const Eigen::LLT<Eigen::MatrixXd> h(ArdHessian(jj, beta, a));
-    Eigen::VectorXd gamma = Eigen::VectorXd::Constant(G, std::numeric_limits<double>::quiet_NaN());
-    if (h.info() == Eigen::Success) {
-      const Eigen::MatrixXd h_inv = h.solve(Eigen::MatrixXd::Identity(a.size(), a.size()));
-      gamma = group_size - alpha.cwiseProduct(GroupSums(group, G, h_inv.diagonal()));
+    if (accepted) {
+      degenerate = ReestimateArd(jj, sse, w, group, group_size, n, &hyper);
+      a = hyper.alpha(group);
+      F = hyper.beta * sse + a.dot(w.cwiseAbs2());
     }
-    const Eigen::VectorXd ssx = GroupSums(group, G, w.cwiseAbs2());
-    Eigen::VectorXd alpha_new(G);
-    for (int g = 0; g < G; ++g)
-      alpha_new(g) = ssx(g) == 0 ? kArdAlphaMax : std::min(gamma(g) / (2 * ssx(g)), kArdAlphaMax);
-    const double beta_new = sse == 0 ? 1.0 : (n - gamma.sum()) / (2 * sse);
-    if (alpha_new.allFinite() && (alpha_new.array() > 0).all() && std::isfinite(beta_new) &&
-        beta_new > 0) {
-      alpha = alpha_new;
-      beta = beta_new;
-      a = per_weight();
-      sum.gamma = gamma.sum();
-    } else {
-      degenerate = "ARD stage: gamma = " + Num(gamma.sum()) + ", beta = " + Num(beta_new) +
-                   " (kept the last finite alpha_g, beta)";
-    }
-    F = beta * sse + a.dot(w.cwiseAbs2());
+    info.objective = F;
+    info.sse = sse;
+    info.ssx = w.squaredNorm();
+    info.gamma = hyper.gamma;
+    info.alpha = hyper.alpha(G - 1);
+    info.beta = hyper.beta;
+    info.mu = mu;
+    info.network = &net;
+    if (callback) callback(info);
   }
-  sum.message = "ARD stage: " + sum.message;
+  sum.message = first_message + "; ARD stage: " + sum.message;
   sum.final_cost = F;
   sum.sse = sse;
   sum.sum_squared_weights = w.squaredNorm();
-  sum.alpha = alpha(G - 1);
-  sum.ard_alpha = alpha;
-  sum.beta = beta;
+  sum.gamma = hyper.gamma;
+  sum.alpha = hyper.alpha(G - 1);
+  sum.ard_alpha = hyper.alpha;
+  sum.beta = hyper.beta;
   sum.mu = mu;
   sum.gradient = gradient;
   sum.rms_error_normalized =
       (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
   sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
-  // Laplace approximation at the final weights, through the eigenvalues of H (as TrainBr).
   ErrorJacobian(net, cache, &J);
-  const Eigen::MatrixXd jj = J.transpose() * J;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ArdHessian(jj, beta, a));
-  const Eigen::VectorXd h_eig = eig.eigenvalues().cwiseMax(a.minCoeff());
-  sum.log_evidence = LogEvidenceGroups(sse, GroupSums(group, G, w.cwiseAbs2()), alpha, group_size,
-                                       beta, h_eig.array().log().sum(),
-                                       static_cast<int>(n), net.layer_sizes);
-  sum.noise_variance = 1.0 / (2.0 * beta);
-  const Eigen::MatrixXd& V = eig.eigenvectors();
-  first.posterior_covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
-  first.posterior_covariance =
-      0.5 * (first.posterior_covariance + first.posterior_covariance.transpose()).eval();
+  const double log_det_h =
+      ArdLaplace(ArdHessian(J.transpose() * J, hyper.beta, a), &first.posterior_covariance);
+  sum.log_evidence =
+      LogEvidenceGroups(sse, GroupSums(group, G, w.cwiseAbs2()), hyper.alpha, group_size,
+                        hyper.beta, log_det_h, static_cast<int>(n), net.layer_sizes);
+  sum.noise_variance = 1.0 / (2.0 * hyper.beta);
   return first;
 }
 
@@ -507,6 +557,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
 
     EpochInfo info;
     info.epoch = epoch + 1;
+    info.ard_stage = true;
     info.max_epochs = options.epochs;
     info.objective_before = F;
     info.gradient = gradient;
@@ -632,10 +683,13 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
   }
   if (options.ard && bayes) {
     // MacKay's model comparison: the ARD stage is kept only when the data support it.
-    TrainResult ard = RefineArd(data, result, options);
-    if (ard.summary.log_evidence > sum.log_evidence) return ard;
-    sum.message += "; ARD stage not kept (log evidence " + Num(ard.summary.log_evidence) +
-                   " <= " + Num(sum.log_evidence) + ")";
+    int steps = 0;
+    TrainResult ard = RefineArd(data, result, options, callback, &steps);
+    const double margin = kArdEvidenceMargin * std::max(1.0, std::abs(sum.log_evidence));
+    if (steps > 0 && ard.summary.log_evidence > sum.log_evidence + margin) return ard;
+    sum.message += "; ARD stage not kept (" + std::to_string(steps) +
+                   " accepted steps, log evidence " + Num(ard.summary.log_evidence) + " against " +
+                   Num(sum.log_evidence) + ")";
   }
   return result;
 }

@@ -101,16 +101,21 @@ struct TrainOptions {
   /// with one weight-decay coefficient per group: the first-layer weights from input i (one
   /// group per input) and all other weights and biases (one group), so
   ///   F = beta ssE + sum_g alpha_g ssX_g,  H = beta J'J + diag(alpha_g(i)),
-  /// LM steps dw = -(H + mu I)^-1 (beta J'e + alpha_g(i) w_i) (the weights form), and after
-  /// each accepted step gamma_g = N_g - alpha_g trace_g(H^-1), alpha_g = gamma_g / (2 ssX_g)
-  /// (capped at kArdAlphaMax: an input the data do not support is switched off),
-  /// beta = (n - sum gamma_g) / (2 ssE); the same stopping rules (epochs, change, ...) with the
-  /// epoch count starting again. Why two stages: switched on from the start, the input groups
-  /// are judged before the network has learned anything, and an input with a symmetric effect
-  /// (x3 of Friedman #1) was switched off at 100 rows (a prototype, not kept). The ARD result is kept only when its log
-  /// evidence (LogEvidenceGroups) is higher than trainbr's (MacKay's model comparison; then
-  /// TrainSummary::ard_alpha holds the alpha_g); otherwise trainbr's result stands, ard_alpha
-  /// stays empty and the message says why. Bayesian only.
+  /// LM steps dw = -(H + mu I)^-1 (beta J'e + alpha_g(i) w_i) (the weights form). The groups are
+  /// re-estimated once at trainbr's weights and after each accepted step:
+  /// gamma_g = N_g - alpha_g trace_g(H^-1), alpha_g = gamma_g / (2 ssX_g) (capped at
+  /// kArdAlphaMax, as is a group with gamma_g <= 0: an input the data do not support is switched
+  /// off), beta = (n - sum gamma_g) / (2 ssE); the same stopping rules (epochs, change, ...) with
+  /// the epoch count starting again (EpochInfo::ard_stage). Why two stages: the input groups
+  /// are judged only after the network has learned something. The ARD result is kept only when
+  /// at least one ARD step was accepted and its log evidence (LogEvidenceGroups, at the most
+  /// probable alpha_g and beta) exceeds trainbr's by more than kArdEvidenceMargin (relative);
+  /// then TrainSummary::ard_alpha holds the alpha_g, otherwise trainbr's result stands,
+  /// ard_alpha stays empty and the message says why. The comparison leaves out the Occam
+  /// factors of the extra hyperparameters (MacKay 1992 section 4: about ln(sigma_ln_alpha /
+  /// range) per alpha_g), which would charge ARD for its G - 1 extra alphas: it guards against
+  /// an ARD optimum worse than trainbr's, not against over-fitted hyperparameters; whether ARD
+  /// helps is measured in scripts/bench_peers.sh (README "Against its peers"). Bayesian only.
   bool ard = false;
 
   /// Throws InputError naming the option, its value and the rule.
@@ -125,6 +130,7 @@ double ObjectiveSpread(const std::vector<double>& after_step);
 /// What the per-epoch callback sees after each epoch's LM loop.
 struct EpochInfo {
   int epoch = 0;                    ///< 1-based number of the epoch just finished
+  bool ard_stage = false;           ///< TrainOptions::ard's second stage (epochs count from 1 again)
   int max_epochs = 0;               ///< options.epochs
   bool step_accepted = false;       ///< false when mu passed mu_max without a decrease
   double objective_before = 0;      ///< F(w) at the start of the epoch
@@ -183,8 +189,9 @@ void from_json(const nlohmann::json& j, TrainSummary& s);
 struct TrainResult {
   Network network;  ///< final weights
   TrainSummary summary;
-  /// A^-1 = (2 (beta J'J + alpha I))^-1 at the final weights, final alpha, beta: the Laplace
-  /// (Gauss-Newton) posterior covariance of w, N x N, flat order. Empty without regularization.
+  /// A^-1 = (2 (beta J'J + alpha I))^-1 at the final weights, final alpha, beta (with
+  /// TrainOptions::ard kept: diag(alpha_g(i)) in place of alpha I): the Laplace (Gauss-Newton)
+  /// posterior covariance of w, N x N, flat order. Empty without regularization.
   Eigen::MatrixXd posterior_covariance;
   std::uint64_t init_seed = 0;  ///< seed of InitNguyenWidrow (0 if the caller initialized)
 };
@@ -215,6 +222,10 @@ double LogEvidenceGroups(double sse, const Eigen::VectorXd& group_ssx,
 /// Largest alpha_g of TrainOptions::ard (normalized units; the group's weights are then
 /// effectively zero).
 inline constexpr double kArdAlphaMax = 1e12;
+
+/// The ARD stage is kept when its log evidence exceeds trainbr's by more than this times
+/// max(1, |trainbr's log evidence|): a stage that barely moved is not "kept" by rounding.
+inline constexpr double kArdEvidenceMargin = 1e-6;
 
 /// One training run of a restart series.
 struct RestartRecord {

@@ -94,6 +94,9 @@ struct CrosscheckOptions {
   double training_objective_tolerance = 1e-6;   ///< relative (issue 6: 1e-6)
   double training_prediction_tolerance = 1e-5;  ///< normalized target units (stated in the report)
   /// alpha, beta of F; <= 0 means: the model's final trainbr values (TrainSummary alpha, beta).
+  /// A model trained with --ard (TrainSummary::ard_alpha) is checked with one alpha, the group
+  /// of all weights but the first layer's (its TrainSummary alpha): the cross-check covers the
+  /// network, its Jacobian and trainbr's objective, not ARD's per-input groups.
   double alpha = 0;
   double beta = 0;
   /// Start of both trainings: w0 = w_model .* (1 + p u), u ~ uniform(-1, 1) from nn::Rng(seed),

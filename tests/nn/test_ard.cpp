@@ -3,11 +3,11 @@
 // posterior covariance of the ARD stage against an independent recomputation; the grouped
 // evidence reduces to LogEvidence; files round-trip the setting.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <filesystem>
-#include <unistd.h>
 
 #include "core/error.h"
 #include "core/json_file.h"
@@ -67,11 +67,11 @@ TEST(Ard, InputsTheDataDoNotUseGetTheLargestAlphaAndTheFitGeneralizesBetter) {
     ASSERT_EQ(a.size(), 6) << "5 inputs + all other weights";
     EXPECT_GT(std::min(a(3), a(4)), a.head(3).maxCoeff())
         << "seed " << seed << ": alpha " << a.transpose();
-    EXPECT_EQ(ard.summary.alpha, a(5));
     EXPECT_EQ(plain.summary.ard_alpha.size(), 0);
-    // The same first stage, and the ARD stage is kept only with a higher evidence.
+    // The same first stage, then ARD epochs; kept only with a higher evidence.
     EXPECT_GT(ard.summary.log_evidence, plain.summary.log_evidence);
-    EXPECT_GT(ard.summary.epochs, 0);
+    EXPECT_GT(ard.summary.epochs, plain.summary.epochs);
+    EXPECT_NE(ard.summary.message.find("; ARD stage: "), std::string::npos) << ard.summary.message;
     rms_ard += TestRms(ard.network, test);
     rms_one += TestRms(plain.network, test);
   }
@@ -120,6 +120,64 @@ TEST(Ard, LogEvidenceAndCovarianceFollowTheGroupedLaplaceForm) {
                                    Eigen::MatrixXd::Identity(50, 50), 0, 1e-6));
 }
 
+// At the end of a converged ARD stage the hyperparameters are at MacKay's fixed point, recomputed
+// here from H at the final weights: 2 alpha_g ssX_g = gamma_g = N_g - alpha_g trace_g(H^-1) for
+// every group below the cap, and 2 beta ssE = n - sum gamma_g.
+TEST(Ard, EndsAtTheFixedPointOfTheGroupedReestimation) {
+  for (std::uint64_t seed : {11, 12, 13}) {
+    const TrainingData d = ThreeOfFiveInputs(40, 0.05, seed);
+    TrainOptions o = ArdOptions();
+    o.change = 1e-10;
+    const TrainResult r = TrainBr(d, Initial(seed), o);
+    const TrainSummary& s = r.summary;
+    ASSERT_EQ(s.ard_alpha.size(), 6) << s.message;
+    ForwardCache cache;
+    r.network.Forward(d.inputs, &cache);
+    Eigen::MatrixXd J;
+    ErrorJacobian(r.network, cache, &J);
+    const Eigen::VectorXd w = r.network.GetParameters();
+    Eigen::VectorXi group = Eigen::VectorXi::Constant(w.size(), 5);
+    for (int h = 0; h < 6; ++h)
+      for (int i = 0; i < 5; ++i) group(r.network.WeightIndex(0, h, i)) = i;
+    Eigen::MatrixXd H = s.beta * J.transpose() * J;
+    for (int p = 0; p < w.size(); ++p) H(p, p) += s.ard_alpha(group(p));
+    const Eigen::VectorXd h_inv_diag =
+        H.llt().solve(Eigen::MatrixXd::Identity(w.size(), w.size())).diagonal();
+    double gamma_sum = 0;
+    for (int g = 0; g < 6; ++g) {
+      double size = 0, trace = 0, ssx = 0;
+      for (int p = 0; p < w.size(); ++p)
+        if (group(p) == g) {
+          size += 1;
+          trace += h_inv_diag(p);
+          ssx += w(p) * w(p);
+        }
+      const double gamma = size - s.ard_alpha(g) * trace;
+      gamma_sum += gamma;
+      if (s.ard_alpha(g) < kArdAlphaMax) {
+        EXPECT_NEAR(2 * s.ard_alpha(g) * ssx, gamma, 1e-3 * size)
+            << "seed " << seed << " group " << g << ": " << s.message;
+      }
+    }
+    const double sse = (d.targets - r.network.Forward(d.inputs)).squaredNorm();
+    EXPECT_NEAR(2 * s.beta * sse, 80 - gamma_sum, 1e-3 * 80) << "seed " << seed;
+    EXPECT_NEAR(s.gamma, gamma_sum, 1e-3 * 50);
+  }
+}
+
+// A first stage that ends on the goal leaves the ARD stage nothing to do: it takes no step and is
+// not kept, whatever rounding does to the evidence.
+TEST(Ard, AStageWithoutAStepIsNotKept) {
+  const TrainingData d = ThreeOfFiveInputs(30, 0.05, 5);
+  TrainOptions o = ArdOptions();
+  o.goal = 1e9;
+  const TrainResult r = TrainBr(d, Initial(5), o);
+  EXPECT_EQ(r.summary.termination, TrainTermination::kGoalMet);
+  EXPECT_EQ(r.summary.ard_alpha.size(), 0);
+  EXPECT_NE(r.summary.message.find("ARD stage not kept (0 accepted steps"), std::string::npos)
+      << r.summary.message;
+}
+
 TEST(Ard, GroupedEvidenceWithEqualAlphasIsLogEvidence) {
   Rng rng(3);
   for (int trial = 0; trial < 200; ++trial) {
@@ -164,6 +222,40 @@ TEST(Ard, ModelFileKeepsTheSettingAndTheGroupAlphas) {
   WriteJsonFile(path, j);
   EXPECT_THROW(LoadModel(path), InputError);
   std::filesystem::remove(path);
+}
+
+TEST(Ard, ModelValidationChecksTheGroupAlphas) {
+  ModelTrainOptions o = DefaultTrainingOptions();
+  o.threads = 1;
+  o.noise_folds = 0;
+  Model m = TrainModel(synth::SyntheticProcessTable(20, 0.05, 4), o, "synthetic.csv");
+  EXPECT_NO_THROW(m.Validate());
+  m.training_summary.ard_alpha = Eigen::VectorXd::Constant(6, 0.5);
+  EXPECT_THROW(m.Validate(), InputError) << "alphas without options.ard";
+  m.train_options.ard = true;
+  EXPECT_NO_THROW(m.Validate());
+  for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
+    m.training_summary.ard_alpha(2) = bad;
+    EXPECT_THROW(m.Validate(), InputError) << bad;
+  }
+  m.training_summary.ard_alpha = Eigen::VectorXd::Constant(5, 0.5);
+  EXPECT_THROW(m.Validate(), InputError) << "one alpha per input and one for the rest";
+}
+
+// --stop-by-cv with --ard: the folds choose trainbr's epochs without the ARD stage, so the
+// held-out curve is the one without ARD.
+TEST(Ard, CrossValidatedStoppingIgnoresTheArdStage) {
+  const ProcessTable table = synth::SyntheticProcessTable(20, 0.05, 6);
+  ModelTrainOptions o = DefaultTrainingOptions();
+  o.threads = 1;
+  o.train.epochs = 40;
+  std::vector<double> plain, ard;
+  const int e_plain = ChooseEpochsByCrossValidation(table, o, 4, &plain);
+  o.train.ard = true;
+  const int e_ard = ChooseEpochsByCrossValidation(table, o, 4, &ard);
+  EXPECT_EQ(e_ard, e_plain);
+  EXPECT_EQ(ard, plain);
+  EXPECT_EQ(ard.size(), 40u);
 }
 
 }  // namespace
