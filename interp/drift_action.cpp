@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/safe_text.h"
 
 namespace whirl::interp {
 namespace {
@@ -11,11 +12,13 @@ namespace {
 constexpr std::size_t kMaxNcLine = 512;
 
 // Text from files the user supplies (a model's column names, a path) in a comment line or a CSV
-// cell: control characters (a newline would start a new NC block) and ',' become spaces.
+// cell: control characters (a newline would start a new NC block) and ',' become spaces, and a
+// leading = + - @ gets an apostrophe (core SpreadsheetCell: no formula when the PLC table is
+// opened in a spreadsheet).
 std::string Text(std::string t) {
   for (char& ch : t)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f || ch == ',') ch = ' ';
-  return t;
+  return SpreadsheetCell(t);
 }
 
 std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }

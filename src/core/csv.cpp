@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/safe_text.h"
 
 namespace whirl {
 namespace {
@@ -87,6 +88,10 @@ CsvTable ParseCsv(const std::string& text, const std::string& source, bool allow
       for (std::size_t c = 0; c < cells.size(); ++c) {
         if (cells[c].empty())
           throw InputError(where + ": column " + std::to_string(c + 1) + " has an empty name");
+        if (LooksLikeFormula(cells[c]))
+          throw InputError(where + ": column " + std::to_string(c + 1) + " '" + cells[c] +
+                           "': a column name must not start with =, +, - or @ (a spreadsheet "
+                           "opening a file whirl writes would evaluate it as a formula)");
         if (!seen.insert(cells[c]).second)
           throw InputError(where + ": duplicated column '" + cells[c] + "'");
       }
@@ -143,7 +148,8 @@ std::string FormatCsv(const std::vector<std::string>& header,
     for (const char ch : c) out += (ch == '\n' || ch == '\r') ? ' ' : ch;
     out += "\n";
   }
-  for (std::size_t i = 0; i < header.size(); ++i) out += (i ? "," : "") + header[i];
+  for (std::size_t i = 0; i < header.size(); ++i)
+    out += (i ? "," : "") + SpreadsheetCell(header[i]);
   out += "\n";
   for (const auto& r : rows) {
     for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "," : "") + FormatNumber(r[i]);

@@ -113,4 +113,14 @@ std::string TerminalText(std::string_view text) {
   return out;
 }
 
+bool LooksLikeFormula(std::string_view text) {
+  if (text.empty()) return false;
+  const char c = text.front();
+  return c == '=' || c == '+' || c == '-' || c == '@' || c == '\t' || c == '\r';
+}
+
+std::string SpreadsheetCell(std::string_view text) {
+  return LooksLikeFormula(text) ? "'" + std::string(text) : std::string(text);
+}
+
 }  // namespace whirl

@@ -32,4 +32,14 @@ std::string Slug(std::string_view text, std::size_t max_length = 64);
 /// window, rewrite what is on screen or, on some terminals, reach the clipboard.
 std::string TerminalText(std::string_view text);
 
+/// True when a spreadsheet would evaluate a CSV cell holding `text` as a formula: it starts with
+/// '=', '+', '-', '@', a tab or a carriage return (OWASP "CSV injection").
+bool LooksLikeFormula(std::string_view text);
+
+/// A CSV cell from user text that a spreadsheet shows as text: a cell that LooksLikeFormula gets a
+/// leading apostrophe (spreadsheets show the rest as typed); anything else is unchanged. Use it for
+/// user text in cells of written CSV files (names in PLC tables, headers from model files); CSV
+/// that whirl reads back refuses such names instead (core/csv.h).
+std::string SpreadsheetCell(std::string_view text);
+
 }  // namespace whirl

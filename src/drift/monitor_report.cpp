@@ -78,8 +78,8 @@ std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::stri
         << FormatNumber(e.time) << "," << (measured ? FormatNumber(e.measured_um) : "") << ","
         << FormatNumber(e.predicted_um) << ","
         << (e.kind == MonitorEvent::Kind::kCheck ? FormatNumber(e.threshold_um) : "") << ","
-        << (e.kind == MonitorEvent::Kind::kCheck ? (e.valid ? "1" : "0") : "") << "," << msg
-        << "\n";
+        << (e.kind == MonitorEvent::Kind::kCheck ? (e.valid ? "1" : "0") : "") << ","
+        << SpreadsheetCell(msg) << "\n";
     }
   return o.str();
 }

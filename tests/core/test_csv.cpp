@@ -50,6 +50,19 @@ TEST(Csv, FormatNumberRoundTripsRandomDoubles) {
   }
 }
 
+// A header a spreadsheet would evaluate (OWASP CSV injection) is refused with file, line, column
+// and the rule; FormatCsv writes such a name (e.g. from a hand-edited model file) as text.
+TEST(Csv, FormulaLikeColumnNamesAreRefusedOnReadAndInertOnWrite) {
+  for (const std::string bad : {"=1+1_C", "+x", "-2", "@SUM(A1)", "=HYPERLINK(\"h\")_um"}) {
+    const std::string e = ErrorOf("a," + bad + "\n1,2\n");
+    EXPECT_NE(e.find("t.csv:1: column 2 '" + bad + "'"), std::string::npos) << e;
+    EXPECT_NE(e.find("must not start with =, +, - or @"), std::string::npos) << e;
+  }
+  EXPECT_EQ(ErrorOf("a,x=1,b-2,c@d\n1,2,3,4\n"), "") << "only the first character counts";
+  const std::string text = FormatCsv({"x", "=cmd|' /C calc'!A0"}, {{1, 2}});
+  EXPECT_NE(text.find("x,'=cmd|' /C calc'!A0\n"), std::string::npos) << text;
+}
+
 TEST(Csv, FormatThenParseIsIdentity) {
   std::vector<std::vector<double>> rows = {{1.0 / 3, 2e-300}, {-7, 1e10}};
   const CsvTable t = ParseCsv(FormatCsv({"x", "y"}, rows, {"c"}), "m");

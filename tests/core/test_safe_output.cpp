@@ -111,6 +111,25 @@ TEST(SafeText, TerminalTextIsAlwaysInertAndKeepsInertText) {
   }
 }
 
+// Property over random byte strings: a spreadsheet cell never starts like a formula, text that
+// does not is unchanged, and one that does keeps its text after the apostrophe.
+TEST(SafeText, SpreadsheetCellNeverStartsAFormula) {
+  std::mt19937_64 rng(20261126);
+  const std::string alphabet = "=+-@\t\r'a1 ,\"";
+  std::uniform_int_distribution<std::size_t> pick(0, alphabet.size() - 1), length(0, 6);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::string text(length(rng), '\0');
+    for (char& c : text) c = alphabet[pick(rng)];
+    const std::string cell = SpreadsheetCell(text);
+    ASSERT_FALSE(LooksLikeFormula(cell)) << "trial " << trial;
+    if (!text.empty() && std::string("=+-@\t\r").find(text[0]) != std::string::npos) {
+      ASSERT_EQ(cell, "'" + text) << "trial " << trial;
+    } else {
+      ASSERT_EQ(cell, text) << "trial " << trial;
+    }
+  }
+}
+
 // Gnuplot itself parses the quoted string back to the original text (control characters aside):
 // the reference is gnuplot's own reader, not our encoder.
 TEST(SafeText, GnuplotReadsTheStringBack) {
