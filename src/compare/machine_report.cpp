@@ -53,9 +53,12 @@ std::string LeadScript(const std::string& title) {
       "set xlabel 'position along the thread [mm]'\n"
       "set ylabel 'travel deviation [um]'\nset title " +
       GnuplotString(title) + "\nplot ";
+  // The variants of 'both' are dashed, so 'both' stays visible where they coincide with it.
+  const auto both = static_cast<std::size_t>(MachineStrategy::kBoth);
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
     gp += (k ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(k + 2) +
-          " with lines lw 2 title " + GnuplotString(ToString(static_cast<MachineStrategy>(k)));
+          " with lines lw 2" + (k > both ? " dt " + std::to_string(k - both + 1) : "") +
+          " title " + GnuplotString(ToString(static_cast<MachineStrategy>(k)));
   return gp + "\n";
 }
 
