@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "core/csv.h"
-#include "core/numbers.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/parallel.h"
 #include "nn/dense_kernels.h"
 
