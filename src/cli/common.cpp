@@ -102,8 +102,9 @@ void Progress::Update(std::size_t done, const std::string& detail) {
                  total_, TerminalText(detail).c_str());
     std::fflush(RawStderr());
   } else {
+    // Only forward: parallel restarts report interleaved counts, which would flip the decile.
     const int decile = static_cast<int>(frac * 10);
-    if (decile != last_decile_) {
+    if (decile > last_decile_) {
       last_decile_ = decile;
       std::fprintf(stderr, "%s: %zu/%zu %s\n", label_.c_str(), done, total_, detail.c_str());
     }

@@ -11,6 +11,7 @@
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/parallel.h"
 #include "nn/dense_kernels.h"
 
@@ -24,7 +25,8 @@ using detail::TraceOfInverse;
 
 constexpr double kMuFloor = 1e-20;  // trainbr: mu = max(mu * mu_dec, 1e-20)
 
-std::string Num(double x) { return FormatNumber(x); }
+// Numbers in messages (stop reasons, errors): 6 significant digits; the summary keeps exact values.
+std::string Num(double x) { return MessageNumber(x); }
 
 double SumSquares(const Eigen::MatrixXd& e) { return e.squaredNorm(); }
 
@@ -557,7 +559,6 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
 
     EpochInfo info;
     info.epoch = epoch + 1;
-    info.ard_stage = true;
     info.max_epochs = options.epochs;
     info.objective_before = F;
     info.gradient = gradient;

@@ -178,6 +178,37 @@ TEST(Ard, AStageWithoutAStepIsNotKept) {
       << r.summary.message;
 }
 
+// The epoch callback: first-stage epochs 1, 2, ... with ard_stage false, then the ARD stage's
+// epochs counting from 1 again with ard_stage true; without --ard never true.
+TEST(Ard, CallbackMarksTheStagesAndCountsEachFromOne) {
+  const TrainingData d = ThreeOfFiveInputs(30, 0.05, 9);
+  for (bool ard : {false, true}) {
+    TrainOptions o = ArdOptions();
+    o.ard = ard;
+    std::vector<std::pair<bool, int>> seen;
+    const TrainResult r = TrainBr(d, Initial(9), o, [&](const EpochInfo& info) {
+      seen.emplace_back(info.ard_stage, info.epoch);
+    });
+    ASSERT_FALSE(seen.empty());
+    int first = 0, second = 0;
+    for (const auto& [stage, epoch] : seen) {
+      if (!stage) {
+        EXPECT_EQ(second, 0) << "no first-stage epoch after the ARD stage began";
+        EXPECT_EQ(epoch, ++first);
+      } else {
+        EXPECT_EQ(epoch, ++second);
+      }
+    }
+    EXPECT_GT(first, 0);
+    if (ard) {
+      EXPECT_GT(second, 0);
+      EXPECT_EQ(first + second, r.summary.epochs) << r.summary.message;
+    } else {
+      EXPECT_EQ(second, 0);
+    }
+  }
+}
+
 TEST(Ard, GroupedEvidenceWithEqualAlphasIsLogEvidence) {
   Rng rng(3);
   for (int trial = 0; trial < 200; ++trial) {
