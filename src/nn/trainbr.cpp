@@ -133,16 +133,16 @@ double ObjectiveSpread(const std::vector<double>& after_step) {
 }
 
 std::string TrainSummary::BriefReport() const {
-  // Four significant digits for a person to read; the model file keeps the exact values.
+  // Four significant digits for a person to read; the model file keeps the exact values. No F:
+  // trainbr starts and ends near F = n / 2 by its alpha/beta rule, so F tells nothing here.
   auto brief = [](double x) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.4g", x);
     return std::string(buf);
   };
   std::ostringstream s;
-  s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": F "
-    << brief(initial_cost) << " -> " << brief(final_cost) << ", ssE " << brief(initial_sse)
-    << " -> " << brief(sse) << " in " << epochs << " epochs, gamma " << brief(gamma) << " of "
+  s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": ssE "
+    << brief(initial_sse) << " -> " << brief(sse) << " in " << epochs << " epochs, gamma " << brief(gamma) << " of "
     << parameter_count << ", " << ToString(termination) << " (" << message << ")";
   return s.str();
 }

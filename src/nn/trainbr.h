@@ -180,7 +180,8 @@ struct TrainSummary {
   /// evidence did not keep the ARD stage.
   Eigen::VectorXd ard_alpha;
 
-  /// "trainbr: F 12.3 -> 0.45, ssE 3.1 -> 0.02 in 212 epochs, gamma 17.2 of 50, max_mu (...)".
+  /// "trainbr: ssE 3.1 -> 0.02 in 212 epochs, gamma 17.2 of 50, max_mu (...)" (normalized ssE;
+  /// F is left out: trainbr's alpha/beta rule keeps it near n / 2 at the start and the end).
   std::string BriefReport() const;
 };
 void to_json(nlohmann::json& j, const TrainSummary& s);
