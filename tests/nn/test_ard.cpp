@@ -49,6 +49,29 @@ TrainOptions ArdOptions() {
   return o;
 }
 
+// A finished ARD fit recomputed from its weights: group(p) = i for the first-layer weights from
+// input i, 5 for all other weights; H = beta J'J + diag(alpha_group(p)).
+struct Recomputed {
+  Eigen::VectorXd w;
+  Eigen::VectorXi group;
+  Eigen::MatrixXd H;
+};
+
+Recomputed Recompute(const TrainResult& r, const TrainingData& d) {
+  Recomputed x;
+  ForwardCache cache;
+  r.network.Forward(d.inputs, &cache);
+  Eigen::MatrixXd J;
+  ErrorJacobian(r.network, cache, &J);
+  x.w = r.network.GetParameters();
+  x.group = Eigen::VectorXi::Constant(x.w.size(), 5);
+  for (int h = 0; h < r.network.layer_sizes[1]; ++h)
+    for (int i = 0; i < 5; ++i) x.group(r.network.WeightIndex(0, h, i)) = i;
+  x.H = r.summary.beta * J.transpose() * J;
+  for (int p = 0; p < x.w.size(); ++p) x.H(p, p) += r.summary.ard_alpha(x.group(p));
+  return x;
+}
+
 double TestRms(const Network& net, const TrainingData& test) {
   return std::sqrt((test.targets - net.Forward(test.inputs)).squaredNorm() /
                    static_cast<double>(test.targets.size()));
@@ -86,26 +109,17 @@ TEST(Ard, LogEvidenceAndCovarianceFollowTheGroupedLaplaceForm) {
   const TrainResult r = TrainBr(d, Initial(7), ArdOptions());
   const TrainSummary& s = r.summary;
   ASSERT_EQ(s.ard_alpha.size(), 6) << s.message;
-  ForwardCache cache;
-  r.network.Forward(d.inputs, &cache);
-  Eigen::MatrixXd J;
-  ErrorJacobian(r.network, cache, &J);
-  const Eigen::VectorXd w = r.network.GetParameters();
-  Eigen::VectorXd a(w.size()), group_size = Eigen::VectorXd::Zero(6);
+  const Recomputed x = Recompute(r, d);
+  const Eigen::VectorXd& w = x.w;
+  const Eigen::MatrixXd& H = x.H;
+  Eigen::VectorXd group_size = Eigen::VectorXd::Zero(6);
   double prior = 0;
   for (int p = 0; p < w.size(); ++p) {
-    int g = 5;
-    for (int h = 0; h < 6; ++h)
-      for (int i = 0; i < 5; ++i)
-        if (r.network.WeightIndex(0, h, i) == p) g = i;
-    a(p) = s.ard_alpha(g);
-    group_size(g) += 1;
-    prior += a(p) * w(p) * w(p);
+    group_size(x.group(p)) += 1;
+    prior += s.ard_alpha(x.group(p)) * w(p) * w(p);
   }
   EXPECT_EQ(group_size(0), 6);
   EXPECT_EQ(group_size(5), 50 - 30);
-  Eigen::MatrixXd H = s.beta * J.transpose() * J;
-  H.diagonal() += a;
   const Eigen::LLT<Eigen::MatrixXd> llt(H);
   ASSERT_EQ(llt.info(), Eigen::Success);
   const double log_det = 2 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
@@ -131,18 +145,11 @@ TEST(Ard, EndsAtTheFixedPointOfTheGroupedReestimation) {
     const TrainResult r = TrainBr(d, Initial(seed), o);
     const TrainSummary& s = r.summary;
     ASSERT_EQ(s.ard_alpha.size(), 6) << s.message;
-    ForwardCache cache;
-    r.network.Forward(d.inputs, &cache);
-    Eigen::MatrixXd J;
-    ErrorJacobian(r.network, cache, &J);
-    const Eigen::VectorXd w = r.network.GetParameters();
-    Eigen::VectorXi group = Eigen::VectorXi::Constant(w.size(), 5);
-    for (int h = 0; h < 6; ++h)
-      for (int i = 0; i < 5; ++i) group(r.network.WeightIndex(0, h, i)) = i;
-    Eigen::MatrixXd H = s.beta * J.transpose() * J;
-    for (int p = 0; p < w.size(); ++p) H(p, p) += s.ard_alpha(group(p));
+    const Recomputed x = Recompute(r, d);
+    const Eigen::VectorXd& w = x.w;
+    const Eigen::VectorXi& group = x.group;
     const Eigen::VectorXd h_inv_diag =
-        H.llt().solve(Eigen::MatrixXd::Identity(w.size(), w.size())).diagonal();
+        x.H.llt().solve(Eigen::MatrixXd::Identity(w.size(), w.size())).diagonal();
     double gamma_sum = 0;
     for (int g = 0; g < 6; ++g) {
       double size = 0, trace = 0, ssx = 0;
