@@ -483,7 +483,7 @@ TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOp
   sum.rms_error_normalized =
       (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
   sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
-  ErrorJacobian(net, cache, &J);
+  // J is at the final weights: the loop ends right after computing it.
   const double log_det_h = ArdLaplace(ArdHessian(J.transpose() * J, hyper.beta, a),
                                       hyper.alpha.minCoeff(), &first.posterior_covariance);
   sum.log_evidence =
