@@ -142,8 +142,9 @@ std::string TrainSummary::BriefReport() const {
   };
   std::ostringstream s;
   s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": ssE "
-    << brief(initial_sse) << " -> " << brief(sse) << " in " << epochs << " epochs, gamma " << brief(gamma) << " of "
-    << parameter_count << ", " << ToString(termination) << " (" << message << ")";
+    << brief(initial_sse) << " -> " << brief(sse) << " in " << epochs << " epochs, gamma "
+    << brief(gamma) << " of " << parameter_count << ", " << ToString(termination) << " (" << message
+    << ")";
   return s.str();
 }
 
@@ -366,8 +367,9 @@ std::string ReestimateArd(const Eigen::MatrixXd& jj, double sse, const Eigen::Ve
 
 // The Laplace approximation of the ARD stage at its final weights: ln det H and (2 H)^-1 from a
 // Cholesky factor of H = beta J'J + diag(alpha_g(i)) (accurate also with alpha_g at
-// kArdAlphaMax); through eigenvalues clamped at min alpha only if the factor fails.
-double ArdLaplace(const Eigen::MatrixXd& h, Eigen::MatrixXd* covariance) {
+// kArdAlphaMax); through eigenvalues clamped at the smallest alpha_g (H >= diag(alpha_g(i)) bounds
+// them from below) only if the factor fails.
+double ArdLaplace(const Eigen::MatrixXd& h, double min_alpha, Eigen::MatrixXd* covariance) {
   const Eigen::Index N = h.rows();
   const Eigen::LLT<Eigen::MatrixXd> llt(h);
   if (llt.info() == Eigen::Success) {
@@ -376,7 +378,7 @@ double ArdLaplace(const Eigen::MatrixXd& h, Eigen::MatrixXd* covariance) {
     return 2 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum();
   }
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
-  const Eigen::VectorXd h_eig = eig.eigenvalues().cwiseMax(h.diagonal().minCoeff());
+  const Eigen::VectorXd h_eig = eig.eigenvalues().cwiseMax(min_alpha);
   const Eigen::MatrixXd& V = eig.eigenvectors();
   *covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
   *covariance = 0.5 * (*covariance + covariance->transpose()).eval();
@@ -481,9 +483,9 @@ TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOp
   sum.rms_error_normalized =
       (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
   sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
-  ErrorJacobian(net, cache, &J);
-  const double log_det_h =
-      ArdLaplace(ArdHessian(J.transpose() * J, hyper.beta, a), &first.posterior_covariance);
+  // J is at the final weights: the loop ends right after computing it.
+  const double log_det_h = ArdLaplace(ArdHessian(J.transpose() * J, hyper.beta, a),
+                                      hyper.alpha.minCoeff(), &first.posterior_covariance);
   sum.log_evidence =
       LogEvidenceGroups(sse, GroupSums(group, G, w.cwiseAbs2()), hyper.alpha, group_size,
                         hyper.beta, log_det_h, static_cast<int>(n), net.layer_sizes);
