@@ -92,7 +92,9 @@ Progress::Progress(std::string label, std::size_t total)
     : label_(std::move(label)), total_(total == 0 ? 1 : total), tty_(::isatty(2) != 0) {}
 
 void Progress::Update(std::size_t done, const std::string& detail) {
-  const double frac = std::min(1.0, static_cast<double>(done) / static_cast<double>(total_));
+  most_done_ = std::max(most_done_, std::min(done, total_));
+  done = most_done_;
+  const double frac = static_cast<double>(done) / static_cast<double>(total_);
   if (tty_) {
     const int width = 30;
     const int filled = static_cast<int>(frac * width + 0.5);
@@ -102,9 +104,8 @@ void Progress::Update(std::size_t done, const std::string& detail) {
                  total_, TerminalText(detail).c_str());
     std::fflush(RawStderr());
   } else {
-    // Only forward: parallel restarts report interleaved counts, which would flip the decile.
     const int decile = static_cast<int>(frac * 10);
-    if (decile > last_decile_) {
+    if (decile != last_decile_) {
       last_decile_ = decile;
       std::fprintf(stderr, "%s: %zu/%zu %s\n", label_.c_str(), done, total_, detail.c_str());
     }

@@ -64,6 +64,7 @@ class Progress {
   std::size_t total_;
   bool tty_;
   int last_decile_ = -1;
+  std::size_t most_done_ = 0;  ///< the bar never moves back (parallel workers report out of order)
   bool finished_ = false;
 };
 
