@@ -12,14 +12,15 @@ namespace {
 constexpr std::size_t kMaxNcLine = 512;
 
 // Text from files the user supplies (a model's column names, a path) in a comment line or a CSV
-// cell: control characters (a newline would start a new NC block) and ',' become spaces, and a
-// leading = + - @ gets an apostrophe (core SpreadsheetCell: no formula when the PLC table is
-// opened in a spreadsheet).
+// cell: control characters (a newline would start a new NC block) and ',' become spaces.
 std::string Text(std::string t) {
   for (char& ch : t)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f || ch == ',') ch = ' ';
-  return SpreadsheetCell(t);
+  return t;
 }
+
+// Text in a cell of its own in the PLC table: also no formula when opened in a spreadsheet.
+std::string Cell(const std::string& t) { return SpreadsheetCell(Text(t)); }
 
 std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
 std::string R(int n) { return "R" + std::to_string(n); }
@@ -455,7 +456,7 @@ std::string PlcRows(const std::string& output, const drift::DriftModel& m,
     const std::string af =
         feat.tau > 0 ? Num(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
                      : "";
-    out += output + "," + Text(feat.Name(m.time_unit)) + "," + Text(feat.input) + "," +
+    out += output + "," + Cell(feat.Name(m.time_unit)) + "," + Cell(feat.input) + "," +
            std::to_string(a.index) + "," + Num(a.scale, kDecimalsDriftCoefficient) + "," +
            Num(a.offset, 4) + "," + ref + "," + tau + "," + af + "," +
            Num(c(static_cast<Eigen::Index>(f) + 1), decimals) + "\n";

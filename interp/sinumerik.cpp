@@ -8,6 +8,7 @@
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/safe_text.h"
 #include "core/json_file.h"
 #include "core/limits.h"
 
@@ -390,7 +391,7 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
   ValidatePlan(plan);
   const PlanOptions& o = plan.options;
   std::string out;
-  for (const std::string& p : provenance) out += "#" + OneLine(p) + "\n";
+  for (const std::string& p : provenance) out += "#" + SpreadsheetLine(p) + "\n";
   out += "# SINUMERIK 840D temperature compensation, axis " + o.axis +
          ": when the axis (MCS) passes trigger_position_mm in the direction of travel (" +
          (o.direction > 0 ? "+" : "-") +
@@ -424,7 +425,7 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
 std::string FormatPointsCsv(const CompensationPlan& plan,
                             const std::vector<std::string>& comments) {
   std::string out;
-  for (const std::string& c : comments) out += "#" + OneLine(c) + "\n";
+  for (const std::string& c : comments) out += "#" + SpreadsheetLine(c) + "\n";
   out += "time_s,thread_position_mm,elongation_um,sd43900_mm,sd43910,sd43920_mm\n";
   auto travel = [&](double t) {
     return FormatFixed(t * plan.axial_feed_mm_s, kDecimalsPositionMm);

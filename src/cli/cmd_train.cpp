@@ -148,17 +148,21 @@ void Run(const TrainCliOptions& o) {
     throw InputError("train: --trainbr-matlab is MATLAB's trainbr as it is; it excludes --ard");
   opt.train.ard = o.ard;
   const auto start = std::chrono::steady_clock::now();
-  const std::size_t total =
-      static_cast<std::size_t>(o.restarts) * static_cast<std::size_t>(std::max(o.epochs, 1));
+  // At most epochs per stage and restart (ARD adds a second stage). Restarts run in parallel and
+  // report out of order (one at a time: TrainBrRestarts serializes the callback), so the bar
+  // shows the epochs finished over all restarts.
+  const std::size_t total = static_cast<std::size_t>(o.restarts) *
+                            static_cast<std::size_t>(std::max(o.epochs, 1)) * (o.ard ? 2 : 1);
   Progress progress("train", total);
+  std::size_t epochs_done = 0;
   const nn::Model model = nn::TrainModel(
       table, opt, std::filesystem::path(o.data_path).filename().string(),
       [&](int restart, const nn::EpochInfo& info) {
-        progress.Update(
-            static_cast<std::size_t>(restart) * std::max(o.epochs, 1) + info.epoch,
-            "restart " + std::to_string(restart + 1) + "/" + std::to_string(o.restarts) +
-                (info.ard_stage ? " ARD epoch " : " epoch ") + std::to_string(info.epoch) + " F " +
-                Fmt(info.objective) + " gamma " + Fmt(info.gamma));
+        progress.Update(++epochs_done, "restart " + std::to_string(restart + 1) + "/" +
+                                           std::to_string(o.restarts) +
+                                           (info.ard_stage ? " ARD epoch " : " epoch ") +
+                                           std::to_string(info.epoch) + " F " +
+                                           Fmt(info.objective) + " gamma " + Fmt(info.gamma));
       });
   progress.Finish();
   const double fit_ms =

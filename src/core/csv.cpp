@@ -88,10 +88,10 @@ CsvTable ParseCsv(const std::string& text, const std::string& source, bool allow
       for (std::size_t c = 0; c < cells.size(); ++c) {
         if (cells[c].empty())
           throw InputError(where + ": column " + std::to_string(c + 1) + " has an empty name");
-        if (LooksLikeFormula(cells[c]))
-          throw InputError(where + ": column " + std::to_string(c + 1) + " '" + cells[c] +
-                           "': a column name must not start with =, +, - or @ (a spreadsheet "
-                           "opening a file whirl writes would evaluate it as a formula)");
+        // The spreadsheet text marker whirl writes before a formula-like name
+        // (SpreadsheetCell) is not part of the name, as in a spreadsheet.
+        if (cells[c].size() > 1 && cells[c][0] == '\'' && LooksLikeFormula(cells[c].substr(1)))
+          cells[c].erase(0, 1);
         if (!seen.insert(cells[c]).second)
           throw InputError(where + ": duplicated column '" + cells[c] + "'");
       }
@@ -142,15 +142,12 @@ std::string FormatCsv(const std::vector<std::string>& header,
                       const std::vector<std::vector<double>>& rows,
                       const std::vector<std::string>& comments) {
   std::string out;
-  for (const auto& c : comments) {
-    out += "# ";
-    // A comment is one line: a newline in a user-supplied name must not start a data row.
-    for (const char ch : c) out += (ch == '\n' || ch == '\r') ? ' ' : ch;
-    out += "\n";
-  }
-  for (std::size_t i = 0; i < header.size(); ++i)
-    out += (i ? "," : "") + SpreadsheetCell(header[i]);
-  out += "\n";
+  // Comments and header carry user text (names, paths): one line each (a newline in a name must
+  // not start a data row) and inert in a spreadsheet (SpreadsheetLine).
+  for (const auto& c : comments) out += "# " + SpreadsheetLine(c) + "\n";
+  std::string names;
+  for (std::size_t i = 0; i < header.size(); ++i) names += (i ? "," : "") + header[i];
+  out += SpreadsheetLine(names) + "\n";
   for (const auto& r : rows) {
     for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "," : "") + FormatNumber(r[i]);
     out += "\n";

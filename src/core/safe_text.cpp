@@ -1,6 +1,10 @@
 #include "core/safe_text.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 namespace whirl {
 namespace {
@@ -20,9 +24,9 @@ std::size_t Utf8Length(std::string_view text, std::size_t i) {
   if (n == 0 || lead > 0xF4 || i + n > text.size()) return 0;
   for (std::size_t k = 1; k < n; ++k)
     if ((b(k) & 0xC0) != 0x80) return 0;
-  if (lead == 0xE0 && b(1) < 0xA0) return 0;  // overlong
+  if (lead == 0xE0 && b(1) < 0xA0) return 0;   // overlong
   if (lead == 0xED && b(1) >= 0xA0) return 0;  // surrogate
-  if (lead == 0xF0 && b(1) < 0x90) return 0;  // overlong
+  if (lead == 0xF0 && b(1) < 0x90) return 0;   // overlong
   if (lead == 0xF4 && b(1) >= 0x90) return 0;  // above U+10FFFF
   return n;
 }
@@ -121,6 +125,32 @@ bool LooksLikeFormula(std::string_view text) {
 
 std::string SpreadsheetCell(std::string_view text) {
   return LooksLikeFormula(text) ? "'" + std::string(text) : std::string(text);
+}
+
+std::string SpreadsheetLine(std::string_view line) {
+  std::string out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = std::min(line.find(',', start), line.size());
+    std::string cell(line.substr(start, end - start));
+    for (char& ch : cell)
+      if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
+    const std::size_t first = cell.find_first_not_of(' ');
+    if (first != std::string::npos) {
+      const std::string rest = cell.substr(first);
+      char* parsed_end = nullptr;
+      const double value = std::strtod(rest.c_str(), &parsed_end);
+      const bool number =
+          parsed_end != rest.c_str() &&
+          rest.find_first_not_of(' ', parsed_end - rest.c_str()) == std::string::npos &&
+          std::isfinite(value);
+      if (LooksLikeFormula(rest) && !number) cell.insert(first, "'");
+    }
+    out += cell;
+    if (end == line.size()) return out;
+    out += ',';
+    start = end + 1;
+  }
 }
 
 }  // namespace whirl

@@ -37,9 +37,15 @@ std::string TerminalText(std::string_view text);
 bool LooksLikeFormula(std::string_view text);
 
 /// A CSV cell from user text that a spreadsheet shows as text: a cell that LooksLikeFormula gets a
-/// leading apostrophe (spreadsheets show the rest as typed); anything else is unchanged. Use it for
-/// user text in cells of written CSV files (names in PLC tables, headers from model files); CSV
-/// that whirl reads back refuses such names instead (core/csv.h).
+/// leading apostrophe (spreadsheets show the rest as typed, without the apostrophe); anything else
+/// is unchanged. whirl's CSV reader drops that apostrophe again (core/csv.h), so a column such as
+/// "-Z_um" survives a write and a read.
 std::string SpreadsheetCell(std::string_view text);
+
+/// A whole CSV line holding user text (a '#' comment, a header), made inert for spreadsheets, which
+/// split it at every comma: control characters become spaces, and each comma-separated cell whose
+/// first non-blank character starts a formula gets an apostrophe before that character, unless the
+/// cell is a plain number ("-0.5" stays). Data rows of numbers need no such pass.
+std::string SpreadsheetLine(std::string_view line);
 
 }  // namespace whirl

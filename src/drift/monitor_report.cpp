@@ -64,7 +64,8 @@ std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::st
 
 std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
   std::ostringstream o;
-  for (const auto& c : WithComments(comments, "monitor events of " + r.run)) o << "# " << c << "\n";
+  for (const auto& c : WithComments(comments, "monitor events of " + r.run))
+    o << "# " << SpreadsheetLine(c) << "\n";
   o << "rule,kind,sample," << TimeName(r)
     << ",measured_um,predicted_um,threshold_um,valid,message\n";
   for (const auto& s : r.strategies)

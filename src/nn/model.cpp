@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 #include "core/parallel.h"
 #include "nn/selection.h"
 
@@ -174,10 +175,15 @@ void ValidateArdAlpha(const Model& m) {
   if (!m.train_options.ard)
     throw InputError(
         "model 'training_summary.ard_alpha' is present but 'training.options.ard' is not true");
-  if (a.size() != m.network.InputCount() + 1 || !a.allFinite() || !(a.array() > 0).all())
-    throw InputError(
-        "model 'training_summary.ard_alpha' needs " + std::to_string(m.network.InputCount() + 1) +
-        " finite values > 0 (one per input, then the rest), has " + std::to_string(a.size()));
+  if (a.size() != m.network.InputCount() + 1)
+    throw InputError("model 'training_summary.ard_alpha' has " + std::to_string(a.size()) +
+                     " values, needs " + std::to_string(m.network.InputCount() + 1) +
+                     " (one per input, then one for all other weights)");
+  for (Eigen::Index g = 0; g < a.size(); ++g)
+    if (!std::isfinite(a(g)) || !(a(g) > 0) || a(g) > kArdAlphaMax)
+      throw InputError("model 'training_summary.ard_alpha' value " + std::to_string(g + 1) +
+                       " = " + MessageNumber(a(g)) + ": must be finite, > 0 and <= " +
+                       MessageNumber(kArdAlphaMax));
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -127,6 +129,53 @@ TEST(SafeText, SpreadsheetCellNeverStartsAFormula) {
     } else {
       ASSERT_EQ(cell, text) << "trial " << trial;
     }
+  }
+}
+
+// Property over random lines: after SpreadsheetLine no comma-separated cell starts a formula
+// (first non-blank character) unless it is a plain number, there is no control character, and
+// removing the inserted apostrophes gives the input with controls as spaces.
+TEST(SafeText, SpreadsheetLineLeavesNoCellStartingAFormula) {
+  std::mt19937_64 rng(20261127);
+  const std::string alphabet = "=+-@\t\r\n ,'a1.";
+  std::uniform_int_distribution<std::size_t> pick(0, alphabet.size() - 1), length(0, 12);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::string line(length(rng), '\0');
+    for (char& c : line) c = alphabet[pick(rng)];
+    const std::string out = SpreadsheetLine(line);
+    std::string expected = line;
+    for (char& c : expected)
+      if (c == '\t' || c == '\r' || c == '\n') c = ' ';
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t end = std::min(out.find(',', start), out.size());
+      const std::string cell = out.substr(start, end - start);
+      ASSERT_EQ(cell.find_first_of("\t\r\n"), std::string::npos) << "trial " << trial;
+      const std::size_t first = cell.find_first_not_of(' ');
+      if (first != std::string::npos) {
+        const std::string rest = cell.substr(first);
+        char* parsed = nullptr;
+        std::strtod(rest.c_str(), &parsed);
+        const bool number = parsed != rest.c_str() &&
+                            rest.find_first_not_of(' ', parsed - rest.c_str()) == std::string::npos;
+        ASSERT_TRUE(number || !LooksLikeFormula(rest)) << "trial " << trial << ": " << out;
+      }
+      if (end == out.size()) break;
+      start = end + 1;
+    }
+    // Walking both: every extra character of the output is an apostrophe right before the
+    // formula character it protects.
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (j < expected.size() && out[i] == expected[j]) {
+        ++j;
+        continue;
+      }
+      ASSERT_EQ(out[i], '\'') << "trial " << trial << ": '" << line << "' -> '" << out << "'";
+      ASSERT_TRUE(i + 1 < out.size() && LooksLikeFormula(out.substr(i + 1, 1)))
+          << "trial " << trial;
+    }
+    ASSERT_EQ(j, expected.size()) << "trial " << trial << ": '" << line << "' -> '" << out << "'";
   }
 }
 

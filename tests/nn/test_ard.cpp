@@ -272,7 +272,7 @@ TEST(Ard, ModelValidationChecksTheGroupAlphas) {
   EXPECT_THROW(m.Validate(), InputError) << "alphas without options.ard";
   m.train_options.ard = true;
   EXPECT_NO_THROW(m.Validate());
-  for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
+  for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL, 2 * kArdAlphaMax}) {
     m.training_summary.ard_alpha(2) = bad;
     EXPECT_THROW(m.Validate(), InputError) << bad;
   }
