@@ -31,6 +31,16 @@ std::size_t Utf8Length(std::string_view text, std::size_t i) {
   return n;
 }
 
+// A finite number and nothing after it but blanks ("-0.5", "+3e2 ").
+bool IsPlainNumber(const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  return end != text.c_str() &&
+         text.find_first_not_of(' ', static_cast<std::size_t>(end - text.c_str())) ==
+             std::string::npos &&
+         std::isfinite(value);
+}
+
 }  // namespace
 
 std::string HtmlEscape(std::string_view text) {
@@ -136,16 +146,9 @@ std::string SpreadsheetLine(std::string_view line) {
     for (char& ch : cell)
       if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
     const std::size_t first = cell.find_first_not_of(' ');
-    if (first != std::string::npos) {
-      const std::string rest = cell.substr(first);
-      char* parsed_end = nullptr;
-      const double value = std::strtod(rest.c_str(), &parsed_end);
-      const bool number =
-          parsed_end != rest.c_str() &&
-          rest.find_first_not_of(' ', parsed_end - rest.c_str()) == std::string::npos &&
-          std::isfinite(value);
-      if (LooksLikeFormula(rest) && !number) cell.insert(first, "'");
-    }
+    if (first != std::string::npos && LooksLikeFormula(cell.substr(first)) &&
+        !IsPlainNumber(cell.substr(first)))
+      cell.insert(first, "'");
     out += cell;
     if (end == line.size()) return out;
     out += ',';
