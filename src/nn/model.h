@@ -148,7 +148,8 @@ struct ModelTrainOptions {
   /// How a size among hidden_candidates is chosen: false = k-fold cross-validation (above);
   /// true = the highest log evidence ln P(D | alpha, beta) of the fit on all rows (MacKay 1992,
   /// model comparison; nn/trainbr.h LogEvidence, which counts the 2^A H! / (H - A)! equivalent
-  /// networks of A active neurons), one fit per candidate (restarts each), then the noise calibration of the chosen model only.
+  /// networks of A active neurons), one fit per candidate (restarts each), then the noise
+  /// calibration of the chosen model only.
   bool hidden_by_evidence = false;
   Stopping stopping = Stopping::kTrainbrMatlab;  ///< see Stopping
   int stopping_folds = 5;  ///< K of the stopping cross-validation (min(K, rows); rows >= 4)
