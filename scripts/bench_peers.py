@@ -119,7 +119,7 @@ def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
     t, mean, sd = run_whirl_once(whirl, args, train, test, model, seed, 1)
     s = t["training_summary"]
     info = {"gamma": s["gamma"], "epochs": s["epochs"],
-            "hidden": t["layer_sizes"][1]}
+            "hidden": t["layer_sizes"][1], "flat": bool(t.get("warnings"))}
     if threads2:
         t2, mean2, sd2 = run_whirl_once(whirl, args, train, test, model, seed, 2)
         if not (np.array_equal(mean, mean2) and np.array_equal(sd, sd2)):
@@ -255,7 +255,7 @@ def report(results, prob, n, variants, peers):
     med = lambda key, m, k: float(np.median([r["methods"][m][key][k] for r in rs]))
     print(f"\n{prob}, {n} training rows, {len(rs)} seeds (median test RMSE, out1 / out2)")
     print(f"{'method':<14} {'rmse_out1':>9} {'rmse_out2':>9} {'wins1':>6} {'wins2':>6} "
-          f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8} {'time2_ms':>8}")
+          f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8} {'time2_ms':>8} {'flat':>5}")
     for m in [v[0] for v in variants] + peers:
         line = f"{m:<14} {med('rmse', m, 0):9.3f} {med('rmse', m, 1):9.3f}"
         cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
@@ -272,12 +272,14 @@ def report(results, prob, n, variants, peers):
             line += f" {'':>11} {'':>11} {'':>11}"
         line += f" {float(np.median([r['methods'][m]['time_ms'] for r in rs])):8.1f}"
         t2 = [r["methods"][m]["time2_ms"] for r in rs if "time2_ms" in r["methods"][m]]
-        if t2:
-            line += f" {float(np.median(t2)):8.1f}"
+        line += f" {float(np.median(t2)):8.1f}" if t2 else f" {'':>8}"
+        if m not in peers:
+            line += f" {sum(bool(r['methods'][m].get('flat')) for r in rs):>5}"
         print(line)
     print("wins = seeds on which the method beats the best peer of that seed; cov = mean % of test "
           "targets within +-1/2 sd (noisy), cov1sd_f = +-1 sd against the noise-free function; "
-          "time = median fit time (time2: whirl --threads 2)")
+          "time = median fit time (time2: whirl --threads 2); flat = seeds on which whirl train warned "
+          "that the network is nearly flat (nn::FlatOutputs: it ignores the inputs)")
     sys.stdout.flush()
 
 

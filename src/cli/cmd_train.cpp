@@ -169,6 +169,9 @@ void Run(const TrainCliOptions& o) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   nn::SaveModel(o.out_path, model);
   const auto& s = model.training_summary;
+  const std::vector<nn::FlatOutput> flat = nn::FlatOutputs(model, table);
+  const std::string flat_warning = flat.empty() ? "" : nn::DescribeFlatOutputs(model, flat);
+  if (!flat.empty()) Warn(flat_warning);
   if (o.json) {
     PrintJson({{"model", o.out_path},
                {"layer_sizes", model.network.layer_sizes},
@@ -179,6 +182,8 @@ void Run(const TrainCliOptions& o) {
                {"stopping", model.stopping},
                {"hidden_selection", model.hidden_selection},
                {"fit_time_ms", fit_ms},
+               {"warnings", flat.empty() ? nlohmann::json::array()
+                                         : nlohmann::json::array({flat_warning})},
                {"training_summary", s}});
     return;
   }

@@ -718,6 +718,44 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
   return m;
 }
 
+std::vector<FlatOutput> FlatOutputs(const Model& model, const ProcessTable& table) {
+  if (table.targets.size() != table.inputs.size() || table.inputs.empty())
+    throw InputError(table.source + ": the flatness check needs the training rows with targets");
+  const Eigen::MatrixXd x = model.input_scaling.Apply(InputMatrix(table.inputs));
+  const Eigen::MatrixXd y = model.target_scaling.Reverse(model.network.Forward(x));
+  const Eigen::MatrixXd t = TargetMatrix(table.targets);
+  auto sd = [](const Eigen::RowVectorXd& v) {
+    return std::sqrt((v.array() - v.mean()).square().mean());
+  };
+  std::vector<FlatOutput> flat;
+  for (int k = 0; k < static_cast<int>(t.rows()); ++k) {
+    const double target_sd = sd(t.row(k)), prediction_sd = sd(y.row(k));
+    if (!(target_sd > 0)) continue;
+    const double ratio = prediction_sd / target_sd;
+    if (ratio < kFlatSpreadRatio) flat.push_back({k, ratio, prediction_sd, target_sd});
+  }
+  return flat;
+}
+
+std::string DescribeFlatOutputs(const Model& model, const std::vector<FlatOutput>& flat) {
+  std::string names, ratios;
+  for (std::size_t i = 0; i < flat.size(); ++i) {
+    const std::string sep = i == 0 ? "" : (i + 1 == flat.size() ? " and " : ", ");
+    names += sep + model.outputs.at(static_cast<std::size_t>(flat[i].output)).name;
+    ratios += (i == 0 ? "" : ", ") + MessageNumber(flat[i].spread_ratio);
+  }
+  const auto& s = model.training_summary;
+  return "the network is nearly flat in " + names + ": over the " +
+         std::to_string(model.training_samples) +
+         " training rows its predictions vary by less than " +
+         MessageNumber(100 * kFlatSpreadRatio) + " % of the targets' spread (sd ratio " + ratios +
+         "; gamma " + MessageNumber(s.gamma) + " of " + std::to_string(s.parameter_count) +
+         "). The evidence preferred a fit that ignores the inputs, so it predicts about one "
+         "value for every process, with the cross-validated noise as its uncertainty. More "
+         "training rows usually help; other hidden sizes or restarts rarely do (README "
+         "'Against its peers')";
+}
+
 int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOptions& options,
                                   int folds, std::vector<double>* curve) {
   const int rows = static_cast<int>(table.inputs.size());

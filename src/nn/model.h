@@ -147,8 +147,9 @@ struct ModelTrainOptions {
   std::vector<int> hidden_candidates;
   /// How a size among hidden_candidates is chosen: false = k-fold cross-validation (above);
   /// true = the highest log evidence ln P(D | alpha, beta) of the fit on all rows (MacKay 1992,
-  /// model comparison; nn/trainbr.h LogEvidence, which counts the 2^H H! equivalent networks),
-  /// one fit per candidate (restarts each), then the noise calibration of the chosen model only.
+  /// model comparison; nn/trainbr.h LogEvidence, which counts the 2^A H! / (H - A)! equivalent
+  /// networks of A active neurons), one fit per candidate (restarts each), then the noise
+  /// calibration of the chosen model only.
   bool hidden_by_evidence = false;
   Stopping stopping = Stopping::kTrainbrMatlab;  ///< see Stopping
   int stopping_folds = 5;  ///< K of the stopping cross-validation (min(K, rows); rows >= 4)
@@ -192,6 +193,27 @@ using ModelProgress = std::function<void(int restart, const EpochInfo& info)>;
 /// fewer than 2 rows or inconsistent lengths.
 Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
                  const std::string& data_name, const ModelProgress& progress = {});
+
+/// An output the trained network hardly lets depend on the inputs. On small noisy tables trainbr's
+/// evidence can prefer the collapsed fixed point (alpha large, every weight near 0, gamma near 0):
+/// the network then predicts about one value for every process (scripts/bench_peers.sh: 3 of 20
+/// Friedman tables of 20 rows, at every hidden size; README "Against its peers").
+struct FlatOutput {
+  int output = 0;              ///< index into Features (kTargetColumns)
+  double spread_ratio = 0;     ///< sd of the network's mean predictions / sd of the targets
+  double prediction_sd = 0;    ///< sd of the mean predictions over the rows, original units
+  double target_sd = 0;        ///< sd of the targets over the rows, original units
+};
+/// An output is flat when its spread_ratio is below this. Measured on the benchmark's 20-row
+/// Friedman tables: collapsed fits have ratios below 1e-4, every other fit 0.3 or more.
+inline constexpr double kFlatSpreadRatio = 0.05;
+/// The flat outputs of `model` over the rows of `table` (its training table): population sd of
+/// the network's mean predictions against the sd of the targets, per output. Outputs whose targets
+/// are constant are skipped. InputError if the table has no targets.
+std::vector<FlatOutput> FlatOutputs(const Model& model, const ProcessTable& table);
+/// One sentence for the user about `flat` (non-empty), naming the outputs, their ratios and
+/// gamma; whirl train prints it as a warning.
+std::string DescribeFlatOutputs(const Model& model, const std::vector<FlatOutput>& flat);
 
 /// The epoch limit of Stopping::kCrossValidated (see there), from `folds` folds (row q held out in
 /// fold q % folds) of `table`; `curve`, if set, receives the summed held-out squared error after

@@ -260,12 +260,21 @@ void from_json(const nlohmann::json& j, RestartRecord& r) {
 }
 
 double LogEvidence(double sse, double ssx, double alpha, double beta, double log_det_h,
-                   int parameter_count, int error_count, const std::vector<int>& layer_sizes) {
+                   int parameter_count, int error_count, const std::vector<int>& layer_sizes,
+                   const std::vector<int>& active_units) {
   const double N = parameter_count;
   const double n = error_count;
+  if (!active_units.empty() && active_units.size() + 2 != layer_sizes.size())
+    throw InputError("log evidence: " + std::to_string(active_units.size()) +
+                     " active-unit counts for " + std::to_string(layer_sizes.size() - 2) +
+                     " hidden layers");
   double symmetry = 0;
-  for (std::size_t l = 1; l + 1 < layer_sizes.size(); ++l)
-    symmetry += std::lgamma(layer_sizes[l] + 1.0) + layer_sizes[l] * std::log(2.0);
+  for (std::size_t l = 1; l + 1 < layer_sizes.size(); ++l) {
+    const int S = layer_sizes[l];
+    const int active = active_units.empty() ? S : std::clamp(active_units[l - 1], 0, S);
+    // ln(2^active S! / (S - active)!): the distinct images of the weight vector
+    symmetry += active * std::log(2.0) + std::lgamma(S + 1.0) - std::lgamma(S - active + 1.0);
+  }
   const double F = beta * sse + alpha * ssx;
   return -F - 0.5 * log_det_h + 0.5 * N * std::log(alpha) + 0.5 * n * std::log(beta) -
          0.5 * n * std::log(M_PI) + symmetry;
@@ -274,11 +283,38 @@ double LogEvidence(double sse, double ssx, double alpha, double beta, double log
 double LogEvidenceGroups(double sse, const Eigen::VectorXd& group_ssx,
                          const Eigen::VectorXd& group_alpha, const Eigen::VectorXd& group_size,
                          double beta, double log_det_h, int error_count,
-                         const std::vector<int>& layer_sizes) {
+                         const std::vector<int>& layer_sizes,
+                         const std::vector<int>& active_units) {
   // LogEvidence with alpha = 1 and ssX = 0 leaves out the prior's terms; they are added per group.
-  const double rest = LogEvidence(sse, 0.0, 1.0, beta, log_det_h, 0, error_count, layer_sizes);
+  const double rest =
+      LogEvidence(sse, 0.0, 1.0, beta, log_det_h, 0, error_count, layer_sizes, active_units);
   return rest - group_alpha.dot(group_ssx) +
          0.5 * group_size.dot(group_alpha.array().log().matrix());
+}
+
+std::vector<int> ActiveHiddenUnits(const Network& net, const Eigen::MatrixXd& posterior_covariance,
+                                   const Eigen::VectorXd& alpha_per_parameter) {
+  const int N = net.ParameterCount();
+  if (posterior_covariance.rows() != N || posterior_covariance.cols() != N ||
+      alpha_per_parameter.size() != N)
+    throw InputError("active units: covariance " + std::to_string(posterior_covariance.rows()) +
+                     " x " + std::to_string(posterior_covariance.cols()) + " and " +
+                     std::to_string(alpha_per_parameter.size()) + " alphas for " +
+                     std::to_string(N) + " parameters");
+  // gamma_i = 1 - alpha_i (H^-1)_ii, H^-1 = 2 A^-1 (trainbr.h: A^-1 = (2 H)^-1)
+  auto gamma = [&](int i) { return 1.0 - 2.0 * alpha_per_parameter(i) * posterior_covariance(i, i); };
+  std::vector<int> active;
+  for (int l = 0; l + 1 < net.LayerCount(); ++l) {
+    int count = 0;
+    for (int r = 0; r < net.layer_sizes[l + 1]; ++r) {
+      double g = gamma(net.BiasIndex(l, r));
+      for (int c = 0; c < net.layer_sizes[l]; ++c) g += gamma(net.WeightIndex(l, r, c));
+      for (int k = 0; k < net.layer_sizes[l + 2]; ++k) g += gamma(net.WeightIndex(l + 1, k, r));
+      count += g >= kActiveUnitGamma ? 1 : 0;
+    }
+    active.push_back(count);
+  }
+  return active;
 }
 
 namespace {
@@ -486,9 +522,11 @@ TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOp
   // J is at the final weights: the loop ends right after computing it.
   const double log_det_h = ArdLaplace(ArdHessian(J.transpose() * J, hyper.beta, a),
                                       hyper.alpha.minCoeff(), &first.posterior_covariance);
-  sum.log_evidence =
-      LogEvidenceGroups(sse, GroupSums(group, G, w.cwiseAbs2()), hyper.alpha, group_size,
-                        hyper.beta, log_det_h, static_cast<int>(n), net.layer_sizes);
+  const Eigen::VectorXd final_alpha = hyper.alpha(group);
+  sum.log_evidence = LogEvidenceGroups(
+      sse, GroupSums(group, G, w.cwiseAbs2()), hyper.alpha, group_size, hyper.beta, log_det_h,
+      static_cast<int>(n), net.layer_sizes,
+      ActiveHiddenUnits(net, first.posterior_covariance, final_alpha));
   sum.noise_variance = 1.0 / (2.0 * hyper.beta);
   return first;
 }
@@ -672,14 +710,16 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     const Eigen::VectorXd h_eig =
         (beta * eig.eigenvalues().cwiseMax(0.0)).array() + alpha;  // eigenvalues of H
     const double log_det_h = h_eig.array().log().sum();
-    sum.log_evidence =
-        LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n), net.layer_sizes);
     sum.noise_variance = 1.0 / (2.0 * beta);
     const Eigen::MatrixXd& V = eig.eigenvectors();
     result.posterior_covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
     // Exact symmetry (the product leaves rounding-level asymmetry).
     result.posterior_covariance =
         0.5 * (result.posterior_covariance + result.posterior_covariance.transpose()).eval();
+    sum.log_evidence =
+        LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n), net.layer_sizes,
+                    ActiveHiddenUnits(net, result.posterior_covariance,
+                                      Eigen::VectorXd::Constant(N, alpha)));
   } else {
     sum.log_evidence = std::numeric_limits<double>::quiet_NaN();
     sum.noise_variance = std::numeric_limits<double>::quiet_NaN();

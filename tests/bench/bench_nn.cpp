@@ -103,7 +103,7 @@ void BM_DefaultTrainModel_20Rows(benchmark::State& state) {
   const whirl::ProcessTable table = whirl::ReadProcessTable(
       std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_train.csv", /*require_targets=*/true);
   ModelTrainOptions o = DefaultTrainingOptions();
-  o.threads = 1;
+  o.threads = static_cast<int>(state.range(1));
   if (state.range(0) == 1) o.noise_folds = 0;
   std::uint64_t i = 0;
   double hidden = 0;
@@ -116,7 +116,7 @@ void BM_DefaultTrainModel_20Rows(benchmark::State& state) {
   }
   state.counters["hidden"] = benchmark::Counter(hidden / static_cast<double>(i));
 }
-BENCHMARK(BM_DefaultTrainModel_20Rows)->ArgName("phase")->Arg(0)->Arg(1)->Unit(
+BENCHMARK(BM_DefaultTrainModel_20Rows)->ArgNames({"phase", "threads"})->ArgsProduct({{0, 1}, {1, 2}})->Unit(
     benchmark::kMillisecond);
 
 void BM_PredictBatch(benchmark::State& state) {

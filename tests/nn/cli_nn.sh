@@ -105,6 +105,40 @@ expect 0 "" -- "$whirl" predict --model m1.json --input far.csv --json
 [ "$(grep -c '"outside_domain": true' out.txt)" -eq 6 ] || fail "JSON lacks per-row flags"
 grep -q '"outside_domain_count": 6' out.txt || fail "JSON lacks outside_domain_count"
 
+# issue 12: targets that do not depend on the inputs (20 rows; inputs and targets uniform random,
+# drawn independently: awk 'BEGIN{srand(7); ...}'): the evidence prefers a flat network, and train
+# says so on stderr and in --json; a table with structure gives no warning
+{ echo "$H"; cat <<'ROWS'
+49.738,54.719,10.926,2.859,102.045,55.148,359.757
+40.639,44.063,5.553,4.107,117.875,57.644,348.930
+57.779,26.556,7.155,5.151,257.740,50.666,325.953
+41.068,33.637,10.098,2.064,152.274,53.637,345.565
+40.718,22.896,6.816,4.091,288.077,57.741,344.252
+59.012,31.559,12.335,5.930,278.106,57.888,330.559
+59.598,42.131,8.248,5.476,243.433,55.403,339.393
+50.117,44.279,5.891,4.237,289.579,55.989,334.516
+44.185,58.505,8.347,2.981,107.009,55.162,346.081
+59.509,31.616,10.056,5.704,215.871,52.390,354.515
+49.398,21.115,9.179,3.799,216.227,57.427,319.120
+45.966,31.322,14.752,5.217,278.001,50.643,321.805
+56.758,46.530,14.387,2.189,225.179,52.734,317.542
+53.219,51.585,5.604,4.545,116.001,55.659,333.745
+53.187,52.199,9.710,2.517,266.569,58.889,334.741
+48.280,45.265,13.977,4.849,282.933,58.729,330.987
+56.093,57.489,13.799,4.570,220.095,58.185,341.385
+44.527,23.676,14.821,5.549,276.305,50.425,331.421
+59.231,44.337,5.861,4.484,182.680,55.571,345.007
+44.925,37.839,8.291,4.641,115.521,52.268,322.351
+ROWS
+} > noise.csv
+expect 0 "the network is nearly flat in max_elongation_um and settle_time_s" -- \
+  "$whirl" train --data noise.csv --out noise.json --json
+grep -q '"warnings": \[$' out.txt || fail "train --json lacks the flat-network warning"
+grep -q "nearly flat" out.txt || fail "train --json warning lacks its text"
+expect 0 "" -- "$whirl" train --data "$data" --out m3.json --json
+grep -q '"warnings": \[\]' out.txt || fail "train --json warns on the shipped table"
+! grep -q "nearly flat" err.txt || fail "train warned about a table with structure"
+
 # bad training tables: exit 1, message names file, line and column
 printf "$H\n62,80,10,5,180,20,300\n62,80,x10,5,180,20,300\n" > cell.csv
 printf "$H\n62,80,10,5,180,20,300\n62,nan,10,5,180,20,300\n" > nan.csv

@@ -262,5 +262,90 @@ TEST(HiddenSweep, ReportsEveryHiddenSizeWithConsistentNumbers) {
   EXPECT_THROW(HiddenSweep(t, o), InputError);
 }
 
+
+// FlatOutputs (issue 12): the collapsed fit predicts one value; the check compares the spread of
+// the mean predictions with the spread of the targets over the training rows.
+TEST(FlatOutputs, ConstantNetworkIsFlatInBothOutputsWithHandComputedTargetSd) {
+  ProcessTable t = synth::SyntheticProcessTable(4, 0.0, 3);
+  const double e[4] = {100, 110, 130, 140}, s[4] = {200, 200, 260, 260};
+  for (int q = 0; q < 4; ++q) {
+    t.targets[q].max_elongation_um = e[q];
+    t.targets[q].settle_time_s = s[q];
+  }
+  Model m = SharedModel();
+  m.network = Network::Zeros(m.network.layer_sizes);  // output = mid-range for every input
+  const std::vector<FlatOutput> flat = FlatOutputs(m, t);
+  ASSERT_EQ(flat.size(), 2u);
+  EXPECT_EQ(flat[0].output, 0);
+  EXPECT_EQ(flat[1].output, 1);
+  // population sd: elongation mean 120, deviations -20 -10 10 20 -> sqrt(1000 / 4); settle 30
+  EXPECT_NEAR(flat[0].target_sd, std::sqrt(250.0), 1e-12);
+  EXPECT_NEAR(flat[1].target_sd, 30.0, 1e-12);
+  EXPECT_LT(flat[0].prediction_sd, 1e-12);
+  EXPECT_LT(flat[0].spread_ratio, 1e-12);
+  const std::string text = DescribeFlatOutputs(m, flat);
+  EXPECT_NE(text.find("max_elongation_um and settle_time_s"), std::string::npos) << text;
+  EXPECT_NE(text.find("gamma"), std::string::npos) << text;
+}
+
+TEST(FlatOutputs, FittedSmoothTableIsNotFlatAndZeroedOutputRowIsTheOnlyFlatOne) {
+  const ProcessTable t = synth::SyntheticProcessTable(20, 0.05, 1);
+  EXPECT_TRUE(FlatOutputs(SharedModel(), t).empty());
+  Model m = SharedModel();
+  const int L = m.network.LayerCount();
+  m.network.weights[L - 1].row(1).setZero();  // settle time = its output bias for every input
+  const std::vector<FlatOutput> flat = FlatOutputs(m, t);
+  ASSERT_EQ(flat.size(), 1u);
+  EXPECT_EQ(flat[0].output, 1);
+  EXPECT_LT(flat[0].spread_ratio, 1e-12);  // one value, up to the rounding of its mean
+  // output weights shrunk 1000-fold: the output layer is linear and mapminmax affine, so the
+  // elongation's spread ratio shrinks 1000-fold too (from above 0.3 to below kFlatSpreadRatio)
+  Model tiny = SharedModel();
+  tiny.network.weights[L - 1].row(0) *= 1e-3;
+  const std::vector<FlatOutput> shrunk = FlatOutputs(tiny, t);
+  ASSERT_EQ(shrunk.size(), 1u);
+  EXPECT_EQ(shrunk[0].output, 0);
+  EXPECT_GT(shrunk[0].spread_ratio, 0.0);
+  EXPECT_LT(shrunk[0].spread_ratio, 1e-3);
+}
+
+TEST(FlatOutputs, ConstantTargetsAreSkippedAndTargetlessTableIsRejected) {
+  ProcessTable t = synth::SyntheticProcessTable(6, 0.0, 4);
+  for (auto& f : t.targets) f.settle_time_s = 300;
+  Model m = SharedModel();
+  m.network = Network::Zeros(m.network.layer_sizes);
+  const std::vector<FlatOutput> flat = FlatOutputs(m, t);
+  ASSERT_EQ(flat.size(), 1u);
+  EXPECT_EQ(flat[0].output, 0);
+  t.targets.clear();
+  EXPECT_THROW(FlatOutputs(m, t), InputError);
+}
+
+// Targets that do not depend on the inputs (uniform draws): every hidden size collapses to the
+// same flat function, so the check flags it and, with the symmetry term counting only active
+// neurons (ActiveHiddenUnits), the log evidence no longer depends on the size. Before that
+// correction 8 neurons got ln(2^8 8!) - ln(2^4 4!) = 10.2 more than 4 for the same function.
+TEST(FlatOutputs, CollapsedFitsOfEverySizeAreFlaggedAndHaveTheSameEvidence) {
+  ProcessTable t = synth::SyntheticProcessTable(20, 0.0, 2);
+  Rng rng(102);
+  for (auto& f : t.targets) {
+    f.max_elongation_um = 50 + 10 * rng.Uniform01();
+    f.settle_time_s = 300 + 60 * rng.Uniform01();
+  }
+  std::vector<double> evidence;
+  for (int h : {4, 6, 8}) {
+    ModelTrainOptions o = DefaultTrainingOptions();
+    o.hidden_candidates.clear();
+    o.hidden_sizes = {h};
+    o.noise_folds = 0;
+    o.threads = 1;
+    const Model m = TrainModel(t, o, "noise");
+    ASSERT_EQ(FlatOutputs(m, t).size(), 2u) << h << " neurons, gamma " << m.training_summary.gamma;
+    evidence.push_back(m.training_summary.log_evidence);
+  }
+  EXPECT_NEAR(evidence[1], evidence[0], 1e-3);
+  EXPECT_NEAR(evidence[2], evidence[0], 1e-3);
+}
+
 }  // namespace
 }  // namespace whirl::nn

@@ -355,5 +355,45 @@ TEST(TrainBr, RejectsInconsistentDataAndBadOptions) {
   EXPECT_THROW(TrainBr(data, net, o), InputError);
 }
 
+
+// The symmetry term counts ln(2^A S! / (S - A)!) for A active neurons of S (hand-computed).
+TEST(TrainBr, LogEvidenceSymmetryTermCountsOnlyActiveNeurons) {
+  auto ev = [](const std::vector<int>& active) {
+    return LogEvidence(3.0, 2.0, 0.5, 4.0, 7.0, 66, 40, {5, 8, 2}, active);
+  };
+  EXPECT_DOUBLE_EQ(ev({}), ev({8}));
+  EXPECT_NEAR(ev({8}) - ev({0}), 8 * std::log(2.0) + std::log(40320.0), 1e-12);
+  EXPECT_NEAR(ev({3}) - ev({0}), 3 * std::log(2.0) + std::log(8.0 * 7 * 6), 1e-12);
+  // no hidden layer, no symmetry term: equal to 0 active neurons
+  EXPECT_NEAR(LogEvidence(3.0, 2.0, 0.5, 4.0, 7.0, 66, 40, {5, 2}), ev({0}), 1e-12);
+  EXPECT_THROW(ev({1, 2}), InputError);
+}
+
+// gamma_i = 1 - alpha (H^-1)_ii with H^-1 = 2 A^-1: the prior's covariance (2 alpha)^-1 I gives
+// gamma_i = 0 (nothing active); a covariance the data have shrunk gives gamma_i near 1.
+TEST(TrainBr, ActiveHiddenUnitsFollowTheWellDeterminedParameters) {
+  const Network net = Network::Zeros({5, 4, 2});
+  const int N = net.ParameterCount();  // 4 * 6 + 2 * 5 = 34
+  ASSERT_EQ(N, 34);
+  const double alpha = 0.7;
+  const Eigen::VectorXd a = Eigen::VectorXd::Constant(N, alpha);
+  Eigen::MatrixXd prior = Eigen::MatrixXd::Identity(N, N) / (2 * alpha);
+  EXPECT_EQ(ActiveHiddenUnits(net, prior, a), std::vector<int>{0});
+  EXPECT_EQ(ActiveHiddenUnits(net, 1e-9 * Eigen::MatrixXd::Identity(N, N), a),
+            std::vector<int>{4});
+  // neuron 2 determined through its two outgoing weights alone: gamma 2 >= 0.5
+  Eigen::MatrixXd one = prior;
+  for (int k = 0; k < 2; ++k) one(net.WeightIndex(1, k, 2), net.WeightIndex(1, k, 2)) = 1e-9;
+  EXPECT_EQ(ActiveHiddenUnits(net, one, a), std::vector<int>{1});
+  // neuron 0 with gamma 0.4 in its bias only: below kActiveUnitGamma
+  Eigen::MatrixXd below = prior;
+  below(net.BiasIndex(0, 0), net.BiasIndex(0, 0)) = (1 - 0.4) / (2 * alpha);
+  EXPECT_EQ(ActiveHiddenUnits(net, below, a), std::vector<int>{0});
+  below(net.WeightIndex(0, 0, 3), net.WeightIndex(0, 0, 3)) = (1 - 0.2) / (2 * alpha);
+  EXPECT_EQ(ActiveHiddenUnits(net, below, a), std::vector<int>{1});  // 0.4 + 0.2 >= 0.5
+  EXPECT_THROW(ActiveHiddenUnits(net, prior, Eigen::VectorXd::Constant(N - 1, alpha)),
+               InputError);
+}
+
 }  // namespace
 }  // namespace whirl::nn
