@@ -187,7 +187,7 @@ void RegisterDemo(CLI::App& app) {
       "the lead-error reductions (um and %).");
   sub->add_option("--out-dir", o->out_dir, "output directory (default whirl-demo-out)");
   sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists, with `whirl train`'s\n"
-                "default (hidden size 4/6/8 by log evidence, brnn's stopping rule,\n"
+                "default (linear or hidden size 4/6/8 by log evidence, brnn's stopping rule,\n"
                 "5-fold CV noise)");
   AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");

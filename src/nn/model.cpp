@@ -558,6 +558,11 @@ double NoiseForCoverage(const std::vector<double>& r2, const std::vector<double>
   return hi;
 }
 
+// The hidden layers of a candidate size: none for 0 (a linear network), else one tansig layer.
+std::vector<int> HiddenLayers(int size) {
+  return size == 0 ? std::vector<int>{} : std::vector<int>{size};
+}
+
 // ModelTrainOptions::hidden_by_evidence: one fit per candidate size (in parallel, each on one
 // thread; the choice happens after all fits, in candidate order: the same for any thread count).
 Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOptions& options,
@@ -567,7 +572,7 @@ Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOpti
   ParallelFor(fits.size(), options.threads, [&](std::size_t i) {
     ModelTrainOptions one = options;
     one.hidden_candidates.clear();
-    one.hidden_sizes = {options.hidden_candidates[i]};
+    one.hidden_sizes = HiddenLayers(options.hidden_candidates[i]);
     one.noise_folds = 0;  // calibrated below, for the chosen size only
     one.threads = 1;
     fits[i] = TrainModel(table, one, data_name);
@@ -583,11 +588,13 @@ Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOpti
     if (ev > fits[best].training_summary.log_evidence) best = i;
   }
   Model m = std::move(fits[best]);
-  m.hidden_selection = "hidden size " + std::to_string(options.hidden_candidates[best]) +
+  const int size = options.hidden_candidates[best];
+  m.hidden_selection = (size == 0 ? std::string("hidden size 0 (no hidden layer: linear)")
+                                  : "hidden size " + std::to_string(size)) +
                        " of the highest log evidence (" + tried + ")";
   ModelTrainOptions chosen = options;
   chosen.hidden_candidates.clear();
-  chosen.hidden_sizes = {options.hidden_candidates[best]};
+  chosen.hidden_sizes = HiddenLayers(size);
   if (options.noise_folds > 0 && rows >= 4)
     CalibrateOutputNoise(table, chosen, std::min(options.noise_folds, rows), &m);
   return m;
@@ -600,7 +607,7 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
   ModelTrainOptions fixed = options;
   fixed.hidden_candidates.clear();
   if (rows < 4) {
-    fixed.hidden_sizes = {options.hidden_candidates.front()};
+    fixed.hidden_sizes = HiddenLayers(options.hidden_candidates.front());
     return TrainModel(table, fixed, data_name, progress);
   }
   if (options.hidden_by_evidence) return TrainModelHiddenByEvidence(table, options, data_name);
@@ -636,7 +643,7 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
 
 ModelTrainOptions DefaultTrainingOptions() {
   ModelTrainOptions o;
-  o.hidden_candidates = {4, 6, 8};
+  o.hidden_candidates = {0, 4, 6, 8};
   o.hidden_by_evidence = true;
   o.train.change = kBrnnChange;
   return o;

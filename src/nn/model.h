@@ -142,8 +142,11 @@ struct ModelTrainOptions {
   /// cross-validation error (SweepRow::cv_rms_normalized of nn/selection.h, stopping_folds
   /// folds, one start per fit; ties: the earlier candidate); hidden_sizes is then ignored.
   /// `whirl train --hidden auto` uses {4, 6, 8, 10, 12}; its default (`--hidden evidence`,
-  /// hidden_by_evidence below) uses {4, 6, 8}. Why (issue 12, scripts/bench_peers.sh): at 100
-  /// rows six neurons shared by two outputs are too few.
+  /// hidden_by_evidence below) uses {0, 4, 6, 8}, where 0 is no hidden layer (a linear network,
+  /// evidence choice only). Why (issue 12, scripts/bench_peers.sh): at 100 rows six neurons
+  /// shared by two outputs are too few; at 20 rows the evidence sometimes prefers a collapsed
+  /// network that ignores its inputs (FlatOutputs) to every fitted one, and a linear fit then
+  /// has more evidence.
   std::vector<int> hidden_candidates;
   /// How a size among hidden_candidates is chosen: false = k-fold cross-validation (above);
   /// true = the highest log evidence ln P(D | alpha, beta) of the fit on all rows (MacKay 1992,
@@ -169,8 +172,8 @@ struct ModelTrainOptions {
 inline constexpr double kBrnnChange = 0.001;
 
 /// The default of `whirl train` (issue 12, measured with scripts/bench_peers.sh; the numbers are
-/// in the README section on the network): one tansig hidden layer of 4, 6 or 8 neurons, the size
-/// of the highest log evidence (hidden_by_evidence), each fit trainbr with R brnn's stopping rule
+/// in the README section on the network): no hidden layer (linear) or one tansig hidden layer of
+/// 4, 6 or 8 neurons, the choice of the highest log evidence (hidden_by_evidence), each fit trainbr with R brnn's stopping rule
 /// (TrainOptions::change = kBrnnChange), then 5-fold cross-validated noise per output.
 /// Why: trainbr run to MATLAB's own criteria takes 200-1000 epochs (40-60 ms) for the same
 /// test error as brnn's rule after 40-60 epochs; six neurons shared by two outputs are too few at

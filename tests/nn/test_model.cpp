@@ -347,5 +347,43 @@ TEST(FlatOutputs, CollapsedFitsOfEverySizeAreFlaggedAndHaveTheSameEvidence) {
   EXPECT_NEAR(evidence[2], evidence[0], 1e-3);
 }
 
+
+// Default training (issue 12) includes a linear network (no hidden layer) among the sizes by
+// evidence: on a table whose targets are linear in the inputs plus noise it has the highest
+// evidence, depends on the inputs, round-trips through the model file and predicts the truth.
+TEST(HiddenByEvidence, LinearTruthGivesTheLinearNetwork) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    ProcessTable t = synth::SyntheticProcessTable(20, 0.0, seed);
+    Rng rng(200 + seed);
+    auto truth = [](const ProcessInputs& in) {
+      return Features{2.0 * in.hardness_hrc + 0.5 * in.diameter_mm - 3.0 * in.pitch_mm + 100,
+                      0.8 * in.cutting_speed_m_min + 4.0 * in.raceway_radius_mm + 50};
+    };
+    for (std::size_t q = 0; q < t.inputs.size(); ++q) {
+      t.targets[q] = truth(t.inputs[q]);
+      t.targets[q].max_elongation_um += 0.5 * synth::Gaussian(&rng);
+      t.targets[q].settle_time_s += 1.0 * synth::Gaussian(&rng);
+    }
+    ModelTrainOptions o = DefaultTrainingOptions();
+    o.seed = seed;
+    o.threads = 1;
+    const Model m = TrainModel(t, o, "linear.csv");
+    ASSERT_EQ(m.network.layer_sizes, (std::vector<int>{5, 2})) << m.hidden_selection;
+    EXPECT_NE(m.hidden_selection.find("hidden size 0 (no hidden layer: linear)"),
+              std::string::npos) << m.hidden_selection;
+    EXPECT_TRUE(FlatOutputs(m, t).empty());
+    const fs::path file = Scratch("linear" + std::to_string(seed) + ".json");
+    SaveModel(file, m);
+    const Model back = LoadModel(file);
+    const ProcessTable probe = synth::SyntheticProcessTable(50, 0.0, 40 + seed);
+    const std::vector<Prediction> p = PredictBatch(back, probe.inputs);
+    for (std::size_t q = 0; q < p.size(); ++q) {
+      const Features f = truth(probe.inputs[q]);
+      EXPECT_NEAR(p[q].mean.max_elongation_um, f.max_elongation_um, 1.5) << q;
+      EXPECT_NEAR(p[q].mean.settle_time_s, f.settle_time_s, 3.0) << q;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace whirl::nn

@@ -135,7 +135,7 @@ TEST(HiddenByEvidence, ChoosesTheHighestEvidenceAndIsIdenticalForAnyThreadCount)
   for (int h : o.hidden_candidates) {
     ModelTrainOptions fixed = o;
     fixed.hidden_candidates.clear();
-    fixed.hidden_sizes = {h};
+    fixed.hidden_sizes = h == 0 ? std::vector<int>{} : std::vector<int>{h};  // 0: linear
     fits.push_back(TrainModel(table, fixed, "t.csv"));
     const TrainSummary& s = fits.back().training_summary;
     EXPECT_NE(s.termination, TrainTermination::kMaxEpochs) << s.BriefReport();
@@ -143,7 +143,9 @@ TEST(HiddenByEvidence, ChoosesTheHighestEvidenceAndIsIdenticalForAnyThreadCount)
   }
   EXPECT_EQ(fits[best].network.GetParameters(), one.network.GetParameters());
   EXPECT_EQ(fits[best].output_noise_variance, one.output_noise_variance);
-  EXPECT_EQ(one.network.layer_sizes, (std::vector<int>{5, o.hidden_candidates[best], 2}));
+  const int h = o.hidden_candidates[best];
+  const std::vector<int> sizes = h == 0 ? std::vector<int>{5, 2} : std::vector<int>{5, h, 2};
+  EXPECT_EQ(one.network.layer_sizes, sizes);
   EXPECT_NE(one.hidden_selection.find("highest log evidence"), std::string::npos)
       << one.hidden_selection;
   const nlohmann::json reference = one;

@@ -395,5 +395,38 @@ TEST(TrainBr, ActiveHiddenUnitsFollowTheWellDeterminedParameters) {
                InputError);
 }
 
+
+// For a network without a hidden layer (linear) the Laplace evidence is exact: at the most
+// probable weights for alpha, beta, LogEvidence must equal the closed-form marginal likelihood
+// of Bayesian linear regression, per output t_k ~ N(0, I / (2 beta) + Phi Phi' / (2 alpha)) with
+// Phi = [1, x'] (MATLAB convention: F = beta ssE + alpha ssX, so noise variance 1 / (2 beta) and
+// prior variance 1 / (2 alpha)).
+TEST(TrainBr, LogEvidenceOfALinearNetworkIsTheClosedFormMarginalLikelihood) {
+  const TrainingData d = synth::SmoothProblem(15, 0.1, 21);
+  const int Q = 15, S = 2;
+  const double alpha = 0.8, beta = 12.0;
+  Eigen::MatrixXd phi(Q, 6);
+  phi.col(0).setOnes();
+  phi.rightCols(5) = d.inputs.transpose();
+  const Eigen::MatrixXd h_k = beta * phi.transpose() * phi + alpha * Eigen::MatrixXd::Identity(6, 6);
+  double sse = 0, ssx = 0, log_det_h = 0, closed = 0;
+  const Eigen::MatrixXd C = Eigen::MatrixXd::Identity(Q, Q) / (2 * beta) +
+                            phi * phi.transpose() / (2 * alpha);
+  const Eigen::LLT<Eigen::MatrixXd> c_llt(C);
+  const Eigen::LLT<Eigen::MatrixXd> h_llt(h_k);
+  for (int k = 0; k < S; ++k) {
+    const Eigen::VectorXd t = d.targets.row(k).transpose();
+    const Eigen::VectorXd w = h_llt.solve(beta * phi.transpose() * t);  // most probable weights
+    sse += (t - phi * w).squaredNorm();
+    ssx += w.squaredNorm();
+    log_det_h += 2 * h_llt.matrixLLT().diagonal().array().log().sum();
+    const Eigen::VectorXd ci_t = c_llt.solve(t);
+    closed += -0.5 * t.dot(ci_t) - c_llt.matrixLLT().diagonal().array().log().sum() -
+              0.5 * Q * std::log(2 * M_PI);
+  }
+  const double laplace = LogEvidence(sse, ssx, alpha, beta, log_det_h, 12, S * Q, {5, 2});
+  EXPECT_NEAR(laplace, closed, 1e-9 * std::abs(closed));
+}
+
 }  // namespace
 }  // namespace whirl::nn
