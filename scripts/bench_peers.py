@@ -119,7 +119,7 @@ def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
     t, mean, sd = run_whirl_once(whirl, args, train, test, model, seed, 1)
     s = t["training_summary"]
     info = {"gamma": s["gamma"], "epochs": s["epochs"],
-            "hidden": t["layer_sizes"][1], "flat": bool(t.get("warnings"))}
+            "hidden": t["layer_sizes"][1] if len(t["layer_sizes"]) > 2 else 0, "flat": bool(t.get("warnings"))}
     if threads2:
         t2, mean2, sd2 = run_whirl_once(whirl, args, train, test, model, seed, 2)
         if not (np.array_equal(mean, mean2) and np.array_equal(sd, sd2)):

@@ -247,7 +247,7 @@ void RegisterTrain(CLI::App& app) {
   sub->add_option("--hidden", o->hidden,
                   "tansig neurons in the hidden layer (1-200); 'evidence': the size in\n"
                   "{0, 4, 6, 8} with the highest log evidence ln P(D|alpha,beta) (MacKay 1992;\n"
-                  "0 = no hidden layer, a linear network);\n"
+                  "0 = no hidden layer, a linear network, offered only here);\n"
                   "'auto': the size in {4, 6, 8, 10, 12} with the lowest 5-fold cross-\n"
                   "validation error (normalized RMS; 35 fits, slow). With --trainbr-matlab\n"
                   "'evidence' and 'auto' mean 6 (the paper's size)")

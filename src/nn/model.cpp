@@ -589,9 +589,8 @@ Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOpti
   }
   Model m = std::move(fits[best]);
   const int size = options.hidden_candidates[best];
-  m.hidden_selection = (size == 0 ? std::string("hidden size 0 (no hidden layer: linear)")
-                                  : "hidden size " + std::to_string(size)) +
-                       " of the highest log evidence (" + tried + ")";
+  m.hidden_selection = "hidden size " + std::to_string(size) + " of the highest log evidence (" +
+                       tried + ")" + (size == 0 ? "; 0 = no hidden layer (linear)" : "");
   ModelTrainOptions chosen = options;
   chosen.hidden_candidates.clear();
   chosen.hidden_sizes = HiddenLayers(size);
@@ -608,7 +607,11 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
   fixed.hidden_candidates.clear();
   if (rows < 4) {
     fixed.hidden_sizes = HiddenLayers(options.hidden_candidates.front());
-    return TrainModel(table, fixed, data_name, progress);
+    Model m = TrainModel(table, fixed, data_name, progress);
+    m.hidden_selection = "hidden size " + std::to_string(options.hidden_candidates.front()) +
+                         ", the first candidate: " + std::to_string(rows) +
+                         " rows are too few to choose";
+    return m;
   }
   if (options.hidden_by_evidence) return TrainModelHiddenByEvidence(table, options, data_name);
   SweepOptions sweep;
@@ -757,10 +760,12 @@ std::string DescribeFlatOutputs(const Model& model, const std::vector<FlatOutput
          " training rows its predictions vary by less than " +
          MessageNumber(100 * kFlatSpreadRatio) + " % of the targets' spread (sd ratio " + ratios +
          "; gamma " + MessageNumber(s.gamma) + " of " + std::to_string(s.parameter_count) +
-         "). The evidence preferred a fit that ignores the inputs, so it predicts about one "
-         "value for every process, with the cross-validated noise as its uncertainty. More "
-         "training rows usually help; other hidden sizes or restarts rarely do (README "
-         "'Against its peers')";
+         "). " +
+         (model.hidden_selection.find("highest log evidence") != std::string::npos
+              ? "The evidence preferred it to every size tried, so it predicts "
+              : "It predicts ") +
+         "about one value for every process, with the cross-validated noise as its "
+         "uncertainty. More training rows usually help (README 'Against its peers')";
 }
 
 int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOptions& options,

@@ -173,8 +173,9 @@ inline constexpr double kBrnnChange = 0.001;
 
 /// The default of `whirl train` (issue 12, measured with scripts/bench_peers.sh; the numbers are
 /// in the README section on the network): no hidden layer (linear) or one tansig hidden layer of
-/// 4, 6 or 8 neurons, the choice of the highest log evidence (hidden_by_evidence), each fit trainbr with R brnn's stopping rule
-/// (TrainOptions::change = kBrnnChange), then 5-fold cross-validated noise per output.
+/// 4, 6 or 8 neurons, the choice of the highest log evidence (hidden_by_evidence), each fit
+/// trainbr with R brnn's stopping rule (TrainOptions::change = kBrnnChange), then 5-fold
+/// cross-validated noise per output.
 /// Why: trainbr run to MATLAB's own criteria takes 200-1000 epochs (40-60 ms) for the same
 /// test error as brnn's rule after 40-60 epochs; six neurons shared by two outputs are too few at
 /// 100 rows (Friedman: 1.69 / 3.92 against 1.00 / 3.39 with 8), and the evidence picks 8 there.

@@ -271,7 +271,10 @@ double LogEvidence(double sse, double ssx, double alpha, double beta, double log
   double symmetry = 0;
   for (std::size_t l = 1; l + 1 < layer_sizes.size(); ++l) {
     const int S = layer_sizes[l];
-    const int active = active_units.empty() ? S : std::clamp(active_units[l - 1], 0, S);
+    const int active = active_units.empty() ? S : active_units[l - 1];
+    if (active < 0 || active > S)
+      throw InputError("log evidence: " + std::to_string(active) +
+                       " active neurons in a layer of " + std::to_string(S));
     // ln(2^active S! / (S - active)!): the distinct images of the weight vector
     symmetry += active * std::log(2.0) + std::lgamma(S + 1.0) - std::lgamma(S - active + 1.0);
   }
@@ -302,7 +305,9 @@ std::vector<int> ActiveHiddenUnits(const Network& net, const Eigen::MatrixXd& po
                      std::to_string(alpha_per_parameter.size()) + " alphas for " +
                      std::to_string(N) + " parameters");
   // gamma_i = 1 - alpha_i (H^-1)_ii, H^-1 = 2 A^-1 (trainbr.h: A^-1 = (2 H)^-1)
-  auto gamma = [&](int i) { return 1.0 - 2.0 * alpha_per_parameter(i) * posterior_covariance(i, i); };
+  auto gamma = [&](int i) {
+    return 1.0 - 2.0 * alpha_per_parameter(i) * posterior_covariance(i, i);
+  };
   std::vector<int> active;
   for (int l = 0; l + 1 < net.LayerCount(); ++l) {
     int count = 0;

@@ -369,7 +369,7 @@ TEST(HiddenByEvidence, LinearTruthGivesTheLinearNetwork) {
     o.threads = 1;
     const Model m = TrainModel(t, o, "linear.csv");
     ASSERT_EQ(m.network.layer_sizes, (std::vector<int>{5, 2})) << m.hidden_selection;
-    EXPECT_NE(m.hidden_selection.find("hidden size 0 (no hidden layer: linear)"),
+    EXPECT_NE(m.hidden_selection.find("hidden size 0 of the highest log evidence"),
               std::string::npos) << m.hidden_selection;
     EXPECT_TRUE(FlatOutputs(m, t).empty());
     const fs::path file = Scratch("linear" + std::to_string(seed) + ".json");

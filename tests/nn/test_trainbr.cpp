@@ -408,7 +408,8 @@ TEST(TrainBr, LogEvidenceOfALinearNetworkIsTheClosedFormMarginalLikelihood) {
   Eigen::MatrixXd phi(Q, 6);
   phi.col(0).setOnes();
   phi.rightCols(5) = d.inputs.transpose();
-  const Eigen::MatrixXd h_k = beta * phi.transpose() * phi + alpha * Eigen::MatrixXd::Identity(6, 6);
+  const Eigen::MatrixXd h_k =
+      beta * phi.transpose() * phi + alpha * Eigen::MatrixXd::Identity(6, 6);
   double sse = 0, ssx = 0, log_det_h = 0, closed = 0;
   const Eigen::MatrixXd C = Eigen::MatrixXd::Identity(Q, Q) / (2 * beta) +
                             phi * phi.transpose() / (2 * alpha);
@@ -426,6 +427,31 @@ TEST(TrainBr, LogEvidenceOfALinearNetworkIsTheClosedFormMarginalLikelihood) {
   }
   const double laplace = LogEvidence(sse, ssx, alpha, beta, log_det_h, 12, S * Q, {5, 2});
   EXPECT_NEAR(laplace, closed, 1e-9 * std::abs(closed));
+}
+
+// The same closed form against trainbr itself on a 5-2 network (the default's linear candidate):
+// run to MATLAB's criteria, its final weights are the most probable ones for (nearly) its final
+// alpha, beta, so its reported evidence is the exact marginal likelihood there.
+TEST(TrainBr, LinearNetworkTrainsToTheClosedFormEvidence) {
+  const TrainingData d = synth::SmoothProblem(15, 0.1, 22);
+  Network net = Network::Zeros({5, 2});
+  InitNguyenWidrow(3, &net);
+  const TrainResult r = TrainBr(d, net, TrainOptions{});
+  const double alpha = r.summary.alpha, beta = r.summary.beta;
+  const int Q = 15;
+  Eigen::MatrixXd phi(Q, 6);
+  phi.col(0).setOnes();
+  phi.rightCols(5) = d.inputs.transpose();
+  const Eigen::LLT<Eigen::MatrixXd> c_llt(Eigen::MatrixXd::Identity(Q, Q) / (2 * beta) +
+                                          phi * phi.transpose() / (2 * alpha));
+  double closed = 0;
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::VectorXd t = d.targets.row(k).transpose();
+    closed += -0.5 * t.dot(c_llt.solve(t)) - c_llt.matrixLLT().diagonal().array().log().sum() -
+              0.5 * Q * std::log(2 * M_PI);
+  }
+  EXPECT_GT(r.summary.gamma, 1.0) << r.summary.BriefReport();
+  EXPECT_NEAR(r.summary.log_evidence, closed, 1e-8) << r.summary.BriefReport();
 }
 
 }  // namespace
