@@ -61,8 +61,8 @@ std::pair<int, int> ParseSweep(const std::string& s) {
 int ParseHidden(const std::string& s) {
   int h = 0;
   char tail = 0;
-  if (std::sscanf(s.c_str(), "%d%c", &h, &tail) != 1 || h < 1 || h > 200)
-    throw InputError("--hidden '" + s + "': expected 'evidence', 'auto' or an integer in [1, 200]");
+  if (std::sscanf(s.c_str(), "%d%c", &h, &tail) != 1 || h < 0 || h > 200)
+    throw InputError("--hidden '" + s + "': expected 'evidence', 'auto' or an integer in [0, 200]");
   return h;
 }
 
@@ -133,7 +133,8 @@ void Run(const TrainCliOptions& o) {
     opt.hidden_by_evidence = false;
   } else if (o.hidden != "evidence" && o.hidden != "auto") {
     opt.hidden_candidates.clear();
-    opt.hidden_sizes = {ParseHidden(o.hidden)};
+    const int h = ParseHidden(o.hidden);
+    opt.hidden_sizes = h == 0 ? std::vector<int>{} : std::vector<int>{h};  // 0: linear
   }
   if (o.change >= 0) opt.train.change = o.change;
   opt.seed = o.seed;
@@ -245,9 +246,9 @@ void RegisterTrain(CLI::App& app) {
                               "model file to write (JSON, atomically); required unless "
                               "--hidden-sweep");
   sub->add_option("--hidden", o->hidden,
-                  "tansig neurons in the hidden layer (1-200); 'evidence': the size in\n"
-                  "{0, 4, 6, 8} with the highest log evidence ln P(D|alpha,beta) (MacKay 1992;\n"
-                  "0 = no hidden layer, a linear network, offered only here);\n"
+                  "tansig neurons in the hidden layer (0-200; 0 = no hidden layer, a linear\n"
+                  "network); 'evidence': the size in {0, 4, 6, 8} with the highest log\n"
+                  "evidence ln P(D|alpha,beta) (MacKay 1992);\n"
                   "'auto': the size in {4, 6, 8, 10, 12} with the lowest 5-fold cross-\n"
                   "validation error (normalized RMS; 35 fits, slow). With --trainbr-matlab\n"
                   "'evidence' and 'auto' mean 6 (the paper's size)")

@@ -573,6 +573,8 @@ Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOpti
     ModelTrainOptions one = options;
     one.hidden_candidates.clear();
     one.hidden_sizes = HiddenLayers(options.hidden_candidates[i]);
+    // linear: every start reaches the same fit (to the stopping rule), so one is enough
+    if (one.hidden_sizes.empty()) one.restarts = 1;
     one.noise_folds = 0;  // calibrated below, for the chosen size only
     one.threads = 1;
     fits[i] = TrainModel(table, one, data_name);
@@ -594,6 +596,7 @@ Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOpti
   ModelTrainOptions chosen = options;
   chosen.hidden_candidates.clear();
   chosen.hidden_sizes = HiddenLayers(size);
+  if (size == 0) chosen.restarts = 1;
   if (options.noise_folds > 0 && rows >= 4)
     CalibrateOutputNoise(table, chosen, std::min(options.noise_folds, rows), &m);
   return m;

@@ -149,6 +149,8 @@ awk 'BEGIN { print "'"$H"'"; for (i = 0; i < 20; i++) { h = 40 + (i * 7) % 20; d
 expect 0 "" -- "$whirl" train --data linear.csv --out linear.json
 grep -q "network 5-2 (no hidden layer, linear; N = 12" out.txt || fail "linear table: $(head -1 out.txt)"
 tr -d ' \n' < linear.json | grep -q '"layer_sizes":\[5,2\]' || fail "linear model file: not 5-2"
+expect 0 "" -- "$whirl" train --data "$data" --out forced_linear.json --hidden 0 --restarts 2
+grep -q "network 5-2 (no hidden layer, linear; N = 12" out.txt || fail "--hidden 0: $(head -1 out.txt)"
 expect 0 "" -- "$whirl" predict --model linear.json --hardness 50 --diameter 40 --pitch 10 \
   --raceway-radius 4 --cutting-speed 200 --json
 grep -Eq '"max_elongation_um": 1(89\.[5-9]|90\.[0-4])' out.txt || fail "linear model: $(cat out.txt)"
@@ -171,7 +173,9 @@ expect 1 "missing column 'max_elongation_um'" -- "$whirl" train --data notarget.
 expect 1 "" -- "$whirl" train --data does_not_exist.csv --out bad.json
 expect 1 "does not exist" -- "$whirl" train --data "$data" --out no_such_dir/m.json
 [ ! -e bad.json ] || fail "a failed train left bad.json behind"
-expect 1 "" -- "$whirl" train --data "$data" --out bad.json --hidden 0
+expect 1 "integer in [0, 200]" -- "$whirl" train --data "$data" --out bad.json --hidden -1
+[ ! -e bad.json ] || fail "a failed train left bad.json behind"
+expect 1 "integer in [0, 200]" -- "$whirl" train --data "$data" --out bad.json --hidden 201
 [ ! -e bad.json ] || fail "a failed train left bad.json behind"
 
 # bad predict input
