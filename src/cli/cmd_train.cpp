@@ -133,8 +133,7 @@ void Run(const TrainCliOptions& o) {
     opt.hidden_by_evidence = false;
   } else if (o.hidden != "evidence" && o.hidden != "auto") {
     opt.hidden_candidates.clear();
-    const int h = ParseHidden(o.hidden);
-    opt.hidden_sizes = h == 0 ? std::vector<int>{} : std::vector<int>{h};  // 0: linear
+    opt.hidden_sizes = nn::HiddenLayers(ParseHidden(o.hidden));
   }
   if (o.change >= 0) opt.train.change = o.change;
   opt.seed = o.seed;

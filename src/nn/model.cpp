@@ -558,11 +558,6 @@ double NoiseForCoverage(const std::vector<double>& r2, const std::vector<double>
   return hi;
 }
 
-// The hidden layers of a candidate size: none for 0 (a linear network), else one tansig layer.
-std::vector<int> HiddenLayers(int size) {
-  return size == 0 ? std::vector<int>{} : std::vector<int>{size};
-}
-
 // ModelTrainOptions::hidden_by_evidence: one fit per candidate size (in parallel, each on one
 // thread; the choice happens after all fits, in candidate order: the same for any thread count).
 Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOptions& options,
@@ -646,6 +641,10 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
 }
 
 }  // namespace
+
+std::vector<int> HiddenLayers(int size) {
+  return size == 0 ? std::vector<int>{} : std::vector<int>{size};
+}
 
 ModelTrainOptions DefaultTrainingOptions() {
   ModelTrainOptions o;

@@ -189,6 +189,10 @@ inline constexpr double kBrnnChange = 0.001;
 /// and on the simulator's settle time, worse on its elongation, 2-7x slower).
 ModelTrainOptions DefaultTrainingOptions();
 
+/// ModelTrainOptions::hidden_sizes for a network with `size` hidden neurons: none for 0 (a linear
+/// 5-2 network, `--hidden 0` and the evidence choice's first candidate), else one tansig layer.
+std::vector<int> HiddenLayers(int size);
+
 /// Progress of TrainModel: restart index (0-based) and the epoch just finished.
 using ModelProgress = std::function<void(int restart, const EpochInfo& info)>;
 
