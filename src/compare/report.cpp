@@ -385,7 +385,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                  {"schema_version", 1},
                                  {"provenance", options.provenance},
                                  {"comparisons", report_json}};
-  outputs.emplace_back(dir / "report.json", report.dump(2) + "\n");
+  outputs.emplace_back(dir / "report.json", DumpJson(report) + "\n");
 
   std::ostringstream html;
   html
