@@ -139,9 +139,9 @@ MachineProfile LoadMachineProfile(const std::filesystem::path& path) {
   m.name = RequireString(j, "name", what);
   m.axis = RequireString(j, "axis", what);
   m.direction = RequireInt(j, "direction", what);
-  m.machine_offset_mm = RequireNumber(j, "machine_offset_mm", what);
+  m.machine_offset_mm = RequireNumberIn(j, "machine_offset_mm", kAxisPositionRange, what);
   if (j.contains("start_position_mm"))
-    m.start_position_mm = RequireNumber(j, "start_position_mm", what);
+    m.start_position_mm = RequireNumberIn(j, "start_position_mm", kAxisPositionRange, what);
   m.control_dk = ParseControlDk(RequireString(j, "control_dk", what));
   m.md32760 = RequireNumber(j, "md32760", what);
   m.sync_id_first = RequireInt(j, "sync_id_first", what);

@@ -43,6 +43,12 @@ SignConvention ParseSignConvention(const std::string&);  ///< InputError for oth
 /// +1 for kAdd, -1 for kSubtract.
 double SignFactor(SignConvention s);
 
+/// An axis name in $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (an NC identifier): a letter, then
+/// letters, digits or '_', at most kMaxAxisNameLength characters. InputError "<field> = '<axis>':
+/// <rule>" otherwise. Every command that writes an axis name checks it here.
+inline constexpr std::size_t kMaxAxisNameLength = 32;
+void CheckAxisName(const std::string& axis, const std::string& field = "axis");
+
 /// How the control applies the compensation value dK to the axis (a fact of the machine).
 enum class ControlDk { kAdded, kSubtracted };
 std::string ToString(ControlDk c);                  ///< "added" / "subtracted"
