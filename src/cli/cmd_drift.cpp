@@ -140,6 +140,7 @@ void RegisterSelect(CLI::App* drift_app) {
     drift::FitOptions fit;  // --classes cv scores each count with the fit's cross-validation
     fit.selection = ToSelection(o->sel);
     const drift::Selection s = drift::SelectSensorsForFit(runs, o->error, fit);
+    for (const auto& w : s.left_out) Warn(w);
     if (o->json)
       PrintJson({{"schema", "whirl.drift_select"},
                  {"schema_version", 1},
@@ -177,6 +178,7 @@ void RegisterFitModel(CLI::App* drift_app) {
     std::fprintf(stderr, "fitting %s model of %s on %zu run(s)...\n", o->model.kind.c_str(),
                  o->error.c_str(), runs.size());
     drift::FitReport rep = drift::FitDriftModel(runs, o->error, ToFit(o->model, o->sel));
+    for (const auto& w : rep.warnings) Warn(w);
     rep.model.notes.push_back("whirl drift fit --model " + o->model.kind + " --error " + o->error);
     drift::WriteDriftModel(o->out, rep.model);
     if (o->json) {
@@ -281,6 +283,7 @@ void RegisterCrossval(CLI::App* drift_app) {
       for (Run& r : runs) r = drift::ErrorsFromStart(r);
     std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
     const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
+    for (const auto& w : r.warnings) Warn(w);
     if (o->json)
       PrintJson(drift::CrossRunJson(r));
     else
@@ -344,6 +347,7 @@ void RegisterHoldout(CLI::App* drift_app) {
     h.fit = ToFit(o->model, o->sel);
     const auto r = drift::Holdout(
         log, h, [](const std::string& s) { std::fprintf(stderr, "fitting %s\n", s.c_str()); });
+    for (const auto& w : r.warnings) Warn(w);
     if (!o->report.empty()) {
       const auto rep =
           drift::WriteHoldoutReport(o->report, log, r, {"whirl drift holdout --log " + o->log});
@@ -371,7 +375,8 @@ void RegisterSplit(CLI::App* drift_app) {
       "run-file format (time_min [min]); all or nothing.");
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--at", o->column, "column whose rise starts a run (default spindle_rpm)");
-  sub->add_option("--threshold", o->threshold, "start threshold in the column's unit (default 0)");
+  FiniteNumber(sub->add_option("--threshold", o->threshold,
+                               "start threshold in the column's unit (default 0)"));
   sub->add_option("--out-dir", o->out_dir, "directory for the run files")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
@@ -427,6 +432,7 @@ void RegisterReport(CLI::App* drift_app) {
     if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
       runs = LoadRuns(o->runs);
     const drift::FitReport rep = drift::FitDriftModel(train, o->error, ToFit(o->model, o->sel));
+    for (const auto& w : rep.warnings) Warn(w);
     const auto r =
         drift::WriteModelReport(o->out, rep, runs, {"whirl drift report --error " + o->error});
     for (const auto& w : r.warnings) Warn(w);
