@@ -12,6 +12,7 @@
 #include "cli/common.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "drift/model.h"
 #include "interp/drift_action.h"
 #include "interp/machine_profile.h"
@@ -41,6 +42,10 @@ std::pair<std::string, interp::AnalogInput> ParseInput(const std::string& text) 
 }
 
 void Run(const DriftNcOptions& o) {
+  CheckOutputs({{"--model", o.model_path},
+                {"--slope-model", o.slope_model_path},
+                {"--machine", o.machine_path}},
+               {{"--nc", o.nc_path}, {"--reset-nc", o.reset_path}, {"--csv", o.csv_path}});
   const drift::DriftModel model = drift::ReadDriftModel(o.model_path);
   std::optional<drift::DriftModel> slope;
   if (!o.slope_model_path.empty()) slope = drift::ReadDriftModel(o.slope_model_path);

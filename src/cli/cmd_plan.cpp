@@ -10,6 +10,7 @@
 #include "compare/plan_document.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/output_dir.h"
 #include "fit/arctan_curve.h"
 #include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
@@ -91,6 +92,12 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
 }
 
 void Run(const PlanCliOptions& o) {
+  CheckOutputs(
+      {{"--model", o.model_path}, {"--screw", o.screw_path}, {"--machine", o.machine_path}},
+      {{"--out", o.out_path},
+       {"--csv", o.csv_path},
+       {"--nc", o.nc_path},
+       {"--reset-nc", o.reset_nc_path}});
   const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
   if (by_features == !o.model_path.empty())
     throw InputError("plan: give either --model M or --max-elongation L --settle-time T");

@@ -21,8 +21,10 @@ nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
   }
 }
 
+std::string JsonFileText(const nlohmann::json& j) { return j.dump(2) + "\n"; }
+
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
-  WriteFileAtomic(path, j.dump(2) + "\n");
+  WriteFileAtomic(path, JsonFileText(j));
 }
 
 void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char*> allowed,

@@ -1,5 +1,6 @@
 target_sources(whirl_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/atomic_file.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/output_dir.cpp
   ${CMAKE_CURRENT_LIST_DIR}/csv.cpp
   ${CMAKE_CURRENT_LIST_DIR}/json_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/process.cpp

@@ -13,5 +13,10 @@ done
 grep -q "SA_TEMP_COMP" out/reference_80x10x6000_temp_comp.spf
 test -s out/machine_report/index.html || { echo "missing machine report"; exit 1; }
 grep -q "both halves on a drifting machine" demo.txt
+# Again into the same directory: the demo replaces its own output (core/output_dir.h).
+"$whirl" demo --out-dir out --no-plots > demo2.txt
+grep -q "summary:" demo2.txt
+test -s out/report/index.html && test -s out/machine_report/index.html
+if ls out/report/*.png > /dev/null 2>&1; then echo "old figures beside a page without plots"; exit 1; fi
 
 echo OK
