@@ -1,0 +1,286 @@
+#include "family/family.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/numbers.h"
+#include "core/parallel.h"
+
+namespace whirl::family {
+namespace {
+
+constexpr double kOneSigma = 0.6827;  // share of a normal within +-1 sd
+
+std::string KernelShort(gp::Kernel k) {
+  return k == gp::Kernel::kSquaredExponential ? "se" : "matern52";
+}
+
+// The table with its inputs and targets mapped through `t` (a table in the transformed space).
+ProcessTable TransformedTable(const ProcessTable& table, const TableTransform& t) {
+  const Eigen::MatrixXd x = TransformInputs(t, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd y = TransformTargets(t, nn::TargetMatrix(table.targets));
+  ProcessTable out;
+  out.source = table.source;
+  for (Eigen::Index q = 0; q < x.cols(); ++q) {
+    std::array<double, ProcessInputs::kCount> a{};
+    std::array<double, Features::kCount> f{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = x(i, q);
+    for (int k = 0; k < Features::kCount; ++k) f[k] = y(k, q);
+    out.inputs.push_back(ProcessInputs::FromArray(a));
+    out.targets.push_back(Features::FromArray(f));
+  }
+  return out;
+}
+
+nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions& o,
+                     bool calibrate) {
+  nn::ModelTrainOptions m = nn::DefaultTrainingOptions();
+  m.seed = o.seed;
+  m.restarts = o.network_restarts;
+  m.threads = o.threads;
+  m.noise_folds = calibrate ? o.network_noise_folds : 0;
+  if (c.hidden != Candidate::kHiddenByEvidence) {
+    m.hidden_candidates.clear();
+    m.hidden_by_evidence = false;
+    m.hidden_sizes = nn::HiddenLayers(c.hidden);
+    if (c.hidden == 0) m.restarts = 1;
+  }
+  return nn::TrainModel(t, m, t.source);
+}
+
+// GP noise of the family header: coverage of the closed-form leave-one-out residuals.
+void CalibrateGp(gp::Gp* g) {
+  const gp::LeaveOneOut loo = gp::LeaveOneOutGp(*g);
+  const double s2 = CoverageNoiseVariance(loo.residual, loo.latent_variance);
+  g->noise_variance = s2 / (g->target_scale * g->target_scale);
+}
+
+std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o,
+                           bool calibrate) {
+  const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
+  gp::GpOptions go = o.gp;
+  go.kernel = c.kernel;
+  go.mean = c.mean;
+  std::vector<gp::Gp> gps(static_cast<std::size_t>(y.rows()));
+  for (Eigen::Index k = 0; k < y.rows(); ++k) {
+    gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
+    if (calibrate) CalibrateGp(&gps[k]);
+  }
+  return gps;
+}
+
+// Means (2 x Q) in the transformed space.
+Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<ProcessInputs>& z,
+                                 Eigen::MatrixXd* sd) {
+  Eigen::MatrixXd mean(Features::kCount, z.size());
+  sd->resize(Features::kCount, z.size());
+  if (m.candidate.family == Family::kNetwork) {
+    const std::vector<nn::Prediction> p = nn::PredictBatch(m.network, z);
+    for (std::size_t q = 0; q < p.size(); ++q)
+      for (int k = 0; k < Features::kCount; ++k) {
+        mean(k, q) = p[q].mean.ToArray()[k];
+        (*sd)(k, q) = p[q].stddev.ToArray()[k];
+      }
+    return mean;
+  }
+  const Eigen::MatrixXd x = nn::InputMatrix(z);
+  for (int k = 0; k < Features::kCount; ++k) {
+    const gp::GpPrediction p = gp::PredictGp(m.gps[k], x);
+    mean.row(k) = p.mean.transpose();
+    sd->row(k) = p.Stddev().transpose();
+  }
+  return mean;
+}
+
+ProcessTable Rows(const ProcessTable& table, int folds, int fold, bool held_out) {
+  ProcessTable out;
+  out.source = table.source;
+  for (std::size_t i = 0; i < table.inputs.size(); ++i)
+    if ((static_cast<int>(i) % folds == fold) == held_out) {
+      out.inputs.push_back(table.inputs[i]);
+      out.targets.push_back(table.targets[i]);
+    }
+  return out;
+}
+
+// Squared held-out errors (2 x rows, original units) of one candidate's fold fit.
+void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
+                int fold, Eigen::MatrixXd* sq) {
+  const ProcessTable train = Rows(table, folds, fold, false), held = Rows(table, folds, fold, true);
+  const FamilyModel m = FitCandidate(train, c, o, false);
+  const std::vector<FamilyPrediction> p = PredictFamily(m, held.inputs);
+  for (std::size_t i = 0, row = 0; row < table.inputs.size(); ++row) {
+    if (static_cast<int>(row) % folds != fold) continue;
+    for (int k = 0; k < Features::kCount; ++k) {
+      const double e = held.targets[i].ToArray()[k] - p[i].mean.ToArray()[k];
+      (*sq)(k, static_cast<Eigen::Index>(row)) = e * e;
+    }
+    ++i;
+  }
+}
+
+void CheckTable(const ProcessTable& table) {
+  if (table.targets.size() != table.inputs.size())
+    throw InputError(table.source + ": the training table needs the target columns " +
+                     kTargetColumns[0] + " and " + kTargetColumns[1]);
+  if (table.inputs.size() < 4)
+    throw InputError(table.source + ": " + std::to_string(table.inputs.size()) +
+                     " training rows; choosing a model family needs at least 4");
+}
+
+}  // namespace
+
+std::string Candidate::Name() const {
+  const std::string t = log ? "/log" : "/identity";
+  if (family == Family::kNetwork)
+    return (hidden == kHiddenByEvidence ? std::string("network-evidence")
+                                        : "network-h" + std::to_string(hidden)) + t;
+  return "gp-" + KernelShort(kernel) + "-" + gp::ToString(mean) + t;
+}
+
+Candidate ParseCandidate(const std::string& name) {
+  const auto slash = name.rfind('/');
+  const std::string bad = "candidate '" + name +
+                          "': must be network-evidence, network-hN or gp-(se|matern52)-"
+                          "(constant|linear), then /identity or /log";
+  if (slash == std::string::npos) throw InputError(bad);
+  Candidate c;
+  const std::string body = name.substr(0, slash), t = name.substr(slash + 1);
+  if (t != "log" && t != "identity") throw InputError(bad);
+  c.log = t == "log";
+  for (const Family f : {Family::kNetwork, Family::kGaussianProcess}) {
+    c.family = f;
+    for (int h = Candidate::kHiddenByEvidence; h <= 64 && f == Family::kNetwork; ++h) {
+      c.hidden = h;
+      if (c.Name() == name) return c;
+    }
+    for (const auto k : {gp::Kernel::kSquaredExponential, gp::Kernel::kMatern52})
+      for (const auto m : {gp::Mean::kConstant, gp::Mean::kLinear}) {
+        c.kernel = k;
+        c.mean = m;
+        if (f == Family::kGaussianProcess && c.Name() == name) return c;
+      }
+  }
+  throw InputError(bad);
+}
+
+FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
+                         const FitOptions& options, bool calibrate) {
+  CheckTable(table);
+  FamilyModel m;
+  m.candidate = candidate;
+  if (candidate.log) m.transform = LogWherePositive(table);
+  const ProcessTable t = TransformedTable(table, m.transform);
+  if (candidate.family == Family::kNetwork) {
+    m.network = FitNetwork(t, candidate, options, calibrate);
+    m.calibration = m.network.noise_calibration;
+  } else {
+    m.gps = FitGps(t, candidate, options, calibrate);
+    if (calibrate)
+      m.calibration =
+          "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
+          "covers 68.27 % of the closed-form leave-one-out residuals";
+  }
+  return m;
+}
+
+std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
+                                            const std::vector<ProcessInputs>& inputs) {
+  std::vector<FamilyPrediction> out(inputs.size());
+  if (inputs.empty()) return out;
+  const Eigen::MatrixXd z = TransformInputs(model.transform, nn::InputMatrix(inputs));
+  std::vector<ProcessInputs> zi;
+  for (Eigen::Index q = 0; q < z.cols(); ++q) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = z(i, q);
+    zi.push_back(ProcessInputs::FromArray(a));
+  }
+  Eigen::MatrixXd sd;
+  const Eigen::MatrixXd mean = TransformedMeans(model, zi, &sd);
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    std::array<double, Features::kCount> m{}, s{};
+    for (int k = 0; k < Features::kCount; ++k) {
+      const MeanSd back = MapBack(model.transform.outputs[k], mean(k, q), sd(k, q));
+      m[k] = back.mean;
+      s[k] = back.sd;
+    }
+    out[q] = {Features::FromArray(m), Features::FromArray(s)};
+  }
+  return out;
+}
+
+double CoverageNoiseVariance(const Eigen::VectorXd& residual, const Eigen::VectorXd& latent_variance) {
+  if (residual.size() == 0 || residual.size() != latent_variance.size())
+    throw InputError("noise calibration: " + std::to_string(residual.size()) + " residuals and " +
+                     std::to_string(latent_variance.size()) + " variances; need equal, > 0");
+  const Eigen::ArrayXd r2 = residual.array().square();
+  auto coverage = [&](double s2) {
+    return (r2 <= s2 + latent_variance.array()).cast<double>().mean();
+  };
+  double lo = 0.0, hi = r2.maxCoeff() + 1e-300;
+  if (coverage(lo) >= kOneSigma) return 0.0;
+  for (int it = 0; it < 200 && hi > lo; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (coverage(mid) >= kOneSigma ? hi : lo) = mid;
+  }
+  return hi;
+}
+
+void to_json(nlohmann::json& j, const CvRow& r) {
+  j = {{"candidate", r.candidate.Name()},
+       {"cv_rmse", std::vector<double>(r.cv_rmse.data(), r.cv_rmse.data() + r.cv_rmse.size())},
+       {"score", r.score},
+       {"fit_ms", r.fit_ms}};
+}
+
+std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
+  std::vector<Candidate> c;
+  for (const bool log : {false, true}) {
+    Candidate net;
+    net.family = Family::kNetwork;
+    net.log = log;
+    c.push_back(net);
+    Candidate g;
+    g.log = log;
+    c.push_back(g);
+  }
+  return c;
+}
+
+Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
+  CheckTable(table);
+  if (options.candidates.empty()) throw InputError("family choice: no candidates");
+  const int rows = static_cast<int>(table.inputs.size());
+  const int folds = std::min(options.folds, rows), nc = static_cast<int>(options.candidates.size());
+  if (folds < 2) throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
+  std::vector<Eigen::MatrixXd> sq(static_cast<std::size_t>(nc), Eigen::MatrixXd(Features::kCount, rows));
+  std::vector<double> ms(static_cast<std::size_t>(nc * folds));
+  FitOptions fold_options = options.fit;
+  fold_options.threads = 1;
+  ParallelFor(static_cast<std::size_t>(nc * folds), options.fit.threads, [&](std::size_t i) {
+    const auto start = std::chrono::steady_clock::now();
+    const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
+    FoldErrors(table, options.candidates[c], fold_options, folds, f, &sq[c]);
+    ms[i] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  });
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::ArrayXd var = ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows)
+                                 .array().max(1e-300);
+  Choice choice;
+  for (int c = 0; c < nc; ++c) {
+    CvRow r;
+    r.candidate = options.candidates[c];
+    const Eigen::ArrayXd mse = sq[c].rowwise().mean().array();
+    r.cv_rmse = mse.sqrt().matrix();
+    r.score = (mse / var).sum();
+    for (int f = 0; f < folds; ++f) r.fit_ms += ms[c * folds + f];
+    choice.table.push_back(r);
+    if (r.score < choice.table[choice.chosen].score) choice.chosen = c;
+  }
+  choice.model = FitCandidate(table, options.candidates[choice.chosen], options.fit, true);
+  return choice;
+}
+
+}  // namespace whirl::family

@@ -1,0 +1,118 @@
+#pragma once
+// The workpiece model as one of several families, chosen from the data by cross-validated error:
+// the trainbr network of nn/ (a fixed hidden size, or its evidence choice among sizes) and the
+// Gaussian process of gp/, each on identity or log columns (family/transform.h).
+//
+// Choice (ChooseFamily): K-fold cross-validation (row q held out in fold q % K, K = min(folds,
+// rows)); every candidate is refitted on each fold's training rows (its hyperparameters, weights,
+// scalings and transform ranges included, nothing from the held-out rows) and predicts the
+// held-out means; the score is
+//   score = sum over outputs k of mean_i (t_ik - mean_-i,k)^2 / var_k,
+// var_k = the population variance of output k over the whole table (both outputs weigh equally,
+// as in the network's normalized errors). The candidate with the lowest score (ties: the earlier)
+// is refitted on all rows with its noise calibration and returned with the table of scores.
+// Within the network family the hidden size may still be chosen by the evidence (MacKay 1992:
+// comparable only within one family); across families only cross-validated errors are compared.
+//
+// Predictive sd, per output, in the candidate's transformed space, then mapped back by the delta
+// method (family/transform.h):
+//   network: nn::Predict (noise calibrated by nn's K-fold cross-validation, nn/model.h);
+//   gp:      sqrt(latent variance + s_k^2), s_k^2 = the smallest level at which +-1 sd covers
+//            68.27 % of the closed-form leave-one-out residuals (gp/gp.h LeaveOneOutGp with its
+//            latent variances; CoverageNoiseVariance below), the network's rule applied to the
+//            GP's leave-one-out instead of refitted folds.
+#include <Eigen/Core>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/process.h"
+#include "family/transform.h"
+#include "gp/gp.h"
+#include "nn/model.h"
+
+namespace whirl::family {
+
+enum class Family { kNetwork, kGaussianProcess };
+
+/// One candidate model. Name() (and ParseCandidate) spell it as
+///   "network-evidence/log", "network-h6/identity", "gp-matern52-constant/log",
+///   "gp-se-linear/identity".
+struct Candidate {
+  Family family = Family::kGaussianProcess;
+  bool log = false;  ///< LogWherePositive of the table, else identity
+  /// Network: hidden neurons (0 = linear 5-2 network), or kHiddenByEvidence for the highest log
+  /// evidence among nn::DefaultTrainingOptions' sizes {0, 4, 6, 8}.
+  int hidden = kHiddenByEvidence;
+  gp::Kernel kernel = gp::Kernel::kMatern52;  ///< GP only
+  gp::Mean mean = gp::Mean::kConstant;        ///< GP only
+  static constexpr int kHiddenByEvidence = -1;
+  std::string Name() const;
+};
+/// Inverse of Candidate::Name(); InputError listing the accepted spellings otherwise.
+Candidate ParseCandidate(const std::string& name);
+
+/// How candidates are fitted.
+struct FitOptions {
+  std::uint64_t seed = 1;  ///< networks: restart r initializes with seed + r (nn/model.h)
+  int network_restarts = 1;
+  int network_noise_folds = 5;  ///< nn::ModelTrainOptions::noise_folds of the final network
+  gp::GpOptions gp;             ///< the GP's options (kernel and mean come from the candidate)
+  int threads = 1;              ///< core/parallel.h; the result is the same for any count
+};
+
+/// A fitted candidate: the network (Family::kNetwork, in the transformed space) or one GP per
+/// output (Family::kGaussianProcess, x and y in the transformed space).
+struct FamilyModel {
+  Candidate candidate;
+  TableTransform transform;
+  nn::Model network;
+  std::vector<gp::Gp> gps;
+  std::string calibration;  ///< how the predictive sd was calibrated (provenance)
+};
+
+/// Fits `candidate` on all rows of `table` (targets required, >= 4 rows); `calibrate` = false
+/// skips the noise calibration (the cross-validation folds need only means). InputError on bad
+/// tables.
+FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
+                         const FitOptions& options, bool calibrate = true);
+
+struct FamilyPrediction {
+  Features mean;    ///< original units (delta method: for a log output, the median)
+  Features stddev;  ///< predictive sd (noise included), original units
+};
+std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
+                                            const std::vector<ProcessInputs>& inputs);
+
+/// sigma^2 >= 0: the smallest level at which sqrt(sigma^2 + latent_variance[i]) >= |r_i| for at
+/// least 68.27 % of the residuals (bisection; the coverage is monotone in sigma^2). The rule of
+/// nn::CalibrateOutputNoise (nn/model.h). InputError if the sizes differ or are 0.
+double CoverageNoiseVariance(const Eigen::VectorXd& residual, const Eigen::VectorXd& latent_variance);
+
+/// One row of the choice table.
+struct CvRow {
+  Candidate candidate;
+  Eigen::VectorXd cv_rmse;  ///< per output, original units
+  double score = 0;         ///< see the header comment (dimensionless)
+  double fit_ms = 0;        ///< wall time of the candidate's fold fits
+};
+void to_json(nlohmann::json& j, const CvRow& r);
+
+struct ChoiceOptions {
+  std::vector<Candidate> candidates = DefaultCandidates();
+  int folds = 5;    ///< K of the cross-validation (min(K, rows))
+  FitOptions fit;
+  static std::vector<Candidate> DefaultCandidates();
+};
+
+struct Choice {
+  FamilyModel model;         ///< the chosen candidate, refitted on all rows and calibrated
+  std::vector<CvRow> table;  ///< in candidate order
+  int chosen = 0;            ///< index into table
+};
+/// The choice of the header comment. InputError if the table has no targets or fewer than 4
+/// rows, or if there are no candidates.
+Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
+
+}  // namespace whirl::family

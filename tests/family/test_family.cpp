@@ -1,0 +1,122 @@
+// family/family.h: the choice finds the power law in a power-law table, every candidate predicts
+// through its transform, the calibrated GP covers fresh data, the coverage rule on hand-computed
+// cases, candidate names, and bad input.
+#include "family/family.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "support/expect_error.h"
+
+namespace whirl::family {
+namespace {
+
+// Inputs uniform in the paper's ranges; targets a power law times exp(noise_sd N(0, 1)), or the
+// smooth non-power law of `curved`.
+ProcessTable MakeTable(int rows, double noise_sd, unsigned seed, bool curved = false) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n01;
+  const double lo[5] = {60, 50, 6, 3, 150}, span[5] = {5, 50, 10, 7, 60};
+  ProcessTable t;
+  t.source = "generated.csv";
+  for (int q = 0; q < rows; ++q) {
+    std::array<double, 5> x{};
+    for (int i = 0; i < 5; ++i) x[i] = lo[i] + span[i] * u(rng);
+    double e = 30 * std::pow(x[3], 1.97) * std::pow(x[4], -1.7) * std::pow(x[2], -0.99) * 1e3;
+    double s = 2.0 * std::pow(x[1], 0.8) * std::pow(x[0] / 60, 3.0);
+    if (curved) {
+      e = 10 + 5 * std::sin(x[3]) + 0.1 * x[1];
+      s = 50 + 20 * std::cos(x[2] / 3) * (x[4] / 150);
+    }
+    t.inputs.push_back(ProcessInputs::FromArray(x));
+    t.targets.push_back(Features::FromArray({e * std::exp(noise_sd * n01(rng)),
+                                             s * std::exp(noise_sd * n01(rng))}));
+  }
+  return t;
+}
+
+double MaxRelativeError(const FamilyModel& m, const ProcessTable& test) {
+  const std::vector<FamilyPrediction> p = PredictFamily(m, test.inputs);
+  double worst = 0;
+  for (std::size_t q = 0; q < p.size(); ++q)
+    for (int k = 0; k < 2; ++k)
+      worst = std::max(worst, std::abs(p[q].mean.ToArray()[k] / test.targets[q].ToArray()[k] - 1));
+  return worst;
+}
+
+TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
+  const ProcessTable train = MakeTable(20, 0.01, 1), test = MakeTable(200, 0.0, 2);
+  ChoiceOptions o;
+  o.candidates = {ParseCandidate("gp-matern52-constant/identity"),
+                  ParseCandidate("gp-se-linear/log"), ParseCandidate("network-h6/identity")};
+  const Choice c = ChooseFamily(train, o);
+  ASSERT_EQ(c.table.size(), 3u);
+  EXPECT_EQ(c.model.candidate.Name(), "gp-se-linear/log");
+  for (const CvRow& r : c.table) EXPECT_GE(r.score, c.table[c.chosen].score);
+  EXPECT_EQ(c.table[c.chosen].candidate.Name(), c.model.candidate.Name());
+  EXPECT_LT(MaxRelativeError(c.model, test), 0.03);
+}
+
+TEST(FamilyChoice, ALinearNetworkOnLogColumnsIsAPowerLaw) {
+  const ProcessTable train = MakeTable(20, 0.0, 3), test = MakeTable(100, 0.0, 4);
+  const FamilyModel log_net = FitCandidate(train, ParseCandidate("network-h0/log"), {});
+  const FamilyModel raw_net = FitCandidate(train, ParseCandidate("network-h0/identity"), {});
+  EXPECT_LT(MaxRelativeError(log_net, test), 0.01);
+  EXPECT_GT(MaxRelativeError(raw_net, test), 0.05);  // a linear fit on raw columns is not
+  ExpectInputError(
+      [&] {
+        std::vector<ProcessInputs> in = {test.inputs[0]};
+        in[0].pitch_mm = 0.0;
+        PredictFamily(log_net, in);
+      },
+      "pitch_mm = 0");
+}
+
+TEST(FamilyCalibration, CalibratedGpCoversFreshData) {
+  // 40 noisy rows of a smooth non-power law: +-1 / +-2 sd coverage on 2000 fresh rows.
+  const ProcessTable train = MakeTable(40, 0.05, 5, true), test = MakeTable(2000, 0.05, 6, true);
+  for (const char* name : {"gp-matern52-constant/identity", "gp-se-constant/log"}) {
+    const FamilyModel m = FitCandidate(train, ParseCandidate(name), {});
+    const std::vector<FamilyPrediction> p = PredictFamily(m, test.inputs);
+    for (int k = 0; k < 2; ++k) {
+      int in1 = 0, in2 = 0;
+      for (std::size_t q = 0; q < p.size(); ++q) {
+        const double r = std::abs(test.targets[q].ToArray()[k] - p[q].mean.ToArray()[k]);
+        in1 += r <= p[q].stddev.ToArray()[k];
+        in2 += r <= 2 * p[q].stddev.ToArray()[k];
+      }
+      EXPECT_NEAR(in1 / 2000.0, 0.68, 0.12) << name << " output " << k;
+      EXPECT_NEAR(in2 / 2000.0, 0.95, 0.05) << name << " output " << k;
+    }
+  }
+}
+
+TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
+  Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
+  r << 1, -2, 3, 4;
+  EXPECT_NEAR(CoverageNoiseVariance(r, v), 9.0, 1e-9);  // 3 of 4 within sqrt(9)
+  v(3) = 100;  // the 4th row is covered by its own variance
+  EXPECT_NEAR(CoverageNoiseVariance(r, v), 4.0, 1e-9);
+  v << 10, 10, 10, 0;
+  EXPECT_EQ(CoverageNoiseVariance(r, v), 0.0);
+  ExpectInputError([&] { CoverageNoiseVariance(r, v.head(2)); }, "4 residuals and 2");
+}
+
+TEST(FamilyCandidates, NamesRoundTripAndBadInput) {
+  for (const Candidate& c : ChoiceOptions::DefaultCandidates())
+    EXPECT_EQ(ParseCandidate(c.Name()).Name(), c.Name());
+  for (const char* n : {"network-h6/log", "network-h0/identity", "gp-se-linear/identity"})
+    EXPECT_EQ(ParseCandidate(n).Name(), n);
+  ExpectInputError([] { ParseCandidate("gp-rbf/log"); }, "candidate 'gp-rbf/log'");
+  ExpectInputError([] { ParseCandidate("network-h6"); }, "/identity or /log");
+  ExpectInputError([] { ChooseFamily(MakeTable(3, 0.1, 1), {}); }, "at least 4");
+  ProcessTable no_targets = MakeTable(10, 0.1, 1);
+  no_targets.targets.clear();
+  ExpectInputError([&] { ChooseFamily(no_targets, {}); }, "target columns");
+}
+
+}  // namespace
+}  // namespace whirl::family
