@@ -50,10 +50,30 @@ nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions
   return nn::TrainModel(t, m, t.source);
 }
 
-// GP noise of the family header: coverage of the closed-form leave-one-out residuals.
-void CalibrateGp(gp::Gp* g) {
-  const gp::LeaveOneOut loo = gp::LeaveOneOutGp(*g);
-  const double s2 = CoverageNoiseVariance(loo.residual, loo.latent_variance);
+// GP noise of the family header from closed-form leave-one-out (folds == 0) or from K-fold
+// refits warm-started at the full fit's hyperparameters (folds = K), residuals r and latent
+// variances v in units of y; the noise is CoverageNoiseVariance(r, v).
+void CalibrateGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const gp::GpOptions& o,
+                 int folds, gp::Gp* g) {
+  Eigen::VectorXd r(y.size()), v(y.size());
+  if (folds == 0) {
+    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(*g);
+    r = loo.residual;
+    v = loo.latent_variance;
+  } else {
+    const int n = static_cast<int>(y.size()), k = std::min(folds, n);
+    for (int f = 0; f < k; ++f) {
+      std::vector<int> tr, te;
+      for (int q = 0; q < n; ++q) (q % k == f ? te : tr).push_back(q);
+      const Eigen::VectorXi tri = Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
+      const Eigen::VectorXi tei = Eigen::Map<Eigen::VectorXi>(te.data(), static_cast<Eigen::Index>(te.size()));
+      const gp::Gp fold = gp::FitGpFrom(x(Eigen::all, tri), y(tri), o, g->theta);
+      const gp::GpPrediction p = gp::PredictGp(fold, x(Eigen::all, tei));
+      r(tei) = y(tei) - p.mean;
+      v(tei) = p.latent_variance;
+    }
+  }
+  const double s2 = CoverageNoiseVariance(r, v);
   g->noise_variance = s2 / (g->target_scale * g->target_scale);
 }
 
@@ -65,10 +85,24 @@ std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitO
   go.mean = c.mean;
   std::vector<gp::Gp> gps(static_cast<std::size_t>(y.rows()));
   for (Eigen::Index k = 0; k < y.rows(); ++k) {
-    gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
-    if (calibrate) CalibrateGp(&gps[k]);
+    const Eigen::VectorXd yk = y.row(k).transpose();
+    gps[k] = gp::FitGp(x, yk, go);
+    if (calibrate) CalibrateGp(x, yk, go, o.gp_calibration_folds, &gps[k]);
   }
   return gps;
+}
+
+std::vector<LinearModel> FitLinears(const ProcessTable& t, bool calibrate) {
+  const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
+  std::vector<LinearModel> fits;
+  for (Eigen::Index k = 0; k < y.rows(); ++k) {
+    const Eigen::VectorXd yk = y.row(k).transpose();
+    fits.push_back(FitLinear(x, yk));
+    if (!calibrate) continue;
+    const LinearLeaveOneOut loo = LeaveOneOutLinear(fits.back(), x, yk);
+    fits.back().noise_variance = CoverageNoiseVariance(loo.residual, loo.latent_variance);
+  }
+  return fits;
 }
 
 // Means (2 x Q) in the transformed space.
@@ -86,7 +120,12 @@ Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<Process
     return mean;
   }
   const Eigen::MatrixXd x = nn::InputMatrix(z);
-  for (int k = 0; k < Features::kCount; ++k) {
+  for (int k = 0; k < Features::kCount && m.candidate.family == Family::kLinear; ++k) {
+    const LinearPrediction p = PredictLinear(m.linears[k], x);
+    mean.row(k) = p.mean.transpose();
+    sd->row(k) = (p.latent_variance.array() + m.linears[k].noise_variance).sqrt().matrix().transpose();
+  }
+  for (int k = 0; k < Features::kCount && m.candidate.family == Family::kGaussianProcess; ++k) {
     const gp::GpPrediction p = gp::PredictGp(m.gps[k], x);
     mean.row(k) = p.mean.transpose();
     sd->row(k) = p.Stddev().transpose();
@@ -134,6 +173,7 @@ void CheckTable(const ProcessTable& table) {
 
 std::string Candidate::Name() const {
   const std::string t = log ? "/log" : "/identity";
+  if (family == Family::kLinear) return "linear" + t;
   if (family == Family::kNetwork)
     return (hidden == kHiddenByEvidence ? std::string("network-evidence")
                                         : "network-h" + std::to_string(hidden)) + t;
@@ -143,13 +183,15 @@ std::string Candidate::Name() const {
 Candidate ParseCandidate(const std::string& name) {
   const auto slash = name.rfind('/');
   const std::string bad = "candidate '" + name +
-                          "': must be network-evidence, network-hN or gp-(se|matern52)-"
+                          "': must be linear, network-evidence, network-hN or gp-(se|matern52)-"
                           "(constant|linear), then /identity or /log";
   if (slash == std::string::npos) throw InputError(bad);
   Candidate c;
   const std::string body = name.substr(0, slash), t = name.substr(slash + 1);
   if (t != "log" && t != "identity") throw InputError(bad);
   c.log = t == "log";
+  c.family = Family::kLinear;
+  if (c.Name() == name) return c;
   for (const Family f : {Family::kNetwork, Family::kGaussianProcess}) {
     c.family = f;
     for (int h = Candidate::kHiddenByEvidence; h <= 64 && f == Family::kNetwork; ++h) {
@@ -176,12 +218,21 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
   if (candidate.family == Family::kNetwork) {
     m.network = FitNetwork(t, candidate, options, calibrate);
     m.calibration = m.network.noise_calibration;
+  } else if (candidate.family == Family::kLinear) {
+    m.linears = FitLinears(t, calibrate);
+    if (calibrate)
+      m.calibration = "per output the smallest noise variance at which +-1 sd covers 68.27 % of "
+                      "the closed-form leave-one-out residuals";
   } else {
     m.gps = FitGps(t, candidate, options, calibrate);
     if (calibrate)
       m.calibration =
           "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
-          "covers 68.27 % of the closed-form leave-one-out residuals";
+          "covers 68.27 % of the " +
+          (options.gp_calibration_folds == 0
+               ? std::string("closed-form leave-one-out residuals")
+               : std::to_string(options.gp_calibration_folds) +
+                     "-fold cross-validation residuals (hyperparameters refitted per fold)");
   }
   return m;
 }

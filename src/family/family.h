@@ -16,11 +16,13 @@
 //
 // Predictive sd, per output, in the candidate's transformed space, then mapped back by the delta
 // method (family/transform.h):
+//   linear:  sqrt(latent variance + s_k^2), s_k^2 by CoverageNoiseVariance from the exact
+//            closed-form leave-one-out residuals (family/linear.h);
 //   network: nn::Predict (noise calibrated by nn's K-fold cross-validation, nn/model.h);
 //   gp:      sqrt(latent variance + s_k^2), s_k^2 = the smallest level at which +-1 sd covers
-//            68.27 % of the closed-form leave-one-out residuals (gp/gp.h LeaveOneOutGp with its
-//            latent variances; CoverageNoiseVariance below), the network's rule applied to the
-//            GP's leave-one-out instead of refitted folds.
+//            68.27 % of cross-validated residuals (FitOptions::gp_calibration_folds: K-fold
+//            refits, or the closed-form leave-one-out of gp/gp.h with its latent variances;
+//            CoverageNoiseVariance below): the network's rule (nn/model.h).
 #include <Eigen/Core>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -28,17 +30,18 @@
 #include <vector>
 
 #include "core/process.h"
+#include "family/linear.h"
 #include "family/transform.h"
 #include "gp/gp.h"
 #include "nn/model.h"
 
 namespace whirl::family {
 
-enum class Family { kNetwork, kGaussianProcess };
+enum class Family { kLinear, kNetwork, kGaussianProcess };
 
 /// One candidate model. Name() (and ParseCandidate) spell it as
-///   "network-evidence/log", "network-h6/identity", "gp-matern52-constant/log",
-///   "gp-se-linear/identity".
+///   "linear/log" (least squares; on log columns a power law), "network-evidence/log",
+///   "network-h6/identity", "gp-matern52-constant/log", "gp-se-linear/identity".
 struct Candidate {
   Family family = Family::kGaussianProcess;
   bool log = false;  ///< LogWherePositive of the table, else identity
@@ -59,16 +62,23 @@ struct FitOptions {
   int network_restarts = 1;
   int network_noise_folds = 5;  ///< nn::ModelTrainOptions::noise_folds of the final network
   gp::GpOptions gp;             ///< the GP's options (kernel and mean come from the candidate)
+  /// GP noise calibration: 0 = closed-form leave-one-out at the full fit's hyperparameters;
+  /// K > 0 = K-fold cross-validation (min(K, rows) folds, row q held out in fold q % K), each
+  /// fold's GP refitted from the full fit's hyperparameters (one start), its held-out residuals
+  /// and latent variances in CoverageNoiseVariance (the network's rule, nn/model.h).
+  int gp_calibration_folds = 5;
   int threads = 1;              ///< core/parallel.h; the result is the same for any count
 };
 
-/// A fitted candidate: the network (Family::kNetwork, in the transformed space) or one GP per
-/// output (Family::kGaussianProcess, x and y in the transformed space).
+/// A fitted candidate: the network (Family::kNetwork, in the transformed space), one least-squares
+/// fit per output (Family::kLinear) or one GP per output (Family::kGaussianProcess), x and y in
+/// the transformed space.
 struct FamilyModel {
   Candidate candidate;
   TableTransform transform;
   nn::Model network;
   std::vector<gp::Gp> gps;
+  std::vector<LinearModel> linears;
   std::string calibration;  ///< how the predictive sd was calibrated (provenance)
 };
 
