@@ -160,6 +160,20 @@ void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions&
   }
 }
 
+void CheckTable(const ProcessTable& table);
+
+// Refits each distinct chosen candidate on all rows, with calibration.
+void FitChosen(const ProcessTable& table, const ChoiceOptions& options, Choice* choice) {
+  std::vector<int> fitted;
+  for (int k = 0; k < Features::kCount; ++k) {
+    const auto it = std::find(fitted.begin(), fitted.end(), choice->chosen[k]);
+    choice->model_of_output[k] = static_cast<int>(it - fitted.begin());
+    if (it != fitted.end()) continue;
+    fitted.push_back(choice->chosen[k]);
+    choice->models.push_back(FitCandidate(table, options.candidates[choice->chosen[k]], options.fit, true));
+  }
+}
+
 void CheckTable(const ProcessTable& table) {
   if (table.targets.size() != table.inputs.size())
     throw InputError(table.source + ": the training table needs the target columns " +
@@ -328,10 +342,39 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
     r.score = (mse / var).sum();
     for (int f = 0; f < folds; ++f) r.fit_ms += ms[c * folds + f];
     choice.table.push_back(r);
-    if (r.score < choice.table[choice.chosen].score) choice.chosen = c;
+    for (int k = 0; k < Features::kCount; ++k) {
+      const CvRow& best = choice.table[choice.chosen[k]];
+      if (options.per_output ? r.cv_rmse(k) < best.cv_rmse(k) : r.score < best.score)
+        choice.chosen[k] = c;
+    }
   }
-  choice.model = FitCandidate(table, options.candidates[choice.chosen], options.fit, true);
+  FitChosen(table, options, &choice);
   return choice;
+}
+
+std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
+                                            const std::vector<ProcessInputs>& inputs) {
+  std::vector<std::vector<FamilyPrediction>> per_model;
+  for (const FamilyModel& m : choice.models) per_model.push_back(PredictFamily(m, inputs));
+  std::vector<FamilyPrediction> out(inputs.size());
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    std::array<double, Features::kCount> mean{}, sd{};
+    for (int k = 0; k < Features::kCount; ++k) {
+      const FamilyPrediction& p = per_model[choice.model_of_output[k]][q];
+      mean[k] = p.mean.ToArray()[k];
+      sd[k] = p.stddev.ToArray()[k];
+    }
+    out[q] = {Features::FromArray(mean), Features::FromArray(sd)};
+  }
+  return out;
+}
+
+std::string Choice::Describe() const {
+  std::string s;
+  for (int k = 0; k < Features::kCount; ++k)
+    s += (k ? ", " : "") + std::string(kTargetColumns[k]) + ": " +
+         table.at(chosen[k]).candidate.Name();
+  return s;
 }
 
 }  // namespace whirl::family

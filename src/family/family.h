@@ -24,6 +24,7 @@
 //            refits, or the closed-form leave-one-out of gp/gp.h with its latent variances;
 //            CoverageNoiseVariance below): the network's rule (nn/model.h).
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -112,17 +113,28 @@ void to_json(nlohmann::json& j, const CvRow& r);
 struct ChoiceOptions {
   std::vector<Candidate> candidates = DefaultCandidates();
   int folds = 5;    ///< K of the cross-validation (min(K, rows))
+  /// true: each output takes the candidate with the lowest cross-validated error of that output
+  /// (mean_i (t_ik - mean_-i,k)^2; ties: the earlier candidate), so the two outputs may come
+  /// from different families; false: one candidate for both, by the summed score.
+  bool per_output = true;
   FitOptions fit;
   static std::vector<Candidate> DefaultCandidates();
 };
 
 struct Choice {
-  FamilyModel model;         ///< the chosen candidate, refitted on all rows and calibrated
   std::vector<CvRow> table;  ///< in candidate order
-  int chosen = 0;            ///< index into table
+  std::array<int, Features::kCount> chosen{};  ///< per output: index into table
+  /// The chosen candidates refitted on all rows and calibrated: one per distinct candidate
+  /// in `chosen` (output k is predicted by models[model_of_output[k]]).
+  std::vector<FamilyModel> models;
+  std::array<int, Features::kCount> model_of_output{};
+  std::string Describe() const;  ///< "max_elongation_um: linear/log, settle_time_s: gp-se-constant/log"
 };
 /// The choice of the header comment. InputError if the table has no targets or fewer than 4
 /// rows, or if there are no candidates.
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
+/// Output k from models[model_of_output[k]] (mean and sd).
+std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
+                                            const std::vector<ProcessInputs>& inputs);
 
 }  // namespace whirl::family

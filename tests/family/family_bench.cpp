@@ -1,7 +1,7 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--joint] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -35,6 +35,7 @@ Args Parse(int argc, char** argv) {
     else if (k == "--test") a.test = value();
     else if (k == "--candidates") a.candidates = value();
     else if (k == "--no-cv") a.no_cv = true;
+    else if (k == "--joint") a.choice.per_output = false;
     else if (k == "--seed") a.choice.fit.seed = std::stoull(value());
     else if (k == "--folds") a.choice.folds = std::stoi(value());
     else if (k == "--gp-restarts") a.choice.fit.gp.restarts = std::stoi(value());
@@ -56,16 +57,20 @@ nlohmann::json Run(const Args& a) {
   const auto wall0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
   whirl::family::Choice c;
-  if (a.no_cv) c.model = whirl::family::FitCandidate(train, a.choice.candidates.front(), a.choice.fit);
-  else c = whirl::family::ChooseFamily(train, a.choice);
+  if (a.no_cv) {
+    c.models = {whirl::family::FitCandidate(train, a.choice.candidates.front(), a.choice.fit)};
+    c.table.push_back({a.choice.candidates.front(), {}, 0, 0});
+  } else {
+    c = whirl::family::ChooseFamily(train, a.choice);
+  }
   const double cpu_ms = 1000.0 * static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   const double wall_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
-  nlohmann::json out = {{"chosen", c.model.candidate.Name()}, {"cv_table", c.table},
+  nlohmann::json out = {{"chosen", c.Describe()}, {"cv_table", c.table},
                         {"fit_time_ms", wall_ms}, {"fit_cpu_ms", cpu_ms},
-                        {"calibration", c.model.calibration}};
+                        {"calibration", c.models.front().calibration}};
   out["predictions"] = nlohmann::json::array();
-  for (const auto& p : whirl::family::PredictFamily(c.model, test.inputs))
+  for (const auto& p : whirl::family::PredictChoice(c, test.inputs))
     out["predictions"].push_back({{"mean", {p.mean.max_elongation_um, p.mean.settle_time_s}},
                                   {"sd", {p.stddev.max_elongation_um, p.stddev.settle_time_s}}});
   return out;
