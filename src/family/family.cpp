@@ -162,15 +162,27 @@ void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions&
 
 void CheckTable(const ProcessTable& table);
 
-// Refits each distinct chosen candidate on all rows, with calibration.
-void FitChosen(const ProcessTable& table, const ChoiceOptions& options, Choice* choice) {
+bool UsesClosedForm(const ChoiceOptions& o, const Candidate& c) {
+  return o.closed_form_loo && c.family != Family::kNetwork;
+}
+
+// Fits (or takes from `full`, the closed-form fits) each distinct chosen candidate on all rows,
+// with calibration.
+void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
+               std::vector<FamilyModel>& full, Choice* choice) {
   std::vector<int> fitted;
   for (int k = 0; k < Features::kCount; ++k) {
     const auto it = std::find(fitted.begin(), fitted.end(), choice->chosen[k]);
     choice->model_of_output[k] = static_cast<int>(it - fitted.begin());
     if (it != fitted.end()) continue;
-    fitted.push_back(choice->chosen[k]);
-    choice->models.push_back(FitCandidate(table, options.candidates[choice->chosen[k]], options.fit, true));
+    const int c = choice->chosen[k];
+    fitted.push_back(c);
+    if (UsesClosedForm(options, options.candidates[c])) {
+      Calibrate(table, options.fit, &full[c]);
+      choice->models.push_back(std::move(full[c]));
+    } else {
+      choice->models.push_back(FitCandidate(table, options.candidates[c], options.fit, true));
+    }
   }
 }
 
@@ -232,23 +244,56 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
   if (candidate.family == Family::kNetwork) {
     m.network = FitNetwork(t, candidate, options, calibrate);
     m.calibration = m.network.noise_calibration;
-  } else if (candidate.family == Family::kLinear) {
-    m.linears = FitLinears(t, calibrate);
-    if (calibrate)
-      m.calibration = "per output the smallest noise variance at which +-1 sd covers 68.27 % of "
-                      "the closed-form leave-one-out residuals";
   } else {
-    m.gps = FitGps(t, candidate, options, calibrate);
-    if (calibrate)
-      m.calibration =
-          "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
-          "covers 68.27 % of the " +
-          (options.gp_calibration_folds == 0
-               ? std::string("closed-form leave-one-out residuals")
-               : std::to_string(options.gp_calibration_folds) +
-                     "-fold cross-validation residuals (hyperparameters refitted per fold)");
+    if (candidate.family == Family::kLinear) m.linears = FitLinears(t, false);
+    else m.gps = FitGps(t, candidate, options, false);
+    if (calibrate) Calibrate(table, options, &m);
   }
   return m;
+}
+
+void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
+  const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
+  for (int k = 0; k < Features::kCount; ++k) {
+    const Eigen::VectorXd yk = y.row(k).transpose();
+    if (m->candidate.family == Family::kLinear) {
+      const LinearLeaveOneOut loo = LeaveOneOutLinear(m->linears[k], x, yk);
+      m->linears[k].noise_variance = CoverageNoiseVariance(loo.residual, loo.latent_variance);
+    } else {
+      gp::GpOptions go = options.gp;
+      go.kernel = m->candidate.kernel;
+      go.mean = m->candidate.mean;
+      CalibrateGp(x, yk, go, options.gp_calibration_folds, &m->gps[k]);
+    }
+  }
+  const bool loo = m->candidate.family == Family::kLinear || options.gp_calibration_folds == 0;
+  m->calibration =
+      "per output the smallest noise variance at which +-1 sd (noise + latent variance) covers "
+      "68.27 % of the " +
+      (loo ? std::string("closed-form leave-one-out residuals")
+           : std::to_string(options.gp_calibration_folds) +
+                 "-fold cross-validation residuals (hyperparameters refitted per fold)");
+}
+
+Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTable& table) {
+  if (m.candidate.family == Family::kNetwork)
+    throw InputError("closed-form leave-one-out: not available for " + m.candidate.Name());
+  const Eigen::MatrixXd x = TransformInputs(m.transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::MatrixXd y = TransformTargets(m.transform, t);
+  Eigen::MatrixXd sq(t.rows(), t.cols());
+  for (int k = 0; k < Features::kCount; ++k) {
+    const Eigen::VectorXd yk = y.row(k).transpose();
+    const Eigen::VectorXd r = m.candidate.family == Family::kLinear
+                                  ? LeaveOneOutLinear(m.linears[k], x, yk).residual
+                                  : gp::LeaveOneOutGp(m.gps[k]).residual;
+    for (Eigen::Index i = 0; i < t.cols(); ++i) {
+      const double e = t(k, i) - Inverse(m.transform.outputs[k], yk(i) - r(i));
+      sq(k, i) = e * e;
+    }
+  }
+  return sq;
 }
 
 std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
@@ -324,10 +369,16 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   std::vector<double> ms(static_cast<std::size_t>(nc * folds));
   FitOptions fold_options = options.fit;
   fold_options.threads = 1;
+  std::vector<FamilyModel> full(static_cast<std::size_t>(nc));  // closed-form LOO fits
   ParallelFor(static_cast<std::size_t>(nc * folds), options.fit.threads, [&](std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
     const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
-    FoldErrors(table, options.candidates[c], fold_options, folds, f, &sq[c]);
+    if (!UsesClosedForm(options, options.candidates[c])) {
+      FoldErrors(table, options.candidates[c], fold_options, folds, f, &sq[c]);
+    } else if (f == 0) {
+      full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
+      sq[c] = LeaveOneOutSquaredErrors(full[c], table);
+    }
     ms[i] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   });
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
@@ -348,7 +399,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
         choice.chosen[k] = c;
     }
   }
-  FitChosen(table, options, &choice);
+  FitChosen(table, options, full, &choice);
   return choice;
 }
 

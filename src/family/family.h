@@ -96,6 +96,13 @@ struct FamilyPrediction {
 std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
                                             const std::vector<ProcessInputs>& inputs);
 
+/// Noise calibration of a linear or GP candidate fitted on `table` (see the header comment).
+void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m);
+/// Squared closed-form leave-one-out errors (2 x rows, original units: t_ik - g^-1(z_ik - r_ik)
+/// with r the residual in the transformed space) of a linear or GP candidate fitted on `table`;
+/// InputError for a network.
+Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTable& table);
+
 /// sigma^2 >= 0: the smallest level at which sqrt(sigma^2 + latent_variance[i]) >= |r_i| for at
 /// least 68.27 % of the residuals (bisection; the coverage is monotone in sigma^2). The rule of
 /// nn::CalibrateOutputNoise (nn/model.h). InputError if the sizes differ or are 0.
@@ -117,6 +124,11 @@ struct ChoiceOptions {
   /// (mean_i (t_ik - mean_-i,k)^2; ties: the earlier candidate), so the two outputs may come
   /// from different families; false: one candidate for both, by the summed score.
   bool per_output = true;
+  /// true: linear and GP candidates are scored by their closed-form leave-one-out errors at
+  /// the full fit (family/linear.h, exact; gp/gp.h, exact for the full fit's hyperparameters,
+  /// which have seen the held-out row: optimistic), one fit each instead of K; networks stay
+  /// K-fold. The errors then come from n - 1 training rows instead of (K - 1) n / K.
+  bool closed_form_loo = false;
   FitOptions fit;
   static std::vector<Candidate> DefaultCandidates();
 };

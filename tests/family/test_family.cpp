@@ -102,6 +102,29 @@ TEST(FamilyChoice, ALinearNetworkOnLogColumnsIsAPowerLaw) {
       "pitch_mm = 0");
 }
 
+TEST(FamilyChoice, ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits) {
+  // linear/log: the held-out prediction of a refit without row i, mapped back by exp.
+  const ProcessTable table = MakeTable(12, 0.05, 21);
+  const FamilyModel m = FitCandidate(table, ParseCandidate("linear/log"), {}, false);
+  const Eigen::MatrixXd sq = LeaveOneOutSquaredErrors(m, table);
+  for (int i = 0; i < 12; ++i) {
+    ProcessTable without = table;
+    without.inputs.erase(without.inputs.begin() + i);
+    without.targets.erase(without.targets.begin() + i);
+    const FamilyModel mi = FitCandidate(without, ParseCandidate("linear/log"), {}, false);
+    const FamilyPrediction p = PredictFamily(mi, {table.inputs[i]}).front();
+    for (int k = 0; k < 2; ++k) {
+      const double e = table.targets[i].ToArray()[k] - p.mean.ToArray()[k];
+      EXPECT_NEAR(sq(k, i), e * e, 1e-9 * std::max(1.0, e * e)) << "row " << i << " output " << k;
+    }
+  }
+  ChoiceOptions o;
+  o.closed_form_loo = true;
+  o.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-se-constant/identity")};
+  const Choice c = ChooseFamily(table, o);
+  EXPECT_NEAR(c.table[0].cv_rmse(0), std::sqrt(sq.row(0).mean()), 1e-12);
+}
+
 TEST(FamilyCalibration, CalibratedGpCoversFreshData) {
   // 40 noisy rows of a smooth non-power law: +-1 / +-2 sd coverage on 2000 fresh rows.
   const ProcessTable train = MakeTable(40, 0.05, 5, true), test = MakeTable(2000, 0.05, 6, true);
