@@ -77,31 +77,22 @@ void CalibrateGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const gp::G
   g->noise_variance = s2 / (g->target_scale * g->target_scale);
 }
 
-std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o,
-                           bool calibrate) {
+std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o) {
   const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
   gp::GpOptions go = o.gp;
   go.kernel = c.kernel;
   go.mean = c.mean;
   std::vector<gp::Gp> gps(static_cast<std::size_t>(y.rows()));
   for (Eigen::Index k = 0; k < y.rows(); ++k) {
-    const Eigen::VectorXd yk = y.row(k).transpose();
-    gps[k] = gp::FitGp(x, yk, go);
-    if (calibrate) CalibrateGp(x, yk, go, o.gp_calibration_folds, &gps[k]);
+    gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
   }
   return gps;
 }
 
-std::vector<LinearModel> FitLinears(const ProcessTable& t, bool calibrate) {
+std::vector<LinearModel> FitLinears(const ProcessTable& t) {
   const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
   std::vector<LinearModel> fits;
-  for (Eigen::Index k = 0; k < y.rows(); ++k) {
-    const Eigen::VectorXd yk = y.row(k).transpose();
-    fits.push_back(FitLinear(x, yk));
-    if (!calibrate) continue;
-    const LinearLeaveOneOut loo = LeaveOneOutLinear(fits.back(), x, yk);
-    fits.back().noise_variance = CoverageNoiseVariance(loo.residual, loo.latent_variance);
-  }
+  for (Eigen::Index k = 0; k < y.rows(); ++k) fits.push_back(FitLinear(x, y.row(k).transpose()));
   return fits;
 }
 
@@ -245,8 +236,8 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
     m.network = FitNetwork(t, candidate, options, calibrate);
     m.calibration = m.network.noise_calibration;
   } else {
-    if (candidate.family == Family::kLinear) m.linears = FitLinears(t, false);
-    else m.gps = FitGps(t, candidate, options, false);
+    if (candidate.family == Family::kLinear) m.linears = FitLinears(t);
+    else m.gps = FitGps(t, candidate, options);
     if (calibrate) Calibrate(table, options, &m);
   }
   return m;
@@ -319,6 +310,20 @@ std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
     out[q] = {Features::FromArray(m), Features::FromArray(s)};
   }
   return out;
+}
+
+int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors) {
+  if (squared_errors.empty()) throw InputError("one-standard-error rule: no candidates");
+  std::size_t best = 0;
+  for (std::size_t c = 1; c < squared_errors.size(); ++c)
+    if (squared_errors[c].mean() < squared_errors[best].mean()) best = c;
+  for (std::size_t c = 0; c < squared_errors.size(); ++c) {
+    const Eigen::ArrayXd d = (squared_errors[c] - squared_errors[best]).array();
+    const double n = static_cast<double>(d.size()), mean = d.mean();
+    const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
+    if (mean <= se) return static_cast<int>(c);
+  }
+  return static_cast<int>(best);
 }
 
 double CoverageNoiseVariance(const Eigen::VectorXd& residual, const Eigen::VectorXd& latent_variance) {
@@ -398,6 +403,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
       if (options.per_output ? r.cv_rmse(k) < best.cv_rmse(k) : r.score < best.score)
         choice.chosen[k] = c;
     }
+  }
+  for (int k = 0; k < Features::kCount && options.per_output && options.one_standard_error; ++k) {
+    std::vector<Eigen::VectorXd> output_sq;
+    for (const Eigen::MatrixXd& m : sq) output_sq.push_back(m.row(k).transpose());
+    choice.chosen[k] = SimplestWithinOneStandardError(output_sq);
   }
   FitChosen(table, options, full, &choice);
   return choice;

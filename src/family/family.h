@@ -108,6 +108,12 @@ Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTabl
 /// nn::CalibrateOutputNoise (nn/model.h). InputError if the sizes differ or are 0.
 double CoverageNoiseVariance(const Eigen::VectorXd& residual, const Eigen::VectorXd& latent_variance);
 
+/// ChoiceOptions::one_standard_error for one output: squared_errors[c] holds candidate c's
+/// squared held-out errors per row (candidates from the simplest); returns the first c with
+/// mean(d) <= sd(d) / sqrt(n), d = squared_errors[c] - squared_errors[b], b the lowest mean.
+/// InputError without candidates.
+int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors);
+
 /// One row of the choice table.
 struct CvRow {
   Candidate candidate;
@@ -124,6 +130,16 @@ struct ChoiceOptions {
   /// (mean_i (t_ik - mean_-i,k)^2; ties: the earlier candidate), so the two outputs may come
   /// from different families; false: one candidate for both, by the summed score.
   bool per_output = true;
+  /// true: the one-standard-error rule (Breiman, Friedman, Olshen & Stone, "Classification and
+  /// Regression Trees", 1984, section 3.4.3; Hastie, Tibshirani & Friedman, "The Elements of
+  /// Statistical Learning", section 7.10), with `candidates` listed from the simplest: per
+  /// output the first candidate c whose CV error exceeds the lowest one (candidate b) by at most
+  /// one standard error of the paired differences, mean_i(d_i) <= sd(d) / sqrt(n) with
+  /// d_i = e_ci^2 - e_bi^2 (squared held-out errors of row i). Why: at 20 rows the CV errors
+  /// of several candidates differ by less than their noise, and the lowest of them is biased
+  /// low (scripts/bench_peers.sh, simulator tables: the power law lost to a GP chosen by CV).
+  /// Applies to per_output choices.
+  bool one_standard_error = true;
   /// true: linear and GP candidates are scored by their closed-form leave-one-out errors at
   /// the full fit (family/linear.h, exact; gp/gp.h, exact for the full fit's hyperparameters,
   /// which have seen the held-out row: optimistic), one fit each instead of K; networks stay

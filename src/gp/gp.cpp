@@ -77,14 +77,10 @@ Eigen::VectorXd Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta,
   const Eigen::MatrixXd wg = w.cwiseProduct(f.g);
   Eigen::VectorXd grad(d + 2);
   for (int i = 0; i < d; ++i) {
-    const double inv_l = std::exp(-theta(i));
+    const Eigen::ArrayXd zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
     double s = 0;
-    for (int q = 0; q < n; ++q)
-      for (int p = 0; p < n; ++p) {
-        const double dz = (z(i, p) - z(i, q)) * inv_l;
-        s += wg(p, q) * dz * dz;
-      }
-    grad(i) = -0.5 * s;
+    for (int q = 0; q < n; ++q) s += (wg.col(q).array() * (zi - zi(q)).square()).sum();
+    grad(i) = -0.5 * s * std::exp(-2.0 * theta(i));
   }
   grad(d) = -w.cwiseProduct(f.kf).sum();
   grad(d + 1) = -0.5 * w.trace() * dsn2_dtheta;

@@ -46,6 +46,14 @@ std::string ToString(Mean m);    ///< "constant", "linear"
 Kernel ParseKernel(const std::string& s);  ///< inverse; InputError otherwise
 Mean ParseMean(const std::string& s);      ///< inverse; InputError otherwise
 
+/// core/bfgs.h defaults with function_tolerance 1e-7 and gradient_tolerance 1e-4.
+inline BfgsOptions GpBfgsDefaults() {
+  BfgsOptions b;
+  b.function_tolerance = 1e-7;
+  b.gradient_tolerance = 1e-4;
+  return b;
+}
+
 struct GpOptions {
   Kernel kernel = Kernel::kMatern52;
   Mean mean = Mean::kConstant;
@@ -55,7 +63,9 @@ struct GpOptions {
   /// Floor added to s_n^2, standardized target units (keeps K well conditioned when the data
   /// are interpolated; 1e-6 = noise sd of 0.1 % of the target's sd).
   double min_noise_variance = 1e-6;
-  BfgsOptions bfgs;  ///< the optimizer's options
+  /// The optimizer's options; NLML is in nats, so the relative decrease of 1e-7 (about 1e-5
+  /// nats) and max |dNLML/dtheta| <= 1e-4 are far below what changes a prediction.
+  BfgsOptions bfgs = GpBfgsDefaults();
   void Validate() const;  ///< InputError naming the option, its value and the rule
 };
 inline constexpr int kStartCount = 4;

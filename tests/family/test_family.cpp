@@ -52,6 +52,7 @@ TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
   ChoiceOptions o;
   o.candidates = {ParseCandidate("gp-matern52-constant/identity"),
                   ParseCandidate("gp-se-linear/log"), ParseCandidate("network-h6/identity")};
+  o.one_standard_error = false;  // the plain lowest error (tested alone below)
   for (const bool per_output : {false, true}) {
     o.per_output = per_output;
     const Choice c = ChooseFamily(train, o);
@@ -142,6 +143,22 @@ TEST(FamilyCalibration, CalibratedGpCoversFreshData) {
       EXPECT_NEAR(in2 / 2000.0, 0.95, 0.05) << name << " output " << k;
     }
   }
+}
+
+TEST(FamilyChoice, OneStandardErrorRuleOnHandComputedCases) {
+  Eigen::VectorXd a(4), b(4);
+  a << 1, 1, 1, 1;
+  b << 0.9, 0.9, 0.9, 0.9;  // lower on every row: d = 0.1 with sd 0
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 1);
+  a << 1, 2, 1, 2;  // mean 1.5
+  b << 1.5, 1.0, 1.2, 1.5;  // mean 1.3; d = (-0.5, 1, -0.2, 0.5), mean 0.2, sd sqrt(0.46)
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 0);  // 0.2 <= sqrt(0.46) / 2 = 0.339
+  a << 1, 2.4, 1, 2;  // mean 1.6; d = (-0.5, 1.4, -0.2, 0.5), mean 0.3, sd 0.845
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 0);  // 0.3 <= 0.845 / 2
+  a << 2, 2, 2, 2.1;  // d = (0.5, 1, 0.8, 0.6): mean 0.725 > se 0.11
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 1);
+  EXPECT_EQ(SimplestWithinOneStandardError({b, a}), 0);
+  ExpectInputError([] { SimplestWithinOneStandardError({}); }, "no candidates");
 }
 
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
