@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 
 #include "core/error.h"
 #include "core/numbers.h"
@@ -50,31 +51,65 @@ nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions
   return nn::TrainModel(t, m, t.source);
 }
 
-// GP noise of the family header from closed-form leave-one-out (folds == 0) or from K-fold
-// refits warm-started at the full fit's hyperparameters (folds = K), residuals r and latent
-// variances v in units of y; the noise is CoverageNoiseVariance(r, v).
+// Held-out residuals r and latent variances v (units of y) of K-fold refits, row q held out in
+// fold q % K; fit_predict(train rows, held-out rows, &mean, &latent variance).
+using FoldFitPredict = std::function<void(const Eigen::VectorXi&, const Eigen::VectorXi&,
+                                          Eigen::VectorXd*, Eigen::VectorXd*)>;
+void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FoldFitPredict& fit_predict,
+                    Eigen::VectorXd* r, Eigen::VectorXd* v) {
+  const int n = static_cast<int>(y.size()), k = std::min(folds, n);
+  r->resize(n);
+  v->resize(n);
+  for (int f = 0; f < k; ++f) {
+    std::vector<int> tr, te;
+    for (int q = 0; q < n; ++q) (q % k == f ? te : tr).push_back(q);
+    const Eigen::VectorXi tri = Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
+    const Eigen::VectorXi tei = Eigen::Map<Eigen::VectorXi>(te.data(), static_cast<Eigen::Index>(te.size()));
+    Eigen::VectorXd mean, latent;
+    fit_predict(tri, tei, &mean, &latent);
+    (*r)(tei) = y(tei) - mean;
+    (*v)(tei) = latent;
+  }
+}
+
+// GP noise (FitOptions::calibration_folds): closed-form LOO or K-fold refits warm-started at the
+// full fit's hyperparameters.
 void CalibrateGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const gp::GpOptions& o,
                  int folds, gp::Gp* g) {
-  Eigen::VectorXd r(y.size()), v(y.size());
+  Eigen::VectorXd r, v;
   if (folds == 0) {
     const gp::LeaveOneOut loo = gp::LeaveOneOutGp(*g);
     r = loo.residual;
     v = loo.latent_variance;
   } else {
-    const int n = static_cast<int>(y.size()), k = std::min(folds, n);
-    for (int f = 0; f < k; ++f) {
-      std::vector<int> tr, te;
-      for (int q = 0; q < n; ++q) (q % k == f ? te : tr).push_back(q);
-      const Eigen::VectorXi tri = Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
-      const Eigen::VectorXi tei = Eigen::Map<Eigen::VectorXi>(te.data(), static_cast<Eigen::Index>(te.size()));
-      const gp::Gp fold = gp::FitGpFrom(x(Eigen::all, tri), y(tri), o, g->theta);
-      const gp::GpPrediction p = gp::PredictGp(fold, x(Eigen::all, tei));
-      r(tei) = y(tei) - p.mean;
-      v(tei) = p.latent_variance;
-    }
+    KFoldResiduals(y, folds, [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te,
+                                 Eigen::VectorXd* mean, Eigen::VectorXd* latent) {
+      const gp::GpPrediction p = gp::PredictGp(gp::FitGpFrom(x(Eigen::all, tr), y(tr), o, g->theta),
+                                               x(Eigen::all, te));
+      *mean = p.mean;
+      *latent = p.latent_variance;
+    }, &r, &v);
   }
-  const double s2 = CoverageNoiseVariance(r, v);
-  g->noise_variance = s2 / (g->target_scale * g->target_scale);
+  g->noise_variance = CoverageNoiseVariance(r, v) / (g->target_scale * g->target_scale);
+}
+
+// Least-squares noise (FitOptions::calibration_folds): exact closed-form LOO or K-fold refits.
+void CalibrateLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int folds,
+                     LinearModel* m) {
+  Eigen::VectorXd r, v;
+  if (folds == 0) {
+    const LinearLeaveOneOut loo = LeaveOneOutLinear(*m, x, y);
+    r = loo.residual;
+    v = loo.latent_variance;
+  } else {
+    KFoldResiduals(y, folds, [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te,
+                                 Eigen::VectorXd* mean, Eigen::VectorXd* latent) {
+      const LinearPrediction p = PredictLinear(FitLinear(x(Eigen::all, tr), y(tr)), x(Eigen::all, te));
+      *mean = p.mean;
+      *latent = p.latent_variance;
+    }, &r, &v);
+  }
+  m->noise_variance = CoverageNoiseVariance(r, v);
 }
 
 std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o) {
@@ -249,22 +284,20 @@ void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel
   for (int k = 0; k < Features::kCount; ++k) {
     const Eigen::VectorXd yk = y.row(k).transpose();
     if (m->candidate.family == Family::kLinear) {
-      const LinearLeaveOneOut loo = LeaveOneOutLinear(m->linears[k], x, yk);
-      m->linears[k].noise_variance = CoverageNoiseVariance(loo.residual, loo.latent_variance);
+      CalibrateLinear(x, yk, options.calibration_folds, &m->linears[k]);
     } else {
       gp::GpOptions go = options.gp;
       go.kernel = m->candidate.kernel;
       go.mean = m->candidate.mean;
-      CalibrateGp(x, yk, go, options.gp_calibration_folds, &m->gps[k]);
+      CalibrateGp(x, yk, go, options.calibration_folds, &m->gps[k]);
     }
   }
-  const bool loo = m->candidate.family == Family::kLinear || options.gp_calibration_folds == 0;
   m->calibration =
       "per output the smallest noise variance at which +-1 sd (noise + latent variance) covers "
       "68.27 % of the " +
-      (loo ? std::string("closed-form leave-one-out residuals")
-           : std::to_string(options.gp_calibration_folds) +
-                 "-fold cross-validation residuals (hyperparameters refitted per fold)");
+      (options.calibration_folds == 0
+           ? std::string("closed-form leave-one-out residuals")
+           : std::to_string(options.calibration_folds) + "-fold cross-validation residuals (refits)");
 }
 
 Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTable& table) {

@@ -16,11 +16,11 @@
 //
 // Predictive sd, per output, in the candidate's transformed space, then mapped back by the delta
 // method (family/transform.h):
-//   linear:  sqrt(latent variance + s_k^2), s_k^2 by CoverageNoiseVariance from the exact
-//            closed-form leave-one-out residuals (family/linear.h);
+//   linear:  sqrt(latent variance + s_k^2), s_k^2 by CoverageNoiseVariance from K-fold or the
+//            exact closed-form leave-one-out residuals (family/linear.h);
 //   network: nn::Predict (noise calibrated by nn's K-fold cross-validation, nn/model.h);
 //   gp:      sqrt(latent variance + s_k^2), s_k^2 = the smallest level at which +-1 sd covers
-//            68.27 % of cross-validated residuals (FitOptions::gp_calibration_folds: K-fold
+//            68.27 % of cross-validated residuals (FitOptions::calibration_folds: K-fold
 //            refits, or the closed-form leave-one-out of gp/gp.h with its latent variances;
 //            CoverageNoiseVariance below): the network's rule (nn/model.h).
 #include <Eigen/Core>
@@ -63,11 +63,13 @@ struct FitOptions {
   int network_restarts = 1;
   int network_noise_folds = 5;  ///< nn::ModelTrainOptions::noise_folds of the final network
   gp::GpOptions gp;             ///< the GP's options (kernel and mean come from the candidate)
-  /// GP noise calibration: 0 = closed-form leave-one-out at the full fit's hyperparameters;
-  /// K > 0 = K-fold cross-validation (min(K, rows) folds, row q held out in fold q % K), each
-  /// fold's GP refitted from the full fit's hyperparameters (one start), its held-out residuals
-  /// and latent variances in CoverageNoiseVariance (the network's rule, nn/model.h).
-  int gp_calibration_folds = 5;
+  /// Noise calibration of linear and GP candidates: 0 = closed-form leave-one-out (for a GP at
+  /// the full fit's hyperparameters); K > 0 = K-fold cross-validation (min(K, rows) folds, row
+  /// q held out in fold q % K; a GP refitted from the full fit's hyperparameters, one start),
+  /// the held-out residuals and latent variances in CoverageNoiseVariance (the network's rule,
+  /// nn/model.h). Why K-fold for both: leave-one-out residuals come from fits on n - 1 rows and
+  /// undercovered the simulator's hold-out tables (scripts/bench_peers.sh, 20 rows).
+  int calibration_folds = 5;
   int threads = 1;              ///< core/parallel.h; the result is the same for any count
 };
 
