@@ -72,44 +72,71 @@ void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FoldFitPredict& f
   }
 }
 
-// GP noise (FitOptions::calibration_folds): closed-form LOO or K-fold refits warm-started at the
-// full fit's hyperparameters.
-void CalibrateGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const gp::GpOptions& o,
-                 int folds, gp::Gp* g) {
-  Eigen::VectorXd r, v;
-  if (folds == 0) {
-    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(*g);
-    r = loo.residual;
-    v = loo.latent_variance;
-  } else {
-    KFoldResiduals(y, folds, [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te,
-                                 Eigen::VectorXd* mean, Eigen::VectorXd* latent) {
-      const gp::GpPrediction p = gp::PredictGp(gp::FitGpFrom(x(Eigen::all, tr), y(tr), o, g->theta),
-                                               x(Eigen::all, te));
-      *mean = p.mean;
-      *latent = p.latent_variance;
-    }, &r, &v);
-  }
-  g->noise_variance = CoverageNoiseVariance(r, v) / (g->target_scale * g->target_scale);
+gp::GpOptions CandidateGpOptions(const FitOptions& o, const Candidate& c) {
+  gp::GpOptions go = o.gp;
+  go.kernel = c.kernel;
+  go.mean = c.mean;
+  return go;
 }
 
-// Least-squares noise (FitOptions::calibration_folds): exact closed-form LOO or K-fold refits.
-void CalibrateLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int folds,
-                     LinearModel* m) {
+// Output k of a linear or GP candidate fitted on (x, y): held-out residuals r and latent variances
+// v (transformed units) by closed-form leave-one-out (folds == 0) or K-fold refits (a GP from the
+// full fit's hyperparameters, one start).
+struct HeldOut {
   Eigen::VectorXd r, v;
+};
+HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
+                      const Eigen::VectorXd& y, const FitOptions& o, int folds) {
+  HeldOut h;
+  const bool linear = m.candidate.family == Family::kLinear;
+  if (folds == 0 && linear) {
+    const LinearLeaveOneOut loo = LeaveOneOutLinear(m.linears[k], x, y);
+    return {loo.residual, loo.latent_variance};
+  }
   if (folds == 0) {
-    const LinearLeaveOneOut loo = LeaveOneOutLinear(*m, x, y);
-    r = loo.residual;
-    v = loo.latent_variance;
-  } else {
-    KFoldResiduals(y, folds, [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te,
-                                 Eigen::VectorXd* mean, Eigen::VectorXd* latent) {
+    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(m.gps[k]);
+    return {loo.residual, loo.latent_variance};
+  }
+  const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
+  KFoldResiduals(y, folds, [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te,
+                               Eigen::VectorXd* mean, Eigen::VectorXd* latent) {
+    if (linear) {
       const LinearPrediction p = PredictLinear(FitLinear(x(Eigen::all, tr), y(tr)), x(Eigen::all, te));
       *mean = p.mean;
       *latent = p.latent_variance;
-    }, &r, &v);
+      return;
+    }
+    const gp::GpPrediction p =
+        gp::PredictGp(gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta), x(Eigen::all, te));
+    *mean = p.mean;
+    *latent = p.latent_variance;
+  }, &h.r, &h.v);
+  return h;
+}
+
+// The noise of output k from its held-out residuals (CoverageNoiseVariance).
+void SetNoise(const HeldOut& h, int k, FamilyModel* m) {
+  const double s2 = CoverageNoiseVariance(h.r, h.v);
+  if (m->candidate.family == Family::kLinear) m->linears[k].noise_variance = s2;
+  else m->gps[k].noise_variance = s2 / (m->gps[k].target_scale * m->gps[k].target_scale);
+}
+
+std::string CalibrationText(int folds) {
+  return "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
+         "covers 68.27 % of the " +
+         (folds == 0 ? std::string("closed-form leave-one-out residuals")
+                     : std::to_string(folds) + "-fold cross-validation residuals (refits)");
+}
+
+// Squared held-out errors in original units, t_ik - g^-1(z_ik - r_ik), of output k.
+Eigen::RowVectorXd OriginalSquaredErrors(const FamilyModel& m, int k, const Eigen::RowVectorXd& t,
+                                         const Eigen::VectorXd& z, const HeldOut& h) {
+  Eigen::RowVectorXd sq(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double e = t(i) - Inverse(m.transform.outputs[k], z(i) - h.r(i));
+    sq(i) = e * e;
   }
-  m->noise_variance = CoverageNoiseVariance(r, v);
+  return sq;
 }
 
 std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o) {
@@ -188,8 +215,11 @@ void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions&
 
 void CheckTable(const ProcessTable& table);
 
-bool UsesClosedForm(const ChoiceOptions& o, const Candidate& c) {
-  return o.closed_form_loo && c.family != Family::kNetwork;
+// Folds of the held-out errors of linear and GP candidates: 0 = closed-form leave-one-out.
+int HeldOutFolds(const ChoiceOptions& o, int folds) { return o.closed_form_loo ? 0 : folds; }
+// The choice's held-out residuals are the calibration's when both use the same folds.
+bool ReusesCalibration(const ChoiceOptions& o, int folds) {
+  return HeldOutFolds(o, folds) == std::min(o.fit.calibration_folds, folds);
 }
 
 // Fits (or takes from `full`, the closed-form fits) each distinct chosen candidate on all rows,
@@ -203,8 +233,9 @@ void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
     if (it != fitted.end()) continue;
     const int c = choice->chosen[k];
     fitted.push_back(c);
-    if (UsesClosedForm(options, options.candidates[c])) {
-      Calibrate(table, options.fit, &full[c]);
+    if (options.candidates[c].family != Family::kNetwork) {
+      const int folds = std::min(options.folds, static_cast<int>(table.inputs.size()));
+      if (!ReusesCalibration(options, folds)) Calibrate(table, options.fit, &full[c]);
       choice->models.push_back(std::move(full[c]));
     } else {
       choice->models.push_back(FitCandidate(table, options.candidates[c], options.fit, true));
@@ -281,43 +312,31 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
 void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
   const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
   const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
+  for (int k = 0; k < Features::kCount; ++k)
+    SetNoise(OutputHeldOut(*m, k, x, y.row(k).transpose(), options, options.calibration_folds), k, m);
+  m->calibration = CalibrationText(options.calibration_folds);
+}
+
+Eigen::MatrixXd HeldOutSquaredErrors(const ProcessTable& table, const FitOptions& options,
+                                     int folds, FamilyModel* m, bool calibrate) {
+  if (m->candidate.family == Family::kNetwork)
+    throw InputError("held-out errors of a fitted model: not available for " + m->candidate.Name());
+  const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::MatrixXd y = TransformTargets(m->transform, t);
+  Eigen::MatrixXd sq(t.rows(), t.cols());
   for (int k = 0; k < Features::kCount; ++k) {
-    const Eigen::VectorXd yk = y.row(k).transpose();
-    if (m->candidate.family == Family::kLinear) {
-      CalibrateLinear(x, yk, options.calibration_folds, &m->linears[k]);
-    } else {
-      gp::GpOptions go = options.gp;
-      go.kernel = m->candidate.kernel;
-      go.mean = m->candidate.mean;
-      CalibrateGp(x, yk, go, options.calibration_folds, &m->gps[k]);
-    }
+    const HeldOut h = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds);
+    sq.row(k) = OriginalSquaredErrors(*m, k, t.row(k), y.row(k).transpose(), h);
+    if (calibrate) SetNoise(h, k, m);
   }
-  m->calibration =
-      "per output the smallest noise variance at which +-1 sd (noise + latent variance) covers "
-      "68.27 % of the " +
-      (options.calibration_folds == 0
-           ? std::string("closed-form leave-one-out residuals")
-           : std::to_string(options.calibration_folds) + "-fold cross-validation residuals (refits)");
+  if (calibrate) m->calibration = CalibrationText(folds);
+  return sq;
 }
 
 Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTable& table) {
-  if (m.candidate.family == Family::kNetwork)
-    throw InputError("closed-form leave-one-out: not available for " + m.candidate.Name());
-  const Eigen::MatrixXd x = TransformInputs(m.transform, nn::InputMatrix(table.inputs));
-  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
-  const Eigen::MatrixXd y = TransformTargets(m.transform, t);
-  Eigen::MatrixXd sq(t.rows(), t.cols());
-  for (int k = 0; k < Features::kCount; ++k) {
-    const Eigen::VectorXd yk = y.row(k).transpose();
-    const Eigen::VectorXd r = m.candidate.family == Family::kLinear
-                                  ? LeaveOneOutLinear(m.linears[k], x, yk).residual
-                                  : gp::LeaveOneOutGp(m.gps[k]).residual;
-    for (Eigen::Index i = 0; i < t.cols(); ++i) {
-      const double e = t(k, i) - Inverse(m.transform.outputs[k], yk(i) - r(i));
-      sq(k, i) = e * e;
-    }
-  }
-  return sq;
+  FamilyModel copy = m;
+  return HeldOutSquaredErrors(table, {}, 0, &copy, false);
 }
 
 std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
@@ -385,15 +404,9 @@ void to_json(nlohmann::json& j, const CvRow& r) {
 
 std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   std::vector<Candidate> c;
-  for (const bool log : {false, true}) {
-    Candidate net;
-    net.family = Family::kNetwork;
-    net.log = log;
-    c.push_back(net);
-    Candidate g;
-    g.log = log;
-    c.push_back(g);
-  }
+  for (const char* name : {"linear/log", "linear/identity", "gp-matern52-constant/log",
+                           "gp-matern52-constant/identity"})
+    c.push_back(ParseCandidate(name));
   return c;
 }
 
@@ -411,11 +424,12 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   ParallelFor(static_cast<std::size_t>(nc * folds), options.fit.threads, [&](std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
     const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
-    if (!UsesClosedForm(options, options.candidates[c])) {
+    if (options.candidates[c].family == Family::kNetwork) {
       FoldErrors(table, options.candidates[c], fold_options, folds, f, &sq[c]);
-    } else if (f == 0) {
+    } else if (f == 0) {  // one full fit, its held-out errors (and calibration) from it
       full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
-      sq[c] = LeaveOneOutSquaredErrors(full[c], table);
+      sq[c] = HeldOutSquaredErrors(table, fold_options, HeldOutFolds(options, folds), &full[c],
+                                   ReusesCalibration(options, folds));
     }
     ms[i] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   });
