@@ -1,8 +1,8 @@
 // The family library's fits (src/family, src/gp) on the simulator's tables, beside one trainbr fit
 // and whirl's current default network fit in the same run, all on one thread:
-//   BM_FamilyDefault/rows:R    ChooseFamily with the default candidates and options (the
-//                              cross-validated choice, then the chosen candidate's fit and
-//                              calibration); the speed target of the default is 2.5 ms for
+//   BM_FamilyDefault/rows:R/loo:L  ChooseFamily with the default candidates (the
+//                              cross-validated choice, then the chosen candidates' fits and
+//                              calibration); the speed target of the default is 2.5 ms CPU for
 //                              20 rows, both outputs;
 //   BM_FamilyCandidate/rows:R/candidate:C   FitCandidate of DefaultCandidates()[C] (with its
 //                              calibration; no choice);
@@ -27,16 +27,22 @@ whirl::ProcessTable Table(int rows) {
   return t;
 }
 
+// Argument loo: ChoiceOptions::closed_form_loo (0: K-fold refits of each candidate's full fit;
+// 1: closed-form leave-one-out, then the chosen candidates' K-fold calibration).
 void BM_FamilyDefault(benchmark::State& state) {
   const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
   whirl::family::ChoiceOptions o;
   o.fit.threads = 1;
+  o.closed_form_loo = state.range(1) == 1;
   for (auto _ : state) {
     const whirl::family::Choice c = whirl::family::ChooseFamily(table, o);
     benchmark::DoNotOptimize(c.chosen);
   }
 }
-BENCHMARK(BM_FamilyDefault)->ArgName("rows")->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FamilyDefault)
+    ->ArgNames({"rows", "loo"})
+    ->ArgsProduct({{20, 100}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_FamilyCandidate(benchmark::State& state) {
   const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
