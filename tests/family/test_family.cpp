@@ -53,11 +53,12 @@ TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
   o.candidates = {ParseCandidate("gp-matern52-constant/identity"),
                   ParseCandidate("gp-se-linear/log"), ParseCandidate("network-h6/identity")};
   o.one_standard_error = false;  // the plain lowest error (tested alone below)
+  o.closed_form_loo = false;      // 5-fold refits for every candidate
   for (const bool per_output : {false, true}) {
     o.per_output = per_output;
     const Choice c = ChooseFamily(train, o);
     ASSERT_EQ(c.table.size(), 3u);
-    ASSERT_EQ(c.models.size(), 1u);
+    ASSERT_EQ(c.models.size(), 1u) << c.Describe() << nlohmann::json(c.table).dump();
     EXPECT_EQ(c.models[0].candidate.Name(), "gp-se-linear/log");
     for (int k = 0; k < 2; ++k) {
       EXPECT_EQ(c.table[c.chosen[k]].candidate.Name(), "gp-se-linear/log");
@@ -67,6 +68,10 @@ TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
     }
     EXPECT_LT(MaxRelativeError(c.models[0], test), 0.03);
   }
+  o.closed_form_loo = true;  // GP by closed-form LOO, the network by 5-fold refits
+  o.per_output = false;
+  EXPECT_EQ(ChooseFamily(train, o).Describe(),
+            "max_elongation_um: gp-se-linear/log, settle_time_s: gp-se-linear/log");
 }
 
 TEST(FamilyChoice, OutputsMayComeFromDifferentFamilies) {
@@ -101,6 +106,28 @@ TEST(FamilyChoice, ALinearNetworkOnLogColumnsIsAPowerLaw) {
         PredictFamily(log_net, in);
       },
       "pitch_mm = 0");
+}
+
+TEST(FamilyChoice, SameResultOnAnyThreadCountAndWithKFoldScoring) {
+  const ProcessTable train = MakeTable(24, 0.05, 31, true), test = MakeTable(50, 0.0, 32, true);
+  for (const bool loo : {true, false}) {
+    ChoiceOptions o;
+    o.closed_form_loo = loo;
+    o.candidates.push_back(ParseCandidate("network-h4/identity"));
+    const Choice one = ChooseFamily(train, o);
+    o.fit.threads = 2;
+    const Choice two = ChooseFamily(train, o);
+    ASSERT_EQ(one.Describe(), two.Describe());
+    const std::vector<FamilyPrediction> a = PredictChoice(one, test.inputs);
+    const std::vector<FamilyPrediction> b = PredictChoice(two, test.inputs);
+    for (std::size_t q = 0; q < a.size(); ++q)
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_EQ(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k]);
+        EXPECT_EQ(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k]);
+      }
+    for (std::size_t c = 0; c < one.table.size(); ++c)
+      EXPECT_EQ(one.table[c].score, two.table[c].score);
+  }
 }
 
 TEST(FamilyChoice, ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits) {
