@@ -130,6 +130,28 @@ TEST(FamilyChoice, SameResultOnAnyThreadCountAndWithKFoldScoring) {
   }
 }
 
+TEST(FamilyChoice, ChosenModelsEqualAFreshCalibratedFit) {
+  // Whether the choice reuses its held-out residuals for the calibration (K-fold scoring) or
+  // calibrates afterwards (closed-form LOO scoring), the chosen model predicts as FitCandidate.
+  const ProcessTable train = MakeTable(24, 0.05, 41, true), test = MakeTable(30, 0.0, 42, true);
+  for (const bool loo : {true, false})
+    for (const char* name : {"linear/log", "gp-matern52-constant/identity"}) {
+      ChoiceOptions o;
+      o.closed_form_loo = loo;
+      o.candidates = {ParseCandidate(name)};
+      const Choice c = ChooseFamily(train, o);
+      const FamilyModel fresh = FitCandidate(train, ParseCandidate(name), o.fit);
+      const std::vector<FamilyPrediction> a = PredictChoice(c, test.inputs);
+      const std::vector<FamilyPrediction> b = PredictFamily(fresh, test.inputs);
+      for (std::size_t q = 0; q < a.size(); ++q)
+        for (int k = 0; k < 2; ++k) {
+          EXPECT_NEAR(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k], 1e-9) << name;
+          EXPECT_NEAR(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k], 1e-9) << name << " loo " << loo;
+        }
+      EXPECT_EQ(c.models[0].calibration, fresh.calibration);
+    }
+}
+
 TEST(FamilyChoice, ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits) {
   // linear/log: the held-out prediction of a refit without row i, mapped back by exp.
   const ProcessTable table = MakeTable(12, 0.05, 21);
