@@ -1,7 +1,7 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--joint] [--loo] [--no-1se] [--gp-ftol F] [--calibration-folds K] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--joint] [--loo|--kfold] [--no-1se] [--gp-ftol F] [--calibration-folds K] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -37,6 +37,7 @@ Args Parse(int argc, char** argv) {
     else if (k == "--no-cv") a.no_cv = true;
     else if (k == "--joint") a.choice.per_output = false;
     else if (k == "--loo") a.choice.closed_form_loo = true;
+    else if (k == "--kfold") a.choice.closed_form_loo = false;
     else if (k == "--no-1se") a.choice.one_standard_error = false;
     else if (k == "--gp-ftol") a.choice.fit.gp.bfgs.function_tolerance = std::stod(value());
     else if (k == "--calibration-folds") a.choice.fit.calibration_folds = std::stoi(value());
