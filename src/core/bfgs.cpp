@@ -97,8 +97,7 @@ class LineSearch {
 
 void ValidateOptions(const BfgsOptions& o) {
   if (o.max_iterations < 0)
-    throw InputError("bfgs: max_iterations " + std::to_string(o.max_iterations) +
-                     ": must be >= 0");
+    throw InputError("bfgs: max_iterations " + std::to_string(o.max_iterations) + ": must be >= 0");
   if (o.max_line_search_steps < 1)
     throw InputError("bfgs: max_line_search_steps " + std::to_string(o.max_line_search_steps) +
                      ": must be >= 1");
@@ -125,11 +124,16 @@ bool UpdateInverseHessian(const Eigen::VectorXd& s, const Eigen::VectorXd& y, bo
 
 std::string ToString(BfgsTermination t) {
   switch (t) {
-    case BfgsTermination::kGradientTolerance: return "gradient_tolerance";
-    case BfgsTermination::kFunctionTolerance: return "function_tolerance";
-    case BfgsTermination::kMaxIterations: return "max_iterations";
-    case BfgsTermination::kLineSearchFailed: return "line_search_failed";
-    case BfgsTermination::kNonFiniteStart: return "non_finite_start";
+    case BfgsTermination::kGradientTolerance:
+      return "gradient_tolerance";
+    case BfgsTermination::kFunctionTolerance:
+      return "function_tolerance";
+    case BfgsTermination::kMaxIterations:
+      return "max_iterations";
+    case BfgsTermination::kLineSearchFailed:
+      return "line_search_failed";
+    case BfgsTermination::kNonFiniteStart:
+      return "non_finite_start";
   }
   return "unknown";
 }
@@ -140,8 +144,7 @@ std::string BfgsSummary::BriefReport() const {
          " evaluations), " + ToString(termination) + " (" + message + ")";
 }
 
-BfgsSummary MinimizeBfgs(const SmoothObjective& f, Eigen::VectorXd* x,
-                         const BfgsOptions& options) {
+BfgsSummary MinimizeBfgs(const SmoothObjective& f, Eigen::VectorXd* x, const BfgsOptions& options) {
   ValidateOptions(options);
   BfgsSummary s;
   Trial cur;
@@ -162,8 +165,8 @@ BfgsSummary MinimizeBfgs(const SmoothObjective& f, Eigen::VectorXd* x,
     const double gmax = cur.g.cwiseAbs().maxCoeff();
     if (gmax <= options.gradient_tolerance) {
       s.termination = BfgsTermination::kGradientTolerance;
-      s.message = "max |g| " + MessageNumber(gmax) + " <= " +
-                  MessageNumber(options.gradient_tolerance);
+      s.message =
+          "max |g| " + MessageNumber(gmax) + " <= " + MessageNumber(options.gradient_tolerance);
       break;
     }
     Eigen::VectorXd p = -h * cur.g;
@@ -191,8 +194,8 @@ BfgsSummary MinimizeBfgs(const SmoothObjective& f, Eigen::VectorXd* x,
     if (decrease <= options.function_tolerance * std::max(1.0, std::abs(cur.f))) {
       ++s.iterations;
       s.termination = BfgsTermination::kFunctionTolerance;
-      s.message = "decrease " + MessageNumber(decrease) + " <= " +
-                  MessageNumber(options.function_tolerance) + " * max(1, |f|)";
+      s.message = "decrease " + MessageNumber(decrease) +
+                  " <= " + MessageNumber(options.function_tolerance) + " * max(1, |f|)";
       break;
     }
   }

@@ -30,9 +30,9 @@ namespace whirl {
 using SmoothObjective = std::function<double(const Eigen::VectorXd& x, Eigen::VectorXd* gradient)>;
 
 struct BfgsOptions {
-  int max_iterations = 200;         ///< outer iterations (line searches)
-  int max_line_search_steps = 30;   ///< function evaluations per line search
-  double gradient_tolerance = 1e-6; ///< stop when max_i |g_i| <= this (units of f per unit x)
+  int max_iterations = 200;          ///< outer iterations (line searches)
+  int max_line_search_steps = 30;    ///< function evaluations per line search
+  double gradient_tolerance = 1e-6;  ///< stop when max_i |g_i| <= this (units of f per unit x)
   /// Stop when |f_k - f_k+1| <= function_tolerance * max(1, |f_k+1|) (relative decrease).
   double function_tolerance = 1e-10;
   double wolfe_c1 = 1e-4;  ///< sufficient-decrease constant c1 (Nocedal & Wright: 1e-4)
@@ -49,13 +49,13 @@ enum class BfgsTermination {
 std::string ToString(BfgsTermination t);  ///< "gradient_tolerance", ...
 
 struct BfgsSummary {
-  double initial_cost = 0;  ///< f(x_0)
-  double final_cost = 0;    ///< f at the returned x (the lowest value seen)
+  double initial_cost = 0;       ///< f(x_0)
+  double final_cost = 0;         ///< f at the returned x (the lowest value seen)
   double gradient_max_norm = 0;  ///< max |g_i| at the returned x
   int iterations = 0;
-  int evaluations = 0;      ///< calls of the objective
+  int evaluations = 0;  ///< calls of the objective
   BfgsTermination termination = BfgsTermination::kMaxIterations;
-  std::string message;      ///< the reason with the numbers it compared
+  std::string message;  ///< the reason with the numbers it compared
   /// "bfgs: f 12.3 -> 4.56 in 31 iterations (45 evaluations), gradient_tolerance (...)".
   std::string BriefReport() const;
 };

@@ -63,8 +63,10 @@ void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FoldFitPredict& f
   for (int f = 0; f < k; ++f) {
     std::vector<int> tr, te;
     for (int q = 0; q < n; ++q) (q % k == f ? te : tr).push_back(q);
-    const Eigen::VectorXi tri = Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
-    const Eigen::VectorXi tei = Eigen::Map<Eigen::VectorXi>(te.data(), static_cast<Eigen::Index>(te.size()));
+    const Eigen::VectorXi tri =
+        Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
+    const Eigen::VectorXi tei =
+        Eigen::Map<Eigen::VectorXi>(te.data(), static_cast<Eigen::Index>(te.size()));
     Eigen::VectorXd mean, latent;
     fit_predict(tri, tei, &mean, &latent);
     (*r)(tei) = y(tei) - mean;
@@ -98,27 +100,33 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
     return {loo.residual, loo.latent_variance};
   }
   const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
-  KFoldResiduals(y, folds, [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te,
-                               Eigen::VectorXd* mean, Eigen::VectorXd* latent) {
-    if (linear) {
-      const LinearPrediction p = PredictLinear(FitLinear(x(Eigen::all, tr), y(tr)), x(Eigen::all, te));
-      *mean = p.mean;
-      *latent = p.latent_variance;
-      return;
-    }
-    const gp::GpPrediction p =
-        gp::PredictGp(gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta), x(Eigen::all, te));
-    *mean = p.mean;
-    *latent = p.latent_variance;
-  }, &h.r, &h.v);
+  KFoldResiduals(
+      y, folds,
+      [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te, Eigen::VectorXd* mean,
+          Eigen::VectorXd* latent) {
+        if (linear) {
+          const LinearPrediction p =
+              PredictLinear(FitLinear(x(Eigen::all, tr), y(tr)), x(Eigen::all, te));
+          *mean = p.mean;
+          *latent = p.latent_variance;
+          return;
+        }
+        const gp::GpPrediction p = gp::PredictGp(
+            gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta), x(Eigen::all, te));
+        *mean = p.mean;
+        *latent = p.latent_variance;
+      },
+      &h.r, &h.v);
   return h;
 }
 
 // The noise of output k from its held-out residuals (CoverageNoiseVariance).
 void SetNoise(const HeldOut& h, int k, FamilyModel* m) {
   const double s2 = CoverageNoiseVariance(h.r, h.v);
-  if (m->candidate.family == Family::kLinear) m->linears[k].noise_variance = s2;
-  else m->gps[k].noise_variance = s2 / (m->gps[k].target_scale * m->gps[k].target_scale);
+  if (m->candidate.family == Family::kLinear)
+    m->linears[k].noise_variance = s2;
+  else
+    m->gps[k].noise_variance = s2 / (m->gps[k].target_scale * m->gps[k].target_scale);
 }
 
 std::string CalibrationText(int folds) {
@@ -176,7 +184,8 @@ Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<Process
   for (int k = 0; k < Features::kCount && m.candidate.family == Family::kLinear; ++k) {
     const LinearPrediction p = PredictLinear(m.linears[k], x);
     mean.row(k) = p.mean.transpose();
-    sd->row(k) = (p.latent_variance.array() + m.linears[k].noise_variance).sqrt().matrix().transpose();
+    sd->row(k) =
+        (p.latent_variance.array() + m.linears[k].noise_variance).sqrt().matrix().transpose();
   }
   for (int k = 0; k < Features::kCount && m.candidate.family == Family::kGaussianProcess; ++k) {
     const gp::GpPrediction p = gp::PredictGp(m.gps[k], x);
@@ -259,7 +268,8 @@ std::string Candidate::Name() const {
   if (family == Family::kLinear) return "linear" + t;
   if (family == Family::kNetwork)
     return (hidden == kHiddenByEvidence ? std::string("network-evidence")
-                                        : "network-h" + std::to_string(hidden)) + t;
+                                        : "network-h" + std::to_string(hidden)) +
+           t;
   return "gp-" + KernelShort(kernel) + "-" + gp::ToString(mean) + t;
 }
 
@@ -302,8 +312,10 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
     m.network = FitNetwork(t, candidate, options, calibrate);
     m.calibration = m.network.noise_calibration;
   } else {
-    if (candidate.family == Family::kLinear) m.linears = FitLinears(t);
-    else m.gps = FitGps(t, candidate, options);
+    if (candidate.family == Family::kLinear)
+      m.linears = FitLinears(t);
+    else
+      m.gps = FitGps(t, candidate, options);
     if (calibrate) Calibrate(table, options, &m);
   }
   return m;
@@ -313,7 +325,8 @@ void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel
   const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
   const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
   for (int k = 0; k < Features::kCount; ++k)
-    SetNoise(OutputHeldOut(*m, k, x, y.row(k).transpose(), options, options.calibration_folds), k, m);
+    SetNoise(OutputHeldOut(*m, k, x, y.row(k).transpose(), options, options.calibration_folds), k,
+             m);
   m->calibration = CalibrationText(options.calibration_folds);
 }
 
@@ -378,7 +391,8 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
   return static_cast<int>(best);
 }
 
-double CoverageNoiseVariance(const Eigen::VectorXd& residual, const Eigen::VectorXd& latent_variance) {
+double CoverageNoiseVariance(const Eigen::VectorXd& residual,
+                             const Eigen::VectorXd& latent_variance) {
   if (residual.size() == 0 || residual.size() != latent_variance.size())
     throw InputError("noise calibration: " + std::to_string(residual.size()) + " residuals and " +
                      std::to_string(latent_variance.size()) + " variances; need equal, > 0");
@@ -415,8 +429,10 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   if (options.candidates.empty()) throw InputError("family choice: no candidates");
   const int rows = static_cast<int>(table.inputs.size());
   const int folds = std::min(options.folds, rows), nc = static_cast<int>(options.candidates.size());
-  if (folds < 2) throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
-  std::vector<Eigen::MatrixXd> sq(static_cast<std::size_t>(nc), Eigen::MatrixXd(Features::kCount, rows));
+  if (folds < 2)
+    throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
+  std::vector<Eigen::MatrixXd> sq(static_cast<std::size_t>(nc),
+                                  Eigen::MatrixXd(Features::kCount, rows));
   std::vector<double> ms(static_cast<std::size_t>(nc * folds));
   FitOptions fold_options = options.fit;
   fold_options.threads = 1;
@@ -431,11 +447,12 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
       sq[c] = HeldOutSquaredErrors(table, fold_options, HeldOutFolds(options, folds), &full[c],
                                    ReusesCalibration(options, folds));
     }
-    ms[i] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    ms[i] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   });
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
-  const Eigen::ArrayXd var = ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows)
-                                 .array().max(1e-300);
+  const Eigen::ArrayXd var =
+      ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows).array().max(1e-300);
   Choice choice;
   for (int c = 0; c < nc; ++c) {
     CvRow r;

@@ -70,7 +70,7 @@ struct FitOptions {
   /// nn/model.h). Why K-fold for both: leave-one-out residuals come from fits on n - 1 rows and
   /// undercovered the simulator's hold-out tables (scripts/bench_peers.sh, 20 rows).
   int calibration_folds = 5;
-  int threads = 1;              ///< core/parallel.h; the result is the same for any count
+  int threads = 1;  ///< core/parallel.h; the result is the same for any count
 };
 
 /// A fitted candidate: the network (Family::kNetwork, in the transformed space), one least-squares
@@ -108,7 +108,8 @@ Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTabl
 /// sigma^2 >= 0: the smallest level at which sqrt(sigma^2 + latent_variance[i]) >= |r_i| for at
 /// least 68.27 % of the residuals (bisection; the coverage is monotone in sigma^2). The rule of
 /// nn::CalibrateOutputNoise (nn/model.h). InputError if the sizes differ or are 0.
-double CoverageNoiseVariance(const Eigen::VectorXd& residual, const Eigen::VectorXd& latent_variance);
+double CoverageNoiseVariance(const Eigen::VectorXd& residual,
+                             const Eigen::VectorXd& latent_variance);
 
 /// ChoiceOptions::one_standard_error for one output: squared_errors[c] holds candidate c's
 /// squared held-out errors per row (candidates from the simplest); returns the first c with
@@ -127,7 +128,7 @@ void to_json(nlohmann::json& j, const CvRow& r);
 
 struct ChoiceOptions {
   std::vector<Candidate> candidates = DefaultCandidates();
-  int folds = 5;    ///< K of the cross-validation (min(K, rows))
+  int folds = 5;  ///< K of the cross-validation (min(K, rows))
   /// true: each output takes the candidate with the lowest cross-validated error of that output
   /// (mean_i (t_ik - mean_-i,k)^2; ties: the earlier candidate), so the two outputs may come
   /// from different families; false: one candidate for both, by the summed score.
@@ -167,13 +168,14 @@ struct ChoiceOptions {
 };
 
 struct Choice {
-  std::vector<CvRow> table;  ///< in candidate order
+  std::vector<CvRow> table;                    ///< in candidate order
   std::array<int, Features::kCount> chosen{};  ///< per output: index into table
   /// The chosen candidates refitted on all rows and calibrated: one per distinct candidate
   /// in `chosen` (output k is predicted by models[model_of_output[k]]).
   std::vector<FamilyModel> models;
   std::array<int, Features::kCount> model_of_output{};
-  std::string Describe() const;  ///< "max_elongation_um: linear/log, settle_time_s: gp-se-constant/log"
+  std::string Describe()
+      const;  ///< "max_elongation_um: linear/log, settle_time_s: gp-se-constant/log"
 };
 /// The choice of the header comment. InputError if the table has no targets or fewer than 4
 /// rows, or if there are no candidates.

@@ -67,8 +67,7 @@ LinearPrediction PredictLinear(const LinearModel& m, const Eigen::MatrixXd& x) {
   const Eigen::MatrixXd a = Design(m, x);
   LinearPrediction p;
   p.mean = a * m.coef;
-  p.latent_variance =
-      m.fitted_noise_variance * (a * m.ata_inv).cwiseProduct(a).rowwise().sum();
+  p.latent_variance = m.fitted_noise_variance * (a * m.ata_inv).cwiseProduct(a).rowwise().sum();
   return p;
 }
 
@@ -84,9 +83,12 @@ LinearLeaveOneOut LeaveOneOutLinear(const LinearModel& m, const Eigen::MatrixXd&
 void to_json(nlohmann::json& j, const LinearModel& m) {
   nlohmann::json rows = nlohmann::json::array();
   for (Eigen::Index r = 0; r < m.ata_inv.rows(); ++r) rows.push_back(ToStd(m.ata_inv.row(r)));
-  j = {{"input_shift", ToStd(m.input_shift)}, {"input_scale", ToStd(m.input_scale)},
-       {"coef", ToStd(m.coef)}, {"ata_inv", rows},
-       {"fitted_noise_variance", m.fitted_noise_variance}, {"noise_variance", m.noise_variance}};
+  j = {{"input_shift", ToStd(m.input_shift)},
+       {"input_scale", ToStd(m.input_scale)},
+       {"coef", ToStd(m.coef)},
+       {"ata_inv", rows},
+       {"fitted_noise_variance", m.fitted_noise_variance},
+       {"noise_variance", m.noise_variance}};
 }
 
 void from_json(const nlohmann::json& j, LinearModel& m) {
@@ -97,14 +99,16 @@ void from_json(const nlohmann::json& j, LinearModel& m) {
   const Eigen::Index p = m.coef.size();
   if (m.input_scale.size() != m.input_shift.size() || p != m.input_shift.size() + 1 ||
       !(m.input_scale.array() > 0).all())
-    throw InputError("linear model: 'input_scale' (> 0) and 'coef' (inputs + 1) must match 'input_shift'");
+    throw InputError(
+        "linear model: 'input_scale' (> 0) and 'coef' (inputs + 1) must match 'input_shift'");
   if (!j.contains("ata_inv") || !j.at("ata_inv").is_array() ||
       j.at("ata_inv").size() != static_cast<std::size_t>(p))
     throw InputError("linear model: 'ata_inv' must hold " + std::to_string(p) + " rows");
   m.ata_inv.resize(p, p);
   for (Eigen::Index r = 0; r < p; ++r) {
     const Eigen::VectorXd row = ToVector(nlohmann::json{{"row", j.at("ata_inv")[r]}}, "row");
-    if (row.size() != p) throw InputError("linear model: 'ata_inv' rows must hold " + std::to_string(p) + " values");
+    if (row.size() != p)
+      throw InputError("linear model: 'ata_inv' rows must hold " + std::to_string(p) + " values");
     m.ata_inv.row(r) = row.transpose();
   }
   for (const char* key : {"fitted_noise_variance", "noise_variance"})

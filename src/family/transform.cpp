@@ -68,9 +68,11 @@ std::string TableTransform::Describe() const {
   std::string logs;
   int count = 0;
   for (std::size_t i = 0; i < inputs.size(); ++i)
-    if (inputs[i] == ColumnTransform::kLog) logs += (count++ ? ", " : "") + std::string(kInputColumns[i]);
+    if (inputs[i] == ColumnTransform::kLog)
+      logs += (count++ ? ", " : "") + std::string(kInputColumns[i]);
   for (std::size_t k = 0; k < outputs.size(); ++k)
-    if (outputs[k] == ColumnTransform::kLog) logs += (count++ ? ", " : "") + std::string(kTargetColumns[k]);
+    if (outputs[k] == ColumnTransform::kLog)
+      logs += (count++ ? ", " : "") + std::string(kTargetColumns[k]);
   if (count == 0) return "identity";
   if (count == ProcessInputs::kCount + Features::kCount) return "log of every input and output";
   return "log of " + logs + "; identity for the others";

@@ -24,7 +24,7 @@
 namespace whirl::family {
 
 enum class ColumnTransform { kIdentity, kLog };
-std::string ToString(ColumnTransform t);                   ///< "identity", "log"
+std::string ToString(ColumnTransform t);                     ///< "identity", "log"
 ColumnTransform ParseColumnTransform(const std::string& s);  ///< inverse; InputError otherwise
 
 /// One transform per input (kInputColumns order) and per output (kTargetColumns order).

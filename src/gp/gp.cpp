@@ -19,7 +19,8 @@ void KernelMatrices(Kernel kernel, const Eigen::MatrixXd& a, const Eigen::Matrix
                     Eigen::MatrixXd* g) {
   const Eigen::MatrixXd as = length.cwiseInverse().asDiagonal() * a;
   const Eigen::MatrixXd bs = length.cwiseInverse().asDiagonal() * b;
-  Eigen::MatrixXd r2 = (-2.0 * as.transpose() * bs).colwise() + as.colwise().squaredNorm().transpose();
+  Eigen::MatrixXd r2 =
+      (-2.0 * as.transpose() * bs).colwise() + as.colwise().squaredNorm().transpose();
   r2.rowwise() += bs.colwise().squaredNorm();
   r2 = r2.cwiseMax(0.0);
   if (kernel == Kernel::kSquaredExponential) {
@@ -134,8 +135,8 @@ Eigen::VectorXd StartPoint(int index, int d) {
 void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp* gp,
               GpSummary* summary) {
   const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
-    return NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t,
-                                    gp->min_noise_variance, grad);
+    return NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t, gp->min_noise_variance,
+                                    grad);
   };
   GpSummary s;
   s.nlml = kInf;
@@ -177,7 +178,8 @@ Eigen::VectorXd ArrayToVector(const nlohmann::json& a, const std::string& name) 
 }
 
 Eigen::VectorXd JsonVector(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key)) throw InputError("gaussian process: key '" + std::string(key) + "' missing");
+  if (!j.contains(key))
+    throw InputError("gaussian process: key '" + std::string(key) + "' missing");
   return ArrayToVector(j.at(key), key);
 }
 
@@ -225,9 +227,7 @@ double NegLogMarginalLikelihood(Kernel kernel, Mean mean, const Eigen::MatrixXd&
   return nlml;
 }
 
-double Gp::SigmaN2() const {
-  return std::exp(2.0 * theta(InputCount() + 1)) + min_noise_variance;
-}
+double Gp::SigmaN2() const { return std::exp(2.0 * theta(InputCount() + 1)) + min_noise_variance; }
 
 void Gp::Factorize() {
   Factors f;
@@ -243,14 +243,14 @@ void Gp::Factorize() {
 std::string GpSummary::BriefReport() const {
   std::string starts;
   for (double v : start_nlml) starts += (starts.empty() ? "" : ", ") + MessageNumber(v);
-  return "gp: nlml " + MessageNumber(nlml) + " (starts " + starts + "); " +
-         optimizer.BriefReport();
+  return "gp: nlml " + MessageNumber(nlml) + " (starts " + starts + "); " + optimizer.BriefReport();
 }
 
 Gp FitGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
          GpSummary* summary) {
   std::vector<Eigen::VectorXd> starts;
-  for (int i = 0; i < options.restarts; ++i) starts.push_back(StartPoint(i, static_cast<int>(x.rows())));
+  for (int i = 0; i < options.restarts; ++i)
+    starts.push_back(StartPoint(i, static_cast<int>(x.rows())));
   return FitFromStarts(x, y, options, starts, summary);
 }
 
@@ -271,12 +271,13 @@ GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x) {
   if (x.rows() != d)
     throw InputError("gaussian process: predictions need " + std::to_string(d) + " inputs, got " +
                      std::to_string(x.rows()));
-  const Eigen::MatrixXd zs = gp.input_scale.cwiseInverse().asDiagonal() * (x.colwise() - gp.input_shift);
+  const Eigen::MatrixXd zs =
+      gp.input_scale.cwiseInverse().asDiagonal() * (x.colwise() - gp.input_shift);
   const Eigen::VectorXd length = gp.theta.head(d).array().exp();
   const double sf2 = std::exp(2.0 * gp.theta(d));
   Eigen::MatrixXd ks;
   KernelMatrices(gp.kernel, gp.z, zs, length, sf2, &ks, nullptr);  // n x q
-  const Eigen::MatrixXd hs = Basis(gp.mean, zs);                      // q x m
+  const Eigen::MatrixXd hs = Basis(gp.mean, zs);                   // q x m
   GpPrediction p;
   p.mean = (hs * gp.b + ks.transpose() * gp.alpha).array() * gp.target_scale + gp.target_shift;
   const Eigen::MatrixXd v = gp.chol.matrixL().solve(ks);
@@ -293,7 +294,8 @@ LeaveOneOut LeaveOneOutGp(const Gp& gp) {
   const int n = static_cast<int>(gp.u.size());
   const Eigen::MatrixXd k_inv = gp.chol.solve(Eigen::MatrixXd::Identity(n, n));
   const Eigen::MatrixXd ah = gp.a_chol.matrixL().solve(gp.k_inv_h.transpose());  // m x n
-  const Eigen::ArrayXd p_diag = k_inv.diagonal().array() - ah.colwise().squaredNorm().transpose().array();
+  const Eigen::ArrayXd p_diag =
+      k_inv.diagonal().array() - ah.colwise().squaredNorm().transpose().array();
   LeaveOneOut loo;
   loo.residual = (gp.alpha.array() / p_diag * gp.target_scale).matrix();
   loo.latent_variance =
@@ -302,14 +304,21 @@ LeaveOneOut LeaveOneOutGp(const Gp& gp) {
 }
 
 void to_json(nlohmann::json& j, const Gp& gp) {
-  auto vec = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
+  auto vec = [](const Eigen::VectorXd& v) {
+    return std::vector<double>(v.data(), v.data() + v.size());
+  };
   nlohmann::json rows = nlohmann::json::array();
   for (Eigen::Index q = 0; q < gp.z.cols(); ++q) rows.push_back(vec(gp.z.col(q)));
-  j = {{"kernel", ToString(gp.kernel)}, {"mean", ToString(gp.mean)},
-       {"input_shift", vec(gp.input_shift)}, {"input_scale", vec(gp.input_scale)},
-       {"target_shift", gp.target_shift}, {"target_scale", gp.target_scale},
-       {"theta", vec(gp.theta)}, {"min_noise_variance", gp.min_noise_variance},
-       {"noise_variance", gp.noise_variance}, {"inputs_standardized", rows},
+  j = {{"kernel", ToString(gp.kernel)},
+       {"mean", ToString(gp.mean)},
+       {"input_shift", vec(gp.input_shift)},
+       {"input_scale", vec(gp.input_scale)},
+       {"target_shift", gp.target_shift},
+       {"target_scale", gp.target_scale},
+       {"theta", vec(gp.theta)},
+       {"min_noise_variance", gp.min_noise_variance},
+       {"noise_variance", gp.noise_variance},
+       {"inputs_standardized", rows},
        {"targets_standardized", vec(gp.u)}};
 }
 
@@ -333,7 +342,8 @@ void from_json(const nlohmann::json& j, Gp& gp) {
   if (gp.input_scale.size() != d || gp.theta.size() != d + 2 || !(gp.input_scale.array() > 0).all())
     throw InputError(what + ": input_scale (> 0) and theta (inputs + 2) must match input_shift");
   if (!(gp.target_scale > 0) || !(gp.min_noise_variance > 0) || !(gp.noise_variance >= 0))
-    throw InputError(what + ": target_scale and min_noise_variance must be > 0, noise_variance >= 0");
+    throw InputError(what +
+                     ": target_scale and min_noise_variance must be > 0, noise_variance >= 0");
   if (!j.contains("inputs_standardized") || !j.at("inputs_standardized").is_array() ||
       j.at("inputs_standardized").size() != static_cast<std::size_t>(gp.u.size()))
     throw InputError(what + ": 'inputs_standardized' must hold one row per target");

@@ -41,8 +41,8 @@ namespace whirl::gp {
 
 enum class Kernel { kSquaredExponential, kMatern52 };
 enum class Mean { kConstant, kLinear };
-std::string ToString(Kernel k);  ///< "squared_exponential", "matern52"
-std::string ToString(Mean m);    ///< "constant", "linear"
+std::string ToString(Kernel k);            ///< "squared_exponential", "matern52"
+std::string ToString(Mean m);              ///< "constant", "linear"
 Kernel ParseKernel(const std::string& s);  ///< inverse; InputError otherwise
 Mean ParseMean(const std::string& s);      ///< inverse; InputError otherwise
 
@@ -88,19 +88,19 @@ double NegLogMarginalLikelihood(Kernel kernel, Mean mean, const Eigen::MatrixXd&
 struct Gp {
   Kernel kernel = Kernel::kMatern52;
   Mean mean = Mean::kConstant;
-  Eigen::VectorXd input_shift, input_scale;  ///< per input, units of x
+  Eigen::VectorXd input_shift, input_scale;   ///< per input, units of x
   double target_shift = 0, target_scale = 1;  ///< units of y
-  Eigen::VectorXd theta;         ///< (ln l_1..ln l_d, ln s_f, ln s_n), standardized space
+  Eigen::VectorXd theta;  ///< (ln l_1..ln l_d, ln s_f, ln s_n), standardized space
   double min_noise_variance = 1e-6;
-  double noise_variance = 0;     ///< of predictions, standardized target units
-  Eigen::MatrixXd z;             ///< d x n standardized training inputs
-  Eigen::VectorXd u;             ///< n standardized training targets
+  double noise_variance = 0;  ///< of predictions, standardized target units
+  Eigen::MatrixXd z;          ///< d x n standardized training inputs
+  Eigen::VectorXd u;          ///< n standardized training targets
   // Derived by Factorize() from the fields above (not stored in files):
-  Eigen::LLT<Eigen::MatrixXd> chol;  ///< K = L L'
-  Eigen::MatrixXd k_inv_h;           ///< K^-1 H, n x m
+  Eigen::LLT<Eigen::MatrixXd> chol;    ///< K = L L'
+  Eigen::MatrixXd k_inv_h;             ///< K^-1 H, n x m
   Eigen::LLT<Eigen::MatrixXd> a_chol;  ///< H' K^-1 H = L_A L_A'
-  Eigen::VectorXd b;                 ///< GLS mean coefficients
-  Eigen::VectorXd alpha;             ///< K^-1 (u - H b)
+  Eigen::VectorXd b;                   ///< GLS mean coefficients
+  Eigen::VectorXd alpha;               ///< K^-1 (u - H b)
 
   int InputCount() const { return static_cast<int>(z.rows()); }
   double SigmaN2() const;  ///< exp(2 theta_noise) + min_noise_variance (the fitted noise)
@@ -134,8 +134,8 @@ GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x);
 
 /// Closed-form leave-one-out of the training rows (header comment), units of y.
 struct LeaveOneOut {
-  Eigen::VectorXd residual;          ///< y_i - mean_-i
-  Eigen::VectorXd latent_variance;   ///< predictive variance 1 / P_ii minus the fitted noise
+  Eigen::VectorXd residual;         ///< y_i - mean_-i
+  Eigen::VectorXd latent_variance;  ///< predictive variance 1 / P_ii minus the fitted noise
 };
 LeaveOneOut LeaveOneOutGp(const Gp& gp);
 

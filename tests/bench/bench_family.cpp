@@ -57,8 +57,10 @@ void BM_FamilyCandidate(benchmark::State& state) {
 }
 BENCHMARK(BM_FamilyCandidate)
     ->ArgNames({"rows", "candidate"})
-    ->ArgsProduct({{20, 100}, benchmark::CreateDenseRange(
-                                  0, static_cast<int>(whirl::family::ChoiceOptions::DefaultCandidates().size()) - 1, 1)})
+    ->ArgsProduct(
+        {{20, 100},
+         benchmark::CreateDenseRange(
+             0, static_cast<int>(whirl::family::ChoiceOptions::DefaultCandidates().size()) - 1, 1)})
     ->Unit(benchmark::kMillisecond);
 
 void BM_TrainbrSingleFit(benchmark::State& state) {

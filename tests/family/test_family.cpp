@@ -1,13 +1,12 @@
 // family/family.h: the choice finds the power law in a power-law table, every candidate predicts
 // through its transform, the calibrated GP covers fresh data, the coverage rule on hand-computed
 // cases, candidate names, and bad input.
-#include "family/family.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "family/family.h"
 #include "support/expect_error.h"
 
 namespace whirl::family {
@@ -32,8 +31,8 @@ ProcessTable MakeTable(int rows, double noise_sd, unsigned seed, bool curved = f
       s = 50 + 20 * std::cos(x[2] / 3) * (x[4] / 150);
     }
     t.inputs.push_back(ProcessInputs::FromArray(x));
-    t.targets.push_back(Features::FromArray({e * std::exp(noise_sd * n01(rng)),
-                                             s * std::exp(noise_sd * n01(rng))}));
+    t.targets.push_back(Features::FromArray(
+        {e * std::exp(noise_sd * n01(rng)), s * std::exp(noise_sd * n01(rng))}));
   }
   return t;
 }
@@ -53,7 +52,7 @@ TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
   o.candidates = {ParseCandidate("gp-matern52-constant/identity"),
                   ParseCandidate("gp-se-linear/log"), ParseCandidate("network-h6/identity")};
   o.one_standard_error = false;  // the plain lowest error (tested alone below)
-  o.closed_form_loo = false;      // 5-fold refits for every candidate
+  o.closed_form_loo = false;     // 5-fold refits for every candidate
   for (const bool per_output : {false, true}) {
     o.per_output = per_output;
     const Choice c = ChooseFamily(train, o);
@@ -84,7 +83,8 @@ TEST(FamilyChoice, OutputsMayComeFromDifferentFamilies) {
   ChoiceOptions o;
   o.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-constant/identity")};
   const Choice c = ChooseFamily(train, o);
-  EXPECT_EQ(c.Describe(), "max_elongation_um: linear/log, settle_time_s: gp-matern52-constant/identity");
+  EXPECT_EQ(c.Describe(),
+            "max_elongation_um: linear/log, settle_time_s: gp-matern52-constant/identity");
   ASSERT_EQ(c.models.size(), 2u);
   const std::vector<FamilyPrediction> p = PredictChoice(c, train.inputs);
   const std::vector<FamilyPrediction> p0 = PredictFamily(c.models[0], train.inputs);
@@ -146,7 +146,8 @@ TEST(FamilyChoice, ChosenModelsEqualAFreshCalibratedFit) {
       for (std::size_t q = 0; q < a.size(); ++q)
         for (int k = 0; k < 2; ++k) {
           EXPECT_NEAR(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k], 1e-9) << name;
-          EXPECT_NEAR(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k], 1e-9) << name << " loo " << loo;
+          EXPECT_NEAR(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k], 1e-9)
+              << name << " loo " << loo;
         }
       EXPECT_EQ(c.models[0].calibration, fresh.calibration);
     }
@@ -199,7 +200,7 @@ TEST(FamilyChoice, OneStandardErrorRuleOnHandComputedCases) {
   a << 1, 1, 1, 1;
   b << 0.9, 0.9, 0.9, 0.9;  // lower on every row: d = 0.1 with sd 0
   EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 1);
-  a << 1, 2, 1, 2;  // mean 1.5
+  a << 1, 2, 1, 2;          // mean 1.5
   b << 1.5, 1.0, 1.2, 1.5;  // mean 1.3; d = (-0.5, 1, -0.2, 0.5), mean 0.2, sd sqrt(0.46)
   EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 0);  // 0.2 <= sqrt(0.46) / 2 = 0.339
   a << 1, 2.4, 1, 2;  // mean 1.6; d = (-0.5, 1.4, -0.2, 0.5), mean 0.3, sd 0.845

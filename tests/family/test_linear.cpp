@@ -1,13 +1,12 @@
 // family/linear.h: least squares against the normal equations, its closed-form leave-one-out
 // against refits without each row, the latent variance against its formula, and the JSON round
 // trip.
-#include "family/linear.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cstdlib>
 
+#include "family/linear.h"
 #include "support/eigen_near.h"
 #include "support/expect_error.h"
 
@@ -41,7 +40,8 @@ TEST(Linear, MatchesTheNormalEquationsOnRawInputs) {
   const Data fresh = Make(4, 3, 2);
   Eigen::MatrixXd af(3, 5);
   af << Eigen::VectorXd::Ones(3), fresh.x.transpose();
-  const Eigen::VectorXd v = s2 * (af * (a.transpose() * a).inverse()).cwiseProduct(af).rowwise().sum();
+  const Eigen::VectorXd v =
+      s2 * (af * (a.transpose() * a).inverse()).cwiseProduct(af).rowwise().sum();
   EXPECT_TRUE(test::AllNear(PredictLinear(m, fresh.x).latent_variance, v, 1e-8));
 }
 

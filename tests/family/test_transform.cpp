@@ -1,12 +1,11 @@
 // family/transform.h: which columns get a log, the refusal of non-positive values, the delta
 // method against finite differences and Monte Carlo, and the JSON round trip.
-#include "family/transform.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "family/transform.h"
 #include "support/expect_error.h"
 
 namespace whirl::family {
@@ -28,8 +27,8 @@ TEST(Transform, LogOnlyWhereEveryValueIsPositive) {
   for (ColumnTransform c : all.inputs) EXPECT_EQ(c, ColumnTransform::kLog);
   for (ColumnTransform c : all.outputs) EXPECT_EQ(c, ColumnTransform::kLog);
   EXPECT_EQ(all.Describe(), "log of every input and output");
-  t.targets[2].max_elongation_um = 0.0;   // a zero
-  t.inputs[4].pitch_mm = -1.0;            // a negative value
+  t.targets[2].max_elongation_um = 0.0;  // a zero
+  t.inputs[4].pitch_mm = -1.0;           // a negative value
   const TableTransform some = LogWherePositive(t);
   EXPECT_EQ(some.outputs[0], ColumnTransform::kIdentity);
   EXPECT_EQ(some.outputs[1], ColumnTransform::kLog);
@@ -77,7 +76,7 @@ TEST(Transform, DeltaMethodAgreesWithMonteCarloForSmallSd) {
   const double mean = sum / y.size(), sd = std::sqrt(sum2 / y.size() - mean * mean);
   std::nth_element(y.begin(), y.begin() + y.size() / 2, y.end());
   const MeanSd b = MapBack(ColumnTransform::kLog, m, s);
-  EXPECT_NEAR(b.sd / sd, 1.0, 0.01);               // relative error O(s^2) + sampling
+  EXPECT_NEAR(b.sd / sd, 1.0, 0.01);                  // relative error O(s^2) + sampling
   EXPECT_NEAR(b.mean / y[y.size() / 2], 1.0, 0.001);  // the median
 }
 

@@ -1,12 +1,11 @@
 // core/bfgs.h: minima of functions with known minimizers, the Wolfe line search's handling of
 // non-finite values, and the summary's outcomes.
-#include "core/bfgs.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
+#include "core/bfgs.h"
 #include "support/eigen_near.h"
 #include "support/expect_error.h"
 

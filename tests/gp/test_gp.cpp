@@ -1,8 +1,6 @@
 // gp/gp.h: the marginal likelihood against a direct dense evaluation, its gradient against finite
 // differences, the closed-form leave-one-out against refits without each row, interpolation,
 // recovery of a known noise level and irrelevant inputs, and the JSON round trip.
-#include "gp/gp.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -10,6 +8,7 @@
 #include <cstdlib>
 
 #include "core/numbers.h"
+#include "gp/gp.h"
 #include "support/eigen_near.h"
 #include "support/expect_error.h"
 
@@ -55,7 +54,8 @@ double DenseNlml(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen
   const Eigen::MatrixXd ki = k.inverse();
   const Eigen::VectorXd b = (h.transpose() * ki * h).inverse() * h.transpose() * ki * u;
   const Eigen::VectorXd r = u - h * b;
-  return 0.5 * r.dot(ki * r) + 0.5 * std::log(k.fullPivLu().determinant()) + 0.5 * n * std::log(2 * kPi);
+  return 0.5 * r.dot(ki * r) + 0.5 * std::log(k.fullPivLu().determinant()) +
+         0.5 * n * std::log(2 * kPi);
 }
 
 const Kernel kKernels[] = {Kernel::kSquaredExponential, Kernel::kMatern52};
@@ -87,7 +87,8 @@ TEST(GpLikelihood, GradientMatchesCentralDifferences) {
           tp(j) += h;
           tm(j) -= h;
           fd(j) = (NegLogMarginalLikelihood(k, m, data.x, data.y, tp, 1e-6, nullptr) -
-                   NegLogMarginalLikelihood(k, m, data.x, data.y, tm, 1e-6, nullptr)) / (2 * h);
+                   NegLogMarginalLikelihood(k, m, data.x, data.y, tm, 1e-6, nullptr)) /
+                  (2 * h);
         }
         EXPECT_TRUE(test::AllNear(g, fd, 1e-5, 1e-6)) << ToString(k) << " " << ToString(m);
       }
@@ -116,7 +117,8 @@ TEST(GpLeaveOneOut, EqualsRefitsWithoutEachRow) {
         without.Factorize();
         const GpPrediction p = PredictGp(without, data.x.col(i));
         EXPECT_NEAR(loo.residual(i), data.y(i) - p.mean(0), 1e-7 * gp.target_scale);
-        EXPECT_NEAR(loo.latent_variance(i), p.latent_variance(0), 1e-7 * gp.target_scale * gp.target_scale);
+        EXPECT_NEAR(loo.latent_variance(i), p.latent_variance(0),
+                    1e-7 * gp.target_scale * gp.target_scale);
       }
     }
 }
