@@ -1,8 +1,8 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--joint] [--loo|--kfold] [--no-1se] [--gp-ftol F] [--calibration-folds K] [--seed
-//                N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--joint] [--loo|--kfold] [--no-1se] [--gp-ftol F] [--calibration-folds K]
+//                [--seed N] [--folds K] [--gp-restarts R] [--threads N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
