@@ -9,4 +9,5 @@ target_sources(whirl_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/run_program.cpp
   ${CMAKE_CURRENT_LIST_DIR}/safe_text.cpp
   ${CMAKE_CURRENT_LIST_DIR}/limits.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/bfgs.cpp
 )
