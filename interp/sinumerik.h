@@ -69,7 +69,8 @@ inline constexpr double kMd32760Default = 0.01;
 inline constexpr double kMd32760Max = 0.10;
 
 /// SETAL numbers whirl raises lie within the user cycle alarms 65000..69999; 60000..64999 belong
-/// to Siemens' own cycles (SINUMERIK 840D cycle alarm ranges).
+/// to Siemens' own cycles (SINUMERIK 840D cycle alarm ranges). The programs assume the alarm
+/// stops the program (its configured reaction); not verified on a control here.
 inline constexpr int kUserAlarmFirst = 65000;
 inline constexpr int kUserAlarmLast = 69999;
 /// The default numbering: the drift check's four alarms from 65000 (drift_missing_alarm,
@@ -83,7 +84,8 @@ inline constexpr double kMaxPositionMm = 1e5;
 /// SINUMERIK program names: two letters, then letters, digits or '_', at most 24 characters
 /// (Siemens, SINUMERIK 840D sl Programming Manual Fundamentals, "Program names": the first two
 /// characters must be letters, then only letters, digits and underscores, no blanks or other
-/// separators, the '.' only before the file extension, at most 24 characters). The program names
+/// separators, the '.' only before the file extension, at most 24 characters; recalled, not
+/// checked against a copy of the manual here: the stricter reading is used). The program names
 /// whirl writes into its headers are those of the files (their stem, the extension .SPF aside).
 inline constexpr std::size_t kMaxProgramNameLength = 24;
 /// InputError naming `what` (e.g. "--nc 'x/1 my comp.spf'") and the rule unless `name` is a
