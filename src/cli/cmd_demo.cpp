@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <utility>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -104,7 +105,11 @@ void RunDemo(const DemoOptions& o) {
   // The example machine's facts (ID range, R parameters, offset): a real run names its own.
   interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile)).ApplyTo(co.plan);
   std::vector<compare::ScrewComparison> results;
-  for (const sim::Screw* screw : std::vector<const sim::Screw*>{&reference, &new_type}) {
+  // The NC files' stems are their program names on the control (letters, digits, '_', at most
+  // 24 characters: interp::CheckProgramName), so they cannot carry the screw's name.
+  const std::pair<const sim::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
+                                                              {&new_type, "WHIRL_NEW_TYPE"}};
+  for (const auto& [screw, program] : screws) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
     const std::string slug = compare::Slug(screw->name);
     const auto& p = c.prediction;
@@ -120,16 +125,16 @@ void RunDemo(const DemoOptions& o) {
         compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
                               {model_source, c.prediction, c.prediction.mean}, provenance);
     const std::vector<std::string> names = {slug + "_plan.json", slug + "_plan.csv",
-                                            slug + "_temp_comp.spf", slug + "_temp_comp_reset.spf"};
+                                            program + ".SPF", program + "_RESET.SPF"};
     compare::WritePlanFiles(
         {stage / names[0], stage / names[1], stage / names[2], stage / names[3]}, plan_json, c.plan,
         provenance, "whirl demo: model " + model_source + ", screw " + screw->name);
     for (const auto& name : names) files.AddStaged(name);
     std::printf(
         "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
-        "%s_plan.json/.csv and %s_temp_comp.spf (reset: %s_temp_comp_reset.spf)\n",
+        "%s_plan.json/.csv and %s.SPF (reset: %s_RESET.SPF)\n",
         screw->name.c_str(), c.plan.segments.size(), c.plan.max_abs_slope, c.plan.options.md32760,
-        (out / slug).string().c_str(), slug.c_str(), slug.c_str());
+        (out / slug).string().c_str(), program.c_str(), program.c_str());
     results.push_back(std::move(c));
   }
 
@@ -187,8 +192,9 @@ void RegisterDemo(CLI::App& app) {
       "elongation of the reference screw (datasets/screws/reference_80x10x6000.json) and of a\n"
       "new-type screw outside the training rows (reference blank; 61 HRC, 63 mm, lead 12 mm,\n"
       "raceway radius 4.0 mm, 200 m/min), build the arctangent curve, plan the 840D setting data\n"
-      "(SD43900 mm, SD43910 -, SD43920 mm; files <screw>_plan.json/.csv and\n"
-      "<screw>_temp_comp.spf), cut both screws in the simulator with no compensation, the\n"
+      "(SD43900 mm, SD43910 -, SD43920 mm; files <screw>_plan.json/.csv and the NC programs\n"
+      "WHIRL_REFERENCE.SPF, WHIRL_NEW_TYPE.SPF with their _RESET.SPF), cut both screws in the\n"
+      "simulator with no compensation, the\n"
       "traditional experience rule and the plan, write the report (report/index.html) and print\n"
       "the lead-error reductions (um and %).");
   sub->add_option("--out-dir", o->out_dir,

@@ -176,7 +176,9 @@ void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& files
   std::set<fs::path> seen;
   for (const auto& [path, text] : files) {
     CheckTarget(path);
-    if (!seen.insert(fs::weakly_canonical(path)).second)
+    // Absolute first: weakly_canonical leaves a relative path whose parts do not exist yet
+    // relative ("A.SPF"), but makes "./A.SPF" absolute, so the two would compare unequal.
+    if (!seen.insert(fs::weakly_canonical(fs::absolute(path))).second)
       throw InputError("cannot write " + Quoted(path) + ": the same file is given twice");
   }
   std::map<fs::path, std::set<std::string>> targets;  // what killed runs left beside them
