@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/safe_text.h"
 
 namespace whirl::interp {
@@ -223,29 +224,87 @@ DriftReference ParseDriftReference(const std::string& s) {
                    "temperatures) or 'start' (the temperatures when the action starts)");
 }
 
+void ControlLimits::Validate() const {
+  if (!Stated()) return;
+  if (!(analog_inputs >= 0 && analog_inputs <= kMaxAnalogIndex))
+    throw InputError("MD10300 analog inputs " + std::to_string(analog_inputs) +
+                     ": must be within 0.." + std::to_string(kMaxAnalogIndex));
+  if (!(sync_elements >= 1))
+    throw InputError("MD28250 synchronized-action elements " + std::to_string(sync_elements) +
+                     ": must be at least 1");
+  if (!(ac_params >= 1 && ac_params <= 10000))
+    throw InputError("MD28254 $AC_PARAM count " + std::to_string(ac_params) +
+                     ": must be within 1..10000");
+}
+
+namespace {
+
+void CheckAnalogInput(const std::string& name, const AnalogInput& a, const ControlLimits& c) {
+  const int max_index = c.Stated() ? c.analog_inputs : kMaxAnalogIndex;
+  const std::string w = "analog input for '" + Text(name) + "'";
+  if (!(a.index >= 1 && a.index <= max_index))
+    throw InputError(w + ": index " + std::to_string(a.index) + " must be within 1.." +
+                     std::to_string(max_index) +
+                     (c.Stated() ? " (MD10300 $MN_FASTIO_ANA_NUM_INPUTS of the control)"
+                                 : std::string()));
+  if (!(std::abs(a.scale) >= kMinAnalogScale && std::abs(a.scale) <= kMaxAnalogScale))
+    throw InputError(w + ": scale " + MessageNumber(a.scale) + " must satisfy " +
+                     MessageNumber(kMinAnalogScale) + " <= |scale| <= " +
+                     MessageNumber(kMaxAnalogScale) +
+                     " per input unit (a smaller one prints as zero: the sensor would be gone)");
+  if (!(std::abs(a.offset) <= kMaxAnalogOffset))
+    throw InputError(w + ": offset " + MessageNumber(a.offset) + " must be within +-" +
+                     MessageNumber(kMaxAnalogOffset));
+}
+
+// Every $AC_PARAM slot the options name lies below MD28254 (when stated).
+void CheckSlotsBelowCount(const DriftActionOptions& o) {
+  if (!o.control.Stated()) return;
+  const int last = std::max({o.param_last < 0 ? o.param_first : o.param_last,
+                             o.workpiece_k0_param,
+                             o.workpiece_slope_param < 0 ? -1 : o.workpiece_slope_param + 1});
+  if (last >= o.control.ac_params)
+    throw InputError("drift $AC_PARAM slot " + std::to_string(last) +
+                     " does not exist: MD28254 $MC_MM_NUM_AC_PARAM is " +
+                     std::to_string(o.control.ac_params) + " (slots 0.." +
+                     std::to_string(o.control.ac_params - 1) + ")");
+}
+
+}  // namespace
+
 void DriftActionOptions::Validate() const {
   PlanOptions axis_check;
   axis_check.axis = axis;
   axis_check.sign = ExpectedSign(axis_check.direction, axis_check.control_dk);
   axis_check.Validate();
+  control.Validate();
+  CheckProgramName(program_name, "drift program name");
+  CheckProgramName(reset_program_name, "drift reset program name");
+  CheckDistinctProgramNames(program_name, reset_program_name);
   if (error_direction != 1 && error_direction != -1)
     throw InputError("drift error_direction " + std::to_string(error_direction) +
                      ": must be +1 or -1");
-  if (!(ipo_cycle_ms > 0 && ipo_cycle_ms <= 100))
-    throw InputError("drift ipo_cycle_ms " + FormatFixed(ipo_cycle_ms, 3) +
-                     ": must be within (0, 100] ms");
+  if (!(ipo_cycle_ms >= kMinIpoCycleMs && ipo_cycle_ms <= kMaxIpoCycleMs))
+    throw InputError("drift ipo_cycle_ms " + MessageNumber(ipo_cycle_ms) + ": must be within " +
+                     MessageNumber(kMinIpoCycleMs) + ".." + MessageNumber(kMaxIpoCycleMs) + " ms");
   if (!(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= 255))
     throw InputError("drift synchronized-action IDs " + std::to_string(sync_id_first) + ".." +
                      std::to_string(sync_id_last) + ": must satisfy 1 <= first <= last <= 255");
   if (!(param_first >= 0 && param_first <= 9999))
     throw InputError("drift param_first " + std::to_string(param_first) +
                      ": must be within 0..9999");
+  if (param_last >= 0 && !(param_last >= param_first + 3 && param_last <= 9999))
+    throw InputError("drift param_last " + std::to_string(param_last) + ": must be within " +
+                     std::to_string(param_first + 3) +
+                     "..9999 (param_first + 3: liveness, one feature, one reference, the flag)");
   if (!(save_r_first >= 0 && save_r_first <= 9998))
     throw InputError("drift save_r_first " + std::to_string(save_r_first) +
                      ": must be within 0..9998");
-  if (!(missing_alarm >= 60000 && missing_alarm <= 69996))
-    throw InputError("drift missing_alarm " + std::to_string(missing_alarm) +
-                     ": must be within 60000..69996 (it and the next three numbers are used)");
+  if (!(missing_alarm >= kUserAlarmFirst && missing_alarm <= kUserAlarmLast - 3))
+    throw InputError("drift missing_alarm " + std::to_string(missing_alarm) + ": must be within " +
+                     std::to_string(kUserAlarmFirst) + ".." + std::to_string(kUserAlarmLast - 3) +
+                     " (user cycle alarms, 60000..64999 belong to Siemens' cycles; it and the "
+                     "next three numbers are used)");
   if (workpiece_k0_param > 9999)
     throw InputError("drift workpiece_k0_param " + std::to_string(workpiece_k0_param) +
                      ": must be within 0..9999");
@@ -258,17 +317,12 @@ void DriftActionOptions::Validate() const {
   if (save_r_first > 9995)
     throw InputError("drift save_r_first " + std::to_string(save_r_first) +
                      ": must be within 0..9995 (R<n>..R<n+4> are used)");
-  if (has_slope && (!std::isfinite(slope_fixed_end_mm) || std::abs(slope_fixed_end_mm) > 1e6 ||
+  if (has_slope && (!(std::abs(slope_fixed_end_mm) <= kMaxPositionMm) ||
                     (slope_growth_direction != 1 && slope_growth_direction != -1)))
-    throw InputError(
-        "drift slope: fixed_end_position_mm must be finite within +-1e6 mm and "
-        "growth_direction +1 or -1");
-  for (const auto& [name, a] : inputs)
-    if (!(a.index >= 1 && a.index <= 999) || !std::isfinite(a.scale) || a.scale == 0 ||
-        !std::isfinite(a.offset))
-      throw InputError("analog input for '" + name +
-                       "': index must be 1..999, scale finite and "
-                       "non-zero, offset finite");
+    throw InputError("drift slope: fixed_end_position_mm must be finite within +-" +
+                     MessageNumber(kMaxPositionMm) + " mm and growth_direction +1 or -1");
+  CheckSlotsBelowCount(*this);
+  for (const auto& [name, a] : inputs) CheckAnalogInput(name, a, control);
 }
 
 int DriftParamCount(const drift::DriftModel& m, const drift::DriftModel* g) {
@@ -351,12 +405,51 @@ std::string ModelLine(const std::string& what, const drift::DriftModel& m) {
          std::to_string(m.sensors.size()) + " sensors";
 }
 
+// The largest $A_INA index the program reads.
+int LargestAnalogIndex(const drift::DriftModel& m, const drift::DriftModel* g,
+                       const DriftActionOptions& o) {
+  int largest = 0;
+  for (const std::string& name : Inputs(m)) largest = std::max(largest, Input(o, name).index);
+  if (g)
+    for (const std::string& name : Inputs(*g)) largest = std::max(largest, Input(o, name).index);
+  return largest;
+}
+
+// The control's limits the program depends on, with the values the profile states.
+std::string Prerequisites(const drift::DriftModel& m, const drift::DriftModel* g,
+                          const DriftActionOptions& o, const Slots& s, std::size_t actions) {
+  const ControlLimits& c = o.control;
+  auto stated = [&](int v) {
+    return c.Stated() ? " (profile: " + std::to_string(v) + ")" : std::string(" (not stated)");
+  };
+  return "; requires MD10300 $MN_FASTIO_ANA_NUM_INPUTS >= " +
+         std::to_string(LargestAnalogIndex(m, g, o)) + stated(c.analog_inputs) +
+         ", MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(s.last + 1) +
+         stated(c.ac_params) + ", MD28250 $MC_MM_NUM_SYNC_ELEMENTS room for " +
+         std::to_string(actions) + " static actions" + stated(c.sync_elements) +
+         "; no FCTDEF (MD28252) used\n";
+}
+
+// The model's slots within the profile's range param_first..param_last and below MD28254.
+void CheckSlotRange(const DriftActionOptions& o, const Slots& s) {
+  if (o.param_last >= 0 && s.last > o.param_last)
+    throw InputError("drift action needs $AC_PARAM[" + std::to_string(o.param_first) + ".." +
+                     std::to_string(s.last) + "], the profile reserves " +
+                     std::to_string(o.param_first) + ".." + std::to_string(o.param_last) +
+                     " (drift.param_last): use fewer sensors or lags, or widen the range");
+  if (o.control.Stated() && s.last >= o.control.ac_params)
+    throw InputError("drift action needs $AC_PARAM up to index " + std::to_string(s.last) +
+                     ", the control has " + std::to_string(o.control.ac_params) +
+                     " (MD28254 $MC_MM_NUM_AC_PARAM)");
+}
+
 std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
-                   const DriftActionOptions& o, const std::string& model_source, const Slots& s) {
+                   const DriftActionOptions& o, const std::string& model_source, const Slots& s,
+                   std::size_t actions) {
   const int r = o.save_r_first;
   const bool slope_mode = SlopeMode(o, g);
-  std::string nc =
-      "; WHIRL_DRIFT_COMP: SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
+  std::string nc = "; " + o.program_name +
+                   ": SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
   nc += Line(ModelLine("; model: ", m) +
              (model_source.empty() ? std::string() : ", file " + Text(model_source)));
   if (g) nc += Line(ModelLine("; slope model: ", *g));
@@ -388,9 +481,9 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
           std::to_string(o.workpiece_slope_param + 1) +
           "]: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b)\n";
   nc += "; requires MD32750 $MA_TEMP_COMP_TYPE bit 0" +
-        std::string(slope_mode ? " and bit 1" : "") + " for axis " + o.axis +
-        "; stop it with WHIRL_DRIFT_COMP_RESET (restores what it found)\n";
-  return nc;
+        std::string(slope_mode ? " and bit 1" : "") + " for axis " + o.axis + "; stop it with " +
+        o.reset_program_name + " (restores what it found)\n";
+  return nc + Prerequisites(m, g, o, s, actions);
 }
 
 }  // namespace
@@ -402,13 +495,14 @@ std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOp
   if (g) CheckModel(*g);
   const Slots s = MakeSlots(m, g, o.param_first);
   CheckSlope(g, o, s);
+  CheckSlotRange(o, s);
   const std::vector<std::string> bodies = ActionBodies(m, g, o, s);
   const int available = o.sync_id_last - o.sync_id_first + 1;
   if (static_cast<int>(bodies.size()) > available)
     throw InputError("drift action needs " + std::to_string(bodies.size()) +
                      " synchronized-action IDs, the range " + std::to_string(o.sync_id_first) +
                      ".." + std::to_string(o.sync_id_last) + " has " + std::to_string(available));
-  std::string nc = Header(m, g, o, model_source, s);
+  std::string nc = Header(m, g, o, model_source, s, bodies.size());
   if (o.plan_marker_r >= 0)  // a plan's own compensation is still on the control: reset it first
     nc += "IF " + R(o.plan_marker_r) + "==1\nSETAL(" + std::to_string(o.missing_alarm + 3) +
           ")\nENDIF\n";
@@ -424,7 +518,8 @@ std::string FormatDriftNcResetProgram(const DriftActionOptions& o) {
   o.Validate();
   const int r = o.save_r_first;
   const std::string ax = "[" + o.axis + "]";
-  std::string nc = "; WHIRL_DRIFT_COMP_RESET: stops the live drift compensation of axis " + o.axis +
+  std::string nc = "; " + o.reset_program_name + ": stops the live drift compensation of axis " +
+                   o.axis +
                    " and restores the setting data found before it started (SD43900 if " +
                    R(r + 1) + " = 1, SD43910/SD43920 if " + R(r + 4) + " = 1)\n";
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";

@@ -66,9 +66,33 @@ namespace whirl::interp {
 
 /// One analog input: value = scale * $A_INA[index] + offset (degC for a sensor).
 struct AnalogInput {
-  int index = 1;        ///< $A_INA[index], 1..999
-  double scale = 1.0;   ///< per input unit (e.g. 0.1 degC per unit), finite, non-zero
-  double offset = 0.0;  ///< degC (or the input's unit)
+  int index = 1;        ///< $A_INA[index], 1..MD10300 (1..999 when the count is not stated)
+  double scale = 1.0;   ///< per input unit (e.g. 0.1 degC per unit), 1e-6 <= |scale| <= 1e3
+  double offset = 0.0;  ///< degC (or the input's unit), |offset| <= 1e4
+};
+/// Bounds of an analog input's mapping. The scale is printed with 10 decimals
+/// (kDecimalsDriftCoefficient): at 1e-6 it keeps 5 significant digits, below it a sensor would
+/// fade out of the program (1e-12 prints as 0.0000000000); 1e3 per unit is far above any
+/// transducer (a 0-10 V input over 0-100 degC is 0.01 degC per mV). An offset beyond 1e4 (degC or
+/// the input's unit) is a typing error, not a transducer.
+inline constexpr double kMinAnalogScale = 1e-6;
+inline constexpr double kMaxAnalogScale = 1e3;
+inline constexpr double kMaxAnalogOffset = 1e4;
+inline constexpr int kMaxAnalogIndex = 999;
+/// Interpolation cycle bounds [ms]: a SINUMERIK interpolation cycle is a few milliseconds;
+/// outside 0.1..100 ms the lag factors per cycle would be wrong by orders of magnitude.
+inline constexpr double kMinIpoCycleMs = 0.1;
+inline constexpr double kMaxIpoCycleMs = 100.0;
+
+/// The control's own limits a program depends on (machine data, from the machine profile's
+/// "control" object; -1: not stated, then not checked, and the headers still name what each
+/// program needs).
+struct ControlLimits {
+  int analog_inputs = -1;  ///< MD10300 $MN_FASTIO_ANA_NUM_INPUTS: NCK analog inputs, 0..999
+  int sync_elements = -1;  ///< MD28250 $MC_MM_NUM_SYNC_ELEMENTS: synchronized-action elements
+  int ac_params = -1;      ///< MD28254 $MC_MM_NUM_AC_PARAM: $AC_PARAM[0..n-1] exist, 1..10000
+  bool Stated() const { return analog_inputs >= 0; }
+  void Validate() const;  ///< InputError naming the machine datum and the rule
 };
 
 enum class DriftReference { kModel, kStart };
@@ -82,7 +106,10 @@ struct DriftActionOptions {
   double ipo_cycle_ms = 4.0;  ///< interpolation cycle of the control [ms], (0, 100]
   int sync_id_first = 1;      ///< IDS range of the drift action, within 1..255
   int sync_id_last = 255;
-  int param_first = 0;          ///< first $AC_PARAM slot used (0..9999)
+  int param_first = 0;          ///< first $AC_PARAM slot used (0..9999): the liveness slot
+  /// Last $AC_PARAM slot the action may use (>= param_first + 3); -1: up to 9999. A model that
+  /// needs more slots is an InputError naming both.
+  int param_last = -1;
   int save_r_first = 80;        ///< R<n> saved SD43900, R<n+1> marker (1 while active)
   int workpiece_k0_param = -1;  ///< >= 0: add $AC_PARAM[n] (the whirling plan's K0)
   /// >= 0: the plan's SD43910 in $AC_PARAM[n], its SD43920 in $AC_PARAM[n + 1] (this action owns
@@ -91,15 +118,22 @@ struct DriftActionOptions {
   bool has_slope = false;          ///< the profile's drift.slope object is present
   double slope_fixed_end_mm = 0;   ///< P_b: axis position (MCS) of the zero of the growth, mm
   int slope_growth_direction = 1;  ///< sigma: +1 distance from P_b grows towards +axis, or -1
-  /// First of four SETAL numbers (60000..69996): + 0..2 the plans' liveness check
+  /// First of four SETAL numbers (65000..69996, user cycle alarms): + 0..2 the plans' liveness check
   /// (sinumerik.h PlanOptions::drift_alive_param), + 3 this program finds a plan's compensation
   /// still active (R<plan_marker_r> = 1: run the plan's reset program first).
   int missing_alarm = 65000;
   int plan_marker_r = -1;  ///< the plans' marker R (profile save_r_first + 3); -1: not checked
   DriftReference reference = DriftReference::kModel;
   std::map<std::string, AnalogInput> inputs;  ///< by column name (sensors and extra inputs)
+  ControlLimits control;  ///< MD10300, MD28250, MD28254 (from the profile)
+  /// The program's name and its reset program's on the control (the files' stems); checked by
+  /// CheckProgramName and CheckDistinctProgramNames (sinumerik.h).
+  std::string program_name = "WHIRL_DRIFT_COMP";
+  std::string reset_program_name = "WHIRL_DRIFT_COMP_RESET";
 
-  void Validate() const;  ///< InputError naming the field and the rule
+  /// InputError naming the field and the rule: every bound above, IDs within 1..255, alarms
+  /// within the user cycle alarms, analog indices within MD10300 and slots below MD28254.
+  void Validate() const;
 };
 
 /// How many $AC_PARAM slots the action uses for `model` (features, references, flag) and the
@@ -108,9 +142,11 @@ int DriftParamCount(const drift::DriftModel& model, const drift::DriftModel* slo
 
 /// The NC program (subprogram, .SPF, ends in M17) that installs the static actions. `slope`
 /// (optional) is the machine's slope model (see the header comment). InputError for a network
-/// model, a dynamic model without a time unit of minutes, a missing analog input, an ID range too
-/// small, a line longer than the control's 512 characters, a slope model without the profile's
-/// slope object, or a slope model with a plan that writes SD43910 itself (two writers).
+/// model, a dynamic model without a time unit of minutes, a missing analog input, an ID range or
+/// $AC_PARAM range (param_first..param_last, below MD28254) too small, a line longer than the
+/// control's 512 characters, a slope model without the profile's slope object, or a slope model
+/// with a plan that writes SD43910 itself (two writers). The header names the prerequisites:
+/// MD10300 for the analog inputs read, MD28254 for the slots, MD28250 for the actions.
 std::string FormatDriftNcProgram(const drift::DriftModel& model, const DriftActionOptions& options,
                                  const std::string& model_source = "",
                                  const drift::DriftModel* slope = nullptr);

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 #include "core/csv.h"
@@ -70,7 +71,8 @@ double RoundingBudgetUm(double thread_length_mm, double md32760) {
   return 1000.0 * (k0 + slope + p0);
 }
 
-std::size_t SyncIdsNeeded(const CompensationPlan& plan) { return plan.segments.size(); }
+// One action per segment (the first at the thread start) and one for the restore.
+std::size_t SyncIdsNeeded(const CompensationPlan& plan) { return plan.segments.size() + 1; }
 
 }  // namespace
 
@@ -142,18 +144,34 @@ void PlanOptions::Validate() const {
                      "points against the travel, so dK = -direction * l if the control adds dK "
                      "to the setpoint and +direction * l if it subtracts it (sign '" +
                      ToString(ExpectedSign(direction, control_dk)) + "' here)");
-  if (!(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= kMaxSyncActionId))
+  if (!(sync_id_first == 0 && sync_id_last == 0) &&
+      !(sync_id_first >= 1 && sync_id_first <= sync_id_last && sync_id_last <= kMaxSyncActionId))
     throw InputError("synchronized-action IDs " + std::to_string(sync_id_first) + ".." +
-                     std::to_string(sync_id_last) + ": must satisfy 1 <= first <= last <= 255");
+                     std::to_string(sync_id_last) +
+                     ": must satisfy 1 <= first <= last <= 255 (or both 0: not set)");
+  if (!(start_alarm >= kUserAlarmFirst && start_alarm <= kUserAlarmLast))
+    throw InputError("start_alarm " + std::to_string(start_alarm) + ": must be within " +
+                     std::to_string(kUserAlarmFirst) + ".." + std::to_string(kUserAlarmLast) +
+                     " (user cycle alarms; 60000..64999 belong to Siemens' cycles)");
   if (workpiece_k0_param > 9999 || (workpiece_k0_param >= 0 && drift_alive_param < 0))
     throw InputError("combined with the drift action: workpiece_k0_param " +
                      std::to_string(workpiece_k0_param) +
                      " must be 0..9999 and needs the drift action's liveness slot "
                      "(drift_alive_param, the profile's drift.param_first)");
-  if (drift_alive_param > 9999 || !(drift_missing_alarm >= 60000 && drift_missing_alarm <= 69997))
+  if (drift_alive_param > 9999)
     throw InputError("drift_alive_param " + std::to_string(drift_alive_param) +
-                     " must be at most 9999 and the alarm " + std::to_string(drift_missing_alarm) +
-                     " within 60000..69997 (it and the next two numbers are used)");
+                     ": must be at most 9999");
+  if (!(drift_missing_alarm >= kUserAlarmFirst && drift_missing_alarm <= kUserAlarmLast - 2))
+    throw InputError("drift_missing_alarm " + std::to_string(drift_missing_alarm) +
+                     ": must be within " + std::to_string(kUserAlarmFirst) + ".." +
+                     std::to_string(kUserAlarmLast - 2) +
+                     " (user cycle alarms; it and the next two numbers are used)");
+  if (drift_alive_param >= 0 && start_alarm >= drift_missing_alarm &&
+      start_alarm <= drift_missing_alarm + 2)
+    throw InputError("start_alarm " + std::to_string(start_alarm) +
+                     " is one of the drift check's alarms " + std::to_string(drift_missing_alarm) +
+                     ".." + std::to_string(drift_missing_alarm + 2) +
+                     ": each alarm needs its own number");
   if (workpiece_slope_param >= 0 && !(workpiece_k0_param >= 0 && workpiece_slope_param <= 9998 &&
                                       (workpiece_k0_param < workpiece_slope_param ||
                                        workpiece_k0_param > workpiece_slope_param + 1)))
@@ -217,6 +235,7 @@ CompensationPlan BuildPlan(const fit::ArctanCurve& curve, double axial_feed_mm_s
 double AppliedCompensationUm(const CompensationPlan& plan, double axis_position_mm) {
   if (plan.segments.empty()) return 0.0;
   const double d = static_cast<double>(plan.options.direction);
+  if (d * (axis_position_mm - plan.segments.front().sd43920_mm) < 0) return 0.0;  // not started
   std::size_t active = 0;
   for (std::size_t i = 0; i < plan.segments.size(); ++i)
     if (d * (axis_position_mm - plan.segments[i].sd43920_mm) >= 0) active = i;
@@ -265,7 +284,8 @@ void to_json(nlohmann::json& j, const PlanOptions& o) {
                      {"workpiece_k0_param", o.workpiece_k0_param},
                      {"drift_alive_param", o.drift_alive_param},
                      {"drift_missing_alarm", o.drift_missing_alarm},
-                     {"workpiece_slope_param", o.workpiece_slope_param}};
+                     {"workpiece_slope_param", o.workpiece_slope_param},
+                     {"start_alarm", o.start_alarm}};
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
@@ -274,7 +294,7 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
       {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
        "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
        "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm", "workpiece_slope_param",
-       "drift_slope_marker_r", "drift_alive_param"},
+       "drift_slope_marker_r", "drift_alive_param", "start_alarm"},
       "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
@@ -294,6 +314,8 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
   // drift_marker_r is read over: the check now looks at the running action, not an R marker).
   o.workpiece_slope_param = j.value("workpiece_slope_param", -1);
   o.drift_alive_param = j.value("drift_alive_param", -1);
+  // Absent in plans written before the start check: its documented default.
+  o.start_alarm = j.value("start_alarm", kDefaultStartAlarm);
   o.Validate();
 }
 
@@ -401,6 +423,10 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
          "), write SD43900 $SA_TEMP_COMP_ABS_VALUE, SD43910 $SA_TEMP_COMP_SLOPE, SD43920 "
          "$SA_TEMP_COMP_REF_POSITION of that row; before the first row save the three values "
          "found, and at the row 'restore' (thread end) write the saved values back\n";
+  out += "# start only with the axis before the first row's trigger_position_mm (at or past it "
+         "every passed row would be due at once: raise alarm " +
+         std::to_string(o.start_alarm) +
+         " and change nothing); until the axis reaches it, write nothing\n";
   out += "# sign " + ToString(o.sign) + " (dK = " + (o.sign == SignConvention::kAdd ? "+" : "-") +
          "elongation; control_dk " + ToString(o.control_dk) + ", direction " +
          std::to_string(o.direction) + "), MD32760 cap " + FormatFixed(o.md32760, 4) +
@@ -448,6 +474,40 @@ std::string FormatPointsCsv(const CompensationPlan& plan,
 }
 
 // --- NC programs ---------------------------------------------------------------------------
+
+void CheckProgramName(const std::string& name, const std::string& what) {
+  auto letter = [](char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0; };
+  const bool ok =
+      name.size() >= 2 && name.size() <= kMaxProgramNameLength && letter(name[0]) &&
+      letter(name[1]) && std::all_of(name.begin(), name.end(), [&](char c) {
+        return letter(c) || std::isdigit(static_cast<unsigned char>(c)) || c == '_';
+      });
+  if (!ok)
+    throw InputError(what + ": program name '" + NcComment(name) +
+                     "' is not a SINUMERIK program name: two letters first, then letters, digits "
+                     "or '_' (no blanks, no other characters), at most " +
+                     std::to_string(kMaxProgramNameLength) +
+                     " characters (Siemens, Programming Manual Fundamentals, Program names)");
+}
+
+std::string ProgramNameOf(const std::string& path, const std::string& flag) {
+  const std::string name = std::filesystem::path(path).stem().string();
+  CheckProgramName(name, flag + " '" + NcComment(path) + "'");
+  return name;
+}
+
+void CheckDistinctProgramNames(const std::string& program, const std::string& reset_program) {
+  auto upper = [](std::string t) {
+    for (char& c : t) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return t;
+  };
+  if (upper(program) == upper(reset_program))
+    throw InputError("the program '" + NcComment(program) + "' and its reset program '" +
+                     NcComment(reset_program) +
+                     "' would be one program on the control (the same name, ignoring case): give "
+                     "them different names");
+}
+
 
 namespace {
 
@@ -526,6 +586,43 @@ std::string RequireDriftAction(const PlanOptions& o) {
   return out + "IF " + alive + "==0\n" + alarm(0) + "IF " + alive + "<>" + mode + "\n" + alarm(2);
 }
 
+// Refuses to start (before anything is changed) with the axis at or past the thread start, where
+// the first action's condition would already hold: every passed action would fire at once.
+std::string RequireAxisBeforeStart(const CompensationPlan& plan) {
+  const PlanOptions& o = plan.options;
+  return "STOPRE\nIF $AA_IM[" + o.axis + "]" + (o.direction > 0 ? ">=" : "<=") +
+         FormatFixed(plan.segments.front().sd43920_mm, kDecimalsPositionMm) + "\nSETAL(" +
+         std::to_string(o.start_alarm) + ")\nENDIF\n";
+}
+
+// "MD28254 ... >= n" for the $AC_PARAM slots a plan program uses (none: empty).
+std::string AcParamPrerequisite(const PlanOptions& o) {
+  int last = std::max(o.drift_alive_param, o.workpiece_k0_param);
+  if (SlopeHandedOver(o)) last = std::max(last, o.workpiece_slope_param + 1);
+  if (last < 0) return "";
+  return "; requires MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(last + 1) +
+         " ($AC_PARAM up to index " + std::to_string(last) + ")\n";
+}
+
+void HeaderControl(std::ostringstream& nc, const CompensationPlan& plan, const NcProgramInfo& info) {
+  const PlanOptions& o = plan.options;
+  const std::string& ax = o.axis;
+  const std::string start = FormatFixed(plan.segments.front().p_a_mm, kDecimalsPositionMm);
+  nc << "; start: call it with the axis before the thread start, " << ax
+     << (o.direction > 0 ? " < " : " > ") << start << " mm (MCS); at or past it the program raises "
+     << "alarm " << o.start_alarm << " (axis at or past the thread start: no resume from "
+     << "mid-thread) and changes nothing: run " << info.reset_program_name
+     << ", move the axis before the thread start and cut the whole thread again\n";
+  nc << "; until the axis reaches the thread start the control keeps what it applied before the "
+        "call; the first segment is written by ID="
+     << o.sync_id_first << " at the thread start\n";
+  nc << "; requires MD28250 $MC_MM_NUM_SYNC_ELEMENTS room for " << SyncIdsNeeded(plan)
+     << " synchronized actions (IDs " << o.sync_id_first << ".."
+     << o.sync_id_first + static_cast<int>(SyncIdsNeeded(plan)) - 1
+     << ") beside the machine builder's; no FCTDEF (MD28252) used\n";
+  nc << AcParamPrerequisite(o);
+}
+
 std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
   const PlanOptions& o = plan.options;
   const std::string& ax = o.axis;
@@ -551,6 +648,7 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
      << FormatFixed(plan.segments.front().p_a_mm, kDecimalsPositionMm) << " mm (MCS); thread end "
      << ax << " = " << FormatFixed(ThreadEndMm(plan), kDecimalsPositionMm) << " mm (MCS), "
      << FormatFixed(plan.thread_length_mm, 4) << " mm of travel\n";
+  HeaderControl(nc, plan, info);
   nc << "; uses synchronized-action IDs " << o.sync_id_first << ".." << o.sync_id_last;
   if (SlopeHandedOver(o))
     nc << " (cancelled first); no R parameter (nothing of the control's is written)\n";
@@ -565,7 +663,7 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
   nc << "; $AA_IM = actual position in machine coordinates; $$SA_ = write in the main run\n";
   nc << "; call before the cutting block; the ID= actions stay active until the program ends\n";
   if (o.drift_alive_param >= 0)
-    nc << "; checks the drift action (WHIRL_DRIFT_COMP) by its liveness slot $AC_PARAM["
+    nc << "; checks the live drift action (whirl drift nc) by its liveness slot $AC_PARAM["
        << o.drift_alive_param << "] (cleared, 0.1 s dwell, read back): expects "
        << (SlopeHandedOver(o) ? "2"
            : Combined(o)      ? "1"
@@ -575,7 +673,7 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
        << " action running although this plan writes the setting data itself, "
        << o.drift_missing_alarm + 2 << " action in the other mode\n";
   if (Combined(o))
-    nc << "; combined with WHIRL_DRIFT_COMP: K0 goes to $AC_PARAM[" << o.workpiece_k0_param
+    nc << "; combined with the drift action: K0 goes to $AC_PARAM[" << o.workpiece_k0_param
        << "], which the drift action adds into SD43900 (its only writer)\n";
   if (SlopeHandedOver(o))
     nc << "; slope handed over too: SD43910 goes to $AC_PARAM[" << o.workpiece_slope_param
@@ -584,17 +682,34 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
   return nc.str();
 }
 
+void RequireSyncIds(const PlanOptions& o) {
+  if (!o.HasSyncIds())
+    throw InputError(
+        "NC program: no synchronized-action IDs set: the program cancels every ID of its range, "
+        "so it needs the range the machine builder reserved for whirl (the machine profile's "
+        "sync_id_first/sync_id_last, or --sync-id-first and --sync-id-last without a profile); "
+        "there is no default");
+}
+
+void CheckNames(const NcProgramInfo& info) {
+  CheckProgramName(info.program_name, "NC program name");
+  CheckProgramName(info.reset_program_name, "reset program name");
+  CheckDistinctProgramNames(info.program_name, info.reset_program_name);
+}
+
 }  // namespace
 
 std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info) {
   ValidatePlan(plan);
+  CheckNames(info);
   const PlanOptions& o = plan.options;
+  RequireSyncIds(o);
   const std::string& ax = o.axis;
   const std::size_t available = static_cast<std::size_t>(o.sync_id_last - o.sync_id_first + 1);
   if (SyncIdsNeeded(plan) > available)
     throw InputError("plan has " + std::to_string(plan.segments.size()) +
-                     " segments: the NC program needs one synchronized-action ID per segment after "
-                     "the first and one for the restore at the thread end (" +
+                     " segments: the NC program needs one synchronized-action ID per segment and "
+                     "one for the restore at the thread end (" +
                      std::to_string(SyncIdsNeeded(plan)) + "), but the range " +
                      std::to_string(o.sync_id_first) + ".." + std::to_string(o.sync_id_last) +
                      " has " + std::to_string(available) +
@@ -603,18 +718,13 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   auto pos = [](double v) { return FormatFixed(v, kDecimalsPositionMm); };
   auto k0 = [](double v) { return FormatFixed(v, kDecimalsSd43900Mm); };
   auto slope = [](double v) { return FormatFixed(v, kDecimalsSd43910); };
-  std::string nc =
-      Header(plan, info) + RequireDriftAction(o) + CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
-  const CompensationSegment& first = plan.segments.front();
-  // One datum per block, the slope last: between the blocks the control applies a mix of found
-  // and new values, and with the slope written last (found slope 0, or the hand-over's 0) every
-  // mix is a constant offset, never slope * (P - a stale reference), which can be millimetres.
-  nc += K0Target(o, "$") + "=" + k0(first.sd43900_mm) + "\n";
-  nc += RefTarget(o, "$") + "=" + pos(first.sd43920_mm) + "\n";
-  nc += SlopeTarget(o, "$") + "=" + slope(first.sd43910) + "\n";
-  nc += "STOPRE\n";
+  std::string nc = Header(plan, info) + RequireAxisBeforeStart(plan) + RequireDriftAction(o) +
+                   CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
+  // Every segment, the first included, is a position-triggered action: with the axis before the
+  // thread start (checked above) nothing of the plan applies until the axis reaches it, so the
+  // first segment's slope is never extrapolated to where the axis is parked.
   int id = o.sync_id_first;
-  for (std::size_t i = 1; i < plan.segments.size(); ++i, ++id) {
+  for (std::size_t i = 0; i < plan.segments.size(); ++i, ++id) {
     const CompensationSegment& s = plan.segments[i];
     nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(s.sd43920_mm) +
           " DO " + SdWrites(o, "$$", k0(s.sd43900_mm), slope(s.sd43910), pos(s.sd43920_mm)) + "\n";
@@ -629,13 +739,15 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
 
 std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info) {
   o.Validate();
+  CheckNames(info);
+  RequireSyncIds(o);
   const std::string& ax = o.axis;
   const int m = o.save_r_first;
   std::string nc = "; " + info.reset_program_name +
                    ": restores the SINUMERIK 840D temperature "
                    "compensation of axis " +
                    ax + " after an aborted " + info.program_name + " run\n";
-  // The slope first (see FormatNcProgram): every intermediate state is then a constant offset.
+  // The slope first: when the saved slope is 0, every intermediate state is a constant offset.
   const std::string writes = SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n" +
                              RefTarget(o, "$") + "=" + RestoredRef(o, "") + "\n" +
                              K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";

@@ -17,11 +17,13 @@
 // so that dK(P) = s * l(t(P)) / 1000 on the chord. The segment is active while the axis is between
 // P_A and P_B; the plan covers the whole thread: after the curve's last change a final segment with
 // slope 0 holds the plateau to the end of the thread.
+#include <cstddef>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "core/limits.h"
 #include "fit/arctan_curve.h"
 #include "interp/breakpoints.h"
 
@@ -73,6 +75,37 @@ double RoundTo(double x, int decimals);
 inline constexpr double kMd32760Default = 0.01;
 inline constexpr double kMd32760Max = 0.10;
 
+/// SETAL numbers whirl raises lie within the user cycle alarms 65000..69999; 60000..64999 belong
+/// to Siemens' own cycles (SINUMERIK 840D cycle alarm ranges). The programs assume the alarm
+/// stops the program (its configured reaction); not verified on a control here.
+inline constexpr int kUserAlarmFirst = 65000;
+inline constexpr int kUserAlarmLast = 69999;
+/// The default numbering: the drift check's four alarms from 65000 (drift_missing_alarm,
+/// drift_action.h), then the plan's start alarm.
+inline constexpr int kDefaultStartAlarm = kUserAlarmFirst + 4;
+/// Largest |position| accepted for the machine offset, the thread start and other axis positions,
+/// mm: 100 m, longer than any machine bed (a larger value is a typing error, and at 1e308 the
+/// trigger positions of neighbouring segments become equal).
+inline constexpr double kMaxPositionMm = kMaxAxisPositionMm;  // core/limits.h
+
+/// SINUMERIK program names: two letters, then letters, digits or '_', at most 24 characters
+/// (Siemens, SINUMERIK 840D sl Programming Manual Fundamentals, "Program names": the first two
+/// characters must be letters, then only letters, digits and underscores, no blanks or other
+/// separators, the '.' only before the file extension, at most 24 characters; recalled, not
+/// checked against a copy of the manual here: the stricter reading is used). The program names
+/// whirl writes into its headers are those of the files (their stem, the extension .SPF aside).
+inline constexpr std::size_t kMaxProgramNameLength = 24;
+/// InputError naming `what` (e.g. "--nc 'x/1 my comp.spf'") and the rule unless `name` is a
+/// SINUMERIK program name (see kMaxProgramNameLength).
+void CheckProgramName(const std::string& name, const std::string& what);
+/// The program name of an NC file: the file name without its extension, checked by
+/// CheckProgramName (`flag` names the option in the message).
+std::string ProgramNameOf(const std::string& path, const std::string& flag);
+/// InputError if a program and its reset program would be one program on the control: the same
+/// name ignoring case (a case-insensitive file system, such as that of a Windows-based HMI,
+/// stores A.SPF and a.spf as one file), which also covers one file given twice (./A.SPF, A.SPF).
+void CheckDistinctProgramNames(const std::string& program, const std::string& reset_program);
+
 struct PlanOptions {
   /// Largest |applied compensation - predicted curve| along the thread, um (>= 0.001 um = 1 nm,
   /// kMinPlanToleranceUm of core/limits.h).
@@ -95,10 +128,18 @@ struct PlanOptions {
   /// Check-grid step for the tolerance, s (BreakpointOptions::check_step_s).
   double check_step_s = 0.25;
   /// Synchronized-action IDs whirl may use, [sync_id_first, sync_id_last] within 1..255: one per
-  /// segment after the first plus one for the restore at the thread end. The NC program cancels
-  /// exactly these IDs before it starts, so choose a range the machine builder does not use.
-  int sync_id_first = 1;
-  int sync_id_last = 255;
+  /// segment (the first segment's too, at the thread start) plus one for the restore at the
+  /// thread end. The NC program cancels exactly these IDs before it starts, so they are the ones
+  /// the machine builder reserved for whirl (machine profile, or explicit flags when there is
+  /// none). 0 and 0: not set, the default; a plan can be built, but FormatNcProgram and
+  /// FormatNcResetProgram refuse (there is no safe default range).
+  int sync_id_first = 0;
+  int sync_id_last = 0;
+  /// SETAL number the NC program raises, before it changes anything, when it is called with the
+  /// axis at or past the thread start (its first position trigger): the cut must start with the
+  /// axis before the thread start (no resume from mid-thread). Within kUserAlarmFirst..
+  /// kUserAlarmLast; profile key "start_alarm"; default kDefaultStartAlarm.
+  int start_alarm = kDefaultStartAlarm;
   /// R parameters R<n>..R<n+3> the NC program uses to save the setting data it found (SD43900,
   /// SD43910, SD43920) and a marker (1 while whirl's compensation is active), so the thread end
   /// and the reset program restore exactly what was there before. 0..9996; the machine must
@@ -123,11 +164,14 @@ struct PlanOptions {
   /// drift_missing_alarm (expected 1 or 2, found 0: the action is not running), + 1 (expected 0:
   /// a running drift action would be a second writer) or + 2 (the action's mode does not match).
   int drift_alive_param = -1;
-  int drift_missing_alarm = 65000;
+  int drift_missing_alarm = kUserAlarmFirst;
 
-  /// InputError naming the field, value and rule for any option out of range, and for a sign
-  /// that is not ExpectedSign(direction, control_dk).
+  /// InputError naming the field, value and rule for any option out of range (positions within
+  /// +-kMaxPositionMm, alarms within the user cycle alarms and distinct), and for a sign that is
+  /// not ExpectedSign(direction, control_dk).
   void Validate() const;
+  /// True when the synchronized-action IDs are set (sync_id_first > 0).
+  bool HasSyncIds() const { return sync_id_first > 0; }
 };
 
 struct CompensationSegment {
@@ -166,11 +210,12 @@ CompensationPlan BuildPlan(const CurveFunction& curve_um, double axial_feed_mm_s
 CompensationPlan BuildPlan(const fit::ArctanCurve& curve, double axial_feed_mm_s,
                            double thread_length_mm, const PlanOptions& options);
 
-/// The elongation (um) the control compensates with the axis at `axis_position_mm` (MCS),
+/// The elongation (um) the plan compensates with the axis at `axis_position_mm` (MCS),
 /// reconstructed from SD43900/SD43910/SD43920 and the sign convention only: the active segment is
-/// the last one whose SD43920 the axis has passed in the direction of travel (the first one before
-/// the start); value = (SD43900 + SD43910 (P - SD43920)) * 1000 / s. Positive = the same direction
-/// as the elongation it cancels.
+/// the last one whose SD43920 the axis has passed in the direction of travel; value = (SD43900 +
+/// SD43910 (P - SD43920)) * 1000 / s. Before the thread start it is 0: the NC program writes the
+/// first segment only when the axis reaches the thread start, until then the control applies what
+/// it applied before the call. Positive = the same direction as the elongation it cancels.
 double AppliedCompensationUm(const CompensationPlan& plan, double axis_position_mm);
 
 /// Checks a plan read back or built elsewhere: contiguous segments, finite values, slopes within
@@ -191,7 +236,8 @@ void from_json(const nlohmann::json& j, PlanOptions& options);
 /// segment,trigger_position_mm,t_a_s,t_b_s,p_a_mm,p_b_mm,l_a_um,l_b_um,sd43900_mm,sd43910,
 /// sd43920_mm, fixed decimals per quantity (kDecimals*), then one final row "restore" at the
 /// thread end whose setting-data cells say "saved" (write back the values found before the cut),
-/// with '#' comment lines (axis, sign, direction, MD32760, tolerance, provenance).
+/// with '#' comment lines (axis, sign, direction, MD32760, tolerance, the start condition and its
+/// alarm, provenance).
 std::string FormatPlcCsv(const CompensationPlan& plan,
                          const std::vector<std::string>& provenance = {});
 
@@ -204,31 +250,42 @@ std::string FormatPointsCsv(const CompensationPlan& plan, const std::vector<std:
 
 /// Text facts for the NC program header.
 struct NcProgramInfo {
-  std::string program_name = "WHIRL_TEMP_COMP";  ///< header comment; letters, digits, '_'
-  std::string reset_program_name = "WHIRL_TEMP_COMP_RESET";  ///< named in the header
+  /// The program's own name and that of its reset program, as on the control (the files' stems,
+  /// ProgramNameOf); checked by CheckProgramName and CheckDistinctProgramNames.
+  std::string program_name = "WHIRL_TEMP_COMP";
+  std::string reset_program_name = "WHIRL_TEMP_COMP_RESET";
   std::string curve_source;  ///< e.g. "model m.json, screw s.json (L=..., t_s=..., k=...)";
                              ///< control characters become spaces (one comment line)
 };
 
 /// SINUMERIK subprogram (.SPF) that leaves the control as it found it:
+///   STOPRE; IF $AA_IM[<axis>]>=<thread start> ('<=' travelling in -direction): SETAL(start_alarm)
+///     and stop, before anything is changed: every action below is triggered by the position
+///     alone, so with the axis at or past a trigger it would fire at once (a WHEN whose condition
+///     holds fires in the first interpolation cycle). The cut starts with the axis before the
+///     thread start; there is no resume from mid-thread;
+///   [with a drift action on the machine: its liveness check, alarms drift_missing_alarm + 0..2];
 ///   CANCEL(n) for every ID of [sync_id_first, sync_id_last] (stale actions of an aborted run);
 ///   STOPRE; IF R<m+3><>1: save SD43900/43910/43920 into R<m>..R<m+2> (m = save_r_first), set
-///   the marker R<m+3>=1 (a rerun after an abort does not save whirl's own values); write the
-///   first segment's setting data; STOPRE;
+///   the marker R<m+3>=1 (a rerun after an abort does not save whirl's own values);
 ///   ID=<id> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=...
 ///        $$SA_TEMP_COMP_SLOPE[<axis>]=... $$SA_TEMP_COMP_REF_POSITION[<axis>]=...
-///     one modal action per later segment ('<=' when travelling in -direction), IDs counting
-///     up from sync_id_first;
+///     one modal action per segment, the first at the thread start, so nothing of the plan is
+///     applied during the approach (the control keeps what it applied before the call), IDs
+///     counting up from sync_id_first;
 ///   ID=<last> WHEN $AA_IM[<axis>]>=<thread end> DO <restore from R<m>..R<m+2>> $R<m+3>=0;
-///   M17 (subprogram end). Call it before the cutting block. IDs beyond sync_id_last are an
-///   InputError (raise the tolerance or widen the range). Header comments state MD32750 = 3,
-///   the MD32760 cap against the largest slope, the sign rule, the axis, IDs and R parameters.
+///   M17 (subprogram end). Call it before the cutting block. IDs not set, or more needed than
+///   the range holds, are an InputError (raise the tolerance or widen the range). Header
+///   comments state the program names, MD32750 = 3, the MD32760 cap against the largest slope,
+///   the sign rule, the axis, the start condition and its alarm, IDs, R parameters and the
+///   control's limits it depends on (MD28250 for its actions, MD28254 for the $AC_PARAM it uses).
 /// Not verified on a control here (REFERENCE.md 7): the access level for main-run writes of
 /// SD43900-43920 on a given machine.
 std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info = {});
 
 /// The reset subprogram for an aborted cut: CANCEL(n) over the ID range, then, if the marker
-/// R<m+3> is 1, write back the saved SD43900/43910/43920 and clear the marker; M17.
+/// R<m+3> is 1, write back the saved SD43900/43910/43920 and clear the marker; M17. InputError if
+/// the IDs are not set.
 std::string FormatNcResetProgram(const PlanOptions& options, const NcProgramInfo& info = {});
 
 }  // namespace whirl::interp

@@ -16,6 +16,10 @@ Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regressi
 Problem 2, "simulator": datasets/whirling_train.csv (20 simulated rows) for training and
   datasets/whirling_500.csv for testing (whirl's simulator, not measurements); the seed only
   changes the initializations; RMSE and coverage against the table's (noisy) targets.
+Problem 3, "simgen": a training table of N rows (20, 100) generated per seed by `whirl dataset
+  --count N --seed 100000 + 1000 N + seed` (the simulator's Halton design and disturbances; the
+  shipped tables use seeds 1-3), tested on datasets/whirling_500.csv as problem 2; the tables are
+  kept in --sim-cache (default: a temporary folder) so that reruns do not simulate again.
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl):
@@ -34,6 +38,13 @@ both outputs as whirl):
                the textbook choice for a smooth function from a few dozen noisy rows. Its
                predictive sd (return_std, noise included) gives it coverage columns too.
   gp_rbf:      the same with one length scale for all inputs (isotropic RBF).
+  loglinear:   LinearRegression() of ln y on ln x per output (a power law in the five inputs,
+               6 coefficients per output), predictions exp(.); the physics-shaped baseline
+               (every input and both features are positive). Skipped (NaN) when a column is <= 0.
+The family library (src/family, src/gp; `--family-bench build/family_bench --family NAME=ARGS`)
+is run in-process by the development driver tests/family/family_bench.cpp with ARGS (e.g.
+"--candidates gp-matern52-constant/log --no-cv"; NAME=default: the default choice); its
+fit_time_ms is the driver's wall time of the fit on one thread.
 The "best peer" of a seed (wins) is the best of all peers run on that seed, per output.
 Fit times: whirl's in-process time (whirl train --json fit_time_ms), on one thread (time_ms) and
 with --threads 2 (time2_ms; the 2-thread run must predict identically, else the script stops);
@@ -42,8 +53,9 @@ sklearn's wall time of fit() (mlp_cv includes its grid search).
 Peer cache (--peer-cache FILE): the peers' results per (problem, rows, seed, peer, sklearn
 version) are read from and added to FILE (JSON), so exploring whirl settings does not refit them.
 
-Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--sizes 20,100] [--problems friedman,simulator]
-       [--variant NAME=ARGS ...] [--no-default] [--peer-cache FILE] [--json out.json]
+Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--sizes 20,100]
+       [--problems friedman,simulator,simgen] [--variant NAME=ARGS ...] [--no-default]
+       [--family-bench PATH --family NAME=ARGS ...] [--peer-cache FILE] [--json out.json]
 """
 import argparse
 import json
@@ -150,6 +162,13 @@ def fit_sklearn(kind, xtr, ytr, xte, seed):
         start = time.perf_counter()
         mean, sd = fit_gp(xtr, ytr, xte, seed, kind == "gp_ard")
         return mean, 1000 * (time.perf_counter() - start), sd
+    if kind == "loglinear":
+        if (xtr <= 0).any() or (ytr <= 0).any() or (xte <= 0).any():
+            return np.full((len(xte), ytr.shape[1]), np.nan), 0.0, None
+        start = time.perf_counter()
+        model = LinearRegression().fit(np.log(xtr), np.log(ytr))
+        ms = 1000 * (time.perf_counter() - start)
+        return np.exp(model.predict(np.log(xte))), ms, None
     if kind in ("ols", "ridge_gcv"):
         model = LinearRegression() if kind == "ols" else make_pipeline(
             StandardScaler(), RidgeCV(alphas=np.logspace(-4, 4, 41), alpha_per_target=True))
@@ -172,6 +191,28 @@ def fit_sklearn(kind, xtr, ytr, xte, seed):
     return model.predict(xte), 1000 * (time.perf_counter() - start), None
 
 
+def run_family(driver, args, xtr, ytr, xte, tmp):
+    """The family library through tests/family/family_bench.cpp: (mean, sd, fit ms, info)."""
+    train, test = os.path.join(tmp, "ftrain.csv"), os.path.join(tmp, "ftest.csv")
+    write_table(train, xtr, ytr)
+    write_table(test, xte)
+    out = json.loads(subprocess.run([driver, "--train", train, "--test", test, "--threads", "1"] + args,
+                                    check=True, capture_output=True, text=True).stdout)
+    mean = np.array([p["mean"] for p in out["predictions"]])
+    sd = np.array([p["sd"] for p in out["predictions"]])
+    return mean, sd, out["fit_time_ms"], {"chosen": out["chosen"], "cpu_ms": out["fit_cpu_ms"]}
+
+
+def simulated_table(whirl, rows, seed, cache_dir):
+    """Problem "simgen": whirl dataset --count rows --seed 100000 + 1000 rows + seed (cached)."""
+    path = os.path.join(cache_dir, f"sim_{rows}_{seed}.csv")
+    if not os.path.exists(path):
+        subprocess.run([whirl, "dataset", "--count", str(rows), "--seed",
+                        str(100000 + 1000 * rows + seed), "--out", path, "--threads", "2"],
+                       check=True, capture_output=True)
+    return read_table(path)
+
+
 def coverage(mean, sd, yte, fte):
     """Shares of noisy targets within +-1/+-2 sd and of the noise-free truth within +-1/+-2 sd."""
     return {"cover1": np.mean(np.abs(yte - mean) <= sd, axis=0).tolist(),
@@ -192,7 +233,11 @@ def main():
     ap.add_argument("--problems", default="friedman,simulator")
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
-    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv,gp_ard,gp_rbf")
+    ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv,loglinear,gp_ard,gp_rbf")
+    ap.add_argument("--family-bench", help="path of build/family_bench (the family library's driver)")
+    ap.add_argument("--family", action="append", default=[],
+                    help="NAME=ARGS: run family_bench with ARGS (needs --family-bench)")
+    ap.add_argument("--sim-cache", help="folder for the generated simulator tables (simgen)")
     ap.add_argument("--no-threads2", action="store_true",
                     help="skip the second whirl run with --threads 2 (time2_ms)")
     ap.add_argument("--json", help="write all per-seed results here")
@@ -202,10 +247,13 @@ def main():
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     a = ap.parse_args()
     variants = ([] if a.no_default else [("whirl", [])]) + [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.variant]
+    families = [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.family]
+    if families and not a.family_bench:
+        sys.exit("bench_peers: --family needs --family-bench")
     peers = [p for p in a.peers.split(",") if p]
     cases = []
     for prob in a.problems.split(","):
-        sizes = [int(s) for s in a.sizes.split(",")] if prob == "friedman" else [20]
+        sizes = [int(s) for s in a.sizes.split(",")] if prob in ("friedman", "simgen") else [20]
         cases += [(prob, n) for n in sizes]
     cache = {}
     if a.peer_cache and os.path.exists(a.peer_cache):
@@ -213,12 +261,18 @@ def main():
             cache = json.load(f)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
+        sim_cache = a.sim_cache or tmp
+        os.makedirs(sim_cache, exist_ok=True)
         for prob, n in cases:
             for seed in range(1, a.seeds + 1):
                 if prob == "friedman":
                     rng = np.random.default_rng(1000 * n + seed)
                     xtr, _, ytr = friedman(rng, n)
                     xte, fte, yte = friedman(rng, TEST_ROWS)
+                elif prob == "simgen":
+                    xtr, ytr = simulated_table(a.whirl, n, seed, sim_cache)
+                    xte, yte = read_table(os.path.join(a.datasets, "whirling_500.csv"))
+                    fte = yte
                 else:
                     xtr, ytr = read_table(os.path.join(a.datasets, "whirling_train.csv"))
                     xte, yte = read_table(os.path.join(a.datasets, "whirling_500.csv"))
@@ -227,6 +281,10 @@ def main():
                 for name, args in variants:
                     mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp,
                                                  not a.no_threads2)
+                    rec["methods"][name] = {"rmse": rmse(mean, fte).tolist(), "time_ms": ms,
+                                            **info, **coverage(mean, sd, yte, fte)}
+                for name, args in families:
+                    mean, sd, ms, info = run_family(a.family_bench, args, xtr, ytr, xte, tmp)
                     rec["methods"][name] = {"rmse": rmse(mean, fte).tolist(), "time_ms": ms,
                                             **info, **coverage(mean, sd, yte, fte)}
                 for p in peers:
@@ -244,7 +302,7 @@ def main():
                 print(f"{prob} {n} rows seed {seed}: " + ", ".join(
                     f"{k} {v['rmse'][0]:.3g}/{v['rmse'][1]:.3g}" for k, v in rec["methods"].items()),
                     file=sys.stderr)
-            report(results, prob, n, variants, peers)
+            report(results, prob, n, variants + families, peers)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(results, f, indent=1)
@@ -276,6 +334,12 @@ def report(results, prob, n, variants, peers):
         if m not in peers:
             line += f" {sum(bool(r['methods'][m].get('flat')) for r in rs):>5}"
         print(line)
+    for m in [v[0] for v in variants]:
+        chosen = [r["methods"][m]["chosen"] for r in rs if "chosen" in r["methods"][m]]
+        if chosen:
+            counts = {c: chosen.count(c) for c in sorted(set(chosen))}
+            print(f"{m} chose: " + ", ".join(f"{c} {k}" for c, k in counts.items()) +
+                  f"; median fit CPU {np.median([r['methods'][m]['cpu_ms'] for r in rs]):.2f} ms")
     print("wins = seeds on which the method beats the best peer of that seed; cov = mean % of test "
           "targets within +-1/2 sd (noisy), cov1sd_f = +-1 sd against the noise-free function; "
           "time = median fit time (time2: whirl --threads 2); flat = seeds on which whirl train warned "

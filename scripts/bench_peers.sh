@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Peer benchmark of whirl's network (issue 12): Friedman #1 plus a second smooth output (20 and 100
-# training rows, 1000 test rows) and the simulator's tables (train 20, test 500), whirl train against
-# scikit-learn's MLPRegressor (default and grid-searched), LinearRegression, RidgeCV and Gaussian
-# processes (ARD and isotropic RBF kernels); prints
+# Peer benchmark of whirl's workpiece models: Friedman #1 plus a second smooth output (20 and 100
+# training rows, 1000 test rows), the simulator's shipped tables (train 20, test 500) and generated
+# simulator tables (simgen: 20 and 100 rows per seed, test 500), whirl train (and, with
+# --family-bench build/tests/family_bench --family NAME=ARGS, the family library) against
+# scikit-learn's MLPRegressor (default and grid-searched), LinearRegression, RidgeCV, the power law
+# (LinearRegression on log inputs and log outputs) and Gaussian processes (ARD and isotropic RBF
+# kernels); prints
 # median test RMSE per output, wins, interval coverage and fit time. The functions, noise and
 # peers are documented in scripts/bench_peers.py.
 # Installs Debian's python3-sklearn on first use (only here: the default setup and tests never need it).

@@ -3,10 +3,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/numbers.h"
+#include "core/output_dir.h"
 #include "sim/random.h"
 
 namespace whirl::ballbar {
@@ -230,14 +230,10 @@ nlohmann::json WriteSimulatedMeasurement(const std::filesystem::path& dir, const
     files.push_back({t.file, FormatCircleTrace(c)});
   }
   files.push_back({"README.md", Readme(s, o, command, traces)});
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError("cannot create directory '" + dir.string() + "': " + ec.message());
+  OutputDir out(dir, "output directory");
+  for (const auto& [name, text] : files) out.Add(name, text);
   nlohmann::json written = nlohmann::json::array();
-  for (const auto& [name, text] : files) {
-    WriteFileAtomic(dir / name, text);
-    written.push_back((dir / name).string());
-  }
+  for (const auto& path : out.Commit()) written.push_back(path.string());
   return {{"schema", "whirl.ballbar.simulation"},
           {"schema_version", 1},
           {"command", command},

@@ -82,8 +82,9 @@ CircleTrace SimulateCircle(const CirclePlant& plant);
 
 /// Writes the demo measurement into `dir` (created if missing): readings.csv, pivots.json,
 /// truth_drift.csv, circle_xy_scale.csv, circle_xy_cyclic.csv, circle_xz_parallelism.csv and a
-/// README.md giving the command, the seed and every planted value. All contents are built before
-/// the first file is written. Returns a JSON summary (files, truth).
+/// README.md giving the command, the seed and every planted value, all-or-nothing through
+/// core/output_dir.h (`dir` must be new, empty or a whirl output, never a symbolic link).
+/// Returns a JSON summary (files, truth).
 nlohmann::json WriteSimulatedMeasurement(const std::filesystem::path& dir,
                                          const WarmupOptions& options);
 

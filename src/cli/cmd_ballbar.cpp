@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/atomic_file.h"
+#include "core/output_dir.h"
 
 namespace whirl::cli {
 namespace {
@@ -39,6 +40,7 @@ void PrintDrift(const ballbar::DriftResult& r) {
 }
 
 void RunDrift(DriftCmd c) {
+  CheckOutputs({{"--readings", c.readings}, {"--pivots", c.pivots}}, {{"--out", c.out}});
   c.o.sign = interp::ParseSignConvention(c.sign);
   c.o.correct_bar_temperature = !c.no_temperature;
   const ballbar::DriftResult r =
@@ -172,7 +174,8 @@ void AddSimulate(CLI::App& parent) {
       "warm-up (drift 2-10 um in X, Y and 20-60 um in Z, seeded) read with bar noise 0.1 um at\n"
       "0.1 um resolution and a warming bar (readings.csv, pivots.json, truth_drift.csv), circle\n"
       "traces with a planted scale mismatch, cyclic error and XZ parallelism, and a README.md.");
-  sub->add_option("--out-dir", c->out_dir, "output directory")->required();
+  sub->add_option("--out-dir", c->out_dir, std::string("output directory: ") + kOutputDirRule)
+      ->required();
   AddSeedOption(sub, &c->o.seed, "random seed (default 1)");
   sub->add_option("--duration-min", c->o.duration_min, "warm-up length, min (default 240)")
       ->check(CLI::Range(60.0, 720.0));
@@ -180,6 +183,7 @@ void AddSimulate(CLI::App& parent) {
       ->check(CLI::Range(4.0, 720.0));
   sub->add_flag("--json", c->json, "machine output: JSON on stdout");
   sub->callback([c] {
+    CheckOutputs({}, {}, {{"--out-dir", c->out_dir}});
     const nlohmann::json j = ballbar::WriteSimulatedMeasurement(c->out_dir, c->o);
     if (c->json) return PrintJson(j);
     for (const auto& f : j["files"]) std::printf("wrote %s\n", f.get<std::string>().c_str());

@@ -8,6 +8,7 @@
 #include "cli/common.h"
 #include "compare/compare.h"
 #include "compare/report.h"
+#include "core/output_dir.h"
 #include "core/process.h"
 #include "nn/model.h"
 #include "sim/screw.h"
@@ -32,6 +33,11 @@ struct CompareCliOptions {
 };
 
 void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
+  CheckOutputs({{"--model", o.model_path},
+                {"--screw", o.screw_path},
+                {"--history", o.history},
+                {"--iso-table", o.iso_table}},
+               {}, {{"--report", o.report_dir}});
   const nn::Model model = nn::LoadModel(o.model_path);
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   const compare::ExperienceRule rule =
@@ -110,7 +116,8 @@ void RegisterCompare(CLI::App& app) {
   sub->add_flag("--no-disturbances", o->no_disturbances,
                 "simulate the truth without disturbances (the model's own world)");
   sub->add_option("--report", o->report_dir,
-                  "write the HTML report (index.html, PNG plots, CSV data, report.json) here");
+                  "write the HTML report (index.html, PNG plots, CSV data, report.json) here: " +
+                      std::string(kOutputDirRule));
   sub->add_flag("--no-plots", o->no_plots, "with --report: skip gnuplot (data and HTML only)");
   sub->add_option("--history", o->history,
                   "past screws for the traditional rule: process table with targets "

@@ -12,6 +12,7 @@
 #include "core/curve.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/output_dir.h"
 #include "fit/arctan_curve.h"
 #include "nn/model.h"
 #include "sim/screw.h"
@@ -34,6 +35,7 @@ struct CurveOptions {
 };
 
 void Run(const CurveOptions& o) {
+  CheckOutputs({{"--model", o.model_path}, {"--screw", o.screw_path}}, {{"--out", o.out_path}});
   const bool by_model = !o.model_path.empty() || !o.screw_path.empty();
   const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
   if (by_model == by_features)

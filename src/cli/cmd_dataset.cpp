@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/curve.h"
+#include "core/output_dir.h"
 #include "sim/dataset.h"
 
 namespace whirl::cli {
@@ -22,6 +23,7 @@ struct DatasetCliOptions {
 };
 
 void Run(const DatasetCliOptions& o) {
+  CheckOutputs({}, {{"--out", o.out_path}}, {{"--curves-dir", o.curves_dir}});
   sim::DatasetOptions options;
   options.count = o.count;
   options.seed = o.seed;
@@ -66,7 +68,9 @@ void RegisterDataset(CLI::App& app) {
   sub->add_option("--out", opts->out_path, "output CSV (inputs, then targets), written atomically")
       ->required();
   sub->add_option("--curves-dir", opts->curves_dir,
-                  "also write each row's curve (time_s, elongation_um) as row_NNNN.csv here");
+                  "also write each row's curve (time_s, elongation_um) as row_NNNN.csv here, "
+                  "with the table all-or-nothing (" +
+                      std::string(kOutputDirRule) + ")");
   sub->add_option("--window-s", opts->window_s, "simulated time per row in s")
       ->check(CLI::PositiveNumber);
   sub->add_option("--threads", opts->threads, "worker threads")->check(CLI::Range(1, 64));

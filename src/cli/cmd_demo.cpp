@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <utility>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -13,6 +14,7 @@
 #include "compare/plan_document.h"
 #include "compare/report.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "interp/machine_profile.h"
 #include "nn/model.h"
 #include "sim/screw.h"
@@ -37,10 +39,9 @@ void RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model
   mo.machines = 1;
   mo.screws_per_machine = 2;
   mo.seed = seed;
-  mo.report_dir = (out / "machine_report").string();
+  mo.report_dir = (out / "machine_report").string();  // replaces the demo's earlier report
   // The combined 840D programs of the report's screw, for the simulated machine's profile.
   mo.profile = interp::LoadMachineProfile(ProjectPath("datasets/machines/whirling_840d.json"));
-  std::filesystem::remove_all(mo.report_dir);  // the demo's own output of an earlier run
   const compare::MachineEvaluation e = compare::EvaluateWithMachines(
       sim::ReferenceScrew(), model,
       compare::BuildExperienceRule(ReadProcessTable(ProjectPath(kHistoryTable), true)),
@@ -58,11 +59,11 @@ void RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model
 void RunDemo(const DemoOptions& o) {
   namespace fs = std::filesystem;
   const auto start = std::chrono::steady_clock::now();
-  const fs::path out(o.out_dir);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec || !fs::is_directory(out))
-    throw InputError("--out-dir '" + o.out_dir + "': cannot create it (" + ec.message() + ")");
+  // The output directory's rule before anything runs; the plan files and the model are made in
+  // its staging folder and committed together, the reports are output directories of their own.
+  OutputDir files(o.out_dir, "--out-dir");
+  const fs::path out = files.path();
+  const fs::path stage = files.Staging();
 
   const std::string model_path = ProjectPath("models/default.json");
   const std::string train_path = ProjectPath(kHistoryTable);
@@ -78,7 +79,8 @@ void RunDemo(const DemoOptions& o) {
     if (!o.retrain) Warn(model_path + " not found: training a model from " + train_path);
     model = nn::TrainModel(history, nn::DefaultTrainingOptions(), train_path);
     model_source = "trained now from " + train_path;
-    nn::SaveModel(out / "model.json", model);
+    nn::SaveModel(stage / "model.json", model);
+    files.AddStaged("model.json");
     std::printf("1. model: trained on %zu rows of %s (%s), saved to %s\n", history.inputs.size(),
                 train_path.c_str(), model.training_summary.BriefReport().c_str(),
                 (out / "model.json").string().c_str());
@@ -103,7 +105,11 @@ void RunDemo(const DemoOptions& o) {
   // The example machine's facts (ID range, R parameters, offset): a real run names its own.
   interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile)).ApplyTo(co.plan);
   std::vector<compare::ScrewComparison> results;
-  for (const sim::Screw* screw : std::vector<const sim::Screw*>{&reference, &new_type}) {
+  // The NC files' stems are their program names on the control (letters, digits, '_', at most
+  // 24 characters: interp::CheckProgramName), so they cannot carry the screw's name.
+  const std::pair<const sim::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
+                                                              {&new_type, "WHIRL_NEW_TYPE"}};
+  for (const auto& [screw, program] : screws) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
     const std::string slug = compare::Slug(screw->name);
     const auto& p = c.prediction;
@@ -118,18 +124,23 @@ void RunDemo(const DemoOptions& o) {
     const nlohmann::json plan_json =
         compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
                               {model_source, c.prediction, c.prediction.mean}, provenance);
+    const std::vector<std::string> names = {slug + "_plan.json", slug + "_plan.csv",
+                                            program + ".SPF", program + "_RESET.SPF"};
     compare::WritePlanFiles(
-        {out / (slug + "_plan.json"), out / (slug + "_plan.csv"), out / (slug + "_temp_comp.spf"),
-         out / (slug + "_temp_comp_reset.spf")},
-        plan_json, c.plan, provenance,
-        "whirl demo: model " + model_source + ", screw " + screw->name);
+        {stage / names[0], stage / names[1], stage / names[2], stage / names[3]}, plan_json, c.plan,
+        provenance, "whirl demo: model " + model_source + ", screw " + screw->name);
+    for (const auto& name : names) files.AddStaged(name);
     std::printf(
         "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
-        "%s_plan.json/.csv and %s_temp_comp.spf (reset: %s_temp_comp_reset.spf)\n",
+        "%s_plan.json/.csv and %s.SPF (reset: %s_RESET.SPF)\n",
         screw->name.c_str(), c.plan.segments.size(), c.plan.max_abs_slope, c.plan.options.md32760,
-        (out / slug).string().c_str(), slug.c_str(), slug.c_str());
+        (out / slug).string().c_str(), program.c_str(), program.c_str());
     results.push_back(std::move(c));
   }
+
+  files.Keep("report");
+  files.Keep("machine_report");
+  files.Commit();
 
   compare::ReportOptions ro;
   ro.plots = !o.no_plots;
@@ -181,11 +192,14 @@ void RegisterDemo(CLI::App& app) {
       "elongation of the reference screw (datasets/screws/reference_80x10x6000.json) and of a\n"
       "new-type screw outside the training rows (reference blank; 61 HRC, 63 mm, lead 12 mm,\n"
       "raceway radius 4.0 mm, 200 m/min), build the arctangent curve, plan the 840D setting data\n"
-      "(SD43900 mm, SD43910 -, SD43920 mm; files <screw>_plan.json/.csv and\n"
-      "<screw>_temp_comp.spf), cut both screws in the simulator with no compensation, the\n"
+      "(SD43900 mm, SD43910 -, SD43920 mm; files <screw>_plan.json/.csv and the NC programs\n"
+      "WHIRL_REFERENCE.SPF, WHIRL_NEW_TYPE.SPF with their _RESET.SPF), cut both screws in the\n"
+      "simulator with no compensation, the\n"
       "traditional experience rule and the plan, write the report (report/index.html) and print\n"
       "the lead-error reductions (um and %).");
-  sub->add_option("--out-dir", o->out_dir, "output directory (default whirl-demo-out)");
+  sub->add_option("--out-dir", o->out_dir,
+                  "output directory (default whirl-demo-out): " + std::string(kOutputDirRule) +
+                      "; running the demo again replaces its files");
   sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists, with `whirl train`'s\n"
                 "default (linear or hidden size 4/6/8 by log evidence, brnn's stopping rule,\n"
                 "5-fold CV noise)");

@@ -10,6 +10,7 @@
 #include "cli/drift_args.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "drift/documents.h"
 #include "drift/evaluation.h"
 #include "drift/model.h"
@@ -43,6 +44,15 @@ void AddRunOptions(CLI::App* sub, RunInputs* r, bool required = true) {
     b->group("Runs (at least one)");
     c->group("Runs (at least one)");
   }
+}
+
+// The run files as inputs for CheckOutputs; `prefix` "train-" for drift report's --train-*.
+std::vector<FlagPath> InputPaths(const RunInputs& in, const std::string& prefix = "") {
+  std::vector<FlagPath> paths;
+  for (const auto& [flag, files] :
+       {std::pair{"--run", &in.runs}, {"--idle", &in.idle}, {"--cutting", &in.cutting}})
+    for (const auto& f : *files) paths.push_back({"--" + prefix + (flag + 2), f});
+  return paths;
 }
 
 std::vector<Run> LoadRuns(const RunInputs& in) {
@@ -174,6 +184,7 @@ void RegisterFitModel(CLI::App* drift_app) {
   sub->add_option("--out", o->out, "model file to write (JSON)")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
+    CheckOutputs(InputPaths(o->runs), {{"--out", o->out}});
     const auto runs = LoadRuns(o->runs);
     std::fprintf(stderr, "fitting %s model of %s on %zu run(s)...\n", o->model.kind.c_str(),
                  o->error.c_str(), runs.size());
@@ -221,6 +232,7 @@ void RegisterPredictDrift(CLI::App* drift_app) {
       ->check(CLI::IsMember({"run-start", "model"}));
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
+    CheckOutputs({{"--model", o->model}, {"--run", o->run}}, {{"--out", o->out}});
     const drift::DriftModel m = drift::ReadDriftModel(o->model);
     const Run run = drift::ReadRun(o->run, RunState::kUnknown);
     const drift::RunPrediction p =
@@ -337,9 +349,11 @@ void RegisterHoldout(CLI::App* drift_app) {
                 "leave-one-block-out instead of forward-chaining");
   sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")
       ->check(CLI::Range(1, 10000));
-  sub->add_option("--report", o->report, "also write an HTML report into this directory");
+  sub->add_option("--report", o->report,
+                  std::string("also write an HTML report into this directory: ") + kOutputDirRule);
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
+    CheckOutputs({{"--log", o->log}}, {}, {{"--report", o->report}});
     const Run log = drift::ReadRun(o->log, RunState::kUnknown);
     drift::HoldoutOptions h = o->h;
     h.channels = o->channels;
@@ -377,13 +391,17 @@ void RegisterSplit(CLI::App* drift_app) {
   sub->add_option("--at", o->column, "column whose rise starts a run (default spindle_rpm)");
   FiniteNumber(sub->add_option("--threshold", o->threshold,
                                "start threshold in the column's unit (default 0)"));
-  sub->add_option("--out-dir", o->out_dir, "directory for the run files")->required();
+  sub->add_option("--out-dir", o->out_dir,
+                  std::string("directory for the run files: ") + kOutputDirRule)
+      ->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
+    CheckOutputs({{"--log", o->log}}, {}, {{"--out-dir", o->out_dir}});
     const Run log = drift::ReadRun(o->log, RunState::kUnknown);
     const auto runs = drift::SplitAtStarts(log, o->column, o->threshold);
-    const auto paths = drift::WriteRuns(
-        o->out_dir, runs, {"whirl drift split --log " + o->log + " --at " + o->column});
+    const auto paths =
+        drift::WriteRuns(o->out_dir, runs,
+                         {"whirl drift split --log " + o->log + " --at " + o->column}, "--out-dir");
     nlohmann::json list = nlohmann::json::array();
     for (std::size_t i = 0; i < runs.size(); ++i)
       list.push_back({{"file", paths[i].string()},
@@ -425,8 +443,11 @@ void RegisterReport(CLI::App* drift_app) {
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
   sub->add_option("--error", o->error, "error column (<name>_um)")->required();
-  sub->add_option("--out", o->out, "report directory (created)")->required();
+  sub->add_option("--out", o->out, std::string("report directory: ") + kOutputDirRule)->required();
   sub->callback([o] {
+    std::vector<FlagPath> inputs = InputPaths(o->train, "train-"), more = InputPaths(o->runs);
+    inputs.insert(inputs.end(), more.begin(), more.end());
+    CheckOutputs(inputs, {}, {{"--out", o->out}});
     const auto train = LoadRuns(o->train);
     std::vector<Run> runs = train;
     if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())

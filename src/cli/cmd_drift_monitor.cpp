@@ -9,6 +9,7 @@
 #include "cli/common.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "drift/monitor.h"
 
 namespace whirl::cli {
@@ -85,11 +86,15 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
                   "and residual [um])");
   sub->add_option("--events", a->events,
                   "write every check, refit measurement and update with its reason (CSV)");
-  sub->add_option("--report", a->report, "write an HTML page with the plot into this directory");
+  sub->add_option(
+      "--report", a->report,
+      std::string("write an HTML page with the plot into this directory: ") + kOutputDirRule);
   sub->add_flag("--json", a->json, "machine output on stdout");
 }
 
 void RunMonitor(MonitorArgs& a) {
+  CheckOutputs({{"--model", a.model}, {"--run", a.run}},
+               {{"--timeline", a.timeline}, {"--events", a.events}}, {{"--report", a.report}});
   a.o.reference = drift::ParseReferenceMode(a.reference);
   a.o.score_from = a.score_rows.at(0);
   a.o.score_to = a.score_rows.at(1);
@@ -102,15 +107,16 @@ void RunMonitor(MonitorArgs& a) {
   const std::vector<std::string> prov{"whirl drift monitor --model " + a.model + " --run " + a.run};
   const std::string timeline = drift::MonitorTimelineCsv(r, prov);
   const std::string events = drift::MonitorEventsCsv(r, prov);
-  if (!a.report.empty()) {
-    const auto rep = drift::WriteMonitorReport(a.report, r, a.o, prov);
-    for (const auto& w : rep.warnings) Warn(w);
-    std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
-  }
   std::vector<std::pair<std::filesystem::path, std::string>> files;
   if (!a.timeline.empty()) files.emplace_back(a.timeline, timeline);
   if (!a.events.empty()) files.emplace_back(a.events, events);
-  WriteFilesAtomic(files);  // both or neither
+  if (!a.report.empty()) {  // the report with the files: all or none
+    const auto rep = drift::WriteMonitorReport(a.report, r, a.o, prov, "gnuplot", files);
+    for (const auto& w : rep.warnings) Warn(w);
+    std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
+  } else {
+    WriteFilesAtomic(files);  // both or neither
+  }
   if (a.json)
     PrintJson(drift::MonitorJson(r, a.o));
   else

@@ -12,6 +12,7 @@
 #include "cli/common.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "drift/model.h"
 #include "interp/drift_action.h"
 #include "interp/machine_profile.h"
@@ -40,7 +41,27 @@ std::pair<std::string, interp::AnalogInput> ParseInput(const std::string& text) 
   return {text.substr(0, eq), a};
 }
 
+// An --input for a name the models do not read would be silently ignored: refused.
+void CheckKnownInput(const std::string& text, const std::string& name,
+                     const drift::DriftModel& model, const drift::DriftModel* slope) {
+  std::string known;
+  for (const drift::DriftModel* m : {&model, slope}) {
+    if (!m) continue;
+    for (const auto* list : {&m->sensors, &m->extra_inputs})
+      for (const std::string& input : *list) {
+        if (input == name) return;
+        known += (known.empty() ? "" : ", ") + input;
+      }
+  }
+  throw InputError("--input '" + text + "': the model has no input '" + name +
+                   "' (its inputs: " + known + ")");
+}
+
 void Run(const DriftNcOptions& o) {
+  CheckOutputs({{"--model", o.model_path},
+                {"--slope-model", o.slope_model_path},
+                {"--machine", o.machine_path}},
+               {{"--nc", o.nc_path}, {"--reset-nc", o.reset_path}, {"--csv", o.csv_path}});
   const drift::DriftModel model = drift::ReadDriftModel(o.model_path);
   std::optional<drift::DriftModel> slope;
   if (!o.slope_model_path.empty()) slope = drift::ReadDriftModel(o.slope_model_path);
@@ -50,8 +71,18 @@ void Run(const DriftNcOptions& o) {
   options.reference = interp::ParseDriftReference(o.reference);
   for (const std::string& text : o.inputs) {
     const auto [name, a] = ParseInput(text);
+    CheckKnownInput(text, name, model, g);
     options.inputs[name] = a;
+    try {  // the profile's bounds and the control's analog input count (MD10300)
+      options.Validate();
+    } catch (const InputError& e) {
+      throw InputError("--input '" + text + "' (machine profile '" + o.machine_path +
+                       "'): " + e.what());
+    }
   }
+  if (!o.nc_path.empty()) options.program_name = interp::ProgramNameOf(o.nc_path, "--nc");
+  if (!o.reset_path.empty())
+    options.reset_program_name = interp::ProgramNameOf(o.reset_path, "--reset-nc");
   // Render everything first (a model the control cannot run fails here), then write all or none.
   const std::string nc = interp::FormatDriftNcProgram(model, options, o.model_path, g);
   const std::string reset = interp::FormatDriftNcResetProgram(options);
@@ -129,14 +160,20 @@ void RegisterDriftNc(CLI::App* drift_app) {
       ->check(CLI::ExistingFile);
   sub->add_option("--input", o->inputs,
                   "NAME=INDEX:SCALE:OFFSET: analog input of a model input, overriding the "
-                  "profile (value = SCALE * $A_INA[INDEX] + OFFSET, degC for a sensor)");
+                  "profile (value = SCALE * $A_INA[INDEX] + OFFSET, degC for a sensor; INDEX "
+                  "1..the profile's MD10300, 1e-6 <= |SCALE| <= 1e3, |OFFSET| <= 1e4; a name "
+                  "the model does not read is refused)");
   sub->add_option("--reference", o->reference,
                   "rises against the model's reference temperatures (model) or those when the "
                   "action starts (start)")
       ->capture_default_str()
       ->check(CLI::IsMember({"model", "start"}));
-  sub->add_option("--nc", o->nc_path, "write the NC program here (.SPF)");
-  sub->add_option("--reset-nc", o->reset_path, "write the reset program here (.SPF)");
+  sub->add_option("--nc", o->nc_path,
+                  "write the NC program here (.SPF); its file name without the extension is the "
+                  "program name on the control: two letters, then letters, digits or '_', at "
+                  "most 24 characters");
+  sub->add_option("--reset-nc", o->reset_path,
+                  "write the reset program here (.SPF; a program name as for --nc, not the same)");
   sub->add_option("--csv", o->csv_path, "write the PLC table here (CSV)");
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] { Run(*o); });

@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "nn/model.h"
 #include "torch/crosscheck.h"
 
@@ -21,6 +22,7 @@ struct ExportCliOptions {
 };
 
 void RunExport(const ExportCliOptions& o) {
+  CheckOutputs({{"--model", o.model_path}}, {{"--torchscript", o.torchscript_path}});
   const nn::Model model = nn::LoadModel(o.model_path);
   torch::ExportOptions options;
   options.description = "whirl elongation-feature model exported by 'whirl export --model " +

@@ -11,6 +11,7 @@
 #include "compare/machine_eval.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/process.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
@@ -54,6 +55,7 @@ machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
 }
 
 void RunSensors(const MachineCliOptions& o) {
+  CheckOutputs({{"--machine", o.machine_path}}, {}, {{"--out", o.out}});
   const machine::MachineConfig config = LoadMachine(o);
   std::vector<drift::Run> runs;
   for (auto state : {drift::RunState::kIdle, drift::RunState::kCutting})
@@ -65,7 +67,7 @@ void RunSensors(const MachineCliOptions& o) {
           " (src/machine/machine.h; idle 180 min, cutting 150 min)",
       "offset_um = head + bed drift (SD43900 part); zscrew_per_1000_um = Z screw growth over "
       "1000 mm (SD43910 part)"};
-  const auto paths = drift::WriteRuns(o.out, runs, comments);
+  const auto paths = drift::WriteRuns(o.out, runs, comments, "--out");
   if (o.json) {
     nlohmann::json files = nlohmann::json::array();
     for (std::size_t k = 0; k < paths.size(); ++k)
@@ -79,6 +81,13 @@ void RunSensors(const MachineCliOptions& o) {
 }
 
 void RunMachineEvaluate(const MachineCliOptions& o) {
+  CheckOutputs({{"--machine", o.machine_path},
+                {"--model", o.model_path},
+                {"--history", o.history},
+                {"--base-screw", o.base_screw},
+                {"--iso-table", o.iso_table},
+                {"--profile", o.profile}},
+               {}, {{"--report", o.report}});
   const nn::Model model = nn::LoadModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
@@ -146,7 +155,8 @@ void RegisterMachine(CLI::App& app) {
       "and cutting runs (150 min); sample step from the machine JSON [min]. Fit them with\n"
       "'whirl drift fit --runs DIR/cutting_*.csv --error offset_um'.");
   CommonOptions(s, o.get());
-  s->add_option("--out", o->out, "output folder (created; all files or none)")->required();
+  s->add_option("--out", o->out, std::string("output folder, all files or none: ") + kOutputDirRule)
+      ->required();
   s->add_option("--machine-seed", o->machine_seed, "seed of the machine (default 1)");
   s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")
       ->check(CLI::Range(0, 20));
@@ -191,7 +201,8 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--report", o->report,
                 "write the first screw's report here: sensor plot [degC over min], chosen "
                 "sensors, lead deviation per strategy [um over mm] and the screw's combined 840D "
-                "programs for --profile (folder must not exist or be empty)");
+                "programs for --profile (" +
+                    std::string(kOutputDirRule) + ")");
   e->add_option("--profile", o->profile,
                 "840D machine profile of the combined programs in the report (schema "
                 "whirl.machine with drift.slope and drift.workpiece_slope_param; default "

@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <tuple>
 
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/plan_document.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/output_dir.h"
 #include "fit/arctan_curve.h"
 #include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
@@ -40,6 +42,7 @@ struct PlanCliOptions {
   int sync_id_first = -1;
   int sync_id_last = -1;
   int save_r_first = -1;
+  int start_alarm = -1;
   std::string out_path;
   std::string csv_path;
   std::string nc_path;
@@ -48,6 +51,31 @@ struct PlanCliOptions {
   bool allow_extrapolation = false;
   bool json = false;
 };
+
+// The control resources a profile reserves for whirl (IDs, R parameters, the start alarm): an
+// explicit flag may repeat the profile's value but never contradict it; without a profile the
+// IDs come only from the flags (FormatNcProgram refuses a program without them).
+void ApplyReservedFlags(const PlanCliOptions& o, interp::PlanOptions& p) {
+  const bool profile = !o.machine_path.empty();
+  for (const auto& [flag, key, given, value] :
+       {std::tuple{"--sync-id-first", "sync_id_first", o.sync_id_first, &p.sync_id_first},
+        {"--sync-id-last", "sync_id_last", o.sync_id_last, &p.sync_id_last},
+        {"--save-r", "save_r_first", o.save_r_first, &p.save_r_first},
+        {"--start-alarm", "start_alarm", o.start_alarm, &p.start_alarm}}) {
+    if (given < 0) continue;
+    if (profile && given != *value)
+      throw InputError(std::string("plan: ") + flag + " " + std::to_string(given) +
+                       " contradicts the machine profile '" + o.machine_path + "' (" + key + " " +
+                       std::to_string(*value) +
+                       "), which states what the machine builder reserved for whirl: drop the "
+                       "flag or change the profile");
+    *value = given;
+  }
+  if (!profile && (o.sync_id_first < 0) != (o.sync_id_last < 0))
+    throw InputError(
+        "plan: --sync-id-first and --sync-id-last go together (the range whirl's programs "
+        "cancel and use)");
+}
 
 // The plan options from the machine profile and the explicit flags; the machine-specific
 // positions have no default (a wrong zero would put every trigger at the wrong place).
@@ -69,9 +97,7 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
   if (o.direction != 0) p.direction = o.direction;
   if (!o.control_dk.empty()) p.control_dk = interp::ParseControlDk(o.control_dk);
   if (!std::isnan(o.md32760)) p.md32760 = o.md32760;
-  if (o.sync_id_first >= 0) p.sync_id_first = o.sync_id_first;
-  if (o.sync_id_last >= 0) p.sync_id_last = o.sync_id_last;
-  if (o.save_r_first >= 0) p.save_r_first = o.save_r_first;
+  ApplyReservedFlags(o, p);
   if (!std::isnan(o.start_position_mm))
     p.start_position_mm = o.start_position_mm, have_start = true;
   if (!std::isnan(o.machine_offset_mm))
@@ -91,6 +117,12 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
 }
 
 void Run(const PlanCliOptions& o) {
+  CheckOutputs(
+      {{"--model", o.model_path}, {"--screw", o.screw_path}, {"--machine", o.machine_path}},
+      {{"--out", o.out_path},
+       {"--csv", o.csv_path},
+       {"--nc", o.nc_path},
+       {"--reset-nc", o.reset_nc_path}});
   const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
   if (by_features == !o.model_path.empty())
     throw InputError("plan: give either --model M or --max-elongation L --settle-time T");
@@ -173,14 +205,19 @@ void RegisterPlan(CLI::App& app) {
       "subtracts it; --sign is optional and an inconsistent one is refused. Verify control_dk\n"
       "once on the machine (constant SD43900 test value, dial gauge).\n"
       "Machine facts come from --machine M.json (schema whirl.machine, see\n"
-      "datasets/machines/example_840d.json; each overridable by its flag): axis, direction,\n"
-      "machine offset, control_dk, MD32760, the synchronized-action IDs and R parameters whirl "
-      "may\n"
-      "use. --start-position-mm and --machine-offset-mm have no default: give them or a profile.\n"
-      "The NC program (--nc, a subprogram ending in M17: save it as .SPF) cancels its ID range,\n"
-      "saves the setting data it finds in R parameters, writes the segments through synchronized\n"
-      "actions and restores the saved values at the thread end; --reset-nc writes the program\n"
-      "to run after an aborted cut. Numbers: positions and SD43920 4 decimals [mm], SD43900 6\n"
+      "datasets/machines/example_840d.json): axis, direction, machine offset, control_dk and\n"
+      "MD32760 (each overridable by its flag), and what the machine builder reserved for whirl:\n"
+      "the synchronized-action IDs, R parameters and the start alarm (a flag that contradicts\n"
+      "the profile is refused; without a profile --nc/--reset-nc need --sync-id-first and\n"
+      "--sync-id-last, there is no default range). --start-position-mm and --machine-offset-mm\n"
+      "have no default: give them or a profile.\n"
+      "The NC program (--nc, a subprogram ending in M17: save it as .SPF) refuses to start with\n"
+      "alarm --start-alarm unless the axis stands before the thread start (no resume from\n"
+      "mid-thread), cancels its ID range, saves the setting data it finds in R parameters,\n"
+      "writes every segment, the first at the thread start, through synchronized actions (so\n"
+      "the approach keeps what the control applied before) and restores the saved values at\n"
+      "the thread end; --reset-nc writes the program to run after an aborted cut. The file\n"
+      "names are the program names. Numbers: positions and SD43920 4 decimals [mm], SD43900 6\n"
       "[mm], SD43910 8 [-], identical in NC, PLC table and JSON. A slope above MD32760 is an\n"
       "error. Outputs: plan JSON (--out, schema whirl.plan, the same document as 'whirl demo'),\n"
       "PLC table CSV (--csv), NC programs (--nc, --reset-nc);\n"
@@ -232,25 +269,34 @@ void RegisterPlan(CLI::App& app) {
                   "default 0.01")
       ->check(CLI::Range(1e-12, interp::kMd32760Max));
   sub->add_option("--sync-id-first", o->sync_id_first,
-                  "first synchronized-action ID whirl may use (1-255, default 1)")
+                  "first synchronized-action ID whirl may use (1-255); no default: from the "
+                  "profile, or required with --sync-id-last for --nc/--reset-nc without one; a "
+                  "value that contradicts the profile is refused")
       ->check(CLI::Range(1, 255));
   sub->add_option("--sync-id-last", o->sync_id_last,
-                  "last synchronized-action ID whirl may use (1-255, default 255); the programs "
-                  "CANCEL the whole range first")
+                  "last synchronized-action ID whirl may use (1-255); the programs CANCEL the "
+                  "whole range first, so it must be the range the machine builder reserved")
       ->check(CLI::Range(1, 255));
   sub->add_option("--save-r", o->save_r_first,
                   "R<n>..R<n+3> keep the setting data found before the cut and a marker "
-                  "(0-9996, default 90)")
+                  "(0-9996, default 90 without a profile; must match the profile's)")
       ->check(CLI::Range(0, 9996));
+  sub->add_option("--start-alarm", o->start_alarm,
+                  "SETAL number raised when the program is called with the axis at or past the "
+                  "thread start (user cycle alarms 65000-69999; default 65004 without a profile; "
+                  "must match the profile's start_alarm)")
+      ->check(CLI::Range(interp::kUserAlarmFirst, interp::kUserAlarmLast));
   sub->add_option("--check-step-s", o->check_step_s,
                   "largest step of the grid the tolerance is checked on [s] (refined as needed)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sub->add_option("--out", o->out_path, "write the plan JSON here");
   sub->add_option("--csv", o->csv_path, "write the PLC table (CSV) here");
-  sub->add_option(
-      "--nc", o->nc_path,
-      "write the NC subprogram here (ends in M17: name it .SPF, e.g. WHIRL_TEMP_COMP.SPF)");
+  sub->add_option("--nc", o->nc_path,
+                  "write the NC subprogram here (ends in M17: name it .SPF, e.g. "
+                  "WHIRL_TEMP_COMP.SPF); its file name without the extension is the program name "
+                  "on the control: two letters, then letters, digits or '_', at most 24 "
+                  "characters");
   sub->add_flag("--with-drift-action", o->with_drift_action,
                 "combined with the live drift action (whirl drift nc) on the same axis: the plan "
                 "writes its K0 into the profile's drift.workpiece_k0_param and the drift action "
@@ -259,7 +305,8 @@ void RegisterPlan(CLI::App& app) {
                 "drift action (with --slope-model) owns all three; the program raises the "
                 "profile's alarm if the drift action is not active");
   sub->add_option("--reset-nc", o->reset_nc_path,
-                  "write the reset subprogram for an aborted cut here (.SPF)");
+                  "write the reset subprogram for an aborted cut here (.SPF; a program name as "
+                  "for --nc, not the same)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
                 "plan even if the screw is outside the model's training domain");
   sub->add_flag("--json", o->json, "machine output: the plan JSON on stdout");

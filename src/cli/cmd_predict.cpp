@@ -12,6 +12,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/output_dir.h"
 #include "core/process.h"
 #include "nn/model.h"
 
@@ -32,6 +33,7 @@ struct PredictOptions {
 };
 
 void Run(const PredictOptions& o) {
+  CheckOutputs({{"--model", o.model_path}, {"--input", o.input_path}}, {{"--out", o.out_path}});
   const std::array<double, ProcessInputs::kCount> single = {
       o.hardness_hrc, o.diameter_mm, o.pitch_mm, o.raceway_radius_mm, o.cutting_speed_m_min};
   const std::array<const char*, ProcessInputs::kCount> flags = {

@@ -8,6 +8,7 @@
 #include "core/csv.h"
 #include "core/curve.h"
 #include "core/limits.h"
+#include "core/output_dir.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
 
@@ -69,6 +70,7 @@ nlohmann::json ResultJson(const sim::Screw& screw, const sim::SimulationResult& 
 }
 
 void Run(const SimulateOptions& o) {
+  CheckOutputs({{"--screw", o.screw_path}}, {{"--out", o.out_path}});
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   sim::SimOptions options;
   options.duration_s = o.duration_s;

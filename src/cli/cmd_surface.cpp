@@ -14,6 +14,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/output_dir.h"
 #include "surface/choice.h"
 #ifdef WHIRL_HAVE_DRIFT
 #include "drift/run_file.h"
@@ -39,6 +40,7 @@ struct SynthCli {
 };
 
 void RunSynth(const SynthCli& o) {
+  CheckOutputs({}, {{"--out", o.out}});
   SyntheticOptions s = o.synth;
   s.field = ParseSyntheticField(o.field);
   const auto points = SyntheticPoints(s);
@@ -98,6 +100,7 @@ struct FitCli {
 };
 
 void RunFit(const FitCli& o, const std::string& command) {
+  CheckOutputs({{"--points", o.points}}, {{"--out", o.out}}, {{"--report", o.report}});
   const auto points = ReadSurfacePoints(o.points);
   SurfaceFit fit = FitSurface(points, {ParseMethod(o.method), o.degree});
   fit.provenance = {command + " --points " + o.points + " --method " + o.method + " --degree " +
@@ -120,11 +123,13 @@ void RunFit(const FitCli& o, const std::string& command) {
     SurfaceReportOptions ro;
     ro.provenance = fit.provenance;
     ro.plots = !o.no_plots;
+    if (!o.out.empty()) ro.also_write = {{o.out, JsonFileText(j)}};  // with the report or neither
     const auto r = WriteSurfaceReport(o.report, fit, choice ? &*choice : nullptr, lines, ro);
     for (const auto& w : r.warnings) Warn(w);
     std::cerr << "report: " << r.index_html.string() << "\n";
+  } else if (!o.out.empty()) {
+    WriteJsonFile(o.out, j);
   }
-  if (!o.out.empty()) WriteJsonFile(o.out, j);
   if (o.json)
     PrintJson(j);
   else
@@ -156,7 +161,8 @@ void SetupFit(CLI::App& parent, const std::string& command) {
   sub->add_option("--out", o->out, "surface JSON to write (schema whirl.surface)");
   sub->add_option("--report", o->report,
                   "directory for an HTML page: map of the surface with the measured points, "
-                  "cubic-vs-B-spline choice, 840D line per axis");
+                  "cubic-vs-B-spline choice, 840D line per axis (" +
+                      std::string(kOutputDirRule) + ")");
   sub->add_flag("--no-plots", o->no_plots, "with --report: skip gnuplot (page without the map)");
   sub->add_flag("--json", o->json, "machine output: the surface JSON on stdout");
   sub->callback([o, command] { RunFit(*o, command); });
@@ -176,6 +182,7 @@ void RunPredict(const PredictCli& o) {
     throw InputError("surface predict: give either --x X --y Y or --input XY.csv");
   if (single && (std::isnan(o.x) || std::isnan(o.y)))
     throw InputError("surface predict: --x and --y go together");
+  CheckOutputs({{"--surface", o.surface}, {"--input", o.input}}, {{"--out", o.out}});
   const Surface s = ReadSurfaceFile(o.surface);
   const auto xy =
       single ? std::vector<std::pair<double, double>>{{o.x, o.y}} : ReadPositions(o.input);
@@ -328,6 +335,9 @@ struct PointsCli {
 
 #ifdef WHIRL_HAVE_DRIFT
 void RunPoints(const PointsCli& o) {
+  std::vector<FlagPath> inputs{{"--run", o.run}, {"--manifest", o.manifest}};
+  for (const auto& t : o.train) inputs.push_back({"--train", t});
+  CheckOutputs(inputs, {{"--out", o.out}, {"--predictions", o.predictions}});
   const drift::RunState state = drift::ParseRunState(o.state);
   const drift::Run target = drift::ReadRun(o.run, state);
   std::vector<drift::Run> training;
@@ -352,14 +362,13 @@ void RunPoints(const PointsCli& o) {
           (o.train.empty() ? o.run : std::to_string(o.train.size()) + " run(s)")};
   for (const auto& pc : points)
     fit.provenance.push_back(pc.column + ": " + notes.by_column[pc.column]);
-  // Every file is built first and written all or nothing: an error leaves none behind.
-  std::vector<std::pair<std::filesystem::path, std::string>> files;
+  std::vector<std::pair<std::filesystem::path, std::string>> files;  // both or neither
   if (!o.predictions.empty())
     files.emplace_back(o.predictions,
                        FormatPointPredictionsCsv(
                            p, target.time_min, target.time_from_index ? "sample" : "time_min",
                            {" per-point predictions, whirl surface points --run " + o.run}));
-  if (!o.out.empty()) files.emplace_back(o.out, DumpJson(SurfaceFitToJson(fit)) + "\n");
+  if (!o.out.empty()) files.emplace_back(o.out, JsonFileText(SurfaceFitToJson(fit)));
   WriteFilesAtomic(files);
   if (o.json) {
     PrintJson(SurfaceFitToJson(fit));

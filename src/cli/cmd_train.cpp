@@ -14,6 +14,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/output_dir.h"
 #include "core/process.h"
 #include "nn/model.h"
 #include "nn/selection.h"
@@ -117,6 +118,7 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
 }
 
 void Run(const TrainCliOptions& o) {
+  CheckOutputs({{"--data", o.data_path}}, {{"--out", o.out_path}});
   const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
   if (!o.hidden_sweep.empty()) {
     RunSweep(o, table);

@@ -144,8 +144,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
                                         double monitor_every_min = 30,
                                         MachineScrewDetail* detail = nullptr);
 
-/// Report of one screw in `dir` (must not exist or be empty; written as <dir>.partial, renamed
-/// when complete, so nothing half-written remains): sensors.csv/.png (the screw's sensor log,
+/// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a
+/// symbolic link; written all-or-nothing): sensors.csv/.png (the screw's sensor log,
 /// degC over min), lead.csv/.png (lead deviation per strategy, um over mm), index.html with the
 /// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
 /// Returns the index path.

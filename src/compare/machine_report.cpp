@@ -10,6 +10,7 @@
 #include "compare/machine_nc.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 
@@ -62,15 +63,22 @@ std::string LeadScript(const std::string& title) {
   return gp + "\n";
 }
 
-// Renders <stem>.gp into <stem>.png inside dir; returns the <img> tag or a note.
-std::string Render(const fs::path& dir, const std::string& stem, const std::string& body) {
-  WriteFileAtomic(dir / (stem + ".gp"), std::string(kTerminal) + "set output " +
-                                            GnuplotString(stem + ".png") + "\n" + body);
+// Adds <stem>.gp to the report and renders <stem>.png in its staging folder; returns the <img>
+// tag or a note.
+std::string Render(OutputDir& out, const std::string& stem, const std::string& body) {
+  out.Add(stem + ".gp",
+          std::string(kTerminal) + "set output " + GnuplotString(stem + ".png") + "\n" + body);
   if (!ProgramSucceeds({"gnuplot", "--version"}))
     return "<p>(gnuplot not found: " + HtmlEscape(stem) + ".gp not rendered)</p>";
-  const int rc = RunProgram({"gnuplot", stem + ".gp"}, dir, dir / "gnuplot.log");
-  if (rc != 0 || !fs::exists(dir / (stem + ".png")))
-    return "<p>(gnuplot failed on " + HtmlEscape(stem) + ".gp, see gnuplot.log)</p>";
+  const fs::path stage = fs::absolute(out.Staging());
+  const int rc = RunProgram({"gnuplot", stem + ".gp"}, stage, stage / (stem + ".log"));
+  std::error_code ec;
+  if (rc != 0 || !fs::is_regular_file(stage / (stem + ".png"), ec)) {
+    if (fs::is_regular_file(stage / (stem + ".log"), ec)) out.AddStaged(stem + ".log");
+    return "<p>(gnuplot failed on " + HtmlEscape(stem) + ".gp, see " + HtmlEscape(stem) +
+           ".log)</p>";
+  }
+  out.AddStaged(stem + ".png");
   return "<img src='" + HtmlEscape(stem + ".png") + "' alt='" + HtmlEscape(stem) + "'>";
 }
 
@@ -148,43 +156,31 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                                     const CombinedPrograms* programs,
                                     const std::string& programs_note) {
   if (!screw.ok) throw InputError("report of screw '" + screw.screw.name + "': " + screw.error);
-  const fs::path target = fs::absolute(dir);
-  std::error_code ec;
-  if (fs::exists(target) && !fs::is_empty(target, ec))
-    throw InputError("report directory '" + dir + "': exists and is not empty");
-  const fs::path partial = target.string() + ".partial";
-  fs::remove_all(partial, ec);
-  fs::create_directories(partial, ec);
-  if (ec) throw InputError("report directory '" + partial.string() + "': " + ec.message());
-  try {
-    std::string sensor_img = "<p>(no sensor log: the machine does not drift)</p>";
-    if (detail.log.samples() > 0) {
-      // The screw's log in the drift run format (temperatures and the two error channels), so
-      // `whirl drift predict --run sensors.csv` evaluates a machine model on it.
-      WriteFileAtomic(
-          partial / "sensors.csv",
-          drift::FormatRun(detail.log, {"virtual sensor log of screw " + screw.screw.name +
-                                            " during its cut (simulated, src/machine/machine.h; "
-                                            "machine day seed " +
-                                            std::to_string(screw.day_seed) + ")",
-                                        "offset_um: machine drift at the Z screw's fixed end; "
-                                        "zscrew_per_1000_um: its growth per 1000 mm (um)"}));
-      sensor_img = Render(partial, "sensors",
-                          SensorScript(detail.log, screw.screw.name + ": virtual sensors"));
-    }
-    WriteFileAtomic(partial / "lead.csv", LeadCsv(detail));
-    const std::string lead_img =
-        Render(partial, "lead", LeadScript(screw.screw.name + ": lead deviation"));
-    if (programs) WriteFilesAtomic(CombinedProgramFiles(partial, *programs));
-    WriteFileAtomic(partial / "index.html", Html(screw, sensors_cutting, sensors_idle, sensor_img,
-                                                 lead_img, programs, programs_note));
-    fs::remove(target, ec);  // an empty directory only
-    fs::rename(partial, target);
-  } catch (...) {
-    fs::remove_all(partial, ec);
-    throw;
+  OutputDir out(dir, "report directory");
+  std::string sensor_img = "<p>(no sensor log: the machine does not drift)</p>";
+  if (detail.log.samples() > 0) {
+    // The screw's log in the drift run format (temperatures and the two error channels), so
+    // `whirl drift predict --run sensors.csv` evaluates a machine model on it.
+    out.Add("sensors.csv",
+            drift::FormatRun(detail.log, {"virtual sensor log of screw " + screw.screw.name +
+                                              " during its cut (simulated, src/machine/machine.h; "
+                                              "machine day seed " +
+                                              std::to_string(screw.day_seed) + ")",
+                                          "offset_um: machine drift at the Z screw's fixed end; "
+                                          "zscrew_per_1000_um: its growth per 1000 mm (um)"}));
+    sensor_img =
+        Render(out, "sensors", SensorScript(detail.log, screw.screw.name + ": virtual sensors"));
   }
-  return (target / "index.html").string();
+  out.Add("lead.csv", LeadCsv(detail));
+  const std::string lead_img =
+      Render(out, "lead", LeadScript(screw.screw.name + ": lead deviation"));
+  if (programs)
+    for (const auto& [path, text] : CombinedProgramFiles("", *programs))
+      out.Add(path.filename().string(), text);
+  out.Add("index.html", Html(screw, sensors_cutting, sensors_idle, sensor_img, lead_img, programs,
+                             programs_note));
+  out.Commit();
+  return (fs::path(dir) / "index.html").string();
 }
 
 }  // namespace whirl::compare

@@ -38,10 +38,14 @@ void WritePlanFiles(const PlanOutputPaths& paths, const nlohmann::json& document
                     const interp::CompensationPlan& plan, const std::string& provenance,
                     const std::string& curve_source) {
   std::vector<std::pair<std::filesystem::path, std::string>> files;
-  if (!paths.json.empty()) files.emplace_back(paths.json, DumpJson(document) + "\n");
+  if (!paths.json.empty()) files.emplace_back(paths.json, JsonFileText(document));
   if (!paths.csv.empty()) files.emplace_back(paths.csv, interp::FormatPlcCsv(plan, {provenance}));
   interp::NcProgramInfo info;
   info.curve_source = curve_source;
+  // The headers name the programs as the control will know them: the files' stems.
+  if (!paths.nc.empty()) info.program_name = interp::ProgramNameOf(paths.nc.string(), "--nc");
+  if (!paths.reset_nc.empty())
+    info.reset_program_name = interp::ProgramNameOf(paths.reset_nc.string(), "--reset-nc");
   if (!paths.nc.empty()) files.emplace_back(paths.nc, interp::FormatNcProgram(plan, info));
   if (!paths.reset_nc.empty())
     files.emplace_back(paths.reset_nc, interp::FormatNcResetProgram(plan.options, info));

@@ -48,6 +48,8 @@ struct PlanOutputPaths {
 
 /// Renders and writes the requested plan files all-or-nothing (core/atomic_file.h
 /// WriteFilesAtomic): one unwritable path leaves none of them written and previous files intact.
+/// The NC headers name the programs by the files' stems, which must be SINUMERIK program names
+/// and differ from each other (interp::ProgramNameOf, CheckDistinctProgramNames).
 /// `curve_source` goes into the NC header; `provenance` into the PLC table's comments.
 void WritePlanFiles(const PlanOutputPaths& paths, const nlohmann::json& document,
                     const interp::CompensationPlan& plan, const std::string& provenance,

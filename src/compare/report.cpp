@@ -1,18 +1,14 @@
 #include "compare/report.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <set>
 #include <sstream>
 
-#include "core/atomic_file.h"
 #include "core/csv.h"
-#include "core/error.h"
 #include "core/json_file.h"
+#include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 
@@ -42,25 +38,6 @@ std::string Terminal(const std::string& command) {
   return cairo ? "pngcairo size 1000,560 font 'Sans,11' noenhanced"
                : "png size 1000,560 noenhanced";
 }
-
-// A fresh folder inside the report directory, removed with everything in it on destruction.
-struct StagingDir {
-  std::filesystem::path path;
-  explicit StagingDir(const std::filesystem::path& dir) {
-    std::random_device rd;
-    path = dir / (".whirl-report-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-    std::error_code ec;
-    if (!std::filesystem::create_directory(path, ec))
-      throw InputError("report directory '" + dir.string() + "': cannot create a staging folder (" +
-                       ec.message() + ")");
-  }
-  ~StagingDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  StagingDir(const StagingDir&) = delete;
-  StagingDir& operator=(const StagingDir&) = delete;
-};
 
 struct PlotFiles {
   std::string elongation, lead, lead_start;
@@ -221,11 +198,10 @@ std::string Slug(const std::string& name) {
 ReportResult WriteReport(const std::filesystem::path& dir,
                          const std::vector<ScrewComparison>& comparisons,
                          const ReportOptions& options) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw InputError("report directory '" + dir.string() + "': cannot create it (" + ec.message() +
-                     ")");
+  // Everything is collected in memory (gnuplot renders in the directory's staging folder), then
+  // committed all-or-nothing; files of an earlier report that this one does not write (a PNG now
+  // "not rendered") are removed (core/output_dir.h).
+  OutputDir out(dir, "report directory");
   ReportResult result;
   const bool gnuplot = options.plots && HaveGnuplot(options.gnuplot_command);
   if (options.plots && !gnuplot)
@@ -234,12 +210,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                               "scripts/setup.sh); the HTML, CSV data and .gp scripts are written");
   const std::string terminal = gnuplot ? Terminal(options.gnuplot_command) : "pngcairo";
   bool all_rendered = gnuplot;
-  // Everything is first written into a staging folder inside `dir` (gnuplot renders there), then
-  // committed all-or-nothing (WriteFilesAtomic); the staging folder is removed in any case.
-  const StagingDir stage(dir);
-  std::vector<std::pair<std::filesystem::path, std::string>> outputs;
   std::set<std::string> rendered;
-  std::vector<std::filesystem::path> not_rendered;  // a PNG an earlier run left there is removed
 
   std::vector<std::string> slugs;
   nlohmann::json report_json = nlohmann::json::array();
@@ -257,10 +228,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                       c.compensation_um[static_cast<std::size_t>(Strategy::kTraditional)][i],
                       c.compensation_um[static_cast<std::size_t>(Strategy::kModel)][i]});
     }
-    auto write = [&](const std::string& name, const std::string& text) {
-      WriteFileAtomic(stage.path / name, text);
-      outputs.emplace_back(dir / name, text);
-    };
+    auto write = [&](const std::string& name, const std::string& text) { out.Add(name, text); };
     write(slug + "_elongation.csv",
           FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
                      "traditional_compensation_um", "model_compensation_um"},
@@ -294,32 +262,28 @@ ReportResult WriteReport(const std::filesystem::path& dir,
     if (gnuplot) {
       // An argument vector, no shell: neither the directory nor the names are ever parsed.
       const std::string log = slug + ".gp.log";
-      const int rc =
-          RunProgram({options.gnuplot_command, slug + ".gp"}, stage.path, stage.path / log);
+      const std::filesystem::path stage = std::filesystem::absolute(out.Staging());
+      const int rc = RunProgram({options.gnuplot_command, slug + ".gp"}, stage, stage / log);
       bool ok = rc == 0;
       for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
         std::error_code ec;
-        ok = ok && std::filesystem::is_regular_file(stage.path / png, ec) &&
-             std::filesystem::file_size(stage.path / png, ec) > 0;
+        ok = ok && std::filesystem::is_regular_file(stage / png, ec) &&
+             std::filesystem::file_size(stage / png, ec) > 0;
       }
       if (ok) {
         for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-          outputs.emplace_back(dir / png, ReadTextFile(stage.path / png));
+          out.AddStaged(png);
           rendered.insert(png);
         }
       } else {
         std::error_code ec;
-        if (std::filesystem::exists(stage.path / log, ec))
-          outputs.emplace_back(dir / log, ReadTextFile(stage.path / log));
+        if (std::filesystem::exists(stage / log, ec)) out.AddStaged(log);
         all_rendered = false;
         result.warnings.push_back("gnuplot failed on " + (dir / (slug + ".gp")).string() +
                                   " (see " + (dir / (slug + ".gp.log")).string() + "): plots of '" +
                                   c.screw.name + "' skipped");
       }
     }
-
-    for (const std::string& png : {files.elongation, files.lead, files.lead_start})
-      if (rendered.count(png) == 0) not_rendered.push_back(dir / png);
 
     // HTML section.
     const auto in = c.screw.process;
@@ -385,7 +349,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                  {"schema_version", 1},
                                  {"provenance", options.provenance},
                                  {"comparisons", report_json}};
-  outputs.emplace_back(dir / "report.json", DumpJson(report) + "\n");
+  out.Add("report.json", JsonFileText(report));
 
   std::ostringstream html;
   html
@@ -417,14 +381,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
           "(Steinmeyer, HIWIN catalogue); the others are recalled values "
           "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
        << body.str() << "</body></html>\n";
-  outputs.emplace_back(dir / "index.html", html.str());  // last: the page of a complete set
-  WriteFilesAtomic(outputs);
-  for (const auto& png :
-       not_rendered) {  // never an old figure beside a page that says "not rendered"
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(png, ec)) std::filesystem::remove(png, ec);
-  }
-  for (const auto& [path, text] : outputs) result.files.push_back(path);
+  out.Add("index.html", html.str());
+  result.files = out.Commit();
   result.index_html = dir / "index.html";
   return result;
 }

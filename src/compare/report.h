@@ -13,8 +13,10 @@
 // embeds in any browser or mail. If gnuplot is missing at run time, the HTML, CSVs and scripts are
 // still written and ReportResult::warnings says the plots were skipped.
 // All-or-nothing: every file (CSVs, .gp scripts, PNGs rendered by gnuplot, report.json,
-// index.html) is first made in a staging folder inside the report directory, then committed with
-// core/atomic_file.h WriteFilesAtomic; a failure leaves no new file and the previous report intact.
+// index.html) is collected by core/output_dir.h's OutputDir (gnuplot renders in its staging
+// folder) and committed at once; a failure leaves no new file and the previous report intact. The
+// directory follows OutputDir's rule: new, empty or a whirl output (never a symbolic link); files
+// of an earlier report that this one does not write are removed.
 // Safe with any screw name: names reach gnuplot only as GnuplotString literals (titles
 // `noenhanced`), the page only through HtmlEscape, file names only as Slug; gnuplot runs through
 // RunProgram (an argument vector, no shell), in the staging folder.

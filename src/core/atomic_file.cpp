@@ -1,12 +1,15 @@
 #include "core/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <random>
 #include <set>
 #include <sstream>
@@ -16,6 +19,10 @@
 namespace whirl {
 namespace {
 namespace fs = std::filesystem;
+
+constexpr const char* kTmp = ".whirl-tmp-";
+constexpr const char* kBak = ".whirl-bak-";
+constexpr const char* kStage = ".whirl-stage-";
 
 std::string Quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
@@ -29,11 +36,15 @@ std::string KindOf(mode_t mode) {
   return "not a regular file";
 }
 
+fs::path DirectoryOf(const fs::path& path) {
+  return path.has_parent_path() ? path.parent_path() : fs::path(".");
+}
+
 // The rule of the writer: the target is absent or a regular file, in an existing directory.
 void CheckTarget(const fs::path& path) {
   if (path.empty() || !path.has_filename())
     throw InputError("cannot write " + Quoted(path) + ": not a file path");
-  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const fs::path dir = DirectoryOf(path);
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     throw InputError("cannot write " + Quoted(path) + ": directory " + Quoted(dir) +
@@ -48,16 +59,66 @@ void CheckTarget(const fs::path& path) {
                      "; whirl replaces only regular files (choose a file path)");
 }
 
-fs::path TemporaryName(const fs::path& path, const char* what) {
-  static thread_local std::mt19937_64 rng{std::random_device{}()};
-  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  return dir / ("." + path.filename().string() + what + std::to_string(::getpid()) + "_" +
-                std::to_string(rng()));
+fs::path TemporaryName(const fs::path& path, const char* kind) {
+  return DirectoryOf(path) / WhirlTemporaryName(path.filename().string(), kind);
+}
+
+// "<digits>-<digits>" and nothing else: the tail of a whirl temporary's name.
+bool ParsePidTail(const std::string& tail, long* pid) {
+  const auto dash = tail.find('-');
+  if (dash == 0 || dash == std::string::npos || dash + 1 == tail.size() || dash > 18) return false;
+  for (std::size_t i = 0; i < tail.size(); ++i)
+    if (i != dash && !std::isdigit(static_cast<unsigned char>(tail[i]))) return false;
+  if (pid) *pid = std::stol(tail.substr(0, dash));
+  return true;
+}
+
+// A process that no longer runs (kill(pid, 0) fails with ESRCH); EPERM means it runs as another
+// user. A reused pid makes a stale temporary look alive: it is then left, never a live one removed.
+bool ProcessIsGone(long pid) {
+  return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+// A whirl temporary's target file name ("" for a staging folder) and process id; false when
+// `name` is not a whirl temporary.
+bool ParseTemporary(const std::string& name, std::string* target, long* pid) {
+  const std::string stage = kStage;
+  if (name.compare(0, stage.size(), stage) == 0) {
+    if (target) target->clear();
+    return ParsePidTail(name.substr(stage.size()), pid);
+  }
+  if (name.size() < 2 || name[0] != '.') return false;
+  for (const std::string kind : {kTmp, kBak}) {
+    const auto at = name.rfind(kind);
+    if (at != std::string::npos && at > 1 && ParsePidTail(name.substr(at + kind.size()), pid)) {
+      if (target) *target = name.substr(1, at - 1);
+      return true;
+    }
+  }
+  return false;
+}
+
+// Removes the temporaries in `dir` whose process is gone: all (`targets` null) or those of the
+// named targets. One pass over the directory.
+void RemoveStale(const fs::path& dir, const std::set<std::string>* targets) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    std::string target;
+    long pid = 0;
+    if (!ParseTemporary(it->path().filename().string(), &target, &pid) || !ProcessIsGone(pid) ||
+        (targets && targets->count(target) == 0))
+      continue;
+    std::error_code rm;
+    if (fs::is_directory(it->symlink_status(rm)))  // a staging folder
+      fs::remove_all(it->path(), rm);
+    else
+      fs::remove(it->path(), rm);  // a file, or a link itself (never what it points to)
+  }
 }
 
 // Writes `contents` to a new temporary file beside `path`, flushed to disk; returns its name.
 fs::path WriteTemporary(const fs::path& path, const std::string& contents) {
-  const fs::path tmp = TemporaryName(path, ".tmp");
+  const fs::path tmp = TemporaryName(path, kTmp);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) throw InputError("cannot write " + Quoted(path) + ": " + std::strerror(errno));
   std::size_t off = 0;
@@ -93,13 +154,37 @@ void WriteFileAtomic(const fs::path& path, const std::string& contents) {
   WriteFilesAtomic({{path, contents}});
 }
 
+void CheckOutputFile(const fs::path& path) { CheckTarget(path); }
+
+std::string WhirlTemporaryName(const std::string& base, const char* kind) {
+  static thread_local std::mt19937_64 rng{std::random_device{}()};
+  const std::string tail = std::to_string(::getpid()) + "-" + std::to_string(rng() >> 16);
+  return base.empty() ? kStage + tail : "." + base + kind + tail;
+}
+
+bool IsWhirlTemporary(const std::string& name, long* pid) {
+  return ParseTemporary(name, nullptr, pid);
+}
+
+void RemoveStaleTemporaries(const fs::path& dir, const std::string& target) {
+  if (target.empty()) return RemoveStale(dir, nullptr);
+  const std::set<std::string> targets{target};
+  RemoveStale(dir, &targets);
+}
+
 void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& files) {
   std::set<fs::path> seen;
   for (const auto& [path, text] : files) {
     CheckTarget(path);
-    if (!seen.insert(fs::weakly_canonical(path)).second)
+    // Absolute first: weakly_canonical leaves a relative path whose parts do not exist yet
+    // relative ("A.SPF"), but makes "./A.SPF" absolute, so the two would compare unequal.
+    if (!seen.insert(fs::weakly_canonical(fs::absolute(path))).second)
       throw InputError("cannot write " + Quoted(path) + ": the same file is given twice");
   }
+  std::map<fs::path, std::set<std::string>> targets;  // what killed runs left beside them
+  for (const auto& [path, text] : files)
+    targets[DirectoryOf(path)].insert(path.filename().string());
+  for (const auto& [dir, names] : targets) RemoveStale(dir, &names);
   // 1. Every file into a temporary beside its target: a failure here leaves nothing behind.
   std::vector<fs::path> tmps;
   try {
@@ -117,7 +202,7 @@ void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& files
     std::error_code ec;
     existed[i] = fs::is_regular_file(fs::symlink_status(path, ec));
     if (existed[i]) {
-      backups[i] = TemporaryName(path, ".bak");
+      backups[i] = TemporaryName(path, kBak);
       fs::create_hard_link(path, backups[i], ec);
       if (ec) backups[i].clear();  // e.g. a file system without hard links: no restore possible
     }

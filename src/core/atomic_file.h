@@ -20,10 +20,38 @@ inline constexpr std::uintmax_t kMaxInputFileBytes = 64ull << 20;
 void WriteFileAtomic(const std::filesystem::path& path, const std::string& contents);
 
 /// Writes several files all-or-nothing: every target is checked (as WriteFileAtomic, and no path
-/// twice), every file is written to a temporary beside its target, and only then are they renamed
-/// over the targets. A failure in any step removes every temporary; a rename failing after others
-/// succeeded puts the previous files back (from hard-linked backups). Throws InputError.
+/// twice) before anything is written, every file is written to a temporary beside its target, and
+/// only then are they renamed over the targets. A failure in any step removes every temporary; a
+/// rename failing after others succeeded puts the previous files back (from hard-linked backups).
+/// Throws InputError.
+///
+/// What a killed process (kill -9, power loss) leaves: never a half-written target, only hidden
+/// temporaries beside the targets, named so they are recognisably whirl's (see IsWhirlTemporary):
+/// ".<target>.whirl-tmp-<pid>-<n>" while a file is written, ".<target>.whirl-bak-<pid>-<n>" (a hard
+/// link to the previous file) while several are renamed. Killed in the renaming step, which takes
+/// microseconds, some targets may be new and others old. The next write of the same target removes
+/// the temporaries of processes that no longer run (RemoveStaleTemporaries), and an output
+/// directory (core/output_dir.h) removes all of them; a running process's temporaries are left.
 void WriteFilesAtomic(const std::vector<std::pair<std::filesystem::path, std::string>>& files);
+
+/// The writer's rule for one target, checked without writing (for checks before a long run):
+/// `path` names a file (not a directory path), its directory exists, and it is absent or a regular
+/// file. Throws the InputError WriteFileAtomic would, naming the path and what it is.
+void CheckOutputFile(const std::filesystem::path& path);
+
+/// The name of a new whirl temporary for `base` (a file name without directory):
+/// "." + base + kind + "<pid>-<n>", kind one of ".whirl-tmp-", ".whirl-bak-"; with an empty
+/// `base`, ".whirl-stage-<pid>-<n>" (the staging folder of an output directory).
+std::string WhirlTemporaryName(const std::string& base, const char* kind);
+
+/// True when the file name `name` (no directory) is one of whirl's temporaries (see
+/// WhirlTemporaryName); `pid` (optional) receives the id of the process that made it.
+bool IsWhirlTemporary(const std::string& name, long* pid = nullptr);
+
+/// Removes from `dir` the whirl temporaries (files and staging folders) whose process no longer
+/// runs; with `target` (a file name), only those of that target. Never follows a symbolic link and
+/// never throws (what cannot be removed stays).
+void RemoveStaleTemporaries(const std::filesystem::path& dir, const std::string& target = "");
 
 /// Reads a whole text file; throws InputError naming the path if it cannot be opened, is not a
 /// regular file (a FIFO, device or directory) or is larger than kMaxInputFileBytes.

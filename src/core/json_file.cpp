@@ -49,8 +49,10 @@ std::string DumpJson(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+std::string JsonFileText(const nlohmann::json& j) { return DumpJson(j) + "\n"; }
+
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
-  WriteFileAtomic(path, DumpJson(j) + "\n");
+  WriteFileAtomic(path, JsonFileText(j));
 }
 
 void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char*> allowed,

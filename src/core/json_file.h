@@ -24,6 +24,9 @@ std::string DumpJson(const nlohmann::json& j, int indent = 2);
 /// Writes pretty-printed JSON (2-space indent, trailing newline, DumpJson) atomically.
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j);
 
+/// The text WriteJsonFile writes, for a file that is written together with others.
+std::string JsonFileText(const nlohmann::json& j);
+
 /// Checks that `j` is an object whose keys are all in `allowed`; an unknown key is an InputError
 /// naming `what` (e.g. "screw file 'a.json'") and the key. Catches typos in hand-written files.
 void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char*> allowed,

@@ -49,6 +49,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drift/evaluation.h"
@@ -162,12 +163,18 @@ struct MonitorReportResult {
   std::filesystem::path index_html;
   std::vector<std::string> warnings;
 };
+/// Files written together with a report, outside its directory: (path, contents).
+using AlsoWrite = std::vector<std::pair<std::filesystem::path, std::string>>;
+
 /// HTML page with the table and a plot of measured and predicted error per rule with the checks
 /// and recalibrations marked, and the residuals (gnuplot via RunProgram; skipped with a warning
-/// when absent), beside the timeline and events CSV it is drawn from.
+/// when absent), beside the timeline and events CSV it is drawn from. `dir` follows the
+/// output-directory rule of core/output_dir.h; the page, its files and `also` (e.g. the
+/// --timeline and --events files) are written all-or-nothing.
 MonitorReportResult WriteMonitorReport(const std::filesystem::path& dir, const MonitorResult& r,
                                        const MonitorOptions& o,
                                        const std::vector<std::string>& provenance,
-                                       const std::string& gnuplot = "gnuplot");
+                                       const std::string& gnuplot = "gnuplot",
+                                       const AlsoWrite& also = {});
 
 }  // namespace whirl::drift

@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
@@ -175,13 +176,11 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
 MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult& r,
                                        const MonitorOptions& o,
                                        const std::vector<std::string>& provenance,
-                                       const std::string& gnuplot) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw InputError("report directory '" + dir.string() + "': " + ec.message());
+                                       const std::string& gnuplot, const AlsoWrite& also) {
+  OutputDir files(dir, "report directory");
   MonitorReportResult out;
-  WriteFileAtomic(dir / "timeline.csv", MonitorTimelineCsv(r, provenance));
-  WriteFileAtomic(dir / "events.csv", MonitorEventsCsv(r, provenance));
+  files.Add("timeline.csv", MonitorTimelineCsv(r, provenance));
+  files.Add("events.csv", MonitorEventsCsv(r, provenance));
   // Marker data per rule (gnuplot index blocks, CSV like the timeline): time, measured, 1 for
   // an invalid check or a refit measurement, 0 for a valid check.
   std::ostringstream marks;
@@ -194,7 +193,7 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
               << (e.kind == MonitorEvent::Kind::kCheck && e.valid ? 0 : 1) << "\n";
     marks << FormatNumber(r.time.front()) << ",0,-1\n\n\n";  // sentinel: no block is empty
   }
-  WriteFileAtomic(dir / "checks.csv", marks.str());
+  files.Add("checks.csv", marks.str());
   const std::string x = r.time_from_index ? "1" : "($1/60)";
   const std::size_t q = r.strategies.size();
   std::ostringstream gp;
@@ -223,18 +222,23 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
     gp << (i ? ", " : "") << "'timeline.csv' using " << x << ":" << i + 3 + q << " with lines lc "
        << i + 1 << " title " << GnuplotString(ToString(r.strategies[i].rule));
   gp << "\nunset multiplot\n";
-  WriteFileAtomic(dir / "monitor.gp",
-                  "# gnuplot script written by whirl; re-run: gnuplot monitor.gp\n" + gp.str());
+  files.Add("monitor.gp",
+            "# gnuplot script written by whirl; re-run: gnuplot monitor.gp\n" + gp.str());
   std::string img = "<p>(plot not rendered: monitor.gp)</p>";
-  fs::remove(dir / "monitor.png", ec);
+  std::error_code ec;
   if (!ProgramSucceeds({gnuplot, "--version"})) {
     out.warnings.push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
-  } else if (RunProgram({gnuplot, "monitor.gp"}, dir, dir / "gnuplot.log") == 0 &&
-             fs::exists(dir / "monitor.png")) {
-    img = "<img src='monitor.png' alt='monitor timeline'>";
   } else {
-    out.warnings.push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
-                           " (see gnuplot.log)");
+    const fs::path stage = fs::absolute(files.Staging());  // gnuplot renders there
+    if (RunProgram({gnuplot, "monitor.gp"}, stage, stage / "gnuplot.log") == 0 &&
+        fs::is_regular_file(stage / "monitor.png", ec)) {
+      files.AddStaged("monitor.png");
+      img = "<img src='monitor.png' alt='monitor timeline'>";
+    } else {
+      out.warnings.push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
+                             " (see gnuplot.log)");
+      if (fs::is_regular_file(stage / "gnuplot.log", ec)) files.AddStaged("gnuplot.log");
+    }
   }
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>"
@@ -250,7 +254,8 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
        "(every check and update with its reason), <a href='monitor.gp'>monitor.gp</a>.</p>\n";
   for (const auto& w : out.warnings) h << "<p><i>" << HtmlEscape(w) << "</i></p>\n";
   h << "</body></html>\n";
-  WriteFileAtomic(dir / "index.html", h.str());
+  files.Add("index.html", h.str());
+  files.Commit(also);
   out.index_html = dir / "index.html";
   return out;
 }

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
@@ -24,56 +25,53 @@ std::string F(const char* fmt, double v) {
 
 const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
 
-// Writes files, renders the gnuplot scripts, writes index.html last.
+// Collects the files, renders the gnuplot scripts in the output directory's staging folder and
+// commits everything with index.html all-or-nothing (core/output_dir.h).
 class ReportWriter {
  public:
-  ReportWriter(fs::path dir, std::string gnuplot)
-      : dir_(std::move(dir)), gnuplot_(std::move(gnuplot)) {
-    std::error_code ec;
-    fs::create_directories(dir_, ec);
-    if (!ec) dir_ = fs::absolute(dir_, ec);  // gnuplot runs inside dir_: paths must not be relative
-    if (ec) throw InputError("report directory '" + dir_.string() + "': " + ec.message());
+  ReportWriter(const fs::path& dir, std::string gnuplot)
+      : out_(dir, "report directory"), gnuplot_(std::move(gnuplot)) {
     have_gnuplot_ = ProgramSucceeds({gnuplot_, "--version"});
     if (!have_gnuplot_)
       result_.warnings.push_back("'" + gnuplot_ +
                                  "' not found: plots skipped (install gnuplot-nox)");
   }
-  void File(const std::string& name, const std::string& text) {
-    WriteFileAtomic(dir_ / name, text);
-    result_.files.push_back(dir_ / name);
-  }
+  void File(const std::string& name, const std::string& text) { out_.Add(name, text); }
   // Script `stem`.gp renders `stem`.png; returns the <img> tag (or a note when not rendered).
   std::string Plot(const std::string& stem, const std::string& body, const std::string& alt) {
-    const std::string png = stem + ".png", tmp = stem + ".png.tmp";
+    const std::string png = stem + ".png";
     File(stem + ".gp", "# gnuplot script written by whirl; re-run with: gnuplot " + stem + ".gp\n" +
                            kTerminal + "set output " + GnuplotString(png) + "\n" + body);
     if (have_gnuplot_) {
-      const std::string script =
-          std::string(kTerminal) + "set output " + GnuplotString(tmp) + "\n" + body;
-      WriteFileAtomic(dir_ / (stem + ".tmp.gp"), script);
-      const int rc = RunProgram({gnuplot_, stem + ".tmp.gp"}, dir_, dir_ / "gnuplot.log");
-      fs::remove(dir_ / (stem + ".tmp.gp"));
-      if (rc == 0 && fs::exists(dir_ / tmp)) {
-        fs::rename(dir_ / tmp, dir_ / png);
-        result_.files.push_back(dir_ / png);
+      // gnuplot never sees the output directory: it renders in the staging folder.
+      const fs::path stage = fs::absolute(out_.Staging());
+      const int rc = RunProgram({gnuplot_, stem + ".gp"}, stage, stage / "gnuplot.log");
+      std::error_code ec;
+      if (rc == 0 && fs::is_regular_file(stage / png, ec) && fs::file_size(stage / png, ec) > 0) {
+        out_.AddStaged(png);
         return "<img src='" + HtmlEscape(png) + "' alt='" + HtmlEscape(alt) + "'>";
       }
-      result_.warnings.push_back("gnuplot failed on " + (dir_ / (stem + ".gp")).string() +
+      gnuplot_failed_ = true;
+      result_.warnings.push_back("gnuplot failed on " + (out_.path() / (stem + ".gp")).string() +
                                  " (see gnuplot.log)");
     }
     return "<p>(plot not rendered: " + HtmlEscape(stem) + ".gp)</p>";
   }
   const std::vector<std::string>& warnings() const { return result_.warnings; }
   DriftReportResult Finish(const std::string& html) {
+    std::error_code ec;
+    if (gnuplot_failed_ && fs::is_regular_file(out_.Staging() / "gnuplot.log", ec))
+      out_.AddStaged("gnuplot.log");
     File("index.html", html);
-    result_.index_html = dir_ / "index.html";
+    result_.files = out_.Commit();
+    result_.index_html = out_.path() / "index.html";
     return result_;
   }
 
  private:
-  fs::path dir_;
+  OutputDir out_;
   std::string gnuplot_;
-  bool have_gnuplot_ = false;
+  bool have_gnuplot_ = false, gnuplot_failed_ = false;
   DriftReportResult result_;
 };
 

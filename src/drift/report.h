@@ -2,9 +2,10 @@
 // HTML reports of the drift module, for a process engineer: one index.html per directory with
 // PNG plots (gnuplot, run through RunProgram without a shell; pngcairo, noenhanced titles, every
 // user-supplied name through GnuplotString / HtmlEscape / Slug), the CSV each plot comes from
-// and the gnuplot scripts, so anyone can re-plot. PNGs are rendered to temporary names and
-// renamed; index.html is written last. If gnuplot is missing the CSVs, scripts and HTML are
-// still written and `warnings` says the plots were skipped.
+// and the gnuplot scripts, so anyone can re-plot. The directory follows core/output_dir.h's rule
+// (new, empty or a whirl output; never a symbolic link) and the whole report is written
+// all-or-nothing (gnuplot renders in its staging folder). If gnuplot is missing the CSVs, scripts
+// and HTML are still written and `warnings` says the plots were skipped.
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/safe_text.h"
 
 namespace whirl::drift {
@@ -199,27 +200,16 @@ std::string FormatRun(const Run& run, const std::vector<std::string>& comments) 
 
 std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
                                              const std::vector<Run>& runs,
-                                             const std::vector<std::string>& comments) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError("run directory '" + dir.string() + "': " + ec.message());
-  std::vector<std::filesystem::path> paths, temps;
-  try {
-    for (const Run& r : runs) {
-      paths.push_back(dir / (Slug(r.name) + ".csv"));
-      temps.push_back(dir / (Slug(r.name) + ".csv.partial"));
-      std::vector<std::string> c{r.name + ": lines " + std::to_string(r.line_numbers.front()) +
-                                 " to " + std::to_string(r.line_numbers.back()) + " of " +
-                                 r.source};
-      c.insert(c.end(), comments.begin(), comments.end());
-      WriteFileAtomic(temps.back(), FormatRun(r, c));
-    }
-    for (std::size_t i = 0; i < paths.size(); ++i) std::filesystem::rename(temps[i], paths[i]);
-  } catch (...) {
-    for (const auto& t : temps) std::filesystem::remove(t, ec);
-    throw;
+                                             const std::vector<std::string>& comments,
+                                             const std::string& what) {
+  OutputDir out(dir, what);
+  for (const Run& r : runs) {
+    std::vector<std::string> c{r.name + ": lines " + std::to_string(r.line_numbers.front()) +
+                               " to " + std::to_string(r.line_numbers.back()) + " of " + r.source};
+    c.insert(c.end(), comments.begin(), comments.end());
+    out.Add(Slug(r.name) + ".csv", FormatRun(r, c));
   }
-  return paths;
+  return out.Commit();
 }
 
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold) {

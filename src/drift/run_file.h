@@ -77,12 +77,13 @@ Run ReadRun(const std::filesystem::path& path, RunState state);
 std::string FormatRun(const Run& run, const std::vector<std::string>& comments = {});
 
 /// Writes each run as <dir>/<Slug(name)>.csv (FormatRun with `comments` plus the run's own
-/// source lines), creating `dir`. All or nothing: every file is first written to a temporary
-/// name; only when all succeeded are they renamed, otherwise the temporaries are removed and the
-/// InputError is rethrown. Returns the paths in run order.
+/// source lines) through core/output_dir.h's OutputDir: `dir` follows the output-directory rule
+/// (`what` names it in messages, e.g. "--out-dir"), and the files are written all or nothing.
+/// Returns the paths in run order.
 std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
                                              const std::vector<Run>& runs,
-                                             const std::vector<std::string>& comments);
+                                             const std::vector<std::string>& comments,
+                                             const std::string& what = "run directory");
 
 /// Cuts one long log into runs, a new run starting at every sample where `column` (an `other`
 /// column such as spindle_rpm) changes from <= threshold to > threshold (a machine start). The

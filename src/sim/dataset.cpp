@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/parallel.h"
 #include "sim/random.h"
 
@@ -129,35 +130,26 @@ Dataset GenerateDataset(const DatasetOptions& options,
 
 void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_path,
                   const std::filesystem::path& curves_dir, const std::string& regenerate) {
-  namespace fs = std::filesystem;
-  std::vector<std::pair<fs::path, std::string>> files;
-  files.emplace_back(table_path, FormatProcessTable(dataset.table));
+  const std::string table = FormatProcessTable(dataset.table);
+  if (curves_dir.empty()) {
+    WriteFileAtomic(table_path, table);
+    return;
+  }
+  OutputDir curves(curves_dir, "--curves-dir");
   const std::string table_name = table_path.filename().string();
-  for (std::size_t i = 0; !curves_dir.empty() && i < dataset.curves.size(); ++i) {
+  for (std::size_t i = 0; i < dataset.curves.size(); ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "row_%04zu.csv", i + 1);
     const ElongationCurve& c = dataset.curves[i];
     std::vector<std::vector<double>> rows;
     rows.reserve(c.size());
     for (std::size_t k = 0; k < c.size(); ++k) rows.push_back({c.time_s[k], c.elongation_um[k]});
-    files.emplace_back(
-        curves_dir / name,
-        FormatCsv({"time_s", "elongation_um"}, rows,
-                  {" SIMULATED curve of row " + std::to_string(i + 1) + " of " + table_name,
-                   regenerate}));
+    curves.Add(name,
+               FormatCsv({"time_s", "elongation_um"}, rows,
+                         {" SIMULATED curve of row " + std::to_string(i + 1) + " of " + table_name,
+                          regenerate}));
   }
-  std::error_code ec;
-  const bool created =
-      !curves_dir.empty() && !fs::exists(curves_dir, ec) && fs::create_directories(curves_dir, ec);
-  if (ec)
-    throw InputError("--curves-dir '" + curves_dir.string() + "': cannot create it (" +
-                     ec.message() + ")");
-  try {
-    WriteFilesAtomic(files);
-  } catch (...) {
-    if (created) fs::remove(curves_dir, ec);  // empty: nothing was written into it
-    throw;
-  }
+  curves.Commit({{table_path, table}});  // the table and its curves: all or nothing
 }
 
 }  // namespace whirl::sim

@@ -64,10 +64,10 @@ Dataset GenerateDataset(const DatasetOptions& options,
                         const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 /// Writes the table (CSV, `table_path`) and, unless `curves_dir` is empty, each row's recorded
-/// curve as `curves_dir/row_0001.csv`, ... (time_s,elongation_um; the directory is created),
-/// all-or-nothing (core/atomic_file.h WriteFilesAtomic): one file that cannot be written leaves
-/// none written and previous files intact. `regenerate` (the command line) goes into every
-/// curve's '#' comments.
+/// curve as `curves_dir/row_0001.csv`, ... (time_s,elongation_um; the directory follows
+/// core/output_dir.h's rule: new, empty or a whirl output, never a symbolic link), all-or-nothing:
+/// one file that cannot be written leaves none written and previous files intact. `regenerate` (the
+/// command line) goes into every curve's '#' comments.
 void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_path,
                   const std::filesystem::path& curves_dir, const std::string& regenerate);
 

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 
@@ -57,7 +58,7 @@ std::string MapScript(const SurfaceReportOptions& o, const std::string& terminal
   std::ostringstream s;
   s << "# gnuplot script written by whirl surface; re-run with: gnuplot map.gp\n"
     << "set terminal " << terminal << "\n"
-    << "set output 'map.png.tmp'\n"
+    << "set output 'map.png'\n"
     << "set title " << GnuplotString(o.title + ": " + subtitle) << " noenhanced\n"
     << "set xlabel 'X [mm]'\nset ylabel 'Y [mm]'\nset cblabel 'thermal error [um]'\n"
     << "set view map\nset size ratio -1\nset palette rgbformulae 33,13,10\n"
@@ -78,22 +79,22 @@ std::string Terminal(const std::string& gnuplot) {
                : "png size 1000,700 noenhanced";
 }
 
-bool Render(const fs::path& dir, const SurfaceReportOptions& o, SurfaceReportResult& r) {
+// Renders map.gp in the output directory's staging folder; adds map.png to the output.
+bool Render(OutputDir& out, const SurfaceReportOptions& o, SurfaceReportResult& r) {
   if (!ProgramSucceeds({o.gnuplot_command, "--version"})) {
     r.warnings.push_back("gnuplot ('" + o.gnuplot_command + "') not found: map skipped");
     return false;
   }
-  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, dir, fs::absolute(dir / "gnuplot.log"));
+  const fs::path stage = fs::absolute(out.Staging());
+  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, stage, stage / "gnuplot.log");
   std::error_code ec;
-  if (rc != 0 || !fs::exists(dir / "map.png.tmp")) {
-    fs::remove(dir / "map.png.tmp", ec);
+  if (rc != 0 || !fs::is_regular_file(stage / "map.png", ec)) {
+    if (fs::is_regular_file(stage / "gnuplot.log", ec)) out.AddStaged("gnuplot.log");
     r.warnings.push_back("gnuplot failed (exit " + std::to_string(rc) +
                          "), see gnuplot.log: map skipped");
     return false;
   }
-  fs::rename(dir / "map.png.tmp", dir / "map.png", ec);
-  if (ec) throw InputError("cannot rename the map into '" + (dir / "map.png").string() + "'");
-  r.files.push_back(dir / "map.png");
+  out.AddStaged("map.png");
   return true;
 }
 
@@ -192,27 +193,23 @@ SurfaceReportResult WriteSurfaceReport(const fs::path& dir, const SurfaceFit& fi
                                        const SurfaceReportOptions& o) {
   if (o.map_samples < 2 || o.map_samples > 401)
     throw InputError("map samples " + std::to_string(o.map_samples) + " is outside 2..401");
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw InputError("cannot create the report directory '" + dir.string() + "'");
+  OutputDir out(dir, "report directory");
   SurfaceReportResult r;
   const Bounds& b = fit.surface.bounds;
   const std::string subtitle = ToString(fit.surface.method) + " surface, " +
                                std::to_string(fit.points.size()) + " measured points (black dots)";
   const bool flat = b.x_max_mm <= b.x_min_mm || b.y_max_mm <= b.y_min_mm;
-  WriteFileAtomic(dir / "surface_grid.dat", GridData(fit, o.map_samples));
+  out.Add("surface_grid.dat", GridData(fit, o.map_samples));
   std::vector<std::string> comments;
   for (const auto& p : o.provenance) comments.push_back(" " + p);
-  WriteFileAtomic(dir / "points.csv", FormatPointsCsv(fit.points, comments));
-  WriteFileAtomic(dir / "points.dat", PointsData(fit));
-  WriteFileAtomic(dir / "map.gp", MapScript(o, Terminal(o.gnuplot_command), subtitle));
-  r.files = {dir / "surface_grid.dat", dir / "points.csv", dir / "points.dat", dir / "map.gp"};
-  if (o.plots && !flat) r.plot_rendered = Render(dir, o, r);
+  out.Add("points.csv", FormatPointsCsv(fit.points, comments));
+  out.Add("points.dat", PointsData(fit));
+  out.Add("map.gp", MapScript(o, Terminal(o.gnuplot_command), subtitle));
+  if (o.plots && !flat) r.plot_rendered = Render(out, o, r);
   if (flat) r.warnings.push_back("the points span no rectangle: map skipped");
+  out.Add("index.html", PageHtml(fit, choice, lines, o, r.plot_rendered, r.warnings));
+  r.files = out.Commit(o.also_write);
   r.index_html = dir / "index.html";
-  WriteFileAtomic(r.index_html, PageHtml(fit, choice, lines, o, r.plot_rendered, r.warnings));
-  r.files.push_back(r.index_html);
   return r;
 }
 

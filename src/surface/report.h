@@ -8,11 +8,13 @@
 // core/run_program.h with an argument vector (never a shell); every user string that reaches the
 // script goes through GnuplotString with noenhanced text, every one that reaches the page through
 // HtmlEscape. Files in `dir`: surface_grid.dat (the map, x_mm y_mm error_um with a blank line
-// between rows), points.csv (and points.dat for gnuplot), map.gp, map.png, index.html. All are
-// written atomically, the PNG is rendered to a temporary name and renamed, index.html last; if
-// gnuplot is missing or fails the page is written without the picture and `warnings` says why.
+// between rows), points.csv (and points.dat for gnuplot), map.gp, map.png, index.html. `dir`
+// follows core/output_dir.h's rule (new, empty or a whirl output; never a symbolic link); the page
+// and its files are written all-or-nothing (gnuplot renders in the staging folder); if gnuplot is
+// missing or fails the page is written without the picture and `warnings` says why.
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "surface/choice.h"
@@ -27,6 +29,8 @@ struct SurfaceReportOptions {
   bool plots = true;
   std::string gnuplot_command = "gnuplot";
   int map_samples = 121;  ///< map grid points per direction (2..401)
+  /// Files outside `dir` written in the same all-or-nothing step (e.g. the --out surface JSON).
+  std::vector<std::pair<std::filesystem::path, std::string>> also_write;
 };
 
 struct SurfaceReportResult {
@@ -36,7 +40,8 @@ struct SurfaceReportResult {
   std::vector<std::string> warnings;
 };
 
-/// Writes the page into `dir` (created if missing). `choice` and `lines` may be empty.
+/// Writes the page into `dir` (created if missing) and `options.also_write`. `choice` and `lines`
+/// may be empty.
 SurfaceReportResult WriteSurfaceReport(const std::filesystem::path& dir, const SurfaceFit& fit,
                                        const MethodComparison* choice,
                                        const std::vector<AxisLine>& lines,

@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 
 namespace whirl::torch {
@@ -469,7 +470,11 @@ ExportReport ExportTorchScript(const nn::Model& model, const std::filesystem::pa
   // Verify a complete temporary file in the target directory, then rename it into place: a
   // failed check or an interrupted run leaves no file (and any previous file untouched).
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  const fs::path tmp = dir / ("." + path.filename().string() + ".verify.tmp");
+  // The writer's rule for the target (a symbolic link or directory there is refused), and a whirl
+  // temporary (core/atomic_file.h): a killed run's leftover is recognised and removed.
+  CheckOutputFile(path);
+  RemoveStaleTemporaries(dir, path.filename().string());
+  const fs::path tmp = dir / WhirlTemporaryName(path.filename().string(), ".whirl-tmp-");
   ExportReport report;
   report.path = path.string();
   report.check_points = static_cast<int>(x.cols());

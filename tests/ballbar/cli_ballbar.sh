@@ -17,9 +17,14 @@ grep -q "um/m" "$D/help_circle.txt" || fail "circle --help has no units"
 # The shipped demo data set is what the documented command writes (byte for byte).
 (cd "$D" && "$W" ballbar simulate --seed 1 --out-dir datasets/ballbar > /dev/null) || fail "simulate"
 for f in readings.csv pivots.json truth_drift.csv circle_xy_scale.csv circle_xy_cyclic.csv \
-         circle_xz_parallelism.csv README.md; do
+         circle_xz_parallelism.csv README.md .whirl-output.json; do
   cmp -s "$D/datasets/ballbar/$f" "$SRC/datasets/ballbar/$f" || fail "datasets/ballbar/$f differs from its command"
 done
+# The documented command also runs over the shipped folder itself (whirl's output: replaced).
+mkdir -p "$D/regen/datasets" && cp -r "$SRC/datasets/ballbar" "$D/regen/datasets/"
+(cd "$D/regen" && "$W" ballbar simulate --seed 1 --out-dir datasets/ballbar > /dev/null) \
+  || fail "simulate over the shipped datasets/ballbar"
+diff -r "$D/regen/datasets/ballbar" "$SRC/datasets/ballbar" > /dev/null || fail "regenerated folder differs"
 S="$D/datasets/ballbar"
 
 # Drift: run file, JSON, SD43900 = -drift/1000 with the default sign.

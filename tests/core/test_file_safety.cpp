@@ -1,18 +1,24 @@
 // Files a shop can trust (issue 17): the atomic writer replaces only regular files, multi-file
 // outputs are all-or-nothing, readers refuse FIFOs, directories and oversized files, and a JSON
-// number beyond the double range is an InputError naming the file.
+// number beyond the double range is an InputError naming the file. Where whirl writes: killed
+// runs' temporaries are recognised and removed later, output directories follow one rule
+// (core/output_dir.h), and outputs that resolve to an input or to another output are refused.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <functional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/output_dir.h"
 #include "core/run_program.h"
 
 namespace whirl {
@@ -138,6 +144,232 @@ TEST(RunProgram, RelativeLogIsRelativeToTheCallerNotToCwd) {
   EXPECT_EQ(rc, 0);
   ASSERT_TRUE(fs::exists(d / "log.txt"));
   EXPECT_NE(ReadTextFile(d / "log.txt").find("/sub"), std::string::npos);
+}
+
+bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+std::set<std::string> Entries(const fs::path& d) {
+  std::set<std::string> s;
+  for (const auto& e : fs::directory_iterator(d)) s.insert(e.path().filename().string());
+  return s;
+}
+
+// The id of a process that has ended (forked, exited, reaped).
+long DeadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+void Write(OutputDir& out, const std::vector<std::string>& names) {
+  for (const auto& n : names) out.Add(n, "text of " + n);
+  out.Commit();
+}
+
+TEST(WhirlTemporary, NamesAreRecognisedAndCarryThePid) {
+  long pid = 0;
+  const std::string tmp = WhirlTemporaryName("runs_1.csv", ".whirl-tmp-");
+  EXPECT_TRUE(IsWhirlTemporary(tmp, &pid)) << tmp;
+  EXPECT_EQ(pid, static_cast<long>(::getpid()));
+  EXPECT_EQ(tmp.rfind(".runs_1.csv.whirl-tmp-", 0), 0u) << tmp;
+  EXPECT_TRUE(IsWhirlTemporary(WhirlTemporaryName("a", ".whirl-bak-")));
+  EXPECT_TRUE(IsWhirlTemporary(WhirlTemporaryName("", "")));  // a staging folder
+  for (const std::string name :
+       {"runs_1.csv", ".whirl-tmp-1-2", ".a.whirl-tmp-x-2", ".a.whirl-tmp-1-", ".a.whirl-tmp-1-2x",
+        "a.whirl-tmp-1-2", ".whirl-stage-1", ".a.tmp12_3"})
+    EXPECT_FALSE(IsWhirlTemporary(name)) << name;
+}
+
+TEST(WhirlTemporary, WriteRemovesWhatAKilledRunLeftButNotALiveRunsFiles) {
+  const fs::path d = Scratch("out_debris");
+  const std::string dead = ".a.csv.whirl-tmp-" + std::to_string(DeadPid()) + "-7";
+  const std::string live = ".a.csv.whirl-tmp-" + std::to_string(::getpid()) + "-8";
+  const std::string other = ".b.csv.whirl-tmp-" + std::to_string(DeadPid()) + "-9";
+  for (const auto& n : {dead, live, other}) WriteFileAtomic(d / n, "half");
+  WriteFileAtomic(d / "a.csv", "new");
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", live, other}));  // only a.csv's dead one
+}
+
+TEST(OutputDir, NewDirectoryIsCreatedAndListedInTheManifest) {
+  const fs::path d = Scratch("out_new") / "sub" / "out";
+  OutputDir out(d, "--out-dir");
+  EXPECT_FALSE(fs::exists(d));  // nothing before Commit
+  Write(out, {"a.csv", "b.csv"});
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", "b.csv", kOutputManifest}));
+  EXPECT_EQ(ReadTextFile(d / "a.csv"), "text of a.csv");
+}
+
+TEST(OutputDir, RerunReplacesAndRemovesWhatItNoLongerWrites) {
+  const fs::path d = Scratch("out_rerun") / "out";
+  {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"log_1.csv", "log_2.csv", "log_3.csv"});
+  }
+  OutputDir again(d, "--out-dir");
+  again.Add("log_1.csv", "new 1");
+  again.Add("log_2.csv", "new 2");
+  again.Commit();
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"log_1.csv", "log_2.csv", kOutputManifest}));
+  EXPECT_EQ(ReadTextFile(d / "log_2.csv"), "new 2");
+  OutputDir third(d, "--out-dir");  // and a third time
+  Write(third, {"log_1.csv"});
+}
+
+TEST(OutputDir, EmptyDirectoryIsAcceptedAForeignFileRefusedByName) {
+  const fs::path d = Scratch("out_foreign");
+  OutputDir empty(d, "--out-dir");
+  Write(empty, {"a.csv"});
+  WriteFileAtomic(d / "notes.txt", "mine");
+  const std::string e = ErrorOf([&] { OutputDir out(d, "--report"); });
+  EXPECT_TRUE(Has(e, "--report")) << e;
+  EXPECT_TRUE(Has(e, d.string())) << e;
+  EXPECT_TRUE(Has(e, "notes.txt")) << e;
+  const fs::path other = Scratch("out_foreign_nomanifest");
+  WriteFileAtomic(other / "thesis.tex", "mine");
+  const std::string e2 = ErrorOf([&] { OutputDir out(other, "--out-dir"); });
+  EXPECT_TRUE(Has(e2, "thesis.tex") && Has(e2, "did not write")) << e2;
+  EXPECT_EQ(ReadTextFile(other / "thesis.tex"), "mine");
+}
+
+TEST(OutputDir, SymlinkedDirectoryIsRefusedAndLeftAlone) {
+  const fs::path d = Scratch("out_symlink");
+  fs::create_directories(d / "real");
+  fs::create_directory_symlink(d / "real", d / "link");
+  for (const fs::path& p : {d / "link", fs::path((d / "link").string() + "/")}) {
+    const std::string e = ErrorOf([&] { OutputDir out(p, "--out"); });
+    EXPECT_TRUE(Has(e, "symbolic link") && Has(e, "--out")) << e;
+  }
+  EXPECT_TRUE(Entries(d / "real").empty());
+  WriteFileAtomic(d / "file", "x");
+  EXPECT_TRUE(Has(ErrorOf([&] { OutputDir out(d / "file", "--out-dir"); }), "not a directory"));
+}
+
+TEST(OutputDir, ADirectoryAtOneTargetWritesNothing) {
+  const fs::path d = Scratch("out_dir_target");
+  {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"a.csv", "b.csv"});
+  }
+  fs::remove(d / "b.csv");
+  fs::create_directory(d / "b.csv");  // planted where whirl writes (listed: not foreign)
+  OutputDir out(d, "--out-dir");
+  out.Add("a.csv", "new a");
+  out.Add("b.csv", "new b");
+  const std::string e = ErrorOf([&] { out.Commit(); });
+  EXPECT_TRUE(Has(e, "b.csv") && Has(e, "a directory")) << e;
+  EXPECT_EQ(ReadTextFile(d / "a.csv"), "text of a.csv");
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", "b.csv", kOutputManifest}));
+}
+
+TEST(OutputDir, KilledRunsDebrisIsIgnoredAndRemoved) {
+  const fs::path d = Scratch("out_killed");
+  const std::string pid = std::to_string(DeadPid());
+  fs::create_directories(d / (".whirl-stage-" + pid + "-1"));
+  WriteFileAtomic(d / (".whirl-stage-" + pid + "-1") / "map.gp", "x");
+  WriteFileAtomic(d / (".a.csv.whirl-tmp-" + pid + "-2"), "half");
+  WriteFileAtomic(d / (".zz.whirl-bak-" + pid + "-3"), "old");
+  OutputDir out(d, "--out-dir");  // only debris: an empty directory
+  Write(out, {"a.csv"});
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", kOutputManifest}));
+}
+
+TEST(OutputDir, FailureBeforeCommitLeavesNoDirectory) {
+  const fs::path d = Scratch("out_fail") / "out";
+  {
+    OutputDir out(d, "--report");
+    out.Add("a.csv", "x");
+    ASSERT_TRUE(fs::is_directory(out.Staging()));
+  }  // an exception would leave here without Commit
+  EXPECT_FALSE(fs::exists(d));
+}
+
+TEST(OutputDir, StagingHoldsTheFilesForAProgramAndTakesItsOutput) {
+  const fs::path d = Scratch("out_staging");
+  OutputDir out(d, "--report");
+  out.Add("data.csv", "1,2\n");
+  const fs::path s = out.Staging();
+  out.Add("plot.gp", "plot 'data.csv'\n");
+  EXPECT_EQ(ReadTextFile(s / "data.csv"), "1,2\n");
+  EXPECT_EQ(ReadTextFile(s / "plot.gp"), "plot 'data.csv'\n");
+  WriteFileAtomic(s / "plot.png", std::string("\x89PNG\0\x01", 6));  // what gnuplot would write
+  out.AddStaged("plot.png");
+  out.Commit();
+  EXPECT_EQ(ReadTextFile(d / "plot.png"), std::string("\x89PNG\0\x01", 6));
+  EXPECT_EQ(Entries(d).size(), 4u);  // data.csv, plot.gp, plot.png, manifest; staging is gone
+}
+
+TEST(OutputDir, NestedWhirlDirectoryCountsAsWhirls) {
+  const fs::path d = Scratch("out_nested");
+  {
+    OutputDir report(d / "report", "report directory");
+    Write(report, {"index.html"});
+  }  // a parent killed before its own commit: only the nested output exists
+  OutputDir out(d, "--out-dir");
+  out.Keep("report");
+  Write(out, {"plan.json"});
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"plan.json", "report", kOutputManifest}));
+  OutputDir again(d, "--out-dir");  // a rerun without the report removes it through its manifest
+  Write(again, {"plan.json"});
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"plan.json", kOutputManifest}));
+}
+
+TEST(OutputDir, ABrokenManifestIsRefusedByName) {
+  const fs::path d = Scratch("out_badmanifest");
+  WriteFileAtomic(d / kOutputManifest, "{\"schema\": \"whirl.output_dir\", \"files\": [\"../x\"]}");
+  const std::string e = ErrorOf([&] { OutputDir out(d, "--out-dir"); });
+  EXPECT_TRUE(Has(e, kOutputManifest) && Has(e, "not a whirl output manifest")) << e;
+}
+
+TEST(CheckOutputs, OutputThatIsAnInputIsRefusedThroughDotSlashLinksAndHardLinks) {
+  const fs::path d = Scratch("out_same");
+  WriteFileAtomic(d / "run.csv", "data");
+  fs::create_symlink(d / "run.csv", d / "alias.csv");
+  fs::create_hard_link(d / "run.csv", d / "hard.csv");
+  fs::create_directories(d / "sub");
+  const std::vector<FlagPath> in{{"--model", d / "model.json"}, {"--run", d / "run.csv"}};
+  for (const fs::path& out :
+       {d / "." / "run.csv", d / "sub" / ".." / "run.csv", d / "alias.csv", d / "hard.csv"}) {
+    const std::string e = ErrorOf([&] { CheckOutputs(in, {{"--out", out}}); });
+    EXPECT_TRUE(Has(e, "--out") && Has(e, "--run") && Has(e, out.string())) << out << ": " << e;
+  }
+  EXPECT_EQ(ReadTextFile(d / "run.csv"), "data");
+  CheckOutputs(in, {{"--out", d / "pred.csv"}, {"--csv", {}}});  // different or not given: fine
+}
+
+TEST(CheckOutputs, RelativeOutputAgainstAnAbsoluteInput) {
+  const fs::path d = Scratch("out_relative");
+  WriteFileAtomic(d / "m.json", "{}");
+  const fs::path cwd = fs::current_path();
+  fs::current_path(d);
+  const std::string e = ErrorOf([&] {
+    CheckOutputs({{"--model", d / "m.json"}}, {{"--csv", "./m.json"}});
+  });
+  fs::current_path(cwd);
+  EXPECT_TRUE(Has(e, "--csv") && Has(e, "--model")) << e;
+}
+
+TEST(CheckOutputs, TwoOutputsOneFileAndOutputsInsideOutputDirectories) {
+  const fs::path d = Scratch("out_outs");
+  fs::current_path(d);
+  std::string e = ErrorOf([&] {
+    CheckOutputs({}, {{"--nc", "A.SPF"}, {"--reset-nc", "./A.SPF"}});
+  });
+  EXPECT_TRUE(Has(e, "--nc") && Has(e, "--reset-nc") && Has(e, "same file")) << e;
+  e = ErrorOf([&] { CheckOutputs({}, {{"--out", "rep/b.json"}}, {{"--report", "rep"}}); });
+  EXPECT_TRUE(Has(e, "--out") && Has(e, "--report")) << e;
+  WriteFileAtomic(d / "log.csv", "x");
+  e = ErrorOf([&] { CheckOutputs({{"--log", "log.csv"}}, {}, {{"--out-dir", "."}}); });
+  EXPECT_TRUE(Has(e, "--log") && Has(e, "--out-dir") && Has(e, "holds the input")) << e;
+  e = ErrorOf([&] { CheckOutputs({}, {}, {{"--report", "a"}, {"--out-dir", "a/b"}}); });
+  EXPECT_TRUE(Has(e, "--report") && Has(e, "--out-dir")) << e;
+  fs::create_directory(d / "adir");
+  e = ErrorOf([&] { CheckOutputs({}, {{"--timeline", "adir"}}); });
+  EXPECT_TRUE(Has(e, "--timeline") && Has(e, "a directory")) << e;
+  fs::current_path(fs::temp_directory_path());
 }
 
 }  // namespace

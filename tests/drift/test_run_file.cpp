@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "drift/run_file.h"
 
@@ -99,12 +101,23 @@ TEST(RunFile, WriteRunsIsAllOrNothing) {
   const drift::Run log =
       ParseRun("time_s,a_C,e_um\n0,20,0\n60,21,1\n120,22,2\n", "log.csv", RunState::kIdle);
   std::vector<drift::Run> runs{log.Slice(0, 2, "a"), log.Slice(2, 3, "b")};
-  // The second file cannot be written (a directory sits at its temporary name).
-  std::filesystem::create_directories(dir / "b.csv.partial");
-  EXPECT_THROW(WriteRuns(dir, runs, {}), InputError);
-  EXPECT_FALSE(std::filesystem::exists(dir / "a.csv"));
-  EXPECT_FALSE(std::filesystem::exists(dir / "a.csv.partial"));
-  std::filesystem::remove_all(dir / "b.csv.partial");
+  const auto first = WriteRuns(dir, runs, {"first"});
+  const std::string a_before = ReadTextFile(dir / "a.csv");
+  // The second file cannot be written (a directory sits at its name): the first stays as it was,
+  // the message names the target and what it is, no temporary remains.
+  std::filesystem::remove(dir / "b.csv");
+  std::filesystem::create_directories(dir / "b.csv");
+  try {
+    WriteRuns(dir, runs, {"second"});
+    ADD_FAILURE() << "a directory at b.csv was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.csv': it is a directory"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(ReadTextFile(dir / "a.csv"), a_before);
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_FALSE(IsWhirlTemporary(e.path().filename().string())) << e.path();
+  std::filesystem::remove_all(dir / "b.csv");
   const auto paths = WriteRuns(dir, runs, {"test"});
   ASSERT_EQ(paths.size(), 2u);
   EXPECT_EQ(ReadRun(paths[1], RunState::kIdle).temperature_C(0, 0), 22.0);

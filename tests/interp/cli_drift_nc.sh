@@ -32,10 +32,43 @@ expect_fail "t2_C" "$W" drift nc --model "$D/model.json" --machine "$D/machine_n
 [ -e "$D/none.spf" ] && fail "a failed drift nc wrote a file"
 expect_fail "INDEX:SCALE:OFFSET" "$W" drift nc --model "$D/model.json" --machine "$M" \
   --input "t1_C=3;rm" --nc "$D/none.spf"
+# --input: physical bounds, the control's analog inputs (the profile's MD10300 = 8), known names.
+for bad in "t1_C=3:1e-12:0/scale" "t1_C=3:0.1:1e308/offset" "t1_C=3:0.1:-1e9/offset" \
+           "t1_C=9:0.1:0/MD10300" "t1_C=0:0.1:0/index" "t8_C=3:0.1:0/no input 't8_C'"; do
+  expect_fail "${bad#*/}" "$W" drift nc --model "$D/model.json" --machine "$M" \
+    --input "${bad%%/*}" --nc "$D/none.spf"
+  grep -q -- "--input '${bad%%/*}'" "$D/err.txt" || fail "message does not name the --input: $(cat "$D/err.txt")"
+done
+[ -e "$D/none.spf" ] && fail "a refused --input wrote a file"
+# The headers name the programs by their files and the control's limits they need.
+"$W" drift nc --model "$D/model.json" --machine "$M" --nc "$D/DRIFT_ON.SPF" \
+  --reset-nc "$D/DRIFT_OFF.SPF" > /dev/null || fail "drift nc with own names"
+head -1 "$D/DRIFT_ON.SPF" | grep -q '^; DRIFT_ON: ' || fail "header does not name DRIFT_ON"
+grep -q 'stop it with DRIFT_OFF' "$D/DRIFT_ON.SPF" || fail "header does not name DRIFT_OFF"
+head -1 "$D/DRIFT_OFF.SPF" | grep -q '^; DRIFT_OFF: ' || fail "reset header"
+grep -q 'MD10300 \$MN_FASTIO_ANA_NUM_INPUTS >= 2 (profile: 8)' "$D/DRIFT_ON.SPF" \
+  || fail "header: MD10300 prerequisite"
+grep -q 'MD28254 \$MC_MM_NUM_AC_PARAM >= [0-9]* (profile: 300)' "$D/DRIFT_ON.SPF" \
+  || fail "header: MD28254 prerequisite"
+expect_fail "one program" "$W" drift nc --model "$D/model.json" --machine "$M" \
+  --nc "$D/DRIFT_ON.SPF" --reset-nc "$D/drift_on.spf"
+expect_fail "program name" "$W" drift nc --model "$D/model.json" --machine "$M" \
+  --nc "$D/1 drift.spf"
+# One validation for every command: a profile that one refuses, the other refuses too.
+for edit in 's/"workpiece_k0_param": 99/"workpiece_k0_param": 101/;workpiece_k0_param' \
+            's/"sync_id_last": 240/"sync_id_last": 201/;sync_id_last' \
+            's/"missing_alarm": 65000/"missing_alarm": 60000/;missing_alarm' \
+            's/"md10300_analog_inputs": 8/"md10300_analog_inputs": 4/;MD10300'; do
+  sed "${edit%;*}" "$M" > "$D/edited.json"
+  expect_fail "${edit##*;}" "$W" drift nc --model "$D/model.json" --machine "$D/edited.json"
+  grep -q "edited.json" "$D/err.txt" || fail "message does not name the profile"
+  expect_fail "${edit##*;}" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+    --machine "$D/edited.json"
+done
 # The plan combined with it: K0 into $AC_PARAM[99], an alarm if the drift action is not active.
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --with-drift-action \
   --nc "$D/plan.spf" > /dev/null || fail "plan --with-drift-action"
-grep -q '^\$AC_PARAM\[99\]=' "$D/plan.spf" || fail "combined plan must write K0 into AC_PARAM[99]"
+grep -q 'DO \$AC_PARAM\[99\]=' "$D/plan.spf" || fail "combined plan must write K0 into AC_PARAM[99]"
 grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/plan.spf" | grep -v '^;' && fail "combined plan writes SD43900"
 grep -q '^SETAL(65000)' "$D/plan.spf" || fail "combined plan lacks the alarm"
 grep -v '"drift"' "$M" > /dev/null

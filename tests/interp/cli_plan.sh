@@ -19,8 +19,9 @@ grep -q '"uniform_point_count"' "$D/plan.json" || fail "plan JSON uniform count"
 grep -q "MD32750 \$MA_TEMP_COMP_TYPE = 3" "$D/plan.spf" || fail "NC header"
 segments=$(grep -v '^#' "$D/plan.csv" | tail -n +2 | grep -vc '^restore')
 actions=$(grep -c '^ID=' "$D/plan.spf")
-# One action per later segment plus the restore at the thread end, IDs from the profile's range.
-[ "$actions" -eq "$segments" ] || fail "$segments segments but $actions synchronized actions"
+# One action per segment (the first at the thread start) plus the restore at the thread end, IDs
+# from the profile's range.
+[ "$actions" -eq $((segments + 1)) ] || fail "$segments segments but $actions synchronized actions"
 grep -q "^ID=100 " "$D/plan.spf" || fail "IDs do not start at the profile's sync_id_first"
 [ "$(grep -c '^CANCEL(' "$D/plan.spf")" -eq 50 ] || fail "the ID range 100..149 is not cancelled"
 grep -q '^CANCEL(149)' "$D/reset.spf" || fail "reset program does not cancel the range"
@@ -44,6 +45,66 @@ expect_fail "machine-offset-mm" "$W" plan --screw "$S" --max-elongation 30 --set
   --start-position-mm 0
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 "${POS[@]}" > /dev/null \
   || fail "plan with explicit positions"
+
+# Synchronized-action IDs come from the profile or explicit flags, never a default 1..255 (the
+# program cancels its whole range, the machine builder's actions too); a flag that contradicts
+# the profile is refused, naming both.
+expect_fail "no synchronized-action IDs" "$W" plan --screw "$S" --max-elongation 30 \
+  --settle-time 250 "${POS[@]}" --nc "$D/noids.spf"
+[ -e "$D/noids.spf" ] && fail "program written without an ID range"
+expect_fail "go together" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  "${POS[@]}" --sync-id-first 120 --nc "$D/noids.spf"
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 "${POS[@]}" --sync-id-first 120 \
+  --sync-id-last 160 --nc "$D/ids.spf" > /dev/null || fail "plan with explicit IDs"
+[ "$(grep -c '^CANCEL(' "$D/ids.spf")" -eq 41 ] || fail "explicit range 120..160 not cancelled"
+grep -Eq '^(CANCEL\(|ID=)([0-9]|[1-9][0-9]|1[01][0-9]|16[1-9]|1[7-9][0-9]|2[0-9][0-9])[^0-9]' \
+  "$D/ids.spf" && fail "an ID outside 120..160 is touched"
+expect_fail "sync_id_first 100" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --sync-id-first 1 --nc "$D/override.spf"
+grep -q -- "--sync-id-first 1 contradicts the machine profile" "$D/err.txt" \
+  || fail "the message does not name the flag: $(cat "$D/err.txt")"
+expect_fail "sync_id_last 149" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --sync-id-last 255
+expect_fail "save_r_first 90" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --save-r 10
+expect_fail "start_alarm 65004" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --start-alarm 65100
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --sync-id-first 100 \
+  --sync-id-last 149 > /dev/null || fail "flags equal to the profile's refused"
+
+# The start: the program refuses (alarm from the profile) unless the axis stands before the
+# thread start, and says so in its header; the control's limits it needs are named.
+grep -q '^IF \$AA_IM\[Z\]>=' "$D/plan.spf" || fail "no start check"
+grep -q '^SETAL(65004)' "$D/plan.spf" || fail "the profile's start_alarm is not raised"
+grep -q 'alarm 65004 (axis at or past the thread start' "$D/plan.spf" || fail "header: start alarm"
+grep -q 'MD28250 \$MC_MM_NUM_SYNC_ELEMENTS' "$D/plan.spf" || fail "header: MD28250"
+grep -q '^\$SA_TEMP_COMP_SLOPE' "$D/plan.spf" && fail "the part program writes a slope before motion"
+
+# Program names: the headers name the files' stems; names a control refuses are refused, and
+# so is one program given twice (same file by another path, or names differing only in case).
+"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" \
+  --nc "$D/MY_COMP.SPF" --reset-nc "$D/MY_UNDO.SPF" > /dev/null || fail "plan with own names"
+head -1 "$D/MY_COMP.SPF" | grep -q '^; MY_COMP: ' || fail "header does not name MY_COMP"
+grep -q 'call MY_UNDO after' "$D/MY_COMP.SPF" || fail "header does not name MY_UNDO"
+head -1 "$D/MY_UNDO.SPF" | grep -q '^; MY_UNDO: .*aborted MY_COMP run' || fail "reset header"
+grep -q 'WHIRL_TEMP_COMP' "$D/MY_COMP.SPF" "$D/MY_UNDO.SPF" && fail "another program named"
+for bad in "1 my comp.spf" "my comp.spf" "WHIRL-COMP.SPF" "A_VERY_LONG_PROGRAM_NAME_X.SPF"; do
+  expect_fail "program name" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+    --machine "$M" --nc "$D/$bad"
+  [ -e "$D/$bad" ] && fail "'$bad' written"
+done
+mkdir -p "$D/real" && ln -sfn real "$D/link"
+(cd "$D" && expect_fail "same file\|one program" "$W" plan --screw "$S" --max-elongation 30 \
+  --settle-time 250 --machine "$M" --nc AB.SPF --reset-nc ./AB.SPF) || exit 1
+[ -e "$D/AB.SPF" ] && fail "AB.SPF written although given twice"
+expect_fail "same file\|one program" "$W" plan --screw "$S" --max-elongation 30 \
+  --settle-time 250 --machine "$M" --nc "$D/real/AB.SPF" --reset-nc "$D/link/AB.SPF"
+expect_fail "one program" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --nc "$D/AB.SPF" --reset-nc "$D/real/ab.spf"
+# Any two outputs naming one file by different paths are refused (canonical paths compared).
+(cd "$D" && expect_fail "same file\|given twice" "$W" plan --screw "$S" --max-elongation 30 \
+  --settle-time 250 --machine "$M" --out P.json --csv ./P.json) || exit 1
+[ -e "$D/P.json" ] && fail "P.json written although given twice"
 # Bad machine profile: the message names the file and the key.
 sed 's/"direction": 1/"direction": 2/' "$M" > "$D/bad_machine.json"
 expect_fail "bad_machine.json" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \

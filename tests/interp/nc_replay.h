@@ -4,7 +4,9 @@
 // preprocessing would, and then runs the synchronized actions interpolation cycle by cycle, in ID
 // order: WHEN fires once, WHENEVER every cycle while its condition holds, no condition every
 // cycle; ID= actions end with the program, IDS= actions stay until CANCEL; a dwell (G4) runs one
-// cycle at standstill_mm; PowerOn() drops actions and $AC_PARAM. Expressions: numbers,
+// cycle with the axis where it stands (axis_mm, the last cycle's position); a part-program IF on
+// $AA_IM reads axis_mm (a test that runs such a program must place the axis first);
+// PowerOn() drops actions and $AC_PARAM. Expressions: numbers,
 // + - * / and parentheses over $AC_PARAM[n], $A_INA[n], R parameters and the setting data. A line
 // it does not understand fails the test, so the writer cannot emit something the replay ignores.
 #include <gtest/gtest.h>
@@ -155,7 +157,7 @@ struct Replay {
   // Called after each part-program assignment: the main run goes on between blocks, so a test can
   // run interpolation cycles there and see the states a program passes through.
   std::function<void()> between_blocks;
-  double standstill_mm = 0;  // axis position during a dwell (G4) in a part program
+  double axis_mm = NAN;  // where the axis stands: set by the test or by the last Cycle()
 
   double Value(const std::string& expr) const { return Expr(expr, control, axis).Eval(); }
 
@@ -204,22 +206,35 @@ struct Replay {
     return out;
   }
 
+  static bool Compare(double l, const std::string& op, double r) {
+    if (op == ">=") return l >= r;
+    if (op == "<=") return l <= r;
+    if (op == "==") return l == r;
+    if (op == "<>") return l != r;
+    ADD_FAILURE() << "operator " << op;
+    return false;
+  }
+
   bool Holds(const SyncAction& a, double p_mm) const {
     if (a.mode == SyncAction::Mode::kEveryCycle) return true;
     const double l = a.lhs == "$AA_IM[" + axis + "]" ? p_mm : Value(a.lhs);
-    const double r = Value(a.rhs);
-    if (a.op == ">=") return l >= r;
-    if (a.op == "<=") return l <= r;
-    if (a.op == "==") return l == r;
-    ADD_FAILURE() << "operator " << a.op;
-    return false;
+    return Compare(l, a.op, Value(a.rhs));
+  }
+
+  // A part-program condition's left side: R<n>, $AC_PARAM[n] or the axis position $AA_IM[axis].
+  double ProgramValue(const std::string& lhs) const {
+    if (lhs.rfind("$AA_IM[", 0) != 0) return Value(lhs);
+    EXPECT_EQ(lhs, "$AA_IM[" + axis + "]");
+    EXPECT_FALSE(std::isnan(axis_mm)) << "the program reads $AA_IM: place the axis first";
+    return axis_mm;
   }
 
   // Runs the part program's preprocessing; fails the test on any unknown line. Returns false if
   // the program stopped with an alarm (SETAL).
   bool RunProgram(const std::string& text) {
     static const std::regex kCancel(R"(^CANCEL\((\d+)\)$)");
-    static const std::regex kIf(R"(^IF (R\d+|\$AC_PARAM\[\d+\])(<>|==)([-0-9.]+)$)");
+    static const std::regex kIf(
+        R"(^IF (R\d+|\$AC_PARAM\[\d+\]|\$AA_IM\[\w+\])(<>|==|>=|<=)([-0-9.]+)$)");
     static const std::regex kDwell(R"(^G4 F[0-9.]+$)");
     static const std::regex kSetal(R"(^SETAL\((\d+)\)$)");
     static const std::regex kAssign(R"(^(\$?\$?[A-Z_]+(\[\w+\])?|R\d+)=(\S+)$)");
@@ -237,12 +252,10 @@ struct Replay {
         EXPECT_FALSE(skipping.empty()) << "ENDIF without IF";
         if (!skipping.empty()) skipping.pop_back();
       } else if (std::regex_match(line, m, kIf)) {
-        const double r = Value(m[1]);
-        const double c = std::stod(m[3]);
-        skipping.push_back(skip || !(m[2] == "==" ? r == c : r != c));
+        skipping.push_back(skip || !Compare(ProgramValue(m[1]), m[2], std::stod(m[3])));
       } else if (skip || (!line.empty() && line[0] == ';') || line == "STOPRE") {
       } else if (std::regex_match(line, m, kDwell)) {  // the main run goes on: one cycle
-        Cycle(standstill_mm);
+        Cycle(axis_mm);
         if (between_blocks) between_blocks();
       } else if (line == "M17") {
         ended = true;
@@ -277,6 +290,7 @@ struct Replay {
 
   // One interpolation cycle with the axis at p_mm: every action in ID order.
   void Cycle(double p_mm) {
+    axis_mm = p_mm;
     for (auto& [id, a] : actions) {
       if (a.mode == SyncAction::Mode::kWhen && a.fired) continue;
       if (!Holds(a, p_mm)) continue;

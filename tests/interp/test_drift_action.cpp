@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -135,6 +136,7 @@ TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
   r.control.abs_value_mm = 0.0007;  // found values
   r.control.slope = 3e-6;
   r.control.ref_position_mm = 12.0;
+  r.axis_mm = AxisPositionMm(p, feed, 0.0) - 1.0;  // parked before the thread start
   // Without the drift action the plan refuses to start, and changes nothing.
   EXPECT_FALSE(r.RunProgram(FormatNcProgram(plan)));
   EXPECT_EQ(r.control.alarm, p.drift_missing_alarm);
@@ -253,6 +255,7 @@ TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
   r.control.abs_value_mm = 0.0007;
   r.control.slope = 3e-6;
   r.control.ref_position_mm = 12.0;
+  r.axis_mm = AxisPositionMm(p, feed, 0.0) + 1.0;  // before the thread start, travelling -Z
   // An offset-only drift action does not own the slope: the plan refuses to start (mode alarm).
   SetInputs(r, d, Temperatures(0));
   DriftActionOptions offset_only = d;
@@ -292,6 +295,75 @@ TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
   EXPECT_TRUE(r.actions.empty());
 }
 
+// Combined with the drift action (K0 handed over, or K0, slope and reference): while the axis is
+// parked before the thread start and on the approach, the control applies the machine part alone,
+// exactly as before the plan's call; nothing of the plan's first segment (its slope about the
+// thread start) is extrapolated to the parking position. Both directions of travel, near and far.
+TEST(DriftAction, CombinedTheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
+  std::mt19937 rng(1814);
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({20.0, 40.0}, 4.0, 1.0);
+  const double feed = 2.0, thread = 300.0;
+  for (int direction : {1, -1})
+    for (bool slope_handed_over : {false, true})
+      for (double before_mm : {1.0, 2000.0}) {
+        const drift::DriftModel m = HandModel(true, rng), g = SlopeModel(rng);
+        DriftActionOptions d = SlopeOptions(ControlDk::kAdded, direction, direction);
+        d.workpiece_k0_param = 99;
+        if (slope_handed_over) d.workpiece_slope_param = 97;
+        PlanOptions p;
+        p.direction = direction;
+        p.sign = ExpectedSign(p.direction, p.control_dk);
+        p.start_position_mm = direction > 0 ? 100.0 : 6200.0;
+        p.machine_offset_mm = -812.5;
+        p.sync_id_first = 100;
+        p.sync_id_last = 140;
+        p.workpiece_k0_param = 99;
+        p.workpiece_slope_param = d.workpiece_slope_param;
+        p.drift_alive_param = d.param_first;
+        p.md32760 = kMd32760Max;
+        const CompensationPlan plan = BuildPlan(curve, feed, thread, p);
+        const double start = plan.segments.front().sd43920_mm;
+        const double park = start - direction * before_mm;
+        replay::Replay r;
+        r.control.abs_value_mm = 0.0007;  // found values
+        r.control.slope = 3e-6;
+        r.control.ref_position_mm = 12.0;
+        r.axis_mm = park;
+        SetInputs(r, d, Temperatures(0));  // constant temperatures: the machine part stays put
+        ASSERT_TRUE(r.RunProgram(slope_handed_over ? FormatDriftNcProgram(m, d, "", &g)
+                                                   : FormatDriftNcProgram(m, d)));
+        for (int k = 0; k < 3; ++k) r.Cycle(park);
+        const replay::Control before = r.control;  // what the control applies before the call
+        double worst_call_mm = 0;
+        r.between_blocks = [&] {
+          worst_call_mm =
+              std::max(worst_call_mm, std::abs(r.control.DkMm(park) - before.DkMm(park)));
+        };
+        ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan))) << "alarm " << r.control.alarm;
+        r.between_blocks = nullptr;
+        double worst_approach_mm = 0;
+        for (int i = 0; i < 200; ++i) {  // up to, not onto, the thread start
+          const double pos = park + (start - park) * i / 200.0;
+          r.Cycle(pos);
+          worst_approach_mm =
+              std::max(worst_approach_mm, std::abs(r.control.DkMm(pos) - before.DkMm(pos)));
+        }
+        SCOPED_TRACE("direction " + std::to_string(direction) + ", slope handed over " +
+                     std::to_string(slope_handed_over) + ", parked " + std::to_string(before_mm) +
+                     " mm before the start");
+        EXPECT_EQ(worst_call_mm, 0.0);
+        EXPECT_EQ(worst_approach_mm, 0.0);
+        // At the thread start the plan's first segment joins the machine part (l(0) = 0 here):
+        // handed over, the machine line goes on; with K0 only, the plan's slope replaces the
+        // found one and the machine's K0 remains.
+        r.Cycle(start);
+        EXPECT_NEAR(r.control.DkMm(start),
+                    slope_handed_over ? before.DkMm(start) : before.abs_value_mm,
+                    std::abs(curve.ElongationUm(0.0)) / 1000.0 + 1e-9);
+        ASSERT_FALSE(HasFailure());
+      }
+}
+
 // The plans check the running action, not a retentive marker: after a power cycle (actions and
 // $AC_PARAM gone, R parameters kept) a combined plan refuses to start; a plan that writes the
 // setting data itself refuses while a drift action runs; a drift program refuses while a plan's
@@ -315,6 +387,8 @@ TEST(DriftAction, LivenessNotMarkersDecideWhoMayWrite) {
   const CompensationPlan standalone = BuildPlan(curve, 2.0, 300.0, p);
 
   replay::Replay r;
+  const double park = -1.0;  // before the thread start at 0
+  r.axis_mm = park;
   SetInputs(r, d, Temperatures(0));
   ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(m, d)));
   ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));  // running: accepted
@@ -323,7 +397,7 @@ TEST(DriftAction, LivenessNotMarkersDecideWhoMayWrite) {
   const double k0 = r.control.abs_value_mm;
   EXPECT_FALSE(r.RunProgram(FormatNcProgram(standalone)));
   EXPECT_EQ(r.control.alarm, p.drift_missing_alarm + 1);
-  r.Cycle(0.0);
+  r.Cycle(park);
   EXPECT_EQ(r.control.abs_value_mm, k0);
   // Power cycle: the markers R81 survive, the action does not: the combined plan refuses.
   r.PowerOn();
@@ -334,6 +408,7 @@ TEST(DriftAction, LivenessNotMarkersDecideWhoMayWrite) {
   // A standalone plan aborted mid-cut leaves R93 = 1: the drift program refuses to start (it
   // would save the plan's values as the control's own).
   replay::Replay q;
+  q.axis_mm = park;
   ASSERT_TRUE(q.RunProgram(FormatNcProgram(standalone)));
   q.EndProgram();
   EXPECT_FALSE(q.RunProgram(FormatDriftNcProgram(m, d)));
@@ -395,6 +470,56 @@ TEST(DriftAction, RefusesWhatTheControlCannotRun) {
   m.kind = drift::ModelKind::kNetwork;
   EXPECT_THROW(FormatDriftNcProgram(m, Options(ControlDk::kAdded, 1, DriftReference::kModel)),
                InputError);
+}
+
+// Physical bounds of the mapping and the control's own limits (MD10300 analog inputs, MD28254
+// $AC_PARAM, the profile's param_last): refused with the datum named; the header names the
+// program by its name and states what the program needs from the control.
+TEST(DriftAction, ControlLimitsAndBoundsAreCheckedAndNamed) {
+  std::mt19937 rng(1815);
+  const drift::DriftModel m = HandModel(true, rng);
+  const DriftActionOptions good = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  auto refused = [&](const std::function<void(DriftActionOptions&)>& edit,
+                     const std::string& word) {
+    DriftActionOptions o = good;
+    edit(o);
+    try {
+      FormatDriftNcProgram(m, o);
+      ADD_FAILURE() << "accepted; expected a message with '" << word << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+    }
+  };
+  refused([](DriftActionOptions& o) { o.inputs["t1_C"].scale = 1e-12; }, "scale");
+  refused([](DriftActionOptions& o) { o.inputs["t1_C"].scale = -2e3; }, "scale");
+  refused([](DriftActionOptions& o) { o.inputs["t1_C"].offset = 1e308; }, "offset");
+  refused([](DriftActionOptions& o) { o.inputs["t1_C"].offset = NAN; }, "offset");
+  refused([](DriftActionOptions& o) { o.inputs["t1_C"].index = 1000; }, "index");
+  refused([](DriftActionOptions& o) { o.ipo_cycle_ms = 1e-9; }, "ipo_cycle_ms");
+  refused([](DriftActionOptions& o) { o.missing_alarm = 60000; }, "missing_alarm");
+  refused(
+      [](DriftActionOptions& o) {
+        o.control = {8, 400, 300};
+        o.inputs["t2_C"].index = 9;
+      },
+      "MD10300");
+  refused([](DriftActionOptions& o) { o.control = {8, 400, 105}; }, "MD28254");
+  refused([](DriftActionOptions& o) { o.param_last = 105; }, "param_last");  // needs 100..109
+  refused([](DriftActionOptions& o) { o.program_name = "1 my comp"; }, "program name");
+  refused([](DriftActionOptions& o) { o.reset_program_name = "whirl_drift_comp"; }, "one program");
+  DriftActionOptions o = good;
+  o.control = {8, 400, 300};
+  o.param_last = 109;  // exactly what the model needs
+  o.program_name = "MACHINE_DRIFT";
+  o.reset_program_name = "MACHINE_DRIFT_OFF";
+  const std::string nc = FormatDriftNcProgram(m, o);
+  EXPECT_EQ(nc.rfind("; MACHINE_DRIFT: ", 0), 0u);
+  EXPECT_NE(nc.find("stop it with MACHINE_DRIFT_OFF"), std::string::npos);
+  EXPECT_NE(nc.find("MD10300 $MN_FASTIO_ANA_NUM_INPUTS >= 7 (profile: 8)"), std::string::npos);
+  EXPECT_NE(nc.find("MD28254 $MC_MM_NUM_AC_PARAM >= 110 (profile: 300)"), std::string::npos);
+  EXPECT_NE(nc.find("MD28250 $MC_MM_NUM_SYNC_ELEMENTS"), std::string::npos);
+  EXPECT_EQ(nc.find("WHIRL_DRIFT"), std::string::npos);
+  EXPECT_EQ(FormatDriftNcResetProgram(o).rfind("; MACHINE_DRIFT_OFF: ", 0), 0u);
 }
 
 TEST(DriftAction, HostileNamesStayInsideCommentsAndCells) {

@@ -6,12 +6,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
+#include <vector>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "core/error.h"
 #include "core/json_file.h"
 #include "interp/machine_profile.h"
+#include "interp/profile_uses.h"
 
 namespace whirl::interp {
 namespace {
@@ -91,6 +94,130 @@ TEST(MachineProfile, PlanOptionsCarryTheLivenessCheckThroughTheJsonRoundTrip) {
   j["workpiece_k0_param"] = -1;
   j["drift_marker_r"] = -1;
   EXPECT_NO_THROW(j.get<PlanOptions>());
+}
+
+const fs::path kExample = fs::path(WHIRL_SOURCE_DIR) / "datasets/machines/example_840d.json";
+
+TEST(MachineProfile, ShippedProfilesStateTheControlsLimits) {
+  for (const fs::path& path : {kShipped, kExample}) {
+    const MachineProfile m = LoadMachineProfile(path);
+    EXPECT_EQ(m.schema_version, 2);
+    ASSERT_TRUE(m.control.Stated()) << path;
+    ASSERT_TRUE(m.drift);
+    for (const auto& [name, a] : m.drift->inputs)
+      EXPECT_LE(a.index, m.control.analog_inputs) << name;
+    EXPECT_LT(m.drift->param_last, m.control.ac_params);
+    EXPECT_GE(m.start_alarm, kUserAlarmFirst);
+    EXPECT_NO_THROW(testing::UseProfileEverywhere(m)) << path;
+  }
+  EXPECT_EQ(LoadMachineProfile(kExample).control.analog_inputs, 8);
+}
+
+// A profile of schema version 1 (the example as shipped before the control's limits were stated)
+// still loads, with the documented defaults, and every command accepts it.
+TEST(MachineProfile, Version1LoadsWithTheDocumentedDefaults) {
+  const MachineProfile v1 =
+      LoadMachineProfile(fs::path(WHIRL_SOURCE_DIR) / "tests/interp/data/example_840d_v1.json");
+  EXPECT_EQ(v1.schema_version, 1);
+  EXPECT_FALSE(v1.control.Stated());
+  ASSERT_TRUE(v1.drift);
+  EXPECT_EQ(v1.start_alarm, v1.drift->missing_alarm + 4);
+  EXPECT_EQ(v1.drift->param_last, 9999) << "no workpiece slot above param_first";
+  EXPECT_EQ(v1.drift->inputs.size(), 16u);
+  EXPECT_NO_THROW(testing::UseProfileEverywhere(v1));
+}
+
+// The sections against each other and the control's limits: each contradiction that one command
+// accepted and another refused, or that no command checked, is refused at load, naming the key.
+TEST(MachineProfile, CrossChecksAndBoundsAreRefusedByName) {
+  using J = nlohmann::json;
+  // Workpiece slots inside the drift action's own $AC_PARAM range.
+  ExpectRefused([](J& j) { j["drift"]["workpiece_k0_param"] = 101; }, "workpiece_k0_param");
+  ExpectRefused([](J& j) { j["drift"]["workpiece_slope_param"] = 250; }, "workpiece_slope_param");
+  // Ranges too small for the smallest program.
+  ExpectRefused([](J& j) { j["drift"]["sync_id_last"] = 201; }, "sync_id_last");
+  ExpectRefused([](J& j) { j["drift"]["param_last"] = 103; }, "param_last");
+  ExpectRefused([](J& j) { j["sync_id_last"] = 100; }, "sync_id_last");
+  // Alarms: only the user cycle alarms, each number once.
+  for (int alarm : {60000, 62000, 64999, 69997})
+    ExpectRefused([&](J& j) { j["drift"]["missing_alarm"] = alarm; }, "missing_alarm");
+  ExpectRefused([](J& j) { j["start_alarm"] = 64000; }, "start_alarm");
+  ExpectRefused([](J& j) { j["start_alarm"] = 65003; }, "start_alarm");
+  // Physical bounds.
+  ExpectRefused([](J& j) { j["drift"]["analog_inputs"]["ambient_C"]["scale"] = 1e-12; }, "scale");
+  ExpectRefused([](J& j) { j["drift"]["analog_inputs"]["ambient_C"]["offset"] = -1e9; },
+                "offset");
+  ExpectRefused([](J& j) { j["drift"]["ipo_cycle_ms"] = 1e-9; }, "ipo_cycle_ms");
+  ExpectRefused([](J& j) { j["machine_offset_mm"] = 1e308; }, "machine_offset_mm");
+  ExpectRefused([](J& j) { j["drift"]["slope"]["fixed_end_position_mm"] = 2e5; },
+                "fixed_end_position_mm");
+  // The control's own limits: analog inputs (MD10300), $AC_PARAM (MD28254), elements (MD28250).
+  ExpectRefused([](J& j) { j["control"]["md10300_analog_inputs"] = 8; }, "MD10300");
+  ExpectRefused([](J& j) { j["drift"]["analog_inputs"]["cabinet_C"]["index"] = 14; }, "MD10300");
+  ExpectRefused([](J& j) { j["control"]["md28254_ac_params"] = 250; }, "MD28254");
+  ExpectRefused([](J& j) { j["control"]["md28250_sync_elements"] = 50; }, "MD28250");
+  ExpectRefused([](J& j) { j["control"]["md10300_analog_inputs"] = 1000; }, "MD10300");
+  // Version 2 states them; version 1 may not claim version 2's keys half-way.
+  ExpectRefused([](J& j) { j.erase("control"); }, "control");
+  ExpectRefused([](J& j) { j.erase("start_alarm"); }, "start_alarm");
+  ExpectRefused([](J& j) { j["drift"].erase("param_last"); }, "param_last");
+  ExpectRefused([](J& j) { j["schema_version"] = 3; }, "schema_version");
+  // A slope object beside a plan that keeps SD43910: two writers.
+  ExpectRefused([](J& j) { j["drift"].erase("workpiece_slope_param"); }, "workpiece_slope_param");
+}
+
+// One validation for every command: random edits of the shipped profiles either are refused at
+// load (an InputError naming the file) or are accepted by every use (plan, combined plan, drift
+// programs with the smallest models, resets, PLC tables).
+TEST(MachineProfile, AProfileThatLoadsIsAcceptedByEveryCommand) {
+  std::mt19937 rng(2601);
+  const std::vector<std::vector<std::string>> keys = {
+      {"sync_id_first"}, {"sync_id_last"}, {"save_r_first"}, {"start_alarm"},
+      {"machine_offset_mm"}, {"md32760"}, {"control", "md10300_analog_inputs"},
+      {"control", "md28250_sync_elements"}, {"control", "md28254_ac_params"},
+      {"drift", "sync_id_first"}, {"drift", "sync_id_last"}, {"drift", "param_first"},
+      {"drift", "param_last"}, {"drift", "save_r_first"}, {"drift", "ipo_cycle_ms"},
+      {"drift", "workpiece_k0_param"}, {"drift", "workpiece_slope_param"},
+      {"drift", "missing_alarm"}, {"drift", "analog_inputs", "ambient_C", "index"},
+      {"drift", "analog_inputs", "ambient_C", "scale"}};
+  const std::vector<double> values = {0,   1,    2,    3,     8,     13,    80,     89,    95,
+                                      97,  98,   99,   100,   101,   103,   107,    140,   149,
+                                      150, 199,  200,  201,   202,   205,   240,    250,   255,
+                                      256, 299,  300,  1e-6,  1e-7,  0.05,  65000,  65003, 65004,
+                                      64999, 69996, 69999, 9995, 9999, 1e5, -1e5, 2e5};
+  int loaded = 0, refused = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const fs::path base = trial % 2 ? kShipped : kExample;
+    nlohmann::json j = ReadJsonFile(base);
+    for (int e = 0; e < 1 + static_cast<int>(rng() % 3); ++e) {
+      const auto& key = keys[rng() % keys.size()];
+      nlohmann::json* node = &j;
+      for (const std::string& k : key) {
+        if (!node->contains(k)) break;
+        node = &(*node)[k];
+      }
+      if (node->is_number()) *node = values[rng() % values.size()];
+    }
+    const fs::path p = fs::path(::testing::TempDir()) / "whirl_profile_random.json";
+    std::ofstream(p) << j.dump(2);
+    MachineProfile m;
+    try {
+      m = LoadMachineProfile(p);
+    } catch (const InputError& err) {
+      ++refused;
+      EXPECT_NE(std::string(err.what()).find("whirl_profile_random.json"), std::string::npos)
+          << err.what();
+      continue;
+    }
+    ++loaded;
+    try {
+      testing::UseProfileEverywhere(m);
+    } catch (const InputError& err) {
+      ADD_FAILURE() << "loaded, then refused by a command: " << err.what() << "\n" << j.dump();
+    }
+  }
+  EXPECT_GT(loaded, 50);
+  EXPECT_GT(refused, 50);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -42,6 +43,8 @@ Case RandomCase(std::mt19937& rng) {
                              : ControlDk::kSubtracted;
   c.options.check_step_s = 0.5;
   c.options.md32760 = kMd32760Max;  // random feeds and curves reach slopes up to ~0.04
+  c.options.sync_id_first = 1;      // the whole range: enough for the tightest random tolerance
+  c.options.sync_id_last = 255;
   return c;
 }
 
@@ -334,7 +337,7 @@ TEST(Sinumerik, NcProgramValuesReconstructTheCompensation) {
     for (auto it = std::sregex_iterator(nc.begin(), nc.end(), action); it != std::sregex_iterator();
          ++it) {
       const auto& m = *it;
-      const std::size_t id = std::stoul(m[1]) - c.options.sync_id_first + 1;
+      const std::size_t id = std::stoul(m[1]) - c.options.sync_id_first;  // the first included
       ASSERT_LT(id, plan.segments.size());
       const CompensationSegment& s = plan.segments[id];
       EXPECT_EQ(m[2].str(), c.options.direction > 0 ? ">=" : "<=");
@@ -344,9 +347,97 @@ TEST(Sinumerik, NcProgramValuesReconstructTheCompensation) {
       EXPECT_NEAR(std::stod(m[6]), s.sd43920_mm, 0.5e-4);
       ++count;
     }
-    EXPECT_EQ(count, plan.segments.size() - 1);
+    EXPECT_EQ(count, plan.segments.size()) << "every segment, the first too, is an action";
     EXPECT_NE(nc.find("MD32750 $MA_TEMP_COMP_TYPE = 3"), std::string::npos);
+    // Nothing of the plan is written by the part program itself (only the found values saved).
+    EXPECT_EQ(nc.find("\n$SA_TEMP_COMP_SLOPE"), std::string::npos);
+    EXPECT_EQ(nc.find("\n$SA_TEMP_COMP_ABS_VALUE"), std::string::npos);
   }
+}
+
+// The program cancels every ID of its range: without a range stated by the machine builder (a
+// profile or explicit flags) there is no program, never a default 1..255.
+TEST(Sinumerik, NcProgramsNeedTheReservedIdRange) {
+  CompensationPlan plan = SmallPlan();
+  plan.options.sync_id_first = plan.options.sync_id_last = 0;
+  EXPECT_NO_THROW(plan.options.Validate()) << "a plan without IDs can be built and checked";
+  using Make = std::function<std::string()>;
+  for (const Make& make : {Make([&] { return FormatNcProgram(plan); }),
+                           Make([&] { return FormatNcResetProgram(plan.options); })}) {
+    try {
+      make();
+      ADD_FAILURE() << "NC program written without a reserved ID range";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("no synchronized-action IDs"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(PlanOptions{}.sync_id_first, 0) << "no default range";
+  EXPECT_EQ(PlanOptions{}.sync_id_last, 0);
+}
+
+TEST(Sinumerik, ProgramNamesAreTheFileStemsAndSinumerikNames) {
+  EXPECT_EQ(ProgramNameOf("out/WHIRL_COMP_2.SPF", "--nc"), "WHIRL_COMP_2");
+  EXPECT_EQ(ProgramNameOf("ab.spf", "--nc"), "ab");
+  EXPECT_EQ(ProgramNameOf(std::string(24, 'W') + ".SPF", "--nc"), std::string(24, 'W'));
+  for (const std::string bad : {"1 my comp.spf", "my comp.spf", "A.SPF", "A1B.SPF", "AB-C.SPF",
+                                "_AB.SPF", "AB$C.SPF", ".SPF", "AB\nM30.SPF"}) {
+    try {
+      ProgramNameOf("dir/" + bad, "--nc");
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--nc"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("24"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(ProgramNameOf(std::string(25, 'W') + ".SPF", "--nc"), InputError);
+  EXPECT_THROW(CheckDistinctProgramNames("WHIRL_A", "whirl_a"), InputError);
+  EXPECT_NO_THROW(CheckDistinctProgramNames("WHIRL_A", "WHIRL_A_RESET"));
+  // The headers name the programs they are given; a name the control refuses is an error.
+  NcProgramInfo info;
+  info.program_name = "THREAD_COMP";
+  info.reset_program_name = "THREAD_UNDO";
+  const std::string nc = FormatNcProgram(SmallPlan(), info);
+  EXPECT_EQ(nc.rfind("; THREAD_COMP: ", 0), 0u) << nc.substr(0, 80);
+  EXPECT_NE(nc.find("call THREAD_UNDO after"), std::string::npos);
+  EXPECT_EQ(nc.find("WHIRL_TEMP_COMP"), std::string::npos) << "no other program named";
+  const std::string reset = FormatNcResetProgram(SmallPlan().options, info);
+  EXPECT_EQ(reset.rfind("; THREAD_UNDO: ", 0), 0u);
+  EXPECT_NE(reset.find("aborted THREAD_COMP run"), std::string::npos);
+  info.reset_program_name = "thread_comp";
+  EXPECT_THROW(FormatNcProgram(SmallPlan(), info), InputError);
+  info.reset_program_name = "1 my comp";
+  EXPECT_THROW(FormatNcResetProgram(SmallPlan().options, info), InputError);
+}
+
+TEST(Sinumerik, PositionsAndAlarmsHavePhysicalAndUserRanges) {
+  for (double v : {1e308, -1e6, 1.0001e5, double(NAN), double(INFINITY)}) {
+    PlanOptions o;
+    o.machine_offset_mm = v;
+    EXPECT_THROW(o.Validate(), InputError) << "machine_offset_mm " << v;
+    o = PlanOptions{};
+    o.start_position_mm = v;
+    EXPECT_THROW(o.Validate(), InputError) << "start_position_mm " << v;
+  }
+  PlanOptions o;
+  o.machine_offset_mm = -99999.0;
+  EXPECT_NO_THROW(o.Validate());
+  // SETAL numbers: the user cycle alarms only (60000..64999 belong to Siemens' cycles).
+  for (int alarm : {60000, 64999, 70000}) {
+    o = PlanOptions{};
+    o.start_alarm = alarm;
+    EXPECT_THROW(o.Validate(), InputError) << alarm;
+    o = PlanOptions{};
+    o.drift_missing_alarm = alarm;
+    EXPECT_THROW(o.Validate(), InputError) << alarm;
+  }
+  o = PlanOptions{};
+  o.drift_alive_param = 100;
+  o.drift_missing_alarm = 65010;
+  o.start_alarm = 65012;  // the drift check's third number
+  EXPECT_THROW(o.Validate(), InputError);
+  o.start_alarm = 65013;
+  EXPECT_NO_THROW(o.Validate());
 }
 
 }  // namespace

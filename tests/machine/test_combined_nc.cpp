@@ -88,16 +88,17 @@ void ReplayOneCut(int direction, interp::ControlDk control_dk) {
   ASSERT_TRUE(r.RunProgram(p.drift_nc));
   const double s = interp::SignFactor(p.plan.options.sign);
   const double z0 = kin.thread_start_position_mm, z_fixed = config.z_screw.fixed_end_mm;
-  // While the plan's part program writes its first values block by block the axis stands at the
-  // thread start; every state it passes through applies the machine line plus at most the first
-  // segment's K0 (the elongation at t = 0 is 0), never a slope about a stale reference.
-  const double p0 = interp::AxisPositionMm(p.plan.options, kin.axial_feed_mm_s, 0.0);
-  const double machine0_um = k_um(0) + g_um(0) * (z_fixed - z0) / 1e3;
+  // While the plan's part program runs the axis stands 5 mm before the thread start (z0 + 5 mm:
+  // the cut runs towards the chuck); every state it passes through applies the machine line
+  // alone (nothing of the plan before the thread start), never a slope about a stale reference.
+  const double park = interp::AxisPositionMm(p.plan.options, kin.axial_feed_mm_s, -5.0 / feed);
+  const double machine0_um = k_um(0) + g_um(0) * (z_fixed - (z0 + 5.0)) / 1e3;
   double worst_start_um = 0;
+  r.axis_mm = park;
   r.between_blocks = [&] {
-    r.Cycle(p0);
+    r.Cycle(park);
     worst_start_um =
-        std::max(worst_start_um, std::abs(r.control.DkMm(p0) * 1000.0 / s - machine0_um));
+        std::max(worst_start_um, std::abs(r.control.DkMm(park) * 1000.0 / s - machine0_um));
   };
   ASSERT_TRUE(r.RunProgram(p.plan_nc));
   r.between_blocks = nullptr;

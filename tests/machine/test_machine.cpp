@@ -280,8 +280,11 @@ TEST(MachineReport, HostileNamesStayText) {
   const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
   EXPECT_NE(script.find(GnuplotString(hostile)), std::string::npos);
   EXPECT_NE(script.find("noenhanced"), std::string::npos);
-  // A second report into the same (now non-empty) folder is refused; nothing partial remains.
+  // A second report replaces whirl's own; a file that is not whirl's refuses the folder and stays.
+  EXPECT_NO_THROW(WriteMachineScrewReport(dir.string(), r, d, {}, {}));
+  { std::ofstream(dir / "notes.txt") << "mine"; }
   EXPECT_THROW(WriteMachineScrewReport(dir.string(), r, d, {}, {}), InputError);
+  EXPECT_TRUE(std::filesystem::exists(dir / "notes.txt"));
   EXPECT_FALSE(std::filesystem::exists(dir.string() + ".partial"));
   std::filesystem::remove_all(dir);
 }

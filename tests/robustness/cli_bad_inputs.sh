@@ -77,11 +77,11 @@ expect_fail "32 characters" t "$W" plan --screw "$S" --start-position-mm 0 --mac
 echo previous > keep.json
 mkdir adir
 expect_fail "adir.*directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
-  --out keep.json --csv new.csv --nc adir
+  --out keep.json --csv new.csv --nc adir --sync-id-first 100 --sync-id-last 149
 [ "$(cat keep.json)" = previous ] || fail "plan replaced keep.json although --nc failed"
 [ -e new.csv ] && fail "plan wrote new.csv although --nc failed"
 expect_fail "nodir" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
-  --out keep.json --nc nodir/x.mpf
+  --out keep.json --nc nodir/XY.mpf --sync-id-first 100 --sync-id-last 149
 [ "$(cat keep.json)" = previous ] || fail "plan replaced keep.json although --nc failed"
 # The atomic writer respects what sits at the path: a symlink, a FIFO, a directory.
 ln -s keep.json link.json

@@ -1,0 +1,110 @@
+#pragma once
+// Where whirl writes: the one rule for output directories (--out-dir, --report, --curves-dir, ...)
+// and the check that no output lands on one of the command's inputs or on another output. Every
+// command with a directory output writes it through OutputDir; every command with inputs and
+// outputs calls CheckOutputs before it reads or writes anything.
+#include <filesystem>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace whirl {
+
+/// The file in each output directory that lists what whirl wrote there: JSON, schema
+/// "whirl.output_dir", key "files" (the names, one path component each).
+inline constexpr const char* kOutputManifest = ".whirl-output.json";
+
+/// The rule below in a few words, for --help texts of directory flags.
+inline constexpr const char* kOutputDirRule =
+    "a new or empty directory, or one whirl wrote before (its files are replaced); never a "
+    "symbolic link";
+
+/// The rule for an output directory `dir`, checked without writing anything. `dir` must be
+///  - not a symbolic link (refused even when it points to a directory: a link planted at the path
+///    would send the files elsewhere; give the directory itself), and
+///  - absent (it is created, with its parents), or an empty directory, or a directory whirl wrote
+///    before: one holding kOutputManifest. The files listed there are whirl's: a new run replaces
+///    them and removes those it does not write again. A sub-directory holding its own manifest
+///    (the demo's report/) counts as whirl's too. Anything else in the directory refuses it.
+/// whirl's temporaries (core/atomic_file.h IsWhirlTemporary) are ignored. Throws an InputError
+/// naming `what` (the flag, e.g. "--out-dir"), the directory and, when it refuses a directory with
+/// foreign content, one such file.
+/// Why this rule: running a command again into its own directory must work (`whirl demo --out-dir
+/// out` twice) and must not leave files of the earlier run beside the new ones, while whirl must
+/// never mix its files with someone else's or delete what it did not write; the manifest is how
+/// it tells the two apart.
+void CheckOutputDir(const std::filesystem::path& dir, const std::string& what);
+
+/// An output directory written all-or-nothing. The constructor applies CheckOutputDir and creates
+/// nothing; Add collects files in memory; Commit writes them and the manifest in one
+/// WriteFilesAtomic (a failure leaves the directory as it was), then removes the files of the
+/// previous manifest this run did not write. Without Commit (an exception on the way) the
+/// destructor removes the staging folder and the directory itself if this object created it.
+/// Killed (kill -9) before Commit, a run leaves the directory as it was plus hidden whirl
+/// temporaries (".whirl-stage-<pid>-<n>"); killed inside Commit, see WriteFilesAtomic. The next
+/// run ignores them and its Commit removes them.
+class OutputDir {
+ public:
+  OutputDir(std::filesystem::path dir, std::string what);
+  ~OutputDir();
+  OutputDir(const OutputDir&) = delete;
+  OutputDir& operator=(const OutputDir&) = delete;
+
+  const std::filesystem::path& path() const { return dir_; }
+
+  /// Creates the directory (and its parents) unless it exists; returns path().
+  const std::filesystem::path& Create();
+
+  /// A file of the output: `name` is one path component (no '/', not the manifest), given once.
+  void Add(const std::string& name, std::string contents);
+
+  /// An entry written by its own OutputDir during this run (the demo's report/ sub-directory):
+  /// listed in the manifest, never written by Commit.
+  void Keep(const std::string& name);
+
+  /// A folder inside the directory (".whirl-stage-<pid>-<n>", created on the first call) holding
+  /// a copy of every file added, before and after the call, for a program that reads them and
+  /// writes its own files there (gnuplot); removed by Commit or the destructor.
+  const std::filesystem::path& Staging();
+
+  /// Adds the file `name` a program wrote into Staging() (binary safe).
+  void AddStaged(const std::string& name);
+
+  /// Writes every added file, the manifest and `also` (files outside the directory, e.g. the
+  /// --out JSON beside a --report) all-or-nothing; re-checks the rule first. Returns the paths
+  /// of the added files.
+  std::vector<std::filesystem::path> Commit(
+      const std::vector<std::pair<std::filesystem::path, std::string>>& also = {});
+
+ private:
+  void Insert(const std::string& name, std::string contents);  // checks the name, keeps it
+
+  std::filesystem::path dir_;
+  std::string what_;
+  std::vector<std::pair<std::string, std::string>> files_;
+  std::set<std::string> names_;  ///< of files_
+  std::vector<std::string> kept_;
+  std::filesystem::path staging_;
+  bool created_ = false, committed_ = false;
+};
+
+/// A path given on the command line and its flag, for messages.
+struct FlagPath {
+  std::string flag;  ///< e.g. "--run"
+  std::filesystem::path path;
+};
+
+/// Refuses, before a command reads or writes anything, any output that would overwrite one of its
+/// inputs or another output. Paths are compared as canonical absolute paths (through symbolic
+/// links, "./" and ".."; an output that does not exist yet by its existing parent) and by device
+/// and inode (hard links). Refused, with an InputError naming both flags and the path:
+///  - an output file that is an input, or another output file;
+///  - an input or an output file inside an output directory (whirl replaces and removes the files
+///    it wrote there), or two output directories that are the same or nested.
+/// Then each output file must pass CheckOutputFile (core/atomic_file.h) and each output directory
+/// CheckOutputDir. Entries with an empty path (flags not given) are skipped.
+void CheckOutputs(const std::vector<FlagPath>& inputs, const std::vector<FlagPath>& files,
+                  const std::vector<FlagPath>& dirs = {});
+
+}  // namespace whirl

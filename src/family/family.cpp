@@ -1,0 +1,505 @@
+#include "family/family.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+#include "core/error.h"
+#include "core/numbers.h"
+#include "core/parallel.h"
+
+namespace whirl::family {
+namespace {
+
+constexpr double kOneSigma = 0.6827;  // share of a normal within +-1 sd
+
+std::string KernelShort(gp::Kernel k) {
+  return k == gp::Kernel::kSquaredExponential ? "se" : "matern52";
+}
+
+// The table with its inputs and targets mapped through `t` (a table in the transformed space).
+ProcessTable TransformedTable(const ProcessTable& table, const TableTransform& t) {
+  const Eigen::MatrixXd x = TransformInputs(t, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd y = TransformTargets(t, nn::TargetMatrix(table.targets));
+  ProcessTable out;
+  out.source = table.source;
+  for (Eigen::Index q = 0; q < x.cols(); ++q) {
+    std::array<double, ProcessInputs::kCount> a{};
+    std::array<double, Features::kCount> f{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = x(i, q);
+    for (int k = 0; k < Features::kCount; ++k) f[k] = y(k, q);
+    out.inputs.push_back(ProcessInputs::FromArray(a));
+    out.targets.push_back(Features::FromArray(f));
+  }
+  return out;
+}
+
+nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions& o,
+                     bool calibrate) {
+  nn::ModelTrainOptions m = nn::DefaultTrainingOptions();
+  m.seed = o.seed;
+  m.restarts = o.network_restarts;
+  m.threads = o.threads;
+  m.noise_folds = calibrate ? o.network_noise_folds : 0;
+  if (c.hidden != Candidate::kHiddenByEvidence) {
+    m.hidden_candidates.clear();
+    m.hidden_by_evidence = false;
+    m.hidden_sizes = nn::HiddenLayers(c.hidden);
+    if (c.hidden == 0) m.restarts = 1;
+  }
+  return nn::TrainModel(t, m, t.source);
+}
+
+// Held-out residuals r and latent variances v (units of y) of K-fold refits, row q held out in
+// fold q % K; fit_predict(train rows, held-out rows, &mean, &latent variance).
+using FoldFitPredict = std::function<void(const Eigen::VectorXi&, const Eigen::VectorXi&,
+                                          Eigen::VectorXd*, Eigen::VectorXd*)>;
+void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FoldFitPredict& fit_predict,
+                    Eigen::VectorXd* r, Eigen::VectorXd* v) {
+  const int n = static_cast<int>(y.size()), k = std::min(folds, n);
+  r->resize(n);
+  v->resize(n);
+  for (int f = 0; f < k; ++f) {
+    std::vector<int> tr, te;
+    for (int q = 0; q < n; ++q) (q % k == f ? te : tr).push_back(q);
+    const Eigen::VectorXi tri =
+        Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
+    const Eigen::VectorXi tei =
+        Eigen::Map<Eigen::VectorXi>(te.data(), static_cast<Eigen::Index>(te.size()));
+    Eigen::VectorXd mean, latent;
+    fit_predict(tri, tei, &mean, &latent);
+    (*r)(tei) = y(tei) - mean;
+    (*v)(tei) = latent;
+  }
+}
+
+gp::GpOptions CandidateGpOptions(const FitOptions& o, const Candidate& c) {
+  gp::GpOptions go = o.gp;
+  go.kernel = c.kernel;
+  go.mean = c.mean;
+  return go;
+}
+
+// Output k of a linear or GP candidate fitted on (x, y): held-out residuals r and latent variances
+// v (transformed units) by closed-form leave-one-out (folds == 0) or K-fold refits (a GP from the
+// full fit's hyperparameters, one start).
+struct HeldOut {
+  Eigen::VectorXd r, v;
+};
+HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
+                      const Eigen::VectorXd& y, const FitOptions& o, int folds) {
+  HeldOut h;
+  const bool linear = m.candidate.family == Family::kLinear;
+  if (folds == 0 && linear) {
+    const LinearLeaveOneOut loo = LeaveOneOutLinear(m.linears[k], x, y);
+    return {loo.residual, loo.latent_variance};
+  }
+  if (folds == 0) {
+    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(m.gps[k]);
+    return {loo.residual, loo.latent_variance};
+  }
+  const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
+  KFoldResiduals(
+      y, folds,
+      [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te, Eigen::VectorXd* mean,
+          Eigen::VectorXd* latent) {
+        if (linear) {
+          const LinearPrediction p =
+              PredictLinear(FitLinear(x(Eigen::all, tr), y(tr)), x(Eigen::all, te));
+          *mean = p.mean;
+          *latent = p.latent_variance;
+          return;
+        }
+        const gp::GpPrediction p = gp::PredictGp(
+            gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta), x(Eigen::all, te));
+        *mean = p.mean;
+        *latent = p.latent_variance;
+      },
+      &h.r, &h.v);
+  return h;
+}
+
+// The noise of output k from its held-out residuals (CoverageNoiseVariance).
+void SetNoise(const HeldOut& h, int k, FamilyModel* m) {
+  const double s2 = CoverageNoiseVariance(h.r, h.v);
+  if (m->candidate.family == Family::kLinear)
+    m->linears[k].noise_variance = s2;
+  else
+    m->gps[k].noise_variance = s2 / (m->gps[k].target_scale * m->gps[k].target_scale);
+}
+
+std::string CalibrationText(int folds) {
+  return "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
+         "covers 68.27 % of the " +
+         (folds == 0 ? std::string("closed-form leave-one-out residuals")
+                     : std::to_string(folds) + "-fold cross-validation residuals (refits)");
+}
+
+// Squared held-out errors in original units, t_ik - g^-1(z_ik - r_ik), of output k.
+Eigen::RowVectorXd OriginalSquaredErrors(const FamilyModel& m, int k, const Eigen::RowVectorXd& t,
+                                         const Eigen::VectorXd& z, const HeldOut& h) {
+  Eigen::RowVectorXd sq(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double e = t(i) - Inverse(m.transform.outputs[k], z(i) - h.r(i));
+    sq(i) = e * e;
+  }
+  return sq;
+}
+
+std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o) {
+  const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
+  gp::GpOptions go = o.gp;
+  go.kernel = c.kernel;
+  go.mean = c.mean;
+  std::vector<gp::Gp> gps(static_cast<std::size_t>(y.rows()));
+  for (Eigen::Index k = 0; k < y.rows(); ++k) {
+    gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
+  }
+  return gps;
+}
+
+std::vector<LinearModel> FitLinears(const ProcessTable& t) {
+  const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
+  std::vector<LinearModel> fits;
+  for (Eigen::Index k = 0; k < y.rows(); ++k) fits.push_back(FitLinear(x, y.row(k).transpose()));
+  return fits;
+}
+
+// Means (2 x Q) in the transformed space.
+Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<ProcessInputs>& z,
+                                 Eigen::MatrixXd* sd) {
+  Eigen::MatrixXd mean(Features::kCount, z.size());
+  sd->resize(Features::kCount, z.size());
+  if (m.candidate.family == Family::kNetwork) {
+    const std::vector<nn::Prediction> p = nn::PredictBatch(m.network, z);
+    for (std::size_t q = 0; q < p.size(); ++q)
+      for (int k = 0; k < Features::kCount; ++k) {
+        mean(k, q) = p[q].mean.ToArray()[k];
+        (*sd)(k, q) = p[q].stddev.ToArray()[k];
+      }
+    return mean;
+  }
+  const Eigen::MatrixXd x = nn::InputMatrix(z);
+  for (int k = 0; k < Features::kCount && m.candidate.family == Family::kLinear; ++k) {
+    const LinearPrediction p = PredictLinear(m.linears[k], x);
+    mean.row(k) = p.mean.transpose();
+    sd->row(k) =
+        (p.latent_variance.array() + m.linears[k].noise_variance).sqrt().matrix().transpose();
+  }
+  for (int k = 0; k < Features::kCount && m.candidate.family == Family::kGaussianProcess; ++k) {
+    const gp::GpPrediction p = gp::PredictGp(m.gps[k], x);
+    mean.row(k) = p.mean.transpose();
+    sd->row(k) = p.Stddev().transpose();
+  }
+  return mean;
+}
+
+ProcessTable Rows(const ProcessTable& table, int folds, int fold, bool held_out) {
+  ProcessTable out;
+  out.source = table.source;
+  for (std::size_t i = 0; i < table.inputs.size(); ++i)
+    if ((static_cast<int>(i) % folds == fold) == held_out) {
+      out.inputs.push_back(table.inputs[i]);
+      out.targets.push_back(table.targets[i]);
+    }
+  return out;
+}
+
+// Squared held-out errors (2 x rows, original units) of one candidate's fold fit.
+void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
+                int fold, Eigen::MatrixXd* sq) {
+  const ProcessTable train = Rows(table, folds, fold, false), held = Rows(table, folds, fold, true);
+  const FamilyModel m = FitCandidate(train, c, o, false);
+  const std::vector<FamilyPrediction> p = PredictFamily(m, held.inputs);
+  for (std::size_t i = 0, row = 0; row < table.inputs.size(); ++row) {
+    if (static_cast<int>(row) % folds != fold) continue;
+    for (int k = 0; k < Features::kCount; ++k) {
+      const double e = held.targets[i].ToArray()[k] - p[i].mean.ToArray()[k];
+      (*sq)(k, static_cast<Eigen::Index>(row)) = e * e;
+    }
+    ++i;
+  }
+}
+
+void CheckTable(const ProcessTable& table);
+
+// Folds of the held-out errors of linear and GP candidates: 0 = closed-form leave-one-out.
+int HeldOutFolds(const ChoiceOptions& o, int folds) { return o.closed_form_loo ? 0 : folds; }
+// The choice's held-out residuals are the calibration's when both use the same folds.
+bool ReusesCalibration(const ChoiceOptions& o, int folds) {
+  return HeldOutFolds(o, folds) == std::min(o.fit.calibration_folds, folds);
+}
+
+// Fits (or takes from `full`, the closed-form fits) each distinct chosen candidate on all rows,
+// with calibration.
+void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
+               std::vector<FamilyModel>& full, Choice* choice) {
+  std::vector<int> fitted;
+  for (int k = 0; k < Features::kCount; ++k) {
+    const auto it = std::find(fitted.begin(), fitted.end(), choice->chosen[k]);
+    choice->model_of_output[k] = static_cast<int>(it - fitted.begin());
+    if (it != fitted.end()) continue;
+    const int c = choice->chosen[k];
+    fitted.push_back(c);
+    if (options.candidates[c].family != Family::kNetwork) {
+      const int folds = std::min(options.folds, static_cast<int>(table.inputs.size()));
+      if (!ReusesCalibration(options, folds)) Calibrate(table, options.fit, &full[c]);
+      choice->models.push_back(std::move(full[c]));
+    } else {
+      choice->models.push_back(FitCandidate(table, options.candidates[c], options.fit, true));
+    }
+  }
+}
+
+void CheckTable(const ProcessTable& table) {
+  if (table.targets.size() != table.inputs.size())
+    throw InputError(table.source + ": the training table needs the target columns " +
+                     kTargetColumns[0] + " and " + kTargetColumns[1]);
+  if (table.inputs.size() < 4)
+    throw InputError(table.source + ": " + std::to_string(table.inputs.size()) +
+                     " training rows; choosing a model family needs at least 4");
+}
+
+}  // namespace
+
+std::string Candidate::Name() const {
+  const std::string t = log ? "/log" : "/identity";
+  if (family == Family::kLinear) return "linear" + t;
+  if (family == Family::kNetwork)
+    return (hidden == kHiddenByEvidence ? std::string("network-evidence")
+                                        : "network-h" + std::to_string(hidden)) +
+           t;
+  return "gp-" + KernelShort(kernel) + "-" + gp::ToString(mean) + t;
+}
+
+Candidate ParseCandidate(const std::string& name) {
+  const auto slash = name.rfind('/');
+  const std::string bad = "candidate '" + name +
+                          "': must be linear, network-evidence, network-hN or gp-(se|matern52)-"
+                          "(constant|linear), then /identity or /log";
+  if (slash == std::string::npos) throw InputError(bad);
+  Candidate c;
+  const std::string body = name.substr(0, slash), t = name.substr(slash + 1);
+  if (t != "log" && t != "identity") throw InputError(bad);
+  c.log = t == "log";
+  c.family = Family::kLinear;
+  if (c.Name() == name) return c;
+  for (const Family f : {Family::kNetwork, Family::kGaussianProcess}) {
+    c.family = f;
+    for (int h = Candidate::kHiddenByEvidence; h <= 64 && f == Family::kNetwork; ++h) {
+      c.hidden = h;
+      if (c.Name() == name) return c;
+    }
+    for (const auto k : {gp::Kernel::kSquaredExponential, gp::Kernel::kMatern52})
+      for (const auto m : {gp::Mean::kConstant, gp::Mean::kLinear}) {
+        c.kernel = k;
+        c.mean = m;
+        if (f == Family::kGaussianProcess && c.Name() == name) return c;
+      }
+  }
+  throw InputError(bad);
+}
+
+FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
+                         const FitOptions& options, bool calibrate) {
+  CheckTable(table);
+  FamilyModel m;
+  m.candidate = candidate;
+  if (candidate.log) m.transform = LogWherePositive(table);
+  const ProcessTable t = TransformedTable(table, m.transform);
+  if (candidate.family == Family::kNetwork) {
+    m.network = FitNetwork(t, candidate, options, calibrate);
+    m.calibration = m.network.noise_calibration;
+  } else {
+    if (candidate.family == Family::kLinear)
+      m.linears = FitLinears(t);
+    else
+      m.gps = FitGps(t, candidate, options);
+    if (calibrate) Calibrate(table, options, &m);
+  }
+  return m;
+}
+
+void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
+  const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
+  for (int k = 0; k < Features::kCount; ++k)
+    SetNoise(OutputHeldOut(*m, k, x, y.row(k).transpose(), options, options.calibration_folds), k,
+             m);
+  m->calibration = CalibrationText(options.calibration_folds);
+}
+
+Eigen::MatrixXd HeldOutSquaredErrors(const ProcessTable& table, const FitOptions& options,
+                                     int folds, FamilyModel* m, bool calibrate) {
+  if (m->candidate.family == Family::kNetwork)
+    throw InputError("held-out errors of a fitted model: not available for " + m->candidate.Name());
+  const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::MatrixXd y = TransformTargets(m->transform, t);
+  Eigen::MatrixXd sq(t.rows(), t.cols());
+  for (int k = 0; k < Features::kCount; ++k) {
+    const HeldOut h = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds);
+    sq.row(k) = OriginalSquaredErrors(*m, k, t.row(k), y.row(k).transpose(), h);
+    if (calibrate) SetNoise(h, k, m);
+  }
+  if (calibrate) m->calibration = CalibrationText(folds);
+  return sq;
+}
+
+Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTable& table) {
+  FamilyModel copy = m;
+  return HeldOutSquaredErrors(table, {}, 0, &copy, false);
+}
+
+std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
+                                            const std::vector<ProcessInputs>& inputs) {
+  std::vector<FamilyPrediction> out(inputs.size());
+  if (inputs.empty()) return out;
+  const Eigen::MatrixXd z = TransformInputs(model.transform, nn::InputMatrix(inputs));
+  std::vector<ProcessInputs> zi;
+  for (Eigen::Index q = 0; q < z.cols(); ++q) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = z(i, q);
+    zi.push_back(ProcessInputs::FromArray(a));
+  }
+  Eigen::MatrixXd sd;
+  const Eigen::MatrixXd mean = TransformedMeans(model, zi, &sd);
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    std::array<double, Features::kCount> m{}, s{};
+    for (int k = 0; k < Features::kCount; ++k) {
+      const MeanSd back = MapBack(model.transform.outputs[k], mean(k, q), sd(k, q));
+      m[k] = back.mean;
+      s[k] = back.sd;
+    }
+    out[q] = {Features::FromArray(m), Features::FromArray(s)};
+  }
+  return out;
+}
+
+int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors) {
+  if (squared_errors.empty()) throw InputError("one-standard-error rule: no candidates");
+  std::size_t best = 0;
+  for (std::size_t c = 1; c < squared_errors.size(); ++c)
+    if (squared_errors[c].mean() < squared_errors[best].mean()) best = c;
+  for (std::size_t c = 0; c < squared_errors.size(); ++c) {
+    const Eigen::ArrayXd d = (squared_errors[c] - squared_errors[best]).array();
+    const double n = static_cast<double>(d.size()), mean = d.mean();
+    const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
+    if (mean <= se) return static_cast<int>(c);
+  }
+  return static_cast<int>(best);
+}
+
+double CoverageNoiseVariance(const Eigen::VectorXd& residual,
+                             const Eigen::VectorXd& latent_variance) {
+  if (residual.size() == 0 || residual.size() != latent_variance.size())
+    throw InputError("noise calibration: " + std::to_string(residual.size()) + " residuals and " +
+                     std::to_string(latent_variance.size()) + " variances; need equal, > 0");
+  const Eigen::ArrayXd r2 = residual.array().square();
+  auto coverage = [&](double s2) {
+    return (r2 <= s2 + latent_variance.array()).cast<double>().mean();
+  };
+  double lo = 0.0, hi = r2.maxCoeff() + 1e-300;
+  if (coverage(lo) >= kOneSigma) return 0.0;
+  for (int it = 0; it < 200 && hi > lo; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (coverage(mid) >= kOneSigma ? hi : lo) = mid;
+  }
+  return hi;
+}
+
+void to_json(nlohmann::json& j, const CvRow& r) {
+  j = {{"candidate", r.candidate.Name()},
+       {"cv_rmse", std::vector<double>(r.cv_rmse.data(), r.cv_rmse.data() + r.cv_rmse.size())},
+       {"score", r.score},
+       {"fit_ms", r.fit_ms}};
+}
+
+std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
+  std::vector<Candidate> c;
+  for (const char* name : {"linear/log", "linear/identity", "gp-matern52-constant/log",
+                           "gp-matern52-constant/identity"})
+    c.push_back(ParseCandidate(name));
+  return c;
+}
+
+Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
+  CheckTable(table);
+  if (options.candidates.empty()) throw InputError("family choice: no candidates");
+  const int rows = static_cast<int>(table.inputs.size());
+  const int folds = std::min(options.folds, rows), nc = static_cast<int>(options.candidates.size());
+  if (folds < 2)
+    throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
+  std::vector<Eigen::MatrixXd> sq(static_cast<std::size_t>(nc),
+                                  Eigen::MatrixXd(Features::kCount, rows));
+  std::vector<double> ms(static_cast<std::size_t>(nc * folds));
+  FitOptions fold_options = options.fit;
+  fold_options.threads = 1;
+  std::vector<FamilyModel> full(static_cast<std::size_t>(nc));  // closed-form LOO fits
+  ParallelFor(static_cast<std::size_t>(nc * folds), options.fit.threads, [&](std::size_t i) {
+    const auto start = std::chrono::steady_clock::now();
+    const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
+    if (options.candidates[c].family == Family::kNetwork) {
+      FoldErrors(table, options.candidates[c], fold_options, folds, f, &sq[c]);
+    } else if (f == 0) {  // one full fit, its held-out errors (and calibration) from it
+      full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
+      sq[c] = HeldOutSquaredErrors(table, fold_options, HeldOutFolds(options, folds), &full[c],
+                                   ReusesCalibration(options, folds));
+    }
+    ms[i] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  });
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::ArrayXd var =
+      ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows).array().max(1e-300);
+  Choice choice;
+  for (int c = 0; c < nc; ++c) {
+    CvRow r;
+    r.candidate = options.candidates[c];
+    const Eigen::ArrayXd mse = sq[c].rowwise().mean().array();
+    r.cv_rmse = mse.sqrt().matrix();
+    r.score = (mse / var).sum();
+    for (int f = 0; f < folds; ++f) r.fit_ms += ms[c * folds + f];
+    choice.table.push_back(r);
+    for (int k = 0; k < Features::kCount; ++k) {
+      const CvRow& best = choice.table[choice.chosen[k]];
+      if (options.per_output ? r.cv_rmse(k) < best.cv_rmse(k) : r.score < best.score)
+        choice.chosen[k] = c;
+    }
+  }
+  for (int k = 0; k < Features::kCount && options.per_output && options.one_standard_error; ++k) {
+    std::vector<Eigen::VectorXd> output_sq;
+    for (const Eigen::MatrixXd& m : sq) output_sq.push_back(m.row(k).transpose());
+    choice.chosen[k] = SimplestWithinOneStandardError(output_sq);
+  }
+  FitChosen(table, options, full, &choice);
+  return choice;
+}
+
+std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
+                                            const std::vector<ProcessInputs>& inputs) {
+  std::vector<std::vector<FamilyPrediction>> per_model;
+  for (const FamilyModel& m : choice.models) per_model.push_back(PredictFamily(m, inputs));
+  std::vector<FamilyPrediction> out(inputs.size());
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    std::array<double, Features::kCount> mean{}, sd{};
+    for (int k = 0; k < Features::kCount; ++k) {
+      const FamilyPrediction& p = per_model[choice.model_of_output[k]][q];
+      mean[k] = p.mean.ToArray()[k];
+      sd[k] = p.stddev.ToArray()[k];
+    }
+    out[q] = {Features::FromArray(mean), Features::FromArray(sd)};
+  }
+  return out;
+}
+
+std::string Choice::Describe() const {
+  std::string s;
+  for (int k = 0; k < Features::kCount; ++k)
+    s += (k ? ", " : "") + std::string(kTargetColumns[k]) + ": " +
+         table.at(chosen[k]).candidate.Name();
+  return s;
+}
+
+}  // namespace whirl::family

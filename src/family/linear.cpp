@@ -1,0 +1,121 @@
+#include "family/linear.h"
+
+#include <Eigen/QR>
+#include <cmath>
+#include <vector>
+
+#include "core/error.h"
+
+namespace whirl::family {
+namespace {
+
+Eigen::MatrixXd Design(const LinearModel& m, const Eigen::MatrixXd& x) {
+  Eigen::MatrixXd a(x.cols(), x.rows() + 1);
+  a.col(0).setOnes();
+  a.rightCols(x.rows()) =
+      (m.input_scale.cwiseInverse().asDiagonal() * (x.colwise() - m.input_shift)).transpose();
+  return a;
+}
+
+Eigen::VectorXd ToVector(const nlohmann::json& j, const char* key) {
+  if (!j.contains(key) || !j.at(key).is_array())
+    throw InputError(std::string("linear model: '") + key + "' must be an array");
+  Eigen::VectorXd v(static_cast<Eigen::Index>(j.at(key).size()));
+  for (std::size_t i = 0; i < j.at(key).size(); ++i) {
+    const auto& e = j.at(key)[i];
+    if (!e.is_number() || !std::isfinite(e.get<double>()))
+      throw InputError(std::string("linear model: '") + key + "'[" + std::to_string(i) +
+                       "] must be a finite number");
+    v(static_cast<Eigen::Index>(i)) = e.get<double>();
+  }
+  return v;
+}
+
+std::vector<double> ToStd(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+}  // namespace
+
+LinearModel FitLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+  const Eigen::Index d = x.rows(), n = x.cols();
+  if (y.size() != n || !x.allFinite() || !y.allFinite())
+    throw InputError("linear model: " + std::to_string(n) + " input columns and " +
+                     std::to_string(y.size()) + " targets; need equal sizes and finite values");
+  if (n <= d + 2)
+    throw InputError("linear model: " + std::to_string(n) + " rows for " + std::to_string(d + 1) +
+                     " coefficients; needs at least " + std::to_string(d + 3));
+  LinearModel m;
+  m.input_shift = x.rowwise().mean();
+  m.input_scale =
+      ((x.colwise() - m.input_shift).rowwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt();
+  for (Eigen::Index i = 0; i < d; ++i)
+    if (!(m.input_scale(i) > 0)) m.input_scale(i) = 1.0;
+  const Eigen::MatrixXd a = Design(m, x);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+  m.coef = qr.solve(y);
+  m.ata_inv = (a.transpose() * a).ldlt().solve(Eigen::MatrixXd::Identity(d + 1, d + 1));
+  m.fitted_noise_variance = (y - a * m.coef).squaredNorm() / static_cast<double>(n - d - 1);
+  m.noise_variance = m.fitted_noise_variance;
+  return m;
+}
+
+LinearPrediction PredictLinear(const LinearModel& m, const Eigen::MatrixXd& x) {
+  if (x.rows() != m.input_shift.size())
+    throw InputError("linear model: predictions need " + std::to_string(m.input_shift.size()) +
+                     " inputs, got " + std::to_string(x.rows()));
+  const Eigen::MatrixXd a = Design(m, x);
+  LinearPrediction p;
+  p.mean = a * m.coef;
+  p.latent_variance = m.fitted_noise_variance * (a * m.ata_inv).cwiseProduct(a).rowwise().sum();
+  return p;
+}
+
+LinearLeaveOneOut LeaveOneOutLinear(const LinearModel& m, const Eigen::MatrixXd& x,
+                                    const Eigen::VectorXd& y) {
+  const Eigen::MatrixXd a = Design(m, x);
+  const Eigen::ArrayXd h = (a * m.ata_inv).cwiseProduct(a).rowwise().sum().array();
+  const Eigen::ArrayXd e = (y - a * m.coef).array();
+  const Eigen::ArrayXd one_minus = (1.0 - h).max(1e-12);
+  return {(e / one_minus).matrix(), (m.fitted_noise_variance * h / one_minus).matrix()};
+}
+
+void to_json(nlohmann::json& j, const LinearModel& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index r = 0; r < m.ata_inv.rows(); ++r) rows.push_back(ToStd(m.ata_inv.row(r)));
+  j = {{"input_shift", ToStd(m.input_shift)},
+       {"input_scale", ToStd(m.input_scale)},
+       {"coef", ToStd(m.coef)},
+       {"ata_inv", rows},
+       {"fitted_noise_variance", m.fitted_noise_variance},
+       {"noise_variance", m.noise_variance}};
+}
+
+void from_json(const nlohmann::json& j, LinearModel& m) {
+  if (!j.is_object()) throw InputError("linear model: must be a JSON object");
+  m.input_shift = ToVector(j, "input_shift");
+  m.input_scale = ToVector(j, "input_scale");
+  m.coef = ToVector(j, "coef");
+  const Eigen::Index p = m.coef.size();
+  if (m.input_scale.size() != m.input_shift.size() || p != m.input_shift.size() + 1 ||
+      !(m.input_scale.array() > 0).all())
+    throw InputError(
+        "linear model: 'input_scale' (> 0) and 'coef' (inputs + 1) must match 'input_shift'");
+  if (!j.contains("ata_inv") || !j.at("ata_inv").is_array() ||
+      j.at("ata_inv").size() != static_cast<std::size_t>(p))
+    throw InputError("linear model: 'ata_inv' must hold " + std::to_string(p) + " rows");
+  m.ata_inv.resize(p, p);
+  for (Eigen::Index r = 0; r < p; ++r) {
+    const Eigen::VectorXd row = ToVector(nlohmann::json{{"row", j.at("ata_inv")[r]}}, "row");
+    if (row.size() != p)
+      throw InputError("linear model: 'ata_inv' rows must hold " + std::to_string(p) + " values");
+    m.ata_inv.row(r) = row.transpose();
+  }
+  for (const char* key : {"fitted_noise_variance", "noise_variance"})
+    if (!j.contains(key) || !j.at(key).is_number() || !(j.at(key).get<double>() >= 0))
+      throw InputError(std::string("linear model: '") + key + "' must be a number >= 0");
+  m.fitted_noise_variance = j.at("fitted_noise_variance").get<double>();
+  m.noise_variance = j.at("noise_variance").get<double>();
+}
+
+}  // namespace whirl::family

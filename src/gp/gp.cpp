@@ -1,0 +1,360 @@
+#include "gp/gp.h"
+
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/json_file.h"
+#include "core/numbers.h"
+
+namespace whirl::gp {
+namespace {
+
+constexpr double kSqrt5 = 2.2360679774997896964;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Kernel values K_f(p, q) and, in g, the factor with dK_f/d ln l_i = g * (dz_i / l_i)^2.
+void KernelMatrices(Kernel kernel, const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                    const Eigen::VectorXd& length, double sf2, Eigen::MatrixXd* kf,
+                    Eigen::MatrixXd* g) {
+  const Eigen::MatrixXd as = length.cwiseInverse().asDiagonal() * a;
+  const Eigen::MatrixXd bs = length.cwiseInverse().asDiagonal() * b;
+  Eigen::MatrixXd r2 =
+      (-2.0 * as.transpose() * bs).colwise() + as.colwise().squaredNorm().transpose();
+  r2.rowwise() += bs.colwise().squaredNorm();
+  r2 = r2.cwiseMax(0.0);
+  if (kernel == Kernel::kSquaredExponential) {
+    *kf = sf2 * (-0.5 * r2.array()).exp().matrix();
+    if (g) *g = *kf;
+    return;
+  }
+  const Eigen::ArrayXXd r = r2.array().sqrt(), e = (-kSqrt5 * r).exp();
+  *kf = (sf2 * (1.0 + kSqrt5 * r + (5.0 / 3.0) * r2.array()) * e).matrix();
+  if (g) *g = (sf2 * (5.0 / 3.0) * (1.0 + kSqrt5 * r) * e).matrix();
+}
+
+// H: n x m basis of the mean at the columns of z.
+Eigen::MatrixXd Basis(Mean mean, const Eigen::MatrixXd& z) {
+  Eigen::MatrixXd h(z.cols(), MeanSize(mean, static_cast<int>(z.rows())));
+  h.col(0).setOnes();
+  if (mean == Mean::kLinear) h.rightCols(z.rows()) = z.transpose();
+  return h;
+}
+
+// Everything NLML and its gradient need at one theta; false if K or H'K^-1H is not PD.
+struct Factors {
+  Eigen::MatrixXd kf, g;
+  Eigen::LLT<Eigen::MatrixXd> chol, a_chol;
+  Eigen::MatrixXd k_inv_h;
+  Eigen::VectorXd b, alpha, r;
+};
+bool Factor(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::VectorXd& u,
+            const Eigen::VectorXd& theta, double noise2, bool with_g, Factors* f) {
+  const int d = static_cast<int>(z.rows());
+  const Eigen::VectorXd length = theta.head(d).array().exp();
+  const double sf2 = std::exp(2.0 * theta(d));
+  if (!length.allFinite() || !std::isfinite(sf2) || !std::isfinite(noise2)) return false;
+  KernelMatrices(kernel, z, z, length, sf2, &f->kf, with_g ? &f->g : nullptr);
+  Eigen::MatrixXd k = f->kf;
+  k.diagonal().array() += noise2;
+  f->chol.compute(k);
+  if (f->chol.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd h = Basis(mean, z);
+  f->k_inv_h = f->chol.solve(h);
+  f->a_chol.compute(h.transpose() * f->k_inv_h);
+  if (f->a_chol.info() != Eigen::Success) return false;
+  f->b = f->a_chol.solve(f->k_inv_h.transpose() * u);
+  f->r = u - h * f->b;
+  f->alpha = f->chol.solve(f->r);
+  return f->alpha.allFinite();
+}
+
+// -tr(W dK/dtheta_j) / 2 for every j, W = alpha alpha' - K^-1 (R&W eq. 5.9).
+Eigen::VectorXd Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn2_dtheta,
+                         const Factors& f) {
+  const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
+  const Eigen::MatrixXd w =
+      f.alpha * f.alpha.transpose() - f.chol.solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::MatrixXd wg = w.cwiseProduct(f.g);
+  Eigen::VectorXd grad(d + 2);
+  for (int i = 0; i < d; ++i) {
+    const Eigen::ArrayXd zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
+    double s = 0;
+    for (int q = 0; q < n; ++q) s += (wg.col(q).array() * (zi - zi(q)).square()).sum();
+    grad(i) = -0.5 * s * std::exp(-2.0 * theta(i));
+  }
+  grad(d) = -w.cwiseProduct(f.kf).sum();
+  grad(d + 1) = -0.5 * w.trace() * dsn2_dtheta;
+  return grad;
+}
+
+void ValidateData(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, Mean mean) {
+  if (x.cols() != y.size())
+    throw InputError("gaussian process: " + std::to_string(x.cols()) + " input columns but " +
+                     std::to_string(y.size()) + " targets");
+  if (!x.allFinite() || !y.allFinite())
+    throw InputError("gaussian process: the training data hold a non-finite value");
+  const int m = MeanSize(mean, static_cast<int>(x.rows()));
+  if (y.size() <= m + 1)
+    throw InputError("gaussian process: " + std::to_string(y.size()) + " rows for a " +
+                     ToString(mean) + " mean with " + std::to_string(m) +
+                     " coefficients; needs at least " + std::to_string(m + 2));
+}
+
+// Standardization of the header comment (population sd; 1 for a constant column).
+Gp Standardized(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& o) {
+  Gp gp;
+  gp.kernel = o.kernel;
+  gp.mean = o.mean;
+  gp.min_noise_variance = o.min_noise_variance;
+  gp.input_shift = x.rowwise().mean();
+  const Eigen::MatrixXd xc = x.colwise() - gp.input_shift;
+  gp.input_scale = (xc.rowwise().squaredNorm() / static_cast<double>(x.cols())).cwiseSqrt();
+  for (Eigen::Index i = 0; i < gp.input_scale.size(); ++i)
+    if (!(gp.input_scale(i) > 0)) gp.input_scale(i) = 1.0;
+  gp.z = gp.input_scale.cwiseInverse().asDiagonal() * xc;
+  gp.target_shift = y.mean();
+  const double sd = std::sqrt((y.array() - gp.target_shift).square().mean());
+  gp.target_scale = sd > 0 ? sd : 1.0;
+  gp.u = (y.array() - gp.target_shift) / gp.target_scale;
+  return gp;
+}
+
+// Fixed starting points (length scale in standardized units, noise sd), signal sd 1.
+Eigen::VectorXd StartPoint(int index, int d) {
+  static const double kLength[kStartCount] = {1.0, 0.5, 2.0, 0.25};
+  static const double kNoise[kStartCount] = {0.1, 0.3, 0.03, 0.5};
+  Eigen::VectorXd theta(d + 2);
+  theta.head(d).setConstant(std::log(kLength[index] * std::sqrt(static_cast<double>(d))));
+  theta(d) = 0.0;
+  theta(d + 1) = std::log(kNoise[index]);
+  return theta;
+}
+
+// Minimizes NLML from each start; fills gp->theta with the best.
+void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp* gp,
+              GpSummary* summary) {
+  const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
+    return NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t, gp->min_noise_variance,
+                                    grad);
+  };
+  GpSummary s;
+  s.nlml = kInf;
+  for (const Eigen::VectorXd& start : starts) {
+    Eigen::VectorXd t = start;
+    const BfgsSummary b = MinimizeBfgs(f, &t, o.bfgs);
+    s.start_nlml.push_back(b.final_cost);
+    if (b.final_cost < s.nlml || gp->theta.size() == 0) {
+      s.nlml = b.final_cost;
+      s.optimizer = b;
+      gp->theta = t;
+    }
+  }
+  if (summary) *summary = s;
+}
+
+Gp FitFromStarts(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& o,
+                 const std::vector<Eigen::VectorXd>& starts, GpSummary* summary) {
+  o.Validate();
+  ValidateData(x, y, o.mean);
+  Gp gp = Standardized(x, y, o);
+  Optimize(o, starts, &gp, summary);
+  gp.noise_variance = gp.SigmaN2();
+  gp.Factorize();
+  return gp;
+}
+
+// A JSON array of finite numbers named `name` in messages.
+Eigen::VectorXd ArrayToVector(const nlohmann::json& a, const std::string& name) {
+  if (!a.is_array()) throw InputError("gaussian process: '" + name + "' must be an array");
+  Eigen::VectorXd v(static_cast<Eigen::Index>(a.size()));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!a[i].is_number() || !std::isfinite(a[i].get<double>()))
+      throw InputError("gaussian process: '" + name + "'[" + std::to_string(i) +
+                       "] must be a finite number");
+    v(static_cast<Eigen::Index>(i)) = a[i].get<double>();
+  }
+  return v;
+}
+
+Eigen::VectorXd JsonVector(const nlohmann::json& j, const char* key) {
+  if (!j.contains(key))
+    throw InputError("gaussian process: key '" + std::string(key) + "' missing");
+  return ArrayToVector(j.at(key), key);
+}
+
+}  // namespace
+
+std::string ToString(Kernel k) {
+  return k == Kernel::kSquaredExponential ? "squared_exponential" : "matern52";
+}
+std::string ToString(Mean m) { return m == Mean::kConstant ? "constant" : "linear"; }
+Kernel ParseKernel(const std::string& s) {
+  if (s == "squared_exponential") return Kernel::kSquaredExponential;
+  if (s == "matern52") return Kernel::kMatern52;
+  throw InputError("gaussian process kernel '" + s + "': must be squared_exponential or matern52");
+}
+Mean ParseMean(const std::string& s) {
+  if (s == "constant") return Mean::kConstant;
+  if (s == "linear") return Mean::kLinear;
+  throw InputError("gaussian process mean '" + s + "': must be constant or linear");
+}
+
+void GpOptions::Validate() const {
+  if (restarts < 1 || restarts > kStartCount)
+    throw InputError("gaussian process restarts " + std::to_string(restarts) + ": must be in 1.." +
+                     std::to_string(kStartCount));
+  if (!(min_noise_variance > 0) || !std::isfinite(min_noise_variance))
+    throw InputError("gaussian process min_noise_variance " + MessageNumber(min_noise_variance) +
+                     ": must be a finite number > 0");
+}
+
+int MeanSize(Mean mean, int inputs) { return mean == Mean::kConstant ? 1 : 1 + inputs; }
+
+double NegLogMarginalLikelihood(Kernel kernel, Mean mean, const Eigen::MatrixXd& z,
+                                const Eigen::VectorXd& u, const Eigen::VectorXd& theta,
+                                double min_noise_variance, Eigen::VectorXd* gradient) {
+  const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
+  const double sn2_free = std::exp(2.0 * theta(d + 1));
+  Factors f;
+  if (!Factor(kernel, mean, z, u, theta, sn2_free + min_noise_variance, gradient != nullptr, &f)) {
+    if (gradient) gradient->setConstant(theta.size(), kInf);
+    return kInf;
+  }
+  const double log_det_half = f.chol.matrixLLT().diagonal().array().log().sum();
+  const double nlml = 0.5 * f.r.dot(f.alpha) + log_det_half + 0.5 * n * std::log(2.0 * kPi);
+  if (gradient) *gradient = Gradient(z, theta, 2.0 * sn2_free, f);
+  return nlml;
+}
+
+double Gp::SigmaN2() const { return std::exp(2.0 * theta(InputCount() + 1)) + min_noise_variance; }
+
+void Gp::Factorize() {
+  Factors f;
+  if (!Factor(kernel, mean, z, u, theta, SigmaN2(), false, &f))
+    throw InputError("gaussian process: the covariance matrix is not positive definite");
+  chol = f.chol;
+  a_chol = f.a_chol;
+  k_inv_h = f.k_inv_h;
+  b = f.b;
+  alpha = f.alpha;
+}
+
+std::string GpSummary::BriefReport() const {
+  std::string starts;
+  for (double v : start_nlml) starts += (starts.empty() ? "" : ", ") + MessageNumber(v);
+  return "gp: nlml " + MessageNumber(nlml) + " (starts " + starts + "); " + optimizer.BriefReport();
+}
+
+Gp FitGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
+         GpSummary* summary) {
+  std::vector<Eigen::VectorXd> starts;
+  for (int i = 0; i < options.restarts; ++i)
+    starts.push_back(StartPoint(i, static_cast<int>(x.rows())));
+  return FitFromStarts(x, y, options, starts, summary);
+}
+
+Gp FitGpFrom(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
+             const Eigen::VectorXd& theta_start, GpSummary* summary) {
+  if (theta_start.size() != x.rows() + 2)
+    throw InputError("gaussian process: a warm start needs " + std::to_string(x.rows() + 2) +
+                     " hyperparameters, got " + std::to_string(theta_start.size()));
+  return FitFromStarts(x, y, options, {theta_start}, summary);
+}
+
+Eigen::VectorXd GpPrediction::Stddev() const {
+  return (latent_variance.array() + noise_variance).sqrt().matrix();
+}
+
+GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x) {
+  const int d = gp.InputCount();
+  if (x.rows() != d)
+    throw InputError("gaussian process: predictions need " + std::to_string(d) + " inputs, got " +
+                     std::to_string(x.rows()));
+  const Eigen::MatrixXd zs =
+      gp.input_scale.cwiseInverse().asDiagonal() * (x.colwise() - gp.input_shift);
+  const Eigen::VectorXd length = gp.theta.head(d).array().exp();
+  const double sf2 = std::exp(2.0 * gp.theta(d));
+  Eigen::MatrixXd ks;
+  KernelMatrices(gp.kernel, gp.z, zs, length, sf2, &ks, nullptr);  // n x q
+  const Eigen::MatrixXd hs = Basis(gp.mean, zs);                   // q x m
+  GpPrediction p;
+  p.mean = (hs * gp.b + ks.transpose() * gp.alpha).array() * gp.target_scale + gp.target_shift;
+  const Eigen::MatrixXd v = gp.chol.matrixL().solve(ks);
+  const Eigen::MatrixXd r = hs.transpose() - gp.k_inv_h.transpose() * ks;  // m x q
+  const Eigen::MatrixXd ar = gp.a_chol.matrixL().solve(r);
+  const Eigen::ArrayXd latent =
+      (sf2 - v.colwise().squaredNorm().array() + ar.colwise().squaredNorm().array()).max(0.0);
+  p.latent_variance = (latent * gp.target_scale * gp.target_scale).matrix();
+  p.noise_variance = gp.noise_variance * gp.target_scale * gp.target_scale;
+  return p;
+}
+
+LeaveOneOut LeaveOneOutGp(const Gp& gp) {
+  const int n = static_cast<int>(gp.u.size());
+  const Eigen::MatrixXd k_inv = gp.chol.solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::MatrixXd ah = gp.a_chol.matrixL().solve(gp.k_inv_h.transpose());  // m x n
+  const Eigen::ArrayXd p_diag =
+      k_inv.diagonal().array() - ah.colwise().squaredNorm().transpose().array();
+  LeaveOneOut loo;
+  loo.residual = (gp.alpha.array() / p_diag * gp.target_scale).matrix();
+  loo.latent_variance =
+      ((1.0 / p_diag - gp.SigmaN2()).max(0.0) * gp.target_scale * gp.target_scale).matrix();
+  return loo;
+}
+
+void to_json(nlohmann::json& j, const Gp& gp) {
+  auto vec = [](const Eigen::VectorXd& v) {
+    return std::vector<double>(v.data(), v.data() + v.size());
+  };
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index q = 0; q < gp.z.cols(); ++q) rows.push_back(vec(gp.z.col(q)));
+  j = {{"kernel", ToString(gp.kernel)},
+       {"mean", ToString(gp.mean)},
+       {"input_shift", vec(gp.input_shift)},
+       {"input_scale", vec(gp.input_scale)},
+       {"target_shift", gp.target_shift},
+       {"target_scale", gp.target_scale},
+       {"theta", vec(gp.theta)},
+       {"min_noise_variance", gp.min_noise_variance},
+       {"noise_variance", gp.noise_variance},
+       {"inputs_standardized", rows},
+       {"targets_standardized", vec(gp.u)}};
+}
+
+void from_json(const nlohmann::json& j, Gp& gp) {
+  const std::string what = "gaussian process";
+  if (!j.is_object()) throw InputError(what + ": must be a JSON object");
+  if (!j.contains("kernel") || !j.at("kernel").is_string() || !j.contains("mean") ||
+      !j.at("mean").is_string())
+    throw InputError(what + ": 'kernel' and 'mean' must be strings");
+  gp.kernel = ParseKernel(j.at("kernel").get<std::string>());
+  gp.mean = ParseMean(j.at("mean").get<std::string>());
+  gp.input_shift = JsonVector(j, "input_shift");
+  gp.input_scale = JsonVector(j, "input_scale");
+  gp.theta = JsonVector(j, "theta");
+  gp.u = JsonVector(j, "targets_standardized");
+  gp.target_shift = RequireNumber(j, "target_shift", what);
+  gp.target_scale = RequireNumber(j, "target_scale", what);
+  gp.min_noise_variance = RequireNumber(j, "min_noise_variance", what);
+  gp.noise_variance = RequireNumber(j, "noise_variance", what);
+  const auto d = gp.input_shift.size();
+  if (gp.input_scale.size() != d || gp.theta.size() != d + 2 || !(gp.input_scale.array() > 0).all())
+    throw InputError(what + ": input_scale (> 0) and theta (inputs + 2) must match input_shift");
+  if (!(gp.target_scale > 0) || !(gp.min_noise_variance > 0) || !(gp.noise_variance >= 0))
+    throw InputError(what +
+                     ": target_scale and min_noise_variance must be > 0, noise_variance >= 0");
+  if (!j.contains("inputs_standardized") || !j.at("inputs_standardized").is_array() ||
+      j.at("inputs_standardized").size() != static_cast<std::size_t>(gp.u.size()))
+    throw InputError(what + ": 'inputs_standardized' must hold one row per target");
+  gp.z.resize(d, gp.u.size());
+  for (Eigen::Index q = 0; q < gp.u.size(); ++q) {
+    const std::string name = "inputs_standardized[" + std::to_string(q) + "]";
+    const Eigen::VectorXd row = ArrayToVector(j.at("inputs_standardized")[q], name);
+    if (row.size() != d) throw InputError(what + ": '" + name + "' must hold one value per input");
+    gp.z.col(q) = row;
+  }
+  gp.Factorize();
+}
+
+}  // namespace whirl::gp

@@ -1,0 +1,96 @@
+// The family library's fits (src/family, src/gp) on the simulator's tables, beside one trainbr fit
+// and whirl's current default network fit in the same run, all on one thread:
+//   BM_FamilyDefault/rows:R/loo:L  ChooseFamily with the default candidates (the
+//                              cross-validated choice, then the chosen candidates' fits and
+//                              calibration); the speed target of the default is 2.5 ms CPU for
+//                              20 rows, both outputs;
+//   BM_FamilyCandidate/rows:R/candidate:C   FitCandidate of DefaultCandidates()[C] (with its
+//                              calibration; no choice);
+//   BM_TrainbrSingleFit/rows:R one nn::TrainModel of 5-6-2 with R brnn's stopping rule, no size
+//                              choice, no noise folds (the unit the README's speed figures use);
+//   BM_NetworkDefault/rows:R   nn::DefaultTrainingOptions() (size by evidence + 5 noise folds).
+// Tables: datasets/whirling_train.csv (20 rows); the first 100 rows of datasets/whirling_500.csv.
+#include <benchmark/benchmark.h>
+
+#include "core/process.h"
+#include "family/family.h"
+#include "nn/model.h"
+
+namespace {
+
+whirl::ProcessTable Table(int rows) {
+  const std::string dir = std::string(WHIRL_SOURCE_DIR) + "/datasets/";
+  whirl::ProcessTable t =
+      whirl::ReadProcessTable(dir + (rows <= 20 ? "whirling_train.csv" : "whirling_500.csv"), true);
+  t.inputs.resize(static_cast<std::size_t>(rows));
+  t.targets.resize(static_cast<std::size_t>(rows));
+  return t;
+}
+
+// Argument loo: ChoiceOptions::closed_form_loo (0: K-fold refits of each candidate's full fit;
+// 1: closed-form leave-one-out, then the chosen candidates' K-fold calibration).
+void BM_FamilyDefault(benchmark::State& state) {
+  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
+  whirl::family::ChoiceOptions o;
+  o.fit.threads = 1;
+  o.closed_form_loo = state.range(1) == 1;
+  for (auto _ : state) {
+    const whirl::family::Choice c = whirl::family::ChooseFamily(table, o);
+    benchmark::DoNotOptimize(c.chosen);
+  }
+}
+BENCHMARK(BM_FamilyDefault)
+    ->ArgNames({"rows", "loo"})
+    ->ArgsProduct({{20, 100}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_FamilyCandidate(benchmark::State& state) {
+  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
+  const auto candidates = whirl::family::ChoiceOptions::DefaultCandidates();
+  const auto& c = candidates.at(static_cast<std::size_t>(state.range(1)));
+  state.SetLabel(c.Name());
+  whirl::family::FitOptions o;
+  for (auto _ : state) {
+    const whirl::family::FamilyModel m = whirl::family::FitCandidate(table, c, o);
+    benchmark::DoNotOptimize(m.gps.size());
+  }
+}
+BENCHMARK(BM_FamilyCandidate)
+    ->ArgNames({"rows", "candidate"})
+    ->ArgsProduct(
+        {{20, 100},
+         benchmark::CreateDenseRange(
+             0, static_cast<int>(whirl::family::ChoiceOptions::DefaultCandidates().size()) - 1, 1)})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_TrainbrSingleFit(benchmark::State& state) {
+  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
+  whirl::nn::ModelTrainOptions o;
+  o.train.change = whirl::nn::kBrnnChange;
+  o.noise_folds = 0;
+  o.threads = 1;
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    o.seed = 1 + (i++ % 16);
+    const whirl::nn::Model m = whirl::nn::TrainModel(table, o, "bench");
+    benchmark::DoNotOptimize(m.training_summary.sse);
+  }
+}
+BENCHMARK(BM_TrainbrSingleFit)->ArgName("rows")->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
+
+void BM_NetworkDefault(benchmark::State& state) {
+  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
+  whirl::nn::ModelTrainOptions o = whirl::nn::DefaultTrainingOptions();
+  o.threads = 1;
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    o.seed = 1 + (i++ % 16);
+    const whirl::nn::Model m = whirl::nn::TrainModel(table, o, "bench");
+    benchmark::DoNotOptimize(m.training_summary.sse);
+  }
+}
+BENCHMARK(BM_NetworkDefault)->ArgName("rows")->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,113 @@
+// Development driver (not installed, not a test): fits the family choice or one candidate on a
+// training table and predicts a test table, printing JSON for scripts/bench_peers.py.
+//   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
+//                [--joint] [--loo|--kfold] [--no-1se] [--gp-ftol F] [--calibration-folds K]
+//                [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+// Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
+// [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
+#include <chrono>
+#include <ctime>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include "core/error.h"
+#include "family/family.h"
+
+namespace {
+
+using whirl::family::Candidate;
+
+struct Args {
+  std::string train, test, candidates = "default";
+  bool no_cv = false;
+  whirl::family::ChoiceOptions choice;
+};
+
+Args Parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw whirl::InputError(k + ": needs a value");
+      return argv[++i];
+    };
+    if (k == "--train")
+      a.train = value();
+    else if (k == "--test")
+      a.test = value();
+    else if (k == "--candidates")
+      a.candidates = value();
+    else if (k == "--no-cv")
+      a.no_cv = true;
+    else if (k == "--joint")
+      a.choice.per_output = false;
+    else if (k == "--loo")
+      a.choice.closed_form_loo = true;
+    else if (k == "--kfold")
+      a.choice.closed_form_loo = false;
+    else if (k == "--no-1se")
+      a.choice.one_standard_error = false;
+    else if (k == "--gp-ftol")
+      a.choice.fit.gp.bfgs.function_tolerance = std::stod(value());
+    else if (k == "--calibration-folds")
+      a.choice.fit.calibration_folds = std::stoi(value());
+    else if (k == "--seed")
+      a.choice.fit.seed = std::stoull(value());
+    else if (k == "--folds")
+      a.choice.folds = std::stoi(value());
+    else if (k == "--gp-restarts")
+      a.choice.fit.gp.restarts = std::stoi(value());
+    else if (k == "--threads")
+      a.choice.fit.threads = std::stoi(value());
+    else
+      throw whirl::InputError("unknown argument " + k);
+  }
+  if (a.train.empty() || a.test.empty()) throw whirl::InputError("--train and --test are required");
+  if (a.candidates != "default") {
+    a.choice.candidates.clear();
+    std::stringstream ss(a.candidates);
+    for (std::string n; std::getline(ss, n, ',');)
+      a.choice.candidates.push_back(whirl::family::ParseCandidate(n));
+  }
+  return a;
+}
+
+nlohmann::json Run(const Args& a) {
+  const whirl::ProcessTable train = whirl::ReadProcessTable(a.train, true);
+  const whirl::ProcessTable test = whirl::ReadProcessTable(a.test, false);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  whirl::family::Choice c;
+  if (a.no_cv) {
+    c.models = {whirl::family::FitCandidate(train, a.choice.candidates.front(), a.choice.fit)};
+    c.table.push_back({a.choice.candidates.front(), {}, 0, 0});
+  } else {
+    c = whirl::family::ChooseFamily(train, a.choice);
+  }
+  const double cpu_ms = 1000.0 * static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  const double wall_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
+  nlohmann::json out = {{"chosen", c.Describe()},
+                        {"cv_table", c.table},
+                        {"fit_time_ms", wall_ms},
+                        {"fit_cpu_ms", cpu_ms},
+                        {"calibration", c.models.front().calibration}};
+  out["predictions"] = nlohmann::json::array();
+  for (const auto& p : whirl::family::PredictChoice(c, test.inputs))
+    out["predictions"].push_back({{"mean", {p.mean.max_elongation_um, p.mean.settle_time_s}},
+                                  {"sd", {p.stddev.max_elongation_um, p.stddev.settle_time_s}}});
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    std::cout << Run(Parse(argc, argv)).dump() << "\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "family_bench: " << e.what() << "\n";
+    return 2;
+  }
+}

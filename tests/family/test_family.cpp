@@ -1,0 +1,239 @@
+// family/family.h: the choice finds the power law in a power-law table, every candidate predicts
+// through its transform, the calibrated GP covers fresh data, the coverage rule on hand-computed
+// cases, candidate names, and bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "family/family.h"
+#include "support/expect_error.h"
+
+namespace whirl::family {
+namespace {
+
+// Inputs uniform in the paper's ranges; targets a power law times exp(noise_sd N(0, 1)), or the
+// smooth non-power law of `curved`.
+ProcessTable MakeTable(int rows, double noise_sd, unsigned seed, bool curved = false) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n01;
+  const double lo[5] = {60, 50, 6, 3, 150}, span[5] = {5, 50, 10, 7, 60};
+  ProcessTable t;
+  t.source = "generated.csv";
+  for (int q = 0; q < rows; ++q) {
+    std::array<double, 5> x{};
+    for (int i = 0; i < 5; ++i) x[i] = lo[i] + span[i] * u(rng);
+    double e = 30 * std::pow(x[3], 1.97) * std::pow(x[4], -1.7) * std::pow(x[2], -0.99) * 1e3;
+    double s = 2.0 * std::pow(x[1], 0.8) * std::pow(x[0] / 60, 3.0);
+    if (curved) {
+      e = 10 + 5 * std::sin(x[3]) + 0.1 * x[1];
+      s = 50 + 20 * std::cos(x[2] / 3) * (x[4] / 150);
+    }
+    t.inputs.push_back(ProcessInputs::FromArray(x));
+    t.targets.push_back(Features::FromArray(
+        {e * std::exp(noise_sd * n01(rng)), s * std::exp(noise_sd * n01(rng))}));
+  }
+  return t;
+}
+
+double MaxRelativeError(const FamilyModel& m, const ProcessTable& test) {
+  const std::vector<FamilyPrediction> p = PredictFamily(m, test.inputs);
+  double worst = 0;
+  for (std::size_t q = 0; q < p.size(); ++q)
+    for (int k = 0; k < 2; ++k)
+      worst = std::max(worst, std::abs(p[q].mean.ToArray()[k] / test.targets[q].ToArray()[k] - 1));
+  return worst;
+}
+
+TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
+  const ProcessTable train = MakeTable(20, 0.01, 1), test = MakeTable(200, 0.0, 2);
+  ChoiceOptions o;
+  o.candidates = {ParseCandidate("gp-matern52-constant/identity"),
+                  ParseCandidate("gp-se-linear/log"), ParseCandidate("network-h6/identity")};
+  o.one_standard_error = false;  // the plain lowest error (tested alone below)
+  o.closed_form_loo = false;     // 5-fold refits for every candidate
+  for (const bool per_output : {false, true}) {
+    o.per_output = per_output;
+    const Choice c = ChooseFamily(train, o);
+    ASSERT_EQ(c.table.size(), 3u);
+    ASSERT_EQ(c.models.size(), 1u) << c.Describe() << nlohmann::json(c.table).dump();
+    EXPECT_EQ(c.models[0].candidate.Name(), "gp-se-linear/log");
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_EQ(c.table[c.chosen[k]].candidate.Name(), "gp-se-linear/log");
+      for (const CvRow& r : c.table)
+        EXPECT_GE(per_output ? r.cv_rmse(k) : r.score,
+                  per_output ? c.table[c.chosen[k]].cv_rmse(k) : c.table[c.chosen[k]].score);
+    }
+    EXPECT_LT(MaxRelativeError(c.models[0], test), 0.03);
+  }
+  o.closed_form_loo = true;  // GP by closed-form LOO, the network by 5-fold refits
+  o.per_output = false;
+  EXPECT_EQ(ChooseFamily(train, o).Describe(),
+            "max_elongation_um: gp-se-linear/log, settle_time_s: gp-se-linear/log");
+}
+
+TEST(FamilyChoice, OutputsMayComeFromDifferentFamilies) {
+  // Output 0 a power law, output 1 a curved function of the inputs: per output, the choice
+  // takes the power law for the first and a GP on raw columns for the second.
+  ProcessTable train = MakeTable(30, 0.01, 11);
+  const ProcessTable curved = MakeTable(30, 0.01, 11, true);
+  for (std::size_t q = 0; q < train.targets.size(); ++q)
+    train.targets[q].settle_time_s = curved.targets[q].settle_time_s;
+  ChoiceOptions o;
+  o.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-constant/identity")};
+  const Choice c = ChooseFamily(train, o);
+  EXPECT_EQ(c.Describe(),
+            "max_elongation_um: linear/log, settle_time_s: gp-matern52-constant/identity");
+  ASSERT_EQ(c.models.size(), 2u);
+  const std::vector<FamilyPrediction> p = PredictChoice(c, train.inputs);
+  const std::vector<FamilyPrediction> p0 = PredictFamily(c.models[0], train.inputs);
+  const std::vector<FamilyPrediction> p1 = PredictFamily(c.models[1], train.inputs);
+  EXPECT_EQ(p[3].mean.max_elongation_um, p0[3].mean.max_elongation_um);
+  EXPECT_EQ(p[3].stddev.settle_time_s, p1[3].stddev.settle_time_s);
+}
+
+TEST(FamilyChoice, ALinearNetworkOnLogColumnsIsAPowerLaw) {
+  const ProcessTable train = MakeTable(20, 0.0, 3), test = MakeTable(100, 0.0, 4);
+  const FamilyModel log_net = FitCandidate(train, ParseCandidate("network-h0/log"), {});
+  const FamilyModel raw_net = FitCandidate(train, ParseCandidate("network-h0/identity"), {});
+  EXPECT_LT(MaxRelativeError(log_net, test), 0.01);
+  EXPECT_GT(MaxRelativeError(raw_net, test), 0.05);  // a linear fit on raw columns is not
+  ExpectInputError(
+      [&] {
+        std::vector<ProcessInputs> in = {test.inputs[0]};
+        in[0].pitch_mm = 0.0;
+        PredictFamily(log_net, in);
+      },
+      "pitch_mm = 0");
+}
+
+TEST(FamilyChoice, SameResultOnAnyThreadCountAndWithKFoldScoring) {
+  const ProcessTable train = MakeTable(24, 0.05, 31, true), test = MakeTable(50, 0.0, 32, true);
+  for (const bool loo : {true, false}) {
+    ChoiceOptions o;
+    o.closed_form_loo = loo;
+    o.candidates.push_back(ParseCandidate("network-h4/identity"));
+    const Choice one = ChooseFamily(train, o);
+    o.fit.threads = 2;
+    const Choice two = ChooseFamily(train, o);
+    ASSERT_EQ(one.Describe(), two.Describe());
+    const std::vector<FamilyPrediction> a = PredictChoice(one, test.inputs);
+    const std::vector<FamilyPrediction> b = PredictChoice(two, test.inputs);
+    for (std::size_t q = 0; q < a.size(); ++q)
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_EQ(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k]);
+        EXPECT_EQ(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k]);
+      }
+    for (std::size_t c = 0; c < one.table.size(); ++c)
+      EXPECT_EQ(one.table[c].score, two.table[c].score);
+  }
+}
+
+TEST(FamilyChoice, ChosenModelsEqualAFreshCalibratedFit) {
+  // Whether the choice reuses its held-out residuals for the calibration (K-fold scoring) or
+  // calibrates afterwards (closed-form LOO scoring), the chosen model predicts as FitCandidate.
+  const ProcessTable train = MakeTable(24, 0.05, 41, true), test = MakeTable(30, 0.0, 42, true);
+  for (const bool loo : {true, false})
+    for (const char* name : {"linear/log", "gp-matern52-constant/identity"}) {
+      ChoiceOptions o;
+      o.closed_form_loo = loo;
+      o.candidates = {ParseCandidate(name)};
+      const Choice c = ChooseFamily(train, o);
+      const FamilyModel fresh = FitCandidate(train, ParseCandidate(name), o.fit);
+      const std::vector<FamilyPrediction> a = PredictChoice(c, test.inputs);
+      const std::vector<FamilyPrediction> b = PredictFamily(fresh, test.inputs);
+      for (std::size_t q = 0; q < a.size(); ++q)
+        for (int k = 0; k < 2; ++k) {
+          EXPECT_NEAR(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k], 1e-9) << name;
+          EXPECT_NEAR(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k], 1e-9)
+              << name << " loo " << loo;
+        }
+      EXPECT_EQ(c.models[0].calibration, fresh.calibration);
+    }
+}
+
+TEST(FamilyChoice, ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits) {
+  // linear/log: the held-out prediction of a refit without row i, mapped back by exp.
+  const ProcessTable table = MakeTable(12, 0.05, 21);
+  const FamilyModel m = FitCandidate(table, ParseCandidate("linear/log"), {}, false);
+  const Eigen::MatrixXd sq = LeaveOneOutSquaredErrors(m, table);
+  for (int i = 0; i < 12; ++i) {
+    ProcessTable without = table;
+    without.inputs.erase(without.inputs.begin() + i);
+    without.targets.erase(without.targets.begin() + i);
+    const FamilyModel mi = FitCandidate(without, ParseCandidate("linear/log"), {}, false);
+    const FamilyPrediction p = PredictFamily(mi, {table.inputs[i]}).front();
+    for (int k = 0; k < 2; ++k) {
+      const double e = table.targets[i].ToArray()[k] - p.mean.ToArray()[k];
+      EXPECT_NEAR(sq(k, i), e * e, 1e-9 * std::max(1.0, e * e)) << "row " << i << " output " << k;
+    }
+  }
+  ChoiceOptions o;
+  o.closed_form_loo = true;
+  o.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-se-constant/identity")};
+  const Choice c = ChooseFamily(table, o);
+  EXPECT_NEAR(c.table[0].cv_rmse(0), std::sqrt(sq.row(0).mean()), 1e-12);
+}
+
+TEST(FamilyCalibration, CalibratedGpCoversFreshData) {
+  // 40 noisy rows of a smooth non-power law: +-1 / +-2 sd coverage on 2000 fresh rows.
+  const ProcessTable train = MakeTable(40, 0.05, 5, true), test = MakeTable(2000, 0.05, 6, true);
+  for (const char* name : {"gp-matern52-constant/identity", "gp-se-constant/log"}) {
+    const FamilyModel m = FitCandidate(train, ParseCandidate(name), {});
+    const std::vector<FamilyPrediction> p = PredictFamily(m, test.inputs);
+    for (int k = 0; k < 2; ++k) {
+      int in1 = 0, in2 = 0;
+      for (std::size_t q = 0; q < p.size(); ++q) {
+        const double r = std::abs(test.targets[q].ToArray()[k] - p[q].mean.ToArray()[k]);
+        in1 += r <= p[q].stddev.ToArray()[k];
+        in2 += r <= 2 * p[q].stddev.ToArray()[k];
+      }
+      EXPECT_NEAR(in1 / 2000.0, 0.68, 0.12) << name << " output " << k;
+      EXPECT_NEAR(in2 / 2000.0, 0.95, 0.05) << name << " output " << k;
+    }
+  }
+}
+
+TEST(FamilyChoice, OneStandardErrorRuleOnHandComputedCases) {
+  Eigen::VectorXd a(4), b(4);
+  a << 1, 1, 1, 1;
+  b << 0.9, 0.9, 0.9, 0.9;  // lower on every row: d = 0.1 with sd 0
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 1);
+  a << 1, 2, 1, 2;          // mean 1.5
+  b << 1.5, 1.0, 1.2, 1.5;  // mean 1.3; d = (-0.5, 1, -0.2, 0.5), mean 0.2, sd sqrt(0.46)
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 0);  // 0.2 <= sqrt(0.46) / 2 = 0.339
+  a << 1, 2.4, 1, 2;  // mean 1.6; d = (-0.5, 1.4, -0.2, 0.5), mean 0.3, sd 0.845
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 0);  // 0.3 <= 0.845 / 2
+  a << 2, 2, 2, 2.1;  // d = (0.5, 1, 0.8, 0.6): mean 0.725 > se 0.11
+  EXPECT_EQ(SimplestWithinOneStandardError({a, b}), 1);
+  EXPECT_EQ(SimplestWithinOneStandardError({b, a}), 0);
+  ExpectInputError([] { SimplestWithinOneStandardError({}); }, "no candidates");
+}
+
+TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
+  Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
+  r << 1, -2, 3, 4;
+  EXPECT_NEAR(CoverageNoiseVariance(r, v), 9.0, 1e-9);  // 3 of 4 within sqrt(9)
+  v(3) = 100;  // the 4th row is covered by its own variance
+  EXPECT_NEAR(CoverageNoiseVariance(r, v), 4.0, 1e-9);
+  v << 10, 10, 10, 0;
+  EXPECT_EQ(CoverageNoiseVariance(r, v), 0.0);
+  ExpectInputError([&] { CoverageNoiseVariance(r, v.head(2)); }, "4 residuals and 2");
+}
+
+TEST(FamilyCandidates, NamesRoundTripAndBadInput) {
+  for (const Candidate& c : ChoiceOptions::DefaultCandidates())
+    EXPECT_EQ(ParseCandidate(c.Name()).Name(), c.Name());
+  for (const char* n : {"network-h6/log", "network-h0/identity", "gp-se-linear/identity"})
+    EXPECT_EQ(ParseCandidate(n).Name(), n);
+  ExpectInputError([] { ParseCandidate("gp-rbf/log"); }, "candidate 'gp-rbf/log'");
+  ExpectInputError([] { ParseCandidate("network-h6"); }, "/identity or /log");
+  ExpectInputError([] { ChooseFamily(MakeTable(3, 0.1, 1), {}); }, "at least 4");
+  ProcessTable no_targets = MakeTable(10, 0.1, 1);
+  no_targets.targets.clear();
+  ExpectInputError([&] { ChooseFamily(no_targets, {}); }, "target columns");
+}
+
+}  // namespace
+}  // namespace whirl::family

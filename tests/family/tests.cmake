@@ -1,0 +1,10 @@
+# Tests of the family module: column transforms and the choice of the model family.
+whirl_add_gtest(test_family SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/test_transform.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_linear.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_family.cpp
+  LABELS family)
+# Development driver of scripts/bench_peers.py (--family-bench): not a test, not installed.
+add_executable(family_bench ${CMAKE_CURRENT_LIST_DIR}/family_bench.cpp)
+target_link_libraries(family_bench PRIVATE whirl::core)
+whirl_set_warnings(family_bench)

@@ -1,0 +1,180 @@
+// gp/gp.h: the marginal likelihood against a direct dense evaluation, its gradient against finite
+// differences, the closed-form leave-one-out against refits without each row, interpolation,
+// recovery of a known noise level and irrelevant inputs, and the JSON round trip.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdlib>
+
+#include "core/numbers.h"
+#include "gp/gp.h"
+#include "support/eigen_near.h"
+#include "support/expect_error.h"
+
+namespace whirl::gp {
+namespace {
+
+struct Data {
+  Eigen::MatrixXd x;  // d x n
+  Eigen::VectorXd y;
+};
+
+// y = sin(x1) + 0.5 x2 + noise_sd * N(0,1)-ish (sum of uniforms), x in [0, 4]^d.
+Data MakeData(int d, int n, double noise_sd, unsigned seed) {
+  std::srand(seed);
+  Data data;
+  data.x = 2.0 * (Eigen::MatrixXd::Random(d, n).array() + 1.0);
+  data.y.resize(n);
+  for (int q = 0; q < n; ++q) {
+    const double e = (Eigen::VectorXd::Random(12).sum()) / 2.0;  // sd 1
+    data.y(q) = std::sin(data.x(0, q)) + 0.5 * data.x(1, q) + noise_sd * e;
+  }
+  return data;
+}
+
+// -ln N(u | H b, K) with b by GLS, by dense inverse and LU determinant.
+double DenseNlml(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::VectorXd& u,
+                 const Eigen::VectorXd& theta, double floor) {
+  const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
+  Eigen::MatrixXd k(n, n);
+  for (int p = 0; p < n; ++p)
+    for (int q = 0; q < n; ++q) {
+      double r2 = 0;
+      for (int i = 0; i < d; ++i) r2 += std::pow((z(i, p) - z(i, q)) / std::exp(theta(i)), 2);
+      const double r = std::sqrt(r2), sf2 = std::exp(2 * theta(d));
+      k(p, q) = kernel == Kernel::kSquaredExponential
+                    ? sf2 * std::exp(-r2 / 2)
+                    : sf2 * (1 + std::sqrt(5.0) * r + 5 * r2 / 3) * std::exp(-std::sqrt(5.0) * r);
+    }
+  k.diagonal().array() += std::exp(2 * theta(d + 1)) + floor;
+  Eigen::MatrixXd h(n, MeanSize(mean, d));
+  h.col(0).setOnes();
+  if (mean == Mean::kLinear) h.rightCols(d) = z.transpose();
+  const Eigen::MatrixXd ki = k.inverse();
+  const Eigen::VectorXd b = (h.transpose() * ki * h).inverse() * h.transpose() * ki * u;
+  const Eigen::VectorXd r = u - h * b;
+  return 0.5 * r.dot(ki * r) + 0.5 * std::log(k.fullPivLu().determinant()) +
+         0.5 * n * std::log(2 * kPi);
+}
+
+const Kernel kKernels[] = {Kernel::kSquaredExponential, Kernel::kMatern52};
+const Mean kMeans[] = {Mean::kConstant, Mean::kLinear};
+
+TEST(GpLikelihood, EqualsTheDenseFormula) {
+  const Data data = MakeData(3, 12, 0.1, 1);
+  Eigen::VectorXd theta(5);
+  theta << 0.3, -0.2, 0.8, 0.1, -1.5;
+  for (Kernel k : kKernels)
+    for (Mean m : kMeans)
+      EXPECT_NEAR(NegLogMarginalLikelihood(k, m, data.x, data.y, theta, 1e-6, nullptr),
+                  DenseNlml(k, m, data.x, data.y, theta, 1e-6), 1e-8)
+          << ToString(k) << " " << ToString(m);
+}
+
+TEST(GpLikelihood, GradientMatchesCentralDifferences) {
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const Data data = MakeData(4, 15, 0.2, seed);
+    std::srand(100 + seed);
+    const Eigen::VectorXd theta = 0.7 * Eigen::VectorXd::Random(6);
+    for (Kernel k : kKernels)
+      for (Mean m : kMeans) {
+        Eigen::VectorXd g(6), fd(6);
+        NegLogMarginalLikelihood(k, m, data.x, data.y, theta, 1e-6, &g);
+        for (int j = 0; j < 6; ++j) {
+          const double h = 1e-5;
+          Eigen::VectorXd tp = theta, tm = theta;
+          tp(j) += h;
+          tm(j) -= h;
+          fd(j) = (NegLogMarginalLikelihood(k, m, data.x, data.y, tp, 1e-6, nullptr) -
+                   NegLogMarginalLikelihood(k, m, data.x, data.y, tm, 1e-6, nullptr)) /
+                  (2 * h);
+        }
+        EXPECT_TRUE(test::AllNear(g, fd, 1e-5, 1e-6)) << ToString(k) << " " << ToString(m);
+      }
+  }
+}
+
+TEST(GpLeaveOneOut, EqualsRefitsWithoutEachRow) {
+  const Data data = MakeData(3, 14, 0.2, 7);
+  for (Kernel k : kKernels)
+    for (Mean m : kMeans) {
+      GpOptions o;
+      o.kernel = k;
+      o.mean = m;
+      const Gp gp = FitGp(data.x, data.y, o);
+      const LeaveOneOut loo = LeaveOneOutGp(gp);
+      for (int i = 0; i < 14; ++i) {
+        Gp without = gp;  // same hyperparameters and standardization, row i removed
+        const int n = 13;
+        without.z.resize(3, n);
+        without.u.resize(n);
+        for (int q = 0, c = 0; q < 14; ++q)
+          if (q != i) {
+            without.z.col(c) = gp.z.col(q);
+            without.u(c++) = gp.u(q);
+          }
+        without.Factorize();
+        const GpPrediction p = PredictGp(without, data.x.col(i));
+        EXPECT_NEAR(loo.residual(i), data.y(i) - p.mean(0), 1e-7 * gp.target_scale);
+        EXPECT_NEAR(loo.latent_variance(i), p.latent_variance(0),
+                    1e-7 * gp.target_scale * gp.target_scale);
+      }
+    }
+}
+
+TEST(GpFit, RecoversTheNoiseLevelAndIgnoresAnIrrelevantInput) {
+  // y depends on inputs 0 and 1 only; input 2 is irrelevant; noise sd 0.1.
+  const Data data = MakeData(3, 80, 0.1, 3);
+  for (Kernel k : kKernels) {
+    GpOptions o;
+    o.kernel = k;
+    GpSummary s;
+    const Gp gp = FitGp(data.x, data.y, o, &s);
+    const double noise_sd = std::sqrt(gp.SigmaN2()) * gp.target_scale;
+    EXPECT_GT(noise_sd, 0.06) << s.BriefReport();
+    EXPECT_LT(noise_sd, 0.15) << s.BriefReport();
+    EXPECT_GT(gp.theta(2), gp.theta(0) + 1.0) << "irrelevant input's length scale is not longer";
+    const Data test = MakeData(3, 200, 0.0, 4);
+    const GpPrediction p = PredictGp(gp, test.x);
+    EXPECT_LT(std::sqrt((p.mean - test.y).array().square().mean()), 0.1);
+  }
+}
+
+TEST(GpFit, InterpolatesNoiseFreeDataAndVarianceVanishesThere) {
+  const Data data = MakeData(2, 10, 0.0, 5);
+  const Gp gp = FitGp(data.x, data.y, {});
+  const GpPrediction p = PredictGp(gp, data.x);
+  EXPECT_TRUE(test::AllNear(p.mean, data.y, 0, 1e-3));
+  EXPECT_LT(p.latent_variance.maxCoeff(), 1e-4 * gp.target_scale * gp.target_scale);
+}
+
+TEST(GpFit, JsonRoundTripPredictsIdentically) {
+  const Data data = MakeData(3, 20, 0.1, 9);
+  GpOptions o;
+  o.mean = Mean::kLinear;
+  Gp gp = FitGp(data.x, data.y, o);
+  gp.noise_variance *= 2;  // a calibrated level is kept
+  const Gp back = nlohmann::json::parse(nlohmann::json(gp).dump()).get<Gp>();
+  const Data test = MakeData(3, 7, 0.1, 10);
+  const GpPrediction a = PredictGp(gp, test.x), b = PredictGp(back, test.x);
+  EXPECT_TRUE(test::AllNear(a.mean, b.mean, 1e-12));
+  EXPECT_TRUE(test::AllNear(a.Stddev(), b.Stddev(), 1e-12));
+}
+
+TEST(GpFit, BadInputIsAnInputError) {
+  const Data data = MakeData(3, 20, 0.1, 9);
+  GpOptions o;
+  o.mean = Mean::kLinear;
+  ExpectInputError([&] { FitGp(data.x.leftCols(5), data.y.head(5), o); }, "needs at least 6");
+  ExpectInputError([&] { FitGp(data.x, data.y.head(5), {}); }, "targets");
+  o.restarts = 0;
+  ExpectInputError([&] { FitGp(data.x, data.y, o); }, "restarts");
+  nlohmann::json j = FitGp(data.x, data.y, {});
+  j["theta"] = {1.0, 2.0};
+  ExpectInputError([&] { j.get<Gp>(); }, "theta");
+  ExpectInputError([] { ParseKernel("rbf"); }, "matern52");
+}
+
+}  // namespace
+}  // namespace whirl::gp
