@@ -126,10 +126,7 @@ TEST(StuckSensors, ARemainingCollinearityNamesTheFileAndTheFeatures) {
 }
 
 TEST(DriftInputs, ModelFileNumbersAreRangeChecked) {
-  // error = 3 L_40(dT_a) - dT_b: the lag search keeps tau = 40 (as in test_models.cpp).
-  drift::Run run = synth::PlantedRun(9, 3, 1, {0.0, 0.0, 0.0}, 400, 0.0, 0.0);
-  const Eigen::MatrixXd d = run.Rises();
-  run.error_um.col(0) = 3.0 * FirstOrderLag(d.col(0), run.time_min, 40.0) - d.col(2);
+  const drift::Run run = synth::LaggedRun();  // the lag search keeps tau = 40
   FitOptions o;
   o.kind = ModelKind::kDynamic;
   o.sensors = {"g0s0_C", "g2s0_C"};
