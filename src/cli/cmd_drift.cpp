@@ -26,7 +26,13 @@ using drift::RunState;
 const char* kRunFilesHelp =
     "Run files: CSV, header row; time_s [s] or time_min [min] (empty/nan cells: the sample\n"
     "index is used and said so); temperatures <name>_C [degC]; errors <name>_um [um]; other\n"
-    "columns (e.g. spindle_rpm) are optional inputs. At most 2,000,000 rows, 512 columns.\n";
+    "columns (e.g. spindle_rpm) are optional inputs. At most 2,000,000 rows, 512 columns.\n"
+    "UTF-8 text (a leading byte-order mark is skipped); decimal numbers only.\n";
+
+const std::string kDeadSensorsHelp =
+    "A sensor whose reading never moves (stuck, disconnected) or moves exactly as another (the\n"
+    "same sensor twice) is left out with a warning naming it; runs with no moving sensor are an\n"
+    "error.\n";
 
 struct RunInputs {
   std::vector<std::string> runs, idle, cutting;
@@ -138,7 +144,8 @@ void RegisterSelect(CLI::App* drift_app) {
           "Temperature-sensitive points as seed 000: similarity |Pearson r| of the rises,\n"
           "fuzzy equivalence by max-min squaring, lambda-cuts, F test for the class count,\n"
           "Deng's grey grade (rho 0.5) against the error to pick one sensor per class.\n"
-          "Prints the lambda levels with partitions and F values, the grades, the choice.\n") +
+          "Prints the lambda levels with partitions and F values, the grades, the choice.\n" +
+          kDeadSensorsHelp) +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
@@ -175,7 +182,8 @@ void RegisterFitModel(CLI::App* drift_app) {
       std::string("Fit a drift model of one error channel [um] on the training runs and write it\n"
                   "as a versioned JSON file (sensors, reference temperatures [degC], coefficients\n"
                   "[um/K] with standard errors, VIF, residual std [um], lag time constants [min],\n"
-                  "training runs, state and ranges).\n") +
+                  "training runs, state and ranges).\n" +
+                  kDeadSensorsHelp) +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
