@@ -19,18 +19,9 @@ constexpr int kMinPlanIds = 2;
 int MinDriftIds(const DriftActionOptions& d) { return d.has_slope ? 8 : 4; }
 int MinDriftSlots(const DriftActionOptions& d) { return d.has_slope ? 8 : 4; }
 
+// A whole number within +-1e6 (the fields' own ranges are checked where they are used).
 int RequireInt(const nlohmann::json& j, const char* key, const std::string& what) {
-  const double v = RequireNumber(j, key, what);
-  if (v != std::floor(v) || std::abs(v) > 1e6)
-    throw InputError(what + ": '" + key + "' = " + j.at(key).dump() + ": must be an integer");
-  return static_cast<int>(v);
-}
-
-std::string RequireString(const nlohmann::json& j, const char* key, const std::string& what) {
-  if (!j.contains(key)) throw InputError(what + ": missing required key '" + key + "'");
-  if (!j.at(key).is_string())
-    throw InputError(what + ": '" + key + "' must be a string, got " + j.at(key).dump());
-  return j.at(key).get<std::string>();
+  return static_cast<int>(RequireInteger(j, key, -1000000, 1000000, what));
 }
 
 ControlLimits ReadControlSection(const nlohmann::json& j, const std::string& what) {
@@ -266,9 +257,9 @@ MachineProfile LoadMachineProfile(const std::filesystem::path& path) {
   m.name = RequireString(j, "name", what);
   m.axis = RequireString(j, "axis", what);
   m.direction = RequireInt(j, "direction", what);
-  m.machine_offset_mm = RequireNumber(j, "machine_offset_mm", what);
+  m.machine_offset_mm = RequireNumberIn(j, "machine_offset_mm", kAxisPositionRange, what);
   if (j.contains("start_position_mm"))
-    m.start_position_mm = RequireNumber(j, "start_position_mm", what);
+    m.start_position_mm = RequireNumberIn(j, "start_position_mm", kAxisPositionRange, what);
   m.control_dk = ParseControlDk(RequireString(j, "control_dk", what));
   m.md32760 = RequireNumber(j, "md32760", what);
   m.sync_id_first = RequireInt(j, "sync_id_first", what);

@@ -113,24 +113,26 @@ SignConvention ParseSignConvention(const std::string& s) {
 
 double SignFactor(SignConvention s) { return s == SignConvention::kAdd ? 1.0 : -1.0; }
 
+void CheckAxisName(const std::string& axis, const std::string& field) {
+  if (axis.size() > kMaxAxisNameLength)
+    throw InputError(field + " = '" + axis.substr(0, kMaxAxisNameLength) + "...': at most " +
+                     std::to_string(kMaxAxisNameLength) + " characters");
+  if (axis.empty() || !std::isalpha(static_cast<unsigned char>(axis[0])) ||
+      !std::all_of(axis.begin(), axis.end(),
+                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
+    throw InputError(field + " = '" + axis +
+                     "': must be an axis name (a letter, then letters, digits or '_')");
+}
+
 void PlanOptions::Validate() const {
   CheckFinitePositive(tolerance_um, "tolerance_um");
   if (tolerance_um < kMinPlanToleranceUm)
     throw InputError("tolerance_um = " + Num(tolerance_um) + ": must be at least " +
                      Num(kMinPlanToleranceUm) + " um (1 nm, the resolution of SD43900)");
   CheckFinitePositive(check_step_s, "check_step_s");
-  if (axis.size() > 32)
-    throw InputError("axis = '" + axis.substr(0, 32) + "...': at most 32 characters");
-  if (axis.empty() || !std::isalpha(static_cast<unsigned char>(axis[0])) ||
-      !std::all_of(axis.begin(), axis.end(),
-                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
-    throw InputError("axis = '" + axis +
-                     "': must be an axis name (a letter, then letters, digits or '_')");
-  for (const auto& [name, v] : {std::pair{"start_position_mm", start_position_mm},
-                                {"machine_offset_mm", machine_offset_mm}})
-    if (!(std::abs(v) <= kMaxPositionMm))
-      throw InputError(std::string(name) + " = " + Num(v) + ": must be finite within +-" +
-                       Num(kMaxPositionMm) + " mm (100 m, longer than any machine bed)");
+  CheckAxisName(axis);
+  CheckRange(start_position_mm, kAxisPositionRange, "start_position_mm", "plan");
+  CheckRange(machine_offset_mm, kAxisPositionRange, "machine_offset_mm", "plan");
   if (direction != 1 && direction != -1)
     throw InputError("direction = " + std::to_string(direction) + ": must be +1 or -1");
   if (!(md32760 > 0 && md32760 <= kMd32760Max))

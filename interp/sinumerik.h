@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/limits.h"
 #include "fit/arctan_curve.h"
 #include "interp/breakpoints.h"
 
@@ -43,6 +44,12 @@ std::string ToString(SignConvention s);                  ///< "subtract" / "add"
 SignConvention ParseSignConvention(const std::string&);  ///< InputError for other strings
 /// +1 for kAdd, -1 for kSubtract.
 double SignFactor(SignConvention s);
+
+/// An axis name in $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (an NC identifier): a letter, then
+/// letters, digits or '_', at most kMaxAxisNameLength characters. InputError "<field> = '<axis>':
+/// <rule>" otherwise. Every command that writes an axis name checks it here.
+inline constexpr std::size_t kMaxAxisNameLength = 32;
+void CheckAxisName(const std::string& axis, const std::string& field = "axis");
 
 /// How the control applies the compensation value dK to the axis (a fact of the machine).
 enum class ControlDk { kAdded, kSubtracted };
@@ -79,7 +86,7 @@ inline constexpr int kDefaultStartAlarm = kUserAlarmFirst + 4;
 /// Largest |position| accepted for the machine offset, the thread start and other axis positions,
 /// mm: 100 m, longer than any machine bed (a larger value is a typing error, and at 1e308 the
 /// trigger positions of neighbouring segments become equal).
-inline constexpr double kMaxPositionMm = 1e5;
+inline constexpr double kMaxPositionMm = kMaxAxisPositionMm;  // core/limits.h
 
 /// SINUMERIK program names: two letters, then letters, digits or '_', at most 24 characters
 /// (Siemens, SINUMERIK 840D sl Programming Manual Fundamentals, "Program names": the first two

@@ -86,10 +86,7 @@ std::string FormatReadings(const Readings& readings) {
 
 PivotCentres PivotsFromJson(const nlohmann::json& j, const std::string& what) {
   RejectUnknownKeys(j, {"schema", "schema_version", "pivots_mm", "comment"}, what);
-  if (!j.contains("schema") || j["schema"] != "whirl.ballbar.pivots")
-    throw InputError(what + ": \"schema\" must be \"whirl.ballbar.pivots\"");
-  if (RequireNumber(j, "schema_version", what) != 1)
-    throw InputError(what + ": \"schema_version\" must be 1");
+  RequireSchema(j, "whirl.ballbar.pivots", 1, what);
   if (!j.contains("pivots_mm") || !j["pivots_mm"].is_array() || j["pivots_mm"].size() != 3)
     throw InputError(what + ": \"pivots_mm\" must be an array of three [x, y, z] points (mm)");
   PivotCentres p;

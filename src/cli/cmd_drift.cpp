@@ -26,7 +26,13 @@ using drift::RunState;
 const char* kRunFilesHelp =
     "Run files: CSV, header row; time_s [s] or time_min [min] (empty/nan cells: the sample\n"
     "index is used and said so); temperatures <name>_C [degC]; errors <name>_um [um]; other\n"
-    "columns (e.g. spindle_rpm) are optional inputs. At most 2,000,000 rows, 512 columns.\n";
+    "columns (e.g. spindle_rpm) are optional inputs. At most 2,000,000 rows, 512 columns.\n"
+    "UTF-8 text (a leading byte-order mark is skipped); decimal numbers only.\n";
+
+const std::string kDeadSensorsHelp =
+    "A sensor whose reading never moves (stuck, disconnected) or moves exactly as another (the\n"
+    "same sensor twice) is left out with a warning naming it; runs with no moving sensor are an\n"
+    "error.\n";
 
 struct RunInputs {
   std::vector<std::string> runs, idle, cutting;
@@ -138,7 +144,8 @@ void RegisterSelect(CLI::App* drift_app) {
           "Temperature-sensitive points as seed 000: similarity |Pearson r| of the rises,\n"
           "fuzzy equivalence by max-min squaring, lambda-cuts, F test for the class count,\n"
           "Deng's grey grade (rho 0.5) against the error to pick one sensor per class.\n"
-          "Prints the lambda levels with partitions and F values, the grades, the choice.\n") +
+          "Prints the lambda levels with partitions and F values, the grades, the choice.\n" +
+          kDeadSensorsHelp) +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
@@ -150,6 +157,7 @@ void RegisterSelect(CLI::App* drift_app) {
     drift::FitOptions fit;  // --classes cv scores each count with the fit's cross-validation
     fit.selection = ToSelection(o->sel);
     const drift::Selection s = drift::SelectSensorsForFit(runs, o->error, fit);
+    for (const auto& w : s.left_out) Warn(w);
     if (o->json)
       PrintJson({{"schema", "whirl.drift_select"},
                  {"schema_version", 1},
@@ -174,7 +182,8 @@ void RegisterFitModel(CLI::App* drift_app) {
       std::string("Fit a drift model of one error channel [um] on the training runs and write it\n"
                   "as a versioned JSON file (sensors, reference temperatures [degC], coefficients\n"
                   "[um/K] with standard errors, VIF, residual std [um], lag time constants [min],\n"
-                  "training runs, state and ranges).\n") +
+                  "training runs, state and ranges).\n" +
+                  kDeadSensorsHelp) +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
@@ -188,6 +197,7 @@ void RegisterFitModel(CLI::App* drift_app) {
     std::fprintf(stderr, "fitting %s model of %s on %zu run(s)...\n", o->model.kind.c_str(),
                  o->error.c_str(), runs.size());
     drift::FitReport rep = drift::FitDriftModel(runs, o->error, ToFit(o->model, o->sel));
+    for (const auto& w : rep.warnings) Warn(w);
     rep.model.notes.push_back("whirl drift fit --model " + o->model.kind + " --error " + o->error);
     drift::WriteDriftModel(o->out, rep.model);
     if (o->json) {
@@ -293,6 +303,7 @@ void RegisterCrossval(CLI::App* drift_app) {
       for (Run& r : runs) r = drift::ErrorsFromStart(r);
     std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
     const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
+    for (const auto& w : r.warnings) Warn(w);
     if (o->json)
       PrintJson(drift::CrossRunJson(r));
     else
@@ -358,6 +369,7 @@ void RegisterHoldout(CLI::App* drift_app) {
     h.fit = ToFit(o->model, o->sel);
     const auto r = drift::Holdout(
         log, h, [](const std::string& s) { std::fprintf(stderr, "fitting %s\n", s.c_str()); });
+    for (const auto& w : r.warnings) Warn(w);
     if (!o->report.empty()) {
       const auto rep =
           drift::WriteHoldoutReport(o->report, log, r, {"whirl drift holdout --log " + o->log});
@@ -385,7 +397,8 @@ void RegisterSplit(CLI::App* drift_app) {
       "run-file format (time_min [min]); all or nothing.");
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--at", o->column, "column whose rise starts a run (default spindle_rpm)");
-  sub->add_option("--threshold", o->threshold, "start threshold in the column's unit (default 0)");
+  FiniteNumber(sub->add_option("--threshold", o->threshold,
+                               "start threshold in the column's unit (default 0)"));
   sub->add_option("--out-dir", o->out_dir,
                   std::string("directory for the run files: ") + kOutputDirRule)
       ->required();
@@ -448,6 +461,7 @@ void RegisterReport(CLI::App* drift_app) {
     if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
       runs = LoadRuns(o->runs);
     const drift::FitReport rep = drift::FitDriftModel(train, o->error, ToFit(o->model, o->sel));
+    for (const auto& w : rep.warnings) Warn(w);
     const auto r =
         drift::WriteModelReport(o->out, rep, runs, {"whirl drift report --error " + o->error});
     for (const auto& w : r.warnings) Warn(w);

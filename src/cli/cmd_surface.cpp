@@ -68,7 +68,8 @@ void SetupSynth(CLI::App& parent) {
       "plus normal noise; the file's '#' lines record the field, options and seed.");
   sub->add_option("--field", o->field, "smooth | bump (default smooth)")
       ->check(CLI::IsMember({"smooth", "bump"}));
-  sub->add_option("--nx", o->synth.nx, "grid columns along X (2..200, default 9)")
+  sub->add_option("--nx", o->synth.nx,
+                  "grid columns along X (2..200, default 9; nx * ny <= 10000, the points limit)")
       ->check(CLI::Range(2, 200));
   sub->add_option("--ny", o->synth.ny, "grid rows along Y (2..200, default 7)")
       ->check(CLI::Range(2, 200));
@@ -214,8 +215,8 @@ void SetupPredict(CLI::App& parent) {
   sub->add_option("--surface", o->surface, "surface JSON from 'whirl surface fit'")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--x", o->x, "table X, mm");
-  sub->add_option("--y", o->y, "table Y, mm");
+  FiniteNumber(sub->add_option("--x", o->x, "table X, mm"));
+  FiniteNumber(sub->add_option("--y", o->y, "table Y, mm"));
   sub->add_option("--input", o->input, "CSV of positions x_mm,y_mm (at most 10000 rows)")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "CSV to write: x_mm,y_mm,error_um");
@@ -301,13 +302,18 @@ void SetupLine(CLI::App& parent) {
       ->check(CLI::ExistingFile);
   sub->add_option("--along", o->along, "surface coordinate the axis moves along: x | y")
       ->check(CLI::IsMember({"x", "y"}));
-  sub->add_option("--axis", o->line.axis, "840D axis name for $SA_...[axis] (default X)");
-  sub->add_option("--at-mm", o->at_mm,
-                  "one traverse at this fixed other coordinate, mm (default: the whole table)");
-  sub->add_option("--ref-position-mm", o->ref_mm,
-                  "reference position P0 in surface coordinates, mm (default: travel start)");
-  sub->add_option("--machine-offset-mm", o->line.machine_offset_mm,
-                  "MCS position of the surface's coordinate origin on this axis, mm (default 0)");
+  sub->add_option("--axis", o->line.axis,
+                  "840D axis name for $SA_...[axis]: a letter, then letters, digits or '_' "
+                  "(default X)");
+  FiniteNumber(sub->add_option(
+      "--at-mm", o->at_mm,
+      "one traverse at this fixed other coordinate, mm (default: the whole table)"));
+  FiniteNumber(
+      sub->add_option("--ref-position-mm", o->ref_mm,
+                      "reference position P0 in surface coordinates, mm (default: travel start)"));
+  FiniteNumber(sub->add_option(
+      "--machine-offset-mm", o->line.machine_offset_mm,
+      "MCS position of the surface's coordinate origin on this axis, mm (default 0)"));
   sub->add_option("--sign", o->sign, "subtract (dK = -line, default) | add")
       ->check(CLI::IsMember({"subtract", "add"}));
   sub->add_option("--md32760", o->line.md32760,
@@ -402,7 +408,8 @@ void SetupPoints(CLI::App& parent) {
   sub->add_option("--sensors", o->sensors,
                   "temperature columns to use (default: seed 000 selection)")
       ->delimiter(',');
-  sub->add_option("--time-min", o->time_min, "moment of the surface, min (nearest sample)")
+  FiniteNumber(
+      sub->add_option("--time-min", o->time_min, "moment of the surface, min (nearest sample)"))
       ->required();
   sub->add_option("--method", o->method, "cubic | bspline (default cubic)")
       ->check(CLI::IsMember({"cubic", "bspline"}));

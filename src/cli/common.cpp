@@ -11,7 +11,9 @@
 #include <iostream>
 
 #include "cli/terminal.h"
+#include "core/csv.h"
 #include "core/error.h"
+#include "core/json_file.h"
 #include "core/safe_text.h"
 #include "fit/arctan_curve.h"
 
@@ -42,6 +44,14 @@ CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string
   };
   return sub->add_option("--seed", *seed, help + " [0 .. 2^64-1]")
       ->check(CLI::Validator(rule, "UINT64"));
+}
+
+CLI::Option* FiniteNumber(CLI::Option* option) {
+  const auto rule = [](std::string& text) -> std::string {
+    if (ParseDecimal(text)) return "";
+    return "'" + text + "' must be a finite decimal number";
+  };
+  return option->check(CLI::Validator(rule, "FINITE"));
 }
 
 int RunApp(CLI::App& app, int argc, char** argv) {
@@ -84,7 +94,7 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
        " (extrapolating)");
 }
 
-void PrintJson(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+void PrintJson(const nlohmann::json& j) { std::cout << DumpJson(j) << std::endl; }
 
 void Warn(const std::string& text) { std::cerr << "warning: " << text << std::endl; }
 

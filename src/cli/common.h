@@ -45,6 +45,10 @@ void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent)
 /// number is a parse error naming the rule, never wrapped. Returns the option for chaining.
 CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help);
 
+/// Makes a number option refuse nan, inf and every form that is not a finite decimal number
+/// (parse error "<flag>: '<text>' must be a finite number"). Returns the option for chaining.
+CLI::Option* FiniteNumber(CLI::Option* option);
+
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.
 void PrintJson(const nlohmann::json& j);
 

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "core/json_file.h"
 
 namespace whirl::compare {
 
@@ -37,7 +38,7 @@ void WritePlanFiles(const PlanOutputPaths& paths, const nlohmann::json& document
                     const interp::CompensationPlan& plan, const std::string& provenance,
                     const std::string& curve_source) {
   std::vector<std::pair<std::filesystem::path, std::string>> files;
-  if (!paths.json.empty()) files.emplace_back(paths.json, document.dump(2) + "\n");
+  if (!paths.json.empty()) files.emplace_back(paths.json, JsonFileText(document));
   if (!paths.csv.empty()) files.emplace_back(paths.csv, interp::FormatPlcCsv(plan, {provenance}));
   interp::NcProgramInfo info;
   info.curve_source = curve_source;

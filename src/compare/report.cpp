@@ -349,7 +349,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                  {"schema_version", 1},
                                  {"provenance", options.provenance},
                                  {"comparisons", report_json}};
-  out.Add("report.json", report.dump(2) + "\n");
+  out.Add("report.json", JsonFileText(report));
 
   std::ostringstream html;
   html

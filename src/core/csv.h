@@ -1,8 +1,16 @@
 #pragma once
-// Strict numeric CSV: a header row of column names, then rows of finite numbers.
-// Lines starting with '#' are comments (data files carry their provenance there); blank lines are
-// skipped. Every error names the file, the 1-based line and the column.
+// Strict numeric CSV, the one reader of every CSV file whirl takes: a header row of column names,
+// then rows of finite decimal numbers. Lines starting with '#' are comments (data files carry
+// their provenance there); blank lines are skipped. Every error names the file, the 1-based line
+// and the column.
+// Text: UTF-8 (RFC 3629). A byte-order mark at the start (what spreadsheet programs write) is
+// skipped, so it can neither hide the first column's name nor turn a first '#' line into the
+// header; a byte that is not UTF-8 anywhere (header, comment, cell) is an InputError naming the
+// line, the column and the character position.
+// Numbers: decimal only, [+-]digits[.digits][(e|E)[+-]digits] (also ".5" and "5."); hexadecimal
+// floats (0x1p3), "inf", "nan" and every other form strtod would take are refused.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +22,7 @@ struct CsvTable {
   std::vector<std::vector<double>> rows;  ///< one vector per data row, header.size() values each
   std::vector<int> line_numbers;          ///< 1-based file line of each row
   std::vector<std::string> comments;      ///< '#' lines without the leading '#', in order
+  int header_line = 0;                    ///< 1-based file line of the header row
 
   /// Index of a column; InputError "file: missing column 'x' (have: ...)" if absent.
   std::size_t ColumnIndex(const std::string& name) const;
@@ -25,13 +34,27 @@ struct CsvTable {
   std::vector<double> IncreasingColumn(const std::string& name) const;
 };
 
-/// Parses CSV text. Rejects: no header, an empty or duplicated column name, a row with the wrong
-/// number of cells, a cell that is not a complete number, NaN or infinity, and (unless
-/// allow_empty) a table with no data row. `source` names the text in error messages.
+struct CsvOptions {
+  bool allow_empty = false;  ///< a table without data rows is not an error
+  /// Columns whose cells may be missing: an empty cell or "nan" (any case) reads as NaN (a logger
+  /// that did not record time in some rows, drift/run_file.h); their other cells follow the
+  /// number rules above.
+  std::vector<std::string> missing_allowed;
+};
+
+/// Parses CSV text. Rejects: text that is not UTF-8, no header, an empty or duplicated column
+/// name, a row with the wrong number of cells, a cell that is not a complete decimal number, NaN
+/// or infinity (outside options.missing_allowed), and (unless options.allow_empty) a table with
+/// no data row. `source` names the text in error messages.
+CsvTable ParseCsv(const std::string& text, const std::string& source, const CsvOptions& options);
 CsvTable ParseCsv(const std::string& text, const std::string& source, bool allow_empty = false);
 
 /// Reads and parses a CSV file (InputError if it cannot be opened).
 CsvTable ReadCsv(const std::filesystem::path& path, bool allow_empty = false);
+
+/// The value of `text` when it is a finite decimal number by the rule above (a CSV cell, a
+/// command-line number); nullopt otherwise ("0x1p3", "nan", "1e999", "1,5", "").
+std::optional<double> ParseDecimal(const std::string& text);
 
 /// Formats a number for CSV/JSON-like text output with round-trip precision (17 significant
 /// digits, shortest form that parses back to the same double).

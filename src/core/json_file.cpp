@@ -7,21 +7,49 @@
 #include "core/error.h"
 
 namespace whirl {
+namespace {
+
+// The value at a required key; InputError naming `what` and the key when it is missing.
+const nlohmann::json& At(const nlohmann::json& j, const char* key, const std::string& what) {
+  if (!j.is_object()) throw InputError(what + ": expected a JSON object");
+  if (!j.contains(key)) throw InputError(what + ": missing required key '" + key + "'");
+  return j.at(key);
+}
+
+// nlohmann's message without its "[json.exception.parse_error.101] " tag.
+std::string Untagged(const std::string& message) {
+  const auto end = message.rfind("] ", message.find(' '));
+  return message.rfind("[json.exception.", 0) == 0 && end != std::string::npos
+             ? message.substr(end + 2)
+             : message;
+}
+
+std::string List(std::initializer_list<const char*> items) {
+  std::string list;
+  for (const char* a : items) list += std::string(list.empty() ? "" : ", ") + a;
+  return list;
+}
+
+}  // namespace
 
 nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
   const std::string text = ReadTextFile(path);
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::json::parse(text);  // skips a UTF-8 byte-order mark, rejects invalid UTF-8
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError("'" + path.string() + "' is not valid JSON (byte " + std::to_string(e.byte) +
-                     "): " + e.what());
+                     "): " + Untagged(e.what()));
   } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range: a number beyond double
-    throw InputError("'" + path.string() + "': " + e.what() +
+    throw InputError("'" + path.string() + "': " + Untagged(e.what()) +
                      " (rule: numbers must lie within the double range, |x| < 1.8e308)");
   }
 }
 
-std::string JsonFileText(const nlohmann::json& j) { return j.dump(2) + "\n"; }
+std::string DumpJson(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string JsonFileText(const nlohmann::json& j) { return DumpJson(j) + "\n"; }
 
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
   WriteFileAtomic(path, JsonFileText(j));
@@ -33,21 +61,80 @@ void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char
   std::set<std::string> ok;
   for (const char* a : allowed) ok.insert(a);
   for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!ok.count(it.key())) {
-      std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      throw InputError(what + ": unknown key '" + it.key() + "' (allowed: " + list + ")");
-    }
+    if (!ok.count(it.key()))
+      throw InputError(what + ": unknown key '" + it.key() + "' (allowed: " + List(allowed) + ")");
   }
 }
 
 double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what) {
-  if (!j.contains(key)) throw InputError(what + ": missing required key '" + key + "'");
-  const auto& v = j.at(key);
-  if (!v.is_number()) throw InputError(what + ": '" + key + "' must be a number, got " + v.dump());
+  const auto& v = At(j, key, what);
+  if (!v.is_number())
+    throw InputError(what + ": '" + key + "' must be a number, got " + DumpJson(v, -1));
   const double x = v.get<double>();
   if (!std::isfinite(x)) throw InputError(what + ": '" + key + "' must be finite");
   return x;
+}
+
+double RequireNumberIn(const nlohmann::json& j, const char* key, const Range& range,
+                       const std::string& what) {
+  const double x = RequireNumber(j, key, what);
+  CheckRange(x, range, key, what);
+  return x;
+}
+
+void OptionalNumberIn(const nlohmann::json& j, const char* key, const Range& range, double& value,
+                      const std::string& what) {
+  if (j.is_object() && j.contains(key)) value = RequireNumberIn(j, key, range, what);
+}
+
+long long RequireInteger(const nlohmann::json& j, const char* key, long long min, long long max,
+                         const std::string& what) {
+  const auto& v = At(j, key, what);
+  const std::string rule =
+      "must be a whole number in " + std::to_string(min) + ".." + std::to_string(max);
+  if (!v.is_number())
+    throw InputError(what + ": '" + key + "' = " + DumpJson(v, -1) + " breaks the rule: " + rule);
+  const double x = v.get<double>();
+  if (!(x >= static_cast<double>(min) && x <= static_cast<double>(max)) || x != std::floor(x))
+    throw InputError(what + ": '" + key + "' = " + DumpJson(v, -1) + " breaks the rule: " + rule);
+  return static_cast<long long>(x);
+}
+
+std::string RequireString(const nlohmann::json& j, const char* key, const std::string& what,
+                          std::size_t max_length) {
+  const auto& v = At(j, key, what);
+  if (!v.is_string())
+    throw InputError(what + ": '" + key + "' must be a string, got " + DumpJson(v, -1));
+  std::string s = v.get<std::string>();
+  if (s.size() > max_length)
+    throw InputError(what + ": '" + key + "' has " + std::to_string(s.size()) +
+                     " bytes; the limit is " + std::to_string(max_length));
+  return s;
+}
+
+std::string RequireOneOf(const nlohmann::json& j, const char* key,
+                         std::initializer_list<const char*> allowed, const std::string& what) {
+  const std::string s = RequireString(j, key, what);
+  for (const char* a : allowed)
+    if (s == a) return s;
+  throw InputError(what + ": '" + key + "' = " + DumpJson(s, -1) + " must be one of " +
+                   List(allowed));
+}
+
+void RequireSchema(const nlohmann::json& j, const std::string& schema, int version,
+                   const std::string& what, const char* schema_key) {
+  if (!j.is_object()) throw InputError(what + ": expected a JSON object");
+  if (!j.contains(schema_key) || !j.at(schema_key).is_string() ||
+      j.at(schema_key).get<std::string>() != schema)
+    throw InputError(what + ": '" + schema_key + "' must be \"" + schema + "\"" +
+                     (j.contains(schema_key) ? ", got " + DumpJson(j.at(schema_key), -1)
+                                             : std::string(" (missing)")));
+  const bool have = j.contains("schema_version");
+  const auto& v = have ? j.at("schema_version") : j;
+  if (!have || !v.is_number() || v.get<double>() != version)
+    throw InputError(what + ": 'schema_version' = " + (have ? DumpJson(v, -1) : "(missing)") +
+                     " breaks the rule: this whirl reads schema_version " +
+                     std::to_string(version));
 }
 
 }  // namespace whirl

@@ -1,15 +1,27 @@
 #pragma once
+// JSON files: reading, writing, and the field checks every loader uses, so a file field breaks a
+// rule with the same message as the command-line flag of the same quantity (core/limits.h Range):
+// "<what>: <key> = <value> breaks the rule: ...", `what` naming the file (e.g. "screw file
+// 'a.json'"), `key` the field as the user wrote it.
 #include <filesystem>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/limits.h"
+
 namespace whirl {
 
-/// Parses a JSON file; a syntax error, a truncation or a number beyond the double range is an
-/// InputError naming the file (and byte). Size limit: kMaxInputFileBytes (core/atomic_file.h).
+/// Parses a JSON file; a syntax error, a truncation, text that is not UTF-8 or a number beyond
+/// the double range is an InputError naming the file (and line, column). A UTF-8 byte-order mark
+/// at the start is skipped. Size limit: kMaxInputFileBytes (core/atomic_file.h).
 nlohmann::json ReadJsonFile(const std::filesystem::path& path);
 
-/// Writes pretty-printed JSON (2-space indent, trailing newline) atomically.
+/// JSON text (`indent` spaces, as nlohmann::json::dump). A string holding bytes that are not
+/// UTF-8 (a file name from the command line) gets U+FFFD in their place instead of an exception.
+std::string DumpJson(const nlohmann::json& j, int indent = 2);
+
+/// Writes pretty-printed JSON (2-space indent, trailing newline, DumpJson) atomically.
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j);
 
 /// The text WriteJsonFile writes, for a file that is written together with others.
@@ -22,5 +34,33 @@ void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char
 
 /// Required finite number at key; an InputError names `what`, the key and the rule otherwise.
 double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what);
+
+/// Required number at key within `range` (core/limits.h); the message names `what`, the key, the
+/// value and the range with its unit.
+double RequireNumberIn(const nlohmann::json& j, const char* key, const Range& range,
+                       const std::string& what);
+
+/// As RequireNumberIn when the key is present; leaves `value` (the default) unchanged otherwise.
+void OptionalNumberIn(const nlohmann::json& j, const char* key, const Range& range, double& value,
+                      const std::string& what);
+
+/// Required whole number at key in [min, max]: a string ("1"), a fraction (1.5) or a number out
+/// of range is an InputError naming `what` and the key (1.0 is accepted as 1).
+long long RequireInteger(const nlohmann::json& j, const char* key, long long min, long long max,
+                         const std::string& what);
+
+/// Required string at key of at most `max_length` bytes.
+std::string RequireString(const nlohmann::json& j, const char* key, const std::string& what,
+                          std::size_t max_length = 1000);
+
+/// Required string at key that is one of `allowed`; the message lists them.
+std::string RequireOneOf(const nlohmann::json& j, const char* key,
+                         std::initializer_list<const char*> allowed, const std::string& what);
+
+/// The schema of a versioned file: `j` is an object whose `schema_key` (usually "schema") is the
+/// string `schema` and whose "schema_version" is the whole number `version`. InputError naming
+/// `what` and the key otherwise (a missing key, 99, "1" or 1.5 for version 1).
+void RequireSchema(const nlohmann::json& j, const std::string& schema, int version,
+                   const std::string& what, const char* schema_key = "schema");
 
 }  // namespace whirl

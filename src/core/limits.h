@@ -14,6 +14,10 @@
 //   max_elongation_um     0 .. 10000 um      (10 mm: no screw grows that much while cut)
 //   settle_time_s         0 .. 1e6 s         (11.6 days)
 // Screw blank: length_mm (0, 20000] mm (whirling machines cut up to about 15 m).
+// Axis positions (a machine offset, a start position), mm: within +-kMaxAxisPositionMm (100 m).
+//
+// Range and CheckRange state any such rule once, so a file field (core/json_file.h
+// RequireNumberIn) and a command-line flag break it with the same message.
 #include <cstdint>
 #include <string>
 
@@ -29,11 +33,30 @@ inline constexpr double kMaxCuttingSpeedMMin = 1000;
 inline constexpr double kMaxElongationUm = 10000;
 inline constexpr double kMaxSettleTimeS = 1e6;
 inline constexpr double kMaxBlankLengthMm = 20000;
+/// Largest |axis position| in machine or program coordinates, mm (a 100 m axis): machine offsets,
+/// start and reference positions.
+inline constexpr double kMaxAxisPositionMm = 100000;
 /// Shortest settle time of a curve a plan is built from, s (CheckPlanFeatures).
 inline constexpr double kMinPlanSettleTimeS = 1;
 /// Smallest plan tolerance, um: 1 nm, the resolution of SD43900 written with 6 decimals of mm
 /// (interp::PlanOptions::Validate).
 inline constexpr double kMinPlanToleranceUm = 1e-3;
+
+/// A closed range [min, max] of a quantity, or (min, max] when min_open, with its unit.
+struct Range {
+  double min = 0, max = 0;
+  bool min_open = false;
+  const char* unit = "";
+  bool Contains(double x) const;  ///< false for NaN
+  std::string Text() const;       ///< "[0, 1] K", "(0, 500] mm"
+};
+
+/// Axis positions (machine offsets, start positions), +-kMaxAxisPositionMm.
+inline constexpr Range kAxisPositionRange{-kMaxAxisPositionMm, kMaxAxisPositionMm, false, "mm"};
+
+/// InputError "<what>: <field> = <value> breaks the rule: must lie in <range>" unless
+/// range.Contains(x). `what` names the file (and line) or the command; `field` the key or flag.
+void CheckRange(double x, const Range& range, const std::string& field, const std::string& what);
 
 /// Checks the five inputs against the ranges above; InputError "<what>: <field> = <value> breaks
 /// the rule: <range with unit>" otherwise (`what` names the file and line, or the flag set).

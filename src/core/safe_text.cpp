@@ -127,6 +127,19 @@ std::string TerminalText(std::string_view text) {
   return out;
 }
 
+std::size_t InvalidUtf8Offset(std::string_view text) {
+  for (std::size_t i = 0; i < text.size();) {
+    if (static_cast<unsigned char>(text[i]) < 0x80) {
+      ++i;
+      continue;
+    }
+    const std::size_t n = Utf8Length(text, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return std::string_view::npos;
+}
+
 bool LooksLikeFormula(std::string_view text) {
   if (text.empty()) return false;
   const char c = text.front();

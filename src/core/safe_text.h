@@ -32,6 +32,11 @@ std::string Slug(std::string_view text, std::size_t max_length = 64);
 /// window, rewrite what is on screen or, on some terminals, reach the clipboard.
 std::string TerminalText(std::string_view text);
 
+/// Offset of the first byte of `text` that does not belong to a valid UTF-8 sequence (overlong
+/// forms, surrogates and code points above U+10FFFF are invalid), or std::string_view::npos when
+/// all of it is UTF-8. Input files are read as UTF-8 (core/csv.h, core/json_file.h).
+std::size_t InvalidUtf8Offset(std::string_view text);
+
 /// True when a spreadsheet would evaluate a CSV cell holding `text` as a formula: it starts with
 /// '=', '+', '-', '@', a tab or a carriage return (OWASP "CSV injection").
 bool LooksLikeFormula(std::string_view text);

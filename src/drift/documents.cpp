@@ -71,6 +71,7 @@ json SelectionJson(const Selection& s) {
               {"partitions", parts},       {"chosen_partition", s.chosen_partition},
               {"grey_grades", grades},     {"chosen_sensors", s.ChosenNames()},
               {"rule", s.message}};
+  if (!s.left_out.empty()) out["left_out"] = s.left_out;
   if (!s.class_count_scores.empty()) {
     json scores = json::array();
     for (const auto& c : s.class_count_scores)

@@ -1,5 +1,6 @@
 #include "drift/evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -8,6 +9,12 @@
 
 namespace whirl::drift {
 namespace {
+
+// Appends the lines of `more` not yet in `lines` (a sensor left out by several fits is named once).
+void AddOnce(std::vector<std::string>* lines, const std::vector<std::string>& more) {
+  for (const auto& m : more)
+    if (std::find(lines->begin(), lines->end(), m) == lines->end()) lines->push_back(m);
+}
 
 void Accumulate(ErrorStats* sum, const ErrorStats& s) {
   sum->samples += s.samples;
@@ -65,13 +72,17 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
   }
   FitOptions inner = options;
   inner.threads = 1;
+  std::vector<std::vector<std::string>> left_out(n);
   ParallelFor(n, options.threads, [&](std::size_t i) {
     const FitReport rep = FitDriftModel({runs[i]}, error_column, inner);
     FitOptions all = inner;
     all.kind = ModelKind::kMlr;
     all.sensors = runs[i].sensor_names;
     all.extra_inputs.clear();
-    const DriftModel all_model = FitDriftModel({runs[i]}, error_column, all).model;
+    const FitReport all_rep = FitDriftModel({runs[i]}, error_column, all);
+    const DriftModel& all_model = all_rep.model;
+    left_out[i] = rep.warnings;
+    left_out[i].insert(left_out[i].end(), all_rep.warnings.begin(), all_rep.warnings.end());
     res.models[i] = rep.model;
     res.chosen[i] = rep.model.sensors;
     for (std::size_t j = 0; j < n; ++j) {
@@ -81,6 +92,7 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
       c.none = ComputeErrorStats(runs[j].error_um.col(runs[j].ErrorIndex(error_column)));
     }
   });
+  for (const auto& w : left_out) AddOnce(&res.warnings, w);
   std::map<std::string, CrossRunGroup> groups;
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < n; ++j) {
@@ -142,7 +154,9 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
   for (const std::string& ch : channels) {
     auto add = [&](const std::string& method, FitOptions f) {
       if (progress) progress(ch + ": " + method);
-      DriftModel m = FitDriftModel({train}, ch, f).model;
+      FitReport rep = FitDriftModel({train}, ch, f);
+      AddOnce(&res.warnings, rep.warnings);
+      DriftModel m = std::move(rep.model);
       RunPrediction p = PredictRun(m, scored);
       res.rows_out.push_back(Score(ch, method, m, p, res.train_end, res.test_end));
       res.models.push_back(std::move(m));

@@ -50,6 +50,7 @@ struct CrossRunResult {
   std::vector<std::vector<CrossRunCell>> cells;  ///< [train][test]
   std::vector<CrossRunGroup> groups;
   std::vector<DriftModel> models;  ///< each run's model
+  std::vector<std::string> warnings;  ///< sensors the fits left out (FitReport::warnings), once
 };
 
 /// Builds one model per run (options.kind, seed 000 selection unless options.sensors is set) and
@@ -85,6 +86,7 @@ struct HoldoutResult {
   std::vector<HoldoutRow> rows_out;
   std::vector<DriftModel> models;          ///< same order as rows_out (none: an empty model)
   std::vector<RunPrediction> predictions;  ///< on rows [0, test_end), same order
+  std::vector<std::string> warnings;       ///< sensors the fits left out, once each
 };
 
 HoldoutResult Holdout(const Run& log, const HoldoutOptions& options,

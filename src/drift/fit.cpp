@@ -145,6 +145,28 @@ void FitNetwork(const Stacked& s, const FitOptions& o, DriftModel* m, std::strin
             std::to_string(q) + " samples, best of " + std::to_string(o.restarts) + " restarts)";
 }
 
+// The given sensors without the dead and duplicate ones (selection.h convention 8).
+std::vector<std::string> UsableSensors(const std::vector<Run>& runs,
+                                       const std::vector<std::string>& sensors,
+                                       std::vector<std::string>* warnings) {
+  Eigen::Index total = 0;
+  for (const Run& r : runs) total += r.samples();
+  Eigen::MatrixXd rises(total, static_cast<Eigen::Index>(sensors.size()));
+  Eigen::Index at = 0;
+  for (const Run& r : runs) {
+    const Eigen::MatrixXd all = r.Rises();
+    for (std::size_t i = 0; i < sensors.size(); ++i)
+      rises.block(at, static_cast<Eigen::Index>(i), r.samples(), 1) =
+          all.col(r.SensorIndex(sensors[i]));
+    at += r.samples();
+  }
+  const SensorScreen screen = ScreenSensors(rises, sensors, RunSources(runs));
+  *warnings = screen.left_out;
+  std::vector<std::string> out;
+  for (const int i : screen.usable) out.push_back(sensors[static_cast<std::size_t>(i)]);
+  return out;
+}
+
 }  // namespace
 
 void FitOptions::Validate() const {
@@ -238,8 +260,9 @@ FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_c
     rep.selection = SelectSensorsForFit(runs, error_column, o);
     m.sensors = rep.selection.ChosenNames();
     m.selection = "seed 000 selection: " + rep.selection.message;
+    rep.warnings = rep.selection.left_out;
   } else {
-    m.sensors = o.sensors;
+    m.sensors = UsableSensors(runs, o.sensors, &rep.warnings);
     m.selection = "given";
   }
   m.reference_C = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.sensors.size()));
@@ -281,7 +304,15 @@ FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_c
                  .row(0)
                  .transpose();
   } else {
-    m.linear = FitLinear(s.x, s.y);
+    try {
+      m.linear = FitLinear(s.x, s.y);
+    } catch (const InputError& e) {
+      std::string features;
+      for (const Feature& f : m.features)
+        features += (features.empty() ? "" : ", ") + f.Name(m.time_unit);
+      throw InputError(RunSources(runs) + ": model of " + error_column + " on " + features + ": " +
+                       e.what());
+    }
     fitted = EvaluateLinear(m.linear.coefficients, s.x);
   }
   const Eigen::VectorXd res = s.y - fitted;

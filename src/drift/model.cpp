@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
 
@@ -126,18 +127,22 @@ void DriftModel::Validate() const {
     throw InputError("drift model 'reference_C' must have one value per sensor");
   if (nf != InputCount() * (1 + static_cast<Eigen::Index>(time_constants.size())))
     throw InputError("drift model 'features' must be inputs x (1 + time constants)");
-  for (double t : time_constants)
-    if (!(t > 0))
-      throw InputError("drift model time constant " + MessageNumber(t) + ": must be > 0");
-  if (feature_min.size() != nf || feature_max.size() != nf)
-    throw InputError("drift model training ranges must have one value per feature");
   if (time_unit != "min" && time_unit != "sample")
     throw InputError("drift model 'time_unit' '" + time_unit + "': must be min or sample");
+  for (double t : time_constants)
+    CheckRange(t, {0, kMaxTimeConstant, true, time_unit.c_str()}, "time_constants", "drift model");
+  CheckRange(residual_std_um, {0, kMaxResidualStdUm, false, "um"}, "residual_std_um",
+             "drift model");
+  CheckRange(r_squared, {-1e6, 1, false, ""}, "r_squared", "drift model");
+  if (feature_min.size() != nf || feature_max.size() != nf)
+    throw InputError("drift model training ranges must have one value per feature");
   if (IsLinear(kind)) {
     if (linear.coefficients.size() != nf + 1 || linear.covariance.rows() != nf + 1)
       throw InputError("drift model coefficients must be 1 + " + std::to_string(nf));
   } else {
     network.Validate("drift model network");
+    CheckRange(noise_variance, {0, 1e6, false, "(normalized)"}, "network.noise_variance_normalized",
+               "drift model");
     if (network.InputCount() != nf || network.OutputCount() != 1)
       throw InputError("drift model network must have one input per feature and one output");
     if (posterior_covariance.rows() != network.ParameterCount())
@@ -202,9 +207,7 @@ void from_json(const json& j, DriftModel& m) {
                      "reference_C", "extra_inputs", "time_unit", "time_constants", "features",
                      "residual_std_um", "r_squared", "training", "linear", "network"},
                     "drift model");
-  if (j.at("schema_version").get<int>() != DriftModel::kSchemaVersion)
-    throw InputError("drift model schema_version " + j.at("schema_version").dump() +
-                     ": this whirl reads version " + std::to_string(DriftModel::kSchemaVersion));
+  RequireSchema(j, DriftModel::kFormat, DriftModel::kSchemaVersion, "drift model", "format");
   m = DriftModel{};
   m.kind = ParseModelKind(j.at("kind").get<std::string>());
   m.error_column = j.at("error_column").get<std::string>();

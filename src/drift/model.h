@@ -53,6 +53,12 @@ struct Feature {
   std::string Name(const std::string& time_unit) const;  ///< "t3_C" or "t3_C_lag40min"
 };
 
+/// Largest training residual std a model may state, um (10 x the error range of a run file,
+/// kMaxAbsErrorUm): a larger one is a corrupt file and would make every threshold infinite.
+inline constexpr double kMaxResidualStdUm = 10 * kMaxAbsErrorUm;
+/// Longest lag time constant, in the model's time unit (FitOptions::tau_grid's limit).
+inline constexpr double kMaxTimeConstant = 1e6;
+
 struct DriftModel {
   static constexpr int kSchemaVersion = 1;
   static constexpr const char* kFormat = "whirl-drift-model";
@@ -75,8 +81,8 @@ struct DriftModel {
   Eigen::MatrixXd posterior_covariance;  ///< network: A^-1 (nn/trainbr.h)
   double noise_variance = 0;             ///< network: 1 / (2 beta), normalized units
 
-  double residual_std_um = 0;  ///< training residual std (all kinds)
-  double r_squared = 0;        ///< training R^2 (all kinds)
+  double residual_std_um = 0;  ///< training residual std (all kinds), [0, kMaxResidualStdUm]
+  double r_squared = 0;        ///< training R^2 (all kinds), at most 1
   std::vector<std::string> training_runs;
   RunState state = RunState::kUnknown;  ///< common state of the training runs, else unknown
   int training_samples = 0;
@@ -84,7 +90,8 @@ struct DriftModel {
   std::vector<std::string> notes;  ///< provenance (command line, lag search)
 
   int InputCount() const { return static_cast<int>(sensors.size() + extra_inputs.size()); }
-  /// Throws InputError naming the field when sizes or values are inconsistent.
+  /// Throws InputError naming the field when sizes are inconsistent or a value is outside its
+  /// range (residual_std_um, r_squared, time constants, noise variance).
   void Validate() const;
 };
 void to_json(nlohmann::json& j, const DriftModel& m);
@@ -166,6 +173,9 @@ struct FitReport {
   Selection selection;                    ///< when selected
   std::vector<LagSearchStep> lag_search;  ///< dynamic: accepted steps, static first
   std::string train_report;               ///< network: trainbr BriefReport
+  /// Sensors left out (selection.h convention 8: dead or duplicate), chosen or given, one line
+  /// each naming the sensor and the runs.
+  std::vector<std::string> warnings;
 };
 
 /// Seed 000's selection for a fit: SelectSensors (drift/selection.h) with options.selection, or,
@@ -183,6 +193,9 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
                               const FitOptions& options);
 
 /// Fits a model of `error_column` on `runs` (InputError on missing columns or bad options).
+/// Dead and duplicate sensors (selection.h convention 8) are left out of the selection and of
+/// given sensors, with a warning each (FitReport::warnings); InputError naming the run files when
+/// no sensor is left, or when the regression is still rank-deficient (naming the features).
 FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);
 

@@ -1,10 +1,8 @@
 #include "drift/run_file.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <set>
-#include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
@@ -20,74 +18,21 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 std::string Join(const std::vector<std::string>& v) {
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
   return out.empty() ? "none" : out;
 }
 
-// The time column may hold empty or nan cells, which core's strict CSV rejects: such cells are
-// replaced by 0 before parsing (same line numbers) and remembered, so every other cell keeps the
-// strict rules and their messages.
-struct TimePrepass {
-  std::string text;
-  std::string time_column;  // "" if none
-  int missing = 0;
-};
-
-TimePrepass PrepareTime(const std::string& text, const std::string& source) {
-  TimePrepass p;
-  std::istringstream in(text);
-  std::string line, out;
-  int time_index = -1, line_no = 0;
-  bool header = false;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string trimmed = Trim(line);
-    if (!trimmed.empty() && trimmed[0] != '#') {
-      std::vector<std::string> cells;
-      std::string cell;
-      std::istringstream ss(line);
-      while (std::getline(ss, cell, ',')) cells.push_back(cell);
-      if (!line.empty() && line.back() == ',') cells.push_back("");
-      if (!header) {
-        header = true;
-        for (std::size_t i = 0; i < cells.size(); ++i) {
-          const std::string name = Trim(cells[i]);
-          if (name != "time_s" && name != "time_min") continue;
-          if (time_index >= 0)
-            throw InputError(source + ":" + std::to_string(line_no) + ": two time columns ('" +
-                             p.time_column + "' and '" + name +
-                             "'): give time_s or time_min, not both");
-          time_index = static_cast<int>(i);
-          p.time_column = name;
-        }
-      } else if (time_index >= 0 && static_cast<int>(cells.size()) > time_index) {
-        const std::string v = Lower(Trim(cells[static_cast<std::size_t>(time_index)]));
-        if (v.empty() || v == "nan") {
-          ++p.missing;
-          cells[static_cast<std::size_t>(time_index)] = "0";
-          line.clear();
-          for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
-        }
-      }
-    }
-    out += line;
-    out += '\n';
-  }
-  p.text = std::move(out);
-  return p;
+// The time column: time_s or time_min (not both); "" if none. Its cells may be missing (empty
+// or nan, CsvOptions::missing_allowed), every other cell keeps the reader's strict rules.
+std::string TimeColumn(const CsvTable& t) {
+  const bool s = t.HasColumn("time_s"), m = t.HasColumn("time_min");
+  if (s && m)
+    throw InputError(t.source + ":" + std::to_string(t.header_line) +
+                     ": two time columns ('time_s' and 'time_min'): give time_s or time_min, not "
+                     "both");
+  return s ? "time_s" : m ? "time_min" : "";
 }
 
 void CheckRange(const CsvTable& t, std::size_t row, std::size_t col, double lo, double hi,
@@ -164,8 +109,10 @@ Run ErrorsFromStart(const Run& run) {
 }
 
 Run ParseRun(const std::string& text, const std::string& source, RunState state) {
-  const TimePrepass prep = PrepareTime(text, source);
-  const CsvTable t = ParseCsv(prep.text, source);
+  CsvOptions csv;
+  csv.missing_allowed = {"time_s", "time_min"};
+  const CsvTable t = ParseCsv(text, source, csv);
+  const std::string time_column = TimeColumn(t);
   if (t.rows.size() > static_cast<std::size_t>(kMaxRunSamples))
     throw InputError(source + ": " + std::to_string(t.rows.size()) +
                      " rows: a run file holds at most " + std::to_string(kMaxRunSamples) +
@@ -181,7 +128,7 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
   std::vector<std::size_t> s_cols, e_cols, o_cols;
   for (std::size_t c = 0; c < t.header.size(); ++c) {
     const std::string& h = t.header[c];
-    if (h == prep.time_column) continue;
+    if (h == time_column) continue;
     if (EndsWith(h, "_C")) {
       s_cols.push_back(c);
       r.sensor_names.push_back(h);
@@ -217,13 +164,16 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
     for (std::size_t j = 0; j < o_cols.size(); ++j)
       r.other(k, static_cast<Eigen::Index>(j)) = t.rows[i][o_cols[j]];
   }
-  if (prep.time_column.empty() || prep.missing > 0) {
+  bool missing = false;  // a time cell was empty or nan
+  if (!time_column.empty())
+    for (double v : t.Column(time_column)) missing = missing || std::isnan(v);
+  if (time_column.empty() || missing) {
     r.time_from_index = true;
     r.time_min.resize(q);
     for (std::size_t i = 0; i < q; ++i) r.time_min[i] = static_cast<double>(i);
   } else {
-    r.time_min = t.IncreasingColumn(prep.time_column);
-    if (prep.time_column == "time_s")
+    r.time_min = t.IncreasingColumn(time_column);
+    if (time_column == "time_s")
       for (double& v : r.time_min) v /= 60.0;
   }
   return r;
@@ -264,6 +214,8 @@ std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
 
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold) {
   const int c = run.OtherIndex(column);
+  if (!std::isfinite(threshold))
+    throw InputError("split threshold " + FormatNumber(threshold) + ": must be a finite number");
   std::vector<int> starts{0};
   for (int k = 1; k < run.samples(); ++k)
     if (run.other(k - 1, c) <= threshold && run.other(k, c) > threshold && k > starts.back())

@@ -318,12 +318,60 @@ void StackRuns(const std::vector<Run>& runs, const std::string& error_column,
   }
 }
 
+SensorScreen ScreenSensors(const Eigen::MatrixXd& rises, const std::vector<std::string>& names,
+                           const std::string& sources) {
+  const Eigen::MatrixXd c = rises.rowwise() - rises.colwise().mean();
+  const Eigen::MatrixXd gram = c.transpose() * c;  // centred cross products
+  SensorScreen s;
+  for (Eigen::Index j = 0; j < rises.cols(); ++j) {
+    const std::string& name = names[static_cast<std::size_t>(j)];
+    if (rises.rows() == 0 || rises.col(j).cwiseAbs().maxCoeff() == 0) {
+      s.left_out.push_back(name + " is dead: its reading never moves in " + sources +
+                           " (a stuck or disconnected sensor); left out");
+      continue;
+    }
+    int copy_of = -1;
+    for (const int i : s.usable) {
+      const double norms = std::sqrt(gram(i, i) * gram(j, j));
+      if (norms > 0 && std::abs(gram(i, j)) >= (1 - kDuplicateTolerance) * norms) copy_of = i;
+      if (copy_of >= 0) break;
+    }
+    if (copy_of >= 0) {
+      s.left_out.push_back(name + " moves exactly as " + names[static_cast<std::size_t>(copy_of)] +
+                           " in " + sources + " (the same sensor twice?); left out");
+      continue;
+    }
+    s.usable.push_back(static_cast<int>(j));
+  }
+  if (s.usable.empty())
+    throw InputError(sources +
+                     ": no usable temperature sensor: every _C column is dead (its "
+                     "reading never moves) or a copy of another; check the logger");
+  return s;
+}
+
+std::string RunSources(const std::vector<Run>& runs) {
+  std::string out;
+  for (const Run& r : runs) out += (out.empty() ? "" : ", ") + r.source;
+  return out;
+}
+
 Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
                         const SelectionOptions& options) {
   Eigen::MatrixXd rises;
   Eigen::VectorXd error;
   StackRuns(runs, error_column, &rises, &error);
-  return SelectSensors(rises, error, runs.front().sensor_names, options);
+  const std::vector<std::string>& all = runs.front().sensor_names;
+  const SensorScreen screen = ScreenSensors(rises, all, RunSources(runs));
+  Eigen::MatrixXd kept(rises.rows(), static_cast<Eigen::Index>(screen.usable.size()));
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < screen.usable.size(); ++k) {
+    kept.col(static_cast<Eigen::Index>(k)) = rises.col(screen.usable[k]);
+    names.push_back(all[static_cast<std::size_t>(screen.usable[k])]);
+  }
+  Selection s = SelectSensors(kept, error, names, options);
+  s.left_out = screen.left_out;
+  return s;
 }
 
 }  // namespace whirl::drift

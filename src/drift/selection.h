@@ -38,6 +38,12 @@
 //        xi_i(k) = (d_min + rho d_max) / (d_i(k) + rho d_max),  grade_i = mean_k xi_i(k)
 //     (every grade is 1 when d_max = 0). In each class the sensor with the highest grade is
 //     chosen (ties: the first in file order). Chosen sensors are listed in file order.
+//  8. Before all this, on runs (and before a fit on given sensors, drift/model.h), sensors that
+//     carry nothing of their own are left out, each named in a warning (ScreenSensors): a dead
+//     sensor, whose rise is 0 in every sample of every run (a stuck or disconnected sensor, a
+//     constant column), and a duplicate, whose rise series equals an earlier sensor's up to scale
+//     and offset (|r| >= 1 - kDuplicateTolerance: the same sensor logged twice). Either would
+//     make the regression rank-deficient. When no sensor is left, the runs are refused.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -86,6 +92,8 @@ struct Selection {
     double cv_rmse_um = 0;
   };
   std::vector<ClassCountScore> class_count_scores;
+  /// Sensors left out before the selection (convention 8), one line each naming the sensor.
+  std::vector<std::string> left_out;
 
   std::vector<std::string> ChosenNames() const;
 };
@@ -118,6 +126,22 @@ Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& err
 /// it or the runs' sensors differ.
 Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
                         const SelectionOptions& options = {});
+
+/// 1 - |r| below which two rise series count as one (convention 8).
+inline constexpr double kDuplicateTolerance = 1e-12;
+
+/// Convention 8 on stacked rises (samples x sensors, convention 1) named `names`.
+struct SensorScreen {
+  std::vector<int> usable;            ///< columns kept, in file order
+  std::vector<std::string> left_out;  ///< one line per column left out: its name and why
+};
+/// InputError "<sources>: no usable temperature sensor: ..." when every column is left out
+/// (`sources` names the run files).
+SensorScreen ScreenSensors(const Eigen::MatrixXd& rises, const std::vector<std::string>& names,
+                           const std::string& sources);
+
+/// "a.csv, b.csv": the files of the runs, for messages.
+std::string RunSources(const std::vector<Run>& runs);
 
 /// Rises and errors of several runs stacked (convention 1). Sensors must agree by name.
 void StackRuns(const std::vector<Run>& runs, const std::string& error_column,

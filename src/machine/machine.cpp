@@ -7,6 +7,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
 #include "sim/random.h"
 
 namespace whirl::machine {
@@ -15,14 +16,22 @@ namespace {
 
 double Rise(double t_min, double tau_min) { return 1.0 - std::exp(-t_min / tau_min); }
 
-void Positive(double v, const std::string& what) {
-  if (!(v > 0) || !std::isfinite(v))
-    throw InputError(what + " = " + FormatNumber(v) + ": must be finite and > 0");
-}
-void NonNegative(double v, const std::string& what) {
-  if (!(v >= 0) || !std::isfinite(v))
-    throw InputError(what + " = " + FormatNumber(v) + ": must be finite and >= 0");
-}
+// Physical ranges of the machine file's fields (machine.h); far outside any real machine, so they
+// only stop mistakes (a unit slip, a typo'd exponent, a corrupt file).
+constexpr Range kPowerKw{0, 100, false, "kW"};          // a whirling head: a few kW
+constexpr Range kGainUmPerKw{0, 1000, false, "um/kW"};  // 1 mm per kW: none moves that much
+constexpr Range kTauMin{0, 10000, true, "min"};         // about a week
+constexpr Range kExpansionPerK{0, 1e-4, false, "1/K"};  // metals 1e-5 to 2.5e-5
+constexpr Range kRiseK{0, 100, false, "K"};             // steady rise of the Z screw
+constexpr Range kFixedEndMm{0, kMaxAxisPositionMm, false, "mm"};
+constexpr Range kRateKPerH{0, 10, false, "K/h"};         // ambient drift per hour
+constexpr Range kStartC{-20, 50, false, "degC"};         // a workshop
+constexpr Range kSpread{0, 1, false, "(relative std)"};  // 1 = 100 %
+constexpr Range kSensorK{0, 10, false, "K"};             // noise, quantum
+constexpr Range kSampleMin{0, 1440, true, "min"};        // at least one sample a day
+constexpr Range kWeight{0, 1, false, ""};                // ambient weight a_i
+constexpr Range kSensorGainKPerKw{0, 100, false, "K/kW"};
+constexpr Range kSensorGainKPerK{0, 10, false, "K/K"};
 
 SensorSpec Sensor(const char* name, double a, double motor, double process, double z, double tau) {
   return SensorSpec{name, a, {motor, process, z}, tau};
@@ -54,29 +63,25 @@ void MachineConfig::Validate(const std::string& where) const {
                      ": name must be 1..100 characters without control characters (it "
                      "goes into file comments)");
   if (head.sign != 1 && head.sign != -1) throw InputError(where + ": head.sign must be +1 or -1");
-  NonNegative(head.idle_power_kw, where + ": head.idle_power_kw [kW]");
-  NonNegative(head.cutting_power_kw, where + ": head.cutting_power_kw [kW]");
-  NonNegative(head.motor_gain_um_per_kw, where + ": head.motor_gain_um_per_kw [um/kW]");
-  NonNegative(head.process_gain_um_per_kw, where + ": head.process_gain_um_per_kw [um/kW]");
-  Positive(head.motor_tau_min, where + ": head.motor_tau_min [min]");
-  Positive(head.process_tau_min, where + ": head.process_tau_min [min]");
-  NonNegative(z_screw.expansion_per_k, where + ": z_screw.expansion_per_k [1/K]");
-  NonNegative(z_screw.steady_rise_k, where + ": z_screw.steady_rise_k [K]");
-  Positive(z_screw.tau_min, where + ": z_screw.tau_min [min]");
-  NonNegative(z_screw.fixed_end_mm, where + ": z_screw.fixed_end_mm [mm]");
-  NonNegative(ambient.expansion_per_k, where + ": ambient.expansion_per_k [1/K]");
-  Positive(ambient.bed_tau_min, where + ": ambient.bed_tau_min [min]");
-  NonNegative(ambient.rate_std_k_per_h, where + ": ambient.rate_std_k_per_h [K/h]");
-  if (!std::isfinite(ambient.start_c) || ambient.start_c < -20 || ambient.start_c > 50)
-    throw InputError(where + ": ambient.start_c = " + FormatNumber(ambient.start_c) +
-                     " degC: must be within [-20, 50]");
-  NonNegative(machine_spread, where + ": machine_spread");
-  NonNegative(power_spread, where + ": power_spread");
-  NonNegative(noise_std_k, where + ": noise_std_k [K]");
-  NonNegative(quantum_k, where + ": quantum_k [K]");
-  Positive(sample_min, where + ": sample_min [min]");
-  if (head.idle_power_kw > 100 || head.cutting_power_kw > 100)
-    throw InputError(where + ": head power above 100 kW: not a whirling head");
+  CheckRange(head.idle_power_kw, kPowerKw, "head.idle_power_kw", where);
+  CheckRange(head.cutting_power_kw, kPowerKw, "head.cutting_power_kw", where);
+  CheckRange(head.motor_gain_um_per_kw, kGainUmPerKw, "head.motor_gain_um_per_kw", where);
+  CheckRange(head.process_gain_um_per_kw, kGainUmPerKw, "head.process_gain_um_per_kw", where);
+  CheckRange(head.motor_tau_min, kTauMin, "head.motor_tau_min", where);
+  CheckRange(head.process_tau_min, kTauMin, "head.process_tau_min", where);
+  CheckRange(z_screw.expansion_per_k, kExpansionPerK, "z_screw.expansion_per_k", where);
+  CheckRange(z_screw.steady_rise_k, kRiseK, "z_screw.steady_rise_k", where);
+  CheckRange(z_screw.tau_min, kTauMin, "z_screw.tau_min", where);
+  CheckRange(z_screw.fixed_end_mm, kFixedEndMm, "z_screw.fixed_end_mm", where);
+  CheckRange(ambient.expansion_per_k, kExpansionPerK, "ambient.expansion_per_k", where);
+  CheckRange(ambient.bed_tau_min, kTauMin, "ambient.bed_tau_min", where);
+  CheckRange(ambient.rate_std_k_per_h, kRateKPerH, "ambient.rate_std_k_per_h", where);
+  CheckRange(ambient.start_c, kStartC, "ambient.start_c", where);
+  CheckRange(machine_spread, kSpread, "machine_spread", where);
+  CheckRange(power_spread, kSpread, "power_spread", where);
+  CheckRange(noise_std_k, kSensorK, "noise_std_k", where);
+  CheckRange(quantum_k, kSensorK, "quantum_k", where);
+  CheckRange(sample_min, kSampleMin, "sample_min", where);
   if (sensors.empty() || sensors.size() > 64)
     throw InputError(where + ": sensors: " + std::to_string(sensors.size()) +
                      " given, must be 1..64");
@@ -88,7 +93,12 @@ void MachineConfig::Validate(const std::string& where) const {
     if (!plain)
       throw InputError(where + ": sensor name '" + s.name +
                        "': must be 1..64 letters, digits or '_' (it becomes a CSV column)");
-    Positive(s.tau_min, where + ": sensor '" + s.name + "' tau_min [min]");
+    const std::string field = "sensor '" + s.name + "' ";
+    CheckRange(s.ambient_weight, kWeight, field + "ambient_weight", where);
+    CheckRange(s.gains[0], kSensorGainKPerKw, field + "motor_k_per_kw", where);
+    CheckRange(s.gains[1], kSensorGainKPerKw, field + "process_k_per_kw", where);
+    CheckRange(s.gains[2], kSensorGainKPerK, field + "z_screw_k_per_k", where);
+    CheckRange(s.tau_min, kTauMin, field + "tau_min", where);
   }
 }
 
@@ -155,16 +165,16 @@ void to_json(nlohmann::json& j, const MachineConfig& m) {
        {"sensors", sensors}};
 }
 
-void from_json(const nlohmann::json& j, MachineConfig& m) {
-  const std::string w = "machine";
+namespace {
+
+void FromJson(const nlohmann::json& j, MachineConfig& m, const std::string& w) {
   RejectUnknownKeys(
       j,
       {"schema", "schema_version", "name", "head", "z_screw", "ambient", "machine_spread",
        "power_spread", "noise_std_k", "quantum_k", "sample_min", "sensors", "sources"},
       w);
-  if (j.contains("schema") && j.at("schema") != "whirl.machine_thermal")
-    throw InputError(w + ": schema must be \"whirl.machine_thermal\"");
-  if (j.contains("name")) m.name = j.at("name").get<std::string>();
+  RequireSchema(j, "whirl.machine_thermal", kMachineSchemaVersion, w);
+  if (j.contains("name")) m.name = RequireString(j, "name", w);
   if (j.contains("head")) {
     const auto& h = j.at("head");
     const std::string hw = w + " head";
@@ -174,9 +184,7 @@ void from_json(const nlohmann::json& j, MachineConfig& m) {
          "motor_tau_min", "process_gain_um_per_kw", "process_tau_min"},
         hw);
     OptionalBool(h, "enabled", m.head.enabled, hw);
-    double sign = m.head.sign;
-    Optional(h, "sign", sign, hw);
-    m.head.sign = static_cast<int>(sign);
+    if (h.contains("sign")) m.head.sign = static_cast<int>(RequireInteger(h, "sign", -1, 1, hw));
     Optional(h, "idle_power_kw", m.head.idle_power_kw, hw);
     Optional(h, "cutting_power_kw", m.head.cutting_power_kw, hw);
     Optional(h, "motor_gain_um_per_kw", m.head.motor_gain_um_per_kw, hw);
@@ -212,6 +220,7 @@ void from_json(const nlohmann::json& j, MachineConfig& m) {
   Optional(j, "quantum_k", m.quantum_k, w);
   Optional(j, "sample_min", m.sample_min, w);
   if (j.contains("sensors")) {
+    if (!j.at("sensors").is_array()) throw InputError(w + ": 'sensors' must be an array");
     m.sensors.clear();
     for (const auto& s : j.at("sensors")) {
       const std::string sw = w + " sensor";
@@ -220,7 +229,7 @@ void from_json(const nlohmann::json& j, MachineConfig& m) {
                          "z_screw_k_per_k", "tau_min", "location"},
                         sw);
       SensorSpec spec;
-      spec.name = s.at("name").get<std::string>();
+      spec.name = RequireString(s, "name", sw);
       Optional(s, "ambient_weight", spec.ambient_weight, sw + " " + spec.name);
       Optional(s, "motor_k_per_kw", spec.gains[0], sw + " " + spec.name);
       Optional(s, "process_k_per_kw", spec.gains[1], sw + " " + spec.name);
@@ -231,19 +240,20 @@ void from_json(const nlohmann::json& j, MachineConfig& m) {
   }
 }
 
+}  // namespace
+
+void from_json(const nlohmann::json& j, MachineConfig& m) { FromJson(j, m, "machine"); }
+
 MachineConfig ReadMachine(const std::string& path) {
+  const std::string what = "machine file '" + path + "'";
   const nlohmann::json j = ReadJsonFile(path);
   MachineConfig m = DefaultMachine();
   try {
-    from_json(j, m);
-    m.Validate("machine file '" + path + "'");
+    FromJson(j, m, what);
   } catch (const nlohmann::json::exception& e) {
-    throw InputError("machine file '" + path + "': " + e.what());
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    if (msg.rfind("machine file", 0) == 0) throw;
-    throw InputError("machine file '" + path + "': " + msg);
+    throw InputError(what + ": " + e.what());
   }
+  m.Validate(what);
   return m;
 }
 
@@ -315,7 +325,7 @@ double MachineDay::DriftUm(double t_min, double z_mm, bool cutting, double v_c) 
 }
 
 drift::Run SimulateRun(const MachineDay& day, const RunSpec& spec) {
-  Positive(spec.duration_min, "run '" + spec.name + "' duration_min");
+  CheckRange(spec.duration_min, {0, 1e6, true, "min"}, "duration_min", "run '" + spec.name + "'");
   const MachineConfig& c = day.config;
   const double step = c.sample_min;
   const int samples = static_cast<int>(std::floor(spec.duration_min / step + 1e-9)) + 1;

@@ -119,8 +119,14 @@ struct MachineConfig {
 /// The default machine (the values above and 12 named sensors), equal to the shipped JSON.
 MachineConfig DefaultMachine();
 void to_json(nlohmann::json& j, const MachineConfig& m);
-void from_json(const nlohmann::json& j, MachineConfig& m);  ///< unknown keys rejected
-MachineConfig ReadMachine(const std::string& path);         ///< InputError names file and key
+/// "schema": "whirl.machine_thermal" and "schema_version": 1 are required, every other key is
+/// optional (the default above); unknown keys are rejected.
+void from_json(const nlohmann::json& j, MachineConfig& m);
+/// from_json, then Validate: every number within its physical range (powers [0, 100] kW, time
+/// constants (0, 10000] min, expansion coefficients [0, 1e-4] 1/K, spreads [0, 1], sensor noise
+/// and quantum [0, 10] K, sample step (0, 1440] min, ...; machine.cpp states each). InputError
+/// names the file, the field, the value and the range.
+MachineConfig ReadMachine(const std::string& path);
 
 /// One machine on one day: the drawn parameters (seeded), closed forms of m.
 struct MachineDay {

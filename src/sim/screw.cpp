@@ -57,9 +57,10 @@ void ValidateScrew(const Screw& s, const std::string& what) {
     Fail(what, "process.tool_count", st.tool_count, "a whirling ring carries 1-24 tools");
   if (!(st.feed_per_tooth_mm > 0 && st.feed_per_tooth_mm <= 1.0))
     Fail(what, "process.feed_per_tooth_mm", st.feed_per_tooth_mm, "must be in (0, 1] mm");
-  RequirePositive(what, "process.tool_circle_margin_mm", st.tool_circle_margin_mm);
-  if (!(st.thread_start_offset_mm >= 0) || !std::isfinite(st.thread_start_offset_mm))
-    Fail(what, "process.thread_start_offset_mm", st.thread_start_offset_mm, "must be >= 0 mm");
+  CheckRange(st.tool_circle_margin_mm, {0, kMaxToolCircleMarginMm, true, "mm"},
+             "process.tool_circle_margin_mm", what);
+  CheckRange(st.thread_start_offset_mm, {0, kMaxBlankLengthMm, false, "mm"},
+             "process.thread_start_offset_mm", what);
   if (!(st.ambient_temperature_c > -50 && st.ambient_temperature_c < 80))
     Fail(what, "process.ambient_temperature_c", st.ambient_temperature_c,
          "a workshop temperature is within -50..80 degC");

@@ -15,6 +15,10 @@
 
 namespace whirl::sim {
 
+/// Largest tool-circle margin, mm: a whirling ring's tool circle only just clears the blank (6 mm
+/// on the reference screw); 100 mm would be a ring several screw sizes too large.
+inline constexpr double kMaxToolCircleMarginMm = 100;
+
 /// Machine/process settings that are not among the five network inputs.
 struct ProcessSettings {
   /// Formed tools on the whirling ring, - (REFERENCE 1: 6-8 tools).
@@ -26,8 +30,9 @@ struct ProcessSettings {
   /// (plateau after ~250 s); the axial reading gives 40 mm/min, a ~2 h cut of the 5100 mm thread
   /// and the paper's time scale.
   double feed_per_tooth_mm = 0.01;
-  /// Tool-circle diameter minus screw diameter, mm: D_tool = D + margin. Assumption chosen so that
-  /// the paper's ring speed 667 r/min and 180 m/min give D_tool = 86 mm for the 80 mm screw.
+  /// Tool-circle diameter minus screw diameter, mm: D_tool = D + margin, in (0,
+  /// kMaxToolCircleMarginMm]. Assumption chosen so that the paper's ring speed 667 r/min and
+  /// 180 m/min give D_tool = 86 mm for the 80 mm screw.
   double tool_circle_margin_mm = 6.0;
   /// Distance from the free end of the blank to the start of the thread, mm (unthreaded journal).
   double thread_start_offset_mm = 400.0;
@@ -83,6 +88,8 @@ struct Kinematics {
 /// Throws InputError (naming the field, value and rule) for impossible values: process inputs
 /// outside the physical limits of core/limits.h (hardness 20-70 HRC, diameter (0, 500] mm, ...),
 /// a blank longer than kMaxBlankLengthMm (20 m), non-positive sizes, tool count outside 1-24,
+/// a tool-circle margin outside (0, kMaxToolCircleMarginMm] mm, a thread start offset outside
+/// [0, kMaxBlankLengthMm] mm,
 /// thread longer than the blank minus the offset, a groove wider than lead - kMinLandMm ("ball too
 /// large for the lead"), or deeper than kMaxGrooveDepthFraction * D. `what` prefixes messages (e.g.
 /// the file name).

@@ -17,7 +17,10 @@ PointModelFn DriftPointModel(const std::vector<drift::Run>& training, const drif
       std::snprintf(buf, sizeof buf, "; R^2 %.4f, residual std %.3f um", fit.model.r_squared,
                     fit.model.residual_std_um);
       const std::lock_guard<std::mutex> lock(notes->mutex);
-      notes->by_column[column] = drift::ToString(fit.model.kind) + " on " + sensors + buf;
+      std::string left_out;
+      for (const auto& w : fit.warnings) left_out += "; " + w;
+      notes->by_column[column] =
+          drift::ToString(fit.model.kind) + " on " + sensors + buf + left_out;
     }
     return std::vector<double>(p.predicted_um.data(),
                                p.predicted_um.data() + p.predicted_um.size());

@@ -1,12 +1,12 @@
 #include "surface/line840d.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace whirl::surface {
 namespace {
@@ -52,17 +52,12 @@ std::string Num(double x, const char* fmt) {
 void AxisLineOptions::Validate(const Surface& surface) const {
   if (along != 'x' && along != 'y')
     throw InputError(std::string("--along '") + along + "' must be x or y");
-  if (axis.empty() || axis.size() > 16 ||
-      !std::all_of(axis.begin(), axis.end(),
-                   [](unsigned char ch) { return std::isalnum(ch) || ch == '_'; }))
-    throw InputError("axis name '" + axis + "' must be 1-16 letters, digits or '_'");
+  interp::CheckAxisName(axis);
   if (!(md32760 > 0 && md32760 <= interp::kMd32760Max))
     throw InputError("md32760 " + FormatNumber(md32760) + " must be in (0, 0.10]");
   if (samples < 2 || samples > 1001)
     throw InputError("samples " + std::to_string(samples) + " is outside 2..1001");
-  if (!std::isfinite(machine_offset_mm) || std::abs(machine_offset_mm) > kMaxCoordinateMm)
-    throw InputError("machine_offset_mm " + FormatNumber(machine_offset_mm) +
-                     " must be finite and within +-100000 mm");
+  CheckRange(machine_offset_mm, kAxisPositionRange, "machine_offset_mm", "surface line");
   const Bounds& b = surface.bounds;
   const bool x = along == 'x';
   if (at_mm) {

@@ -33,7 +33,7 @@ namespace whirl::surface {
 
 struct AxisLineOptions {
   char along = 'x';             ///< surface coordinate the axis moves along: 'x' or 'y'
-  std::string axis = "X";       ///< 840D axis name in $SA_...[axis] (letters, digits, '_')
+  std::string axis = "X";       ///< 840D axis name in $SA_...[axis] (interp::CheckAxisName)
   std::optional<double> at_mm;  ///< fixed other coordinate (one traverse), mm; none: whole table
   std::optional<double> ref_position_mm;  ///< c0 in surface coordinates, mm; none: travel start
   double machine_offset_mm = 0;           ///< MCS position of the surface's coordinate origin, mm

@@ -56,8 +56,7 @@ std::vector<PointColumn> ReadPointManifest(const std::filesystem::path& path,
   const std::string what = "manifest '" + path.string() + "'";
   const nlohmann::json j = ReadJsonFile(path);
   RejectUnknownKeys(j, {"schema", "schema_version", "points", "provenance"}, what);
-  if (j.value("schema", "") != "whirl.surface_manifest" || j.value("schema_version", 0) != 1)
-    throw InputError(what + ": schema 'whirl.surface_manifest' version 1 expected");
+  RequireSchema(j, "whirl.surface_manifest", 1, what);
   if (!j.contains("points") || !j.at("points").is_array())
     throw InputError(what + ": 'points' must be an array");
   std::set<std::string> have(header.begin(), header.end());
@@ -66,9 +65,7 @@ std::vector<PointColumn> ReadPointManifest(const std::filesystem::path& path,
     const auto& p = j.at("points")[k];
     const std::string where = what + " point " + std::to_string(k + 1);
     RejectUnknownKeys(p, {"column", "x_mm", "y_mm"}, where);
-    if (!p.contains("column") || !p.at("column").is_string())
-      throw InputError(where + ": 'column' must be a string");
-    const std::string column = p.at("column").get<std::string>();
+    const std::string column = RequireString(p, "column", where);
     if (!EndsWithUm(column))
       throw InputError(where + ": column '" + column + "' is not an error column (*_um)");
     if (!have.count(column)) throw InputError(where + ": the run has no column '" + column + "'");
@@ -134,6 +131,8 @@ std::string FormatPointPredictionsCsv(const PointPredictions& p, const std::vect
 
 std::size_t NearestSample(const std::vector<double>& times, double time) {
   if (times.empty()) throw InputError("no samples to pick a time from");
+  if (!std::isfinite(time))
+    throw InputError("time " + FormatNumber(time) + ": must be a finite number");
   std::size_t best = 0;
   for (std::size_t k = 1; k < times.size(); ++k)
     if (std::abs(times[k] - time) < std::abs(times[best] - time)) best = k;

@@ -7,6 +7,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
 
 namespace whirl::surface {
 namespace {
@@ -73,8 +74,6 @@ CubicSurface CubicFromJson(const json& j, const std::string& what) {
   c.y_center_mm = RequireNumber(j, "y_center_mm", what);
   c.x_half_range_mm = RequireNumber(j, "x_half_range_mm", what);
   c.y_half_range_mm = RequireNumber(j, "y_half_range_mm", what);
-  if (!(c.x_half_range_mm > 0) || !(c.y_half_range_mm > 0))
-    throw InputError(what + ": x_half_range_mm and y_half_range_mm must be > 0");
   const std::vector<double> b = Numbers(j, "b_um", what);
   if (b.size() != kCubicTerms) throw InputError(what + ": 'b_um' must hold 10 coefficients");
   for (int k = 0; k < kCubicTerms; ++k) c.b[k] = b[k];
@@ -117,6 +116,23 @@ BsplineSurface BsplineFromJson(const json& j, const std::string& what) {
   return s;
 }
 
+const Range kCoordinate{-kMaxCoordinateMm, kMaxCoordinateMm, false, "mm"};
+const Range kHalfRange{kSamePositionMm, kMaxCoordinateMm, false, "mm"};
+const Range kCoefficient{-kMaxSurfaceCoefficientUm, kMaxSurfaceCoefficientUm, false, "um"};
+
+std::string Indexed(const char* name, std::size_t i) {
+  return name + ("[" + std::to_string(i) + "]");
+}
+
+void CheckBounds(const Bounds& b, const std::string& what) {
+  CheckRange(b.x_min_mm, kCoordinate, "bounds.x_min_mm", what);
+  CheckRange(b.x_max_mm, kCoordinate, "bounds.x_max_mm", what);
+  CheckRange(b.y_min_mm, kCoordinate, "bounds.y_min_mm", what);
+  CheckRange(b.y_max_mm, kCoordinate, "bounds.y_max_mm", what);
+  if (b.x_min_mm > b.x_max_mm || b.y_min_mm > b.y_max_mm)
+    throw InputError(what + ": bounds: x_min_mm must not exceed x_max_mm, nor y_min_mm y_max_mm");
+}
+
 std::string Fixed(double x, int decimals) {
   if (std::isnan(x)) return "-";
   char buf[64];
@@ -132,6 +148,31 @@ Method ParseMethod(const std::string& text) {
   if (text == "cubic") return Method::kCubic;
   if (text == "bspline") return Method::kBspline;
   throw InputError("surface method '" + text + "' is not 'cubic' or 'bspline'");
+}
+
+void CheckSurface(const Surface& s, const std::string& what) {
+  CheckBounds(s.bounds, what);
+  if (s.method == Method::kCubic) {
+    const CubicSurface& c = s.cubic;
+    CheckRange(c.x_center_mm, kCoordinate, "cubic.x_center_mm", what);
+    CheckRange(c.y_center_mm, kCoordinate, "cubic.y_center_mm", what);
+    CheckRange(c.x_half_range_mm, kHalfRange, "cubic.x_half_range_mm", what);
+    CheckRange(c.y_half_range_mm, kHalfRange, "cubic.y_half_range_mm", what);
+    for (std::size_t k = 0; k < c.b.size(); ++k)
+      CheckRange(c.b[k], kCoefficient, Indexed("cubic.b_um", k), what);
+    return;
+  }
+  const BsplineSurface& b = s.bspline;
+  for (std::size_t i = 0; i < b.grid_x.size(); ++i)
+    CheckRange(b.grid_x[i], kCoordinate, Indexed("bspline.grid_x_mm", i), what);
+  for (std::size_t i = 0; i < b.grid_y.size(); ++i)
+    CheckRange(b.grid_y[i], kCoordinate, Indexed("bspline.grid_y_mm", i), what);
+  for (Eigen::Index i = 0; i < b.weights.rows(); ++i)
+    for (Eigen::Index k = 0; k < b.weights.cols(); ++k)
+      CheckRange(b.weights(i, k), kCoefficient,
+                 Indexed("bspline.weights_um", static_cast<std::size_t>(i)) + "[" +
+                     std::to_string(k) + "]",
+                 what);
 }
 
 double Surface::Evaluate(double x_mm, double y_mm) const {
@@ -169,6 +210,7 @@ SurfaceFit FitSurface(const std::vector<SurfacePoint>& points, const SurfaceFitO
   }
   for (std::size_t k = 0; k < points.size(); ++k)
     f.fitted_um.push_back(points[k].error_um - f.residual_um[k]);
+  CheckSurface(f.surface, "surface fit");  // what is written reads back
   return f;
 }
 
@@ -203,14 +245,11 @@ nlohmann::json SurfaceFitToJson(const SurfaceFit& f) {
 }
 
 Surface SurfaceFromJson(const nlohmann::json& j, const std::string& what) {
-  if (!j.is_object() || j.value("schema", "") != "whirl.surface")
+  if (!j.is_object() || !j.contains("schema") || j.at("schema") != "whirl.surface")
     throw InputError(what + ": not a whirl surface file (schema 'whirl.surface' expected)");
-  if (j.value("schema_version", 0) != 1)
-    throw InputError(what + ": unsupported schema_version (1 expected)");
+  RequireSchema(j, "whirl.surface", 1, what);
   Surface s;
-  if (!j.contains("method") || !j.at("method").is_string())
-    throw InputError(what + ": missing 'method'");
-  s.method = ParseMethod(j.at("method").get<std::string>());
+  s.method = ParseMethod(RequireOneOf(j, "method", {"cubic", "bspline"}, what));
   if (!j.contains("bounds")) throw InputError(what + ": missing 'bounds'");
   const json& b = j.at("bounds");
   s.bounds = {RequireNumber(b, "x_min_mm", what), RequireNumber(b, "x_max_mm", what),
@@ -222,6 +261,7 @@ Surface SurfaceFromJson(const nlohmann::json& j, const std::string& what) {
     s.cubic = CubicFromJson(j.at(key), what);
   else
     s.bspline = BsplineFromJson(j.at(key), what);
+  CheckSurface(s, what);
   return s;
 }
 

@@ -26,7 +26,8 @@
 //   points [{x_mm, y_mm, error_um, fitted_um, residual_um, loo_error_um (null: undefined)}];
 //   summary {rms_residual_um, max_abs_residual_um, loo_rms_um, loo_max_abs_um, loo_count};
 //   provenance [strings].
-// Reading it back (SurfaceFromJson) checks the schema, the lengths, finiteness and the knot rule.
+// Reading it back (SurfaceFromJson) checks the schema, the lengths, the knot rule and the range of
+// every number (CheckSurface), the same checks a fit passes before it is written.
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -54,6 +55,18 @@ struct Surface {
   bool Inside(double x_mm, double y_mm) const { return bounds.Contains(x_mm, y_mm); }
 };
 
+/// Largest |coefficient| of a surface, um: |b_um| of the cubic, |weights_um| of the B-spline
+/// (1 km: far beyond any thermal error, so only a corrupt or hand-made file reaches it). With it,
+/// positions within kMaxCoordinateMm and half ranges of at least kSamePositionMm, an evaluation
+/// stays finite.
+inline constexpr double kMaxSurfaceCoefficientUm = 1e12;
+
+/// The ranges of a surface, as the file names them: bounds.* and the cubic's centre within
+/// +-kMaxCoordinateMm mm, x_min_mm <= x_max_mm (and y), half ranges in [kSamePositionMm,
+/// kMaxCoordinateMm] mm, grid lines within +-kMaxCoordinateMm mm, coefficients within
+/// +-kMaxSurfaceCoefficientUm um. InputError "<what>: <field> = <value> breaks the rule: ...".
+void CheckSurface(const Surface& surface, const std::string& what);
+
 struct SurfaceFitOptions {
   Method method = Method::kCubic;
   /// B-spline degree p in X and Y, 1..kMaxDegree (3: bicubic). Ignored by the cubic.
@@ -80,7 +93,8 @@ struct ErrorStats {
 };
 ErrorStats StatsOf(const std::vector<double>& errors_um);
 
-/// Fits the chosen surface. InputError from cubic.h / bspline.h rules.
+/// Fits the chosen surface. InputError from cubic.h / bspline.h rules, and from CheckSurface, so a
+/// written surface file always reads back.
 SurfaceFit FitSurface(const std::vector<SurfacePoint>& points, const SurfaceFitOptions& options);
 
 /// The surface file (schema above).

@@ -31,6 +31,11 @@ void SyntheticOptions::Validate() const {
           "must be in (0, 100000] mm");
   Require(nx >= 2 && nx <= static_cast<int>(kMaxGridLines), "nx", nx, "must be in 2..200");
   Require(ny >= 2 && ny <= static_cast<int>(kMaxGridLines), "ny", ny, "must be in 2..200");
+  Require(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) <= kMaxPoints, "nx * ny",
+          nx * ny,
+          "at most " + std::to_string(kMaxPoints) +
+              " points (the limit of a points file, which "
+              "surface fit reads)");
   Require(noise_um >= 0 && noise_um <= 10, "noise_um", noise_um, "must be in [0, 10] um");
   Require(bump_um >= 0 && bump_um <= 100, "bump_um", bump_um, "must be in [0, 100] um");
   Require(bump_sigma_fraction >= 0.01 && bump_sigma_fraction <= 1, "bump_sigma_fraction",

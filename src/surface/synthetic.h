@@ -28,8 +28,8 @@ struct SyntheticOptions {
   SyntheticField field = SyntheticField::kSmooth;
   double length_x_mm = 800;          ///< table travel in X, mm (> 0)
   double length_y_mm = 500;          ///< table travel in Y, mm (> 0)
-  int nx = 9;                        ///< grid columns (2..kMaxGridLines)
-  int ny = 7;                        ///< grid rows (2..kMaxGridLines)
+  int nx = 9;                        ///< grid columns (2..kMaxGridLines), nx * ny <= kMaxPoints
+  int ny = 7;                        ///< grid rows (2..kMaxGridLines), nx * ny <= kMaxPoints
   double noise_um = 1.0;             ///< standard deviation of the noise, um (0..10)
   double bump_um = 15;               ///< bump amplitude, um (0..100)
   double bump_sigma_fraction = 0.1;  ///< bump width / length_x (0.01..1)

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+#include <regex>
 
 #include "core/csv.h"
 #include "core/error.h"
@@ -65,6 +67,99 @@ TEST(Csv, FormulaLikeNamesAreInertInSpreadsheetsAndRoundTrip) {
   EXPECT_EQ(t.rows, (std::vector<std::vector<double>>{{1, 2, 3, 4}}));
   EXPECT_EQ(ParseCsv("-Z_um,+X_C\n1,2\n", "m").header, (std::vector<std::string>{"-Z_um", "+X_C"}))
       << "such names are read as they are";
+}
+
+// Spreadsheet programs start a CSV with a UTF-8 byte-order mark: it must neither become part of
+// the first column's name nor turn a first '#' comment into the header.
+TEST(Csv, ByteOrderMarkIsSkipped) {
+  const CsvTable t = ParseCsv("\xEF\xBB\xBFtime_min,a_C\n0,20\n", "t.csv");
+  EXPECT_EQ(t.header, (std::vector<std::string>{"time_min", "a_C"}));
+  EXPECT_TRUE(t.HasColumn("time_min"));
+  const CsvTable c = ParseCsv("\xEF\xBB\xBF# provenance\nx,y\n1,2\n", "t.csv");
+  EXPECT_EQ(c.comments, (std::vector<std::string>{"provenance"}));
+  EXPECT_EQ(c.header, (std::vector<std::string>{"x", "y"}));
+  EXPECT_EQ(c.header_line, 2);
+  EXPECT_NE(ErrorOf("a,b\n1,\xEF\xBB\xBF"
+                    "2\n")
+                .find("t.csv:2: column 2"),
+            std::string::npos)
+      << "a mark inside the text is not skipped";
+}
+
+// Bytes that are not UTF-8, anywhere: refused naming the file, line, column and character, so a
+// column name can never carry them on into JSON output.
+TEST(Csv, InvalidUtf8IsRefusedWithLineAndColumn) {
+  EXPECT_NE(
+      ErrorOf("a,b\xFF_C\n1,2\n").find("t.csv:1: column 2, character 4: byte 0xFF is not UTF-8"),
+      std::string::npos)
+      << ErrorOf("a,b\xFF_C\n1,2\n");
+  EXPECT_NE(ErrorOf("# \xC3\xA9t\xE9\na\n1\n").find("t.csv:1: column 1, character 5: byte 0xE9"),
+            std::string::npos)
+      << "in a comment, after a valid two-byte character: " << ErrorOf("# \xC3\xA9t\xE9\na\n1\n");
+  EXPECT_NE(ErrorOf("a,b\n1,2\n3,4\xC0\x80\n").find("t.csv:3: column 2, character 4: byte 0xC0"),
+            std::string::npos)
+      << "an overlong form";
+  EXPECT_NE(ErrorOf("a,b\n1,\xED\xA0\x80\n").find("t.csv:2: column 2"), std::string::npos)
+      << "a surrogate";
+  const CsvTable t = ParseCsv(
+      "temp_\xC2\xB0"
+      "C,d_\xC2\xB5m\n1,2\n",
+      "t.csv");  // "°", "µ"
+  EXPECT_EQ(t.header[0],
+            "temp_\xC2\xB0"
+            "C");
+}
+
+// Only decimal numbers: strtod would also take hexadecimal floats and other forms.
+TEST(Csv, OnlyDecimalNumbers) {
+  for (const char* bad : {"0x1p3", "0X10", "-0x1.8p1", "0x0", "1e", "1e+", ".", "+", "-", "1.2.3",
+                          "1e5.0", "1_000", "1d3"}) {
+    const std::string e = ErrorOf(std::string("a,b\n1,") + bad + "\n");
+    EXPECT_NE(e.find("t.csv:2: column 2 ('b')"), std::string::npos) << bad << ": " << e;
+  }
+  EXPECT_NE(ErrorOf("a\n0x1p3\n").find("not a decimal number"), std::string::npos);
+  for (const char* nonfinite : {"nan", "NaN", "inf", "-Infinity", "1e999"})
+    EXPECT_NE(ErrorOf(std::string("a\n") + nonfinite + "\n").find("not finite"), std::string::npos)
+        << nonfinite;
+  const CsvTable t = ParseCsv("a,b,c,d,e,f\n1,-0.5,.5,5.,+3e-2,1E5\n", "t.csv");
+  EXPECT_EQ(t.rows[0], (std::vector<double>{1, -0.5, 0.5, 5, 0.03, 1e5}));
+}
+
+// The decimal rule against an independent statement of it (a regular expression), on random
+// strings over the characters that matter; accepted text reads as strtod reads it.
+TEST(Csv, DecimalRuleMatchesItsRegularExpressionOnRandomText) {
+  const std::regex decimal(R"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?)");
+  const std::string alphabet = "0123456789+-.eExXpPaAnNiIfF ,";
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<std::size_t> pick(0, alphabet.size() - 1), length(0, 8);
+  int accepted = 0;
+  for (int i = 0; i < 200000; ++i) {
+    std::string s;
+    for (std::size_t n = length(rng); n > 0; --n)
+      s += alphabet[pick(rng) % (i % 3 ? 13 : alphabet.size())];
+    const bool finite = std::isfinite(std::strtod(s.c_str(), nullptr));
+    const auto v = ParseDecimal(s);
+    ASSERT_EQ(v.has_value(), std::regex_match(s, decimal) && finite) << "'" << s << "'";
+    if (v) {
+      EXPECT_EQ(*v, std::strtod(s.c_str(), nullptr));
+      ++accepted;
+    }
+  }
+  EXPECT_GT(accepted, 10000);
+}
+
+// Columns whose cells may be missing read empty and nan cells as NaN; the other columns and the
+// column's own numbers keep every rule.
+TEST(Csv, MissingAllowedColumns) {
+  CsvOptions o;
+  o.missing_allowed = {"time_s"};
+  const CsvTable t = ParseCsv("time_s,a\n,1\nNaN,2\n3,3\n", "t.csv", o);
+  EXPECT_TRUE(std::isnan(t.rows[0][0]));
+  EXPECT_TRUE(std::isnan(t.rows[1][0]));
+  EXPECT_EQ(t.rows[2][0], 3);
+  EXPECT_THROW(ParseCsv("time_s,a\n1,\n", "t.csv", o), InputError);
+  EXPECT_THROW(ParseCsv("time_s,a\n0x1p3,1\n", "t.csv", o), InputError);
+  EXPECT_THROW(ParseCsv("time_s,a\ninf,1\n", "t.csv", o), InputError);
 }
 
 TEST(Csv, FormatThenParseIsIdentity) {

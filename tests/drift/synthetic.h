@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "drift/regression.h"
 #include "drift/run_file.h"
 
 namespace whirl::drift::synth {
@@ -53,6 +54,15 @@ inline Run PlantedRun(unsigned seed, int groups, int per_group, const std::vecto
     r.error_um(q, 0) = e + error_noise * n01(rng);
   }
   return r;
+}
+
+/// 400 noise-free samples of three one-sensor groups whose error is 3 L_40(dT_a) - dT_b: sensors
+/// g0s0_C (a) and g2s0_C (b), the lag of a with tau = 40 min (drift/regression.h FirstOrderLag).
+inline Run LaggedRun() {
+  Run run = PlantedRun(9, 3, 1, {0.0, 0.0, 0.0}, 400, 0.0, 0.0);
+  const Eigen::MatrixXd d = run.Rises();
+  run.error_um.col(0) = 3.0 * FirstOrderLag(d.col(0), run.time_min, 40.0) - d.col(2);
+  return run;
 }
 
 }  // namespace whirl::drift::synth

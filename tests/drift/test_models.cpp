@@ -105,9 +105,7 @@ TEST(DriftModel, EvaluatorEqualsBatchFeaturesAndFileRoundTrips) {
 
 TEST(DriftModel, LagSearchFindsAPlantedTimeConstant) {
   // error = 3 L_40(dT_a) - 1 dT_b: the search must pick 40 from the grid and recover both.
-  drift::Run run = synth::PlantedRun(9, 3, 1, {0.0, 0.0, 0.0}, 400, 0.0, 0.0);
-  const Eigen::MatrixXd d = run.Rises();
-  run.error_um.col(0) = 3.0 * FirstOrderLag(d.col(0), run.time_min, 40.0) - d.col(2);
+  const drift::Run run = synth::LaggedRun();
   FitOptions o;
   o.kind = ModelKind::kDynamic;
   o.sensors = {"g0s0_C", "g2s0_C"};

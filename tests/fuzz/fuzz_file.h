@@ -3,8 +3,10 @@
 // per process (overwritten every run) and the loader reads it like a user's file.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,6 +21,12 @@ inline std::filesystem::path FuzzFile(const std::uint8_t* data, std::size_t size
   std::ofstream(path, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;
+}
+
+/// A loaded file must never produce nonsense: a result that is not a finite number is a finding
+/// (abort, so libFuzzer keeps the input), like a crash.
+inline void RequireFinite(double x) {
+  if (!std::isfinite(x)) std::abort();
 }
 
 }  // namespace whirl::fuzz

@@ -119,6 +119,52 @@ TEST(MachineConfigFile, ShippedJsonEqualsDefaultAndRejectsTypos) {
   EXPECT_THROW(named.Validate("test"), InputError);
 }
 
+// A machine file is checked like a flag: the schema is required ('{}' ran the built-in machine),
+// schema_version is the number 1 (99, "1" and 1.5 were accepted), and every number, set to
+// +-1e308, is refused naming the file and the key (a spread of 1e308 wrote -nan cells).
+TEST(MachineConfigFile, SchemaRequiredAndEveryNumberInItsRange) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("whirl_test_machine_" + std::to_string(::getpid()) + ".json");
+  const auto error_of = [&](const nlohmann::json& j) {
+    std::ofstream(path) << j.dump();
+    try {
+      (void)ReadMachine(path.string());
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string file = "machine file '" + path.string() + "'";
+  const nlohmann::json shipped = DefaultMachine();
+  ASSERT_EQ(error_of(shipped), "");
+  EXPECT_EQ(error_of(nlohmann::json::object()).rfind(file + ": 'schema'", 0), 0u);
+  for (const nlohmann::json& v : {nlohmann::json(99), nlohmann::json("1"), nlohmann::json(1.5)}) {
+    nlohmann::json j = shipped;
+    j["schema_version"] = v;
+    EXPECT_EQ(error_of(j).rfind(file + ": 'schema_version' = " + v.dump(), 0), 0u) << error_of(j);
+  }
+  const nlohmann::json flat = shipped.flatten();
+  int swept = 0;
+  for (auto it = flat.begin(); it != flat.end(); ++it) {
+    if (!it.value().is_number() || it.key() == "/schema_version") continue;
+    const std::string key = it.key().substr(it.key().rfind('/') + 1);
+    for (double v : {1e308, -1e308}) {
+      nlohmann::json j = shipped;
+      j[nlohmann::json::json_pointer(it.key())] = v;
+      const std::string e = error_of(j);
+      EXPECT_EQ(e.rfind(file, 0), 0u) << it.key() << " = " << v << ": " << e;
+      EXPECT_NE(e.find(key), std::string::npos) << it.key() << " = " << v << ": " << e;
+    }
+    ++swept;
+  }
+  EXPECT_GT(swept, 80);  // 20 machine numbers and 5 per sensor
+  nlohmann::json spread = shipped;
+  spread["machine_spread"] = 1e308;
+  EXPECT_EQ(error_of(spread),
+            file + ": machine_spread = 1e+308 breaks the rule: must lie in [0, 1] (relative std)");
+  std::filesystem::remove(path);
+}
+
 TEST(MachineSensors, RunRoundTripsThroughTheDriftFormatAndFits) {
   MachineConfig c = DefaultMachine();
   const MachineDay day = MachineDay::Draw(c, 3, 5);

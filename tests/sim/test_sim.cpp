@@ -277,6 +277,45 @@ TEST(Screw, JsonRoundTripAndClearErrors) {
   expect_error(bad, "pitch_mm");
 }
 
+// Every number of a screw file, set to +-1e308 (a typo'd exponent), is refused naming the key the
+// user wrote, never surfacing later under a derived name ("axial_feed_mm_s = 0" from a tool-circle
+// margin, "thread_length_mm" from a thread start offset).
+TEST(Screw, EveryNumberOutOfRangeIsNamedAsWritten) {
+  const nlohmann::json ref = ReferenceScrew();
+  const nlohmann::json flat = ref.flatten();
+  int swept = 0;
+  for (auto it = flat.begin(); it != flat.end(); ++it) {
+    if (!it.value().is_number()) continue;
+    const std::string pointer = it.key();  // e.g. "/process/tool_circle_margin_mm"
+    const std::string key = pointer.substr(pointer.rfind('/') + 1);
+    for (double v : {1e308, -1e308}) {
+      nlohmann::json bad = ref;
+      bad[nlohmann::json::json_pointer(pointer)] = v;
+      try {
+        (void)bad.get<Screw>();
+        ADD_FAILURE() << pointer << " = " << v << " accepted";
+      } catch (const InputError& e) {
+        const std::string m = e.what(), value = key + " = " + (v > 0 ? "1e+308" : "-1e+308");
+        EXPECT_TRUE(m.find(" " + value) != std::string::npos ||
+                    m.find("." + value) != std::string::npos)
+            << pointer << " = " << v << ": " << m;
+      }
+    }
+    ++swept;
+  }
+  EXPECT_EQ(swept, 13);
+  nlohmann::json margin = ref;
+  margin["process"]["tool_circle_margin_mm"] = 1e308;
+  try {
+    (void)margin.get<Screw>();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("process.tool_circle_margin_mm = 1e+308 breaks the rule: "
+                                         "must lie in (0, 100] mm"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Features, SettleTimeOfSyntheticCurvesWithNoiseAndDrift) {
   // l(t) = L (1 - exp(-t / tau)): within 2 % from t = tau ln(50) (closed form).
   Rng rng(11);

@@ -3,7 +3,8 @@ set(WHIRL_SURFACE_TESTS
   ${CMAKE_CURRENT_LIST_DIR}/test_surface_fit.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_surface_choice.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_surface_report.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/test_per_point.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/test_per_point.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_surface_inputs.cpp)
 if(EXISTS ${PROJECT_SOURCE_DIR}/src/drift/model.h)
   list(APPEND WHIRL_SURFACE_TESTS ${CMAKE_CURRENT_LIST_DIR}/test_drift_adapter.cpp)
 endif()
