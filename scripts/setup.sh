@@ -3,7 +3,7 @@
 # Idempotent and non-interactive; runs as root (or through sudo when not root).
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libtorch-dev

@@ -15,10 +15,8 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "surface/choice.h"
-#ifdef WHIRL_HAVE_DRIFT
 #include "drift/run_file.h"
 #include "surface/drift_adapter.h"
-#endif
 #include "surface/line840d.h"
 #include "surface/report.h"
 #include "surface/surface.h"
@@ -320,7 +318,6 @@ struct PointsCli {
   bool json = false;
 };
 
-#ifdef WHIRL_HAVE_DRIFT
 void RunPoints(const PointsCli& o) {
   const drift::RunState state = drift::ParseRunState(o.state);
   const drift::Run target = drift::ReadRun(o.run, state);
@@ -359,13 +356,6 @@ void RunPoints(const PointsCli& o) {
   for (const auto& line : fit.provenance) std::printf("%s\n", line.c_str());
   std::printf("%s", FormatFitText(fit).c_str());
 }
-#else
-void RunPoints(const PointsCli&) {
-  throw InputError(
-      "surface points: per-point models need the drift module (src/drift, issue 13), which is "
-      "not in this build");
-}
-#endif
 
 void SetupPoints(CLI::App& parent) {
   auto o = std::make_shared<PointsCli>();

@@ -2,7 +2,6 @@ whirl_add_gtest(test_core SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_csv.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_files.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_safe_output.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/test_file_safety.cpp
-  LABELS core)
+  ${CMAKE_CURRENT_LIST_DIR}/test_file_safety.cpp)
 
 whirl_add_cli_test(cli_terminal ${CMAKE_CURRENT_LIST_DIR}/cli_terminal.sh)
