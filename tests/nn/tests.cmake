@@ -8,11 +8,10 @@ whirl_add_gtest(test_nn SOURCES
   LIBS whirl::sim)
 whirl_add_cli_test(cli_nn ${CMAKE_CURRENT_LIST_DIR}/cli_nn.sh)
 # Retrains models/default.json with scripts/train_default.sh (~2 s) and compares its predictions
-# within a relative 1e-4 (any compiler or flags); the byte-for-byte check is labelled 'slow'.
+# within a relative 1e-4 (any compiler or flags), and the file byte for byte with the reference
+# flags (WHIRL_EXACT_OUTPUTS).
 whirl_add_cli_test(nn_default_model ${CMAKE_CURRENT_LIST_DIR}/default_model.sh
-                   $<TARGET_FILE:numeric_diff>)
-whirl_add_cli_test(nn_default_model_exact ${CMAKE_CURRENT_LIST_DIR}/default_model.sh)
-set_property(TEST nn_default_model_exact APPEND PROPERTY LABELS slow)
+                   $<TARGET_FILE:numeric_diff> ${WHIRL_EXACT_OUTPUTS})
 # Issue 11: coverage of the predictive intervals on a generated 200-row hold-out (~10 s).
 whirl_add_gtest(test_calibration SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_calibration.cpp
                 LIBS whirl::sim)
