@@ -9,6 +9,7 @@ packages=(
   libtorch-dev
   gnuplot-nox fonts-liberation   # report plots (pngcairo needs a font; a Recommends of gnuplot-nox)
   libboost-dev                   # Boost.Math (header-only): F-distribution quantile of the drift selection
+  python3                        # the command-line tests read JSON outputs with it
 )
 # Only for scripts/bench_peers.sh (issue 12's peer benchmark), never for the default build or tests.
 if [ "${WHIRL_SETUP_BENCH_PEERS:-0}" = 1 ]; then packages+=(python3-sklearn); fi

@@ -7,7 +7,8 @@ source "$SRC/tests/support/cli_common.sh"
 
 "$W" fit --help > "$D/help.txt" || fail "fit --help"
 grep -q "elongation_um" "$D/help.txt" || fail "fit --help does not explain the columns"
-"$W" curve --help | grep -q "um" || fail "curve --help has no units"
+"$W" curve --help > "$D/curve_help.txt" || fail "curve --help"
+grep -q "\[um\]" "$D/curve_help.txt" || fail "curve --help has no units"
 
 # A curve from given features, then its fit: the arctan model recovers L, t_s, k and p.
 "$W" curve --max-elongation 30 --settle-time 250 --shape-k 4 --time-exponent 0.8 --duration-s 900 \

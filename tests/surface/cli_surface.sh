@@ -109,7 +109,7 @@ expect_fail "not a whirl surface file" "$whirl" surface predict --surface notsur
 
 # Per-point models (point 1): the drift module's MLR at each point.
 "$whirl" surface points --help | grep -c "_x<X>_y<Y>_um" > /dev/null || fail "points --help"
-python3 - <<'PY'
+python3 - <<'PY' || fail "per-point runs not generated"
 import math
 xs, ys = [0, 200, 400, 600], [0, 100, 200, 300]
 def run(tau1, tau2, gain, name):  # error = (1 + x/400) dT1 + (0.5 + y/300) dT2
