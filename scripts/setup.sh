@@ -3,12 +3,13 @@
 # Idempotent and non-interactive; runs as root (or through sudo when not root).
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libtorch-dev
   gnuplot-nox fonts-liberation   # report plots (pngcairo needs a font; a Recommends of gnuplot-nox)
   libboost-dev                   # Boost.Math (header-only): F-distribution quantile of the drift selection
+  python3                        # the command-line tests read JSON outputs with it
 )
 # Only for scripts/bench_peers.sh (issue 12's peer benchmark), never for the default build or tests.
 if [ "${WHIRL_SETUP_BENCH_PEERS:-0}" = 1 ]; then packages+=(python3-sklearn); fi

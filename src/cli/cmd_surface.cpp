@@ -16,10 +16,8 @@
 #include "core/json_file.h"
 #include "core/output_dir.h"
 #include "surface/choice.h"
-#ifdef WHIRL_HAVE_DRIFT
 #include "drift/run_file.h"
 #include "surface/drift_adapter.h"
-#endif
 #include "surface/line840d.h"
 #include "surface/report.h"
 #include "surface/surface.h"
@@ -333,7 +331,6 @@ struct PointsCli {
   bool json = false;
 };
 
-#ifdef WHIRL_HAVE_DRIFT
 void RunPoints(const PointsCli& o) {
   std::vector<FlagPath> inputs{{"--run", o.run}, {"--manifest", o.manifest}};
   for (const auto& t : o.train) inputs.push_back({"--train", t});
@@ -377,13 +374,6 @@ void RunPoints(const PointsCli& o) {
   for (const auto& line : fit.provenance) std::printf("%s\n", line.c_str());
   std::printf("%s", FormatFitText(fit).c_str());
 }
-#else
-void RunPoints(const PointsCli&) {
-  throw InputError(
-      "surface points: per-point models need the drift module (src/drift, issue 13), which is "
-      "not in this build");
-}
-#endif
 
 void SetupPoints(CLI::App& parent) {
   auto o = std::make_shared<PointsCli>();

@@ -3,7 +3,6 @@
 // column (per_point.h), seed 000's sensitive-point selection and multiple linear regression
 // (drift::FitDriftModel, kind mlr by default; any drift::FitOptions works) fitted on the training
 // runs, then drift::PredictRun on the target run: the PointModelFn of per_point.h.
-// Compiled only when src/drift is in the tree (WHIRL_HAVE_DRIFT, src/surface/sources.cmake).
 #include <map>
 #include <mutex>
 #include <string>

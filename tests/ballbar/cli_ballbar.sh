@@ -46,7 +46,8 @@ k=$(tr -d ' \n' < "$D/drift.json" | grep -o '"Z":[-0-9.e+]*' | cut -d: -f2)
 awk -v k="$k" -v z="$zm" 'BEGIN { d = k + z / 1000; if (d < 0) d = -d; exit !(d < 1e-12) }' \
   || fail "SD43900 Z $k is not -drift/1000 ($zm um)"
 "$W" ballbar drift --readings "$S/readings.csv" --pivots "$S/pivots.json" --sign add --json \
-  | tr -d ' \n' | grep -q '"sign":"add"' || fail "--sign add"
+  > "$D/drift_add.json" || fail "--sign add"
+tr -d ' \n' < "$D/drift_add.json" | grep -q '"sign":"add"' || fail "--sign add: no sign in the JSON"
 
 # Circle: each planted error back within 2 %.
 "$W" ballbar circle --trace "$S/circle_xy_scale.csv" --plane XY --radius-mm 100 --json > "$D/c1.json" \

@@ -4,6 +4,5 @@ whirl_add_gtest(test_ballbar
     ${CMAKE_CURRENT_LIST_DIR}/test_trilateration.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_drift.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_circle.cpp
-  LIBS whirl::ballbar
-  LABELS ballbar)
+  LIBS whirl::sim)
 whirl_add_cli_test(cli_ballbar ${CMAKE_CURRENT_LIST_DIR}/cli_ballbar.sh)

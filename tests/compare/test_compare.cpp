@@ -109,8 +109,8 @@ class ShippedModel : public ::testing::Test {
   void SetUp() override {
     model_path_ = kSource / "models/default.json";
     history_path_ = kSource / "datasets/whirling_train.csv";
-    if (!std::filesystem::exists(model_path_) || !std::filesystem::exists(history_path_))
-      GTEST_SKIP() << "models/default.json or datasets/whirling_train.csv not shipped";
+    ASSERT_TRUE(std::filesystem::exists(model_path_)) << model_path_ << " not shipped";
+    ASSERT_TRUE(std::filesystem::exists(history_path_)) << history_path_ << " not shipped";
   }
   std::filesystem::path model_path_, history_path_;
 };

@@ -26,8 +26,8 @@ class ShippedModelReport : public ::testing::Test {
   void SetUp() override {
     const fs::path model = kSource / "models/default.json";
     const fs::path history = kSource / "datasets/whirling_train.csv";
-    if (!fs::exists(model) || !fs::exists(history))
-      GTEST_SKIP() << "models/default.json or datasets/whirling_train.csv not shipped";
+    ASSERT_TRUE(fs::exists(model)) << model << " not shipped";
+    ASSERT_TRUE(fs::exists(history)) << history << " not shipped";
     model_ = nn::LoadModel(model);
     rule_ = BuildExperienceRule(ReadProcessTable(history, true));
     iso_ = ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");

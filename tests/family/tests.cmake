@@ -6,5 +6,5 @@ whirl_add_gtest(test_family SOURCES
   LABELS family)
 # Development driver of scripts/bench_peers.py (--family-bench): not a test, not installed.
 add_executable(family_bench ${CMAKE_CURRENT_LIST_DIR}/family_bench.cpp)
-target_link_libraries(family_bench PRIVATE whirl::core)
+target_link_libraries(family_bench PRIVATE whirl::family)
 whirl_set_warnings(family_bench)

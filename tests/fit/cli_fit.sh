@@ -7,7 +7,8 @@ source "$SRC/tests/support/cli_common.sh"
 
 "$W" fit --help > "$D/help.txt" || fail "fit --help"
 grep -q "elongation_um" "$D/help.txt" || fail "fit --help does not explain the columns"
-"$W" curve --help | grep -q "um" || fail "curve --help has no units"
+"$W" curve --help > "$D/curve_help.txt" || fail "curve --help"
+grep -q "\[um\]" "$D/curve_help.txt" || fail "curve --help has no units"
 
 # A curve from given features, then its fit: the arctan model recovers L, t_s, k and p.
 "$W" curve --max-elongation 30 --settle-time 250 --shape-k 4 --time-exponent 0.8 --duration-s 900 \
@@ -32,9 +33,9 @@ printf 'time_s,elongation_um\n0,0\n1,1\n2,2\n3,3\n4,4\n5,5\n100,6\n' > "$D/gap.c
 expect_fail "gap" "$W" fit --curve "$D/gap.csv"
 printf 'time_s,elongation_um\n0,0\n1,1\n1,2\n2,3\n' > "$D/dup.csv"
 expect_fail "increas" "$W" fit --curve "$D/dup.csv"
-"$W" fit --curve "$D/none.csv" > /dev/null 2>&1 && fail "missing file accepted"
+expect_fail "none.csv" "$W" fit --curve "$D/none.csv"
 expect_fail "--curve" "$W" fit
 # curve: negative elongation and half-given features are rejected.
-"$W" curve --max-elongation -3 --settle-time 100 > /dev/null 2>&1 && fail "negative L accepted"
+expect_fail "--max-elongation" "$W" curve --max-elongation -3 --settle-time 100
 expect_fail "together" "$W" curve --max-elongation 3
 echo "ok"

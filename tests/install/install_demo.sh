@@ -16,8 +16,10 @@ for f in models/default.json datasets/whirling_500.csv datasets/screws/reference
          datasets/standards/iso3408_3_lead_tolerances.csv; do
   [ -s "$P/share/whirl/$f" ] || fail "not installed: share/whirl/$f"
 done
-"$W" --help | grep -q "WHIRL_HOME" || fail "whirl --help does not document WHIRL_HOME"
-"$W" demo --help | grep -q "WHIRL_HOME" || fail "whirl demo --help does not document WHIRL_HOME"
+"$W" --help > "$D/help.txt" || fail "whirl --help"
+grep -q "WHIRL_HOME" "$D/help.txt" || fail "whirl --help does not document WHIRL_HOME"
+"$W" demo --help > "$D/demo_help.txt" || fail "whirl demo --help"
+grep -q "WHIRL_HOME" "$D/demo_help.txt" || fail "whirl demo --help does not document WHIRL_HOME"
 
 mkdir -p "$D/elsewhere"; cd "$D/elsewhere"
 env -u WHIRL_HOME "$W" demo --no-plots --out-dir out > demo.txt 2> demo.err || fail "installed demo: $(cat demo.err)"

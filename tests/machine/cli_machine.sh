@@ -9,7 +9,8 @@ rm -rf "$D"; mkdir -p "$D"
 source "$S/tests/support/cli_common.sh"
 
 "$W" machine --help > "$D/help.txt" || fail "machine --help"
-"$W" machine evaluate --help | grep -q "um" || fail "evaluate --help names no unit"
+"$W" machine evaluate --help > "$D/evaluate_help.txt" || fail "machine evaluate --help"
+grep -q "\[um\]" "$D/evaluate_help.txt" || fail "evaluate --help names no unit"
 "$W" machine sensors --out "$D/runs" --idle 1 --cutting 2 > "$D/sensors.txt" || fail "sensors"
 [ -f "$D/runs/idle_1.csv" ] && [ -f "$D/runs/cutting_2.csv" ] || fail "run files missing"
 n=$(grep -v '^#' "$D/runs/cutting_1.csv" | head -n 1 | tr ',' '\n' | grep -c '_C$')
@@ -42,9 +43,12 @@ expect_fail "missing.json" "$W" machine sensors --machine "$D/missing.json" --ou
 # Combined 840D programs with the existing combined mode: the plan writes its K0 into
 # $AC_PARAM, the machine drift action (the offset model) is the single writer of SD43900.
 P="$S/datasets/machines/example_840d.json"
+sensors=$(python3 -c "import json,sys; print(' '.join(json.load(open(sys.argv[1]))['sensors']))" \
+  "$D/offset.json") || fail "no sensors in offset.json"
+[ -n "$sensors" ] || fail "offset.json names no sensor"
 inputs=()
 k=1
-for s in $(python3 -c "import json,sys; print(' '.join(json.load(open(sys.argv[1]))['sensors']))" "$D/offset.json"); do
+for s in $sensors; do
   inputs+=(--input "$s=$k:0.1:0"); k=$((k + 1))
 done
 "$W" plan --screw "$S/datasets/screws/reference_80x10x6000.json" --machine "$P" \

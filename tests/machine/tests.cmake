@@ -2,6 +2,5 @@
 whirl_add_gtest(test_machine SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_machine.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_combined_nc.cpp
-  LIBS whirl::compare
-  LABELS machine)
+  LIBS whirl::compare)
 whirl_add_cli_test(cli_machine ${CMAKE_CURRENT_LIST_DIR}/cli_machine.sh)

@@ -75,17 +75,22 @@ TEST(Calibration, TwentyRowModelCoversTheHoldOut) {
 }
 
 // As `whirl train --data datasets/whirling_train.csv` (the default training, issue 12). On this
-// one hold-out its +-2 sigma intervals are too wide (99.5 % / 99 %; +-1 sigma 76 % / 71.5 %), so
-// only a loose band is asserted here; the issue's band is measured over 20 seeds by
-// scripts/bench_peers.sh (README, network section), where the default meets it.
+// one hold-out its +-2 sigma intervals are wide (99.5 % / 99 %; +-1 sigma 76 % / 71.5 %), so the
+// band asserted here is what chance allows a calibrated model on 200 rows: the binomial mean +- 3
+// standard deviations of the covered share (+-1 sigma: 68.27 +- 3 * 3.29 %; +-2 sigma: 95.45 +-
+// 3 * 1.47 %, capped below 100 %: all 200 rows covered fails). The tighter band of the issue is
+// measured over 20 seeds by scripts/bench_peers.sh (README, network section). The settle time's
+// calibrated noise is 0 here: the fold models' weight uncertainty alone already covers more than
+// 68.27 % of the held-out errors, and the calibration only adds noise, never narrows.
 TEST(Calibration, DefaultTrainingRoughlyCoversTheHoldOut) {
   const Model m = TrainModel(ReadProcessTable(kData / "whirling_train.csv", true),
                              DefaultTrainingOptions(), "whirling_train.csv");
   const Coverage c = Measure(m, HoldOut());
   for (int k = 0; k < 2; ++k) {
-    EXPECT_GE(c.one[k], 0.55) << kTargetColumns[k];
-    EXPECT_LE(c.one[k], 0.85) << kTargetColumns[k];
-    EXPECT_GE(c.two[k], 0.85) << kTargetColumns[k];
+    EXPECT_GE(c.one[k], 0.6827 - 3 * 0.0329) << kTargetColumns[k];
+    EXPECT_LE(c.one[k], 0.6827 + 3 * 0.0329) << kTargetColumns[k];
+    EXPECT_GE(c.two[k], 0.9545 - 3 * 0.0147) << kTargetColumns[k];
+    EXPECT_LT(c.two[k], 1.0) << kTargetColumns[k];
   }
   std::printf(
       "[ figures  ] 20-row default model: +-1 sigma %.1f %% / %.1f %%, +-2 sigma %.1f %% / "

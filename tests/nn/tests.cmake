@@ -5,13 +5,13 @@ whirl_add_gtest(test_nn SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_parallel_nn.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_ard.cpp
-  LABELS nn)
+  LIBS whirl::sim)
 whirl_add_cli_test(cli_nn ${CMAKE_CURRENT_LIST_DIR}/cli_nn.sh)
 # Retrains models/default.json with scripts/train_default.sh (~2 s) and compares its predictions
-# within a relative 1e-4 (any compiler or flags); the byte-for-byte check is labelled 'slow'.
+# within a relative 1e-4 (any compiler or flags), and the file byte for byte with the reference
+# flags (WHIRL_EXACT_OUTPUTS).
 whirl_add_cli_test(nn_default_model ${CMAKE_CURRENT_LIST_DIR}/default_model.sh
-                   $<TARGET_FILE:numeric_diff>)
-whirl_add_cli_test(nn_default_model_exact ${CMAKE_CURRENT_LIST_DIR}/default_model.sh)
-set_tests_properties(nn_default_model_exact PROPERTIES LABELS "cli;slow")
+                   $<TARGET_FILE:numeric_diff> ${WHIRL_EXACT_OUTPUTS})
 # Issue 11: coverage of the predictive intervals on a generated 200-row hold-out (~10 s).
-whirl_add_gtest(test_calibration SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_calibration.cpp LABELS nn)
+whirl_add_gtest(test_calibration SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_calibration.cpp
+                LIBS whirl::sim)

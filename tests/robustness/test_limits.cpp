@@ -117,11 +117,11 @@ TEST(Limits, SimulationCellsAndStepsAreBoundedBeforeAllocating) {
   EXPECT_NO_THROW(sim::Simulate(s, o));
 }
 
-// A copy of the shipped model's JSON with one change; skipped if the model is not shipped.
+// A copy of the shipped model's JSON with one change (the model is always shipped).
 class ModelFile : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!fs::exists(kSource / "models/default.json")) GTEST_SKIP() << "models/default.json absent";
+    ASSERT_TRUE(fs::exists(kSource / "models/default.json")) << "models/default.json not shipped";
     model_ = ReadJsonFile(kSource / "models/default.json");
     dir_ = Scratch("model");
   }

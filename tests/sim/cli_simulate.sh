@@ -7,7 +7,7 @@ rm -rf "$SCRATCH"; mkdir -p "$SCRATCH"
 REF="$SRC/datasets/screws/reference_80x10x6000.json"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-"$WHIRL" simulate --help | grep -q "duration-s" || fail "--help lacks --duration-s"
+"$WHIRL" simulate --help | grep "duration-s" > /dev/null || fail "--help lacks --duration-s"
 "$WHIRL" simulate --screw "$REF" --duration-s 600 --out "$SCRATCH/curve.csv" > "$SCRATCH/out.txt"
 grep -q "max_elongation_um" "$SCRATCH/out.txt" || fail "no features printed"
 head -1 "$SCRATCH/curve.csv" | grep -q '^#' || fail "curve has no provenance comment"

@@ -107,9 +107,9 @@ expect_fail "outside the measured range" "$whirl" surface line --surface b.json 
 printf '{"schema": "whirl.plan"}' > notsurface.json
 expect_fail "not a whirl surface file" "$whirl" surface predict --surface notsurface.json --x 1 --y 1
 
-# Per-point models (point 1): needs src/drift in the build; otherwise the command says so.
+# Per-point models (point 1): the drift module's MLR at each point.
 "$whirl" surface points --help | grep -c "_x<X>_y<Y>_um" > /dev/null || fail "points --help"
-python3 - <<'PY'
+python3 - <<'PY' || fail "per-point runs not generated"
 import math
 xs, ys = [0, 200, 400, 600], [0, 100, 200, 300]
 def run(tau1, tau2, gain, name):  # error = (1 + x/400) dT1 + (0.5 + y/300) dT2
@@ -124,18 +124,14 @@ def run(tau1, tau2, gain, name):  # error = (1 + x/400) dT1 + (0.5 + y/300) dT2
                     + "\n")
 run(30, 120, 1.0, "train.csv"); run(50, 90, 0.7, "target.csv")
 PY
-if "$whirl" surface points --run target.csv --train train.csv --sensors t1_C,t2_C --time-min 100 \
-     --out pts.json > pts.txt 2> pts.err; then
-  "$whirl" surface predict --surface pts.json --x 333 --y 77 --json > pp.json || fail "points predict"
-  python3 -c "
+"$whirl" surface points --run target.csv --train train.csv --sensors t1_C,t2_C --time-min 100 \
+  --out pts.json > pts.txt 2> pts.err || fail "points: $(cat pts.err)"
+"$whirl" surface predict --surface pts.json --x 333 --y 77 --json > pp.json || fail "points predict"
+python3 -c "
 import json, math
 d1, d2 = 0.7 * 8 * (1 - math.exp(-100 / 50)), 3 * (1 - math.exp(-100 / 90))
 want = (1 + 333 / 400) * d1 + (0.5 + 77 / 300) * d2
 got = json.load(open('pp.json'))['predictions'][0]['error_um']
 assert abs(got - want) < 1e-5, (got, want)
 " || fail "per-point surface"
-else
-  grep -q "not in this build" pts.err || fail "points: $(cat pts.err)"
-  echo "surface points skipped: src/drift not in this build"
-fi
 echo OK

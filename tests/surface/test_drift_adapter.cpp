@@ -1,6 +1,5 @@
 // Per-point models from the drift module (surface/drift_adapter.h): MLR per position-tagged error
-// column on a training run, predicted on another run, then a surface at one moment. Built only
-// when src/drift is in the tree (WHIRL_HAVE_DRIFT).
+// column on a training run, predicted on another run, then a surface at one moment.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -5,7 +5,7 @@ WHIRL="$1"; SCRATCH="$2"; MAKE_MODEL="$4"
 rm -rf "$SCRATCH"; mkdir -p "$SCRATCH"; cd "$SCRATCH"
 "$MAKE_MODEL" model.json table.csv
 
-"$WHIRL" export --help | grep -q "original units"
+"$WHIRL" export --help | grep "original units" > /dev/null
 
 "$WHIRL" export --model model.json --torchscript out.pt | tee export.txt
 [ -s out.pt ] || { echo "out.pt missing"; exit 1; }
