@@ -236,25 +236,28 @@ void Run(const TrainCliOptions& o) {
   PrintModelSummary(o, model, table.inputs.size(), fit_ms);
 }
 
+// The subcommand's description in --help: what it trains, the default, the table's columns.
+std::string TrainDescription() {
+  return "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
+         "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
+         "on a process table and write a model file (JSON), or sweep the hidden size.\n"
+         "Default (issue 12): no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
+         "highest log evidence, each fit stopped by R brnn's rule (--change 0.001),\n"
+         "per-output noise by 5-fold cross-validation; about 10 ms for 20 rows, 70 ms for\n"
+         "100 rows (one thread). A warning says when the network ignores its inputs.\n"
+         "--trainbr-matlab: the paper's 5-6-2 trained to MATLAB's own criteria.\n"
+         "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
+         "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
+         "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
+         "Progress goes to stderr, results to stdout. Exit code 0 only on success.\n" +
+         ProcessLimitsHelp();
+}
+
 }  // namespace
 
 void RegisterTrain(CLI::App& app) {
   auto o = std::make_shared<TrainCliOptions>();
-  auto* sub = app.add_subcommand(
-      "train",
-      "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
-      "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
-      "on a process table and write a model file (JSON), or sweep the hidden size.\n"
-      "Default (issue 12): no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
-      "highest log evidence, each fit stopped by R brnn's rule (--change 0.001),\n"
-      "per-output noise by 5-fold cross-validation; about 10 ms for 20 rows, 70 ms for\n"
-      "100 rows (one thread). A warning says when the network ignores its inputs.\n"
-      "--trainbr-matlab: the paper's 5-6-2 trained to MATLAB's own criteria.\n"
-      "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
-      "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
-      "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
-      "Progress goes to stderr, results to stdout. Exit code 0 only on success.\n" +
-          ProcessLimitsHelp());
+  auto* sub = app.add_subcommand("train", TrainDescription());
   sub->add_option("--data", o->data_path, "training table (CSV, see above)")
       ->required()
       ->check(CLI::ExistingFile);
