@@ -508,6 +508,10 @@ void CheckDistinctProgramNames(const std::string& program, const std::string& re
                      "them different names");
 }
 
+std::string CheckOrAlarm(const std::string& condition, int alarm, const std::string& ok_label) {
+  return "IF " + condition + " GOTOF " + ok_label + "\nSETAL(" + std::to_string(alarm) +
+         ")\nGOTOF " + kProgramEndLabel + "\n" + ok_label + ":\n";
+}
 
 namespace {
 
@@ -577,22 +581,22 @@ std::string RestoredRef(const PlanOptions& o, const std::string& r_prefix) {
 std::string RequireDriftAction(const PlanOptions& o) {
   if (o.drift_alive_param < 0) return "";
   const std::string alive = Param(o.drift_alive_param);
-  auto alarm = [&](int k) {
-    return "SETAL(" + std::to_string(o.drift_missing_alarm + k) + ")\nENDIF\n";
-  };
+  const int a = o.drift_missing_alarm;
   std::string out = alive + "=0\nG4 F0.1\nSTOPRE\n";  // a running action writes it again
-  if (!Combined(o)) return out + "IF " + alive + "<>0\n" + alarm(1);
+  if (!Combined(o)) return out + CheckOrAlarm(alive + "==0", a + 1, "WHIRL_NO_DRIFT_ACTION");
   const std::string mode = SlopeHandedOver(o) ? "2" : "1";
-  return out + "IF " + alive + "==0\n" + alarm(0) + "IF " + alive + "<>" + mode + "\n" + alarm(2);
+  return out + CheckOrAlarm(alive + "<>0", a, "WHIRL_DRIFT_ACTION_RUNS") +
+         CheckOrAlarm(alive + "==" + mode, a + 2, "WHIRL_DRIFT_MODE_OK");
 }
 
 // Refuses to start (before anything is changed) with the axis at or past the thread start, where
 // the first action's condition would already hold: every passed action would fire at once.
 std::string RequireAxisBeforeStart(const CompensationPlan& plan) {
   const PlanOptions& o = plan.options;
-  return "STOPRE\nIF $AA_IM[" + o.axis + "]" + (o.direction > 0 ? ">=" : "<=") +
-         FormatFixed(plan.segments.front().sd43920_mm, kDecimalsPositionMm) + "\nSETAL(" +
-         std::to_string(o.start_alarm) + ")\nENDIF\n";
+  return "STOPRE\n" + CheckOrAlarm("$AA_IM[" + o.axis + "]" + (o.direction > 0 ? "<" : ">") +
+                                       FormatFixed(plan.segments.front().sd43920_mm,
+                                                   kDecimalsPositionMm),
+                                   o.start_alarm, "WHIRL_AXIS_BEFORE_START");
 }
 
 // "MD28254 ... >= n" for the $AC_PARAM slots a plan program uses (none: empty).
@@ -613,6 +617,9 @@ void HeaderControl(std::ostringstream& nc, const CompensationPlan& plan, const N
      << "alarm " << o.start_alarm << " (axis at or past the thread start: no resume from "
      << "mid-thread) and changes nothing: run " << info.reset_program_name
      << ", move the axis before the thread start and cut the whole thread again\n";
+  nc << "; after a failed check (alarm) the program jumps to " << kProgramEndLabel
+     << " and cancels, saves and writes nothing, whatever the alarm's response; if that response "
+        "does not stop the program, the calling program goes on without whirl's compensation\n";
   nc << "; until the axis reaches the thread start the control keeps what it applied before the "
         "call; the first segment is written by ID="
      << o.sync_id_first << " at the thread start\n";
@@ -733,7 +740,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
         " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), RestoredSlope(o, "$"), RestoredRef(o, "$")) +
         (SlopeHandedOver(o) ? std::string() : " $" + R(m + 3) + "=0") + "\n";
-  nc += "M17\n";
+  nc += std::string(kProgramEndLabel) + ":\nM17\n";
   return nc;
 }
 

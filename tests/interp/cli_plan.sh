@@ -74,10 +74,14 @@ expect_fail "start_alarm 65004" "$W" plan --screw "$S" --max-elongation 30 --set
 
 # The start: the program refuses (alarm from the profile) unless the axis stands before the
 # thread start, and says so in its header; the control's limits it needs are named.
-grep -q '^IF \$AA_IM\[Z\]>=' "$D/plan.spf" || fail "no start check"
+grep -q '^IF \$AA_IM\[Z\]<-5600.0000 GOTOF ' "$D/plan.spf" || fail "no start check"
 grep -q '^SETAL(65004)' "$D/plan.spf" || fail "the profile's start_alarm is not raised"
 grep -q 'alarm 65004 (axis at or past the thread start' "$D/plan.spf" || fail "header: start alarm"
 grep -q 'MD28250 \$MC_MM_NUM_SYNC_ELEMENTS' "$D/plan.spf" || fail "header: MD28250"
+# After every alarm the program jumps to its end (the label just before M17), so it changes
+# nothing whether or not the alarm stops the program.
+expect_jumps_to_end "$D/plan.spf"
+expect_jumps_to_end "$D/ids.spf"
 grep -q '^\$SA_TEMP_COMP_SLOPE' "$D/plan.spf" && fail "the part program writes a slope before motion"
 
 # Program names: the headers name the files' stems; names a control refuses are refused, and
