@@ -179,9 +179,9 @@ void PlanOptions::Validate() const {
                      std::to_string(workpiece_slope_param) +
                      " needs workpiece_k0_param >= 0 outside its two slots (" +
                      std::to_string(workpiece_k0_param) + ") and must be 0..9998");
-  if (!(save_r_first >= 0 && save_r_first <= 9996))
+  if (!(save_r_first >= -1 && save_r_first <= 9996))
     throw InputError("save_r_first = " + std::to_string(save_r_first) +
-                     ": must be within 0..9996 (R<n>..R<n+3> are used)");
+                     ": must be within 0..9996 (R<n>..R<n+3> are used), or -1: not set");
 }
 
 double AxisPositionMm(const PlanOptions& o, double axial_feed_mm_s, double t_s) {
@@ -698,6 +698,15 @@ void RequireSyncIds(const PlanOptions& o) {
         "there is no default");
 }
 
+void RequireSaveR(const PlanOptions& o) {
+  if (!o.HasSaveR() && !SlopeHandedOver(o))
+    throw InputError(
+        "NC program: no R parameters set: the program saves the setting data it finds in "
+        "R<n>..R<n+3>, the user's R parameters, so it needs the ones the machine builder "
+        "reserved for whirl (the machine profile's save_r_first, or --save-r-first without a "
+        "profile); there is no default");
+}
+
 void CheckNames(const NcProgramInfo& info) {
   CheckProgramName(info.program_name, "NC program name");
   CheckProgramName(info.reset_program_name, "reset program name");
@@ -711,6 +720,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   CheckNames(info);
   const PlanOptions& o = plan.options;
   RequireSyncIds(o);
+  RequireSaveR(o);
   const std::string& ax = o.axis;
   const std::size_t available = static_cast<std::size_t>(o.sync_id_last - o.sync_id_first + 1);
   if (SyncIdsNeeded(plan) > available)
@@ -748,6 +758,7 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
   o.Validate();
   CheckNames(info);
   RequireSyncIds(o);
+  RequireSaveR(o);
   const std::string& ax = o.axis;
   const int m = o.save_r_first;
   std::string nc = "; " + info.reset_program_name +

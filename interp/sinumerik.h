@@ -159,8 +159,11 @@ struct PlanOptions {
   /// R parameters R<n>..R<n+3> the NC program uses to save the setting data it found (SD43900,
   /// SD43910, SD43920) and a marker (1 while whirl's compensation is active), so the thread end
   /// and the reset program restore exactly what was there before. 0..9996; the machine must
-  /// have them (MD28050 $MC_MM_NUM_R_PARAM).
-  int save_r_first = 90;
+  /// have them (MD28050 $MC_MM_NUM_R_PARAM). They are the user's R parameters, so they come
+  /// only from the machine profile (save_r_first) or an explicit flag without one: -1, the
+  /// default, is "not set": a plan can be built, but FormatNcProgram and FormatNcResetProgram
+  /// refuse when the plan saves anything (not when it hands its slope to the drift action).
+  int save_r_first = -1;
   /// -1: the plan writes SD43900 itself. >= 0: combined with the live drift action
   /// (interp/drift_action.h): the plan writes its K0 into $AC_PARAM[workpiece_k0_param], which the
   /// drift action adds to the machine's K0, so SD43900 has one writer.
@@ -188,6 +191,8 @@ struct PlanOptions {
   void Validate() const;
   /// True when the synchronized-action IDs are set (sync_id_first > 0).
   bool HasSyncIds() const { return sync_id_first > 0; }
+  /// True when the R parameters are set (save_r_first >= 0).
+  bool HasSaveR() const { return save_r_first >= 0; }
 };
 
 struct CompensationSegment {
@@ -303,7 +308,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
 
 /// The reset subprogram for an aborted cut: CANCEL(n) over the ID range, then, if the marker
 /// R<m+3> is 1, write back the saved SD43900/43910/43920 and clear the marker; M17. InputError if
-/// the IDs are not set.
+/// the IDs or (unless the slope is handed over) the R parameters are not set.
 std::string FormatNcResetProgram(const PlanOptions& options, const NcProgramInfo& info = {});
 
 }  // namespace whirl::interp

@@ -8,7 +8,9 @@ S="$SRC/datasets/screws/reference_80x10x6000.json"
 M="$SRC/datasets/machines/example_840d.json"
 POS=(--start-position-mm 0 --machine-offset-mm -850)
 
-"$W" plan --help | grep -q "SD43910" || fail "plan --help"
+"$W" plan --help > "$D/help.txt" || fail "plan --help exits non-zero"
+grep -q "SD43910" "$D/help.txt" || fail "plan --help does not explain SD43910"
+grep -q -- "--save-r-first" "$D/help.txt" || fail "plan --help lacks --save-r-first"
 
 # From given features: all three outputs, consistent with each other.
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --out "$D/plan.json" \
@@ -55,10 +57,20 @@ expect_fail "no synchronized-action IDs" "$W" plan --screw "$S" --max-elongation
 expect_fail "go together" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   "${POS[@]}" --sync-id-first 120 --nc "$D/noids.spf"
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 "${POS[@]}" --sync-id-first 120 \
-  --sync-id-last 160 --nc "$D/ids.spf" > /dev/null || fail "plan with explicit IDs"
+  --sync-id-last 160 --save-r-first 40 --nc "$D/ids.spf" > /dev/null || fail "plan with explicit IDs"
 [ "$(grep -c '^CANCEL(' "$D/ids.spf")" -eq 41 ] || fail "explicit range 120..160 not cancelled"
 grep -Eq '^(CANCEL\(|ID=)([0-9]|[1-9][0-9]|1[01][0-9]|16[1-9]|1[7-9][0-9]|2[0-9][0-9])[^0-9]' \
   "$D/ids.spf" && fail "an ID outside 120..160 is touched"
+# R parameters likewise (the program saves what it finds in the user's R parameters): from the
+# profile or --save-r-first, never a default R90..R93; a contradicting flag is refused below.
+expect_fail "no R parameters" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  "${POS[@]}" --sync-id-first 120 --sync-id-last 160 --nc "$D/nor.spf"
+grep -q -- "--save-r-first" "$D/err.txt" || fail "the message does not name --save-r-first"
+expect_fail "no R parameters" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  "${POS[@]}" --sync-id-first 120 --sync-id-last 160 --reset-nc "$D/nor.spf"
+[ -e "$D/nor.spf" ] && fail "program written without R parameters"
+used_r=$(grep -v '^;' "$D/ids.spf" | grep -Eo '(^|[^A-Z_$])\$?R[0-9]+' | grep -Eo '[0-9]+$' | sort -un | tr '\n' ' ')
+[ "$used_r" = "40 41 42 43 " ] || fail "--save-r-first 40 must use R40..R43 only, uses: $used_r"
 expect_fail "sync_id_first 100" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   --machine "$M" --sync-id-first 1 --nc "$D/override.spf"
 grep -q -- "--sync-id-first 1 contradicts the machine profile" "$D/err.txt" \
@@ -66,7 +78,7 @@ grep -q -- "--sync-id-first 1 contradicts the machine profile" "$D/err.txt" \
 expect_fail "sync_id_last 149" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   --machine "$M" --sync-id-last 255
 expect_fail "save_r_first 90" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
-  --machine "$M" --save-r 10
+  --machine "$M" --save-r-first 10
 expect_fail "start_alarm 65004" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   --machine "$M" --start-alarm 65100
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --sync-id-first 100 \

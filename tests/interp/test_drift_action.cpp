@@ -317,6 +317,7 @@ TEST(DriftAction, CombinedTheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
         p.machine_offset_mm = -812.5;
         p.sync_id_first = 100;
         p.sync_id_last = 140;
+        p.save_r_first = 90;
         p.workpiece_k0_param = 99;
         p.workpiece_slope_param = d.workpiece_slope_param;
         p.drift_alive_param = d.param_first;
