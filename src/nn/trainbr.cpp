@@ -373,6 +373,38 @@ Eigen::MatrixXd ArdHessian(const Eigen::MatrixXd& jj, double beta, const Eigen::
   return h;
 }
 
+// The figures both iterations (trainbr's and the ARD stage's) report after an epoch and at the
+// end: F, ssE, ssX, gamma, alpha, beta, mu and the gradient 2 ||J'e||.
+struct IterationFigures {
+  double objective, sse, ssx, gamma, alpha, beta, mu, gradient;
+
+  void FillEpochEnd(const Network* net, EpochInfo* info) const {
+    info->objective = objective;
+    info->sse = sse;
+    info->ssx = ssx;
+    info->gamma = gamma;
+    info->alpha = alpha;
+    info->beta = beta;
+    info->mu = mu;
+    info->network = net;
+  }
+  // With the RMS errors of the errors e (S x Q, normalized), also in original units.
+  void FillSummaryEnd(const Eigen::MatrixXd& e, const MapMinMax& target_scaling,
+                      TrainSummary* sum) const {
+    sum->final_cost = objective;
+    sum->sse = sse;
+    sum->sum_squared_weights = ssx;
+    sum->gamma = gamma;
+    sum->alpha = alpha;
+    sum->beta = beta;
+    sum->mu = mu;
+    sum->gradient = gradient;
+    sum->rms_error_normalized =
+        (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
+    sum->rms_error = sum->rms_error_normalized.cwiseProduct(target_scaling.HalfRange());
+  }
+};
+
 // alpha_g and beta of TrainOptions::ard after a step (MacKay 1992, one alpha per group).
 struct ArdHyper {
   Eigen::VectorXd alpha;  ///< per group
@@ -500,33 +532,14 @@ class ArdIteration {
   }
 
   // The values an epoch reports after its step and update (alpha: the group of the other weights).
-  void FillEpochEnd(EpochInfo* info) const {
-    info->objective = F_;
-    info->sse = sse_;
-    info->ssx = w_.squaredNorm();
-    info->gamma = hyper_.gamma;
-    info->alpha = hyper_.alpha(G_ - 1);
-    info->beta = hyper_.beta;
-    info->mu = mu_;
-    info->network = &net_;
-  }
+  void FillEpochEnd(EpochInfo* info) const { Figures().FillEpochEnd(&net_, info); }
 
   // The summary at the final weights (J is at them: the loop ends right after Linearize) with the
   // Laplace approximation of the grouped prior (ArdLaplace, LogEvidenceGroups).
   void Finish(TrainResult* result) {
     TrainSummary& sum = result->summary;
-    sum.final_cost = F_;
-    sum.sse = sse_;
-    sum.sum_squared_weights = w_.squaredNorm();
-    sum.gamma = hyper_.gamma;
-    sum.alpha = hyper_.alpha(G_ - 1);
+    Figures().FillSummaryEnd(e_, data_.target_scaling, &sum);
     sum.ard_alpha = hyper_.alpha;
-    sum.beta = hyper_.beta;
-    sum.mu = mu_;
-    sum.gradient = gradient_;
-    sum.rms_error_normalized =
-        (e_.array().square().rowwise().sum() / static_cast<double>(e_.cols())).sqrt();
-    sum.rms_error = sum.rms_error_normalized.cwiseProduct(data_.target_scaling.HalfRange());
     const double log_det_h = ArdLaplace(ArdHessian(J_.transpose() * J_, hyper_.beta, a_),
                                         hyper_.alpha.minCoeff(), &result->posterior_covariance);
     const Eigen::VectorXd final_alpha = hyper_.alpha(group_);
@@ -545,6 +558,12 @@ class ArdIteration {
   const std::string& degenerate() const { return degenerate_; }
 
  private:
+  // alpha: the group of the weights that are not an input's.
+  IterationFigures Figures() const {
+    return {F_,          sse_, w_.squaredNorm(), hyper_.gamma, hyper_.alpha(G_ - 1),
+            hyper_.beta, mu_,  gradient_};
+  }
+
   const TrainingData& data_;
   const TrainOptions& options_;
   Network net_, trial_;
@@ -712,32 +731,13 @@ class BrIteration {
   }
 
   // The values an epoch reports after its step and update.
-  void FillEpochEnd(EpochInfo* info) const {
-    info->objective = F_;
-    info->sse = sse_;
-    info->ssx = ssx_;
-    info->gamma = gamma_;
-    info->alpha = alpha_;
-    info->beta = beta_;
-    info->mu = mu_;
-    info->network = &net_;
-  }
+  void FillEpochEnd(EpochInfo* info) const { Figures().FillEpochEnd(&net_, info); }
 
   // The summary at the final weights (J is at them: the loop ends right after Linearize) and, with
   // Bayesian regularization, the Laplace approximation: log evidence and posterior covariance.
   void Finish(TrainResult* result) {
     TrainSummary& sum = result->summary;
-    sum.final_cost = F_;
-    sum.sse = sse_;
-    sum.sum_squared_weights = ssx_;
-    sum.gamma = gamma_;
-    sum.alpha = alpha_;
-    sum.beta = beta_;
-    sum.mu = mu_;
-    sum.gradient = gradient_;
-    sum.rms_error_normalized =
-        (e_.array().square().rowwise().sum() / static_cast<double>(data_.inputs.cols())).sqrt();
-    sum.rms_error = sum.rms_error_normalized.cwiseProduct(data_.target_scaling.HalfRange());
+    Figures().FillSummaryEnd(e_, data_.target_scaling, &sum);
     if (bayes_) {
       Laplace(result);
     } else {
@@ -755,6 +755,10 @@ class BrIteration {
   double error_count() const { return n_; }
 
  private:
+  IterationFigures Figures() const {
+    return {F_, sse_, ssx_, gamma_, alpha_, beta_, mu_, gradient_};
+  }
+
   // Evaluates w + dw; takes it when F falls (c = mu + alpha of the step, whose factor A holds).
   bool TryWeights(double c) {
     w2_ = w_ + dw_;
