@@ -205,7 +205,7 @@ TEST(Monitor, BayesWithAVeryWeakPriorEqualsThePatentRefit) {
     Eigen::MatrixXd a(q, q);
     for (int i = 0; i < a.size(); ++i) a.data()[i] = n01(rng);
     Eigen::MatrixXd prior = 1e9 * (a * a.transpose() + Eigen::MatrixXd::Identity(q, q));
-    const Eigen::VectorXd ls = PatentRefit(x, y);
+    const Eigen::VectorXd ls = PatentRefit(x, y, b);
     const Eigen::VectorXd bayes = BayesUpdate(x, y, b, &prior, 0.04);
     EXPECT_LT((bayes - ls).cwiseAbs().maxCoeff(), 1e-5 * (1 + ls.cwiseAbs().maxCoeff()))
         << bayes.transpose() << " vs " << ls.transpose();
