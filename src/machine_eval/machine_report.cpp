@@ -6,15 +6,15 @@
 #include <filesystem>
 #include <sstream>
 
-#include "compare/machine_eval.h"
-#include "compare/machine_nc.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
+#include "machine_eval/machine_eval.h"
+#include "machine_eval/machine_nc.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 namespace {
 
 namespace fs = std::filesystem;
@@ -58,8 +58,8 @@ std::string LeadScript(const std::string& title) {
   const auto both = static_cast<std::size_t>(MachineStrategy::kBoth);
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
     gp += (k ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(k + 2) +
-          " with lines lw 2" + (k > both ? " dt " + std::to_string(k - both + 1) : "") +
-          " title " + GnuplotString(ToString(static_cast<MachineStrategy>(k)));
+          " with lines lw 2" + (k > both ? " dt " + std::to_string(k - both + 1) : "") + " title " +
+          GnuplotString(ToString(static_cast<MachineStrategy>(k)));
   return gp + "\n";
 }
 
@@ -183,4 +183,4 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
   return (fs::path(dir) / "index.html").string();
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

@@ -1,16 +1,16 @@
-#include "compare/machine_eval.h"
+#include "machine_eval/machine_eval.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "compare/machine_nc.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/random.h"
 #include "drift/monitor.h"
-#include "sim/random.h"
+#include "machine_eval/machine_nc.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 
 std::string ToString(MachineStrategy s) {
   static const char* kNames[] = {"none", "traditional", "workpiece",   "machine",
@@ -30,7 +30,7 @@ bool AnyMachineComponent(const machine::MachineConfig& c) {
 }
 
 std::uint64_t DaySeed(std::uint64_t machine_seed, std::uint64_t day) {
-  return sim::MixSeed(machine_seed, 0x1000 + day);
+  return MixSeed(machine_seed, 0x1000 + day);
 }
 
 // Model predictions on a run, linearly interpolated between the samples (the control evaluates
@@ -57,13 +57,13 @@ HeldSeries Predict(const drift::DriftModel& model, const drift::Run& run, double
   return h;
 }
 
-double TotalOf(const ElongationCurve& truth, const CompensationFunction& comp, double feed,
-               const sim::Screw& screw, const CompareOptions& options) {
-  LeadMetricOptions mo = options.metrics;
+double TotalOf(const ElongationCurve& truth, const compare::CompensationFunction& comp, double feed,
+               const sim::Screw& screw, const compare::CompareOptions& options) {
+  compare::LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
-  const LeadDeviation lead = CutLeadDeviation(truth, comp, feed, screw.thread_length_mm,
-                                              screw.process.pitch_mm, options.cut);
-  return ComputeLeadMetrics(lead, mo).accumulated_total_um;
+  const compare::LeadDeviation lead = compare::CutLeadDeviation(
+      truth, comp, feed, screw.thread_length_mm, screw.process.pitch_mm, options.cut);
+  return compare::ComputeLeadMetrics(lead, mo).accumulated_total_um;
 }
 
 }  // namespace
@@ -79,7 +79,7 @@ std::vector<drift::Run> TrainingRuns(const machine::MachineConfig& config,
     spec.name = std::string(cutting ? "cutting_" : "idle_") + std::to_string(r + 1);
     spec.state = state;
     spec.duration_min = cutting ? 150 : 180;
-    sim::Rng rng(day_seed);
+    Rng rng(day_seed);
     spec.cutting_speed_m_min = 150 + 60 * rng.Uniform();
     spec.noise_seed = day_seed;
     out.push_back(machine::SimulateRun(day, spec));
@@ -104,19 +104,19 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
 }
 
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
-                                        const ExperienceRule& rule,
-                                        const IsoToleranceTable& iso_table,
+                                        const compare::ExperienceRule& rule,
+                                        const compare::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
-                                        const CompareOptions& options, double monitor_every_min,
-                                        MachineScrewDetail* detail) {
+                                        const compare::CompareOptions& options,
+                                        double monitor_every_min, MachineScrewDetail* detail) {
   MachineEvalScrew out;
   out.screw = screw;
   out.seed = options.seed;
   // One hall: the workpiece follows the same ambient ramp as the machine's bed.
-  CompareOptions co = options;
+  compare::CompareOptions co = options;
   if (day.config.ambient.enabled)
     co.disturbance.ambient_drift_fixed_k_per_h = day.ambient_rate_k_per_h;
-  const ScrewComparison c = CompareScrew(screw, model, rule, iso_table, co);
+  const compare::ScrewComparison c = compare::CompareScrew(screw, model, rule, iso_table, co);
   if (detail) {
     detail->predicted_curve = c.predicted_curve;
     detail->kinematics = c.kinematics;
@@ -153,27 +153,28 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
     traditional_plan = interp::BuildPlan(
         fit::ArctanCurve::FromFeatures(tf, options.shape_k, options.time_exponent), feed,
         screw.thread_length_mm, options.plan);
-  auto planned = [feed](const interp::CompensationPlan& plan) -> CompensationFunction {
-    if (plan.segments.empty()) return NoCompensation();
+  auto planned = [feed](const interp::CompensationPlan& plan) -> compare::CompensationFunction {
+    if (plan.segments.empty()) return compare::NoCompensation();
     return [&plan, feed](double t_s) {
       return interp::AppliedCompensationUm(plan, interp::AxisPositionMm(plan.options, feed, t_s));
     };
   };
-  const CompensationFunction wp = planned(c.plan), trad = planned(traditional_plan);
-  CompensationFunction mach_cut = NoCompensation(), mach_idle = NoCompensation(),
-                       mach_monitor = NoCompensation();
+  const compare::CompensationFunction wp = planned(c.plan), trad = planned(traditional_plan);
+  compare::CompensationFunction mach_cut = compare::NoCompensation(),
+                                mach_idle = compare::NoCompensation(),
+                                mach_monitor = compare::NoCompensation();
   if (models.fitted) {
     machine::RunSpec spec;
     spec.name = screw.name + "_log";
     spec.duration_min = c.kinematics.cutting_time_s / 60.0 + 2 * day.config.sample_min;
     spec.cutting_speed_m_min = v_c;
-    spec.noise_seed = sim::MixSeed(options.seed, 77);
+    spec.noise_seed = MixSeed(options.seed, 77);
     const drift::Run log = machine::SimulateRun(day, spec);
     if (detail) detail->log = log;
     const double step = day.config.sample_min;
     auto held = [&](const drift::DriftModel& k0, const drift::DriftModel& g) {
       const HeldSeries a = Predict(k0, log, step), b = Predict(g, log, step);
-      return CompensationFunction([a, b, z_of, z_fixed](double t) {
+      return compare::CompensationFunction([a, b, z_of, z_fixed](double t) {
         return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3;
       });
     };
@@ -193,24 +194,25 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
       return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3;
     };
   }
-  auto sum = [](CompensationFunction a, CompensationFunction b) -> CompensationFunction {
+  auto sum = [](compare::CompensationFunction a,
+                compare::CompensationFunction b) -> compare::CompensationFunction {
     return [a, b](double t) { return a(t) + b(t); };
   };
-  const std::array<CompensationFunction, kMachineStrategyCount> comp = {
-      NoCompensation(),     trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle),
+  const std::array<compare::CompensationFunction, kMachineStrategyCount> comp = {
+      compare::NoCompensation(), trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle),
       sum(wp, mach_monitor)};
 
-  LeadMetricOptions mo = options.metrics;
+  compare::LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const LeadDeviation lead = CutLeadDeviation(truth, comp[k], feed, screw.thread_length_mm,
-                                                screw.process.pitch_mm, options.cut);
-    out.metrics[k] = ComputeLeadMetrics(lead, mo);
+    const compare::LeadDeviation lead = compare::CutLeadDeviation(
+        truth, comp[k], feed, screw.thread_length_mm, screw.process.pitch_mm, options.cut);
+    out.metrics[k] = compare::ComputeLeadMetrics(lead, mo);
     if (detail) detail->leads[k] = lead;
-    out.iso[k] = EvaluateIsoClass(out.metrics[k], iso_table).reached;
+    out.iso[k] = compare::EvaluateIsoClass(out.metrics[k], iso_table).reached;
   }
   for (std::size_t s = 0; s < kErrorSourceCount; ++s)
-    out.source_total_um[s] = TotalOf(parts[s], NoCompensation(), feed, screw, options);
+    out.source_total_um[s] = TotalOf(parts[s], compare::NoCompensation(), feed, screw, options);
   out.residual_workpiece_total_um = TotalOf(c.truth, wp, feed, screw, options);
   out.residual_machine_total_um = TotalOf(machine_truth, mach_cut, feed, screw, options);
   out.ok = true;
@@ -218,10 +220,10 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
 }
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
-                                       const ExperienceRule& rule,
-                                       const IsoToleranceTable& iso_table,
+                                       const compare::ExperienceRule& rule,
+                                       const compare::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,
-                                       const EvaluateProgress& progress) {
+                                       const compare::EvaluateProgress& progress) {
   auto range = [](int v, int lo, int hi, const char* what) {
     if (v < lo || v > hi)
       throw InputError(std::string(what) + " = " + std::to_string(v) + ": must be within " +
@@ -235,8 +237,7 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
   const std::size_t n_machines = static_cast<std::size_t>(options.machines);
   std::vector<MachineModels> models(n_machines);
   std::vector<std::uint64_t> machine_seeds(n_machines);
-  for (std::size_t i = 0; i < n_machines; ++i)
-    machine_seeds[i] = sim::MixSeed(options.seed, 0x4d00 + i);
+  for (std::size_t i = 0; i < n_machines; ++i) machine_seeds[i] = MixSeed(options.seed, 0x4d00 + i);
   ParallelFor(n_machines, options.threads, [&](std::size_t i) {
     models[i] =
         FitMachineModels(options.machine, machine_seeds[i], options.train_runs, options.fit);
@@ -248,7 +249,7 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
   }
   const std::size_t per = static_cast<std::size_t>(options.screws_per_machine);
   const std::vector<sim::Screw> screws =
-      RandomFeasibleScrews(base, static_cast<int>(per * n_machines), options.seed);
+      compare::RandomFeasibleScrews(base, static_cast<int>(per * n_machines), options.seed);
   e.screws.resize(screws.size());
   ParallelFor(
       screws.size(), options.threads,
@@ -257,8 +258,8 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
         const std::uint64_t day_seed = DaySeed(machine_seeds[i], k);
         const machine::MachineDay day =
             machine::MachineDay::Draw(options.machine, machine_seeds[i], day_seed);
-        CompareOptions co = options.compare;
-        co.seed = sim::MixSeed(options.seed, k);
+        compare::CompareOptions co = options.compare;
+        co.seed = MixSeed(options.seed, k);
         try {
           e.screws[k] = EvaluateScrewOnMachine(screws[k], model, rule, iso_table, day, models[i],
                                                co, options.monitor_every_min);
@@ -276,7 +277,7 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
     // The first screw again, keeping its curves (same seeds: the same figures).
     const machine::MachineDay day =
         machine::MachineDay::Draw(options.machine, machine_seeds[0], e.screws.front().day_seed);
-    CompareOptions co = options.compare;
+    compare::CompareOptions co = options.compare;
     co.seed = e.screws.front().seed;
     MachineScrewDetail detail;
     const MachineEvalScrew first =
@@ -316,9 +317,10 @@ MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& scr
     for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
       acc[k].push_back(std::abs(r.metrics[k].accumulated_1000_um));
       total[k].push_back(std::abs(r.metrics[k].accumulated_total_um));
-      const IsoClass c = r.iso[k];
-      if (c == IsoClass::kP1 || c == IsoClass::kP3) ++p3[k];
-      if (c == IsoClass::kP1 || c == IsoClass::kP3 || c == IsoClass::kP5) ++p5[k];
+      const compare::IsoClass c = r.iso[k];
+      if (c == compare::IsoClass::kP1 || c == compare::IsoClass::kP3) ++p3[k];
+      if (c == compare::IsoClass::kP1 || c == compare::IsoClass::kP3 || c == compare::IsoClass::kP5)
+        ++p5[k];
     }
     for (std::size_t q = 0; q < kErrorSourceCount; ++q) sources[q].push_back(r.source_total_um[q]);
     if (r.residual_workpiece_total_um >= r.residual_machine_total_um)
@@ -327,7 +329,7 @@ MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& scr
       ++s.residual_machine_dominates;
   }
   auto median = [](std::vector<double> v) {
-    return v.empty() ? 0.0 : Stats(std::move(v)).median_pct;
+    return v.empty() ? 0.0 : compare::Stats(std::move(v)).median_pct;
   };
   auto worst = [](const std::vector<double>& v) {
     return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
@@ -365,7 +367,7 @@ std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown) {
   else
     out += "strategy      1000mm med  worst  thread med  worst   P3    P5\n";
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const AbsoluteStats& a = s.absolute[k];
+    const compare::AbsoluteStats& a = s.absolute[k];
     const char* fmt = markdown ? "| %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f |\n"
                                : "%-12s %9.1f %6.1f %11.1f %6.1f %5.2f %5.2f\n";
     std::snprintf(buf, sizeof buf, fmt, ToString(static_cast<MachineStrategy>(k)).c_str(),
@@ -430,4 +432,4 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
        {"screws", screws}};
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

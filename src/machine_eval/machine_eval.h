@@ -44,7 +44,7 @@
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 
 enum class MachineStrategy {
   kNone,
@@ -70,14 +70,14 @@ struct MachineEvalOptions {
   int screws_per_machine = 3;  ///< random screws per machine (1..200)
   int train_runs = 2;          ///< idle and cutting training runs per machine (1..20)
   std::uint64_t seed = 1;
-  CompareOptions compare;
+  compare::CompareOptions compare;
   drift::FitOptions fit;  ///< threads are forced to 1 (the screws run in parallel)
   int threads = 2;
   double monitor_every_min = 30;  ///< both_monitor: check interval, min (> 0)
   /// Non-empty: WriteMachineScrewReport of the first screw (machine 0) into this folder.
   std::string report_dir;
   /// With report_dir: the report also holds the combined 840D programs of that screw for this
-  /// profile (compare/machine_nc.h; shipped: datasets/machines/whirling_840d.json).
+  /// profile (machine_eval/machine_nc.h; shipped: datasets/machines/whirling_840d.json).
   std::optional<interp::MachineProfile> profile;
 };
 
@@ -93,8 +93,8 @@ struct MachineEvalScrew {
   std::uint64_t seed = 0, day_seed = 0;
   bool ok = false;
   std::string error;
-  std::array<LeadMetrics, kMachineStrategyCount> metrics;
-  std::array<IsoClass, kMachineStrategyCount> iso{};
+  std::array<compare::LeadMetrics, kMachineStrategyCount> metrics;
+  std::array<compare::IsoClass, kMachineStrategyCount> iso{};
   /// Uncompensated accumulated error over the thread of each source alone, um.
   std::array<double, kErrorSourceCount> source_total_um{};
   /// "both": accumulated error over the thread of the workpiece and machine residuals, um.
@@ -103,7 +103,7 @@ struct MachineEvalScrew {
 
 struct MachineEvalSummary {
   std::size_t screws = 0, failed = 0;
-  std::array<AbsoluteStats, kMachineStrategyCount> absolute;
+  std::array<compare::AbsoluteStats, kMachineStrategyCount> absolute;
   std::array<double, kMachineStrategyCount> share_p3{}, share_p5{};
   std::array<double, kErrorSourceCount> source_median_um{};  ///< uncompensated, per source
   std::size_t residual_workpiece_dominates = 0, residual_machine_dominates = 0;
@@ -128,19 +128,19 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
 /// Curves of one screw, for the report: its sensor log and the lead deviation per strategy.
 struct MachineScrewDetail {
   drift::Run log;  ///< empty when no machine model was fitted
-  std::array<LeadDeviation, kMachineStrategyCount> leads;
+  std::array<compare::LeadDeviation, kMachineStrategyCount> leads;
   fit::ArctanCurve predicted_curve;  ///< the network's curve (the workpiece plan's)
   sim::Kinematics kinematics;
 };
 
-struct CombinedPrograms;  // compare/machine_nc.h
+struct CombinedPrograms;  // machine_eval/machine_nc.h
 
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
-                                        const ExperienceRule& rule,
-                                        const IsoToleranceTable& iso_table,
+                                        const compare::ExperienceRule& rule,
+                                        const compare::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
-                                        const CompareOptions& options,
+                                        const compare::CompareOptions& options,
                                         double monitor_every_min = 30,
                                         MachineScrewDetail* detail = nullptr);
 
@@ -150,7 +150,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
 /// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
 /// Returns the index path.
 /// `programs` (optional): the screw's combined 840D programs, written beside the figures
-/// (compare/machine_nc.h CombinedProgramFiles) and shown in index.html.
+/// (machine_eval/machine_nc.h CombinedProgramFiles) and shown in index.html.
 std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
                                     const MachineScrewDetail& detail,
                                     const std::vector<std::string>& sensors_cutting,
@@ -159,10 +159,10 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                                     const std::string& programs_note = "");
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
-                                       const ExperienceRule& rule,
-                                       const IsoToleranceTable& iso_table,
+                                       const compare::ExperienceRule& rule,
+                                       const compare::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,
-                                       const EvaluateProgress& progress = {});
+                                       const compare::EvaluateProgress& progress = {});
 
 MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& screws);
 /// Fixed-width text table (strategy: median/worst um within 1000 mm and over the thread, P3/P5).
@@ -170,4 +170,4 @@ std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown);
 
 void to_json(nlohmann::json& j, const MachineEvaluation& e);
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <random>
 
-namespace whirl::sim {
+namespace whirl {
 
 class Rng {
  public:
@@ -44,4 +44,4 @@ inline std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t stream) {
   return z ^ (z >> 31);
 }
 
-}  // namespace whirl::sim
+}  // namespace whirl
