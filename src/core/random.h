@@ -1,8 +1,17 @@
 #pragma once
-// Deterministic random numbers for the simulator's disturbances and the dataset design: the
-// std::mt19937_64 engine (its output sequence is fixed by the C++ standard) with this project's own
-// mapping to uniform and normal variates (the standard distributions are implementation-defined),
-// so every shipped file is identical across standard libraries.
+// Deterministic random numbers, the one random stream of the project (the simulator's
+// disturbances, the dataset design, the network's initialization, machines and days, ball-bar
+// and surface noise, the check bar's noise): the std::mt19937_64 engine, whose output sequence the
+// C++ standard fixes, with this project's own mapping to uniform and normal variates (the
+// standard distributions are implementation-defined), so every shipped file and every result is
+// identical across standard libraries.
+//   Uniform()      (u64 >> 11) * 2^-53, uniform in [0, 1) with 53 random bits;
+//   Uniform(a, b)  a + (b - a) Uniform();
+//   Normal()       standard normal by the Box-Muller transform (G. E. P. Box and M. E. Muller,
+//                  "A note on the generation of random normal deviates", Ann. Math. Statist. 29,
+//                  1958): from u1 in (0, 1) and u2 in [0, 1), r = sqrt(-2 ln u1), the pair
+//                  r cos(2 pi u2), r sin(2 pi u2), both used, in that order.
+// Every draw of Uniform takes one engine output; Normal takes two at every second call.
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -14,6 +23,8 @@ class Rng {
   explicit Rng(std::uint64_t seed) : engine_(seed) {}
   /// Uniform in [0, 1) with 53 random bits.
   double Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
+  /// Uniform in [lo, hi).
+  double Uniform(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
   /// Standard normal by the Box-Muller transform (both values used, in order).
   double Normal() {
     if (has_spare_) {
