@@ -12,8 +12,9 @@
 //     x = [1 f], model.h) predicts e_k = x_k' b every sample from the run's first row on (the lag
 //     states and the reference run from there, as in PredictRun);
 //   * the thermal error is known only at measurements: the run's error column at that sample plus
-//     optional Gaussian noise N(0, noise_um^2) (one draw per sample from `seed`, so every rule sees
-//     the same value at the same sample);
+//     optional Gaussian noise N(0, noise_um^2) (one draw per sample, Rng(seed).Normal() of
+//     core/random.h, the same on every standard library; every rule sees the same value at the
+//     same sample);
 //   * checks: the first at start + check_every, the next check_every after the last measurement
 //     (the patent: "when the machining time reaches the set time"); each measurement (check or
 //     refit) stops the machine stop_min_per_measurement [min]. The log cannot be paused: the stop
