@@ -8,7 +8,7 @@
 #include "core/parallel.h"
 #include "core/random.h"
 #include "drift/monitor.h"
-#include "machine_eval/machine_nc.h"
+#include "machine_eval/machine_report.h"
 
 namespace whirl::machine_eval {
 

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "compare/evaluate.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
@@ -133,8 +134,6 @@ struct MachineScrewDetail {
   sim::Kinematics kinematics;
 };
 
-struct CombinedPrograms;  // machine_eval/machine_nc.h
-
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
                                         const compare::ExperienceRule& rule,
@@ -143,20 +142,6 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
                                         const compare::CompareOptions& options,
                                         double monitor_every_min = 30,
                                         MachineScrewDetail* detail = nullptr);
-
-/// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a
-/// symbolic link; written all-or-nothing): sensors.csv/.png (the screw's sensor log,
-/// degC over min), lead.csv/.png (lead deviation per strategy, um over mm), index.html with the
-/// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
-/// Returns the index path.
-/// `programs` (optional): the screw's combined 840D programs, written beside the figures
-/// (machine_eval/machine_nc.h CombinedProgramFiles) and shown in index.html.
-std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
-                                    const MachineScrewDetail& detail,
-                                    const std::vector<std::string>& sensors_cutting,
-                                    const std::vector<std::string>& sensors_idle,
-                                    const CombinedPrograms* programs = nullptr,
-                                    const std::string& programs_note = "");
 
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
                                        const compare::ExperienceRule& rule,

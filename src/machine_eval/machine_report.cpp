@@ -2,6 +2,8 @@
 // sensors, lead deviation per strategy. User strings (sensor and screw names) reach gnuplot only
 // through GnuplotString (terminal noenhanced) and HTML only through HtmlEscape; gnuplot runs
 // through RunProgram with an argument vector.
+#include "machine_eval/machine_report.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -11,8 +13,6 @@
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
-#include "machine_eval/machine_eval.h"
-#include "machine_eval/machine_nc.h"
 
 namespace whirl::machine_eval {
 namespace {

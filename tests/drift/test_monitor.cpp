@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/random.h"
+#include "drift/fit.h"
 #include "drift/monitor.h"
 
 namespace whirl::drift {

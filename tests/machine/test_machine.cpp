@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"

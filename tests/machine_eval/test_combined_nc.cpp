@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "interp/nc_replay.h"
 #include "machine_eval/machine_nc.h"

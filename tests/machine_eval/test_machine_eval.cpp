@@ -14,6 +14,7 @@
 #include "core/safe_text.h"
 #include "machine/machine.h"
 #include "machine_eval/machine_eval.h"
+#include "machine_eval/machine_report.h"
 #include "nn/model.h"
 #include "sim/screw.h"
 
