@@ -103,6 +103,171 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
   return m;
 }
 
+namespace {
+
+// Where the tool is during the cut: z(t) = z_0 - v_f min(t, t_cut) [mm from the chuck face], and
+// the Z screw's fixed bearing z_fixed.
+struct ToolPath {
+  double feed_mm_s = 0, start_mm = 0, cutting_time_s = 0, fixed_end_mm = 0;
+  double ZAt(double t_s) const { return start_mm - feed_mm_s * std::min(t_s, cutting_time_s); }
+};
+
+ToolPath PathOf(const sim::Kinematics& k, const machine::MachineDay& day) {
+  return {k.axial_feed_mm_s, k.thread_start_position_mm, k.cutting_time_s,
+          day.config.z_screw.fixed_end_mm};
+}
+
+// The workpiece's comparison on this machine's day. One hall: with the machine's ambient
+// component on, the blank follows the day's ambient ramp, the one the bed follows.
+compare::ScrewComparison CompareOnDay(const sim::Screw& screw, const nn::Model& model,
+                                      const compare::ExperienceRule& rule,
+                                      const compare::IsoToleranceTable& iso_table,
+                                      const machine::MachineDay& day,
+                                      const compare::CompareOptions& options) {
+  compare::CompareOptions co = options;
+  if (day.config.ambient.enabled)
+    co.disturbance.ambient_drift_fixed_k_per_h = day.ambient_rate_k_per_h;
+  return compare::CompareScrew(screw, model, rule, iso_table, co);
+}
+
+// The truth of the cut, e + m, and its parts: the workpiece e and the machine's head, Z screw and
+// bed at the tool position (ErrorSource order), and m alone.
+struct TruthOnMachine {
+  std::array<ElongationCurve, kErrorSourceCount> parts;
+  ElongationCurve total, machine;
+};
+
+TruthOnMachine TruthWithMachine(const ElongationCurve& workpiece, const machine::MachineDay& day,
+                                const ToolPath& path, double cutting_speed_m_min) {
+  TruthOnMachine t;
+  t.total = workpiece;
+  for (auto& p : t.parts) p.time_s = workpiece.time_s;
+  t.machine.time_s = workpiece.time_s;
+  t.parts[0].elongation_um = workpiece.elongation_um;
+  for (std::size_t i = 0; i < workpiece.size(); ++i) {
+    const double t_min = workpiece.time_s[i] / 60.0, z = path.ZAt(workpiece.time_s[i]);
+    const double head = day.HeadUm(t_min, true, cutting_speed_m_min);
+    const double screw_um = day.ZScrewPer1000Um(t_min, true) * (path.fixed_end_mm - z) / 1000.0;
+    const double bed = day.BedUm(t_min);
+    t.parts[1].elongation_um.push_back(head);
+    t.parts[2].elongation_um.push_back(screw_um);
+    t.parts[3].elongation_um.push_back(bed);
+    const double m = head + screw_um + bed;
+    t.machine.elongation_um.push_back(m);
+    t.total.elongation_um[i] += m;
+  }
+  return t;
+}
+
+// The class-mean curve's 840D plan (empty when the rule has no features for the screw).
+interp::CompensationPlan TraditionalPlan(const compare::ScrewComparison& c, double thread_length_mm,
+                                         const compare::CompareOptions& options) {
+  const Features& tf = c.traditional_features;
+  if (!(tf.max_elongation_um > 0 && tf.settle_time_s > 0)) return {};
+  return interp::BuildPlan(
+      fit::ArctanCurve::FromFeatures(tf, options.shape_k, options.time_exponent),
+      c.kinematics.axial_feed_mm_s, thread_length_mm, options.plan);
+}
+
+// What a plan applies at time t_s (none for an empty plan). The plan is kept by the function.
+compare::CompensationFunction Planned(const interp::CompensationPlan& plan, double feed_mm_s) {
+  if (plan.segments.empty()) return compare::NoCompensation();
+  return [plan, feed_mm_s](double t_s) {
+    return interp::AppliedCompensationUm(plan,
+                                         interp::AxisPositionMm(plan.options, feed_mm_s, t_s));
+  };
+}
+
+compare::CompensationFunction Sum(compare::CompensationFunction a,
+                                  compare::CompensationFunction b) {
+  return [a, b](double t) { return a(t) + b(t); };
+}
+
+// The machine line c_m(t) = K0(t) + G(t) (z_fixed - z(t)) / 1000 from the offset and slope
+// predictions.
+compare::CompensationFunction MachineLine(const HeldSeries& offset, const HeldSeries& slope,
+                                          const ToolPath& path) {
+  return [offset, slope, path](double t) {
+    return offset.At(t) + slope.At(t) * (path.fixed_end_mm - path.ZAt(t)) / 1e3;
+  };
+}
+
+// The screw's own sensor log: the machine's day over the cut and two samples more.
+drift::Run ScrewSensorLog(const machine::MachineDay& day, const sim::Screw& screw,
+                          const sim::Kinematics& kinematics, std::uint64_t seed) {
+  machine::RunSpec spec;
+  spec.name = screw.name + "_log";
+  spec.duration_min = kinematics.cutting_time_s / 60.0 + 2 * day.config.sample_min;
+  spec.cutting_speed_m_min = screw.process.cutting_speed_m_min;
+  spec.noise_seed = MixSeed(seed, 77);
+  return machine::SimulateRun(day, spec);
+}
+
+// The cutting-trained offset model kept valid by the check bar (drift/monitor.h MonitorRun, rule
+// offset from the invalid check alone, 0.5 um noise): its prediction on the log.
+HeldSeries MonitoredOffset(const drift::DriftModel& offset, const drift::Run& log, double every_min,
+                           std::uint64_t seed, double step_min) {
+  drift::MonitorOptions mo;
+  mo.check_every = every_min;
+  mo.refit_samples = 0;
+  mo.noise_um = 0.5;
+  mo.seed = seed;
+  mo.rules = {drift::UpdateRule::kOffset};
+  const drift::MonitorResult monitored = drift::MonitorRun(offset, log, mo);
+  const Eigen::VectorXd& k0 = monitored.strategies.back().predicted_um;
+  return {step_min, std::vector<double>(k0.data(), k0.data() + k0.size())};
+}
+
+// The machine models' compensations on the screw's log: trained cutting, trained idle, and the
+// cutting-trained one with the check bar; none when no model was fitted.
+struct MachineCompensations {
+  compare::CompensationFunction cutting = compare::NoCompensation(),
+                                idle = compare::NoCompensation(),
+                                monitored = compare::NoCompensation();
+  drift::Run log;
+};
+
+MachineCompensations MachineModelCompensations(const MachineModels& models,
+                                               const machine::MachineDay& day,
+                                               const sim::Screw& screw,
+                                               const sim::Kinematics& kinematics,
+                                               const ToolPath& path, std::uint64_t seed,
+                                               double monitor_every_min) {
+  MachineCompensations m;
+  if (!models.fitted) return m;
+  m.log = ScrewSensorLog(day, screw, kinematics, seed);
+  const double step = day.config.sample_min;
+  const HeldSeries slope_cutting = Predict(models.slope_cutting, m.log, step);
+  m.cutting = MachineLine(Predict(models.offset_cutting, m.log, step), slope_cutting, path);
+  m.idle = MachineLine(Predict(models.offset_idle, m.log, step),
+                       Predict(models.slope_idle, m.log, step), path);
+  m.monitored =
+      MachineLine(MonitoredOffset(models.offset_cutting, m.log, monitor_every_min, seed, step),
+                  slope_cutting, path);
+  return m;
+}
+
+// Metrics and ISO class of every strategy on the truth; `detail` (optional) keeps the leads.
+void ScoreStrategies(
+    const ElongationCurve& truth,
+    const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
+    double feed_mm_s, const sim::Screw& screw, const compare::CompareOptions& options,
+    const compare::IsoToleranceTable& iso_table, MachineEvalScrew* out,
+    MachineScrewDetail* detail) {
+  compare::LeadMetricOptions mo = options.metrics;
+  mo.lead_mm = screw.process.pitch_mm;
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+    const compare::LeadDeviation lead =
+        compare::CutLeadDeviation(truth, compensations[k], feed_mm_s, screw.thread_length_mm,
+                                  screw.process.pitch_mm, options.cut);
+    out->metrics[k] = compare::ComputeLeadMetrics(lead, mo);
+    if (detail) detail->leads[k] = lead;
+    out->iso[k] = compare::EvaluateIsoClass(out->metrics[k], iso_table).reached;
+  }
+}
+
+}  // namespace
+
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
                                         const compare::ExperienceRule& rule,
                                         const compare::IsoToleranceTable& iso_table,
@@ -112,118 +277,40 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
   MachineEvalScrew out;
   out.screw = screw;
   out.seed = options.seed;
-  // One hall: the workpiece follows the same ambient ramp as the machine's bed.
-  compare::CompareOptions co = options;
-  if (day.config.ambient.enabled)
-    co.disturbance.ambient_drift_fixed_k_per_h = day.ambient_rate_k_per_h;
-  const compare::ScrewComparison c = compare::CompareScrew(screw, model, rule, iso_table, co);
+  const compare::ScrewComparison c = CompareOnDay(screw, model, rule, iso_table, day, options);
+  const ToolPath path = PathOf(c.kinematics, day);
+  const double feed = path.feed_mm_s;
+  const TruthOnMachine truth =
+      TruthWithMachine(c.truth, day, path, screw.process.cutting_speed_m_min);
+  const compare::CompensationFunction workpiece = Planned(c.plan, feed);
+  MachineCompensations machine = MachineModelCompensations(models, day, screw, c.kinematics, path,
+                                                           options.seed, monitor_every_min);
+  const std::array<compare::CompensationFunction, kMachineStrategyCount> compensations = {
+      compare::NoCompensation(),
+      Planned(TraditionalPlan(c, screw.thread_length_mm, options), feed),
+      workpiece,
+      machine.cutting,
+      Sum(workpiece, machine.cutting),
+      Sum(workpiece, machine.idle),
+      Sum(workpiece, machine.monitored)};
+  ScoreStrategies(truth.total, compensations, feed, screw, options, iso_table, &out, detail);
+  for (std::size_t s = 0; s < kErrorSourceCount; ++s)
+    out.source_total_um[s] =
+        TotalOf(truth.parts[s], compare::NoCompensation(), feed, screw, options);
+  out.residual_workpiece_total_um = TotalOf(c.truth, workpiece, feed, screw, options);
+  out.residual_machine_total_um = TotalOf(truth.machine, machine.cutting, feed, screw, options);
   if (detail) {
     detail->predicted_curve = c.predicted_curve;
     detail->kinematics = c.kinematics;
+    detail->log = std::move(machine.log);
   }
-  const double feed = c.kinematics.axial_feed_mm_s;
-  const double z0 = c.kinematics.thread_start_position_mm;
-  const double v_c = screw.process.cutting_speed_m_min;
-  const double z_fixed = day.config.z_screw.fixed_end_mm;
-  auto z_of = [&](double t_s) { return z0 - feed * std::min(t_s, c.kinematics.cutting_time_s); };
-
-  // Truth: workpiece + machine; and each source alone.
-  std::array<ElongationCurve, kErrorSourceCount> parts;
-  ElongationCurve truth = c.truth, machine_truth;
-  for (auto& p : parts) p.time_s = c.truth.time_s;
-  machine_truth.time_s = c.truth.time_s;
-  parts[0].elongation_um = c.truth.elongation_um;
-  for (std::size_t i = 0; i < c.truth.size(); ++i) {
-    const double t_min = c.truth.time_s[i] / 60.0, z = z_of(c.truth.time_s[i]);
-    const double head = day.HeadUm(t_min, true, v_c);
-    const double screw_um = day.ZScrewPer1000Um(t_min, true) * (z_fixed - z) / 1000.0;
-    const double bed = day.BedUm(t_min);
-    parts[1].elongation_um.push_back(head);
-    parts[2].elongation_um.push_back(screw_um);
-    parts[3].elongation_um.push_back(bed);
-    const double m = head + screw_um + bed;
-    machine_truth.elongation_um.push_back(m);
-    truth.elongation_um[i] += m;
-  }
-
-  // Compensations.
-  interp::CompensationPlan traditional_plan;
-  const Features& tf = c.traditional_features;
-  if (tf.max_elongation_um > 0 && tf.settle_time_s > 0)
-    traditional_plan = interp::BuildPlan(
-        fit::ArctanCurve::FromFeatures(tf, options.shape_k, options.time_exponent), feed,
-        screw.thread_length_mm, options.plan);
-  auto planned = [feed](const interp::CompensationPlan& plan) -> compare::CompensationFunction {
-    if (plan.segments.empty()) return compare::NoCompensation();
-    return [&plan, feed](double t_s) {
-      return interp::AppliedCompensationUm(plan, interp::AxisPositionMm(plan.options, feed, t_s));
-    };
-  };
-  const compare::CompensationFunction wp = planned(c.plan), trad = planned(traditional_plan);
-  compare::CompensationFunction mach_cut = compare::NoCompensation(),
-                                mach_idle = compare::NoCompensation(),
-                                mach_monitor = compare::NoCompensation();
-  if (models.fitted) {
-    machine::RunSpec spec;
-    spec.name = screw.name + "_log";
-    spec.duration_min = c.kinematics.cutting_time_s / 60.0 + 2 * day.config.sample_min;
-    spec.cutting_speed_m_min = v_c;
-    spec.noise_seed = MixSeed(options.seed, 77);
-    const drift::Run log = machine::SimulateRun(day, spec);
-    if (detail) detail->log = log;
-    const double step = day.config.sample_min;
-    auto held = [&](const drift::DriftModel& k0, const drift::DriftModel& g) {
-      const HeldSeries a = Predict(k0, log, step), b = Predict(g, log, step);
-      return compare::CompensationFunction([a, b, z_of, z_fixed](double t) {
-        return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3;
-      });
-    };
-    mach_cut = held(models.offset_cutting, models.slope_cutting);
-    mach_idle = held(models.offset_idle, models.slope_idle);
-    drift::MonitorOptions mo;
-    mo.check_every = monitor_every_min;
-    mo.refit_samples = 0;
-    mo.noise_um = 0.5;
-    mo.seed = options.seed;
-    mo.rules = {drift::UpdateRule::kOffset};
-    const drift::MonitorResult monitored = drift::MonitorRun(models.offset_cutting, log, mo);
-    const Eigen::VectorXd& k0 = monitored.strategies.back().predicted_um;
-    HeldSeries a{step, std::vector<double>(k0.data(), k0.data() + k0.size())};
-    const HeldSeries b = Predict(models.slope_cutting, log, step);
-    mach_monitor = [a, b, z_of, z_fixed](double t) {
-      return a.At(t) + b.At(t) * (z_fixed - z_of(t)) / 1e3;
-    };
-  }
-  auto sum = [](compare::CompensationFunction a,
-                compare::CompensationFunction b) -> compare::CompensationFunction {
-    return [a, b](double t) { return a(t) + b(t); };
-  };
-  const std::array<compare::CompensationFunction, kMachineStrategyCount> comp = {
-      compare::NoCompensation(), trad, wp, mach_cut, sum(wp, mach_cut), sum(wp, mach_idle),
-      sum(wp, mach_monitor)};
-
-  compare::LeadMetricOptions mo = options.metrics;
-  mo.lead_mm = screw.process.pitch_mm;
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const compare::LeadDeviation lead = compare::CutLeadDeviation(
-        truth, comp[k], feed, screw.thread_length_mm, screw.process.pitch_mm, options.cut);
-    out.metrics[k] = compare::ComputeLeadMetrics(lead, mo);
-    if (detail) detail->leads[k] = lead;
-    out.iso[k] = compare::EvaluateIsoClass(out.metrics[k], iso_table).reached;
-  }
-  for (std::size_t s = 0; s < kErrorSourceCount; ++s)
-    out.source_total_um[s] = TotalOf(parts[s], compare::NoCompensation(), feed, screw, options);
-  out.residual_workpiece_total_um = TotalOf(c.truth, wp, feed, screw, options);
-  out.residual_machine_total_um = TotalOf(machine_truth, mach_cut, feed, screw, options);
   out.ok = true;
   return out;
 }
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
-                                       const compare::ExperienceRule& rule,
-                                       const compare::IsoToleranceTable& iso_table,
-                                       const MachineEvalOptions& options,
-                                       const compare::EvaluateProgress& progress) {
+namespace {
+
+void ValidateMachineEvalOptions(const MachineEvalOptions& options) {
   auto range = [](int v, int lo, int hi, const char* what) {
     if (v < lo || v > hi)
       throw InputError(std::string(what) + " = " + std::to_string(v) + ": must be within " +
@@ -234,70 +321,107 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& 
   range(options.train_runs, 1, 20, "training runs");
   range(options.threads, 1, 64, "threads");
   options.machine.Validate("machine '" + options.machine.name + "'");
-  const std::size_t n_machines = static_cast<std::size_t>(options.machines);
-  std::vector<MachineModels> models(n_machines);
-  std::vector<std::uint64_t> machine_seeds(n_machines);
-  for (std::size_t i = 0; i < n_machines; ++i) machine_seeds[i] = MixSeed(options.seed, 0x4d00 + i);
-  ParallelFor(n_machines, options.threads, [&](std::size_t i) {
-    models[i] =
-        FitMachineModels(options.machine, machine_seeds[i], options.train_runs, options.fit);
+}
+
+// The drawn machines: their seeds and drift models, fitted in parallel.
+struct Machines {
+  std::vector<std::uint64_t> seeds;
+  std::vector<MachineModels> models;
+};
+
+Machines FitMachines(const MachineEvalOptions& options) {
+  const std::size_t n = static_cast<std::size_t>(options.machines);
+  Machines m;
+  m.models.resize(n);
+  for (std::size_t i = 0; i < n; ++i) m.seeds.push_back(MixSeed(options.seed, 0x4d00 + i));
+  ParallelFor(n, options.threads, [&](std::size_t i) {
+    m.models[i] = FitMachineModels(options.machine, m.seeds[i], options.train_runs, options.fit);
   });
-  MachineEvaluation e;
-  for (const auto& m : models) {
-    e.sensors_cutting.push_back(m.offset_cutting.sensors);
-    e.sensors_idle.push_back(m.offset_idle.sensors);
-  }
+  return m;
+}
+
+// Screw k is cut on machine k / screws_per_machine, on its own day, with its own truth seed; a
+// screw whose comparison fails is kept with its error.
+std::vector<MachineEvalScrew> EvaluateScrewsOnMachines(
+    const std::vector<sim::Screw>& screws, const Machines& machines, const nn::Model& model,
+    const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso_table,
+    const MachineEvalOptions& options, const compare::EvaluateProgress& progress) {
   const std::size_t per = static_cast<std::size_t>(options.screws_per_machine);
-  const std::vector<sim::Screw> screws =
-      compare::RandomFeasibleScrews(base, static_cast<int>(per * n_machines), options.seed);
-  e.screws.resize(screws.size());
+  std::vector<MachineEvalScrew> out(screws.size());
   ParallelFor(
       screws.size(), options.threads,
       [&](std::size_t k) {
         const std::size_t i = k / per;
-        const std::uint64_t day_seed = DaySeed(machine_seeds[i], k);
+        const std::uint64_t day_seed = DaySeed(machines.seeds[i], k);
         const machine::MachineDay day =
-            machine::MachineDay::Draw(options.machine, machine_seeds[i], day_seed);
+            machine::MachineDay::Draw(options.machine, machines.seeds[i], day_seed);
         compare::CompareOptions co = options.compare;
         co.seed = MixSeed(options.seed, k);
         try {
-          e.screws[k] = EvaluateScrewOnMachine(screws[k], model, rule, iso_table, day, models[i],
-                                               co, options.monitor_every_min);
+          out[k] = EvaluateScrewOnMachine(screws[k], model, rule, iso_table, day,
+                                          machines.models[i], co, options.monitor_every_min);
         } catch (const InputError& err) {
-          e.screws[k].screw = screws[k];
-          e.screws[k].ok = false;
-          e.screws[k].error = err.what();
+          out[k].screw = screws[k];
+          out[k].ok = false;
+          out[k].error = err.what();
         }
-        e.screws[k].machine = static_cast<int>(i);
-        e.screws[k].day_seed = day_seed;
+        out[k].machine = static_cast<int>(i);
+        out[k].day_seed = day_seed;
       },
       progress);
-  e.summary = SummarizeMachineEval(e.screws);
-  if (!options.report_dir.empty() && e.screws.front().ok) {
-    // The first screw again, keeping its curves (same seeds: the same figures).
-    const machine::MachineDay day =
-        machine::MachineDay::Draw(options.machine, machine_seeds[0], e.screws.front().day_seed);
-    compare::CompareOptions co = options.compare;
-    co.seed = e.screws.front().seed;
-    MachineScrewDetail detail;
-    const MachineEvalScrew first =
-        EvaluateScrewOnMachine(screws.front(), model, rule, iso_table, day, models[0], co,
-                               options.monitor_every_min, &detail);
-    std::optional<CombinedPrograms> programs;
-    if (options.profile && models[0].fitted) {
-      try {
-        programs = BuildCombinedPrograms(detail.predicted_curve, detail.kinematics,
-                                         screws.front().thread_length_mm, co.plan, models[0],
-                                         day.config, *options.profile,
-                                         "network curve of screw " + screws.front().name);
-      } catch (const InputError& err) {  // the evaluation stands; the page says why
-        e.programs_note = std::string("combined 840D programs not written: ") + err.what();
-      }
+  return out;
+}
+
+// The first screw again, keeping its curves (same seeds: the same figures), and its report with
+// the combined programs for options.profile; a profile that does not fit the machine leaves the
+// programs out with a note (the evaluation stands).
+void WriteFirstScrewReport(const sim::Screw& screw, const Machines& machines,
+                           const nn::Model& model, const compare::ExperienceRule& rule,
+                           const compare::IsoToleranceTable& iso_table,
+                           const MachineEvalOptions& options, MachineEvaluation* e) {
+  const machine::MachineDay day =
+      machine::MachineDay::Draw(options.machine, machines.seeds[0], e->screws.front().day_seed);
+  compare::CompareOptions co = options.compare;
+  co.seed = e->screws.front().seed;
+  MachineScrewDetail detail;
+  const MachineEvalScrew first =
+      EvaluateScrewOnMachine(screw, model, rule, iso_table, day, machines.models[0], co,
+                             options.monitor_every_min, &detail);
+  std::optional<CombinedPrograms> programs;
+  if (options.profile && machines.models[0].fitted) {
+    try {
+      programs = BuildCombinedPrograms(
+          detail.predicted_curve, detail.kinematics, screw.thread_length_mm, co.plan,
+          machines.models[0], day.config, *options.profile, "network curve of screw " + screw.name);
+    } catch (const InputError& err) {
+      e->programs_note = std::string("combined 840D programs not written: ") + err.what();
     }
-    e.report_index = WriteMachineScrewReport(options.report_dir, first, detail,
-                                             e.sensors_cutting[0], e.sensors_idle[0],
-                                             programs ? &*programs : nullptr, e.programs_note);
   }
+  e->report_index = WriteMachineScrewReport(options.report_dir, first, detail,
+                                            e->sensors_cutting[0], e->sensors_idle[0],
+                                            programs ? &*programs : nullptr, e->programs_note);
+}
+
+}  // namespace
+
+MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
+                                       const compare::ExperienceRule& rule,
+                                       const compare::IsoToleranceTable& iso_table,
+                                       const MachineEvalOptions& options,
+                                       const compare::EvaluateProgress& progress) {
+  ValidateMachineEvalOptions(options);
+  const Machines machines = FitMachines(options);
+  MachineEvaluation e;
+  for (const auto& m : machines.models) {
+    e.sensors_cutting.push_back(m.offset_cutting.sensors);
+    e.sensors_idle.push_back(m.offset_idle.sensors);
+  }
+  const std::vector<sim::Screw> screws = compare::RandomFeasibleScrews(
+      base, options.screws_per_machine * options.machines, options.seed);
+  e.screws = EvaluateScrewsOnMachines(screws, machines, model, rule, iso_table, options, progress);
+  e.summary = SummarizeMachineEval(e.screws);
+  if (!options.report_dir.empty() && e.screws.front().ok)
+    WriteFirstScrewReport(screws.front(), machines, model, rule, iso_table, options, &e);
   return e;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The combined 840D programs of one screw on a drifting whirling machine (issue 19, point 3):
+// The combined 840D programs of one screw on a drifting whirling machine (machine_eval.h):
 // the workpiece plan (the network's curve, interp/sinumerik.h) and the live machine-drift action
 // (the offset model and the Z feed screw's slope model, interp/drift_action.h) in one pair of
 // programs in which each setting datum has one writer:

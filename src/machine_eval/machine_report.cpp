@@ -1,4 +1,4 @@
-// Report of one screw cut on a drifting machine (issue 19, point 5): sensor plot, chosen
+// Report of one screw cut on a drifting machine (machine_report.h): sensor plot, chosen
 // sensors, lead deviation per strategy. User strings (sensor and screw names) reach gnuplot only
 // through GnuplotString (terminal noenhanced) and HTML only through HtmlEscape; gnuplot runs
 // through RunProgram with an argument vector.
