@@ -2,10 +2,10 @@
 // Fitting the drift models of drift/model.h on training runs: the choice of sensors (the fuzzy
 // clustering and grey relational grades of Miao, Gao, Dang and Miao, "Analysis of the thermal
 // error characteristics of CNC machine tools", Hefei University of Technology: drift/selection.h;
-// or a class count by cross-validation), the lag search of the dynamic kind (greedy forward selection
-// of time constants from FitOptions::tau_grid on the cross-validated RMSE) and the network kind's
-// Bayesian-regularized training (nn/trainbr.h). drift/model.h says what each kind computes; this
-// header, how it is fitted.
+// or a class count by cross-validation), the lag search of the dynamic kind (greedy forward
+// selection of time constants from FitOptions::tau_grid on the cross-validated RMSE) and the
+// network kind's Bayesian-regularized training (nn/trainbr.h). drift/model.h says what each kind
+// computes; this header, how it is fitted.
 #include <cstdint>
 #include <string>
 #include <vector>
