@@ -13,7 +13,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
-#include "drift/monitor.h"
+#include "drift/monitor_report.h"
 
 namespace whirl::cli {
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "drift/evaluation.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/selection.h"
 

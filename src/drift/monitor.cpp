@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <random>
 
 #include "core/error.h"
+#include "core/random.h"
 #include "drift/regression.h"
 
 namespace whirl::drift {
@@ -359,10 +359,9 @@ MonitorResult StartResult(const DriftModel& model, const Run& run, const Monitor
   if (r.score_end <= r.score_begin)
     throw InputError("monitor: no scored rows: rows [" + std::to_string(r.score_begin) + ", " +
                      std::to_string(r.score_end) + ") (start and score window)");
-  std::mt19937_64 rng(o.seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
+  Rng rng(o.seed);
   r.measurement_noise_um.resize(n);
-  for (int k = 0; k < n; ++k) r.measurement_noise_um(k) = o.noise_um * n01(rng);
+  for (int k = 0; k < n; ++k) r.measurement_noise_um(k) = o.noise_um * rng.Normal();
   if (model.zero.zero == ErrorZero::kAsLogged)
     r.warnings.push_back(model.error_column +
                          ": the model file predates the error zero (schema 1): errors as logged");
