@@ -580,6 +580,8 @@ FitReport FitCandidates(const std::vector<Run>& runs, const std::string& error_c
   FitReport rep = name == "sensors"        ? sensors
                   : name == "sensors+time" ? FitSensorTimeModel(runs, error_column, o, sensors)
                                            : FitTimeModel(runs, error_column, o, name == "time1" ? 1 : 2);
+  if (name != "sensors" && name != "sensors+time")  // the screen's warnings stand for every family
+    rep.warnings = sensors.warnings;
   rep.candidates = scores;
   rep.candidates[pick].time_constants = rep.model.elapsed_time_constants;
   rep.chosen = ChoiceMessage(scores, pick, runs, o);
