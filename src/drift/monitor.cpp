@@ -47,6 +47,7 @@ struct Replay {
   Eigen::MatrixXd p0;  // bayes prior
   double threshold_um, noise_variance;
   int start_sample;
+  Eigen::VectorXd column_scale;  // patent: 1 for the intercept, then each feature's training range
 };
 
 struct Piece {
@@ -61,10 +62,11 @@ std::string CheckMessage(double t, double y, double p, double thr, bool valid) {
 }
 
 Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
-                          const Eigen::VectorXd& b, Eigen::MatrixXd* p, double r, int* rank) {
+                          const Eigen::VectorXd& b, Eigen::MatrixXd* p, double r, int* rank,
+                          const Eigen::VectorXd& scale) {
   switch (rule) {
     case UpdateRule::kPatent:
-      return PatentRefit(xs, ys, b, rank);
+      return PatentRefit(xs, ys, b, rank, scale);
     case UpdateRule::kBayes:
       return BayesUpdate(xs, ys, b, p, r);
     case UpdateRule::kOffset:
@@ -181,7 +183,8 @@ class RuleReplay {
     const Eigen::VectorXd before = pieces_.back().b;
     u.kind = MonitorEvent::Kind::kUpdate;
     int rank = 0;
-    u.coefficients = ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance, &rank);
+    u.coefficients =
+        ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance, &rank, in_.column_scale);
     u.predicted_um = in_.x.row(*last).dot(u.coefficients);
     u.message = UpdateMessage(rule_, xs, ys, before, u.coefficients, rank, in_.o.prior_scale);
     s_.events.push_back(u);
@@ -291,8 +294,10 @@ Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, Reference
 }
 
 Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                            const Eigen::VectorXd& b, int* rank) {
-  Eigen::VectorXd scale = x.colwise().norm().transpose();
+                            const Eigen::VectorXd& b, int* rank,
+                            const Eigen::VectorXd& column_scale) {
+  Eigen::VectorXd scale =
+      column_scale.size() == x.cols() ? column_scale : Eigen::VectorXd(x.colwise().norm().transpose());
   for (Eigen::Index j = 0; j < scale.size(); ++j)
     if (!(scale(j) > 0)) scale(j) = 1;
   const Eigen::MatrixXd xs = x * scale.cwiseInverse().asDiagonal();
@@ -333,6 +338,19 @@ Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
 }
 
 namespace {
+
+// The patent's column scale: 1 for the intercept, each feature's training range (1 if none), so
+// the directions it keeps are those the measurements identify relative to the range the model
+// was fitted on, not to the few values at the measurements.
+Eigen::VectorXd PatentScale(const DriftModel& m) {
+  Eigen::VectorXd s(m.feature_max.size() + 1);
+  s(0) = 1;
+  for (Eigen::Index j = 0; j < m.feature_max.size(); ++j) {
+    const double range = m.feature_max(j) - m.feature_min(j);
+    s(j + 1) = range > 0 ? range : 1;
+  }
+  return s;
+}
 
 // The result's run, rows, scored window and threshold (MonitorRun's checks of its inputs).
 MonitorResult StartResult(const DriftModel& model, const Run& run, const MonitorOptions& o,
@@ -418,7 +436,8 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
                         : Eigen::MatrixXd(o.prior_scale * model.linear.covariance),
                     r.threshold_um,
                     std::max(noise_variance, 1e-12),
-                    start};
+                    start,
+                    PatentScale(model)};
     StrategyResult sr = RunRule(rules[i], in);
     sr.stop_share = sr.stop_min / (r.monitored_min + sr.stop_min);
     sr.score = ComputeErrorStats(r.measured_um.segment(r.score_begin, m) -

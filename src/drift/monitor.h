@@ -28,8 +28,9 @@
 // x_j = [1 f_j] and values y_j; the new coefficients apply from the last measurement on. Rules:
 //   patent   the patent's least-squares refit made rank-aware: the minimum change of the current
 //            coefficients that fits the n measurements in the directions they identify:
-//              Delta = S^-1 V_k diag(1/s_i) U_k' (y - X b),  X S^-1 = U diag(s) V' (unit-norm
-//              columns), keeping the k directions with s_i >= 0.05 s_max;
+//              Delta = S^-1 V_k diag(1/s_i) U_k' (y - X b),  X S^-1 = U diag(s) V' (S: 1 for the
+//              intercept, each feature's training range), keeping the k directions with
+//              s_i >= 0.05 s_max;
 //            the other directions keep the current coefficients, and the event says how many of
 //            the p + 1 were identified. With n >= p + 1 well-spread rows it is the patent's refit
 //            (all coefficients by least squares on the n measurements alone); with fewer it no
@@ -191,8 +192,12 @@ Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, Reference
 /// coefficients; prior_covariance (bayes, updated in place); noise_variance r [um^2].
 /// patent (header comment): the rank-aware minimum change from b; *rank (optional): the number of
 /// directions identified.
+/// `column_scale` (size x.cols()): the unit of each column for the singular-value cut (the
+/// replay passes 1 for the intercept and each feature's training range); empty: the columns'
+/// norms over the n rows.
 Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                            const Eigen::VectorXd& b, int* rank = nullptr);
+                            const Eigen::VectorXd& b, int* rank = nullptr,
+                            const Eigen::VectorXd& column_scale = Eigen::VectorXd());
 Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                             const Eigen::VectorXd& b, Eigen::MatrixXd* prior_covariance,
                             double noise_variance);
