@@ -50,6 +50,7 @@ struct ScheduleEvent {
   int job = -1;                       ///< index into DayPlan::jobs (cuts, set-ups, idles)
   double ring_rpm = 0;                ///< warm-up idles and laser-free idle tests
   double z_from_mm = 0, z_to_mm = 0;  ///< axis travel over the event (rapid or cut)
+  double feed_mm_min = 0;             ///< laser cycle: the axis feed (end to end and back)
 };
 
 struct DayPlan {

@@ -36,6 +36,9 @@ struct SensorNoise {
   double offset_std_k = 0.3;      ///< offset N(0, this), K
 };
 
+/// DrawnSensor::index_a of a sensor on the Z nut (not a network node, see field.h).
+inline constexpr int kNutSensorIndex = -1000;
+
 /// A sensor as mounted on one machine (resolved node indices, drawn errors).
 struct DrawnSensor {
   SensorSpec spec;        ///< with the drawn weight / position / tau
