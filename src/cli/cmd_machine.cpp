@@ -211,6 +211,7 @@ void RegisterMachine(CLI::App& app) {
       ->check(CLI::ExistingFile);
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
+  RegisterMachineTruth(m);
 }
 
 }  // namespace whirl::cli

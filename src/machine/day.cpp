@@ -42,7 +42,10 @@ struct Layout {
         return;
       }
       const Break& br = options.breaks[b];
-      if (br.clock_min > t) Push(kind, t, br.clock_min, job, z_to), left -= br.clock_min - t;
+      if (br.clock_min > t) {
+        left -= br.clock_min - t;
+        Push(kind, t, br.clock_min, job, z_to);
+      }
       Push(EventKind::kBreak, std::max(t, br.clock_min), br.clock_min + br.duration_min, -1, z);
       taken[b] = true;
     }
@@ -181,6 +184,12 @@ bool LayOutJob(Layout& lay, DayPlan& plan, int j, Rng& rng) {
   if (stop && !o.one_cut_per_day) lay.Interruptible(EventKind::kStop, stop_min, j, z_start);
   if (lay.t + job.idle_before_min + cut_min > o.shift_end_min + o.late_end_min) return false;
   if (job.idle_before_min > 0) {
+    // An idle run that would end inside a break idles on until the operator is back: no cut
+    // starts inside a break.
+    for (const Break& b : o.breaks) {
+      const double end = lay.t + job.idle_before_min, b_end = b.clock_min + b.duration_min;
+      if (end > b.clock_min && end < b_end) job.idle_before_min = b_end - lay.t;
+    }
     ScheduleEvent idle = Event(EventKind::kWarmupIdle, lay.t, lay.t + job.idle_before_min, j);
     idle.ring_rpm = job.kinematics.ring_speed_rpm;
     idle.z_from_mm = idle.z_to_mm = z_start;

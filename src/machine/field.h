@@ -95,11 +95,12 @@ struct FieldMachineConfig {
   double bed_expansion_per_k = 10.5e-6;    ///< alpha_b (cast iron)
   double steel_conductivity = 38, steel_density = 7810, steel_heat = 465;  ///< screw material
   double cabinet_base_c = 25, cabinet_hall_gain = 0.3;
+  double blank_tau_min = 45;  ///< a blank stored in the hall follows it with this lag (truth.h)
   double capacity_spread = 0.10;    ///< per machine: capacities x (1 + this N)
   double conductance_spread = 0.15; ///< per machine: conductances and source powers
   double length_spread = 0.10;      ///< per machine: the head's lengths L_j
   double power_spread = 0.10;       ///< per day: cutting power factor
-  std::vector<SensorSpec> sensors = DefaultSensorSpecs();
+  std::vector<FieldSensorSpec> sensors = DefaultSensorSpecs();
   SensorNoise noise;
   void Validate(const std::string& where) const;
 };

@@ -9,8 +9,8 @@ namespace whirl::machine {
 
 namespace {
 
-SensorSpec Node(const std::string& name, const std::string& node, double tau_min) {
-  SensorSpec s;
+FieldSensorSpec Node(const std::string& name, const std::string& node, double tau_min) {
+  FieldSensorSpec s;
   s.name = name;
   s.kind = "node";
   s.node_a = node;
@@ -18,17 +18,17 @@ SensorSpec Node(const std::string& name, const std::string& node, double tau_min
   return s;
 }
 
-SensorSpec Pair(const std::string& name, const std::string& a, const std::string& b, double w,
+FieldSensorSpec Pair(const std::string& name, const std::string& a, const std::string& b, double w,
                 double tau_min) {
-  SensorSpec s = Node(name, a, tau_min);
+  FieldSensorSpec s = Node(name, a, tau_min);
   s.kind = "pair";
   s.node_b = b;
   s.weight = w;
   return s;
 }
 
-SensorSpec Bed(const std::string& name, double position_mm, double tau_min) {
-  SensorSpec s;
+FieldSensorSpec Bed(const std::string& name, double position_mm, double tau_min) {
+  FieldSensorSpec s;
   s.name = name;
   s.kind = "bed";
   s.position_mm = position_mm;
@@ -36,15 +36,15 @@ SensorSpec Bed(const std::string& name, double position_mm, double tau_min) {
   return s;
 }
 
-SensorSpec Boundary(const std::string& name, const std::string& boundary, double tau_min) {
-  SensorSpec s = Node(name, boundary, tau_min);
+FieldSensorSpec Boundary(const std::string& name, const std::string& boundary, double tau_min) {
+  FieldSensorSpec s = Node(name, boundary, tau_min);
   s.kind = "boundary";
   return s;
 }
 
 }  // namespace
 
-std::vector<SensorSpec> DefaultSensorSpecs() {
+std::vector<FieldSensorSpec> DefaultSensorSpecs() {
   // Lags: a sensor screwed into a bore or clamped to a surface follows it within minutes
   // (estimates); the air sensors are faster.
   return {Boundary("ambient", "hall", 2),
@@ -62,10 +62,10 @@ std::vector<SensorSpec> DefaultSensorSpecs() {
           Boundary("cabinet", "cabinet", 3)};
 }
 
-SensorSpec DrawPlacement(const SensorSpec& nominal, const SensorNoise& noise, std::uint64_t seed,
+FieldSensorSpec DrawPlacement(const FieldSensorSpec& nominal, const SensorNoise& noise, std::uint64_t seed,
                          double* gain, double* offset_k) {
   Rng rng(seed);
-  SensorSpec s = nominal;
+  FieldSensorSpec s = nominal;
   const double dw = rng.Uniform(-noise.placement_spread, noise.placement_spread);
   const double dx = rng.Uniform(-noise.position_spread_mm, noise.position_spread_mm);
   if (s.kind == "pair") s.weight = std::clamp(s.weight + dw, 0.0, 1.0);

@@ -17,7 +17,7 @@ namespace whirl::machine {
 
 /// Where a sensor sits. kind "node": `node_a`; "pair": w T(node_a) + (1 - w) T(node_b);
 /// "bed": the bed at position_mm (linear between cell centres); "boundary": hall or cabinet air.
-struct SensorSpec {
+struct FieldSensorSpec {
   std::string name;      ///< column name without the _C suffix (names of the 840D profile)
   std::string kind = "node";
   std::string node_a, node_b;
@@ -41,7 +41,7 @@ inline constexpr int kNutSensorIndex = -1000;
 
 /// A sensor as mounted on one machine (resolved node indices, drawn errors).
 struct DrawnSensor {
-  SensorSpec spec;        ///< with the drawn weight / position / tau
+  FieldSensorSpec spec;        ///< with the drawn weight / position / tau
   int index_a = -1, index_b = -1;  ///< network node indices (-1: unused); boundary: -2 - index
   int bed_a = -1, bed_b = -1;      ///< "bed": the two cells and weight towards bed_a
   double bed_weight = 1.0;
@@ -52,10 +52,10 @@ struct DrawnSensor {
 /// (3200), bed_tailstock (6000), chip_tray (bed 2500, 3 min), head_motor (motor|housing 0.8),
 /// head_bearing (bearing|housing 0.6), head_housing, ring_gearbox (belt|housing 0.8), z_nut,
 /// z_fixed_bearing (bearing|motor 0.8), z_motor (motor|bearing 0.9), cabinet (cabinet air).
-std::vector<SensorSpec> DefaultSensorSpecs();
+std::vector<FieldSensorSpec> DefaultSensorSpecs();
 
 /// Placement, lag, gain and offset of one sensor on one machine (stream of the machine's seed).
-SensorSpec DrawPlacement(const SensorSpec& nominal, const SensorNoise& noise, std::uint64_t seed,
+FieldSensorSpec DrawPlacement(const FieldSensorSpec& nominal, const SensorNoise& noise, std::uint64_t seed,
                          double* gain, double* offset_k);
 
 /// Reading of a lagged location temperature y (degC) through the sensor's gain/offset, the noise

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "machine/timeline_data.h"
+#include "sim/physics.h"
 
 namespace whirl::machine {
 
@@ -173,6 +174,22 @@ detail::TimelineData::Parts detail::TimelineData::ErrorAt(double t, double z_mm)
   const ErrorParts p = machine.Error(temp, z_mm);
   const double extra = options.extra_error_um ? options.extra_error_um(t, z_mm) : 0.0;
   return {p.head_um, p.z_um, extra};
+}
+
+double detail::BlankTemperatureC(const TimelineData& d, double abs_min) {
+  const double tau = d.machine.config().blank_tau_min, step = tau / 20;
+  double sum = 0, weight = 0;
+  for (int i = 0; i < 160; ++i) {  // 8 tau, midpoint rule
+    const double age = (i + 0.5) * step, w = std::exp(-age / tau);
+    const double t = abs_min - age;
+    sum += w * (d.hall.At(t) + (t >= 0 ? d.options.test_window_hall_offset_k : 0.0));
+    weight += w;
+  }
+  return sum / weight;
+}
+
+double detail::BlankReferenceUm(double blank_start_c, double z_mm) {
+  return 1e3 * sim::PhysicsConstants{}.expansion_per_k * (blank_start_c - 20) * z_mm;
 }
 
 double detail::LocationC(const TimelineData& d, const DrawnSensor& s, int k) {

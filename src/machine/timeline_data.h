@@ -25,6 +25,15 @@ struct TimelineData {
   Parts ErrorAt(double t, double z_mm) const;
 };
 
+/// Temperature of a blank stored in the hall at abs_min: the hall air through a first-order lag
+/// of FieldMachineConfig::blank_tau_min (convolution over the preceding 8 time constants).
+double BlankTemperatureC(const TimelineData& d, double abs_min);
+/// The blank's part of the lead at 20 degC (Bryan 1990: only differential expansion against the
+/// 20 degC reference matters): the workpiece simulator measures its elongation from the blank's
+/// temperature T_0 at the cut start; measured at 20 degC a groove cut at z lies further towards
+/// the chuck by alpha_blank (T_0 - 20) z, um (m's sign). alpha_blank of sim::PhysicsConstants.
+double BlankReferenceUm(double blank_start_c, double z_mm);
+
 /// Location temperature of a sensor in kept state k (before its lag).
 double LocationC(const TimelineData& d, const DrawnSensor& s, int k);
 

@@ -27,11 +27,14 @@ std::vector<TruthSample> TrueCutError(const MachineTimeline& timeline, const Cut
   const double start = cut.day * 1440.0 + job.cut_start_min;
   const double end = cut.day * 1440.0 + job.cut_end_min;
   const double step = timeline.options().control_sample_s / 60;
+  const double blank_c = detail::BlankTemperatureC(timeline.data(), start);
   std::vector<TruthSample> out;
   for (double t = start; t <= end + 1e-9; t += step) {
     const double z = job.kinematics.thread_start_position_mm -
                      job.kinematics.axial_feed_mm_min * (t - start);
-    out.push_back(TrueError(timeline, t, z));
+    TruthSample p = TrueError(timeline, t, z);
+    p.blank_um = detail::BlankReferenceUm(blank_c, z);
+    out.push_back(p);
   }
   return out;
 }
@@ -56,8 +59,8 @@ CutHall HallDuringCut(const MachineTimeline& timeline, const CutRef& cut) {
   const Job& job = CutJob(timeline, cut);
   const double start = cut.day * 1440.0 + job.cut_start_min;
   const double end = cut.day * 1440.0 + job.cut_end_min;
-  const double offset = start >= 0 ? timeline.options().test_window_hall_offset_k : 0.0;
-  return {timeline.hall().At(start) + offset, timeline.hall().SlopeKPerH(start, end)};
+  return {detail::BlankTemperatureC(timeline.data(), start),
+          timeline.hall().SlopeKPerH(start, end)};
 }
 
 }  // namespace whirl::machine
