@@ -31,7 +31,16 @@ Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm) {
   std::size_t n = 0;
   for (const auto& r : rec.records) {
     const auto l = static_cast<std::size_t>(r.log);
-    if (phi[l].size() == 0) phi[l] = BuildFeatures(rec.day_logs[l], in.sensors, in.others, in.taus);
+    if (phi[l].size() == 0) {
+      phi[l] = BuildFeatures(rec.day_logs[l], in.sensors, in.others, in.taus);
+      // A control signal enters through its lags only (a warm-up clock is 1 - exp(-t / tau),
+      // not the power-on step itself): its static column would fit each record's first
+      // reading and, in the slope part, a z-linear term no lag supports.
+      const std::size_t per = 1 + in.taus.size();
+      if (!in.taus.empty())
+        for (std::size_t i = 0; i < in.others.size(); ++i)
+          phi[l].col(static_cast<Eigen::Index>((in.sensors.size() + i) * per)).setZero();
+    }
     n += r.rows.size();
   }
   const Eigen::Index p = static_cast<Eigen::Index>(

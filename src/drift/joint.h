@@ -17,9 +17,10 @@
 // temperature), w = 1 / sigma^2. A slope direction that no record identifies (its psi column lies
 // in the span of the phi columns after demeaning, e.g. every reading at one z) is left out (g = 0)
 // and reported. A ridge of 1e-8 x trace / p on the standardized columns keeps the solve safe.
-// Lags: greedy forward choice of at most max_lags shared time constants from tau_grid, accepted
-// while the grouped cross-validated RMSE (leave one calendar day out; a held-out record is scored
-// after removing its own weighted mean) falls. Sensor family: greedy forward choice of at most
+// Control signals enter through their lags only (their static step column is left out when a
+// lag is chosen). Lags: greedy forward choice of at most max_lags shared time constants from
+// tau_grid, accepted while the grouped cross-validated RMSE (leave one calendar day out; a
+// held-out record is scored after removing its own weighted mean) falls. Sensor family: greedy forward choice of at most
 // max_sensors sensors by the same cross-validation (static features), before the lags.
 #include <array>
 #include <string>
