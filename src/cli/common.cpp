@@ -9,11 +9,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include "cli/terminal.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 #include "core/safe_text.h"
 #include "fit/arctan_curve.h"
 
@@ -24,13 +26,32 @@ void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent)
                   "shape k of the arctangent curve l(t) = L atan(k (t/t_s)^p)/atan(k) [-] "
                   "(default: fitted on simulated curves, 'whirl fit --simulated 25')")
       ->capture_default_str()
-      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+      ->check(NumberIn(fit::kMinShapeK, fit::kMaxShapeK));
   sub->add_option("--time-exponent", *time_exponent,
                   "time exponent p of that curve, in [0.5, 1]; 1 = the plain arctangent in time "
                   "[-] (default: fitted with k). Below about 0.7 the curve starts so steeply that "
                   "the first segment's SD43910 can exceed the MD32760 cap (an error)")
       ->capture_default_str()
-      ->check(CLI::Range(fit::kMinTimeExponent, fit::kMaxTimeExponent));
+      ->check(NumberIn(fit::kMinTimeExponent, fit::kMaxTimeExponent));
+}
+
+void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_required) {
+  sub->add_option("--model", a->model_path, "model file written by 'whirl train'")
+      ->check(CLI::ExistingFile);
+  auto* screw = sub->add_option("--screw", a->screw_path,
+                                "screw file (JSON, see 'whirl simulate --help'): process inputs, "
+                                "thread length and settings that give the axial feed")
+                    ->check(CLI::ExistingFile);
+  if (screw_required) screw->required();
+  sub->add_option("--max-elongation", a->max_elongation_um,
+                  "instead of --model: plateau elongation L [um], 0..10000")
+      ->check(NonNegativeNumber("um"));
+  sub->add_option("--settle-time", a->settle_time_s,
+                  "instead of --model: settle time t_s [s], 1..1e6")
+      ->check(PositiveNumber("s"));
+  AddCurveShapeOptions(sub, &a->shape_k, &a->time_exponent);
+  sub->add_flag("--allow-extrapolation", a->allow_extrapolation,
+                "use the prediction even if the screw lies outside the model's training domain");
 }
 
 CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help) {
@@ -46,12 +67,41 @@ CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string
       ->check(CLI::Validator(rule, "UINT64"));
 }
 
-CLI::Option* FiniteNumber(CLI::Option* option) {
-  const auto rule = [](std::string& text) -> std::string {
-    if (ParseDecimal(text)) return "";
-    return "'" + text + "' must be a finite decimal number";
+CLI::Validator NumberIn(const Range& range) {
+  std::string text = std::string(range.min_open ? "(" : "[") + MessageNumber(range.min) + ", " +
+                     MessageNumber(range.max) + "]";
+  if (*range.unit) text += std::string(" ") + range.unit;
+  const std::string rule = "a finite number in " + text + (*range.note ? std::string(" (") + range.note + ")" : "");
+  const auto check = [range, rule](std::string& value) -> std::string {
+    const auto x = ParseDecimal(value);
+    if (x && range.Contains(*x)) return "";
+    return (x ? MessageNumber(*x) : "'" + value + "'") + " breaks the rule: " + rule;
   };
-  return option->check(CLI::Validator(rule, "FINITE"));
+  return CLI::Validator(check, text);
+}
+
+CLI::Validator NumberIn(double min, double max, const char* unit) {
+  return NumberIn(Range{min, max, false, unit});
+}
+
+CLI::Validator PositiveNumber(const char* unit) {
+  return NumberIn(Range{0, std::numeric_limits<double>::max(), true, unit});
+}
+
+CLI::Validator NonNegativeNumber(const char* unit) {
+  return NumberIn(0, std::numeric_limits<double>::max(), unit);
+}
+
+CLI::Validator FiniteNumber(const char* unit) {
+  return NumberIn(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), unit);
+}
+
+void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
+  sub->add_option("--tolerance-um", *tolerance_um,
+                  "largest |840D chord - predicted curve| of the plan along the thread [um]; at "
+                  "least 1 nm, the resolution of SD43900")
+      ->capture_default_str()
+      ->check(NumberIn(kPlanToleranceRange));
 }
 
 int RunApp(CLI::App& app, int argc, char** argv) {

@@ -4,7 +4,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -24,9 +23,6 @@ using detail::SolveFactored;
 using detail::TraceOfInverse;
 
 constexpr double kMuFloor = 1e-20;  // trainbr: mu = max(mu * mu_dec, 1e-20)
-
-// Numbers in messages (stop reasons, errors): 6 significant digits; the summary keeps exact values.
-std::string Num(double x) { return MessageNumber(x); }
 
 double SumSquares(const Eigen::MatrixXd& e) { return e.squaredNorm(); }
 
@@ -72,7 +68,7 @@ Regularization ParseRegularization(const std::string& s) {
 
 void TrainOptions::Validate() const {
   auto fail = [](const std::string& name, double v, const std::string& rule) {
-    throw InputError("train option '" + name + "' = " + Num(v) + ": " + rule);
+    throw InputError("train option '" + name + "' = " + MessageNumber(v) + ": " + rule);
   };
   if (epochs < 0) fail("epochs", epochs, "must be >= 0");
   if (!(goal >= 0) || !std::isfinite(goal)) fail("goal", goal, "must be finite and >= 0");
@@ -99,7 +95,7 @@ bool StopReached(const TrainOptions& options, int epoch, double sse, double grad
     sum->message = degenerate_message;
   } else if (sse <= options.goal) {
     sum->termination = TrainTermination::kGoalMet;
-    sum->message = "ssE = " + Num(sse) + " <= goal = " + Num(options.goal);
+    sum->message = "ssE = " + MessageNumber(sse) + " <= goal = " + MessageNumber(options.goal);
   } else if (epoch == options.epochs) {
     sum->termination = TrainTermination::kMaxEpochs;
     sum->message =
@@ -107,14 +103,14 @@ bool StopReached(const TrainOptions& options, int epoch, double sse, double grad
   } else if (gradient <= options.min_grad) {
     sum->termination = TrainTermination::kMinGradient;
     sum->message =
-        "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " + Num(options.min_grad);
+        "gradient 2||J'e|| = " + MessageNumber(gradient) + " <= min_grad = " + MessageNumber(options.min_grad);
   } else if (mu >= options.mu_max) {
     sum->termination = TrainTermination::kMaxMu;
-    sum->message = "mu = " + Num(mu) + " >= mu_max = " + Num(options.mu_max);
+    sum->message = "mu = " + MessageNumber(mu) + " >= mu_max = " + MessageNumber(options.mu_max);
   } else if (options.change > 0 && ObjectiveSpread(after_step) < options.change) {
     sum->termination = TrainTermination::kObjectiveStalled;
-    sum->message = "F after the step changed by at most " + Num(ObjectiveSpread(after_step)) +
-                   " < change = " + Num(options.change) + " over the last 4 epochs";
+    sum->message = "F after the step changed by at most " + MessageNumber(ObjectiveSpread(after_step)) +
+                   " < change = " + MessageNumber(options.change) + " over the last 4 epochs";
   } else {
     return false;
   }
@@ -135,11 +131,7 @@ double ObjectiveSpread(const std::vector<double>& after_step) {
 std::string TrainSummary::BriefReport() const {
   // Four significant digits for a person to read; the model file keeps the exact values. No F:
   // trainbr starts and ends near F = n / 2 by its alpha/beta rule, so F tells nothing here.
-  auto brief = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", x);
-    return std::string(buf);
-  };
+  auto brief = [](double x) { return FormatSignificant(x, 4); };
   std::ostringstream s;
   s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": ssE "
     << brief(initial_sse) << " -> " << brief(sse) << " in " << epochs << " epochs, gamma "
@@ -400,7 +392,7 @@ std::string ReestimateArd(const Eigen::MatrixXd& jj, double sse, const Eigen::Ve
                                               : std::min(gamma(g) / (2 * ssx(g)), kArdAlphaMax);
   const double beta = sse == 0 ? 1.0 : (n - gamma.sum()) / (2 * sse);
   if (!alpha.allFinite() || !std::isfinite(beta) || !(beta > 0))
-    return "gamma = " + Num(gamma.sum()) + ", beta = " + Num(beta) +
+    return "gamma = " + MessageNumber(gamma.sum()) + ", beta = " + MessageNumber(beta) +
            " (kept the last finite alpha_g, beta)";
   *h = {alpha, beta, gamma.sum()};
   return "";
@@ -671,9 +663,9 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
         alpha = alpha_new;
         beta = beta_new;
       } else {
-        degenerate_message = "gamma = " + Num(gamma_new) + ", alpha = " + Num(alpha_new) +
-                             ", beta = (n - gamma)/(2 ssE) = " + Num(beta_new) +
-                             " at ssE = " + Num(sse) + " (kept the last finite alpha, beta)";
+        degenerate_message = "gamma = " + MessageNumber(gamma_new) + ", alpha = " + MessageNumber(alpha_new) +
+                             ", beta = (n - gamma)/(2 ssE) = " + MessageNumber(beta_new) +
+                             " at ssE = " + MessageNumber(sse) + " (kept the last finite alpha, beta)";
       }
       F = beta * sse + alpha * ssx;
     }
@@ -736,8 +728,8 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     const double margin = kArdEvidenceMargin * std::max(1.0, std::abs(sum.log_evidence));
     if (steps > 0 && ard.summary.log_evidence > sum.log_evidence + margin) return ard;
     sum.message += "; ARD stage not kept (" + std::to_string(steps) +
-                   " accepted steps, log evidence " + Num(ard.summary.log_evidence) + " against " +
-                   Num(sum.log_evidence) + ")";
+                   " accepted steps, log evidence " + MessageNumber(ard.summary.log_evidence) + " against " +
+                   MessageNumber(sum.log_evidence) + ")";
   }
   return result;
 }
