@@ -129,7 +129,7 @@ void RegisterCompare(CLI::App& app) {
   AddToleranceOption(sub, &o->tolerance_um);
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910|, - (default 0.01, max 0.10)")
-      ->check(NumberIn(1e-9, interp::kMd32760Max));
+      ->check(Md32760Number());
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_flag("--json", o->json, "machine output: the comparison as JSON on stdout");
   sub->callback([o, sub] {

@@ -89,6 +89,7 @@ void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
       ->delimiter(',');
   sub->add_option("--lag-grid", m->lags,
                   "dynamic: candidate lag time constants [min] (default 5,10,20,40,80,160,320)")
+      ->check(PositiveNumber("min"))
       ->delimiter(',');
   sub->add_option("--max-lags", m->max_lags, "dynamic: at most this many time constants (1..4)")
       ->check(NumberIn(1, 4));

@@ -72,10 +72,12 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   AddSeedOption(sub, &o.seed, "seed of the measurement noise (default 1)");
   sub->add_option("--start", o.start,
                   "monitoring starts here [min; samples]: no check before, scores from here "
-                  "(default 0)");
+                  "(default 0)")
+      ->check(FiniteNumber());
   sub->add_option("--score-rows", a->score_rows,
                   "scored share of the run's rows FROM,TO (default 0,1; FL_THERMAL's test "
                   "window: 0.6,0.8)")
+      ->check(NumberIn(0, 1))
       ->delimiter(',')
       ->expected(2);
   sub->add_option("--reference", a->reference,

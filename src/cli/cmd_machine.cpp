@@ -157,7 +157,7 @@ void RegisterMachine(CLI::App& app) {
   CommonOptions(s, o.get());
   s->add_option("--out", o->out, std::string("output folder, all files or none: ") + kOutputDirRule)
       ->required();
-  s->add_option("--machine-seed", o->machine_seed, "seed of the machine (default 1)");
+  AddSeedOption(s, &o->machine_seed, "seed of the machine (default 1)", "--machine-seed");
   s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")
       ->check(NumberIn(0, 20));
   s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")
@@ -180,7 +180,7 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--train-runs", o->train_runs,
                 "idle and cutting training runs per machine (1..20, default 2)")
       ->check(NumberIn(1, 20));
-  e->add_option("--seed", o->seed, "seed of machines, days, screws and truth (default 1)");
+  AddSeedOption(e, &o->seed, "seed of machines, days, screws and truth (default 1)");
   e->add_option("--threads", o->threads, "worker threads (1..64, default 2)")
       ->check(NumberIn(1, 64));
   e->add_option("--model", o->model_path, "workpiece model (default models/default.json)")

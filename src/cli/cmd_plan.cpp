@@ -246,7 +246,7 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR of the axis: cap on |SD43910| (0-0.10], "
                   "default 0.01")
-      ->check(NumberIn(1e-12, interp::kMd32760Max));
+      ->check(Md32760Number());
   sub->add_option("--sync-id-first", o->sync_id_first,
                   "first synchronized-action ID whirl may use (1-255); no default: from the "
                   "profile, or required with --sync-id-last for --nc/--reset-nc without one; a "

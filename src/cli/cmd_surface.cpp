@@ -255,11 +255,14 @@ void SetupCompare(CLI::App& parent) {
   sub->add_option("--degree", o->choice.degree, "B-spline degree (1..5, default 3)")
       ->check(NumberIn(1, kMaxDegree));
   sub->add_option("--edge-ratio", o->choice.edge_ratio,
-                  "edge / interior LOO RMS that flags oscillation (> 1, default 1.5)");
+                  "edge / interior LOO RMS that flags oscillation (> 1, default 1.5)")
+      ->check(FiniteNumber());
   sub->add_option("--overshoot-fraction", o->choice.overshoot_fraction,
-                  "overshoot / measured range that flags oscillation (> 0, default 0.1)");
+                  "overshoot / measured range that flags oscillation (> 0, default 0.1)")
+      ->check(FiniteNumber());
   sub->add_option("--min-excess-um", o->choice.min_excess_um,
-                  "smallest excess that flags oscillation, um (default 0.5)");
+                  "smallest excess that flags oscillation, um (default 0.5)")
+      ->check(FiniteNumber("um"));
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] { RunCompare(*o); });
 }
@@ -319,8 +322,10 @@ void SetupLine(CLI::App& parent) {
   sub->add_option("--sign", o->sign, "subtract (dK = -line, default) | add")
       ->check(CLI::IsMember({"subtract", "add"}));
   sub->add_option("--md32760", o->line.md32760,
-                  "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910| (0..0.10, default 0.01)");
-  sub->add_option("--samples", o->line.samples, "samples per direction (2..1001, default 101)");
+                  "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910| (0..0.10, default 0.01)")
+      ->check(Md32760Number());
+  sub->add_option("--samples", o->line.samples, "samples per direction (2..1001, default 101)")
+      ->check(NumberIn(2, 1001));
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] { RunLine(*o); });
 }

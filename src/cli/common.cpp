@@ -18,6 +18,7 @@
 #include "core/numbers.h"
 #include "core/safe_text.h"
 #include "fit/arctan_curve.h"
+#include "interp/sinumerik.h"
 
 namespace whirl::cli {
 
@@ -54,17 +55,17 @@ void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_require
                 "use the prediction even if the screw lies outside the model's training domain");
 }
 
-CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help) {
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help,
+                           const std::string& flag) {
   const auto rule = [](std::string& text) -> std::string {
     const bool digits = !text.empty() && text.size() <= 20 &&
                         text.find_first_not_of("0123456789") == std::string::npos;
     errno = 0;
     if (digits) (void)std::strtoull(text.c_str(), nullptr, 10);
     if (digits && errno == 0) return "";
-    return "seed '" + text + "' breaks the rule: a whole number in [0, 18446744073709551615]";
+    return "'" + text + "' breaks the rule: a whole number in [0, 18446744073709551615]";
   };
-  return sub->add_option("--seed", *seed, help + " [0 .. 2^64-1]")
-      ->check(CLI::Validator(rule, "UINT64"));
+  return sub->add_option(flag, *seed, help)->check(CLI::Validator(rule, "[0, 2^64-1]"));
 }
 
 CLI::Validator NumberIn(const Range& range) {
@@ -95,6 +96,8 @@ CLI::Validator NonNegativeNumber(const char* unit) {
 CLI::Validator FiniteNumber(const char* unit) {
   return NumberIn(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), unit);
 }
+
+CLI::Validator Md32760Number() { return NumberIn(Range{0, interp::kMd32760Max, true, ""}); }
 
 void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
   sub->add_option("--tolerance-um", *tolerance_um,

@@ -62,9 +62,10 @@ struct CurveSourceArgs {
 /// options (AddCurveShapeOptions) and --allow-extrapolation.
 void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_required);
 
-/// A --seed option: a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5" or a larger
-/// number is a parse error naming the rule, never wrapped. Returns the option for chaining.
-CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help);
+/// A --seed option (or `flag`): a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5"
+/// or a larger number is a parse error naming the rule, never wrapped. Returns the option.
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help,
+                           const std::string& flag = "--seed");
 
 /// The one check of every numeric flag: the text must be a finite decimal number (core/csv.h
 /// ParseDecimal: "nan", "inf", "1e999", "0x1p3" and "1,5" are refused) inside `range`. CLI11
@@ -81,6 +82,9 @@ CLI::Validator PositiveNumber(const char* unit = "");
 CLI::Validator NonNegativeNumber(const char* unit = "");
 /// NumberIn over the whole double range: any finite number.
 CLI::Validator FiniteNumber(const char* unit = "");
+
+/// NumberIn over (0, interp::kMd32760Max]: the MD32760 factor of every --md32760 flag.
+CLI::Validator Md32760Number();
 
 /// --tolerance-um, shared by plan, compare and evaluate: the largest |840D chord - predicted
 /// curve| of a plan [um], in kPlanToleranceRange (core/limits.h) (checked again by PlanOptions::Validate
