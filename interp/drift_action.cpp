@@ -64,8 +64,8 @@ const AnalogInput& Input(const DriftActionOptions& o, const std::string& name) {
 }
 
 std::string Reading(const AnalogInput& a) {
-  return FormatFixed(a.scale, kDecimalsDriftCoefficient) + "*$A_INA[" + std::to_string(a.index) + "]" +
-         Term(a.offset, 4);
+  return FormatFixed(a.scale, kDecimalsDriftCoefficient) + "*$A_INA[" + std::to_string(a.index) +
+         "]" + Term(a.offset, 4);
 }
 
 struct Layout {
@@ -548,8 +548,9 @@ std::string PlcRows(const std::string& output, const drift::DriftModel& m,
     const std::string ref = input < ns ? FormatFixed(m.reference_C(input), 4) : "";
     const std::string tau = feat.tau > 0 ? FormatFixed(feat.tau, 3) : "";
     const std::string af =
-        feat.tau > 0 ? FormatFixed(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
-                     : "";
+        feat.tau > 0
+            ? FormatFixed(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
+            : "";
     out += output + "," + Cell(feat.Name(m.time_unit)) + "," + Cell(feat.input) + "," +
            std::to_string(a.index) + "," + FormatFixed(a.scale, kDecimalsDriftCoefficient) + "," +
            FormatFixed(a.offset, 4) + "," + ref + "," + tau + "," + af + "," +

@@ -22,7 +22,8 @@ constexpr int kMaxSyncActionId = 255;
 
 void CheckFinitePositive(double v, const std::string& field) {
   if (!std::isfinite(v) || !(v > 0))
-    throw InputError(field + " = " + FormatSignificant(v, 10) + ": must be a positive finite number");
+    throw InputError(field + " = " + FormatSignificant(v, 10) +
+                     ": must be a positive finite number");
 }
 
 CompensationSegment MakeSegment(const PlanOptions& o, double feed, double t_a, double t_b,
@@ -46,10 +47,12 @@ CompensationSegment MakeSegment(const PlanOptions& o, double feed, double t_a, d
 
 void CheckSlope(const CompensationSegment& s, std::size_t index, double cap) {
   if (!(std::abs(s.sd43910) <= cap))
-    throw InputError("segment " + std::to_string(index + 1) + " (t " + FormatSignificant(s.t_a_s, 10) + " to " +
-                     FormatSignificant(s.t_b_s, 10) + " s, P " + FormatSignificant(s.p_a_mm, 10) + " to " + FormatSignificant(s.p_b_mm, 10) +
-                     " mm): |SD43910| = " + FormatSignificant(std::abs(s.sd43910), 10) + " exceeds the MD32760 cap " +
-                     FormatSignificant(cap, 10) +
+    throw InputError("segment " + std::to_string(index + 1) + " (t " +
+                     FormatSignificant(s.t_a_s, 10) + " to " + FormatSignificant(s.t_b_s, 10) +
+                     " s, P " + FormatSignificant(s.p_a_mm, 10) + " to " +
+                     FormatSignificant(s.p_b_mm, 10) +
+                     " mm): |SD43910| = " + FormatSignificant(std::abs(s.sd43910), 10) +
+                     " exceeds the MD32760 cap " + FormatSignificant(cap, 10) +
                      " (the control would limit it silently): raise --md32760 if the machine "
                      "allows, or lower the feed");
 }
@@ -118,7 +121,8 @@ void PlanOptions::Validate() const {
   if (direction != 1 && direction != -1)
     throw InputError("direction = " + std::to_string(direction) + ": must be +1 or -1");
   if (!(md32760 > 0 && md32760 <= kMd32760Max))
-    throw InputError("md32760 = " + FormatSignificant(md32760, 10) + ": must be within (0, 0.10] (MD32760 range)");
+    throw InputError("md32760 = " + FormatSignificant(md32760, 10) +
+                     ": must be within (0, 0.10] (MD32760 range)");
   if (sign != ExpectedSign(direction, control_dk))
     throw InputError("sign '" + ToString(sign) + "' with direction " + std::to_string(direction) +
                      " and control_dk '" + ToString(control_dk) +
@@ -184,8 +188,8 @@ CompensationPlan BuildPlan(const CurveFunction& curve_um, double axial_feed_mm_s
   plan.cutting_time_s = thread_length_mm / axial_feed_mm_s;
   const double budget_um = RoundingBudgetUm(thread_length_mm, options.md32760);
   if (!(options.tolerance_um > 2.0 * budget_um))
-    throw InputError("tolerance_um = " + FormatSignificant(options.tolerance_um, 10) + ": must exceed " +
-                     FormatSignificant(2.0 * budget_um, 10) +
+    throw InputError("tolerance_um = " + FormatSignificant(options.tolerance_um, 10) +
+                     ": must exceed " + FormatSignificant(2.0 * budget_um, 10) +
                      " um, twice what rounding the written setting data "
                      "can cost over a " +
                      FormatSignificant(thread_length_mm, 10) + " mm thread");

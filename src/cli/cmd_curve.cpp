@@ -29,9 +29,11 @@ struct CurveOptions {
 };
 
 void Run(const CurveOptions& o) {
-  CheckOutputs({{"--model", o.source.model_path}, {"--screw", o.source.screw_path}}, {{"--out", o.out_path}});
+  CheckOutputs({{"--model", o.source.model_path}, {"--screw", o.source.screw_path}},
+               {{"--out", o.out_path}});
   const bool by_model = !o.source.model_path.empty() || !o.source.screw_path.empty();
-  const bool by_features = !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
+  const bool by_features =
+      !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
   if (by_model == by_features)
     throw InputError(
         "curve: give either --model M --screw S.json or --max-elongation L --settle-time T");

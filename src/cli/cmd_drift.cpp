@@ -109,8 +109,7 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--sensors", m->sensors, "use these _C columns instead of the selection")
       ->delimiter(',');
   AddDynamicOptions(sub, m);
-  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")
-      ->check(NumberIn(1, 20));
+  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")->check(NumberIn(1, 20));
   sub->add_option("--restarts", m->restarts, "network: trainbr restarts (1..50)")
       ->check(NumberIn(1, 50));
   sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000)")
@@ -395,8 +394,7 @@ void RegisterSplit(CLI::App* drift_app) {
       "run-file format (time_min [min]); all or nothing.");
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--at", o->column, "column whose rise starts a run (default spindle_rpm)");
-  sub->add_option("--threshold", o->threshold,
-                               "start threshold in the column's unit (default 0)")
+  sub->add_option("--threshold", o->threshold, "start threshold in the column's unit (default 0)")
       ->check(FiniteNumber());
   sub->add_option("--out-dir", o->out_dir,
                   std::string("directory for the run files: ") + kOutputDirRule)

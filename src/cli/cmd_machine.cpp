@@ -158,10 +158,8 @@ void RegisterMachine(CLI::App& app) {
   s->add_option("--out", o->out, std::string("output folder, all files or none: ") + kOutputDirRule)
       ->required();
   AddSeedOption(s, &o->machine_seed, "seed of the machine (default 1)", "--machine-seed");
-  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")
-      ->check(NumberIn(0, 20));
-  s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")
-      ->check(NumberIn(0, 20));
+  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")->check(NumberIn(0, 20));
+  s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")->check(NumberIn(0, 20));
   s->callback([o] { RunSensors(*o); });
 
   auto* e = m->add_subcommand(

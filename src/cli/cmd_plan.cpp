@@ -10,8 +10,8 @@
 #include "cli/common.h"
 #include "compare/plan_document.h"
 #include "core/error.h"
-#include "core/numbers.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "fit/arctan_curve.h"
 #include "interp/machine_profile.h"
@@ -112,13 +112,15 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
 }
 
 void Run(const PlanCliOptions& o) {
-  CheckOutputs(
-      {{"--model", o.source.model_path}, {"--screw", o.source.screw_path}, {"--machine", o.machine_path}},
-      {{"--out", o.out_path},
-       {"--csv", o.csv_path},
-       {"--nc", o.nc_path},
-       {"--reset-nc", o.reset_nc_path}});
-  const bool by_features = !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
+  CheckOutputs({{"--model", o.source.model_path},
+                {"--screw", o.source.screw_path},
+                {"--machine", o.machine_path}},
+               {{"--out", o.out_path},
+                {"--csv", o.csv_path},
+                {"--nc", o.nc_path},
+                {"--reset-nc", o.reset_nc_path}});
+  const bool by_features =
+      !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
   if (by_features == !o.source.model_path.empty())
     throw InputError("plan: give either --model M or --max-elongation L --settle-time T");
   const interp::PlanOptions options = ResolvePlanOptions(o);
@@ -142,8 +144,8 @@ void Run(const PlanCliOptions& o) {
   }
   CheckPlanFeatures(plan_source.features, by_features ? "--max-elongation/--settle-time"
                                                       : "prediction of " + o.source.model_path);
-  const fit::ArctanCurve curve =
-      fit::ArctanCurve::FromFeatures(plan_source.features, o.source.shape_k, o.source.time_exponent);
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures(
+      plan_source.features, o.source.shape_k, o.source.time_exponent);
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
   const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();

@@ -213,10 +213,8 @@ void SetupPredict(CLI::App& parent) {
   sub->add_option("--surface", o->surface, "surface JSON from 'whirl surface fit'")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--x", o->x, "table X, mm")
-      ->check(FiniteNumber());
-  sub->add_option("--y", o->y, "table Y, mm")
-      ->check(FiniteNumber());
+  sub->add_option("--x", o->x, "table X, mm")->check(FiniteNumber());
+  sub->add_option("--y", o->y, "table Y, mm")->check(FiniteNumber());
   sub->add_option("--input", o->input, "CSV of positions x_mm,y_mm (at most 10000 rows)")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "CSV to write: x_mm,y_mm,error_um");
@@ -308,16 +306,14 @@ void SetupLine(CLI::App& parent) {
   sub->add_option("--axis", o->line.axis,
                   "840D axis name for $SA_...[axis]: a letter, then letters, digits or '_' "
                   "(default X)");
-  sub->add_option(
-      "--at-mm", o->at_mm,
-      "one traverse at this fixed other coordinate, mm (default: the whole table)")
+  sub->add_option("--at-mm", o->at_mm,
+                  "one traverse at this fixed other coordinate, mm (default: the whole table)")
       ->check(FiniteNumber());
   sub->add_option("--ref-position-mm", o->ref_mm,
-                      "reference position P0 in surface coordinates, mm (default: travel start)")
+                  "reference position P0 in surface coordinates, mm (default: travel start)")
       ->check(FiniteNumber());
-  sub->add_option(
-      "--machine-offset-mm", o->line.machine_offset_mm,
-      "MCS position of the surface's coordinate origin on this axis, mm (default 0)")
+  sub->add_option("--machine-offset-mm", o->line.machine_offset_mm,
+                  "MCS position of the surface's coordinate origin on this axis, mm (default 0)")
       ->check(FiniteNumber());
   sub->add_option("--sign", o->sign, "subtract (dK = -line, default) | add")
       ->check(CLI::IsMember({"subtract", "add"}));

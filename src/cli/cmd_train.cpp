@@ -158,7 +158,8 @@ void Run(const TrainCliOptions& o) {
                                            std::to_string(o.restarts) +
                                            (info.ard_stage ? " ARD epoch " : " epoch ") +
                                            std::to_string(info.epoch) + " F " +
-                                           FormatSignificant(info.objective, 4) + " gamma " + FormatSignificant(info.gamma, 4));
+                                           FormatSignificant(info.objective, 4) + " gamma " +
+                                           FormatSignificant(info.gamma, 4));
       });
   progress.Finish();
   const double fit_ms =
@@ -194,22 +195,28 @@ void Run(const TrainCliOptions& o) {
   std::cout << "  stopping: " << model.stopping << "\n";
   std::cout << "  fit time " << FormatSignificant(fit_ms, 4)
             << " ms (hidden-size choice, training, noise calibration)\n";
-  std::cout << "  RMS training error: max_elongation " << FormatSignificant(s.rms_error(0), 4) << " um, settle_time "
-            << FormatSignificant(s.rms_error(1), 4) << " s (normalized ssE " << FormatSignificant(s.sse, 4) << ")\n";
-  std::cout << "  gamma " << FormatSignificant(s.gamma, 4) << " of " << s.parameter_count << ", alpha "
-            << FormatSignificant(s.alpha, 4) << ", beta " << FormatSignificant(s.beta, 4) << ", sum of squared weights "
-            << FormatSignificant(s.sum_squared_weights, 4) << ", log evidence " << FormatSignificant(s.log_evidence, 6) << "\n";
+  std::cout << "  RMS training error: max_elongation " << FormatSignificant(s.rms_error(0), 4)
+            << " um, settle_time " << FormatSignificant(s.rms_error(1), 4) << " s (normalized ssE "
+            << FormatSignificant(s.sse, 4) << ")\n";
+  std::cout << "  gamma " << FormatSignificant(s.gamma, 4) << " of " << s.parameter_count
+            << ", alpha " << FormatSignificant(s.alpha, 4) << ", beta "
+            << FormatSignificant(s.beta, 4) << ", sum of squared weights "
+            << FormatSignificant(s.sum_squared_weights, 4) << ", log evidence "
+            << FormatSignificant(s.log_evidence, 6) << "\n";
   if (s.ard_alpha.size() == ProcessInputs::kCount + 1) {
     std::cout << "  ARD alpha per input (larger = less relevant; normalized units):";
     for (int i = 0; i < ProcessInputs::kCount; ++i)
-      std::cout << (i ? ", " : " ") << kInputColumns[i] << " " << FormatSignificant(s.ard_alpha(i), 4);
-    std::cout << "; other weights " << FormatSignificant(s.ard_alpha(ProcessInputs::kCount), 4) << "\n";
+      std::cout << (i ? ", " : " ") << kInputColumns[i] << " "
+                << FormatSignificant(s.ard_alpha(i), 4);
+    std::cout << "; other weights " << FormatSignificant(s.ard_alpha(ProcessInputs::kCount), 4)
+              << "\n";
   }
   if (model.restarts > 1) {
     std::cout << "  restarts (best log evidence kept):\n";
     for (const auto& r : model.restart_runs)
-      std::cout << "    seed " << r.seed << ": log evidence " << FormatSignificant(r.log_evidence, 6) << ", ssE "
-                << FormatSignificant(r.sse, 4) << ", gamma " << FormatSignificant(r.gamma, 4) << ", " << r.epochs << " epochs, "
+      std::cout << "    seed " << r.seed << ": log evidence "
+                << FormatSignificant(r.log_evidence, 6) << ", ssE " << FormatSignificant(r.sse, 4)
+                << ", gamma " << FormatSignificant(r.gamma, 4) << ", " << r.epochs << " epochs, "
                 << nn::ToString(r.termination) << (r.seed == model.init_seed ? "  <- kept" : "")
                 << "\n";
   }

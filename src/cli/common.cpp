@@ -72,7 +72,8 @@ CLI::Validator NumberIn(const Range& range) {
   std::string text = std::string(range.min_open ? "(" : "[") + MessageNumber(range.min) + ", " +
                      MessageNumber(range.max) + "]";
   if (*range.unit) text += std::string(" ") + range.unit;
-  const std::string rule = "a finite number in " + text + (*range.note ? std::string(" (") + range.note + ")" : "");
+  const std::string rule =
+      "a finite number in " + text + (*range.note ? std::string(" (") + range.note + ")" : "");
   const auto check = [range, rule](std::string& value) -> std::string {
     const auto x = ParseDecimal(value);
     if (x && range.Contains(*x)) return "";

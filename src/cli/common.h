@@ -87,8 +87,8 @@ CLI::Validator FiniteNumber(const char* unit = "");
 CLI::Validator Md32760Number();
 
 /// --tolerance-um, shared by plan, compare and evaluate: the largest |840D chord - predicted
-/// curve| of a plan [um], in kPlanToleranceRange (core/limits.h) (checked again by PlanOptions::Validate
-/// with the same rule), default interp::PlanOptions's.
+/// curve| of a plan [um], in kPlanToleranceRange (core/limits.h) (checked again by
+/// PlanOptions::Validate with the same rule), default interp::PlanOptions's.
 void AddToleranceOption(CLI::App* sub, double* tolerance_um);
 
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.

@@ -152,7 +152,8 @@ IsoVerdict EvaluateIsoClass(const LeadMetrics& m, const IsoToleranceTable& table
   for (IsoClass c : kOrder) {
     const auto tol = table.Lookup(c, m.useful_travel_mm);
     if (!tol) {
-      failures += ToString(c) + " not tabulated for l_u " + FormatDecimalsTrimmed(m.useful_travel_mm, 3) + " mm; ";
+      failures += ToString(c) + " not tabulated for l_u " +
+                  FormatDecimalsTrimmed(m.useful_travel_mm, 3) + " mm; ";
       continue;
     }
     std::vector<IsoCheck> checks;
@@ -166,13 +167,15 @@ IsoVerdict EvaluateIsoClass(const LeadMetrics& m, const IsoToleranceTable& table
     std::string detail;
     for (const auto& k : checks)
       detail += (detail.empty() ? "" : ", ") +
-                std::string(k.metric == "e_a" ? "|e_a| " : k.metric + " ") + FormatDecimalsTrimmed(k.actual_um, 3) +
-                (k.passed ? " <= " : " > ") + FormatDecimalsTrimmed(k.permitted_um, 3);
+                std::string(k.metric == "e_a" ? "|e_a| " : k.metric + " ") +
+                FormatDecimalsTrimmed(k.actual_um, 3) + (k.passed ? " <= " : " > ") +
+                FormatDecimalsTrimmed(k.permitted_um, 3);
     verdict.checks = checks;
     if (ok) {
       verdict.reached = c;
       verdict.table_cells_confirmed = tol->all_cells_confirmed;
-      verdict.message = ToString(c) + " at l_u " + FormatDecimalsTrimmed(m.useful_travel_mm, 3) + " mm (" + detail + ")";
+      verdict.message = ToString(c) + " at l_u " + FormatDecimalsTrimmed(m.useful_travel_mm, 3) +
+                        " mm (" + detail + ")";
       if (!failures.empty()) verdict.message += "; " + failures.substr(0, failures.size() - 2);
       if (!verdict.v_2pi_evaluated) verdict.message += "; v_2pi not evaluated";
       return verdict;

@@ -56,8 +56,9 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
   // Elongation: truth vs prediction, compensation points, traditional ramp.
   s << "set output " << GnuplotString(f.elongation) << "\n"
     << "set title "
-    << GnuplotString(name + ": elongation of the unmachined section (first " + FormatDecimals(t_zoom, 0) +
-                     " s of " + FormatDecimals(t_end, 0) + " s cutting time)")
+    << GnuplotString(name + ": elongation of the unmachined section (first " +
+                     FormatDecimals(t_zoom, 0) + " s of " + FormatDecimals(t_end, 0) +
+                     " s cutting time)")
     << " noenhanced\n"
     << "set xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
     << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
@@ -105,9 +106,9 @@ std::string MetricsTable(const ScrewComparison& c) {
        "<th>model-based</th><th>model vs traditional</th><th>model vs none</th></tr>\n";
   auto row = [&](const std::string& name, double a, double b, double d,
                  const std::optional<double>& r1, const std::optional<double>& r2) {
-    h << "<tr><td>" << name << "</td><td>" << FormatDecimals(a, 1) << "</td><td>" << FormatDecimals(b, 1)
-      << "</td><td>" << FormatDecimals(d, 1) << "</td><td>" << Pct(r1) << "</td><td>" << Pct(r2)
-      << "</td></tr>\n";
+    h << "<tr><td>" << name << "</td><td>" << FormatDecimals(a, 1) << "</td><td>"
+      << FormatDecimals(b, 1) << "</td><td>" << FormatDecimals(d, 1) << "</td><td>" << Pct(r1)
+      << "</td><td>" << Pct(r2) << "</td></tr>\n";
   };
   row("accumulated error within any 1000 mm", n.metrics.accumulated_1000_um,
       t.metrics.accumulated_1000_um, m.metrics.accumulated_1000_um,
@@ -283,11 +284,12 @@ ReportResult WriteReport(const std::filesystem::path& dir,
     // HTML section.
     const auto in = c.screw.process;
     body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
-         << FormatDecimals(in.hardness_hrc, 1) << " HRC, diameter " << FormatDecimals(in.diameter_mm, 1)
-         << " mm, lead " << FormatDecimals(in.pitch_mm, 2) << " mm, raceway radius "
-         << FormatDecimals(in.raceway_radius_mm, 2) << " mm, cutting speed "
-         << FormatDecimals(in.cutting_speed_m_min, 0) << " m/min; blank " << FormatDecimals(c.screw.length_mm, 0)
-         << " mm, thread " << FormatDecimals(c.screw.thread_length_mm, 0) << " mm; axial feed "
+         << FormatDecimals(in.hardness_hrc, 1) << " HRC, diameter "
+         << FormatDecimals(in.diameter_mm, 1) << " mm, lead " << FormatDecimals(in.pitch_mm, 2)
+         << " mm, raceway radius " << FormatDecimals(in.raceway_radius_mm, 2)
+         << " mm, cutting speed " << FormatDecimals(in.cutting_speed_m_min, 0) << " m/min; blank "
+         << FormatDecimals(c.screw.length_mm, 0) << " mm, thread "
+         << FormatDecimals(c.screw.thread_length_mm, 0) << " mm; axial feed "
          << FormatDecimals(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
          << FormatDecimals(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
     if (c.prediction.outside_domain) {
@@ -307,8 +309,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
          << FormatDecimals(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
          << FormatDecimals(c.prediction.mean.settle_time_s, 0) << " +- "
          << FormatDecimals(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
-         << "<tr><td>traditional rule (class " << FormatDecimals(c.experience_class.nominal_diameter_mm, 0)
-         << " mm, " << c.experience_class.screws << " past screws)</td><td>"
+         << "<tr><td>traditional rule (class "
+         << FormatDecimals(c.experience_class.nominal_diameter_mm, 0) << " mm, "
+         << c.experience_class.screws << " past screws)</td><td>"
          << FormatDecimals(c.experience_class.plateau_um, 1) << "</td><td>"
          << FormatDecimals(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n"
          << "<p class='small'>Disturbances of the truth (unknown to the model): heat partition x"
@@ -319,9 +322,9 @@ ReportResult WriteReport(const std::filesystem::path& dir,
          << " points; uniform spacing would need "
          << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
                                             : std::string("more than 1000000"))
-         << "), max |chord - curve| " << FormatDecimals(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
-         << FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910) << " (MD32760 cap "
-         << FormatFixed(c.plan.options.md32760, 4) << "), axis "
+         << "), max |chord - curve| " << FormatDecimals(c.plan.max_deviation_um, 2)
+         << " um, max |SD43910| " << FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910)
+         << " (MD32760 cap " << FormatFixed(c.plan.options.md32760, 4) << "), axis "
          << HtmlEscape(c.plan.options.axis) << ", sign " << interp::ToString(c.plan.options.sign)
          << ".</p>\n"
          << MetricsTable(c);

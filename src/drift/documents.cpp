@@ -84,14 +84,16 @@ std::string FormatSelection(const Selection& s) {
     const Partition& p = s.partitions[i];
     o << (static_cast<int>(i) == s.chosen_partition ? "* " : "  ") << FormatDecimals(p.lambda, 4)
       << PadLeft(FormatDecimals(p.classes, 0), 5) << "  "
-      << (p.has_f ? PadLeft(FormatDecimals(p.f, 3), 9) + "  " + PadLeft(FormatDecimals(p.f_critical, 3), 9) +
+      << (p.has_f ? PadLeft(FormatDecimals(p.f, 3), 9) + "  " +
+                        PadLeft(FormatDecimals(p.f_critical, 3), 9) +
                         (p.significant() ? "  yes" : "   no")
                   : std::string(25, ' ') + "-")
       << "  " << Classes(s, p) << "\n";
   }
   o << "grey relational grades (rho 0.5):";
   for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
-    o << " " << s.sensor_names[i] << " " << FormatDecimals(s.grades(static_cast<Eigen::Index>(i)), 4);
+    o << " " << s.sensor_names[i] << " "
+      << FormatDecimals(s.grades(static_cast<Eigen::Index>(i)), 4);
   o << "\nclass count: " << s.message << "\nchosen sensors: " << Join(s.ChosenNames()) << "\n";
   return o.str();
 }
@@ -142,7 +144,8 @@ std::string FormatModel(const DriftModel& m) {
   for (const auto& n : m.notes) o << "  " << n << "\n";
   if (m.kind != ModelKind::kNetwork) {
     o << "  feature                        coefficient   std error        VIF\n";
-    o << "  intercept [um]                " << PadLeft(FormatDecimals(m.linear.coefficients(0), 4), 12)
+    o << "  intercept [um]                "
+      << PadLeft(FormatDecimals(m.linear.coefficients(0), 4), 12)
       << PadLeft(FormatDecimals(m.linear.standard_errors(0), 4), 12) << "\n";
     for (std::size_t i = 0; i < m.features.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
@@ -150,7 +153,8 @@ std::string FormatModel(const DriftModel& m) {
       std::snprintf(name, sizeof name, "%-30s",
                     (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
       o << "  " << name << PadLeft(FormatDecimals(m.linear.coefficients(k + 1), 4), 12)
-        << PadLeft(FormatDecimals(m.linear.standard_errors(k + 1), 4), 12) << PadLeft(FormatSignificant(m.linear.vif(k), 4), 11) << "\n";
+        << PadLeft(FormatDecimals(m.linear.standard_errors(k + 1), 4), 12)
+        << PadLeft(FormatSignificant(m.linear.vif(k), 4), 11) << "\n";
     }
   } else {
     o << "  network " << m.network.layer_sizes[0] << "-" << m.network.layer_sizes[1] << "-1\n";
@@ -249,7 +253,8 @@ std::string FormatCrossRun(const CrossRunResult& r) {
     char name[32];
     std::snprintf(name, sizeof name, "%-16.16s", r.runs[i].c_str());
     o << name;
-    for (std::size_t j = 0; j < r.runs.size(); ++j) o << PadLeft(FormatDecimals(r.cells[i][j].model.rmse_um, 2), 12);
+    for (std::size_t j = 0; j < r.runs.size(); ++j)
+      o << PadLeft(FormatDecimals(r.cells[i][j].model.rmse_um, 2), 12);
     o << "\n";
   }
   o << "group means (seed 000 tables 6-8)   pairs |  model: RMSE    std    max | all sensors: "

@@ -19,7 +19,8 @@ std::string Vec(const Eigen::VectorXd& v) {
 }
 
 void Require(bool ok, const std::string& option, double value, const std::string& rule) {
-  if (!ok) throw InputError("monitor option " + option + " = " + MessageNumber(value) + ": " + rule);
+  if (!ok)
+    throw InputError("monitor option " + option + " = " + MessageNumber(value) + ": " + rule);
 }
 
 // First sample at or after `time`, not before `min_sample`; -1 when the run ends first.
@@ -47,9 +48,10 @@ struct Piece {
 };
 
 std::string CheckMessage(double t, double y, double p, double thr, bool valid) {
-  return "check at " + FormatDecimals(t, 1) + ": |measured " + FormatDecimals(y, 3) + " - predicted " + FormatDecimals(p, 3) +
-         "| = " + FormatDecimals(std::abs(y - p), 3) + " um " + (valid ? "<=" : ">") + " threshold " + FormatDecimals(thr, 3) +
-         " um: model " + (valid ? "valid" : "invalid");
+  return "check at " + FormatDecimals(t, 1) + ": |measured " + FormatDecimals(y, 3) +
+         " - predicted " + FormatDecimals(p, 3) + "| = " + FormatDecimals(std::abs(y - p), 3) +
+         " um " + (valid ? "<=" : ">") + " threshold " + FormatDecimals(thr, 3) + " um: model " +
+         (valid ? "valid" : "invalid");
 }
 
 Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
@@ -73,8 +75,8 @@ std::string UpdateMessage(UpdateRule rule, const Eigen::MatrixXd& xs, const Eige
     return std::sqrt((ys - xs * b).squaredNorm() / static_cast<double>(ys.size()));
   };
   return ToString(rule) + " update from " + std::to_string(ys.size()) +
-         " measurements: RMS misfit on them " + FormatDecimals(rms(before), 3) + " -> " + FormatDecimals(rms(after), 3) +
-         " um; coefficients " + Vec(before) + " -> " + Vec(after);
+         " measurements: RMS misfit on them " + FormatDecimals(rms(before), 3) + " -> " +
+         FormatDecimals(rms(after), 3) + " um; coefficients " + Vec(before) + " -> " + Vec(after);
 }
 
 StrategyResult RunRule(UpdateRule rule, const Replay& in) {
@@ -115,8 +117,9 @@ StrategyResult RunRule(UpdateRule rule, const Replay& in) {
         if (q < 0) break;
         MonitorEvent e = measure(q, MonitorEvent::Kind::kRefitMeasurement);
         e.message = "refit measurement " + std::to_string(j + 1) + " of " +
-                    std::to_string(in.o.refit_samples) + ": measured " + FormatDecimals(e.measured_um, 3) +
-                    ", predicted " + FormatDecimals(e.predicted_um, 3) + " um";
+                    std::to_string(in.o.refit_samples) + ": measured " +
+                    FormatDecimals(e.measured_um, 3) + ", predicted " +
+                    FormatDecimals(e.predicted_um, 3) + " um";
         s.events.push_back(e);
         rows.push_back(q);
         last = q;
@@ -278,8 +281,9 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
   const int n = run.samples();
   const int start = SampleAt(r.time, o.start, 0);
   if (start < 0 || start >= n - 1)
-    throw InputError("monitor option start = " + MessageNumber(o.start) + ": the run " + run.source +
-                     " ends at " + MessageNumber(r.time.back()) + ": nothing to monitor");
+    throw InputError("monitor option start = " + MessageNumber(o.start) + ": the run " +
+                     run.source + " ends at " + MessageNumber(r.time.back()) +
+                     ": nothing to monitor");
   r.monitored_min = r.time.back() - r.time[static_cast<std::size_t>(start)];
   if (r.monitored_min / o.check_every > kMaxMonitorChecks)
     throw InputError("monitor option check_every = " + MessageNumber(o.check_every) + ": over " +

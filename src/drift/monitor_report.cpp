@@ -138,12 +138,13 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
   std::ostringstream s;
   s << "run " << r.run << ", " << r.error_column << ", " << r.model_kind << " model; checks every "
     << MessageNumber(o.check_every) << (idx ? " samples" : " min") << ", threshold "
-    << FormatDecimals(r.threshold_um, 2) << " um, " << o.refit_samples << " refit measurements every "
-    << MessageNumber(o.refit_every) << (idx ? " samples" : " min") << ", "
-    << MessageNumber(o.stop_min_per_measurement) << " min stop each\n";
+    << FormatDecimals(r.threshold_um, 2) << " um, " << o.refit_samples
+    << " refit measurements every " << MessageNumber(o.refit_every) << (idx ? " samples" : " min")
+    << ", " << MessageNumber(o.stop_min_per_measurement) << " min stop each\n";
   s << "scored rows [" << r.score_begin << ", " << r.score_end
     << "): " << FormatDecimals(r.time[static_cast<std::size_t>(r.score_begin)] * to_h, 2) << " to "
-    << FormatDecimals(r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h, 2) << " " << unit << "\n";
+    << FormatDecimals(r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h, 2) << " " << unit
+    << "\n";
   s << "rule      MAE um  RMSE um  max um  checks  invalid  recal  stop min  stop %\n";
   char buf[200];
   std::snprintf(buf, sizeof buf,

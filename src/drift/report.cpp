@@ -105,8 +105,9 @@ std::string SelectionHtml(const Selection& s) {
       classes += "} ";
     }
     const bool chosen = static_cast<int>(i) == s.chosen_partition;
-    h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>" << FormatDecimals(p.lambda, 4)
-      << "</td><td>" << p.classes << "</td><td>" << (p.has_f ? FormatDecimals(p.f, 3) : "-") << "</td><td>"
+    h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>"
+      << FormatDecimals(p.lambda, 4) << "</td><td>" << p.classes << "</td><td>"
+      << (p.has_f ? FormatDecimals(p.f, 3) : "-") << "</td><td>"
       << (p.has_f ? FormatDecimals(p.f_critical, 3) : "-") << "</td><td>"
       << (p.has_f ? (p.significant() ? "yes" : "no") : "-") << "</td><td style='text-align:left'>"
       << HtmlEscape(classes) << "</td></tr>\n";
@@ -167,9 +168,10 @@ std::string LevelsPlot(ReportWriter* w, const Selection& s) {
 }
 
 std::string StatsRow(const std::string& name, const ErrorStats& s) {
-  return "<tr><td style='text-align:left'>" + HtmlEscape(name) + "</td><td>" + FormatDecimals(s.mae_um, 2) +
-         "</td><td>" + FormatDecimals(s.rmse_um, 2) + "</td><td>" + FormatDecimals(s.std_um, 2) + "</td><td>" +
-         FormatDecimals(s.max_abs_um, 2) + "</td></tr>\n";
+  return "<tr><td style='text-align:left'>" + HtmlEscape(name) + "</td><td>" +
+         FormatDecimals(s.mae_um, 2) + "</td><td>" + FormatDecimals(s.rmse_um, 2) + "</td><td>" +
+         FormatDecimals(s.std_um, 2) + "</td><td>" + FormatDecimals(s.max_abs_um, 2) +
+         "</td></tr>\n";
 }
 
 }  // namespace

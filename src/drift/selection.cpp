@@ -69,8 +69,9 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
     if (best >= 0) {
       const Partition& p = parts[static_cast<std::size_t>(best)];
       *message = "fewest classes with a significant F: r = " + std::to_string(p.classes) +
-                 " at lambda " + FormatSignificant(p.lambda, 4) + " (F " + FormatSignificant(p.f, 4) + " > F_crit " +
-                 FormatSignificant(p.f_critical, 4) + ")";
+                 " at lambda " + FormatSignificant(p.lambda, 4) + " (F " +
+                 FormatSignificant(p.f, 4) + " > F_crit " + FormatSignificant(p.f_critical, 4) +
+                 ")";
       return best;
     }
   }
@@ -81,8 +82,9 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
                                ? "largest (F - F_crit) / F_crit"
                                : "no eligible partition has a significant F; fallback: largest "
                                  "(F - F_crit) / F_crit") +
-               ": r = " + std::to_string(p.classes) + " at lambda " + FormatSignificant(p.lambda, 4) + " (F " +
-               FormatSignificant(p.f, 4) + ", F_crit " + FormatSignificant(p.f_critical, 4) + ")";
+               ": r = " + std::to_string(p.classes) + " at lambda " +
+               FormatSignificant(p.lambda, 4) + " (F " + FormatSignificant(p.f, 4) + ", F_crit " +
+               FormatSignificant(p.f_critical, 4) + ")";
     return best;
   }
   *message = "no partition with 1 < r < m (and r <= max classes): every sensor is its own class";
@@ -114,8 +116,10 @@ ClassCountRule ParseClassCountRule(const std::string& s) {
 }
 
 void SelectionOptions::Validate() const {
-  if (!(alpha > 0 && alpha < 1)) throw InputError("alpha " + FormatSignificant(alpha, 4) + ": must be in (0, 1)");
-  if (!(rho > 0 && rho <= 1)) throw InputError("rho " + FormatSignificant(rho, 4) + ": must be in (0, 1]");
+  if (!(alpha > 0 && alpha < 1))
+    throw InputError("alpha " + FormatSignificant(alpha, 4) + ": must be in (0, 1)");
+  if (!(rho > 0 && rho <= 1))
+    throw InputError("rho " + FormatSignificant(rho, 4) + ": must be in (0, 1]");
   if (rule == ClassCountRule::kFixed && fixed_classes < 1)
     throw InputError("fixed class count " + std::to_string(fixed_classes) + ": must be >= 1");
   if (max_classes < 0)

@@ -65,8 +65,8 @@ ArctanCurve ArctanCurve::FromFeatures(const Features& features, double shape_k,
 }
 
 std::string ArctanCurve::Describe() const {
-  return "arctan L=" + FormatDecimals(max_elongation_um, 4) + " um, t_s=" +
-         FormatDecimals(settle_time_s, 2) + " s, k=" + FormatDecimals(shape_k, 4) +
+  return "arctan L=" + FormatDecimals(max_elongation_um, 4) +
+         " um, t_s=" + FormatDecimals(settle_time_s, 2) + " s, k=" + FormatDecimals(shape_k, 4) +
          ", p=" + FormatDecimals(time_exponent, 4);
 }
 

@@ -102,14 +102,15 @@ bool StopReached(const TrainOptions& options, int epoch, double sse, double grad
         "epoch = " + std::to_string(epoch) + " == epochs = " + std::to_string(options.epochs);
   } else if (gradient <= options.min_grad) {
     sum->termination = TrainTermination::kMinGradient;
-    sum->message =
-        "gradient 2||J'e|| = " + MessageNumber(gradient) + " <= min_grad = " + MessageNumber(options.min_grad);
+    sum->message = "gradient 2||J'e|| = " + MessageNumber(gradient) +
+                   " <= min_grad = " + MessageNumber(options.min_grad);
   } else if (mu >= options.mu_max) {
     sum->termination = TrainTermination::kMaxMu;
     sum->message = "mu = " + MessageNumber(mu) + " >= mu_max = " + MessageNumber(options.mu_max);
   } else if (options.change > 0 && ObjectiveSpread(after_step) < options.change) {
     sum->termination = TrainTermination::kObjectiveStalled;
-    sum->message = "F after the step changed by at most " + MessageNumber(ObjectiveSpread(after_step)) +
+    sum->message = "F after the step changed by at most " +
+                   MessageNumber(ObjectiveSpread(after_step)) +
                    " < change = " + MessageNumber(options.change) + " over the last 4 epochs";
   } else {
     return false;
@@ -663,9 +664,10 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
         alpha = alpha_new;
         beta = beta_new;
       } else {
-        degenerate_message = "gamma = " + MessageNumber(gamma_new) + ", alpha = " + MessageNumber(alpha_new) +
-                             ", beta = (n - gamma)/(2 ssE) = " + MessageNumber(beta_new) +
-                             " at ssE = " + MessageNumber(sse) + " (kept the last finite alpha, beta)";
+        degenerate_message =
+            "gamma = " + MessageNumber(gamma_new) + ", alpha = " + MessageNumber(alpha_new) +
+            ", beta = (n - gamma)/(2 ssE) = " + MessageNumber(beta_new) +
+            " at ssE = " + MessageNumber(sse) + " (kept the last finite alpha, beta)";
       }
       F = beta * sse + alpha * ssx;
     }
@@ -728,8 +730,8 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
     const double margin = kArdEvidenceMargin * std::max(1.0, std::abs(sum.log_evidence));
     if (steps > 0 && ard.summary.log_evidence > sum.log_evidence + margin) return ard;
     sum.message += "; ARD stage not kept (" + std::to_string(steps) +
-                   " accepted steps, log evidence " + MessageNumber(ard.summary.log_evidence) + " against " +
-                   MessageNumber(sum.log_evidence) + ")";
+                   " accepted steps, log evidence " + MessageNumber(ard.summary.log_evidence) +
+                   " against " + MessageNumber(sum.log_evidence) + ")";
   }
   return result;
 }

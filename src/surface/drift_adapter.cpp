@@ -1,6 +1,5 @@
 #include "surface/drift_adapter.h"
 
-
 #include "core/numbers.h"
 
 namespace whirl::surface {
@@ -15,8 +14,8 @@ PointModelFn DriftPointModel(const std::vector<drift::Run>& training, const drif
       std::string sensors;
       for (const auto& s : fit.model.sensors) sensors += (sensors.empty() ? "" : ", ") + s;
       const std::string quality = "; R^2 " + FormatDecimals(fit.model.r_squared, 4) +
-                                  ", residual std " +
-                                  FormatDecimals(fit.model.residual_std_um, 3) + " um";
+                                  ", residual std " + FormatDecimals(fit.model.residual_std_um, 3) +
+                                  " um";
       const std::lock_guard<std::mutex> lock(notes->mutex);
       std::string left_out;
       for (const auto& w : fit.warnings) left_out += "; " + w;

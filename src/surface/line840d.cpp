@@ -147,8 +147,9 @@ std::string FormatAxisLineText(const AxisLine& l) {
                   FormatDecimals(l.travel_min_mm, 1) + ".." + FormatDecimals(l.travel_max_mm, 1) +
                   " mm), least-squares line over " + where + " (" + std::to_string(l.sample_count) +
                   " samples):\n";
-  s += "  error ~ " + FormatDecimals(l.value_at_ref_um, 3) + " um + " + FormatDecimals(l.slope_um_per_mm, 6) +
-       " um/mm * (" + std::string(1, o.along) + " - " + FormatDecimals(l.reference_mm, 1) + " mm)\n";
+  s += "  error ~ " + FormatDecimals(l.value_at_ref_um, 3) + " um + " +
+       FormatDecimals(l.slope_um_per_mm, 6) + " um/mm * (" + std::string(1, o.along) + " - " +
+       FormatDecimals(l.reference_mm, 1) + " mm)\n";
   s += "  SD43900 $SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]    = " + FormatDecimals(l.sd43900_mm, 6) +
        " mm\n";
   s += "  SD43910 $SA_TEMP_COMP_SLOPE[" + o.axis + "]        = " + FormatDecimals(l.sd43910, 8) +
@@ -163,11 +164,11 @@ std::string FormatAxisLineText(const AxisLine& l) {
        "line/1000 (check on the machine, interp/sinumerik.h)\n";
   s += "  error without compensation: max " + FormatDecimals(l.error_max_abs_um, 3) + " um, RMS " +
        FormatDecimals(l.error_rms_um, 3) + " um\n";
-  s += "  left by SD43900 alone:      max " + FormatDecimals(l.offset_only_max_abs_um, 3) + " um, RMS " +
-       FormatDecimals(l.offset_only_rms_um, 3) + " um\n";
+  s += "  left by SD43900 alone:      max " + FormatDecimals(l.offset_only_max_abs_um, 3) +
+       " um, RMS " + FormatDecimals(l.offset_only_rms_um, 3) + " um\n";
   s += "  left by the line (uncorrected by the 840D): max " +
-       FormatDecimals(l.uncorrected_max_abs_um, 3) + " um, RMS " + FormatDecimals(l.uncorrected_rms_um, 3) +
-       " um\n";
+       FormatDecimals(l.uncorrected_max_abs_um, 3) + " um, RMS " +
+       FormatDecimals(l.uncorrected_rms_um, 3) + " um\n";
   return s;
 }
 

@@ -93,11 +93,13 @@ std::string SummaryHtml(const SurfaceFit& f) {
   h << "</td></tr>\n<tr><th>points</th><td>" << f.points.size() << "</td></tr>\n"
     << "<tr><th>condition number</th><td>" << FormatDecimalsOr(f.condition_number, 1, "-");
   if (f.surface.method == Method::kCubic)
-    h << " (normalized coordinates; " << FormatSignificant(f.condition_number_mm, 3) << " in raw mm)";
-  h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << FormatDecimalsOr(res.rms_um, 3, "-") << " / "
-    << FormatDecimalsOr(res.max_abs_um, 3, "-") << " um</td></tr>\n"
+    h << " (normalized coordinates; " << FormatSignificant(f.condition_number_mm, 3)
+      << " in raw mm)";
+  h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << FormatDecimalsOr(res.rms_um, 3, "-")
+    << " / " << FormatDecimalsOr(res.max_abs_um, 3, "-") << " um</td></tr>\n"
     << "<tr><th>leave-one-out RMS / max</th><td>" << FormatDecimalsOr(loo.rms_um, 3, "-") << " / "
-    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count << " points</td></tr>\n</table>\n";
+    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count
+    << " points</td></tr>\n</table>\n";
   if (f.surface.method == Method::kCubic) {
     const auto a = f.surface.cubic.CoefficientsMm();
     h << "<p>dE = a0 + a1 X + a2 Y + a3 X&sup2; + a4 XY + a5 Y&sup2; + a6 X&sup3; + a7 X&sup2;Y + "
@@ -121,11 +123,13 @@ std::string LinesHtml(const std::vector<AxisLine>& lines) {
        "[um]</th></tr>\n";
   for (const auto& l : lines)
     h << "<tr><td>" << HtmlEscape(l.options.axis) << "</td><td>" << l.options.along << "</td><td>"
-      << FormatDecimalsOr(l.sd43900_mm, 6, "-") << "</td><td>" << FormatDecimalsOr(l.sd43910, 8, "-")
-      << (l.slope_capped ? " (capped)" : "") << "</td><td>" << FormatDecimalsOr(l.sd43920_mm, 4, "-") << "</td><td>"
-      << FormatDecimalsOr(l.error_max_abs_um, 2, "-") << " / " << FormatDecimalsOr(l.error_rms_um, 2, "-") << "</td><td>"
-      << FormatDecimalsOr(l.uncorrected_max_abs_um, 2, "-") << " / " << FormatDecimalsOr(l.uncorrected_rms_um, 2, "-")
-      << "</td></tr>\n";
+      << FormatDecimalsOr(l.sd43900_mm, 6, "-") << "</td><td>"
+      << FormatDecimalsOr(l.sd43910, 8, "-") << (l.slope_capped ? " (capped)" : "") << "</td><td>"
+      << FormatDecimalsOr(l.sd43920_mm, 4, "-") << "</td><td>"
+      << FormatDecimalsOr(l.error_max_abs_um, 2, "-") << " / "
+      << FormatDecimalsOr(l.error_rms_um, 2, "-") << "</td><td>"
+      << FormatDecimalsOr(l.uncorrected_max_abs_um, 2, "-") << " / "
+      << FormatDecimalsOr(l.uncorrected_rms_um, 2, "-") << "</td></tr>\n";
   h << "</table>\n<p class='small'>sign " << interp::ToString(lines[0].options.sign)
     << " (dK = s &middot; line / 1000, interp/sinumerik.h); check it on the machine.</p>\n";
   return h.str();
@@ -137,9 +141,11 @@ std::string PointsHtml(const SurfaceFit& f) {
        "<th>error [um]</th><th>fitted [um]</th><th>residual [um]</th><th>leave-one-out "
        "error [um]</th></tr>\n";
   for (std::size_t k = 0; k < f.points.size(); ++k)
-    h << "<tr><td>" << k + 1 << "</td><td>" << FormatDecimalsOr(f.points[k].x_mm, 2, "-") << "</td><td>"
-      << FormatDecimalsOr(f.points[k].y_mm, 2, "-") << "</td><td>" << FormatDecimalsOr(f.points[k].error_um, 3, "-") << "</td><td>"
-      << FormatDecimalsOr(f.fitted_um[k], 3, "-") << "</td><td>" << FormatDecimalsOr(f.residual_um[k], 3, "-") << "</td><td>"
+    h << "<tr><td>" << k + 1 << "</td><td>" << FormatDecimalsOr(f.points[k].x_mm, 2, "-")
+      << "</td><td>" << FormatDecimalsOr(f.points[k].y_mm, 2, "-") << "</td><td>"
+      << FormatDecimalsOr(f.points[k].error_um, 3, "-") << "</td><td>"
+      << FormatDecimalsOr(f.fitted_um[k], 3, "-") << "</td><td>"
+      << FormatDecimalsOr(f.residual_um[k], 3, "-") << "</td><td>"
       << FormatDecimalsOr(f.loo_error_um[k], 3, "-") << "</td></tr>\n";
   h << "</table>\n";
   return h.str();

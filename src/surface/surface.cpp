@@ -308,20 +308,22 @@ std::string FormatFitText(const SurfaceFit& f) {
   std::ostringstream s;
   const Bounds& b = f.surface.bounds;
   s << "surface: " << ToString(f.surface.method) << " over " << f.points.size() << " points, x "
-    << FormatDecimalsOr(b.x_min_mm, 1, "-") << ".." << FormatDecimalsOr(b.x_max_mm, 1, "-") << " mm, y " << FormatDecimalsOr(b.y_min_mm, 1, "-")
-    << ".." << FormatDecimalsOr(b.y_max_mm, 1, "-") << " mm\n";
+    << FormatDecimalsOr(b.x_min_mm, 1, "-") << ".." << FormatDecimalsOr(b.x_max_mm, 1, "-")
+    << " mm, y " << FormatDecimalsOr(b.y_min_mm, 1, "-") << ".."
+    << FormatDecimalsOr(b.y_max_mm, 1, "-") << " mm\n";
   if (f.surface.method == Method::kCubic) {
     const auto a = f.surface.cubic.CoefficientsMm();
     s << "  dE = a0 + a1 X + a2 Y + a3 X^2 + a4 XY + a5 Y^2 + a6 X^3 + a7 X^2Y + a8 XY^2 + a9 Y^3"
          " (um, X/Y in mm)\n";
-    for (int k = 0; k < kCubicTerms; ++k) s << "  a" << k << " = " << FormatExponent(a[k], 6) << "\n";
+    for (int k = 0; k < kCubicTerms; ++k)
+      s << "  a" << k << " = " << FormatExponent(a[k], 6) << "\n";
     s << "  condition number " << FormatDecimals(f.condition_number, 1) << " (normalized u, v), "
       << FormatSignificant(f.condition_number_mm, 3) << " (raw mm)\n";
   } else {
     const BsplineSurface& bs = f.surface.bspline;
     s << "  degree " << bs.degree << ", grid " << bs.grid_y.size() << " rows x " << bs.grid_x.size()
-      << " columns, condition number of the collocation matrices " << FormatDecimalsOr(f.condition_number, 1, "-")
-      << "\n";
+      << " columns, condition number of the collocation matrices "
+      << FormatDecimalsOr(f.condition_number, 1, "-") << "\n";
   }
   s << "  point        x_mm        y_mm    error_um   fitted_um  residual_um  loo_error_um\n";
   for (std::size_t k = 0; k < f.points.size(); ++k) {
@@ -332,10 +334,11 @@ std::string FormatFitText(const SurfaceFit& f) {
     s << buf;
   }
   const ErrorStats res = StatsOf(f.residual_um), loo = StatsOf(f.loo_error_um);
-  s << "  residual: RMS " << FormatDecimalsOr(res.rms_um, 3, "-") << " um, max |.| " << FormatDecimalsOr(res.max_abs_um, 3, "-")
-    << " um\n  leave-one-out: RMS " << FormatDecimalsOr(loo.rms_um, 3, "-") << " um, max |.| "
-    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count << " of " << f.points.size()
-    << " points\n";
+  s << "  residual: RMS " << FormatDecimalsOr(res.rms_um, 3, "-") << " um, max |.| "
+    << FormatDecimalsOr(res.max_abs_um, 3, "-") << " um\n  leave-one-out: RMS "
+    << FormatDecimalsOr(loo.rms_um, 3, "-") << " um, max |.| "
+    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count << " of "
+    << f.points.size() << " points\n";
   return s.str();
 }
 

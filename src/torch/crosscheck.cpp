@@ -141,9 +141,9 @@ std::string ToString(GaussNewtonTermination t) {
 }
 
 std::string GaussNewtonSummary::BriefReport() const {
-  return "Gauss-Newton (Eigen, nn Jacobian): F " + FormatSignificant(initial_objective, 10) + " -> " +
-         FormatSignificant(final_objective, 10) + " in " + std::to_string(iterations) + " iterations, " +
-         ToString(termination) + " (" + message + ")";
+  return "Gauss-Newton (Eigen, nn Jacobian): F " + FormatSignificant(initial_objective, 10) +
+         " -> " + FormatSignificant(final_objective, 10) + " in " + std::to_string(iterations) +
+         " iterations, " + ToString(termination) + " (" + message + ")";
 }
 
 GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const Eigen::MatrixXd& x,
@@ -152,8 +152,8 @@ GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const 
   start.Validate("Gauss-Newton start network");
   CheckData(start, x, t);
   if (!(alpha >= 0) || !(beta > 0) || !std::isfinite(alpha) || !std::isfinite(beta)) {
-    throw InputError("Gauss-Newton: alpha = " + FormatSignificant(alpha, 3) + ", beta = " + FormatSignificant(beta, 3) +
-                     " (need alpha >= 0, beta > 0, finite)");
+    throw InputError("Gauss-Newton: alpha = " + FormatSignificant(alpha, 3) + ", beta = " +
+                     FormatSignificant(beta, 3) + " (need alpha >= 0, beta > 0, finite)");
   }
   if (options.max_iterations < 1 || !(options.gradient_tolerance > 0) || !(options.mu > 0) ||
       !(options.mu_dec > 0 && options.mu_dec < 1) || !(options.mu_inc > 1) ||
@@ -174,20 +174,23 @@ GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const 
     g_inf = (2.0 * (beta * cur.je + alpha * w)).cwiseAbs().maxCoeff();
     if (g_inf <= options.gradient_tolerance) {
       summary.termination = GaussNewtonTermination::kGradientTolerance;
-      summary.message = "||dF/dw||_inf " + FormatSignificant(g_inf, 3) + " <= " + FormatSignificant(options.gradient_tolerance, 3);
+      summary.message = "||dF/dw||_inf " + FormatSignificant(g_inf, 3) +
+                        " <= " + FormatSignificant(options.gradient_tolerance, 3);
       break;
     }
     if (summary.iterations >= options.max_iterations) {
       summary.termination = GaussNewtonTermination::kMaxIterations;
       summary.message = std::to_string(options.max_iterations) + " iterations, ||dF/dw||_inf " +
-                        FormatSignificant(g_inf, 3) + " > " + FormatSignificant(options.gradient_tolerance, 3);
+                        FormatSignificant(g_inf, 3) + " > " +
+                        FormatSignificant(options.gradient_tolerance, 3);
       break;
     }
     if (mu > options.mu_max) {
       summary.termination = GaussNewtonTermination::kMaxMu;
-      summary.message = "mu " + FormatSignificant(mu, 3) + " > " + FormatSignificant(options.mu_max, 3) +
-                        ": no step lowers F = " + FormatSignificant(cur.objective, 17) + ", ||dF/dw||_inf " +
-                        FormatSignificant(g_inf, 3);
+      summary.message = "mu " + FormatSignificant(mu, 3) + " > " +
+                        FormatSignificant(options.mu_max, 3) +
+                        ": no step lowers F = " + FormatSignificant(cur.objective, 17) +
+                        ", ||dF/dw||_inf " + FormatSignificant(g_inf, 3);
       break;
     }
     ++summary.iterations;
@@ -233,8 +236,9 @@ void CrosscheckOptions::Validate() const {
     throw InputError("cross-check option alpha/beta: must be finite (<= 0 = the model's values)");
   }
   if (!(start_perturbation >= 0 && start_perturbation <= 1)) {
-    throw InputError("cross-check option start_perturbation = " + FormatSignificant(start_perturbation, 3) +
-                     ": must be in [0, 1] (relative change of each starting weight)");
+    throw InputError(
+        "cross-check option start_perturbation = " + FormatSignificant(start_perturbation, 3) +
+        ": must be in [0, 1] (relative change of each starting weight)");
   }
 }
 
@@ -260,8 +264,9 @@ std::string CrosscheckReport::Table() const {
     << "tolerance" << std::setw(6) << ""
     << "definition\n";
   for (const auto& f : figures) {
-    s << std::left << std::setw(24) << f.name << std::setw(12) << FormatSignificant(f.value, 3) << std::setw(12)
-      << FormatSignificant(f.tolerance, 3) << std::setw(6) << (f.Passed() ? "ok" : "FAIL") << f.definition << "\n";
+    s << std::left << std::setw(24) << f.name << std::setw(12) << FormatSignificant(f.value, 3)
+      << std::setw(12) << FormatSignificant(f.tolerance, 3) << std::setw(6)
+      << (f.Passed() ? "ok" : "FAIL") << f.definition << "\n";
   }
   s << eigen_training.BriefReport() << "\n" << torch_training.BriefReport() << "\n";
   return s.str();
@@ -342,8 +347,9 @@ CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& in
   report.alpha = options.alpha > 0 ? options.alpha : model.training_summary.alpha;
   report.beta = options.beta > 0 ? options.beta : model.training_summary.beta;
   if (!(report.alpha >= 0) || !(report.beta > 0)) {
-    throw InputError("cross-check: the model has no usable trainbr alpha = " + FormatSignificant(report.alpha, 3) +
-                     ", beta = " + FormatSignificant(report.beta, 3) + " (need alpha >= 0, beta > 0); pass them");
+    throw InputError("cross-check: the model has no usable trainbr alpha = " +
+                     FormatSignificant(report.alpha, 3) + ", beta = " +
+                     FormatSignificant(report.beta, 3) + " (need alpha >= 0, beta > 0); pass them");
   }
   const double alpha = report.alpha, beta = report.beta;
 

@@ -485,9 +485,9 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
     evaluate(&f, &g_inf);
     if (std::isfinite(f) && f >= f_before && g_inf > options.gradient_tolerance) {
       summary.termination = LbfgsTermination::kNoProgress;
-      summary.message = "a step left F at " + MessageNumber(f) + " (was " + MessageNumber(f_before) +
-                        "), ||dF/dw||_inf " + MessageNumber(g_inf) + " > " +
-                        MessageNumber(options.gradient_tolerance);
+      summary.message = "a step left F at " + MessageNumber(f) + " (was " +
+                        MessageNumber(f_before) + "), ||dF/dw||_inf " + MessageNumber(g_inf) +
+                        " > " + MessageNumber(options.gradient_tolerance);
       break;
     }
   }
