@@ -94,6 +94,16 @@ long long RequireWholeValue(const nlohmann::json& v, const std::string& where, d
   return static_cast<long long>(v.get<double>());
 }
 
+std::vector<double> RequireNumbers(const nlohmann::json& v, const std::string& where) {
+  if (!v.is_array())
+    throw InputError(where + " must be an array of numbers, got " + DumpJson(v, -1));
+  std::vector<double> out;
+  out.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out.push_back(RequireFiniteValue(v[i], where + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
 double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what) {
   return RequireFiniteValue(At(j, key, what), what + ": '" + key + "'");
 }

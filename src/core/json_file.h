@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/limits.h"
 
@@ -46,6 +47,10 @@ double RequireFiniteValue(const nlohmann::json& v, const std::string& where);
 /// <v>" otherwise (1.0 is accepted as 1).
 long long RequireWholeValue(const nlohmann::json& v, const std::string& where, double min,
                             double max);
+
+/// `v` as an array of finite numbers; InputError "<where> must be an array of numbers, got <v>"
+/// or "<where>[<i>] must be a number, got <x>" otherwise.
+std::vector<double> RequireNumbers(const nlohmann::json& v, const std::string& where);
 
 /// Required finite number at key; an InputError names `what`, the key and the rule otherwise.
 double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what);

@@ -10,6 +10,7 @@
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/json_file.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
 #include "nn/dense_kernels.h"
@@ -146,31 +147,18 @@ nlohmann::json VecJson(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
 Eigen::VectorXd VecFromJson(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key) || !j.at(key).is_array())
-    throw InputError(std::string("training_summary: '") + key + "' must be an array of numbers");
-  const auto& a = j.at(key);
-  Eigen::VectorXd v(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!a[i].is_number())
-      throw InputError(std::string("training_summary: '") + key + "'[" + std::to_string(i) +
-                       "] must be a number, got " + a[i].dump());
-    v(i) = a[i].get<double>();
-  }
-  return v;
+  const std::vector<double> v = RequireNumbers(RequireKey(j, key, "training_summary"),
+                                               std::string("training_summary: '") + key + "'");
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 // NaN (no regularization) is stored as null.
 nlohmann::json MaybeNumber(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
 }
 double NumberOrNan(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key))
-    throw InputError(std::string("training_summary: missing key '") + key + "'");
-  const auto& v = j.at(key);
+  const auto& v = RequireKey(j, key, "training_summary");
   if (v.is_null()) return std::numeric_limits<double>::quiet_NaN();
-  if (!v.is_number())
-    throw InputError(std::string("training_summary: '") + key + "' must be a number, got " +
-                     v.dump());
-  return v.get<double>();
+  return RequireFiniteValue(v, std::string("training_summary: '") + key + "'");
 }
 }  // namespace
 
@@ -200,18 +188,15 @@ void to_json(nlohmann::json& j, const TrainSummary& s) {
 
 void from_json(const nlohmann::json& j, TrainSummary& s) {
   if (!j.is_object()) throw InputError("training_summary: expected a JSON object");
-  auto num = [&](const char* key) {
-    if (!j.contains(key))
-      throw InputError(std::string("training_summary: missing key '") + key + "'");
-    const auto& v = j.at(key);
-    if (!v.is_number())
-      throw InputError(std::string("training_summary: '") + key + "' must be a number, got " +
-                       v.dump());
-    return v.get<double>();
+  auto num = [&](const char* key) { return RequireNumber(j, key, "training_summary"); };
+  // Counts checked before the cast (a float-to-int cast out of range is undefined behaviour).
+  auto count = [&](const char* key) {
+    return static_cast<int>(
+        RequireInteger(j, key, 0, std::numeric_limits<int>::max(), "training_summary"));
   };
-  s.epochs = static_cast<int>(num("epochs"));
-  s.parameter_count = static_cast<int>(num("parameter_count"));
-  s.error_count = static_cast<int>(num("error_count"));
+  s.epochs = count("epochs");
+  s.parameter_count = count("parameter_count");
+  s.error_count = count("error_count");
   s.initial_cost = num("initial_cost");
   s.final_cost = num("final_cost");
   s.initial_sse = num("initial_sse_normalized");

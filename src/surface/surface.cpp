@@ -25,15 +25,7 @@ json BoundsJson(const Bounds& b) {
 }
 
 std::vector<double> Numbers(const json& j, const char* key, const std::string& what) {
-  if (!j.contains(key) || !j.at(key).is_array())
-    throw InputError(what + ": '" + key + "' must be an array of numbers");
-  std::vector<double> v;
-  for (const auto& x : j.at(key)) {
-    if (!x.is_number() || !std::isfinite(x.get<double>()))
-      throw InputError(what + ": '" + key + "' holds a non-number or non-finite value " + x.dump());
-    v.push_back(x.get<double>());
-  }
-  return v;
+  return RequireNumbers(RequireKey(j, key, what), what + ": '" + key + "'");
 }
 
 json CubicJson(const SurfaceFit& f) {
@@ -107,7 +99,8 @@ BsplineSurface BsplineFromJson(const json& j, const std::string& what) {
   s.weights.resize(static_cast<Eigen::Index>(s.grid_y.size()),
                    static_cast<Eigen::Index>(s.grid_x.size()));
   for (std::size_t i = 0; i < w.size(); ++i) {
-    const std::vector<double> row = Numbers(json{{"row", w[i]}}, "row", what + " weights_um");
+    const std::vector<double> row =
+        RequireNumbers(w[i], what + ": 'weights_um[" + std::to_string(i) + "]'");
     if (row.size() != s.grid_x.size())
       throw InputError(what + ": weights_um row " + std::to_string(i + 1) +
                        " must hold one value per grid_x line");
