@@ -231,14 +231,14 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--start-position-mm", o->start_position_mm,
                   "axis position at the thread start (time 0), program coordinates [mm]; "
                   "required unless the profile has it")
-      ->check(NumberIn(-kMaxAxisPositionMm, kMaxAxisPositionMm));
+      ->check(NumberIn(kAxisPositionRange));
   sub->add_option("--direction", o->direction,
                   "direction of travel along the axis while cutting: 1 or -1 (default 1)")
       ->check(CLI::IsMember({1, -1}));
   sub->add_option("--machine-offset-mm", o->machine_offset_mm,
                   "machine coordinate of the program zero on this axis [mm] (SD43920 and "
                   "$AA_IM are machine coordinates); required unless --machine")
-      ->check(NumberIn(-kMaxAxisPositionMm, kMaxAxisPositionMm));
+      ->check(NumberIn(kAxisPositionRange));
   sub->add_option("--control-dk", o->control_dk,
                   "how the control applies dK: added (default) or subtracted")
       ->check(CLI::IsMember({"added", "subtracted"}));

@@ -8,21 +8,12 @@
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "support/expect_error.h"
 
 namespace whirl {
 namespace {
 
 using nlohmann::json;
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(JsonFields, NumberInRangeNamesFileKeyValueAndRange) {
   const Range r{0, 1, false, "K"};
