@@ -502,13 +502,16 @@ std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOp
                      " synchronized-action IDs, the range " + std::to_string(o.sync_id_first) +
                      ".." + std::to_string(o.sync_id_last) + " has " + std::to_string(available));
   std::string nc = Header(m, g, o, model_source, s, bodies.size());
-  if (o.plan_marker_r >= 0)  // a plan's own compensation is still on the control: reset it first
-    nc += "IF " + R(o.plan_marker_r) + "==1\nSETAL(" + std::to_string(o.missing_alarm + 3) +
-          ")\nENDIF\n";
+  const bool check = o.plan_marker_r >= 0;
+  if (check)  // a plan's own compensation is still on the control: reset it first
+    nc += "; after the alarm the program jumps to " + std::string(kProgramEndLabel) +
+          " and cancels, saves and writes nothing, whatever the alarm's response\n" +
+          CheckOrAlarm(R(o.plan_marker_r) + "<>1", o.missing_alarm + 3, "WHIRL_NO_PLAN_ACTIVE");
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
   nc += Preamble(o, SlopeMode(o, g), s) + "STOPRE\n";
   for (std::size_t k = 0; k < bodies.size(); ++k)
     nc += Line("IDS=" + std::to_string(o.sync_id_first + static_cast<int>(k)) + " " + bodies[k]);
+  if (check) nc += std::string(kProgramEndLabel) + ":\n";
   nc += "M17\n";
   return nc;
 }

@@ -120,7 +120,9 @@ struct DriftActionOptions {
   int slope_growth_direction = 1;  ///< sigma: +1 distance from P_b grows towards +axis, or -1
   /// First of four SETAL numbers (65000..69996, user cycle alarms): + 0..2 the plans' liveness check
   /// (sinumerik.h PlanOptions::drift_alive_param), + 3 this program finds a plan's compensation
-  /// still active (R<plan_marker_r> = 1: run the plan's reset program first).
+  /// still active (R<plan_marker_r> = 1: run the plan's reset program first); after it the
+  /// program jumps to its end (sinumerik.h CheckOrAlarm) and changes nothing, whatever the
+  /// alarm's response.
   int missing_alarm = 65000;
   int plan_marker_r = -1;  ///< the plans' marker R (profile save_r_first + 3); -1: not checked
   DriftReference reference = DriftReference::kModel;

@@ -174,6 +174,9 @@ void MachineProfile::Validate() const {
       throw InputError("sync_id_first..sync_id_last " + Range(sync_id_first, sync_id_last) +
                        ": whirl's IDs within 1..255, at least " + std::to_string(kMinPlanIds) +
                        " (a plan's first segment and its restore)");
+    if (save_r_first < 0)
+      throw InputError("save_r_first " + std::to_string(save_r_first) +
+                       ": required, within 0..9996 (the R parameters reserved for whirl)");
     PlanOptions check;
     Fill(check);
     check.Validate();

@@ -18,9 +18,15 @@
 //                                 synchronized-action IDs reserved for whirl (1..255); the
 //                                 programs cancel exactly this range first; at least 2
 //    "save_r_first": 90,          R<n>..R<n+3> hold the setting data found before a cut and a
-//                                 marker (MD28050 must provide them)
+//                                 marker (MD28050 must provide them); required: the R
+//                                 parameters are the user's, there is no default
 //    "start_alarm": 65004,        SETAL number of the plan called with the axis at or past the
-//                                 thread start (65000..69999, the user cycle alarms)
+//                                 thread start (65000..69999, the user cycle alarms; after
+//                                 every alarm the programs jump to their end, so they change
+//                                 nothing whatever its response; recalled, not confirmed here:
+//                                 65000..66999 stop the program, 67000..67999 are only
+//                                 displayed, and then the calling program cuts without
+//                                 whirl's compensation: see sinumerik.h kUserAlarmFirst)
 //    "control": {                 the control's own limits (machine data), checked and named in
 //                                 the programs' headers as prerequisites:
 //      "md10300_analog_inputs": 8,    MD10300 $MN_FASTIO_ANA_NUM_INPUTS: NCK analog inputs
@@ -85,7 +91,7 @@ struct MachineProfile {
   double md32760 = kMd32760Default;
   int sync_id_first = 0;  ///< required in the file
   int sync_id_last = 0;
-  int save_r_first = 90;
+  int save_r_first = -1;  ///< required in the file
   int start_alarm = kDefaultStartAlarm;
   ControlLimits control;                    ///< the "control" object (version 1: not stated)
   std::optional<DriftActionOptions> drift;  ///< the "drift" object, when present

@@ -165,9 +165,9 @@ void PlanOptions::Validate() const {
                      std::to_string(workpiece_slope_param) +
                      " needs workpiece_k0_param >= 0 outside its two slots (" +
                      std::to_string(workpiece_k0_param) + ") and must be 0..9998");
-  if (!(save_r_first >= 0 && save_r_first <= 9996))
+  if (!(save_r_first >= -1 && save_r_first <= 9996))
     throw InputError("save_r_first = " + std::to_string(save_r_first) +
-                     ": must be within 0..9996 (R<n>..R<n+3> are used)");
+                     ": must be within 0..9996 (R<n>..R<n+3> are used), or -1: not set");
 }
 
 double AxisPositionMm(const PlanOptions& o, double axial_feed_mm_s, double t_s) {
@@ -494,6 +494,10 @@ void CheckDistinctProgramNames(const std::string& program, const std::string& re
                      "them different names");
 }
 
+std::string CheckOrAlarm(const std::string& condition, int alarm, const std::string& ok_label) {
+  return "IF " + condition + " GOTOF " + ok_label + "\nSETAL(" + std::to_string(alarm) +
+         ")\nGOTOF " + kProgramEndLabel + "\n" + ok_label + ":\n";
+}
 
 namespace {
 
@@ -563,22 +567,22 @@ std::string RestoredRef(const PlanOptions& o, const std::string& r_prefix) {
 std::string RequireDriftAction(const PlanOptions& o) {
   if (o.drift_alive_param < 0) return "";
   const std::string alive = Param(o.drift_alive_param);
-  auto alarm = [&](int k) {
-    return "SETAL(" + std::to_string(o.drift_missing_alarm + k) + ")\nENDIF\n";
-  };
+  const int a = o.drift_missing_alarm;
   std::string out = alive + "=0\nG4 F0.1\nSTOPRE\n";  // a running action writes it again
-  if (!Combined(o)) return out + "IF " + alive + "<>0\n" + alarm(1);
+  if (!Combined(o)) return out + CheckOrAlarm(alive + "==0", a + 1, "WHIRL_NO_DRIFT_ACTION");
   const std::string mode = SlopeHandedOver(o) ? "2" : "1";
-  return out + "IF " + alive + "==0\n" + alarm(0) + "IF " + alive + "<>" + mode + "\n" + alarm(2);
+  return out + CheckOrAlarm(alive + "<>0", a, "WHIRL_DRIFT_ACTION_RUNS") +
+         CheckOrAlarm(alive + "==" + mode, a + 2, "WHIRL_DRIFT_MODE_OK");
 }
 
 // Refuses to start (before anything is changed) with the axis at or past the thread start, where
 // the first action's condition would already hold: every passed action would fire at once.
 std::string RequireAxisBeforeStart(const CompensationPlan& plan) {
   const PlanOptions& o = plan.options;
-  return "STOPRE\nIF $AA_IM[" + o.axis + "]" + (o.direction > 0 ? ">=" : "<=") +
-         FormatFixed(plan.segments.front().sd43920_mm, kDecimalsPositionMm) + "\nSETAL(" +
-         std::to_string(o.start_alarm) + ")\nENDIF\n";
+  return "STOPRE\n" + CheckOrAlarm("$AA_IM[" + o.axis + "]" + (o.direction > 0 ? "<" : ">") +
+                                       FormatFixed(plan.segments.front().sd43920_mm,
+                                                   kDecimalsPositionMm),
+                                   o.start_alarm, "WHIRL_AXIS_BEFORE_START");
 }
 
 // "MD28254 ... >= n" for the $AC_PARAM slots a plan program uses (none: empty).
@@ -599,6 +603,9 @@ void HeaderControl(std::ostringstream& nc, const CompensationPlan& plan, const N
      << "alarm " << o.start_alarm << " (axis at or past the thread start: no resume from "
      << "mid-thread) and changes nothing: run " << info.reset_program_name
      << ", move the axis before the thread start and cut the whole thread again\n";
+  nc << "; after a failed check (alarm) the program jumps to " << kProgramEndLabel
+     << " and cancels, saves and writes nothing, whatever the alarm's response; if that response "
+        "does not stop the program, the calling program goes on without whirl's compensation\n";
   nc << "; until the axis reaches the thread start the control keeps what it applied before the "
         "call; the first segment is written by ID="
      << o.sync_id_first << " at the thread start\n";
@@ -677,6 +684,15 @@ void RequireSyncIds(const PlanOptions& o) {
         "there is no default");
 }
 
+void RequireSaveR(const PlanOptions& o) {
+  if (!o.HasSaveR() && !SlopeHandedOver(o))
+    throw InputError(
+        "NC program: no R parameters set: the program saves the setting data it finds in "
+        "R<n>..R<n+3>, the user's R parameters, so it needs the ones the machine builder "
+        "reserved for whirl (the machine profile's save_r_first, or --save-r-first without a "
+        "profile); there is no default");
+}
+
 void CheckNames(const NcProgramInfo& info) {
   CheckProgramName(info.program_name, "NC program name");
   CheckProgramName(info.reset_program_name, "reset program name");
@@ -690,6 +706,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   CheckNames(info);
   const PlanOptions& o = plan.options;
   RequireSyncIds(o);
+  RequireSaveR(o);
   const std::string& ax = o.axis;
   const std::size_t available = static_cast<std::size_t>(o.sync_id_last - o.sync_id_first + 1);
   if (SyncIdsNeeded(plan) > available)
@@ -719,7 +736,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
         " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), RestoredSlope(o, "$"), RestoredRef(o, "$")) +
         (SlopeHandedOver(o) ? std::string() : " $" + R(m + 3) + "=0") + "\n";
-  nc += "M17\n";
+  nc += std::string(kProgramEndLabel) + ":\nM17\n";
   return nc;
 }
 
@@ -727,6 +744,7 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
   o.Validate();
   CheckNames(info);
   RequireSyncIds(o);
+  RequireSaveR(o);
   const std::string& ax = o.axis;
   const int m = o.save_r_first;
   std::string nc = "; " + info.reset_program_name +

@@ -75,13 +75,29 @@ inline constexpr double kMd32760Default = 0.01;
 inline constexpr double kMd32760Max = 0.10;
 
 /// SETAL numbers whirl raises lie within the user cycle alarms 65000..69999; 60000..64999 belong
-/// to Siemens' own cycles (SINUMERIK 840D cycle alarm ranges). The programs assume the alarm
-/// stops the program (its configured reaction); not verified on a control here.
+/// to Siemens' own cycles (SINUMERIK 840D cycle alarm ranges; recalled, not confirmed against a
+/// copy of Siemens' Diagnostics Manual here).
+/// Whether a cycle alarm stops the program depends on its number's sub-range (and the machine's
+/// alarm configuration). Recalled, not confirmed here: 65000..65999 stop the interpreter (cleared
+/// with RESET), 66000..66999 stop it (cleared with NC START), 67000..67999 are only displayed and
+/// the program goes on. The programs do not depend on it: after every SETAL they jump to their
+/// end (kProgramEndLabel), so nothing is cancelled, saved or written after a failed check,
+/// whatever the alarm's response. What the response still decides: if the alarm does not stop
+/// the program, the calling part program goes on and cuts without whirl's compensation (the
+/// control as found). So keep whirl's alarms in a stopping sub-range (the default numbering,
+/// 65000..65004, lies in 65000..65999) and check once on the machine that the start alarm stops.
 inline constexpr int kUserAlarmFirst = 65000;
 inline constexpr int kUserAlarmLast = 69999;
 /// The default numbering: the drift check's four alarms from 65000 (drift_missing_alarm,
 /// drift_action.h), then the plan's start alarm.
 inline constexpr int kDefaultStartAlarm = kUserAlarmFirst + 4;
+/// The label just before M17 that every failed check of whirl's programs jumps to (GOTOF).
+inline constexpr const char* kProgramEndLabel = "WHIRL_END";
+/// Part-program lines of a check: go on at `ok_label` if `condition` holds (a single-block
+/// conditional jump, "IF <condition> GOTOF <ok_label>"), else raise SETAL(alarm) and jump to
+/// kProgramEndLabel. No jump leaves or enters an IF block (whether a control accepts a jump out
+/// of IF..ENDIF is not checked here, so the checks do without one).
+std::string CheckOrAlarm(const std::string& condition, int alarm, const std::string& ok_label);
 /// Largest |position| accepted for the machine offset, the thread start and other axis positions,
 /// mm: 100 m, longer than any machine bed (a larger value is a typing error, and at 1e308 the
 /// trigger positions of neighbouring segments become equal).
@@ -142,8 +158,11 @@ struct PlanOptions {
   /// R parameters R<n>..R<n+3> the NC program uses to save the setting data it found (SD43900,
   /// SD43910, SD43920) and a marker (1 while whirl's compensation is active), so the thread end
   /// and the reset program restore exactly what was there before. 0..9996; the machine must
-  /// have them (MD28050 $MC_MM_NUM_R_PARAM).
-  int save_r_first = 90;
+  /// have them (MD28050 $MC_MM_NUM_R_PARAM). They are the user's R parameters, so they come
+  /// only from the machine profile (save_r_first) or an explicit flag without one: -1, the
+  /// default, is "not set": a plan can be built, but FormatNcProgram and FormatNcResetProgram
+  /// refuse when the plan saves anything (not when it hands its slope to the drift action).
+  int save_r_first = -1;
   /// -1: the plan writes SD43900 itself. >= 0: combined with the live drift action
   /// (interp/drift_action.h): the plan writes its K0 into $AC_PARAM[workpiece_k0_param], which the
   /// drift action adds to the machine's K0, so SD43900 has one writer.
@@ -171,6 +190,8 @@ struct PlanOptions {
   void Validate() const;
   /// True when the synchronized-action IDs are set (sync_id_first > 0).
   bool HasSyncIds() const { return sync_id_first > 0; }
+  /// True when the R parameters are set (save_r_first >= 0).
+  bool HasSaveR() const { return save_r_first >= 0; }
 };
 
 struct CompensationSegment {
@@ -258,12 +279,13 @@ struct NcProgramInfo {
 };
 
 /// SINUMERIK subprogram (.SPF) that leaves the control as it found it:
-///   STOPRE; IF $AA_IM[<axis>]>=<thread start> ('<=' travelling in -direction): SETAL(start_alarm)
-///     and stop, before anything is changed: every action below is triggered by the position
-///     alone, so with the axis at or past a trigger it would fire at once (a WHEN whose condition
-///     holds fires in the first interpolation cycle). The cut starts with the axis before the
-///     thread start; there is no resume from mid-thread;
-///   [with a drift action on the machine: its liveness check, alarms drift_missing_alarm + 0..2];
+///   STOPRE; IF $AA_IM[<axis>]<P_start GOTOF <ok> ('>' travelling in -direction), else
+///     SETAL(start_alarm) and GOTOF WHIRL_END (CheckOrAlarm), before anything is changed: every
+///     action below is triggered by the position alone, so with the axis at or past a trigger it
+///     would fire at once (a WHEN whose condition holds fires in the first interpolation cycle).
+///     The cut starts with the axis before the thread start; there is no resume from mid-thread;
+///   [with a drift action on the machine: its liveness check, alarms drift_missing_alarm + 0..2,
+///     each followed by the jump to WHIRL_END likewise];
 ///   CANCEL(n) for every ID of [sync_id_first, sync_id_last] (stale actions of an aborted run);
 ///   STOPRE; IF R<m+3><>1: save SD43900/43910/43920 into R<m>..R<m+2> (m = save_r_first), set
 ///   the marker R<m+3>=1 (a rerun after an abort does not save whirl's own values);
@@ -273,8 +295,9 @@ struct NcProgramInfo {
 ///     applied during the approach (the control keeps what it applied before the call), IDs
 ///     counting up from sync_id_first;
 ///   ID=<last> WHEN $AA_IM[<axis>]>=<thread end> DO <restore from R<m>..R<m+2>> $R<m+3>=0;
-///   M17 (subprogram end). Call it before the cutting block. IDs not set, or more needed than
-///   the range holds, are an InputError (raise the tolerance or widen the range). Header
+///   WHIRL_END: M17 (subprogram end). Call it before the cutting block. IDs or R parameters not
+///   set, or more IDs needed than the range holds, are an InputError (raise the tolerance or
+///   widen the range). Header
 ///   comments state the program names, MD32750 = 3, the MD32760 cap against the largest slope,
 ///   the sign rule, the axis, the start condition and its alarm, IDs, R parameters and the
 ///   control's limits it depends on (MD28250 for its actions, MD28254 for the $AC_PARAM it uses).
@@ -284,7 +307,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
 
 /// The reset subprogram for an aborted cut: CANCEL(n) over the ID range, then, if the marker
 /// R<m+3> is 1, write back the saved SD43900/43910/43920 and clear the marker; M17. InputError if
-/// the IDs are not set.
+/// the IDs or (unless the slope is handed over) the R parameters are not set.
 std::string FormatNcResetProgram(const PlanOptions& options, const NcProgramInfo& info = {});
 
 }  // namespace whirl::interp

@@ -49,13 +49,13 @@ struct PlanCliOptions {
 
 // The control resources a profile reserves for whirl (IDs, R parameters, the start alarm): an
 // explicit flag may repeat the profile's value but never contradict it; without a profile the
-// IDs come only from the flags (FormatNcProgram refuses a program without them).
+// IDs and R parameters come only from the flags (FormatNcProgram refuses a program without them).
 void ApplyReservedFlags(const PlanCliOptions& o, interp::PlanOptions& p) {
   const bool profile = !o.machine_path.empty();
   for (const auto& [flag, key, given, value] :
        {std::tuple{"--sync-id-first", "sync_id_first", o.sync_id_first, &p.sync_id_first},
         {"--sync-id-last", "sync_id_last", o.sync_id_last, &p.sync_id_last},
-        {"--save-r", "save_r_first", o.save_r_first, &p.save_r_first},
+        {"--save-r-first", "save_r_first", o.save_r_first, &p.save_r_first},
         {"--start-alarm", "start_alarm", o.start_alarm, &p.start_alarm}}) {
     if (given < 0) continue;
     if (profile && given != *value)
@@ -205,12 +205,13 @@ void RegisterPlan(CLI::App& app) {
       "datasets/machines/example_840d.json): axis, direction, machine offset, control_dk and\n"
       "MD32760 (each overridable by its flag), and what the machine builder reserved for whirl:\n"
       "the synchronized-action IDs, R parameters and the start alarm (a flag that contradicts\n"
-      "the profile is refused; without a profile --nc/--reset-nc need --sync-id-first and\n"
-      "--sync-id-last, there is no default range). --start-position-mm and --machine-offset-mm\n"
-      "have no default: give them or a profile.\n"
+      "the profile is refused; without a profile --nc/--reset-nc need --sync-id-first,\n"
+      "--sync-id-last and --save-r-first, there is no default). --start-position-mm and\n"
+      "--machine-offset-mm have no default: give them or a profile.\n"
       "The NC program (--nc, a subprogram ending in M17: save it as .SPF) refuses to start with\n"
       "alarm --start-alarm unless the axis stands before the thread start (no resume from\n"
-      "mid-thread), cancels its ID range, saves the setting data it finds in R parameters,\n"
+      "mid-thread; after any alarm it jumps to its end and changes nothing), cancels its ID\n"
+      "range, saves the setting data it finds in R parameters,\n"
       "writes every segment, the first at the thread start, through synchronized actions (so\n"
       "the approach keeps what the control applied before) and restores the saved values at\n"
       "the thread end; --reset-nc writes the program to run after an aborted cut. The file\n"
@@ -258,9 +259,10 @@ void RegisterPlan(CLI::App& app) {
                   "last synchronized-action ID whirl may use (1-255); the programs CANCEL the "
                   "whole range first, so it must be the range the machine builder reserved")
       ->check(NumberIn(1, 255));
-  sub->add_option("--save-r", o->save_r_first,
+  sub->add_option("--save-r-first", o->save_r_first,
                   "R<n>..R<n+3> keep the setting data found before the cut and a marker "
-                  "(0-9996, default 90 without a profile; must match the profile's)")
+                  "(0-9996); no default: from the profile, or required for --nc/--reset-nc "
+                  "without one; a value that contradicts the profile is refused")
       ->check(NumberIn(0, 9996));
   sub->add_option("--start-alarm", o->start_alarm,
                   "SETAL number raised when the program is called with the axis at or past the "

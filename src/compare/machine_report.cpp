@@ -91,10 +91,10 @@ std::string List(const std::vector<std::string>& names) {
 
 // The last static action of the drift program: the one that writes the setting data.
 std::string OutputAction(const std::string& drift_nc) {
-  const std::size_t end = drift_nc.rfind("\nM17");
-  const std::size_t begin = drift_nc.rfind("\nIDS=", end);
-  if (end == std::string::npos || begin == std::string::npos) return "";
-  return drift_nc.substr(begin + 1, end - begin - 1);
+  const std::size_t begin = drift_nc.rfind("\nIDS=");
+  if (begin == std::string::npos) return "";
+  const std::size_t end = drift_nc.find('\n', begin + 1);
+  return drift_nc.substr(begin + 1, end == std::string::npos ? end : end - begin - 1);
 }
 
 std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {

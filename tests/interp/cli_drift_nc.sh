@@ -7,7 +7,8 @@ source "$SRC/tests/support/cli_common.sh"
 M="$SRC/datasets/machines/example_840d.json"
 S="$SRC/datasets/screws/reference_80x10x6000.json"
 
-"$W" drift nc --help | grep -q 'A_INA' || fail "drift nc --help"
+"$W" drift nc --help > "$D/help.txt" || fail "drift nc --help exits non-zero"
+grep -q 'A_INA' "$D/help.txt" || fail "drift nc --help does not explain \$A_INA"
 # A small run: two sensors warming, an error driven by both (2 um/K and -1 um/K) plus a wiggle.
 awk 'BEGIN { print "# synthetic run for the smoke test"; print "time_min,t1_C,t2_C,ch1_um";
   for (k = 0; k < 200; k++) { t1 = 20 + 8 * (1 - exp(-k / 50)); t2 = 21 + 0.02 * k;
@@ -69,13 +70,17 @@ done
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --with-drift-action \
   --nc "$D/plan.spf" > /dev/null || fail "plan --with-drift-action"
 grep -q 'DO \$AC_PARAM\[99\]=' "$D/plan.spf" || fail "combined plan must write K0 into AC_PARAM[99]"
-grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/plan.spf" | grep -v '^;' && fail "combined plan writes SD43900"
+grep -v '^;' "$D/plan.spf" | grep -q 'SA_TEMP_COMP_ABS_VALUE' && fail "combined plan writes SD43900"
 grep -q '^SETAL(65000)' "$D/plan.spf" || fail "combined plan lacks the alarm"
-grep -v '"drift"' "$M" > /dev/null
+# After every alarm (the plan's, and the drift program's for a plan left active) the program
+# jumps to the label just before M17: nothing is changed whether or not the alarm stops it.
+grep -q '^SETAL(65003)' "$D/drift.spf" || fail "drift program lacks the alarm for an active plan"
+expect_jumps_to_end "$D/plan.spf"
+expect_jumps_to_end "$D/drift.spf"
+# --with-drift-action needs the profile's drift object.
 python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); del j["drift"]; json.dump(j, open(sys.argv[2], "w"))' \
-  "$M" "$D/machine_nodrift.json" 2>/dev/null || cp "$M" "$D/machine_nodrift.json"
-if ! grep -q '"drift"' "$D/machine_nodrift.json"; then
-  expect_fail "drift" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
-    --machine "$D/machine_nodrift.json" --with-drift-action
-fi
+  "$M" "$D/machine_nodrift.json" || fail "could not write the profile without its drift object"
+grep -q '"drift"' "$D/machine_nodrift.json" && fail "the edited profile still has a drift object"
+expect_fail "needs a 'drift' object" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$D/machine_nodrift.json" --with-drift-action
 echo "ok"

@@ -8,7 +8,9 @@ S="$SRC/datasets/screws/reference_80x10x6000.json"
 M="$SRC/datasets/machines/example_840d.json"
 POS=(--start-position-mm 0 --machine-offset-mm -850)
 
-"$W" plan --help | grep -q "SD43910" || fail "plan --help"
+"$W" plan --help > "$D/help.txt" || fail "plan --help exits non-zero"
+grep -q "SD43910" "$D/help.txt" || fail "plan --help does not explain SD43910"
+grep -q -- "--save-r-first" "$D/help.txt" || fail "plan --help lacks --save-r-first"
 
 # From given features: all three outputs, consistent with each other.
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --out "$D/plan.json" \
@@ -55,10 +57,20 @@ expect_fail "no synchronized-action IDs" "$W" plan --screw "$S" --max-elongation
 expect_fail "go together" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   "${POS[@]}" --sync-id-first 120 --nc "$D/noids.spf"
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 "${POS[@]}" --sync-id-first 120 \
-  --sync-id-last 160 --nc "$D/ids.spf" > /dev/null || fail "plan with explicit IDs"
+  --sync-id-last 160 --save-r-first 40 --nc "$D/ids.spf" > /dev/null || fail "plan with explicit IDs"
 [ "$(grep -c '^CANCEL(' "$D/ids.spf")" -eq 41 ] || fail "explicit range 120..160 not cancelled"
 grep -Eq '^(CANCEL\(|ID=)([0-9]|[1-9][0-9]|1[01][0-9]|16[1-9]|1[7-9][0-9]|2[0-9][0-9])[^0-9]' \
   "$D/ids.spf" && fail "an ID outside 120..160 is touched"
+# R parameters likewise (the program saves what it finds in the user's R parameters): from the
+# profile or --save-r-first, never a default R90..R93; a contradicting flag is refused below.
+expect_fail "no R parameters" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  "${POS[@]}" --sync-id-first 120 --sync-id-last 160 --nc "$D/nor.spf"
+grep -q -- "--save-r-first" "$D/err.txt" || fail "the message does not name --save-r-first"
+expect_fail "no R parameters" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  "${POS[@]}" --sync-id-first 120 --sync-id-last 160 --reset-nc "$D/nor.spf"
+[ -e "$D/nor.spf" ] && fail "program written without R parameters"
+used_r=$(grep -v '^;' "$D/ids.spf" | grep -Eo '(^|[^A-Z_$])\$?R[0-9]+' | grep -Eo '[0-9]+$' | sort -un | tr '\n' ' ')
+[ "$used_r" = "40 41 42 43 " ] || fail "--save-r-first 40 must use R40..R43 only, uses: $used_r"
 expect_fail "sync_id_first 100" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   --machine "$M" --sync-id-first 1 --nc "$D/override.spf"
 grep -q -- "--sync-id-first 1 contradicts the machine profile" "$D/err.txt" \
@@ -66,7 +78,7 @@ grep -q -- "--sync-id-first 1 contradicts the machine profile" "$D/err.txt" \
 expect_fail "sync_id_last 149" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   --machine "$M" --sync-id-last 255
 expect_fail "save_r_first 90" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
-  --machine "$M" --save-r 10
+  --machine "$M" --save-r-first 10
 expect_fail "start_alarm 65004" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
   --machine "$M" --start-alarm 65100
 "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --sync-id-first 100 \
@@ -74,10 +86,14 @@ expect_fail "start_alarm 65004" "$W" plan --screw "$S" --max-elongation 30 --set
 
 # The start: the program refuses (alarm from the profile) unless the axis stands before the
 # thread start, and says so in its header; the control's limits it needs are named.
-grep -q '^IF \$AA_IM\[Z\]>=' "$D/plan.spf" || fail "no start check"
+grep -q '^IF \$AA_IM\[Z\]<-5600.0000 GOTOF ' "$D/plan.spf" || fail "no start check"
 grep -q '^SETAL(65004)' "$D/plan.spf" || fail "the profile's start_alarm is not raised"
 grep -q 'alarm 65004 (axis at or past the thread start' "$D/plan.spf" || fail "header: start alarm"
 grep -q 'MD28250 \$MC_MM_NUM_SYNC_ELEMENTS' "$D/plan.spf" || fail "header: MD28250"
+# After every alarm the program jumps to its end (the label just before M17), so it changes
+# nothing whether or not the alarm stops the program.
+expect_jumps_to_end "$D/plan.spf"
+expect_jumps_to_end "$D/ids.spf"
 grep -q '^\$SA_TEMP_COMP_SLOPE' "$D/plan.spf" && fail "the part program writes a slope before motion"
 
 # Program names: the headers name the files' stems; names a control refuses are refused, and
@@ -120,27 +136,26 @@ tight=$(grep -v '^#' "$D/tight.csv" | tail -n +2 | grep -vc '^restore')
 
 # Bad input: negative tolerance, a slope cap below the plan's slopes (nothing overwritten).
 cp "$D/plan.json" "$D/plan.before"
-"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --tolerance-um -1 \
-  > /dev/null 2>&1 && fail "negative tolerance accepted"
+expect_fail "tolerance-um" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  --machine "$M" --tolerance-um -1
 expect_fail "MD32760" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" \
   --md32760 1e-6 --out "$D/plan.json"
 cmp -s "$D/plan.json" "$D/plan.before" || fail "failed plan overwrote the previous file"
 expect_fail "either" "$W" plan --screw "$S"
 
 # With a model: train a small one on the shipped table, then plan inside and outside its domain.
-if [ -f "$SRC/datasets/whirling_train.csv" ]; then
-  "$W" train --data "$SRC/datasets/whirling_train.csv" --out "$D/m.json" --epochs 200 \
-    > /dev/null 2>&1 || fail "train"
-  "$W" plan --model "$D/m.json" --screw "$S" --machine "$M" --json > "$D/model_plan.json" \
-    || fail "plan --model"
-  grep -q '"max_elongation_std_um"' "$D/model_plan.json" || fail "plan JSON lacks the std"
-  sed 's/"diameter_mm": 80.0/"diameter_mm": 130.0/' "$S" > "$D/big.json"
-  expect_fail "allow-extrapolation" "$W" plan --model "$D/m.json" --screw "$D/big.json" --machine "$M"
-  "$W" plan --model "$D/m.json" --screw "$D/big.json" --machine "$M" --allow-extrapolation \
-    > /dev/null 2> "$D/warn.txt" \
-    || fail "plan --allow-extrapolation: $(cat "$D/warn.txt")"
-  grep -q "warning" "$D/warn.txt" || fail "no extrapolation warning"
-  "$W" curve --model "$D/m.json" --screw "$S" --out "$D/model_curve.csv" > /dev/null || fail "curve --model"
-  expect_fail "allow-extrapolation" "$W" curve --model "$D/m.json" --screw "$D/big.json"
-fi
+[ -f "$SRC/datasets/whirling_train.csv" ] || fail "the shipped training table is missing"
+"$W" train --data "$SRC/datasets/whirling_train.csv" --out "$D/m.json" --epochs 200 \
+  > /dev/null 2>&1 || fail "train"
+"$W" plan --model "$D/m.json" --screw "$S" --machine "$M" --json > "$D/model_plan.json" \
+  || fail "plan --model"
+grep -q '"max_elongation_std_um"' "$D/model_plan.json" || fail "plan JSON lacks the std"
+sed 's/"diameter_mm": 80.0/"diameter_mm": 130.0/' "$S" > "$D/big.json"
+expect_fail "allow-extrapolation" "$W" plan --model "$D/m.json" --screw "$D/big.json" --machine "$M"
+"$W" plan --model "$D/m.json" --screw "$D/big.json" --machine "$M" --allow-extrapolation \
+  > /dev/null 2> "$D/warn.txt" \
+  || fail "plan --allow-extrapolation: $(cat "$D/warn.txt")"
+grep -q "warning" "$D/warn.txt" || fail "no extrapolation warning"
+"$W" curve --model "$D/m.json" --screw "$S" --out "$D/model_curve.csv" > /dev/null || fail "curve --model"
+expect_fail "allow-extrapolation" "$W" curve --model "$D/m.json" --screw "$D/big.json"
 echo "ok"

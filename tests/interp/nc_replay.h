@@ -9,6 +9,12 @@
 // PowerOn() drops actions and $AC_PARAM. Expressions: numbers,
 // + - * / and parentheses over $AC_PARAM[n], $A_INA[n], R parameters and the setting data. A line
 // it does not understand fails the test, so the writer cannot emit something the replay ignores.
+// Jumps: "GOTOF <label>" and "IF <condition> GOTOF <label>" go forward to "<label>:" (a label
+// that does not exist, lies behind the jump or is defined twice fails the test, and so does a
+// jump out of or into an IF block, which the writers avoid). SETAL raises the alarm and the
+// program goes on: whether a cycle alarm stops the interpreter depends on the machine's alarm
+// configuration, so the replay assumes it does not, and a program is safe only if it jumps past
+// everything it must not do after a failed check.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -30,6 +36,7 @@ struct Control {
   std::map<int, double> ac_param;  // $AC_PARAM
   std::map<int, double> ain;       // $A_INA (set by the test)
   int alarm = 0;                   // last SETAL
+  std::vector<int> alarms;         // every SETAL, in order
 
   double DkMm(double p_mm) const { return abs_value_mm + slope * (p_mm - ref_position_mm); }
 };
@@ -209,6 +216,8 @@ struct Replay {
   static bool Compare(double l, const std::string& op, double r) {
     if (op == ">=") return l >= r;
     if (op == "<=") return l <= r;
+    if (op == ">") return l > r;
+    if (op == "<") return l < r;
     if (op == "==") return l == r;
     if (op == "<>") return l != r;
     ADD_FAILURE() << "operator " << op;
@@ -229,31 +238,56 @@ struct Replay {
     return axis_mm;
   }
 
-  // Runs the part program's preprocessing; fails the test on any unknown line. Returns false if
-  // the program stopped with an alarm (SETAL).
+  // Runs the part program's preprocessing; fails the test on any unknown line or jump (see the
+  // header comment). Returns false if the program raised an alarm (SETAL) on its way to M17.
   bool RunProgram(const std::string& text) {
     static const std::regex kCancel(R"(^CANCEL\((\d+)\)$)");
     static const std::regex kIf(
-        R"(^IF (R\d+|\$AC_PARAM\[\d+\]|\$AA_IM\[\w+\])(<>|==|>=|<=)([-0-9.]+)$)");
+        R"(^IF (R\d+|\$AC_PARAM\[\d+\]|\$AA_IM\[\w+\])(<>|==|>=|<=|<|>)([-0-9.]+)$)");
+    static const std::regex kIfJump(
+        R"(^IF (R\d+|\$AC_PARAM\[\d+\]|\$AA_IM\[\w+\])(<>|==|>=|<=|<|>)([-0-9.]+) GOTOF (\w+)$)");
+    static const std::regex kJump(R"(^GOTOF (\w+)$)");
+    static const std::regex kLabel(R"(^([A-Z_]{2}[A-Z0-9_]{0,30}):$)");
     static const std::regex kDwell(R"(^G4 F[0-9.]+$)");
     static const std::regex kSetal(R"(^SETAL\((\d+)\)$)");
     static const std::regex kAssign(R"(^(\$?\$?[A-Z_]+(\[\w+\])?|R\d+)=(\S+)$)");
     static const std::regex kSync(
         R"(^(ID|IDS)=(\d+) (?:(WHEN|WHENEVER) (\S+?)(>=|<=|==)(\S+) )?DO (.*)$)");
-    std::istringstream in(text);
-    std::string line;
+    std::vector<std::string> lines;
+    {
+      std::istringstream in(text);
+      for (std::string line; std::getline(in, line);) lines.push_back(line);
+    }
+    // Labels and the IF depth they stand at.
+    std::map<std::string, std::pair<std::size_t, int>> labels;
+    int depth = 0;
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      std::smatch m;
+      if (std::regex_match(lines[k], m, kIf)) ++depth;
+      if (lines[k] == "ENDIF") --depth;
+      if (std::regex_match(lines[k], m, kLabel) &&
+          !labels.emplace(m[1].str(), std::pair{k, depth}).second)
+        ADD_FAILURE() << "label " << m[1] << " defined twice";
+    }
     std::vector<bool> skipping;
-    bool ended = false;
-    while (std::getline(in, line)) {
+    bool ended = false, raised = false;
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      const std::string& line = lines[k];
       EXPECT_FALSE(ended) << "text after M17: " << line;
       std::smatch m;
       const bool skip = !skipping.empty() && skipping.back();
+      std::string jump_to;
       if (line == "ENDIF") {
         EXPECT_FALSE(skipping.empty()) << "ENDIF without IF";
         if (!skipping.empty()) skipping.pop_back();
       } else if (std::regex_match(line, m, kIf)) {
         skipping.push_back(skip || !Compare(ProgramValue(m[1]), m[2], std::stod(m[3])));
-      } else if (skip || (!line.empty() && line[0] == ';') || line == "STOPRE") {
+      } else if (skip || (!line.empty() && line[0] == ';') || line == "STOPRE" ||
+                 std::regex_match(line, m, kLabel)) {
+      } else if (std::regex_match(line, m, kIfJump)) {
+        if (Compare(ProgramValue(m[1]), m[2], std::stod(m[3]))) jump_to = m[4];
+      } else if (std::regex_match(line, m, kJump)) {
+        jump_to = m[1];
       } else if (std::regex_match(line, m, kDwell)) {  // the main run goes on: one cycle
         Cycle(axis_mm);
         if (between_blocks) between_blocks();
@@ -261,7 +295,8 @@ struct Replay {
         ended = true;
       } else if (std::regex_match(line, m, kSetal)) {
         control.alarm = std::stoi(m[1]);
-        return false;  // a cycle alarm stops the program
+        control.alarms.push_back(control.alarm);
+        raised = true;  // and on: the alarm is assumed not to stop the interpreter
       } else if (std::regex_match(line, m, kCancel)) {
         actions.erase(std::stoi(m[1]));
       } else if (std::regex_match(line, m, kSync)) {
@@ -282,10 +317,19 @@ struct Replay {
       } else {
         ADD_FAILURE() << "line the replay does not understand: '" << line << "'";
       }
+      if (jump_to.empty()) continue;
+      const auto it = labels.find(jump_to);
+      if (it == labels.end() || it->second.first <= k || it->second.second != 0 ||
+          !skipping.empty()) {
+        ADD_FAILURE() << "jump '" << line << "': the label must exist, lie ahead and outside "
+                      << "every IF block, and the jump must not leave one";
+        return false;
+      }
+      k = it->second.first;  // the label line itself does nothing
     }
     EXPECT_TRUE(ended) << "no M17";
     EXPECT_TRUE(skipping.empty()) << "IF without ENDIF";
-    return true;
+    return !raised;
   }
 
   // One interpolation cycle with the axis at p_mm: every action in ID order.

@@ -9,6 +9,8 @@
 #include <functional>
 #include <random>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -24,9 +26,9 @@ namespace {
 constexpr double kCycleMs = 50.0;
 
 // A hand-made model: two sensors, lags of 0.02 and 0.1 min (a few hundred cycles of 50 ms, so
-// the lag recursion is exercised), coefficients of a typical size (um per K).
-drift::DriftModel HandModel(bool lags, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-8.0, 8.0);
+// the lag recursion is exercised), the given coefficients (intercept um, then um per K for each
+// sensor's direct rise and its lags, sensor by sensor).
+drift::DriftModel HandModel(bool lags, const std::vector<double>& coefficients) {
   drift::DriftModel m;
   m.kind = lags ? drift::ModelKind::kDynamic : drift::ModelKind::kMlr;
   m.error_column = "ch1_um";
@@ -40,11 +42,21 @@ drift::DriftModel HandModel(bool lags, std::mt19937& rng) {
   const auto nf = static_cast<Eigen::Index>(m.features.size());
   m.feature_min = Eigen::VectorXd::Constant(nf, -5);
   m.feature_max = Eigen::VectorXd::Constant(nf, 5);
-  m.linear.coefficients = Eigen::VectorXd(nf + 1);
-  for (Eigen::Index i = 0; i <= nf; ++i) m.linear.coefficients(i) = u(rng);
+  if (static_cast<Eigen::Index>(coefficients.size()) != nf + 1)
+    throw std::invalid_argument("HandModel: coefficient count");
+  m.linear.coefficients = Eigen::Map<const Eigen::VectorXd>(coefficients.data(), nf + 1);
   m.linear.covariance = Eigen::MatrixXd::Identity(nf + 1, nf + 1) * 0.01;
   m.Validate();
   return m;
+}
+
+// The same with coefficients of a typical size (um per K) drawn uniformly within +-8 (for the
+// replay tests, which compare with the model itself; the golden files use fixed coefficients).
+drift::DriftModel HandModel(bool lags, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-8.0, 8.0);
+  std::vector<double> c(lags ? 7 : 3);
+  for (double& v : c) v = u(rng);
+  return HandModel(lags, c);
 }
 
 DriftActionOptions Options(ControlDk control, int error_direction, DriftReference ref) {
@@ -173,10 +185,9 @@ TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
 }
 
 // The slope channel of a screw growing from its fixed end: um per 1000 mm, from two sensors.
-drift::DriftModel SlopeModel(std::mt19937& rng) {
-  drift::DriftModel g = HandModel(false, rng);
+drift::DriftModel SlopeModel() {
+  drift::DriftModel g = HandModel(false, {0.8, 11.5, -3.0});  // ~ 11.5 um per metre per K
   g.error_column = "zscrew_per_1000_um";
-  g.linear.coefficients = Eigen::Vector3d(0.8, 11.5, -3.0);  // ~ 11.5 um per metre per K
   return g;
 }
 
@@ -194,7 +205,7 @@ TEST(DriftAction, SlopeModeWritesTheMachineLineAboutTheFixedEnd) {
   for (auto control : {ControlDk::kAdded, ControlDk::kSubtracted})
     for (int dir : {1, -1})
       for (int sigma : {1, -1}) {
-        const drift::DriftModel m = HandModel(true, rng), g = SlopeModel(rng);
+        const drift::DriftModel m = HandModel(true, rng), g = SlopeModel();
         const DriftActionOptions o = SlopeOptions(control, dir, sigma);
         replay::Replay r;
         r.control.abs_value_mm = 0.0021;  // found values
@@ -231,7 +242,7 @@ TEST(DriftAction, SlopeModeWritesTheMachineLineAboutTheFixedEnd) {
 // control applies workpiece plan + machine line at every position of the cut.
 TEST(DriftAction, SlopeHandedOverTheSumOfBothLinesHoldsEverywhere) {
   std::mt19937 rng(1811);
-  const drift::DriftModel m = HandModel(true, rng), g = SlopeModel(rng);
+  const drift::DriftModel m = HandModel(true, rng), g = SlopeModel();
   DriftActionOptions d = SlopeOptions(ControlDk::kAdded, -1, -1);
   d.workpiece_k0_param = 99;
   d.workpiece_slope_param = 97;
@@ -306,7 +317,7 @@ TEST(DriftAction, CombinedTheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
   for (int direction : {1, -1})
     for (bool slope_handed_over : {false, true})
       for (double before_mm : {1.0, 2000.0}) {
-        const drift::DriftModel m = HandModel(true, rng), g = SlopeModel(rng);
+        const drift::DriftModel m = HandModel(true, rng), g = SlopeModel();
         DriftActionOptions d = SlopeOptions(ControlDk::kAdded, direction, direction);
         d.workpiece_k0_param = 99;
         if (slope_handed_over) d.workpiece_slope_param = 97;
@@ -317,6 +328,7 @@ TEST(DriftAction, CombinedTheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
         p.machine_offset_mm = -812.5;
         p.sync_id_first = 100;
         p.sync_id_last = 140;
+        p.save_r_first = 90;
         p.workpiece_k0_param = 99;
         p.workpiece_slope_param = d.workpiece_slope_param;
         p.drift_alive_param = d.param_first;
@@ -421,7 +433,7 @@ TEST(DriftAction, LivenessNotMarkersDecideWhoMayWrite) {
 // A program without a slope gives back the slope an aborted slope run left behind.
 TEST(DriftAction, OffsetOnlyProgramGivesBackAnAbandonedSlope) {
   std::mt19937 rng(1812);
-  const drift::DriftModel m = HandModel(false, rng), g = SlopeModel(rng);
+  const drift::DriftModel m = HandModel(false, rng), g = SlopeModel();
   const DriftActionOptions o = SlopeOptions(ControlDk::kAdded, 1, 1);
   replay::Replay r;
   r.control.slope = 2e-6;
@@ -454,7 +466,7 @@ TEST(DriftAction, RefusesWhatTheControlCannotRun) {
                InputError);  // lags in samples
   // Slope models: without the profile's slope object; with a plan that keeps SD43910 itself;
   // the plan's slope slots inside the action's own.
-  const drift::DriftModel g = SlopeModel(rng);
+  const drift::DriftModel g = SlopeModel();
   m = HandModel(false, rng);
   o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
   EXPECT_THROW(FormatDriftNcProgram(m, o, "", &g), InputError);
@@ -539,17 +551,19 @@ TEST(DriftAction, HostileNamesStayInsideCommentsAndCells) {
 }
 
 TEST(DriftAction, GoldenProgramAndPlcTable) {
-  std::mt19937 rng(1807);
-  const drift::DriftModel m = HandModel(true, rng);
+  // Fixed coefficients (the file pins the text, so no value may depend on a standard library's
+  // random distributions): intercept, then t1_C direct and lagged, t2_C likewise.
+  const drift::DriftModel m = HandModel(true, {1.25, 3.5, -0.75, 0.4, -2.2, 0.9, 1.6});
   DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kStart);
   o.workpiece_k0_param = 99;
+  o.plan_marker_r = 93;  // the start check for a plan left active, and its jump to the end
   const std::string nc = FormatDriftNcProgram(m, o, "golden model") + FormatDriftNcResetProgram(o) +
                          FormatDriftPlcCsv(m, o);
   const std::string path = std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action.spf";
   if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path, nc);
   EXPECT_EQ(nc, ReadTextFile(path)) << "actual:\n" << nc;
   // With the machine's slope, handed over by the plan.
-  const drift::DriftModel g = SlopeModel(rng);
+  const drift::DriftModel g = SlopeModel();
   DriftActionOptions os = SlopeOptions(ControlDk::kAdded, -1, -1);
   os.workpiece_k0_param = 99;
   os.workpiece_slope_param = 97;

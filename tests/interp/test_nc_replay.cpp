@@ -9,8 +9,10 @@
 
 #include "core/error.h"
 #include "fit/arctan_curve.h"
+#include "interp/drift_action.h"
 #include "interp/machine_profile.h"
 #include "interp/nc_replay.h"
+#include "interp/profile_uses.h"
 #include "interp/sinumerik.h"
 
 namespace whirl::interp {
@@ -80,6 +82,26 @@ void ExpectUnchanged(const replay::Control& now, const replay::Control& before) 
   EXPECT_EQ(now.abs_value_mm, before.abs_value_mm);
   EXPECT_EQ(now.slope, before.slope);
   EXPECT_EQ(now.ref_position_mm, before.ref_position_mm);
+}
+
+// Setting data, R parameters, $AC_PARAM and every synchronized action (ID, kind, condition,
+// writes) exactly as before.
+void ExpectControlAsFound(const replay::Replay& now, const replay::Replay& before) {
+  ExpectUnchanged(now.control, before.control);
+  EXPECT_EQ(now.control.r, before.control.r) << "R parameters";
+  EXPECT_EQ(now.control.ac_param, before.control.ac_param) << "$AC_PARAM";
+  ASSERT_EQ(now.actions.size(), before.actions.size()) << "an action added or cancelled";
+  for (const auto& [id, a] : before.actions) {
+    const auto it = now.actions.find(id);
+    ASSERT_NE(it, now.actions.end()) << "ID " << id << " cancelled";
+    const replay::SyncAction& b = it->second;
+    EXPECT_TRUE(b.is_static == a.is_static && b.mode == a.mode && b.lhs == a.lhs &&
+                b.op == a.op && b.rhs == a.rhs && b.writes.size() == a.writes.size())
+        << "ID " << id << " redefined";
+    for (std::size_t k = 0; k < a.writes.size() && k < b.writes.size(); ++k)
+      EXPECT_TRUE(b.writes[k].target == a.writes[k].target && b.writes[k].expr == a.writes[k].expr)
+          << "ID " << id << " redefined";
+  }
 }
 
 TEST(NcReplay, CompensationFollowsTheCurveAndTheControlEndsAsFound) {
@@ -198,13 +220,10 @@ TEST(NcReplay, CalledWithTheAxisPastTheFirstTriggerRefusesAndChangesNothing) {
       r.axis_mm = past[k];
       if (k % 2) r.control.r[o.save_r_first + 3] = 1;  // also after an aborted run
       const replay::Replay before = r;
+      // The replay goes on after SETAL: the program's own jump keeps the control as found.
       EXPECT_FALSE(r.RunProgram(nc)) << "started at " << past[k];
-      EXPECT_EQ(r.control.alarm, o.start_alarm);
-      ExpectUnchanged(r.control, before.control);
-      EXPECT_EQ(r.control.r, before.control.r) << "R parameters";
-      EXPECT_EQ(r.control.ac_param, before.control.ac_param);
-      ASSERT_EQ(r.actions.size(), before.actions.size()) << "an action added or cancelled";
-      for (const auto& [id, a] : before.actions) EXPECT_EQ(r.actions.count(id), 1u) << id;
+      EXPECT_EQ(r.control.alarms, std::vector<int>{o.start_alarm});
+      ExpectControlAsFound(r, before);
     }
     // A hair before the thread start the program runs, and no action fires before the axis moves.
     replay::Replay r = FoundState(o, rng);
@@ -260,6 +279,96 @@ TEST(NcReplay, TheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
   }
   EXPECT_GT(seen[0], 3);
   EXPECT_GT(seen[1], 3);
+}
+
+// Every start check that fails (axis at or past the thread start, the drift action missing,
+// running beside a plan that writes the setting data itself or in the other mode, a plan's own
+// compensation still active when the drift program starts) raises exactly its alarm and leaves
+// the control exactly as found: setting data, R parameters, $AC_PARAM and every action. The
+// replay does not stop at SETAL (a display-only alarm does not), so this is the programs' own
+// jump to their end at work. Both shipped profiles (offset only, and slope handed over).
+TEST(NcReplay, EveryFailedStartCheckJumpsToTheEndAndChangesNothing) {
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({30.0, 250.0}, 4.0, 0.9);
+  for (const char* file : {"example_840d.json", "whirling_840d.json"}) {
+    SCOPED_TRACE(file);
+    const MachineProfile profile =
+        LoadMachineProfile(std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/" + file);
+    const DriftActionOptions d = profile.DriftOptions();
+    const std::string sensor = d.inputs.begin()->first;
+    const drift::DriftModel m = testing::OneSensorModel(sensor, "offset_um");
+    const drift::DriftModel g = testing::OneSensorModel(sensor, "zscrew_per_1000_um");
+    PlanOptions plain, combined;
+    profile.ApplyTo(plain);
+    profile.ApplyCombinedTo(combined);
+    const CompensationPlan plain_plan = BuildPlan(curve, 0.6, 1200.0, plain);
+    const CompensationPlan combined_plan = BuildPlan(curve, 0.6, 1200.0, combined);
+    // The drift program in the mode the combined plan expects (2 with the slope handed over,
+    // else 1), and in the other one.
+    const bool handover = combined.workpiece_slope_param >= 0;
+    DriftActionOptions other = d;
+    other.workpiece_slope_param = handover ? -1 : d.workpiece_k0_param - 2;  // the 2 slots below
+    const std::string drift_expected = handover ? FormatDriftNcProgram(m, d, "", &g)
+                                                : FormatDriftNcProgram(m, d);
+    const std::string drift_other_mode = FormatDriftNcProgram(m, other);
+    const double before_start = Park(plain, 10.0), past_start = Park(plain, -100.0);
+    const int a = d.missing_alarm;
+    struct Case {
+      std::string what;
+      std::string running;  // the drift program already running ("" none)
+      double axis_mm;
+      bool plan_active;  // a plan's own compensation left active (its marker R = 1)
+      std::string program;
+      int alarm;
+    };
+    std::vector<Case> cases = {
+        {"plain plan, axis past the start", "", past_start, false, FormatNcProgram(plain_plan),
+         plain.start_alarm},
+        {"combined plan, axis past the start", drift_expected, past_start, false,
+         FormatNcProgram(combined_plan), combined.start_alarm},
+        {"plain plan beside a running drift action", drift_expected, before_start, false,
+         FormatNcProgram(plain_plan), a + 1},
+        {"combined plan without the drift action", "", before_start, false,
+         FormatNcProgram(combined_plan), a},
+        {"drift program, a plan's compensation active", "", before_start, true,
+         FormatDriftNcProgram(m, d), a + 3},
+        {"combined plan, drift action in the other mode", drift_other_mode, before_start, false,
+         FormatNcProgram(combined_plan), a + 2}};
+    for (const Case& c : cases) {
+      SCOPED_TRACE(c.what);
+      replay::Replay r;
+      r.axis = profile.axis;
+      r.axis_mm = c.axis_mm;
+      r.control.abs_value_mm = 0.0031;  // found values
+      r.control.slope = -2e-6;
+      r.control.ref_position_mm = 250.0;
+      for (int k = 0; k < 4; ++k) r.control.r[profile.save_r_first + k] = 11.0 + k;
+      for (int k = 0; k < 5; ++k) r.control.r[d.save_r_first + k] = 21.0 + k;
+      r.control.r[profile.save_r_first + 3] = c.plan_active ? 1 : 0;
+      r.control.r[d.save_r_first + 1] = r.control.r[d.save_r_first + 4] = 0;
+      r.control.ain[d.inputs.at(sensor).index] = 230.0;
+      r.control.ac_param[d.param_first] = 0;  // the liveness slot: no action has written it
+      if (!c.running.empty()) {
+        ASSERT_TRUE(r.RunProgram(c.running)) << "alarm " << r.control.alarm;
+        r.EndProgram();
+      }
+      for (int id : {profile.sync_id_last, d.sync_id_last}) {  // leftovers in whirl's ranges
+        replay::SyncAction stale;
+        stale.id = id;
+        stale.is_static = true;
+        stale.writes = {{"P" + std::to_string(d.param_last), "7"}};
+        r.actions[id] = stale;
+      }
+      for (int k = 0; k < 3; ++k) r.Cycle(c.axis_mm);  // a running action at its steady state
+      const replay::Replay before = r;
+      r.control.alarms.clear();
+      EXPECT_FALSE(r.RunProgram(c.program));
+      EXPECT_EQ(r.control.alarms, std::vector<int>{c.alarm}) << "exactly its own alarm";
+      r.Cycle(c.axis_mm);
+      replay::Replay expected = before;
+      expected.Cycle(c.axis_mm);  // what the running actions write in that cycle anyway
+      ExpectControlAsFound(r, expected);
+    }
+  }
 }
 
 // A profile's reserved range: with the machine builder's actions on every other ID 1..255, the

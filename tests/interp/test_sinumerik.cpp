@@ -8,6 +8,7 @@
 #include <random>
 #include <regex>
 #include <sstream>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
@@ -45,6 +46,7 @@ Case RandomCase(std::mt19937& rng) {
   c.options.md32760 = kMd32760Max;  // random feeds and curves reach slopes up to ~0.04
   c.options.sync_id_first = 1;      // the whole range: enough for the tightest random tolerance
   c.options.sync_id_last = 255;
+  c.options.save_r_first = 90;
   return c;
 }
 
@@ -357,23 +359,47 @@ TEST(Sinumerik, NcProgramValuesReconstructTheCompensation) {
 
 // The program cancels every ID of its range: without a range stated by the machine builder (a
 // profile or explicit flags) there is no program, never a default 1..255.
-TEST(Sinumerik, NcProgramsNeedTheReservedIdRange) {
-  CompensationPlan plan = SmallPlan();
-  plan.options.sync_id_first = plan.options.sync_id_last = 0;
-  EXPECT_NO_THROW(plan.options.Validate()) << "a plan without IDs can be built and checked";
+// Both programs of `plan` are refused with a message holding every one of `words`.
+void ExpectBothProgramsRefused(const CompensationPlan& plan, const std::vector<std::string>& words) {
   using Make = std::function<std::string()>;
   for (const Make& make : {Make([&] { return FormatNcProgram(plan); }),
                            Make([&] { return FormatNcResetProgram(plan.options); })}) {
     try {
       make();
-      ADD_FAILURE() << "NC program written without a reserved ID range";
+      ADD_FAILURE() << "NC program written; expected a refusal naming " << words.front();
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("no synchronized-action IDs"), std::string::npos)
-          << e.what();
+      for (const std::string& w : words)
+        EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(Sinumerik, NcProgramsNeedTheReservedIdRange) {
+  CompensationPlan plan = SmallPlan();
+  plan.options.sync_id_first = plan.options.sync_id_last = 0;
+  EXPECT_NO_THROW(plan.options.Validate()) << "a plan without IDs can be built and checked";
+  ExpectBothProgramsRefused(plan, {"no synchronized-action IDs"});
   EXPECT_EQ(PlanOptions{}.sync_id_first, 0) << "no default range";
   EXPECT_EQ(PlanOptions{}.sync_id_last, 0);
+}
+
+// The program saves what it finds in R<n>..R<n+3>, the user's R parameters: without a number
+// stated by the machine builder (a profile or an explicit flag) there is no program, never a
+// default R90..R93. A plan that hands its slope to the drift action saves nothing and needs none.
+TEST(Sinumerik, NcProgramsNeedTheReservedRParameters) {
+  EXPECT_EQ(PlanOptions{}.save_r_first, -1) << "no default R parameters";
+  CompensationPlan plan = SmallPlan();
+  plan.options.save_r_first = -1;
+  EXPECT_NO_THROW(plan.options.Validate()) << "a plan without R parameters can be built";
+  ExpectBothProgramsRefused(plan, {"no R parameters", "--save-r-first"});
+  plan.options.workpiece_k0_param = 99;  // K0 handed over, the slope kept: still saves it
+  plan.options.drift_alive_param = 100;
+  EXPECT_THROW(FormatNcProgram(plan), InputError);
+  plan.options.workpiece_slope_param = 97;  // everything handed over: no R parameter used
+  const std::string nc = FormatNcProgram(plan) + FormatNcResetProgram(plan.options);
+  EXPECT_EQ(std::regex_search(nc, std::regex(R"((^|[^A-Z_])\$?R\d)")), false) << nc;
+  plan.options.save_r_first = 9997;
+  EXPECT_THROW(plan.options.Validate(), InputError);
 }
 
 TEST(Sinumerik, ProgramNamesAreTheFileStemsAndSinumerikNames) {

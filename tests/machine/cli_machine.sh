@@ -81,6 +81,9 @@ expect_fail "drift.slope" "$W" drift nc --model "$D/offset.json" --slope-model "
 for f in WHIRL_TEMP_COMP.SPF WHIRL_DRIFT_COMP.SPF WHIRL_DRIFT_COMP_RESET.SPF index.html; do
   [ -f "$D/report/$f" ] || fail "report lacks $f"
 done
+# The page quotes the drift action's output action: one IDS line, nothing after it (a label).
+grep -q "output:</p><pre>IDS=[0-9]* [^<]*</pre>" "$D/report/index.html" \
+  || fail "report: the drift action's output action is not one IDS line"
 # The screw's own sensor log is a drift run file: a machine model evaluates on it.
 "$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \
   2>/dev/null || fail "drift predict on the screw's log"

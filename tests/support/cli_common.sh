@@ -7,3 +7,9 @@ expect_fail() {  # expect_fail <pattern> <command...>: exit code 1 and 'error:' 
   grep -q "error" "$D/err.txt" || fail "no error message: $*"
   grep -qi -- "$pattern" "$D/err.txt" || fail "message lacks '$pattern': $(cat "$D/err.txt")"
 }
+expect_jumps_to_end() {  # expect_jumps_to_end <file>: an NC program whose every SETAL is followed
+  # by "GOTOF WHIRL_END", the label just before its M17 (it changes nothing after a failed check)
+  awk '/^SETAL\(/ { n++; if ((getline next_line) <= 0 || next_line != "GOTOF WHIRL_END") bad = 1 }
+       END { exit (bad || n == 0) }' "$1" || fail "$1: a SETAL not followed by GOTOF WHIRL_END"
+  [ "$(tail -n 2 "$1" | tr '\n' ' ')" = "WHIRL_END: M17 " ] || fail "$1: no WHIRL_END: before M17"
+}
