@@ -45,11 +45,11 @@ void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_require
                     ->check(CLI::ExistingFile);
   if (screw_required) screw->required();
   sub->add_option("--max-elongation", a->max_elongation_um,
-                  "instead of --model: plateau elongation L [um], 0..10000")
-      ->check(NonNegativeNumber("um"));
+                  "instead of --model: plateau elongation L [um]")
+      ->check(NumberIn(0, kMaxElongationUm, "um"));
   sub->add_option("--settle-time", a->settle_time_s,
-                  "instead of --model: settle time t_s [s], 1..1e6")
-      ->check(PositiveNumber("s"));
+                  "instead of --model: settle time t_s [s]")
+      ->check(NumberIn(kMinPlanSettleTimeS, kMaxSettleTimeS, "s"));
   AddCurveShapeOptions(sub, &a->shape_k, &a->time_exponent);
   sub->add_flag("--allow-extrapolation", a->allow_extrapolation,
                 "use the prediction even if the screw lies outside the model's training domain");
@@ -68,12 +68,28 @@ CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string
   return sub->add_option(flag, *seed, help)->check(CLI::Validator(rule, "[0, 2^64-1]"));
 }
 
+namespace {
+
+// "[0.001, 10000]"; without an upper bound "> 0" or ">= 0"; "" for any finite number.
+std::string Bounds(const Range& range) {
+  constexpr double kLargest = std::numeric_limits<double>::max();
+  if (range.max < kLargest)
+    return std::string(range.min_open ? "(" : "[") + MessageNumber(range.min) + ", " +
+           MessageNumber(range.max) + "]";
+  if (range.min > -kLargest)
+    return std::string(range.min_open ? "> " : ">= ") + MessageNumber(range.min);
+  return "";
+}
+
+}  // namespace
+
 CLI::Validator NumberIn(const Range& range) {
-  std::string text = std::string(range.min_open ? "(" : "[") + MessageNumber(range.min) + ", " +
-                     MessageNumber(range.max) + "]";
-  if (*range.unit) text += std::string(" ") + range.unit;
-  const std::string rule =
-      "a finite number in " + text + (*range.note ? std::string(" (") + range.note + ")" : "");
+  const std::string bounds = Bounds(range);
+  const std::string unit = *range.unit ? std::string(" ") + range.unit : "";
+  const std::string text = (bounds.empty() ? "finite" : bounds) + unit;  // shown in --help
+  const std::string rule = "a finite number" +
+                           (bounds.empty() ? "" : (bounds[0] == '>' ? " " : " in ") + bounds) +
+                           unit + (*range.note ? std::string(" (") + range.note + ")" : "");
   const auto check = [range, rule](std::string& value) -> std::string {
     const auto x = ParseDecimal(value);
     if (x && range.Contains(*x)) return "";

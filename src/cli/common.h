@@ -72,7 +72,8 @@ CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string
 /// names the flag in front of the message: "--tolerance-um: 1e-09 breaks the rule: a finite
 /// number in [0.001, 10000] um (...)", the value and the range written as in every message
 /// (MessageNumber). A whole-number flag also needs its text to convert, which CLI11 checks after.
-/// The range shows in --help after the type ("FLOAT:[0.001, 10000] um").
+/// The range shows in --help after the type: "FLOAT:[0.001, 10000] um", "FLOAT:> 0 s" (no upper
+/// bound), "FLOAT:finite".
 CLI::Validator NumberIn(const Range& range);
 /// NumberIn of the closed range [min, max] with `unit` ("" for counts and ratios).
 CLI::Validator NumberIn(double min, double max, const char* unit = "");

@@ -36,7 +36,7 @@ check_flag() {  # check_flag <flag> <command words...>
 # Numeric option lines of "$@" --help without a range or a list after the type.
 without_range() {
   "$@" --help | grep -E -- '^ +(-[a-zA-Z],)?--[a-z0-9-]+ +(FLOAT|INT|UINT)([: ]|$)' |
-    grep -vE -- '(FLOAT|INT|UINT):[[({]'
+    grep -vE -- '(FLOAT|INT|UINT):([[({]|>=? |finite)'
 }
 
 walk() {  # walk <command words...>: checks the command's flags, then its subcommands'
