@@ -111,15 +111,9 @@ void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
                "train --hidden N --out MODEL.json'.\n";
 }
 
-void Run(const TrainCliOptions& o) {
-  CheckOutputs({{"--data", o.data_path}}, {{"--out", o.out_path}});
-  const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
-  if (!o.hidden_sweep.empty()) {
-    RunSweep(o, table);
-    return;
-  }
-  if (o.out_path.empty())
-    throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
+// The library's training options for the command's flags (the default training, or MATLAB's
+// trainbr with --trainbr-matlab); flags that exclude each other are refused.
+nn::ModelTrainOptions ModelOptions(const TrainCliOptions& o) {
   if (o.trainbr_matlab && o.change >= 0)
     throw InputError("train: --trainbr-matlab is MATLAB's trainbr as it is; it excludes --change");
   nn::ModelTrainOptions opt =
@@ -143,6 +137,62 @@ void Run(const TrainCliOptions& o) {
   if (o.trainbr_matlab && o.ard)
     throw InputError("train: --trainbr-matlab is MATLAB's trainbr as it is; it excludes --ard");
   opt.train.ard = o.ard;
+  return opt;
+}
+
+// The human summary on stdout: the network, the training summary, the choices and, with ARD or
+// restarts, their figures.
+void PrintModelSummary(const TrainCliOptions& o, const nn::Model& model, std::size_t rows,
+                       double fit_ms) {
+  const auto& s = model.training_summary;
+  std::string sizes;
+  for (int n : model.network.layer_sizes) sizes += (sizes.empty() ? "" : "-") + std::to_string(n);
+  std::cout << "model " << o.out_path << ": network " << sizes << " ("
+            << (model.network.LayerCount() == 1 ? "no hidden layer, linear; " : "")
+            << "N = " << s.parameter_count << " weights and biases), " << rows << " samples from "
+            << o.data_path << "\n";
+  std::cout << "  " << s.BriefReport() << "\n";
+  std::cout << "  hidden layer: " << model.hidden_selection << "\n";
+  std::cout << "  stopping: " << model.stopping << "\n";
+  std::cout << "  fit time " << FormatSignificant(fit_ms, 4)
+            << " ms (hidden-size choice, training, noise calibration)\n";
+  std::cout << "  RMS training error: max_elongation " << FormatSignificant(s.rms_error(0), 4)
+            << " um, settle_time " << FormatSignificant(s.rms_error(1), 4) << " s (normalized ssE "
+            << FormatSignificant(s.sse, 4) << ")\n";
+  std::cout << "  gamma " << FormatSignificant(s.gamma, 4) << " of " << s.parameter_count
+            << ", alpha " << FormatSignificant(s.alpha, 4) << ", beta "
+            << FormatSignificant(s.beta, 4) << ", sum of squared weights "
+            << FormatSignificant(s.sum_squared_weights, 4) << ", log evidence "
+            << FormatSignificant(s.log_evidence, 6) << "\n";
+  if (s.ard_alpha.size() == ProcessInputs::kCount + 1) {
+    std::cout << "  ARD alpha per input (larger = less relevant; normalized units):";
+    for (int i = 0; i < ProcessInputs::kCount; ++i)
+      std::cout << (i ? ", " : " ") << kInputColumns[i] << " "
+                << FormatSignificant(s.ard_alpha(i), 4);
+    std::cout << "; other weights " << FormatSignificant(s.ard_alpha(ProcessInputs::kCount), 4)
+              << "\n";
+  }
+  if (model.restarts > 1) {
+    std::cout << "  restarts (best log evidence kept):\n";
+    for (const auto& r : model.restart_runs)
+      std::cout << "    seed " << r.seed << ": log evidence "
+                << FormatSignificant(r.log_evidence, 6) << ", ssE " << FormatSignificant(r.sse, 4)
+                << ", gamma " << FormatSignificant(r.gamma, 4) << ", " << r.epochs << " epochs, "
+                << nn::ToString(r.termination) << (r.seed == model.init_seed ? "  <- kept" : "")
+                << "\n";
+  }
+}
+
+void Run(const TrainCliOptions& o) {
+  CheckOutputs({{"--data", o.data_path}}, {{"--out", o.out_path}});
+  const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
+  if (!o.hidden_sweep.empty()) {
+    RunSweep(o, table);
+    return;
+  }
+  if (o.out_path.empty())
+    throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
+  const nn::ModelTrainOptions opt = ModelOptions(o);
   const auto start = std::chrono::steady_clock::now();
   // At most epochs per stage and restart (ARD adds a second stage). Restarts run in parallel and
   // report out of order (one at a time: TrainBrRestarts serializes the callback), so the bar
@@ -179,68 +229,36 @@ void Run(const TrainCliOptions& o) {
                {"stopping", model.stopping},
                {"hidden_selection", model.hidden_selection},
                {"fit_time_ms", fit_ms},
-               {"warnings", flat.empty() ? nlohmann::json::array()
-                                         : nlohmann::json::array({flat_warning})},
+               {"warnings",
+                flat.empty() ? nlohmann::json::array() : nlohmann::json::array({flat_warning})},
                {"training_summary", s}});
     return;
   }
-  std::string sizes;
-  for (int n : model.network.layer_sizes) sizes += (sizes.empty() ? "" : "-") + std::to_string(n);
-  std::cout << "model " << o.out_path << ": network " << sizes << " ("
-            << (model.network.LayerCount() == 1 ? "no hidden layer, linear; " : "")
-            << "N = " << s.parameter_count << " weights and biases), " << table.inputs.size()
-            << " samples from " << o.data_path << "\n";
-  std::cout << "  " << s.BriefReport() << "\n";
-  std::cout << "  hidden layer: " << model.hidden_selection << "\n";
-  std::cout << "  stopping: " << model.stopping << "\n";
-  std::cout << "  fit time " << FormatSignificant(fit_ms, 4)
-            << " ms (hidden-size choice, training, noise calibration)\n";
-  std::cout << "  RMS training error: max_elongation " << FormatSignificant(s.rms_error(0), 4)
-            << " um, settle_time " << FormatSignificant(s.rms_error(1), 4) << " s (normalized ssE "
-            << FormatSignificant(s.sse, 4) << ")\n";
-  std::cout << "  gamma " << FormatSignificant(s.gamma, 4) << " of " << s.parameter_count
-            << ", alpha " << FormatSignificant(s.alpha, 4) << ", beta "
-            << FormatSignificant(s.beta, 4) << ", sum of squared weights "
-            << FormatSignificant(s.sum_squared_weights, 4) << ", log evidence "
-            << FormatSignificant(s.log_evidence, 6) << "\n";
-  if (s.ard_alpha.size() == ProcessInputs::kCount + 1) {
-    std::cout << "  ARD alpha per input (larger = less relevant; normalized units):";
-    for (int i = 0; i < ProcessInputs::kCount; ++i)
-      std::cout << (i ? ", " : " ") << kInputColumns[i] << " "
-                << FormatSignificant(s.ard_alpha(i), 4);
-    std::cout << "; other weights " << FormatSignificant(s.ard_alpha(ProcessInputs::kCount), 4)
-              << "\n";
-  }
-  if (model.restarts > 1) {
-    std::cout << "  restarts (best log evidence kept):\n";
-    for (const auto& r : model.restart_runs)
-      std::cout << "    seed " << r.seed << ": log evidence "
-                << FormatSignificant(r.log_evidence, 6) << ", ssE " << FormatSignificant(r.sse, 4)
-                << ", gamma " << FormatSignificant(r.gamma, 4) << ", " << r.epochs << " epochs, "
-                << nn::ToString(r.termination) << (r.seed == model.init_seed ? "  <- kept" : "")
-                << "\n";
-  }
+  PrintModelSummary(o, model, table.inputs.size(), fit_ms);
+}
+
+// The subcommand's description in --help: what it trains, the default, the table's columns.
+std::string TrainDescription() {
+  return "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
+         "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
+         "on a process table and write a model file (JSON), or sweep the hidden size.\n"
+         "Default (issue 12): no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
+         "highest log evidence, each fit stopped by R brnn's rule (--change 0.001),\n"
+         "per-output noise by 5-fold cross-validation; about 10 ms for 20 rows, 70 ms for\n"
+         "100 rows (one thread). A warning says when the network ignores its inputs.\n"
+         "--trainbr-matlab: the paper's 5-6-2 trained to MATLAB's own criteria.\n"
+         "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
+         "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
+         "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
+         "Progress goes to stderr, results to stdout. Exit code 0 only on success.\n" +
+         ProcessLimitsHelp();
 }
 
 }  // namespace
 
 void RegisterTrain(CLI::App& app) {
   auto o = std::make_shared<TrainCliOptions>();
-  auto* sub = app.add_subcommand(
-      "train",
-      "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
-      "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
-      "on a process table and write a model file (JSON), or sweep the hidden size.\n"
-      "Default (issue 12): no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
-      "highest log evidence, each fit stopped by R brnn's rule (--change 0.001),\n"
-      "per-output noise by 5-fold cross-validation; about 10 ms for 20 rows, 70 ms for\n"
-      "100 rows (one thread). A warning says when the network ignores its inputs.\n"
-      "--trainbr-matlab: the paper's 5-6-2 trained to MATLAB's own criteria.\n"
-      "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
-      "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
-      "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
-      "Progress goes to stderr, results to stdout. Exit code 0 only on success.\n" +
-          ProcessLimitsHelp());
+  auto* sub = app.add_subcommand("train", TrainDescription());
   sub->add_option("--data", o->data_path, "training table (CSV, see above)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -88,27 +88,22 @@ sim::Screw NewTypeScrew(const sim::Screw& reference) {
   return ScrewWithInputs(reference, in, "new-type_63x12x6000");
 }
 
-ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
-                             const ExperienceRule& rule, const IsoToleranceTable& iso_table,
-                             const CompareOptions& options) {
-  ScrewComparison c;
-  c.screw = screw;
-  c.kinematics = sim::ComputeKinematics(screw);  // validates; InputError if infeasible
-  c.seed = options.seed;
-  c.disturbances_on = options.disturbances_on;
+namespace {
 
-  // Truth: the whole thread, disturbances on.
+// The truth of the comparison: the whole thread simulated with the comparison's disturbances (its
+// noise-free curve), and the features as the training table measures them.
+void SimulateTruth(const sim::Screw& screw, const CompareOptions& options, ScrewComparison* c) {
   sim::SimOptions sim_options = options.sim;
   sim_options.duration_s = 0.0;
   sim::DisturbanceOptions disturbance = options.disturbance;
   disturbance.enabled = options.disturbances_on;
   disturbance.seed = options.seed;
   const sim::SimulationResult sim = sim::Simulate(screw, sim_options, disturbance);
-  c.disturbances = sim.disturbances;
-  c.truth.time_s = sim.curve.time_s;
-  c.truth.elongation_um = sim.elongation_noise_free_um.size() == sim.curve.size()
-                              ? sim.elongation_noise_free_um
-                              : sim.curve.elongation_um;
+  c->disturbances = sim.disturbances;
+  c->truth.time_s = sim.curve.time_s;
+  c->truth.elongation_um = sim.elongation_noise_free_um.size() == sim.curve.size()
+                               ? sim.elongation_noise_free_um
+                               : sim.curve.elongation_um;
   // Features as the training table measures them: the recorded curve over the dataset's window
   // (sim::DatasetOptions::window_s), not over the whole thread, whose tail is no plateau.
   const double window_s = sim::DatasetOptions{}.window_s;
@@ -117,9 +112,70 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
     recorded.time_s.push_back(sim.curve.time_s[i]);
     recorded.elongation_um.push_back(sim.curve.elongation_um[i]);
   }
-  c.truth_features = recorded.size() >= 10 && sim.curve.time_s.back() >= window_s
-                         ? sim::ExtractFeatures(recorded, sim_options.settle)
-                         : sim.features;
+  c->truth_features = recorded.size() >= 10 && sim.curve.time_s.back() >= window_s
+                          ? sim::ExtractFeatures(recorded, sim_options.settle)
+                          : sim.features;
+}
+
+// The 840D plan of a baseline's features with the model's curve shape (none without a positive
+// plateau and settle time); `what` names the baseline in errors.
+interp::CompensationPlan BaselinePlan(const Features& f, const std::string& what,
+                                      const sim::Screw& screw, double feed_mm_s,
+                                      const CompareOptions& options) {
+  if (!(f.max_elongation_um > 0) || !(f.settle_time_s > 0)) return interp::CompensationPlan{};
+  const fit::ArctanCurve curve =
+      fit::ArctanCurve::FromFeatures(f, options.shape_k, options.time_exponent);
+  curve.Validate(what + " curve of screw '" + screw.name + "'");
+  return interp::BuildPlan(curve, feed_mm_s, screw.thread_length_mm, options.plan);
+}
+
+// The compensation a plan applies over time (it refers to `plan`, which must outlive it).
+CompensationFunction PlannedCompensation(const interp::CompensationPlan& plan, double feed_mm_s) {
+  if (plan.segments.empty()) return NoCompensation();
+  return [&plan, feed_mm_s](double t_s) {
+    return interp::AppliedCompensationUm(plan,
+                                         interp::AxisPositionMm(plan.options, feed_mm_s, t_s));
+  };
+}
+
+// Cuts the truth with each strategy's compensation: compensation over time, lead deviation,
+// metrics and ISO class per strategy.
+void CutWithEveryStrategy(const std::array<CompensationFunction, kStrategyCount>& comp,
+                          const sim::Screw& screw, const IsoToleranceTable& iso_table,
+                          const CompareOptions& options, ScrewComparison* c) {
+  const double feed = c->kinematics.axial_feed_mm_s;
+  LeadMetricOptions metric_options = options.metrics;
+  metric_options.lead_mm = screw.process.pitch_mm;
+  for (std::size_t k = 0; k < kStrategyCount; ++k) {
+    for (double t : c->truth.time_s) c->compensation_um[k].push_back(comp[k](t));
+    StrategyOutcome& o = c->outcomes[k];
+    o.strategy = kStrategies[k];
+    o.lead = CutLeadDeviation(c->truth, comp[k], feed, screw.thread_length_mm,
+                              screw.process.pitch_mm, options.cut);
+    o.metrics = ComputeLeadMetrics(o.lead, metric_options);
+    o.iso = EvaluateIsoClass(o.metrics, iso_table);
+  }
+  auto vs = [c](Strategy a, Strategy b) {
+    return Reductions(c->Outcome(a).metrics, c->Outcome(b).metrics);
+  };
+  c->model_vs_traditional = vs(Strategy::kModel, Strategy::kTraditional);
+  c->model_vs_none = vs(Strategy::kModel, Strategy::kNone);
+  c->traditional_vs_none = vs(Strategy::kTraditional, Strategy::kNone);
+  c->model_vs_regression = vs(Strategy::kModel, Strategy::kRegression);
+  c->model_vs_ramp = vs(Strategy::kModel, Strategy::kRamp);
+}
+
+}  // namespace
+
+ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
+                             const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+                             const CompareOptions& options) {
+  ScrewComparison c;
+  c.screw = screw;
+  c.kinematics = sim::ComputeKinematics(screw);  // validates; InputError if infeasible
+  c.seed = options.seed;
+  c.disturbances_on = options.disturbances_on;
+  SimulateTruth(screw, options, &c);
 
   // Model: prediction -> arctangent curve -> 840D plan.
   c.prediction = nn::Predict(model, screw.process);
@@ -134,46 +190,17 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
   c.experience_ramp_time_s = rule.ramp_time_s;
   c.traditional_features = rule.ClassFeatures(screw.process.diameter_mm);
   if (rule.has_regression) c.regression_features = rule.regression.Predict(screw.process);
-  auto plan_of = [&](const Features& f, const std::string& what) {
-    if (!(f.max_elongation_um > 0) || !(f.settle_time_s > 0)) return interp::CompensationPlan{};
-    const fit::ArctanCurve curve =
-        fit::ArctanCurve::FromFeatures(f, options.shape_k, options.time_exponent);
-    curve.Validate(what + " curve of screw '" + screw.name + "'");
-    return interp::BuildPlan(curve, feed, screw.thread_length_mm, options.plan);
-  };
-  const interp::CompensationPlan traditional_plan = plan_of(c.traditional_features, "traditional");
-  const interp::CompensationPlan regression_plan = plan_of(c.regression_features, "regression");
-  auto planned = [feed](const interp::CompensationPlan& plan) -> CompensationFunction {
-    if (plan.segments.empty()) return NoCompensation();
-    return [&plan, feed](double t_s) {
-      return interp::AppliedCompensationUm(plan, interp::AxisPositionMm(plan.options, feed, t_s));
-    };
-  };
+  const interp::CompensationPlan traditional_plan =
+      BaselinePlan(c.traditional_features, "traditional", screw, feed, options);
+  const interp::CompensationPlan regression_plan =
+      BaselinePlan(c.regression_features, "regression", screw, feed, options);
   const double diameter = screw.process.diameter_mm;
   const std::array<CompensationFunction, kStrategyCount> comp = {
       NoCompensation(),
       [&rule, diameter](double t_s) { return rule.CompensationUm(diameter, t_s); },
-      planned(traditional_plan), planned(regression_plan), planned(c.plan)};
-
-  LeadMetricOptions metric_options = options.metrics;
-  metric_options.lead_mm = screw.process.pitch_mm;
-  for (std::size_t k = 0; k < kStrategyCount; ++k) {
-    for (double t : c.truth.time_s) c.compensation_um[k].push_back(comp[k](t));
-    StrategyOutcome& o = c.outcomes[k];
-    o.strategy = kStrategies[k];
-    o.lead = CutLeadDeviation(c.truth, comp[k], feed, screw.thread_length_mm,
-                              screw.process.pitch_mm, options.cut);
-    o.metrics = ComputeLeadMetrics(o.lead, metric_options);
-    o.iso = EvaluateIsoClass(o.metrics, iso_table);
-  }
-  auto vs = [&c](Strategy a, Strategy b) {
-    return Reductions(c.Outcome(a).metrics, c.Outcome(b).metrics);
-  };
-  c.model_vs_traditional = vs(Strategy::kModel, Strategy::kTraditional);
-  c.model_vs_none = vs(Strategy::kModel, Strategy::kNone);
-  c.traditional_vs_none = vs(Strategy::kTraditional, Strategy::kNone);
-  c.model_vs_regression = vs(Strategy::kModel, Strategy::kRegression);
-  c.model_vs_ramp = vs(Strategy::kModel, Strategy::kRamp);
+      PlannedCompensation(traditional_plan, feed), PlannedCompensation(regression_plan, feed),
+      PlannedCompensation(c.plan, feed)};
+  CutWithEveryStrategy(comp, screw, iso_table, options, &c);
   return c;
 }
 

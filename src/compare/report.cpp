@@ -149,6 +149,190 @@ std::string MetricsTable(const ScrewComparison& c) {
   return h.str();
 }
 
+// The screw's data files: the elongation with the compensations applied, the plan's compensation
+// points and the travel deviation of each strategy (CSV with `options.provenance` as comments).
+void AddScrewData(const ScrewComparison& c, const std::string& slug, const ReportOptions& options,
+                  OutputDir& out) {
+  std::vector<std::vector<double>> rows;
+  for (std::size_t i = 0; i < c.truth.size(); ++i) {
+    const double t = c.truth.time_s[i];
+    rows.push_back({t, c.truth.elongation_um[i], c.predicted_curve.ElongationUm(t),
+                    c.compensation_um[static_cast<std::size_t>(Strategy::kTraditional)][i],
+                    c.compensation_um[static_cast<std::size_t>(Strategy::kModel)][i]});
+  }
+  out.Add(slug + "_elongation.csv",
+          FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
+                     "traditional_compensation_um", "model_compensation_um"},
+                    rows,
+                    Comments(options, "elongation of the unmachined section of screw '" +
+                                          c.screw.name + "' and the compensation applied")));
+  out.Add(slug + "_points.csv",
+          interp::FormatPointsCsv(
+              c.plan, Comments(options,
+                               "compensation points of the 840D plan (the last row is the "
+                               "thread end, where the values found before the cut are "
+                               "restored)")));
+  rows.clear();
+  const auto& ln = c.Outcome(Strategy::kNone).lead;
+  const auto& lt = c.Outcome(Strategy::kTraditional).lead;
+  const auto& lm = c.Outcome(Strategy::kModel).lead;
+  for (std::size_t i = 0; i < ln.size(); ++i)
+    rows.push_back({ln.position_mm[i], ln.deviation_um[i], lt.deviation_um[i], lm.deviation_um[i]});
+  out.Add(slug + "_lead.csv", FormatCsv({"position_mm", "none_deviation_um",
+                                         "traditional_deviation_um", "model_deviation_um"},
+                                        rows,
+                                        Comments(options,
+                                                 "travel deviation (actual - specified travel from "
+                                                 "the thread start) of screw '" +
+                                                     c.screw.name + "'")));
+}
+
+// Runs gnuplot on the screw's script in the staging folder (an argument vector, no shell: neither
+// the directory nor the names are ever parsed). Returns whether all three plots were rendered
+// (they are then added to `out` and to `rendered`); else `warning` says why and gnuplot's log is
+// kept.
+bool RenderPlots(const ScrewComparison& c, const std::string& slug, const PlotFiles& files,
+                 const std::filesystem::path& dir, const ReportOptions& options, OutputDir& out,
+                 std::set<std::string>* rendered, std::string* warning) {
+  const std::string log = slug + ".gp.log";
+  const std::filesystem::path stage = std::filesystem::absolute(out.Staging());
+  const int rc = RunProgram({options.gnuplot_command, slug + ".gp"}, stage, stage / log);
+  bool ok = rc == 0;
+  for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+    std::error_code ec;
+    ok = ok && std::filesystem::is_regular_file(stage / png, ec) &&
+         std::filesystem::file_size(stage / png, ec) > 0;
+  }
+  if (ok) {
+    for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+      out.AddStaged(png);
+      rendered->insert(png);
+    }
+  } else {
+    std::error_code ec;
+    if (std::filesystem::exists(stage / log, ec)) out.AddStaged(log);
+    *warning = "gnuplot failed on " + (dir / (slug + ".gp")).string() + " (see " +
+               (dir / (slug + ".gp.log")).string() + "): plots of '" + c.screw.name + "' skipped";
+  }
+  return ok;
+}
+
+// The screw's heading, its inputs and, when the model extrapolates, the inputs outside its domain.
+std::string InputsSection(const ScrewComparison& c) {
+  std::ostringstream body;
+  const auto in = c.screw.process;
+  body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
+       << FormatDecimals(in.hardness_hrc, 1) << " HRC, diameter "
+       << FormatDecimals(in.diameter_mm, 1) << " mm, lead " << FormatDecimals(in.pitch_mm, 2)
+       << " mm, raceway radius " << FormatDecimals(in.raceway_radius_mm, 2) << " mm, cutting speed "
+       << FormatDecimals(in.cutting_speed_m_min, 0) << " m/min; blank "
+       << FormatDecimals(c.screw.length_mm, 0) << " mm, thread "
+       << FormatDecimals(c.screw.thread_length_mm, 0) << " mm; axial feed "
+       << FormatDecimals(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
+       << FormatDecimals(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
+  if (c.prediction.outside_domain) {
+    std::string fields;
+    for (const auto& f : c.prediction.outside_domain_fields)
+      fields += (fields.empty() ? "" : ", ") + f;
+    body << "<p class='warn'>The model extrapolates: outside its training domain in "
+         << HtmlEscape(fields) << ".</p>\n";
+  }
+  return body.str();
+}
+
+// The features of the truth, the model's prediction and the traditional rule's class.
+std::string FeaturesTable(const ScrewComparison& c) {
+  std::ostringstream body;
+  body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n"
+       << "<tr><td>simulated truth (seed " << c.seed << ", disturbances "
+       << (c.disturbances_on ? "on" : "off") << ")</td><td>"
+       << FormatDecimals(c.truth_features.max_elongation_um, 1) << "</td><td>"
+       << FormatDecimals(c.truth_features.settle_time_s, 0) << "</td></tr>\n"
+       << "<tr><td>model prediction (+- 1 std)</td><td>"
+       << FormatDecimals(c.prediction.mean.max_elongation_um, 1) << " +- "
+       << FormatDecimals(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
+       << FormatDecimals(c.prediction.mean.settle_time_s, 0) << " +- "
+       << FormatDecimals(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
+       << "<tr><td>traditional rule (class "
+       << FormatDecimals(c.experience_class.nominal_diameter_mm, 0) << " mm, "
+       << c.experience_class.screws << " past screws)</td><td>"
+       << FormatDecimals(c.experience_class.plateau_um, 1) << "</td><td>"
+       << FormatDecimals(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n";
+  return body.str();
+}
+
+// The disturbances of the truth and the 840D plan's figures.
+std::string PlanParagraph(const ScrewComparison& c) {
+  std::ostringstream body;
+  body << "<p class='small'>Disturbances of the truth (unknown to the model): heat partition x"
+       << FormatDecimals(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
+       << FormatDecimals(c.disturbances.expansion_factor, 3) << ", ambient drift "
+       << FormatDecimals(c.disturbances.ambient_drift_k_per_h, 3)
+       << " K/h. 840D plan: " << c.plan.segments.size() << " segments (" << c.plan.point_count
+       << " points; uniform spacing would need "
+       << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
+                                          : std::string("more than 1000000"))
+       << "), max |chord - curve| " << FormatDecimals(c.plan.max_deviation_um, 2)
+       << " um, max |SD43910| " << FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910)
+       << " (MD32760 cap " << FormatFixed(c.plan.options.md32760, 4) << "), axis "
+       << HtmlEscape(c.plan.options.axis) << ", sign " << interp::ToString(c.plan.options.sign)
+       << ".</p>\n";
+  return body.str();
+}
+
+// The screw's HTML section: inputs, features, plan, metrics, plots (or why not) and data links.
+std::string ScrewSection(const ScrewComparison& c, const std::string& slug, const PlotFiles& files,
+                         const std::set<std::string>& rendered) {
+  std::ostringstream body;
+  body << InputsSection(c) << FeaturesTable(c) << PlanParagraph(c) << MetricsTable(c);
+  for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
+    if (rendered.count(png) > 0)
+      body << "<p><img src='" << png << "' alt='" << png << "'></p>\n";
+    else
+      body << "<p class='warn'>Plot " << png << " not rendered (see warnings).</p>\n";
+  }
+  body << "<p class='small'>Data: <a href='" << slug << "_elongation.csv'>" << slug
+       << "_elongation.csv</a>, <a href='" << slug << "_points.csv'>" << slug
+       << "_points.csv</a>, <a href='" << slug << "_lead.csv'>" << slug
+       << "_lead.csv</a>, gnuplot script <a href='" << slug << ".gp'>" << slug << ".gp</a>.</p>\n";
+  return body.str();
+}
+
+// The page: title, provenance, notes, warnings, how to read it, then the screws' sections.
+std::string IndexHtml(const ReportOptions& options, const std::vector<std::string>& warnings,
+                      const std::string& sections) {
+  std::ostringstream html;
+  html
+      << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>"
+      << HtmlEscape(options.title)
+      << "</title>\n<style>body{font-family:sans-serif;max-width:1060px;margin:2em auto;color:#222}"
+         "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #bbb;padding:3px "
+         "8px;"
+         "text-align:right}td:first-child,th:first-child{text-align:left}th{background:#eee}"
+         "tr.cls td{font-weight:bold}.small{font-size:0.85em;color:#555}.warn{color:#a00}"
+         "img{max-width:100%;border:1px solid #ddd}</style></head><body>\n<h1>"
+      << HtmlEscape(options.title) << "</h1>\n";
+  for (const auto& p : options.provenance) html << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
+  for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
+  for (const auto& w : warnings) html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
+  html << "<p>How to read this page. Each screw is cut in the simulator (the ground truth, with "
+          "seeded disturbances the model never saw) three times: without compensation, with the "
+          "traditional experience rule (one correction per diameter class, ramped in linearly over "
+          "the machine's mean settle time, from the same past screws the model was trained on), "
+          "and with the model-based 840D plan (prediction, arctangent curve, "
+          "SD43900/SD43910/SD43920 "
+          "segments). Travel deviation = actual minus specified travel from the thread start after "
+          "cooling; accumulated error within 1000 mm = the largest max - min of the deviation "
+          "within any 1000 mm of thread (the paper's figure), over the whole thread = max - min "
+          "over the thread. e_a, v_u, v_300, v_2pi as ISO 3408-3 (about the least-squares mean "
+          "travel line). Reductions are 100 (1 - model / baseline).</p>\n"
+          "<p class='small'>ISO 3408-3 caveat: only some tolerance cells are confirmed by a source "
+          "(Steinmeyer, HIWIN catalogue); the others are recalled values "
+          "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
+       << sections << "</body></html>\n";
+  return html.str();
+}
+
 }  // namespace
 
 std::string FormatComparisonTable(const ScrewComparison& c) {
@@ -216,129 +400,15 @@ ReportResult WriteReport(const std::filesystem::path& dir,
     while (std::find(slugs.begin(), slugs.end(), slug) != slugs.end()) slug += "_";
     slugs.push_back(slug);
 
-    // Data files.
-    std::vector<std::vector<double>> rows;
-    for (std::size_t i = 0; i < c.truth.size(); ++i) {
-      const double t = c.truth.time_s[i];
-      rows.push_back({t, c.truth.elongation_um[i], c.predicted_curve.ElongationUm(t),
-                      c.compensation_um[static_cast<std::size_t>(Strategy::kTraditional)][i],
-                      c.compensation_um[static_cast<std::size_t>(Strategy::kModel)][i]});
-    }
-    auto write = [&](const std::string& name, const std::string& text) { out.Add(name, text); };
-    write(slug + "_elongation.csv",
-          FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
-                     "traditional_compensation_um", "model_compensation_um"},
-                    rows,
-                    Comments(options, "elongation of the unmachined section of screw '" +
-                                          c.screw.name + "' and the compensation applied")));
-    write(slug + "_points.csv",
-          interp::FormatPointsCsv(
-              c.plan, Comments(options,
-                               "compensation points of the 840D plan (the last row is the "
-                               "thread end, where the values found before the cut are "
-                               "restored)")));
-    rows.clear();
-    const auto& ln = c.Outcome(Strategy::kNone).lead;
-    const auto& lt = c.Outcome(Strategy::kTraditional).lead;
-    const auto& lm = c.Outcome(Strategy::kModel).lead;
-    for (std::size_t i = 0; i < ln.size(); ++i)
-      rows.push_back(
-          {ln.position_mm[i], ln.deviation_um[i], lt.deviation_um[i], lm.deviation_um[i]});
-    write(slug + "_lead.csv", FormatCsv({"position_mm", "none_deviation_um",
-                                         "traditional_deviation_um", "model_deviation_um"},
-                                        rows,
-                                        Comments(options,
-                                                 "travel deviation (actual - specified travel from "
-                                                 "the thread start) of screw '" +
-                                                     c.screw.name + "'")));
-
-    // Plots.
+    AddScrewData(c, slug, options, out);
     const PlotFiles files{slug + "_elongation.png", slug + "_lead.png", slug + "_lead_start.png"};
-    write(slug + ".gp", GnuplotScript(c, slug, files, terminal));
-    if (gnuplot) {
-      // An argument vector, no shell: neither the directory nor the names are ever parsed.
-      const std::string log = slug + ".gp.log";
-      const std::filesystem::path stage = std::filesystem::absolute(out.Staging());
-      const int rc = RunProgram({options.gnuplot_command, slug + ".gp"}, stage, stage / log);
-      bool ok = rc == 0;
-      for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-        std::error_code ec;
-        ok = ok && std::filesystem::is_regular_file(stage / png, ec) &&
-             std::filesystem::file_size(stage / png, ec) > 0;
-      }
-      if (ok) {
-        for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-          out.AddStaged(png);
-          rendered.insert(png);
-        }
-      } else {
-        std::error_code ec;
-        if (std::filesystem::exists(stage / log, ec)) out.AddStaged(log);
-        all_rendered = false;
-        result.warnings.push_back("gnuplot failed on " + (dir / (slug + ".gp")).string() +
-                                  " (see " + (dir / (slug + ".gp.log")).string() + "): plots of '" +
-                                  c.screw.name + "' skipped");
-      }
+    out.Add(slug + ".gp", GnuplotScript(c, slug, files, terminal));
+    std::string warning;
+    if (gnuplot && !RenderPlots(c, slug, files, dir, options, out, &rendered, &warning)) {
+      all_rendered = false;
+      result.warnings.push_back(warning);
     }
-
-    // HTML section.
-    const auto in = c.screw.process;
-    body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
-         << FormatDecimals(in.hardness_hrc, 1) << " HRC, diameter "
-         << FormatDecimals(in.diameter_mm, 1) << " mm, lead " << FormatDecimals(in.pitch_mm, 2)
-         << " mm, raceway radius " << FormatDecimals(in.raceway_radius_mm, 2)
-         << " mm, cutting speed " << FormatDecimals(in.cutting_speed_m_min, 0) << " m/min; blank "
-         << FormatDecimals(c.screw.length_mm, 0) << " mm, thread "
-         << FormatDecimals(c.screw.thread_length_mm, 0) << " mm; axial feed "
-         << FormatDecimals(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
-         << FormatDecimals(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
-    if (c.prediction.outside_domain) {
-      std::string fields;
-      for (const auto& f : c.prediction.outside_domain_fields)
-        fields += (fields.empty() ? "" : ", ") + f;
-      body << "<p class='warn'>The model extrapolates: outside its training domain in "
-           << HtmlEscape(fields) << ".</p>\n";
-    }
-    body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n"
-         << "<tr><td>simulated truth (seed " << c.seed << ", disturbances "
-         << (c.disturbances_on ? "on" : "off") << ")</td><td>"
-         << FormatDecimals(c.truth_features.max_elongation_um, 1) << "</td><td>"
-         << FormatDecimals(c.truth_features.settle_time_s, 0) << "</td></tr>\n"
-         << "<tr><td>model prediction (+- 1 std)</td><td>"
-         << FormatDecimals(c.prediction.mean.max_elongation_um, 1) << " +- "
-         << FormatDecimals(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
-         << FormatDecimals(c.prediction.mean.settle_time_s, 0) << " +- "
-         << FormatDecimals(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
-         << "<tr><td>traditional rule (class "
-         << FormatDecimals(c.experience_class.nominal_diameter_mm, 0) << " mm, "
-         << c.experience_class.screws << " past screws)</td><td>"
-         << FormatDecimals(c.experience_class.plateau_um, 1) << "</td><td>"
-         << FormatDecimals(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n"
-         << "<p class='small'>Disturbances of the truth (unknown to the model): heat partition x"
-         << FormatDecimals(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
-         << FormatDecimals(c.disturbances.expansion_factor, 3) << ", ambient drift "
-         << FormatDecimals(c.disturbances.ambient_drift_k_per_h, 3)
-         << " K/h. 840D plan: " << c.plan.segments.size() << " segments (" << c.plan.point_count
-         << " points; uniform spacing would need "
-         << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
-                                            : std::string("more than 1000000"))
-         << "), max |chord - curve| " << FormatDecimals(c.plan.max_deviation_um, 2)
-         << " um, max |SD43910| " << FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910)
-         << " (MD32760 cap " << FormatFixed(c.plan.options.md32760, 4) << "), axis "
-         << HtmlEscape(c.plan.options.axis) << ", sign " << interp::ToString(c.plan.options.sign)
-         << ".</p>\n"
-         << MetricsTable(c);
-    for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
-      if (rendered.count(png) > 0)
-        body << "<p><img src='" << png << "' alt='" << png << "'></p>\n";
-      else
-        body << "<p class='warn'>Plot " << png << " not rendered (see warnings).</p>\n";
-    }
-    body << "<p class='small'>Data: <a href='" << slug << "_elongation.csv'>" << slug
-         << "_elongation.csv</a>, <a href='" << slug << "_points.csv'>" << slug
-         << "_points.csv</a>, <a href='" << slug << "_lead.csv'>" << slug
-         << "_lead.csv</a>, gnuplot script <a href='" << slug << ".gp'>" << slug
-         << ".gp</a>.</p>\n";
+    body << ScrewSection(c, slug, files, rendered);
     report_json.push_back(c);
   }
   result.plots_rendered = all_rendered && !comparisons.empty();
@@ -348,38 +418,7 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                  {"provenance", options.provenance},
                                  {"comparisons", report_json}};
   out.Add("report.json", JsonFileText(report));
-
-  std::ostringstream html;
-  html
-      << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>"
-      << HtmlEscape(options.title)
-      << "</title>\n<style>body{font-family:sans-serif;max-width:1060px;margin:2em auto;color:#222}"
-         "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #bbb;padding:3px "
-         "8px;"
-         "text-align:right}td:first-child,th:first-child{text-align:left}th{background:#eee}"
-         "tr.cls td{font-weight:bold}.small{font-size:0.85em;color:#555}.warn{color:#a00}"
-         "img{max-width:100%;border:1px solid #ddd}</style></head><body>\n<h1>"
-      << HtmlEscape(options.title) << "</h1>\n";
-  for (const auto& p : options.provenance) html << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
-  for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
-  for (const auto& w : result.warnings)
-    html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
-  html << "<p>How to read this page. Each screw is cut in the simulator (the ground truth, with "
-          "seeded disturbances the model never saw) three times: without compensation, with the "
-          "traditional experience rule (one correction per diameter class, ramped in linearly over "
-          "the machine's mean settle time, from the same past screws the model was trained on), "
-          "and with the model-based 840D plan (prediction, arctangent curve, "
-          "SD43900/SD43910/SD43920 "
-          "segments). Travel deviation = actual minus specified travel from the thread start after "
-          "cooling; accumulated error within 1000 mm = the largest max - min of the deviation "
-          "within any 1000 mm of thread (the paper's figure), over the whole thread = max - min "
-          "over the thread. e_a, v_u, v_300, v_2pi as ISO 3408-3 (about the least-squares mean "
-          "travel line). Reductions are 100 (1 - model / baseline).</p>\n"
-          "<p class='small'>ISO 3408-3 caveat: only some tolerance cells are confirmed by a source "
-          "(Steinmeyer, HIWIN catalogue); the others are recalled values "
-          "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
-       << body.str() << "</body></html>\n";
-  out.Add("index.html", html.str());
+  out.Add("index.html", IndexHtml(options, result.warnings, body.str()));
   result.files = out.Commit();
   result.index_html = dir / "index.html";
   return result;

@@ -224,40 +224,47 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
     scores += (scores.empty() ? "" : ", ") + std::string("r = ") + std::to_string(counts[i]) +
               ": " + (std::isfinite(rmse[i]) ? FormatSignificant(rmse[i], 4) + " um" : "-");
   }
-  chosen.message = "class count by cross-validated MLR RMSE (" +
-                   (runs.size() > 1 ? std::string("leave one run out")
-                                    : std::to_string(o.folds) + (forward ? " forward-chaining" : "") +
-                                          " blocks") +
-                   "): r = " + std::to_string(counts[best]) + " (" + scores + "); " +
-                   chosen.message;
+  chosen.message =
+      "class count by cross-validated MLR RMSE (" +
+      (runs.size() > 1
+           ? std::string("leave one run out")
+           : std::to_string(o.folds) + (forward ? " forward-chaining" : "") + " blocks") +
+      "): r = " + std::to_string(counts[best]) + " (" + scores + "); " + chosen.message;
   return chosen;
 }
 
-FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
-                        const FitOptions& o) {
-  o.Validate();
+namespace {
+
+void CheckTrainingRuns(const std::vector<Run>& runs, const std::string& error_column) {
   if (runs.empty()) throw InputError("fit: no training run");
   for (const Run& r : runs) {
     r.ErrorIndex(error_column);
     if (r.time_from_index != runs.front().time_from_index)
       throw InputError(r.source + ": some training runs record time and others do not");
   }
-  FitReport rep;
-  DriftModel& m = rep.model;
-  m.kind = o.kind;
-  m.error_column = error_column;
-  m.extra_inputs = o.extra_inputs;
-  m.time_unit = runs.front().time_from_index ? "sample" : "min";
+}
+
+// The model's sensors: chosen by the selection (FitOptions::sensors empty) or the given ones that
+// are usable; left-out sensors become warnings.
+void ChooseSensors(const std::vector<Run>& runs, const std::string& error_column,
+                   const FitOptions& o, FitReport* rep) {
+  DriftModel& m = rep->model;
   if (o.sensors.empty()) {
-    rep.selected = true;
-    rep.selection = SelectSensorsForFit(runs, error_column, o);
-    m.sensors = rep.selection.ChosenNames();
-    m.selection = "seed 000 selection: " + rep.selection.message;
-    rep.warnings = rep.selection.left_out;
+    rep->selected = true;
+    rep->selection = SelectSensorsForFit(runs, error_column, o);
+    m.sensors = rep->selection.ChosenNames();
+    m.selection = "seed 000 selection: " + rep->selection.message;
+    rep->warnings = rep->selection.left_out;
   } else {
-    m.sensors = UsableSensors(runs, o.sensors, &rep.warnings);
+    m.sensors = UsableSensors(runs, o.sensors, &rep->warnings);
     m.selection = "given";
   }
+}
+
+// The reference temperatures (mean first sample of each sensor over the runs), the training
+// runs and samples, and the machine state they share (unknown when they differ).
+void SetTrainingProvenance(const std::vector<Run>& runs, DriftModel* model) {
+  DriftModel& m = *model;
   m.reference_C = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.sensors.size()));
   for (const Run& r : runs) {
     for (std::size_t i = 0; i < m.sensors.size(); ++i)
@@ -271,43 +278,77 @@ FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_c
   m.state = runs.front().state;
   for (const Run& r : runs)
     if (r.state != m.state) m.state = RunState::kUnknown;
-  if (o.kind == ModelKind::kDynamic) {
-    rep.lag_search = SearchLags(runs, error_column, m.sensors, o);
-    m.time_constants = rep.lag_search.back().time_constants;
-    for (const auto& st : rep.lag_search) {
-      std::string t;
-      for (double v : st.time_constants) t += (t.empty() ? "" : ", ") + FormatSignificant(v, 4);
-      m.notes.push_back("lag search: time constants [" + t + "] " + m.time_unit +
-                        ": cross-validated RMSE " + FormatSignificant(st.cv_rmse_um, 4) + " um");
-    }
+}
+
+// ModelKind::kDynamic: the time constants of the lag search, each step noted with its score.
+void ChooseTimeConstants(const std::vector<Run>& runs, const std::string& error_column,
+                         const FitOptions& o, FitReport* rep) {
+  DriftModel& m = rep->model;
+  rep->lag_search = SearchLags(runs, error_column, m.sensors, o);
+  m.time_constants = rep->lag_search.back().time_constants;
+  for (const auto& st : rep->lag_search) {
+    std::string t;
+    for (double v : st.time_constants) t += (t.empty() ? "" : ", ") + FormatSignificant(v, 4);
+    m.notes.push_back("lag search: time constants [" + t + "] " + m.time_unit +
+                      ": cross-validated RMSE " + FormatSignificant(st.cv_rmse_um, 4) + " um");
   }
+}
+
+// The features: every sensor and extra input, as it is and lagged by each time constant.
+void ListFeatures(DriftModel* model) {
+  DriftModel& m = *model;
   std::vector<std::string> inputs = m.sensors;
   inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
   for (const auto& in : inputs) {
     m.features.push_back({in, 0.0});
     for (double t : m.time_constants) m.features.push_back({in, t});
   }
+}
+
+// Fits the network or the least-squares model on the stacked features; returns its fitted
+// values on them. A rank-deficient linear fit is refused naming the runs and the features.
+Eigen::VectorXd FitOnFeatures(const Stacked& s, const std::vector<Run>& runs,
+                              const std::string& error_column, const FitOptions& o,
+                              FitReport* rep) {
+  DriftModel& m = rep->model;
+  if (o.kind == ModelKind::kNetwork) {
+    FitNetwork(s, o, &m, &rep->train_report);
+    return m.target_scaling.Reverse(m.network.Forward(m.input_scaling.Apply(s.x.transpose())))
+        .row(0)
+        .transpose();
+  }
+  try {
+    m.linear = FitLinear(s.x, s.y);
+  } catch (const InputError& e) {
+    std::string features;
+    for (const Feature& f : m.features)
+      features += (features.empty() ? "" : ", ") + f.Name(m.time_unit);
+    throw InputError(RunSources(runs) + ": model of " + error_column + " on " + features + ": " +
+                     e.what());
+  }
+  return EvaluateLinear(m.linear.coefficients, s.x);
+}
+
+}  // namespace
+
+FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
+                        const FitOptions& o) {
+  o.Validate();
+  CheckTrainingRuns(runs, error_column);
+  FitReport rep;
+  DriftModel& m = rep.model;
+  m.kind = o.kind;
+  m.error_column = error_column;
+  m.extra_inputs = o.extra_inputs;
+  m.time_unit = runs.front().time_from_index ? "sample" : "min";
+  ChooseSensors(runs, error_column, o, &rep);
+  SetTrainingProvenance(runs, &m);
+  if (o.kind == ModelKind::kDynamic) ChooseTimeConstants(runs, error_column, o, &rep);
+  ListFeatures(&m);
   const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
   m.feature_min = s.x.colwise().minCoeff().transpose();
   m.feature_max = s.x.colwise().maxCoeff().transpose();
-  Eigen::VectorXd fitted;
-  if (o.kind == ModelKind::kNetwork) {
-    FitNetwork(s, o, &m, &rep.train_report);
-    fitted = m.target_scaling.Reverse(m.network.Forward(m.input_scaling.Apply(s.x.transpose())))
-                 .row(0)
-                 .transpose();
-  } else {
-    try {
-      m.linear = FitLinear(s.x, s.y);
-    } catch (const InputError& e) {
-      std::string features;
-      for (const Feature& f : m.features)
-        features += (features.empty() ? "" : ", ") + f.Name(m.time_unit);
-      throw InputError(RunSources(runs) + ": model of " + error_column + " on " + features + ": " +
-                       e.what());
-    }
-    fitted = EvaluateLinear(m.linear.coefficients, s.x);
-  }
+  const Eigen::VectorXd fitted = FitOnFeatures(s, runs, error_column, o, &rep);
   const Eigen::VectorXd res = s.y - fitted;
   const double dof =
       o.kind == ModelKind::kNetwork ? static_cast<double>(res.size()) : m.linear.degrees_of_freedom;

@@ -79,89 +79,122 @@ std::string UpdateMessage(UpdateRule rule, const Eigen::MatrixXd& xs, const Eige
          FormatDecimals(rms(after), 3) + " um; coefficients " + Vec(before) + " -> " + Vec(after);
 }
 
-StrategyResult RunRule(UpdateRule rule, const Replay& in) {
-  StrategyResult s;
-  s.rule = rule;
-  std::vector<Piece> pieces{{0, in.b0}};
-  Eigen::MatrixXd prior = in.p0;
-  const int n = static_cast<int>(in.t.size());
-  const auto measure = [&](int k, MonitorEvent::Kind kind) {
+// One rule replayed on a run: the checks at the check interval, and after a failed check the
+// refit measurements and the rule's update; the coefficients in force are kept as pieces.
+class RuleReplay {
+ public:
+  RuleReplay(UpdateRule rule, const Replay& in)
+      : in_(in), rule_(rule), pieces_{{0, in.b0}}, prior_(in.p0) {
+    s_.rule = rule;
+  }
+
+  StrategyResult Run() {
+    double next = in_.t[static_cast<std::size_t>(in_.start_sample)] + in_.o.check_every;
+    int last = in_.start_sample;
+    while (rule_ != UpdateRule::kStatic) {
+      const int k = SampleAt(in_.t, next, last + 1);
+      if (k < 0) break;
+      last = k;
+      if (!Check(k) && !Recalibrate(&last)) break;
+      next = in_.t[static_cast<std::size_t>(last)] + in_.o.check_every;
+    }
+    Predict();
+    s_.final_coefficients = pieces_.back().b;
+    s_.stop_min = s_.measurements * in_.o.stop_min_per_measurement;
+    return s_;
+  }
+
+ private:
+  // A measurement at sample k against the coefficients in force.
+  MonitorEvent Measure(int k, MonitorEvent::Kind kind) {
     MonitorEvent e;
     e.kind = kind;
     e.sample = k;
-    e.time = in.t[static_cast<std::size_t>(k)];
-    e.measured_um = in.y(k);
-    e.predicted_um = in.x.row(k).dot(pieces.back().b);
-    ++s.measurements;
+    e.time = in_.t[static_cast<std::size_t>(k)];
+    e.measured_um = in_.y(k);
+    e.predicted_um = in_.x.row(k).dot(pieces_.back().b);
+    ++s_.measurements;
     return e;
-  };
-  double next = in.t[static_cast<std::size_t>(in.start_sample)] + in.o.check_every;
-  int last = in.start_sample;
-  while (rule != UpdateRule::kStatic) {
-    const int k = SampleAt(in.t, next, last + 1);
-    if (k < 0) break;
-    MonitorEvent check = measure(k, MonitorEvent::Kind::kCheck);
-    check.threshold_um = in.threshold_um;
-    check.valid = std::abs(check.measured_um - check.predicted_um) <= in.threshold_um;
-    check.message = CheckMessage(check.time, check.measured_um, check.predicted_um, in.threshold_um,
-                                 check.valid);
-    ++s.checks;
-    s.events.push_back(check);
-    last = k;
-    if (!check.valid) {
-      ++s.invalid_checks;
-      std::vector<int> rows{k};
-      for (int j = 0; j < in.o.refit_samples; ++j) {
-        const int q =
-            SampleAt(in.t, in.t[static_cast<std::size_t>(last)] + in.o.refit_every, last + 1);
-        if (q < 0) break;
-        MonitorEvent e = measure(q, MonitorEvent::Kind::kRefitMeasurement);
-        e.message = "refit measurement " + std::to_string(j + 1) + " of " +
-                    std::to_string(in.o.refit_samples) + ": measured " +
-                    FormatDecimals(e.measured_um, 3) + ", predicted " +
-                    FormatDecimals(e.predicted_um, 3) + " um";
-        s.events.push_back(e);
-        rows.push_back(q);
-        last = q;
-      }
-      MonitorEvent u;
-      u.sample = last;
-      u.time = in.t[static_cast<std::size_t>(last)];
-      if (static_cast<int>(rows.size()) < in.o.refit_samples + 1) {
-        u.kind = MonitorEvent::Kind::kSkipped;
-        u.message = "the run ended after " + std::to_string(rows.size() - 1) + " of " +
-                    std::to_string(in.o.refit_samples) + " refit measurements: no update";
-        u.coefficients = pieces.back().b;
-        s.events.push_back(u);
-        break;
-      }
-      Eigen::MatrixXd xs(static_cast<Eigen::Index>(rows.size()), in.x.cols());
-      Eigen::VectorXd ys(xs.rows());
-      for (std::size_t j = 0; j < rows.size(); ++j) {
-        xs.row(static_cast<Eigen::Index>(j)) = in.x.row(rows[j]);
-        ys(static_cast<Eigen::Index>(j)) = in.y(rows[j]);
-      }
-      const Eigen::VectorXd before = pieces.back().b;
-      u.kind = MonitorEvent::Kind::kUpdate;
-      u.coefficients = ApplyRule(rule, xs, ys, before, &prior, in.noise_variance);
-      u.predicted_um = in.x.row(last).dot(u.coefficients);
-      u.message = UpdateMessage(rule, xs, ys, before, u.coefficients);
-      s.events.push_back(u);
-      pieces.push_back({last, u.coefficients});
-      ++s.recalibrations;
+  }
+
+  // The check at sample k: valid when |measured - predicted| <= threshold.
+  bool Check(int k) {
+    MonitorEvent check = Measure(k, MonitorEvent::Kind::kCheck);
+    check.threshold_um = in_.threshold_um;
+    check.valid = std::abs(check.measured_um - check.predicted_um) <= in_.threshold_um;
+    check.message = CheckMessage(check.time, check.measured_um, check.predicted_um,
+                                 in_.threshold_um, check.valid);
+    ++s_.checks;
+    s_.events.push_back(check);
+    if (!check.valid) ++s_.invalid_checks;
+    return check.valid;
+  }
+
+  // After a failed check at *last: refit_samples more measurements at the refit interval, then
+  // the rule's update from all of them; *last becomes the last sample measured. Returns false
+  // when the run ends before the measurements are complete (no update).
+  bool Recalibrate(int* last) {
+    std::vector<int> rows{*last};
+    for (int j = 0; j < in_.o.refit_samples; ++j) {
+      const int q =
+          SampleAt(in_.t, in_.t[static_cast<std::size_t>(*last)] + in_.o.refit_every, *last + 1);
+      if (q < 0) break;
+      MonitorEvent e = Measure(q, MonitorEvent::Kind::kRefitMeasurement);
+      e.message = "refit measurement " + std::to_string(j + 1) + " of " +
+                  std::to_string(in_.o.refit_samples) + ": measured " +
+                  FormatDecimals(e.measured_um, 3) + ", predicted " +
+                  FormatDecimals(e.predicted_um, 3) + " um";
+      s_.events.push_back(e);
+      rows.push_back(q);
+      *last = q;
     }
-    next = in.t[static_cast<std::size_t>(last)] + in.o.check_every;
+    MonitorEvent u;
+    u.sample = *last;
+    u.time = in_.t[static_cast<std::size_t>(*last)];
+    if (static_cast<int>(rows.size()) < in_.o.refit_samples + 1) {
+      u.kind = MonitorEvent::Kind::kSkipped;
+      u.message = "the run ended after " + std::to_string(rows.size() - 1) + " of " +
+                  std::to_string(in_.o.refit_samples) + " refit measurements: no update";
+      u.coefficients = pieces_.back().b;
+      s_.events.push_back(u);
+      return false;
+    }
+    Eigen::MatrixXd xs(static_cast<Eigen::Index>(rows.size()), in_.x.cols());
+    Eigen::VectorXd ys(xs.rows());
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+      xs.row(static_cast<Eigen::Index>(j)) = in_.x.row(rows[j]);
+      ys(static_cast<Eigen::Index>(j)) = in_.y(rows[j]);
+    }
+    const Eigen::VectorXd before = pieces_.back().b;
+    u.kind = MonitorEvent::Kind::kUpdate;
+    u.coefficients = ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance);
+    u.predicted_um = in_.x.row(*last).dot(u.coefficients);
+    u.message = UpdateMessage(rule_, xs, ys, before, u.coefficients);
+    s_.events.push_back(u);
+    pieces_.push_back({*last, u.coefficients});
+    ++s_.recalibrations;
+    return true;
   }
-  s.predicted_um.resize(n);
-  for (std::size_t i = 0; i < pieces.size(); ++i) {
-    const int from = pieces[i].from;
-    const int to = i + 1 < pieces.size() ? pieces[i + 1].from : n;
-    s.predicted_um.segment(from, to - from) = in.x.middleRows(from, to - from) * pieces[i].b;
+
+  // The prediction over the whole run, each piece's coefficients from its sample on.
+  void Predict() {
+    const int n = static_cast<int>(in_.t.size());
+    s_.predicted_um.resize(n);
+    for (std::size_t i = 0; i < pieces_.size(); ++i) {
+      const int from = pieces_[i].from;
+      const int to = i + 1 < pieces_.size() ? pieces_[i + 1].from : n;
+      s_.predicted_um.segment(from, to - from) = in_.x.middleRows(from, to - from) * pieces_[i].b;
+    }
   }
-  s.final_coefficients = pieces.back().b;
-  s.stop_min = s.measurements * in.o.stop_min_per_measurement;
-  return s;
-}
+
+  const Replay& in_;
+  const UpdateRule rule_;
+  StrategyResult s_;
+  std::vector<Piece> pieces_;
+  Eigen::MatrixXd prior_;
+};
+
+StrategyResult RunRule(UpdateRule rule, const Replay& in) { return RuleReplay(rule, in).Run(); }
 
 }  // namespace
 

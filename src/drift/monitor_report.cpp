@@ -169,16 +169,11 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
   return s.str();
 }
 
-MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult& r,
-                                       const MonitorOptions& o,
-                                       const std::vector<std::string>& provenance,
-                                       const std::string& gnuplot, const AlsoWrite& also) {
-  OutputDir files(dir, "report directory");
-  MonitorReportResult out;
-  files.Add("timeline.csv", MonitorTimelineCsv(r, provenance));
-  files.Add("events.csv", MonitorEventsCsv(r, provenance));
-  // Marker data per rule (gnuplot index blocks, CSV like the timeline): time, measured, 1 for
-  // an invalid check or a refit measurement, 0 for a valid check.
+namespace {
+
+// checks.csv: marker data per rule (gnuplot index blocks, CSV like the timeline): time, measured,
+// 1 for an invalid check or a refit measurement, 0 for a valid check.
+std::string ChecksCsv(const MonitorResult& r) {
   std::ostringstream marks;
   marks << "# one block per rule in the order of timeline.csv: time,measured_um,invalid\n";
   for (const auto& st : r.strategies) {
@@ -189,7 +184,12 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
               << (e.kind == MonitorEvent::Kind::kCheck && e.valid ? 0 : 1) << "\n";
     marks << FormatNumber(r.time.front()) << ",0,-1\n\n\n";  // sentinel: no block is empty
   }
-  files.Add("checks.csv", marks.str());
+  return marks.str();
+}
+
+// monitor.gp: the measured error and every rule's model over time, the checks as markers, and
+// the residuals below.
+std::string MonitorGnuplot(const MonitorResult& r) {
   const std::string x = r.time_from_index ? "1" : "($1/60)";
   const std::size_t q = r.strategies.size();
   std::ostringstream gp;
@@ -218,12 +218,17 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
     gp << (i ? ", " : "") << "'timeline.csv' using " << x << ":" << i + 3 + q << " with lines lc "
        << i + 1 << " title " << GnuplotString(ToString(r.strategies[i].rule));
   gp << "\nunset multiplot\n";
-  files.Add("monitor.gp",
-            "# gnuplot script written by whirl; re-run: gnuplot monitor.gp\n" + gp.str());
+  return "# gnuplot script written by whirl; re-run: gnuplot monitor.gp\n" + gp.str();
+}
+
+// Renders monitor.gp in the staging folder of `files`; returns the page's image element (or the
+// note that it was not rendered), warnings say why not.
+std::string RenderMonitorPlot(const fs::path& dir, const std::string& gnuplot, OutputDir& files,
+                              std::vector<std::string>* warnings) {
   std::string img = "<p>(plot not rendered: monitor.gp)</p>";
   std::error_code ec;
   if (!ProgramSucceeds({gnuplot, "--version"})) {
-    out.warnings.push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
+    warnings->push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
   } else {
     const fs::path stage = fs::absolute(files.Staging());  // gnuplot renders there
     if (RunProgram({gnuplot, "monitor.gp"}, stage, stage / "gnuplot.log") == 0 &&
@@ -231,11 +236,18 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
       files.AddStaged("monitor.png");
       img = "<img src='monitor.png' alt='monitor timeline'>";
     } else {
-      out.warnings.push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
-                             " (see gnuplot.log)");
+      warnings->push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
+                          " (see gnuplot.log)");
       if (fs::is_regular_file(stage / "gnuplot.log", ec)) files.AddStaged("gnuplot.log");
     }
   }
+  return img;
+}
+
+// index.html: provenance, the text report, the plot and the data files.
+std::string MonitorIndexHtml(const MonitorResult& r, const MonitorOptions& o,
+                             const std::vector<std::string>& provenance, const std::string& img,
+                             const std::vector<std::string>& warnings) {
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>"
     << HtmlEscape("whirl: drift monitor of " + r.run)
@@ -248,9 +260,25 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
     << img << "\n"
     << "<p>Data: <a href='timeline.csv'>timeline.csv</a>, <a href='events.csv'>events.csv</a> "
        "(every check and update with its reason), <a href='monitor.gp'>monitor.gp</a>.</p>\n";
-  for (const auto& w : out.warnings) h << "<p><i>" << HtmlEscape(w) << "</i></p>\n";
+  for (const auto& w : warnings) h << "<p><i>" << HtmlEscape(w) << "</i></p>\n";
   h << "</body></html>\n";
-  files.Add("index.html", h.str());
+  return h.str();
+}
+
+}  // namespace
+
+MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult& r,
+                                       const MonitorOptions& o,
+                                       const std::vector<std::string>& provenance,
+                                       const std::string& gnuplot, const AlsoWrite& also) {
+  OutputDir files(dir, "report directory");
+  MonitorReportResult out;
+  files.Add("timeline.csv", MonitorTimelineCsv(r, provenance));
+  files.Add("events.csv", MonitorEventsCsv(r, provenance));
+  files.Add("checks.csv", ChecksCsv(r));
+  files.Add("monitor.gp", MonitorGnuplot(r));
+  const std::string img = RenderMonitorPlot(dir, gnuplot, files, &out.warnings);
+  files.Add("index.html", MonitorIndexHtml(r, o, provenance, img, out.warnings));
   files.Commit(also);
   out.index_html = dir / "index.html";
   return out;

@@ -128,6 +128,105 @@ Eigen::MatrixXd FiniteDifferenceJacobian(const ResidualFunction& residual, int n
   return jac;
 }
 
+namespace {
+
+// The residual function with its Jacobian: analytic or by finite differences (at the point
+// evaluated, inside the box), the residual count checked.
+struct LmEvaluator {
+  const ResidualFunction& residual;
+  int num_residuals;
+  bool analytic_jacobian;
+  const LmOptions& options;
+
+  void operator()(const Eigen::VectorXd& at, Eigen::VectorXd* res, Eigen::MatrixXd* j) const {
+    res->resize(num_residuals);
+    if (j != nullptr && analytic_jacobian) {
+      j->resize(num_residuals, at.size());
+      residual(at, res, j);
+    } else {
+      residual(at, res, nullptr);
+      if (j != nullptr) *j = FiniteDifferenceJacobian(residual, num_residuals, at, options);
+    }
+    if (res->size() != num_residuals)
+      throw InputError("LM: residual function returned " + std::to_string(res->size()) +
+                       " residuals, expected " + std::to_string(num_residuals));
+  }
+};
+
+// The stopping tests at the current point before a step: zero cost, then the projected gradient.
+bool StopAtPoint(double cost, double grad_norm, const LmOptions& options, LmSummary* summary) {
+  if (cost == 0) {
+    summary->termination = LmTermination::kZeroCost;
+    summary->message = "cost is exactly 0";
+    return true;
+  }
+  if (grad_norm <= options.gradient_tolerance) {
+    summary->termination = LmTermination::kGradientTolerance;
+    summary->message = "projected gradient " + MessageNumber(grad_norm) +
+                       " <= gradient_tolerance " + MessageNumber(options.gradient_tolerance);
+    return true;
+  }
+  return false;
+}
+
+// The Marquardt step (J'J + mu diag(J'J)) step = -g (the diagonal floored at kMinDiagonal), its
+// end projected on the box.
+Eigen::VectorXd DampedStepEnd(const Eigen::MatrixXd& jtj, const Eigen::VectorXd& g, double mu,
+                              const Eigen::VectorXd& x, const LmOptions& options) {
+  Eigen::VectorXd diag = jtj.diagonal().cwiseMax(kMinDiagonal);
+  Eigen::MatrixXd a = jtj;
+  a.diagonal() += mu * diag;
+  const Eigen::VectorXd step = a.ldlt().solve(-g);
+  return Project(options, x + step);
+}
+
+// The parameter test on the projected step h from x.
+bool StepTooSmall(const Eigen::VectorXd& h, const Eigen::VectorXd& x, const LmOptions& options,
+                  LmSummary* summary) {
+  const double step_norm = h.norm();
+  if (step_norm > options.parameter_tolerance * (x.norm() + options.parameter_tolerance))
+    return false;
+  summary->termination = LmTermination::kParameterTolerance;
+  summary->message = "step " + MessageNumber(step_norm) + " <= parameter_tolerance " +
+                     MessageNumber(options.parameter_tolerance) + " * (|x| " +
+                     MessageNumber(x.norm()) + " + tol)";
+  return true;
+}
+
+// Gain ratio of the step h: the actual cost decrease (r the residuals before, r_new after) over
+// the decrease the linear model predicts (g = J'r, jtj = J'J); -1 when the new cost is not finite
+// or the model predicts no decrease. `decrease` receives the actual decrease.
+double GainRatio(const Eigen::VectorXd& r, const Eigen::VectorXd& r_new, double cost_new,
+                 const Eigen::VectorXd& g, const Eigen::MatrixXd& jtj, const Eigen::VectorXd& h,
+                 double* decrease) {
+  // cost - cost_new as 1/2 (r - r_new).(r + r_new): no cancellation near the optimum, where the
+  // plain difference of two nearly equal costs is rounding noise.
+  *decrease = 0.5 * (r - r_new).dot(r + r_new);
+  const double model_decrease = -(g.dot(h) + 0.5 * h.dot(jtj * h));
+  return (std::isfinite(cost_new) && model_decrease > 0) ? *decrease / model_decrease : -1.0;
+}
+
+// The cost test after an accepted step that decreased the cost by `decrease` to `cost`.
+bool CostStalled(double decrease, double cost, const LmOptions& options, LmSummary* summary) {
+  if (!(decrease <= options.cost_tolerance * (cost + decrease))) return false;
+  summary->termination = LmTermination::kCostTolerance;
+  summary->message = "relative cost decrease " + MessageNumber(decrease / (cost + decrease)) +
+                     " <= cost_tolerance " + MessageNumber(options.cost_tolerance);
+  return true;
+}
+
+// The damping test after a rejected step raised mu.
+bool DampingTooLarge(double mu, double cost, const LmOptions& options, LmSummary* summary) {
+  if (mu <= options.max_mu) return false;
+  summary->termination = LmTermination::kMuTooLarge;
+  summary->message = "damping mu " + MessageNumber(mu) + " > max_mu " +
+                     MessageNumber(options.max_mu) + " without a cost decrease (cost " +
+                     MessageNumber(cost) + ")";
+  return true;
+}
+
+}  // namespace
+
 LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
                             bool analytic_jacobian, Eigen::VectorXd* x_ptr,
                             const LmOptions& options) {
@@ -140,20 +239,7 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
   LmSummary summary;
   Eigen::VectorXd r(num_residuals);
   Eigen::MatrixXd jac(num_residuals, n);
-  auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* res, Eigen::MatrixXd* j) {
-    res->resize(num_residuals);
-    if (j != nullptr && analytic_jacobian) {
-      j->resize(num_residuals, n);
-      residual(at, res, j);
-    } else {
-      residual(at, res, nullptr);
-      if (j != nullptr) *j = FiniteDifferenceJacobian(residual, num_residuals, at, options);
-    }
-    if (res->size() != num_residuals)
-      throw InputError("LM: residual function returned " + std::to_string(res->size()) +
-                       " residuals, expected " + std::to_string(num_residuals));
-  };
-
+  const LmEvaluator evaluate{residual, num_residuals, analytic_jacobian, options};
   evaluate(x, &r, &jac);
   double cost = 0.5 * r.squaredNorm();
   summary.initial_cost = summary.final_cost = cost;
@@ -169,51 +255,23 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
   double mu = options.initial_mu * std::max(jtj.diagonal().maxCoeff(), kMinDiagonal);
   double nu = 2.0;
   Eigen::VectorXd r_new(num_residuals);
-  Eigen::MatrixXd jac_new(num_residuals, n);
 
   summary.termination = LmTermination::kMaxIterations;
   summary.message = "reached max_iterations " + std::to_string(options.max_iterations);
   for (int iter = 0;; ++iter) {
-    const double grad_norm = ProjectedGradientNorm(options, x, g);
-    summary.final_gradient_norm = grad_norm;
-    if (cost == 0) {
-      summary.termination = LmTermination::kZeroCost;
-      summary.message = "cost is exactly 0";
-      break;
-    }
-    if (grad_norm <= options.gradient_tolerance) {
-      summary.termination = LmTermination::kGradientTolerance;
-      summary.message = "projected gradient " + MessageNumber(grad_norm) +
-                        " <= gradient_tolerance " + MessageNumber(options.gradient_tolerance);
-      break;
-    }
+    summary.final_gradient_norm = ProjectedGradientNorm(options, x, g);
+    if (StopAtPoint(cost, summary.final_gradient_norm, options, &summary)) break;
     if (iter >= options.max_iterations) break;
     summary.iterations = iter + 1;
-
-    Eigen::VectorXd diag = jtj.diagonal().cwiseMax(kMinDiagonal);
-    Eigen::MatrixXd a = jtj;
-    a.diagonal() += mu * diag;
-    const Eigen::VectorXd step = a.ldlt().solve(-g);
-    const Eigen::VectorXd x_new = Project(options, x + step);
+    const Eigen::VectorXd x_new = DampedStepEnd(jtj, g, mu, x, options);
     const Eigen::VectorXd h = x_new - x;
-    const double step_norm = h.norm();
-    if (step_norm <= options.parameter_tolerance * (x.norm() + options.parameter_tolerance)) {
-      summary.termination = LmTermination::kParameterTolerance;
-      summary.message = "step " + MessageNumber(step_norm) + " <= parameter_tolerance " +
-                        MessageNumber(options.parameter_tolerance) + " * (|x| " +
-                        MessageNumber(x.norm()) + " + tol)";
-      break;
-    }
+    if (StepTooSmall(h, x, options, &summary)) break;
     // The residual function is evaluated once here; the Jacobian only after acceptance.
     r_new.resize(num_residuals);
     residual(x_new, &r_new, nullptr);
     const double cost_new = 0.5 * r_new.squaredNorm();
-    // cost - cost_new as 1/2 (r - r_new).(r + r_new): no cancellation near the optimum, where the
-    // plain difference of two nearly equal costs is rounding noise.
-    const double decrease = 0.5 * (r - r_new).dot(r + r_new);
-    const double model_decrease = -(g.dot(h) + 0.5 * h.dot(jtj * h));
-    const double rho =
-        (std::isfinite(cost_new) && model_decrease > 0) ? decrease / model_decrease : -1.0;
+    double decrease = 0;
+    const double rho = GainRatio(r, r_new, cost_new, g, jtj, h, &decrease);
     if (rho > 0 && std::isfinite(cost_new)) {
       x = x_new;
       evaluate(x, &r, &jac);
@@ -223,23 +281,14 @@ LmSummary SolveLeastSquares(const ResidualFunction& residual, int num_residuals,
       ++summary.accepted_steps;
       mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
       nu = 2.0;
-      if (decrease <= options.cost_tolerance * (cost + decrease)) {
-        summary.termination = LmTermination::kCostTolerance;
-        summary.message = "relative cost decrease " + MessageNumber(decrease / (cost + decrease)) +
-                          " <= cost_tolerance " + MessageNumber(options.cost_tolerance);
+      if (CostStalled(decrease, cost, options, &summary)) {
         summary.final_gradient_norm = ProjectedGradientNorm(options, x, g);
         break;
       }
     } else {
       mu *= nu;
       nu *= 2.0;
-      if (!(mu <= options.max_mu)) {
-        summary.termination = LmTermination::kMuTooLarge;
-        summary.message = "damping mu " + MessageNumber(mu) + " > max_mu " +
-                          MessageNumber(options.max_mu) + " without a cost decrease (cost " +
-                          MessageNumber(cost) + ")";
-        break;
-      }
+      if (DampingTooLarge(mu, cost, options, &summary)) break;
     }
   }
   summary.final_cost = cost;

@@ -74,9 +74,15 @@ struct Model {
   /// Throws InputError naming the key and the rule if anything is missing or inconsistent.
   void Validate() const;
 };
+// The model file (model.cpp): every key checked, schema 1 files still load (ReadUncertainty).
 void to_json(nlohmann::json& j, const Model& m);
 /// Validates everything (schema version, sizes, finiteness, names); InputError names the key.
 void from_json(const nlohmann::json& j, Model& m);
+
+/// The inputs and outputs of every model, with their units, in order (kInputColumns with
+/// kInputUnits, kTargetColumns with kTargetUnits): a model file must list exactly these.
+std::vector<VariableInfo> ExpectedInputs();
+std::vector<VariableInfo> ExpectedOutputs();
 
 /// Limits of a model file (LoadModel), checked before anything is allocated: at most kMaxLayers
 /// layer sizes, each in [1, kMaxLayerSize] neurons, at most kMaxParameters weights and biases
@@ -93,6 +99,7 @@ Model LoadModel(const std::filesystem::path& path);
 /// bit-identically).
 void SaveModel(const std::filesystem::path& path, const Model& model);
 
+// Prediction (model_predict.cpp).
 struct Prediction {
   Features mean;    ///< network output, original units
   Features stddev;  ///< predictive standard deviation (noise + weight uncertainty), original units
@@ -120,6 +127,8 @@ Prediction Predict(const Model& model, const ProcessInputs& inputs);
 /// Predictions for many processes (one forward pass for the means).
 std::vector<Prediction> PredictBatch(const Model& model, const std::vector<ProcessInputs>& inputs);
 
+// Training (model_train.cpp): TrainModel with its default, the hidden size and epoch limit
+// choices, and the check of a trained model for flat outputs.
 /// When training stops (issue 12).
 ///   kCrossValidated (measured, not the default): the epoch limit is chosen by K-fold
 ///   cross-validation: each fold
@@ -207,10 +216,10 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
 /// the network then predicts about one value for every process (scripts/bench_peers.sh: 3 of 20
 /// Friedman tables of 20 rows, at every hidden size; README "Against its peers").
 struct FlatOutput {
-  int output = 0;              ///< index into Features (kTargetColumns)
-  double spread_ratio = 0;     ///< sd of the network's mean predictions / sd of the targets
-  double prediction_sd = 0;    ///< sd of the mean predictions over the rows, original units
-  double target_sd = 0;        ///< sd of the targets over the rows, original units
+  int output = 0;            ///< index into Features (kTargetColumns)
+  double spread_ratio = 0;   ///< sd of the network's mean predictions / sd of the targets
+  double prediction_sd = 0;  ///< sd of the mean predictions over the rows, original units
+  double target_sd = 0;      ///< sd of the targets over the rows, original units
 };
 /// An output is flat when its spread_ratio is below this. Measured on the benchmark's 20-row
 /// Friedman tables: collapsed fits have ratios below 1e-4, every other fit 0.3 or more.
@@ -229,12 +238,14 @@ std::string DescribeFlatOutputs(const Model& model, const std::vector<FlatOutput
 int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOptions& options,
                                   int folds, std::vector<double>* curve = nullptr);
 
+// Calibration of the predictive sd (model_calibration.cpp).
 /// Sets model->output_noise_variance and noise_calibration by K-fold cross-validation on the
 /// table the model was trained on (see the header comment). InputError if folds < 2 or the table
 /// has fewer rows than folds.
 void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& options, int folds,
                           Model* model);
 
+// Tables as matrices (model_predict.cpp).
 /// Inputs (5 x Q) and targets (2 x Q) of a table, original units.
 Eigen::MatrixXd InputMatrix(const std::vector<ProcessInputs>& inputs);
 Eigen::MatrixXd TargetMatrix(const std::vector<Features>& targets);

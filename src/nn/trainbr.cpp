@@ -351,6 +351,38 @@ Eigen::MatrixXd ArdHessian(const Eigen::MatrixXd& jj, double beta, const Eigen::
   return h;
 }
 
+// The figures both iterations (trainbr's and the ARD stage's) report after an epoch and at the
+// end: F, ssE, ssX, gamma, alpha, beta, mu and the gradient 2 ||J'e||.
+struct IterationFigures {
+  double objective, sse, ssx, gamma, alpha, beta, mu, gradient;
+
+  void FillEpochEnd(const Network* net, EpochInfo* info) const {
+    info->objective = objective;
+    info->sse = sse;
+    info->ssx = ssx;
+    info->gamma = gamma;
+    info->alpha = alpha;
+    info->beta = beta;
+    info->mu = mu;
+    info->network = net;
+  }
+  // With the RMS errors of the errors e (S x Q, normalized), also in original units.
+  void FillSummaryEnd(const Eigen::MatrixXd& e, const MapMinMax& target_scaling,
+                      TrainSummary* sum) const {
+    sum->final_cost = objective;
+    sum->sse = sse;
+    sum->sum_squared_weights = ssx;
+    sum->gamma = gamma;
+    sum->alpha = alpha;
+    sum->beta = beta;
+    sum->mu = mu;
+    sum->gradient = gradient;
+    sum->rms_error_normalized =
+        (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
+    sum->rms_error = sum->rms_error_normalized.cwiseProduct(target_scaling.HalfRange());
+  }
+};
+
 // alpha_g and beta of TrainOptions::ard after a step (MacKay 1992, one alpha per group).
 struct ArdHyper {
   Eigen::VectorXd alpha;  ///< per group
@@ -404,114 +436,385 @@ double ArdLaplace(const Eigen::MatrixXd& h, double min_alpha, Eigen::MatrixXd* c
   return h_eig.array().log().sum();
 }
 
+// The LM iteration of TrainOptions::ard's second stage, in the weights form: F = beta ssE +
+// sum_i a_i w_i^2 with a_i = alpha_g(i), each accepted step followed by a grouped re-estimation
+// (ReestimateArd). Starts from trainbr's result with one re-estimation at its weights.
+class ArdIteration {
+ public:
+  ArdIteration(const TrainingData& data, const TrainResult& first, const TrainOptions& options)
+      : data_(data),
+        options_(options),
+        net_(first.network),
+        trial_(first.network),
+        group_(ArdGroups(net_)),
+        G_(net_.InputCount() + 1),
+        group_size_(GroupSums(group_, G_, Eigen::VectorXd::Ones(group_.size()))),
+        n_(static_cast<double>(data.targets.size())),
+        hyper_{Eigen::VectorXd::Constant(G_, first.summary.alpha), first.summary.beta,
+               first.summary.gamma} {
+    w_ = net_.GetParameters();
+    net_.Forward(data.inputs, &cache_);
+    e_ = data.targets - cache_.output();
+    sse_ = SumSquares(e_);
+    ErrorJacobian(net_, cache_, &J_);
+    degenerate_ = ReestimateArd(J_.transpose() * J_, sse_, w_, group_, group_size_, n_, &hyper_);
+    a_ = hyper_.alpha(group_);
+    F_ = hyper_.beta * sse_ + a_.dot(w_.cwiseAbs2());
+    mu_ = options.mu;
+  }
+
+  // J'J, J'e and the gradient 2 ||J'e|| at the current weights (J recomputed unless it is the
+  // constructor's).
+  void Linearize(bool jacobian_is_current) {
+    if (!jacobian_is_current) ErrorJacobian(net_, cache_, &J_);
+    const Eigen::Map<const Eigen::VectorXd> e_flat(e_.data(), e_.size());
+    jj_ = J_.transpose() * J_;
+    je_ = J_.transpose() * e_flat;
+    gradient_ = 2 * je_.norm();
+  }
+
+  // One LM step: mu grows by mu_inc until F falls (the step is taken, mu shrinks by mu_dec) or mu
+  // passes mu_max. Returns whether a step was taken.
+  bool Step() {
+    const Eigen::VectorXd rhs = hyper_.beta * je_ + a_.cwiseProduct(w_);
+    for (; mu_ <= options_.mu_max; mu_ *= options_.mu_inc) {
+      Eigen::MatrixXd shifted = ArdHessian(jj_, hyper_.beta, a_);
+      shifted.diagonal().array() += mu_;
+      const Eigen::LLT<Eigen::MatrixXd> llt(shifted);
+      if (llt.info() != Eigen::Success) continue;
+      const Eigen::VectorXd w2 = w_ - llt.solve(rhs);
+      if (!w2.allFinite()) continue;
+      trial_.SetParameters(w2);
+      trial_.Forward(data_.inputs, &trial_cache_);
+      const Eigen::MatrixXd e2 = data_.targets - trial_cache_.output();
+      const double sse2 = SumSquares(e2), F2 = hyper_.beta * sse2 + a_.dot(w2.cwiseAbs2());
+      if (F2 < F_) {
+        w_ = w2;
+        std::swap(net_, trial_);
+        std::swap(cache_, trial_cache_);
+        e_ = e2;
+        sse_ = sse2;
+        F_ = F2;
+        mu_ = std::max(mu_ * options_.mu_dec, kMuFloor);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The grouped re-estimation after an accepted step, with this epoch's J'J; updates F.
+  void Reestimate() {
+    degenerate_ = ReestimateArd(jj_, sse_, w_, group_, group_size_, n_, &hyper_);
+    a_ = hyper_.alpha(group_);
+    F_ = hyper_.beta * sse_ + a_.dot(w_.cwiseAbs2());
+  }
+
+  // The values an epoch reports after its step and update (alpha: the group of the other weights).
+  void FillEpochEnd(EpochInfo* info) const { Figures().FillEpochEnd(&net_, info); }
+
+  // The summary at the final weights (J is at them: the loop ends right after Linearize) with the
+  // Laplace approximation of the grouped prior (ArdLaplace, LogEvidenceGroups).
+  void Finish(TrainResult* result) {
+    TrainSummary& sum = result->summary;
+    Figures().FillSummaryEnd(e_, data_.target_scaling, &sum);
+    sum.ard_alpha = hyper_.alpha;
+    const double log_det_h = ArdLaplace(ArdHessian(J_.transpose() * J_, hyper_.beta, a_),
+                                        hyper_.alpha.minCoeff(), &result->posterior_covariance);
+    const Eigen::VectorXd final_alpha = hyper_.alpha(group_);
+    sum.log_evidence =
+        LogEvidenceGroups(sse_, GroupSums(group_, G_, w_.cwiseAbs2()), hyper_.alpha, group_size_,
+                          hyper_.beta, log_det_h, static_cast<int>(n_), net_.layer_sizes,
+                          ActiveHiddenUnits(net_, result->posterior_covariance, final_alpha));
+    sum.noise_variance = 1.0 / (2.0 * hyper_.beta);
+    result->network = std::move(net_);
+  }
+
+  double sse() const { return sse_; }
+  double gradient() const { return gradient_; }
+  double mu() const { return mu_; }
+  double objective() const { return F_; }
+  const std::string& degenerate() const { return degenerate_; }
+
+ private:
+  // alpha: the group of the weights that are not an input's.
+  IterationFigures Figures() const {
+    return {F_,          sse_, w_.squaredNorm(), hyper_.gamma, hyper_.alpha(G_ - 1),
+            hyper_.beta, mu_,  gradient_};
+  }
+
+  const TrainingData& data_;
+  const TrainOptions& options_;
+  Network net_, trial_;
+  const Eigen::VectorXi group_;
+  const int G_;  // groups: one per input, then all other weights
+  const Eigen::VectorXd group_size_;
+  const double n_;  // errors
+  ArdHyper hyper_;
+  ForwardCache cache_, trial_cache_;
+  Eigen::MatrixXd e_, J_, jj_;
+  Eigen::VectorXd w_, a_, je_;
+  double sse_ = 0, F_ = 0, mu_ = 0, gradient_ = 0;
+  std::string degenerate_;  // ReestimateArd's reason when its update was not finite
+};
+
 // The second stage of TrainOptions::ard, from trainbr's result `first` (nn/trainbr.h): one
 // grouped re-estimation at trainbr's weights, then LM epochs in the weights form, each accepted
 // step followed by a re-estimation. `steps` counts the accepted steps.
 TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOptions& options,
                       const EpochCallback& callback, int* steps) {
-  Network& net = first.network;
   TrainSummary& sum = first.summary;
-  const Eigen::VectorXi group = ArdGroups(net);
-  const int G = net.InputCount() + 1;
-  const Eigen::VectorXd group_size = GroupSums(group, G, Eigen::VectorXd::Ones(group.size()));
-  const double n = static_cast<double>(data.targets.size());
-  ArdHyper hyper{Eigen::VectorXd::Constant(G, sum.alpha), sum.beta, sum.gamma};
-  Eigen::VectorXd w = net.GetParameters();
-  Network trial = net;
-  ForwardCache cache, trial_cache;
-  net.Forward(data.inputs, &cache);
-  Eigen::MatrixXd e = data.targets - cache.output(), J;
-  double sse = SumSquares(e);
-  ErrorJacobian(net, cache, &J);
-  std::string degenerate = ReestimateArd(J.transpose() * J, sse, w, group, group_size, n, &hyper);
-  Eigen::VectorXd a = hyper.alpha(group);
-  double F = hyper.beta * sse + a.dot(w.cwiseAbs2());
-  double mu = options.mu, gradient = 0;
+  ArdIteration it(data, first, options);
   std::vector<double> after_step;
   const std::string first_message = sum.message;
   const int first_epochs = sum.epochs;
   *steps = 0;
   for (int epoch = 0;; ++epoch) {
-    if (epoch > 0) ErrorJacobian(net, cache, &J);
-    const Eigen::Map<const Eigen::VectorXd> e_flat(e.data(), e.size());
-    const Eigen::MatrixXd jj = J.transpose() * J;
-    const Eigen::VectorXd je = J.transpose() * e_flat;
-    gradient = 2 * je.norm();
+    it.Linearize(epoch == 0);
     sum.epochs = first_epochs + epoch;
-    if (StopReached(options, epoch, sse, gradient, mu, after_step, degenerate, &sum)) break;
+    if (StopReached(options, epoch, it.sse(), it.gradient(), it.mu(), after_step, it.degenerate(),
+                    &sum))
+      break;
     EpochInfo info;
     info.epoch = epoch + 1;
     info.ard_stage = true;
     info.max_epochs = options.epochs;
-    info.gradient = gradient;
-    info.objective_before = F;
-    const Eigen::VectorXd rhs = hyper.beta * je + a.cwiseProduct(w);
-    bool accepted = false;
-    for (; mu <= options.mu_max; mu *= options.mu_inc) {
-      Eigen::MatrixXd shifted = ArdHessian(jj, hyper.beta, a);
-      shifted.diagonal().array() += mu;
-      const Eigen::LLT<Eigen::MatrixXd> llt(shifted);
-      if (llt.info() != Eigen::Success) continue;
-      const Eigen::VectorXd w2 = w - llt.solve(rhs);
-      if (!w2.allFinite()) continue;
-      trial.SetParameters(w2);
-      trial.Forward(data.inputs, &trial_cache);
-      const Eigen::MatrixXd e2 = data.targets - trial_cache.output();
-      const double sse2 = SumSquares(e2), F2 = hyper.beta * sse2 + a.dot(w2.cwiseAbs2());
-      if (F2 < F) {
-        w = w2;
-        std::swap(net, trial);
-        std::swap(cache, trial_cache);
-        e = e2;
-        sse = sse2;
-        F = F2;
-        mu = std::max(mu * options.mu_dec, kMuFloor);
-        accepted = true;
-        ++*steps;
-        break;
-      }
-    }
-    info.step_accepted = accepted;
-    info.objective_after_step = F;
-    if (options.change > 0) after_step.push_back(F);
-    if (accepted) {
-      degenerate = ReestimateArd(jj, sse, w, group, group_size, n, &hyper);
-      a = hyper.alpha(group);
-      F = hyper.beta * sse + a.dot(w.cwiseAbs2());
-    }
-    info.objective = F;
-    info.sse = sse;
-    info.ssx = w.squaredNorm();
-    info.gamma = hyper.gamma;
-    info.alpha = hyper.alpha(G - 1);
-    info.beta = hyper.beta;
-    info.mu = mu;
-    info.network = &net;
+    info.gradient = it.gradient();
+    info.objective_before = it.objective();
+    info.step_accepted = it.Step();
+    if (info.step_accepted) ++*steps;
+    info.objective_after_step = it.objective();
+    if (options.change > 0) after_step.push_back(it.objective());
+    if (info.step_accepted) it.Reestimate();
+    it.FillEpochEnd(&info);
     if (callback) callback(info);
   }
   sum.message = first_message + "; ARD stage: " + sum.message;
-  sum.final_cost = F;
-  sum.sse = sse;
-  sum.sum_squared_weights = w.squaredNorm();
-  sum.gamma = hyper.gamma;
-  sum.alpha = hyper.alpha(G - 1);
-  sum.ard_alpha = hyper.alpha;
-  sum.beta = hyper.beta;
-  sum.mu = mu;
-  sum.gradient = gradient;
-  sum.rms_error_normalized =
-      (e.array().square().rowwise().sum() / static_cast<double>(e.cols())).sqrt();
-  sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
-  // J is at the final weights: the loop ends right after computing it.
-  const double log_det_h = ArdLaplace(ArdHessian(J.transpose() * J, hyper.beta, a),
-                                      hyper.alpha.minCoeff(), &first.posterior_covariance);
-  const Eigen::VectorXd final_alpha = hyper.alpha(group);
-  sum.log_evidence = LogEvidenceGroups(
-      sse, GroupSums(group, G, w.cwiseAbs2()), hyper.alpha, group_size, hyper.beta, log_det_h,
-      static_cast<int>(n), net.layer_sizes,
-      ActiveHiddenUnits(net, first.posterior_covariance, final_alpha));
-  sum.noise_variance = 1.0 / (2.0 * hyper.beta);
+  it.Finish(&first);
   return first;
+}
+
+// trainbr's iteration (nn/trainbr.h): Levenberg-Marquardt steps on F = beta ssE + alpha ssX with
+// the re-estimation of alpha and beta after each accepted step, on work arrays allocated once.
+// The systems of an epoch are N x N (beta J'J + c I, the weights form) or n x n (beta J J' + c I,
+// the errors form); see LinearSystem. gram holds J'J (lower triangle) or J J'.
+class BrIteration {
+ public:
+  BrIteration(const TrainingData& data, const Network& initial, const TrainOptions& options)
+      : data_(data),
+        options_(options),
+        bayes_(options.regularization == Regularization::kBayesian),
+        net_(initial),
+        trial_net_(initial) {
+    const int S = initial.OutputCount();
+    const Eigen::Index Q = data.inputs.cols();
+    N_ = net_.ParameterCount();
+    n_ = static_cast<double>(S) * static_cast<double>(Q);
+    errors_form_ =
+        options.linear_system == LinearSystem::kErrors ||
+        (options.linear_system == LinearSystem::kAuto && static_cast<double>(S) * Q < N_);
+    M_ = errors_form_ ? S * Q : N_;
+    w_ = net_.GetParameters();
+    for (Eigen::VectorXd* v : {&w2_, &dw_, &je_}) v->resize(N_);
+    for (Eigen::VectorXd* v : {&rhs_, &y_, &work_, &inv_diag_}) v->resize(M_);
+    jw_.resize(S * Q);
+    gram_.resize(M_, M_);
+    A_.resize(M_, M_);
+    e_.resize(S, Q);
+    e2_.resize(S, Q);
+    Jt_.resize(N_, S * Q);
+    net_.Forward(data.inputs, &cache_);
+    e_ = data.targets - cache_.output();
+    sse_ = SumSquares(e_);
+    ssx_ = w_.squaredNorm();
+    gamma_ = N_;
+    if (bayes_) {  // the initial alpha and beta (nn/trainbr.h, step 1)
+      beta_ = sse_ == 0 ? 1.0 : (n_ - N_) / (2 * sse_);
+      if (!(beta_ > 0)) beta_ = 1.0;
+      alpha_ = ssx_ == 0 ? 1.0 : N_ / (2 * ssx_);
+    }
+    F_ = beta_ * sse_ + alpha_ * ssx_;
+    mu_ = options.mu;
+  }
+
+  // J, J'e, the Gram matrix (and J w in the errors form) and the gradient 2 ||J'e|| at the current
+  // weights.
+  void Linearize() {
+    ErrorJacobian(net_, cache_, &J_);
+    Eigen::Map<const Eigen::VectorXd> e_flat(e_.data(), e_.size());
+    je_.noalias() = J_.transpose() * e_flat;
+    if (errors_form_) {
+      ErrorGram(net_, cache_, J_, &gram_);
+      jw_.noalias() = J_ * w_;
+    } else {
+      GramLower(J_, &Jt_, &gram_);  // lower triangle only
+    }
+    gradient_ = 2 * je_.norm();
+  }
+
+  // One LM step with the current alpha and beta: mu grows by mu_inc until F falls (the step is
+  // taken and mu shrinks by mu_dec) or mu passes mu_max. Returns whether a step was taken.
+  bool Step() {
+    Eigen::Map<const Eigen::VectorXd> e_flat(e_.data(), e_.size());
+    if (!errors_form_) rhs_ = beta_ * je_ + alpha_ * w_;
+    shift_accepted_ = 0;
+    while (mu_ <= options_.mu_max) {
+      const double c = mu_ + alpha_;
+      if (FactorShifted(gram_, beta_, c, &A_, &inv_diag_)) {
+        if (errors_form_) {
+          // dw = -(alpha/c) w - beta J' K_c^-1 (e - (alpha/c) J w) (LinearSystem::kErrors).
+          const double r = alpha_ / c;
+          rhs_ = e_flat - r * jw_;
+          SolveFactored(A_, inv_diag_, rhs_, &y_);
+          dw_.noalias() = -beta_ * (J_.transpose() * y_);
+          dw_ -= r * w_;
+        } else {
+          SolveFactored(A_, inv_diag_, rhs_, &dw_);
+          dw_ = -dw_;
+        }
+        if (dw_.allFinite() && TryWeights(c)) return true;
+      }
+      mu_ *= options_.mu_inc;
+    }
+    return false;
+  }
+
+  // Re-estimates gamma, alpha and beta from this epoch's Gram matrix and the old alpha, beta
+  // (MacKay 1992; Foresee and Hagan 1997) and updates F. Returns "" or, when the update is not
+  // finite and positive, the reason (the last finite alpha and beta are kept).
+  std::string Reestimate() {
+    // trace(H^-1) = ||L^-1||_F^2 for H = L L'; in the errors form gamma = n - alpha
+    // trace(K_alpha^-1) (LinearSystem), so M - alpha trace covers both. Once mu has fallen below
+    // rounding of alpha, mu + alpha == alpha and the accepted step's factor is bit for bit the
+    // factor of this H: reuse it. An H that is not numerically positive definite gives
+    // gamma = NaN, which ends the fit on the degenerate path.
+    std::string degenerate;
+    bool factored = shift_accepted_ == alpha_;
+    if (!factored) factored = FactorShifted(gram_, beta_, alpha_, &A_, &inv_diag_);
+    const double gamma_new =
+        factored ? static_cast<double>(M_) - alpha_ * TraceOfInverse(A_, inv_diag_, &work_)
+                 : std::numeric_limits<double>::quiet_NaN();
+    const double alpha_new = ssx_ == 0 ? 1.0 : gamma_new / (2 * ssx_);
+    const double beta_new = sse_ == 0 ? 1.0 : (n_ - gamma_new) / (2 * sse_);
+    if (std::isfinite(alpha_new) && alpha_new > 0 && std::isfinite(beta_new) && beta_new > 0) {
+      gamma_ = gamma_new;
+      alpha_ = alpha_new;
+      beta_ = beta_new;
+    } else {
+      degenerate = "gamma = " + MessageNumber(gamma_new) + ", alpha = " + MessageNumber(alpha_new) +
+                   ", beta = (n - gamma)/(2 ssE) = " + MessageNumber(beta_new) +
+                   " at ssE = " + MessageNumber(sse_) + " (kept the last finite alpha, beta)";
+    }
+    F_ = beta_ * sse_ + alpha_ * ssx_;
+    return degenerate;
+  }
+
+  // The values an epoch reports after its step and update.
+  void FillEpochEnd(EpochInfo* info) const { Figures().FillEpochEnd(&net_, info); }
+
+  // The summary at the final weights (J is at them: the loop ends right after Linearize) and, with
+  // Bayesian regularization, the Laplace approximation: log evidence and posterior covariance.
+  void Finish(TrainResult* result) {
+    TrainSummary& sum = result->summary;
+    Figures().FillSummaryEnd(e_, data_.target_scaling, &sum);
+    if (bayes_) {
+      Laplace(result);
+    } else {
+      sum.log_evidence = std::numeric_limits<double>::quiet_NaN();
+      sum.noise_variance = std::numeric_limits<double>::quiet_NaN();
+    }
+    result->network = std::move(net_);
+  }
+
+  double sse() const { return sse_; }
+  double gradient() const { return gradient_; }
+  double mu() const { return mu_; }
+  double objective() const { return F_; }
+  int parameter_count() const { return N_; }
+  double error_count() const { return n_; }
+
+ private:
+  IterationFigures Figures() const {
+    return {F_, sse_, ssx_, gamma_, alpha_, beta_, mu_, gradient_};
+  }
+
+  // Evaluates w + dw; takes it when F falls (c = mu + alpha of the step, whose factor A holds).
+  bool TryWeights(double c) {
+    w2_ = w_ + dw_;
+    trial_net_.SetParameters(w2_);
+    trial_net_.Forward(data_.inputs, &trial_cache_);
+    e2_ = data_.targets - trial_cache_.output();
+    const double sse2 = SumSquares(e2_);
+    const double ssx2 = w2_.squaredNorm();
+    const double F2 = beta_ * sse2 + alpha_ * ssx2;
+    if (!(F2 < F_)) return false;
+    std::swap(w_, w2_);
+    std::swap(net_, trial_net_);
+    std::swap(cache_, trial_cache_);
+    std::swap(e_, e2_);
+    sse_ = sse2;
+    ssx_ = ssx2;
+    F_ = F2;
+    shift_accepted_ = c;
+    mu_ = std::max(mu_ * options_.mu_dec, kMuFloor);
+    return true;
+  }
+
+  // Through the eigenvalues of J'J (clamped at 0) rather than a Cholesky factor, so that a
+  // near-interpolating fit (beta ~ 1e8 or more, H badly conditioned) still gives a finite log det
+  // and a positive semi-definite covariance. In the weights form gram holds J'J's lower triangle.
+  void Laplace(TrainResult* result) {
+    TrainSummary& sum = result->summary;
+    Eigen::MatrixXd jj(N_, N_);
+    if (errors_form_) {
+      GramLower(J_, &Jt_, &jj);
+    } else {
+      jj = gram_;
+    }
+    jj.triangularView<Eigen::StrictlyUpper>() = jj.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jj);
+    const Eigen::VectorXd h_eig =
+        (beta_ * eig.eigenvalues().cwiseMax(0.0)).array() + alpha_;  // eigenvalues of H
+    const double log_det_h = h_eig.array().log().sum();
+    sum.noise_variance = 1.0 / (2.0 * beta_);
+    const Eigen::MatrixXd& V = eig.eigenvectors();
+    result->posterior_covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
+    // Exact symmetry (the product leaves rounding-level asymmetry).
+    result->posterior_covariance =
+        0.5 * (result->posterior_covariance + result->posterior_covariance.transpose()).eval();
+    sum.log_evidence = LogEvidence(sse_, ssx_, alpha_, beta_, log_det_h, N_, static_cast<int>(n_),
+                                   net_.layer_sizes,
+                                   ActiveHiddenUnits(net_, result->posterior_covariance,
+                                                     Eigen::VectorXd::Constant(N_, alpha_)));
+  }
+
+  const TrainingData& data_;
+  const TrainOptions& options_;
+  const bool bayes_;
+  bool errors_form_ = false;
+  int N_ = 0;           // parameters
+  double n_ = 0;        // errors, S Q
+  Eigen::Index M_ = 0;  // size of the epoch's systems
+  Network net_, trial_net_;
+  Eigen::VectorXd w_, w2_, dw_, rhs_, je_, jw_, y_, work_, inv_diag_;
+  Eigen::MatrixXd J_, gram_, A_, e_, e2_, Jt_;
+  ForwardCache cache_, trial_cache_;
+  double sse_ = 0, ssx_ = 0, gamma_ = 0, alpha_ = 0, beta_ = 1, F_ = 0, mu_ = 0, gradient_ = 0;
+  double shift_accepted_ = 0;  // mu + alpha of the accepted step; A holds its factor
+};
+
+// TrainOptions::ard after trainbr: MacKay's model comparison keeps the ARD stage only when the
+// data support it (a log evidence above trainbr's by kArdEvidenceMargin).
+TrainResult KeepArdIfSupported(const TrainingData& data, TrainResult result,
+                               const TrainOptions& options, const EpochCallback& callback) {
+  TrainSummary& sum = result.summary;
+  int steps = 0;
+  TrainResult ard = RefineArd(data, result, options, callback, &steps);
+  const double margin = kArdEvidenceMargin * std::max(1.0, std::abs(sum.log_evidence));
+  if (steps > 0 && ard.summary.log_evidence > sum.log_evidence + margin) return ard;
+  sum.message += "; ARD stage not kept (" + std::to_string(steps) +
+                 " accepted steps, log evidence " + MessageNumber(ard.summary.log_evidence) +
+                 " against " + MessageNumber(sum.log_evidence) + ")";
+  return result;
 }
 
 }  // namespace
@@ -519,205 +822,40 @@ TrainResult RefineArd(const TrainingData& data, TrainResult first, const TrainOp
 TrainResult TrainBr(const TrainingData& data, const Network& initial, const TrainOptions& options,
                     const EpochCallback& callback) {
   CheckTrainingData(data, initial, options);
-  const int S = initial.OutputCount();
-  const Eigen::Index Q = data.inputs.cols();
   const bool bayes = options.regularization == Regularization::kBayesian;
+  BrIteration it(data, initial, options);
   TrainResult result;
-  result.network = initial;
-  Network& net = result.network;
-  Network trial_net = initial;
-  const int N = net.ParameterCount();
-  const double n = static_cast<double>(S) * static_cast<double>(Q);
-
-  // The systems of the epoch: N x N (beta J'J + c I) or n x n (beta J J' + c I); see LinearSystem.
-  const bool errors_form =
-      options.linear_system == LinearSystem::kErrors ||
-      (options.linear_system == LinearSystem::kAuto && static_cast<double>(S) * Q < N);
-  const Eigen::Index M = errors_form ? S * Q : N;
-
-  // Work arrays, allocated once. gram is jj = J'J (kWeights) or J J' (kErrors).
-  Eigen::VectorXd w = net.GetParameters();
-  Eigen::VectorXd w2(N), dw(N), rhs(M), je(N), jw(S * Q), y(M);
-  Eigen::MatrixXd J, gram(M, M), A(M, M), e(S, Q), e2(S, Q);
-  Eigen::VectorXd work(M), inv_diag(M);
-  Eigen::MatrixXd Jt(N, S * Q);
-  ForwardCache cache, trial_cache;
-
-  net.Forward(data.inputs, &cache);
-  e = data.targets - cache.output();
-  double sse = SumSquares(e);
-  double ssx = w.squaredNorm();
-  double gamma = N, alpha = 0, beta = 1;
-  if (bayes) {
-    beta = sse == 0 ? 1.0 : (n - N) / (2 * sse);
-    if (!(beta > 0)) beta = 1.0;
-    alpha = ssx == 0 ? 1.0 : N / (2 * ssx);
-  }
-  double F = beta * sse + alpha * ssx;
   TrainSummary& sum = result.summary;
-  sum.parameter_count = N;
-  sum.error_count = static_cast<int>(n);
-  sum.initial_cost = F;
-  sum.initial_sse = sse;
+  sum.parameter_count = it.parameter_count();
+  sum.error_count = static_cast<int>(it.error_count());
+  sum.initial_cost = it.objective();
+  sum.initial_sse = it.sse();
   sum.regularization = options.regularization;
-  double mu = options.mu;
-  double gradient = 0;
   std::string degenerate_message;  // set when the alpha/beta update stops being finite
   std::vector<double> after_step;  // F right after each epoch's LM step (TrainOptions::change)
-
   for (int epoch = 0;; ++epoch) {
-    ErrorJacobian(net, cache, &J);
-    Eigen::Map<const Eigen::VectorXd> e_flat(e.data(), e.size());
-    je.noalias() = J.transpose() * e_flat;
-    if (errors_form) {
-      ErrorGram(net, cache, J, &gram);
-      jw.noalias() = J * w;
-    } else {
-      GramLower(J, &Jt, &gram);  // lower triangle only
-    }
-    gradient = 2 * je.norm();
-
+    it.Linearize();
     sum.epochs = epoch;
-    if (StopReached(options, epoch, sse, gradient, mu, after_step, degenerate_message, &sum)) break;
-
+    if (StopReached(options, epoch, it.sse(), it.gradient(), it.mu(), after_step,
+                    degenerate_message, &sum))
+      break;
     EpochInfo info;
     info.epoch = epoch + 1;
     info.max_epochs = options.epochs;
-    info.objective_before = F;
-    info.gradient = gradient;
-    if (!errors_form) rhs = beta * je + alpha * w;
-    bool accepted = false;
-    double shift_accepted = 0;  // mu + alpha of the accepted step; A holds its factor
-    while (mu <= options.mu_max) {
-      const double c = mu + alpha;
-      if (FactorShifted(gram, beta, c, &A, &inv_diag)) {
-        if (errors_form) {
-          // dw = -(alpha/c) w - beta J' K_c^-1 (e - (alpha/c) J w) (LinearSystem::kErrors).
-          const double r = alpha / c;
-          rhs = e_flat - r * jw;
-          SolveFactored(A, inv_diag, rhs, &y);
-          dw.noalias() = -beta * (J.transpose() * y);
-          dw -= r * w;
-        } else {
-          SolveFactored(A, inv_diag, rhs, &dw);
-          dw = -dw;
-        }
-        if (dw.allFinite()) {
-          w2 = w + dw;
-          trial_net.SetParameters(w2);
-          trial_net.Forward(data.inputs, &trial_cache);
-          e2 = data.targets - trial_cache.output();
-          const double sse2 = SumSquares(e2);
-          const double ssx2 = w2.squaredNorm();
-          const double F2 = beta * sse2 + alpha * ssx2;
-          if (F2 < F) {
-            std::swap(w, w2);
-            std::swap(net, trial_net);
-            std::swap(cache, trial_cache);
-            std::swap(e, e2);
-            sse = sse2;
-            ssx = ssx2;
-            F = F2;
-            shift_accepted = c;
-            mu = std::max(mu * options.mu_dec, kMuFloor);
-            accepted = true;
-            break;
-          }
-        }
-      }
-      mu *= options.mu_inc;
+    info.objective_before = it.objective();
+    info.gradient = it.gradient();
+    info.step_accepted = it.Step();
+    info.objective_after_step = it.objective();
+    if (options.change > 0) after_step.push_back(it.objective());
+    if (info.step_accepted && bayes) {
+      std::string degenerate = it.Reestimate();
+      if (!degenerate.empty()) degenerate_message = std::move(degenerate);
     }
-    info.step_accepted = accepted;
-    info.objective_after_step = F;
-    if (options.change > 0) after_step.push_back(F);
-    if (accepted && bayes) {
-      // gamma from the Gram matrix of this epoch and the old alpha, beta (REFERENCE.md
-      // section 2): trace(H^-1) = ||L^-1||_F^2 for H = L L'; in the errors form
-      // gamma = n - alpha trace(K_alpha^-1) (LinearSystem), so M - alpha trace covers both.
-      // Once mu has fallen below rounding of alpha, mu + alpha == alpha and the accepted step's
-      // factor is bit for bit the factor of this H: reuse it. An H that is not numerically
-      // positive definite gives gamma = NaN, which ends the fit on the degenerate path below.
-      bool factored = shift_accepted == alpha;
-      if (!factored) factored = FactorShifted(gram, beta, alpha, &A, &inv_diag);
-      const double gamma_new =
-          factored ? static_cast<double>(M) - alpha * TraceOfInverse(A, inv_diag, &work)
-                   : std::numeric_limits<double>::quiet_NaN();
-      const double alpha_new = ssx == 0 ? 1.0 : gamma_new / (2 * ssx);
-      const double beta_new = sse == 0 ? 1.0 : (n - gamma_new) / (2 * sse);
-      if (std::isfinite(alpha_new) && alpha_new > 0 && std::isfinite(beta_new) && beta_new > 0) {
-        gamma = gamma_new;
-        alpha = alpha_new;
-        beta = beta_new;
-      } else {
-        degenerate_message =
-            "gamma = " + MessageNumber(gamma_new) + ", alpha = " + MessageNumber(alpha_new) +
-            ", beta = (n - gamma)/(2 ssE) = " + MessageNumber(beta_new) +
-            " at ssE = " + MessageNumber(sse) + " (kept the last finite alpha, beta)";
-      }
-      F = beta * sse + alpha * ssx;
-    }
-    info.objective = F;
-    info.sse = sse;
-    info.ssx = ssx;
-    info.gamma = gamma;
-    info.alpha = alpha;
-    info.beta = beta;
-    info.mu = mu;
-    info.network = &net;
+    it.FillEpochEnd(&info);
     if (callback) callback(info);
   }
-
-  sum.final_cost = F;
-  sum.sse = sse;
-  sum.sum_squared_weights = ssx;
-  sum.gamma = gamma;
-  sum.alpha = alpha;
-  sum.beta = beta;
-  sum.mu = mu;
-  sum.gradient = gradient;
-  sum.rms_error_normalized = (e.array().square().rowwise().sum() / static_cast<double>(Q)).sqrt();
-  sum.rms_error = sum.rms_error_normalized.cwiseProduct(data.target_scaling.HalfRange());
-  if (bayes) {
-    // Laplace approximation at the final weights (J is at the final w: the loop ended right
-    // after computing it; in the weights form gram holds the lower triangle of its jj).
-    // Through the eigenvalues of jj (clamped at 0) rather than a Cholesky factor, so that a
-    // near-interpolating fit (beta ~ 1e8 or more, H badly conditioned) still gives a finite
-    // log det and a positive semi-definite covariance.
-    Eigen::MatrixXd jj(N, N);
-    if (errors_form) {
-      GramLower(J, &Jt, &jj);
-    } else {
-      jj = gram;
-    }
-    jj.triangularView<Eigen::StrictlyUpper>() = jj.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jj);
-    const Eigen::VectorXd h_eig =
-        (beta * eig.eigenvalues().cwiseMax(0.0)).array() + alpha;  // eigenvalues of H
-    const double log_det_h = h_eig.array().log().sum();
-    sum.noise_variance = 1.0 / (2.0 * beta);
-    const Eigen::MatrixXd& V = eig.eigenvectors();
-    result.posterior_covariance = V * (0.5 * h_eig.cwiseInverse()).asDiagonal() * V.transpose();
-    // Exact symmetry (the product leaves rounding-level asymmetry).
-    result.posterior_covariance =
-        0.5 * (result.posterior_covariance + result.posterior_covariance.transpose()).eval();
-    sum.log_evidence =
-        LogEvidence(sse, ssx, alpha, beta, log_det_h, N, static_cast<int>(n), net.layer_sizes,
-                    ActiveHiddenUnits(net, result.posterior_covariance,
-                                      Eigen::VectorXd::Constant(N, alpha)));
-  } else {
-    sum.log_evidence = std::numeric_limits<double>::quiet_NaN();
-    sum.noise_variance = std::numeric_limits<double>::quiet_NaN();
-  }
-  if (options.ard && bayes) {
-    // MacKay's model comparison: the ARD stage is kept only when the data support it.
-    int steps = 0;
-    TrainResult ard = RefineArd(data, result, options, callback, &steps);
-    const double margin = kArdEvidenceMargin * std::max(1.0, std::abs(sum.log_evidence));
-    if (steps > 0 && ard.summary.log_evidence > sum.log_evidence + margin) return ard;
-    sum.message += "; ARD stage not kept (" + std::to_string(steps) +
-                   " accepted steps, log evidence " + MessageNumber(ard.summary.log_evidence) +
-                   " against " + MessageNumber(sum.log_evidence) + ")";
-  }
+  it.Finish(&result);
+  if (options.ard && bayes) return KeepArdIfSupported(data, std::move(result), options, callback);
   return result;
 }
 

@@ -99,6 +99,71 @@ void CheckCurve(const ElongationCurve& curve) {
   }
 }
 
+// Centred moving-average windows [lo[i], hi[i]] of width `width_s` over the times t (two
+// pointers).
+struct MovingWindows {
+  std::vector<std::size_t> lo, hi;
+  MovingWindows(const std::vector<double>& t, double width_s) : lo(t.size()), hi(t.size()) {
+    const std::size_t n = t.size();
+    const double half = 0.5 * width_s;
+    for (std::size_t i = 0, l = 0, h = 0; i < n; ++i) {
+      while (t[l] < t[i] - half) ++l;
+      if (h < i) h = i;
+      while (h + 1 < n && t[h + 1] <= t[i] + half) ++h;
+      lo[i] = l;
+      hi[i] = h;
+    }
+  }
+  double Count(std::size_t i) const { return static_cast<double>(hi[i] - lo[i] + 1); }
+};
+
+// Where the detrended curve y - drift, smoothed over the windows, last leaves the band around
+// the plateau: the settle index is the sample after the last one outside (0 if none is), with
+// the band's half width there, um.
+struct BandExit {
+  std::size_t settle_index = 0;
+  double band_um = 0;
+};
+BandExit LastBandExit(const std::vector<double>& u, const std::vector<double>& y,
+                      const DriftFit& fit, const MovingWindows& w, const SettleOptions& options) {
+  const std::size_t n = y.size();
+  const double plateau = fit.coef(0);
+  std::vector<double> prefix(n + 1), smooth(n);
+  for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (y[i] - fit.Drift(u[i]));
+  for (std::size_t i = 0; i < n; ++i)
+    smooth[i] = (prefix[w.hi[i] + 1] - prefix[w.lo[i]]) / w.Count(i);
+  auto band = [&](std::size_t i) {
+    return std::max(options.tolerance_rel * std::abs(plateau),
+                    options.noise_sigma_multiplier * fit.sigma / std::sqrt(w.Count(i)));
+  };
+  BandExit exit;
+  for (std::size_t i = n; i-- > 0;) {
+    if (std::abs(smooth[i] - plateau) > band(i)) {
+      exit.settle_index = std::min(i + 1, n - 1);
+      break;
+    }
+  }
+  exit.band_um = band(exit.settle_index);
+  return exit;
+}
+
+// SettleAnalysis::message: the plateau, the fit and the band that decided the settle time.
+std::string DescribeSettle(const SettleAnalysis& a, const SettleOptions& options) {
+  std::ostringstream msg;
+  msg << "plateau " << FormatNumber(a.features.max_elongation_um)
+      << " um at the settle time (fit of"
+      << " plateau + degree-" << options.drift_degree << " drift from "
+      << FormatNumber(a.fit_start_s) << " s, " << a.iterations << " passes; drift "
+      << FormatNumber(a.drift_at_settle_um) << " um at the settle time, "
+      << FormatNumber(a.drift_at_end_um) << " um at the end), band +-" << FormatNumber(a.band_um)
+      << " um = max(" << options.tolerance_rel << " x plateau, " << options.noise_sigma_multiplier
+      << " x noise " << FormatNumber(a.noise_std_um) << " um / sqrt(samples in "
+      << options.smoothing_window_s << " s)); detrended smoothed curve stays in the band from "
+      << FormatNumber(a.features.settle_time_s) << " s"
+      << (a.settled_before_tail ? "" : " (NOT before the tail window: record too short)");
+  return msg.str();
+}
+
 // Steps 1-6 of the header on the whole of `curve`.
 SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& options) {
   const std::size_t n = curve.size();
@@ -111,56 +176,26 @@ SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& 
     std::size_t i = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), tt) - t.begin());
     return std::min(i, n - 3);
   };
-
-  // Centred moving-average windows [lo_i, hi_i] (two pointers); counts n_i.
-  std::vector<std::size_t> win_lo(n), win_hi(n);
-  const double half = 0.5 * options.smoothing_window_s;
-  for (std::size_t i = 0, lo = 0, hi = 0; i < n; ++i) {
-    while (t[lo] < t[i] - half) ++lo;
-    if (hi < i) hi = i;
-    while (hi + 1 < n && t[hi + 1] <= t[i] + half) ++hi;
-    win_lo[i] = lo;
-    win_hi[i] = hi;
-  }
-  std::vector<double> prefix(n + 1), smooth(n);
+  const MovingWindows windows(t, options.smoothing_window_s);
 
   const double t_tail = t0 + (1.0 - options.tail_fraction) * span;
   const std::size_t tail_begin = index_at(t_tail);
   std::size_t fit_begin = tail_begin;
   int degree = std::min(1, options.drift_degree);
   DriftFit fit;
-  std::size_t settle_index = 0;
-  double band_at_settle = 0;
+  BandExit settle;
   int iterations = 0;
   std::vector<std::size_t> visited;
   for (int pass = 0; pass < options.max_iterations; ++pass) {
     ++iterations;
     fit = FitPlateauAndDrift(u, y, fit_begin, degree);
-    const double plateau = fit.coef(0);
-    for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (y[i] - fit.Drift(u[i]));
-    for (std::size_t i = 0; i < n; ++i)
-      smooth[i] = (prefix[win_hi[i] + 1] - prefix[win_lo[i]]) /
-                  static_cast<double>(win_hi[i] - win_lo[i] + 1);
-    auto band = [&](std::size_t i) {
-      const double count = static_cast<double>(win_hi[i] - win_lo[i] + 1);
-      return std::max(options.tolerance_rel * std::abs(plateau),
-                      options.noise_sigma_multiplier * fit.sigma / std::sqrt(count));
-    };
-    std::size_t s = 0;
-    for (std::size_t i = n; i-- > 0;) {
-      if (std::abs(smooth[i] - plateau) > band(i)) {
-        s = std::min(i + 1, n - 1);
-        break;
-      }
-    }
-    band_at_settle = band(s);
-    const std::size_t next_begin =
-        std::min(tail_begin, index_at(t0 + options.fit_start_factor * (t[s] - t0)));
+    settle = LastBandExit(u, y, fit, windows, options);
+    const std::size_t next_begin = std::min(
+        tail_begin, index_at(t0 + options.fit_start_factor * (t[settle.settle_index] - t0)));
     // Stop at a fixed point, or when the window start comes back to an earlier value (a cycle
     // of two windows one sample apart: either answer is as good).
     const bool converged = degree == options.drift_degree &&
                            std::find(visited.begin(), visited.end(), next_begin) != visited.end();
-    settle_index = s;
     if (converged) break;
     if (degree == options.drift_degree) visited.push_back(fit_begin);
     fit_begin = next_begin;
@@ -168,6 +203,7 @@ SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& 
   }
 
   SettleAnalysis a;
+  const std::size_t settle_index = settle.settle_index;
   const double ts = t[settle_index];
   a.features.settle_time_s = ts - t0;
   // The level where the plateau is reached, P + d(t_s): the fit determines it from samples just
@@ -177,23 +213,11 @@ SettleAnalysis AnalyzeRecord(const ElongationCurve& curve, const SettleOptions& 
   a.drift_at_end_um = fit.Drift(1.0);
   a.plateau_slope_um_per_s = (fit.Drift(1.0) - fit.Drift(u[fit_begin])) / (t.back() - t[fit_begin]);
   a.noise_std_um = fit.sigma;
-  a.band_um = band_at_settle;
+  a.band_um = settle.band_um;
   a.fit_start_s = t[fit_begin];
   a.iterations = iterations;
   a.settled_before_tail = ts < t_tail;
-  std::ostringstream msg;
-  msg << "plateau " << FormatNumber(a.features.max_elongation_um)
-      << " um at the settle time (fit of"
-      << " plateau + degree-" << options.drift_degree << " drift from "
-      << FormatNumber(a.fit_start_s) << " s, " << iterations << " passes; drift "
-      << FormatNumber(a.drift_at_settle_um) << " um at the settle time, "
-      << FormatNumber(a.drift_at_end_um) << " um at the end), band +-" << FormatNumber(a.band_um)
-      << " um = max(" << options.tolerance_rel << " x plateau, " << options.noise_sigma_multiplier
-      << " x noise " << FormatNumber(a.noise_std_um) << " um / sqrt(samples in "
-      << options.smoothing_window_s << " s)); detrended smoothed curve stays in the band from "
-      << FormatNumber(a.features.settle_time_s) << " s"
-      << (a.settled_before_tail ? "" : " (NOT before the tail window: record too short)");
-  a.message = msg.str();
+  a.message = DescribeSettle(a, options);
   return a;
 }
 

@@ -329,70 +329,79 @@ void to_json(nlohmann::json& j, const CrosscheckReport& r) {
         {"message", r.torch_training.message}}}};
 }
 
-CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& inputs_raw,
-                               const Eigen::MatrixXd& targets_raw,
-                               const CrosscheckOptions& options) {
-  options.Validate();
-  const nn::Network& net = model.network;
-  const FlatLayout layout = MakeLayout(net);
-  CheckData(net, inputs_raw, targets_raw);
-  const Eigen::MatrixXd x = model.input_scaling.Apply(inputs_raw);
-  const Eigen::MatrixXd t = model.target_scaling.Apply(targets_raw);
-  const Eigen::VectorXd w_model = net.GetParameters();
+namespace {
 
-  CrosscheckReport report;
-  report.torch_version = TorchVersion();
-  report.sample_count = static_cast<int>(x.cols());
-  report.parameter_count = net.ParameterCount();
-  report.alpha = options.alpha > 0 ? options.alpha : model.training_summary.alpha;
-  report.beta = options.beta > 0 ? options.beta : model.training_summary.beta;
-  if (!(report.alpha >= 0) || !(report.beta > 0)) {
-    throw InputError("cross-check: the model has no usable trainbr alpha = " +
-                     FormatSignificant(report.alpha, 3) + ", beta = " +
-                     FormatSignificant(report.beta, 3) + " (need alpha >= 0, beta > 0); pass them");
-  }
-  const double alpha = report.alpha, beta = report.beta;
-
-  // Start of the trainings: a seeded relative perturbation of the model's weights.
+// The common start of both trainings: the model's weights, each times 1 + p u, u ~ U(-1, 1)
+// seeded (CrosscheckOptions::start_perturbation, seed).
+Eigen::VectorXd PerturbedStart(const Eigen::VectorXd& w_model, const CrosscheckOptions& options) {
   Eigen::VectorXd w0 = w_model;
   nn::Rng rng(options.seed);
   for (Eigen::Index i = 0; i < w0.size(); ++i) {
     w0(i) *= 1.0 + options.start_perturbation * rng.Uniform(-1.0, 1.0);
   }
+  return w0;
+}
 
+// The data of one cross-check in the model's normalized space, the layout and the two weight
+// vectors compared (the model's and the perturbed start).
+struct CrosscheckData {
+  const nn::Model& model;
+  const Eigen::MatrixXd& inputs_raw;
+  FlatLayout layout;
+  Eigen::MatrixXd x, t;  // normalized inputs and targets
+  Eigen::VectorXd w_model, w0;
+  double alpha = 0, beta = 0;
+};
+
+// Figures 1 and 2: forward outputs of the normalized network and of the whole model in original
+// units (scaling included).
+void AddForwardFigures(const CrosscheckData& d, const CrosscheckOptions& options,
+                       CrosscheckReport* report) {
+  const nn::Model& model = d.model;
+  const nn::Network& net = model.network;
+  const Eigen::MatrixXd& x = d.x;
+  const Eigen::MatrixXd& inputs_raw = d.inputs_raw;
   // 1. Forward, normalized network outputs.
   const Eigen::MatrixXd y_eigen = net.Forward(x);
-  const Eigen::MatrixXd y_torch = TorchForward(layout, w_model, x);
-  report.figures.push_back({"forward", MaxRelative(y_torch, y_eigen, 1.0),
-                            options.forward_tolerance,
-                            "max |y_T - y_E| / max(|y_E|, 1), network outputs (normalized)"});
+  const Eigen::MatrixXd y_torch = TorchForward(d.layout, d.w_model, x);
+  report->figures.push_back({"forward", MaxRelative(y_torch, y_eigen, 1.0),
+                             options.forward_tolerance,
+                             "max |y_T - y_E| / max(|y_E|, 1), network outputs (normalized)"});
 
   // 2. Forward, whole model in original units (scaling included).
   const ModelSpec spec = MakeModelSpec(model);
   const Eigen::MatrixXd raw_torch = TorchPredictRaw(spec, inputs_raw);
   const Eigen::MatrixXd raw_eigen = PredictMeans(model, inputs_raw);
-  report.figures.push_back(
+  report->figures.push_back(
       {"forward_original_units", MaxRelative(raw_torch, raw_eigen, 1e-300),
        options.forward_tolerance,
        "max |y_T - y_E| / |y_E|, model in original units: torch::nn::Module vs nn::Predict"});
+}
 
-  // 3. Jacobian J_e_w at the model's weights and at w0.
+// Figure 3: the Jacobian J_e_w at the model's weights and at the start.
+CrosscheckFigure JacobianFigure(const CrosscheckData& d, const CrosscheckOptions& options) {
+  const nn::Network& net = d.model.network;
   double jac = 0;
-  for (const Eigen::VectorXd* w : {&w_model, static_cast<const Eigen::VectorXd*>(&w0)}) {
-    const EigenObjective e = EvaluateEigen(net, *w, x, t, alpha, beta);
-    const Eigen::MatrixXd j_torch = TorchJacobian(layout, *w, x);
+  for (const Eigen::VectorXd* w : {&d.w_model, &d.w0}) {
+    const EigenObjective e = EvaluateEigen(net, *w, d.x, d.t, d.alpha, d.beta);
+    const Eigen::MatrixXd j_torch = TorchJacobian(d.layout, *w, d.x);
     jac = std::max(jac, MaxAbs(j_torch - e.jacobian) / std::max(1.0, MaxAbs(e.jacobian)));
     if (!j_torch.allFinite()) jac = std::numeric_limits<double>::quiet_NaN();
   }
-  report.figures.push_back({"jacobian", jac, options.jacobian_tolerance,
-                            "max |J_T - J_E| / max(1, max |J_E|), J = de/dw, autograd vs "
-                            "nn::ErrorJacobian, at w_model and w0"});
+  return {"jacobian", jac, options.jacobian_tolerance,
+          "max |J_T - J_E| / max(1, max |J_E|), J = de/dw, autograd vs "
+          "nn::ErrorJacobian, at w_model and w0"};
+}
 
-  // 4. Objective and gradient at the model's weights and at w0.
+// Figures 4 and 5: the objective and its gradient at the model's weights and at the start.
+void AddObjectiveFigures(const CrosscheckData& d, const CrosscheckOptions& options,
+                         CrosscheckReport* report) {
+  const nn::Network& net = d.model.network;
+  const double alpha = d.alpha, beta = d.beta;
   double obj = 0, grad = 0;
-  for (const Eigen::VectorXd* w : {&w_model, static_cast<const Eigen::VectorXd*>(&w0)}) {
-    const EigenObjective e = EvaluateEigen(net, *w, x, t, alpha, beta);
-    const TorchObjective tt = TorchEvaluate(layout, *w, x, t, alpha, beta);
+  for (const Eigen::VectorXd* w : {&d.w_model, &d.w0}) {
+    const EigenObjective e = EvaluateEigen(net, *w, d.x, d.t, alpha, beta);
+    const TorchObjective tt = TorchEvaluate(d.layout, *w, d.x, d.t, alpha, beta);
     obj = std::max(obj, std::abs(tt.objective - e.objective) / std::abs(e.objective));
     const Eigen::VectorXd g_eigen = 2.0 * (beta * e.je + alpha * *w);
     // e = t - y cancels when the fit is close: two correct implementations differ by ~eps |y|
@@ -405,30 +414,77 @@ CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& in
       obj = grad = std::numeric_limits<double>::quiet_NaN();
     }
   }
-  report.figures.push_back({"objective", obj, options.objective_tolerance,
-                            "|F_T - F_E| / |F_E|, F = beta ssE + alpha ssX, at w_model and w0"});
-  report.figures.push_back({"gradient", grad, options.gradient_tolerance,
-                            "max |g_T - g_E| / max(2 beta |J|'(|t|+|y|) + 2 alpha |w|), g = dF/dw, "
-                            "autograd vs 2(beta J'e + alpha w)"});
+  report->figures.push_back({"objective", obj, options.objective_tolerance,
+                             "|F_T - F_E| / |F_E|, F = beta ssE + alpha ssX, at w_model and w0"});
+  report->figures.push_back(
+      {"gradient", grad, options.gradient_tolerance,
+       "max |g_T - g_E| / max(2 beta |J|'(|t|+|y|) + 2 alpha |w|), g = dF/dw, "
+       "autograd vs 2(beta J'e + alpha w)"});
+}
 
-  // 5. Training with alpha, beta fixed from the same start.
+// Figures 6 and 7: both trainings with alpha, beta fixed from the same start, their minima and
+// predictions.
+void AddTrainingFigures(const CrosscheckData& d, const CrosscheckOptions& options,
+                        CrosscheckReport* report) {
+  const nn::Network& net = d.model.network;
+  const Eigen::MatrixXd& x = d.x;
   nn::Network start = net;
-  start.SetParameters(w0);
-  report.eigen_training =
-      MinimizeFixedHyperparameters(start, x, t, alpha, beta, options.eigen_training);
-  report.torch_training = TorchMinimize(layout, w0, x, t, alpha, beta, options.torch_training);
-  const double f_e = report.eigen_training.final_objective;
-  const double f_t = report.torch_training.final_objective;
-  report.figures.push_back({"training_objective", std::abs(f_t - f_e) / std::abs(f_e),
-                            options.training_objective_tolerance,
-                            "|F_LBFGS - F_GN| / |F_GN| at the two minima (alpha, beta fixed)"});
+  start.SetParameters(d.w0);
+  report->eigen_training =
+      MinimizeFixedHyperparameters(start, x, d.t, d.alpha, d.beta, options.eigen_training);
+  report->torch_training =
+      TorchMinimize(d.layout, d.w0, x, d.t, d.alpha, d.beta, options.torch_training);
+  const double f_e = report->eigen_training.final_objective;
+  const double f_t = report->torch_training.final_objective;
+  report->figures.push_back({"training_objective", std::abs(f_t - f_e) / std::abs(f_e),
+                             options.training_objective_tolerance,
+                             "|F_LBFGS - F_GN| / |F_GN| at the two minima (alpha, beta fixed)"});
   nn::Network trained_eigen = net, trained_torch = net;
-  trained_eigen.SetParameters(report.eigen_training.w);
-  trained_torch.SetParameters(report.torch_training.w);
+  trained_eigen.SetParameters(report->eigen_training.w);
+  trained_torch.SetParameters(report->torch_training.w);
   const double pred = MaxAbs(trained_torch.Forward(x) - trained_eigen.Forward(x));
-  report.figures.push_back({"training_prediction", std::isfinite(pred) ? pred : NAN,
-                            options.training_prediction_tolerance,
-                            "max |y_LBFGS - y_GN| on the data, normalized target units"});
+  report->figures.push_back({"training_prediction", std::isfinite(pred) ? pred : NAN,
+                             options.training_prediction_tolerance,
+                             "max |y_LBFGS - y_GN| on the data, normalized target units"});
+}
+
+}  // namespace
+
+CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& inputs_raw,
+                               const Eigen::MatrixXd& targets_raw,
+                               const CrosscheckOptions& options) {
+  options.Validate();
+  const nn::Network& net = model.network;
+  const FlatLayout layout = MakeLayout(net);
+  CheckData(net, inputs_raw, targets_raw);
+  CrosscheckData d{model,
+                   inputs_raw,
+                   layout,
+                   model.input_scaling.Apply(inputs_raw),
+                   model.target_scaling.Apply(targets_raw),
+                   net.GetParameters(),
+                   /*w0=*/{},
+                   /*alpha=*/0,
+                   /*beta=*/0};
+
+  CrosscheckReport report;
+  report.torch_version = TorchVersion();
+  report.sample_count = static_cast<int>(d.x.cols());
+  report.parameter_count = net.ParameterCount();
+  report.alpha = options.alpha > 0 ? options.alpha : model.training_summary.alpha;
+  report.beta = options.beta > 0 ? options.beta : model.training_summary.beta;
+  if (!(report.alpha >= 0) || !(report.beta > 0)) {
+    throw InputError("cross-check: the model has no usable trainbr alpha = " +
+                     FormatSignificant(report.alpha, 3) + ", beta = " +
+                     FormatSignificant(report.beta, 3) + " (need alpha >= 0, beta > 0); pass them");
+  }
+  d.alpha = report.alpha;
+  d.beta = report.beta;
+  d.w0 = PerturbedStart(d.w_model, options);
+  AddForwardFigures(d, options, &report);
+  report.figures.push_back(JacobianFigure(d, options));
+  AddObjectiveFigures(d, options, &report);
+  AddTrainingFigures(d, options, &report);
   return report;
 }
 

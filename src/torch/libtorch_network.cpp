@@ -393,60 +393,121 @@ std::string LbfgsSummary::BriefReport() const {
          message + ")";
 }
 
-LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
-                           const Eigen::MatrixXd& x_norm, const Eigen::MatrixXd& t_norm,
-                           double alpha, double beta, const LbfgsOptions& options) {
-  Prepare();
-  CheckData(layout, x_norm, &t_norm);
+namespace {
+
+void CheckLbfgsOptions(const LbfgsOptions& options) {
   if (options.max_steps < 1 || options.iterations_per_step < 1 || options.history_size < 1 ||
       !(options.gradient_tolerance > 0) || !(options.change_tolerance >= 0)) {
     throw InputError(
         "LBFGS options: max_steps, iterations_per_step, history_size must be >= 1, "
         "gradient_tolerance > 0 and change_tolerance >= 0");
   }
-  WhirlNet net(layout, w0);
-  const Tensor x = SamplesToTensor(x_norm), t = SamplesToTensor(t_norm);
-  const std::vector<Tensor> params = net->LayerParameters();
-  const auto lbfgs_options = [&] {
-    return ::torch::optim::LBFGSOptions(1.0)
-        .max_iter(options.iterations_per_step)
-        .history_size(options.history_size)
-        .tolerance_grad(options.gradient_tolerance)
-        .tolerance_change(options.change_tolerance)
-        .line_search_fn("strong_wolfe");
-  };
+}
+
+// LibTorch's LBFGS for one step of TorchMinimize: unit learning rate, strong Wolfe line search.
+::torch::optim::LBFGSOptions TorchLbfgsOptions(const LbfgsOptions& options) {
+  return ::torch::optim::LBFGSOptions(1.0)
+      .max_iter(options.iterations_per_step)
+      .history_size(options.history_size)
+      .tolerance_grad(options.gradient_tolerance)
+      .tolerance_change(options.change_tolerance)
+      .line_search_fn("strong_wolfe");
+}
+
+// Iterations an LBFGS optimizer has made so far (its state's n_iter).
+int IterationsOf(const ::torch::optim::LBFGS& optimizer) {
+  int64_t n = 0;
+  for (const auto& kv : optimizer.state()) {
+    n = static_cast<const ::torch::optim::LBFGSParamState&>(*kv.second).n_iter();
+  }
+  return static_cast<int>(n);
+}
+
+// F = beta ssE + alpha ssX of the network parameters `params` on fixed data, counting every
+// evaluation (with its gradient) for LbfgsSummary::function_evaluations.
+struct CountedObjective {
+  const std::vector<Tensor>& params;
+  const Tensor& x;
+  const Tensor& t;
+  double alpha, beta;
   int evaluations = 0;
-  // Objective and inf-norm of dF/dw at the current parameters.
-  const auto evaluate = [&](double* f, double* g_inf) {
-    const Tensor value = ObjectiveWith(params, x, t, alpha, beta, nullptr, nullptr);
+
+  // F at the parameters `w` (shaped like params), with its autograd graph.
+  Tensor At(const std::vector<Tensor>& w) const {
+    return ObjectiveWith(w, x, t, alpha, beta, nullptr, nullptr);
+  }
+  // F and the inf-norm of dF/dw at the current parameters.
+  void Evaluate(double* f, double* g_inf) {
+    const Tensor value = At(params);
     const std::vector<Tensor> grads = ::torch::autograd::grad({value}, params);
     double worst = 0;
     for (const Tensor& g : grads) worst = std::max(worst, g.abs().max().item<double>());
     ++evaluations;
     *f = value.item<double>();
     *g_inf = worst;
-  };
-  const auto iterations_of = [](const ::torch::optim::LBFGS& optimizer) {
-    int64_t n = 0;
-    for (const auto& kv : optimizer.state()) {
-      n = static_cast<const ::torch::optim::LBFGSParamState&>(*kv.second).n_iter();
-    }
-    return static_cast<int>(n);
-  };
+  }
+};
 
+// One preconditioned step: LBFGS on z with w = w_c + M z (the same F, Hessian ~ 2 I near w_c),
+// from z = 0; the parameters are then set to w_c + M z. Returns the LBFGS iterations.
+int PreconditionedStep(const Tensor& m, const LbfgsOptions& options, CountedObjective& objective) {
+  const std::vector<Tensor>& params = objective.params;
+  const Tensor w_c = CatParameters(params);
+  Tensor z = ::torch::zeros({w_c.size(0)}, kF64).requires_grad_(true);
+  ::torch::optim::LBFGS optimizer({z}, TorchLbfgsOptions(options));
+  auto closure = [&]() -> Tensor {
+    optimizer.zero_grad();
+    Tensor value = objective.At(SplitParameters(w_c + m.mv(z), params));
+    value.backward();
+    ++objective.evaluations;
+    return value;
+  };
+  optimizer.step(closure);
+  const int iterations = IterationsOf(optimizer);
+  ::torch::NoGradGuard no_grad;
+  const std::vector<Tensor> w_new = SplitParameters(w_c + m.mv(z.detach()), params);
+  for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(w_new[k]);
+  return iterations;
+}
+
+// The termination of a run that used all its steps without another stop: the gradient test at
+// the final point, or max_steps.
+void SetEndOfSteps(double g_inf, const LbfgsOptions& options, LbfgsSummary* summary) {
+  if (g_inf <= options.gradient_tolerance) {
+    summary->termination = LbfgsTermination::kGradientTolerance;
+    summary->message = "||dF/dw||_inf " + MessageNumber(g_inf) +
+                       " <= " + MessageNumber(options.gradient_tolerance);
+  } else {
+    summary->message = std::to_string(options.max_steps) + " steps, ||dF/dw||_inf " +
+                       MessageNumber(g_inf) + " > " + MessageNumber(options.gradient_tolerance);
+  }
+}
+
+}  // namespace
+
+LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
+                           const Eigen::MatrixXd& x_norm, const Eigen::MatrixXd& t_norm,
+                           double alpha, double beta, const LbfgsOptions& options) {
+  Prepare();
+  CheckData(layout, x_norm, &t_norm);
+  CheckLbfgsOptions(options);
+  WhirlNet net(layout, w0);
+  const Tensor x = SamplesToTensor(x_norm), t = SamplesToTensor(t_norm);
+  const std::vector<Tensor> params = net->LayerParameters();
+  CountedObjective objective{params, x, t, alpha, beta};
   // Plain LBFGS keeps one optimizer (and its history) over all steps.
-  ::torch::optim::LBFGS plain(params, lbfgs_options());
+  ::torch::optim::LBFGS plain(params, TorchLbfgsOptions(options));
   auto plain_closure = [&]() -> Tensor {
     plain.zero_grad();
-    Tensor f = ObjectiveWith(params, x, t, alpha, beta, nullptr, nullptr);
+    Tensor f = objective.At(params);
     f.backward();
-    ++evaluations;
+    ++objective.evaluations;
     return f;
   };
 
   LbfgsSummary summary;
   double f = 0, g_inf = 0;
-  evaluate(&f, &g_inf);
+  objective.Evaluate(&f, &g_inf);
   summary.initial_objective = f;
   summary.termination = LbfgsTermination::kMaxSteps;
   int preconditioned_iterations = 0;
@@ -460,29 +521,12 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
     const double f_before = f;
     Tensor m;
     if (options.gauss_newton_preconditioner) m = GaussNewtonPreconditioner(params, x, alpha, beta);
-    if (m.defined()) {
-      // LBFGS on z with w = w_c + M z: the same F, Hessian ~ 2 I near w_c.
-      const Tensor w_c = CatParameters(params);
-      Tensor z = ::torch::zeros({w_c.size(0)}, kF64).requires_grad_(true);
-      ::torch::optim::LBFGS optimizer({z}, lbfgs_options());
-      auto closure = [&]() -> Tensor {
-        optimizer.zero_grad();
-        Tensor value = ObjectiveWith(SplitParameters(w_c + m.mv(z), params), x, t, alpha, beta,
-                                     nullptr, nullptr);
-        value.backward();
-        ++evaluations;
-        return value;
-      };
-      optimizer.step(closure);
-      preconditioned_iterations += iterations_of(optimizer);
-      ::torch::NoGradGuard no_grad;
-      const std::vector<Tensor> w_new = SplitParameters(w_c + m.mv(z.detach()), params);
-      for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(w_new[k]);
-    } else {
+    if (m.defined())
+      preconditioned_iterations += PreconditionedStep(m, options, objective);
+    else
       plain.step(plain_closure);
-    }
     ++summary.steps;
-    evaluate(&f, &g_inf);
+    objective.Evaluate(&f, &g_inf);
     if (std::isfinite(f) && f >= f_before && g_inf > options.gradient_tolerance) {
       summary.termination = LbfgsTermination::kNoProgress;
       summary.message = "a step left F at " + MessageNumber(f) + " (was " +
@@ -491,21 +535,12 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
       break;
     }
   }
-  if (summary.termination == LbfgsTermination::kMaxSteps) {
-    if (g_inf <= options.gradient_tolerance) {
-      summary.termination = LbfgsTermination::kGradientTolerance;
-      summary.message = "||dF/dw||_inf " + MessageNumber(g_inf) +
-                        " <= " + MessageNumber(options.gradient_tolerance);
-    } else {
-      summary.message = std::to_string(options.max_steps) + " steps, ||dF/dw||_inf " +
-                        MessageNumber(g_inf) + " > " + MessageNumber(options.gradient_tolerance);
-    }
-  }
-  summary.iterations = preconditioned_iterations + iterations_of(plain);
+  if (summary.termination == LbfgsTermination::kMaxSteps) SetEndOfSteps(g_inf, options, &summary);
+  summary.iterations = preconditioned_iterations + IterationsOf(plain);
   summary.preconditioned = options.gauss_newton_preconditioner;
   summary.final_objective = f;
   summary.final_gradient_inf = g_inf;
-  summary.function_evaluations = evaluations;
+  summary.function_evaluations = objective.evaluations;
   std::vector<Tensor> detached;
   for (const Tensor& p : params) detached.push_back(p.detach());
   summary.w = net->Flatten(detached);
