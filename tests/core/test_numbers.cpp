@@ -78,8 +78,7 @@ TEST(Numbers, FixedNeverNegativeZeroNorExponent) {
       const bool zero = s.find_first_not_of("-0.") == std::string::npos;
       ASSERT_FALSE(zero && s[0] == '-') << x << " -> " << s;
       // Otherwise exactly printf's text: the value the control reads is what was rounded.
-      if (!zero) ASSERT_EQ(s, Printf("%.*f", decimals, x)) << x;
-      if (zero) ASSERT_EQ(s, Printf("%.*f", decimals, 0.0)) << x;
+      ASSERT_EQ(s, Printf("%.*f", decimals, zero ? 0.0 : x)) << x;
     }
   }
 }

@@ -10,14 +10,13 @@ W="$1"; D="$2"; SRC="$3"
 rm -rf "$D"; mkdir -p "$D"
 source "$SRC/tests/support/cli_common.sh"
 
-# The subcommand names listed under "Subcommands:" in the --help of "$@".
+# The subcommand names listed under "Subcommands:" in a --help text on stdin.
 subcommands() {
-  "$@" --help | awk '/^Subcommands:/ {on = 1; next} on && /^  [a-z][a-z0-9-]* / {print $1}'
+  awk '/^Subcommands:/ {on = 1; next} on && /^  [a-z][a-z0-9-]* / {print $1}'
 }
-# The numeric flags in the --help of "$@": "--name FLOAT...", "--name INT...", "--name UINT...".
+# The numeric flags in a --help text on stdin: "--name FLOAT...", "--name INT...", "--name UINT...".
 numeric_flags() {
-  "$@" --help | grep -oE -- '^ +(-[a-zA-Z],)?--[a-z0-9-]+ +(FLOAT|INT|UINT)([: ]|$)' |
-    grep -oE -- '--[a-z0-9-]+'
+  grep -oE -- '^ +(-[a-zA-Z],)?--[a-z0-9-]+ +(FLOAT|INT|UINT)([: ]|$)' | grep -oE -- '--[a-z0-9-]+'
 }
 
 failures=0
@@ -33,31 +32,32 @@ check_flag() {  # check_flag <flag> <command words...>
   done
 }
 
-# Numeric option lines of "$@" --help without a range or a list after the type.
+# Numeric option lines of a --help text on stdin without a range or a list after the type.
 without_range() {
-  "$@" --help | grep -E -- '^ +(-[a-zA-Z],)?--[a-z0-9-]+ +(FLOAT|INT|UINT)([: ]|$)' |
+  grep -E -- '^ +(-[a-zA-Z],)?--[a-z0-9-]+ +(FLOAT|INT|UINT)([: ]|$)' |
     grep -vE -- '(FLOAT|INT|UINT):([[({]|>=? |finite)'
 }
 
 walk() {  # walk <command words...>: checks the command's flags, then its subcommands'
-  local flag sub line
+  local flag sub line help
+  help=$("$W" "$@" --help) || fail "whirl $* --help failed"
   while IFS= read -r line; do
     [ -n "$line" ] || continue
     echo "FAIL: whirl $*: no range in --help: $line"
     failures=$((failures + 1))
     [ "${KEEP_GOING:-0}" = 1 ] || exit 1
-  done <<< "$(without_range "$W" "$@")"
-  for flag in $(numeric_flags "$W" "$@"); do
+  done <<< "$(without_range <<< "$help")"
+  for flag in $(numeric_flags <<< "$help"); do
     check_flag "$flag" "$@"
     checked=$((checked + 1))
   done
-  for sub in $(subcommands "$W" "$@"); do walk "$@" "$sub"; done
+  for sub in $(subcommands <<< "$help"); do walk "$@" "$sub"; done
 }
 
 checked=0
-for sub in $(subcommands "$W"); do walk "$sub"; done
+for sub in $("$W" --help | subcommands); do walk "$sub"; done
 [ "$failures" -eq 0 ] || fail "$failures flag values accepted or refused without naming the flag"
 # The walk itself must find the flags: plan alone has more than ten numeric ones.
 [ "$checked" -gt 50 ] || fail "only $checked numeric flags found: has the --help format changed?"
-[ -n "$(numeric_flags "$W" plan | grep -x -- --tolerance-um)" ] || fail "plan --tolerance-um not found"
+[ -n "$("$W" plan --help | numeric_flags | grep -x -- --tolerance-um)" ] || fail "plan --tolerance-um not found"
 echo "checked $checked numeric flags"
