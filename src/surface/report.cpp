@@ -15,17 +15,19 @@ namespace whirl::surface {
 namespace fs = std::filesystem;
 namespace {
 
+// gnuplot data: 10 significant digits.
+std::string G10(double x) { return FormatSignificant(x, 10); }
+
 std::string GridData(const SurfaceFit& fit, int n) {
   const Bounds& b = fit.surface.bounds;
   std::ostringstream s;
-  s.precision(10);
   s << "# x_mm y_mm error_um: the " << ToString(fit.surface.method) << " surface on a " << n
     << " x " << n << " map\n";
   for (int i = 0; i < n; ++i) {
     const double y = b.y_min_mm + (b.y_max_mm - b.y_min_mm) * i / (n - 1);
     for (int j = 0; j < n; ++j) {
       const double x = b.x_min_mm + (b.x_max_mm - b.x_min_mm) * j / (n - 1);
-      s << x << ' ' << y << ' ' << fit.surface.Evaluate(x, y) << '\n';
+      s << G10(x) << ' ' << G10(y) << ' ' << G10(fit.surface.Evaluate(x, y)) << '\n';
     }
     s << '\n';
   }
@@ -34,9 +36,9 @@ std::string GridData(const SurfaceFit& fit, int n) {
 
 std::string PointsData(const SurfaceFit& fit) {
   std::ostringstream s;
-  s.precision(10);
   s << "# x_mm y_mm error_um: the measured points\n";
-  for (const auto& p : fit.points) s << p.x_mm << ' ' << p.y_mm << ' ' << p.error_um << '\n';
+  for (const auto& p : fit.points)
+    s << G10(p.x_mm) << ' ' << G10(p.y_mm) << ' ' << G10(p.error_um) << '\n';
   return s.str();
 }
 
