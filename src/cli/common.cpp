@@ -46,10 +46,10 @@ void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_require
   if (screw_required) screw->required();
   sub->add_option("--max-elongation", a->max_elongation_um,
                   "instead of --model: plateau elongation L [um]")
-      ->check(NumberIn(0, kMaxElongationUm, "um"));
-  sub->add_option("--settle-time", a->settle_time_s,
-                  "instead of --model: settle time t_s [s]")
-      ->check(NumberIn(kMinPlanSettleTimeS, kMaxSettleTimeS, "s"));
+      ->check(NumberIn(Range{0, kMaxElongationUm, false, "um", "max_elongation_um"}));
+  sub->add_option("--settle-time", a->settle_time_s, "instead of --model: settle time t_s [s]")
+      ->check(NumberIn(Range{kMinPlanSettleTimeS, kMaxSettleTimeS, false, "s",
+                             "settle_time_s: at least 1 s, so the check grid stays bounded"}));
   AddCurveShapeOptions(sub, &a->shape_k, &a->time_exponent);
   sub->add_flag("--allow-extrapolation", a->allow_extrapolation,
                 "use the prediction even if the screw lies outside the model's training domain");
@@ -93,7 +93,7 @@ CLI::Validator NumberIn(const Range& range) {
   const auto check = [range, rule](std::string& value) -> std::string {
     const auto x = ParseDecimal(value);
     if (x && range.Contains(*x)) return "";
-    return (x ? MessageNumber(*x) : "'" + value + "'") + " breaks the rule: " + rule;
+    return (x ? value : "'" + value + "'") + " breaks the rule: " + rule;  // as typed
   };
   return CLI::Validator(check, text);
 }
@@ -114,7 +114,10 @@ CLI::Validator FiniteNumber(const char* unit) {
   return NumberIn(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), unit);
 }
 
-CLI::Validator Md32760Number() { return NumberIn(Range{0, interp::kMd32760Max, true, ""}); }
+CLI::Validator Md32760Number() {
+  return NumberIn(
+      Range{0, interp::kMd32760Max, true, "", "MD32760 on the 840D must be in (0, 0.10]"});
+}
 
 void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
   sub->add_option("--tolerance-um", *tolerance_um,

@@ -69,8 +69,8 @@ CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string
 
 /// The one check of every numeric flag: the text must be a finite decimal number (core/csv.h
 /// ParseDecimal: "nan", "inf", "1e999", "0x1p3" and "1,5" are refused) inside `range`. CLI11
-/// names the flag in front of the message: "--tolerance-um: 1e-09 breaks the rule: a finite
-/// number in [0.001, 10000] um (...)", the value and the range written as in every message
+/// names the flag in front of the message: "--tolerance-um: 1e-9 breaks the rule: a finite
+/// number in [0.001, 10000] um (...)", the value as typed, the range written as in every message
 /// (MessageNumber). A whole-number flag also needs its text to convert, which CLI11 checks after.
 /// The range shows in --help after the type: "FLOAT:[0.001, 10000] um", "FLOAT:> 0 s" (no upper
 /// bound), "FLOAT:finite".
