@@ -50,39 +50,39 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   sub->add_option("--check-every-min", a->check_every_min,
                   "interval between checks [min] (default 120: 3-4 checks in an 8-h shift; at "
                   "most 100,000 checks per run)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber("min"));
   sub->add_option("--check-every-samples", a->check_every_samples,
                   "interval between checks [samples], for runs without recorded time")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--check-every", o.check_every,
                   "deprecated: the interval [min; samples if the run has no time]; use "
                   "--check-every-min or --check-every-samples")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--threshold-um", o.threshold_um,
                   "validity threshold on |measured - predicted| [um] (default 0: use "
                   "--threshold-sigma)")
-      ->check(CLI::Range(0.0, 1e5));
+      ->check(NumberIn(0.0, 1e5));
   sub->add_option("--threshold-sigma", o.threshold_sigma,
                   "threshold as a multiple of sqrt(s^2 + noise^2), s the model's training residual "
                   "std [um] (default 3)")
-      ->check(CLI::Range(0.01, 100.0));
+      ->check(NumberIn(0.01, 100.0));
   sub->add_option(
          "--refit-samples", o.refit_samples,
          "m: further measurements after an invalid check (0..100, default 0: update from the "
          "check alone; 3 recommended with check-bar noise >= 0.5 um)")
-      ->check(CLI::Range(0, drift::kMaxRefitSamples));
+      ->check(NumberIn(0, drift::kMaxRefitSamples));
   sub->add_option("--refit-every-min", a->refit_every_min,
                   "interval between the refit measurements [min] (default 5)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber("min"));
   sub->add_option("--refit-every-samples", a->refit_every_samples,
                   "interval between the refit measurements [samples], runs without time")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--refit-every", o.refit_every,
                   "deprecated: --refit-every-min or --refit-every-samples")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--stop-min", o.stop_min_per_measurement,
                   "machine stop per check-bar measurement [min] (default 1)")
-      ->check(CLI::Range(0.0, 1440.0));
+      ->check(NumberIn(0.0, 1440.0));
   sub->add_option("--update", a->updates,
                   "update rules replayed beside the static model: bayes (recursive least squares, "
                   "the training fit as prior; the recommended rule: its change is bounded), "
@@ -93,20 +93,24 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   sub->add_option("--prior-scale", o.prior_scale,
                   "bayes: prior covariance = this x the training fit's Cov(b) (default 100, chosen "
                   "on a validation block before the test window of FL_THERMAL)")
-      ->check(CLI::Range(1e-6, 1e12));
+      ->check(NumberIn(1e-6, 1e12));
   sub->add_option(
          "--noise-um", o.noise_um,
          "std of the check-bar measurement noise added to the logged error [um] (default 0)")
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(NumberIn(0.0, 1000.0));
   AddSeedOption(sub, &o.seed, "seed of the measurement noise (default 1)");
   sub->add_option("--start-min", a->start_min,
-                  "monitoring starts here [min]: no check before, scores from here (default 0)");
+                  "monitoring starts here [min]: no check before, scores from here (default 0)")
+      ->check(FiniteNumber("min"));
   sub->add_option("--start-samples", a->start_samples,
-                  "monitoring starts at this sample, for runs without recorded time");
-  sub->add_option("--start", o.start, "deprecated: --start-min or --start-samples");
+                  "monitoring starts at this sample, for runs without recorded time")
+      ->check(FiniteNumber());
+  sub->add_option("--start", o.start, "deprecated: --start-min or --start-samples")
+      ->check(FiniteNumber());
   sub->add_option("--score-rows", a->score_rows,
                   "scored share of the run's rows FROM,TO (default 0,1; FL_THERMAL's test "
                   "window: 0.6,0.8)")
+      ->check(NumberIn(0, 1))
       ->delimiter(',')
       ->expected(2);
   sub->add_option("--reference", a->reference,

@@ -2,13 +2,14 @@
 
 #include <stdexcept>
 
+#include "cli/common.h"
 #include "core/error.h"
 
 namespace whirl::cli {
 
 void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
   sub->add_option("--alpha", s->alpha, "significance level of the F test (default 0.05)")
-      ->check(CLI::Range(1e-6, 0.5));
+      ->check(NumberIn(1e-6, 0.5));
   sub->add_option("--classes", s->classes,
                   "class count: 'fewest' (seed 000: fewest classes with a significant F, "
                   "default), 'margin' (largest (F - F_crit)/F_crit), 'cv' (the count whose "
@@ -18,7 +19,7 @@ void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
                   "at most this many classes = chosen sensors (default 0: no limit, the same in "
                   "every drift command; the fewest rule rarely reaches a cap, --classes cv may "
                   "keep many sensors)")
-      ->check(CLI::Range(0, 64));
+      ->check(NumberIn(0, 64));
 }
 
 drift::SelectionOptions ToSelection(const SelectionArgs& a) {

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
@@ -16,12 +17,6 @@ namespace whirl::drift {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string F(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
 
 std::string TimeName(const MonitorResult& r) { return r.time_from_index ? "sample" : "time_min"; }
 
@@ -149,15 +144,16 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
   const std::string unit = idx ? "samples" : "h";
   std::ostringstream s;
   s << "run " << r.run << ", " << r.error_column << ", " << r.model_kind << " model; checks every "
-    << F("%g", o.check_every) << (idx ? " samples" : " min") << ", threshold "
-    << F("%.2f", r.threshold_um) << " um, " << o.refit_samples << " refit measurements every "
-    << F("%g", o.refit_every) << (idx ? " samples" : " min") << ", "
-    << F("%g", o.stop_min_per_measurement) << " min stop each"
+    << MessageNumber(o.check_every) << (idx ? " samples" : " min") << ", threshold "
+    << FormatDecimals(r.threshold_um, 2) << " um, " << o.refit_samples
+    << " refit measurements every " << MessageNumber(o.refit_every) << (idx ? " samples" : " min")
+    << ", " << MessageNumber(o.stop_min_per_measurement) << " min stop each"
     << (idx ? " (no recorded time: intervals count samples; stop share not computed)" : "")
     << "\n";
   s << "scored rows [" << r.score_begin << ", " << r.score_end
-    << "): " << F("%.2f", r.time[static_cast<std::size_t>(r.score_begin)] * to_h) << " to "
-    << F("%.2f", r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h) << " " << unit << "\n";
+    << "): " << FormatDecimals(r.time[static_cast<std::size_t>(r.score_begin)] * to_h, 2) << " to "
+    << FormatDecimals(r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h, 2) << " " << unit
+    << "\n";
   s << "rule      MAE um  RMSE um  max um  checks  invalid  recal  stop min  stop %\n";
   char buf[200];
   std::snprintf(buf, sizeof buf,
@@ -168,7 +164,7 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
     std::snprintf(buf, sizeof buf, "%-8s %7.2f %8.2f %7.2f %7d %8d %6d %9.1f ",
                   ToString(st.rule).c_str(), st.score.mae_um, st.score.rmse_um, st.score.max_abs_um,
                   st.checks, st.invalid_checks, st.recalibrations, st.stop_min);
-    s << buf << (idx ? "      -" : F("%7.2f", 100.0 * st.stop_share)) << "\n";
+    s << buf << (idx ? "      -" : PadLeft(FormatDecimals(100.0 * st.stop_share, 2), 7)) << "\n";
   }
   for (const auto& b : r.baselines) {
     std::snprintf(buf, sizeof buf,
@@ -182,7 +178,7 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
     s << ToString(st.rule) << " updates:\n";
     for (const auto& e : st.events)
       if (e.kind == MonitorEvent::Kind::kUpdate || e.kind == MonitorEvent::Kind::kSkipped)
-        s << "  " << F("%.2f", e.time * to_h) << " " << unit << ": " << e.message << "\n";
+        s << "  " << FormatDecimals(e.time * to_h, 2) << " " << unit << ": " << e.message << "\n";
   }
   for (const auto& w : r.warnings) s << "warning: " << w << "\n";
   return s.str();
@@ -192,18 +188,18 @@ std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
   std::ostringstream s;
   const bool idx = w.days.front().time_from_index;
   s << "production week of " << w.days.size() << " day(s), " << w.days.front().error_column
-    << ": checks every " << F("%g", o.check_every) << (idx ? " samples" : " min")
+    << ": checks every " << MessageNumber(o.check_every) << (idx ? " samples" : " min")
     << " from each day's start, " << o.refit_samples
     << " refit measurements; each rule carries its coefficients (and the bayes covariance) "
        "from day to day\n";
   s << "MAE um per day (previous = refit on the previous day; time = sensor-free warm-up fitted "
        "on the previous day)\n";
   for (const auto& d : w.days) {
-    s << "  " << d.run << ": none " << F("%.2f", d.none.mae_um);
+    s << "  " << d.run << ": none " << FormatDecimals(d.none.mae_um, 2);
     for (const auto& st : d.strategies)
-      s << ", " << ToString(st.rule) << " " << F("%.2f", st.score.mae_um) << " (" << st.checks
-        << " checks, " << F("%.0f", st.stop_min) << " min)";
-    for (const auto& b : d.baselines) s << ", " << b.name << " " << F("%.2f", b.score.mae_um);
+      s << ", " << ToString(st.rule) << " " << FormatDecimals(st.score.mae_um, 2) << " (" << st.checks
+        << " checks, " << FormatDecimals(st.stop_min, 0) << " min)";
+    for (const auto& b : d.baselines) s << ", " << b.name << " " << FormatDecimals(b.score.mae_um, 2);
     s << "; strongest " << d.Strongest() << "\n";
   }
   s << "week         MAE um  RMSE um  measurements  stop min\n";
@@ -213,7 +209,7 @@ std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
     s << buf;
     for (std::size_t i = 0; i < w.days.front().strategies.size(); ++i)
       if (ToString(w.days.front().strategies[i].rule) == name)
-        s << F("%14.0f", w.measurements[i]) << F("%10.0f", w.stop_min[i]);
+        s << PadLeft(std::to_string(w.measurements[i]), 14) << PadLeft(FormatDecimals(w.stop_min[i], 0), 10);
     s << "\n";
   }
   s << "strongest over the week (lowest MAE): " << w.strongest << "\n";
