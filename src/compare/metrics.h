@@ -25,6 +25,7 @@
 #include <string>
 
 #include "compare/lead.h"
+#include "core/window_range.h"
 
 namespace whirl::compare {
 
@@ -57,10 +58,9 @@ struct LeadMetrics {
 /// a negative margin, a margin that leaves fewer than 2 samples, or non-positive windows.
 LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOptions& options = {});
 
-/// Band width (max - min) of `values` over every window [x_i, x_i + window_mm]; returns the
-/// worst. `x` strictly increasing, same size as `values`. Exposed for tests.
-double MaxWindowRange(const std::vector<double>& x, const std::vector<double>& values,
-                      double window_mm);
+/// Band width over sliding windows (core/window_range.h), used for v_300, v_2pi and the 1000 mm
+/// figure.
+using whirl::MaxWindowRange;
 
 void to_json(nlohmann::json& j, const LeadMetrics& m);
 
