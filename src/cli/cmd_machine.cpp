@@ -246,6 +246,7 @@ void RegisterMachine(CLI::App& app) {
                 "|e_a - c| column (default 0)");
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
+  RegisterMachineTruth(m);
 }
 
 }  // namespace whirl::cli
