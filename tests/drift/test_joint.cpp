@@ -155,8 +155,8 @@ TEST(JointFit, ForwardChoiceFindsThePlantedSensorAndLag) {
 
 // A slope is learned only over the range the Z-spanning readings cover: s1 barely moves on the
 // laser days (z 1000..5000 mm: 5 % of its rise) and rises fully only on probe-only days (one
-// z). Its slope coefficient would be an extrapolation from a sensor that did not move: it stays 0 and unidentified, while
-// s2, which moves on the laser days too, keeps its slope.
+// z). Its slope coefficient would be an extrapolation from a sensor that did not move: it stays
+// 0 and unidentified, while s2, which moves on the laser days too, keeps its slope.
 TEST(JointFit, ASlopeIsNotLearnedBeyondTheRangeTheZSpanningReadingsCover) {
   Planted p = MakePlanted(false, 10);
   for (auto& rec : p.record.records)
