@@ -79,8 +79,9 @@ std::vector<Reading> MeasureLead(const MachineTimeline& timeline, const CutRef& 
                                  const std::function<double(double t_s)>& workpiece_minus_comp_um,
                                  const LeadOptions& options, std::uint64_t seed);
 
-/// Control log while a cut runs (for causal application): DayLog rows at the control sample
-/// between the day's power-on and the cut end (sensors and duty), seeded.
+/// Control log of day d (for causal application): DayLog rows at the control sample from the
+/// day's power-on to its power-off (sensors and duty), seeded; the caller takes the rows it may
+/// use (those at or before the time of the compensation).
 drift::Run ControlLog(const MachineTimeline& timeline, int day, std::uint64_t seed);
 
 }  // namespace whirl::machine
