@@ -238,10 +238,11 @@ void RegisterMachine(CLI::App& app) {
                 "print the pooled table: median [range of per-seed medians] and worst [um], "
                 "|e_a - c| median [um], P3/P5 shares, and the headlines against the strongest "
                 "sensor-free strategy (1..20, default 1: the single-seed table)")
-      ->check(CLI::Range(1, 20));
+      ->check(NumberIn(1, 20));
   e->add_option("--travel-c-um", o->travel_c_um,
                 "with --seeds: specified travel compensation c of ISO 3408-3 [um] for the "
-                "|e_a - c| column (default 0)");
+                "|e_a - c| column (default 0)")
+      ->check(FiniteNumber());
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
   RegisterMachineTruth(m);
