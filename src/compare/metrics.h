@@ -1,6 +1,6 @@
 #pragma once
 // Lead-accuracy metrics of a travel-deviation curve, as ISO 3408-3 and the paper define them
-// (REFERENCE.md sections 1 and 4). All values in micrometres, positions in millimetres.
+// (Li, Ma and Jiang; ISO 3408-3). All values in micrometres, positions in millimetres.
 //
 // Definitions used here (x = position along the thread from its start, d(x) = travel deviation):
 // - Useful travel l_u: [x0 + m, x_end - m] with m = LeadMetricOptions::end_margin_mm (the excess
