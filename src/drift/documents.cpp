@@ -289,7 +289,7 @@ std::string FormatCrossRun(const CrossRunResult& r) {
   }
   o << "errors from zero '" << ToString(r.zero.zero)
     << "' for every column; time = sensor-free time-only warm-up of the training run\n";
-  o << "group means (seed 000 tables 6-8)   pairs |  model: RMSE    std    max | all sensors: "
+  o << "group means (Miao et al. tab 6-8)   pairs |  model: RMSE    std    max | all sensors: "
        "RMSE    std    max | none: RMSE    std    max | time: RMSE | strongest\n";
   for (const auto& g : r.groups) {
     char line[320];
