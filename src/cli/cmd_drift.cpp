@@ -1,6 +1,8 @@
 // whirl drift: machine thermal drift from temperature sensors (Miao et al.): sensitive points,
 // drift models, prediction, cross-run and hold-out evaluation, report (src/drift/).
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -10,6 +12,7 @@
 #include "cli/drift_args.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "drift/documents.h"
 #include "drift/evaluation.h"
@@ -82,6 +85,9 @@ struct ModelArgs {
   bool shuffle_cv = false;
   std::uint64_t seed = 1;
   int threads = 0;
+  std::string error_zero = "run-start", candidates = "auto";
+  double gauge_level_um = std::numeric_limits<double>::quiet_NaN();
+  bool from_start = false;  // deprecated alias of --error-zero run-start
 };
 
 // The dynamic model's options (lagged copies of the rises), shared by every command that fits it.
@@ -101,6 +107,21 @@ void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
 }
 
 // --model, the sensors, the dynamic and the network model's options, --threads.
+// --error-zero, --gauge-level-um, --errors-from-start (every command that fits or evaluates).
+void AddZeroOptions(CLI::App* sub, ModelArgs* m) {
+  sub->add_option("--error-zero", m->error_zero,
+                  "zero of the errors for the model, 'none' and every baseline alike: run-start "
+                  "(e - e at the run's first row, default; a gauge level cancels) or fixed "
+                  "(e - --gauge-level-um, for a machine never re-referenced); stored in the model")
+      ->check(CLI::IsMember({"run-start", "fixed"}));
+  sub->add_option("--gauge-level-um", m->gauge_level_um,
+                  "fixed zero: the gauge level [um] (default: the first row of the first training "
+                  "run)")
+      ->check(FiniteNumber("um"));
+  sub->add_flag("--errors-from-start", m->from_start,
+                "deprecated: the same as --error-zero run-start (the default)");
+}
+
 void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--model", m->kind,
                   "mlr (Miao et al.'s regression on the rises), dynamic (rises plus first-order "
@@ -117,6 +138,7 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
       ->check(NumberIn(1, 10000));
   AddSeedOption(sub, &m->seed, "network: initialization seed");
   sub->add_option("--threads", m->threads, "threads (0: all cores)")->check(NumberIn(0, 256));
+  AddZeroOptions(sub, m);
 }
 
 drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s) {
@@ -134,6 +156,14 @@ drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s) {
   o.seed = m.seed;
   o.threads = m.threads;
   o.selection = ToSelection(s);
+  o.zero.zero = drift::ParseErrorZero(m.error_zero);
+  o.zero.gauge_level_um = m.gauge_level_um;
+  if (o.zero.zero != drift::ErrorZero::kFixed && !std::isnan(m.gauge_level_um))
+    throw InputError("--gauge-level-um " + MessageNumber(m.gauge_level_um) +
+                     ": only with --error-zero fixed");
+  if (m.from_start && o.zero.zero == drift::ErrorZero::kFixed)
+    throw InputError("--errors-from-start contradicts --error-zero fixed: give one");
+  o.candidates = drift::ParseCandidates(m.candidates);
   return o;
 }
 
@@ -188,13 +218,23 @@ void RegisterFitModel(CLI::App* drift_app) {
       "fit",
       std::string("Fit a drift model of one error channel [um] on the training runs and write it\n"
                   "as a versioned JSON file (sensors, reference temperatures [degC], coefficients\n"
-                  "[um/K] with standard errors, VIF, residual std [um], lag time constants [min],\n"
-                  "training runs, state and ranges).\n" +
+                  "[um/K for rises; um per the input's unit for other inputs; um for elapsed-time\n"
+                  "terms] with standard errors, VIF, residual std [um], lag time constants [min;\n"
+                  "samples on runs without time], error zero, training runs, state and ranges).\n"
+                  "By default the sensor model competes with sensor-free time-only warm-up\n"
+                  "models (--candidates); the table of candidates and the choice are printed.\n" +
                   kDeadSensorsHelp) +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
+  sub->add_option("--candidates", o->model.candidates,
+                  "model families scored by validation on the training runs (the whole fit redone "
+                  "in every fold: leave one run out, or blocks of one run): auto (default: "
+                  "sensors, time1, time2, and sensors+time with >= 3 runs; the lowest RMSE, "
+                  "within 5 % the fewest parameters), sensors, time (first-order warm-up in time "
+                  "since the run start, 1 or 2 terms) or sensors+time")
+      ->check(CLI::IsMember({"auto", "sensors", "time", "sensors+time"}));
   sub->add_option("--error", o->error, "error column to model (<name>_um)")->required();
   sub->add_option("--out", o->out, "model file to write (JSON)")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
@@ -213,11 +253,13 @@ void RegisterFitModel(CLI::App* drift_app) {
                           {"model_file", o->out},
                           {"model", drift::ModelSummaryJson(rep.model)}};
       if (rep.selected) j["selection"] = drift::SelectionJson(rep.selection);
+      if (!rep.candidates.empty()) j["candidates"] = drift::CandidatesJson(rep);
       if (!rep.train_report.empty()) j["trainbr"] = rep.train_report;
       PrintJson(j);
       return;
     }
     if (rep.selected) std::fputs(drift::FormatSelection(rep.selection).c_str(), stdout);
+    std::fputs(drift::FormatCandidates(rep).c_str(), stdout);
     std::fputs(drift::FormatModel(rep.model).c_str(), stdout);
     if (!rep.train_report.empty()) std::printf("  %s\n", rep.train_report.c_str());
     std::printf("model written to %s\n", o->out.c_str());
@@ -286,7 +328,7 @@ void RegisterCrossval(CLI::App* drift_app) {
     SelectionArgs sel;
     ModelArgs model;
     std::string error;
-    bool from_start = false, json = false;
+    bool json = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -295,20 +337,16 @@ void RegisterCrossval(CLI::App* drift_app) {
                   "(own sensor selection) predicts every run; RMSE, std and max |error| [um] per\n"
                   "pair, "
                   "group means (idle on idle, idle on cutting, cutting on cutting, ...) beside no\n"
-                  "compensation and MLR on all sensors.\n") +
+                  "compensation, MLR on all sensors and the sensor-free time-only warm-up model\n"
+                  "of the training run, all on one error zero; each group names the strongest.\n") +
           kRunFilesHelp);
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
   sub->add_option("--error", o->error, "error column (<name>_um)")->required();
-  sub->add_flag("--errors-from-start", o->from_start,
-                "take each run's errors relative to its first row [um] (runs cut from one log "
-                "do not start from a zeroed machine)");
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
     auto runs = LoadRuns(o->runs);
-    if (o->from_start)
-      for (Run& r : runs) r = drift::ErrorsFromStart(r);
     std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
     const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
     for (const auto& w : r.warnings) Warn(w);
@@ -335,9 +373,10 @@ void RegisterHoldout(CLI::App* drift_app) {
       std::string(
           "Chronological hold-out on one long log (FL_THERMAL's split): train on the first\n"
           "--train share of the rows, test on the next --test share; the models run from\n"
-          "the log's first row. Per channel: none, mlr_all (all sensors), mlr, dynamic and\n"
-          "network on the selected sensors (at most --max-sensors), dynamic_extra with\n"
-          "--inputs. Test and train MAE, RMSE, max [um].\n") +
+          "the log's first row. Per channel: none, time (sensor-free warm-up in time since\n"
+          "the log's start), mlr_all (all sensors), mlr, dynamic and network on the selected\n"
+          "sensors (at most --max-sensors), dynamic_extra with --inputs, all on one error\n"
+          "zero. Test and train MAE, RMSE, max [um]; the strongest per channel.\n") +
           kRunFilesHelp);
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--train", o->h.train_fraction, "training share of the rows (default 0.6)")
@@ -346,12 +385,8 @@ void RegisterHoldout(CLI::App* drift_app) {
       ->check(NumberIn(0.01, 0.99));
   sub->add_option("--channels", o->channels, "error columns (default: every _um column)")
       ->delimiter(',');
-  sub->add_option("--max-sensors", o->h.max_sensors,
-                  "at most this many selected sensors (default 4)")
-      ->check(NumberIn(1, 64));
-  sub->add_option("--classes", o->sel.classes,
-                  "class count of the selection: fewest (default), margin, cv or a number "
-                  "(as in 'whirl drift fit --help')");
+  AddSelectionOptions(sub, &o->sel);
+  AddZeroOptions(sub, &o->model);
   sub->add_flag("--no-network", o->no_network, "skip the network model");
   AddDynamicOptions(sub, &o->model);  // --inputs: those of dynamic_extra
   sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")
@@ -366,6 +401,7 @@ void RegisterHoldout(CLI::App* drift_app) {
     h.channels = o->channels;
     h.network = !o->no_network;
     h.fit = ToFit(o->model, o->sel);
+    h.max_sensors = o->sel.max_sensors;
     const auto r = drift::Holdout(
         log, h, [](const std::string& s) { std::fprintf(stderr, "fitting %s\n", s.c_str()); });
     for (const auto& w : r.warnings) Warn(w);

@@ -1,6 +1,8 @@
 // whirl drift monitor: replay of the on-line model check with a check bar and the recalibration
 // rules (Liu et al.'s check-bar patent) on a logged run (src/drift/monitor.h).
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,6 +11,7 @@
 #include "cli/common.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "drift/monitor_report.h"
 
@@ -18,7 +21,14 @@ namespace {
 
 struct MonitorArgs {
   std::string model, run, reference = "run-start", timeline, events, report;
-  std::vector<std::string> updates{"patent", "bayes", "offset"};
+  std::vector<std::string> days, updates{"patent", "bayes", "offset"};
+  // Intervals with their unit in the flag's name; NaN: not given.
+  double check_every_min = std::numeric_limits<double>::quiet_NaN(),
+         check_every_samples = std::numeric_limits<double>::quiet_NaN(),
+         refit_every_min = std::numeric_limits<double>::quiet_NaN(),
+         refit_every_samples = std::numeric_limits<double>::quiet_NaN(),
+         start_min = std::numeric_limits<double>::quiet_NaN(),
+         start_samples = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> score_rows{0.0, 1.0};
   drift::MonitorOptions o;
   bool json = false;
@@ -29,13 +39,24 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   sub->add_option("--model", a->model, "drift model file (whirl drift fit; mlr or dynamic)")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--run", a->run, "run file with the model's error column (the check-bar values)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  sub->add_option(
-         "--check-every", o.check_every,
-         "interval between checks [min; samples if the run has no time] (default 60; at most "
-         "100,000 checks per run)")
+  auto* run = sub->add_option("--run", a->run,
+                              "run file with the model's error column (the check-bar values)")
+                  ->check(CLI::ExistingFile);
+  auto* day = sub->add_option("--day", a->days,
+                              "a production week: day files in order (repeat); each rule carries "
+                              "its updated coefficients from day to day")
+                  ->check(CLI::ExistingFile);
+  run->excludes(day);
+  sub->add_option("--check-every-min", a->check_every_min,
+                  "interval between checks [min] (default 120: 3-4 checks in an 8-h shift; at "
+                  "most 100,000 checks per run)")
+      ->check(PositiveNumber("min"));
+  sub->add_option("--check-every-samples", a->check_every_samples,
+                  "interval between checks [samples], for runs without recorded time")
+      ->check(PositiveNumber());
+  sub->add_option("--check-every", o.check_every,
+                  "deprecated: the interval [min; samples if the run has no time]; use "
+                  "--check-every-min or --check-every-samples")
       ->check(PositiveNumber());
   sub->add_option("--threshold-um", o.threshold_um,
                   "validity threshold on |measured - predicted| [um] (default 0: use "
@@ -47,32 +68,44 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
       ->check(NumberIn(0.01, 100.0));
   sub->add_option(
          "--refit-samples", o.refit_samples,
-         "m: further measurements after an invalid check (0..100, default 3; 0: update from the "
-         "check alone)")
+         "m: further measurements after an invalid check (0..100, default 0: update from the "
+         "check alone; 3 recommended with check-bar noise >= 0.5 um)")
       ->check(NumberIn(0, drift::kMaxRefitSamples));
+  sub->add_option("--refit-every-min", a->refit_every_min,
+                  "interval between the refit measurements [min] (default 5)")
+      ->check(PositiveNumber("min"));
+  sub->add_option("--refit-every-samples", a->refit_every_samples,
+                  "interval between the refit measurements [samples], runs without time")
+      ->check(PositiveNumber());
   sub->add_option("--refit-every", o.refit_every,
-                  "interval between the refit measurements [min; samples] (default 5)")
+                  "deprecated: --refit-every-min or --refit-every-samples")
       ->check(PositiveNumber());
   sub->add_option("--stop-min", o.stop_min_per_measurement,
                   "machine stop per check-bar measurement [min] (default 1)")
       ->check(NumberIn(0.0, 1440.0));
   sub->add_option("--update", a->updates,
-                  "update rules replayed beside the static model: patent (least-squares refit on "
-                  "the new measurements), bayes (recursive least squares, the training fit as "
-                  "prior), offset (intercept only); default all three")
+                  "update rules replayed beside the static model: bayes (recursive least squares, "
+                  "the training fit as prior; the recommended rule: its change is bounded), "
+                  "patent (least-squares refit on the new measurements, rank-aware: only the "
+                  "directions they identify change), offset (intercept only); default all three")
       ->delimiter(',')
       ->check(CLI::IsMember({"patent", "bayes", "offset"}));
   sub->add_option("--prior-scale", o.prior_scale,
-                  "bayes: prior covariance = this x the training fit's Cov(b) (default 1)")
+                  "bayes: prior covariance = this x the training fit's Cov(b) (default 100, chosen "
+                  "on a validation block before the test window of FL_THERMAL)")
       ->check(NumberIn(1e-6, 1e12));
   sub->add_option(
          "--noise-um", o.noise_um,
          "std of the check-bar measurement noise added to the logged error [um] (default 0)")
       ->check(NumberIn(0.0, 1000.0));
   AddSeedOption(sub, &o.seed, "seed of the measurement noise (default 1)");
-  sub->add_option("--start", o.start,
-                  "monitoring starts here [min; samples]: no check before, scores from here "
-                  "(default 0)")
+  sub->add_option("--start-min", a->start_min,
+                  "monitoring starts here [min]: no check before, scores from here (default 0)")
+      ->check(FiniteNumber("min"));
+  sub->add_option("--start-samples", a->start_samples,
+                  "monitoring starts at this sample, for runs without recorded time")
+      ->check(FiniteNumber());
+  sub->add_option("--start", o.start, "deprecated: --start-min or --start-samples")
       ->check(FiniteNumber());
   sub->add_option("--score-rows", a->score_rows,
                   "scored share of the run's rows FROM,TO (default 0,1; FL_THERMAL's test "
@@ -94,7 +127,50 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   sub->add_flag("--json", a->json, "machine output on stdout");
 }
 
+// The intervals from the flags named by their unit; a *-min flag on a run without recorded time
+// (or *-samples on one with time) is refused naming the flag.
+void ApplyIntervals(MonitorArgs& a, bool time_from_index) {
+  const struct {
+    double value;
+    const char* flag;
+    bool minutes;
+    double* target;
+  } flags[] = {{a.check_every_min, "--check-every-min", true, &a.o.check_every},
+               {a.check_every_samples, "--check-every-samples", false, &a.o.check_every},
+               {a.refit_every_min, "--refit-every-min", true, &a.o.refit_every},
+               {a.refit_every_samples, "--refit-every-samples", false, &a.o.refit_every},
+               {a.start_min, "--start-min", true, &a.o.start},
+               {a.start_samples, "--start-samples", false, &a.o.start}};
+  for (const auto& f : flags) {
+    if (std::isnan(f.value)) continue;
+    if (f.minutes == time_from_index)
+      throw InputError(std::string(f.flag) + " " + MessageNumber(f.value) + ": the run " +
+                       (time_from_index ? "has no recorded time (use the *-samples flag)"
+                                        : "records time (use the *-min flag)"));
+    *f.target = f.value;
+  }
+}
+
+void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
+  std::vector<drift::Run> days;
+  for (const auto& d : a.days) days.push_back(drift::ReadRun(d, drift::RunState::kUnknown));
+  ApplyIntervals(a, days.front().time_from_index);
+  drift::FitOptions refit;
+  refit.kind = m.kind;
+  refit.candidates = drift::Candidates::kSensors;
+  refit.extra_inputs = m.extra_inputs;
+  std::fprintf(stderr, "replaying %zu days...\n", days.size());
+  const drift::WeekResult w = drift::MonitorWeek(m, days, a.o, refit);
+  for (const auto& d : w.days)
+    for (const auto& warning : d.warnings) Warn(warning);
+  if (a.json)
+    PrintJson(drift::WeekJson(w, a.o));
+  else
+    std::fputs(drift::FormatWeek(w, a.o).c_str(), stdout);
+}
+
 void RunMonitor(MonitorArgs& a) {
+  if (a.run.empty() && a.days.empty()) throw InputError("give --run FILE or --day FILE ...");
   CheckOutputs({{"--model", a.model}, {"--run", a.run}},
                {{"--timeline", a.timeline}, {"--events", a.events}}, {{"--report", a.report}});
   a.o.reference = drift::ParseReferenceMode(a.reference);
@@ -103,7 +179,9 @@ void RunMonitor(MonitorArgs& a) {
   a.o.rules.clear();
   for (const auto& u : a.updates) a.o.rules.push_back(drift::ParseUpdateRule(u));
   const drift::DriftModel m = drift::ReadDriftModel(a.model);
+  if (!a.days.empty()) return RunWeek(a, m);
   const drift::Run run = drift::ReadRun(a.run, drift::RunState::kUnknown);
+  ApplyIntervals(a, run.time_from_index);
   std::fprintf(stderr, "replaying checks on %s (%d samples)...\n", run.name.c_str(), run.samples());
   const drift::MonitorResult r = drift::MonitorRun(m, run, a.o);
   const std::vector<std::string> prov{"whirl drift monitor --model " + a.model + " --run " + a.run};

@@ -16,7 +16,9 @@ void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
                   "sensors' MLR has the lowest cross-validated RMSE: leave one run out, or "
                   "forward-chaining blocks of one run) or a number");
   sub->add_option("--max-sensors", s->max_sensors,
-                  "at most this many classes = chosen sensors (0: no limit)")
+                  "at most this many classes = chosen sensors (default 0: no limit, the same in "
+                  "every drift command; the fewest rule rarely reaches a cap, --classes cv may "
+                  "keep many sensors)")
       ->check(NumberIn(0, 64));
 }
 

@@ -1,5 +1,6 @@
 #include "drift/documents.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -37,6 +38,18 @@ std::string Classes(const Selection& s, const Partition& p) {
   std::string out;
   for (const auto& g : groups) out += "{" + g + "}";
   return out;
+}
+
+// The unit of a feature's coefficient: rises and their lags um/K, elapsed-time terms um, other
+// inputs um per the unit their name ends in (spindle_rpm: um/rpm).
+std::string CoefficientUnit(const DriftModel& m, const Feature& f) {
+  if (f.input == "elapsed") return "um";
+  for (const auto& s : m.sensors)
+    if (s == f.input) return "um/K";
+  const auto cut = f.input.rfind('_');
+  if (cut != std::string::npos && cut + 1 < f.input.size())
+    return "um/" + f.input.substr(cut + 1);
+  return "um per unit of " + f.input;
 }
 
 }  // namespace
@@ -108,6 +121,7 @@ json ModelSummaryJson(const DriftModel& m) {
     for (std::size_t i = 0; i < m.features.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
       coeffs.push_back({{"feature", m.features[i].Name(m.time_unit)},
+                        {"unit", CoefficientUnit(m, m.features[i])},
                         {"value", m.linear.coefficients(k + 1)},
                         {"standard_error", m.linear.standard_errors(k + 1)},
                         {"vif", Finite(m.linear.vif(k))}});
@@ -120,6 +134,8 @@ json ModelSummaryJson(const DriftModel& m) {
             {"extra_inputs", m.extra_inputs},
             {"time_unit", m.time_unit},
             {"time_constants", m.time_constants},
+            {"elapsed_time_constants", m.elapsed_time_constants},
+            {"error_zero", ToString(m.zero.zero)},
             {"r_squared", m.r_squared},
             {"residual_std_um", m.residual_std_um},
             {"training_runs", m.training_runs},
@@ -136,8 +152,17 @@ json ModelSummaryJson(const DriftModel& m) {
 
 std::string FormatModel(const DriftModel& m) {
   std::ostringstream o;
-  o << ToString(m.kind) << " model of " << m.error_column << " on " << Join(m.sensors)
-    << (m.extra_inputs.empty() ? "" : " + " + Join(m.extra_inputs)) << "\n";
+  std::vector<std::string> inputs = m.sensors;
+  inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+  if (!m.elapsed_time_constants.empty()) inputs.push_back("elapsed time");
+  o << ToString(m.kind) << " model of " << m.error_column << " on " << Join(inputs) << "\n";
+  o << "  error zero: " << ToString(m.zero.zero)
+    << (m.zero.zero == ErrorZero::kFixed ? " (gauge level " + FormatDecimals(m.zero.gauge_level_um, 3) + " um)"
+                                         : "")
+    << "\n";
+  if (!m.elapsed_time_constants.empty())
+    o << "  elapsed-time constants: " << JoinNumbers(m.elapsed_time_constants) << " "
+      << m.time_unit << "\n";
   o << "  sensors: " << m.selection << "\n";
   if (!m.time_constants.empty())
     o << "  lag time constants: " << JoinNumbers(m.time_constants) << " " << m.time_unit << "\n";
@@ -151,7 +176,8 @@ std::string FormatModel(const DriftModel& m) {
       const auto k = static_cast<Eigen::Index>(i);
       char name[64];
       std::snprintf(name, sizeof name, "%-30s",
-                    (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
+                    (m.features[i].Name(m.time_unit) + " [" + CoefficientUnit(m, m.features[i]) +
+                     "]").c_str());
       o << "  " << name << PadLeft(FormatDecimals(m.linear.coefficients(k + 1), 4), 12)
         << PadLeft(FormatDecimals(m.linear.standard_errors(k + 1), 4), 12)
         << PadLeft(FormatSignificant(m.linear.vif(k), 4), 11) << "\n";
@@ -219,16 +245,20 @@ json CrossRunJson(const CrossRunResult& r) {
                        {"test", r.runs[j]},
                        {"model", ErrorStatsJson(r.cells[i][j].model)},
                        {"mlr_all_sensors", ErrorStatsJson(r.cells[i][j].all_sensors)},
-                       {"no_compensation", ErrorStatsJson(r.cells[i][j].none)}});
+                       {"no_compensation", ErrorStatsJson(r.cells[i][j].none)},
+                       {"time_only", ErrorStatsJson(r.cells[i][j].time)}});
   json groups = json::array();
   for (const auto& g : r.groups)
     groups.push_back({{"group", g.name},
                       {"pairs", g.pairs},
                       {"model", ErrorStatsJson(g.model)},
                       {"mlr_all_sensors", ErrorStatsJson(g.all_sensors)},
-                      {"no_compensation", ErrorStatsJson(g.none)}});
+                      {"no_compensation", ErrorStatsJson(g.none)},
+                      {"time_only", ErrorStatsJson(g.time)},
+                      {"strongest", g.Strongest()}});
   return {{"schema", "whirl.drift_crossval"},
-          {"schema_version", 1},
+          {"schema_version", 2},
+          {"error_zero", ToString(r.zero.zero)},
           {"error_column", r.error_column},
           {"model", ToString(r.kind)},
           {"runs", runs},
@@ -257,15 +287,19 @@ std::string FormatCrossRun(const CrossRunResult& r) {
       o << PadLeft(FormatDecimals(r.cells[i][j].model.rmse_um, 2), 12);
     o << "\n";
   }
+  o << "errors from zero '" << ToString(r.zero.zero)
+    << "' for every column; time = sensor-free time-only warm-up of the training run\n";
   o << "group means (Miao et al. tab 6-8)   pairs |  model: RMSE    std    max | all sensors: "
-       "RMSE    std    max | none: RMSE    std    max\n";
+       "RMSE    std    max | none: RMSE    std    max | time: RMSE | strongest\n";
   for (const auto& g : r.groups) {
-    char line[256];
+    char line[320];
     std::snprintf(line, sizeof line,
-                  "  %-32s %5d | %12.2f %6.2f %6.2f | %18.2f %6.2f %6.2f | %10.2f %6.2f %6.2f\n",
+                  "  %-32s %5d | %12.2f %6.2f %6.2f | %18.2f %6.2f %6.2f | %10.2f %6.2f %6.2f | "
+                  "%10.2f | %s\n",
                   g.name.c_str(), g.pairs, g.model.rmse_um, g.model.std_um, g.model.max_abs_um,
                   g.all_sensors.rmse_um, g.all_sensors.std_um, g.all_sensors.max_abs_um,
-                  g.none.rmse_um, g.none.std_um, g.none.max_abs_um);
+                  g.none.rmse_um, g.none.std_um, g.none.max_abs_um, g.time.rmse_um,
+                  g.Strongest().c_str());
     o << line;
   }
   return o.str();
@@ -280,8 +314,12 @@ json HoldoutJson(const HoldoutResult& r) {
                     {"time_constants_min", row.time_constants},
                     {"train", ErrorStatsJson(row.train)},
                     {"test", ErrorStatsJson(row.test)}});
+  json strongest = json::object();
+  for (const auto& [ch, method] : r.Strongest()) strongest[ch] = method;
   return {{"schema", "whirl.drift_holdout"},
-          {"schema_version", 1},
+          {"schema_version", 2},
+          {"error_zero", ToString(r.zero.zero)},
+          {"strongest_by_test_mae", strongest},
           {"log", r.log},
           {"rows", r.rows},
           {"train_rows", {0, r.train_end}},
@@ -314,6 +352,36 @@ std::string FormatHoldout(const HoldoutResult& r) {
       o << " (" << JoinNumbers(row.time_constants) << (r.time_from_index ? " samples)" : " min)");
     o << "\n";
   }
+  o << "errors from zero '" << ToString(r.zero.zero)
+    << "'; time = sensor-free warm-up in time since the log's start\n";
+  for (const auto& [ch, method] : r.Strongest())
+    o << "strongest on " << ch << " (lowest test MAE): " << method << "\n";
+  return o.str();
+}
+
+json CandidatesJson(const FitReport& rep) {
+  json c = json::array();
+  for (const auto& s : rep.candidates)
+    c.push_back({{"name", s.name},
+                 {"elapsed_time_constants", s.time_constants},
+                 {"parameters", s.parameters},
+                 {"cv_rmse_um", Finite(s.cv_rmse_um)},
+                 {"folds", s.folds}});
+  return c;
+}
+
+std::string FormatCandidates(const FitReport& rep) {
+  if (rep.candidates.empty()) return "";
+  std::ostringstream o;
+  o << "candidates (validation RMSE, the whole fit redone in every fold):\n"
+    << "  candidate       parameters  validation RMSE um  folds\n";
+  for (const auto& s : rep.candidates) {
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-15s %10d  %18s  %5d\n", s.name.c_str(), s.parameters,
+                  FormatDecimalsOr(std::isfinite(s.cv_rmse_um) ? s.cv_rmse_um : NAN, 3, "-").c_str(), s.folds);
+    o << line;
+  }
+  o << rep.chosen << "\n";
   return o.str();
 }
 

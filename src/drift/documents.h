@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "drift/evaluation.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/selection.h"
 
@@ -32,5 +33,8 @@ nlohmann::json CrossRunJson(const CrossRunResult& r);
 std::string FormatCrossRun(const CrossRunResult& r);
 nlohmann::json HoldoutJson(const HoldoutResult& r);
 std::string FormatHoldout(const HoldoutResult& r);
+/// drift fit's candidate table (empty when one family was asked for) and the choice.
+nlohmann::json CandidatesJson(const FitReport& rep);
+std::string FormatCandidates(const FitReport& rep);
 
 }  // namespace whirl::drift

@@ -43,6 +43,33 @@ ErrorStats PredictionStats(const DriftModel& m, const Run& run) {
 
 }  // namespace
 
+std::string CrossRunGroup::Strongest() const {
+  std::string best = "model";
+  double v = model.rmse_um;
+  for (const auto& [name, s] : {std::pair<const char*, const ErrorStats*>{"mlr_all", &all_sensors},
+                                {"none", &none},
+                                {"time", &time}})
+    if (s->rmse_um < v) best = name, v = s->rmse_um;
+  return best;
+}
+
+std::vector<std::pair<std::string, std::string>> HoldoutResult::Strongest() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::map<std::string, const HoldoutRow*> best;
+  std::vector<std::string> order;
+  for (const HoldoutRow& r : rows_out) {
+    auto it = best.find(r.channel);
+    if (it == best.end()) {
+      order.push_back(r.channel);
+      best[r.channel] = &r;
+    } else if (r.test.mae_um < it->second->test.mae_um) {
+      it->second = &r;
+    }
+  }
+  for (const auto& ch : order) out.emplace_back(ch, best[ch]->method);
+  return out;
+}
+
 ErrorStats ComputeErrorStats(const Eigen::VectorXd& r) {
   ErrorStats s;
   s.samples = static_cast<int>(r.size());
@@ -72,6 +99,14 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
   }
   FitOptions inner = options;
   inner.threads = 1;
+  inner.candidates = Candidates::kSensors;
+  res.zero = options.zero;
+  if (res.zero.zero == ErrorZero::kFixed && std::isnan(res.zero.gauge_level_um))
+    res.zero.gauge_level_um = runs.front().error_um(0, runs.front().ErrorIndex(error_column));
+  inner.zero = res.zero;
+  FitOptions time_only = inner;
+  time_only.kind = ModelKind::kMlr;
+  time_only.candidates = Candidates::kTime;
   std::vector<std::vector<std::string>> left_out(n);
   ParallelFor(n, options.threads, [&](std::size_t i) {
     const FitReport rep = FitDriftModel({runs[i]}, error_column, inner);
@@ -81,6 +116,7 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
     all.extra_inputs.clear();
     const FitReport all_rep = FitDriftModel({runs[i]}, error_column, all);
     const DriftModel& all_model = all_rep.model;
+    const DriftModel time_model = FitDriftModel({runs[i]}, error_column, time_only).model;
     left_out[i] = rep.warnings;
     left_out[i].insert(left_out[i].end(), all_rep.warnings.begin(), all_rep.warnings.end());
     res.models[i] = rep.model;
@@ -89,7 +125,9 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
       CrossRunCell& c = res.cells[i][j];
       c.model = PredictionStats(rep.model, runs[j]);
       c.all_sensors = PredictionStats(all_model, runs[j]);
-      c.none = ComputeErrorStats(runs[j].error_um.col(runs[j].ErrorIndex(error_column)));
+      c.time = PredictionStats(time_model, runs[j]);
+      c.none = ComputeErrorStats(
+          ApplyErrorZero(runs[j], res.zero).error_um.col(runs[j].ErrorIndex(error_column)));
     }
   });
   for (const auto& w : left_out) AddOnce(&res.warnings, w);
@@ -103,11 +141,13 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
       Accumulate(&g.model, res.cells[i][j].model);
       Accumulate(&g.all_sensors, res.cells[i][j].all_sensors);
       Accumulate(&g.none, res.cells[i][j].none);
+      Accumulate(&g.time, res.cells[i][j].time);
     }
   for (auto& [name, g] : groups) {
     Divide(&g.model, g.pairs);
     Divide(&g.all_sensors, g.pairs);
     Divide(&g.none, g.pairs);
+    Divide(&g.time, g.pairs);
     res.groups.push_back(g);
   }
   return res;
@@ -123,6 +163,11 @@ HoldoutRow Score(const std::string& channel, const std::string& method, const Dr
   row.inputs = m.sensors;
   row.inputs.insert(row.inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
   row.time_constants = m.time_constants;
+  if (!m.elapsed_time_constants.empty()) {
+    row.inputs.push_back("elapsed");
+    row.time_constants.insert(row.time_constants.end(), m.elapsed_time_constants.begin(),
+                              m.elapsed_time_constants.end());
+  }
   const Eigen::VectorXd r = p.measured_um - p.predicted_um;
   row.train = ComputeErrorStats(r.head(train_end));
   row.test = ComputeErrorStats(r.segment(train_end, test_end - train_end));
@@ -137,7 +182,7 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
     throw InputError("holdout: train fraction " + std::to_string(o.train_fraction) +
                      " and test fraction " + std::to_string(o.test_fraction) +
                      " must be > 0 with a sum <= 1");
-  if (o.max_sensors < 1) throw InputError("holdout: max sensors must be >= 1");
+  if (o.max_sensors < 0) throw InputError("holdout: max sensors must be >= 0 (0: no limit)");
   HoldoutResult res;
   res.log = log.name;
   res.time_from_index = log.time_from_index;
@@ -151,7 +196,11 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
   const Run train = log.Slice(0, res.train_end, log.name + "_train");
   const Run scored = log.Slice(0, res.test_end, log.name + "_train_test");
   const std::vector<std::string> channels = o.channels.empty() ? log.error_names : o.channels;
+  res.zero = o.fit.zero;
   for (const std::string& ch : channels) {
+    ZeroConvention zero = o.fit.zero;
+    if (zero.zero == ErrorZero::kFixed && std::isnan(zero.gauge_level_um))
+      zero.gauge_level_um = log.error_um(0, log.ErrorIndex(ch));
     auto add = [&](const std::string& method, FitOptions f) {
       if (progress) progress(ch + ": " + method);
       FitReport rep = FitDriftModel({train}, ch, f);
@@ -166,7 +215,7 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
       HoldoutRow row;
       row.channel = ch;
       row.method = "none";
-      const Eigen::VectorXd e = scored.error_um.col(scored.ErrorIndex(ch));
+      const Eigen::VectorXd e = ApplyErrorZero(scored, zero).error_um.col(scored.ErrorIndex(ch));
       row.train = ComputeErrorStats(e.head(res.train_end));
       row.test = ComputeErrorStats(e.segment(res.train_end, res.test_end - res.train_end));
       res.rows_out.push_back(row);
@@ -181,8 +230,12 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
       res.predictions.push_back(std::move(p));
     }
     FitOptions f = o.fit;
+    f.zero = zero;
     f.extra_inputs.clear();
     f.kind = ModelKind::kMlr;
+    f.candidates = Candidates::kTime;
+    add("time", f);
+    f.candidates = Candidates::kSensors;
     f.sensors = log.sensor_names;
     add("mlr_all", f);
     f.sensors.clear();

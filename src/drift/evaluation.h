@@ -30,16 +30,22 @@ struct ErrorStats {
 };
 ErrorStats ComputeErrorStats(const Eigen::VectorXd& residual_um);
 
+// Every figure below is on one error zero (FitOptions::zero, run_file.h ErrorZero): the models,
+// "no compensation" and the sensor-free baselines alike, so gains are comparable.
+
 struct CrossRunCell {
   ErrorStats model;        ///< the selected-sensor model of the training run
   ErrorStats all_sensors;  ///< MLR on every sensor of the training run
-  ErrorStats none;         ///< no compensation (the test run's error)
+  ErrorStats none;         ///< no compensation (the test run's error on the zero)
+  ErrorStats time;         ///< sensor-free: the training run's time-only warm-up model
 };
 
 struct CrossRunGroup {
   std::string name;  ///< "idle on cutting" = trained idle, tested cutting; "own run"
   int pairs = 0;
-  ErrorStats model, all_sensors, none;  ///< means of each statistic over the pairs
+  ErrorStats model, all_sensors, none, time;  ///< means of each statistic over the pairs
+  /// The lowest mean RMSE of the group: "model", "mlr_all", "none" or "time".
+  std::string Strongest() const;
 };
 
 struct CrossRunResult {
@@ -52,21 +58,27 @@ struct CrossRunResult {
   std::vector<CrossRunGroup> groups;
   std::vector<DriftModel> models;  ///< each run's model
   std::vector<std::string> warnings;  ///< sensors the fits left out (FitReport::warnings), once
+  ZeroConvention zero;                ///< the zero of every figure
 };
 
-/// Builds one model per run (options.kind, Miao et al.'s selection unless options.sensors is set)
-/// and predicts every run. Runs need at least 2 entries and the error column. Parallel over runs.
+/// Builds one model per run (options.kind, Miao et al.'s selection unless options.sensors is set;
+/// the sensor family, whatever options.candidates says) and a time-only warm-up model per run,
+/// and predicts every run, all on options.zero (a fixed zero without a level: the first run's
+/// first row). Runs need at least 2 entries and the error column. Parallel over runs.
 CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);
 
 struct HoldoutOptions {
   double train_fraction = 0.6;        ///< first part of the rows for training, in (0, 1)
   double test_fraction = 0.2;         ///< next part for testing; train + test <= 1
-  int max_sensors = 4;                ///< the selection's class count is capped here
+  /// The selection's class count is capped here (0: no limit, as drift fit; the fewest rule
+  /// rarely reaches a cap, --classes cv may keep many sensors).
+  int max_sensors = 0;
   std::vector<std::string> channels;  ///< error columns (empty: every _um column)
-  /// Methods: none, mlr_all (MLR on every sensor), mlr (selected), dynamic (selected, lags),
+  /// Methods: none, time (sensor-free: time-only warm-up since the log's start, 1 or 2 terms by
+  /// validation), mlr_all (MLR on every sensor), mlr (selected), dynamic (selected, lags),
   /// network (selected, k-h-1), and dynamic_extra (selected + the extra inputs, lags) when
-  /// fit.extra_inputs is not empty.
+  /// fit.extra_inputs is not empty. All on fit.zero (run-start: from the log's first row).
   bool network = true;
   FitOptions fit;  ///< lag grid, network settings, selection options, extra inputs
 };
@@ -88,6 +100,9 @@ struct HoldoutResult {
   std::vector<DriftModel> models;          ///< same order as rows_out (none: an empty model)
   std::vector<RunPrediction> predictions;  ///< on rows [0, test_end), same order
   std::vector<std::string> warnings;       ///< sensors the fits left out, once each
+  ZeroConvention zero;                     ///< the zero of every figure
+  /// Per channel, the method with the lowest test MAE, and the lowest without a sensor.
+  std::vector<std::pair<std::string, std::string>> Strongest() const;  ///< (channel, method)
 };
 
 HoldoutResult Holdout(const Run& log, const HoldoutOptions& options,

@@ -17,15 +17,18 @@ struct Stacked {
   Eigen::MatrixXd x;
   Eigen::VectorXd y;
   std::vector<int> fold;  // fold of each sample
+  std::vector<int> run;   // run of each sample
+  std::vector<double> elapsed;  // time since the run's start [min or samples]
 };
 
 Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
               const std::vector<std::string>& sensors, const std::vector<std::string>& extras,
-              const std::vector<double>& taus, int folds) {
+              const std::vector<double>& taus, int folds,
+              const std::vector<double>& elapsed_taus = {}) {
   std::vector<Eigen::MatrixXd> parts;
   Eigen::Index total = 0, cols = 0;
   for (const Run& r : runs) {
-    parts.push_back(BuildFeatures(r, sensors, extras, taus));
+    parts.push_back(BuildFeatures(r, sensors, extras, taus, elapsed_taus));
     total += r.samples();
     cols = parts.back().cols();
   }
@@ -33,15 +36,20 @@ Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
   s.x.resize(total, cols);
   s.y.resize(total);
   s.fold.resize(static_cast<std::size_t>(total));
+  s.run.resize(static_cast<std::size_t>(total));
+  s.elapsed.resize(static_cast<std::size_t>(total));
   Eigen::Index at = 0;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const Run& r = runs[i];
     s.x.middleRows(at, r.samples()) = parts[i];
     s.y.segment(at, r.samples()) = r.error_um.col(r.ErrorIndex(error_column));
-    for (int k = 0; k < r.samples(); ++k)
-      s.fold[static_cast<std::size_t>(at + k)] =
-          runs.size() > 1 ? static_cast<int>(i)
-                          : static_cast<int>(k * static_cast<long>(folds) / r.samples());
+    for (int k = 0; k < r.samples(); ++k) {
+      const auto q = static_cast<std::size_t>(at + k);
+      s.fold[q] = runs.size() > 1 ? static_cast<int>(i)
+                                  : static_cast<int>(k * static_cast<long>(folds) / r.samples());
+      s.run[q] = static_cast<int>(i);
+      s.elapsed[q] = r.time_min[static_cast<std::size_t>(k)] - r.time_min.front();
+    }
     at += r.samples();
   }
   return s;
@@ -54,29 +62,91 @@ Eigen::MatrixXd Rows(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& 
   return out;
 }
 
-// Pooled RMSE of predicting each fold from a fit on the others.
-double CrossValidatedRmse(const Stacked& s, bool forward) {
-  const int nf = *std::max_element(s.fold.begin(), s.fold.end()) + 1;
+struct Split {
+  std::vector<Eigen::Index> train, test;
+};
+
+// The folds' (train, test) rows: leave one fold out, or forward-chaining (train = earlier folds).
+std::vector<Split> FoldSplits(const std::vector<int>& fold, bool forward) {
+  const int nf = *std::max_element(fold.begin(), fold.end()) + 1;
+  std::vector<Split> splits;
+  for (int f = forward ? 1 : 0; f < nf; ++f) {
+    Split sp;
+    for (std::size_t i = 0; i < fold.size(); ++i) {
+      if (fold[i] == f)
+        sp.test.push_back(static_cast<Eigen::Index>(i));
+      else if (!forward || fold[i] < f)
+        sp.train.push_back(static_cast<Eigen::Index>(i));
+    }
+    if (!sp.test.empty()) splits.push_back(std::move(sp));
+  }
+  return splits;
+}
+
+// Pooled RMSE of predicting each fold from a fit on the others; `predict` returns the test rows'
+// predictions from a fit on the training rows, or an empty vector when they are too few (the
+// fold's samples still count, as errors of 0: the pooled RMSE of every candidate alike).
+template <typename Predict>
+double PooledRmse(const Stacked& s, bool forward, int parameters, Predict predict) {
   double sse = 0;
   Eigen::Index count = 0;
-  for (int f = forward ? 1 : 0; f < nf; ++f) {
-    std::vector<Eigen::Index> train, test;
-    for (std::size_t i = 0; i < s.fold.size(); ++i) {
-      if (s.fold[i] == f)
-        test.push_back(static_cast<Eigen::Index>(i));
-      else if (!forward || s.fold[i] < f)
-        train.push_back(static_cast<Eigen::Index>(i));
-    }
-    if (test.empty()) continue;
-    count += static_cast<Eigen::Index>(test.size());
-    if (train.size() <= static_cast<std::size_t>(s.x.cols()) + 1) continue;  // too few to fit
-    const Eigen::VectorXd b = LeastSquaresCoefficients(Rows(s.x, train), Rows(s.y, train));
-    sse += (Rows(s.y, test) - EvaluateLinear(b, Rows(s.x, test))).squaredNorm();
+  for (const Split& sp : FoldSplits(s.fold, forward)) {
+    count += static_cast<Eigen::Index>(sp.test.size());
+    if (sp.train.size() <= static_cast<std::size_t>(parameters)) continue;  // too few to fit
+    sse += (Rows(s.y, sp.test) - predict(sp)).squaredNorm();
   }
   if (count == 0)
     throw InputError("cross-validation: no fold has enough training samples for " +
-                     std::to_string(s.x.cols()) + " features");
+                     std::to_string(parameters) + " parameters");
   return std::sqrt(sse / static_cast<double>(count));
+}
+
+// Pooled RMSE of predicting each fold from a fit on the others.
+double CrossValidatedRmse(const Stacked& s, bool forward) {
+  return PooledRmse(s, forward, static_cast<int>(s.x.cols()) + 1, [&](const Split& sp) {
+    const Eigen::VectorXd b = LeastSquaresCoefficients(Rows(s.x, sp.train), Rows(s.y, sp.train));
+    return EvaluateLinear(b, Rows(s.x, sp.test));
+  });
+}
+
+// The warm-up fit (regression.h FitWarmUp) on rows `idx`, grouped by run, with s.x's columns as
+// fixed regressors when `with_x`.
+WarmUpFit WarmUpOnRows(const Stacked& s, const std::vector<Eigen::Index>& idx, int terms,
+                       bool with_x) {
+  std::vector<std::vector<double>> t;
+  std::vector<std::vector<double>> e;
+  int last = -1;
+  for (const Eigen::Index i : idx) {
+    const auto q = static_cast<std::size_t>(i);
+    if (s.run[q] != last) t.emplace_back(), e.emplace_back(), last = s.run[q];
+    t.back().push_back(s.elapsed[q]);
+    e.back().push_back(s.y(i));
+  }
+  std::vector<Eigen::VectorXd> ev;
+  for (const auto& v : e) ev.push_back(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
+  return FitWarmUp(t, ev, terms, with_x ? Rows(s.x, idx) : Eigen::MatrixXd());
+}
+
+Eigen::VectorXd PredictWarmUp(const WarmUpFit& f, const Stacked& s,
+                              const std::vector<Eigen::Index>& idx, bool with_x) {
+  const Eigen::Index c = with_x ? s.x.cols() : 0;
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(idx.size()),
+                    c + static_cast<Eigen::Index>(f.time_constants.size()));
+  if (c > 0) x.leftCols(c) = Rows(s.x, idx);
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    for (std::size_t j = 0; j < f.time_constants.size(); ++j)
+      x(static_cast<Eigen::Index>(k), c + static_cast<Eigen::Index>(j)) =
+          1.0 - std::exp(-s.elapsed[static_cast<std::size_t>(idx[k])] / f.time_constants[j]);
+  return EvaluateLinear(f.coefficients, x);
+}
+
+// Validation RMSE of the warm-up model (time since start, `terms` terms, beside s.x's columns
+// when `with_x`), its time constants searched again in every fold.
+double WarmUpCvRmse(const Stacked& s, bool forward, int terms, bool with_x) {
+  const int parameters = 1 + 2 * terms + (with_x ? static_cast<int>(s.x.cols()) : 0);
+  return PooledRmse(s, forward, parameters, [&](const Split& sp) {
+    return PredictWarmUp(WarmUpOnRows(s, sp.train, terms, with_x), s, sp.test, with_x);
+  });
 }
 
 // Greedy forward choice of lag time constants (drift/model.h, kind dynamic).
@@ -162,6 +232,27 @@ std::vector<std::string> UsableSensors(const std::vector<Run>& runs,
 }
 
 }  // namespace
+
+std::string ToString(Candidates c) {
+  switch (c) {
+    case Candidates::kSensors:
+      return "sensors";
+    case Candidates::kTime:
+      return "time";
+    case Candidates::kSensorsTime:
+      return "sensors+time";
+    case Candidates::kAuto:
+      break;
+  }
+  return "auto";
+}
+
+Candidates ParseCandidates(const std::string& text) {
+  for (Candidates c :
+       {Candidates::kAuto, Candidates::kSensors, Candidates::kTime, Candidates::kSensorsTime})
+    if (ToString(c) == text) return c;
+  throw InputError("candidates '" + text + "': must be auto, sensors, time or sensors+time");
+}
 
 void FitOptions::Validate() const {
   selection.Validate();
@@ -332,30 +423,181 @@ Eigen::VectorXd FitOnFeatures(const Stacked& s, const std::vector<Run>& runs,
 
 }  // namespace
 
-FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
-                        const FitOptions& o) {
-  o.Validate();
-  CheckTrainingRuns(runs, error_column);
-  FitReport rep;
-  DriftModel& m = rep.model;
-  m.kind = o.kind;
-  m.error_column = error_column;
-  m.extra_inputs = o.extra_inputs;
-  m.time_unit = runs.front().time_from_index ? "sample" : "min";
-  ChooseSensors(runs, error_column, o, &rep);
-  SetTrainingProvenance(runs, &m);
-  if (o.kind == ModelKind::kDynamic) ChooseTimeConstants(runs, error_column, o, &rep);
+namespace {
+
+// The final fit on the chosen sensors, sensor lags and elapsed-time constants (already in `rep`):
+// features, ranges, coefficients, residual statistics.
+void FitChosen(const std::vector<Run>& runs, const std::string& error_column, const FitOptions& o,
+               FitReport* rep) {
+  DriftModel& m = rep->model;
   ListFeatures(&m);
-  const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
+  for (double t : m.elapsed_time_constants) m.features.push_back({"elapsed", t});
+  const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds,
+                          m.elapsed_time_constants);
   m.feature_min = s.x.colwise().minCoeff().transpose();
   m.feature_max = s.x.colwise().maxCoeff().transpose();
-  const Eigen::VectorXd fitted = FitOnFeatures(s, runs, error_column, o, &rep);
+  const Eigen::VectorXd fitted = FitOnFeatures(s, runs, error_column, o, rep);
   const Eigen::VectorXd res = s.y - fitted;
   const double dof =
       o.kind == ModelKind::kNetwork ? static_cast<double>(res.size()) : m.linear.degrees_of_freedom;
   m.residual_std_um = std::sqrt(res.squaredNorm() / dof);
   const double tss = (s.y.array() - s.y.mean()).square().sum();
   m.r_squared = tss > 0 ? 1.0 - res.squaredNorm() / tss : 1.0;
+}
+
+// A report with the model's identity and training provenance (no sensors: sensor-free).
+FitReport StartReport(const std::vector<Run>& runs, const std::string& error_column,
+                      const FitOptions& o, bool sensors) {
+  FitReport rep;
+  DriftModel& m = rep.model;
+  m.kind = o.kind;
+  m.error_column = error_column;
+  m.time_unit = runs.front().time_from_index ? "sample" : "min";
+  if (sensors) {
+    m.extra_inputs = o.extra_inputs;
+    ChooseSensors(runs, error_column, o, &rep);
+  } else {
+    m.kind = ModelKind::kMlr;
+    m.selection = "none (sensor-free)";
+  }
+  SetTrainingProvenance(runs, &m);
+  return rep;
+}
+
+FitReport FitSensorModel(const std::vector<Run>& runs, const std::string& error_column,
+                         const FitOptions& o) {
+  FitReport rep = StartReport(runs, error_column, o, true);
+  if (o.kind == ModelKind::kDynamic) ChooseTimeConstants(runs, error_column, o, &rep);
+  FitChosen(runs, error_column, o, &rep);
+  return rep;
+}
+
+// The time-only model: a warm-up of `terms` terms, its time constants fitted on every run.
+FitReport FitTimeModel(const std::vector<Run>& runs, const std::string& error_column,
+                       const FitOptions& o, int terms) {
+  FitReport rep = StartReport(runs, error_column, o, false);
+  const Stacked s = Stack(runs, error_column, {}, {}, {}, o.folds);
+  std::vector<Eigen::Index> all(s.fold.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
+  const WarmUpFit w = WarmUpOnRows(s, all, terms, false);
+  rep.model.elapsed_time_constants = w.time_constants;
+  if (!w.identified) rep.model.notes.push_back(w.note);
+  FitChosen(runs, error_column, o, &rep);
+  return rep;
+}
+
+// The sensor model plus one elapsed-time term, its time constant fitted beside the features.
+FitReport FitSensorTimeModel(const std::vector<Run>& runs, const std::string& error_column,
+                             const FitOptions& o, FitReport rep) {
+  DriftModel& m = rep.model;
+  const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
+  std::vector<Eigen::Index> all(s.fold.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
+  const WarmUpFit w = WarmUpOnRows(s, all, 1, true);
+  m.elapsed_time_constants = w.time_constants;
+  if (!w.identified) m.notes.push_back(w.note);
+  m.features.clear();
+  FitChosen(runs, error_column, o, &rep);
+  return rep;
+}
+
+// The candidates' validation scores and the choice: lowest validation RMSE, and within 5 % of it
+// the fewest parameters (the order of `scores`).
+std::size_t ChooseCandidate(const std::vector<CandidateScore>& scores) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& c : scores) best = std::min(best, c.cv_rmse_um);
+  if (!std::isfinite(best))
+    throw InputError("fit: no candidate model could be validated (too few samples per fold)");
+  std::size_t pick = 0;
+  for (std::size_t i = 0; i < scores.size(); ++i)
+    if (scores[i].cv_rmse_um <= 1.05 * best) {
+      pick = i;
+      break;
+    }
+  return pick;
+}
+
+std::string ChoiceMessage(const std::vector<CandidateScore>& c, std::size_t pick,
+                          const std::vector<Run>& runs, const FitOptions& o) {
+  std::string others;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (i != pick)
+      others += (others.empty() ? "" : ", ") + c[i].name + " " +
+                (std::isfinite(c[i].cv_rmse_um) ? MessageNumber(c[i].cv_rmse_um) : std::string("-"));
+  const std::string how =
+      runs.size() > 1 ? "leave one run out, " + std::to_string(runs.size()) + " runs"
+                      : std::to_string(o.folds) + (o.forward_cv ? " forward-chaining" : "") +
+                            " blocks of one run";
+  return "chosen: " + c[pick].name + ": validation RMSE " + MessageNumber(c[pick].cv_rmse_um) +
+         " um (lowest, or within 5 % of it with fewer parameters) against " +
+         (others.empty() ? std::string("no other") : others) + " um (" + how + ")";
+}
+
+// Scores every candidate family of o.candidates and fits the chosen one (model.h Candidates).
+FitReport FitCandidates(const std::vector<Run>& runs, const std::string& error_column,
+                        const FitOptions& o) {
+  const bool forward = o.forward_cv && runs.size() == 1;
+  const Stacked time_stack = Stack(runs, error_column, {}, {}, {}, o.folds);
+  std::vector<CandidateScore> scores;
+  auto score = [&](const std::string& name, int parameters, auto cv) {
+    CandidateScore c{name, {}, parameters, std::numeric_limits<double>::infinity(),
+                     static_cast<int>(FoldSplits(time_stack.fold, forward).size())};
+    try {
+      c.cv_rmse_um = cv();
+    } catch (const InputError&) {
+      // too few samples per fold: not a candidate
+    }
+    scores.push_back(c);
+  };
+  const bool want_time = o.candidates == Candidates::kAuto || o.candidates == Candidates::kTime;
+  const bool want_sensors = o.candidates == Candidates::kAuto;
+  const bool want_mixed = o.candidates == Candidates::kSensorsTime ||
+                          (o.candidates == Candidates::kAuto && runs.size() >= 3);
+  if (want_time) {
+    score("time1", 3, [&] { return WarmUpCvRmse(time_stack, forward, 1, false); });
+    score("time2", 5, [&] { return WarmUpCvRmse(time_stack, forward, 2, false); });
+  }
+  FitReport sensors;
+  if (want_sensors || want_mixed) {
+    sensors = FitSensorModel(runs, error_column, o);
+    const DriftModel& m = sensors.model;
+    const Stacked ss =
+        Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
+    const int p = static_cast<int>(ss.x.cols()) + 1 + static_cast<int>(m.time_constants.size());
+    if (want_sensors) score("sensors", p, [&] { return CrossValidatedRmse(ss, forward); });
+    if (want_mixed)
+      score("sensors+time", p + 2, [&] { return WarmUpCvRmse(ss, forward, 1, true); });
+  }
+  const std::size_t pick = ChooseCandidate(scores);
+  const std::string& name = scores[pick].name;
+  FitReport rep = name == "sensors"        ? sensors
+                  : name == "sensors+time" ? FitSensorTimeModel(runs, error_column, o, sensors)
+                                           : FitTimeModel(runs, error_column, o, name == "time1" ? 1 : 2);
+  if (name != "sensors" && name != "sensors+time")  // the screen's warnings stand for every family
+    rep.warnings = sensors.warnings;
+  rep.candidates = scores;
+  rep.candidates[pick].time_constants = rep.model.elapsed_time_constants;
+  rep.chosen = ChoiceMessage(scores, pick, runs, o);
+  rep.model.notes.push_back(rep.chosen);
+  return rep;
+}
+
+}  // namespace
+
+FitReport FitDriftModel(const std::vector<Run>& raw_runs, const std::string& error_column,
+                        const FitOptions& o) {
+  o.Validate();
+  CheckTrainingRuns(raw_runs, error_column);
+  ZeroConvention zero = o.zero;
+  if (zero.zero == ErrorZero::kFixed && std::isnan(zero.gauge_level_um))
+    zero.gauge_level_um = raw_runs.front().error_um(0, raw_runs.front().ErrorIndex(error_column));
+  std::vector<Run> runs;
+  for (const Run& r : raw_runs) runs.push_back(ApplyErrorZero(r, zero));
+  const bool sensors_only = o.kind == ModelKind::kNetwork || o.candidates == Candidates::kSensors ||
+                           (o.candidates == Candidates::kAuto && !o.sensors.empty());
+  FitReport rep = sensors_only ? FitSensorModel(runs, error_column, o)
+                      : FitCandidates(runs, error_column, o);
+  rep.model.zero = zero;
   return rep;
 }
 

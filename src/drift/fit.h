@@ -17,8 +17,22 @@
 
 namespace whirl::drift {
 
+/// The model families `drift fit` scores by validation on the training runs (FitDriftModel):
+///   sensors       the selected sensors (and extra inputs), kind mlr / dynamic / network;
+///   time          time-only first-order warm-up, 1 or 2 terms (time1, time2; model.h header);
+///   sensors+time  the selected sensors plus one elapsed-time term (only with >= 3 training runs:
+///                 with fewer, the validation favours it and it extrapolates badly);
+///   auto          all of them (linear kinds; a network, or sensors given by name, fit
+///                 `sensors` only).
+enum class Candidates { kAuto, kSensors, kTime, kSensorsTime };
+std::string ToString(Candidates c);                  ///< "auto", "sensors", "time", "sensors+time"
+Candidates ParseCandidates(const std::string& text);  ///< inverse; InputError otherwise
+
 struct FitOptions {
   ModelKind kind = ModelKind::kMlr;
+  /// Zero of the training errors, stored in the model (run_file.h ErrorZero).
+  ZeroConvention zero;
+  Candidates candidates = Candidates::kAuto;
   std::vector<std::string> sensors;  ///< empty: Miao et al.'s selection (selection.h)
   SelectionOptions selection;
   std::vector<std::string> extra_inputs;  ///< other columns used as inputs
@@ -44,8 +58,20 @@ struct LagSearchStep {
   double cv_rmse_um = 0;
 };
 
+/// One candidate of FitDriftModel's validation: its validation RMSE (pooled over the folds of the
+/// lag search: leave one run out with several runs, else blocks of the one run).
+struct CandidateScore {
+  std::string name;                    ///< "sensors", "time1", "time2", "sensors+time"
+  std::vector<double> time_constants;  ///< elapsed-time constants fitted on all runs
+  int parameters = 0;                  ///< coefficients incl. intercept and time constants
+  double cv_rmse_um = 0;               ///< +inf when it could not be validated
+  int folds = 0;
+};
+
 struct FitReport {
   DriftModel model;
+  std::vector<CandidateScore> candidates;  ///< scored candidates (empty: one family asked for)
+  std::string chosen;                      ///< the candidate fitted and why
   bool selected = false;                  ///< sensors came from the selection
   Selection selection;                    ///< when selected
   std::vector<LagSearchStep> lag_search;  ///< dynamic: accepted steps, static first
@@ -70,6 +96,11 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
                               const FitOptions& options);
 
 /// Fits a model of `error_column` on `runs` (InputError on missing columns or bad options).
+/// The errors are first put on options.zero (a fixed zero without a level takes the first row of
+/// the first run), which the model stores. With several candidates (options.candidates), each is
+/// scored by the validation RMSE with its whole fit (selection excepted, as the class-count
+/// choice) redone in every fold; the lowest wins, and within 5 % of it the fewest parameters
+/// (time1 < time2 < sensors < sensors+time).
 /// Dead and duplicate sensors (selection.h convention 8) are left out of the selection and of
 /// given sensors, with a warning each (FitReport::warnings); InputError naming the run files when
 /// no sensor is left, or when the regression is still rank-deficient (naming the features).

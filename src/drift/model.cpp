@@ -56,13 +56,17 @@ Eigen::MatrixXd ReadMatrix(const json& j, const char* key, Eigen::Index n) {
 
 bool IsLinear(ModelKind k) { return k != ModelKind::kNetwork; }
 
+const char* const kElapsedInput = "elapsed";
+
 std::vector<Feature> MakeFeatures(const std::vector<std::string>& inputs,
-                                  const std::vector<double>& taus) {
+                                  const std::vector<double>& taus,
+                                  const std::vector<double>& elapsed_taus) {
   std::vector<Feature> f;
   for (const auto& in : inputs) {
     f.push_back({in, 0.0});
     for (double t : taus) f.push_back({in, t});
   }
+  for (double t : elapsed_taus) f.push_back({kElapsedInput, t});
   return f;
 }
 
@@ -84,6 +88,18 @@ Eigen::MatrixXd FeaturesFromInputs(const Eigen::MatrixXd& u, const std::vector<d
       f.col(i * per + 1 + static_cast<Eigen::Index>(l)) = FirstOrderLag(u.col(i), t, taus[l]);
   }
   return f;
+}
+
+// Schema 2's error zero and elapsed-time features; a schema 1 file has neither (as-logged).
+void ReadZeroAndElapsed(const json& j, bool schema1, DriftModel* m) {
+  if (schema1) {
+    m->zero.zero = ErrorZero::kAsLogged;
+    return;
+  }
+  m->elapsed_time_constants = j.at("elapsed_time_constants").get<std::vector<double>>();
+  m->zero.zero = ParseErrorZero(RequireOneOf(j, "error_zero", {"run-start", "fixed"}, "drift model"));
+  if (m->zero.zero == ErrorZero::kFixed)
+    m->zero.gauge_level_um = RequireNumber(j, "gauge_level_um", "drift model");
 }
 
 }  // namespace
@@ -122,15 +138,23 @@ std::string Feature::Name(const std::string& time_unit) const {
 
 void DriftModel::Validate() const {
   const auto nf = static_cast<Eigen::Index>(features.size());
-  if (sensors.empty() && extra_inputs.empty()) throw InputError("drift model has no input");
+  if (sensors.empty() && extra_inputs.empty() && elapsed_time_constants.empty())
+    throw InputError("drift model has no input");
   if (reference_C.size() != static_cast<Eigen::Index>(sensors.size()))
     throw InputError("drift model 'reference_C' must have one value per sensor");
-  if (nf != InputCount() * (1 + static_cast<Eigen::Index>(time_constants.size())))
-    throw InputError("drift model 'features' must be inputs x (1 + time constants)");
+  if (nf != InputCount() * (1 + static_cast<Eigen::Index>(time_constants.size())) +
+                static_cast<Eigen::Index>(elapsed_time_constants.size()))
+    throw InputError(
+        "drift model 'features' must be inputs x (1 + time constants) + elapsed time constants");
   if (time_unit != "min" && time_unit != "sample")
     throw InputError("drift model 'time_unit' '" + time_unit + "': must be min or sample");
   for (double t : time_constants)
     CheckRange(t, {0, kMaxTimeConstant, true, time_unit.c_str()}, "time_constants", "drift model");
+  for (double t : elapsed_time_constants)
+    CheckRange(t, {0, kMaxTimeConstant, true, time_unit.c_str()}, "elapsed_time_constants",
+               "drift model");
+  if (zero.zero == ErrorZero::kFixed && !std::isfinite(zero.gauge_level_um))
+    throw InputError("drift model 'gauge_level_um' must be a finite number with error zero fixed");
   CheckRange(residual_std_um, {0, kMaxResidualStdUm, false, "um"}, "residual_std_um",
              "drift model");
   CheckRange(r_squared, {-1e6, 1, false, ""}, "r_squared", "drift model");
@@ -168,6 +192,10 @@ void to_json(json& j, const DriftModel& m) {
        {"extra_inputs", m.extra_inputs},
        {"time_unit", m.time_unit},
        {"time_constants", m.time_constants},
+       {"elapsed_time_constants", m.elapsed_time_constants},
+       {"error_zero", ToString(m.zero.zero)},
+       {"gauge_level_um", m.zero.zero == ErrorZero::kFixed ? json(m.zero.gauge_level_um)
+                                                           : json(nullptr)},
        {"features", features},
        {"residual_std_um", m.residual_std_um},
        {"r_squared", m.r_squared},
@@ -179,7 +207,9 @@ void to_json(json& j, const DriftModel& m) {
          {"notes", m.notes}}}};
   if (IsLinear(m.kind)) {
     j["linear"] = {{"coefficients", VectorJson(m.linear.coefficients)},
-                   {"coefficient_units", "b0 in um, then um per feature unit (K, or the input's)"},
+                   {"coefficient_units",
+                    "b0 in um, then per feature: um/K for rises and their lags, um per the "
+                    "input's unit for other inputs, um for elapsed-time features"},
                    {"standard_errors", VectorJson(m.linear.standard_errors)},
                    {"covariance", MatrixJson(m.linear.covariance)},
                    {"xtx_inverse", MatrixJson(m.linear.xtx_inverse)},
@@ -205,9 +235,12 @@ void from_json(const json& j, DriftModel& m) {
   RejectUnknownKeys(j,
                     {"format", "schema_version", "kind", "error_column", "error_unit", "sensors",
                      "reference_C", "extra_inputs", "time_unit", "time_constants", "features",
-                     "residual_std_um", "r_squared", "training", "linear", "network"},
+                     "residual_std_um", "r_squared", "training", "linear", "network",
+                     "elapsed_time_constants", "error_zero", "gauge_level_um"},
                     "drift model");
-  RequireSchema(j, DriftModel::kFormat, DriftModel::kSchemaVersion, "drift model", "format");
+  const bool schema1 = j.contains("schema_version") && j["schema_version"] == 1;
+  RequireSchema(j, DriftModel::kFormat, schema1 ? 1 : DriftModel::kSchemaVersion, "drift model",
+                "format");
   m = DriftModel{};
   m.kind = ParseModelKind(j.at("kind").get<std::string>());
   m.error_column = j.at("error_column").get<std::string>();
@@ -216,7 +249,9 @@ void from_json(const json& j, DriftModel& m) {
   m.extra_inputs = j.at("extra_inputs").get<std::vector<std::string>>();
   m.time_unit = j.at("time_unit").get<std::string>();
   m.time_constants = j.at("time_constants").get<std::vector<double>>();
-  m.features = MakeFeatures(Inputs(m.sensors, m.extra_inputs), m.time_constants);
+  ReadZeroAndElapsed(j, schema1, &m);
+  m.features =
+      MakeFeatures(Inputs(m.sensors, m.extra_inputs), m.time_constants, m.elapsed_time_constants);
   const auto nf = static_cast<Eigen::Index>(m.features.size());
   const json& fj = j.at("features");
   if (fj.size() != m.features.size())
@@ -300,6 +335,14 @@ double DriftEvaluator::Step(double time, const Eigen::VectorXd& raw) {
       }
     }
   }
+  const Eigen::Index ne = static_cast<Eigen::Index>(m.elapsed_time_constants.size());
+  for (Eigen::Index l = 0; l < ne; ++l) {
+    double& y = features_(features_.size() - ne + l);
+    y = started_ ? y + (1.0 - std::exp(-(time - last_time_) /
+                                       m.elapsed_time_constants[static_cast<std::size_t>(l)])) *
+                           (1.0 - y)
+                 : 0.0;
+  }
   started_ = true;
   last_time_ = time;
   if (IsLinear(m.kind))
@@ -329,9 +372,19 @@ Eigen::MatrixXd RawInputs(const DriftModel& model, const Run& run) {
   return u;
 }
 
+Eigen::MatrixXd ElapsedFeatures(const std::vector<double>& t, const std::vector<double>& taus) {
+  Eigen::MatrixXd f(static_cast<Eigen::Index>(t.size()), static_cast<Eigen::Index>(taus.size()));
+  for (std::size_t l = 0; l < taus.size(); ++l)
+    for (std::size_t k = 0; k < t.size(); ++k)
+      f(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(l)) =
+          1.0 - std::exp(-(t[k] - t.front()) / taus[l]);
+  return f;
+}
+
 Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& sensors,
                               const std::vector<std::string>& extra_inputs,
-                              const std::vector<double>& time_constants) {
+                              const std::vector<double>& time_constants,
+                              const std::vector<double>& elapsed_time_constants) {
   Eigen::MatrixXd u(run.samples(), static_cast<Eigen::Index>(sensors.size() + extra_inputs.size()));
   Eigen::Index c = 0;
   for (const auto& s : sensors) {
@@ -339,7 +392,11 @@ Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& se
     u.col(c++) = run.temperature_C.col(i).array() - run.temperature_C(0, i);
   }
   for (const auto& e : extra_inputs) u.col(c++) = run.other.col(run.OtherIndex(e));
-  return FeaturesFromInputs(u, run.time_min, time_constants);
+  const Eigen::MatrixXd f = FeaturesFromInputs(u, run.time_min, time_constants);
+  if (elapsed_time_constants.empty()) return f;
+  Eigen::MatrixXd all(f.rows(), f.cols() + static_cast<Eigen::Index>(elapsed_time_constants.size()));
+  all << f, ElapsedFeatures(run.time_min, elapsed_time_constants);
+  return all;
 }
 
 RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode reference) {
@@ -372,7 +429,11 @@ RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode 
   const auto& names = run.error_names;
   if (std::find(names.begin(), names.end(), model.error_column) != names.end()) {
     p.has_measured = true;
-    p.measured_um = run.error_um.col(run.ErrorIndex(model.error_column));
+    p.measured_um = ApplyErrorZero(run, model.zero).error_um.col(run.ErrorIndex(model.error_column));
+    if (model.zero.zero == ErrorZero::kAsLogged)
+      p.warnings.push_back(model.error_column +
+                           ": the model file predates the error zero (schema 1): errors as "
+                           "logged; refit for one zero for the model and its comparisons");
   }
   if (p.outside_range_samples > 0)
     p.warnings.push_back(run.name + ": " + std::to_string(p.outside_range_samples) + " of " +

@@ -11,6 +11,13 @@
 // one per time constant in `time_constants` (shared by all inputs; unit: min, or samples when the
 // training runs had no time column). Deformation lags temperature; a control evaluates the same
 // recursion every interpolation cycle with a = 1 - exp(-T_cycle / tau) (interp/drift_action.h).
+// Elapsed time (a sensor-free input): the virtual input "elapsed" is 0 at the run's first row and
+// 1 afterwards (a unit step at the run start); its features are its first-order lags with
+// L_0 = 0, one per time constant in `elapsed_time_constants`:
+//   elapsed_lag<tau>(t) = 1 - exp(-(t - t_0) / tau)   (exact: the step is piecewise constant),
+// so a model on them alone is the first-order warm-up e = b0 + sum_j A_j (1 - exp(-(t - t0)/tau_j))
+// (the time-only baseline and candidate, FitWarmUp in drift/regression.h). They follow the
+// input-major features. A control evaluates them with the same recursion from the run start.
 // Kinds:
 //   mlr      Miao et al.'s multiple linear regression, no lags: e = b0 + sum_s b_s dT_s.
 //   dynamic  the same regression on the features with lags; the time constants are picked from
@@ -59,7 +66,9 @@ inline constexpr double kMaxResidualStdUm = 10 * kMaxAbsErrorUm;
 inline constexpr double kMaxTimeConstant = 1e6;
 
 struct DriftModel {
-  static constexpr int kSchemaVersion = 1;
+  /// 2: error_zero, gauge_level_um and elapsed_time_constants; schema 1 files are read with
+  /// error zero as-logged (run_file.h) and no elapsed features.
+  static constexpr int kSchemaVersion = 2;
   static constexpr const char* kFormat = "whirl-drift-model";
 
   ModelKind kind = ModelKind::kMlr;
@@ -69,7 +78,12 @@ struct DriftModel {
   std::vector<std::string> extra_inputs;     ///< other columns used as logged
   std::string time_unit = "min";             ///< "min", or "sample" (training runs had no time)
   std::vector<double> time_constants;        ///< lag time constants [time_unit], ascending
-  std::vector<Feature> features;             ///< input-major, see the header comment
+  /// Time constants of the elapsed-time features [time_unit] (header comment); may be the only
+  /// features (a time-only model, no sensor).
+  std::vector<double> elapsed_time_constants;
+  std::vector<Feature> features;             ///< input-major, then the elapsed lags
+  /// The zero of the errors the model was fitted on and is evaluated against (run_file.h).
+  ZeroConvention zero;
   Eigen::VectorXd feature_min, feature_max;  ///< training range per feature
 
   LinearFit linear;  ///< mlr, dynamic: coefficients b0 [um], then um per feature unit
@@ -89,6 +103,8 @@ struct DriftModel {
   std::vector<std::string> notes;  ///< provenance (command line, lag search)
 
   int InputCount() const { return static_cast<int>(sensors.size() + extra_inputs.size()); }
+  /// True when the model uses no temperature sensor (time-only or duty baselines).
+  bool SensorFree() const { return sensors.empty(); }
   /// Throws InputError naming the field when sizes are inconsistent or a value is outside its
   /// range (residual_std_um, r_squared, time constants, noise variance).
   void Validate() const;
@@ -120,10 +136,14 @@ class DriftEvaluator {
 /// Raw inputs (sensors' temperatures, extras) of every sample of a run: samples x inputs.
 /// InputError if the run lacks a column the model needs.
 Eigen::MatrixXd RawInputs(const DriftModel& model, const Run& run);
-/// Feature matrix (samples x features) of a run with the run's first row as reference.
+/// Feature matrix (samples x features) of a run with the run's first row as reference; the
+/// elapsed-time features (header comment) last.
 Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& sensors,
                               const std::vector<std::string>& extra_inputs,
-                              const std::vector<double>& time_constants);
+                              const std::vector<double>& time_constants,
+                              const std::vector<double>& elapsed_time_constants = {});
+/// The elapsed-time features of a run: samples x taus, column j = 1 - exp(-(t - t0) / tau_j).
+Eigen::MatrixXd ElapsedFeatures(const std::vector<double>& t, const std::vector<double>& taus);
 
 struct RunPrediction {
   std::string run;

@@ -1,8 +1,10 @@
 #include "drift/monitor.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/error.h"
 #include "core/numbers.h"
@@ -40,6 +42,7 @@ struct Replay {
   Eigen::MatrixXd p0;  // bayes prior
   double threshold_um, noise_variance;
   int start_sample;
+  Eigen::VectorXd column_scale;  // patent: 1 for the intercept, then each feature's training range
 };
 
 struct Piece {
@@ -55,10 +58,11 @@ std::string CheckMessage(double t, double y, double p, double thr, bool valid) {
 }
 
 Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
-                          const Eigen::VectorXd& b, Eigen::MatrixXd* p, double r) {
+                          const Eigen::VectorXd& b, Eigen::MatrixXd* p, double r, int* rank,
+                          const Eigen::VectorXd& scale) {
   switch (rule) {
     case UpdateRule::kPatent:
-      return PatentRefit(xs, ys);
+      return PatentRefit(xs, ys, b, rank, scale);
     case UpdateRule::kBayes:
       return BayesUpdate(xs, ys, b, p, r);
     case UpdateRule::kOffset:
@@ -70,11 +74,18 @@ Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eige
 }
 
 std::string UpdateMessage(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
-                          const Eigen::VectorXd& before, const Eigen::VectorXd& after) {
+                          const Eigen::VectorXd& before, const Eigen::VectorXd& after, int rank,
+                          double prior_scale) {
   const auto rms = [&](const Eigen::VectorXd& b) {
     return std::sqrt((ys - xs * b).squaredNorm() / static_cast<double>(ys.size()));
   };
-  return ToString(rule) + " update from " + std::to_string(ys.size()) +
+  std::string how;
+  if (rule == UpdateRule::kPatent)
+    how = ": " + std::to_string(rank) + " of " + std::to_string(before.size()) +
+          " directions identified" +
+          (rank < before.size() ? " (the others keep the current coefficients)" : "");
+  if (rule == UpdateRule::kBayes) how = ": prior scale " + MessageNumber(prior_scale) + " x Cov(b)";
+  return ToString(rule) + how + "; update from " + std::to_string(ys.size()) +
          " measurements: RMS misfit on them " + FormatDecimals(rms(before), 3) + " -> " +
          FormatDecimals(rms(after), 3) + " um; coefficients " + Vec(before) + " -> " + Vec(after);
 }
@@ -100,6 +111,7 @@ class RuleReplay {
     }
     Predict();
     s_.final_coefficients = pieces_.back().b;
+    s_.final_covariance = prior_;
     s_.stop_min = s_.measurements * in_.o.stop_min_per_measurement;
     return s_;
   }
@@ -167,9 +179,11 @@ class RuleReplay {
     }
     const Eigen::VectorXd before = pieces_.back().b;
     u.kind = MonitorEvent::Kind::kUpdate;
-    u.coefficients = ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance);
+    int rank = 0;
+    u.coefficients =
+        ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance, &rank, in_.column_scale);
     u.predicted_um = in_.x.row(*last).dot(u.coefficients);
-    u.message = UpdateMessage(rule_, xs, ys, before, u.coefficients);
+    u.message = UpdateMessage(rule_, xs, ys, before, u.coefficients, rank, in_.o.prior_scale);
     s_.events.push_back(u);
     pieces_.push_back({*last, u.coefficients});
     ++s_.recalibrations;
@@ -195,6 +209,7 @@ class RuleReplay {
 };
 
 StrategyResult RunRule(UpdateRule rule, const Replay& in) { return RuleReplay(rule, in).Run(); }
+
 
 }  // namespace
 
@@ -275,8 +290,26 @@ Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, Reference
   return x;
 }
 
-Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
-  return LeastSquaresCoefficients(x.rightCols(x.cols() - 1), y);
+Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                            const Eigen::VectorXd& b, int* rank,
+                            const Eigen::VectorXd& column_scale) {
+  Eigen::VectorXd scale =
+      column_scale.size() == x.cols() ? column_scale : Eigen::VectorXd(x.colwise().norm().transpose());
+  for (Eigen::Index j = 0; j < scale.size(); ++j)
+    if (!(scale(j) > 0)) scale(j) = 1;
+  const Eigen::MatrixXd xs = x * scale.cwiseInverse().asDiagonal();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(xs, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  const Eigen::VectorXd misfit = y - x * b;
+  Eigen::VectorXd change_scaled = Eigen::VectorXd::Zero(x.cols());
+  int k = 0;
+  for (Eigen::Index i = 0; i < s.size(); ++i) {
+    if (!(s(i) >= 0.05 * s(0)) || !(s(i) > 0)) continue;
+    change_scaled += svd.matrixV().col(i) * (svd.matrixU().col(i).dot(misfit) / s(i));
+    ++k;
+  }
+  if (rank) *rank = k;
+  return b + scale.cwiseInverse().asDiagonal() * change_scaled;
 }
 
 Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
@@ -301,28 +334,43 @@ Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
   return updated;
 }
 
-MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorOptions& o) {
-  o.Validate();
-  const Eigen::MatrixXd x = MonitorDesign(model, run, o.reference);
+namespace {
+
+// The patent's column scale: 1 for the intercept, each feature's training range (1 if none), so
+// the directions it keeps are those the measurements identify relative to the range the model
+// was fitted on, not to the few values at the measurements.
+Eigen::VectorXd PatentScale(const DriftModel& m) {
+  Eigen::VectorXd s(m.feature_max.size() + 1);
+  s(0) = 1;
+  for (Eigen::Index j = 0; j < m.feature_max.size(); ++j) {
+    const double range = m.feature_max(j) - m.feature_min(j);
+    s(j + 1) = range > 0 ? range : 1;
+  }
+  return s;
+}
+
+// The result's run, rows, scored window and threshold (MonitorRun's checks of its inputs).
+MonitorResult StartResult(const DriftModel& model, const Run& run, const MonitorOptions& o,
+                          int* start) {
   MonitorResult r;
   r.run = run.name;
   r.error_column = model.error_column;
   r.model_kind = ToString(model.kind);
   r.time = run.time_min;
   r.time_from_index = run.time_from_index;
-  r.measured_um = run.error_um.col(run.ErrorIndex(model.error_column));
+  r.measured_um = ApplyErrorZero(run, model.zero).error_um.col(run.ErrorIndex(model.error_column));
   const int n = run.samples();
-  const int start = SampleAt(r.time, o.start, 0);
-  if (start < 0 || start >= n - 1)
+  *start = SampleAt(r.time, o.start, 0);
+  if (*start < 0 || *start >= n - 1)
     throw InputError("monitor option start = " + MessageNumber(o.start) + ": the run " +
                      run.source + " ends at " + MessageNumber(r.time.back()) +
                      ": nothing to monitor");
-  r.monitored_min = r.time.back() - r.time[static_cast<std::size_t>(start)];
+  r.monitored_min = r.time.back() - r.time[static_cast<std::size_t>(*start)];
   if (r.monitored_min / o.check_every > kMaxMonitorChecks)
     throw InputError("monitor option check_every = " + MessageNumber(o.check_every) + ": over " +
                      std::to_string(kMaxMonitorChecks) + " checks in " +
                      MessageNumber(r.monitored_min) + " (limit)");
-  r.score_begin = std::max(start, static_cast<int>(o.score_from * n));
+  r.score_begin = std::max(*start, static_cast<int>(o.score_from * n));
   r.score_end = std::min(n, static_cast<int>(o.score_to * n));
   if (r.score_end <= r.score_begin)
     throw InputError("monitor: no scored rows: rows [" + std::to_string(r.score_begin) + ", " +
@@ -330,6 +378,38 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
   Rng rng(o.seed);
   r.measurement_noise_um.resize(n);
   for (int k = 0; k < n; ++k) r.measurement_noise_um(k) = o.noise_um * rng.Normal();
+  if (model.zero.zero == ErrorZero::kAsLogged)
+    r.warnings.push_back(model.error_column +
+                         ": the model file predates the error zero (schema 1): errors as logged");
+  return r;
+}
+
+std::vector<UpdateRule> RulesOf(const MonitorOptions& o) {
+  std::vector<UpdateRule> rules{UpdateRule::kStatic};
+  for (UpdateRule u : o.rules)
+    if (std::find(rules.begin(), rules.end(), u) == rules.end()) rules.push_back(u);
+  return rules;
+}
+
+}  // namespace
+
+std::string MonitorResult::Strongest() const {
+  std::string best = "none";
+  double v = none.mae_um;
+  for (const auto& st : strategies)
+    if (st.score.mae_um < v) best = ToString(st.rule), v = st.score.mae_um;
+  for (const auto& b : baselines)
+    if (b.score.mae_um < v) best = b.name, v = b.score.mae_um;
+  return best;
+}
+
+MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorOptions& o,
+                         const std::vector<DriftModel>& baselines,
+                         const std::vector<StrategyResult>* initial) {
+  o.Validate();
+  const Eigen::MatrixXd x = MonitorDesign(model, run, o.reference);
+  int start = 0;
+  MonitorResult r = StartResult(model, run, o, &start);
   const Eigen::VectorXd y = r.measured_um + r.measurement_noise_um;
   const double s = model.residual_std_um;
   const double noise_variance = s * s + o.noise_um * o.noise_um;
@@ -339,30 +419,108 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
     throw InputError(
         "monitor: threshold is 0 um (the model's residual std is 0 and no noise): "
         "give an absolute threshold");
-  const Replay in{x,
-                  y,
-                  r.time,
-                  o,
-                  model.linear.coefficients,
-                  o.prior_scale * model.linear.covariance,
-                  r.threshold_um,
-                  std::max(noise_variance, 1e-12),
-                  start};
   const int m = r.score_end - r.score_begin;
   r.none = ComputeErrorStats(r.measured_um.segment(r.score_begin, m));
-  std::vector<UpdateRule> rules{UpdateRule::kStatic};
-  for (UpdateRule u : o.rules)
-    if (std::find(rules.begin(), rules.end(), u) == rules.end()) rules.push_back(u);
-  for (UpdateRule u : rules) {
-    StrategyResult sr = RunRule(u, in);
+  const std::vector<UpdateRule> rules = RulesOf(o);
+  for (std::size_t i = 0; i < rules.size(); ++i) {
+    const bool carried = initial != nullptr && i < initial->size();
+    const Replay in{x,
+                    y,
+                    r.time,
+                    o,
+                    carried ? (*initial)[i].final_coefficients : model.linear.coefficients,
+                    carried && (*initial)[i].final_covariance.size() > 0
+                        ? (*initial)[i].final_covariance
+                        : Eigen::MatrixXd(o.prior_scale * model.linear.covariance),
+                    r.threshold_um,
+                    std::max(noise_variance, 1e-12),
+                    start,
+                    PatentScale(model)};
+    StrategyResult sr = RunRule(rules[i], in);
     sr.stop_share = sr.stop_min / (r.monitored_min + sr.stop_min);
     sr.score = ComputeErrorStats(r.measured_um.segment(r.score_begin, m) -
                                  sr.predicted_um.segment(r.score_begin, m));
     r.strategies.push_back(std::move(sr));
   }
+  for (const DriftModel& b : baselines) {
+    BaselineResult br;
+    br.name = b.SensorFree() && b.extra_inputs.empty() ? "time" : "duty:" + b.extra_inputs.front();
+    br.predicted_um = PredictRun(b, run, o.reference).predicted_um;
+    br.score = ComputeErrorStats(r.measured_um.segment(r.score_begin, m) -
+                                 br.predicted_um.segment(r.score_begin, m));
+    r.baselines.push_back(std::move(br));
+  }
   if (run.time_from_index)
     r.warnings.push_back(run.name + ": no recorded time: intervals and stop share in samples");
   return r;
+}
+
+namespace {
+
+// Appends the scored residuals of `r` per name (none, strategies, baselines) to `week`.
+void CollectScored(const MonitorResult& r,
+                   std::vector<std::pair<std::string, std::vector<double>>>* week) {
+  auto add = [&](const std::string& name, const Eigen::VectorXd& predicted) {
+    auto it = std::find_if(week->begin(), week->end(), [&](const auto& p) { return p.first == name; });
+    if (it == week->end()) it = week->insert(week->end(), {name, {}});
+    for (int k = r.score_begin; k < r.score_end; ++k)
+      it->second.push_back(r.measured_um(k) - (predicted.size() ? predicted(k) : 0.0));
+  };
+  add("none", Eigen::VectorXd());
+  for (const auto& st : r.strategies) add(ToString(st.rule), st.predicted_um);
+  for (const auto& b : r.baselines) add(b.name, b.predicted_um);
+}
+
+}  // namespace
+
+WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
+                       const MonitorOptions& o, const FitOptions& refit,
+                       const std::vector<Run>& first_time_training) {
+  if (days.empty()) throw InputError("monitor: give at least one day (--day)");
+  WeekResult w;
+  std::vector<std::pair<std::string, std::vector<double>>> scored;
+  FitOptions time_only = refit;
+  time_only.kind = ModelKind::kMlr;
+  time_only.candidates = Candidates::kTime;
+  time_only.zero = model.zero;
+  FitOptions previous_fit = refit;
+  previous_fit.zero = model.zero;
+  for (std::size_t d = 0; d < days.size(); ++d) {
+    std::vector<DriftModel> baselines;
+    DriftModel previous = model;
+    if (d > 0) {
+      previous = FitDriftModel({days[d - 1]}, model.error_column, previous_fit).model;
+      baselines.push_back(FitDriftModel({days[d - 1]}, model.error_column, time_only).model);
+    } else if (!first_time_training.empty()) {
+      baselines.push_back(FitDriftModel(first_time_training, model.error_column, time_only).model);
+    }
+    const std::vector<StrategyResult>* carried = d > 0 ? &w.days.back().strategies : nullptr;
+    MonitorResult r = MonitorRun(model, days[d], o, baselines, carried);
+    BaselineResult prev;
+    prev.name = "previous";
+    prev.predicted_um = PredictRun(previous, days[d], o.reference).predicted_um;
+    prev.score = ComputeErrorStats(
+        r.measured_um.segment(r.score_begin, r.score_end - r.score_begin) -
+        prev.predicted_um.segment(r.score_begin, r.score_end - r.score_begin));
+    r.baselines.push_back(std::move(prev));
+    CollectScored(r, &scored);
+    w.days.push_back(std::move(r));
+  }
+  w.measurements.assign(w.days.front().strategies.size(), 0);
+  w.stop_min.assign(w.days.front().strategies.size(), 0.0);
+  for (const auto& r : w.days)
+    for (std::size_t i = 0; i < r.strategies.size(); ++i) {
+      w.measurements[i] += r.strategies[i].measurements;
+      w.stop_min[i] += r.strategies[i].stop_min;
+    }
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [name, res] : scored) {
+    const ErrorStats st = ComputeErrorStats(
+        Eigen::Map<const Eigen::VectorXd>(res.data(), static_cast<Eigen::Index>(res.size())));
+    w.week.emplace_back(name, st);
+    if (st.mae_um < best) best = st.mae_um, w.strongest = name;
+  }
+  return w;
 }
 
 }  // namespace whirl::drift

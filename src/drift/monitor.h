@@ -27,9 +27,15 @@
 // Recalibration on an invalid check: m = refit_samples further measurements every refit_every,
 // then the update from the n = m + 1 measurements (the invalid check and the m) with design rows
 // x_j = [1 f_j] and values y_j; the new coefficients apply from the last measurement on. Rules:
-//   patent   least squares of all coefficients on the n measurements alone (the patent's rule;
-//            its model has no intercept, ours fits b0 too). n < p + 1 (p features) or collinear
-//            rows: the minimum-norm solution of the unit-scaled columns (regression.h).
+//   patent   the patent's least-squares refit made rank-aware: the minimum change of the current
+//            coefficients that fits the n measurements in the directions they identify:
+//              Delta = S^-1 V_k diag(1/s_i) U_k' (y - X b),  X S^-1 = U diag(s) V' (S: 1 for the
+//              intercept, each feature's training range), keeping the k directions with
+//              s_i >= 0.05 s_max;
+//            the other directions keep the current coefficients, and the event says how many of
+//            the p + 1 were identified. With n >= p + 1 well-spread rows it is the patent's refit
+//            (all coefficients by least squares on the n measurements alone); with fewer it no
+//            longer extrapolates a fit of 4 coefficients to 4 points.
 //   bayes    recursive least squares = Gaussian posterior with the current coefficients as the
 //            prior mean and prior covariance P (first P0 = prior_scale * Cov(b) of the training
 //            fit, regression.h), observation variance r = s^2 + noise_um^2:
@@ -38,7 +44,12 @@
 //            b+ = b + K (y - X b), P+ = (I - K X) P of Kalman with no process noise, computed in
 //            this information form for accuracy), and P+ is the prior of the next update. A very
 //            weak prior (prior_scale -> inf) gives the patent's refit when X has full column rank
-//            (tests/drift/test_monitor.cpp).
+//            (tests/drift/test_monitor.cpp). Its change is bounded in closed form: b+ minimises
+//            J(b) = (b - b)' P^-1 (b - b) + |y - X b|^2 / r, so J(b+) <= |y - X b|^2 / r and, for
+//            every direction z, |z'(b+ - b)| <= sqrt(z' P z) |y - X b| / sqrt(r) (Cauchy-Schwarz).
+//            The default rule; prior_scale 100 (Cov(b) of hundreds of autocorrelated training
+//            samples states sampling error, not a model used far outside its training range),
+//            chosen on a validation block before the test window of a 46-h log (FL_THERMAL).
 //   offset   only the intercept: b0 += mean_j (y_j - x_j' b).
 //   static   (reference) the model as fitted, never checked.
 // Every check and update is logged (MonitorEvent) with the numbers it compared.
@@ -53,6 +64,7 @@
 #include <vector>
 
 #include "drift/evaluation.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
 
@@ -68,7 +80,9 @@ inline constexpr int kMaxMonitorChecks = 100000;
 
 struct MonitorOptions {
   /// Interval between checks [min; samples when the run has no time column] (> 0).
-  double check_every = 60;
+  /// Default 120 min: 3-4 checks in an 8-h shift. On a run without time the unit is samples and
+  /// every output says so.
+  double check_every = 120;
   /// Machine stop per check-bar measurement (a check or a refit measurement) [min] (>= 0).
   double stop_min_per_measurement = 1.0;
   /// Absolute validity threshold [um]; 0: use threshold_sigma.
@@ -77,14 +91,14 @@ struct MonitorOptions {
   double threshold_sigma = 3;
   /// m: further measurements after an invalid check (0..kMaxRefitSamples; 0: the update uses
   /// the invalid check alone, no extra stop).
-  int refit_samples = 3;
+  int refit_samples = 0;
   /// Interval between the refit measurements [min; samples without time] (> 0).
   double refit_every = 5;
   /// Std of the check-bar measurement noise added to the logged error [um] (>= 0).
   double noise_um = 0;
   std::uint64_t seed = 1;  ///< noise draws
   /// bayes: prior covariance = prior_scale * the training fit's Cov(b) (> 0).
-  double prior_scale = 1;
+  double prior_scale = 100;
   /// Monitoring starts here [min; samples]: no check before it, scores from it.
   double start = 0;
   double score_from = 0, score_to = 1;  ///< scored share of the run's rows, [from, to)
@@ -116,6 +130,15 @@ struct StrategyResult {
   double stop_min = 0, stop_share = 0;
   ErrorStats score;  ///< measured - predicted over the scored rows
   Eigen::VectorXd final_coefficients;
+  Eigen::MatrixXd final_covariance;  ///< bayes: the posterior covariance after the last update
+};
+
+/// A sensor-free baseline (a time-only or duty model fitted on the training runs) replayed as a
+/// static model, never checked.
+struct BaselineResult {
+  std::string name;  ///< "time", "duty:<col>", ...
+  Eigen::VectorXd predicted_um;
+  ErrorStats score;
 };
 
 struct MonitorResult {
@@ -129,12 +152,38 @@ struct MonitorResult {
   double threshold_um = 0;                 ///< the threshold in force
   ErrorStats none;                         ///< no compensation over the scored rows
   std::vector<StrategyResult> strategies;  ///< static first, then options.rules
+  std::vector<BaselineResult> baselines;   ///< sensor-free baselines (MonitorRun's argument)
   std::vector<std::string> warnings;
+  /// The lowest scored MAE among none, the strategies and the baselines.
+  std::string Strongest() const;
 };
 
 /// Replays `options` on `run` (which must have model.error_column). InputError for a network
 /// model (not linear in coefficients), a missing column, a time-unit mismatch or bad options.
-MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorOptions& options);
+/// The errors are on the model's zero (DriftModel::zero), "none" and the baselines too.
+/// `initial` (optional): coefficients and bayes covariance per rule to start from (a carried
+/// model, MonitorWeek), in the order static, options.rules.
+MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorOptions& options,
+                         const std::vector<DriftModel>& baselines = {},
+                         const std::vector<StrategyResult>* initial = nullptr);
+
+/// A production week: the days replayed in order, each day's rules starting from the previous
+/// day's final coefficients and bayes covariance (the static row stays the given model), the
+/// check schedule from each day's start. Baselines per day: none, the given model (static),
+/// `previous`: the model refitted on the previous day with `refit` (the given model on the first
+/// day), and `time`: a time-only warm-up fitted on the previous day (on the first day: on
+/// `first_time_training` when given, else none).
+struct WeekResult {
+  std::vector<MonitorResult> days;
+  /// Per strategy/baseline name: the week's statistics over every scored sample of every day.
+  std::vector<std::pair<std::string, ErrorStats>> week;
+  std::vector<int> measurements;  ///< per strategy of days[0].strategies: over the week
+  std::vector<double> stop_min;   ///< per strategy: total stop time [min; samples]
+  std::string strongest;          ///< lowest week MAE
+};
+WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
+                       const MonitorOptions& options, const FitOptions& refit,
+                       const std::vector<Run>& first_time_training = {});
 
 /// Features of every sample as the control computes them: samples x (1 + features), first
 /// column 1 (the design rows of the updates).
@@ -142,7 +191,14 @@ Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, Reference
 
 /// The update rules on n measurements (rows of x: [1 f], y: measured [um]); b: current
 /// coefficients; prior_covariance (bayes, updated in place); noise_variance r [um^2].
-Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
+/// patent (header comment): the rank-aware minimum change from b; *rank (optional): the number of
+/// directions identified.
+/// `column_scale` (size x.cols()): the unit of each column for the singular-value cut (the
+/// replay passes 1 for the intercept and each feature's training range); empty: the columns'
+/// norms over the n rows.
+Eigen::VectorXd PatentRefit(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                            const Eigen::VectorXd& b, int* rank = nullptr,
+                            const Eigen::VectorXd& column_scale = Eigen::VectorXd());
 Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                             const Eigen::VectorXd& b, Eigen::MatrixXd* prior_covariance,
                             double noise_variance);

@@ -63,8 +63,9 @@ std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::stri
   std::ostringstream o;
   for (const auto& c : WithComments(comments, "monitor events of " + r.run))
     o << "# " << SpreadsheetLine(c) << "\n";
-  o << "rule,kind,sample," << TimeName(r)
-    << ",measured_um,predicted_um,threshold_um,valid,message\n";
+  // Without recorded time the time axis is the sample index: one column, not two.
+  o << "rule,kind,sample," << (r.time_from_index ? "" : "time_min,")
+    << "measured_um,predicted_um,threshold_um,valid,message\n";
   for (const auto& s : r.strategies)
     for (const auto& e : s.events) {
       std::string msg = e.message;
@@ -73,7 +74,7 @@ std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::stri
       const bool measured =
           e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement;
       o << ToString(s.rule) << "," << ToString(e.kind) << "," << e.sample << ","
-        << FormatNumber(e.time) << "," << (measured ? FormatNumber(e.measured_um) : "") << ","
+        << (r.time_from_index ? "" : FormatNumber(e.time) + ",") << (measured ? FormatNumber(e.measured_um) : "") << ","
         << FormatNumber(e.predicted_um) << ","
         << (e.kind == MonitorEvent::Kind::kCheck ? FormatNumber(e.threshold_um) : "") << ","
         << (e.kind == MonitorEvent::Kind::kCheck ? (e.valid ? "1" : "0") : "") << ","
@@ -95,7 +96,7 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
          {"measurements", s.measurements},
          {"recalibrations", s.recalibrations},
          {"stop_min", s.stop_min},
-         {"stop_share", s.stop_share},
+         {"stop_share", r.time_from_index ? nlohmann::json(nullptr) : nlohmann::json(s.stop_share)},
          {"final_coefficients",
           std::vector<double>(s.final_coefficients.data(),
                               s.final_coefficients.data() + s.final_coefficients.size())},
@@ -103,8 +104,13 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
   }
   std::vector<std::string> rules;
   for (UpdateRule u : o.rules) rules.push_back(ToString(u));
+  nlohmann::json baselines = nlohmann::json::array();
+  for (const auto& b : r.baselines)
+    baselines.push_back({{"name", b.name}, {"score", ErrorStatsJson(b.score)}});
   return {{"schema", "whirl.drift_monitor"},
-          {"schema_version", 1},
+          {"schema_version", 2},
+          {"baselines", baselines},
+          {"strongest", r.Strongest()},
           {"run", r.run},
           {"error_column", r.error_column},
           {"model_kind", r.model_kind},
@@ -141,7 +147,9 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
     << MessageNumber(o.check_every) << (idx ? " samples" : " min") << ", threshold "
     << FormatDecimals(r.threshold_um, 2) << " um, " << o.refit_samples
     << " refit measurements every " << MessageNumber(o.refit_every) << (idx ? " samples" : " min")
-    << ", " << MessageNumber(o.stop_min_per_measurement) << " min stop each\n";
+    << ", " << MessageNumber(o.stop_min_per_measurement) << " min stop each"
+    << (idx ? " (no recorded time: intervals count samples; stop share not computed)" : "")
+    << "\n";
   s << "scored rows [" << r.score_begin << ", " << r.score_end
     << "): " << FormatDecimals(r.time[static_cast<std::size_t>(r.score_begin)] * to_h, 2) << " to "
     << FormatDecimals(r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h, 2) << " " << unit
@@ -153,12 +161,18 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
                 r.none.mae_um, r.none.rmse_um, r.none.max_abs_um);
   s << buf;
   for (const auto& st : r.strategies) {
-    std::snprintf(buf, sizeof buf, "%-8s %7.2f %8.2f %7.2f %7d %8d %6d %9.1f %7.2f\n",
+    std::snprintf(buf, sizeof buf, "%-8s %7.2f %8.2f %7.2f %7d %8d %6d %9.1f ",
                   ToString(st.rule).c_str(), st.score.mae_um, st.score.rmse_um, st.score.max_abs_um,
-                  st.checks, st.invalid_checks, st.recalibrations, st.stop_min,
-                  100.0 * st.stop_share);
+                  st.checks, st.invalid_checks, st.recalibrations, st.stop_min);
+    s << buf << (idx ? "      -" : PadLeft(FormatDecimals(100.0 * st.stop_share, 2), 7)) << "\n";
+  }
+  for (const auto& b : r.baselines) {
+    std::snprintf(buf, sizeof buf,
+                  "%-8s %7.2f %8.2f %7.2f       -        -      -         -       -  (sensor-free)\n",
+                  b.name.c_str(), b.score.mae_um, b.score.rmse_um, b.score.max_abs_um);
     s << buf;
   }
+  s << "strongest (lowest MAE): " << r.Strongest() << "\n";
   for (const auto& st : r.strategies) {
     if (st.recalibrations == 0) continue;
     s << ToString(st.rule) << " updates:\n";
@@ -168,6 +182,52 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
   }
   for (const auto& w : r.warnings) s << "warning: " << w << "\n";
   return s.str();
+}
+
+std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
+  std::ostringstream s;
+  const bool idx = w.days.front().time_from_index;
+  s << "production week of " << w.days.size() << " day(s), " << w.days.front().error_column
+    << ": checks every " << MessageNumber(o.check_every) << (idx ? " samples" : " min")
+    << " from each day's start, " << o.refit_samples
+    << " refit measurements; each rule carries its coefficients (and the bayes covariance) "
+       "from day to day\n";
+  s << "MAE um per day (previous = refit on the previous day; time = sensor-free warm-up fitted "
+       "on the previous day)\n";
+  for (const auto& d : w.days) {
+    s << "  " << d.run << ": none " << FormatDecimals(d.none.mae_um, 2);
+    for (const auto& st : d.strategies)
+      s << ", " << ToString(st.rule) << " " << FormatDecimals(st.score.mae_um, 2) << " (" << st.checks
+        << " checks, " << FormatDecimals(st.stop_min, 0) << " min)";
+    for (const auto& b : d.baselines) s << ", " << b.name << " " << FormatDecimals(b.score.mae_um, 2);
+    s << "; strongest " << d.Strongest() << "\n";
+  }
+  s << "week         MAE um  RMSE um  measurements  stop min\n";
+  for (const auto& [name, st] : w.week) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "  %-10s %6.2f %8.2f", name.c_str(), st.mae_um, st.rmse_um);
+    s << buf;
+    for (std::size_t i = 0; i < w.days.front().strategies.size(); ++i)
+      if (ToString(w.days.front().strategies[i].rule) == name)
+        s << PadLeft(std::to_string(w.measurements[i]), 14) << PadLeft(FormatDecimals(w.stop_min[i], 0), 10);
+    s << "\n";
+  }
+  s << "strongest over the week (lowest MAE): " << w.strongest << "\n";
+  return s.str();
+}
+
+nlohmann::json WeekJson(const WeekResult& w, const MonitorOptions& o) {
+  nlohmann::json days = nlohmann::json::array();
+  for (const auto& d : w.days) days.push_back(MonitorJson(d, o));
+  nlohmann::json week = nlohmann::json::array();
+  for (const auto& [name, st] : w.week) week.push_back({{"name", name}, {"score", ErrorStatsJson(st)}});
+  return {{"schema", "whirl.drift_monitor_week"},
+          {"schema_version", 1},
+          {"days", days},
+          {"week", week},
+          {"measurements", w.measurements},
+          {"stop_min", w.stop_min},
+          {"strongest", w.strongest}};
 }
 
 namespace {

@@ -19,6 +19,11 @@ std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::st
 /// threshold_um, valid, message.
 std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments);
 nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o);
+/// The week: per day the table of none, each rule and the baselines (MAE [um]), checks and stop
+/// minutes; then the week's MAE / RMSE per row, measurements and stop time totalled, and the
+/// strongest. JSON schema whirl.drift_monitor_week v1.
+std::string FormatWeek(const WeekResult& w, const MonitorOptions& o);
+nlohmann::json WeekJson(const WeekResult& w, const MonitorOptions& o);
 std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o);
 
 struct MonitorReportResult {

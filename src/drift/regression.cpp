@@ -1,6 +1,7 @@
 #include "drift/regression.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -123,6 +124,152 @@ Eigen::VectorXd FirstOrderLag(const Eigen::VectorXd& x, const std::vector<double
     y(k) = y(k - 1) + a * (x(k) - y(k - 1));
   }
   return y;
+}
+
+}  // namespace whirl::drift
+
+namespace whirl::drift {
+namespace {
+
+struct WarmUpData {
+  const std::vector<std::vector<double>>& t;
+  const std::vector<Eigen::VectorXd>& e;
+  const Eigen::MatrixXd& fixed;
+  Eigen::Index rows = 0;
+};
+
+// Stacked design [elapsed lags] of every run for time constants `taus`.
+Eigen::MatrixXd WarmUpDesign(const WarmUpData& d, const std::vector<double>& taus) {
+  const Eigen::Index c = d.fixed.cols();
+  Eigen::MatrixXd x(d.rows, c + static_cast<Eigen::Index>(taus.size()));
+  if (c > 0) x.leftCols(c) = d.fixed;
+  Eigen::Index at = 0;
+  for (const auto& t : d.t) {
+    for (std::size_t k = 0; k < t.size(); ++k, ++at)
+      for (std::size_t j = 0; j < taus.size(); ++j)
+        x(at, c + static_cast<Eigen::Index>(j)) = 1.0 - std::exp(-t[k] / taus[j]);
+  }
+  return x;
+}
+
+Eigen::VectorXd WarmUpTarget(const WarmUpData& d) {
+  Eigen::VectorXd y(d.rows);
+  Eigen::Index at = 0;
+  for (const auto& e : d.e) {
+    y.segment(at, e.size()) = e;
+    at += e.size();
+  }
+  return y;
+}
+
+// The projected residual sum of squares: the gains by least squares for these taus.
+double ProjectedSse(const WarmUpData& d, const Eigen::VectorXd& y, const std::vector<double>& taus,
+                    Eigen::VectorXd* b) {
+  const Eigen::MatrixXd x = WarmUpDesign(d, taus);
+  *b = LeastSquaresCoefficients(x, y);
+  return (y - EvaluateLinear(*b, x)).squaredNorm();
+}
+
+// Golden-section minimum of f over log tau in [lo, hi] (Kiefer, "Sequential minimax search for a
+// maximum"), 30 steps: a bracket of 1e-6 of the log range.
+template <typename F>
+double GoldenLog(F f, double lo, double hi) {
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double a = std::log(lo), c = std::log(hi);
+  double x1 = c - g * (c - a), x2 = a + g * (c - a);
+  double f1 = f(std::exp(x1)), f2 = f(std::exp(x2));
+  for (int i = 0; i < 30; ++i) {
+    if (f1 <= f2) {
+      c = x2, x2 = x1, f2 = f1, x1 = c - g * (c - a), f1 = f(std::exp(x1));
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + g * (c - a), f2 = f(std::exp(x2));
+    }
+  }
+  return std::exp(f1 <= f2 ? x1 : x2);
+}
+
+std::vector<double> LogGrid(const WarmUpData& d) {
+  std::vector<double> steps;
+  double longest = 0;
+  for (const auto& t : d.t) {
+    for (std::size_t k = 1; k < t.size(); ++k) steps.push_back(t[k] - t[k - 1]);
+    if (!t.empty()) longest = std::max(longest, t.back());
+  }
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2),
+                   steps.end());
+  const double lo = 2 * steps[steps.size() / 2], hi = std::max(3 * longest, 2 * lo);
+  std::vector<double> grid(41);
+  for (int i = 0; i < 41; ++i) grid[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, i / 40.0);
+  return grid;
+}
+
+// Best grid point (one term) or pair with tau_2 >= 3 tau_1 (two terms), as grid indices.
+std::vector<std::size_t> GridSearch(const WarmUpData& d, const Eigen::VectorXd& y,
+                                    const std::vector<double>& grid, int terms) {
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<std::size_t> at;
+  Eigen::VectorXd b;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (terms == 1) {
+      const double sse = ProjectedSse(d, y, {grid[i]}, &b);
+      if (sse < best) best = sse, at = {i};
+      continue;
+    }
+    for (std::size_t k = i + 1; k < grid.size(); ++k) {
+      if (grid[k] < 3 * grid[i]) continue;
+      const double sse = ProjectedSse(d, y, {grid[i], grid[k]}, &b);
+      if (sse < best) best = sse, at = {i, k};
+    }
+  }
+  return at;
+}
+
+}  // namespace
+
+WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
+                    const std::vector<Eigen::VectorXd>& errors, int terms,
+                    const Eigen::MatrixXd& fixed) {
+  if (terms < 1 || terms > 2)
+    throw InputError("warm-up model: " + std::to_string(terms) + " terms: must be 1 or 2");
+  WarmUpData d{times, errors, fixed};
+  bool long_enough = false;
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    d.rows += static_cast<Eigen::Index>(times[i].size());
+    long_enough = long_enough || times[i].size() >= 3;
+  }
+  if (!long_enough) throw InputError("warm-up model: no run has 3 samples");
+  if (fixed.cols() > 0 && fixed.rows() != d.rows)
+    throw InputError("warm-up model: the fixed columns need one row per sample");
+  const Eigen::VectorXd y = WarmUpTarget(d);
+  const std::vector<double> grid = LogGrid(d);
+  const std::vector<std::size_t> at = GridSearch(d, y, grid, terms);
+  std::vector<double> taus;
+  for (std::size_t i : at) taus.push_back(grid[i]);
+  Eigen::VectorXd b;
+  for (std::size_t j = 0; j < taus.size(); ++j) {  // refine each tau between its neighbours
+    const std::size_t i = at[j];
+    const double lo = grid[i > 0 ? i - 1 : 0], hi = grid[std::min(i + 1, grid.size() - 1)];
+    std::vector<double> trial = taus;
+    const double lower = j == 1 ? std::max(lo, 3 * taus[0]) : lo;
+    const double upper = j == 0 && taus.size() == 2 ? std::min(hi, taus[1] / 3) : hi;
+    if (!(upper > lower)) continue;
+    taus[j] = GoldenLog(
+        [&](double tau) {
+          trial[j] = tau;
+          return ProjectedSse(d, y, trial, &b);
+        },
+        lower, upper);
+  }
+  WarmUpFit f;
+  f.time_constants = taus;
+  f.rmse_um = std::sqrt(ProjectedSse(d, y, taus, &f.coefficients) / static_cast<double>(d.rows));
+  if (at.back() + 1 == grid.size()) {
+    f.identified = false;
+    f.note = "tau not identified: a ramp (tau at the grid's upper end, " +
+             std::to_string(static_cast<long long>(std::lround(grid.back()))) +
+             "); only the initial slope A/tau is";
+  }
+  return f;
 }
 
 }  // namespace whirl::drift

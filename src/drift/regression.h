@@ -13,6 +13,8 @@
 // The posterior of b under a flat prior and Gaussian noise is N(b, Cov(b)), which the on-line
 // recalibration (drift/monitor.h) uses as its prior; xtx_inverse is kept for it unscaled.
 #include <Eigen/Core>
+#include <string>
+#include <vector>
 
 namespace whirl::drift {
 
@@ -49,5 +51,32 @@ Eigen::VectorXd VarianceInflation(const Eigen::MatrixXd& x);
 ///   y_0 = x_0,  y_k = y_{k-1} + a_k (x_k - y_{k-1}),  a_k = 1 - exp(-(t_k - t_{k-1}) / tau).
 /// tau in the unit of t (> 0).
 Eigen::VectorXd FirstOrderLag(const Eigen::VectorXd& x, const std::vector<double>& t, double tau);
+
+/// A first-order warm-up in time since the start of each run, the sensor-free baseline:
+///   e(t) = b0 + sum_j A_j (1 - exp(-(t - t0) / tau_j)),  j = 1..terms (1 or 2),
+/// t0 the run's first sample (the step response of a first-order lag, FirstOrderLag with L_0 = 0),
+/// optionally beside fixed regressors (e.g. sensor rises: e = b0 + c' x + sum_j A_j (...)).
+struct WarmUpFit {
+  std::vector<double> time_constants;  ///< tau_j ascending [unit of t]
+  Eigen::VectorXd coefficients;        ///< b0 [um], the fixed columns' c, then A_j [um]
+  double rmse_um = 0;                  ///< training RMSE
+  /// false when the best tau is the grid's upper end: only the initial slope A/tau is identified
+  /// (a ramp); the capped tau is kept and `note` says so.
+  bool identified = true;
+  std::string note;
+};
+
+/// Variable projection (Golub & Pereyra, "The differentiation of pseudo-inverses and nonlinear
+/// least squares problems whose variables separate"): for fixed time constants the gains are
+/// linear (least squares on the stacked runs, each run's time since its own start), so only tau is
+/// searched: a log grid of 41 points from 2 sample intervals (the median step) to 3 x the longest
+/// run, then a golden-section refinement of log tau between the best point's neighbours
+/// (coordinate-wise for two terms, which need tau_2 >= 3 tau_1). Deterministic, never diverges.
+/// `times`: time since each run's start, t - t0 [min or samples], and `errors` [um], per run;
+/// `fixed`: extra regressors, one row per sample of the runs in order (0 columns: none).
+/// InputError when no run has 3 samples.
+WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
+                    const std::vector<Eigen::VectorXd>& errors, int terms,
+                    const Eigen::MatrixXd& fixed = Eigen::MatrixXd());
 
 }  // namespace whirl::drift

@@ -102,11 +102,39 @@ Run Run::Slice(int begin, int end, const std::string& new_name) const {
   return r;
 }
 
-Run ErrorsFromStart(const Run& run) {
+std::string ToString(ErrorZero z) {
+  switch (z) {
+    case ErrorZero::kFixed:
+      return "fixed";
+    case ErrorZero::kAsLogged:
+      return "as-logged";
+    case ErrorZero::kRunStart:
+      break;
+  }
+  return "run-start";
+}
+
+ErrorZero ParseErrorZero(const std::string& text) {
+  if (text == "run-start") return ErrorZero::kRunStart;
+  if (text == "fixed") return ErrorZero::kFixed;
+  if (text == "as-logged") return ErrorZero::kAsLogged;
+  throw InputError("error zero '" + text + "': must be run-start or fixed");
+}
+
+Run ApplyErrorZero(const Run& run, const ZeroConvention& zero) {
   Run r = run;
-  if (r.error_um.rows() > 0) r.error_um.rowwise() -= run.error_um.row(0);
+  if (r.error_um.rows() == 0) return r;
+  if (zero.zero == ErrorZero::kRunStart) {
+    r.error_um.rowwise() -= run.error_um.row(0);
+  } else if (zero.zero == ErrorZero::kFixed) {
+    if (!std::isfinite(zero.gauge_level_um))
+      throw InputError(run.source + ": error zero 'fixed' needs a finite gauge level [um]");
+    r.error_um.array() -= zero.gauge_level_um;
+  }
   return r;
 }
+
+Run ErrorsFromStart(const Run& run) { return ApplyErrorZero(run, {ErrorZero::kRunStart, 0.0}); }
 
 Run ParseRun(const std::string& text, const std::string& source, RunState state) {
   CsvOptions csv;

@@ -18,6 +18,7 @@
 // kMaxRunColumns columns; temperatures within [-60, 400] degC; errors within +-100000 um.
 #include <Eigen/Core>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -61,9 +62,32 @@ struct Run {
   Run Slice(int begin, int end, const std::string& name) const;
 };
 
-/// The run with every error channel taken relative to its first row, e(k) - e(0): the error
-/// gained since the run started, the counterpart of the rises, for logs whose runs do not start
-/// from a cold, zeroed machine (a run cut from a longer log).
+/// The zero of the thermal error: what "no error" means, for the model and for every figure it is
+/// compared with (no compensation, the sensor-free baselines). One convention per model, chosen
+/// when it is fitted and stored in the model file; every evaluation applies the same one.
+///   run-start  e(k) - e(0): the error gained since the run started, the counterpart of the rises
+///              (the temperature reference of training, ReferenceMode::kRunStart); for a machine
+///              that is referenced (homed or probed) at each run start, and for runs cut from a
+///              longer log. A constant gauge level cancels exactly. The default.
+///   fixed      e(k) - L: one gauge level L [um] for every run (default: the first row of the
+///              first training run), for a machine that is never re-referenced.
+///   as-logged  e(k) as in the file: only for models written before the convention existed
+///              (schema 1); evaluations warn, since "no compensation" then moves with any gauge
+///              level while the model's intercept absorbs it.
+enum class ErrorZero { kRunStart, kFixed, kAsLogged };
+std::string ToString(ErrorZero z);                 ///< "run-start", "fixed", "as-logged"
+ErrorZero ParseErrorZero(const std::string& text);  ///< inverse (run-start, fixed); InputError
+
+struct ZeroConvention {
+  ErrorZero zero = ErrorZero::kRunStart;
+  /// fixed: the gauge level L [um]; NaN: the first row of the first training run.
+  double gauge_level_um = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The run with every error channel on the convention's zero (see ErrorZero). fixed needs a
+/// finite gauge_level_um (InputError otherwise); as-logged returns the run unchanged.
+Run ApplyErrorZero(const Run& run, const ZeroConvention& zero);
+/// ApplyErrorZero(run, run-start).
 Run ErrorsFromStart(const Run& run);
 
 /// Parses run-file text; `source` names it in messages. InputError (file:line: column 'x': value

@@ -115,6 +115,9 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
   if (!AnyMachineComponent(config)) return m;
   drift::FitOptions f = fit;
   f.threads = 1;
+  // The sensor models as documented: no time-only candidate, errors as the simulator logs them.
+  f.candidates = drift::Candidates::kSensors;
+  f.zero.zero = drift::ErrorZero::kAsLogged;
   const auto idle = TrainingRuns(config, machine_seed, runs, drift::RunState::kIdle);
   const auto cutting = TrainingRuns(config, machine_seed, runs, drift::RunState::kCutting);
   m.offset_cutting = drift::FitDriftModel(cutting, "offset_um", f).model;

@@ -7,6 +7,8 @@ namespace whirl::surface {
 PointModelFn DriftPointModel(const std::vector<drift::Run>& training, const drift::Run& target,
                              drift::FitOptions options, DriftPointNotes* notes) {
   options.threads = 1;  // the points already run in parallel (PredictAllPoints)
+  options.candidates = drift::Candidates::kSensors;  // the sensor models as documented
+  options.zero.zero = drift::ErrorZero::kAsLogged;     // the surface errors as logged
   return [&training, &target, options, notes](const std::string& column) {
     const drift::FitReport fit = drift::FitDriftModel(training, column, options);
     const drift::RunPrediction p = drift::PredictRun(fit.model, target);

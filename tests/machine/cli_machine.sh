@@ -15,7 +15,7 @@ grep -q "\[um\]" "$D/evaluate_help.txt" || fail "evaluate --help names no unit"
 [ -f "$D/runs/idle_1.csv" ] && [ -f "$D/runs/cutting_2.csv" ] || fail "run files missing"
 n=$(grep -v '^#' "$D/runs/cutting_1.csv" | head -n 1 | tr ',' '\n' | grep -c '_C$')
 [ "$n" -ge 10 ] && [ "$n" -le 16 ] || fail "expected 10-16 sensors, got $n"
-"$W" drift fit --cutting "$D/runs/cutting_1.csv" --error offset_um --out "$D/offset.json" \
+"$W" drift fit --cutting "$D/runs/cutting_1.csv" --error offset_um --candidates sensors --out "$D/offset.json" \
   > /dev/null 2>&1 || fail "drift fit on a sensor file"
 "$W" drift predict --model "$D/offset.json" --run "$D/runs/cutting_2.csv" --json > "$D/pred.json" \
   2>/dev/null || fail "drift predict on a sensor file"
@@ -61,7 +61,7 @@ grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/DRIFT.SPF" || fail "drift action does not w
 # The machine's Z-screw slope on the control: with the simulated machine's profile the plan hands
 # K0, slope and reference over and the drift action (offset + slope model) owns SD43900-43920.
 W840="$S/datasets/machines/whirling_840d.json"
-"$W" drift fit --cutting "$D/runs/cutting_1.csv" --error zscrew_per_1000_um \
+"$W" drift fit --cutting "$D/runs/cutting_1.csv" --error zscrew_per_1000_um --candidates sensors \
   --out "$D/zscrew.json" > /dev/null 2>&1 || fail "drift fit of the slope channel"
 "$W" plan --screw "$S/datasets/screws/reference_80x10x6000.json" --machine "$W840" \
   --start-position-mm 5600 --model "$S/models/default.json" --with-drift-action \

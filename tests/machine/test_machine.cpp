@@ -1,5 +1,6 @@
 // Machine thermal errors: each component against its closed form, the sensor run files
 // against the drift format (the evaluation of both halves: tests/machine_eval).
+#include <cstdio>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -189,10 +190,17 @@ TEST(MachineSensors, RunRoundTripsThroughTheDriftFormatAndFits) {
       SimulateRun(MachineDay::Draw(c, 3, 7), {"b", drift::RunState::kCutting, 150, 205, 13})};
   drift::FitOptions fo;
   fo.threads = 1;
+  fo.candidates = drift::Candidates::kSensors;  // the regression on the sensors (see below)
   const drift::DriftModel model = drift::FitDriftModel(train, "offset_um", fo).model;
+  // With every candidate, the validation on these two runs picks a time-only model, which
+  // predicts this third run worse: printed, not asserted (the choice is data-dependent).
+  drift::FitOptions any = fo;
+  any.candidates = drift::Candidates::kAuto;
+  std::printf("auto candidates: %s\n", drift::FitDriftModel(train, "offset_um", any).chosen.c_str());
   const drift::RunPrediction p = drift::PredictRun(model, back);
-  const double range = back.error_um.col(0).maxCoeff() - back.error_um.col(0).minCoeff();
-  EXPECT_LT((p.predicted_um - back.error_um.col(0)).cwiseAbs().maxCoeff(), 0.25 * range);
+  // Compared on the model's error zero (run-start by default: the error gained since the start).
+  const double range = p.measured_um.maxCoeff() - p.measured_um.minCoeff();
+  EXPECT_LT((p.predicted_um - p.measured_um).cwiseAbs().maxCoeff(), 0.25 * range);
 }
 
 }  // namespace
