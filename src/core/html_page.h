@@ -10,9 +10,9 @@
 namespace whirl {
 
 /// The stylesheet of every report page: readable width, tables with a header row, the "load onto
-/// the control" box (class `control`), warnings (class `warn`), small print (class `small`),
-/// images no wider than the page, and <pre> blocks that wrap long lines (an NC line of 300
-/// characters stays on the page).
+/// the control" box (class `control`), warnings (class `warn`), small print (class `small`).
+/// Nothing is wider than the page: images shrink to it, <pre> blocks wrap long lines (an NC line
+/// of 300 characters stays on the page), a table wider than the page scrolls inside itself.
 std::string_view ReportStylesheet();
 
 /// The opening of a report page up to and including its <h1>: doctype, UTF-8, viewport, the
