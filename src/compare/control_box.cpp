@@ -100,7 +100,7 @@ ControlLoad PlanFilesLoad(const std::string& prefix, const std::string& program,
   load.files = {{prefix + program + ".SPF", "NC program"},
                 {prefix + program + "_RESET.SPF", "its reset program"},
                 {prefix + plc_csv, "PLC table: the same setting data per trigger position"},
-                {prefix + plan_json, "plan document (JSON), for the record"}};
+                {prefix + plan_json, "plan document (JSON): for the record, not for the control"}};
   load.prerequisites = NcPrerequisites(nc_program);
   if (profile)
     for (auto& line : ProfilePrerequisites(*profile)) load.prerequisites.push_back(line);
