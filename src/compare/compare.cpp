@@ -21,6 +21,12 @@ std::string ToString(Strategy s) {
       return "traditional";
     case Strategy::kModel:
       return "model";
+    case Strategy::kClass:
+      return "class";
+    case Strategy::kTable:
+      return "table";
+    case Strategy::kNearest:
+      return "nearest";
   }
   return "none";
 }
@@ -194,7 +200,14 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
   // Curve baselines: the same shape and the same 840D planning as the model.
   c.experience_class = rule.ClassFor(screw.process.diameter_mm);
   c.experience_ramp_time_s = rule.ramp_time_s;
-  c.traditional_features = rule.ClassFeatures(screw.process.diameter_mm);
+  c.traditional_rule = rule.has_choice ? rule.choice.chosen : HistoryRule::kClass;
+  c.traditional_features = rule.TraditionalFeatures(screw.process);
+  std::array<interp::CompensationPlan, kHistoryRuleCount> history_plans;
+  for (std::size_t k = 0; k < kHistoryRuleCount; ++k) {
+    const HistoryRule h = static_cast<HistoryRule>(k);
+    c.history_features[k] = rule.HistoryFeatures(h, screw.process);
+    history_plans[k] = BaselinePlan(c.history_features[k], ToString(h), screw, feed, options);
+  }
   if (rule.has_regression) c.regression_features = rule.regression.Predict(screw.process);
   const interp::CompensationPlan traditional_plan =
       BaselinePlan(c.traditional_features, "traditional", screw, feed, options);
@@ -204,8 +217,12 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
   const std::array<CompensationFunction, kStrategyCount> comp = {
       NoCompensation(),
       [&rule, diameter](double t_s) { return rule.CompensationUm(diameter, t_s); },
-      PlannedCompensation(traditional_plan, feed), PlannedCompensation(regression_plan, feed),
-      PlannedCompensation(c.plan, feed)};
+      PlannedCompensation(traditional_plan, feed),
+      PlannedCompensation(regression_plan, feed),
+      PlannedCompensation(c.plan, feed),
+      PlannedCompensation(history_plans[0], feed),
+      PlannedCompensation(history_plans[1], feed),
+      PlannedCompensation(history_plans[2], feed)};
   CutWithEveryStrategy(comp, screw, iso_table, options, &c);
   return c;
 }
@@ -266,7 +283,9 @@ void to_json(nlohmann::json& j, const ScrewComparison& c) {
                        {"class_screws", c.experience_class.screws},
                        {"ramp_time_s", c.experience_ramp_time_s}}},
                      {"traditional",
-                      {{"rule", "class means (P_class, T_class), arctangent curve, 840D plan"},
+                      {{"rule", "the strongest history rule (leave-one-out on the history), "
+                                "arctangent curve, 840D plan"},
+                       {"chosen", ToString(c.traditional_rule)},
                        {"max_elongation_um", c.traditional_features.max_elongation_um},
                        {"settle_time_s", c.traditional_features.settle_time_s}}},
                      {"regression",

@@ -54,11 +54,17 @@ std::string StrategyLabel(Strategy s) {
     case Strategy::kRamp:
       return "ramp (old rule: class plateau ramped in)";
     case Strategy::kTraditional:
-      return "traditional (class-mean curve, 840D plan)";
+      return "traditional (strongest history rule, 840D plan)";
     case Strategy::kRegression:
       return "regression (log-linear features, 840D plan)";
     case Strategy::kModel:
       return "model (network, 840D plan)";
+    case Strategy::kClass:
+      return "class (diameter-class means, 840D plan)";
+    case Strategy::kTable:
+      return "table (experience table, 840D plan)";
+    case Strategy::kNearest:
+      return "nearest (3 nearest past screws, 840D plan)";
   }
   return ToString(s);
 }
@@ -172,10 +178,13 @@ std::string MetricsTable(const ScrewComparison& c) {
   for (const auto& o : c.outcomes)
     h << "<li><b>" << ToString(o.strategy) << "</b>: " << HtmlEscape(o.iso.message) << "</li>\n";
   h << "</ul>\n<p class='small'>none: no compensation; ramp: the class plateau ramped in "
-       "linearly over the mean settle time (the previous rule); traditional: class-mean plateau "
-       "and settle time with the model's curve shape and 840D plan; regression: log-linear least "
-       "squares of both features on the five inputs, same history, curve and plan; model: the "
-       "network's prediction, curve and plan. \"model vs it\" = 100 (1 - model / it).</p>\n";
+       "linearly over the mean settle time (the previous rule); traditional: the strongest of the "
+       "history rules class, table and nearest (chosen by leave-one-out on the history, here "
+    << ToString(c.traditional_rule)
+    << "); class: diameter-class means; table: the experience table; nearest: the 3 nearest past "
+       "screws; regression: log-linear least squares of both features on the five inputs. All "
+       "but none and ramp use the model's curve shape and the same 840D planning; model: the "
+       "network's prediction. \"model vs it\" = 100 (1 - model / it).</p>\n";
   return h.str();
 }
 
@@ -295,8 +304,14 @@ std::string FeaturesTable(const ScrewComparison& c) {
                           std::to_string(c.experience_class.screws) + " past screws";
   row("ramp (" + cls + ")", Fixed(c.experience_class.plateau_um, 1),
       Fixed(c.experience_ramp_time_s, 0) + " (linear ramp)");
-  row("traditional (" + cls + ", means)", Fixed(c.traditional_features.max_elongation_um, 1),
+  row("traditional (= " + ToString(c.traditional_rule) + ", chosen on the history)",
+      Fixed(c.traditional_features.max_elongation_um, 1),
       Fixed(c.traditional_features.settle_time_s, 0));
+  for (std::size_t k = 0; k < kHistoryRuleCount; ++k)
+    row(ToString(static_cast<HistoryRule>(k)) +
+            (k == 0 ? " (" + cls + ", means)" : std::string(" (history rule)")),
+        Fixed(c.history_features[k].max_elongation_um, 1),
+        Fixed(c.history_features[k].settle_time_s, 0));
   if (c.regression_features.max_elongation_um > 0)
     row("regression (log-linear on the five inputs)",
         Fixed(c.regression_features.max_elongation_um, 1),

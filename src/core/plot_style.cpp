@@ -10,13 +10,30 @@ namespace whirl {
 const std::vector<SeriesStyle>& SeriesStyles() {
   // "both" is drawn before its variants and thicker, so a variant that coincides with it (dotted,
   // thin) shows on top of it instead of hiding it.
+  // One entry a line (clang-format off keeps it so, and a new strategy a one-line change).
+  // clang-format off
   static const std::vector<SeriesStyle> kStyles = {
-      {"measured", "#000000", 1, 2.0},    {"prediction", "#1f77b4", 3, 1.5},
-      {"none", "#7f7f7f", 1, 2.0},        {"ramp", "#8c564b", 4, 2.0},
-      {"traditional", "#ff7f0e", 2, 2.0}, {"regression", "#9467bd", 5, 1.5, 4},
-      {"model", "#1f77b4", 1, 2.5},       {"workpiece", "#1f77b4", 2, 2.0},
-      {"machine", "#e377c2", 2, 2.0},     {"both", "#2ca02c", 1, 3.5},
-      {"both_idle", "#bcbd22", 4, 1.5},   {"both_monitor", "#d62728", 1, 1.0, 6}};
+      {"measured",     "#000000", 1, 2.0},
+      {"prediction",   "#1f77b4", 3, 1.5},
+      {"none",         "#7f7f7f", 1, 2.0},
+      {"ramp",         "#8c564b", 4, 2.0},
+      {"traditional",  "#ff7f0e", 2, 2.0},
+      {"regression",   "#9467bd", 5, 1.5, 4},
+      {"model",        "#1f77b4", 1, 2.5},
+      {"workpiece",    "#1f77b4", 2, 2.0},
+      {"machine",      "#e377c2", 2, 2.0},
+      {"both",         "#2ca02c", 1, 3.5},
+      {"both_idle",    "#bcbd22", 4, 1.5},
+      {"both_monitor", "#d62728", 1, 1.0, 6},
+      // The history rules (traditional is the strongest of them) and the shop's machine rows.
+      {"class",        "#ff7f0e", 4, 1.5},
+      {"table",        "#17becf", 1, 1.5},
+      {"nearest",      "#17becf", 2, 1.5},
+      {"warmup",       "#8c564b", 2, 1.5},
+      {"schedule",     "#e377c2", 4, 1.5},
+      {"machine_shop", "#e377c2", 1, 1.5},
+      {"both_shop",    "#2ca02c", 2, 2.5}};
+  // clang-format on
   return kStyles;
 }
 

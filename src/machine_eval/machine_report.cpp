@@ -73,19 +73,40 @@ std::string SensorScript(const drift::Run& log, const std::string& title,
   return gp + "unset multiplot\n";
 }
 
+// The strategies of each panel of the lead plot: the evaluation's first rows (up to
+// both_monitor), then none and both again beside the shop's rows, so no panel holds 14 lines.
+std::vector<std::vector<std::size_t>> LeadPanels() {
+  const auto last_first = static_cast<std::size_t>(MachineStrategy::kBothMonitor);
+  std::vector<std::vector<std::size_t>> panels(1);
+  for (std::size_t k = 0; k <= last_first && k < kMachineStrategyCount; ++k) panels[0].push_back(k);
+  if (kMachineStrategyCount > last_first + 1) {
+    panels.push_back({static_cast<std::size_t>(MachineStrategy::kNone),
+                      static_cast<std::size_t>(MachineStrategy::kBoth)});
+    for (std::size_t k = last_first + 1; k < kMachineStrategyCount; ++k) panels[1].push_back(k);
+  }
+  return panels;
+}
+
 // Every strategy in its colour and dash (core/plot_style.h), x from the thread start to its end.
-std::string LeadScript(const std::string& title, double thread_length_mm) {
+std::string LeadScript(const std::string& title, double thread_length_mm,
+                       const std::vector<std::vector<std::size_t>>& panels) {
   std::string gp =
       "set datafile separator ','\nset key outside right\nset grid\n"
       "set xlabel 'position along the thread [mm]'\nset xrange [0:" +
-      std::to_string(thread_length_mm) + "]\nset ylabel 'travel deviation [um]'\nset title " +
-      GnuplotString(title) + "\nplot ";
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const std::string name = ToString(static_cast<MachineStrategy>(k));
-    gp += (k ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(k + 2) + " " +
-          GnuplotWith(name) + " title " + GnuplotString(name);
+      std::to_string(thread_length_mm) +
+      "]\nset ylabel 'travel deviation [um]'\nset lmargin at screen 0.08\n"
+      "set rmargin at screen 0.8\nset multiplot layout " +
+      std::to_string(panels.size()) + ",1 title " + GnuplotString(title) + "\n";
+  for (const auto& panel : panels) {
+    gp += "plot ";
+    for (std::size_t j = 0; j < panel.size(); ++j) {
+      const std::string name = ToString(static_cast<MachineStrategy>(panel[j]));
+      gp += (j ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(panel[j] + 2) +
+            " " + GnuplotWith(name) + " title " + GnuplotString(name);
+    }
+    gp += "\n";
   }
-  return gp + "\n";
+  return gp + "unset multiplot\n";
 }
 
 // Adds <stem>.gp to the report and renders <stem>.png in its staging folder; returns the <img>
@@ -189,10 +210,14 @@ std::string StrategyTable(const MachineEvalScrew& r) {
                 "part %.1f um.</p>\n",
                 r.residual_workpiece_total_um, r.residual_machine_total_um);
   return h + buf +
-         "<p class='small'>none: no compensation; traditional: the class-mean curve's plan; "
+         "<p class='small'>none: no compensation; traditional: the strongest history rule's plan; "
          "workpiece: the network's plan alone; machine: the drift action alone; both: plan and "
          "drift action with the cutting-trained machine model; both_idle: with the idle-trained "
-         "model; both_monitor: both, checked and refitted on-line.</p>\n";
+         "model; both_monitor: both, checked and refitted on-line. Shop rows (machine models "
+         "trained from probe and laser readings, applied causally): class, table, nearest: the "
+         "history rules' plans; warmup: workpiece plus a time-since-power-on rule; schedule: "
+         "workpiece plus a control-signal rule; machine_shop: the sensor model alone; both_shop: "
+         "workpiece plus machine_shop.</p>\n";
 }
 
 std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
@@ -238,8 +263,11 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                80 + kPanelHeightPx * static_cast<int>(panels.size()));
   }
   out.Add("lead.csv", LeadCsv(detail));
+  const auto lead_panels = LeadPanels();
   const std::string lead_img = Render(
-      out, "lead", LeadScript(screw.screw.name + ": lead deviation", screw.screw.thread_length_mm));
+      out, "lead",
+      LeadScript(screw.screw.name + ": lead deviation", screw.screw.thread_length_mm, lead_panels),
+      40 + 420 * static_cast<int>(lead_panels.size()));
   if (programs)
     for (const auto& [path, text] : CombinedProgramFiles("", *programs))
       out.Add(path.filename().string(), text);

@@ -39,7 +39,9 @@ TEST(PlotStyle, GnuplotStyleIsTheTableEntry) {
     EXPECT_NE(with.find("lc rgb '" + std::string(s.colour) + "'"), std::string::npos) << with;
     EXPECT_NE(with.find(" dt " + std::to_string(s.dash)), std::string::npos) << with;
     EXPECT_EQ(with.rfind(s.point ? "with linespoints " : "with lines ", 0), 0u) << with;
-    if (s.point) EXPECT_NE(with.find(" pt " + std::to_string(s.point)), std::string::npos) << with;
+    if (s.point) {
+      EXPECT_NE(with.find(" pt " + std::to_string(s.point)), std::string::npos) << with;
+    }
   }
   // A name the table lacks gets a look no entry has.
   const std::string unknown = GnuplotWith("no such strategy");
