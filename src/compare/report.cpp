@@ -127,8 +127,10 @@ std::string ElongationPlot(const ScrewComparison& c, const std::string& slug,
 std::string LeadPlot(const ScrewComparison& c, const std::string& slug, const std::string& png,
                      double x_end_mm, const std::string& title) {
   std::ostringstream s;
-  s << "set key below horizontal box\nset bmargin 7\nset output " << GnuplotString(png)
-    << "\nset title " << GnuplotString(c.screw.name + ": " + title) << " noenhanced\n"
+  // The key below in two columns: room for its rows, the x label and the tick labels.
+  s << "set key below horizontal box maxcols 2\nset bmargin " << (c.outcomes.size() + 1) / 2 + 5
+    << "\nset output " << GnuplotString(png) << "\nset title "
+    << GnuplotString(c.screw.name + ": " + title) << " noenhanced\n"
     << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
     << "set xrange [0:" << x_end_mm << "]\nset yrange [*:*]\nplot ";
   for (std::size_t k = 0; k < c.outcomes.size(); ++k)
