@@ -183,11 +183,9 @@ void RegisterMachine(CLI::App& app) {
   CommonOptions(s, o.get());
   s->add_option("--out", o->out, std::string("output folder, all files or none: ") + kOutputDirRule)
       ->required();
-  s->add_option("--machine-seed", o->machine_seed, "seed of the machine (default 1)");
-  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")
-      ->check(CLI::Range(0, 20));
-  s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")
-      ->check(CLI::Range(0, 20));
+  AddSeedOption(s, &o->machine_seed, "seed of the machine (default 1)", "--machine-seed");
+  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")->check(NumberIn(0, 20));
+  s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")->check(NumberIn(0, 20));
   s->callback([o] { RunSensors(*o); });
 
   auto* e = m->add_subcommand(
@@ -200,15 +198,15 @@ void RegisterMachine(CLI::App& app) {
       "accumulated lead error [um] within 1000 mm and over the thread, P3/P5 shares, the\n"
       "uncompensated error of each source alone and which part dominates what is left.");
   CommonOptions(e, o.get());
-  e->add_option("--machines", o->machines, "machines (1..50, default 2)")->check(CLI::Range(1, 50));
+  e->add_option("--machines", o->machines, "machines (1..50, default 2)")->check(NumberIn(1, 50));
   e->add_option("--screws", o->screws, "random screws per machine (1..200, default 3)")
-      ->check(CLI::Range(1, 200));
+      ->check(NumberIn(1, 200));
   e->add_option("--train-runs", o->train_runs,
                 "idle and cutting training runs per machine (1..20, default 2)")
-      ->check(CLI::Range(1, 20));
-  e->add_option("--seed", o->seed, "seed of machines, days, screws and truth (default 1)");
+      ->check(NumberIn(1, 20));
+  AddSeedOption(e, &o->seed, "seed of machines, days, screws and truth (default 1)");
   e->add_option("--threads", o->threads, "worker threads (1..64, default 2)")
-      ->check(CLI::Range(1, 64));
+      ->check(NumberIn(1, 64));
   e->add_option("--model", o->model_path, "workpiece model (default models/default.json)")
       ->check(CLI::ExistingFile);
   e->add_option("--history", o->history, "past screws for the traditional rule")
@@ -223,7 +221,7 @@ void RegisterMachine(CLI::App& app) {
   AddSelectionOptions(e, &o->selection);  // seed 000's sensor selection of the machine models
   e->add_option("--monitor-every-min", o->monitor_every_min,
                 "both_monitor: check-bar interval of seed 004's monitor [min] (1..600, default 30)")
-      ->check(CLI::Range(1.0, 600.0));
+      ->check(NumberIn(1.0, 600.0));
   e->add_option("--report", o->report,
                 "write the first screw's report here: sensor plot [degC over min], chosen "
                 "sensors, lead deviation per strategy [um over mm] and the screw's combined 840D "
@@ -246,6 +244,7 @@ void RegisterMachine(CLI::App& app) {
                 "|e_a - c| column (default 0)");
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
+  RegisterMachineTruth(m);
 }
 
 }  // namespace whirl::cli

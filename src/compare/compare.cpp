@@ -1,9 +1,9 @@
 #include "compare/compare.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "sim/dataset.h"
 #include "sim/features.h"
 
@@ -43,12 +43,6 @@ nlohmann::json Optional(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json();
 }
 
-std::string Fixed(double x, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  return buf;
-}
-
 }  // namespace
 
 MetricReductions Reductions(const LeadMetrics& s, const LeadMetrics& b) {
@@ -69,13 +63,13 @@ const StrategyOutcome& ScrewComparison::Outcome(Strategy s) const {
 std::string ScrewComparison::BriefReport() const {
   std::string s = screw.name + ": accumulated within 1000 mm";
   for (const auto& o : outcomes)
-    s += " " + ToString(o.strategy) + " " + Fixed(o.metrics.accumulated_1000_um, 1);
+    s += " " + ToString(o.strategy) + " " + FormatDecimals(o.metrics.accumulated_1000_um, 1);
   s += " um; whole thread";
   for (const auto& o : outcomes)
-    s += " " + ToString(o.strategy) + " " + Fixed(o.metrics.accumulated_total_um, 1);
+    s += " " + ToString(o.strategy) + " " + FormatDecimals(o.metrics.accumulated_total_um, 1);
   s += " um";
   if (model_vs_traditional.accumulated_1000_pct)
-    s += " (model " + Fixed(*model_vs_traditional.accumulated_1000_pct, 1) +
+    s += " (model " + FormatDecimals(*model_vs_traditional.accumulated_1000_pct, 1) +
          " % less than traditional within 1000 mm)";
   s += ", ISO class";
   for (const auto& o : outcomes) s += " " + ToString(o.strategy) + " " + ToString(o.iso.reached);

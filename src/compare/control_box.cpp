@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/html_page.h"
+#include "core/numbers.h"
 #include "core/safe_text.h"
 
 namespace whirl::compare {
@@ -11,7 +12,6 @@ namespace {
 
 // The plan's setting data, one row per segment, and the restoring row at the thread end.
 std::string SettingDataTable(const interp::CompensationPlan& plan) {
-  using interp::FormatFixed;
   std::ostringstream h;
   h << "<table><tr><th>segment</th><th>written when " << HtmlEscape(plan.options.axis)
     << " passes [mm, MCS]</th><th>SD43900 K0 [mm]</th><th>SD43910 slope [-]</th>"
@@ -88,7 +88,7 @@ std::vector<std::string> ProfilePrerequisites(const interp::MachineProfile& prof
                     std::to_string(c.analog_inputs) + " analog inputs, MD28250 " +
                     std::to_string(c.sync_elements) + " synchronized-action elements, MD28254 " +
                     std::to_string(c.ac_params) + " $AC_PARAM, MD32760 " +
-                    interp::FormatFixed(profile.md32760, 4) + " on axis " + profile.axis +
+                    FormatFixed(profile.md32760, 4) + " on axis " + profile.axis +
                     "; if the control's values differ, correct the profile and plan again");
   return lines;
 }

@@ -10,6 +10,7 @@
 #include "core/csv.h"
 #include "core/html_page.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/plot_style.h"
 #include "core/run_program.h"
@@ -18,13 +19,7 @@
 namespace whirl::compare {
 namespace {
 
-std::string Fixed(double x, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  return buf;
-}
-
-std::string Pct(const std::optional<double>& v) { return v ? Fixed(*v, 1) + " %" : "-"; }
+std::string Pct(const std::optional<double>& v) { return v ? FormatDecimals(*v, 1) + " %" : "-"; }
 
 std::vector<std::string> Comments(const ReportOptions& o, const std::string& what) {
   std::vector<std::string> c{" " + what};
@@ -104,7 +99,8 @@ std::string ElongationPlot(const ScrewComparison& c, const std::string& slug,
   s << "set output " << GnuplotString(png) << "\nset key right bottom box opaque\n"
     << "set title "
     << GnuplotString(c.screw.name + ": elongation of the unmachined section (first " +
-                     Fixed(t_zoom, 0) + " s of " + Fixed(t_end, 0) + " s cutting time)")
+                     FormatDecimals(t_zoom, 0) + " s of " + FormatDecimals(t_end, 0) +
+                     " s cutting time)")
     << " noenhanced\nset xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
     << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
     << "plot " << GnuplotString(slug + "_elongation.csv")
@@ -151,7 +147,8 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
          LeadPlot(c, slug, f.lead, l,
                   "travel deviation along the thread after cooling (actual - specified)") +
          LeadPlot(c, slug, f.lead_start, std::min(l, 1000.0),
-                  "travel deviation, first " + Fixed(std::min(l, 1000.0), 0) + " mm of the thread");
+                  "travel deviation, first " + FormatDecimals(std::min(l, 1000.0), 0) +
+                      " mm of the thread");
 }
 
 // One row per strategy: the accumulated errors, the ISO 3408-3 figures and class, and how much
@@ -169,10 +166,11 @@ std::string MetricsTable(const ScrewComparison& c) {
     const MetricReductions r = Reductions(m.metrics, o.metrics);
     const bool model = o.strategy == Strategy::kModel;
     h << "<tr" << (model ? " class='cls'" : "") << "><td>" << ToString(o.strategy) << "</td><td>"
-      << Fixed(o.metrics.accumulated_1000_um, 1) << "</td><td>"
-      << Fixed(o.metrics.accumulated_total_um, 1) << "</td><td>" << Fixed(o.metrics.e_a_um, 1)
-      << "</td><td>" << Fixed(o.metrics.v_u_um, 1) << "</td><td>" << Fixed(o.metrics.v_300_um, 1)
-      << "</td>" << (v_2pi ? "<td>" + Fixed(*o.metrics.v_2pi_um, 1) + "</td>" : "") << "<td>"
+      << FormatDecimals(o.metrics.accumulated_1000_um, 1) << "</td><td>"
+      << FormatDecimals(o.metrics.accumulated_total_um, 1) << "</td><td>"
+      << FormatDecimals(o.metrics.e_a_um, 1) << "</td><td>" << FormatDecimals(o.metrics.v_u_um, 1)
+      << "</td><td>" << FormatDecimals(o.metrics.v_300_um, 1) << "</td>"
+      << (v_2pi ? "<td>" + FormatDecimals(*o.metrics.v_2pi_um, 1) + "</td>" : "") << "<td>"
       << ToString(o.iso.reached) << "</td><td>" << (model ? "" : Pct(r.accumulated_1000_pct))
       << "</td><td>" << (model ? "" : Pct(r.accumulated_total_pct)) << "</td></tr>\n";
   }
@@ -270,12 +268,14 @@ std::string InputsSection(const ScrewComparison& c) {
   std::ostringstream body;
   const auto in = c.screw.process;
   body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
-       << Fixed(in.hardness_hrc, 1) << " HRC, diameter " << Fixed(in.diameter_mm, 1) << " mm, lead "
-       << Fixed(in.pitch_mm, 2) << " mm, raceway radius " << Fixed(in.raceway_radius_mm, 2)
-       << " mm, cutting speed " << Fixed(in.cutting_speed_m_min, 0) << " m/min; blank "
-       << Fixed(c.screw.length_mm, 0) << " mm, thread " << Fixed(c.screw.thread_length_mm, 0)
-       << " mm; axial feed " << Fixed(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
-       << Fixed(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
+       << FormatDecimals(in.hardness_hrc, 1) << " HRC, diameter "
+       << FormatDecimals(in.diameter_mm, 1) << " mm, lead " << FormatDecimals(in.pitch_mm, 2)
+       << " mm, raceway radius " << FormatDecimals(in.raceway_radius_mm, 2) << " mm, cutting speed "
+       << FormatDecimals(in.cutting_speed_m_min, 0) << " m/min; blank "
+       << FormatDecimals(c.screw.length_mm, 0) << " mm, thread "
+       << FormatDecimals(c.screw.thread_length_mm, 0) << " mm; axial feed "
+       << FormatDecimals(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
+       << FormatDecimals(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
   if (c.prediction.outside_domain) {
     std::string fields;
     for (const auto& f : c.prediction.outside_domain_fields)
@@ -296,28 +296,29 @@ std::string FeaturesTable(const ScrewComparison& c) {
   body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n";
   row("simulated truth (seed " + std::to_string(c.seed) + ", disturbances " +
           (c.disturbances_on ? "on" : "off") + ")",
-      Fixed(c.truth_features.max_elongation_um, 1), Fixed(c.truth_features.settle_time_s, 0));
+      FormatDecimals(c.truth_features.max_elongation_um, 1),
+      FormatDecimals(c.truth_features.settle_time_s, 0));
   row("model prediction (+- 1 sd)",
-      Fixed(c.prediction.mean.max_elongation_um, 1) + " +- " +
-          Fixed(c.prediction.stddev.max_elongation_um, 1),
-      Fixed(c.prediction.mean.settle_time_s, 0) + " +- " +
-          Fixed(c.prediction.stddev.settle_time_s, 0));
-  const std::string cls = "class " + Fixed(c.experience_class.nominal_diameter_mm, 0) + " mm, " +
-                          std::to_string(c.experience_class.screws) + " past screws";
-  row("ramp (" + cls + ")", Fixed(c.experience_class.plateau_um, 1),
-      Fixed(c.experience_ramp_time_s, 0) + " (linear ramp)");
+      FormatDecimals(c.prediction.mean.max_elongation_um, 1) + " +- " +
+          FormatDecimals(c.prediction.stddev.max_elongation_um, 1),
+      FormatDecimals(c.prediction.mean.settle_time_s, 0) + " +- " +
+          FormatDecimals(c.prediction.stddev.settle_time_s, 0));
+  const std::string cls = "class " + FormatDecimals(c.experience_class.nominal_diameter_mm, 0) +
+                          " mm, " + std::to_string(c.experience_class.screws) + " past screws";
+  row("ramp (" + cls + ")", FormatDecimals(c.experience_class.plateau_um, 1),
+      FormatDecimals(c.experience_ramp_time_s, 0) + " (linear ramp)");
   row("traditional (= " + ToString(c.traditional_rule) + ", chosen on the history)",
-      Fixed(c.traditional_features.max_elongation_um, 1),
-      Fixed(c.traditional_features.settle_time_s, 0));
+      FormatDecimals(c.traditional_features.max_elongation_um, 1),
+      FormatDecimals(c.traditional_features.settle_time_s, 0));
   for (std::size_t k = 0; k < kHistoryRuleCount; ++k)
     row(ToString(static_cast<HistoryRule>(k)) +
             (k == 0 ? " (" + cls + ", means)" : std::string(" (history rule)")),
-        Fixed(c.history_features[k].max_elongation_um, 1),
-        Fixed(c.history_features[k].settle_time_s, 0));
+        FormatDecimals(c.history_features[k].max_elongation_um, 1),
+        FormatDecimals(c.history_features[k].settle_time_s, 0));
   if (c.regression_features.max_elongation_um > 0)
     row("regression (log-linear on the five inputs)",
-        Fixed(c.regression_features.max_elongation_um, 1),
-        Fixed(c.regression_features.settle_time_s, 0));
+        FormatDecimals(c.regression_features.max_elongation_um, 1),
+        FormatDecimals(c.regression_features.settle_time_s, 0));
   else
     row("regression", "-", "- (the history has no regression: equals none)");
   body << "</table>\n";
@@ -328,16 +329,16 @@ std::string FeaturesTable(const ScrewComparison& c) {
 std::string PlanParagraph(const ScrewComparison& c) {
   std::ostringstream body;
   body << "<p class='small'>Disturbances of the truth (unknown to the model): heat partition x"
-       << Fixed(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
-       << Fixed(c.disturbances.expansion_factor, 3) << ", ambient drift "
-       << Fixed(c.disturbances.ambient_drift_k_per_h, 3)
+       << FormatDecimals(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
+       << FormatDecimals(c.disturbances.expansion_factor, 3) << ", ambient drift "
+       << FormatDecimals(c.disturbances.ambient_drift_k_per_h, 3)
        << " K/h. 840D plan: " << c.plan.segments.size() << " segments (" << c.plan.point_count
        << " points; uniform spacing would need "
        << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
                                           : std::string("more than 1000000"))
-       << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
-       << interp::FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910) << " (MD32760 cap "
-       << interp::FormatFixed(c.plan.options.md32760, 4) << "), axis "
+       << "), max |chord - curve| " << FormatDecimals(c.plan.max_deviation_um, 2)
+       << " um, max |SD43910| " << FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910)
+       << " (MD32760 cap " << FormatFixed(c.plan.options.md32760, 4) << "), axis "
        << HtmlEscape(c.plan.options.axis) << ", sign " << interp::ToString(c.plan.options.sign)
        << ".</p>\n";
   return body.str();

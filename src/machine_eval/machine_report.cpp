@@ -13,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/html_page.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/plot_style.h"
 #include "core/run_program.h"
@@ -188,9 +189,8 @@ std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
          "(offset model and Z-screw slope model, evaluated every interpolation cycle from the "
          "analog inputs) writes SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m "
          "(P_w - P_b), the fixed bearing at P_b = " +
-         interp::FormatFixed(d.slope_fixed_end_mm, 4) +
-         " mm (MCS). The drift action's output:</p><pre>" + HtmlEscape(OutputAction(p->drift_nc)) +
-         "</pre>";
+         FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:</p><pre>" +
+         HtmlEscape(OutputAction(p->drift_nc)) + "</pre>";
 }
 
 std::string StrategyTable(const MachineEvalScrew& r) {

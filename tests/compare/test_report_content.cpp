@@ -14,6 +14,7 @@
 #include "compare/report.h"
 #include "core/atomic_file.h"
 #include "core/csv.h"
+#include "core/numbers.h"
 #include "interp/machine_profile.h"
 
 namespace whirl::compare {
@@ -89,11 +90,9 @@ TEST_F(ReportContent, ControlBoxComesFirstWithSettingDataFilesAndPrerequisites) 
       << "a section before the box";
   const std::string b = html.substr(box, box_end - box);
   for (const auto& s : comparison_->plan.segments) {
-    EXPECT_NE(b.find(interp::FormatFixed(s.sd43900_mm, interp::kDecimalsSd43900Mm)),
-              std::string::npos);
-    EXPECT_NE(b.find(interp::FormatFixed(s.sd43910, interp::kDecimalsSd43910)), std::string::npos);
-    EXPECT_NE(b.find(interp::FormatFixed(s.sd43920_mm, interp::kDecimalsPositionMm)),
-              std::string::npos);
+    EXPECT_NE(b.find(FormatFixed(s.sd43900_mm, interp::kDecimalsSd43900Mm)), std::string::npos);
+    EXPECT_NE(b.find(FormatFixed(s.sd43910, interp::kDecimalsSd43910)), std::string::npos);
+    EXPECT_NE(b.find(FormatFixed(s.sd43920_mm, interp::kDecimalsPositionMm)), std::string::npos);
   }
   for (const char* f : {"../WHIRL_T.SPF", "../WHIRL_T_RESET.SPF", "../t_plan.csv"})
     EXPECT_NE(b.find(std::string("href='") + f + "'"), std::string::npos) << f;
