@@ -15,7 +15,7 @@ packages=(
   # about 15 s (most of it the demo that writes the reports).
   chromium-headless-shell
 )
-# Only for scripts/bench_peers.sh (issue 12's peer benchmark), never for the default build or tests.
+# Only for scripts/bench_peers.sh (the peer benchmark), never for the default build or tests.
 if [ "${WHIRL_SETUP_BENCH_PEERS:-0}" = 1 ]; then packages+=(python3-sklearn); fi
 missing=()
 for p in "${packages[@]}"; do
