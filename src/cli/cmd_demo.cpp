@@ -1,6 +1,6 @@
 // whirl demo: the whole mission on the shipped defaults, in seconds: model (load or train),
 // prediction for the reference screw and a new-type screw, arctangent curve, 840D plan files,
-// comparison against the traditional rule and no compensation, report, short summary.
+// comparison of every strategy (none, ramp, traditional, regression, model), report, summary.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +12,7 @@
 #include "compare/compare.h"
 #include "compare/plan_document.h"
 #include "compare/report.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "interp/machine_profile.h"
@@ -103,8 +104,11 @@ void RunDemo(const DemoOptions& o) {
   compare::CompareOptions co;
   co.seed = o.seed;
   // The example machine's facts (ID range, R parameters, offset): a real run names its own.
-  interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile)).ApplyTo(co.plan);
+  const interp::MachineProfile profile =
+      interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile));
+  profile.ApplyTo(co.plan);
   std::vector<compare::ScrewComparison> results;
+  std::vector<compare::ControlLoad> control;  // the report's "load onto the control" box
   // The NC files' stems are their program names on the control (letters, digits, '_', at most
   // 24 characters: interp::CheckProgramName), so they cannot carry the screw's name.
   const std::pair<const sim::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
@@ -130,6 +134,9 @@ void RunDemo(const DemoOptions& o) {
         {stage / names[0], stage / names[1], stage / names[2], stage / names[3]}, plan_json, c.plan,
         provenance, "whirl demo: model " + model_source + ", screw " + screw->name);
     for (const auto& name : names) files.AddStaged(name);
+    // The report lives in report/, the files one level up.
+    control.push_back(compare::PlanFilesLoad("../", program, names[1], names[0],
+                                             ReadTextFile(stage / names[2]), &profile));
     std::printf(
         "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
         "%s_plan.json/.csv and %s.SPF (reset: %s_RESET.SPF)\n",
@@ -144,6 +151,7 @@ void RunDemo(const DemoOptions& o) {
 
   compare::ReportOptions ro;
   ro.plots = !o.no_plots;
+  ro.control = control;
   ro.provenance = {"command: whirl demo --out-dir " + o.out_dir + " --seed " +
                        std::to_string(o.seed) + (o.retrain ? " --retrain" : ""),
                    "model: " + model_source, "history (traditional rule): " + train_path};
@@ -194,9 +202,10 @@ void RegisterDemo(CLI::App& app) {
       "raceway radius 4.0 mm, 200 m/min), build the arctangent curve, plan the 840D setting data\n"
       "(SD43900 mm, SD43910 -, SD43920 mm; files <screw>_plan.json/.csv and the NC programs\n"
       "WHIRL_REFERENCE.SPF, WHIRL_NEW_TYPE.SPF with their _RESET.SPF), cut both screws in the\n"
-      "simulator with no compensation, the\n"
-      "traditional experience rule and the plan, write the report (report/index.html) and print\n"
-      "the lead-error reductions (um and %).");
+      "simulator once per strategy (none, ramp, traditional, regression, model: see 'whirl\n"
+      "compare --help'), write the report (report/index.html: first the files to load onto the\n"
+      "control, then the results) and print the lead errors (um) and reductions (%); then the\n"
+      "same on a drifting machine (machine_report/index.html, see 'whirl machine evaluate').");
   sub->add_option("--out-dir", o->out_dir,
                   "output directory (default whirl-demo-out): " + std::string(kOutputDirRule) +
                       "; running the demo again replaces its files");

@@ -1,4 +1,4 @@
-// whirl evaluate: the three-strategy comparison over the validation table and N random feasible
+// whirl evaluate: the strategy comparison (compare/compare.h) over the validation table and N random feasible
 // screws, each with its own seeded disturbances; median/worst reductions and ISO class shares.
 #include <cstdio>
 #include <filesystem>

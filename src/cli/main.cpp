@@ -6,9 +6,10 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "whirl: thermal-elongation compensation for hard whirling of ball screws on SINUMERIK 840D.\n"
-      "Train a Bayesian-regularized 5-6-2 network on process tables, predict the elongation curve\n"
-      "of the unmachined section, plan 840D temperature-compensation setting data (SD43900/\n"
-      "SD43910/SD43920) and compare the lead error against traditional compensation.\n"
+      "Train a Bayesian-regularized network on process tables (its size chosen from the data by\n"
+      "the evidence: linear, or 4, 6 or 8 hidden neurons), predict the elongation curve of the\n"
+      "unmachined section, plan 840D temperature-compensation setting data (SD43900/SD43910/\n"
+      "SD43920) and compare the lead error against the traditional rules and a regression.\n"
       "Run 'whirl <command> --help' for each command. Exit code 0 only on success; 1 on bad\n"
       "input or failure; 2 when a check ran and failed."};
   app.require_subcommand(1);

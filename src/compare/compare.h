@@ -1,5 +1,5 @@
 #pragma once
-// The lead error a real-size screw gets with three compensation strategies, cut in the simulator
+// The lead error a real-size screw gets with each compensation strategy, cut in the simulator
 // (Li, Ma and Jiang's comparison; ISO 3408-3):
 //
 //   none         c(t) = 0

@@ -6,10 +6,13 @@
 #include <set>
 #include <sstream>
 
+#include "compare/control_box.h"
 #include "core/csv.h"
+#include "core/html_page.h"
 #include "core/json_file.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
+#include "core/plot_style.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 
@@ -38,153 +41,196 @@ struct PlotFiles {
   std::string elongation, lead, lead_start;
 };
 
-// The gnuplot script for one screw: reads the CSVs and writes the PNGs beside it.
-std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, const PlotFiles& f,
-                          const std::string& terminal) {
+// The legend's words for a strategy (the tables use the bare names).
+std::string StrategyLabel(Strategy s) {
+  switch (s) {
+    case Strategy::kNone:
+      return "none (no compensation)";
+    case Strategy::kRamp:
+      return "ramp (old rule: class plateau ramped in)";
+    case Strategy::kTraditional:
+      return "traditional (strongest history rule, 840D plan)";
+    case Strategy::kRegression:
+      return "regression (log-linear features, 840D plan)";
+    case Strategy::kModel:
+      return "model (network, 840D plan)";
+    case Strategy::kClass:
+      return "class (diameter-class means, 840D plan)";
+    case Strategy::kTable:
+      return "table (experience table, 840D plan)";
+    case Strategy::kNearest:
+      return "nearest (3 nearest past screws, 840D plan)";
+  }
+  return ToString(s);
+}
+
+// The strategies that compensate (all but none), in kStrategies order: the elongation plot's
+// compensation columns.
+std::vector<Strategy> CompensatingStrategies() {
+  std::vector<Strategy> out;
+  for (Strategy s : kStrategies)
+    if (s != Strategy::kNone) out.push_back(s);
+  return out;
+}
+
+// The +-1 sd band of the predicted curve: the arctangent curves of (L - sd_L, t_s + sd_t) and
+// (L + sd_L, t_s - sd_t), the two corners that move the whole curve down and up (l(t) grows with L
+// and falls with t_s); t_s stays at least 1 s.
+std::pair<fit::ArctanCurve, fit::ArctanCurve> PredictionBand(const ScrewComparison& c) {
+  const Features& m = c.prediction.mean;
+  const Features& sd = c.prediction.stddev;
+  const fit::ArctanCurve& p = c.predicted_curve;
+  auto curve = [&p](double l_um, double t_s) {
+    return fit::ArctanCurve::FromFeatures({std::max(0.0, l_um), std::max(1.0, t_s)}, p.shape_k,
+                                          p.time_exponent);
+  };
+  return {curve(m.max_elongation_um - sd.max_elongation_um, m.settle_time_s + sd.settle_time_s),
+          curve(m.max_elongation_um + sd.max_elongation_um, m.settle_time_s - sd.settle_time_s)};
+}
+
+// Elongation: the truth, the prediction with its band, each strategy's compensation, the plan's
+// points. Columns of <slug>_elongation.csv: see AddScrewData.
+std::string ElongationPlot(const ScrewComparison& c, const std::string& slug,
+                           const std::string& png) {
   const double t_end = c.truth.time_s.back();
   const double settle = std::max(c.predicted_curve.settle_time_s, c.experience_ramp_time_s);
   const double t_zoom = std::min(t_end, std::max(60.0, 3.0 * settle));
-  const double l = c.screw.thread_length_mm;
-  const std::string& name = c.screw.name;  // user-supplied: only ever inside GnuplotString
   std::ostringstream s;
-  s << "# gnuplot script written by whirl; re-run with: gnuplot " << slug << ".gp\n"
-    << "set datafile separator ','\nset datafile commentschars '#'\n"
-    << "set terminal " << terminal << "\nset grid\nset key right bottom box opaque\n"
-    << "set style line 1 lc rgb '#1f77b4' lw 2\nset style line 2 lc rgb '#d62728' lw 2 dt 2\n"
-    << "set style line 3 lc rgb '#2ca02c' lw 2\nset style line 4 lc rgb '#ff7f0e' lw 2 dt 4\n"
-    << "set style line 5 lc rgb '#000000' pt 7 ps 0.8\n";
-  // Elongation: truth vs prediction, compensation points, traditional ramp.
-  s << "set output " << GnuplotString(f.elongation) << "\n"
+  s << "set output " << GnuplotString(png) << "\nset key right bottom box opaque\n"
     << "set title "
-    << GnuplotString(name + ": elongation of the unmachined section (first " +
+    << GnuplotString(c.screw.name + ": elongation of the unmachined section (first " +
                      FormatDecimals(t_zoom, 0) + " s of " + FormatDecimals(t_end, 0) +
                      " s cutting time)")
-    << " noenhanced\n"
-    << "set xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
+    << " noenhanced\nset xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
     << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
     << "plot " << GnuplotString(slug + "_elongation.csv")
-    << " using 1:2 with lines ls 1 title 'simulated truth "
-    << "(disturbed)', \\\n"
-    << "  '' using 1:3 with lines ls 2 title 'predicted arctan curve (model)', \\\n"
-    << "  '' using 1:5 with lines ls 3 title '840D compensation applied (model plan)', \\\n"
-    << "  '' using 1:4 with lines ls 4 title 'traditional compensation (class-mean curve, 840D "
-       "plan)', \\\n"
-    << "  " << GnuplotString(slug + "_points.csv")
-    << " using 1:3 with points ls 5 title 'compensation points "
-    << "(SD43900/10/20 breakpoints)'\n"
-    << "set output\n";
-  // Lead deviation along the whole thread.
-  s << "set key below horizontal box\nset bmargin 6\n"
-    << "set output " << GnuplotString(f.lead) << "\n"
-    << "set title "
-    << GnuplotString(name +
-                     ": travel deviation along the thread after cooling (actual - specified)")
-    << " noenhanced\n"
-    << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
-    << "set xrange [0:" << l << "]\nset yrange [*:*]\n"
-    << "plot " << GnuplotString(slug + "_lead.csv")
-    << " using 1:2 with lines ls 2 title 'no compensation', \\\n"
-    << "  '' using 1:3 with lines ls 4 title 'traditional (class-mean curve)', \\\n"
-    << "  '' using 1:4 with lines ls 3 title 'model-based (840D plan)'\n"
-    << "set output\n";
-  s << "set output " << GnuplotString(f.lead_start) << "\n"
-    << "set title "
-    << GnuplotString(name + ": travel deviation, first " + FormatDecimals(std::min(l, 1000.0), 0) +
-                     " mm of the thread")
-    << " noenhanced\n"
-    << "set xrange [0:" << std::min(l, 1000.0) << "]\n"
-    << "replot\nset output\n";
+    << " using 1:4:5 with filledcurves fs transparent solid 0.15 noborder lc rgb '"
+    << FindSeriesStyle("prediction")->colour << "' title 'prediction +- 1 sd', \\\n"
+    << "  '' using 1:3 " << GnuplotWith("prediction")
+    << " title 'predicted arctan curve (model)', \\\n"
+    << "  '' using 1:2 " << GnuplotWith("measured") << " title 'simulated truth (disturbed)'";
+  int column = 6;
+  for (Strategy st : CompensatingStrategies())
+    s << ", \\\n  '' using 1:" << column++ << " " << GnuplotWith(ToString(st)) << " title "
+      << GnuplotString("compensation: " + StrategyLabel(st));
+  s << ", \\\n  " << GnuplotString(slug + "_points.csv")
+    << " using 1:3 with points pt 7 ps 0.8 lc rgb '#000000' title 'SD43900/10/20 breakpoints "
+       "(model plan)'\nset output\n";
   return s.str();
 }
 
+// Travel deviation of every strategy along the thread (x from 0 to `x_end_mm`).
+std::string LeadPlot(const ScrewComparison& c, const std::string& slug, const std::string& png,
+                     double x_end_mm, const std::string& title) {
+  std::ostringstream s;
+  // The key below in two columns: room for its rows, the x label and the tick labels.
+  s << "set key below horizontal box maxcols 2\nset bmargin " << (c.outcomes.size() + 1) / 2 + 5
+    << "\nset output " << GnuplotString(png) << "\nset title "
+    << GnuplotString(c.screw.name + ": " + title) << " noenhanced\n"
+    << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
+    << "set xrange [0:" << x_end_mm << "]\nset yrange [*:*]\nplot ";
+  for (std::size_t k = 0; k < c.outcomes.size(); ++k)
+    s << (k ? ", \\\n  '' " : GnuplotString(slug + "_lead.csv") + " ") << "using 1:" << k + 2 << " "
+      << GnuplotWith(ToString(c.outcomes[k].strategy)) << " title "
+      << GnuplotString(StrategyLabel(c.outcomes[k].strategy));
+  s << "\nset output\n";
+  return s.str();
+}
+
+// The gnuplot script for one screw: reads the CSVs and writes the PNGs beside it.
+std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, const PlotFiles& f,
+                          const std::string& terminal) {
+  const double l = c.screw.thread_length_mm;
+  return "# gnuplot script written by whirl; re-run with: gnuplot " + slug + ".gp\n" +
+         "set datafile separator ','\nset datafile commentschars '#'\nset terminal " + terminal +
+         "\nset grid\n" + ElongationPlot(c, slug, f.elongation) +
+         LeadPlot(c, slug, f.lead, l,
+                  "travel deviation along the thread after cooling (actual - specified)") +
+         LeadPlot(c, slug, f.lead_start, std::min(l, 1000.0),
+                  "travel deviation, first " + FormatDecimals(std::min(l, 1000.0), 0) +
+                      " mm of the thread");
+}
+
+// One row per strategy: the accumulated errors, the ISO 3408-3 figures and class, and how much
+// less the model leaves than the strategy.
 std::string MetricsTable(const ScrewComparison& c) {
-  const auto& n = c.Outcome(Strategy::kNone);
-  const auto& t = c.Outcome(Strategy::kTraditional);
   const auto& m = c.Outcome(Strategy::kModel);
+  bool v_2pi = true;
+  for (const auto& o : c.outcomes) v_2pi = v_2pi && o.metrics.v_2pi_um.has_value();
   std::ostringstream h;
-  h << "<table><tr><th>metric [um]</th><th>no compensation</th><th>traditional</th>"
-       "<th>model-based</th><th>model vs traditional</th><th>model vs none</th></tr>\n";
-  auto row = [&](const std::string& name, double a, double b, double d,
-                 const std::optional<double>& r1, const std::optional<double>& r2) {
-    h << "<tr><td>" << name << "</td><td>" << FormatDecimals(a, 1) << "</td><td>"
-      << FormatDecimals(b, 1) << "</td><td>" << FormatDecimals(d, 1) << "</td><td>" << Pct(r1)
-      << "</td><td>" << Pct(r2) << "</td></tr>\n";
-  };
-  row("accumulated error within any 1000 mm", n.metrics.accumulated_1000_um,
-      t.metrics.accumulated_1000_um, m.metrics.accumulated_1000_um,
-      c.model_vs_traditional.accumulated_1000_pct, c.model_vs_none.accumulated_1000_pct);
-  row("accumulated error over the whole thread", n.metrics.accumulated_total_um,
-      t.metrics.accumulated_total_um, m.metrics.accumulated_total_um,
-      c.model_vs_traditional.accumulated_total_pct, c.model_vs_none.accumulated_total_pct);
-  row("e_a (mean travel deviation over l_u)", n.metrics.e_a_um, t.metrics.e_a_um, m.metrics.e_a_um,
-      c.model_vs_traditional.e_a_pct, c.model_vs_none.e_a_pct);
-  row("v_u (band over l_u)", n.metrics.v_u_um, t.metrics.v_u_um, m.metrics.v_u_um,
-      c.model_vs_traditional.v_u_pct, c.model_vs_none.v_u_pct);
-  row("v_300 (band within 300 mm)", n.metrics.v_300_um, t.metrics.v_300_um, m.metrics.v_300_um,
-      c.model_vs_traditional.v_300_pct, c.model_vs_none.v_300_pct);
-  if (n.metrics.v_2pi_um && t.metrics.v_2pi_um && m.metrics.v_2pi_um)
-    row("v_2pi (band within one revolution)", *n.metrics.v_2pi_um, *t.metrics.v_2pi_um,
-        *m.metrics.v_2pi_um, c.model_vs_traditional.v_2pi_pct, c.model_vs_none.v_2pi_pct);
-  h << "<tr class='cls'><td>ISO 3408-3 class reached</td><td>" << ToString(n.iso.reached)
-    << "</td><td>" << ToString(t.iso.reached) << "</td><td>" << ToString(m.iso.reached)
-    << "</td><td colspan='2'></td></tr>\n</table>\n<ul class='small'>\n";
-  for (const auto* o : {&n, &t, &m})
-    h << "<li><b>" << ToString(o->strategy) << "</b>: " << HtmlEscape(o->iso.message) << "</li>\n";
-  h << "</ul>\n";
-  // Every baseline, absolute micrometres first (compare/traditional.h says why each is
-  // a fair stand-in).
-  h << "<table><tr><th>strategy</th><th>within 1000 mm [um]</th><th>whole thread [um]</th>"
-       "<th>ISO class</th><th>model vs it, 1000 mm</th></tr>\n";
+  h << "<table><tr><th>strategy</th><th>within any 1000 mm [um]</th><th>whole thread [um]</th>"
+       "<th>e_a [um]</th><th>v_u [um]</th><th>v_300 [um]</th>"
+    << (v_2pi ? "<th>v_2pi [um]</th>" : "")
+    << "<th>ISO 3408-3 class</th><th>model vs it, 1000 mm</th><th>model vs it, thread</th></tr>\n";
   for (const auto& o : c.outcomes) {
-    const auto r = Reductions(m.metrics, o.metrics).accumulated_1000_pct;
-    h << "<tr><td>" << ToString(o.strategy) << "</td><td>"
-      << FormatDecimals(o.metrics.accumulated_1000_um, 2) << "</td><td>"
-      << FormatDecimals(o.metrics.accumulated_total_um, 2) << "</td><td>" << ToString(o.iso.reached)
-      << "</td><td>" << (o.strategy == Strategy::kModel ? "" : Pct(r)) << "</td></tr>\n";
+    const MetricReductions r = Reductions(m.metrics, o.metrics);
+    const bool model = o.strategy == Strategy::kModel;
+    h << "<tr" << (model ? " class='cls'" : "") << "><td>" << ToString(o.strategy) << "</td><td>"
+      << FormatDecimals(o.metrics.accumulated_1000_um, 1) << "</td><td>"
+      << FormatDecimals(o.metrics.accumulated_total_um, 1) << "</td><td>"
+      << FormatDecimals(o.metrics.e_a_um, 1) << "</td><td>" << FormatDecimals(o.metrics.v_u_um, 1)
+      << "</td><td>" << FormatDecimals(o.metrics.v_300_um, 1) << "</td>"
+      << (v_2pi ? "<td>" + FormatDecimals(*o.metrics.v_2pi_um, 1) + "</td>" : "") << "<td>"
+      << ToString(o.iso.reached) << "</td><td>" << (model ? "" : Pct(r.accumulated_1000_pct))
+      << "</td><td>" << (model ? "" : Pct(r.accumulated_total_pct)) << "</td></tr>\n";
   }
-  h << "</table>\n<p class='small'>ramp: class plateau ramped in linearly (the previous rule); "
-       "traditional: class mean plateau and settle time with the model's curve shape and plan; "
-       "regression: log-linear least squares of both features on the five inputs, same history, "
-       "curve and plan; model: the network.</p>\n";
+  h << "</table>\n<ul class='small'>\n";
+  for (const auto& o : c.outcomes)
+    h << "<li><b>" << ToString(o.strategy) << "</b>: " << HtmlEscape(o.iso.message) << "</li>\n";
+  h << "</ul>\n<p class='small'>none: no compensation; ramp: the class plateau ramped in "
+       "linearly over the mean settle time (the previous rule); traditional: the strongest of the "
+       "history rules class, table and nearest (chosen by leave-one-out on the history, here "
+    << ToString(c.traditional_rule)
+    << "); class: diameter-class means; table: the experience table; nearest: the 3 nearest past "
+       "screws; regression: log-linear least squares of both features on the five inputs. All "
+       "but none and ramp use the model's curve shape and the same 840D planning; model: the "
+       "network's prediction. \"model vs it\" = 100 (1 - model / it).</p>\n";
   return h.str();
 }
 
-// The screw's data files: the elongation with the compensations applied, the plan's compensation
-// points and the travel deviation of each strategy (CSV with `options.provenance` as comments).
+// The screw's data files: <slug>_elongation.csv (time, truth, prediction, its band, then each
+// compensating strategy's compensation, in CompensatingStrategies order: the columns the plot
+// script reads by number), the plan's compensation points and the travel deviation of each
+// strategy (CSV with `options.provenance` as comments).
 void AddScrewData(const ScrewComparison& c, const std::string& slug, const ReportOptions& options,
                   OutputDir& out) {
+  const auto [low, high] = PredictionBand(c);
+  std::vector<std::string> header{"time_s", "truth_elongation_um", "predicted_elongation_um",
+                                  "predicted_minus_1sd_um", "predicted_plus_1sd_um"};
+  for (Strategy st : CompensatingStrategies()) header.push_back(ToString(st) + "_compensation_um");
   std::vector<std::vector<double>> rows;
   for (std::size_t i = 0; i < c.truth.size(); ++i) {
     const double t = c.truth.time_s[i];
     rows.push_back({t, c.truth.elongation_um[i], c.predicted_curve.ElongationUm(t),
-                    c.compensation_um[static_cast<std::size_t>(Strategy::kTraditional)][i],
-                    c.compensation_um[static_cast<std::size_t>(Strategy::kModel)][i]});
+                    low.ElongationUm(t), high.ElongationUm(t)});
+    for (Strategy st : CompensatingStrategies())
+      rows.back().push_back(c.compensation_um[static_cast<std::size_t>(st)][i]);
   }
-  out.Add(slug + "_elongation.csv",
-          FormatCsv({"time_s", "truth_elongation_um", "predicted_elongation_um",
-                     "traditional_compensation_um", "model_compensation_um"},
-                    rows,
-                    Comments(options, "elongation of the unmachined section of screw '" +
-                                          c.screw.name + "' and the compensation applied")));
+  out.Add(
+      slug + "_elongation.csv",
+      FormatCsv(header, rows,
+                Comments(options, "elongation of the unmachined section of screw '" + c.screw.name +
+                                      "', the prediction +- 1 sd (curves of "
+                                      "the features at +-1 sd) and the compensation applied")));
   out.Add(slug + "_points.csv",
           interp::FormatPointsCsv(
               c.plan, Comments(options,
                                "compensation points of the 840D plan (the last row is the "
                                "thread end, where the values found before the cut are "
                                "restored)")));
+  header = {"position_mm"};
+  for (const auto& o : c.outcomes) header.push_back(ToString(o.strategy) + "_deviation_um");
   rows.clear();
-  const auto& ln = c.Outcome(Strategy::kNone).lead;
-  const auto& lt = c.Outcome(Strategy::kTraditional).lead;
-  const auto& lm = c.Outcome(Strategy::kModel).lead;
-  for (std::size_t i = 0; i < ln.size(); ++i)
-    rows.push_back({ln.position_mm[i], ln.deviation_um[i], lt.deviation_um[i], lm.deviation_um[i]});
-  out.Add(slug + "_lead.csv", FormatCsv({"position_mm", "none_deviation_um",
-                                         "traditional_deviation_um", "model_deviation_um"},
-                                        rows,
-                                        Comments(options,
-                                                 "travel deviation (actual - specified travel from "
-                                                 "the thread start) of screw '" +
-                                                     c.screw.name + "'")));
+  for (std::size_t i = 0; i < c.outcomes[0].lead.size(); ++i) {
+    rows.push_back({c.outcomes[0].lead.position_mm[i]});
+    for (const auto& o : c.outcomes) rows.back().push_back(o.lead.deviation_um[i]);
+  }
+  out.Add(slug + "_lead.csv",
+          FormatCsv(header, rows,
+                    Comments(options,
+                             "travel deviation (actual - specified travel from the "
+                             "thread start) of screw '" +
+                                 c.screw.name + "'")));
 }
 
 // Runs gnuplot on the screw's script in the staging folder (an argument vector, no shell: neither
@@ -240,24 +286,42 @@ std::string InputsSection(const ScrewComparison& c) {
   return body.str();
 }
 
-// The features of the truth, the model's prediction and the traditional rule's class.
+// The features each strategy works from: the truth's, the model's (+- 1 sd), the ramp's class
+// plateau and ramp time, the traditional rule's class means and the regression's.
 std::string FeaturesTable(const ScrewComparison& c) {
   std::ostringstream body;
-  body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n"
-       << "<tr><td>simulated truth (seed " << c.seed << ", disturbances "
-       << (c.disturbances_on ? "on" : "off") << ")</td><td>"
-       << FormatDecimals(c.truth_features.max_elongation_um, 1) << "</td><td>"
-       << FormatDecimals(c.truth_features.settle_time_s, 0) << "</td></tr>\n"
-       << "<tr><td>model prediction (+- 1 std)</td><td>"
-       << FormatDecimals(c.prediction.mean.max_elongation_um, 1) << " +- "
-       << FormatDecimals(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
-       << FormatDecimals(c.prediction.mean.settle_time_s, 0) << " +- "
-       << FormatDecimals(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
-       << "<tr><td>traditional rule (class "
-       << FormatDecimals(c.experience_class.nominal_diameter_mm, 0) << " mm, "
-       << c.experience_class.screws << " past screws)</td><td>"
-       << FormatDecimals(c.experience_class.plateau_um, 1) << "</td><td>"
-       << FormatDecimals(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n";
+  auto row = [&body](const std::string& what, const std::string& l, const std::string& t) {
+    body << "<tr><td>" << what << "</td><td>" << l << "</td><td>" << t << "</td></tr>\n";
+  };
+  body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n";
+  row("simulated truth (seed " + std::to_string(c.seed) + ", disturbances " +
+          (c.disturbances_on ? "on" : "off") + ")",
+      FormatDecimals(c.truth_features.max_elongation_um, 1),
+      FormatDecimals(c.truth_features.settle_time_s, 0));
+  row("model prediction (+- 1 sd)",
+      FormatDecimals(c.prediction.mean.max_elongation_um, 1) + " +- " +
+          FormatDecimals(c.prediction.stddev.max_elongation_um, 1),
+      FormatDecimals(c.prediction.mean.settle_time_s, 0) + " +- " +
+          FormatDecimals(c.prediction.stddev.settle_time_s, 0));
+  const std::string cls = "class " + FormatDecimals(c.experience_class.nominal_diameter_mm, 0) +
+                          " mm, " + std::to_string(c.experience_class.screws) + " past screws";
+  row("ramp (" + cls + ")", FormatDecimals(c.experience_class.plateau_um, 1),
+      FormatDecimals(c.experience_ramp_time_s, 0) + " (linear ramp)");
+  row("traditional (= " + ToString(c.traditional_rule) + ", chosen on the history)",
+      FormatDecimals(c.traditional_features.max_elongation_um, 1),
+      FormatDecimals(c.traditional_features.settle_time_s, 0));
+  for (std::size_t k = 0; k < kHistoryRuleCount; ++k)
+    row(ToString(static_cast<HistoryRule>(k)) +
+            (k == 0 ? " (" + cls + ", means)" : std::string(" (history rule)")),
+        FormatDecimals(c.history_features[k].max_elongation_um, 1),
+        FormatDecimals(c.history_features[k].settle_time_s, 0));
+  if (c.regression_features.max_elongation_um > 0)
+    row("regression (log-linear on the five inputs)",
+        FormatDecimals(c.regression_features.max_elongation_um, 1),
+        FormatDecimals(c.regression_features.settle_time_s, 0));
+  else
+    row("regression", "-", "- (the history has no regression: equals none)");
+  body << "</table>\n";
   return body.str();
 }
 
@@ -280,56 +344,77 @@ std::string PlanParagraph(const ScrewComparison& c) {
   return body.str();
 }
 
-// The screw's HTML section: inputs, features, plan, metrics, plots (or why not) and data links.
+// The screw's HTML section: inputs, the strategies' results, plots (or why not), the features,
+// the plan and the data links.
 std::string ScrewSection(const ScrewComparison& c, const std::string& slug, const PlotFiles& files,
                          const std::set<std::string>& rendered) {
   std::ostringstream body;
-  body << InputsSection(c) << FeaturesTable(c) << PlanParagraph(c) << MetricsTable(c);
+  body << InputsSection(c) << MetricsTable(c);
   for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
     if (rendered.count(png) > 0)
-      body << "<p><img src='" << png << "' alt='" << png << "'></p>\n";
+      body << HtmlImage(png, png) << "\n";
     else
-      body << "<p class='warn'>Plot " << png << " not rendered (see warnings).</p>\n";
+      body << "<p class='warn'>Plot " << HtmlEscape(png) << " not rendered (see warnings).</p>\n";
   }
-  body << "<p class='small'>Data: <a href='" << slug << "_elongation.csv'>" << slug
-       << "_elongation.csv</a>, <a href='" << slug << "_points.csv'>" << slug
-       << "_points.csv</a>, <a href='" << slug << "_lead.csv'>" << slug
-       << "_lead.csv</a>, gnuplot script <a href='" << slug << ".gp'>" << slug << ".gp</a>.</p>\n";
+  body << "<p>Features each strategy works from:</p>\n" << FeaturesTable(c) << PlanParagraph(c);
+  body << "<p class='small'>Data: ";
+  for (const std::string& f : {slug + "_elongation.csv", slug + "_points.csv", slug + "_lead.csv"})
+    body << HtmlLink(f, f) << ", ";
+  body << "gnuplot script " << HtmlLink(slug + ".gp", slug + ".gp") << ".</p>\n";
   return body.str();
 }
 
-// The page: title, provenance, notes, warnings, how to read it, then the screws' sections.
+// The box's entries: the caller's (files, prerequisites, ...) with each screw's name and plan, or,
+// without them, each plan's setting data and where the programs come from.
+std::vector<ControlLoad> ControlLoads(const std::vector<ScrewComparison>& comparisons,
+                                      const ReportOptions& options) {
+  std::vector<ControlLoad> loads;
+  for (std::size_t i = 0; i < comparisons.size(); ++i) {
+    ControlLoad load;
+    if (i < options.control.size()) {
+      load = options.control[i];
+    } else {
+      load.no_files =
+          "this command writes no NC programs; 'whirl plan' writes them for your machine (give "
+          "it the model, the screw and the machine profile, see whirl plan --help).";
+      load.plan_note =
+          "Setting data of this comparison's plan (positions from the plan options given here, "
+          "not from a machine profile): plan for your machine with 'whirl plan'.";
+    }
+    load.heading = comparisons[i].screw.name;
+    load.plan = &comparisons[i].plan;
+    loads.push_back(std::move(load));
+  }
+  return loads;
+}
+
+// How to read the page; the strategies are listed from kStrategies.
+std::string HowToRead() {
+  std::string names;
+  for (Strategy s : kStrategies) names += (names.empty() ? "" : "; ") + StrategyLabel(s);
+  return "<h2>How to read this page</h2>\n<p>Each screw is cut in the simulator (the ground "
+         "truth, with seeded disturbances the model never saw) once per strategy: " +
+         HtmlEscape(names) +
+         ". The curve-based strategies share the model's curve shape and 840D planning; the "
+         "history of past screws is the one the model was trained on. Travel deviation = actual "
+         "minus specified travel from the thread start after cooling; accumulated error within "
+         "1000 mm = the largest max - min of the deviation within any 1000 mm of thread (the "
+         "paper's figure), over the whole thread = max - min over the thread. e_a, v_u, v_300, "
+         "v_2pi as ISO 3408-3 (about the least-squares mean travel line).</p>\n"
+         "<p class='small'>ISO 3408-3 caveat: only some tolerance cells are confirmed by a source "
+         "(Steinmeyer, HIWIN catalogue); the others are recalled values "
+         "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n";
+}
+
+// The page: title, provenance, the "load onto the control" box, notes, warnings, the screws'
+// sections, how to read it.
 std::string IndexHtml(const ReportOptions& options, const std::vector<std::string>& warnings,
-                      const std::string& sections) {
+                      const std::vector<ControlLoad>& loads, const std::string& sections) {
   std::ostringstream html;
-  html
-      << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>"
-      << HtmlEscape(options.title)
-      << "</title>\n<style>body{font-family:sans-serif;max-width:1060px;margin:2em auto;color:#222}"
-         "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #bbb;padding:3px "
-         "8px;"
-         "text-align:right}td:first-child,th:first-child{text-align:left}th{background:#eee}"
-         "tr.cls td{font-weight:bold}.small{font-size:0.85em;color:#555}.warn{color:#a00}"
-         "img{max-width:100%;border:1px solid #ddd}</style></head><body>\n<h1>"
-      << HtmlEscape(options.title) << "</h1>\n";
-  for (const auto& p : options.provenance) html << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
+  html << HtmlPageBegin(options.title, options.provenance) << ControlBoxHtml(loads);
   for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
   for (const auto& w : warnings) html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
-  html << "<p>How to read this page. Each screw is cut in the simulator (the ground truth, with "
-          "seeded disturbances the model never saw) three times: without compensation, with the "
-          "traditional experience rule (one correction per diameter class, ramped in linearly over "
-          "the machine's mean settle time, from the same past screws the model was trained on), "
-          "and with the model-based 840D plan (prediction, arctangent curve, "
-          "SD43900/SD43910/SD43920 "
-          "segments). Travel deviation = actual minus specified travel from the thread start after "
-          "cooling; accumulated error within 1000 mm = the largest max - min of the deviation "
-          "within any 1000 mm of thread (the paper's figure), over the whole thread = max - min "
-          "over the thread. e_a, v_u, v_300, v_2pi as ISO 3408-3 (about the least-squares mean "
-          "travel line). Reductions are 100 (1 - model / baseline).</p>\n"
-          "<p class='small'>ISO 3408-3 caveat: only some tolerance cells are confirmed by a source "
-          "(Steinmeyer, HIWIN catalogue); the others are recalled values "
-          "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.</p>\n"
-       << sections << "</body></html>\n";
+  html << sections << HowToRead() << HtmlPageEnd();
   return html.str();
 }
 
@@ -418,7 +503,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                  {"provenance", options.provenance},
                                  {"comparisons", report_json}};
   out.Add("report.json", JsonFileText(report));
-  out.Add("index.html", IndexHtml(options, result.warnings, body.str()));
+  out.Add("index.html",
+          IndexHtml(options, result.warnings, ControlLoads(comparisons, options), body.str()));
   result.files = out.Commit();
   result.index_html = dir / "index.html";
   return result;

@@ -1,10 +1,14 @@
 #pragma once
-// The report a process engineer opens after a comparison: one HTML page (index.html) with, per
-// screw, the elongation curve (simulated truth against the prediction, with the compensation points
-// of the 840D plan and the traditional ramp), the lead deviation along the thread for the three
-// strategies (whole thread, and the first 1000 mm where the transient lives), the metrics table
-// with the ISO 3408-3 class reached and the reductions, plus the CSV files every plot comes from
-// and report.json.
+// The report a process engineer opens after a comparison: one HTML page (index.html, the shared
+// skeleton and stylesheet of core/html_page.h) that opens with the "load onto the control" box
+// (compare/control_box.h: setting data, programs, prerequisites, what to run after an abort), then
+// per screw the metrics of every strategy (kStrategies) with the ISO 3408-3 class reached and how
+// much less the model leaves, the elongation curve (simulated truth, the prediction with its
+// +-1 sd band, i.e. the arctangent curves of the features at mean -+ 1 sd, and each strategy's
+// compensation with the plan's compensation points), the lead deviation of every strategy along
+// the thread (whole thread, and the first 1000 mm where the transient lives), plus the CSV files
+// every plot comes from and report.json. Each strategy has one colour and dash in every plot
+// (core/plot_style.h).
 //
 // Plots: gnuplot (Debian package gnuplot-nox, pngcairo terminal, falling back to png). Why gnuplot:
 // it is a well-kept Debian package already installed by scripts/setup.sh, it needs no library
@@ -25,6 +29,7 @@
 #include <vector>
 
 #include "compare/compare.h"
+#include "compare/control_box.h"
 
 namespace whirl::compare {
 
@@ -37,6 +42,12 @@ struct ReportOptions {
   std::string gnuplot_command = "gnuplot";
   /// Extra notes shown at the top of the page (e.g. how the new-type screw was defined).
   std::vector<std::string> notes;
+  /// The "load onto the control" box, one entry per comparison in the same order (heading and
+  /// plan are taken from the comparison): the programs and PLC table written with the report
+  /// (links relative to `dir`), the prerequisites, the call order, what to run after an abort.
+  /// Missing entries: the box shows the plan's setting data and says that `whirl plan` writes
+  /// the programs.
+  std::vector<ControlLoad> control;
 };
 
 struct ReportResult {
@@ -52,8 +63,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                          const std::vector<ScrewComparison>& comparisons,
                          const ReportOptions& options = {});
 
-/// Plain-text metrics table of one comparison (for the terminal): the metrics of the three
-/// strategies, the ISO class reached and the reductions of the model against both baselines.
+/// Plain-text metrics table of one comparison (for the terminal): the metrics of every strategy,
+/// the ISO class reached and how much less the model leaves than each.
 std::string FormatComparisonTable(const ScrewComparison& c);
 
 /// File-name stem for a screw name: lower case letters, digits, '-' and '_' only, at most 64

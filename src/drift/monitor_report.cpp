@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
@@ -310,13 +311,8 @@ std::string MonitorIndexHtml(const MonitorResult& r, const MonitorOptions& o,
                              const std::vector<std::string>& provenance, const std::string& img,
                              const std::vector<std::string>& warnings) {
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>"
-    << HtmlEscape("whirl: drift monitor of " + r.run)
-    << "</title><style>body{font-family:sans-serif;max-width:1200px;margin:1em auto}"
-       "pre{background:#f6f6f6;padding:6px}img{max-width:100%}</style></head><body>\n<h1>"
-    << HtmlEscape("whirl: on-line check and recalibration of " + r.error_column + " on " + r.run)
-    << "</h1>\n";
-  for (const auto& p : provenance) h << "<p><code>" << HtmlEscape(p) << "</code></p>\n";
+  h << HtmlPageBegin(  // the shared skeleton and stylesheet (core/html_page.h)
+      "whirl: on-line check and recalibration of " + r.error_column + " on " + r.run, provenance);
   h << "<pre>" << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n"
     << img << "\n"
     << "<p>Data: <a href='timeline.csv'>timeline.csv</a>, <a href='events.csv'>events.csv</a> "

@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
@@ -69,16 +70,9 @@ class ReportWriter {
   DriftReportResult result_;
 };
 
+// The shared skeleton and stylesheet of every report (core/html_page.h).
 std::string Head(const std::string& title, const std::vector<std::string>& provenance) {
-  std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << HtmlEscape(title)
-    << "</title><style>body{font-family:sans-serif;max-width:1100px;margin:1em auto}"
-       "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;"
-       "text-align:right}th{background:#eee}pre{background:#f6f6f6;padding:6px}"
-       "img{max-width:100%}</style></head><body>\n<h1>"
-    << HtmlEscape(title) << "</h1>\n";
-  for (const auto& p : provenance) h << "<p><code>" << HtmlEscape(p) << "</code></p>\n";
-  return h.str();
+  return HtmlPageBegin(title, provenance);
 }
 
 std::vector<std::string> Comments(const std::vector<std::string>& provenance,

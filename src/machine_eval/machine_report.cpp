@@ -1,17 +1,21 @@
-// Report of one screw cut on a drifting machine (machine_report.h): sensor plot, chosen
-// sensors, lead deviation per strategy. User strings (sensor and screw names) reach gnuplot only
-// through GnuplotString (terminal noenhanced) and HTML only through HtmlEscape; gnuplot runs
-// through RunProgram with an argument vector.
+// Report of one screw cut on a drifting machine (machine_report.h): the "load onto the control"
+// box, lead deviation per strategy, sensor plots, how the programs share the setting data. User
+// strings (sensor and screw names) reach gnuplot only through GnuplotString (terminal noenhanced)
+// and HTML only through HtmlEscape; gnuplot runs through RunProgram with an argument vector.
 #include "machine_eval/machine_report.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 
+#include "compare/control_box.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
+#include "core/plot_style.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 
@@ -20,7 +24,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
+// The terminal of every plot: `height_px` tall (the sensor plot grows with its panels).
+std::string Terminal(int height_px) {
+  return "set terminal pngcairo size 1000," + std::to_string(height_px) +
+         " font 'Sans,10' noenhanced\n";
+}
 
 std::string LeadCsv(const MachineScrewDetail& d) {
   std::ostringstream out;
@@ -37,50 +45,89 @@ std::string LeadCsv(const MachineScrewDetail& d) {
   return out.str();
 }
 
-std::string SensorScript(const drift::Run& log, const std::string& title) {
+constexpr std::size_t kSensorsPerPanel = 8;  // more lines than this in one plot are unreadable
+constexpr int kPanelHeightPx = 300;
+
+// The sensor log in panels of at most kSensorsPerPanel lines, related sensors together
+// (core/plot_style.h GroupSeries); the machine models' chosen sensors drawn thick.
+std::string SensorScript(const drift::Run& log, const std::string& title,
+                         const std::vector<std::string>& chosen,
+                         const std::vector<std::vector<std::size_t>>& panels) {
   std::string gp =
       "set datafile separator ','\nset key outside right\nset grid\n"
-      "set xlabel 'time [min]'\nset ylabel 'temperature [degC]'\nset title " +
-      GnuplotString(title) + "\nplot ";
-  for (std::size_t s = 0; s < log.sensor_names.size(); ++s)
-    gp += (s ? ", " : "") + std::string("'sensors.csv' using 1:") + std::to_string(s + 2) +
-          " with lines dt " + std::to_string(s / 8 + 1) + " title " +
-          GnuplotString(log.sensor_names[s]);  // 8 colours, then dashes
-  return gp + "\n";
+      "set ylabel 'temperature [degC]'\n"
+      "set lmargin at screen 0.08\nset rmargin at screen 0.76\nset multiplot layout " +
+      std::to_string(panels.size()) + ",1 title " + GnuplotString(title) + "\n";
+  for (std::size_t p = 0; p < panels.size(); ++p) {
+    gp += p + 1 == panels.size() ? "set xlabel 'time [min]'\n" : "unset xlabel\n";
+    gp += "plot ";
+    for (std::size_t j = 0; j < panels[p].size(); ++j) {
+      const std::string& name = log.sensor_names[panels[p][j]];
+      const bool model = std::find(chosen.begin(), chosen.end(), name) != chosen.end();
+      gp += (j ? ", " : "") + std::string("'sensors.csv' using 1:") +
+            std::to_string(panels[p][j] + 2) + " with lines lc rgb '" +
+            std::string(SeriesPalette()[j % SeriesPalette().size()]) + "' lw " +
+            (model ? "3.5" : "1.5") + " title " + GnuplotString(name);
+    }
+    gp += "\n";
+  }
+  return gp + "unset multiplot\n";
 }
 
-std::string LeadScript(const std::string& title) {
+// The strategies of each panel of the lead plot: the evaluation's first rows (up to
+// both_monitor), then none and both again beside the shop's rows, so no panel holds 14 lines.
+std::vector<std::vector<std::size_t>> LeadPanels() {
+  const auto last_first = static_cast<std::size_t>(MachineStrategy::kBothMonitor);
+  std::vector<std::vector<std::size_t>> panels(1);
+  for (std::size_t k = 0; k <= last_first && k < kMachineStrategyCount; ++k) panels[0].push_back(k);
+  if (kMachineStrategyCount > last_first + 1) {
+    panels.push_back({static_cast<std::size_t>(MachineStrategy::kNone),
+                      static_cast<std::size_t>(MachineStrategy::kBoth)});
+    for (std::size_t k = last_first + 1; k < kMachineStrategyCount; ++k) panels[1].push_back(k);
+  }
+  return panels;
+}
+
+// Every strategy in its colour and dash (core/plot_style.h), x from the thread start to its end.
+std::string LeadScript(const std::string& title, double thread_length_mm,
+                       const std::vector<std::vector<std::size_t>>& panels) {
   std::string gp =
       "set datafile separator ','\nset key outside right\nset grid\n"
-      "set xlabel 'position along the thread [mm]'\n"
-      "set ylabel 'travel deviation [um]'\nset title " +
-      GnuplotString(title) + "\nplot ";
-  // The variants of 'both' are dashed, so 'both' stays visible where they coincide with it.
-  const auto both = static_cast<std::size_t>(MachineStrategy::kBoth);
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
-    gp += (k ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(k + 2) +
-          " with lines lw 2" + (k > both ? " dt " + std::to_string(k - both + 1) : "") + " title " +
-          GnuplotString(ToString(static_cast<MachineStrategy>(k)));
-  return gp + "\n";
+      "set xlabel 'position along the thread [mm]'\nset xrange [0:" +
+      std::to_string(thread_length_mm) +
+      "]\nset ylabel 'travel deviation [um]'\nset lmargin at screen 0.08\n"
+      "set rmargin at screen 0.8\nset multiplot layout " +
+      std::to_string(panels.size()) + ",1 title " + GnuplotString(title) + "\n";
+  for (const auto& panel : panels) {
+    gp += "plot ";
+    for (std::size_t j = 0; j < panel.size(); ++j) {
+      const std::string name = ToString(static_cast<MachineStrategy>(panel[j]));
+      gp += (j ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(panel[j] + 2) +
+            " " + GnuplotWith(name) + " title " + GnuplotString(name);
+    }
+    gp += "\n";
+  }
+  return gp + "unset multiplot\n";
 }
 
 // Adds <stem>.gp to the report and renders <stem>.png in its staging folder; returns the <img>
 // tag or a note.
-std::string Render(OutputDir& out, const std::string& stem, const std::string& body) {
+std::string Render(OutputDir& out, const std::string& stem, const std::string& body,
+                   int height_px = 480) {
   out.Add(stem + ".gp",
-          std::string(kTerminal) + "set output " + GnuplotString(stem + ".png") + "\n" + body);
+          Terminal(height_px) + "set output " + GnuplotString(stem + ".png") + "\n" + body);
   if (!ProgramSucceeds({"gnuplot", "--version"}))
-    return "<p>(gnuplot not found: " + HtmlEscape(stem) + ".gp not rendered)</p>";
+    return "<p class='warn'>(gnuplot not found: " + HtmlEscape(stem) + ".gp not rendered)</p>";
   const fs::path stage = fs::absolute(out.Staging());
   const int rc = RunProgram({"gnuplot", stem + ".gp"}, stage, stage / (stem + ".log"));
   std::error_code ec;
   if (rc != 0 || !fs::is_regular_file(stage / (stem + ".png"), ec)) {
     if (fs::is_regular_file(stage / (stem + ".log"), ec)) out.AddStaged(stem + ".log");
-    return "<p>(gnuplot failed on " + HtmlEscape(stem) + ".gp, see " + HtmlEscape(stem) +
-           ".log)</p>";
+    return "<p class='warn'>(gnuplot failed on " + HtmlEscape(stem) + ".gp, see " +
+           HtmlEscape(stem) + ".log)</p>";
   }
   out.AddStaged(stem + ".png");
-  return "<img src='" + HtmlEscape(stem + ".png") + "' alt='" + HtmlEscape(stem) + "'>";
+  return HtmlImage(stem + ".png", stem);
 }
 
 std::string List(const std::vector<std::string>& names) {
@@ -97,45 +144,62 @@ std::string OutputAction(const std::string& drift_nc) {
   return drift_nc.substr(begin + 1, end == std::string::npos ? end : end - begin - 1);
 }
 
-std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
-  if (!p) return note.empty() ? "" : "<p>" + HtmlEscape(note) + "</p>";
-  const interp::DriftActionOptions& d = p->drift;
-  std::string h =
-      "<h2>Combined 840D programs (one writer per setting datum)</h2><p>The workpiece plan (" +
-      std::to_string(p->plan.segments.size()) +
-      " segments of the network's curve) writes its K0, SD43910 and SD43920 into $AC_PARAM[" +
+// The "load onto the control" box of the combined programs (compare/control_box.h).
+std::string ControlBox(const std::string& screw_name, const CombinedPrograms& p) {
+  compare::ControlLoad load;
+  load.heading = screw_name;
+  load.plan = &p.plan;
+  const interp::DriftActionOptions& d = p.drift;
+  load.plan_note =
+      "The plan does not write these into the setting data itself: it hands K0, "
+      "SD43910 and SD43920 to the drift action through $AC_PARAM[" +
       std::to_string(d.workpiece_k0_param) + "], [" + std::to_string(d.workpiece_slope_param) +
       "], [" + std::to_string(d.workpiece_slope_param + 1) +
-      "]; the machine drift action (offset model and Z-screw slope model, evaluated every "
-      "interpolation cycle from the analog inputs) is the only writer of SD43900-43920: "
-      "SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b), the fixed "
-      "bearing at P_b = " +
-      FormatFixed(d.slope_fixed_end_mm, 4) +
-      " mm (MCS). Call WHIRL_DRIFT_COMP first, then WHIRL_TEMP_COMP before the cutting block, "
-      "the reset programs after the cut or an abort.</p><ul>";
-  for (const char* f : {"WHIRL_TEMP_COMP.SPF", "WHIRL_TEMP_COMP_RESET.SPF", "WHIRL_DRIFT_COMP.SPF",
-                        "WHIRL_DRIFT_COMP_RESET.SPF", "WHIRL_DRIFT_COMP_PLC.csv"})
-    h += std::string("<li><a href='") + f + "'>" + f + "</a></li>";
-  return h + "</ul><p>The drift action's output:</p><pre>" + HtmlEscape(OutputAction(p->drift_nc)) +
-         "</pre>";
+      "], which adds the machine's drift every interpolation cycle and is the only "
+      "writer of SD43900-43920.";
+  load.files = {{"WHIRL_DRIFT_COMP.SPF", "live machine-drift action"},
+                {"WHIRL_DRIFT_COMP_RESET.SPF", "stops it, restores the setting data"},
+                {"WHIRL_DRIFT_COMP_PLC.csv", "the drift action as a PLC table"},
+                {"WHIRL_TEMP_COMP.SPF", "workpiece plan"},
+                {"WHIRL_TEMP_COMP_RESET.SPF", "its reset program"}};
+  load.call_order =
+      "WHIRL_DRIFT_COMP first (it keeps running), then WHIRL_TEMP_COMP before the "
+      "cutting block with the axis before the thread start; WHIRL_TEMP_COMP_RESET "
+      "after the cutting block; WHIRL_DRIFT_COMP_RESET to stop the drift action.";
+  load.after_abort =
+      "call WHIRL_TEMP_COMP_RESET (it cancels the plan's actions and sets its "
+      "hand-over values to 0; the drift action goes on compensating the machine "
+      "alone), move the axis before the thread start and cut the whole thread "
+      "again with WHIRL_TEMP_COMP. WHIRL_DRIFT_COMP refuses to start while a "
+      "plan's compensation is active: call WHIRL_TEMP_COMP_RESET first.";
+  for (const std::string* nc : {&p.drift_nc, &p.plan_nc})
+    for (auto& line : compare::NcPrerequisites(*nc))
+      if (std::find(load.prerequisites.begin(), load.prerequisites.end(), line) ==
+          load.prerequisites.end())
+        load.prerequisites.push_back(line);
+  return compare::ControlBoxHtml({load});
 }
 
-std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
-                 const std::vector<std::string>& idle, const std::string& sensor_img,
-                 const std::string& lead_img, const CombinedPrograms* programs,
-                 const std::string& programs_note) {
-  std::string h = "<!doctype html><html><head><meta charset='utf-8'><title>" +
-                  HtmlEscape(r.screw.name) + ": both halves</title></head><body><h1>" +
-                  HtmlEscape(r.screw.name) +
-                  ": workpiece and machine drift in one cut (simulated)</h1>"
-                  "<p>Chosen sensors of the machine's offset model, trained cutting: " +
-                  List(cutting) + "; trained idle: " + List(idle) + ".</p><h2>Sensors</h2>" +
-                  sensor_img + "<h2>Lead deviation per strategy</h2>" + lead_img +
-                  "<table border='1' cellpadding='4'><tr><th>strategy</th><th>within 1000 mm "
-                  "[um]</th><th>over the thread [um]</th><th>ISO class</th></tr>";
+std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
+  if (!p) return note.empty() ? "" : "<p class='warn'>" + HtmlEscape(note) + "</p>";
+  const interp::DriftActionOptions& d = p->drift;
+  return "<h2>How the two programs share the setting data</h2><p>The workpiece plan (" +
+         std::to_string(p->plan.segments.size()) +
+         " segments of the network's curve) hands K0_w, S_w and P_w over; the machine drift action "
+         "(offset model and Z-screw slope model, evaluated every interpolation cycle from the "
+         "analog inputs) writes SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m "
+         "(P_w - P_b), the fixed bearing at P_b = " +
+         FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:</p><pre>" +
+         HtmlEscape(OutputAction(p->drift_nc)) + "</pre>";
+}
+
+std::string StrategyTable(const MachineEvalScrew& r) {
+  std::string h =
+      "<table><tr><th>strategy</th><th>within 1000 mm [um]</th><th>over the thread "
+      "[um]</th><th>ISO 3408-3 class</th></tr>\n";
   char buf[256];
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    std::snprintf(buf, sizeof buf, "<tr><td>%s</td><td>%.1f</td><td>%.1f</td><td>%s</td></tr>",
+    std::snprintf(buf, sizeof buf, "<tr><td>%s</td><td>%.1f</td><td>%.1f</td><td>%s</td></tr>\n",
                   ToString(static_cast<MachineStrategy>(k)).c_str(),
                   r.metrics[k].accumulated_1000_um, r.metrics[k].accumulated_total_um,
                   HtmlEscape(ToString(r.iso[k])).c_str());
@@ -143,9 +207,30 @@ std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutt
   }
   std::snprintf(buf, sizeof buf,
                 "</table><p>Left after both, over the thread: workpiece part %.1f um, machine "
-                "part %.1f um.</p>",
+                "part %.1f um.</p>\n",
                 r.residual_workpiece_total_um, r.residual_machine_total_um);
-  return h + buf + ProgramsHtml(programs, programs_note) + "</body></html>\n";
+  return h + buf +
+         "<p class='small'>none: no compensation; traditional: the strongest history rule's plan; "
+         "workpiece: the network's plan alone; machine: the drift action alone; both: plan and "
+         "drift action with the cutting-trained machine model; both_idle: with the idle-trained "
+         "model; both_monitor: both, checked and refitted on-line. Shop rows (machine models "
+         "trained from probe and laser readings, applied causally): class, table, nearest: the "
+         "history rules' plans; warmup: workpiece plus a time-since-power-on rule; schedule: "
+         "workpiece plus a control-signal rule; machine_shop: the sensor model alone; both_shop: "
+         "workpiece plus machine_shop.</p>\n";
+}
+
+std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
+                 const std::vector<std::string>& idle, const std::string& sensor_img,
+                 const std::string& lead_img, const CombinedPrograms* programs,
+                 const std::string& programs_note) {
+  return HtmlPageBegin(r.screw.name + ": workpiece and machine drift in one cut (simulated)") +
+         (programs ? ControlBox(r.screw.name, *programs) : "") +
+         "<h2>Lead deviation per strategy</h2>" + StrategyTable(r) + lead_img +
+         "<h2>Sensors</h2><p>Chosen sensors of the machine's offset model (thick lines), trained "
+         "cutting: " +
+         List(cutting) + "; trained idle: " + List(idle) + ".</p>" + sensor_img +
+         ProgramsHtml(programs, programs_note) + HtmlPageEnd();
 }
 
 }  // namespace
@@ -169,12 +254,20 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                                               std::to_string(screw.day_seed) + ")",
                                           "offset_um: machine drift at the Z screw's fixed end; "
                                           "zscrew_per_1000_um: its growth per 1000 mm (um)"}));
+    const auto panels = GroupSeries(detail.log.sensor_names, kSensorsPerPanel);
+    std::vector<std::string> chosen = sensors_cutting;
+    chosen.insert(chosen.end(), sensors_idle.begin(), sensors_idle.end());
     sensor_img =
-        Render(out, "sensors", SensorScript(detail.log, screw.screw.name + ": virtual sensors"));
+        Render(out, "sensors",
+               SensorScript(detail.log, screw.screw.name + ": virtual sensors", chosen, panels),
+               80 + kPanelHeightPx * static_cast<int>(panels.size()));
   }
   out.Add("lead.csv", LeadCsv(detail));
-  const std::string lead_img =
-      Render(out, "lead", LeadScript(screw.screw.name + ": lead deviation"));
+  const auto lead_panels = LeadPanels();
+  const std::string lead_img = Render(
+      out, "lead",
+      LeadScript(screw.screw.name + ": lead deviation", screw.screw.thread_length_mm, lead_panels),
+      40 + 420 * static_cast<int>(lead_panels.size()));
   if (programs)
     for (const auto& [path, text] : CombinedProgramFiles("", *programs))
       out.Add(path.filename().string(), text);

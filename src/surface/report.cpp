@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
@@ -157,13 +158,7 @@ std::string PageHtml(const SurfaceFit& f, const MethodComparison* choice,
                      const std::vector<AxisLine>& lines, const SurfaceReportOptions& o,
                      bool have_map, const std::vector<std::string>& warnings) {
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << HtmlEscape(o.title)
-    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
-       "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
-       "text-align:right}th{background:#eee}.small{font-size:90%;color:#444}pre{background:#f6f6f6;"
-       "padding:8px;white-space:pre-wrap}</style></head><body>\n<h1>"
-    << HtmlEscape(o.title) << "</h1>\n";
-  for (const auto& p : o.provenance) h << "<p class='small'>" << HtmlEscape(p) << "</p>\n";
+  h << HtmlPageBegin(o.title, o.provenance);  // the shared skeleton (core/html_page.h)
   for (const auto& w : warnings) h << "<p><b>warning:</b> " << HtmlEscape(w) << "</p>\n";
   if (have_map)
     h << "<p><img src='map.png' alt='map of the thermal error over the table' width='1000'></p>\n";

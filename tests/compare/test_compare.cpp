@@ -1,4 +1,4 @@
-// The three-strategy comparison: properties through the 840D plan, and a smoke test on the
+// The strategy comparison: properties through the 840D plan, and a smoke test on the
 // reference screw with the shipped model (skipped, with a message, if the model is not shipped).
 #include <gtest/gtest.h>
 

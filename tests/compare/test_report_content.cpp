@@ -1,0 +1,173 @@
+// What the workpiece report shows (compare/report.h, compare/control_box.h), checked against the
+// comparison it is written from: the "load onto the control" box first, with the plan's setting
+// data, the files and the programs' own prerequisites; every strategy in the data and the plots;
+// the prediction's +-1 sd band around the prediction; each baseline's own features.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "compare/compare.h"
+#include "compare/control_box.h"
+#include "compare/report.h"
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/numbers.h"
+#include "interp/machine_profile.h"
+
+namespace whirl::compare {
+namespace {
+namespace fs = std::filesystem;
+
+const fs::path kSource(WHIRL_SOURCE_DIR);
+
+class ReportContent : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const nn::Model model = nn::LoadModel(kSource / "models/default.json");
+    const ExperienceRule rule =
+        BuildExperienceRule(ReadProcessTable(kSource / "datasets/whirling_train.csv", true));
+    const IsoToleranceTable iso =
+        ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
+    profile_ = new interp::MachineProfile(
+        interp::LoadMachineProfile(kSource / "datasets/machines/example_840d.json"));
+    CompareOptions options;
+    options.seed = 4;
+    profile_->ApplyTo(options.plan);
+    comparison_ =
+        new ScrewComparison(CompareScrew(sim::ReferenceScrew(), model, rule, iso, options));
+    nc_ = new std::string(
+        interp::FormatNcProgram(comparison_->plan, {"WHIRL_T", "WHIRL_T_RESET", "t"}));
+  }
+  static void TearDownTestSuite() {
+    delete comparison_;
+    delete profile_;
+    delete nc_;
+  }
+  // The report of the comparison in a fresh directory (no plots: the scripts are still written).
+  static fs::path Write(const std::string& name, const ReportOptions& options) {
+    const fs::path dir = fs::path(::testing::TempDir()) / name;
+    fs::remove_all(dir);
+    ReportOptions o = options;
+    o.plots = false;
+    WriteReport(dir, {*comparison_}, o);
+    return dir;
+  }
+  static ScrewComparison* comparison_;
+  static interp::MachineProfile* profile_;
+  static std::string* nc_;
+};
+ScrewComparison* ReportContent::comparison_ = nullptr;
+interp::MachineProfile* ReportContent::profile_ = nullptr;
+std::string* ReportContent::nc_ = nullptr;
+
+TEST_F(ReportContent, NcPrerequisitesAreTheProgramsHeaderRequirements) {
+  // Independently: the comment lines before the first statement that state a requirement.
+  std::vector<std::string> expected;
+  std::istringstream in(*nc_);
+  for (std::string line; std::getline(in, line) && line.rfind(";", 0) == 0;)
+    if (line.rfind("; requires ", 0) == 0 || line.rfind("; uses ", 0) == 0)
+      expected.push_back(line.substr(2));
+  ASSERT_GE(expected.size(), 3u);  // MD32750, MD32760, MD28250, ... IDs and R parameters
+  EXPECT_EQ(NcPrerequisites(*nc_), expected);
+  // A "; requires" comment after the header is not a prerequisite of the program.
+  EXPECT_EQ(NcPrerequisites(*nc_ + "; requires nothing else\n"), expected);
+}
+
+TEST_F(ReportContent, ControlBoxComesFirstWithSettingDataFilesAndPrerequisites) {
+  ReportOptions o;
+  o.control = {PlanFilesLoad("../", "WHIRL_T", "t_plan.csv", "t_plan.json", *nc_, profile_)};
+  const std::string html = ReadTextFile(Write("whirl_report_box", o) / "index.html");
+  const std::size_t box = html.find("<section class='control'");
+  const std::size_t box_end = html.find("</section>");
+  const std::size_t screw = html.find("<h2>" + comparison_->screw.name + "</h2>");
+  ASSERT_NE(box, std::string::npos);
+  ASSERT_NE(screw, std::string::npos);
+  EXPECT_LT(box_end, screw) << "the box must come before the results";
+  EXPECT_EQ(html.find("<h2>", html.find("<h1>")), html.find("<h2>", box))
+      << "a section before the box";
+  const std::string b = html.substr(box, box_end - box);
+  for (const auto& s : comparison_->plan.segments) {
+    EXPECT_NE(b.find(FormatFixed(s.sd43900_mm, interp::kDecimalsSd43900Mm)), std::string::npos);
+    EXPECT_NE(b.find(FormatFixed(s.sd43910, interp::kDecimalsSd43910)), std::string::npos);
+    EXPECT_NE(b.find(FormatFixed(s.sd43920_mm, interp::kDecimalsPositionMm)), std::string::npos);
+  }
+  for (const char* f : {"../WHIRL_T.SPF", "../WHIRL_T_RESET.SPF", "../t_plan.csv"})
+    EXPECT_NE(b.find(std::string("href='") + f + "'"), std::string::npos) << f;
+  EXPECT_NE(b.find("MD28254 " + std::to_string(profile_->control.ac_params)), std::string::npos);
+  EXPECT_NE(b.find("After an aborted cut"), std::string::npos);
+  EXPECT_NE(b.find("WHIRL_T_RESET"), std::string::npos);
+  // Without files the box still gives the setting data and says where the programs come from.
+  const std::string bare = ReadTextFile(Write("whirl_report_bare", {}) / "index.html");
+  EXPECT_NE(bare.find("writes no NC programs"), std::string::npos);
+  EXPECT_NE(bare.find("SD43910 slope"), std::string::npos);
+}
+
+TEST_F(ReportContent, EveryStrategyIsInTheDataAndThePlots) {
+  const ScrewComparison& c = *comparison_;
+  const fs::path dir = Write("whirl_report_strategies", {});
+  const std::string slug = Slug(c.screw.name);
+  const CsvTable lead = ReadCsv(dir / (slug + "_lead.csv"));
+  const CsvTable el = ReadCsv(dir / (slug + "_elongation.csv"));
+  const std::string gp = ReadTextFile(dir / (slug + ".gp"));
+  for (const auto& o : c.outcomes) {
+    const std::vector<double> dev = lead.Column(ToString(o.strategy) + "_deviation_um");
+    ASSERT_EQ(dev.size(), o.lead.size());
+    for (std::size_t i = 0; i < dev.size(); i += 97)
+      EXPECT_NEAR(dev[i], o.lead.deviation_um[i], 1e-6);
+    // Its column is plotted, in its style, in both lead plots.
+    const std::size_t col = lead.ColumnIndex(ToString(o.strategy) + "_deviation_um") + 1;
+    std::size_t n = 0;
+    for (std::size_t at = gp.find("using 1:" + std::to_string(col) + " "); at != std::string::npos;
+         at = gp.find("using 1:" + std::to_string(col) + " ", at + 1))
+      ++n;
+    EXPECT_GE(n, 2u) << ToString(o.strategy);
+    if (o.strategy == Strategy::kNone) continue;
+    const std::vector<double> comp = el.Column(ToString(o.strategy) + "_compensation_um");
+    const auto& expected = c.compensation_um[static_cast<std::size_t>(o.strategy)];
+    for (std::size_t i = 0; i < comp.size(); i += 97) EXPECT_NEAR(comp[i], expected[i], 1e-6);
+  }
+  // The lead axis ends at the thread's end.
+  EXPECT_NE(gp.find("set xrange [0:" + FormatNumber(c.screw.thread_length_mm) + "]"),
+            std::string::npos);
+}
+
+TEST_F(ReportContent, PredictionBandContainsThePredictionAndWidensWithItsSd) {
+  const ScrewComparison& c = *comparison_;
+  ASSERT_GT(c.prediction.stddev.max_elongation_um, 0);
+  const CsvTable el =
+      ReadCsv(Write("whirl_report_band", {}) / (Slug(c.screw.name) + "_elongation.csv"));
+  const auto t = el.Column("time_s"), p = el.Column("predicted_elongation_um"),
+             lo = el.Column("predicted_minus_1sd_um"), hi = el.Column("predicted_plus_1sd_um");
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    ASSERT_LE(lo[i], p[i] + 1e-9) << "t = " << t[i];
+    ASSERT_GE(hi[i], p[i] - 1e-9) << "t = " << t[i];
+  }
+  // On the plateau the band is the plateau -+ its sd (hand check of the corner curves).
+  const double l = c.prediction.mean.max_elongation_um, sd = c.prediction.stddev.max_elongation_um;
+  EXPECT_NEAR(lo.back(), std::max(0.0, l - sd), 1e-3);
+  EXPECT_NEAR(hi.back(), l + sd, 1e-3);
+}
+
+TEST_F(ReportContent, EachBaselineShowsItsOwnFeaturesAndNoStaleProse) {
+  const ScrewComparison& c = *comparison_;
+  const std::string html = ReadTextFile(Write("whirl_report_features", {}) / "index.html");
+  auto row = [&html](const std::string& start) {
+    const std::size_t at = html.find("<tr><td>" + start);
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</tr>", at) - at);
+  };
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.0f", c.experience_ramp_time_s);
+  EXPECT_NE(row("ramp (").find(std::string(buf) + " (linear ramp)"), std::string::npos);
+  std::snprintf(buf, sizeof buf, "<td>%.0f</td>", c.traditional_features.settle_time_s);
+  EXPECT_NE(row("traditional (").find(buf), std::string::npos) << row("traditional (");
+  std::snprintf(buf, sizeof buf, "<td>%.0f</td>", c.regression_features.settle_time_s);
+  EXPECT_NE(row("regression (").find(buf), std::string::npos) << row("regression (");
+  EXPECT_EQ(html.find("three"), std::string::npos);
+  EXPECT_EQ(html.find("traditional rule ("), std::string::npos);
+}
+
+}  // namespace
+}  // namespace whirl::compare
