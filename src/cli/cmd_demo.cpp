@@ -15,7 +15,7 @@
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "interp/machine_profile.h"
-#include "machine_eval/machine_eval.h"  // step 7 (issue 19)
+#include "machine_eval/machine_eval.h"  // step 7
 #include "nn/model.h"
 #include "sim/screw.h"
 

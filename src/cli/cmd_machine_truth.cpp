@@ -73,8 +73,7 @@ void RegisterMachineTruth(CLI::App* machine) {
                 "comma list of machine scenarios or 'all' (legacy is skipped; default all)");
   AddSeedOption(t, &o->seed, "seed of machines, calendars and halls (default 1)");
   t->add_option("--machines", o->machines, "machines (1..20, default 2)")->check(NumberIn(1, 20));
-  t->add_option("--test-days", o->test_days,
-                "production days in the test window (1..20, default 2)")
+  t->add_option("--test-days", o->test_days, "production days in the test window (1..20, default 2)")
       ->check(NumberIn(1, 20));
   t->add_option("--past-days", o->past_days, "history production days (0..30, default 5)")
       ->check(NumberIn(0, 30));

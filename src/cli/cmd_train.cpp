@@ -242,7 +242,7 @@ std::string TrainDescription() {
   return "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
          "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
          "on a process table and write a model file (JSON), or sweep the hidden size.\n"
-         "Default (issue 12): no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
+         "Default: no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
          "highest log evidence, each fit stopped by R brnn's rule (--change 0.001),\n"
          "per-output noise by 5-fold cross-validation; about 10 ms for 20 rows, 70 ms for\n"
          "100 rows (one thread). A warning says when the network ignores its inputs.\n"
@@ -302,7 +302,7 @@ void RegisterTrain(CLI::App& app) {
                 "every size fit, restart and noise fold, and every fit of --hidden-sweep\n"
                 "(src/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
                 "choose trainbr's epochs without ARD. Better from about 100 rows and for\n"
-                "settle time; README 'Against its peers'");
+                "settle time; docs/network.md");
   sub->add_flag("--stop-by-cv", o->stop_by_cv,
                 "stop at the epoch count with the lowest 5-fold cross-validation error\n"
                 "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"
