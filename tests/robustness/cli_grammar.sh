@@ -30,6 +30,17 @@ DIMENSIONLESS=(
   --threshold             # drift split: in the unit of the --at column, whatever it is
   --train --test          # drift holdout: shares of the rows
 )
+# Not yet renamed: the drift commands' flags wait for the drift rework in progress (then
+# --lag-grid-min, --check-every-min / --check-every-samples, --refit-every-*, --start-*, --out-dir
+# and --json on drift report). Each entry is "<command> <flag>" ("<command> --json": no --json
+# yet); remove an entry when its flag is renamed, and the test checks it from then on.
+PENDING=(
+  "drift fit --lag-grid" "drift crossval --lag-grid" "drift holdout --lag-grid"
+  "drift report --lag-grid" "drift holdout --report" "drift report --out" "drift report --json"
+  "drift monitor --check-every" "drift monitor --refit-every" "drift monitor --start"
+  "drift monitor --report"
+)
+pending() { local p; for p in "${PENDING[@]}"; do [ "$p" = "$1" ] && return 0; done; return 1; }
 UNIT_SUFFIX='-(um|mm|m|s|min|h|k|c|pct|rpm|mm-min|m-min|hrc|urad|per-k)$'
 DIMENSIONLESS_SUFFIX='-(fraction|factor|ratio|sigma|scale|share)$'
 
@@ -60,6 +71,7 @@ check_command() {  # check_command <help text> <command words...>
   while IFS=$'\t' read -r name type text; do
     [ -n "$name" ] || continue
     [ "$name" = --json ] && has_json=1
+    pending "$* $name" && continue
     case "$type" in
       FLOAT*)
         checked_flags=$((checked_flags + 1))
@@ -78,7 +90,7 @@ check_command() {  # check_command <help text> <command words...>
       bad "whirl $* $name names a folder: call it --out-dir (or *-dir)"
     fi
   done <<< "$(options <<< "$help")"
-  [ "$has_json" = 1 ] || bad "whirl $*: no --json (a JSON summary on stdout)"
+  [ "$has_json" = 1 ] || pending "$* --json" || bad "whirl $*: no --json (a JSON summary on stdout)"
   checked_commands=$((checked_commands + 1))
 }
 
