@@ -17,7 +17,7 @@ for field in smooth bump; do
   "$whirl" surface compare --points "$out/$field.csv"
   for method in cubic bspline; do
     "$whirl" surface fit --points "$out/$field.csv" --method "$method" \
-      --out "$out/${field}_$method.json" --report "$out/${field}_$method" > /dev/null
+      --out "$out/${field}_$method.json" --out-dir "$out/${field}_$method" > /dev/null
   done
   echo "== $field field, B-spline surface: 840D line along X"
   "$whirl" surface line --surface "$out/${field}_bspline.json" --along x --axis X

@@ -91,16 +91,22 @@ void AddDrift(CLI::App& parent) {
                   "sd of one bar reading, um (default 0: pooled from repeated readings of a pivot "
                   "within blocks)")
       ->check(NumberIn(0.0, 100.0));
-  sub->add_option("--bar-alpha-per-K", c->o.bar_alpha_per_K,
-                  "bar expansion coefficient, 1/K (default 12e-6: 1.8 um/K on 150 mm); a reading "
-                  "is corrected to L (1 + alpha (T - T_ref))")
-      ->check(NumberIn(0.0, 50e-6));
-  sub->add_option("--bar-alpha-sd-per-K", c->o.bar_alpha_sd_per_K,
-                  "sd of that coefficient, 1/K (default 1e-6; 0 for a calibrated bar)")
-      ->check(NumberIn(0.0, 50e-6));
-  sub->add_option("--bar-reference-C", c->o.bar_reference_C,
-                  "bar calibration temperature T_ref, degC (default 20)")
-      ->check(NumberIn(-20.0, 60.0));
+  auto* bar_alpha_per_k =
+      sub->add_option(
+             "--bar-alpha-per-k", c->o.bar_alpha_per_K,
+             "bar expansion coefficient, 1/K (default 12e-6: 1.8 um/K on 150 mm); a reading "
+             "is corrected to L (1 + alpha (T - T_ref))")
+          ->check(NumberIn(0.0, 50e-6, "1/K"));
+  AddDeprecatedAlias(sub, bar_alpha_per_k, "--bar-alpha-per-K");
+  auto* bar_alpha_sd_per_k =
+      sub->add_option("--bar-alpha-sd-per-k", c->o.bar_alpha_sd_per_K,
+                      "sd of that coefficient, 1/K (default 1e-6; 0 for a calibrated bar)")
+          ->check(NumberIn(0.0, 50e-6, "1/K"));
+  AddDeprecatedAlias(sub, bar_alpha_sd_per_k, "--bar-alpha-sd-per-K");
+  auto* bar_reference_c = sub->add_option("--bar-reference-c", c->o.bar_reference_C,
+                                          "bar calibration temperature T_ref, degC (default 20)")
+                              ->check(NumberIn(-20.0, 60.0, "degC"));
+  AddDeprecatedAlias(sub, bar_reference_c, "--bar-reference-C");
   sub->add_flag("--no-bar-temperature", c->no_temperature,
                 "ignore bar_temperature_C (no expansion correction)");
   sub->add_option("--sign", c->sign,

@@ -37,7 +37,7 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
                 {"--screw", o.screw_path},
                 {"--history", o.history},
                 {"--iso-table", o.iso_table}},
-               {}, {{"--report", o.report_dir}});
+               {}, {{"--out-dir", o.report_dir}});
   const nn::Model model = nn::LoadModel(o.model_path);
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   const compare::ExperienceRule rule =
@@ -115,10 +115,12 @@ void RegisterCompare(CLI::App& app) {
   AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-disturbances", o->no_disturbances,
                 "simulate the truth without disturbances (the model's own world)");
-  sub->add_option("--report", o->report_dir,
-                  "write the HTML report (index.html, PNG plots, CSV data, report.json) here: " +
-                      std::string(kOutputDirRule));
-  sub->add_flag("--no-plots", o->no_plots, "with --report: skip gnuplot (data and HTML only)");
+  auto* report = sub->add_option(
+      "--out-dir", o->report_dir,
+      "write the HTML report (index.html, PNG plots, CSV data, report.json) into this directory: " +
+          std::string(kOutputDirRule));
+  AddDeprecatedAlias(sub, report, "--report");
+  sub->add_flag("--no-plots", o->no_plots, "with --out-dir: skip gnuplot (data and HTML only)");
   sub->add_option("--history", o->history,
                   "past screws for the traditional rule: process table with targets "
                   "(default: " +

@@ -36,7 +36,7 @@ void Run(const CurveOptions& o) {
       !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
   if (by_model == by_features)
     throw InputError(
-        "curve: give either --model M --screw S.json or --max-elongation L --settle-time T");
+        "curve: give either --model M --screw S.json or --max-elongation-um L --settle-time-s T");
   Features features;
   Features stddev{NAN, NAN};
   double duration_s = o.duration_s;
@@ -57,11 +57,12 @@ void Run(const CurveOptions& o) {
     source = "model " + o.source.model_path + ", screw " + o.source.screw_path;
   } else {
     if (std::isnan(o.source.max_elongation_um) || std::isnan(o.source.settle_time_s))
-      throw InputError("curve: --max-elongation and --settle-time go together");
+      throw InputError("curve: --max-elongation-um and --settle-time-s go together");
     features = {o.source.max_elongation_um, o.source.settle_time_s};
     source = "given features";
   }
-  CheckPlanFeatures(features, by_features ? "--max-elongation/--settle-time" : "the prediction");
+  CheckPlanFeatures(features,
+                    by_features ? "--max-elongation-um/--settle-time-s" : "the prediction");
   const fit::ArctanCurve curve =
       fit::ArctanCurve::FromFeatures(features, o.source.shape_k, o.source.time_exponent);
   if (duration_s == 0) duration_s = 3.0 * curve.settle_time_s;
@@ -121,8 +122,8 @@ void RegisterCurve(CLI::App& app) {
       "  l(t) = L atan(k (t/t_s)^p)/atan(k) for t < t_s, L after   [l in um, t in s]\n"
       "from a model's prediction for a screw (--model M --screw S.json; L and t_s are the\n"
       "predicted max elongation and settle time) or from given features\n"
-      "(--max-elongation L --settle-time T). Writes CSV time_s,elongation_um (--out, atomically;\n"
-      "else CSV on stdout). A screw outside the training domain is an error unless\n"
+      "(--max-elongation-um L --settle-time-s T). Writes CSV time_s,elongation_um (--out,\n"
+      "atomically; else CSV on stdout). A screw outside the training domain is an error unless\n"
       "--allow-extrapolation.");
   AddCurveSourceOptions(sub, &o->source, false);
   sub->add_option("--duration-s", o->duration_s,

@@ -20,6 +20,7 @@ struct DatasetCliOptions {
   double window_s = sim::DatasetOptions{}.window_s;
   int threads = 2;
   bool no_disturbances = false;
+  bool json = false;
 };
 
 void Run(const DatasetCliOptions& o) {
@@ -47,6 +48,18 @@ void Run(const DatasetCliOptions& o) {
     Warn(std::to_string(unsettled) +
          " rows did not settle before the tail window; use a longer "
          "--window-s");
+  if (o.json) {
+    PrintJson({{"schema", "whirl.dataset"},
+               {"schema_version", 1},
+               {"rows", d.table.inputs.size()},
+               {"unsettled_rows", unsettled},
+               {"seed", o.seed},
+               {"window_s", o.window_s},
+               {"disturbances", !o.no_disturbances},
+               {"out", o.out_path},
+               {"curves_dir", o.curves_dir}});
+    return;
+  }
   std::cout << "wrote " << d.table.inputs.size() << " rows to " << o.out_path;
   if (!o.curves_dir.empty()) std::cout << " and their curves to " << o.curves_dir;
   std::cout << "\n";
@@ -76,6 +89,8 @@ void RegisterDataset(CLI::App& app) {
   sub->add_option("--threads", opts->threads, "worker threads")->check(NumberIn(1, 64));
   sub->add_flag("--no-disturbances", opts->no_disturbances,
                 "pure physics (no noise, no variation)");
+  sub->add_flag("--json", opts->json,
+                "machine output: JSON summary on stdout (rows, unsettled rows, files)");
   sub->callback([opts] { Run(*opts); });
 }
 

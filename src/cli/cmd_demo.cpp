@@ -31,11 +31,13 @@ struct DemoOptions {
   bool retrain = false;
   std::uint64_t seed = 1;
   bool no_plots = false;
+  bool json = false;  ///< a JSON summary on stdout; the step lines go to stderr
 };
 
 // 7. The workpiece plan and a machine drift model on a machine that drifts (cmd_machine.cpp).
-void RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model,
-                        std::uint64_t seed) {
+// Returns the summary of step 7 for --json.
+nlohmann::json RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model,
+                                  std::uint64_t seed, std::FILE* say) {
   machine_eval::MachineEvalOptions mo;
   mo.machines = 1;
   mo.screws_per_machine = 2;
@@ -49,17 +51,44 @@ void RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model
       compare::ReadIsoToleranceTable(
           ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv")),
       mo);
-  std::printf(
+  std::fprintf(
+      say,
       "7. both halves on a drifting machine (whirl machine evaluate): %s\n%s   report: %s\n"
       "   combined 840D programs (the drift action owns SD43900-43920; the plan hands its K0,\n"
       "   slope and reference over): %s/WHIRL_DRIFT_COMP.SPF, WHIRL_TEMP_COMP.SPF, resets\n",
       e.summary.message.c_str(), machine_eval::FormatMachineEvalTable(e, false).c_str(),
       e.report_index.c_str(), mo.report_dir.c_str());
+  return {{"summary", e.summary.message}, {"report", e.report_index}, {"dir", mo.report_dir}};
+}
+
+// The --json summary of one screw: prediction, plan files and each strategy's accumulated lead
+// error within 1000 mm [um].
+nlohmann::json DemoScrewJson(const compare::ScrewComparison& c, const std::filesystem::path& out,
+                             const std::vector<std::string>& files) {
+  nlohmann::json j = {{"name", c.screw.name},
+                      {"predicted_max_elongation_um", c.prediction.mean.max_elongation_um},
+                      {"predicted_max_elongation_std_um", c.prediction.stddev.max_elongation_um},
+                      {"predicted_settle_time_s", c.prediction.mean.settle_time_s},
+                      {"predicted_settle_time_std_s", c.prediction.stddev.settle_time_s},
+                      {"outside_domain", c.prediction.outside_domain},
+                      {"plan_segments", c.plan.segments.size()},
+                      {"files", nlohmann::json::array()},
+                      {"accumulated_1000_um", nlohmann::json::object()}};
+  for (const auto& f : files) j["files"].push_back((out / f).string());
+  for (compare::Strategy s : compare::kStrategies)
+    j["accumulated_1000_um"][compare::ToString(s)] = c.Outcome(s).metrics.accumulated_1000_um;
+  return j;
 }
 
 void RunDemo(const DemoOptions& o) {
   namespace fs = std::filesystem;
   const auto start = std::chrono::steady_clock::now();
+  std::FILE* say = o.json ? stderr : stdout;  // stdout holds only the JSON with --json
+  nlohmann::json summary = {{"schema", "whirl.demo"},
+                            {"schema_version", 1},
+                            {"out_dir", o.out_dir},
+                            {"seed", o.seed},
+                            {"screws", nlohmann::json::array()}};
   // The output directory's rule before anything runs; the plan files and the model are made in
   // its staging folder and committed together, the reports are output directories of their own.
   OutputDir files(o.out_dir, "--out-dir");
@@ -74,29 +103,30 @@ void RunDemo(const DemoOptions& o) {
   if (!o.retrain && fs::exists(model_path)) {
     model = nn::LoadModel(model_path);
     model_source = model_path;
-    std::printf("1. model: loaded %s (trained on %d samples of %s)\n", model_path.c_str(),
-                model.training_samples, model.training_data.c_str());
+    std::fprintf(say, "1. model: loaded %s (trained on %d samples of %s)\n", model_path.c_str(),
+                 model.training_samples, model.training_data.c_str());
   } else {
     if (!o.retrain) Warn(model_path + " not found: training a model from " + train_path);
     model = nn::TrainModel(history, nn::DefaultTrainingOptions(), train_path);
     model_source = "trained now from " + train_path;
     nn::SaveModel(stage / "model.json", model);
     files.AddStaged("model.json");
-    std::printf("1. model: trained on %zu rows of %s (%s), saved to %s\n", history.inputs.size(),
-                train_path.c_str(), model.training_summary.BriefReport().c_str(),
-                (out / "model.json").string().c_str());
+    std::fprintf(say, "1. model: trained on %zu rows of %s (%s), saved to %s\n",
+                 history.inputs.size(), train_path.c_str(),
+                 model.training_summary.BriefReport().c_str(),
+                 (out / "model.json").string().c_str());
   }
 
   const std::string ref_path = ProjectPath("datasets/screws/reference_80x10x6000.json");
   const sim::Screw reference = sim::ReadScrew(ref_path);  // a missing shipped file is an error
   const sim::Screw new_type = compare::NewTypeScrew(reference);
   const auto& n = new_type.process;
-  std::printf(
-      "2. screws: %s (shipped), and %s defined in code: reference blank with hardness "
-      "%.0f HRC, diameter %.0f mm, lead %.0f mm, raceway radius %.1f mm, cutting speed "
-      "%.0f m/min (not a training row)\n",
-      reference.name.c_str(), new_type.name.c_str(), n.hardness_hrc, n.diameter_mm, n.pitch_mm,
-      n.raceway_radius_mm, n.cutting_speed_m_min);
+  std::fprintf(say,
+               "2. screws: %s (shipped), and %s defined in code: reference blank with hardness "
+               "%.0f HRC, diameter %.0f mm, lead %.0f mm, raceway radius %.1f mm, cutting speed "
+               "%.0f m/min (not a training row)\n",
+               reference.name.c_str(), new_type.name.c_str(), n.hardness_hrc, n.diameter_mm,
+               n.pitch_mm, n.raceway_radius_mm, n.cutting_speed_m_min);
 
   const compare::ExperienceRule rule = compare::BuildExperienceRule(history);
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(
@@ -117,13 +147,13 @@ void RunDemo(const DemoOptions& o) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
     const std::string slug = compare::Slug(screw->name);
     const auto& p = c.prediction;
-    std::printf(
-        "3. %s: predicted max elongation %.1f +- %.1f um, settle time %.0f +- %.0f s%s; "
-        "arctan curve k = %.2f, p = %.3f\n",
-        screw->name.c_str(), p.mean.max_elongation_um, p.stddev.max_elongation_um,
-        p.mean.settle_time_s, p.stddev.settle_time_s,
-        p.outside_domain ? " (outside the training domain)" : "", c.predicted_curve.shape_k,
-        c.predicted_curve.time_exponent);
+    std::fprintf(say,
+                 "3. %s: predicted max elongation %.1f +- %.1f um, settle time %.0f +- %.0f s%s; "
+                 "arctan curve k = %.2f, p = %.3f\n",
+                 screw->name.c_str(), p.mean.max_elongation_um, p.stddev.max_elongation_um,
+                 p.mean.settle_time_s, p.stddev.settle_time_s,
+                 p.outside_domain ? " (outside the training domain)" : "",
+                 c.predicted_curve.shape_k, c.predicted_curve.time_exponent);
     const std::string provenance = "whirl demo, model " + model_source;
     const nlohmann::json plan_json =
         compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
@@ -137,11 +167,13 @@ void RunDemo(const DemoOptions& o) {
     // The report lives in report/, the files one level up.
     control.push_back(compare::PlanFilesLoad("../", program, names[1], names[0],
                                              ReadTextFile(stage / names[2]), &profile));
-    std::printf(
-        "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
-        "%s_plan.json/.csv and %s.SPF (reset: %s_RESET.SPF)\n",
-        screw->name.c_str(), c.plan.segments.size(), c.plan.max_abs_slope, c.plan.options.md32760,
-        (out / slug).string().c_str(), program.c_str(), program.c_str());
+    summary["screws"].push_back(DemoScrewJson(c, out, names));
+    std::fprintf(say,
+                 "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
+                 "%s_plan.json/.csv and %s.SPF (reset: %s_RESET.SPF)\n",
+                 screw->name.c_str(), c.plan.segments.size(), c.plan.max_abs_slope,
+                 c.plan.options.md32760, (out / slug).string().c_str(), program.c_str(),
+                 program.c_str());
     results.push_back(std::move(c));
   }
 
@@ -162,21 +194,23 @@ void RunDemo(const DemoOptions& o) {
   const compare::ReportResult report = compare::WriteReport(out / "report", results, ro);
   for (const auto& w : report.warnings) Warn(w);
 
-  std::printf("5. comparison (truth: simulator with seeded disturbances, seed %llu):\n",
-              static_cast<unsigned long long>(o.seed));
+  std::fprintf(say, "5. comparison (truth: simulator with seeded disturbances, seed %llu):\n",
+               static_cast<unsigned long long>(o.seed));
   for (const auto& c : results) {
-    std::printf("%s\n%s", c.screw.name.c_str(), compare::FormatComparisonTable(c).c_str());
+    std::fprintf(say, "%s\n%s", c.screw.name.c_str(), compare::FormatComparisonTable(c).c_str());
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("6. report: %s (%s)\n", report.index_html.string().c_str(),
-              report.plots_rendered ? "with plots" : "plots skipped");
-  RunDemoMachineStep(out, model, o.seed);  // both halves on a drifting machine
-  std::printf("summary:");
+  std::fprintf(say, "6. report: %s (%s)\n", report.index_html.string().c_str(),
+               report.plots_rendered ? "with plots" : "plots skipped");
+  summary["machine"] =
+      RunDemoMachineStep(out, model, o.seed, say);  // both halves on a drifting machine
+  std::fprintf(say, "summary:");
   for (const auto& c : results) {
     const auto um = [&c](compare::Strategy s) { return c.Outcome(s).metrics.accumulated_1000_um; };
     const auto& r = c.model_vs_traditional;
-    std::printf(
+    std::fprintf(
+        say,
         " %s: accumulated lead error within 1000 mm %.1f um (model), %.1f um (regression), "
         "%.1f um (traditional), %.1f um (ramp), %.1f um (none); model %.0f %% less than "
         "traditional;",
@@ -184,7 +218,12 @@ void RunDemo(const DemoOptions& o) {
         um(compare::Strategy::kTraditional), um(compare::Strategy::kRamp),
         um(compare::Strategy::kNone), r.accumulated_1000_pct ? *r.accumulated_1000_pct : 0.0);
   }
-  std::printf(" done in %.1f s\n", seconds);
+  std::fprintf(say, " done in %.1f s\n", seconds);
+  if (!o.json) return;
+  summary["model"] = model_source;
+  summary["report"] = report.index_html.string();
+  summary["plots_rendered"] = report.plots_rendered;
+  PrintJson(summary);
 }
 
 }  // namespace
@@ -214,6 +253,9 @@ void RegisterDemo(CLI::App& app) {
                 "5-fold CV noise)");
   AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");
+  sub->add_flag("--json", o->json,
+                "machine output: a JSON summary on stdout (predictions, plan files, accumulated "
+                "lead error per strategy [um], reports); the step lines go to stderr");
   sub->callback([o] { RunDemo(*o); });
 }
 

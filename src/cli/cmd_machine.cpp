@@ -58,7 +58,7 @@ machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
 }
 
 void RunSensors(const MachineCliOptions& o) {
-  CheckOutputs({{"--machine", o.machine_path}}, {}, {{"--out", o.out}});
+  CheckOutputs({{"--machine", o.machine_path}}, {}, {{"--out-dir", o.out}});
   const machine::MachineConfig config = LoadMachine(o);
   std::vector<drift::Run> runs;
   for (auto state : {drift::RunState::kIdle, drift::RunState::kCutting})
@@ -70,7 +70,7 @@ void RunSensors(const MachineCliOptions& o) {
           " (src/machine/machine.h; idle 180 min, cutting 150 min)",
       "offset_um = head + bed drift (SD43900 part); zscrew_per_1000_um = Z screw growth over "
       "1000 mm (SD43910 part)"};
-  const auto paths = drift::WriteRuns(o.out, runs, comments, "--out");
+  const auto paths = drift::WriteRuns(o.out, runs, comments, "--out-dir");
   if (o.json) {
     nlohmann::json files = nlohmann::json::array();
     for (std::size_t k = 0; k < paths.size(); ++k)
@@ -109,7 +109,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
                 {"--base-screw", o.base_screw},
                 {"--iso-table", o.iso_table},
                 {"--profile", o.profile}},
-               {}, {{"--report", o.report}});
+               {}, {{"--out-dir", o.report}});
   const nn::Model model = nn::LoadModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
@@ -181,8 +181,10 @@ void RegisterMachine(CLI::App& app) {
       "and cutting runs (150 min); sample step from the machine JSON [min]. Fit them with\n"
       "'whirl drift fit --runs DIR/cutting_*.csv --error offset_um'.");
   CommonOptions(s, o.get());
-  s->add_option("--out", o->out, std::string("output folder, all files or none: ") + kOutputDirRule)
-      ->required();
+  auto* out_dir = s->add_option("--out-dir", o->out,
+                                std::string("output folder, all files or none: ") + kOutputDirRule)
+                      ->required();
+  AddDeprecatedAlias(s, out_dir, "--out");
   AddSeedOption(s, &o->machine_seed, "seed of the machine (default 1)", "--machine-seed");
   s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")->check(NumberIn(0, 20));
   s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")->check(NumberIn(0, 20));
@@ -222,11 +224,13 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--monitor-every-min", o->monitor_every_min,
                 "both_monitor: check-bar interval of the monitor [min] (1..600, default 30)")
       ->check(NumberIn(1.0, 600.0));
-  e->add_option("--report", o->report,
-                "write the first screw's report here: sensor plot [degC over min], chosen "
-                "sensors, lead deviation per strategy [um over mm] and the screw's combined 840D "
-                "programs for --profile (" +
-                    std::string(kOutputDirRule) + ")");
+  auto* report = e->add_option(
+      "--out-dir", o->report,
+      "write the first screw's report into this directory: sensor plot [degC over min], chosen "
+      "sensors, lead deviation per strategy [um over mm] and the screw's combined 840D "
+      "programs for --profile (" +
+          std::string(kOutputDirRule) + ")");
+  AddDeprecatedAlias(e, report, "--report");
   e->add_option("--profile", o->profile,
                 "840D machine profile of the combined programs in the report (schema "
                 "whirl.machine with drift.slope and drift.workpiece_slope_param; default "

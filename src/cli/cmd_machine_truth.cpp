@@ -18,7 +18,30 @@ struct MachineTruthOptions {
   std::uint64_t seed = 1;
   int machines = 2, test_days = 2, past_days = 5;
   bool markdown = false;
+  bool json = false;
 };
+
+// --json: every test-day cut of every scenario, figures in um.
+nlohmann::json MachineTruthJson(const std::vector<machine::ScenarioMagnitudes>& rows) {
+  nlohmann::json scenarios = nlohmann::json::array();
+  for (const auto& row : rows) {
+    nlohmann::json cuts = nlohmann::json::array();
+    for (const auto& c : row.cuts)
+      cuts.push_back({{"machine", c.machine},
+                      {"day", c.day},
+                      {"job", c.job},
+                      {"start_type", machine::ToString(c.start_type)},
+                      {"head_thread_um", c.head_thread_um},
+                      {"z_thread_um", c.z_thread_um},
+                      {"total_thread_um", c.total_thread_um},
+                      {"head_1000_um", c.head_1000_um},
+                      {"z_1000_um", c.z_1000_um},
+                      {"total_1000_um", c.total_1000_um},
+                      {"hall_slope_k_per_h", c.hall_slope_k_per_h}});
+    scenarios.push_back({{"scenario", row.scenario}, {"cuts", cuts}});
+  }
+  return {{"schema", "whirl.machine_truth"}, {"schema_version", 1}, {"scenarios", scenarios}};
+}
 
 void RunMachineTruth(const MachineTruthOptions& o) {
   std::vector<machine::ScenarioMagnitudes> rows;
@@ -31,7 +54,10 @@ void RunMachineTruth(const MachineTruthOptions& o) {
     rows.push_back(machine::MeasureMagnitudes(machine::DefaultFieldMachine(), s, o.seed,
                                               o.machines, spec));
   }
-  std::fputs(machine::FormatMagnitudes(rows, o.markdown).c_str(), stdout);
+  if (o.json)
+    PrintJson(MachineTruthJson(rows));
+  else
+    std::fputs(machine::FormatMagnitudes(rows, o.markdown).c_str(), stdout);
 }
 
 }  // namespace
@@ -52,6 +78,7 @@ void RegisterMachineTruth(CLI::App* machine) {
   t->add_option("--past-days", o->past_days, "history production days (0..30, default 5)")
       ->check(NumberIn(0, 30));
   t->add_flag("--markdown", o->markdown, "print the table as Markdown");
+  t->add_flag("--json", o->json, "machine output: every cut's figures [um] as JSON on stdout");
   t->callback([o] { RunMachineTruth(*o); });
 }
 

@@ -66,6 +66,10 @@ void ApplyReservedFlags(const PlanCliOptions& o, interp::PlanOptions& p) {
                        "flag or change the profile");
     *value = given;
   }
+  if (o.sync_id_first > 0 && o.sync_id_last > 0 && o.sync_id_first > o.sync_id_last)
+    throw InputError("plan: --sync-id-first " + std::to_string(o.sync_id_first) +
+                     " is above --sync-id-last " + std::to_string(o.sync_id_last) +
+                     ": the range runs from the first ID to the last");
   if (!profile && (o.sync_id_first < 0) != (o.sync_id_last < 0))
     throw InputError(
         "plan: --sync-id-first and --sync-id-last go together (the range whirl's programs "
@@ -107,6 +111,14 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
                      "for where the thread starts on the machine");
   p.sign = o.sign.empty() ? interp::ExpectedSign(p.direction, p.control_dk)
                           : interp::ParseSignConvention(o.sign);
+  if (p.sign != interp::ExpectedSign(p.direction, p.control_dk))
+    throw InputError("plan: --sign " + o.sign + " contradicts direction " +
+                     std::to_string(p.direction) + " and control_dk '" +
+                     interp::ToString(p.control_dk) + "' (--direction, --control-dk or " +
+                     (o.machine_path.empty() ? "their defaults" : "the machine profile") +
+                     "): the growth points against the travel, so the sign must be '" +
+                     interp::ToString(interp::ExpectedSign(p.direction, p.control_dk)) +
+                     "' here; leave --sign out to have it derived");
   p.Validate();
   return p;
 }
@@ -122,7 +134,7 @@ void Run(const PlanCliOptions& o) {
   const bool by_features =
       !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
   if (by_features == !o.source.model_path.empty())
-    throw InputError("plan: give either --model M or --max-elongation L --settle-time T");
+    throw InputError("plan: give either --model M or --max-elongation-um L --settle-time-s T");
   const interp::PlanOptions options = ResolvePlanOptions(o);
   const sim::Screw screw = sim::ReadScrew(o.source.screw_path);
   const sim::Kinematics kin = sim::ComputeKinematics(screw);
@@ -138,11 +150,11 @@ void Run(const PlanCliOptions& o) {
     source = "model " + o.source.model_path + ", screw " + o.source.screw_path;
   } else {
     if (std::isnan(o.source.max_elongation_um) || std::isnan(o.source.settle_time_s))
-      throw InputError("plan: --max-elongation and --settle-time go together");
+      throw InputError("plan: --max-elongation-um and --settle-time-s go together");
     plan_source.features = {o.source.max_elongation_um, o.source.settle_time_s};
     source = "given features, screw " + o.source.screw_path;
   }
-  CheckPlanFeatures(plan_source.features, by_features ? "--max-elongation/--settle-time"
+  CheckPlanFeatures(plan_source.features, by_features ? "--max-elongation-um/--settle-time-s"
                                                       : "prediction of " + o.source.model_path);
   const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures(
       plan_source.features, o.source.shape_k, o.source.time_exponent);
@@ -187,8 +199,8 @@ void RegisterPlan(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "plan",
       "Plan SINUMERIK 840D temperature compensation of the thermal elongation for a screw:\n"
-      "predict (max elongation, settle time) with --model (or give --max-elongation and\n"
-      "--settle-time), build the arctan curve l(t) [um], choose the fewest breakpoints so the\n"
+      "predict (max elongation, settle time) with --model (or give --max-elongation-um and\n"
+      "--settle-time-s), build the arctan curve l(t) [um], choose the fewest breakpoints so the\n"
       "piecewise-linear compensation stays within --tolerance-um of the curve (dense while the\n"
       "curve moves, one flat segment on the plateau to the end of the thread), map time to axis\n"
       "position P(t) = machine offset + start + direction * feed * t [mm] with the screw's axial\n"
@@ -228,7 +240,8 @@ void RegisterPlan(CLI::App& app) {
                   "control_dk, MD32760, ID range, R parameters")
       ->check(CLI::ExistingFile);
   sub->add_option("--axis", o->axis,
-                  "axis name for $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (default Z)");
+                  "axis name for $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (default Z)")
+      ->check(AxisName());
   sub->add_option("--start-position-mm", o->start_position_mm,
                   "axis position at the thread start (time 0), program coordinates [mm]; "
                   "required unless the profile has it")
@@ -259,11 +272,13 @@ void RegisterPlan(CLI::App& app) {
                   "last synchronized-action ID whirl may use (1-255); the programs CANCEL the "
                   "whole range first, so it must be the range the machine builder reserved")
       ->check(NumberIn(1, 255));
-  sub->add_option("--save-r-first", o->save_r_first,
-                  "R<n>..R<n+3> keep the setting data found before the cut and a marker "
-                  "(0-9996); no default: from the profile, or required for --nc/--reset-nc "
-                  "without one; a value that contradicts the profile is refused")
-      ->check(NumberIn(0, 9996));
+  auto* save_r = sub->add_option("--save-r-first", o->save_r_first,
+                                 "R<n>..R<n+3> keep the setting data found before the cut and a "
+                                 "marker (0-9996); no default: from the profile, or required for "
+                                 "--nc/--reset-nc without one; a value that contradicts the "
+                                 "profile is refused")
+                     ->check(NumberIn(0, 9996));
+  AddDeprecatedAlias(sub, save_r, "--save-r");
   sub->add_option("--start-alarm", o->start_alarm,
                   "SETAL number raised when the program is called with the axis at or past the "
                   "thread start (user cycle alarms 65000-69999; default 65004 without a profile; "

@@ -36,8 +36,9 @@ void Run(const PredictOptions& o) {
   CheckOutputs({{"--model", o.model_path}, {"--input", o.input_path}}, {{"--out", o.out_path}});
   const std::array<double, ProcessInputs::kCount> single = {
       o.hardness_hrc, o.diameter_mm, o.pitch_mm, o.raceway_radius_mm, o.cutting_speed_m_min};
-  const std::array<const char*, ProcessInputs::kCount> flags = {
-      "--hardness", "--diameter", "--pitch", "--raceway-radius", "--cutting-speed"};
+  const std::array<const char*, ProcessInputs::kCount> flags = {"--hardness-hrc", "--diameter-mm",
+                                                                "--pitch-mm", "--raceway-radius-mm",
+                                                                "--cutting-speed-m-min"};
   std::string given, missing;
   for (int i = 0; i < ProcessInputs::kCount; ++i)
     (std::isnan(single[i]) ? missing : given) += std::string(" ") + flags[i];
@@ -51,8 +52,8 @@ void Run(const PredictOptions& o) {
   } else {
     if (!missing.empty())
       throw InputError(
-          "predict: give --input CSV or all five of --hardness --diameter --pitch "
-          "--raceway-radius --cutting-speed (missing:" +
+          "predict: give --input CSV or all five of --hardness-hrc --diameter-mm --pitch-mm "
+          "--raceway-radius-mm --cutting-speed-m-min (missing:" +
           missing + ")");
     table.source = "command line";
     table.inputs.push_back(ProcessInputs::FromArray(single));
@@ -186,20 +187,26 @@ void RegisterPredict(CLI::App& app) {
                     ->check(CLI::ExistingFile);
   // Ranges: the physical limits (core/limits.h); the message names the table column as well.
   auto* h =
-      sub->add_option("--hardness", o->hardness_hrc, "workpiece hardness [HRC], 20..70")
+      sub->add_option("--hardness-hrc", o->hardness_hrc, "workpiece hardness [HRC], 20..70")
           ->check(NumberIn(Range{kMinHardnessHrc, kMaxHardnessHrc, false, "HRC", "hardness_hrc"}));
-  auto* d = sub->add_option("--diameter", o->diameter_mm, "screw diameter [mm], (0, 500]")
+  auto* d = sub->add_option("--diameter-mm", o->diameter_mm, "screw diameter [mm], (0, 500]")
                 ->check(NumberIn(Range{0, kMaxDiameterMm, true, "mm", "diameter_mm"}));
-  auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm], (0, 100]")
+  auto* p = sub->add_option("--pitch-mm", o->pitch_mm, "lead (pitch) of the thread [mm], (0, 100]")
                 ->check(NumberIn(Range{0, kMaxPitchMm, true, "mm", "pitch_mm"}));
-  auto* r = sub->add_option("--raceway-radius", o->raceway_radius_mm,
+  auto* r = sub->add_option("--raceway-radius-mm", o->raceway_radius_mm,
                             "raceway (ball-groove) radius [mm], (0, 50]")
                 ->check(NumberIn(Range{0, kMaxRacewayRadiusMm, true, "mm", "raceway_radius_mm"}));
   auto* v =
-      sub->add_option("--cutting-speed", o->cutting_speed_m_min,
+      sub->add_option("--cutting-speed-m-min", o->cutting_speed_m_min,
                       "cutting speed of the whirling tools [m/min], (0, 1000]")
           ->check(NumberIn(Range{0, kMaxCuttingSpeedMMin, true, "m/min", "cutting_speed_m_min"}));
   for (auto* flag : {h, d, p, r, v}) input->excludes(flag);
+  for (auto [flag, old] : {std::pair{h, "--hardness"},
+                           {d, "--diameter"},
+                           {p, "--pitch"},
+                           {r, "--raceway-radius"},
+                           {v, "--cutting-speed"}})
+    AddDeprecatedAlias(sub, flag, old);
   sub->add_option("--out", o->out_path,
                   "write a CSV: the inputs, max_elongation_um, max_elongation_std_um,\n"
                   "settle_time_s, settle_time_std_s, outside_domain (0/1)");

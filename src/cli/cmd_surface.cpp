@@ -99,7 +99,7 @@ struct FitCli {
 };
 
 void RunFit(const FitCli& o, const std::string& command) {
-  CheckOutputs({{"--points", o.points}}, {{"--out", o.out}}, {{"--report", o.report}});
+  CheckOutputs({{"--points", o.points}}, {{"--out", o.out}}, {{"--out-dir", o.report}});
   const auto points = ReadSurfacePoints(o.points);
   SurfaceFit fit = FitSurface(points, {ParseMethod(o.method), o.degree});
   fit.provenance = {command + " --points " + o.points + " --method " + o.method + " --degree " +
@@ -158,11 +158,12 @@ void SetupFit(CLI::App& parent, const std::string& command) {
   sub->add_option("--degree", o->degree, "B-spline degree p in X and Y (1..5, default 3)")
       ->check(NumberIn(1, kMaxDegree));
   sub->add_option("--out", o->out, "surface JSON to write (schema whirl.surface)");
-  sub->add_option("--report", o->report,
-                  "directory for an HTML page: map of the surface with the measured points, "
-                  "cubic-vs-B-spline choice, 840D line per axis (" +
-                      std::string(kOutputDirRule) + ")");
-  sub->add_flag("--no-plots", o->no_plots, "with --report: skip gnuplot (page without the map)");
+  auto* report = sub->add_option("--out-dir", o->report,
+                                 "directory for an HTML page: map of the surface with the measured "
+                                 "points, cubic-vs-B-spline choice, 840D line per axis (" +
+                                     std::string(kOutputDirRule) + ")");
+  AddDeprecatedAlias(sub, report, "--report");
+  sub->add_flag("--no-plots", o->no_plots, "with --out-dir: skip gnuplot (page without the map)");
   sub->add_flag("--json", o->json, "machine output: the surface JSON on stdout");
   sub->callback([o, command] { RunFit(*o, command); });
 }
@@ -178,9 +179,9 @@ struct PredictCli {
 void RunPredict(const PredictCli& o) {
   const bool single = !std::isnan(o.x) || !std::isnan(o.y);
   if (single == !o.input.empty())
-    throw InputError("surface predict: give either --x X --y Y or --input XY.csv");
+    throw InputError("surface predict: give either --x-mm X --y-mm Y or --input XY.csv");
   if (single && (std::isnan(o.x) || std::isnan(o.y)))
-    throw InputError("surface predict: --x and --y go together");
+    throw InputError("surface predict: --x-mm and --y-mm go together");
   CheckOutputs({{"--surface", o.surface}, {"--input", o.input}}, {{"--out", o.out}});
   const Surface s = ReadSurfaceFile(o.surface);
   const auto xy =
@@ -214,8 +215,10 @@ void SetupPredict(CLI::App& parent) {
   sub->add_option("--surface", o->surface, "surface JSON from 'whirl surface fit'")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--x", o->x, "table X, mm")->check(FiniteNumber());
-  sub->add_option("--y", o->y, "table Y, mm")->check(FiniteNumber());
+  AddDeprecatedAlias(sub, sub->add_option("--x-mm", o->x, "table X, mm")->check(FiniteNumber("mm")),
+                     "--x");
+  AddDeprecatedAlias(sub, sub->add_option("--y-mm", o->y, "table Y, mm")->check(FiniteNumber("mm")),
+                     "--y");
   sub->add_option("--input", o->input, "CSV of positions x_mm,y_mm (at most 10000 rows)")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "CSV to write: x_mm,y_mm,error_um");
@@ -306,7 +309,8 @@ void SetupLine(CLI::App& parent) {
       ->check(CLI::IsMember({"x", "y"}));
   sub->add_option("--axis", o->line.axis,
                   "840D axis name for $SA_...[axis]: a letter, then letters, digits or '_' "
-                  "(default X)");
+                  "(default X)")
+      ->check(AxisName());
   sub->add_option("--at-mm", o->at_mm,
                   "one traverse at this fixed other coordinate, mm (default: the whole table)")
       ->check(FiniteNumber());

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
 #include "cli/terminal.h"
 #include "core/csv.h"
@@ -44,12 +45,15 @@ void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_require
                                 "thread length and settings that give the axial feed")
                     ->check(CLI::ExistingFile);
   if (screw_required) screw->required();
-  sub->add_option("--max-elongation", a->max_elongation_um,
-                  "instead of --model: plateau elongation L [um]")
-      ->check(NumberIn(Range{0, kMaxElongationUm, false, "um", "max_elongation_um"}));
-  sub->add_option("--settle-time", a->settle_time_s, "instead of --model: settle time t_s [s]")
-      ->check(NumberIn(Range{kMinPlanSettleTimeS, kMaxSettleTimeS, false, "s",
-                             "settle_time_s: at least 1 s, so the check grid stays bounded"}));
+  auto* max_elongation = sub->add_option("--max-elongation-um", a->max_elongation_um,
+                                         "instead of --model: plateau elongation L [um]")
+                             ->check(NumberIn(0, kMaxElongationUm, "um"));
+  AddDeprecatedAlias(sub, max_elongation, "--max-elongation");
+  auto* settle_time = sub->add_option("--settle-time-s", a->settle_time_s,
+                                      "instead of --model: settle time t_s [s]")
+                          ->check(NumberIn(Range{kMinPlanSettleTimeS, kMaxSettleTimeS, false, "s",
+                                                 "at least 1 s, so the check grid stays bounded"}));
+  AddDeprecatedAlias(sub, settle_time, "--settle-time");
   AddCurveShapeOptions(sub, &a->shape_k, &a->time_exponent);
   sub->add_flag("--allow-extrapolation", a->allow_extrapolation,
                 "use the prediction even if the screw lies outside the model's training domain");
@@ -119,6 +123,22 @@ CLI::Validator Md32760Number() {
       Range{0, interp::kMd32760Max, true, "", "MD32760 on the 840D must be in (0, 0.10]"});
 }
 
+CLI::Validator AxisName() {
+  const auto check = [](std::string& value) -> std::string {
+    try {
+      interp::CheckAxisName(value, "axis");
+      return "";
+    } catch (const InputError&) {
+      return "'" + value.substr(0, interp::kMaxAxisNameLength) +
+             (value.size() > interp::kMaxAxisNameLength ? "...'" : "'") +
+             " breaks the rule: an 840D axis name (a letter, then letters, digits or '_', at "
+             "most " +
+             std::to_string(interp::kMaxAxisNameLength) + " characters)";
+    }
+  };
+  return CLI::Validator(check, "AXIS");
+}
+
 void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
   sub->add_option("--tolerance-um", *tolerance_um,
                   "largest |840D chord - predicted curve| of the plan along the thread [um]; at "
@@ -127,13 +147,145 @@ void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
       ->check(NumberIn(kPlanToleranceRange));
 }
 
-int RunApp(CLI::App& app, int argc, char** argv) {
-  GuardTerminalOutput();  // user text in messages never reaches the terminal as a control
+CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::string& old_flag) {
+  const std::string now = current->get_name();
+  const auto forward = [current, old_flag, now](const std::vector<std::string>& values) {
+    if (current->count() > 0)
+      throw CLI::ValidationError(old_flag, "give " + now + " only (" + old_flag +
+                                               " is its deprecated spelling), not both");
+    std::fprintf(stderr, "whirl: %s is deprecated, use %s\n", old_flag.c_str(), now.c_str());
+    for (const auto& v : values) current->add_result(v);
+    try {
+      current->run_callback();  // current's checks and conversion, as if it had been typed
+    } catch (const CLI::ParseError& e) {  // "--new: 1e999 breaks the rule ..." under --old
+      std::string message = e.what();
+      if (message.rfind(now + ": ", 0) == 0) message.erase(0, now.size() + 2);
+      throw CLI::ValidationError(old_flag, message);
+    }
+  };
+  CLI::Option* alias = nullptr;
+  if (current->get_expected_max() == 0) {  // a flag
+    alias = sub->add_flag_callback(
+        old_flag, [forward, current, now] { forward({current->get_flag_value(now, "")}); });
+  } else {
+    alias = sub->add_option(old_flag,
+                            [forward](const CLI::results_t& r) {
+                              forward(r);
+                              return true;
+                            })
+                ->type_size(current->get_type_size_min(), current->get_type_size_max())
+                ->expected(current->get_expected_min(), current->get_expected_max());
+  }
+  return alias->group("");  // hidden from --help
+}
+
+std::string ClosestName(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+  for (const auto& c : candidates) {
+    // Levenshtein distance, one row at a time.
+    std::vector<std::size_t> row(c.size() + 1);
+    for (std::size_t j = 0; j <= c.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= word.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= c.size(); ++j) {
+        const std::size_t above = row[j];
+        row[j] =
+            std::min({row[j] + 1, row[j - 1] + 1, diagonal + (word[i - 1] == c[j - 1] ? 0 : 1)});
+        diagonal = above;
+      }
+    }
+    if (row[c.size()] < best_distance) best_distance = row[c.size()], best = c;
+  }
+  return best;
+}
+
+namespace {
+
+// "drift fit": a command's words below the program.
+std::string CommandPath(const CLI::App* app) {
+  std::string path;
+  for (; app != nullptr && app->get_parent() != nullptr; app = app->get_parent())
+    path = app->get_name() + (path.empty() ? "" : " " + path);
+  return path;
+}
+
+std::vector<std::string> SubcommandNames(const CLI::App* app) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app->get_subcommands([](const CLI::App*) { return true; }))
+    names.push_back(sub->get_name());
+  return names;
+}
+
+// The description's first sentence on one line (up to ". ", ": " or "; ").
+std::string FirstSentence(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::size_t end = text.size();
+  for (const char* stop : {". ", ": ", "; "}) end = std::min(end, text.find(stop));
+  text.resize(end);
+  if (!text.empty() && text.back() == '.') text.pop_back();
+  return text;
+}
+
+// Lists subcommands one line each: the summary, and a group's own subcommands.
+class OneLineFormatter : public CLI::Formatter {
+ public:
+  explicit OneLineFormatter(CommandSummaries summaries) : summaries_(std::move(summaries)) {}
+  std::string make_subcommand(const CLI::App* sub) const override {
+    const auto it = summaries_.find(CommandPath(sub));
+    std::string line = it != summaries_.end() ? it->second : FirstSentence(sub->get_description());
+    const std::vector<std::string> names = SubcommandNames(sub);
+    if (!names.empty()) line += " (" + JoinFields(names) + ")";
+    std::stringstream out;
+    CLI::detail::format_help(out, sub->get_display_name(true), line, column_width_);
+    return out.str();
+  }
+
+ private:
+  CommandSummaries summaries_;
+};
+
+void SetHelpRecursively(CLI::App* app, const std::shared_ptr<CLI::FormatterBase>& formatter) {
+  app->formatter(formatter);
   // Every --help says where the shipped files come from (and how to point at them).
-  if (app.get_footer().empty()) app.footer(kShippedFilesHelp);
-  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
-    if (sub->get_footer().empty()) sub->footer(kShippedFilesHelp);
+  if (app->get_footer().empty()) app->footer(kShippedFilesHelp);
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; }))
+    SetHelpRecursively(sub, formatter);
+}
+
+// The command words of argv must each name a command of the one before (options end the
+// walk): an unknown one is an error naming it and the closest command.
+void CheckCommandWords(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* current = &app;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    const std::vector<std::string> names = SubcommandNames(current);
+    if (word.empty() || word[0] == '-' || names.empty()) return;
+    if (!current->get_options([](const CLI::Option* o) { return o->get_positional(); }).empty())
+      return;  // the word may be a positional argument
+    const CLI::App* next = nullptr;
+    for (const CLI::App* sub : current->get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->check_name(word)) next = sub;
+    if (next == nullptr) {
+      const std::string prefix = current == &app ? "" : CommandPath(current) + " ";
+      throw CLI::ValidationError(
+          "unknown command '" + prefix + word + "'; did you mean '" + prefix +
+          ClosestName(word, names) + "'? The commands" +
+          (prefix.empty() ? "" : " of '" + prefix.substr(0, prefix.size() - 1) + "'") + ": " +
+          JoinFields(names));
+    }
+    current = next;
+  }
+}
+
+}  // namespace
+
+int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summaries) {
+  GuardTerminalOutput();  // user text in messages never reaches the terminal as a control
+  SetHelpRecursively(&app, std::make_shared<OneLineFormatter>(summaries));
   try {
+    CheckCommandWords(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -20,10 +21,29 @@ class Validator;
 
 namespace whirl::cli {
 
+/// One line per command in a --help listing, keyed by the command's words below the program
+/// ("plan", "drift fit"). A command without an entry shows its description's first sentence; a
+/// command with subcommands also lists their names on that line.
+using CommandSummaries = std::map<std::string, std::string>;
+
 /// Parses the command line and runs the chosen subcommand's callback. Exit code: 0 on success
 /// (and for --help/--version), 1 on a parse error or bad input ("error: <message>" on stderr),
-/// CommandFailure::exit_code when a check ran and failed. Shared by whirl and whirl-torch.
-int RunApp(CLI::App& app, int argc, char** argv);
+/// CommandFailure::exit_code when a check ran and failed. A word where a command is expected
+/// that names none is an error naming it and the closest command ("unknown command 'fitt';
+/// did you mean 'fit'?"). Every --help lists subcommands one line each (`summaries`). Shared
+/// by whirl and whirl-torch.
+int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summaries = {});
+
+/// "fit": the name in `candidates` closest to `word` by edit distance (Levenshtein: insertions,
+/// deletions and substitutions count 1; ties go to the earlier candidate). "" if none.
+std::string ClosestName(const std::string& word, const std::vector<std::string>& candidates);
+
+/// An old spelling of the flag `current` kept working for scripts: hidden from --help, it hands
+/// its value (or, for a flag, its presence) to `current` as if `current` had been typed, so
+/// `current`'s checks, defaults and relations (excludes, required) apply, and it prints one line
+/// "whirl: --old is deprecated, use --new" on stderr. Giving both is a parse error; a value the
+/// check refuses is reported under the spelling typed. Returns the hidden option.
+CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::string& old_flag);
 
 /// A command that ran but whose result is a failure (e.g. a cross-check that disagrees):
 /// main prints the message and exits with `exit_code` (never 0).
@@ -47,8 +67,9 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
 void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent);
 
 /// Where the arctangent curve of `curve` and `plan` comes from: a model's prediction for a screw
-/// (--model M --screw S.json) or given features (--max-elongation L --settle-time T), its shape,
-/// and whether a screw outside the model's training domain may be used (GuardTrainingDomain).
+/// (--model M --screw S.json) or given features (--max-elongation-um L --settle-time-s T), its
+/// shape, and whether a screw outside the model's training domain may be used
+/// (GuardTrainingDomain).
 struct CurveSourceArgs {
   std::string model_path, screw_path;
   double max_elongation_um = NAN;  ///< um; NAN: not given
@@ -58,8 +79,9 @@ struct CurveSourceArgs {
   bool allow_extrapolation = false;
 };
 
-/// --model, --screw (required when `screw_required`), --max-elongation, --settle-time, the shape
-/// options (AddCurveShapeOptions) and --allow-extrapolation.
+/// --model, --screw (required when `screw_required`), --max-elongation-um, --settle-time-s (old
+/// spellings --max-elongation, --settle-time), the shape options (AddCurveShapeOptions) and
+/// --allow-extrapolation.
 void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_required);
 
 /// A --seed option (or `flag`): a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5"
@@ -86,6 +108,10 @@ CLI::Validator FiniteNumber(const char* unit = "");
 
 /// NumberIn over (0, interp::kMd32760Max]: the MD32760 factor of every --md32760 flag.
 CLI::Validator Md32760Number();
+
+/// The check of every --axis flag (interp::CheckAxisName): "--axis: '1X' breaks the rule: an
+/// 840D axis name (a letter, then letters, digits or '_', at most 32 characters)".
+CLI::Validator AxisName();
 
 /// --tolerance-um, shared by plan, compare and evaluate: the largest |840D chord - predicted
 /// curve| of a plan [um], in kPlanToleranceRange (core/limits.h) (checked again by

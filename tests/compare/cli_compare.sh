@@ -6,7 +6,7 @@ whirl="$1"; scratch="$2"; src="$3"
 rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
 model="$src/models/default.json"; screw="$src/datasets/screws/reference_80x10x6000.json"
 if [[ ! -f "$model" || ! -f "$screw" ]]; then echo "shipped model or screw missing"; exit 1; fi
-"$whirl" compare --model "$model" --screw "$screw" --seed 2 --json --report rep > cmp.json
+"$whirl" compare --model "$model" --screw "$screw" --seed 2 --json --out-dir rep > cmp.json
 python3 - <<'PY'
 import json
 j = json.load(open("cmp.json"))

@@ -11,7 +11,7 @@ grep -q "elongation_um" "$D/help.txt" || fail "fit --help does not explain the c
 grep -q "\[um\]" "$D/curve_help.txt" || fail "curve --help has no units"
 
 # A curve from given features, then its fit: the arctan model recovers L, t_s, k and p.
-"$W" curve --max-elongation 30 --settle-time 250 --shape-k 4 --time-exponent 0.8 --duration-s 900 \
+"$W" curve --max-elongation-um 30 --settle-time-s 250 --shape-k 4 --time-exponent 0.8 --duration-s 900 \
   --out "$D/c.csv" \
   || fail "curve --out"
 head -1 "$D/c.csv" | grep -q "^#" || fail "curve CSV has no provenance comment"
@@ -26,7 +26,7 @@ awk -v k="$k" 'BEGIN { exit !(k > 3.96 && k < 4.04) }' || fail "fitted k = $k, e
 p=$(tr -d ' \n' < "$D/fit.json" | grep -o '"time_exponent":[0-9.e+-]*' | head -1 | cut -d: -f2)
 awk -v p="$p" 'BEGIN { exit !(p > 0.79 && p < 0.81) }' || fail "fitted p = $p, expected 0.8"
 grep -q "p = 0.8" "$D/c.csv" || fail "curve CSV comment does not give p"
-expect_fail "time-exponent" "$W" curve --max-elongation 3 --settle-time 100 --time-exponent 1.2
+expect_fail "time-exponent" "$W" curve --max-elongation-um 3 --settle-time-s 100 --time-exponent 1.2
 
 # Bad curves: a gap, non-increasing time, a missing file.
 printf 'time_s,elongation_um\n0,0\n1,1\n2,2\n3,3\n4,4\n5,5\n100,6\n' > "$D/gap.csv"
@@ -36,6 +36,6 @@ expect_fail "increas" "$W" fit --curve "$D/dup.csv"
 expect_fail "none.csv" "$W" fit --curve "$D/none.csv"
 expect_fail "--curve" "$W" fit
 # curve: negative elongation and half-given features are rejected.
-expect_fail "--max-elongation" "$W" curve --max-elongation -3 --settle-time 100
-expect_fail "together" "$W" curve --max-elongation 3
+expect_fail "--max-elongation-um" "$W" curve --max-elongation-um -3 --settle-time-s 100
+expect_fail "together" "$W" curve --max-elongation-um 3
 echo "ok"

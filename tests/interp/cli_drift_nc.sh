@@ -63,11 +63,11 @@ for edit in 's/"workpiece_k0_param": 99/"workpiece_k0_param": 101/;workpiece_k0_
   sed "${edit%;*}" "$M" > "$D/edited.json"
   expect_fail "${edit##*;}" "$W" drift nc --model "$D/model.json" --machine "$D/edited.json"
   grep -q "edited.json" "$D/err.txt" || fail "message does not name the profile"
-  expect_fail "${edit##*;}" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+  expect_fail "${edit##*;}" "$W" plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 \
     --machine "$D/edited.json"
 done
 # The plan combined with it: K0 into $AC_PARAM[99], an alarm if the drift action is not active.
-"$W" plan --screw "$S" --max-elongation 30 --settle-time 250 --machine "$M" --with-drift-action \
+"$W" plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 --machine "$M" --with-drift-action \
   --nc "$D/plan.spf" > /dev/null || fail "plan --with-drift-action"
 grep -q 'DO \$AC_PARAM\[99\]=' "$D/plan.spf" || fail "combined plan must write K0 into AC_PARAM[99]"
 grep -v '^;' "$D/plan.spf" | grep -q 'SA_TEMP_COMP_ABS_VALUE' && fail "combined plan writes SD43900"
@@ -81,6 +81,6 @@ expect_jumps_to_end "$D/drift.spf"
 python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); del j["drift"]; json.dump(j, open(sys.argv[2], "w"))' \
   "$M" "$D/machine_nodrift.json" || fail "could not write the profile without its drift object"
 grep -q '"drift"' "$D/machine_nodrift.json" && fail "the edited profile still has a drift object"
-expect_fail "needs a 'drift' object" "$W" plan --screw "$S" --max-elongation 30 --settle-time 250 \
+expect_fail "needs a 'drift' object" "$W" plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 \
   --machine "$D/machine_nodrift.json" --with-drift-action
 echo "ok"

@@ -11,7 +11,7 @@ source "$S/tests/support/cli_common.sh"
 "$W" machine --help > "$D/help.txt" || fail "machine --help"
 "$W" machine evaluate --help > "$D/evaluate_help.txt" || fail "machine evaluate --help"
 grep -q "\[um\]" "$D/evaluate_help.txt" || fail "evaluate --help names no unit"
-"$W" machine sensors --out "$D/runs" --idle 1 --cutting 2 > "$D/sensors.txt" || fail "sensors"
+"$W" machine sensors --out-dir "$D/runs" --idle 1 --cutting 2 > "$D/sensors.txt" || fail "sensors"
 [ -f "$D/runs/idle_1.csv" ] && [ -f "$D/runs/cutting_2.csv" ] || fail "run files missing"
 n=$(grep -v '^#' "$D/runs/cutting_1.csv" | head -n 1 | tr ',' '\n' | grep -c '_C$')
 [ "$n" -ge 10 ] && [ "$n" -le 16 ] || fail "expected 10-16 sensors, got $n"
@@ -36,9 +36,9 @@ PY
 
 # Bad input: a typo in the machine file, a missing named file; nothing written.
 sed 's/"motor_tau_min"/"motor_tau_mn"/' "$S/datasets/machines/whirling_thermal.json" > "$D/bad.json"
-expect_fail "motor_tau_mn" "$W" machine sensors --machine "$D/bad.json" --out "$D/none"
+expect_fail "motor_tau_mn" "$W" machine sensors --machine "$D/bad.json" --out-dir "$D/none"
 [ ! -e "$D/none" ] || fail "files written on bad input"
-expect_fail "missing.json" "$W" machine sensors --machine "$D/missing.json" --out "$D/none"
+expect_fail "missing.json" "$W" machine sensors --machine "$D/missing.json" --out-dir "$D/none"
 
 # Combined 840D programs with the existing combined mode: the plan writes its K0 into
 # $AC_PARAM, the machine drift action (the offset model) is the single writer of SD43900.
@@ -77,7 +77,7 @@ expect_fail "drift.slope" "$W" drift nc --model "$D/offset.json" --slope-model "
   --machine "$P" "${inputs[@]}" --nc "$D/none.SPF"
 [ ! -e "$D/none.SPF" ] || fail "program written on bad input"
 # The report holds the combined programs of its screw.
-"$W" machine evaluate --machines 1 --screws 1 --report "$D/report" > /dev/null 2>&1 || fail "evaluate --report"
+"$W" machine evaluate --machines 1 --screws 1 --out-dir "$D/report" > /dev/null 2>&1 || fail "evaluate --out-dir"
 for f in WHIRL_TEMP_COMP.SPF WHIRL_DRIFT_COMP.SPF WHIRL_DRIFT_COMP_RESET.SPF index.html; do
   [ -f "$D/report/$f" ] || fail "report lacks $f"
 done

@@ -74,8 +74,8 @@ expect 1 "hidden-sweep" -- "$whirl" train --data "$data" --hidden-sweep 5..2
 expect 1 "--out" -- "$whirl" train --data "$data"
 
 # predict one process (flags), a table, JSON, CSV output
-expect 0 "" -- "$whirl" predict --model m1.json --hardness 62 --diameter 80 --pitch 10 \
-  --raceway-radius 5 --cutting-speed 180
+expect 0 "" -- "$whirl" predict --model m1.json --hardness-hrc 62 --diameter-mm 80 --pitch-mm 10 \
+  --raceway-radius-mm 5 --cutting-speed-m-min 180
 grep -q "+-" out.txt || fail "predict table lacks +- std"
 grep -q "max elongation \[um\]" out.txt || fail "predict table lacks units"
 expect 0 "" -- "$whirl" predict --model m1.json --input "$src/datasets/whirling_validation.csv" \
@@ -86,8 +86,8 @@ head -n 5 pred.csv | grep -q "^hardness_hrc,diameter_mm,pitch_mm,raceway_radius_
   || fail "predict --out row count"
 grep -q "mean absolute error" out.txt || fail "targets in --input not used for an error report"
 # outside the domain: warning + JSON flag, still exit 0
-expect 0 "outside the training domain" -- "$whirl" predict --model m1.json --hardness 62 \
-  --diameter 300 --pitch 10 --raceway-radius 5 --cutting-speed 180 --json
+expect 0 "outside the training domain" -- "$whirl" predict --model m1.json --hardness-hrc 62 \
+  --diameter-mm 300 --pitch-mm 10 --raceway-radius-mm 5 --cutting-speed-m-min 180 --json
 grep -q '"outside_domain": true' out.txt || fail "JSON lacks outside_domain flag"
 grep -q '"diameter_mm"' out.txt || fail "JSON lacks the outside field name"
 grep -q '"max_elongation_std_um"' out.txt || fail "JSON lacks std"
@@ -151,8 +151,8 @@ grep -q "network 5-2 (no hidden layer, linear; N = 12" out.txt || fail "linear t
 tr -d ' \n' < linear.json | grep -q '"layer_sizes":\[5,2\]' || fail "linear model file: not 5-2"
 expect 0 "" -- "$whirl" train --data "$data" --out forced_linear.json --hidden 0 --restarts 2
 grep -q "network 5-2 (no hidden layer, linear; N = 12" out.txt || fail "--hidden 0: $(head -1 out.txt)"
-expect 0 "" -- "$whirl" predict --model linear.json --hardness 50 --diameter 40 --pitch 10 \
-  --raceway-radius 4 --cutting-speed 200 --json
+expect 0 "" -- "$whirl" predict --model linear.json --hardness-hrc 50 --diameter-mm 40 --pitch-mm 10 \
+  --raceway-radius-mm 4 --cutting-speed-m-min 200 --json
 grep -Eq '"max_elongation_um": 1(89\.[5-9]|90\.[0-4])' out.txt || fail "linear model: $(cat out.txt)"
 
 # bad training tables: exit 1, message names file, line and column
@@ -179,18 +179,18 @@ expect 1 "integer in [0, 200]" -- "$whirl" train --data "$data" --out bad.json -
 [ ! -e bad.json ] || fail "a failed train left bad.json behind"
 
 # bad predict input
-expect 1 "missing: --pitch --raceway-radius --cutting-speed" -- "$whirl" predict --model m1.json \
-  --hardness 62 --diameter 80
-expect 1 "" -- "$whirl" predict --model m1.json --input "$src/datasets/whirling_validation.csv" --hardness 62
+expect 1 "missing: --pitch-mm --raceway-radius-mm --cutting-speed-m-min" -- "$whirl" predict --model m1.json \
+  --hardness-hrc 62 --diameter-mm 80
+expect 1 "" -- "$whirl" predict --model m1.json --input "$src/datasets/whirling_validation.csv" --hardness-hrc 62
 expect 1 "nan.csv:3" -- "$whirl" predict --model m1.json --input nan.csv
 head -c 3000 m1.json > trunc.json
-expect 1 "trunc.json" -- "$whirl" predict --model trunc.json --hardness 62 --diameter 80 \
-  --pitch 10 --raceway-radius 5 --cutting-speed 180
+expect 1 "trunc.json" -- "$whirl" predict --model trunc.json --hardness-hrc 62 --diameter-mm 80 \
+  --pitch-mm 10 --raceway-radius-mm 5 --cutting-speed-m-min 180
 sed 's/"schema_version": 2/"schema_version": 7/' m1.json > v7.json
-expect 1 "schema_version" -- "$whirl" predict --model v7.json --hardness 62 --diameter 80 \
-  --pitch 10 --raceway-radius 5 --cutting-speed 180
-expect 1 "" -- "$whirl" predict --model m1.json --hardness 62 --diameter -80 --pitch 10 \
-  --raceway-radius 5 --cutting-speed 180
+expect 1 "schema_version" -- "$whirl" predict --model v7.json --hardness-hrc 62 --diameter-mm 80 \
+  --pitch-mm 10 --raceway-radius-mm 5 --cutting-speed-m-min 180
+expect 1 "" -- "$whirl" predict --model m1.json --hardness-hrc 62 --diameter-mm -80 --pitch-mm 10 \
+  --raceway-radius-mm 5 --cutting-speed-m-min 180
 
 if [ "$fails" -ne 0 ]; then echo "$fails failure(s)" >&2; exit 1; fi
 echo "ok: whirl train/predict smoke test"

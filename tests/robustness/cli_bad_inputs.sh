@@ -36,17 +36,17 @@ expect_fail "missing.json" t "$W" evaluate --base-screw missing.json --random 1 
 [ -f "$M" ] || fail "models/default.json not shipped"
 tr -d '\n' < "$M" | sed -E 's/"layer_sizes": *\[[^]]*\]/"layer_sizes": [5, 2000000000, 2]/' > big_layer.json
 grep -q '"layer_sizes": \[5, 2000000000, 2\]' big_layer.json || fail "could not make big_layer.json"
-expect_fail "layer_sizes\[1\]" t "$W" predict --model big_layer.json --hardness 62 --diameter 80 \
-  --pitch 10 --raceway-radius 3.7 --cutting-speed 180
+expect_fail "layer_sizes\[1\]" t "$W" predict --model big_layer.json --hardness-hrc 62 --diameter-mm 80 \
+  --pitch-mm 10 --raceway-radius-mm 3.7 --cutting-speed-m-min 180
 tr -d '\n' < "$M" | sed -E 's/"epochs": *[0-9]+,/"epochs": 1e30,/' > epochs.json
 grep -q '"epochs": 1e30' epochs.json || fail "could not make epochs.json"
-expect_fail "epochs" t "$W" predict --model epochs.json --hardness 62 --diameter 80 \
-  --pitch 10 --raceway-radius 3.7 --cutting-speed 180
+expect_fail "epochs" t "$W" predict --model epochs.json --hardness-hrc 62 --diameter-mm 80 \
+  --pitch-mm 10 --raceway-radius-mm 3.7 --cutting-speed-m-min 180
 tr -d '\n' < "$M" | sed -E 's/"epochs": *[0-9]+,/"epochs": 1e999,/' > huge.json
 grep -q '"epochs": 1e999' huge.json || fail "could not make huge.json"
-expect_fail "huge.json.*double range" t "$W" predict --model huge.json --hardness 62 \
-  --diameter 80 --pitch 10 --raceway-radius 3.7 --cutting-speed 180
-# Process tables with an impossible diameter; predict --diameter 0 likewise.
+expect_fail "huge.json.*double range" t "$W" predict --model huge.json --hardness-hrc 62 \
+  --diameter-mm 80 --pitch-mm 10 --raceway-radius-mm 3.7 --cutting-speed-m-min 180
+# Process tables with an impossible diameter; predict --diameter-mm 0 likewise.
 for bad in -80 0 1e308; do
   awk -F, -v OFS=, -v bad="$bad" '/^#/ {print; next} !h {h=1; print; next} !r {r=1; $2=bad} {print}' \
     "$T" > "table_$bad.csv"
@@ -54,8 +54,8 @@ for bad in -80 0 1e308; do
     --out m.json --epochs 5
 done
 [ -e m.json ] && fail "a failed train wrote m.json"
-expect_fail "diameter_mm" t "$W" predict --hardness 62 --diameter 0 --pitch 10 --raceway-radius 3.7 \
-  --cutting-speed 180
+expect_fail "diameter_mm" t "$W" predict --hardness-hrc 62 --diameter-mm 0 --pitch-mm 10 --raceway-radius-mm 3.7 \
+  --cutting-speed-m-min 180
 # lead-report: positions near 1e308, positions closer than 1 nm (subnormal steps).
 printf 'position_mm,deviation_um\n0,0\n1e307,1\n1.7e308,2\n' > lead_big.csv
 expect_fail "position" t "$W" lead-report --lead lead_big.csv
@@ -79,31 +79,31 @@ walk(json.load(open(sys.argv[1]), parse_constant=lambda c: float(c)), [])
 PY
 
 # plan and curve: absurd features and tolerances are refused at once (no long grid search).
-expect_fail "1 nm" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --tolerance-um 1e-300
-expect_fail "max_elongation_um" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 1e300 --settle-time 250
-expect_fail "at least 1 s" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 1e-300
-expect_fail "settle_time_s" t "$W" curve --max-elongation 30 --settle-time 1e300
-expect_fail "32 characters" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
+expect_fail "1 nm" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 --tolerance-um 1e-300
+expect_fail "--max-elongation-um: 1e300" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 1e300 --settle-time-s 250
+expect_fail "at least 1 s" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 1e-300
+expect_fail "--settle-time-s: 1e300" t "$W" curve --max-elongation-um 30 --settle-time-s 1e300
+expect_fail "32 characters" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 \
   --axis "$(printf 'X%.0s' $(seq 1 40))"
 
 # plan: one unwritable output leaves the others unwritten (and previous files intact).
 echo previous > keep.json
 mkdir adir
-expect_fail "adir.*directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
+expect_fail "adir.*directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 \
   --out keep.json --csv new.csv --nc adir --sync-id-first 100 --sync-id-last 149
 [ "$(cat keep.json)" = previous ] || fail "plan replaced keep.json although --nc failed"
 [ -e new.csv ] && fail "plan wrote new.csv although --nc failed"
-expect_fail "nodir" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 \
+expect_fail "nodir" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 \
   --out keep.json --nc nodir/XY.mpf --sync-id-first 100 --sync-id-last 149
 [ "$(cat keep.json)" = previous ] || fail "plan replaced keep.json although --nc failed"
 # The atomic writer respects what sits at the path: a symlink, a FIFO, a directory.
 ln -s keep.json link.json
-expect_fail "symbolic link" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --out link.json
+expect_fail "symbolic link" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 --out link.json
 [ -L link.json ] || fail "the symlink was replaced"
 mkfifo pipe
-expect_fail "FIFO" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --out pipe
+expect_fail "FIFO" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 --out pipe
 [ -p pipe ] || fail "the FIFO was replaced"
-expect_fail "is a directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation 30 --settle-time 250 --out adir
+expect_fail "is a directory" t "$W" plan --screw "$S" --start-position-mm 0 --machine-offset-mm 0 --max-elongation-um 30 --settle-time-s 250 --out adir
 grep -q "Success" err.txt && fail "message says Success: $(cat err.txt)"
 # Reading a FIFO would block: refused.
 expect_fail "FIFO" t "$W" simulate --screw pipe

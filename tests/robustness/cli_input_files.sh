@@ -27,35 +27,35 @@ json_set cubic.json version.json "j['schema_version'] = 1.5"
 json_set bspline.json weight.json "j['bspline']['weights_um'][1][2] = -1e300"
 expect_fail "centre.json.*cubic.x_center_mm = 1e+308.*\[-100000, 100000\] mm" "$W" surface line --surface centre.json
 expect_fail "bound.json.*bounds.x_max_mm = 1e+308" "$W" surface line --surface bound.json
-expect_fail "centre.json.*cubic.x_center_mm" "$W" surface predict --surface centre.json --x 1 --y 1
-expect_fail "coeff.json.*cubic.b_um\[3\] = 1e+300" "$W" surface predict --surface coeff.json --x 1 --y 1
-expect_fail "version.json.*schema_version" "$W" surface predict --surface version.json --x 1 --y 1
-expect_fail "weight.json.*bspline.weights_um\[1\]\[2\]" "$W" surface predict --surface weight.json --x 1 --y 1
+expect_fail "centre.json.*cubic.x_center_mm" "$W" surface predict --surface centre.json --x-mm 1 --y-mm 1
+expect_fail "coeff.json.*cubic.b_um\[3\] = 1e+300" "$W" surface predict --surface coeff.json --x-mm 1 --y-mm 1
+expect_fail "version.json.*schema_version" "$W" surface predict --surface version.json --x-mm 1 --y-mm 1
+expect_fail "weight.json.*bspline.weights_um\[1\]\[2\]" "$W" surface predict --surface weight.json --x-mm 1 --y-mm 1
 # --axis is an 840D axis name, as in 'plan'.
 for axis in 1 _ "X Y" ""; do
-  expect_fail "axis = '$axis': must be an axis name" "$W" surface line --surface cubic.json --axis "$axis"
+  expect_fail "--axis: '$axis' breaks the rule: an 840D axis name" "$W" surface line --surface cubic.json --axis "$axis"
 done
 "$W" surface line --surface cubic.json --axis Z1 > /dev/null || fail "axis Z1 refused"
 # Flags that stand for numbers are finite numbers.
 expect_fail "at-mm.*finite" "$W" surface line --surface cubic.json --at-mm nan
-expect_fail "\-\-x.*finite" "$W" surface predict --surface cubic.json --x nan --y 1
+expect_fail "\-\-x.*finite" "$W" surface predict --surface cubic.json --x-mm nan --y-mm 1
 # synth writes only what fit reads (at most 10000 points).
 expect_fail "nx \* ny = 40000.*10000" "$W" surface synth --nx 200 --ny 200 --out big.csv
 [ -e big.csv ] && fail "synth wrote a points file that fit refuses"
 
 # --- Machine thermal files: schema required, every field in its physical range ---------------
 echo '{}' > empty.json
-expect_fail "empty.json.*'schema' must be" "$W" machine sensors --machine empty.json --out m_out
+expect_fail "empty.json.*'schema' must be" "$W" machine sensors --machine empty.json --out-dir m_out
 for v in 99 '"1"' 1.5; do
   sed "s/\"schema_version\": 1,/\"schema_version\": $v,/" "$MACHINE" > "version_$v.json"
-  expect_fail "version_$v.json.*schema_version" "$W" machine sensors --machine "version_$v.json" --out m_out
+  expect_fail "version_$v.json.*schema_version" "$W" machine sensors --machine "version_$v.json" --out-dir m_out
 done
 json_set "$MACHINE" spread.json "j['machine_spread'] = 1e308"
-expect_fail "spread.json.*machine_spread = 1e+308.*\[0, 1\]" "$W" machine sensors --machine spread.json --out m_out
+expect_fail "spread.json.*machine_spread = 1e+308.*\[0, 1\]" "$W" machine sensors --machine spread.json --out-dir m_out
 json_set "$MACHINE" tau.json "j['sensors'][2]['tau_min'] = 1e308"
 expect_fail "tau.json.*sensor 'bed_middle' tau_min = 1e+308" "$W" machine evaluate --machine tau.json --machines 1 --screws 1
 json_set "$MACHINE" sign.json "j['head']['sign'] = 0.5"
-expect_fail "sign.json.*'sign'" "$W" machine sensors --machine sign.json --out m_out
+expect_fail "sign.json.*'sign'" "$W" machine sensors --machine sign.json --out-dir m_out
 [ -e m_out ] && fail "machine wrote files from a bad machine file"
 
 # --- Drift model files: residual_std_um of +-1e308 gave std inf and a threshold of inf ---------
@@ -81,7 +81,7 @@ json_set "$S" margin.json "j.setdefault('process', {})['tool_circle_margin_mm'] 
 expect_fail "margin.json.*process.tool_circle_margin_mm = 1e+308.*(0, 100\] mm" "$W" simulate --screw margin.json --duration-s 10
 json_set "$S" offset.json "j.setdefault('process', {})['thread_start_offset_mm'] = 1e308"
 expect_fail "offset.json.*process.thread_start_offset_mm = 1e+308" "$W" simulate --screw offset.json --duration-s 10
-PLAN=(plan --screw "$S" --max-elongation 30 --settle-time 250 --nc P.SPF)
+PLAN=(plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 --nc P.SPF)
 expect_fail "machine-offset-mm.*1e308" "$W" "${PLAN[@]}" --start-position-mm 0 --machine-offset-mm 1e308
 expect_fail "start-position-mm.*1e308" "$W" "${PLAN[@]}" --start-position-mm 1e308 --machine-offset-mm 0
 json_set "$PROFILE" profile.json "j['machine_offset_mm'] = 1e308"

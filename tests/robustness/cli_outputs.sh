@@ -51,17 +51,17 @@ t "$W" drift split --log two.csv --out-dir split > /dev/null || fail "split afte
 [ "$(ls split)" = "$(printf 'two_1.csv\ntwo_2.csv')" ] || fail "split kept old runs: $(ls split)"
 
 # machine sensors: the same writer.
-t "$W" machine sensors --out msens --idle 1 --cutting 1 > /dev/null || fail "machine sensors"
+t "$W" machine sensors --out-dir msens --idle 1 --cutting 1 > /dev/null || fail "machine sensors"
 cp msens/idle_1.csv keep_idle.csv
 rm msens/cutting_1.csv; mkdir msens/cutting_1.csv
-expect_fail "cutting_1.csv" t "$W" machine sensors --out msens --idle 1 --cutting 1 --machine-seed 2
+expect_fail "cutting_1.csv" t "$W" machine sensors --out-dir msens --idle 1 --cutting 1 --machine-seed 2
 grep -q "filesystem error" err.txt && fail "sensors: raw filesystem error: $(cat err.txt)"
 cmp -s msens/idle_1.csv keep_idle.csv || fail "sensors: idle_1.csv replaced although cutting_1 failed"
 rmdir msens/cutting_1.csv; ln -s ../victim.txt msens/cutting_1.csv
-expect_fail "symbolic link" t "$W" machine sensors --out msens --idle 1 --cutting 1
+expect_fail "symbolic link" t "$W" machine sensors --out-dir msens --idle 1 --cutting 1
 [ -L msens/cutting_1.csv ] && [ "$(cat victim.txt)" = precious ] || fail "sensors replaced a link"
 rm msens/cutting_1.csv
-t "$W" machine sensors --out msens --idle 1 --cutting 1 --machine-seed 2 > /dev/null \
+t "$W" machine sensors --out-dir msens --idle 1 --cutting 1 --machine-seed 2 > /dev/null \
   || fail "machine sensors again"
 
 # drift monitor: the report and --timeline/--events together; a directory at --events stops all.
@@ -80,7 +80,7 @@ exec sleep 60
 EOF
 chmod +x fakebin/gnuplot
 "$W" surface synth --out pts.csv > /dev/null || fail "surface synth"
-PATH="$D/fakebin:$PATH" "$W" surface fit --points pts.csv --report srep > /dev/null 2>&1 &
+PATH="$D/fakebin:$PATH" "$W" surface fit --points pts.csv --out-dir srep > /dev/null 2>&1 &
 wpid=$!
 for _ in $(seq 100); do [ -s gnuplot.pid ] && break; sleep 0.1; done
 [ -s gnuplot.pid ] || fail "the fake gnuplot never ran"
@@ -88,7 +88,7 @@ kill -9 "$wpid"; kill -9 "$(cat gnuplot.pid)"; wait "$wpid" 2> /dev/null
 [ -d srep ] || fail "no report directory while gnuplot ran"
 [ -z "$(ls srep)" ] || fail "kill -9 left visible report files: $(ls srep)"
 [ -n "$(debris srep)" ] || fail "expected the killed run's staging folder in srep"
-t "$W" surface fit --points pts.csv --report srep --no-plots > /dev/null || fail "report after kill"
+t "$W" surface fit --points pts.csv --out-dir srep --no-plots > /dev/null || fail "report after kill"
 [ -f srep/index.html ] && [ -z "$(debris srep)" ] || fail "rerun did not clean up: $(ls -A srep)"
 
 # --- One rule for every directory output -----------------------------------------------------
@@ -103,16 +103,16 @@ dir_rule() {  # dir_rule <flag> <command...>: a symlinked and a foreign director
   [ "$(ls -A foreign)" = notes.txt ] || fail "$*: wrote into a foreign $flag: $(ls -A foreign)"
 }
 dir_rule --out-dir "$W" drift split --log log.csv
-dir_rule --out "$W" machine sensors --idle 1 --cutting 0
+dir_rule --out-dir "$W" machine sensors --idle 1 --cutting 0
 dir_rule --out "$W" drift report --train-run log.csv --error ch1_um --sensors t1_C,t2_C
 dir_rule --report "$W" drift holdout --log log.csv --channels ch1_um --no-network
 dir_rule --report "$W" drift monitor --model model.json --run log.csv
 dir_rule --out-dir "$W" ballbar simulate
-dir_rule --report "$W" surface fit --points pts.csv --no-plots
+dir_rule --out-dir "$W" surface fit --points pts.csv --no-plots
 dir_rule --curves-dir "$W" dataset --count 1 --out table.csv
-dir_rule --report "$W" compare --model "$SRC/models/default.json" \
+dir_rule --out-dir "$W" compare --model "$SRC/models/default.json" \
   --screw "$SRC/datasets/screws/reference_80x10x6000.json"
-dir_rule --report "$W" machine evaluate --machines 1 --screws 1
+dir_rule --out-dir "$W" machine evaluate --machines 1 --screws 1
 dir_rule --out-dir "$W" demo --no-plots
 [ -e table.csv ] && fail "dataset wrote its table although --curves-dir was refused"
 # Run twice into the same directory: whirl's own output is replaced.
@@ -142,12 +142,12 @@ grep -q -- "--out" err.txt && grep -q -- "--run" err.txt || fail "predict: flags
 same run_copy.csv run.csv "$W" drift predict --model model.json --run run.csv --out alias.csv
 same model_copy.json model.json "$W" drift nc --model model.json --machine "$M840" --csv ./model.json
 grep -q -- "--csv" err.txt && grep -q -- "--model" err.txt || fail "drift nc: flags: $(cat err.txt)"
-same screw_copy.json screw.json "$W" plan --screw screw.json --max-elongation 30 \
-  --settle-time 250 --machine "$M840" --out ./screw.json
+same screw_copy.json screw.json "$W" plan --screw screw.json --max-elongation-um 30 \
+  --settle-time-s 250 --machine "$M840" --out ./screw.json
 same run_copy.csv run.csv "$W" drift fit --run run.csv --error ch1_um --out "$D/run.csv"
 same run_copy.csv run.csv "$W" drift monitor --model model.json --run run.csv --timeline alias.csv
 same model_copy.json model.json "$W" drift predict --model model.json --run run.csv --out model.json
-expect_fail "same file" t "$W" plan --screw screw.json --max-elongation 30 --settle-time 250 \
+expect_fail "same file" t "$W" plan --screw screw.json --max-elongation-um 30 --settle-time-s 250 \
   --machine "$M840" --nc A.SPF --reset-nc ./A.SPF
 [ -e A.SPF ] && fail "plan wrote A.SPF although --nc and --reset-nc are one file"
 # An output directory that holds an input: whirl would replace or remove it.

@@ -8,3 +8,7 @@ whirl_add_cli_test(cli_outputs ${CMAKE_CURRENT_LIST_DIR}/cli_outputs.sh)
 # Every numeric flag of every subcommand refuses nan, inf and 1e999 naming the flag (found by
 # walking --help, so new flags are covered).
 whirl_add_cli_test(cli_numeric_flags ${CMAKE_CURRENT_LIST_DIR}/cli_numeric_flags.sh)
+# One command-line grammar: units in decimal flag names, --out a file and --out-dir a folder,
+# --json on every computing command, one help line per command, unknown commands named with the
+# closest match, and each deprecated old spelling still working with its one-line notice.
+whirl_add_cli_test(cli_grammar ${CMAKE_CURRENT_LIST_DIR}/cli_grammar.sh)

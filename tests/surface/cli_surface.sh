@@ -16,7 +16,7 @@ source "$src/tests/support/cli_common.sh"
 grep -q "^# .*seed 1" smooth.csv || fail "synth provenance"
 "$whirl" surface fit --points smooth.csv --method cubic --out cubic.json --json > fit.json \
   || fail "fit cubic"
-"$whirl" surface predict --surface cubic.json --x 800 --y 500 --json > p.json || fail "predict"
+"$whirl" surface predict --surface cubic.json --x-mm 800 --y-mm 500 --json > p.json || fail "predict"
 "$whirl" surface fit --points smooth.csv --method bspline --out bspline.json > /dev/null \
   || fail "fit bspline"
 printf 'x_mm,y_mm\n0,0\n400,250\n800,500\n' > xy.csv
@@ -64,7 +64,7 @@ assert l['uncorrected_max_abs_um'] < 1e-9 and not l['slope_capped'], l
   || fail "line text"
 
 # Report with a map.
-"$whirl" surface fit --points bump.csv --method bspline --out b.json --report rep > /dev/null \
+"$whirl" surface fit --points bump.csv --method bspline --out b.json --out-dir rep > /dev/null \
   2> rep.err || fail "report"
 [ -s rep/index.html ] && [ -s rep/map.gp ] || fail "report files"
 if command -v gnuplot > /dev/null; then [ -s rep/map.png ] || fail "no map.png"; fi
@@ -72,7 +72,7 @@ if command -v gnuplot > /dev/null; then [ -s rep/map.png ] || fail "no map.png";
 # Hostile file names (quote, backslash, newline, markup) stay text in the page, the CSVs and gnuplot.
 evil=$'ev\'il\\ "x"\n<script>alert(1).csv'
 cp bump.csv "$evil"
-"$whirl" surface fit --points "$evil" --method cubic --out "$evil.json" --report rep2 > /dev/null \
+"$whirl" surface fit --points "$evil" --method cubic --out "$evil.json" --out-dir rep2 > /dev/null \
   2> rep2.err || fail "report with a hostile name: $(cat rep2.err)"
 ! grep -q "<script>" rep2/index.html || fail "markup reached the page"
 grep -q "&lt;script&gt;" rep2/index.html || fail "name not shown escaped"
@@ -100,12 +100,12 @@ printf 'x_mm,y_mm,error_um\n0,0,1\n1,x,1\n' > bad.csv
 expect_fail "bad.csv:3" "$whirl" surface fit --points bad.csv
 printf 'x_mm,error_um\n0,1\n' > nocol.csv
 expect_fail "missing column 'y_mm'" "$whirl" surface fit --points nocol.csv
-expect_fail "does not extrapolate" "$whirl" surface predict --surface b.json --x 900 --y 10
-expect_fail "either --x X --y Y or --input" "$whirl" surface predict --surface b.json
+expect_fail "does not extrapolate" "$whirl" surface predict --surface b.json --x-mm 900 --y-mm 10
+expect_fail "either --x-mm X --y-mm Y or --input" "$whirl" surface predict --surface b.json
 expect_fail "must be in (0, 0.10]" "$whirl" surface line --surface b.json --md32760 0.5
 expect_fail "outside the measured range" "$whirl" surface line --surface b.json --at-mm 9999
 printf '{"schema": "whirl.plan"}' > notsurface.json
-expect_fail "not a whirl surface file" "$whirl" surface predict --surface notsurface.json --x 1 --y 1
+expect_fail "not a whirl surface file" "$whirl" surface predict --surface notsurface.json --x-mm 1 --y-mm 1
 
 # Per-point models (point 1): the drift module's MLR at each point.
 "$whirl" surface points --help | grep -c "_x<X>_y<Y>_um" > /dev/null || fail "points --help"
@@ -126,7 +126,7 @@ run(30, 120, 1.0, "train.csv"); run(50, 90, 0.7, "target.csv")
 PY
 "$whirl" surface points --run target.csv --train train.csv --sensors t1_C,t2_C --time-min 100 \
   --out pts.json > pts.txt 2> pts.err || fail "points: $(cat pts.err)"
-"$whirl" surface predict --surface pts.json --x 333 --y 77 --json > pp.json || fail "points predict"
+"$whirl" surface predict --surface pts.json --x-mm 333 --y-mm 77 --json > pp.json || fail "points predict"
 python3 -c "
 import json, math
 d1, d2 = 0.7 * 8 * (1 - math.exp(-100 / 50)), 3 * (1 - math.exp(-100 / 90))
