@@ -17,7 +17,7 @@
 #include "drift/run_file.h"
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/random.h"
 #include "sim/screw.h"
 
@@ -88,7 +88,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
                 {"--iso-table", o.iso_table},
                 {"--profile", o.profile}},
                {}, {{"--report", o.report}});
-  const nn::Model model = nn::LoadModel(o.model_path);
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);

@@ -103,7 +103,7 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
   return m;
 }
 
-MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
+MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                                         const ExperienceRule& rule,
                                         const IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
@@ -217,7 +217,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
   return out;
 }
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
+MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                        const ExperienceRule& rule,
                                        const IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,

@@ -136,7 +136,7 @@ struct MachineScrewDetail {
 struct CombinedPrograms;  // compare/machine_nc.h
 
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
-MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
+MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                                         const ExperienceRule& rule,
                                         const IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
@@ -158,7 +158,7 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
                                     const CombinedPrograms* programs = nullptr,
                                     const std::string& programs_note = "");
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
+MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                        const ExperienceRule& rule,
                                        const IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,

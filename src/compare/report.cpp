@@ -149,7 +149,8 @@ std::string MetricsTable(const ScrewComparison& c) {
   h << "</table>\n<p class='small'>ramp: class plateau ramped in linearly (the previous rule); "
        "traditional: class mean plateau and settle time with the model's curve shape and plan; "
        "regression: log-linear least squares of both features on the five inputs, same history, "
-       "curve and plan; model: the network.</p>\n";
+       "curve and plan; model: the workpiece model, "
+    << HtmlEscape(c.model_description) << ".</p>\n";
   return h.str();
 }
 

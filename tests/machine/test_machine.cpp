@@ -17,7 +17,7 @@
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/random.h"
 #include "sim/screw.h"
 
@@ -208,7 +208,8 @@ namespace whirl::compare {
 namespace {
 
 struct Fixture {
-  nn::Model model = nn::LoadModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
+  workpiece::WorkpieceModel model =
+      workpiece::LoadWorkpieceModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
   ExperienceRule rule = BuildExperienceRule(
       ReadProcessTable(std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_500.csv", true));
   IsoToleranceTable iso = ReadIsoToleranceTable(
