@@ -177,7 +177,7 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
 
 /// The largest |S_m| the slope model gives over its training ranges (a box bound: |c_0| +
 /// sum |c_f| max(|min_f|, |max_f|)), mm/mm. The plan's slopes plus this must stay within MD32760
-/// (compare/machine_nc.h checks it for the combined programs).
+/// (machine_eval/machine_nc.h checks it for the combined programs).
 double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options);
 
 inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)

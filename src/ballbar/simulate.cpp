@@ -7,12 +7,12 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::ballbar {
 namespace {
 
-double Uniform(sim::Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.Uniform(); }
+double Uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.Uniform(); }
 
 // Rounds to a decimal step (0.1 um = 1e-4 mm, 0.01 K): round(x k) / k with k = 1 / step an exact
 // integer, so the result is the double nearest to the decimal value and prints short.
@@ -22,7 +22,7 @@ double Round(double x, double step) {
   return std::round(x * k) / k;
 }
 
-PivotCentres Layout(const WarmupOptions& o, sim::Rng& rng) {
+PivotCentres Layout(const WarmupOptions& o, Rng& rng) {
   const double h = o.bar_length_mm / std::sqrt(3.0), r = o.bar_length_mm * std::sqrt(2.0 / 3.0);
   PivotCentres p;
   const double angles_deg[3] = {210, 330, 90};
@@ -68,7 +68,7 @@ Eigen::Vector3d WarmupDrift(const WarmupSimulation& s, double t) {
 
 WarmupSimulation SimulateWarmup(const WarmupOptions& o) {
   o.Validate();
-  sim::Rng rng(sim::MixSeed(o.seed, 15));
+  Rng rng(MixSeed(o.seed, 15));
   WarmupSimulation s;
   for (int a = 0; a < 2; ++a)
     s.final_drift_um(a) = (rng.Uniform() < 0.5 ? -1 : 1) * Uniform(rng, 2, 10);
@@ -107,7 +107,7 @@ WarmupSimulation SimulateWarmup(const WarmupOptions& o) {
 }
 
 CircleTrace SimulateCircle(const CirclePlant& p) {
-  sim::Rng rng(sim::MixSeed(p.seed, 1500));
+  Rng rng(MixSeed(p.seed, 1500));
   const bool semi = p.plane != Plane::kXY;
   const int n = semi ? p.samples / 2 + 1 : p.samples;
   const double span = semi ? 180.0 : 360.0 * (n - 1) / n;
@@ -158,7 +158,7 @@ std::vector<DemoTrace> DemoTraces(std::uint64_t seed) {
           {}};
   t[2].plant.plane = Plane::kXZ;
   t[2].plant.squareness_urad = 40;
-  for (std::size_t i = 0; i < t.size(); ++i) t[i].plant.seed = sim::MixSeed(seed, i);
+  for (std::size_t i = 0; i < t.size(); ++i) t[i].plant.seed = MixSeed(seed, i);
   return t;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Documented simulated ball-bar measurements (no public measurements exist): a spindle warm-up
 // read with three pivots, and circle traces with planted thermal errors. Deterministic for a seed
-// on every platform (sim::Rng). SIMULATED: every file written says so.
+// on every platform (core/random.h). SIMULATED: every file written says so.
 //
 // Warm-up (the truth the drift command must recover):
 //   drift_a(t) = D_a (1 - exp(-t / tau_a))  per MCS axis a, um, t in min from the spindle start;

@@ -10,12 +10,12 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/compare.h"
-#include "compare/machine_eval.h"  // step 7 (issue 19)
 #include "compare/plan_document.h"
 #include "compare/report.h"
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "interp/machine_profile.h"
+#include "machine_eval/machine_eval.h"  // step 7 (issue 19)
 #include "workpiece/model.h"
 #include "sim/screw.h"
 
@@ -35,14 +35,14 @@ struct DemoOptions {
 // 7. The workpiece plan and a machine drift model on a machine that drifts (cmd_machine.cpp).
 void RunDemoMachineStep(const std::filesystem::path& out, const workpiece::WorkpieceModel& model,
                         std::uint64_t seed) {
-  compare::MachineEvalOptions mo;
+  machine_eval::MachineEvalOptions mo;
   mo.machines = 1;
   mo.screws_per_machine = 2;
   mo.seed = seed;
   mo.report_dir = (out / "machine_report").string();  // replaces the demo's earlier report
   // The combined 840D programs of the report's screw, for the simulated machine's profile.
   mo.profile = interp::LoadMachineProfile(ProjectPath("datasets/machines/whirling_840d.json"));
-  const compare::MachineEvaluation e = compare::EvaluateWithMachines(
+  const machine_eval::MachineEvaluation e = machine_eval::EvaluateWithMachines(
       sim::ReferenceScrew(), model,
       compare::BuildExperienceRule(ReadProcessTable(ProjectPath(kHistoryTable), true)),
       compare::ReadIsoToleranceTable(
@@ -52,7 +52,7 @@ void RunDemoMachineStep(const std::filesystem::path& out, const workpiece::Workp
       "7. both halves on a drifting machine (whirl machine evaluate): %s\n%s   report: %s\n"
       "   combined 840D programs (the drift action owns SD43900-43920; the plan hands its K0,\n"
       "   slope and reference over): %s/WHIRL_DRIFT_COMP.SPF, WHIRL_TEMP_COMP.SPF, resets\n",
-      e.summary.message.c_str(), compare::FormatMachineEvalTable(e, false).c_str(),
+      e.summary.message.c_str(), machine_eval::FormatMachineEvalTable(e, false).c_str(),
       e.report_index.c_str(), mo.report_dir.c_str());
 }
 

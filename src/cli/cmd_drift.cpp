@@ -13,6 +13,7 @@
 #include "core/output_dir.h"
 #include "drift/documents.h"
 #include "drift/evaluation.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/report.h"
 #include "drift/run_file.h"

@@ -10,7 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_dir.h"
-#include "drift/monitor.h"
+#include "drift/monitor_report.h"
 
 namespace whirl::cli {
 

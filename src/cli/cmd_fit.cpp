@@ -1,16 +1,16 @@
 // whirl fit: features and fitted curve parameters of a measured (or simulated) elongation curve,
 // and the model comparison / shape calibration over simulated curves (src/fit/curve_fit.h,
-// src/fit/simulated_fits.h).
+// src/compare/curve_study.h).
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "compare/curve_study.h"
 #include "core/curve.h"
 #include "core/error.h"
 #include "fit/curve_fit.h"
-#include "fit/simulated_fits.h"
 #include "sim/features.h"
 
 namespace whirl::cli {
@@ -114,14 +114,14 @@ void RunCurve(const FitOptions& o) {
 }
 
 void RunSimulated(const FitOptions& o) {
-  fit::SimulatedFitOptions so;
+  compare::SimulatedFitOptions so;
   so.count = o.simulated;
   so.seed = o.seed;
   so.window_s = o.window_s;
   so.disturbances = o.disturbances;
   Progress progress("simulating and fitting", static_cast<std::size_t>(o.simulated));
-  const fit::SimulatedFitReport r =
-      fit::FitSimulatedCurves(so, [&](std::size_t d, std::size_t) { progress.Update(d); });
+  const compare::SimulatedFitReport r =
+      compare::FitSimulatedCurves(so, [&](std::size_t d, std::size_t) { progress.Update(d); });
   progress.Finish();
   if (o.json) {
     nlohmann::json models = nlohmann::json::array();

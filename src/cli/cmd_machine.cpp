@@ -8,17 +8,17 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/drift_args.h"
-#include "compare/machine_eval.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "core/process.h"
+#include "core/random.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
+#include "machine_eval/machine_eval.h"
 #include "workpiece/model.h"
-#include "sim/random.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -59,7 +59,7 @@ void RunSensors(const MachineCliOptions& o) {
   const machine::MachineConfig config = LoadMachine(o);
   std::vector<drift::Run> runs;
   for (auto state : {drift::RunState::kIdle, drift::RunState::kCutting})
-    for (auto& r : compare::TrainingRuns(
+    for (auto& r : machine_eval::TrainingRuns(
              config, o.machine_seed, state == drift::RunState::kIdle ? o.idle : o.cutting, state))
       runs.push_back(r);
   const std::vector<std::string> comments = {
@@ -94,7 +94,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
   const sim::Screw base =
       std::filesystem::exists(o.base_screw) ? sim::ReadScrew(o.base_screw) : sim::ReferenceScrew();
-  compare::MachineEvalOptions eo;
+  machine_eval::MachineEvalOptions eo;
   eo.machine = LoadMachine(o);
   eo.machines = o.machines;
   eo.screws_per_machine = o.screws;
@@ -107,7 +107,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.report_dir = o.report;
   if (!o.report.empty()) eo.profile = interp::LoadMachineProfile(o.profile);
   Progress progress("machine evaluate", static_cast<std::size_t>(o.machines * o.screws));
-  const compare::MachineEvaluation e = compare::EvaluateWithMachines(
+  const machine_eval::MachineEvaluation e = machine_eval::EvaluateWithMachines(
       base, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); });
   progress.Finish();
   if (o.json) {
@@ -121,7 +121,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
       std::printf("\n");
     }
     std::printf("%s\n%s", e.summary.message.c_str(),
-                compare::FormatMachineEvalTable(e, o.markdown).c_str());
+                machine_eval::FormatMachineEvalTable(e, o.markdown).c_str());
   }
   if (!e.programs_note.empty()) Warn(e.programs_note);
   if (!e.report_index.empty())

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "core/output_dir.h"
+#include "drift/fit.h"
 #include "surface/choice.h"
 #include "drift/run_file.h"
 #include "surface/drift_adapter.h"

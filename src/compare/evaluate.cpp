@@ -7,7 +7,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/parallel.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::compare {
 
@@ -15,7 +15,7 @@ std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, 
                                              const InputRanges& ranges) {
   if (count < 0)
     throw InputError("random screw count = " + std::to_string(count) + ": must be >= 0");
-  sim::Rng rng(seed);
+  Rng rng(seed);
   const auto lo = ranges.min.ToArray(), hi = ranges.max.ToArray();
   for (int i = 0; i < ProcessInputs::kCount; ++i)
     if (!(hi[i] >= lo[i]))
@@ -82,7 +82,7 @@ Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const workpiece
       [&](std::size_t i) {
         EvaluatedScrew& out = e.screws[i];
         out.screw = screws[i];
-        out.seed = sim::MixSeed(options.seed, i);
+        out.seed = MixSeed(options.seed, i);
         CompareOptions co = options.compare;
         co.seed = out.seed;
         try {

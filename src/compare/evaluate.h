@@ -21,7 +21,7 @@ struct InputRanges {
 };
 
 /// `count` random screws like `base` (same length, thread length and machine settings) with inputs
-/// drawn uniformly in `ranges` (sim::Rng from `seed`, so the set is the same on every platform);
+/// drawn uniformly in `ranges` (core/random.h's Rng from `seed`, the same set on every platform);
 /// a draw that sim::ValidateScrew rejects (e.g. a raceway too wide for the lead) is drawn again.
 /// Names "random-<k>". InputError if 1000 draws in a row are infeasible.
 std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, std::uint64_t seed,

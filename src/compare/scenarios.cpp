@@ -4,7 +4,7 @@
 
 #include "core/csv.h"
 #include "core/error.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::compare {
 

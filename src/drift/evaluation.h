@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "drift/fit.h"
 #include "drift/model.h"
 
 namespace whirl::drift {

@@ -1,5 +1,7 @@
 // FitDriftModel: sensor selection, the lag search of the dynamic model by cross-validation, and
-// the final least-squares or trainbr fit (drift/model.h).
+// the final least-squares or trainbr fit (drift/fit.h).
+#include "drift/fit.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,7 +9,6 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
-#include "drift/model.h"
 
 namespace whirl::drift {
 namespace {

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <random>
 
 #include "core/error.h"
+#include "core/random.h"
 #include "drift/regression.h"
 
 namespace whirl::drift {
@@ -329,10 +329,9 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
   if (r.score_end <= r.score_begin)
     throw InputError("monitor: no scored rows: rows [" + std::to_string(r.score_begin) + ", " +
                      std::to_string(r.score_end) + ") (start and score window)");
-  std::mt19937_64 rng(o.seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
+  Rng rng(o.seed);
   r.measurement_noise_um.resize(n);
-  for (int k = 0; k < n; ++k) r.measurement_noise_um(k) = o.noise_um * n01(rng);
+  for (int k = 0; k < n; ++k) r.measurement_noise_um(k) = o.noise_um * rng.Normal();
   const Eigen::VectorXd y = r.measured_um + r.measurement_noise_um;
   const double s = model.residual_std_um;
   const double noise_variance = s * s + o.noise_um * o.noise_um;

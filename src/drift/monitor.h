@@ -12,8 +12,9 @@
 //     x = [1 f], model.h) predicts e_k = x_k' b every sample from the run's first row on (the lag
 //     states and the reference run from there, as in PredictRun);
 //   * the thermal error is known only at measurements: the run's error column at that sample plus
-//     optional Gaussian noise N(0, noise_um^2) (one draw per sample from `seed`, so every rule sees
-//     the same value at the same sample);
+//     optional Gaussian noise N(0, noise_um^2) (one draw per sample, Rng(seed).Normal() of
+//     core/random.h, the same on every standard library; every rule sees the same value at the
+//     same sample);
 //   * checks: the first at start + check_every, the next check_every after the last measurement
 //     (the patent: "when the machining time reaches the set time"); each measurement (check or
 //     refit) stops the machine stop_min_per_measurement [min]. The log cannot be paused: the stop
@@ -44,12 +45,10 @@
 // `start` whose row index lies in [score_from, score_to) * samples; "none" is the measured error
 // itself (no compensation). Machine time: stop_min = measurements * stop_min_per_measurement,
 // stop share = stop_min / (monitored time + stop_min), monitored time = t_end - start.
+// Output documents (CSV, JSON, text, HTML report): drift/monitor_report.h.
 #include <Eigen/Core>
 #include <cstdint>
-#include <filesystem>
-#include <nlohmann/json.hpp>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "drift/evaluation.h"
@@ -148,33 +147,5 @@ Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                             double noise_variance);
 Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                              const Eigen::VectorXd& b);
-
-// Output documents (built here once; the command line only writes or prints them).
-/// Per sample: time_min (or sample), measured_um, none_um (0), <rule>_um predictions, and
-/// <rule>_residual_um.
-std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::string>& comments);
-/// Every event of every rule: rule, kind, sample, time, measured_um, predicted_um,
-/// threshold_um, valid, message.
-std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments);
-nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o);
-std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o);
-
-struct MonitorReportResult {
-  std::filesystem::path index_html;
-  std::vector<std::string> warnings;
-};
-/// Files written together with a report, outside its directory: (path, contents).
-using AlsoWrite = std::vector<std::pair<std::filesystem::path, std::string>>;
-
-/// HTML page with the table and a plot of measured and predicted error per rule with the checks
-/// and recalibrations marked, and the residuals (gnuplot via RunProgram; skipped with a warning
-/// when absent), beside the timeline and events CSV it is drawn from. `dir` follows the
-/// output-directory rule of core/output_dir.h; the page, its files and `also` (e.g. the
-/// --timeline and --events files) are written all-or-nothing.
-MonitorReportResult WriteMonitorReport(const std::filesystem::path& dir, const MonitorResult& r,
-                                       const MonitorOptions& o,
-                                       const std::vector<std::string>& provenance,
-                                       const std::string& gnuplot = "gnuplot",
-                                       const AlsoWrite& also = {});
 
 }  // namespace whirl::drift

@@ -1,4 +1,6 @@
 // Output documents of the monitor (issue 14): timeline and events CSV, JSON, text table, HTML page.
+#include "drift/monitor_report.h"
+
 #include <cstdio>
 #include <sstream>
 
@@ -9,7 +11,6 @@
 #include "core/run_program.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
-#include "drift/monitor.h"
 
 namespace whirl::drift {
 namespace {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "drift/evaluation.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 
 namespace whirl::drift {

@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "core/limits.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::machine {
 
@@ -262,7 +262,7 @@ MachineDay MachineDay::Draw(const MachineConfig& config, std::uint64_t machine_s
   config.Validate("machine '" + config.name + "'");
   MachineDay d;
   d.config = config;
-  sim::Rng machine_rng(sim::MixSeed(machine_seed, 0x6d616368));
+  Rng machine_rng(MixSeed(machine_seed, 0x6d616368));
   auto factor = [&](double spread) { return std::max(0.2, 1.0 + spread * machine_rng.Normal()); };
   HeadComponent& h = d.config.head;
   h.motor_gain_um_per_kw *= factor(config.machine_spread);
@@ -271,7 +271,7 @@ MachineDay MachineDay::Draw(const MachineConfig& config, std::uint64_t machine_s
   h.process_tau_min *= factor(config.machine_spread);
   d.config.z_screw.steady_rise_k *= factor(config.machine_spread);
   d.config.z_screw.tau_min *= factor(config.machine_spread);
-  sim::Rng day_rng(sim::MixSeed(day_seed, 0x646179));
+  Rng day_rng(MixSeed(day_seed, 0x646179));
   d.ambient_rate_k_per_h = config.ambient.rate_std_k_per_h * day_rng.Normal();
   d.power_factor = std::max(0.2, 1.0 + config.power_spread * day_rng.Normal());
   return d;
@@ -345,7 +345,7 @@ drift::Run SimulateRun(const MachineDay& day, const RunSpec& spec) {
   run.error_um.resize(samples, 2);
   // Lag states per sensor and source (motor, process, z-screw, ambient).
   std::vector<std::array<double, kSourceCount>> lag(m, std::array<double, kSourceCount>{});
-  sim::Rng noise(sim::MixSeed(spec.noise_seed, 0x73656e73));
+  Rng noise(MixSeed(spec.noise_seed, 0x73656e73));
   constexpr int kSub = 10;
   for (int k = 0; k < samples; ++k) {
     const double t = k * step;

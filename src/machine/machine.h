@@ -39,7 +39,7 @@
 // Variation: a machine seed scales g_motor, g_process, R_z and the three time constants each by
 // (1 + machine_spread N(0,1)) (clamped to >= 0.2); a day seed draws the ambient rate
 // r ~ N(0, ambient_rate_std) and the day's cutting power factor (1 + power_spread N(0,1)). The same
-// seeds give the same machine and day on every platform (sim::Rng).
+// seeds give the same machine and day on every platform (core/random.h).
 //
 // Virtual sensors: each named point i reads
 //   T_i(t) = T_0 + a_i T_amb lag + sum_j g_ij L_i(S_j)(t) + noise,

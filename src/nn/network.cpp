@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/random.h"
 
 namespace whirl::nn {
 
@@ -266,10 +267,6 @@ Eigen::MatrixXd OutputJacobian(const Network& net, const Eigen::VectorXd& x) {
   ErrorJacobian(net, cache, &J);
   return -J;
 }
-
-Rng::Rng(std::uint64_t seed) : engine_(seed) {}
-
-double Rng::Uniform01() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
 
 void InitNguyenWidrow(std::uint64_t seed, Network* net) {
   Rng rng(seed);

@@ -19,7 +19,6 @@
 //   - J_e_w = de/dw (n x N, n = S * Q) = -dy/dw.
 #include <Eigen/Core>
 #include <cstdint>
-#include <random>
 #include <vector>
 
 namespace whirl::nn {
@@ -109,19 +108,6 @@ void ErrorGram(const Network& net, const ForwardCache& cache, const Eigen::Matri
 /// dy/dw for one input (normalized): S x N, row k = gradient of output k (= -J_e_w rows).
 Eigen::MatrixXd OutputJacobian(const Network& net, const Eigen::VectorXd& x);
 
-/// Seeded uniform numbers with a fixed mapping (identical on every platform and standard
-/// library, unlike std::uniform_real_distribution): std::mt19937_64 output u64, then
-/// (u64 >> 11) * 2^-53 in [0, 1).
-class Rng {
- public:
-  explicit Rng(std::uint64_t seed);
-  double Uniform01();
-  double Uniform(double lo, double hi) { return lo + (hi - lo) * Uniform01(); }
-
- private:
-  std::mt19937_64 engine_;  // its output sequence is fixed by the C++ standard
-};
-
 /// Nguyen-Widrow initialization as MATLAB initnw (REFERENCE.md section 2). For each hidden
 /// (tansig) layer with S neurons and R inputs (assumed in [-1, 1]):
 ///   wMag = 0.7 S^(1/R); each row of W = a uniform(-1, 1) row scaled to unit length times wMag;
@@ -129,7 +115,8 @@ class Rng {
 ///   then W and b times 2 (tansig's active input range is [-2, 2]).
 /// Output (purelin) layer: W and b uniform(-1, 1).
 /// Random draws, in order: per hidden layer its W row by row; then the output layer's W row by
-/// row, then its b. Same seed and sizes => identical weights on every platform.
+/// row, then its b, each Rng(seed).Uniform(-1, 1) (core/random.h). Same seed and sizes =>
+/// identical weights on every platform.
 void InitNguyenWidrow(std::uint64_t seed, Network* net);
 
 }  // namespace whirl::nn

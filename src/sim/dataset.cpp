@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "core/parallel.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::sim {
 namespace {

@@ -9,7 +9,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/numbers.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::sim {
 namespace {

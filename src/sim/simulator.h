@@ -67,7 +67,7 @@ struct SimOptions {
 /// Disturbances the prediction model cannot know (for honest comparisons), all seeded and
 /// individually switchable. Off by default in the library; `whirl simulate` and `whirl dataset`
 /// turn them on. Random numbers: std::mt19937_64 with the project's own uniform/normal mapping
-/// (sim/random.h), so results are identical across standard libraries.
+/// (core/random.h), so results are identical across standard libraries.
 /// Draw order from `seed`: heat-partition factor, expansion factor, drift rate, then one noise
 /// value per recorded sample.
 struct DisturbanceOptions {
@@ -84,7 +84,7 @@ struct DisturbanceOptions {
   bool ambient_drift = true;
   double ambient_drift_std_k_per_h = 0.2;
   /// When finite: the hall's rate r is given instead of drawn (the same hall as the machine's
-  /// bed, compare/machine_eval.h); the draw is still made, so every later draw is unchanged.
+  /// bed, machine_eval/machine_eval.h); the draw is still made, so every later draw is unchanged.
   double ambient_drift_fixed_k_per_h = std::numeric_limits<double>::quiet_NaN();
   /// Inductive-sensor noise on the recorded curve: N(0, std) per sample, std 0.25 um, i.e. about
   /// +-0.5 um (95 %).

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "surface/per_point.h"
 

@@ -4,7 +4,7 @@
 
 #include "core/csv.h"
 #include "core/error.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace whirl::surface {
 namespace {
@@ -56,7 +56,7 @@ double SyntheticErrorUm(const SyntheticOptions& o, double x_mm, double y_mm) {
 
 std::vector<SurfacePoint> SyntheticPoints(const SyntheticOptions& o) {
   o.Validate();
-  sim::Rng rng(o.seed);
+  Rng rng(o.seed);
   std::vector<SurfacePoint> points;
   for (int i = 0; i < o.ny; ++i)
     for (int j = 0; j < o.nx; ++j) {

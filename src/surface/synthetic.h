@@ -9,7 +9,8 @@
 //                  A = bump_um (default 15 um), (x0, y0) = (0.7 length_x, 0.35 length_y),
 //                  sigma = bump_sigma_fraction * length_x (default 0.1): a local hot spot
 //   measured     = field + noise, noise ~ Normal(0, noise_um^2) (default 1 um), drawn with
-//                  sim::Rng(seed) (deterministic across standard libraries), row by row.
+//                  core/random.h's Rng(seed) (deterministic across standard libraries), row
+//                  by row.
 // Points: an nx x ny grid from (0, 0) to (length_x, length_y), evenly spaced, row by row (y outer).
 #include <cstdint>
 #include <string>

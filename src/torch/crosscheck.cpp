@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/random.h"
 
 namespace whirl::torch {
 namespace {
@@ -335,7 +336,7 @@ namespace {
 // seeded (CrosscheckOptions::start_perturbation, seed).
 Eigen::VectorXd PerturbedStart(const Eigen::VectorXd& w_model, const CrosscheckOptions& options) {
   Eigen::VectorXd w0 = w_model;
-  nn::Rng rng(options.seed);
+  Rng rng(options.seed);
   for (Eigen::Index i = 0; i < w0.size(); ++i) {
     w0(i) *= 1.0 + options.start_perturbation * rng.Uniform(-1.0, 1.0);
   }

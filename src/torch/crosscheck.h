@@ -99,7 +99,7 @@ struct CrosscheckOptions {
   /// network, its Jacobian and trainbr's objective, not ARD's per-input groups.
   double alpha = 0;
   double beta = 0;
-  /// Start of both trainings: w0 = w_model .* (1 + p u), u ~ uniform(-1, 1) from nn::Rng(seed),
+  /// Start of both trainings: w0 = w_model .* (1 + p u), u ~ uniform(-1, 1) from Rng(seed),
   /// p = start_perturbation (0 starts at the model's weights). Both minimisers then descend into
   /// the same basin; from a random start they may legitimately find different local minima.
   double start_perturbation = 0.1;

@@ -9,7 +9,7 @@
 
 #include "ballbar/trilateration.h"
 #include "core/error.h"
-#include "sim/random.h"
+#include "core/random.h"
 #include "support/eigen_near.h"
 
 namespace whirl::ballbar {
@@ -18,14 +18,14 @@ namespace {
 using Eigen::Vector3d;
 constexpr double kPi = 3.14159265358979323846;
 
-double U(sim::Rng& r, double lo, double hi) { return lo + (hi - lo) * r.Uniform(); }
+double U(Rng& r, double lo, double hi) { return lo + (hi - lo) * r.Uniform(); }
 
 // A random pivot triangle on a plane tilted up to 30 degrees, and a tool ball above it.
 struct Case {
   PivotCentres pivots;
   Vector3d ball;
 };
-Case RandomCase(sim::Rng& r) {
+Case RandomCase(Rng& r) {
   const Vector3d centre(U(r, -500, 500), U(r, -500, 500), U(r, -200, 200));
   const Vector3d tilt(U(r, -0.5, 0.5), U(r, -0.5, 0.5), 1);  // plane normal within ~35 deg
   const Vector3d n = tilt.normalized();
@@ -58,7 +58,7 @@ TEST(Trilateration, HandComputedExampleFollowsEachEquation) {
 }
 
 TEST(Trilateration, RoundTripPositionLengthsPositionTo1e9mm) {
-  sim::Rng r(7);
+  Rng r(7);
   double worst = 0;
   for (int i = 0; i < 2000; ++i) {
     const Case c = RandomCase(r);
@@ -80,7 +80,7 @@ TEST(Trilateration, PivotOrderDoesNotMatterForTheSide) {
 }
 
 TEST(Trilateration, JacobianMatchesFiniteDifferencesOfEquations11To17) {
-  sim::Rng r(11);
+  Rng r(11);
   for (int i = 0; i < 200; ++i) {
     const Case c = RandomCase(r);
     const PivotFrame f = MakePivotFrame(c.pivots);
@@ -151,7 +151,7 @@ TEST(Placement, LowBallIsPoorAndAdviceSaysRaiseIt) {
 
 TEST(Placement, NoiseGainIsTheSdPerUnitReadingSd) {
   // Property: the gain predicts the scatter of positions from noisy lengths (Monte Carlo).
-  sim::Rng r(3);
+  Rng r(3);
   const Case c = RandomCase(r);
   const PivotFrame f = MakePivotFrame(c.pivots);
   const PlacementAdvice a = AdvisePlacement(f, c.ball);

@@ -7,7 +7,7 @@
 #include "compare/scenarios.h"
 #include "compare/traditional.h"
 #include "core/error.h"
-#include "sim/random.h"
+#include "core/random.h"
 #include "sim/simulator.h"
 
 namespace whirl::compare {
@@ -17,7 +17,7 @@ namespace {
 TEST(Baselines, LogLinearRegressionRecoversAnExactPowerLaw) {
   ProcessTable h;
   h.source = "power_law";
-  sim::Rng rng(3);
+  Rng rng(3);
   auto law = [](const ProcessInputs& p) {
     return Features{2.0 * std::pow(p.hardness_hrc, 0.5) * std::pow(p.diameter_mm, 0.8) *
                         std::pow(p.pitch_mm, -0.6) * std::pow(p.raceway_radius_mm, 0.9) *

@@ -6,6 +6,7 @@ whirl_add_gtest(test_compare SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_compare.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_baselines.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_report_safety.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_curve_study.cpp
 )
 whirl_add_cli_test(cli_lead_report ${CMAKE_CURRENT_LIST_DIR}/cli_lead_report.sh)
 whirl_add_cli_test(cli_compare ${CMAKE_CURRENT_LIST_DIR}/cli_compare.sh)

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/selection.h"
 #include "synthetic.h"

@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "drift/evaluation.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "synthetic.h"
 

@@ -10,6 +10,8 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/random.h"
+#include "drift/fit.h"
 #include "drift/monitor.h"
 
 namespace whirl::drift {
@@ -264,6 +266,22 @@ TEST(Monitor, OffsetRuleRecoversAPlantedOffset) {
   // 16 measurements: the mean's std is sigma / 4 = 0.05 um; add the fit's own intercept error.
   EXPECT_NEAR(shift, 4.0, 4 * (p.sigma / 4 + m.linear.standard_errors(0)));
   EXPECT_LT((s.final_coefficients.tail(3) - m.linear.coefficients.tail(3)).norm(), 1e-12);
+}
+
+// The check bar's noise is the project's own normal stream (core/random.h: the same draws on
+// every standard library), one draw per sample times noise_um.
+TEST(Monitor, CheckBarNoiseIsOneDrawPerSampleOfTheProjectsNormalStream) {
+  Planted p;
+  const drift::Run run = MakeRun(p, 3);
+  const DriftModel m = FitOn(run.Slice(0, 300, "train"));
+  MonitorOptions o;
+  o.noise_um = 0.5;
+  o.seed = 42;
+  const MonitorResult r = MonitorRun(m, run, o);
+  ASSERT_EQ(r.measurement_noise_um.size(), run.samples());
+  Rng rng(42);
+  for (int k = 0; k < run.samples(); ++k)
+    ASSERT_EQ(r.measurement_noise_um(k), 0.5 * rng.Normal()) << "sample " << k;
 }
 
 TEST(Monitor, RefusesBadInput) {

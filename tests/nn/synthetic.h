@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "core/process.h"
+#include "core/random.h"
 #include "nn/network.h"
 #include "nn/trainbr.h"
 
@@ -17,8 +18,8 @@ inline Eigen::Vector2d SmoothFunction(const Eigen::VectorXd& x) {
 
 /// Standard normal by Box-Muller from the fixed-mapping Rng.
 inline double Gaussian(Rng* rng) {
-  const double u1 = 1.0 - rng->Uniform01();  // (0, 1]
-  const double u2 = rng->Uniform01();
+  const double u1 = 1.0 - rng->Uniform();  // (0, 1]
+  const double u2 = rng->Uniform();
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 

@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/random.h"
 #include "nn/model.h"
 #include "nn/trainbr.h"
 #include "support/eigen_near.h"

@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/random.h"
 #include "nn/model.h"
 #include "nn/selection.h"
 #include "support/eigen_near.h"
@@ -329,8 +330,8 @@ TEST(FlatOutputs, CollapsedFitsOfEverySizeAreFlaggedAndHaveTheSameEvidence) {
   ProcessTable t = synth::SyntheticProcessTable(20, 0.0, 2);
   Rng rng(102);
   for (auto& f : t.targets) {
-    f.max_elongation_um = 50 + 10 * rng.Uniform01();
-    f.settle_time_s = 300 + 60 * rng.Uniform01();
+    f.max_elongation_um = 50 + 10 * rng.Uniform();
+    f.settle_time_s = 300 + 60 * rng.Uniform();
   }
   std::vector<double> evidence;
   for (int h : {4, 6, 8}) {

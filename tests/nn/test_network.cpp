@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/random.h"
 #include "nn/network.h"
 #include "support/eigen_near.h"
 
@@ -169,19 +170,6 @@ TEST(InitNguyenWidrow, FollowsInitnwAndIsSeeded) {
     EXPECT_LE(a.weights[L].cwiseAbs().maxCoeff(), 1.0);
     EXPECT_LE(a.biases[L].cwiseAbs().maxCoeff(), 1.0);
   }
-}
-
-TEST(Rng, UniformIsInRangeWithMeanOneHalf) {
-  Rng rng(3);
-  double sum = 0;
-  const int n = 100000;
-  for (int i = 0; i < n; ++i) {
-    const double u = rng.Uniform01();
-    ASSERT_GE(u, 0.0);
-    ASSERT_LT(u, 1.0);
-    sum += u;
-  }
-  EXPECT_NEAR(sum / n, 0.5, 0.005);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/random.h"
 #include "nn/trainbr.h"
 #include "support/eigen_near.h"
 #include "synthetic.h"

@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/random.h"
 #include "sim/dataset.h"
 #include "sim/features.h"
-#include "sim/random.h"
 #include "sim/simulator.h"
 
 namespace whirl::sim {

@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/random.h"
 #include "sim/dataset.h"
 #include "sim/features.h"
-#include "sim/random.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
 
@@ -165,8 +165,8 @@ TEST(Simulator, DisturbancesAreSeededAndSwitchable) {
   EXPECT_EQ(off.curve.elongation_um, off.elongation_noise_free_um);
 }
 
-// The hall's rate given (the machine's day, compare/machine_eval.h): applied exactly, every other
-// draw unchanged, and a warming hall lengthens the screw more than a cooling one.
+// The hall's rate given (the machine's day, machine_eval/machine_eval.h): applied exactly, every
+// other draw unchanged, and a warming hall lengthens the screw more than a cooling one.
 TEST(Simulator, GivenAmbientRateReplacesOnlyTheDrawnOne) {
   SimOptions o;
   o.duration_s = 1200;

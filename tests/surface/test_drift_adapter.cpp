@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "drift/fit.h"
 #include "drift/run_file.h"
 #include "surface/drift_adapter.h"
 #include "surface/surface.h"

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/random.h"
 #include "nn/model.h"
 #include "nn/network.h"
 #include "support/eigen_near.h"
@@ -32,7 +33,7 @@ nn::Network RandomNetwork(const std::vector<int>& sizes, std::uint64_t seed) {
 }
 
 Eigen::MatrixXd RandomMatrix(int rows, int cols, double lo, double hi, std::uint64_t seed) {
-  nn::Rng rng(seed);
+  Rng rng(seed);
   Eigen::MatrixXd m(rows, cols);
   for (int c = 0; c < cols; ++c)
     for (int r = 0; r < rows; ++r) m(r, c) = rng.Uniform(lo, hi);
@@ -241,7 +242,7 @@ TEST(TorchExport, LoadedTorchScriptPredictsLikeTheEigenModel) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 
   // Fresh inputs inside and somewhat outside the training domain, original units.
-  nn::Rng rng(77);
+  Rng rng(77);
   std::vector<ProcessInputs> inputs;
   for (int q = 0; q < 40; ++q) {
     inputs.push_back({rng.Uniform(58, 67), rng.Uniform(40, 110), rng.Uniform(5, 18),

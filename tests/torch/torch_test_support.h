@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "core/process.h"
+#include "core/random.h"
 #include "nn/model.h"
 #include "nn/network.h"
 
@@ -14,7 +15,7 @@ namespace whirl::test {
 /// mildly nonlinear targets of a plausible size (tens of um, a few hundred s)
 /// plus seeded measurement noise.
 inline ProcessTable SyntheticTable(int samples, std::uint64_t seed) {
-  nn::Rng rng(seed);
+  Rng rng(seed);
   ProcessTable table;
   table.source = "synthetic table (seed " + std::to_string(seed) + ")";
   for (int q = 0; q < samples; ++q) {

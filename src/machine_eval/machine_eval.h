@@ -1,13 +1,38 @@
 #pragma once
-// Both halves in one cut (issue 19, point 4): the comparison of compare/compare.h on a whirling
-// machine that drifts (machine/machine.h), compensated by the workpiece plan, by a machine drift
-// model, or by both.
+// Both halves of the compensation in one cut, the manual of the machine_eval module: the strategy
+// comparison of compare/compare.h (the workpiece's own thermal elongation) on a whirling machine
+// that drifts (machine/machine.h), compensated by the workpiece plan, by a machine drift model or
+// by both; the combined 840D programs of one screw (machine_nc.h) and its report
+// (machine_report.h). Driven by `whirl machine evaluate` and step 7 of `whirl demo` (demo.h).
+// Every figure it gives is measured in the project's simulator, not on a machine.
+//
+// Sources.
+//   Workpiece half: Li Yanfeng, Ma Hongjun and Jiang Hongkui (Shandong Jianzhu University),
+//     "Research on the thermal elongation of screws in hard whirling based on a BP neural network"
+//     (in Chinese; network prediction of the elongation's maximum and settle time, arctangent
+//     curve, piecewise-linear compensation on a SINUMERIK 840D).
+//   Machine half: Miao Enming, Gao Zenghan, Dang Lianchun and Miao Jichao (Hefei University of
+//     Technology), "Analysis of the thermal error characteristics of CNC machine tools" (in
+//     Chinese; temperature-sensitive points by fuzzy clustering and grey relational grade, multiple
+//     linear regression of the thermal error on the temperature rises, and the finding that a model
+//     trained in idle running does not carry over to cutting: the both_idle strategy).
+//   Check bar: the patent "Temperature compensation method, system and medium for CNC machine
+//     tools" (Xi'an University of Posts and Telecommunications): an on-line check of the model
+//     with a check bar and a refit when it disagrees (drift/monitor.h; the both_monitor strategy).
+//   Control: Siemens, SINUMERIK 840D Function Manual Extended Functions, K3 (temperature
+//     compensation, SD43900-43920; interp/sinumerik.h, interp/drift_action.h).
+//
+// Inputs and units: the workpiece model (workpiece/model.h), the traditional rule's history and the ISO
+// 3408-3 table (compare/), a base screw (its blank and machine settings; the screws are drawn
+// around it, compare/evaluate.h RandomFeasibleScrews), the machine (machine/machine.h: a JSON file
+// or machine::DefaultMachine()), and MachineEvalOptions below. Times in s or min as named, lengths
+// in mm, errors and lead deviations in um, temperatures in degC.
 //
 // Truth of one screw on machine i, day d: e_tot(t) = e(t) + m(t, z(t)), e the workpiece truth of
 // CompareScrew (same seed, disturbances on; with the machine's ambient component on, the blank
 // follows the day's hall rate r, the same ramp the bed follows: one hall, not two independent
-// draws), m the machine drift at the tool position
-// z(t) = thread_start_position - v_f t. Lead deviation: compare/cut.h with e_tot.
+// draws), m the machine drift at the tool position z(t) = thread_start_position - v_f t
+// [mm from the chuck face]. Lead deviation: compare/cut.h with e_tot.
 // Strategies (compensation c(t), um):
 //   none            0
 //   traditional     the class-mean curve's 840D plan (as in compare.h)
@@ -18,20 +43,24 @@
 //                   linearly interpolated between its samples (the control evaluates the model
 //                   every interpolation cycle from inputs read continuously)
 //   both            workpiece + machine (cutting-trained)
-//   both_idle       workpiece + machine trained on idle warm-ups (seed 000's comparison)
-//   both_monitor    both, with the offset model kept valid by seed 004's check bar
+//   both_idle       workpiece + machine trained on idle warm-ups (Miao et al.'s comparison)
+//   both_monitor    both, with the offset model kept valid by the patent's check bar
 //                   (drift/monitor.h MonitorRun on the screw's log: a check every
 //                   `monitor_every_min`, measured at the fixed end (offset_um) with N(0, 0.5 um)
-//                   noise, 3-sigma threshold, rule `offset` from the invalid check alone; the
-//                   stops are not simulated: the log goes on as if the cut never paused)
+//                   noise from core/random.h, 3-sigma threshold, rule `offset` from the invalid
+//                   check alone; the stops are not simulated: the log goes on as if the cut never
+//                   paused)
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
 // `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
-// drift::FitDriftModel (kind and sensor selection from `fit`, default seed 000's MLR on the
-// selected points) for each channel. With every machine component off, m = 0 and no machine
-// model is fitted (c_m = 0): every strategy then equals its workpiece-only counterpart exactly.
+// drift::FitDriftModel (drift/fit.h; kind and sensor selection from `fit`, by default Miao et
+// al.'s regression on their selected points) for each channel. With every machine component off,
+// m = 0 and no machine model is fitted (c_m = 0): every strategy then equals its workpiece-only
+// counterpart exactly.
 // What is left (both): the residual lead error of the workpiece part (e - c_wp) and of the machine
 // part (m - c_m) are measured separately; the larger accumulated error over the thread dominates.
 // The uncompensated pattern is split the same way into workpiece, head, Z screw and bed.
+// Seeds: machine i from MixSeed(seed, 0x4d00 + i), screw k's day from the machine's seed, its
+// truth from MixSeed(seed, k) (core/random.h): results do not depend on the thread count.
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -40,11 +69,12 @@
 #include <vector>
 
 #include "compare/evaluate.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 
 enum class MachineStrategy {
   kNone,
@@ -66,18 +96,18 @@ std::string ToString(ErrorSource s);  ///< workpiece, head, z_screw, bed
 
 struct MachineEvalOptions {
   machine::MachineConfig machine = machine::DefaultMachine();
-  int machines = 2;            ///< machines drawn (1..50)
-  int screws_per_machine = 3;  ///< random screws per machine (1..200)
-  int train_runs = 2;          ///< idle and cutting training runs per machine (1..20)
-  std::uint64_t seed = 1;
-  CompareOptions compare;
-  drift::FitOptions fit;  ///< threads are forced to 1 (the screws run in parallel)
-  int threads = 2;
-  double monitor_every_min = 30;  ///< both_monitor: check interval, min (> 0)
+  int machines = 2;                 ///< machines drawn (1..50)
+  int screws_per_machine = 3;       ///< random screws per machine (1..200)
+  int train_runs = 2;               ///< idle and cutting training runs per machine (1..20)
+  std::uint64_t seed = 1;           ///< machines, days, screws and truths (see Seeds above)
+  compare::CompareOptions compare;  ///< the workpiece comparison (plan, curve shape, metrics)
+  drift::FitOptions fit;            ///< threads are forced to 1 (the screws run in parallel)
+  int threads = 2;                  ///< worker threads (1..64)
+  double monitor_every_min = 30;    ///< both_monitor: check interval, min (> 0)
   /// Non-empty: WriteMachineScrewReport of the first screw (machine 0) into this folder.
   std::string report_dir;
   /// With report_dir: the report also holds the combined 840D programs of that screw for this
-  /// profile (compare/machine_nc.h; shipped: datasets/machines/whirling_840d.json).
+  /// profile (machine_eval/machine_nc.h; shipped: datasets/machines/whirling_840d.json).
   std::optional<interp::MachineProfile> profile;
 };
 
@@ -93,8 +123,8 @@ struct MachineEvalScrew {
   std::uint64_t seed = 0, day_seed = 0;
   bool ok = false;
   std::string error;
-  std::array<LeadMetrics, kMachineStrategyCount> metrics;
-  std::array<IsoClass, kMachineStrategyCount> iso{};
+  std::array<compare::LeadMetrics, kMachineStrategyCount> metrics;
+  std::array<compare::IsoClass, kMachineStrategyCount> iso{};
   /// Uncompensated accumulated error over the thread of each source alone, um.
   std::array<double, kErrorSourceCount> source_total_um{};
   /// "both": accumulated error over the thread of the workpiece and machine residuals, um.
@@ -103,7 +133,7 @@ struct MachineEvalScrew {
 
 struct MachineEvalSummary {
   std::size_t screws = 0, failed = 0;
-  std::array<AbsoluteStats, kMachineStrategyCount> absolute;
+  std::array<compare::AbsoluteStats, kMachineStrategyCount> absolute;
   std::array<double, kMachineStrategyCount> share_p3{}, share_p5{};
   std::array<double, kErrorSourceCount> source_median_um{};  ///< uncompensated, per source
   std::size_t residual_workpiece_dominates = 0, residual_machine_dominates = 0;
@@ -128,41 +158,25 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
 /// Curves of one screw, for the report: its sensor log and the lead deviation per strategy.
 struct MachineScrewDetail {
   drift::Run log;  ///< empty when no machine model was fitted
-  std::array<LeadDeviation, kMachineStrategyCount> leads;
+  std::array<compare::LeadDeviation, kMachineStrategyCount> leads;
   fit::ArctanCurve predicted_curve;  ///< the network's curve (the workpiece plan's)
   sim::Kinematics kinematics;
 };
 
-struct CombinedPrograms;  // compare/machine_nc.h
-
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
-                                        const ExperienceRule& rule,
-                                        const IsoToleranceTable& iso_table,
+                                        const compare::ExperienceRule& rule,
+                                        const compare::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
-                                        const CompareOptions& options,
+                                        const compare::CompareOptions& options,
                                         double monitor_every_min = 30,
                                         MachineScrewDetail* detail = nullptr);
 
-/// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a
-/// symbolic link; written all-or-nothing): sensors.csv/.png (the screw's sensor log,
-/// degC over min), lead.csv/.png (lead deviation per strategy, um over mm), index.html with the
-/// chosen sensors and the screw's figures. Plots need gnuplot (skipped with a note otherwise).
-/// Returns the index path.
-/// `programs` (optional): the screw's combined 840D programs, written beside the figures
-/// (compare/machine_nc.h CombinedProgramFiles) and shown in index.html.
-std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
-                                    const MachineScrewDetail& detail,
-                                    const std::vector<std::string>& sensors_cutting,
-                                    const std::vector<std::string>& sensors_idle,
-                                    const CombinedPrograms* programs = nullptr,
-                                    const std::string& programs_note = "");
-
 MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
-                                       const ExperienceRule& rule,
-                                       const IsoToleranceTable& iso_table,
+                                       const compare::ExperienceRule& rule,
+                                       const compare::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,
-                                       const EvaluateProgress& progress = {});
+                                       const compare::EvaluateProgress& progress = {});
 
 MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& screws);
 /// Fixed-width text table (strategy: median/worst um within 1000 mm and over the thread, P3/P5).
@@ -170,4 +184,4 @@ std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown);
 
 void to_json(nlohmann::json& j, const MachineEvaluation& e);
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

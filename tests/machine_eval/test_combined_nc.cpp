@@ -2,20 +2,21 @@
 // replayed as the control runs them (tests/interp/nc_replay.h) with the screw's own virtual
 // sensor log on the analog inputs: at every cycle of the cut the control applies the workpiece
 // plan plus the machine's offset and Z-screw line, i.e. what the evaluation's "both" strategy
-// applies (compare/machine_eval.h: K(t) + G(t) (z_fixed - z(t)) / 1000, K and G the drift models
-// on the log, linear between samples); the drift action is the only writer of SD43900-43920 and
-// the reset programs leave the control as found.
+// applies (machine_eval/machine_eval.h: K(t) + G(t) (z_fixed - z(t)) / 1000, K and G the drift
+// models on the log, linear between samples); the drift action is the only writer of SD43900-43920
+// and the reset programs leave the control as found.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "compare/machine_nc.h"
 #include "core/error.h"
+#include "drift/fit.h"
 #include "drift/model.h"
 #include "interp/nc_replay.h"
+#include "machine_eval/machine_nc.h"
 #include "sim/screw.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 namespace {
 
 std::string ProfilePath() {
@@ -166,4 +167,4 @@ TEST(CombinedPrograms, ProfileThatDisagreesWithTheMachineIsRefused) {
 }
 
 }  // namespace
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

@@ -1,20 +1,20 @@
-// Report of one screw cut on a drifting machine (issue 19, point 5): sensor plot, chosen
+// Report of one screw cut on a drifting machine (machine_report.h): sensor plot, chosen
 // sensors, lead deviation per strategy. User strings (sensor and screw names) reach gnuplot only
 // through GnuplotString (terminal noenhanced) and HTML only through HtmlEscape; gnuplot runs
 // through RunProgram with an argument vector.
+#include "machine_eval/machine_report.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 
-#include "compare/machine_eval.h"
-#include "compare/machine_nc.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 namespace {
 
 namespace fs = std::filesystem;
@@ -58,8 +58,8 @@ std::string LeadScript(const std::string& title) {
   const auto both = static_cast<std::size_t>(MachineStrategy::kBoth);
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
     gp += (k ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(k + 2) +
-          " with lines lw 2" + (k > both ? " dt " + std::to_string(k - both + 1) : "") +
-          " title " + GnuplotString(ToString(static_cast<MachineStrategy>(k)));
+          " with lines lw 2" + (k > both ? " dt " + std::to_string(k - both + 1) : "") + " title " +
+          GnuplotString(ToString(static_cast<MachineStrategy>(k)));
   return gp + "\n";
 }
 
@@ -183,4 +183,4 @@ std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScr
   return (fs::path(dir) / "index.html").string();
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

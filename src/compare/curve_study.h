@@ -18,7 +18,7 @@
 #include "core/process.h"
 #include "fit/curve_fit.h"
 
-namespace whirl::fit {
+namespace whirl::compare {
 
 struct SimulatedFitOptions {
   int count = 25;             ///< simulated curves (design points), >= 1
@@ -27,11 +27,11 @@ struct SimulatedFitOptions {
   bool disturbances = false;  ///< add the simulator's disturbances (noise, drift, variation)
   /// Fit window for the free model fits: [0, fit_window_factor * t_s], clamped to the record.
   double fit_window_factor = 2.0;
-  CurveFitOptions fit;
+  fit::CurveFitOptions fit;
 };
 
 struct ModelComparison {
-  CurveModel model = CurveModel::kArctan;
+  fit::CurveModel model = fit::CurveModel::kArctan;
   double median_r_squared = 0;
   double median_rms_residual_um = 0;
   double worst_rms_residual_um = 0;
@@ -40,11 +40,11 @@ struct ModelComparison {
 };
 
 struct SimulatedFitReport {
-  std::vector<ProcessInputs> inputs;            ///< the design points
-  std::vector<Features> features;               ///< sim::ExtractFeatures of each curve
-  ShapeCalibration shape;                       ///< (k, p) with L, t_s fixed
-  std::vector<ModelComparison> models;          ///< in kAllCurveModels order
-  CurveModel best_model = CurveModel::kArctan;  ///< smallest median RMS residual
+  std::vector<ProcessInputs> inputs;                      ///< the design points
+  std::vector<Features> features;                         ///< sim::ExtractFeatures of each curve
+  fit::ShapeCalibration shape;                            ///< (k, p) with L, t_s fixed
+  std::vector<ModelComparison> models;                    ///< in kAllCurveModels order
+  fit::CurveModel best_model = fit::CurveModel::kArctan;  ///< smallest median RMS residual
 };
 
 /// Runs the simulations and fits. `progress(done, total)` after each curve. InputError for
@@ -53,4 +53,4 @@ SimulatedFitReport FitSimulatedCurves(
     const SimulatedFitOptions& options,
     const std::function<void(std::size_t, std::size_t)>& progress = {});
 
-}  // namespace whirl::fit
+}  // namespace whirl::compare

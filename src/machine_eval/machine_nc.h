@@ -1,5 +1,5 @@
 #pragma once
-// The combined 840D programs of one screw on a drifting whirling machine (issue 19, point 3):
+// The combined 840D programs of one screw on a drifting whirling machine (machine_eval.h):
 // the workpiece plan (the network's curve, interp/sinumerik.h) and the live machine-drift action
 // (the offset model and the Z feed screw's slope model, interp/drift_action.h) in one pair of
 // programs in which each setting datum has one writer:
@@ -24,11 +24,11 @@
 #include <string>
 #include <vector>
 
-#include "compare/machine_eval.h"
 #include "interp/drift_action.h"
 #include "interp/machine_profile.h"
+#include "machine_eval/machine_eval.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 
 struct CombinedPrograms {
   interp::CompensationPlan plan;       ///< the workpiece plan, handing K0 and slope over
@@ -55,4 +55,4 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
 std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
     const std::filesystem::path& dir, const CombinedPrograms& programs);
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

@@ -1,10 +1,10 @@
-#include "compare/machine_nc.h"
+#include "machine_eval/machine_nc.h"
 
 #include <cmath>
 
 #include "core/error.h"
 
-namespace whirl::compare {
+namespace whirl::machine_eval {
 namespace {
 
 void Require(bool ok, const interp::MachineProfile& p, const std::string& field,
@@ -84,4 +84,4 @@ std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
           {dir / "WHIRL_DRIFT_COMP_PLC.csv", p.drift_plc_csv}};
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::machine_eval

@@ -1,4 +1,4 @@
-#include "fit/simulated_fits.h"
+#include "compare/curve_study.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "sim/features.h"
 #include "sim/simulator.h"
 
-namespace whirl::fit {
+namespace whirl::compare {
 namespace {
 
 ElongationCurve Head(const ElongationCurve& c, double t_max) {
@@ -39,7 +39,7 @@ SimulatedFitReport FitSimulatedCurves(
   SimulatedFitReport report;
   report.inputs = sim::DesignPoints(options.count, options.seed, defaults.ranges);
   std::vector<ElongationCurve> curves;
-  std::vector<std::vector<CurveFit>> fits;
+  std::vector<std::vector<fit::CurveFit>> fits;
   for (std::size_t i = 0; i < report.inputs.size(); ++i) {
     sim::SimOptions so = defaults.sim;
     so.duration_s = options.window_s;
@@ -51,15 +51,15 @@ SimulatedFitReport FitSimulatedCurves(
     // The shape is calibrated over the window the features were extracted from (a few settle
     // times, sim/features.h step 0): beyond it the simulated curve keeps creeping up slowly.
     curves.push_back(Head(r.curve, sim::AnalyzeSettle(r.curve, so.settle).window_s));
-    fits.push_back(FitAllModels(Head(r.curve, options.fit_window_factor * r.features.settle_time_s),
-                                options.fit));
+    fits.push_back(fit::FitAllModels(
+        Head(r.curve, options.fit_window_factor * r.features.settle_time_s), options.fit));
     if (progress) progress(i + 1, report.inputs.size());
   }
-  report.shape = CalibrateShape(curves, report.features, options.fit);
+  report.shape = fit::CalibrateShape(curves, report.features, options.fit);
   double best_median = INFINITY;
-  for (std::size_t m = 0; m < std::size(kAllCurveModels); ++m) {
+  for (std::size_t m = 0; m < std::size(fit::kAllCurveModels); ++m) {
     ModelComparison mc;
-    mc.model = kAllCurveModels[m];
+    mc.model = fit::kAllCurveModels[m];
     std::vector<double> r2, rms;
     for (std::size_t i = 0; i < fits.size(); ++i) {
       r2.push_back(fits[i][m].r_squared);
@@ -82,4 +82,4 @@ SimulatedFitReport FitSimulatedCurves(
   return report;
 }
 
-}  // namespace whirl::fit
+}  // namespace whirl::compare

@@ -1,0 +1,42 @@
+#pragma once
+// Output documents of the on-line check (drift/monitor.h MonitorRun), built here once; the
+// command line only writes or prints them: the timeline and events CSV, the JSON document, the
+// text table and the HTML report with its plot.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "drift/monitor.h"
+
+namespace whirl::drift {
+
+/// Per sample: time_min (or sample), measured_um, none_um (0), <rule>_um predictions, and
+/// <rule>_residual_um.
+std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::string>& comments);
+/// Every event of every rule: rule, kind, sample, time, measured_um, predicted_um,
+/// threshold_um, valid, message.
+std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments);
+nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o);
+std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o);
+
+struct MonitorReportResult {
+  std::filesystem::path index_html;
+  std::vector<std::string> warnings;
+};
+/// Files written together with a report, outside its directory: (path, contents).
+using AlsoWrite = std::vector<std::pair<std::filesystem::path, std::string>>;
+
+/// HTML page with the table and a plot of measured and predicted error per rule with the checks
+/// and recalibrations marked, and the residuals (gnuplot via RunProgram; skipped with a warning
+/// when absent), beside the timeline and events CSV it is drawn from. `dir` follows the
+/// output-directory rule of core/output_dir.h; the page, its files and `also` (e.g. the
+/// --timeline and --events files) are written all-or-nothing.
+MonitorReportResult WriteMonitorReport(const std::filesystem::path& dir, const MonitorResult& r,
+                                       const MonitorOptions& o,
+                                       const std::vector<std::string>& provenance,
+                                       const std::string& gnuplot = "gnuplot",
+                                       const AlsoWrite& also = {});
+
+}  // namespace whirl::drift

@@ -1,0 +1,4 @@
+# Tests of src/machine_eval: the evaluation of both halves, its report and the combined programs.
+whirl_add_gtest(test_machine_eval SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/test_machine_eval.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_combined_nc.cpp)
