@@ -2,19 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::interp {
 namespace {
-
-std::string Num(double x) {
-  std::ostringstream ss;
-  ss.precision(10);
-  ss << x;
-  return ss.str();
-}
 
 // The check grid: uniform samples plus forced times, with the curve evaluated once.
 struct Grid {
@@ -28,13 +21,13 @@ struct Grid {
 
 void ValidateRange(double t_begin, double t_end, const BreakpointOptions& o) {
   if (!std::isfinite(t_begin) || !std::isfinite(t_end) || !(t_end > t_begin))
-    throw InputError("breakpoints: time range [" + Num(t_begin) + ", " + Num(t_end) +
-                     "] s: must be finite with end > begin");
+    throw InputError("breakpoints: time range [" + FormatSignificant(t_begin, 10) + ", " +
+                     FormatSignificant(t_end, 10) + "] s: must be finite with end > begin");
   if (!std::isfinite(o.tolerance_um) || !(o.tolerance_um > 0))
-    throw InputError("tolerance_um = " + Num(o.tolerance_um) +
+    throw InputError("tolerance_um = " + FormatSignificant(o.tolerance_um, 10) +
                      ": must be a positive finite number");
   if (!std::isfinite(o.check_step_s) || !(o.check_step_s > 0))
-    throw InputError("check_step_s = " + Num(o.check_step_s) +
+    throw InputError("check_step_s = " + FormatSignificant(o.check_step_s, 10) +
                      ": must be a positive finite number");
 }
 
@@ -42,9 +35,10 @@ Grid MakeGrid(const CurveFunction& curve, double t0, double t1, const Breakpoint
   ValidateRange(t0, t1, o);
   const double steps_real = std::ceil((t1 - t0) / o.check_step_s);
   if (!(steps_real + 1 <= static_cast<double>(o.max_grid_samples)))
-    throw InputError("breakpoints: check grid of " + Num(steps_real + 1) + " samples over " +
-                     Num(t1 - t0) + " s exceeds max_grid_samples " +
-                     std::to_string(o.max_grid_samples) + ": raise check_step_s");
+    throw InputError("breakpoints: check grid of " + FormatSignificant(steps_real + 1, 10) +
+                     " samples over " + FormatSignificant(t1 - t0, 10) +
+                     " s exceeds max_grid_samples " + std::to_string(o.max_grid_samples) +
+                     ": raise check_step_s");
   const auto steps = static_cast<std::size_t>(std::max(1.0, steps_real));
   const double h = (t1 - t0) / static_cast<double>(steps);
   std::vector<double> forced;
@@ -74,8 +68,8 @@ Grid MakeGrid(const CurveFunction& curve, double t0, double t1, const Breakpoint
   for (std::size_t i = 0; i < g.t.size(); ++i) {
     g.l[i] = curve(g.t[i]);
     if (!std::isfinite(g.l[i]))
-      throw InputError("breakpoints: curve value at t = " + Num(g.t[i]) + " s is " + Num(g.l[i]) +
-                       ": must be finite");
+      throw InputError("breakpoints: curve value at t = " + FormatSignificant(g.t[i], 10) +
+                       " s is " + FormatSignificant(g.l[i], 10) + ": must be finite");
   }
   double max_curv = 0;
   for (std::size_t i = 0; i + 1 < g.t.size(); ++i)
@@ -130,8 +124,8 @@ double RefineStart(const CurveFunction& curve, Grid* g, double target_um) {
     const double tm = g->t[worst] + 0.5 * h;
     const double lm = curve(tm);
     if (!std::isfinite(lm))
-      throw InputError("breakpoints: curve value at t = " + Num(tm) + " s is " + Num(lm) +
-                       ": must be finite");
+      throw InputError("breakpoints: curve value at t = " + FormatSignificant(tm, 10) + " s is " +
+                       FormatSignificant(lm, 10) + ": must be finite");
     g->t.insert(g->t.begin() + static_cast<std::ptrdiff_t>(worst) + 1, tm);
     g->l.insert(g->l.begin() + static_cast<std::ptrdiff_t>(worst) + 1, lm);
     g->forced.insert(g->forced.begin() + static_cast<std::ptrdiff_t>(worst) + 1, 0);
@@ -156,10 +150,10 @@ Grid MakeRefinedGrid(const CurveFunction& curve, double t0, double t1, Breakpoin
     }
     if (2.0 * static_cast<double>(g.t.size()) > static_cast<double>(o.max_grid_samples))
       throw InputError(
-          "tolerance_um = " + Num(o.tolerance_um) +
+          "tolerance_um = " + FormatSignificant(o.tolerance_um, 10) +
           " um is too small for a check grid of at most " + std::to_string(o.max_grid_samples) +
           " samples: the margin between samples (curvature, or the bulge of a steep start) is " +
-          Num(g.margin_um) + " um at step " + Num(g.max_step) +
+          FormatSignificant(g.margin_um, 10) + " um at step " + FormatSignificant(g.max_step, 10) +
           " s (must stay below half the tolerance)");
     o.check_step_s = 0.5 * g.max_step;
   }

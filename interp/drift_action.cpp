@@ -25,10 +25,9 @@ std::string Cell(const std::string& t) { return SpreadsheetCell(Text(t)); }
 
 std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
 std::string R(int n) { return "R" + std::to_string(n); }
-std::string Num(double v, int decimals) { return FormatFixed(v, decimals); }
 // "+x" or "-x": a term appended to an expression (never "+-x", which a control may refuse).
 std::string Term(double v, int decimals) {
-  const std::string text = Num(v, decimals);
+  const std::string text = FormatFixed(v, decimals);
   return text[0] == '-' ? text : "+" + text;
 }
 
@@ -65,8 +64,8 @@ const AnalogInput& Input(const DriftActionOptions& o, const std::string& name) {
 }
 
 std::string Reading(const AnalogInput& a) {
-  return Num(a.scale, kDecimalsDriftCoefficient) + "*$A_INA[" + std::to_string(a.index) + "]" +
-         Term(a.offset, 4);
+  return FormatFixed(a.scale, kDecimalsDriftCoefficient) + "*$A_INA[" + std::to_string(a.index) +
+         "]" + Term(a.offset, 4);
 }
 
 struct Layout {
@@ -154,7 +153,7 @@ std::vector<std::string> FeatureBodies(const drift::DriftModel& m, const DriftAc
 
 // c_0 + sum c_f x_f over the layout's feature slots.
 std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals) {
-  std::string out = Num(c(0), decimals);
+  std::string out = FormatFixed(c(0), decimals);
   for (Eigen::Index f = 1; f < c.size(); ++f)
     out += Term(c(f), decimals) + "*" + P(l.features + static_cast<int>(f) - 1);
   return out;
@@ -183,7 +182,7 @@ std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
     }
   } else {
     slope = P(s.s_m);
-    ref = Num(o.slope_fixed_end_mm, kDecimalsPositionMm);
+    ref = FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm);
   }
   return "DO $$SA_TEMP_COMP_SLOPE" + ax + "=" + slope + " $$SA_TEMP_COMP_REF_POSITION" + ax + "=" +
          ref + " $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=2";
@@ -396,7 +395,7 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
   if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
   if (o.workpiece_slope_param >= 0)  // no plan yet: slope 0 about the fixed end
     nc += P(o.workpiece_slope_param) + "=0\n" + P(o.workpiece_slope_param + 1) + "=" +
-          Num(o.has_slope ? o.slope_fixed_end_mm : 0.0, kDecimalsPositionMm) + "\n";
+          FormatFixed(o.has_slope ? o.slope_fixed_end_mm : 0.0, kDecimalsPositionMm) + "\n";
   return nc;
 }
 
@@ -453,15 +452,15 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
   nc += Line(ModelLine("; model: ", m) +
              (model_source.empty() ? std::string() : ", file " + Text(model_source)));
   if (g) nc += Line(ModelLine("; slope model: ", *g));
-  nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + Num(DriftSign(o), 0) +
+  nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + FormatFixed(DriftSign(o), 0) +
         " (control_dk " + ToString(o.control_dk) + ", error_direction " +
         std::to_string(o.error_direction) + "); reference " + ToString(o.reference) +
-        "; interpolation cycle " + Num(o.ipo_cycle_ms, 3) + " ms\n";
+        "; interpolation cycle " + FormatFixed(o.ipo_cycle_ms, 3) + " ms\n";
   if (g)
     nc += "; slope S_m = s * sigma * (g0 + sum g_f x_f) / 1e6 (sigma = " +
           std::to_string(o.slope_growth_direction) + ") about the fixed end " +
-          Num(o.slope_fixed_end_mm, kDecimalsPositionMm) +
-          " mm (MCS); |S_m| <= " + Num(DriftSlopeBound(*g, o), kDecimalsSd43910) +
+          FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
+          " mm (MCS); |S_m| <= " + FormatFixed(DriftSlopeBound(*g, o), kDecimalsSd43910) +
           " over the training ranges: the plan's slopes plus this must stay within MD32760\n";
   const std::string saved = slope_mode ? R(r) + ".." + R(r + 4) + " (SD43900-43920 found, markers)"
                                        : R(r) + " (SD43900 found), " + R(r + 1) +
@@ -543,21 +542,22 @@ std::string PlcRows(const std::string& output, const drift::DriftModel& m,
                     const DriftActionOptions& o, const Eigen::VectorXd& c, int decimals) {
   const std::vector<std::string> in = Inputs(m);
   const int ns = static_cast<int>(m.sensors.size());
-  std::string out = output + ",intercept,,,,,,,," + Num(c(0), decimals) + "\n";
+  std::string out = output + ",intercept,,,,,,,," + FormatFixed(c(0), decimals) + "\n";
   for (std::size_t f = 0; f < m.features.size(); ++f) {
     const drift::Feature& feat = m.features[f];
     int input = 0;
     while (in[static_cast<std::size_t>(input)] != feat.input) ++input;
     const AnalogInput& a = Input(o, feat.input);
-    const std::string ref = input < ns ? Num(m.reference_C(input), 4) : "";
-    const std::string tau = feat.tau > 0 ? Num(feat.tau, 3) : "";
+    const std::string ref = input < ns ? FormatFixed(m.reference_C(input), 4) : "";
+    const std::string tau = feat.tau > 0 ? FormatFixed(feat.tau, 3) : "";
     const std::string af =
-        feat.tau > 0 ? Num(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
-                     : "";
+        feat.tau > 0
+            ? FormatFixed(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
+            : "";
     out += output + "," + Cell(feat.Name(m.time_unit)) + "," + Cell(feat.input) + "," +
-           std::to_string(a.index) + "," + Num(a.scale, kDecimalsDriftCoefficient) + "," +
-           Num(a.offset, 4) + "," + ref + "," + tau + "," + af + "," +
-           Num(c(static_cast<Eigen::Index>(f) + 1), decimals) + "\n";
+           std::to_string(a.index) + "," + FormatFixed(a.scale, kDecimalsDriftCoefficient) + "," +
+           FormatFixed(a.offset, 4) + "," + ref + "," + tau + "," + af + "," +
+           FormatFixed(c(static_cast<Eigen::Index>(f) + 1), decimals) + "\n";
   }
   return out;
 }
@@ -577,12 +577,12 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
       "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); K_m (mm) = sum of "
       "the k0_mm rows' coefficient_per_unit * feature value, intercept included\n";
   out += "# model " + drift::ToString(m.kind) + " of " + Text(m.error_column) +
-         "; sign applied (s = " + Num(DriftSign(o), 0) + "); interpolation cycle " +
-         Num(o.ipo_cycle_ms, 3) + " ms\n";
+         "; sign applied (s = " + FormatFixed(DriftSign(o), 0) + "); interpolation cycle " +
+         FormatFixed(o.ipo_cycle_ms, 3) + " ms\n";
   if (g)
     out += "# slope model " + drift::ToString(g->kind) + " of " + Text(g->error_column) +
            ": S_m (mm/mm) = sum of the slope rows likewise; SD43910[" + o.axis +
-           "] = S_m, SD43920 = " + Num(o.slope_fixed_end_mm, kDecimalsPositionMm) +
+           "] = S_m, SD43920 = " + FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
            " mm, SD43900 = K_m (with a plan: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + "
            "K_m + S_m (P_w - fixed end))\n";
   else

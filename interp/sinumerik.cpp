@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -12,6 +11,7 @@
 #include "core/safe_text.h"
 #include "core/json_file.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 
 namespace whirl::interp {
 namespace {
@@ -20,16 +20,10 @@ constexpr const char* kPlanSchema = "whirl.plan";
 constexpr int kPlanSchemaVersion = 2;
 constexpr int kMaxSyncActionId = 255;
 
-std::string Num(double x) {
-  std::ostringstream ss;
-  ss.precision(10);
-  ss << x;
-  return ss.str();
-}
-
 void CheckFinitePositive(double v, const std::string& field) {
   if (!std::isfinite(v) || !(v > 0))
-    throw InputError(field + " = " + Num(v) + ": must be a positive finite number");
+    throw InputError(field + " = " + FormatSignificant(v, 10) +
+                     ": must be a positive finite number");
 }
 
 CompensationSegment MakeSegment(const PlanOptions& o, double feed, double t_a, double t_b,
@@ -53,10 +47,12 @@ CompensationSegment MakeSegment(const PlanOptions& o, double feed, double t_a, d
 
 void CheckSlope(const CompensationSegment& s, std::size_t index, double cap) {
   if (!(std::abs(s.sd43910) <= cap))
-    throw InputError("segment " + std::to_string(index + 1) + " (t " + Num(s.t_a_s) + " to " +
-                     Num(s.t_b_s) + " s, P " + Num(s.p_a_mm) + " to " + Num(s.p_b_mm) +
-                     " mm): |SD43910| = " + Num(std::abs(s.sd43910)) + " exceeds the MD32760 cap " +
-                     Num(cap) +
+    throw InputError("segment " + std::to_string(index + 1) + " (t " +
+                     FormatSignificant(s.t_a_s, 10) + " to " + FormatSignificant(s.t_b_s, 10) +
+                     " s, P " + FormatSignificant(s.p_a_mm, 10) + " to " +
+                     FormatSignificant(s.p_b_mm, 10) +
+                     " mm): |SD43910| = " + FormatSignificant(std::abs(s.sd43910), 10) +
+                     " exceeds the MD32760 cap " + FormatSignificant(cap, 10) +
                      " (the control would limit it silently): raise --md32760 if the machine "
                      "allows, or lower the feed");
 }
@@ -75,14 +71,6 @@ double RoundingBudgetUm(double thread_length_mm, double md32760) {
 std::size_t SyncIdsNeeded(const CompensationPlan& plan) { return plan.segments.size() + 1; }
 
 }  // namespace
-
-std::string FormatFixed(double x, int decimals) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  std::string s = buf;
-  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
-}
 
 double RoundTo(double x, int decimals) {
   return std::stod(FormatFixed(x, decimals));  // exactly what is printed, read back
@@ -125,10 +113,7 @@ void CheckAxisName(const std::string& axis, const std::string& field) {
 }
 
 void PlanOptions::Validate() const {
-  CheckFinitePositive(tolerance_um, "tolerance_um");
-  if (tolerance_um < kMinPlanToleranceUm)
-    throw InputError("tolerance_um = " + Num(tolerance_um) + ": must be at least " +
-                     Num(kMinPlanToleranceUm) + " um (1 nm, the resolution of SD43900)");
+  CheckRange(tolerance_um, kPlanToleranceRange, "tolerance_um", "plan");
   CheckFinitePositive(check_step_s, "check_step_s");
   CheckAxisName(axis);
   CheckRange(start_position_mm, kAxisPositionRange, "start_position_mm", "plan");
@@ -136,7 +121,8 @@ void PlanOptions::Validate() const {
   if (direction != 1 && direction != -1)
     throw InputError("direction = " + std::to_string(direction) + ": must be +1 or -1");
   if (!(md32760 > 0 && md32760 <= kMd32760Max))
-    throw InputError("md32760 = " + Num(md32760) + ": must be within (0, 0.10] (MD32760 range)");
+    throw InputError("md32760 = " + FormatSignificant(md32760, 10) +
+                     ": must be within (0, 0.10] (MD32760 range)");
   if (sign != ExpectedSign(direction, control_dk))
     throw InputError("sign '" + ToString(sign) + "' with direction " + std::to_string(direction) +
                      " and control_dk '" + ToString(control_dk) +
@@ -202,11 +188,11 @@ CompensationPlan BuildPlan(const CurveFunction& curve_um, double axial_feed_mm_s
   plan.cutting_time_s = thread_length_mm / axial_feed_mm_s;
   const double budget_um = RoundingBudgetUm(thread_length_mm, options.md32760);
   if (!(options.tolerance_um > 2.0 * budget_um))
-    throw InputError("tolerance_um = " + Num(options.tolerance_um) + ": must exceed " +
-                     Num(2.0 * budget_um) +
+    throw InputError("tolerance_um = " + FormatSignificant(options.tolerance_um, 10) +
+                     ": must exceed " + FormatSignificant(2.0 * budget_um, 10) +
                      " um, twice what rounding the written setting data "
                      "can cost over a " +
-                     Num(thread_length_mm) + " mm thread");
+                     FormatSignificant(thread_length_mm, 10) + " mm thread");
   BreakpointOptions bo;
   bo.tolerance_um = options.tolerance_um - budget_um;
   bo.check_step_s = options.check_step_s;

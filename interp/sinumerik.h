@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/limits.h"
+#include "core/numbers.h"  // FormatFixed: every value the control reads
 #include "fit/arctan_curve.h"
 #include "interp/breakpoints.h"
 
@@ -66,9 +67,7 @@ inline constexpr int kDecimalsSd43900Mm = 6;     ///< SD43900: 1 nm (below any c
 inline constexpr int kDecimalsSd43910 = 8;       ///< SD43910: 1e-8 = 0.01 um per metre of travel
 inline constexpr int kDecimalsTimeS = 3;         ///< times: 1 ms
 inline constexpr int kDecimalsElongationUm = 3;  ///< predicted elongation: 1 nm
-/// Fixed-decimal text of x (no exponent; "-0.000" printed as "0.000"). x must be finite.
-std::string FormatFixed(double x, int decimals);
-/// x rounded to `decimals` decimals (the value FormatFixed prints).
+/// x rounded to `decimals` decimals (the value FormatFixed, core/numbers.h, prints).
 double RoundTo(double x, int decimals);
 
 /// MD32760 bounds from K3.
@@ -123,8 +122,8 @@ std::string ProgramNameOf(const std::string& path, const std::string& flag);
 void CheckDistinctProgramNames(const std::string& program, const std::string& reset_program);
 
 struct PlanOptions {
-  /// Largest |applied compensation - predicted curve| along the thread, um (>= 0.001 um = 1 nm,
-  /// kMinPlanToleranceUm of core/limits.h).
+  /// Largest |applied compensation - predicted curve| along the thread, um, in
+  /// kPlanToleranceRange of core/limits.h (1 nm to 10 mm).
   double tolerance_um = 0.5;
   /// Axis name used in $SA_TEMP_COMP_*[axis] and $AA_IM[axis] (letters, digits, '_').
   std::string axis = "Z";

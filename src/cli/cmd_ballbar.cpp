@@ -84,21 +84,21 @@ void AddDrift(CLI::App& parent) {
   sub->add_option("--block-gap-min", c->o.block_gap_min,
                   "a reading more than this after the previous one starts a new block, min "
                   "(default 2)")
-      ->check(CLI::Range(1e-6, 1440.0));
+      ->check(NumberIn(1e-6, 1440.0));
   sub->add_option("--bar-sd-um", c->o.bar_sd_um,
                   "sd of one bar reading, um (default 0: pooled from repeated readings of a pivot "
                   "within blocks)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(NumberIn(0.0, 100.0));
   sub->add_option("--bar-alpha-per-K", c->o.bar_alpha_per_K,
                   "bar expansion coefficient, 1/K (default 12e-6: 1.8 um/K on 150 mm); a reading "
                   "is corrected to L (1 + alpha (T - T_ref))")
-      ->check(CLI::Range(0.0, 50e-6));
+      ->check(NumberIn(0.0, 50e-6));
   sub->add_option("--bar-alpha-sd-per-K", c->o.bar_alpha_sd_per_K,
                   "sd of that coefficient, 1/K (default 1e-6; 0 for a calibrated bar)")
-      ->check(CLI::Range(0.0, 50e-6));
+      ->check(NumberIn(0.0, 50e-6));
   sub->add_option("--bar-reference-C", c->o.bar_reference_C,
                   "bar calibration temperature T_ref, degC (default 20)")
-      ->check(CLI::Range(-20.0, 60.0));
+      ->check(NumberIn(-20.0, 60.0));
   sub->add_flag("--no-bar-temperature", c->no_temperature,
                 "ignore bar_temperature_C (no expansion correction)");
   sub->add_option("--sign", c->sign,
@@ -145,17 +145,17 @@ void AddCircle(CLI::App& parent) {
   sub->add_option("--plane", c->plane, "XY, XZ or YZ (default XY)")
       ->check(CLI::IsMember({"XY", "XZ", "YZ", "xy", "xz", "yz"}));
   sub->add_option("--radius-mm", c->o.radius_mm, "nominal radius (bar length), mm (default 100)")
-      ->check(CLI::Range(1.0, 2000.0));
+      ->check(NumberIn(1.0, 2000.0));
   sub->add_option("--cyclic-period-1-mm", c->o.cyclic_period_1_mm,
                   "period of axis 1's cyclic error (its screw lead), mm (default 0: not fitted)")
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(NumberIn(0.0, 1000.0));
   sub->add_option("--cyclic-period-2-mm", c->o.cyclic_period_2_mm,
                   "period of axis 2's cyclic error, mm (default 0: not fitted)")
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(NumberIn(0.0, 1000.0));
   sub->add_option("--spindle-tram-urad", c->o.spindle_tram_urad,
                   "XZ only: measured tilt of the spindle axis from square to the X travel, urad "
                   "(default 0); parallelism = XZ squareness - tram")
-      ->check(CLI::Range(-1e5, 1e5));
+      ->check(NumberIn(-1e5, 1e5));
   sub->add_flag("--json", c->json, "machine output: JSON on stdout");
   sub->callback([c] { RunCircle(*c); });
 }
@@ -178,9 +178,9 @@ void AddSimulate(CLI::App& parent) {
       ->required();
   AddSeedOption(sub, &c->o.seed, "random seed (default 1)");
   sub->add_option("--duration-min", c->o.duration_min, "warm-up length, min (default 240)")
-      ->check(CLI::Range(60.0, 720.0));
+      ->check(NumberIn(60.0, 720.0));
   sub->add_option("--interval-min", c->o.interval_min, "time between blocks, min (default 15)")
-      ->check(CLI::Range(4.0, 720.0));
+      ->check(NumberIn(4.0, 720.0));
   sub->add_flag("--json", c->json, "machine output: JSON on stdout");
   sub->callback([c] {
     CheckOutputs({}, {}, {{"--out-dir", c->out_dir}});

@@ -126,12 +126,10 @@ void RegisterCompare(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sub->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV (default: shipped)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |840D chord - predicted curve| of the plan, um (default 0.5, >= 0.001)")
-      ->check(CLI::PositiveNumber);
+  AddToleranceOption(sub, &o->tolerance_um);
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910|, - (default 0.01, max 0.10)")
-      ->check(CLI::Range(1e-9, interp::kMd32760Max));
+      ->check(Md32760Number());
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
   sub->add_flag("--json", o->json, "machine output: the comparison as JSON on stdout");
   sub->callback([o, sub] {

@@ -84,21 +84,21 @@ void RegisterCrosscheck(CLI::App& app) {
   sub->add_option("--alpha", o->alpha,
                   "Weight-decay coefficient alpha of F (MATLAB convention, dimensionless); "
                   "default: the model's final trainbr value")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--beta", o->beta,
                   "Data coefficient beta of F (1/normalized unit^2); default: the model's final "
                   "trainbr value")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--perturbation", o->perturbation,
                   "Relative perturbation of the model weights for the common training start: "
                   "w0 = w .* (1 + p*u), u ~ U(-1, 1)")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(NumberIn(0.0, 1.0))
       ->capture_default_str();
   AddSeedOption(sub, &o->seed, "Seed of the start perturbation")->capture_default_str();
   sub->add_option("--prediction-tolerance", o->prediction_tolerance,
                   "Tolerance of the trained-prediction difference, normalized target units (the "
                   "training range of a target spans 2 units)")
-      ->check(CLI::PositiveNumber)
+      ->check(PositiveNumber())
       ->capture_default_str();
   sub->callback([o] { RunCrosscheck(*o); });
 }

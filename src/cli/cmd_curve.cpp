@@ -21,23 +21,19 @@ namespace whirl::cli {
 namespace {
 
 struct CurveOptions {
-  std::string model_path;
-  std::string screw_path;
-  double max_elongation_um = NAN;
-  double settle_time_s = NAN;
-  double shape_k = fit::kDefaultShapeK;
-  double time_exponent = fit::kDefaultTimeExponent;
+  CurveSourceArgs source;
   double duration_s = 0;
   double step_s = 1.0;
   std::string out_path;
-  bool allow_extrapolation = false;
   bool json = false;
 };
 
 void Run(const CurveOptions& o) {
-  CheckOutputs({{"--model", o.model_path}, {"--screw", o.screw_path}}, {{"--out", o.out_path}});
-  const bool by_model = !o.model_path.empty() || !o.screw_path.empty();
-  const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
+  CheckOutputs({{"--model", o.source.model_path}, {"--screw", o.source.screw_path}},
+               {{"--out", o.out_path}});
+  const bool by_model = !o.source.model_path.empty() || !o.source.screw_path.empty();
+  const bool by_features =
+      !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
   if (by_model == by_features)
     throw InputError(
         "curve: give either --model M --screw S.json or --max-elongation L --settle-time T");
@@ -46,28 +42,28 @@ void Run(const CurveOptions& o) {
   double duration_s = o.duration_s;
   std::string source;
   if (by_model) {
-    if (o.model_path.empty() || o.screw_path.empty())
+    if (o.source.model_path.empty() || o.source.screw_path.empty())
       throw InputError("curve: --model and --screw go together (got only " +
-                       std::string(o.model_path.empty() ? "--screw" : "--model") + ")");
-    const sim::Screw screw = sim::ReadScrew(o.screw_path);
+                       std::string(o.source.model_path.empty() ? "--screw" : "--model") + ")");
+    const sim::Screw screw = sim::ReadScrew(o.source.screw_path);
     const sim::Kinematics kin = sim::ComputeKinematics(screw);
-    const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
+    const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.source.model_path);
     const workpiece::Prediction pred = workpiece::Predict(model, screw.process);
-    GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.screw_path,
-                        o.allow_extrapolation);
+    GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.source.screw_path,
+                        o.source.allow_extrapolation);
     features = pred.mean;
     stddev = pred.stddev;
     if (duration_s == 0) duration_s = kin.cutting_time_s;
-    source = "model " + o.model_path + ", screw " + o.screw_path;
+    source = "model " + o.source.model_path + ", screw " + o.source.screw_path;
   } else {
-    if (std::isnan(o.max_elongation_um) || std::isnan(o.settle_time_s))
+    if (std::isnan(o.source.max_elongation_um) || std::isnan(o.source.settle_time_s))
       throw InputError("curve: --max-elongation and --settle-time go together");
-    features = {o.max_elongation_um, o.settle_time_s};
+    features = {o.source.max_elongation_um, o.source.settle_time_s};
     source = "given features";
   }
   CheckPlanFeatures(features, by_features ? "--max-elongation/--settle-time" : "the prediction");
   const fit::ArctanCurve curve =
-      fit::ArctanCurve::FromFeatures(features, o.shape_k, o.time_exponent);
+      fit::ArctanCurve::FromFeatures(features, o.source.shape_k, o.source.time_exponent);
   if (duration_s == 0) duration_s = 3.0 * curve.settle_time_s;
   const double samples = std::floor(duration_s / o.step_s) + 1;
   if (samples > 1e7)
@@ -128,24 +124,14 @@ void RegisterCurve(CLI::App& app) {
       "(--max-elongation L --settle-time T). Writes CSV time_s,elongation_um (--out, atomically;\n"
       "else CSV on stdout). A screw outside the training domain is an error unless\n"
       "--allow-extrapolation.");
-  sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
-      ->check(CLI::ExistingFile);
-  sub->add_option("--screw", o->screw_path, "screw file (JSON, see 'whirl simulate --help')")
-      ->check(CLI::ExistingFile);
-  sub->add_option("--max-elongation", o->max_elongation_um, "plateau elongation L [um], 0..10000")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--settle-time", o->settle_time_s, "settle time t_s [s], 1..1e6")
-      ->check(CLI::PositiveNumber);
-  AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
+  AddCurveSourceOptions(sub, &o->source, false);
   sub->add_option("--duration-s", o->duration_s,
                   "sampled time span [s] (default: the screw's cutting time, else 3 t_s)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   sub->add_option("--step-s", o->step_s, "sample spacing [s]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--out", o->out_path, "write the curve CSV here (atomically)");
-  sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
-                "use the prediction even if the screw is outside the training domain");
   sub->add_flag("--json", o->json, "machine output: curve parameters as JSON on stdout");
   sub->callback([o] { Run(*o); });
 }

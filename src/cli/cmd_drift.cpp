@@ -84,6 +84,23 @@ struct ModelArgs {
   int threads = 0;
 };
 
+// The dynamic model's options (lagged copies of the rises), shared by every command that fits it.
+void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
+  sub->add_option("--inputs", m->inputs, "other columns used as inputs as logged, e.g. spindle_rpm")
+      ->delimiter(',');
+  sub->add_option("--lag-grid", m->lags,
+                  "dynamic: candidate lag time constants [min] (default 5,10,20,40,80,160,320)")
+      ->check(PositiveNumber("min"))
+      ->delimiter(',');
+  sub->add_option("--max-lags", m->max_lags, "dynamic: at most this many time constants (1..4)")
+      ->check(NumberIn(1, 4));
+  sub->add_option("--folds", m->folds, "dynamic: blocks of a single training run (2..20)")
+      ->check(NumberIn(2, 20));
+  sub->add_flag("--leave-block-out", m->shuffle_cv,
+                "dynamic: leave-one-block-out instead of forward-chaining blocks");
+}
+
+// --model, the sensors, the dynamic and the network model's options, --threads.
 void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--model", m->kind,
                   "mlr (seed 000's regression on the rises), dynamic (rises plus first-order "
@@ -92,25 +109,14 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
       ->check(CLI::IsMember({"mlr", "dynamic", "network"}));
   sub->add_option("--sensors", m->sensors, "use these _C columns instead of the selection")
       ->delimiter(',');
-  sub->add_option("--inputs", m->inputs, "other columns used as inputs as logged, e.g. spindle_rpm")
-      ->delimiter(',');
-  sub->add_option("--lag-grid", m->lags,
-                  "dynamic: candidate lag time constants [min] (default 5,10,20,40,80,160,320)")
-      ->delimiter(',');
-  sub->add_option("--max-lags", m->max_lags, "dynamic: at most this many time constants (1..4)")
-      ->check(CLI::Range(1, 4));
-  sub->add_option("--folds", m->folds, "dynamic: blocks of a single training run (2..20)")
-      ->check(CLI::Range(2, 20));
-  sub->add_flag("--leave-block-out", m->shuffle_cv,
-                "dynamic: leave-one-block-out instead of forward-chaining blocks");
-  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")
-      ->check(CLI::Range(1, 20));
+  AddDynamicOptions(sub, m);
+  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")->check(NumberIn(1, 20));
   sub->add_option("--restarts", m->restarts, "network: trainbr restarts (1..50)")
-      ->check(CLI::Range(1, 50));
+      ->check(NumberIn(1, 50));
   sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000)")
-      ->check(CLI::Range(1, 10000));
+      ->check(NumberIn(1, 10000));
   AddSeedOption(sub, &m->seed, "network: initialization seed");
-  sub->add_option("--threads", m->threads, "threads (0: all cores)")->check(CLI::Range(0, 256));
+  sub->add_option("--threads", m->threads, "threads (0: all cores)")->check(NumberIn(0, 256));
 }
 
 drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s) {
@@ -334,30 +340,21 @@ void RegisterHoldout(CLI::App* drift_app) {
           kRunFilesHelp);
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--train", o->h.train_fraction, "training share of the rows (default 0.6)")
-      ->check(CLI::Range(0.01, 0.99));
+      ->check(NumberIn(0.01, 0.99));
   sub->add_option("--test", o->h.test_fraction, "test share after it (default 0.2)")
-      ->check(CLI::Range(0.01, 0.99));
+      ->check(NumberIn(0.01, 0.99));
   sub->add_option("--channels", o->channels, "error columns (default: every _um column)")
       ->delimiter(',');
   sub->add_option("--max-sensors", o->h.max_sensors,
                   "at most this many selected sensors (default 4)")
-      ->check(CLI::Range(1, 64));
+      ->check(NumberIn(1, 64));
   sub->add_option("--classes", o->sel.classes,
                   "class count of the selection: fewest (default), margin, cv or a number "
                   "(as in 'whirl drift fit --help')");
   sub->add_flag("--no-network", o->no_network, "skip the network model");
-  sub->add_option("--inputs", o->model.inputs, "extra inputs of dynamic_extra, e.g. spindle_rpm")
-      ->delimiter(',');
-  sub->add_option("--lag-grid", o->model.lags, "candidate lag time constants [min]")
-      ->delimiter(',');
-  sub->add_option("--max-lags", o->model.max_lags, "at most this many lags (1..4)")
-      ->check(CLI::Range(1, 4));
-  sub->add_option("--folds", o->model.folds, "cross-validation blocks (2..20)")
-      ->check(CLI::Range(2, 20));
-  sub->add_flag("--leave-block-out", o->model.shuffle_cv,
-                "leave-one-block-out instead of forward-chaining");
+  AddDynamicOptions(sub, &o->model);  // --inputs: those of dynamic_extra
   sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")
-      ->check(CLI::Range(1, 10000));
+      ->check(NumberIn(1, 10000));
   sub->add_option("--report", o->report,
                   std::string("also write an HTML report into this directory: ") + kOutputDirRule);
   sub->add_flag("--json", o->json, "machine output on stdout");
@@ -398,8 +395,8 @@ void RegisterSplit(CLI::App* drift_app) {
       "run-file format (time_min [min]); all or nothing.");
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--at", o->column, "column whose rise starts a run (default spindle_rpm)");
-  FiniteNumber(sub->add_option("--threshold", o->threshold,
-                               "start threshold in the column's unit (default 0)"));
+  sub->add_option("--threshold", o->threshold, "start threshold in the column's unit (default 0)")
+      ->check(FiniteNumber());
   sub->add_option("--out-dir", o->out_dir,
                   std::string("directory for the run files: ") + kOutputDirRule)
       ->required();

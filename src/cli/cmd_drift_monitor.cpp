@@ -36,26 +36,26 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
          "--check-every", o.check_every,
          "interval between checks [min; samples if the run has no time] (default 60; at most "
          "100,000 checks per run)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--threshold-um", o.threshold_um,
                   "validity threshold on |measured - predicted| [um] (default 0: use "
                   "--threshold-sigma)")
-      ->check(CLI::Range(0.0, 1e5));
+      ->check(NumberIn(0.0, 1e5));
   sub->add_option("--threshold-sigma", o.threshold_sigma,
                   "threshold as a multiple of sqrt(s^2 + noise^2), s the model's training residual "
                   "std [um] (default 3)")
-      ->check(CLI::Range(0.01, 100.0));
+      ->check(NumberIn(0.01, 100.0));
   sub->add_option(
          "--refit-samples", o.refit_samples,
          "m: further measurements after an invalid check (0..100, default 3; 0: update from the "
          "check alone)")
-      ->check(CLI::Range(0, drift::kMaxRefitSamples));
+      ->check(NumberIn(0, drift::kMaxRefitSamples));
   sub->add_option("--refit-every", o.refit_every,
                   "interval between the refit measurements [min; samples] (default 5)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--stop-min", o.stop_min_per_measurement,
                   "machine stop per check-bar measurement [min] (default 1)")
-      ->check(CLI::Range(0.0, 1440.0));
+      ->check(NumberIn(0.0, 1440.0));
   sub->add_option("--update", a->updates,
                   "update rules replayed beside the static model: patent (least-squares refit on "
                   "the new measurements), bayes (recursive least squares, the training fit as "
@@ -64,18 +64,20 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
       ->check(CLI::IsMember({"patent", "bayes", "offset"}));
   sub->add_option("--prior-scale", o.prior_scale,
                   "bayes: prior covariance = this x the training fit's Cov(b) (default 1)")
-      ->check(CLI::Range(1e-6, 1e12));
+      ->check(NumberIn(1e-6, 1e12));
   sub->add_option(
          "--noise-um", o.noise_um,
          "std of the check-bar measurement noise added to the logged error [um] (default 0)")
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(NumberIn(0.0, 1000.0));
   AddSeedOption(sub, &o.seed, "seed of the measurement noise (default 1)");
   sub->add_option("--start", o.start,
                   "monitoring starts here [min; samples]: no check before, scores from here "
-                  "(default 0)");
+                  "(default 0)")
+      ->check(FiniteNumber());
   sub->add_option("--score-rows", a->score_rows,
                   "scored share of the run's rows FROM,TO (default 0,1; FL_THERMAL's test "
                   "window: 0.6,0.8)")
+      ->check(NumberIn(0, 1))
       ->delimiter(',')
       ->expected(2);
   sub->add_option("--reference", a->reference,

@@ -271,19 +271,16 @@ void RegisterEvaluate(CLI::App& app) {
   sub->add_option("--random", o->random,
                   "number of random feasible screws (default 40; 0 to 10000, and --random x "
                   "--seeds at most 10000)")
-      ->check(CLI::Range(0, kMaxRandomScrews));
+      ->check(NumberIn(0, kMaxRandomScrews));
   AddSeedOption(sub, &o->seed, "seed of the random screws and the disturbances (default 1)");
   sub->add_option("--seeds", o->seeds,
                   "repeat the evaluation for seeds --seed .. --seed + N - 1 (each with its own "
                   "random screws and disturbances); prints one line per seed and the figures "
                   "pooled over all screws, which --require-median-pct then checks (default 1)")
-      ->check(CLI::Range(1, 1000));
-  sub->add_option(
-         "--tolerance-um", o->tolerance_um,
-         "largest |840D chord - predicted curve| of each plan [um] (default 0.5, >= 0.001)")
-      ->check(CLI::PositiveNumber);
+      ->check(NumberIn(1, 1000));
+  AddToleranceOption(sub, &o->tolerance_um);
   AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
-  sub->add_option("--threads", o->threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
+  sub->add_option("--threads", o->threads, "worker threads (default 2)")->check(NumberIn(1, 64));
   sub->add_option("--history", o->history,
                   std::string("past screws for the traditional rule (default ") + kHistoryTable +
                       ", the table models/default.json is trained on)")
@@ -296,7 +293,8 @@ void RegisterEvaluate(CLI::App& app) {
   sub->add_option("--require-median-pct", o->require_median_pct,
                   "fail (exit 2) if the median reduction of the accumulated error within 1000 mm "
                   "against traditional is below this, or if any screw's comparison failed, "
-                  "percent (target: 85)");
+                  "percent (target: 85)")
+      ->check(FiniteNumber("%"));
   sub->add_option("--scenarios", o->scenarios,
                   "named truth scenarios, comma-separated or 'all': today, heat-spread (heat "
                   "partition std 12.5 %), ambient-drift (std 0.5 K/h), tool-wear (+20 % heat over "

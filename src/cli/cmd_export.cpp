@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "nn/model.h"
 #include "workpiece/model.h"
@@ -49,12 +50,11 @@ void RunExport(const ExportCliOptions& o) {
         report.max_relative_difference, report.tolerance);
   }
   if (!report.written) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "the reloaded TorchScript differs from the Eigen model by %.3g relative "
-                  "(tolerance %.3g); nothing written",
-                  report.max_relative_difference, report.tolerance);
-    throw CommandFailure(buf, 2);
+    throw CommandFailure("the reloaded TorchScript differs from the Eigen model by " +
+                             FormatSignificant(report.max_relative_difference, 3) +
+                             " relative (tolerance " + FormatSignificant(report.tolerance, 3) +
+                             "); nothing written",
+                         2);
   }
 }
 

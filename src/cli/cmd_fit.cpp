@@ -10,6 +10,7 @@
 #include "compare/curve_study.h"
 #include "core/curve.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "fit/curve_fit.h"
 #include "sim/features.h"
 
@@ -101,12 +102,9 @@ void RunCurve(const FitOptions& o) {
   std::printf("%-9s %-84s %10s %12s\n", "model", "parameters (all free)", "R^2", "RMS [um]");
   for (const auto& f : fits) {
     std::string params;
-    for (std::size_t i = 0; i < f.parameter_names.size(); ++i) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "%s%s=%.5g", i ? " " : "", f.parameter_names[i].c_str(),
-                    f.parameters[static_cast<Eigen::Index>(i)]);
-      params += buf;
-    }
+    for (std::size_t i = 0; i < f.parameter_names.size(); ++i)
+      params += (i ? " " : "") + f.parameter_names[i] + "=" +
+                FormatSignificant(f.parameters[static_cast<Eigen::Index>(i)], 5);
     std::printf("%-9s %-84s %10.6f %12.4f%s\n", fit::ToString(f.model).c_str(), params.c_str(),
                 f.r_squared, f.rms_residual_um, f.summary.Converged() ? "" : " (not converged)");
   }
@@ -212,25 +210,25 @@ void RegisterFit(CLI::App& app) {
   auto* simulated = sub->add_option("--simulated", o->simulated,
                                     "number of simulated curves to fit (model comparison and "
                                     "shape calibration)")
-                        ->check(CLI::Range(1, 1000));
+                        ->check(NumberIn(1, 1000));
   curve->excludes(simulated);
   AddSeedOption(sub, &o->seed, "seed of the design points and disturbances (--simulated)")
       ->capture_default_str();
   sub->add_option("--window-s", o->window_s, "simulated time per curve [s] (--simulated)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_flag("--disturbances", o->disturbances,
                 "add the simulator's disturbances: noise, drift, per-workpiece variation "
                 "(--simulated)");
   sub->add_option("--max-gap-factor", o->max_gap_factor,
                   "a time step larger than this times the median step is a gap (error) [-]")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 1e6));
+      ->check(NumberIn(1.0, 1e6));
   sub->add_option("--fit-window-factor", o->fit_window_factor,
                   "fit the models on [0, factor * settle time] (the rise and its plateau, not a "
                   "long record's drift); 0 = the whole record [-]")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] {
     if (o->curve_path.empty() && o->simulated == 0)

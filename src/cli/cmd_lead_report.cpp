@@ -81,10 +81,10 @@ void RegisterLeadReport(CLI::App& app) {
   sub->add_option("--lead-mm", o->lead_mm,
                   "lead of the screw (one revolution of travel), mm; needed for v_2pi "
                   "(default 0: v_2pi not evaluated and left out of the class check)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   sub->add_option("--end-margin-mm", o->end_margin_mm,
                   "excess travel l_e left out at each end, mm: l_u = length - 2 l_e (default 0)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   sub->add_option("--iso-table", o->iso_table,
                   "ISO 3408-3 tolerance table CSV (default: the shipped "
                   "datasets/standards/iso3408_3_lead_tolerances.csv)")

@@ -18,6 +18,7 @@
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
 #include "machine_eval/machine_eval.h"
+#include "machine_eval/seeds.h"
 #include "workpiece/model.h"
 #include "sim/screw.h"
 
@@ -40,6 +41,8 @@ struct MachineCliOptions {
   SelectionArgs selection;
   std::string drift_model = "mlr";
   double monitor_every_min = 30;
+  int seeds = 1;
+  double travel_c_um = 0;
   std::string report;
   std::string profile = ProjectPath("datasets/machines/whirling_840d.json");
 };
@@ -80,6 +83,25 @@ void RunSensors(const MachineCliOptions& o) {
                 drift::ToString(runs[k].state).c_str(), runs[k].samples());
 }
 
+// --seeds N > 1: the evaluation over seeds S..S+N-1 (machine_eval/seeds.h).
+void RunOverSeeds(const MachineCliOptions& o, const sim::Screw& base, const workpiece::WorkpieceModel& model,
+                  const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
+                  const machine_eval::MachineEvalOptions& eo) {
+  Progress progress("machine evaluate",
+                    static_cast<std::size_t>(o.seeds * o.machines * o.screws));
+  machine_eval::SeedsEvaluation e = machine_eval::EvaluateOverSeeds(
+      base, model, rule, iso, eo, o.seeds, [&](std::size_t d, std::size_t) { progress.Update(d); });
+  progress.Finish();
+  e.travel_c_um = o.travel_c_um;
+  if (o.json)
+    PrintJson(e);
+  else
+    std::printf("%s", machine_eval::FormatSeedsTable(e, o.markdown).c_str());
+  std::size_t ok = 0;
+  for (const auto& r : e.runs) ok += r.summary.screws - r.summary.failed;
+  if (ok == 0) throw CommandFailure("every comparison failed", 1);
+}
+
 void RunMachineEvaluate(const MachineCliOptions& o) {
   CheckOutputs({{"--machine", o.machine_path},
                 {"--model", o.model_path},
@@ -106,6 +128,10 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.monitor_every_min = o.monitor_every_min;
   eo.report_dir = o.report;
   if (!o.report.empty()) eo.profile = interp::LoadMachineProfile(o.profile);
+  if (o.seeds > 1) {
+    RunOverSeeds(o, base, model, rule, iso, eo);
+    return;
+  }
   Progress progress("machine evaluate", static_cast<std::size_t>(o.machines * o.screws));
   const machine_eval::MachineEvaluation e = machine_eval::EvaluateWithMachines(
       base, model, rule, iso, eo, [&](std::size_t d, std::size_t) { progress.Update(d); });
@@ -157,11 +183,9 @@ void RegisterMachine(CLI::App& app) {
   CommonOptions(s, o.get());
   s->add_option("--out", o->out, std::string("output folder, all files or none: ") + kOutputDirRule)
       ->required();
-  s->add_option("--machine-seed", o->machine_seed, "seed of the machine (default 1)");
-  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")
-      ->check(CLI::Range(0, 20));
-  s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")
-      ->check(CLI::Range(0, 20));
+  AddSeedOption(s, &o->machine_seed, "seed of the machine (default 1)", "--machine-seed");
+  s->add_option("--idle", o->idle, "idle warm-up runs (0..20, default 2)")->check(NumberIn(0, 20));
+  s->add_option("--cutting", o->cutting, "cutting runs (0..20, default 2)")->check(NumberIn(0, 20));
   s->callback([o] { RunSensors(*o); });
 
   auto* e = m->add_subcommand(
@@ -174,15 +198,15 @@ void RegisterMachine(CLI::App& app) {
       "accumulated lead error [um] within 1000 mm and over the thread, P3/P5 shares, the\n"
       "uncompensated error of each source alone and which part dominates what is left.");
   CommonOptions(e, o.get());
-  e->add_option("--machines", o->machines, "machines (1..50, default 2)")->check(CLI::Range(1, 50));
+  e->add_option("--machines", o->machines, "machines (1..50, default 2)")->check(NumberIn(1, 50));
   e->add_option("--screws", o->screws, "random screws per machine (1..200, default 3)")
-      ->check(CLI::Range(1, 200));
+      ->check(NumberIn(1, 200));
   e->add_option("--train-runs", o->train_runs,
                 "idle and cutting training runs per machine (1..20, default 2)")
-      ->check(CLI::Range(1, 20));
-  e->add_option("--seed", o->seed, "seed of machines, days, screws and truth (default 1)");
+      ->check(NumberIn(1, 20));
+  AddSeedOption(e, &o->seed, "seed of machines, days, screws and truth (default 1)");
   e->add_option("--threads", o->threads, "worker threads (1..64, default 2)")
-      ->check(CLI::Range(1, 64));
+      ->check(NumberIn(1, 64));
   e->add_option("--model", o->model_path, "workpiece model (default models/default.json)")
       ->check(CLI::ExistingFile);
   e->add_option("--history", o->history, "past screws for the traditional rule")
@@ -197,7 +221,7 @@ void RegisterMachine(CLI::App& app) {
   AddSelectionOptions(e, &o->selection);  // seed 000's sensor selection of the machine models
   e->add_option("--monitor-every-min", o->monitor_every_min,
                 "both_monitor: check-bar interval of seed 004's monitor [min] (1..600, default 30)")
-      ->check(CLI::Range(1.0, 600.0));
+      ->check(NumberIn(1.0, 600.0));
   e->add_option("--report", o->report,
                 "write the first screw's report here: sensor plot [degC over min], chosen "
                 "sensors, lead deviation per strategy [um over mm] and the screw's combined 840D "
@@ -209,8 +233,18 @@ void RegisterMachine(CLI::App& app) {
                 "datasets/machines/whirling_840d.json, which matches the shipped machine file; a "
                 "profile that does not fit the machine leaves the programs out with a warning)")
       ->check(CLI::ExistingFile);
+  e->add_option("--seeds", o->seeds,
+                "repeat over seeds S..S+N-1 (new machines, training days and screws each) and "
+                "print the pooled table: median [range of per-seed medians] and worst [um], "
+                "|e_a - c| median [um], P3/P5 shares, and the headlines against the strongest "
+                "sensor-free strategy (1..20, default 1: the single-seed table)")
+      ->check(CLI::Range(1, 20));
+  e->add_option("--travel-c-um", o->travel_c_um,
+                "with --seeds: specified travel compensation c of ISO 3408-3 [um] for the "
+                "|e_a - c| column (default 0)");
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
+  RegisterMachineTruth(m);
 }
 
 }  // namespace whirl::cli

@@ -11,6 +11,7 @@
 #include "compare/plan_document.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "fit/arctan_curve.h"
 #include "interp/machine_profile.h"
@@ -22,12 +23,7 @@ namespace whirl::cli {
 namespace {
 
 struct PlanCliOptions {
-  std::string model_path;
-  std::string screw_path;
-  double max_elongation_um = NAN;
-  double settle_time_s = NAN;
-  double shape_k = fit::kDefaultShapeK;
-  double time_exponent = fit::kDefaultTimeExponent;
+  CurveSourceArgs source;
   double tolerance_um = interp::PlanOptions{}.tolerance_um;
   double check_step_s = interp::PlanOptions{}.check_step_s;
   // Machine facts: from --machine, each overridable; NAN / 0 / -1 / "" = not given.
@@ -48,7 +44,6 @@ struct PlanCliOptions {
   std::string nc_path;
   std::string reset_nc_path;
   bool with_drift_action = false;
-  bool allow_extrapolation = false;
   bool json = false;
 };
 
@@ -117,38 +112,40 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
 }
 
 void Run(const PlanCliOptions& o) {
-  CheckOutputs(
-      {{"--model", o.model_path}, {"--screw", o.screw_path}, {"--machine", o.machine_path}},
-      {{"--out", o.out_path},
-       {"--csv", o.csv_path},
-       {"--nc", o.nc_path},
-       {"--reset-nc", o.reset_nc_path}});
-  const bool by_features = !std::isnan(o.max_elongation_um) || !std::isnan(o.settle_time_s);
-  if (by_features == !o.model_path.empty())
+  CheckOutputs({{"--model", o.source.model_path},
+                {"--screw", o.source.screw_path},
+                {"--machine", o.machine_path}},
+               {{"--out", o.out_path},
+                {"--csv", o.csv_path},
+                {"--nc", o.nc_path},
+                {"--reset-nc", o.reset_nc_path}});
+  const bool by_features =
+      !std::isnan(o.source.max_elongation_um) || !std::isnan(o.source.settle_time_s);
+  if (by_features == !o.source.model_path.empty())
     throw InputError("plan: give either --model M or --max-elongation L --settle-time T");
   const interp::PlanOptions options = ResolvePlanOptions(o);
-  const sim::Screw screw = sim::ReadScrew(o.screw_path);
+  const sim::Screw screw = sim::ReadScrew(o.source.screw_path);
   const sim::Kinematics kin = sim::ComputeKinematics(screw);
 
   compare::PlanSource plan_source;
   std::string source;
   if (!by_features) {
-    const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
+    const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.source.model_path);
     const workpiece::Prediction pred = workpiece::Predict(model, screw.process);
-    GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.screw_path,
-                        o.allow_extrapolation);
-    plan_source = {o.model_path, pred, pred.mean};
-    source = "model " + o.model_path + ", screw " + o.screw_path;
+    GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.source.screw_path,
+                        o.source.allow_extrapolation);
+    plan_source = {o.source.model_path, pred, pred.mean};
+    source = "model " + o.source.model_path + ", screw " + o.source.screw_path;
   } else {
-    if (std::isnan(o.max_elongation_um) || std::isnan(o.settle_time_s))
+    if (std::isnan(o.source.max_elongation_um) || std::isnan(o.source.settle_time_s))
       throw InputError("plan: --max-elongation and --settle-time go together");
-    plan_source.features = {o.max_elongation_um, o.settle_time_s};
-    source = "given features, screw " + o.screw_path;
+    plan_source.features = {o.source.max_elongation_um, o.source.settle_time_s};
+    source = "given features, screw " + o.source.screw_path;
   }
   CheckPlanFeatures(plan_source.features, by_features ? "--max-elongation/--settle-time"
-                                                      : "prediction of " + o.model_path);
-  const fit::ArctanCurve curve =
-      fit::ArctanCurve::FromFeatures(plan_source.features, o.shape_k, o.time_exponent);
+                                                      : "prediction of " + o.source.model_path);
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures(
+      plan_source.features, o.source.shape_k, o.source.time_exponent);
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
   const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();
@@ -173,8 +170,8 @@ void Run(const PlanCliOptions& o) {
   std::printf("largest |curve - compensation| on the check grid: %.4f um (tolerance %.4g um)\n",
               plan.max_deviation_um, options.tolerance_um);
   std::printf("largest |SD43910| %s (MD32760 cap %s), axis %s, sign %s, direction %+d\n",
-              interp::FormatFixed(plan.max_abs_slope, interp::kDecimalsSd43910).c_str(),
-              interp::FormatFixed(options.md32760, 4).c_str(), options.axis.c_str(),
+              FormatFixed(plan.max_abs_slope, interp::kDecimalsSd43910).c_str(),
+              FormatFixed(options.md32760, 4).c_str(), options.axis.c_str(),
               interp::ToString(options.sign).c_str(), options.direction);
   for (const auto& [path, what] : {std::pair{o.out_path, "plan JSON"},
                                    {o.csv_path, "PLC table"},
@@ -224,24 +221,8 @@ void RegisterPlan(CLI::App& app) {
       "PLC table CSV (--csv), NC programs (--nc, --reset-nc);\n"
       "all-or-nothing: if one cannot be written (missing directory, a directory, symlink, FIFO or\n"
       "device at the path) none is and previous files stay. Requires MD32750 = 3.");
-  sub->add_option("--model", o->model_path, "model file written by 'whirl train'")
-      ->check(CLI::ExistingFile);
-  sub->add_option("--screw", o->screw_path,
-                  "screw file (JSON): process inputs, thread length "
-                  "and settings that give the axial feed")
-      ->required()
-      ->check(CLI::ExistingFile);
-  sub->add_option("--max-elongation", o->max_elongation_um,
-                  "instead of --model: plateau elongation L [um], 0..10000")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--settle-time", o->settle_time_s,
-                  "instead of --model: settle time t_s [s], 1..1e6")
-      ->check(CLI::PositiveNumber);
-  AddCurveShapeOptions(sub, &o->shape_k, &o->time_exponent);
-  sub->add_option("--tolerance-um", o->tolerance_um,
-                  "largest |compensation - curve| along the thread [um], >= 0.001 (1 nm)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  AddCurveSourceOptions(sub, &o->source, true);
+  AddToleranceOption(sub, &o->tolerance_um);
   sub->add_option("--machine", o->machine_path,
                   "machine profile JSON (schema whirl.machine): axis, direction, machine offset, "
                   "control_dk, MD32760, ID range, R parameters")
@@ -251,14 +232,14 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--start-position-mm", o->start_position_mm,
                   "axis position at the thread start (time 0), program coordinates [mm]; "
                   "required unless the profile has it")
-      ->check(CLI::Range(-kMaxAxisPositionMm, kMaxAxisPositionMm));
+      ->check(NumberIn(kAxisPositionRange));
   sub->add_option("--direction", o->direction,
                   "direction of travel along the axis while cutting: 1 or -1 (default 1)")
       ->check(CLI::IsMember({1, -1}));
   sub->add_option("--machine-offset-mm", o->machine_offset_mm,
                   "machine coordinate of the program zero on this axis [mm] (SD43920 and "
                   "$AA_IM are machine coordinates); required unless --machine")
-      ->check(CLI::Range(-kMaxAxisPositionMm, kMaxAxisPositionMm));
+      ->check(NumberIn(kAxisPositionRange));
   sub->add_option("--control-dk", o->control_dk,
                   "how the control applies dK: added (default) or subtracted")
       ->check(CLI::IsMember({"added", "subtracted"}));
@@ -268,30 +249,30 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--md32760", o->md32760,
                   "MD32760 $MA_COMP_ADD_VELO_FACTOR of the axis: cap on |SD43910| (0-0.10], "
                   "default 0.01")
-      ->check(CLI::Range(1e-12, interp::kMd32760Max));
+      ->check(Md32760Number());
   sub->add_option("--sync-id-first", o->sync_id_first,
                   "first synchronized-action ID whirl may use (1-255); no default: from the "
                   "profile, or required with --sync-id-last for --nc/--reset-nc without one; a "
                   "value that contradicts the profile is refused")
-      ->check(CLI::Range(1, 255));
+      ->check(NumberIn(1, 255));
   sub->add_option("--sync-id-last", o->sync_id_last,
                   "last synchronized-action ID whirl may use (1-255); the programs CANCEL the "
                   "whole range first, so it must be the range the machine builder reserved")
-      ->check(CLI::Range(1, 255));
+      ->check(NumberIn(1, 255));
   sub->add_option("--save-r-first", o->save_r_first,
                   "R<n>..R<n+3> keep the setting data found before the cut and a marker "
                   "(0-9996); no default: from the profile, or required for --nc/--reset-nc "
                   "without one; a value that contradicts the profile is refused")
-      ->check(CLI::Range(0, 9996));
+      ->check(NumberIn(0, 9996));
   sub->add_option("--start-alarm", o->start_alarm,
                   "SETAL number raised when the program is called with the axis at or past the "
                   "thread start (user cycle alarms 65000-69999; default 65004 without a profile; "
                   "must match the profile's start_alarm)")
-      ->check(CLI::Range(interp::kUserAlarmFirst, interp::kUserAlarmLast));
+      ->check(NumberIn(interp::kUserAlarmFirst, interp::kUserAlarmLast));
   sub->add_option("--check-step-s", o->check_step_s,
                   "largest step of the grid the tolerance is checked on [s] (refined as needed)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--out", o->out_path, "write the plan JSON here");
   sub->add_option("--csv", o->csv_path, "write the PLC table (CSV) here");
   sub->add_option("--nc", o->nc_path,
@@ -309,8 +290,6 @@ void RegisterPlan(CLI::App& app) {
   sub->add_option("--reset-nc", o->reset_nc_path,
                   "write the reset subprogram for an aborted cut here (.SPF; a program name as "
                   "for --nc, not the same)");
-  sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
-                "plan even if the screw is outside the model's training domain");
   sub->add_flag("--json", o->json, "machine output: the plan JSON on stdout");
   sub->callback([o] { Run(*o); });
 }

@@ -104,14 +104,21 @@ void RegisterPredict(CLI::App& app) {
       ->check(CLI::ExistingFile);
   auto* input = sub->add_option("--input", o->input_path, "table of processes (CSV)")
                     ->check(CLI::ExistingFile);
-  // Ranges: the physical limits (core/limits.h), checked with one clear message after parsing.
-  auto* h = sub->add_option("--hardness", o->hardness_hrc, "workpiece hardness [HRC], 20..70");
-  auto* d = sub->add_option("--diameter", o->diameter_mm, "screw diameter [mm], (0, 500]");
-  auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm], (0, 100]");
+  // Ranges: the physical limits (core/limits.h); the message names the table column as well.
+  auto* h =
+      sub->add_option("--hardness", o->hardness_hrc, "workpiece hardness [HRC], 20..70")
+          ->check(NumberIn(Range{kMinHardnessHrc, kMaxHardnessHrc, false, "HRC", "hardness_hrc"}));
+  auto* d = sub->add_option("--diameter", o->diameter_mm, "screw diameter [mm], (0, 500]")
+                ->check(NumberIn(Range{0, kMaxDiameterMm, true, "mm", "diameter_mm"}));
+  auto* p = sub->add_option("--pitch", o->pitch_mm, "lead (pitch) of the thread [mm], (0, 100]")
+                ->check(NumberIn(Range{0, kMaxPitchMm, true, "mm", "pitch_mm"}));
   auto* r = sub->add_option("--raceway-radius", o->raceway_radius_mm,
-                            "raceway (ball-groove) radius [mm], (0, 50]");
-  auto* v = sub->add_option("--cutting-speed", o->cutting_speed_m_min,
-                            "cutting speed of the whirling tools [m/min], (0, 1000]");
+                            "raceway (ball-groove) radius [mm], (0, 50]")
+                ->check(NumberIn(Range{0, kMaxRacewayRadiusMm, true, "mm", "raceway_radius_mm"}));
+  auto* v =
+      sub->add_option("--cutting-speed", o->cutting_speed_m_min,
+                      "cutting speed of the whirling tools [m/min], (0, 1000]")
+          ->check(NumberIn(Range{0, kMaxCuttingSpeedMMin, true, "m/min", "cutting_speed_m_min"}));
   for (auto* flag : {h, d, p, r, v}) input->excludes(flag);
   sub->add_option("--out", o->out_path,
                   "write a CSV: the inputs, max_elongation_um, max_elongation_std_um,\n"

@@ -8,6 +8,7 @@
 #include "core/csv.h"
 #include "core/curve.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
@@ -100,11 +101,7 @@ void Run(const SimulateOptions& o) {
   }
   // Human output rounds to what a process engineer reads (4 significant digits); --json and the
   // curve file keep full precision.
-  const auto g = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", x);
-    return std::string(buf);
-  };
+  const auto g = [](double x) { return FormatSignificant(x, 4); };
   const auto& k = r.kinematics;
   std::cout << "screw " << screw.name << ": " << g(screw.process.diameter_mm) << " mm x "
             << g(screw.process.pitch_mm) << " mm lead, thread " << g(screw.thread_length_mm)
@@ -147,14 +144,14 @@ void RegisterSimulate(CLI::App& app) {
                   "write the recorded curve as CSV time_s,elongation_um (s, um), atomically");
   sub->add_option("--duration-s", opts->duration_s,
                   "simulated cutting time in s; 0 = the whole thread (hours)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   sub->add_flag("--no-disturbances", opts->no_disturbances,
                 "pure physics: no workpiece variation, ambient drift or measurement noise");
   AddSeedOption(sub, &opts->seed, "seed of the disturbances (default 1)");
   sub->add_option("--cell-size-mm", opts->cell_size_mm, "finite-volume cell size in mm")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_option("--time-step-s", opts->time_step_s, "BDF2 time step in s")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   sub->add_flag("--json", opts->json, "print the result as JSON on stdout");
   sub->callback([opts] { Run(*opts); });
 }

@@ -69,21 +69,21 @@ void SetupSynth(CLI::App& parent) {
       ->check(CLI::IsMember({"smooth", "bump"}));
   sub->add_option("--nx", o->synth.nx,
                   "grid columns along X (2..200, default 9; nx * ny <= 10000, the points limit)")
-      ->check(CLI::Range(2, 200));
+      ->check(NumberIn(2, 200));
   sub->add_option("--ny", o->synth.ny, "grid rows along Y (2..200, default 7)")
-      ->check(CLI::Range(2, 200));
+      ->check(NumberIn(2, 200));
   sub->add_option("--length-x-mm", o->synth.length_x_mm, "table travel in X, mm (default 800)")
-      ->check(CLI::Range(1e-3, kMaxCoordinateMm));
+      ->check(NumberIn(1e-3, kMaxCoordinateMm));
   sub->add_option("--length-y-mm", o->synth.length_y_mm, "table travel in Y, mm (default 500)")
-      ->check(CLI::Range(1e-3, kMaxCoordinateMm));
+      ->check(NumberIn(1e-3, kMaxCoordinateMm));
   sub->add_option("--noise-um", o->synth.noise_um,
                   "standard deviation of the measurement noise, um (0..10, default 1)")
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(NumberIn(0.0, 10.0));
   sub->add_option("--bump-um", o->synth.bump_um, "bump amplitude A, um (0..100, default 15)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(NumberIn(0.0, 100.0));
   sub->add_option("--bump-sigma-fraction", o->synth.bump_sigma_fraction,
                   "bump width sigma / Lx (0.01..1, default 0.1)")
-      ->check(CLI::Range(0.01, 1.0));
+      ->check(NumberIn(0.01, 1.0));
   AddSeedOption(sub, &o->synth.seed, "noise seed (default 1)");
   sub->add_option("--out", o->out, "points CSV to write")->required();
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
@@ -156,7 +156,7 @@ void SetupFit(CLI::App& parent, const std::string& command) {
   sub->add_option("--method", o->method, "cubic | bspline (default cubic)")
       ->check(CLI::IsMember({"cubic", "bspline"}));
   sub->add_option("--degree", o->degree, "B-spline degree p in X and Y (1..5, default 3)")
-      ->check(CLI::Range(1, kMaxDegree));
+      ->check(NumberIn(1, kMaxDegree));
   sub->add_option("--out", o->out, "surface JSON to write (schema whirl.surface)");
   sub->add_option("--report", o->report,
                   "directory for an HTML page: map of the surface with the measured points, "
@@ -214,8 +214,8 @@ void SetupPredict(CLI::App& parent) {
   sub->add_option("--surface", o->surface, "surface JSON from 'whirl surface fit'")
       ->required()
       ->check(CLI::ExistingFile);
-  FiniteNumber(sub->add_option("--x", o->x, "table X, mm"));
-  FiniteNumber(sub->add_option("--y", o->y, "table Y, mm"));
+  sub->add_option("--x", o->x, "table X, mm")->check(FiniteNumber());
+  sub->add_option("--y", o->y, "table Y, mm")->check(FiniteNumber());
   sub->add_option("--input", o->input, "CSV of positions x_mm,y_mm (at most 10000 rows)")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "CSV to write: x_mm,y_mm,error_um");
@@ -252,13 +252,16 @@ void SetupCompare(CLI::App& parent) {
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--degree", o->choice.degree, "B-spline degree (1..5, default 3)")
-      ->check(CLI::Range(1, kMaxDegree));
+      ->check(NumberIn(1, kMaxDegree));
   sub->add_option("--edge-ratio", o->choice.edge_ratio,
-                  "edge / interior LOO RMS that flags oscillation (> 1, default 1.5)");
+                  "edge / interior LOO RMS that flags oscillation (> 1, default 1.5)")
+      ->check(FiniteNumber());
   sub->add_option("--overshoot-fraction", o->choice.overshoot_fraction,
-                  "overshoot / measured range that flags oscillation (> 0, default 0.1)");
+                  "overshoot / measured range that flags oscillation (> 0, default 0.1)")
+      ->check(FiniteNumber());
   sub->add_option("--min-excess-um", o->choice.min_excess_um,
-                  "smallest excess that flags oscillation, um (default 0.5)");
+                  "smallest excess that flags oscillation, um (default 0.5)")
+      ->check(FiniteNumber("um"));
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] { RunCompare(*o); });
 }
@@ -304,20 +307,22 @@ void SetupLine(CLI::App& parent) {
   sub->add_option("--axis", o->line.axis,
                   "840D axis name for $SA_...[axis]: a letter, then letters, digits or '_' "
                   "(default X)");
-  FiniteNumber(sub->add_option(
-      "--at-mm", o->at_mm,
-      "one traverse at this fixed other coordinate, mm (default: the whole table)"));
-  FiniteNumber(
-      sub->add_option("--ref-position-mm", o->ref_mm,
-                      "reference position P0 in surface coordinates, mm (default: travel start)"));
-  FiniteNumber(sub->add_option(
-      "--machine-offset-mm", o->line.machine_offset_mm,
-      "MCS position of the surface's coordinate origin on this axis, mm (default 0)"));
+  sub->add_option("--at-mm", o->at_mm,
+                  "one traverse at this fixed other coordinate, mm (default: the whole table)")
+      ->check(FiniteNumber());
+  sub->add_option("--ref-position-mm", o->ref_mm,
+                  "reference position P0 in surface coordinates, mm (default: travel start)")
+      ->check(FiniteNumber());
+  sub->add_option("--machine-offset-mm", o->line.machine_offset_mm,
+                  "MCS position of the surface's coordinate origin on this axis, mm (default 0)")
+      ->check(FiniteNumber());
   sub->add_option("--sign", o->sign, "subtract (dK = -line, default) | add")
       ->check(CLI::IsMember({"subtract", "add"}));
   sub->add_option("--md32760", o->line.md32760,
-                  "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910| (0..0.10, default 0.01)");
-  sub->add_option("--samples", o->line.samples, "samples per direction (2..1001, default 101)");
+                  "MD32760 $MA_COMP_ADD_VELO_FACTOR: cap on |SD43910| (0..0.10, default 0.01)")
+      ->check(Md32760Number());
+  sub->add_option("--samples", o->line.samples, "samples per direction (2..1001, default 101)")
+      ->check(NumberIn(2, 1001));
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] { RunLine(*o); });
 }
@@ -399,13 +404,13 @@ void SetupPoints(CLI::App& parent) {
   sub->add_option("--sensors", o->sensors,
                   "temperature columns to use (default: seed 000 selection)")
       ->delimiter(',');
-  FiniteNumber(
-      sub->add_option("--time-min", o->time_min, "moment of the surface, min (nearest sample)"))
+  sub->add_option("--time-min", o->time_min, "moment of the surface, min (nearest sample)")
+      ->check(FiniteNumber())
       ->required();
   sub->add_option("--method", o->method, "cubic | bspline (default cubic)")
       ->check(CLI::IsMember({"cubic", "bspline"}));
   sub->add_option("--degree", o->degree, "B-spline degree (1..5, default 3)")
-      ->check(CLI::Range(1, kMaxDegree));
+      ->check(NumberIn(1, kMaxDegree));
   sub->add_option("--out", o->out, "surface JSON to write");
   sub->add_option("--predictions", o->predictions,
                   "CSV of every point's prediction per sample, um");

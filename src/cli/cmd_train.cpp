@@ -9,13 +9,13 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/process.h"
 #include "nn/model.h"
@@ -71,12 +71,6 @@ int ParseHidden(const std::string& s) {
   if (std::sscanf(s.c_str(), "%d%c", &h, &tail) != 1 || h < 0 || h > 200)
     throw InputError("--hidden '" + s + "': expected 'evidence', 'auto' or an integer in [0, 200]");
   return h;
-}
-
-std::string Fmt(double x, int digits = 4) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-  return buf;
 }
 
 void RunSweep(const TrainCliOptions& o, const ProcessTable& table) {
@@ -166,24 +160,30 @@ void PrintModelSummary(const TrainCliOptions& o, const nn::Model& model, std::si
   std::cout << "  " << s.BriefReport() << "\n";
   std::cout << "  hidden layer: " << model.hidden_selection << "\n";
   std::cout << "  stopping: " << model.stopping << "\n";
-  std::cout << "  fit time " << Fmt(fit_ms)
+  std::cout << "  fit time " << FormatSignificant(fit_ms, 4)
             << " ms (hidden-size choice, training, noise calibration)\n";
-  std::cout << "  RMS training error: max_elongation " << Fmt(s.rms_error(0)) << " um, settle_time "
-            << Fmt(s.rms_error(1)) << " s (normalized ssE " << Fmt(s.sse) << ")\n";
-  std::cout << "  gamma " << Fmt(s.gamma) << " of " << s.parameter_count << ", alpha "
-            << Fmt(s.alpha) << ", beta " << Fmt(s.beta) << ", sum of squared weights "
-            << Fmt(s.sum_squared_weights) << ", log evidence " << Fmt(s.log_evidence, 6) << "\n";
+  std::cout << "  RMS training error: max_elongation " << FormatSignificant(s.rms_error(0), 4)
+            << " um, settle_time " << FormatSignificant(s.rms_error(1), 4) << " s (normalized ssE "
+            << FormatSignificant(s.sse, 4) << ")\n";
+  std::cout << "  gamma " << FormatSignificant(s.gamma, 4) << " of " << s.parameter_count
+            << ", alpha " << FormatSignificant(s.alpha, 4) << ", beta "
+            << FormatSignificant(s.beta, 4) << ", sum of squared weights "
+            << FormatSignificant(s.sum_squared_weights, 4) << ", log evidence "
+            << FormatSignificant(s.log_evidence, 6) << "\n";
   if (s.ard_alpha.size() == ProcessInputs::kCount + 1) {
     std::cout << "  ARD alpha per input (larger = less relevant; normalized units):";
     for (int i = 0; i < ProcessInputs::kCount; ++i)
-      std::cout << (i ? ", " : " ") << kInputColumns[i] << " " << Fmt(s.ard_alpha(i));
-    std::cout << "; other weights " << Fmt(s.ard_alpha(ProcessInputs::kCount)) << "\n";
+      std::cout << (i ? ", " : " ") << kInputColumns[i] << " "
+                << FormatSignificant(s.ard_alpha(i), 4);
+    std::cout << "; other weights " << FormatSignificant(s.ard_alpha(ProcessInputs::kCount), 4)
+              << "\n";
   }
   if (model.restarts > 1) {
     std::cout << "  restarts (best log evidence kept):\n";
     for (const auto& r : model.restart_runs)
-      std::cout << "    seed " << r.seed << ": log evidence " << Fmt(r.log_evidence, 6) << ", ssE "
-                << Fmt(r.sse) << ", gamma " << Fmt(r.gamma) << ", " << r.epochs << " epochs, "
+      std::cout << "    seed " << r.seed << ": log evidence "
+                << FormatSignificant(r.log_evidence, 6) << ", ssE " << FormatSignificant(r.sse, 4)
+                << ", gamma " << FormatSignificant(r.gamma, 4) << ", " << r.epochs << " epochs, "
                 << nn::ToString(r.termination) << (r.seed == model.init_seed ? "  <- kept" : "")
                 << "\n";
   }
@@ -278,7 +278,8 @@ void Run(const TrainCliOptions& o) {
                                            std::to_string(o.restarts) +
                                            (info.ard_stage ? " ARD epoch " : " epoch ") +
                                            std::to_string(info.epoch) + " F " +
-                                           Fmt(info.objective) + " gamma " + Fmt(info.gamma));
+                                           FormatSignificant(info.objective, 4) + " gamma " +
+                                           FormatSignificant(info.gamma, 4));
       });
   progress.Finish();
   const double fit_ms =
@@ -353,10 +354,10 @@ void RegisterTrain(CLI::App& app) {
                   "train this many networks (seeds seed..seed+K-1) and keep the one with the\n"
                   "highest log evidence ln P(D|alpha,beta) (MacKay 1992)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+      ->check(NumberIn(1, 1000));
   sub->add_option("--epochs", o->epochs, "trainbr epoch limit (MATLAB default 1000)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 1000000));
+      ->check(NumberIn(0, 1000000));
   auto* sweep = sub->add_option(
       "--hidden-sweep", o->hidden_sweep,
       "A..B: instead of writing a model, report for each hidden size A..B the training RMS\n"
@@ -364,7 +365,7 @@ void RegisterTrain(CLI::App& app) {
       "cross-validation RMS error, so the size can be picked as in the paper; 1 <= A <= B <= 200");
   sub->add_option("--folds", o->folds, "k of k-fold cross-validation for --hidden-sweep")
       ->capture_default_str()
-      ->check(CLI::Range(2, 1000));
+      ->check(NumberIn(2, 1000));
   sub->add_flag("--trainbr-matlab", o->trainbr_matlab,
                 "the paper's MATLAB trainbr setting: 5-6-2 (or --hidden N) trained to\n"
                 "trainbr's own stopping criteria (mu_max, min_grad, --epochs); no size search");
@@ -386,16 +387,16 @@ void RegisterTrain(CLI::App& app) {
                   "(dimensionless, normalized targets) changed by less than this between each\n"
                   "of the last 4 epochs; 0 = off (MATLAB). Default 0.001 (brnn's), not allowed\n"
                   "with --trainbr-matlab")
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(NumberIn(0.0, 1e6));
   sub->add_option("--noise-folds", o->noise_folds,
                   "K of the K-fold cross-validation that sets each output's noise level")
       ->capture_default_str()
-      ->check(CLI::Range(2, 1000));
+      ->check(NumberIn(2, 1000));
   sub->add_option("--threads", o->threads,
                   "threads for restarts, stopping/noise folds and sweep fits (0 = all cores);\n"
                   "the result is identical for any count")
       ->capture_default_str()
-      ->check(CLI::Range(0, 256));
+      ->check(NumberIn(0, 256));
   sub->add_flag("--json", o->json, "machine output: JSON summary on stdout");
   sub->add_option("--family", o->family,
                   "auto (default): the family choice by cross-validated error; network: the\n"

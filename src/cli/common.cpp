@@ -9,13 +9,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include "cli/terminal.h"
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 #include "core/safe_text.h"
 #include "fit/arctan_curve.h"
+#include "interp/sinumerik.h"
 
 namespace whirl::cli {
 
@@ -24,34 +27,104 @@ void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent)
                   "shape k of the arctangent curve l(t) = L atan(k (t/t_s)^p)/atan(k) [-] "
                   "(default: fitted on simulated curves, 'whirl fit --simulated 25')")
       ->capture_default_str()
-      ->check(CLI::Range(fit::kMinShapeK, fit::kMaxShapeK));
+      ->check(NumberIn(fit::kMinShapeK, fit::kMaxShapeK));
   sub->add_option("--time-exponent", *time_exponent,
                   "time exponent p of that curve, in [0.5, 1]; 1 = the plain arctangent in time "
                   "[-] (default: fitted with k). Below about 0.7 the curve starts so steeply that "
                   "the first segment's SD43910 can exceed the MD32760 cap (an error)")
       ->capture_default_str()
-      ->check(CLI::Range(fit::kMinTimeExponent, fit::kMaxTimeExponent));
+      ->check(NumberIn(fit::kMinTimeExponent, fit::kMaxTimeExponent));
 }
 
-CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help) {
+void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_required) {
+  sub->add_option("--model", a->model_path, "model file written by 'whirl train'")
+      ->check(CLI::ExistingFile);
+  auto* screw = sub->add_option("--screw", a->screw_path,
+                                "screw file (JSON, see 'whirl simulate --help'): process inputs, "
+                                "thread length and settings that give the axial feed")
+                    ->check(CLI::ExistingFile);
+  if (screw_required) screw->required();
+  sub->add_option("--max-elongation", a->max_elongation_um,
+                  "instead of --model: plateau elongation L [um]")
+      ->check(NumberIn(Range{0, kMaxElongationUm, false, "um", "max_elongation_um"}));
+  sub->add_option("--settle-time", a->settle_time_s, "instead of --model: settle time t_s [s]")
+      ->check(NumberIn(Range{kMinPlanSettleTimeS, kMaxSettleTimeS, false, "s",
+                             "settle_time_s: at least 1 s, so the check grid stays bounded"}));
+  AddCurveShapeOptions(sub, &a->shape_k, &a->time_exponent);
+  sub->add_flag("--allow-extrapolation", a->allow_extrapolation,
+                "use the prediction even if the screw lies outside the model's training domain");
+}
+
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help,
+                           const std::string& flag) {
   const auto rule = [](std::string& text) -> std::string {
     const bool digits = !text.empty() && text.size() <= 20 &&
                         text.find_first_not_of("0123456789") == std::string::npos;
     errno = 0;
     if (digits) (void)std::strtoull(text.c_str(), nullptr, 10);
     if (digits && errno == 0) return "";
-    return "seed '" + text + "' breaks the rule: a whole number in [0, 18446744073709551615]";
+    return "'" + text + "' breaks the rule: a whole number in [0, 18446744073709551615]";
   };
-  return sub->add_option("--seed", *seed, help + " [0 .. 2^64-1]")
-      ->check(CLI::Validator(rule, "UINT64"));
+  return sub->add_option(flag, *seed, help)->check(CLI::Validator(rule, "[0, 2^64-1]"));
 }
 
-CLI::Option* FiniteNumber(CLI::Option* option) {
-  const auto rule = [](std::string& text) -> std::string {
-    if (ParseDecimal(text)) return "";
-    return "'" + text + "' must be a finite decimal number";
+namespace {
+
+// "[0.001, 10000]"; without an upper bound "> 0" or ">= 0"; "" for any finite number.
+std::string Bounds(const Range& range) {
+  constexpr double kLargest = std::numeric_limits<double>::max();
+  if (range.max < kLargest)
+    return std::string(range.min_open ? "(" : "[") + MessageNumber(range.min) + ", " +
+           MessageNumber(range.max) + "]";
+  if (range.min > -kLargest)
+    return std::string(range.min_open ? "> " : ">= ") + MessageNumber(range.min);
+  return "";
+}
+
+}  // namespace
+
+CLI::Validator NumberIn(const Range& range) {
+  const std::string bounds = Bounds(range);
+  const std::string unit = *range.unit ? std::string(" ") + range.unit : "";
+  const std::string text = (bounds.empty() ? "finite" : bounds) + unit;  // shown in --help
+  const std::string rule = "a finite number" +
+                           (bounds.empty() ? "" : (bounds[0] == '>' ? " " : " in ") + bounds) +
+                           unit + (*range.note ? std::string(" (") + range.note + ")" : "");
+  const auto check = [range, rule](std::string& value) -> std::string {
+    const auto x = ParseDecimal(value);
+    if (x && range.Contains(*x)) return "";
+    return (x ? value : "'" + value + "'") + " breaks the rule: " + rule;  // as typed
   };
-  return option->check(CLI::Validator(rule, "FINITE"));
+  return CLI::Validator(check, text);
+}
+
+CLI::Validator NumberIn(double min, double max, const char* unit) {
+  return NumberIn(Range{min, max, false, unit});
+}
+
+CLI::Validator PositiveNumber(const char* unit) {
+  return NumberIn(Range{0, std::numeric_limits<double>::max(), true, unit});
+}
+
+CLI::Validator NonNegativeNumber(const char* unit) {
+  return NumberIn(0, std::numeric_limits<double>::max(), unit);
+}
+
+CLI::Validator FiniteNumber(const char* unit) {
+  return NumberIn(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), unit);
+}
+
+CLI::Validator Md32760Number() {
+  return NumberIn(
+      Range{0, interp::kMd32760Max, true, "", "MD32760 on the 840D must be in (0, 0.10]"});
+}
+
+void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
+  sub->add_option("--tolerance-um", *tolerance_um,
+                  "largest |840D chord - predicted curve| of the plan along the thread [um]; at "
+                  "least 1 nm, the resolution of SD43900")
+      ->capture_default_str()
+      ->check(NumberIn(kPlanToleranceRange));
 }
 
 int RunApp(CLI::App& app, int argc, char** argv) {

@@ -1,5 +1,6 @@
 #pragma once
 // Small helpers shared by the subcommands. The library never includes CLI11; this folder does.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -8,9 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "core/limits.h"
+#include "fit/arctan_curve.h"
+
 namespace CLI {
 class App;
 class Option;
+class Validator;
 }
 
 namespace whirl::cli {
@@ -41,13 +46,51 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
 /// --shape-k K and --time-exponent P, with their ranges and defaults (fit/arctan_curve.h).
 void AddCurveShapeOptions(CLI::App* sub, double* shape_k, double* time_exponent);
 
-/// A --seed option: a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5" or a larger
-/// number is a parse error naming the rule, never wrapped. Returns the option for chaining.
-CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help);
+/// Where the arctangent curve of `curve` and `plan` comes from: a model's prediction for a screw
+/// (--model M --screw S.json) or given features (--max-elongation L --settle-time T), its shape,
+/// and whether a screw outside the model's training domain may be used (GuardTrainingDomain).
+struct CurveSourceArgs {
+  std::string model_path, screw_path;
+  double max_elongation_um = NAN;  ///< um; NAN: not given
+  double settle_time_s = NAN;      ///< s; NAN: not given
+  double shape_k = fit::kDefaultShapeK;
+  double time_exponent = fit::kDefaultTimeExponent;
+  bool allow_extrapolation = false;
+};
 
-/// Makes a number option refuse nan, inf and every form that is not a finite decimal number
-/// (parse error "<flag>: '<text>' must be a finite number"). Returns the option for chaining.
-CLI::Option* FiniteNumber(CLI::Option* option);
+/// --model, --screw (required when `screw_required`), --max-elongation, --settle-time, the shape
+/// options (AddCurveShapeOptions) and --allow-extrapolation.
+void AddCurveSourceOptions(CLI::App* sub, CurveSourceArgs* a, bool screw_required);
+
+/// A --seed option (or `flag`): a whole number in [0, 2^64 - 1] (unsigned 64 bit); "-1", "1.5"
+/// or a larger number is a parse error naming the rule, never wrapped. Returns the option.
+CLI::Option* AddSeedOption(CLI::App* sub, std::uint64_t* seed, const std::string& help,
+                           const std::string& flag = "--seed");
+
+/// The one check of every numeric flag: the text must be a finite decimal number (core/csv.h
+/// ParseDecimal: "nan", "inf", "1e999", "0x1p3" and "1,5" are refused) inside `range`. CLI11
+/// names the flag in front of the message: "--tolerance-um: 1e-9 breaks the rule: a finite
+/// number in [0.001, 10000] um (...)", the value as typed, the range written as in every message
+/// (MessageNumber). A whole-number flag also needs its text to convert, which CLI11 checks after.
+/// The range shows in --help after the type: "FLOAT:[0.001, 10000] um", "FLOAT:> 0 s" (no upper
+/// bound), "FLOAT:finite".
+CLI::Validator NumberIn(const Range& range);
+/// NumberIn of the closed range [min, max] with `unit` ("" for counts and ratios).
+CLI::Validator NumberIn(double min, double max, const char* unit = "");
+/// NumberIn over (0, largest double]: a positive finite number.
+CLI::Validator PositiveNumber(const char* unit = "");
+/// NumberIn over [0, largest double]: a finite number >= 0.
+CLI::Validator NonNegativeNumber(const char* unit = "");
+/// NumberIn over the whole double range: any finite number.
+CLI::Validator FiniteNumber(const char* unit = "");
+
+/// NumberIn over (0, interp::kMd32760Max]: the MD32760 factor of every --md32760 flag.
+CLI::Validator Md32760Number();
+
+/// --tolerance-um, shared by plan, compare and evaluate: the largest |840D chord - predicted
+/// curve| of a plan [um], in kPlanToleranceRange (core/limits.h) (checked again by
+/// PlanOptions::Validate with the same rule), default interp::PlanOptions's.
+void AddToleranceOption(CLI::App* sub, double* tolerance_um);
 
 /// Machine output: JSON on stdout, pretty-printed, newline-terminated.
 void PrintJson(const nlohmann::json& j);

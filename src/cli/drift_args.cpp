@@ -2,13 +2,14 @@
 
 #include <stdexcept>
 
+#include "cli/common.h"
 #include "core/error.h"
 
 namespace whirl::cli {
 
 void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
   sub->add_option("--alpha", s->alpha, "significance level of the F test (default 0.05)")
-      ->check(CLI::Range(1e-6, 0.5));
+      ->check(NumberIn(1e-6, 0.5));
   sub->add_option("--classes", s->classes,
                   "class count: 'fewest' (seed 000: fewest classes with a significant F, "
                   "default), 'margin' (largest (F - F_crit)/F_crit), 'cv' (the count whose "
@@ -16,7 +17,7 @@ void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
                   "forward-chaining blocks of one run) or a number");
   sub->add_option("--max-sensors", s->max_sensors,
                   "at most this many classes = chosen sensors (0: no limit)")
-      ->check(CLI::Range(0, 64));
+      ->check(NumberIn(0, 64));
 }
 
 drift::SelectionOptions ToSelection(const SelectionArgs& a) {

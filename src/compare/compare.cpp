@@ -1,9 +1,9 @@
 #include "compare/compare.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "sim/dataset.h"
 #include "sim/features.h"
 
@@ -21,6 +21,12 @@ std::string ToString(Strategy s) {
       return "traditional";
     case Strategy::kModel:
       return "model";
+    case Strategy::kClass:
+      return "class";
+    case Strategy::kTable:
+      return "table";
+    case Strategy::kNearest:
+      return "nearest";
   }
   return "none";
 }
@@ -35,12 +41,6 @@ std::optional<double> Reduce(double value, double baseline) {
 
 nlohmann::json Optional(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json();
-}
-
-std::string Fixed(double x, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  return buf;
 }
 
 }  // namespace
@@ -63,13 +63,13 @@ const StrategyOutcome& ScrewComparison::Outcome(Strategy s) const {
 std::string ScrewComparison::BriefReport() const {
   std::string s = screw.name + ": accumulated within 1000 mm";
   for (const auto& o : outcomes)
-    s += " " + ToString(o.strategy) + " " + Fixed(o.metrics.accumulated_1000_um, 1);
+    s += " " + ToString(o.strategy) + " " + FormatDecimals(o.metrics.accumulated_1000_um, 1);
   s += " um; whole thread";
   for (const auto& o : outcomes)
-    s += " " + ToString(o.strategy) + " " + Fixed(o.metrics.accumulated_total_um, 1);
+    s += " " + ToString(o.strategy) + " " + FormatDecimals(o.metrics.accumulated_total_um, 1);
   s += " um";
   if (model_vs_traditional.accumulated_1000_pct)
-    s += " (model " + Fixed(*model_vs_traditional.accumulated_1000_pct, 1) +
+    s += " (model " + FormatDecimals(*model_vs_traditional.accumulated_1000_pct, 1) +
          " % less than traditional within 1000 mm)";
   s += ", ISO class";
   for (const auto& o : outcomes) s += " " + ToString(o.strategy) + " " + ToString(o.iso.reached);
@@ -195,7 +195,14 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const workpiece::Workpiece
   // Curve baselines: the same shape and the same 840D planning as the model.
   c.experience_class = rule.ClassFor(screw.process.diameter_mm);
   c.experience_ramp_time_s = rule.ramp_time_s;
-  c.traditional_features = rule.ClassFeatures(screw.process.diameter_mm);
+  c.traditional_rule = rule.has_choice ? rule.choice.chosen : HistoryRule::kClass;
+  c.traditional_features = rule.TraditionalFeatures(screw.process);
+  std::array<interp::CompensationPlan, kHistoryRuleCount> history_plans;
+  for (std::size_t k = 0; k < kHistoryRuleCount; ++k) {
+    const HistoryRule h = static_cast<HistoryRule>(k);
+    c.history_features[k] = rule.HistoryFeatures(h, screw.process);
+    history_plans[k] = BaselinePlan(c.history_features[k], ToString(h), screw, feed, options);
+  }
   if (rule.has_regression) c.regression_features = rule.regression.Predict(screw.process);
   const interp::CompensationPlan traditional_plan =
       BaselinePlan(c.traditional_features, "traditional", screw, feed, options);
@@ -205,8 +212,12 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const workpiece::Workpiece
   const std::array<CompensationFunction, kStrategyCount> comp = {
       NoCompensation(),
       [&rule, diameter](double t_s) { return rule.CompensationUm(diameter, t_s); },
-      PlannedCompensation(traditional_plan, feed), PlannedCompensation(regression_plan, feed),
-      PlannedCompensation(c.plan, feed)};
+      PlannedCompensation(traditional_plan, feed),
+      PlannedCompensation(regression_plan, feed),
+      PlannedCompensation(c.plan, feed),
+      PlannedCompensation(history_plans[0], feed),
+      PlannedCompensation(history_plans[1], feed),
+      PlannedCompensation(history_plans[2], feed)};
   CutWithEveryStrategy(comp, screw, iso_table, options, &c);
   return c;
 }
@@ -268,7 +279,9 @@ void to_json(nlohmann::json& j, const ScrewComparison& c) {
                        {"class_screws", c.experience_class.screws},
                        {"ramp_time_s", c.experience_ramp_time_s}}},
                      {"traditional",
-                      {{"rule", "class means (P_class, T_class), arctangent curve, 840D plan"},
+                      {{"rule", "the strongest history rule (leave-one-out on the history), "
+                                "arctangent curve, 840D plan"},
+                       {"chosen", ToString(c.traditional_rule)},
                        {"max_elongation_um", c.traditional_features.max_elongation_um},
                        {"settle_time_s", c.traditional_features.settle_time_s}}},
                      {"regression",

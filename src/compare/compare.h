@@ -4,12 +4,17 @@
 //
 //   none         c(t) = 0
 //   ramp         c(t) = P_class min(1, t / T), the previous experience rule (compare/traditional.h)
-//   traditional  the class means (P_class, T_class) -> arctangent curve -> 840D plan (as model)
+//   traditional  the strongest history rule (compare/history_rules.h: class, table or nearest,
+//                chosen by leave-one-out on the history, never on the screw being cut) ->
+//                arctangent curve -> 840D plan (as model)
 //   regression   log-linear least squares on the history -> arctangent curve -> 840D plan
 //   model        workpiece::Predict -> fit::ArctanCurve::FromFeatures -> interp::BuildPlan with the
 //                screw's kinematics -> c(t) = interp::AppliedCompensationUm(plan, P(t)), i.e. the
 //                value the 840D reconstructs from SD43900/SD43910/SD43920 at the axis position
 //                P(t) = interp::AxisPositionMm(plan options, feed, t).
+//   class        the diameter-class means (P_class, T_class) -> arctangent curve -> 840D plan
+//   table        the experience table (raceway radius x speed x lead) -> curve -> 840D plan
+//   nearest      the 3 nearest past screws' mean features -> curve -> 840D plan
 //
 // Truth: sim::Simulate over the whole thread with the seeded disturbances ON (per-workpiece heat
 // partition and expansion coefficient, ambient drift) that the model never saw. The groove is
@@ -35,12 +40,22 @@
 
 namespace whirl::compare {
 
-enum class Strategy { kNone, kRamp, kTraditional, kRegression, kModel };
-inline constexpr std::size_t kStrategyCount = 5;
+enum class Strategy {
+  kNone,
+  kRamp,
+  kTraditional,
+  kRegression,
+  kModel,
+  kClass,
+  kTable,
+  kNearest
+};
+inline constexpr std::size_t kStrategyCount = 8;
 inline constexpr std::array<Strategy, kStrategyCount> kStrategies = {
-    Strategy::kNone, Strategy::kRamp, Strategy::kTraditional, Strategy::kRegression,
-    Strategy::kModel};
-std::string ToString(Strategy s);  ///< "none", "ramp", "traditional", "regression", "model"
+    Strategy::kNone,  Strategy::kRamp,  Strategy::kTraditional, Strategy::kRegression,
+    Strategy::kModel, Strategy::kClass, Strategy::kTable,       Strategy::kNearest};
+/// "none", "ramp", "traditional", "regression", "model", "class", "table", "nearest"
+std::string ToString(Strategy s);
 
 struct CompareOptions {
   /// Seed of the truth's disturbances (sim::DisturbanceOptions::seed).
@@ -92,9 +107,12 @@ struct ScrewComparison {
   interp::CompensationPlan plan;
   ExperienceClass experience_class;  ///< the traditional rule's class of this screw
   double experience_ramp_time_s = 0;
-  /// Features the curve-based baselines use: class means (traditional), regression (zero when
-  /// the history has no regression baseline: the strategy then equals none).
+  /// Features the curve-based baselines use: the strongest history rule (traditional),
+  /// regression (zero when the history has no regression baseline: the strategy then equals
+  /// none), and each history rule (HistoryRule order: class, table, nearest).
   Features traditional_features, regression_features;
+  std::array<Features, kHistoryRuleCount> history_features{};
+  HistoryRule traditional_rule = HistoryRule::kClass;  ///< which rule "traditional" is
   /// Compensation applied at the truth's sample times, um, per strategy (kStrategies order).
   std::array<std::vector<double>, kStrategyCount> compensation_um;
   std::array<StrategyOutcome, kStrategyCount> outcomes;  ///< in kStrategies order

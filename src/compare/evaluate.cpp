@@ -158,14 +158,15 @@ EvaluationSummary Summarize(const std::vector<EvaluatedScrew>& screws) {
   }
   std::string m = std::to_string(s.screws) + " screws (" + std::to_string(s.failed) +
                   " failed): accumulated error within 1000 mm, median (worst) um:";
-  char buf[160];
+  char buf[256];
   for (std::size_t k = 0; k < kStrategyCount; ++k) {
     std::snprintf(buf, sizeof buf, " %s %.2f (%.1f)", ToString(kStrategies[k]).c_str(),
                   s.absolute[k].acc1000_median_um, s.absolute[k].acc1000_worst_um);
     m += buf;
   }
   std::snprintf(buf, sizeof buf,
-                "; model vs traditional: median reduction %.1f %%, vs regression %.1f %%",
+                "; model vs traditional (the strongest history rule, chosen by leave-one-out on "
+                "the history): median reduction %.1f %%, vs regression %.1f %%",
                 s.acc1000_vs_traditional.median_pct, s.acc1000_vs_regression.median_pct);
   s.message = m + buf;
   return s;

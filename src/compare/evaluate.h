@@ -46,8 +46,11 @@ struct EvaluatedScrew {
   std::string error;            ///< the InputError message when !ok (e.g. a slope beyond MD32760)
   bool outside_domain = false;  ///< the model extrapolated
   std::array<LeadMetrics, kStrategyCount> metrics;  ///< kStrategies order
-  std::array<IsoClass, kStrategyCount> iso{IsoClass::kNone, IsoClass::kNone, IsoClass::kNone,
-                                           IsoClass::kNone, IsoClass::kNone};
+  std::array<IsoClass, kStrategyCount> iso = [] {
+    std::array<IsoClass, kStrategyCount> a{};
+    a.fill(IsoClass::kNone);
+    return a;
+  }();
   MetricReductions model_vs_traditional, model_vs_none, model_vs_regression, model_vs_ramp;
 };
 

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <sstream>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::compare {
 namespace {
@@ -15,16 +15,6 @@ constexpr IsoClass kOrder[] = {IsoClass::kP1, IsoClass::kP3, IsoClass::kP5, IsoC
                                IsoClass::kT10};
 
 bool IsTransport(IsoClass c) { return c == IsoClass::kT7 || c == IsoClass::kT10; }
-
-std::string Num(double x) {
-  std::ostringstream s;
-  s.precision(3);
-  s << std::fixed << x;
-  std::string out = s.str();
-  while (out.size() > 1 && out.back() == '0') out.pop_back();
-  if (out.back() == '.') out.pop_back();
-  return out;
-}
 
 }  // namespace
 
@@ -162,7 +152,8 @@ IsoVerdict EvaluateIsoClass(const LeadMetrics& m, const IsoToleranceTable& table
   for (IsoClass c : kOrder) {
     const auto tol = table.Lookup(c, m.useful_travel_mm);
     if (!tol) {
-      failures += ToString(c) + " not tabulated for l_u " + Num(m.useful_travel_mm) + " mm; ";
+      failures += ToString(c) + " not tabulated for l_u " +
+                  FormatDecimalsTrimmed(m.useful_travel_mm, 3) + " mm; ";
       continue;
     }
     std::vector<IsoCheck> checks;
@@ -176,13 +167,15 @@ IsoVerdict EvaluateIsoClass(const LeadMetrics& m, const IsoToleranceTable& table
     std::string detail;
     for (const auto& k : checks)
       detail += (detail.empty() ? "" : ", ") +
-                std::string(k.metric == "e_a" ? "|e_a| " : k.metric + " ") + Num(k.actual_um) +
-                (k.passed ? " <= " : " > ") + Num(k.permitted_um);
+                std::string(k.metric == "e_a" ? "|e_a| " : k.metric + " ") +
+                FormatDecimalsTrimmed(k.actual_um, 3) + (k.passed ? " <= " : " > ") +
+                FormatDecimalsTrimmed(k.permitted_um, 3);
     verdict.checks = checks;
     if (ok) {
       verdict.reached = c;
       verdict.table_cells_confirmed = tol->all_cells_confirmed;
-      verdict.message = ToString(c) + " at l_u " + Num(m.useful_travel_mm) + " mm (" + detail + ")";
+      verdict.message = ToString(c) + " at l_u " + FormatDecimalsTrimmed(m.useful_travel_mm, 3) +
+                        " mm (" + detail + ")";
       if (!failures.empty()) verdict.message += "; " + failures.substr(0, failures.size() - 2);
       if (!verdict.v_2pi_evaluated) verdict.message += "; v_2pi not evaluated";
       return verdict;

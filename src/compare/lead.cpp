@@ -4,18 +4,17 @@
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
+#include "core/curve.h"
 #include "core/error.h"
 
 namespace whirl::compare {
 
 LeadDeviation ReadLeadDeviation(const std::filesystem::path& path) {
-  const CsvTable csv = ReadCsv(path);
+  const CurveColumns csv =
+      ReadCurveColumns(path, "position_mm", "deviation_um", 2, "a lead-deviation curve");
   LeadDeviation lead;
-  lead.position_mm = csv.IncreasingColumn("position_mm");
-  lead.deviation_um = csv.Column("deviation_um");
-  if (lead.size() < 2)
-    throw InputError(csv.source + ": a lead-deviation curve needs at least 2 rows, found " +
-                     std::to_string(lead.size()));
+  lead.position_mm = csv.x;
+  lead.deviation_um = csv.y;
   ValidateLeadDeviation(lead, csv.source);
   return lead;
 }

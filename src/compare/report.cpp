@@ -8,6 +8,7 @@
 
 #include "core/csv.h"
 #include "core/json_file.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
@@ -15,13 +16,7 @@
 namespace whirl::compare {
 namespace {
 
-std::string Fixed(double x, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  return buf;
-}
-
-std::string Pct(const std::optional<double>& v) { return v ? Fixed(*v, 1) + " %" : "-"; }
+std::string Pct(const std::optional<double>& v) { return v ? FormatDecimals(*v, 1) + " %" : "-"; }
 
 std::vector<std::string> Comments(const ReportOptions& o, const std::string& what) {
   std::vector<std::string> c{" " + what};
@@ -61,8 +56,9 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
   // Elongation: truth vs prediction, compensation points, traditional ramp.
   s << "set output " << GnuplotString(f.elongation) << "\n"
     << "set title "
-    << GnuplotString(name + ": elongation of the unmachined section (first " + Fixed(t_zoom, 0) +
-                     " s of " + Fixed(t_end, 0) + " s cutting time)")
+    << GnuplotString(name + ": elongation of the unmachined section (first " +
+                     FormatDecimals(t_zoom, 0) + " s of " + FormatDecimals(t_end, 0) +
+                     " s cutting time)")
     << " noenhanced\n"
     << "set xlabel 'cutting time t [s]'\nset ylabel 'elongation [um]'\n"
     << "set xrange [0:" << t_zoom << "]\nset yrange [0:*]\n"
@@ -93,7 +89,7 @@ std::string GnuplotScript(const ScrewComparison& c, const std::string& slug, con
     << "set output\n";
   s << "set output " << GnuplotString(f.lead_start) << "\n"
     << "set title "
-    << GnuplotString(name + ": travel deviation, first " + Fixed(std::min(l, 1000.0), 0) +
+    << GnuplotString(name + ": travel deviation, first " + FormatDecimals(std::min(l, 1000.0), 0) +
                      " mm of the thread")
     << " noenhanced\n"
     << "set xrange [0:" << std::min(l, 1000.0) << "]\n"
@@ -110,9 +106,9 @@ std::string MetricsTable(const ScrewComparison& c) {
        "<th>model-based</th><th>model vs traditional</th><th>model vs none</th></tr>\n";
   auto row = [&](const std::string& name, double a, double b, double d,
                  const std::optional<double>& r1, const std::optional<double>& r2) {
-    h << "<tr><td>" << name << "</td><td>" << Fixed(a, 1) << "</td><td>" << Fixed(b, 1)
-      << "</td><td>" << Fixed(d, 1) << "</td><td>" << Pct(r1) << "</td><td>" << Pct(r2)
-      << "</td></tr>\n";
+    h << "<tr><td>" << name << "</td><td>" << FormatDecimals(a, 1) << "</td><td>"
+      << FormatDecimals(b, 1) << "</td><td>" << FormatDecimals(d, 1) << "</td><td>" << Pct(r1)
+      << "</td><td>" << Pct(r2) << "</td></tr>\n";
   };
   row("accumulated error within any 1000 mm", n.metrics.accumulated_1000_um,
       t.metrics.accumulated_1000_um, m.metrics.accumulated_1000_um,
@@ -142,8 +138,8 @@ std::string MetricsTable(const ScrewComparison& c) {
   for (const auto& o : c.outcomes) {
     const auto r = Reductions(m.metrics, o.metrics).accumulated_1000_pct;
     h << "<tr><td>" << ToString(o.strategy) << "</td><td>"
-      << Fixed(o.metrics.accumulated_1000_um, 2) << "</td><td>"
-      << Fixed(o.metrics.accumulated_total_um, 2) << "</td><td>" << ToString(o.iso.reached)
+      << FormatDecimals(o.metrics.accumulated_1000_um, 2) << "</td><td>"
+      << FormatDecimals(o.metrics.accumulated_total_um, 2) << "</td><td>" << ToString(o.iso.reached)
       << "</td><td>" << (o.strategy == Strategy::kModel ? "" : Pct(r)) << "</td></tr>\n";
   }
   h << "</table>\n<p class='small'>ramp: class plateau ramped in linearly (the previous rule); "
@@ -227,12 +223,14 @@ std::string InputsSection(const ScrewComparison& c) {
   std::ostringstream body;
   const auto in = c.screw.process;
   body << "<h2>" << HtmlEscape(c.screw.name) << "</h2>\n<p>Inputs: hardness "
-       << Fixed(in.hardness_hrc, 1) << " HRC, diameter " << Fixed(in.diameter_mm, 1) << " mm, lead "
-       << Fixed(in.pitch_mm, 2) << " mm, raceway radius " << Fixed(in.raceway_radius_mm, 2)
-       << " mm, cutting speed " << Fixed(in.cutting_speed_m_min, 0) << " m/min; blank "
-       << Fixed(c.screw.length_mm, 0) << " mm, thread " << Fixed(c.screw.thread_length_mm, 0)
-       << " mm; axial feed " << Fixed(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
-       << Fixed(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
+       << FormatDecimals(in.hardness_hrc, 1) << " HRC, diameter "
+       << FormatDecimals(in.diameter_mm, 1) << " mm, lead " << FormatDecimals(in.pitch_mm, 2)
+       << " mm, raceway radius " << FormatDecimals(in.raceway_radius_mm, 2) << " mm, cutting speed "
+       << FormatDecimals(in.cutting_speed_m_min, 0) << " m/min; blank "
+       << FormatDecimals(c.screw.length_mm, 0) << " mm, thread "
+       << FormatDecimals(c.screw.thread_length_mm, 0) << " mm; axial feed "
+       << FormatDecimals(c.kinematics.axial_feed_mm_min, 1) << " mm/min, cutting time "
+       << FormatDecimals(c.kinematics.cutting_time_s / 60, 1) << " min.</p>\n";
   if (c.prediction.outside_domain) {
     std::string fields;
     for (const auto& f : c.prediction.outside_domain_fields)
@@ -249,17 +247,18 @@ std::string FeaturesTable(const ScrewComparison& c) {
   body << "<table><tr><th></th><th>max elongation [um]</th><th>settle time [s]</th></tr>\n"
        << "<tr><td>simulated truth (seed " << c.seed << ", disturbances "
        << (c.disturbances_on ? "on" : "off") << ")</td><td>"
-       << Fixed(c.truth_features.max_elongation_um, 1) << "</td><td>"
-       << Fixed(c.truth_features.settle_time_s, 0) << "</td></tr>\n"
+       << FormatDecimals(c.truth_features.max_elongation_um, 1) << "</td><td>"
+       << FormatDecimals(c.truth_features.settle_time_s, 0) << "</td></tr>\n"
        << "<tr><td>model prediction (+- 1 std)</td><td>"
-       << Fixed(c.prediction.mean.max_elongation_um, 1) << " +- "
-       << Fixed(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
-       << Fixed(c.prediction.mean.settle_time_s, 0) << " +- "
-       << Fixed(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
-       << "<tr><td>traditional rule (class " << Fixed(c.experience_class.nominal_diameter_mm, 0)
-       << " mm, " << c.experience_class.screws << " past screws)</td><td>"
-       << Fixed(c.experience_class.plateau_um, 1) << "</td><td>"
-       << Fixed(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n";
+       << FormatDecimals(c.prediction.mean.max_elongation_um, 1) << " +- "
+       << FormatDecimals(c.prediction.stddev.max_elongation_um, 1) << "</td><td>"
+       << FormatDecimals(c.prediction.mean.settle_time_s, 0) << " +- "
+       << FormatDecimals(c.prediction.stddev.settle_time_s, 0) << "</td></tr>\n"
+       << "<tr><td>traditional rule (class "
+       << FormatDecimals(c.experience_class.nominal_diameter_mm, 0) << " mm, "
+       << c.experience_class.screws << " past screws)</td><td>"
+       << FormatDecimals(c.experience_class.plateau_um, 1) << "</td><td>"
+       << FormatDecimals(c.experience_ramp_time_s, 0) << " (ramp)</td></tr></table>\n";
   return body.str();
 }
 
@@ -267,16 +266,16 @@ std::string FeaturesTable(const ScrewComparison& c) {
 std::string PlanParagraph(const ScrewComparison& c) {
   std::ostringstream body;
   body << "<p class='small'>Disturbances of the truth (unknown to the model): heat partition x"
-       << Fixed(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
-       << Fixed(c.disturbances.expansion_factor, 3) << ", ambient drift "
-       << Fixed(c.disturbances.ambient_drift_k_per_h, 3)
+       << FormatDecimals(c.disturbances.heat_partition_factor, 3) << ", expansion coefficient x"
+       << FormatDecimals(c.disturbances.expansion_factor, 3) << ", ambient drift "
+       << FormatDecimals(c.disturbances.ambient_drift_k_per_h, 3)
        << " K/h. 840D plan: " << c.plan.segments.size() << " segments (" << c.plan.point_count
        << " points; uniform spacing would need "
        << (c.plan.uniform_point_count > 0 ? std::to_string(c.plan.uniform_point_count)
                                           : std::string("more than 1000000"))
-       << "), max |chord - curve| " << Fixed(c.plan.max_deviation_um, 2) << " um, max |SD43910| "
-       << interp::FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910) << " (MD32760 cap "
-       << interp::FormatFixed(c.plan.options.md32760, 4) << "), axis "
+       << "), max |chord - curve| " << FormatDecimals(c.plan.max_deviation_um, 2)
+       << " um, max |SD43910| " << FormatFixed(c.plan.max_abs_slope, interp::kDecimalsSd43910)
+       << " (MD32760 cap " << FormatFixed(c.plan.options.md32760, 4) << "), axis "
        << HtmlEscape(c.plan.options.axis) << ", sign " << interp::ToString(c.plan.options.sign)
        << ".</p>\n";
   return body.str();

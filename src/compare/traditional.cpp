@@ -27,6 +27,22 @@ Features ExperienceRule::ClassFeatures(double diameter_mm) const {
   return {c.plateau_um, c.settle_time_s};
 }
 
+Features ExperienceRule::HistoryFeatures(HistoryRule r, const ProcessInputs& inputs) const {
+  switch (r) {
+    case HistoryRule::kTable:
+      return table.Predict(inputs);
+    case HistoryRule::kNearest:
+      return nearest.Predict(inputs);
+    case HistoryRule::kClass:
+      break;
+  }
+  return ClassFeatures(inputs.diameter_mm);
+}
+
+Features ExperienceRule::TraditionalFeatures(const ProcessInputs& inputs) const {
+  return HistoryFeatures(has_choice ? choice.chosen : HistoryRule::kClass, inputs);
+}
+
 Features LogLinearFeatures::Predict(const ProcessInputs& inputs) const {
   const auto x = inputs.ToArray();
   std::array<double, 2> y{};
@@ -128,6 +144,12 @@ ExperienceRule BuildExperienceRule(const ProcessTable& history,
     c.plateau_um = c.screws > 0 ? sum[i] / c.screws : rule.machine_plateau_um;
     c.settle_time_s = c.screws > 0 ? sum_settle[i] / c.screws : rule.ramp_time_s;
   }
+  rule.table = BuildExperienceTable(history);
+  rule.nearest = BuildNearestScrews(history);
+  if (history.inputs.size() >= 2) {
+    rule.choice = ChooseTraditional(history, rule, rule.table, rule.nearest);
+    rule.has_choice = true;
+  }
   try {
     rule.regression = FitLogLinear(history);
     rule.has_regression = true;
@@ -151,6 +173,13 @@ void to_json(nlohmann::json& j, const ExperienceRule& rule) {
                      {"machine_plateau_um", rule.machine_plateau_um},
                      {"classes", classes},
                      {"source", rule.source}};
+  if (rule.has_choice) {
+    nlohmann::json loo = nlohmann::json::object();
+    for (std::size_t k = 0; k < kHistoryRuleCount; ++k)
+      loo[ToString(static_cast<HistoryRule>(k))] = rule.choice.loo_relative_error[k];
+    j["traditional"] = {{"chosen", ToString(rule.choice.chosen)},
+                        {"leave_one_out_mean_relative_error", loo}};
+  }
   if (rule.has_regression) {
     nlohmann::json reg = nlohmann::json::object();
     for (int k = 0; k < 2; ++k) reg[kTargetColumns[k]] = rule.regression.coef[k];

@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "compare/history_rules.h"
 #include "core/process.h"
 
 namespace whirl::compare {
@@ -82,6 +83,16 @@ struct ExperienceRule {
   std::string regression_error;  ///< why there is no regression baseline
   /// traditional: (P_class, T_class) of the screw's class.
   Features ClassFeatures(double diameter_mm) const;
+  /// The other history rules (compare/history_rules.h) and the leave-one-out choice of the
+  /// strongest one; `has_choice` false with fewer than 2 past screws (the class rule is used).
+  ExperienceTable table;
+  NearestScrews nearest;
+  TraditionalChoice choice;
+  bool has_choice = false;
+  /// Features of one history rule for a screw.
+  Features HistoryFeatures(HistoryRule r, const ProcessInputs& inputs) const;
+  /// Features of the strongest history rule (choice.chosen): the headline "traditional".
+  Features TraditionalFeatures(const ProcessInputs& inputs) const;
 
   /// The class of a screw of that diameter.
   const ExperienceClass& ClassFor(double diameter_mm) const;

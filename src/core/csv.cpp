@@ -215,15 +215,6 @@ std::optional<double> ParseDecimal(const std::string& text) {
   return v;
 }
 
-std::string FormatNumber(double x) {
-  char buf[64];
-  for (int prec = 6; prec <= 17; ++prec) {
-    std::snprintf(buf, sizeof buf, "%.*g", prec, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
-
 std::string FormatCsv(const std::vector<std::string>& header,
                       const std::vector<std::vector<double>>& rows,
                       const std::vector<std::string>& comments) {

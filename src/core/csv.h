@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "core/numbers.h"  // FormatNumber, the round-trip format of the cells
+
 namespace whirl {
 
 struct CsvTable {
@@ -55,10 +57,6 @@ CsvTable ReadCsv(const std::filesystem::path& path, bool allow_empty = false);
 /// The value of `text` when it is a finite decimal number by the rule above (a CSV cell, a
 /// command-line number); nullopt otherwise ("0x1p3", "nan", "1e999", "1,5", "").
 std::optional<double> ParseDecimal(const std::string& text);
-
-/// Formats a number for CSV/JSON-like text output with round-trip precision (17 significant
-/// digits, shortest form that parses back to the same double).
-std::string FormatNumber(double x);
 
 /// Builds CSV text: optional '#' comment lines, a header, and rows (formatted by FormatNumber).
 std::string FormatCsv(const std::vector<std::string>& header,

@@ -8,14 +8,20 @@
 
 namespace whirl {
 
-ElongationCurve ReadElongationCurve(const std::filesystem::path& path, double max_gap_factor) {
+CurveColumns ReadCurveColumns(const std::filesystem::path& path, const std::string& x_name,
+                              const std::string& y_name, std::size_t min_rows,
+                              const std::string& what) {
   const CsvTable csv = ReadCsv(path);
-  ElongationCurve c;
-  c.time_s = csv.IncreasingColumn("time_s");
-  c.elongation_um = csv.Column("elongation_um");
-  if (c.size() < 3)
-    throw InputError(csv.source + ": a curve needs at least 3 samples, found " +
-                     std::to_string(c.size()));
+  CurveColumns c{csv.source, csv.IncreasingColumn(x_name), csv.Column(y_name), csv.line_numbers};
+  if (c.x.size() < min_rows)
+    throw InputError(csv.source + ": " + what + " needs at least " + std::to_string(min_rows) +
+                     " rows, found " + std::to_string(c.x.size()));
+  return c;
+}
+
+ElongationCurve ReadElongationCurve(const std::filesystem::path& path, double max_gap_factor) {
+  const CurveColumns csv = ReadCurveColumns(path, "time_s", "elongation_um", 3, "a curve");
+  ElongationCurve c{csv.x, csv.y};
   std::vector<double> steps;
   for (std::size_t i = 1; i < c.size(); ++i) {
     steps.push_back(c.time_s[i] - c.time_s[i - 1]);

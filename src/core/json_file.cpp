@@ -5,15 +5,20 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl {
 namespace {
 
-// The value at a required key; InputError naming `what` and the key when it is missing.
 const nlohmann::json& At(const nlohmann::json& j, const char* key, const std::string& what) {
-  if (!j.is_object()) throw InputError(what + ": expected a JSON object");
-  if (!j.contains(key)) throw InputError(what + ": missing required key '" + key + "'");
-  return j.at(key);
+  return RequireKey(j, key, what);
+}
+
+// A number that is whole and within [min, max] (false for NaN and for anything not a number).
+bool IsWholeIn(const nlohmann::json& v, double min, double max) {
+  if (!v.is_number()) return false;
+  const double x = v.get<double>();
+  return x >= min && x <= max && x == std::floor(x);
 }
 
 // nlohmann's message without its "[json.exception.parse_error.101] " tag.
@@ -66,13 +71,41 @@ void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char
   }
 }
 
-double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what) {
-  const auto& v = At(j, key, what);
-  if (!v.is_number())
-    throw InputError(what + ": '" + key + "' must be a number, got " + DumpJson(v, -1));
+const nlohmann::json& RequireKey(const nlohmann::json& j, const std::string& key,
+                                 const std::string& what) {
+  if (!j.is_object()) throw InputError(what + ": expected a JSON object");
+  if (!j.contains(key)) throw InputError(what + ": missing required key '" + key + "'");
+  return j.at(key);
+}
+
+double RequireFiniteValue(const nlohmann::json& v, const std::string& where) {
+  if (!v.is_number()) throw InputError(where + " must be a number, got " + DumpJson(v, -1));
   const double x = v.get<double>();
-  if (!std::isfinite(x)) throw InputError(what + ": '" + key + "' must be finite");
+  if (!std::isfinite(x)) throw InputError(where + " must be finite, got " + DumpJson(v, -1));
   return x;
+}
+
+long long RequireWholeValue(const nlohmann::json& v, const std::string& where, double min,
+                            double max) {
+  RequireFiniteValue(v, where);
+  if (!IsWholeIn(v, min, max))
+    throw InputError(where + " must be a whole number in [" + FormatNumber(min) + ", " +
+                     FormatNumber(max) + "], got " + DumpJson(v, -1));
+  return static_cast<long long>(v.get<double>());
+}
+
+std::vector<double> RequireNumbers(const nlohmann::json& v, const std::string& where) {
+  if (!v.is_array())
+    throw InputError(where + " must be an array of numbers, got " + DumpJson(v, -1));
+  std::vector<double> out;
+  out.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out.push_back(RequireFiniteValue(v[i], where + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what) {
+  return RequireFiniteValue(At(j, key, what), what + ": '" + key + "'");
 }
 
 double RequireNumberIn(const nlohmann::json& j, const char* key, const Range& range,
@@ -92,12 +125,9 @@ long long RequireInteger(const nlohmann::json& j, const char* key, long long min
   const auto& v = At(j, key, what);
   const std::string rule =
       "must be a whole number in " + std::to_string(min) + ".." + std::to_string(max);
-  if (!v.is_number())
+  if (!IsWholeIn(v, static_cast<double>(min), static_cast<double>(max)))
     throw InputError(what + ": '" + key + "' = " + DumpJson(v, -1) + " breaks the rule: " + rule);
-  const double x = v.get<double>();
-  if (!(x >= static_cast<double>(min) && x <= static_cast<double>(max)) || x != std::floor(x))
-    throw InputError(what + ": '" + key + "' = " + DumpJson(v, -1) + " breaks the rule: " + rule);
-  return static_cast<long long>(x);
+  return static_cast<long long>(v.get<double>());
 }
 
 std::string RequireString(const nlohmann::json& j, const char* key, const std::string& what,

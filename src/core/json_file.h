@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/limits.h"
 
@@ -31,6 +32,25 @@ std::string JsonFileText(const nlohmann::json& j);
 /// naming `what` (e.g. "screw file 'a.json'") and the key. Catches typos in hand-written files.
 void RejectUnknownKeys(const nlohmann::json& j, std::initializer_list<const char*> allowed,
                        const std::string& what);
+
+/// The value at `key` of the object `j`; InputError "<what>: expected a JSON object" or
+/// "<what>: missing required key '<key>'" otherwise.
+const nlohmann::json& RequireKey(const nlohmann::json& j, const std::string& key,
+                                 const std::string& what);
+
+/// `v` (an array element, or a value looked up already) as a finite number; InputError
+/// "<where> must be a number, got <v>" or "<where> must be finite, got <v>" otherwise.
+double RequireFiniteValue(const nlohmann::json& v, const std::string& where);
+
+/// `v` as a whole number in [min, max], checked before any cast (a float-to-integer cast out of
+/// range is undefined behaviour); InputError "<where> must be a whole number in [min, max], got
+/// <v>" otherwise (1.0 is accepted as 1).
+long long RequireWholeValue(const nlohmann::json& v, const std::string& where, double min,
+                            double max);
+
+/// `v` as an array of finite numbers; InputError "<where> must be an array of numbers, got <v>"
+/// or "<where>[<i>] must be a number, got <x>" otherwise.
+std::vector<double> RequireNumbers(const nlohmann::json& v, const std::string& where);
 
 /// Required finite number at key; an InputError names `what`, the key and the rule otherwise.
 double RequireNumber(const nlohmann::json& j, const char* key, const std::string& what);

@@ -33,7 +33,8 @@ std::string Range::Text() const {
 void CheckRange(double x, const Range& range, const std::string& field, const std::string& what) {
   if (range.Contains(x)) return;
   throw InputError(what + ": " + field + " = " + FormatNumber(x) +
-                   " breaks the rule: must lie in " + range.Text());
+                   " breaks the rule: must lie in " + range.Text() +
+                   (*range.note ? std::string(" (") + range.note + ")" : std::string()));
 }
 
 void CheckProcessInputs(const ProcessInputs& inputs, const std::string& what) {

@@ -42,11 +42,13 @@ inline constexpr double kMinPlanSettleTimeS = 1;
 /// (interp::PlanOptions::Validate).
 inline constexpr double kMinPlanToleranceUm = 1e-3;
 
-/// A closed range [min, max] of a quantity, or (min, max] when min_open, with its unit.
+/// A closed range [min, max] of a quantity, or (min, max] when min_open, with its unit and an
+/// optional note on why (said after the range in messages).
 struct Range {
   double min = 0, max = 0;
   bool min_open = false;
   const char* unit = "";
+  const char* note = "";
   bool Contains(double x) const;  ///< false for NaN
   std::string Text() const;       ///< "[0, 1] K", "(0, 500] mm"
 };
@@ -54,7 +56,15 @@ struct Range {
 /// Axis positions (machine offsets, start positions), +-kMaxAxisPositionMm.
 inline constexpr Range kAxisPositionRange{-kMaxAxisPositionMm, kMaxAxisPositionMm, false, "mm"};
 
-/// InputError "<what>: <field> = <value> breaks the rule: must lie in <range>" unless
+/// Largest plan tolerance, um: the largest elongation whirl accepts (kMaxElongationUm); a wider
+/// band leaves every curve uncompensated.
+inline constexpr double kMaxPlanToleranceUm = kMaxElongationUm;
+/// The tolerance of a plan, |840D chord - predicted curve| (the --tolerance-um flag and
+/// interp::PlanOptions::tolerance_um, one rule).
+inline constexpr Range kPlanToleranceRange{kMinPlanToleranceUm, kMaxPlanToleranceUm, false, "um",
+                                           "at least 1 nm, the resolution of SD43900"};
+
+/// InputError "<what>: <field> = <value> breaks the rule: must lie in <range> (<note>)" unless
 /// range.Contains(x). `what` names the file (and line) or the command; `field` the key or flag.
 void CheckRange(double x, const Range& range, const std::string& field, const std::string& what);
 

@@ -4,17 +4,12 @@
 #include <sstream>
 
 #include "core/csv.h"
+#include "core/numbers.h"
 
 namespace whirl::drift {
 namespace {
 
 using nlohmann::json;
-
-std::string F(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
 
 std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string out;
@@ -24,7 +19,7 @@ std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
 
 std::string JoinNumbers(const std::vector<double>& v) {
   std::string out;
-  for (double x : v) out += (out.empty() ? "" : ", ") + F("%g", x);
+  for (double x : v) out += (out.empty() ? "" : ", ") + MessageNumber(x);
   return out;
 }
 
@@ -87,16 +82,18 @@ std::string FormatSelection(const Selection& s) {
   o << "  lambda    r          F     F_crit  sig  classes\n";
   for (std::size_t i = 0; i < s.partitions.size(); ++i) {
     const Partition& p = s.partitions[i];
-    o << (static_cast<int>(i) == s.chosen_partition ? "* " : "  ") << F("%.4f", p.lambda)
-      << F("%5.0f", p.classes) << "  "
-      << (p.has_f ? F("%9.3f", p.f) + "  " + F("%9.3f", p.f_critical) +
+    o << (static_cast<int>(i) == s.chosen_partition ? "* " : "  ") << FormatDecimals(p.lambda, 4)
+      << PadLeft(FormatDecimals(p.classes, 0), 5) << "  "
+      << (p.has_f ? PadLeft(FormatDecimals(p.f, 3), 9) + "  " +
+                        PadLeft(FormatDecimals(p.f_critical, 3), 9) +
                         (p.significant() ? "  yes" : "   no")
                   : std::string(25, ' ') + "-")
       << "  " << Classes(s, p) << "\n";
   }
   o << "grey relational grades (rho 0.5):";
   for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
-    o << " " << s.sensor_names[i] << " " << F("%.4f", s.grades(static_cast<Eigen::Index>(i)));
+    o << " " << s.sensor_names[i] << " "
+      << FormatDecimals(s.grades(static_cast<Eigen::Index>(i)), 4);
   o << "\nclass count: " << s.message << "\nchosen sensors: " << Join(s.ChosenNames()) << "\n";
   return o.str();
 }
@@ -147,21 +144,23 @@ std::string FormatModel(const DriftModel& m) {
   for (const auto& n : m.notes) o << "  " << n << "\n";
   if (m.kind != ModelKind::kNetwork) {
     o << "  feature                        coefficient   std error        VIF\n";
-    o << "  intercept [um]                " << F("%12.4f", m.linear.coefficients(0))
-      << F("%12.4f", m.linear.standard_errors(0)) << "\n";
+    o << "  intercept [um]                "
+      << PadLeft(FormatDecimals(m.linear.coefficients(0), 4), 12)
+      << PadLeft(FormatDecimals(m.linear.standard_errors(0), 4), 12) << "\n";
     for (std::size_t i = 0; i < m.features.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
       char name[64];
       std::snprintf(name, sizeof name, "%-30s",
                     (m.features[i].Name(m.time_unit) + " [um/unit]").c_str());
-      o << "  " << name << F("%12.4f", m.linear.coefficients(k + 1))
-        << F("%12.4f", m.linear.standard_errors(k + 1)) << F("%11.4g", m.linear.vif(k)) << "\n";
+      o << "  " << name << PadLeft(FormatDecimals(m.linear.coefficients(k + 1), 4), 12)
+        << PadLeft(FormatDecimals(m.linear.standard_errors(k + 1), 4), 12)
+        << PadLeft(FormatSignificant(m.linear.vif(k), 4), 11) << "\n";
     }
   } else {
     o << "  network " << m.network.layer_sizes[0] << "-" << m.network.layer_sizes[1] << "-1\n";
   }
-  o << "  training: R^2 " << F("%.4f", m.r_squared) << ", residual std "
-    << F("%.3f", m.residual_std_um) << " um, " << m.training_samples << " samples of "
+  o << "  training: R^2 " << FormatDecimals(m.r_squared, 4) << ", residual std "
+    << FormatDecimals(m.residual_std_um, 3) << " um, " << m.training_samples << " samples of "
     << Join(m.training_runs) << " (state " << ToString(m.state) << ")\n";
   return o.str();
 }
@@ -254,7 +253,8 @@ std::string FormatCrossRun(const CrossRunResult& r) {
     char name[32];
     std::snprintf(name, sizeof name, "%-16.16s", r.runs[i].c_str());
     o << name;
-    for (std::size_t j = 0; j < r.runs.size(); ++j) o << F("%12.2f", r.cells[i][j].model.rmse_um);
+    for (std::size_t j = 0; j < r.runs.size(); ++j)
+      o << PadLeft(FormatDecimals(r.cells[i][j].model.rmse_um, 2), 12);
     o << "\n";
   }
   o << "group means (seed 000 tables 6-8)   pairs |  model: RMSE    std    max | all sensors: "
@@ -295,8 +295,8 @@ json HoldoutJson(const HoldoutResult& r) {
 std::string FormatHoldout(const HoldoutResult& r) {
   std::ostringstream o;
   auto when = [&](double t) {
-    return r.time_from_index ? "sample " + F("%.0f", t) + " (no recorded time)"
-                             : F("%.1f", t / 60) + " h";
+    return r.time_from_index ? "sample " + FormatDecimals(t, 0) + " (no recorded time)"
+                             : FormatDecimals(t / 60, 1) + " h";
   };
   o << "chronological hold-out on " << r.log << ": train rows [0, " << r.train_end << ") (to "
     << when(r.train_end_min) << "), test rows [" << r.train_end << ", " << r.test_end << ") (to "

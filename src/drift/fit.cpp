@@ -5,20 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/parallel.h"
 
 namespace whirl::drift {
 namespace {
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
 
 struct Stacked {
   Eigen::MatrixXd x;
@@ -180,7 +173,7 @@ void FitOptions::Validate() const {
     throw InputError("lag grid: give 1 to 32 time constants");
   for (double t : tau_grid)
     if (!(t > 0 && t <= 1e6))
-      throw InputError("lag time constant " + Num(t) + ": must be in (0, 1e6]");
+      throw InputError("lag time constant " + FormatSignificant(t, 4) + ": must be in (0, 1e6]");
   if (hidden < 1 || hidden > 20)
     throw InputError("hidden " + std::to_string(hidden) + ": must be 1..20");
   if (restarts < 1 || restarts > 50)
@@ -230,7 +223,7 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
   for (std::size_t i = 0; i < counts.size(); ++i) {
     chosen.class_count_scores.push_back({counts[i], rmse[i]});
     scores += (scores.empty() ? "" : ", ") + std::string("r = ") + std::to_string(counts[i]) +
-              ": " + (std::isfinite(rmse[i]) ? Num(rmse[i]) + " um" : "-");
+              ": " + (std::isfinite(rmse[i]) ? FormatSignificant(rmse[i], 4) + " um" : "-");
   }
   chosen.message =
       "class count by cross-validated MLR RMSE (" +
@@ -296,9 +289,9 @@ void ChooseTimeConstants(const std::vector<Run>& runs, const std::string& error_
   m.time_constants = rep->lag_search.back().time_constants;
   for (const auto& st : rep->lag_search) {
     std::string t;
-    for (double v : st.time_constants) t += (t.empty() ? "" : ", ") + Num(v);
+    for (double v : st.time_constants) t += (t.empty() ? "" : ", ") + FormatSignificant(v, 4);
     m.notes.push_back("lag search: time constants [" + t + "] " + m.time_unit +
-                      ": cross-validated RMSE " + Num(st.cv_rmse_um) + " um");
+                      ": cross-validated RMSE " + FormatSignificant(st.cv_rmse_um, 4) + " um");
   }
 }
 

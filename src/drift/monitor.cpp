@@ -3,29 +3,24 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/random.h"
 #include "drift/regression.h"
 
 namespace whirl::drift {
 namespace {
 
-std::string Num(double v, const char* fmt = "%.3f") {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
-
 std::string Vec(const Eigen::VectorXd& v) {
   std::string s = "[";
-  for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + Num(v(i), "%.4g");
+  for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + FormatSignificant(v(i), 4);
   return s + "]";
 }
 
 void Require(bool ok, const std::string& option, double value, const std::string& rule) {
-  if (!ok) throw InputError("monitor option " + option + " = " + Num(value, "%g") + ": " + rule);
+  if (!ok)
+    throw InputError("monitor option " + option + " = " + MessageNumber(value) + ": " + rule);
 }
 
 // First sample at or after `time`, not before `min_sample`; -1 when the run ends first.
@@ -53,9 +48,10 @@ struct Piece {
 };
 
 std::string CheckMessage(double t, double y, double p, double thr, bool valid) {
-  return "check at " + Num(t, "%.1f") + ": |measured " + Num(y) + " - predicted " + Num(p) +
-         "| = " + Num(std::abs(y - p)) + " um " + (valid ? "<=" : ">") + " threshold " + Num(thr) +
-         " um: model " + (valid ? "valid" : "invalid");
+  return "check at " + FormatDecimals(t, 1) + ": |measured " + FormatDecimals(y, 3) +
+         " - predicted " + FormatDecimals(p, 3) + "| = " + FormatDecimals(std::abs(y - p), 3) +
+         " um " + (valid ? "<=" : ">") + " threshold " + FormatDecimals(thr, 3) + " um: model " +
+         (valid ? "valid" : "invalid");
 }
 
 Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
@@ -79,8 +75,8 @@ std::string UpdateMessage(UpdateRule rule, const Eigen::MatrixXd& xs, const Eige
     return std::sqrt((ys - xs * b).squaredNorm() / static_cast<double>(ys.size()));
   };
   return ToString(rule) + " update from " + std::to_string(ys.size()) +
-         " measurements: RMS misfit on them " + Num(rms(before)) + " -> " + Num(rms(after)) +
-         " um; coefficients " + Vec(before) + " -> " + Vec(after);
+         " measurements: RMS misfit on them " + FormatDecimals(rms(before), 3) + " -> " +
+         FormatDecimals(rms(after), 3) + " um; coefficients " + Vec(before) + " -> " + Vec(after);
 }
 
 // One rule replayed on a run: the checks at the check interval, and after a failed check the
@@ -145,8 +141,9 @@ class RuleReplay {
       if (q < 0) break;
       MonitorEvent e = Measure(q, MonitorEvent::Kind::kRefitMeasurement);
       e.message = "refit measurement " + std::to_string(j + 1) + " of " +
-                  std::to_string(in_.o.refit_samples) + ": measured " + Num(e.measured_um) +
-                  ", predicted " + Num(e.predicted_um) + " um";
+                  std::to_string(in_.o.refit_samples) + ": measured " +
+                  FormatDecimals(e.measured_um, 3) + ", predicted " +
+                  FormatDecimals(e.predicted_um, 3) + " um";
       s_.events.push_back(e);
       rows.push_back(q);
       *last = q;
@@ -251,7 +248,7 @@ void MonitorOptions::Validate() const {
   Require(std::isfinite(prior_scale) && prior_scale > 0, "prior_scale", prior_scale, "must be > 0");
   Require(std::isfinite(start), "start", start, "must be finite");
   Require(score_from >= 0 && score_from < score_to && score_to <= 1, "score_from", score_from,
-          "need 0 <= score_from < score_to <= 1 (score_to = " + Num(score_to, "%g") + ")");
+          "need 0 <= score_from < score_to <= 1 (score_to = " + MessageNumber(score_to) + ")");
 }
 
 Eigen::MatrixXd MonitorDesign(const DriftModel& model, const Run& run, ReferenceMode reference) {
@@ -317,13 +314,14 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
   const int n = run.samples();
   const int start = SampleAt(r.time, o.start, 0);
   if (start < 0 || start >= n - 1)
-    throw InputError("monitor option start = " + Num(o.start, "%g") + ": the run " + run.source +
-                     " ends at " + Num(r.time.back(), "%g") + ": nothing to monitor");
+    throw InputError("monitor option start = " + MessageNumber(o.start) + ": the run " +
+                     run.source + " ends at " + MessageNumber(r.time.back()) +
+                     ": nothing to monitor");
   r.monitored_min = r.time.back() - r.time[static_cast<std::size_t>(start)];
   if (r.monitored_min / o.check_every > kMaxMonitorChecks)
-    throw InputError("monitor option check_every = " + Num(o.check_every, "%g") + ": over " +
+    throw InputError("monitor option check_every = " + MessageNumber(o.check_every) + ": over " +
                      std::to_string(kMaxMonitorChecks) + " checks in " +
-                     Num(r.monitored_min, "%g") + " (limit)");
+                     MessageNumber(r.monitored_min) + " (limit)");
   r.score_begin = std::max(start, static_cast<int>(o.score_from * n));
   r.score_end = std::min(n, static_cast<int>(o.score_to * n));
   if (r.score_end <= r.score_begin)

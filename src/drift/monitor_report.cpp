@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
@@ -16,12 +17,6 @@ namespace whirl::drift {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string F(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
 
 std::string TimeName(const MonitorResult& r) { return r.time_from_index ? "sample" : "time_min"; }
 
@@ -143,13 +138,14 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
   const std::string unit = idx ? "samples" : "h";
   std::ostringstream s;
   s << "run " << r.run << ", " << r.error_column << ", " << r.model_kind << " model; checks every "
-    << F("%g", o.check_every) << (idx ? " samples" : " min") << ", threshold "
-    << F("%.2f", r.threshold_um) << " um, " << o.refit_samples << " refit measurements every "
-    << F("%g", o.refit_every) << (idx ? " samples" : " min") << ", "
-    << F("%g", o.stop_min_per_measurement) << " min stop each\n";
+    << MessageNumber(o.check_every) << (idx ? " samples" : " min") << ", threshold "
+    << FormatDecimals(r.threshold_um, 2) << " um, " << o.refit_samples
+    << " refit measurements every " << MessageNumber(o.refit_every) << (idx ? " samples" : " min")
+    << ", " << MessageNumber(o.stop_min_per_measurement) << " min stop each\n";
   s << "scored rows [" << r.score_begin << ", " << r.score_end
-    << "): " << F("%.2f", r.time[static_cast<std::size_t>(r.score_begin)] * to_h) << " to "
-    << F("%.2f", r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h) << " " << unit << "\n";
+    << "): " << FormatDecimals(r.time[static_cast<std::size_t>(r.score_begin)] * to_h, 2) << " to "
+    << FormatDecimals(r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h, 2) << " " << unit
+    << "\n";
   s << "rule      MAE um  RMSE um  max um  checks  invalid  recal  stop min  stop %\n";
   char buf[200];
   std::snprintf(buf, sizeof buf,
@@ -168,7 +164,7 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
     s << ToString(st.rule) << " updates:\n";
     for (const auto& e : st.events)
       if (e.kind == MonitorEvent::Kind::kUpdate || e.kind == MonitorEvent::Kind::kSkipped)
-        s << "  " << F("%.2f", e.time * to_h) << " " << unit << ": " << e.message << "\n";
+        s << "  " << FormatDecimals(e.time * to_h, 2) << " " << unit << ": " << e.message << "\n";
   }
   for (const auto& w : r.warnings) s << "warning: " << w << "\n";
   return s.str();

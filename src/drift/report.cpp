@@ -1,12 +1,12 @@
 #include "drift/report.h"
 
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
@@ -16,12 +16,6 @@ namespace whirl::drift {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string F(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
 
 const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
 
@@ -111,9 +105,10 @@ std::string SelectionHtml(const Selection& s) {
       classes += "} ";
     }
     const bool chosen = static_cast<int>(i) == s.chosen_partition;
-    h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>" << F("%.4f", p.lambda)
-      << "</td><td>" << p.classes << "</td><td>" << (p.has_f ? F("%.3f", p.f) : "-") << "</td><td>"
-      << (p.has_f ? F("%.3f", p.f_critical) : "-") << "</td><td>"
+    h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>"
+      << FormatDecimals(p.lambda, 4) << "</td><td>" << p.classes << "</td><td>"
+      << (p.has_f ? FormatDecimals(p.f, 3) : "-") << "</td><td>"
+      << (p.has_f ? FormatDecimals(p.f_critical, 3) : "-") << "</td><td>"
       << (p.has_f ? (p.significant() ? "yes" : "no") : "-") << "</td><td style='text-align:left'>"
       << HtmlEscape(classes) << "</td></tr>\n";
   }
@@ -121,7 +116,7 @@ std::string SelectionHtml(const Selection& s) {
   for (const auto& n : s.sensor_names) h << "<th>" << HtmlEscape(n) << "</th>";
   h << "</tr><tr>";
   for (Eigen::Index i = 0; i < s.grades.size(); ++i)
-    h << "<td>" << F("%.4f", s.grades(i)) << "</td>";
+    h << "<td>" << FormatDecimals(s.grades(i), 4) << "</td>";
   h << "</tr></table>\n";
   return h.str();
 }
@@ -173,9 +168,10 @@ std::string LevelsPlot(ReportWriter* w, const Selection& s) {
 }
 
 std::string StatsRow(const std::string& name, const ErrorStats& s) {
-  return "<tr><td style='text-align:left'>" + HtmlEscape(name) + "</td><td>" + F("%.2f", s.mae_um) +
-         "</td><td>" + F("%.2f", s.rmse_um) + "</td><td>" + F("%.2f", s.std_um) + "</td><td>" +
-         F("%.2f", s.max_abs_um) + "</td></tr>\n";
+  return "<tr><td style='text-align:left'>" + HtmlEscape(name) + "</td><td>" +
+         FormatDecimals(s.mae_um, 2) + "</td><td>" + FormatDecimals(s.rmse_um, 2) + "</td><td>" +
+         FormatDecimals(s.std_um, 2) + "</td><td>" + FormatDecimals(s.max_abs_um, 2) +
+         "</td></tr>\n";
 }
 
 }  // namespace
@@ -240,9 +236,9 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const 
   ReportWriter w(dir, gnuplot);
   std::ostringstream h;
   h << Head("whirl: chronological hold-out on " + log.name, provenance);
-  h << "<p>Train rows [0, " << r.train_end << ") to " << F("%.1f", r.train_end_min / 60)
+  h << "<p>Train rows [0, " << r.train_end << ") to " << FormatDecimals(r.train_end_min / 60, 1)
     << " h; test rows [" << r.train_end << ", " << r.test_end << ") to "
-    << F("%.1f", r.test_end_min / 60) << " h. Models run from the log's first row.</p>\n";
+    << FormatDecimals(r.test_end_min / 60, 1) << " h. Models run from the log's first row.</p>\n";
   h << "<pre>" << HtmlEscape(FormatHoldout(r)) << "</pre>\n";
   std::vector<std::string> channels;
   for (const auto& row : r.rows_out)

@@ -4,19 +4,12 @@
 #include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::drift {
 namespace {
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
 
 Eigen::VectorXd MinMaxNormalize(const Eigen::VectorXd& x) {
   const double lo = x.minCoeff(), hi = x.maxCoeff();
@@ -59,7 +52,7 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
     for (std::size_t i = 0; i < parts.size(); ++i)
       if (parts[i].classes == o.fixed_classes) {
         *message = "fixed class count " + std::to_string(o.fixed_classes) + " (lambda " +
-                   Num(parts[i].lambda) + ")";
+                   FormatSignificant(parts[i].lambda, 4) + ")";
         return static_cast<int>(i);
       }
     std::string have;
@@ -76,8 +69,9 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
     if (best >= 0) {
       const Partition& p = parts[static_cast<std::size_t>(best)];
       *message = "fewest classes with a significant F: r = " + std::to_string(p.classes) +
-                 " at lambda " + Num(p.lambda) + " (F " + Num(p.f) + " > F_crit " +
-                 Num(p.f_critical) + ")";
+                 " at lambda " + FormatSignificant(p.lambda, 4) + " (F " +
+                 FormatSignificant(p.f, 4) + " > F_crit " + FormatSignificant(p.f_critical, 4) +
+                 ")";
       return best;
     }
   }
@@ -88,8 +82,9 @@ int ChoosePartition(const std::vector<Partition>& parts, const SelectionOptions&
                                ? "largest (F - F_crit) / F_crit"
                                : "no eligible partition has a significant F; fallback: largest "
                                  "(F - F_crit) / F_crit") +
-               ": r = " + std::to_string(p.classes) + " at lambda " + Num(p.lambda) + " (F " +
-               Num(p.f) + ", F_crit " + Num(p.f_critical) + ")";
+               ": r = " + std::to_string(p.classes) + " at lambda " +
+               FormatSignificant(p.lambda, 4) + " (F " + FormatSignificant(p.f, 4) + ", F_crit " +
+               FormatSignificant(p.f_critical, 4) + ")";
     return best;
   }
   *message = "no partition with 1 < r < m (and r <= max classes): every sensor is its own class";
@@ -121,8 +116,10 @@ ClassCountRule ParseClassCountRule(const std::string& s) {
 }
 
 void SelectionOptions::Validate() const {
-  if (!(alpha > 0 && alpha < 1)) throw InputError("alpha " + Num(alpha) + ": must be in (0, 1)");
-  if (!(rho > 0 && rho <= 1)) throw InputError("rho " + Num(rho) + ": must be in (0, 1]");
+  if (!(alpha > 0 && alpha < 1))
+    throw InputError("alpha " + FormatSignificant(alpha, 4) + ": must be in (0, 1)");
+  if (!(rho > 0 && rho <= 1))
+    throw InputError("rho " + FormatSignificant(rho, 4) + ": must be in (0, 1]");
   if (rule == ClassCountRule::kFixed && fixed_classes < 1)
     throw InputError("fixed class count " + std::to_string(fixed_classes) + ": must be >= 1");
   if (max_classes < 0)

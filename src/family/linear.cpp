@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/json_file.h"
 
 namespace whirl::family {
 namespace {
@@ -17,18 +18,14 @@ Eigen::MatrixXd Design(const LinearModel& m, const Eigen::MatrixXd& x) {
   return a;
 }
 
+// An array of finite numbers: the value `v`, named `where` in messages.
+Eigen::VectorXd ToVector(const nlohmann::json& v, const std::string& where) {
+  const std::vector<double> x = RequireNumbers(v, where);
+  return Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size()));
+}
+
 Eigen::VectorXd ToVector(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key) || !j.at(key).is_array())
-    throw InputError(std::string("linear model: '") + key + "' must be an array");
-  Eigen::VectorXd v(static_cast<Eigen::Index>(j.at(key).size()));
-  for (std::size_t i = 0; i < j.at(key).size(); ++i) {
-    const auto& e = j.at(key)[i];
-    if (!e.is_number() || !std::isfinite(e.get<double>()))
-      throw InputError(std::string("linear model: '") + key + "'[" + std::to_string(i) +
-                       "] must be a finite number");
-    v(static_cast<Eigen::Index>(i)) = e.get<double>();
-  }
-  return v;
+  return ToVector(RequireKey(j, key, "linear model"), std::string("linear model: '") + key + "'");
 }
 
 std::vector<double> ToStd(const Eigen::VectorXd& v) {
@@ -106,7 +103,8 @@ void from_json(const nlohmann::json& j, LinearModel& m) {
     throw InputError("linear model: 'ata_inv' must hold " + std::to_string(p) + " rows");
   m.ata_inv.resize(p, p);
   for (Eigen::Index r = 0; r < p; ++r) {
-    const Eigen::VectorXd row = ToVector(nlohmann::json{{"row", j.at("ata_inv")[r]}}, "row");
+    const Eigen::VectorXd row =
+        ToVector(j.at("ata_inv")[r], "linear model: 'ata_inv[" + std::to_string(r) + "]'");
     if (row.size() != p)
       throw InputError("linear model: 'ata_inv' rows must hold " + std::to_string(p) + " values");
     m.ata_inv.row(r) = row.transpose();

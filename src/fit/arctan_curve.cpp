@@ -1,11 +1,10 @@
 #include "fit/arctan_curve.h"
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
-#include <sstream>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::fit {
 
@@ -66,10 +65,9 @@ ArctanCurve ArctanCurve::FromFeatures(const Features& features, double shape_k,
 }
 
 std::string ArctanCurve::Describe() const {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "arctan L=%.4f um, t_s=%.2f s, k=%.4f, p=%.4f", max_elongation_um,
-                settle_time_s, shape_k, time_exponent);
-  return buf;
+  return "arctan L=" + FormatDecimals(max_elongation_um, 4) +
+         " um, t_s=" + FormatDecimals(settle_time_s, 2) + " s, k=" + FormatDecimals(shape_k, 4) +
+         ", p=" + FormatDecimals(time_exponent, 4);
 }
 
 void to_json(nlohmann::json& j, const ArctanCurve& c) {
@@ -83,10 +81,7 @@ void to_json(nlohmann::json& j, const ArctanCurve& c) {
 
 void ArctanCurve::Validate(const std::string& what) const {
   auto fail = [&](const char* field, double value, const char* rule) {
-    std::ostringstream ss;
-    ss.precision(17);
-    ss << what << ": " << field << " = " << value << ": " << rule;
-    throw InputError(ss.str());
+    throw InputError(what + ": " + field + " = " + FormatSignificant(value, 17) + ": " + rule);
   };
   if (!std::isfinite(max_elongation_um) || max_elongation_um < 0)
     fail("max_elongation_um", max_elongation_um, "must be finite and >= 0");

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "core/error.h"
 #include "core/numbers.h"
@@ -98,12 +97,9 @@ bool LmSummary::Converged() const {
 }
 
 std::string LmSummary::BriefReport() const {
-  std::ostringstream ss;
-  ss.precision(6);
-  ss << "LM: cost " << initial_cost << " -> " << final_cost << " in " << iterations
-     << " iterations (" << accepted_steps << " accepted), " << ToString(termination) << " ("
-     << message << ")";
-  return ss.str();
+  return "LM: cost " + MessageNumber(initial_cost) + " -> " + MessageNumber(final_cost) + " in " +
+         std::to_string(iterations) + " iterations (" + std::to_string(accepted_steps) +
+         " accepted), " + ToString(termination) + " (" + message + ")";
 }
 
 Eigen::MatrixXd FiniteDifferenceJacobian(const ResidualFunction& residual, int num_residuals,

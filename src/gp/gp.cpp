@@ -166,21 +166,12 @@ Gp FitFromStarts(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOpt
 
 // A JSON array of finite numbers named `name` in messages.
 Eigen::VectorXd ArrayToVector(const nlohmann::json& a, const std::string& name) {
-  if (!a.is_array()) throw InputError("gaussian process: '" + name + "' must be an array");
-  Eigen::VectorXd v(static_cast<Eigen::Index>(a.size()));
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!a[i].is_number() || !std::isfinite(a[i].get<double>()))
-      throw InputError("gaussian process: '" + name + "'[" + std::to_string(i) +
-                       "] must be a finite number");
-    v(static_cast<Eigen::Index>(i)) = a[i].get<double>();
-  }
-  return v;
+  const std::vector<double> v = RequireNumbers(a, "gaussian process: '" + name + "'");
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
 Eigen::VectorXd JsonVector(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key))
-    throw InputError("gaussian process: key '" + std::string(key) + "' missing");
-  return ArrayToVector(j.at(key), key);
+  return ArrayToVector(RequireKey(j, key, "gaussian process"), key);
 }
 
 }  // namespace

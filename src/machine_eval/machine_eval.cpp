@@ -9,13 +9,30 @@
 #include "core/random.h"
 #include "drift/monitor.h"
 #include "machine_eval/machine_report.h"
+#include "machine_eval/strategies.h"
 
 namespace whirl::machine_eval {
 
 std::string ToString(MachineStrategy s) {
-  static const char* kNames[] = {"none", "traditional", "workpiece",   "machine",
-                                 "both", "both_idle",   "both_monitor"};
+  static const char* kNames[] = {"none",        "traditional", "workpiece",    "machine",
+                                 "both",        "both_idle",   "both_monitor", "class",
+                                 "table",       "nearest",     "warmup",       "schedule",
+                                 "machine_shop", "both_shop"};
   return kNames[static_cast<int>(s)];
+}
+
+bool UsesSensors(MachineStrategy s) {
+  switch (s) {
+    case MachineStrategy::kMachine:
+    case MachineStrategy::kBoth:
+    case MachineStrategy::kBothIdle:
+    case MachineStrategy::kBothMonitor:
+    case MachineStrategy::kMachineShop:
+    case MachineStrategy::kBothShop:
+      return true;
+    default:
+      return false;
+  }
 }
 
 std::string ToString(ErrorSource s) {
@@ -31,6 +48,12 @@ bool AnyMachineComponent(const machine::MachineConfig& c) {
 
 std::uint64_t DaySeed(std::uint64_t machine_seed, std::uint64_t day) {
   return MixSeed(machine_seed, 0x1000 + day);
+}
+
+// Cutting speed of a training run, m/min, drawn from its day seed.
+double TrainingSpeed(std::uint64_t day_seed) {
+  Rng rng(day_seed);
+  return 150 + 60 * rng.Uniform();
 }
 
 // Model predictions on a run, linearly interpolated between the samples (the control evaluates
@@ -79,8 +102,7 @@ std::vector<drift::Run> TrainingRuns(const machine::MachineConfig& config,
     spec.name = std::string(cutting ? "cutting_" : "idle_") + std::to_string(r + 1);
     spec.state = state;
     spec.duration_min = cutting ? 150 : 180;
-    Rng rng(day_seed);
-    spec.cutting_speed_m_min = 150 + 60 * rng.Uniform();
+    spec.cutting_speed_m_min = TrainingSpeed(day_seed);
     spec.noise_seed = day_seed;
     out.push_back(machine::SimulateRun(day, spec));
   }
@@ -99,8 +121,20 @@ MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64
   m.slope_cutting = drift::FitDriftModel(cutting, "zscrew_per_1000_um", f).model;
   m.offset_idle = drift::FitDriftModel(idle, "offset_um", f).model;
   m.slope_idle = drift::FitDriftModel(idle, "zscrew_per_1000_um", f).model;
+  m.shop = FitShopModels(ShopRecordOf(config, machine_seed, runs), config.z_screw.fixed_end_mm);
   m.fitted = true;
   return m;
+}
+
+drift::ShopRecord ShopRecordOf(const machine::MachineConfig& config, std::uint64_t machine_seed,
+                               int runs) {
+  std::vector<drift::Run> all = TrainingRuns(config, machine_seed, runs, drift::RunState::kIdle);
+  const auto cutting = TrainingRuns(config, machine_seed, runs, drift::RunState::kCutting);
+  std::vector<double> speeds(all.size(), 0.0);
+  for (int r = 0; r < runs; ++r) speeds.push_back(TrainingSpeed(DaySeed(machine_seed, 100 + r)));
+  all.insert(all.end(), cutting.begin(), cutting.end());
+  return MeasureTrainingRuns(all, speeds, config.z_screw.fixed_end_mm, ShopProtocol{},
+                             MixSeed(machine_seed, 0x73686f70));
 }
 
 namespace {
@@ -159,10 +193,10 @@ TruthOnMachine TruthWithMachine(const ElongationCurve& workpiece, const machine:
   return t;
 }
 
-// The class-mean curve's 840D plan (empty when the rule has no features for the screw).
-interp::CompensationPlan TraditionalPlan(const compare::ScrewComparison& c, double thread_length_mm,
-                                         const compare::CompareOptions& options) {
-  const Features& tf = c.traditional_features;
+// A history rule's curve as an 840D plan (empty when the rule has no features for the screw).
+interp::CompensationPlan FeaturePlan(const compare::ScrewComparison& c, const Features& tf,
+                                     double thread_length_mm,
+                                     const compare::CompareOptions& options) {
   if (!(tf.max_elongation_um > 0 && tf.settle_time_s > 0)) return {};
   return interp::BuildPlan(
       fit::ArctanCurve::FromFeatures(tf, options.shape_k, options.time_exponent),
@@ -225,7 +259,25 @@ struct MachineCompensations {
                                 idle = compare::NoCompensation(),
                                 monitored = compare::NoCompensation();
   drift::Run log;
+  /// Trained from measurements only, applied causally (strategies.h).
+  compare::CompensationFunction shop = compare::NoCompensation(),
+                                warmup = compare::NoCompensation(),
+                                schedule = compare::NoCompensation();
 };
+
+// The shop-trained models on the control's log of the cut (its first row is the cold start, the
+// legacy world's power-on), each held sample by sample.
+void ShopCompensations(const MachineModels& models, const sim::Screw& screw, const ToolPath& path,
+                       MachineCompensations* m) {
+  const drift::Run control = ControlDayLog(m->log, screw.process.cutting_speed_m_min);
+  auto line = [&](const drift::JointDriftModel& model) {
+    return CausalMachineLine(RunCausally(model, control), 0.0, path.fixed_end_mm,
+                             [path](double t) { return path.ZAt(t); });
+  };
+  m->shop = line(models.shop.sensors);
+  m->warmup = line(models.shop.warmup);
+  m->schedule = line(models.shop.schedule);
+}
 
 MachineCompensations MachineModelCompensations(const MachineModels& models,
                                                const machine::MachineDay& day,
@@ -244,6 +296,7 @@ MachineCompensations MachineModelCompensations(const MachineModels& models,
   m.monitored =
       MachineLine(MonitoredOffset(models.offset_cutting, m.log, monitor_every_min, seed, step),
                   slope_cutting, path);
+  ShopCompensations(models, screw, path, &m);
   return m;
 }
 
@@ -285,14 +338,24 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece
   const compare::CompensationFunction workpiece = Planned(c.plan, feed);
   MachineCompensations machine = MachineModelCompensations(models, day, screw, c.kinematics, path,
                                                            options.seed, monitor_every_min);
+  auto history = [&](const Features& f) {
+    return Planned(FeaturePlan(c, f, screw.thread_length_mm, options), feed);
+  };
   const std::array<compare::CompensationFunction, kMachineStrategyCount> compensations = {
       compare::NoCompensation(),
-      Planned(TraditionalPlan(c, screw.thread_length_mm, options), feed),
+      history(c.traditional_features),
       workpiece,
       machine.cutting,
       Sum(workpiece, machine.cutting),
       Sum(workpiece, machine.idle),
-      Sum(workpiece, machine.monitored)};
+      Sum(workpiece, machine.monitored),
+      history(c.history_features[0]),
+      history(c.history_features[1]),
+      history(c.history_features[2]),
+      Sum(workpiece, machine.warmup),
+      Sum(workpiece, machine.schedule),
+      machine.shop,
+      Sum(workpiece, machine.shop)};
   ScoreStrategies(truth.total, compensations, feed, screw, options, iso_table, &out, detail);
   for (std::size_t s = 0; s < kErrorSourceCount; ++s)
     out.source_total_um[s] =

@@ -50,6 +50,19 @@
 //                   noise from core/random.h, 3-sigma threshold, rule `offset` from the invalid
 //                   check alone; the stops are not simulated: the log goes on as if the cut never
 //                   paused)
+//   The rows above are the legacy evaluation, unchanged. The rows below are the baselines a
+//   shop uses and the models a shop can train (machine_eval/history.h: the training runs
+//   measured by a probe and a laser, never read as exact channels), every machine model applied
+//   causally (machine_eval/strategies.h: zero-order hold of the latest control sample):
+//   class           the diameter-class means' 840D plan (today's "traditional" before the
+//                   strongest history rule replaced it)
+//   table, nearest  the experience table and the 3 nearest past screws (compare/history_rules.h)
+//   warmup          workpiece + the time-since-power-on rule (lags of power_on)
+//   schedule        workpiece + the control-signal rule (lags of ring_on, cutting, ring load;
+//                   Brecher, Hirsch and Weck, "Compensation of thermo-elastic machine tool
+//                   deformation based on control internal data", CIRP Annals 53(1), 2004)
+//   machine_shop    the sensor model trained from the measurements only
+//   both_shop       workpiece + machine_shop
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
 // `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
 // drift::FitDriftModel (drift/fit.h; kind and sensor selection from `fit`, by default Miao et
@@ -73,6 +86,7 @@
 #include "drift/model.h"
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
+#include "machine_eval/history.h"
 
 namespace whirl::machine_eval {
 
@@ -83,10 +97,21 @@ enum class MachineStrategy {
   kMachine,
   kBoth,
   kBothIdle,
-  kBothMonitor
+  kBothMonitor,
+  kClass,
+  kTable,
+  kNearest,
+  kWarmup,
+  kSchedule,
+  kMachineShop,
+  kBothShop
 };
-inline constexpr std::size_t kMachineStrategyCount = 7;
-/// none, traditional, workpiece, machine, both, both_idle, both_monitor
+inline constexpr std::size_t kMachineStrategyCount = 14;
+/// none, traditional, workpiece, machine, both, both_idle, both_monitor, class, table, nearest,
+/// warmup, schedule, machine_shop, both_shop
+/// Whether a strategy's machine half uses temperature sensors (machine, both*, machine_shop,
+/// both_shop); the others are sensor-free.
+bool UsesSensors(MachineStrategy s);
 std::string ToString(MachineStrategy s);
 
 /// Sources of the uncompensated lead error (accumulated over the thread, um, each alone).
@@ -115,6 +140,7 @@ struct MachineEvalOptions {
 struct MachineModels {
   bool fitted = false;  ///< false when every machine component is off
   drift::DriftModel offset_cutting, slope_cutting, offset_idle, slope_idle;
+  ShopModels shop;  ///< trained from the measured training runs only (history.h)
 };
 
 struct MachineEvalScrew {
@@ -154,6 +180,9 @@ std::vector<drift::Run> TrainingRuns(const machine::MachineConfig& config,
                                      std::uint64_t machine_seed, int runs, drift::RunState state);
 MachineModels FitMachineModels(const machine::MachineConfig& config, std::uint64_t machine_seed,
                                int runs, const drift::FitOptions& fit);
+/// The shop's measurement records of the same training runs (history.h), what ShopModels learn.
+drift::ShopRecord ShopRecordOf(const machine::MachineConfig& config, std::uint64_t machine_seed,
+                               int runs);
 
 /// Curves of one screw, for the report: its sensor log and the lead deviation per strategy.
 struct MachineScrewDetail {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::machine_eval {
 namespace {
@@ -27,8 +28,8 @@ void CheckAgainstMachine(const interp::MachineProfile& p, const interp::DriftAct
               " (the distance from the fixed bearing grows towards the chuck)");
   Require(std::abs(d.slope_fixed_end_mm - fixed_end_mm) < 1e-3, p,
           "drift.slope.fixed_end_position_mm",
-          interp::FormatFixed(d.slope_fixed_end_mm, 4) + " mm, but the machine's fixed bearing " +
-              "(z_fixed) sits at " + interp::FormatFixed(fixed_end_mm, 4) + " mm (MCS)");
+          FormatFixed(d.slope_fixed_end_mm, 4) + " mm, but the machine's fixed bearing " +
+              "(z_fixed) sits at " + FormatFixed(fixed_end_mm, 4) + " mm (MCS)");
 }
 
 }  // namespace
@@ -63,10 +64,10 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
   const double bound = interp::DriftSlopeBound(g, out.drift);
   if (out.plan.max_abs_slope + bound > po.md32760)
     throw InputError("combined programs: the plan's largest slope " +
-                     interp::FormatFixed(out.plan.max_abs_slope, interp::kDecimalsSd43910) +
+                     FormatFixed(out.plan.max_abs_slope, interp::kDecimalsSd43910) +
                      " plus the machine slope's bound " +
-                     interp::FormatFixed(bound, interp::kDecimalsSd43910) +
-                     " exceed MD32760 = " + interp::FormatFixed(po.md32760, 4) + " (profile '" +
+                     FormatFixed(bound, interp::kDecimalsSd43910) +
+                     " exceed MD32760 = " + FormatFixed(po.md32760, 4) + " (profile '" +
                      profile.source + "'): SD43910 could be capped mid-cut");
   out.drift_nc = interp::FormatDriftNcProgram(models.offset_cutting, out.drift,
                                               "machine model trained on cutting runs", &g);

@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
@@ -109,7 +110,7 @@ std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
       "interpolation cycle from the analog inputs) is the only writer of SD43900-43920: "
       "SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b), the fixed "
       "bearing at P_b = " +
-      interp::FormatFixed(d.slope_fixed_end_mm, 4) +
+      FormatFixed(d.slope_fixed_end_mm, 4) +
       " mm (MCS). Call WHIRL_DRIFT_COMP first, then WHIRL_TEMP_COMP before the cutting block, "
       "the reset programs after the cut or an abort.</p><ul>";
   for (const char* f : {"WHIRL_TEMP_COMP.SPF", "WHIRL_TEMP_COMP_RESET.SPF", "WHIRL_DRIFT_COMP.SPF",

@@ -16,27 +16,16 @@ namespace {
 
 using nlohmann::json;
 
+// The field checks of core/json_file.h under this file's short names: epochs of 1e30 or a layer
+// of 2e9 neurons are errors, not allocations.
 const json& Require(const json& j, const std::string& key, const std::string& where) {
-  if (!j.is_object()) throw InputError(where + ": expected a JSON object");
-  if (!j.contains(key)) throw InputError(where + ": missing required key '" + key + "'");
-  return j.at(key);
+  return RequireKey(j, key, where);
 }
-
 double RequireFinite(const json& v, const std::string& where) {
-  if (!v.is_number()) throw InputError(where + " must be a number, got " + v.dump());
-  const double x = v.get<double>();
-  if (!std::isfinite(x)) throw InputError(where + " must be finite, got " + v.dump());
-  return x;
+  return RequireFiniteValue(v, where);
 }
-
-// A whole number within [lo, hi], checked before any cast (a float-to-int cast out of range is
-// undefined behaviour): epochs of 1e30 or a layer of 2e9 neurons are errors, not allocations.
 int RequireInt(const json& v, const std::string& where, double lo, double hi) {
-  const double x = RequireFinite(v, where);
-  if (x != std::floor(x) || x < lo || x > hi)
-    throw InputError(where + " must be a whole number in [" + FormatNumber(lo) + ", " +
-                     FormatNumber(hi) + "], got " + v.dump());
-  return static_cast<int>(x);
+  return static_cast<int>(RequireWholeValue(v, where, lo, hi));
 }
 
 // `path` is the key path inside the model file, e.g. "layers[0].weights"; messages quote it.

@@ -4,7 +4,6 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -38,10 +37,8 @@ Model TrainModelHiddenByEvidence(const ProcessTable& table, const ModelTrainOpti
   std::string tried;
   for (std::size_t i = 0; i < fits.size(); ++i) {
     const double ev = fits[i].training_summary.log_evidence;
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "%s%d: %.6g", tried.empty() ? "" : ", ",
-                  options.hidden_candidates[i], ev);
-    tried += buf;
+    tried += (tried.empty() ? "" : ", ") + std::to_string(options.hidden_candidates[i]) + ": " +
+             MessageNumber(ev);
     if (ev > fits[best].training_summary.log_evidence) best = i;
   }
   Model m = std::move(fits[best]);
@@ -83,10 +80,8 @@ Model TrainModelAutoHidden(const ProcessTable& table, const ModelTrainOptions& o
   for (int h : options.hidden_candidates) {
     sweep.hidden_min = sweep.hidden_max = h;
     const SweepRow row = HiddenSweep(table, sweep).front();
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%s%d: %.4g", tried.empty() ? "" : ", ", h,
-                  row.cv_rms_normalized);
-    tried += buf;
+    tried += (tried.empty() ? "" : ", ") + std::to_string(h) + ": " +
+             FormatSignificant(row.cv_rms_normalized, 4);
     if (row.cv_rms_normalized < best_cv) {
       best_cv = row.cv_rms_normalized;
       best = h;

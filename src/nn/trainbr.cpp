@@ -4,13 +4,13 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <sstream>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/json_file.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
 #include "nn/dense_kernels.h"
@@ -24,9 +24,6 @@ using detail::SolveFactored;
 using detail::TraceOfInverse;
 
 constexpr double kMuFloor = 1e-20;  // trainbr: mu = max(mu * mu_dec, 1e-20)
-
-// Numbers in messages (stop reasons, errors): 6 significant digits; the summary keeps exact values.
-std::string Num(double x) { return MessageNumber(x); }
 
 double SumSquares(const Eigen::MatrixXd& e) { return e.squaredNorm(); }
 
@@ -72,7 +69,7 @@ Regularization ParseRegularization(const std::string& s) {
 
 void TrainOptions::Validate() const {
   auto fail = [](const std::string& name, double v, const std::string& rule) {
-    throw InputError("train option '" + name + "' = " + Num(v) + ": " + rule);
+    throw InputError("train option '" + name + "' = " + MessageNumber(v) + ": " + rule);
   };
   if (epochs < 0) fail("epochs", epochs, "must be >= 0");
   if (!(goal >= 0) || !std::isfinite(goal)) fail("goal", goal, "must be finite and >= 0");
@@ -99,22 +96,23 @@ bool StopReached(const TrainOptions& options, int epoch, double sse, double grad
     sum->message = degenerate_message;
   } else if (sse <= options.goal) {
     sum->termination = TrainTermination::kGoalMet;
-    sum->message = "ssE = " + Num(sse) + " <= goal = " + Num(options.goal);
+    sum->message = "ssE = " + MessageNumber(sse) + " <= goal = " + MessageNumber(options.goal);
   } else if (epoch == options.epochs) {
     sum->termination = TrainTermination::kMaxEpochs;
     sum->message =
         "epoch = " + std::to_string(epoch) + " == epochs = " + std::to_string(options.epochs);
   } else if (gradient <= options.min_grad) {
     sum->termination = TrainTermination::kMinGradient;
-    sum->message =
-        "gradient 2||J'e|| = " + Num(gradient) + " <= min_grad = " + Num(options.min_grad);
+    sum->message = "gradient 2||J'e|| = " + MessageNumber(gradient) +
+                   " <= min_grad = " + MessageNumber(options.min_grad);
   } else if (mu >= options.mu_max) {
     sum->termination = TrainTermination::kMaxMu;
-    sum->message = "mu = " + Num(mu) + " >= mu_max = " + Num(options.mu_max);
+    sum->message = "mu = " + MessageNumber(mu) + " >= mu_max = " + MessageNumber(options.mu_max);
   } else if (options.change > 0 && ObjectiveSpread(after_step) < options.change) {
     sum->termination = TrainTermination::kObjectiveStalled;
-    sum->message = "F after the step changed by at most " + Num(ObjectiveSpread(after_step)) +
-                   " < change = " + Num(options.change) + " over the last 4 epochs";
+    sum->message = "F after the step changed by at most " +
+                   MessageNumber(ObjectiveSpread(after_step)) +
+                   " < change = " + MessageNumber(options.change) + " over the last 4 epochs";
   } else {
     return false;
   }
@@ -135,11 +133,7 @@ double ObjectiveSpread(const std::vector<double>& after_step) {
 std::string TrainSummary::BriefReport() const {
   // Four significant digits for a person to read; the model file keeps the exact values. No F:
   // trainbr starts and ends near F = n / 2 by its alpha/beta rule, so F tells nothing here.
-  auto brief = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", x);
-    return std::string(buf);
-  };
+  auto brief = [](double x) { return FormatSignificant(x, 4); };
   std::ostringstream s;
   s << (regularization == Regularization::kBayesian ? "trainbr" : "trainlm") << ": ssE "
     << brief(initial_sse) << " -> " << brief(sse) << " in " << epochs << " epochs, gamma "
@@ -153,31 +147,18 @@ nlohmann::json VecJson(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
 Eigen::VectorXd VecFromJson(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key) || !j.at(key).is_array())
-    throw InputError(std::string("training_summary: '") + key + "' must be an array of numbers");
-  const auto& a = j.at(key);
-  Eigen::VectorXd v(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!a[i].is_number())
-      throw InputError(std::string("training_summary: '") + key + "'[" + std::to_string(i) +
-                       "] must be a number, got " + a[i].dump());
-    v(i) = a[i].get<double>();
-  }
-  return v;
+  const std::vector<double> v = RequireNumbers(RequireKey(j, key, "training_summary"),
+                                               std::string("training_summary: '") + key + "'");
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 // NaN (no regularization) is stored as null.
 nlohmann::json MaybeNumber(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
 }
 double NumberOrNan(const nlohmann::json& j, const char* key) {
-  if (!j.contains(key))
-    throw InputError(std::string("training_summary: missing key '") + key + "'");
-  const auto& v = j.at(key);
+  const auto& v = RequireKey(j, key, "training_summary");
   if (v.is_null()) return std::numeric_limits<double>::quiet_NaN();
-  if (!v.is_number())
-    throw InputError(std::string("training_summary: '") + key + "' must be a number, got " +
-                     v.dump());
-  return v.get<double>();
+  return RequireFiniteValue(v, std::string("training_summary: '") + key + "'");
 }
 }  // namespace
 
@@ -207,18 +188,15 @@ void to_json(nlohmann::json& j, const TrainSummary& s) {
 
 void from_json(const nlohmann::json& j, TrainSummary& s) {
   if (!j.is_object()) throw InputError("training_summary: expected a JSON object");
-  auto num = [&](const char* key) {
-    if (!j.contains(key))
-      throw InputError(std::string("training_summary: missing key '") + key + "'");
-    const auto& v = j.at(key);
-    if (!v.is_number())
-      throw InputError(std::string("training_summary: '") + key + "' must be a number, got " +
-                       v.dump());
-    return v.get<double>();
+  auto num = [&](const char* key) { return RequireNumber(j, key, "training_summary"); };
+  // Counts checked before the cast (a float-to-int cast out of range is undefined behaviour).
+  auto count = [&](const char* key) {
+    return static_cast<int>(
+        RequireInteger(j, key, 0, std::numeric_limits<int>::max(), "training_summary"));
   };
-  s.epochs = static_cast<int>(num("epochs"));
-  s.parameter_count = static_cast<int>(num("parameter_count"));
-  s.error_count = static_cast<int>(num("error_count"));
+  s.epochs = count("epochs");
+  s.parameter_count = count("parameter_count");
+  s.error_count = count("error_count");
   s.initial_cost = num("initial_cost");
   s.final_cost = num("final_cost");
   s.initial_sse = num("initial_sse_normalized");
@@ -432,7 +410,7 @@ std::string ReestimateArd(const Eigen::MatrixXd& jj, double sse, const Eigen::Ve
                                               : std::min(gamma(g) / (2 * ssx(g)), kArdAlphaMax);
   const double beta = sse == 0 ? 1.0 : (n - gamma.sum()) / (2 * sse);
   if (!alpha.allFinite() || !std::isfinite(beta) || !(beta > 0))
-    return "gamma = " + Num(gamma.sum()) + ", beta = " + Num(beta) +
+    return "gamma = " + MessageNumber(gamma.sum()) + ", beta = " + MessageNumber(beta) +
            " (kept the last finite alpha_g, beta)";
   *h = {alpha, beta, gamma.sum()};
   return "";
@@ -722,9 +700,9 @@ class BrIteration {
       alpha_ = alpha_new;
       beta_ = beta_new;
     } else {
-      degenerate = "gamma = " + Num(gamma_new) + ", alpha = " + Num(alpha_new) +
-                   ", beta = (n - gamma)/(2 ssE) = " + Num(beta_new) + " at ssE = " + Num(sse_) +
-                   " (kept the last finite alpha, beta)";
+      degenerate = "gamma = " + MessageNumber(gamma_new) + ", alpha = " + MessageNumber(alpha_new) +
+                   ", beta = (n - gamma)/(2 ssE) = " + MessageNumber(beta_new) +
+                   " at ssE = " + MessageNumber(sse_) + " (kept the last finite alpha, beta)";
     }
     F_ = beta_ * sse_ + alpha_ * ssx_;
     return degenerate;
@@ -834,8 +812,8 @@ TrainResult KeepArdIfSupported(const TrainingData& data, TrainResult result,
   const double margin = kArdEvidenceMargin * std::max(1.0, std::abs(sum.log_evidence));
   if (steps > 0 && ard.summary.log_evidence > sum.log_evidence + margin) return ard;
   sum.message += "; ARD stage not kept (" + std::to_string(steps) +
-                 " accepted steps, log evidence " + Num(ard.summary.log_evidence) + " against " +
-                 Num(sum.log_evidence) + ")";
+                 " accepted steps, log evidence " + MessageNumber(ard.summary.log_evidence) +
+                 " against " + MessageNumber(sum.log_evidence) + ")";
   return result;
 }
 

@@ -2,22 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::surface {
 namespace {
 
 using nlohmann::json;
 
-std::string Um(double x) {
-  if (std::isnan(x)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3f um", x);
-  return buf;
-}
+// "1.234 um", or "-" when there is no value.
+std::string Um(double x) { return std::isnan(x) ? "-" : FormatDecimals(x, 3) + " um"; }
 
 json StatsJson(const ErrorStats& s) {
   auto n = [](double x) { return std::isnan(x) ? json(nullptr) : json(x); };

@@ -1,6 +1,6 @@
 #include "surface/drift_adapter.h"
 
-#include <cstdio>
+#include "core/numbers.h"
 
 namespace whirl::surface {
 
@@ -13,14 +13,14 @@ PointModelFn DriftPointModel(const std::vector<drift::Run>& training, const drif
     if (notes) {
       std::string sensors;
       for (const auto& s : fit.model.sensors) sensors += (sensors.empty() ? "" : ", ") + s;
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "; R^2 %.4f, residual std %.3f um", fit.model.r_squared,
-                    fit.model.residual_std_um);
+      const std::string quality = "; R^2 " + FormatDecimals(fit.model.r_squared, 4) +
+                                  ", residual std " + FormatDecimals(fit.model.residual_std_um, 3) +
+                                  " um";
       const std::lock_guard<std::mutex> lock(notes->mutex);
       std::string left_out;
       for (const auto& w : fit.warnings) left_out += "; " + w;
       notes->by_column[column] =
-          drift::ToString(fit.model.kind) + " on " + sensors + buf + left_out;
+          drift::ToString(fit.model.kind) + " on " + sensors + quality + left_out;
     }
     return std::vector<double>(p.predicted_um.data(),
                                p.predicted_um.data() + p.predicted_um.size());

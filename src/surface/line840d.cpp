@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 
 namespace whirl::surface {
 namespace {
@@ -39,12 +39,6 @@ void Stats(const std::vector<double>& r, double* max_abs, double* rms) {
   for (double v : r) m = std::max(m, std::abs(v)), sum2 += v * v;
   *max_abs = m;
   *rms = std::sqrt(sum2 / static_cast<double>(r.size()));
-}
-
-std::string Num(double x, const char* fmt) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, x);
-  return buf;
 }
 
 }  // namespace
@@ -150,30 +144,31 @@ std::string FormatAxisLineText(const AxisLine& l) {
                                     " = " + FormatNumber(*o.at_mm) + " mm"
                               : "the whole measured table";
   std::string s = "axis " + o.axis + " along surface " + std::string(1, o.along) + " (" +
-                  Num(l.travel_min_mm, "%.1f") + ".." + Num(l.travel_max_mm, "%.1f") +
+                  FormatDecimals(l.travel_min_mm, 1) + ".." + FormatDecimals(l.travel_max_mm, 1) +
                   " mm), least-squares line over " + where + " (" + std::to_string(l.sample_count) +
                   " samples):\n";
-  s += "  error ~ " + Num(l.value_at_ref_um, "%.3f") + " um + " + Num(l.slope_um_per_mm, "%.6f") +
-       " um/mm * (" + std::string(1, o.along) + " - " + Num(l.reference_mm, "%.1f") + " mm)\n";
-  s += "  SD43900 $SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]    = " + Num(l.sd43900_mm, "%.6f") +
+  s += "  error ~ " + FormatDecimals(l.value_at_ref_um, 3) + " um + " +
+       FormatDecimals(l.slope_um_per_mm, 6) + " um/mm * (" + std::string(1, o.along) + " - " +
+       FormatDecimals(l.reference_mm, 1) + " mm)\n";
+  s += "  SD43900 $SA_TEMP_COMP_ABS_VALUE[" + o.axis + "]    = " + FormatDecimals(l.sd43900_mm, 6) +
        " mm\n";
-  s += "  SD43910 $SA_TEMP_COMP_SLOPE[" + o.axis + "]        = " + Num(l.sd43910, "%.8f") +
-       (l.slope_capped ? "  (capped by MD32760 = " + Num(o.md32760, "%.4f") + "; uncapped " +
-                             Num(l.uncapped_sd43910, "%.8f") + ")"
+  s += "  SD43910 $SA_TEMP_COMP_SLOPE[" + o.axis + "]        = " + FormatDecimals(l.sd43910, 8) +
+       (l.slope_capped ? "  (capped by MD32760 = " + FormatDecimals(o.md32760, 4) + "; uncapped " +
+                             FormatDecimals(l.uncapped_sd43910, 8) + ")"
                        : std::string()) +
        "\n";
-  s += "  SD43920 $SA_TEMP_COMP_REF_POSITION[" + o.axis + "] = " + Num(l.sd43920_mm, "%.4f") +
+  s += "  SD43920 $SA_TEMP_COMP_REF_POSITION[" + o.axis + "] = " + FormatDecimals(l.sd43920_mm, 4) +
        " mm (MCS)\n";
   s += "  sign " + interp::ToString(o.sign) +
        ": dK = " + (o.sign == interp::SignConvention::kSubtract ? "-" : "+") +
        "line/1000 (check on the machine, interp/sinumerik.h)\n";
-  s += "  error without compensation: max " + Num(l.error_max_abs_um, "%.3f") + " um, RMS " +
-       Num(l.error_rms_um, "%.3f") + " um\n";
-  s += "  left by SD43900 alone:      max " + Num(l.offset_only_max_abs_um, "%.3f") + " um, RMS " +
-       Num(l.offset_only_rms_um, "%.3f") + " um\n";
+  s += "  error without compensation: max " + FormatDecimals(l.error_max_abs_um, 3) + " um, RMS " +
+       FormatDecimals(l.error_rms_um, 3) + " um\n";
+  s += "  left by SD43900 alone:      max " + FormatDecimals(l.offset_only_max_abs_um, 3) +
+       " um, RMS " + FormatDecimals(l.offset_only_rms_um, 3) + " um\n";
   s += "  left by the line (uncorrected by the 840D): max " +
-       Num(l.uncorrected_max_abs_um, "%.3f") + " um, RMS " + Num(l.uncorrected_rms_um, "%.3f") +
-       " um\n";
+       FormatDecimals(l.uncorrected_max_abs_um, 3) + " um, RMS " +
+       FormatDecimals(l.uncorrected_rms_um, 3) + " um\n";
   return s;
 }
 

@@ -1,12 +1,12 @@
 #include "surface/report.h"
 
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
@@ -15,30 +15,19 @@ namespace whirl::surface {
 namespace fs = std::filesystem;
 namespace {
 
-std::string Fixed(double x, int decimals) {
-  if (std::isnan(x)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  return buf;
-}
-
-std::string Sci(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
+// gnuplot data: 10 significant digits.
+std::string G10(double x) { return FormatSignificant(x, 10); }
 
 std::string GridData(const SurfaceFit& fit, int n) {
   const Bounds& b = fit.surface.bounds;
   std::ostringstream s;
-  s.precision(10);
   s << "# x_mm y_mm error_um: the " << ToString(fit.surface.method) << " surface on a " << n
     << " x " << n << " map\n";
   for (int i = 0; i < n; ++i) {
     const double y = b.y_min_mm + (b.y_max_mm - b.y_min_mm) * i / (n - 1);
     for (int j = 0; j < n; ++j) {
       const double x = b.x_min_mm + (b.x_max_mm - b.x_min_mm) * j / (n - 1);
-      s << x << ' ' << y << ' ' << fit.surface.Evaluate(x, y) << '\n';
+      s << G10(x) << ' ' << G10(y) << ' ' << G10(fit.surface.Evaluate(x, y)) << '\n';
     }
     s << '\n';
   }
@@ -47,9 +36,9 @@ std::string GridData(const SurfaceFit& fit, int n) {
 
 std::string PointsData(const SurfaceFit& fit) {
   std::ostringstream s;
-  s.precision(10);
   s << "# x_mm y_mm error_um: the measured points\n";
-  for (const auto& p : fit.points) s << p.x_mm << ' ' << p.y_mm << ' ' << p.error_um << '\n';
+  for (const auto& p : fit.points)
+    s << G10(p.x_mm) << ' ' << G10(p.y_mm) << ' ' << G10(p.error_um) << '\n';
   return s.str();
 }
 
@@ -104,13 +93,15 @@ std::string SummaryHtml(const SurfaceFit& f) {
   h << "<table><tr><th>method</th><td>" << ToString(f.surface.method);
   if (f.surface.method == Method::kBspline) h << ", degree " << f.surface.bspline.degree;
   h << "</td></tr>\n<tr><th>points</th><td>" << f.points.size() << "</td></tr>\n"
-    << "<tr><th>condition number</th><td>" << Fixed(f.condition_number, 1);
+    << "<tr><th>condition number</th><td>" << FormatDecimalsOr(f.condition_number, 1, "-");
   if (f.surface.method == Method::kCubic)
-    h << " (normalized coordinates; " << Sci(f.condition_number_mm) << " in raw mm)";
-  h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << Fixed(res.rms_um, 3) << " / "
-    << Fixed(res.max_abs_um, 3) << " um</td></tr>\n"
-    << "<tr><th>leave-one-out RMS / max</th><td>" << Fixed(loo.rms_um, 3) << " / "
-    << Fixed(loo.max_abs_um, 3) << " um over " << loo.count << " points</td></tr>\n</table>\n";
+    h << " (normalized coordinates; " << FormatSignificant(f.condition_number_mm, 3)
+      << " in raw mm)";
+  h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << FormatDecimalsOr(res.rms_um, 3, "-")
+    << " / " << FormatDecimalsOr(res.max_abs_um, 3, "-") << " um</td></tr>\n"
+    << "<tr><th>leave-one-out RMS / max</th><td>" << FormatDecimalsOr(loo.rms_um, 3, "-") << " / "
+    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count
+    << " points</td></tr>\n</table>\n";
   if (f.surface.method == Method::kCubic) {
     const auto a = f.surface.cubic.CoefficientsMm();
     h << "<p>dE = a0 + a1 X + a2 Y + a3 X&sup2; + a4 XY + a5 Y&sup2; + a6 X&sup3; + a7 X&sup2;Y + "
@@ -118,9 +109,7 @@ std::string SummaryHtml(const SurfaceFit& f) {
     for (int k = 0; k < kCubicTerms; ++k) h << "<th>a" << k << "</th>";
     h << "</tr><tr>";
     for (int k = 0; k < kCubicTerms; ++k) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%.4e", a[k]);
-      h << "<td>" << buf << "</td>";
+      h << "<td>" << FormatExponent(a[k], 4) << "</td>";
     }
     h << "</tr></table>\n";
   }
@@ -136,11 +125,13 @@ std::string LinesHtml(const std::vector<AxisLine>& lines) {
        "[um]</th></tr>\n";
   for (const auto& l : lines)
     h << "<tr><td>" << HtmlEscape(l.options.axis) << "</td><td>" << l.options.along << "</td><td>"
-      << Fixed(l.sd43900_mm, 6) << "</td><td>" << Fixed(l.sd43910, 8)
-      << (l.slope_capped ? " (capped)" : "") << "</td><td>" << Fixed(l.sd43920_mm, 4) << "</td><td>"
-      << Fixed(l.error_max_abs_um, 2) << " / " << Fixed(l.error_rms_um, 2) << "</td><td>"
-      << Fixed(l.uncorrected_max_abs_um, 2) << " / " << Fixed(l.uncorrected_rms_um, 2)
-      << "</td></tr>\n";
+      << FormatDecimalsOr(l.sd43900_mm, 6, "-") << "</td><td>"
+      << FormatDecimalsOr(l.sd43910, 8, "-") << (l.slope_capped ? " (capped)" : "") << "</td><td>"
+      << FormatDecimalsOr(l.sd43920_mm, 4, "-") << "</td><td>"
+      << FormatDecimalsOr(l.error_max_abs_um, 2, "-") << " / "
+      << FormatDecimalsOr(l.error_rms_um, 2, "-") << "</td><td>"
+      << FormatDecimalsOr(l.uncorrected_max_abs_um, 2, "-") << " / "
+      << FormatDecimalsOr(l.uncorrected_rms_um, 2, "-") << "</td></tr>\n";
   h << "</table>\n<p class='small'>sign " << interp::ToString(lines[0].options.sign)
     << " (dK = s &middot; line / 1000, interp/sinumerik.h); check it on the machine.</p>\n";
   return h.str();
@@ -152,10 +143,12 @@ std::string PointsHtml(const SurfaceFit& f) {
        "<th>error [um]</th><th>fitted [um]</th><th>residual [um]</th><th>leave-one-out "
        "error [um]</th></tr>\n";
   for (std::size_t k = 0; k < f.points.size(); ++k)
-    h << "<tr><td>" << k + 1 << "</td><td>" << Fixed(f.points[k].x_mm, 2) << "</td><td>"
-      << Fixed(f.points[k].y_mm, 2) << "</td><td>" << Fixed(f.points[k].error_um, 3) << "</td><td>"
-      << Fixed(f.fitted_um[k], 3) << "</td><td>" << Fixed(f.residual_um[k], 3) << "</td><td>"
-      << Fixed(f.loo_error_um[k], 3) << "</td></tr>\n";
+    h << "<tr><td>" << k + 1 << "</td><td>" << FormatDecimalsOr(f.points[k].x_mm, 2, "-")
+      << "</td><td>" << FormatDecimalsOr(f.points[k].y_mm, 2, "-") << "</td><td>"
+      << FormatDecimalsOr(f.points[k].error_um, 3, "-") << "</td><td>"
+      << FormatDecimalsOr(f.fitted_um[k], 3, "-") << "</td><td>"
+      << FormatDecimalsOr(f.residual_um[k], 3, "-") << "</td><td>"
+      << FormatDecimalsOr(f.loo_error_um[k], 3, "-") << "</td></tr>\n";
   h << "</table>\n";
   return h.str();
 }

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "core/limits.h"
+#include "core/numbers.h"
 
 namespace whirl::surface {
 namespace {
@@ -24,15 +25,7 @@ json BoundsJson(const Bounds& b) {
 }
 
 std::vector<double> Numbers(const json& j, const char* key, const std::string& what) {
-  if (!j.contains(key) || !j.at(key).is_array())
-    throw InputError(what + ": '" + key + "' must be an array of numbers");
-  std::vector<double> v;
-  for (const auto& x : j.at(key)) {
-    if (!x.is_number() || !std::isfinite(x.get<double>()))
-      throw InputError(what + ": '" + key + "' holds a non-number or non-finite value " + x.dump());
-    v.push_back(x.get<double>());
-  }
-  return v;
+  return RequireNumbers(RequireKey(j, key, what), what + ": '" + key + "'");
 }
 
 json CubicJson(const SurfaceFit& f) {
@@ -106,7 +99,8 @@ BsplineSurface BsplineFromJson(const json& j, const std::string& what) {
   s.weights.resize(static_cast<Eigen::Index>(s.grid_y.size()),
                    static_cast<Eigen::Index>(s.grid_x.size()));
   for (std::size_t i = 0; i < w.size(); ++i) {
-    const std::vector<double> row = Numbers(json{{"row", w[i]}}, "row", what + " weights_um");
+    const std::vector<double> row =
+        RequireNumbers(w[i], what + ": 'weights_um[" + std::to_string(i) + "]'");
     if (row.size() != s.grid_x.size())
       throw InputError(what + ": weights_um row " + std::to_string(i + 1) +
                        " must hold one value per grid_x line");
@@ -131,13 +125,6 @@ void CheckBounds(const Bounds& b, const std::string& what) {
   CheckRange(b.y_max_mm, kCoordinate, "bounds.y_max_mm", what);
   if (b.x_min_mm > b.x_max_mm || b.y_min_mm > b.y_max_mm)
     throw InputError(what + ": bounds: x_min_mm must not exceed x_max_mm, nor y_min_mm y_max_mm");
-}
-
-std::string Fixed(double x, int decimals) {
-  if (std::isnan(x)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-  return buf;
 }
 
 }  // namespace
@@ -314,40 +301,37 @@ std::string FormatFitText(const SurfaceFit& f) {
   std::ostringstream s;
   const Bounds& b = f.surface.bounds;
   s << "surface: " << ToString(f.surface.method) << " over " << f.points.size() << " points, x "
-    << Fixed(b.x_min_mm, 1) << ".." << Fixed(b.x_max_mm, 1) << " mm, y " << Fixed(b.y_min_mm, 1)
-    << ".." << Fixed(b.y_max_mm, 1) << " mm\n";
+    << FormatDecimalsOr(b.x_min_mm, 1, "-") << ".." << FormatDecimalsOr(b.x_max_mm, 1, "-")
+    << " mm, y " << FormatDecimalsOr(b.y_min_mm, 1, "-") << ".."
+    << FormatDecimalsOr(b.y_max_mm, 1, "-") << " mm\n";
   if (f.surface.method == Method::kCubic) {
     const auto a = f.surface.cubic.CoefficientsMm();
     s << "  dE = a0 + a1 X + a2 Y + a3 X^2 + a4 XY + a5 Y^2 + a6 X^3 + a7 X^2Y + a8 XY^2 + a9 Y^3"
          " (um, X/Y in mm)\n";
-    for (int k = 0; k < kCubicTerms; ++k) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "  a%d = %.6e\n", k, a[k]);
-      s << buf;
-    }
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "%.1f (normalized u, v), %.3g (raw mm)", f.condition_number,
-                  f.condition_number_mm);
-    s << "  condition number " << buf << "\n";
+    for (int k = 0; k < kCubicTerms; ++k)
+      s << "  a" << k << " = " << FormatExponent(a[k], 6) << "\n";
+    s << "  condition number " << FormatDecimals(f.condition_number, 1) << " (normalized u, v), "
+      << FormatSignificant(f.condition_number_mm, 3) << " (raw mm)\n";
   } else {
     const BsplineSurface& bs = f.surface.bspline;
     s << "  degree " << bs.degree << ", grid " << bs.grid_y.size() << " rows x " << bs.grid_x.size()
-      << " columns, condition number of the collocation matrices " << Fixed(f.condition_number, 1)
-      << "\n";
+      << " columns, condition number of the collocation matrices "
+      << FormatDecimalsOr(f.condition_number, 1, "-") << "\n";
   }
   s << "  point        x_mm        y_mm    error_um   fitted_um  residual_um  loo_error_um\n";
   for (std::size_t k = 0; k < f.points.size(); ++k) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "  %5zu %11.2f %11.2f %11.3f %11.3f %12.3f %13s\n", k + 1,
                   f.points[k].x_mm, f.points[k].y_mm, f.points[k].error_um, f.fitted_um[k],
-                  f.residual_um[k], Fixed(f.loo_error_um[k], 3).c_str());
+                  f.residual_um[k], FormatDecimalsOr(f.loo_error_um[k], 3, "-").c_str());
     s << buf;
   }
   const ErrorStats res = StatsOf(f.residual_um), loo = StatsOf(f.loo_error_um);
-  s << "  residual: RMS " << Fixed(res.rms_um, 3) << " um, max |.| " << Fixed(res.max_abs_um, 3)
-    << " um\n  leave-one-out: RMS " << Fixed(loo.rms_um, 3) << " um, max |.| "
-    << Fixed(loo.max_abs_um, 3) << " um over " << loo.count << " of " << f.points.size()
-    << " points\n";
+  s << "  residual: RMS " << FormatDecimalsOr(res.rms_um, 3, "-") << " um, max |.| "
+    << FormatDecimalsOr(res.max_abs_um, 3, "-") << " um\n  leave-one-out: RMS "
+    << FormatDecimalsOr(loo.rms_um, 3, "-") << " um, max |.| "
+    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count << " of "
+    << f.points.size() << " points\n";
   return s.str();
 }
 

@@ -10,16 +10,11 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/random.h"
 
 namespace whirl::torch {
 namespace {
-
-std::string Num(double x, int precision = 3) {
-  std::ostringstream ss;
-  ss << std::setprecision(precision) << x;
-  return ss.str();
-}
 
 double MaxAbs(const Eigen::MatrixXd& m) { return m.size() == 0 ? 0.0 : m.cwiseAbs().maxCoeff(); }
 
@@ -147,9 +142,9 @@ std::string ToString(GaussNewtonTermination t) {
 }
 
 std::string GaussNewtonSummary::BriefReport() const {
-  return "Gauss-Newton (Eigen, nn Jacobian): F " + Num(initial_objective, 10) + " -> " +
-         Num(final_objective, 10) + " in " + std::to_string(iterations) + " iterations, " +
-         ToString(termination) + " (" + message + ")";
+  return "Gauss-Newton (Eigen, nn Jacobian): F " + FormatSignificant(initial_objective, 10) +
+         " -> " + FormatSignificant(final_objective, 10) + " in " + std::to_string(iterations) +
+         " iterations, " + ToString(termination) + " (" + message + ")";
 }
 
 GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const Eigen::MatrixXd& x,
@@ -158,8 +153,8 @@ GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const 
   start.Validate("Gauss-Newton start network");
   CheckData(start, x, t);
   if (!(alpha >= 0) || !(beta > 0) || !std::isfinite(alpha) || !std::isfinite(beta)) {
-    throw InputError("Gauss-Newton: alpha = " + Num(alpha) + ", beta = " + Num(beta) +
-                     " (need alpha >= 0, beta > 0, finite)");
+    throw InputError("Gauss-Newton: alpha = " + FormatSignificant(alpha, 3) + ", beta = " +
+                     FormatSignificant(beta, 3) + " (need alpha >= 0, beta > 0, finite)");
   }
   if (options.max_iterations < 1 || !(options.gradient_tolerance > 0) || !(options.mu > 0) ||
       !(options.mu_dec > 0 && options.mu_dec < 1) || !(options.mu_inc > 1) ||
@@ -180,20 +175,23 @@ GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const 
     g_inf = (2.0 * (beta * cur.je + alpha * w)).cwiseAbs().maxCoeff();
     if (g_inf <= options.gradient_tolerance) {
       summary.termination = GaussNewtonTermination::kGradientTolerance;
-      summary.message = "||dF/dw||_inf " + Num(g_inf) + " <= " + Num(options.gradient_tolerance);
+      summary.message = "||dF/dw||_inf " + FormatSignificant(g_inf, 3) +
+                        " <= " + FormatSignificant(options.gradient_tolerance, 3);
       break;
     }
     if (summary.iterations >= options.max_iterations) {
       summary.termination = GaussNewtonTermination::kMaxIterations;
       summary.message = std::to_string(options.max_iterations) + " iterations, ||dF/dw||_inf " +
-                        Num(g_inf) + " > " + Num(options.gradient_tolerance);
+                        FormatSignificant(g_inf, 3) + " > " +
+                        FormatSignificant(options.gradient_tolerance, 3);
       break;
     }
     if (mu > options.mu_max) {
       summary.termination = GaussNewtonTermination::kMaxMu;
-      summary.message = "mu " + Num(mu) + " > " + Num(options.mu_max) +
-                        ": no step lowers F = " + Num(cur.objective, 17) + ", ||dF/dw||_inf " +
-                        Num(g_inf);
+      summary.message = "mu " + FormatSignificant(mu, 3) + " > " +
+                        FormatSignificant(options.mu_max, 3) +
+                        ": no step lowers F = " + FormatSignificant(cur.objective, 17) +
+                        ", ||dF/dw||_inf " + FormatSignificant(g_inf, 3);
       break;
     }
     ++summary.iterations;
@@ -225,7 +223,7 @@ GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const 
 void CrosscheckOptions::Validate() const {
   const auto positive = [](double v, const char* name) {
     if (!(v > 0) || !std::isfinite(v)) {
-      throw InputError(std::string("cross-check option ") + name + " = " + Num(v) +
+      throw InputError(std::string("cross-check option ") + name + " = " + FormatSignificant(v, 3) +
                        ": must be a positive finite number");
     }
   };
@@ -239,8 +237,9 @@ void CrosscheckOptions::Validate() const {
     throw InputError("cross-check option alpha/beta: must be finite (<= 0 = the model's values)");
   }
   if (!(start_perturbation >= 0 && start_perturbation <= 1)) {
-    throw InputError("cross-check option start_perturbation = " + Num(start_perturbation) +
-                     ": must be in [0, 1] (relative change of each starting weight)");
+    throw InputError(
+        "cross-check option start_perturbation = " + FormatSignificant(start_perturbation, 3) +
+        ": must be in [0, 1] (relative change of each starting weight)");
   }
 }
 
@@ -260,14 +259,15 @@ bool CrosscheckReport::Passed() const {
 std::string CrosscheckReport::Table() const {
   std::ostringstream s;
   s << "LibTorch cross-check (" << torch_version << ", float64, 1 thread): " << sample_count
-    << " samples, N = " << parameter_count << " weights, alpha = " << Num(alpha, 6)
-    << ", beta = " << Num(beta, 6) << "\n";
+    << " samples, N = " << parameter_count << " weights, alpha = " << MessageNumber(alpha)
+    << ", beta = " << MessageNumber(beta) << "\n";
   s << std::left << std::setw(24) << "figure" << std::setw(12) << "value" << std::setw(12)
     << "tolerance" << std::setw(6) << ""
     << "definition\n";
   for (const auto& f : figures) {
-    s << std::left << std::setw(24) << f.name << std::setw(12) << Num(f.value) << std::setw(12)
-      << Num(f.tolerance) << std::setw(6) << (f.Passed() ? "ok" : "FAIL") << f.definition << "\n";
+    s << std::left << std::setw(24) << f.name << std::setw(12) << FormatSignificant(f.value, 3)
+      << std::setw(12) << FormatSignificant(f.tolerance, 3) << std::setw(6)
+      << (f.Passed() ? "ok" : "FAIL") << f.definition << "\n";
   }
   s << eigen_training.BriefReport() << "\n" << torch_training.BriefReport() << "\n";
   return s.str();
@@ -288,8 +288,8 @@ std::string CrosscheckReport::BriefReport() const {
   std::string out = "crosscheck: " + std::to_string(passed) + "/" + std::to_string(figures.size()) +
                     " figures within tolerance";
   if (worst != nullptr) {
-    out += " (closest to its limit: " + worst->name + " " + Num(worst->value) +
-           (worst->Passed() ? " <= " : " > ") + Num(worst->tolerance) + ")";
+    out += " (closest to its limit: " + worst->name + " " + FormatSignificant(worst->value, 3) +
+           (worst->Passed() ? " <= " : " > ") + FormatSignificant(worst->tolerance, 3) + ")";
   }
   return out;
 }
@@ -475,8 +475,9 @@ CrosscheckReport RunCrosscheck(const nn::Model& model, const Eigen::MatrixXd& in
   report.alpha = options.alpha > 0 ? options.alpha : model.training_summary.alpha;
   report.beta = options.beta > 0 ? options.beta : model.training_summary.beta;
   if (!(report.alpha >= 0) || !(report.beta > 0)) {
-    throw InputError("cross-check: the model has no usable trainbr alpha = " + Num(report.alpha) +
-                     ", beta = " + Num(report.beta) + " (need alpha >= 0, beta > 0); pass them");
+    throw InputError("cross-check: the model has no usable trainbr alpha = " +
+                     FormatSignificant(report.alpha, 3) + ", beta = " +
+                     FormatSignificant(report.beta, 3) + " (need alpha >= 0, beta > 0); pass them");
   }
   d.alpha = report.alpha;
   d.beta = report.beta;
@@ -504,7 +505,7 @@ ExportReport ExportTorchScript(const nn::Model& model, const std::filesystem::pa
                                const ExportOptions& options) {
   namespace fs = std::filesystem;
   if (!(options.tolerance > 0)) {
-    throw InputError("TorchScript export: tolerance = " + Num(options.tolerance) +
+    throw InputError("TorchScript export: tolerance = " + FormatSignificant(options.tolerance, 3) +
                      ": must be positive");
   }
   model.Validate();

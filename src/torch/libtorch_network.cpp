@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 
 // Torch helpers live outside namespace whirl::torch so that `torch::` never resolves to it.
 namespace whirl_torch_detail {
@@ -235,13 +236,6 @@ void Prepare() {
   (void)once;
 }
 
-std::string FormatDouble(double x) {
-  std::ostringstream ss;
-  ss.precision(6);
-  ss << x;
-  return ss.str();
-}
-
 /// TorchScript source of the exported module; layer count is spliced in, everything else is data.
 std::string ScriptSource(int layers, int inputs) {
   std::ostringstream s;
@@ -393,7 +387,7 @@ std::string ToString(LbfgsTermination t) {
 std::string LbfgsSummary::BriefReport() const {
   return "LBFGS (LibTorch, strong Wolfe" +
          std::string(preconditioned ? ", Gauss-Newton preconditioner" : "") + "): F " +
-         FormatDouble(initial_objective) + " -> " + FormatDouble(final_objective) + " in " +
+         MessageNumber(initial_objective) + " -> " + MessageNumber(final_objective) + " in " +
          std::to_string(iterations) + " iterations (" + std::to_string(steps) + " steps, " +
          std::to_string(function_evaluations) + " evaluations), " + ToString(termination) + " (" +
          message + ")";
@@ -481,11 +475,11 @@ int PreconditionedStep(const Tensor& m, const LbfgsOptions& options, CountedObje
 void SetEndOfSteps(double g_inf, const LbfgsOptions& options, LbfgsSummary* summary) {
   if (g_inf <= options.gradient_tolerance) {
     summary->termination = LbfgsTermination::kGradientTolerance;
-    summary->message =
-        "||dF/dw||_inf " + FormatDouble(g_inf) + " <= " + FormatDouble(options.gradient_tolerance);
+    summary->message = "||dF/dw||_inf " + MessageNumber(g_inf) +
+                       " <= " + MessageNumber(options.gradient_tolerance);
   } else {
     summary->message = std::to_string(options.max_steps) + " steps, ||dF/dw||_inf " +
-                       FormatDouble(g_inf) + " > " + FormatDouble(options.gradient_tolerance);
+                       MessageNumber(g_inf) + " > " + MessageNumber(options.gradient_tolerance);
   }
 }
 
@@ -520,7 +514,7 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
   for (int step = 0; step < options.max_steps; ++step) {
     if (!std::isfinite(f) || !std::isfinite(g_inf)) {
       summary.termination = LbfgsTermination::kNonFinite;
-      summary.message = "F = " + FormatDouble(f) + ", ||g||_inf = " + FormatDouble(g_inf);
+      summary.message = "F = " + MessageNumber(f) + ", ||g||_inf = " + MessageNumber(g_inf);
       break;
     }
     if (g_inf <= options.gradient_tolerance) break;
@@ -535,9 +529,9 @@ LbfgsSummary TorchMinimize(const FlatLayout& layout, const Eigen::VectorXd& w0,
     objective.Evaluate(&f, &g_inf);
     if (std::isfinite(f) && f >= f_before && g_inf > options.gradient_tolerance) {
       summary.termination = LbfgsTermination::kNoProgress;
-      summary.message = "a step left F at " + FormatDouble(f) + " (was " + FormatDouble(f_before) +
-                        "), ||dF/dw||_inf " + FormatDouble(g_inf) + " > " +
-                        FormatDouble(options.gradient_tolerance);
+      summary.message = "a step left F at " + MessageNumber(f) + " (was " +
+                        MessageNumber(f_before) + "), ||dF/dw||_inf " + MessageNumber(g_inf) +
+                        " > " + MessageNumber(options.gradient_tolerance);
       break;
     }
   }

@@ -79,11 +79,9 @@ BENCHMARK(BM_FamilyCandidate)
              0, static_cast<int>(whirl::family::ChoiceOptions::DefaultCandidates().size()) - 1, 1)})
     ->Unit(benchmark::kMillisecond);
 
-void BM_TrainbrSingleFit(benchmark::State& state) {
+// Trains the network with `o` (one thread) on the benchmark's table, 16 seeds in turn.
+void TrainNetwork(benchmark::State& state, whirl::nn::ModelTrainOptions o) {
   const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
-  whirl::nn::ModelTrainOptions o;
-  o.train.change = whirl::nn::kBrnnChange;
-  o.noise_folds = 0;
   o.threads = 1;
   std::uint64_t i = 0;
   for (auto _ : state) {
@@ -92,18 +90,17 @@ void BM_TrainbrSingleFit(benchmark::State& state) {
     benchmark::DoNotOptimize(m.training_summary.sse);
   }
 }
+
+void BM_TrainbrSingleFit(benchmark::State& state) {
+  whirl::nn::ModelTrainOptions o;
+  o.train.change = whirl::nn::kBrnnChange;
+  o.noise_folds = 0;
+  TrainNetwork(state, o);
+}
 BENCHMARK(BM_TrainbrSingleFit)->ArgName("rows")->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
 
 void BM_NetworkDefault(benchmark::State& state) {
-  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
-  whirl::nn::ModelTrainOptions o = whirl::nn::DefaultTrainingOptions();
-  o.threads = 1;
-  std::uint64_t i = 0;
-  for (auto _ : state) {
-    o.seed = 1 + (i++ % 16);
-    const whirl::nn::Model m = whirl::nn::TrainModel(table, o, "bench");
-    benchmark::DoNotOptimize(m.training_summary.sse);
-  }
+  TrainNetwork(state, whirl::nn::DefaultTrainingOptions());
 }
 BENCHMARK(BM_NetworkDefault)->ArgName("rows")->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
 

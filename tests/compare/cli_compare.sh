@@ -75,7 +75,8 @@ assert j["schema"] == "whirl.evaluate_scenarios"
 assert [s["scenario"] for s in j["scenarios"]] == ["today", "steady-rest"]
 for s in j["scenarios"]:
     a = s["summary"]["absolute_um"]
-    assert set(a) == {"none", "ramp", "traditional", "regression", "model"}, a
+    assert set(a) == {"none", "ramp", "traditional", "regression", "model", "class", "table",
+                      "nearest"}, a
     for v in a.values():
         assert v["accumulated_1000_worst_um"] >= v["accumulated_1000_median_um"] >= 0
 PY

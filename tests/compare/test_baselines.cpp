@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "compare/history_rules.h"
 #include "compare/scenarios.h"
 #include "compare/traditional.h"
 #include "core/error.h"
@@ -103,6 +104,88 @@ TEST(Baselines, ScenarioSelectionAndOutOfRangeScrews) {
                          p.cutting_speed_m_min > training.max.cutting_speed_m_min;
     EXPECT_TRUE(outside) << s.name;
   }
+}
+
+
+// Six hand-placed past screws: two in one cell, one in each of four others. Cells by (raceway
+// radius, speed, lead) class with the default edges 4.48/6.69 mm, 167.8/187.7 m/min, 8.32/11.54 mm.
+ProcessTable SixRowTable() {
+  ProcessTable h;
+  h.source = "six";
+  h.inputs = {{62, 60, 7, 4.0, 160},    // cell (0,0,0)
+              {62, 90, 8, 4.2, 155},    // cell (0,0,0)
+              {62, 60, 10, 5.0, 160},   // cell (1,0,1)
+              {62, 60, 14, 8.0, 200},   // cell (2,2,2)
+              {62, 60, 14, 8.0, 160},   // cell (2,0,2)
+              {62, 60, 7, 4.0, 200}};   // cell (0,2,0)
+  h.targets = {{10, 100}, {20, 300}, {30, 400}, {40, 500}, {50, 600}, {60, 700}};
+  return h;
+}
+
+TEST(HistoryRules, ExperienceTableCellMeansAndEmptyCellFallback) {
+  const ExperienceTable t = BuildExperienceTable(SixRowTable());
+  // The populated cell: mean of its two screws.
+  EXPECT_DOUBLE_EQ(t.Predict({60, 70, 7.5, 4.1, 151}).max_elongation_um, 15);
+  EXPECT_DOUBLE_EQ(t.Predict({60, 70, 7.5, 4.1, 151}).settle_time_s, 200);
+  // Cell (1,0,0) is empty; its Chebyshev-1 neighbours that hold screws: (0,0,0) mean 15/200 and
+  // (1,0,1) 30/400: the mean of the two cell means.
+  EXPECT_DOUBLE_EQ(t.Predict({60, 70, 7.0, 5.0, 160}).max_elongation_um, 22.5);
+  EXPECT_DOUBLE_EQ(t.Predict({60, 70, 7.0, 5.0, 160}).settle_time_s, 300);
+  // Cell (2,1,0) is empty; distance 1: (1,0,1) only -> 30.
+  EXPECT_DOUBLE_EQ(t.Predict({60, 70, 7.0, 9.0, 180}).max_elongation_um, 30);
+  // A class upper edge belongs to the lower class.
+  EXPECT_EQ(t.CellOf({60, 70, 8.32, 4.48, 167.8}), 0);
+  EXPECT_EQ(t.CellOf({60, 70, 8.33, 4.49, 167.9}), 13);
+  ProcessTable empty;
+  empty.source = "empty";
+  EXPECT_THROW(BuildExperienceTable(empty), InputError);
+}
+
+TEST(HistoryRules, NearestScrewsReturnsARowForKOneAndAveragesK) {
+  const ProcessTable h = SixRowTable();
+  const NearestScrews n = BuildNearestScrews(h);
+  for (std::size_t r = 0; r < h.inputs.size(); ++r) {
+    EXPECT_DOUBLE_EQ(n.Predict(h.inputs[r], 1).max_elongation_um, h.targets[r].max_elongation_um);
+    EXPECT_DOUBLE_EQ(n.Predict(h.inputs[r], 1).settle_time_s, h.targets[r].settle_time_s);
+  }
+  // Leaving row 0 out (scaled by the ranges: diameter 30, lead 7, radius 4, speed 45), its
+  // nearest is row 2 (lead 3/7, radius 1/4: squared distance 0.246) before row 5 (speed 40/45:
+  // 0.790) and row 1 (diameter 30/30: > 1).
+  EXPECT_DOUBLE_EQ(n.Predict(h.inputs[0], 1, 0).max_elongation_um, 30);
+  EXPECT_DOUBLE_EQ(n.Predict(h.inputs[0], 2, 0).max_elongation_um, 45);
+  // k larger than the history: the mean of all rows.
+  EXPECT_DOUBLE_EQ(n.Predict(h.inputs[0], 50).max_elongation_um, 35);
+}
+
+// A planted history where the features depend on the table's key only (each cell's value exact,
+// two or more screws per cell, diameters random): leave-one-out must choose the table, whose
+// error is zero, and "traditional" must use it.
+TEST(HistoryRules, LeaveOneOutChoosesTheTableWhenItIsExact) {
+  ProcessTable h;
+  h.source = "planted";
+  Rng rng(11);
+  const double radius[] = {3.5, 5.5, 8.5}, speed[] = {155, 178, 200}, lead[] = {7, 10, 14};
+  for (int cell = 0; cell < 27; ++cell)
+    for (int rep = 0; rep < 3; ++rep) {
+      const int a = cell / 9, b = (cell / 3) % 3, c = cell % 3;
+      h.inputs.push_back({60 + 5 * rng.Uniform(), 50 + 50 * rng.Uniform(), lead[c], radius[a],
+                          speed[b]});
+      h.targets.push_back({10.0 + 3 * a + 5 * b + 7 * c, 200.0 + 40 * a - 30 * b + 10 * c});
+    }
+  const ExperienceRule rule = BuildExperienceRule(h);
+  ASSERT_TRUE(rule.has_choice);
+  EXPECT_EQ(rule.choice.chosen, HistoryRule::kTable);
+  EXPECT_NEAR(rule.choice.loo_relative_error[1], 0.0, 1e-12);
+  EXPECT_GT(rule.choice.loo_relative_error[0], 0.05);
+  EXPECT_GT(rule.choice.loo_relative_error[2], 0.0);
+  const ProcessInputs q{61, 70, 10, 5.5, 200};
+  EXPECT_DOUBLE_EQ(rule.TraditionalFeatures(q).max_elongation_um, 10 + 3 + 5 * 2 + 7);
+  // The class rule's choice when the diameter alone decides.
+  ProcessTable d = h;
+  for (std::size_t r = 0; r < d.inputs.size(); ++r)
+    d.targets[r] = {d.inputs[r].diameter_mm < 63 ? 10.0 : 30.0, 300};
+  for (auto& p : d.inputs) p.diameter_mm = p.diameter_mm < 63 ? 50 : 90;
+  EXPECT_EQ(BuildExperienceRule(d).choice.chosen, HistoryRule::kClass);
 }
 
 }  // namespace

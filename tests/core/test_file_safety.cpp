@@ -20,6 +20,7 @@
 #include "core/json_file.h"
 #include "core/output_dir.h"
 #include "core/run_program.h"
+#include "support/expect_error.h"
 
 namespace whirl {
 namespace {
@@ -30,15 +31,6 @@ fs::path Scratch(const std::string& name) {
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 int CountEntries(const fs::path& d) {

@@ -5,24 +5,17 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "support/expect_error.h"
 
 namespace whirl {
 namespace {
 
 using nlohmann::json;
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(JsonFields, NumberInRangeNamesFileKeyValueAndRange) {
   const Range r{0, 1, false, "K"};
@@ -105,6 +98,25 @@ TEST(JsonFields, InvalidUtf8) {
   std::filesystem::remove(path);
   const json j = {{"file", std::string("run\xFF.csv")}};
   EXPECT_EQ(DumpJson(j, -1), "{\"file\":\"run\xEF\xBF\xBD.csv\"}");
+}
+
+// The value-level checks (array elements, values looked up already): the message names the
+// element, the rule and what was there; a whole number is checked before any cast.
+TEST(JsonFields, ArraysAndWholeValues) {
+  const json j = json::parse(R"({"v": [1, 2.5, -3], "bad": [1, "x"], "s": "1", "n": 7})");
+  EXPECT_EQ(RequireNumbers(j.at("v"), "f: 'v'"), (std::vector<double>{1, 2.5, -3}));
+  EXPECT_EQ(ErrorOf([&] { RequireNumbers(j.at("bad"), "f: 'bad'"); }),
+            "f: 'bad'[1] must be a number, got \"x\"");
+  EXPECT_EQ(ErrorOf([&] { RequireNumbers(j.at("s"), "f: 's'"); }),
+            "f: 's' must be an array of numbers, got \"1\"");
+  EXPECT_EQ(RequireWholeValue(j.at("n"), "f: 'n'", 0, 10), 7);
+  for (const char* bad : {"7.5", "1e30", "-1", "\"7\""})
+    EXPECT_NE(ErrorOf([&] { RequireWholeValue(json::parse(bad), "f: 'n'", 0, 10); })
+                  .find("f: 'n' must"),
+              std::string::npos)
+        << bad;
+  EXPECT_EQ(ErrorOf([&] { RequireKey(j, "zz", "f"); }), "f: missing required key 'zz'");
+  EXPECT_EQ(ErrorOf([&] { RequireKey(json::array(), "zz", "f"); }), "f: expected a JSON object");
 }
 
 }  // namespace

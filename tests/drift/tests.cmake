@@ -9,3 +9,5 @@ whirl_add_gtest(test_drift
   LIBS Boost::headers)
 whirl_add_cli_test(cli_drift ${CMAKE_CURRENT_LIST_DIR}/cli_drift.sh)
 whirl_add_cli_test(cli_drift_monitor ${CMAKE_CURRENT_LIST_DIR}/cli_monitor.sh)
+# The joint estimator from shop measurements (drift/joint.h).
+whirl_add_gtest(test_drift_joint SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_joint.cpp)

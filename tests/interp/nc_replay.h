@@ -17,6 +17,7 @@
 // everything it must not do after a failed check.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <functional>
@@ -341,6 +342,19 @@ struct Replay {
       for (const Write& w : a.writes) Assign(w.target, Value(w.expr));
       a.fired = true;
     }
+  }
+
+  // Moves the axis from `from_mm` up to, not onto, `to_mm` in `steps` cycles; returns the
+  // largest |applied dK - reference's dK| on the way, mm.
+  double WorstDeviationOnApproach(double from_mm, double to_mm, int steps,
+                                  const Control& reference) {
+    double worst_mm = 0;
+    for (int i = 0; i < steps; ++i) {
+      const double p = from_mm + (to_mm - from_mm) * i / static_cast<double>(steps);
+      Cycle(p);
+      worst_mm = std::max(worst_mm, std::abs(control.DkMm(p) - reference.DkMm(p)));
+    }
+    return worst_mm;
   }
 
   // Power off and on: every synchronized action and $AC_PARAM is gone; R parameters and setting

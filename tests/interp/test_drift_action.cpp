@@ -353,13 +353,7 @@ TEST(DriftAction, CombinedTheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
         };
         ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan))) << "alarm " << r.control.alarm;
         r.between_blocks = nullptr;
-        double worst_approach_mm = 0;
-        for (int i = 0; i < 200; ++i) {  // up to, not onto, the thread start
-          const double pos = park + (start - park) * i / 200.0;
-          r.Cycle(pos);
-          worst_approach_mm =
-              std::max(worst_approach_mm, std::abs(r.control.DkMm(pos) - before.DkMm(pos)));
-        }
+        const double worst_approach_mm = r.WorstDeviationOnApproach(park, start, 200, before);
         SCOPED_TRACE("direction " + std::to_string(direction) + ", slope handed over " +
                      std::to_string(slope_handed_over) + ", parked " + std::to_string(before_mm) +
                      " mm before the start");

@@ -262,13 +262,7 @@ TEST(NcReplay, TheApproachKeepsWhatTheControlAppliedBeforeTheCall) {
       ASSERT_TRUE(r.RunProgram(nc));
       r.between_blocks = nullptr;
       EXPECT_EQ(worst_call_mm, 0.0) << "parked " << before_mm << " mm before the start";
-      double worst_approach_mm = 0;
-      for (int i = 0; i < 400; ++i) {  // up to, not onto, the thread start
-        const double p = park + (start - park) * i / 400.0;
-        r.Cycle(p);
-        worst_approach_mm =
-            std::max(worst_approach_mm, std::abs(r.control.DkMm(p) - found.DkMm(p)));
-      }
+      const double worst_approach_mm = r.WorstDeviationOnApproach(park, start, 400, found);
       EXPECT_EQ(worst_approach_mm, 0.0) << "parked " << before_mm << " mm before the start";
       r.Cycle(start);
       EXPECT_NEAR(r.control.DkMm(start) * 1000.0 / SignFactor(o.sign), s.curve.ElongationUm(0.0),

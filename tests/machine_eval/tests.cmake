@@ -2,3 +2,5 @@
 whirl_add_gtest(test_machine_eval SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_machine_eval.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_combined_nc.cpp)
+# Shop training, causal application, the legacy reproduction and the seeds summary.
+whirl_add_gtest(test_machine_shop SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_shop.cpp)

@@ -22,21 +22,13 @@
 #include "sim/dataset.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
+#include "support/expect_error.h"
 
 namespace whirl {
 namespace {
 namespace fs = std::filesystem;
 
 const fs::path kSource(WHIRL_SOURCE_DIR);
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // One folder per test (CTest runs the tests of this file in parallel processes).
 fs::path Scratch(const std::string& name) {

@@ -1,0 +1,205 @@
+#include "machine_eval/seeds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+
+namespace whirl::machine_eval {
+
+SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::WorkpieceModel& model,
+                                  const compare::ExperienceRule& rule,
+                                  const compare::IsoToleranceTable& iso_table,
+                                  const MachineEvalOptions& options, int seeds,
+                                  const compare::EvaluateProgress& progress) {
+  if (seeds < 1 || seeds > 20)
+    throw InputError("seeds = " + std::to_string(seeds) + ": must be within 1..20");
+  SeedsEvaluation e;
+  const std::size_t per = static_cast<std::size_t>(options.machines * options.screws_per_machine);
+  for (int s = 0; s < seeds; ++s) {
+    MachineEvalOptions o = options;
+    o.seed = options.seed + static_cast<std::uint64_t>(s);
+    if (s > 0) o.report_dir.clear();
+    e.seeds.push_back(o.seed);
+    e.runs.push_back(EvaluateWithMachines(base, model, rule, iso_table, o,
+                                          [&](std::size_t done, std::size_t) {
+                                            if (progress) progress(s * per + done, seeds * per);
+                                          }));
+  }
+  return e;
+}
+
+namespace {
+
+double Median(std::vector<double> v) {
+  return v.empty() ? 0.0 : compare::Stats(std::move(v)).median_pct;
+}
+double Max(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+}
+double Min(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : *std::min_element(v.begin(), v.end());
+}
+
+bool ReachesP(compare::IsoClass c, int p) {
+  using compare::IsoClass;
+  return c == IsoClass::kP1 || c == IsoClass::kP3 || (p == 5 && c == IsoClass::kP5);
+}
+
+SeedStats StatsOf(const SeedsEvaluation& e, std::size_t k) {
+  SeedStats s;
+  std::vector<double> acc, tot, ea, seed_acc, seed_tot;
+  std::size_t p3 = 0, p5 = 0;
+  for (const MachineEvaluation& run : e.runs) {
+    std::vector<double> a, t;
+    for (const MachineEvalScrew& r : run.screws) {
+      if (!r.ok) continue;
+      a.push_back(std::abs(r.metrics[k].accumulated_1000_um));
+      t.push_back(std::abs(r.metrics[k].accumulated_total_um));
+      ea.push_back(std::abs(r.metrics[k].e_a_um - e.travel_c_um));
+      p3 += ReachesP(r.iso[k], 3);
+      p5 += ReachesP(r.iso[k], 5);
+    }
+    seed_acc.push_back(Median(a));
+    seed_tot.push_back(Median(t));
+    acc.insert(acc.end(), a.begin(), a.end());
+    tot.insert(tot.end(), t.begin(), t.end());
+  }
+  s.screws = acc.size();
+  s.acc1000_median_um = Median(acc);
+  s.acc1000_worst_um = Max(acc);
+  s.total_median_um = Median(tot);
+  s.total_worst_um = Max(tot);
+  s.acc1000_seed_min_um = Min(seed_acc);
+  s.acc1000_seed_max_um = Max(seed_acc);
+  s.total_seed_min_um = Min(seed_tot);
+  s.total_seed_max_um = Max(seed_tot);
+  s.e_a_minus_c_median_um = Median(ea);
+  s.share_p3 = s.screws ? static_cast<double>(p3) / s.screws : 0.0;
+  s.share_p5 = s.screws ? static_cast<double>(p5) / s.screws : 0.0;
+  return s;
+}
+
+// Median over the screws of one seed's run of the thread error of strategy k.
+double SeedMedian(const MachineEvaluation& run, std::size_t k) {
+  std::vector<double> t;
+  for (const auto& r : run.screws)
+    if (r.ok) t.push_back(std::abs(r.metrics[k].accumulated_total_um));
+  return Median(t);
+}
+
+}  // namespace
+
+std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvaluation& e) {
+  std::array<SeedStats, kMachineStrategyCount> s;
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) s[k] = StatsOf(e, k);
+  return s;
+}
+
+MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < kMachineStrategyCount; ++k) {
+    if (UsesSensors(static_cast<MachineStrategy>(k))) continue;
+    if (best == 0 || s[k].total_median_um < s[best].total_median_um) best = k;
+  }
+  return static_cast<MachineStrategy>(best);
+}
+
+std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
+  const auto s = SummarizeOverSeeds(e);
+  const MachineStrategy best = StrongestSensorFree(s);
+  const auto b = static_cast<std::size_t>(best);
+  std::vector<std::string> out;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "%s: the strongest sensor-free strategy is %s (thread median %.1f um, within "
+                "1000 mm %.1f um, over %zu screws and %zu seeds)",
+                e.scenario.c_str(), ToString(best).c_str(), s[b].total_median_um,
+                s[b].acc1000_median_um, s[b].screws, e.seeds.size());
+  out.push_back(buf);
+  for (MachineStrategy x : {MachineStrategy::kBoth, MachineStrategy::kBothShop,
+                            MachineStrategy::kBothMonitor}) {
+    const auto k = static_cast<std::size_t>(x);
+    std::vector<double> gains;
+    for (const auto& run : e.runs) {
+      const double ref = SeedMedian(run, b);
+      if (ref > 1e-9) gains.push_back(100.0 * (1.0 - SeedMedian(run, k) / ref));
+    }
+    const double pooled =
+        s[b].total_median_um > 1e-9 ? 100.0 * (1.0 - s[k].total_median_um / s[b].total_median_um)
+                                    : 0.0;
+    std::snprintf(buf, sizeof buf,
+                  "%s vs %s over the thread: %+.1f %% (per seed %+.1f .. %+.1f %%; positive = "
+                  "%s leaves less)",
+                  ToString(x).c_str(), ToString(best).c_str(), pooled, Min(gains), Max(gains),
+                  ToString(x).c_str());
+    out.push_back(buf);
+  }
+  return out;
+}
+
+std::string FormatSeedsTable(const SeedsEvaluation& e, bool markdown) {
+  const auto s = SummarizeOverSeeds(e);
+  std::string out;
+  char buf[400];
+  if (markdown)
+    out += "| scenario | strategy | 1000 mm median [seeds] um | 1000 mm worst um | thread median "
+           "[seeds] um | thread worst um | \\|e_a - c\\| median um | P3 / P5 |\n"
+           "|---|---|---|---|---|---|---|---|\n";
+  else
+    out += "scenario  strategy       1000mm med [seeds]      worst  thread med [seeds]      "
+           "worst  |ea-c|  P3/P5\n";
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+    const SeedStats& x = s[k];
+    const char* fmt = markdown
+                          ? "| %s | %s | %.1f [%.1f-%.1f] | %.1f | %.1f [%.1f-%.1f] | %.1f | %.1f "
+                            "| %.2f / %.2f |\n"
+                          : "%-9s %-13s %6.1f [%5.1f-%5.1f] %6.1f %7.1f [%5.1f-%5.1f] %6.1f "
+                            "%6.1f  %.2f/%.2f\n";
+    std::snprintf(buf, sizeof buf, fmt, e.scenario.c_str(),
+                  ToString(static_cast<MachineStrategy>(k)).c_str(), x.acc1000_median_um,
+                  x.acc1000_seed_min_um, x.acc1000_seed_max_um, x.acc1000_worst_um,
+                  x.total_median_um, x.total_seed_min_um, x.total_seed_max_um, x.total_worst_um,
+                  x.e_a_minus_c_median_um, x.share_p3, x.share_p5);
+    out += buf;
+  }
+  for (const auto& h : MachineHeadlines(e)) out += (markdown ? "\n- " : "") + h + "\n";
+  return out;
+}
+
+void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
+  const auto s = SummarizeOverSeeds(e);
+  nlohmann::json strategies = nlohmann::json::object();
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+    const SeedStats& x = s[k];
+    std::vector<double> per_seed;
+    for (const auto& run : e.runs) per_seed.push_back(SeedMedian(run, k));
+    strategies[ToString(static_cast<MachineStrategy>(k))] = {
+        {"uses_sensors", UsesSensors(static_cast<MachineStrategy>(k))},
+        {"accumulated_1000_median_um", x.acc1000_median_um},
+        {"accumulated_1000_worst_um", x.acc1000_worst_um},
+        {"accumulated_1000_seed_median_range_um", {x.acc1000_seed_min_um, x.acc1000_seed_max_um}},
+        {"accumulated_total_median_um", x.total_median_um},
+        {"accumulated_total_worst_um", x.total_worst_um},
+        {"accumulated_total_seed_median_range_um", {x.total_seed_min_um, x.total_seed_max_um}},
+        {"accumulated_total_median_per_seed_um", per_seed},
+        {"e_a_minus_c_median_um", x.e_a_minus_c_median_um},
+        {"share_reaching_p3", x.share_p3},
+        {"share_reaching_p5", x.share_p5},
+        {"screws", x.screws}};
+  }
+  nlohmann::json runs = nlohmann::json::array();
+  for (const auto& r : e.runs) runs.push_back(r);
+  j = {{"schema", "whirl.machine_evaluate"},
+       {"schema_version", 2},
+       {"scenario", e.scenario},
+       {"seeds", e.seeds},
+       {"travel_c_um", e.travel_c_um},
+       {"strongest_sensor_free", ToString(StrongestSensorFree(s))},
+       {"strategies", strategies},
+       {"headlines", MachineHeadlines(e)},
+       {"runs", runs}};
+}
+
+}  // namespace whirl::machine_eval

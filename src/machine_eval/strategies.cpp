@@ -1,0 +1,37 @@
+#include "machine_eval/strategies.h"
+
+#include <algorithm>
+
+namespace whirl::machine_eval {
+
+std::size_t HeldSamples::IndexAt(double t_min) const {
+  const auto it = std::upper_bound(time_min.begin(), time_min.end(), t_min);
+  return it == time_min.begin() ? 0 : static_cast<std::size_t>(it - time_min.begin()) - 1;
+}
+
+HeldSamples RunCausally(const drift::JointDriftModel& model, const drift::Run& log) {
+  HeldSamples h;
+  drift::JointEvaluator ev(model);
+  const Eigen::MatrixXd u = drift::JointRawInputs(model, log);
+  for (int k = 0; k < log.samples(); ++k) {
+    const drift::JointEvaluator::Output o =
+        ev.Step(log.time_min[static_cast<std::size_t>(k)], u.row(k).transpose());
+    h.time_min.push_back(log.time_min[static_cast<std::size_t>(k)]);
+    h.k0_um.push_back(o.k0_um);
+    h.slope_um_per_1000.push_back(o.slope_um_per_1000);
+  }
+  return h;
+}
+
+compare::CompensationFunction CausalMachineLine(HeldSamples samples, double cut_start_min,
+                                                double z_ref_mm,
+                                                std::function<double(double)> z_of_t) {
+  return [samples = std::move(samples), cut_start_min, z_ref_mm,
+          z_of_t = std::move(z_of_t)](double t_s) {
+    if (samples.time_min.empty()) return 0.0;
+    const std::size_t k = samples.IndexAt(cut_start_min + t_s / 60.0);
+    return samples.k0_um[k] + samples.slope_um_per_1000[k] * (z_ref_mm - z_of_t(t_s)) / 1000.0;
+  };
+}
+
+}  // namespace whirl::machine_eval
