@@ -244,7 +244,7 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table,
             << "; cross-validated RMSE in um and s, score = sum of MSE / variance:\n"
             << workpiece::FormatChoiceTable(model.choice);
   std::cout << "  sd: " << model.choice.models.front().calibration << "\n";
-  std::cout << "  fit time " << Fmt(fit_ms) << " ms (choice, refits, calibration)\n";
+  std::cout << "  fit time " << FormatSignificant(fit_ms, 4) << " ms (choice, refits, calibration)\n";
 }
 
 void Run(const TrainCliOptions& o) {
