@@ -1,6 +1,6 @@
 #pragma once
 // Compensation points: breakpoints on a curve l(t) such that the piecewise-linear interpolant
-// through them (the compensation the control applies, paper seed 002 section 3:
+// through them (the compensation the control applies, Li, Ma and Jiang section 3:
 // l_C = l_A + (t_C - t_A) tan(beta), tan(beta) = (l_B - l_A)/(t_B - t_A)) never leaves the curve
 // by more than a tolerance, with as few points as possible: dense while the curve moves, sparse on
 // its plateau.

@@ -2,13 +2,13 @@
 // The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/drift, kinds mlr and
 // dynamic) evaluated every interpolation cycle by static synchronized actions from the machine's
 // analog inputs, written into SD43900 $SA_TEMP_COMP_ABS_VALUE (the position-independent K0 that
-// Siemens designed for exactly this, REFERENCE.md 7), plus the same model as a PLC table.
+// Siemens designed for exactly this, Siemens K3), plus the same model as a PLC table.
 //
 // Inputs. Sensor i of the model reads T_i = scale_i * $A_INA[index_i] + offset_i [degC]; an extra
 // input (e.g. spindle_rpm) reads scale * $A_INA[index] + offset in its own unit. The mapping is a
 // machine fact (profile "drift.analog_inputs", or --input on the command line).
 // Rises. u_i = T_i - T_ref,i: T_ref is the model's reference_C (reference "model", for a control
-// that runs all day) or the temperatures when the action starts (reference "start", seed 000's
+// that runs all day) or the temperatures when the action starts (reference "start", Miao et al.'s
 // convention of rises from the run's first row).
 // Lags. Each lagged feature runs the recursion of drift/regression.h FirstOrderLag once per
 // interpolation cycle T_ipo: L <- L + a (u - L), a = 1 - exp(-T_ipo / tau), L_0 = u_0.
@@ -54,7 +54,7 @@
 // program cancels the actions and restores them, so the control ends as it was found. A program
 // without a slope gives back a slope an aborted slope run left behind (R<n+4> = 1).
 // Not verified on a control here: the access level of main-run writes and whether IDS actions
-// survive a reset on every software version (REFERENCE.md 7).
+// survive a reset on every software version (docs/840d.md).
 #include <map>
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// SINUMERIK 840D temperature-compensation setting data for one axis (REFERENCE.md section 3;
+// SINUMERIK 840D temperature-compensation setting data for one axis (Siemens, SINUMERIK 840D
 // Function Manual Extended Functions K3):
 //
 //   dK = K0 + tan(beta) * (P - P0)                   dK in mm, P actual axis position (MCS), mm
@@ -37,7 +37,7 @@ namespace whirl::interp {
 /// dK (ControlDk). Cutting runs from the free end towards the chuck, so the growth of the
 /// unmachined section points against the direction of travel; following the grown material means
 /// shifting the axis by -direction * l. If the control adds dK to the position setpoint
-/// (ControlDk::kAdded, assumed by default: K3 does not state it plainly, REFERENCE.md 3), that is
+/// (ControlDk::kAdded, assumed by default: K3 does not state it plainly), that is
 /// s = -direction; if it subtracts dK, s = +direction (ExpectedSign). Check it once on the
 /// machine (a constant SD43900 test value and a dial gauge) and record it in the machine profile.
 enum class SignConvention { kSubtract, kAdd };
@@ -301,7 +301,7 @@ struct NcProgramInfo {
 ///   comments state the program names, MD32750 = 3, the MD32760 cap against the largest slope,
 ///   the sign rule, the axis, the start condition and its alarm, IDs, R parameters and the
 ///   control's limits it depends on (MD28250 for its actions, MD28254 for the $AC_PARAM it uses).
-/// Not verified on a control here (REFERENCE.md 7): the access level for main-run writes of
+/// Not verified on a control here (docs/840d.md): the access level for main-run writes of
 /// SD43900-43920 on a given machine.
 std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& info = {});
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Peer benchmark of whirl's network (issue 12): whirl train against scikit-learn's regressors.
+"""Peer benchmark of whirl's network: whirl train against scikit-learn's regressors.
 
 Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regression splines"):
   x ~ U[0, 1]^5 (written into whirl's five input columns, in order),

@@ -17,7 +17,7 @@ fi
 mkdir -p "$OUT"
 echo "== source's results (its README; test MAE um): ch1 RF 6.456 XGB 5.611 seq2seq 3.561;"
 echo "   ch3 RF 7.330 XGB 6.039 seq2seq 3.704; ch5 RF 12.440 XGB 9.535 seq2seq 4.284"
-echo "== whirl: hold-out, at most 4 sensors from seed 000's selection on the training rows"
+echo "== whirl: hold-out, at most 4 sensors from Miao et al.'s selection on the training rows"
 "$W" drift holdout --log "$DATA" --channels ch1_um,ch3_um,ch5_um --max-sensors 4 \
   --inputs spindle_rpm --report "$OUT/holdout" | tee "$OUT/holdout.txt"
 "$W" drift holdout --log "$DATA" --channels ch1_um,ch3_um,ch5_um --max-sensors 4 \

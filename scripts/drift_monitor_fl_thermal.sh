@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# On-line check and recalibration (issue 14, seed 004) on real measurements: FL_THERMAL
+# On-line check and recalibration (Liu et al.'s check-bar patent) on real measurements: FL_THERMAL
 # (../shared/data/fl_thermal, MIT). Train on the log up to the end of its first 4-hour running
 # block (1250 rpm), monitor the rest with check-bar measurements every 1, 2 and 4 h; MAE per
 # channel and rule over the monitored part and over the source's test window (rows 60-80 %), with

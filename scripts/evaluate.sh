@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Evaluation over many screws (issue 5, point 7): the three-strategy comparison over the validation
+# Evaluation over many screws: the strategy comparison over the validation
 # table and N random feasible screws with seeded disturbances; prints per-screw lines, the median
 # and worst reduction of the accumulated lead error against the traditional rule, and the share of
 # screws reaching ISO 3408-3 P3 and P5. Target: median reduction within 1000 mm >= 85 %.

@@ -11,7 +11,7 @@ packages=(
   libboost-dev                   # Boost.Math (header-only): F-distribution quantile of the drift selection
   python3                        # the command-line tests read JSON outputs with it
 )
-# Only for scripts/bench_peers.sh (issue 12's peer benchmark), never for the default build or tests.
+# Only for scripts/bench_peers.sh (the peer benchmark), never for the default build or tests.
 if [ "${WHIRL_SETUP_BENCH_PEERS:-0}" = 1 ]; then packages+=(python3-sklearn); fi
 missing=()
 for p in "${packages[@]}"; do

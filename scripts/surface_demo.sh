@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Demo of the worktable surface (issue 16, seed 003) on the documented synthetic fields: writes the
+# Demo of the worktable surface on the documented synthetic fields: writes the
 # smooth and the bump field (seed 1), fits the cubic and the B-spline to each with an HTML page per
 # fit (map with the measured points, cubic-vs-B-spline choice, 840D line per axis), prints the
 # choice and the 840D line along X.

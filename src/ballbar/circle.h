@@ -1,5 +1,5 @@
 #pragma once
-// Circle-test diagnostics of a ball-bar trace (ISO 230-4 style; seed 001 section 2.1-2.3 shows the
+// Circle-test diagnostics of a ball-bar trace (ISO 230-4 style; Shang et al., 2.1-2.3, show the
 // thermal errors that appear in these traces: spindle / Z-guide parallelism in the XZ semicircle,
 // the scale mismatch of an axis whose scale grows with heat, the cyclic error of a ball screw).
 //

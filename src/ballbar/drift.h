@@ -1,5 +1,5 @@
 #pragma once
-// Thermal drift of the spindle from ball-bar readings (seed 001, eq. 18), with its uncertainty.
+// Thermal drift of the spindle from ball-bar readings (Shang et al., eq. 18), with its uncertainty.
 //
 // Files.
 // - Readings CSV, header `time_min,pivot,length_mm` and optionally `bar_temperature_C`, one row per
@@ -16,10 +16,10 @@
 // - Pivots JSON: {"schema": "whirl.ballbar.pivots", "schema_version": 1,
 //                 "pivots_mm": [[x, y, z], [x, y, z], [x, y, z]]}: B1, B2, B3 in MCS, mm.
 //
-// Per block (eqs. 11-18 of seed 001, trilateration.h):
+// Per block (eqs. 11-18 of Shang, Ruan and Zhang, trilateration.h):
 //   - bar expansion: the bar's body grows with its temperature, so a warm bar reads short; each
 //     reading is corrected to L = L_read (1 + alpha (T - T_ref)), alpha the bar's expansion
-//     coefficient (1/K; 12e-6: 1.8 um/K on a 150 mm bar, REFERENCE.md section 7), T_ref the
+//     coefficient (1/K; 12e-6: 1.8 um/K on a 150 mm bar, a typical ball bar's figure), T_ref the
 //     temperature at which the bar was calibrated (20 degC, ISO 1);
 //   - averaging (eq. 18's mean position): if every pivot has the same number n of readings, the
 //     k-th readings of pivots 1, 2, 3 form triplet k, each triplet is trilaterated (eqs. 11-17) and
@@ -38,7 +38,7 @@
 // pivots. Growth of the table between the pivots is not separated (it changes LB1..LB3 and is read
 // as a small drift); measure the pivots' centres cold and keep the pivots close together.
 //
-// 840D (README "840D setting data: conventions", REFERENCE.md section 3): the position-independent
+// 840D (docs/840d.md; Siemens K3 function manual): the position-independent
 // compensation of axis a is SD43900 $SA_TEMP_COMP_ABS_VALUE[a] = s * D_a / 1000 mm with s = -1
 // (SignConvention kSubtract, the default: compensation = minus the drift) or +1 (kAdd); D of the
 // last block is the current value.

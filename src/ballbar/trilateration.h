@@ -1,7 +1,7 @@
 #pragma once
-// Spindle-ball position from three ball-bar lengths: the trilateration of seed 001 (Shang, Ruan,
-// Zhang, "Double-ball-bar-based thermal errors measurement method for 3-axis CNC machine tool",
-// Journal of Tianjin University 39(11), 2006, section 2.4 and Fig. 7; REFERENCE.md section 6).
+// Spindle-ball position from three ball-bar lengths: the trilateration of Shang, Ruan and
+// Zhang ("Double-ball-bar-based thermal errors measurement method for 3-axis CNC machine tool",
+// Journal of Tianjin University 39(11), 2006, section 2.4 and Fig. 7).
 //
 // Set-up. Three pivot balls B1, B2, B3 are fixed on the table; their centres are known in machine
 // coordinates (MCS, mm). The spindle holds the tool ball P at one commanded position; the bar is

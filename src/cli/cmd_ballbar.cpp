@@ -1,5 +1,5 @@
-// whirl ballbar drift|circle|simulate: spindle thermal drift from ball-bar readings (seed 001),
-// circle-test diagnostics, and the documented simulated measurement.
+// whirl ballbar drift|circle|simulate: spindle thermal drift from ball-bar readings (Shang, Ruan
+// and Zhang), circle-test diagnostics, and the documented simulated measurement.
 #include <cstdio>
 #include <memory>
 
@@ -48,7 +48,8 @@ void RunDrift(DriftCmd c) {
   if (!c.out.empty()) {
     WriteFileAtomic(c.out,
                     ballbar::FormatDriftCsv(
-                        r, {"spindle thermal drift from ball-bar readings (seed 001, eq. 18)",
+                        r, {"spindle thermal drift from ball-bar readings (Shang, Ruan and Zhang, "
+                            "eq. 18)",
                             "readings: " + c.readings + ", pivots: " + c.pivots,
                             "drift = tool-ball position now - cold block, MCS, um"}));
     std::fprintf(stderr, "wrote %s\n", c.out.c_str());
@@ -63,7 +64,8 @@ void AddDrift(CLI::App& parent) {
   auto c = std::make_shared<DriftCmd>();
   auto* sub = parent.add_subcommand(
       "drift",
-      "Spindle thermal drift from ball-bar readings to three table pivots (seed 001 eqs. 11-18).\n"
+      "Spindle thermal drift from ball-bar readings to three table pivots (Shang, Ruan and\n"
+      "Zhang, eqs. 11-18).\n"
       "Readings CSV: time_min (min, non-decreasing), pivot (1, 2, 3), length_mm "
       "(centre-to-centre,\n"
       "mm, at most 2000), optional bar_temperature_C (degC, -20..60); at most 1e6 rows. Readings\n"
@@ -103,7 +105,7 @@ void AddDrift(CLI::App& parent) {
                 "ignore bar_temperature_C (no expansion correction)");
   sub->add_option("--sign", c->sign,
                   "SD43900 = s drift/1000: subtract (s = -1, default: compensation = minus the "
-                  "drift) or add (s = +1); see README '840D setting data: conventions'")
+                  "drift) or add (s = +1); see docs/840d.md")
       ->check(CLI::IsMember({"subtract", "add"}));
   sub->add_flag("--json", c->json, "machine output: JSON on stdout");
   sub->callback([c] { RunDrift(*c); });

@@ -1,4 +1,4 @@
-// whirl crosscheck: the Eigen network against an independent LibTorch implementation (issue 6).
+// whirl crosscheck: the Eigen network against an independent LibTorch implementation.
 // Compiled into build/whirl-torch only (the one whirl executable that links LibTorch);
 // build/whirl forwards "whirl crosscheck ..." to it (cli/torch_forward.cpp).
 #include <cstdio>

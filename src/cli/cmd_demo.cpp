@@ -15,7 +15,7 @@
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "interp/machine_profile.h"
-#include "machine_eval/machine_eval.h"  // step 7 (issue 19)
+#include "machine_eval/machine_eval.h"  // step 7
 #include "workpiece/model.h"
 #include "sim/screw.h"
 
@@ -163,7 +163,7 @@ void RunDemo(const DemoOptions& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("6. report: %s (%s)\n", report.index_html.string().c_str(),
               report.plots_rendered ? "with plots" : "plots skipped");
-  RunDemoMachineStep(out, model, o.seed);  // issue 19: both halves on a drifting machine
+  RunDemoMachineStep(out, model, o.seed);  // both halves on a drifting machine
   std::printf("summary:");
   for (const auto& c : results) {
     const auto um = [&c](compare::Strategy s) { return c.Outcome(s).metrics.accumulated_1000_um; };

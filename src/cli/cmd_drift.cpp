@@ -1,4 +1,4 @@
-// whirl drift: machine thermal drift from temperature sensors (seed 000): sensitive points,
+// whirl drift: machine thermal drift from temperature sensors (Miao et al.): sensitive points,
 // drift models, prediction, cross-run and hold-out evaluation, report (src/drift/).
 #include <cstdio>
 #include <memory>
@@ -103,7 +103,7 @@ void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
 // --model, the sensors, the dynamic and the network model's options, --threads.
 void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--model", m->kind,
-                  "mlr (seed 000's regression on the rises), dynamic (rises plus first-order "
+                  "mlr (Miao et al.'s regression on the rises), dynamic (rises plus first-order "
                   "lagged copies, time constants by cross-validation) or network (Bayesian-"
                   "regularized k-h-1)")
       ->check(CLI::IsMember({"mlr", "dynamic", "network"}));
@@ -148,7 +148,7 @@ void RegisterSelect(CLI::App* drift_app) {
   auto* sub = drift_app->add_subcommand(
       "select",
       std::string(
-          "Temperature-sensitive points as seed 000: similarity |Pearson r| of the rises,\n"
+          "Temperature-sensitive points as Miao et al.: similarity |Pearson r| of the rises,\n"
           "fuzzy equivalence by max-min squaring, lambda-cuts, F test for the class count,\n"
           "Deng's grey grade (rho 0.5) against the error to pick one sensor per class.\n"
           "Prints the lambda levels with partitions and F values, the grades, the choice.\n" +
@@ -291,8 +291,9 @@ void RegisterCrossval(CLI::App* drift_app) {
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
       "crossval",
-      std::string("Cross-run evaluation as seed 000's tables 6-8: a model built on each run (own\n"
-                  "sensor selection) predicts every run; RMSE, std and max |error| [um] per pair,\n"
+      std::string("Cross-run evaluation as Miao et al.'s tables 6-8: a model built on each run\n"
+                  "(own sensor selection) predicts every run; RMSE, std and max |error| [um] per\n"
+                  "pair, "
                   "group means (idle on idle, idle on cutting, cutting on cutting, ...) beside no\n"
                   "compensation and MLR on all sensors.\n") +
           kRunFilesHelp);
@@ -469,11 +470,11 @@ void RegisterReport(CLI::App* drift_app) {
 
 }  // namespace
 
-void RegisterDriftMonitor(CLI::App* drift_app);  // cmd_drift_monitor.cpp (issue 14)
+void RegisterDriftMonitor(CLI::App* drift_app);  // cmd_drift_monitor.cpp
 void RegisterDrift(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "drift",
-      "Machine thermal drift from temperature sensors (seed 000): select sensitive points, fit\n"
+      "Machine thermal drift from temperature sensors (Miao et al.): select sensitive points, fit\n"
       "MLR / dynamic / network drift models, predict the compensation per sample, cross-run and\n"
       "hold-out evaluation, HTML report.");
   sub->require_subcommand(1);

@@ -1,5 +1,5 @@
 // whirl drift monitor: replay of the on-line model check with a check bar and the recalibration
-// rules (seed 004, issue 14) on a logged run (src/drift/monitor.h).
+// rules (Liu et al.'s check-bar patent) on a logged run (src/drift/monitor.h).
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -131,7 +131,7 @@ void RegisterDriftMonitor(CLI::App* drift_app) {
   auto a = std::make_shared<MonitorArgs>();
   auto* sub = drift_app->add_subcommand(
       "monitor",
-      "Replay seed 004's on-line check on a logged run: temperatures every sample, the thermal\n"
+      "Replay the patent's on-line check on a logged run: temperatures every sample, the thermal\n"
       "error known only at check-bar measurements (every --check-every, each stopping the\n"
       "machine --stop-min [min]); a check with |measured - predicted| above the threshold marks\n"
       "the model invalid, --refit-samples more measurements follow and the coefficients are\n"

@@ -1,4 +1,4 @@
-// whirl export: a trained model as a TorchScript module for the PyTorch world (issue 6).
+// whirl export: a trained model as a TorchScript module for the PyTorch world.
 // Compiled into build/whirl-torch only (the one whirl executable that links LibTorch);
 // build/whirl forwards "whirl export ..." to it (cli/torch_forward.cpp).
 #include <cstdio>

@@ -199,7 +199,7 @@ void RegisterFit(CLI::App& app) {
       "                    sine     l = L sin(pi t/(2 t_s)) up to t_s, L after\n"
       "                  each with R^2 and RMS residual [um] (LM least squares). The arctan has\n"
       "                  one parameter more than the parabola (p); with p held at 1 it fitted\n"
-      "                  best as well (README, Results).\n"
+      "                  best as well (docs/results.md).\n"
       "  --simulated N   simulate N curves over the paper's training ranges, fit (k, p) with the\n"
       "                  simulator's features fixed (the pooled fit over the N curves = how\n"
       "                  kDefaultShapeK and kDefaultTimeExponent are derived) and compare the "

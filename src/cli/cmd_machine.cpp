@@ -1,4 +1,4 @@
-// whirl machine: the whirling machine's own thermal drift (issue 19, src/machine/machine.h).
+// whirl machine: the whirling machine's own thermal drift (src/machine/machine.h).
 //   whirl machine sensors  --out DIR   virtual-sensor run files in the drift format
 //   whirl machine evaluate             none / traditional / workpiece / machine / both / both_idle
 #include <cstdio>
@@ -191,10 +191,10 @@ void RegisterMachine(CLI::App& app) {
   auto* e = m->add_subcommand(
       "evaluate",
       "Random screws cut on drifting machines (each machine: its own seeded parameters, idle and\n"
-      "cutting training runs, its MLR drift models on seed 000's sensitive points). Strategies:\n"
+      "cutting training runs, MLR drift models on Miao et al.'s sensitive points). Strategies:\n"
       "none, traditional (class means), workpiece (network plan), machine (cutting-trained drift\n"
       "models), both, both_idle (machine model trained on idle warm-ups), both_monitor (offset\n"
-      "model kept valid by a check bar, seed 004). Prints median and worst\n"
+      "model kept valid by a check bar, Liu et al.'s patent). Prints median and worst\n"
       "accumulated lead error [um] within 1000 mm and over the thread, P3/P5 shares, the\n"
       "uncompensated error of each source alone and which part dominates what is left.");
   CommonOptions(e, o.get());
@@ -215,12 +215,12 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV")
       ->check(CLI::ExistingFile);
   e->add_option("--drift-model", o->drift_model,
-                "machine drift model kind: mlr (seed 000's regression, default) or dynamic (with "
-                "first-order lags [min] chosen by cross-validation)")
+                "machine drift model kind: mlr (Miao et al.'s regression, default) or dynamic "
+                "(with first-order lags [min] chosen by cross-validation)")
       ->check(CLI::IsMember({"mlr", "dynamic"}));
-  AddSelectionOptions(e, &o->selection);  // seed 000's sensor selection of the machine models
+  AddSelectionOptions(e, &o->selection);  // Miao et al.'s sensor selection of the machine models
   e->add_option("--monitor-every-min", o->monitor_every_min,
-                "both_monitor: check-bar interval of seed 004's monitor [min] (1..600, default 30)")
+                "both_monitor: check-bar interval of the monitor [min] (1..600, default 30)")
       ->check(NumberIn(1.0, 600.0));
   e->add_option("--report", o->report,
                 "write the first screw's report here: sensor plot [degC over min], chosen "
@@ -238,10 +238,11 @@ void RegisterMachine(CLI::App& app) {
                 "print the pooled table: median [range of per-seed medians] and worst [um], "
                 "|e_a - c| median [um], P3/P5 shares, and the headlines against the strongest "
                 "sensor-free strategy (1..20, default 1: the single-seed table)")
-      ->check(CLI::Range(1, 20));
+      ->check(NumberIn(1, 20));
   e->add_option("--travel-c-um", o->travel_c_um,
                 "with --seeds: specified travel compensation c of ISO 3408-3 [um] for the "
-                "|e_a - c| column (default 0)");
+                "|e_a - c| column (default 0)")
+      ->check(FiniteNumber());
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->callback([o] { RunMachineEvaluate(*o); });
   RegisterMachineTruth(m);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/common.h"
 #include "machine/magnitudes.h"
 #include "machine/scenarios.h"
 
@@ -44,12 +45,12 @@ void RegisterMachineTruth(CLI::App* machine) {
       "type (cold, warm, interrupted, long_pause). The truth side only: no model is trained.");
   t->add_option("--scenarios", o->scenarios,
                 "comma list of machine scenarios or 'all' (legacy is skipped; default all)");
-  t->add_option("--seed", o->seed, "seed of machines, calendars and halls (default 1)");
-  t->add_option("--machines", o->machines, "machines (1..20, default 2)")->check(CLI::Range(1, 20));
+  AddSeedOption(t, &o->seed, "seed of machines, calendars and halls (default 1)");
+  t->add_option("--machines", o->machines, "machines (1..20, default 2)")->check(NumberIn(1, 20));
   t->add_option("--test-days", o->test_days, "production days in the test window (1..20, default 2)")
-      ->check(CLI::Range(1, 20));
+      ->check(NumberIn(1, 20));
   t->add_option("--past-days", o->past_days, "history production days (0..30, default 5)")
-      ->check(CLI::Range(0, 30));
+      ->check(NumberIn(0, 30));
   t->add_flag("--markdown", o->markdown, "print the table as Markdown");
   t->callback([o] { RunMachineTruth(*o); });
 }

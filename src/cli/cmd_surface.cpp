@@ -1,4 +1,4 @@
-// whirl surface: thermal error over the worktable (seed 003): synthetic fields, cubic polynomial or
+// whirl surface: thermal error over the worktable: synthetic fields, cubic polynomial or
 // B-spline surfaces, prediction at any position, the choice between the two, and the 840D line per
 // axis. The library is src/surface (its header surface/surface.h is the manual).
 #include <cmath>
@@ -140,7 +140,7 @@ void SetupFit(CLI::App& parent, const std::string& command) {
   auto o = std::make_shared<FitCli>();
   auto* sub = parent.add_subcommand(
       "fit",
-      "Fit a thermal-error surface to the points of one moment (seed 003).\n"
+      "Fit a thermal-error surface to the points of one moment.\n"
       "Input: CSV x_mm,y_mm,error_um (positions mm, error um), one row per measured point.\n"
       "cubic:   dE = a0 + a1 X + a2 Y + a3 X^2 + a4 XY + a5 Y^2 + a6 X^3 + a7 X^2Y + a8 XY^2\n"
       "         + a9 Y^3 by least squares (QR, in normalized coordinates); needs >= 10 distinct\n"
@@ -327,7 +327,7 @@ void SetupLine(CLI::App& parent) {
   sub->callback([o] { RunLine(*o); });
 }
 
-// --- points (per-point models, seed 003's first step) -----------------------------------------
+// --- points (per-point models, the surface method's first step) --------------------------------
 
 struct PointsCli {
   std::string run, manifest, method = "cubic", out, predictions, state = "cutting";
@@ -360,7 +360,7 @@ void RunPoints(const PointsCli& o) {
       "whirl surface points --run " + o.run + " at time " + FormatNumber(target.time_min[k]) +
           (target.time_from_index ? " (sample index)" : " min"),
       "per-point models: " +
-          std::string(o.sensors.empty() ? "seed 000 selection + " : "given sensors, ") +
+          std::string(o.sensors.empty() ? "Miao et al. selection + " : "given sensors, ") +
           "MLR (src/drift), trained on " +
           (o.train.empty() ? o.run : std::to_string(o.train.size()) + " run(s)")};
   for (const auto& pc : points)
@@ -385,10 +385,10 @@ void SetupPoints(CLI::App& parent) {
   auto o = std::make_shared<PointsCli>();
   auto* sub = parent.add_subcommand(
       "points",
-      "Per-point models, then a surface (seed 003): each error column of a position-tagged run\n"
+      "Per-point models, then a surface: each error column of a position-tagged run\n"
       "file (drift run format: time_s|time_min, *_C temperatures, *_um errors, each error\n"
       "column named <name>_x<X>_y<Y>_um with X, Y in mm, or placed by --manifest) gets its own\n"
-      "model from its sensitive temperatures (seed 000 selection + MLR, src/drift) fitted on\n"
+      "model from its sensitive temperatures (Miao et al.'s selection + MLR, src/drift) fitted on\n"
       "--train runs (default: the run itself); the P predictions at --time-min become the points\n"
       "of a cubic or B-spline surface (as 'surface fit').");
   sub->add_option("--run", o->run, "run file to predict (CSV)")
@@ -402,7 +402,7 @@ void SetupPoints(CLI::App& parent) {
                   "idle | cutting | unknown: state of the runs (default cutting)")
       ->check(CLI::IsMember({"idle", "cutting", "unknown"}));
   sub->add_option("--sensors", o->sensors,
-                  "temperature columns to use (default: seed 000 selection)")
+                  "temperature columns to use (default: Miao et al.'s selection)")
       ->delimiter(',');
   sub->add_option("--time-min", o->time_min, "moment of the surface, min (nearest sample)")
       ->check(FiniteNumber())
@@ -423,7 +423,7 @@ void SetupPoints(CLI::App& parent) {
 void RegisterSurface(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "surface",
-      "Thermal error over the whole worktable (seed 003): cubic polynomial or B-spline surface\n"
+      "Thermal error over the whole worktable: cubic polynomial or B-spline surface\n"
       "from the errors at measured points, prediction anywhere on the table, the choice between\n"
       "the two, and the 840D per-axis line (SD43900/SD43910/SD43920).");
   sub->require_subcommand(1);

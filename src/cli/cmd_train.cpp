@@ -310,10 +310,11 @@ void Run(const TrainCliOptions& o) {
 // The subcommand's description in --help: what it trains, the default, the table's columns.
 std::string TrainDescription() {
   return "Train the workpiece model on a process table and write a model file (JSON).\n"
-         "Default (no model options): per output the candidate with the lowest 5-fold\n"
-         "cross-validated error among the power law (least squares on log columns), a linear\n"
-         "fit and a Gaussian process (ARD Matern 5/2, on log or raw columns), the simplest\n"
-         "within one standard error; prints the choice and the CV table (src/family/family.h).\n"
+         "Default (no model options): per output the candidate with the lowest cross-\n"
+         "validated (closed-form leave-one-out) error among the power law (least squares on\n"
+         "log columns), a linear fit and a Gaussian process (ARD Matern 5/2, on log or raw\n"
+         "columns), the simplest within one standard error; prints the choice and the CV\n"
+         "table (src/family/family.h); sd calibrated by 5-fold cross-validation.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
          "--family network (implied by any network option below, raw columns unless\n"
          "--transform says otherwise): the Bayesian-regularized network (MATLAB trainbr:\n"
@@ -377,7 +378,7 @@ void RegisterTrain(CLI::App& app) {
                 "every size fit, restart and noise fold, and every fit of --hidden-sweep\n"
                 "(src/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
                 "choose trainbr's epochs without ARD. Better from about 100 rows and for\n"
-                "settle time; README 'Against its peers'");
+                "settle time; docs/network.md");
   sub->add_flag("--stop-by-cv", o->stop_by_cv,
                 "stop at the epoch count with the lowest 5-fold cross-validation error\n"
                 "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"

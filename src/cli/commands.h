@@ -24,7 +24,7 @@ void RegisterBallbar(CLI::App& app);     // cmd_ballbar.cpp
 void RegisterSurface(CLI::App& app);     // cmd_surface.cpp
 void RegisterDrift(CLI::App& app);       // cmd_drift.cpp
 void RegisterDriftNc(CLI::App* drift);   // cmd_drift_nc.cpp: whirl drift nc
-void RegisterMachine(CLI::App& app);     // cmd_machine.cpp (issue 19)
+void RegisterMachine(CLI::App& app);     // cmd_machine.cpp
 void RegisterMachineTruth(CLI::App* machine);  // cmd_machine_truth.cpp: whirl machine truth
 
 }  // namespace whirl::cli

@@ -11,7 +11,7 @@ void AddSelectionOptions(CLI::App* sub, SelectionArgs* s) {
   sub->add_option("--alpha", s->alpha, "significance level of the F test (default 0.05)")
       ->check(NumberIn(1e-6, 0.5));
   sub->add_option("--classes", s->classes,
-                  "class count: 'fewest' (seed 000: fewest classes with a significant F, "
+                  "class count: 'fewest' (Miao et al.: fewest classes with a significant F, "
                   "default), 'margin' (largest (F - F_crit)/F_crit), 'cv' (the count whose "
                   "sensors' MLR has the lowest cross-validated RMSE: leave one run out, or "
                   "forward-chaining blocks of one run) or a number");

@@ -1,6 +1,6 @@
 #pragma once
-// Command-line options of seed 000's sensor selection (drift/selection.h), shared by the commands
-// that fit drift models: whirl drift fit/crossval/holdout/... and whirl machine evaluate.
+// Command-line options of Miao et al.'s sensor selection (drift/selection.h), shared by the
+// commands that fit drift models: whirl drift fit/crossval/holdout/... and whirl machine evaluate.
 #include <CLI/CLI.hpp>
 #include <string>
 

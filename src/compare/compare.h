@@ -1,6 +1,6 @@
 #pragma once
 // The lead error a real-size screw gets with three compensation strategies, cut in the simulator
-// (REFERENCE.md sections 1 and 4; issue 5):
+// (Li, Ma and Jiang's comparison; ISO 3408-3):
 //
 //   none         c(t) = 0
 //   ramp         c(t) = P_class min(1, t / T), the previous experience rule (compare/traditional.h)

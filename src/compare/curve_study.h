@@ -1,7 +1,7 @@
 #pragma once
 // Fits over simulated curves of the training domain (src/sim): derives the default shape k and
 // time exponent p of the arctan curve (kDefaultShapeK, kDefaultTimeExponent) and repeats the
-// paper's model comparison (arctan vs parabola vs sine, paper seed 002 section 3) on them. Driven
+// paper's model comparison (arctan vs parabola vs sine, Li, Ma and Jiang section 3) on them. Driven
 // by `whirl fit --simulated N`.
 //
 // For each design point (sim::DesignPoints: space-filling over the paper's ranges) the reference

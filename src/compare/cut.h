@@ -1,6 +1,7 @@
 #pragma once
 // The lead deviation a cut leaves behind, from the elongation of the unmachined section and the
-// compensation applied while cutting (REFERENCE.md section 1; the lead's geometry note).
+// compensation applied while cutting (Li, Ma and Jiang: the unmachined section's elongation
+// displaces the groove).
 //
 // Geometry: the thread is cut from its start (free end) towards the chuck at constant axial feed
 // v, so the cut point at time t is x = v t along the thread. The unmachined section (cut point to

@@ -1,5 +1,5 @@
 #pragma once
-// Evaluation over many screws (issue 5, point 7): the comparison of compare/compare.h over the
+// Evaluation over many screws: the comparison of compare/compare.h over the
 // validation table and N random feasible screws, each with its own seeded disturbances, and the
 // figures that summarize it: median and worst reduction of the accumulated lead error against the
 // traditional compensation, and the share of screws that reach ISO 3408-3 P3 and P5.
@@ -14,7 +14,7 @@
 
 namespace whirl::compare {
 
-/// Ranges of the random screws: the paper's training ranges (REFERENCE.md section 1).
+/// Ranges of the random screws: the paper's training ranges (Li, Ma and Jiang).
 struct InputRanges {
   ProcessInputs min{60, 50, 6, 3, 150};
   ProcessInputs max{65, 100, 16, 10, 210};

@@ -1,8 +1,8 @@
 #pragma once
 // ISO 3408-3 (JIS B 1192, GB/T 17587.3) lead-accuracy classes: the tolerance table, loaded from one
 // data file (datasets/standards/iso3408_3_lead_tolerances.csv), and the best class a lead-deviation
-// curve reaches. REFERENCE.md section 4. CAVEAT: only some cells of the table are confirmed by a
-// source (flags in the file); the rest are recalled values. Treat a verdict as indicative.
+// curve reaches (datasets/standards/README.md). CAVEAT: only some cells of the table are confirmed
+// by a source (flags in the file); the rest are recalled values. Treat a verdict as indicative.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>

@@ -5,7 +5,7 @@
 // Sign convention (whole project): travel deviation = actual travel minus specified travel, both
 // measured from the thread start (the free end, where cutting begins) towards the chuck, in um.
 // Positive = the groove lies further from the thread start than specified (the lead is long there).
-// REFERENCE.md section 4 ("travel deviation = actual minus specified travel").
+// ISO 3408-3 ("travel deviation = actual minus specified travel").
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // Lead-accuracy metrics of a travel-deviation curve, as ISO 3408-3 and the paper define them
-// (REFERENCE.md sections 1 and 4). All values in micrometres, positions in millimetres.
+// (Li, Ma and Jiang; ISO 3408-3). All values in micrometres, positions in millimetres.
 //
 // Definitions used here (x = position along the thread from its start, d(x) = travel deviation):
 // - Useful travel l_u: [x0 + m, x_end - m] with m = LeadMetricOptions::end_margin_mm (the excess
@@ -25,6 +25,7 @@
 #include <string>
 
 #include "compare/lead.h"
+#include "core/window_range.h"
 
 namespace whirl::compare {
 
@@ -57,10 +58,9 @@ struct LeadMetrics {
 /// a negative margin, a margin that leaves fewer than 2 samples, or non-positive windows.
 LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOptions& options = {});
 
-/// Band width (max - min) of `values` over every window [x_i, x_i + window_mm]; returns the
-/// worst. `x` strictly increasing, same size as `values`. Exposed for tests.
-double MaxWindowRange(const std::vector<double>& x, const std::vector<double>& values,
-                      double window_mm);
+/// Band width over sliding windows (core/window_range.h), used for v_300, v_2pi and the 1000 mm
+/// figure.
+using whirl::MaxWindowRange;
 
 void to_json(nlohmann::json& j, const LeadMetrics& m);
 

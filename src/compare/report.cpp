@@ -131,7 +131,7 @@ std::string MetricsTable(const ScrewComparison& c) {
   for (const auto* o : {&n, &t, &m})
     h << "<li><b>" << ToString(o->strategy) << "</b>: " << HtmlEscape(o->iso.message) << "</li>\n";
   h << "</ul>\n";
-  // Issue 11: every baseline, absolute micrometres first (compare/traditional.h says why each is
+  // Every baseline, absolute micrometres first (compare/traditional.h says why each is
   // a fair stand-in).
   h << "<table><tr><th>strategy</th><th>within 1000 mm [um]</th><th>whole thread [um]</th>"
        "<th>ISO class</th><th>model vs it, 1000 mm</th></tr>\n";

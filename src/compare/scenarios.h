@@ -1,5 +1,5 @@
 #pragma once
-// Named scenarios of `whirl evaluate --scenarios` (issue 11, point 2): truth the model has not
+// Named scenarios of `whirl evaluate --scenarios`: truth the model has not
 // seen. Each scenario is a set of disturbance levels of the simulated truth (sim/simulator.h
 // DisturbanceOptions) and a range of screws; every strategy (compare/compare.h) is judged against
 // it. The levels (assumptions, stated so they can be argued with):
@@ -72,7 +72,7 @@ std::vector<ScenarioResult> RunScenarios(const std::vector<Scenario>& scenarios,
                                          const EvaluateProgress& progress = {});
 
 /// The sensitivity table (scenario x strategy: median / worst um within 1000 mm and over the
-/// thread) as fixed-width text and as Markdown (the README quotes it).
+/// thread) as fixed-width text and as Markdown (docs/results.md quotes it).
 std::string FormatScenarioTable(const std::vector<ScenarioResult>& results, bool markdown);
 
 void to_json(nlohmann::json& j, const ScenarioResult& r);

@@ -1,6 +1,6 @@
 #pragma once
 // The traditional empirical compensation: the stand-in for a factory's experience rule that the
-// model-based compensation is compared against (the paper's "传统的经验补偿法", REFERENCE.md 1).
+// model-based compensation is compared against (the "传统的经验补偿法" of Li, Ma and Jiang).
 //
 // What it is. A shop without a model keeps, per machine, an experience table keyed by the screw's
 // diameter class: "screws of about this diameter grow by about P um once the cut has warmed up",
@@ -24,7 +24,7 @@
 // (3) It is right on average for its class: it captures the dominant diameter effect and the mean
 // time scale; what it cannot know is what the model adds: the effect of hardness, lead, raceway
 // radius and cutting speed on the plateau and the settle time, and the curved (arctangent) rise.
-// Issue 11: the history gives three baselines besides `none`, all from the same table:
+// The history gives three baselines besides `none`, all from the same table:
 //   ramp         the rule above (kept for continuity with earlier figures);
 //   traditional  per class the mean past CURVE: class plateau P_class and class settle time
 //                T_class (mean settle_time_s of the class) with the same arctangent shape the model

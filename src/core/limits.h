@@ -1,5 +1,5 @@
 #pragma once
-// Physical and resource limits on every input whirl accepts (issue 17): a value outside them is
+// Physical and resource limits on every input whirl accepts: a value outside them is
 // an InputError naming the file (line), the field, the value and the limit, never a run that
 // overflows, allocates without bound or takes hours. Each limit is far outside any real
 // hard-whirling job, so it only stops mistakes (a unit slip, a corrupt file, a typo'd exponent).

@@ -1,7 +1,8 @@
 #pragma once
 // The vocabulary every module shares: the five process parameters of a hard-whirling job
 // (network inputs) and the two features of its elongation curve (network targets).
-// REFERENCE.md section 1 (paper seed 002, section 2.1).
+// From Li, Ma and Jiang, "Thermal elongation prediction of whirlwind hard milling
+// ballscrew based on BP neural network", section 2.1 (docs/references.md).
 #include <array>
 #include <filesystem>
 #include <string>

@@ -257,7 +257,7 @@ std::string FormatCrossRun(const CrossRunResult& r) {
       o << PadLeft(FormatDecimals(r.cells[i][j].model.rmse_um, 2), 12);
     o << "\n";
   }
-  o << "group means (seed 000 tables 6-8)   pairs |  model: RMSE    std    max | all sensors: "
+  o << "group means (Miao et al. tab 6-8)   pairs |  model: RMSE    std    max | all sensors: "
        "RMSE    std    max | none: RMSE    std    max\n";
   for (const auto& g : r.groups) {
     char line[256];

@@ -1,6 +1,6 @@
 #pragma once
 // Evaluation of drift models:
-//  - cross-run evaluation as seed 000's tables 6-8: a model built on each run (its own sensor
+//  - cross-run evaluation as Miao et al.'s tables 6-8: a model built on each run (its own sensor
 //    selection) predicts every run; RMSE, std and max |.| of the prediction error e - e_hat [um]
 //    per pair, beside "no compensation" (e_hat = 0: the statistics of the error itself) and "MLR
 //    on all sensors". Group means over ordered pairs of different runs (train != test) by state:
@@ -25,7 +25,7 @@ struct ErrorStats {
   int samples = 0;
   double mae_um = 0;      ///< mean |r|
   double rmse_um = 0;     ///< sqrt(mean r^2)
-  double std_um = 0;      ///< population std of r (seed 000's "prediction std")
+  double std_um = 0;      ///< population std of r (Miao et al.'s "prediction std")
   double max_abs_um = 0;  ///< max |r|
 };
 ErrorStats ComputeErrorStats(const Eigen::VectorXd& residual_um);
@@ -54,8 +54,8 @@ struct CrossRunResult {
   std::vector<std::string> warnings;  ///< sensors the fits left out (FitReport::warnings), once
 };
 
-/// Builds one model per run (options.kind, seed 000 selection unless options.sensors is set) and
-/// predicts every run. Runs need at least 2 entries and the error column. Parallel over runs.
+/// Builds one model per run (options.kind, Miao et al.'s selection unless options.sensors is set)
+/// and predicts every run. Runs need at least 2 entries and the error column. Parallel over runs.
 CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);
 

@@ -254,7 +254,7 @@ void ChooseSensors(const std::vector<Run>& runs, const std::string& error_column
     rep->selected = true;
     rep->selection = SelectSensorsForFit(runs, error_column, o);
     m.sensors = rep->selection.ChosenNames();
-    m.selection = "seed 000 selection: " + rep->selection.message;
+    m.selection = "Miao et al. selection: " + rep->selection.message;
     rep->warnings = rep->selection.left_out;
   } else {
     m.sensors = UsableSensors(runs, o.sensors, &rep->warnings);

@@ -19,7 +19,7 @@ namespace whirl::drift {
 
 struct FitOptions {
   ModelKind kind = ModelKind::kMlr;
-  std::vector<std::string> sensors;  ///< empty: seed 000's selection (selection.h)
+  std::vector<std::string> sensors;  ///< empty: Miao et al.'s selection (selection.h)
   SelectionOptions selection;
   std::vector<std::string> extra_inputs;  ///< other columns used as inputs
   /// dynamic: candidate lag time constants [min, or samples without time]
@@ -55,7 +55,7 @@ struct FitReport {
   std::vector<std::string> warnings;
 };
 
-/// Seed 000's selection for a fit: SelectSensors (drift/selection.h) with options.selection, or,
+/// Miao et al.'s selection for a fit: SelectSensors (drift/selection.h) with options.selection, or,
 /// for ClassCountRule::kCrossValidated, the class count chosen by cross-validation: for each
 /// class count r the lambda-cuts offer (r <= max_classes when set), the sensors of SelectSensors
 /// with kFixed r; their static MLR (no lags, plus the extra inputs) is scored by the pooled
@@ -63,7 +63,7 @@ struct FitReport {
 /// several runs, else `folds` contiguous blocks, forward-chaining by default); the lowest RMSE
 /// wins (ties: fewer classes). Selection::class_count_scores lists every candidate. The sensors
 /// of each r are chosen on all runs (the clustering is unsupervised; the grey grades also see the
-/// held-out run's error), so every candidate's RMSE is slightly optimistic alike. Why (issue 19):
+/// held-out run's error), so every candidate's RMSE is slightly optimistic alike. Why:
 /// on the simulated whirling machine the fewest-significant rule keeps fewer sensors as training
 /// runs are added and the combined compensation gets worse.
 Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& error_column,

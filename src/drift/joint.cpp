@@ -19,14 +19,36 @@ struct Design {
   Eigen::MatrixXd x;
   Eigen::VectorXd y, w;
   std::vector<int> day;
+  Eigen::MatrixXd phi;          ///< features before demeaning (rises since power-on)
+  std::vector<bool> slope_row;  ///< the row's log has readings >= kSlopeSpanMm apart along z
+  double coverage = 0.5;        ///< JointFitOptions::slope_coverage
 };
+
+// Readings this far apart along Z on one day log (or in one record) see the slope.
+constexpr double kSlopeSpanMm = 1000;
+
+// Per day log: whether its readings span at least kSlopeSpanMm along Z.
+std::vector<bool> SlopeLogs(const ShopRecord& rec) {
+  std::vector<double> lo(rec.day_logs.size(), 1e300), hi(rec.day_logs.size(), -1e300);
+  for (const auto& r : rec.records)
+    for (const Measurement& m : r.rows) {
+      const auto l = static_cast<std::size_t>(r.log);
+      lo[l] = std::min(lo[l], m.z_mm);
+      hi[l] = std::max(hi[l], m.z_mm);
+    }
+  std::vector<bool> out(rec.day_logs.size());
+  for (std::size_t l = 0; l < out.size(); ++l) out[l] = hi[l] - lo[l] >= kSlopeSpanMm;
+  return out;
+}
 
 struct Inputs {
   std::vector<std::string> sensors, others;
   std::vector<double> taus;
 };
 
-Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm) {
+Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm,
+                   double coverage) {
+  const std::vector<bool> slope_logs = SlopeLogs(rec);
   std::vector<Eigen::MatrixXd> phi(rec.day_logs.size());
   std::size_t n = 0;
   for (const auto& r : rec.records) {
@@ -46,7 +68,9 @@ Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm) {
   const Eigen::Index p = static_cast<Eigen::Index>(
       (in.sensors.size() + in.others.size()) * (1 + in.taus.size()));
   Design d;
+  d.coverage = coverage;
   d.x.resize(static_cast<Eigen::Index>(n), 2 * p);
+  d.phi.resize(static_cast<Eigen::Index>(n), p);
   d.y.resize(static_cast<Eigen::Index>(n));
   d.w.resize(static_cast<Eigen::Index>(n));
   Eigen::Index row = 0;
@@ -56,6 +80,8 @@ Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm) {
     for (const Measurement& m : r.rows) {
       const Eigen::RowVectorXd ph = f.row(m.sample);
       d.x.row(row) << ph, ph * ((z_ref_mm - m.z_mm) / 1000.0);
+      d.phi.row(row) = ph;
+      d.slope_row.push_back(slope_logs[static_cast<std::size_t>(r.log)]);
       d.y(row) = m.value_um;
       d.w(row) = 1.0 / (m.sigma_um * m.sigma_um);
       d.day.push_back(r.day);
@@ -74,9 +100,14 @@ Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm) {
   return d;
 }
 
-// Columns of X (rows `use`) the weighted solve can estimate: every phi column with spread, and a
-// psi column only when its part outside the span of the phi columns is not negligible.
-std::vector<bool> Identified(const Eigen::MatrixXd& x, const Eigen::VectorXd& w) {
+// Columns of X the weighted solve can estimate (rows with w > 0): every phi column with spread,
+// and a psi column only when (i) its part outside the span of the phi columns is not negligible
+// and (ii) the rows that see the slope (day logs with readings >= kSlopeSpanMm apart along Z)
+// cover the feature's range: max |phi_j| over those rows >= coverage x max |phi_j| over all rows.
+// Without (ii) a slope learned on idle laser tests, where a sensor barely moves, is applied to
+// the rises that sensor takes while cutting: an extrapolation no reading supports.
+std::vector<bool> Identified(const Design& d, const Eigen::VectorXd& w) {
+  const Eigen::MatrixXd& x = d.x;
   const Eigen::Index p = x.cols() / 2;
   const Eigen::VectorXd sw = w.array().sqrt();
   const Eigen::MatrixXd xw = x.array().colwise() * sw.array();
@@ -88,7 +119,16 @@ std::vector<bool> Identified(const Eigen::MatrixXd& x, const Eigen::VectorXd& w)
   for (Eigen::Index j = 0; j < p; ++j) {
     const Eigen::VectorXd gj = xw.col(p + j);
     const double norm = gj.norm();
+    ok[static_cast<std::size_t>(p + j)] = false;
     if (norm <= 1e-12) continue;
+    double all = 0, seen = 0;
+    for (Eigen::Index i = 0; i < x.rows(); ++i) {
+      if (!(w(i) > 0)) continue;
+      const double v = std::abs(d.phi(i, j));
+      all = std::max(all, v);
+      if (d.slope_row[static_cast<std::size_t>(i)]) seen = std::max(seen, v);
+    }
+    if (seen < d.coverage * all) continue;
     const Eigen::VectorXd resid = gj - a * cod.solve(gj);
     ok[static_cast<std::size_t>(p + j)] = resid.norm() > 1e-6 * norm;
   }
@@ -137,7 +177,7 @@ double GroupedCvRmse(const Design& d) {
   double num = 0, den = 0;
   const auto n = d.x.rows();
   if (days.size() < 2) {
-    const Eigen::VectorXd b = Solve(d.x, d.y, d.w, Identified(d.x, d.w));
+    const Eigen::VectorXd b = Solve(d.x, d.y, d.w, Identified(d, d.w));
     const Eigen::VectorXd r = d.y - d.x * b;
     return std::sqrt(d.w.dot(r.cwiseProduct(r)) / d.w.sum());
   }
@@ -145,7 +185,7 @@ double GroupedCvRmse(const Design& d) {
     Eigen::VectorXd wt = d.w;
     for (Eigen::Index i = 0; i < n; ++i)
       if (d.day[static_cast<std::size_t>(i)] == day) wt(i) = 0;
-    const Eigen::VectorXd b = Solve(d.x, d.y, wt, Identified(d.x, wt));
+    const Eigen::VectorXd b = Solve(d.x, d.y, wt, Identified(d, wt));
     for (Eigen::Index i = 0; i < n; ++i) {
       if (d.day[static_cast<std::size_t>(i)] != day) continue;
       const double r = d.y(i) - d.x.row(i).dot(b);
@@ -156,15 +196,15 @@ double GroupedCvRmse(const Design& d) {
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
-double Score(const ShopRecord& rec, const Inputs& in, double z_ref) {
-  return GroupedCvRmse(BuildDesign(rec, in, z_ref));
+double Score(const ShopRecord& rec, const Inputs& in, double z_ref, double coverage) {
+  return GroupedCvRmse(BuildDesign(rec, in, z_ref, coverage));
 }
 
 // Greedy forward choice of sensors from the pool (static features), while the CV RMSE falls by
 // more than 1 %.
 void ChooseSensors(const ShopRecord& rec, const JointSpec& spec, const JointFitOptions& o,
                    Inputs* in, JointFitReport* report) {
-  double current = Score(rec, *in, spec.z_ref_mm);
+  double current = Score(rec, *in, spec.z_ref_mm, o.slope_coverage);
   while (static_cast<int>(in->sensors.size()) < o.max_sensors) {
     double best = current;
     std::string pick;
@@ -172,7 +212,7 @@ void ChooseSensors(const ShopRecord& rec, const JointSpec& spec, const JointFitO
       if (std::find(in->sensors.begin(), in->sensors.end(), s) != in->sensors.end()) continue;
       Inputs trial = *in;
       trial.sensors.push_back(s);
-      const double e = Score(rec, trial, spec.z_ref_mm);
+      const double e = Score(rec, trial, spec.z_ref_mm, o.slope_coverage);
       if (e < best) best = e, pick = s;
     }
     if (pick.empty() || !(best < 0.99 * current)) break;
@@ -186,7 +226,7 @@ void ChooseSensors(const ShopRecord& rec, const JointSpec& spec, const JointFitO
 // a lag is required).
 void ChooseLags(const ShopRecord& rec, const JointSpec& spec, const JointFitOptions& o, Inputs* in,
                 JointFitReport* report) {
-  double current = Score(rec, *in, spec.z_ref_mm);
+  double current = Score(rec, *in, spec.z_ref_mm, o.slope_coverage);
   while (static_cast<int>(in->taus.size()) < o.max_lags) {
     double best = 1e300, pick = 0;
     for (double tau : o.tau_grid) {
@@ -194,7 +234,7 @@ void ChooseLags(const ShopRecord& rec, const JointSpec& spec, const JointFitOpti
       Inputs trial = *in;
       trial.taus.push_back(tau);
       std::sort(trial.taus.begin(), trial.taus.end());
-      const double e = Score(rec, trial, spec.z_ref_mm);
+      const double e = Score(rec, trial, spec.z_ref_mm, o.slope_coverage);
       if (e < best) best = e, pick = tau;
     }
     const bool forced = o.require_lag && in->taus.empty();
@@ -214,12 +254,13 @@ JointFitReport FitJoint(const ShopRecord& record, const JointSpec& spec,
   if (options.max_lags < 0 || options.max_lags > 4)
     throw InputError("max_lags = " + std::to_string(options.max_lags) + ": must be within 0..4");
   JointFitReport report;
-  Inputs in{spec.sensors, spec.other_inputs, {}};
+  Inputs in{spec.sensors, spec.other_inputs, spec.time_constants};
+  std::sort(in.taus.begin(), in.taus.end());
   if (!spec.sensor_pool.empty()) ChooseSensors(record, spec, options, &in, &report);
   if (in.sensors.empty() && in.others.empty())
     throw InputError("joint drift fit: no input (no sensor given or chosen, no control signal)");
   ChooseLags(record, spec, options, &in, &report);
-  const Design d = BuildDesign(record, in, spec.z_ref_mm);
+  const Design d = BuildDesign(record, in, spec.z_ref_mm, options.slope_coverage);
   if (d.x.rows() <= d.x.cols() / 2)
     throw InputError("joint drift fit: " + std::to_string(d.x.rows()) +
                      " readings for " + std::to_string(d.x.cols() / 2) + " features");
@@ -228,7 +269,7 @@ JointFitReport FitJoint(const ShopRecord& record, const JointSpec& spec,
   m.other_inputs = in.others;
   m.time_constants = in.taus;
   m.z_ref_mm = spec.z_ref_mm;
-  const std::vector<bool> keep = Identified(d.x, d.w);
+  const std::vector<bool> keep = Identified(d, d.w);
   const Eigen::VectorXd b = Solve(d.x, d.y, d.w, keep, &m.covariance);
   const Eigen::Index p = d.x.cols() / 2;
   m.a = b.head(p);

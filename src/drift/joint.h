@@ -15,8 +15,10 @@
 //   min sum_r sum_k w_rk (y_rk - mu_r - a' phi_rk - g' psi_rk)^2,  psi = phi (z_ref - z) / 1000,
 // solved by weighted demeaning within each record (no record needs a zero or a reference
 // temperature), w = 1 / sigma^2. A slope direction that no record identifies (its psi column lies
-// in the span of the phi columns after demeaning, e.g. every reading at one z) is left out (g = 0)
-// and reported. A ridge of 1e-8 x trace / p on the standardized columns keeps the solve safe.
+// in the span of the phi columns after demeaning, e.g. every reading at one z), or whose feature
+// the readings that see the slope do not cover (JointFitOptions::slope_coverage), is left out
+// (g = 0) and reported. A ridge of 1e-8 x trace / p on the standardized columns keeps the solve
+// safe.
 // Control signals enter through their lags only (their static step column is left out when a
 // lag is chosen). Lags: greedy forward choice of at most max_lags shared time constants from
 // tau_grid, accepted while the grouped cross-validated RMSE (leave one calendar day out; a
@@ -36,6 +38,9 @@ struct JointSpec {
   std::vector<std::string> sensors;       ///< temperature columns (without _C) used as given
   std::vector<std::string> sensor_pool;   ///< non-empty: choose sensors from these by CV
   std::vector<std::string> other_inputs;  ///< control signals (other columns), as logged
+  /// Time constants [min] taken as chosen before any search (sensors are then chosen with these
+  /// lags; the lag search adds more only up to max_lags).
+  std::vector<double> time_constants;
   double z_ref_mm = 6400;                 ///< reference position of the slope, mm
 };
 
@@ -46,6 +51,11 @@ struct JointFitOptions {
   /// false: static only when the lag search rejects every lag; true: at least one lag (inputs
   /// that are steps, such as power_on, carry no information without one).
   bool require_lag = false;
+  /// A slope coefficient g_j is estimated only where the readings that see the slope (day logs
+  /// with readings >= 1000 mm apart along Z: laser targets, leads) cover the feature's range:
+  /// max |phi_j| over them >= slope_coverage x max |phi_j| over all readings; otherwise g_j = 0
+  /// and it is reported unidentified (no extrapolation from idle laser tests to cutting rises).
+  double slope_coverage = 0.5;
 };
 
 struct JointDriftModel {

@@ -3,16 +3,16 @@
 //
 // Inputs u_i (in this order): the rises of `sensors`, dT_s = T_s - T_ref,s [K], then the
 // `extra_inputs` as logged (e.g. spindle_rpm, their own unit). T_ref is the run's first row
-// (ReferenceMode::kRunStart, seed 000's convention and the default; training always uses it) or
+// (ReferenceMode::kRunStart, Miao et al.'s convention and the default; training always uses it) or
 // the model's reference_C (kModel: the mean first row of the training runs, for a control that
 // cannot know when a run started).
 // Features (regressors), input-major: for each input its value and its first-order-lagged copies
 //   L_tau(u)_k = L_{k-1} + (1 - exp(-(t_k - t_{k-1}) / tau)) (u_k - L_{k-1}),  L_0 = u_0,
 // one per time constant in `time_constants` (shared by all inputs; unit: min, or samples when the
 // training runs had no time column). Deformation lags temperature; a control evaluates the same
-// recursion every interpolation cycle with a = 1 - exp(-T_cycle / tau) (issue 18).
+// recursion every interpolation cycle with a = 1 - exp(-T_cycle / tau) (interp/drift_action.h).
 // Kinds:
-//   mlr      seed 000's multiple linear regression, no lags: e = b0 + sum_s b_s dT_s.
+//   mlr      Miao et al.'s multiple linear regression, no lags: e = b0 + sum_s b_s dT_s.
 //   dynamic  the same regression on the features with lags; the time constants are picked from
 //            FitOptions::tau_grid by greedy forward selection on the cross-validated RMSE (folds:
 //            leave one run out with several runs, else `folds` contiguous blocks of the one run,

@@ -1,11 +1,12 @@
 #pragma once
 // On-line check of a drift model with a check bar, and recalibration when it has gone stale
-// (issue 14, seed 004: patent of Xi'an Univ. of Posts and Telecommunications, digest in
-// REFERENCE.md section 6). A model fitted once goes stale (ambient, ageing, process); the patent
-// stops the machine at set intervals, measures a check bar at a fixed position, and when the
-// measured error disagrees with the model E = sum k_i dT_i it re-fits the coefficients by least
-// squares from a few new measurements. MonitorRun replays this on a logged run, so a shop can
-// choose the interval and the threshold from its own data before touching the machine.
+// (Liu, Hou, Li, Zhang, Wang and Mao, Xi'an University of Posts and Telecommunications, patent
+// "Temperature compensation method, system and medium for CNC machine tools"). A model fitted
+// once goes stale (ambient, ageing, process); the patent stops the machine at set intervals,
+// measures a check bar at a fixed position, and when the measured error disagrees with the model
+// E = sum k_i dT_i it re-fits the coefficients by least squares from a few new measurements.
+// MonitorRun replays this on a logged run, so a shop can choose the interval and the threshold
+// from its own data before touching the machine.
 //
 // Replay (what the control sees):
 //   * temperatures arrive every sample; the model (mlr or dynamic: linear in its features

@@ -1,4 +1,4 @@
-// Output documents of the monitor (issue 14): timeline and events CSV, JSON, text table, HTML page.
+// Output documents of the monitor: timeline and events CSV, JSON, text table, HTML page.
 #include "drift/monitor_report.h"
 
 #include <cstdio>

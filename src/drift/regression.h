@@ -1,5 +1,5 @@
 #pragma once
-// Least squares for the drift models: seed 000's multiple linear regression
+// Least squares for the drift models: Miao et al.'s multiple linear regression
 //   error = b0 + sum_j b_j x_j  (x_j = a temperature rise [K] or a lagged copy of it)
 // solved with Eigen (column-pivoting QR of the design matrix [1 X]), with the classical
 // statistics of ordinary least squares (any regression text, e.g. Montgomery, Peck & Vining,
@@ -11,7 +11,7 @@
 //   VIF_j = 1 / (1 - R_j^2), R_j^2 of regressing x_j on the other regressors (with intercept);
 //           1 for a single regressor, +inf for an exactly collinear one.
 // The posterior of b under a flat prior and Gaussian noise is N(b, Cov(b)), which the on-line
-// recalibration (issue 14) uses as its prior; xtx_inverse is kept for it unscaled.
+// recalibration (drift/monitor.h) uses as its prior; xtx_inverse is kept for it unscaled.
 #include <Eigen/Core>
 
 namespace whirl::drift {

@@ -90,7 +90,7 @@ std::vector<std::string> Comments(const std::vector<std::string>& provenance,
 
 std::string SelectionHtml(const Selection& s) {
   std::ostringstream h;
-  h << "<h2>Sensitive points (seed 000)</h2>\n<p>" << HtmlEscape(s.message)
+  h << "<h2>Sensitive points (Miao et al.)</h2>\n<p>" << HtmlEscape(s.message)
     << ". Chosen sensors: <b>";
   for (const auto& n : s.ChosenNames()) h << HtmlEscape(n) << " ";
   h << "</b></p>\n<table><tr><th>lambda</th><th>classes</th><th>F</th><th>F crit</th>"

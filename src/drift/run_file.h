@@ -1,5 +1,5 @@
 #pragma once
-// Run files of machine thermal drift (issue 13, seed 000): one CSV per run (a warm-up, a day, a
+// Run files of machine thermal drift (after Miao et al.): one CSV per run (a warm-up, a day, a
 // batch) with a header row. Columns are recognized by name:
 //   time_s or time_min   time of the sample [s] or [min] (at most one of them; optional). Cells
 //                        may be empty or `nan` where the source did not record time: then the
@@ -12,7 +12,7 @@
 //   anything else        an optional input carried along (e.g. spindle_rpm), used only when a
 //                        model names it.
 // Cells other than time must be finite numbers; '#' lines are comments (provenance), as in
-// core/csv.h. A run's state (idle or cutting, seed 000's two conditions) is not in the file: it
+// core/csv.h. A run's state (idle or cutting, Miao et al.'s two conditions) is not in the file: it
 // comes from the command line (--idle / --cutting) or the caller.
 // Limits (resource and plausibility, stated in the messages): at most kMaxRunSamples rows and
 // kMaxRunColumns columns; temperatures within [-60, 400] degC; errors within +-100000 um.
@@ -29,7 +29,7 @@ inline constexpr double kMinTemperatureC = -60.0;
 inline constexpr double kMaxTemperatureC = 400.0;
 inline constexpr double kMaxAbsErrorUm = 100000.0;
 
-/// Seed 000's two operating conditions of a run (plus "not stated").
+/// Miao et al.'s two operating conditions of a run (plus "not stated").
 enum class RunState { kUnknown, kIdle, kCutting };
 std::string ToString(RunState s);                 ///< "unknown", "idle", "cutting"
 RunState ParseRunState(const std::string& text);  ///< inverse; InputError otherwise

@@ -1,8 +1,9 @@
 #pragma once
-// Temperature-sensitive points exactly as seed 000 (Miao et al.; REFERENCE.md section 6): fuzzy
+// Temperature-sensitive points exactly as Miao, Gao, Dang and Miao, "Thermal error
+// characteristics analysis of CNC machine tools" (Hefei University of Technology): fuzzy
 // clustering of the sensors, the F statistic for the number of classes, and Deng's grey relational
 // grade to pick one sensor per class. The paper's formulas did not survive in its text, so these
-// are the project's conventions (issue 13):
+// are the project's conventions:
 //
 //  1. Rises: each run's temperatures minus its first row (Run::Rises); several runs are stacked
 //     sample by sample (each relative to its own first row), so are their error series.

@@ -1,7 +1,7 @@
 #pragma once
-// The arctangent elongation curve of the unmachined section (REFERENCE.md section 1; paper seed
-// 002, section 3: "the dynamic part is fitted with an arctangent function, the plateau with a
-// line").
+// The arctangent elongation curve of the unmachined section (Li, Ma and Jiang, "Thermal
+// elongation prediction of whirlwind hard milling ballscrew based on BP neural network", section
+// 3: "the dynamic part is fitted with an arctangent function, the plateau with a line").
 //
 //   l(t) = L * atan(k (t / t_s)^p) / atan(k)     for 0 <= t < t_s
 //   l(t) = L                                     for t >= t_s          (and l(t) = 0 for t < 0)
@@ -16,13 +16,9 @@
 // lands in the unmachined section). What p < 1 compensates is that this slope falls fast (to
 // 0.21 um/s within 10 s, as the heat spreads ahead of the cut), while a plain arctangent through the
 // same L and t_s starts at only 0.21 um/s and bends later; p < 1 makes the start steep and the bend
-// early (its infinite slope at t = 0 matters only in the first seconds). Over 25
-// simulated curves (whirl fit --simulated 25, with the 2 % settle times used before issue 11) the
-// pooled least-squares fit gave p = 0.882 and
-// a median RMS residual of 0.059 um against 0.083 um for the best plain arctangent (k = 5.54);
-// the gain sits in the first minutes, the part of the curve that drives the accumulated lead
-// error: over 10 evaluation seeds (whirl evaluate --seeds 10, README) the median reduction within
-// 1000 mm rises by 0.2 to 3.7 points per seed against the previous plain curve (k = 5.62). The
+// early (its infinite slope at t = 0 matters only in the first seconds). k and p are a pooled
+// least-squares fit over simulated curves (whirl fit --simulated 25); what that fit and the
+// exponent gain is measured in docs/methods.md ("Build the curve"). The
 // network still only predicts L and t_s; k and p are properties of the process family, fitted once
 // (kDefaultShapeK, kDefaultTimeExponent).
 //

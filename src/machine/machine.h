@@ -1,5 +1,5 @@
 #pragma once
-// Machine thermal errors of a whirling machine and its virtual temperature sensors (issue 19).
+// Machine thermal errors of a whirling machine and its virtual temperature sensors.
 // The workpiece simulator (sim/simulator.h) gives the elongation e(t) of the unmachined section;
 // this module adds the machine's own drift m(t, z) of the tool relative to the chuck, in the same
 // sign convention (um, positive = the groove lands further towards the chuck, compare/cut.h), so

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <map>
 
-#include "compare/metrics.h"
+#include "core/window_range.h"
 #include "machine/timeline_data.h"
 #include "machine/truth.h"
 
@@ -38,9 +38,9 @@ CutMagnitude MeasureCut(const MachineTimeline& timeline, const CutRef& cut) {
   m.job = cut.job;
   m.start_type = job.start_type;
   m.head_thread_um = Range(head), m.z_thread_um = Range(z), m.total_thread_um = Range(total);
-  m.head_1000_um = compare::MaxWindowRange(x, head, 1000);
-  m.z_1000_um = compare::MaxWindowRange(x, z, 1000);
-  m.total_1000_um = compare::MaxWindowRange(x, total, 1000);
+  m.head_1000_um = MaxWindowRange(x, head, 1000);
+  m.z_1000_um = MaxWindowRange(x, z, 1000);
+  m.total_1000_um = MaxWindowRange(x, total, 1000);
   m.hall_slope_k_per_h = HallDuringCut(timeline, cut).slope_k_per_h;
   return m;
 }

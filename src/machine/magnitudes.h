@@ -4,7 +4,7 @@
 // test-day cut the machine's part of the lead deviation, d_p(x) = m_p(t(x), z(x)) - m_p(0, z_0)
 // with the tool at z(x) = z_start - x at t(x) = x / v_f, for p = head, Z axis and their sum; the
 // figures are the band width (max - min) over the thread and the worst band width within any
-// 1000 mm (compare/metrics.h MaxWindowRange), um. The workpiece's own part comes from the
+// 1000 mm (core/window_range.h), um. The workpiece's own part comes from the
 // workpiece simulator and is not in these figures.
 #include <cstdint>
 #include <string>

@@ -1,7 +1,9 @@
 #include "machine_eval/history.h"
 
 #include <cmath>
+#include <optional>
 
+#include "core/error.h"
 #include "core/random.h"
 
 namespace whirl::machine_eval {
@@ -80,10 +82,6 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm) {
   ShopModels m;
   drift::JointFitOptions lagged;
   lagged.require_lag = true;
-  drift::JointSpec sensors;
-  sensors.z_ref_mm = z_fixed_mm;
-  for (const auto& name : record.day_logs.front().sensor_names) sensors.sensor_pool.push_back(name);
-  m.sensors = drift::FitJoint(record, sensors, drift::JointFitOptions{}).model;
   drift::JointSpec warmup;
   warmup.z_ref_mm = z_fixed_mm;
   warmup.other_inputs = {"power_on"};
@@ -92,6 +90,35 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm) {
   schedule.z_ref_mm = z_fixed_mm;
   schedule.other_inputs = {"ring_on", "cutting", "ring_load_pct"};
   m.schedule = drift::FitJoint(record, schedule, lagged).model;
+  const bool schedule_base = m.schedule.cv_rmse_um <= m.warmup.cv_rmse_um;
+  const drift::JointDriftModel& base = schedule_base ? m.schedule : m.warmup;
+  std::vector<std::string> pool;
+  for (const auto& name : record.day_logs.front().sensor_names) pool.push_back(name);
+  drift::JointSpec alone;
+  alone.z_ref_mm = z_fixed_mm;
+  alone.sensor_pool = pool;
+  // No sensor lowers the CV below the constant: the candidate does not exist (the record itself
+  // passed the fits above, so this is the only InputError left).
+  std::optional<drift::JointDriftModel> sensors;
+  try {
+    sensors = drift::FitJoint(record, alone, {}).model;
+  } catch (const InputError&) {
+  }
+  // Sensors on top of the sensor-free rule: its inputs and lags, a sensor added only while the
+  // grouped CV falls.
+  drift::JointSpec on_top = alone;
+  on_top.other_inputs = base.other_inputs;
+  on_top.time_constants = base.time_constants;
+  drift::JointFitOptions keep_lags;
+  keep_lags.max_lags = static_cast<int>(base.time_constants.size());
+  const drift::JointDriftModel combined = drift::FitJoint(record, on_top, keep_lags).model;
+  const std::string base_name = schedule_base ? "schedule" : "warmup";
+  m.sensors = base;
+  m.sensors_choice = base_name;
+  if (sensors && sensors->cv_rmse_um < m.sensors.cv_rmse_um)
+    m.sensors = *sensors, m.sensors_choice = "sensors";
+  if (combined.cv_rmse_um < m.sensors.cv_rmse_um)
+    m.sensors = combined, m.sensors_choice = "sensors+" + base_name;
   return m;
 }
 

@@ -15,6 +15,7 @@
 // the first row: the power-on sample), ring_on, cutting, ring_load_pct (the legacy world's
 // stand-in: 20 % idle, 20 + 60 v_c / 180 % cutting).
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "drift/joint.h"
@@ -42,10 +43,18 @@ drift::ShopRecord MeasureTrainingRuns(const std::vector<drift::Run>& runs,
                                       const ShopProtocol& protocol, std::uint64_t seed);
 
 /// The machine models a shop can fit from those records, every family with the same records
-/// and the same estimator (drift/joint.h): sensors (forward choice from all sensors), warmup
-/// (lags of power_on: time since power-on), schedule (lags of ring_on, cutting, ring_load_pct).
+/// and the same estimator (drift/joint.h): warmup (lags of power_on: time since power-on),
+/// schedule (lags of ring_on, cutting, ring_load_pct), and the sensor model: the candidate with
+/// the smallest grouped cross-validated RMSE (leave one calendar day out) among
+///   sensors             forward choice from all sensors, own lags;
+///   sensors+<rule>      the better sensor-free rule's inputs and lags, sensors added while the
+///                       CV falls by more than 1 %;
+///   <rule>              the better sensor-free rule itself (warmup or schedule by CV),
+/// so the sensor model is never worse than the sensor-free rules in cross-validation; a slope
+/// is learned only over the range the Z-spanning readings cover (JointFitOptions).
 struct ShopModels {
   drift::JointDriftModel sensors, warmup, schedule;
+  std::string sensors_choice;  ///< which candidate the sensor model is (see above)
 };
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm);
 

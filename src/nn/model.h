@@ -6,7 +6,7 @@
 // Predictive uncertainty (MacKay 1992 section 4 "error bars"; Bishop 1995 section 10.3), per
 // output k at input x, in the normalized target space:
 //   var_k(x) = sigma_k^2 + g_k(x)' A^-1 g_k(x),
-//   sigma_k^2 = the noise variance of output k (schema 2, issue 11): calibrated by K-fold cross-
+//   sigma_k^2 = the noise variance of output k (schema 2): calibrated by K-fold cross-
 //               validation when the model is trained (CalibrateOutputNoise below):
 //               sigma_k^2 = the smallest level at which +-1 predictive sigma,
 //               sqrt(sigma_k^2 + v_ik), covers 68.27 % of the held-out errors r_ik (bisection;
@@ -16,8 +16,8 @@
 //               Schema 1 files (one level for both outputs, trainbr's sigma_nu^2 = 1 / (2 beta) =
 //               ssE / (n - gamma)) still load, with sigma_k^2 = sigma_nu^2 for both outputs.
 //               Why: trainbr's one level is ssE / (n - gamma) over both outputs; with 20 rows
-//               gamma nears n and it shrinks (+-1 sigma covered 47-60 % of hold-out errors), with
-//               500 rows one output's noise inflates the other's (96 %).
+//               gamma nears n and it shrinks, with 500 rows one output's noise inflates the
+//               other's (coverage measured in docs/network.md).
 //   A^-1 = (2 (beta J'J + alpha I))^-1        (posterior covariance of w, J at the final weights),
 //   g_k(x) = d y_k / d w at x (flat order, nn/network.h),
 // with MATLAB's alpha, beta (F = beta ssE + alpha ssX, see nn/trainbr.h for why the factors 2).
@@ -129,17 +129,16 @@ std::vector<Prediction> PredictBatch(const Model& model, const std::vector<Proce
 
 // Training (model_train.cpp): TrainModel with its default, the hidden size and epoch limit
 // choices, and the check of a trained model for flat outputs.
-/// When training stops (issue 12).
+/// When training stops.
 ///   kCrossValidated (measured, not the default): the epoch limit is chosen by K-fold
 ///   cross-validation: each fold
 ///     trains with trainbr from the Nguyen-Widrow initialization of `seed` and records its
 ///     held-out squared error (normalized by the table's mapminmax half ranges, both outputs
 ///     equally) after every epoch; the limit is the epoch count E in [1, train.epochs] with the
 ///     lowest sum over folds (ties: the smallest E), and the model is trained with epochs = E.
-///     Why: with 20 rows trainbr run to convergence reaches gamma = 30-40 of n = 40 and overfits
-///     (issue 12 reported --epochs 30 closing the gap). In scripts/bench_peers.sh it did NOT
-///     beat kTrainbrMatlab (Friedman 20 rows, 6 seeds: 3.09 / 10.9 against 2.91 / 11.1;
-///     simulator: settle time 10.1 s against 8.65 s), so it stays an option (--stop-by-cv).
+///     Why: with 20 rows trainbr run to convergence reaches gamma = 30-40 of n = 40 and may
+///     overfit. In scripts/bench_peers.sh it did NOT beat kTrainbrMatlab (docs/network.md), so
+///     it stays an option (--stop-by-cv).
 ///   kTrainbrMatlab (default): trainbr's own stopping (MATLAB's criteria, at most train.epochs
 ///     epochs, plus R brnn's rule when train.change > 0, as in DefaultTrainingOptions); with
 ///     change = 0 what the LibTorch cross-check compares against.
@@ -152,7 +151,7 @@ struct ModelTrainOptions {
   /// folds, one start per fit; ties: the earlier candidate); hidden_sizes is then ignored.
   /// `whirl train --hidden auto` uses {4, 6, 8, 10, 12}; its default (`--hidden evidence`,
   /// hidden_by_evidence below) uses {0, 4, 6, 8}, where 0 is no hidden layer (a linear network,
-  /// evidence choice only). Why (issue 12, scripts/bench_peers.sh): at 100 rows six neurons
+  /// evidence choice only). Why (scripts/bench_peers.sh, docs/network.md): at 100 rows six neurons
   /// shared by two outputs are too few; at 20 rows the evidence sometimes prefers a collapsed
   /// network that ignores its inputs (FlatOutputs) to every fitted one, and a linear fit then
   /// has more evidence.
@@ -180,22 +179,14 @@ struct ModelTrainOptions {
 /// R brnn's default `change` (TrainOptions::change), the stopping rule of the default training.
 inline constexpr double kBrnnChange = 0.001;
 
-/// The default of `whirl train` (issue 12, measured with scripts/bench_peers.sh; the numbers are
-/// in the README section on the network): no hidden layer (linear) or one tansig hidden layer of
+/// The default of `whirl train` (measured with scripts/bench_peers.sh; figures in
+/// docs/network.md): no hidden layer (linear) or one tansig hidden layer of
 /// 4, 6 or 8 neurons, the choice of the highest log evidence (hidden_by_evidence), each fit
 /// trainbr with R brnn's stopping rule (TrainOptions::change = kBrnnChange), then 5-fold
 /// cross-validated noise per output.
-/// Why: trainbr run to MATLAB's own criteria takes 200-1000 epochs (40-60 ms) for the same
-/// test error as brnn's rule after 40-60 epochs; six neurons shared by two outputs are too few at
-/// 100 rows (Friedman: 1.69 / 3.92 against 1.00 / 3.39 with 8), and the evidence picks 8 there.
-/// Measured and not adopted: MacKay's three weight-decay groups (the hidden-bias group collapses,
-/// alpha -> 1e17; with two groups the fit became near-linear: 100 rows 1.80 / 3.74); a committee
-/// of 5 starts averaged (20 rows 2.98 / 11.7 against 2.83 / 11.3 for one); noise by the evidence
-/// (ssE_k / (Q - gamma/2)) or by closed-form leave-one-out from the Laplace posterior (both
-/// cost nothing but covered only 35-55 % on the simulator and at 20 rows); 3 noise folds
-/// instead of 5 (simulator: 35 % at +-1 sigma); noise folds warm-started from the full fit
-/// (simulator: 42 %). Available, not the default: TrainOptions::ard (`--ard`: better at 100 rows
-/// and on the simulator's settle time, worse on its elongation, 2-7x slower).
+/// Why: trainbr run to MATLAB's own criteria takes many more epochs for the same test error as
+/// brnn's rule; six neurons shared by two outputs are too few at 100 rows, where the evidence
+/// picks 8. Available, not the default: TrainOptions::ard (`--ard`).
 ModelTrainOptions DefaultTrainingOptions();
 
 /// ModelTrainOptions::hidden_sizes for a network with `size` hidden neurons: none for 0 (a linear
@@ -214,7 +205,7 @@ Model TrainModel(const ProcessTable& table, const ModelTrainOptions& options,
 /// An output the trained network hardly lets depend on the inputs. On small noisy tables trainbr's
 /// evidence can prefer the collapsed fixed point (alpha large, every weight near 0, gamma near 0):
 /// the network then predicts about one value for every process (scripts/bench_peers.sh: 3 of 20
-/// Friedman tables of 20 rows, at every hidden size; README "Against its peers").
+/// Friedman tables of 20 rows, at every hidden size; docs/network.md).
 struct FlatOutput {
   int output = 0;            ///< index into Features (kTargetColumns)
   double spread_ratio = 0;   ///< sd of the network's mean predictions / sd of the targets

@@ -247,7 +247,7 @@ std::string DescribeFlatOutputs(const Model& model, const std::vector<FlatOutput
               ? "The evidence preferred it to every size tried, so it predicts "
               : "It predicts ") +
          "about one value for every process, with the cross-validated noise as its "
-         "uncertainty. More training rows usually help (README 'Against its peers')";
+         "uncertainty. More training rows usually help (docs/network.md)";
 }
 
 int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOptions& options,

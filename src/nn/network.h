@@ -1,5 +1,5 @@
 #pragma once
-// Feed-forward network of the paper (5-6-2, REFERENCE.md sections 1-2): tansig hidden layers, a
+// Feed-forward network of the paper (5-6-2, Li, Ma and Jiang; MATLAB): tansig hidden layers, a
 // linear output layer, mapminmax scaling, Nguyen-Widrow initialization and the analytic Jacobian of
 // the errors that trainbr needs.
 //
@@ -25,7 +25,7 @@ namespace whirl::nn {
 
 /// MATLAB mapminmax with ymin = -1, ymax = 1, per variable (row):
 ///   y = 2 (x - xmin) / (xmax - xmin) - 1,   x = (y + 1) (xmax - xmin) / 2 + xmin.
-/// A constant variable (xmax == xmin) is passed through unchanged (y = x), REFERENCE.md section 2.
+/// A constant variable (xmax == xmin) is passed through unchanged (y = x), as MATLAB's mapminmax.
 struct MapMinMax {
   Eigen::VectorXd xmin;  ///< per variable minimum of the fitted data, original units
   Eigen::VectorXd xmax;  ///< per variable maximum of the fitted data, original units
@@ -108,8 +108,9 @@ void ErrorGram(const Network& net, const ForwardCache& cache, const Eigen::Matri
 /// dy/dw for one input (normalized): S x N, row k = gradient of output k (= -J_e_w rows).
 Eigen::MatrixXd OutputJacobian(const Network& net, const Eigen::VectorXd& x);
 
-/// Nguyen-Widrow initialization as MATLAB initnw (REFERENCE.md section 2). For each hidden
-/// (tansig) layer with S neurons and R inputs (assumed in [-1, 1]):
+/// Nguyen-Widrow initialization as MATLAB initnw (Nguyen and Widrow, "Improving the learning
+/// speed of 2-layer neural networks by choosing initial values of the adaptive weights").
+/// For each hidden (tansig) layer with S neurons and R inputs (assumed in [-1, 1]):
 ///   wMag = 0.7 S^(1/R); each row of W = a uniform(-1, 1) row scaled to unit length times wMag;
 ///   b = wMag * linspace(-1, 1, S) .* sign(W(:, 1)) (linspace of one point = 1);
 ///   then W and b times 2 (tansig's active input range is [-2, 2]).

@@ -1,7 +1,7 @@
 #pragma once
 // Choosing the hidden size the way the paper did (grow from 4 until the error stops improving,
-// REFERENCE.md section 1), with numbers a user can judge: training error, gamma (effective number
-// of parameters), log evidence and k-fold cross-validation error per hidden size.
+// Li, Ma and Jiang's whirling paper), with numbers a user can judge: training error, gamma
+// (effective number of parameters), log evidence and k-fold cross-validation error per hidden size.
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>

@@ -1,5 +1,5 @@
 #pragma once
-// Bayesian-regularized Levenberg-Marquardt training, MATLAB `trainbr` (REFERENCE.md section 2;
+// Bayesian-regularized Levenberg-Marquardt training, MATLAB `trainbr` (MathWorks documentation;
 // MacKay, "Bayesian interpolation", Neural Computation 4(3) 1992; Foresee & Hagan, "Gauss-Newton
 // approximation to Bayesian learning", ICNN 1997).
 //
@@ -14,7 +14,7 @@
 // covariance of w is A^-1 = (beta_M J'J + alpha_M I)^-1 = (2 H)^-1 with H = beta J'J + alpha I
 // (MacKay 1992 eqs. 2.8-2.10 and 4.3; Foresee & Hagan eqs. 11-13).
 //
-// Algorithm, per epoch (REFERENCE.md section 2, to the letter):
+// Algorithm, per epoch (MathWorks' trainbr documentation, to the letter):
 //   1. at the current w: ssE, J, je = J'e, jj = J'J, gradient = 2 ||J'e||.
 //   2. stop if ssE <= goal (kGoalMet), epoch == epochs (kMaxEpochs), gradient <= min_grad
 //      (kMinGradient), mu >= mu_max (kMaxMu), tested in that order; then, only when
@@ -96,7 +96,7 @@ struct TrainOptions {
   /// How the epoch's linear systems are solved (same algorithm, results agree to rounding; not
   /// stored in model files). See LinearSystem.
   LinearSystem linear_system = LinearSystem::kAuto;
-  /// Automatic relevance determination (MacKay 1994/1995; not in MATLAB; issue 12; `whirl train
+  /// Automatic relevance determination (MacKay 1994/1995; not in MATLAB; `whirl train
   /// --ard`). After trainbr has stopped, training continues from its weights, alpha and beta
   /// with one weight-decay coefficient per group: the first-layer weights from input i (one
   /// group per input) and all other weights and biases (one group), so
@@ -115,7 +115,7 @@ struct TrainOptions {
   /// factors of the extra hyperparameters (MacKay 1992 section 4: about ln(sigma_ln_alpha /
   /// range) per alpha_g), which would charge ARD for its G - 1 extra alphas: it guards against
   /// an ARD optimum worse than trainbr's, not against over-fitted hyperparameters; whether ARD
-  /// helps is measured in scripts/bench_peers.sh (README "Against its peers"). Bayesian only.
+  /// helps is measured in scripts/bench_peers.sh (docs/network.md). Bayesian only.
   bool ard = false;
 
   /// Throws InputError naming the option, its value and the rule.
@@ -214,7 +214,7 @@ TrainResult TrainBr(const TrainingData& data, const Network& initial, const Trai
 /// adds none. Without that correction a collapsed network (every weight near 0, gamma near 0)
 /// of 8 neurons got ln(2^8 8!) = 16.1 more evidence than the same function without hidden
 /// neurons (ln(2^8 8!) - ln(2^4 4!) = 10.2 more than with 4), and
-/// the default chose such fits over fitted ones (issue 12, README "Against its peers").
+/// the default chose such fits over fitted ones (docs/network.md, "Against its peers").
 double LogEvidence(double sse, double ssx, double alpha, double beta, double log_det_h,
                    int parameter_count, int error_count, const std::vector<int>& layer_sizes,
                    const std::vector<int>& active_units = {});

@@ -1,5 +1,5 @@
 #pragma once
-// Process tables for training and validation, simulated (REFERENCE.md section 1: the paper's ranges
+// Process tables for training and validation, simulated (the ranges of Li, Ma and Jiang's paper
 // and its 20 training + 5 validation samples). The paper's own tables are not public.
 //
 // Design: a space-filling Halton sequence (bases 2, 3, 5, 7, 11) with a seeded Cranley-Patterson
@@ -26,7 +26,7 @@ struct InputRange {
 struct DatasetOptions {
   int count = 20;          ///< rows, >= 1
   std::uint64_t seed = 1;  ///< design shift and per-row disturbance seeds
-  /// Paper ranges (REFERENCE 1), in the column order of kInputColumns.
+  /// The paper's training ranges, in the column order of kInputColumns.
   std::array<InputRange, ProcessInputs::kCount> ranges = {
       {{60, 65}, {50, 100}, {6, 16}, {3, 10}, {150, 210}}};
   /// Simulated time per row, s: long enough that the slowest row (100 mm, 150 m/min, settle ~650 s)

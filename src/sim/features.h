@@ -15,7 +15,7 @@
 // over a whole 2 h cut (whirl simulate's default) it is not a low-order polynomial (the workpiece
 // lags the ambient by hours and the unmachined section shrinks from 5.2 m to 0.5 m), and a
 // polynomial fitted to it moved the reference screw's settle time from 295 s to 2373-4883 s at
-// seeds 1-5 (issue 11).
+// seeds 1-5.
 //
 // Method kShapeFit (default). The record is fitted, by least squares over ALL samples of the
 // window, with the project's curve shape plus a drift that starts flat:
@@ -86,7 +86,7 @@ struct SettleOptions {
   double noise_sigma_multiplier = 3.0;  ///< band floor in smoothed-noise standard deviations, -
   /// Degree of the drift polynomial d(t) (d(t0) = 0): 0 = no drift (constant plateau), 1 = linear
   /// drift (a sensor), 2 (default) = also the curvature of the workpiece's lagged response to an
-  /// ambient ramp (REFERENCE 5 heat loss; tested: with degree 1 a 0.2 K/h ramp biases the plateau
+  /// ambient ramp (surface heat loss; tested: with degree 1 a 0.2 K/h ramp biases the plateau
   /// and moves settle times by tens of percent).
   int drift_degree = 2;
   /// Fit window start after the settle time: t_f = t0 + fit_start_factor (t_s - t0), -

@@ -1,20 +1,20 @@
 #pragma once
 // All physical constants and process-model relations of the simulator in one place
-// (REFERENCE.md section 5). Each constant says whether it comes from a source or is an assumption.
+// (docs/simulator.md). Each constant says whether it comes from a source or is an assumption.
 #include "sim/screw.h"
 
 namespace whirl::sim {
 
 /// Material, heat-transfer and cutting constants. Defaults: GCr15SiMn bearing steel.
 struct PhysicsConstants {
-  // --- GCr15SiMn (REFERENCE 5: 7800-7830 kg/m^3, 460-475 J/(kg K), 37-40 W/(m K), 11.5-12.5e-6/K)
+  // --- GCr15SiMn (handbook: 7800-7830 kg/m^3, 460-475 J/(kg K), 37-40 W/(m K), 11.5-12.5e-6/K)
   double density_kg_m3 = 7810.0;
   double specific_heat_j_kg_k = 470.0;
   double conductivity_w_m_k = 38.0;
   double expansion_per_k = 11.8e-6;  ///< linear expansion coefficient alpha, 1/K
 
   /// Surface heat-transfer coefficient to ambient, W/(m^2 K): natural convection plus forced
-  /// convection by the rotating workpiece and the whirling ring's air flow (REFERENCE 5 range
+  /// convection by the rotating workpiece and the whirling ring's air flow (handbook range
   /// 10-50 for air; assumption, mid value). Biot = h R / k = 25 * 0.04 / 38 = 0.026 << 0.1 for the
   /// 80 mm screw (0.033 for 100 mm), so the cross section is isothermal to within ~1 % and the 1D
   /// model of the section-mean temperature is exact up to O(Bi) in the loss term.
@@ -32,7 +32,7 @@ struct PhysicsConstants {
   /// Fraction of the cutting power that ends up in the workpiece at the reference cutting speed,
   /// eta_ref, -. THE CALIBRATION CONSTANT (datasets/README.md, "Calibration"): chosen so the
   /// reference screw's plateau is ~15 um (the order of tens of um the paper's lead errors imply).
-  /// It is above the 0.1-0.2 ballpark for the cutting zone alone (REFERENCE 5; 0.2 gives 6.9 um):
+  /// It is above the 0.1-0.2 ballpark for the cutting zone alone (textbook; 0.2 gives 6.9 um):
   /// it lumps every heat path into the screw the model does not resolve (flank rubbing on the
   /// hardened groove, hot chips falling on the screw, steady-rest friction).
   double heat_partition_at_ref_speed = 0.43;

@@ -1,6 +1,7 @@
 #pragma once
 // A hard-whirling job: the screw blank, the five network inputs and the machine settings, plus the
-// kinematics and groove geometry that follow from them (REFERENCE.md sections 1 and 5).
+// kinematics and groove geometry that follow from them (Li, Ma and Jiang's process;
+// docs/simulator.md).
 //
 // Geometry convention used by the whole project: the blank is clamped in the chuck (the FIXED end,
 // axial coordinate x = 0 at the chuck face) and free at x = length_mm. The thread starts
@@ -21,11 +22,11 @@ inline constexpr double kMaxToolCircleMarginMm = 100;
 
 /// Machine/process settings that are not among the five network inputs.
 struct ProcessSettings {
-  /// Formed tools on the whirling ring, - (REFERENCE 1: 6-8 tools).
+  /// Formed tools on the whirling ring, - (the paper: 6-8 tools).
   int tool_count = 6;
   /// Feed per tooth, mm: the AXIAL advance of the ring relative to the workpiece per tool
   /// engagement, so axial feed v_f = f_z * z * n_ring. INTERPRETATION of the paper's "0.01 mm per
-  /// tool" (seed 002): the circumferential reading (v_f = lead * f_z * z * n_ring / (pi D)) gives
+  /// tool" (Li, Ma and Jiang): the circumferential reading (v_f = lead f_z z n_ring / (pi D)) gives
   /// ~1.6 mm/min, a 50 h cut and a curve that settles in hours, contradicting the paper's Fig. 1
   /// (plateau after ~250 s); the axial reading gives 40 mm/min, a ~2 h cut of the 5100 mm thread
   /// and the paper's time scale.
@@ -66,7 +67,7 @@ inline constexpr double kGrooveDepthRatio = 0.6;  ///< h / r, - (assumption, see
 inline constexpr double kMinLandMm = 0.4;  ///< smallest land between grooves, mm (assumption)
 inline constexpr double kMaxGrooveDepthFraction = 0.125;  ///< h <= this * D, i.e. root >= 75 % of D
 
-/// Kinematics of the whirling process (REFERENCE 5):
+/// Kinematics of the whirling process:
 ///   D_tool = D + margin;  n_ring = v_c / (pi D_tool);  v_f = f_z z n_ring (axial, see
 ///   ProcessSettings::feed_per_tooth_mm);  n_workpiece = v_f / lead;  cutting time = thread / v_f.
 struct Kinematics {

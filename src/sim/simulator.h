@@ -1,6 +1,6 @@
 #pragma once
 // Transient axial heat conduction in the screw blank during hard whirling and the resulting
-// thermal elongation of the unmachined section (REFERENCE.md sections 1 and 5).
+// thermal elongation of the unmachined section (Li, Ma and Jiang's process; docs/simulator.md).
 //
 // Model (1D in the section-mean temperature rise theta(x, t) = T - T_ref, x from the chuck face):
 //   rho c A d(theta)/dt = k A d2(theta)/dx2 - h P (theta - theta_amb(t)) + q(t) s(x - x_c(t))
@@ -19,7 +19,7 @@
 //   (ProcessSettings::ambient_temperature_c).
 //     Elongation is measured against T_ref: the finished screw is measured after cooling back to
 //     it.
-//   * Elongation of the unmachined section at the cut point (REFERENCE 1):
+//   * Elongation of the unmachined section at the cut point (Li, Ma and Jiang):
 //       dL(t) = alpha * integral_0^{x_c(t)} theta(x, t) dx,  reported in um; positive = growth of
 //       the unmachined section, which moves the cut point away from the chuck (towards the free
 //       end).
@@ -90,11 +90,11 @@ struct DisturbanceOptions {
   /// +-0.5 um (95 %).
   bool measurement_noise = true;
   double measurement_noise_std_um = 0.25;
-  /// Tool wear (issue 11 scenario): the heat input rises linearly over the cut, from 1 at t = 0 to
+  /// Tool wear (scenario): the heat input rises linearly over the cut, from 1 at t = 0 to
   /// 1 + tool_wear_heat_rise_rel at the end of the thread (flank wear raises the cutting force and
   /// the rubbing; assumption: +20 % over a 2 h tool life), -. Deterministic; 0 = off.
   double tool_wear_heat_rise_rel = 0.0;
-  /// Friction heat of a steady rest riding on the blank (issue 11 scenario): this power, W, spread
+  /// Friction heat of a steady rest riding on the blank (scenario): this power, W, spread
   /// over steady_rest_width_mm, steady_rest_offset_mm from the cut on the unmachined (chuck) side,
   /// moving with the whirling head. Deterministic; 0 = off (assumption: tens of W for a loaded
   /// rest pad).

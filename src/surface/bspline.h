@@ -1,7 +1,7 @@
 #pragma once
-// Tensor-product B-spline surface interpolating a rectangular grid (seed 003, "B-spline surface
-// interpolation", its eqs. 7-23 to 7-29; the knot formulas did not survive in the text, so the
-// construction below is the project's, stated in full).
+// Tensor-product B-spline surface interpolating a rectangular grid (the worktable chapter's
+// "B-spline surface interpolation", its eqs. 7-23 to 7-29; the knot formulas did not survive in
+// the text, so the construction below is the project's, stated in full).
 //
 // Grid: M rows (Y_1 < ... < Y_M) and N columns (X_1 < ... < X_N); one measured error per node
 // E(X_j, Y_i). Refused (InputError): a point set that is not a complete rectangular grid (a node

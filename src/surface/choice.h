@@ -1,5 +1,5 @@
 #pragma once
-// Choosing between the cubic polynomial and the B-spline (seed 003: fit where the field is smooth
+// Choosing between the cubic polynomial and the B-spline (the book: fit where the field is smooth
 // and of low order; interpolate where it has local bumps, because a forced fit oscillates, most at
 // the edges: Runge's phenomenon).
 //

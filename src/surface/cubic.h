@@ -1,5 +1,6 @@
 #pragma once
-// Cubic polynomial surface fitted by least squares (seed 003, "multiple regression surface fit").
+// Cubic polynomial surface fitted by least squares (the worktable chapter's "multiple
+// regression surface fit").
 //
 // The model, 10 coefficients, this order of terms (the seed's formula did not survive in the text;
 // this is the project's order, used everywhere: JSON, --help, tests):

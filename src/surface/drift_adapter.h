@@ -1,6 +1,6 @@
 #pragma once
-// Per-point models from the drift module (src/drift, issue 13): for each position-tagged error
-// column (per_point.h), seed 000's sensitive-point selection and multiple linear regression
+// Per-point models from the drift module (src/drift): for each position-tagged error
+// column (per_point.h), Miao et al.'s sensitive-point selection and multiple linear regression
 // (drift::FitDriftModel, kind mlr by default; any drift::FitOptions works) fitted on the training
 // runs, then drift::PredictRun on the target run: the PointModelFn of per_point.h.
 #include <map>

@@ -1,7 +1,7 @@
 #pragma once
 // The part of a surface a SINUMERIK 840D can apply: temperature compensation is linear per axis
-// (REFERENCE.md section 3, interp/sinumerik.h), dK = K0 + tan(beta) (P - P0), so at a given time
-// the best it can do along one axis is the least-squares line of the error along that axis's
+// (Siemens K3 function manual, interp/sinumerik.h), dK = K0 + tan(beta) (P - P0), so at a given
+// time the best it can do along one axis is the least-squares line of the error along that axis's
 // travel; this reports that line as setting data and what it leaves uncorrected.
 //
 // The surface must hold the error of the axis being compensated (for example the X positioning

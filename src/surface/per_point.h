@@ -1,9 +1,9 @@
 #pragma once
-// Per-point models over the worktable (seed 003, first step): the thermal error is measured at P
+// Per-point models over the worktable (the method's first step): the thermal error is measured at P
 // points of the table, each point gets its own model from its sensitive temperatures, and at any
 // moment the P predictions become the points of a surface (surface.h).
 //
-// Position-tagged run files: the drift module's run-file format (issue 13, drift/run_file.h:
+// Position-tagged run files: the drift module's run-file format (drift/run_file.h:
 // time_s or time_min, temperatures *_C, errors *_um), where each error column is one measured
 // point of the table. Its position comes either
 //   (a) from the column name: <name>_x<X>_y<Y>_um, X and Y in mm (optional '-', digits, optional
@@ -16,7 +16,7 @@
 //
 // The model of one point is a function (PointModelFn): given the error column, it fits the model
 // on the training data it holds and returns the predicted error (um) at every sample of the target
-// run. The library does not fix the model: drift_adapter.h wires seed 000's sensitive points and
+// run. The library does not fix the model: drift_adapter.h wires Miao et al.'s sensitive points and
 // MLR (src/drift) into it; tests use closed-form stand-ins.
 #include <Eigen/Core>
 #include <filesystem>

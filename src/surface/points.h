@@ -1,6 +1,6 @@
 #pragma once
 // Measured (or predicted) thermal errors at points of the worktable at one moment: the input of
-// both surface models (seed 003, REFERENCE.md section 6).
+// both surface models (surface.h).
 //
 // Points CSV: a header row with the columns x_mm, y_mm, error_um (other columns are ignored),
 // then one row per point; '#' lines are provenance comments (core/csv.h).

@@ -1,8 +1,8 @@
 #pragma once
-// Thermal error over the whole worktable (seed 003; REFERENCE.md section 6): the manual of
+// Thermal error over the whole worktable (the worktable chapter, docs/references.md): the manual of
 // src/surface.
 //
-// Seed 003 measures the thermal error at P points of the table, builds a model per point from its
+// The method measures the thermal error at P points of the table, builds a model per point from its
 // sensitive temperatures (surface/per_point.h; the models themselves come from src/drift through
 // surface/drift_adapter.h), and at any moment turns the P predicted errors into a surface over
 // the table, so the error is known at every position:

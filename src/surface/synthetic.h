@@ -1,6 +1,6 @@
 #pragma once
 // Documented synthetic thermal-error fields over a worktable. No public measurements of a whole
-// table exist, so tests and the demo use these (seed 003 shows only smooth fields; the bump is the
+// table exist, so tests and the demo use these (the book shows only smooth fields; the bump is the
 // rough case its B-spline is for). With s = x / length_x, t = y / length_y in [0, 1]:
 //
 //   smooth(x, y) = 10 + 10 s + 6 t + 4 s^2 + 3 s t - 2 t^2 + 5 s^3 + 2 s t^2   um

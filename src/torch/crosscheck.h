@@ -45,7 +45,7 @@ FlatLayout MakeLayout(const nn::Network& net);
 ModelSpec MakeModelSpec(const nn::Model& model, const std::string& description = "");
 
 /// Eigen-side minimiser of F(w) = beta ssE + alpha ssX with alpha, beta FIXED: the LM loop of
-/// trainbr (trainbr.h step 3, REFERENCE.md section 2) without the alpha/beta update,
+/// trainbr (trainbr.h step 3) without the alpha/beta update,
 ///   dw = -(beta J'J + (mu + alpha) I)^-1 (beta J'e + alpha w),
 /// accept if F(w + dw) < F(w) (mu *= mu_dec, floor 1e-20), else mu *= mu_inc.
 struct GaussNewtonOptions {
@@ -87,11 +87,11 @@ GaussNewtonSummary MinimizeFixedHyperparameters(const nn::Network& start, const 
 
 struct CrosscheckOptions {
   /// Tolerances of the five figures (definitions at the top of this file).
-  double forward_tolerance = 1e-12;             ///< relative (issue 6: 1e-12)
-  double jacobian_tolerance = 1e-10;            ///< relative to max |J| (issue 6: 1e-10)
+  double forward_tolerance = 1e-12;             ///< relative
+  double jacobian_tolerance = 1e-10;            ///< relative to max |J|
   double objective_tolerance = 1e-12;           ///< relative
   double gradient_tolerance = 1e-10;            ///< relative to the term magnitudes
-  double training_objective_tolerance = 1e-6;   ///< relative (issue 6: 1e-6)
+  double training_objective_tolerance = 1e-6;   ///< relative
   double training_prediction_tolerance = 1e-5;  ///< normalized target units (stated in the report)
   /// alpha, beta of F; <= 0 means: the model's final trainbr values (TrainSummary alpha, beta).
   /// A model trained with --ard (TrainSummary::ard_alpha) is checked with one alpha, the group

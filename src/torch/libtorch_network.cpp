@@ -1,4 +1,4 @@
-// The only translation unit of whirl that includes torch/torch.h (compile time: see README).
+// The only translation unit of whirl that includes torch/torch.h (compile time: docs/network.md).
 #include "torch/libtorch_network.h"
 
 #include <torch/script.h>

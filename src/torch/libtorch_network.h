@@ -1,10 +1,10 @@
 #pragma once
 // The network of nn/network.h re-implemented independently in LibTorch (double precision), plus
 // its TorchScript export. This header is torch-free on purpose: only libtorch_network.cpp includes
-// torch/torch.h (it is the single slow translation unit; see README "LibTorch build time"), every
-// other file talks to LibTorch through the plain Eigen/std types declared here.
+// torch/torch.h (it is the single slow translation unit; see docs/network.md), every other file
+// talks to LibTorch through the plain Eigen/std types declared here.
 //
-// Conventions shared with nn (REFERENCE.md section 2):
+// Conventions shared with nn (MATLAB's trainbr, nn/trainbr.h):
 //   - a network is layers l = 0..L-1 with weights W_l (rows = outputs of layer l) and biases b_l,
 //     tansig (tanh) on every hidden layer, linear output layer;
 //   - inputs and outputs here are in the normalized (mapminmax, [-1, 1]) space, one sample per

@@ -1,5 +1,5 @@
-// Trilateration (seed 001 eqs. 11-17): hand example, round trips, Jacobian against finite
-// differences, degenerate geometry, placement advice.
+// Trilateration (Shang, Ruan and Zhang, eqs. 11-17): hand example, round trips, Jacobian against
+// finite differences, degenerate geometry, placement advice.
 #include <gtest/gtest.h>
 
 #include "support/expect_error.h"

@@ -10,7 +10,7 @@
 //   BM_FamilyCandidate/rows:R/candidate:C   FitCandidate of DefaultCandidates()[C] (with its
 //                              calibration; no choice);
 //   BM_TrainbrSingleFit/rows:R one nn::TrainModel of 5-6-2 with R brnn's stopping rule, no size
-//                              choice, no noise folds (the unit the README's speed figures use);
+//                              choice, no noise folds (the unit of docs/network.md's figures);
 //   BM_NetworkDefault/rows:R   nn::DefaultTrainingOptions() (size by evidence + 5 noise folds).
 // Tables: datasets/whirling_train.csv (20 rows); the first 100 rows of datasets/whirling_500.csv.
 #include <benchmark/benchmark.h>

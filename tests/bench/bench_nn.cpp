@@ -94,12 +94,12 @@ void BM_EpochLinearAlgebra_n40(benchmark::State& state) {
 BENCHMARK(BM_EpochLinearAlgebra_n40)->Unit(benchmark::kMicrosecond);
 
 // The default `whirl train` on 20 rows (datasets/whirling_train.csv) on 1 and 2 threads (the
-// default --threads 0 on a 2-core machine). Issue 12's speed target: at least 10x faster than R
-// brnn's 20-35 ms per output, i.e. a median of at most 4 ms for both outputs (README "Against its
-// peers" quotes where whirl stands). Argument phase: 0 = the whole default fit (4 candidate fits
-// + 5 noise folds); 1 = the candidate fits alone (noise folds off), so the split of the time is
-// visible. The seed varies with the iteration (16 seeds) so the
-// time covers typical fits. Counter "hidden" = mean chosen hidden size.
+// default --threads 0 on a 2-core machine). The speed target set for this work: at least 10x
+// faster than R brnn's 20-35 ms per output, i.e. a median of at most 4 ms for both outputs
+// (docs/network.md, "Against its peers", says where whirl stands). Argument phase: 0 = the
+// whole default fit (4 candidate fits + 5 noise folds); 1 = the candidate fits alone (noise
+// folds off), so the split of the time is visible. The seed varies with the iteration (16 seeds)
+// so the time covers typical fits. Counter "hidden" = mean chosen hidden size.
 void BM_DefaultTrainModel_20Rows(benchmark::State& state) {
   const whirl::ProcessTable table = whirl::ReadProcessTable(
       std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_train.csv", /*require_targets=*/true);

@@ -1,4 +1,4 @@
-// Speed targets of the simulator (issue 3, item 9): the whole reference screw (5100 mm of thread,
+// Speed targets of the simulator: the whole reference screw (5100 mm of thread,
 // ~2.1 h of cutting) well under one second; the 500-row table in under a minute on 2 cores.
 #include <benchmark/benchmark.h>
 

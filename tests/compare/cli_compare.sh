@@ -65,7 +65,7 @@ j = json.load(open("evals.json"))
 # the per-seed screws are in the output, so the pooled figure can be recomputed from it
 assert [len(s["screws"]) for s in j["seeds"]] == [3, 3]
 PY
-# Named scenarios (issue 11): the table has a row per scenario and strategy; the out-of-range
+# Named scenarios: the table has a row per scenario and strategy; the out-of-range
 # scenario needs the explicit override.
 "$whirl" evaluate --scenarios today,steady-rest --random 2 --seed 3 --json > scen.json
 python3 - <<'PY'

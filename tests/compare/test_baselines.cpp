@@ -1,4 +1,4 @@
-// Issue 11: the history baselines (compare/traditional.h) and the scenario disturbances
+// The history baselines (compare/traditional.h) and the scenario disturbances
 // (sim/simulator.h) against closed forms and hand-computed examples.
 #include <gtest/gtest.h>
 

@@ -19,16 +19,16 @@ TEST(SimulatedFits, DefaultShapeIsNearThePooledFitOfFreshSimulations) {
   EXPECT_TRUE(r.shape.summary.Converged()) << r.shape.summary.BriefReport();
   EXPECT_NEAR(r.shape.shape_k, fit::kDefaultShapeK, 0.1 * fit::kDefaultShapeK)
       << "re-derive the defaults with 'whirl fit --simulated 25' if the simulator changed";
-  // Since issue 11 the settle time is itself the least-squares t_s of this shape plus a drift
+  // The settle time is itself the least-squares t_s of this shape plus a drift
   // (sim/features.h), so the calibration with the features fixed is partly circular and lands at
   // p = 0.91 (k = 4.61) on the window the features come from.
   EXPECT_NEAR(r.shape.time_exponent, fit::kDefaultTimeExponent, 0.04)
       << "re-derive the defaults with 'whirl fit --simulated 25' if the simulator changed";
   EXPECT_GT(r.shape.median_r_squared, 0.99);
-  // (Until issue 11 the pooled (k, p) beat the best plain arctangent by more than 20 % here; with
+  // (Earlier the pooled (k, p) beat the best plain arctangent by more than 20 % here; with
   // the features fitted with the pooled shape the two are within about 20 % either way, so that
-  // comparison no longer tests the exponent. The evaluation does: README, p = 1 row.)
-  // Paper seed 002 section 3: the arctangent fits the dynamic part better than parabola or sine.
+  // comparison no longer tests the exponent. The evaluation does: docs/results.md, p = 1 row.)
+  // Li, Ma and Jiang, section 3: the arctangent fits the dynamic part better than parabola or sine.
   EXPECT_EQ(r.best_model, fit::CurveModel::kArctan);
   ASSERT_EQ(r.models.size(), 3u);
   EXPECT_LT(r.models[0].median_rms_residual_um, r.models[1].median_rms_residual_um);

@@ -15,7 +15,7 @@ const std::filesystem::path kTable =
 
 TEST(IsoTable, ShippedFileHoldsTheReferenceCells) {
   const IsoToleranceTable t = ReadIsoToleranceTable(kTable);
-  // Cells of REFERENCE.md section 4 (confirmed ones marked *).
+  // Cells of the ISO 3408-3 table (datasets/standards/README.md; confirmed ones marked *).
   auto p3 = t.Lookup(IsoClass::kP3, 900);  // 800-1000: 21*/17
   ASSERT_TRUE(p3);
   EXPECT_EQ(p3->e_p_um, 21);

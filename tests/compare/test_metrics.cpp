@@ -1,4 +1,4 @@
-// Lead metrics against closed forms (REFERENCE.md section 4), and the measured-lead reader.
+// Lead metrics against closed forms (ISO 3408-3 definitions), and the measured-lead reader.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// The report with hostile screw names (issue 17): gnuplot still renders every plot, nothing a name
+// The report with hostile screw names: gnuplot still renders every plot, nothing a name
 // says is ever executed, the page carries no markup from a name; and the evaluation's worker
 // threads hand any exception to the caller.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Files a shop can trust (issue 17): the atomic writer replaces only regular files, multi-file
+// Files a shop can trust: the atomic writer replaces only regular files, multi-file
 // outputs are all-or-nothing, readers refuse FIFOs, directories and oversized files, and a JSON
 // number beyond the double range is an InputError naming the file. Where whirl writes: killed
 // runs' temporaries are recognised and removed later, output directories follow one rule

@@ -153,6 +153,47 @@ TEST(JointFit, ForwardChoiceFindsThePlantedSensorAndLag) {
   EXPECT_EQ(r.model.time_constants, std::vector<double>{40});
 }
 
+// A slope is learned only over the range the Z-spanning readings cover: s1 barely moves on the
+// laser days (z 1000..5000 mm: 5 % of its rise) and rises fully only on probe-only days (one
+// z). Its slope coefficient would be an extrapolation from a sensor that did not move: it stays
+// 0 and unidentified, while s2, which moves on the laser days too, keeps its slope.
+TEST(JointFit, ASlopeIsNotLearnedBeyondTheRangeTheZSpanningReadingsCover) {
+  Planted p = MakePlanted(false, 10);
+  for (auto& rec : p.record.records)
+    if (rec.day < 2 && rec.kind == MeasurementRecord::Kind::kProbe) rec.rows.clear();
+  // Days 0 and 1: laser only, s1 at 5 % of its rise; days 2 and 3: probe only.
+  std::vector<MeasurementRecord> kept;
+  for (auto& rec : p.record.records) {
+    if (rec.rows.empty()) continue;
+    if (rec.day >= 2 && rec.kind == MeasurementRecord::Kind::kLaser) continue;
+    kept.push_back(rec);
+  }
+  p.record.records = kept;
+  for (int day = 0; day < 2; ++day) {
+    drift::Run& log = p.record.day_logs[static_cast<std::size_t>(day)];
+    const double t0 = log.temperature_C(0, 0);
+    log.temperature_C.col(0) = (log.temperature_C.col(0).array() - t0) * 0.05 + t0;
+  }
+  Rng rng(11);  // the readings of the changed logs
+  for (auto& rec : p.record.records) {
+    const std::vector<double> m = PredictRecord(p.truth, p.record, rec);
+    for (std::size_t i = 0; i < rec.rows.size(); ++i)
+      rec.rows[i].value_um = m[i] + 0.5 * rng.Normal();
+  }
+  JointSpec spec;
+  spec.sensors = {"s1", "s2"};
+  const JointFitReport r = FitJoint(p.record, spec, FixedLag());
+  for (int j : {0, 1}) {  // s1 static and lag
+    EXPECT_EQ(r.model.g(j), 0.0) << j;
+    EXPECT_FALSE(r.model.slope_identified[static_cast<std::size_t>(j)]) << j;
+  }
+  EXPECT_TRUE(r.model.slope_identified[2]);
+  // With the coverage rule off the same fit estimates a slope for s1 (the rule is what acts).
+  JointFitOptions off = FixedLag();
+  off.slope_coverage = 0;
+  EXPECT_TRUE(FitJoint(p.record, spec, off).model.slope_identified[0]);
+}
+
 TEST(JointFit, BadRecordsAreInputErrors) {
   Planted p = MakePlanted(false, 9);
   JointSpec spec;

@@ -1,4 +1,4 @@
-// On-line check and recalibration (issue 14, seed 004): the replayed prediction equals the batch
+// On-line check and recalibration (Liu et al.'s patent): the replayed prediction equals the batch
 // prediction, a planted change of coefficients is flagged by the next check and recovered within
 // the noise, the false-alarm rate of a stationary run at 3 and 1 sigma matches the normal tails,
 // the Bayesian update with a very weak prior equals the patent's least-squares refit, a strong

@@ -1,4 +1,4 @@
-// Seed 000's sensitive-point selection: fuzzy equivalence properties, nested lambda-cuts, the F
+// Miao et al.'s sensitive-point selection: fuzzy equivalence properties, nested lambda-cuts, the F
 // statistic and the grey grade against hand-computed examples, planted clusters.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-# libFuzzer harnesses of every loader (issue 17), built only when the compiler is Clang
+# libFuzzer harnesses of every loader, built only when the compiler is Clang
 # (-fsanitize=fuzzer): scripts/fuzz.sh configures such a build in build-fuzz and runs them.
 # The library sources are compiled once more with coverage and ASan/UBSan for the fuzzers
 # (whirl_fuzz_lib, one library of every module's sources), so the normal libraries stay

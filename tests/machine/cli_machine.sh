@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Smoke test of 'whirl machine' (issue 19): sensor files round-trip through 'whirl drift fit /
+# Smoke test of 'whirl machine': sensor files round-trip through 'whirl drift fit /
 # predict', the evaluation runs and its machine-off figures equal the workpiece-only truth,
 # bad input is refused with exit 1 and nothing written, the combined 840D programs are written by
 # the existing combined mode.

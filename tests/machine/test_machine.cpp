@@ -1,4 +1,4 @@
-// Machine thermal errors (issue 19): each component against its closed form, the sensor run files
+// Machine thermal errors: each component against its closed form, the sensor run files
 // against the drift format (the evaluation of both halves: tests/machine_eval).
 #include <gtest/gtest.h>
 #include <unistd.h>

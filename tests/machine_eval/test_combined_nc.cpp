@@ -1,4 +1,4 @@
-// The combined 840D programs of a screw on a simulated drifting machine (issue 19, point 3),
+// The combined 840D programs of a screw on a simulated drifting machine,
 // replayed as the control runs them (tests/interp/nc_replay.h) with the screw's own virtual
 // sensor log on the analog inputs: at every cycle of the cut the control applies the workpiece
 // plan plus the machine's offset and Z-screw line, i.e. what the evaluation's "both" strategy

@@ -101,6 +101,80 @@ drift::Run HandLog(int samples, std::uint64_t seed) {
   return r;
 }
 
+// A planted shop record whose drift follows the time since power-on alone, while four sensors
+// wander independently of it (they carry nothing): per day a log of 300 min (the control's duty
+// columns as ControlDayLog writes them), probe readings at z = 150 mm every 10 min, and on the
+// first two days laser targets at 500, 3000 and 5500 mm; m = 20 w + 3 w (6400 - z) / 1000,
+// w = 1 - exp(-t / 40), 1 um noise, a zero per record.
+drift::ShopRecord SensorsCarryNothing(std::uint64_t seed, int days) {
+  Rng rng(seed);
+  drift::ShopRecord rec;
+  for (int d = 0; d < days; ++d) {
+    drift::Run log;
+    log.name = "day" + std::to_string(d);
+    log.sensor_names = {"s1", "s2", "s3", "s4"};
+    log.other_names = {"power_on", "ring_on", "cutting", "ring_load_pct"};
+    log.temperature_C.resize(301, 4);
+    log.other.resize(301, 4);
+    Eigen::RowVector4d walk(20, 21, 22, 23);
+    const bool cutting = d % 2 == 1;
+    for (int k = 0; k <= 300; ++k) {
+      log.time_min.push_back(k);
+      for (int j = 0; j < 4; ++j) walk(j) += 0.05 * rng.Normal();
+      log.temperature_C.row(k) = walk;
+      const double on = k == 0 ? 0.0 : 1.0;
+      log.other.row(k) << on, on, cutting ? on : 0.0, on * (cutting ? 70.0 : 20.0);
+    }
+    rec.day_logs.push_back(log);
+    std::vector<double> zs = {150};
+    if (d < 2) zs = {150, 500, 3000, 5500};
+    for (double z : zs) {
+      drift::MeasurementRecord r;
+      r.kind = z == 150 ? drift::MeasurementRecord::Kind::kProbe
+                        : drift::MeasurementRecord::Kind::kLaser;
+      r.day = d;
+      r.log = d;
+      const double zero = 50 * rng.Normal();
+      for (int k = 0; k <= 300; k += 10) {
+        const double w = 1 - std::exp(-k / 40.0);
+        const double m = 20 * w + 3 * w * (6400 - z) / 1000;
+        r.rows.push_back({k, double(k), z, m + zero + rng.Normal(), 1.0});
+      }
+      rec.records.push_back(r);
+    }
+  }
+  return rec;
+}
+
+// Where the sensors carry nothing, the shop-trained sensor model is not worse than the warm-up
+// rule in the grouped cross-validation (it can fall back to the sensor-free rules), and on a new
+// day it predicts the drift within 1.5 x the warm-up rule's error + 0.5 um; over 6 random worlds.
+TEST(ShopTraining, WhereSensorsCarryNothingTheSensorModelIsNotWorseThanWarmup) {
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const drift::ShopRecord rec = SensorsCarryNothing(seed, 6);
+    const ShopModels m = FitShopModels(rec, 6400);
+    EXPECT_LE(m.sensors.cv_rmse_um, m.warmup.cv_rmse_um + 1e-9) << "seed " << seed;
+    // A new day of the same world: the error of each model's prediction at z = 1000 mm.
+    const drift::ShopRecord test = SensorsCarryNothing(100 + seed, 1);
+    drift::ShopRecord one = test;
+    one.records = {test.records[1]};  // the laser target at 500 mm
+    auto rms = [&](const drift::JointDriftModel& model) {
+      const std::vector<double> p = drift::PredictRecord(model, one, one.records[0]);
+      // readings carry a zero: compare the rises from the first reading
+      double s = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double w = 1 - std::exp(-one.records[0].rows[i].time_min / 40.0);
+        const double truth = 20 * w + 3 * w * (6400 - 500) / 1000;
+        const double e = (p[i] - p[0]) - truth;
+        s += e * e;
+      }
+      return std::sqrt(s / static_cast<double>(p.size()));
+    };
+    EXPECT_LE(rms(m.sensors), 1.5 * rms(m.warmup) + 0.5)
+        << "seed " << seed << " choice " << m.sensors_choice;
+  }
+}
+
 // No look-ahead: replacing every control sample after i (sensors +5 K, duty doubled) leaves the
 // applied compensation before sample i + 1 exactly unchanged, for random i and times.
 TEST(CausalApplication, TheValueBeforeSampleIPlusOneIgnoresLaterSamples) {

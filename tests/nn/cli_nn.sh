@@ -35,7 +35,7 @@ cmp -s m1.json m2.json || fail "same seed gave different model files"
 grep -q '"termination"' out.txt || fail "train --json lacks termination"
 grep -q '"log_evidence"' out.txt || fail "train --json lacks log_evidence"
 
-# issue 12: hidden size by evidence and brnn's stopping rule by default, --trainbr-matlab = fixed
+# hidden size by evidence and brnn's stopping rule by default, --trainbr-matlab = fixed
 # 5-6-2 trained to MATLAB's criteria, same file for any thread count
 grep -q '"hidden_selection": "hidden size [0-9]* of the highest log evidence' m1.json \
   || fail "default train lacks the evidence hidden-size choice"
@@ -91,7 +91,7 @@ expect 0 "outside the training domain" -- "$whirl" predict --model m1.json --har
 grep -q '"outside_domain": true' out.txt || fail "JSON lacks outside_domain flag"
 grep -q '"diameter_mm"' out.txt || fail "JSON lacks the outside field name"
 grep -q '"max_elongation_std_um"' out.txt || fail "JSON lacks std"
-# many rows outside the domain: ONE summary warning line, the per-row list in --json (issue 12)
+# many rows outside the domain: ONE summary warning line, the per-row list in --json
 printf "hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min\n" > far.csv
 for d in 300 310 320 330 340; do printf "62,$d,10,5,180\n" >> far.csv; done
 printf "62,80,10,5,999\n" >> far.csv
@@ -105,7 +105,7 @@ expect 0 "" -- "$whirl" predict --model m1.json --input far.csv --json
 [ "$(grep -c '"outside_domain": true' out.txt)" -eq 6 ] || fail "JSON lacks per-row flags"
 grep -q '"outside_domain_count": 6' out.txt || fail "JSON lacks outside_domain_count"
 
-# issue 12: targets that do not depend on the inputs (20 rows; inputs and targets uniform random,
+# targets that do not depend on the inputs (20 rows; inputs and targets uniform random,
 # drawn independently: awk 'BEGIN{srand(7); ...}'): the evidence prefers a flat network, and train
 # --family network says so on stderr and in --json; a table with structure gives no warning
 { echo "$H"; cat <<'ROWS'
@@ -139,7 +139,7 @@ expect 0 "" -- "$whirl" train --data "$data" --out m3.json --family network --js
 grep -q '"warnings": \[\]' out.txt || fail "train --json warns on the shipped table"
 ! grep -q "nearly flat" err.txt || fail "train warned about a table with structure"
 
-# issue 12: targets linear in the inputs (20 rows, deterministic; elongation = 2 HRC + 0.5 D - 3 P
+# targets linear in the inputs (20 rows, deterministic; elongation = 2 HRC + 0.5 D - 3 P
 # + 100, settle = 0.8 v + 4 R + 50, +-0.6 of fixed 'noise'): the default's evidence picks the
 # network without a hidden layer (--family network), and predict uses the file (truth at the probe: 190 um, 226 s)
 awk 'BEGIN { print "'"$H"'"; for (i = 0; i < 20; i++) { h = 40 + (i * 7) % 20; d = 20 + (i * 13) % 40;

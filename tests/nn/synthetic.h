@@ -39,7 +39,7 @@ inline TrainingData SmoothProblem(int Q, double noise, std::uint64_t seed) {
   return d;
 }
 
-/// A process table in the paper's ranges (REFERENCE.md section 1) whose targets are a smooth
+/// A process table in the paper's ranges (Li, Ma and Jiang) whose targets are a smooth
 /// function of the inputs plus noise: max elongation ~ 100-200 um, settle time ~ 150-300 s.
 inline ProcessTable SyntheticProcessTable(int Q, double noise, std::uint64_t seed) {
   Rng rng(seed);

@@ -1,4 +1,4 @@
-// TrainOptions::ard (automatic relevance determination, issue 12): inputs the data do not use are
+// TrainOptions::ard (automatic relevance determination, MacKay): inputs the data do not use are
 // switched off and the ARD stage is kept only with a higher evidence; the log evidence and
 // posterior covariance of the ARD stage against an independent recomputation; the grouped
 // evidence reduces to LogEvidence; files round-trip the setting.

@@ -71,7 +71,7 @@ TEST(Model, SaveLoadRoundTripPredictsBitIdentically) {
   EXPECT_EQ(j.at("schema_version"), Model::kSchemaVersion);
 }
 
-// Schema 1 files (one noise level, before issue 11) still load: both outputs get that level.
+// Schema 1 files (one noise level for both outputs) still load: both outputs get that level.
 TEST(Model, SchemaOneFileLoadsWithOneNoiseLevelForBothOutputs) {
   const Model& m = SharedModel();
   nlohmann::json j = m;
@@ -264,7 +264,7 @@ TEST(HiddenSweep, ReportsEveryHiddenSizeWithConsistentNumbers) {
 }
 
 
-// FlatOutputs (issue 12): the collapsed fit predicts one value; the check compares the spread of
+// FlatOutputs: the collapsed fit predicts one value; the check compares the spread of
 // the mean predictions with the spread of the targets over the training rows.
 TEST(FlatOutputs, ConstantNetworkIsFlatInBothOutputsWithHandComputedTargetSd) {
   ProcessTable t = synth::SyntheticProcessTable(4, 0.0, 3);
@@ -349,7 +349,7 @@ TEST(FlatOutputs, CollapsedFitsOfEverySizeAreFlaggedAndHaveTheSameEvidence) {
 }
 
 
-// Default training (issue 12) includes a linear network (no hidden layer) among the sizes by
+// Default training includes a linear network (no hidden layer) among the sizes by
 // evidence: on a table whose targets are linear in the inputs plus noise it has the highest
 // evidence, depends on the inputs, round-trips through the model file and predicts the truth.
 TEST(HiddenByEvidence, LinearTruthGivesTheLinearNetwork) {

@@ -1,4 +1,4 @@
-// Issue 12: restarts, hidden-size sweeps and the stopping/noise folds run through ParallelFor;
+// Restarts, hidden-size sweeps and the stopping/noise folds run through ParallelFor;
 // the results must not depend on the thread count. And the cross-validated stopping rule: its
 // epoch limit is the argmin of the summed held-out curve, and the model is trained with it.
 #include <gtest/gtest.h>
@@ -120,7 +120,7 @@ TEST(HiddenAuto, ChoosesTheCandidateWithTheLowestCrossValidationError) {
 namespace whirl::nn {
 namespace {
 
-// The default training (issue 12): the size of the highest log evidence among the candidates,
+// The default training: the size of the highest log evidence among the candidates,
 // each fit with brnn's rule; the chosen model is the fixed-size fit of that size (before the
 // noise calibration, which uses the same folds), and any thread count gives the same file.
 TEST(HiddenByEvidence, ChoosesTheHighestEvidenceAndIsIdenticalForAnyThreadCount) {

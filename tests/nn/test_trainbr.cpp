@@ -1,4 +1,4 @@
-// trainbr invariants (REFERENCE.md section 2): acceptance rule, gamma range, the first epoch's
+// trainbr invariants (MATLAB's trainbr): acceptance rule, gamma range, the first epoch's
 // updates recomputed independently, stopping reasons, regularization helps on small noisy data,
 // the noise estimate, the log-evidence convention, restarts.
 #include <gtest/gtest.h>
@@ -48,8 +48,8 @@ TEST(TrainBr, AcceptedStepNeverIncreasesFAndGammaStaysInRange) {
   EXPECT_GT(accepted, 0);
 }
 
-// One epoch by hand from the rules of REFERENCE.md section 2, with gamma from the eigenvalues of
-// J'J rather than a matrix inverse.
+// One epoch by hand from trainbr's documented rules (nn/trainbr.h), with gamma from the eigenvalues
+// of J'J rather than a matrix inverse.
 TEST(TrainBr, FirstEpochFollowsTheReferenceRules) {
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     const TrainingData data = synth::SmoothProblem(20, 0.1, 50 + seed);

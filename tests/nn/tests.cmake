@@ -12,6 +12,6 @@ whirl_add_cli_test(cli_nn ${CMAKE_CURRENT_LIST_DIR}/cli_nn.sh)
 # flags (WHIRL_EXACT_OUTPUTS).
 whirl_add_cli_test(nn_default_model ${CMAKE_CURRENT_LIST_DIR}/default_model.sh
                    $<TARGET_FILE:numeric_diff> ${WHIRL_EXACT_OUTPUTS})
-# Issue 11: coverage of the predictive intervals on a generated 200-row hold-out (~10 s).
+# Coverage of the predictive intervals on a generated 200-row hold-out (~10 s).
 whirl_add_gtest(test_calibration SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_calibration.cpp
                 LIBS whirl::sim)

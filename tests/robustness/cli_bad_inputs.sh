@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 17, point 5: every bad input of the sweep is refused with exit 1 and a message naming the
+# Every bad input of the sweep is refused with exit 1 and a message naming the
 # rule, quickly, and leaves no output behind. Args: <whirl> <scratch dir> <source dir>.
 set -u
 W="$1"; D="$2"; SRC="$3"

@@ -1,4 +1,4 @@
-// Physical and resource limits (issue 17): each bad input of the sweep is an InputError naming
+// Physical and resource limits: each bad input of the sweep is an InputError naming
 // the field and the rule, raised before any large allocation or long run; limits hold at their
 // edges; metrics of valid extreme inputs stay finite; multi-file outputs are all-or-nothing.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-# Issue 17: bounded inputs, files a shop can trust. Unit tests of the limits and a CLI sweep of
+# Bounded inputs, files a shop can trust. Unit tests of the limits and a CLI sweep of
 # every bad input the issue lists (each a regression test).
 whirl_add_gtest(test_robustness SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_limits.cpp
                 LIBS whirl::compare)

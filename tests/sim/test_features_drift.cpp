@@ -1,4 +1,4 @@
-// Issue 11, point 3: settle times that survive drift. The features of a recorded curve (sensor
+// Settle times that survive drift. The features of a recorded curve (sensor
 // noise 0.25 um, ambient drift up to 1 K/h, short and whole-thread records) must match those of
 // the SAME screw and workpiece simulated without noise and drift.
 #include <gtest/gtest.h>

@@ -1,5 +1,4 @@
-// Verification of the hard-whirling simulator against closed forms and invariants (issue 3, item
-// 5).
+// Verification of the hard-whirling simulator against closed forms and invariants.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,7 +18,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Quasi-steady moving box source on an infinite fin (REFERENCE 5): the point-source solution
+// Quasi-steady moving box source on an infinite fin (Rosenthal): the point-source solution
 // theta = q / (k A (l1 + l2)) exp(-l1 |xi|) ahead, exp(-l2 |xi|) behind, convolved with the box.
 double ClosedFormBox(double xi_m, double q_w, double w_m, double v, double a, double k, double area,
                      double m2) {
@@ -342,7 +341,7 @@ TEST(Features, SettleTimeOfSyntheticCurvesWithNoiseAndDrift) {
   }
 }
 
-// Property (issue 3: "robust to sensor noise and to slow drift"): over random feasible screws and
+// Property ("robust to sensor noise and to slow drift"): over random feasible screws and
 // seeds, the features of the recorded curve (noise 0.25 um, ambient drift std 0.2 K/h as in
 // `whirl simulate`, four times the tables' 0.05 K/h) match those of the SAME screw and workpiece
 // (same heat-partition and expansion factors) simulated without noise and drift.

@@ -6,7 +6,7 @@ whirl="$1"; D="$2"; src="$3"
 rm -rf "$D"; mkdir -p "$D"; cd "$D"
 source "$src/tests/support/cli_common.sh"
 
-"$whirl" surface --help | grep -c "seed 003" > /dev/null || fail "surface --help"
+"$whirl" surface --help | grep -c "B-spline" > /dev/null || fail "surface --help"
 "$whirl" surface fit --help | grep -c "x_mm,y_mm,error_um" > /dev/null || fail "fit --help"
 "$whirl" surface line --help | grep -c "SD43910" > /dev/null || fail "line --help"
 
@@ -87,7 +87,7 @@ PY
 if command -v gnuplot > /dev/null; then [ -s rep2/map.png ] || fail "no map with a hostile name"; fi
 
 # Bad input: exit 1, the message names the rule; nothing written.
-head -12 smooth.csv > few.csv  # a regular file: whirl reads no FIFOs (issue 17)
+head -12 smooth.csv > few.csv  # a regular file: whirl reads no FIFOs
 expect_fail "distinct positions" "$whirl" surface fit --points few.csv \
   --method cubic --out none.json
 [ ! -e none.json ] || fail "wrote a surface on failure"

@@ -1,4 +1,4 @@
-// LibTorch cross-check of the Eigen network (issue 6). References: nn's analytic results (the
+// LibTorch cross-check of the Eigen network. References: nn's analytic results (the
 // thing under test from the other side), central finite differences, and the closed-form ridge
 // regression minimum of a network without hidden layer. No number here comes from a previous run.
 #include <gtest/gtest.h>

@@ -11,7 +11,7 @@
 
 namespace whirl::test {
 
-/// Q samples drawn uniformly in the paper's ranges (REFERENCE.md section 1) with smooth,
+/// Q samples drawn uniformly in the paper's ranges (Li, Ma and Jiang) with smooth,
 /// mildly nonlinear targets of a plausible size (tens of um, a few hundred s)
 /// plus seeded measurement noise.
 inline ProcessTable SyntheticTable(int samples, std::uint64_t seed) {

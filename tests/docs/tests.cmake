@@ -1,0 +1,4 @@
+# Documentation checks (labels docs, cli): relative links of README.md and docs/*.md resolve, the
+# README stays within 260 lines and names the commands .ci/run relies on (check_docs.sh says how).
+add_test(NAME docs_links COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/check_docs.sh ${PROJECT_SOURCE_DIR})
+set_tests_properties(docs_links PROPERTIES LABELS "docs;cli" TIMEOUT 60)
