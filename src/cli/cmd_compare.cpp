@@ -10,7 +10,7 @@
 #include "compare/report.h"
 #include "core/output_dir.h"
 #include "core/process.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -38,7 +38,7 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
                 {"--history", o.history},
                 {"--iso-table", o.iso_table}},
                {}, {{"--out-dir", o.report_dir}});
-  const nn::Model model = nn::LoadModel(o.model_path);
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
   const sim::Screw screw = sim::ReadScrew(o.screw_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));

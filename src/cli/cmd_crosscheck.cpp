@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/process.h"
 #include "nn/model.h"
+#include "workpiece/model.h"
 #include "torch/crosscheck.h"
 
 namespace whirl::cli {
@@ -27,7 +28,7 @@ struct CrosscheckCliOptions {
 };
 
 void RunCrosscheck(const CrosscheckCliOptions& o) {
-  const nn::Model model = nn::LoadModel(o.model_path);
+  const nn::Model model = workpiece::LoadNetworkModel(o.model_path, "crosscheck");
   const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
   torch::CrosscheckOptions options;
   options.alpha = o.alpha;

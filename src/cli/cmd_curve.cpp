@@ -14,7 +14,7 @@
 #include "core/limits.h"
 #include "core/output_dir.h"
 #include "fit/arctan_curve.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -47,8 +47,8 @@ void Run(const CurveOptions& o) {
                        std::string(o.source.model_path.empty() ? "--screw" : "--model") + ")");
     const sim::Screw screw = sim::ReadScrew(o.source.screw_path);
     const sim::Kinematics kin = sim::ComputeKinematics(screw);
-    const nn::Model model = nn::LoadModel(o.source.model_path);
-    const nn::Prediction pred = nn::Predict(model, screw.process);
+    const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.source.model_path);
+    const workpiece::Prediction pred = workpiece::Predict(model, screw.process);
     GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.source.screw_path,
                         o.source.allow_extrapolation);
     features = pred.mean;

@@ -17,7 +17,7 @@
 #include "core/output_dir.h"
 #include "interp/machine_profile.h"
 #include "machine_eval/machine_eval.h"  // step 7
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -36,8 +36,9 @@ struct DemoOptions {
 
 // 7. The workpiece plan and a machine drift model on a machine that drifts (cmd_machine.cpp).
 // Returns the summary of step 7 for --json.
-nlohmann::json RunDemoMachineStep(const std::filesystem::path& out, const nn::Model& model,
-                                  std::uint64_t seed, std::FILE* say) {
+nlohmann::json RunDemoMachineStep(const std::filesystem::path& out,
+                                  const workpiece::WorkpieceModel& model, std::uint64_t seed,
+                                  std::FILE* say) {
   machine_eval::MachineEvalOptions mo;
   mo.machines = 1;
   mo.screws_per_machine = 2;
@@ -98,22 +99,22 @@ void RunDemo(const DemoOptions& o) {
   const std::string model_path = ProjectPath("models/default.json");
   const std::string train_path = ProjectPath(kHistoryTable);
   const ProcessTable history = ReadProcessTable(train_path, /*require_targets=*/true);
-  nn::Model model;
+  workpiece::WorkpieceModel model;
   std::string model_source;
   if (!o.retrain && fs::exists(model_path)) {
-    model = nn::LoadModel(model_path);
+    model = workpiece::LoadWorkpieceModel(model_path);
     model_source = model_path;
-    std::fprintf(say, "1. model: loaded %s (trained on %d samples of %s)\n", model_path.c_str(),
-                 model.training_samples, model.training_data.c_str());
+    std::fprintf(say, "1. model: loaded %s, %s (trained on %d samples of %s)\n",
+                 model_path.c_str(), model.Describe().c_str(), model.training_samples,
+                 model.training_data.c_str());
   } else {
     if (!o.retrain) Warn(model_path + " not found: training a model from " + train_path);
-    model = nn::TrainModel(history, nn::DefaultTrainingOptions(), train_path);
+    model = workpiece::TrainWorkpieceModel(history, {}, train_path);
     model_source = "trained now from " + train_path;
-    nn::SaveModel(stage / "model.json", model);
+    workpiece::SaveWorkpieceModel(stage / "model.json", model);
     files.AddStaged("model.json");
     std::fprintf(say, "1. model: trained on %zu rows of %s (%s), saved to %s\n",
-                 history.inputs.size(), train_path.c_str(),
-                 model.training_summary.BriefReport().c_str(),
+                 history.inputs.size(), train_path.c_str(), model.Describe().c_str(),
                  (out / "model.json").string().c_str());
   }
 
@@ -248,9 +249,10 @@ void RegisterDemo(CLI::App& app) {
   sub->add_option("--out-dir", o->out_dir,
                   "output directory (default whirl-demo-out): " + std::string(kOutputDirRule) +
                       "; running the demo again replaces its files");
-  sub->add_flag("--retrain", o->retrain, "train the model even if models/default.json exists, with `whirl train`'s\n"
-                "default (linear or hidden size 4/6/8 by log evidence, brnn's stopping rule,\n"
-                "5-fold CV noise)");
+  sub->add_flag("--retrain", o->retrain,
+                "train the model even if models/default.json exists, with `whirl train`'s\n"
+                "default (per output the power law, a linear fit or a Gaussian process, chosen\n"
+                "by cross-validated error; src/workpiece/model.h)");
   AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");
   sub->add_flag("--json", o->json,

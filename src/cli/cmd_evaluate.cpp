@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -56,7 +56,7 @@ void PrintSummary(const compare::EvaluationSummary& m) {
   const auto& abs = m.absolute;
   std::printf(
       "gain breakdown, medians within 1000 mm: curve shape (ramp -> traditional) %.2f um, five "
-      "inputs (traditional -> regression) %.2f um, network over regression %.2f um\n",
+      "inputs (traditional -> regression) %.2f um, model over regression %.2f um\n",
       abs[1].acc1000_median_um - abs[2].acc1000_median_um,
       abs[2].acc1000_median_um - abs[3].acc1000_median_um,
       abs[3].acc1000_median_um - abs[4].acc1000_median_um);
@@ -146,7 +146,7 @@ void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluat
 }
 
 // --scenarios: the sensitivity table (compare/scenarios.h).
-void RunScenarioTable(const EvaluateCliOptions& o, const nn::Model& model,
+void RunScenarioTable(const EvaluateCliOptions& o, const workpiece::WorkpieceModel& model,
                       const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
                       const sim::Screw& base, const compare::EvaluateOptions& eo) {
   compare::ScenarioOptions so;
@@ -180,7 +180,7 @@ void RunScenarioTable(const EvaluateCliOptions& o, const nn::Model& model,
 }
 
 void RunEvaluate(const EvaluateCliOptions& o) {
-  const nn::Model model = nn::LoadModel(o.model_path);
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);

@@ -11,6 +11,7 @@
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "nn/model.h"
+#include "workpiece/model.h"
 #include "torch/crosscheck.h"
 
 namespace whirl::cli {
@@ -24,7 +25,7 @@ struct ExportCliOptions {
 
 void RunExport(const ExportCliOptions& o) {
   CheckOutputs({{"--model", o.model_path}}, {{"--torchscript", o.torchscript_path}});
-  const nn::Model model = nn::LoadModel(o.model_path);
+  const nn::Model model = workpiece::LoadNetworkModel(o.model_path, "export");
   torch::ExportOptions options;
   options.description = "whirl elongation-feature model exported by 'whirl export --model " +
                         o.model_path + "' (" + torch::TorchVersion() +

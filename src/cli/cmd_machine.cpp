@@ -19,7 +19,7 @@
 #include "machine/machine.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/seeds.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -84,7 +84,7 @@ void RunSensors(const MachineCliOptions& o) {
 }
 
 // --seeds N > 1: the evaluation over seeds S..S+N-1 (machine_eval/seeds.h).
-void RunOverSeeds(const MachineCliOptions& o, const sim::Screw& base, const nn::Model& model,
+void RunOverSeeds(const MachineCliOptions& o, const sim::Screw& base, const workpiece::WorkpieceModel& model,
                   const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
                   const machine_eval::MachineEvalOptions& eo) {
   Progress progress("machine evaluate",
@@ -110,7 +110,7 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
                 {"--iso-table", o.iso_table},
                 {"--profile", o.profile}},
                {}, {{"--out-dir", o.report}});
-  const nn::Model model = nn::LoadModel(o.model_path);
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);

@@ -16,7 +16,7 @@
 #include "fit/arctan_curve.h"
 #include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::cli {
@@ -142,8 +142,8 @@ void Run(const PlanCliOptions& o) {
   compare::PlanSource plan_source;
   std::string source;
   if (!by_features) {
-    const nn::Model model = nn::LoadModel(o.source.model_path);
-    const nn::Prediction pred = nn::Predict(model, screw.process);
+    const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.source.model_path);
+    const workpiece::Prediction pred = workpiece::Predict(model, screw.process);
     GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.source.screw_path,
                         o.source.allow_extrapolation);
     plan_source = {o.source.model_path, pred, pred.mean};

@@ -1,5 +1,5 @@
-// whirl predict: elongation features with Laplace standard deviations from a trained model
-// (src/nn/model.h).
+// whirl predict: elongation features with standard deviations from a workpiece model
+// (src/workpiece/model.h; the figures in src/workpiece/prediction_report.h).
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -14,7 +14,7 @@
 #include "core/limits.h"
 #include "core/output_dir.h"
 #include "core/process.h"
-#include "nn/model.h"
+#include "workpiece/prediction_report.h"
 
 namespace whirl::cli {
 namespace {
@@ -59,110 +59,29 @@ void Run(const PredictOptions& o) {
     table.inputs.push_back(ProcessInputs::FromArray(single));
     CheckProcessInputs(table.inputs.back(), "predict flags");
   }
-  const nn::Model model = nn::LoadModel(o.model_path);
-  const std::vector<nn::Prediction> pred = nn::PredictBatch(model, table.inputs);
-  const bool have_targets = table.targets.size() == table.inputs.size() && !table.targets.empty();
-
-  const nn::OutsideDomainSummary outside_summary = nn::SummarizeOutsideDomain(model, pred);
-  const int outside = outside_summary.rows;
-  if (outside > 0) {
+  const workpiece::TablePrediction p =
+      workpiece::PredictTable(workpiece::LoadWorkpieceModel(o.model_path), table);
+  if (p.outside.rows > 0) {
     const std::string first =
         o.input_path.empty() ? std::string("the process")
                              : o.input_path + " line " +
-                                   std::to_string(table.line_numbers[outside_summary.first_row]);
-    Warn(outside_summary.Describe(static_cast<int>(pred.size()), first) +
+                                   std::to_string(table.line_numbers[p.outside.first_row]);
+    Warn(p.outside.Describe(static_cast<int>(p.predictions.size()), first) +
          " (the predictions extrapolate; their standard deviations may understate the error; "
          "--json lists the inputs of every row)");
   }
-
-  if (!o.out_path.empty()) {
-    std::vector<std::string> header(kInputColumns.begin(), kInputColumns.end());
-    for (const char* c : {"max_elongation_um", "max_elongation_std_um", "settle_time_s",
-                          "settle_time_std_s", "outside_domain"})
-      header.push_back(c);
-    std::vector<std::vector<double>> rows;
-    for (std::size_t q = 0; q < pred.size(); ++q) {
-      const auto a = table.inputs[q].ToArray();
-      std::vector<double> row(a.begin(), a.end());
-      row.insert(row.end(), {pred[q].mean.max_elongation_um, pred[q].stddev.max_elongation_um,
-                             pred[q].mean.settle_time_s, pred[q].stddev.settle_time_s,
-                             pred[q].outside_domain ? 1.0 : 0.0});
-      rows.push_back(std::move(row));
-    }
-    WriteFileAtomic(o.out_path,
-                    FormatCsv(header, rows,
-                              {"whirl predict --model " + o.model_path +
-                                   (o.input_path.empty() ? "" : " --input " + o.input_path),
-                               "std = Laplace predictive standard deviation (noise + weights), "
-                               "outside_domain = 1 if an input is outside the training domain"}));
-  }
-
-  if (o.json) {
-    nlohmann::json rows = nlohmann::json::array();
-    double sq_e = 0, sq_t = 0;
-    for (std::size_t q = 0; q < pred.size(); ++q) {
-      nlohmann::json inputs;
-      const auto a = table.inputs[q].ToArray();
-      for (int i = 0; i < ProcessInputs::kCount; ++i) inputs[kInputColumns[i]] = a[i];
-      nlohmann::json r = {{"inputs", inputs},
-                          {"max_elongation_um", pred[q].mean.max_elongation_um},
-                          {"max_elongation_std_um", pred[q].stddev.max_elongation_um},
-                          {"settle_time_s", pred[q].mean.settle_time_s},
-                          {"settle_time_std_s", pred[q].stddev.settle_time_s},
-                          {"outside_domain", pred[q].outside_domain},
-                          {"outside_domain_fields", pred[q].outside_domain_fields}};
-      if (have_targets) {
-        const double de = pred[q].mean.max_elongation_um - table.targets[q].max_elongation_um;
-        const double dt = pred[q].mean.settle_time_s - table.targets[q].settle_time_s;
-        r["error"] = {{"max_elongation_um", de}, {"settle_time_s", dt}};
-        sq_e += de * de;
-        sq_t += dt * dt;
-      }
-      rows.push_back(r);
-    }
-    nlohmann::json j = {
-        {"model", o.model_path}, {"predictions", rows}, {"outside_domain_count", outside}};
-    if (have_targets) {
-      const double n = static_cast<double>(pred.size());
-      j["rms_error"] = {{"max_elongation_um", std::sqrt(sq_e / n)},
-                        {"settle_time_s", std::sqrt(sq_t / n)}};
-    }
-    PrintJson(j);
-    return;
-  }
-
-  std::printf("%4s %8s %8s %7s %8s %9s | %22s | %18s | %s\n", "row", "HRC", "D [mm]", "P [mm]",
-              "R [mm]", "v [m/min]", "max elongation [um]", "settle time [s]", "domain");
-  double ape_e = 0, ape_t = 0;
-  int n_e = 0, n_t = 0;  // a zero target has no percentage error: left out, never a division by 0
-  for (std::size_t q = 0; q < pred.size(); ++q) {
-    const auto& in = table.inputs[q];
-    const auto& p = pred[q];
-    std::printf("%4zu %8.4g %8.4g %7.4g %8.4g %9.4g | %10.5g +- %-8.3g | %8.5g +- %-6.3g | %s\n",
-                q + 1, in.hardness_hrc, in.diameter_mm, in.pitch_mm, in.raceway_radius_mm,
-                in.cutting_speed_m_min, p.mean.max_elongation_um, p.stddev.max_elongation_um,
-                p.mean.settle_time_s, p.stddev.settle_time_s, p.outside_domain ? "OUTSIDE" : "in");
-    if (have_targets) {
-      const Features& t = table.targets[q];
-      if (t.max_elongation_um > 0) {
-        ape_e += std::abs(p.mean.max_elongation_um - t.max_elongation_um) / t.max_elongation_um;
-        ++n_e;
-      }
-      if (t.settle_time_s > 0) {
-        ape_t += std::abs(p.mean.settle_time_s - t.settle_time_s) / t.settle_time_s;
-        ++n_t;
-      }
-    }
-  }
-  std::printf("(+- one predictive standard deviation, Laplace approximation)\n");
-  if (have_targets) {
-    std::printf(
-        "targets in %s: mean absolute error %.3g %% (max elongation, %d rows with a target > 0), "
-        "%.3g %% (settle time, %d rows)\n",
-        o.input_path.c_str(), n_e > 0 ? 100 * ape_e / n_e : 0.0, n_e,
-        n_t > 0 ? 100 * ape_t / n_t : 0.0, n_t);
-  }
-  if (!o.out_path.empty()) std::printf("written: %s\n", o.out_path.c_str());
+  if (!o.out_path.empty())
+    workpiece::WritePredictionCsv(
+        o.out_path, table, p,
+        {"whirl predict --model " + o.model_path +
+             (o.input_path.empty() ? "" : " --input " + o.input_path),
+         "std = predictive standard deviation (noise + model uncertainty), "
+         "outside_domain = 1 if an input is outside the training domain"});
+  if (o.json)
+    PrintJson(workpiece::PredictionJson(table, p, o.model_path));
+  else
+    std::cout << workpiece::FormatPredictionTable(table, p, o.input_path);
+  if (!o.json && !o.out_path.empty()) std::cout << "written: " << o.out_path << "\n";
 }
 
 }  // namespace
@@ -173,8 +92,9 @@ void RegisterPredict(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "predict",
       "Predict the two elongation features of hard whirling - maximum elongation of the\n"
-      "unmachined section [um] and settle time [s] - each with a standard deviation from the\n"
-      "Laplace approximation of the Bayesian network (noise plus weight uncertainty).\n"
+      "unmachined section [um] and settle time [s] - each with a predictive standard deviation\n"
+      "(noise plus model uncertainty: the network's Laplace approximation, or the chosen\n"
+      "family's, calibrated by cross-validation; src/workpiece/model.h).\n"
       "Inputs outside the training domain get a warning on stderr and a flag in the output.\n"
       "Give either --input CSV (columns hardness_hrc, diameter_mm, pitch_mm,\n"
       "raceway_radius_mm, cutting_speed_m_min; if max_elongation_um and settle_time_s are\n"

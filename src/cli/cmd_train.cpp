@@ -1,5 +1,7 @@
-// whirl train: fit the Bayesian-regularized network (src/nn/trainbr.h) to a process table, or
-// sweep the hidden size with k-fold cross-validation (src/nn/selection.h).
+// whirl train: fit the workpiece model (src/workpiece/model.h) to a process table: by default the
+// family choice by cross-validated error (src/family/family.h), or the Bayesian-regularized network
+// (src/nn/trainbr.h); or sweep the network's hidden size with k-fold cross-validation
+// (src/nn/selection.h).
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "core/process.h"
 #include "nn/model.h"
 #include "nn/selection.h"
+#include "workpiece/model.h"
 
 namespace whirl::cli {
 namespace {
@@ -38,6 +41,9 @@ struct TrainCliOptions {
   int noise_folds = 5;
   int threads = 0;
   bool json = false;
+  std::string family;     // empty: not given
+  std::string transform;  // empty: not given
+  std::string network_flags;  // the network-only flags given, " --hidden --ard"
 };
 
 constexpr int kMaxHidden = 200;  // neurons in the hidden layer (--hidden, --hidden-sweep)
@@ -183,6 +189,64 @@ void PrintModelSummary(const TrainCliOptions& o, const nn::Model& model, std::si
   }
 }
 
+// --family and --transform with the network-only flags: a network flag without --family means
+// --family network; with another family it is refused; --transform defaults to identity for a
+// network (the network of earlier versions), auto otherwise.
+workpiece::TrainOptions WorkpieceOptions(const TrainCliOptions& o) {
+  workpiece::TrainOptions w;
+  w.family = o.family.empty() ? (o.network_flags.empty() ? workpiece::FamilyFlag::kAuto
+                                                         : workpiece::FamilyFlag::kNetwork)
+                              : workpiece::ParseFamilyFlag(o.family);
+  const bool network = w.family == workpiece::FamilyFlag::kNetwork;
+  if (!network && !o.network_flags.empty())
+    throw InputError("train:" + o.network_flags + ": options of the network; they need --family " +
+                     "network (got --family " + o.family + ")");
+  w.transform = o.transform.empty() ? (network ? workpiece::TransformFlag::kIdentity
+                                               : workpiece::TransformFlag::kAuto)
+                                    : workpiece::ParseTransformFlag(o.transform);
+  if (!o.network_flags.empty() && w.transform != workpiece::TransformFlag::kIdentity)
+    throw InputError("train:" + o.network_flags + ": options of the network on raw columns; " +
+                     "they exclude --transform " + o.transform +
+                     " (a network on log columns is a family candidate with its defaults)");
+  if (network) w.network = ModelOptions(o);
+  w.choice.fit.seed = o.seed;
+  w.choice.fit.threads = o.threads;
+  return w;
+}
+
+// A family choice: train, save and print what was chosen with the CV table.
+void RunFamily(const TrainCliOptions& o, const ProcessTable& table,
+               const workpiece::TrainOptions& w) {
+  const auto start = std::chrono::steady_clock::now();
+  const workpiece::WorkpieceModel model = workpiece::TrainWorkpieceModel(
+      table, w, std::filesystem::path(o.data_path).filename().string());
+  const double fit_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  workpiece::SaveWorkpieceModel(o.out_path, model);
+  const family::ChoiceOptions& c = w.choice;
+  if (o.json) {
+    PrintJson({{"model", o.out_path},
+               {"kind", "family"},
+               {"chosen", model.Describe()},
+               {"folds", c.folds},
+               {"cv_table", model.choice.table},
+               {"calibration", model.choice.models.front().calibration},
+               {"fit_time_ms", fit_ms}});
+    return;
+  }
+  std::cout << "model " << o.out_path << ": " << model.Describe() << "; " << table.inputs.size()
+            << " samples from " << o.data_path << "\n";
+  std::cout << "  chosen per output by cross-validated error ("
+            << (c.closed_form_loo ? "closed-form leave-one-out for linear and GP fits, "
+                                  : "")
+            << c.folds << "-fold refits" << (c.closed_form_loo ? " for networks" : "") << ")"
+            << (c.one_standard_error ? ", the simplest within one standard error" : "")
+            << "; cross-validated RMSE in um and s, score = sum of MSE / variance:\n"
+            << workpiece::FormatChoiceTable(model.choice);
+  std::cout << "  sd: " << model.choice.models.front().calibration << "\n";
+  std::cout << "  fit time " << FormatSignificant(fit_ms, 4) << " ms (choice, refits, calibration)\n";
+}
+
 void Run(const TrainCliOptions& o) {
   CheckOutputs({{"--data", o.data_path}}, {{"--out", o.out_path}});
   const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
@@ -192,7 +256,13 @@ void Run(const TrainCliOptions& o) {
   }
   if (o.out_path.empty())
     throw InputError("train: --out MODEL.json is required (or use --hidden-sweep)");
-  const nn::ModelTrainOptions opt = ModelOptions(o);
+  const workpiece::TrainOptions w = WorkpieceOptions(o);
+  if (w.family != workpiece::FamilyFlag::kNetwork ||
+      w.transform != workpiece::TransformFlag::kIdentity) {
+    RunFamily(o, table, w);
+    return;
+  }
+  const nn::ModelTrainOptions& opt = w.network;
   const auto start = std::chrono::steady_clock::now();
   // At most epochs per stage and restart (ARD adds a second stage). Restarts run in parallel and
   // report out of order (one at a time: TrainBrRestarts serializes the callback), so the bar
@@ -201,7 +271,7 @@ void Run(const TrainCliOptions& o) {
                             static_cast<std::size_t>(std::max(o.epochs, 1)) * (o.ard ? 2 : 1);
   Progress progress("train", total);
   std::size_t epochs_done = 0;
-  const nn::Model model = nn::TrainModel(
+  const nn::Model model = nn::TrainModel(  // = workpiece::TrainWorkpieceModel for a network
       table, opt, std::filesystem::path(o.data_path).filename().string(),
       [&](int restart, const nn::EpochInfo& info) {
         progress.Update(++epochs_done, "restart " + std::to_string(restart + 1) + "/" +
@@ -239,14 +309,20 @@ void Run(const TrainCliOptions& o) {
 
 // The subcommand's description in --help: what it trains, the default, the table's columns.
 std::string TrainDescription() {
-  return "Train the Bayesian-regularized network (MATLAB trainbr: Levenberg-Marquardt with\n"
-         "MacKay's alpha/beta re-estimation, errors in the mapminmax-normalized target space)\n"
-         "on a process table and write a model file (JSON), or sweep the hidden size.\n"
-         "Default: no hidden layer (linear) or 4, 6 or 8 hidden neurons by the\n"
-         "highest log evidence, each fit stopped by R brnn's rule (--change 0.001),\n"
-         "per-output noise by 5-fold cross-validation; about 10 ms for 20 rows, 70 ms for\n"
-         "100 rows (one thread). A warning says when the network ignores its inputs.\n"
-         "--trainbr-matlab: the paper's 5-6-2 trained to MATLAB's own criteria.\n"
+  return "Train the workpiece model on a process table and write a model file (JSON).\n"
+         "Default (no model options): per output the candidate with the lowest cross-\n"
+         "validated (closed-form leave-one-out) error among the power law (least squares on\n"
+         "log columns), a linear fit and a Gaussian process (ARD Matern 5/2, on log or raw\n"
+         "columns), the simplest within one standard error; prints the choice and the CV\n"
+         "table (src/family/family.h); sd calibrated by 5-fold cross-validation.\n"
+         "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
+         "--family network (implied by any network option below, raw columns unless\n"
+         "--transform says otherwise): the Bayesian-regularized network (MATLAB trainbr:\n"
+         "Levenberg-Marquardt with MacKay's alpha/beta re-estimation); no hidden layer or 4, 6\n"
+         "or 8 hidden neurons by the highest log evidence, brnn's stopping rule (--change\n"
+         "0.001), per-output noise by 5-fold cross-validation. A warning says when the network\n"
+         "ignores its inputs. --trainbr-matlab: the paper's 5-6-2 trained to MATLAB's own\n"
+         "criteria. --hidden-sweep: the network's hidden-size sweep instead of a model.\n"
          "Table: CSV with a header row and columns hardness_hrc [HRC], diameter_mm [mm],\n"
          "pitch_mm [mm], raceway_radius_mm [mm], cutting_speed_m_min [m/min] (inputs) and\n"
          "max_elongation_um [um], settle_time_s [s] (targets); '#' lines are comments.\n"
@@ -323,8 +399,30 @@ void RegisterTrain(CLI::App& app) {
       ->capture_default_str()
       ->check(NumberIn(0, 256));
   sub->add_flag("--json", o->json, "machine output: JSON summary on stdout");
+  sub->add_option("--family", o->family,
+                  "auto (default): the family choice by cross-validated error; network: the\n"
+                  "Bayesian-regularized network; gp: a Gaussian process (ARD Matern 5/2);\n"
+                  "linear: least squares (on log columns a power law)")
+      ->check(CLI::IsMember({"auto", "network", "gp", "linear"}));
+  sub->add_option("--transform", o->transform,
+                  "log: every strictly positive column (all inputs and targets of a valid\n"
+                  "table) on a log scale (a linear fit becomes a power law); identity: raw\n"
+                  "columns; auto: both, chosen by cross-validated error. Default auto, for\n"
+                  "--family network identity")
+      ->check(CLI::IsMember({"auto", "log", "identity"}));
   out->excludes(sweep);
-  sub->callback([o] { Run(*o); });
+  // The flags that only the network has (they imply --family network).
+  std::vector<CLI::Option*> network_options;
+  for (const char* name : {"--hidden", "--restarts", "--epochs", "--hidden-sweep", "--folds",
+                           "--trainbr-matlab", "--ard", "--stop-by-cv", "--change",
+                           "--noise-folds"})
+    network_options.push_back(sub->get_option(name));
+  sub->callback([o, network_options] {
+    o->network_flags.clear();
+    for (const CLI::Option* opt : network_options)
+      if (opt->count() > 0) o->network_flags += " " + opt->get_name();
+    Run(*o);
+  });
 }
 
 }  // namespace whirl::cli

@@ -173,7 +173,7 @@ void CutWithEveryStrategy(const std::array<CompensationFunction, kStrategyCount>
 
 }  // namespace
 
-ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
+ScrewComparison CompareScrew(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                              const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                              const CompareOptions& options) {
   ScrewComparison c;
@@ -184,7 +184,8 @@ ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
   SimulateTruth(screw, options, &c);
 
   // Model: prediction -> arctangent curve -> 840D plan.
-  c.prediction = nn::Predict(model, screw.process);
+  c.prediction = workpiece::Predict(model, screw.process);
+  c.model_description = model.Describe();
   c.predicted_curve =
       fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k, options.time_exponent);
   c.predicted_curve.Validate("predicted curve of screw '" + screw.name + "'");
@@ -261,7 +262,8 @@ void to_json(nlohmann::json& j, const ScrewComparison& c) {
                        {"max_elongation_um", c.truth_features.max_elongation_um},
                        {"settle_time_s", c.truth_features.settle_time_s}}},
                      {"prediction",
-                      {{"max_elongation_um", c.prediction.mean.max_elongation_um},
+                      {{"model", c.model_description},
+                       {"max_elongation_um", c.prediction.mean.max_elongation_um},
                        {"settle_time_s", c.prediction.mean.settle_time_s},
                        {"max_elongation_std_um", c.prediction.stddev.max_elongation_um},
                        {"settle_time_std_s", c.prediction.stddev.settle_time_s},

@@ -8,7 +8,7 @@
 //                chosen by leave-one-out on the history, never on the screw being cut) ->
 //                arctangent curve -> 840D plan (as model)
 //   regression   log-linear least squares on the history -> arctangent curve -> 840D plan
-//   model        nn::Predict -> fit::ArctanCurve::FromFeatures -> interp::BuildPlan with the
+//   model        workpiece::Predict -> fit::ArctanCurve::FromFeatures -> interp::BuildPlan with the
 //                screw's kinematics -> c(t) = interp::AppliedCompensationUm(plan, P(t)), i.e. the
 //                value the 840D reconstructs from SD43900/SD43910/SD43920 at the axis position
 //                P(t) = interp::AxisPositionMm(plan options, feed, t).
@@ -34,7 +34,7 @@
 #include "compare/traditional.h"
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
 
@@ -101,7 +101,8 @@ struct ScrewComparison {
   /// Features of the recorded (noisy) truth over the training table's window
   /// (sim::DatasetOptions::window_s, 1800 s) or the whole cut if shorter: what the model learns.
   Features truth_features;
-  nn::Prediction prediction;  ///< model prediction for the screw's five inputs
+  workpiece::Prediction prediction;  ///< model prediction for the screw's five inputs
+  std::string model_description;     ///< workpiece::WorkpieceModel::Describe() of the model
   fit::ArctanCurve predicted_curve;
   interp::CompensationPlan plan;
   ExperienceClass experience_class;  ///< the traditional rule's class of this screw
@@ -126,7 +127,7 @@ struct ScrewComparison {
 
 /// Runs the comparison for one screw. InputError for an infeasible screw, invalid options, or a
 /// plan the control cannot run (slope beyond MD32760).
-ScrewComparison CompareScrew(const sim::Screw& screw, const nn::Model& model,
+ScrewComparison CompareScrew(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                              const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                              const CompareOptions& options = {});
 

@@ -68,7 +68,7 @@ ReductionStats Stats(std::vector<double> values) {
   return s;
 }
 
-Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model& model,
+Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const workpiece::WorkpieceModel& model,
                           const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                           const EvaluateOptions& options, const EvaluateProgress& progress) {
   if (options.threads < 1)

@@ -88,7 +88,7 @@ using EvaluateProgress = std::function<void(std::size_t done, std::size_t total)
 /// for any thread count). A screw whose comparison throws InputError is recorded as failed; any
 /// other exception (in a comparison or in `progress`) stops the run and is rethrown here after all
 /// threads have joined (core/parallel.h), never std::terminate.
-Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const nn::Model& model,
+Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const workpiece::WorkpieceModel& model,
                           const ExperienceRule& rule, const IsoToleranceTable& iso_table,
                           const EvaluateOptions& options, const EvaluateProgress& progress = {});
 

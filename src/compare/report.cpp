@@ -184,7 +184,8 @@ std::string MetricsTable(const ScrewComparison& c) {
     << "); class: diameter-class means; table: the experience table; nearest: the 3 nearest past "
        "screws; regression: log-linear least squares of both features on the five inputs. All "
        "but none and ramp use the model's curve shape and the same 840D planning; model: the "
-       "network's prediction. \"model vs it\" = 100 (1 - model / it).</p>\n";
+       "workpiece model, "
+    << HtmlEscape(c.model_description) << ". \"model vs it\" = 100 (1 - model / it).</p>\n";
   return h.str();
 }
 

@@ -91,7 +91,7 @@ std::vector<sim::Screw> ScenarioScrews(const Scenario& scenario, const sim::Scre
 }
 
 std::vector<ScenarioResult> RunScenarios(const std::vector<Scenario>& scenarios,
-                                         const sim::Screw& base, const nn::Model& model,
+                                         const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                          const ExperienceRule& rule,
                                          const IsoToleranceTable& iso_table,
                                          const ScenarioOptions& options,

@@ -65,7 +65,7 @@ struct ScenarioOptions {
 /// Runs every scenario (same screws for the in-range scenarios at a seed, so their rows differ
 /// only by the disturbance levels).
 std::vector<ScenarioResult> RunScenarios(const std::vector<Scenario>& scenarios,
-                                         const sim::Screw& base, const nn::Model& model,
+                                         const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                          const ExperienceRule& rule,
                                          const IsoToleranceTable& iso_table,
                                          const ScenarioOptions& options,

@@ -184,4 +184,20 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
 std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
                                             const std::vector<ProcessInputs>& inputs);
 
+// JSON (family_file.cpp), the part of the workpiece model file (workpiece/model.h) that holds a
+// family choice. Doubles are written with round-trip precision, so a reloaded choice predicts
+// bit-identically. from_json checks every key (names, sizes, finiteness, indices; a GP is
+// refactorized) and throws InputError naming the key and the rule.
+//   FamilyModel: {"candidate": Candidate::Name(), "transform", "calibration",
+//                 "linears" | "gps" | "network": one fit per output (a network: nn/model.h)}
+//   CvRow:       {"candidate", "cv_rmse" (per output, original units), "score", "fit_ms"}
+//   Choice:      {"describe": Describe(), "table": [CvRow], "chosen", "model_of_output",
+//                 "models": [FamilyModel]}; the model of output k must be the candidate chosen
+//                 for it.
+void to_json(nlohmann::json& j, const FamilyModel& m);
+void from_json(const nlohmann::json& j, FamilyModel& m);
+void from_json(const nlohmann::json& j, CvRow& r);
+void to_json(nlohmann::json& j, const Choice& c);
+void from_json(const nlohmann::json& j, Choice& c);
+
 }  // namespace whirl::family

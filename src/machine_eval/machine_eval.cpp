@@ -156,7 +156,7 @@ ToolPath PathOf(const sim::Kinematics& k, const machine::MachineDay& day) {
 
 // The workpiece's comparison on this machine's day. One hall: with the machine's ambient
 // component on, the blank follows the day's ambient ramp, the one the bed follows.
-compare::ScrewComparison CompareOnDay(const sim::Screw& screw, const nn::Model& model,
+compare::ScrewComparison CompareOnDay(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                                       const compare::ExperienceRule& rule,
                                       const compare::IsoToleranceTable& iso_table,
                                       const machine::MachineDay& day,
@@ -324,7 +324,7 @@ void ScoreStrategies(
 
 }  // namespace
 
-MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
+MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
                                         const compare::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
@@ -409,7 +409,7 @@ Machines FitMachines(const MachineEvalOptions& options) {
 // Screw k is cut on machine k / screws_per_machine, on its own day, with its own truth seed; a
 // screw whose comparison fails is kept with its error.
 std::vector<MachineEvalScrew> EvaluateScrewsOnMachines(
-    const std::vector<sim::Screw>& screws, const Machines& machines, const nn::Model& model,
+    const std::vector<sim::Screw>& screws, const Machines& machines, const workpiece::WorkpieceModel& model,
     const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso_table,
     const MachineEvalOptions& options, const compare::EvaluateProgress& progress) {
   const std::size_t per = static_cast<std::size_t>(options.screws_per_machine);
@@ -442,7 +442,7 @@ std::vector<MachineEvalScrew> EvaluateScrewsOnMachines(
 // the combined programs for options.profile; a profile that does not fit the machine leaves the
 // programs out with a note (the evaluation stands).
 void WriteFirstScrewReport(const sim::Screw& screw, const Machines& machines,
-                           const nn::Model& model, const compare::ExperienceRule& rule,
+                           const workpiece::WorkpieceModel& model, const compare::ExperienceRule& rule,
                            const compare::IsoToleranceTable& iso_table,
                            const MachineEvalOptions& options, MachineEvaluation* e) {
   const machine::MachineDay day =
@@ -470,7 +470,7 @@ void WriteFirstScrewReport(const sim::Screw& screw, const Machines& machines,
 
 }  // namespace
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
+MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
                                        const compare::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,

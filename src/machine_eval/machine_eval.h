@@ -22,7 +22,7 @@
 //   Control: Siemens, SINUMERIK 840D Function Manual Extended Functions, K3 (temperature
 //     compensation, SD43900-43920; interp/sinumerik.h, interp/drift_action.h).
 //
-// Inputs and units: the network model (nn/model.h), the traditional rule's history and the ISO
+// Inputs and units: the workpiece model (workpiece/model.h), the traditional rule's history and the ISO
 // 3408-3 table (compare/), a base screw (its blank and machine settings; the screws are drawn
 // around it, compare/evaluate.h RandomFeasibleScrews), the machine (machine/machine.h: a JSON file
 // or machine::DefaultMachine()), and MachineEvalOptions below. Times in s or min as named, lengths
@@ -193,7 +193,7 @@ struct MachineScrewDetail {
 };
 
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
-MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model& model,
+MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
                                         const compare::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
@@ -201,7 +201,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const nn::Model
                                         double monitor_every_min = 30,
                                         MachineScrewDetail* detail = nullptr);
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const nn::Model& model,
+MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
                                        const compare::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,

@@ -8,7 +8,7 @@
 
 namespace whirl::machine_eval {
 
-SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const nn::Model& model,
+SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::WorkpieceModel& model,
                                   const compare::ExperienceRule& rule,
                                   const compare::IsoToleranceTable& iso_table,
                                   const MachineEvalOptions& options, int seeds,

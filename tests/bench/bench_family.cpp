@@ -4,6 +4,9 @@
 //                              cross-validated choice, then the chosen candidates' fits and
 //                              calibration); the speed target of the default is 2.5 ms CPU for
 //                              20 rows, both outputs;
+//   BM_WorkpieceDefault/rows:R  workpiece::TrainWorkpieceModel with its defaults: what `whirl
+//                              train` with no model options fits (the family choice above with
+//                              closed-form leave-one-out, plus the model's domain);
 //   BM_FamilyCandidate/rows:R/candidate:C   FitCandidate of DefaultCandidates()[C] (with its
 //                              calibration; no choice);
 //   BM_TrainbrSingleFit/rows:R one nn::TrainModel of 5-6-2 with R brnn's stopping rule, no size
@@ -15,6 +18,7 @@
 #include "core/process.h"
 #include "family/family.h"
 #include "nn/model.h"
+#include "workpiece/model.h"
 
 namespace {
 
@@ -43,6 +47,18 @@ BENCHMARK(BM_FamilyDefault)
     ->ArgNames({"rows", "loo"})
     ->ArgsProduct({{20, 100}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
+
+void BM_WorkpieceDefault(benchmark::State& state) {
+  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
+  whirl::workpiece::TrainOptions o;
+  o.choice.fit.threads = 1;
+  for (auto _ : state) {
+    const whirl::workpiece::WorkpieceModel m =
+        whirl::workpiece::TrainWorkpieceModel(table, o, "bench");
+    benchmark::DoNotOptimize(m.domain_max);
+  }
+}
+BENCHMARK(BM_WorkpieceDefault)->ArgName("rows")->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
 
 void BM_FamilyCandidate(benchmark::State& state) {
   const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));

@@ -116,7 +116,7 @@ class ShippedModel : public ::testing::Test {
 };
 
 TEST_F(ShippedModel, ReferenceScrewComparisonIsConsistent) {
-  const nn::Model model = nn::LoadModel(model_path_);
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(model_path_);
   const ExperienceRule rule = BuildExperienceRule(ReadProcessTable(history_path_, true));
   const IsoToleranceTable iso =
       ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");

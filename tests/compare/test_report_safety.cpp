@@ -28,11 +28,11 @@ class ShippedModelReport : public ::testing::Test {
     const fs::path history = kSource / "datasets/whirling_train.csv";
     ASSERT_TRUE(fs::exists(model)) << model << " not shipped";
     ASSERT_TRUE(fs::exists(history)) << history << " not shipped";
-    model_ = nn::LoadModel(model);
+    model_ = workpiece::LoadWorkpieceModel(model);
     rule_ = BuildExperienceRule(ReadProcessTable(history, true));
     iso_ = ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
   }
-  nn::Model model_;
+  workpiece::WorkpieceModel model_;
   ExperienceRule rule_;
   IsoToleranceTable iso_;
 };

@@ -15,14 +15,15 @@
 #include "machine/machine.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/machine_report.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::machine_eval {
 namespace {
 
 struct Fixture {
-  nn::Model model = nn::LoadModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
+  workpiece::WorkpieceModel model =
+      workpiece::LoadWorkpieceModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
   compare::ExperienceRule rule = compare::BuildExperienceRule(
       ReadProcessTable(std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_500.csv", true));
   compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(

@@ -14,7 +14,7 @@
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/seeds.h"
 #include "machine_eval/strategies.h"
-#include "nn/model.h"
+#include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::machine_eval {
@@ -216,7 +216,8 @@ TEST(LegacyWorld, ReproducesTheTableOfThePreviousProgram) {
   o.machines = 2;
   o.screws_per_machine = 2;
   o.seed = 1;
-  const nn::Model model = nn::LoadModel(Source("models/default.json"));
+  const workpiece::WorkpieceModel model =
+      workpiece::LoadWorkpieceModel(Source("models/default.json"));
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(Source("datasets/whirling_500.csv"), true));
   const compare::IsoToleranceTable iso =

@@ -107,7 +107,7 @@ grep -q '"outside_domain_count": 6' out.txt || fail "JSON lacks outside_domain_c
 
 # targets that do not depend on the inputs (20 rows; inputs and targets uniform random,
 # drawn independently: awk 'BEGIN{srand(7); ...}'): the evidence prefers a flat network, and train
-# says so on stderr and in --json; a table with structure gives no warning
+# --family network says so on stderr and in --json; a table with structure gives no warning
 { echo "$H"; cat <<'ROWS'
 49.738,54.719,10.926,2.859,102.045,55.148,359.757
 40.639,44.063,5.553,4.107,117.875,57.644,348.930
@@ -132,21 +132,21 @@ grep -q '"outside_domain_count": 6' out.txt || fail "JSON lacks outside_domain_c
 ROWS
 } > noise.csv
 expect 0 "the network is nearly flat in max_elongation_um and settle_time_s" -- \
-  "$whirl" train --data noise.csv --out noise.json --json
+  "$whirl" train --data noise.csv --out noise.json --family network --json
 grep -q '"warnings": \[$' out.txt || fail "train --json lacks the flat-network warning"
 grep -q "nearly flat" out.txt || fail "train --json warning lacks its text"
-expect 0 "" -- "$whirl" train --data "$data" --out m3.json --json
+expect 0 "" -- "$whirl" train --data "$data" --out m3.json --family network --json
 grep -q '"warnings": \[\]' out.txt || fail "train --json warns on the shipped table"
 ! grep -q "nearly flat" err.txt || fail "train warned about a table with structure"
 
 # targets linear in the inputs (20 rows, deterministic; elongation = 2 HRC + 0.5 D - 3 P
 # + 100, settle = 0.8 v + 4 R + 50, +-0.6 of fixed 'noise'): the default's evidence picks the
-# network without a hidden layer, and predict uses the file (truth at the probe: 190 um, 226 s)
+# network without a hidden layer (--family network), and predict uses the file (truth at the probe: 190 um, 226 s)
 awk 'BEGIN { print "'"$H"'"; for (i = 0; i < 20; i++) { h = 40 + (i * 7) % 20; d = 20 + (i * 13) % 40;
   p = 5 + (i * 3) % 10; r = 2 + (i * 11) % 4 + 0.5 * (i % 2); v = 100 + (i * 37) % 200;
   n = ((i * 7) % 5 - 2) * 0.3; printf "%g,%g,%g,%g,%g,%g,%g\n", h, d, p, r, v,
   2 * h + 0.5 * d - 3 * p + 100 + n, 0.8 * v + 4 * r + 50 - n } }' > linear.csv
-expect 0 "" -- "$whirl" train --data linear.csv --out linear.json
+expect 0 "" -- "$whirl" train --data linear.csv --out linear.json --family network
 grep -q "network 5-2 (no hidden layer, linear; N = 12" out.txt || fail "linear table: $(head -1 out.txt)"
 tr -d ' \n' < linear.json | grep -q '"layer_sizes":\[5,2\]' || fail "linear model file: not 5-2"
 expect 0 "" -- "$whirl" train --data "$data" --out forced_linear.json --hidden 0 --restarts 2

@@ -10,7 +10,8 @@ LAYERS=(
   "core"                       # errors, CSV, JSON, numbers, atomic files, curves, parallel-for
   "sim nn gp"                  # the simulator, the network, Gaussian processes
   "fit family drift torch"     # curve fits (sim), model families (gp, nn), drift (nn), LibTorch (nn)
-  "interp machine"             # 840D output (drift, fit), machine errors (drift, sim)
+  "interp machine workpiece"   # 840D output (drift, fit), machine errors (drift, sim), the
+                               # workpiece model (family, nn)
   "ballbar surface compare"    # ball bar, worktable, strategy comparison (machine, interp, ...)
   "machine_eval"               # the machine evaluation (compare, machine)
   "cli"                        # the command line: parses and calls the library

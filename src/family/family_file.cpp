@@ -1,0 +1,136 @@
+// The JSON of a fitted family model and of a family choice (family/family.h): what the workpiece
+// model file (workpiece/model.h) stores for a model that is not a network.
+#include <string>
+
+#include "core/error.h"
+#include "core/json_file.h"
+#include "family/family.h"
+
+namespace whirl::family {
+namespace {
+
+using nlohmann::json;
+
+const json& Key(const json& j, const char* key, const std::string& what) {
+  if (!j.is_object() || !j.contains(key))
+    throw InputError(what + ": missing key '" + std::string(key) + "'");
+  return j.at(key);
+}
+
+template <typename T>
+std::vector<T> Fits(const json& j, const char* key, const std::string& what) {
+  const json& a = Key(j, key, what);
+  if (!a.is_array() || a.size() != static_cast<std::size_t>(Features::kCount))
+    throw InputError(what + ": '" + key + "' must hold one fit per output (" +
+                     std::to_string(Features::kCount) + ")");
+  std::vector<T> out;
+  for (const json& e : a) out.push_back(e.get<T>());
+  return out;
+}
+
+// Every per-output fit takes the five inputs.
+template <typename T>
+void CheckInputCount(const std::vector<T>& fits, const std::string& what) {
+  for (const T& f : fits)
+    if (f.input_shift.size() != ProcessInputs::kCount)
+      throw InputError(what + ": a fit has " + std::to_string(f.input_shift.size()) +
+                       " inputs, expected " + std::to_string(ProcessInputs::kCount));
+}
+
+std::array<int, Features::kCount> Indices(const json& j, const char* key, int count,
+                                          const std::string& what) {
+  const json& a = Key(j, key, what);
+  std::array<int, Features::kCount> out{};
+  if (!a.is_array() || a.size() != out.size())
+    throw InputError(what + ": '" + key + "' must hold one index per output");
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (!a[k].is_number_integer() || a[k].get<int>() < 0 || a[k].get<int>() >= count)
+      throw InputError(what + ": '" + key + "' entries must be whole numbers in [0, " +
+                       std::to_string(count) + ")");
+    out[k] = a[k].get<int>();
+  }
+  return out;
+}
+
+}  // namespace
+
+void to_json(json& j, const FamilyModel& m) {
+  j = {{"candidate", m.candidate.Name()},
+       {"transform", m.transform},
+       {"calibration", m.calibration}};
+  if (m.candidate.family == Family::kLinear) j["linears"] = m.linears;
+  if (m.candidate.family == Family::kGaussianProcess) j["gps"] = m.gps;
+  if (m.candidate.family == Family::kNetwork) j["network"] = m.network;
+}
+
+void from_json(const json& j, FamilyModel& m) {
+  const std::string what = "family model";
+  const json& name = Key(j, "candidate", what);
+  if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
+  m.candidate = ParseCandidate(name.get<std::string>());
+  m.transform = Key(j, "transform", what).get<TableTransform>();
+  if (m.transform.IsIdentity() == m.candidate.log)
+    throw InputError(what + ": 'transform' disagrees with the candidate " + m.candidate.Name());
+  const json& calibration = Key(j, "calibration", what);
+  if (!calibration.is_string()) throw InputError(what + ": 'calibration' must be a string");
+  m.calibration = calibration.get<std::string>();
+  m.linears.clear();
+  m.gps.clear();
+  if (m.candidate.family == Family::kLinear) {
+    m.linears = Fits<LinearModel>(j, "linears", what);
+    CheckInputCount(m.linears, what);
+  } else if (m.candidate.family == Family::kGaussianProcess) {
+    m.gps = Fits<gp::Gp>(j, "gps", what);
+    CheckInputCount(m.gps, what);
+  } else {
+    m.network = Key(j, "network", what).get<nn::Model>();
+  }
+}
+
+void from_json(const json& j, CvRow& r) {
+  const std::string what = "choice table row";
+  const json& name = Key(j, "candidate", what);
+  if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
+  r.candidate = ParseCandidate(name.get<std::string>());
+  const json& rmse = Key(j, "cv_rmse", what);
+  if (!rmse.is_array() || rmse.size() != static_cast<std::size_t>(Features::kCount))
+    throw InputError(what + ": 'cv_rmse' must hold one value per output");
+  r.cv_rmse.resize(Features::kCount);
+  for (int k = 0; k < Features::kCount; ++k) {
+    if (!rmse[k].is_number()) throw InputError(what + ": 'cv_rmse' must hold numbers");
+    r.cv_rmse(k) = rmse[k].get<double>();
+  }
+  r.score = RequireNumber(j, "score", what);
+  r.fit_ms = RequireNumber(j, "fit_ms", what);
+}
+
+void to_json(json& j, const Choice& c) {
+  j = {{"describe", c.Describe()},
+       {"table", c.table},
+       {"chosen", c.chosen},
+       {"model_of_output", c.model_of_output},
+       {"models", c.models}};
+}
+
+void from_json(const json& j, Choice& c) {
+  const std::string what = "family choice";
+  const json& table = Key(j, "table", what);
+  const json& models = Key(j, "models", what);
+  if (!table.is_array() || table.empty() || !models.is_array() || models.empty() ||
+      models.size() > static_cast<std::size_t>(Features::kCount))
+    throw InputError(what + ": 'table' must be a non-empty array and 'models' hold 1 to " +
+                     std::to_string(Features::kCount) + " models");
+  c.table = table.get<std::vector<CvRow>>();
+  c.models = models.get<std::vector<FamilyModel>>();
+  c.chosen = Indices(j, "chosen", static_cast<int>(c.table.size()), what);
+  c.model_of_output = Indices(j, "model_of_output", static_cast<int>(c.models.size()), what);
+  for (int k = 0; k < Features::kCount; ++k) {
+    const std::string chosen = c.table[c.chosen[k]].candidate.Name();
+    const std::string used = c.models[c.model_of_output[k]].candidate.Name();
+    if (chosen != used)
+      throw InputError(what + ": output " + kTargetColumns[k] + " is predicted by " + used +
+                       " but 'chosen' names " + chosen);
+  }
+}
+
+}  // namespace whirl::family

@@ -1,0 +1,247 @@
+#include "workpiece/model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "core/error.h"
+#include "core/json_file.h"
+
+namespace whirl::workpiece {
+namespace {
+
+using nlohmann::json;
+
+std::vector<double> ToStd(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+
+json Variables(const std::vector<nn::VariableInfo>& vars) {
+  json a = json::array();
+  for (const auto& v : vars) a.push_back({{"name", v.name}, {"unit", v.unit}});
+  return a;
+}
+
+// "inputs"/"outputs" must list exactly `expected` (names and units, in order).
+void CheckVariables(const json& j, const char* key, const std::vector<nn::VariableInfo>& expected) {
+  if (!j.contains(key) || j.at(key) != Variables(expected))
+    throw InputError(std::string("'") + key + "' must be " + Variables(expected).dump());
+}
+
+Eigen::VectorXd DomainVector(const json& domain, const char* key) {
+  if (!domain.is_object() || !domain.contains(key) || !domain.at(key).is_array() ||
+      domain.at(key).size() != static_cast<std::size_t>(ProcessInputs::kCount))
+    throw InputError(std::string("'domain.") + key + "' must hold one number per input (" +
+                     std::to_string(ProcessInputs::kCount) + ")");
+  Eigen::VectorXd v(ProcessInputs::kCount);
+  for (int i = 0; i < ProcessInputs::kCount; ++i) {
+    const json& e = domain.at(key)[i];
+    if (!e.is_number() || !std::isfinite(e.get<double>()))
+      throw InputError(std::string("'domain.") + key + "' must hold finite numbers");
+    v(i) = e.get<double>();
+  }
+  return v;
+}
+
+json FamilyJson(const WorkpieceModel& m) {
+  return {{"format", WorkpieceModel::kFormat},
+          {"schema_version", WorkpieceModel::kSchemaVersion},
+          {"kind", "family"},
+          {"describe", m.Describe()},
+          {"inputs", Variables(nn::ExpectedInputs())},
+          {"outputs", Variables(nn::ExpectedOutputs())},
+          {"domain", {{"min", ToStd(m.domain_min)}, {"max", ToStd(m.domain_max)}}},
+          {"training", {{"data", m.training_data}, {"samples", m.training_samples}}},
+          {"choice", m.choice}};
+}
+
+WorkpieceModel FamilyFromJson(const json& j) {
+  RejectUnknownKeys(j,
+                    {"format", "schema_version", "kind", "describe", "inputs", "outputs", "domain",
+                     "training", "choice"},
+                    "workpiece model");
+  RequireInteger(j, "schema_version", WorkpieceModel::kSchemaVersion,
+                 WorkpieceModel::kSchemaVersion, "workpiece model");
+  RequireOneOf(j, "kind", {"family"}, "workpiece model");
+  CheckVariables(j, "inputs", nn::ExpectedInputs());
+  CheckVariables(j, "outputs", nn::ExpectedOutputs());
+  WorkpieceModel m;
+  m.kind = WorkpieceModel::Kind::kFamily;
+  if (!j.contains("domain")) throw InputError("missing key 'domain'");
+  m.domain_min = DomainVector(j.at("domain"), "min");
+  m.domain_max = DomainVector(j.at("domain"), "max");
+  if (!(m.domain_min.array() <= m.domain_max.array()).all())
+    throw InputError("'domain.min' must not exceed 'domain.max'");
+  if (!j.contains("training") || !j.at("training").is_object())
+    throw InputError("missing object 'training'");
+  m.training_data = RequireString(j.at("training"), "data", "workpiece model 'training'");
+  m.training_samples = static_cast<int>(
+      RequireInteger(j.at("training"), "samples", 4, 100000000, "workpiece model 'training'"));
+  if (!j.contains("choice")) throw InputError("missing key 'choice'");
+  m.choice = j.at("choice").get<family::Choice>();
+  return m;
+}
+
+}  // namespace
+
+std::string WorkpieceModel::Describe() const {
+  if (kind == Kind::kFamily) return choice.Describe();
+  std::string sizes;
+  for (int n : network.network.layer_sizes)
+    sizes += (sizes.empty() ? "" : "-") + std::to_string(n);
+  return "network " + sizes;
+}
+
+WorkpieceModel FromNetwork(nn::Model network) {
+  WorkpieceModel m;
+  m.kind = WorkpieceModel::Kind::kNetwork;
+  m.domain_min = network.domain_min;
+  m.domain_max = network.domain_max;
+  m.training_data = network.training_data;
+  m.training_samples = network.training_samples;
+  m.network = std::move(network);
+  return m;
+}
+
+WorkpieceModel FromChoice(family::Choice choice, const ProcessTable& table,
+                          const std::string& data_name) {
+  if (table.inputs.empty()) throw InputError(data_name + ": no training rows");
+  WorkpieceModel m;
+  m.kind = WorkpieceModel::Kind::kFamily;
+  m.choice = std::move(choice);
+  const Eigen::MatrixXd x = nn::InputMatrix(table.inputs);
+  m.domain_min = x.rowwise().minCoeff();
+  m.domain_max = x.rowwise().maxCoeff();
+  m.training_data = data_name;
+  m.training_samples = static_cast<int>(table.inputs.size());
+  return m;
+}
+
+std::vector<Prediction> PredictBatch(const WorkpieceModel& model,
+                                     const std::vector<ProcessInputs>& inputs) {
+  if (model.IsNetwork()) return nn::PredictBatch(model.network, inputs);
+  const Eigen::MatrixXd x = nn::InputMatrix(inputs);
+  if (!x.allFinite()) throw InputError("predict: an input is NaN or infinite");
+  const std::vector<family::FamilyPrediction> f = family::PredictChoice(model.choice, inputs);
+  std::vector<Prediction> out(inputs.size());
+  for (std::size_t q = 0; q < inputs.size(); ++q) {
+    out[q].mean = f[q].mean;
+    out[q].stddev = f[q].stddev;
+    for (int i = 0; i < ProcessInputs::kCount; ++i)
+      if (x(i, q) < model.domain_min(i) || x(i, q) > model.domain_max(i)) {
+        out[q].outside_domain = true;
+        out[q].outside_domain_fields.push_back(kInputColumns[i]);
+      }
+  }
+  return out;
+}
+
+Prediction Predict(const WorkpieceModel& model, const ProcessInputs& inputs) {
+  return PredictBatch(model, {inputs}).front();
+}
+
+nn::OutsideDomainSummary SummarizeOutsideDomain(const std::vector<Prediction>& predictions) {
+  nn::OutsideDomainSummary s;
+  s.input_names.assign(kInputColumns.begin(), kInputColumns.end());
+  s.per_input.assign(s.input_names.size(), 0);
+  for (std::size_t q = 0; q < predictions.size(); ++q) {
+    if (!predictions[q].outside_domain) continue;
+    if (s.rows++ == 0) s.first_row = q;
+    for (const std::string& f : predictions[q].outside_domain_fields) {
+      const auto it = std::find(s.input_names.begin(), s.input_names.end(), f);
+      if (it != s.input_names.end()) ++s.per_input[it - s.input_names.begin()];
+    }
+  }
+  return s;
+}
+
+WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
+  const json j = ReadJsonFile(path);
+  if (!j.is_object() || !j.contains("format") || j.at("format") != WorkpieceModel::kFormat)
+    return FromNetwork(nn::LoadModel(path));  // names the file and the key on errors
+  try {
+    return FamilyFromJson(j);
+  } catch (const InputError& e) {
+    throw InputError("model file '" + path.string() + "': " + e.what());
+  } catch (const json::exception& e) {
+    throw InputError("model file '" + path.string() + "': " + e.what());
+  }
+}
+
+void SaveWorkpieceModel(const std::filesystem::path& path, const WorkpieceModel& model) {
+  if (model.IsNetwork()) {
+    nn::SaveModel(path, model.network);
+    return;
+  }
+  WriteJsonFile(path, FamilyJson(model));
+}
+
+nn::Model LoadNetworkModel(const std::filesystem::path& path, const std::string& command) {
+  WorkpieceModel m = LoadWorkpieceModel(path);
+  if (!m.IsNetwork())
+    throw InputError("model file '" + path.string() + "': " + command +
+                     " needs a network model; this file holds " + m.Describe() +
+                     ", which is not a network (train one with 'whirl train --family network')");
+  return std::move(m.network);
+}
+
+FamilyFlag ParseFamilyFlag(const std::string& s) {
+  if (s == "auto") return FamilyFlag::kAuto;
+  if (s == "network") return FamilyFlag::kNetwork;
+  if (s == "gp") return FamilyFlag::kGaussianProcess;
+  if (s == "linear") return FamilyFlag::kLinear;
+  throw InputError("--family '" + s + "': must be auto, network, gp or linear");
+}
+
+TransformFlag ParseTransformFlag(const std::string& s) {
+  if (s == "auto") return TransformFlag::kAuto;
+  if (s == "log") return TransformFlag::kLog;
+  if (s == "identity") return TransformFlag::kIdentity;
+  throw InputError("--transform '" + s + "': must be auto, log or identity");
+}
+
+std::vector<family::Candidate> Candidates(FamilyFlag family, TransformFlag transform) {
+  std::vector<family::Candidate> all;
+  if (family == FamilyFlag::kAuto) all = family::ChoiceOptions::DefaultCandidates();
+  const char* body = family == FamilyFlag::kLinear            ? "linear"
+                     : family == FamilyFlag::kGaussianProcess ? "gp-matern52-constant"
+                                                              : "network-evidence";
+  if (family != FamilyFlag::kAuto)
+    for (const char* t : {"/log", "/identity"})
+      all.push_back(family::ParseCandidate(std::string(body) + t));
+  std::vector<family::Candidate> out;
+  for (const family::Candidate& c : all)
+    if (transform == TransformFlag::kAuto || c.log == (transform == TransformFlag::kLog))
+      out.push_back(c);
+  return out;
+}
+
+WorkpieceModel TrainWorkpieceModel(const ProcessTable& table, const TrainOptions& options,
+                                   const std::string& data_name,
+                                   const nn::ModelProgress& progress) {
+  if (options.family == FamilyFlag::kNetwork && options.transform == TransformFlag::kIdentity)
+    return FromNetwork(nn::TrainModel(table, options.network, data_name, progress));
+  family::ChoiceOptions choice = options.choice;
+  choice.candidates = Candidates(options.family, options.transform);
+  ProcessTable named = table;
+  named.source = data_name;
+  return FromChoice(family::ChooseFamily(named, choice), table, data_name);
+}
+
+std::string FormatChoiceTable(const family::Choice& choice) {
+  std::string s = "  candidate                         cv_rmse_um  cv_rmse_s     score  fit_ms\n";
+  char line[200];
+  for (std::size_t c = 0; c < choice.table.size(); ++c) {
+    const family::CvRow& r = choice.table[c];
+    std::string mark;
+    for (int k = 0; k < Features::kCount; ++k)
+      if (choice.chosen[k] == static_cast<int>(c))
+        mark += std::string(mark.empty() ? "  <- " : ", ") + kTargetColumns[k];
+    std::snprintf(line, sizeof line, "  %-32s %10.4g %10.4g %9.4g %7.2f%s\n",
+                  r.candidate.Name().c_str(), r.cv_rmse(0), r.cv_rmse(1), r.score, r.fit_ms,
+                  mark.c_str());
+    s += line;
+  }
+  return s;
+}
+
+}  // namespace whirl::workpiece

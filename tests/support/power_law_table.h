@@ -1,0 +1,36 @@
+#pragma once
+// Generated process tables for the model tests (family/, workpiece/).
+#include <array>
+#include <cmath>
+#include <random>
+
+#include "core/process.h"
+
+namespace whirl::test {
+
+// Inputs uniform in the paper's ranges; targets a power law times exp(noise_sd N(0, 1)), or the
+// smooth non-power law of `curved`.
+inline ProcessTable MakeTable(int rows, double noise_sd, unsigned seed, bool curved = false) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n01;
+  const double lo[5] = {60, 50, 6, 3, 150}, span[5] = {5, 50, 10, 7, 60};
+  ProcessTable t;
+  t.source = "generated.csv";
+  for (int q = 0; q < rows; ++q) {
+    std::array<double, 5> x{};
+    for (int i = 0; i < 5; ++i) x[i] = lo[i] + span[i] * u(rng);
+    double e = 30 * std::pow(x[3], 1.97) * std::pow(x[4], -1.7) * std::pow(x[2], -0.99) * 1e3;
+    double s = 2.0 * std::pow(x[1], 0.8) * std::pow(x[0] / 60, 3.0);
+    if (curved) {
+      e = 10 + 5 * std::sin(x[3]) + 0.1 * x[1];
+      s = 50 + 20 * std::cos(x[2] / 3) * (x[4] / 150);
+    }
+    t.inputs.push_back(ProcessInputs::FromArray(x));
+    t.targets.push_back(Features::FromArray(
+        {e * std::exp(noise_sd * n01(rng)), s * std::exp(noise_sd * n01(rng))}));
+  }
+  return t;
+}
+
+}  // namespace whirl::test

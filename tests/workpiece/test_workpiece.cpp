@@ -1,0 +1,199 @@
+// workpiece/model.h: one prediction for a network and a family choice (mean, delta-method sd,
+// training-domain guard), the model files (round trip, the shipped network files, bad files),
+// the "not a network" error, training by the flags, and the choice against the power law.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include "core/json_file.h"
+#include "support/expect_error.h"
+#include "support/power_law_table.h"
+#include "workpiece/model.h"
+
+namespace whirl::workpiece {
+namespace {
+
+namespace fs = std::filesystem;
+using test::MakeTable;
+
+fs::path Scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "whirl_test_workpiece";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+WorkpieceModel DefaultModel(const ProcessTable& table) {
+  return TrainWorkpieceModel(table, {}, "generated.csv");
+}
+
+std::string Shipped(const std::string& relative) {
+  return std::string(WHIRL_SOURCE_DIR) + "/" + relative;
+}
+
+TEST(WorkpieceModel, FamilyFileRoundTripPredictsBitIdentically) {
+  const ProcessTable train = MakeTable(20, 0.05, 11, true), test = MakeTable(30, 0.0, 12, true);
+  const WorkpieceModel m = DefaultModel(train);
+  ASSERT_FALSE(m.IsNetwork());
+  SaveWorkpieceModel(Scratch("family.json"), m);
+  const WorkpieceModel back = LoadWorkpieceModel(Scratch("family.json"));
+  ASSERT_FALSE(back.IsNetwork());
+  EXPECT_EQ(back.Describe(), m.Describe());
+  EXPECT_EQ(back.training_samples, 20);
+  EXPECT_EQ(ReadJsonFile(Scratch("family.json")).at("schema_version"), 3);
+  const std::vector<Prediction> a = PredictBatch(m, test.inputs), b = PredictBatch(back, test.inputs);
+  for (std::size_t q = 0; q < a.size(); ++q)
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_EQ(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k]);
+      EXPECT_EQ(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k]);
+    }
+  // Writing the reloaded model gives the same file.
+  SaveWorkpieceModel(Scratch("family2.json"), back);
+  EXPECT_EQ(ReadJsonFile(Scratch("family.json")), ReadJsonFile(Scratch("family2.json")));
+}
+
+TEST(WorkpieceModel, ShippedNetworkFileLoadsAndPredictsAsTheNetwork) {
+  const std::string path = Shipped("models/default.json");
+  const WorkpieceModel m = LoadWorkpieceModel(path);
+  ASSERT_TRUE(m.IsNetwork());
+  EXPECT_EQ(m.Describe(), "network 5-6-2");
+  const nn::Model net = nn::LoadModel(path);
+  const ProcessInputs in{62, 80, 10, 3.7, 180}, out{62, 80, 10, 3.7, 400};
+  for (const ProcessInputs& x : {in, out}) {
+    const Prediction p = Predict(m, x), r = nn::Predict(net, x);
+    EXPECT_EQ(p.mean.max_elongation_um, r.mean.max_elongation_um);
+    EXPECT_EQ(p.stddev.settle_time_s, r.stddev.settle_time_s);
+    EXPECT_EQ(p.outside_domain, r.outside_domain);
+  }
+  EXPECT_TRUE(Predict(m, out).outside_domain);
+  // Saving it writes the network file byte for byte.
+  SaveWorkpieceModel(Scratch("network.json"), m);
+  std::ifstream a(path), b(Scratch("network.json"));
+  const std::string sa((std::istreambuf_iterator<char>(a)), {}),
+      sb((std::istreambuf_iterator<char>(b)), {});
+  EXPECT_EQ(sa, sb);
+}
+
+TEST(WorkpieceModel, NetworkOnRawColumnsIsTheNetworkOfEarlierVersions) {
+  const ProcessTable train = MakeTable(20, 0.05, 5);
+  TrainOptions o;
+  o.family = FamilyFlag::kNetwork;
+  o.transform = TransformFlag::kIdentity;
+  o.network = nn::ModelTrainOptions{};  // --trainbr-matlab: 5-6-2 to MATLAB's criteria
+  const WorkpieceModel m = TrainWorkpieceModel(train, o, "generated.csv");
+  ASSERT_TRUE(m.IsNetwork());
+  const nn::Model direct = nn::TrainModel(train, nn::ModelTrainOptions{}, "generated.csv");
+  EXPECT_EQ(nlohmann::json(m.network), nlohmann::json(direct));
+}
+
+TEST(WorkpieceModel, DomainGuardNamesTheInputsOutsideTheTrainingRanges) {
+  const ProcessTable train = MakeTable(20, 0.02, 21);
+  const WorkpieceModel m = DefaultModel(train);
+  ProcessInputs x = train.inputs[3];
+  EXPECT_FALSE(Predict(m, x).outside_domain);
+  x.diameter_mm = m.domain_max(1) * 1.01;
+  x.cutting_speed_m_min = m.domain_min(4) * 0.99;
+  const Prediction p = Predict(m, x);
+  EXPECT_TRUE(p.outside_domain);
+  EXPECT_EQ(p.outside_domain_fields, (std::vector<std::string>{"diameter_mm", "cutting_speed_m_min"}));
+  const nn::OutsideDomainSummary s = SummarizeOutsideDomain({p, Predict(m, train.inputs[0])});
+  EXPECT_EQ(s.rows, 1);
+  EXPECT_EQ(s.per_input[1], 1);
+  EXPECT_EQ(s.per_input[4], 1);
+  EXPECT_EQ(s.per_input[0], 0);
+}
+
+// sd of a log output = d exp(z)/dz at the mean times the sd in log units: against a central finite
+// difference of the back-mapped mean when the transformed mean is shifted by +-h.
+TEST(WorkpieceModel, DeltaMethodSdMatchesFiniteDifferencesOfTheBackMapping) {
+  const ProcessTable train = MakeTable(20, 0.05, 31);
+  TrainOptions o;
+  o.family = FamilyFlag::kLinear;
+  o.transform = TransformFlag::kLog;
+  const WorkpieceModel m = TrainWorkpieceModel(train, o, "generated.csv");
+  const family::FamilyModel& f = m.choice.models.front();
+  const ProcessTable test = MakeTable(10, 0.0, 32);
+  const Eigen::MatrixXd z = family::TransformInputs(f.transform, nn::InputMatrix(test.inputs));
+  for (int k = 0; k < 2; ++k) {
+    const family::LinearPrediction lp = family::PredictLinear(f.linears[k], z);
+    for (std::size_t q = 0; q < test.inputs.size(); ++q) {
+      const double mz = lp.mean(q);
+      const double sz = std::sqrt(lp.latent_variance(q) + f.linears[k].noise_variance);
+      const double h = 1e-5;
+      const double slope = (std::exp(mz + h) - std::exp(mz - h)) / (2 * h);
+      const Prediction p = Predict(m, test.inputs[q]);
+      EXPECT_NEAR(p.mean.ToArray()[k], std::exp(mz), 1e-12 * std::exp(mz));
+      EXPECT_NEAR(p.stddev.ToArray()[k], slope * sz, 1e-6 * slope * sz);
+    }
+  }
+}
+
+TEST(WorkpieceModel, NotANetworkForCrosscheckAndExport) {
+  const WorkpieceModel m = DefaultModel(MakeTable(20, 0.05, 41));
+  const fs::path path = Scratch("not_a_network.json");
+  SaveWorkpieceModel(path, m);
+  ExpectInputError([&] { LoadNetworkModel(path, "crosscheck"); }, "not a network");
+  ExpectInputError([&] { LoadNetworkModel(path, "export"); }, path.string());
+  EXPECT_EQ(LoadNetworkModel(Shipped("models/default.json"), "export").network.layer_sizes,
+            (std::vector<int>{5, 6, 2}));
+}
+
+TEST(WorkpieceModel, BadFamilyFilesNameTheFileAndTheKey) {
+  const WorkpieceModel m = DefaultModel(MakeTable(20, 0.05, 51));
+  const nlohmann::json good = ReadJsonFile((SaveWorkpieceModel(Scratch("good.json"), m),
+                                            Scratch("good.json")));
+  const auto expect_bad = [&](const std::function<void(nlohmann::json&)>& edit,
+                              const std::string& fragment) {
+    nlohmann::json j = good;
+    edit(j);
+    WriteJsonFile(Scratch("bad.json"), j);
+    ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad.json")); }, fragment);
+    ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad.json")); }, "bad.json");
+  };
+  expect_bad([](nlohmann::json& j) { j["schema_version"] = 4; }, "schema_version");
+  expect_bad([](nlohmann::json& j) { j["kind"] = "network"; }, "kind");
+  expect_bad([](nlohmann::json& j) { j["domain"]["min"] = {1, 2}; }, "domain.min");
+  expect_bad([](nlohmann::json& j) { j["choice"]["chosen"] = {0, 99}; }, "chosen");
+  expect_bad([](nlohmann::json& j) { j["choice"]["models"][0]["candidate"] = "svm/log"; },
+             "candidate 'svm/log'");
+  expect_bad([](nlohmann::json& j) { j["choice"].erase("models"); }, "models");
+  expect_bad([](nlohmann::json& j) { j["extra"] = 1; }, "extra");
+  expect_bad([](nlohmann::json& j) { j["inputs"][0]["name"] = "hardness"; }, "inputs");
+}
+
+TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
+  const auto names = [](FamilyFlag f, TransformFlag t) {
+    std::string s;
+    for (const family::Candidate& c : Candidates(f, t)) s += c.Name() + " ";
+    return s;
+  };
+  EXPECT_EQ(names(FamilyFlag::kLinear, TransformFlag::kAuto), "linear/log linear/identity ");
+  EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-constant/log ");
+  EXPECT_EQ(names(FamilyFlag::kNetwork, TransformFlag::kLog), "network-evidence/log ");
+  EXPECT_EQ(names(FamilyFlag::kAuto, TransformFlag::kIdentity),
+            "linear/identity gp-matern52-constant/identity ");
+  ExpectInputError([] { ParseFamilyFlag("svm"); }, "--family 'svm'");
+  ExpectInputError([] { ParseTransformFlag("sqrt"); }, "--transform 'sqrt'");
+}
+
+// On tables that follow a power law, the default's chosen model is never worse in cross-validated
+// error than the power law itself, output by output.
+TEST(WorkpieceTraining, ChosenNeverWorseInCvThanThePowerLawOnPowerLawTables) {
+  for (unsigned seed = 100; seed < 115; ++seed) {
+    const WorkpieceModel m = DefaultModel(MakeTable(20 + static_cast<int>(seed % 3) * 20, 0.05, seed));
+    const family::Choice& c = m.choice;
+    const auto power_law = std::find_if(c.table.begin(), c.table.end(), [](const auto& r) {
+      return r.candidate.Name() == "linear/log";
+    });
+    ASSERT_NE(power_law, c.table.end());
+    for (int k = 0; k < 2; ++k)
+      EXPECT_LE(c.table[c.chosen[k]].cv_rmse(k), power_law->cv_rmse(k) * (1 + 1e-12))
+          << "seed " << seed << ": " << c.Describe();
+  }
+}
+
+}  // namespace
+}  // namespace whirl::workpiece

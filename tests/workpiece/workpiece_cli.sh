@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Smoke test of the workpiece model on the command line: 'whirl train' with no model options
+# chooses a family and prints the choice and the CV table; its model predicts, plans and compares
+# (naming the model); --family/--transform are checked; a family model is "not a network" for
+# crosscheck and export; the network flags still train the network file.
+# Usage (CTest): workpiece_cli.sh <whirl> <scratch dir> <source dir>
+set -uo pipefail
+whirl="$1"; D="$2"; src="$3"
+rm -rf "$D"; mkdir -p "$D"; cd "$D"
+source "$src/tests/support/cli_common.sh"
+data="$src/datasets/whirling_train.csv"
+screw="$src/datasets/screws/reference_80x10x6000.json"
+
+# The default: a family choice, its table on stdout, a schema-3 file.
+"$whirl" train --data "$data" --out fam.json > out.txt 2> err.txt || fail "train: $(cat err.txt)"
+grep -q "max_elongation_um: .*settle_time_s: " out.txt || fail "train does not say what it chose"
+grep -q "linear/log" out.txt || fail "train lacks the CV table: $(cat out.txt)"
+grep -q "<- " out.txt || fail "the CV table does not mark the choice"
+grep -q '"format": "whirl-workpiece-model"' fam.json || fail "not a workpiece model file"
+grep -q '"schema_version": 3' fam.json || fail "not schema 3"
+
+# It predicts with sd and the domain guard, plans and compares.
+"$whirl" predict --model fam.json --input "$src/datasets/whirling_validation.csv" --json \
+  > pred.json 2> err.txt || fail "predict: $(cat err.txt)"
+grep -q '"max_elongation_std_um"' pred.json || fail "predict lacks the sd"
+"$whirl" predict --model fam.json --hardness 62 --diameter 80 --pitch 10 --raceway-radius 3.7 \
+  --cutting-speed 900 > out.txt 2> err.txt || fail "predict outside the domain: $(cat err.txt)"
+grep -q "cutting_speed_m_min" err.txt || fail "no domain warning naming the input: $(cat err.txt)"
+grep -q "OUTSIDE" out.txt || fail "row not flagged outside"
+"$whirl" plan --model fam.json --screw "$screw" --machine "$src/datasets/machines/example_840d.json" --out plan.json > /dev/null 2> err.txt \
+  || fail "plan: $(cat err.txt)"
+"$whirl" curve --model fam.json --screw "$screw" --out curve.csv > /dev/null 2> err.txt \
+  || fail "curve: $(cat err.txt)"
+"$whirl" compare --model fam.json --screw "$screw" --json > cmp.json 2> err.txt \
+  || fail "compare: $(cat err.txt)"
+grep -q '"model": "max_elongation_um: ' cmp.json || fail "compare does not name the model"
+grep -q '"model_vs_regression"' cmp.json || fail "compare lacks model vs regression"
+
+# Flags: named families, transforms, refusals.
+"$whirl" train --data "$data" --out lin.json --family linear --transform log > out.txt 2>&1 \
+  || fail "--family linear --transform log: $(cat out.txt)"
+grep -q "max_elongation_um: linear/log, settle_time_s: linear/log" out.txt \
+  || fail "--family linear --transform log did not give the power law: $(cat out.txt)"
+expect_fail "--family" "$whirl" train --data "$data" --out x.json --family svm
+expect_fail "--hidden" "$whirl" train --data "$data" --out x.json --family gp --hidden 4
+expect_fail "--transform" "$whirl" train --data "$data" --out x.json --trainbr-matlab --transform log
+[ ! -e x.json ] || fail "a refused train wrote a file"
+
+# A network: the network flags, the network file.
+"$whirl" train --data "$data" --out net.json --trainbr-matlab > out.txt 2>&1 \
+  || fail "--trainbr-matlab: $(cat out.txt)"
+grep -q '"format": "whirl-nn-model"' net.json || fail "--trainbr-matlab did not write a network file"
+grep -q "network 5-6-2" out.txt || fail "--trainbr-matlab is not the 5-6-2: $(cat out.txt)"
+
+# crosscheck/export need a network: a clear error naming the file.
+if "$whirl" export --help > /dev/null 2>&1; then
+  expect_fail "fam.json" "$whirl" export --model fam.json --torchscript m.pt
+  grep -q "not a network" err.txt || fail "export: no 'not a network': $(cat err.txt)"
+  expect_fail "not a network" "$whirl" crosscheck --model fam.json --data "$data"
+fi
+echo ok
