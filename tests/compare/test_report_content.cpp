@@ -16,6 +16,7 @@
 #include "core/csv.h"
 #include "core/numbers.h"
 #include "interp/machine_profile.h"
+#include "workpiece/model.h"
 
 namespace whirl::compare {
 namespace {
@@ -26,7 +27,8 @@ const fs::path kSource(WHIRL_SOURCE_DIR);
 class ReportContent : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    const nn::Model model = nn::LoadModel(kSource / "models/default.json");
+    const workpiece::WorkpieceModel model =
+        workpiece::LoadWorkpieceModel(kSource / "models/default.json");
     const ExperienceRule rule =
         BuildExperienceRule(ReadProcessTable(kSource / "datasets/whirling_train.csv", true));
     const IsoToleranceTable iso =
