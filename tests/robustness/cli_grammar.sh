@@ -41,7 +41,7 @@ PENDING=(
   "drift monitor --report"
 )
 pending() { local p; for p in "${PENDING[@]}"; do [ "$p" = "$1" ] && return 0; done; return 1; }
-UNIT_SUFFIX='-(um|mm|m|s|min|h|k|c|pct|rpm|mm-min|m-min|hrc|urad|per-k)$'
+UNIT_SUFFIX='-(um|mm|m|s|min|h|k|c|pct|rpm|mm-min|m-min|hrc|urad|per-k|samples)$'
 DIMENSIONLESS_SUFFIX='-(fraction|factor|ratio|sigma|scale|share)$'
 
 failures=0
