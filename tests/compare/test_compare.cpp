@@ -9,6 +9,7 @@
 #include "compare/evaluate.h"
 #include "compare/report.h"
 #include "core/error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::compare {
 namespace {
@@ -150,7 +151,7 @@ TEST_F(ShippedModel, ReferenceScrewComparisonIsConsistent) {
     EXPECT_DOUBLE_EQ(o.lead.position_mm.back(), c.screw.thread_length_mm);
   }
   // The report writes its files (plots skipped here to keep the test free of gnuplot).
-  const auto dir = std::filesystem::path(::testing::TempDir()) / "whirl_compare_report";
+  const auto dir = whirl::test::ScratchDir() / "whirl_compare_report";
   std::filesystem::remove_all(dir);
   ReportOptions ro;
   ro.plots = false;

@@ -6,6 +6,7 @@
 
 #include "compare/iso3408.h"
 #include "core/error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::compare {
 namespace {
@@ -101,7 +102,7 @@ TEST(IsoVerdict, PicksTheTightestClassWhoseEveryCheckHolds) {
 
 class BadTable : public ::testing::Test {
  protected:
-  std::filesystem::path dir_ = std::filesystem::path(::testing::TempDir()) / "whirl_iso_table";
+  std::filesystem::path dir_ = whirl::test::ScratchDir() / "whirl_iso_table";
   void SetUp() override { std::filesystem::create_directories(dir_); }
   std::string Error(const std::string& body) {
     const auto p = dir_ / "t.csv";

@@ -8,6 +8,7 @@
 
 #include "compare/metrics.h"
 #include "core/error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::compare {
 namespace {
@@ -171,7 +172,7 @@ TEST(LeadMetrics, CoarseSamplesLeaveV2piUnevaluated) {
 
 class LeadFile : public ::testing::Test {
  protected:
-  std::filesystem::path dir_ = std::filesystem::path(::testing::TempDir()) / "whirl_lead_file";
+  std::filesystem::path dir_ = whirl::test::ScratchDir() / "whirl_lead_file";
   void SetUp() override { std::filesystem::create_directories(dir_); }
   std::filesystem::path Write(const std::string& name, const std::string& text) {
     const auto p = dir_ / name;

@@ -17,6 +17,7 @@
 #include "core/numbers.h"
 #include "interp/machine_profile.h"
 #include "workpiece/model.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::compare {
 namespace {
@@ -50,7 +51,7 @@ class ReportContent : public ::testing::Test {
   }
   // The report of the comparison in a fresh directory (no plots: the scripts are still written).
   static fs::path Write(const std::string& name, const ReportOptions& options) {
-    const fs::path dir = fs::path(::testing::TempDir()) / name;
+    const fs::path dir = whirl::test::ScratchDir() / name;
     fs::remove_all(dir);
     ReportOptions o = options;
     o.plots = false;

@@ -14,6 +14,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/run_program.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::compare {
 namespace {
@@ -39,9 +40,9 @@ class ShippedModelReport : public ::testing::Test {
 
 TEST_F(ShippedModelReport, HostileScrewNamesRenderPlotsAndRunNothing) {
   if (!ProgramSucceeds({"gnuplot", "--version"})) GTEST_SKIP() << "gnuplot not installed";
-  const fs::path dir = fs::path(::testing::TempDir()) / "whirl_hostile report 'dir'";
+  const fs::path dir = whirl::test::ScratchDir() / "whirl_hostile report 'dir'";
   fs::remove_all(dir);
-  const fs::path pwned = fs::path(::testing::TempDir()) / "whirl_PWNED";
+  const fs::path pwned = whirl::test::ScratchDir() / "whirl_PWNED";
   fs::remove(pwned);
   const std::vector<std::string> names = {
       "x'; system \"touch " + pwned.string() + "\"; set title '", "O'Brien",
@@ -75,7 +76,7 @@ TEST_F(ShippedModelReport, HostileScrewNamesRenderPlotsAndRunNothing) {
 }
 
 TEST_F(ShippedModelReport, AFailingReportLeavesNoFileBehind) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "whirl_report_all_or_nothing";
+  const fs::path dir = whirl::test::ScratchDir() / "whirl_report_all_or_nothing";
   fs::remove_all(dir);
   fs::create_directories(dir / "index.html");  // the last file cannot be written
   CompareOptions options;
@@ -99,7 +100,7 @@ TEST_F(ShippedModelReport, AFailingReportLeavesNoFileBehind) {
 // says "not rendered" never sits beside an old figure of the same screw.
 TEST_F(ShippedModelReport, UnrenderedPlotLeavesNoOldFigure) {
   if (!ProgramSucceeds({"gnuplot", "--version"})) GTEST_SKIP() << "gnuplot not installed";
-  const fs::path dir = fs::path(::testing::TempDir()) / "whirl_report_stale_png";
+  const fs::path dir = whirl::test::ScratchDir() / "whirl_report_stale_png";
   fs::remove_all(dir);
   CompareOptions options;
   options.seed = 3;

@@ -15,6 +15,7 @@
 #include "core/json_file.h"
 #include "interp/machine_profile.h"
 #include "interp/profile_uses.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::interp {
 namespace {
@@ -26,7 +27,7 @@ const fs::path kShipped = fs::path(WHIRL_SOURCE_DIR) / "datasets/machines/whirli
 fs::path Edited(const std::function<void(nlohmann::json&)>& edit) {
   nlohmann::json j = ReadJsonFile(kShipped);
   edit(j);
-  const fs::path p = fs::path(::testing::TempDir()) / "whirl_profile_test.json";
+  const fs::path p = whirl::test::ScratchDir() / "whirl_profile_test.json";
   std::ofstream(p) << j.dump(2);
   return p;
 }
@@ -198,7 +199,7 @@ TEST(MachineProfile, AProfileThatLoadsIsAcceptedByEveryCommand) {
       }
       if (node->is_number()) *node = values[rng() % values.size()];
     }
-    const fs::path p = fs::path(::testing::TempDir()) / "whirl_profile_random.json";
+    const fs::path p = whirl::test::ScratchDir() / "whirl_profile_random.json";
     std::ofstream(p) << j.dump(2);
     MachineProfile m;
     try {
