@@ -106,7 +106,6 @@ void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
                 "dynamic: leave-one-block-out instead of forward-chaining blocks");
 }
 
-// --model, the sensors, the dynamic and the network model's options, --threads.
 // --error-zero, --gauge-level-um, --errors-from-start (every command that fits or evaluates).
 void AddZeroOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--error-zero", m->error_zero,
@@ -122,6 +121,7 @@ void AddZeroOptions(CLI::App* sub, ModelArgs* m) {
                 "deprecated: the same as --error-zero run-start (the default)");
 }
 
+// --model, the sensors, the dynamic and the network model's options, --threads.
 void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--model", m->kind,
                   "mlr (Miao et al.'s regression on the rises), dynamic (rises plus first-order "
