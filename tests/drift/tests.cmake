@@ -12,3 +12,6 @@ whirl_add_cli_test(cli_drift ${CMAKE_CURRENT_LIST_DIR}/cli_drift.sh)
 whirl_add_cli_test(cli_drift_monitor ${CMAKE_CURRENT_LIST_DIR}/cli_monitor.sh)
 # The joint estimator from shop measurements (drift/joint.h).
 whirl_add_gtest(test_drift_joint SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_joint.cpp)
+# The FL_THERMAL target's settings chosen before the test window (needs ../shared; exit 77: skipped).
+whirl_add_cli_test(cli_fl_thermal_moonshot ${CMAKE_CURRENT_LIST_DIR}/cli_fl_moonshot.sh)
+set_tests_properties(cli_fl_thermal_moonshot PROPERTIES SKIP_RETURN_CODE 77)
