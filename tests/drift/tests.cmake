@@ -10,6 +10,9 @@ whirl_add_gtest(test_drift
   LIBS Boost::headers)
 whirl_add_cli_test(cli_drift ${CMAKE_CURRENT_LIST_DIR}/cli_drift.sh)
 whirl_add_cli_test(cli_drift_monitor ${CMAKE_CURRENT_LIST_DIR}/cli_monitor.sh)
+# A first user's frictions: BOM before the time column, events header, coefficient units, minutes
+# flags on a run without time.
+whirl_add_cli_test(cli_drift_frictions ${CMAKE_CURRENT_LIST_DIR}/cli_frictions.sh)
 # The joint estimator from shop measurements (drift/joint.h).
 whirl_add_gtest(test_drift_joint SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_joint.cpp)
 # The FL_THERMAL target's settings chosen before the test window (needs ../shared; exit 77: skipped).
