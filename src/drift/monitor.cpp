@@ -42,7 +42,8 @@ struct Replay {
   Eigen::MatrixXd p0;  // bayes prior
   double threshold_um, noise_variance;
   int start_sample;
-  Eigen::VectorXd column_scale;  // patent, bayes drift: 1 for the intercept, each feature's training range
+  // patent, bayes drift: 1 for the intercept, then each feature's training range
+  Eigen::VectorXd column_scale;
 };
 
 struct Piece {
@@ -139,7 +140,7 @@ class RuleReplay {
       const Eigen::RowVectorXd xk = in_.x.row(k);
       innovations_.push_back({check.measured_um - check.predicted_um,
                               xk.dot(prior_ * xk.transpose()) + in_.noise_variance,
-                              xk.cwiseQuotient(in_.column_scale.transpose()).squaredNorm()});
+                              xk.cwiseQuotient(DriftScale(k).transpose()).squaredNorm()});
     }
     check.message = CheckMessage(check.time, check.measured_um, check.predicted_um,
                                  in_.threshold_um, check.valid);
@@ -187,7 +188,7 @@ class RuleReplay {
     const Eigen::VectorXd before = pieces_.back().b;
     u.kind = MonitorEvent::Kind::kUpdate;
     int rank = 0;
-    const std::string drift = AddDrift();
+    const std::string drift = AddDrift(*last);
     u.coefficients =
         ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance, &rank, in_.column_scale);
     u.predicted_um = in_.x.row(*last).dot(u.coefficients);
@@ -201,15 +202,30 @@ class RuleReplay {
 
   // bayes with estimate_drift: P += q^2 D^-2, q^2 from this run's checks (header comment);
   // returns the phrase for the update's event.
-  std::string AddDrift() {
+  std::string AddDrift(int k) {
     if (rule_ != UpdateRule::kBayes || !in_.o.estimate_drift) return "";
     const double q2 = DriftVarianceMle(innovations_);
-    prior_.diagonal() += q2 * in_.column_scale.cwiseAbs2().cwiseInverse();
+    prior_.diagonal() += q2 * DriftScale(k).cwiseAbs2().cwiseInverse();
     const std::string from = " (maximum likelihood from " + std::to_string(innovations_.size()) +
                              " checks)";
     if (!(q2 > 0)) return " + no drift: the checks' misfits are within noise and Cov(b)" + from;
-    return " + drift q = " + FormatSignificant(std::sqrt(q2), 3) +
-           " um per training range" + from;
+    return " + drift q = " + FormatSignificant(std::sqrt(q2), 3) + " um per range seen" + from;
+  }
+
+  // D of the drift covariance through sample k: 1 for the intercept, per feature the larger of
+  // its training range and the range of the samples 0..k (the box the control has seen).
+  Eigen::VectorXd DriftScale(int k) {
+    if (seen_lo_.size() == 0) {
+      seen_lo_ = seen_hi_ = in_.x.row(0).transpose();
+      seen_to_ = 1;
+    }
+    for (; seen_to_ <= k; ++seen_to_) {
+      seen_lo_ = seen_lo_.cwiseMin(in_.x.row(seen_to_).transpose());
+      seen_hi_ = seen_hi_.cwiseMax(in_.x.row(seen_to_).transpose());
+    }
+    Eigen::VectorXd d = in_.column_scale.cwiseMax(seen_hi_ - seen_lo_);
+    d(0) = 1;
+    return d;
   }
 
   // The prediction over the whole run, each piece's coefficients from its sample on.
@@ -229,6 +245,8 @@ class RuleReplay {
   std::vector<Piece> pieces_;
   Eigen::MatrixXd prior_;
   std::vector<Innovation> innovations_;  // bayes: every check's misfit (DriftVarianceMle)
+  Eigen::VectorXd seen_lo_, seen_hi_;     // bayes: the features' box over samples [0, seen_to_)
+  int seen_to_ = 0;
 };
 
 StrategyResult RunRule(UpdateRule rule, const Replay& in) { return RuleReplay(rule, in).Run(); }

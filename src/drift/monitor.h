@@ -53,18 +53,20 @@
 //            extrapolates. With estimate_drift (default) each update first adds a drift
 //            covariance, a random walk of the coefficients (Ljung and Soderstrom, "Theory and
 //            Practice of Recursive Identification", 1983, ch. 6):
-//              P <- P + q^2 D^-2,  D = diag(1, training range of each feature)
-//            (a change of q um in the intercept or in each feature's contribution over its
-//            training range, no direction preferred), with q^2 estimated from this run's checks
-//            by maximum likelihood of their misfits (empirical Bayes; Mehra, "On the
-//            identification of variances and adaptive Kalman filtering", IEEE Trans. Automatic
-//            Control 15, 1970): DriftVarianceMle over every check so far, valid ones included,
+//              P <- P + q^2 D^-2,  D = diag(1, per feature the larger of its training range
+//                                           and its range over the run's samples so far)
+//            (a change of q um in the intercept or in each feature's contribution over the
+//            range the control has seen, no direction preferred: a feature driven far outside
+//            its training range is not made the cheapest to change), with q^2 estimated from
+//            this run's checks by maximum likelihood of their misfits (empirical Bayes; Mehra,
+//            "On the identification of variances and adaptive Kalman filtering", IEEE Trans.
+//            Automatic Control 15, 1970): DriftVarianceMle over every check so far, valid ones included,
 //            each check's misfit m_k ~ N(0, v_k + q^2 g_k), v_k = x_k' P x_k + r,
 //            g_k = x_k' D^-2 x_k. q = 0 when the checks' misfits are what the noise and Cov(b)
 //            explain: the update then barely moves. prior_scale 1 (Cov(b) as fitted).
-//            Measured: random runs with persistent changes (tests/drift/test_monitor.cpp) 0.57 of
+//            Measured: random runs with persistent changes (tests/drift/test_monitor.cpp) 0.47 of
 //            the static RMSE on average where prior scale 100 without the drift term gave 1.05;
-//            FL_THERMAL (docs/drift.md) better on the validation block and the week.
+//            FL_THERMAL (docs/drift.md): better on the validation block and the week.
 //   offset   only the intercept: b0 += mean_j (y_j - x_j' b).
 //   static   (reference) the model as fitted, never checked.
 // Every check and update is logged (MonitorEvent) with the numbers it compared.
