@@ -17,7 +17,8 @@
 #     the choice does not move).
 # Only the whirl command line is called; awk reads its timelines.
 # Usage: scripts/fl_thermal_moonshot.sh [data.csv] [out dir]
-# Environment: WHIRL_FL_THERMAL (data.csv when no argument), WHIRL_BIN (default build/whirl).
+# Environment: WHIRL_FL_THERMAL (data.csv when no argument), WHIRL_BIN (default build/whirl),
+# MOONSHOT_SETTINGS (a sub-grid; default the 8 settings above).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA="${1:-${WHIRL_FL_THERMAL:-../shared/data/fl_thermal/data.csv}}"
@@ -50,6 +51,8 @@ for cand in auto sensors; do
     for refit in 0 3; do settings+=("$cand/$recal/$refit"); done
   done
 done
+# MOONSHOT_SETTINGS: a sub-grid (space-separated candidates/recalibration/refit), for quick tests.
+[ -n "${MOONSHOT_SETTINGS:-}" ] && read -r -a settings <<< "$MOONSHOT_SETTINGS"
 for cand in auto sensors; do
   for ch in "${channels[@]}"; do
     "$W" drift fit --run "$OUT/train.csv" --error "$ch" --candidates "$cand" \
@@ -86,6 +89,7 @@ echo "chosen: $best (lowest validation mean $best_mean um)"
 echo "== test MAE [um] (rows [$v1, $t1)): ch1 ch3 ch5; the source's seq2seq 3.56 3.70 4.28"
 target=(3.56 3.70 4.28)
 for s in "$best" "auto/default/0"; do
+  [ -f "$OUT/timeline_${s//\//_}_ch1_um.csv" ] || continue
   line="" met=yes i=0
   for ch in "${channels[@]}"; do
     v=$(mae "$OUT/timeline_${s//\//_}_$ch.csv" "$v1" "$t1")
