@@ -30,6 +30,7 @@ struct MonitorArgs {
          start_min = std::numeric_limits<double>::quiet_NaN(),
          start_samples = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> score_rows{0.0, 1.0};
+  bool no_drift_estimate = false;
   drift::MonitorOptions o;
   bool json = false;
 };
@@ -91,9 +92,12 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
       ->delimiter(',')
       ->check(CLI::IsMember({"patent", "bayes", "offset"}));
   sub->add_option("--prior-scale", o.prior_scale,
-                  "bayes: prior covariance = this x the training fit's Cov(b) (default 100, chosen "
-                  "on a validation block before the test window of FL_THERMAL)")
+                  "bayes: prior covariance = this x the training fit's Cov(b) (default 1), plus "
+                  "the drift covariance estimated from the run's checks")
       ->check(NumberIn(1e-6, 1e12));
+  sub->add_flag("--no-drift-estimate", a->no_drift_estimate,
+                "bayes: no drift covariance (the prior is --prior-scale x Cov(b) alone; the "
+                "default before the drift estimate was --prior-scale 100 this way)");
   sub->add_option(
          "--noise-um", o.noise_um,
          "std of the check-bar measurement noise added to the logged error [um] (default 0)")
@@ -176,6 +180,7 @@ void RunMonitor(MonitorArgs& a) {
   a.o.reference = drift::ParseReferenceMode(a.reference);
   a.o.score_from = a.score_rows.at(0);
   a.o.score_to = a.score_rows.at(1);
+  a.o.estimate_drift = !a.no_drift_estimate;
   a.o.rules.clear();
   for (const auto& u : a.updates) a.o.rules.push_back(drift::ParseUpdateRule(u));
   const drift::DriftModel m = drift::ReadDriftModel(a.model);

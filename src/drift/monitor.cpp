@@ -42,7 +42,8 @@ struct Replay {
   Eigen::MatrixXd p0;  // bayes prior
   double threshold_um, noise_variance;
   int start_sample;
-  Eigen::VectorXd column_scale;  // patent: 1 for the intercept, then each feature's training range
+  // patent, bayes drift: 1 for the intercept, then each feature's training range
+  Eigen::VectorXd column_scale;
 };
 
 struct Piece {
@@ -75,7 +76,7 @@ Eigen::VectorXd ApplyRule(UpdateRule rule, const Eigen::MatrixXd& xs, const Eige
 
 std::string UpdateMessage(UpdateRule rule, const Eigen::MatrixXd& xs, const Eigen::VectorXd& ys,
                           const Eigen::VectorXd& before, const Eigen::VectorXd& after, int rank,
-                          double prior_scale) {
+                          double prior_scale, const std::string& drift) {
   const auto rms = [&](const Eigen::VectorXd& b) {
     return std::sqrt((ys - xs * b).squaredNorm() / static_cast<double>(ys.size()));
   };
@@ -84,7 +85,8 @@ std::string UpdateMessage(UpdateRule rule, const Eigen::MatrixXd& xs, const Eige
     how = ": " + std::to_string(rank) + " of " + std::to_string(before.size()) +
           " directions identified" +
           (rank < before.size() ? " (the others keep the current coefficients)" : "");
-  if (rule == UpdateRule::kBayes) how = ": prior scale " + MessageNumber(prior_scale) + " x Cov(b)";
+  if (rule == UpdateRule::kBayes)
+    how = ": prior scale " + MessageNumber(prior_scale) + " x Cov(b)" + drift;
   return ToString(rule) + how + "; update from " + std::to_string(ys.size()) +
          " measurements: RMS misfit on them " + FormatDecimals(rms(before), 3) + " -> " +
          FormatDecimals(rms(after), 3) + " um; coefficients " + Vec(before) + " -> " + Vec(after);
@@ -134,6 +136,12 @@ class RuleReplay {
     MonitorEvent check = Measure(k, MonitorEvent::Kind::kCheck);
     check.threshold_um = in_.threshold_um;
     check.valid = std::abs(check.measured_um - check.predicted_um) <= in_.threshold_um;
+    if (rule_ == UpdateRule::kBayes) {
+      const Eigen::RowVectorXd xk = in_.x.row(k);
+      innovations_.push_back({check.measured_um - check.predicted_um,
+                              xk.dot(prior_ * xk.transpose()) + in_.noise_variance,
+                              xk.cwiseQuotient(DriftScale(k).transpose()).squaredNorm()});
+    }
     check.message = CheckMessage(check.time, check.measured_um, check.predicted_um,
                                  in_.threshold_um, check.valid);
     ++s_.checks;
@@ -180,14 +188,44 @@ class RuleReplay {
     const Eigen::VectorXd before = pieces_.back().b;
     u.kind = MonitorEvent::Kind::kUpdate;
     int rank = 0;
+    const std::string drift = AddDrift(*last);
     u.coefficients =
         ApplyRule(rule_, xs, ys, before, &prior_, in_.noise_variance, &rank, in_.column_scale);
     u.predicted_um = in_.x.row(*last).dot(u.coefficients);
-    u.message = UpdateMessage(rule_, xs, ys, before, u.coefficients, rank, in_.o.prior_scale);
+    u.message =
+        UpdateMessage(rule_, xs, ys, before, u.coefficients, rank, in_.o.prior_scale, drift);
     s_.events.push_back(u);
     pieces_.push_back({*last, u.coefficients});
     ++s_.recalibrations;
     return true;
+  }
+
+  // bayes with estimate_drift: P += q^2 D^-2, q^2 from this run's checks (header comment);
+  // returns the phrase for the update's event.
+  std::string AddDrift(int k) {
+    if (rule_ != UpdateRule::kBayes || !in_.o.estimate_drift) return "";
+    const double q2 = DriftVarianceMle(innovations_);
+    prior_.diagonal() += q2 * DriftScale(k).cwiseAbs2().cwiseInverse();
+    const std::string from = " (maximum likelihood from " + std::to_string(innovations_.size()) +
+                             " checks)";
+    if (!(q2 > 0)) return " + no drift: the checks' misfits are within noise and Cov(b)" + from;
+    return " + drift q = " + FormatSignificant(std::sqrt(q2), 3) + " um per range seen" + from;
+  }
+
+  // D of the drift covariance through sample k: 1 for the intercept, per feature the larger of
+  // its training range and the range of the samples 0..k (the box the control has seen).
+  Eigen::VectorXd DriftScale(int k) {
+    if (seen_lo_.size() == 0) {
+      seen_lo_ = seen_hi_ = in_.x.row(0).transpose();
+      seen_to_ = 1;
+    }
+    for (; seen_to_ <= k; ++seen_to_) {
+      seen_lo_ = seen_lo_.cwiseMin(in_.x.row(seen_to_).transpose());
+      seen_hi_ = seen_hi_.cwiseMax(in_.x.row(seen_to_).transpose());
+    }
+    Eigen::VectorXd d = in_.column_scale.cwiseMax(seen_hi_ - seen_lo_);
+    d(0) = 1;
+    return d;
   }
 
   // The prediction over the whole run, each piece's coefficients from its sample on.
@@ -206,6 +244,9 @@ class RuleReplay {
   StrategyResult s_;
   std::vector<Piece> pieces_;
   Eigen::MatrixXd prior_;
+  std::vector<Innovation> innovations_;  // bayes: every check's misfit (DriftVarianceMle)
+  Eigen::VectorXd seen_lo_, seen_hi_;     // bayes: the features' box over samples [0, seen_to_)
+  int seen_to_ = 0;
 };
 
 StrategyResult RunRule(UpdateRule rule, const Replay& in) { return RuleReplay(rule, in).Run(); }
@@ -325,6 +366,40 @@ Eigen::VectorXd BayesUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
   const Eigen::MatrixXd next = ldlt.solve(identity);
   *p = 0.5 * (next + next.transpose());
   return updated;
+}
+
+double DriftVarianceMle(const std::vector<Innovation>& checks) {
+  double unit = std::numeric_limits<double>::infinity();
+  for (const Innovation& c : checks)
+    if (c.gain > 0) unit = std::min(unit, std::max(c.variance_um2, 1e-300) / c.gain);
+  if (!std::isfinite(unit)) return 0;
+  const auto log_likelihood = [&](double q2) {
+    double sum = 0;
+    for (const Innovation& c : checks) {
+      const double v = std::max(c.variance_um2 + q2 * c.gain, 1e-300);
+      sum -= 0.5 * (std::log(v) + c.misfit_um * c.misfit_um / v);
+    }
+    return sum;
+  };
+  // Log grid in decades of `unit`, then golden section on the log between the best point's
+  // neighbours (the likelihood is unimodal in q^2 for one check; the grid guards the rest).
+  const double lo = -6, hi = 8, step = 0.02;
+  double best_e = lo, best = log_likelihood(unit * std::pow(10.0, lo));
+  for (double e = lo + step; e <= hi + 1e-9; e += step) {
+    const double v = log_likelihood(unit * std::pow(10.0, e));
+    if (v > best) best = v, best_e = e;
+  }
+  double a = best_e - step, b = best_e + step;
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  for (int i = 0; i < 40; ++i) {
+    const double c = b - g * (b - a), d = a + g * (b - a);
+    if (log_likelihood(unit * std::pow(10.0, c)) > log_likelihood(unit * std::pow(10.0, d)))
+      b = d;
+    else
+      a = c;
+  }
+  const double q2 = unit * std::pow(10.0, 0.5 * (a + b));
+  return log_likelihood(q2) > log_likelihood(0.0) ? q2 : 0.0;
 }
 
 Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,

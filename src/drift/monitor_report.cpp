@@ -126,6 +126,7 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o) {
             {"noise_um", o.noise_um},
             {"seed", o.seed},
             {"prior_scale", o.prior_scale},
+            {"estimate_drift", o.estimate_drift},
             {"start", o.start},
             {"score_from", o.score_from},
             {"score_to", o.score_to},

