@@ -304,15 +304,16 @@ void RegisterPredictDrift(CLI::App* drift_app) {
       "Evaluate a drift model on a run sample by sample (as the control would) and write the\n"
       "compensation value per sample: CSV columns time_min [min], predicted_um, compensation_um\n"
       "(= -predicted) [um], std_um [um], and measured_um, residual_um [um] when the run has the\n"
-      "model's error column. Warns when inputs leave the training range.");
+      "model's error column. Warns when inputs leave the training range.\n" +
+          std::string(kRunFilesHelp));
   sub->add_option("--model", o->model, "drift model file (whirl drift fit)")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--run", o->run, "run file")->required()->check(CLI::ExistingFile);
-  sub->add_option("--out", o->out, "prediction CSV to write");
+  sub->add_option("--run", o->run, "run file (format below)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--out", o->out, "write the per-sample prediction to this CSV file");
   sub->add_option("--reference", o->reference,
-                  "temperature reference: run-start (the run's first row, default, as training) "
-                  "or model (the model's reference_C [degC])")
+                  "temperature reference of the rises: run-start (the run's first row, default, "
+                  "as in training) or model (the model's reference_C [degC])")
       ->check(CLI::IsMember({"run-start", "model"}));
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
@@ -570,7 +571,8 @@ void RegisterDrift(CLI::App& app) {
       "drift",
       "Machine thermal drift from temperature sensors (Miao et al.): select sensitive points, fit\n"
       "MLR / dynamic / network drift models, predict the compensation per sample, cross-run and\n"
-      "hold-out evaluation, HTML report.");
+      "hold-out evaluation, HTML report, the 840D program of the live compensation (nc) and the\n"
+      "replay of an on-line check with a check bar (monitor).");
   sub->require_subcommand(1);
   RegisterSelect(sub);
   RegisterFitModel(sub);
