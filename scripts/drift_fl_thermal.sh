@@ -19,7 +19,7 @@ echo "== source's results (its README; test MAE um): ch1 RF 6.456 XGB 5.611 seq2
 echo "   ch3 RF 7.330 XGB 6.039 seq2seq 3.704; ch5 RF 12.440 XGB 9.535 seq2seq 4.284"
 echo "== whirl: hold-out, at most 4 sensors from Miao et al.'s selection on the training rows"
 "$W" drift holdout --log "$DATA" --channels ch1_um,ch3_um,ch5_um --max-sensors 4 \
-  --inputs spindle_rpm --report "$OUT/holdout" | tee "$OUT/holdout.txt"
+  --inputs spindle_rpm --out-dir "$OUT/holdout" | tee "$OUT/holdout.txt"
 "$W" drift holdout --log "$DATA" --channels ch1_um,ch3_um,ch5_um --max-sensors 4 \
   --inputs spindle_rpm --json > "$OUT/holdout.json" 2> /dev/null
 echo "== the same with the class count by cross-validation (--classes cv, training rows only)"
@@ -37,10 +37,10 @@ for ch in ch1_um ch3_um ch5_um; do
   for model in mlr dynamic; do
     echo "-- $ch, $model, errors taken from each run's start"
     "$W" drift crossval --idle "$OUT"/runs/data_*.csv --error "$ch" --max-sensors 4 --model "$model" \
-      --errors-from-start 2> /dev/null
+      --error-zero run-start 2> /dev/null
   done
 done
 "$W" drift report --train-idle "$OUT"/runs/data_1.csv "$OUT"/runs/data_2.csv "$OUT"/runs/data_3.csv \
-  --idle "$OUT"/runs/data_*.csv --error ch1_um --max-sensors 4 --model dynamic --out "$OUT/report_ch1" \
+  --idle "$OUT"/runs/data_*.csv --error ch1_um --max-sensors 4 --model dynamic --out-dir "$OUT/report_ch1" \
   2> /dev/null
 echo "reports: $OUT/holdout/index.html, $OUT/report_ch1/index.html"

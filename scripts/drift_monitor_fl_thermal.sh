@@ -32,14 +32,14 @@ for ch in ch1_um ch3_um ch5_um; do
     ${INPUTS:+--inputs "$INPUTS"} --out "$OUT/model_$ch.json" > "$OUT/fit_$ch.txt" 2> /dev/null
   echo "-- $ch: $(grep -m1 -i 'sensors' "$OUT/fit_$ch.txt" || true); $(grep -m1 -i 'time constants\|lag' "$OUT/fit_$ch.txt" || true)"
   for every in 60 120 240; do
-    args=(--model "$OUT/model_$ch.json" --run "$DATA" --start "$end_min" --check-every "$every"
+    args=(--model "$OUT/model_$ch.json" --run "$DATA" --start-min "$end_min" --check-every-min "$every"
           --threshold-sigma "${THRESHOLD:-3}" --refit-samples "${REFIT:-3}"
-          --refit-every "${REFIT_EVERY:-5}" --stop-min "${STOP_MIN:-1}"
+          --refit-every-min "${REFIT_EVERY:-5}" --stop-min "${STOP_MIN:-1}"
           --prior-scale "${PRIOR:-1}" --noise-um "${NOISE_UM:-0}")
     "$W" drift monitor "${args[@]}" --json > "$OUT/monitor_${ch}_${every}.json" 2> /dev/null
     "$W" drift monitor "${args[@]}" --score-rows 0.6,0.8 --json \
       > "$OUT/monitor_${ch}_${every}_test.json" 2> /dev/null
-    [ "$every" = 120 ] && "$W" drift monitor "${args[@]}" --report "$OUT/report_$ch" \
+    [ "$every" = 120 ] && "$W" drift monitor "${args[@]}" --out-dir "$OUT/report_$ch" \
       > /dev/null 2>&1
     python3 - "$OUT/monitor_${ch}_${every}.json" "$OUT/monitor_${ch}_${every}_test.json" "$every" <<'EOF'
 import json, sys

@@ -80,45 +80,57 @@ std::vector<Run> LoadRuns(const RunInputs& in) {
 struct ModelArgs {
   std::string kind = "mlr";
   std::vector<std::string> sensors, inputs;
-  std::vector<double> lags;
+  std::vector<double> lags_min, lags_samples;  // --lag-grid-min, --lag-grid-samples
+  TimeAxisFlags lag_flags;
   int max_lags = 2, folds = 5, hidden = 3, restarts = 3, epochs = 1000;
   bool shuffle_cv = false;
   std::uint64_t seed = 1;
   int threads = 0;
   std::string error_zero = "run-start", candidates = "auto";
   double gauge_level_um = std::numeric_limits<double>::quiet_NaN();
-  bool from_start = false;  // deprecated alias of --error-zero run-start
 };
 
 // The dynamic model's options (lagged copies of the rises), shared by every command that fits it.
 void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--inputs", m->inputs, "other columns used as inputs as logged, e.g. spindle_rpm")
       ->delimiter(',');
-  sub->add_option("--lag-grid", m->lags,
-                  "dynamic: candidate lag time constants [min] (default 5,10,20,40,80,160,320)")
-      ->check(PositiveNumber("min"))
-      ->delimiter(',');
-  sub->add_option("--max-lags", m->max_lags, "dynamic: at most this many time constants (1..4)")
+  m->lag_flags.min = sub->add_option("--lag-grid-min", m->lags_min,
+                                     "dynamic: candidate lag time constants [min], comma-separated "
+                                     "(default 5,10,20,40,80,160,320)")
+                         ->check(PositiveNumber("min"))
+                         ->delimiter(',');
+  m->lag_flags.samples =
+      sub->add_option("--lag-grid-samples", m->lags_samples,
+                      "dynamic: the same in samples, for runs without recorded time (default "
+                      "5,10,20,40,80,160,320 samples)")
+          ->check(PositiveNumber())
+          ->delimiter(',');
+  m->lag_flags.old = AddDeprecatedAlias(sub, m->lag_flags.min, "--lag-grid");
+  sub->add_option("--max-lags", m->max_lags,
+                  "dynamic: at most this many time constants (1..4, default 2)")
       ->check(NumberIn(1, 4));
-  sub->add_option("--folds", m->folds, "dynamic: blocks of a single training run (2..20)")
+  sub->add_option("--folds", m->folds,
+                  "dynamic: cross-validation blocks of a single training run (2..20, default 5)")
       ->check(NumberIn(2, 20));
   sub->add_flag("--leave-block-out", m->shuffle_cv,
                 "dynamic: leave-one-block-out instead of forward-chaining blocks");
 }
 
-// --error-zero, --gauge-level-um, --errors-from-start (every command that fits or evaluates).
+// --error-zero (old spelling --errors-from-start: run-start), --gauge-level-um (every command
+// that fits or evaluates).
 void AddZeroOptions(CLI::App* sub, ModelArgs* m) {
-  sub->add_option("--error-zero", m->error_zero,
-                  "zero of the errors for the model, 'none' and every baseline alike: run-start "
-                  "(e - e at the run's first row, default; a gauge level cancels) or fixed "
-                  "(e - --gauge-level-um, for a machine never re-referenced); stored in the model")
-      ->check(CLI::IsMember({"run-start", "fixed"}));
+  auto* zero =
+      sub->add_option(
+             "--error-zero", m->error_zero,
+             "zero of the errors for the model, 'none' and every baseline alike: run-start "
+             "(e - e at the run's first row, default; a gauge level cancels) or fixed "
+             "(e - --gauge-level-um, for a machine never re-referenced); stored in the model")
+          ->check(CLI::IsMember({"run-start", "fixed"}));
+  AddDeprecatedAlias(sub, zero, "--errors-from-start", "run-start");
   sub->add_option("--gauge-level-um", m->gauge_level_um,
                   "fixed zero: the gauge level [um] (default: the first row of the first training "
                   "run)")
       ->check(FiniteNumber("um"));
-  sub->add_flag("--errors-from-start", m->from_start,
-                "deprecated: the same as --error-zero run-start (the default)");
 }
 
 // --model, the sensors, the dynamic and the network model's options, --threads.
@@ -126,27 +138,43 @@ void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--model", m->kind,
                   "mlr (Miao et al.'s regression on the rises), dynamic (rises plus first-order "
                   "lagged copies, time constants by cross-validation) or network (Bayesian-"
-                  "regularized k-h-1)")
+                  "regularized k-h-1); default mlr")
       ->check(CLI::IsMember({"mlr", "dynamic", "network"}));
-  sub->add_option("--sensors", m->sensors, "use these _C columns instead of the selection")
+  sub->add_option("--sensors", m->sensors,
+                  "use these _C columns (comma-separated) instead of Miao et al.'s selection")
       ->delimiter(',');
   AddDynamicOptions(sub, m);
-  sub->add_option("--hidden", m->hidden, "network: hidden neurons (1..20)")->check(NumberIn(1, 20));
-  sub->add_option("--restarts", m->restarts, "network: trainbr restarts (1..50)")
+  sub->add_option("--hidden", m->hidden, "network: hidden neurons h (1..20, default 3)")
+      ->check(NumberIn(1, 20));
+  sub->add_option("--restarts", m->restarts,
+                  "network: trainbr restarts, the highest evidence kept (1..50, default 3)")
       ->check(NumberIn(1, 50));
-  sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000)")
+  sub->add_option("--epochs", m->epochs, "network: trainbr epochs (1..10000, default 1000)")
       ->check(NumberIn(1, 10000));
-  AddSeedOption(sub, &m->seed, "network: initialization seed");
-  sub->add_option("--threads", m->threads, "threads (0: all cores)")->check(NumberIn(0, 256));
+  AddSeedOption(sub, &m->seed, "network: initialization seed (default 1)");
+  sub->add_option("--threads", m->threads,
+                  "threads for cross-validation and restarts (0: all cores, default)")
+      ->check(NumberIn(0, 256));
   AddZeroOptions(sub, m);
 }
 
-drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s) {
+// The fit's options for runs with (`time_from_index` false) or without recorded time (the unit
+// of the lag grid).
+drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s, bool time_from_index) {
   drift::FitOptions o;
   o.kind = drift::ParseModelKind(m.kind);
   o.sensors = m.sensors;
   o.extra_inputs = m.inputs;
-  if (!m.lags.empty()) o.tau_grid = m.lags;
+  switch (ChooseTimeAxis(m.lag_flags, time_from_index)) {
+    case TimeAxisValue::kMin:
+      o.tau_grid = m.lags_min;
+      break;
+    case TimeAxisValue::kSamples:
+      o.tau_grid = m.lags_samples;
+      break;
+    case TimeAxisValue::kNone:
+      break;
+  }
   o.max_lags = m.max_lags;
   o.folds = m.folds;
   o.forward_cv = !m.shuffle_cv;
@@ -161,8 +189,6 @@ drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s) {
   if (o.zero.zero != drift::ErrorZero::kFixed && !std::isnan(m.gauge_level_um))
     throw InputError("--gauge-level-um " + MessageNumber(m.gauge_level_um) +
                      ": only with --error-zero fixed");
-  if (m.from_start && o.zero.zero == drift::ErrorZero::kFixed)
-    throw InputError("--errors-from-start contradicts --error-zero fixed: give one");
   o.candidates = drift::ParseCandidates(m.candidates);
   return o;
 }
@@ -243,7 +269,8 @@ void RegisterFitModel(CLI::App* drift_app) {
     const auto runs = LoadRuns(o->runs);
     std::fprintf(stderr, "fitting %s model of %s on %zu run(s)...\n", o->model.kind.c_str(),
                  o->error.c_str(), runs.size());
-    drift::FitReport rep = drift::FitDriftModel(runs, o->error, ToFit(o->model, o->sel));
+    drift::FitReport rep =
+        drift::FitDriftModel(runs, o->error, ToFit(o->model, o->sel, runs.front().time_from_index));
     for (const auto& w : rep.warnings) Warn(w);
     rep.model.notes.push_back("whirl drift fit --model " + o->model.kind + " --error " + o->error);
     drift::WriteDriftModel(o->out, rep.model);
@@ -277,15 +304,16 @@ void RegisterPredictDrift(CLI::App* drift_app) {
       "Evaluate a drift model on a run sample by sample (as the control would) and write the\n"
       "compensation value per sample: CSV columns time_min [min], predicted_um, compensation_um\n"
       "(= -predicted) [um], std_um [um], and measured_um, residual_um [um] when the run has the\n"
-      "model's error column. Warns when inputs leave the training range.");
+      "model's error column. Warns when inputs leave the training range.\n" +
+          std::string(kRunFilesHelp));
   sub->add_option("--model", o->model, "drift model file (whirl drift fit)")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--run", o->run, "run file")->required()->check(CLI::ExistingFile);
-  sub->add_option("--out", o->out, "prediction CSV to write");
+  sub->add_option("--run", o->run, "run file (format below)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--out", o->out, "write the per-sample prediction to this CSV file");
   sub->add_option("--reference", o->reference,
-                  "temperature reference: run-start (the run's first row, default, as training) "
-                  "or model (the model's reference_C [degC])")
+                  "temperature reference of the rises: run-start (the run's first row, default, "
+                  "as in training) or model (the model's reference_C [degC])")
       ->check(CLI::IsMember({"run-start", "model"}));
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
@@ -348,7 +376,8 @@ void RegisterCrossval(CLI::App* drift_app) {
   sub->callback([o] {
     auto runs = LoadRuns(o->runs);
     std::fprintf(stderr, "cross-run evaluation of %zu runs...\n", runs.size());
-    const auto r = drift::CrossRun(runs, o->error, ToFit(o->model, o->sel));
+    const auto r =
+        drift::CrossRun(runs, o->error, ToFit(o->model, o->sel, runs.front().time_from_index));
     for (const auto& w : r.warnings) Warn(w);
     if (o->json)
       PrintJson(drift::CrossRunJson(r));
@@ -364,50 +393,54 @@ void RegisterHoldout(CLI::App* drift_app) {
     ModelArgs model;
     SelectionArgs sel;
     std::vector<std::string> channels;
-    std::string report;
+    std::string out_dir;
     bool no_network = false, json = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
       "holdout",
       std::string(
-          "Chronological hold-out on one long log (FL_THERMAL's split): train on the first\n"
-          "--train share of the rows, test on the next --test share; the models run from\n"
-          "the log's first row. Per channel: none, time (sensor-free warm-up in time since\n"
-          "the log's start), mlr_all (all sensors), mlr, dynamic and network on the selected\n"
-          "sensors (at most --max-sensors), dynamic_extra with --inputs, all on one error\n"
-          "zero. Test and train MAE, RMSE, max [um]; the strongest per channel.\n") +
+          "Chronological hold-out on one long log (the split of the FL_THERMAL data set):\n"
+          "train on the first --train share of the rows, test on the next --test share; the\n"
+          "models run from the log's first row. Per channel: none, time (sensor-free warm-up\n"
+          "in time since the log's start), mlr_all (all sensors), mlr, dynamic and network on\n"
+          "the selected sensors (at most --max-sensors), dynamic_extra with --inputs, all on one\n"
+          "error zero. Test and train MAE, RMSE, max [um]; the strongest per channel.\n") +
           kRunFilesHelp);
   sub->add_option("--log", o->log, "the log (a run file)")->required()->check(CLI::ExistingFile);
   sub->add_option("--train", o->h.train_fraction, "training share of the rows (default 0.6)")
       ->check(NumberIn(0.01, 0.99));
   sub->add_option("--test", o->h.test_fraction, "test share after it (default 0.2)")
       ->check(NumberIn(0.01, 0.99));
-  sub->add_option("--channels", o->channels, "error columns (default: every _um column)")
+  sub->add_option("--channels", o->channels,
+                  "error columns, comma-separated (default: every _um column)")
       ->delimiter(',');
   AddSelectionOptions(sub, &o->sel);
   AddZeroOptions(sub, &o->model);
   sub->add_flag("--no-network", o->no_network, "skip the network model");
   AddDynamicOptions(sub, &o->model);  // --inputs: those of dynamic_extra
-  sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs")
+  sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs (1..10000, default 1000)")
       ->check(NumberIn(1, 10000));
-  sub->add_option("--report", o->report,
-                  std::string("also write an HTML report into this directory: ") + kOutputDirRule);
+  auto* out_dir = sub->add_option("--out-dir", o->out_dir,
+                                  std::string("also write an HTML report (index.html, plots, CSV) "
+                                              "into this directory: ") +
+                                      kOutputDirRule);
+  AddDeprecatedAlias(sub, out_dir, "--report");
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
-    CheckOutputs({{"--log", o->log}}, {}, {{"--report", o->report}});
+    CheckOutputs({{"--log", o->log}}, {}, {{"--out-dir", o->out_dir}});
     const Run log = drift::ReadRun(o->log, RunState::kUnknown);
     drift::HoldoutOptions h = o->h;
     h.channels = o->channels;
     h.network = !o->no_network;
-    h.fit = ToFit(o->model, o->sel);
+    h.fit = ToFit(o->model, o->sel, log.time_from_index);
     h.max_sensors = o->sel.max_sensors;
     const auto r = drift::Holdout(
         log, h, [](const std::string& s) { std::fprintf(stderr, "fitting %s\n", s.c_str()); });
     for (const auto& w : r.warnings) Warn(w);
-    if (!o->report.empty()) {
+    if (!o->out_dir.empty()) {
       const auto rep =
-          drift::WriteHoldoutReport(o->report, log, r, {"whirl drift holdout --log " + o->log});
+          drift::WriteHoldoutReport(o->out_dir, log, r, {"whirl drift holdout --log " + o->log});
       for (const auto& w : rep.warnings) Warn(w);
       std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
     }
@@ -466,7 +499,8 @@ void RegisterReport(CLI::App* drift_app) {
     RunInputs train, runs;
     SelectionArgs sel;
     ModelArgs model;
-    std::string error, out;
+    std::string error, out_dir;
+    bool json = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -486,21 +520,46 @@ void RegisterReport(CLI::App* drift_app) {
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
   sub->add_option("--error", o->error, "error column (<name>_um)")->required();
-  sub->add_option("--out", o->out, std::string("report directory: ") + kOutputDirRule)->required();
+  auto* out_dir = sub->add_option("--out-dir", o->out_dir,
+                                  std::string("write the report (index.html, plots, a prediction "
+                                              "CSV per run) into this directory: ") +
+                                      kOutputDirRule)
+                      ->required();
+  AddDeprecatedAlias(sub, out_dir, "--out");
+  sub->add_flag("--json", o->json,
+                "machine output on stdout: the model, the selection and each run's residual "
+                "against no compensation [um]");
   sub->callback([o] {
     std::vector<FlagPath> inputs = InputPaths(o->train, "train-"), more = InputPaths(o->runs);
     inputs.insert(inputs.end(), more.begin(), more.end());
-    CheckOutputs(inputs, {}, {{"--out", o->out}});
+    CheckOutputs(inputs, {}, {{"--out-dir", o->out_dir}});
     const auto train = LoadRuns(o->train);
     std::vector<Run> runs = train;
     if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
       runs = LoadRuns(o->runs);
-    const drift::FitReport rep = drift::FitDriftModel(train, o->error, ToFit(o->model, o->sel));
+    const drift::FitReport rep = drift::FitDriftModel(
+        train, o->error, ToFit(o->model, o->sel, train.front().time_from_index));
     for (const auto& w : rep.warnings) Warn(w);
     const auto r =
-        drift::WriteModelReport(o->out, rep, runs, {"whirl drift report --error " + o->error});
+        drift::WriteModelReport(o->out_dir, rep, runs, {"whirl drift report --error " + o->error});
     for (const auto& w : r.warnings) Warn(w);
-    std::printf("report written to %s\n", r.index_html.string().c_str());
+    if (!o->json) {
+      std::printf("report written to %s\n", r.index_html.string().c_str());
+      return;
+    }
+    nlohmann::json predictions = nlohmann::json::array(), files = nlohmann::json::array();
+    for (const Run& run : runs)
+      predictions.push_back(drift::PredictionJson(drift::PredictRun(rep.model, run)));
+    for (const auto& f : r.files) files.push_back(f.string());
+    nlohmann::json j = {{"schema", "whirl.drift_report"},
+                        {"schema_version", 1},
+                        {"index_html", r.index_html.string()},
+                        {"files", files},
+                        {"model", drift::ModelSummaryJson(rep.model)},
+                        {"runs", predictions}};
+    if (rep.selected) j["selection"] = drift::SelectionJson(rep.selection);
+    if (!rep.candidates.empty()) j["candidates"] = drift::CandidatesJson(rep);
+    PrintJson(j);
   });
 }
 
@@ -512,7 +571,8 @@ void RegisterDrift(CLI::App& app) {
       "drift",
       "Machine thermal drift from temperature sensors (Miao et al.): select sensitive points, fit\n"
       "MLR / dynamic / network drift models, predict the compensation per sample, cross-run and\n"
-      "hold-out evaluation, HTML report.");
+      "hold-out evaluation, HTML report, the 840D program of the live compensation (nc) and the\n"
+      "replay of an on-line check with a check bar (monitor).");
   sub->require_subcommand(1);
   RegisterSelect(sub);
   RegisterFitModel(sub);

@@ -1,6 +1,5 @@
 // whirl drift monitor: replay of the on-line model check with a check bar and the recalibration
 // rules (Liu et al.'s check-bar patent) on a logged run (src/drift/monitor.h).
-#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -9,9 +8,9 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/drift_args.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/numbers.h"
 #include "core/output_dir.h"
 #include "drift/monitor_report.h"
 
@@ -20,7 +19,7 @@ namespace whirl::cli {
 namespace {
 
 struct MonitorArgs {
-  std::string model, run, reference = "run-start", timeline, events, report;
+  std::string model, run, reference = "run-start", timeline, events, out_dir;
   std::vector<std::string> days, updates{"patent", "bayes", "offset"};
   // Intervals with their unit in the flag's name; NaN: not given.
   double check_every_min = std::numeric_limits<double>::quiet_NaN(),
@@ -29,15 +28,43 @@ struct MonitorArgs {
          refit_every_samples = std::numeric_limits<double>::quiet_NaN(),
          start_min = std::numeric_limits<double>::quiet_NaN(),
          start_samples = std::numeric_limits<double>::quiet_NaN();
+  TimeAxisFlags check_flags, refit_flags, start_flags;
   std::vector<double> score_rows{0.0, 1.0};
   bool no_drift_estimate = false;
   drift::MonitorOptions o;
   bool json = false;
 };
 
+// One quantity on the run's time axis: --<name>-min, --<name>-samples and the old spelling
+// --<name> (ChooseTimeAxis picks the flag that fits the run). Help: "<what> [min] (default
+// <min_default>)" and "<what> [samples], for runs without recorded time (default ...)".
+struct MonitorTimeOption {
+  const char* name;
+  const char* what;
+  const char* min_default;
+  const char* samples_default;
+  bool positive;  ///< > 0; else any finite number
+};
+
+TimeAxisFlags AddMonitorTimeOption(CLI::App* sub, const MonitorTimeOption& t, double* min,
+                                   double* samples) {
+  const std::string name = std::string("--") + t.name;
+  TimeAxisFlags f;
+  f.min = sub->add_option(name + "-min", *min,
+                          std::string(t.what) + " [min] (default " + t.min_default + ")")
+              ->check(t.positive ? PositiveNumber("min") : FiniteNumber("min"));
+  f.samples =
+      sub->add_option(name + "-samples", *samples,
+                      std::string(t.what) + " [samples], for runs without recorded time (default " +
+                          t.samples_default + ")")
+          ->check(t.positive ? PositiveNumber() : FiniteNumber());
+  f.old = AddDeprecatedAlias(sub, f.min, name);
+  return f;
+}
+
 void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
   drift::MonitorOptions& o = a->o;
-  sub->add_option("--model", a->model, "drift model file (whirl drift fit; mlr or dynamic)")
+  sub->add_option("--model", a->model, "drift model file (whirl drift fit; kind mlr or dynamic)")
       ->required()
       ->check(CLI::ExistingFile);
   auto* run = sub->add_option("--run", a->run,
@@ -48,17 +75,11 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
                               "its updated coefficients from day to day")
                   ->check(CLI::ExistingFile);
   run->excludes(day);
-  sub->add_option("--check-every-min", a->check_every_min,
-                  "interval between checks [min] (default 120: 3-4 checks in an 8-h shift; at "
-                  "most 100,000 checks per run)")
-      ->check(PositiveNumber("min"));
-  sub->add_option("--check-every-samples", a->check_every_samples,
-                  "interval between checks [samples], for runs without recorded time")
-      ->check(PositiveNumber());
-  sub->add_option("--check-every", o.check_every,
-                  "deprecated: the interval [min; samples if the run has no time]; use "
-                  "--check-every-min or --check-every-samples")
-      ->check(PositiveNumber());
+  a->check_flags =
+      AddMonitorTimeOption(sub,
+                           {"check-every", "interval between check-bar checks",
+                            "120: 3-4 checks in an 8-h shift; at most 100,000 checks", "120", true},
+                           &a->check_every_min, &a->check_every_samples);
   sub->add_option("--threshold-um", o.threshold_um,
                   "validity threshold on |measured - predicted| [um] (default 0: use "
                   "--threshold-sigma)")
@@ -72,15 +93,9 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
          "m: further measurements after an invalid check (0..100, default 0: update from the "
          "check alone; 3 recommended with check-bar noise >= 0.5 um)")
       ->check(NumberIn(0, drift::kMaxRefitSamples));
-  sub->add_option("--refit-every-min", a->refit_every_min,
-                  "interval between the refit measurements [min] (default 5)")
-      ->check(PositiveNumber("min"));
-  sub->add_option("--refit-every-samples", a->refit_every_samples,
-                  "interval between the refit measurements [samples], runs without time")
-      ->check(PositiveNumber());
-  sub->add_option("--refit-every", o.refit_every,
-                  "deprecated: --refit-every-min or --refit-every-samples")
-      ->check(PositiveNumber());
+  a->refit_flags = AddMonitorTimeOption(
+      sub, {"refit-every", "interval between the refit measurements", "5", "5", true},
+      &a->refit_every_min, &a->refit_every_samples);
   sub->add_option("--stop-min", o.stop_min_per_measurement,
                   "machine stop per check-bar measurement [min] (default 1)")
       ->check(NumberIn(0.0, 1440.0));
@@ -103,56 +118,56 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
          "std of the check-bar measurement noise added to the logged error [um] (default 0)")
       ->check(NumberIn(0.0, 1000.0));
   AddSeedOption(sub, &o.seed, "seed of the measurement noise (default 1)");
-  sub->add_option("--start-min", a->start_min,
-                  "monitoring starts here [min]: no check before, scores from here (default 0)")
-      ->check(FiniteNumber("min"));
-  sub->add_option("--start-samples", a->start_samples,
-                  "monitoring starts at this sample, for runs without recorded time")
-      ->check(FiniteNumber());
-  sub->add_option("--start", o.start, "deprecated: --start-min or --start-samples")
-      ->check(FiniteNumber());
+  a->start_flags = AddMonitorTimeOption(
+      sub,
+      {"start", "start of the monitoring (no check before it, scores from it)", "0", "0", false},
+      &a->start_min, &a->start_samples);
   sub->add_option("--score-rows", a->score_rows,
                   "scored share of the run's rows FROM,TO (default 0,1; FL_THERMAL's test "
                   "window: 0.6,0.8)")
       ->check(NumberIn(0, 1))
       ->delimiter(',')
       ->expected(2);
-  sub->add_option("--reference", a->reference,
-                  "temperature reference: run-start (default, as training) or model")
+  sub->add_option(
+         "--reference", a->reference,
+         "temperature reference of the rises: run-start (the run's first row, default, as in "
+         "training) or model (the model's reference_C [degC])")
       ->check(CLI::IsMember({"run-start", "model"}));
   sub->add_option("--timeline", a->timeline,
-                  "write the per-sample timeline CSV (time, measured and each rule's prediction "
-                  "and residual [um])");
-  sub->add_option("--events", a->events,
-                  "write every check, refit measurement and update with its reason (CSV)");
+                  "write the per-sample timeline CSV to this file (time, measured and each rule's "
+                  "prediction and residual [um])");
   sub->add_option(
-      "--report", a->report,
-      std::string("write an HTML page with the plot into this directory: ") + kOutputDirRule);
+      "--events", a->events,
+      "write every check, refit measurement and update with its reason to this CSV file");
+  auto* out_dir = sub->add_option(
+      "--out-dir", a->out_dir,
+      std::string("write an HTML page with the plot, the timeline and events CSV into this "
+                  "directory: ") +
+          kOutputDirRule);
+  AddDeprecatedAlias(sub, out_dir, "--report");
   sub->add_flag("--json", a->json, "machine output on stdout");
 }
 
-// The intervals from the flags named by their unit; a *-min flag on a run without recorded time
-// (or *-samples on one with time) is refused naming the flag.
+// The intervals from the flags named by their unit (ChooseTimeAxis: a *-min flag on a run
+// without recorded time, or *-samples on one with time, is refused naming the flag).
 void ApplyIntervals(MonitorArgs& a, bool time_from_index) {
   const struct {
-    double value;
-    const char* flag;
-    bool minutes;
+    const TimeAxisFlags* flags;
+    double min, samples;
     double* target;
-  } flags[] = {{a.check_every_min, "--check-every-min", true, &a.o.check_every},
-               {a.check_every_samples, "--check-every-samples", false, &a.o.check_every},
-               {a.refit_every_min, "--refit-every-min", true, &a.o.refit_every},
-               {a.refit_every_samples, "--refit-every-samples", false, &a.o.refit_every},
-               {a.start_min, "--start-min", true, &a.o.start},
-               {a.start_samples, "--start-samples", false, &a.o.start}};
-  for (const auto& f : flags) {
-    if (std::isnan(f.value)) continue;
-    if (f.minutes == time_from_index)
-      throw InputError(std::string(f.flag) + " " + MessageNumber(f.value) + ": the run " +
-                       (time_from_index ? "has no recorded time (use the *-samples flag)"
-                                        : "records time (use the *-min flag)"));
-    *f.target = f.value;
-  }
+  } intervals[] = {{&a.check_flags, a.check_every_min, a.check_every_samples, &a.o.check_every},
+                   {&a.refit_flags, a.refit_every_min, a.refit_every_samples, &a.o.refit_every},
+                   {&a.start_flags, a.start_min, a.start_samples, &a.o.start}};
+  for (const auto& i : intervals) switch (ChooseTimeAxis(*i.flags, time_from_index)) {
+      case TimeAxisValue::kMin:
+        *i.target = i.min;
+        break;
+      case TimeAxisValue::kSamples:
+        *i.target = i.samples;
+        break;
+      case TimeAxisValue::kNone:
+        break;
+    }
 }
 
 void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
@@ -176,7 +191,7 @@ void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
 void RunMonitor(MonitorArgs& a) {
   if (a.run.empty() && a.days.empty()) throw InputError("give --run FILE or --day FILE ...");
   CheckOutputs({{"--model", a.model}, {"--run", a.run}},
-               {{"--timeline", a.timeline}, {"--events", a.events}}, {{"--report", a.report}});
+               {{"--timeline", a.timeline}, {"--events", a.events}}, {{"--out-dir", a.out_dir}});
   a.o.reference = drift::ParseReferenceMode(a.reference);
   a.o.score_from = a.score_rows.at(0);
   a.o.score_to = a.score_rows.at(1);
@@ -195,8 +210,8 @@ void RunMonitor(MonitorArgs& a) {
   std::vector<std::pair<std::filesystem::path, std::string>> files;
   if (!a.timeline.empty()) files.emplace_back(a.timeline, timeline);
   if (!a.events.empty()) files.emplace_back(a.events, events);
-  if (!a.report.empty()) {  // the report with the files: all or none
-    const auto rep = drift::WriteMonitorReport(a.report, r, a.o, prov, "gnuplot", files);
+  if (!a.out_dir.empty()) {  // the report with the files: all or none
+    const auto rep = drift::WriteMonitorReport(a.out_dir, r, a.o, prov, "gnuplot", files);
     for (const auto& w : rep.warnings) Warn(w);
     std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
   } else {
@@ -214,13 +229,16 @@ void RegisterDriftMonitor(CLI::App* drift_app) {
   auto a = std::make_shared<MonitorArgs>();
   auto* sub = drift_app->add_subcommand(
       "monitor",
-      "Replay the patent's on-line check on a logged run: temperatures every sample, the thermal\n"
-      "error known only at check-bar measurements (every --check-every, each stopping the\n"
-      "machine --stop-min [min]); a check with |measured - predicted| above the threshold marks\n"
-      "the model invalid, --refit-samples more measurements follow and the coefficients are\n"
-      "updated (patent: least squares on them; bayes: recursive least squares from the training\n"
-      "posterior; offset: intercept only). Prints MAE, RMSE, max [um] for no compensation, the\n"
-      "static model and each rule, with checks, recalibrations and stop time [min, % of time].");
+      "Replay on a logged run the on-line model check of Liu et al.'s patent \"Temperature\n"
+      "compensation method, system and medium for CNC machine tools\": temperatures every\n"
+      "sample, the thermal error known only at check-bar measurements (every --check-every-min,\n"
+      "each stopping the machine --stop-min [min]); a check with |measured - predicted| above\n"
+      "the threshold marks the model invalid, --refit-samples more measurements follow and the\n"
+      "coefficients are updated (patent: least squares on them; bayes: recursive least squares\n"
+      "from the training posterior; offset: intercept only). Prints MAE, RMSE, max [um] for no\n"
+      "compensation, the static model and each rule, with checks, recalibrations and stop time\n"
+      "[min, % of time]. With --day ...: a production week, each rule carrying its coefficients\n"
+      "from day to day.");
   AddMonitorOptions(sub, a.get());
   sub->callback([a] { RunMonitor(*a); });
 }

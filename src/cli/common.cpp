@@ -147,36 +147,57 @@ void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
       ->check(NumberIn(kPlanToleranceRange));
 }
 
+namespace {
+
+// The value(s) `values` of the old spelling `old_flag` handed to `current` (AddDeprecatedAlias);
+// `use` is what the deprecation line tells the user to type instead.
+void ForwardDeprecated(CLI::Option* current, const std::string& old_flag, const std::string& use,
+                       const std::vector<std::string>& values) {
+  const std::string now = current->get_name();
+  if (current->count() > 0)
+    throw CLI::ValidationError(
+        old_flag, "give " + now + " only (" + old_flag + " is its deprecated spelling), not both");
+  std::fprintf(stderr, "whirl: %s is deprecated, use %s\n", old_flag.c_str(), use.c_str());
+  for (const auto& v : values) current->add_result(v);
+  try {
+    current->run_callback();            // current's checks and conversion, as if it had been typed
+  } catch (const CLI::ParseError& e) {  // "--new: 1e999 breaks the rule ..." under --old
+    std::string message = e.what();
+    if (message.rfind(now + ": ", 0) == 0) message.erase(0, now.size() + 2);
+    throw CLI::ValidationError(old_flag, message);
+  }
+}
+
+}  // namespace
+
 CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::string& old_flag) {
   const std::string now = current->get_name();
-  const auto forward = [current, old_flag, now](const std::vector<std::string>& values) {
-    if (current->count() > 0)
-      throw CLI::ValidationError(old_flag, "give " + now + " only (" + old_flag +
-                                               " is its deprecated spelling), not both");
-    std::fprintf(stderr, "whirl: %s is deprecated, use %s\n", old_flag.c_str(), now.c_str());
-    for (const auto& v : values) current->add_result(v);
-    try {
-      current->run_callback();  // current's checks and conversion, as if it had been typed
-    } catch (const CLI::ParseError& e) {  // "--new: 1e999 breaks the rule ..." under --old
-      std::string message = e.what();
-      if (message.rfind(now + ": ", 0) == 0) message.erase(0, now.size() + 2);
-      throw CLI::ValidationError(old_flag, message);
-    }
-  };
   CLI::Option* alias = nullptr;
   if (current->get_expected_max() == 0) {  // a flag
-    alias = sub->add_flag_callback(
-        old_flag, [forward, current, now] { forward({current->get_flag_value(now, "")}); });
+    alias = sub->add_flag_callback(old_flag, [current, old_flag, now] {
+      ForwardDeprecated(current, old_flag, now, {current->get_flag_value(now, "")});
+    });
   } else {
     alias = sub->add_option(old_flag,
-                            [forward](const CLI::results_t& r) {
-                              forward(r);
+                            [current, old_flag, now](const CLI::results_t& r) {
+                              ForwardDeprecated(current, old_flag, now, r);
                               return true;
                             })
                 ->type_size(current->get_type_size_min(), current->get_type_size_max())
                 ->expected(current->get_expected_min(), current->get_expected_max());
   }
   return alias->group("");  // hidden from --help
+}
+
+CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::string& old_flag,
+                                const std::string& implied_value) {
+  const std::string use = current->get_name() + " " + implied_value;
+  return sub
+      ->add_flag_callback(old_flag,
+                          [current, old_flag, use, implied_value] {
+                            ForwardDeprecated(current, old_flag, use, {implied_value});
+                          })
+      ->group("");  // hidden from --help
 }
 
 std::string ClosestName(const std::string& word, const std::vector<std::string>& candidates) {

@@ -44,6 +44,11 @@ std::string ClosestName(const std::string& word, const std::vector<std::string>&
 /// "whirl: --old is deprecated, use --new" on stderr. Giving both is a parse error; a value the
 /// check refuses is reported under the spelling typed. Returns the hidden option.
 CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::string& old_flag);
+/// The same for an old flag without a value that stood for `current` with one value
+/// (--errors-from-start for --error-zero run-start): its presence hands `implied_value` to
+/// `current`, and the deprecation line says "use --new <implied_value>".
+CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::string& old_flag,
+                                const std::string& implied_value);
 
 /// A command that ran but whose result is a failure (e.g. a cross-check that disagrees):
 /// main prints the message and exits with `exit_code` (never 0).

@@ -41,4 +41,34 @@ drift::SelectionOptions ToSelection(const SelectionArgs& a) {
   return o;
 }
 
+namespace {
+
+// "5,10,20": an option's values as typed, for messages.
+std::string Typed(const CLI::Option* o) {
+  std::string text;
+  for (const auto& r : o->results()) text += (text.empty() ? "" : ",") + r;
+  return text;
+}
+
+}  // namespace
+
+TimeAxisValue ChooseTimeAxis(const TimeAxisFlags& f, bool time_from_index) {
+  const bool old = f.old != nullptr && f.old->count() > 0;
+  const bool min = f.min->count() > 0, samples = f.samples->count() > 0;
+  if (old && time_from_index) {
+    Warn("--" + f.old->get_lnames().front() +
+         ": the run has no recorded time, so the value is read in samples; use " +
+         f.samples->get_name());
+    return TimeAxisValue::kMin;
+  }
+  if (min && time_from_index)
+    throw InputError(f.min->get_name() + " " + Typed(f.min) +
+                     ": the run has no recorded time (its time is the sample index): use " +
+                     f.samples->get_name());
+  if (samples && !time_from_index)
+    throw InputError(f.samples->get_name() + " " + Typed(f.samples) +
+                     ": the run records time: use " + f.min->get_name());
+  return min ? TimeAxisValue::kMin : samples ? TimeAxisValue::kSamples : TimeAxisValue::kNone;
+}
+
 }  // namespace whirl::cli

@@ -20,4 +20,22 @@ void AddSelectionOptions(CLI::App* sub, SelectionArgs* s);
 /// The library's options; InputError for a --classes that is not fewest, margin, cv or a number.
 drift::SelectionOptions ToSelection(const SelectionArgs& a);
 
+/// A drift quantity on the run's time axis: minutes on runs that record time, samples on runs
+/// that do not (their time is the sample index). The flag pair --<name>-min and
+/// --<name>-samples, and the old spelling --<name> (a hidden deprecated alias of --<name>-min,
+/// AddDeprecatedAlias) that meant either, as the run's time axis.
+struct TimeAxisFlags {
+  CLI::Option* min = nullptr;
+  CLI::Option* samples = nullptr;
+  CLI::Option* old = nullptr;  ///< nullptr: no old spelling
+};
+
+/// Which flag's value applies to a run with (`time_from_index` false) or without recorded time:
+/// kNone (neither given: the default), kMin (the -min flag's variable; on a run without time
+/// this can only be the old spelling, read in samples as it always was, with a warning) or
+/// kSamples. A -min flag on a run without time, or a -samples flag on a run with time, is an
+/// InputError naming the flag and the one to use.
+enum class TimeAxisValue { kNone, kMin, kSamples };
+TimeAxisValue ChooseTimeAxis(const TimeAxisFlags& f, bool time_from_index);
+
 }  // namespace whirl::cli

@@ -24,7 +24,7 @@ command -v gnuplot > /dev/null || { echo "SKIPPED: gnuplot missing, reports have
 # The reports: workpiece (demo), machine (demo step 7), drift (on the demo's sensor log).
 (cd "$D" && "$W" demo --out-dir out > demo.txt 2>&1) || fail "demo: $(tail -5 "$D/demo.txt")"
 "$W" drift report --train-cutting "$D/out/machine_report/sensors.csv" --error offset_um \
-  --out "$D/drift" > "$D/drift.txt" 2>&1 || fail "drift report: $(tail -5 "$D/drift.txt")"
+  --out-dir "$D/drift" > "$D/drift.txt" 2>&1 || fail "drift report: $(tail -5 "$D/drift.txt")"
 
 # Writes probe.html beside a page: the page plus a script that, once everything has loaded,
 # records the images that failed and the page's width into the DOM.

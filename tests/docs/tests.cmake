@@ -2,3 +2,6 @@
 # README stays within 260 lines and names the commands .ci/run relies on (check_docs.sh says how).
 add_test(NAME docs_links COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/check_docs.sh ${PROJECT_SOURCE_DIR})
 set_tests_properties(docs_links PROPERTIES LABELS "docs;cli" TIMEOUT 60)
+# Every `whirl ...` in README.md and docs/*.md uses flags the binary has, and docs/commands.md's
+# option table is the binary's (tests/docs/commands_doc.py).
+whirl_add_cli_test(docs_commands ${CMAKE_CURRENT_LIST_DIR}/check_commands.sh)

@@ -31,7 +31,8 @@ for c in select fit predict crossval holdout split report; do
 done
 grep -q "degC" "$D/help_fit.txt" || fail "fit --help has no units"
 grep -q "\[um\]" "$D/help_predict.txt" || fail "predict --help has no units"
-grep -q "min" "$D/help_fit.txt" || fail "fit --help does not give the lag unit"
+grep -q -- "--lag-grid-min FLOAT:> 0 min" "$D/help_fit.txt" && grep -q "lag time constants \[min\]" \
+  "$D/help_fit.txt" || fail "fit --help does not give the lag unit"
 
 # select: the two sensor groups (and c1) are found; JSON too.
 "$W" drift select --idle "$D/idle1.csv" --error err_um --classes margin > "$D/select.txt" || fail "select"
@@ -77,17 +78,31 @@ grep -q '"method": "dynamic"' "$D/ho.json" || fail "holdout methods"
 
 # report with a hostile run name: escaped in HTML, never markup.
 "$W" drift report --train-idle "$D/idle1.csv" --run "$D/it's \"<script>x.csv" --error err_um \
-  --classes margin --out "$D/report" > /dev/null 2> "$D/rep_err.txt" || fail "report: $(cat "$D/rep_err.txt")"
+  --classes margin --out-dir "$D/report" > /dev/null 2> "$D/rep_err.txt" || fail "report: $(cat "$D/rep_err.txt")"
 [ -f "$D/report/index.html" ] || fail "report has no index.html"
 grep -q "<script>" "$D/report/index.html" && fail "run name reached the HTML unescaped"
 grep -q "&lt;script&gt;x" "$D/report/index.html" || fail "escaped run name missing"
 if command -v gnuplot > /dev/null; then  # the hostile name reached gnuplot's titles safely
   ls "$D/report/"*script*_prediction.png > /dev/null 2>&1 || fail "no plot for the hostile run name"
-  # a relative --out (gnuplot runs inside the report directory)
-  (cd "$D" && "$W" drift report --train-idle idle1.csv --error err_um --out rel > /dev/null 2>&1) \
-    || fail "report with a relative --out"
-  [ -f "$D/rel/idle1_prediction.png" ] || fail "relative --out: plot not rendered"
+  # a relative --out-dir (gnuplot runs inside the report directory)
+  (cd "$D" && "$W" drift report --train-idle idle1.csv --error err_um --out-dir rel > /dev/null 2>&1) \
+    || fail "report with a relative --out-dir"
+  [ -f "$D/rel/idle1_prediction.png" ] || fail "relative --out-dir: plot not rendered"
 fi
+
+# report --json: the model, each run's residual against no compensation, the page's path.
+"$W" drift report --train-idle "$D/idle1.csv" --run "$D/cut1.csv" --error err_um --out-dir "$D/rj" \
+  --json > "$D/report.json" 2> /dev/null || fail "report --json"
+python3 - "$D/report.json" "$D/rj/index.html" <<'EOF2' || fail "report --json content: $(head -c 400 "$D/report.json")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["schema"] == "whirl.drift_report", j["schema"]
+assert j["index_html"] == sys.argv[2], j["index_html"]
+assert j["model"]["error_column"] == "err_um", j["model"]
+runs = j["runs"]
+assert [r["run"] for r in runs] == ["cut1"], runs
+assert runs[0]["residual"]["rmse_um"] < runs[0]["no_compensation"]["rmse_um"], runs[0]
+EOF2
 
 # Bad input: clear errors, nothing written.
 printf 'time_min,a_C,err_um\n0,20,0\n1,abc,1\n' > "$D/bad.csv"

@@ -23,15 +23,15 @@ make_run "$D/it's \"<script>run.csv" 600 250
 H="$D/it's \"<script>run.csv"
 
 "$W" drift monitor --help > "$D/help.txt" || fail "monitor --help"
-for u in "\[min" "\[um\]" "patent" "bayes" "offset" "--check-every" "--refit-samples"; do
+for u in "\[min" "\[um\]" "patent" "bayes" "offset" "--check-every-min" "--refit-samples"; do
   grep -q -- "$u" "$D/help.txt" || fail "monitor --help lacks $u"
 done
 "$W" drift fit --run "$D/train.csv" --error err_um --sensors a_C,b_C --out "$D/m.json" > /dev/null 2>&1 \
   || fail "fit"
 
-"$W" drift monitor --model "$D/m.json" --run "$H" --check-every 60 --threshold-um 1 \
-  --refit-samples 4 --refit-every 10 --timeline "$D/timeline.csv" --events "$D/events.csv" \
-  --report "$D/report" > "$D/monitor.txt" 2> "$D/monitor_err.txt" || fail "monitor: $(cat "$D/monitor_err.txt")"
+"$W" drift monitor --model "$D/m.json" --run "$H" --check-every-min 60 --threshold-um 1 \
+  --refit-samples 4 --refit-every-min 10 --timeline "$D/timeline.csv" --events "$D/events.csv" \
+  --out-dir "$D/report" > "$D/monitor.txt" 2> "$D/monitor_err.txt" || fail "monitor: $(cat "$D/monitor_err.txt")"
 for rule in none static patent bayes offset; do
   grep -q "^$rule " "$D/monitor.txt" || fail "no row for $rule: $(cat "$D/monitor.txt")"
 done
@@ -68,7 +68,7 @@ EOF
 expect_fail "score" "$W" drift monitor --model "$D/m.json" --run "$H" --score-rows 0.8,0.6 \
   --timeline "$D/bad.csv"
 [ -e "$D/bad.csv" ] && fail "timeline written on failure"
-expect_fail "check-every" "$W" drift monitor --model "$D/m.json" --run "$H" --check-every 0
+expect_fail "check-every-min" "$W" drift monitor --model "$D/m.json" --run "$H" --check-every-min 0
 sed 's/err_um/other_um/' "$D/train.csv" > "$D/noerr.csv"
 expect_fail "err_um" "$W" drift monitor --model "$D/m.json" --run "$D/noerr.csv"
 "$W" drift fit --run "$D/train.csv" --error err_um --sensors a_C,b_C --model network --epochs 20 \

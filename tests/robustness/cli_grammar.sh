@@ -30,17 +30,10 @@ DIMENSIONLESS=(
   --threshold             # drift split: in the unit of the --at column, whatever it is
   --train --test          # drift holdout: shares of the rows
 )
-# Not yet renamed: the drift commands' flags wait for the drift rework in progress (then
-# --lag-grid-min, --check-every-min / --check-every-samples, --refit-every-*, --start-*, --out-dir
-# and --json on drift report). Each entry is "<command> <flag>" ("<command> --json": no --json
-# yet); remove an entry when its flag is renamed, and the test checks it from then on.
-PENDING=(
-  "drift fit --lag-grid" "drift crossval --lag-grid" "drift holdout --lag-grid"
-  "drift report --lag-grid" "drift holdout --report" "drift report --out" "drift report --json"
-  "drift monitor --check-every" "drift monitor --refit-every" "drift monitor --start"
-  "drift monitor --report"
-)
-pending() { local p; for p in "${PENDING[@]}"; do [ "$p" = "$1" ] && return 0; done; return 1; }
+# Flags not yet renamed, each "<command> <flag>" ("<command> --json": no --json yet): skipped by
+# the walk until renamed. Empty: every command follows the grammar.
+PENDING=()
+pending() { local p; for p in ${PENDING[@]+"${PENDING[@]}"}; do [ "$p" = "$1" ] && return 0; done; return 1; }
 UNIT_SUFFIX='-(um|mm|m|s|min|h|k|c|pct|rpm|mm-min|m-min|hrc|urad|per-k|samples)$'
 DIMENSIONLESS_SUFFIX='-(fraction|factor|ratio|sigma|scale|share)$'
 
@@ -216,6 +209,63 @@ alias_case --report --out-dir compare -- --model "$SRC/models/default.json" --sc
   @FLAG@ "$D/compare_@FLAG@" --json
 alias_case --report --out-dir machine evaluate -- --machines 1 --screws 1 --train-runs 1 \
   @FLAG@ "$D/machine_@FLAG@" --json
+
+# drift: a run log with time and one without (its time is the sample index); the error follows
+# sensor a through a first-order lag of 20 min (so the dynamic model's lag grid matters).
+awk 'BEGIN { print "time_min,a_C,b_C,err_um";
+  for (k = 0; k < 300; k++) { A = 8 * (1 - exp(-k / 30)) + 2 * sin(k / 25); B = k / 40;
+    L += (A - L) / 20;
+    printf "%d,%.4f,%.4f,%.4f\n", k, 20 + A, 21 + B, 2 * L - 1.5 * B + 0.05 * sin(7 * k) } }' \
+  > "$D/drift.csv"
+cut -d, -f2- "$D/drift.csv" > "$D/drift_samples.csv"
+DR=(--run "$D/drift.csv" --error err_um --sensors a_C,b_C)
+alias_case --lag-grid --lag-grid-min drift holdout -- --log "$D/drift.csv" --no-network \
+  @FLAG@ 10,40 --json
+# --errors-from-start stood for --error-zero run-start (a flag for an option with its value).
+HO=(drift holdout --log "$D/drift.csv" --no-network --json)
+"$W" "${HO[@]}" --help | grep -q -- "--errors-from-start" && fail "holdout --help lists --errors-from-start"
+"$W" "${HO[@]}" --error-zero run-start > "$D/new.out" 2> "$D/new.err" || fail "holdout --error-zero"
+"$W" "${HO[@]}" --errors-from-start > "$D/old.out" 2> "$D/old.err" ||
+  fail "holdout --errors-from-start refused: $(cat "$D/old.err")"
+grep -qx "whirl: --errors-from-start is deprecated, use --error-zero run-start" "$D/old.err" ||
+  fail "--errors-from-start: no deprecation line: $(cat "$D/old.err")"
+cmp -s "$D/new.out" "$D/old.out" || fail "--errors-from-start and --error-zero run-start differ"
+expect_fail "errors-from-start" "$W" "${HO[@]}" --errors-from-start --error-zero fixed
+aliases=$((aliases + 1))
+"$W" drift fit "${DR[@]}" --out "$D/drift_model.json" > /dev/null || fail "drift fit"
+MON=(--model "$D/drift_model.json" --run "$D/drift.csv" --threshold-um 1)
+alias_case --check-every --check-every-min drift monitor -- "${MON[@]}" @FLAG@ 60 --json
+alias_case --refit-every --refit-every-min drift monitor -- "${MON[@]}" --refit-samples 2 @FLAG@ 7 --json
+alias_case --start --start-min drift monitor -- "${MON[@]}" @FLAG@ 30 --json
+alias_case --report --out-dir drift monitor -- "${MON[@]}" @FLAG@ "$D/monitor_@FLAG@" --json
+alias_case --report --out-dir drift holdout -- --log "$D/drift.csv" --no-network @FLAG@ \
+  "$D/holdout_@FLAG@" --json
+alias_case --out --out-dir drift report -- --train-run "$D/drift.csv" --error err_um \
+  --sensors a_C,b_C @FLAG@ "$D/report_@FLAG@" --json
+# The unit follows the run's time axis: a -min flag on a run without recorded time (or -samples
+# on one with time) is refused naming the flag to use; the old spelling keeps its meaning there
+# (samples), with a warning; the -samples flag acts (its output differs from the default's).
+"$W" drift fit --run "$D/drift_samples.csv" --error err_um --sensors a_C,b_C \
+  --out "$D/drift_model_samples.json" > /dev/null 2>&1 || fail "drift fit on a run without time"
+MS=(drift monitor --model "$D/drift_model_samples.json" --run "$D/drift_samples.csv" --threshold-um 1 --json)
+HS=(drift holdout --log "$D/drift_samples.csv" --no-network --json)
+for c in "MS check-every 60" "MS refit-every 7" "MS start 30" "HS lag-grid 10,40"; do
+  read -r cmd flag value <<< "$c"
+  [ "$cmd" = MS ] && args=("${MS[@]}" --refit-samples 2) || args=("${HS[@]}")
+  expect_fail "--$flag-min $value: the run has no recorded time.*use --$flag-samples" \
+    "$W" "${args[@]}" "--$flag-min" "$value"
+  "$W" "${args[@]}" "--$flag-samples" "$value" > "$D/new.out" 2> /dev/null || fail "--$flag-samples"
+  "$W" "${args[@]}" > "$D/default.out" 2> /dev/null || fail "${args[*]}"
+  cmp -s "$D/new.out" "$D/default.out" && fail "--$flag-samples $value changes nothing"
+  "$W" "${args[@]}" "--$flag" "$value" > "$D/old.out" 2> "$D/old.err" || fail "--$flag on samples"
+  cmp -s "$D/new.out" "$D/old.out" || fail "--$flag on a run without time is not read in samples"
+  grep -q "^warning: --$flag: the run has no recorded time.*use --$flag-samples" "$D/old.err" ||
+    fail "--$flag on samples: no warning: $(cat "$D/old.err")"
+done
+expect_fail "--check-every-samples 60: the run records time: use --check-every-min" \
+  "$W" drift monitor "${MON[@]}" --check-every-samples 60
+expect_fail "--lag-grid-samples 10: the run records time: use --lag-grid-min" \
+  "$W" drift holdout --log "$D/drift.csv" --no-network --lag-grid-samples 10
 
 # Both spellings at once: an error naming the old one; a bad value: named as typed.
 expect_fail "--max-elongation" "$W" curve --max-elongation 30 --max-elongation-um 30 --settle-time-s 250

@@ -66,7 +66,7 @@ t "$W" machine sensors --out-dir msens --idle 1 --cutting 1 --machine-seed 2 > /
 
 # drift monitor: the report and --timeline/--events together; a directory at --events stops all.
 mkdir evdir
-expect_fail "evdir" t "$W" drift monitor --model model.json --run log.csv --report mrep \
+expect_fail "evdir" t "$W" drift monitor --model model.json --run log.csv --out-dir mrep \
   --timeline tl.csv --events evdir
 [ -e mrep ] || [ -e tl.csv ] && fail "monitor wrote a report or timeline although --events failed"
 
@@ -104,9 +104,9 @@ dir_rule() {  # dir_rule <flag> <command...>: a symlinked and a foreign director
 }
 dir_rule --out-dir "$W" drift split --log log.csv
 dir_rule --out-dir "$W" machine sensors --idle 1 --cutting 0
-dir_rule --out "$W" drift report --train-run log.csv --error ch1_um --sensors t1_C,t2_C
-dir_rule --report "$W" drift holdout --log log.csv --channels ch1_um --no-network
-dir_rule --report "$W" drift monitor --model model.json --run log.csv
+dir_rule --out-dir "$W" drift report --train-run log.csv --error ch1_um --sensors t1_C,t2_C
+dir_rule --out-dir "$W" drift holdout --log log.csv --channels ch1_um --no-network
+dir_rule --out-dir "$W" drift monitor --model model.json --run log.csv
 dir_rule --out-dir "$W" ballbar simulate
 dir_rule --out-dir "$W" surface fit --points pts.csv --no-plots
 dir_rule --curves-dir "$W" dataset --count 1 --out table.csv
@@ -118,9 +118,9 @@ dir_rule --out-dir "$W" demo --no-plots
 # Run twice into the same directory: whirl's own output is replaced.
 for k in 1 2; do
   t "$W" ballbar simulate --out-dir bb > /dev/null || fail "ballbar simulate run $k"
-  t "$W" drift report --train-run log.csv --error ch1_um --sensors t1_C,t2_C --out drep \
+  t "$W" drift report --train-run log.csv --error ch1_um --sensors t1_C,t2_C --out-dir drep \
     > /dev/null 2>&1 || fail "drift report run $k"
-  t "$W" drift monitor --model model.json --run log.csv --report mon > /dev/null 2>&1 \
+  t "$W" drift monitor --model model.json --run log.csv --out-dir mon > /dev/null 2>&1 \
     || fail "drift monitor run $k"
 done
 # A file that is not whirl's, added to whirl's output, refuses it and is never removed.
