@@ -219,6 +219,7 @@ TEST(FamilyCalibration, TwoSdCoversEveryLeaveOneOutResidualAtTwentyRows) {
   ProcessTable table = MakeTable(20, 0.01, 41);
   table.targets[7].max_elongation_um *= 1.3;
   FitOptions one, two;
+  one.calibrate_two_sd = false;
   two.calibrate_two_sd = true;
   const Candidate c = ParseCandidate("linear/identity");
   const FamilyModel m1 = FitCandidate(table, c, one), m2 = FitCandidate(table, c, two);
