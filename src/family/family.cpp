@@ -1,5 +1,6 @@
 #include "family/family.h"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@ namespace whirl::family {
 namespace {
 
 constexpr double kOneSigma = 0.6827;  // share of a normal within +-1 sd
+constexpr double kTwoSigma = 0.9545;  // share of a normal within +-2 sd
 
 std::string KernelShort(gp::Kernel k) {
   return k == gp::Kernel::kSquaredExponential ? "se" : "matern52";
@@ -78,6 +80,7 @@ gp::GpOptions CandidateGpOptions(const FitOptions& o, const Candidate& c) {
   gp::GpOptions go = o.gp;
   go.kernel = c.kernel;
   go.mean = c.mean;
+  go.isotropic = c.isotropic;
   return go;
 }
 
@@ -120,31 +123,45 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
   return h;
 }
 
-// The noise of output k from its held-out residuals (CoverageNoiseVariance).
-void SetNoise(const HeldOut& h, int k, FamilyModel* m) {
-  const double s2 = CoverageNoiseVariance(h.r, h.v);
+// The noise of output k from its held-out residuals h (CoverageNoiseVariance, +-1 sd); with
+// `loo` (FitOptions::calibrate_two_sd) at least the level at which the closed-form leave-one-out
+// residuals are covered at both +-1 and +-2 sd.
+void SetNoise(const HeldOut& h, const HeldOut* loo, int k, FamilyModel* m) {
+  double s2 = CoverageNoiseVariance(h.r, h.v);
+  if (loo) s2 = std::max(s2, CoverageNoiseVariance(loo->r, loo->v, true));
   if (m->candidate.family == Family::kLinear)
     m->linears[k].noise_variance = s2;
   else
     m->gps[k].noise_variance = s2 / (m->gps[k].target_scale * m->gps[k].target_scale);
 }
 
-std::string CalibrationText(int folds) {
+// SetNoise for output k (x, y transformed) from its residuals h of `folds` (OutputHeldOut), with
+// the closed-form leave-one-out residuals when FitOptions::calibrate_two_sd.
+void SetNoiseFrom(const HeldOut& h, int folds, const FitOptions& o, const Eigen::MatrixXd& x,
+                  const Eigen::VectorXd& y, int k, FamilyModel* m) {
+  if (!o.calibrate_two_sd) return SetNoise(h, nullptr, k, m);
+  if (folds == 0) return SetNoise(h, &h, k, m);
+  const HeldOut loo = OutputHeldOut(*m, k, x, y, o, 0);
+  SetNoise(h, &loo, k, m);
+}
+
+std::string CalibrationText(int folds, bool two_sd) {
   return "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
          "covers 68.27 % of the " +
          (folds == 0 ? std::string("closed-form leave-one-out residuals")
-                     : std::to_string(folds) + "-fold cross-validation residuals (refits)");
+                     : std::to_string(folds) + "-fold cross-validation residuals (refits)") +
+         (two_sd ? ", and +-1 sd 68.27 % and +-2 sd 95.45 % of the closed-form leave-one-out "
+                   "residuals"
+                 : "");
 }
 
-// Squared held-out errors in original units, t_ik - g^-1(z_ik - r_ik), of output k.
-Eigen::RowVectorXd OriginalSquaredErrors(const FamilyModel& m, int k, const Eigen::RowVectorXd& t,
-                                         const Eigen::VectorXd& z, const HeldOut& h) {
-  Eigen::RowVectorXd sq(t.size());
-  for (Eigen::Index i = 0; i < t.size(); ++i) {
-    const double e = t(i) - Inverse(m.transform.outputs[k], z(i) - h.r(i));
-    sq(i) = e * e;
-  }
-  return sq;
+// Held-out errors in original units, t_ik - g^-1(z_ik - r_ik), of output k.
+Eigen::RowVectorXd OriginalErrors(const FamilyModel& m, int k, const Eigen::RowVectorXd& t,
+                                  const Eigen::VectorXd& z, const HeldOut& h) {
+  Eigen::RowVectorXd e(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i)
+    e(i) = t(i) - Inverse(m.transform.outputs[k], z(i) - h.r(i));
+  return e;
 }
 
 std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o) {
@@ -152,6 +169,7 @@ std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitO
   gp::GpOptions go = o.gp;
   go.kernel = c.kernel;
   go.mean = c.mean;
+  go.isotropic = c.isotropic;
   std::vector<gp::Gp> gps(static_cast<std::size_t>(y.rows()));
   for (Eigen::Index k = 0; k < y.rows(); ++k) {
     gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
@@ -206,17 +224,17 @@ ProcessTable Rows(const ProcessTable& table, int folds, int fold, bool held_out)
   return out;
 }
 
-// Squared held-out errors (2 x rows, original units) of one candidate's fold fit.
+// Held-out errors (2 x rows, original units) of one candidate's fold fit.
 void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
-                int fold, Eigen::MatrixXd* sq) {
+                int fold, Eigen::MatrixXd* err) {
   const ProcessTable train = Rows(table, folds, fold, false), held = Rows(table, folds, fold, true);
   const FamilyModel m = FitCandidate(train, c, o, false);
   const std::vector<FamilyPrediction> p = PredictFamily(m, held.inputs);
   for (std::size_t i = 0, row = 0; row < table.inputs.size(); ++row) {
     if (static_cast<int>(row) % folds != fold) continue;
     for (int k = 0; k < Features::kCount; ++k) {
-      const double e = held.targets[i].ToArray()[k] - p[i].mean.ToArray()[k];
-      (*sq)(k, static_cast<Eigen::Index>(row)) = e * e;
+      (*err)(k, static_cast<Eigen::Index>(row)) =
+          held.targets[i].ToArray()[k] - p[i].mean.ToArray()[k];
     }
     ++i;
   }
@@ -231,16 +249,16 @@ bool ReusesCalibration(const ChoiceOptions& o, int folds) {
   return HeldOutFolds(o, folds) == std::min(o.fit.calibration_folds, folds);
 }
 
-// Fits (or takes from `full`, the closed-form fits) each distinct chosen candidate on all rows,
-// with calibration.
+// Fits (or takes from `full`, the closed-form fits) each candidate that predicts an output
+// (chosen, or a positive stacking weight) on all rows, with calibration; fills models,
+// model_of_output and, for stacked outputs, weights.
 void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
+               const std::array<Eigen::VectorXd, Features::kCount>& stack,
                std::vector<FamilyModel>& full, Choice* choice) {
   std::vector<int> fitted;
-  for (int k = 0; k < Features::kCount; ++k) {
-    const auto it = std::find(fitted.begin(), fitted.end(), choice->chosen[k]);
-    choice->model_of_output[k] = static_cast<int>(it - fitted.begin());
-    if (it != fitted.end()) continue;
-    const int c = choice->chosen[k];
+  auto model_of = [&](int c) {
+    const auto it = std::find(fitted.begin(), fitted.end(), c);
+    if (it != fitted.end()) return static_cast<int>(it - fitted.begin());
     fitted.push_back(c);
     if (options.candidates[c].family != Family::kNetwork) {
       const int folds = std::min(options.folds, static_cast<int>(table.inputs.size()));
@@ -249,6 +267,17 @@ void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
     } else {
       choice->models.push_back(FitCandidate(table, options.candidates[c], options.fit, true));
     }
+    return static_cast<int>(fitted.size()) - 1;
+  };
+  for (int k = 0; k < Features::kCount; ++k) {
+    choice->model_of_output[k] = model_of(choice->chosen[k]);
+    for (Eigen::Index c = 0; c < stack[k].size(); ++c)
+      if (stack[k](c) > 0) model_of(static_cast<int>(c));
+  }
+  for (int k = 0; k < Features::kCount; ++k) {
+    if (stack[k].size() == 0) continue;
+    choice->weights[k].assign(fitted.size(), 0.0);
+    for (std::size_t j = 0; j < fitted.size(); ++j) choice->weights[k][j] = stack[k](fitted[j]);
   }
 }
 
@@ -270,14 +299,14 @@ std::string Candidate::Name() const {
     return (hidden == kHiddenByEvidence ? std::string("network-evidence")
                                         : "network-h" + std::to_string(hidden)) +
            t;
-  return "gp-" + KernelShort(kernel) + "-" + gp::ToString(mean) + t;
+  return "gp-" + KernelShort(kernel) + (isotropic ? "-iso-" : "-") + gp::ToString(mean) + t;
 }
 
 Candidate ParseCandidate(const std::string& name) {
   const auto slash = name.rfind('/');
   const std::string bad = "candidate '" + name +
                           "': must be linear, network-evidence, network-hN or gp-(se|matern52)-"
-                          "(constant|linear), then /identity or /log";
+                          "[iso-](constant|linear), then /identity or /log";
   if (slash == std::string::npos) throw InputError(bad);
   Candidate c;
   const std::string body = name.substr(0, slash), t = name.substr(slash + 1);
@@ -293,9 +322,12 @@ Candidate ParseCandidate(const std::string& name) {
     }
     for (const auto k : {gp::Kernel::kSquaredExponential, gp::Kernel::kMatern52})
       for (const auto m : {gp::Mean::kConstant, gp::Mean::kLinear}) {
-        c.kernel = k;
-        c.mean = m;
-        if (f == Family::kGaussianProcess && c.Name() == name) return c;
+        for (const bool iso : {false, true}) {
+          c.kernel = k;
+          c.mean = m;
+          c.isotropic = iso;
+          if (f == Family::kGaussianProcess && c.Name() == name) return c;
+        }
       }
   }
   throw InputError(bad);
@@ -324,32 +356,34 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
 void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
   const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
   const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
-  for (int k = 0; k < Features::kCount; ++k)
-    SetNoise(OutputHeldOut(*m, k, x, y.row(k).transpose(), options, options.calibration_folds), k,
-             m);
-  m->calibration = CalibrationText(options.calibration_folds);
+  for (int k = 0; k < Features::kCount; ++k) {
+    const Eigen::VectorXd yk = y.row(k).transpose();
+    SetNoiseFrom(OutputHeldOut(*m, k, x, yk, options, options.calibration_folds),
+                 options.calibration_folds, options, x, yk, k, m);
+  }
+  m->calibration = CalibrationText(options.calibration_folds, options.calibrate_two_sd);
 }
 
-Eigen::MatrixXd HeldOutSquaredErrors(const ProcessTable& table, const FitOptions& options,
-                                     int folds, FamilyModel* m, bool calibrate) {
+Eigen::MatrixXd HeldOutErrors(const ProcessTable& table, const FitOptions& options, int folds,
+                              FamilyModel* m, bool calibrate) {
   if (m->candidate.family == Family::kNetwork)
     throw InputError("held-out errors of a fitted model: not available for " + m->candidate.Name());
   const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::MatrixXd y = TransformTargets(m->transform, t);
-  Eigen::MatrixXd sq(t.rows(), t.cols());
+  Eigen::MatrixXd err(t.rows(), t.cols());
   for (int k = 0; k < Features::kCount; ++k) {
     const HeldOut h = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds);
-    sq.row(k) = OriginalSquaredErrors(*m, k, t.row(k), y.row(k).transpose(), h);
-    if (calibrate) SetNoise(h, k, m);
+    err.row(k) = OriginalErrors(*m, k, t.row(k), y.row(k).transpose(), h);
+    if (calibrate) SetNoiseFrom(h, folds, options, x, y.row(k).transpose(), k, m);
   }
-  if (calibrate) m->calibration = CalibrationText(folds);
-  return sq;
+  if (calibrate) m->calibration = CalibrationText(folds, options.calibrate_two_sd);
+  return err;
 }
 
 Eigen::MatrixXd LeaveOneOutSquaredErrors(const FamilyModel& m, const ProcessTable& table) {
   FamilyModel copy = m;
-  return HeldOutSquaredErrors(table, {}, 0, &copy, false);
+  return HeldOutErrors(table, {}, 0, &copy, false).array().square().matrix();
 }
 
 std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
@@ -377,6 +411,43 @@ std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
   return out;
 }
 
+Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
+                                   const Eigen::VectorXd& target) {
+  const Eigen::Index n = predictions.rows(), nc = predictions.cols();
+  if (n == 0 || nc == 0 || nc > 12 || target.size() != n)
+    throw InputError("stacking weights: " + std::to_string(n) + " x " + std::to_string(nc) +
+                     " predictions and " + std::to_string(target.size()) +
+                     " targets; need rows > 0, 1 to 12 candidates, one target per row");
+  Eigen::VectorXd best = Eigen::VectorXd::Unit(nc, 0);
+  double best_sse = (target - predictions.col(0)).squaredNorm();
+  int best_size = 1;
+  for (unsigned mask = 1; mask < (1u << nc); ++mask) {
+    std::vector<Eigen::Index> on;
+    for (Eigen::Index c = 0; c < nc; ++c)
+      if (mask & (1u << c)) on.push_back(c);
+    const Eigen::Index m = static_cast<Eigen::Index>(on.size());
+    const Eigen::MatrixXd p = predictions(Eigen::all, on);
+    Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(m + 1, m + 1);  // [P'P 1; 1' 0]
+    kkt.topLeftCorner(m, m) = p.transpose() * p;
+    kkt.topRightCorner(m, 1).setOnes();
+    kkt.bottomLeftCorner(1, m).setOnes();
+    Eigen::VectorXd rhs(m + 1);
+    rhs << p.transpose() * target, 1.0;
+    const Eigen::VectorXd sol = kkt.completeOrthogonalDecomposition().solve(rhs);
+    const Eigen::VectorXd w = sol.head(m);
+    if (!w.allFinite() || (w.array() < 0).any() || std::abs(w.sum() - 1.0) > 1e-9) continue;
+    const double sse = (target - p * w).squaredNorm();
+    const double tol = 1e-12 * std::max(best_sse, 1e-300);
+    if (sse < best_sse - tol || (sse <= best_sse + tol && m < best_size)) {
+      best.setZero();
+      best(on) = w;
+      best_sse = sse;
+      best_size = static_cast<int>(m);
+    }
+  }
+  return best;
+}
+
 int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors) {
   if (squared_errors.empty()) throw InputError("one-standard-error rule: no candidates");
   std::size_t best = 0;
@@ -392,19 +463,21 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
 }
 
 double CoverageNoiseVariance(const Eigen::VectorXd& residual,
-                             const Eigen::VectorXd& latent_variance) {
+                             const Eigen::VectorXd& latent_variance, bool two_sd) {
   if (residual.size() == 0 || residual.size() != latent_variance.size())
     throw InputError("noise calibration: " + std::to_string(residual.size()) + " residuals and " +
                      std::to_string(latent_variance.size()) + " variances; need equal, > 0");
   const Eigen::ArrayXd r2 = residual.array().square();
-  auto coverage = [&](double s2) {
-    return (r2 <= s2 + latent_variance.array()).cast<double>().mean();
+  auto covers = [&](double s2) {
+    const auto v = s2 + latent_variance.array();
+    return (r2 <= v).cast<double>().mean() >= kOneSigma &&
+           (!two_sd || (r2 <= 4.0 * v).cast<double>().mean() >= kTwoSigma);
   };
   double lo = 0.0, hi = r2.maxCoeff() + 1e-300;
-  if (coverage(lo) >= kOneSigma) return 0.0;
+  if (covers(lo)) return 0.0;
   for (int it = 0; it < 200 && hi > lo; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (coverage(mid) >= kOneSigma ? hi : lo) = mid;
+    (covers(mid) ? hi : lo) = mid;
   }
   return hi;
 }
@@ -418,8 +491,8 @@ void to_json(nlohmann::json& j, const CvRow& r) {
 
 std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   std::vector<Candidate> c;
-  for (const char* name : {"linear/log", "linear/identity", "gp-matern52-constant/log",
-                           "gp-matern52-constant/identity"})
+  for (const char* name : {"linear/log", "linear/identity", "gp-se-iso-constant/identity",
+                           "gp-matern52-constant/log", "gp-matern52-constant/identity"})
     c.push_back(ParseCandidate(name));
   return c;
 }
@@ -431,8 +504,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   const int folds = std::min(options.folds, rows), nc = static_cast<int>(options.candidates.size());
   if (folds < 2)
     throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
-  std::vector<Eigen::MatrixXd> sq(static_cast<std::size_t>(nc),
-                                  Eigen::MatrixXd(Features::kCount, rows));
+  std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
+                                   Eigen::MatrixXd(Features::kCount, rows));
   std::vector<double> ms(static_cast<std::size_t>(nc * folds));
   FitOptions fold_options = options.fit;
   fold_options.threads = 1;
@@ -441,11 +514,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
     if (options.candidates[c].family == Family::kNetwork) {
-      FoldErrors(table, options.candidates[c], fold_options, folds, f, &sq[c]);
+      FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
     } else if (f == 0) {  // one full fit, its held-out errors (and calibration) from it
       full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
-      sq[c] = HeldOutSquaredErrors(table, fold_options, HeldOutFolds(options, folds), &full[c],
-                                   ReusesCalibration(options, folds));
+      err[c] = HeldOutErrors(table, fold_options, HeldOutFolds(options, folds), &full[c],
+                             ReusesCalibration(options, folds));
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -457,7 +530,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   for (int c = 0; c < nc; ++c) {
     CvRow r;
     r.candidate = options.candidates[c];
-    const Eigen::ArrayXd mse = sq[c].rowwise().mean().array();
+    const Eigen::ArrayXd mse = err[c].array().square().rowwise().mean();
     r.cv_rmse = mse.sqrt().matrix();
     r.score = (mse / var).sum();
     for (int f = 0; f < folds; ++f) r.fit_ms += ms[c * folds + f];
@@ -468,12 +541,22 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
         choice.chosen[k] = c;
     }
   }
-  for (int k = 0; k < Features::kCount && options.per_output && options.one_standard_error; ++k) {
-    std::vector<Eigen::VectorXd> output_sq;
-    for (const Eigen::MatrixXd& m : sq) output_sq.push_back(m.row(k).transpose());
-    choice.chosen[k] = SimplestWithinOneStandardError(output_sq);
+  std::array<Eigen::VectorXd, Features::kCount> stack;
+  for (int k = 0; k < Features::kCount && options.per_output; ++k) {
+    if (options.stack) {
+      Eigen::MatrixXd p(rows, nc);
+      for (int c = 0; c < nc; ++c) p.col(c) = (t.row(k) - err[c].row(k)).transpose();
+      stack[k] = ConvexStackWeights(p, t.row(k).transpose());
+      Eigen::Index top = 0;
+      stack[k].maxCoeff(&top);
+      choice.chosen[k] = static_cast<int>(top);
+    } else if (options.one_standard_error) {
+      std::vector<Eigen::VectorXd> output_sq;
+      for (const Eigen::MatrixXd& m : err) output_sq.push_back(m.row(k).array().square().matrix());
+      choice.chosen[k] = SimplestWithinOneStandardError(output_sq);
+    }
   }
-  FitChosen(table, options, full, &choice);
+  FitChosen(table, options, stack, full, &choice);
   return choice;
 }
 
@@ -485,9 +568,19 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
   for (std::size_t q = 0; q < inputs.size(); ++q) {
     std::array<double, Features::kCount> mean{}, sd{};
     for (int k = 0; k < Features::kCount; ++k) {
-      const FamilyPrediction& p = per_model[choice.model_of_output[k]][q];
-      mean[k] = p.mean.ToArray()[k];
-      sd[k] = p.stddev.ToArray()[k];
+      if (choice.weights[k].empty()) {
+        const FamilyPrediction& p = per_model[choice.model_of_output[k]][q];
+        mean[k] = p.mean.ToArray()[k];
+        sd[k] = p.stddev.ToArray()[k];
+        continue;
+      }
+      double var = 0;
+      for (std::size_t j = 0; j < per_model.size(); ++j) {
+        const double w = choice.weights[k][j], s = per_model[j][q].stddev.ToArray()[k];
+        mean[k] += w * per_model[j][q].mean.ToArray()[k];
+        var += w * s * s;
+      }
+      sd[k] = std::sqrt(var);
     }
     out[q] = {Features::FromArray(mean), Features::FromArray(sd)};
   }
@@ -496,9 +589,19 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
 
 std::string Choice::Describe() const {
   std::string s;
-  for (int k = 0; k < Features::kCount; ++k)
-    s += (k ? ", " : "") + std::string(kTargetColumns[k]) + ": " +
-         table.at(chosen[k]).candidate.Name();
+  for (int k = 0; k < Features::kCount; ++k) {
+    s += (k ? ", " : "") + std::string(kTargetColumns[k]) + ": ";
+    if (weights[k].empty()) {
+      s += table.at(chosen[k]).candidate.Name();
+      continue;
+    }
+    std::string terms;
+    for (std::size_t j = 0; j < weights[k].size() && j < models.size(); ++j)
+      if (weights[k][j] > 0)
+        terms += (terms.empty() ? "" : " + ") + FormatFixed(weights[k][j], 2) + " " +
+                 models[j].candidate.Name();
+    s += terms;
+  }
   return s;
 }
 

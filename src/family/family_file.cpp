@@ -1,5 +1,7 @@
 // The JSON of a fitted family model and of a family choice (family/family.h): what the workpiece
 // model file (workpiece/model.h) stores for a model that is not a network.
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/error.h"
@@ -110,16 +112,50 @@ void to_json(json& j, const Choice& c) {
        {"chosen", c.chosen},
        {"model_of_output", c.model_of_output},
        {"models", c.models}};
+  if (std::any_of(c.weights.begin(), c.weights.end(), [](const auto& w) { return !w.empty(); }))
+    j["weights"] = c.weights;
 }
+
+namespace {
+// Choice::weights from "weights" (optional): per output an empty array or one weight >= 0 per
+// model, summing to 1, the largest on the output's model.
+void ReadWeights(const json& j, const std::string& what, Choice* c) {
+  if (!j.contains("weights")) return;
+  const json& w = j.at("weights");
+  if (!w.is_array() || w.size() != static_cast<std::size_t>(Features::kCount))
+    throw InputError(what + ": 'weights' must hold one array per output");
+  for (int k = 0; k < Features::kCount; ++k) {
+    const std::string at = what + ": 'weights' of " + kTargetColumns[k];
+    if (!w[k].is_array()) throw InputError(at + " must be an array");
+    if (w[k].empty()) continue;
+    if (w[k].size() != c->models.size())
+      throw InputError(at + " must hold one weight per model (" +
+                       std::to_string(c->models.size()) + ")");
+    double sum = 0;
+    for (const json& v : w[k]) {
+      if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0)
+        throw InputError(at + " must be finite numbers >= 0");
+      c->weights[k].push_back(v.get<double>());
+      sum += v.get<double>();
+    }
+    if (std::abs(sum - 1.0) > 1e-9) throw InputError(at + " must sum to 1");
+    const auto top = std::max_element(c->weights[k].begin(), c->weights[k].end());
+    if (*top != c->weights[k][c->model_of_output[k]])
+      throw InputError(at + ": the largest weight must be on the model of 'model_of_output'");
+  }
+}
+}  // namespace
+
 
 void from_json(const json& j, Choice& c) {
   const std::string what = "family choice";
   const json& table = Key(j, "table", what);
   const json& models = Key(j, "models", what);
   if (!table.is_array() || table.empty() || !models.is_array() || models.empty() ||
-      models.size() > static_cast<std::size_t>(Features::kCount))
+      models.size() > std::max<std::size_t>(Features::kCount, table.size()))
     throw InputError(what + ": 'table' must be a non-empty array and 'models' hold 1 to " +
-                     std::to_string(Features::kCount) + " models");
+                     std::to_string(Features::kCount) + " models (a stack: up to one per row " +
+                     "of 'table')");
   c.table = table.get<std::vector<CvRow>>();
   c.models = models.get<std::vector<FamilyModel>>();
   c.chosen = Indices(j, "chosen", static_cast<int>(c.table.size()), what);
@@ -131,6 +167,7 @@ void from_json(const json& j, Choice& c) {
       throw InputError(what + ": output " + kTargetColumns[k] + " is predicted by " + used +
                        " but 'chosen' names " + chosen);
   }
+  ReadWeights(j, what, &c);
 }
 
 }  // namespace whirl::family

@@ -138,11 +138,30 @@ void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp
     return NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t, gp->min_noise_variance,
                                     grad);
   };
+  const int d = gp->InputCount();
+  // Isotropic: (ln l, ln s_f, ln s_n) <-> theta with d equal length scales.
+  const auto expand = [d](const Eigen::VectorXd& t3) {
+    Eigen::VectorXd t(d + 2);
+    t.head(d).setConstant(t3(0));
+    t.tail(2) = t3.tail(2);
+    return t;
+  };
+  const SmoothObjective f_iso = [&](const Eigen::VectorXd& t3, Eigen::VectorXd* grad3) {
+    Eigen::VectorXd g;
+    const double v = f(expand(t3), grad3 ? &g : nullptr);
+    if (grad3) {
+      grad3->resize(3);
+      *grad3 << g.head(d).sum(), g(d), g(d + 1);
+    }
+    return v;
+  };
   GpSummary s;
   s.nlml = kInf;
   for (const Eigen::VectorXd& start : starts) {
     Eigen::VectorXd t = start;
-    const BfgsSummary b = MinimizeBfgs(f, &t, o.bfgs);
+    if (o.isotropic) t = Eigen::Vector3d(start.head(d).mean(), start(d), start(d + 1));
+    const BfgsSummary b = MinimizeBfgs(o.isotropic ? f_iso : f, &t, o.bfgs);
+    if (o.isotropic) t = expand(t);
     s.start_nlml.push_back(b.final_cost);
     if (b.final_cost < s.nlml || gp->theta.size() == 0) {
       s.nlml = b.final_cost;

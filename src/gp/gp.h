@@ -57,6 +57,11 @@ inline BfgsOptions GpBfgsDefaults() {
 struct GpOptions {
   Kernel kernel = Kernel::kMatern52;
   Mean mean = Mean::kConstant;
+  /// true: one length scale for all (standardized) inputs, l_1 = ... = l_d = l (an isotropic
+  /// kernel, R&W eq. 4.9 and 4.17 with a scalar l): the likelihood is maximized over
+  /// (ln l, ln s_f, ln s_n), dNLML/d ln l = sum_i dNLML/d ln l_i; Gp::theta still holds d equal
+  /// length scales, so predictions, leave-one-out and files are those of the ARD form.
+  bool isotropic = false;
   /// Starting points of the likelihood maximization (1..kStartCount), taken in this order from
   /// a fixed list (no random numbers: the same table gives the same GP everywhere). One by
   /// default: in scripts/bench_peers.sh (20 seeds each of Friedman and simulator tables, 20 and
@@ -119,7 +124,8 @@ struct GpSummary {
 /// sizes disagree, values are not finite, or n <= m + 1 (too few rows for the mean).
 Gp FitGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
          GpSummary* summary = nullptr);
-/// Same, optimizing from `theta_start` only (warm start, e.g. a fold from the full fit).
+/// Same, optimizing from `theta_start` only (warm start, e.g. a fold from the full fit; with
+/// GpOptions::isotropic, from the mean of its log length scales).
 Gp FitGpFrom(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
              const Eigen::VectorXd& theta_start, GpSummary* summary = nullptr);
 

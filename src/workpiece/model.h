@@ -94,7 +94,8 @@ struct TrainOptions {
 };
 
 /// The candidates of a choice for the flags:
-///   kAuto:            ChoiceOptions::DefaultCandidates() (power law, linear, GP Matern 5/2),
+///   kAuto:            ChoiceOptions::DefaultCandidates() (power law, linear, isotropic GP,
+///                     GP Matern 5/2),
 ///   kLinear:          linear/log, linear/identity,
 ///   kGaussianProcess: gp-matern52-constant/log, gp-matern52-constant/identity,
 ///   kNetwork:         network-evidence/log, network-evidence/identity,

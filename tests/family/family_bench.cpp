@@ -2,7 +2,7 @@
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
 //                [--joint] [--loo|--kfold] [--no-1se] [--gp-ftol F] [--calibration-folds K]
-//                [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -46,6 +46,12 @@ Args Parse(int argc, char** argv) {
       a.choice.closed_form_loo = true;
     else if (k == "--kfold")
       a.choice.closed_form_loo = false;
+    else if (k == "--stack")
+      a.choice.stack = true;
+    else if (k == "--two-sd")
+      a.choice.fit.calibrate_two_sd = true;
+    else if (k == "--one-sd")
+      a.choice.fit.calibrate_two_sd = false;
     else if (k == "--no-1se")
       a.choice.one_standard_error = false;
     else if (k == "--gp-ftol")

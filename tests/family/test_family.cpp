@@ -200,11 +200,122 @@ TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   ExpectInputError([&] { CoverageNoiseVariance(r, v.head(2)); }, "4 residuals and 2");
 }
 
+TEST(FamilyCalibration, TwoSdCoverageOnHandComputedCases) {
+  Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
+  r << 1, 1, 1, 4;
+  EXPECT_NEAR(CoverageNoiseVariance(r, v), 1.0, 1e-9);  // 3 of 4 within sqrt(1)
+  // +-2 sd must cover 95.45 %: all four, 2 sqrt(s2) >= 4.
+  EXPECT_NEAR(CoverageNoiseVariance(r, v, true), 4.0, 1e-9);
+  r << 1, 2, 3, 4;  // +-1 sd needs 9; 2 sqrt(9) = 6 covers all four
+  EXPECT_NEAR(CoverageNoiseVariance(r, v, true), 9.0, 1e-9);
+  v << 0, 0, 0, 12;  // the 4th: 4 (s2 + 12) >= 16 for any s2; +-1 sd: 3 of 4 at s2 = 4
+  EXPECT_NEAR(CoverageNoiseVariance(r, v, true), 4.0, 1e-9);
+}
+
+TEST(FamilyCalibration, TwoSdCoversEveryLeaveOneOutResidualAtTwentyRows) {
+  // One outlier among 20 rows: FitOptions::calibrate_two_sd raises the noise until +-2 sd covers
+  // 95.45 % (at 20 rows: all) of the closed-form leave-one-out residuals, and keeps at least the
+  // +-1 sd level of the 5-fold residuals.
+  ProcessTable table = MakeTable(20, 0.01, 41);
+  table.targets[7].max_elongation_um *= 1.3;
+  FitOptions one, two;
+  one.calibrate_two_sd = false;
+  two.calibrate_two_sd = true;
+  const Candidate c = ParseCandidate("linear/identity");
+  const FamilyModel m1 = FitCandidate(table, c, one), m2 = FitCandidate(table, c, two);
+  const Eigen::MatrixXd x = nn::InputMatrix(table.inputs), y = nn::TargetMatrix(table.targets);
+  for (int k = 0; k < 2; ++k) {
+    const double s2 = m2.linears[k].noise_variance;
+    EXPECT_GE(s2, m1.linears[k].noise_variance) << "output " << k;
+    const LinearLeaveOneOut loo = LeaveOneOutLinear(m2.linears[k], x, y.row(k).transpose());
+    for (int i = 0; i < 20; ++i)
+      EXPECT_LE(loo.residual(i) * loo.residual(i),
+                4.0 * (s2 + loo.latent_variance(i)) * (1 + 1e-9))
+          << "output " << k << " row " << i;
+  }
+  EXPECT_GT(m2.linears[0].noise_variance, 2.0 * m1.linears[0].noise_variance);
+  EXPECT_NE(m2.calibration.find("+-2 sd 95.45 %"), std::string::npos) << m2.calibration;
+}
+
+TEST(FamilyStacking, WeightsOnHandComputedCases) {
+  Eigen::MatrixXd p(2, 2);
+  Eigen::VectorXd t(2);
+  t << 0, 0;
+  p << 1, -1, 1, -1;  // symmetric errors: the half-half mean is exact
+  EXPECT_TRUE(ConvexStackWeights(p, t).isApprox(Eigen::Vector2d(0.5, 0.5), 1e-12));
+  p << 0, 1, 0, 2;  // the first is exact: the unconstrained solution needs no second
+  EXPECT_TRUE(ConvexStackWeights(p, t).isApprox(Eigen::Vector2d(1, 0), 1e-12));
+  p << 1, 3, 1, 3;  // both above the target: the convex optimum is the nearer one alone
+  EXPECT_TRUE(ConvexStackWeights(p, t).isApprox(Eigen::Vector2d(1, 0), 1e-12));
+  ExpectInputError([&] { ConvexStackWeights(p, Eigen::VectorXd(3)); }, "one target per row");
+}
+
+TEST(FamilyStacking, WeightsBeatEveryPointOfASimplexGrid) {
+  // Property over random cases: w >= 0, sum 1, and no point of a 0.01 grid of the simplex has a
+  // lower squared error.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01;
+  for (int trial = 0; trial < 50; ++trial) {
+    Eigen::MatrixXd p(8, 3);
+    Eigen::VectorXd t(8);
+    for (int i = 0; i < 8; ++i) {
+      t(i) = n01(rng);
+      for (int c = 0; c < 3; ++c) p(i, c) = t(i) + (c + 1) * 0.3 * n01(rng) + 0.2 * c;
+    }
+    const Eigen::VectorXd w = ConvexStackWeights(p, t);
+    ASSERT_GE(w.minCoeff(), 0.0);
+    ASSERT_NEAR(w.sum(), 1.0, 1e-12);
+    const double sse = (t - p * w).squaredNorm();
+    for (int a = 0; a <= 100; ++a)
+      for (int b = 0; a + b <= 100; ++b) {
+        const Eigen::Vector3d g(a / 100.0, b / 100.0, (100 - a - b) / 100.0);
+        ASSERT_LE(sse, (t - p * g).squaredNorm() + 1e-12) << "trial " << trial;
+      }
+  }
+}
+
+TEST(FamilyStacking, StackedChoicePredictsTheWeightedMeanAndRoundTrips) {
+  const ProcessTable train = MakeTable(20, 0.05, 31, true), test = MakeTable(30, 0.0, 32, true);
+  ChoiceOptions o;
+  o.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-constant/identity"),
+                  ParseCandidate("gp-se-iso-constant/log")};
+  o.stack = true;
+  const Choice c = ChooseFamily(train, o);
+  ASSERT_GE(c.models.size(), 2u) << "no combination: the test would be moot; " << c.Describe();
+  const std::vector<FamilyPrediction> p = PredictChoice(c, test.inputs);
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_EQ(c.weights[k].size(), c.models.size()) << c.Describe();
+    double sum = 0;
+    for (const double w : c.weights[k]) sum += w;
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+    for (std::size_t q = 0; q < test.inputs.size(); ++q) {
+      double mean = 0, var = 0;
+      for (std::size_t j = 0; j < c.models.size(); ++j) {
+        const FamilyPrediction pj = PredictFamily(c.models[j], {test.inputs[q]}).front();
+        mean += c.weights[k][j] * pj.mean.ToArray()[k];
+        var += c.weights[k][j] * std::pow(pj.stddev.ToArray()[k], 2);
+      }
+      EXPECT_NEAR(p[q].mean.ToArray()[k], mean, 1e-9 * std::abs(mean));
+      EXPECT_NEAR(p[q].stddev.ToArray()[k], std::sqrt(var), 1e-9 * std::sqrt(var));
+    }
+  }
+  const Choice back = nlohmann::json(c).get<Choice>();
+  const std::vector<FamilyPrediction> pb = PredictChoice(back, test.inputs);
+  for (std::size_t q = 0; q < test.inputs.size(); ++q)
+    for (int k = 0; k < 2; ++k) EXPECT_EQ(pb[q].mean.ToArray()[k], p[q].mean.ToArray()[k]);
+  nlohmann::json bad = c;
+  bad["weights"][0][0] = bad["weights"][0][0].get<double>() + 0.5;
+  ExpectInputError([&] { bad.get<Choice>(); }, "must sum to 1");
+}
+
 TEST(FamilyCandidates, NamesRoundTripAndBadInput) {
   for (const Candidate& c : ChoiceOptions::DefaultCandidates())
     EXPECT_EQ(ParseCandidate(c.Name()).Name(), c.Name());
-  for (const char* n : {"network-h6/log", "network-h0/identity", "gp-se-linear/identity"})
+  for (const char* n : {"network-h6/log", "network-h0/identity", "gp-se-linear/identity",
+                        "gp-se-iso-constant/identity", "gp-matern52-iso-linear/log"})
     EXPECT_EQ(ParseCandidate(n).Name(), n);
+  EXPECT_TRUE(ParseCandidate("gp-se-iso-constant/log").isotropic);
+  EXPECT_FALSE(ParseCandidate("gp-se-constant/log").isotropic);
   ExpectInputError([] { ParseCandidate("gp-rbf/log"); }, "candidate 'gp-rbf/log'");
   ExpectInputError([] { ParseCandidate("network-h6"); }, "/identity or /log");
   ExpectInputError([] { ChooseFamily(MakeTable(3, 0.1, 1), {}); }, "at least 4");

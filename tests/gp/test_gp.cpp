@@ -178,3 +178,43 @@ TEST(GpFit, BadInputIsAnInputError) {
 
 }  // namespace
 }  // namespace whirl::gp
+
+namespace whirl::gp {
+namespace {
+
+TEST(GpFit, IsotropicKernelSharesOneLengthScaleAtAStationaryPoint) {
+  // GpOptions::isotropic: every length scale equal, and the likelihood stationary along the
+  // shared log length scale (the sum of the ARD gradient's length components) and in s_f, s_n;
+  // the ARD fit, a superset of the isotropic models, reaches at most the isotropic NLML.
+  const Data data = MakeData(3, 40, 0.1, 7);
+  for (Kernel k : kKernels) {
+    GpOptions o;
+    o.kernel = k;
+    o.isotropic = true;
+    o.bfgs.gradient_tolerance = 1e-7;
+    o.bfgs.function_tolerance = 1e-12;
+    GpSummary iso_summary, ard_summary;
+    const Gp iso = FitGp(data.x, data.y, o, &iso_summary);
+    ASSERT_EQ(iso.theta.size(), 5);
+    EXPECT_EQ(iso.theta(1), iso.theta(0));
+    EXPECT_EQ(iso.theta(2), iso.theta(0));
+    Eigen::VectorXd g;
+    const double nlml =
+        NegLogMarginalLikelihood(k, iso.mean, iso.z, iso.u, iso.theta, iso.min_noise_variance, &g);
+    EXPECT_NEAR(nlml, iso_summary.nlml, 1e-9);
+    EXPECT_NEAR(g.head(3).sum(), 0.0, 1e-4) << iso_summary.BriefReport();
+    EXPECT_NEAR(g(3), 0.0, 1e-4);
+    EXPECT_NEAR(g(4), 0.0, 1e-4);
+    EXPECT_GT(std::abs(g(0) - g(2)), 1e-3) << "the ARD gradient is not zero: the test would be moot";
+    o.isotropic = false;
+    FitGp(data.x, data.y, o, &ard_summary);
+    EXPECT_LE(ard_summary.nlml, iso_summary.nlml + 1e-6);
+    // A warm start from an ARD theta stays isotropic.
+    o.isotropic = true;
+    const Gp warm = FitGpFrom(data.x, data.y, o, FitGp(data.x, data.y, GpOptions{}).theta);
+    EXPECT_EQ(warm.theta(2), warm.theta(0));
+  }
+}
+
+}  // namespace
+}  // namespace whirl::gp
