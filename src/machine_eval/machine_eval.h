@@ -145,6 +145,8 @@ struct MachineModels {
 
 struct MachineEvalScrew {
   int machine = 0;
+  int day = 0;              ///< field world: calendar day of the cut (legacy: 0)
+  std::string start_type;   ///< field world: cold, warm, interrupted, long_pause (legacy: "")
   sim::Screw screw;
   std::uint64_t seed = 0, day_seed = 0;
   bool ok = false;
@@ -167,6 +169,8 @@ struct MachineEvalSummary {
 };
 
 struct MachineEvaluation {
+  /// The strategies this evaluation scores (empty: every one, the legacy table).
+  std::vector<MachineStrategy> rows;
   std::vector<std::vector<std::string>> sensors_cutting, sensors_idle;  ///< per machine
   std::vector<MachineEvalScrew> screws;
   MachineEvalSummary summary;
@@ -208,6 +212,8 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::
                                        const compare::EvaluateProgress& progress = {});
 
 MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& screws);
+/// The rows of an evaluation: `rows`, or every strategy when empty.
+std::vector<MachineStrategy> RowsOf(const std::vector<MachineStrategy>& rows);
 /// Fixed-width text table (strategy: median/worst um within 1000 mm and over the thread, P3/P5).
 std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown);
 
