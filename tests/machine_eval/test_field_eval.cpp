@@ -186,3 +186,112 @@ TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
 
 }  // namespace
 }  // namespace whirl::machine_eval
+
+namespace whirl::machine_eval {
+namespace {
+
+// The machine part a model leaves on the test-day cuts: per cut the band width (max - min) of
+// m - c over the cut, m the truth along the cut (head, Z axis, blank), c the model held causally
+// on the day's control log; the median over the cuts, um.
+double MachinePartLeft(const machine::MachineWorld& w, const FieldMachineModels& m,
+                       const drift::JointDriftModel* model) {
+  std::vector<double> left;
+  for (const machine::DayPlan& plan : w.timeline.days()) {
+    if (plan.day < 0) continue;
+    const drift::Run log =
+        AverageSensors(machine::ControlLog(w.timeline, plan.day, plan.seed), 5);
+    const HeldSamples held = model ? RunCausally(*model, log) : HeldSamples{};
+    for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
+      const machine::Job& job = plan.jobs[static_cast<std::size_t>(j)];
+      const double start = plan.day * 1440.0 + job.cut_start_min;
+      const compare::CompensationFunction c =
+          CausalMachineLine(held, start, m.z_ref_mm, [&job](double t) {
+            return job.kinematics.thread_start_position_mm - job.kinematics.axial_feed_mm_s * t;
+          });
+      double lo = 1e300, hi = -1e300;
+      for (const machine::TruthSample& s : machine::TrueCutError(w.timeline, {plan.day, j})) {
+        const double v = s.total_um() - c((s.abs_min - start) * 60.0);
+        lo = std::min(lo, v), hi = std::max(hi, v);
+      }
+      left.push_back(hi - lo);
+    }
+  }
+  std::sort(left.begin(), left.end());
+  return left[left.size() / 2];
+}
+
+machine::FieldMachineConfig HeatOff() {
+  machine::FieldMachineConfig c = machine::DefaultFieldMachine();
+  c.head.bearing_power = c.head.motor_power = c.head.belt_power = 0;
+  c.head.motor_cut_share = c.head.tool_heat_share = 0;
+  c.z.motor_hold_power = c.z.motor_power_per_100mm_min = 0;
+  c.z.bearing_torque_nm = c.z.nut_torque_nm = 0;
+  c.bed.chip_share = c.bed.headstock_power = 0;
+  return c;
+}
+
+// A planted world where only the hall moves the machine (every heat source off, unconditioned
+// hall): the control's duty signals carry nothing, the temperatures do. Expected: the sensor model
+// leaves less than half of what the schedule rule leaves on the test-day cuts, on each of 3
+// machines. DISABLED because it FAILS with the present estimator (drift/joint.h): its features
+// are rises since power-on, while the hall drives the Z axis against the blank through absolute
+// temperature differences (screw, bed and blank at different lags of the hall: a slope along the
+// cut that is not zero at power-on); the fit bends the sensor coefficients towards it. Machine
+// part left, median um, machines 0/1/2: none 20.0/19.6/26.2, warmup 18.5/29.7/33.4, schedule
+// 30.1/17.6/43.6, sensors 61.1/32.9/52.1. Enable it when the estimator can use absolute
+// temperatures.
+TEST(FieldSensorFree, DISABLED_WhereOnlyTheHallMovesTheMachineSensorsBeatTheSchedule) {
+  machine::CalendarSpec cal;
+  cal.past_days = 4;
+  cal.test_days = 2;
+  for (int i = 0; i < 3; ++i) {
+    const machine::MachineWorld w = machine::BuildMachineWorld(
+        HeatOff(), machine::FindMachineScenario("unconditioned-hall"), 5, i, cal);
+    const FieldMachineModels m = TrainFieldMachine(w.timeline, FieldProtocol{}, nullptr, 9);
+    const double sensors = MachinePartLeft(w, m, &m.shop.sensors);
+    const double schedule = MachinePartLeft(w, m, &m.shop.schedule);
+    EXPECT_LT(sensors, 0.5 * schedule) << "machine " << i << " sensors " << sensors
+                                       << " schedule " << schedule << " ("
+                                       << m.shop.sensors_choice << ")";
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
+
+namespace whirl::machine_eval {
+namespace {
+
+// A planted world where only the ring's duty moves the machine (hall fixed at 20 degC, Z drive
+// and bed heat off, interrupted starts): everything that drives the head is in the control's duty
+// log, and the head's sensors read its state. On the median of the test-day cuts of each of 3
+// machines the sensor model leaves less than half the uncompensated machine part and less than
+// the warm-up clock (which sees only the time since power-on), and the schedule rule less than
+// 0.6 x the uncompensated part. (The stronger expectation "schedule within 1.1 x sensors + 0.5 um
+// here" does not hold: with two shared time constants the schedule rule follows the head's
+// several time constants less well than sensors that read them; machines 0/1/2: none
+// 23.9/24.4/23.7, warmup 10.1/10.4/10.2, schedule 5.5/12.2/9.3, sensors 4.5/3.9/3.0 um.)
+TEST(FieldSensorFree, WhereTheDutyLogHoldsEverythingTrainedModelsFollowTheHead) {
+  machine::FieldMachineConfig c = machine::DefaultFieldMachine();
+  c.z.motor_hold_power = c.z.motor_power_per_100mm_min = 0;
+  c.z.bearing_torque_nm = c.z.nut_torque_nm = 0;
+  c.bed.chip_share = c.bed.headstock_power = 0;
+  machine::MachineScenario s = machine::FindMachineScenario("interrupted-starts");
+  s.hall.amplitude_k = s.hall.ou_std_k = s.hall.day_offset_std_k = 0;
+  s.hall.door_events_per_day = 0;
+  machine::CalendarSpec cal;
+  cal.past_days = 4;
+  cal.test_days = 2;
+  for (int i = 0; i < 3; ++i) {
+    const machine::MachineWorld w = machine::BuildMachineWorld(c, s, 5, i, cal);
+    const FieldMachineModels m = TrainFieldMachine(w.timeline, FieldProtocol{}, nullptr, 9);
+    const double none = MachinePartLeft(w, m, nullptr);
+    const double sensors = MachinePartLeft(w, m, &m.shop.sensors);
+    EXPECT_LT(sensors, 0.5 * none) << "machine " << i;
+    EXPECT_LT(sensors, MachinePartLeft(w, m, &m.shop.warmup)) << "machine " << i;
+    EXPECT_LT(MachinePartLeft(w, m, &m.shop.schedule), 0.6 * none) << "machine " << i;
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
