@@ -194,6 +194,46 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
   return out;
 }
 
+std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e) {
+  const auto s = SummarizeOverSeeds(e);
+  const auto best = static_cast<std::size_t>(StrongestSensorFree(s, e.rows));
+  const auto shop = static_cast<std::size_t>(MachineStrategy::kBothShop);
+  std::vector<std::string> out;
+  std::string line = e.scenario + ": thread median by start type, " +
+                     ToString(static_cast<MachineStrategy>(best)) + " / both_shop um (screws):";
+  bool any = false;
+  for (const char* type : {"cold", "warm", "interrupted", "long_pause"}) {
+    std::vector<double> b, x;
+    for (const auto& run : e.runs)
+      for (const auto& r : run.screws)
+        if (r.ok && r.start_type == type) {
+          b.push_back(std::abs(r.metrics[best].accumulated_total_um));
+          x.push_back(std::abs(r.metrics[shop].accumulated_total_um));
+        }
+    if (b.empty()) continue;
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "%s %s %.1f / %.1f (%zu)", any ? "," : "", type, Median(b),
+                  Median(x), b.size());
+    line += buf;
+    any = true;
+  }
+  if (any) out.push_back(line);
+  const bool field = !e.rows.empty();
+  line = e.scenario + ": uncompensated over the thread, each source alone, median um:";
+  const char* names[] = {"workpiece", "head", field ? "Z axis and blank" : "z_screw", "bed"};
+  for (std::size_t q = 0; q < (field ? 3u : kErrorSourceCount); ++q) {
+    std::vector<double> v;
+    for (const auto& run : e.runs)
+      for (const auto& r : run.screws)
+        if (r.ok) v.push_back(r.source_total_um[q]);
+    char buf[80];
+    std::snprintf(buf, sizeof buf, "%s %s %.1f", q ? "," : "", names[q], Median(v));
+    line += buf;
+  }
+  out.push_back(line);
+  return out;
+}
+
 namespace {
 
 std::string TableHeader(bool markdown) {
@@ -228,6 +268,7 @@ std::string TableRows(const SeedsEvaluation& e, bool markdown) {
 std::string Headlines(const SeedsEvaluation& e, bool markdown) {
   std::string out;
   for (const auto& h : MachineHeadlines(e)) out += (markdown ? "\n- " : "") + h + "\n";
+  for (const auto& h : ScenarioNotes(e)) out += (markdown ? "\n- " : "  ") + h + "\n";
   return out;
 }
 
@@ -241,6 +282,10 @@ std::string FormatScenarioTables(const std::vector<SeedsEvaluation>& e, bool mar
   std::string out = TableHeader(markdown);
   for (const auto& x : e) out += TableRows(x, markdown);
   for (const auto& x : e) out += Headlines(x, markdown);
+  out += std::string(markdown ? "\n" : "") +
+         "(accumulated lead error in um, median [range of the per-seed medians] and worst screw; "
+         "simulator only: every figure is measured in the project's simulator, not on a "
+         "machine)\n";
   return out;
 }
 
@@ -276,6 +321,7 @@ void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
        {"strongest_sensor_free", ToString(StrongestSensorFree(s, e.rows))},
        {"strategies", strategies},
        {"headlines", MachineHeadlines(e)},
+       {"notes", ScenarioNotes(e)},
        {"runs", runs}};
 }
 

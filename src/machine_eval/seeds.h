@@ -55,6 +55,11 @@ MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategy
 /// sensor-free machine rules (warmup, schedule: the value of the sensors alone).
 std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e);
 
+/// Notes under the headlines: the thread median of the strongest sensor-free strategy and of
+/// both_shop per start type (cold, warm, interrupted, long_pause; field world only) with the
+/// screw count, and the uncompensated error over the thread of each source alone (median um).
+std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e);
+
 /// One block: scenario, strategy, 1000 mm median [seed range], worst, thread median [range],
 /// worst, |e_a - c| median, P3 / P5; then the headlines.
 std::string FormatSeedsTable(const SeedsEvaluation& e, bool markdown);
