@@ -1,6 +1,8 @@
 // whirl machine: the whirling machine's own thermal drift (src/machine/machine.h).
 //   whirl machine sensors  --out DIR   virtual-sensor run files in the drift format
 //   whirl machine evaluate             none / traditional / workpiece / machine / both / both_idle
+//                                      (legacy world); --scenarios: the field world's table over
+//                                      seeds (machine_eval/field_eval.h)
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -301,7 +303,12 @@ void RegisterMachine(CLI::App& app) {
       "models), both, both_idle (machine model trained on idle warm-ups), both_monitor (offset\n"
       "model kept valid by a check bar, Liu et al.'s patent). Prints median and worst\n"
       "accumulated lead error [um] within 1000 mm and over the thread, P3/P5 shares, the\n"
-      "uncompensated error of each source alone and which part dominates what is left.");
+      "uncompensated error of each source alone and which part dominates what is left.\n"
+      "--scenarios (e.g. production,duty-changes or all): the field world (a shop's calendar;\n"
+      "models trained only from probe, laser and past screws' lead measurements, applied from\n"
+      "past control samples only) with the shop baselines (class, table, nearest, warmup,\n"
+      "schedule), machine_shop and both_shop, over --seeds, with the headline against the\n"
+      "strongest sensor-free strategy per scenario. Simulator figures only.");
   CommonOptions(e, o.get());
   AddScenarioOptions(e, o.get());
   e->add_option("--machines", o->machines, "machines (1..50, default 2)")->check(NumberIn(1, 50));

@@ -1,8 +1,15 @@
 #include "machine_eval/cut_scoring.h"
 
 #include "compare/lead.h"
+#include "core/error.h"
 
 namespace whirl::machine_eval::detail {
+
+void CheckCount(int v, int lo, int hi, const char* what) {
+  if (v < lo || v > hi)
+    throw InputError(std::string(what) + " = " + std::to_string(v) + ": must be within " +
+                     std::to_string(lo) + ".." + std::to_string(hi));
+}
 
 double TotalOf(const ElongationCurve& truth, const compare::CompensationFunction& comp, double feed,
                const sim::Screw& screw, const compare::CompareOptions& options) {

@@ -11,6 +11,9 @@
 
 namespace whirl::machine_eval::detail {
 
+/// InputError "<what> = <v>: must be within lo..hi" unless lo <= v <= hi.
+void CheckCount(int v, int lo, int hi, const char* what);
+
 /// Accumulated lead error over the thread of `truth` under `comp`, um.
 double TotalOf(const ElongationCurve& truth, const compare::CompensationFunction& comp, double feed,
                const sim::Screw& screw, const compare::CompareOptions& options);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/curve.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/random.h"
@@ -73,16 +74,7 @@ WorkpieceResidual HistoryResidual(const MachineTimeline& tl, const Workpiece& wp
           detail::Planned(c.plan, c.kinematics.axial_feed_mm_s);
       const ElongationCurve e = c.truth;
       return [e, plan](double t) {
-        const auto it = std::lower_bound(e.time_s.begin(), e.time_s.end(), t);
-        double v;
-        if (it == e.time_s.begin()) v = e.elongation_um.front();
-        else if (it == e.time_s.end()) v = e.elongation_um.back();
-        else {
-          const std::size_t k = static_cast<std::size_t>(it - e.time_s.begin());
-          const double f = (t - e.time_s[k - 1]) / (e.time_s[k] - e.time_s[k - 1]);
-          v = (1 - f) * e.elongation_um[k - 1] + f * e.elongation_um[k];
-        }
-        return v - plan(t);
+        return InterpolateLinear(e.time_s, e.elongation_um, t) - plan(t);
       };
     } catch (const InputError&) {
       return nullptr;
@@ -95,19 +87,11 @@ WorkpieceResidual HistoryResidual(const MachineTimeline& tl, const Workpiece& wp
 ElongationCurve TruthCurve(const std::vector<machine::TruthSample>& m, double start_min,
                            const std::vector<double>& time_s,
                            double (*part)(const machine::TruthSample&)) {
+  std::vector<double> at, value;
+  for (const machine::TruthSample& s : m) at.push_back(s.abs_min), value.push_back(part(s));
   ElongationCurve c;
   c.time_s = time_s;
-  for (double t : time_s) {
-    const double a = start_min + t / 60.0;
-    std::size_t k = 0;
-    while (k + 2 < m.size() && m[k + 1].abs_min <= a) ++k;
-    double v = part(m[k]);
-    if (k + 1 < m.size() && m[k + 1].abs_min > m[k].abs_min) {
-      const double f = std::clamp((a - m[k].abs_min) / (m[k + 1].abs_min - m[k].abs_min), 0.0, 1.0);
-      v = (1 - f) * part(m[k]) + f * part(m[k + 1]);
-    }
-    c.elongation_um.push_back(v);
-  }
+  for (double t : time_s) c.elongation_um.push_back(InterpolateLinear(at, value, start_min + t / 60.0));
   return c;
 }
 
@@ -200,11 +184,7 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
 }
 
 void ValidateFieldOptions(const FieldEvalOptions& o) {
-  auto range = [](int v, int lo, int hi, const char* what) {
-    if (v < lo || v > hi)
-      throw InputError(std::string(what) + " = " + std::to_string(v) + ": must be within " +
-                       std::to_string(lo) + ".." + std::to_string(hi));
-  };
+  const auto range = detail::CheckCount;
   range(o.machines, 1, 20, "machines");
   range(o.threads, 1, 64, "threads");
   range(o.calendar.test_days, 1, 20, "test days");
@@ -259,8 +239,7 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
                                        const compare::IsoToleranceTable& iso_table,
                                        const FieldEvalOptions& options, int seeds,
                                        const compare::EvaluateProgress& progress) {
-  if (seeds < 1 || seeds > 20)
-    throw InputError("seeds = " + std::to_string(seeds) + ": must be within 1..20");
+  detail::CheckCount(seeds, 1, 20, "seeds");
   SeedsEvaluation e;
   e.scenario = scenario.name;
   e.rows = FieldStrategies();

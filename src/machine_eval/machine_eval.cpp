@@ -340,11 +340,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece
 namespace {
 
 void ValidateMachineEvalOptions(const MachineEvalOptions& options) {
-  auto range = [](int v, int lo, int hi, const char* what) {
-    if (v < lo || v > hi)
-      throw InputError(std::string(what) + " = " + std::to_string(v) + ": must be within " +
-                       std::to_string(lo) + ".." + std::to_string(hi));
-  };
+  const auto range = detail::CheckCount;
   range(options.machines, 1, 50, "machines");
   range(options.screws_per_machine, 1, 200, "screws per machine");
   range(options.train_runs, 1, 20, "training runs");

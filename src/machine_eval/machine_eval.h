@@ -4,7 +4,8 @@
 // that drifts (machine/machine.h), compensated by the workpiece plan, by a machine drift model or
 // by both; the combined 840D programs of one screw (machine_nc.h) and its report
 // (machine_report.h). Driven by `whirl machine evaluate` and step 7 of `whirl demo` (demo.h).
-// Every figure it gives is measured in the project's simulator, not on a machine.
+// Every figure it gives is measured in the project's simulator, not on a machine. This header is
+// the legacy world (machine/machine.h); the field world's scenarios are in field_eval.h.
 //
 // Sources.
 //   Workpiece half: Li Yanfeng, Ma Hongjun and Jiang Hongkui (Shandong Jianzhu University),

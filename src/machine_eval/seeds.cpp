@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "machine_eval/cut_scoring.h"
 
 namespace whirl::machine_eval {
 
@@ -13,8 +14,7 @@ SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::Workp
                                   const compare::IsoToleranceTable& iso_table,
                                   const MachineEvalOptions& options, int seeds,
                                   const compare::EvaluateProgress& progress) {
-  if (seeds < 1 || seeds > 20)
-    throw InputError("seeds = " + std::to_string(seeds) + ": must be within 1..20");
+  detail::CheckCount(seeds, 1, 20, "seeds");
   SeedsEvaluation e;
   const std::size_t per = static_cast<std::size_t>(options.machines * options.screws_per_machine);
   for (int s = 0; s < seeds; ++s) {

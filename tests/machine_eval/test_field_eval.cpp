@@ -115,8 +115,9 @@ TEST(FieldCausal, TheAppliedValueAtSampleIDependsOnlyOnSamplesUpToI) {
         const double t = rng.Uniform() * t_next_s * (1 - 1e-12);
         ASSERT_EQ(c(t), d(t)) << "i " << i << " t " << t;
       }
-      if (!model->sensors.empty() || !model->other_inputs.empty())
+      if (!model->sensors.empty() || !model->other_inputs.empty()) {
         EXPECT_NE(c(t_next_s + 1e-6), d(t_next_s + 1e-6)) << "the change shows from i + 1 on";
+      }
     }
   }
 }
