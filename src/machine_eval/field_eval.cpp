@@ -15,8 +15,8 @@ namespace whirl::machine_eval {
 
 std::vector<MachineStrategy> FieldStrategies() {
   using S = MachineStrategy;
-  return {S::kNone,    S::kTraditional, S::kWorkpiece, S::kClass,       S::kTable,
-          S::kNearest, S::kWarmup,      S::kSchedule,  S::kMachineShop, S::kBothShop};
+  return {S::kNone,   S::kTraditional, S::kWorkpiece, S::kClass,       S::kTable,    S::kNearest,
+          S::kWarmup, S::kSchedule,    S::kLeadSlope, S::kMachineShop, S::kBothShop};
 }
 
 std::vector<std::string> FieldScheduleInputs() {
@@ -27,9 +27,9 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
                                      const FieldProtocol& protocol,
                                      const WorkpieceResidual& workpiece_residual,
                                      std::uint64_t seed) {
-  const drift::ShopRecord record =
-      FieldShopRecord(timeline, protocol, workpiece_residual, seed);
   FieldMachineModels m;
+  const drift::ShopRecord record =
+      FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
   m.shop = FitShopModels(record, m.z_ref_mm, FieldScheduleInputs());
   m.records = static_cast<int>(record.records.size());
@@ -110,7 +110,8 @@ struct DayHeld {
 };
 
 MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, const DayHeld& held,
-                                  double z_ref_mm, const Workpiece& wp) {
+                                  const FieldMachineModels& models, const Workpiece& wp) {
+  const double z_ref_mm = models.z_ref_mm;
   const Job& job = tl.Day(cut.day).jobs[static_cast<std::size_t>(cut.job)];
   MachineEvalScrew out;
   out.screw = job.screw;
@@ -136,11 +137,16 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
     return Planned(detail::FeaturePlan(c, f, job.screw.thread_length_mm, wp.options), feed);
   };
   const compare::CompensationFunction none = compare::NoCompensation(), shop = line(held.sensors);
+  const double b = LeadSlopeFor(models.lead_slopes, job.screw.process.diameter_mm,
+                                job.screw.process.pitch_mm);
+  const compare::CompensationFunction lead_slope = [b, feed](double t) {
+    return b * feed * t / 1000.0;
+  };
   const std::array<compare::CompensationFunction, kMachineStrategyCount> comp = {
       none, history(c.traditional_features), workpiece, none, none, none, none,
       history(c.history_features[0]), history(c.history_features[1]),
       history(c.history_features[2]), Sum(workpiece, line(held.warmup)),
-      Sum(workpiece, line(held.schedule)), shop, Sum(workpiece, shop)};
+      Sum(workpiece, line(held.schedule)), shop, Sum(workpiece, shop), Sum(workpiece, lead_slope)};
   detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out, nullptr);
   const std::size_t sources[] = {0, 1, 2};
   const ElongationCurve parts[] = {c.truth, TruthCurve(m, start, c.truth.time_s, HeadPart),
@@ -168,7 +174,7 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
     for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
       MachineEvalScrew r;
       try {
-        r = EvaluateFieldCut(tl, {plan.day, j}, held, models.z_ref_mm, wp);
+        r = EvaluateFieldCut(tl, {plan.day, j}, held, models, wp);
       } catch (const InputError& err) {
         r.screw = plan.jobs[static_cast<std::size_t>(j)].screw;
         r.day = plan.day;

@@ -19,8 +19,9 @@
 // field table: they read exact truth channels):
 //   none; traditional (the strongest history rule by leave-one-out, compare/history_rules.h);
 //   workpiece (the network's plan); class, table, nearest (each history rule); warmup and
-//   schedule (workpiece + that sensor-free machine rule); machine_shop (the sensor model alone);
-//   both_shop (workpiece + the sensor model).
+//   schedule (workpiece + that sensor-free machine rule); lead_slope (workpiece + the pitch
+//   correction of the nearest past screw type, field_history.h LeadSlopeFor); machine_shop (the
+//   sensor model alone); both_shop (workpiece + the sensor model).
 // Seeds: machine i of seed S is MachineSeed(S, i) (machine/scenarios.h); the workpiece truth of
 // job j on day d from MixSeed(DaySeed, 0x77700 + j): results do not depend on the thread count.
 #include <cstdint>
@@ -57,6 +58,7 @@ struct FieldMachineModels {
   ShopModels shop;
   int records = 0, readings = 0;
   double z_ref_mm = 0;  ///< reference of the slope (the Z screw's fixed bearing)
+  std::vector<PastLeadSlope> lead_slopes;  ///< the lead-slope rule's past screws
 };
 
 /// The models of one machine world from its shop record (field_history.h) only.

@@ -1,6 +1,7 @@
 #include "machine_eval/field_history.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/random.h"
@@ -65,9 +66,19 @@ void LaserTest(const machine::MachineTimeline& tl, const machine::DayPlan& plan,
 
 // A past screw's measured lead, thinned to one point per lead_sample_min of cutting time; the
 // reading's z becomes the tool position (thread start - x).
+// Least-squares slope of the readings' values over their x (z_mm holds x), um per m.
+double SlopeUmPerM(const std::vector<machine::Reading>& r) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = static_cast<double>(r.size());
+  for (const auto& x : r) sx += x.z_mm, sy += x.value_um, sxx += x.z_mm * x.z_mm, sxy += x.z_mm * x.value_um;
+  const double d = n * sxx - sx * sx;
+  return d > 0 ? 1000.0 * (n * sxy - sx * sy) / d : 0.0;
+}
+
 void PastLead(const machine::MachineTimeline& tl, const machine::DayPlan& plan, int log,
               const drift::Run& day_log, int job, const FieldProtocol& p,
-              const WorkpieceResidual& residual, std::uint64_t seed, drift::ShopRecord* rec) {
+              const WorkpieceResidual& residual, std::uint64_t seed, drift::ShopRecord* rec,
+              std::vector<PastLeadSlope>* slopes) {
   const machine::Job& j = plan.jobs[static_cast<std::size_t>(job)];
   const machine::CutRef cut{plan.day, job};
   const std::function<double(double)> wp = residual ? residual(j, cut) : nullptr;
@@ -78,6 +89,8 @@ void PastLead(const machine::MachineTimeline& tl, const machine::DayPlan& plan, 
   lo.scale_noise_um_per_m = p.lead_scale_noise_um_per_m;
   const auto all = machine::MeasureLead(
       tl, cut, wp ? wp : [](double) { return 0.0; }, lo, seed);
+  if (slopes && all.size() > 1)
+    slopes->push_back({j.screw.process.diameter_mm, j.screw.process.pitch_mm, SlopeUmPerM(all)});
   std::vector<machine::Reading> kept;
   double next = all.empty() ? 0 : all.front().abs_min;
   for (machine::Reading x : all) {
@@ -105,6 +118,23 @@ void SetupChecks(const machine::MachineTimeline& tl, const machine::DayPlan& pla
 
 }  // namespace
 
+double LeadSlopeFor(const std::vector<PastLeadSlope>& past, double diameter_mm, double lead_mm,
+                    int k) {
+  if (past.empty()) return 0.0;
+  std::vector<std::pair<double, std::size_t>> d;
+  for (std::size_t i = 0; i < past.size(); ++i) {
+    const double a = std::log(past[i].diameter_mm / diameter_mm);
+    const double b = std::log(past[i].lead_mm / lead_mm);
+    d.push_back({a * a + b * b, i});
+  }
+  std::stable_sort(d.begin(), d.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  const std::size_t n = std::min(d.size(), static_cast<std::size_t>(std::max(k, 1)));
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) sum += past[d[i].second].slope_um_per_m;
+  return sum / static_cast<double>(n);
+}
+
 drift::Run AverageSensors(drift::Run log, double window_min) {
   if (window_min <= 0 || log.samples() == 0) return log;
   const Eigen::MatrixXd raw = log.temperature_C;
@@ -122,7 +152,8 @@ drift::Run AverageSensors(drift::Run log, double window_min) {
 
 drift::ShopRecord FieldShopRecord(const machine::MachineTimeline& timeline,
                                   const FieldProtocol& p,
-                                  const WorkpieceResidual& workpiece_residual, std::uint64_t seed) {
+                                  const WorkpieceResidual& workpiece_residual, std::uint64_t seed,
+                                  std::vector<PastLeadSlope>* lead_slopes) {
   drift::ShopRecord rec;
   machine::LogOptions lo;
   lo.sample_s = p.log_sample_s;
@@ -143,7 +174,7 @@ drift::ShopRecord FieldShopRecord(const machine::MachineTimeline& timeline,
       default:
         for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j)
           PastLead(timeline, plan, log, rec.day_logs.back(), j, p, workpiece_residual,
-                   MixSeed(s, 100 + j), &rec);
+                   MixSeed(s, 100 + j), &rec, lead_slopes);
         if (p.setup_checks) SetupChecks(timeline, plan, log, day_log, p, MixSeed(s, 4), &rec);
     }
   }

@@ -55,9 +55,27 @@ drift::Run AverageSensors(drift::Run log, double window_min);
 using WorkpieceResidual =
     std::function<std::function<double(double)>(const machine::Job& job, const machine::CutRef& cut)>;
 
-/// The shop record of every day < 0 of the timeline (see the header comment), seeded.
+/// A past screw's measured lead reduced to its least-squares slope over the thread (the pitch
+/// error a shop reads off the lead chart), with the screw's type: diameter and lead.
+struct PastLeadSlope {
+  double diameter_mm = 0, lead_mm = 0;
+  double slope_um_per_m = 0;  ///< of the measured d(x) over x (all points, full resolution)
+};
+
+/// The shop record of every day < 0 of the timeline (see the header comment), seeded;
+/// `lead_slopes` (optional) receives the slope of every measured past screw.
 drift::ShopRecord FieldShopRecord(const machine::MachineTimeline& timeline,
                                   const FieldProtocol& protocol,
-                                  const WorkpieceResidual& workpiece_residual, std::uint64_t seed);
+                                  const WorkpieceResidual& workpiece_residual, std::uint64_t seed,
+                                  std::vector<PastLeadSlope>* lead_slopes = nullptr);
+
+/// The lead-slope rule (a pitch correction per screw type, learned from measured past screws
+/// only): the mean slope of the past screws of the nearest type, types compared by
+/// (ln D, ln lead) with equal weights, the k nearest screws (ties by record order); 0 without
+/// past screws. The correction is applied on top of the workpiece plan as c(t) = b x(t) / 1000,
+/// x = v_f t the cut length [mm] (an SD43910-like slope the operator types in: a positive slope
+/// of d(x) is cancelled by a compensation growing the same way).
+double LeadSlopeFor(const std::vector<PastLeadSlope>& past, double diameter_mm, double lead_mm,
+                    int k = 3);
 
 }  // namespace whirl::machine_eval

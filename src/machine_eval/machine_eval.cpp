@@ -24,7 +24,7 @@ std::string ToString(MachineStrategy s) {
   static const char* kNames[] = {"none",        "traditional", "workpiece",    "machine",
                                  "both",        "both_idle",   "both_monitor", "class",
                                  "table",       "nearest",     "warmup",       "schedule",
-                                 "machine_shop", "both_shop"};
+                                 "machine_shop", "both_shop",  "lead_slope"};
   return kNames[static_cast<int>(s)];
 }
 
@@ -42,12 +42,16 @@ bool UsesSensors(MachineStrategy s) {
   }
 }
 
-std::vector<MachineStrategy> RowsOf(const std::vector<MachineStrategy>& rows) {
-  if (!rows.empty()) return rows;
+std::vector<MachineStrategy> LegacyStrategies() {
   std::vector<MachineStrategy> all;
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
-    all.push_back(static_cast<MachineStrategy>(k));
+    if (static_cast<MachineStrategy>(k) != MachineStrategy::kLeadSlope)
+      all.push_back(static_cast<MachineStrategy>(k));
   return all;
+}
+
+std::vector<MachineStrategy> RowsOf(const std::vector<MachineStrategy>& rows) {
+  return rows.empty() ? LegacyStrategies() : rows;
 }
 
 std::string ToString(ErrorSource s) {
@@ -321,7 +325,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece
       Sum(workpiece, machine.warmup),
       Sum(workpiece, machine.schedule),
       machine.shop,
-      Sum(workpiece, machine.shop)};
+      Sum(workpiece, machine.shop),
+      workpiece};
   ScoreStrategies(truth.total, compensations, feed, screw, options, iso_table, &out, detail);
   for (std::size_t s = 0; s < kErrorSourceCount; ++s)
     out.source_total_um[s] =

@@ -64,6 +64,9 @@
 //                   deformation based on control internal data", CIRP Annals 53(1), 2004)
 //   machine_shop    the sensor model trained from the measurements only
 //   both_shop       workpiece + machine_shop
+//   lead_slope      workpiece + a pitch correction learned from measured past screws (field
+//                   world, field_eval.h); the legacy protocol measures no past screw, so here it
+//                   equals workpiece and is not a row of the legacy table
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
 // `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
 // drift::FitDriftModel (drift/fit.h; kind and sensor selection from `fit`, by default Miao et
@@ -105,11 +108,12 @@ enum class MachineStrategy {
   kWarmup,
   kSchedule,
   kMachineShop,
-  kBothShop
+  kBothShop,
+  kLeadSlope
 };
-inline constexpr std::size_t kMachineStrategyCount = 14;
+inline constexpr std::size_t kMachineStrategyCount = 15;
 /// none, traditional, workpiece, machine, both, both_idle, both_monitor, class, table, nearest,
-/// warmup, schedule, machine_shop, both_shop
+/// warmup, schedule, machine_shop, both_shop, lead_slope
 /// Whether a strategy's machine half uses temperature sensors (machine, both*, machine_shop,
 /// both_shop); the others are sensor-free.
 bool UsesSensors(MachineStrategy s);
@@ -213,7 +217,9 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::
                                        const compare::EvaluateProgress& progress = {});
 
 MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& screws);
-/// The rows of an evaluation: `rows`, or every strategy when empty.
+/// The rows of the legacy table: every strategy but lead_slope.
+std::vector<MachineStrategy> LegacyStrategies();
+/// The rows of an evaluation: `rows`, or the legacy table's when empty.
 std::vector<MachineStrategy> RowsOf(const std::vector<MachineStrategy>& rows);
 /// Fixed-width text table (strategy: median/worst um within 1000 mm and over the thread, P3/P5).
 std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown);

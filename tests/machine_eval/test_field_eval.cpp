@@ -151,8 +151,9 @@ SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_sho
 // whether the sensors beat it.
 TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
   // none traditional workpiece machine both both_idle both_monitor class table nearest warmup
-  // schedule machine_shop both_shop
-  std::vector<double> v = {60, 40, 30, 1, 1, 1, 1, 45, 42, 41, 25, 20, 18, 15};
+  // schedule machine_shop both_shop lead_slope
+  std::vector<double> v = {60, 40, 30, 1, 1, 1, 1, 45, 42, 41, 25, 20, 18, 15, 28};
+  ASSERT_EQ(v.size(), kMachineStrategyCount);
   SeedsEvaluation e = Planted(v, 1.0);
   auto h = MachineHeadlines(e);
   ASSERT_GE(h.size(), 3u);
@@ -291,6 +292,65 @@ TEST(FieldSensorFree, WhereTheDutyLogHoldsEverythingTrainedModelsFollowTheHead) 
     EXPECT_LT(sensors, 0.5 * none) << "machine " << i;
     EXPECT_LT(sensors, MachinePartLeft(w, m, &m.shop.warmup)) << "machine " << i;
     EXPECT_LT(MachinePartLeft(w, m, &m.shop.schedule), 0.6 * none) << "machine " << i;
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
+
+#include "compare/history_rules.h"
+#include "core/process.h"
+#include "workpiece/model.h"
+
+namespace whirl::machine_eval {
+namespace {
+
+// The lead-slope rule by hand: the k nearest past screws in (ln D, ln lead), equal weights.
+TEST(LeadSlope, TheNearestPastScrewTypesByHand) {
+  const std::vector<PastLeadSlope> past = {{50, 10, 1}, {50, 10, 3}, {100, 16, 10}, {60, 6, 20}};
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 50, 10, 2), 2.0);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 95, 15, 1), 10.0);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 62, 6, 1), 20.0);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 50, 10, 10), 34.0 / 4);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor({}, 50, 10), 0.0);
+}
+
+// A world with every heat source off and the hall fixed at 20 degC, and a planted pure slope of
+// 5 um per m of Z travel (TimelineOptions::extra_error_um, no temperature change): every past
+// screw's measured slope is 5 um/m within 4 x its scale noise (1 um/m), and on the test day the
+// lead_slope row leaves at least 15 um less over the thread than the workpiece plan alone (the
+// planted slope is ~25 um over the thread).
+TEST(LeadSlope, RecoversAPlantedSlopeAndCancelsIt) {
+  machine::FieldMachineConfig c = HeatOff();
+  machine::MachineScenario s = machine::FindMachineScenario("production");
+  s.hall.amplitude_k = s.hall.ou_std_k = s.hall.day_offset_std_k = 0;
+  FieldEvalOptions o;
+  o.machine = c;
+  o.machines = 1;
+  o.threads = 1;
+  o.calendar = SmallCalendar();
+  o.calendar.test_days = 1;
+  const double z_fixed = c.z.fixed_end_mm;
+  o.timeline.extra_error_um = [z_fixed](double, double z) { return 0.005 * (z_fixed - z); };
+  const machine::MachineWorld w =
+      machine::BuildMachineWorld(c, s, o.seed, 0, o.calendar, o.timeline);
+  const FieldMachineModels m = TrainFieldMachine(w.timeline, o.protocol, nullptr, 9);
+  ASSERT_GE(m.lead_slopes.size(), 3u);
+  for (const auto& p : m.lead_slopes) EXPECT_NEAR(p.slope_um_per_m, 5.0, 4.0);
+  const std::string root = std::string(WHIRL_SOURCE_DIR) + "/";
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(root + "models/default.json");
+  const compare::ExperienceRule rule =
+      compare::BuildExperienceRule(ReadProcessTable(root + "datasets/whirling_500.csv", true));
+  const compare::IsoToleranceTable iso =
+      compare::ReadIsoToleranceTable(root + "datasets/standards/iso3408_3_lead_tolerances.csv");
+  const MachineEvaluation e = EvaluateFieldScenario(s, model, rule, iso, o);
+  const auto lead = static_cast<std::size_t>(MachineStrategy::kLeadSlope);
+  const auto wp = static_cast<std::size_t>(MachineStrategy::kWorkpiece);
+  ASSERT_FALSE(e.screws.empty());
+  for (const MachineEvalScrew& r : e.screws) {
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_LT(std::abs(r.metrics[lead].accumulated_total_um),
+              std::abs(r.metrics[wp].accumulated_total_um) - 15.0);
   }
 }
 
