@@ -1,6 +1,8 @@
 // whirl machine: the whirling machine's own thermal drift (src/machine/machine.h).
 //   whirl machine sensors  --out DIR   virtual-sensor run files in the drift format
 //   whirl machine evaluate             none / traditional / workpiece / machine / both / both_idle
+//                                      (legacy world); --scenarios: the field world's table over
+//                                      seeds (machine_eval/field_eval.h)
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -17,6 +19,8 @@
 #include "drift/run_file.h"
 #include "interp/machine_profile.h"
 #include "machine/machine.h"
+#include "machine/scenarios.h"
+#include "machine_eval/field_eval.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/seeds.h"
 #include "workpiece/model.h"
@@ -45,7 +49,40 @@ struct MachineCliOptions {
   double travel_c_um = 0;
   std::string report;
   std::string profile = ProjectPath("datasets/machines/whirling_840d.json");
+  // field scenarios
+  std::string scenarios = "legacy";
+  int test_days = 2, past_days = 5;
+  double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
+  bool no_setup_checks = false;
+  std::vector<CLI::Option*> legacy_only, field_only;  ///< flags that apply to one world only
 };
+
+// A flag of one world given while no selected scenario is of that world: InputError naming it.
+void CheckWorldFlags(const MachineCliOptions& o, bool any_legacy, bool any_field) {
+  for (const auto* opt : o.legacy_only)
+    if (opt->count() > 0 && !any_legacy)
+      throw InputError(opt->get_name() + ": applies to the legacy world only; --scenarios " +
+                       o.scenarios + " selects no legacy scenario");
+  for (const auto* opt : o.field_only)
+    if (opt->count() > 0 && !any_field)
+      throw InputError(opt->get_name() + ": applies to the field scenarios only; --scenarios " +
+                       o.scenarios + " selects only the legacy world");
+}
+
+machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
+  machine_eval::FieldEvalOptions f;
+  f.machines = o.machines;
+  f.seed = o.seed;
+  f.threads = o.threads;
+  f.calendar.test_days = o.test_days;
+  f.calendar.past_days = o.past_days;
+  f.protocol.check_every_min = o.check_every_min;
+  f.protocol.probe_sigma_um = o.probe_noise_um;
+  f.protocol.laser_every_min = o.laser_every_min;
+  f.protocol.lead_sample_min = o.lead_sample_min;
+  f.protocol.setup_checks = !o.no_setup_checks;
+  return f;
+}
 
 machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
   // Only the shipped default may be missing (a clone without datasets/): a named file must exist.
@@ -102,6 +139,31 @@ void RunOverSeeds(const MachineCliOptions& o, const sim::Screw& base, const work
   if (ok == 0) throw CommandFailure("every comparison failed", 1);
 }
 
+// Field scenarios (and legacy beside them): one table over seeds (machine_eval/field_eval.h).
+void RunScenarios(const MachineCliOptions& o, const std::vector<machine::MachineScenario>& scenarios,
+                  const sim::Screw& base, const workpiece::WorkpieceModel& model,
+                  const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
+                  const machine_eval::MachineEvalOptions& eo) {
+  Progress progress("machine evaluate", scenarios.size() * 1000);
+  std::vector<machine_eval::SeedsEvaluation> all = machine_eval::EvaluateMachineScenarios(
+      scenarios, base, model, rule, iso, eo, FieldOptions(o), o.seeds,
+      [&](std::size_t d, std::size_t) { progress.Update(d); });
+  progress.Finish();
+  std::size_t ok = 0;
+  for (auto& e : all) {
+    e.travel_c_um = o.travel_c_um;
+    for (const auto& r : e.runs) ok += r.summary.screws - r.summary.failed;
+  }
+  if (o.json) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& e : all) j.push_back(e);
+    PrintJson({{"schema", "whirl.machine_scenarios"}, {"schema_version", 1}, {"scenarios", j}});
+  } else {
+    std::printf("%s", machine_eval::FormatScenarioTables(all, o.markdown).c_str());
+  }
+  if (ok == 0) throw CommandFailure("every comparison failed", 1);
+}
+
 void RunMachineEvaluate(const MachineCliOptions& o) {
   CheckOutputs({{"--machine", o.machine_path},
                 {"--model", o.model_path},
@@ -128,6 +190,14 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   eo.monitor_every_min = o.monitor_every_min;
   eo.report_dir = o.report;
   if (!o.report.empty()) eo.profile = interp::LoadMachineProfile(o.profile);
+  const auto scenarios = machine::SelectMachineScenarios(o.scenarios, "--scenarios");
+  bool any_legacy = false, any_field = false;
+  for (const auto& s : scenarios) (s.world == machine::World::kLegacy ? any_legacy : any_field) = true;
+  CheckWorldFlags(o, any_legacy, any_field);
+  if (any_field) {
+    RunScenarios(o, scenarios, base, model, rule, iso, eo);
+    return;
+  }
   if (o.seeds > 1) {
     RunOverSeeds(o, base, model, rule, iso, eo);
     return;
@@ -164,6 +234,41 @@ void CommonOptions(CLI::App* sub, MachineCliOptions* o) {
   sub->add_flag("--json", o->json, "machine output on stdout");
 }
 
+// The field scenarios' options (machine/scenarios.h, machine_eval/field_history.h).
+void AddScenarioOptions(CLI::App* e, MachineCliOptions* o) {
+  e->add_option("--scenarios", o->scenarios,
+                "comma list of machine scenarios or 'all': legacy (the closed-form machine, its old "
+                "protocol; default), constant-duty, production, duty-changes, interrupted-starts, "
+                "unconditioned-hall, linear-scale (the field world: a shop's calendar, models "
+                "trained from probe, laser and lead measurements only)");
+  auto field = [&](CLI::Option* opt) { o->field_only.push_back(opt); };
+  field(e->add_option("--test-days", o->test_days,
+                      "field: production days scored per machine (1..20, default 2)")
+            ->check(NumberIn(1, 20)));
+  field(e->add_option("--past-days", o->past_days,
+                      "field: history production days per machine whose screws' leads are "
+                      "measured (1..30, default 5)")
+            ->check(NumberIn(1, 30)));
+  field(e->add_option("--check-every-min", o->check_every_min,
+                      "field: probe reading of the check ring every [min] in the warm-up tests "
+                      "(1..120, default 10)")
+            ->check(NumberIn(1.0, 120.0)));
+  field(e->add_option("--probe-noise-um", o->probe_noise_um,
+                      "field: standard deviation of one probe reading [um] (0.01..10, default 1)")
+            ->check(NumberIn(0.01, 10.0)));
+  field(e->add_option("--laser-every-min", o->laser_every_min,
+                      "field: laser-interferometer reading every [min] in the Z warm-up test "
+                      "(5..120, default 20)")
+            ->check(NumberIn(5.0, 120.0)));
+  field(e->add_option("--lead-sample-min", o->lead_sample_min,
+                      "field: one point of a past screw's measured lead per [min] of cutting "
+                      "time in the training record (1..30, default 5)")
+            ->check(NumberIn(1.0, 30.0)));
+  field(e->add_flag("--no-setup-checks", o->no_setup_checks,
+                    "field: no probe reading of the check ring at power-on and at each set-up "
+                    "of the past production days"));
+}
+
 }  // namespace
 
 void RegisterMachine(CLI::App& app) {
@@ -198,14 +303,22 @@ void RegisterMachine(CLI::App& app) {
       "models), both, both_idle (machine model trained on idle warm-ups), both_monitor (offset\n"
       "model kept valid by a check bar, Liu et al.'s patent). Prints median and worst\n"
       "accumulated lead error [um] within 1000 mm and over the thread, P3/P5 shares, the\n"
-      "uncompensated error of each source alone and which part dominates what is left.");
+      "uncompensated error of each source alone and which part dominates what is left.\n"
+      "--scenarios (e.g. production,duty-changes or all): the field world (a shop's calendar;\n"
+      "models trained only from probe, laser and past screws' lead measurements, applied from\n"
+      "past control samples only) with the shop baselines (class, table, nearest, warmup,\n"
+      "schedule), machine_shop and both_shop, over --seeds, with the headline against the\n"
+      "strongest sensor-free strategy per scenario. Simulator figures only.");
   CommonOptions(e, o.get());
+  AddScenarioOptions(e, o.get());
   e->add_option("--machines", o->machines, "machines (1..50, default 2)")->check(NumberIn(1, 50));
-  e->add_option("--screws", o->screws, "random screws per machine (1..200, default 3)")
-      ->check(NumberIn(1, 200));
-  e->add_option("--train-runs", o->train_runs,
-                "idle and cutting training runs per machine (1..20, default 2)")
-      ->check(NumberIn(1, 20));
+  o->legacy_only.push_back(
+      e->add_option("--screws", o->screws, "legacy: random screws per machine (1..200, default 3)")
+          ->check(NumberIn(1, 200)));
+  o->legacy_only.push_back(
+      e->add_option("--train-runs", o->train_runs,
+                    "legacy: idle and cutting training runs per machine (1..20, default 2)")
+          ->check(NumberIn(1, 20)));
   AddSeedOption(e, &o->seed, "seed of machines, days, screws and truth (default 1)");
   e->add_option("--threads", o->threads, "worker threads (1..64, default 2)")
       ->check(NumberIn(1, 64));
@@ -216,14 +329,18 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--base-screw", o->base_screw, "screw whose blank and settings are shared");
   e->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV")
       ->check(CLI::ExistingFile);
-  e->add_option("--drift-model", o->drift_model,
+  o->legacy_only.push_back(e->get_option("--machine"));
+  o->legacy_only.push_back(e->get_option("--machine-off"));
+  o->legacy_only.push_back(e->add_option("--drift-model", o->drift_model,
                 "machine drift model kind: mlr (Miao et al.'s regression, default) or dynamic "
                 "(with first-order lags [min] chosen by cross-validation)")
-      ->check(CLI::IsMember({"mlr", "dynamic"}));
+      ->check(CLI::IsMember({"mlr", "dynamic"})));
   AddSelectionOptions(e, &o->selection);  // Miao et al.'s sensor selection of the machine models
-  e->add_option("--monitor-every-min", o->monitor_every_min,
-                "both_monitor: check-bar interval of the monitor [min] (1..600, default 30)")
-      ->check(NumberIn(1.0, 600.0));
+  o->legacy_only.push_back(
+      e->add_option("--monitor-every-min", o->monitor_every_min,
+                    "legacy both_monitor: check-bar interval of the monitor [min] (1..600, "
+                    "default 30)")
+          ->check(NumberIn(1.0, 600.0)));
   auto* report = e->add_option(
       "--out-dir", o->report,
       "write the first screw's report into this directory: sensor plot [degC over min], chosen "
@@ -231,12 +348,14 @@ void RegisterMachine(CLI::App& app) {
       "programs for --profile (" +
           std::string(kOutputDirRule) + ")");
   AddDeprecatedAlias(e, report, "--report");
+  o->legacy_only.push_back(report);
   e->add_option("--profile", o->profile,
                 "840D machine profile of the combined programs in the report (schema "
                 "whirl.machine with drift.slope and drift.workpiece_slope_param; default "
                 "datasets/machines/whirling_840d.json, which matches the shipped machine file; a "
                 "profile that does not fit the machine leaves the programs out with a warning)")
       ->check(CLI::ExistingFile);
+  o->legacy_only.push_back(e->get_option("--profile"));
   e->add_option("--seeds", o->seeds,
                 "repeat over seeds S..S+N-1 (new machines, training days and screws each) and "
                 "print the pooled table: median [range of per-seed medians] and worst [um], "

@@ -29,7 +29,7 @@ struct SeriesStyle {
 /// The table: measured (truth), prediction, then the strategies none, ramp, traditional,
 /// regression, model (the workpiece comparison), workpiece, machine, both, both_idle,
 /// both_monitor (the machine evaluation), the history rules class, table, nearest and the shop's
-/// machine rows warmup, schedule, machine_shop, both_shop.
+/// machine rows warmup, schedule, machine_shop, both_shop, lead_slope.
 const std::vector<SeriesStyle>& SeriesStyles();
 
 /// The entry named `name`, or nullptr when the table has none.

@@ -78,7 +78,8 @@ drift::ShopRecord MeasureTrainingRuns(const std::vector<drift::Run>& runs,
   return rec;
 }
 
-ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm) {
+ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
+                         const std::vector<std::string>& schedule_inputs) {
   ShopModels m;
   drift::JointFitOptions lagged;
   lagged.require_lag = true;
@@ -88,7 +89,7 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm) {
   m.warmup = drift::FitJoint(record, warmup, lagged).model;
   drift::JointSpec schedule;
   schedule.z_ref_mm = z_fixed_mm;
-  schedule.other_inputs = {"ring_on", "cutting", "ring_load_pct"};
+  schedule.other_inputs = schedule_inputs;
   m.schedule = drift::FitJoint(record, schedule, lagged).model;
   const bool schedule_base = m.schedule.cv_rmse_um <= m.warmup.cv_rmse_um;
   const drift::JointDriftModel& base = schedule_base ? m.schedule : m.warmup;

@@ -56,6 +56,9 @@ struct ShopModels {
   drift::JointDriftModel sensors, warmup, schedule;
   std::string sensors_choice;  ///< which candidate the sensor model is (see above)
 };
-ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm);
+/// `schedule_inputs`: the control signals of the schedule rule (the legacy log has these three).
+ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
+                         const std::vector<std::string>& schedule_inputs = {"ring_on", "cutting",
+                                                                            "ring_load_pct"});
 
 }  // namespace whirl::machine_eval

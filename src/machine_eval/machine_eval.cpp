@@ -9,15 +9,22 @@
 #include "core/random.h"
 #include "drift/monitor.h"
 #include "machine_eval/machine_report.h"
+#include "machine_eval/cut_scoring.h"
 #include "machine_eval/strategies.h"
 
 namespace whirl::machine_eval {
+
+using detail::FeaturePlan;
+using detail::Planned;
+using detail::ScoreStrategies;
+using detail::Sum;
+using detail::TotalOf;
 
 std::string ToString(MachineStrategy s) {
   static const char* kNames[] = {"none",        "traditional", "workpiece",    "machine",
                                  "both",        "both_idle",   "both_monitor", "class",
                                  "table",       "nearest",     "warmup",       "schedule",
-                                 "machine_shop", "both_shop"};
+                                 "machine_shop", "both_shop",  "lead_slope"};
   return kNames[static_cast<int>(s)];
 }
 
@@ -33,6 +40,18 @@ bool UsesSensors(MachineStrategy s) {
     default:
       return false;
   }
+}
+
+std::vector<MachineStrategy> LegacyStrategies() {
+  std::vector<MachineStrategy> all;
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
+    if (static_cast<MachineStrategy>(k) != MachineStrategy::kLeadSlope)
+      all.push_back(static_cast<MachineStrategy>(k));
+  return all;
+}
+
+std::vector<MachineStrategy> RowsOf(const std::vector<MachineStrategy>& rows) {
+  return rows.empty() ? LegacyStrategies() : rows;
 }
 
 std::string ToString(ErrorSource s) {
@@ -78,15 +97,6 @@ HeldSeries Predict(const drift::DriftModel& model, const drift::Run& run, double
   h.step_min = step_min;
   h.values.assign(p.predicted_um.data(), p.predicted_um.data() + p.predicted_um.size());
   return h;
-}
-
-double TotalOf(const ElongationCurve& truth, const compare::CompensationFunction& comp, double feed,
-               const sim::Screw& screw, const compare::CompareOptions& options) {
-  compare::LeadMetricOptions mo = options.metrics;
-  mo.lead_mm = screw.process.pitch_mm;
-  const compare::LeadDeviation lead = compare::CutLeadDeviation(
-      truth, comp, feed, screw.thread_length_mm, screw.process.pitch_mm, options.cut);
-  return compare::ComputeLeadMetrics(lead, mo).accumulated_total_um;
 }
 
 }  // namespace
@@ -196,30 +206,6 @@ TruthOnMachine TruthWithMachine(const ElongationCurve& workpiece, const machine:
   return t;
 }
 
-// A history rule's curve as an 840D plan (empty when the rule has no features for the screw).
-interp::CompensationPlan FeaturePlan(const compare::ScrewComparison& c, const Features& tf,
-                                     double thread_length_mm,
-                                     const compare::CompareOptions& options) {
-  if (!(tf.max_elongation_um > 0 && tf.settle_time_s > 0)) return {};
-  return interp::BuildPlan(
-      fit::ArctanCurve::FromFeatures(tf, options.shape_k, options.time_exponent),
-      c.kinematics.axial_feed_mm_s, thread_length_mm, options.plan);
-}
-
-// What a plan applies at time t_s (none for an empty plan). The plan is kept by the function.
-compare::CompensationFunction Planned(const interp::CompensationPlan& plan, double feed_mm_s) {
-  if (plan.segments.empty()) return compare::NoCompensation();
-  return [plan, feed_mm_s](double t_s) {
-    return interp::AppliedCompensationUm(plan,
-                                         interp::AxisPositionMm(plan.options, feed_mm_s, t_s));
-  };
-}
-
-compare::CompensationFunction Sum(compare::CompensationFunction a,
-                                  compare::CompensationFunction b) {
-  return [a, b](double t) { return a(t) + b(t); };
-}
-
 // The machine line c_m(t) = K0(t) + G(t) (z_fixed - z(t)) / 1000 from the offset and slope
 // predictions.
 compare::CompensationFunction MachineLine(const HeldSeries& offset, const HeldSeries& slope,
@@ -303,25 +289,6 @@ MachineCompensations MachineModelCompensations(const MachineModels& models,
   return m;
 }
 
-// Metrics and ISO class of every strategy on the truth; `detail` (optional) keeps the leads.
-void ScoreStrategies(
-    const ElongationCurve& truth,
-    const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
-    double feed_mm_s, const sim::Screw& screw, const compare::CompareOptions& options,
-    const compare::IsoToleranceTable& iso_table, MachineEvalScrew* out,
-    MachineScrewDetail* detail) {
-  compare::LeadMetricOptions mo = options.metrics;
-  mo.lead_mm = screw.process.pitch_mm;
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const compare::LeadDeviation lead =
-        compare::CutLeadDeviation(truth, compensations[k], feed_mm_s, screw.thread_length_mm,
-                                  screw.process.pitch_mm, options.cut);
-    out->metrics[k] = compare::ComputeLeadMetrics(lead, mo);
-    if (detail) detail->leads[k] = lead;
-    out->iso[k] = compare::EvaluateIsoClass(out->metrics[k], iso_table).reached;
-  }
-}
-
 }  // namespace
 
 MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
@@ -358,7 +325,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece
       Sum(workpiece, machine.warmup),
       Sum(workpiece, machine.schedule),
       machine.shop,
-      Sum(workpiece, machine.shop)};
+      Sum(workpiece, machine.shop),
+      workpiece};
   ScoreStrategies(truth.total, compensations, feed, screw, options, iso_table, &out, detail);
   for (std::size_t s = 0; s < kErrorSourceCount; ++s)
     out.source_total_um[s] =
@@ -377,11 +345,7 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece
 namespace {
 
 void ValidateMachineEvalOptions(const MachineEvalOptions& options) {
-  auto range = [](int v, int lo, int hi, const char* what) {
-    if (v < lo || v > hi)
-      throw InputError(std::string(what) + " = " + std::to_string(v) + ": must be within " +
-                       std::to_string(lo) + ".." + std::to_string(hi));
-  };
+  const auto range = detail::CheckCount;
   range(options.machines, 1, 50, "machines");
   range(options.screws_per_machine, 1, 200, "screws per machine");
   range(options.train_runs, 1, 20, "training runs");
@@ -579,14 +543,16 @@ std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown) {
 void to_json(nlohmann::json& j, const MachineEvaluation& e) {
   const MachineEvalSummary& s = e.summary;
   nlohmann::json strategies = nlohmann::json::object(), sources = nlohmann::json::object();
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
-    strategies[ToString(static_cast<MachineStrategy>(k))] = {
+  for (MachineStrategy st : RowsOf(e.rows)) {
+    const auto k = static_cast<std::size_t>(st);
+    strategies[ToString(st)] = {
         {"accumulated_1000_median_um", s.absolute[k].acc1000_median_um},
         {"accumulated_1000_worst_um", s.absolute[k].acc1000_worst_um},
         {"accumulated_total_median_um", s.absolute[k].total_median_um},
         {"accumulated_total_worst_um", s.absolute[k].total_worst_um},
         {"share_reaching_p3", s.share_p3[k]},
         {"share_reaching_p5", s.share_p5[k]}};
+  }
   for (std::size_t q = 0; q < kErrorSourceCount; ++q)
     sources[ToString(static_cast<ErrorSource>(q))] = s.source_median_um[q];
   nlohmann::json screws = nlohmann::json::array();
@@ -599,9 +565,12 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
     if (!r.ok) {
       x["error"] = r.error;
     } else {
-      for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
-        x["strategies"][ToString(static_cast<MachineStrategy>(k))] = {
-            {"metrics", r.metrics[k]}, {"iso_class", ToString(r.iso[k])}};
+      for (MachineStrategy st : RowsOf(e.rows)) {
+        const auto k = static_cast<std::size_t>(st);
+        x["strategies"][ToString(st)] = {{"metrics", r.metrics[k]},
+                                         {"iso_class", ToString(r.iso[k])}};
+      }
+      if (!r.start_type.empty()) x["day"] = r.day, x["start_type"] = r.start_type;
       x["residual_workpiece_total_um"] = r.residual_workpiece_total_um;
       x["residual_machine_total_um"] = r.residual_machine_total_um;
     }

@@ -4,7 +4,8 @@
 // that drifts (machine/machine.h), compensated by the workpiece plan, by a machine drift model or
 // by both; the combined 840D programs of one screw (machine_nc.h) and its report
 // (machine_report.h). Driven by `whirl machine evaluate` and step 7 of `whirl demo` (demo.h).
-// Every figure it gives is measured in the project's simulator, not on a machine.
+// Every figure it gives is measured in the project's simulator, not on a machine. This header is
+// the legacy world (machine/machine.h); the field world's scenarios are in field_eval.h.
 //
 // Sources.
 //   Workpiece half: Li Yanfeng, Ma Hongjun and Jiang Hongkui (Shandong Jianzhu University),
@@ -63,6 +64,9 @@
 //                   deformation based on control internal data", CIRP Annals 53(1), 2004)
 //   machine_shop    the sensor model trained from the measurements only
 //   both_shop       workpiece + machine_shop
+//   lead_slope      workpiece + a pitch correction learned from measured past screws (field
+//                   world, field_eval.h); the legacy protocol measures no past screw, so here it
+//                   equals workpiece and is not a row of the legacy table
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
 // `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
 // drift::FitDriftModel (drift/fit.h; kind and sensor selection from `fit`, by default Miao et
@@ -104,11 +108,12 @@ enum class MachineStrategy {
   kWarmup,
   kSchedule,
   kMachineShop,
-  kBothShop
+  kBothShop,
+  kLeadSlope
 };
-inline constexpr std::size_t kMachineStrategyCount = 14;
+inline constexpr std::size_t kMachineStrategyCount = 15;
 /// none, traditional, workpiece, machine, both, both_idle, both_monitor, class, table, nearest,
-/// warmup, schedule, machine_shop, both_shop
+/// warmup, schedule, machine_shop, both_shop, lead_slope
 /// Whether a strategy's machine half uses temperature sensors (machine, both*, machine_shop,
 /// both_shop); the others are sensor-free.
 bool UsesSensors(MachineStrategy s);
@@ -145,6 +150,8 @@ struct MachineModels {
 
 struct MachineEvalScrew {
   int machine = 0;
+  int day = 0;              ///< field world: calendar day of the cut (legacy: 0)
+  std::string start_type;   ///< field world: cold, warm, interrupted, long_pause (legacy: "")
   sim::Screw screw;
   std::uint64_t seed = 0, day_seed = 0;
   bool ok = false;
@@ -167,6 +174,8 @@ struct MachineEvalSummary {
 };
 
 struct MachineEvaluation {
+  /// The strategies this evaluation scores (empty: every one, the legacy table).
+  std::vector<MachineStrategy> rows;
   std::vector<std::vector<std::string>> sensors_cutting, sensors_idle;  ///< per machine
   std::vector<MachineEvalScrew> screws;
   MachineEvalSummary summary;
@@ -208,6 +217,10 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::
                                        const compare::EvaluateProgress& progress = {});
 
 MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& screws);
+/// The rows of the legacy table: every strategy but lead_slope.
+std::vector<MachineStrategy> LegacyStrategies();
+/// The rows of an evaluation: `rows`, or the legacy table's when empty.
+std::vector<MachineStrategy> RowsOf(const std::vector<MachineStrategy>& rows);
 /// Fixed-width text table (strategy: median/worst um within 1000 mm and over the thread, P3/P5).
 std::string FormatMachineEvalTable(const MachineEvaluation& e, bool markdown);
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "machine_eval/cut_scoring.h"
 
 namespace whirl::machine_eval {
 
@@ -13,8 +14,7 @@ SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::Workp
                                   const compare::IsoToleranceTable& iso_table,
                                   const MachineEvalOptions& options, int seeds,
                                   const compare::EvaluateProgress& progress) {
-  if (seeds < 1 || seeds > 20)
-    throw InputError("seeds = " + std::to_string(seeds) + ": must be within 1..20");
+  detail::CheckCount(seeds, 1, 20, "seeds");
   SeedsEvaluation e;
   const std::size_t per = static_cast<std::size_t>(options.machines * options.screws_per_machine);
   for (int s = 0; s < seeds; ++s) {
@@ -97,18 +97,70 @@ std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvalu
   return s;
 }
 
-MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s) {
+MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s,
+                                    const std::vector<MachineStrategy>& rows) {
   std::size_t best = 0;
-  for (std::size_t k = 1; k < kMachineStrategyCount; ++k) {
-    if (UsesSensors(static_cast<MachineStrategy>(k))) continue;
+  for (MachineStrategy x : RowsOf(rows)) {
+    const auto k = static_cast<std::size_t>(x);
+    if (k == 0 || UsesSensors(x)) continue;
     if (best == 0 || s[k].total_median_um < s[best].total_median_um) best = k;
   }
   return static_cast<MachineStrategy>(best);
 }
 
+namespace {
+
+bool InRows(const std::vector<MachineStrategy>& rows, MachineStrategy x) {
+  const auto all = RowsOf(rows);
+  return std::find(all.begin(), all.end(), x) != all.end();
+}
+
+// Gain 1 - median(x) / median(ref) over the thread, percent: pooled and per seed.
+struct Gain {
+  double pooled = 0;
+  std::vector<double> per_seed;
+  int seeds_won() const {
+    return static_cast<int>(std::count_if(per_seed.begin(), per_seed.end(),
+                                          [](double g) { return g > 0; }));
+  }
+};
+
+Gain GainOver(const SeedsEvaluation& e, const std::array<SeedStats, kMachineStrategyCount>& s,
+              std::size_t k, std::size_t ref) {
+  Gain g;
+  for (const auto& run : e.runs) {
+    const double r = SeedMedian(run, ref);
+    if (r > 1e-9) g.per_seed.push_back(100.0 * (1.0 - SeedMedian(run, k) / r));
+  }
+  if (s[ref].total_median_um > 1e-9)
+    g.pooled = 100.0 * (1.0 - s[k].total_median_um / s[ref].total_median_um);
+  return g;
+}
+
+// The verdict of both_shop against a reference row.
+std::string Verdict(const SeedsEvaluation& e, const Gain& g, MachineStrategy ref,
+                    const char* what) {
+  char buf[400];
+  if (g.pooled > 0)
+    std::snprintf(buf, sizeof buf,
+                  "%s: both_shop (sensors) beats %s %s over the thread by %.1f %% (better in %d "
+                  "of %zu seeds)",
+                  e.scenario.c_str(), what, ToString(ref).c_str(), g.pooled, g.seeds_won(),
+                  g.per_seed.size());
+  else
+    std::snprintf(buf, sizeof buf,
+                  "%s: both_shop (sensors) does NOT beat %s %s over the thread (%+.1f %%; better "
+                  "in %d of %zu seeds)",
+                  e.scenario.c_str(), what, ToString(ref).c_str(), g.pooled, g.seeds_won(),
+                  g.per_seed.size());
+  return buf;
+}
+
+}  // namespace
+
 std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
   const auto s = SummarizeOverSeeds(e);
-  const MachineStrategy best = StrongestSensorFree(s);
+  const MachineStrategy best = StrongestSensorFree(s, e.rows);
   const auto b = static_cast<std::size_t>(best);
   std::vector<std::string> out;
   char buf[400];
@@ -120,58 +172,128 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
   out.push_back(buf);
   for (MachineStrategy x : {MachineStrategy::kBoth, MachineStrategy::kBothShop,
                             MachineStrategy::kBothMonitor}) {
-    const auto k = static_cast<std::size_t>(x);
-    std::vector<double> gains;
-    for (const auto& run : e.runs) {
-      const double ref = SeedMedian(run, b);
-      if (ref > 1e-9) gains.push_back(100.0 * (1.0 - SeedMedian(run, k) / ref));
-    }
-    const double pooled =
-        s[b].total_median_um > 1e-9 ? 100.0 * (1.0 - s[k].total_median_um / s[b].total_median_um)
-                                    : 0.0;
+    if (!InRows(e.rows, x)) continue;
+    const Gain g = GainOver(e, s, static_cast<std::size_t>(x), b);
     std::snprintf(buf, sizeof buf,
                   "%s vs %s over the thread: %+.1f %% (per seed %+.1f .. %+.1f %%; positive = "
                   "%s leaves less)",
-                  ToString(x).c_str(), ToString(best).c_str(), pooled, Min(gains), Max(gains),
-                  ToString(x).c_str());
+                  ToString(x).c_str(), ToString(best).c_str(), g.pooled, Min(g.per_seed),
+                  Max(g.per_seed), ToString(x).c_str());
     out.push_back(buf);
+  }
+  const auto shop = static_cast<std::size_t>(MachineStrategy::kBothShop);
+  out.push_back(Verdict(e, GainOver(e, s, shop, b), best, "the strongest sensor-free strategy"));
+  const MachineStrategy rule =
+      s[static_cast<std::size_t>(MachineStrategy::kSchedule)].total_median_um <=
+              s[static_cast<std::size_t>(MachineStrategy::kWarmup)].total_median_um
+          ? MachineStrategy::kSchedule
+          : MachineStrategy::kWarmup;
+  if (rule != best)
+    out.push_back(Verdict(e, GainOver(e, s, shop, static_cast<std::size_t>(rule)), rule,
+                          "the better sensor-free machine rule"));
+  return out;
+}
+
+std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e) {
+  const auto s = SummarizeOverSeeds(e);
+  const auto best = static_cast<std::size_t>(StrongestSensorFree(s, e.rows));
+  const auto shop = static_cast<std::size_t>(MachineStrategy::kBothShop);
+  std::vector<std::string> out;
+  std::string line = e.scenario + ": thread median by start type, " +
+                     ToString(static_cast<MachineStrategy>(best)) + " / both_shop um (screws):";
+  bool any = false;
+  for (const char* type : {"cold", "warm", "interrupted", "long_pause"}) {
+    std::vector<double> b, x;
+    for (const auto& run : e.runs)
+      for (const auto& r : run.screws)
+        if (r.ok && r.start_type == type) {
+          b.push_back(std::abs(r.metrics[best].accumulated_total_um));
+          x.push_back(std::abs(r.metrics[shop].accumulated_total_um));
+        }
+    if (b.empty()) continue;
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "%s %s %.1f / %.1f (%zu)", any ? "," : "", type, Median(b),
+                  Median(x), b.size());
+    line += buf;
+    any = true;
+  }
+  if (any) out.push_back(line);
+  const bool field = !e.rows.empty();
+  line = e.scenario + ": uncompensated over the thread, each source alone, median um:";
+  const char* names[] = {"workpiece", "head", field ? "Z axis and blank" : "z_screw", "bed"};
+  for (std::size_t q = 0; q < (field ? 3u : kErrorSourceCount); ++q) {
+    std::vector<double> v;
+    for (const auto& run : e.runs)
+      for (const auto& r : run.screws)
+        if (r.ok) v.push_back(r.source_total_um[q]);
+    char buf[80];
+    std::snprintf(buf, sizeof buf, "%s %s %.1f", q ? "," : "", names[q], Median(v));
+    line += buf;
+  }
+  out.push_back(line);
+  return out;
+}
+
+namespace {
+
+std::string TableHeader(bool markdown) {
+  if (markdown)
+    return "| scenario | strategy | 1000 mm median [seeds] um | 1000 mm worst um | thread median "
+           "[seeds] um | thread worst um | \\|e_a - c\\| median um | P3 / P5 |\n"
+           "|---|---|---|---|---|---|---|---|\n";
+  return "scenario            strategy      1000mm med [seeds]      worst  thread med [seeds]    "
+         "  worst  |ea-c|  P3/P5\n";
+}
+
+std::string TableRows(const SeedsEvaluation& e, bool markdown) {
+  const auto s = SummarizeOverSeeds(e);
+  std::string out;
+  char buf[400];
+  for (MachineStrategy st : RowsOf(e.rows)) {
+    const SeedStats& x = s[static_cast<std::size_t>(st)];
+    const char* fmt = markdown
+                          ? "| %s | %s | %.1f [%.1f-%.1f] | %.1f | %.1f [%.1f-%.1f] | %.1f | %.1f "
+                            "| %.2f / %.2f |\n"
+                          : "%-19s %-13s %6.1f [%5.1f-%5.1f] %6.1f %7.1f [%5.1f-%5.1f] %6.1f "
+                            "%6.1f  %.2f/%.2f\n";
+    std::snprintf(buf, sizeof buf, fmt, e.scenario.c_str(), ToString(st).c_str(),
+                  x.acc1000_median_um, x.acc1000_seed_min_um, x.acc1000_seed_max_um,
+                  x.acc1000_worst_um, x.total_median_um, x.total_seed_min_um, x.total_seed_max_um,
+                  x.total_worst_um, x.e_a_minus_c_median_um, x.share_p3, x.share_p5);
+    out += buf;
   }
   return out;
 }
 
-std::string FormatSeedsTable(const SeedsEvaluation& e, bool markdown) {
-  const auto s = SummarizeOverSeeds(e);
+std::string Headlines(const SeedsEvaluation& e, bool markdown) {
   std::string out;
-  char buf[400];
-  if (markdown)
-    out += "| scenario | strategy | 1000 mm median [seeds] um | 1000 mm worst um | thread median "
-           "[seeds] um | thread worst um | \\|e_a - c\\| median um | P3 / P5 |\n"
-           "|---|---|---|---|---|---|---|---|\n";
-  else
-    out += "scenario  strategy       1000mm med [seeds]      worst  thread med [seeds]      "
-           "worst  |ea-c|  P3/P5\n";
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const SeedStats& x = s[k];
-    const char* fmt = markdown
-                          ? "| %s | %s | %.1f [%.1f-%.1f] | %.1f | %.1f [%.1f-%.1f] | %.1f | %.1f "
-                            "| %.2f / %.2f |\n"
-                          : "%-9s %-13s %6.1f [%5.1f-%5.1f] %6.1f %7.1f [%5.1f-%5.1f] %6.1f "
-                            "%6.1f  %.2f/%.2f\n";
-    std::snprintf(buf, sizeof buf, fmt, e.scenario.c_str(),
-                  ToString(static_cast<MachineStrategy>(k)).c_str(), x.acc1000_median_um,
-                  x.acc1000_seed_min_um, x.acc1000_seed_max_um, x.acc1000_worst_um,
-                  x.total_median_um, x.total_seed_min_um, x.total_seed_max_um, x.total_worst_um,
-                  x.e_a_minus_c_median_um, x.share_p3, x.share_p5);
-    out += buf;
-  }
   for (const auto& h : MachineHeadlines(e)) out += (markdown ? "\n- " : "") + h + "\n";
+  for (const auto& h : ScenarioNotes(e)) out += (markdown ? "\n- " : "  ") + h + "\n";
+  return out;
+}
+
+}  // namespace
+
+std::string FormatSeedsTable(const SeedsEvaluation& e, bool markdown) {
+  return TableHeader(markdown) + TableRows(e, markdown) + Headlines(e, markdown);
+}
+
+std::string FormatScenarioTables(const std::vector<SeedsEvaluation>& e, bool markdown) {
+  std::string out = TableHeader(markdown);
+  for (const auto& x : e) out += TableRows(x, markdown);
+  for (const auto& x : e) out += Headlines(x, markdown);
+  out += std::string(markdown ? "\n" : "") +
+         "(accumulated lead error in um, median [range of the per-seed medians] and worst screw; "
+         "simulator only: every figure is measured in the project's simulator, not on a "
+         "machine)\n";
   return out;
 }
 
 void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
   const auto s = SummarizeOverSeeds(e);
   nlohmann::json strategies = nlohmann::json::object();
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+  for (MachineStrategy st : RowsOf(e.rows)) {
+    const auto k = static_cast<std::size_t>(st);
     const SeedStats& x = s[k];
     std::vector<double> per_seed;
     for (const auto& run : e.runs) per_seed.push_back(SeedMedian(run, k));
@@ -196,9 +318,10 @@ void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
        {"scenario", e.scenario},
        {"seeds", e.seeds},
        {"travel_c_um", e.travel_c_um},
-       {"strongest_sensor_free", ToString(StrongestSensorFree(s))},
+       {"strongest_sensor_free", ToString(StrongestSensorFree(s, e.rows))},
        {"strategies", strategies},
        {"headlines", MachineHeadlines(e)},
+       {"notes", ScenarioNotes(e)},
        {"runs", runs}};
 }
 

@@ -21,6 +21,9 @@ struct SeedsEvaluation {
   std::vector<std::uint64_t> seeds;
   std::vector<MachineEvaluation> runs;  ///< one per seed (reports only for the first)
   double travel_c_um = 0;               ///< specified travel compensation c, um
+  /// The strategies of the table (empty: every one, the legacy table; the field world's rows are
+  /// field_eval.h FieldStrategies).
+  std::vector<MachineStrategy> rows;
 };
 
 struct SeedStats {
@@ -40,16 +43,29 @@ SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::Workp
 
 std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvaluation& e);
 
-/// The strongest sensor-free strategy by pooled thread median (see the header comment).
-MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s);
+/// The strongest sensor-free strategy by pooled thread median (see the header comment), among
+/// `rows` (empty: every strategy).
+MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s,
+                                    const std::vector<MachineStrategy>& rows = {});
 
 /// Sentences: the strongest sensor-free rule and the gain 1 - median(x) / median(best) over the
-/// thread of both, both_shop and machine_shop's pairing, with the per-seed range of the gain.
+/// thread of both, both_shop and both_monitor (those among the rows), with the per-seed range of
+/// the gain; then the verdict: whether both_shop beats the strongest sensor-free rule over the
+/// thread (pooled gain > 0) and in how many seeds, and both_shop against the better of the
+/// sensor-free machine rules (warmup, schedule: the value of the sensors alone).
 std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e);
+
+/// Notes under the headlines: the thread median of the strongest sensor-free strategy and of
+/// both_shop per start type (cold, warm, interrupted, long_pause; field world only) with the
+/// screw count, and the uncompensated error over the thread of each source alone (median um).
+std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e);
 
 /// One block: scenario, strategy, 1000 mm median [seed range], worst, thread median [range],
 /// worst, |e_a - c| median, P3 / P5; then the headlines.
 std::string FormatSeedsTable(const SeedsEvaluation& e, bool markdown);
+
+/// Several scenarios in one table (one header, the rows of each, then each one's headlines).
+std::string FormatScenarioTables(const std::vector<SeedsEvaluation>& e, bool markdown);
 
 /// Schema "whirl.machine_evaluate" version 2: per strategy the pooled statistics and per-seed
 /// medians, the headlines, and each seed's version-1 evaluation.

@@ -88,4 +88,27 @@ grep -q "output:</p><pre>IDS=[0-9]* [^<]*</pre>" "$D/report/index.html" \
 "$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \
   2>/dev/null || fail "drift predict on the screw's log"
 grep -q '"residual"' "$D/pred2.json" || fail "the screw's log has no offset_um channel"
+# Scenarios: the field flags carry units in --help; a bad scenario name and a flag of the other
+# world exit 1 naming the flag and the rule; a small field run gives the field rows only.
+grep -A1 -- "--check-every-min" "$D/evaluate_help.txt" | grep -q "\[min\]" || fail "--check-every-min without [min]"
+grep -A1 -- "--probe-noise-um" "$D/evaluate_help.txt" | grep -q "\[um\]" || fail "--probe-noise-um without [um]"
+expect_fail "--scenarios" "$W" machine evaluate --scenarios productoin
+expect_fail "production" "$W" machine evaluate --scenarios productoin
+expect_fail "--screws: applies to the legacy world only" "$W" machine evaluate --scenarios production --screws 2
+expect_fail "--train-runs: applies to the legacy world only" "$W" machine evaluate --scenarios duty-changes --train-runs 2
+expect_fail "--test-days: applies to the field scenarios only" "$W" machine evaluate --scenarios legacy --test-days 2
+expect_fail "--check-every-min" "$W" machine evaluate --scenarios production --check-every-min 0
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  > "$D/field.json" 2> "$D/field_err.txt" || fail "field evaluate: $(cat "$D/field_err.txt")"
+python3 - "$D/field.json" <<'PY' || fail "field evaluate: rows or screws wrong"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["schema"] == "whirl.machine_scenarios", j["schema"]
+s = j["scenarios"][0]
+assert s["scenario"] == "production"
+rows = set(s["strategies"])
+assert {"none", "traditional", "warmup", "schedule", "both_shop"} <= rows, rows
+assert not ({"machine", "both", "both_idle", "both_monitor"} & rows), rows
+assert s["strategies"]["none"]["screws"] >= 1
+PY
 echo "cli_machine: ok"

