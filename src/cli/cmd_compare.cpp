@@ -83,8 +83,10 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
               c.experience_class.plateau_um, c.experience_class.nominal_diameter_mm,
               c.experience_class.screws, c.experience_ramp_time_s);
   std::printf(
-      "traditional (class-mean curve): %.1f um, %.0f s; regression (log-linear): %.1f um, %.0f s\n",
-      c.traditional_features.max_elongation_um, c.traditional_features.settle_time_s,
+      "traditional (%s, the strongest history rule): %.1f um, %.0f s; regression (log-linear): "
+      "%.1f um, %.0f s\n",
+      compare::ToString(c.traditional_rule).c_str(), c.traditional_features.max_elongation_um,
+      c.traditional_features.settle_time_s,
       c.regression_features.max_elongation_um, c.regression_features.settle_time_s);
   std::printf("%s", compare::FormatComparisonTable(c).c_str());
 }
@@ -95,12 +97,14 @@ void RegisterCompare(CLI::App& app) {
   auto o = std::make_shared<CompareCliOptions>();
   auto* sub = app.add_subcommand(
       "compare",
-      "Cut a screw in the simulator five times and compare the lead error: none (no\n"
+      "Cut a screw in the simulator once per strategy and compare the lead error: none (no\n"
       "compensation); ramp (the old rule: the class's mean plateau of the past screws in\n"
-      "--history ramped in linearly over their mean settle time); traditional (the class's mean\n"
-      "plateau and settle time as an arctangent curve); regression (log-linear least squares of\n"
-      "both features on the five inputs of --history); model (the network's prediction). The\n"
-      "last three go through the same 840D plan (curve -> SD43900/SD43910/SD43920).\n"
+      "--history ramped in linearly over their mean settle time); class, table, nearest (the\n"
+      "shop's history rules: the diameter class's mean curve, a table keyed on ball size, speed\n"
+      "and lead, the 3 nearest past screws); traditional (the strongest of those three, chosen\n"
+      "by leave-one-out on --history); regression (log-linear least squares of both features on\n"
+      "the five inputs of --history); model (the workpiece model's prediction). Every strategy\n"
+      "but none and ramp goes through the same 840D plan (curve -> SD43900/SD43910/SD43920).\n"
       "The truth is the whole-thread simulation with seeded disturbances (--seed) the model\n"
       "never saw. Prints, in um, the accumulated lead error within any 1000 mm and over the\n"
       "thread, e_a, v_u, v_300, v_2pi, the ISO 3408-3 class reached and the reductions of the\n"
