@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +12,9 @@
 #include <iostream>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cli/terminal.h"
 #include "core/csv.h"
@@ -149,6 +153,34 @@ void AddToleranceOption(CLI::App* sub, double* tolerance_um) {
 
 namespace {
 
+// The old spellings typed in this run, as {current name, old name}: an error raised after parsing
+// (a folder refused, a file not found) names the flag by its current name; RunApp shows the
+// spelling the user typed beside it (NameTypedFlags).
+std::vector<std::pair<std::string, std::string>>& TypedOldSpellings() {
+  static std::vector<std::pair<std::string, std::string>> typed;
+  return typed;
+}
+
+bool IsFlagChar(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_';
+}
+
+// "--out-dir 'x': ..." -> "--report (now --out-dir) 'x': ..." for each old spelling typed.
+std::string NameTypedFlags(std::string message) {
+  for (const auto& [now, old] : TypedOldSpellings()) {
+    const std::string shown = old + " (now " + now + ")";
+    for (std::size_t at = message.find(now); at != std::string::npos;
+         at = message.find(now, at + 1)) {
+      const bool starts = at == 0 || !IsFlagChar(message[at - 1]);
+      const std::size_t end = at + now.size();
+      if (!starts || (end < message.size() && IsFlagChar(message[end]))) continue;
+      message.replace(at, now.size(), shown);
+      at += shown.size() - 1;
+    }
+  }
+  return message;
+}
+
 // The value(s) `values` of the old spelling `old_flag` handed to `current` (AddDeprecatedAlias);
 // `use` is what the deprecation line tells the user to type instead.
 void ForwardDeprecated(CLI::Option* current, const std::string& old_flag, const std::string& use,
@@ -158,6 +190,7 @@ void ForwardDeprecated(CLI::Option* current, const std::string& old_flag, const 
     throw CLI::ValidationError(
         old_flag, "give " + now + " only (" + old_flag + " is its deprecated spelling), not both");
   std::fprintf(stderr, "whirl: %s is deprecated, use %s\n", old_flag.c_str(), use.c_str());
+  TypedOldSpellings().emplace_back(now, old_flag);
   for (const auto& v : values) current->add_result(v);
   try {
     current->run_callback();            // current's checks and conversion, as if it had been typed
@@ -314,10 +347,10 @@ int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summari
     std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
     return 1;
   } catch (const CommandFailure& e) {
-    std::fprintf(stderr, "failed: %s\n", e.what());
+    std::fprintf(stderr, "failed: %s\n", NameTypedFlags(e.what()).c_str());
     return e.exit_code;
   } catch (const std::exception& e) {  // InputError and anything else: bad input or failure
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", NameTypedFlags(e.what()).c_str());
     return 1;
   }
   return 0;

@@ -271,4 +271,9 @@ expect_fail "--lag-grid-samples 10: the run records time: use --lag-grid-min" \
 expect_fail "--max-elongation" "$W" curve --max-elongation 30 --max-elongation-um 30 --settle-time-s 250
 expect_fail "^error: --settle-time: '1e999' breaks the rule" "$W" curve --max-elongation-um 30 --settle-time 1e999
 grep -- "^error:" "$D/err.txt" | grep -q -- "--settle-time-s" && fail "a refused old spelling is named as the new one"
+# An error raised after parsing (here a folder with a foreign file) names the spelling typed.
+mkdir -p "$D/foreign" && echo x > "$D/foreign/f.txt"
+expect_fail "^error: --out (now --out-dir) '" "$W" machine sensors --out "$D/foreign" --idle 1 --cutting 0
+expect_fail "^error: --out-dir '" "$W" machine sensors --out-dir "$D/foreign" --idle 1 --cutting 0
+grep -q "(now" "$D/err.txt" && fail "the current spelling is shown as an old one: $(cat "$D/err.txt")"
 echo "deprecated spellings: $aliases checked"
