@@ -17,6 +17,23 @@ function(whirl_library folder)
   add_library(whirl::${folder} ALIAS whirl_${folder})
   target_compile_features(whirl_${folder} PUBLIC cxx_std_17)
   whirl_set_warnings(whirl_${folder})
+  whirl_unity_build(whirl_${folder})
+endfunction()
+
+# whirl_unity_build(<target>): compile the target's files in batches of WHIRL_UNITY_BATCH_SIZE, one
+# translation unit per batch (behind WHIRL_UNITY_BUILD). Each file of the libraries includes Eigen,
+# nlohmann/json and the standard library and instantiates the same templates (matrix products and
+# decompositions, JSON parsing and dumping); at -O3 each instance is optimized once per translation
+# unit, so batching saves most of that repeated work (measured in docs/development.md, "Build time").
+# So the files of one folder must not define the same name twice at namespace scope, anonymous
+# namespaces included: give a file's helpers names of their own. The batch size bounds what an edit
+# of one file recompiles; WHIRL_UNITY_BUILD=OFF compiles file by file (and checks that each file
+# includes what it uses).
+function(whirl_unity_build target)
+  if(WHIRL_UNITY_BUILD)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON
+                                               UNITY_BUILD_BATCH_SIZE ${WHIRL_UNITY_BATCH_SIZE})
+  endif()
 endfunction()
 
 # whirl_precompile(<target> <kind>): the precompiled third-party headers of <kind>, built once by

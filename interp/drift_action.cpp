@@ -24,7 +24,7 @@ std::string Text(std::string t) {
 std::string Cell(const std::string& t) { return SpreadsheetCell(Text(t)); }
 
 std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
-std::string R(int n) { return "R" + std::to_string(n); }
+std::string Rp(int n) { return "R" + std::to_string(n); }
 // "+x" or "-x": a term appended to an expression (never "+-x", which a control may refuse).
 std::string Term(double v, int decimals) {
   const std::string text = FormatFixed(v, decimals);
@@ -209,7 +209,7 @@ std::string CancelRange(int first, int last) {
   return out;
 }
 
-bool Overlap(int a0, int a1, int b0, int b1) { return a0 <= b1 && b0 <= a1; }
+bool RangesOverlap(int a0, int a1, int b0, int b1) { return a0 <= b1 && b0 <= a1; }
 
 }  // namespace
 
@@ -372,7 +372,7 @@ void CheckSlope(const drift::DriftModel* g, const DriftActionOptions& o, const S
         {"workpiece_slope_param", o.workpiece_slope_param},
         {"workpiece_slope_param + 1",
          o.workpiece_slope_param < 0 ? -1 : o.workpiece_slope_param + 1}})
-    if (slot >= 0 && Overlap(slot, slot, o.param_first, s.last))
+    if (slot >= 0 && RangesOverlap(slot, slot, o.param_first, s.last))
       throw InputError("drift action: " + std::string(name) + " " + std::to_string(slot) +
                        " lies in the action's own $AC_PARAM slots " +
                        std::to_string(o.param_first) + ".." + std::to_string(s.last));
@@ -382,14 +382,14 @@ void CheckSlope(const drift::DriftModel* g, const DriftActionOptions& o, const S
 std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& s) {
   const int r = o.save_r_first;
   const std::string ax = "[" + o.axis + "]";
-  std::string nc = "IF " + R(r + 1) + "<>1\n" + R(r) + "=$SA_TEMP_COMP_ABS_VALUE" + ax + "\n" +
-                   R(r + 1) + "=1\nENDIF\n";
+  std::string nc = "IF " + Rp(r + 1) + "<>1\n" + Rp(r) + "=$SA_TEMP_COMP_ABS_VALUE" + ax + "\n" +
+                   Rp(r + 1) + "=1\nENDIF\n";
   if (slope_mode)
-    nc += "IF " + R(r + 4) + "<>1\n" + R(r + 2) + "=$SA_TEMP_COMP_SLOPE" + ax + "\n" + R(r + 3) +
-          "=$SA_TEMP_COMP_REF_POSITION" + ax + "\n" + R(r + 4) + "=1\nENDIF\n";
+    nc += "IF " + Rp(r + 4) + "<>1\n" + Rp(r + 2) + "=$SA_TEMP_COMP_SLOPE" + ax + "\n" + Rp(r + 3) +
+          "=$SA_TEMP_COMP_REF_POSITION" + ax + "\n" + Rp(r + 4) + "=1\nENDIF\n";
   else  // an aborted slope run left its slope behind: give the found one back
-    nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
-          "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";
+    nc += "IF " + Rp(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + Rp(r + 2) +
+          "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + Rp(r + 3) + "\n" + Rp(r + 4) + "=0\nENDIF\n";
   nc += P(s.alive) + "=0\n" + P(s.offset.flag) + "=0\n";
   if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
   if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
@@ -462,10 +462,11 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
           FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
           " mm (MCS); |S_m| <= " + FormatFixed(DriftSlopeBound(*g, o), kDecimalsSd43910) +
           " over the training ranges: the plan's slopes plus this must stay within MD32760\n";
-  const std::string saved = slope_mode ? R(r) + ".." + R(r + 4) + " (SD43900-43920 found, markers)"
-                                       : R(r) + " (SD43900 found), " + R(r + 1) +
-                                             " (1 while active), " + R(r + 2) + ".." + R(r + 4) +
-                                             " (a slope left by an earlier run)";
+  const std::string saved = slope_mode
+                                ? Rp(r) + ".." + Rp(r + 4) + " (SD43900-43920 found, markers)"
+                                : Rp(r) + " (SD43900 found), " + Rp(r + 1) +
+                                      " (1 while active), " + Rp(r + 2) + ".." + Rp(r + 4) +
+                                      " (a slope left by an earlier run)";
   nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
         std::to_string(o.param_first) + ".." + std::to_string(s.last) + "] (liveness $AC_PARAM[" +
@@ -506,7 +507,7 @@ std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOp
   if (check)  // a plan's own compensation is still on the control: reset it first
     nc += "; after the alarm the program jumps to " + std::string(kProgramEndLabel) +
           " and cancels, saves and writes nothing, whatever the alarm's response\n" +
-          CheckOrAlarm(R(o.plan_marker_r) + "<>1", o.missing_alarm + 3, "WHIRL_NO_PLAN_ACTIVE");
+          CheckOrAlarm(Rp(o.plan_marker_r) + "<>1", o.missing_alarm + 3, "WHIRL_NO_PLAN_ACTIVE");
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
   nc += Preamble(o, SlopeMode(o, g), s) + "STOPRE\n";
   for (std::size_t k = 0; k < bodies.size(); ++k)
@@ -523,13 +524,13 @@ std::string FormatDriftNcResetProgram(const DriftActionOptions& o) {
   std::string nc = "; " + o.reset_program_name + ": stops the live drift compensation of axis " +
                    o.axis +
                    " and restores the setting data found before it started (SD43900 if " +
-                   R(r + 1) + " = 1, SD43910/SD43920 if " + R(r + 4) + " = 1)\n";
+                   Rp(r + 1) + " = 1, SD43910/SD43920 if " + Rp(r + 4) + " = 1)\n";
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
   nc += P(o.param_first) + "=0\n";  // liveness: no action runs any more
   // The slope first: every intermediate state is then a constant offset (sinumerik.h).
-  nc += "IF " + R(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + R(r + 2) +
-        "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + R(r + 3) + "\n" + R(r + 4) + "=0\nENDIF\n";
-  nc += "IF " + R(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + R(r) + "\n" + R(r + 1) +
+  nc += "IF " + Rp(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + Rp(r + 2) +
+        "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + Rp(r + 3) + "\n" + Rp(r + 4) + "=0\nENDIF\n";
+  nc += "IF " + Rp(r + 1) + "==1\n$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + Rp(r) + "\n" + Rp(r + 1) +
         "=0\nENDIF\n";
   nc += "STOPRE\nM17\n";
   return nc;

@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kDeg = kPi / 180;
 
-CircleTrace FromTable(const CsvTable& t) {
+CircleTrace TraceFromTable(const CsvTable& t) {
   for (const auto& name : t.header)
     if (name != "angle_deg" && name != "deviation_um")
       throw InputError(t.source + ": unknown column '" + name +
@@ -60,10 +60,12 @@ Plane ParsePlane(const std::string& s) {
 }
 
 CircleTrace ParseCircleTrace(const std::string& text, const std::string& source) {
-  return FromTable(ParseCsv(text, source));
+  return TraceFromTable(ParseCsv(text, source));
 }
 
-CircleTrace ReadCircleTrace(const std::filesystem::path& path) { return FromTable(ReadCsv(path)); }
+CircleTrace ReadCircleTrace(const std::filesystem::path& path) {
+  return TraceFromTable(ReadCsv(path));
+}
 
 std::string FormatCircleTrace(const CircleTrace& c) {
   std::vector<std::vector<double>> rows;

@@ -40,7 +40,7 @@ Reading ParseRow(const CsvTable& t, std::size_t r, bool has_t) {
   return x;
 }
 
-Readings FromTable(const CsvTable& t) {
+Readings ReadingsFromTable(const CsvTable& t) {
   const std::string& source = t.source;
   const bool has_t = t.HasColumn("bar_temperature_C");
   for (const auto& name : t.header)
@@ -68,10 +68,12 @@ Readings FromTable(const CsvTable& t) {
 }  // namespace
 
 Readings ParseReadings(const std::string& text, const std::string& source) {
-  return FromTable(ParseCsv(text, source));
+  return ReadingsFromTable(ParseCsv(text, source));
 }
 
-Readings ReadReadings(const std::filesystem::path& path) { return FromTable(ReadCsv(path)); }
+Readings ReadReadings(const std::filesystem::path& path) {
+  return ReadingsFromTable(ReadCsv(path));
+}
 
 std::string FormatReadings(const Readings& readings) {
   std::vector<std::string> header{"time_min", "pivot", "length_mm"};
@@ -324,7 +326,7 @@ std::string FormatDriftCsv(const DriftResult& r, const std::vector<std::string>&
 }
 
 namespace {
-nlohmann::json Xyz(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+nlohmann::json XyzJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 }  // namespace
 
 nlohmann::json ToJson(const DriftResult& r) {
@@ -334,11 +336,11 @@ nlohmann::json ToJson(const DriftResult& r) {
                       {"lines", {b.first_line, b.last_line}},
                       {"readings_per_pivot", b.readings},
                       {"averaging", b.averaging},
-                      {"mean_length_mm", Xyz(b.mean_length_mm)},
-                      {"mean_bar_temperature_C", Xyz(b.mean_bar_temperature_C)},
-                      {"position_mm", Xyz(b.position_mm)},
-                      {"drift_um", Xyz(b.drift_um)},
-                      {"drift_sd_um", Xyz(b.drift_sd_um)}});
+                      {"mean_length_mm", XyzJson(b.mean_length_mm)},
+                      {"mean_bar_temperature_C", XyzJson(b.mean_bar_temperature_C)},
+                      {"position_mm", XyzJson(b.position_mm)},
+                      {"drift_um", XyzJson(b.drift_um)},
+                      {"drift_sd_um", XyzJson(b.drift_sd_um)}});
   const auto& p = r.placement;
   nlohmann::json j = {
       {"schema", "whirl.ballbar.drift"},
@@ -355,7 +357,7 @@ nlohmann::json ToJson(const DriftResult& r) {
       {"block_gap_min", r.options.block_gap_min},
       {"placement",
        {{"condition_number", p.condition_number},
-        {"noise_gain", Xyz(p.noise_gain)},
+        {"noise_gain", XyzJson(p.noise_gain)},
         {"height_mm", p.height_mm},
         {"mean_radius_mm", p.mean_radius_mm},
         {"ideal_height_mm", p.ideal_height_mm},

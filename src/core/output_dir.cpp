@@ -17,7 +17,7 @@ namespace whirl {
 namespace {
 namespace fs = std::filesystem;
 
-std::string Quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+std::string QuotedPath(const fs::path& p) { return "'" + p.string() + "'"; }
 
 // "out/", "out/." and "out" are the same directory; lstat of "link/" would follow the link.
 fs::path WithoutTrailingSeparator(const fs::path& p) {
@@ -34,7 +34,7 @@ bool ValidEntryName(const std::string& name) {
 // The names a manifest lists; an InputError naming it when it is not whirl's manifest.
 std::set<std::string> ReadManifest(const fs::path& file, const std::string& what) {
   const nlohmann::json j = ReadJsonFile(file);
-  const std::string rule = what + ": " + Quoted(file) +
+  const std::string rule = what + ": " + QuotedPath(file) +
                            " is not a whirl output manifest (schema whirl.output_dir with a list "
                            "of file names); remove the directory or choose another";
   if (!j.is_object() || j.value("schema", "") != "whirl.output_dir" || !j.contains("files") ||
@@ -67,7 +67,7 @@ bool HasManifest(const fs::path& dir) {
 // The rule of the header; returns the names the manifest lists (the previous run's files).
 std::set<std::string> Inspect(const fs::path& given, const std::string& what) {
   const fs::path dir = WithoutTrailingSeparator(given);
-  const std::string name = what + " " + Quoted(given);
+  const std::string name = what + " " + QuotedPath(given);
   if (dir.empty()) throw InputError(what + ": empty directory path");
   struct stat st {};
   if (::lstat(dir.c_str(), &st) != 0) {
@@ -94,7 +94,8 @@ std::set<std::string> Inspect(const fs::path& given, const std::string& what) {
   }
   if (ec) throw InputError(name + ": cannot list it (" + ec.message() + ")");
   if (!foreign.empty())
-    throw InputError(name + " holds " + Quoted(*std::min_element(foreign.begin(), foreign.end())) +
+    throw InputError(name + " holds " +
+                     QuotedPath(*std::min_element(foreign.begin(), foreign.end())) +
                      (manifest ? ", which is not among the files whirl wrote there ("
                                : ", and whirl did not write into it (no ") +
                      std::string(kOutputManifest) +
@@ -151,7 +152,7 @@ bool Inside(const fs::path& p, const fs::path& dir) {
   return true;
 }
 
-std::string Named(const FlagPath& f) { return f.flag + " " + Quoted(f.path); }
+std::string Named(const FlagPath& f) { return f.flag + " " + QuotedPath(f.path); }
 
 }  // namespace
 
@@ -173,7 +174,8 @@ const fs::path& OutputDir::Create() {
   if (!fs::exists(fs::symlink_status(dir_, ec))) {
     fs::create_directories(dir_, ec);
     if (ec)
-      throw InputError(what_ + " " + Quoted(dir_) + ": cannot create it (" + ec.message() + ")");
+      throw InputError(what_ + " " + QuotedPath(dir_) + ": cannot create it (" + ec.message() +
+                       ")");
     created_ = true;
   }
   return dir_;
@@ -181,10 +183,10 @@ const fs::path& OutputDir::Create() {
 
 void OutputDir::Insert(const std::string& name, std::string contents) {
   if (!ValidEntryName(name) || IsWhirlTemporary(name))
-    throw InputError(what_ + " " + Quoted(dir_) + ": " + Quoted(name) +
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": " + QuotedPath(name) +
                      " is not a file name whirl may write there");
   if (!names_.insert(name).second)
-    throw InputError(what_ + " " + Quoted(dir_) + ": two outputs named " + Quoted(name));
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": two outputs named " + QuotedPath(name));
   files_.emplace_back(name, std::move(contents));
 }
 
@@ -195,7 +197,7 @@ void OutputDir::Add(const std::string& name, std::string contents) {
 
 void OutputDir::Keep(const std::string& name) {
   if (!ValidEntryName(name))
-    throw InputError(what_ + ": " + Quoted(name) + " is not an entry name");
+    throw InputError(what_ + ": " + QuotedPath(name) + " is not an entry name");
   kept_.push_back(name);
 }
 
@@ -205,7 +207,7 @@ const fs::path& OutputDir::Staging() {
   const fs::path s = dir_ / WhirlTemporaryName("", "");
   std::error_code ec;
   if (!fs::create_directory(s, ec))
-    throw InputError(what_ + " " + Quoted(dir_) + ": cannot create a staging folder (" +
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": cannot create a staging folder (" +
                      ec.message() + ")");
   staging_ = s;
   for (const auto& [name, text] : files_) WriteFileAtomic(staging_ / name, text);
@@ -263,12 +265,12 @@ void CheckOutputs(const std::vector<FlagPath>& inputs, const std::vector<FlagPat
     for (const auto& i : in)
       if (SameFile(o.path, i.path))
         throw InputError(Named(o) + " is the input " + Named(i) + " (both are " +
-                         Quoted(Resolved(i.path)) + ")" + never);
+                         QuotedPath(Resolved(i.path)) + ")" + never);
   for (std::size_t a = 0; a < out.size(); ++a)
     for (std::size_t b = a + 1; b < out.size(); ++b)
       if (SameFile(out[a].path, out[b].path))
         throw InputError(Named(out[a]) + " and " + Named(out[b]) + " are the same file (" +
-                         Quoted(Resolved(out[a].path)) + ")" + never);
+                         QuotedPath(Resolved(out[a].path)) + ")" + never);
   for (std::size_t a = 0; a < dir.size(); ++a) {
     for (const auto& i : in)
       if (Inside(i.path, dir[a].path))

@@ -12,7 +12,7 @@ namespace {
 
 using nlohmann::json;
 
-std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
+std::string JoinNames(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
   return out;
@@ -24,7 +24,7 @@ std::string JoinNumbers(const std::vector<double>& v) {
   return out;
 }
 
-std::vector<double> Vec(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+std::vector<double> StdVector(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
 
 // F values may be +inf (a partition into tight classes); JSON has no infinity.
 json Finite(double v) { return std::isfinite(v) ? json(v) : json("inf"); }
@@ -107,7 +107,7 @@ std::string FormatSelection(const Selection& s) {
   for (std::size_t i = 0; i < s.sensor_names.size(); ++i)
     o << " " << s.sensor_names[i] << " "
       << FormatDecimals(s.grades(static_cast<Eigen::Index>(i)), 4);
-  o << "\nclass count: " << s.message << "\nchosen sensors: " << Join(s.ChosenNames()) << "\n";
+  o << "\nclass count: " << s.message << "\nchosen sensors: " << JoinNames(s.ChosenNames()) << "\n";
   return o.str();
 }
 
@@ -130,7 +130,7 @@ json ModelSummaryJson(const DriftModel& m) {
   json j = {{"kind", ToString(m.kind)},
             {"error_column", m.error_column},
             {"sensors", m.sensors},
-            {"reference_C", Vec(m.reference_C)},
+            {"reference_C", StdVector(m.reference_C)},
             {"extra_inputs", m.extra_inputs},
             {"time_unit", m.time_unit},
             {"time_constants", m.time_constants},
@@ -155,7 +155,7 @@ std::string FormatModel(const DriftModel& m) {
   std::vector<std::string> inputs = m.sensors;
   inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
   if (!m.elapsed_time_constants.empty()) inputs.push_back("elapsed time");
-  o << ToString(m.kind) << " model of " << m.error_column << " on " << Join(inputs) << "\n";
+  o << ToString(m.kind) << " model of " << m.error_column << " on " << JoinNames(inputs) << "\n";
   o << "  error zero: " << ToString(m.zero.zero)
     << (m.zero.zero == ErrorZero::kFixed ? " (gauge level " + FormatDecimals(m.zero.gauge_level_um, 3) + " um)"
                                          : "")
@@ -187,7 +187,7 @@ std::string FormatModel(const DriftModel& m) {
   }
   o << "  training: R^2 " << FormatDecimals(m.r_squared, 4) << ", residual std "
     << FormatDecimals(m.residual_std_um, 3) << " um, " << m.training_samples << " samples of "
-    << Join(m.training_runs) << " (state " << ToString(m.state) << ")\n";
+    << JoinNames(m.training_runs) << " (state " << ToString(m.state) << ")\n";
   return o.str();
 }
 
@@ -271,7 +271,8 @@ std::string FormatCrossRun(const CrossRunResult& r) {
   o << "cross-run evaluation of " << r.error_column << " (" << ToString(r.kind)
     << " model on each run's chosen sensors; statistics of measured - predicted [um])\n";
   for (std::size_t i = 0; i < r.runs.size(); ++i)
-    o << "  " << r.runs[i] << " (" << ToString(r.states[i]) << "): " << Join(r.chosen[i]) << "\n";
+    o << "  " << r.runs[i] << " (" << ToString(r.states[i]) << "): " << JoinNames(r.chosen[i])
+      << "\n";
   o << "RMSE [um], rows = model built on, columns = run predicted:\n" << std::string(16, ' ');
   for (const auto& n : r.runs) {
     char cell[32];
@@ -347,7 +348,7 @@ std::string FormatHoldout(const HoldoutResult& r) {
                   row.test.max_abs_um, row.train.mae_um);
     o << line
       << (row.inputs.size() > 6 ? std::to_string(row.inputs.size()) + " sensors"
-                                : Join(row.inputs));
+                                : JoinNames(row.inputs));
     if (!row.time_constants.empty())
       o << " (" << JoinNumbers(row.time_constants) << (r.time_from_index ? " samples)" : " min)");
     o << "\n";

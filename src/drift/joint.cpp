@@ -41,12 +41,12 @@ std::vector<bool> SlopeLogs(const ShopRecord& rec) {
   return out;
 }
 
-struct Inputs {
+struct ChosenInputs {
   std::vector<std::string> sensors, others;
   std::vector<double> taus;
 };
 
-Design BuildDesign(const ShopRecord& rec, const Inputs& in, double z_ref_mm,
+Design BuildDesign(const ShopRecord& rec, const ChosenInputs& in, double z_ref_mm,
                    double coverage) {
   const std::vector<bool> slope_logs = SlopeLogs(rec);
   std::vector<Eigen::MatrixXd> phi(rec.day_logs.size());
@@ -196,21 +196,21 @@ double GroupedCvRmse(const Design& d) {
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
-double Score(const ShopRecord& rec, const Inputs& in, double z_ref, double coverage) {
+double Score(const ShopRecord& rec, const ChosenInputs& in, double z_ref, double coverage) {
   return GroupedCvRmse(BuildDesign(rec, in, z_ref, coverage));
 }
 
 // Greedy forward choice of sensors from the pool (static features), while the CV RMSE falls by
 // more than 1 %.
 void ChooseSensors(const ShopRecord& rec, const JointSpec& spec, const JointFitOptions& o,
-                   Inputs* in, JointFitReport* report) {
+                   ChosenInputs* in, JointFitReport* report) {
   double current = Score(rec, *in, spec.z_ref_mm, o.slope_coverage);
   while (static_cast<int>(in->sensors.size()) < o.max_sensors) {
     double best = current;
     std::string pick;
     for (const auto& s : spec.sensor_pool) {
       if (std::find(in->sensors.begin(), in->sensors.end(), s) != in->sensors.end()) continue;
-      Inputs trial = *in;
+      ChosenInputs trial = *in;
       trial.sensors.push_back(s);
       const double e = Score(rec, trial, spec.z_ref_mm, o.slope_coverage);
       if (e < best) best = e, pick = s;
@@ -224,14 +224,14 @@ void ChooseSensors(const ShopRecord& rec, const JointSpec& spec, const JointFitO
 
 // Greedy forward choice of time constants, while the CV RMSE falls (the first one always when
 // a lag is required).
-void ChooseLags(const ShopRecord& rec, const JointSpec& spec, const JointFitOptions& o, Inputs* in,
-                JointFitReport* report) {
+void ChooseLags(const ShopRecord& rec, const JointSpec& spec, const JointFitOptions& o,
+                ChosenInputs* in, JointFitReport* report) {
   double current = Score(rec, *in, spec.z_ref_mm, o.slope_coverage);
   while (static_cast<int>(in->taus.size()) < o.max_lags) {
     double best = 1e300, pick = 0;
     for (double tau : o.tau_grid) {
       if (std::find(in->taus.begin(), in->taus.end(), tau) != in->taus.end()) continue;
-      Inputs trial = *in;
+      ChosenInputs trial = *in;
       trial.taus.push_back(tau);
       std::sort(trial.taus.begin(), trial.taus.end());
       const double e = Score(rec, trial, spec.z_ref_mm, o.slope_coverage);
@@ -254,7 +254,7 @@ JointFitReport FitJoint(const ShopRecord& record, const JointSpec& spec,
   if (options.max_lags < 0 || options.max_lags > 4)
     throw InputError("max_lags = " + std::to_string(options.max_lags) + ": must be within 0..4");
   JointFitReport report;
-  Inputs in{spec.sensors, spec.other_inputs, spec.time_constants};
+  ChosenInputs in{spec.sensors, spec.other_inputs, spec.time_constants};
   std::sort(in.taus.begin(), in.taus.end());
   if (!spec.sensor_pool.empty()) ChooseSensors(record, spec, options, &in, &report);
   if (in.sensors.empty() && in.others.empty())

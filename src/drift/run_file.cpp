@@ -35,7 +35,7 @@ std::string TimeColumn(const CsvTable& t) {
   return s ? "time_s" : m ? "time_min" : "";
 }
 
-void CheckRange(const CsvTable& t, std::size_t row, std::size_t col, double lo, double hi,
+void CheckCellRange(const CsvTable& t, std::size_t row, std::size_t col, double lo, double hi,
                 const std::string& rule) {
   const double v = t.rows[row][col];
   if (v >= lo && v <= hi) return;
@@ -180,12 +180,12 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
   for (std::size_t i = 0; i < q; ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     for (std::size_t j = 0; j < s_cols.size(); ++j) {
-      CheckRange(t, i, s_cols[j], kMinTemperatureC, kMaxTemperatureC,
+      CheckCellRange(t, i, s_cols[j], kMinTemperatureC, kMaxTemperatureC,
                  "is outside the plausible temperature range [-60, 400] degC");
       r.temperature_C(k, static_cast<Eigen::Index>(j)) = t.rows[i][s_cols[j]];
     }
     for (std::size_t j = 0; j < e_cols.size(); ++j) {
-      CheckRange(t, i, e_cols[j], -kMaxAbsErrorUm, kMaxAbsErrorUm,
+      CheckCellRange(t, i, e_cols[j], -kMaxAbsErrorUm, kMaxAbsErrorUm,
                  "is outside the plausible thermal-error range +-100000 um");
       r.error_um(k, static_cast<Eigen::Index>(j)) = t.rows[i][e_cols[j]];
     }

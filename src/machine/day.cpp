@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/random.h"
 #include "sim/physics.h"
 
@@ -12,7 +13,6 @@ namespace whirl::machine {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kParkMm = 6000;  // Z parked near the tailstock end between jobs
 
 ScheduleEvent Event(EventKind kind, double start, double end, int job = -1) {

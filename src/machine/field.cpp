@@ -4,13 +4,12 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/random.h"
 
 namespace whirl::machine {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Integral over [a, b] (mm) of a piecewise-constant profile: cell i covers [x0 + i dx, x0 +
 // (i + 1) dx); outside the cells the nearest cell's value continues. Returns value x mm.

@@ -4,12 +4,12 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/random.h"
 
 namespace whirl::machine {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kGridMin = 10;  // OU grid
 }  // namespace
 

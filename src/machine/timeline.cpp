@@ -5,6 +5,7 @@
 #include <map>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "machine/timeline_data.h"
 #include "sim/physics.h"
 
@@ -12,7 +13,6 @@ namespace whirl::machine {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Axis position and speed within an event at clock c.
 void AxisIn(const ScheduleEvent& e, const DayPlan& plan, double c, DutyState& d, double rapid) {

@@ -10,11 +10,12 @@
 #include "compare/report.h"
 #include "core/error.h"
 #include "support/scratch_dir.h"
+#include "support/source_dir.h"
 
 namespace whirl::compare {
 namespace {
 
-const std::filesystem::path kSource(WHIRL_SOURCE_DIR);
+using test::kSource;
 
 ElongationCurve Sampled(const fit::ArctanCurve& curve, double duration_s, double step_s) {
   ElongationCurve c;

@@ -18,12 +18,13 @@
 #include "interp/machine_profile.h"
 #include "workpiece/model.h"
 #include "support/scratch_dir.h"
+#include "support/source_dir.h"
 
 namespace whirl::compare {
 namespace {
 namespace fs = std::filesystem;
 
-const fs::path kSource(WHIRL_SOURCE_DIR);
+using test::kSource;
 
 class ReportContent : public ::testing::Test {
  protected:

@@ -15,12 +15,13 @@
 #include "core/error.h"
 #include "core/run_program.h"
 #include "support/scratch_dir.h"
+#include "support/source_dir.h"
 
 namespace whirl::compare {
 namespace {
 namespace fs = std::filesystem;
 
-const fs::path kSource(WHIRL_SOURCE_DIR);
+using test::kSource;
 
 class ShippedModelReport : public ::testing::Test {
  protected:

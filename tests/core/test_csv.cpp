@@ -11,7 +11,7 @@
 namespace whirl {
 namespace {
 
-std::string ErrorOf(const std::string& text) {
+std::string CsvErrorOf(const std::string& text) {
   try {
     ParseCsv(text, "t.csv");
   } catch (const InputError& e) {
@@ -31,15 +31,15 @@ TEST(Csv, ParsesHeaderRowsAndComments) {
 }
 
 TEST(Csv, ErrorsNameFileLineAndColumn) {
-  EXPECT_NE(ErrorOf("a,b\n1,x\n").find("t.csv:2: column 2 ('b')"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,b\n1,nan\n").find("not finite"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,b\n1,inf\n").find("not finite"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,b\n1,2\n3\n").find("t.csv:3: expected 2 cells"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,a\n1,2\n").find("duplicated column 'a'"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,b\n").find("no data rows"), std::string::npos);
-  EXPECT_NE(ErrorOf("").find("empty file"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,b\n1,2x\n").find("'2x' is not a number"), std::string::npos);
-  EXPECT_NE(ErrorOf("a,b\n1,\n").find("empty cell"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,x\n").find("t.csv:2: column 2 ('b')"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,nan\n").find("not finite"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,inf\n").find("not finite"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,2\n3\n").find("t.csv:3: expected 2 cells"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,a\n1,2\n").find("duplicated column 'a'"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n").find("no data rows"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("").find("empty file"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,2x\n").find("'2x' is not a number"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,\n").find("empty cell"), std::string::npos);
 }
 
 TEST(Csv, FormatNumberRoundTripsRandomDoubles) {
@@ -79,7 +79,7 @@ TEST(Csv, ByteOrderMarkIsSkipped) {
   EXPECT_EQ(c.comments, (std::vector<std::string>{"provenance"}));
   EXPECT_EQ(c.header, (std::vector<std::string>{"x", "y"}));
   EXPECT_EQ(c.header_line, 2);
-  EXPECT_NE(ErrorOf("a,b\n1,\xEF\xBB\xBF"
+  EXPECT_NE(CsvErrorOf("a,b\n1,\xEF\xBB\xBF"
                     "2\n")
                 .find("t.csv:2: column 2"),
             std::string::npos)
@@ -90,16 +90,17 @@ TEST(Csv, ByteOrderMarkIsSkipped) {
 // column name can never carry them on into JSON output.
 TEST(Csv, InvalidUtf8IsRefusedWithLineAndColumn) {
   EXPECT_NE(
-      ErrorOf("a,b\xFF_C\n1,2\n").find("t.csv:1: column 2, character 4: byte 0xFF is not UTF-8"),
+      CsvErrorOf("a,b\xFF_C\n1,2\n").find("t.csv:1: column 2, character 4: byte 0xFF is not UTF-8"),
       std::string::npos)
-      << ErrorOf("a,b\xFF_C\n1,2\n");
-  EXPECT_NE(ErrorOf("# \xC3\xA9t\xE9\na\n1\n").find("t.csv:1: column 1, character 5: byte 0xE9"),
+      << CsvErrorOf("a,b\xFF_C\n1,2\n");
+  EXPECT_NE(CsvErrorOf("# \xC3\xA9t\xE9\na\n1\n").find("t.csv:1: column 1, character 5: byte 0xE9"),
             std::string::npos)
-      << "in a comment, after a valid two-byte character: " << ErrorOf("# \xC3\xA9t\xE9\na\n1\n");
-  EXPECT_NE(ErrorOf("a,b\n1,2\n3,4\xC0\x80\n").find("t.csv:3: column 2, character 4: byte 0xC0"),
+      << "in a comment, after a valid two-byte character: "
+      << CsvErrorOf("# \xC3\xA9t\xE9\na\n1\n");
+  EXPECT_NE(CsvErrorOf("a,b\n1,2\n3,4\xC0\x80\n").find("t.csv:3: column 2, character 4: byte 0xC0"),
             std::string::npos)
       << "an overlong form";
-  EXPECT_NE(ErrorOf("a,b\n1,\xED\xA0\x80\n").find("t.csv:2: column 2"), std::string::npos)
+  EXPECT_NE(CsvErrorOf("a,b\n1,\xED\xA0\x80\n").find("t.csv:2: column 2"), std::string::npos)
       << "a surrogate";
   const CsvTable t = ParseCsv(
       "temp_\xC2\xB0"
@@ -114,12 +115,13 @@ TEST(Csv, InvalidUtf8IsRefusedWithLineAndColumn) {
 TEST(Csv, OnlyDecimalNumbers) {
   for (const char* bad : {"0x1p3", "0X10", "-0x1.8p1", "0x0", "1e", "1e+", ".", "+", "-", "1.2.3",
                           "1e5.0", "1_000", "1d3"}) {
-    const std::string e = ErrorOf(std::string("a,b\n1,") + bad + "\n");
+    const std::string e = CsvErrorOf(std::string("a,b\n1,") + bad + "\n");
     EXPECT_NE(e.find("t.csv:2: column 2 ('b')"), std::string::npos) << bad << ": " << e;
   }
-  EXPECT_NE(ErrorOf("a\n0x1p3\n").find("not a decimal number"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a\n0x1p3\n").find("not a decimal number"), std::string::npos);
   for (const char* nonfinite : {"nan", "NaN", "inf", "-Infinity", "1e999"})
-    EXPECT_NE(ErrorOf(std::string("a\n") + nonfinite + "\n").find("not finite"), std::string::npos)
+    EXPECT_NE(CsvErrorOf(std::string("a\n") + nonfinite + "\n").find("not finite"),
+              std::string::npos)
         << nonfinite;
   const CsvTable t = ParseCsv("a,b,c,d,e,f\n1,-0.5,.5,5.,+3e-2,1E5\n", "t.csv");
   EXPECT_EQ(t.rows[0], (std::vector<double>{1, -0.5, 0.5, 5, 0.03, 1e5}));

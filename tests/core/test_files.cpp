@@ -11,7 +11,7 @@ namespace whirl {
 namespace {
 namespace fs = std::filesystem;
 
-fs::path Scratch(const std::string& name) {
+fs::path FilesScratch(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("whirl_test_core_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
@@ -19,7 +19,7 @@ fs::path Scratch(const std::string& name) {
 }
 
 TEST(AtomicFile, FailedWriteLeavesOldFileAndNoTemporary) {
-  const fs::path d = Scratch("atomic");
+  const fs::path d = FilesScratch("atomic");
   WriteFileAtomic(d / "a.txt", "old");
   EXPECT_THROW(WriteFileAtomic(d / "missing_dir" / "a.txt", "x"), InputError);
   EXPECT_EQ(ReadTextFile(d / "a.txt"), "old");
@@ -31,7 +31,7 @@ TEST(AtomicFile, FailedWriteLeavesOldFileAndNoTemporary) {
 }
 
 TEST(ProcessTable, RoundTripAndMissingColumn) {
-  const fs::path d = Scratch("table");
+  const fs::path d = FilesScratch("table");
   ProcessTable t;
   t.inputs = {{60, 80, 10, 3.5, 180}, {65, 50, 6, 3, 150}};
   t.targets = {{30.5, 210}, {12.25, 180}};
@@ -51,7 +51,7 @@ TEST(ProcessTable, RoundTripAndMissingColumn) {
 }
 
 TEST(Curve, RejectsNonIncreasingTimeAndGaps) {
-  const fs::path d = Scratch("curve");
+  const fs::path d = FilesScratch("curve");
   WriteFileAtomic(d / "ok.csv", "time_s,elongation_um\n0,0\n1,1\n2,1.5\n3,1.7\n");
   EXPECT_EQ(ReadElongationCurve(d / "ok.csv").size(), 4u);
   WriteFileAtomic(d / "back.csv", "time_s,elongation_um\n0,0\n1,1\n1,1.5\n");

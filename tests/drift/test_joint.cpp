@@ -30,15 +30,15 @@ drift::Run DayLog(int day, int minutes) {
   return r;
 }
 
-struct Planted {
+struct PlantedJoint {
   JointDriftModel truth;
   ShopRecord record;
 };
 
 // Truth: features of {s1, s2} with one lag of 40 min; records: per day three laser targets
 // (z 1000, 3000, 5000 mm, a reading every 10 min) and one probe series at z = 150 mm.
-Planted MakePlanted(bool probes_only, std::uint64_t seed) {
-  Planted p;
+PlantedJoint MakePlanted(bool probes_only, std::uint64_t seed) {
+  PlantedJoint p;
   JointDriftModel& t = p.truth;
   t.sensors = {"s1", "s2"};
   t.time_constants = {40};
@@ -79,7 +79,7 @@ JointFitOptions FixedLag() {
 }
 
 TEST(JointFit, RecoversPlantedOffsetAndSlopeWithinFourStandardErrors) {
-  const Planted p = MakePlanted(false, 5);
+  const PlantedJoint p = MakePlanted(false, 5);
   JointSpec spec;
   spec.sensors = {"s1", "s2"};
   const JointFitReport r = FitJoint(p.record, spec, FixedLag());
@@ -112,7 +112,7 @@ TEST(JointFit, RecoversPlantedOffsetAndSlopeWithinFourStandardErrors) {
 }
 
 TEST(JointFit, AConstantAddedToARecordChangesNothing) {
-  Planted p = MakePlanted(false, 6);
+  PlantedJoint p = MakePlanted(false, 6);
   JointSpec spec;
   spec.sensors = {"s1", "s2"};
   const JointFitReport before = FitJoint(p.record, spec, FixedLag());
@@ -127,7 +127,7 @@ TEST(JointFit, AConstantAddedToARecordChangesNothing) {
 }
 
 TEST(JointFit, ProbeOnlyRecordsLeaveTheSlopeUnidentifiedAtZero) {
-  const Planted p = MakePlanted(true, 7);
+  const PlantedJoint p = MakePlanted(true, 7);
   JointSpec spec;
   spec.sensors = {"s1", "s2"};
   const JointFitReport r = FitJoint(p.record, spec, FixedLag());
@@ -142,7 +142,7 @@ TEST(JointFit, ProbeOnlyRecordsLeaveTheSlopeUnidentifiedAtZero) {
 // The sensor pool: the fit chooses the sensors that carry the planted drift, and the lag search
 // finds the planted time constant among the grid.
 TEST(JointFit, ForwardChoiceFindsThePlantedSensorAndLag) {
-  Planted p = MakePlanted(false, 8);
+  PlantedJoint p = MakePlanted(false, 8);
   JointSpec spec;
   spec.sensor_pool = {"s2", "s1"};
   JointFitOptions o;
@@ -158,7 +158,7 @@ TEST(JointFit, ForwardChoiceFindsThePlantedSensorAndLag) {
 // z). Its slope coefficient would be an extrapolation from a sensor that did not move: it stays
 // 0 and unidentified, while s2, which moves on the laser days too, keeps its slope.
 TEST(JointFit, ASlopeIsNotLearnedBeyondTheRangeTheZSpanningReadingsCover) {
-  Planted p = MakePlanted(false, 10);
+  PlantedJoint p = MakePlanted(false, 10);
   for (auto& rec : p.record.records)
     if (rec.day < 2 && rec.kind == MeasurementRecord::Kind::kProbe) rec.rows.clear();
   // Days 0 and 1: laser only, s1 at 5 % of its rise; days 2 and 3: probe only.
@@ -195,7 +195,7 @@ TEST(JointFit, ASlopeIsNotLearnedBeyondTheRangeTheZSpanningReadingsCover) {
 }
 
 TEST(JointFit, BadRecordsAreInputErrors) {
-  Planted p = MakePlanted(false, 9);
+  PlantedJoint p = MakePlanted(false, 9);
   JointSpec spec;
   spec.sensors = {"s1"};
   p.record.records[0].rows[0].sample = 100000;
