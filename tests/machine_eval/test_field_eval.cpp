@@ -15,9 +15,12 @@
 #include "machine_eval/field_history.h"
 #include "machine_eval/seeds.h"
 #include "machine_eval/strategies.h"
+#include "machine_eval/trained_numbers.h"
 
 namespace whirl::machine_eval {
 namespace {
+
+using testing_support::TrainedNumbers;
 
 // A small calendar: one warm-up test, one laser test, two past production days, one test day.
 machine::CalendarSpec SmallCalendar() {
@@ -34,17 +37,9 @@ machine::MachineWorld SmallWorld(const machine::TimelineOptions& options, std::u
                                     SmallCalendar(), options);
 }
 
-// Every trained number of a joint model: inputs, time constants, coefficients, the CV.
-nlohmann::json Trained(const drift::JointDriftModel& m) {
-  return {{"sensors", m.sensors},
-          {"others", m.other_inputs},
-          {"taus", m.time_constants},
-          {"a", std::vector<double>(m.a.data(), m.a.data() + m.a.size())},
-          {"g", std::vector<double>(m.g.data(), m.g.data() + m.g.size())},
-          {"cv", m.cv_rmse_um}};
-}
 nlohmann::json Trained(const FieldMachineModels& f) {
-  return {Trained(f.shop.sensors), Trained(f.shop.warmup), Trained(f.shop.schedule),
+  return {TrainedNumbers(f.shop.sensors), TrainedNumbers(f.shop.warmup),
+          TrainedNumbers(f.shop.schedule),
           f.shop.sensors_choice, f.records, f.readings};
 }
 

@@ -14,11 +14,14 @@
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/seeds.h"
 #include "machine_eval/strategies.h"
+#include "machine_eval/trained_numbers.h"
 #include "workpiece/model.h"
 #include "sim/screw.h"
 
 namespace whirl::machine_eval {
 namespace {
+
+using testing_support::TrainedNumbers;
 
 std::string Source(const std::string& rel) { return std::string(WHIRL_SOURCE_DIR) + "/" + rel; }
 
@@ -36,16 +39,8 @@ Training LegacyTraining(std::uint64_t machine_seed) {
   return t;
 }
 
-// Every trained number of a joint model: inputs, time constants, coefficients.
-nlohmann::json Trained(const drift::JointDriftModel& m) {
-  return {{"sensors", m.sensors},
-          {"others", m.other_inputs},
-          {"taus", m.time_constants},
-          {"a", std::vector<double>(m.a.data(), m.a.data() + m.a.size())},
-          {"g", std::vector<double>(m.g.data(), m.g.data() + m.g.size())}};
-}
 nlohmann::json Trained(const ShopModels& s) {
-  return {Trained(s.sensors), Trained(s.warmup), Trained(s.schedule)};
+  return {TrainedNumbers(s.sensors), TrainedNumbers(s.warmup), TrainedNumbers(s.schedule)};
 }
 
 // No truth channel reaches a model: 20 um pulses added to the runs' exact error channels at the
