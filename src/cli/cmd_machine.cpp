@@ -307,7 +307,8 @@ void RegisterMachine(CLI::App& app) {
       "--scenarios (e.g. production,duty-changes or all): the field world (a shop's calendar;\n"
       "models trained only from probe, laser and past screws' lead measurements, applied from\n"
       "past control samples only) with the shop baselines (class, table, nearest, warmup,\n"
-      "schedule), machine_shop and both_shop, over --seeds, with the headline against the\n"
+      "schedule), machine_shop, both_shop and both_shop_monitor (both_shop kept valid by the\n"
+      "probe checks at the test day's set-ups), over --seeds, with the headline against the\n"
       "strongest sensor-free strategy per scenario. Simulator figures only.");
   CommonOptions(e, o.get());
   AddScenarioOptions(e, o.get());

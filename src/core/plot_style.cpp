@@ -33,7 +33,8 @@ const std::vector<SeriesStyle>& SeriesStyles() {
       {"schedule",     "#e377c2", 4, 1.5},
       {"machine_shop", "#e377c2", 1, 1.5},
       {"both_shop",    "#2ca02c", 2, 2.5},
-      {"lead_slope",   "#8c564b", 5, 1.5}};
+      {"lead_slope",   "#8c564b", 5, 1.5},
+      {"both_shop_monitor", "#d62728", 2, 2.0}};
   // clang-format on
   return kStyles;
 }

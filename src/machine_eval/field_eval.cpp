@@ -16,7 +16,8 @@ namespace whirl::machine_eval {
 std::vector<MachineStrategy> FieldStrategies() {
   using S = MachineStrategy;
   return {S::kNone,   S::kTraditional, S::kWorkpiece, S::kClass,       S::kTable,    S::kNearest,
-          S::kWarmup, S::kSchedule,    S::kLeadSlope, S::kMachineShop, S::kBothShop};
+          S::kWarmup, S::kSchedule,    S::kLeadSlope, S::kMachineShop, S::kBothShop,
+          S::kBothShopMonitor};
 }
 
 std::vector<std::string> FieldScheduleInputs() {
@@ -32,6 +33,7 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
       FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
   m.shop = FitShopModels(record, m.z_ref_mm, FieldScheduleInputs());
+  m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.records = static_cast<int>(record.records.size());
   for (const auto& r : record.records) m.readings += static_cast<int>(r.rows.size());
   return m;
@@ -104,9 +106,10 @@ ElongationCurve Add(ElongationCurve a, const ElongationCurve& b) {
   return a;
 }
 
-// The shop models held sample by sample over the day's control log: sensors, warmup, schedule.
+// The shop models held sample by sample over the day's control log: sensors, warmup, schedule,
+// and the sensor model kept valid by the day's set-up checks.
 struct DayHeld {
-  HeldSamples sensors, warmup, schedule;
+  HeldSamples sensors, warmup, schedule, monitored;
 };
 
 MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, const DayHeld& held,
@@ -146,7 +149,8 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
       none, history(c.traditional_features), workpiece, none, none, none, none,
       history(c.history_features[0]), history(c.history_features[1]),
       history(c.history_features[2]), Sum(workpiece, line(held.warmup)),
-      Sum(workpiece, line(held.schedule)), shop, Sum(workpiece, shop), Sum(workpiece, lead_slope)};
+      Sum(workpiece, line(held.schedule)), shop, Sum(workpiece, shop), Sum(workpiece, lead_slope),
+      Sum(workpiece, line(held.monitored))};
   detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out, nullptr);
   const std::size_t sources[] = {0, 1, 2};
   const ElongationCurve parts[] = {c.truth, TruthCurve(m, start, c.truth.time_s, HeadPart),
@@ -165,12 +169,20 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
                                                const FieldProtocol& protocol,
                                                const Workpiece& wp, int machine_index) {
   std::vector<MachineEvalScrew> out;
+  MonitorState monitor;  // kept by the control from one test day to the next
   for (const machine::DayPlan& plan : tl.days()) {
     if (plan.day < 0) continue;
     const drift::Run log = AverageSensors(
         machine::ControlLog(tl, plan.day, MixSeed(plan.seed, 0x63746c)), protocol.sensor_average_min);
-    const DayHeld held = {RunCausally(models.shop.sensors, log), RunCausally(models.shop.warmup, log),
-                          RunCausally(models.shop.schedule, log)};
+    DayHeld held = {RunCausally(models.shop.sensors, log), RunCausally(models.shop.warmup, log),
+                    RunCausally(models.shop.schedule, log), {}};
+    const std::vector<machine::Reading> checks =
+        machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
+                               protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));
+    held.monitored = MonitorWithSetupChecks(held.sensors, models.monitor, log, checks,
+                                            models.z_ref_mm, protocol.probe_z_mm,
+                                            protocol.probe_sigma_um, protocol.monitor, &monitor)
+                         .held;
     for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
       MachineEvalScrew r;
       try {

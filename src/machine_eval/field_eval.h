@@ -21,7 +21,9 @@
 //   workpiece (the network's plan); class, table, nearest (each history rule); warmup and
 //   schedule (workpiece + that sensor-free machine rule); lead_slope (workpiece + the pitch
 //   correction of the nearest past screw type, field_history.h LeadSlopeFor); machine_shop (the
-//   sensor model alone); both_shop (workpiece + the sensor model).
+//   sensor model alone); both_shop (workpiece + the sensor model); both_shop_monitor (both_shop
+//   with the offset channel updated on the test day from the probe checks at its set-ups,
+//   field_monitor.h; the checks' probe readings are instruments, seeded per day).
 // Seeds: machine i of seed S is MachineSeed(S, i) (machine/scenarios.h); the workpiece truth of
 // job j on day d from MixSeed(DaySeed, 0x77700 + j): results do not depend on the thread count.
 #include <cstdint>
@@ -30,6 +32,7 @@
 #include "compare/evaluate.h"
 #include "machine/scenarios.h"
 #include "machine_eval/field_history.h"
+#include "machine_eval/field_monitor.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/seeds.h"
 
@@ -59,6 +62,7 @@ struct FieldMachineModels {
   int records = 0, readings = 0;
   double z_ref_mm = 0;  ///< reference of the slope (the Z screw's fixed bearing)
   std::vector<PastLeadSlope> lead_slopes;  ///< the lead-slope rule's past screws
+  ProbeMonitor monitor;  ///< both_shop_monitor: the sensor model's offset channel and its ranges
 };
 
 /// The models of one machine world from its shop record (field_history.h) only.

@@ -107,16 +107,21 @@ void PastLead(const machine::MachineTimeline& tl, const machine::DayPlan& plan, 
 void SetupChecks(const machine::MachineTimeline& tl, const machine::DayPlan& plan, int log,
                  const drift::Run& day_log, const FieldProtocol& p, std::uint64_t seed,
                  drift::ShopRecord* rec) {
-  std::vector<double> t = {plan.day * 1440.0 + plan.power_on_min()};
-  for (const machine::ScheduleEvent& e : plan.events)
-    if (e.kind == machine::EventKind::kSetup && e.start_min > plan.power_on_min() + 1e-9)
-      t.push_back(plan.day * 1440.0 + e.start_min);
+  const std::vector<double> t = SetupCheckTimes(plan);
   if (t.size() < 2) return;
   const auto r = machine::ProbeReadings(tl, t, p.probe_z_mm, p.probe_sigma_um, seed);
   rec->records.push_back(RecordOf(Kind::kSetupCheck, plan, log, "setup_checks", day_log, r, 0));
 }
 
 }  // namespace
+
+std::vector<double> SetupCheckTimes(const machine::DayPlan& plan) {
+  std::vector<double> t = {plan.day * 1440.0 + plan.power_on_min()};
+  for (const machine::ScheduleEvent& e : plan.events)
+    if (e.kind == machine::EventKind::kSetup && e.start_min > plan.power_on_min() + 1e-9)
+      t.push_back(plan.day * 1440.0 + e.start_min);
+  return t;
+}
 
 double LeadSlopeFor(const std::vector<PastLeadSlope>& past, double diameter_mm, double lead_mm,
                     int k) {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "drift/measurements.h"
+#include "drift/monitor.h"
 #include "machine/instruments.h"
 #include "machine/timeline.h"
 
@@ -43,6 +44,11 @@ struct FieldProtocol {
   /// the 0.1 K noise of one reading goes straight into the compensation. Applied alike to the
   /// training logs and to the control log of the test days.
   double sensor_average_min = 5;
+  /// both_shop_monitor (field_monitor.h): the test day's set-up checks (probe at probe_z_mm,
+  /// sigma probe_sigma_um) update the sensor model's offset channel; threshold_sigma,
+  /// threshold_um, prior_scale and estimate_drift are read, and bayes in rules switches the
+  /// update on (rules without bayes: the row is both_shop).
+  drift::MonitorOptions monitor;
 };
 
 /// The temperature columns of `log` replaced by their mean over the rows with time in
@@ -54,6 +60,10 @@ drift::Run AverageSensors(drift::Run log, double window_min);
 /// (its lead is not measured).
 using WorkpieceResidual =
     std::function<std::function<double(double)>(const machine::Job& job, const machine::CutRef& cut)>;
+
+/// The times of a production day's set-up checks [abs min]: the day's power-on first, then the
+/// start of every set-up after it (the probe reads the check ring while the machine stands).
+std::vector<double> SetupCheckTimes(const machine::DayPlan& plan);
 
 /// A past screw's measured lead reduced to its least-squares slope over the thread (the pitch
 /// error a shop reads off the lead chart), with the screw's type: diameter and lead.

@@ -24,7 +24,7 @@ std::string ToString(MachineStrategy s) {
   static const char* kNames[] = {"none",        "traditional", "workpiece",    "machine",
                                  "both",        "both_idle",   "both_monitor", "class",
                                  "table",       "nearest",     "warmup",       "schedule",
-                                 "machine_shop", "both_shop",  "lead_slope"};
+                                 "machine_shop", "both_shop",  "lead_slope",   "both_shop_monitor"};
   return kNames[static_cast<int>(s)];
 }
 
@@ -36,6 +36,7 @@ bool UsesSensors(MachineStrategy s) {
     case MachineStrategy::kBothMonitor:
     case MachineStrategy::kMachineShop:
     case MachineStrategy::kBothShop:
+    case MachineStrategy::kBothShopMonitor:
       return true;
     default:
       return false;
@@ -45,7 +46,8 @@ bool UsesSensors(MachineStrategy s) {
 std::vector<MachineStrategy> LegacyStrategies() {
   std::vector<MachineStrategy> all;
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
-    if (static_cast<MachineStrategy>(k) != MachineStrategy::kLeadSlope)
+    if (static_cast<MachineStrategy>(k) != MachineStrategy::kLeadSlope &&
+        static_cast<MachineStrategy>(k) != MachineStrategy::kBothShopMonitor)
       all.push_back(static_cast<MachineStrategy>(k));
   return all;
 }
@@ -326,7 +328,8 @@ MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece
       Sum(workpiece, machine.schedule),
       machine.shop,
       Sum(workpiece, machine.shop),
-      workpiece};
+      workpiece,
+      Sum(workpiece, machine.shop)};  // lead_slope and both_shop_monitor: not legacy rows
   ScoreStrategies(truth.total, compensations, feed, screw, options, iso_table, &out, detail);
   for (std::size_t s = 0; s < kErrorSourceCount; ++s)
     out.source_total_um[s] =

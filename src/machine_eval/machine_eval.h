@@ -67,6 +67,9 @@
 //   lead_slope      workpiece + a pitch correction learned from measured past screws (field
 //                   world, field_eval.h); the legacy protocol measures no past screw, so here it
 //                   equals workpiece and is not a row of the legacy table
+//   both_shop_monitor  both_shop with the offset channel kept valid on the test day by the probe
+//                   checks a shop takes at set-ups (field world only, field_monitor.h); not a
+//                   row of the legacy table (it has no set-ups)
 // Machine models: per machine, `train_runs` idle warm-ups (ring turning, no cut, 180 min) and
 // `train_runs` cutting runs (150 min, cutting speed uniform in 150..210 m/min) on their own days;
 // drift::FitDriftModel (drift/fit.h; kind and sensor selection from `fit`, by default Miao et
@@ -109,13 +112,14 @@ enum class MachineStrategy {
   kSchedule,
   kMachineShop,
   kBothShop,
-  kLeadSlope
+  kLeadSlope,
+  kBothShopMonitor
 };
-inline constexpr std::size_t kMachineStrategyCount = 15;
+inline constexpr std::size_t kMachineStrategyCount = 16;
 /// none, traditional, workpiece, machine, both, both_idle, both_monitor, class, table, nearest,
-/// warmup, schedule, machine_shop, both_shop, lead_slope
+/// warmup, schedule, machine_shop, both_shop, lead_slope, both_shop_monitor
 /// Whether a strategy's machine half uses temperature sensors (machine, both*, machine_shop,
-/// both_shop); the others are sensor-free.
+/// both_shop, both_shop_monitor); the others are sensor-free.
 bool UsesSensors(MachineStrategy s);
 std::string ToString(MachineStrategy s);
 

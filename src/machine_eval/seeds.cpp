@@ -137,22 +137,22 @@ Gain GainOver(const SeedsEvaluation& e, const std::array<SeedStats, kMachineStra
   return g;
 }
 
-// The verdict of both_shop against a reference row.
-std::string Verdict(const SeedsEvaluation& e, const Gain& g, MachineStrategy ref,
+// The verdict of a "both" row (both_shop or both_shop_monitor) against a reference row.
+std::string Verdict(const SeedsEvaluation& e, MachineStrategy x, const Gain& g, MachineStrategy ref,
                     const char* what) {
   char buf[400];
   if (g.pooled > 0)
     std::snprintf(buf, sizeof buf,
-                  "%s: both_shop (sensors) beats %s %s over the thread by %.1f %% (better in %d "
-                  "of %zu seeds)",
-                  e.scenario.c_str(), what, ToString(ref).c_str(), g.pooled, g.seeds_won(),
-                  g.per_seed.size());
+                  "%s: %s (sensors) beats %s %s over the thread by %.1f %% (better in %d of %zu "
+                  "seeds)",
+                  e.scenario.c_str(), ToString(x).c_str(), what, ToString(ref).c_str(), g.pooled,
+                  g.seeds_won(), g.per_seed.size());
   else
     std::snprintf(buf, sizeof buf,
-                  "%s: both_shop (sensors) does NOT beat %s %s over the thread (%+.1f %%; better "
-                  "in %d of %zu seeds)",
-                  e.scenario.c_str(), what, ToString(ref).c_str(), g.pooled, g.seeds_won(),
-                  g.per_seed.size());
+                  "%s: %s (sensors) does NOT beat %s %s over the thread (%+.1f %%; better in %d "
+                  "of %zu seeds)",
+                  e.scenario.c_str(), ToString(x).c_str(), what, ToString(ref).c_str(), g.pooled,
+                  g.seeds_won(), g.per_seed.size());
   return buf;
 }
 
@@ -171,7 +171,7 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
                 s[b].acc1000_median_um, s[b].screws, e.seeds.size());
   out.push_back(buf);
   for (MachineStrategy x : {MachineStrategy::kBoth, MachineStrategy::kBothShop,
-                            MachineStrategy::kBothMonitor}) {
+                            MachineStrategy::kBothMonitor, MachineStrategy::kBothShopMonitor}) {
     if (!InRows(e.rows, x)) continue;
     const Gain g = GainOver(e, s, static_cast<std::size_t>(x), b);
     std::snprintf(buf, sizeof buf,
@@ -181,16 +181,19 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
                   Max(g.per_seed), ToString(x).c_str());
     out.push_back(buf);
   }
-  const auto shop = static_cast<std::size_t>(MachineStrategy::kBothShop);
-  out.push_back(Verdict(e, GainOver(e, s, shop, b), best, "the strongest sensor-free strategy"));
   const MachineStrategy rule =
       s[static_cast<std::size_t>(MachineStrategy::kSchedule)].total_median_um <=
               s[static_cast<std::size_t>(MachineStrategy::kWarmup)].total_median_um
           ? MachineStrategy::kSchedule
           : MachineStrategy::kWarmup;
-  if (rule != best)
-    out.push_back(Verdict(e, GainOver(e, s, shop, static_cast<std::size_t>(rule)), rule,
-                          "the better sensor-free machine rule"));
+  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor}) {
+    if (x == MachineStrategy::kBothShopMonitor && !InRows(e.rows, x)) continue;
+    const auto k = static_cast<std::size_t>(x);
+    out.push_back(Verdict(e, x, GainOver(e, s, k, b), best, "the strongest sensor-free strategy"));
+    if (rule != best)
+      out.push_back(Verdict(e, x, GainOver(e, s, k, static_cast<std::size_t>(rule)), rule,
+                            "the better sensor-free machine rule"));
+  }
   return out;
 }
 

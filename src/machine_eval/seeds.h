@@ -49,10 +49,12 @@ MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategy
                                     const std::vector<MachineStrategy>& rows = {});
 
 /// Sentences: the strongest sensor-free rule and the gain 1 - median(x) / median(best) over the
-/// thread of both, both_shop and both_monitor (those among the rows), with the per-seed range of
-/// the gain; then the verdict: whether both_shop beats the strongest sensor-free rule over the
-/// thread (pooled gain > 0) and in how many seeds, and both_shop against the better of the
-/// sensor-free machine rules (warmup, schedule: the value of the sensors alone).
+/// thread of both, both_shop, both_monitor and both_shop_monitor (those among the rows), with
+/// the per-seed range of the gain; then the verdicts, each naming the "both" row it judges:
+/// whether both_shop beats the strongest sensor-free rule over the thread (pooled gain > 0) and
+/// in how many seeds, and both_shop against the better of the sensor-free machine rules (warmup,
+/// schedule: the value of the sensors alone); then the same two for both_shop_monitor when it is
+/// a row (field table: the sensor model kept valid by the set-up checks).
 std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e);
 
 /// Notes under the headlines: the thread median of the strongest sensor-free strategy and of

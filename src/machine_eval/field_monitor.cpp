@@ -1,0 +1,116 @@
+#include "machine_eval/field_monitor.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace whirl::machine_eval {
+
+ProbeMonitor MakeProbeMonitor(const drift::JointDriftModel& sensors,
+                              const std::vector<drift::Run>& training_logs) {
+  ProbeMonitor m;
+  if (sensors.features() == 0 || training_logs.empty()) return m;
+  m.offset = drift::ToDriftModels(sensors).first;
+  m.offset.residual_std_um = sensors.cv_rmse_um;
+  const Eigen::Index p = sensors.features();
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, 1e300), hi = -lo;
+  for (const drift::Run& log : training_logs) {
+    if (log.samples() == 0) continue;
+    const Eigen::MatrixXd x = drift::MonitorDesign(m.offset, log, drift::ReferenceMode::kRunStart);
+    lo = lo.cwiseMin(x.rightCols(p).colwise().minCoeff().transpose());
+    hi = hi.cwiseMax(x.rightCols(p).colwise().maxCoeff().transpose());
+  }
+  if (!(lo.array() <= hi.array()).all()) return m;
+  m.offset.feature_min = lo;
+  m.offset.feature_max = hi;
+  m.active = true;
+  return m;
+}
+
+namespace {
+
+// The coefficients in force from a sample on.
+struct Piece {
+  Eigen::Index from = 0;
+  Eigen::VectorXd b;
+};
+
+// D of the drift covariance: 1 for the intercept, per feature the larger of its training range
+// and its range over the samples seen (drift/monitor.h).
+Eigen::VectorXd DriftScale(const drift::DriftModel& m, const Eigen::VectorXd& seen_lo,
+                           const Eigen::VectorXd& seen_hi) {
+  Eigen::VectorXd d(seen_lo.size());
+  d(0) = 1;
+  for (Eigen::Index j = 1; j < d.size(); ++j) {
+    const double range = m.feature_max(j - 1) - m.feature_min(j - 1);
+    d(j) = std::max({range, seen_hi(j) - seen_lo(j), 1e-12});
+  }
+  return d;
+}
+
+}  // namespace
+
+MonitoredDay MonitorWithSetupChecks(const HeldSamples& held, const ProbeMonitor& monitor,
+                                    const drift::Run& log,
+                                    const std::vector<machine::Reading>& checks, double z_ref_mm,
+                                    double probe_z_mm, double probe_sigma_um,
+                                    const drift::MonitorOptions& options,
+                                    MonitorState* state) {
+  MonitoredDay out;
+  out.held = held;
+  if (!monitor.active || log.samples() == 0) return out;
+  const drift::DriftModel& m = monitor.offset;
+  const Eigen::MatrixXd x = drift::MonitorDesign(m, log, drift::ReferenceMode::kRunStart);
+  const Eigen::MatrixXd dx = x.rowwise() - x.row(0);
+  const Eigen::VectorXd trained = m.linear.coefficients;
+  const bool carried = state && state->coefficients.size() == trained.size();
+  Eigen::VectorXd b = carried ? state->coefficients : trained;
+  Eigen::MatrixXd prior =
+      carried ? state->covariance : Eigen::MatrixXd(options.prior_scale * m.linear.covariance);
+  const double s = m.residual_std_um;
+  const double r = s * s + 2 * probe_sigma_um * probe_sigma_um;
+  const double threshold =
+      options.threshold_um > 0 ? options.threshold_um : options.threshold_sigma * std::sqrt(r);
+  const bool update = std::find(options.rules.begin(), options.rules.end(),
+                                drift::UpdateRule::kBayes) != options.rules.end();
+  const double w = (z_ref_mm - probe_z_mm) / 1000.0;
+  std::vector<drift::Innovation> innovations;
+  std::vector<Piece> pieces = {{0, b}};
+  Eigen::VectorXd seen_lo = x.row(0).transpose(), seen_hi = seen_lo;
+  Eigen::Index seen = 1;
+  for (std::size_t c = 1; c < checks.size(); ++c) {
+    const double t = checks[c].abs_min;
+    if (t < log.time_min.front()) continue;
+    const auto i = static_cast<Eigen::Index>(held.IndexAt(t));
+    for (; seen <= i; ++seen) {
+      seen_lo = seen_lo.cwiseMin(x.row(seen).transpose());
+      seen_hi = seen_hi.cwiseMax(x.row(seen).transpose());
+    }
+    const double y = checks[c].value_um - checks[0].value_um -
+                     held.slope_um_per_1000[static_cast<std::size_t>(i)] * w;
+    const Eigen::RowVectorXd xi = dx.row(i);
+    const double misfit = y - xi.dot(b);
+    const Eigen::VectorXd d = DriftScale(m, seen_lo, seen_hi);
+    innovations.push_back({misfit, xi.dot(prior * xi.transpose()) + r,
+                           xi.cwiseQuotient(d.transpose()).squaredNorm()});
+    ++out.checks;
+    if (std::abs(misfit) <= threshold) continue;
+    ++out.invalid;
+    if (!update) continue;
+    if (options.estimate_drift)
+      prior.diagonal() += drift::DriftVarianceMle(innovations) * d.cwiseAbs2().cwiseInverse();
+    b = drift::BayesUpdate(xi, Eigen::VectorXd::Constant(1, y), b, &prior, r);
+    const auto from = std::lower_bound(log.time_min.begin(), log.time_min.end(), t - 1e-9) -
+                      log.time_min.begin();
+    pieces.push_back({static_cast<Eigen::Index>(from), b});
+    ++out.updates;
+  }
+  if (state) *state = {b, prior};
+  std::size_t piece = 0;
+  for (Eigen::Index k = 0; k < dx.rows(); ++k) {
+    while (piece + 1 < pieces.size() && pieces[piece + 1].from <= k) ++piece;
+    out.held.k0_um[static_cast<std::size_t>(k)] += dx.row(k).dot(pieces[piece].b - trained);
+  }
+  return out;
+}
+
+}  // namespace whirl::machine_eval
