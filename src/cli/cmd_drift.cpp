@@ -559,6 +559,7 @@ void RegisterReport(CLI::App* drift_app) {
                         {"runs", predictions}};
     if (rep.selected) j["selection"] = drift::SelectionJson(rep.selection);
     if (!rep.candidates.empty()) j["candidates"] = drift::CandidatesJson(rep);
+    j["baselines"] = drift::ReportBaselinesJson(r.baselines, r.baseline_notes);
     PrintJson(j);
   });
 }

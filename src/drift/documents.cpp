@@ -387,3 +387,21 @@ std::string FormatCandidates(const FitReport& rep) {
 }
 
 }  // namespace whirl::drift
+
+namespace whirl::drift {
+
+nlohmann::json ReportBaselinesJson(const std::vector<ReportBaseline>& baselines,
+                                   const std::vector<std::string>& notes) {
+  const auto value = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  json runs = json::array();
+  for (const ReportBaseline& b : baselines)
+    runs.push_back({{"run", b.run},
+                    {"model_mae_um", value(b.model_mae_um)},
+                    {"none_mae_um", value(b.none_mae_um)},
+                    {"time_only_mae_um", value(b.time_only_mae_um)},
+                    {"previous_run_mae_um", value(b.previous_run_mae_um)},
+                    {"strongest", b.strongest}});
+  return {{"runs", runs}, {"notes", notes}};
+}
+
+}  // namespace whirl::drift

@@ -9,6 +9,7 @@
 #include "drift/evaluation.h"
 #include "drift/fit.h"
 #include "drift/model.h"
+#include "drift/report.h"
 #include "drift/selection.h"
 
 namespace whirl::drift {
@@ -35,6 +36,10 @@ nlohmann::json HoldoutJson(const HoldoutResult& r);
 std::string FormatHoldout(const HoldoutResult& r);
 /// drift fit's candidate table (empty when one family was asked for) and the choice.
 nlohmann::json CandidatesJson(const FitReport& rep);
+/// The model report's baselines per run (MAE um; null where a baseline does not exist) and why
+/// one is missing.
+nlohmann::json ReportBaselinesJson(const std::vector<ReportBaseline>& baselines,
+                                   const std::vector<std::string>& notes);
 std::string FormatCandidates(const FitReport& rep);
 
 }  // namespace whirl::drift

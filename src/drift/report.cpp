@@ -1,5 +1,6 @@
 #include "drift/report.h"
 
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -168,11 +169,6 @@ std::string StatsRow(const std::string& name, const ErrorStats& s) {
          "</td></tr>\n";
 }
 
-// A baseline's MAE on one run [um], or NaN when it does not exist for that run.
-struct BaselineCells {
-  std::string run;
-  double model = NAN, none = NAN, time = NAN, previous = NAN;
-};
 
 // The model's training runs among the runs shown (all of them, in the model's order), or empty.
 std::vector<Run> TrainingRunsShown(const DriftModel& m, const std::vector<Run>& runs) {
@@ -198,6 +194,21 @@ FitOptions RefitOptions(const DriftModel& m) {
   return f;
 }
 
+constexpr const char* kBaselineNames[] = {"model", "none", "time only", "previous run"};
+
+std::array<double, 4> BaselineValues(const ReportBaseline& c) {
+  return {c.model_mae_um, c.none_mae_um, c.time_only_mae_um, c.previous_run_mae_um};
+}
+
+// The name of the smallest finite MAE, or "" when there is none.
+std::string Strongest(const ReportBaseline& c) {
+  const std::array<double, 4> v = BaselineValues(c);
+  int best = -1;
+  for (int k = 0; k < 4; ++k)
+    if (std::isfinite(v[k]) && (best < 0 || v[k] < v[best])) best = k;
+  return best < 0 ? "" : kBaselineNames[best];
+}
+
 double BaselineMae(const DriftModel& b, const Run& run) {
   const RunPrediction p = PredictRun(b, run);
   return p.has_measured ? ComputeErrorStats(p.measured_um - p.predicted_um).mae_um : NAN;
@@ -207,9 +218,9 @@ double BaselineMae(const DriftModel& b, const Run& run) {
 // training runs (first order in time since the run's start, drift/regression.h FitWarmUp), and
 // the same features refitted on the previous run shown. A baseline that cannot be fitted (the
 // training runs are not shown, too few samples) stays empty and the notes say why.
-std::vector<BaselineCells> Baselines(const DriftModel& m, const std::vector<RunPrediction>& preds,
+std::vector<ReportBaseline> Baselines(const DriftModel& m, const std::vector<RunPrediction>& preds,
                                      const std::vector<Run>& runs, std::vector<std::string>* notes) {
-  std::vector<BaselineCells> cells(runs.size());
+  std::vector<ReportBaseline> cells(runs.size());
   DriftModel time;
   bool have_time = false;
   const std::vector<Run> training = TrainingRunsShown(m, runs);
@@ -228,24 +239,26 @@ std::vector<BaselineCells> Baselines(const DriftModel& m, const std::vector<RunP
     }
   }
   for (std::size_t i = 0; i < runs.size(); ++i) {
-    BaselineCells& c = cells[i];
+    ReportBaseline& c = cells[i];
     c.run = runs[i].name;
     if (!preds[i].has_measured) continue;
-    c.model = ComputeErrorStats(preds[i].measured_um - preds[i].predicted_um).mae_um;
-    c.none = ComputeErrorStats(preds[i].measured_um).mae_um;
-    if (have_time) c.time = BaselineMae(time, runs[i]);
-    if (i == 0) continue;
-    try {
-      c.previous = BaselineMae(FitDriftModel({runs[i - 1]}, m.error_column, RefitOptions(m)).model,
-                               runs[i]);
-    } catch (const InputError& e) {
-      notes->push_back("previous run: no refit on " + runs[i - 1].name + ": " + e.what());
+    c.model_mae_um = ComputeErrorStats(preds[i].measured_um - preds[i].predicted_um).mae_um;
+    c.none_mae_um = ComputeErrorStats(preds[i].measured_um).mae_um;
+    if (have_time) c.time_only_mae_um = BaselineMae(time, runs[i]);
+    if (i > 0) {
+      try {
+        c.previous_run_mae_um = BaselineMae(
+            FitDriftModel({runs[i - 1]}, m.error_column, RefitOptions(m)).model, runs[i]);
+      } catch (const InputError& e) {
+        notes->push_back("previous run: no refit on " + runs[i - 1].name + ": " + e.what());
+      }
     }
+    c.strongest = Strongest(c);
   }
   return cells;
 }
 
-std::string BaselinesHtml(const std::vector<BaselineCells>& cells,
+std::string BaselinesHtml(const std::vector<ReportBaseline>& cells,
                           const std::vector<std::string>& notes) {
   std::ostringstream h;
   h << "<h2>Baselines</h2>\n<p>MAE um per run: the model, no compensation, a time-only warm-up "
@@ -253,16 +266,12 @@ std::string BaselinesHtml(const std::vector<BaselineCells>& cells,
        "training runs) and the same features refitted on the previous run shown; the strongest "
        "is named.</p>\n<table><tr><th style='text-align:left'>run</th><th>model</th><th>none</th>"
        "<th>time only</th><th>previous run</th><th>strongest</th></tr>\n";
-  const char* names[] = {"model", "none", "time only", "previous run"};
-  for (const BaselineCells& c : cells) {
-    const double v[] = {c.model, c.none, c.time, c.previous};
-    int best = -1;
-    for (int k = 0; k < 4; ++k)
-      if (std::isfinite(v[k]) && (best < 0 || v[k] < v[best])) best = k;
+  for (const ReportBaseline& c : cells) {
+    const std::array<double, 4> v = BaselineValues(c);
     h << "<tr><td style='text-align:left'>" << HtmlEscape(c.run) << "</td>";
     for (int k = 0; k < 4; ++k)
       h << "<td>" << (std::isfinite(v[k]) ? FormatDecimals(v[k], 2) : "&ndash;") << "</td>";
-    h << "<td>" << (best < 0 ? "&ndash;" : names[best]) << "</td></tr>\n";
+    h << "<td>" << (c.strongest.empty() ? "&ndash;" : c.strongest) << "</td></tr>\n";
   }
   h << "</table>\n";
   for (const auto& n : notes) h << "<p><i>" << HtmlEscape(n) << "</i></p>\n";
@@ -321,11 +330,15 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   }
   h << "</table>\n";
   std::vector<std::string> notes;
-  h << BaselinesHtml(Baselines(m, preds, runs, &notes), notes);
+  const std::vector<ReportBaseline> baselines = Baselines(m, preds, runs, &notes);
+  h << BaselinesHtml(baselines, notes);
   h << plots.str();
   for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
   h << "</body></html>\n";
-  return w.Finish(h.str());
+  DriftReportResult result = w.Finish(h.str());
+  result.baselines = baselines;
+  result.baseline_notes = notes;
+  return result;
 }
 
 DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const HoldoutResult& r,

@@ -6,6 +6,7 @@
 // (new, empty or a whirl output; never a symbolic link) and the whole report is written
 // all-or-nothing (gnuplot renders in its staging folder). If gnuplot is missing the CSVs, scripts
 // and HTML are still written and `warnings` says the plots were skipped.
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -16,10 +17,23 @@
 
 namespace whirl::drift {
 
+/// One run shown by a model report: MAE [um] of the model and of the sensor-free baselines --
+/// no compensation, a time-only warm-up fitted on the model's training runs (first order in the
+/// time since the run's start, FitWarmUp), the same features refitted on the previous run shown
+/// -- NaN where a baseline does not exist for that run; `strongest` names the smallest
+/// ("model", "none", "time only", "previous run"; empty when the run has no measured error).
+struct ReportBaseline {
+  std::string run;
+  double model_mae_um = NAN, none_mae_um = NAN, time_only_mae_um = NAN, previous_run_mae_um = NAN;
+  std::string strongest;
+};
+
 struct DriftReportResult {
   std::filesystem::path index_html;
   std::vector<std::filesystem::path> files;
   std::vector<std::string> warnings;
+  std::vector<ReportBaseline> baselines;    ///< model reports: one per run shown
+  std::vector<std::string> baseline_notes;  ///< why a baseline is missing
 };
 
 /// A fitted model (with its selection) applied to `runs`: the similarity matrix and lambda

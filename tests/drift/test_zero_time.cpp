@@ -12,6 +12,7 @@
 #include "drift/evaluation.h"
 #include "drift/monitor.h"
 #include "drift/regression.h"
+#include "drift/documents.h"
 #include "drift/report.h"
 #include "support/scratch_dir.h"
 #include "synthetic.h"
@@ -226,6 +227,15 @@ TEST(Baselines, ModelReportShowsThemAndNamesTheStrongest) {
   EXPECT_LT(std::stod(third[2]), 0.5);
   EXPECT_LT(std::stod(third[2]), std::stod(third[0]));
   EXPECT_NE(third[3], "&ndash;");  // the sensor features refitted on the second run
+  // The result (and the JSON of `drift report --json`) carries the same figures as the page.
+  ASSERT_EQ(r.baselines.size(), 3u);
+  EXPECT_EQ(r.baselines[2].strongest, "time only");
+  EXPECT_NEAR(r.baselines[2].time_only_mae_um, std::stod(third[2]), 0.005);
+  EXPECT_NEAR(r.baselines[2].model_mae_um, std::stod(third[0]), 0.005);
+  const nlohmann::json j = ReportBaselinesJson(r.baselines, r.baseline_notes);
+  EXPECT_TRUE(j["runs"][0]["previous_run_mae_um"].is_null());
+  EXPECT_EQ(j["runs"][2]["strongest"], "time only");
+  EXPECT_NEAR(j["runs"][2]["none_mae_um"].get<double>(), std::stod(third[1]), 0.005);
   // Only the third run shown: the training runs are absent, the time-only cell stays empty.
   const DriftReportResult r2 =
       WriteModelReport(dir, rep, {runs[2]}, {"test"}, "whirl-no-gnuplot-here");
