@@ -275,9 +275,10 @@ void RegisterMachine(CLI::App& app) {
   auto o = std::make_shared<MachineCliOptions>();
   auto* m = app.add_subcommand(
       "machine",
-      "The whirling machine's own thermal drift (head warming, Z feed screw growth from its fixed\n"
-      "bearing, ambient on the bed; src/machine/machine.h): virtual sensor files and the\n"
-      "evaluation of both halves of the compensation together.");
+      "The simulated whirling machine's own thermal drift: virtual sensor files (the legacy\n"
+      "closed-form machine, src/machine/machine.h), the field world's uncompensated error by\n"
+      "source (a shop's days with set-ups, breaks and duty changes; src/machine/truth.h), and the\n"
+      "evaluation of both halves of the compensation together against the shop's baselines.");
   m->require_subcommand(1);
   auto* s = m->add_subcommand(
       "sensors",
