@@ -63,6 +63,16 @@ b = j["strategies"][1]
 assert b["recalibrations"] >= 1 and b["stop_min"] == b["measurements"] * 1.0
 assert any(e["kind"] == "update" and "coefficients" in e for e in b["events"])
 EOF
+# The default bayes update adds the drift variance estimated from the checks and says so in its
+# events; --no-drift-estimate leaves it out (the prior is --prior-scale x Cov(b) alone).
+"$W" drift monitor --model "$D/m.json" --run "$H" --threshold-um 1 --update bayes \
+  --events "$D/ev_drift.csv" > /dev/null 2>&1 || fail "monitor with the drift estimate"
+"$W" drift monitor --model "$D/m.json" --run "$H" --threshold-um 1 --update bayes \
+  --no-drift-estimate --events "$D/ev_nodrift.csv" > /dev/null 2>&1 || fail "--no-drift-estimate"
+grep -q "^bayes,update,.*maximum likelihood" "$D/ev_drift.csv" ||
+  fail "default bayes update does not state the drift estimate: $(grep update "$D/ev_drift.csv")"
+grep -q "maximum likelihood" "$D/ev_nodrift.csv" && fail "--no-drift-estimate still estimates the drift"
+grep -q "^bayes,update," "$D/ev_nodrift.csv" || fail "--no-drift-estimate: no bayes update"
 
 # Bad input: nothing written, exit 1 with a message naming the rule.
 expect_fail "score" "$W" drift monitor --model "$D/m.json" --run "$H" --score-rows 0.8,0.6 \
