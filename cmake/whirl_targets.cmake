@@ -17,14 +17,15 @@ function(whirl_library folder)
   add_library(whirl::${folder} ALIAS whirl_${folder})
   target_compile_features(whirl_${folder} PUBLIC cxx_std_17)
   whirl_set_warnings(whirl_${folder})
+  target_compile_options(whirl_${folder} PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})
   whirl_unity_build(whirl_${folder})
 endfunction()
 
 # whirl_unity_build(<target>): compile the target's files in batches of WHIRL_UNITY_BATCH_SIZE, one
 # translation unit per batch (behind WHIRL_UNITY_BUILD). Each file of the libraries includes Eigen,
 # nlohmann/json and the standard library and instantiates the same templates (matrix products and
-# decompositions, JSON parsing and dumping); at -O3 each instance is optimized once per translation
-# unit, so batching saves most of that repeated work (measured in docs/development.md, "Build time").
+# decompositions, JSON parsing and dumping); each instance is optimized once per translation unit,
+# so batching saves most of that repeated work (measured in docs/development.md, "Build time").
 # So the files of one folder must not define the same name twice at namespace scope, anonymous
 # namespaces included: give a file's helpers names of their own. The batch size bounds what an edit
 # of one file recompiles; WHIRL_UNITY_BUILD=OFF compiles file by file (and checks that each file
@@ -43,7 +44,8 @@ endfunction()
 #         level; measured: a test file compiles in 81 % of its time (5.3 s against 6.6 s).
 # Not used where it did not pay: the libraries (a clean build's library files took 243 s of CPU
 # with and without it, back to back, plus 6 s to build it: the time goes into optimizing, not
-# parsing) and the command line (a unity build: too few files to pay for the header's build).
+# parsing; at -O2, 2026-11-26, the libraries' batches took longer with it) and the command line
+# (a unity build: too few files to pay for the header's build).
 # A forced include hides a missing #include in a source file: WHIRL_PRECOMPILED_HEADERS=OFF checks.
 set(WHIRL_PCH_test <algorithm> <cmath> <cstdint> <cstdio> <filesystem> <fstream> <functional>
     <map> <optional> <random> <set> <sstream> <string> <vector> <Eigen/Dense>

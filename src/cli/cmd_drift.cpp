@@ -24,7 +24,6 @@
 namespace whirl::cli {
 namespace {
 
-using drift::Run;
 using drift::RunState;
 
 const char* kRunFilesHelp =
@@ -65,13 +64,13 @@ std::vector<FlagPath> InputPaths(const RunInputs& in, const std::string& prefix 
   return paths;
 }
 
-std::vector<Run> LoadRuns(const RunInputs& in) {
-  std::vector<Run> runs;
+std::vector<drift::Run> LoadRuns(const RunInputs& in) {
+  std::vector<drift::Run> runs;
   for (const auto& p : in.idle) runs.push_back(drift::ReadRun(p, RunState::kIdle));
   for (const auto& p : in.cutting) runs.push_back(drift::ReadRun(p, RunState::kCutting));
   for (const auto& p : in.runs) runs.push_back(drift::ReadRun(p, RunState::kUnknown));
   if (runs.empty()) throw InputError("give at least one run file (--run, --idle or --cutting)");
-  for (const Run& r : runs)
+  for (const drift::Run& r : runs)
     if (r.time_from_index)
       Warn(r.source + ": no complete time column: the sample index is used as time");
   return runs;
@@ -319,7 +318,7 @@ void RegisterPredictDrift(CLI::App* drift_app) {
   sub->callback([o] {
     CheckOutputs({{"--model", o->model}, {"--run", o->run}}, {{"--out", o->out}});
     const drift::DriftModel m = drift::ReadDriftModel(o->model);
-    const Run run = drift::ReadRun(o->run, RunState::kUnknown);
+    const drift::Run run = drift::ReadRun(o->run, RunState::kUnknown);
     const drift::RunPrediction p =
         drift::PredictRun(m, run, drift::ParseReferenceMode(o->reference));
     for (const auto& w : p.warnings) Warn(w);
@@ -429,7 +428,7 @@ void RegisterHoldout(CLI::App* drift_app) {
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
     CheckOutputs({{"--log", o->log}}, {}, {{"--out-dir", o->out_dir}});
-    const Run log = drift::ReadRun(o->log, RunState::kUnknown);
+    const drift::Run log = drift::ReadRun(o->log, RunState::kUnknown);
     drift::HoldoutOptions h = o->h;
     h.channels = o->channels;
     h.network = !o->no_network;
@@ -473,7 +472,7 @@ void RegisterSplit(CLI::App* drift_app) {
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
     CheckOutputs({{"--log", o->log}}, {}, {{"--out-dir", o->out_dir}});
-    const Run log = drift::ReadRun(o->log, RunState::kUnknown);
+    const drift::Run log = drift::ReadRun(o->log, RunState::kUnknown);
     const auto runs = drift::SplitAtStarts(log, o->column, o->threshold);
     const auto paths =
         drift::WriteRuns(o->out_dir, runs,
@@ -534,7 +533,7 @@ void RegisterReport(CLI::App* drift_app) {
     inputs.insert(inputs.end(), more.begin(), more.end());
     CheckOutputs(inputs, {}, {{"--out-dir", o->out_dir}});
     const auto train = LoadRuns(o->train);
-    std::vector<Run> runs = train;
+    std::vector<drift::Run> runs = train;
     if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
       runs = LoadRuns(o->runs);
     const drift::FitReport rep = drift::FitDriftModel(
@@ -548,7 +547,7 @@ void RegisterReport(CLI::App* drift_app) {
       return;
     }
     nlohmann::json predictions = nlohmann::json::array(), files = nlohmann::json::array();
-    for (const Run& run : runs)
+    for (const drift::Run& run : runs)
       predictions.push_back(drift::PredictionJson(drift::PredictRun(rep.model, run)));
     for (const auto& f : r.files) files.push_back(f.string());
     nlohmann::json j = {{"schema", "whirl.drift_report"},

@@ -237,8 +237,9 @@ TEST(Monitor, BayesWithAVeryWeakPriorEqualsThePatentRefit) {
   ASSERT_TRUE(up[0] && up[1]);
   EXPECT_EQ(up[0]->sample, up[1]->sample);
   // The rank-aware patent equals the full refit when the measurements identify every direction.
-  if (up[0]->message.find("4 of 4 directions") != std::string::npos)
+  if (up[0]->message.find("4 of 4 directions") != std::string::npos) {
     EXPECT_LT((up[0]->coefficients - up[1]->coefficients).cwiseAbs().maxCoeff(), 1e-4);
+  }
 }
 
 TEST(Monitor, BayesWithAStrongPriorKeepsTheCoefficientsAndShrinksItsCovariance) {
@@ -400,7 +401,9 @@ TEST(MonitorProperty, RankAwarePatentKeepsTheNullSpace) {
     const Eigen::VectorXd change_scaled = scale.asDiagonal() * (after - b);
     const Eigen::MatrixXd null = svd.matrixV().rightCols(q - n);
     EXPECT_LE((null.transpose() * change_scaled).norm(), 1e-9 * (1 + change_scaled.norm()));
-    if (rank == n) EXPECT_LT((y - x * after).norm(), 1e-8 * (1 + y.norm()));
+    if (rank == n) {
+      EXPECT_LT((y - x * after).norm(), 1e-8 * (1 + y.norm()));
+    }
   }
   // Through the replay: the update event states the rank.
   Planted p;

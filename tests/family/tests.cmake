@@ -8,3 +8,4 @@ whirl_add_gtest(test_family SOURCES
 add_executable(family_bench ${CMAKE_CURRENT_LIST_DIR}/family_bench.cpp)
 target_link_libraries(family_bench PRIVATE whirl::family)
 whirl_set_warnings(family_bench)
+target_compile_options(family_bench PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})
