@@ -136,12 +136,9 @@ class RuleReplay {
     MonitorEvent check = Measure(k, MonitorEvent::Kind::kCheck);
     check.threshold_um = in_.threshold_um;
     check.valid = std::abs(check.measured_um - check.predicted_um) <= in_.threshold_um;
-    if (rule_ == UpdateRule::kBayes) {
-      const Eigen::RowVectorXd xk = in_.x.row(k);
-      innovations_.push_back({check.measured_um - check.predicted_um,
-                              xk.dot(prior_ * xk.transpose()) + in_.noise_variance,
-                              xk.cwiseQuotient(DriftScale(k).transpose()).squaredNorm()});
-    }
+    if (rule_ == UpdateRule::kBayes)
+      innovations_.push_back(CheckInnovation(in_.x.row(k), check.measured_um - check.predicted_um,
+                                             prior_, in_.noise_variance, SeenDriftScale(k)));
     check.message = CheckMessage(check.time, check.measured_um, check.predicted_um,
                                  in_.threshold_um, check.valid);
     ++s_.checks;
@@ -204,28 +201,17 @@ class RuleReplay {
   // returns the phrase for the update's event.
   std::string AddDrift(int k) {
     if (rule_ != UpdateRule::kBayes || !in_.o.estimate_drift) return "";
-    const double q2 = DriftVarianceMle(innovations_);
-    prior_.diagonal() += q2 * DriftScale(k).cwiseAbs2().cwiseInverse();
+    const double q2 = AddDriftVariance(innovations_, SeenDriftScale(k), &prior_);
     const std::string from = " (maximum likelihood from " + std::to_string(innovations_.size()) +
                              " checks)";
     if (!(q2 > 0)) return " + no drift: the checks' misfits are within noise and Cov(b)" + from;
     return " + drift q = " + FormatSignificant(std::sqrt(q2), 3) + " um per range seen" + from;
   }
 
-  // D of the drift covariance through sample k: 1 for the intercept, per feature the larger of
-  // its training range and the range of the samples 0..k (the box the control has seen).
-  Eigen::VectorXd DriftScale(int k) {
-    if (seen_lo_.size() == 0) {
-      seen_lo_ = seen_hi_ = in_.x.row(0).transpose();
-      seen_to_ = 1;
-    }
-    for (; seen_to_ <= k; ++seen_to_) {
-      seen_lo_ = seen_lo_.cwiseMin(in_.x.row(seen_to_).transpose());
-      seen_hi_ = seen_hi_.cwiseMax(in_.x.row(seen_to_).transpose());
-    }
-    Eigen::VectorXd d = in_.column_scale.cwiseMax(seen_hi_ - seen_lo_);
-    d(0) = 1;
-    return d;
+  // D of the drift covariance through sample k: the box of the samples 0..k (DriftScale).
+  Eigen::VectorXd SeenDriftScale(int k) {
+    for (; seen_to_ <= k; ++seen_to_) seen_.Add(in_.x.row(seen_to_));
+    return DriftScale(in_.column_scale, seen_);
   }
 
   // The prediction over the whole run, each piece's coefficients from its sample on.
@@ -245,7 +231,7 @@ class RuleReplay {
   std::vector<Piece> pieces_;
   Eigen::MatrixXd prior_;
   std::vector<Innovation> innovations_;  // bayes: every check's misfit (DriftVarianceMle)
-  Eigen::VectorXd seen_lo_, seen_hi_;     // bayes: the features' box over samples [0, seen_to_)
+  SeenBox seen_;                          // bayes: the features' box over samples [0, seen_to_)
   int seen_to_ = 0;
 };
 
@@ -402,19 +388,7 @@ double DriftVarianceMle(const std::vector<Innovation>& checks) {
   return log_likelihood(q2) > log_likelihood(0.0) ? q2 : 0.0;
 }
 
-Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                             const Eigen::VectorXd& b) {
-  Eigen::VectorXd updated = b;
-  updated(0) += (y - x * b).mean();
-  return updated;
-}
-
-namespace {
-
-// The patent's column scale: 1 for the intercept, each feature's training range (1 if none), so
-// the directions it keeps are those the measurements identify relative to the range the model
-// was fitted on, not to the few values at the measurements.
-Eigen::VectorXd PatentScale(const DriftModel& m) {
+Eigen::VectorXd TrainingColumnScale(const DriftModel& m) {
   Eigen::VectorXd s(m.feature_max.size() + 1);
   s(0) = 1;
   for (Eigen::Index j = 0; j < m.feature_max.size(); ++j) {
@@ -423,6 +397,44 @@ Eigen::VectorXd PatentScale(const DriftModel& m) {
   }
   return s;
 }
+
+void SeenBox::Add(const Eigen::RowVectorXd& row) {
+  if (lo.size() == 0) {
+    lo = hi = row.transpose();
+    return;
+  }
+  lo = lo.cwiseMin(row.transpose());
+  hi = hi.cwiseMax(row.transpose());
+}
+
+Eigen::VectorXd DriftScale(const Eigen::VectorXd& column_scale, const SeenBox& seen) {
+  Eigen::VectorXd d = column_scale.cwiseMax(seen.hi - seen.lo);
+  d(0) = 1;
+  return d;
+}
+
+Innovation CheckInnovation(const Eigen::RowVectorXd& x, double misfit_um,
+                           const Eigen::MatrixXd& prior_covariance, double noise_variance,
+                           const Eigen::VectorXd& drift_scale) {
+  return {misfit_um, x.dot(prior_covariance * x.transpose()) + noise_variance,
+          x.cwiseQuotient(drift_scale.transpose()).squaredNorm()};
+}
+
+double AddDriftVariance(const std::vector<Innovation>& checks, const Eigen::VectorXd& drift_scale,
+                        Eigen::MatrixXd* prior_covariance) {
+  const double q2 = DriftVarianceMle(checks);
+  prior_covariance->diagonal() += q2 * drift_scale.cwiseAbs2().cwiseInverse();
+  return q2;
+}
+
+Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& b) {
+  Eigen::VectorXd updated = b;
+  updated(0) += (y - x * b).mean();
+  return updated;
+}
+
+namespace {
 
 // The result's run, rows, scored window and threshold (MonitorRun's checks of its inputs).
 MonitorResult StartResult(const DriftModel& model, const Run& run, const MonitorOptions& o,
@@ -510,7 +522,7 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
                     r.threshold_um,
                     std::max(noise_variance, 1e-12),
                     start,
-                    PatentScale(model)};
+                    TrainingColumnScale(model)};
     StrategyResult sr = RunRule(rules[i], in);
     sr.stop_share = sr.stop_min / (r.monitored_min + sr.stop_min);
     sr.score = ComputeErrorStats(r.measured_um.segment(r.score_begin, m) -

@@ -231,6 +231,25 @@ struct Innovation {
 /// Log grid of 0.02 decades over [1e-6, 1e8] x min v_k / g_k, then golden section between the
 /// neighbours of the best grid point.
 double DriftVarianceMle(const std::vector<Innovation>& checks);
+/// The unit of each coefficient for the patent's cut and the drift scale: 1 for the intercept,
+/// then each feature's training range (1 when training saw a single value).
+Eigen::VectorXd TrainingColumnScale(const DriftModel& m);
+/// The box of design rows (intercept column included) the control has seen so far.
+struct SeenBox {
+  Eigen::VectorXd lo, hi;  // empty until the first row
+  void Add(const Eigen::RowVectorXd& row);
+};
+/// D of the drift covariance: 1 for the intercept, per feature the larger of its column scale
+/// (TrainingColumnScale) and its range in the box seen.
+Eigen::VectorXd DriftScale(const Eigen::VectorXd& column_scale, const SeenBox& seen);
+/// The check's record for DriftVarianceMle: misfit m = y - x b, variance x P x' + r, gain
+/// x D^-2 x'.
+Innovation CheckInnovation(const Eigen::RowVectorXd& x, double misfit_um,
+                           const Eigen::MatrixXd& prior_covariance, double noise_variance,
+                           const Eigen::VectorXd& drift_scale);
+/// P += q^2 D^-2 with q^2 = DriftVarianceMle(checks); returns q^2.
+double AddDriftVariance(const std::vector<Innovation>& checks, const Eigen::VectorXd& drift_scale,
+                        Eigen::MatrixXd* prior_covariance);
 Eigen::VectorXd OffsetUpdate(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                              const Eigen::VectorXd& b);
 

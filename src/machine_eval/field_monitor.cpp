@@ -34,19 +34,6 @@ struct Piece {
   Eigen::VectorXd b;
 };
 
-// D of the drift covariance: 1 for the intercept, per feature the larger of its training range
-// and its range over the samples seen (drift/monitor.h).
-Eigen::VectorXd DriftScale(const drift::DriftModel& m, const Eigen::VectorXd& seen_lo,
-                           const Eigen::VectorXd& seen_hi) {
-  Eigen::VectorXd d(seen_lo.size());
-  d(0) = 1;
-  for (Eigen::Index j = 1; j < d.size(); ++j) {
-    const double range = m.feature_max(j - 1) - m.feature_min(j - 1);
-    d(j) = std::max({range, seen_hi(j) - seen_lo(j), 1e-12});
-  }
-  return d;
-}
-
 }  // namespace
 
 MonitoredDay MonitorWithSetupChecks(const HeldSamples& held, const ProbeMonitor& monitor,
@@ -75,29 +62,25 @@ MonitoredDay MonitorWithSetupChecks(const HeldSamples& held, const ProbeMonitor&
   const double w = (z_ref_mm - probe_z_mm) / 1000.0;
   std::vector<drift::Innovation> innovations;
   std::vector<Piece> pieces = {{0, b}};
-  Eigen::VectorXd seen_lo = x.row(0).transpose(), seen_hi = seen_lo;
-  Eigen::Index seen = 1;
+  const Eigen::VectorXd column_scale = drift::TrainingColumnScale(m);
+  drift::SeenBox seen_box;
+  Eigen::Index seen = 0;
   for (std::size_t c = 1; c < checks.size(); ++c) {
     const double t = checks[c].abs_min;
     if (t < log.time_min.front()) continue;
     const auto i = static_cast<Eigen::Index>(held.IndexAt(t));
-    for (; seen <= i; ++seen) {
-      seen_lo = seen_lo.cwiseMin(x.row(seen).transpose());
-      seen_hi = seen_hi.cwiseMax(x.row(seen).transpose());
-    }
+    for (; seen <= i; ++seen) seen_box.Add(x.row(seen));
     const double y = checks[c].value_um - checks[0].value_um -
                      held.slope_um_per_1000[static_cast<std::size_t>(i)] * w;
     const Eigen::RowVectorXd xi = dx.row(i);
     const double misfit = y - xi.dot(b);
-    const Eigen::VectorXd d = DriftScale(m, seen_lo, seen_hi);
-    innovations.push_back({misfit, xi.dot(prior * xi.transpose()) + r,
-                           xi.cwiseQuotient(d.transpose()).squaredNorm()});
+    const Eigen::VectorXd d = drift::DriftScale(column_scale, seen_box);
+    innovations.push_back(drift::CheckInnovation(xi, misfit, prior, r, d));
     ++out.checks;
     if (std::abs(misfit) <= threshold) continue;
     ++out.invalid;
     if (!update) continue;
-    if (options.estimate_drift)
-      prior.diagonal() += drift::DriftVarianceMle(innovations) * d.cwiseAbs2().cwiseInverse();
+    if (options.estimate_drift) drift::AddDriftVariance(innovations, d, &prior);
     b = drift::BayesUpdate(xi, Eigen::VectorXd::Constant(1, y), b, &prior, r);
     const auto from = std::lower_bound(log.time_min.begin(), log.time_min.end(), t - 1e-9) -
                       log.time_min.begin();

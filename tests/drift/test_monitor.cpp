@@ -491,6 +491,40 @@ TEST(MonitorProperty, DriftVarianceIsTheMaximumLikelihoodEstimate) {
   EXPECT_EQ(DriftVarianceMle({}), 0.0);
 }
 
+// The drift covariance's pieces by hand: the training column scale (1 for a feature trained on
+// one value), the box seen widening it, the check's variance and gain, and P += q^2 D^-2.
+TEST(MonitorDriftScale, PiecesMatchAHandComputedExample) {
+  DriftModel m;
+  m.feature_min = Eigen::Vector2d(1.0, 5.0);
+  m.feature_max = Eigen::Vector2d(3.0, 5.0);  // the second feature: one training value
+  const Eigen::VectorXd scale = TrainingColumnScale(m);
+  EXPECT_EQ(scale, Eigen::Vector3d(1.0, 2.0, 1.0));
+  SeenBox seen;
+  seen.Add(Eigen::RowVector3d(1.0, 2.0, 5.0));
+  seen.Add(Eigen::RowVector3d(1.0, 6.0, 3.5));  // feature 1 spans 4 > 2, feature 2 spans 1.5 > 1
+  seen.Add(Eigen::RowVector3d(1.0, 3.0, 4.0));
+  const Eigen::VectorXd d = DriftScale(scale, seen);
+  EXPECT_EQ(d, Eigen::Vector3d(1.0, 4.0, 1.5));
+  const Eigen::RowVector3d x(1.0, 2.0, 3.0);
+  const Eigen::Matrix3d p = Eigen::Vector3d(0.5, 0.25, 2.0).asDiagonal();
+  const Innovation in = CheckInnovation(x, 2.5, p, 0.1, d);
+  EXPECT_DOUBLE_EQ(in.misfit_um, 2.5);
+  EXPECT_NEAR(in.variance_um2, 0.5 + 4 * 0.25 + 9 * 2.0 + 0.1, 1e-12);
+  EXPECT_NEAR(in.gain, 1.0 + 0.25 + 4.0, 1e-12);  // 1 + (2/4)^2 + (3/1.5)^2
+  Eigen::MatrixXd prior = p;
+  const double q2 = AddDriftVariance({in}, d, &prior);
+  EXPECT_NEAR(q2, (2.5 * 2.5 - in.variance_um2) > 0 ? (2.5 * 2.5 - in.variance_um2) / in.gain : 0,
+              1e-6);
+  const Innovation big = CheckInnovation(x, 30.0, p, 0.1, d);
+  prior = p;
+  const double q2_big = AddDriftVariance({big}, d, &prior);
+  ASSERT_GT(q2_big, 0);
+  EXPECT_NEAR(q2_big, (900.0 - big.variance_um2) / big.gain, 1e-6 * q2_big);
+  for (int j = 0; j < 3; ++j)
+    EXPECT_NEAR(prior(j, j), p(j, j) + q2_big / (d(j) * d(j)), 1e-9 * (1 + prior(j, j)));
+  EXPECT_EQ(prior(0, 1), 0.0);
+}
+
 // A week: day d+1 starts from day d's final coefficients and covariance; stop minutes total the
 // days; identical days on which the model is right give no update, so the week equals static.
 TEST(MonitorWeek, CarriesStateAndTotals) {
