@@ -21,13 +21,14 @@
 #include "core/output_dir.h"
 #include "core/run_program.h"
 #include "support/expect_error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl {
 namespace {
 namespace fs = std::filesystem;
 
 fs::path Scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("whirl_test_file_safety_" + name);
+  const fs::path d = whirl::test::ScratchDir() / ("whirl_test_file_safety_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -361,7 +362,7 @@ TEST(CheckOutputs, TwoOutputsOneFileAndOutputsInsideOutputDirectories) {
   fs::create_directory(d / "adir");
   e = ErrorOf([&] { CheckOutputs({}, {{"--timeline", "adir"}}); });
   EXPECT_TRUE(Has(e, "--timeline") && Has(e, "a directory")) << e;
-  fs::current_path(fs::temp_directory_path());
+  fs::current_path(whirl::test::ScratchDir());
 }
 
 }  // namespace

@@ -6,13 +6,14 @@
 #include "core/curve.h"
 #include "core/error.h"
 #include "core/process.h"
+#include "support/scratch_dir.h"
 
 namespace whirl {
 namespace {
 namespace fs = std::filesystem;
 
 fs::path FilesScratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("whirl_test_core_" + name);
+  const fs::path d = whirl::test::ScratchDir() / ("whirl_test_core_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/json_file.h"
 #include "support/expect_error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl {
 namespace {
@@ -86,7 +87,7 @@ TEST(JsonFields, StringsAndEnums) {
 // Invalid UTF-8 never escapes as a raw nlohmann exception: in a file it is an InputError naming
 // the file; in a string bound for output (a file name) it is replaced.
 TEST(JsonFields, InvalidUtf8) {
-  const auto path = std::filesystem::temp_directory_path() / "whirl_test_json_utf8.json";
+  const auto path = whirl::test::ScratchDir() / "whirl_test_json_utf8.json";
   std::ofstream(path, std::ios::binary) << "{\"name\": \"a\xFF\"}";
   const std::string e = ErrorOf([&] { ReadJsonFile(path); });
   EXPECT_NE(e.find(path.string()), std::string::npos) << e;

@@ -14,6 +14,7 @@
 #include "core/parallel.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
+#include "support/scratch_dir.h"
 
 namespace whirl {
 namespace {
@@ -183,7 +184,7 @@ TEST(SafeText, SpreadsheetLineLeavesNoCellStartingAFormula) {
 // the reference is gnuplot's own reader, not our encoder.
 TEST(SafeText, GnuplotReadsTheStringBack) {
   if (!ProgramSucceeds({"gnuplot", "--version"})) GTEST_SKIP() << "gnuplot not installed";
-  const fs::path d = fs::temp_directory_path() / "whirl_test_gnuplot_string";
+  const fs::path d = whirl::test::ScratchDir() / "whirl_test_gnuplot_string";
   fs::remove_all(d);
   fs::create_directories(d);
   const std::string name = "x'; system \"touch PWNED\"; print 'y\\ \"<b>\"";
@@ -194,7 +195,7 @@ TEST(SafeText, GnuplotReadsTheStringBack) {
 }
 
 TEST(RunProgram, PassesArgumentsWithoutAShell) {
-  const fs::path d = fs::temp_directory_path() / "whirl_test_run_program";
+  const fs::path d = whirl::test::ScratchDir() / "whirl_test_run_program";
   fs::remove_all(d);
   fs::create_directories(d);
   const std::string arg = "a b; touch PWNED $(touch PWNED2) 'c'";

@@ -18,6 +18,7 @@
 #include "drift/fit.h"
 #include "drift/model.h"
 #include "synthetic.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::drift {
 namespace {
@@ -97,7 +98,7 @@ TEST(DriftModel, EvaluatorEqualsBatchFeaturesAndFileRoundTrips) {
     ev.Step(run.time_min[static_cast<std::size_t>(k)], u.row(k).transpose());
     EXPECT_LT((ev.features() - f.row(k).transpose()).cwiseAbs().maxCoeff(), 1e-12);
   }
-  const auto path = std::filesystem::temp_directory_path() / "whirl_test_drift_model.json";
+  const auto path = whirl::test::ScratchDir() / "whirl_test_drift_model.json";
   WriteDriftModel(path, m);
   const DriftModel back = ReadDriftModel(path);
   std::filesystem::remove(path);
@@ -135,7 +136,7 @@ TEST(DriftModel, NetworkFitsAndGivesAFiniteErrorBar) {
   EXPECT_LT(m.residual_std_um, 0.5);  // the truth is linear in the rises plus 0.1 um noise
   EXPECT_TRUE(p.std_um.allFinite());
   EXPECT_GT(p.std_um.minCoeff(), 0.0);
-  const auto path = std::filesystem::temp_directory_path() / "whirl_test_drift_net.json";
+  const auto path = whirl::test::ScratchDir() / "whirl_test_drift_net.json";
   WriteDriftModel(path, m);
   const RunPrediction q = PredictRun(ReadDriftModel(path), run);
   std::filesystem::remove(path);

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "drift/run_file.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::drift {
 namespace {
@@ -96,7 +97,7 @@ namespace whirl::drift {
 namespace {
 
 TEST(RunFile, WriteRunsIsAllOrNothing) {
-  const auto dir = std::filesystem::temp_directory_path() / "whirl_test_write_runs";
+  const auto dir = whirl::test::ScratchDir() / "whirl_test_write_runs";
   std::filesystem::remove_all(dir);
   const drift::Run log =
       ParseRun("time_s,a_C,e_um\n0,20,0\n60,21,1\n120,22,2\n", "log.csv", RunState::kIdle);

@@ -15,6 +15,7 @@
 #include "drift/model.h"
 #include "drift/run_file.h"
 #include "machine/machine.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::machine {
 namespace {
@@ -118,7 +119,7 @@ TEST(MachineConfigFile, ShippedJsonEqualsDefaultAndRejectsTypos) {
 // schema_version is the number 1 (99, "1" and 1.5 were accepted), and every number, set to
 // +-1e308, is refused naming the file and the key (a spread of 1e308 wrote -nan cells).
 TEST(MachineConfigFile, SchemaRequiredAndEveryNumberInItsRange) {
-  const auto path = std::filesystem::temp_directory_path() /
+  const auto path = whirl::test::ScratchDir() /
                     ("whirl_test_machine_" + std::to_string(::getpid()) + ".json");
   const auto error_of = [&](const nlohmann::json& j) {
     std::ofstream(path) << j.dump();

@@ -17,6 +17,7 @@
 #include "machine_eval/machine_report.h"
 #include "workpiece/model.h"
 #include "sim/screw.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::machine_eval {
 namespace {
@@ -83,7 +84,7 @@ TEST(MachineReport, HostileNamesStayText) {
     l.position_mm = {0, 1, 2};
     l.deviation_um = {0, 0.5, 1};
   }
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+  const std::filesystem::path dir = whirl::test::ScratchDir() /
                                     ("whirl_machine_report_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   const std::string index = WriteMachineScrewReport(dir.string(), r, d, {hostile}, {});

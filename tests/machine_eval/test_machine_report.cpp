@@ -14,6 +14,7 @@
 #include "core/plot_style.h"
 #include "machine/machine.h"
 #include "machine_eval/machine_report.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::machine_eval {
 namespace {
@@ -42,7 +43,7 @@ TEST(MachineReport, SensorPanelsHoldAtMostEightLinesAndLeadEndsAtTheThread) {
     l.position_mm = {0, 1000, r.screw.thread_length_mm};
     l.deviation_um = {0, 0.5, 1};
   }
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+  const std::filesystem::path dir = whirl::test::ScratchDir() /
                                     ("whirl_machine_report_plots_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   WriteMachineScrewReport(dir.string(), r, d, {d.log.sensor_names[0]}, {});

@@ -16,6 +16,7 @@
 #include "nn/trainbr.h"
 #include "support/eigen_near.h"
 #include "synthetic.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::nn {
 namespace {
@@ -250,7 +251,7 @@ TEST(Ard, ModelFileKeepsTheSettingAndTheGroupAlphas) {
   EXPECT_TRUE(kept == 6 || (kept == 0 && m.training_summary.message.find("ARD stage not kept") !=
                                              std::string::npos))
       << m.training_summary.message;
-  const auto path = std::filesystem::temp_directory_path() /
+  const auto path = whirl::test::ScratchDir() /
                     ("whirl_ard_test_" + std::to_string(::getpid()) + ".json");
   SaveModel(path, m);
   const Model back = LoadModel(path);

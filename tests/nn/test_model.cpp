@@ -14,6 +14,7 @@
 #include "nn/selection.h"
 #include "support/eigen_near.h"
 #include "synthetic.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::nn {
 namespace {
@@ -21,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path Scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("whirl_nn_test_" + std::to_string(::getpid()));
+  const fs::path dir = whirl::test::ScratchDir() / ("whirl_nn_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
 }

@@ -23,6 +23,7 @@
 #include "sim/screw.h"
 #include "sim/simulator.h"
 #include "support/expect_error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl {
 namespace {
@@ -34,7 +35,7 @@ const fs::path kSource(WHIRL_SOURCE_DIR);
 fs::path Scratch(const std::string& name) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::string test = info ? std::string(info->test_suite_name()) + "_" + info->name() : "";
-  const fs::path d = fs::temp_directory_path() / ("whirl_test_limits_" + name + "_" + test);
+  const fs::path d = whirl::test::ScratchDir() / ("whirl_test_limits_" + name + "_" + test);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -12,6 +12,7 @@
 #include "sim/features.h"
 #include "sim/screw.h"
 #include "sim/simulator.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::sim {
 namespace {
@@ -232,7 +233,7 @@ TEST(ProcessModel, ElongationMovesInPhysicallySensibleDirections) {
 }
 
 TEST(Screw, JsonRoundTripAndClearErrors) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "whirl_sim_screw";
+  const std::filesystem::path dir = whirl::test::ScratchDir() / "whirl_sim_screw";
   std::filesystem::create_directories(dir);
   const Screw ref = ReferenceScrew();
   WriteScrew(dir / "ref.json", ref);

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "surface/per_point.h"
 #include "surface/surface.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::surface {
 namespace {
@@ -25,7 +26,7 @@ TEST(PerPoint, PositionsFromColumnNames) {
 }
 
 TEST(PerPoint, ManifestIsCheckedAgainstTheRun) {
-  const auto path = std::filesystem::temp_directory_path() / "whirl_surface_manifest.json";
+  const auto path = whirl::test::ScratchDir() / "whirl_surface_manifest.json";
   auto write = [&](const std::string& text) { std::ofstream(path) << text; };
   const std::vector<std::string> header{"time_min", "t1_C", "e1_um", "e2_um"};
   write(R"({"schema": "whirl.surface_manifest", "schema_version": 1, "points": [

@@ -7,6 +7,7 @@
 #include "core/run_program.h"
 #include "surface/report.h"
 #include "surface/synthetic.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::surface {
 namespace {
@@ -14,7 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(SurfaceReport, HostileTitleAndProvenanceStayText) {
-  const fs::path dir = fs::temp_directory_path() / "whirl_surface_report_test";
+  const fs::path dir = whirl::test::ScratchDir() / "whirl_surface_report_test";
   fs::remove_all(dir);
   SyntheticOptions s;
   const SurfaceFit fit = FitSurface(SyntheticPoints(s), {Method::kBspline, 3});

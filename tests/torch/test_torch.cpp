@@ -17,6 +17,7 @@
 #include "torch/crosscheck.h"
 #include "torch/libtorch_network.h"
 #include "torch_test_support.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::torch {
 namespace {
@@ -42,7 +43,7 @@ Eigen::MatrixXd RandomMatrix(int rows, int cols, double lo, double hi, std::uint
 
 fs::path ScratchDir(const std::string& name) {
   const fs::path dir =
-      fs::temp_directory_path() / ("whirl_torch_test_" + name + "_" + std::to_string(::getpid()));
+      whirl::test::ScratchDir() / ("whirl_torch_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -13,6 +13,7 @@
 #include "support/expect_error.h"
 #include "support/power_law_table.h"
 #include "workpiece/model.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::workpiece {
 namespace {
@@ -21,7 +22,7 @@ namespace fs = std::filesystem;
 using test::MakeTable;
 
 fs::path Scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "whirl_test_workpiece";
+  const fs::path dir = whirl::test::ScratchDir() / "whirl_test_workpiece";
   fs::create_directories(dir);
   return dir / name;
 }
