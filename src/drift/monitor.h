@@ -232,7 +232,9 @@ struct Innovation {
 /// neighbours of the best grid point.
 double DriftVarianceMle(const std::vector<Innovation>& checks);
 /// The unit of each coefficient for the patent's cut and the drift scale: 1 for the intercept,
-/// then each feature's training range (1 when training saw a single value).
+/// then each feature's training range (1 when training saw a single value), so the directions
+/// the patent keeps are those the measurements identify relative to the range the model was
+/// fitted on, not to the few values at the measurements.
 Eigen::VectorXd TrainingColumnScale(const DriftModel& m);
 /// The box of design rows (intercept column included) the control has seen so far.
 struct SeenBox {
