@@ -230,6 +230,7 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table,
                {"chosen", model.Describe()},
                {"folds", c.folds},
                {"cv_table", model.choice.table},
+               {"notes", model.choice.notes},
                {"calibration", model.choice.models.front().calibration},
                {"fit_time_ms", fit_ms}});
     return;
@@ -313,8 +314,11 @@ std::string TrainDescription() {
          "Default (no model options): per output the candidate with the lowest cross-\n"
          "validated (closed-form leave-one-out) error among the power law (least squares on\n"
          "log columns), a linear fit and a Gaussian process (ARD Matern 5/2, on log or raw\n"
-         "columns), the simplest within one standard error; prints the choice and the CV\n"
-         "table (src/family/family.h); sd calibrated by 5-fold cross-validation.\n"
+         "columns), the simplest within one standard error; with fewer than 10 rows per GP\n"
+         "hyperparameter (70 for the ARD kernel), a GP whose fit lies within 0.1 sd of the\n"
+         "linear fit on its columns gives way to the linear candidates (a note says so);\n"
+         "prints the choice and the CV table (src/family/family.h); sd calibrated by 5-fold\n"
+         "cross-validation.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
          "--family network (implied by any network option below, raw columns unless\n"
          "--transform says otherwise): the Bayesian-regularized network (MATLAB trainbr:\n"

@@ -184,6 +184,19 @@ std::vector<LinearModel> FitLinears(const ProcessTable& t) {
   return fits;
 }
 
+// The inputs mapped through t, one row per input row.
+std::vector<ProcessInputs> TransformedRows(const TableTransform& t,
+                                           const std::vector<ProcessInputs>& inputs) {
+  const Eigen::MatrixXd z = TransformInputs(t, nn::InputMatrix(inputs));
+  std::vector<ProcessInputs> rows;
+  for (Eigen::Index q = 0; q < z.cols(); ++q) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = z(i, q);
+    rows.push_back(ProcessInputs::FromArray(a));
+  }
+  return rows;
+}
+
 // Means (2 x Q) in the transformed space.
 Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<ProcessInputs>& z,
                                  Eigen::MatrixXd* sd) {
@@ -390,15 +403,8 @@ std::vector<FamilyPrediction> PredictFamily(const FamilyModel& model,
                                             const std::vector<ProcessInputs>& inputs) {
   std::vector<FamilyPrediction> out(inputs.size());
   if (inputs.empty()) return out;
-  const Eigen::MatrixXd z = TransformInputs(model.transform, nn::InputMatrix(inputs));
-  std::vector<ProcessInputs> zi;
-  for (Eigen::Index q = 0; q < z.cols(); ++q) {
-    std::array<double, ProcessInputs::kCount> a{};
-    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = z(i, q);
-    zi.push_back(ProcessInputs::FromArray(a));
-  }
   Eigen::MatrixXd sd;
-  const Eigen::MatrixXd mean = TransformedMeans(model, zi, &sd);
+  const Eigen::MatrixXd mean = TransformedMeans(model, TransformedRows(model.transform, inputs), &sd);
   for (std::size_t q = 0; q < inputs.size(); ++q) {
     std::array<double, Features::kCount> m{}, s{};
     for (int k = 0; k < Features::kCount; ++k) {
@@ -497,6 +503,77 @@ std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   return c;
 }
 
+double FitDifferenceInSd(const FamilyModel& a, const FamilyModel& b, const ProcessTable& table,
+                         int k) {
+  if (a.transform.inputs != b.transform.inputs || a.transform.outputs != b.transform.outputs)
+    throw InputError("fit difference of " + a.candidate.Name() + " and " + b.candidate.Name() +
+                     ": the two must share their transform (" + a.transform.Describe() +
+                     " against " + b.transform.Describe() + ")");
+  if (k < 0 || k >= Features::kCount || table.targets.size() != table.inputs.size())
+    throw InputError("fit difference: output " + std::to_string(k) + " of a table with " +
+                     std::to_string(table.targets.size()) + " targets and " +
+                     std::to_string(table.inputs.size()) + " rows");
+  const std::vector<ProcessInputs> z = TransformedRows(a.transform, table.inputs);
+  Eigen::MatrixXd sd;
+  const Eigen::VectorXd d =
+      (TransformedMeans(a, z, &sd).row(k) - TransformedMeans(b, z, &sd).row(k)).transpose();
+  const Eigen::VectorXd y =
+      TransformTargets(a.transform, nn::TargetMatrix(table.targets)).row(k).transpose();
+  const double spread = std::sqrt((y.array() - y.mean()).square().mean());
+  return spread > 0 ? std::sqrt(d.squaredNorm() / static_cast<double>(d.size())) / spread : 0.0;
+}
+
+int FittedHyperparameters(const Candidate& c) {
+  if (c.family != Family::kGaussianProcess) return 0;
+  return (c.isotropic ? 1 : ProcessInputs::kCount) + 2;
+}
+
+namespace {
+
+// The linear candidate on the columns of candidate c (-1 if there is none).
+int LinearOnTheSameColumns(const ChoiceOptions& o, const Candidate& c) {
+  for (std::size_t l = 0; l < o.candidates.size(); ++l)
+    if (o.candidates[l].family == Family::kLinear && o.candidates[l].log == c.log)
+      return static_cast<int>(l);
+  return -1;
+}
+
+// ChoiceOptions::equivalence_sd for output k: if candidate c is a GP fitted with too few rows per
+// hyperparameter whose fit lies within the threshold of the linear fit on its columns, the reason
+// (else empty).
+std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
+                        const std::vector<FamilyModel>& full, int c, int k) {
+  const Candidate& gp = o.candidates[c];
+  const int rows = static_cast<int>(table.inputs.size());
+  const int limit = ChoiceOptions::kRowsPerHyperparameter * FittedHyperparameters(gp);
+  const int lin = o.equivalence_sd > 0 && rows < limit ? LinearOnTheSameColumns(o, gp) : -1;
+  if (lin < 0) return "";
+  const double diff = FitDifferenceInSd(full[c], full[lin], table, k);
+  if (diff >= o.equivalence_sd) return "";
+  return std::string(kTargetColumns[k]) + ": " + gp.Name() + " set aside, the linear family " +
+         "chosen: its fit lies within " + FormatSignificant(diff, 2) + " sd of " +
+         o.candidates[lin].Name() + "'s (< " + FormatSignificant(o.equivalence_sd, 2) + ") at " +
+         std::to_string(rows) + " rows, fewer than " +
+         std::to_string(ChoiceOptions::kRowsPerHyperparameter) +
+         " per GP hyperparameter (a difference so few rows cannot confirm; its leave-one-out " +
+         "error is optimistic)";
+}
+
+// Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the
+// lowest error).
+int ChooseAmong(const std::vector<int>& kept, const std::vector<Eigen::MatrixXd>& err,
+                const ChoiceOptions& o, int k) {
+  std::vector<Eigen::VectorXd> sq;
+  for (int c : kept) sq.push_back(err[c].row(k).array().square().matrix());
+  if (o.one_standard_error) return kept[SimplestWithinOneStandardError(sq)];
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < sq.size(); ++i)
+    if (sq[i].mean() < sq[best].mean()) best = i;
+  return kept[best];
+}
+
+}  // namespace
+
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   CheckTable(table);
   if (options.candidates.empty()) throw InputError("family choice: no candidates");
@@ -550,10 +627,15 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
-    } else if (options.one_standard_error) {
-      std::vector<Eigen::VectorXd> output_sq;
-      for (const Eigen::MatrixXd& m : err) output_sq.push_back(m.row(k).array().square().matrix());
-      choice.chosen[k] = SimplestWithinOneStandardError(output_sq);
+    } else {
+      std::vector<int> all(static_cast<std::size_t>(nc)), linear;
+      for (int c = 0; c < nc; ++c) {
+        all[c] = c;
+        if (options.candidates[c].family == Family::kLinear) linear.push_back(c);
+      }
+      choice.chosen[k] = ChooseAmong(all, err, options, k);
+      choice.notes[k] = WhySetAside(table, options, full, choice.chosen[k], k);
+      if (!choice.notes[k].empty()) choice.chosen[k] = ChooseAmong(linear, err, options, k);
     }
   }
   FitChosen(table, options, stack, full, &choice);

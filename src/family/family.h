@@ -144,6 +144,17 @@ Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
 /// InputError without candidates.
 int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors);
 
+/// How far apart two fits of output k are on the training rows, in sd of the output: the RMS over
+/// the rows of table of (mean_a - mean_b) in the transformed space, divided by the population sd
+/// of the transformed output (0 for a constant output). Both models must share their transform
+/// (InputError naming both otherwise). ChoiceOptions::equivalence_sd uses it.
+double FitDifferenceInSd(const FamilyModel& a, const FamilyModel& b, const ProcessTable& table,
+                         int k);
+
+/// Hyperparameters a GP candidate fits by maximum likelihood: one length scale per input (one
+/// if isotropic), the signal sd and the noise sd; 0 for other families.
+int FittedHyperparameters(const Candidate& c);
+
 /// One row of the choice table.
 struct CvRow {
   Candidate candidate;
@@ -189,6 +200,25 @@ struct ChoiceOptions {
   /// own; the combination's sd is sqrt(sum_c w_c sd_c^2), an upper bound of the sd of
   /// sum_c w_c e_c for any correlation of the candidates' errors e_c (Minkowski, then Jensen).
   bool stack = false;
+  /// Practical equivalence at few rows (per-output choices without `stack`): if output k's choice
+  /// is a GP fitted with fewer than kRowsPerHyperparameter rows per hyperparameter
+  /// (FittedHyperparameters: 20 rows against 70 for an ARD kernel on 5 inputs) and its fit
+  /// differs from the fit of the linear candidate on the same columns by less than
+  /// equivalence_sd sd of the output (FitDifferenceInSd, both fitted on all rows), the GP is set
+  /// aside and output k is chosen among the linear candidates alone (the one-standard-error
+  /// rule, or the lowest error); Choice::notes says so. 0 disables the rule.
+  /// Why: at 20 rows the closed-form leave-one-out error of a GP is exact only for
+  /// hyperparameters that were fitted with the held-out row (Cawley & Talbot, "On over-fitting in
+  /// model selection and subsequent selection bias in performance evaluation", JMLR 11, 2010), so
+  /// a GP that is a power law plus a small bend can beat the power law's leave-one-out error by
+  /// more than one standard error and lose on new rows. A bend of less than 0.1 sd (1 % of the
+  /// output's variance) is what 20 rows cannot resolve, and the linear candidate is the GP's own
+  /// long-length-scale limit (a smooth kernel with length scales far beyond the data is a
+  /// constant plus a linear function plus terms of order 1 / l^2). Rows per parameter: the rule
+  /// of thumb of 10 (Harrell, "Regression Modeling Strategies", 2nd ed., section 4.4).
+  /// Measured with scripts/bench_peers.sh (docs/workpiece-model.md, "Practical equivalence").
+  double equivalence_sd = 0.1;
+  static constexpr int kRowsPerHyperparameter = 10;
   FitOptions fit;
   /// From the simplest (ChoiceOptions::one_standard_error): linear/log (the power law),
   /// linear/identity, gp-se-iso-constant/identity (one length scale: 3 hyperparameters),
@@ -217,6 +247,8 @@ struct Choice {
   /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight); empty: output
   /// k is models[model_of_output[k]] alone.
   std::array<std::vector<double>, Features::kCount> weights;
+  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none. Printed by `whirl train` (and in its --json), not stored in the model file.
+  std::array<std::string, Features::kCount> notes;
   std::string Describe()
       const;  ///< "max_elongation_um: linear/log, settle_time_s: gp-se-constant/log"
 };

@@ -241,6 +241,8 @@ std::string FormatChoiceTable(const family::Choice& choice) {
                   mark.c_str());
     s += line;
   }
+  for (const std::string& note : choice.notes)
+    if (!note.empty()) s += "  note: " + note + "\n";
   return s;
 }
 

@@ -112,7 +112,8 @@ WorkpieceModel TrainWorkpieceModel(const ProcessTable& table, const TrainOptions
                                    const nn::ModelProgress& progress = {});
 
 /// The choice's CV table as text: one line per candidate with its cross-validated RMSE per output
-/// (um, s), the score and the fit time, and the chosen candidate of each output marked.
+/// (um, s), the score and the fit time, and the chosen candidate of each output marked; then a
+/// "note:" line per output with family::Choice::notes.
 std::string FormatChoiceTable(const family::Choice& choice);
 
 }  // namespace whirl::workpiece

@@ -1,7 +1,7 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--joint] [--loo|--kfold] [--no-1se] [--gp-ftol F] [--calibration-folds K]
+//                [--joint] [--loo|--kfold] [--no-1se] [--equivalence-sd SD] [--gp-ftol F] [--calibration-folds K]
 //                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
@@ -52,6 +52,8 @@ Args Parse(int argc, char** argv) {
       a.choice.fit.calibrate_two_sd = true;
     else if (k == "--one-sd")
       a.choice.fit.calibrate_two_sd = false;
+    else if (k == "--equivalence-sd")
+      a.choice.equivalence_sd = std::stod(value());
     else if (k == "--no-1se")
       a.choice.one_standard_error = false;
     else if (k == "--gp-ftol")

@@ -237,6 +237,93 @@ TEST(FamilyCalibration, TwoSdCoversEveryLeaveOneOutResidualAtTwentyRows) {
   EXPECT_NE(m2.calibration.find("+-2 sd 95.45 %"), std::string::npos) << m2.calibration;
 }
 
+// Two linear fits whose output-k intercepts differ by c: their fits differ by c everywhere, so
+// FitDifferenceInSd is c / (population sd of the transformed output k).
+TEST(FamilyEquivalence, FitDifferenceOnAHandComputedCase) {
+  const ProcessTable t = MakeTable(20, 0.05, 21);
+  FitOptions fit;
+  const FamilyModel a = FitCandidate(t, ParseCandidate("linear/log"), fit, false);
+  for (int k = 0; k < 2; ++k) {
+    FamilyModel b = a;
+    b.linears[k].coef(0) += 0.3;
+    Eigen::VectorXd y(20);
+    for (int q = 0; q < 20; ++q) y(q) = std::log(t.targets[q].ToArray()[k]);
+    const double sd = std::sqrt((y.array() - y.mean()).square().mean());
+    EXPECT_NEAR(FitDifferenceInSd(a, b, t, k), 0.3 / sd, 1e-12);
+    EXPECT_NEAR(FitDifferenceInSd(b, a, t, k), 0.3 / sd, 1e-12);
+    EXPECT_EQ(FitDifferenceInSd(a, b, t, 1 - k), 0.0);
+    EXPECT_EQ(FitDifferenceInSd(a, a, t, k), 0.0);
+  }
+  const FamilyModel raw = FitCandidate(t, ParseCandidate("linear/identity"), fit, false);
+  ExpectInputError([&] { FitDifferenceInSd(a, raw, t, 0); }, "must share their transform");
+  ExpectInputError([&] { FitDifferenceInSd(a, a, t, 2); }, "output 2");
+  EXPECT_EQ(FittedHyperparameters(ParseCandidate("gp-matern52-constant/log")), 7);
+  EXPECT_EQ(FittedHyperparameters(ParseCandidate("gp-se-iso-constant/identity")), 3);
+  EXPECT_EQ(FittedHyperparameters(ParseCandidate("linear/log")), 0);
+}
+
+// ChoiceOptions::equivalence_sd over many 20-row tables (power laws with a mild bend, where the
+// log-column GP sometimes beats the power law's leave-one-out error): a choice changes only from
+// that GP, when its fit lies within the threshold of the power law's, to a linear candidate, with
+// a note; a GP that stays chosen lies farther away; and the rule changes some choices and keeps
+// some GPs.
+TEST(FamilyEquivalence, ANearlyLinearGpAtFewRowsGivesWayToTheLinearFamily) {
+  ChoiceOptions on, off;
+  for (ChoiceOptions* o : {&on, &off})
+    o->candidates = {ParseCandidate("linear/log"), ParseCandidate("linear/identity"),
+                     ParseCandidate("gp-matern52-constant/log")};
+  off.equivalence_sd = 0;
+  int changed = 0, kept_gp = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    ProcessTable t = MakeTable(20, 0.04, seed);
+    for (std::size_t q = 0; q < t.targets.size(); ++q)  // a bend in ln(raceway radius)
+      t.targets[q].max_elongation_um *=
+          std::exp(0.15 * std::pow(std::log(t.inputs[q].raceway_radius_mm / 6), 2));
+    const Choice a = ChooseFamily(t, off), b = ChooseFamily(t, on);
+    const FamilyModel gp = FitCandidate(t, on.candidates[2], on.fit, false);
+    const FamilyModel lin = FitCandidate(t, on.candidates[0], on.fit, false);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_TRUE(a.notes[k].empty());
+      const bool near = FitDifferenceInSd(gp, lin, t, k) < on.equivalence_sd;
+      if (b.chosen[k] == a.chosen[k]) {
+        EXPECT_TRUE(b.notes[k].empty()) << "seed " << seed << " " << b.notes[k];
+        if (a.chosen[k] == 2) {
+          EXPECT_FALSE(near) << "seed " << seed;
+          ++kept_gp;
+        }
+        continue;
+      }
+      ++changed;
+      EXPECT_EQ(a.chosen[k], 2) << "seed " << seed;
+      EXPECT_TRUE(near) << "seed " << seed;
+      EXPECT_EQ(b.table[b.chosen[k]].candidate.family, Family::kLinear) << "seed " << seed;
+      EXPECT_NE(b.notes[k].find("gp-matern52-constant/log set aside, the linear family chosen"),
+                std::string::npos)
+          << b.notes[k];
+      EXPECT_NE(b.notes[k].find("of linear/log's (< 0.1) at 20 rows, fewer than 10 per GP"),
+                std::string::npos)
+          << b.notes[k];
+    }
+  }
+  EXPECT_GT(changed, 0);
+  EXPECT_GT(kept_gp, 0);
+}
+
+// At 10 rows per hyperparameter or more the rule never applies, however large the threshold;
+// below it, a threshold above any difference turns every GP choice into a linear one.
+TEST(FamilyEquivalence, AppliesOnlyBelowTenRowsPerHyperparameter) {
+  ChoiceOptions wide, off;
+  wide.equivalence_sd = 1e9;
+  off.equivalence_sd = 0;
+  const ProcessTable curved = MakeTable(70, 0.01, 5, true);
+  EXPECT_EQ(ChooseFamily(curved, wide).Describe(), ChooseFamily(curved, off).Describe());
+  const Choice small = ChooseFamily(MakeTable(25, 0.01, 5, true), wide);
+  for (int k = 0; k < 2; ++k)
+    EXPECT_EQ(small.table[small.chosen[k]].candidate.family, Family::kLinear) << small.Describe();
+  const Choice small_off = ChooseFamily(MakeTable(25, 0.01, 5, true), off);
+  EXPECT_NE(small_off.Describe(), small.Describe());  // the curved table's choice had a GP
+}
+
 TEST(FamilyStacking, WeightsOnHandComputedCases) {
   Eigen::MatrixXd p(2, 2);
   Eigen::VectorXd t(2);
