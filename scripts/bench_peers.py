@@ -53,7 +53,7 @@ sklearn's wall time of fit() (mlp_cv includes its grid search).
 Peer cache (--peer-cache FILE): the peers' results per (problem, rows, seed, peer, sklearn
 version) are read from and added to FILE (JSON), so exploring whirl settings does not refit them.
 
-Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--sizes 20,100]
+Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--first-seed 1] [--sizes 20,100]
        [--problems friedman,simulator,simgen] [--variant NAME=ARGS ...] [--no-default]
        [--family-bench PATH --family NAME=ARGS ...] [--peer-cache FILE] [--json out.json]
 """
@@ -229,6 +229,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--whirl", required=True)
     ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--first-seed", type=int, default=1,
+                    help="seeds FIRST .. FIRST + SEEDS - 1 (default 1): a fresh set of tables")
     ap.add_argument("--sizes", default="20,100")
     ap.add_argument("--problems", default="friedman,simulator")
     ap.add_argument("--variant", action="append", default=[],
@@ -264,7 +266,7 @@ def main():
         sim_cache = a.sim_cache or tmp
         os.makedirs(sim_cache, exist_ok=True)
         for prob, n in cases:
-            for seed in range(1, a.seeds + 1):
+            for seed in range(a.first_seed, a.first_seed + a.seeds):
                 if prob == "friedman":
                     rng = np.random.default_rng(1000 * n + seed)
                     xtr, _, ytr = friedman(rng, n)
@@ -311,7 +313,9 @@ def main():
 def report(results, prob, n, variants, peers):
     rs = [r for r in results if r["problem"] == prob and r["rows"] == n]
     med = lambda key, m, k: float(np.median([r["methods"][m][key][k] for r in rs]))
-    print(f"\n{prob}, {n} training rows, {len(rs)} seeds (median test RMSE, out1 / out2)")
+    seeds = [r["seed"] for r in rs]
+    print(f"\n{prob}, {n} training rows, {len(rs)} seeds ({min(seeds)}-{max(seeds)}; median test "
+          "RMSE, out1 / out2)")
     print(f"{'method':<14} {'rmse_out1':>9} {'rmse_out2':>9} {'wins1':>6} {'wins2':>6} "
           f"{'cov1sd':>11} {'cov2sd':>11} {'cov1sd_f':>11} {'time_ms':>8} {'time2_ms':>8} {'flat':>5}")
     for m in [v[0] for v in variants] + peers:
