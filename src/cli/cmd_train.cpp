@@ -242,6 +242,9 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table,
                                   : "")
             << c.folds << "-fold refits" << (c.closed_form_loo ? " for networks" : "") << ")"
             << (c.one_standard_error ? ", the simplest within one standard error" : "")
+            << (model.choice.notes[0].empty() && model.choice.notes[1].empty()
+                    ? ""
+                    : " (notes below the table: GPs set aside at few rows)")
             << "; cross-validated RMSE in um and s, score = sum of MSE / variance:\n"
             << workpiece::FormatChoiceTable(model.choice);
   std::cout << "  sd: " << model.choice.models.front().calibration << "\n";
@@ -314,11 +317,14 @@ std::string TrainDescription() {
          "Default (no model options): per output the candidate with the lowest cross-\n"
          "validated (closed-form leave-one-out) error among the power law (least squares on\n"
          "log columns), a linear fit and a Gaussian process (ARD Matern 5/2, on log or raw\n"
-         "columns), the simplest within one standard error; with fewer than 10 rows per GP\n"
-         "hyperparameter (70 for the ARD kernel), a GP whose fit lies within 0.1 sd of the\n"
-         "linear fit on its columns gives way to the linear candidates (a note says so);\n"
-         "prints the choice and the CV table (src/family/family.h); sd calibrated by 5-fold\n"
-         "cross-validation.\n"
+         "columns), the simplest within one standard error. Below 10 rows per GP\n"
+         "hyperparameter (70 rows for the ARD GP, 30 for the isotropic one), a chosen GP that\n"
+         "spends more degrees of freedom than the linear fit (6) on a fit within 0.1 sd of the\n"
+         "output (of ln y on log columns) from the linear fit on its columns (the power law on\n"
+         "log columns) must also beat the linear candidates' choice when both are refitted on\n"
+         "5 folds, by more than one standard error; else that linear fit is taken and a note\n"
+         "says why. Prints the choice and the CV table (src/family/family.h); sd calibrated by\n"
+         "5-fold cross-validation.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
          "--family network (implied by any network option below, raw columns unless\n"
          "--transform says otherwise): the Bayesian-regularized network (MATLAB trainbr:\n"

@@ -86,12 +86,13 @@ gp::GpOptions CandidateGpOptions(const FitOptions& o, const Candidate& c) {
 
 // Output k of a linear or GP candidate fitted on (x, y): held-out residuals r and latent variances
 // v (transformed units) by closed-form leave-one-out (folds == 0) or K-fold refits (a GP from the
-// full fit's hyperparameters, one start).
+// full fit's hyperparameters, one start; with cold_start from GpOptions' fixed starting points).
 struct HeldOut {
   Eigen::VectorXd r, v;
 };
 HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
-                      const Eigen::VectorXd& y, const FitOptions& o, int folds) {
+                      const Eigen::VectorXd& y, const FitOptions& o, int folds,
+                      bool cold_start = false) {
   HeldOut h;
   const bool linear = m.candidate.family == Family::kLinear;
   if (folds == 0 && linear) {
@@ -115,7 +116,9 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
           return;
         }
         const gp::GpPrediction p = gp::PredictGp(
-            gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta), x(Eigen::all, te));
+            cold_start ? gp::FitGp(x(Eigen::all, tr), y(tr), go)
+                 : gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta),
+            x(Eigen::all, te));
         *mean = p.mean;
         *latent = p.latent_variance;
       },
@@ -538,25 +541,56 @@ int LinearOnTheSameColumns(const ChoiceOptions& o, const Candidate& c) {
   return -1;
 }
 
-// ChoiceOptions::equivalence_sd for output k: if candidate c is a GP fitted with too few rows per
-// hyperparameter whose fit lies within the threshold of the linear fit on its columns, the reason
-// (else empty).
+// Squared held-out errors of output k (original units) from K-fold refits of m (row q held out
+// in fold q % K; a GP from GpOptions' fixed starting points, so that no hyperparameter has seen
+// the held-out rows).
+Eigen::VectorXd RefitSquaredErrors(const FamilyModel& m, const ProcessTable& table,
+                                   const FitOptions& o, int folds, int k) {
+  const Eigen::MatrixXd x = TransformInputs(m.transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::VectorXd y = TransformTargets(m.transform, t).row(k).transpose();
+  const HeldOut h = OutputHeldOut(m, k, x, y, o, folds, true);
+  return OriginalErrors(m, k, t.row(k), y, h).array().square().matrix().transpose();
+}
+
+// ChoiceOptions::equivalence_sd for output k: if the chosen candidate c is a GP fitted with too
+// few rows per hyperparameter, with more degrees of freedom than the linear fit, whose fit lies
+// within the threshold of the linear fit on its columns, and its K-fold refit errors do not beat
+// those of the linear family's choice `lin` by more than one standard error, the reason (else
+// empty).
 std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
-                        const std::vector<FamilyModel>& full, int c, int k) {
+                        const std::vector<FamilyModel>& full, int c, int lin, int k) {
   const Candidate& gp = o.candidates[c];
   const int rows = static_cast<int>(table.inputs.size());
   const int limit = ChoiceOptions::kRowsPerHyperparameter * FittedHyperparameters(gp);
-  const int lin = o.equivalence_sd > 0 && rows < limit ? LinearOnTheSameColumns(o, gp) : -1;
-  if (lin < 0) return "";
-  const double diff = FitDifferenceInSd(full[c], full[lin], table, k);
-  if (diff >= o.equivalence_sd) return "";
-  return std::string(kTargetColumns[k]) + ": " + gp.Name() + " set aside, the linear family " +
-         "chosen: its fit lies within " + FormatSignificant(diff, 2) + " sd of " +
-         o.candidates[lin].Name() + "'s (< " + FormatSignificant(o.equivalence_sd, 2) + ") at " +
-         std::to_string(rows) + " rows, fewer than " +
+  const bool few_rows = gp.family == Family::kGaussianProcess && rows < limit;
+  const int same = o.equivalence_sd > 0 && few_rows ? LinearOnTheSameColumns(o, gp) : -1;
+  if (same < 0) return "";
+  const double diff = FitDifferenceInSd(full[c], full[same], table, k);
+  const double df = gp::EffectiveDegreesOfFreedom(full[c].gps[k]);
+  const int linear_df = ProcessInputs::kCount + 1;
+  if (diff >= o.equivalence_sd || df <= linear_df) return "";
+  FitOptions fo = o.fit;
+  fo.threads = 1;
+  const int folds = std::min(o.folds, rows);
+  const Eigen::VectorXd e_lin = RefitSquaredErrors(full[lin], table, fo, folds, k);
+  const Eigen::VectorXd e_gp = RefitSquaredErrors(full[c], table, fo, folds, k);
+  if (SimplestWithinOneStandardError({e_lin, e_gp}) == 1) return "";
+  const std::string column = kTargetColumns[k];
+  return column + ": " + gp.Name() + " set aside for " +
+         o.candidates[lin].Name() + ": at " + std::to_string(rows) + " rows (fewer than " +
          std::to_string(ChoiceOptions::kRowsPerHyperparameter) +
-         " per GP hyperparameter (a difference so few rows cannot confirm; its leave-one-out " +
-         "error is optimistic)";
+         " per GP hyperparameter) it spends " + FormatSignificant(df, 3) +
+         " degrees of freedom (the linear fit " + std::to_string(linear_df) +
+         ") on a fit within " + FormatSignificant(diff, 2) + " sd of " +
+         (full[c].transform.outputs[k] == ColumnTransform::kLog ? "ln(" + column + ")" : column) +
+         " from " + o.candidates[same].Name() + "'s (< " +
+         FormatSignificant(o.equivalence_sd, 2) + "), and refitted on " + std::to_string(folds) +
+         " folds its RMSE " + FormatSignificant(std::sqrt(e_gp.mean()), 3) +
+         " does not beat " + o.candidates[lin].Name() + "'s " +
+         FormatSignificant(std::sqrt(e_lin.mean()), 3) +
+         " by more than one standard error (its leave-one-out error, with hyperparameters " +
+         "fitted on every row, was optimistic)";
 }
 
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the
@@ -634,8 +668,10 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
         if (options.candidates[c].family == Family::kLinear) linear.push_back(c);
       }
       choice.chosen[k] = ChooseAmong(all, err, options, k);
-      choice.notes[k] = WhySetAside(table, options, full, choice.chosen[k], k);
-      if (!choice.notes[k].empty()) choice.chosen[k] = ChooseAmong(linear, err, options, k);
+      if (linear.empty()) continue;
+      const int lin = ChooseAmong(linear, err, options, k);
+      choice.notes[k] = WhySetAside(table, options, full, choice.chosen[k], lin, k);
+      if (!choice.notes[k].empty()) choice.chosen[k] = lin;
     }
   }
   FitChosen(table, options, stack, full, &choice);

@@ -300,12 +300,20 @@ GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x) {
   return p;
 }
 
-LeaveOneOut LeaveOneOutGp(const Gp& gp) {
+// The diagonal of P = K^-1 - K^-1 H (H' K^-1 H)^-1 H' K^-1 (the header's leave-one-out comment).
+Eigen::ArrayXd ProjectionDiagonal(const Gp& gp) {
   const int n = static_cast<int>(gp.u.size());
   const Eigen::MatrixXd k_inv = gp.chol.solve(Eigen::MatrixXd::Identity(n, n));
   const Eigen::MatrixXd ah = gp.a_chol.matrixL().solve(gp.k_inv_h.transpose());  // m x n
-  const Eigen::ArrayXd p_diag =
-      k_inv.diagonal().array() - ah.colwise().squaredNorm().transpose().array();
+  return k_inv.diagonal().array() - ah.colwise().squaredNorm().transpose().array();
+}
+
+double EffectiveDegreesOfFreedom(const Gp& gp) {
+  return static_cast<double>(gp.u.size()) - gp.SigmaN2() * ProjectionDiagonal(gp).sum();
+}
+
+LeaveOneOut LeaveOneOutGp(const Gp& gp) {
+  const Eigen::ArrayXd p_diag = ProjectionDiagonal(gp);
   LeaveOneOut loo;
   loo.residual = (gp.alpha.array() / p_diag * gp.target_scale).matrix();
   loo.latent_variance =

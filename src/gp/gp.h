@@ -145,6 +145,13 @@ struct LeaveOneOut {
 };
 LeaveOneOut LeaveOneOutGp(const Gp& gp);
 
+/// Effective degrees of freedom of the fit at the training rows (Hastie, Tibshirani & Friedman,
+/// "The Elements of Statistical Learning", eq. 7.32; R&W section 2.6): tr(S) of the smoother that
+/// maps the targets to the fitted means at the training rows, u_hat = S u = u - sigma_n^2 P u
+/// (P of the leave-one-out comment, sigma_n^2 the fitted noise), so df = n - sigma_n^2 tr(P);
+/// between the mean's coefficient count m (the kernel adds nothing) and n (interpolation).
+double EffectiveDegreesOfFreedom(const Gp& gp);
+
 /// JSON of the fields above the "Derived" line; from_json validates sizes and finiteness
 /// (InputError naming the key) and calls Factorize().
 void to_json(nlohmann::json& j, const Gp& gp);

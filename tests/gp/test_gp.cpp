@@ -123,6 +123,38 @@ TEST(GpLeaveOneOut, EqualsRefitsWithoutEachRow) {
     }
 }
 
+// df = sum_i d u_hat_i / d u_i (u_hat = u - sigma_n^2 alpha, the fitted means at the training
+// rows, hyperparameters fixed), by central differences; and it lies between the mean's
+// coefficient count and the row count.
+TEST(GpDegreesOfFreedom, EqualTheTraceOfTheSmootherByFiniteDifferences) {
+  const Data data = MakeData(3, 14, 0.2, 5);
+  for (Kernel k : kKernels)
+    for (Mean m : {Mean::kConstant, Mean::kLinear}) {
+      GpOptions o;
+      o.kernel = k;
+      o.mean = m;
+      const Gp gp = FitGp(data.x, data.y, o);
+      auto fitted = [&](const Eigen::VectorXd& u, int i) {
+        Gp g = gp;
+        g.u = u;
+        g.Factorize();
+        return u(i) - g.SigmaN2() * g.alpha(i);
+      };
+      double trace = 0;
+      const double h = 1e-5;
+      for (int i = 0; i < 14; ++i) {
+        Eigen::VectorXd up = gp.u, down = gp.u;
+        up(i) += h;
+        down(i) -= h;
+        trace += (fitted(up, i) - fitted(down, i)) / (2 * h);
+      }
+      const double df = EffectiveDegreesOfFreedom(gp);
+      EXPECT_NEAR(df, trace, 1e-6) << ToString(k) << " " << ToString(m);
+      EXPECT_GE(df, MeanSize(m, 3) - 1e-9);
+      EXPECT_LE(df, 14 + 1e-9);
+    }
+}
+
 TEST(GpFit, RecoversTheNoiseLevelAndIgnoresAnIrrelevantInput) {
   // y depends on inputs 0 and 1 only; input 2 is irrelevant; noise sd 0.1.
   const Data data = MakeData(3, 80, 0.1, 3);
