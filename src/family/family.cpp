@@ -553,44 +553,65 @@ Eigen::VectorXd RefitSquaredErrors(const FamilyModel& m, const ProcessTable& tab
   return OriginalErrors(m, k, t.row(k), y, h).array().square().matrix().transpose();
 }
 
-// ChoiceOptions::equivalence_sd for output k: if the chosen candidate c is a GP fitted with too
-// few rows per hyperparameter, with more degrees of freedom than the linear fit, whose fit lies
-// within the threshold of the linear fit on its columns, and its K-fold refit errors do not beat
-// those of the linear family's choice `lin` by more than one standard error, the reason (else
-// empty).
-std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
-                        const std::vector<FamilyModel>& full, int c, int lin, int k) {
+// A chosen GP that ChoiceOptions::equivalence_sd checks: few rows per hyperparameter, more degrees
+// of freedom than the linear fit, a fit near the linear candidate's on the same columns.
+struct NearLinearGp {
+  int same = -1;        // that linear candidate
+  double distance = 0;  // FitDifferenceInSd to it
+  double df = 0;        // gp::EffectiveDegreesOfFreedom
+};
+constexpr int kLinearCoefficients = ProcessInputs::kCount + 1;
+
+bool IsNearLinearGp(const ProcessTable& table, const ChoiceOptions& o,
+                    const std::vector<FamilyModel>& full, int c, int k, NearLinearGp* n) {
   const Candidate& gp = o.candidates[c];
   const int rows = static_cast<int>(table.inputs.size());
-  const int limit = ChoiceOptions::kRowsPerHyperparameter * FittedHyperparameters(gp);
-  const bool few_rows = gp.family == Family::kGaussianProcess && rows < limit;
-  const int same = o.equivalence_sd > 0 && few_rows ? LinearOnTheSameColumns(o, gp) : -1;
-  if (same < 0) return "";
-  const double diff = FitDifferenceInSd(full[c], full[same], table, k);
-  const double df = gp::EffectiveDegreesOfFreedom(full[c].gps[k]);
-  const int linear_df = ProcessInputs::kCount + 1;
-  if (diff >= o.equivalence_sd || df <= linear_df) return "";
+  if (o.equivalence_sd <= 0 || gp.family != Family::kGaussianProcess ||
+      rows >= ChoiceOptions::kRowsPerHyperparameter * FittedHyperparameters(gp))
+    return false;
+  n->same = LinearOnTheSameColumns(o, gp);
+  if (n->same < 0) return false;
+  n->distance = FitDifferenceInSd(full[c], full[n->same], table, k);
+  n->df = gp::EffectiveDegreesOfFreedom(full[c].gps[k]);
+  return n->distance < o.equivalence_sd && n->df > kLinearCoefficients;
+}
+
+std::string SetAsideNote(const ChoiceOptions& o, const FamilyModel& gp, int lin, int k, int rows,
+                         const NearLinearGp& n, int folds, double rmse_gp, double rmse_lin) {
+  const std::string column = kTargetColumns[k], unit = kTargetUnits[k];
+  const std::string& linear = o.candidates[lin].Name();
+  return column + ": " + gp.candidate.Name() + " set aside for " + linear + ": at " +
+         std::to_string(rows) + " rows (fewer than " +
+         std::to_string(ChoiceOptions::kRowsPerHyperparameter) +
+         " per GP hyperparameter) it spends " + FormatSignificant(n.df, 3) +
+         " degrees of freedom (the linear fit's " + std::to_string(kLinearCoefficients) +
+         " coefficients) on a fit that differs from " + o.candidates[n.same].Name() + "'s by " +
+         FormatSignificant(n.distance, 2) + " of the training spread (sd) of " +
+         (gp.transform.outputs[k] == ColumnTransform::kLog ? "ln(" + column + ")" : column) +
+         " (< " + FormatSignificant(o.equivalence_sd, 2) + "), and refitted on " +
+         std::to_string(folds) + " folds its RMSE " + FormatSignificant(rmse_gp, 3) + " " + unit +
+         " does not beat " + linear + "'s " + FormatSignificant(rmse_lin, 3) + " " + unit +
+         " by more than one standard error: not enough to trust its held-out error in the table, "
+         "whose hyperparameters were fitted on every row";
+}
+
+// ChoiceOptions::equivalence_sd for output k: the reason to set the chosen candidate c aside for
+// the linear candidates' choice `lin` (empty: keep c). The refits need every training split to
+// hold at least kLinearCoefficients + 2 rows (FitLinear); below that the choice stays.
+std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
+                        const std::vector<FamilyModel>& full, int c, int lin, int k) {
+  NearLinearGp n;
+  if (!IsNearLinearGp(table, o, full, c, k, &n)) return "";
+  const int rows = static_cast<int>(table.inputs.size());
+  const int folds = std::min(o.folds, rows);
+  if (rows - (rows + folds - 1) / folds < kLinearCoefficients + 2) return "";
   FitOptions fo = o.fit;
   fo.threads = 1;
-  const int folds = std::min(o.folds, rows);
   const Eigen::VectorXd e_lin = RefitSquaredErrors(full[lin], table, fo, folds, k);
   const Eigen::VectorXd e_gp = RefitSquaredErrors(full[c], table, fo, folds, k);
   if (SimplestWithinOneStandardError({e_lin, e_gp}) == 1) return "";
-  const std::string column = kTargetColumns[k];
-  return column + ": " + gp.Name() + " set aside for " +
-         o.candidates[lin].Name() + ": at " + std::to_string(rows) + " rows (fewer than " +
-         std::to_string(ChoiceOptions::kRowsPerHyperparameter) +
-         " per GP hyperparameter) it spends " + FormatSignificant(df, 3) +
-         " degrees of freedom (the linear fit " + std::to_string(linear_df) +
-         ") on a fit within " + FormatSignificant(diff, 2) + " sd of " +
-         (full[c].transform.outputs[k] == ColumnTransform::kLog ? "ln(" + column + ")" : column) +
-         " from " + o.candidates[same].Name() + "'s (< " +
-         FormatSignificant(o.equivalence_sd, 2) + "), and refitted on " + std::to_string(folds) +
-         " folds its RMSE " + FormatSignificant(std::sqrt(e_gp.mean()), 3) +
-         " does not beat " + o.candidates[lin].Name() + "'s " +
-         FormatSignificant(std::sqrt(e_lin.mean()), 3) +
-         " by more than one standard error (its leave-one-out error, with hyperparameters " +
-         "fitted on every row, was optimistic)";
+  return SetAsideNote(o, full[c], lin, k, rows, n, folds, std::sqrt(e_gp.mean()),
+                      std::sqrt(e_lin.mean()));
 }
 
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the

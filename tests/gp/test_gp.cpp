@@ -123,9 +123,9 @@ TEST(GpLeaveOneOut, EqualsRefitsWithoutEachRow) {
     }
 }
 
-// df = sum_i d u_hat_i / d u_i (u_hat = u - sigma_n^2 alpha, the fitted means at the training
-// rows, hyperparameters fixed), by central differences; and it lies between the mean's
-// coefficient count and the row count.
+// df = sum_i d u_hat_i / d u_i (u_hat: PredictGp's means at the training rows, standardized,
+// hyperparameters fixed), by central differences; and it lies between the mean's coefficient
+// count and the row count.
 TEST(GpDegreesOfFreedom, EqualTheTraceOfTheSmootherByFiniteDifferences) {
   const Data data = MakeData(3, 14, 0.2, 5);
   for (Kernel k : kKernels)
@@ -134,11 +134,11 @@ TEST(GpDegreesOfFreedom, EqualTheTraceOfTheSmootherByFiniteDifferences) {
       o.kernel = k;
       o.mean = m;
       const Gp gp = FitGp(data.x, data.y, o);
-      auto fitted = [&](const Eigen::VectorXd& u, int i) {
+      auto fitted = [&](const Eigen::VectorXd& u, int i) {  // standardized fitted mean at row i
         Gp g = gp;
         g.u = u;
         g.Factorize();
-        return u(i) - g.SigmaN2() * g.alpha(i);
+        return (PredictGp(g, data.x.col(i)).mean(0) - g.target_shift) / g.target_scale;
       };
       double trace = 0;
       const double h = 1e-5;
