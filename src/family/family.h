@@ -206,22 +206,22 @@ struct ChoiceOptions {
   /// degrees of freedom than the linear fit (gp::EffectiveDegreesOfFreedom above 1 + inputs: not
   /// a shrunk linear fit but a bent one) on a fit that differs from the linear candidate's on the
   /// same columns by less than equivalence_sd sd of the output (FitDifferenceInSd, both fitted on
-  /// all rows), the GP must earn its place
-  /// honestly: refitted on `folds` folds (hyperparameters refitted per fold from the fixed
-  /// starting points of gp::GpOptions, so none has seen the held-out rows), its held-out
-  /// squared errors must beat those of the linear candidates' own choice (the one-standard-error
-  /// rule among them) by more than one standard error (SimplestWithinOneStandardError); else
-  /// output k takes that linear candidate and Choice::notes says why. 0 disables the rule.
+  /// all rows), the GP must earn its place honestly: refitted on `folds` folds (hyperparameters
+  /// refitted per fold from the fixed starting points of gp::GpOptions, so none has seen the
+  /// held-out rows), its held-out squared errors must beat those of the linear candidates' own
+  /// choice (the one-standard-error rule among them) by more than one standard error
+  /// (SimplestWithinOneStandardError); else output k takes that linear candidate and
+  /// Choice::notes says why. The refits need 8 rows in every training split (smaller tables keep
+  /// their choice). 0 disables the rule.
   /// Why: at 20 rows the closed-form leave-one-out error of a GP is exact only for
   /// hyperparameters that were fitted with the held-out row (Cawley & Talbot, "On over-fitting in
   /// model selection and subsequent selection bias in performance evaluation", JMLR 11, 2010):
   /// on generated 20-row simulator tables it chose GPs that were power laws with a small bend and
   /// lost to the power law on new rows. Only near-linear GPs are checked, because refits of 16
-  /// rows also penalize a GP that is right about a strong nonlinearity (on Friedman's tables every
-  /// chosen GP lies 0.18 sd or more from the linear fit), and the checks cost refits. Rows per
-  /// parameter: the rule of thumb of 10 (Harrell, "Regression Modeling Strategies", 2nd ed.,
-  /// section 4.4). Measured with scripts/bench_peers.sh (docs/workpiece-model.md, "Practical
-  /// equivalence at few rows").
+  /// rows also penalize a GP that is right about a strong nonlinearity, and the checks cost
+  /// refits. Rows per parameter: the rule of thumb of 10 (Harrell, "Regression Modeling
+  /// Strategies", 2nd ed., section 4.4). Measured with scripts/bench_peers.sh and
+  /// tests/family/bend_probe.cpp (docs/workpiece-model.md, "Practical equivalence at few rows").
   double equivalence_sd = 0.1;
   static constexpr int kRowsPerHyperparameter = 10;
   FitOptions fit;

@@ -355,7 +355,9 @@ TEST(FamilyEquivalence, SmallTablesTrainAsWithoutTheRule) {
       }
       ++fitted;
       const Choice b = ChooseFamily(t, on);
-      if (rows < 10) EXPECT_EQ(a.Describe(), b.Describe()) << rows << " rows, seed " << seed;
+      if (rows < 10) {
+        EXPECT_EQ(a.Describe(), b.Describe()) << rows << " rows, seed " << seed;
+      }
     }
   EXPECT_GT(fitted, 5);
 }
