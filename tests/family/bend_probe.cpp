@@ -1,11 +1,11 @@
 // Development driver (not installed, not a test): the practical-equivalence rule of
 // family::ChoiceOptions::equivalence_sd on power laws with a real bend, where the GP is right.
 // Tables: max elongation = a power law of the five inputs times exp(bend ln^2(raceway radius / 6))
-// times exp(noise N(0, 1)) (tests/support/power_law_table.h), 20 training rows, 30 seeds per
-// (noise, bend); each prediction is scored against the noise-free truth of 400 new rows, as the
-// RMSE of ln(prediction / truth) (a relative error). Prints, per (noise, bend), the mean of that
-// error over the seeds for the default choice, the choice without the rule (equivalence_sd = 0)
-// and the power law alone, and on how many tables the rule set the GP aside.
+// times exp(noise N(0, 1)) (MakeBentTable, tests/support/power_law_table.h), 20 training rows,
+// 30 seeds per (noise, bend); each prediction is scored against the noise-free truth of 400 new
+// rows, as the RMSE of ln(prediction / truth) (a relative error). Prints, per (noise, bend), the
+// mean of that error over the seeds for the default choice, the choice without the rule
+// (equivalence_sd = 0) and the power law alone, and on how many tables the rule set the GP aside.
 //   bend_probe        (no arguments; about 2 s)
 #include <cmath>
 #include <cstdio>
@@ -17,13 +17,6 @@ namespace {
 
 using namespace whirl;
 using namespace whirl::family;
-
-ProcessTable Bent(ProcessTable t, double bend) {
-  for (std::size_t q = 0; q < t.targets.size(); ++q)
-    t.targets[q].max_elongation_um *=
-        std::exp(bend * std::pow(std::log(t.inputs[q].raceway_radius_mm / 6), 2));
-  return t;
-}
 
 // RMSE of ln(prediction / truth) of max elongation over `test`.
 double RelativeRmse(const Choice& c, const ProcessTable& test) {
@@ -46,8 +39,8 @@ int main() {
       double e_on = 0, e_off = 0, e_pl = 0;
       int fired = 0;
       for (unsigned seed = 1; seed <= 30; ++seed) {
-        const ProcessTable train = Bent(test::MakeTable(20, noise, seed), bend);
-        const ProcessTable truth = Bent(test::MakeTable(400, 0.0, seed + 1000), bend);
+        const ProcessTable train = test::MakeBentTable(20, noise, bend, seed);
+        const ProcessTable truth = test::MakeBentTable(400, 0.0, bend, seed + 1000);
         const Choice c = ChooseFamily(train, on);
         fired += !c.notes[0].empty();
         e_on += RelativeRmse(c, truth) / 30;

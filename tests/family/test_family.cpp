@@ -262,14 +262,8 @@ TEST(FamilyEquivalence, FitDifferenceOnAHandComputedCase) {
   EXPECT_EQ(FittedHyperparameters(ParseCandidate("linear/log")), 0);
 }
 
-// A power law (times exp(bend ln^2(raceway radius / 6)) for max elongation) with multiplicative
-// noise, 20 rows.
 ProcessTable BentTable(double noise, double bend, unsigned seed) {
-  ProcessTable t = MakeTable(20, noise, seed);
-  for (std::size_t q = 0; q < t.targets.size(); ++q)
-    t.targets[q].max_elongation_um *=
-        std::exp(bend * std::pow(std::log(t.inputs[q].raceway_radius_mm / 6), 2));
-  return t;
+  return test::MakeBentTable(20, noise, bend, seed);
 }
 
 // ChoiceOptions::equivalence_sd over many 20-row tables: a choice changes only from a GP whose fit

@@ -15,3 +15,7 @@ target_link_libraries(bend_probe PRIVATE whirl::family)
 target_include_directories(bend_probe PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 whirl_set_warnings(bend_probe)
 target_compile_options(bend_probe PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})
+# Smoke test: the probe runs and prints its 12 rows under the header.
+add_test(NAME bend_probe_runs
+         COMMAND sh -c "test \"$($<TARGET_FILE:bend_probe> | wc -l)\" -eq 13")
+set_tests_properties(bend_probe_runs PROPERTIES LABELS "family;cli")

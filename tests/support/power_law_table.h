@@ -33,4 +33,14 @@ inline ProcessTable MakeTable(int rows, double noise_sd, unsigned seed, bool cur
   return t;
 }
 
+// MakeTable's power law with max elongation times exp(bend ln^2(raceway radius / 6)): a real bend
+// in one input (the practical-equivalence tests and tests/family/bend_probe.cpp).
+inline ProcessTable MakeBentTable(int rows, double noise_sd, double bend, unsigned seed) {
+  ProcessTable t = MakeTable(rows, noise_sd, seed);
+  for (std::size_t q = 0; q < t.targets.size(); ++q)
+    t.targets[q].max_elongation_um *=
+        std::exp(bend * std::pow(std::log(t.inputs[q].raceway_radius_mm / 6), 2));
+  return t;
+}
+
 }  // namespace whirl::test
