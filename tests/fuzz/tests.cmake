@@ -21,7 +21,8 @@ foreach(module core sim nn gp family fit drift interp machine ballbar surface co
   endforeach()
 endforeach()
 add_library(whirl_fuzz_lib STATIC ${fuzz_lib_sources})
-target_include_directories(whirl_fuzz_lib PUBLIC ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR})
+target_include_directories(whirl_fuzz_lib PUBLIC ${PROJECT_SOURCE_DIR}/src/product
+                                                 ${PROJECT_SOURCE_DIR}/src/lab ${PROJECT_SOURCE_DIR})
 target_link_libraries(whirl_fuzz_lib PUBLIC Eigen3::Eigen nlohmann_json::nlohmann_json Boost::headers)
 target_compile_features(whirl_fuzz_lib PUBLIC cxx_std_17)
 target_compile_options(whirl_fuzz_lib PRIVATE -fsanitize=fuzzer-no-link ${WHIRL_FUZZ_FLAGS})
