@@ -60,6 +60,7 @@
 #include <vector>
 
 #include "drift/model.h"
+#include "interp/control_requirements.h"
 #include "interp/sinumerik.h"
 
 namespace whirl::interp {
@@ -179,6 +180,16 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
 /// sum |c_f| max(|min_f|, |max_f|)), mm/mm. The plan's slopes plus this must stay within MD32760
 /// (machine_eval/machine_nc.h checks it for the combined programs).
 double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options);
+
+/// What the control must provide for the drift program (control_requirements.h), the same
+/// thresholds its header states: MD10300 >= the largest $A_INA index read, MD28254 >= the last
+/// $AC_PARAM slot + 1, MD28250 room for its static actions, MD32750 bit 0 (and bit 1 with a
+/// slope model that owns SD43910/SD43920) on the axis and, with a slope model, MD32760 >= its
+/// slope bound (DriftSlopeBound); each with the profile's value when options.control states it.
+/// InputError as FormatDriftNcProgram for a model it cannot write.
+std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& model,
+                                                  const DriftActionOptions& options,
+                                                  const drift::DriftModel* slope = nullptr);
 
 inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)
 inline constexpr int kDecimalsDriftSlopeCoefficient = 14;  ///< mm/mm per K: 1e-14 per K

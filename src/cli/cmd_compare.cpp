@@ -11,7 +11,7 @@
 #include "core/output_dir.h"
 #include "core/process.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -39,10 +39,10 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
                 {"--iso-table", o.iso_table}},
                {}, {{"--out-dir", o.report_dir}});
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
-  const sim::Screw screw = sim::ReadScrew(o.screw_path);
+  const screw::Screw screw = screw::ReadScrew(o.screw_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
-  const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
+  const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(o.iso_table);
   compare::CompareOptions co;
   co.seed = o.seed;
   co.disturbances_on = !o.no_disturbances;

@@ -10,7 +10,8 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/compare.h"
-#include "compare/plan_document.h"
+#include "plan/load.h"
+#include "plan/plan_document.h"
 #include "compare/report.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -18,7 +19,7 @@
 #include "interp/machine_profile.h"
 #include "machine_eval/machine_eval.h"  // step 7
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -47,9 +48,9 @@ nlohmann::json RunDemoMachineStep(const std::filesystem::path& out,
   // The combined 840D programs of the report's screw, for the simulated machine's profile.
   mo.profile = interp::LoadMachineProfile(ProjectPath("datasets/machines/whirling_840d.json"));
   const machine_eval::MachineEvaluation e = machine_eval::EvaluateWithMachines(
-      sim::ReferenceScrew(), model,
+      screw::ReferenceScrew(), model,
       compare::BuildExperienceRule(ReadProcessTable(ProjectPath(kHistoryTable), true)),
-      compare::ReadIsoToleranceTable(
+      lead::ReadIsoToleranceTable(
           ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv")),
       mo);
   std::fprintf(
@@ -119,8 +120,8 @@ void RunDemo(const DemoOptions& o) {
   }
 
   const std::string ref_path = ProjectPath("datasets/screws/reference_80x10x6000.json");
-  const sim::Screw reference = sim::ReadScrew(ref_path);  // a missing shipped file is an error
-  const sim::Screw new_type = compare::NewTypeScrew(reference);
+  const screw::Screw reference = screw::ReadScrew(ref_path);  // a missing shipped file is an error
+  const screw::Screw new_type = compare::NewTypeScrew(reference);
   const auto& n = new_type.process;
   std::fprintf(say,
                "2. screws: %s (shipped), and %s defined in code: reference blank with hardness "
@@ -130,7 +131,7 @@ void RunDemo(const DemoOptions& o) {
                n.pitch_mm, n.raceway_radius_mm, n.cutting_speed_m_min);
 
   const compare::ExperienceRule rule = compare::BuildExperienceRule(history);
-  const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(
+  const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(
       ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv"));
   compare::CompareOptions co;
   co.seed = o.seed;
@@ -139,10 +140,10 @@ void RunDemo(const DemoOptions& o) {
       interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile));
   profile.ApplyTo(co.plan);
   std::vector<compare::ScrewComparison> results;
-  std::vector<compare::ControlLoad> control;  // the report's "load onto the control" box
+  std::vector<plan::ControlLoad> control;  // the report's "load onto the control" box
   // The NC files' stems are their program names on the control (letters, digits, '_', at most
   // 24 characters: interp::CheckProgramName), so they cannot carry the screw's name.
-  const std::pair<const sim::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
+  const std::pair<const screw::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
                                                               {&new_type, "WHIRL_NEW_TYPE"}};
   for (const auto& [screw, program] : screws) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
@@ -157,17 +158,16 @@ void RunDemo(const DemoOptions& o) {
                  c.predicted_curve.shape_k, c.predicted_curve.time_exponent);
     const std::string provenance = "whirl demo, model " + model_source;
     const nlohmann::json plan_json =
-        compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
+        plan::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
                               {model_source, c.prediction, c.prediction.mean}, provenance);
     const std::vector<std::string> names = {slug + "_plan.json", slug + "_plan.csv",
                                             program + ".SPF", program + "_RESET.SPF"};
-    compare::WritePlanFiles(
+    plan::WritePlanFiles(
         {stage / names[0], stage / names[1], stage / names[2], stage / names[3]}, plan_json, c.plan,
         provenance, "whirl demo: model " + model_source + ", screw " + screw->name);
     for (const auto& name : names) files.AddStaged(name);
     // The report lives in report/, the files one level up.
-    control.push_back(compare::PlanFilesLoad("../", program, names[1], names[0],
-                                             ReadTextFile(stage / names[2]), &profile));
+    control.push_back(plan::PlanFilesLoad("../", program, names[1], names[0], c.plan, &profile));
     summary["screws"].push_back(DemoScrewJson(c, out, names));
     std::fprintf(say,
                  "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "

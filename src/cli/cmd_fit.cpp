@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "fit/curve_fit.h"
-#include "sim/features.h"
+#include "fit/features.h"
 
 namespace whirl::cli {
 namespace {
@@ -45,7 +45,7 @@ nlohmann::json FitJson(const fit::CurveFit& f) {
 
 void RunCurve(const FitOptions& o) {
   const ElongationCurve record = ReadElongationCurve(o.curve_path, o.max_gap_factor);
-  const sim::SettleAnalysis settle = sim::AnalyzeSettle(record);
+  const fit::SettleAnalysis settle = fit::AnalyzeSettle(record);
   // The models describe the rise and the plateau it settles on; a long record's slow drift
   // (ambient, sensor) is not part of them, so they are fitted on [0, factor * t_s].
   ElongationCurve curve;
@@ -94,7 +94,7 @@ void RunCurve(const FitOptions& o) {
   std::printf("curve %s: %zu samples, %.6g to %.6g s; models fitted on %.6g to %.6g s\n",
               o.curve_path.c_str(), record.size(), record.time_s.front(), record.time_s.back(),
               curve.time_s.front(), curve.time_s.back());
-  std::printf("features: max elongation %.4f um, settle time %.2f s (sim::AnalyzeSettle)\n",
+  std::printf("features: max elongation %.4f um, settle time %.2f s (fit::AnalyzeSettle)\n",
               settle.features.max_elongation_um, settle.features.settle_time_s);
   std::printf(
       "arctan shape with these features fixed: k = %.4f, p = %.4f (R^2 %.6f, RMS %.4f um)\n",
@@ -191,7 +191,7 @@ void RegisterFit(CLI::App& app) {
       "Fit elongation-curve models to a measured or simulated curve and report its features.\n"
       "  --curve C.csv   columns time_s [s], elongation_um [um] ('#' comments allowed; gaps and\n"
       "                  non-increasing time are errors). Reports the features (max elongation\n"
-      "                  [um], settle time [s]; sim::AnalyzeSettle criterion), the arctan shape\n"
+      "                  [um], settle time [s]; fit::AnalyzeSettle criterion), the arctan shape\n"
       "                  (k, p) with those features fixed, and three models with all parameters\n"
       "                  free:\n"
       "                    arctan   l = L atan(k (t/t_s)^p)/atan(k) up to t_s, L after\n"

@@ -24,7 +24,7 @@
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/seeds.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -121,8 +121,8 @@ void RunSensors(const MachineCliOptions& o) {
 }
 
 // --seeds N > 1: the evaluation over seeds S..S+N-1 (machine_eval/seeds.h).
-void RunOverSeeds(const MachineCliOptions& o, const sim::Screw& base, const workpiece::WorkpieceModel& model,
-                  const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
+void RunOverSeeds(const MachineCliOptions& o, const screw::Screw& base, const workpiece::WorkpieceModel& model,
+                  const compare::ExperienceRule& rule, const lead::IsoToleranceTable& iso,
                   const machine_eval::MachineEvalOptions& eo) {
   Progress progress("machine evaluate",
                     static_cast<std::size_t>(o.seeds * o.machines * o.screws));
@@ -141,8 +141,8 @@ void RunOverSeeds(const MachineCliOptions& o, const sim::Screw& base, const work
 
 // Field scenarios (and legacy beside them): one table over seeds (machine_eval/field_eval.h).
 void RunScenarios(const MachineCliOptions& o, const std::vector<machine::MachineScenario>& scenarios,
-                  const sim::Screw& base, const workpiece::WorkpieceModel& model,
-                  const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
+                  const screw::Screw& base, const workpiece::WorkpieceModel& model,
+                  const compare::ExperienceRule& rule, const lead::IsoToleranceTable& iso,
                   const machine_eval::MachineEvalOptions& eo) {
   Progress progress("machine evaluate", scenarios.size() * 1000);
   std::vector<machine_eval::SeedsEvaluation> all = machine_eval::EvaluateMachineScenarios(
@@ -175,9 +175,9 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
-  const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
-  const sim::Screw base =
-      std::filesystem::exists(o.base_screw) ? sim::ReadScrew(o.base_screw) : sim::ReferenceScrew();
+  const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(o.iso_table);
+  const screw::Screw base =
+      std::filesystem::exists(o.base_screw) ? screw::ReadScrew(o.base_screw) : screw::ReferenceScrew();
   machine_eval::MachineEvalOptions eo;
   eo.machine = LoadMachine(o);
   eo.machines = o.machines;

@@ -2,12 +2,12 @@
 // other exception, crash, hang, leak or sanitizer report is a bug (tests/fuzz/README.md).
 #include "core/error.h"
 #include "fuzz_file.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::filesystem::path path = whirl::fuzz::FuzzFile(data, size, ".json");
   try {
-    (void)whirl::sim::ReadScrew(path);
+    (void)whirl::screw::ReadScrew(path);
   } catch (const whirl::InputError&) {
   }
   return 0;

@@ -14,7 +14,7 @@
 #include "drift/model.h"
 #include "interp/nc_replay.h"
 #include "machine_eval/machine_nc.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::machine_eval {
 namespace {
@@ -54,9 +54,9 @@ void ReplayOneCut(int direction, interp::ControlDk control_dk) {
   const std::uint64_t machine_seed = 5;
   const MachineModels models = FitMachineModels(config, machine_seed, 2, drift::FitOptions{});
   const machine::MachineDay day = machine::MachineDay::Draw(config, machine_seed, 991);
-  sim::Screw screw = sim::ReferenceScrew();
+  screw::Screw screw = screw::ReferenceScrew();
   screw.thread_length_mm = 1500;  // 37 min of cutting keeps the test short
-  const sim::Kinematics kin = sim::ComputeKinematics(screw);
+  const screw::Kinematics kin = screw::ComputeKinematics(screw);
   const double feed = kin.axial_feed_mm_s, t_cut = kin.cutting_time_s;
   const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({14.0, 900.0}, 4.0, 0.9);
   const interp::MachineProfile profile = Profile(direction, control_dk);
@@ -143,8 +143,8 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusMachineLineEverySecondOfTheCut) {
 TEST(CombinedPrograms, ProfileThatDisagreesWithTheMachineIsRefused) {
   const machine::MachineConfig config = machine::DefaultMachine();
   const MachineModels models = FitMachineModels(config, 2, 1, drift::FitOptions{});
-  const sim::Screw screw = sim::ReferenceScrew();
-  const sim::Kinematics kin = sim::ComputeKinematics(screw);
+  const screw::Screw screw = screw::ReferenceScrew();
+  const screw::Kinematics kin = screw::ComputeKinematics(screw);
   const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({14.0, 900.0}, 4.0, 0.9);
   interp::MachineProfile profile = interp::LoadMachineProfile(ProfilePath());
   auto build = [&] {

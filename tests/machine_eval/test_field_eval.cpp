@@ -513,8 +513,8 @@ TEST(LeadSlope, RecoversAPlantedSlopeAndCancelsIt) {
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(root + "models/default.json");
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(root + "datasets/whirling_500.csv", true));
-  const compare::IsoToleranceTable iso =
-      compare::ReadIsoToleranceTable(root + "datasets/standards/iso3408_3_lead_tolerances.csv");
+  const lead::IsoToleranceTable iso =
+      lead::ReadIsoToleranceTable(root + "datasets/standards/iso3408_3_lead_tolerances.csv");
   const MachineEvaluation e = EvaluateFieldScenario(s, model, rule, iso, o);
   const auto lead = static_cast<std::size_t>(MachineStrategy::kLeadSlope);
   const auto wp = static_cast<std::size_t>(MachineStrategy::kWorkpiece);

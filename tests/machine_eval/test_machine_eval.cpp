@@ -16,7 +16,7 @@
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/machine_report.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 #include "support/scratch_dir.h"
 
 namespace whirl::machine_eval {
@@ -27,7 +27,7 @@ struct Fixture {
       workpiece::LoadWorkpieceModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
   compare::ExperienceRule rule = compare::BuildExperienceRule(
       ReadProcessTable(std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_500.csv", true));
-  compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(
+  lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(
       std::string(WHIRL_SOURCE_DIR) + "/datasets/standards/iso3408_3_lead_tolerances.csv");
 };
 
@@ -37,12 +37,12 @@ TEST(MachineEvaluation, EveryComponentOffEqualsTheWorkpieceOnlyComparisonExactly
   off.DisableAll();
   const machine::MachineDay day = machine::MachineDay::Draw(off, 2, 3);
   const MachineModels none;  // nothing fitted when the machine does not drift
-  const sim::Screw screw = compare::RandomFeasibleScrews(sim::ReferenceScrew(), 1, 5).front();
+  const screw::Screw screw = compare::RandomFeasibleScrews(screw::ReferenceScrew(), 1, 5).front();
   compare::CompareOptions co;
   co.seed = 9;
   const MachineEvalScrew m = EvaluateScrewOnMachine(screw, f.model, f.rule, f.iso, day, none, co);
   const compare::ScrewComparison c = compare::CompareScrew(screw, f.model, f.rule, f.iso, co);
-  auto same = [](const compare::LeadMetrics& a, const compare::LeadMetrics& b) {
+  auto same = [](const lead::LeadMetrics& a, const lead::LeadMetrics& b) {
     EXPECT_EQ(a.accumulated_1000_um, b.accumulated_1000_um);
     EXPECT_EQ(a.accumulated_total_um, b.accumulated_total_um);
     EXPECT_EQ(a.e_a_um, b.e_a_um);

@@ -32,7 +32,7 @@ TEST(ReportStyle, EveryStrategyHasItsOwnEntryInTheStyleTable) {
 TEST(MachineReport, SensorPanelsHoldAtMostEightLinesAndLeadEndsAtTheThread) {
   MachineEvalScrew r;
   r.ok = true;
-  r.screw = sim::ReferenceScrew();
+  r.screw = screw::ReferenceScrew();
   MachineScrewDetail d;
   const machine::MachineConfig c = machine::DefaultMachine();
   d.log = machine::SimulateRun(machine::MachineDay::Draw(c, 1, 1),

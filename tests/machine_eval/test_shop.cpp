@@ -16,7 +16,7 @@
 #include "machine_eval/strategies.h"
 #include "machine_eval/trained_numbers.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::machine_eval {
 namespace {
@@ -215,10 +215,10 @@ TEST(LegacyWorld, ReproducesTheTableOfThePreviousProgram) {
       workpiece::LoadWorkpieceModel(Source("models/default.json"));
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(Source("datasets/whirling_500.csv"), true));
-  const compare::IsoToleranceTable iso =
-      compare::ReadIsoToleranceTable(Source("datasets/standards/iso3408_3_lead_tolerances.csv"));
+  const lead::IsoToleranceTable iso =
+      lead::ReadIsoToleranceTable(Source("datasets/standards/iso3408_3_lead_tolerances.csv"));
   const MachineEvaluation e = EvaluateWithMachines(
-      sim::ReadScrew(Source("datasets/screws/reference_80x10x6000.json")), model, rule, iso, o);
+      screw::ReadScrew(Source("datasets/screws/reference_80x10x6000.json")), model, rule, iso, o);
   nlohmann::json now = e;
   ASSERT_EQ(ref["screws"].size(), now["screws"].size());
   const std::vector<std::pair<std::string, std::string>> rows = {

@@ -15,10 +15,11 @@
 # layer:
 PRODUCT_LAYERS=(
   "core"                       # errors, CSV, JSON, numbers, atomic files, curves, parallel-for
-  "nn gp fit"                  # the network, Gaussian processes, curve fits (core only)
+  "screw lead nn gp fit"       # the screw, lead metrics, the network, Gaussian processes, curve
+                               # fits and features (core only)
   "family drift"               # model families (gp, nn), drift (nn)
   "interp workpiece"           # 840D output (drift, fit), the workpiece model (family, nn)
-  "ballbar surface"            # ball bar (interp), worktable (drift, interp)
+  "plan ballbar surface"       # plan files (interp, screw), ball bar (interp), worktable (drift, interp)
 )
 LAB_LAYERS=(
   "sim torch"                  # the simulator, the LibTorch cross-check (nn)

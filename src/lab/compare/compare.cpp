@@ -5,7 +5,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "sim/dataset.h"
-#include "sim/features.h"
+#include "fit/features.h"
 
 namespace whirl::compare {
 
@@ -45,7 +45,7 @@ nlohmann::json Optional(const std::optional<double>& v) {
 
 }  // namespace
 
-MetricReductions Reductions(const LeadMetrics& s, const LeadMetrics& b) {
+MetricReductions Reductions(const lead::LeadMetrics& s, const lead::LeadMetrics& b) {
   MetricReductions r;
   r.e_a_pct = Reduce(s.e_a_um, b.e_a_um);
   r.v_u_pct = Reduce(s.v_u_um, b.v_u_um);
@@ -76,15 +76,15 @@ std::string ScrewComparison::BriefReport() const {
   return s;
 }
 
-sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
+screw::Screw ScrewWithInputs(const screw::Screw& base, const ProcessInputs& inputs,
                            const std::string& name) {
-  sim::Screw s = base;
+  screw::Screw s = base;
   s.process = inputs;
   s.name = name;
   return s;
 }
 
-sim::Screw NewTypeScrew(const sim::Screw& reference) {
+screw::Screw NewTypeScrew(const screw::Screw& reference) {
   ProcessInputs in;
   in.hardness_hrc = 61.0;
   in.diameter_mm = 63.0;
@@ -98,7 +98,7 @@ namespace {
 
 // The truth of the comparison: the whole thread simulated with the comparison's disturbances (its
 // noise-free curve), and the features as the training table measures them.
-void SimulateTruth(const sim::Screw& screw, const CompareOptions& options, ScrewComparison* c) {
+void SimulateTruth(const screw::Screw& screw, const CompareOptions& options, ScrewComparison* c) {
   sim::SimOptions sim_options = options.sim;
   sim_options.duration_s = 0.0;
   sim::DisturbanceOptions disturbance = options.disturbance;
@@ -119,14 +119,14 @@ void SimulateTruth(const sim::Screw& screw, const CompareOptions& options, Screw
     recorded.elongation_um.push_back(sim.curve.elongation_um[i]);
   }
   c->truth_features = recorded.size() >= 10 && sim.curve.time_s.back() >= window_s
-                          ? sim::ExtractFeatures(recorded, sim_options.settle)
+                          ? fit::ExtractFeatures(recorded, sim_options.settle)
                           : sim.features;
 }
 
 // The 840D plan of a baseline's features with the model's curve shape (none without a positive
 // plateau and settle time); `what` names the baseline in errors.
 interp::CompensationPlan BaselinePlan(const Features& f, const std::string& what,
-                                      const sim::Screw& screw, double feed_mm_s,
+                                      const screw::Screw& screw, double feed_mm_s,
                                       const CompareOptions& options) {
   if (!(f.max_elongation_um > 0) || !(f.settle_time_s > 0)) return interp::CompensationPlan{};
   const fit::ArctanCurve curve =
@@ -147,10 +147,10 @@ CompensationFunction PlannedCompensation(const interp::CompensationPlan& plan, d
 // Cuts the truth with each strategy's compensation: compensation over time, lead deviation,
 // metrics and ISO class per strategy.
 void CutWithEveryStrategy(const std::array<CompensationFunction, kStrategyCount>& comp,
-                          const sim::Screw& screw, const IsoToleranceTable& iso_table,
+                          const screw::Screw& screw, const lead::IsoToleranceTable& iso_table,
                           const CompareOptions& options, ScrewComparison* c) {
   const double feed = c->kinematics.axial_feed_mm_s;
-  LeadMetricOptions metric_options = options.metrics;
+  lead::LeadMetricOptions metric_options = options.metrics;
   metric_options.lead_mm = screw.process.pitch_mm;
   for (std::size_t k = 0; k < kStrategyCount; ++k) {
     for (double t : c->truth.time_s) c->compensation_um[k].push_back(comp[k](t));
@@ -158,8 +158,8 @@ void CutWithEveryStrategy(const std::array<CompensationFunction, kStrategyCount>
     o.strategy = kStrategies[k];
     o.lead = CutLeadDeviation(c->truth, comp[k], feed, screw.thread_length_mm,
                               screw.process.pitch_mm, options.cut);
-    o.metrics = ComputeLeadMetrics(o.lead, metric_options);
-    o.iso = EvaluateIsoClass(o.metrics, iso_table);
+    o.metrics = lead::ComputeLeadMetrics(o.lead, metric_options);
+    o.iso = lead::EvaluateIsoClass(o.metrics, iso_table);
   }
   auto vs = [c](Strategy a, Strategy b) {
     return Reductions(c->Outcome(a).metrics, c->Outcome(b).metrics);
@@ -173,12 +173,12 @@ void CutWithEveryStrategy(const std::array<CompensationFunction, kStrategyCount>
 
 }  // namespace
 
-ScrewComparison CompareScrew(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
-                             const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
+                             const ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
                              const CompareOptions& options) {
   ScrewComparison c;
   c.screw = screw;
-  c.kinematics = sim::ComputeKinematics(screw);  // validates; InputError if infeasible
+  c.kinematics = screw::ComputeKinematics(screw);  // validates; InputError if infeasible
   c.seed = options.seed;
   c.disturbances_on = options.disturbances_on;
   SimulateTruth(screw, options, &c);

@@ -29,13 +29,13 @@
 #include <vector>
 
 #include "compare/cut.h"
-#include "compare/iso3408.h"
-#include "compare/metrics.h"
+#include "lead/iso3408.h"
+#include "lead/metrics.h"
 #include "compare/traditional.h"
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 #include "sim/simulator.h"
 
 namespace whirl::compare {
@@ -71,15 +71,15 @@ struct CompareOptions {
   double shape_k = fit::kDefaultShapeK;
   double time_exponent = fit::kDefaultTimeExponent;
   /// Metric options; lead_mm is set to the screw's lead.
-  LeadMetricOptions metrics;
+  lead::LeadMetricOptions metrics;
   CutOptions cut;
 };
 
 struct StrategyOutcome {
   Strategy strategy = Strategy::kNone;
-  LeadDeviation lead;  ///< travel deviation along the thread, um (sign: compare/lead.h)
-  LeadMetrics metrics;
-  IsoVerdict iso;
+  lead::LeadDeviation lead;  ///< travel deviation along the thread, um (sign: compare/lead.h)
+  lead::LeadMetrics metrics;
+  lead::IsoVerdict iso;
 };
 
 /// Reduction of each metric by one strategy against a baseline, percent:
@@ -89,11 +89,11 @@ struct MetricReductions {
   std::optional<double> e_a_pct, v_u_pct, v_300_pct, v_2pi_pct, accumulated_1000_pct,
       accumulated_total_pct;
 };
-MetricReductions Reductions(const LeadMetrics& strategy, const LeadMetrics& baseline);
+MetricReductions Reductions(const lead::LeadMetrics& strategy, const lead::LeadMetrics& baseline);
 
 struct ScrewComparison {
-  sim::Screw screw;
-  sim::Kinematics kinematics;
+  screw::Screw screw;
+  screw::Kinematics kinematics;
   std::uint64_t seed = 0;
   bool disturbances_on = true;
   sim::AppliedDisturbances disturbances;
@@ -127,12 +127,12 @@ struct ScrewComparison {
 
 /// Runs the comparison for one screw. InputError for an infeasible screw, invalid options, or a
 /// plan the control cannot run (slope beyond MD32760).
-ScrewComparison CompareScrew(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
-                             const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
+                             const ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
                              const CompareOptions& options = {});
 
 /// A screw like `base` (length, thread length, machine settings) with other process inputs.
-sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
+screw::Screw ScrewWithInputs(const screw::Screw& base, const ProcessInputs& inputs,
                            const std::string& name);
 
 /// The demo's "new type" screw, outside the training rows (the paper's new workpiece type I):
@@ -140,7 +140,7 @@ sim::Screw ScrewWithInputs(const sim::Screw& base, const ProcessInputs& inputs,
 /// with new process inputs inside the training ranges but unlike any training row:
 /// hardness 61 HRC, diameter 63 mm, lead 12 mm, raceway radius 4.0 mm, cutting speed 200 m/min.
 /// Name "new-type_63x12x6000".
-sim::Screw NewTypeScrew(const sim::Screw& reference);
+screw::Screw NewTypeScrew(const screw::Screw& reference);
 
 void to_json(nlohmann::json& j, const MetricReductions& r);
 /// Summary JSON (schema "whirl.compare", version 1): screw, kinematics, disturbances, features

@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "core/stats.h"
 #include "sim/dataset.h"
-#include "sim/features.h"
+#include "fit/features.h"
 #include "sim/simulator.h"
 
 namespace whirl::compare {
@@ -50,7 +50,7 @@ SimulatedFitReport FitSimulatedCurves(
     report.features.push_back(r.features);
     // The shape is calibrated over the window the features were extracted from (a few settle
     // times, sim/features.h step 0): beyond it the simulated curve keeps creeping up slowly.
-    curves.push_back(Head(r.curve, sim::AnalyzeSettle(r.curve, so.settle).window_s));
+    curves.push_back(Head(r.curve, fit::AnalyzeSettle(r.curve, so.settle).window_s));
     fits.push_back(fit::FitAllModels(
         Head(r.curve, options.fit_window_factor * r.features.settle_time_s), options.fit));
     if (progress) progress(i + 1, report.inputs.size());

@@ -12,7 +12,7 @@ CompensationFunction NoCompensation() {
   return [](double) { return 0.0; };
 }
 
-LeadDeviation CutLeadDeviation(const ElongationCurve& truth,
+lead::LeadDeviation CutLeadDeviation(const ElongationCurve& truth,
                                const CompensationFunction& compensation_um, double axial_feed_mm_s,
                                double thread_length_mm, double lead_mm, const CutOptions& options) {
   auto positive = [](double value, const char* name) {
@@ -37,7 +37,7 @@ LeadDeviation CutLeadDeviation(const ElongationCurve& truth,
   const double step =
       options.sample_step_mm > 0 ? options.sample_step_mm : std::min(1.0, lead_mm / 10.0);
   const std::size_t intervals = static_cast<std::size_t>(std::ceil(thread_length_mm / step - 1e-9));
-  LeadDeviation lead;
+  lead::LeadDeviation lead;
   lead.position_mm.reserve(intervals + 1);
   lead.deviation_um.reserve(intervals + 1);
   auto residual = [&](double t_s) {

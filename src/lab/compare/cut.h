@@ -16,7 +16,7 @@
 // A constant c shifts nothing; only the change of e - c along the cut makes lead error.
 #include <functional>
 
-#include "compare/lead.h"
+#include "lead/lead.h"
 #include "core/curve.h"
 
 namespace whirl::compare {
@@ -34,7 +34,7 @@ struct CutOptions {
 /// e(t) is linearly interpolated in `truth` (held at its first value before its first sample).
 /// InputError: non-positive or non-finite feed, length, lead or step; a truth curve that stops
 /// before the cut ends (more than one of its own sample steps short of thread_length / feed).
-LeadDeviation CutLeadDeviation(const ElongationCurve& truth,
+lead::LeadDeviation CutLeadDeviation(const ElongationCurve& truth,
                                const CompensationFunction& compensation_um, double axial_feed_mm_s,
                                double thread_length_mm, double lead_mm,
                                const CutOptions& options = {});

@@ -11,7 +11,7 @@
 
 namespace whirl::compare {
 
-std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, std::uint64_t seed,
+std::vector<screw::Screw> RandomFeasibleScrews(const screw::Screw& base, int count, std::uint64_t seed,
                                              const InputRanges& ranges) {
   if (count < 0)
     throw InputError("random screw count = " + std::to_string(count) + ": must be >= 0");
@@ -21,7 +21,7 @@ std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, 
     if (!(hi[i] >= lo[i]))
       throw InputError(std::string("input range of ") + kInputColumns[i] + ": max " +
                        FormatNumber(hi[i]) + " < min " + FormatNumber(lo[i]));
-  std::vector<sim::Screw> screws;
+  std::vector<screw::Screw> screws;
   for (int k = 0; k < count; ++k) {
     for (int attempt = 0;; ++attempt) {
       if (attempt == 1000)
@@ -29,10 +29,10 @@ std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, 
       std::array<double, ProcessInputs::kCount> a{};
       for (int i = 0; i < ProcessInputs::kCount; ++i)
         a[i] = lo[i] + (hi[i] - lo[i]) * rng.Uniform();
-      sim::Screw s =
+      screw::Screw s =
           ScrewWithInputs(base, ProcessInputs::FromArray(a), "random-" + std::to_string(k + 1));
       try {
-        sim::ValidateScrew(s, s.name);
+        screw::ValidateScrew(s, s.name);
       } catch (const InputError&) {
         continue;
       }
@@ -43,14 +43,14 @@ std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, 
   return screws;
 }
 
-std::vector<sim::Screw> ScrewsFromTable(const sim::Screw& base, const ProcessTable& table,
+std::vector<screw::Screw> ScrewsFromTable(const screw::Screw& base, const ProcessTable& table,
                                         const std::string& prefix) {
-  std::vector<sim::Screw> screws;
+  std::vector<screw::Screw> screws;
   for (std::size_t r = 0; r < table.inputs.size(); ++r) {
-    sim::Screw s = ScrewWithInputs(base, table.inputs[r], prefix + "-" + std::to_string(r + 1));
+    screw::Screw s = ScrewWithInputs(base, table.inputs[r], prefix + "-" + std::to_string(r + 1));
     const std::string line =
         r < table.line_numbers.size() ? ":" + std::to_string(table.line_numbers[r]) : "";
-    sim::ValidateScrew(s, table.source + line);
+    screw::ValidateScrew(s, table.source + line);
     screws.push_back(s);
   }
   return screws;
@@ -68,8 +68,8 @@ ReductionStats Stats(std::vector<double> values) {
   return s;
 }
 
-Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const workpiece::WorkpieceModel& model,
-                          const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+Evaluation EvaluateScrews(const std::vector<screw::Screw>& screws, const workpiece::WorkpieceModel& model,
+                          const ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
                           const EvaluateOptions& options, const EvaluateProgress& progress) {
   if (options.threads < 1)
     throw InputError("threads = " + std::to_string(options.threads) + ": must be >= 1");
@@ -141,9 +141,9 @@ EvaluationSummary Summarize(const std::vector<EvaluatedScrew>& screws) {
     for (std::size_t k = 0; k < kStrategyCount; ++k) {
       acc[k].push_back(std::abs(r.metrics[k].accumulated_1000_um));
       total[k].push_back(std::abs(r.metrics[k].accumulated_total_um));
-      const IsoClass c = r.iso[k];
-      if (c == IsoClass::kP1 || c == IsoClass::kP3) ++p3[k];
-      if (c == IsoClass::kP1 || c == IsoClass::kP3 || c == IsoClass::kP5) ++p5[k];
+      const lead::IsoClass c = r.iso[k];
+      if (c == lead::IsoClass::kP1 || c == lead::IsoClass::kP3) ++p3[k];
+      if (c == lead::IsoClass::kP1 || c == lead::IsoClass::kP3 || c == lead::IsoClass::kP5) ++p5[k];
     }
   }
   s.acc1000_vs_traditional = Stats(acc_t);

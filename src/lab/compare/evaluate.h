@@ -24,12 +24,12 @@ struct InputRanges {
 /// drawn uniformly in `ranges` (core/random.h's Rng from `seed`, the same set on every platform);
 /// a draw that sim::ValidateScrew rejects (e.g. a raceway too wide for the lead) is drawn again.
 /// Names "random-<k>". InputError if 1000 draws in a row are infeasible.
-std::vector<sim::Screw> RandomFeasibleScrews(const sim::Screw& base, int count, std::uint64_t seed,
+std::vector<screw::Screw> RandomFeasibleScrews(const screw::Screw& base, int count, std::uint64_t seed,
                                              const InputRanges& ranges = {});
 
 /// Screws like `base` with the inputs of each row of a process table. Names "<prefix>-<row>"
 /// (1-based row). Rows that sim::ValidateScrew rejects are an InputError naming the file line.
-std::vector<sim::Screw> ScrewsFromTable(const sim::Screw& base, const ProcessTable& table,
+std::vector<screw::Screw> ScrewsFromTable(const screw::Screw& base, const ProcessTable& table,
                                         const std::string& prefix);
 
 struct EvaluateOptions {
@@ -40,15 +40,15 @@ struct EvaluateOptions {
 
 /// The figures kept per screw (the full comparison is not kept: it holds whole curves).
 struct EvaluatedScrew {
-  sim::Screw screw;
+  screw::Screw screw;
   std::uint64_t seed = 0;
   bool ok = false;
   std::string error;            ///< the InputError message when !ok (e.g. a slope beyond MD32760)
   bool outside_domain = false;  ///< the model extrapolated
-  std::array<LeadMetrics, kStrategyCount> metrics;  ///< kStrategies order
-  std::array<IsoClass, kStrategyCount> iso = [] {
-    std::array<IsoClass, kStrategyCount> a{};
-    a.fill(IsoClass::kNone);
+  std::array<lead::LeadMetrics, kStrategyCount> metrics;  ///< kStrategies order
+  std::array<lead::IsoClass, kStrategyCount> iso = [] {
+    std::array<lead::IsoClass, kStrategyCount> a{};
+    a.fill(lead::IsoClass::kNone);
     return a;
   }();
   MetricReductions model_vs_traditional, model_vs_none, model_vs_regression, model_vs_ramp;
@@ -88,8 +88,8 @@ using EvaluateProgress = std::function<void(std::size_t done, std::size_t total)
 /// for any thread count). A screw whose comparison throws InputError is recorded as failed; any
 /// other exception (in a comparison or in `progress`) stops the run and is rethrown here after all
 /// threads have joined (core/parallel.h), never std::terminate.
-Evaluation EvaluateScrews(const std::vector<sim::Screw>& screws, const workpiece::WorkpieceModel& model,
-                          const ExperienceRule& rule, const IsoToleranceTable& iso_table,
+Evaluation EvaluateScrews(const std::vector<screw::Screw>& screws, const workpiece::WorkpieceModel& model,
+                          const ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
                           const EvaluateOptions& options, const EvaluateProgress& progress = {});
 
 /// The summary of evaluated screws (those of one run, or pooled over several seeds).

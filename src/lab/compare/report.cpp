@@ -367,11 +367,11 @@ std::string ScrewSection(const ScrewComparison& c, const std::string& slug, cons
 
 // The box's entries: the caller's (files, prerequisites, ...) with each screw's name and plan, or,
 // without them, each plan's setting data and where the programs come from.
-std::vector<ControlLoad> ControlLoads(const std::vector<ScrewComparison>& comparisons,
-                                      const ReportOptions& options) {
-  std::vector<ControlLoad> loads;
+std::vector<plan::ControlLoad> ControlLoads(const std::vector<ScrewComparison>& comparisons,
+                                            const ReportOptions& options) {
+  std::vector<plan::ControlLoad> loads;
   for (std::size_t i = 0; i < comparisons.size(); ++i) {
-    ControlLoad load;
+    plan::ControlLoad load;
     if (i < options.control.size()) {
       load = options.control[i];
     } else {
@@ -383,7 +383,7 @@ std::vector<ControlLoad> ControlLoads(const std::vector<ScrewComparison>& compar
           "not from a machine profile): plan for your machine with 'whirl plan'.";
     }
     load.heading = comparisons[i].screw.name;
-    load.plan = &comparisons[i].plan;
+    load.plan = comparisons[i].plan;
     loads.push_back(std::move(load));
   }
   return loads;
@@ -410,7 +410,7 @@ std::string HowToRead() {
 // The page: title, provenance, the "load onto the control" box, notes, warnings, the screws'
 // sections, how to read it.
 std::string IndexHtml(const ReportOptions& options, const std::vector<std::string>& warnings,
-                      const std::vector<ControlLoad>& loads, const std::string& sections) {
+                      const std::vector<plan::ControlLoad>& loads, const std::string& sections) {
   std::ostringstream html;
   html << HtmlPageBegin(options.title, options.provenance) << ControlBoxHtml(loads);
   for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";

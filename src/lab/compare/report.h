@@ -47,7 +47,7 @@ struct ReportOptions {
   /// (links relative to `dir`), the prerequisites, the call order, what to run after an abort.
   /// Missing entries: the box shows the plan's setting data and says that `whirl plan` writes
   /// the programs.
-  std::vector<ControlLoad> control;
+  std::vector<plan::ControlLoad> control;
 };
 
 struct ReportResult {

@@ -72,10 +72,10 @@ bool OutsideTraining(const ProcessInputs& p, const InputRanges& t) {
 
 }  // namespace
 
-std::vector<sim::Screw> ScenarioScrews(const Scenario& scenario, const sim::Screw& base, int count,
+std::vector<screw::Screw> ScenarioScrews(const Scenario& scenario, const screw::Screw& base, int count,
                                        std::uint64_t seed, const InputRanges& training) {
   if (!scenario.out_of_range) return RandomFeasibleScrews(base, count, seed, scenario.ranges);
-  std::vector<sim::Screw> screws;
+  std::vector<screw::Screw> screws;
   const auto draws = RandomFeasibleScrews(base, 20 * count, seed, scenario.ranges);
   for (const auto& s : draws) {
     if (static_cast<int>(screws.size()) == count) break;
@@ -91,9 +91,9 @@ std::vector<sim::Screw> ScenarioScrews(const Scenario& scenario, const sim::Scre
 }
 
 std::vector<ScenarioResult> RunScenarios(const std::vector<Scenario>& scenarios,
-                                         const sim::Screw& base, const workpiece::WorkpieceModel& model,
+                                         const screw::Screw& base, const workpiece::WorkpieceModel& model,
                                          const ExperienceRule& rule,
-                                         const IsoToleranceTable& iso_table,
+                                         const lead::IsoToleranceTable& iso_table,
                                          const ScenarioOptions& options,
                                          const EvaluateProgress& progress) {
   if (options.seeds < 1 || options.random < 1)

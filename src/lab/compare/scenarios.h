@@ -45,7 +45,7 @@ std::vector<Scenario> SelectScenarios(const std::string& names);
 
 /// `count` random screws of the scenario (for out_of_range: the first `count` feasible draws with
 /// a diameter, lead or speed outside the training ranges `training`).
-std::vector<sim::Screw> ScenarioScrews(const Scenario& scenario, const sim::Screw& base, int count,
+std::vector<screw::Screw> ScenarioScrews(const Scenario& scenario, const screw::Screw& base, int count,
                                        std::uint64_t seed, const InputRanges& training = {});
 
 struct ScenarioResult {
@@ -65,9 +65,9 @@ struct ScenarioOptions {
 /// Runs every scenario (same screws for the in-range scenarios at a seed, so their rows differ
 /// only by the disturbance levels).
 std::vector<ScenarioResult> RunScenarios(const std::vector<Scenario>& scenarios,
-                                         const sim::Screw& base, const workpiece::WorkpieceModel& model,
+                                         const screw::Screw& base, const workpiece::WorkpieceModel& model,
                                          const ExperienceRule& rule,
-                                         const IsoToleranceTable& iso_table,
+                                         const lead::IsoToleranceTable& iso_table,
                                          const ScenarioOptions& options,
                                          const EvaluateProgress& progress = {});
 

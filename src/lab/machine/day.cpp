@@ -129,10 +129,10 @@ double RingRpm(double cutting_speed_m_min, double tool_circle_mm) {
   return cutting_speed_m_min * 1000.0 / (kPi * tool_circle_mm);
 }
 
-Job MakeJob(const sim::Screw& screw) {
+Job MakeJob(const screw::Screw& screw) {
   Job job;
   job.screw = screw;
-  job.kinematics = sim::ComputeKinematics(screw);
+  job.kinematics = screw::ComputeKinematics(screw);
   job.cutting_power_w =
       sim::ComputeHeatInput(screw, job.kinematics, sim::PhysicsConstants{}).cutting_power_w;
   return job;
@@ -146,11 +146,11 @@ Job DrawJob(const JobMix& mix, std::uint64_t seed, int alternate_index) {
   for (int attempt = 0; attempt < 1000; ++attempt) {
     std::array<double, ProcessInputs::kCount> x{};
     for (int i = 0; i < ProcessInputs::kCount; ++i) x[i] = DrawIn(rng, lo[i], hi[i]);
-    sim::Screw screw = mix.base;
+    screw::Screw screw = mix.base;
     screw.process = ProcessInputs::FromArray(x);
     screw.name = "job";
     try {
-      sim::ValidateScrew(screw);
+      screw::ValidateScrew(screw);
     } catch (const InputError&) {
       continue;
     }

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "core/process.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::machine {
 
@@ -33,8 +33,8 @@ std::string ToString(DayRole r);
 
 /// One screw on the machine: its inputs and what the machine sees of it.
 struct Job {
-  sim::Screw screw;
-  sim::Kinematics kinematics;    ///< of screw (v_f, ring speed, thread positions)
+  screw::Screw screw;
+  screw::Kinematics kinematics;    ///< of screw (v_f, ring speed, thread positions)
   double cutting_power_w = 0;    ///< Kienzle power of the cut (sim::ComputeHeatInput)
   double idle_before_min = 0;    ///< idle ring run before the cut
   // Filled by the layout:
@@ -90,7 +90,7 @@ struct JobMix {
   bool alternate = false;              ///< alternate between (min, max) and (min2, max2)
   ProcessInputs min2{60, 90, 6, 3, 200};
   ProcessInputs max2{65, 100, 16, 10, 210};
-  sim::Screw base = sim::ReferenceScrew();  ///< length, thread, settings of every screw
+  screw::Screw base = screw::ReferenceScrew();  ///< length, thread, settings of every screw
 };
 
 /// Seed of day d of a machine: MixSeed(machine_seed, 0x646179000000 + (d + 2^20)); distinct for
@@ -102,7 +102,7 @@ bool IsWorkday(int day);
 /// Draws a feasible screw (sim::ValidateScrew) of the mix; `alternate_index` picks the range.
 Job DrawJob(const JobMix& mix, std::uint64_t seed, int alternate_index);
 /// Fills kinematics and cutting power of a screw (sim::ComputeKinematics, ComputeHeatInput).
-Job MakeJob(const sim::Screw& screw);
+Job MakeJob(const screw::Screw& screw);
 
 /// A production day: the job list drawn first, then laid out by the rules above.
 DayPlan PlanDay(const DayOptions& options, int day, std::uint64_t machine_seed, const JobMix& mix,

@@ -114,7 +114,7 @@ std::vector<Reading> MeasureLead(const MachineTimeline& timeline, const CutRef& 
     throw InputError("lead measurement: day " + std::to_string(cut.day) + " has no job " +
                      std::to_string(cut.job));
   const Job& job = plan.jobs[cut.job];
-  const sim::Kinematics& k = job.kinematics;
+  const screw::Kinematics& k = job.kinematics;
   const double start = cut.day * 1440.0 + job.cut_start_min;
   Rng rng(seed);
   const double scale = options.scale_noise_um_per_m * rng.Normal();

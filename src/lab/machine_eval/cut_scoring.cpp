@@ -1,6 +1,6 @@
 #include "machine_eval/cut_scoring.h"
 
-#include "compare/lead.h"
+#include "lead/lead.h"
 #include "core/error.h"
 
 namespace whirl::machine_eval::detail {
@@ -12,12 +12,12 @@ void CheckCount(int v, int lo, int hi, const char* what) {
 }
 
 double TotalOf(const ElongationCurve& truth, const compare::CompensationFunction& comp, double feed,
-               const sim::Screw& screw, const compare::CompareOptions& options) {
-  compare::LeadMetricOptions mo = options.metrics;
+               const screw::Screw& screw, const compare::CompareOptions& options) {
+  lead::LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
-  const compare::LeadDeviation lead = compare::CutLeadDeviation(
+  const lead::LeadDeviation lead = compare::CutLeadDeviation(
       truth, comp, feed, screw.thread_length_mm, screw.process.pitch_mm, options.cut);
-  return compare::ComputeLeadMetrics(lead, mo).accumulated_total_um;
+  return lead::ComputeLeadMetrics(lead, mo).accumulated_total_um;
 }
 
 interp::CompensationPlan FeaturePlan(const compare::ScrewComparison& c, const Features& tf,
@@ -45,18 +45,18 @@ compare::CompensationFunction Sum(compare::CompensationFunction a,
 void ScoreStrategies(
     const ElongationCurve& truth,
     const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
-    double feed_mm_s, const sim::Screw& screw, const compare::CompareOptions& options,
-    const compare::IsoToleranceTable& iso_table, MachineEvalScrew* out,
+    double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
+    const lead::IsoToleranceTable& iso_table, MachineEvalScrew* out,
     MachineScrewDetail* detail) {
-  compare::LeadMetricOptions mo = options.metrics;
+  lead::LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const compare::LeadDeviation lead =
+    const lead::LeadDeviation lead =
         compare::CutLeadDeviation(truth, compensations[k], feed_mm_s, screw.thread_length_mm,
                                   screw.process.pitch_mm, options.cut);
-    out->metrics[k] = compare::ComputeLeadMetrics(lead, mo);
+    out->metrics[k] = lead::ComputeLeadMetrics(lead, mo);
     if (detail) detail->leads[k] = lead;
-    out->iso[k] = compare::EvaluateIsoClass(out->metrics[k], iso_table).reached;
+    out->iso[k] = lead::EvaluateIsoClass(out->metrics[k], iso_table).reached;
   }
 }
 

@@ -16,7 +16,7 @@ void CheckCount(int v, int lo, int hi, const char* what);
 
 /// Accumulated lead error over the thread of `truth` under `comp`, um.
 double TotalOf(const ElongationCurve& truth, const compare::CompensationFunction& comp, double feed,
-               const sim::Screw& screw, const compare::CompareOptions& options);
+               const screw::Screw& screw, const compare::CompareOptions& options);
 
 /// A history rule's curve as an 840D plan (empty when the rule has no features for the screw).
 interp::CompensationPlan FeaturePlan(const compare::ScrewComparison& c, const Features& tf,
@@ -32,8 +32,8 @@ compare::CompensationFunction Sum(compare::CompensationFunction a, compare::Comp
 void ScoreStrategies(
     const ElongationCurve& truth,
     const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
-    double feed_mm_s, const sim::Screw& screw, const compare::CompareOptions& options,
-    const compare::IsoToleranceTable& iso_table, MachineEvalScrew* out,
+    double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
+    const lead::IsoToleranceTable& iso_table, MachineEvalScrew* out,
     MachineScrewDetail* detail);
 
 }  // namespace whirl::machine_eval::detail

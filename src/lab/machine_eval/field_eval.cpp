@@ -48,7 +48,7 @@ using machine::MachineTimeline;
 struct Workpiece {
   const workpiece::WorkpieceModel& model;
   const compare::ExperienceRule& rule;
-  const compare::IsoToleranceTable& iso;
+  const lead::IsoToleranceTable& iso;
   const compare::CompareOptions& options;
 };
 
@@ -59,7 +59,7 @@ compare::ScrewComparison CompareFieldCut(const MachineTimeline& tl, const CutRef
   const machine::DayPlan& plan = tl.Day(cut.day);
   const Job& job = plan.jobs[static_cast<std::size_t>(cut.job)];
   const machine::CutHall hall = machine::HallDuringCut(tl, cut);
-  sim::Screw screw = job.screw;
+  screw::Screw screw = job.screw;
   screw.settings.ambient_temperature_c = hall.start_c;
   compare::CompareOptions co = wp.options;
   co.disturbance.ambient_drift_fixed_k_per_h = hall.slope_k_per_h;
@@ -127,7 +127,7 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
   const ElongationCurve machine_total = TruthCurve(m, start, c.truth.time_s, TotalPart);
   const ElongationCurve truth = Add(c.truth, machine_total);
   const double feed = c.kinematics.axial_feed_mm_s;
-  const sim::Kinematics k = job.kinematics;
+  const screw::Kinematics k = job.kinematics;
   auto line = [&](const HeldSamples& h) {
     return CausalMachineLine(h, start, z_ref_mm, [k](double t) {
       return k.thread_start_position_mm - k.axial_feed_mm_s * std::min(t, k.cutting_time_s);
@@ -215,7 +215,7 @@ void ValidateFieldOptions(const FieldEvalOptions& o) {
 MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario,
                                         const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
-                                        const compare::IsoToleranceTable& iso_table,
+                                        const lead::IsoToleranceTable& iso_table,
                                         const FieldEvalOptions& options,
                                         const compare::EvaluateProgress& progress) {
   ValidateFieldOptions(options);
@@ -254,7 +254,7 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
 SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
                                        const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
-                                       const compare::IsoToleranceTable& iso_table,
+                                       const lead::IsoToleranceTable& iso_table,
                                        const FieldEvalOptions& options, int seeds,
                                        const compare::EvaluateProgress& progress) {
   detail::CheckCount(seeds, 1, 20, "seeds");
@@ -275,9 +275,9 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
 }
 
 std::vector<SeedsEvaluation> EvaluateMachineScenarios(
-    const std::vector<machine::MachineScenario>& scenarios, const sim::Screw& legacy_base,
+    const std::vector<machine::MachineScenario>& scenarios, const screw::Screw& legacy_base,
     const workpiece::WorkpieceModel& model, const compare::ExperienceRule& rule,
-    const compare::IsoToleranceTable& iso_table, const MachineEvalOptions& legacy,
+    const lead::IsoToleranceTable& iso_table, const MachineEvalOptions& legacy,
     const FieldEvalOptions& field, int seeds, const compare::EvaluateProgress& progress) {
   std::vector<SeedsEvaluation> out;
   const std::size_t n = scenarios.size();

@@ -75,7 +75,7 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
 MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario,
                                         const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
-                                        const compare::IsoToleranceTable& iso_table,
+                                        const lead::IsoToleranceTable& iso_table,
                                         const FieldEvalOptions& options,
                                         const compare::EvaluateProgress& progress = {});
 
@@ -83,16 +83,16 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
 SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
                                        const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
-                                       const compare::IsoToleranceTable& iso_table,
+                                       const lead::IsoToleranceTable& iso_table,
                                        const FieldEvalOptions& options, int seeds,
                                        const compare::EvaluateProgress& progress = {});
 
 /// Every selected scenario over seeds: legacy through EvaluateOverSeeds (legacy options), the
 /// field scenarios through EvaluateFieldOverSeeds. progress(done, n) counts scenarios x seeds.
 std::vector<SeedsEvaluation> EvaluateMachineScenarios(
-    const std::vector<machine::MachineScenario>& scenarios, const sim::Screw& legacy_base,
+    const std::vector<machine::MachineScenario>& scenarios, const screw::Screw& legacy_base,
     const workpiece::WorkpieceModel& model, const compare::ExperienceRule& rule,
-    const compare::IsoToleranceTable& iso_table, const MachineEvalOptions& legacy,
+    const lead::IsoToleranceTable& iso_table, const MachineEvalOptions& legacy,
     const FieldEvalOptions& field, int seeds, const compare::EvaluateProgress& progress = {});
 
 }  // namespace whirl::machine_eval

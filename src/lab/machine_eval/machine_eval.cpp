@@ -161,16 +161,16 @@ struct ToolPath {
   double ZAt(double t_s) const { return start_mm - feed_mm_s * std::min(t_s, cutting_time_s); }
 };
 
-ToolPath PathOf(const sim::Kinematics& k, const machine::MachineDay& day) {
+ToolPath PathOf(const screw::Kinematics& k, const machine::MachineDay& day) {
   return {k.axial_feed_mm_s, k.thread_start_position_mm, k.cutting_time_s,
           day.config.z_screw.fixed_end_mm};
 }
 
 // The workpiece's comparison on this machine's day. One hall: with the machine's ambient
 // component on, the blank follows the day's ambient ramp, the one the bed follows.
-compare::ScrewComparison CompareOnDay(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
+compare::ScrewComparison CompareOnDay(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
                                       const compare::ExperienceRule& rule,
-                                      const compare::IsoToleranceTable& iso_table,
+                                      const lead::IsoToleranceTable& iso_table,
                                       const machine::MachineDay& day,
                                       const compare::CompareOptions& options) {
   compare::CompareOptions co = options;
@@ -218,8 +218,8 @@ compare::CompensationFunction MachineLine(const HeldSeries& offset, const HeldSe
 }
 
 // The screw's own sensor log: the machine's day over the cut and two samples more.
-drift::Run ScrewSensorLog(const machine::MachineDay& day, const sim::Screw& screw,
-                          const sim::Kinematics& kinematics, std::uint64_t seed) {
+drift::Run ScrewSensorLog(const machine::MachineDay& day, const screw::Screw& screw,
+                          const screw::Kinematics& kinematics, std::uint64_t seed) {
   machine::RunSpec spec;
   spec.name = screw.name + "_log";
   spec.duration_min = kinematics.cutting_time_s / 60.0 + 2 * day.config.sample_min;
@@ -258,7 +258,7 @@ struct MachineCompensations {
 
 // The shop-trained models on the control's log of the cut (its first row is the cold start, the
 // legacy world's power-on), each held sample by sample.
-void ShopCompensations(const MachineModels& models, const sim::Screw& screw, const ToolPath& path,
+void ShopCompensations(const MachineModels& models, const screw::Screw& screw, const ToolPath& path,
                        MachineCompensations* m) {
   const drift::Run control = ControlDayLog(m->log, screw.process.cutting_speed_m_min);
   auto line = [&](const drift::JointDriftModel& model) {
@@ -272,8 +272,8 @@ void ShopCompensations(const MachineModels& models, const sim::Screw& screw, con
 
 MachineCompensations MachineModelCompensations(const MachineModels& models,
                                                const machine::MachineDay& day,
-                                               const sim::Screw& screw,
-                                               const sim::Kinematics& kinematics,
+                                               const screw::Screw& screw,
+                                               const screw::Kinematics& kinematics,
                                                const ToolPath& path, std::uint64_t seed,
                                                double monitor_every_min) {
   MachineCompensations m;
@@ -293,9 +293,9 @@ MachineCompensations MachineModelCompensations(const MachineModels& models,
 
 }  // namespace
 
-MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
+MachineEvalScrew EvaluateScrewOnMachine(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
-                                        const compare::IsoToleranceTable& iso_table,
+                                        const lead::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
                                         const compare::CompareOptions& options,
                                         double monitor_every_min, MachineScrewDetail* detail) {
@@ -376,8 +376,8 @@ Machines FitMachines(const MachineEvalOptions& options) {
 // Screw k is cut on machine k / screws_per_machine, on its own day, with its own truth seed; a
 // screw whose comparison fails is kept with its error.
 std::vector<MachineEvalScrew> EvaluateScrewsOnMachines(
-    const std::vector<sim::Screw>& screws, const Machines& machines, const workpiece::WorkpieceModel& model,
-    const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso_table,
+    const std::vector<screw::Screw>& screws, const Machines& machines, const workpiece::WorkpieceModel& model,
+    const compare::ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
     const MachineEvalOptions& options, const compare::EvaluateProgress& progress) {
   const std::size_t per = static_cast<std::size_t>(options.screws_per_machine);
   std::vector<MachineEvalScrew> out(screws.size());
@@ -408,9 +408,9 @@ std::vector<MachineEvalScrew> EvaluateScrewsOnMachines(
 // The first screw again, keeping its curves (same seeds: the same figures), and its report with
 // the combined programs for options.profile; a profile that does not fit the machine leaves the
 // programs out with a note (the evaluation stands).
-void WriteFirstScrewReport(const sim::Screw& screw, const Machines& machines,
+void WriteFirstScrewReport(const screw::Screw& screw, const Machines& machines,
                            const workpiece::WorkpieceModel& model, const compare::ExperienceRule& rule,
-                           const compare::IsoToleranceTable& iso_table,
+                           const lead::IsoToleranceTable& iso_table,
                            const MachineEvalOptions& options, MachineEvaluation* e) {
   const machine::MachineDay day =
       machine::MachineDay::Draw(options.machine, machines.seeds[0], e->screws.front().day_seed);
@@ -437,9 +437,9 @@ void WriteFirstScrewReport(const sim::Screw& screw, const Machines& machines,
 
 }  // namespace
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
+MachineEvaluation EvaluateWithMachines(const screw::Screw& base, const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
-                                       const compare::IsoToleranceTable& iso_table,
+                                       const lead::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,
                                        const compare::EvaluateProgress& progress) {
   ValidateMachineEvalOptions(options);
@@ -449,7 +449,7 @@ MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::
     e.sensors_cutting.push_back(m.offset_cutting.sensors);
     e.sensors_idle.push_back(m.offset_idle.sensors);
   }
-  const std::vector<sim::Screw> screws = compare::RandomFeasibleScrews(
+  const std::vector<screw::Screw> screws = compare::RandomFeasibleScrews(
       base, options.screws_per_machine * options.machines, options.seed);
   e.screws = EvaluateScrewsOnMachines(screws, machines, model, rule, iso_table, options, progress);
   e.summary = SummarizeMachineEval(e.screws);
@@ -474,9 +474,9 @@ MachineEvalSummary SummarizeMachineEval(const std::vector<MachineEvalScrew>& scr
     for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
       acc[k].push_back(std::abs(r.metrics[k].accumulated_1000_um));
       total[k].push_back(std::abs(r.metrics[k].accumulated_total_um));
-      const compare::IsoClass c = r.iso[k];
-      if (c == compare::IsoClass::kP1 || c == compare::IsoClass::kP3) ++p3[k];
-      if (c == compare::IsoClass::kP1 || c == compare::IsoClass::kP3 || c == compare::IsoClass::kP5)
+      const lead::IsoClass c = r.iso[k];
+      if (c == lead::IsoClass::kP1 || c == lead::IsoClass::kP3) ++p3[k];
+      if (c == lead::IsoClass::kP1 || c == lead::IsoClass::kP3 || c == lead::IsoClass::kP5)
         ++p5[k];
     }
     for (std::size_t q = 0; q < kErrorSourceCount; ++q) sources[q].push_back(r.source_total_um[q]);

@@ -156,12 +156,12 @@ struct MachineEvalScrew {
   int machine = 0;
   int day = 0;              ///< field world: calendar day of the cut (legacy: 0)
   std::string start_type;   ///< field world: cold, warm, interrupted, long_pause (legacy: "")
-  sim::Screw screw;
+  screw::Screw screw;
   std::uint64_t seed = 0, day_seed = 0;
   bool ok = false;
   std::string error;
-  std::array<compare::LeadMetrics, kMachineStrategyCount> metrics;
-  std::array<compare::IsoClass, kMachineStrategyCount> iso{};
+  std::array<lead::LeadMetrics, kMachineStrategyCount> metrics;
+  std::array<lead::IsoClass, kMachineStrategyCount> iso{};
   /// Uncompensated accumulated error over the thread of each source alone, um.
   std::array<double, kErrorSourceCount> source_total_um{};
   /// "both": accumulated error over the thread of the workpiece and machine residuals, um.
@@ -200,23 +200,23 @@ drift::ShopRecord ShopRecordOf(const machine::MachineConfig& config, std::uint64
 /// Curves of one screw, for the report: its sensor log and the lead deviation per strategy.
 struct MachineScrewDetail {
   drift::Run log;  ///< empty when no machine model was fitted
-  std::array<compare::LeadDeviation, kMachineStrategyCount> leads;
+  std::array<lead::LeadDeviation, kMachineStrategyCount> leads;
   fit::ArctanCurve predicted_curve;  ///< the network's curve (the workpiece plan's)
-  sim::Kinematics kinematics;
+  screw::Kinematics kinematics;
 };
 
 /// One screw on one machine day (see the header comment); `detail` (optional) receives the curves.
-MachineEvalScrew EvaluateScrewOnMachine(const sim::Screw& screw, const workpiece::WorkpieceModel& model,
+MachineEvalScrew EvaluateScrewOnMachine(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
-                                        const compare::IsoToleranceTable& iso_table,
+                                        const lead::IsoToleranceTable& iso_table,
                                         const machine::MachineDay& day, const MachineModels& models,
                                         const compare::CompareOptions& options,
                                         double monitor_every_min = 30,
                                         MachineScrewDetail* detail = nullptr);
 
-MachineEvaluation EvaluateWithMachines(const sim::Screw& base, const workpiece::WorkpieceModel& model,
+MachineEvaluation EvaluateWithMachines(const screw::Screw& base, const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
-                                       const compare::IsoToleranceTable& iso_table,
+                                       const lead::IsoToleranceTable& iso_table,
                                        const MachineEvalOptions& options,
                                        const compare::EvaluateProgress& progress = {});
 

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/numbers.h"
+#include "plan/load.h"
 
 namespace whirl::machine_eval {
 namespace {
@@ -35,7 +36,7 @@ void CheckAgainstMachine(const interp::MachineProfile& p, const interp::DriftAct
 }  // namespace
 
 CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
-                                       const sim::Kinematics& kinematics, double thread_length_mm,
+                                       const screw::Kinematics& kinematics, double thread_length_mm,
                                        const interp::PlanOptions& plan_options,
                                        const MachineModels& models,
                                        const machine::MachineConfig& machine,
@@ -73,6 +74,10 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
                                               "machine model trained on cutting runs", &g);
   out.drift_reset_nc = interp::FormatDriftNcResetProgram(out.drift);
   out.drift_plc_csv = interp::FormatDriftPlcCsv(models.offset_cutting, out.drift, &g);
+  out.requirements = plan::WithProfileValues(
+      interp::MergeRequirements(interp::DriftRequirements(models.offset_cutting, out.drift, &g),
+                                interp::PlanRequirements(out.plan, info.program_name)),
+      profile);
   return out;
 }
 

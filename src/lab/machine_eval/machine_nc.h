@@ -35,6 +35,9 @@ struct CombinedPrograms {
   interp::DriftActionOptions drift;    ///< the drift action's options (from the profile)
   std::string plan_nc, plan_reset_nc;  ///< .SPF subprograms
   std::string drift_nc, drift_reset_nc, drift_plc_csv;
+  /// What the control must provide for both programs together, each datum once
+  /// (interp::MergeRequirements of the plan's and the drift action's), with the profile's values.
+  std::vector<interp::ControlRequirement> requirements;
 };
 
 /// Builds both programs. `plan_options` gives the tolerance and check step (the profile sets
@@ -42,7 +45,7 @@ struct CombinedPrograms {
 /// profile lacks the drift object, its slope object or workpiece_slope_param, disagrees with the
 /// machine (see above), or when a program cannot be written (IDs, MD32760, analog inputs).
 CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
-                                       const sim::Kinematics& kinematics, double thread_length_mm,
+                                       const screw::Kinematics& kinematics, double thread_length_mm,
                                        const interp::PlanOptions& plan_options,
                                        const MachineModels& models,
                                        const machine::MachineConfig& machine,

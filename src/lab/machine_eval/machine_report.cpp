@@ -146,9 +146,9 @@ std::string OutputAction(const std::string& drift_nc) {
 
 // The "load onto the control" box of the combined programs (compare/control_box.h).
 std::string ControlBox(const std::string& screw_name, const CombinedPrograms& p) {
-  compare::ControlLoad load;
+  plan::ControlLoad load;
   load.heading = screw_name;
-  load.plan = &p.plan;
+  load.plan = p.plan;
   const interp::DriftActionOptions& d = p.drift;
   load.plan_note =
       "The plan does not write these into the setting data itself: it hands K0, "
@@ -172,11 +172,7 @@ std::string ControlBox(const std::string& screw_name, const CombinedPrograms& p)
       "alone), move the axis before the thread start and cut the whole thread "
       "again with WHIRL_TEMP_COMP. WHIRL_DRIFT_COMP refuses to start while a "
       "plan's compensation is active: call WHIRL_TEMP_COMP_RESET first.";
-  for (const std::string* nc : {&p.drift_nc, &p.plan_nc})
-    for (auto& line : compare::NcPrerequisites(*nc))
-      if (std::find(load.prerequisites.begin(), load.prerequisites.end(), line) ==
-          load.prerequisites.end())
-        load.prerequisites.push_back(line);
+  load.requirements = p.requirements;
   return compare::ControlBoxHtml({load});
 }
 

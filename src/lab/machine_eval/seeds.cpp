@@ -9,9 +9,9 @@
 
 namespace whirl::machine_eval {
 
-SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::WorkpieceModel& model,
+SeedsEvaluation EvaluateOverSeeds(const screw::Screw& base, const workpiece::WorkpieceModel& model,
                                   const compare::ExperienceRule& rule,
-                                  const compare::IsoToleranceTable& iso_table,
+                                  const lead::IsoToleranceTable& iso_table,
                                   const MachineEvalOptions& options, int seeds,
                                   const compare::EvaluateProgress& progress) {
   detail::CheckCount(seeds, 1, 20, "seeds");
@@ -42,8 +42,8 @@ double Min(const std::vector<double>& v) {
   return v.empty() ? 0.0 : *std::min_element(v.begin(), v.end());
 }
 
-bool ReachesP(compare::IsoClass c, int p) {
-  using compare::IsoClass;
+bool ReachesP(lead::IsoClass c, int p) {
+  using lead::IsoClass;
   return c == IsoClass::kP1 || c == IsoClass::kP3 || (p == 5 && c == IsoClass::kP5);
 }
 

@@ -35,9 +35,9 @@ struct SeedStats {
 };
 
 /// Seeds options.seed .. options.seed + seeds - 1 (1..20; InputError otherwise).
-SeedsEvaluation EvaluateOverSeeds(const sim::Screw& base, const workpiece::WorkpieceModel& model,
+SeedsEvaluation EvaluateOverSeeds(const screw::Screw& base, const workpiece::WorkpieceModel& model,
                                   const compare::ExperienceRule& rule,
-                                  const compare::IsoToleranceTable& iso_table,
+                                  const lead::IsoToleranceTable& iso_table,
                                   const MachineEvalOptions& options, int seeds,
                                   const compare::EvaluateProgress& progress = {});
 

@@ -27,8 +27,8 @@ double RadicalInverse(std::uint64_t index, std::uint64_t base) {
 
 }  // namespace
 
-Screw RowScrew(const ProcessInputs& inputs) {
-  Screw s = ReferenceScrew();
+screw::Screw RowScrew(const ProcessInputs& inputs) {
+  screw::Screw s = screw::ReferenceScrew();
   s.name = "table_row";
   s.process = inputs;
   return s;
@@ -60,7 +60,7 @@ std::vector<ProcessInputs> DesignPoints(
     }
     const ProcessInputs p = ProcessInputs::FromArray(x);
     try {
-      ValidateScrew(RowScrew(p));
+      screw::ValidateScrew(RowScrew(p));
     } catch (const InputError&) {
       continue;  // infeasible combination: skipped by design
     }
@@ -94,7 +94,7 @@ Dataset GenerateDataset(const DatasetOptions& options,
         DisturbanceOptions dist = options.disturbance;
         dist.seed = MixSeed(options.seed, i);
         SimulationResult r = Simulate(RowScrew(points[i]), sim, dist);
-        out.settle[i] = AnalyzeSettle(r.curve, sim.settle);
+        out.settle[i] = fit::AnalyzeSettle(r.curve, sim.settle);
         out.table.targets[i] = out.settle[i].features;
         out.curves[i] = std::move(r.curve);
       },
@@ -123,7 +123,7 @@ Dataset GenerateDataset(const DatasetOptions& options,
     s << " disturbances OFF";
   c.push_back(s.str());
   c.push_back(
-      " features: ExtractFeatures (plateau + quadratic drift fitted after the settle time, "
+      " features: fit::ExtractFeatures (plateau + quadratic drift fitted after the settle time, "
       "detrended 60 s moving average within a noise-aware 2 % band; src/sim/features.h)");
   return out;
 }

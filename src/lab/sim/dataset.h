@@ -50,7 +50,7 @@ struct DatasetOptions {
 struct Dataset {
   ProcessTable table;                   ///< inputs and features, with provenance comments
   std::vector<ElongationCurve> curves;  ///< recorded curve of each row
-  std::vector<SettleAnalysis> settle;   ///< settle analysis of each row
+  std::vector<fit::SettleAnalysis> settle;   ///< settle analysis of each row
 };
 
 /// The first `count` feasible design points (InputError if the ranges are empty/inverted or fewer
@@ -72,6 +72,6 @@ void WriteDataset(const Dataset& dataset, const std::filesystem::path& table_pat
                   const std::filesystem::path& curves_dir, const std::string& regenerate);
 
 /// The reference blank with the given inputs (the screw of a table row).
-Screw RowScrew(const ProcessInputs& inputs);
+screw::Screw RowScrew(const ProcessInputs& inputs);
 
 }  // namespace whirl::sim

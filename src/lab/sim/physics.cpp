@@ -4,7 +4,7 @@
 
 namespace whirl::sim {
 
-HeatInput ComputeHeatInput(const Screw& screw, const Kinematics& kinematics,
+HeatInput ComputeHeatInput(const screw::Screw& screw, const screw::Kinematics& kinematics,
                            const PhysicsConstants& physics) {
   HeatInput h;
   h.chip_thickness_mm = screw.settings.feed_per_tooth_mm;

@@ -1,7 +1,7 @@
 #pragma once
 // All physical constants and process-model relations of the simulator in one place
 // (docs/simulator.md). Each constant says whether it comes from a source or is an assumption.
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::sim {
 
@@ -58,7 +58,7 @@ struct HeatInput {
 };
 
 /// Process model: cutting power and the heat that flows into the workpiece.
-HeatInput ComputeHeatInput(const Screw& screw, const Kinematics& kinematics,
+HeatInput ComputeHeatInput(const screw::Screw& screw, const screw::Kinematics& kinematics,
                            const PhysicsConstants& physics);
 
 }  // namespace whirl::sim

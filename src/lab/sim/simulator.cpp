@@ -113,7 +113,7 @@ struct Rod {
 };
 
 // Discretizes the blank; a cell size giving fewer than 3 or more than kMaxCells cells is refused.
-Rod DiscretizeRod(const Screw& screw, const PhysicsConstants& ph, double cell_size_mm) {
+Rod DiscretizeRod(const screw::Screw& screw, const PhysicsConstants& ph, double cell_size_mm) {
   const double length_m = screw.length_mm * 1e-3;
   const double cells = std::round(screw.length_mm / cell_size_mm);
   if (!(cells >= 3 && cells <= kMaxCells))
@@ -148,7 +148,7 @@ struct TimeGrid {
 };
 
 // Plans the time steps; more than kMaxTimeSteps steps or kMaxCellSteps cell-steps are refused.
-TimeGrid PlanTimeGrid(const Kinematics& kin, const SimOptions& options, int n_cells) {
+TimeGrid PlanTimeGrid(const screw::Kinematics& kin, const SimOptions& options, int n_cells) {
   TimeGrid grid;
   grid.dt = options.time_step_s;
   const double dt = grid.dt;
@@ -218,7 +218,7 @@ struct MovingBox {
 // normalised over the cells inside the blank so that all of the heat enters the workpiece.
 class SourceDeposit {
  public:
-  SourceDeposit(const Rod& rod, const Kinematics& kin, double dt)
+  SourceDeposit(const Rod& rod, const screw::Kinematics& kin, double dt)
       : rod_(rod),
         x_start_m_(kin.thread_start_position_mm * 1e-3),
         v_m_s_(kin.axial_feed_mm_s * 1e-3),
@@ -338,7 +338,7 @@ struct RodHistory {
 // [t - dt/2, t + dt/2] (clipped to the heating period), so the deposit is centred on t (second
 // order, consistent with BDF2) and moves continuously; the loss is integrated by the trapezoidal
 // rule; the elongation at the cut point is recorded at t = 0 and at every sample.
-RodHistory IntegrateCut(const Rod& rod, const TimeGrid& grid, const Kinematics& kin,
+RodHistory IntegrateCut(const Rod& rod, const TimeGrid& grid, const screw::Kinematics& kin,
                         const CutLoads& loads) {
   RodHistory h;
   const double dt = grid.dt;
@@ -401,7 +401,7 @@ CutLoads MakeCutLoads(const SimulationResult& r, const SimOptions& options,
 
 // The energy balance and the numbers it compared.
 SimulationSummary Summarize(const RodHistory& h, const Rod& rod, const TimeGrid& grid,
-                            const CutLoads& loads, const Kinematics& kin) {
+                            const CutLoads& loads, const screw::Kinematics& kin) {
   SimulationSummary s;
   s.termination = grid.termination;
   s.time_steps = static_cast<int>(grid.n_steps);
@@ -446,12 +446,12 @@ std::string SimulationSummary::BriefReport() const {
   return s.str();
 }
 
-SimulationResult Simulate(const Screw& screw, const SimOptions& options,
+SimulationResult Simulate(const screw::Screw& screw, const SimOptions& options,
                           const DisturbanceOptions& disturbances) {
   CheckSimOptions(options);
   SimulationResult result;
-  result.kinematics = ComputeKinematics(screw);  // validates the screw
-  const Kinematics& kin = result.kinematics;
+  result.kinematics = screw::ComputeKinematics(screw);  // validates the screw
+  const screw::Kinematics& kin = result.kinematics;
   result.heat = ComputeHeatInput(screw, kin, options.physics);
   Rng rng(disturbances.seed);
   result.disturbances = DrawDisturbances(disturbances, rng);
@@ -476,7 +476,7 @@ SimulationResult Simulate(const Screw& screw, const SimOptions& options,
     for (int i = 0; i < rod.n; ++i) result.cell_center_mm[i] = (i + 0.5) * rod.dx * 1e3;
     result.temperature_rise_k = history.theta_k;
   }
-  if (curve.size() >= 10) result.features = ExtractFeatures(curve, options.settle);
+  if (curve.size() >= 10) result.features = fit::ExtractFeatures(curve, options.settle);
   return result;
 }
 

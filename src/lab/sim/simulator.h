@@ -34,9 +34,9 @@
 
 #include "core/curve.h"
 #include "core/process.h"
-#include "sim/features.h"
+#include "fit/features.h"
 #include "sim/physics.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::sim {
 
@@ -61,7 +61,7 @@ struct SimOptions {
   double heat_input_override_w = -1.0;
   /// Keep the final temperature profile in the result (cell_center_mm, temperature_rise_k).
   bool keep_final_profile = false;
-  SettleOptions settle;  ///< feature extraction from the recorded curve
+  fit::SettleOptions settle;  ///< feature extraction from the recorded curve
 };
 
 /// Disturbances the prediction model cannot know (for honest comparisons), all seeded and
@@ -140,7 +140,7 @@ struct SimulationResult {
   ElongationCurve curve;
   /// The same curve without measurement noise (the truth a compensation is judged against), um.
   std::vector<double> elongation_noise_free_um;
-  Kinematics kinematics;
+  screw::Kinematics kinematics;
   HeatInput heat;  ///< process-model heat input (before the disturbance factor)
   AppliedDisturbances disturbances;
   Features features;  ///< ExtractFeatures(curve, options.settle)
@@ -151,7 +151,7 @@ struct SimulationResult {
 
 /// Runs the simulation. Bad options (non-positive cell size, time step, ...) or an infeasible screw
 /// throw InputError.
-SimulationResult Simulate(const Screw& screw, const SimOptions& options = {},
+SimulationResult Simulate(const screw::Screw& screw, const SimOptions& options = {},
                           const DisturbanceOptions& disturbances = {});
 
 }  // namespace whirl::sim

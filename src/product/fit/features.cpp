@@ -1,4 +1,4 @@
-#include "sim/features.h"
+#include "fit/features.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "core/stats.h"
 
-namespace whirl::sim {
+namespace whirl::fit {
 namespace {
 
 void CheckOptions(const SettleOptions& o) {
@@ -81,7 +81,7 @@ DriftFit FitPlateauAndDrift(const std::vector<double>& u, const std::vector<doub
 
 namespace {
 
-void CheckCurve(const ElongationCurve& curve) {
+void CheckFeatureCurve(const ElongationCurve& curve) {
   const std::size_t n = curve.size();
   if (n < 10 || curve.elongation_um.size() != n)
     throw InputError("elongation curve: " + std::to_string(n) +
@@ -330,7 +330,7 @@ ElongationCurve Head(const ElongationCurve& curve, double window_s) {
 
 SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& options) {
   CheckOptions(options);
-  CheckCurve(curve);
+  CheckFeatureCurve(curve);
   const double record_s = curve.time_s.back() - curve.time_s.front();
   int windows = 0;
   for (double w = options.min_window_s; w < record_s; w *= options.window_growth) {
@@ -354,4 +354,4 @@ Features ExtractFeatures(const ElongationCurve& curve, const SettleOptions& opti
   return AnalyzeSettle(curve, options).features;
 }
 
-}  // namespace whirl::sim
+}  // namespace whirl::fit

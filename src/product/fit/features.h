@@ -71,7 +71,7 @@
 #include "core/curve.h"
 #include "core/process.h"
 
-namespace whirl::sim {
+namespace whirl::fit {
 
 enum class SettleMethod { kShapeFit, kBand };
 
@@ -124,4 +124,4 @@ struct SettleAnalysis {
 SettleAnalysis AnalyzeSettle(const ElongationCurve& curve, const SettleOptions& options = {});
 Features ExtractFeatures(const ElongationCurve& curve, const SettleOptions& options = {});
 
-}  // namespace whirl::sim
+}  // namespace whirl::fit

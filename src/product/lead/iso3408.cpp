@@ -1,4 +1,4 @@
-#include "compare/iso3408.h"
+#include "lead/iso3408.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 
-namespace whirl::compare {
+namespace whirl::lead {
 namespace {
 
 constexpr IsoClass kOrder[] = {IsoClass::kP1, IsoClass::kP3, IsoClass::kP5, IsoClass::kT7,
@@ -202,4 +202,4 @@ void to_json(nlohmann::json& j, const IsoVerdict& v) {
                      {"message", v.message}};
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::lead

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "compare/metrics.h"
+#include "lead/metrics.h"
 
-namespace whirl::compare {
+namespace whirl::lead {
 
 /// Classes in order from the tightest to the loosest. kNone = no class holds.
 enum class IsoClass { kP1, kP3, kP5, kT7, kT10, kNone };
@@ -80,4 +80,4 @@ IsoVerdict EvaluateIsoClass(const LeadMetrics& metrics, const IsoToleranceTable&
 void to_json(nlohmann::json& j, const IsoCheck& c);
 void to_json(nlohmann::json& j, const IsoVerdict& v);
 
-}  // namespace whirl::compare
+}  // namespace whirl::lead

@@ -1,4 +1,4 @@
-#include "compare/lead.h"
+#include "lead/lead.h"
 
 #include <cmath>
 
@@ -7,7 +7,7 @@
 #include "core/curve.h"
 #include "core/error.h"
 
-namespace whirl::compare {
+namespace whirl::lead {
 
 LeadDeviation ReadLeadDeviation(const std::filesystem::path& path) {
   const CurveColumns csv =
@@ -66,4 +66,4 @@ void WriteLeadDeviation(const std::filesystem::path& path, const LeadDeviation& 
   WriteFileAtomic(path, FormatCsv({"position_mm", "deviation_um"}, rows, comments));
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::lead

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace whirl::compare {
+namespace whirl::lead {
 
 struct LeadDeviation {
   std::vector<double> position_mm;   ///< along the thread from its start, strictly increasing, mm
@@ -38,4 +38,4 @@ void ValidateLeadDeviation(const LeadDeviation& lead, const std::string& what);
 void WriteLeadDeviation(const std::filesystem::path& path, const LeadDeviation& lead,
                         const std::vector<std::string>& comments = {});
 
-}  // namespace whirl::compare
+}  // namespace whirl::lead

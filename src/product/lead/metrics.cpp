@@ -1,4 +1,4 @@
-#include "compare/metrics.h"
+#include "lead/metrics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include "core/csv.h"
 #include "core/error.h"
 
-namespace whirl::compare {
+namespace whirl::lead {
 
 LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOptions& options) {
   ValidateLeadDeviation(lead, "lead-deviation curve");
@@ -93,4 +93,4 @@ void to_json(nlohmann::json& j, const LeadMetrics& m) {
                      {"samples", m.samples}};
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::lead

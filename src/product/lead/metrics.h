@@ -24,10 +24,10 @@
 #include <optional>
 #include <string>
 
-#include "compare/lead.h"
+#include "lead/lead.h"
 #include "core/window_range.h"
 
-namespace whirl::compare {
+namespace whirl::lead {
 
 struct LeadMetricOptions {
   /// Excess travel l_e excluded at each end of the curve, mm (ISO 3408-3 l_u = l_1 - 2 l_e). >= 0.
@@ -64,4 +64,4 @@ using whirl::MaxWindowRange;
 
 void to_json(nlohmann::json& j, const LeadMetrics& m);
 
-}  // namespace whirl::compare
+}  // namespace whirl::lead

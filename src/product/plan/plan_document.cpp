@@ -1,4 +1,4 @@
-#include "compare/plan_document.h"
+#include "plan/plan_document.h"
 
 #include <utility>
 #include <vector>
@@ -6,10 +6,10 @@
 #include "core/atomic_file.h"
 #include "core/json_file.h"
 
-namespace whirl::compare {
+namespace whirl::plan {
 
 nlohmann::json PlanDocument(const interp::CompensationPlan& plan, const fit::ArctanCurve& curve,
-                            const sim::Screw& screw, const sim::Kinematics& kinematics,
+                            const screw::Screw& screw, const screw::Kinematics& kinematics,
                             const PlanSource& source, const std::string& provenance) {
   nlohmann::json prediction = {
       {"model", source.model.empty() ? nlohmann::json(nullptr) : nlohmann::json(source.model)},
@@ -52,4 +52,4 @@ void WritePlanFiles(const PlanOutputPaths& paths, const nlohmann::json& document
   if (!files.empty()) WriteFilesAtomic(files);
 }
 
-}  // namespace whirl::compare
+}  // namespace whirl::plan

@@ -19,9 +19,9 @@
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
 #include "nn/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
-namespace whirl::compare {
+namespace whirl::plan {
 
 /// Where the curve's features came from.
 struct PlanSource {
@@ -35,7 +35,7 @@ struct PlanSource {
 
 /// The `whirl.plan` document (see the header comment).
 nlohmann::json PlanDocument(const interp::CompensationPlan& plan, const fit::ArctanCurve& curve,
-                            const sim::Screw& screw, const sim::Kinematics& kinematics,
+                            const screw::Screw& screw, const screw::Kinematics& kinematics,
                             const PlanSource& source, const std::string& provenance);
 
 /// Output paths of the plan files; an empty path is not written.
@@ -55,4 +55,4 @@ void WritePlanFiles(const PlanOutputPaths& paths, const nlohmann::json& document
                     const interp::CompensationPlan& plan, const std::string& provenance,
                     const std::string& curve_source);
 
-}  // namespace whirl::compare
+}  // namespace whirl::plan

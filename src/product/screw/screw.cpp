@@ -1,4 +1,4 @@
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "core/limits.h"
 #include "core/numbers.h"
 
-namespace whirl::sim {
+namespace whirl::screw {
 namespace {
 
 [[noreturn]] void Fail(const std::string& what, const std::string& field, double value,
@@ -205,4 +205,4 @@ void WriteScrew(const std::filesystem::path& path, const Screw& screw) {
   WriteJsonFile(path, j);
 }
 
-}  // namespace whirl::sim
+}  // namespace whirl::screw

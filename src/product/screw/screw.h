@@ -14,7 +14,7 @@
 
 #include "core/process.h"
 
-namespace whirl::sim {
+namespace whirl::screw {
 
 /// Largest tool-circle margin, mm: a whirling ring's tool circle only just clears the blank (6 mm
 /// on the reference screw); 100 mm would be a ring several screw sizes too large.
@@ -124,4 +124,4 @@ Screw ReadScrew(const std::filesystem::path& path);
 /// Validates and writes a screw file atomically.
 void WriteScrew(const std::filesystem::path& path, const Screw& screw);
 
-}  // namespace whirl::sim
+}  // namespace whirl::screw
