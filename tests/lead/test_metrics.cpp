@@ -10,13 +10,13 @@
 #include "core/error.h"
 #include "support/scratch_dir.h"
 
-namespace whirl::compare {
+namespace whirl::lead {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-lead::LeadDeviation Sampled(double length_mm, double step_mm, const std::function<double(double)>& f) {
-  lead::LeadDeviation lead;
+LeadDeviation Sampled(double length_mm, double step_mm, const std::function<double(double)>& f) {
+  LeadDeviation lead;
   const int n = static_cast<int>(std::lround(length_mm / step_mm));
   for (int k = 0; k <= n; ++k) {
     const double x = k * step_mm;
@@ -32,10 +32,10 @@ TEST(LeadMetrics, PureLinearDeviationHasNoBandAndEaIsSlopeTimesLength) {
       len_dist(200, 6000);
   for (int trial = 0; trial < 50; ++trial) {
     const double slope = slope_dist(rng), offset = off_dist(rng), length = len_dist(rng);
-    const lead::LeadDeviation lead = Sampled(length, 1.0, [&](double x) { return offset + slope * x; });
-    lead::LeadMetricOptions options;
+    const LeadDeviation lead = Sampled(length, 1.0, [&](double x) { return offset + slope * x; });
+    LeadMetricOptions options;
     options.lead_mm = 10;
-    const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, options);
+    const LeadMetrics m = ComputeLeadMetrics(lead, options);
     const double l_u = lead.position_mm.back();
     EXPECT_NEAR(m.useful_travel_mm, l_u, 1e-9);
     EXPECT_NEAR(m.e_a_um, slope * l_u, 1e-9 * std::max(1.0, std::abs(slope * l_u)));
@@ -54,12 +54,12 @@ TEST(LeadMetrics, SineAboutALineMatchesClosedForms) {
   // the sine over whole periods is not exactly 0 (x sin(..) has a non-zero integral), so check the
   // band widths on windows with lambda small against the length, where the tilt is negligible.
   const double amplitude = 3.0, lambda = 40.0, slope = 0.002, length = 4000.0;
-  const lead::LeadDeviation lead = Sampled(length, 0.25, [&](double x) {
+  const LeadDeviation lead = Sampled(length, 0.25, [&](double x) {
     return slope * x + amplitude * std::sin(2 * kPi * x / lambda);
   });
-  lead::LeadMetricOptions options;
+  LeadMetricOptions options;
   options.lead_mm = 10;
-  const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, options);
+  const LeadMetrics m = ComputeLeadMetrics(lead, options);
   // Fit of x sin(2 pi x/lambda) over [0, L] with L = N lambda: the LS slope error is
   // cov(x, A sin)/var(x) = (-A lambda L/(2 pi) / L - mean terms) ... small: A*lambda/(2 pi) /
   // (L^2/12) times L; bound it and check e_a.
@@ -82,11 +82,11 @@ TEST(LeadMetrics, PureSineWithoutTilt) {
   // A sine with a window of a full period: the band is exactly 2 A; with a window of half a period
   // centred on a crest: 2 A too (from -A to +A takes half a period).
   const double amplitude = 5.0, lambda = 600.0;
-  const lead::LeadDeviation lead =
+  const LeadDeviation lead =
       Sampled(6000.0, 0.5, [&](double x) { return amplitude * std::cos(2 * kPi * x / lambda); });
-  lead::LeadMetricOptions options;
+  LeadMetricOptions options;
   options.lead_mm = 0;  // v_2pi not evaluated
-  const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, options);
+  const LeadMetrics m = ComputeLeadMetrics(lead, options);
   EXPECT_FALSE(m.v_2pi_um.has_value());
   EXPECT_NEAR(m.v_300_um, 2 * amplitude, 1e-2);  // 300 = half a period
   EXPECT_NEAR(m.accumulated_1000_um, 2 * amplitude, 1e-9);
@@ -124,32 +124,32 @@ TEST(LeadMetrics, MaxWindowRangeMatchesBruteForceOnRandomData) {
 
 TEST(LeadMetrics, EndMarginShortensTheUsefulTravel) {
   // Deviation steep only near the ends: a margin that cuts the ends removes it.
-  const lead::LeadDeviation lead = Sampled(
+  const LeadDeviation lead = Sampled(
       1000.0, 1.0, [](double x) { return x < 100 ? (100 - x) : (x > 900 ? (x - 900) : 0.0); });
-  lead::LeadMetricOptions options;
+  LeadMetricOptions options;
   options.end_margin_mm = 100;
-  const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, options);
+  const LeadMetrics m = ComputeLeadMetrics(lead, options);
   EXPECT_NEAR(m.useful_travel_mm, 800, 1e-9);
   EXPECT_NEAR(m.v_u_um, 0, 1e-12);
   EXPECT_NEAR(m.accumulated_total_um, 0, 1e-12);
   options.end_margin_mm = 500;
-  EXPECT_THROW(lead::ComputeLeadMetrics(lead, options), InputError);
+  EXPECT_THROW(ComputeLeadMetrics(lead, options), InputError);
   options.end_margin_mm = -1;
-  EXPECT_THROW(lead::ComputeLeadMetrics(lead, options), InputError);
+  EXPECT_THROW(ComputeLeadMetrics(lead, options), InputError);
 }
 
 TEST(LeadMetrics, MetricsAreOffsetFreeAndSignSymmetric) {
   std::mt19937 rng(3);
   std::normal_distribution<double> g(0, 5);
-  lead::LeadDeviation lead = Sampled(3000, 2.0, [&](double) { return g(rng); });
-  lead::LeadMetricOptions options;
+  LeadDeviation lead = Sampled(3000, 2.0, [&](double) { return g(rng); });
+  LeadMetricOptions options;
   options.lead_mm = 16;
-  const lead::LeadMetrics a = lead::ComputeLeadMetrics(lead, options);
-  lead::LeadDeviation shifted = lead, flipped = lead;
+  const LeadMetrics a = ComputeLeadMetrics(lead, options);
+  LeadDeviation shifted = lead, flipped = lead;
   for (auto& d : shifted.deviation_um) d += 123.0;
   for (auto& d : flipped.deviation_um) d = -d;
-  for (const lead::LeadDeviation* other : {&shifted, &flipped}) {
-    const lead::LeadMetrics b = lead::ComputeLeadMetrics(*other, options);
+  for (const LeadDeviation* other : {&shifted, &flipped}) {
+    const LeadMetrics b = ComputeLeadMetrics(*other, options);
     EXPECT_NEAR(std::abs(a.e_a_um), std::abs(b.e_a_um), 1e-9);
     EXPECT_NEAR(a.v_u_um, b.v_u_um, 1e-9);
     EXPECT_NEAR(a.v_300_um, b.v_300_um, 1e-9);
@@ -164,10 +164,10 @@ TEST(LeadMetrics, MetricsAreOffsetFreeAndSignSymmetric) {
 }
 
 TEST(LeadMetrics, CoarseSamplesLeaveV2piUnevaluated) {
-  const lead::LeadDeviation lead = Sampled(1000, 10.0, [](double x) { return 0.01 * x; });
-  lead::LeadMetricOptions options;
+  const LeadDeviation lead = Sampled(1000, 10.0, [](double x) { return 0.01 * x; });
+  LeadMetricOptions options;
   options.lead_mm = 10;
-  EXPECT_FALSE(lead::ComputeLeadMetrics(lead, options).v_2pi_um.has_value());
+  EXPECT_FALSE(ComputeLeadMetrics(lead, options).v_2pi_um.has_value());
 }
 
 class LeadFile : public ::testing::Test {
@@ -182,10 +182,10 @@ class LeadFile : public ::testing::Test {
 };
 
 TEST_F(LeadFile, RoundTripKeepsEveryValue) {
-  lead::LeadDeviation lead = Sampled(100, 0.1, [](double x) { return std::sin(x) / 3.0; });
+  LeadDeviation lead = Sampled(100, 0.1, [](double x) { return std::sin(x) / 3.0; });
   const auto p = dir_ / "round.csv";
-  lead::WriteLeadDeviation(p, lead, {"provenance: test"});
-  const lead::LeadDeviation back = lead::ReadLeadDeviation(p);
+  WriteLeadDeviation(p, lead, {"provenance: test"});
+  const LeadDeviation back = ReadLeadDeviation(p);
   ASSERT_EQ(back.size(), lead.size());
   for (std::size_t i = 0; i < lead.size(); ++i) {
     EXPECT_EQ(back.position_mm[i], lead.position_mm[i]);
@@ -196,19 +196,19 @@ TEST_F(LeadFile, RoundTripKeepsEveryValue) {
 TEST_F(LeadFile, BadFilesNameFileAndLine) {
   const auto decreasing = Write("dec.csv", "# c\nposition_mm,deviation_um\n0,1\n5,2\n5,3\n");
   try {
-    lead::ReadLeadDeviation(decreasing);
+    ReadLeadDeviation(decreasing);
     FAIL() << "no throw";
   } catch (const InputError& e) {
     const std::string msg = e.what();
     EXPECT_NE(msg.find("dec.csv:5"), std::string::npos) << msg;
     EXPECT_NE(msg.find("increase strictly"), std::string::npos) << msg;
   }
-  EXPECT_THROW(lead::ReadLeadDeviation(Write("one.csv", "position_mm,deviation_um\n0,1\n")), InputError);
-  EXPECT_THROW(lead::ReadLeadDeviation(Write("col.csv", "position_mm,dev_um\n0,1\n1,2\n")), InputError);
-  EXPECT_THROW(lead::ReadLeadDeviation(Write("nan.csv", "position_mm,deviation_um\n0,1\n1,nan\n")),
+  EXPECT_THROW(ReadLeadDeviation(Write("one.csv", "position_mm,deviation_um\n0,1\n")), InputError);
+  EXPECT_THROW(ReadLeadDeviation(Write("col.csv", "position_mm,dev_um\n0,1\n1,2\n")), InputError);
+  EXPECT_THROW(ReadLeadDeviation(Write("nan.csv", "position_mm,deviation_um\n0,1\n1,nan\n")),
                InputError);
-  EXPECT_THROW(lead::ReadLeadDeviation(dir_ / "missing.csv"), InputError);
+  EXPECT_THROW(ReadLeadDeviation(dir_ / "missing.csv"), InputError);
 }
 
 }  // namespace
-}  // namespace whirl::compare
+}  // namespace whirl::lead
