@@ -22,7 +22,7 @@
 #include "surface/line840d.h"
 #include "surface/report.h"
 #include "surface/surface.h"
-#include "surface/synthetic.h"
+#include "synthetic/surface.h"
 
 namespace whirl::cli {
 namespace {
@@ -32,7 +32,7 @@ using namespace whirl::surface;
 // --- synth -------------------------------------------------------------------------------------
 
 struct SynthCli {
-  SyntheticOptions synth;
+  synthetic::SyntheticOptions synth;
   std::string field = "smooth";
   std::string out;
   bool json = false;
@@ -40,10 +40,10 @@ struct SynthCli {
 
 void RunSynth(const SynthCli& o) {
   CheckOutputs({}, {{"--out", o.out}});
-  SyntheticOptions s = o.synth;
-  s.field = ParseSyntheticField(o.field);
-  const auto points = SyntheticPoints(s);
-  WriteFileAtomic(o.out, FormatPointsCsv(points, SyntheticProvenance(s)));
+  synthetic::SyntheticOptions s = o.synth;
+  s.field = synthetic::ParseSyntheticField(o.field);
+  const auto points = synthetic::SyntheticPoints(s);
+  WriteFileAtomic(o.out, FormatPointsCsv(points, synthetic::SyntheticProvenance(s)));
   if (o.json)
     PrintJson({{"schema", "whirl.surface_synth"},
                {"schema_version", 1},

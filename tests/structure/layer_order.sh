@@ -22,7 +22,8 @@ PRODUCT_LAYERS=(
   "plan ballbar surface"       # plan files (interp, screw), ball bar (interp), worktable (drift, interp)
 )
 LAB_LAYERS=(
-  "sim torch"                  # the simulator, the LibTorch cross-check (nn)
+  "sim torch synthetic"        # the simulator, the LibTorch cross-check (nn), synthetic ball-bar
+                               # and worktable data (ballbar, surface)
   "machine compare"            # machine worlds (drift, sim), strategy comparison (sim, interp, ...)
   "machine_eval"               # the machine evaluation (compare, machine)
 )

@@ -1,4 +1,4 @@
-#include "ballbar/simulate.h"
+#include "synthetic/ballbar.h"
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +9,7 @@
 #include "core/output_dir.h"
 #include "core/random.h"
 
-namespace whirl::ballbar {
+namespace whirl::synthetic {
 namespace {
 
 double Uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.Uniform(); }
@@ -22,9 +22,9 @@ double Round(double x, double step) {
   return std::round(x * k) / k;
 }
 
-PivotCentres Layout(const WarmupOptions& o, Rng& rng) {
+ballbar::PivotCentres Layout(const WarmupOptions& o, Rng& rng) {
   const double h = o.bar_length_mm / std::sqrt(3.0), r = o.bar_length_mm * std::sqrt(2.0 / 3.0);
-  PivotCentres p;
+  ballbar::PivotCentres p;
   const double angles_deg[3] = {210, 330, 90};
   for (int i = 0; i < 3; ++i) {
     const double a = angles_deg[i] * kPi / 180;
@@ -90,7 +90,7 @@ WarmupSimulation SimulateWarmup(const WarmupOptions& o) {
         const double true_len = (ball - s.pivots_mm[pivot]).norm();
         const double read = true_len / (1 + o.bar_alpha_per_K * (temp - 20)) +
                             o.bar_noise_sd_um * rng.Normal() / 1000;
-        Reading r;
+        ballbar::Reading r;
         r.time_min = t;
         r.pivot = pivot + 1;
         r.length_mm = Round(read, o.resolution_um / 1000);
@@ -106,12 +106,12 @@ WarmupSimulation SimulateWarmup(const WarmupOptions& o) {
   return s;
 }
 
-CircleTrace SimulateCircle(const CirclePlant& p) {
+ballbar::CircleTrace SimulateCircle(const CirclePlant& p) {
   Rng rng(MixSeed(p.seed, 1500));
-  const bool semi = p.plane != Plane::kXY;
+  const bool semi = p.plane != ballbar::Plane::kXY;
   const int n = semi ? p.samples / 2 + 1 : p.samples;
   const double span = semi ? 180.0 : 360.0 * (n - 1) / n;
-  CircleTrace c;
+  ballbar::CircleTrace c;
   c.source = "simulated";
   const double r_um = p.radius_mm * 1000;
   for (int i = 0; i < n; ++i) {
@@ -156,7 +156,7 @@ std::vector<DemoTrace> DemoTraces(std::uint64_t seed) {
           "Z travel leaning 40 urad towards +X (spindle / Z-guide parallelism), XZ semicircle",
           "--plane XZ --radius-mm 100",
           {}};
-  t[2].plant.plane = Plane::kXZ;
+  t[2].plant.plane = ballbar::Plane::kXZ;
   t[2].plant.squareness_urad = 40;
   for (std::size_t i = 0; i < t.size(); ++i) t[i].plant.seed = MixSeed(seed, i);
   return t;
@@ -209,10 +209,10 @@ nlohmann::json WriteSimulatedMeasurement(const std::filesystem::path& dir, const
   const std::vector<std::string> provenance = {"SIMULATED ball-bar measurement: " + command,
                                                "model and planted values: README.md"};
   std::vector<std::pair<std::string, std::string>> files;
-  Readings readings = s.readings;
+  ballbar::Readings readings = s.readings;
   readings.comments = provenance;
-  files.push_back({"readings.csv", FormatReadings(readings)});
-  nlohmann::json pivots = PivotsToJson(s.pivots_mm);
+  files.push_back({"readings.csv", ballbar::FormatReadings(readings)});
+  nlohmann::json pivots = ballbar::PivotsToJson(s.pivots_mm);
   pivots["comment"] = "SIMULATED: " + command;
   files.push_back({"pivots.json", pivots.dump(2) + "\n"});
   std::vector<std::vector<double>> truth;
@@ -224,10 +224,10 @@ nlohmann::json WriteSimulatedMeasurement(const std::filesystem::path& dir, const
                  {provenance[0], "the planted drift (truth), relative to the cold block"})});
   const std::vector<DemoTrace> traces = DemoTraces(o.seed);
   for (const auto& t : traces) {
-    CircleTrace c = SimulateCircle(t.plant);
+    ballbar::CircleTrace c = SimulateCircle(t.plant);
     c.comments = {provenance[0], "planted: " + t.what,
                   "fit: whirl ballbar circle --trace " + t.file + " " + t.fit_options};
-    files.push_back({t.file, FormatCircleTrace(c)});
+    files.push_back({t.file, ballbar::FormatCircleTrace(c)});
   }
   files.push_back({"README.md", Readme(s, o, command, traces)});
   OutputDir out(dir, "output directory");
@@ -244,4 +244,4 @@ nlohmann::json WriteSimulatedMeasurement(const std::filesystem::path& dir, const
           {"readings", s.readings.rows.size()}};
 }
 
-}  // namespace whirl::ballbar
+}  // namespace whirl::synthetic

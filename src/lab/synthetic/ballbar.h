@@ -32,7 +32,7 @@
 #include "ballbar/circle.h"
 #include "ballbar/drift.h"
 
-namespace whirl::ballbar {
+namespace whirl::synthetic {
 
 struct WarmupOptions {
   std::uint64_t seed = 1;
@@ -52,8 +52,8 @@ struct WarmupOptions {
 };
 
 struct WarmupSimulation {
-  PivotCentres pivots_mm{};
-  Readings readings;
+  ballbar::PivotCentres pivots_mm{};
+  ballbar::Readings readings;
   Eigen::Vector3d final_drift_um;  ///< D per axis
   Eigen::Vector3d tau_min;         ///< tau per axis
   std::vector<double> block_time_min;
@@ -66,7 +66,7 @@ Eigen::Vector3d WarmupDrift(const WarmupSimulation& sim, double t_min);
 
 /// Planted errors of one circle trace (see the header comment).
 struct CirclePlant {
-  Plane plane = Plane::kXY;
+  ballbar::Plane plane = ballbar::Plane::kXY;
   double radius_mm = 100;
   int samples = 1440;  ///< over the full circle (0.25 deg), or half + 1 over the semicircle
   double centre_1_um = 0, centre_2_um = 0;
@@ -78,7 +78,7 @@ struct CirclePlant {
   std::uint64_t seed = 1;
 };
 
-CircleTrace SimulateCircle(const CirclePlant& plant);
+ballbar::CircleTrace SimulateCircle(const CirclePlant& plant);
 
 /// Writes the demo measurement into `dir` (created if missing): readings.csv, pivots.json,
 /// truth_drift.csv, circle_xy_scale.csv, circle_xy_cyclic.csv, circle_xz_parallelism.csv and a
@@ -88,4 +88,4 @@ CircleTrace SimulateCircle(const CirclePlant& plant);
 nlohmann::json WriteSimulatedMeasurement(const std::filesystem::path& dir,
                                          const WarmupOptions& options);
 
-}  // namespace whirl::ballbar
+}  // namespace whirl::synthetic

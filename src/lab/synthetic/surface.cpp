@@ -1,4 +1,4 @@
-#include "surface/synthetic.h"
+#include "synthetic/surface.h"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "core/random.h"
 
-namespace whirl::surface {
+namespace whirl::synthetic {
 namespace {
 
 void Require(bool ok, const std::string& field, double value, const std::string& rule) {
@@ -25,15 +25,15 @@ SyntheticField ParseSyntheticField(const std::string& s) {
 }
 
 void SyntheticOptions::Validate() const {
-  Require(length_x_mm > 0 && length_x_mm <= kMaxCoordinateMm, "length_x_mm", length_x_mm,
+  Require(length_x_mm > 0 && length_x_mm <= surface::kMaxCoordinateMm, "length_x_mm", length_x_mm,
           "must be in (0, 100000] mm");
-  Require(length_y_mm > 0 && length_y_mm <= kMaxCoordinateMm, "length_y_mm", length_y_mm,
+  Require(length_y_mm > 0 && length_y_mm <= surface::kMaxCoordinateMm, "length_y_mm", length_y_mm,
           "must be in (0, 100000] mm");
-  Require(nx >= 2 && nx <= static_cast<int>(kMaxGridLines), "nx", nx, "must be in 2..200");
-  Require(ny >= 2 && ny <= static_cast<int>(kMaxGridLines), "ny", ny, "must be in 2..200");
-  Require(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) <= kMaxPoints, "nx * ny",
-          nx * ny,
-          "at most " + std::to_string(kMaxPoints) +
+  Require(nx >= 2 && nx <= static_cast<int>(surface::kMaxGridLines), "nx", nx, "must be in 2..200");
+  Require(ny >= 2 && ny <= static_cast<int>(surface::kMaxGridLines), "ny", ny, "must be in 2..200");
+  Require(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) <= surface::kMaxPoints,
+          "nx * ny", nx * ny,
+          "at most " + std::to_string(surface::kMaxPoints) +
               " points (the limit of a points file, which "
               "surface fit reads)");
   Require(noise_um >= 0 && noise_um <= 10, "noise_um", noise_um, "must be in [0, 10] um");
@@ -54,10 +54,10 @@ double SyntheticErrorUm(const SyntheticOptions& o, double x_mm, double y_mm) {
   return e;
 }
 
-std::vector<SurfacePoint> SyntheticPoints(const SyntheticOptions& o) {
+std::vector<surface::SurfacePoint> SyntheticPoints(const SyntheticOptions& o) {
   o.Validate();
   Rng rng(o.seed);
-  std::vector<SurfacePoint> points;
+  std::vector<surface::SurfacePoint> points;
   for (int i = 0; i < o.ny; ++i)
     for (int j = 0; j < o.nx; ++j) {
       const double x = o.length_x_mm * j / (o.nx - 1), y = o.length_y_mm * i / (o.ny - 1);
@@ -82,4 +82,4 @@ std::vector<std::string> SyntheticProvenance(const SyntheticOptions& o) {
   return c;
 }
 
-}  // namespace whirl::surface
+}  // namespace whirl::synthetic

@@ -19,7 +19,7 @@
 #include "surface/bspline.h"
 #include "surface/points.h"
 
-namespace whirl::surface {
+namespace whirl::synthetic {
 
 enum class SyntheticField { kSmooth, kBump };
 std::string ToString(SyntheticField f);                  ///< "smooth" / "bump"
@@ -42,9 +42,9 @@ struct SyntheticOptions {
 double SyntheticErrorUm(const SyntheticOptions& o, double x_mm, double y_mm);
 
 /// The measured grid (field + noise).
-std::vector<SurfacePoint> SyntheticPoints(const SyntheticOptions& o);
+std::vector<surface::SurfacePoint> SyntheticPoints(const SyntheticOptions& o);
 
 /// '#' provenance lines for a points file: the field, its formula and the options.
 std::vector<std::string> SyntheticProvenance(const SyntheticOptions& o);
 
-}  // namespace whirl::surface
+}  // namespace whirl::synthetic
