@@ -1,5 +1,5 @@
 #pragma once
-// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/drift, kinds mlr and
+// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/product/drift, kinds mlr and
 // dynamic) evaluated every interpolation cycle by static synchronized actions from the machine's
 // analog inputs, written into SD43900 $SA_TEMP_COMP_ABS_VALUE (the position-independent K0 that
 // Siemens designed for exactly this, Siemens K3), plus the same model as a PLC table.
@@ -178,7 +178,7 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
 
 /// The largest |S_m| the slope model gives over its training ranges (a box bound: |c_0| +
 /// sum |c_f| max(|min_f|, |max_f|)), mm/mm. The plan's slopes plus this must stay within MD32760
-/// (machine_eval/machine_nc.h checks it for the combined programs).
+/// (machine_report/machine_nc.h checks it for the combined programs).
 double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options);
 
 /// What the control must provide for the drift program (control_requirements.h), the same

@@ -178,7 +178,7 @@ void AddSimulate(CLI::App& parent) {
   auto c = std::make_shared<SimulateCmd>();
   auto* sub = parent.add_subcommand(
       "simulate",
-      "Writes the documented SIMULATED ball-bar measurement (src/ballbar/simulate.h): a spindle\n"
+      "Writes the documented SIMULATED ball-bar measurement (src/lab/synthetic/ballbar.h): a spindle\n"
       "warm-up (drift 2-10 um in X, Y and 20-60 um in Z, seeded) read with bar noise 0.1 um at\n"
       "0.1 um resolution and a warming bar (readings.csv, pivots.json, truth_drift.csv), circle\n"
       "traces with a planted scale mismatch, cyclic error and XZ parallelism, and a README.md.");

@@ -1,4 +1,4 @@
-// whirl curve: the arctan elongation curve (src/fit/arctan_curve.h) from a model's prediction for a
+// whirl curve: the arctan elongation curve (src/product/fit/arctan_curve.h) from a model's prediction for a
 // screw, or from given features, sampled as CSV time_s,elongation_um.
 #include <cmath>
 #include <cstdio>

@@ -301,7 +301,7 @@ void RegisterEvaluate(CLI::App& app) {
                   "the cut), steady-rest (60 W), out-of-range (D 40-125 mm, lead 5-20 mm, "
                   "120-250 m/min; needs --allow-extrapolation). --random screws per scenario and "
                   "seed; prints the scenario x strategy table of median and worst accumulated "
-                  "error [um] within 1000 mm and over the thread (src/compare/scenarios.h)");
+                  "error [um] within 1000 mm and over the thread (src/lab/compare/scenarios.h)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
                 "evaluate the out-of-range scenario although the network extrapolates there");
   sub->add_flag("--markdown", o->markdown, "--scenarios: print the table as Markdown");

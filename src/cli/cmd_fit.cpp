@@ -1,6 +1,6 @@
 // whirl fit: features and fitted curve parameters of a measured (or simulated) elongation curve,
-// and the model comparison / shape calibration over simulated curves (src/fit/curve_fit.h,
-// src/compare/curve_study.h).
+// and the model comparison / shape calibration over simulated curves (src/product/fit/curve_fit.h,
+// src/lab/compare/curve_study.h).
 #include <cstdio>
 #include <memory>
 #include <string>

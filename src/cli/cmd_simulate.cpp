@@ -1,4 +1,4 @@
-// whirl simulate: the hard-whirling thermal simulator for one screw (src/sim/simulator.h).
+// whirl simulate: the hard-whirling thermal simulator for one screw (src/lab/sim/simulator.h).
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -124,7 +124,7 @@ void RegisterSimulate(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "simulate",
       "Simulate the thermal elongation (um) of the unmachined section of a screw during hard\n"
-      "whirling (1D transient heat conduction with a moving source, src/sim/simulator.h) and\n"
+      "whirling (1D transient heat conduction with a moving source, src/lab/sim/simulator.h) and\n"
       "print its features: max_elongation_um (plateau) and settle_time_s.\n"
       "Disturbances (workpiece variation, ambient drift, +-0.5 um sensor noise) are ON unless\n"
       "--no-disturbances; they are seeded by --seed.\n"

@@ -1,7 +1,7 @@
-// whirl train: fit the workpiece model (src/workpiece/model.h) to a process table: by default the
-// family choice by cross-validated error (src/family/family.h), or the Bayesian-regularized network
-// (src/nn/trainbr.h); or sweep the network's hidden size with k-fold cross-validation
-// (src/nn/selection.h).
+// whirl train: fit the workpiece model (src/product/workpiece/model.h) to a process table: by default the
+// family choice by cross-validated error (src/product/family/family.h), or the Bayesian-regularized network
+// (src/product/nn/trainbr.h); or sweep the network's hidden size with k-fold cross-validation
+// (src/product/nn/selection.h).
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -324,7 +324,7 @@ std::string TrainDescription() {
          "columns (the power law on log columns) must also beat the linear candidates' choice\n"
          "when both are refitted on 5 folds, by more than one standard error; else that linear\n"
          "fit is taken and a note says why. Prints the choice and the CV table\n"
-         "(src/family/family.h); sd calibrated by 5-fold cross-validation.\n"
+         "(src/product/family/family.h); sd calibrated by 5-fold cross-validation.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
          "--family network (implied by any network option below, raw columns unless\n"
          "--transform says otherwise): the Bayesian-regularized network (MATLAB trainbr:\n"
@@ -386,13 +386,13 @@ void RegisterTrain(CLI::App& app) {
                 "automatic relevance determination: inputs the data do not support are\n"
                 "shrunk), kept only if it took a step and its log evidence is higher;\n"
                 "every size fit, restart and noise fold, and every fit of --hidden-sweep\n"
-                "(src/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
+                "(src/product/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
                 "choose trainbr's epochs without ARD. Better from about 100 rows and for\n"
                 "settle time; docs/network.md");
   sub->add_flag("--stop-by-cv", o->stop_by_cv,
                 "stop at the epoch count with the lowest 5-fold cross-validation error\n"
                 "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"
-                "src/nn/model.h Stopping)");
+                "src/product/nn/model.h Stopping)");
   sub->add_option("--change", o->change,
                   "R brnn's stopping rule: stop when the objective F = beta ssE + alpha ssX\n"
                   "(dimensionless, normalized targets) changed by less than this between each\n"

@@ -1,4 +1,4 @@
-# Tests of src/ballbar (trilateration, drift, circle diagnostics, simulation) and its command line.
+# Tests of src/product/ballbar (trilateration, drift, circle diagnostics, simulation) and its command line.
 whirl_add_gtest(test_ballbar
   SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/test_trilateration.cpp

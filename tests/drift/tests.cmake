@@ -1,4 +1,4 @@
-# Tests of src/drift (run files, Miao et al.'s selection, drift models, evaluation) and its CLI.
+# Tests of src/product/drift (run files, Miao et al.'s selection, drift models, evaluation) and its CLI.
 whirl_add_gtest(test_drift
   SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/test_selection.cpp

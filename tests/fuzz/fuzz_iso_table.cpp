@@ -1,4 +1,4 @@
-// libFuzzer harness: ISO 3408-3 tolerance tables (compare/iso3408.h). Bad input must be an
+// libFuzzer harness: ISO 3408-3 tolerance tables (lead/iso3408.h). Bad input must be an
 // InputError; any other exception, crash, hang, leak or sanitizer report is a bug
 // (tests/fuzz/README.md).
 #include "lead/iso3408.h"

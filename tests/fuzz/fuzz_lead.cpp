@@ -1,4 +1,4 @@
-// libFuzzer harness: lead-deviation curves (compare/lead.h ReadLeadDeviation, then the metrics).
+// libFuzzer harness: lead-deviation curves (lead/lead.h ReadLeadDeviation, then the metrics).
 // Bad input must be an InputError; any other exception, crash, hang, leak or sanitizer report is a
 // bug (tests/fuzz/README.md).
 #include "lead/lead.h"

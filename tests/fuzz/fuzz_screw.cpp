@@ -1,4 +1,4 @@
-// libFuzzer harness: screw files (sim/screw.h ReadScrew). Bad input must be an InputError; any
+// libFuzzer harness: screw files (screw/screw.h ReadScrew). Bad input must be an InputError; any
 // other exception, crash, hang, leak or sanitizer report is a bug (tests/fuzz/README.md).
 #include "core/error.h"
 #include "fuzz_file.h"

@@ -14,7 +14,7 @@
 #include "machine_eval/field_eval.h"
 #include "machine_eval/field_history.h"
 #include "machine_eval/field_monitor.h"
-#include "machine_eval/seeds.h"
+#include "machine_eval/summary.h"
 #include "machine_eval/strategies.h"
 #include "machine_eval/trained_numbers.h"
 
@@ -291,7 +291,6 @@ TEST(FieldMonitor, RemovesMostOfAPersistentChangeTheSensorsDoNotSee) {
 SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_shop_seed_scale) {
   SeedsEvaluation e;
   e.scenario = "planted";
-  e.rows = FieldStrategies();
   for (int s = 0; s < 3; ++s) {
     e.seeds.push_back(static_cast<std::uint64_t>(s + 1));
     MachineEvaluation run;
@@ -310,13 +309,13 @@ SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_sho
   return e;
 }
 
-// T: headlines name the smallest thread median among the sensor-free rows of the table (rows
-// outside the table never), give the gain of both_shop with its per-seed range, and say plainly
-// whether the sensors beat it.
+// T: headlines name the smallest thread median among the sensor-free rows of the table (a
+// sensor row never), give the gain of both_shop with its per-seed range, and say plainly whether
+// the sensors beat it.
 TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
-  // none traditional workpiece machine both both_idle both_monitor class table nearest warmup
-  // schedule machine_shop both_shop lead_slope both_shop_monitor
-  std::vector<double> v = {60, 40, 30, 1, 1, 1, 1, 45, 42, 41, 25, 20, 18, 15, 28, 12};
+  // none traditional workpiece class table nearest warmup schedule lead_slope machine_shop
+  // both_shop both_shop_monitor
+  std::vector<double> v = {60, 40, 30, 45, 42, 41, 25, 20, 28, 18, 15, 12};
   ASSERT_EQ(v.size(), kMachineStrategyCount);
   SeedsEvaluation e = Planted(v, 1.0);
   auto h = MachineHeadlines(e);
@@ -343,19 +342,29 @@ TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
   h = MachineHeadlines(e);
   EXPECT_NE(h[1].find("(per seed -68.8 .. +25.0 %"), std::string::npos) << h[1];
   EXPECT_NE(h[3].find("both_shop (sensors) does NOT beat"), std::string::npos) << h[3];
-  // A sensor-free row outside the table is never named; a sensor row never either.
-  v[static_cast<std::size_t>(MachineStrategy::kNearest)] = 10;
+  // A sensor row is never named, however small; a smaller sensor-free row is.
+  v[static_cast<std::size_t>(MachineStrategy::kMachineShop)] = 5;
   e = Planted(v, 1.0);
-  e.rows.erase(std::find(e.rows.begin(), e.rows.end(), MachineStrategy::kNearest));
   h = MachineHeadlines(e);
   EXPECT_NE(h[0].find("is schedule"), std::string::npos) << h[0];
-  e.rows = FieldStrategies();
+  v[static_cast<std::size_t>(MachineStrategy::kNearest)] = 10;
+  e = Planted(v, 1.0);
   h = MachineHeadlines(e);
   EXPECT_NE(h[0].find("is nearest"), std::string::npos) << h[0];
+  // One row per strategy of the one list, in its order; the retired legacy rows are gone.
   const std::string table = FormatSeedsTable(e, true);
-  EXPECT_EQ(table.find("| planted | both_idle |"), std::string::npos);
-  EXPECT_NE(table.find("| planted | both_shop |"), std::string::npos);
-  EXPECT_NE(table.find("| planted | both_shop_monitor |"), std::string::npos);
+  std::size_t at = 0;
+  for (MachineStrategy s : MachineStrategies()) {
+    const std::string row = "| planted | " + ToString(s) + " |";
+    const std::size_t found = table.find(row);
+    ASSERT_NE(found, std::string::npos) << row;
+    EXPECT_GT(found, at) << row << " out of order";
+    EXPECT_EQ(table.find(row, found + 1), std::string::npos) << row << " twice";
+    at = found;
+  }
+  for (const char* retired : {"both_idle", "both_monitor", "| planted | machine |",
+                              "| planted | both |"})
+    EXPECT_EQ(table.find(retired), std::string::npos) << retired;
 }
 
 }  // namespace

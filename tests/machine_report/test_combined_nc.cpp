@@ -1,170 +1,197 @@
-// The combined 840D programs of a screw on a simulated drifting machine,
-// replayed as the control runs them (tests/interp/nc_replay.h) with the screw's own virtual
-// sensor log on the analog inputs: at every cycle of the cut the control applies the workpiece
-// plan plus the machine's offset and Z-screw line, i.e. what the evaluation's "both" strategy
-// applies (machine_eval/machine_eval.h: K(t) + G(t) (z_fixed - z(t)) / 1000, K and G the drift
-// models on the log, linear between samples); the drift action is the only writer of SD43900-43920
-// and the reset programs leave the control as found.
+// The combined 840D programs of a screw on the field machine (machine_report/machine_nc.h),
+// replayed as the control runs them (tests/interp/nc_replay.h) from the day's power-on, with the
+// control's log (its filtered temperatures and duty signals) on the analog inputs: at every
+// control sample the control applies the workpiece plan plus what the evaluation's both_shop
+// applies from that sample on (the sensor model a shop trained, drift/joint.h, run causally:
+// machine_eval/strategies.h, K0_k + G_k (z_ref - z) / 1000); while the axis waits before the
+// thread start, the machine line alone; the reset programs leave the control as found. The
+// analog inputs hold each sample's values over the interval that ends at it (the interval the
+// causal evaluator's lag step covers), so the two agree at the samples; between samples the
+// control moves on every cycle while both_shop holds the last sample.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
-#include "drift/fit.h"
-#include "drift/model.h"
+#include "core/process.h"
+#include "drift/joint.h"
 #include "interp/nc_replay.h"
-#include "machine_eval/machine_nc.h"
-#include "screw/screw.h"
+#include "machine/scenarios.h"
+#include "machine_eval/field_eval.h"
+#include "machine_eval/strategies.h"
+#include "machine_report/machine_nc.h"
+#include "workpiece/model.h"
 
-namespace whirl::machine_eval {
+namespace whirl::machine_report {
 namespace {
 
-std::string ProfilePath() {
-  return std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_840d.json";
+constexpr double kReplayCycleMs = 100;  // the largest cycle the profile allows: 100 per sample
+
+std::string CombinedSource(const std::string& rel) {
+  return std::string(WHIRL_SOURCE_DIR) + "/" + rel;
 }
 
-// Linear interpolation of a column of samples taken every step_min, held after the last.
-double Interp(const Eigen::VectorXd& v, double step_min, double t_s) {
-  const double u = t_s / 60.0 / step_min;
-  const auto k = static_cast<Eigen::Index>(std::floor(u));
-  if (k + 1 >= v.size()) return v(v.size() - 1);
-  const double f = u - static_cast<double>(k);
-  return (1 - f) * v(k) + f * v(k + 1);
+// The first test-day screw of a constant-duty machine (one cut right after power-on) whose
+// screws have 400 mm of thread (about ten minutes of cut), with the models trained on its
+// history (one warm-up test, one laser test, two past days).
+const machine_eval::ReportScrew& ShortCut() {
+  static const machine_eval::ReportScrew* kept = [] {
+    machine::MachineScenario s = machine::FindMachineScenario("constant-duty");
+    s.jobs.base.thread_length_mm = 400;
+    machine_eval::FieldEvalOptions o;
+    o.machines = 1;
+    o.threads = 1;
+    o.seed = 2;
+    o.calendar.warmup_speeds_m_min = {180};
+    o.calendar.past_days = 2;
+    o.calendar.test_days = 1;
+    o.keep_report_screw = true;
+    const machine_eval::MachineEvaluation e = machine_eval::EvaluateFieldScenario(
+        s, workpiece::LoadWorkpieceModel(CombinedSource("models/default.json")),
+        compare::BuildExperienceRule(
+            ReadProcessTable(CombinedSource("datasets/whirling_500.csv"), true)),
+        lead::ReadIsoToleranceTable(
+            CombinedSource("datasets/standards/iso3408_3_lead_tolerances.csv")),
+        o);
+    if (!e.report) throw std::runtime_error("no report screw");
+    return new machine_eval::ReportScrew(*e.report);
+  }();
+  return *kept;
 }
 
-// The shipped profile (direction -1), or the same machine seen from an axis that runs +Z towards
-// the chuck (direction +1: program coordinate -z, the fixed bearing at offset - z_fixed).
-interp::MachineProfile Profile(int direction, interp::ControlDk control_dk) {
-  interp::MachineProfile p = interp::LoadMachineProfile(ProfilePath());
+// The shipped profile with the replay's cycle (direction -1), or the same machine seen from an
+// axis that runs +Z towards the chuck (direction +1: program coordinate -z, the fixed bearing at
+// offset - z_fixed).
+interp::MachineProfile CombinedProfile(int direction, interp::ControlDk control_dk,
+                                       double z_fixed_mm) {
+  interp::MachineProfile p =
+      interp::LoadMachineProfile(CombinedSource("datasets/machines/whirling_840d.json"));
   p.control_dk = control_dk;
+  p.drift->ipo_cycle_ms = kReplayCycleMs;
   if (direction == 1) {
     p.direction = 1;
     p.drift->error_direction = 1;
     p.drift->slope_growth_direction = 1;
-    p.drift->slope_fixed_end_mm =
-        p.machine_offset_mm - machine::DefaultMachine().z_screw.fixed_end_mm;
+    p.drift->slope_fixed_end_mm = p.machine_offset_mm - z_fixed_mm;
   }
   return p;
 }
 
-void ReplayOneCut(int direction, interp::ControlDk control_dk) {
+CombinedPrograms Build(const machine_eval::ReportScrew& r, const interp::MachineProfile& p) {
+  return BuildCombinedPrograms(r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm,
+                               r.plan_options, r.offset, r.slope, r.z_ref_mm, p, "test curve",
+                               "test model");
+}
+
+void ReplayTheDay(int direction, interp::ControlDk control_dk) {
   SCOPED_TRACE("direction " + std::to_string(direction) + ", control_dk " +
                interp::ToString(control_dk));
-  const machine::MachineConfig config = machine::DefaultMachine();
-  const std::uint64_t machine_seed = 5;
-  const MachineModels models = FitMachineModels(config, machine_seed, 2, drift::FitOptions{});
-  const machine::MachineDay day = machine::MachineDay::Draw(config, machine_seed, 991);
-  screw::Screw screw = screw::ReferenceScrew();
-  screw.thread_length_mm = 1500;  // 37 min of cutting keeps the test short
-  const screw::Kinematics kin = screw::ComputeKinematics(screw);
-  const double feed = kin.axial_feed_mm_s, t_cut = kin.cutting_time_s;
-  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({14.0, 900.0}, 4.0, 0.9);
-  const interp::MachineProfile profile = Profile(direction, control_dk);
-  interp::PlanOptions po;
-  po.tolerance_um = 0.5;
-  const CombinedPrograms p = BuildCombinedPrograms(curve, kin, screw.thread_length_mm, po, models,
-                                                   day.config, profile, "test curve");
-
-  machine::RunSpec spec;
-  spec.duration_min = t_cut / 60.0 + 2 * config.sample_min;
-  spec.cutting_speed_m_min = screw.process.cutting_speed_m_min;
-  const drift::Run log = machine::SimulateRun(day, spec);
-  const Eigen::VectorXd k_um = drift::PredictRun(models.offset_cutting, log).predicted_um;
-  const Eigen::VectorXd g_um = drift::PredictRun(models.slope_cutting, log).predicted_um;
-
-  interp::replay::Replay r;
-  r.control.abs_value_mm = -0.0013;  // what the control holds before
-  r.control.slope = 7e-6;
-  r.control.ref_position_mm = 100.0;
-  auto set_inputs = [&](double t_s) {
-    for (std::size_t s = 0; s < log.sensor_names.size(); ++s) {
-      const auto it = p.drift.inputs.find(log.sensor_names[s]);
-      ASSERT_NE(it, p.drift.inputs.end()) << log.sensor_names[s];
-      const Eigen::VectorXd col = log.temperature_C.col(static_cast<Eigen::Index>(s));
-      r.control.ain[it->second.index] =
-          (Interp(col, config.sample_min, t_s) - it->second.offset) / it->second.scale;
+  const machine_eval::ReportScrew& r = ShortCut();
+  const drift::Run& log = r.log;
+  const CombinedPrograms p = Build(r, CombinedProfile(direction, control_dk, r.z_ref_mm));
+  const machine_eval::HeldSamples held = machine_eval::RunCausally(r.sensor_model, log);
+  const Eigen::MatrixXd raw = drift::JointRawInputs(r.sensor_model, log);
+  std::vector<std::string> inputs = r.sensor_model.sensors;
+  inputs.insert(inputs.end(), r.sensor_model.other_inputs.begin(),
+                r.sensor_model.other_inputs.end());
+  interp::replay::Replay replay;
+  replay.control.abs_value_mm = -0.0013;  // what the control holds before
+  replay.control.slope = 7e-6;
+  replay.control.ref_position_mm = 100.0;
+  auto set_inputs = [&](int k) {
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const auto it = p.drift.inputs.find(inputs[i]);
+      ASSERT_NE(it, p.drift.inputs.end()) << inputs[i];
+      replay.control.ain[it->second.index] =
+          (raw(k, static_cast<Eigen::Index>(i)) - it->second.offset) / it->second.scale;
     }
   };
-  set_inputs(0.0);
-  ASSERT_TRUE(r.RunProgram(p.drift_nc));
-  const double s = interp::SignFactor(p.plan.options.sign);
-  const double z0 = kin.thread_start_position_mm, z_fixed = config.z_screw.fixed_end_mm;
-  // While the plan's part program runs the axis stands 5 mm before the thread start (z0 + 5 mm:
-  // the cut runs towards the chuck); every state it passes through applies the machine line
-  // alone (nothing of the plan before the thread start), never a slope about a stale reference.
-  const double park = interp::AxisPositionMm(p.plan.options, kin.axial_feed_mm_s, -5.0 / feed);
-  const double machine0_um = k_um(0) + g_um(0) * (z_fixed - (z0 + 5.0)) / 1e3;
-  double worst_start_um = 0;
-  r.axis_mm = park;
-  r.between_blocks = [&] {
-    r.Cycle(park);
-    worst_start_um =
-        std::max(worst_start_um, std::abs(r.control.DkMm(park) * 1000.0 / s - machine0_um));
+  const double feed = r.kinematics.axial_feed_mm_s, t_cut = r.kinematics.cutting_time_s;
+  const double z0 = r.kinematics.thread_start_position_mm;
+  const double park = interp::AxisPositionMm(p.plan.options, feed, -5.0 / feed);  // 5 mm before
+  auto axis_at = [&](double t_min) {  // where the axis is at log time t_min
+    const double t_s = (t_min - r.cut_start_min) * 60.0;
+    return t_s < 0 ? park : interp::AxisPositionMm(p.plan.options, feed, std::min(t_s, t_cut));
   };
-  ASSERT_TRUE(r.RunProgram(p.plan_nc));
-  r.between_blocks = nullptr;
-  EXPECT_LT(worst_start_um, 1e-3);
-  double worst_um = 0, largest_machine_um = 0;
-  // One cycle per second: the default machine models are MLR without lags, so the cycle length
-  // does not enter (lags are replayed per cycle in tests/interp/test_drift_action.cpp).
-  for (double t = 0; t < t_cut; t += 1.0) {
-    const double pos = interp::AxisPositionMm(p.plan.options, feed, t);
-    set_inputs(t);
-    r.Cycle(pos);
-    const double machine_um =
-        Interp(k_um, config.sample_min, t) +
-        Interp(g_um, config.sample_min, t) * (z_fixed - (z0 - feed * t)) / 1e3;
-    const double expected = interp::AppliedCompensationUm(p.plan, pos) + machine_um;
-    worst_um = std::max(worst_um, std::abs(r.control.DkMm(pos) * 1000.0 / s - expected));
-    largest_machine_um = std::max(largest_machine_um, std::abs(machine_um));
+  auto z_at = [&](double t_min) {  // the tool's distance from the chuck face
+    const double t_s = (t_min - r.cut_start_min) * 60.0;
+    return t_s < 0 ? z0 + 5.0 : z0 - feed * std::min(t_s, t_cut);
+  };
+  const double s = interp::SignFactor(p.plan.options.sign);
+  // Power-on: the drift action starts on the first sample; then the plan with the axis parked.
+  set_inputs(0);
+  replay.axis_mm = park;
+  ASSERT_TRUE(replay.RunProgram(p.drift_nc));
+  replay.Cycle(park);
+  ASSERT_TRUE(replay.RunProgram(p.plan_nc));
+  const int per_sample =
+      static_cast<int>(std::lround((log.time_min[1] - log.time_min[0]) * 60000.0 / kReplayCycleMs));
+  double worst_um = 0, worst_parked_um = 0, largest_machine_um = 0;
+  int cut_samples = 0;
+  for (int k = 1; k < log.samples(); ++k) {
+    const double t0 = log.time_min[static_cast<std::size_t>(k - 1)];
+    const double t1 = log.time_min[static_cast<std::size_t>(k)];
+    ASSERT_EQ(static_cast<int>(std::lround((t1 - t0) * 60000.0 / kReplayCycleMs)), per_sample);
+    set_inputs(k);
+    for (int c = 1; c <= per_sample; ++c) replay.Cycle(axis_at(t0 + (t1 - t0) * c / per_sample));
     if (::testing::Test::HasFailure()) return;
+    const double pos = axis_at(t1);
+    const double machine_um =
+        held.k0_um[static_cast<std::size_t>(k)] +
+        held.slope_um_per_1000[static_cast<std::size_t>(k)] * (r.z_ref_mm - z_at(t1)) / 1000.0;
+    const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
+    largest_machine_um = std::max(largest_machine_um, std::abs(machine_um));
+    if (t1 < r.cut_start_min) {  // parked before the thread start: the machine line alone
+      worst_parked_um = std::max(worst_parked_um, std::abs(applied_um - machine_um));
+    } else if (t1 <= r.cut_end_min) {
+      ++cut_samples;
+      worst_um = std::max(
+          worst_um, std::abs(applied_um - machine_um - interp::AppliedCompensationUm(p.plan, pos)));
+    }
   }
+  EXPECT_GT(cut_samples, 30);
   EXPECT_LT(worst_um, 1e-3);
-  EXPECT_GT(largest_machine_um, 5.0);  // the machine part is not trivially zero
+  EXPECT_LT(worst_parked_um, 1e-3);
+  EXPECT_GT(largest_machine_um, 2.0);  // the machine part is not trivially zero
   // The plan never writes a setting datum itself; after the cut and both resets the control
   // holds what it held before.
   EXPECT_EQ(p.plan_nc.find("SA_TEMP_COMP"), std::string::npos);
-  r.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
-  r.EndProgram();
-  ASSERT_TRUE(r.RunProgram(p.plan_reset_nc));
-  ASSERT_TRUE(r.RunProgram(p.drift_reset_nc));
-  EXPECT_TRUE(r.actions.empty());
-  EXPECT_EQ(r.control.abs_value_mm, -0.0013);
-  EXPECT_EQ(r.control.slope, 7e-6);
-  EXPECT_EQ(r.control.ref_position_mm, 100.0);
+  replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
+  replay.EndProgram();
+  ASSERT_TRUE(replay.RunProgram(p.plan_reset_nc));
+  ASSERT_TRUE(replay.RunProgram(p.drift_reset_nc));
+  EXPECT_TRUE(replay.actions.empty());
+  EXPECT_EQ(replay.control.abs_value_mm, -0.0013);
+  EXPECT_EQ(replay.control.slope, 7e-6);
+  EXPECT_EQ(replay.control.ref_position_mm, 100.0);
 }
 
-TEST(CombinedPrograms, ReplayAppliesPlanPlusMachineLineEverySecondOfTheCut) {
+TEST(CombinedPrograms, ReplayAppliesPlanPlusTheShopTrainedModelAtEveryControlSample) {
+  ASSERT_GT(ShortCut().sensor_model.features(), 0);
   for (int direction : {-1, 1})
     for (auto control_dk : {interp::ControlDk::kAdded, interp::ControlDk::kSubtracted})
-      ReplayOneCut(direction, control_dk);
+      ReplayTheDay(direction, control_dk);
 }
 
 TEST(CombinedPrograms, ProfileThatDisagreesWithTheMachineIsRefused) {
-  const machine::MachineConfig config = machine::DefaultMachine();
-  const MachineModels models = FitMachineModels(config, 2, 1, drift::FitOptions{});
-  const screw::Screw screw = screw::ReferenceScrew();
-  const screw::Kinematics kin = screw::ComputeKinematics(screw);
-  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({14.0, 900.0}, 4.0, 0.9);
-  interp::MachineProfile profile = interp::LoadMachineProfile(ProfilePath());
-  auto build = [&] {
-    return BuildCombinedPrograms(curve, kin, screw.thread_length_mm, interp::PlanOptions{}, models,
-                                 config, profile, "");
-  };
-  EXPECT_NO_THROW(build());
+  const machine_eval::ReportScrew& r = ShortCut();
+  interp::MachineProfile profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  EXPECT_NO_THROW(Build(r, profile));
   profile.drift->slope_fixed_end_mm += 10.0;  // the bearing is not where the machine has it
-  EXPECT_THROW(build(), InputError);
-  profile = interp::LoadMachineProfile(ProfilePath());
+  EXPECT_THROW(Build(r, profile), InputError);
+  profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
   profile.drift->slope_growth_direction = 1;
-  EXPECT_THROW(build(), InputError);
-  profile = interp::LoadMachineProfile(ProfilePath());
+  EXPECT_THROW(Build(r, profile), InputError);
+  profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
   profile.drift->workpiece_slope_param = -1;  // the plan would keep SD43910: two writers
-  EXPECT_THROW(build(), InputError);
-  MachineModels none;
-  EXPECT_THROW(BuildCombinedPrograms(curve, kin, screw.thread_length_mm, interp::PlanOptions{},
-                                     none, config, interp::LoadMachineProfile(ProfilePath()), ""),
-               InputError);
+  EXPECT_THROW(Build(r, profile), InputError);
+  profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  for (const std::string& in : r.sensor_model.sensors) profile.drift->inputs.erase(in);
+  if (!r.sensor_model.sensors.empty()) {
+    EXPECT_THROW(Build(r, profile), InputError);
+  }
 }
 
 }  // namespace
-}  // namespace whirl::machine_eval
+}  // namespace whirl::machine_report

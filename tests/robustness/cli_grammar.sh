@@ -207,7 +207,7 @@ done
 alias_case --out --out-dir machine sensors -- @FLAG@ "$D/runs_@FLAG@" --idle 1 --cutting 0 --json
 alias_case --report --out-dir compare -- --model "$SRC/models/default.json" --screw "$S" --no-plots \
   @FLAG@ "$D/compare_@FLAG@" --json
-alias_case --report --out-dir machine evaluate -- --machines 1 --screws 1 --train-runs 1 \
+alias_case --report --out-dir machine evaluate -- --machines 1 --test-days 1 --past-days 1 \
   @FLAG@ "$D/machine_@FLAG@" --json
 
 # drift: a run log with time and one without (its time is the sample index); the error follows

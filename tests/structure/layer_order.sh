@@ -26,6 +26,7 @@ LAB_LAYERS=(
                                # and worktable data (ballbar, surface)
   "machine compare"            # machine worlds (drift, sim), strategy comparison (sim, interp, ...)
   "machine_eval"               # the machine evaluation (compare, machine)
+  "machine_report"             # one screw's report and combined programs (machine_eval)
 )
 CLI_LAYERS=("cli")             # the command line: parses and calls the library
 set -u

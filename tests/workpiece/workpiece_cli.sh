@@ -37,7 +37,7 @@ grep -q "OUTSIDE" out.txt || fail "row not flagged outside"
 grep -q '"model": "max_elongation_um: ' cmp.json || fail "compare does not name the model"
 grep -q '"model_vs_regression"' cmp.json || fail "compare lacks model vs regression"
 
-# At 20 rows a GP that bends the power law a little must win honest refits (src/family/family.h,
+# At 20 rows a GP that bends the power law a little must win honest refits (src/product/family/family.h,
 # ChoiceOptions::equivalence_sd). On this generated table (the simulator's seed 120001) the GP on
 # log columns beats the power law's leave-one-out error for max elongation but not the refits:
 # train takes the power law and says why, in its text and in --json.

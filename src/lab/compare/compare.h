@@ -20,7 +20,7 @@
 // partition and expansion coefficient, ambient drift) that the model never saw. The groove is
 // displaced by the true (noise-free) elongation: the sensor noise of the simulated recording is a
 // property of the recording, not of the screw. Lead deviation per strategy: compare/cut.h.
-// Metrics: compare/metrics.h with lead_mm = the screw's lead; ISO class: compare/iso3408.h.
+// Metrics: lead/metrics.h with lead_mm = the screw's lead; ISO class: lead/iso3408.h.
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -77,7 +77,7 @@ struct CompareOptions {
 
 struct StrategyOutcome {
   Strategy strategy = Strategy::kNone;
-  lead::LeadDeviation lead;  ///< travel deviation along the thread, um (sign: compare/lead.h)
+  lead::LeadDeviation lead;  ///< travel deviation along the thread, um (sign: lead/lead.h)
   lead::LeadMetrics metrics;
   lead::IsoVerdict iso;
 };

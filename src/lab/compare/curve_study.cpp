@@ -49,7 +49,7 @@ SimulatedFitReport FitSimulatedCurves(
     const sim::SimulationResult r = sim::Simulate(sim::RowScrew(report.inputs[i]), so, dist);
     report.features.push_back(r.features);
     // The shape is calibrated over the window the features were extracted from (a few settle
-    // times, sim/features.h step 0): beyond it the simulated curve keeps creeping up slowly.
+    // times, fit/features.h step 0): beyond it the simulated curve keeps creeping up slowly.
     curves.push_back(Head(r.curve, fit::AnalyzeSettle(r.curve, so.settle).window_s));
     fits.push_back(fit::FitAllModels(
         Head(r.curve, options.fit_window_factor * r.features.settle_time_s), options.fit));

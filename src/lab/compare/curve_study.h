@@ -1,5 +1,5 @@
 #pragma once
-// Fits over simulated curves of the training domain (src/sim): derives the default shape k and
+// Fits over simulated curves of the training domain (src/lab/sim): derives the default shape k and
 // time exponent p of the arctan curve (kDefaultShapeK, kDefaultTimeExponent) and repeats the
 // paper's model comparison (arctan vs parabola vs sine, Li, Ma and Jiang section 3) on them. Driven
 // by `whirl fit --simulated N`.

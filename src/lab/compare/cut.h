@@ -9,7 +9,7 @@
 // control shifts the tool by the compensation c(t) um (positive = the same direction as the
 // elongation it cancels). After cooling, the groove cut at time t lies (e(t) - c(t)) um further
 // towards the chuck than specified. Measured from the thread start (the first groove), the travel
-// deviation is (sign convention of compare/lead.h: actual minus specified travel)
+// deviation is (sign convention of lead/lead.h: actual minus specified travel)
 //
 //   d(x) = [e(t) - c(t)] - [e(0) - c(0)],      t = x / v,  0 <= x <= thread_length_mm
 //

@@ -75,6 +75,21 @@ drift::Run ControlLog(const MachineTimeline& timeline, int day, std::uint64_t se
   return DayLog(timeline, day, options, seed);
 }
 
+drift::Run CheckRingLog(const MachineTimeline& timeline, int day, double sample_s, double z_mm,
+                        double sigma_um, std::uint64_t seed) {
+  LogOptions options;
+  options.sample_s = sample_s;
+  drift::Run run = DayLog(timeline, day, options, MixSeed(seed, 0x6c6f67));
+  const std::vector<Reading> r =
+      ProbeReadings(timeline, run.time_min, z_mm, sigma_um, MixSeed(seed, 0x70726f));
+  run.error_names = {"offset_um"};
+  run.error_um.resize(run.samples(), 1);
+  for (int k = 0; k < run.samples(); ++k)
+    run.error_um(k, 0) = r[static_cast<std::size_t>(k)].value_um - r.front().value_um;
+  for (double& t : run.time_min) t -= day * 1440.0;  // minutes since the day's 00:00
+  return run;
+}
+
 std::vector<Reading> ProbeReadings(const MachineTimeline& timeline,
                                    const std::vector<double>& abs_min, double z_mm,
                                    double sigma_um, std::uint64_t seed) {

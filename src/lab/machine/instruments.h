@@ -79,6 +79,16 @@ std::vector<Reading> MeasureLead(const MachineTimeline& timeline, const CutRef& 
                                  const std::function<double(double t_s)>& workpiece_minus_comp_um,
                                  const LeadOptions& options, std::uint64_t seed);
 
+/// The day log of day d (sensors and duty every sample_s) with one error channel, `offset_um`: a
+/// displacement sensor against the check ring on the chuck read by the head at z_mm at every
+/// row, ProbeReadings with N(0, sigma_um) noise, zeroed at the first row (the day's power-on:
+/// the record's unknown zero is taken off, the first reading's noise stays in every row). What
+/// `whirl machine sensors` writes for trying the drift commands on the field machine: on a real
+/// machine such a channel is logged on warm-up tests; while cutting a shop reads the check ring
+/// only at set-ups (field_history.h). time_min: minutes since the day's 00:00.
+drift::Run CheckRingLog(const MachineTimeline& timeline, int day, double sample_s, double z_mm,
+                        double sigma_um, std::uint64_t seed);
+
 /// Control log of day d (for causal application): DayLog rows at the control sample from the
 /// day's power-on to its power-off (sensors and duty), seeded; the caller takes the rows it may
 /// use (those at or before the time of the compensation).

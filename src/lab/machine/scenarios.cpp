@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/random.h"
+#include "machine/instruments.h"
 
 namespace whirl::machine {
 
@@ -22,12 +23,6 @@ MachineScenario Production() {
 
 std::vector<MachineScenario> MachineScenarios() {
   std::vector<MachineScenario> all;
-  MachineScenario legacy;
-  legacy.name = "legacy";
-  legacy.description = "closed-form machine, one cut per day from cold (the old world)";
-  legacy.world = World::kLegacy;
-  legacy.hall = HallOptions::Ramp();
-  all.push_back(legacy);
   MachineScenario constant = Production();
   constant.name = "constant-duty";
   constant.description = "field machine, one cut per day right after power-on, hall ramp";
@@ -99,8 +94,6 @@ std::uint64_t MachineSeed(std::uint64_t seed, int machine_index) {
 
 std::vector<DayPlan> PlanCalendar(const MachineScenario& scenario, std::uint64_t machine_seed,
                                   const CalendarSpec& spec, double power_spread) {
-  if (scenario.world != World::kField)
-    throw InputError("machine scenario '" + scenario.name + "' has no field calendar");
   const int history = static_cast<int>(spec.warmup_speeds_m_min.size()) + spec.laser_tests +
                       spec.past_days;
   const int weeks = (history + 4) / 5;
@@ -134,9 +127,6 @@ std::vector<DayPlan> PlanCalendar(const MachineScenario& scenario, std::uint64_t
 MachineWorld BuildMachineWorld(const FieldMachineConfig& config, const MachineScenario& scenario,
                                std::uint64_t seed, int machine_index, const CalendarSpec& spec,
                                const TimelineOptions& options) {
-  if (scenario.world != World::kField)
-    throw InputError("machine scenario '" + scenario.name +
-                     "' is the legacy world: evaluate it with the legacy machine path");
   MachineWorld world;
   world.machine_seed = MachineSeed(seed, machine_index);
   FieldMachineConfig c = config;
@@ -147,6 +137,35 @@ MachineWorld BuildMachineWorld(const FieldMachineConfig& config, const MachineSc
                          MixSeed(world.machine_seed, 0x68616c6c));
   world.timeline = SimulateCalendar(machine, hall, std::move(days), options);
   return world;
+}
+
+std::vector<drift::Run> ShopDayLogs(const MachineScenario& scenario, std::uint64_t seed,
+                                    int warmup_tests, int production_days, double probe_z_mm,
+                                    double noise_um) {
+  for (const auto& [n, what] : {std::pair{warmup_tests, "warm-up tests"},
+                                std::pair{production_days, "production days"}})
+    if (n < 0 || n > 20)
+      throw InputError(std::string(what) + " = " + std::to_string(n) + ": must be within 0..20");
+  CalendarSpec spec;
+  spec.warmup_speeds_m_min.clear();
+  for (int i = 0; i < warmup_tests; ++i)
+    spec.warmup_speeds_m_min.push_back(
+        warmup_tests == 1 ? 180.0 : 150.0 + 60.0 * i / (warmup_tests - 1));
+  spec.laser_tests = 0;
+  spec.past_days = production_days;
+  spec.test_days = 1;
+  const MachineWorld world = BuildMachineWorld(DefaultFieldMachine(), scenario, seed, 0, spec);
+  std::vector<drift::Run> runs;
+  int idle = 0, cutting = 0;
+  for (const DayPlan& plan : world.timeline.days()) {
+    if (plan.day >= 0 || plan.role == DayRole::kLaserTest) continue;
+    drift::Run run = CheckRingLog(world.timeline, plan.day, 60, probe_z_mm, noise_um, plan.seed);
+    const bool warmup = plan.role == DayRole::kWarmupTest;
+    run.state = warmup ? drift::RunState::kIdle : drift::RunState::kCutting;
+    run.name = warmup ? "idle_" + std::to_string(++idle) : "cutting_" + std::to_string(++cutting);
+    runs.push_back(std::move(run));
+  }
+  return runs;
 }
 
 }  // namespace whirl::machine

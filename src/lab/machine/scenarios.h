@@ -1,7 +1,5 @@
 #pragma once
-// Named worlds of the machine evaluation. `legacy` is the closed-form machine of machine.h with
-// its old protocol (one cut per day from cold; reached only through this name; the evaluation
-// runs today's code path for it). Every other scenario is a field machine (field.h) living a
+// Named scenarios of the one machine world of the evaluation: a field machine (field.h) living a
 // shop's calendar (day.h) in a hall (hall.h):
 //   constant-duty       one cut per day right after power-on (>= 15.5 h off), hall ramp
 //                       N(0, 0.3 K/h): the old protocol in the new physics (elapsed time should win)
@@ -19,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "drift/run_file.h"
 #include "machine/day.h"
 #include "machine/field.h"
 #include "machine/hall.h"
@@ -26,19 +25,16 @@
 
 namespace whirl::machine {
 
-enum class World { kLegacy, kField };
-
 struct MachineScenario {
   std::string name;
   std::string description;  ///< one line
-  World world = World::kField;
   DayOptions day;
   JobMix jobs;
   HallOptions hall;
   std::optional<ZFeedback> z_feedback;  ///< override of the machine file's feedback
 };
 
-/// Every scenario, in the order above (legacy first).
+/// Every scenario, in the order above.
 std::vector<MachineScenario> MachineScenarios();
 /// "a,b,c" or "all"; InputError naming `flag`, the bad name and the valid names.
 std::vector<MachineScenario> SelectMachineScenarios(const std::string& list,
@@ -64,7 +60,7 @@ struct CalendarSpec {
 std::vector<DayPlan> PlanCalendar(const MachineScenario& scenario, std::uint64_t machine_seed,
                                   const CalendarSpec& spec, double power_spread);
 
-/// Seed of machine i of a run: MixSeed(seed, 0x4d00 + i) (as the legacy evaluation).
+/// Seed of machine i of a run: MixSeed(seed, 0x4d00 + i).
 std::uint64_t MachineSeed(std::uint64_t seed, int machine_index);
 
 /// One machine of a field scenario, simulated over its calendar.
@@ -73,8 +69,18 @@ struct MachineWorld {
   MachineTimeline timeline;  ///< days(), machine(), hall() inside
 };
 
+/// The day logs `whirl machine sensors` writes: machine 0 of `scenario` (seed `seed`) with
+/// `warmup_tests` warm-up tests (ring idle at speeds spread over 150..210 m/min; 180 m/min for
+/// one) and `production_days` past production days, no laser test; each day as
+/// instruments.h CheckRingLog (one row per minute, the check ring at `probe_z_mm`, displacement
+/// noise `noise_um`), state idle for a warm-up test and cutting for a production day, named
+/// idle_<n> and cutting_<n> in calendar order. InputError for counts outside 0..20.
+std::vector<drift::Run> ShopDayLogs(const MachineScenario& scenario, std::uint64_t seed,
+                                    int warmup_tests, int production_days, double probe_z_mm,
+                                    double noise_um);
+
 /// Draws machine i of the scenario (config with the scenario's Z override), its hall (seed
-/// MixSeed(machine_seed, 0x68616c6c)) and calendar, and simulates it. InputError for `legacy`.
+/// MixSeed(machine_seed, 0x68616c6c)) and calendar, and simulates it.
 MachineWorld BuildMachineWorld(const FieldMachineConfig& config, const MachineScenario& scenario,
                                std::uint64_t seed, int machine_index, const CalendarSpec& spec,
                                const TimelineOptions& options = {});

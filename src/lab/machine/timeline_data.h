@@ -1,5 +1,5 @@
 #pragma once
-// Internal to src/machine: the stored truth of a timeline. Included only by timeline.cpp,
+// Internal to src/lab/machine: the stored truth of a timeline. Included only by timeline.cpp,
 // instruments.cpp and truth.cpp; training code never sees it.
 #include <Eigen/Core>
 #include <vector>

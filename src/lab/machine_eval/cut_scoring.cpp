@@ -1,7 +1,7 @@
 #include "machine_eval/cut_scoring.h"
 
-#include "lead/lead.h"
 #include "core/error.h"
+#include "lead/lead.h"
 
 namespace whirl::machine_eval::detail {
 
@@ -47,7 +47,7 @@ void ScoreStrategies(
     const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
     double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
     const lead::IsoToleranceTable& iso_table, MachineEvalScrew* out,
-    MachineScrewDetail* detail) {
+    std::array<lead::LeadDeviation, kMachineStrategyCount>* leads) {
   lead::LeadMetricOptions mo = options.metrics;
   mo.lead_mm = screw.process.pitch_mm;
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
@@ -55,7 +55,7 @@ void ScoreStrategies(
         compare::CutLeadDeviation(truth, compensations[k], feed_mm_s, screw.thread_length_mm,
                                   screw.process.pitch_mm, options.cut);
     out->metrics[k] = lead::ComputeLeadMetrics(lead, mo);
-    if (detail) detail->leads[k] = lead;
+    if (leads) (*leads)[k] = lead;
     out->iso[k] = lead::EvaluateIsoClass(out->metrics[k], iso_table).reached;
   }
 }

@@ -1,8 +1,7 @@
 #pragma once
-// Pieces shared by the legacy and the field evaluation of one cut (machine_eval.h,
-// field_eval.h): a history rule's curve as an 840D plan, what a plan applies, the sum of two
-// compensations, and the scoring of every strategy's lead deviation (compare/cut.h) with its
-// ISO 3408-3 class.
+// Pieces of the evaluation of one cut (field_eval.h): a history rule's curve as an 840D plan,
+// what a plan applies, the sum of two compensations, and the scoring of every strategy's lead
+// deviation (compare/cut.h) with its ISO 3408-3 class.
 #include <array>
 
 #include "compare/compare.h"
@@ -28,12 +27,12 @@ compare::CompensationFunction Planned(const interp::CompensationPlan& plan, doub
 
 compare::CompensationFunction Sum(compare::CompensationFunction a, compare::CompensationFunction b);
 
-/// Metrics and ISO class of every strategy on the truth; `detail` (optional) keeps the leads.
+/// Metrics and ISO class of every strategy on the truth; `leads` (optional) keeps the leads.
 void ScoreStrategies(
     const ElongationCurve& truth,
     const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
     double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
     const lead::IsoToleranceTable& iso_table, MachineEvalScrew* out,
-    MachineScrewDetail* detail);
+    std::array<lead::LeadDeviation, kMachineStrategyCount>* leads = nullptr);
 
 }  // namespace whirl::machine_eval::detail

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 
 #include "core/curve.h"
 #include "core/error.h"
@@ -13,17 +14,6 @@
 
 namespace whirl::machine_eval {
 
-std::vector<MachineStrategy> FieldStrategies() {
-  using S = MachineStrategy;
-  return {S::kNone,   S::kTraditional, S::kWorkpiece, S::kClass,       S::kTable,    S::kNearest,
-          S::kWarmup, S::kSchedule,    S::kLeadSlope, S::kMachineShop, S::kBothShop,
-          S::kBothShopMonitor};
-}
-
-std::vector<std::string> FieldScheduleInputs() {
-  return {"ring_on", "cutting", "ring_load_pct", "z_speed_mm_min"};
-}
-
 FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
                                      const FieldProtocol& protocol,
                                      const WorkpieceResidual& workpiece_residual,
@@ -32,8 +22,9 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
   const drift::ShopRecord record =
       FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
-  m.shop = FitShopModels(record, m.z_ref_mm, FieldScheduleInputs());
+  m.shop = FitShopModels(record, m.z_ref_mm, ScheduleInputs());
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
+  m.control = ShopControlModels(m.shop.sensors, record.day_logs);
   m.records = static_cast<int>(record.records.size());
   for (const auto& r : record.records) m.readings += static_cast<int>(r.rows.size());
   return m;
@@ -75,13 +66,24 @@ WorkpieceResidual HistoryResidual(const MachineTimeline& tl, const Workpiece& wp
       const compare::CompensationFunction plan =
           detail::Planned(c.plan, c.kinematics.axial_feed_mm_s);
       const ElongationCurve e = c.truth;
-      return [e, plan](double t) {
-        return InterpolateLinear(e.time_s, e.elongation_um, t) - plan(t);
-      };
+      return
+          [e, plan](double t) { return InterpolateLinear(e.time_s, e.elongation_um, t) - plan(t); };
     } catch (const InputError&) {
       return nullptr;
     }
   };
+}
+
+// The screw of a test-day cut named for the pages and tables: its day, its place in the day and
+// its type, e.g. "day 0 cut 2 (D 63.2 mm, lead 10.0 mm, 180 m/min)".
+screw::Screw NamedCutScrew(const machine::Job& job, const CutRef& cut) {
+  screw::Screw s = job.screw;
+  const ProcessInputs& p = s.process;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "day %d cut %d (D %.1f mm, lead %.1f mm, %.0f m/min)", cut.day,
+                cut.job + 1, p.diameter_mm, p.pitch_mm, p.cutting_speed_m_min);
+  s.name = buf;
+  return s;
 }
 
 // A part of the machine's truth along the cut at the workpiece truth's times (linear between the
@@ -93,7 +95,8 @@ ElongationCurve TruthCurve(const std::vector<machine::TruthSample>& m, double st
   for (const machine::TruthSample& s : m) at.push_back(s.abs_min), value.push_back(part(s));
   ElongationCurve c;
   c.time_s = time_s;
-  for (double t : time_s) c.elongation_um.push_back(InterpolateLinear(at, value, start_min + t / 60.0));
+  for (double t : time_s)
+    c.elongation_um.push_back(InterpolateLinear(at, value, start_min + t / 60.0));
   return c;
 }
 
@@ -112,12 +115,15 @@ struct DayHeld {
   HeldSamples sensors, warmup, schedule, monitored;
 };
 
+// One test-day cut, every strategy; `report` (optional) receives its curves (the rest of the
+// report screw is the caller's).
 MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, const DayHeld& held,
-                                  const FieldMachineModels& models, const Workpiece& wp) {
+                                  const FieldMachineModels& models, const Workpiece& wp,
+                                  ReportScrew* report = nullptr) {
   const double z_ref_mm = models.z_ref_mm;
   const Job& job = tl.Day(cut.day).jobs[static_cast<std::size_t>(cut.job)];
   MachineEvalScrew out;
-  out.screw = job.screw;
+  out.screw = NamedCutScrew(job, cut);
   out.day = cut.day;
   out.start_type = machine::ToString(job.start_type);
   const compare::ScrewComparison c = CompareFieldCut(tl, cut, wp);
@@ -140,42 +146,87 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
     return Planned(detail::FeaturePlan(c, f, job.screw.thread_length_mm, wp.options), feed);
   };
   const compare::CompensationFunction none = compare::NoCompensation(), shop = line(held.sensors);
-  const double b = LeadSlopeFor(models.lead_slopes, job.screw.process.diameter_mm,
-                                job.screw.process.pitch_mm);
+  const double b =
+      LeadSlopeFor(models.lead_slopes, job.screw.process.diameter_mm, job.screw.process.pitch_mm);
   const compare::CompensationFunction lead_slope = [b, feed](double t) {
     return b * feed * t / 1000.0;
   };
   const std::array<compare::CompensationFunction, kMachineStrategyCount> comp = {
-      none, history(c.traditional_features), workpiece, none, none, none, none,
-      history(c.history_features[0]), history(c.history_features[1]),
-      history(c.history_features[2]), Sum(workpiece, line(held.warmup)),
-      Sum(workpiece, line(held.schedule)), shop, Sum(workpiece, shop), Sum(workpiece, lead_slope),
-      Sum(workpiece, line(held.monitored))};
-  detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out, nullptr);
+      none,                                 // none
+      history(c.traditional_features),      // traditional
+      workpiece,                            // workpiece
+      history(c.history_features[0]),       // class
+      history(c.history_features[1]),       // table
+      history(c.history_features[2]),       // nearest
+      Sum(workpiece, line(held.warmup)),    // warmup
+      Sum(workpiece, line(held.schedule)),  // schedule
+      Sum(workpiece, lead_slope),           // lead_slope
+      shop,                                 // machine_shop
+      Sum(workpiece, shop),                 // both_shop
+      Sum(workpiece, line(held.monitored))  // both_shop_monitor
+  };
+  detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out,
+                          report ? &report->leads : nullptr);
+  if (report) {
+    report->predicted_curve = c.predicted_curve;
+    report->kinematics = c.kinematics;
+    report->plan_options = wp.options.plan;
+    report->cut_start_min = start;
+    report->cut_end_min = start + k.cutting_time_s / 60.0;
+  }
   const std::size_t sources[] = {0, 1, 2};
   const ElongationCurve parts[] = {c.truth, TruthCurve(m, start, c.truth.time_s, HeadPart),
                                    TruthCurve(m, start, c.truth.time_s, AxisPart)};
   for (std::size_t s : sources)
     out.source_total_um[s] = detail::TotalOf(parts[s], none, feed, job.screw, wp.options);
-  out.residual_workpiece_total_um = detail::TotalOf(c.truth, workpiece, feed, job.screw, wp.options);
+  out.residual_workpiece_total_um =
+      detail::TotalOf(c.truth, workpiece, feed, job.screw, wp.options);
   out.residual_machine_total_um = detail::TotalOf(machine_total, shop, feed, job.screw, wp.options);
   out.ok = true;
   return out;
 }
 
-// Every test-day screw of one machine world.
+// The control's log from power-on to two samples after the cut (the report's sensor log).
+drift::Run LogUpTo(const drift::Run& log, double end_min) {
+  int n = 0;
+  while (n < log.samples() && log.time_min[static_cast<std::size_t>(n)] <= end_min) ++n;
+  return log.Slice(0, std::min(log.samples(), n + 2), log.name);
+}
+
+// The report screw's log, models and sensors (its curves come from EvaluateFieldCut); times from
+// the day's 00:00.
+void CompleteReport(const drift::Run& log, const FieldMachineModels& models, ReportScrew* r) {
+  r->log = LogUpTo(log, r->cut_end_min);
+  const double day_start = r->result.day * 1440.0;
+  for (double& t : r->log.time_min) t -= day_start;
+  r->cut_start_min -= day_start;
+  r->cut_end_min -= day_start;
+  r->sensor_model = models.shop.sensors;
+  r->offset = models.control.offset;
+  r->slope = models.control.slope;
+  r->sensors = models.shop.sensors.sensors;
+  r->sensors_choice = models.shop.sensors_choice;
+  r->z_ref_mm = models.z_ref_mm;
+}
+
+// Every test-day screw of one machine world; `report` (optional) receives the first screw that
+// is evaluated without error.
 std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
                                                const FieldMachineModels& models,
-                                               const FieldProtocol& protocol,
-                                               const Workpiece& wp, int machine_index) {
+                                               const FieldProtocol& protocol, const Workpiece& wp,
+                                               int machine_index,
+                                               std::optional<ReportScrew>* report = nullptr) {
   std::vector<MachineEvalScrew> out;
   MonitorState monitor;  // kept by the control from one test day to the next
   for (const machine::DayPlan& plan : tl.days()) {
     if (plan.day < 0) continue;
-    const drift::Run log = AverageSensors(
-        machine::ControlLog(tl, plan.day, MixSeed(plan.seed, 0x63746c)), protocol.sensor_average_min);
-    DayHeld held = {RunCausally(models.shop.sensors, log), RunCausally(models.shop.warmup, log),
-                    RunCausally(models.shop.schedule, log), {}};
+    const drift::Run log =
+        AverageSensors(machine::ControlLog(tl, plan.day, MixSeed(plan.seed, 0x63746c)),
+                       protocol.sensor_average_min);
+    DayHeld held = {RunCausally(models.shop.sensors, log),
+                    RunCausally(models.shop.warmup, log),
+                    RunCausally(models.shop.schedule, log),
+                    {}};
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));
@@ -185,16 +236,23 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
                          .held;
     for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
       MachineEvalScrew r;
+      ReportScrew kept;
+      const bool keep = report && !report->has_value();
       try {
-        r = EvaluateFieldCut(tl, {plan.day, j}, held, models, wp);
+        r = EvaluateFieldCut(tl, {plan.day, j}, held, models, wp, keep ? &kept : nullptr);
       } catch (const InputError& err) {
-        r.screw = plan.jobs[static_cast<std::size_t>(j)].screw;
+        r.screw = NamedCutScrew(plan.jobs[static_cast<std::size_t>(j)], {plan.day, j});
         r.day = plan.day;
         r.ok = false;
         r.error = err.what();
       }
       r.machine = machine_index;
       r.day_seed = plan.seed;
+      if (keep && r.ok) {
+        kept.result = r;
+        CompleteReport(log, models, &kept);
+        *report = std::move(kept);
+      }
       out.push_back(std::move(r));
     }
   }
@@ -223,31 +281,34 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
   std::vector<std::vector<MachineEvalScrew>> per(n);
   std::vector<FieldMachineModels> models(n);
   const Workpiece wp{model, rule, iso_table, options.compare};
+  std::optional<ReportScrew> report;
   ParallelFor(
       n, options.threads,
       [&](std::size_t i) {
         const machine::MachineWorld world =
-            machine::BuildMachineWorld(options.machine, scenario, options.seed,
-                                       static_cast<int>(i), options.calendar, options.timeline);
-        models[i] = TrainFieldMachine(world.timeline, options.protocol,
-                                      HistoryResidual(world.timeline, wp),
-                                      MixSeed(world.machine_seed, 0x73686f70));
-        per[i] = EvaluateTestDays(world.timeline, models[i], options.protocol, wp,
-                                  static_cast<int>(i));
+            machine::BuildMachineWorld(options.machine, scenario, options.seed, static_cast<int>(i),
+                                       options.calendar, options.timeline);
+        models[i] =
+            TrainFieldMachine(world.timeline, options.protocol, HistoryResidual(world.timeline, wp),
+                              MixSeed(world.machine_seed, 0x73686f70));
+        per[i] =
+            EvaluateTestDays(world.timeline, models[i], options.protocol, wp, static_cast<int>(i),
+                             i == 0 && options.keep_report_screw ? &report : nullptr);
       },
       progress);
   MachineEvaluation e;
-  e.rows = FieldStrategies();
   for (std::size_t i = 0; i < n; ++i) {
-    e.sensors_cutting.push_back(models[i].shop.sensors.sensors);
-    e.sensors_idle.push_back({models[i].shop.sensors_choice});
+    e.sensors.push_back(models[i].shop.sensors.sensors);
+    e.sensors_choice.push_back(models[i].shop.sensors_choice);
     e.screws.insert(e.screws.end(), per[i].begin(), per[i].end());
   }
   e.summary = SummarizeMachineEval(e.screws);
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "%s: %zu test-day screws on %d machines (%zu failed)",
-                scenario.name.c_str(), e.summary.screws, options.machines, e.summary.failed);
-  e.summary.message = buf;
+  e.summary.message = scenario.name + ", " + std::to_string(options.machines) +
+                      (options.machines == 1 ? " machine: " : " machines: ") + e.summary.message;
+  if (report) {
+    report->scenario = scenario.name;
+    e.report = std::move(report);
+  }
   return e;
 }
 
@@ -260,11 +321,11 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
   detail::CheckCount(seeds, 1, 20, "seeds");
   SeedsEvaluation e;
   e.scenario = scenario.name;
-  e.rows = FieldStrategies();
   const std::size_t per = static_cast<std::size_t>(options.machines);
   for (int s = 0; s < seeds; ++s) {
     FieldEvalOptions o = options;
     o.seed = options.seed + static_cast<std::uint64_t>(s);
+    o.keep_report_screw = options.keep_report_screw && s == 0;
     e.seeds.push_back(o.seed);
     e.runs.push_back(EvaluateFieldScenario(scenario, model, rule, iso_table, o,
                                            [&](std::size_t done, std::size_t) {
@@ -275,20 +336,18 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
 }
 
 std::vector<SeedsEvaluation> EvaluateMachineScenarios(
-    const std::vector<machine::MachineScenario>& scenarios, const screw::Screw& legacy_base,
-    const workpiece::WorkpieceModel& model, const compare::ExperienceRule& rule,
-    const lead::IsoToleranceTable& iso_table, const MachineEvalOptions& legacy,
-    const FieldEvalOptions& field, int seeds, const compare::EvaluateProgress& progress) {
+    const std::vector<machine::MachineScenario>& scenarios, const workpiece::WorkpieceModel& model,
+    const compare::ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
+    const FieldEvalOptions& options, int seeds, const compare::EvaluateProgress& progress) {
   std::vector<SeedsEvaluation> out;
   const std::size_t n = scenarios.size();
   for (std::size_t i = 0; i < n; ++i) {
     auto step = [&](std::size_t done, std::size_t total) {
       if (progress && total) progress(i * 1000 + 1000 * done / total, n * 1000);
     };
-    if (scenarios[i].world == machine::World::kLegacy)
-      out.push_back(EvaluateOverSeeds(legacy_base, model, rule, iso_table, legacy, seeds, step));
-    else
-      out.push_back(EvaluateFieldOverSeeds(scenarios[i], model, rule, iso_table, field, seeds, step));
+    FieldEvalOptions o = options;
+    o.keep_report_screw = options.keep_report_screw && i == 0;
+    out.push_back(EvaluateFieldOverSeeds(scenarios[i], model, rule, iso_table, o, seeds, step));
   }
   return out;
 }

@@ -1,6 +1,7 @@
 #pragma once
-// The machine evaluation on the field world (machine/scenarios.h: a machine as a thermal network
-// living a shop's calendar). Every figure it gives is measured in the project's simulator only.
+// The machine evaluation (machine_eval.h) of a field scenario (machine/scenarios.h: a machine as a
+// thermal network living a shop's calendar), over seeds and over several scenarios. Every figure
+// it gives is measured in the project's simulator only. It returns results and writes nothing.
 //
 // Protocol per machine of a scenario (machine/scenarios.h BuildMachineWorld): the calendar's
 // warm-up tests, laser test and past production days (all before day 0) give the shop's
@@ -14,16 +15,8 @@
 // machine/truth.h TrueCutError (head, Z axis, and the blank cut warm and measured at 20 degC). A
 // machine model runs on the day's control log (machine/instruments.h ControlLog, 10 s) from
 // power-on and is applied by zero-order hold of the latest sample at or before t
-// (strategies.h): past samples only.
-// Strategies (rows; the legacy-only rows machine, both, both_idle and both_monitor are not in the
-// field table: they read exact truth channels):
-//   none; traditional (the strongest history rule by leave-one-out, compare/history_rules.h);
-//   workpiece (the network's plan); class, table, nearest (each history rule); warmup and
-//   schedule (workpiece + that sensor-free machine rule); lead_slope (workpiece + the pitch
-//   correction of the nearest past screw type, field_history.h LeadSlopeFor); machine_shop (the
-//   sensor model alone); both_shop (workpiece + the sensor model); both_shop_monitor (both_shop
-//   with the offset channel updated on the test day from the probe checks at its set-ups,
-//   field_monitor.h; the checks' probe readings are instruments, seeded per day).
+// (strategies.h): past samples only. The strategies: machine_eval.h (the checks' probe readings
+// of both_shop_monitor are instruments, seeded per day).
 // Seeds: machine i of seed S is MachineSeed(S, i) (machine/scenarios.h); the workpiece truth of
 // job j on day d from MixSeed(DaySeed, 0x77700 + j): results do not depend on the thread count.
 #include <cstdint>
@@ -34,35 +27,35 @@
 #include "machine_eval/field_history.h"
 #include "machine_eval/field_monitor.h"
 #include "machine_eval/machine_eval.h"
-#include "machine_eval/seeds.h"
+#include "machine_eval/shop_models.h"
+#include "machine_eval/summary.h"
 
 namespace whirl::machine_eval {
 
 struct FieldEvalOptions {
   machine::FieldMachineConfig machine = machine::DefaultFieldMachine();
-  machine::CalendarSpec calendar;   ///< past_days, test_days, warm-up and laser tests
+  machine::CalendarSpec calendar;  ///< past_days, test_days, warm-up and laser tests
   FieldProtocol protocol;
   machine::TimelineOptions timeline;  ///< control sample; verification hooks for tests
-  int machines = 2;                 ///< machines per seed (1..20)
+  int machines = 2;                   ///< machines per seed (1..20)
   std::uint64_t seed = 1;
   compare::CompareOptions compare;  ///< the workpiece comparison (plan, curve shape, metrics)
   int threads = 2;                  ///< worker threads over machines (1..64)
+  /// Keep the first test-day screw of machine 0 (its curves, log and models) in the evaluation's
+  /// `report` for the report module (machine_report/); over seeds and scenarios only the first
+  /// seed of the first scenario keeps it.
+  bool keep_report_screw = false;
 };
-
-/// The rows of the field table, in MachineStrategy order.
-std::vector<MachineStrategy> FieldStrategies();
-
-/// The control signals of the field world's schedule rule: ring_on, cutting, ring_load_pct and
-/// z_speed_mm_min (Brecher, Hirsch and Weck 2004: the control's own drive data).
-std::vector<std::string> FieldScheduleInputs();
 
 /// What a machine's shop models learned, and from how much.
 struct FieldMachineModels {
   ShopModels shop;
   int records = 0, readings = 0;
-  double z_ref_mm = 0;  ///< reference of the slope (the Z screw's fixed bearing)
+  double z_ref_mm = 0;                     ///< reference of the slope (the Z screw's fixed bearing)
   std::vector<PastLeadSlope> lead_slopes;  ///< the lead-slope rule's past screws
   ProbeMonitor monitor;  ///< both_shop_monitor: the sensor model's offset channel and its ranges
+  /// The sensor model as the drift action's offset and slope models (shop_models.h).
+  ShopControl control;
 };
 
 /// The models of one machine world from its shop record (field_history.h) only.
@@ -87,12 +80,11 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
                                        const FieldEvalOptions& options, int seeds,
                                        const compare::EvaluateProgress& progress = {});
 
-/// Every selected scenario over seeds: legacy through EvaluateOverSeeds (legacy options), the
-/// field scenarios through EvaluateFieldOverSeeds. progress(done, n) counts scenarios x seeds.
+/// Every selected scenario over seeds (EvaluateFieldOverSeeds); progress(done, n) counts
+/// scenarios x 1000.
 std::vector<SeedsEvaluation> EvaluateMachineScenarios(
-    const std::vector<machine::MachineScenario>& scenarios, const screw::Screw& legacy_base,
-    const workpiece::WorkpieceModel& model, const compare::ExperienceRule& rule,
-    const lead::IsoToleranceTable& iso_table, const MachineEvalOptions& legacy,
-    const FieldEvalOptions& field, int seeds, const compare::EvaluateProgress& progress = {});
+    const std::vector<machine::MachineScenario>& scenarios, const workpiece::WorkpieceModel& model,
+    const compare::ExperienceRule& rule, const lead::IsoToleranceTable& iso_table,
+    const FieldEvalOptions& options, int seeds, const compare::EvaluateProgress& progress = {});
 
 }  // namespace whirl::machine_eval

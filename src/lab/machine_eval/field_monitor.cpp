@@ -3,26 +3,18 @@
 #include <algorithm>
 #include <cmath>
 
+#include "machine_eval/shop_models.h"
+
 namespace whirl::machine_eval {
 
 ProbeMonitor MakeProbeMonitor(const drift::JointDriftModel& sensors,
                               const std::vector<drift::Run>& training_logs) {
   ProbeMonitor m;
   if (sensors.features() == 0 || training_logs.empty()) return m;
-  m.offset = drift::ToDriftModels(sensors).first;
+  const ShopControl control = ShopControlModels(sensors, training_logs);
+  m.offset = control.offset;
   m.offset.residual_std_um = sensors.cv_rmse_um;
-  const Eigen::Index p = sensors.features();
-  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, 1e300), hi = -lo;
-  for (const drift::Run& log : training_logs) {
-    if (log.samples() == 0) continue;
-    const Eigen::MatrixXd x = drift::MonitorDesign(m.offset, log, drift::ReferenceMode::kRunStart);
-    lo = lo.cwiseMin(x.rightCols(p).colwise().minCoeff().transpose());
-    hi = hi.cwiseMax(x.rightCols(p).colwise().maxCoeff().transpose());
-  }
-  if (!(lo.array() <= hi.array()).all()) return m;
-  m.offset.feature_min = lo;
-  m.offset.feature_max = hi;
-  m.active = true;
+  m.active = control.ranged;
   return m;
 }
 
@@ -40,8 +32,7 @@ MonitoredDay MonitorWithSetupChecks(const HeldSamples& held, const ProbeMonitor&
                                     const drift::Run& log,
                                     const std::vector<machine::Reading>& checks, double z_ref_mm,
                                     double probe_z_mm, double probe_sigma_um,
-                                    const drift::MonitorOptions& options,
-                                    MonitorState* state) {
+                                    const drift::MonitorOptions& options, MonitorState* state) {
   MonitoredDay out;
   out.held = held;
   if (!monitor.active || log.samples() == 0) return out;
@@ -82,8 +73,8 @@ MonitoredDay MonitorWithSetupChecks(const HeldSamples& held, const ProbeMonitor&
     if (!update) continue;
     if (options.estimate_drift) drift::AddDriftVariance(innovations, d, &prior);
     b = drift::BayesUpdate(xi, Eigen::VectorXd::Constant(1, y), b, &prior, r);
-    const auto from = std::lower_bound(log.time_min.begin(), log.time_min.end(), t - 1e-9) -
-                      log.time_min.begin();
+    const auto from =
+        std::lower_bound(log.time_min.begin(), log.time_min.end(), t - 1e-9) - log.time_min.begin();
     pieces.push_back({static_cast<Eigen::Index>(from), b});
     ++out.updates;
   }

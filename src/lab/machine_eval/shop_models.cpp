@@ -1,81 +1,16 @@
-#include "machine_eval/history.h"
+#include "machine_eval/shop_models.h"
 
 #include <cmath>
 #include <optional>
+#include <tuple>
 
 #include "core/error.h"
-#include "core/random.h"
+#include "drift/monitor.h"
 
 namespace whirl::machine_eval {
 
-drift::Run ControlDayLog(const drift::Run& run, double cutting_speed_m_min) {
-  drift::Run log = run;
-  log.error_names.clear();
-  log.error_um.resize(run.samples(), 0);
-  const bool cutting = run.state == drift::RunState::kCutting;
-  log.other_names = {"power_on", "ring_on", "cutting", "ring_load_pct"};
-  log.other.resize(run.samples(), 4);
-  const double load = 20.0 + (cutting ? 60.0 * cutting_speed_m_min / 180.0 : 0.0);
-  for (int k = 0; k < run.samples(); ++k) {
-    const double on = k == 0 ? 0.0 : 1.0;
-    log.other.row(k) << on, on, cutting ? on : 0.0, on * load;
-  }
-  return log;
-}
-
-namespace {
-
-// The run's true m(t, z) at sample k (the instrument's reading before its noise).
-double TrueAt(const drift::Run& run, int k, double z_mm, double z_fixed_mm) {
-  return run.error_um(k, run.ErrorIndex("offset_um")) +
-         run.error_um(k, run.ErrorIndex("zscrew_per_1000_um")) * (z_fixed_mm - z_mm) / 1000.0;
-}
-
-drift::MeasurementRecord Readings(const drift::Run& run, int log, double every_min, double z_mm,
-                                  double sigma_um, double z_fixed_mm, const ShopProtocol& p,
-                                  Rng* rng) {
-  drift::MeasurementRecord r;
-  r.day = log;
-  r.log = log;
-  const double zero = p.record_zero_std_um * rng->Normal();
-  double next = 0;
-  for (int k = 0; k < run.samples(); ++k) {
-    if (run.time_min[k] + 1e-9 < next) continue;
-    next += every_min;
-    r.rows.push_back({k, run.time_min[k], z_mm,
-                      TrueAt(run, k, z_mm, z_fixed_mm) + zero + sigma_um * rng->Normal(),
-                      sigma_um});
-  }
-  return r;
-}
-
-}  // namespace
-
-drift::ShopRecord MeasureTrainingRuns(const std::vector<drift::Run>& runs,
-                                      const std::vector<double>& speeds, double z_fixed_mm,
-                                      const ShopProtocol& p, std::uint64_t seed) {
-  drift::ShopRecord rec;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const drift::Run& run = runs[i];
-    const int log = static_cast<int>(i);
-    Rng rng(MixSeed(seed, 0x50524f42 + i));
-    rec.day_logs.push_back(ControlDayLog(run, speeds[i]));
-    drift::MeasurementRecord probe =
-        Readings(run, log, p.probe_every_min, p.probe_z_mm, p.probe_sigma_um, z_fixed_mm, p, &rng);
-    probe.kind = drift::MeasurementRecord::Kind::kProbe;
-    probe.name = run.name + "_probe";
-    rec.records.push_back(probe);
-    if (run.state != drift::RunState::kIdle) continue;
-    for (double z : p.laser_targets_mm) {
-      const double sigma = p.laser_noise_um + p.laser_noise_ppm * 1e-3 * z;
-      drift::MeasurementRecord laser =
-          Readings(run, log, p.laser_every_min, z, sigma, z_fixed_mm, p, &rng);
-      laser.kind = drift::MeasurementRecord::Kind::kLaser;
-      laser.name = run.name + "_laser_" + std::to_string(static_cast<int>(z));
-      rec.records.push_back(laser);
-    }
-  }
-  return rec;
+std::vector<std::string> ScheduleInputs() {
+  return {"ring_on", "cutting", "ring_load_pct", "z_speed_mm_min"};
 }
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
@@ -121,6 +56,28 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   if (combined.cv_rmse_um < m.sensors.cv_rmse_um)
     m.sensors = combined, m.sensors_choice = "sensors+" + base_name;
   return m;
+}
+
+ShopControl ShopControlModels(const drift::JointDriftModel& model,
+                              const std::vector<drift::Run>& training_logs) {
+  ShopControl c;
+  std::tie(c.offset, c.slope) = drift::ToDriftModels(model);
+  const Eigen::Index p = model.features();
+  if (p == 0) return c;
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, 1e300), hi = -lo;
+  for (const drift::Run& log : training_logs) {
+    if (log.samples() == 0) continue;
+    const Eigen::MatrixXd x = drift::MonitorDesign(c.offset, log, drift::ReferenceMode::kRunStart);
+    lo = lo.cwiseMin(x.rightCols(p).colwise().minCoeff().transpose());
+    hi = hi.cwiseMax(x.rightCols(p).colwise().maxCoeff().transpose());
+  }
+  if (!(lo.array() <= hi.array()).all()) return c;
+  for (drift::DriftModel* m : {&c.offset, &c.slope}) {
+    m->feature_min = lo;
+    m->feature_max = hi;
+  }
+  c.ranged = true;
+  return c;
 }
 
 }  // namespace whirl::machine_eval

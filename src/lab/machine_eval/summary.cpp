@@ -1,34 +1,12 @@
-#include "machine_eval/seeds.h"
+#include "machine_eval/summary.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "core/error.h"
-#include "machine_eval/cut_scoring.h"
+#include "compare/evaluate.h"
 
 namespace whirl::machine_eval {
-
-SeedsEvaluation EvaluateOverSeeds(const screw::Screw& base, const workpiece::WorkpieceModel& model,
-                                  const compare::ExperienceRule& rule,
-                                  const lead::IsoToleranceTable& iso_table,
-                                  const MachineEvalOptions& options, int seeds,
-                                  const compare::EvaluateProgress& progress) {
-  detail::CheckCount(seeds, 1, 20, "seeds");
-  SeedsEvaluation e;
-  const std::size_t per = static_cast<std::size_t>(options.machines * options.screws_per_machine);
-  for (int s = 0; s < seeds; ++s) {
-    MachineEvalOptions o = options;
-    o.seed = options.seed + static_cast<std::uint64_t>(s);
-    if (s > 0) o.report_dir.clear();
-    e.seeds.push_back(o.seed);
-    e.runs.push_back(EvaluateWithMachines(base, model, rule, iso_table, o,
-                                          [&](std::size_t done, std::size_t) {
-                                            if (progress) progress(s * per + done, seeds * per);
-                                          }));
-  }
-  return e;
-}
 
 namespace {
 
@@ -97,10 +75,9 @@ std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvalu
   return s;
 }
 
-MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s,
-                                    const std::vector<MachineStrategy>& rows) {
+MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s) {
   std::size_t best = 0;
-  for (MachineStrategy x : RowsOf(rows)) {
+  for (MachineStrategy x : MachineStrategies()) {
     const auto k = static_cast<std::size_t>(x);
     if (k == 0 || UsesSensors(x)) continue;
     if (best == 0 || s[k].total_median_um < s[best].total_median_um) best = k;
@@ -110,18 +87,13 @@ MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategy
 
 namespace {
 
-bool InRows(const std::vector<MachineStrategy>& rows, MachineStrategy x) {
-  const auto all = RowsOf(rows);
-  return std::find(all.begin(), all.end(), x) != all.end();
-}
-
 // Gain 1 - median(x) / median(ref) over the thread, percent: pooled and per seed.
 struct Gain {
   double pooled = 0;
   std::vector<double> per_seed;
   int seeds_won() const {
-    return static_cast<int>(std::count_if(per_seed.begin(), per_seed.end(),
-                                          [](double g) { return g > 0; }));
+    return static_cast<int>(
+        std::count_if(per_seed.begin(), per_seed.end(), [](double g) { return g > 0; }));
   }
 };
 
@@ -160,7 +132,7 @@ std::string Verdict(const SeedsEvaluation& e, MachineStrategy x, const Gain& g, 
 
 std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
   const auto s = SummarizeOverSeeds(e);
-  const MachineStrategy best = StrongestSensorFree(s, e.rows);
+  const MachineStrategy best = StrongestSensorFree(s);
   const auto b = static_cast<std::size_t>(best);
   std::vector<std::string> out;
   char buf[400];
@@ -170,9 +142,7 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
                 e.scenario.c_str(), ToString(best).c_str(), s[b].total_median_um,
                 s[b].acc1000_median_um, s[b].screws, e.seeds.size());
   out.push_back(buf);
-  for (MachineStrategy x : {MachineStrategy::kBoth, MachineStrategy::kBothShop,
-                            MachineStrategy::kBothMonitor, MachineStrategy::kBothShopMonitor}) {
-    if (!InRows(e.rows, x)) continue;
+  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor}) {
     const Gain g = GainOver(e, s, static_cast<std::size_t>(x), b);
     std::snprintf(buf, sizeof buf,
                   "%s vs %s over the thread: %+.1f %% (per seed %+.1f .. %+.1f %%; positive = "
@@ -187,7 +157,6 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
           ? MachineStrategy::kSchedule
           : MachineStrategy::kWarmup;
   for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor}) {
-    if (x == MachineStrategy::kBothShopMonitor && !InRows(e.rows, x)) continue;
     const auto k = static_cast<std::size_t>(x);
     out.push_back(Verdict(e, x, GainOver(e, s, k, b), best, "the strongest sensor-free strategy"));
     if (rule != best)
@@ -199,7 +168,7 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
 
 std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e) {
   const auto s = SummarizeOverSeeds(e);
-  const auto best = static_cast<std::size_t>(StrongestSensorFree(s, e.rows));
+  const auto best = static_cast<std::size_t>(StrongestSensorFree(s));
   const auto shop = static_cast<std::size_t>(MachineStrategy::kBothShop);
   std::vector<std::string> out;
   std::string line = e.scenario + ": thread median by start type, " +
@@ -221,10 +190,9 @@ std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e) {
     any = true;
   }
   if (any) out.push_back(line);
-  const bool field = !e.rows.empty();
   line = e.scenario + ": uncompensated over the thread, each source alone, median um:";
-  const char* names[] = {"workpiece", "head", field ? "Z axis and blank" : "z_screw", "bed"};
-  for (std::size_t q = 0; q < (field ? 3u : kErrorSourceCount); ++q) {
+  const char* names[] = {"workpiece", "head", "Z axis and blank"};
+  for (std::size_t q = 0; q < kErrorSourceCount; ++q) {
     std::vector<double> v;
     for (const auto& run : e.runs)
       for (const auto& r : run.screws)
@@ -252,7 +220,7 @@ std::string TableRows(const SeedsEvaluation& e, bool markdown) {
   const auto s = SummarizeOverSeeds(e);
   std::string out;
   char buf[400];
-  for (MachineStrategy st : RowsOf(e.rows)) {
+  for (MachineStrategy st : MachineStrategies()) {
     const SeedStats& x = s[static_cast<std::size_t>(st)];
     const char* fmt = markdown
                           ? "| %s | %s | %.1f [%.1f-%.1f] | %.1f | %.1f [%.1f-%.1f] | %.1f | %.1f "
@@ -295,7 +263,7 @@ std::string FormatScenarioTables(const std::vector<SeedsEvaluation>& e, bool mar
 void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
   const auto s = SummarizeOverSeeds(e);
   nlohmann::json strategies = nlohmann::json::object();
-  for (MachineStrategy st : RowsOf(e.rows)) {
+  for (MachineStrategy st : MachineStrategies()) {
     const auto k = static_cast<std::size_t>(st);
     const SeedStats& x = s[k];
     std::vector<double> per_seed;
@@ -317,11 +285,11 @@ void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
   nlohmann::json runs = nlohmann::json::array();
   for (const auto& r : e.runs) runs.push_back(r);
   j = {{"schema", "whirl.machine_evaluate"},
-       {"schema_version", 2},
+       {"schema_version", 3},
        {"scenario", e.scenario},
        {"seeds", e.seeds},
        {"travel_c_um", e.travel_c_um},
-       {"strongest_sensor_free", ToString(StrongestSensorFree(s, e.rows))},
+       {"strongest_sensor_free", ToString(StrongestSensorFree(s))},
        {"strategies", strategies},
        {"headlines", MachineHeadlines(e)},
        {"notes", ScenarioNotes(e)},

@@ -1,11 +1,12 @@
 #pragma once
-// The machine evaluation repeated over seeds (each seed draws new machines, training days and
-// screws): pooled median and worst accumulated lead error per strategy, within 1000 mm and over
-// the thread, with the range (min-max) of the per-seed medians, the median |e_a - c| (ISO 3408-3
-// mean travel deviation against the specified travel compensation c) and the P3/P5 shares beside.
-// Headlines name the strongest sensor-free strategy (the smallest pooled thread median among
-// every row whose machine half uses no temperature sensor, `none` excluded; chosen on the test
-// screws themselves, which can only flatter it) and the gain of the sensor strategies over it.
+// The machine evaluation over seeds (machine_eval.h; each seed draws new machines, calendars and
+// screws, field_eval.h EvaluateFieldOverSeeds): pooled median and worst accumulated lead error per
+// strategy, within 1000 mm and over the thread, with the range (min-max) of the per-seed medians,
+// the median |e_a - c| (ISO 3408-3 mean travel deviation against the specified travel compensation
+// c) and the P3/P5 shares beside. Headlines name the strongest sensor-free strategy (the smallest
+// pooled thread median among every row whose machine half uses no temperature sensor, `none`
+// excluded; chosen on the test screws themselves, which can only flatter it) and the gain of the
+// sensor strategies over it.
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -17,13 +18,10 @@
 namespace whirl::machine_eval {
 
 struct SeedsEvaluation {
-  std::string scenario = "legacy";
+  std::string scenario;
   std::vector<std::uint64_t> seeds;
-  std::vector<MachineEvaluation> runs;  ///< one per seed (reports only for the first)
+  std::vector<MachineEvaluation> runs;  ///< one per seed (the report screw only in the first)
   double travel_c_um = 0;               ///< specified travel compensation c, um
-  /// The strategies of the table (empty: every one, the legacy table; the field world's rows are
-  /// field_eval.h FieldStrategies).
-  std::vector<MachineStrategy> rows;
 };
 
 struct SeedStats {
@@ -34,32 +32,23 @@ struct SeedStats {
   std::size_t screws = 0;
 };
 
-/// Seeds options.seed .. options.seed + seeds - 1 (1..20; InputError otherwise).
-SeedsEvaluation EvaluateOverSeeds(const screw::Screw& base, const workpiece::WorkpieceModel& model,
-                                  const compare::ExperienceRule& rule,
-                                  const lead::IsoToleranceTable& iso_table,
-                                  const MachineEvalOptions& options, int seeds,
-                                  const compare::EvaluateProgress& progress = {});
-
 std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvaluation& e);
 
-/// The strongest sensor-free strategy by pooled thread median (see the header comment), among
-/// `rows` (empty: every strategy).
-MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s,
-                                    const std::vector<MachineStrategy>& rows = {});
+/// The strongest sensor-free strategy by pooled thread median (see the header comment).
+MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s);
 
 /// Sentences: the strongest sensor-free rule and the gain 1 - median(x) / median(best) over the
-/// thread of both, both_shop, both_monitor and both_shop_monitor (those among the rows), with
-/// the per-seed range of the gain; then the verdicts, each naming the "both" row it judges:
-/// whether both_shop beats the strongest sensor-free rule over the thread (pooled gain > 0) and
-/// in how many seeds, and both_shop against the better of the sensor-free machine rules (warmup,
-/// schedule: the value of the sensors alone); then the same two for both_shop_monitor when it is
-/// a row (field table: the sensor model kept valid by the set-up checks).
+/// thread of both_shop and both_shop_monitor, with the per-seed range of the gain; then the
+/// verdicts, each naming the "both" row it judges: whether both_shop beats the strongest
+/// sensor-free rule over the thread (pooled gain > 0) and in how many seeds, and both_shop
+/// against the better of the sensor-free machine rules (warmup, schedule: the value of the
+/// sensors alone); then the same two for both_shop_monitor (the sensor model kept valid by the
+/// set-up checks).
 std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e);
 
 /// Notes under the headlines: the thread median of the strongest sensor-free strategy and of
-/// both_shop per start type (cold, warm, interrupted, long_pause; field world only) with the
-/// screw count, and the uncompensated error over the thread of each source alone (median um).
+/// both_shop per start type (cold, warm, interrupted, long_pause) with the screw count, and the
+/// uncompensated error over the thread of each source alone (median um).
 std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e);
 
 /// One block: scenario, strategy, 1000 mm median [seed range], worst, thread median [range],
@@ -69,8 +58,8 @@ std::string FormatSeedsTable(const SeedsEvaluation& e, bool markdown);
 /// Several scenarios in one table (one header, the rows of each, then each one's headlines).
 std::string FormatScenarioTables(const std::vector<SeedsEvaluation>& e, bool markdown);
 
-/// Schema "whirl.machine_evaluate" version 2: per strategy the pooled statistics and per-seed
-/// medians, the headlines, and each seed's version-1 evaluation.
+/// Schema "whirl.machine_evaluate" version 3: per strategy the pooled statistics and per-seed
+/// medians, the headlines, and each seed's evaluation (machine_eval.h to_json).
 void to_json(nlohmann::json& j, const SeedsEvaluation& e);
 
 }  // namespace whirl::machine_eval

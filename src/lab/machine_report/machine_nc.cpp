@@ -1,4 +1,4 @@
-#include "machine_eval/machine_nc.h"
+#include "machine_report/machine_nc.h"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 #include "core/numbers.h"
 #include "plan/load.h"
 
-namespace whirl::machine_eval {
+namespace whirl::machine_report {
 namespace {
 
 void Require(bool ok, const interp::MachineProfile& p, const std::string& field,
@@ -35,15 +35,11 @@ void CheckAgainstMachine(const interp::MachineProfile& p, const interp::DriftAct
 
 }  // namespace
 
-CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
-                                       const screw::Kinematics& kinematics, double thread_length_mm,
-                                       const interp::PlanOptions& plan_options,
-                                       const MachineModels& models,
-                                       const machine::MachineConfig& machine,
-                                       const interp::MachineProfile& profile,
-                                       const std::string& curve_source) {
-  if (!models.fitted)
-    throw InputError("combined programs: no machine model (every machine component is off)");
+CombinedPrograms BuildCombinedPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::DriftModel& offset,
+    const drift::DriftModel& slope, double z_fixed_mm, const interp::MachineProfile& profile,
+    const std::string& curve_source, const std::string& model_source) {
   CombinedPrograms out;
   interp::PlanOptions po = plan_options;
   profile.ApplyCombinedTo(po);
@@ -53,15 +49,15 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
   out.drift = profile.DriftOptions();
   out.drift.reference = interp::DriftReference::kStart;
   const double z0 = kinematics.thread_start_position_mm;
-  CheckAgainstMachine(profile, out.drift,
-                      po.machine_offset_mm + po.start_position_mm +
-                          po.direction * (z0 - machine.z_screw.fixed_end_mm));
+  CheckAgainstMachine(
+      profile, out.drift,
+      po.machine_offset_mm + po.start_position_mm + po.direction * (z0 - z_fixed_mm));
   out.plan = interp::BuildPlan(curve, kinematics.axial_feed_mm_s, thread_length_mm, po);
   interp::NcProgramInfo info;
   info.curve_source = curve_source;
   out.plan_nc = interp::FormatNcProgram(out.plan, info);
   out.plan_reset_nc = interp::FormatNcResetProgram(po, info);
-  const drift::DriftModel& g = models.slope_cutting;
+  const drift::DriftModel& g = slope;
   const double bound = interp::DriftSlopeBound(g, out.drift);
   if (out.plan.max_abs_slope + bound > po.md32760)
     throw InputError("combined programs: the plan's largest slope " +
@@ -70,12 +66,11 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
                      FormatFixed(bound, interp::kDecimalsSd43910) +
                      " exceed MD32760 = " + FormatFixed(po.md32760, 4) + " (profile '" +
                      profile.source + "'): SD43910 could be capped mid-cut");
-  out.drift_nc = interp::FormatDriftNcProgram(models.offset_cutting, out.drift,
-                                              "machine model trained on cutting runs", &g);
+  out.drift_nc = interp::FormatDriftNcProgram(offset, out.drift, model_source, &g);
   out.drift_reset_nc = interp::FormatDriftNcResetProgram(out.drift);
-  out.drift_plc_csv = interp::FormatDriftPlcCsv(models.offset_cutting, out.drift, &g);
+  out.drift_plc_csv = interp::FormatDriftPlcCsv(offset, out.drift, &g);
   out.requirements = plan::WithProfileValues(
-      interp::MergeRequirements(interp::DriftRequirements(models.offset_cutting, out.drift, &g),
+      interp::MergeRequirements(interp::DriftRequirements(offset, out.drift, &g),
                                 interp::PlanRequirements(out.plan, info.program_name)),
       profile);
   return out;
@@ -90,4 +85,4 @@ std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
           {dir / "WHIRL_DRIFT_COMP_PLC.csv", p.drift_plc_csv}};
 }
 
-}  // namespace whirl::machine_eval
+}  // namespace whirl::machine_report

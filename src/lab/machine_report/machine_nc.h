@@ -6,29 +6,36 @@
 //   the plan writes its K0_w, SD43910 S_w and SD43920 P_w into $AC_PARAM (profile
 //   drift.workpiece_k0_param, drift.workpiece_slope_param and + 1);
 //   the drift action writes SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m +
-//   S_m (P_w - P_b), K_m from the offset model (offset_um), S_m from the slope model
-//   (zscrew_per_1000_um) about the screw's fixed bearing P_b.
-// Coordinates (machine/machine.h): the tool is z mm from the chuck face, the cut runs towards
-// the chuck, z(t) = z_0 - v_f t. The plan's program zero is taken at the chuck face with the
-// program coordinate -direction * z (the travel runs towards the chuck), so the thread start is
+//   S_m (P_w - P_b), K_m from the offset model, S_m from the slope model (um per 1000 mm) about
+//   the screw's fixed bearing P_b.
+// The drift models are what a shop can train: the sensor model of the evaluation's both_shop
+// (machine_eval/shop_models.h, from probe, laser and lead measurements only), its inputs the
+// sensors and the control's duty signals the profile maps to analog inputs. Its rises and lags
+// count from the day's power-on (drift/joint.h), so the drift action starts at power-on and runs
+// all day (reference "start": the temperatures when it starts).
+// Coordinates (machine/field.h): the tool is z mm from the chuck face, the cut runs towards the
+// chuck, z(t) = z_0 - v_f t. The plan's program zero is taken at the chuck face with the program
+// coordinate -direction * z (the travel runs towards the chuck), so the thread start is
 // start_position_mm = -direction z_0 and the axis reads P = machine_offset_mm - direction z. The
 // profile must agree with the simulated machine: error_direction = growth_direction = direction
-// (the machine error m is positive towards the chuck, the direction of travel), and
+// (the machine error is positive towards the chuck, the direction of travel), and
 // drift.slope.fixed_end_position_mm = P at z = z_fixed = machine_offset_mm - direction z_fixed; a
 // profile that does not is an InputError naming the field, its value and the value the machine
-// implies.
-// Shipped profile for the simulated machine: datasets/machines/whirling_840d.json.
-// The drift action's rises are taken from the temperatures when it starts (reference "start"),
-// the convention of drift::PredictRun the evaluation uses (the machine starts cold with the cut).
+// implies. Shipped profile for the simulated machine: datasets/machines/whirling_840d.json.
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "drift/model.h"
+#include "fit/arctan_curve.h"
+#include "interp/control_requirements.h"
 #include "interp/drift_action.h"
 #include "interp/machine_profile.h"
-#include "machine_eval/machine_eval.h"
+#include "interp/sinumerik.h"
+#include "screw/screw.h"
 
-namespace whirl::machine_eval {
+namespace whirl::machine_report {
 
 struct CombinedPrograms {
   interp::CompensationPlan plan;       ///< the workpiece plan, handing K0 and slope over
@@ -41,16 +48,16 @@ struct CombinedPrograms {
 };
 
 /// Builds both programs. `plan_options` gives the tolerance and check step (the profile sets
-/// everything else); `models` must be fitted (machine components on). InputError when the
-/// profile lacks the drift object, its slope object or workpiece_slope_param, disagrees with the
-/// machine (see above), or when a program cannot be written (IDs, MD32760, analog inputs).
-CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
-                                       const screw::Kinematics& kinematics, double thread_length_mm,
-                                       const interp::PlanOptions& plan_options,
-                                       const MachineModels& models,
-                                       const machine::MachineConfig& machine,
-                                       const interp::MachineProfile& profile,
-                                       const std::string& curve_source);
+/// everything else); `offset` and `slope` are the machine's drift models (K0 um, slope um per
+/// 1000 mm, with their training ranges), `z_fixed_mm` the fixed bearing they are about (mm from
+/// the chuck face). InputError when the profile lacks the drift object, its slope object or
+/// workpiece_slope_param, disagrees with the machine (see above), or when a program cannot be
+/// written (IDs, MD32760, analog inputs, $AC_PARAM slots).
+CombinedPrograms BuildCombinedPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::DriftModel& offset,
+    const drift::DriftModel& slope, double z_fixed_mm, const interp::MachineProfile& profile,
+    const std::string& curve_source, const std::string& model_source);
 
 /// The files of the programs in `dir` (created if needed): WHIRL_TEMP_COMP.SPF,
 /// WHIRL_TEMP_COMP_RESET.SPF, WHIRL_DRIFT_COMP.SPF, WHIRL_DRIFT_COMP_RESET.SPF,
@@ -58,4 +65,4 @@ CombinedPrograms BuildCombinedPrograms(const fit::ArctanCurve& curve,
 std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
     const std::filesystem::path& dir, const CombinedPrograms& programs);
 
-}  // namespace whirl::machine_eval
+}  // namespace whirl::machine_report

@@ -2,11 +2,12 @@
 // box, lead deviation per strategy, sensor plots, how the programs share the setting data. User
 // strings (sensor and screw names) reach gnuplot only through GnuplotString (terminal noenhanced)
 // and HTML only through HtmlEscape; gnuplot runs through RunProgram with an argument vector.
-#include "machine_eval/machine_report.h"
+#include "machine_report/machine_report.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "compare/control_box.h"
@@ -18,11 +19,16 @@
 #include "core/plot_style.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
+#include "machine_report/machine_nc.h"
+#include "plan/load.h"
 
-namespace whirl::machine_eval {
+namespace whirl::machine_report {
 namespace {
 
 namespace fs = std::filesystem;
+using machine_eval::kMachineStrategyCount;
+using machine_eval::MachineStrategy;
+using machine_eval::ReportScrew;
 
 // The terminal of every plot: `height_px` tall (the sensor plot grows with its panels).
 std::string Terminal(int height_px) {
@@ -30,11 +36,11 @@ std::string Terminal(int height_px) {
          " font 'Sans,10' noenhanced\n";
 }
 
-std::string LeadCsv(const MachineScrewDetail& d) {
+std::string LeadCsv(const ReportScrew& d) {
   std::ostringstream out;
   out << "position_mm";
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
-    out << ',' << ToString(static_cast<MachineStrategy>(k)) << "_um";
+    out << ',' << machine_eval::ToString(static_cast<MachineStrategy>(k)) << "_um";
   out << '\n';
   const std::size_t n = d.leads[0].size();
   for (std::size_t i = 0; i < n; i += 10) {  // every 10th sample: the curves are smooth
@@ -74,17 +80,18 @@ std::string SensorScript(const drift::Run& log, const std::string& title,
   return gp + "unset multiplot\n";
 }
 
-// The strategies of each panel of the lead plot: the evaluation's first rows (up to
-// both_monitor), then none and both again beside the shop's rows, so no panel holds 14 lines.
+// The strategies of each panel of the lead plot: the workpiece rows (none, the history rules,
+// the network's plan), then none and workpiece again beside the rows with a machine half, so no
+// panel holds more than eight lines.
 std::vector<std::vector<std::size_t>> LeadPanels() {
-  const auto last_first = static_cast<std::size_t>(MachineStrategy::kBothMonitor);
-  std::vector<std::vector<std::size_t>> panels(1);
-  for (std::size_t k = 0; k <= last_first && k < kMachineStrategyCount; ++k) panels[0].push_back(k);
-  if (kMachineStrategyCount > last_first + 1) {
-    panels.push_back({static_cast<std::size_t>(MachineStrategy::kNone),
-                      static_cast<std::size_t>(MachineStrategy::kBoth)});
-    for (std::size_t k = last_first + 1; k < kMachineStrategyCount; ++k) panels[1].push_back(k);
-  }
+  using S = MachineStrategy;
+  const auto at = [](S s) { return static_cast<std::size_t>(s); };
+  std::vector<std::vector<std::size_t>> panels(2);
+  for (S s : {S::kNone, S::kTraditional, S::kWorkpiece, S::kClass, S::kTable, S::kNearest})
+    panels[0].push_back(at(s));
+  for (S s : {S::kNone, S::kWorkpiece, S::kWarmup, S::kSchedule, S::kLeadSlope, S::kMachineShop,
+              S::kBothShop, S::kBothShopMonitor})
+    panels[1].push_back(at(s));
   return panels;
 }
 
@@ -101,7 +108,7 @@ std::string LeadScript(const std::string& title, double thread_length_mm,
   for (const auto& panel : panels) {
     gp += "plot ";
     for (std::size_t j = 0; j < panel.size(); ++j) {
-      const std::string name = ToString(static_cast<MachineStrategy>(panel[j]));
+      const std::string name = machine_eval::ToString(static_cast<MachineStrategy>(panel[j]));
       gp += (j ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(panel[j] + 2) +
             " " + GnuplotWith(name) + " title " + GnuplotString(name);
     }
@@ -133,7 +140,7 @@ std::string Render(OutputDir& out, const std::string& stem, const std::string& b
 std::string List(const std::vector<std::string>& names) {
   std::string s;
   for (const auto& n : names) s += (s.empty() ? "" : ", ") + HtmlEscape(n);
-  return s.empty() ? "(none: no machine model)" : s;
+  return s.empty() ? "(none: the model reads only the control's duty signals)" : s;
 }
 
 // The last static action of the drift program: the one that writes the setting data.
@@ -163,9 +170,10 @@ std::string ControlBox(const std::string& screw_name, const CombinedPrograms& p)
                 {"WHIRL_TEMP_COMP.SPF", "workpiece plan"},
                 {"WHIRL_TEMP_COMP_RESET.SPF", "its reset program"}};
   load.call_order =
-      "WHIRL_DRIFT_COMP first (it keeps running), then WHIRL_TEMP_COMP before the "
-      "cutting block with the axis before the thread start; WHIRL_TEMP_COMP_RESET "
-      "after the cutting block; WHIRL_DRIFT_COMP_RESET to stop the drift action.";
+      "WHIRL_DRIFT_COMP once at power-on (it keeps running all day; the model's rises count "
+      "from its start), then WHIRL_TEMP_COMP before each cutting block with the axis before "
+      "the thread start; WHIRL_TEMP_COMP_RESET after the cutting block; "
+      "WHIRL_DRIFT_COMP_RESET to stop the drift action.";
   load.after_abort =
       "call WHIRL_TEMP_COMP_RESET (it cancels the plan's actions and sets its "
       "hand-over values to 0; the drift action goes on compensating the machine "
@@ -182,95 +190,117 @@ std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
   return "<h2>How the two programs share the setting data</h2><p>The workpiece plan (" +
          std::to_string(p->plan.segments.size()) +
          " segments of the network's curve) hands K0_w, S_w and P_w over; the machine drift action "
-         "(offset model and Z-screw slope model, evaluated every interpolation cycle from the "
-         "analog inputs) writes SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m "
+         "(the sensor model's offset and slope channels, evaluated every interpolation cycle from "
+         "the analog inputs: sensors and the control's duty signals) writes SD43920 = P_w, SD43910 "
+         "= S_w + S_m, SD43900 = K0_w + K_m + S_m "
          "(P_w - P_b), the fixed bearing at P_b = " +
          FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:</p><pre>" +
          HtmlEscape(OutputAction(p->drift_nc)) + "</pre>";
 }
 
-std::string StrategyTable(const MachineEvalScrew& r) {
+std::string StrategyTable(const machine_eval::MachineEvalScrew& r) {
   std::string h =
       "<table><tr><th>strategy</th><th>within 1000 mm [um]</th><th>over the thread "
       "[um]</th><th>ISO 3408-3 class</th></tr>\n";
   char buf[256];
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
     std::snprintf(buf, sizeof buf, "<tr><td>%s</td><td>%.1f</td><td>%.1f</td><td>%s</td></tr>\n",
-                  ToString(static_cast<MachineStrategy>(k)).c_str(),
+                  machine_eval::ToString(static_cast<MachineStrategy>(k)).c_str(),
                   r.metrics[k].accumulated_1000_um, r.metrics[k].accumulated_total_um,
                   HtmlEscape(ToString(r.iso[k])).c_str());
     h += buf;
   }
   std::snprintf(buf, sizeof buf,
-                "</table><p>Left after both, over the thread: workpiece part %.1f um, machine "
-                "part %.1f um.</p>\n",
+                "</table><p>Left after both_shop, over the thread: workpiece part %.1f um, "
+                "machine part %.1f um.</p>\n",
                 r.residual_workpiece_total_um, r.residual_machine_total_um);
   return h + buf +
-         "<p class='small'>none: no compensation; traditional: the strongest history rule's plan; "
-         "workpiece: the network's plan alone; machine: the drift action alone; both: plan and "
-         "drift action with the cutting-trained machine model; both_idle: with the idle-trained "
-         "model; both_monitor: both, checked and refitted on-line. Shop rows (machine models "
-         "trained from probe and laser readings, applied causally): class, table, nearest: the "
-         "history rules' plans; warmup: workpiece plus a time-since-power-on rule; schedule: "
-         "workpiece plus a control-signal rule; machine_shop: the sensor model alone; both_shop: "
-         "workpiece plus machine_shop.</p>\n";
+         "<p class='small'>none: no compensation; traditional: the strongest history rule's plan "
+         "(class, table or nearest, chosen on the history); class, table, nearest: each history "
+         "rule's plan; workpiece: the network's plan alone. Machine models trained only from the "
+         "shop's probe, laser and lead measurements, applied from past control samples: warmup: "
+         "workpiece plus a time-since-power-on rule; schedule: workpiece plus a rule on the "
+         "control's duty signals; lead_slope: workpiece plus a pitch correction from measured past "
+         "screws; machine_shop: the sensor model alone; both_shop: workpiece plus the sensor model "
+         "(the programs above); both_shop_monitor: both_shop kept valid by the probe checks at the "
+         "set-ups.</p>\n";
 }
 
-std::string Html(const MachineEvalScrew& r, const std::vector<std::string>& cutting,
-                 const std::vector<std::string>& idle, const std::string& sensor_img,
-                 const std::string& lead_img, const CombinedPrograms* programs,
-                 const std::string& programs_note) {
-  return HtmlPageBegin(r.screw.name + ": workpiece and machine drift in one cut (simulated)") +
-         (programs ? ControlBox(r.screw.name, *programs) : "") +
-         "<h2>Lead deviation per strategy</h2>" + StrategyTable(r) + lead_img +
-         "<h2>Sensors</h2><p>Chosen sensors of the machine's offset model (thick lines), trained "
-         "cutting: " +
-         List(cutting) + "; trained idle: " + List(idle) + ".</p>" + sensor_img +
-         ProgramsHtml(programs, programs_note) + HtmlPageEnd();
+std::string Html(const ReportScrew& r, const std::string& sensor_img, const std::string& lead_img,
+                 const CombinedPrograms* programs, const std::string& programs_note) {
+  const machine_eval::MachineEvalScrew& x = r.result;
+  return HtmlPageBegin(x.screw.name + ": workpiece and machine drift in one cut (simulated)") +
+         (programs ? ControlBox(x.screw.name, *programs) : "") + "<p>Scenario " +
+         HtmlEscape(r.scenario) + ", machine " + std::to_string(x.machine) + ", test day " +
+         std::to_string(x.day) + ", start type " + HtmlEscape(x.start_type) +
+         ".</p><h2>Lead deviation per strategy</h2>" + StrategyTable(x) + lead_img +
+         "<h2>Sensors</h2><p>The sensor model (" + HtmlEscape(r.sensors_choice) +
+         ", trained from the shop's measurements) reads the sensors drawn thick: " +
+         List(r.sensors) + ".</p>" + sensor_img + ProgramsHtml(programs, programs_note) +
+         HtmlPageEnd();
+}
+
+// The combined programs of the screw for the profile, or the note why there are none.
+std::optional<CombinedPrograms> Programs(const ReportScrew& r,
+                                         const interp::MachineProfile* profile, std::string* note) {
+  if (!profile) {
+    *note = "combined 840D programs not written: no machine profile given";
+    return std::nullopt;
+  }
+  try {
+    return BuildCombinedPrograms(
+        r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options, r.offset,
+        r.slope, r.z_ref_mm, *profile, "network curve of screw " + r.result.screw.name,
+        "sensor model (" + r.sensors_choice + ") trained only from shop measurements");
+  } catch (const InputError& err) {
+    *note = std::string("combined 840D programs not written: ") + err.what();
+    return std::nullopt;
+  }
 }
 
 }  // namespace
 
-std::string WriteMachineScrewReport(const std::string& dir, const MachineEvalScrew& screw,
-                                    const MachineScrewDetail& detail,
-                                    const std::vector<std::string>& sensors_cutting,
-                                    const std::vector<std::string>& sensors_idle,
-                                    const CombinedPrograms* programs,
-                                    const std::string& programs_note) {
-  if (!screw.ok) throw InputError("report of screw '" + screw.screw.name + "': " + screw.error);
+MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew& screw,
+                                      const interp::MachineProfile* profile) {
+  const machine_eval::MachineEvalScrew& x = screw.result;
+  if (!x.ok) throw InputError("report of screw '" + x.screw.name + "': " + x.error);
+  MachineReport report;
+  const std::optional<CombinedPrograms> programs = Programs(screw, profile, &report.programs_note);
   OutputDir out(dir, "report directory");
-  std::string sensor_img = "<p>(no sensor log: the machine does not drift)</p>";
-  if (detail.log.samples() > 0) {
-    // The screw's log in the drift run format (temperatures and the two error channels), so
-    // `whirl drift predict --run sensors.csv` evaluates a machine model on it.
-    out.Add("sensors.csv",
-            drift::FormatRun(detail.log, {"virtual sensor log of screw " + screw.screw.name +
-                                              " during its cut (simulated, src/machine/machine.h; "
-                                              "machine day seed " +
-                                              std::to_string(screw.day_seed) + ")",
-                                          "offset_um: machine drift at the Z screw's fixed end; "
-                                          "zscrew_per_1000_um: its growth per 1000 mm (um)"}));
-    const auto panels = GroupSeries(detail.log.sensor_names, kSensorsPerPanel);
-    std::vector<std::string> chosen = sensors_cutting;
-    chosen.insert(chosen.end(), sensors_idle.begin(), sensors_idle.end());
-    sensor_img =
-        Render(out, "sensors",
-               SensorScript(detail.log, screw.screw.name + ": virtual sensors", chosen, panels),
-               80 + kPanelHeightPx * static_cast<int>(panels.size()));
-  }
-  out.Add("lead.csv", LeadCsv(detail));
+  // The screw's day as the control logged it, in the drift run format, so `whirl drift predict
+  // --run sensors.csv` evaluates a machine model on it.
+  out.Add(
+      "sensors.csv",
+      drift::FormatRun(
+          screw.log, {"control log of screw " + x.screw.name +
+                          "'s day from power-on to the "
+                          "end of its cut (simulated field world, src/lab/machine/; scenario " +
+                          screw.scenario + ", machine day seed " + std::to_string(x.day_seed) + ")",
+                      "temperatures through the control's 5-min input filter; the duty "
+                      "signals as the control logs them; time_min since the day's 00:00; the "
+                      "cut from " +
+                          FormatFixed(screw.cut_start_min, 1) + " to " +
+                          FormatFixed(screw.cut_end_min, 1) + " min"}));
+  const auto panels = GroupSeries(screw.log.sensor_names, kSensorsPerPanel);
+  const std::string sensor_img = Render(
+      out, "sensors",
+      SensorScript(screw.log, x.screw.name + ": sensors on the control", screw.sensors, panels),
+      80 + kPanelHeightPx * static_cast<int>(panels.size()));
+  out.Add("lead.csv", LeadCsv(screw));
   const auto lead_panels = LeadPanels();
-  const std::string lead_img = Render(
-      out, "lead",
-      LeadScript(screw.screw.name + ": lead deviation", screw.screw.thread_length_mm, lead_panels),
-      40 + 420 * static_cast<int>(lead_panels.size()));
+  const std::string lead_img =
+      Render(out, "lead",
+             LeadScript(x.screw.name + ": lead deviation", x.screw.thread_length_mm, lead_panels),
+             40 + 420 * static_cast<int>(lead_panels.size()));
   if (programs)
     for (const auto& [path, text] : CombinedProgramFiles("", *programs))
       out.Add(path.filename().string(), text);
-  out.Add("index.html", Html(screw, sensors_cutting, sensors_idle, sensor_img, lead_img, programs,
-                             programs_note));
+  out.Add("index.html",
+          Html(screw, sensor_img, lead_img, programs ? &*programs : nullptr, report.programs_note));
   out.Commit();
-  return (fs::path(dir) / "index.html").string();
+  report.index_html = (fs::path(dir) / "index.html").string();
+  report.programs = programs.has_value();
+  return report;
 }
 
-}  // namespace whirl::machine_eval
+}  // namespace whirl::machine_report

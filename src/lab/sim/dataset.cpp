@@ -103,7 +103,7 @@ Dataset GenerateDataset(const DatasetOptions& options,
   const DisturbanceOptions& d = options.disturbance;
   std::ostringstream s;
   auto& c = out.table.comments;
-  c.push_back(" SIMULATED data (not measured): whirl hard-whirling thermal simulator (src/sim).");
+  c.push_back(" SIMULATED data (not measured): whirl hard-whirling thermal simulator (src/lab/sim).");
   s << " design: " << n << " feasible Halton points, seed " << options.seed
     << ", ranges hardness 60-65 HRC etc. as in datasets/README.md";
   if (options.ranges[0].min != 60 || options.ranges[4].max != 210) s << " (custom ranges)";
@@ -124,7 +124,7 @@ Dataset GenerateDataset(const DatasetOptions& options,
   c.push_back(s.str());
   c.push_back(
       " features: fit::ExtractFeatures (plateau + quadratic drift fitted after the settle time, "
-      "detrended 60 s moving average within a noise-aware 2 % band; src/sim/features.h)");
+      "detrended 60 s moving average within a noise-aware 2 % band; src/product/fit/features.h)");
   return out;
 }
 

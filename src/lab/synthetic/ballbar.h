@@ -1,4 +1,8 @@
 #pragma once
+// The manual of the lab's synthetic module: documented synthetic measurements for the product
+// modules that have no public data to test on (this file: the ball bar, ballbar/; surface.h: the
+// worktable, surface/).
+//
 // Documented simulated ball-bar measurements (no public measurements exist): a spindle warm-up
 // read with three pivots, and circle traces with planted thermal errors. Deterministic for a seed
 // on every platform (core/random.h). SIMULATED: every file written says so.

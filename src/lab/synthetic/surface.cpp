@@ -78,7 +78,7 @@ std::vector<std::string> SyntheticProvenance(const SyntheticOptions& o) {
                 ") mm, sigma " + FormatNumber(o.bump_sigma_fraction * o.length_x_mm) + " mm");
   c.push_back(" grid " + std::to_string(o.nx) + " x " + std::to_string(o.ny) + ", noise " +
               FormatNumber(o.noise_um) + " um (normal), seed " + std::to_string(o.seed) +
-              " (surface/synthetic.h)");
+              " (synthetic/surface.h)");
   return c;
 }
 

@@ -39,7 +39,7 @@ namespace whirl::fit {
 /// fixed to the simulator's features (sim::ExtractFeatures), each curve normalized by L and its
 /// sample count so that every curve weighs the same (fit::CalibrateShape), over 25 undisturbed
 /// simulated curves spread over the paper's training ranges (design seed 1). Reproduce with
-///   whirl fit --simulated 25          (src/compare/curve_study.h)
+///   whirl fit --simulated 25          (src/lab/compare/curve_study.h)
 /// tests/compare/test_curve_study.cpp checks both against a freshly simulated set.
 inline constexpr double kDefaultShapeK = 4.33;
 inline constexpr double kDefaultTimeExponent = 0.882;

@@ -1,6 +1,6 @@
 #pragma once
 // Fitting elongation-curve models to simulated or measured curves with the LM solver
-// (src/fit/levenberg_marquardt.h). Li, Ma and Jiang compare sine, parabola and arctangent
+// (src/product/fit/levenberg_marquardt.h). Li, Ma and Jiang compare sine, parabola and arctangent
 // fits of the dynamic part (plateau: a line) and finds the arctangent best; this module repeats
 // that comparison. Every model is 0 at t = 0, reaches its plateau L at t_s and stays there:
 //

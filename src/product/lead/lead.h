@@ -1,6 +1,8 @@
 #pragma once
-// A lead (travel) deviation curve along a ball-screw thread: simulated by compare, or measured on
-// the machine after cooling (CSV `position_mm,deviation_um`).
+// A lead (travel) deviation curve along a ball-screw thread, the manual of the product's lead
+// module (with metrics.h, the ISO 3408-3 metrics, and iso3408.h, the class reached; `whirl
+// lead-report`): measured on the machine after cooling (CSV `position_mm,deviation_um`), or
+// simulated by the lab's compare/cut.h.
 //
 // Sign convention (whole project): travel deviation = actual travel minus specified travel, both
 // measured from the thread start (the free end, where cutting begins) towards the chuck, in um.

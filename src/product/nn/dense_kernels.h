@@ -5,7 +5,7 @@
 // over contiguous column segments (all in L1) do the same operations in a different order, so
 // results agree to rounding.
 //
-// Used by trainbr's epoch loop (src/nn/trainbr.cpp) and measured on their own by
+// Used by trainbr's epoch loop (src/product/nn/trainbr.cpp) and measured on their own by
 // tests/bench/bench_nn.cpp (BM_EpochLinearAlgebra: the per-epoch linear-algebra floor).
 #include <Eigen/Core>
 

@@ -1,9 +1,11 @@
 #pragma once
-// The one `whirl.plan` document (schema version 2, interp/sinumerik.h) and the one set of plan files, built here once
-// for every command that plans (`whirl plan`, `whirl demo`): the 840D plan of interp/sinumerik.h
+// The manual of the product's plan module: what `whirl plan` hands a shop. Here the one
+// `whirl.plan` document (schema version 2, interp/sinumerik.h) and the one set of plan files,
+// built once for every command that plans (`whirl plan`, `whirl demo`); the "load onto the
+// control" data of a plan in plan/load.h. The document: the 840D plan of interp/sinumerik.h
 // (settings, segments with SD43900 [mm], SD43910 [-], SD43920 [mm], counts, units) plus
 //   provenance   one line: command, model or given features, curve
-//   screw        the screw file's content (sim/screw.h)
+//   screw        the screw file's content (screw/screw.h)
 //   kinematics   axial_feed_mm_min, cutting_time_s, workpiece_speed_rpm, ring_speed_rpm
 //   curve        the arctangent curve l(t) = L atan(k (t/t_s)^p) / atan(k) (fit/arctan_curve.h)
 //   prediction   model (file or description; null when the features were given),

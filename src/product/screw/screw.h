@@ -1,7 +1,8 @@
 #pragma once
-// A hard-whirling job: the screw blank, the five network inputs and the machine settings, plus the
-// kinematics and groove geometry that follow from them (Li, Ma and Jiang's process;
-// docs/simulator.md).
+// A hard-whirling job, the manual of the product's screw module: the screw blank, the five network
+// inputs and the machine settings, plus the kinematics and groove geometry that follow from them
+// (Li, Ma and Jiang's process; docs/simulator.md), and the screw file a shop writes. The plan
+// (plan/), the lab's simulator (sim/) and the machine world (machine/) all cut this screw.
 //
 // Geometry convention used by the whole project: the blank is clamped in the chuck (the FIXED end,
 // axial coordinate x = 0 at the chuck face) and free at x = length_mm. The thread starts

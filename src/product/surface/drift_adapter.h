@@ -1,5 +1,5 @@
 #pragma once
-// Per-point models from the drift module (src/drift): for each position-tagged error
+// Per-point models from the drift module (src/product/drift): for each position-tagged error
 // column (per_point.h), Miao et al.'s sensitive-point selection and multiple linear regression
 // (drift::FitDriftModel, kind mlr by default; any drift::FitOptions works) fitted on the training
 // runs, then drift::PredictRun on the target run: the PointModelFn of per_point.h.

@@ -17,7 +17,7 @@
 // The model of one point is a function (PointModelFn): given the error column, it fits the model
 // on the training data it holds and returns the predicted error (um) at every sample of the target
 // run. The library does not fix the model: drift_adapter.h wires Miao et al.'s sensitive points and
-// MLR (src/drift) into it; tests use closed-form stand-ins.
+// MLR (src/product/drift) into it; tests use closed-form stand-ins.
 #include <Eigen/Core>
 #include <filesystem>
 #include <functional>

@@ -1,9 +1,9 @@
 #pragma once
 // Thermal error over the whole worktable (the worktable chapter, docs/references.md): the manual of
-// src/surface.
+// src/product/surface.
 //
 // The method measures the thermal error at P points of the table, builds a model per point from its
-// sensitive temperatures (surface/per_point.h; the models themselves come from src/drift through
+// sensitive temperatures (surface/per_point.h; the models themselves come from src/product/drift through
 // surface/drift_adapter.h), and at any moment turns the P predicted errors into a surface over
 // the table, so the error is known at every position:
 //   - a cubic polynomial in X and Y, 10 coefficients by least squares (surface/cubic.h), for a
@@ -13,7 +13,7 @@
 //     extrapolation.
 // Choosing between them from the leave-one-out error (surface/choice.h), and the per-axis line a
 // SINUMERIK 840D can apply, SD43900/SD43910/SD43920 (surface/line840d.h). Synthetic fields for
-// tests and the demo: surface/synthetic.h. HTML page with a map: surface/report.h.
+// tests and the demo: synthetic/surface.h. HTML page with a map: surface/report.h.
 //
 // Units everywhere: positions in mm (x_mm, y_mm), errors in um (error_um).
 // Surface file (JSON, schema "whirl.surface", schema_version 1):
