@@ -111,7 +111,6 @@ TEST(MachineEvaluation, WithoutMachineDriftTheWorkpieceRowsAreTheWorkpieceCompar
 TEST(MachineEvaluation, TheReportScrewIsTheFirstScrewWithItsOwnCurves) {
   const EvalFixture f;
   FieldEvalOptions o = SmallEvaluation();
-  o.machines = 2;
   o.keep_report_screw = true;
   const SeedsEvaluation s = EvaluateFieldOverSeeds(machine::FindMachineScenario("production"),
                                                    f.model, f.rule, f.iso, o, 2);

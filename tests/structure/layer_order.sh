@@ -9,7 +9,9 @@
 # Within the order a module may include headers only of modules in a lower layer, and its
 # CMakeLists.txt must link each of them (whirl::<module>). A module in no layer or on the wrong
 # side, an include of a module of the same or a higher layer (an upward edge, the start of a
-# cycle) or an include the CMake links do not declare fails with the file, the line and the rule.
+# cycle), an include the CMake links do not declare, or an include by tree path ("src/lab/...",
+# which the project root, an include root of interp, would resolve) fails with the file, the line
+# and the rule.
 # args: <source dir>. The layers, from the bottom (the CMake links of each folder, made strict:
 # no two modules of one layer include each other); every product layer lies below every lab
 # layer:
@@ -89,6 +91,10 @@ for d in "${folders[@]}"; do
     file=${hit%%:*}; rest=${hit#*:}; line=${rest%%:*}; text=${rest#*:}
     [[ "$text" =~ include[[:space:]]*[\"\<]([a-z_0-9]+)/ ]] || continue
     inc=${BASH_REMATCH[1]}
+    if [ "$inc" = src ]; then  # "src/lab/sim/..." would pass the include roots by the back door
+      fail_line "$file:$line: $text: include by tree path: name the module (\"sim/...\"), not src/"
+      continue
+    fi
     [ "$inc" = "$mod" ] && continue
     [ -n "${IS_MODULE[$inc]:-}" ] || continue  # a third-party header (nlohmann/..., CLI/...)
     edges=$((edges + 1))

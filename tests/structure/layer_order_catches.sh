@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # layer_order.sh must fail on each kind of violation: it runs on copies of src/ and interp/
-# with one wrong edge added each time (a product module including or linking a lab module, an
-# upward include into core, a same-layer include, an include the CMake links do not declare, a
-# folder in no layer, on the wrong side or on no side, a link to a higher layer) and must exit 1
+# with one wrong edge added each time (a product module including or linking a lab module, a lab
+# header included by its tree path, an upward include into core, a same-layer include, an include
+# the CMake links do not declare, a folder in no layer, on the wrong side or on no side, a link to
+# a higher layer) and must exit 1
 # naming it; on the unchanged copy it must pass. args: <source dir> <scratch dir>.
 set -u
 SRC="$1"; D="$2"
@@ -32,6 +33,10 @@ fresh  # the product's 840D output (interp/, at the top level) including the str
 echo '#include "compare/compare.h"' >> "$D/tree/interp/sinumerik.h"
 expect_failure "interp including a lab module" \
   "product module 'interp' may include no lab module ('compare' is lab)"
+
+fresh  # a lab header reached by its path in the tree (the project root is an include root of interp)
+echo '#include "src/lab/sim/simulator.h"' >> "$P/surface/surface.cpp"
+expect_failure "an include by tree path" "include by tree path"
 
 fresh  # a product module linking a lab module, without any include
 echo 'target_link_libraries(whirl_surface PRIVATE whirl::sim)' >> "$P/surface/CMakeLists.txt"
