@@ -126,6 +126,80 @@ TEST(DriftAction, Sd43900FollowsTheModelEvaluatedSampleBySample) {
         }
 }
 
+// A model with elapsed-time warm-up terms (drift fit's time1, time2, sensors+time): the given
+// sensors (none: time-only) without lags, then elapsed lags of `taus` [min]; coefficients
+// intercept, per sensor, per elapsed term.
+drift::DriftModel ElapsedModel(const std::vector<std::string>& sensors,
+                               const std::vector<double>& taus,
+                               const std::vector<double>& coefficients) {
+  drift::DriftModel m;
+  m.error_column = "ch1_um";
+  m.sensors = sensors;
+  m.reference_C = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 25.0);
+  m.elapsed_time_constants = taus;
+  for (const auto& s : m.sensors) m.features.push_back({s, 0.0});
+  for (double t : taus) m.features.push_back({"elapsed", t});
+  const auto nf = static_cast<Eigen::Index>(m.features.size());
+  m.feature_min = Eigen::VectorXd::Constant(nf, -5);
+  m.feature_max = Eigen::VectorXd::Constant(nf, 5);
+  m.linear.coefficients = Eigen::Map<const Eigen::VectorXd>(coefficients.data(), nf + 1);
+  m.linear.covariance = Eigen::MatrixXd::Identity(nf + 1, nf + 1) * 0.01;
+  m.Validate();
+  return m;
+}
+
+// Elapsed time is counted by the actions themselves from the program's start: SD43900 follows the
+// evaluator (x = 0 at the start, 1 - exp(-t / tau) after) for one and two terms and beside
+// sensors, both references; the PLC table's rows rebuild the same value from a_per_cycle; no
+// analog input is asked for "elapsed" (issue 45: the lookup ran past the model's inputs).
+TEST(DriftAction, ElapsedTimeIsCountedByTheControl) {
+  const std::vector<drift::DriftModel> models{
+      ElapsedModel({}, {0.05}, {0.4, 6.0}),
+      ElapsedModel({}, {0.02, 0.1}, {-0.3, 4.0, 2.5}),
+      ElapsedModel({"t1_C", "t2_C"}, {0.07}, {0.2, 1.5, -0.8, 3.0})};
+  for (const drift::DriftModel& m : models)
+    for (auto ref : {DriftReference::kModel, DriftReference::kStart}) {
+      DriftActionOptions o = Options(ControlDk::kAdded, 1, ref);
+      if (m.sensors.empty()) o.inputs.clear();
+      replay::Replay r;
+      SetInputs(r, Options(ControlDk::kAdded, 1, ref), Temperatures(0));
+      const std::string nc = FormatDriftNcProgram(m, o);
+      ASSERT_TRUE(r.RunProgram(nc)) << nc;
+      const Eigen::VectorXd reference =
+          ref == DriftReference::kModel || m.sensors.empty() ? m.reference_C
+                                                             : Eigen::VectorXd(Temperatures(0));
+      drift::DriftEvaluator ev(m, reference);
+      double worst_mm = 0;
+      for (int k = 0; k < 1500; ++k) {  // 1.25 min: 25 of the shortest time constant
+        SetInputs(r, Options(ControlDk::kAdded, 1, ref), Temperatures(k));
+        r.Cycle(0.0);
+        const Eigen::VectorXd raw = m.sensors.empty() ? Eigen::VectorXd() : Eigen::VectorXd(Temperatures(k));
+        const double e_um = ev.Step(k * kCycleMs / 60000.0, raw);
+        worst_mm = std::max(worst_mm, std::abs(r.control.abs_value_mm - Sign(o) * e_um / 1000.0));
+      }
+      EXPECT_LT(worst_mm, 1e-8) << m.sensors.size() << " sensors, " << ToString(ref) << "\n" << nc;
+      // The PLC table: an elapsed row reads no input; its a_per_cycle rebuilds 1 - exp(-t/tau).
+      std::istringstream csv(FormatDriftPlcCsv(m, o));
+      std::string line;
+      int elapsed_rows = 0;
+      while (std::getline(csv, line)) {
+        if (line.rfind("k0_mm,elapsed_lag", 0) != 0) continue;
+        ++elapsed_rows;
+        std::vector<std::string> cell;
+        std::stringstream ls(line);
+        for (std::string c; std::getline(ls, c, ',');) cell.push_back(c);
+        ASSERT_EQ(cell.size(), 10u) << line;
+        EXPECT_EQ(cell[2], "elapsed");
+        EXPECT_EQ(cell[3], "") << "no analog input for elapsed time";
+        const double tau = std::stod(cell[7]), a = std::stod(cell[8]);
+        double x = 0;
+        for (int k = 0; k < 600; ++k) x += a * (1 - x);
+        EXPECT_NEAR(x, 1 - std::exp(-600 * kCycleMs / 60000.0 / tau), 1e-9) << line;
+      }
+      EXPECT_EQ(elapsed_rows, static_cast<int>(m.elapsed_time_constants.size()));
+    }
+}
+
 TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
   std::mt19937 rng(1805);
   const drift::DriftModel m = HandModel(true, rng);
@@ -567,6 +641,15 @@ TEST(DriftAction, GoldenProgramAndPlcTable) {
       std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action_slope.spf";
   if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path_slope, nc_slope);
   EXPECT_EQ(nc_slope, ReadTextFile(path_slope)) << "actual:\n" << nc_slope;
+  // Sensors with two elapsed-time warm-up terms (drift fit's candidates with time).
+  const drift::DriftModel e = ElapsedModel({"t1_C", "t2_C"}, {35.5, 240.0}, {0.6, 1.5, -0.8, 3.25, 1.75});
+  const DriftActionOptions oe = Options(ControlDk::kAdded, 1, DriftReference::kStart);
+  const std::string nc_elapsed = FormatDriftNcProgram(e, oe, "golden model") +
+                                 FormatDriftNcResetProgram(oe) + FormatDriftPlcCsv(e, oe);
+  const std::string path_elapsed =
+      std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action_elapsed.spf";
+  if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path_elapsed, nc_elapsed);
+  EXPECT_EQ(nc_elapsed, ReadTextFile(path_elapsed)) << "actual:\n" << nc_elapsed;
 }
 
 }  // namespace
