@@ -259,7 +259,7 @@ void RegisterFitModel(CLI::App* drift_app) {
                   "sensors, time1, time2, and sensors+time with >= 3 runs; the lowest RMSE, "
                   "within 5 % the fewest parameters), sensors, time (first-order warm-up in time "
                   "since the run start, 1 or 2 terms) or sensors+time")
-      ->check(CLI::IsMember({"auto", "sensors", "time", "sensors+time"}));
+      ->check(CLI::IsMember({"auto", "sensors", "time", "time1", "time2", "sensors+time"}));
   sub->add_option("--error", o->error, "error column to model (<name>_um)")->required();
   sub->add_option("--out", o->out, "model file to write (JSON)")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");

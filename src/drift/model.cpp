@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
@@ -364,6 +365,27 @@ double DriftEvaluator::StdDev() const {
   return std::sqrt(std::max(var, 0.0)) * m.target_scaling.HalfRange()(0);
 }
 
+double TrainedElapsed(const DriftModel& m) {
+  double trained = 0;
+  const std::size_t ne = m.elapsed_time_constants.size();
+  if (ne == 0) return std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < ne; ++j) {
+    const double x = m.feature_max(static_cast<Eigen::Index>(m.features.size() - ne + j));
+    // x = 1 - exp(-T / tau); x = 1 in double: T beyond 37 tau, where the plateau is reached.
+    const double t = x < 1 ? -m.elapsed_time_constants[j] * std::log1p(-std::max(x, 0.0))
+                           : std::numeric_limits<double>::infinity();
+    trained = std::max(trained, t);
+  }
+  return trained;
+}
+
+double WarmUpPlateau(const DriftModel& m) {
+  if (!IsLinear(m.kind) || m.elapsed_time_constants.empty()) return 0;
+  const auto ne = static_cast<Eigen::Index>(m.elapsed_time_constants.size());
+  const double gains = m.linear.coefficients.tail(ne).sum();
+  return m.SensorFree() && m.extra_inputs.empty() ? m.linear.coefficients(0) + gains : gains;
+}
+
 Eigen::MatrixXd RawInputs(const DriftModel& model, const Run& run) {
   Eigen::MatrixXd u(run.samples(), model.InputCount());
   Eigen::Index c = 0;
@@ -417,15 +439,24 @@ RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode 
   p.time_from_index = run.time_from_index;
   p.predicted_um.resize(run.samples());
   p.std_um.resize(run.samples());
+  // The input features' training ranges; the elapsed-time features (last) have their own test:
+  // time beyond the longest training run.
+  const Eigen::Index ni = static_cast<Eigen::Index>(model.features.size() -
+                                                    model.elapsed_time_constants.size());
+  const double trained = TrainedElapsed(model);
+  int beyond = 0;
   for (int k = 0; k < run.samples(); ++k) {
-    p.predicted_um(k) = ev.Step(run.time_min[static_cast<std::size_t>(k)], u.row(k).transpose());
+    const double t = run.time_min[static_cast<std::size_t>(k)];
+    p.predicted_um(k) = ev.Step(t, u.row(k).transpose());
     p.std_um(k) = ev.StdDev();
-    const Eigen::VectorXd& f = ev.features();
+    const Eigen::VectorXd f = ev.features().head(ni);
     const double span = 1e-9;
-    if (((f - model.feature_max).array() > span).any() ||
-        ((model.feature_min - f).array() > span).any())
+    if (((f - model.feature_max.head(ni)).array() > span).any() ||
+        ((model.feature_min.head(ni) - f).array() > span).any())
       ++p.outside_range_samples;
+    beyond += t - run.time_min.front() > trained * (1 + 1e-9);
   }
+  p.beyond_trained_time_samples = beyond;
   const auto& names = run.error_names;
   if (std::find(names.begin(), names.end(), model.error_column) != names.end()) {
     p.has_measured = true;
@@ -440,6 +471,16 @@ RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode 
                          std::to_string(run.samples()) +
                          " samples have an input outside the model's training range "
                          "(extrapolation)");
+  if (beyond > 0)
+    p.warnings.push_back(
+        run.name + ": " + std::to_string(beyond) + " of " + std::to_string(run.samples()) +
+        " samples lie beyond the longest training run (" + MessageNumber(trained) + " " +
+        model.time_unit + " since its start): the elapsed-time warm-up is extrapolated there; it " +
+        (model.SensorFree() && model.extra_inputs.empty()
+             ? "approaches its plateau " + MessageNumber(WarmUpPlateau(model)) + " um"
+             : "approaches its plateau (" + MessageNumber(WarmUpPlateau(model)) +
+                   " um, the warm-up part)") +
+        " and never passes it");
   if (run.time_from_index)
     p.warnings.push_back(run.name + ": no recorded time: the sample index is the time axis");
   return p;
