@@ -272,6 +272,12 @@ WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
   const Eigen::VectorXd y = WarmUpTarget(d);
   const std::vector<double> grid = LogGrid(d);
   const std::vector<std::size_t> at = GridSearch(d, y, grid, terms);
+  if (at.empty()) {  // two terms 3 apart do not fit between two sample steps and the span
+    WarmUpFit one = FitWarmUp(times, errors, 1, fixed);
+    one.note = "the trained span is too short for two time constants: one term" +
+               std::string(one.note.empty() ? "" : "; ") + one.note;
+    return one;
+  }
   std::vector<double> taus;
   for (std::size_t i : at) taus.push_back(grid[i]);
   Eigen::VectorXd b;

@@ -223,6 +223,10 @@ TEST(WarmUpFitBounds, TimeConstantsAndGainSignsOnRandomRuns) {
       EXPECT_TRUE((g.array() >= 0).all() || (g.array() <= 0).all()) << g.transpose();
     }
   }
+  // A span too short for two time constants 3 apart (2 sample steps to 2.5 steps): one term.
+  const WarmUpFit short_run = FitWarmUp({{0.0, 1.0, 2.0, 2.5}}, {Eigen::Vector4d(0, 1, 1.5, 1.6)}, 2);
+  EXPECT_EQ(short_run.time_constants.size(), 1u);
+  EXPECT_NE(short_run.note.find("too short for two"), std::string::npos) << short_run.note;
 }
 
 }  // namespace
