@@ -75,10 +75,15 @@ std::string Reading(const AnalogInput& a) {
 
 // Slots of one model: its features (input-major, then the elapsed-time features, as
 // DriftModel::features), one reference per sensor, the init flag.
+// A sum of more terms than this is accumulated in a slot over several actions (each line of a
+// program must stay within the control's 512 characters).
+constexpr int kMaxTermsPerAction = 8;
+
 struct Layout {
   int per = 1;  // slots per input: value + lags
   int features = 0, elapsed = 0, elapsed_count = 0, ref = 0, flag = 0;
-  int Last() const { return flag; }
+  int sum = -1;  // the partial sums of a model of more than kMaxTermsPerAction features
+  int Last() const { return std::max(flag, sum); }
 };
 
 Layout MakeLayout(const drift::DriftModel& m, int first) {
@@ -89,6 +94,7 @@ Layout MakeLayout(const drift::DriftModel& m, int first) {
   l.elapsed_count = static_cast<int>(m.elapsed_time_constants.size());
   l.ref = l.features + static_cast<int>(m.features.size());
   l.flag = l.ref + static_cast<int>(m.sensors.size());
+  if (static_cast<int>(m.features.size()) > kMaxTermsPerAction) l.sum = l.flag + 1;
   return l;
 }
 
@@ -169,11 +175,20 @@ std::vector<std::string> FeatureBodies(const drift::DriftModel& m, const DriftAc
   return bodies;
 }
 
-// c_0 + sum c_f x_f over the layout's feature slots.
-std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals) {
+// c_0 + sum c_f x_f over the layout's feature slots: one expression, or, with more than
+// kMaxTermsPerAction features, actions appended to `bodies` that accumulate it in
+// $AC_PARAM[target] kMaxTermsPerAction terms at a time, and then that slot.
+std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals, int target,
+                   std::vector<std::string>* bodies) {
   std::string out = FormatFixed(c(0), decimals);
-  for (Eigen::Index f = 1; f < c.size(); ++f)
+  const bool split = c.size() - 1 > kMaxTermsPerAction;
+  for (Eigen::Index f = 1; f < c.size(); ++f) {
     out += Term(c(f), decimals) + "*" + P(l.features + static_cast<int>(f) - 1);
+    if (split && (f % kMaxTermsPerAction == 0 || f + 1 == c.size())) {
+      bodies->push_back("DO " + P(target) + "=" + out);
+      out = P(target);
+    }
+  }
   return out;
 }
 
@@ -181,11 +196,14 @@ bool SlopeMode(const DriftActionOptions& o, const drift::DriftModel* g) {
   return g != nullptr || o.workpiece_slope_param >= 0;
 }
 
-// The setting-data writes (see the header comment for the composition).
+// The setting-data writes (see the header comment for the composition); partial sums of a
+// long model are appended to `bodies` first.
 std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
-                       const DriftActionOptions& o, const Slots& s) {
+                       const DriftActionOptions& o, const Slots& s,
+                       std::vector<std::string>* bodies) {
   const std::string ax = "[" + o.axis + "]";
-  std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient);
+  std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient,
+                          s.offset.sum, bodies);
   if (o.workpiece_k0_param >= 0) k0 += "+" + P(o.workpiece_k0_param);
   if (!SlopeMode(o, g))
     return "DO $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=1";
@@ -213,11 +231,12 @@ std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::D
   if (g) {
     const std::vector<std::string> more = FeatureBodies(*g, o, s.slope);
     bodies.insert(bodies.end(), more.begin(), more.end());
-    bodies.push_back(
-        "DO " + P(s.s_m) + "=" +
-        Linear(DriftSlopeCoefficients(*g, o), s.slope, kDecimalsDriftSlopeCoefficient));
+    const std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope,
+                                   kDecimalsDriftSlopeCoefficient, s.s_m, &bodies);
+    if (s_m != P(s.s_m)) bodies.push_back("DO " + P(s.s_m) + "=" + s_m);
   }
-  bodies.push_back(OutputBody(m, g, o, s));
+  const std::string output = OutputBody(m, g, o, s, &bodies);
+  bodies.push_back(output);
   return bodies;
 }
 

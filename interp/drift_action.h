@@ -27,11 +27,13 @@
 // $AC_PARAM layout from param_first: the liveness slot (the last action writes the mode there
 // every cycle: 1 owns SD43900, 2 owns SD43900-43920; the plans clear it, dwell and read it back,
 // sinumerik.h), then one slot per model feature (input-major, as DriftModel::features), one
-// reference slot per sensor (reference "start") and an init flag; with a slope model its slots
-// follow likewise, then S_m. The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
+// reference slot per sensor (reference "start") and an init flag, and for a model of more than 8
+// features a slot its sum is accumulated in, 8 terms per action (every program line must stay
+// within the control's 512 characters); with a slope model its slots follow likewise, then S_m.
+// The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
 // Action order (IDs count up from sync_id_first; actions run in ID order every cycle):
 //   [start: capture T_ref once] -> rises u -> [elapsed updates] -> [once: L = u, x = 0, flag]
-//   -> [lag updates] -> SD43900.
+//   -> [lag updates] -> [partial sums] -> SD43900.
 //
 // One writer per setting datum. With a whirling plan on the same axis (whirl plan
 // --with-drift-action), the plan's actions write their K0 into $AC_PARAM[workpiece_k0_param]

@@ -200,6 +200,57 @@ TEST(DriftAction, ElapsedTimeIsCountedByTheControl) {
     }
 }
 
+// A model of 8 sensors with a lag each (16 features, the simulated machine's default fit of
+// issue 45): the sum no longer fits one line of 512 characters, so it is accumulated over several
+// actions; SD43900 still follows the evaluator.
+TEST(DriftAction, LongModelsSumOverSeveralActions) {
+  drift::DriftModel m;
+  m.kind = drift::ModelKind::kDynamic;
+  m.error_column = "offset_um";
+  m.time_constants = {0.05};
+  DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kStart);
+  o.inputs.clear();
+  std::vector<double> c{0.7};
+  for (int i = 0; i < 8; ++i) {
+    const std::string name = "s" + std::to_string(i) + "_C";
+    m.sensors.push_back(name);
+    m.features.push_back({name, 0.0});
+    m.features.push_back({name, 0.05});
+    o.inputs[name] = {i + 1, 0.0625, 0.0};
+    c.push_back(123.4567 * (i % 2 ? -1 : 1) / (i + 1));
+    c.push_back(-45.678 / (i + 1));
+  }
+  m.reference_C = Eigen::VectorXd::Constant(8, 20.0);
+  m.feature_min = Eigen::VectorXd::Constant(16, -5);
+  m.feature_max = Eigen::VectorXd::Constant(16, 5);
+  m.linear.coefficients = Eigen::Map<const Eigen::VectorXd>(c.data(), 17);
+  m.linear.covariance = Eigen::MatrixXd::Identity(17, 17) * 0.01;
+  m.Validate();
+  auto temps = [](int k) {
+    Eigen::VectorXd t(8);
+    for (int i = 0; i < 8; ++i) t(i) = 20 + (i + 1) * (1 - std::exp(-k * kCycleMs / 1000.0 / (5.0 + 3 * i)));
+    return t;
+  };
+  const std::string nc = FormatDriftNcProgram(m, o);
+  std::istringstream lines(nc);
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 512u) << line;
+  replay::Replay r;
+  auto set = [&](const Eigen::VectorXd& t) {
+    for (int i = 0; i < 8; ++i) r.control.ain[i + 1] = t(i) / 0.0625;
+  };
+  set(temps(0));
+  ASSERT_TRUE(r.RunProgram(nc)) << nc;
+  drift::DriftEvaluator ev(m, temps(0));
+  double worst_mm = 0;
+  for (int k = 0; k < 600; ++k) {
+    set(temps(k));
+    r.Cycle(0.0);
+    const double e_um = ev.Step(k * kCycleMs / 60000.0, temps(k));
+    worst_mm = std::max(worst_mm, std::abs(r.control.abs_value_mm - Sign(o) * e_um / 1000.0));
+  }
+  EXPECT_LT(worst_mm, 1e-8) << nc;
+}
+
 TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
   std::mt19937 rng(1805);
   const drift::DriftModel m = HandModel(true, rng);
