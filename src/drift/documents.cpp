@@ -268,6 +268,7 @@ json CrossRunJson(const CrossRunResult& r) {
           {"error_zero", ToString(r.zero.zero)},
           {"error_column", r.error_column},
           {"model", ToString(r.kind)},
+          {"candidates", ToString(r.candidates)},
           {"runs", runs},
           {"pairs", cells},
           {"groups", groups}};
@@ -276,7 +277,8 @@ json CrossRunJson(const CrossRunResult& r) {
 std::string FormatCrossRun(const CrossRunResult& r) {
   std::ostringstream o;
   o << "cross-run evaluation of " << r.error_column << " (" << ToString(r.kind)
-    << " model on each run's chosen sensors; statistics of measured - predicted [um])\n";
+    << " model of each run, candidates " << ToString(r.candidates)
+    << "; statistics of measured - predicted [um])\n";
   for (std::size_t i = 0; i < r.runs.size(); ++i)
     o << "  " << r.runs[i] << " (" << ToString(r.states[i]) << "): " << JoinNames(r.chosen[i])
       << "\n";

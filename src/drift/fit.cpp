@@ -673,6 +673,16 @@ CandidateChoice ChooseCandidate(const std::vector<CandidateScore>& s, const Choi
   return c;
 }
 
+FitOptions PreviousRunOptions(const DriftModel& m) {
+  FitOptions f;
+  f.threads = 1;
+  f.zero = m.zero;
+  f.kind = m.kind == ModelKind::kNetwork ? ModelKind::kMlr : m.kind;
+  f.extra_inputs = m.extra_inputs;
+  if (m.selection == "given") f.sensors = m.sensors;
+  return f;
+}
+
 FitReport FitDriftModel(const std::vector<Run>& raw_runs, const std::string& error_column,
                         const FitOptions& o) {
   o.Validate();

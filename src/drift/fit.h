@@ -139,4 +139,14 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
 FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);
 
+/// The name of the "previous run" baseline in drift report and drift monitor --day.
+inline constexpr const char* kPreviousRunBaseline = "previous run";
+
+/// The "previous run" baseline, one definition for every command: `drift fit` at its defaults
+/// redone on the run before (the previous run shown by drift report, the previous day of drift
+/// monitor --day), what a shop gets by refitting each day: candidates auto, Miao et al.'s
+/// selection afresh (the model's own sensors when they were given), the model's kind (a network:
+/// mlr), extra inputs and error zero; one thread.
+FitOptions PreviousRunOptions(const DriftModel& model);
+
 }  // namespace whirl::drift

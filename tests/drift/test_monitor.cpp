@@ -534,9 +534,7 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   MonitorOptions o;
   o.check_every = 100;
   std::vector<drift::Run> same{MakeRun(p, 2), MakeRun(p, 3)};
-  FitOptions refit;
-  refit.candidates = Candidates::kSensors;
-  const WeekResult quiet = MonitorWeek(m, same, o, refit);
+  const WeekResult quiet = MonitorWeek(m, same, o);
   ASSERT_EQ(quiet.days.size(), 2u);
   for (const auto& d : quiet.days)
     for (const auto& st : d.strategies) {
@@ -550,7 +548,7 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   Planted q = p;
   q.change_min = 0;
   q.w_after = {1.6, 0.1, -0.4};
-  const WeekResult changed = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5)}, o, refit);
+  const WeekResult changed = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5)}, o);
   const StrategyResult& first = Rule(changed.days[0], UpdateRule::kBayes);
   ASSERT_GT(first.recalibrations, 0);
   const StrategyResult& second = Rule(changed.days[1], UpdateRule::kBayes);
