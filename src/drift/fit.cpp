@@ -518,7 +518,7 @@ FitReport FitTimeModel(const std::vector<Run>& runs, const std::string& error_co
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
   const WarmUpFit w = WarmUpOnRows(s, all, terms, false);
   rep.model.elapsed_time_constants = w.time_constants;
-  if (!w.identified) rep.model.notes.push_back(w.note);
+  if (!w.note.empty()) rep.model.notes.push_back(w.note);
   FitChosen(runs, error_column, o, &rep);
   return rep;
 }
@@ -532,7 +532,7 @@ FitReport FitSensorTimeModel(const std::vector<Run>& runs, const std::string& er
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
   const WarmUpFit w = WarmUpOnRows(s, all, 1, true);
   m.elapsed_time_constants = w.time_constants;
-  if (!w.identified) m.notes.push_back(w.note);
+  if (!w.note.empty()) m.notes.push_back(w.note);
   m.features.clear();
   FitChosen(runs, error_column, o, &rep);
   return rep;
