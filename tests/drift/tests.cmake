@@ -29,3 +29,9 @@ target_link_libraries(choice_study PRIVATE whirl::machine_eval)
 target_include_directories(choice_study PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 whirl_set_warnings(choice_study)
 target_compile_options(choice_study PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})
+# The issue-38 table script on a synthetic FL_THERMAL-shaped log (no shared data needed).
+whirl_add_cli_test(cli_fl_thermal_splits ${CMAKE_CURRENT_LIST_DIR}/cli_fl_splits.sh)
+# The choice study driver runs (one seed of the tuning set) and prints its summary.
+add_test(NAME choice_study_runs
+         COMMAND sh -c "$<TARGET_FILE:choice_study> tuning --seeds 1 --quiet | grep -q '^all '")
+set_tests_properties(choice_study_runs PROPERTIES LABELS "drift;cli")
