@@ -131,8 +131,9 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
 /// The errors are first put on options.zero (a fixed zero without a level takes the first row of
 /// the first run), which the model stores. With several candidates (options.candidates), each is
 /// scored by the validation RMSE with its whole fit (selection excepted, as the class-count
-/// choice) redone in every fold; the lowest wins, and within 5 % of it the fewest parameters
-/// (time1 < time2 < sensors < sensors+time).
+/// choice) redone in every fold, per fold and pooled; options.choice picks one (ChooseCandidate:
+/// the fewest parameters within 5 % of the lowest RMSE, a time model replacing the sensors only
+/// when it wins clearly and consistently), and FitReport::chosen says why with the numbers.
 /// Dead and duplicate sensors (selection.h convention 8) are left out of the selection and of
 /// given sensors, with a warning each (FitReport::warnings); InputError naming the run files when
 /// no sensor is left, or when the regression is still rank-deficient (naming the features).
