@@ -171,6 +171,7 @@ void ApplyIntervals(MonitorArgs& a, bool time_from_index) {
 }
 
 void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
+  drift::CheckMonitorDays(a.days.size());  // before reading thousands of files
   std::vector<drift::Run> days;
   for (const auto& d : a.days) days.push_back(drift::ReadRun(d, drift::RunState::kUnknown));
   ApplyIntervals(a, days.front().time_from_index);
@@ -190,7 +191,9 @@ void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
 
 void RunMonitor(MonitorArgs& a) {
   if (a.run.empty() && a.days.empty()) throw InputError("give --run FILE or --day FILE ...");
-  CheckOutputs({{"--model", a.model}, {"--run", a.run}},
+  std::vector<FlagPath> inputs{{"--model", a.model}, {"--run", a.run}};
+  for (const auto& d : a.days) inputs.push_back({"--day", d});
+  CheckOutputs(inputs,
                {{"--timeline", a.timeline}, {"--events", a.events}}, {{"--out-dir", a.out_dir}});
   a.o.reference = drift::ParseReferenceMode(a.reference);
   a.o.score_from = a.score_rows.at(0);

@@ -512,10 +512,11 @@ std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, st
     if (!now.files.count(d)) all.dirs.insert(d);
   std::vector<std::pair<fs::path, std::string>> batch;
   std::vector<fs::path> written;
-  for (const auto& [name, text] : files_) {
-    batch.emplace_back(dir_ / name, text);
+  for (auto& [name, text] : files_) {  // moved: a commit holds the files once (drift split)
+    batch.emplace_back(dir_ / name, std::move(text));
     written.push_back(dir_ / name);
   }
+  files_.clear();
   batch.insert(batch.end(), also.begin(), also.end());
   // Until the old files are gone the manifest lists them too, so a run killed in between
   // leaves a directory the next run accepts.
