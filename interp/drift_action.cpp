@@ -41,6 +41,13 @@ void CheckModel(const drift::DriftModel& m) {
     throw InputError(
         "drift action: a network model cannot be evaluated by synchronized actions "
         "here; fit the channel with --kind mlr or --kind dynamic");
+  // Minimal guard (issue 45): the programs below evaluate sensor and input features only; an
+  // elapsed-time feature has no input, and the lookups ran past the model's inputs (a crash).
+  if (!m.elapsed_time_constants.empty())
+    throw InputError("drift action: the model uses the time since the run start (" +
+                     std::to_string(m.elapsed_time_constants.size()) +
+                     " elapsed-time feature(s)), which these programs cannot evaluate yet; refit "
+                     "with drift fit --candidates sensors to put the model on the control");
   if (!m.time_constants.empty() && m.time_unit != "min")
     throw InputError("drift action: the model's lag time constants are in '" + m.time_unit +
                      "' (its training runs had no time column): refit on runs with time_s or "
