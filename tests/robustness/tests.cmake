@@ -15,3 +15,6 @@ whirl_add_cli_test(cli_grammar ${CMAKE_CURRENT_LIST_DIR}/cli_grammar.sh)
 # Issue 45: output manifests, the control's limits, duplicate keys, model-file messages, time and
 # count bounds, a deprecated flag given twice (each a regression test of a finding).
 whirl_add_cli_test(cli_hardening ${CMAKE_CURRENT_LIST_DIR}/cli_hardening.sh)
+# Every model a command writes (drift fit, train, surface fit/points, ballbar drift) handed to
+# every command that takes a model file: accepted or refused by name, never a signal.
+whirl_add_cli_test(cli_model_roundtrip ${CMAKE_CURRENT_LIST_DIR}/cli_model_roundtrip.sh)
