@@ -119,7 +119,7 @@ for m in "${MODELS[@]}"; do
     grep -q '^error: ' err.txt || fail "$m -> $id: exit $rc without an error line: $(tail -n 2 err.txt)"
     grep -q 'json.exception' err.txt && fail "$m -> $id: a library message: $(cat err.txt)"
     # By name: the message names the model file, or (a model the command cannot use) says why.
-    grep -Eq "$m\.json|model|surface" err.txt || fail "$m -> $id: refused without naming it: $(cat err.txt)"
+    grep -Eq "$m\.json|model|surface|LibTorch" err.txt || fail "$m -> $id: refused without naming it: $(cat err.txt)"
   done
   echo >> matrix.txt
 done
