@@ -112,6 +112,8 @@ nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
   return j;
 }
 
+std::string LibraryRule(const nlohmann::json::exception& e) { return Untagged(e.what()); }
+
 std::string DumpJson(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }

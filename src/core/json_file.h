@@ -19,6 +19,10 @@ namespace whirl {
 /// at the start is skipped. Size limit: kMaxInputFileBytes (core/atomic_file.h).
 nlohmann::json ReadJsonFile(const std::filesystem::path& path);
 
+/// nlohmann's message of `e` without its "[json.exception.type_error.302] " tag ("type must be
+/// number, but is string"), for a message that names the key itself.
+std::string LibraryRule(const nlohmann::json::exception& e);
+
 /// JSON text (`indent` spaces, as nlohmann::json::dump). A string holding bytes that are not
 /// UTF-8 (a file name from the command line) gets U+FFFD in their place instead of an exception.
 std::string DumpJson(const nlohmann::json& j, int indent = 2);

@@ -169,7 +169,7 @@ WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
   } catch (const InputError& e) {
     throw InputError("model file '" + path.string() + "': " + e.what());
   } catch (const json::exception& e) {
-    throw InputError("model file '" + path.string() + "': " + e.what());
+    throw InputError("model file '" + path.string() + "': " + LibraryRule(e));
   }
 }
 
