@@ -15,6 +15,7 @@ if [ "${1:-}" = merge ]; then MODE=merge; shift; fi
 SECONDS_EACH=60
 if [ "$MODE" = run ]; then SECONDS_EACH="${1:-60}"; shift || true; fi
 HARNESSES=("$@")
+FAILED=()
 [ ${#HARNESSES[@]} -eq 0 ] && HARNESSES=(csv process_table curve screw model workpiece_model lead \
   iso_table drift_run drift_model machine_profile ballbar surface)
 command -v clang++ > /dev/null || { echo "fuzz: clang++ not found (apt-get install clang)" >&2; exit 1; }
@@ -46,7 +47,8 @@ for h in "${HARNESSES[@]}"; do
     find $(seeds_of "$h") "$corpus" -type f -size -64k | while read -r f; do
       cp "$f" "$base/$(sha1sum < "$f" | cut -c1-40)"; done
     before=$(ls "$base")
-    "$BUILD/tests/fuzz_$h" -merge=1 -max_len=16384 -timeout=10 -rss_limit_mb=2048 \
+    "$BUILD/tests/fuzz_$h" -set_cover_merge=1 -use_counters=0 -max_len=16384 -timeout=10 \
+      -rss_limit_mb=2048 \
       "$base" "$scratch" 2>&1 | tail -n 1
     for f in "$base"/*; do
       grep -qx "$(basename "$f")" <<< "$before" || cp "$f" "$corpus/"
@@ -58,7 +60,12 @@ for h in "${HARNESSES[@]}"; do
   echo "fuzz: $h for $SECONDS_EACH s" >&2
   # shellcheck disable=SC2046
   "$BUILD/tests/fuzz_$h" -max_total_time="$SECONDS_EACH" -max_len=16384 -timeout=10 \
-    -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz_$h-" "$scratch" $(seeds_of "$h") "$corpus"
+    -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz_$h-" "$scratch" $(seeds_of "$h") "$corpus" ||
+    FAILED+=("$h")  # the others still run; the reproducer is named above
 done
-[ "$MODE" = run ] && echo "fuzz: no finding in ${HARNESSES[*]}" >&2
-exit 0
+[ "$MODE" = merge ] && exit 0
+if [ ${#FAILED[@]} -gt 0 ]; then
+  echo "fuzz: findings in ${FAILED[*]} (reproducers: $BUILD/fuzz_<harness>-crash-*)" >&2
+  exit 1
+fi
+echo "fuzz: no finding in ${HARNESSES[*]}" >&2

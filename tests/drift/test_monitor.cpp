@@ -576,6 +576,17 @@ TEST(Monitor, DayFilesAreBounded) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("3000 day files"), std::string::npos) << e.what();
   }
+  // Days that hold more samples together than one run file may are refused before any replay.
+  Planted p;
+  const DriftModel m = FitOn(MakeRun(p, 1));
+  p.samples = kMaxRunSamples / 2 + 1;
+  const Run big = MakeRun(p, 2);
+  try {
+    MonitorWeek(m, {big, big}, MonitorOptions{}, FitOptions{});
+    ADD_FAILURE() << "2 x " << big.samples() << " samples accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("samples together"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
