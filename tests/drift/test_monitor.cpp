@@ -580,7 +580,7 @@ TEST(Monitor, DayFilesAreBounded) {
   Planted p;
   const DriftModel m = FitOn(MakeRun(p, 1));
   p.samples = kMaxRunSamples / 2 + 1;
-  const Run big = MakeRun(p, 2);
+  const drift::Run big = MakeRun(p, 2);
   try {
     MonitorWeek(m, {big, big}, MonitorOptions{}, FitOptions{});
     ADD_FAILURE() << "2 x " << big.samples() << " samples accepted";
