@@ -187,6 +187,7 @@ void WriteOutputs(const MonitorArgs& a, const std::string& timeline, const std::
 }
 
 void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
+  drift::CheckMonitorDays(a.days.size());  // before reading thousands of files
   std::vector<drift::Run> days;
   for (const auto& d : a.days) days.push_back(drift::ReadRun(d, drift::RunState::kUnknown));
   ApplyIntervals(a, days.front().time_from_index);

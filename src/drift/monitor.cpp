@@ -604,9 +604,24 @@ void RankWeek(const std::vector<std::pair<std::string, DayResiduals>>& scored, W
 
 }  // namespace
 
+void CheckMonitorDays(std::size_t count) {
+  if (count > static_cast<std::size_t>(kMaxMonitorDays))
+    throw InputError("monitor: " + std::to_string(count) + " day files; at most " +
+                     std::to_string(kMaxMonitorDays) +
+                     " (a year of days) in one replay: replay fewer days at a time");
+}
+
 WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
                        const MonitorOptions& o, const std::vector<Run>& first_time_training) {
   if (days.empty()) throw InputError("monitor: give at least one day (--day)");
+  CheckMonitorDays(days.size());
+  long long samples = 0;
+  for (const Run& d : days) samples += d.samples();
+  if (samples > kMaxRunSamples)
+    throw InputError("monitor: the " + std::to_string(days.size()) + " days hold " +
+                     std::to_string(samples) + " samples together; at most " +
+                     std::to_string(kMaxRunSamples) +
+                     " (as one run file): replay fewer days at a time");
   WeekResult w;
   std::vector<std::pair<std::string, DayResiduals>> scored;
   FitOptions time_only;
