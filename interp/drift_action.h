@@ -46,7 +46,7 @@
 // run in ID order each cycle, so the plan's K0 is written before it is added (no cycle of lag).
 //
 // The machine's slope (optional second model, e.g. the Z feed screw growing from its fixed
-// bearing; machine/machine.h channel zscrew_per_1000_um). Its output g [um per 1000 mm] is the
+// bearing, trained on a lead-slope channel such as zscrew_per_1000_um). Its output g [um per 1000 mm] is the
 // growth of the error with the distance from the fixed end P_b (profile drift.slope):
 //   e(P) = e_K + g * sigma * (P - P_b) / 1000   [um along error_direction],
 // sigma = growth_direction (+1: the distance from the fixed end grows towards +axis). So the
