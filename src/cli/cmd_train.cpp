@@ -2,13 +2,18 @@
 // family choice by cross-validated error (src/family/family.h), or the Bayesian-regularized network
 // (src/nn/trainbr.h); or sweep the network's hidden size with k-fold cross-validation
 // (src/nn/selection.h).
+#include <unistd.h>
+
 #include <cerrno>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -214,14 +219,63 @@ workpiece::TrainOptions WorkpieceOptions(const TrainCliOptions& o) {
   return w;
 }
 
+// Progress of a family choice on stderr, only for a fit that takes longer than kQuiet: from then
+// on a line every kQuiet (a watcher thread, so that one long step still gets its lines): steps
+// done, elapsed seconds and the step last finished.
+class SlowFitProgress {
+ public:
+  static constexpr std::chrono::seconds kQuiet{2};
+  SlowFitProgress() : start_(std::chrono::steady_clock::now()), watcher_([this] { Watch(); }) {}
+  ~SlowFitProgress() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    watcher_.join();
+  }
+  void Update(int done, int total, const std::string& step) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    done_ = done;
+    total_ = total;
+    step_ = step;
+  }
+
+ private:
+  void Watch() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!wake_.wait_for(lock, kQuiet, [this] { return stop_; })) {
+      const double s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      std::fprintf(stderr, "train: %d/%d steps in %.0f s%s%s\n", done_, total_, s,
+                   step_.empty() ? "" : ", last: ", step_.c_str());
+      std::fflush(stderr);
+    }
+  }
+  std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  int done_ = 0, total_ = 0;
+  std::string step_;
+  std::thread watcher_;  // last: starts after the fields above exist
+};
+
 // A family choice: train, save and print what was chosen with the CV table.
-void RunFamily(const TrainCliOptions& o, const ProcessTable& table,
-               const workpiece::TrainOptions& w) {
+void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::TrainOptions w) {
   const auto start = std::chrono::steady_clock::now();
-  const workpiece::WorkpieceModel model = workpiece::TrainWorkpieceModel(
-      table, w, std::filesystem::path(o.data_path).filename().string());
+  workpiece::WorkpieceModel model;
+  {
+    SlowFitProgress progress;
+    w.choice.progress = [&progress](int done, int total, const std::string& step) {
+      progress.Update(done, total, step);
+    };
+    model = workpiece::TrainWorkpieceModel(table, w,
+                                           std::filesystem::path(o.data_path).filename().string());
+  }
   const double fit_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  for (const std::string& warning : model.choice.warnings) Warn(warning);
   workpiece::SaveWorkpieceModel(o.out_path, model);
   const family::ChoiceOptions& c = w.choice;
   if (o.json) {
@@ -229,8 +283,9 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table,
                {"kind", "family"},
                {"chosen", model.Describe()},
                {"folds", c.folds},
-               {"cv_table", model.choice.table},
+               {"cv_table", workpiece::ChoiceTableJson(model.choice)},
                {"notes", model.choice.notes},
+               {"warnings", model.choice.warnings},
                {"calibration", model.choice.models.front().calibration},
                {"fit_time_ms", fit_ms}});
     return;

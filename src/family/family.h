@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -99,11 +100,19 @@ struct FamilyModel {
   std::vector<gp::Gp> gps;
   std::vector<LinearModel> linears;
   std::string calibration;  ///< how the predictive sd was calibrated (provenance)
+  /// Name() of the candidate for output k, saying when a log candidate keeps the output on its raw
+  /// scale: "linear/log-inputs" (the log of the inputs only, LogExceptions).
+  std::string OutputName(int k) const;
 };
 
-/// Fits `candidate` on all rows of `table` (targets required, >= 4 rows); `calibrate` = false
-/// skips the noise calibration (the cross-validation folds need only means). InputError on bad
-/// tables.
+/// Fewest rows `c` can be fitted and judged on with `inputs` used inputs: a linear fit its
+/// 1 + inputs coefficients and 2 more (a residual degree of freedom after the leave-one-out), a
+/// GP its mean's coefficients and 2 more, a network 4.
+int MinimumRows(const Candidate& c, int inputs);
+
+/// Fits `candidate` on all rows of `table` (targets required, at least MinimumRows rows; the
+/// InputError counts the table's rows); `calibrate` = false skips the noise calibration (the
+/// cross-validation folds need only means). InputError on bad tables.
 FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
                          const FitOptions& options, bool calibrate = true);
 
@@ -224,7 +233,14 @@ struct ChoiceOptions {
   /// tests/family/bend_probe.cpp (docs/workpiece-model.md, "Practical equivalence at few rows").
   double equivalence_sd = 0.1;
   static constexpr int kRowsPerHyperparameter = 10;
+  /// Below this many rows the held-out errors of GP candidates come from K-fold refits with
+  /// hyperparameters refitted from GpOptions' fixed starting points (none has seen the held-out
+  /// rows) instead of the closed-form leave-one-out; 0 = never.
+  int honest_gp_rows = 0;
   FitOptions fit;
+  /// Called from the fitting threads (one at a time) after each candidate's fit or fold and after
+  /// the final fits: `done` of `total` steps and what was just done. Empty: none.
+  std::function<void(int done, int total, const std::string& step)> progress;
   /// From the simplest (ChoiceOptions::one_standard_error): linear/log (the power law),
   /// linear/identity, gp-se-iso-constant/identity (one length scale: 3 hyperparameters),
   /// gp-matern52-constant/log, gp-matern52-constant/identity (ARD: 7). The isotropic GP on raw
@@ -252,13 +268,18 @@ struct Choice {
   /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight); empty: output
   /// k is models[model_of_output[k]] alone.
   std::array<std::vector<double>, Features::kCount> weights;
-  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none. Printed by `whirl train` (and in its --json), not stored in the model file.
+  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
+  /// Printed by `whirl train` (and in its --json), not stored in the model file.
   std::array<std::string, Features::kCount> notes;
+  /// What the choice did about the table that the user should know: inputs left out because they
+  /// are constant, columns a log candidate keeps on their raw scale (a value <= 0 or near zero,
+  /// LogExceptions). Printed by `whirl train` as warnings (and in its --json), not stored.
+  std::vector<std::string> warnings;
   std::string Describe()
       const;  ///< "max_elongation_um: linear/log, settle_time_s: gp-se-constant/log"
 };
-/// The choice of the header comment. InputError if the table has no targets or fewer than 4
-/// rows, or if there are no candidates.
+/// The choice of the header comment. InputError if the table has no targets or fewer rows than a
+/// candidate's MinimumRows (counting the table's rows), or if there are no candidates.
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
 /// Output k from models[model_of_output[k]] (mean and sd), or for a stacked output the weighted
 /// mean sum_j w_j mean_j and sd sqrt(sum_j w_j sd_j^2) (ChoiceOptions::stack).
@@ -271,7 +292,9 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
 // refactorized) and throws InputError naming the key and the rule.
 //   FamilyModel: {"candidate": Candidate::Name(), "transform", "calibration",
 //                 "linears" | "gps" | "network": one fit per output (a network: nn/model.h)}
-//   CvRow:       {"candidate", "cv_rmse" (per output, original units), "score", "fit_ms"}
+//   CvRow:       {"candidate", "cv_rmse" (per output, original units), "score"} (fit_ms is not
+//                stored, so that the same table and seed give the same file byte for byte; files
+//                of earlier versions that hold it load)
 //   Choice:      {"describe": Describe(), "table": [CvRow], "chosen", "model_of_output",
 //                 "models": [FamilyModel]}; the model of output k must be the candidate chosen
 //                 for it.

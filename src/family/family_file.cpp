@@ -26,17 +26,24 @@ std::vector<T> Fits(const json& j, const char* key, const std::string& what) {
     throw InputError(what + ": '" + key + "' must hold one fit per output (" +
                      std::to_string(Features::kCount) + ")");
   std::vector<T> out;
-  for (const json& e : a) out.push_back(e.get<T>());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    try {
+      out.push_back(a[k].get<T>());
+    } catch (const InputError& e) {
+      throw InputError(what + ": '" + key + "'[" + std::to_string(k) + "] (" + kTargetColumns[k] +
+                       "): " + e.what());
+    }
+  }
   return out;
 }
 
-// Every per-output fit takes the five inputs.
+// Every per-output fit takes the inputs the transform uses.
 template <typename T>
-void CheckInputCount(const std::vector<T>& fits, const std::string& what) {
+void CheckInputCount(const std::vector<T>& fits, const TableTransform& t, const std::string& what) {
   for (const T& f : fits)
-    if (f.input_shift.size() != ProcessInputs::kCount)
+    if (f.input_shift.size() != t.UsedInputCount())
       throw InputError(what + ": a fit has " + std::to_string(f.input_shift.size()) +
-                       " inputs, expected " + std::to_string(ProcessInputs::kCount));
+                       " inputs, the transform uses " + std::to_string(t.UsedInputCount()));
 }
 
 std::array<int, Features::kCount> Indices(const json& j, const char* key, int count,
@@ -71,8 +78,9 @@ void from_json(const json& j, FamilyModel& m) {
   if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
   m.candidate = ParseCandidate(name.get<std::string>());
   m.transform = Key(j, "transform", what).get<TableTransform>();
-  if (m.transform.IsIdentity() == m.candidate.log)
-    throw InputError(what + ": 'transform' disagrees with the candidate " + m.candidate.Name());
+  if (!m.transform.IsIdentity() && !m.candidate.log)
+    throw InputError(what + ": 'transform' (" + m.transform.Describe() +
+                     ") disagrees with the candidate " + m.candidate.Name());
   const json& calibration = Key(j, "calibration", what);
   if (!calibration.is_string()) throw InputError(what + ": 'calibration' must be a string");
   m.calibration = calibration.get<std::string>();
@@ -80,10 +88,10 @@ void from_json(const json& j, FamilyModel& m) {
   m.gps.clear();
   if (m.candidate.family == Family::kLinear) {
     m.linears = Fits<LinearModel>(j, "linears", what);
-    CheckInputCount(m.linears, what);
+    CheckInputCount(m.linears, m.transform, what);
   } else if (m.candidate.family == Family::kGaussianProcess) {
     m.gps = Fits<gp::Gp>(j, "gps", what);
-    CheckInputCount(m.gps, what);
+    CheckInputCount(m.gps, m.transform, what);
   } else {
     m.network = Key(j, "network", what).get<nn::Model>();
   }
@@ -103,7 +111,7 @@ void from_json(const json& j, CvRow& r) {
     r.cv_rmse(k) = rmse[k].get<double>();
   }
   r.score = RequireNumber(j, "score", what);
-  r.fit_ms = RequireNumber(j, "fit_ms", what);
+  if (j.contains("fit_ms")) r.fit_ms = RequireNumber(j, "fit_ms", what);
 }
 
 void to_json(json& j, const Choice& c) {
@@ -157,7 +165,14 @@ void from_json(const json& j, Choice& c) {
                      std::to_string(Features::kCount) + " models (a stack: up to one per row " +
                      "of 'table')");
   c.table = table.get<std::vector<CvRow>>();
-  c.models = models.get<std::vector<FamilyModel>>();
+  c.models.clear();
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    try {
+      c.models.push_back(models[i].get<FamilyModel>());
+    } catch (const InputError& e) {
+      throw InputError(what + ": 'models'[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
   c.chosen = Indices(j, "chosen", static_cast<int>(c.table.size()), what);
   c.model_of_output = Indices(j, "model_of_output", static_cast<int>(c.models.size()), what);
   for (int k = 0; k < Features::kCount; ++k) {

@@ -134,11 +134,17 @@ Eigen::VectorXd StartPoint(int index, int d) {
 // Minimizes NLML from each start; fills gp->theta with the best.
 void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp* gp,
               GpSummary* summary) {
-  const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
-    return NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t, gp->min_noise_variance,
-                                    grad);
-  };
   const int d = gp->InputCount();
+  const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
+    double v = NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t,
+                                        gp->min_noise_variance, grad);
+    if (o.length_prior_sd > 0 && std::isfinite(v)) {
+      const Eigen::ArrayXd dev = (t.head(d).array() - o.length_prior_mean) / o.length_prior_sd;
+      v += 0.5 * dev.square().sum();
+      if (grad) grad->head(d).array() += dev / o.length_prior_sd;
+    }
+    return v;
+  };
   // Isotropic: (ln l, ln s_f, ln s_n) <-> theta with d equal length scales.
   const auto expand = [d](const Eigen::VectorXd& t3) {
     Eigen::VectorXd t(d + 2);
@@ -193,6 +199,22 @@ Eigen::VectorXd JsonVector(const nlohmann::json& j, const char* key) {
   return ArrayToVector(RequireKey(j, key, "gaussian process"), key);
 }
 
+// Rules of a GP file's numbers: wide enough for any fit of whirl's tables, narrow enough that
+// no prediction overflows (every value a fit writes is checked against them before it is saved).
+constexpr Range kShiftRange{-1e7, 1e7, false, "", "a mean of transformed inputs or outputs"};
+constexpr Range kScaleRange{0, 1e7, true, "", "an sd of transformed inputs or outputs"};
+constexpr Range kThetaRange{-30, 30, false, "",
+                            "the natural log of a length scale or sd, standardized units"};
+constexpr Range kNoiseRange{0, 1e4, false, "",
+                            "standardized target units: at most 100 times the training sd"};
+constexpr Range kMinNoiseRange{1e-12, 1, false, "", "standardized target units"};
+constexpr Range kStandardizedRange{-1e6, 1e6, false, "", "standardized units"};
+
+void CheckEach(const Eigen::VectorXd& v, const Range& range, const std::string& key) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    CheckRange(v(i), range, key + "[" + std::to_string(i) + "]", "gaussian process");
+}
+
 }  // namespace
 
 std::string ToString(Kernel k) {
@@ -214,6 +236,11 @@ void GpOptions::Validate() const {
   if (restarts < 1 || restarts > kStartCount)
     throw InputError("gaussian process restarts " + std::to_string(restarts) + ": must be in 1.." +
                      std::to_string(kStartCount));
+  if (!(length_prior_sd >= 0) || !std::isfinite(length_prior_sd) ||
+      !std::isfinite(length_prior_mean))
+    throw InputError("gaussian process length prior N(" + MessageNumber(length_prior_mean) +
+                     ", " + MessageNumber(length_prior_sd) +
+                     "^2): the mean must be finite and the sd finite and >= 0");
   if (!(min_noise_variance > 0) || !std::isfinite(min_noise_variance))
     throw InputError("gaussian process min_noise_variance " + MessageNumber(min_noise_variance) +
                      ": must be a finite number > 0");
@@ -357,11 +384,17 @@ void from_json(const nlohmann::json& j, Gp& gp) {
   gp.min_noise_variance = RequireNumber(j, "min_noise_variance", what);
   gp.noise_variance = RequireNumber(j, "noise_variance", what);
   const auto d = gp.input_shift.size();
-  if (gp.input_scale.size() != d || gp.theta.size() != d + 2 || !(gp.input_scale.array() > 0).all())
-    throw InputError(what + ": input_scale (> 0) and theta (inputs + 2) must match input_shift");
-  if (!(gp.target_scale > 0) || !(gp.min_noise_variance > 0) || !(gp.noise_variance >= 0))
-    throw InputError(what +
-                     ": target_scale and min_noise_variance must be > 0, noise_variance >= 0");
+  if (gp.input_scale.size() != d || gp.theta.size() != d + 2 || d == 0)
+    throw InputError(what + ": 'input_scale' (one per input) and 'theta' (inputs + 2) must match "
+                            "'input_shift' (at least one input)");
+  CheckEach(gp.input_shift, kShiftRange, "input_shift");
+  CheckEach(gp.input_scale, kScaleRange, "input_scale");
+  CheckEach(gp.theta, kThetaRange, "theta");
+  CheckEach(gp.u, kStandardizedRange, "targets_standardized");
+  CheckRange(gp.target_shift, kShiftRange, "target_shift", what);
+  CheckRange(gp.target_scale, kScaleRange, "target_scale", what);
+  CheckRange(gp.min_noise_variance, kMinNoiseRange, "min_noise_variance", what);
+  CheckRange(gp.noise_variance, kNoiseRange, "noise_variance", what);
   if (!j.contains("inputs_standardized") || !j.at("inputs_standardized").is_array() ||
       j.at("inputs_standardized").size() != static_cast<std::size_t>(gp.u.size()))
     throw InputError(what + ": 'inputs_standardized' must hold one row per target");
@@ -370,6 +403,7 @@ void from_json(const nlohmann::json& j, Gp& gp) {
     const std::string name = "inputs_standardized[" + std::to_string(q) + "]";
     const Eigen::VectorXd row = ArrayToVector(j.at("inputs_standardized")[q], name);
     if (row.size() != d) throw InputError(what + ": '" + name + "' must hold one value per input");
+    CheckEach(row, kStandardizedRange, name);
     gp.z.col(q) = row;
   }
   gp.Factorize();

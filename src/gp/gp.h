@@ -68,6 +68,11 @@ struct GpOptions {
   /// 100 rows) a second start changed no median except Friedman 20 rows, where the chosen
   /// models were worse with it (out1 2.94 against 2.88).
   int restarts = 1;
+  /// A log-normal prior on every length scale, ln l_i ~ N(length_prior_mean, length_prior_sd^2)
+  /// (standardized inputs): the hyperparameters maximize the likelihood times this prior
+  /// (maximum a posteriori, R&W section 5.4.1's hierarchical view); 0 = no prior (maximum
+  /// likelihood).
+  double length_prior_mean = 0, length_prior_sd = 0;
   /// Floor added to s_n^2, standardized target units (keeps K well conditioned when the data
   /// are interpolated; 1e-6 = noise sd of 0.1 % of the target's sd).
   double min_noise_variance = 1e-6;

@@ -1,12 +1,15 @@
 #include "workpiece/model.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <utility>
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
+#include "core/numbers.h"
 
 namespace whirl::workpiece {
 namespace {
@@ -81,6 +84,78 @@ WorkpieceModel FamilyFromJson(const json& j) {
   return m;
 }
 
+// Largest |mean| and sd a model may predict inside its training domain: 1000 times the output's
+// physical limit (core/limits.h).
+constexpr double kPredictionBound[Features::kCount] = {1e3 * kMaxElongationUm, 1e3 * kMaxSettleTimeS};
+
+// The corners and the centre of the training domain (33 processes).
+std::vector<ProcessInputs> DomainProbe(const WorkpieceModel& m) {
+  std::vector<ProcessInputs> probe;
+  for (int corner = 0; corner <= (1 << ProcessInputs::kCount); ++corner) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i)
+      a[i] = corner == (1 << ProcessInputs::kCount)
+                 ? 0.5 * (m.domain_min(i) + m.domain_max(i))
+                 : ((corner >> i) & 1 ? m.domain_max(i) : m.domain_min(i));
+    probe.push_back(ProcessInputs::FromArray(a));
+  }
+  return probe;
+}
+
+// InputError unless every mean and sd of `p` (one per process of DomainProbe) is finite, within
+// kPredictionBound and the sd >= 0; `what` names the model.
+void CheckProbe(const std::vector<Features>& mean, const std::vector<Features>& sd,
+                const std::string& what) {
+  for (std::size_t q = 0; q < mean.size(); ++q)
+    for (int k = 0; k < Features::kCount; ++k) {
+      const double m = mean[q].ToArray()[k], s = sd[q].ToArray()[k];
+      if (std::abs(m) <= kPredictionBound[k] && s >= 0 && s <= kPredictionBound[k]) continue;
+      throw InputError(what + " predicts " + kTargetColumns[k] + " = " + MessageNumber(m) +
+                       " +- " + MessageNumber(s) + " " + kTargetUnits[k] +
+                       " at the training domain's " +
+                       (q + 1 == mean.size() ? std::string("centre")
+                                             : "corner " + std::to_string(q + 1)) +
+                       "; a valid model predicts finite values within +-" +
+                       MessageNumber(kPredictionBound[k]) + " " + kTargetUnits[k] +
+                       " (1000 times the output's limit) with an sd >= 0 there");
+    }
+}
+
+// The predictions of a loaded model at DomainProbe, model by model: numbers that pass every field
+// rule of the file can still combine into nonsense.
+void CheckDomainPredictions(const WorkpieceModel& m) {
+  const std::vector<ProcessInputs> probe = DomainProbe(m);
+  std::vector<Features> mean, sd;
+  if (m.IsNetwork()) {
+    for (const nn::Prediction& p : nn::PredictBatch(m.network, probe)) {
+      mean.push_back(p.mean);
+      sd.push_back(p.stddev);
+    }
+    return CheckProbe(mean, sd, "the network");
+  }
+  for (std::size_t j = 0; j < m.choice.models.size(); ++j) {
+    mean.clear();
+    sd.clear();
+    for (const family::FamilyPrediction& p : family::PredictFamily(m.choice.models[j], probe)) {
+      mean.push_back(p.mean);
+      sd.push_back(p.stddev);
+    }
+    CheckProbe(mean, sd, "'choice.models'[" + std::to_string(j) + "] (" +
+                             m.choice.models[j].candidate.Name() + ")");
+  }
+}
+
+// InputError unless every mean and sd of `p` is finite (a damaged file or an overflow).
+void CheckFinite(const std::vector<Prediction>& p) {
+  for (std::size_t q = 0; q < p.size(); ++q)
+    for (int k = 0; k < Features::kCount; ++k)
+      if (!std::isfinite(p[q].mean.ToArray()[k]) || !std::isfinite(p[q].stddev.ToArray()[k]))
+        throw InputError("the model predicts " + std::string(kTargetColumns[k]) + " = " +
+                         MessageNumber(p[q].mean.ToArray()[k]) + " +- " +
+                         MessageNumber(p[q].stddev.ToArray()[k]) + " for process " +
+                         std::to_string(q + 1) + ": not a finite value (a damaged model file?)");
+}
+
 }  // namespace
 
 std::string WorkpieceModel::Describe() const {
@@ -118,7 +193,11 @@ WorkpieceModel FromChoice(family::Choice choice, const ProcessTable& table,
 
 std::vector<Prediction> PredictBatch(const WorkpieceModel& model,
                                      const std::vector<ProcessInputs>& inputs) {
-  if (model.IsNetwork()) return nn::PredictBatch(model.network, inputs);
+  if (model.IsNetwork()) {
+    std::vector<Prediction> out = nn::PredictBatch(model.network, inputs);
+    CheckFinite(out);
+    return out;
+  }
   const Eigen::MatrixXd x = nn::InputMatrix(inputs);
   if (!x.allFinite()) throw InputError("predict: an input is NaN or infinite");
   const std::vector<family::FamilyPrediction> f = family::PredictChoice(model.choice, inputs);
@@ -132,6 +211,7 @@ std::vector<Prediction> PredictBatch(const WorkpieceModel& model,
         out[q].outside_domain_fields.push_back(kInputColumns[i]);
       }
   }
+  CheckFinite(out);
   return out;
 }
 
@@ -156,18 +236,29 @@ nn::OutsideDomainSummary SummarizeOutsideDomain(const std::vector<Prediction>& p
 
 WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
   const json j = ReadJsonFile(path);
-  if (!j.is_object() || !j.contains("format") || j.at("format") != WorkpieceModel::kFormat)
-    return FromNetwork(nn::LoadModel(path));  // names the file and the key on errors
   try {
-    return FamilyFromJson(j);
+    const bool family =
+        j.is_object() && j.contains("format") && j.at("format") == WorkpieceModel::kFormat;
+    // A network file: nn::LoadModel names the file and the key on errors.
+    const WorkpieceModel m = family ? FamilyFromJson(j) : FromNetwork(nn::LoadModel(path));
+    CheckDomainPredictions(m);
+    return m;
   } catch (const InputError& e) {
-    throw InputError("model file '" + path.string() + "': " + e.what());
+    const std::string prefix = "model file '" + path.string() + "': ";
+    const std::string what = e.what();
+    throw InputError(what.rfind(prefix, 0) == 0 ? what : prefix + what);
   } catch (const json::exception& e) {
     throw InputError("model file '" + path.string() + "': " + e.what());
   }
 }
 
 void SaveWorkpieceModel(const std::filesystem::path& path, const WorkpieceModel& model) {
+  try {  // the rules a reader applies, so that every file written loads
+    CheckDomainPredictions(model);
+    if (!model.IsNetwork()) FamilyFromJson(FamilyJson(model));
+  } catch (const InputError& e) {
+    throw InputError("model file '" + path.string() + "' not written: " + e.what());
+  }
   if (model.IsNetwork()) {
     nn::SaveModel(path, model.network);
     return;
@@ -220,11 +311,30 @@ WorkpieceModel TrainWorkpieceModel(const ProcessTable& table, const TrainOptions
                                    const nn::ModelProgress& progress) {
   if (options.family == FamilyFlag::kNetwork && options.transform == TransformFlag::kIdentity)
     return FromNetwork(nn::TrainModel(table, options.network, data_name, progress));
+  if (options.transform == TransformFlag::kLog) {
+    ProcessTable named = table;
+    named.source = data_name;
+    const std::vector<family::LogException> raw = family::LogExceptions(named);
+    if (!raw.empty())
+      throw InputError("--transform log: " + raw.front().Describe(named) +
+                       "; use --transform auto (the log candidates then keep that column on its "
+                       "raw scale and say so) or --transform identity, or correct the row");
+  }
   family::ChoiceOptions choice = options.choice;
   choice.candidates = Candidates(options.family, options.transform);
   ProcessTable named = table;
   named.source = data_name;
   return FromChoice(family::ChooseFamily(named, choice), table, data_name);
+}
+
+nlohmann::json ChoiceTableJson(const family::Choice& choice) {
+  json table = json::array();
+  for (const family::CvRow& r : choice.table) {
+    json row = r;
+    row["fit_ms"] = r.fit_ms;
+    table.push_back(row);
+  }
+  return table;
 }
 
 std::string FormatChoiceTable(const family::Choice& choice) {

@@ -115,5 +115,8 @@ WorkpieceModel TrainWorkpieceModel(const ProcessTable& table, const TrainOptions
 /// (um, s), the score and the fit time, and the chosen candidate of each output marked; then a
 /// "note:" line per output with family::Choice::notes.
 std::string FormatChoiceTable(const family::Choice& choice);
+/// The same table as JSON for `whirl train --json`: per candidate its name, cv_rmse, score and
+/// fit_ms (the fit time, which the model file does not store).
+nlohmann::json ChoiceTableJson(const family::Choice& choice);
 
 }  // namespace whirl::workpiece

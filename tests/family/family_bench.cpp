@@ -3,6 +3,7 @@
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
 //                [--joint] [--loo|--kfold] [--no-1se] [--equivalence-sd SD] [--gp-ftol F] [--calibration-folds K]
 //                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--honest-gp-rows N] [--gp-length-prior MEAN,SD]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -64,7 +65,13 @@ Args Parse(int argc, char** argv) {
       a.choice.fit.seed = std::stoull(value());
     else if (k == "--folds")
       a.choice.folds = std::stoi(value());
-    else if (k == "--gp-restarts")
+    else if (k == "--honest-gp-rows")
+      a.choice.honest_gp_rows = std::stoi(value());
+    else if (k == "--gp-length-prior") {
+      const std::string v = value();
+      a.choice.fit.gp.length_prior_mean = std::stod(v.substr(0, v.find(',')));
+      a.choice.fit.gp.length_prior_sd = std::stod(v.substr(v.find(',') + 1));
+    } else if (k == "--gp-restarts")
       a.choice.fit.gp.restarts = std::stoi(value());
     else if (k == "--threads")
       a.choice.fit.threads = std::stoi(value());
