@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <mutex>
 
 #include "core/error.h"
@@ -101,8 +102,16 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
     return {loo.residual, loo.latent_variance};
   }
   if (folds == 0) {
-    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(m.gps[k]);
-    return {loo.residual, loo.latent_variance};
+    const gp::Gp& gp = m.gps[k];
+    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(gp);
+    if (gp.rows.empty()) return {loo.residual, loo.latent_variance};
+    // A GP on a subset of the rows (GpOptions::max_rows): the other rows are held out already.
+    const gp::GpPrediction p = gp::PredictGp(gp, x);
+    h.r = y - p.mean;
+    h.v = p.latent_variance;
+    h.r(gp.rows) = loo.residual;
+    h.v(gp.rows) = loo.latent_variance;
+    return h;
   }
   const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
   KFoldResiduals(
@@ -118,7 +127,7 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
         }
         const gp::GpPrediction p = gp::PredictGp(
             cold_start ? gp::FitGp(x(Eigen::all, tr), y(tr), go)
-                 : gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta),
+                       : gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta),
             x(Eigen::all, te));
         *mean = p.mean;
         *latent = p.latent_variance;
@@ -153,7 +162,9 @@ std::string CalibrationText(int folds, bool two_sd) {
   return "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
          "covers 68.27 % of the " +
          (folds == 0 ? std::string("closed-form leave-one-out residuals")
-                     : std::to_string(folds) + "-fold cross-validation residuals (refits)") +
+                     : std::to_string(folds) +
+                           "-fold cross-validation residuals (refits; a GP's hyperparameters "
+                           "refitted)") +
          (two_sd ? ", and +-1 sd 68.27 % and +-2 sd 95.45 % of the closed-form leave-one-out "
                    "residuals"
                  : "");
@@ -388,9 +399,14 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
 
 int CalibrationFolds(const FitOptions& options, int rows, const FamilyModel& m) {
   const int k = std::min(options.calibration_folds, rows);
-  if (k == 0 || m.candidate.family != Family::kLinear) return k;
+  if (k == 0 || m.candidate.family == Family::kNetwork) return k;
+  if (options.loo_calibration_rows > 0 && rows >= options.loo_calibration_rows) return 0;
+  // A GP on a subset of the rows: the rows it does not keep are held out already.
+  if (m.candidate.family == Family::kGaussianProcess && options.gp.max_rows > 0 &&
+      rows > options.gp.max_rows)
+    return 0;
   const int smallest_training_split = rows - (rows + k - 1) / k;
-  return smallest_training_split >= m.transform.UsedInputCount() + 3 ? k : 0;
+  return smallest_training_split >= MinimumRows(m.candidate, m.transform.UsedInputCount()) ? k : 0;
 }
 
 void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
@@ -399,13 +415,13 @@ void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel
   const int folds = CalibrationFolds(options, static_cast<int>(table.inputs.size()), *m);
   for (int k = 0; k < Features::kCount; ++k) {
     const Eigen::VectorXd yk = y.row(k).transpose();
-    SetNoiseFrom(OutputHeldOut(*m, k, x, yk, options, folds), folds, options, x, yk, k, m);
+    SetNoiseFrom(OutputHeldOut(*m, k, x, yk, options, folds, true), folds, options, x, yk, k, m);
   }
   m->calibration = CalibrationText(folds, options.calibrate_two_sd);
 }
 
 Eigen::MatrixXd HeldOutErrors(const ProcessTable& table, const FitOptions& options, int folds,
-                              FamilyModel* m, bool calibrate, bool cold = false) {
+                              FamilyModel* m, bool calibrate, bool cold = true) {
   if (m->candidate.family == Family::kNetwork)
     throw InputError("held-out errors of a fitted model: not available for " + m->candidate.Name());
   const Eigen::MatrixXd x = ModelInputs(*m, table.inputs);
@@ -486,11 +502,13 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
   std::size_t best = 0;
   for (std::size_t c = 1; c < squared_errors.size(); ++c)
     if (squared_errors[c].mean() < squared_errors[best].mean()) best = c;
+  double simpler = std::numeric_limits<double>::infinity();  // lowest mean of those before c
   for (std::size_t c = 0; c < squared_errors.size(); ++c) {
     const Eigen::ArrayXd d = (squared_errors[c] - squared_errors[best]).array();
     const double n = static_cast<double>(d.size()), mean = d.mean();
     const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
-    if (mean <= se) return static_cast<int>(c);
+    if (mean <= se && squared_errors[c].mean() <= simpler) return static_cast<int>(c);
+    simpler = std::min(simpler, squared_errors[c].mean());
   }
   return static_cast<int>(best);
 }
@@ -537,7 +555,7 @@ int MinimumRows(const Candidate& c, int inputs) {
 std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   std::vector<Candidate> c;
   for (const char* name : {"linear/log", "linear/identity", "gp-se-iso-constant/identity",
-                           "gp-matern52-constant/log", "gp-matern52-constant/identity"})
+                           "gp-matern52-linear/log", "gp-matern52-constant/identity"})
     c.push_back(ParseCandidate(name));
   return c;
 }
@@ -667,6 +685,25 @@ int ChooseAmong(const std::vector<int>& kept, const std::vector<Eigen::MatrixXd>
 
 namespace {
 
+// `o` without its GP candidates on tables too small for their refits (ChoiceOptions::few_rows:
+// every training split of `folds` needs the rows of a linear fit in `inputs` inputs), unless they
+// are all there is; `note` says so.
+ChoiceOptions ActiveCandidates(const ChoiceOptions& o, int rows, int folds, int inputs,
+                               std::string* note) {
+  ChoiceOptions active = o;
+  const int split = rows - (rows + folds - 1) / folds, need = inputs + 3;
+  if (!o.closed_form_loo || rows >= o.few_rows || split >= need) return active;
+  active.candidates.clear();
+  for (const Candidate& c : o.candidates)
+    if (c.family != Family::kGaussianProcess) active.candidates.push_back(c);
+  if (active.candidates.empty() || active.candidates.size() == o.candidates.size()) return o;
+  *note = "at " + std::to_string(rows) + " rows the GP candidates sit out: a GP must beat the " +
+          "linear fits in " + std::to_string(folds) + "-fold refits, whose training splits of " +
+          std::to_string(split) + " rows are fewer than a linear fit in " +
+          std::to_string(inputs) + " inputs needs (" + std::to_string(need) + ")";
+  return active;
+}
+
 // Choice::warnings: the constant inputs left out, and the columns the log candidates keep raw.
 std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOptions& o,
                                        const std::vector<int>& constant) {
@@ -697,20 +734,24 @@ std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOp
 
 }  // namespace
 
-Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
+Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   CheckTable(table);
-  if (options.candidates.empty()) throw InputError("family choice: no candidates");
+  if (given.candidates.empty()) throw InputError("family choice: no candidates");
   const int rows = static_cast<int>(table.inputs.size());
-  const int folds = std::min(options.folds, rows), nc = static_cast<int>(options.candidates.size());
+  const int folds = std::min(given.folds, rows);
   if (folds < 2)
-    throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
+    throw InputError("family choice: folds " + std::to_string(given.folds) + ": must be >= 2");
+  TableTransform used;
+  const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
+  std::string rows_note;
+  const ChoiceOptions options =
+      ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note);
+  const int nc = static_cast<int>(options.candidates.size());
   std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
                                    Eigen::MatrixXd(Features::kCount, rows));
   std::vector<double> ms(static_cast<std::size_t>(nc * folds));
   FitOptions fold_options = options.fit;
   fold_options.threads = 1;
-  TableTransform used;
-  const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
   for (const Candidate& c : options.candidates) CheckRows(table, c, used.UsedInputCount());
   std::vector<FamilyModel> full(static_cast<std::size_t>(nc));  // closed-form LOO fits
   std::vector<char> calibrated(static_cast<std::size_t>(nc), 0);
@@ -724,11 +765,14 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
       FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
     } else if (f == 0) {  // one full fit, its held-out errors (and calibration) from it
       full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
-      const bool honest = options.candidates[c].family == Family::kGaussianProcess &&
-                          rows < options.honest_gp_rows;
+      const bool honest = options.closed_form_loo &&
+                          options.candidates[c].family == Family::kGaussianProcess &&
+                          rows < options.few_rows &&
+                          rows - (rows + folds - 1) / folds >=
+                              MinimumRows(options.candidates[c], used.UsedInputCount());
       const int held_folds = honest ? folds : HeldOutFolds(options, folds);
-      calibrated[c] = !honest && held_folds == CalibrationFolds(options.fit, rows, full[c]);
-      err[c] = HeldOutErrors(table, fold_options, held_folds, &full[c], calibrated[c], honest);
+      calibrated[c] = held_folds == CalibrationFolds(options.fit, rows, full[c]);
+      err[c] = HeldOutErrors(table, fold_options, held_folds, &full[c], calibrated[c], true);
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -779,6 +823,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
   FitChosen(table, options, stack, full, calibrated, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
   choice.warnings = TableWarnings(table, options, constant);
+  choice.rows_note = rows_note;
   return choice;
 }
 

@@ -293,12 +293,14 @@ TransformFlag ParseTransformFlag(const std::string& s) {
 std::vector<family::Candidate> Candidates(FamilyFlag family, TransformFlag transform) {
   std::vector<family::Candidate> all;
   if (family == FamilyFlag::kAuto) all = family::ChoiceOptions::DefaultCandidates();
-  const char* body = family == FamilyFlag::kLinear            ? "linear"
-                     : family == FamilyFlag::kGaussianProcess ? "gp-matern52-constant"
-                                                              : "network-evidence";
+  const std::string body = family == FamilyFlag::kLinear            ? "linear"
+                           : family == FamilyFlag::kGaussianProcess ? "gp-matern52-"
+                                                                    : "network-evidence";
+  const bool gp = family == FamilyFlag::kGaussianProcess;  // a power-law mean on log columns
   if (family != FamilyFlag::kAuto)
     for (const char* t : {"/log", "/identity"})
-      all.push_back(family::ParseCandidate(std::string(body) + t));
+      all.push_back(family::ParseCandidate(
+          body + (gp ? (std::string(t) == "/log" ? "linear" : "constant") : "") + t));
   std::vector<family::Candidate> out;
   for (const family::Candidate& c : all)
     if (transform == TransformFlag::kAuto || c.log == (transform == TransformFlag::kLog))
@@ -353,6 +355,7 @@ std::string FormatChoiceTable(const family::Choice& choice) {
   }
   for (const std::string& note : choice.notes)
     if (!note.empty()) s += "  note: " + note + "\n";
+  if (!choice.rows_note.empty()) s += "  note: " + choice.rows_note + "\n";
   return s;
 }
 

@@ -95,9 +95,9 @@ struct TrainOptions {
 
 /// The candidates of a choice for the flags:
 ///   kAuto:            ChoiceOptions::DefaultCandidates() (power law, linear, isotropic GP,
-///                     GP Matern 5/2),
+///                     GP Matern 5/2 with a power-law mean on log columns, GP Matern 5/2),
 ///   kLinear:          linear/log, linear/identity,
-///   kGaussianProcess: gp-matern52-constant/log, gp-matern52-constant/identity,
+///   kGaussianProcess: gp-matern52-linear/log, gp-matern52-constant/identity,
 ///   kNetwork:         network-evidence/log, network-evidence/identity,
 /// keeping those of `transform` (kAuto: both). Listed from the simplest (one-standard-error
 /// rule, family/family.h).

@@ -223,7 +223,7 @@ TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
     return s;
   };
   EXPECT_EQ(names(FamilyFlag::kLinear, TransformFlag::kAuto), "linear/log linear/identity ");
-  EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-constant/log ");
+  EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-linear/log ");
   EXPECT_EQ(names(FamilyFlag::kNetwork, TransformFlag::kLog), "network-evidence/log ");
   EXPECT_EQ(names(FamilyFlag::kAuto, TransformFlag::kIdentity),
             "linear/identity gp-se-iso-constant/identity gp-matern52-constant/identity ");
