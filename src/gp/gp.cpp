@@ -15,6 +15,29 @@ namespace {
 constexpr double kSqrt5 = 2.2360679774997896964;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// KernelMatrices for K(z, z): the element-wise functions of the squared distances r2 on the
+// lower triangle (column by column, vectorized), then mirrored.
+void SymmetricKernel(Kernel kernel, const Eigen::MatrixXd& r2, double sf2, Eigen::MatrixXd* kf,
+                     Eigen::MatrixXd* g) {
+  const Eigen::Index n = r2.cols();
+  kf->resize(n, n);
+  if (g) g->resize(n, n);
+  for (Eigen::Index q = 0; q < n; ++q) {
+    const Eigen::Index m = n - q;
+    const Eigen::ArrayXd s2 = r2.col(q).tail(m).array();
+    if (kernel == Kernel::kSquaredExponential) {
+      kf->col(q).tail(m) = (sf2 * (-0.5 * s2).exp()).matrix();
+      if (g) g->col(q).tail(m) = kf->col(q).tail(m);
+      continue;
+    }
+    const Eigen::ArrayXd r = s2.sqrt(), e = (-kSqrt5 * r).exp();
+    kf->col(q).tail(m) = (sf2 * (1.0 + kSqrt5 * r + (5.0 / 3.0) * s2) * e).matrix();
+    if (g) g->col(q).tail(m) = (sf2 * (5.0 / 3.0) * (1.0 + kSqrt5 * r) * e).matrix();
+  }
+  kf->triangularView<Eigen::StrictlyUpper>() = kf->transpose();
+  if (g) g->triangularView<Eigen::StrictlyUpper>() = g->transpose();
+}
+
 // Kernel values K_f(p, q) and, in g, the factor with dK_f/d ln l_i = g * (dz_i / l_i)^2.
 void KernelMatrices(Kernel kernel, const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                     const Eigen::VectorXd& length, double sf2, Eigen::MatrixXd* kf,
@@ -25,6 +48,7 @@ void KernelMatrices(Kernel kernel, const Eigen::MatrixXd& a, const Eigen::Matrix
       (-2.0 * as.transpose() * bs).colwise() + as.colwise().squaredNorm().transpose();
   r2.rowwise() += bs.colwise().squaredNorm();
   r2 = r2.cwiseMax(0.0);
+  if (&a == &b) return SymmetricKernel(kernel, r2, sf2, kf, g);
   if (kernel == Kernel::kSquaredExponential) {
     *kf = sf2 * (-0.5 * r2.array()).exp().matrix();
     if (g) *g = *kf;
