@@ -467,6 +467,8 @@ def main():
     ap.add_argument("--peer-cache", help="read/extend the peers' results in this JSON file")
     ap.add_argument("--no-default", action="store_true",
                     help="do not run whirl with default options (only the --variant settings)")
+    ap.add_argument("--markdown", action="store_true",
+                    help="print the summary (the last table) as a Markdown table")
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     a = ap.parse_args()
     split = SPLITS.get(a.split, {})
@@ -527,7 +529,7 @@ def main():
                     file=sys.stderr)
             report(results, prob, n, variants + families, peers)
     accept = [p for p in a.acceptance_peers.split(",") if p in peers]
-    summary(results, cases, [v[0] for v in variants + families], accept)
+    summary(results, cases, [v[0] for v in variants + families], accept, a.markdown)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(results, f, indent=1)
@@ -575,15 +577,20 @@ def report(results, prob, n, variants, peers):
     sys.stdout.flush()
 
 
-def summary(results, cases, methods, accept):
-    """One line per problem, size and whirl method: median test RMSE per output as % above the
-    best acceptance peer's median (negative: below it) and the +-1 / +-2 sd coverage (mean %)."""
+def summary(results, cases, methods, accept, markdown=False):
+    """One line per problem, size and whirl method: median test RMSE per output, as % above the
+    best acceptance peer's median (negative: below it), and the +-1 / +-2 sd coverage (mean %)."""
     if not accept or not methods:
         return
     print(f"\nSummary against the best of {', '.join(accept)} (median test RMSE per output; "
           "+x % = above the best peer's median; coverage +-1 / +-2 sd, mean % over seeds)")
-    print(f"{'problem':<15} {'rows':>4} {'method':<12} {'out1 %':>7} {'out2 %':>7} "
-          f"{'best peer out1':>22} {'best peer out2':>22} {'cov1 out1/2':>11} {'cov2 out1/2':>11}")
+    if markdown:
+        print("| problem | rows | method | median RMSE out1 / out2 | best peer out1 | best peer out2 "
+              "| out1 % | out2 % | +-1 sd % | +-2 sd % |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+    else:
+        print(f"{'problem':<15} {'rows':>4} {'method':<12} {'out1 %':>7} {'out2 %':>7} "
+              f"{'best peer out1':>22} {'best peer out2':>22} {'cov1 out1/2':>11} {'cov2 out1/2':>11}")
     for prob, n in cases:
         rs = [r for r in results if r["problem"] == prob and r["rows"] == n]
         med = lambda m, k: float(np.median([r["methods"][m]["rmse"][k] for r in rs]))
@@ -592,6 +599,11 @@ def summary(results, cases, methods, accept):
             pct = [100 * (med(m, k) / med(best[k], k) - 1) for k in (0, 1)]
             cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
                                        for k in (0, 1)) if all(key in r["methods"][m] for r in rs) else "-"
+            if markdown:
+                print(f"| {prob} | {n} | {m} | {med(m, 0):.4g} / {med(m, 1):.4g} | "
+                      f"{best[0]} {med(best[0], 0):.4g} | {best[1]} {med(best[1], 1):.4g} | "
+                      f"{pct[0]:+.1f} | {pct[1]:+.1f} | {cov('cover1')} | {cov('cover2')} |")
+                continue
             print(f"{prob:<15} {n:>4} {m:<12} {pct[0]:>+7.1f} {pct[1]:>+7.1f} "
                   f"{best[0] + ' ' + format(med(best[0], 0), '.4g'):>22} "
                   f"{best[1] + ' ' + format(med(best[1], 1), '.4g'):>22} "

@@ -757,7 +757,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::vector<char> calibrated(static_cast<std::size_t>(nc), 0);
   std::mutex progress_mutex;
   int done = 0;
-  const int steps = nc * folds + 1;
+  int steps = 1;  // a network's folds, every other candidate's fit (with its held-out errors), the end
+  for (const Candidate& c : options.candidates) steps += c.family == Family::kNetwork ? folds : 1;
   ParallelFor(static_cast<std::size_t>(nc * folds), options.fit.threads, [&](std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
     const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
@@ -776,9 +777,9 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    if (!options.progress) return;
+    if (!options.progress || (f > 0 && options.candidates[c].family != Family::kNetwork)) return;
     const std::lock_guard<std::mutex> lock(progress_mutex);
-    options.progress(++done, steps, options.candidates[i / folds].Name());
+    options.progress(++done, steps, options.candidates[c].Name());
   });
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::ArrayXd var =
