@@ -106,11 +106,14 @@ void from_json(const json& j, CvRow& r) {
   if (!rmse.is_array() || rmse.size() != static_cast<std::size_t>(Features::kCount))
     throw InputError(what + ": 'cv_rmse' must hold one value per output");
   r.cv_rmse.resize(Features::kCount);
+  // Held-out RMSE in the output's units and a sum of MSE / variance: >= 0 and far below what
+  // overflows (a table's RMSE is at most the output's range, core/limits.h).
+  constexpr Range kErrorRange{0, 1e12, false, "", "a held-out error"};
   for (int k = 0; k < Features::kCount; ++k) {
-    if (!rmse[k].is_number()) throw InputError(what + ": 'cv_rmse' must hold numbers");
-    r.cv_rmse(k) = rmse[k].get<double>();
+    r.cv_rmse(k) = RequireFiniteValue(rmse[k], what + ": 'cv_rmse'[" + std::to_string(k) + "]");
+    CheckRange(r.cv_rmse(k), kErrorRange, "cv_rmse[" + std::to_string(k) + "]", what);
   }
-  r.score = RequireNumber(j, "score", what);
+  r.score = RequireNumberIn(j, "score", kErrorRange, what);
   if (j.contains("fit_ms")) r.fit_ms = RequireNumber(j, "fit_ms", what);
 }
 

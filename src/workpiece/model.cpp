@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -74,6 +75,12 @@ WorkpieceModel FamilyFromJson(const json& j) {
   m.domain_max = DomainVector(j.at("domain"), "max");
   if (!(m.domain_min.array() <= m.domain_max.array()).all())
     throw InputError("'domain.min' must not exceed 'domain.max'");
+  for (const auto& [v, key] : {std::pair{&m.domain_min, "domain.min"},
+                               std::pair{&m.domain_max, "domain.max"}}) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = (*v)(i);
+    CheckProcessInputs(ProcessInputs::FromArray(a), std::string("'") + key + "'");
+  }
   if (!j.contains("training") || !j.at("training").is_object())
     throw InputError("missing object 'training'");
   m.training_data = RequireString(j.at("training"), "data", "workpiece model 'training'");

@@ -163,6 +163,12 @@ TEST(WorkpieceModel, BadFamilyFilesNameTheFileAndTheKey) {
   expect_bad([](nlohmann::json& j) { j["choice"].erase("models"); }, "models");
   expect_bad([](nlohmann::json& j) { j["extra"] = 1; }, "extra");
   expect_bad([](nlohmann::json& j) { j["inputs"][0]["name"] = "hardness"; }, "inputs");
+  expect_bad([](nlohmann::json& j) { j["domain"]["max"][0] = 1e9; },
+             "'domain.max': hardness_hrc = 1e+09 breaks the rule");
+  expect_bad([](nlohmann::json& j) { j["choice"]["table"][0]["cv_rmse"][0] = -1; },
+             "cv_rmse[0] = -1 breaks the rule");
+  expect_bad([](nlohmann::json& j) { j["choice"]["table"][0]["score"] = 1e300; },
+             "score = 1e+300 breaks the rule");
 }
 
 // Numbers of a model file get the range checks of a flag (the message names the file, the field
