@@ -40,8 +40,8 @@ void CheckModel(const drift::DriftModel& m) {
   if (m.kind == drift::ModelKind::kNetwork)
     throw InputError(
         "drift action: a network model cannot be evaluated by synchronized actions "
-        "here; fit the channel with --kind mlr or --kind dynamic");
-  if (!m.time_constants.empty() && m.time_unit != "min")
+        "here; fit the channel with --model mlr or --model dynamic");
+  if ((!m.time_constants.empty() || !m.elapsed_time_constants.empty()) && m.time_unit != "min")
     throw InputError("drift action: the model's lag time constants are in '" + m.time_unit +
                      "' (its training runs had no time column): refit on runs with time_s or "
                      "time_min so the lags can be run per interpolation cycle");
@@ -63,23 +63,38 @@ const AnalogInput& Input(const DriftActionOptions& o, const std::string& name) {
   return it->second;
 }
 
+// a = 1 - exp(-T_ipo / tau): the lag factor per interpolation cycle, tau in minutes.
+double LagFactor(const DriftActionOptions& o, double tau_min) {
+  return 1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / tau_min);
+}
+
 std::string Reading(const AnalogInput& a) {
   return FormatFixed(a.scale, kDecimalsDriftCoefficient) + "*$A_INA[" + std::to_string(a.index) +
          "]" + Term(a.offset, 4);
 }
 
+// Slots of one model: its features (input-major, then the elapsed-time features, as
+// DriftModel::features), one reference per sensor, the init flag.
+// A sum of more terms than this is accumulated in a slot over several actions (each line of a
+// program must stay within the control's 512 characters).
+constexpr int kMaxTermsPerAction = 8;
+
 struct Layout {
   int per = 1;  // slots per input: value + lags
-  int features = 0, ref = 0, flag = 0;
-  int Last() const { return flag; }
+  int features = 0, elapsed = 0, elapsed_count = 0, ref = 0, flag = 0;
+  int sum = -1;  // the partial sums of a model of more than kMaxTermsPerAction features
+  int Last() const { return std::max(flag, sum); }
 };
 
 Layout MakeLayout(const drift::DriftModel& m, int first) {
   Layout l;
   l.per = 1 + static_cast<int>(m.time_constants.size());
   l.features = first;
+  l.elapsed = l.features + m.InputCount() * l.per;
+  l.elapsed_count = static_cast<int>(m.elapsed_time_constants.size());
   l.ref = l.features + static_cast<int>(m.features.size());
   l.flag = l.ref + static_cast<int>(m.sensors.size());
+  if (static_cast<int>(m.features.size()) > kMaxTermsPerAction) l.sum = l.flag + 1;
   return l;
 }
 
@@ -119,7 +134,7 @@ std::vector<std::string> FeatureBodies(const drift::DriftModel& m, const DriftAc
   const int ns = static_cast<int>(m.sensors.size());
   std::vector<std::string> bodies;
   std::string init_ref;
-  if (o.reference == DriftReference::kStart) {
+  if (o.reference == DriftReference::kStart && ns > 0) {
     for (int i = 0; i < ns; ++i) init_ref += " " + P(l.ref + i) + "=" + Reading(Input(o, in[i]));
     bodies.push_back("WHENEVER " + P(l.flag) + "==0 DO" + init_ref);
   }
@@ -129,33 +144,51 @@ std::vector<std::string> FeatureBodies(const drift::DriftModel& m, const DriftAc
       ref = o.reference == DriftReference::kStart ? "-" + P(l.ref + i) : Term(-m.reference_C(i), 4);
     bodies.push_back("DO " + P(l.features + i * l.per) + "=" + Reading(Input(o, in[i])) + ref);
   }
-  if (l.per > 1) {
-    std::string init = "WHENEVER " + P(l.flag) + "==0 DO";
-    for (int i = 0; i < static_cast<int>(in.size()); ++i)
-      for (int k = 1; k < l.per; ++k)
-        init += " " + P(l.features + i * l.per + k) + "=" + P(l.features + i * l.per);
-    bodies.push_back(init + " " + P(l.flag) + "=1");
-    for (int i = 0; i < static_cast<int>(in.size()); ++i) {
-      std::string upd = "DO";
-      const std::string u = P(l.features + i * l.per);
-      for (int k = 1; k < l.per; ++k) {
-        const double a = 1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / m.time_constants[k - 1]);
-        const std::string y = P(l.features + i * l.per + k);
-        upd += " " + y + "=" + y + Term(a, kDecimalsLagFactor) + "*(" + u + "-" + y + ")";
-      }
-      bodies.push_back(upd);
+  if (l.elapsed_count > 0) {  // the lag of a unit step at the start: the time since the start
+    std::string upd = "DO";    // (before the init below, so the start's cycle holds x = 0)
+    for (int j = 0; j < l.elapsed_count; ++j) {
+      const std::string y = P(l.elapsed + j);
+      upd += " " + y + "=" + y +
+             Term(LagFactor(o, m.elapsed_time_constants[static_cast<std::size_t>(j)]),
+                  kDecimalsLagFactor) +
+             "*(1-" + y + ")";
     }
-  } else {
-    bodies.push_back("WHENEVER " + P(l.flag) + "==0 DO " + P(l.flag) + "=1");
+    bodies.push_back(upd);
+  }
+  // Once, at the start: each lag from its input's value, each elapsed-time feature from 0.
+  std::string init = "WHENEVER " + P(l.flag) + "==0 DO";
+  for (int i = 0; i < static_cast<int>(in.size()); ++i)
+    for (int k = 1; k < l.per; ++k)
+      init += " " + P(l.features + i * l.per + k) + "=" + P(l.features + i * l.per);
+  for (int j = 0; j < l.elapsed_count; ++j) init += " " + P(l.elapsed + j) + "=0";
+  bodies.push_back(init + " " + P(l.flag) + "=1");
+  for (int i = 0; l.per > 1 && i < static_cast<int>(in.size()); ++i) {
+    std::string upd = "DO";
+    const std::string u = P(l.features + i * l.per);
+    for (int k = 1; k < l.per; ++k) {
+      const std::string y = P(l.features + i * l.per + k);
+      upd += " " + y + "=" + y + Term(LagFactor(o, m.time_constants[k - 1]), kDecimalsLagFactor) +
+             "*(" + u + "-" + y + ")";
+    }
+    bodies.push_back(upd);
   }
   return bodies;
 }
 
-// c_0 + sum c_f x_f over the layout's feature slots.
-std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals) {
+// c_0 + sum c_f x_f over the layout's feature slots: one expression, or, with more than
+// kMaxTermsPerAction features, actions appended to `bodies` that accumulate it in
+// $AC_PARAM[target] kMaxTermsPerAction terms at a time, and then that slot.
+std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals, int target,
+                   std::vector<std::string>* bodies) {
   std::string out = FormatFixed(c(0), decimals);
-  for (Eigen::Index f = 1; f < c.size(); ++f)
+  const bool split = c.size() - 1 > kMaxTermsPerAction;
+  for (Eigen::Index f = 1; f < c.size(); ++f) {
     out += Term(c(f), decimals) + "*" + P(l.features + static_cast<int>(f) - 1);
+    if (split && (f % kMaxTermsPerAction == 0 || f + 1 == c.size())) {
+      bodies->push_back("DO " + P(target) + "=" + out);
+      out = P(target);
+    }
+  }
   return out;
 }
 
@@ -163,11 +196,14 @@ bool SlopeMode(const DriftActionOptions& o, const drift::DriftModel* g) {
   return g != nullptr || o.workpiece_slope_param >= 0;
 }
 
-// The setting-data writes (see the header comment for the composition).
+// The setting-data writes (see the header comment for the composition); partial sums of a
+// long model are appended to `bodies` first.
 std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
-                       const DriftActionOptions& o, const Slots& s) {
+                       const DriftActionOptions& o, const Slots& s,
+                       std::vector<std::string>* bodies) {
   const std::string ax = "[" + o.axis + "]";
-  std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient);
+  std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient,
+                          s.offset.sum, bodies);
   if (o.workpiece_k0_param >= 0) k0 += "+" + P(o.workpiece_k0_param);
   if (!SlopeMode(o, g))
     return "DO $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=1";
@@ -195,11 +231,12 @@ std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::D
   if (g) {
     const std::vector<std::string> more = FeatureBodies(*g, o, s.slope);
     bodies.insert(bodies.end(), more.begin(), more.end());
-    bodies.push_back(
-        "DO " + P(s.s_m) + "=" +
-        Linear(DriftSlopeCoefficients(*g, o), s.slope, kDecimalsDriftSlopeCoefficient));
+    const std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope,
+                                   kDecimalsDriftSlopeCoefficient, s.s_m, &bodies);
+    if (s_m != P(s.s_m)) bodies.push_back("DO " + P(s.s_m) + "=" + s_m);
   }
-  bodies.push_back(OutputBody(m, g, o, s));
+  const std::string output = OutputBody(m, g, o, s, &bodies);
+  bodies.push_back(output);
   return bodies;
 }
 
@@ -400,8 +437,21 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
 }
 
 std::string ModelLine(const std::string& what, const drift::DriftModel& m) {
-  return what + drift::ToString(m.kind) + " of " + Text(m.error_column) + " from " +
-         std::to_string(m.sensors.size()) + " sensors";
+  std::string line = what + drift::ToString(m.kind) + " of " + Text(m.error_column) + " from " +
+                     std::to_string(m.sensors.size()) + " sensors";
+  if (!m.elapsed_time_constants.empty())
+    line += " and " + std::to_string(m.elapsed_time_constants.size()) +
+            " elapsed-time warm-up term(s)";
+  return line;
+}
+
+// The elapsed-time features: what the control counts and from when.
+std::string ElapsedNote(const drift::DriftModel& m, const drift::DriftModel* g) {
+  if (m.elapsed_time_constants.empty() && (!g || g->elapsed_time_constants.empty())) return "";
+  return "; elapsed time is counted here from this program's start (run it when the machine "
+         "starts, as the model's training runs started): x = 1 - exp(-t / tau) by the recursion "
+         "x <- x + a (1 - x), x = 0 at the start, every interpolation cycle; beyond the longest "
+         "training run the warm-up goes on to its plateau b0 + sum of its gains, never past it\n";
 }
 
 // The largest $A_INA index the program reads.
@@ -421,8 +471,9 @@ std::string Prerequisites(const drift::DriftModel& m, const drift::DriftModel* g
   auto stated = [&](int v) {
     return c.Stated() ? " (profile: " + std::to_string(v) + ")" : std::string(" (not stated)");
   };
-  return "; requires MD10300 $MN_FASTIO_ANA_NUM_INPUTS >= " +
-         std::to_string(LargestAnalogIndex(m, g, o)) + stated(c.analog_inputs) +
+  const int largest = LargestAnalogIndex(m, g, o);
+  return "; requires MD10300 $MN_FASTIO_ANA_NUM_INPUTS >= " + std::to_string(largest) +
+         (largest == 0 ? " (no analog input read)" : "") + stated(c.analog_inputs) +
          ", MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(s.last + 1) +
          stated(c.ac_params) + ", MD28250 $MC_MM_NUM_SYNC_ELEMENTS room for " +
          std::to_string(actions) + " static actions" + stated(c.sync_elements) +
@@ -480,6 +531,7 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
           std::to_string(o.workpiece_slope_param) + "], [" +
           std::to_string(o.workpiece_slope_param + 1) +
           "]: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b)\n";
+  nc += ElapsedNote(m, g);
   nc += "; requires MD32750 $MA_TEMP_COMP_TYPE bit 0" +
         std::string(slope_mode ? " and bit 1" : "") + " for axis " + o.axis + "; stop it with " +
         o.reset_program_name + " (restores what it found)\n";
@@ -544,21 +596,22 @@ std::string PlcRows(const std::string& output, const drift::DriftModel& m,
   const std::vector<std::string> in = Inputs(m);
   const int ns = static_cast<int>(m.sensors.size());
   std::string out = output + ",intercept,,,,,,,," + FormatFixed(c(0), decimals) + "\n";
+  const int inputs = m.InputCount();
   for (std::size_t f = 0; f < m.features.size(); ++f) {
     const drift::Feature& feat = m.features[f];
-    int input = 0;
-    while (in[static_cast<std::size_t>(input)] != feat.input) ++input;
-    const AnalogInput& a = Input(o, feat.input);
-    const std::string ref = input < ns ? FormatFixed(m.reference_C(input), 4) : "";
+    const int input = static_cast<int>(f) / (1 + static_cast<int>(m.time_constants.size()));
     const std::string tau = feat.tau > 0 ? FormatFixed(feat.tau, 3) : "";
-    const std::string af =
-        feat.tau > 0
-            ? FormatFixed(1.0 - std::exp(-o.ipo_cycle_ms / 60000.0 / feat.tau), kDecimalsLagFactor)
-            : "";
-    out += output + "," + Cell(feat.Name(m.time_unit)) + "," + Cell(feat.input) + "," +
-           std::to_string(a.index) + "," + FormatFixed(a.scale, kDecimalsDriftCoefficient) + "," +
-           FormatFixed(a.offset, 4) + "," + ref + "," + tau + "," + af + "," +
-           FormatFixed(c(static_cast<Eigen::Index>(f) + 1), decimals) + "\n";
+    const std::string af = feat.tau > 0 ? FormatFixed(LagFactor(o, feat.tau), kDecimalsLagFactor) : "";
+    std::string source = ",,,";  // an elapsed-time feature reads no input (header comment)
+    if (input < inputs) {
+      const AnalogInput& a = Input(o, in[static_cast<std::size_t>(input)]);
+      source = std::to_string(a.index) + "," + FormatFixed(a.scale, kDecimalsDriftCoefficient) +
+               "," + FormatFixed(a.offset, 4) + "," +
+               (input < ns ? FormatFixed(m.reference_C(input), 4) : "");
+    }
+    out += output + "," + Cell(feat.Name(m.time_unit)) + "," + Cell(feat.input) + "," + source +
+           "," + tau + "," + af + "," + FormatFixed(c(static_cast<Eigen::Index>(f) + 1), decimals) +
+           "\n";
   }
   return out;
 }
@@ -577,6 +630,10 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
   out +=
       "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); K_m (mm) = sum of "
       "the k0_mm rows' coefficient_per_unit * feature value, intercept included\n";
+  if (!m.elapsed_time_constants.empty() || (g && !g->elapsed_time_constants.empty()))
+    out +=
+        "# input 'elapsed' (no analog input): time since the start counted by the PLC, "
+        "L <- L + a_per_cycle * (1 - L) (L = 0 at start) = 1 - exp(-t / tau_min)\n";
   out += "# model " + drift::ToString(m.kind) + " of " + Text(m.error_column) +
          "; sign applied (s = " + FormatFixed(DriftSign(o), 0) + "); interpolation cycle " +
          FormatFixed(o.ipo_cycle_ms, 3) + " ms\n";

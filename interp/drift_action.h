@@ -12,6 +12,13 @@
 // convention of rises from the run's first row).
 // Lags. Each lagged feature runs the recursion of drift/regression.h FirstOrderLag once per
 // interpolation cycle T_ipo: L <- L + a (u - L), a = 1 - exp(-T_ipo / tau), L_0 = u_0.
+// Elapsed time (drift/model.h: the warm-up terms of drift fit's time1, time2 and sensors+time
+// candidates). The control counts it itself, from the cycle the actions start (flag 0): each
+// elapsed-time feature is the lag of a unit step, x <- x + a (1 - x), x = 0 in the start's cycle,
+// so x = 1 - exp(-t / tau) with t the time since the program's start; no analog input, no
+// system timer. Run the program when the machine starts as the model's training runs did (the
+// model's t0); after the longest training run x goes on towards 1, so the warm-up approaches its
+// plateau b0 + sum A_j and never passes it (the gains share one sign, drift/regression.h).
 // Output. dK = s * e / 1000 mm with e = b0 + sum_f b_f x_f [um] (drift/model.h), where
 // s = -error_direction if the control adds dK to the setpoint and +error_direction if it
 // subtracts it; error_direction = +1 means the model's error is the tool's displacement along
@@ -20,10 +27,13 @@
 // $AC_PARAM layout from param_first: the liveness slot (the last action writes the mode there
 // every cycle: 1 owns SD43900, 2 owns SD43900-43920; the plans clear it, dwell and read it back,
 // sinumerik.h), then one slot per model feature (input-major, as DriftModel::features), one
-// reference slot per sensor (reference "start") and an init flag; with a slope model its slots
-// follow likewise, then S_m. The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
+// reference slot per sensor (reference "start") and an init flag, and for a model of more than 8
+// features a slot its sum is accumulated in, 8 terms per action (every program line must stay
+// within the control's 512 characters); with a slope model its slots follow likewise, then S_m.
+// The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
 // Action order (IDs count up from sync_id_first; actions run in ID order every cycle):
-//   [start: capture T_ref once] -> rises u -> [lags: L = u once] -> [lag updates] -> SD43900.
+//   [start: capture T_ref once] -> rises u -> [elapsed updates] -> [once: L = u, x = 0, flag]
+//   -> [lag updates] -> [partial sums] -> SD43900.
 //
 // One writer per setting datum. With a whirling plan on the same axis (whirl plan
 // --with-drift-action), the plan's actions write their K0 into $AC_PARAM[workpiece_k0_param]

@@ -132,6 +132,21 @@ void AddZeroOptions(CLI::App* sub, ModelArgs* m) {
       ->check(FiniteNumber("um"));
 }
 
+// --candidates (every command that fits a model the way drift fit does).
+void AddCandidatesOption(CLI::App* sub, ModelArgs* m, const std::string& what) {
+  sub->add_option(
+         "--candidates", m->candidates,
+         what + ": the model families scored by validation on the training runs (the whole fit "
+                "redone in every fold: leave one run out, or forward-chaining blocks of one run): "
+                "auto (default: sensors, time1, time2, and sensors+time with >= 3 runs; the "
+                "fewest parameters within 5 % of the lowest validation RMSE, and a time model "
+                "replaces the sensors only 20 % lower and lower in 3 of 4 folds), sensors, time "
+                "(first-order warm-up in time since the run start, 1 or 2 terms, each time "
+                "constant at most the longest training run, gains of one sign), time1, time2 or "
+                "sensors+time")
+      ->check(CLI::IsMember({"auto", "sensors", "time", "time1", "time2", "sensors+time"}));
+}
+
 // --model, the sensors, the dynamic and the network model's options, --threads.
 void AddModelOptions(CLI::App* sub, ModelArgs* m) {
   sub->add_option("--model", m->kind,
@@ -253,13 +268,7 @@ void RegisterFitModel(CLI::App* drift_app) {
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
-  sub->add_option("--candidates", o->model.candidates,
-                  "model families scored by validation on the training runs (the whole fit redone "
-                  "in every fold: leave one run out, or blocks of one run): auto (default: "
-                  "sensors, time1, time2, and sensors+time with >= 3 runs; the lowest RMSE, "
-                  "within 5 % the fewest parameters), sensors, time (first-order warm-up in time "
-                  "since the run start, 1 or 2 terms) or sensors+time")
-      ->check(CLI::IsMember({"auto", "sensors", "time", "sensors+time"}));
+  AddCandidatesOption(sub, &o->model, "the model written");
   sub->add_option("--error", o->error, "error column to model (<name>_um)")->required();
   sub->add_option("--out", o->out, "model file to write (JSON)")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
@@ -370,6 +379,7 @@ void RegisterCrossval(CLI::App* drift_app) {
   AddRunOptions(sub, &o->runs);
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
+  AddCandidatesOption(sub, &o->model, "each run's model (the 'model' column)");
   sub->add_option("--error", o->error, "error column (<name>_um)")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] {
@@ -401,8 +411,9 @@ void RegisterHoldout(CLI::App* drift_app) {
       std::string(
           "Chronological hold-out on one long log (the split of the FL_THERMAL data set):\n"
           "train on the first --train share of the rows, test on the next --test share; the\n"
-          "models run from the log's first row. Per channel: none, time (sensor-free warm-up\n"
-          "in time since the log's start), mlr_all (all sensors), mlr, dynamic and network on\n"
+          "models run from the log's first row. Per channel: none, fit (drift fit as run by\n"
+          "default: --candidates, kind mlr), time (sensor-free warm-up in time since the log's\n"
+          "start), mlr_all (all sensors), mlr, dynamic and network on\n"
           "the selected sensors (at most --max-sensors), dynamic_extra with --inputs, all on one\n"
           "error zero. Test and train MAE, RMSE, max [um]; the strongest per channel.\n") +
           kRunFilesHelp);
@@ -416,6 +427,7 @@ void RegisterHoldout(CLI::App* drift_app) {
       ->delimiter(',');
   AddSelectionOptions(sub, &o->sel);
   AddZeroOptions(sub, &o->model);
+  AddCandidatesOption(sub, &o->model, "the 'fit' row (drift fit's own choice, kind mlr, no sensor cap)");
   sub->add_flag("--no-network", o->no_network, "skip the network model");
   AddDynamicOptions(sub, &o->model);  // --inputs: those of dynamic_extra
   sub->add_option("--epochs", o->model.epochs, "network: trainbr epochs (1..10000, default 1000)")
@@ -518,6 +530,7 @@ void RegisterReport(CLI::App* drift_app) {
   AddRunOptions(sub, &o->runs, false);
   AddSelectionOptions(sub, &o->sel);
   AddModelOptions(sub, &o->model);
+  AddCandidatesOption(sub, &o->model, "the model shown");
   sub->add_option("--error", o->error, "error column (<name>_um)")->required();
   auto* out_dir = sub->add_option("--out-dir", o->out_dir,
                                   std::string("write the report (index.html, plots, a prediction "

@@ -1,6 +1,7 @@
 // whirl drift monitor: replay of the on-line model check with a check bar and the recalibration
 // rules (Liu et al.'s check-bar patent) on a logged run (src/drift/monitor.h).
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -170,18 +171,37 @@ void ApplyIntervals(MonitorArgs& a, bool time_from_index) {
     }
 }
 
+// The timeline and events files and the report: all or none (the report with the files).
+void WriteOutputs(const MonitorArgs& a, const std::string& timeline, const std::string& events,
+                  const std::function<drift::MonitorReportResult(const drift::AlsoWrite&)>& report) {
+  std::vector<std::pair<std::filesystem::path, std::string>> files;
+  if (!a.timeline.empty()) files.emplace_back(a.timeline, timeline);
+  if (!a.events.empty()) files.emplace_back(a.events, events);
+  if (!a.out_dir.empty()) {
+    const auto rep = report(files);
+    for (const auto& w : rep.warnings) Warn(w);
+    std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
+  } else {
+    WriteFilesAtomic(files);  // both or neither
+  }
+}
+
 void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
+  drift::CheckMonitorDays(a.days.size());  // before reading thousands of files
   std::vector<drift::Run> days;
   for (const auto& d : a.days) days.push_back(drift::ReadRun(d, drift::RunState::kUnknown));
   ApplyIntervals(a, days.front().time_from_index);
-  drift::FitOptions refit;
-  refit.kind = m.kind;
-  refit.candidates = drift::Candidates::kSensors;
-  refit.extra_inputs = m.extra_inputs;
   std::fprintf(stderr, "replaying %zu days...\n", days.size());
-  const drift::WeekResult w = drift::MonitorWeek(m, days, a.o, refit);
+  const drift::WeekResult w = drift::MonitorWeek(m, days, a.o);
   for (const auto& d : w.days)
     for (const auto& warning : d.warnings) Warn(warning);
+  std::string command = "whirl drift monitor --model " + a.model;
+  for (const auto& d : a.days) command += " --day " + d;
+  const std::vector<std::string> prov{command};
+  WriteOutputs(a, drift::WeekTimelineCsv(w, prov), drift::WeekEventsCsv(w, prov),
+               [&](const drift::AlsoWrite& also) {
+                 return drift::WriteWeekReport(a.out_dir, w, a.o, prov, "gnuplot", also);
+               });
   if (a.json)
     PrintJson(drift::WeekJson(w, a.o));
   else
@@ -190,8 +210,10 @@ void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
 
 void RunMonitor(MonitorArgs& a) {
   if (a.run.empty() && a.days.empty()) throw InputError("give --run FILE or --day FILE ...");
-  CheckOutputs({{"--model", a.model}, {"--run", a.run}},
-               {{"--timeline", a.timeline}, {"--events", a.events}}, {{"--out-dir", a.out_dir}});
+  std::vector<FlagPath> inputs{{"--model", a.model}, {"--run", a.run}};
+  for (const auto& d : a.days) inputs.push_back({"--day", d});
+  CheckOutputs(inputs, {{"--timeline", a.timeline}, {"--events", a.events}},
+               {{"--out-dir", a.out_dir}});
   a.o.reference = drift::ParseReferenceMode(a.reference);
   a.o.score_from = a.score_rows.at(0);
   a.o.score_to = a.score_rows.at(1);
@@ -205,18 +227,10 @@ void RunMonitor(MonitorArgs& a) {
   std::fprintf(stderr, "replaying checks on %s (%d samples)...\n", run.name.c_str(), run.samples());
   const drift::MonitorResult r = drift::MonitorRun(m, run, a.o);
   const std::vector<std::string> prov{"whirl drift monitor --model " + a.model + " --run " + a.run};
-  const std::string timeline = drift::MonitorTimelineCsv(r, prov);
-  const std::string events = drift::MonitorEventsCsv(r, prov);
-  std::vector<std::pair<std::filesystem::path, std::string>> files;
-  if (!a.timeline.empty()) files.emplace_back(a.timeline, timeline);
-  if (!a.events.empty()) files.emplace_back(a.events, events);
-  if (!a.out_dir.empty()) {  // the report with the files: all or none
-    const auto rep = drift::WriteMonitorReport(a.out_dir, r, a.o, prov, "gnuplot", files);
-    for (const auto& w : rep.warnings) Warn(w);
-    std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
-  } else {
-    WriteFilesAtomic(files);  // both or neither
-  }
+  WriteOutputs(a, drift::MonitorTimelineCsv(r, prov), drift::MonitorEventsCsv(r, prov),
+               [&](const drift::AlsoWrite& also) {
+                 return drift::WriteMonitorReport(a.out_dir, r, a.o, prov, "gnuplot", also);
+               });
   if (a.json)
     PrintJson(drift::MonitorJson(r, a.o));
   else
@@ -238,7 +252,10 @@ void RegisterDriftMonitor(CLI::App* drift_app) {
       "from the training posterior; offset: intercept only). Prints MAE, RMSE, max [um] for no\n"
       "compensation, the static model and each rule, with checks, recalibrations and stop time\n"
       "[min, % of time]. With --day ...: a production week, each rule carrying its coefficients\n"
-      "from day to day.");
+      "from day to day, beside the \"previous run\" baseline (drift fit at its defaults redone\n"
+      "on the previous day, as in drift report) and a time-only warm-up fitted on the previous day;\n"
+      "--timeline and --events then hold every day (a day column first) and --out-dir a page\n"
+      "with the week and each day.");
   AddMonitorOptions(sub, a.get());
   sub->callback([a] { RunMonitor(*a); });
 }

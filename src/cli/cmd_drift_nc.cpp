@@ -44,6 +44,10 @@ std::pair<std::string, interp::AnalogInput> ParseInput(const std::string& text) 
 // An --input for a name the models do not read would be silently ignored: refused.
 void CheckKnownInput(const std::string& text, const std::string& name,
                      const drift::DriftModel& model, const drift::DriftModel* slope) {
+  if (name == "elapsed")
+    throw InputError("--input '" + text +
+                     "': elapsed time is counted by the control itself from the program's "
+                     "start (interp/drift_action.h); it reads no analog input");
   std::string known;
   for (const drift::DriftModel* m : {&model, slope}) {
     if (!m) continue;
@@ -111,9 +115,15 @@ void Run(const DriftNcOptions& o) {
                {"csv", o.csv_path}});
     return;
   }
-  std::printf("drift action for axis %s: %s model of %s from %zu sensors, reference %s\n",
+  std::printf("drift action for axis %s: %s model of %s from %zu sensors%s, reference %s\n",
               options.axis.c_str(), drift::ToString(model.kind).c_str(), model.error_column.c_str(),
-              model.sensors.size(), o.reference.c_str());
+              model.sensors.size(),
+              model.elapsed_time_constants.empty()
+                  ? ""
+                  : (" and " + std::to_string(model.elapsed_time_constants.size()) +
+                     " elapsed-time term(s) counted from the program's start")
+                        .c_str(),
+              o.reference.c_str());
   if (g)
     std::printf("  slope (SD43910) from the %s model of %s, fixed end %.4f mm (MCS)%s\n",
                 drift::ToString(g->kind).c_str(), g->error_column.c_str(),
@@ -145,7 +155,10 @@ void RegisterDriftNc(CLI::App* drift_app) {
       "[mm/mm] about SD43920 = the fixed end [mm]; combined with a plan that hands its slope\n"
       "over (profile 'drift.workpiece_slope_param') it owns SD43900-43920: SD43920 = P_w,\n"
       "SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b). Models of kind mlr or\n"
-      "dynamic (a network is refused). The reset program (--reset-nc) cancels the actions and\n"
+      "dynamic (a network is refused), with or without elapsed-time warm-up terms (drift fit's\n"
+      "time1, time2, sensors+time): the actions count the time since the program's start\n"
+      "themselves, x = 1 - exp(-t / tau) by x <- x + a (1 - x) every cycle, so run the program\n"
+      "when the machine starts. The reset program (--reset-nc) cancels the actions and\n"
       "restores the setting data found. Files are .SPF subprograms (M17). Not verified on a\n"
       "control: main-run write access to SD43900-43920.");
   sub->add_option("--model", o->model_path, "drift model JSON (whirl drift fit)")

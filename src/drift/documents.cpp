@@ -29,6 +29,13 @@ std::vector<double> StdVector(const Eigen::VectorXd& v) { return {v.data(), v.da
 // F values may be +inf (a partition into tight classes); JSON has no infinity.
 json Finite(double v) { return std::isfinite(v) ? json(v) : json("inf"); }
 
+// Per-fold figures: null where a fold could not be fitted.
+json FiniteList(const std::vector<double>& v) {
+  json a = json::array();
+  for (double x : v) a.push_back(std::isfinite(x) ? json(x) : json(nullptr));
+  return a;
+}
+
 std::string Classes(const Selection& s, const Partition& p) {
   std::vector<std::string> groups(static_cast<std::size_t>(p.classes));
   for (std::size_t i = 0; i < p.labels.size(); ++i) {
@@ -261,6 +268,7 @@ json CrossRunJson(const CrossRunResult& r) {
           {"error_zero", ToString(r.zero.zero)},
           {"error_column", r.error_column},
           {"model", ToString(r.kind)},
+          {"candidates", ToString(r.candidates)},
           {"runs", runs},
           {"pairs", cells},
           {"groups", groups}};
@@ -269,7 +277,8 @@ json CrossRunJson(const CrossRunResult& r) {
 std::string FormatCrossRun(const CrossRunResult& r) {
   std::ostringstream o;
   o << "cross-run evaluation of " << r.error_column << " (" << ToString(r.kind)
-    << " model on each run's chosen sensors; statistics of measured - predicted [um])\n";
+    << " model of each run, candidates " << ToString(r.candidates)
+    << "; statistics of measured - predicted [um])\n";
   for (std::size_t i = 0; i < r.runs.size(); ++i)
     o << "  " << r.runs[i] << " (" << ToString(r.states[i]) << "): " << JoinNames(r.chosen[i])
       << "\n";
@@ -367,7 +376,9 @@ json CandidatesJson(const FitReport& rep) {
                  {"elapsed_time_constants", s.time_constants},
                  {"parameters", s.parameters},
                  {"cv_rmse_um", Finite(s.cv_rmse_um)},
-                 {"folds", s.folds}});
+                 {"folds", s.folds},
+                 {"fold_rmse_um", FiniteList(s.fold_rmse_um)},
+                 {"sensor_free", s.sensor_free}});
   return c;
 }
 
@@ -375,12 +386,14 @@ std::string FormatCandidates(const FitReport& rep) {
   if (rep.candidates.empty()) return "";
   std::ostringstream o;
   o << "candidates (validation RMSE, the whole fit redone in every fold):\n"
-    << "  candidate       parameters  validation RMSE um  folds\n";
+    << "  candidate       parameters  validation RMSE um  folds  RMSE per fold um\n";
   for (const auto& s : rep.candidates) {
     char line[160];
-    std::snprintf(line, sizeof line, "  %-15s %10d  %18s  %5d\n", s.name.c_str(), s.parameters,
+    std::snprintf(line, sizeof line, "  %-15s %10d  %18s  %5d ", s.name.c_str(), s.parameters,
                   FormatDecimalsOr(std::isfinite(s.cv_rmse_um) ? s.cv_rmse_um : NAN, 3, "-").c_str(), s.folds);
     o << line;
+    for (double f : s.fold_rmse_um) o << " " << FormatDecimalsOr(std::isfinite(f) ? f : NAN, 3, "-");
+    o << "\n";
   }
   o << rep.chosen << "\n";
   return o.str();

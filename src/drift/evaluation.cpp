@@ -99,7 +99,7 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
   }
   FitOptions inner = options;
   inner.threads = 1;
-  inner.candidates = Candidates::kSensors;
+  res.candidates = options.candidates;
   res.zero = options.zero;
   if (res.zero.zero == ErrorZero::kFixed && std::isnan(res.zero.gauge_level_um))
     res.zero.gauge_level_um = runs.front().error_um(0, runs.front().ErrorIndex(error_column));
@@ -121,6 +121,12 @@ CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_c
     left_out[i].insert(left_out[i].end(), all_rep.warnings.begin(), all_rep.warnings.end());
     res.models[i] = rep.model;
     res.chosen[i] = rep.model.sensors;
+    if (!rep.model.elapsed_time_constants.empty()) {
+      std::string taus;
+      for (double t : rep.model.elapsed_time_constants)
+        taus += (taus.empty() ? "" : ", ") + FormatSignificant(t, 4);
+      res.chosen[i].push_back("elapsed time (tau " + taus + " " + rep.model.time_unit + ")");
+    }
     for (std::size_t j = 0; j < n; ++j) {
       CrossRunCell& c = res.cells[i][j];
       c.model = PredictionStats(rep.model, runs[j]);
@@ -233,6 +239,8 @@ HoldoutResult Holdout(const Run& log, const HoldoutOptions& o,
     f.zero = zero;
     f.extra_inputs.clear();
     f.kind = ModelKind::kMlr;
+    f.selection.max_classes = 0;
+    add("fit", f);  // drift fit as run by default: its candidates, no sensor cap
     f.candidates = Candidates::kTime;
     add("time", f);
     f.candidates = Candidates::kSensors;

@@ -53,7 +53,10 @@ struct CrossRunResult {
   ModelKind kind = ModelKind::kMlr;
   std::vector<std::string> runs;
   std::vector<RunState> states;
-  std::vector<std::vector<std::string>> chosen;  ///< sensors of each run's model
+  Candidates candidates = Candidates::kAuto;      ///< the families each run's model chose from
+  /// Inputs of each run's model: its sensors, then "elapsed time (tau ...)" when it has
+  /// elapsed-time terms.
+  std::vector<std::vector<std::string>> chosen;
   std::vector<std::vector<CrossRunCell>> cells;  ///< [train][test]
   std::vector<CrossRunGroup> groups;
   std::vector<DriftModel> models;  ///< each run's model
@@ -61,8 +64,9 @@ struct CrossRunResult {
   ZeroConvention zero;                ///< the zero of every figure
 };
 
-/// Builds one model per run (options.kind, Miao et al.'s selection unless options.sensors is set;
-/// the sensor family, whatever options.candidates says) and a time-only warm-up model per run,
+/// Builds one model per run as drift fit does (options.kind, options.candidates: by default the
+/// choice between the sensors and the time models; Miao et al.'s selection unless options.sensors
+/// is set; --candidates sensors gives Miao et al.'s table) and a time-only warm-up model per run,
 /// and predicts every run, all on options.zero (a fixed zero without a level: the first run's
 /// first row). Runs need at least 2 entries and the error column. Parallel over runs.
 CrossRunResult CrossRun(const std::vector<Run>& runs, const std::string& error_column,
@@ -75,8 +79,10 @@ struct HoldoutOptions {
   /// rarely reaches a cap, --classes cv may keep many sensors).
   int max_sensors = 0;
   std::vector<std::string> channels;  ///< error columns (empty: every _um column)
-  /// Methods: none, time (sensor-free: time-only warm-up since the log's start, 1 or 2 terms by
-  /// validation), mlr_all (MLR on every sensor), mlr (selected), dynamic (selected, lags),
+  /// Methods: none, fit (drift fit at fit.candidates, default auto: the choice between the
+  /// sensors and the time models; kind mlr, no sensor cap), time (sensor-free: time-only warm-up
+  /// since the log's start, 1 or 2 terms by validation), mlr_all (MLR on every sensor), mlr
+  /// (selected), dynamic (selected, lags),
   /// network (selected, k-h-1), and dynamic_extra (selected + the extra inputs, lags) when
   /// fit.extra_inputs is not empty. All on fit.zero (run-start: from the log's first row).
   bool network = true;

@@ -83,30 +83,52 @@ std::vector<Split> FoldSplits(const std::vector<int>& fold, bool forward) {
   return splits;
 }
 
-// Pooled RMSE of predicting each fold from a fit on the others; `predict` returns the test rows'
-// predictions from a fit on the training rows, or an empty vector when they are too few (the
-// fold's samples still count, as errors of 0: the pooled RMSE of every candidate alike).
+// One candidate's validation: each fold predicted from a fit on the others (forward: the earlier
+// ones only).
+struct CvResult {
+  double pooled_rmse_um = std::numeric_limits<double>::infinity();  ///< over the fitted folds
+  std::vector<double> fold_rmse_um;  ///< per fold of FoldSplits; NaN: too few rows to fit
+  Eigen::VectorXd oof;               ///< out-of-fold prediction per row; NaN: not predicted
+};
+
+// `predict` returns the test rows' predictions from a fit on the training rows; a fold with too
+// few training rows for `parameters` is left out (NaN), and so are its rows from the pooled RMSE.
 template <typename Predict>
-double PooledRmse(const Stacked& s, bool forward, int parameters, Predict predict) {
+CvResult CrossValidate(const Stacked& s, bool forward, int parameters, Predict predict) {
+  CvResult r;
+  r.oof = Eigen::VectorXd::Constant(s.y.size(), std::numeric_limits<double>::quiet_NaN());
   double sse = 0;
   Eigen::Index count = 0;
   for (const Split& sp : FoldSplits(s.fold, forward)) {
+    if (sp.train.size() <= static_cast<std::size_t>(parameters)) {  // too few to fit
+      r.fold_rmse_um.push_back(std::numeric_limits<double>::quiet_NaN());
+      continue;
+    }
+    const Eigen::VectorXd p = predict(sp);
+    const double fold_sse = (Rows(s.y, sp.test) - p).squaredNorm();
+    for (std::size_t k = 0; k < sp.test.size(); ++k) r.oof(sp.test[k]) = p(static_cast<Eigen::Index>(k));
+    r.fold_rmse_um.push_back(std::sqrt(fold_sse / static_cast<double>(sp.test.size())));
+    sse += fold_sse;
     count += static_cast<Eigen::Index>(sp.test.size());
-    if (sp.train.size() <= static_cast<std::size_t>(parameters)) continue;  // too few to fit
-    sse += (Rows(s.y, sp.test) - predict(sp)).squaredNorm();
   }
   if (count == 0)
     throw InputError("cross-validation: no fold has enough training samples for " +
                      std::to_string(parameters) + " parameters");
-  return std::sqrt(sse / static_cast<double>(count));
+  r.pooled_rmse_um = std::sqrt(sse / static_cast<double>(count));
+  return r;
+}
+
+// The linear model on s.x validated fold by fold.
+CvResult CrossValidateLinear(const Stacked& s, bool forward) {
+  return CrossValidate(s, forward, static_cast<int>(s.x.cols()) + 1, [&](const Split& sp) {
+    const Eigen::VectorXd b = LeastSquaresCoefficients(Rows(s.x, sp.train), Rows(s.y, sp.train));
+    return EvaluateLinear(b, Rows(s.x, sp.test));
+  });
 }
 
 // Pooled RMSE of predicting each fold from a fit on the others.
 double CrossValidatedRmse(const Stacked& s, bool forward) {
-  return PooledRmse(s, forward, static_cast<int>(s.x.cols()) + 1, [&](const Split& sp) {
-    const Eigen::VectorXd b = LeastSquaresCoefficients(Rows(s.x, sp.train), Rows(s.y, sp.train));
-    return EvaluateLinear(b, Rows(s.x, sp.test));
-  });
+  return CrossValidateLinear(s, forward).pooled_rmse_um;
 }
 
 // The warm-up fit (regression.h FitWarmUp) on rows `idx`, grouped by run, with s.x's columns as
@@ -140,11 +162,11 @@ Eigen::VectorXd PredictWarmUp(const WarmUpFit& f, const Stacked& s,
   return EvaluateLinear(f.coefficients, x);
 }
 
-// Validation RMSE of the warm-up model (time since start, `terms` terms, beside s.x's columns
-// when `with_x`), its time constants searched again in every fold.
-double WarmUpCvRmse(const Stacked& s, bool forward, int terms, bool with_x) {
+// Validation of the warm-up model (time since start, `terms` terms, beside s.x's columns when
+// `with_x`), its time constants searched again in every fold.
+CvResult WarmUpCv(const Stacked& s, bool forward, int terms, bool with_x) {
   const int parameters = 1 + 2 * terms + (with_x ? static_cast<int>(s.x.cols()) : 0);
-  return PooledRmse(s, forward, parameters, [&](const Split& sp) {
+  return CrossValidate(s, forward, parameters, [&](const Split& sp) {
     return PredictWarmUp(WarmUpOnRows(s, sp.train, terms, with_x), s, sp.test, with_x);
   });
 }
@@ -241,6 +263,10 @@ std::string ToString(Candidates c) {
       return "time";
     case Candidates::kSensorsTime:
       return "sensors+time";
+    case Candidates::kTime1:
+      return "time1";
+    case Candidates::kTime2:
+      return "time2";
     case Candidates::kAuto:
       break;
   }
@@ -248,14 +274,25 @@ std::string ToString(Candidates c) {
 }
 
 Candidates ParseCandidates(const std::string& text) {
-  for (Candidates c :
-       {Candidates::kAuto, Candidates::kSensors, Candidates::kTime, Candidates::kSensorsTime})
+  for (Candidates c : {Candidates::kAuto, Candidates::kSensors, Candidates::kTime,
+                       Candidates::kSensorsTime, Candidates::kTime1, Candidates::kTime2})
     if (ToString(c) == text) return c;
-  throw InputError("candidates '" + text + "': must be auto, sensors, time or sensors+time");
+  throw InputError("candidates '" + text +
+                   "': must be auto, sensors, time, time1, time2 or sensors+time");
+}
+
+void ChoiceRule::Validate() const {
+  if (!(tolerance >= 0 && tolerance <= 1))
+    throw InputError("choice tolerance " + MessageNumber(tolerance) + ": must be within 0..1");
+  if (!(margin >= 0 && margin < 1))
+    throw InputError("choice margin " + MessageNumber(margin) + ": must be within 0..1 (not 1)");
+  if (!(consistency >= 0 && consistency <= 1))
+    throw InputError("choice consistency " + MessageNumber(consistency) + ": must be within 0..1");
 }
 
 void FitOptions::Validate() const {
   selection.Validate();
+  choice.Validate();
   if (max_lags < 1 || max_lags > 4)
     throw InputError("max lags " + std::to_string(max_lags) + ": must be 1..4");
   if (folds < 2 || folds > 20)
@@ -481,7 +518,7 @@ FitReport FitTimeModel(const std::vector<Run>& runs, const std::string& error_co
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
   const WarmUpFit w = WarmUpOnRows(s, all, terms, false);
   rep.model.elapsed_time_constants = w.time_constants;
-  if (!w.identified) rep.model.notes.push_back(w.note);
+  if (!w.note.empty()) rep.model.notes.push_back(w.note);
   FitChosen(runs, error_column, o, &rep);
   return rep;
 }
@@ -495,42 +532,16 @@ FitReport FitSensorTimeModel(const std::vector<Run>& runs, const std::string& er
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
   const WarmUpFit w = WarmUpOnRows(s, all, 1, true);
   m.elapsed_time_constants = w.time_constants;
-  if (!w.identified) m.notes.push_back(w.note);
+  if (!w.note.empty()) m.notes.push_back(w.note);
   m.features.clear();
   FitChosen(runs, error_column, o, &rep);
   return rep;
 }
 
-// The candidates' validation scores and the choice: lowest validation RMSE, and within 5 % of it
-// the fewest parameters (the order of `scores`).
-std::size_t ChooseCandidate(const std::vector<CandidateScore>& scores) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& c : scores) best = std::min(best, c.cv_rmse_um);
-  if (!std::isfinite(best))
-    throw InputError("fit: no candidate model could be validated (too few samples per fold)");
-  std::size_t pick = 0;
-  for (std::size_t i = 0; i < scores.size(); ++i)
-    if (scores[i].cv_rmse_um <= 1.05 * best) {
-      pick = i;
-      break;
-    }
-  return pick;
-}
-
-std::string ChoiceMessage(const std::vector<CandidateScore>& c, std::size_t pick,
-                          const std::vector<Run>& runs, const FitOptions& o) {
-  std::string others;
-  for (std::size_t i = 0; i < c.size(); ++i)
-    if (i != pick)
-      others += (others.empty() ? "" : ", ") + c[i].name + " " +
-                (std::isfinite(c[i].cv_rmse_um) ? MessageNumber(c[i].cv_rmse_um) : std::string("-"));
-  const std::string how =
-      runs.size() > 1 ? "leave one run out, " + std::to_string(runs.size()) + " runs"
-                      : std::to_string(o.folds) + (o.forward_cv ? " forward-chaining" : "") +
-                            " blocks of one run";
-  return "chosen: " + c[pick].name + ": validation RMSE " + MessageNumber(c[pick].cv_rmse_um) +
-         " um (lowest, or within 5 % of it with fewer parameters) against " +
-         (others.empty() ? std::string("no other") : others) + " um (" + how + ")";
+std::string HowValidated(const std::vector<Run>& runs, const FitOptions& o) {
+  return runs.size() > 1 ? "leave one run out, " + std::to_string(runs.size()) + " runs"
+                         : std::to_string(o.folds) + (o.forward_cv ? " forward-chaining" : "") +
+                               " blocks of one run";
 }
 
 // Scores every candidate family of o.candidates and fits the chosen one (model.h Candidates).
@@ -539,24 +550,30 @@ FitReport FitCandidates(const std::vector<Run>& runs, const std::string& error_c
   const bool forward = o.forward_cv && runs.size() == 1;
   const Stacked time_stack = Stack(runs, error_column, {}, {}, {}, o.folds);
   std::vector<CandidateScore> scores;
-  auto score = [&](const std::string& name, int parameters, auto cv) {
-    CandidateScore c{name, {}, parameters, std::numeric_limits<double>::infinity(),
-                     static_cast<int>(FoldSplits(time_stack.fold, forward).size())};
+  auto score = [&](const std::string& name, int parameters, bool sensor_free, auto cv) {
+    CandidateScore c;
+    c.name = name;
+    c.parameters = parameters;
+    c.sensor_free = sensor_free;
+    c.folds = static_cast<int>(FoldSplits(time_stack.fold, forward).size());
     try {
-      c.cv_rmse_um = cv();
+      const CvResult r = cv();
+      c.cv_rmse_um = r.pooled_rmse_um;
+      c.fold_rmse_um = r.fold_rmse_um;
     } catch (const InputError&) {
       // too few samples per fold: not a candidate
     }
     scores.push_back(c);
   };
-  const bool want_time = o.candidates == Candidates::kAuto || o.candidates == Candidates::kTime;
+  const bool want_time1 = o.candidates == Candidates::kAuto || o.candidates == Candidates::kTime ||
+                          o.candidates == Candidates::kTime1;
+  const bool want_time2 = o.candidates == Candidates::kAuto || o.candidates == Candidates::kTime ||
+                          o.candidates == Candidates::kTime2;
   const bool want_sensors = o.candidates == Candidates::kAuto;
   const bool want_mixed = o.candidates == Candidates::kSensorsTime ||
                           (o.candidates == Candidates::kAuto && runs.size() >= 3);
-  if (want_time) {
-    score("time1", 3, [&] { return WarmUpCvRmse(time_stack, forward, 1, false); });
-    score("time2", 5, [&] { return WarmUpCvRmse(time_stack, forward, 2, false); });
-  }
+  if (want_time1) score("time1", 3, true, [&] { return WarmUpCv(time_stack, forward, 1, false); });
+  if (want_time2) score("time2", 5, true, [&] { return WarmUpCv(time_stack, forward, 2, false); });
   FitReport sensors;
   if (want_sensors || want_mixed) {
     sensors = FitSensorModel(runs, error_column, o);
@@ -564,25 +581,107 @@ FitReport FitCandidates(const std::vector<Run>& runs, const std::string& error_c
     const Stacked ss =
         Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
     const int p = static_cast<int>(ss.x.cols()) + 1 + static_cast<int>(m.time_constants.size());
-    if (want_sensors) score("sensors", p, [&] { return CrossValidatedRmse(ss, forward); });
+    if (want_sensors) score("sensors", p, false, [&] { return CrossValidateLinear(ss, forward); });
     if (want_mixed)
-      score("sensors+time", p + 2, [&] { return WarmUpCvRmse(ss, forward, 1, true); });
+      score("sensors+time", p + 2, false, [&] { return WarmUpCv(ss, forward, 1, true); });
   }
-  const std::size_t pick = ChooseCandidate(scores);
-  const std::string& name = scores[pick].name;
+  const CandidateChoice choice = ChooseCandidate(scores, o.choice);
+  const std::string& name = scores[choice.pick].name;
   FitReport rep = name == "sensors"        ? sensors
                   : name == "sensors+time" ? FitSensorTimeModel(runs, error_column, o, sensors)
                                            : FitTimeModel(runs, error_column, o, name == "time1" ? 1 : 2);
   if (name != "sensors" && name != "sensors+time")  // the screen's warnings stand for every family
     rep.warnings = sensors.warnings;
   rep.candidates = scores;
-  rep.candidates[pick].time_constants = rep.model.elapsed_time_constants;
-  rep.chosen = ChoiceMessage(scores, pick, runs, o);
+  rep.candidates[choice.pick].time_constants = rep.model.elapsed_time_constants;
+  rep.chosen = "chosen: " + name + ": " + choice.why + " (" + HowValidated(runs, o) + ")";
   rep.model.notes.push_back(rep.chosen);
   return rep;
 }
 
 }  // namespace
+
+namespace {
+
+// Finite RMSEs of two candidates on the folds both were fitted in: the count where `a` is lower.
+int FoldWins(const CandidateScore& a, const CandidateScore& b, int* common) {
+  int wins = 0;
+  *common = 0;
+  for (std::size_t k = 0; k < a.fold_rmse_um.size() && k < b.fold_rmse_um.size(); ++k) {
+    if (!std::isfinite(a.fold_rmse_um[k]) || !std::isfinite(b.fold_rmse_um[k])) continue;
+    ++*common;
+    wins += a.fold_rmse_um[k] < b.fold_rmse_um[k];
+  }
+  return wins;
+}
+
+std::string Um(double v) { return std::isfinite(v) ? MessageNumber(v) + " um" : "-"; }
+
+// The fewest parameters among `among` within (1 + tolerance) of their lowest RMSE (ties: the
+// lower RMSE); `among` holds finite candidates only.
+std::size_t FewestWithin(const std::vector<CandidateScore>& s, const std::vector<std::size_t>& among,
+                         double tolerance, double* best) {
+  *best = std::numeric_limits<double>::infinity();
+  for (std::size_t i : among) *best = std::min(*best, s[i].cv_rmse_um);
+  std::size_t pick = among.front();
+  bool found = false;
+  for (std::size_t i : among) {
+    if (!(s[i].cv_rmse_um <= (1 + tolerance) * *best)) continue;
+    if (!found || s[i].parameters < s[pick].parameters ||
+        (s[i].parameters == s[pick].parameters && s[i].cv_rmse_um < s[pick].cv_rmse_um))
+      pick = i, found = true;
+  }
+  return pick;
+}
+
+}  // namespace
+
+CandidateChoice ChooseCandidate(const std::vector<CandidateScore>& s, const ChoiceRule& rule) {
+  std::vector<std::size_t> finite;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (std::isfinite(s[i].cv_rmse_um)) finite.push_back(i);
+  if (finite.empty())
+    throw InputError("fit: no candidate model could be validated (too few samples per fold)");
+  double best = 0;
+  CandidateChoice c;
+  c.pick = FewestWithin(s, finite, rule.tolerance, &best);
+  const std::string tol = MessageNumber(100 * rule.tolerance) + " %";
+  c.why = "validation RMSE " + Um(s[c.pick].cv_rmse_um) + ", the fewest parameters (" +
+          std::to_string(s[c.pick].parameters) + ") within " + tol + " of the lowest (" + Um(best) +
+          ")";
+  // A sensor-free candidate replaces the sensor model only when it wins clearly and consistently.
+  const auto sensors = std::find_if(s.begin(), s.end(), [](const CandidateScore& x) {
+    return x.name == "sensors" && std::isfinite(x.cv_rmse_um);
+  });
+  if (!s[c.pick].sensor_free || sensors == s.end()) return c;
+  int common = 0;
+  const int wins = FoldWins(s[c.pick], *sensors, &common);
+  const bool clearly = s[c.pick].cv_rmse_um <= (1 - rule.margin) * sensors->cv_rmse_um;
+  const bool consistently = common > 0 && wins >= rule.consistency * common;
+  const std::string record = s[c.pick].name + " " + Um(s[c.pick].cv_rmse_um) + " against sensors " +
+                             Um(sensors->cv_rmse_um) + ", lower in " + std::to_string(wins) +
+                             " of " + std::to_string(common) + " folds";
+  if (clearly && consistently) {
+    c.why += "; it replaces the sensor model, winning clearly and consistently (" + record + ")";
+    return c;
+  }
+  c.pick = static_cast<std::size_t>(sensors - s.begin());
+  c.why = "validation RMSE " + Um(sensors->cv_rmse_um) +
+          "; the sensor model stays: a sensor-free model must be at least " +
+          MessageNumber(100 * rule.margin) + " % lower and lower in " +
+          MessageNumber(100 * rule.consistency) + " % of the folds to replace it (" + record + ")";
+  return c;
+}
+
+FitOptions PreviousRunOptions(const DriftModel& m) {
+  FitOptions f;
+  f.threads = 1;
+  f.zero = m.zero;
+  f.kind = m.kind == ModelKind::kNetwork ? ModelKind::kMlr : m.kind;
+  f.extra_inputs = m.extra_inputs;
+  if (m.selection == "given") f.sensors = m.sensors;
+  return f;
+}
 
 FitReport FitDriftModel(const std::vector<Run>& raw_runs, const std::string& error_column,
                         const FitOptions& o) {

@@ -7,6 +7,7 @@
 // network kind's Bayesian-regularized training (nn/trainbr.h). drift/model.h says what each kind
 // computes; this header, how it is fitted.
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,15 +25,31 @@ namespace whirl::drift {
 ///                 with fewer, the validation favours it and it extrapolates badly);
 ///   auto          all of them (linear kinds; a network, or sensors given by name, fit
 ///                 `sensors` only).
-enum class Candidates { kAuto, kSensors, kTime, kSensorsTime };
-std::string ToString(Candidates c);                  ///< "auto", "sensors", "time", "sensors+time"
+///   time1, time2  one of the time-only models alone.
+enum class Candidates { kAuto, kSensors, kTime, kSensorsTime, kTime1, kTime2 };
+/// "auto", "sensors", "time", "sensors+time", "time1", "time2"
+std::string ToString(Candidates c);
 Candidates ParseCandidates(const std::string& text);  ///< inverse; InputError otherwise
+
+/// How FitDriftModel chooses among the scored candidates (ChooseCandidate).
+struct ChoiceRule {
+  /// Within (1 + tolerance) x the lowest validation RMSE, the fewest parameters win.
+  double tolerance = 0.05;
+  /// A sensor-free candidate replaces the sensor model only with a validation RMSE at most
+  /// (1 - margin) x the sensor model's ...
+  double margin = 0.2;
+  /// ... and a lower RMSE in at least this share of the folds both were fitted in (3 of 4
+  /// forward-chaining folds; with 2 or 3 runs left out one at a time, every run).
+  double consistency = 0.75;
+  void Validate() const;
+};
 
 struct FitOptions {
   ModelKind kind = ModelKind::kMlr;
   /// Zero of the training errors, stored in the model (run_file.h ErrorZero).
   ZeroConvention zero;
   Candidates candidates = Candidates::kAuto;
+  ChoiceRule choice;                 ///< among the candidates (ChooseCandidate)
   std::vector<std::string> sensors;  ///< empty: Miao et al.'s selection (selection.h)
   SelectionOptions selection;
   std::vector<std::string> extra_inputs;  ///< other columns used as inputs
@@ -64,9 +81,24 @@ struct CandidateScore {
   std::string name;                    ///< "sensors", "time1", "time2", "sensors+time"
   std::vector<double> time_constants;  ///< elapsed-time constants fitted on all runs
   int parameters = 0;                  ///< coefficients incl. intercept and time constants
-  double cv_rmse_um = 0;               ///< +inf when it could not be validated
+  double cv_rmse_um = std::numeric_limits<double>::infinity();  ///< +inf: not validated
   int folds = 0;
+  std::vector<double> fold_rmse_um;  ///< per fold, in fold order; NaN: too few rows to fit there
+  bool sensor_free = false;          ///< time1, time2
 };
+
+/// The candidate chosen (index into the scores) and why, with the numbers compared.
+struct CandidateChoice {
+  std::size_t pick = 0;
+  std::string why;
+};
+/// The rule: among the validated candidates (finite RMSE), the fewest parameters within
+/// (1 + tolerance) of the lowest RMSE (ties: the lower RMSE). When that is sensor-free and the
+/// sensor model ("sensors") was validated, it replaces the sensor model only when it wins clearly
+/// (RMSE <= (1 - margin) x the sensors') and consistently (lower in >= consistency of the folds
+/// both were fitted in); otherwise the sensor model stays. InputError when none was validated.
+CandidateChoice ChooseCandidate(const std::vector<CandidateScore>& scores,
+                                const ChoiceRule& rule = {});
 
 struct FitReport {
   DriftModel model;
@@ -99,12 +131,23 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
 /// The errors are first put on options.zero (a fixed zero without a level takes the first row of
 /// the first run), which the model stores. With several candidates (options.candidates), each is
 /// scored by the validation RMSE with its whole fit (selection excepted, as the class-count
-/// choice) redone in every fold; the lowest wins, and within 5 % of it the fewest parameters
-/// (time1 < time2 < sensors < sensors+time).
+/// choice) redone in every fold, per fold and pooled; options.choice picks one (ChooseCandidate:
+/// the fewest parameters within 5 % of the lowest RMSE, a time model replacing the sensors only
+/// when it wins clearly and consistently), and FitReport::chosen says why with the numbers.
 /// Dead and duplicate sensors (selection.h convention 8) are left out of the selection and of
 /// given sensors, with a warning each (FitReport::warnings); InputError naming the run files when
 /// no sensor is left, or when the regression is still rank-deficient (naming the features).
 FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);
+
+/// The name of the "previous run" baseline in drift report and drift monitor --day.
+inline constexpr const char* kPreviousRunBaseline = "previous run";
+
+/// The "previous run" baseline, one definition for every command: `drift fit` at its defaults
+/// redone on the run before (the previous run shown by drift report, the previous day of drift
+/// monitor --day), what a shop gets by refitting each day: candidates auto, Miao et al.'s
+/// selection afresh (the model's own sensors when they were given), the model's kind (a network:
+/// mlr), extra inputs and error zero; one thread.
+FitOptions PreviousRunOptions(const DriftModel& model);
 
 }  // namespace whirl::drift

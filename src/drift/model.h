@@ -17,7 +17,11 @@
 //   elapsed_lag<tau>(t) = 1 - exp(-(t - t_0) / tau)   (exact: the step is piecewise constant),
 // so a model on them alone is the first-order warm-up e = b0 + sum_j A_j (1 - exp(-(t - t0)/tau_j))
 // (the time-only baseline and candidate, FitWarmUp in drift/regression.h). They follow the
-// input-major features. A control evaluates them with the same recursion from the run start.
+// input-major features. A control evaluates them with the same recursion from the run start
+// (interp/drift_action.h). Fitted, every tau_j lies within what the training runs identify (at
+// most the longest run's t - t0, at least two sample intervals) and the gains A_j share one sign:
+// after the trained time range the warm-up goes on towards its plateau b0 + sum_j A_j and never
+// passes it; the predictor counts those samples and says so (TrainedElapsed, WarmUpPlateau).
 // Kinds:
 //   mlr      Miao et al.'s multiple linear regression, no lags: e = b0 + sum_s b_s dT_s.
 //   dynamic  the same regression on the features with lags; the time constants are picked from
@@ -153,10 +157,21 @@ struct RunPrediction {
   Eigen::VectorXd std_um;        ///< standard deviation of each prediction
   bool has_measured = false;     ///< the run has the model's error column
   Eigen::VectorXd measured_um;
-  int outside_range_samples = 0;  ///< samples with a feature outside its training range
+  int outside_range_samples = 0;  ///< samples with an input feature outside its training range
+  /// Samples later after the run's start than the longest training run (elapsed-time models).
+  int beyond_trained_time_samples = 0;
   std::vector<std::string> warnings;
 };
 RunPrediction PredictRun(const DriftModel& model, const Run& run,
                          ReferenceMode reference = ReferenceMode::kRunStart);
+
+/// The trained time range of a model with elapsed-time features: the longest training run's time
+/// since its start [time_unit], from the features' training maxima (x = 1 - exp(-T / tau)); +inf
+/// without elapsed features or where x reached 1 in double (T > 37 tau: the plateau was reached).
+double TrainedElapsed(const DriftModel& model);
+/// The level the elapsed-time warm-up approaches [um]: b0 + sum A_j for a time-only model, sum A_j
+/// (its warm-up part) beside sensors; 0 without elapsed features. The gains share one sign
+/// (drift/regression.h FitWarmUp), so the warm-up is monotone and never passes it.
+double WarmUpPlateau(const DriftModel& model);
 
 }  // namespace whirl::drift

@@ -544,34 +544,91 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
 
 namespace {
 
-// Appends the scored residuals of `r` per name (none, strategies, baselines) to `week`.
-void CollectScored(const MonitorResult& r,
-                   std::vector<std::pair<std::string, std::vector<double>>>* week) {
+// The scored residuals of one name, per day (empty: the name does not exist that day).
+using DayResiduals = std::vector<std::vector<double>>;
+
+// Appends the scored residuals of day `d` of `r` per name (none, strategies, baselines).
+void CollectScored(const MonitorResult& r, std::size_t d, std::size_t days,
+                   std::vector<std::pair<std::string, DayResiduals>>* week) {
   auto add = [&](const std::string& name, const Eigen::VectorXd& predicted) {
     auto it = std::find_if(week->begin(), week->end(), [&](const auto& p) { return p.first == name; });
-    if (it == week->end()) it = week->insert(week->end(), {name, {}});
+    if (it == week->end()) it = week->insert(week->end(), {name, DayResiduals(days)});
     for (int k = r.score_begin; k < r.score_end; ++k)
-      it->second.push_back(r.measured_um(k) - (predicted.size() ? predicted(k) : 0.0));
+      it->second[d].push_back(r.measured_um(k) - (predicted.size() ? predicted(k) : 0.0));
   };
   add("none", Eigen::VectorXd());
   for (const auto& st : r.strategies) add(ToString(st.rule), st.predicted_um);
   for (const auto& b : r.baselines) add(b.name, b.predicted_um);
 }
 
+// Statistics of the residuals of the days in `which` (all days when empty).
+ErrorStats Pooled(const DayResiduals& res, const std::vector<int>& which) {
+  std::vector<double> all;
+  for (std::size_t d = 0; d < res.size(); ++d)
+    if (which.empty() || std::find(which.begin(), which.end(), static_cast<int>(d)) != which.end())
+      all.insert(all.end(), res[d].begin(), res[d].end());
+  return ComputeErrorStats(
+      Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())));
+}
+
+std::vector<int> CoveredDays(const DayResiduals& res) {
+  std::vector<int> days;
+  for (std::size_t d = 0; d < res.size(); ++d)
+    if (!res[d].empty()) days.push_back(static_cast<int>(d));
+  return days;
+}
+
+// The week's rows, the strongest of the full rows and each partial row against them.
+void RankWeek(const std::vector<std::pair<std::string, DayResiduals>>& scored, WeekResult* w) {
+  double best = std::numeric_limits<double>::infinity();
+  const int n = static_cast<int>(w->days.size());
+  for (const auto& [name, res] : scored) {
+    const std::vector<int> covered = CoveredDays(res);
+    w->week.push_back({name, Pooled(res, covered), static_cast<int>(covered.size())});
+    if (static_cast<int>(covered.size()) == n && w->week.back().score.mae_um < best)
+      best = w->week.back().score.mae_um, w->strongest = name;
+  }
+  for (const auto& [name, res] : scored) {
+    const std::vector<int> covered = CoveredDays(res);
+    if (static_cast<int>(covered.size()) == n || covered.empty()) continue;
+    WeekPartial p{name, covered, Pooled(res, covered).mae_um, "",
+                  std::numeric_limits<double>::infinity()};
+    for (const auto& [other, ores] : scored) {
+      if (static_cast<int>(CoveredDays(ores).size()) != n) continue;
+      const double mae = Pooled(ores, covered).mae_um;
+      if (mae < p.strongest_mae_um) p.strongest_mae_um = mae, p.strongest = other;
+    }
+    w->partial.push_back(p);
+  }
+}
+
 }  // namespace
 
+void CheckMonitorDays(std::size_t count) {
+  if (count > static_cast<std::size_t>(kMaxMonitorDays))
+    throw InputError("monitor: " + std::to_string(count) + " day files; at most " +
+                     std::to_string(kMaxMonitorDays) +
+                     " (a year of days) in one replay: replay fewer days at a time");
+}
+
 WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
-                       const MonitorOptions& o, const FitOptions& refit,
-                       const std::vector<Run>& first_time_training) {
+                       const MonitorOptions& o, const std::vector<Run>& first_time_training) {
   if (days.empty()) throw InputError("monitor: give at least one day (--day)");
+  CheckMonitorDays(days.size());
+  long long samples = 0;
+  for (const Run& d : days) samples += d.samples();
+  if (samples > kMaxRunSamples)
+    throw InputError("monitor: the " + std::to_string(days.size()) + " days hold " +
+                     std::to_string(samples) + " samples together; at most " +
+                     std::to_string(kMaxRunSamples) +
+                     " (as one run file): replay fewer days at a time");
   WeekResult w;
-  std::vector<std::pair<std::string, std::vector<double>>> scored;
-  FitOptions time_only = refit;
-  time_only.kind = ModelKind::kMlr;
+  std::vector<std::pair<std::string, DayResiduals>> scored;
+  FitOptions time_only;
+  time_only.threads = 1;
   time_only.candidates = Candidates::kTime;
   time_only.zero = model.zero;
-  FitOptions previous_fit = refit;
-  previous_fit.zero = model.zero;
+  const FitOptions previous_fit = PreviousRunOptions(model);
   for (std::size_t d = 0; d < days.size(); ++d) {
     std::vector<DriftModel> baselines;
     DriftModel previous = model;
@@ -584,13 +641,13 @@ WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
     const std::vector<StrategyResult>* carried = d > 0 ? &w.days.back().strategies : nullptr;
     MonitorResult r = MonitorRun(model, days[d], o, baselines, carried);
     BaselineResult prev;
-    prev.name = "previous";
+    prev.name = kPreviousRunBaseline;
     prev.predicted_um = PredictRun(previous, days[d], o.reference).predicted_um;
     prev.score = ComputeErrorStats(
         r.measured_um.segment(r.score_begin, r.score_end - r.score_begin) -
         prev.predicted_um.segment(r.score_begin, r.score_end - r.score_begin));
     r.baselines.push_back(std::move(prev));
-    CollectScored(r, &scored);
+    CollectScored(r, d, days.size(), &scored);
     w.days.push_back(std::move(r));
   }
   w.measurements.assign(w.days.front().strategies.size(), 0);
@@ -600,13 +657,7 @@ WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
       w.measurements[i] += r.strategies[i].measurements;
       w.stop_min[i] += r.strategies[i].stop_min;
     }
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& [name, res] : scored) {
-    const ErrorStats st = ComputeErrorStats(
-        Eigen::Map<const Eigen::VectorXd>(res.data(), static_cast<Eigen::Index>(res.size())));
-    w.week.emplace_back(name, st);
-    if (st.mae_um < best) best = st.mae_um, w.strongest = name;
-  }
+  RankWeek(scored, &w);
   return w;
 }
 

@@ -190,19 +190,41 @@ MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorO
 /// A production week: the days replayed in order, each day's rules starting from the previous
 /// day's final coefficients and bayes covariance (the static row stays the given model), the
 /// check schedule from each day's start. Baselines per day: none, the given model (static),
-/// `previous`: the model refitted on the previous day with `refit` (the given model on the first
-/// day), and `time`: a time-only warm-up fitted on the previous day (on the first day: on
+/// "previous run" (drift/fit.h kPreviousRunBaseline): drift fit at its defaults redone on the
+/// previous day (PreviousRunOptions, the definition drift report uses; the given model on the
+/// first day), and
+/// `time`: a time-only warm-up fitted on the previous day (on the first day: on
 /// `first_time_training` when given, else none).
+/// The week's rows: every name's statistics over the scored samples of the days it covers. Only
+/// rows covering every day are ranked (`strongest`); a row covering fewer days (time without a
+/// first-day fit) is compared, over its own days, with the rows that cover them all (`partial`).
+struct WeekRow {
+  std::string name;
+  ErrorStats score;  ///< over the scored samples of the days it covers
+  int days = 0;      ///< days covered
+};
+struct WeekPartial {
+  std::string name;          ///< a row covering fewer days
+  std::vector<int> days;     ///< their indices (0-based) in WeekResult::days
+  double mae_um = 0;         ///< its MAE over them
+  std::string strongest;     ///< the full row with the lowest MAE over the same days
+  double strongest_mae_um = 0;
+};
 struct WeekResult {
   std::vector<MonitorResult> days;
-  /// Per strategy/baseline name: the week's statistics over every scored sample of every day.
-  std::vector<std::pair<std::string, ErrorStats>> week;
+  std::vector<WeekRow> week;      ///< none, static, the rules, the baselines
   std::vector<int> measurements;  ///< per strategy of days[0].strategies: over the week
   std::vector<double> stop_min;   ///< per strategy: total stop time [min; samples]
-  std::string strongest;          ///< lowest week MAE
+  std::string strongest;          ///< lowest week MAE among the rows covering every day
+  std::vector<WeekPartial> partial;
 };
+/// Limits of one replay of days (MonitorWeek): at most kMaxMonitorDays files, and together at
+/// most kMaxRunSamples samples (run_file.h), the bound of one run file; InputError otherwise.
+inline constexpr int kMaxMonitorDays = 366;
+/// InputError unless `count` day files are within kMaxMonitorDays (checked before reading them).
+void CheckMonitorDays(std::size_t count);
 WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
-                       const MonitorOptions& options, const FitOptions& refit,
+                       const MonitorOptions& options,
                        const std::vector<Run>& first_time_training = {});
 
 /// Features of every sample as the control computes them: samples x (1 + features), first

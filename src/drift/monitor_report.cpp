@@ -186,6 +186,17 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
   return s.str();
 }
 
+namespace {
+
+// "data_2, data_3": the names of the days `which` (indices into w.days).
+std::string DayNames(const WeekResult& w, const std::vector<int>& which) {
+  std::string out;
+  for (int d : which) out += (out.empty() ? "" : ", ") + w.days[static_cast<std::size_t>(d)].run;
+  return out;
+}
+
+}  // namespace
+
 std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
   std::ostringstream s;
   const bool idx = w.days.front().time_from_index;
@@ -194,8 +205,9 @@ std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
     << " from each day's start, " << o.refit_samples
     << " refit measurements; each rule carries its coefficients (and the bayes covariance) "
        "from day to day\n";
-  s << "MAE um per day (previous = refit on the previous day; time = sensor-free warm-up fitted "
-       "on the previous day)\n";
+  s << "MAE um per day (" << kPreviousRunBaseline
+    << " = drift fit at its defaults redone on the previous day, the given model on the first; time = "
+       "sensor-free warm-up fitted on the previous day)\n";
   for (const auto& d : w.days) {
     s << "  " << d.run << ": none " << FormatDecimals(d.none.mae_um, 2);
     for (const auto& st : d.strategies)
@@ -204,17 +216,24 @@ std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
     for (const auto& b : d.baselines) s << ", " << b.name << " " << FormatDecimals(b.score.mae_um, 2);
     s << "; strongest " << d.Strongest() << "\n";
   }
-  s << "week         MAE um  RMSE um  measurements  stop min\n";
-  for (const auto& [name, st] : w.week) {
+  s << "week           days  MAE um  RMSE um  measurements  stop min\n";
+  for (const WeekRow& row : w.week) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "  %-10s %6.2f %8.2f", name.c_str(), st.mae_um, st.rmse_um);
+    std::snprintf(buf, sizeof buf, "  %-12s %4d %7.2f %8.2f", row.name.c_str(), row.days,
+                  row.score.mae_um, row.score.rmse_um);
     s << buf;
     for (std::size_t i = 0; i < w.days.front().strategies.size(); ++i)
-      if (ToString(w.days.front().strategies[i].rule) == name)
+      if (ToString(w.days.front().strategies[i].rule) == row.name)
         s << PadLeft(std::to_string(w.measurements[i]), 14) << PadLeft(FormatDecimals(w.stop_min[i], 0), 10);
     s << "\n";
   }
-  s << "strongest over the week (lowest MAE): " << w.strongest << "\n";
+  s << "strongest over the week (lowest MAE among the rows covering all " << w.days.size()
+    << " days): " << w.strongest << "\n";
+  for (const WeekPartial& p : w.partial)
+    s << p.name << " covers " << p.days.size() << " of " << w.days.size() << " days (" << DayNames(w, p.days)
+      << "): not ranked; over those days " << p.name << " " << FormatDecimals(p.mae_um, 2)
+      << " um, the strongest row covering every day " << p.strongest << " "
+      << FormatDecimals(p.strongest_mae_um, 2) << " um\n";
   return s.str();
 }
 
@@ -222,14 +241,68 @@ nlohmann::json WeekJson(const WeekResult& w, const MonitorOptions& o) {
   nlohmann::json days = nlohmann::json::array();
   for (const auto& d : w.days) days.push_back(MonitorJson(d, o));
   nlohmann::json week = nlohmann::json::array();
-  for (const auto& [name, st] : w.week) week.push_back({{"name", name}, {"score", ErrorStatsJson(st)}});
+  for (const WeekRow& row : w.week)
+    week.push_back({{"name", row.name}, {"score", ErrorStatsJson(row.score)}, {"days", row.days}});
+  nlohmann::json partial = nlohmann::json::array();
+  for (const WeekPartial& p : w.partial) {
+    std::vector<std::string> names;
+    for (int d : p.days) names.push_back(w.days[static_cast<std::size_t>(d)].run);
+    partial.push_back({{"name", p.name},
+                       {"days", names},
+                       {"mae_um", p.mae_um},
+                       {"strongest", p.strongest},
+                       {"strongest_mae_um", p.strongest_mae_um}});
+  }
   return {{"schema", "whirl.drift_monitor_week"},
           {"schema_version", 1},
           {"days", days},
           {"week", week},
           {"measurements", w.measurements},
           {"stop_min", w.stop_min},
-          {"strongest", w.strongest}};
+          {"strongest", w.strongest},
+          {"partial", partial}};
+}
+
+std::string WeekTimelineCsv(const WeekResult& w, const std::vector<std::string>& comments) {
+  const MonitorResult& first = w.days.front();
+  std::vector<std::string> header{"day", TimeName(first), "measured_um"};
+  for (const auto& s : first.strategies) header.push_back(ToString(s.rule) + "_um");
+  for (const auto& s : first.strategies) header.push_back(ToString(s.rule) + "_residual_um");
+  std::vector<std::string> c = comments;
+  std::vector<std::vector<double>> rows;
+  for (std::size_t d = 0; d < w.days.size(); ++d) {
+    const MonitorResult& r = w.days[d];
+    c.push_back("day " + std::to_string(d + 1) + ": " + r.run);
+    for (Eigen::Index k = 0; k < r.measured_um.size(); ++k) {
+      std::vector<double> row{static_cast<double>(d + 1), r.time[static_cast<std::size_t>(k)],
+                              r.measured_um(k)};
+      for (const auto& s : r.strategies) row.push_back(s.predicted_um(k));
+      for (const auto& s : r.strategies) row.push_back(r.measured_um(k) - s.predicted_um(k));
+      rows.push_back(std::move(row));
+    }
+  }
+  return FormatCsv(header, rows, WithComments(c, "monitor timeline of a week, day by day"));
+}
+
+std::string WeekEventsCsv(const WeekResult& w, const std::vector<std::string>& comments) {
+  std::ostringstream o;
+  for (const auto& c : WithComments(comments, "monitor events of a week, day by day"))
+    o << "# " << SpreadsheetLine(c) << "\n";
+  for (std::size_t d = 0; d < w.days.size(); ++d) {
+    std::istringstream day(MonitorEventsCsv(w.days[d], {}));
+    std::string line;
+    bool header = false;
+    while (std::getline(day, line)) {
+      if (line.rfind("#", 0) == 0) continue;
+      if (!header) {  // the column names once, with the day in front
+        header = true;
+        if (d == 0) o << "day," << line << "\n";
+        continue;
+      }
+      o << SpreadsheetCell(w.days[d].run) << "," << line << "\n";
+    }
+  }
+  return o.str();
 }
 
 namespace {
@@ -251,12 +324,13 @@ std::string ChecksCsv(const MonitorResult& r) {
 }
 
 // monitor.gp: the measured error and every rule's model over time, the checks as markers, and
-// the residuals below.
-std::string MonitorGnuplot(const MonitorResult& r) {
+// the residuals below; `prefix` names the files of one day of a week ("" for one run).
+std::string MonitorGnuplot(const MonitorResult& r, const std::string& prefix = "") {
   const std::string x = r.time_from_index ? "1" : "($1/60)";
   const std::size_t q = r.strategies.size();
   std::ostringstream gp;
-  gp << "set terminal pngcairo size 1100,700 font 'Sans,10' noenhanced\nset output 'monitor.png'\n"
+  gp << "set terminal pngcairo size 1100,700 font 'Sans,10' noenhanced\nset output "
+     << GnuplotString(prefix + "monitor.png") << "\n"
      << "set datafile separator ','\nset key outside right\nset grid\nset xlabel "
      << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset arrow from "
      << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
@@ -268,40 +342,45 @@ std::string MonitorGnuplot(const MonitorResult& r) {
             "run " + r.run + ": measured " + r.error_column +
             " and the models (dashed: monitoring starts; open: valid checks, filled: invalid "
             "checks and refit measurements)")
-     << "\nplot 'timeline.csv' using " << x << ":2 with lines lc rgb 'black' lw 2 title 'measured'";
+     << "\nplot " << GnuplotString(prefix + "timeline.csv") << " using " << x
+     << ":2 with lines lc rgb 'black' lw 2 title 'measured'";
   for (std::size_t i = 0; i < q; ++i)
     gp << ", '' using " << x << ":" << i + 3 << " with lines lc " << i + 1 << " title "
        << GnuplotString(ToString(r.strategies[i].rule));
   for (std::size_t i = 1; i < q; ++i)
-    gp << ", 'checks.csv' index " << i << " using " << x << ":($3==0?$2:1/0) with points pt 6 lc "
+    gp << ", " << GnuplotString(prefix + "checks.csv") << " index " << i << " using " << x
+       << ":($3==0?$2:1/0) with points pt 6 lc "
        << i + 1 << " notitle, '' index " << i << " using " << x
        << ":($3==1?$2:1/0) with points pt 7 lc " << i + 1 << " notitle";
   gp << "\nset title 'residual (measured - model)'\nset ylabel 'residual [um]'\nplot ";
   for (std::size_t i = 0; i < q; ++i)
-    gp << (i ? ", " : "") << "'timeline.csv' using " << x << ":" << i + 3 + q << " with lines lc "
+    gp << (i ? ", " : "") << GnuplotString(prefix + "timeline.csv") << " using " << x << ":"
+       << i + 3 + q << " with lines lc "
        << i + 1 << " title " << GnuplotString(ToString(r.strategies[i].rule));
   gp << "\nunset multiplot\n";
-  return "# gnuplot script written by whirl; re-run: gnuplot monitor.gp\n" + gp.str();
+  return "# gnuplot script written by whirl; re-run: gnuplot " + prefix + "monitor.gp\n" + gp.str();
 }
 
 // Renders monitor.gp in the staging folder of `files`; returns the page's image element (or the
 // note that it was not rendered), warnings say why not.
 std::string RenderMonitorPlot(const fs::path& dir, const std::string& gnuplot, OutputDir& files,
-                              std::vector<std::string>* warnings) {
-  std::string img = "<p>(plot not rendered: monitor.gp)</p>";
+                              std::vector<std::string>* warnings, const std::string& prefix = "") {
+  const std::string script = prefix + "monitor.gp", png = prefix + "monitor.png";
+  std::string img = "<p>(plot not rendered: " + HtmlEscape(script) + ")</p>";
   std::error_code ec;
   if (!ProgramSucceeds({gnuplot, "--version"})) {
     warnings->push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
   } else {
     const fs::path stage = fs::absolute(files.Staging());  // gnuplot renders there
-    if (RunProgram({gnuplot, "monitor.gp"}, stage, stage / "gnuplot.log") == 0 &&
-        fs::is_regular_file(stage / "monitor.png", ec)) {
-      files.AddStaged("monitor.png");
-      img = "<img src='monitor.png' alt='monitor timeline'>";
+    if (RunProgram({gnuplot, script}, stage, stage / (prefix + "gnuplot.log")) == 0 &&
+        fs::is_regular_file(stage / png, ec)) {
+      files.AddStaged(png);
+      img = "<img src='" + HtmlEscape(png) + "' alt='monitor timeline'>";
     } else {
-      warnings->push_back("gnuplot failed on " + (dir / "monitor.gp").string() +
-                          " (see gnuplot.log)");
-      if (fs::is_regular_file(stage / "gnuplot.log", ec)) files.AddStaged("gnuplot.log");
+      warnings->push_back("gnuplot failed on " + (dir / script).string() + " (see " + prefix +
+                          "gnuplot.log)");
+      if (fs::is_regular_file(stage / (prefix + "gnuplot.log"), ec))
+        files.AddStaged(prefix + "gnuplot.log");
     }
   }
   return img;
@@ -337,6 +416,45 @@ MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult&
   files.Add("monitor.gp", MonitorGnuplot(r));
   const std::string img = RenderMonitorPlot(dir, gnuplot, files, &out.warnings);
   files.Add("index.html", MonitorIndexHtml(r, o, provenance, img, out.warnings));
+  files.Commit(also);
+  out.index_html = dir / "index.html";
+  return out;
+}
+
+MonitorReportResult WriteWeekReport(const fs::path& dir, const WeekResult& w,
+                                    const MonitorOptions& o,
+                                    const std::vector<std::string>& provenance,
+                                    const std::string& gnuplot, const AlsoWrite& also) {
+  OutputDir files(dir, "report directory");
+  MonitorReportResult out;
+  files.Add("week_timeline.csv", WeekTimelineCsv(w, provenance));
+  files.Add("week_events.csv", WeekEventsCsv(w, provenance));
+  std::ostringstream days;
+  for (std::size_t d = 0; d < w.days.size(); ++d) {
+    const MonitorResult& r = w.days[d];
+    const std::string prefix = "day" + std::to_string(d + 1) + "_";
+    files.Add(prefix + "timeline.csv", MonitorTimelineCsv(r, provenance));
+    files.Add(prefix + "events.csv", MonitorEventsCsv(r, provenance));
+    files.Add(prefix + "checks.csv", ChecksCsv(r));
+    files.Add(prefix + "monitor.gp", MonitorGnuplot(r, prefix));
+    const std::string img = RenderMonitorPlot(dir, gnuplot, files, &out.warnings, prefix);
+    days << "<h2>Day " << d + 1 << ": " << HtmlEscape(r.run) << "</h2>\n<pre>"
+         << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n" << img << "\n<p>Data: <a href='"
+         << prefix << "timeline.csv'>" << prefix << "timeline.csv</a>, <a href='" << prefix
+         << "events.csv'>" << prefix << "events.csv</a>, <a href='" << prefix << "monitor.gp'>"
+         << prefix << "monitor.gp</a>.</p>\n";
+  }
+  std::ostringstream h;
+  h << HtmlPageBegin("whirl: a production week of " + w.days.front().error_column + ", " +
+                         std::to_string(w.days.size()) + " days",
+                     provenance);
+  h << "<h2>Week</h2>\n<pre>" << HtmlEscape(FormatWeek(w, o)) << "</pre>\n"
+    << "<p>Data: <a href='week_timeline.csv'>week_timeline.csv</a> (every day, a day column "
+       "first), <a href='week_events.csv'>week_events.csv</a>.</p>\n"
+    << days.str();
+  for (const auto& warn : out.warnings) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
+  h << "</body></html>\n";
+  files.Add("index.html", h.str());
   files.Commit(also);
   out.index_html = dir / "index.html";
   return out;

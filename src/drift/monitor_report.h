@@ -24,6 +24,11 @@ nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o);
 /// strongest. JSON schema whirl.drift_monitor_week v1.
 std::string FormatWeek(const WeekResult& w, const MonitorOptions& o);
 nlohmann::json WeekJson(const WeekResult& w, const MonitorOptions& o);
+/// The week's timeline: every day's MonitorTimelineCsv rows with a first column `day` (1, 2, ...;
+/// the comment lines name each day's run).
+std::string WeekTimelineCsv(const WeekResult& w, const std::vector<std::string>& comments);
+/// The week's events: every day's MonitorEventsCsv rows with a first column `day` (the run).
+std::string WeekEventsCsv(const WeekResult& w, const std::vector<std::string>& comments);
 std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o);
 
 struct MonitorReportResult {
@@ -43,5 +48,14 @@ MonitorReportResult WriteMonitorReport(const std::filesystem::path& dir, const M
                                        const std::vector<std::string>& provenance,
                                        const std::string& gnuplot = "gnuplot",
                                        const AlsoWrite& also = {});
+
+/// The week's page: the week table (FormatWeek) and per day its table, plot and files
+/// (day<k>_timeline.csv, day<k>_events.csv, day<k>_monitor.gp/.png), with week_timeline.csv and
+/// week_events.csv; the same rules as WriteMonitorReport (all-or-nothing, `also` included).
+MonitorReportResult WriteWeekReport(const std::filesystem::path& dir, const WeekResult& w,
+                                    const MonitorOptions& o,
+                                    const std::vector<std::string>& provenance,
+                                    const std::string& gnuplot = "gnuplot",
+                                    const AlsoWrite& also = {});
 
 }  // namespace whirl::drift

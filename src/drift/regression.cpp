@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/numbers.h"
 
 namespace whirl::drift {
 namespace {
@@ -162,12 +163,34 @@ Eigen::VectorXd WarmUpTarget(const WarmUpData& d) {
   return y;
 }
 
-// The projected residual sum of squares: the gains by least squares for these taus.
-double ProjectedSse(const WarmUpData& d, const Eigen::VectorXd& y, const std::vector<double>& taus,
-                    Eigen::VectorXd* b) {
+// Least squares of y on [1 design(taus)]: the residual sum of squares, coefficients in *b.
+double LeastSquaresSse(const WarmUpData& d, const Eigen::VectorXd& y,
+                       const std::vector<double>& taus, Eigen::VectorXd* b) {
   const Eigen::MatrixXd x = WarmUpDesign(d, taus);
   *b = LeastSquaresCoefficients(x, y);
   return (y - EvaluateLinear(*b, x)).squaredNorm();
+}
+
+// The projected residual sum of squares: the gains by least squares for these taus, the warm-up
+// gains held to one sign (FitWarmUp). Two gains of opposite sign: the optimum of the convex
+// problem on the closed orthants lies on their boundary, a gain of 0, so it is the better of each
+// term alone (the other's gain set to 0 in *b).
+double ProjectedSse(const WarmUpData& d, const Eigen::VectorXd& y, const std::vector<double>& taus,
+                    Eigen::VectorXd* b) {
+  const double sse = LeastSquaresSse(d, y, taus, b);
+  const Eigen::Index c = 1 + d.fixed.cols();
+  if (taus.size() != 2 || (*b)(c) * (*b)(c + 1) >= 0) return sse;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t drop = 0; drop < 2; ++drop) {
+    Eigen::VectorXd one;
+    const double s = LeastSquaresSse(d, y, {taus[1 - drop]}, &one);
+    if (!(s < best)) continue;
+    best = s;
+    b->head(c) = one.head(c);
+    (*b)(c + static_cast<Eigen::Index>(1 - drop)) = one(c);
+    (*b)(c + static_cast<Eigen::Index>(drop)) = 0.0;
+  }
+  return best;
 }
 
 // Golden-section minimum of f over log tau in [lo, hi] (Kiefer, "Sequential minimax search for a
@@ -188,16 +211,22 @@ double GoldenLog(F f, double lo, double hi) {
   return std::exp(f1 <= f2 ? x1 : x2);
 }
 
+// The longest run's time since its start: the trained time range.
+double LongestSpan(const WarmUpData& d) {
+  double longest = 0;
+  for (const auto& t : d.t)
+    if (!t.empty()) longest = std::max(longest, t.back());
+  return longest;
+}
+
 std::vector<double> LogGrid(const WarmUpData& d) {
   std::vector<double> steps;
-  double longest = 0;
-  for (const auto& t : d.t) {
+  for (const auto& t : d.t)
     for (std::size_t k = 1; k < t.size(); ++k) steps.push_back(t[k] - t[k - 1]);
-    if (!t.empty()) longest = std::max(longest, t.back());
-  }
   std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2),
                    steps.end());
-  const double lo = 2 * steps[steps.size() / 2], hi = std::max(3 * longest, 2 * lo);
+  const double lo = 2 * steps[steps.size() / 2];
+  const double hi = std::max(kMaxWarmUpTauPerSpan * LongestSpan(d), lo);
   std::vector<double> grid(41);
   for (int i = 0; i < 41; ++i) grid[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, i / 40.0);
   return grid;
@@ -243,6 +272,12 @@ WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
   const Eigen::VectorXd y = WarmUpTarget(d);
   const std::vector<double> grid = LogGrid(d);
   const std::vector<std::size_t> at = GridSearch(d, y, grid, terms);
+  if (at.empty()) {  // two terms 3 apart do not fit between two sample steps and the span
+    WarmUpFit one = FitWarmUp(times, errors, 1, fixed);
+    one.note = "the trained span is too short for two time constants: one term" +
+               std::string(one.note.empty() ? "" : "; ") + one.note;
+    return one;
+  }
   std::vector<double> taus;
   for (std::size_t i : at) taus.push_back(grid[i]);
   Eigen::VectorXd b;
@@ -261,13 +296,27 @@ WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
         lower, upper);
   }
   WarmUpFit f;
-  f.time_constants = taus;
+  f.span = LongestSpan(d);
   f.rmse_um = std::sqrt(ProjectedSse(d, y, taus, &f.coefficients) / static_cast<double>(d.rows));
-  if (at.back() + 1 == grid.size()) {
+  const Eigen::Index c = 1 + fixed.cols();
+  std::vector<std::size_t> kept_at = at;
+  if (taus.size() == 2 && (f.coefficients(c) == 0.0 || f.coefficients(c + 1) == 0.0)) {
+    const std::size_t zero = f.coefficients(c) == 0.0 ? 0 : 1;  // the term held at 0: dropped
+    taus.erase(taus.begin() + static_cast<std::ptrdiff_t>(zero));
+    kept_at.erase(kept_at.begin() + static_cast<std::ptrdiff_t>(zero));
+    Eigen::VectorXd kept(c + 1);
+    kept.head(c) = f.coefficients.head(c);
+    kept(c) = f.coefficients(c + 1 - static_cast<Eigen::Index>(zero));
+    f.coefficients = kept;
+    f.note = "two terms would need gains of opposite sign: one term kept";
+  }
+  f.time_constants = taus;
+  if (kept_at.back() + 1 == grid.size() && grid.back() > grid.front()) {
     f.identified = false;
-    f.note = "tau not identified: a ramp (tau at the grid's upper end, " +
-             std::to_string(static_cast<long long>(std::lround(grid.back()))) +
-             "); only the initial slope A/tau is";
+    f.note += std::string(f.note.empty() ? "" : "; ") + "tau at the training span (" +
+              FormatSignificant(f.span, 4) +
+              "): the warm-up is slower than the training runs show; its plateau is a bound, "
+              "not a measured level";
   }
   return f;
 }

@@ -56,22 +56,34 @@ Eigen::VectorXd FirstOrderLag(const Eigen::VectorXd& x, const std::vector<double
 ///   e(t) = b0 + sum_j A_j (1 - exp(-(t - t0) / tau_j)),  j = 1..terms (1 or 2),
 /// t0 the run's first sample (the step response of a first-order lag, FirstOrderLag with L_0 = 0),
 /// optionally beside fixed regressors (e.g. sensor rises: e = b0 + c' x + sum_j A_j (...)).
+/// A warm-up that cannot run away (issue 38): every tau_j lies between 2 sample intervals (what
+/// the sampling resolves) and the trained time range T (the longest run's t - t0; a slower
+/// warm-up is not identified by the data), and the gains share one sign, so the warm-up part is
+/// monotone, its plateau is sum_j A_j and no two large opposite gains cancel. Beyond T the terms go
+/// on towards 1: the prediction approaches the plateau b0 + sum_j A_j and never passes it.
 struct WarmUpFit {
-  std::vector<double> time_constants;  ///< tau_j ascending [unit of t]
+  std::vector<double> time_constants;  ///< tau_j ascending [unit of t]; 2 asked may give 1
   Eigen::VectorXd coefficients;        ///< b0 [um], the fixed columns' c, then A_j [um]
   double rmse_um = 0;                  ///< training RMSE
-  /// false when the best tau is the grid's upper end: only the initial slope A/tau is identified
-  /// (a ramp); the capped tau is kept and `note` says so.
+  double span = 0;                     ///< T, the longest run's t - t0 [unit of t]
+  /// false when the best tau is the upper bound T: the warm-up is slower than the training
+  /// shows and its plateau is a bound, not a measured level; `note` says so.
   bool identified = true;
-  std::string note;
+  std::string note;  ///< also when two terms collapsed to one (gains of opposite sign)
 };
+
+/// The longest elapsed-time constant a warm-up may take, as a multiple of the trained time range.
+inline constexpr double kMaxWarmUpTauPerSpan = 1.0;
 
 /// Variable projection (Golub & Pereyra, "The differentiation of pseudo-inverses and nonlinear
 /// least squares problems whose variables separate"): for fixed time constants the gains are
 /// linear (least squares on the stacked runs, each run's time since its own start), so only tau is
-/// searched: a log grid of 41 points from 2 sample intervals (the median step) to 3 x the longest
-/// run, then a golden-section refinement of log tau between the best point's neighbours
-/// (coordinate-wise for two terms, which need tau_2 >= 3 tau_1). Deterministic, never diverges.
+/// searched: a log grid of 41 points from 2 sample intervals (the median step) to
+/// kMaxWarmUpTauPerSpan x T, then a golden-section refinement of log tau between the best point's
+/// neighbours (coordinate-wise for two terms, which need tau_2 >= 3 tau_1). Two gains of opposite
+/// sign are not allowed: the sign-constrained least squares is then the better of each term
+/// alone, and a two-term fit whose best is one term returns one term (with a note).
+/// Deterministic, never diverges.
 /// `times`: time since each run's start, t - t0 [min or samples], and `errors` [um], per run;
 /// `fixed`: extra regressors, one row per sample of the runs in order (0 columns: none).
 /// InputError when no run has 3 samples.

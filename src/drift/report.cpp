@@ -182,19 +182,7 @@ std::vector<Run> TrainingRunsShown(const DriftModel& m, const std::vector<Run>& 
   return found.size() == m.training_runs.size() ? found : std::vector<Run>{};
 }
 
-// The same features refitted on one run: the model's sensors and inputs (a time-only model: its
-// time terms), its kind (a network: mlr), its zero.
-FitOptions RefitOptions(const DriftModel& m) {
-  FitOptions f;
-  f.kind = m.kind == ModelKind::kNetwork ? ModelKind::kMlr : m.kind;
-  f.zero = m.zero;
-  f.sensors = m.sensors;
-  f.extra_inputs = m.extra_inputs;
-  f.candidates = m.SensorFree() && m.extra_inputs.empty() ? Candidates::kTime : Candidates::kSensors;
-  return f;
-}
-
-constexpr const char* kBaselineNames[] = {"model", "none", "time only", "previous run"};
+constexpr const char* kBaselineNames[] = {"model", "none", "time only", kPreviousRunBaseline};
 
 std::array<double, 4> BaselineValues(const ReportBaseline& c) {
   return {c.model_mae_um, c.none_mae_um, c.time_only_mae_um, c.previous_run_mae_um};
@@ -216,7 +204,7 @@ double BaselineMae(const DriftModel& b, const Run& run) {
 
 // Per run shown: the model against no compensation, a time-only warm-up fitted on the model's
 // training runs (first order in time since the run's start, drift/regression.h FitWarmUp), and
-// the same features refitted on the previous run shown. A baseline that cannot be fitted (the
+// drift fit at its defaults redone on the previous run shown (drift/fit.h PreviousRunOptions). A baseline that cannot be fitted (the
 // training runs are not shown, too few samples) stays empty and the notes say why.
 std::vector<ReportBaseline> Baselines(const DriftModel& m, const std::vector<RunPrediction>& preds,
                                      const std::vector<Run>& runs, std::vector<std::string>* notes) {
@@ -248,9 +236,10 @@ std::vector<ReportBaseline> Baselines(const DriftModel& m, const std::vector<Run
     if (i > 0) {
       try {
         c.previous_run_mae_um = BaselineMae(
-            FitDriftModel({runs[i - 1]}, m.error_column, RefitOptions(m)).model, runs[i]);
+            FitDriftModel({runs[i - 1]}, m.error_column, PreviousRunOptions(m)).model, runs[i]);
       } catch (const InputError& e) {
-        notes->push_back("previous run: no refit on " + runs[i - 1].name + ": " + e.what());
+        notes->push_back(std::string(kPreviousRunBaseline) + ": no refit on " + runs[i - 1].name +
+                         ": " + e.what());
       }
     }
     c.strongest = Strongest(c);
@@ -263,7 +252,8 @@ std::string BaselinesHtml(const std::vector<ReportBaseline>& cells,
   std::ostringstream h;
   h << "<h2>Baselines</h2>\n<p>MAE um per run: the model, no compensation, a time-only warm-up "
        "(first order in the time since the run's start, no sensor, fitted on the model's "
-       "training runs) and the same features refitted on the previous run shown; the strongest "
+       "training runs) and drift fit at its defaults redone on the previous run shown (the "
+       "model's kind, inputs and zero); the strongest "
        "is named.</p>\n<table><tr><th style='text-align:left'>run</th><th>model</th><th>none</th>"
        "<th>time only</th><th>previous run</th><th>strongest</th></tr>\n";
   for (const ReportBaseline& c : cells) {
@@ -291,6 +281,7 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   std::ostringstream h;
   h << Head("whirl: machine thermal drift of " + m.error_column, provenance);
   h << "<h2>Model</h2>\n<pre>" << HtmlEscape(FormatModel(m)) << "</pre>\n";
+  if (!fit.candidates.empty()) h << "<pre>" << HtmlEscape(FormatCandidates(fit)) << "</pre>\n";
   if (fit.selected)
     h << SelectionHtml(fit.selection) << SimilarityPlot(&w, fit.selection) << "\n"
       << LevelsPlot(&w, fit.selection) << "\n";

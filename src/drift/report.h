@@ -17,10 +17,11 @@
 
 namespace whirl::drift {
 
-/// One run shown by a model report: MAE [um] of the model and of the sensor-free baselines --
-/// no compensation, a time-only warm-up fitted on the model's training runs (first order in the
-/// time since the run's start, FitWarmUp), the same features refitted on the previous run shown
-/// -- NaN where a baseline does not exist for that run; `strongest` names the smallest
+/// One run shown by a model report: MAE [um] of the model and of the baselines -- no
+/// compensation, a time-only warm-up fitted on the model's training runs (first order in the
+/// time since the run's start, FitWarmUp), the "previous run": drift fit at its defaults redone on
+/// the previous run shown (drift/fit.h PreviousRunOptions, the same as drift monitor --day's) --
+/// NaN where a baseline does not exist for that run; `strongest` names the smallest
 /// ("model", "none", "time only", "previous run"; empty when the run has no measured error).
 struct ReportBaseline {
   std::string run;

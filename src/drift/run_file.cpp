@@ -91,8 +91,16 @@ Run Run::Slice(int begin, int end, const std::string& new_name) const {
   if (begin < 0 || end > samples() || end - begin < 1)
     throw InputError(source + ": rows [" + std::to_string(begin) + ", " + std::to_string(end) +
                      ") are not a non-empty part of its " + std::to_string(samples()) + " rows");
-  Run r = *this;
+  // The metadata only: copying the whole run first (Run r = *this) made cutting a log into k
+  // runs cost k times the log (drift split's memory grew with the square of the runs).
+  Run r;
   r.name = new_name;
+  r.source = source;
+  r.state = state;
+  r.time_from_index = time_from_index;
+  r.sensor_names = sensor_names;
+  r.error_names = error_names;
+  r.other_names = other_names;
   const int n = end - begin;
   r.time_min.assign(time_min.begin() + begin, time_min.begin() + end);
   r.line_numbers.assign(line_numbers.begin() + begin, line_numbers.begin() + end);
@@ -189,8 +197,11 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
                  "is outside the plausible thermal-error range +-100000 um");
       r.error_um(k, static_cast<Eigen::Index>(j)) = t.rows[i][e_cols[j]];
     }
-    for (std::size_t j = 0; j < o_cols.size(); ++j)
+    for (std::size_t j = 0; j < o_cols.size(); ++j) {
+      CheckCellRange(t, i, o_cols[j], -kMaxAbsOtherValue, kMaxAbsOtherValue,
+                     "is outside +-1e15 (no input of a run is that large: a broken cell)");
       r.other(k, static_cast<Eigen::Index>(j)) = t.rows[i][o_cols[j]];
+    }
   }
   bool missing = false;  // a time cell was empty or nan
   if (!time_column.empty())
@@ -200,6 +211,12 @@ Run ParseRun(const std::string& text, const std::string& source, RunState state)
     r.time_min.resize(q);
     for (std::size_t i = 0; i < q; ++i) r.time_min[i] = static_cast<double>(i);
   } else {
+    const std::size_t tc = t.ColumnIndex(time_column);
+    const double unit = time_column == "time_s" ? 60.0 : 1.0;
+    for (std::size_t i = 0; i < q; ++i)
+      CheckCellRange(t, i, tc, -kMaxRunTimeMin * unit, kMaxRunTimeMin * unit,
+                     "is outside +-1e8 min (+-6e9 s, 190 years: even a time since 1970 fits; a "
+                     "larger time is a broken cell)");
     r.time_min = t.IncreasingColumn(time_column);
     if (time_column == "time_s")
       for (double& v : r.time_min) v /= 60.0;
@@ -252,8 +269,15 @@ std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double
     // rows before the first start belong to the first run
     starts.erase(starts.begin() + 1);
   }
+  if (starts.size() > static_cast<std::size_t>(kMaxSplitRuns))
+    throw InputError(run.source + ": column '" + column + "' rises above " +
+                     FormatNumber(threshold) + " " + std::to_string(starts.size()) +
+                     " times: drift split writes at most " + std::to_string(kMaxSplitRuns) +
+                     " run files (one per machine start); raise --threshold, choose another "
+                     "--at column, or split a shorter part of the log");
   starts.push_back(run.samples());
   std::vector<Run> runs;
+  runs.reserve(starts.size() - 1);
   for (std::size_t i = 0; i + 1 < starts.size(); ++i)
     runs.push_back(run.Slice(starts[i], starts[i + 1], run.name + "_" + std::to_string(i + 1)));
   return runs;

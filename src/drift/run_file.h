@@ -15,7 +15,8 @@
 // core/csv.h. A run's state (idle or cutting, Miao et al.'s two conditions) is not in the file: it
 // comes from the command line (--idle / --cutting) or the caller.
 // Limits (resource and plausibility, stated in the messages): at most kMaxRunSamples rows and
-// kMaxRunColumns columns; temperatures within [-60, 400] degC; errors within +-100000 um.
+// kMaxRunColumns columns; temperatures within [-60, 400] degC; errors within +-100000 um; times
+// within +-kMaxRunTimeMin; other columns within +-kMaxAbsOtherValue.
 #include <Eigen/Core>
 #include <filesystem>
 #include <limits>
@@ -29,6 +30,11 @@ inline constexpr int kMaxRunColumns = 512;
 inline constexpr double kMinTemperatureC = -60.0;
 inline constexpr double kMaxTemperatureC = 400.0;
 inline constexpr double kMaxAbsErrorUm = 100000.0;
+/// Largest |time| of a run [min] (time_s: 60 times it): 190 years, so even minutes or seconds
+/// since 1970 fit; 1e300 min would be written back and break every time difference.
+inline constexpr double kMaxRunTimeMin = 1e8;
+/// Largest |value| of any other column (spindle_rpm, power, ... in their own units).
+inline constexpr double kMaxAbsOtherValue = 1e15;
 
 /// Miao et al.'s two operating conditions of a run (plus "not stated").
 enum class RunState { kUnknown, kIdle, kCutting };
@@ -109,9 +115,15 @@ std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
                                              const std::vector<std::string>& comments,
                                              const std::string& what = "run directory");
 
+/// Most runs SplitAtStarts makes (one file each): a log of a year with ten machine starts a day
+/// has 3650; more is a --threshold below the column's idle noise, not machine starts.
+inline constexpr int kMaxSplitRuns = 10000;
+
 /// Cuts one long log into runs, a new run starting at every sample where `column` (an `other`
 /// column such as spindle_rpm) changes from <= threshold to > threshold (a machine start). The
 /// first run also holds the rows before the first start. Names: "<run.name>_<k>" (k from 1).
+/// More than kMaxSplitRuns starts is an InputError naming the file, the column and the count.
+/// Memory: the runs together hold the log once (each Slice copies only its rows).
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold = 0.0);
 
 }  // namespace whirl::drift

@@ -13,15 +13,9 @@ namespace {
 
 using nlohmann::json;
 
-const json& Key(const json& j, const char* key, const std::string& what) {
-  if (!j.is_object() || !j.contains(key))
-    throw InputError(what + ": missing key '" + std::string(key) + "'");
-  return j.at(key);
-}
-
 template <typename T>
 std::vector<T> Fits(const json& j, const char* key, const std::string& what) {
-  const json& a = Key(j, key, what);
+  const json& a = RequireKey(j, key, what);
   if (!a.is_array() || a.size() != static_cast<std::size_t>(Features::kCount))
     throw InputError(what + ": '" + key + "' must hold one fit per output (" +
                      std::to_string(Features::kCount) + ")");
@@ -48,7 +42,7 @@ void CheckInputCount(const std::vector<T>& fits, const TableTransform& t, const 
 
 std::array<int, Features::kCount> Indices(const json& j, const char* key, int count,
                                           const std::string& what) {
-  const json& a = Key(j, key, what);
+  const json& a = RequireKey(j, key, what);
   std::array<int, Features::kCount> out{};
   if (!a.is_array() || a.size() != out.size())
     throw InputError(what + ": '" + key + "' must hold one index per output");
@@ -74,14 +68,14 @@ void to_json(json& j, const FamilyModel& m) {
 
 void from_json(const json& j, FamilyModel& m) {
   const std::string what = "family model";
-  const json& name = Key(j, "candidate", what);
+  const json& name = RequireKey(j, "candidate", what);
   if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
   m.candidate = ParseCandidate(name.get<std::string>());
-  m.transform = Key(j, "transform", what).get<TableTransform>();
+  m.transform = RequireKey(j, "transform", what).get<TableTransform>();
   if (!m.transform.IsIdentity() && !m.candidate.log)
     throw InputError(what + ": 'transform' (" + m.transform.Describe() +
                      ") disagrees with the candidate " + m.candidate.Name());
-  const json& calibration = Key(j, "calibration", what);
+  const json& calibration = RequireKey(j, "calibration", what);
   if (!calibration.is_string()) throw InputError(what + ": 'calibration' must be a string");
   m.calibration = calibration.get<std::string>();
   m.linears.clear();
@@ -93,16 +87,16 @@ void from_json(const json& j, FamilyModel& m) {
     m.gps = Fits<gp::Gp>(j, "gps", what);
     CheckInputCount(m.gps, m.transform, what);
   } else {
-    m.network = Key(j, "network", what).get<nn::Model>();
+    m.network = RequireKey(j, "network", what).get<nn::Model>();
   }
 }
 
 void from_json(const json& j, CvRow& r) {
   const std::string what = "choice table row";
-  const json& name = Key(j, "candidate", what);
+  const json& name = RequireKey(j, "candidate", what);
   if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
   r.candidate = ParseCandidate(name.get<std::string>());
-  const json& rmse = Key(j, "cv_rmse", what);
+  const json& rmse = RequireKey(j, "cv_rmse", what);
   if (!rmse.is_array() || rmse.size() != static_cast<std::size_t>(Features::kCount))
     throw InputError(what + ": 'cv_rmse' must hold one value per output");
   r.cv_rmse.resize(Features::kCount);
@@ -160,8 +154,8 @@ void ReadWeights(const json& j, const std::string& what, Choice* c) {
 
 void from_json(const json& j, Choice& c) {
   const std::string what = "family choice";
-  const json& table = Key(j, "table", what);
-  const json& models = Key(j, "models", what);
+  const json& table = RequireKey(j, "table", what);
+  const json& models = RequireKey(j, "models", what);
   if (!table.is_array() || table.empty() || !models.is_array() || models.empty() ||
       models.size() > std::max<std::size_t>(Features::kCount, table.size()))
     throw InputError(what + ": 'table' must be a non-empty array and 'models' hold 1 to " +

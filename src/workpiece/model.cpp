@@ -70,9 +70,9 @@ WorkpieceModel FamilyFromJson(const json& j) {
   CheckVariables(j, "outputs", nn::ExpectedOutputs());
   WorkpieceModel m;
   m.kind = WorkpieceModel::Kind::kFamily;
-  if (!j.contains("domain")) throw InputError("missing key 'domain'");
-  m.domain_min = DomainVector(j.at("domain"), "min");
-  m.domain_max = DomainVector(j.at("domain"), "max");
+  const json& domain = RequireKey(j, "domain", "workpiece model");
+  m.domain_min = DomainVector(domain, "min");
+  m.domain_max = DomainVector(domain, "max");
   if (!(m.domain_min.array() <= m.domain_max.array()).all())
     throw InputError("'domain.min' must not exceed 'domain.max'");
   for (const auto& [v, key] : {std::pair{&m.domain_min, "domain.min"},
@@ -81,13 +81,11 @@ WorkpieceModel FamilyFromJson(const json& j) {
     for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = (*v)(i);
     CheckProcessInputs(ProcessInputs::FromArray(a), std::string("'") + key + "'");
   }
-  if (!j.contains("training") || !j.at("training").is_object())
-    throw InputError("missing object 'training'");
-  m.training_data = RequireString(j.at("training"), "data", "workpiece model 'training'");
+  const json& training = RequireObject(j, "training", "workpiece model");
+  m.training_data = RequireString(training, "data", "workpiece model 'training'");
   m.training_samples = static_cast<int>(
-      RequireInteger(j.at("training"), "samples", 4, 100000000, "workpiece model 'training'"));
-  if (!j.contains("choice")) throw InputError("missing key 'choice'");
-  m.choice = j.at("choice").get<family::Choice>();
+      RequireInteger(training, "samples", 4, 100000000, "workpiece model 'training'"));
+  m.choice = RequireKey(j, "choice", "workpiece model").get<family::Choice>();
   return m;
 }
 
@@ -243,6 +241,12 @@ nn::OutsideDomainSummary SummarizeOutsideDomain(const std::vector<Prediction>& p
 
 WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
   const json j = ReadJsonFile(path);
+  // Another whirl file (a drift model, a surface, a profile) is named as what it is.
+  for (const char* key : {"format", "schema"})
+    if (j.is_object() && j.contains(key) && j.at(key).is_string() &&
+        j.at(key) != WorkpieceModel::kFormat && j.at(key) != nn::Model::kFormat)
+      throw InputError("model file '" + path.string() + "' is a " + DumpJson(j.at(key), -1) +
+                       " file, not a workpiece model (whirl train writes one)");
   try {
     const bool family =
         j.is_object() && j.contains("format") && j.at("format") == WorkpieceModel::kFormat;
@@ -255,7 +259,7 @@ WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
     const std::string what = e.what();
     throw InputError(what.rfind(prefix, 0) == 0 ? what : prefix + what);
   } catch (const json::exception& e) {
-    throw InputError("model file '" + path.string() + "': " + e.what());
+    throw InputError("model file '" + path.string() + "': " + LibraryRule(e));
   }
 }
 

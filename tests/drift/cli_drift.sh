@@ -104,6 +104,34 @@ assert [r["run"] for r in runs] == ["cut1"], runs
 assert runs[0]["residual"]["rmse_um"] < runs[0]["no_compensation"]["rmse_um"], runs[0]
 EOF2
 
+# --candidates on every command that fits (issue 38): report, crossval and holdout's fit row.
+"$W" drift report --train-idle "$D/idle1.csv" --run "$D/cut1.csv" --error err_um --candidates time \
+  --out-dir "$D/rt" --json > "$D/rt.json" 2> /dev/null || fail "report --candidates time"
+python3 - "$D/rt.json" <<'EOF2' || fail "report --candidates time: $(head -c 400 "$D/rt.json")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["model"]["sensors"] == [], j["model"]
+assert [c["name"] for c in j["candidates"]] == ["time1", "time2"], j["candidates"]
+EOF2
+grep -q "candidates (validation RMSE" "$D/rt/index.html" || fail "report page lacks the candidates"
+grep -q "previous run" "$D/rt/index.html" || fail "report page lacks the previous-run baseline"
+"$W" drift report --train-idle "$D/idle1.csv" --error err_um --candidates sensors --out-dir "$D/rs" \
+  --json > "$D/rs.json" 2> /dev/null || fail "report --candidates sensors"
+grep -q '"time1"' "$D/rs.json" && fail "report --candidates sensors scored a time model"
+"$W" drift crossval --idle "$D/idle1.csv" "$D/idle2.csv" --error err_um --candidates time \
+  > "$D/cvt.txt" 2> /dev/null || fail "crossval --candidates time"
+grep -q "candidates time" "$D/cvt.txt" || fail "crossval does not say its candidates"
+grep -q "elapsed time (tau" "$D/cvt.txt" || fail "crossval --candidates time: no time model"
+"$W" drift holdout --log "$D/idle1.csv" --no-network --candidates time --json > "$D/hot.json" \
+  2> /dev/null || fail "holdout --candidates time"
+python3 - "$D/hot.json" <<'EOF2' || fail "holdout fit row: $(head -c 400 "$D/hot.json")"
+import json, sys
+rows = {r["method"]: r for r in json.load(open(sys.argv[1]))["results"]}
+assert rows["fit"]["test"]["mae_um"] == rows["time"]["test"]["mae_um"], rows["fit"]
+EOF2
+expect_fail "candidates" "$W" drift report --train-idle "$D/idle1.csv" --error err_um \
+  --candidates nonsense --out-dir "$D/never"
+
 # Bad input: clear errors, nothing written.
 printf 'time_min,a_C,err_um\n0,20,0\n1,abc,1\n' > "$D/bad.csv"
 expect_fail "bad.csv:3" "$W" drift fit --run "$D/bad.csv" --error err_um --out "$D/never.json"

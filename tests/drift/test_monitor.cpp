@@ -534,9 +534,7 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   MonitorOptions o;
   o.check_every = 100;
   std::vector<drift::Run> same{MakeRun(p, 2), MakeRun(p, 3)};
-  FitOptions refit;
-  refit.candidates = Candidates::kSensors;
-  const WeekResult quiet = MonitorWeek(m, same, o, refit);
+  const WeekResult quiet = MonitorWeek(m, same, o);
   ASSERT_EQ(quiet.days.size(), 2u);
   for (const auto& d : quiet.days)
     for (const auto& st : d.strategies) {
@@ -550,7 +548,7 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   Planted q = p;
   q.change_min = 0;
   q.w_after = {1.6, 0.1, -0.4};
-  const WeekResult changed = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5)}, o, refit);
+  const WeekResult changed = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5)}, o);
   const StrategyResult& first = Rule(changed.days[0], UpdateRule::kBayes);
   ASSERT_GT(first.recalibrations, 0);
   const StrategyResult& second = Rule(changed.days[1], UpdateRule::kBayes);
@@ -564,6 +562,29 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   const Eigen::MatrixXd x = MonitorDesign(m, MakeRun(q, 5), ReferenceMode::kRunStart);
   EXPECT_NEAR(check->predicted_um, x.row(check->sample).dot(first.final_coefficients), 1e-9);
   EXPECT_FALSE(changed.strongest.empty());
+}
+
+// Issue 45 item 7: --day had no bound (3,000 files were read); a replay takes at most a year of
+// day files, checked before any is read, and together at most one run file's samples.
+TEST(Monitor, DayFilesAreBounded) {
+  EXPECT_NO_THROW(CheckMonitorDays(kMaxMonitorDays));
+  try {
+    CheckMonitorDays(3000);
+    ADD_FAILURE() << "3000 day files accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("3000 day files"), std::string::npos) << e.what();
+  }
+  // Days that hold more samples together than one run file may are refused before any replay.
+  Planted p;
+  const DriftModel m = FitOn(MakeRun(p, 1));
+  p.samples = kMaxRunSamples / 2 + 1;
+  const drift::Run big = MakeRun(p, 2);
+  try {
+    MonitorWeek(m, {big, big}, MonitorOptions{});
+    ADD_FAILURE() << "2 x " << big.samples() << " samples accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("samples together"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

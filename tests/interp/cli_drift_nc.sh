@@ -83,4 +83,40 @@ python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); del j["drift"]; jso
 grep -q '"drift"' "$D/machine_nodrift.json" && fail "the edited profile still has a drift object"
 expect_fail "needs a 'drift' object" "$W" plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 \
   --machine "$D/machine_nodrift.json" --with-drift-action
+# Every model kind `drift fit` can write goes onto the control (issue 45: a time model crashed
+# drift nc): each candidate family, the default, the dynamic kind; NC program and PLC table.
+awk 'BEGIN { print "time_min,t1_C,t2_C,ch1_um";
+  for (k = 0; k < 300; k++) { t1 = 20 + 8 * (1 - exp(-k / 50)) + 0.5 * sin(k / 9); t2 = 21 + 0.02 * k;
+    printf "%d,%.4f,%.4f,%.4f\n", k, t1, t2, 9 * (1 - exp(-k / 70)) + 0.3 * (t1 - 20) + 0.05 * sin(k) } }' \
+  > "$D/warm.csv"
+for cand in auto sensors time time1 time2 sensors+time; do
+  for kind in mlr dynamic; do
+    tag="${cand/+/_}_$kind"
+    "$W" drift fit --run "$D/warm.csv" --error ch1_um --candidates "$cand" --model "$kind" \
+      --out "$D/m_$tag.json" > "$D/fit_$tag.txt" 2>&1 || fail "drift fit --candidates $cand --model $kind"
+    "$W" drift nc --model "$D/m_$tag.json" --machine "$M" --nc "$D/KK_$tag.spf" \
+      --csv "$D/k_$tag.csv" > "$D/nc_$tag.txt" 2>&1 \
+      || fail "drift nc on --candidates $cand --model $kind: $(cat "$D/nc_$tag.txt")"
+    [ -s "$D/KK_$tag.spf" ] && [ -s "$D/k_$tag.csv" ] || fail "drift nc wrote nothing for $tag"
+    grep -Eq '[0-9]e-?[0-9]' "$D/KK_$tag.spf" "$D/k_$tag.csv" && fail "exponent in a control file ($tag)"
+    if tr -d ' \n' < "$D/m_$tag.json" | grep -q '"elapsed_time_constants":\[[0-9]'; then
+      grep -q '^k0_mm,elapsed_lag.*,elapsed,,,,,' "$D/k_$tag.csv" || fail "PLC row of elapsed time ($tag)"
+      grep -q '\*(1-\$AC_PARAM\[' "$D/KK_$tag.spf" || fail "elapsed-time recursion in the NC ($tag)"
+      grep -q "elapsed time is counted here" "$D/KK_$tag.spf" || fail "NC header on elapsed time ($tag)"
+    fi
+  done
+done
+tr -d ' \n' < "$D/m_time1_mlr.json" | grep -q '"elapsed_time_constants":\[[0-9]' \
+  || fail "time1 without a time constant"
+grep -q 'elapsed time is counted here' "$D/KK_time2_mlr.spf" || fail "time2 not put on the control"
+# Elapsed time reads no analog input: --input elapsed=... is refused with the reason.
+expect_fail "counted by the control" "$W" drift nc --model "$D/m_time1_mlr.json" --machine "$M" \
+  --input elapsed=1:1:0 --nc "$D/none.spf"
+# The simulated machine's runs at the default kind dynamic, with its own profile, --csv only.
+"$W" machine sensors --out-dir "$D/sim" --idle 1 --cutting 1 > /dev/null 2>&1 || fail "machine sensors"
+"$W" drift fit --cutting "$D/sim/cutting_1.csv" --error offset_um --model dynamic \
+  --out "$D/sim_model.json" > /dev/null 2>&1 || fail "drift fit on the simulated machine"
+"$W" drift nc --model "$D/sim_model.json" --machine "$SRC/datasets/machines/whirling_840d.json" \
+  --csv "$D/sim.csv" > /dev/null 2>&1 || fail "drift nc --csv on the simulated machine's model"
+[ -s "$D/sim.csv" ] || fail "the simulated machine's PLC table"
 echo "ok"

@@ -126,6 +126,131 @@ TEST(DriftAction, Sd43900FollowsTheModelEvaluatedSampleBySample) {
         }
 }
 
+// A model with elapsed-time warm-up terms (drift fit's time1, time2, sensors+time): the given
+// sensors (none: time-only) without lags, then elapsed lags of `taus` [min]; coefficients
+// intercept, per sensor, per elapsed term.
+drift::DriftModel ElapsedModel(const std::vector<std::string>& sensors,
+                               const std::vector<double>& taus,
+                               const std::vector<double>& coefficients) {
+  drift::DriftModel m;
+  m.error_column = "ch1_um";
+  m.sensors = sensors;
+  m.reference_C = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 25.0);
+  m.elapsed_time_constants = taus;
+  for (const auto& s : m.sensors) m.features.push_back({s, 0.0});
+  for (double t : taus) m.features.push_back({"elapsed", t});
+  const auto nf = static_cast<Eigen::Index>(m.features.size());
+  m.feature_min = Eigen::VectorXd::Constant(nf, -5);
+  m.feature_max = Eigen::VectorXd::Constant(nf, 5);
+  m.linear.coefficients = Eigen::Map<const Eigen::VectorXd>(coefficients.data(), nf + 1);
+  m.linear.covariance = Eigen::MatrixXd::Identity(nf + 1, nf + 1) * 0.01;
+  m.Validate();
+  return m;
+}
+
+// Elapsed time is counted by the actions themselves from the program's start: SD43900 follows the
+// evaluator (x = 0 at the start, 1 - exp(-t / tau) after) for one and two terms and beside
+// sensors, both references; the PLC table's rows rebuild the same value from a_per_cycle; no
+// analog input is asked for "elapsed" (issue 45: the lookup ran past the model's inputs).
+TEST(DriftAction, ElapsedTimeIsCountedByTheControl) {
+  const std::vector<drift::DriftModel> models{
+      ElapsedModel({}, {0.05}, {0.4, 6.0}),
+      ElapsedModel({}, {0.02, 0.1}, {-0.3, 4.0, 2.5}),
+      ElapsedModel({"t1_C", "t2_C"}, {0.07}, {0.2, 1.5, -0.8, 3.0})};
+  for (const drift::DriftModel& m : models)
+    for (auto ref : {DriftReference::kModel, DriftReference::kStart}) {
+      DriftActionOptions o = Options(ControlDk::kAdded, 1, ref);
+      if (m.sensors.empty()) o.inputs.clear();
+      replay::Replay r;
+      SetInputs(r, Options(ControlDk::kAdded, 1, ref), Temperatures(0));
+      const std::string nc = FormatDriftNcProgram(m, o);
+      ASSERT_TRUE(r.RunProgram(nc)) << nc;
+      const Eigen::VectorXd reference =
+          ref == DriftReference::kModel || m.sensors.empty() ? m.reference_C
+                                                             : Eigen::VectorXd(Temperatures(0));
+      drift::DriftEvaluator ev(m, reference);
+      double worst_mm = 0;
+      for (int k = 0; k < 1500; ++k) {  // 1.25 min: 25 of the shortest time constant
+        SetInputs(r, Options(ControlDk::kAdded, 1, ref), Temperatures(k));
+        r.Cycle(0.0);
+        const Eigen::VectorXd raw = m.sensors.empty() ? Eigen::VectorXd() : Eigen::VectorXd(Temperatures(k));
+        const double e_um = ev.Step(k * kCycleMs / 60000.0, raw);
+        worst_mm = std::max(worst_mm, std::abs(r.control.abs_value_mm - Sign(o) * e_um / 1000.0));
+      }
+      EXPECT_LT(worst_mm, 1e-8) << m.sensors.size() << " sensors, " << ToString(ref) << "\n" << nc;
+      // The PLC table: an elapsed row reads no input; its a_per_cycle rebuilds 1 - exp(-t/tau).
+      std::istringstream csv(FormatDriftPlcCsv(m, o));
+      std::string line;
+      int elapsed_rows = 0;
+      while (std::getline(csv, line)) {
+        if (line.rfind("k0_mm,elapsed_lag", 0) != 0) continue;
+        ++elapsed_rows;
+        std::vector<std::string> cell;
+        std::stringstream ls(line);
+        for (std::string c; std::getline(ls, c, ',');) cell.push_back(c);
+        ASSERT_EQ(cell.size(), 10u) << line;
+        EXPECT_EQ(cell[2], "elapsed");
+        EXPECT_EQ(cell[3], "") << "no analog input for elapsed time";
+        const double tau = std::stod(cell[7]), a = std::stod(cell[8]);
+        double x = 0;
+        for (int k = 0; k < 600; ++k) x += a * (1 - x);
+        EXPECT_NEAR(x, 1 - std::exp(-600 * kCycleMs / 60000.0 / tau), 1e-9) << line;
+      }
+      EXPECT_EQ(elapsed_rows, static_cast<int>(m.elapsed_time_constants.size()));
+    }
+}
+
+// A model of 8 sensors with a lag each (16 features, the simulated machine's default fit of
+// issue 45): the sum no longer fits one line of 512 characters, so it is accumulated over several
+// actions; SD43900 still follows the evaluator.
+TEST(DriftAction, LongModelsSumOverSeveralActions) {
+  drift::DriftModel m;
+  m.kind = drift::ModelKind::kDynamic;
+  m.error_column = "offset_um";
+  m.time_constants = {0.05};
+  DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kStart);
+  o.inputs.clear();
+  std::vector<double> c{0.7};
+  for (int i = 0; i < 8; ++i) {
+    const std::string name = "s" + std::to_string(i) + "_C";
+    m.sensors.push_back(name);
+    m.features.push_back({name, 0.0});
+    m.features.push_back({name, 0.05});
+    o.inputs[name] = {i + 1, 0.0625, 0.0};
+    c.push_back(123.4567 * (i % 2 ? -1 : 1) / (i + 1));
+    c.push_back(-45.678 / (i + 1));
+  }
+  m.reference_C = Eigen::VectorXd::Constant(8, 20.0);
+  m.feature_min = Eigen::VectorXd::Constant(16, -5);
+  m.feature_max = Eigen::VectorXd::Constant(16, 5);
+  m.linear.coefficients = Eigen::Map<const Eigen::VectorXd>(c.data(), 17);
+  m.linear.covariance = Eigen::MatrixXd::Identity(17, 17) * 0.01;
+  m.Validate();
+  auto temps = [](int k) {
+    Eigen::VectorXd t(8);
+    for (int i = 0; i < 8; ++i) t(i) = 20 + (i + 1) * (1 - std::exp(-k * kCycleMs / 1000.0 / (5.0 + 3 * i)));
+    return t;
+  };
+  const std::string nc = FormatDriftNcProgram(m, o);
+  std::istringstream lines(nc);
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 512u) << line;
+  replay::Replay r;
+  auto set = [&](const Eigen::VectorXd& t) {
+    for (int i = 0; i < 8; ++i) r.control.ain[i + 1] = t(i) / 0.0625;
+  };
+  set(temps(0));
+  ASSERT_TRUE(r.RunProgram(nc)) << nc;
+  drift::DriftEvaluator ev(m, temps(0));
+  double worst_mm = 0;
+  for (int k = 0; k < 600; ++k) {
+    set(temps(k));
+    r.Cycle(0.0);
+    const double e_um = ev.Step(k * kCycleMs / 60000.0, temps(k));
+    worst_mm = std::max(worst_mm, std::abs(r.control.abs_value_mm - Sign(o) * e_um / 1000.0));
+  }
+  EXPECT_LT(worst_mm, 1e-8) << nc;
+}
+
 TEST(DriftAction, CombinedWithAPlanOneWriterAddsBothParts) {
   std::mt19937 rng(1805);
   const drift::DriftModel m = HandModel(true, rng);
@@ -567,6 +692,15 @@ TEST(DriftAction, GoldenProgramAndPlcTable) {
       std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action_slope.spf";
   if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path_slope, nc_slope);
   EXPECT_EQ(nc_slope, ReadTextFile(path_slope)) << "actual:\n" << nc_slope;
+  // Sensors with two elapsed-time warm-up terms (drift fit's candidates with time).
+  const drift::DriftModel e = ElapsedModel({"t1_C", "t2_C"}, {35.5, 240.0}, {0.6, 1.5, -0.8, 3.25, 1.75});
+  const DriftActionOptions oe = Options(ControlDk::kAdded, 1, DriftReference::kStart);
+  const std::string nc_elapsed = FormatDriftNcProgram(e, oe, "golden model") +
+                                 FormatDriftNcResetProgram(oe) + FormatDriftPlcCsv(e, oe);
+  const std::string path_elapsed =
+      std::string(WHIRL_SOURCE_DIR) + "/tests/interp/golden/drift_action_elapsed.spf";
+  if (std::getenv("WHIRL_UPDATE_GOLDEN") != nullptr) WriteFileAtomic(path_elapsed, nc_elapsed);
+  EXPECT_EQ(nc_elapsed, ReadTextFile(path_elapsed)) << "actual:\n" << nc_elapsed;
 }
 
 }  // namespace
