@@ -580,7 +580,7 @@ TEST(Monitor, DayFilesAreBounded) {
   p.samples = kMaxRunSamples / 2 + 1;
   const drift::Run big = MakeRun(p, 2);
   try {
-    MonitorWeek(m, {big, big}, MonitorOptions{}, FitOptions{});
+    MonitorWeek(m, {big, big}, MonitorOptions{});
     ADD_FAILURE() << "2 x " << big.samples() << " samples accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("samples together"), std::string::npos) << e.what();
