@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/run_program.h"
 
 namespace whirl {
 namespace {
@@ -245,6 +246,9 @@ std::string UnprovenStaging(const fs::path& s, const std::string& what) {
     const std::string entry = it->path().filename().string();
     if (entry == kStagingRecord || IsWhirlTemporary(entry)) continue;
     const auto f = record.files.find(entry);
+    if (f != record.files.end() && f->second == kProgramOutput &&
+        fs::is_regular_file(it->symlink_status()))
+      continue;  // named before whirl started the program that writes it
     if (f == record.files.end() || f->second.empty() || FileSha256(it->path()) != f->second)
       return QuotedPath(entry) + ", which whirl did not put there (or which changed since)";
   }
@@ -358,8 +362,14 @@ void RemoveStaleStaging(const fs::path& s) {
     record = ReadListing(s / kStagingRecord, s.string(), "whirl.output_dir.staging");
   } catch (const InputError&) {
   }
-  for (const auto& [name, hash] : record.files) RemoveProvenFile(s / name, hash);
   std::error_code ec;
+  for (const auto& [name, hash] : record.files) {
+    if (hash != kProgramOutput) {
+      RemoveProvenFile(s / name, hash);
+    } else if (fs::is_regular_file(fs::symlink_status(s / name, ec))) {
+      fs::remove(s / name, ec);  // UnprovenStaging accepted it as the program's
+    }
+  }
   std::vector<fs::path> temporaries;
   for (fs::directory_iterator it(s, ec), end; !ec && it != end; it.increment(ec))
     if (IsWhirlTemporary(it->path().filename().string()) &&
@@ -453,16 +463,22 @@ void OutputDir::Insert(const std::string& name, std::string contents) {
   files_.emplace_back(name, std::move(contents));
 }
 
-void OutputDir::Stage(const std::string& name, const std::string& contents, bool write) {
-  staged_[name] = Sha256Hex(contents);
+void OutputDir::WriteStagingRecord() const {
   Listing record;
   record.files = staged_;
-  // The record first: a run killed between the two leaves a recorded name without its file
-  // (harmless), never a file the next run cannot prove.
   WriteFileAtomic(staging_ / kStagingRecord,
                   ListingText(record, "whirl.output_dir.staging",
-                              "what whirl put into this staging folder, with SHA-256; a later "
-                              "run removes only these files once this run is gone"));
+                              "what whirl put into this staging folder, with SHA-256 (or " +
+                                  std::string(kProgramOutput) +
+                                  ": a file a program whirl ran was told to write); a later run "
+                                  "removes only these files once this run is gone"));
+}
+
+void OutputDir::Stage(const std::string& name, const std::string& contents, bool write) {
+  staged_[name] = Sha256Hex(contents);
+  // The record first: a run killed between the two leaves a recorded name without its file
+  // (harmless), never a file the next run cannot prove.
+  WriteStagingRecord();
   if (write) WriteFileAtomic(staging_ / name, contents);
 }
 
@@ -488,6 +504,20 @@ const fs::path& OutputDir::Staging() {
   staging_ = s;
   for (const auto& [name, text] : files_) Stage(name, text, true);
   return staging_;
+}
+
+int OutputDir::RunInStaging(const std::vector<std::string>& argv, const std::string& log,
+                            const std::vector<std::string>& outputs) {
+  const fs::path stage = fs::absolute(Staging());
+  for (const auto& name : outputs) {
+    if (!ValidEntryName(name))
+      throw InputError(what_ + ": " + QuotedPath(name) + " is not an entry name");
+    if (!staged_.count(name)) staged_[name] = kProgramOutput;
+  }
+  if (!ValidEntryName(log)) throw InputError(what_ + ": " + QuotedPath(log) + " is not an entry name");
+  if (!staged_.count(log)) staged_[log] = kProgramOutput;
+  WriteStagingRecord();
+  return RunProgram(argv, stage, stage / log);
 }
 
 void OutputDir::AddStaged(const std::string& name) {

@@ -22,6 +22,9 @@ inline constexpr const char* kOutputManifest = ".whirl-output.json";
 /// with their SHA-256 (schema "whirl.output_dir.staging"), so a later run can remove the folder
 /// of a killed run without removing anything else.
 inline constexpr const char* kStagingRecord = ".whirl-stage.json";
+/// The staging record's "hash" of a file a program run by whirl writes (OutputDir::RunInStaging):
+/// its content is not known in advance, its name is.
+inline constexpr const char* kProgramOutput = "program-output";
 
 /// The rule below in a few words, for --help texts of directory flags.
 inline constexpr const char* kOutputDirRule =
@@ -86,6 +89,14 @@ class OutputDir {
   /// Adds the file `name` a program wrote into Staging() (binary safe).
   void AddStaged(const std::string& name);
 
+  /// Runs `argv` (e.g. gnuplot) in Staging() with its output and errors in the file `log`
+  /// there, and returns its exit status (RunProgram). Before it starts, `log` and `outputs` (the
+  /// files the program is told to write) are recorded as the program's in the staging record
+  /// (kProgramOutput instead of a hash): if this run is killed while the program runs, the next
+  /// run can prove those names are whirl's and remove them. Add what it wrote with AddStaged.
+  int RunInStaging(const std::vector<std::string>& argv, const std::string& log,
+                   const std::vector<std::string>& outputs);
+
   /// Writes every added file, the manifest and `also` (files outside the directory, e.g. the
   /// --out JSON beside a --report) all-or-nothing; re-checks the rule first. Returns the paths
   /// of the added files.
@@ -96,6 +107,7 @@ class OutputDir {
   void Insert(const std::string& name, std::string contents);  // checks the name, keeps it
   // Records `name` with its hash in the staging folder's record (and writes it there if `write`).
   void Stage(const std::string& name, const std::string& contents, bool write);
+  void WriteStagingRecord() const;  // staged_ into the staging folder's kStagingRecord
 
   std::filesystem::path dir_;
   std::string what_;

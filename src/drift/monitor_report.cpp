@@ -371,8 +371,8 @@ std::string RenderMonitorPlot(const fs::path& dir, const std::string& gnuplot, O
   if (!ProgramSucceeds({gnuplot, "--version"})) {
     warnings->push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
   } else {
-    const fs::path stage = fs::absolute(files.Staging());  // gnuplot renders there
-    if (RunProgram({gnuplot, script}, stage, stage / (prefix + "gnuplot.log")) == 0 &&
+    const fs::path stage = files.Staging();  // gnuplot renders there
+    if (files.RunInStaging({gnuplot, script}, prefix + "gnuplot.log", {png}) == 0 &&
         fs::is_regular_file(stage / png, ec)) {
       files.AddStaged(png);
       img = "<img src='" + HtmlEscape(png) + "' alt='monitor timeline'>";

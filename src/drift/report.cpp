@@ -40,8 +40,8 @@ class ReportWriter {
                            kTerminal + "set output " + GnuplotString(png) + "\n" + body);
     if (have_gnuplot_) {
       // gnuplot never sees the output directory: it renders in the staging folder.
-      const fs::path stage = fs::absolute(out_.Staging());
-      const int rc = RunProgram({gnuplot_, stem + ".gp"}, stage, stage / "gnuplot.log");
+      const int rc = out_.RunInStaging({gnuplot_, stem + ".gp"}, "gnuplot.log", {png});
+      const fs::path stage = out_.Staging();
       std::error_code ec;
       if (rc == 0 && fs::is_regular_file(stage / png, ec) && fs::file_size(stage / png, ec) > 0) {
         out_.AddStaged(png);
