@@ -219,12 +219,23 @@ void OutputDir::AddStaged(const std::string& name) {
   Insert(name, ReadTextFile(staging_ / name));
 }
 
-std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, std::string>>& also) {
+void OutputDir::AddReady(const std::string& name, const fs::path& ready) {
+  if (!ValidEntryName(name) || IsWhirlTemporary(name))
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": " + QuotedPath(name) +
+                     " is not a file name whirl may write there");
+  if (!names_.insert(name).second)
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": two outputs named " + QuotedPath(name));
+  ready_.push_back({dir_ / name, ready});
+}
+
+std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, std::string>>& also,
+                                        const std::vector<ReadyFile>& also_ready) {
   const std::set<std::string> before = Inspect(dir_, what_);  // the rule again, just before writing
   Create();
   RemoveStaleTemporaries(dir_);
   std::set<std::string> now(kept_.begin(), kept_.end());
   for (const auto& f : files_) now.insert(f.first);
+  for (const auto& r : ready_) now.insert(r.path.filename().string());
   std::set<std::string> all = now;
   all.insert(before.begin(), before.end());
   std::vector<std::pair<fs::path, std::string>> batch;
@@ -237,7 +248,10 @@ std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, st
   // Until the old files are gone the manifest lists them too, so a run killed in between
   // leaves a directory the next run accepts.
   batch.emplace_back(dir_ / kOutputManifest, ManifestText(all));
-  WriteFilesAtomic(batch);
+  std::vector<ReadyFile> ready = ready_;
+  for (const auto& r : ready_) written.push_back(r.path);
+  ready.insert(ready.end(), also_ready.begin(), also_ready.end());
+  WriteFilesAtomic(batch, ready);
   committed_ = true;
   std::error_code ec;
   if (!staging_.empty()) fs::remove_all(staging_, ec);
