@@ -16,6 +16,9 @@ namespace {
 // slope model's three again plus one for S_m. $AC_PARAM: the liveness slot, the model's
 // feature, reference and flag, and with the slope object the slope model's three and S_m.
 constexpr int kMinPlanIds = 2;
+// Upper bounds of the control section (machine data counts far beyond any 840D: typing errors).
+constexpr long long kMaxSyncElements = 1000000;
+constexpr long long kMaxAcParams = 10000;
 int MinDriftIds(const DriftActionOptions& d) { return d.has_slope ? 8 : 4; }
 int MinDriftSlots(const DriftActionOptions& d) { return d.has_slope ? 8 : 4; }
 
@@ -28,10 +31,21 @@ ControlLimits ReadControlSection(const nlohmann::json& j, const std::string& wha
   const std::string w = what + ", object 'control'";
   if (!j.is_object()) throw InputError(w + ": must be a JSON object");
   RejectUnknownKeys(j, {"md10300_analog_inputs", "md28250_sync_elements", "md28254_ac_params"}, w);
+  // Each value within its machine datum's range where it is read: no value may stand for "not
+  // stated" (-1 once switched every check of the control's limits off).
+  const auto datum = [&](const char* key, long long lo, long long hi, const char* name) {
+    try {
+      return static_cast<int>(RequireInteger(j, key, lo, hi, w));
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + " (" + name + " of the control)");
+    }
+  };
   ControlLimits c;
-  c.analog_inputs = RequireInt(j, "md10300_analog_inputs", w);
-  c.sync_elements = RequireInt(j, "md28250_sync_elements", w);
-  c.ac_params = RequireInt(j, "md28254_ac_params", w);
+  c.analog_inputs =
+      datum("md10300_analog_inputs", 0, kMaxAnalogIndex, "MD10300 $MN_FASTIO_ANA_NUM_INPUTS");
+  c.sync_elements =
+      datum("md28250_sync_elements", 1, kMaxSyncElements, "MD28250 $MC_MM_NUM_SYNC_ELEMENTS");
+  c.ac_params = datum("md28254_ac_params", 1, kMaxAcParams, "MD28254 $MC_MM_NUM_AC_PARAM");
   return c;
 }
 
@@ -72,13 +86,16 @@ DriftActionOptions ReadDriftSection(const nlohmann::json& j, const std::string& 
   d.save_r_first = RequireInt(j, "save_r_first", w);
   d.ipo_cycle_ms = RequireNumber(j, "ipo_cycle_ms", w);
   d.error_direction = RequireInt(j, "error_direction", w);
+  // Optional slots are absent or a slot: -1 ("none", the in-memory default) is not a value a
+  // file may give, and param_last bounds the action's slots (no value lifts the bound).
   if (j.contains("workpiece_k0_param"))
-    d.workpiece_k0_param = RequireInt(j, "workpiece_k0_param", w);
+    d.workpiece_k0_param = static_cast<int>(RequireInteger(j, "workpiece_k0_param", 0, 9999, w));
   if (j.contains("workpiece_slope_param"))
-    d.workpiece_slope_param = RequireInt(j, "workpiece_slope_param", w);
+    d.workpiece_slope_param =
+        static_cast<int>(RequireInteger(j, "workpiece_slope_param", 0, 9998, w));
   if (j.contains("missing_alarm")) d.missing_alarm = RequireInt(j, "missing_alarm", w);
   if (version >= 2 || j.contains("param_last")) {
-    d.param_last = RequireInt(j, "param_last", w);
+    d.param_last = static_cast<int>(RequireInteger(j, "param_last", 0, 9999, w));
   } else {
     d.param_last = DefaultParamLast(d);
     if (d.param_last < d.param_first + 3)

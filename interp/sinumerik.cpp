@@ -408,7 +408,8 @@ std::string FormatPlcCsv(const CompensationPlan& plan, const std::vector<std::st
          (o.direction > 0 ? "+" : "-") +
          "), write SD43900 $SA_TEMP_COMP_ABS_VALUE, SD43910 $SA_TEMP_COMP_SLOPE, SD43920 "
          "$SA_TEMP_COMP_REF_POSITION of that row; before the first row save the three values "
-         "found, and at the row 'restore' (thread end) write the saved values back\n";
+         "found (if an earlier cut never reached its row 'restore', write its saved values back "
+         "first), and at the row 'restore' (thread end) write the saved values back\n";
   out += "# start only with the axis before the first row's trigger_position_mm (at or past it "
          "every passed row would be due at once: raise alarm " +
          std::to_string(o.start_alarm) +
@@ -538,8 +539,8 @@ std::string CancelIds(const PlanOptions& o) {
 
 std::string R(int n) { return "R" + std::to_string(n); }
 
-// Part-program lines (preprocessing) that save the found setting data once (combined: not
-// SD43900, which the drift action owns).
+// Part-program lines (preprocessing) that save the found setting data (combined: not SD43900,
+// which the drift action owns) and set the marker.
 std::string SaveFoundValues(const PlanOptions& o) {
   const std::string& ax = o.axis;
   const int m = o.save_r_first;
@@ -561,6 +562,34 @@ std::string RestoredSlope(const PlanOptions& o, const std::string& r_prefix) {
 }
 std::string RestoredRef(const PlanOptions& o, const std::string& r_prefix) {
   return SlopeHandedOver(o) ? "0" : r_prefix + R(o.save_r_first + 2);
+}
+
+// The writes that give back what a run found: the slope first, so that, when the saved slope is
+// 0, every intermediate state is a constant offset. `r_prefix` "" in the part program.
+std::string RestoreWrites(const PlanOptions& o) {
+  return SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n" + RefTarget(o, "$") + "=" +
+         RestoredRef(o, "") + "\n" + K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+}
+
+// Part-program lines that undo an earlier run which never reached its restore (a cut aborted or a
+// power failure mid-cut: its marker R<m+3> is still 1, the setting data hold its segment values):
+// the values it saved are written back and the marker cleared, exactly as the reset program
+// does, so the approach of this run applies what the control had before that run and the save
+// below finds it again. The plan's own $AC_PARAM slots (combined) return to 0 unconditionally:
+// nothing else writes them, and before the thread start the plan's part is 0.
+std::string UndoEarlierRun(const PlanOptions& o) {
+  // Handed over: slope and K0 slots to 0 (slope first); the reference slot may stay, since with
+  // both at 0 the plan adds nothing wherever its reference lies.
+  if (SlopeHandedOver(o))
+    return SlopeTarget(o, "$") + "=0\n" + K0Target(o, "$") + "=0\n";
+  const int m = o.save_r_first;
+  std::string writes = RestoreWrites(o);
+  std::string slots;
+  if (Combined(o)) {  // K0 is the plan's slot: out of the IF, unconditional
+    slots = K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+    writes.erase(writes.find(slots), slots.size());
+  }
+  return slots + "IF " + R(m + 3) + "==1\n" + writes + R(m + 3) + "=0\nENDIF\n";
 }
 
 // Combined: refuse to start unless the drift action says it is active (else K0 would be lost).
@@ -602,7 +631,20 @@ void HeaderControl(std::ostringstream& nc, const CompensationPlan& plan, const N
      << (o.direction > 0 ? " < " : " > ") << start << " mm (MCS); at or past it the program raises "
      << "alarm " << o.start_alarm << " (axis at or past the thread start: no resume from "
      << "mid-thread) and changes nothing: run " << info.reset_program_name
-     << ", move the axis before the thread start and cut the whole thread again\n";
+     << " (or let this program undo the aborted run when it is called again), move the axis "
+        "before the thread start and cut the whole thread again\n";
+  if (SlopeHandedOver(o))
+    nc << "; before its actions it sets its K0 and slope slots $AC_PARAM["
+       << o.workpiece_k0_param << "], [" << o.workpiece_slope_param
+       << "] to 0 (values an aborted run may have left there), so the approach applies the drift "
+          "action's own value\n";
+  else
+    nc << "; after an aborted cut or a power failure mid-cut (marker " << R(o.save_r_first + 3)
+       << " still 1) it first writes back the setting data that run saved"
+       << (Combined(o) ? " and sets $AC_PARAM[" + std::to_string(o.workpiece_k0_param) + "] to 0"
+                       : std::string())
+       << ", as " << info.reset_program_name
+       << " would, so the approach applies what the control had before that run\n";
   nc << "; after a failed check (alarm) the program jumps to " << kProgramEndLabel
      << " and cancels, saves and writes nothing, whatever the alarm's response; if that response "
         "does not stop the program, the calling program goes on without whirl's compensation\n";
@@ -722,7 +764,7 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   auto k0 = [](double v) { return FormatFixed(v, kDecimalsSd43900Mm); };
   auto slope = [](double v) { return FormatFixed(v, kDecimalsSd43910); };
   std::string nc = Header(plan, info) + RequireAxisBeforeStart(plan) + RequireDriftAction(o) +
-                   CancelIds(o) + "STOPRE\n" + SaveFoundValues(o);
+                   CancelIds(o) + "STOPRE\n" + UndoEarlierRun(o) + SaveFoundValues(o);
   // Every segment, the first included, is a position-triggered action: with the axis before the
   // thread start (checked above) nothing of the plan applies until the axis reaches it, so the
   // first segment's slope is never extrapolated to where the axis is parked.
@@ -751,10 +793,7 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
                    ": restores the SINUMERIK 840D temperature "
                    "compensation of axis " +
                    ax + " after an aborted " + info.program_name + " run\n";
-  // The slope first: when the saved slope is 0, every intermediate state is a constant offset.
-  const std::string writes = SlopeTarget(o, "$") + "=" + RestoredSlope(o, "") + "\n" +
-                             RefTarget(o, "$") + "=" + RestoredRef(o, "") + "\n" +
-                             K0Target(o, "$") + "=" + RestoredK0(o, "") + "\n";
+  const std::string writes = RestoreWrites(o);
   if (SlopeHandedOver(o)) {  // only the plan's own $AC_PARAM slots: cleared unconditionally
     nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
           std::to_string(o.sync_id_last) + ", then sets the plan's K0, slope and reference in " +

@@ -287,8 +287,13 @@ struct NcProgramInfo {
 ///   [with a drift action on the machine: its liveness check, alarms drift_missing_alarm + 0..2,
 ///     each followed by the jump to WHIRL_END likewise];
 ///   CANCEL(n) for every ID of [sync_id_first, sync_id_last] (stale actions of an aborted run);
-///   STOPRE; IF R<m+3><>1: save SD43900/43910/43920 into R<m>..R<m+2> (m = save_r_first), set
-///   the marker R<m+3>=1 (a rerun after an abort does not save whirl's own values);
+///   STOPRE; IF R<m+3>==1 (an earlier run never reached its restore: an aborted cut, a power
+///     failure mid-cut): write back the values it saved in R<m>..R<m+2>, slope first, and clear
+///     the marker, as the reset program does, so the approach applies what the control had before
+///     that run (combined: the plan's K0 slot returns to 0 unconditionally; with the slope handed
+///     over there is no marker and only its K0 and slope slots are set to 0);
+///   IF R<m+3><>1: save SD43900/43910/43920 into R<m>..R<m+2> (m = save_r_first), set the marker
+///     R<m+3>=1;
 ///   ID=<id> WHEN $AA_IM[<axis>]>=<P_A> DO $$SA_TEMP_COMP_ABS_VALUE[<axis>]=...
 ///        $$SA_TEMP_COMP_SLOPE[<axis>]=... $$SA_TEMP_COMP_REF_POSITION[<axis>]=...
 ///     one modal action per segment, the first at the thread start, so nothing of the plan is

@@ -213,6 +213,7 @@ void CommitOutputs(const MonitorArgs& a, TimelineFiles& t, const std::string& ev
 }
 
 void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
+  drift::CheckMonitorDays(a.days.size());  // before reading thousands of files
   std::vector<std::filesystem::path> days(a.days.begin(), a.days.end());
   const bool time_from_index = drift::ScanRun(days.front()).time_from_index;
   ApplyIntervals(a, time_from_index);

@@ -189,6 +189,14 @@ void ForwardDeprecated(CLI::Option* current, const std::string& old_flag, const 
   if (current->count() > 0)
     throw CLI::ValidationError(
         old_flag, "give " + now + " only (" + old_flag + " is its deprecated spelling), not both");
+  // The alias is hidden, so CLI11's own "At Most 1 required but received 2" would name no flag.
+  const int most = current->get_expected_max() * current->get_type_size_max();
+  if (most > 0 && static_cast<int>(values.size()) > most)
+    throw CLI::ValidationError(old_flag, "given more than once (" +
+                                             std::to_string(values.size()) + " values, at most " +
+                                             std::to_string(most) +
+                                             "): give it once (it is the deprecated spelling of " +
+                                             now + ")");
   std::fprintf(stderr, "whirl: %s is deprecated, use %s\n", old_flag.c_str(), use.c_str());
   TypedOldSpellings().emplace_back(now, old_flag);
   for (const auto& v : values) current->add_result(v);
@@ -217,7 +225,8 @@ CLI::Option* AddDeprecatedAlias(CLI::App* sub, CLI::Option* current, const std::
                               return true;
                             })
                 ->type_size(current->get_type_size_min(), current->get_type_size_max())
-                ->expected(current->get_expected_min(), current->get_expected_max());
+                ->expected(current->get_expected_min(), current->get_expected_max())
+                ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);  // counted above
   }
   return alias->group("");  // hidden from --help
 }

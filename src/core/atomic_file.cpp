@@ -99,20 +99,19 @@ bool ParseTemporary(const std::string& name, std::string* target, long* pid) {
   return false;
 }
 
-// Removes the temporaries in `dir` whose process is gone: all (`targets` null) or those of the
-// named targets. One pass over the directory.
+// Removes the file temporaries in `dir` whose process is gone: all (`targets` null) or those of
+// the named targets. One pass over the directory. Staging folders (and anything named like one)
+// are left to core/output_dir.h, which removes only what their record proves whirl put there.
 void RemoveStale(const fs::path& dir, const std::set<std::string>* targets) {
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     std::string target;
     long pid = 0;
-    if (!ParseTemporary(it->path().filename().string(), &target, &pid) || !ProcessIsGone(pid) ||
-        (targets && targets->count(target) == 0))
+    if (!ParseTemporary(it->path().filename().string(), &target, &pid) || target.empty() ||
+        !ProcessIsGone(pid) || (targets && targets->count(target) == 0))
       continue;
     std::error_code rm;
-    if (fs::is_directory(it->symlink_status(rm)))  // a staging folder
-      fs::remove_all(it->path(), rm);
-    else
+    if (!fs::is_directory(it->symlink_status(rm)))
       fs::remove(it->path(), rm);  // a file, or a link itself (never what it points to)
   }
 }

@@ -93,9 +93,10 @@ std::string WhirlTemporaryName(const std::string& base, const char* kind);
 /// WhirlTemporaryName); `pid` (optional) receives the id of the process that made it.
 bool IsWhirlTemporary(const std::string& name, long* pid = nullptr);
 
-/// Removes from `dir` the whirl temporaries (files and staging folders) whose process no longer
-/// runs; with `target` (a file name), only those of that target. Never follows a symbolic link and
-/// never throws (what cannot be removed stays).
+/// Removes from `dir` the whirl file temporaries whose process no longer runs; with `target` (a
+/// file name), only those of that target. Staging folders are left to core/output_dir.h (it
+/// removes only what their record proves). Never follows a symbolic link and never throws (what
+/// cannot be removed stays).
 void RemoveStaleTemporaries(const std::filesystem::path& dir, const std::string& target = "");
 
 /// Reads a whole text file; throws InputError naming the path if it cannot be opened, is not a

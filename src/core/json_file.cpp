@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -29,6 +30,56 @@ std::string Untagged(const std::string& message) {
              : message;
 }
 
+// A value as the messages show it: compact JSON, cut after 60 characters (a message about a
+// megabyte array must not repeat it).
+std::string Shown(const nlohmann::json& v) {
+  const std::string text = DumpJson(v, -1);
+  return text.size() > 60 ? text.substr(0, 57) + "..." : text;
+}
+
+// Watches nlohmann's parse (its callback) for the first key given twice in one object: JSON
+// allows it and nlohmann keeps the last value, so a file could say two things at once.
+class DuplicateKeys {
+ public:
+  bool Event(nlohmann::json::parse_event_t event, const nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    if (event == E::object_start || event == E::array_start) {
+      Element();
+      levels_.push_back({event == E::object_start, {}, {}, -1});
+    } else if (event == E::object_end || event == E::array_end) {
+      if (!levels_.empty()) levels_.pop_back();
+    } else if (event == E::key && !levels_.empty()) {
+      Level& top = levels_.back();
+      top.key = parsed.is_string() ? parsed.get<std::string>() : std::string();
+      if (!top.keys.insert(top.key).second && first_.empty()) first_ = Path();
+    } else if (event == E::value) {
+      Element();
+    }
+    return true;  // keep everything: the file is refused afterwards if first_ is set
+  }
+  /// The path of the first duplicate ("drift.analog_inputs.t3_C", "runs[2].name"); empty if none.
+  const std::string& first() const { return first_; }
+
+ private:
+  struct Level {
+    bool object = false;
+    std::set<std::string> keys;
+    std::string key;
+    long index = -1;
+  };
+  void Element() {
+    if (!levels_.empty() && !levels_.back().object) ++levels_.back().index;
+  }
+  std::string Path() const {
+    std::string path;
+    for (const Level& l : levels_)
+      path += l.object ? (path.empty() ? "" : ".") + l.key : "[" + std::to_string(l.index) + "]";
+    return path;
+  }
+  std::vector<Level> levels_;
+  std::string first_;
+};
+
 std::string List(std::initializer_list<const char*> items) {
   std::string list;
   for (const char* a : items) list += std::string(list.empty() ? "" : ", ") + a;
@@ -39,8 +90,14 @@ std::string List(std::initializer_list<const char*> items) {
 
 nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
   const std::string text = ReadTextFile(path);
+  DuplicateKeys duplicates;
+  nlohmann::json j;
   try {
-    return nlohmann::json::parse(text);  // skips a UTF-8 byte-order mark, rejects invalid UTF-8
+    // Skips a UTF-8 byte-order mark, rejects invalid UTF-8.
+    j = nlohmann::json::parse(text, [&duplicates](int, nlohmann::json::parse_event_t event,
+                                                  nlohmann::json& parsed) {
+      return duplicates.Event(event, parsed);
+    });
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError("'" + path.string() + "' is not valid JSON (byte " + std::to_string(e.byte) +
                      "): " + Untagged(e.what()));
@@ -48,7 +105,14 @@ nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
     throw InputError("'" + path.string() + "': " + Untagged(e.what()) +
                      " (rule: numbers must lie within the double range, |x| < 1.8e308)");
   }
+  if (!duplicates.first().empty())
+    throw InputError("'" + path.string() + "': key '" + duplicates.first() +
+                     "' is given twice in one object (rule: each key once; JSON readers differ "
+                     "in which value counts, so whirl refuses the file: keep one)");
+  return j;
 }
+
+std::string LibraryRule(const nlohmann::json::exception& e) { return Untagged(e.what()); }
 
 std::string DumpJson(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
@@ -79,9 +143,9 @@ const nlohmann::json& RequireKey(const nlohmann::json& j, const std::string& key
 }
 
 double RequireFiniteValue(const nlohmann::json& v, const std::string& where) {
-  if (!v.is_number()) throw InputError(where + " must be a number, got " + DumpJson(v, -1));
+  if (!v.is_number()) throw InputError(where + " must be a number, got " + Shown(v));
   const double x = v.get<double>();
-  if (!std::isfinite(x)) throw InputError(where + " must be finite, got " + DumpJson(v, -1));
+  if (!std::isfinite(x)) throw InputError(where + " must be finite, got " + Shown(v));
   return x;
 }
 
@@ -90,13 +154,13 @@ long long RequireWholeValue(const nlohmann::json& v, const std::string& where, d
   RequireFiniteValue(v, where);
   if (!IsWholeIn(v, min, max))
     throw InputError(where + " must be a whole number in [" + FormatNumber(min) + ", " +
-                     FormatNumber(max) + "], got " + DumpJson(v, -1));
+                     FormatNumber(max) + "], got " + Shown(v));
   return static_cast<long long>(v.get<double>());
 }
 
 std::vector<double> RequireNumbers(const nlohmann::json& v, const std::string& where) {
   if (!v.is_array())
-    throw InputError(where + " must be an array of numbers, got " + DumpJson(v, -1));
+    throw InputError(where + " must be an array of numbers, got " + Shown(v));
   std::vector<double> out;
   out.reserve(v.size());
   for (std::size_t i = 0; i < v.size(); ++i)
@@ -126,7 +190,7 @@ long long RequireInteger(const nlohmann::json& j, const char* key, long long min
   const std::string rule =
       "must be a whole number in " + std::to_string(min) + ".." + std::to_string(max);
   if (!IsWholeIn(v, static_cast<double>(min), static_cast<double>(max)))
-    throw InputError(what + ": '" + key + "' = " + DumpJson(v, -1) + " breaks the rule: " + rule);
+    throw InputError(what + ": '" + key + "' = " + Shown(v) + " breaks the rule: " + rule);
   return static_cast<long long>(v.get<double>());
 }
 
@@ -134,7 +198,7 @@ std::string RequireString(const nlohmann::json& j, const char* key, const std::s
                           std::size_t max_length) {
   const auto& v = At(j, key, what);
   if (!v.is_string())
-    throw InputError(what + ": '" + key + "' must be a string, got " + DumpJson(v, -1));
+    throw InputError(what + ": '" + key + "' must be a string, got " + Shown(v));
   std::string s = v.get<std::string>();
   if (s.size() > max_length)
     throw InputError(what + ": '" + key + "' has " + std::to_string(s.size()) +
@@ -142,12 +206,63 @@ std::string RequireString(const nlohmann::json& j, const char* key, const std::s
   return s;
 }
 
+const nlohmann::json& RequireObject(const nlohmann::json& j, const char* key,
+                                    const std::string& what) {
+  const auto& v = At(j, key, what);
+  if (!v.is_object())
+    throw InputError(what + ": '" + key + "' must be a JSON object, got " + Shown(v));
+  return v;
+}
+
+const nlohmann::json& RequireArray(const nlohmann::json& j, const char* key, const std::string& what,
+                                   std::size_t max_count) {
+  const auto& v = At(j, key, what);
+  if (!v.is_array()) throw InputError(what + ": '" + key + "' must be an array, got " + Shown(v));
+  if (v.size() > max_count)
+    throw InputError(what + ": '" + key + "' has " + std::to_string(v.size()) +
+                     " elements; the limit is " + std::to_string(max_count));
+  return v;
+}
+
+std::vector<std::string> RequireStrings(const nlohmann::json& j, const char* key,
+                                        const std::string& what, std::size_t max_count,
+                                        std::size_t max_length) {
+  const auto& a = RequireArray(j, key, what, max_count);
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string where = what + ": '" + key + "'[" + std::to_string(i) + "]";
+    if (!a[i].is_string()) throw InputError(where + " must be a string, got " + Shown(a[i]));
+    if (a[i].get_ref<const std::string&>().size() > max_length)
+      throw InputError(where + " has " + std::to_string(a[i].get_ref<const std::string&>().size()) +
+                       " bytes; the limit is " + std::to_string(max_length));
+    out.push_back(a[i].get<std::string>());
+  }
+  return out;
+}
+
+std::vector<double> RequireNumberArray(const nlohmann::json& j, const char* key,
+                                       const std::string& what, std::size_t max_count) {
+  RequireArray(j, key, what, max_count);
+  return RequireNumbers(j.at(key), what + ": '" + key + "'");
+}
+
+std::vector<long long> RequireIntegers(const nlohmann::json& j, const char* key, long long min,
+                                       long long max, const std::string& what,
+                                       std::size_t max_count) {
+  const auto& a = RequireArray(j, key, what, max_count);
+  std::vector<long long> out;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    out.push_back(RequireWholeValue(a[i], what + ": '" + key + "'[" + std::to_string(i) + "]",
+                                    static_cast<double>(min), static_cast<double>(max)));
+  return out;
+}
+
 std::string RequireOneOf(const nlohmann::json& j, const char* key,
                          std::initializer_list<const char*> allowed, const std::string& what) {
   const std::string s = RequireString(j, key, what);
   for (const char* a : allowed)
     if (s == a) return s;
-  throw InputError(what + ": '" + key + "' = " + DumpJson(s, -1) + " must be one of " +
+  throw InputError(what + ": '" + key + "' = " + Shown(s) + " must be one of " +
                    List(allowed));
 }
 
@@ -157,12 +272,12 @@ void RequireSchema(const nlohmann::json& j, const std::string& schema, int versi
   if (!j.contains(schema_key) || !j.at(schema_key).is_string() ||
       j.at(schema_key).get<std::string>() != schema)
     throw InputError(what + ": '" + schema_key + "' must be \"" + schema + "\"" +
-                     (j.contains(schema_key) ? ", got " + DumpJson(j.at(schema_key), -1)
+                     (j.contains(schema_key) ? ", got " + Shown(j.at(schema_key))
                                              : std::string(" (missing)")));
   const bool have = j.contains("schema_version");
   const auto& v = have ? j.at("schema_version") : j;
   if (!have || !v.is_number() || v.get<double>() != version)
-    throw InputError(what + ": 'schema_version' = " + (have ? DumpJson(v, -1) : "(missing)") +
+    throw InputError(what + ": 'schema_version' = " + (have ? Shown(v) : "(missing)") +
                      " breaks the rule: this whirl reads schema_version " +
                      std::to_string(version));
 }

@@ -13,10 +13,15 @@
 
 namespace whirl {
 
-/// Parses a JSON file; a syntax error, a truncation, text that is not UTF-8 or a number beyond
-/// the double range is an InputError naming the file (and line, column). A UTF-8 byte-order mark
+/// Parses a JSON file; a syntax error, a truncation, text that is not UTF-8, a number beyond
+/// the double range or a key given twice in one object (JSON allows it, readers differ in which
+/// value counts) is an InputError naming the file (and the byte, or the key's path). A UTF-8 byte-order mark
 /// at the start is skipped. Size limit: kMaxInputFileBytes (core/atomic_file.h).
 nlohmann::json ReadJsonFile(const std::filesystem::path& path);
+
+/// nlohmann's message of `e` without its "[json.exception.type_error.302] " tag ("type must be
+/// number, but is string"), for a message that names the key itself.
+std::string LibraryRule(const nlohmann::json::exception& e);
 
 /// JSON text (`indent` spaces, as nlohmann::json::dump). A string holding bytes that are not
 /// UTF-8 (a file name from the command line) gets U+FFFD in their place instead of an exception.
@@ -72,6 +77,29 @@ long long RequireInteger(const nlohmann::json& j, const char* key, long long min
 /// Required string at key of at most `max_length` bytes.
 std::string RequireString(const nlohmann::json& j, const char* key, const std::string& what,
                           std::size_t max_length = 1000);
+
+/// Required JSON object at key; InputError "<what>: '<key>' must be a JSON object, got <v>".
+const nlohmann::json& RequireObject(const nlohmann::json& j, const char* key,
+                                    const std::string& what);
+
+/// Required array at key of at most `max_count` elements (any kind; the caller checks them).
+const nlohmann::json& RequireArray(const nlohmann::json& j, const char* key, const std::string& what,
+                                   std::size_t max_count = 1000000);
+
+/// Required array of strings at key: at most `max_count`, each at most `max_length` bytes. The
+/// message names the key and the element ("'sensors'[2] must be a string, got 5").
+std::vector<std::string> RequireStrings(const nlohmann::json& j, const char* key,
+                                        const std::string& what, std::size_t max_count = 100000,
+                                        std::size_t max_length = 1000);
+
+/// Required array of finite numbers at key, at most `max_count` of them.
+std::vector<double> RequireNumberArray(const nlohmann::json& j, const char* key,
+                                       const std::string& what, std::size_t max_count = 10000000);
+
+/// Required array of whole numbers in [min, max] at key, at most `max_count` of them.
+std::vector<long long> RequireIntegers(const nlohmann::json& j, const char* key, long long min,
+                                       long long max, const std::string& what,
+                                       std::size_t max_count = 1000000);
 
 /// Required string at key that is one of `allowed`; the message lists them.
 std::string RequireOneOf(const nlohmann::json& j, const char* key,

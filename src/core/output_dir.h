@@ -4,6 +4,7 @@
 // command with a directory output writes it through OutputDir; every command with inputs and
 // outputs calls CheckOutputs before it reads or writes anything.
 #include <filesystem>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
@@ -14,8 +15,15 @@
 namespace whirl {
 
 /// The file in each output directory that lists what whirl wrote there: JSON, schema
-/// "whirl.output_dir", key "files" (the names, one path component each).
+/// "whirl.output_dir", schema_version 2, key "files" ({"name", "sha256"}: one path component and
+/// the SHA-256 of the content whirl wrote) and "directories" (sub-directories written through
+/// their own OutputDir, each with its own manifest). A version 1 manifest (names only) still
+/// reads, but proves nothing: whirl refuses a directory whose listed files it cannot prove.
 inline constexpr const char* kOutputManifest = ".whirl-output.json";
+/// The record inside a staging folder (".whirl-stage-<pid>-<n>") of the files whirl put there,
+/// with their SHA-256 (schema "whirl.output_dir.staging"), so a later run can remove the folder
+/// of a killed run without removing anything else.
+inline constexpr const char* kStagingRecord = ".whirl-stage.json";
 
 /// The rule below in a few words, for --help texts of directory flags.
 inline constexpr const char* kOutputDirRule =
@@ -26,26 +34,33 @@ inline constexpr const char* kOutputDirRule =
 ///  - not a symbolic link (refused even when it points to a directory: a link planted at the path
 ///    would send the files elsewhere; give the directory itself), and
 ///  - absent (it is created, with its parents), or an empty directory, or a directory whirl wrote
-///    before: one holding kOutputManifest. The files listed there are whirl's: a new run replaces
-///    them and removes those it does not write again. A sub-directory holding its own manifest
-///    (the demo's report/) counts as whirl's too. Anything else in the directory refuses it.
-/// whirl's temporaries (core/atomic_file.h IsWhirlTemporary) are ignored. Throws an InputError
-/// naming `what` (the flag, e.g. "--out-dir"), the directory and, when it refuses a directory with
-/// foreign content, one such file.
+///    before: one holding kOutputManifest. A file listed there is whirl's only while its content
+///    still has the listed SHA-256: a new run replaces such files and removes those it does not
+///    write again. A sub-directory is whirl's when it holds its own manifest that proves all of
+///    its content likewise (the demo's report/). Anything else in the directory refuses it: a
+///    file not listed, a listed file changed since (or listed without a hash, by an older
+///    whirl), a foreign sub-directory, a staging folder of a run that is gone holding a file
+///    its kStagingRecord does not prove.
+/// whirl's file temporaries (core/atomic_file.h IsWhirlTemporary) are ignored, and so is the
+/// staging folder of a whirl process that still runs. Throws an InputError naming `what` (the
+/// flag, e.g. "--out-dir"), the directory and, when it refuses a directory with foreign content,
+/// one such entry and why.
 /// Why this rule: running a command again into its own directory must work (`whirl demo --out-dir
 /// out` twice) and must not leave files of the earlier run beside the new ones, while whirl must
-/// never mix its files with someone else's or delete what it did not write; the manifest is how
-/// it tells the two apart.
+/// never mix its files with someone else's or delete what it did not write: a forged or copied
+/// manifest cannot make whirl delete a file unless it states that file's exact content hash.
 void CheckOutputDir(const std::filesystem::path& dir, const std::string& what);
 
 /// An output directory written all-or-nothing. The constructor applies CheckOutputDir and creates
 /// nothing; Add collects files in memory; Commit writes them and the manifest in one
 /// WriteFilesAtomic (a failure leaves the directory as it was), then removes the files of the
-/// previous manifest this run did not write. Without Commit (an exception on the way) the
-/// destructor removes the staging folder and the directory itself if this object created it.
-/// Killed (kill -9) before Commit, a run leaves the directory as it was plus hidden whirl
-/// temporaries (".whirl-stage-<pid>-<n>"); killed inside Commit, see WriteFilesAtomic. The next
-/// run ignores them and its Commit removes them.
+/// previous manifest this run did not write (each only if its content still matches). Without
+/// Commit (an exception on the way) the destructor removes the staging folder and the directory
+/// itself if this object created it. Killed (kill -9) before Commit, a run leaves the directory
+/// as it was plus hidden whirl temporaries (".whirl-stage-<pid>-<n>" with its kStagingRecord);
+/// killed inside Commit, see WriteFilesAtomic. The next run ignores them and its Commit removes
+/// the files they provably hold (a file a program wrote into the staging folder just before the
+/// kill is not yet recorded: the folder then stays and refuses the directory by name).
 class OutputDir {
  public:
   OutputDir(std::filesystem::path dir, std::string what);
@@ -78,6 +93,13 @@ class OutputDir {
   /// Adds the file `name` a program wrote into Staging() (binary safe).
   void AddStaged(const std::string& name);
 
+  /// Where a program run in Staging() logs (RunProgram's log_path) for the log `name`: a whirl
+  /// temporary there (the same path for the same name, so runs append), which a later run
+  /// removes if this one is killed while the program runs. AddProgramLog(name) adds it to the
+  /// output as `name`; false when the program wrote no log.
+  std::filesystem::path ProgramLog(const std::string& name);
+  bool AddProgramLog(const std::string& name);
+
   /// Writes every added file, the manifest and `also` (files outside the directory, e.g. the
   /// --out JSON beside a --report) all-or-nothing; re-checks the rule first. Returns the paths
   /// of the added files.
@@ -87,6 +109,8 @@ class OutputDir {
 
  private:
   void Insert(const std::string& name, std::string contents);  // checks the name, keeps it
+  // Records `name` with its hash in the staging folder's record (and writes it there if `write`).
+  void Stage(const std::string& name, const std::string& contents, bool write);
 
   std::filesystem::path dir_;
   std::string what_;
@@ -94,7 +118,10 @@ class OutputDir {
   std::set<std::string> names_;  ///< of files_
   std::vector<std::string> kept_;
   std::vector<ReadyFile> ready_;  ///< AddReady: the target inside the directory, the file
+  std::map<std::string, std::string> ready_hashes_;  ///< AddReady: name -> SHA-256
   std::filesystem::path staging_;
+  std::map<std::string, std::string> staged_;  ///< name -> SHA-256 in the staging folder
+  std::map<std::string, std::filesystem::path> logs_;  ///< ProgramLog: name -> temporary
   bool created_ = false, committed_ = false;
 };
 

@@ -11,6 +11,7 @@
 #include "core/limits.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
+#include "nn/model.h"
 
 namespace whirl::drift {
 namespace {
@@ -21,15 +22,14 @@ json VectorJson(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
 
-Eigen::VectorXd ReadVector(const json& j, const char* key, Eigen::Index size) {
-  const auto v = j.at(key).get<std::vector<double>>();
+// Every read below goes through core/json_file.h, so a wrong field is named with its rule.
+Eigen::VectorXd ReadVector(const json& j, const char* key, Eigen::Index size,
+                           const std::string& what = "drift model") {
+  const auto v = RequireNumberArray(j, key, what);
   if (size >= 0 && static_cast<Eigen::Index>(v.size()) != size)
-    throw InputError(std::string("drift model '") + key + "': " + std::to_string(v.size()) +
+    throw InputError(what + ": '" + key + "' has " + std::to_string(v.size()) +
                      " values, expected " + std::to_string(size));
-  Eigen::VectorXd out =
-      Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-  if (!out.allFinite()) throw InputError(std::string("drift model '") + key + "' is not finite");
-  return out;
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
 json MatrixJson(const Eigen::MatrixXd& m) {
@@ -38,20 +38,20 @@ json MatrixJson(const Eigen::MatrixXd& m) {
   return rows;
 }
 
-Eigen::MatrixXd ReadMatrix(const json& j, const char* key, Eigen::Index n) {
-  const auto rows = j.at(key).get<std::vector<std::vector<double>>>();
+Eigen::MatrixXd ReadMatrix(const json& j, const char* key, Eigen::Index n,
+                           const std::string& what = "drift model") {
+  const json& rows = RequireArray(j, key, what);
   if (static_cast<Eigen::Index>(rows.size()) != n)
-    throw InputError(std::string("drift model '") + key + "' must be " + std::to_string(n) + "x" +
+    throw InputError(what + ": '" + key + "' must be " + std::to_string(n) + "x" +
                      std::to_string(n));
   Eigen::MatrixXd m(n, n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (static_cast<Eigen::Index>(rows[static_cast<std::size_t>(i)].size()) != n)
-      throw InputError(std::string("drift model '") + key + "' row " + std::to_string(i) +
-                       " must have " + std::to_string(n) + " values");
-    for (Eigen::Index k = 0; k < n; ++k)
-      m(i, k) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
+    const std::string row = what + ": '" + key + "' row " + std::to_string(i);
+    const std::vector<double> r = RequireNumbers(rows[static_cast<std::size_t>(i)], row);
+    if (static_cast<Eigen::Index>(r.size()) != n)
+      throw InputError(row + " must have " + std::to_string(n) + " values");
+    for (Eigen::Index k = 0; k < n; ++k) m(i, k) = r[static_cast<std::size_t>(k)];
   }
-  if (!m.allFinite()) throw InputError(std::string("drift model '") + key + "' is not finite");
   return m;
 }
 
@@ -107,7 +107,7 @@ void ReadZeroAndElapsed(const json& j, bool schema1, DriftModel* m) {
     m->zero.zero = ErrorZero::kAsLogged;
     return;
   }
-  m->elapsed_time_constants = j.at("elapsed_time_constants").get<std::vector<double>>();
+  m->elapsed_time_constants = RequireNumberArray(j, "elapsed_time_constants", "drift model");
   m->zero.zero = ParseErrorZero(RequireOneOf(j, "error_zero", {"run-start", "fixed"}, "drift model"));
   if (m->zero.zero == ErrorZero::kFixed)
     m->zero.gauge_level_um = RequireNumber(j, "gauge_level_um", "drift model");
@@ -253,56 +253,64 @@ void from_json(const json& j, DriftModel& m) {
   RequireSchema(j, DriftModel::kFormat, schema1 ? 1 : DriftModel::kSchemaVersion, "drift model",
                 "format");
   m = DriftModel{};
-  m.kind = ParseModelKind(j.at("kind").get<std::string>());
-  m.error_column = j.at("error_column").get<std::string>();
-  m.sensors = j.at("sensors").get<std::vector<std::string>>();
+  const std::string w = "drift model";
+  m.kind = ParseModelKind(RequireString(j, "kind", w));
+  m.error_column = RequireString(j, "error_column", w);
+  m.sensors = RequireStrings(j, "sensors", w);
   m.reference_C = ReadVector(j, "reference_C", static_cast<Eigen::Index>(m.sensors.size()));
-  m.extra_inputs = j.at("extra_inputs").get<std::vector<std::string>>();
-  m.time_unit = j.at("time_unit").get<std::string>();
-  m.time_constants = j.at("time_constants").get<std::vector<double>>();
+  m.extra_inputs = RequireStrings(j, "extra_inputs", w);
+  m.time_unit = RequireString(j, "time_unit", w);
+  m.time_constants = RequireNumberArray(j, "time_constants", w);
   ReadZeroAndElapsed(j, schema1, &m);
   m.features =
       MakeFeatures(Inputs(m.sensors, m.extra_inputs), m.time_constants, m.elapsed_time_constants);
   const auto nf = static_cast<Eigen::Index>(m.features.size());
-  const json& fj = j.at("features");
+  const json& fj = RequireArray(j, "features", w);
   if (fj.size() != m.features.size())
     throw InputError("drift model 'features' must list " + std::to_string(nf) + " features");
   m.feature_min.resize(nf);
   m.feature_max.resize(nf);
   for (Eigen::Index i = 0; i < nf; ++i) {
     const json& f = fj[static_cast<std::size_t>(i)];
-    m.feature_min(i) = RequireNumber(f, "train_min", "drift model feature");
-    m.feature_max(i) = RequireNumber(f, "train_max", "drift model feature");
+    const std::string wf = w + " 'features'[" + std::to_string(i) + "]";
+    m.feature_min(i) = RequireNumber(f, "train_min", wf);
+    m.feature_max(i) = RequireNumber(f, "train_max", wf);
   }
-  m.residual_std_um = RequireNumber(j, "residual_std_um", "drift model");
-  m.r_squared = RequireNumber(j, "r_squared", "drift model");
-  const json& t = j.at("training");
-  m.training_runs = t.at("runs").get<std::vector<std::string>>();
-  m.state = ParseRunState(t.at("state").get<std::string>());
-  m.training_samples = t.at("samples").get<int>();
-  m.selection = t.at("selection").get<std::string>();
-  m.notes = t.at("notes").get<std::vector<std::string>>();
+  m.residual_std_um = RequireNumber(j, "residual_std_um", w);
+  m.r_squared = RequireNumber(j, "r_squared", w);
+  const json& t = RequireObject(j, "training", w);
+  const std::string wt = w + " 'training'";
+  m.training_runs = RequireStrings(t, "runs", wt, 100000, 4096);
+  m.state = ParseRunState(RequireString(t, "state", wt));
+  m.training_samples = static_cast<int>(RequireInteger(t, "samples", 0, 1000000000, wt));
+  m.selection = RequireString(t, "selection", wt, 100000);
+  m.notes = RequireStrings(t, "notes", wt, 100000, 100000);
   if (IsLinear(m.kind)) {
-    const json& l = j.at("linear");
-    m.linear.coefficients = ReadVector(l, "coefficients", nf + 1);
-    m.linear.standard_errors = ReadVector(l, "standard_errors", nf + 1);
-    m.linear.covariance = ReadMatrix(l, "covariance", nf + 1);
-    m.linear.xtx_inverse = ReadMatrix(l, "xtx_inverse", nf + 1);
-    m.linear.vif = ReadVector(l, "vif", nf);
-    m.linear.samples = l.at("samples").get<int>();
-    m.linear.degrees_of_freedom = l.at("degrees_of_freedom").get<int>();
+    const json& l = RequireObject(j, "linear", w);
+    const std::string wl = w + " 'linear'";
+    m.linear.coefficients = ReadVector(l, "coefficients", nf + 1, wl);
+    m.linear.standard_errors = ReadVector(l, "standard_errors", nf + 1, wl);
+    m.linear.covariance = ReadMatrix(l, "covariance", nf + 1, wl);
+    m.linear.xtx_inverse = ReadMatrix(l, "xtx_inverse", nf + 1, wl);
+    m.linear.vif = ReadVector(l, "vif", nf, wl);
+    m.linear.samples = static_cast<int>(RequireInteger(l, "samples", 0, 1000000000, wl));
+    m.linear.degrees_of_freedom =
+        static_cast<int>(RequireInteger(l, "degrees_of_freedom", 0, 1000000000, wl));
     m.linear.residual_std_um = m.residual_std_um;
     m.linear.r_squared = m.r_squared;
   } else {
-    const json& n = j.at("network");
-    m.network = nn::Network::Zeros(n.at("layer_sizes").get<std::vector<int>>());
-    m.network.SetParameters(ReadVector(n, "parameters", m.network.ParameterCount()));
-    m.input_scaling.xmin = ReadVector(n, "input_min", nf);
-    m.input_scaling.xmax = ReadVector(n, "input_max", nf);
-    m.target_scaling.xmin = ReadVector(n, "target_min", 1);
-    m.target_scaling.xmax = ReadVector(n, "target_max", 1);
-    m.noise_variance = RequireNumber(n, "noise_variance_normalized", "drift model network");
-    m.posterior_covariance = ReadMatrix(n, "posterior_covariance", m.network.ParameterCount());
+    const json& n = RequireObject(j, "network", w);
+    const std::string wn = w + " 'network'";
+    const auto sizes = RequireIntegers(n, "layer_sizes", 1, static_cast<long long>(nn::kMaxLayerSize),
+                                       wn, nn::kMaxLayers);
+    m.network = nn::Network::Zeros(std::vector<int>(sizes.begin(), sizes.end()));
+    m.network.SetParameters(ReadVector(n, "parameters", m.network.ParameterCount(), wn));
+    m.input_scaling.xmin = ReadVector(n, "input_min", nf, wn);
+    m.input_scaling.xmax = ReadVector(n, "input_max", nf, wn);
+    m.target_scaling.xmin = ReadVector(n, "target_min", 1, wn);
+    m.target_scaling.xmax = ReadVector(n, "target_max", 1, wn);
+    m.noise_variance = RequireNumber(n, "noise_variance_normalized", wn);
+    m.posterior_covariance = ReadMatrix(n, "posterior_covariance", m.network.ParameterCount(), wn);
   }
   m.Validate();
 }
@@ -311,8 +319,6 @@ DriftModel ReadDriftModel(const std::filesystem::path& path) {
   const json j = ReadJsonFile(path);
   try {
     return j.get<DriftModel>();
-  } catch (const json::exception& e) {
-    throw InputError(path.string() + ": " + e.what());
   } catch (const InputError& e) {
     throw InputError(path.string() + ": " + e.what());
   }

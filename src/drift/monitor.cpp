@@ -834,12 +834,13 @@ void RankWeek(const std::vector<std::pair<std::string, DayScores>>& scored, Week
 // The week's loop (MonitorWeek, MonitorWeekFiles): per day the baselines fitted on the day
 // before (`fit(d, options)` fits day d), then `replay(d, baselines, carried)`.
 WeekResult ReplayWeek(
-    const DriftModel& model, std::size_t days, const MonitorOptions& o,
+    const DriftModel& model, std::size_t days,
     const std::function<DriftModel(std::size_t, const FitOptions&)>& fit,
     const std::function<DriftModel(const FitOptions&)>& first_time,
     const std::function<MonitorResult(std::size_t, const std::vector<NamedBaseline>&,
                                       const std::vector<StrategyResult>*)>& replay) {
   if (days == 0) throw InputError("monitor: give at least one day (--day)");
+  CheckMonitorDays(days);
   WeekResult w;
   std::vector<std::pair<std::string, DayScores>> scored;
   FitOptions time_only;
@@ -875,15 +876,30 @@ WeekResult ReplayWeek(
 
 }  // namespace
 
+void CheckMonitorDays(std::size_t count) {
+  if (count > static_cast<std::size_t>(kMaxMonitorDays))
+    throw InputError("monitor: " + std::to_string(count) + " day files; at most " +
+                     std::to_string(kMaxMonitorDays) +
+                     " (a year of days) in one replay: replay fewer days at a time");
+}
+
 WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
                        const MonitorOptions& o, const std::vector<Run>& first_time_training) {
+  CheckMonitorDays(days.size());
+  long long samples = 0;
+  for (const Run& d : days) samples += d.samples();
+  if (samples > kMaxRunSamples)
+    throw InputError("monitor: the " + std::to_string(days.size()) + " days hold " +
+                     std::to_string(samples) + " samples together; at most " +
+                     std::to_string(kMaxRunSamples) +
+                     " (as one run file): replay fewer days at a time");
   std::function<DriftModel(const FitOptions&)> first;
   if (!first_time_training.empty())
     first = [&](const FitOptions& f) {
       return FitDriftModel(first_time_training, model.error_column, f).model;
     };
   return ReplayWeek(
-      model, days.size(), o,
+      model, days.size(),
       [&](std::size_t d, const FitOptions& f) {
         return FitDriftModel({days[d]}, model.error_column, f).model;
       },
@@ -898,7 +914,7 @@ WeekResult MonitorWeekFiles(const DriftModel& model, const std::vector<std::file
                             const std::function<void(std::size_t, const MonitorSample&)>& sink,
                             const StreamProgress& progress) {
   return ReplayWeek(
-      model, days.size(), o,
+      model, days.size(),
       [&](std::size_t d, const FitOptions& f) {
         return FitFiles({{days[d], RunState::kUnknown}}, model.error_column, f, progress).model;
       },

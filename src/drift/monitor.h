@@ -263,6 +263,11 @@ struct WeekResult {
   std::string strongest;          ///< lowest week MAE among the rows covering every day
   std::vector<WeekPartial> partial;
 };
+/// Limits of one replay of days (MonitorWeek): at most kMaxMonitorDays files, and together at
+/// most kMaxRunSamples samples (run_file.h), the bound of one run file; InputError otherwise.
+inline constexpr int kMaxMonitorDays = 366;
+/// InputError unless `count` day files are within kMaxMonitorDays (checked before reading them).
+void CheckMonitorDays(std::size_t count);
 WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
                        const MonitorOptions& options,
                        const std::vector<Run>& first_time_training = {});

@@ -19,8 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string TimeName(const MonitorResult& r) { return r.time_from_index ? "sample" : "time_min"; }
-
 std::vector<std::string> WithComments(const std::vector<std::string>& c, const std::string& what) {
   std::vector<std::string> out{what};
   out.insert(out.end(), c.begin(), c.end());
@@ -476,15 +474,14 @@ std::string RenderMonitorPlot(const fs::path& dir, const std::string& gnuplot, O
     warnings->push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
   } else {
     const fs::path stage = fs::absolute(files.Staging());  // gnuplot renders there
-    if (RunProgram({gnuplot, script}, stage, stage / (prefix + "gnuplot.log")) == 0 &&
+    if (RunProgram({gnuplot, script}, stage, files.ProgramLog(prefix + "gnuplot.log")) == 0 &&
         fs::is_regular_file(stage / png, ec)) {
       files.AddStaged(png);
       img = "<img src='" + HtmlEscape(png) + "' alt='monitor timeline'>";
     } else {
       warnings->push_back("gnuplot failed on " + (dir / script).string() + " (see " + prefix +
                           "gnuplot.log)");
-      if (fs::is_regular_file(stage / (prefix + "gnuplot.log"), ec))
-        files.AddStaged(prefix + "gnuplot.log");
+      files.AddProgramLog(prefix + "gnuplot.log");
     }
   }
   return img;

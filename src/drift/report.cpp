@@ -41,7 +41,7 @@ class ReportWriter {
     if (have_gnuplot_) {
       // gnuplot never sees the output directory: it renders in the staging folder.
       const fs::path stage = fs::absolute(out_.Staging());
-      const int rc = RunProgram({gnuplot_, stem + ".gp"}, stage, stage / "gnuplot.log");
+      const int rc = RunProgram({gnuplot_, stem + ".gp"}, stage, out_.ProgramLog("gnuplot.log"));
       std::error_code ec;
       if (rc == 0 && fs::is_regular_file(stage / png, ec) && fs::file_size(stage / png, ec) > 0) {
         out_.AddStaged(png);
@@ -55,9 +55,7 @@ class ReportWriter {
   }
   const std::vector<std::string>& warnings() const { return result_.warnings; }
   DriftReportResult Finish(const std::string& html) {
-    std::error_code ec;
-    if (gnuplot_failed_ && fs::is_regular_file(out_.Staging() / "gnuplot.log", ec))
-      out_.AddStaged("gnuplot.log");
+    if (gnuplot_failed_) out_.AddProgramLog("gnuplot.log");
     File("index.html", html);
     result_.files = out_.Commit();
     result_.index_html = out_.path() / "index.html";

@@ -67,8 +67,16 @@ Run Run::Slice(int begin, int end, const std::string& new_name) const {
   if (begin < 0 || end > samples() || end - begin < 1)
     throw InputError(source + ": rows [" + std::to_string(begin) + ", " + std::to_string(end) +
                      ") are not a non-empty part of its " + std::to_string(samples()) + " rows");
-  Run r = *this;
+  // The metadata only: copying the whole run first (Run r = *this) made cutting a log into k
+  // runs cost k times the log (drift split's memory grew with the square of the runs).
+  Run r;
   r.name = new_name;
+  r.source = source;
+  r.state = state;
+  r.time_from_index = time_from_index;
+  r.sensor_names = sensor_names;
+  r.error_names = error_names;
+  r.other_names = other_names;
   const int n = end - begin;
   r.time_min.assign(time_min.begin() + begin, time_min.begin() + end);
   r.line_numbers.assign(line_numbers.begin() + begin, line_numbers.begin() + end);
@@ -153,12 +161,15 @@ std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double
     // rows before the first start belong to the first run
     starts.erase(starts.begin() + 1);
   }
+  if (starts.size() > static_cast<std::size_t>(kMaxSplitRuns))
+    throw InputError(run.source + ": column '" + column + "' rises above " +
+                     FormatNumber(threshold) + " " + std::to_string(starts.size()) +
+                     " times: drift split writes at most " + std::to_string(kMaxSplitRuns) +
+                     " run files (one per machine start); raise --threshold, choose another "
+                     "--at column, or split a shorter part of the log");
   starts.push_back(run.samples());
-  if (starts.size() - 1 > static_cast<std::size_t>(kMaxSplitRuns))
-    throw InputError(run.source + ": " + std::to_string(starts.size() - 1) + " runs: drift split " +
-                     "writes at most " + std::to_string(kMaxSplitRuns) +
-                     " (raise --threshold or split a shorter log)");
   std::vector<Run> runs;
+  runs.reserve(starts.size() - 1);
   for (std::size_t i = 0; i + 1 < starts.size(); ++i)
     runs.push_back(run.Slice(starts[i], starts[i + 1], run.name + "_" + std::to_string(i + 1)));
   return runs;

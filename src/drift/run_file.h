@@ -15,8 +15,8 @@
 // core/csv.h. A run's state (idle or cutting, Miao et al.'s two conditions) is not in the file: it
 // comes from the command line (--idle / --cutting) or the caller.
 // Limits (resource and plausibility, stated in the messages): kMaxRunColumns columns;
-// temperatures within [-60, 400] degC; errors within +-100000 um; times within +-1e8 min (190
-// years); every other column within +-1e15. Rows: a run held whole in memory (Run, ReadRun: drift
+// temperatures within [-60, 400] degC; errors within +-100000 um; times within +-kMaxRunTimeMin (190
+// years); every other column within +-kMaxAbsOtherValue. Rows: a run held whole in memory (Run, ReadRun: drift
 // select, crossval, holdout, monitor --day, every library caller) has at most kMaxRunSamples; the
 // commands that stream a file (RunReader: drift fit, predict, monitor --run, split, report) keep
 // memory independent of its length and take up to kMaxStreamRows.
@@ -39,10 +39,11 @@ inline constexpr int kMaxRunColumns = 512;
 inline constexpr double kMinTemperatureC = -60.0;
 inline constexpr double kMaxTemperatureC = 400.0;
 inline constexpr double kMaxAbsErrorUm = 100000.0;
-inline constexpr double kMaxAbsTimeMin = 1e8;
+/// Largest |time| of a run [min] (time_s: 60 times it): 190 years, so even minutes or seconds
+/// since 1970 fit; 1e300 min would be written back and break every time difference.
+inline constexpr double kMaxRunTimeMin = 1e8;
+/// Largest |value| of any other column (spindle_rpm, power, ... in their own units).
 inline constexpr double kMaxAbsOtherValue = 1e15;
-/// drift split cuts a log into at most this many runs.
-inline constexpr int kMaxSplitRuns = 10'000;
 
 /// Miao et al.'s two operating conditions of a run (plus "not stated").
 enum class RunState { kUnknown, kIdle, kCutting };
@@ -123,10 +124,16 @@ std::vector<std::filesystem::path> WriteRuns(const std::filesystem::path& dir,
                                              const std::vector<std::string>& comments,
                                              const std::string& what = "run directory");
 
+/// Most runs SplitAtStarts makes (one file each): a log of a year with ten machine starts a day
+/// has 3650; more is a --threshold below the column's idle noise, not machine starts.
+inline constexpr int kMaxSplitRuns = 10000;
+
 /// Cuts one long log into runs, a new run starting at every sample where `column` (an `other`
 /// column such as spindle_rpm) changes from <= threshold to > threshold (a machine start). The
 /// first run also holds the rows before the first start. Names: "<run.name>_<k>" (k from 1).
-/// InputError beyond kMaxSplitRuns runs.
+/// More than kMaxSplitRuns starts is an InputError naming the file, the column and the count.
+/// Memory: the runs together hold the log once (each Slice copies only its rows).
+/// SplitLogFile streams the same rule.
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold = 0.0);
 
 // ---- Streaming: run files longer than memory (a year of a machine's log) --------------------

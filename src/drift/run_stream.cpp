@@ -129,9 +129,10 @@ struct RunReader::Impl {
                          "': the time cell is missing, but it was present when the file was "
                          "scanned (did the file change while it was read?)");
     } else {
-      const double scale = layout.time_column == "time_s" ? 1.0 / 60.0 : 1.0;
-      Check(line, layout.time_index, cell * scale, -kMaxAbsTimeMin, kMaxAbsTimeMin,
-            "is outside the plausible time range +-1e8 min (190 years)");
+      const double unit = layout.time_column == "time_s" ? 60.0 : 1.0;
+      Check(line, layout.time_index, cell, -kMaxRunTimeMin * unit, kMaxRunTimeMin * unit,
+            "is outside +-1e8 min (+-6e9 s, 190 years: even a time since 1970 fits; a larger "
+            "time is a broken cell)");
       if (!std::isnan(previous) && !(cell > previous) && violation.empty()) {
         violation = layout.source + ":" + std::to_string(line) + ": " + layout.time_column +
                     " must increase strictly (" + FormatNumber(cell) + " after " +
@@ -163,7 +164,7 @@ struct RunReader::Impl {
     for (std::size_t j = 0; j < layout.other_columns.size(); ++j) {
       const double v = row[layout.other_columns[j]];
       Check(line, layout.other_columns[j], v, -kMaxAbsOtherValue, kMaxAbsOtherValue,
-            "is outside the plausible range +-1e15");
+            "is outside +-1e15 (no input of a run is that large: a broken cell)");
       b->other(at, static_cast<Eigen::Index>(j)) = v;
     }
   }
@@ -415,6 +416,7 @@ std::vector<SplitRun> SplitLogFile(const std::filesystem::path& log, const std::
   std::unique_ptr<SplitPiece> piece;
   double first = NAN, previous = NAN;
   bool seen_start = false;
+  long long count = 0;  // runs begun (SplitAtStarts' starts)
   RunRows b;
   while (reader.Read(&b)) {
     for (int k = 0; k < b.count; ++k) {
@@ -427,22 +429,25 @@ std::vector<SplitRun> SplitLogFile(const std::filesystem::path& log, const std::
       const bool merge = start && !seen_start && first <= threshold;
       seen_start = seen_start || start;
       if (!piece || (start && !merge)) {
+        ++count;
+        if (count > kMaxSplitRuns) continue;  // only counted: the error below names the count
         if (piece) runs.push_back(piece->Finish(out, l, comments));
-        if (runs.size() >= static_cast<std::size_t>(kMaxSplitRuns))
-          throw InputError(l.source + ":" + std::to_string(b.line_numbers[static_cast<std::size_t>(k)]) +
-                           ": more than " + std::to_string(kMaxSplitRuns) +
-                           " runs: drift split writes at most that many (raise --threshold or "
-                           "split a shorter log)");
         piece = std::make_unique<SplitPiece>(staging, l, static_cast<int>(runs.size()) + 1,
                                              scan.time_from_index);
       }
-      piece->Add(b, k);
+      if (count <= kMaxSplitRuns) piece->Add(b, k);
     }
     if (progress) progress(reader.rows(), reader.fraction_read());
   }
   if (reader.rows() != scan.rows)
     throw InputError(l.source + ": " + std::to_string(reader.rows()) + " rows, but " +
                      std::to_string(scan.rows) + " when it was scanned (did the file change?)");
+  if (count > kMaxSplitRuns)
+    throw InputError(l.source + ": column '" + column + "' rises above " +
+                     FormatNumber(threshold) + " " + std::to_string(count) +
+                     " times: drift split writes at most " + std::to_string(kMaxSplitRuns) +
+                     " run files (one per machine start); raise --threshold, choose another "
+                     "--at column, or split a shorter part of the log");
   runs.push_back(piece->Finish(out, l, comments));
   for (SplitRun& r : runs) r.file = dir / r.file;
   out.Commit();

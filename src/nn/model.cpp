@@ -128,7 +128,9 @@ TrainOptions ReadOptions(const json& j) {
   o.mu_inc = RequireFinite(Require(j, "mu_inc", where), where + " 'mu_inc'");
   o.mu_max = RequireFinite(Require(j, "mu_max", where), where + " 'mu_max'");
   o.min_grad = RequireFinite(Require(j, "min_grad", where), where + " 'min_grad'");
-  o.regularization = ParseRegularization(Require(j, "regularization", where).get<std::string>());
+  const json& regularization = Require(j, "regularization", where);
+  if (!regularization.is_string()) throw InputError(where + " 'regularization': must be a string");
+  o.regularization = ParseRegularization(regularization.get<std::string>());
   if (j.contains("change")) o.change = RequireFinite(j.at("change"), where + " 'change'");
   if (j.contains("ard")) {
     if (!j.at("ard").is_boolean()) throw InputError(where + " 'ard': must be true or false");
@@ -246,7 +248,7 @@ void ReadTraining(const json& j, Model& m) {
   try {
     m.training_summary = Require(j, "training_summary", "model").get<TrainSummary>();
   } catch (const json::exception& e) {
-    throw InputError(std::string("model 'training_summary': ") + e.what());
+    throw InputError(std::string("model 'training_summary': ") + LibraryRule(e));
   }
   const json& training = Require(j, "training", "model");
   RejectUnknownKeys(training,
@@ -276,7 +278,8 @@ void ReadTraining(const json& j, Model& m) {
     m.restart_runs =
         Require(training, "restart_runs", "model 'training'").get<std::vector<RestartRecord>>();
   } catch (const json::exception& e) {
-    throw InputError(std::string("model 'training.restart_runs': ") + e.what());
+    throw InputError(std::string("model 'training.restart_runs': ") + LibraryRule(e) +
+                     " (a list of {seed, epochs, gamma, sse_normalized, termination})");
   }
   m.train_options = ReadOptions(Require(training, "options", "model 'training'"));
 }

@@ -76,10 +76,10 @@ bool Render(OutputDir& out, const SurfaceReportOptions& o, SurfaceReportResult& 
     return false;
   }
   const fs::path stage = fs::absolute(out.Staging());
-  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, stage, stage / "gnuplot.log");
+  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, stage, out.ProgramLog("gnuplot.log"));
   std::error_code ec;
   if (rc != 0 || !fs::is_regular_file(stage / "map.png", ec)) {
-    if (fs::is_regular_file(stage / "gnuplot.log", ec)) out.AddStaged("gnuplot.log");
+    out.AddProgramLog("gnuplot.log");
     r.warnings.push_back("gnuplot failed (exit " + std::to_string(rc) +
                          "), see gnuplot.log: map skipped");
     return false;

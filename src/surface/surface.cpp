@@ -93,7 +93,7 @@ BsplineSurface BsplineFromJson(const json& j, const std::string& what) {
     throw InputError(what +
                      ": knots_x_mm/knots_y_mm are not the clamped averaged knots of the "
                      "grid (surface/bspline.h)");
-  const json& w = j.at("weights_um");
+  const json& w = RequireKey(j, "weights_um", what);
   if (!w.is_array() || w.size() != s.grid_y.size())
     throw InputError(what + ": 'weights_um' must hold one row per grid_y line");
   s.weights.resize(static_cast<Eigen::Index>(s.grid_y.size()),

@@ -156,6 +156,12 @@ nn::OutsideDomainSummary SummarizeOutsideDomain(const std::vector<Prediction>& p
 
 WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
   const json j = ReadJsonFile(path);
+  // Another whirl file (a drift model, a surface, a profile) is named as what it is.
+  for (const char* key : {"format", "schema"})
+    if (j.is_object() && j.contains(key) && j.at(key).is_string() &&
+        j.at(key) != WorkpieceModel::kFormat && j.at(key) != nn::Model::kFormat)
+      throw InputError("model file '" + path.string() + "' is a " + DumpJson(j.at(key), -1) +
+                       " file, not a workpiece model (whirl train writes one)");
   if (!j.is_object() || !j.contains("format") || j.at("format") != WorkpieceModel::kFormat)
     return FromNetwork(nn::LoadModel(path));  // names the file and the key on errors
   try {
@@ -163,7 +169,7 @@ WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
   } catch (const InputError& e) {
     throw InputError("model file '" + path.string() + "': " + e.what());
   } catch (const json::exception& e) {
-    throw InputError("model file '" + path.string() + "': " + e.what());
+    throw InputError("model file '" + path.string() + "': " + LibraryRule(e));
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -248,26 +249,153 @@ TEST(OutputDir, ADirectoryAtOneTargetWritesNothing) {
     Write(out, {"a.csv", "b.csv"});
   }
   fs::remove(d / "b.csv");
-  fs::create_directory(d / "b.csv");  // planted where whirl writes (listed: not foreign)
-  OutputDir out(d, "--out-dir");
-  out.Add("a.csv", "new a");
-  out.Add("b.csv", "new b");
-  const std::string e = ErrorOf([&] { out.Commit(); });
+  fs::create_directory(d / "b.csv");  // planted where whirl wrote a file: not provably whirl's
+  const std::string e = ErrorOf([&] {
+    OutputDir out(d, "--out-dir");
+    out.Add("a.csv", "new a");
+    out.Add("b.csv", "new b");
+    out.Commit();
+  });
   EXPECT_TRUE(Has(e, "b.csv") && Has(e, "a directory")) << e;
   EXPECT_EQ(ReadTextFile(d / "a.csv"), "text of a.csv");
   EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", "b.csv", kOutputManifest}));
 }
 
+// A run killed (no destructor, no Commit) while it staged files for a program: forked, so its
+// process is gone afterwards, like a kill -9.
+fs::path KilledRunsStaging(const fs::path& d) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    try {
+      OutputDir out(d, "--out-dir");
+      out.Add("map.gp", "plot x");
+      out.Staging();
+      out.Add("map.csv", "1,2\n");
+      ::_exit(0);  // no destructor: what a kill -9 leaves
+    } catch (...) {
+      ::_exit(1);
+    }
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  for (const auto& e : fs::directory_iterator(d))
+    if (e.path().filename().string().rfind(".whirl-stage-", 0) == 0) return e.path();
+  ADD_FAILURE() << "the killed run left no staging folder";
+  return {};
+}
+
 TEST(OutputDir, KilledRunsDebrisIsIgnoredAndRemoved) {
   const fs::path d = Scratch("out_killed");
+  const fs::path stage = KilledRunsStaging(d);
+  EXPECT_EQ(Entries(stage), (std::set<std::string>{kStagingRecord, "map.gp", "map.csv"}));
   const std::string pid = std::to_string(DeadPid());
-  fs::create_directories(d / (".whirl-stage-" + pid + "-1"));
-  WriteFileAtomic(d / (".whirl-stage-" + pid + "-1") / "map.gp", "x");
   WriteFileAtomic(d / (".a.csv.whirl-tmp-" + pid + "-2"), "half");
   WriteFileAtomic(d / (".zz.whirl-bak-" + pid + "-3"), "old");
   OutputDir out(d, "--out-dir");  // only debris: an empty directory
   Write(out, {"a.csv"});
   EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", kOutputManifest}));
+}
+
+// Issue 45 item 6: a folder named like a killed run's staging folder, holding a user's file, is
+// neither deleted nor emptied: whirl refuses the directory and names the file.
+TEST(OutputDir, AStagingNamedFolderWithAUsersFileIsLeftAlone) {
+  const fs::path d = Scratch("out_fake_stage");
+  const fs::path fake = d / ".whirl-stage-999999-0";
+  fs::create_directories(fake);
+  WriteFileAtomic(fake / "thesis.tex", "mine");
+  const std::string e = ErrorOf([&] {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"a.csv"});
+  });
+  EXPECT_TRUE(Has(e, ".whirl-stage-999999-0") && Has(e, "thesis.tex")) << e;
+  EXPECT_EQ(ReadTextFile(fake / "thesis.tex"), "mine");
+  // And a user's file put into a killed run's real staging folder: its recorded files are all
+  // whirl may remove, so the folder stays, named, with everything in it.
+  fs::remove_all(fake);
+  const fs::path stage = KilledRunsStaging(d);
+  WriteFileAtomic(stage / "notes.txt", "mine too");
+  const std::string e2 = ErrorOf([&] { OutputDir out(d, "--out-dir"); });
+  EXPECT_TRUE(Has(e2, "notes.txt")) << e2;
+  EXPECT_EQ(ReadTextFile(stage / "notes.txt"), "mine too");
+  EXPECT_TRUE(fs::exists(stage / "map.gp"));
+}
+
+// Issue 45 item 6: a forged manifest listing a user's file does not make whirl delete or replace
+// it: the manifest proves a file only by the SHA-256 of its content.
+TEST(OutputDir, AForgedManifestCannotMakeWhirlDeleteAFile) {
+  const fs::path d = Scratch("out_forged");
+  WriteFileAtomic(d / "notes.txt", "my notes");
+  for (const std::string& manifest :
+       {std::string(R"({"schema": "whirl.output_dir", "files": ["notes.txt"]})"),
+        std::string(R"({"schema": "whirl.output_dir", "schema_version": 2, "files": )"
+                    R"([{"name": "notes.txt", "sha256": ")") +
+            std::string(64, '0') + "\"}]}"}) {
+    WriteFileAtomic(d / kOutputManifest, manifest);
+    for (bool rewrite : {false, true}) {
+      const std::string e = ErrorOf([&] {
+        OutputDir out(d, "--out-dir");
+        Write(out, {rewrite ? "notes.txt" : "sensors.csv"});
+      });
+      EXPECT_TRUE(Has(e, "notes.txt")) << e;
+      EXPECT_EQ(ReadTextFile(d / "notes.txt"), "my notes");
+    }
+  }
+}
+
+// A file whirl wrote and the user changed afterwards is the user's now: refused by name, kept.
+TEST(OutputDir, AFileChangedSinceWhirlWroteItIsRefusedAndKept) {
+  const fs::path d = Scratch("out_changed");
+  {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"a.csv", "b.csv"});
+  }
+  WriteFileAtomic(d / "b.csv", "edited in a spreadsheet");
+  const std::string e = ErrorOf([&] {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"a.csv"});  // b.csv would be removed as no longer written
+  });
+  EXPECT_TRUE(Has(e, "b.csv") && Has(e, "changed since")) << e;
+  EXPECT_EQ(ReadTextFile(d / "b.csv"), "edited in a spreadsheet");
+}
+
+// Issue 44 item 10: a foreign sub-directory in an output directory refuses it and stays, with or
+// without a manifest of its own that does not prove its content.
+TEST(OutputDir, AForeignSubDirectoryIsRefusedAndLeftAlone) {
+  const fs::path d = Scratch("out_foreign_sub");
+  {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"a.csv"});
+  }
+  fs::create_directories(d / "photos");
+  WriteFileAtomic(d / "photos" / "screw.jpg", "jpeg");
+  for (const std::string manifest :
+       {"", R"({"schema": "whirl.output_dir", "files": ["screw.jpg"]})"}) {
+    if (!manifest.empty()) WriteFileAtomic(d / "photos" / kOutputManifest, manifest);
+    const std::string e = ErrorOf([&] {
+      OutputDir out(d, "--out-dir");
+      Write(out, {"a.csv"});
+    });
+    EXPECT_TRUE(Has(e, "photos")) << e;
+    EXPECT_EQ(ReadTextFile(d / "photos" / "screw.jpg"), "jpeg");
+  }
+}
+
+// The manifest's hash is SHA-256 (FIPS 180-4 test vectors: "abc", and 56 bytes over two blocks).
+TEST(OutputDir, TheManifestListsTheSha256OfEachFile) {
+  const fs::path d = Scratch("out_sha");
+  OutputDir out(d, "--out-dir");
+  out.Add("abc", "abc");
+  out.Add("two_blocks", "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq");
+  out.Add("empty", "");
+  out.Commit();
+  const nlohmann::json m = ReadJsonFile(d / kOutputManifest);
+  std::map<std::string, std::string> hash;
+  for (const auto& f : m.at("files")) hash[f.at("name")] = f.at("sha256");
+  EXPECT_EQ(hash["abc"], "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(hash["two_blocks"],
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(hash["empty"], "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
 }
 
 TEST(OutputDir, FailureBeforeCommitLeavesNoDirectory) {

@@ -120,5 +120,48 @@ TEST(JsonFields, ArraysAndWholeValues) {
   EXPECT_EQ(ErrorOf([&] { RequireKey(json::array(), "zz", "f"); }), "f: expected a JSON object");
 }
 
+// Issue 45 item 7: a key given twice in one object (JSON allows it; nlohmann keeps the last) is
+// refused, with its path, at every depth; the same key in different objects is fine.
+TEST(JsonFields, AKeyGivenTwiceInOneObjectIsRefusedWithItsPath) {
+  const auto path = whirl::test::ScratchDir() / "whirl_test_duplicate_keys.json";
+  const auto read = [&](const std::string& text) {
+    std::ofstream(path, std::ios::trunc) << text;
+    return ErrorOf([&] { ReadJsonFile(path); });
+  };
+  EXPECT_EQ(read(R"({"a": {"b": 1}, "c": [{"b": 2}, {"b": 3}]})"), "") << "no duplicate";
+  for (const auto& [text, key] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"md32760": 0.01, "md32760": 0.1})", "'md32760'"},
+           {R"({"drift": {"analog_inputs": {"t3_C": {"index": 3, "index": 4}}}})",
+            "'drift.analog_inputs.t3_C.index'"},
+           {R"({"runs": [{"name": "a"}, {"name": "b", "x": 1, "name": "c"}]})",
+            "'runs[1].name'"},
+           {R"([[1], {"k": 1, "k": 1}])", "'[1].k'"}}) {
+    const std::string e = read(text);
+    EXPECT_NE(e.find(key), std::string::npos) << text << "\n" << e;
+    EXPECT_NE(e.find("given twice"), std::string::npos) << e;
+    EXPECT_NE(e.find(path.string()), std::string::npos) << e;
+  }
+}
+
+// Array readers name the key and the element that breaks the rule (no library message).
+TEST(JsonFields, ArraysOfStringsNumbersAndWholeNumbersNameKeyAndElement) {
+  const json j = json::parse(R"({"s": ["a", 5], "n": [1, "x"], "w": [1, 2.5], "o": 3})");
+  EXPECT_EQ(ErrorOf([&] { RequireStrings(j, "s", "model"); }),
+            "model: 's'[1] must be a string, got 5");
+  EXPECT_EQ(ErrorOf([&] { RequireNumberArray(j, "n", "model"); }),
+            "model: 'n'[1] must be a number, got \"x\"");
+  EXPECT_NE(ErrorOf([&] { RequireIntegers(j, "w", 0, 9, "model"); }).find("'w'[1] must be a whole"),
+            std::string::npos);
+  EXPECT_EQ(ErrorOf([&] { RequireObject(j, "o", "model"); }),
+            "model: 'o' must be a JSON object, got 3");
+  EXPECT_NE(ErrorOf([&] { RequireStrings(j, "o", "model"); }).find("'o' must be an array"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { RequireArray(j, "s", "model", 1); }).find("limit is 1"),
+            std::string::npos);
+  const json big = {{"v", std::string(500, 'x')}};
+  EXPECT_LT(ErrorOf([&] { RequireNumber(big, "v", "model"); }).size(), 120u)
+      << "a long value is cut in the message";
+}
+
 }  // namespace
 }  // namespace whirl

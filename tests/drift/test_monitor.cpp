@@ -564,5 +564,28 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   EXPECT_FALSE(changed.strongest.empty());
 }
 
+// Issue 45 item 7: --day had no bound (3,000 files were read); a replay takes at most a year of
+// day files, checked before any is read, and together at most one run file's samples.
+TEST(Monitor, DayFilesAreBounded) {
+  EXPECT_NO_THROW(CheckMonitorDays(kMaxMonitorDays));
+  try {
+    CheckMonitorDays(3000);
+    ADD_FAILURE() << "3000 day files accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("3000 day files"), std::string::npos) << e.what();
+  }
+  // Days that hold more samples together than one run file may are refused before any replay.
+  Planted p;
+  const DriftModel m = FitOn(MakeRun(p, 1));
+  p.samples = kMaxRunSamples / 2 + 1;
+  const drift::Run big = MakeRun(p, 2);
+  try {
+    MonitorWeek(m, {big, big}, MonitorOptions{});
+    ADD_FAILURE() << "2 x " << big.samples() << " samples accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("samples together"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace whirl::drift

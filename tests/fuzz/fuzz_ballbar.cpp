@@ -32,7 +32,8 @@ void CheckDrift(const Readings& readings, const PivotCentres& pivots) {
         RequireFinite(b.drift_sd_um(k));
       }
     for (int k = 0; k < 3; ++k) RequireFinite(r.sd43900_mm(k));
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
 }
 
@@ -47,9 +48,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       RequireFinite(d.residual_rms_um);
       RequireFinite(d.circular_deviation_um);
       for (const Term& t : d.terms) RequireFinite(t.value);
-    } catch (const whirl::InputError&) {
+    } catch (const whirl::InputError& e) {
+    whirl::fuzz::Refused(e);
     }
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   try {
     const PivotCentres pivots = ReadPivots(path);
@@ -61,11 +64,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       for (int pivot : {1, 2, 3, 3, 2, 1})
         r.rows.push_back({30.0 * b, pivot, lengths[b][pivot - 1], std::nullopt, 0});
     CheckDrift(r, pivots);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   try {
     CheckDrift(ReadReadings(path), ShippedPivots());
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   return 0;
 }

@@ -8,7 +8,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::filesystem::path path = whirl::fuzz::FuzzFile(data, size, ".csv");
   try {
     (void)whirl::ReadCsv(path, size % 2 == 0);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   return 0;
 }

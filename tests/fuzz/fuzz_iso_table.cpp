@@ -9,7 +9,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::filesystem::path path = whirl::fuzz::FuzzFile(data, size, ".csv");
   try {
     (void)whirl::compare::ReadIsoToleranceTable(path);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   return 0;
 }

@@ -11,7 +11,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const whirl::compare::LeadDeviation lead = whirl::compare::ReadLeadDeviation(path);
     (void)whirl::compare::ComputeLeadMetrics(lead);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   return 0;
 }

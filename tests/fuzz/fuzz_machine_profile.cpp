@@ -16,7 +16,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   whirl::interp::MachineProfile profile;
   try {
     profile = whirl::interp::LoadMachineProfile(path);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+    whirl::fuzz::Refused(e);
     return 0;
   }
   try {

@@ -10,7 +10,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const whirl::nn::Model m = whirl::nn::LoadModel(path);
     (void)whirl::nn::Predict(m, whirl::ProcessInputs{62, 80, 10, 3.7, 180});
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   return 0;
 }

@@ -38,7 +38,8 @@ void CheckLoadedSurface(const Surface& s) {
     RequireFinite(l.sd43900_mm);
     RequireFinite(l.sd43910);
     RequireFinite(l.uncorrected_rms_um);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
 }
 
@@ -48,13 +49,15 @@ void CheckFittedPoints(const std::vector<SurfacePoint>& points) {
     SurfaceFit fit;
     try {
       fit = FitSurface(points, {m, 1});
-    } catch (const whirl::InputError&) {
+    } catch (const whirl::InputError& e) {
+      whirl::fuzz::Refused(e);
       continue;
     }
     const nlohmann::json j = nlohmann::json::parse(whirl::DumpJson(SurfaceFitToJson(fit)));
     try {
       (void)SurfaceFromJson(j, "fitted surface");
-    } catch (const whirl::InputError&) {
+    } catch (const whirl::InputError& e) {
+      whirl::fuzz::Refused(e);
       std::abort();  // fit wrote a file that the reader refuses
     }
   }
@@ -66,19 +69,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::filesystem::path path = whirl::fuzz::FuzzFile(data, size, ".csv");
   try {
     CheckFittedPoints(ReadSurfacePoints(path));
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   try {
     (void)ReadPositions(path);
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   try {
     CheckLoadedSurface(ReadSurfaceFile(path));
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   try {
     (void)ReadPointManifest(path, {"time_min", "t1_C", "p_x0_y0_um", "e1_um", "e2_um"});
-  } catch (const whirl::InputError&) {
+  } catch (const whirl::InputError& e) {
+  whirl::fuzz::Refused(e);
   }
   return 0;
 }

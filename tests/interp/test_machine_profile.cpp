@@ -32,6 +32,8 @@ fs::path Edited(const std::function<void(nlohmann::json&)>& edit) {
   return p;
 }
 
+using J = nlohmann::json;
+
 void ExpectRefused(const std::function<void(nlohmann::json&)>& edit, const std::string& word) {
   try {
     LoadMachineProfile(Edited(edit));
@@ -131,7 +133,6 @@ TEST(MachineProfile, Version1LoadsWithTheDocumentedDefaults) {
 // The sections against each other and the control's limits: each contradiction that one command
 // accepted and another refused, or that no command checked, is refused at load, naming the key.
 TEST(MachineProfile, CrossChecksAndBoundsAreRefusedByName) {
-  using J = nlohmann::json;
   // Workpiece slots inside the drift action's own $AC_PARAM range.
   ExpectRefused([](J& j) { j["drift"]["workpiece_k0_param"] = 101; }, "workpiece_k0_param");
   ExpectRefused([](J& j) { j["drift"]["workpiece_slope_param"] = 250; }, "workpiece_slope_param");
@@ -167,6 +168,30 @@ TEST(MachineProfile, CrossChecksAndBoundsAreRefusedByName) {
   ExpectRefused([](J& j) { j["drift"].erase("workpiece_slope_param"); }, "workpiece_slope_param");
 }
 
+// Issue 45 item 3: no value in a profile switches the checks of the control's limits off. -1 in
+// control.md10300_analog_inputs once meant "not stated" and let MD28250 = 5 and MD28254 = 50
+// through although the programs need far more; each machine datum is now checked where it is
+// read, and every slot bound (param_last) and optional slot is a real slot or absent.
+TEST(MachineProfile, NoProfileValueSwitchesTheControlChecksOff) {
+  ExpectRefused(
+      [](J& j) {
+        j["control"]["md10300_analog_inputs"] = -1;
+        j["control"]["md28250_sync_elements"] = 5;
+        j["control"]["md28254_ac_params"] = 50;
+      },
+      "MD10300");
+  for (const char* key : {"md10300_analog_inputs", "md28250_sync_elements", "md28254_ac_params"})
+    for (double v : {-1.0, -1000.0, 0.5, 1e9})
+      ExpectRefused([&](J& j) { j["control"][key] = v; }, key);
+  ExpectRefused([](J& j) { j["control"]["md28250_sync_elements"] = 0; }, "MD28250");
+  ExpectRefused([](J& j) { j["control"]["md28254_ac_params"] = 0; }, "MD28254");
+  // With MD10300 stated, MD28250 and MD28254 below what the ranges need are refused by name.
+  ExpectRefused([](J& j) { j["control"]["md28250_sync_elements"] = 5; }, "MD28250");
+  ExpectRefused([](J& j) { j["control"]["md28254_ac_params"] = 50; }, "MD28254");
+  for (const char* key : {"param_last", "workpiece_k0_param", "workpiece_slope_param"})
+    ExpectRefused([&](J& j) { j["drift"][key] = -1; }, key);
+}
+
 // One validation for every command: random edits of the shipped profiles either are refused at
 // load (an InputError naming the file) or are accepted by every use (plan, combined plan, drift
 // programs with the smallest models, resets, PLC tables).
@@ -181,7 +206,7 @@ TEST(MachineProfile, AProfileThatLoadsIsAcceptedByEveryCommand) {
       {"drift", "workpiece_k0_param"}, {"drift", "workpiece_slope_param"},
       {"drift", "missing_alarm"}, {"drift", "analog_inputs", "ambient_C", "index"},
       {"drift", "analog_inputs", "ambient_C", "scale"}};
-  const std::vector<double> values = {0,   1,    2,    3,     8,     13,    80,     89,    95,
+  const std::vector<double> values = {-1, 0,   1,    2,    3,     8,     13,    80,     89,    95,
                                       97,  98,   99,   100,   101,   103,   107,    140,   149,
                                       150, 199,  200,  201,   202,   205,   240,    250,   255,
                                       256, 299,  300,  1e-6,  1e-7,  0.05,  65000,  65003, 65004,

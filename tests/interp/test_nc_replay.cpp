@@ -410,5 +410,213 @@ TEST(NcReplay, OnlyTheProfilesReservedRangeIsTouched) {
   }
 }
 
+// Issue 45 item 5: a plan program run again after a cut that never reached its restore (aborted
+// at 40 % and the axis moved back, or a power failure at 50 %), without the reset program, and a
+// plan program called twice in a row: the values it saves are those found before the first run,
+// the approach applies exactly them (no step by the old plateau at the thread start), and the
+// whole cut ends with the control as found.
+TEST(NcReplay, ARerunAfterAnAbortOrAPowerFailureStartsFromTheFoundValues) {
+  std::mt19937 rng(1806);
+  const char* what[] = {"aborted at 40 %", "power failure at 50 %", "called twice in a row"};
+  for (int trial = 0; trial < 12; ++trial) {
+    const CutSetup s = RandomSetup(rng);
+    const PlanOptions& o = s.options;
+    const CompensationPlan plan = BuildPlan(s.curve, s.feed_mm_s, s.thread_mm, o);
+    const std::string nc = FormatNcProgram(plan);
+    const double t_end = s.thread_mm / s.feed_mm_s;
+    const double start = plan.segments.front().sd43920_mm;
+    const double park = Park(o, 20.0);
+    const int m = o.save_r_first;
+    for (int how = 0; how < 3; ++how) {
+      SCOPED_TRACE(std::string(what[how]) + ", trial " + std::to_string(trial));
+      replay::Replay r = FoundState(o, rng);
+      r.actions.erase(o.sync_id_last);  // no stale action: the found values are what applies
+      const replay::Control found = r.control;
+      ASSERT_TRUE(r.RunProgram(nc));
+      if (how < 2) {
+        const double stop_s = (how == 0 ? 0.4 : 0.5) * t_end;
+        for (int i = 0; i <= 1000; ++i) r.Cycle(AxisPositionMm(o, s.feed_mm_s, stop_s * i / 1000));
+        if (how == 0)
+          r.EndProgram();
+        else
+          r.PowerOn();
+        ASSERT_NE(r.control.abs_value_mm, found.abs_value_mm) << "stopped on the plan's values";
+        ASSERT_EQ(r.control.r[m + 3], 1.0) << "the marker says: not restored";
+      }
+      r.Cycle(park);  // the axis moved back before the thread start
+      ASSERT_TRUE(r.RunProgram(nc)) << "alarm " << r.control.alarm;
+      EXPECT_EQ(r.control.r[m], found.abs_value_mm) << "saved SD43900 is the found one";
+      EXPECT_EQ(r.control.r[m + 1], found.slope);
+      EXPECT_EQ(r.control.r[m + 2], found.ref_position_mm);
+      EXPECT_EQ(r.WorstDeviationOnApproach(park, start, 400, found), 0.0) << "the approach";
+      const double sgn = SignFactor(o.sign);
+      r.Cycle(start);
+      EXPECT_NEAR(r.control.DkMm(start) * 1000.0 / sgn, s.curve.ElongationUm(0.0), o.tolerance_um)
+          << "at the thread start the plan takes over from the found values";
+      for (int i = 0; i <= 2000; ++i) r.Cycle(AxisPositionMm(o, s.feed_mm_s, t_end * i / 2000));
+      r.Cycle(AxisPositionMm(o, s.feed_mm_s, t_end) + o.direction);  // run-out
+      r.EndProgram();
+      ExpectUnchanged(r.control, found);
+      EXPECT_EQ(r.control.r[m + 3], 0.0) << "marker cleared";
+    }
+    ASSERT_FALSE(HasFailure());
+  }
+}
+
+// A machine with the live drift action (both shipped profiles: the plan hands K0 over, or K0 and
+// slope): the drift program running, then the combined plan aborted, cut after a power failure,
+// or called twice. `reference` runs the same drift program and cycles without any plan: what the
+// control must apply whenever no plan is in its cut.
+struct DriftMachine {
+  MachineProfile profile;
+  DriftActionOptions d;
+  PlanOptions o;
+  CompensationPlan plan;
+  std::string drift_nc, drift_reset, plan_nc, plan_reset;
+};
+
+DriftMachine ShippedDriftMachine(const std::string& file) {
+  DriftMachine dm;
+  dm.profile = LoadMachineProfile(std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/" + file);
+  dm.d = dm.profile.DriftOptions();
+  const std::string sensor = dm.d.inputs.begin()->first;
+  const drift::DriftModel m = testing::OneSensorModel(sensor, "offset_um");
+  const drift::DriftModel g = testing::OneSensorModel(sensor, "zscrew_per_1000_um");
+  dm.profile.ApplyCombinedTo(dm.o);
+  const fit::ArctanCurve curve = fit::ArctanCurve::FromFeatures({30.0, 250.0}, 4.0, 0.9);
+  dm.plan = BuildPlan(curve, 0.6, 1200.0, dm.o);
+  dm.drift_nc = dm.o.workpiece_slope_param >= 0 ? FormatDriftNcProgram(m, dm.d, "", &g)
+                                                : FormatDriftNcProgram(m, dm.d);
+  dm.drift_reset = FormatDriftNcResetProgram(dm.d);
+  dm.plan_nc = FormatNcProgram(dm.plan);
+  dm.plan_reset = FormatNcResetProgram(dm.o);
+  return dm;
+}
+
+replay::Replay FoundDriftMachine(const DriftMachine& dm) {
+  replay::Replay r;
+  r.axis = dm.profile.axis;
+  r.axis_mm = Park(dm.o, 30.0);
+  r.control.abs_value_mm = 0.0031;  // found values
+  r.control.slope = -2e-6;
+  r.control.ref_position_mm = 250.0;
+  for (int k = 0; k < 4; ++k) r.control.r[dm.profile.save_r_first + k] = 11.0 + k;
+  for (int k = 0; k < 5; ++k) r.control.r[dm.d.save_r_first + k] = 21.0 + k;
+  r.control.r[dm.profile.save_r_first + 3] = 0;
+  r.control.r[dm.d.save_r_first + 1] = r.control.r[dm.d.save_r_first + 4] = 0;
+  r.control.ain[dm.d.inputs.begin()->second.index] = 230.0;
+  return r;
+}
+
+// Moves both replays through the same positions; returns the largest |dK - reference's dK|, mm.
+double Travel(replay::Replay& r, replay::Replay& reference, const std::vector<double>& positions) {
+  double worst_mm = 0;
+  for (double p : positions) {
+    r.Cycle(p);
+    reference.Cycle(p);
+    worst_mm = std::max(worst_mm, std::abs(r.control.DkMm(p) - reference.control.DkMm(p)));
+  }
+  return worst_mm;
+}
+
+std::vector<double> Positions(double from_mm, double to_mm, int n) {
+  std::vector<double> p;
+  for (int i = 0; i <= n; ++i) p.push_back(from_mm + (to_mm - from_mm) * i / n);
+  return p;
+}
+
+TEST(NcReplay, CombinedPlanAfterAnAbortAPowerFailureOrTwiceStartsFromTheDriftActionAlone) {
+  for (const char* file : {"example_840d.json", "whirling_840d.json"}) {
+    const DriftMachine dm = ShippedDriftMachine(file);
+    const PlanOptions& o = dm.o;
+    const bool handover = o.workpiece_slope_param >= 0;
+    const double feed = dm.plan.axial_feed_mm_s, t_end = dm.plan.cutting_time_s;
+    const double park = Park(o, 30.0), start = dm.plan.segments.front().sd43920_mm;
+    const double end = AxisPositionMm(o, feed, t_end) + o.direction;
+    const auto cut = [&](double fraction) {
+      return Positions(start, AxisPositionMm(o, feed, fraction * t_end), 600);
+    };
+    for (int how = 0; how < 3; ++how) {
+      SCOPED_TRACE(std::string(file) + (how == 0   ? ": aborted at 40 %"
+                                        : how == 1 ? ": power failure at 50 %"
+                                                   : ": called twice in a row"));
+      replay::Replay r = FoundDriftMachine(dm);
+      const replay::Control found = r.control;
+      ASSERT_TRUE(r.RunProgram(dm.drift_nc)) << "alarm " << r.control.alarm;
+      r.EndProgram();
+      replay::Replay reference = r;  // the drift action alone from here on
+      Travel(r, reference, {park, park, park});
+      ASSERT_TRUE(r.RunProgram(dm.plan_nc)) << "alarm " << r.control.alarm;
+      if (how == 0) {
+        Travel(r, reference, cut(0.4));
+        r.EndProgram();  // the drift action's static actions stay
+      } else if (how == 1) {
+        Travel(r, reference, cut(0.5));
+        r.PowerOn();  // every action and $AC_PARAM gone; setting data and R stay
+        reference.PowerOn();
+        r.Cycle(park);
+        r.control.alarms.clear();
+        EXPECT_FALSE(r.RunProgram(dm.plan_nc)) << "the drift action is not running";
+        EXPECT_EQ(r.control.alarms, std::vector<int>{dm.d.missing_alarm});
+        r.control.alarms.clear();
+        if (!handover) {  // the plan's marker is set: the drift program wants the reset first
+          EXPECT_FALSE(r.RunProgram(dm.drift_nc));
+          EXPECT_EQ(r.control.alarms, std::vector<int>{dm.d.missing_alarm + 3});
+          ASSERT_TRUE(r.RunProgram(dm.plan_reset));
+        }
+        ASSERT_TRUE(r.RunProgram(dm.drift_nc)) << "alarm " << r.control.alarm;
+        r.EndProgram();
+        ASSERT_TRUE(reference.RunProgram(dm.drift_nc));
+        reference.EndProgram();
+      }
+      Travel(r, reference, Positions(r.axis_mm, park, 50));  // back before the thread start
+      ASSERT_TRUE(r.RunProgram(dm.plan_nc)) << "alarm " << r.control.alarm;
+      const double before_start = start - o.direction * 1e-3;  // at the start the plan takes over
+      EXPECT_LE(Travel(r, reference, Positions(park, before_start, 400)), 1e-12)
+          << "the approach applies the drift action alone";
+      Travel(r, reference, cut(1.0));
+      Travel(r, reference, {end});
+      EXPECT_LE(std::abs(r.control.DkMm(end) - reference.control.DkMm(end)), 1e-12)
+          << "after the cut the drift action alone again";
+      r.EndProgram();
+      ASSERT_TRUE(r.RunProgram(dm.plan_reset));
+      ASSERT_TRUE(r.RunProgram(dm.drift_reset));
+      ExpectUnchanged(r.control, found);
+      EXPECT_EQ(r.control.r[dm.profile.save_r_first + 3], 0.0);
+      EXPECT_EQ(r.control.r[dm.d.save_r_first + 1], 0.0);
+      EXPECT_EQ(r.control.r[dm.d.save_r_first + 4], 0.0);
+    }
+  }
+}
+
+// The drift program run twice in a row, or again after a power failure, saves only what it
+// found before its first run: its reset program gives back the machine's own values, also when
+// called after a power failure without a rerun, and a second reset changes nothing.
+TEST(NcReplay, DriftProgramTwiceOrAfterAPowerFailureResetsToTheFoundValues) {
+  for (const char* file : {"example_840d.json", "whirling_840d.json"}) {
+    const DriftMachine dm = ShippedDriftMachine(file);
+    for (int how = 0; how < 3; ++how) {
+      SCOPED_TRACE(std::string(file) + ", case " + std::to_string(how));
+      replay::Replay r = FoundDriftMachine(dm);
+      const replay::Control found = r.control;
+      ASSERT_TRUE(r.RunProgram(dm.drift_nc));
+      for (int k = 0; k < 3; ++k) r.Cycle(r.axis_mm);
+      ASSERT_NE(r.control.abs_value_mm, found.abs_value_mm) << "the action writes SD43900";
+      if (how == 0) {
+        ASSERT_TRUE(r.RunProgram(dm.drift_nc));  // twice in a row
+      }
+      if (how >= 1) r.PowerOn();
+      if (how == 1) {
+        ASSERT_TRUE(r.RunProgram(dm.drift_nc));  // restarted after the power failure
+      }
+      for (int k = 0; k < 3; ++k) r.Cycle(r.axis_mm);
+      ASSERT_TRUE(r.RunProgram(dm.drift_reset));
+      ExpectUnchanged(r.control, found);
+      ASSERT_TRUE(r.RunProgram(dm.drift_reset));
+      ExpectUnchanged(r.control, found);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace whirl::interp

@@ -12,3 +12,9 @@ whirl_add_cli_test(cli_numeric_flags ${CMAKE_CURRENT_LIST_DIR}/cli_numeric_flags
 # --json on every computing command, one help line per command, unknown commands named with the
 # closest match, and each deprecated old spelling still working with its one-line notice.
 whirl_add_cli_test(cli_grammar ${CMAKE_CURRENT_LIST_DIR}/cli_grammar.sh)
+# Issue 45: output manifests, the control's limits, duplicate keys, model-file messages, time and
+# count bounds, a deprecated flag given twice (each a regression test of a finding).
+whirl_add_cli_test(cli_hardening ${CMAKE_CURRENT_LIST_DIR}/cli_hardening.sh)
+# Every model a command writes (drift fit, train, surface fit/points, ballbar drift) handed to
+# every command that takes a model file: accepted or refused by name, never a signal.
+whirl_add_cli_test(cli_model_roundtrip ${CMAKE_CURRENT_LIST_DIR}/cli_model_roundtrip.sh)
