@@ -218,16 +218,17 @@ drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s, bool time_fr
   return o;
 }
 
-// FitFiles on the run files (streamed: any length), with LoadRuns' warning for runs without time.
+// FitFiles on the run files (streamed: any length), with LoadRuns' warning for runs without time
+// (`warn` false: the caller loads the same runs with LoadRuns, which warns).
 drift::FitReport FitRunFiles(const RunInputs& in, const std::string& error, const ModelArgs& m,
-                             const SelectionArgs& sel, RowProgress* progress) {
+                             const SelectionArgs& sel, RowProgress* progress, bool warn = true) {
   const std::vector<drift::RunFile> files = RunFiles(in);
   // The time axis of the options (the lag grid's unit) is the runs': ask the first file.
   const bool time_from_index = drift::ScanRun(files.front().path).time_from_index;
   drift::FitReport rep = drift::FitFiles(files, error, ToFit(m, sel, time_from_index),
                                          progress ? progress->Callback() : drift::StreamProgress());
   if (progress) progress->Finish();
-  if (rep.model.time_unit == "sample")
+  if (warn && rep.model.time_unit == "sample")
     for (const auto& f : files)
       Warn(f.path.string() + ": no complete time column: the sample index is used as time");
   return rep;
@@ -592,12 +593,11 @@ void RegisterReport(CLI::App* drift_app) {
     std::vector<FlagPath> inputs = InputPaths(o->train, "train-"), more = InputPaths(o->runs);
     inputs.insert(inputs.end(), more.begin(), more.end());
     CheckOutputs(inputs, {}, {{"--out-dir", o->out_dir}});
-    const auto train = LoadRuns(o->train);
-    std::vector<drift::Run> runs = train;
-    if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
-      runs = LoadRuns(o->runs);
-    const drift::FitReport rep = drift::FitDriftModel(
-        train, o->error, ToFit(o->model, o->sel, train.front().time_from_index));
+    const bool shown = !o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty();
+    // The model as drift fit makes it (streamed; a thinned search on long training runs).
+    const drift::FitReport rep =
+        FitRunFiles(o->train, o->error, o->model, o->sel, nullptr, /*warn=*/shown);
+    const std::vector<drift::Run> runs = LoadRuns(shown ? o->runs : o->train);
     for (const auto& w : rep.warnings) Warn(w);
     const auto r =
         drift::WriteModelReport(o->out_dir, rep, runs, {"whirl drift report --error " + o->error});
