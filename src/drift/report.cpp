@@ -54,6 +54,22 @@ class ReportWriter {
     }
     return "<p>(plot not rendered: " + HtmlEscape(stem) + ".gp)</p>";
   }
+  // A long per-sample CSV written to disk as it is formatted (never held whole): the
+  // prediction's rows through a 1 MiB buffer into the staging folder, renamed into place by Commit.
+  void PredictionFile(const std::string& name, const RunPrediction& p,
+                      const std::vector<std::string>& comments) {
+    StreamedFile file(fs::absolute(out_.Staging()) / name);
+    std::string rows = PredictionCsvHeader(p.time_from_index, p.has_measured, comments);
+    for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k) {
+      AppendPredictionRow(p.time[static_cast<std::size_t>(k)], p.predicted_um(k), p.std_um(k),
+                          p.has_measured ? &p.measured_um(k) : nullptr, &rows);
+      if (rows.size() < (1u << 20)) continue;
+      file.Append(rows);
+      rows.clear();
+    }
+    file.Append(rows);
+    out_.AddReady(name, file.Finish());
+  }
   const std::vector<std::string>& warnings() const { return result_.warnings; }
   DriftReportResult Finish(const std::string& html) {
     if (gnuplot_failed_) out_.AddProgramLog("gnuplot.log");
@@ -311,8 +327,7 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   std::ostringstream plots;
   for (const RunPrediction& p : preds) {
     const std::string slug = Slug(p.run);
-    w.File(slug + "_prediction.csv",
-           PredictionCsv(p, Comments(provenance, "prediction of " + p.run)));
+    w.PredictionFile(slug + "_prediction.csv", p, Comments(provenance, "prediction of " + p.run));
     if (p.has_measured) {
       h << StatsRow(p.run + " (model)", ComputeErrorStats(p.measured_um - p.predicted_um))
         << StatsRow(p.run + " (no compensation)", ComputeErrorStats(p.measured_um));
