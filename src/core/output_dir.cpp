@@ -526,7 +526,29 @@ void OutputDir::AddStaged(const std::string& name) {
   Stage(name, files_.back().second, false);
 }
 
-std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, std::string>>& also) {
+bool OutputDir::AddProgramLog(const std::string& name) {
+  std::error_code ec;
+  if (staging_.empty() || !fs::is_regular_file(fs::symlink_status(staging_ / name, ec)))
+    return false;
+  AddStaged(name);
+  return true;
+}
+
+void OutputDir::AddReady(const std::string& name, const fs::path& ready) {
+  if (!ValidEntryName(name) || IsWhirlTemporary(name))
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": " + QuotedPath(name) +
+                     " is not a file name whirl may write there");
+  if (!names_.insert(name).second)
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": two outputs named " + QuotedPath(name));
+  const std::string hash = FileSha256(ready);
+  if (hash.empty())
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": cannot read back " + QuotedPath(ready));
+  ready_.push_back({dir_ / name, ready});
+  ready_hashes_[name] = hash;
+}
+
+std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, std::string>>& also,
+                                        const std::vector<ReadyFile>& also_ready) {
   // The rule again, just before writing; `before` is what the directory provably holds of whirl's.
   const Proof before = Inspect(dir_, what_, std::set<std::string>(kept_.begin(), kept_.end()));
   Create();
@@ -535,6 +557,7 @@ std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, st
   Listing now;
   now.dirs.insert(kept_.begin(), kept_.end());
   for (const auto& [name, text] : files_) now.files[name] = Sha256Hex(text);
+  for (const auto& [name, hash] : ready_hashes_) now.files[name] = hash;
   Listing all = now;
   for (const auto& [name, hash] : before.listing.files)
     if (!now.files.count(name) && !now.dirs.count(name)) all.files[name] = hash;
@@ -551,7 +574,10 @@ std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, st
   // Until the old files are gone the manifest lists them too, so a run killed in between
   // leaves a directory the next run accepts.
   batch.emplace_back(dir_ / kOutputManifest, ManifestText(all));
-  WriteFilesAtomic(batch);
+  std::vector<ReadyFile> ready = ready_;
+  for (const auto& r : ready_) written.push_back(r.path);
+  ready.insert(ready.end(), also_ready.begin(), also_ready.end());
+  WriteFilesAtomic(batch, ready);
   committed_ = true;
   std::error_code ec;
   if (!staging_.empty()) fs::remove_all(staging_, ec);

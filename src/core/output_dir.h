@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/atomic_file.h"  // ReadyFile
+
 namespace whirl {
 
 /// The file in each output directory that lists what whirl wrote there: JSON, schema
@@ -77,6 +79,11 @@ class OutputDir {
   /// A file of the output: `name` is one path component (no '/', not the manifest), given once.
   void Add(const std::string& name, std::string contents);
 
+  /// A file of the output already on disk, written without holding it (a long per-sample CSV:
+  /// StreamedFile with a target inside Staging(), then Finish()): `ready` is renamed into place
+  /// by Commit, never read into memory. Not copied into Staging() under `name`.
+  void AddReady(const std::string& name, const std::filesystem::path& ready);
+
   /// An entry written by its own OutputDir during this run (the demo's report/ sub-directory):
   /// listed in the manifest, never written by Commit.
   void Keep(const std::string& name);
@@ -96,12 +103,15 @@ class OutputDir {
   /// run can prove those names are whirl's and remove them. Add what it wrote with AddStaged.
   int RunInStaging(const std::vector<std::string>& argv, const std::string& log,
                    const std::vector<std::string>& outputs);
+  /// Adds the log `name` of a RunInStaging program if it wrote one (false if not).
+  bool AddProgramLog(const std::string& name);
 
   /// Writes every added file, the manifest and `also` (files outside the directory, e.g. the
   /// --out JSON beside a --report) all-or-nothing; re-checks the rule first. Returns the paths
   /// of the added files.
   std::vector<std::filesystem::path> Commit(
-      const std::vector<std::pair<std::filesystem::path, std::string>>& also = {});
+      const std::vector<std::pair<std::filesystem::path, std::string>>& also = {},
+      const std::vector<ReadyFile>& also_ready = {});
 
  private:
   void Insert(const std::string& name, std::string contents);  // checks the name, keeps it
@@ -114,6 +124,8 @@ class OutputDir {
   std::vector<std::pair<std::string, std::string>> files_;
   std::set<std::string> names_;  ///< of files_
   std::vector<std::string> kept_;
+  std::vector<ReadyFile> ready_;  ///< AddReady: the target inside the directory, the file
+  std::map<std::string, std::string> ready_hashes_;  ///< AddReady: name -> SHA-256
   std::filesystem::path staging_;
   std::map<std::string, std::string> staged_;  ///< name -> SHA-256 in the staging folder
   bool created_ = false, committed_ = false;

@@ -79,7 +79,7 @@ bool Render(OutputDir& out, const SurfaceReportOptions& o, SurfaceReportResult& 
   const fs::path stage = out.Staging();
   std::error_code ec;
   if (rc != 0 || !fs::is_regular_file(stage / "map.png", ec)) {
-    if (fs::is_regular_file(stage / "gnuplot.log", ec)) out.AddStaged("gnuplot.log");
+    out.AddProgramLog("gnuplot.log");
     r.warnings.push_back("gnuplot failed (exit " + std::to_string(rc) +
                          "), see gnuplot.log: map skipped");
     return false;
