@@ -20,9 +20,19 @@ Problem 3, "simgen": a training table of N rows (20, 100) generated per seed by 
   --count N --seed 100000 + 1000 N + seed` (the simulator's Halton design and disturbances; the
   shipped tables use seeds 1-3), tested on datasets/whirling_500.csv as problem 2; the tables are
   kept in --sim-cache (default: a temporary folder) so that reruns do not simulate again.
+Generator families (GENERATORS; each function documented where it is defined): "powerlaw" and
+  "powerlaw_noisy" (random exponents, 3-15 % noise), "bent" (a power law bent in one input),
+  "additive" (one random smooth shape per input), "friedman23" (Friedman #2 and #3), "interacting"
+  (products and a ratio). A seed draws the function, so seed s is the same function at every size;
+  the test rows (1000) come from the same function, and RMSE is against the noise-free function.
+The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additive, simgen with
+  seeds 1-20; "confirmation" = the same five on seeds 1001-1020 plus friedman23, interacting and
+  powerlaw_noisy, which no setting was tuned on. Settings are chosen on the tuning part only; the
+  confirmation part is run once, at the end (docs/workpiece-model.md reports both).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
-both outputs as whirl):
+both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
+network: trainbr with R brnn's stopping rule, raw columns; R brnn itself is not packaged):
   mlp_default: MLPRegressor() as a new user would call it (100 relu units, adam, 200 iterations);
   mlp_cv:      MLPRegressor(solver="lbfgs", tanh, max_iter=2000) with hidden size in {6, 10} and
                L2 penalty alpha in {1e-3, 1e-2, 1e-1, 1, 10} chosen by 5-fold GridSearchCV
@@ -53,14 +63,24 @@ sklearn's wall time of fit() (mlp_cv includes its grid search).
 Peer cache (--peer-cache FILE): the peers' results per (problem, rows, seed, peer, sklearn
 version) are read from and added to FILE (JSON), so exploring whirl settings does not refit them.
 
-Usage: bench_peers.py --whirl build/whirl [--seeds 20] [--first-seed 1] [--sizes 20,100]
-       [--problems friedman,simulator,simgen] [--variant NAME=ARGS ...] [--no-default]
-       [--family-bench PATH --family NAME=ARGS ...] [--peer-cache FILE] [--json out.json]
+The summary at the end compares each whirl method's median test RMSE per output with the best
+median of the --acceptance-peers (default loglinear, gp_ard, mlp_default, mlp_cv, brnn_whirl: the
+power law, GP-ARD and the networks) and lists its +-1 / +-2 sd coverage.
+
+Usage: bench_peers.py --whirl build/whirl [--split tuning|confirmation] [--seeds 20]
+       [--first-seed 1] [--sizes 20,100] [--problems friedman,simulator,simgen,...]
+       [--variant NAME=ARGS ...] [--no-default] [--family-bench PATH --family NAME=ARGS ...]
+       [--peers ...] [--acceptance-peers ...] [--peer-cache FILE] [--json out.json]
 """
 import argparse
 import json
 import math
 import os
+
+# One thread per fit (numpy/scipy's BLAS): timings comparable with whirl's single-thread runs, and
+# the benchmark leaves the other cores to others.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 import subprocess
 import sys
 import tempfile
@@ -98,6 +118,147 @@ def friedman(rng, n):
     return INPUT_LO + INPUT_SPAN * x, f + TARGET_OFFSET, y + TARGET_OFFSET
 
 
+# ---- Generator families (see GENERATORS and SPLITS below) ----------------------------------------
+# Each family draws its function's parameters from a generator seeded by (family, seed) only, so a
+# seed is the same function at every table size; the rows come from a generator seeded by (family,
+# rows, seed). u ~ U[0, 1]^5 is written as INPUT_LO + INPUT_SPAN u (X below, physical units);
+# R = X / X_mid (X_mid the middle of each input's range, R in [0.5, 1.5] except hardness
+# [0.8, 1.2]). Noise is added to the function f; test RMSE is against f.
+X_MID = INPUT_LO + 0.5 * INPUT_SPAN
+
+
+def powerlaw_params(prng, noise):
+    """Per output: exponents ~ U(-2, 2) (each 0 with probability 0.3: an input that does not
+    matter), level 10 (out1) and 50 (out2); multiplicative noise exp(noise_k N(0, 1))."""
+    a = prng.uniform(-2.0, 2.0, size=(2, 5)) * (prng.uniform(size=(2, 5)) > 0.3)
+    return {"a": a, "c": np.array([10.0, 50.0]), "noise": np.array(noise)}
+
+
+def powerlaw_f(p, u):
+    r = (INPUT_LO + INPUT_SPAN * u) / X_MID
+    return p["c"] * np.exp(np.log(r) @ p["a"].T)
+
+
+def make_powerlaw(noise):
+    def params(prng):
+        return powerlaw_params(prng, noise)
+
+    def sample(p, rng, n):
+        u = rng.uniform(size=(n, 5))
+        f = powerlaw_f(p, u)
+        return u, f, f * np.exp(rng.normal(size=f.shape) * p["noise"])
+    return params, sample
+
+
+def bent_params(prng):
+    """A power law (noise 3 % / 8 %) times exp(b_k ln^2 R_j) per output k: one input j_k, bend
+    |b_k| ~ U(0.5, 2) of either sign (ln^2 R reaches 0.48 at the ends of the range)."""
+    p = powerlaw_params(prng, [0.03, 0.08])
+    p["j"] = prng.integers(0, 5, size=2)
+    p["b"] = prng.uniform(0.5, 2.0, size=2) * prng.choice([-1.0, 1.0], size=2)
+    return p
+
+
+def bent_sample(p, rng, n):
+    u = rng.uniform(size=(n, 5))
+    r = (INPUT_LO + INPUT_SPAN * u) / X_MID
+    f = powerlaw_f(p, u) * np.exp(p["b"] * np.log(r[:, p["j"]]) ** 2)
+    return u, f, f * np.exp(rng.normal(size=f.shape) * p["noise"])
+
+
+ADDITIVE_SHAPES = (
+    lambda v, c: np.sin(2 * np.pi * v + 6 * c),             # a full wave, random phase
+    lambda v, c: 4 * (v - c) ** 2,                           # a parabola, vertex in [0, 1]
+    lambda v, c: np.exp(2 * v) / np.exp(2.0),                # exponential growth
+    lambda v, c: 1 / (1 + np.exp(-12 * (v - 0.2 - 0.6 * c))),  # a smooth step
+    lambda v, c: v,                                          # linear
+)
+
+
+def additive_params(prng):
+    """Per output f = 10 + sum_i a_i g_i(u_i): each input's shape g_i drawn from ADDITIVE_SHAPES,
+    amplitude a_i ~ U(1, 5), one random constant c_i per shape; noise sd 0.5 (out1), 1 (out2)."""
+    return {"shape": prng.integers(0, len(ADDITIVE_SHAPES), size=(2, 5)),
+            "a": prng.uniform(1.0, 5.0, size=(2, 5)), "c": prng.uniform(size=(2, 5)),
+            "noise": np.array([0.5, 1.0])}
+
+
+def additive_sample(p, rng, n):
+    u = rng.uniform(size=(n, 5))
+    f = np.full((n, 2), 10.0)
+    for k in range(2):
+        for i in range(5):
+            f[:, k] += p["a"][k, i] * ADDITIVE_SHAPES[p["shape"][k, i]](u[:, i], p["c"][k, i])
+    return u, f, f + rng.normal(size=f.shape) * p["noise"]
+
+
+def friedman23_params(prng):
+    """Friedman #2 (out1) and #3 (out2) (Friedman 1991; Breiman, "Bagging predictors", 1996) on
+    u_1..u_4 (u_5 does not matter): x1 = 100 u1, x2 = 40 pi + 520 pi u2, x3 = u3, x4 = 1 + 10 u4;
+    f2 = sqrt(x1^2 + (x2 x3 - 1 / (x2 x4))^2) + 500, f3 = 100 atan((x2 x3 - 1 / (x2 x4)) / x1) + 200
+    (shifted and scaled so that noisy values stay positive); noise sd one third of each function's
+    sd (Friedman's 3:1 signal-to-noise ratio: 125 and 31). No random parameters."""
+    return {"noise": np.array([125.0, 31.0])}
+
+
+def friedman23_sample(p, rng, n):
+    u = rng.uniform(size=(n, 5))
+    x1, x2, x3, x4 = 100 * u[:, 0], 40 * np.pi + 520 * np.pi * u[:, 1], u[:, 2], 1 + 10 * u[:, 3]
+    g = x2 * x3 - 1 / (x2 * x4)
+    f = np.column_stack([np.sqrt(x1 ** 2 + g ** 2) + 500,
+                         100 * np.arctan(g / np.maximum(x1, 1e-9)) + 200])
+    return u, f, f + rng.normal(size=f.shape) * p["noise"]
+
+
+def interacting_params(prng):
+    """out1 = 20 + a1 u_i u_j + a2 u_k u_l u_m + a3 u_p (a ~ U(5, 15), inputs drawn per seed),
+    noise sd 1; out2 = 30 exp(4 (u_i - 0.5)(u_j - 0.5) b) + 10 u_k / (0.5 + u_l) (b ~ U(0.8, 1.6)),
+    noise sd 2: products, a ratio, no additive structure."""
+    return {"i1": prng.permutation(5), "a": prng.uniform(5.0, 15.0, size=3),
+            "i2": prng.permutation(5), "b": prng.uniform(0.8, 1.6), "noise": np.array([1.0, 2.0])}
+
+
+def interacting_sample(p, rng, n):
+    u = rng.uniform(size=(n, 5))
+    i, j = p["i1"], p["i2"]
+    f1 = 20 + p["a"][0] * u[:, i[0]] * u[:, i[1]] + p["a"][1] * u[:, i[2]] * u[:, i[3]] * u[:, i[4]] + \
+        p["a"][2] * u[:, i[0]]
+    f2 = 30 * np.exp(4 * (u[:, j[0]] - 0.5) * (u[:, j[1]] - 0.5) * p["b"]) + \
+        10 * u[:, j[2]] / (0.5 + u[:, j[3]])
+    f = np.column_stack([f1, f2])
+    return u, f, f + rng.normal(size=f.shape) * p["noise"]
+
+
+# name -> (family id for the seeds, params(prng), sample(params, rng, n) -> (u, f, y), what it is)
+GENERATORS = {
+    "powerlaw": (1, *make_powerlaw([0.03, 0.08]), "power law, noise 3 % / 8 %"),
+    "bent": (2, bent_params, bent_sample, "power law with a bend in one input per output"),
+    "additive": (3, additive_params, additive_sample, "sum of one smooth shape per input"),
+    "friedman23": (4, friedman23_params, friedman23_sample, "Friedman #2 / #3, 3:1 signal to noise"),
+    "interacting": (5, interacting_params, interacting_sample, "products and a ratio of inputs"),
+    "powerlaw_noisy": (6, *make_powerlaw([0.15, 0.15]), "power law, noise 15 % / 15 %"),
+}
+
+# The split of the suite, fixed before any setting was tuned on it (docs/workpiece-model.md):
+# settings are tuned on "tuning" only; "confirmation" (fresh seeds of the tuning families, three
+# generator families never used for tuning, the simulator on fresh seeds) is run once at the end.
+SPLITS = {
+    "tuning": {"problems": "powerlaw,bent,friedman,additive,simgen", "first_seed": 1},
+    "confirmation": {"problems": "powerlaw,bent,friedman,additive,simgen,friedman23,interacting,"
+                                 "powerlaw_noisy", "first_seed": 1001},
+}
+
+
+def generated(family, n, seed):
+    """(x train, y train, x test, f test (noise-free), y test) of a GENERATORS family."""
+    fid, params, sample, _ = GENERATORS[family]
+    p = params(np.random.default_rng([fid, seed]))
+    rng = np.random.default_rng([fid, n, seed])
+    utr, _, ytr = sample(p, rng, n)
+    ute, fte, yte = sample(p, rng, TEST_ROWS)
+    return INPUT_LO + INPUT_SPAN * utr, ytr, INPUT_LO + INPUT_SPAN * ute, fte, yte
+
+
 def read_table(path):
     rows = [l for l in open(path) if l.strip() and not l.startswith("#")]
     header = rows[0].strip().split(",")
@@ -129,9 +290,12 @@ def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
     write_table(train, xtr, ytr)
     write_table(test, xte)
     t, mean, sd = run_whirl_once(whirl, args, train, test, model, seed, 1)
-    s = t["training_summary"]
-    info = {"gamma": s["gamma"], "epochs": s["epochs"],
-            "hidden": t["layer_sizes"][1] if len(t["layer_sizes"]) > 2 else 0, "flat": bool(t.get("warnings"))}
+    if "training_summary" in t:  # a network file
+        s = t["training_summary"]
+        info = {"gamma": s["gamma"], "epochs": s["epochs"], "flat": bool(t.get("warnings")),
+                "hidden": t["layer_sizes"][1] if len(t["layer_sizes"]) > 2 else 0}
+    else:  # a family choice
+        info = {"chosen": t["chosen"], "cpu_ms": t.get("fit_cpu_ms", t["fit_time_ms"])}
     if threads2:
         t2, mean2, sd2 = run_whirl_once(whirl, args, train, test, model, seed, 2)
         if not (np.array_equal(mean, mean2) and np.array_equal(sd, sd2)):
@@ -139,6 +303,13 @@ def run_whirl(whirl, args, xtr, ytr, xte, seed, tmp, threads2):
                      "differently from --threads 1")
         info["time2_ms"] = t2["fit_time_ms"]
     return mean, sd, t["fit_time_ms"], info
+
+
+def brnn_equivalent(whirl, xtr, ytr, xte, seed, tmp):
+    """Peer "brnn_whirl": whirl train --family network (trainbr with R brnn's stopping rule, the
+    hidden size in {0, 4, 6, 8} by the evidence, raw columns): (mean, fit ms, sd)."""
+    mean, sd, ms, _ = run_whirl(whirl, ["--family", "network"], xtr, ytr, xte, seed, tmp, False)
+    return mean, ms, sd
 
 
 def fit_gp(xtr, ytr, xte, seed, ard):
@@ -225,17 +396,67 @@ def rmse(pred, truth):
     return np.sqrt(np.mean((pred - truth) ** 2, axis=0))
 
 
+def problem_data(prob, n, seed, whirl, datasets, sim_cache):
+    """(x train, y train, x test, f test (the truth RMSE is measured against), y test)."""
+    if prob == "friedman":
+        rng = np.random.default_rng(1000 * n + seed)
+        xtr, _, ytr = friedman(rng, n)
+        xte, fte, yte = friedman(rng, TEST_ROWS)
+        return xtr, ytr, xte, fte, yte
+    if prob in GENERATORS:
+        return generated(prob, n, seed)
+    xte, yte = read_table(os.path.join(datasets, "whirling_500.csv"))
+    if prob == "simgen":
+        xtr, ytr = simulated_table(whirl, n, seed, sim_cache)
+    elif prob == "simulator":
+        xtr, ytr = read_table(os.path.join(datasets, "whirling_train.csv"))
+    else:
+        sys.exit(f"bench_peers: unknown problem '{prob}' (friedman, simulator, simgen, "
+                 + ", ".join(GENERATORS) + ")")
+    return xtr, ytr, xte, yte, yte
+
+
+def save_peer_cache(path, key, value):
+    """Adds one result to the cache file: re-read, extend, replace atomically (several runs may
+    share the file)."""
+    cache = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            cache = json.load(f)
+    cache[key] = value
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "w") as f:
+        json.dump(cache, f, indent=1)
+    os.replace(tmp, path)
+
+
+def failed(e):
+    """The record of a method that failed on a table (NaN figures; the reports count them)."""
+    what = e.stderr.strip() if getattr(e, "stderr", None) else str(e)
+    print(f"bench_peers: failed: {what}", file=sys.stderr)
+    return {"rmse": [math.nan, math.nan], "time_ms": math.nan, "failed": what[:300]}
+
+
+def parse_named(items):
+    return [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in items]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--whirl", required=True)
     ap.add_argument("--seeds", type=int, default=20)
-    ap.add_argument("--first-seed", type=int, default=1,
-                    help="seeds FIRST .. FIRST + SEEDS - 1 (default 1): a fresh set of tables")
+    ap.add_argument("--first-seed", type=int,
+                    help="seeds FIRST .. FIRST + SEEDS - 1 (default 1, or the split's)")
     ap.add_argument("--sizes", default="20,100")
-    ap.add_argument("--problems", default="friedman,simulator")
+    ap.add_argument("--problems", help="default friedman,simulator, or the split's")
+    ap.add_argument("--split", choices=sorted(SPLITS),
+                    help="the suite's tuning or confirmation part (problems and first seed)")
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=ARGS: extra whirl train arguments (default: whirl=(none))")
     ap.add_argument("--peers", default="mlp_default,mlp_cv,ols,ridge_gcv,loglinear,gp_ard,gp_rbf")
+    ap.add_argument("--acceptance-peers", default="loglinear,gp_ard,mlp_default,mlp_cv,brnn_whirl",
+                    help="the peers whose best median each whirl method is compared with (those "
+                         "that were run)")
     ap.add_argument("--family-bench", help="path of build/family_bench (the family library's driver)")
     ap.add_argument("--family", action="append", default=[],
                     help="NAME=ARGS: run family_bench with ARGS (needs --family-bench)")
@@ -246,16 +467,21 @@ def main():
     ap.add_argument("--peer-cache", help="read/extend the peers' results in this JSON file")
     ap.add_argument("--no-default", action="store_true",
                     help="do not run whirl with default options (only the --variant settings)")
+    ap.add_argument("--markdown", action="store_true",
+                    help="print the summary (the last table) as a Markdown table")
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     a = ap.parse_args()
-    variants = ([] if a.no_default else [("whirl", [])]) + [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.variant]
-    families = [(v.split("=", 1)[0], v.split("=", 1)[1].split()) for v in a.family]
+    split = SPLITS.get(a.split, {})
+    problems = a.problems or split.get("problems", "friedman,simulator")
+    first_seed = a.first_seed if a.first_seed is not None else split.get("first_seed", 1)
+    variants = ([] if a.no_default else [("whirl", [])]) + parse_named(a.variant)
+    families = parse_named(a.family)
     if families and not a.family_bench:
         sys.exit("bench_peers: --family needs --family-bench")
     peers = [p for p in a.peers.split(",") if p]
     cases = []
-    for prob in a.problems.split(","):
-        sizes = [int(s) for s in a.sizes.split(",")] if prob in ("friedman", "simgen") else [20]
+    for prob in problems.split(","):
+        sizes = [20] if prob == "simulator" else [int(s) for s in a.sizes.split(",")]
         cases += [(prob, n) for n in sizes]
     cache = {}
     if a.peer_cache and os.path.exists(a.peer_cache):
@@ -266,45 +492,44 @@ def main():
         sim_cache = a.sim_cache or tmp
         os.makedirs(sim_cache, exist_ok=True)
         for prob, n in cases:
-            for seed in range(a.first_seed, a.first_seed + a.seeds):
-                if prob == "friedman":
-                    rng = np.random.default_rng(1000 * n + seed)
-                    xtr, _, ytr = friedman(rng, n)
-                    xte, fte, yte = friedman(rng, TEST_ROWS)
-                elif prob == "simgen":
-                    xtr, ytr = simulated_table(a.whirl, n, seed, sim_cache)
-                    xte, yte = read_table(os.path.join(a.datasets, "whirling_500.csv"))
-                    fte = yte
-                else:
-                    xtr, ytr = read_table(os.path.join(a.datasets, "whirling_train.csv"))
-                    xte, yte = read_table(os.path.join(a.datasets, "whirling_500.csv"))
-                    fte = yte
+            for seed in range(first_seed, first_seed + a.seeds):
+                xtr, ytr, xte, fte, yte = problem_data(prob, n, seed, a.whirl, a.datasets, sim_cache)
                 rec = {"problem": prob, "rows": n, "seed": seed, "methods": {}}
-                for name, args in variants:
-                    mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp,
-                                                 not a.no_threads2)
-                    rec["methods"][name] = {"rmse": rmse(mean, fte).tolist(), "time_ms": ms,
-                                            **info, **coverage(mean, sd, yte, fte)}
-                for name, args in families:
-                    mean, sd, ms, info = run_family(a.family_bench, args, xtr, ytr, xte, tmp)
-                    rec["methods"][name] = {"rmse": rmse(mean, fte).tolist(), "time_ms": ms,
-                                            **info, **coverage(mean, sd, yte, fte)}
+                for name, args in variants + families:
+                    try:
+                        if (name, args) in families:
+                            mean, sd, ms, info = run_family(a.family_bench, args, xtr, ytr, xte, tmp)
+                        else:
+                            mean, sd, ms, info = run_whirl(a.whirl, args, xtr, ytr, xte, seed, tmp,
+                                                           not a.no_threads2)
+                        rec["methods"][name] = {"rmse": rmse(mean, fte).tolist(), "time_ms": ms,
+                                                **info, **coverage(mean, sd, yte, fte)}
+                    except subprocess.CalledProcessError as e:
+                        rec["methods"][name] = failed(e)
                 for p in peers:
-                    key = f"{prob}/{n}/{seed}/{p}/sklearn-{sklearn.__version__}"
+                    key = f"{prob}/{n}/{seed}/{p}/" + (
+                        "whirl" if p == "brnn_whirl" else f"sklearn-{sklearn.__version__}")
                     if key not in cache:
-                        pred, ms, sd = fit_sklearn(p, xtr, ytr, xte, seed)
-                        cache[key] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
-                        if sd is not None:
-                            cache[key].update(coverage(pred, sd, yte, fte))
+                        try:
+                            if p == "brnn_whirl":
+                                pred, ms, sd = brnn_equivalent(a.whirl, xtr, ytr, xte, seed, tmp)
+                            else:
+                                pred, ms, sd = fit_sklearn(p, xtr, ytr, xte, seed)
+                            cache[key] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
+                            if sd is not None:
+                                cache[key].update(coverage(pred, sd, yte, fte))
+                        except (subprocess.CalledProcessError, ValueError) as e:
+                            cache[key] = failed(e)
                         if a.peer_cache:
-                            with open(a.peer_cache, "w") as f:
-                                json.dump(cache, f, indent=1)
+                            save_peer_cache(a.peer_cache, key, cache[key])
                     rec["methods"][p] = cache[key]
                 results.append(rec)
                 print(f"{prob} {n} rows seed {seed}: " + ", ".join(
                     f"{k} {v['rmse'][0]:.3g}/{v['rmse'][1]:.3g}" for k, v in rec["methods"].items()),
                     file=sys.stderr)
             report(results, prob, n, variants + families, peers)
+    accept = [p for p in a.acceptance_peers.split(",") if p in peers]
+    summary(results, cases, [v[0] for v in variants + families], accept, a.markdown)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(results, f, indent=1)
@@ -339,15 +564,50 @@ def report(results, prob, n, variants, peers):
             line += f" {sum(bool(r['methods'][m].get('flat')) for r in rs):>5}"
         print(line)
     for m in [v[0] for v in variants]:
-        chosen = [r["methods"][m]["chosen"] for r in rs if "chosen" in r["methods"][m]]
-        if chosen:
+        ok = [r["methods"][m] for r in rs if "chosen" in r["methods"][m]]
+        if ok:
+            chosen = [o["chosen"] for o in ok]
             counts = {c: chosen.count(c) for c in sorted(set(chosen))}
             print(f"{m} chose: " + ", ".join(f"{c} {k}" for c, k in counts.items()) +
-                  f"; median fit CPU {np.median([r['methods'][m]['cpu_ms'] for r in rs]):.2f} ms")
+                  f"; median fit CPU {np.median([o['cpu_ms'] for o in ok]):.2f} ms")
     print("wins = seeds on which the method beats the best peer of that seed; cov = mean % of test "
           "targets within +-1/2 sd (noisy), cov1sd_f = +-1 sd against the noise-free function; "
           "time = median fit time (time2: whirl --threads 2); flat = seeds on which whirl train warned "
           "that the network is nearly flat (nn::FlatOutputs: it ignores the inputs)")
+    sys.stdout.flush()
+
+
+def summary(results, cases, methods, accept, markdown=False):
+    """One line per problem, size and whirl method: median test RMSE per output, as % above the
+    best acceptance peer's median (negative: below it), and the +-1 / +-2 sd coverage (mean %)."""
+    if not accept or not methods:
+        return
+    print(f"\nSummary against the best of {', '.join(accept)} (median test RMSE per output; "
+          "+x % = above the best peer's median; coverage +-1 / +-2 sd, mean % over seeds)")
+    if markdown:
+        print("| problem | rows | method | median RMSE out1 / out2 | best peer out1 | best peer out2 "
+              "| out1 % | out2 % | +-1 sd % | +-2 sd % |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+    else:
+        print(f"{'problem':<15} {'rows':>4} {'method':<12} {'out1 %':>7} {'out2 %':>7} "
+              f"{'best peer out1':>22} {'best peer out2':>22} {'cov1 out1/2':>11} {'cov2 out1/2':>11}")
+    for prob, n in cases:
+        rs = [r for r in results if r["problem"] == prob and r["rows"] == n]
+        med = lambda m, k: float(np.median([r["methods"][m]["rmse"][k] for r in rs]))
+        best = [min(accept, key=lambda p: med(p, k)) for k in (0, 1)]
+        for m in methods:
+            pct = [100 * (med(m, k) / med(best[k], k) - 1) for k in (0, 1)]
+            cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
+                                       for k in (0, 1)) if all(key in r["methods"][m] for r in rs) else "-"
+            if markdown:
+                print(f"| {prob} | {n} | {m} | {med(m, 0):.4g} / {med(m, 1):.4g} | "
+                      f"{best[0]} {med(best[0], 0):.4g} | {best[1]} {med(best[1], 1):.4g} | "
+                      f"{pct[0]:+.1f} | {pct[1]:+.1f} | {cov('cover1')} | {cov('cover2')} |")
+                continue
+            print(f"{prob:<15} {n:>4} {m:<12} {pct[0]:>+7.1f} {pct[1]:>+7.1f} "
+                  f"{best[0] + ' ' + format(med(best[0], 0), '.4g'):>22} "
+                  f"{best[1] + ' ' + format(med(best[1], 1), '.4g'):>22} "
+                  f"{cov('cover1'):>11} {cov('cover2'):>11}")
     sys.stdout.flush()
 
 

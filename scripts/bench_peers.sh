@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Peer benchmark of whirl's workpiece models: Friedman #1 plus a second smooth output (20 and 100
-# training rows, 1000 test rows), the simulator's shipped tables (train 20, test 500) and generated
-# simulator tables (simgen: 20 and 100 rows per seed, test 500), whirl train (and, with
+# training rows, 1000 test rows), the simulator's shipped tables (train 20, test 500), generated
+# simulator tables (simgen: 20 and 100 rows per seed, test 500) and generator families (power
+# laws with and without bends, additive, Friedman #2/#3, interacting terms; --split tuning or
+# --split confirmation selects the suite's two parts), whirl train (and, with
 # --family-bench build/tests/family_bench --family NAME=ARGS, the family library) against
 # scikit-learn's MLPRegressor (default and grid-searched), LinearRegression, RidgeCV, the power law
 # (LinearRegression on log inputs and log outputs) and Gaussian processes (ARD and isotropic RBF
@@ -10,7 +12,7 @@
 # peers are documented in scripts/bench_peers.py.
 # Installs Debian's python3-sklearn on first use (only here: the default setup and tests never need it).
 # Usage: scripts/bench_peers.sh [SEEDS (default 20)] [extra bench_peers.py arguments, e.g.
-#        --variant matlab=--trainbr-matlab --peer-cache peers.json --json bench.json]
+#        --split tuning --sizes 8,20,100 --peer-cache peers.json --json bench.json]
 #   WHIRL=<path to whirl> overrides the binary (default: ${WHIRL_BUILD_DIR:-build}/whirl).
 set -euo pipefail
 cd "$(dirname "$0")/.."

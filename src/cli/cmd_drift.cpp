@@ -20,6 +20,7 @@
 #include "drift/model.h"
 #include "drift/report.h"
 #include "drift/run_file.h"
+#include "drift/stream.h"
 
 namespace whirl::cli {
 namespace {
@@ -62,6 +63,16 @@ std::vector<FlagPath> InputPaths(const RunInputs& in, const std::string& prefix 
        {std::pair{"--run", &in.runs}, {"--idle", &in.idle}, {"--cutting", &in.cutting}})
     for (const auto& f : *files) paths.push_back({"--" + prefix + (flag + 2), f});
   return paths;
+}
+
+// The run files with their states, in LoadRuns' order (idle, cutting, unstated).
+std::vector<drift::RunFile> RunFiles(const RunInputs& in) {
+  std::vector<drift::RunFile> files;
+  for (const auto& p : in.idle) files.push_back({p, RunState::kIdle});
+  for (const auto& p : in.cutting) files.push_back({p, RunState::kCutting});
+  for (const auto& p : in.runs) files.push_back({p, RunState::kUnknown});
+  if (files.empty()) throw InputError("give at least one run file (--run, --idle or --cutting)");
+  return files;
 }
 
 std::vector<drift::Run> LoadRuns(const RunInputs& in) {
@@ -207,6 +218,22 @@ drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s, bool time_fr
   return o;
 }
 
+// FitFiles on the run files (streamed: any length), with LoadRuns' warning for runs without time
+// (`warn` false: the caller loads the same runs with LoadRuns, which warns).
+drift::FitReport FitRunFiles(const RunInputs& in, const std::string& error, const ModelArgs& m,
+                             const SelectionArgs& sel, RowProgress* progress, bool warn = true) {
+  const std::vector<drift::RunFile> files = RunFiles(in);
+  // The time axis of the options (the lag grid's unit) is the runs': ask the first file.
+  const bool time_from_index = drift::ScanRun(files.front().path).time_from_index;
+  drift::FitReport rep = drift::FitFiles(files, error, ToFit(m, sel, time_from_index),
+                                         progress ? progress->Callback() : drift::StreamProgress());
+  if (progress) progress->Finish();
+  if (warn && rep.model.time_unit == "sample")
+    for (const auto& f : files)
+      Warn(f.path.string() + ": no complete time column: the sample index is used as time");
+  return rep;
+}
+
 void RegisterSelect(CLI::App* drift_app) {
   struct Opts {
     RunInputs runs;
@@ -251,7 +278,7 @@ void RegisterFitModel(CLI::App* drift_app) {
     SelectionArgs sel;
     ModelArgs model;
     std::string error, out;
-    bool json = false;
+    bool json = false, progress = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -272,13 +299,13 @@ void RegisterFitModel(CLI::App* drift_app) {
   sub->add_option("--error", o->error, "error column to model (<name>_um)")->required();
   sub->add_option("--out", o->out, "model file to write (JSON)")->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
+  AddProgressFlag(sub, &o->progress);
   sub->callback([o] {
     CheckOutputs(InputPaths(o->runs), {{"--out", o->out}});
-    const auto runs = LoadRuns(o->runs);
     std::fprintf(stderr, "fitting %s model of %s on %zu run(s)...\n", o->model.kind.c_str(),
-                 o->error.c_str(), runs.size());
-    drift::FitReport rep =
-        drift::FitDriftModel(runs, o->error, ToFit(o->model, o->sel, runs.front().time_from_index));
+                 o->error.c_str(), RunFiles(o->runs).size());
+    RowProgress progress(o->progress, o->json);
+    drift::FitReport rep = FitRunFiles(o->runs, o->error, o->model, o->sel, &progress);
     for (const auto& w : rep.warnings) Warn(w);
     rep.model.notes.push_back("whirl drift fit --model " + o->model.kind + " --error " + o->error);
     drift::WriteDriftModel(o->out, rep.model);
@@ -304,7 +331,7 @@ void RegisterFitModel(CLI::App* drift_app) {
 void RegisterPredictDrift(CLI::App* drift_app) {
   struct Opts {
     std::string model, run, out, reference = "run-start";
-    bool json = false;
+    bool json = false, progress = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -324,17 +351,35 @@ void RegisterPredictDrift(CLI::App* drift_app) {
                   "as in training) or model (the model's reference_C [degC])")
       ->check(CLI::IsMember({"run-start", "model"}));
   sub->add_flag("--json", o->json, "machine output on stdout");
+  AddProgressFlag(sub, &o->progress);
   sub->callback([o] {
     CheckOutputs({{"--model", o->model}, {"--run", o->run}}, {{"--out", o->out}});
     const drift::DriftModel m = drift::ReadDriftModel(o->model);
-    const drift::Run run = drift::ReadRun(o->run, RunState::kUnknown);
-    const drift::RunPrediction p =
-        drift::PredictRun(m, run, drift::ParseReferenceMode(o->reference));
+    // The run is streamed: each sample goes to the CSV as it is predicted (fixed memory).
+    std::unique_ptr<StreamedFile> out;
+    std::string rows;
+    const auto flush = [&] { out->Append(rows), rows.clear(); };
+    const auto sink = [&](const drift::PredictedSample& p) {
+      if (!out) return;
+      if (p.index == 0)
+        rows = drift::PredictionCsvHeader(
+            m.time_unit == "sample", p.has_measured,
+            {"whirl drift predict --model " + o->model + " --run " + o->run + " --reference " +
+             o->reference});
+      drift::AppendPredictionRow(p.time, p.predicted_um, p.std_um,
+                                 p.has_measured ? &p.measured_um : nullptr, &rows);
+      if (rows.size() >= (1u << 20)) flush();
+    };
+    if (!o->out.empty()) out = std::make_unique<StreamedFile>(o->out);
+    RowProgress progress(o->progress, o->json);
+    const drift::PredictionSummary p = drift::PredictFile(
+        m, o->run, drift::ParseReferenceMode(o->reference), sink, progress.Callback());
+    progress.Finish();
     for (const auto& w : p.warnings) Warn(w);
-    if (!o->out.empty())
-      WriteFileAtomic(
-          o->out, drift::PredictionCsv(p, {"whirl drift predict --model " + o->model + " --run " +
-                                           o->run + " --reference " + o->reference}));
+    if (out) {
+      flush();
+      out->Commit();
+    }
     if (o->json) {
       PrintJson({{"schema", "whirl.drift_predict"},
                  {"schema_version", 1},
@@ -343,12 +388,11 @@ void RegisterPredictDrift(CLI::App* drift_app) {
                  {"prediction", drift::PredictionJson(p)}});
       return;
     }
-    std::printf("%s: %lld samples, predicted %s from %.3f to %.3f um\n", run.name.c_str(),
-                static_cast<long long>(p.predicted_um.size()), m.error_column.c_str(),
-                p.predicted_um.minCoeff(), p.predicted_um.maxCoeff());
+    std::printf("%s: %lld samples, predicted %s from %.3f to %.3f um\n", p.run.c_str(), p.samples,
+                m.error_column.c_str(), p.predicted_min_um, p.predicted_max_um);
     if (p.has_measured) {
-      const auto r = drift::ComputeErrorStats(p.measured_um - p.predicted_um);
-      const auto n = drift::ComputeErrorStats(p.measured_um);
+      const auto& r = p.residual;
+      const auto& n = p.none;
       std::printf(
           "residual: MAE %.3f, RMSE %.3f, max %.3f um (no compensation: MAE %.3f, RMSE "
           "%.3f, max %.3f um)\n",
@@ -466,7 +510,7 @@ void RegisterSplit(CLI::App* drift_app) {
   struct Opts {
     std::string log, column = "spindle_rpm", out_dir, state = "unknown";
     double threshold = 0;
-    bool json = false;
+    bool json = false, progress = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -482,26 +526,30 @@ void RegisterSplit(CLI::App* drift_app) {
                   std::string("directory for the run files: ") + kOutputDirRule)
       ->required();
   sub->add_flag("--json", o->json, "machine output on stdout");
+  AddProgressFlag(sub, &o->progress);
   sub->callback([o] {
     CheckOutputs({{"--log", o->log}}, {}, {{"--out-dir", o->out_dir}});
-    const drift::Run log = drift::ReadRun(o->log, RunState::kUnknown);
-    const auto runs = drift::SplitAtStarts(log, o->column, o->threshold);
-    const auto paths =
-        drift::WriteRuns(o->out_dir, runs,
-                         {"whirl drift split --log " + o->log + " --at " + o->column}, "--out-dir");
+    RowProgress progress(o->progress, o->json);
+    const std::string step = "splitting " + o->log;
+    // Streamed: each run file is written as its rows arrive (fixed memory), all or nothing.
+    const auto runs = drift::SplitLogFile(
+        o->log, o->column, o->threshold, o->out_dir,
+        {"whirl drift split --log " + o->log + " --at " + o->column}, "--out-dir",
+        [&](long long rows, double fraction) { progress.Update(step, rows, fraction); });
+    progress.Finish();
     nlohmann::json list = nlohmann::json::array();
-    for (std::size_t i = 0; i < runs.size(); ++i)
-      list.push_back({{"file", paths[i].string()},
-                      {"samples", runs[i].samples()},
-                      {"start_min", runs[i].time_min.front()},
-                      {"end_min", runs[i].time_min.back()}});
+    for (const auto& r : runs)
+      list.push_back({{"file", r.file.string()},
+                      {"samples", r.samples},
+                      {"start_min", r.start_min},
+                      {"end_min", r.end_min}});
     if (o->json) {
       PrintJson({{"schema", "whirl.drift_split"}, {"schema_version", 1}, {"runs", list}});
       return;
     }
-    for (std::size_t i = 0; i < runs.size(); ++i)
-      std::printf("%s: %d samples, %.1f to %.1f h\n", paths[i].string().c_str(), runs[i].samples(),
-                  runs[i].time_min.front() / 60, runs[i].time_min.back() / 60);
+    for (const auto& r : runs)
+      std::printf("%s: %lld samples, %.1f to %.1f h\n", r.file.string().c_str(), r.samples,
+                  r.start_min / 60, r.end_min / 60);
   });
 }
 
@@ -545,12 +593,11 @@ void RegisterReport(CLI::App* drift_app) {
     std::vector<FlagPath> inputs = InputPaths(o->train, "train-"), more = InputPaths(o->runs);
     inputs.insert(inputs.end(), more.begin(), more.end());
     CheckOutputs(inputs, {}, {{"--out-dir", o->out_dir}});
-    const auto train = LoadRuns(o->train);
-    std::vector<drift::Run> runs = train;
-    if (!o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty())
-      runs = LoadRuns(o->runs);
-    const drift::FitReport rep = drift::FitDriftModel(
-        train, o->error, ToFit(o->model, o->sel, train.front().time_from_index));
+    const bool shown = !o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty();
+    // The model as drift fit makes it (streamed; a thinned search on long training runs).
+    const drift::FitReport rep =
+        FitRunFiles(o->train, o->error, o->model, o->sel, nullptr, /*warn=*/shown);
+    const std::vector<drift::Run> runs = LoadRuns(shown ? o->runs : o->train);
     for (const auto& w : rep.warnings) Warn(w);
     const auto r =
         drift::WriteModelReport(o->out_dir, rep, runs, {"whirl drift report --error " + o->error});

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "drift/monitor_report.h"
+#include "drift/run_file.h"
 
 namespace whirl::cli {
 
@@ -33,7 +34,7 @@ struct MonitorArgs {
   std::vector<double> score_rows{0.0, 1.0};
   bool no_drift_estimate = false;
   drift::MonitorOptions o;
-  bool json = false;
+  bool json = false, progress = false;
 };
 
 // One quantity on the run's time axis: --<name>-min, --<name>-samples and the old spelling
@@ -147,6 +148,7 @@ void AddMonitorOptions(CLI::App* sub, MonitorArgs* a) {
           kOutputDirRule);
   AddDeprecatedAlias(sub, out_dir, "--report");
   sub->add_flag("--json", a->json, "machine output on stdout");
+  AddProgressFlag(sub, &a->progress);
 }
 
 // The intervals from the flags named by their unit (ChooseTimeAxis: a *-min flag on a run
@@ -171,37 +173,99 @@ void ApplyIntervals(MonitorArgs& a, bool time_from_index) {
     }
 }
 
-// The timeline and events files and the report: all or none (the report with the files).
-void WriteOutputs(const MonitorArgs& a, const std::string& timeline, const std::string& events,
-                  const std::function<drift::MonitorReportResult(const drift::AlsoWrite&)>& report) {
-  std::vector<std::pair<std::filesystem::path, std::string>> files;
-  if (!a.timeline.empty()) files.emplace_back(a.timeline, timeline);
+// Where a streamed replay's per-sample rows go: the --timeline file and the report's
+// timeline.csv (inside its output directory's staging folder), written as the rows come.
+struct TimelineFiles {
+  std::unique_ptr<OutputDir> dir;  // --out-dir, opened before the replay
+  std::unique_ptr<StreamedFile> flag, report;
+
+  TimelineFiles(const std::string& timeline, const std::string& out_dir,
+                const std::string& report_name = "timeline.csv") {
+    if (!out_dir.empty()) {
+      dir = std::make_unique<OutputDir>(out_dir, "--out-dir");
+      report = std::make_unique<StreamedFile>(dir->Staging() / report_name);
+    }
+    if (!timeline.empty()) flag = std::make_unique<StreamedFile>(timeline);
+  }
+  std::vector<StreamedFile*> Files() const {
+    std::vector<StreamedFile*> f;
+    if (flag) f.push_back(flag.get());
+    if (report) f.push_back(report.get());
+    return f;
+  }
+};
+
+// The --timeline and --events files and the report: all or none (the report with the files).
+void CommitOutputs(const MonitorArgs& a, TimelineFiles& t, const std::string& events,
+                   const std::function<drift::MonitorReportResult(
+                       OutputDir&, const drift::AlsoWrite&, const std::vector<ReadyFile>&)>& report) {
+  drift::AlsoWrite files;
+  std::vector<ReadyFile> ready;
+  if (t.flag) ready.push_back({a.timeline, t.flag->Finish()});
   if (!a.events.empty()) files.emplace_back(a.events, events);
-  if (!a.out_dir.empty()) {
-    const auto rep = report(files);
+  if (t.dir) {
+    const auto rep = report(*t.dir, files, ready);
     for (const auto& w : rep.warnings) Warn(w);
     std::fprintf(stderr, "report: %s\n", rep.index_html.string().c_str());
   } else {
-    WriteFilesAtomic(files);  // both or neither
+    WriteFilesAtomic(files, ready);  // all or none
   }
 }
 
 void RunWeek(MonitorArgs& a, const drift::DriftModel& m) {
   drift::CheckMonitorDays(a.days.size());  // before reading thousands of files
-  std::vector<drift::Run> days;
-  for (const auto& d : a.days) days.push_back(drift::ReadRun(d, drift::RunState::kUnknown));
-  ApplyIntervals(a, days.front().time_from_index);
+  std::vector<std::filesystem::path> days(a.days.begin(), a.days.end());
+  const bool time_from_index = drift::ScanRun(days.front()).time_from_index;
+  ApplyIntervals(a, time_from_index);
   std::fprintf(stderr, "replaying %zu days...\n", days.size());
-  const drift::WeekResult w = drift::MonitorWeek(m, days, a.o);
-  for (const auto& d : w.days)
-    for (const auto& warning : d.warnings) Warn(warning);
   std::string command = "whirl drift monitor --model " + a.model;
   for (const auto& d : a.days) command += " --day " + d;
   const std::vector<std::string> prov{command};
-  WriteOutputs(a, drift::WeekTimelineCsv(w, prov), drift::WeekEventsCsv(w, prov),
-               [&](const drift::AlsoWrite& also) {
-                 return drift::WriteWeekReport(a.out_dir, w, a.o, prov, "gnuplot", also);
-               });
+  // The week's timeline (a day column first) to --timeline and the report; each day's own
+  // timeline to the report; every day's plot rows kept (M4).
+  TimelineFiles week(a.timeline, a.out_dir, "week_timeline.csv");
+  std::vector<std::string> week_comments{"monitor timeline of a week, day by day"};
+  week_comments.insert(week_comments.end(), prov.begin(), prov.end());
+  for (std::size_t d = 0; d < days.size(); ++d)
+    week_comments.push_back("day " + std::to_string(d + 1) + ": " + days[d].stem().string());
+  std::vector<std::unique_ptr<StreamedFile>> day_files;
+  std::vector<std::unique_ptr<drift::TimelineSink>> day_sinks;
+  std::unique_ptr<drift::TimelineSink> week_sink;
+  bool header = true;
+  RowProgress progress(a.progress, a.json);
+  const auto sink = [&](std::size_t d, const drift::MonitorSample& s) {
+    if (s.index == 0) {
+      if (week_sink) week_sink->Finish(nullptr);
+      week_sink = std::make_unique<drift::TimelineSink>(a.o, time_from_index, week_comments,
+                                                        week.Files(), static_cast<int>(d + 1), header);
+      header = false;
+      std::vector<StreamedFile*> own;
+      if (week.dir) {
+        day_files.push_back(std::make_unique<StreamedFile>(
+            week.dir->Staging() / ("day" + std::to_string(d + 1) + "_timeline.csv")));
+        own.push_back(day_files.back().get());
+      }
+      std::vector<std::string> c{"monitor timeline of " + days[d].stem().string()};
+      c.insert(c.end(), prov.begin(), prov.end());
+      day_sinks.push_back(std::make_unique<drift::TimelineSink>(a.o, time_from_index, c, own));
+    }
+    week_sink->Add(s);
+    day_sinks.back()->Add(s);
+  };
+  drift::WeekResult w = drift::MonitorWeekFiles(m, days, a.o, sink, progress.Callback());
+  progress.Finish();
+  if (week_sink) week_sink->Finish(nullptr);
+  for (std::size_t d = 0; d < w.days.size() && d < day_sinks.size(); ++d)
+    day_sinks[d]->Finish(&w.days[d]);
+  for (const auto& d : w.days)
+    for (const auto& warning : d.warnings) Warn(warning);
+  CommitOutputs(a, week, drift::WeekEventsCsv(w, prov),
+                [&](OutputDir& dir, const drift::AlsoWrite& also, const std::vector<ReadyFile>& ready) {
+                  std::vector<std::filesystem::path> day_ready;
+                  for (auto& f : day_files) day_ready.push_back(f->Finish());
+                  return drift::WriteWeekReport(dir, w, a.o, prov, "gnuplot", also, ready,
+                                                day_ready, week.report->Finish());
+                });
   if (a.json)
     PrintJson(drift::WeekJson(w, a.o));
   else
@@ -222,15 +286,27 @@ void RunMonitor(MonitorArgs& a) {
   for (const auto& u : a.updates) a.o.rules.push_back(drift::ParseUpdateRule(u));
   const drift::DriftModel m = drift::ReadDriftModel(a.model);
   if (!a.days.empty()) return RunWeek(a, m);
-  const drift::Run run = drift::ReadRun(a.run, drift::RunState::kUnknown);
-  ApplyIntervals(a, run.time_from_index);
-  std::fprintf(stderr, "replaying checks on %s (%d samples)...\n", run.name.c_str(), run.samples());
-  const drift::MonitorResult r = drift::MonitorRun(m, run, a.o);
+  const drift::RunScan scan = drift::ScanRun(a.run);
+  ApplyIntervals(a, scan.time_from_index);
+  const std::string name = std::filesystem::path(a.run).stem().string();
+  std::fprintf(stderr, "replaying checks on %s (%lld samples)...\n", name.c_str(), scan.rows);
   const std::vector<std::string> prov{"whirl drift monitor --model " + a.model + " --run " + a.run};
-  WriteOutputs(a, drift::MonitorTimelineCsv(r, prov), drift::MonitorEventsCsv(r, prov),
-               [&](const drift::AlsoWrite& also) {
-                 return drift::WriteMonitorReport(a.out_dir, r, a.o, prov, "gnuplot", also);
-               });
+  // The run is streamed: the timeline rows go to their files as they come (fixed memory).
+  TimelineFiles t(a.timeline, a.out_dir);
+  std::vector<std::string> comments{"monitor timeline of " + name};
+  comments.insert(comments.end(), prov.begin(), prov.end());
+  drift::TimelineSink timeline(a.o, scan.time_from_index, comments, t.Files());
+  RowProgress progress(a.progress, a.json);
+  drift::MonitorResult r = drift::MonitorFile(
+      m, a.run, a.o, {}, nullptr, [&](const drift::MonitorSample& s) { timeline.Add(s); },
+      progress.Callback());
+  progress.Finish();
+  timeline.Finish(&r);
+  CommitOutputs(a, t, drift::MonitorEventsCsv(r, prov),
+                [&](OutputDir& dir, const drift::AlsoWrite& also, const std::vector<ReadyFile>& ready) {
+                  return drift::WriteMonitorReport(dir, r, a.o, prov, "gnuplot", also, ready,
+                                                   t.report->Finish());
+                });
   if (a.json)
     PrintJson(drift::MonitorJson(r, a.o));
   else

@@ -1,9 +1,17 @@
 #include "cli/drift_args.h"
 
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "cli/common.h"
+#include "cli/terminal.h"
 #include "core/error.h"
+#include "core/numbers.h"
+#include "core/safe_text.h"
 
 namespace whirl::cli {
 
@@ -69,6 +77,67 @@ TimeAxisValue ChooseTimeAxis(const TimeAxisFlags& f, bool time_from_index) {
     throw InputError(f.samples->get_name() + " " + Typed(f.samples) +
                      ": the run records time: use " + f.min->get_name());
   return min ? TimeAxisValue::kMin : samples ? TimeAxisValue::kSamples : TimeAxisValue::kNone;
+}
+
+void AddProgressFlag(CLI::App* sub, bool* progress) {
+  sub->add_flag("--progress", *progress,
+                "progress on stderr (step, rows read, share of the file) also when stderr is not "
+                "a terminal or with --json; shown on a terminal anyway once a step takes over 2 s");
+}
+
+namespace {
+
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// "1,234,567": rows for people.
+std::string Grouped(long long n) {
+  std::string digits = std::to_string(n), out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+}  // namespace
+
+RowProgress::RowProgress(bool asked, bool json)
+    : enabled_(asked || (!json && ::isatty(2) != 0)), tty_(::isatty(2) != 0),
+      start_s_(NowSeconds()) {}
+
+RowProgress::~RowProgress() { Finish(); }
+
+void RowProgress::Update(const std::string& step, long long rows, double fraction) {
+  if (!enabled_) return;
+  const double now = NowSeconds();
+  if (now - start_s_ < 2.0 || now - last_s_ < (tty_ ? 0.25 : 5.0)) return;
+  last_s_ = now;
+  std::string line = TerminalText(step) + ": " + Grouped(rows) + " rows";
+  if (std::isfinite(fraction)) line += " (" + FormatDecimals(100 * fraction, 0) + " % of the file)";
+  line += ", " + FormatDecimals(now - start_s_, 0) + " s";
+  if (tty_) {
+    std::fprintf(RawStderr(), "\r%s\033[K", line.c_str());
+    std::fflush(RawStderr());
+    shown_ = true;
+  } else {
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+}
+
+drift::StreamProgress RowProgress::Callback() {
+  return [this](const std::string& step, long long rows, double fraction) {
+    Update(step, rows, fraction);
+  };
+}
+
+void RowProgress::Finish() {
+  if (!shown_) return;
+  shown_ = false;
+  std::fprintf(RawStderr(), "\r\033[K");
+  std::fflush(RawStderr());
 }
 
 }  // namespace whirl::cli

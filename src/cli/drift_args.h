@@ -5,6 +5,7 @@
 #include <string>
 
 #include "drift/selection.h"
+#include "drift/stream.h"
 
 namespace whirl::cli {
 
@@ -37,5 +38,28 @@ struct TimeAxisFlags {
 /// InputError naming the flag and the one to use.
 enum class TimeAxisValue { kNone, kMin, kSamples };
 TimeAxisValue ChooseTimeAxis(const TimeAxisFlags& f, bool time_from_index);
+
+/// --progress: progress on stderr also when it is not a terminal or with --json.
+void AddProgressFlag(CLI::App* sub, bool* progress);
+
+/// Progress of a long drift command on stderr (drift/stream.h StreamProgress): nothing for the
+/// first 2 s, then the step, the rows read and the share of the file, redrawn in place on a
+/// terminal (at most 4 times a second), a line every 5 s otherwise. Shown when asked
+/// (--progress) or, without --json, when stderr is a terminal; quiet otherwise.
+class RowProgress {
+ public:
+  RowProgress(bool asked, bool json);
+  ~RowProgress();
+  RowProgress(const RowProgress&) = delete;
+  RowProgress& operator=(const RowProgress&) = delete;
+  void Update(const std::string& step, long long rows, double fraction);
+  /// A callback for the drift library (valid while this object lives).
+  drift::StreamProgress Callback();
+  void Finish();  ///< ends a redrawn line
+
+ private:
+  bool enabled_, tty_, shown_ = false;
+  double start_s_, last_s_ = -1e9;
+};
 
 }  // namespace whirl::cli

@@ -297,6 +297,48 @@ TEST(OutputDir, KilledRunsDebrisIsIgnoredAndRemoved) {
   EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", kOutputManifest}));
 }
 
+// A run killed while gnuplot wrote into its staging folder: the program's log and picture were
+// named in the record before it started (RunInStaging), so the next run removes them; a file the
+// program was not told to write still refuses the directory.
+TEST(OutputDir, AKilledProgramsNamedOutputsAreWhirlsAndNothingElse) {
+  const fs::path d = Scratch("out_killed_program");
+  const auto killed_while_program_ran = [&] {
+    const pid_t child = ::fork();
+    if (child == 0) {
+      try {
+        OutputDir out(d, "--out-dir");
+        out.Add("map.gp", "plot x");
+        out.RunInStaging({"/bin/sh", "-c", "printf png > map.png; echo started"}, "gnuplot.log",
+                         {"map.png"});
+        ::_exit(0);  // killed before AddStaged and Commit
+      } catch (...) {
+        ::_exit(1);
+      }
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    for (const auto& e : fs::directory_iterator(d))
+      if (e.path().filename().string().rfind(".whirl-stage-", 0) == 0) return e.path();
+    ADD_FAILURE() << "the killed run left no staging folder";
+    return fs::path{};
+  };
+  const fs::path stage = killed_while_program_ran();
+  EXPECT_EQ(Entries(stage),
+            (std::set<std::string>{kStagingRecord, "map.gp", "map.png", "gnuplot.log"}));
+  {
+    OutputDir out(d, "--out-dir");
+    Write(out, {"a.csv"});
+  }
+  EXPECT_EQ(Entries(d), (std::set<std::string>{"a.csv", kOutputManifest}));
+  fs::remove_all(d);
+  const fs::path again = killed_while_program_ran();
+  WriteFileAtomic(again / "other.png", "not named");
+  const std::string e = ErrorOf([&] { OutputDir out(d, "--out-dir"); });
+  EXPECT_TRUE(Has(e, "other.png")) << e;
+  EXPECT_EQ(ReadTextFile(again / "map.png"), "png");
+}
+
 // Issue 45 item 6: a folder named like a killed run's staging folder, holding a user's file, is
 // neither deleted nor emptied: whirl refuses the directory and names the file.
 TEST(OutputDir, AStagingNamedFolderWithAUsersFileIsLeftAlone) {

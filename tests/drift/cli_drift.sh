@@ -139,4 +139,22 @@ expect_fail "bad.csv:3" "$W" drift fit --run "$D/bad.csv" --error err_um --out "
 expect_fail "no thermal-error" "$W" drift select --run "$D/idle1.csv" --error ch9_um
 expect_fail "not a drift model" "$W" drift predict --model "$D/select.json" --run "$D/idle1.csv"
 expect_fail "classes" "$W" drift select --run "$D/idle1.csv" --error err_um --classes 99
+# Issue 43: a generated long log (scripts/make_long_log.py) through the streamed commands;
+# --progress prints on stderr only (stdout stays JSON), the report plots the decimated rows.
+python3 "$SRC/scripts/make_long_log.py" --rows 20000 --out "$D/long.csv" || fail "make_long_log.py"
+"$W" drift fit --run "$D/long.csv" --error ch1_um --out "$D/long.json" --progress --json \
+  > "$D/long_fit.json" || fail "fit on the long log"
+python3 -m json.tool "$D/long_fit.json" > /dev/null || fail "fit --json --progress: stdout is not JSON"
+"$W" drift predict --model "$D/long.json" --run "$D/long.csv" --out "$D/long_pred.csv" --progress \
+  > /dev/null || fail "predict on the long log"
+[ "$(grep -vc '^#' "$D/long_pred.csv")" = 20001 ] || fail "predict did not write every row"
+"$W" drift split --log "$D/long.csv" --out-dir "$D/long_split" --json --progress \
+  > "$D/long_split.json" || fail "split of the long log"
+python3 - "$D/long_split.json" <<'EOF2' || fail "split rows do not add up to the log"
+import json, sys
+assert sum(r["samples"] for r in json.load(open(sys.argv[1]))["runs"]) == 20000
+EOF2
+"$W" drift report --train-run "$D/long.csv" --run "$D/long.csv" --error ch1_um \
+  --out-dir "$D/long_rep" > /dev/null 2>&1 || fail "report on the long log"
+[ "$(grep -vc '^#' "$D/long_rep/long_plot.csv")" -lt 20001 ] || fail "the plot rows are not decimated"
 echo "ok"

@@ -8,6 +8,7 @@ whirl_add_gtest(test_drift
     ${CMAKE_CURRENT_LIST_DIR}/test_inputs.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_zero_time.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_choice.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_stream.cpp
   LIBS Boost::headers)
 whirl_add_cli_test(cli_drift ${CMAKE_CURRENT_LIST_DIR}/cli_drift.sh)
 whirl_add_cli_test(cli_drift_monitor ${CMAKE_CURRENT_LIST_DIR}/cli_monitor.sh)

@@ -1,8 +1,10 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--joint] [--loo|--kfold] [--no-1se] [--equivalence-sd SD] [--gp-ftol F] [--calibration-folds K]
+//                [--joint] [--loo|--kfold] [--no-1se] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
 //                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--few-rows N] [--gp-length-prior-sd SD] [--gp-max-rows N]
+//                [--gp-hyper-rows N] [--loo-calibration-rows N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -58,12 +60,28 @@ Args Parse(int argc, char** argv) {
       a.choice.one_standard_error = false;
     else if (k == "--gp-ftol")
       a.choice.fit.gp.bfgs.function_tolerance = std::stod(value());
+    else if (k == "--gp-gtol")
+      a.choice.fit.gp.bfgs.gradient_tolerance = std::stod(value());
+    else if (k == "--gp-large-ftol")
+      a.choice.fit.gp.bfgs_large.function_tolerance = std::stod(value());
+    else if (k == "--gp-large-gtol")
+      a.choice.fit.gp.bfgs_large.gradient_tolerance = std::stod(value());
     else if (k == "--calibration-folds")
       a.choice.fit.calibration_folds = std::stoi(value());
     else if (k == "--seed")
       a.choice.fit.seed = std::stoull(value());
     else if (k == "--folds")
       a.choice.folds = std::stoi(value());
+    else if (k == "--gp-max-rows")
+      a.choice.fit.gp.max_rows = std::stoi(value());
+    else if (k == "--gp-hyper-rows")
+      a.choice.fit.gp.hyperparameter_rows = std::stoi(value());
+    else if (k == "--loo-calibration-rows")
+      a.choice.fit.loo_calibration_rows = std::stoi(value());
+    else if (k == "--few-rows")
+      a.choice.few_rows = std::stoi(value());
+    else if (k == "--gp-length-prior-sd")
+      a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")
       a.choice.fit.gp.restarts = std::stoi(value());
     else if (k == "--threads")

@@ -27,8 +27,8 @@ double MaxRelativeError(const FamilyModel& m, const ProcessTable& test) {
 TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
   const ProcessTable train = MakeTable(20, 0.01, 1), test = MakeTable(200, 0.0, 2);
   ChoiceOptions o;
-  o.candidates = {ParseCandidate("gp-matern52-constant/identity"),
-                  ParseCandidate("gp-se-linear/log"), ParseCandidate("network-h6/identity")};
+  o.candidates = {ParseCandidate("linear/identity"), ParseCandidate("linear/log"),
+                  ParseCandidate("network-h6/identity")};
   o.one_standard_error = false;  // the plain lowest error (tested alone below)
   o.closed_form_loo = false;     // 5-fold refits for every candidate
   for (const bool per_output : {false, true}) {
@@ -36,19 +36,19 @@ TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
     const Choice c = ChooseFamily(train, o);
     ASSERT_EQ(c.table.size(), 3u);
     ASSERT_EQ(c.models.size(), 1u) << c.Describe() << nlohmann::json(c.table).dump();
-    EXPECT_EQ(c.models[0].candidate.Name(), "gp-se-linear/log");
+    EXPECT_EQ(c.models[0].candidate.Name(), "linear/log");
     for (int k = 0; k < 2; ++k) {
-      EXPECT_EQ(c.table[c.chosen[k]].candidate.Name(), "gp-se-linear/log");
+      EXPECT_EQ(c.table[c.chosen[k]].candidate.Name(), "linear/log");
       for (const CvRow& r : c.table)
         EXPECT_GE(per_output ? r.cv_rmse(k) : r.score,
                   per_output ? c.table[c.chosen[k]].cv_rmse(k) : c.table[c.chosen[k]].score);
     }
     EXPECT_LT(MaxRelativeError(c.models[0], test), 0.03);
   }
-  o.closed_form_loo = true;  // GP by closed-form LOO, the network by 5-fold refits
+  o.closed_form_loo = true;  // linear fits by closed-form LOO, the network by 5-fold refits
   o.per_output = false;
   EXPECT_EQ(ChooseFamily(train, o).Describe(),
-            "max_elongation_um: gp-se-linear/log, settle_time_s: gp-se-linear/log");
+            "max_elongation_um: linear/log, settle_time_s: linear/log");
 }
 
 TEST(FamilyChoice, OutputsMayComeFromDifferentFamilies) {
@@ -155,20 +155,26 @@ TEST(FamilyChoice, ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits) {
 }
 
 TEST(FamilyCalibration, CalibratedGpCoversFreshData) {
-  // 40 noisy rows of a smooth non-power law: +-1 / +-2 sd coverage on 2000 fresh rows.
-  const ProcessTable train = MakeTable(40, 0.05, 5, true), test = MakeTable(2000, 0.05, 6, true);
+  // 40 noisy rows of a smooth non-power law, 5 tables: mean +-1 / +-2 sd coverage of 2000 fresh
+  // rows inside the targets of issue 40 (60-76 % and 90-98 %), with a margin for 5 tables.
+  const ProcessTable test = MakeTable(2000, 0.05, 6, true);
   for (const char* name : {"gp-matern52-constant/identity", "gp-se-constant/log"}) {
-    const FamilyModel m = FitCandidate(train, ParseCandidate(name), {});
-    const std::vector<FamilyPrediction> p = PredictFamily(m, test.inputs);
+    double in1[2] = {0, 0}, in2[2] = {0, 0};
+    for (unsigned seed = 5; seed < 10; ++seed) {
+      const FamilyModel m = FitCandidate(MakeTable(40, 0.05, seed, true), ParseCandidate(name), {});
+      const std::vector<FamilyPrediction> p = PredictFamily(m, test.inputs);
+      for (int k = 0; k < 2; ++k)
+        for (std::size_t q = 0; q < p.size(); ++q) {
+          const double r = std::abs(test.targets[q].ToArray()[k] - p[q].mean.ToArray()[k]);
+          in1[k] += (r <= p[q].stddev.ToArray()[k]) / 10000.0;
+          in2[k] += (r <= 2 * p[q].stddev.ToArray()[k]) / 10000.0;
+        }
+    }
     for (int k = 0; k < 2; ++k) {
-      int in1 = 0, in2 = 0;
-      for (std::size_t q = 0; q < p.size(); ++q) {
-        const double r = std::abs(test.targets[q].ToArray()[k] - p[q].mean.ToArray()[k]);
-        in1 += r <= p[q].stddev.ToArray()[k];
-        in2 += r <= 2 * p[q].stddev.ToArray()[k];
-      }
-      EXPECT_NEAR(in1 / 2000.0, 0.68, 0.12) << name << " output " << k;
-      EXPECT_NEAR(in2 / 2000.0, 0.95, 0.05) << name << " output " << k;
+      EXPECT_GE(in1[k], 0.58) << name << " output " << k;
+      EXPECT_LE(in1[k], 0.80) << name << " output " << k;
+      EXPECT_GE(in2[k], 0.88) << name << " output " << k;
+      EXPECT_LE(in2[k], 0.99) << name << " output " << k;
     }
   }
 }
@@ -270,12 +276,20 @@ ProcessTable BentTable(double noise, double bend, unsigned seed) {
 // lies within the threshold of the linear fit on its columns with more degrees of freedom than
 // that fit, to a linear candidate, with a note that names both and the refit errors; on power laws (where a GP chosen by leave-one-out is a
 // power law with a spurious bend) the rule sets GPs aside.
+// (The rule is off by default: with GP held-out errors from refits at few rows it changes
+// nothing; these tests switch it on, with the closed-form leave-one-out of GPs it was made for.)
+ChoiceOptions EquivalenceOptions(double sd) {
+  ChoiceOptions o;
+  o.equivalence_sd = sd;
+  o.few_rows = 0;  // GP held-out errors by their closed-form leave-one-out
+  return o;
+}
+
 TEST(FamilyEquivalence, ANearlyLinearGpAtFewRowsMustBeatTheLinearFamilyInRefits) {
-  ChoiceOptions on, off;
+  ChoiceOptions on = EquivalenceOptions(0.1), off = EquivalenceOptions(0);
   for (ChoiceOptions* o : {&on, &off})
     o->candidates = {ParseCandidate("linear/log"), ParseCandidate("linear/identity"),
                      ParseCandidate("gp-matern52-constant/log")};
-  off.equivalence_sd = 0;
   int changed = 0;
   for (unsigned seed = 1; seed <= 30; ++seed) {
     const ProcessTable t = BentTable(0.04, 0.0, seed);
@@ -308,7 +322,9 @@ TEST(FamilyEquivalence, ANearlyLinearGpAtFewRowsMustBeatTheLinearFamilyInRefits)
 // law. (A rule on the fit distance alone set it aside on every table.)
 TEST(FamilyEquivalence, ARealBendAboveTheNoiseKeepsItsGp) {
   const ProcessTable test = BentTable(0.0, 0.5, 999);
-  ChoiceOptions o;
+  for (const bool rule : {true, false}) {
+  // With the rule (and leave-one-out errors) and with the default (refits at few rows).
+  ChoiceOptions o = rule ? EquivalenceOptions(0.1) : ChoiceOptions{};
   int gp = 0;
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const Choice c = ChooseFamily(BentTable(0.003, 0.5, seed), o);
@@ -327,7 +343,8 @@ TEST(FamilyEquivalence, ARealBendAboveTheNoiseKeepsItsGp) {
     }
     EXPECT_LT(e_c, e_p) << "seed " << seed;
   }
-  EXPECT_GE(gp, 8);
+  EXPECT_GE(gp, 8) << "rule " << rule;
+  }
 }
 
 // The rule's refits need 8 rows in every training split (the linear fit's 6 coefficients and
@@ -335,8 +352,7 @@ TEST(FamilyEquivalence, ARealBendAboveTheNoiseKeepsItsGp) {
 // alone; from 10 rows on it may change it. Either way a table the choice could fit without the
 // rule it still fits.
 TEST(FamilyEquivalence, SmallTablesTrainAsWithoutTheRule) {
-  ChoiceOptions on, off;
-  off.equivalence_sd = 0;
+  ChoiceOptions on = EquivalenceOptions(0.1), off = EquivalenceOptions(0);
   int fitted = 0;
   for (int rows : {8, 9, 10, 11})
     for (unsigned seed = 1; seed <= 15; ++seed) {
@@ -359,9 +375,7 @@ TEST(FamilyEquivalence, SmallTablesTrainAsWithoutTheRule) {
 // At 10 rows per hyperparameter or more the rule never applies, however large the threshold;
 // below it, with a threshold above any distance, every change is a GP giving way to a linear fit.
 TEST(FamilyEquivalence, AppliesOnlyBelowTenRowsPerHyperparameter) {
-  ChoiceOptions wide, off;
-  wide.equivalence_sd = 1e9;
-  off.equivalence_sd = 0;
+  ChoiceOptions wide = EquivalenceOptions(1e9), off = EquivalenceOptions(0);
   for (const bool curved : {false, true}) {
     const ProcessTable big = MakeTable(70, 0.04, 5, curved);
     const Choice a = ChooseFamily(big, off), b = ChooseFamily(big, wide);

@@ -11,11 +11,22 @@
 namespace whirl::family {
 namespace {
 
+namespace nn_free {
+// The table's inputs as 5 x rows (nn::InputMatrix without the nn dependency).
+Eigen::MatrixXd Inputs(const ProcessTable& t) {
+  Eigen::MatrixXd x(5, static_cast<Eigen::Index>(t.inputs.size()));
+  for (std::size_t q = 0; q < t.inputs.size(); ++q)
+    for (int i = 0; i < 5; ++i) x(i, static_cast<Eigen::Index>(q)) = t.inputs[q].ToArray()[i];
+  return x;
+}
+}  // namespace nn_free
+
 ProcessTable Table() {
   ProcessTable t;
   t.source = "t.csv";
   for (int q = 0; q < 5; ++q) {
-    t.inputs.push_back(ProcessInputs::FromArray({60.0 + q, 50.0 + q, 6.0, 3.0 + q, 150.0 + q}));
+    t.inputs.push_back(
+        ProcessInputs::FromArray({60.0 + q, 50.0 + q, 6.0 + 0.1 * q, 3.0 + q, 150.0 + q}));
     t.targets.push_back(Features::FromArray({10.0 + q, 100.0 + 5 * q}));
   }
   return t;
@@ -78,6 +89,32 @@ TEST(Transform, DeltaMethodAgreesWithMonteCarloForSmallSd) {
   const MeanSd b = MapBack(ColumnTransform::kLog, m, s);
   EXPECT_NEAR(b.sd / sd, 1.0, 0.01);                  // relative error O(s^2) + sampling
   EXPECT_NEAR(b.mean / y[y.size() / 2], 1.0, 0.001);  // the median
+}
+
+TEST(Transform, AConstantInputIsLeftOut) {
+  ProcessTable t = Table();
+  for (ProcessInputs& p : t.inputs) p.pitch_mm = 6.0;
+  const TableTransform a = LogWherePositive(t);
+  EXPECT_FALSE(a.input_used[2]);
+  EXPECT_EQ(a.UsedInputCount(), 4);
+  EXPECT_EQ(a.Describe(), "log of every column used; left out (constant): pitch_mm");
+  const Eigen::MatrixXd z = TransformInputs(a, nn_free::Inputs(t));
+  EXPECT_EQ(z.row(2).cwiseAbs().maxCoeff(), 0.0);  // a left-out input is 0 in every row
+  EXPECT_NEAR(z(3, 1), std::log(4.0), 1e-15);
+  const Eigen::MatrixXd used = UsedInputRows(a, z);
+  ASSERT_EQ(used.rows(), 4);
+  EXPECT_EQ(used.row(2), z.row(3));
+  TableTransform b;
+  EXPECT_EQ(LeaveOutConstantInputs(t, &b), std::vector<int>{2});
+  EXPECT_TRUE(b.IsIdentity());
+  const TableTransform back = nlohmann::json(a).get<TableTransform>();
+  EXPECT_EQ(back.input_used, a.input_used);
+  EXPECT_FALSE(nlohmann::json(TableTransform{}).contains("inputs_used"));  // files stay as they were
+  nlohmann::json j = a;
+  j["inputs_used"] = {false, false, false, false, false};
+  ExpectInputError([&] { j.get<TableTransform>(); }, "leaves out every input");
+  j["inputs_used"] = {true, 1, true, true, true};
+  ExpectInputError([&] { j.get<TableTransform>(); }, "'inputs_used'[1] must be true or false");
 }
 
 TEST(Transform, JsonRoundTripAndBadNames) {

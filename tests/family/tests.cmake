@@ -3,6 +3,7 @@ whirl_add_gtest(test_family SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/test_transform.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_linear.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_family.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_table_checks.cpp
   LABELS family)
 # Development driver of scripts/bench_peers.py (--family-bench): not a test, not installed.
 add_executable(family_bench ${CMAKE_CURRENT_LIST_DIR}/family_bench.cpp)

@@ -223,6 +223,7 @@ TEST(GpFit, IsotropicKernelSharesOneLengthScaleAtAStationaryPoint) {
     GpOptions o;
     o.kernel = k;
     o.isotropic = true;
+    o.length_prior_sd = 0;  // maximum likelihood: the summary's objective is the NLML
     o.bfgs.gradient_tolerance = 1e-7;
     o.bfgs.function_tolerance = 1e-12;
     GpSummary iso_summary, ard_summary;
@@ -246,6 +247,64 @@ TEST(GpFit, IsotropicKernelSharesOneLengthScaleAtAStationaryPoint) {
     const Gp warm = FitGpFrom(data.x, data.y, o, FitGp(data.x, data.y, GpOptions{}).theta);
     EXPECT_EQ(warm.theta(2), warm.theta(0));
   }
+}
+
+// GpOptions::length_prior_sd: the fit maximizes the likelihood times the log-normal prior, so at
+// its optimum dNLML/d ln l_i = -(ln l_i - LengthPriorMean(d)) / sd^2 for every length scale; and
+// the prior pulls the log length scales towards its mean.
+TEST(GpFit, LengthPriorIsStationaryInThePosterior) {
+  const Data data = MakeData(3, 25, 0.1, 11);
+  EXPECT_NEAR(LengthPriorMean(5), std::sqrt(2.0) + 0.5 * std::log(5.0) + 0.5 * std::log(12.0),
+              1e-15);
+  for (Kernel k : kKernels) {
+    GpOptions o;
+    o.kernel = k;
+    o.bfgs.gradient_tolerance = 1e-8;
+    o.bfgs.function_tolerance = 1e-14;
+    const Gp map = FitGp(data.x, data.y, o);
+    Eigen::VectorXd g;
+    NegLogMarginalLikelihood(k, map.mean, map.z, map.u, map.theta, map.min_noise_variance, &g);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(g(i), -(map.theta(i) - LengthPriorMean(3)) / (o.length_prior_sd * o.length_prior_sd),
+                  1e-4)
+          << "kernel " << ToString(k) << " length " << i;
+    EXPECT_NEAR(g(3), 0.0, 1e-4);
+    EXPECT_NEAR(g(4), 0.0, 1e-4);
+    o.length_prior_sd = 0;
+    const Gp ml = FitGp(data.x, data.y, o);
+    const double mu = LengthPriorMean(3);
+    EXPECT_LT((map.theta.head(3).array() - mu).square().sum(),
+              (ml.theta.head(3).array() - mu).square().sum());
+  }
+}
+
+// GpOptions::max_rows keeps every ceil-spread row of a large table (and no other), and
+// hyperparameter_rows fits the hyperparameters on a subset while the GP keeps all its rows.
+TEST(GpFit, SubsetsOfLargeTables) {
+  const Data data = MakeData(2, 50, 0.1, 13);
+  GpOptions o;
+  o.max_rows = 20;
+  o.hyperparameter_rows = 0;
+  const Gp sub = FitGp(data.x, data.y, o);
+  ASSERT_EQ(sub.rows.size(), 20u);
+  ASSERT_EQ(sub.u.size(), 20);
+  for (int j = 0; j < 20; ++j) {
+    EXPECT_EQ(sub.rows[j], j * 50 / 20);
+    EXPECT_NEAR(sub.u(j), (data.y(sub.rows[j]) - sub.target_shift) / sub.target_scale, 1e-12);
+  }
+  EXPECT_NEAR(sub.target_shift, data.y.mean(), 1e-12);  // standardized by every row
+  o.max_rows = 0;
+  o.hyperparameter_rows = 20;
+  const Gp hyper = FitGp(data.x, data.y, o);
+  EXPECT_TRUE(hyper.rows.empty());
+  EXPECT_EQ(hyper.u.size(), 50);
+  o.hyperparameter_rows = 0;
+  const Gp full = FitGp(data.x, data.y, o);
+  EXPECT_GT((hyper.theta - full.theta).cwiseAbs().maxCoeff(), 1e-6);
+  o.hyperparameter_rows = 50;  // as many as the table: the full fit
+  EXPECT_EQ(FitGp(data.x, data.y, o).theta, full.theta);
+  o.max_rows = 3;
+  ExpectInputError([&] { FitGp(data.x, data.y, o); }, "at least 8");
 }
 
 }  // namespace

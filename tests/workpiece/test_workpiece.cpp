@@ -163,6 +163,63 @@ TEST(WorkpieceModel, BadFamilyFilesNameTheFileAndTheKey) {
   expect_bad([](nlohmann::json& j) { j["choice"].erase("models"); }, "models");
   expect_bad([](nlohmann::json& j) { j["extra"] = 1; }, "extra");
   expect_bad([](nlohmann::json& j) { j["inputs"][0]["name"] = "hardness"; }, "inputs");
+  expect_bad([](nlohmann::json& j) { j["domain"]["max"][0] = 1e9; },
+             "'domain.max': hardness_hrc = 1e+09 breaks the rule");
+  expect_bad([](nlohmann::json& j) { j["choice"]["table"][0]["cv_rmse"][0] = -1; },
+             "cv_rmse[0] = -1 breaks the rule");
+  expect_bad([](nlohmann::json& j) { j["choice"]["table"][0]["score"] = 1e300; },
+             "score = 1e+300 breaks the rule");
+}
+
+// Numbers of a model file get the range checks of a flag (the message names the file, the field
+// and the rule), and a file whose numbers pass every rule but predict nonsense at the training
+// domain is refused too: a GP target_scale of 1e308 predicted 0 with sd nan, a noise variance of
+// 1e308 an sd of 6e154, and `plan` wrote a program from them.
+TEST(WorkpieceModel, FileNumbersAreRangeCheckedAndPredictionsMustBeFinite) {
+  TrainOptions o;
+  o.family = FamilyFlag::kGaussianProcess;
+  o.transform = TransformFlag::kIdentity;
+  const WorkpieceModel gp = TrainWorkpieceModel(MakeTable(20, 0.05, 52), o, "generated.csv");
+  const nlohmann::json good = ReadJsonFile((SaveWorkpieceModel(Scratch("gp.json"), gp),
+                                            Scratch("gp.json")));
+  const auto expect_bad = [&](const char* key, double value, const std::string& fragment) {
+    nlohmann::json j = good;
+    j["choice"]["models"][0]["gps"][1][key] = value;
+    WriteJsonFile(Scratch("bad_gp.json"), j);
+    ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad_gp.json")); }, fragment);
+    ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad_gp.json")); }, "bad_gp.json");
+  };
+  expect_bad("target_scale", 1e308,
+             "'gps'[1] (settle_time_s): gaussian process: target_scale = 1e+308 breaks the "
+             "rule: must lie in (0, 1e+07]");
+  expect_bad("noise_variance", 1e308, "noise_variance = 1e+308 breaks the rule");
+  expect_bad("min_noise_variance", 0.0, "min_noise_variance = 0 breaks the rule");
+  expect_bad("target_shift", -2e7, "target_shift = -2e+07 breaks the rule");
+  nlohmann::json j = good;
+  j["choice"]["models"][0]["gps"][0]["theta"][2] = 31.0;
+  WriteJsonFile(Scratch("bad_gp.json"), j);
+  ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad_gp.json")); },
+                   "theta[2] = 31 breaks the rule: must lie in [-30, 30]");
+  // Within every field rule, but the signal sd e^29 times the target sd of 1e5 predicts an sd
+  // far beyond any elongation.
+  j = good;
+  j["choice"]["models"][0]["gps"][0]["theta"][5] = 29.0;
+  j["choice"]["models"][0]["gps"][0]["target_scale"] = 1e5;
+  WriteJsonFile(Scratch("bad_gp.json"), j);
+  ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad_gp.json")); },
+                   "'choice.models'[0] (gp-matern52-constant/identity) predicts "
+                   "max_elongation_um = ");
+  // A network file: weights and noise levels beyond their bounds.
+  nlohmann::json net = ReadJsonFile(Shipped("models/default.json"));
+  net["layers"][0]["weights"][1][2] = 1e300;
+  WriteJsonFile(Scratch("bad_net.json"), net);
+  ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad_net.json")); },
+                   "model 'layers[0].weights[1][2]' = 1e+300 breaks the rule: |x| <= 1e+06");
+  net = ReadJsonFile(Shipped("models/default.json"));
+  net["uncertainty"]["output_noise_variance_normalized"][1] = 1e308;
+  WriteJsonFile(Scratch("bad_net.json"), net);
+  ExpectInputError([&] { LoadWorkpieceModel(Scratch("bad_net.json")); },
+                   "output_noise_variance_normalized[1]' = 1e+308 breaks the rule");
 }
 
 TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
@@ -172,7 +229,7 @@ TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
     return s;
   };
   EXPECT_EQ(names(FamilyFlag::kLinear, TransformFlag::kAuto), "linear/log linear/identity ");
-  EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-constant/log ");
+  EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-linear/log ");
   EXPECT_EQ(names(FamilyFlag::kNetwork, TransformFlag::kLog), "network-evidence/log ");
   EXPECT_EQ(names(FamilyFlag::kAuto, TransformFlag::kIdentity),
             "linear/identity gp-se-iso-constant/identity gp-matern52-constant/identity ");

@@ -242,8 +242,9 @@ bool RenderPlots(const ScrewComparison& c, const std::string& slug, const PlotFi
                  const std::filesystem::path& dir, const ReportOptions& options, OutputDir& out,
                  std::set<std::string>* rendered, std::string* warning) {
   const std::string log = slug + ".gp.log";
-  const std::filesystem::path stage = std::filesystem::absolute(out.Staging());
-  const int rc = RunProgram({options.gnuplot_command, slug + ".gp"}, stage, stage / log);
+  const int rc = out.RunInStaging({options.gnuplot_command, slug + ".gp"}, log,
+                                  {files.elongation, files.lead, files.lead_start});
+  const std::filesystem::path stage = out.Staging();
   bool ok = rc == 0;
   for (const std::string& png : {files.elongation, files.lead, files.lead_start}) {
     std::error_code ec;

@@ -125,8 +125,8 @@ std::string Render(OutputDir& out, const std::string& stem, const std::string& b
           Terminal(height_px) + "set output " + GnuplotString(stem + ".png") + "\n" + body);
   if (!ProgramSucceeds({"gnuplot", "--version"}))
     return "<p class='warn'>(gnuplot not found: " + HtmlEscape(stem) + ".gp not rendered)</p>";
-  const fs::path stage = fs::absolute(out.Staging());
-  const int rc = RunProgram({"gnuplot", stem + ".gp"}, stage, stage / (stem + ".log"));
+  const int rc = out.RunInStaging({"gnuplot", stem + ".gp"}, stem + ".log", {stem + ".png"});
+  const fs::path stage = out.Staging();
   std::error_code ec;
   if (rc != 0 || !fs::is_regular_file(stage / (stem + ".png"), ec)) {
     if (fs::is_regular_file(stage / (stem + ".log"), ec)) out.AddStaged(stem + ".log");

@@ -13,6 +13,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/error.h"
 
@@ -172,32 +173,49 @@ void RemoveStaleTemporaries(const fs::path& dir, const std::string& target) {
 }
 
 void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& files) {
-  std::set<fs::path> seen;
-  for (const auto& [path, text] : files) {
-    CheckTarget(path);
-    // Absolute first: weakly_canonical leaves a relative path whose parts do not exist yet
-    // relative ("A.SPF"), but makes "./A.SPF" absolute, so the two would compare unequal.
-    if (!seen.insert(fs::weakly_canonical(fs::absolute(path))).second)
-      throw InputError("cannot write " + Quoted(path) + ": the same file is given twice");
-  }
-  std::map<fs::path, std::set<std::string>> targets;  // what killed runs left beside them
-  for (const auto& [path, text] : files)
-    targets[DirectoryOf(path)].insert(path.filename().string());
-  for (const auto& [dir, names] : targets) RemoveStale(dir, &names);
-  // 1. Every file into a temporary beside its target: a failure here leaves nothing behind.
-  std::vector<fs::path> tmps;
+  WriteFilesAtomic(files, {});
+}
+
+void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& texts,
+                      const std::vector<ReadyFile>& ready) {
+  std::vector<fs::path> paths;
+  for (const auto& [path, text] : texts) paths.push_back(path);
+  for (const ReadyFile& r : ready) paths.push_back(r.path);
+  std::vector<fs::path> ready_files;
+  for (const ReadyFile& r : ready) ready_files.push_back(r.ready);
   try {
-    for (const auto& [path, text] : files) tmps.push_back(WriteTemporary(path, text));
+    std::set<fs::path> seen;
+    for (const auto& path : paths) {
+      CheckTarget(path);
+      // Absolute first: weakly_canonical leaves a relative path whose parts do not exist yet
+      // relative ("A.SPF"), but makes "./A.SPF" absolute, so the two would compare unequal.
+      if (!seen.insert(fs::weakly_canonical(fs::absolute(path))).second)
+        throw InputError("cannot write " + Quoted(path) + ": the same file is given twice");
+    }
   } catch (...) {
-    RemoveAll(tmps);
+    RemoveAll(ready_files);
     throw;
   }
+  std::map<fs::path, std::set<std::string>> targets;  // what killed runs left beside them
+  for (const auto& path : paths) targets[DirectoryOf(path)].insert(path.filename().string());
+  for (const auto& [dir, names] : targets) RemoveStale(dir, &names);
+  // 1. Every file into a temporary beside its target (the ready ones are): a failure here leaves
+  // nothing behind.
+  std::vector<fs::path> tmps;
+  try {
+    for (const auto& [path, text] : texts) tmps.push_back(WriteTemporary(path, text));
+  } catch (...) {
+    RemoveAll(tmps);
+    RemoveAll(ready_files);
+    throw;
+  }
+  tmps.insert(tmps.end(), ready_files.begin(), ready_files.end());
   // 2. Rename them over the targets; an existing target is hard-linked to a backup first, so a
   // failing rename restores every target already replaced.
-  std::vector<fs::path> backups(files.size());
-  std::vector<bool> existed(files.size(), false);
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    const fs::path& path = files[i].first;
+  std::vector<fs::path> backups(paths.size());
+  std::vector<bool> existed(paths.size(), false);
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const fs::path& path = paths[i];
     std::error_code ec;
     existed[i] = fs::is_regular_file(fs::symlink_status(path, ec));
     if (existed[i]) {
@@ -210,9 +228,9 @@ void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& files
     const std::string reason = ec.message();
     for (std::size_t k = 0; k < i; ++k) {
       if (!backups[k].empty())
-        fs::rename(backups[k], files[k].first, ec);
+        fs::rename(backups[k], paths[k], ec);
       else if (!existed[k])
-        fs::remove(files[k].first, ec);
+        fs::remove(paths[k], ec);
     }
     RemoveAll(tmps);
     RemoveAll(backups);
@@ -222,7 +240,72 @@ void WriteFilesAtomic(const std::vector<std::pair<fs::path, std::string>>& files
   RemoveAll(backups);
 }
 
-std::string ReadTextFile(const fs::path& path) {
+StreamedFile::StreamedFile(fs::path path) : path_(std::move(path)) {
+  CheckTarget(path_);
+  tmp_ = TemporaryName(path_, kTmp);
+  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (fd_ < 0) throw InputError("cannot write " + Quoted(path_) + ": " + std::strerror(errno));
+  buffer_.reserve(1u << 20);
+}
+
+StreamedFile::~StreamedFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!handed_over_) {
+    std::error_code ec;
+    fs::remove(tmp_, ec);
+  }
+}
+
+void StreamedFile::Flush() {
+  std::size_t off = 0;
+  while (off < buffer_.size()) {
+    const ssize_t n = ::write(fd_, buffer_.data() + off, buffer_.size() - off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0)
+      throw InputError("cannot write " + Quoted(path_) + ": " +
+                       std::strerror(n < 0 ? errno : ENOSPC));
+    off += static_cast<std::size_t>(n);
+  }
+  buffer_.clear();
+}
+
+void StreamedFile::Append(std::string_view text) {
+  if (fd_ < 0) throw std::logic_error("StreamedFile::Append after Finish");
+  buffer_.append(text);
+  if (buffer_.size() >= (1u << 20)) Flush();
+}
+
+void StreamedFile::AppendFile(const fs::path& other) {
+  const int in = ::open(other.c_str(), O_RDONLY | O_CLOEXEC);
+  if (in < 0) throw InputError("cannot read " + Quoted(other) + ": " + std::strerror(errno));
+  std::string chunk(1u << 20, '\0');
+  for (;;) {
+    const ssize_t n = ::read(in, chunk.data(), chunk.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(in);
+      throw InputError("cannot read " + Quoted(other) + ": " + std::strerror(err));
+    }
+    if (n == 0) break;
+    Append(std::string_view(chunk.data(), static_cast<std::size_t>(n)));
+  }
+  ::close(in);
+}
+
+fs::path StreamedFile::Finish(bool durable) {
+  Flush();
+  int err = durable && ::fsync(fd_) != 0 ? errno : 0;
+  if (::close(fd_) != 0 && err == 0) err = errno;
+  fd_ = -1;
+  if (err != 0) throw InputError("cannot write " + Quoted(path_) + ": " + std::strerror(err));
+  handed_over_ = true;
+  return tmp_;
+}
+
+void StreamedFile::Commit() { WriteFilesAtomic({}, {{path_, Finish()}}); }
+
+std::uintmax_t CheckInputFile(const fs::path& path) {
   // Only regular files: a FIFO or a device would block or never end, a directory has no text.
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
@@ -230,10 +313,16 @@ std::string ReadTextFile(const fs::path& path) {
   if (!S_ISREG(st.st_mode))
     throw InputError("cannot read " + Quoted(path) + ": it is " + KindOf(st.st_mode) +
                      "; whirl reads only regular files");
-  if (static_cast<std::uintmax_t>(st.st_size) > kMaxInputFileBytes)
-    throw InputError("cannot read " + Quoted(path) + ": " + std::to_string(st.st_size) +
+  return static_cast<std::uintmax_t>(st.st_size);
+}
+
+std::string ReadTextFile(const fs::path& path) {
+  const std::uintmax_t size = CheckInputFile(path);
+  if (size > kMaxInputFileBytes)
+    throw InputError("cannot read " + Quoted(path) + ": " + std::to_string(size) +
                      " bytes breaks the limit of " + std::to_string(kMaxInputFileBytes) +
-                     " bytes (64 MiB) per input file");
+                     " bytes (64 MiB) per input file read whole (process tables, models, screws, "
+                     "profiles; run files and logs are streamed without this limit)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("cannot open '" + path.string() + "': " + std::strerror(errno));
   std::ostringstream ss;

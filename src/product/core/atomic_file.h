@@ -2,13 +2,16 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 namespace whirl {
 
-/// Largest input file whirl reads [bytes]: 64 MiB, far above any process table, model or screw
-/// file (the shipped 500-row table is about 60 kB), so a wrong path cannot exhaust memory.
+/// Largest input file whirl reads whole into memory [bytes] (ReadTextFile: process tables, models,
+/// screws, profiles, surfaces): 64 MiB, far above any of them (the shipped 500-row table is about
+/// 60 kB), so a wrong path cannot exhaust memory. Run files and logs of the drift commands are
+/// not read whole: core/csv.h's CsvReader streams them, and drift/run_file.h states their limits.
 inline constexpr std::uintmax_t kMaxInputFileBytes = 64ull << 20;
 
 /// Writes `contents` to `path` atomically: into a temporary file in the same directory, flushed,
@@ -34,6 +37,48 @@ void WriteFileAtomic(const std::filesystem::path& path, const std::string& conte
 /// directory (core/output_dir.h) removes all of them; a running process's temporaries are left.
 void WriteFilesAtomic(const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 
+/// A file of WriteFilesAtomic whose contents are already on disk (a long output written with
+/// StreamedFile and finished): `ready`, a complete file on the same file system as `path`, is
+/// renamed over `path` in the same all-or-nothing step instead of being copied.
+struct ReadyFile {
+  std::filesystem::path path;   ///< the target
+  std::filesystem::path ready;  ///< the finished file (removed when the write fails)
+};
+/// WriteFilesAtomic with some files already on disk.
+void WriteFilesAtomic(const std::vector<std::pair<std::filesystem::path, std::string>>& files,
+                      const std::vector<ReadyFile>& ready);
+
+/// A file written piece by piece without holding it (a per-sample output of a long log): the
+/// text goes through a 1 MiB buffer into a temporary beside `path` (named as WriteFileAtomic's);
+/// Commit() flushes it to disk and renames it over `path`, Finish() flushes it and hands it over
+/// (for WriteFilesAtomic's ReadyFile). Destroyed before either (an error on the way), it removes
+/// the temporary and leaves `path` as it was. The target follows CheckOutputFile's rule (checked
+/// when opened); InputError naming the path on any failure.
+class StreamedFile {
+ public:
+  explicit StreamedFile(std::filesystem::path path);
+  ~StreamedFile();
+  StreamedFile(const StreamedFile&) = delete;
+  StreamedFile& operator=(const StreamedFile&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  void Append(std::string_view text);
+  /// Appends the bytes of another file.
+  void AppendFile(const std::filesystem::path& other);
+  /// Flushes and closes the temporary and returns it; the caller renames or removes it.
+  /// `durable` false: no fsync (a scratch file that never becomes an output).
+  std::filesystem::path Finish(bool durable = true);
+  /// Finish, then rename over path().
+  void Commit();
+
+ private:
+  void Flush();
+  std::filesystem::path path_, tmp_;
+  std::string buffer_;
+  int fd_ = -1;
+  bool handed_over_ = false;
+};
+
 /// The writer's rule for one target, checked without writing (for checks before a long run):
 /// `path` names a file (not a directory path), its directory exists, and it is absent or a regular
 /// file. Throws the InputError WriteFileAtomic would, naming the path and what it is.
@@ -57,5 +102,10 @@ void RemoveStaleTemporaries(const std::filesystem::path& dir, const std::string&
 /// Reads a whole text file; throws InputError naming the path if it cannot be opened, is not a
 /// regular file (a FIFO, device or directory) or is larger than kMaxInputFileBytes.
 std::string ReadTextFile(const std::filesystem::path& path);
+
+/// The rule of every input file, checked before it is opened: it exists and is a regular file (a
+/// FIFO or a device would block or never end, a directory has no text). Returns its size
+/// [bytes]; InputError naming the path otherwise ("cannot open", "cannot read ... it is a FIFO").
+std::uintmax_t CheckInputFile(const std::filesystem::path& path);
 
 }  // namespace whirl

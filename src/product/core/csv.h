@@ -10,6 +10,7 @@
 // Numbers: decimal only, [+-]digits[.digits][(e|E)[+-]digits] (also ".5" and "5."); hexadecimal
 // floats (0x1p3), "inf", "nan" and every other form strtod would take are refused.
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,52 @@ struct CsvOptions {
   /// that did not record time in some rows, drift/run_file.h); their other cells follow the
   /// number rules above.
   std::vector<std::string> missing_allowed;
+};
+
+/// Comment lines a CsvReader on a file keeps (the first ones: a logger may write many).
+inline constexpr std::size_t kMaxCsvComments = 1000;
+/// Longest line a CsvReader takes [bytes] (a run file of 512 columns needs about 15 kB).
+inline constexpr std::size_t kMaxCsvLineBytes = 16u << 20;
+
+/// A CSV text read row by row by the rules of this header, for files too long to hold (a
+/// machine's log of millions of rows): a file is read in chunks of 1 MiB and each row parsed once
+/// into the caller's buffer, so memory does not grow with the file. The constructor reads up to
+/// the header row; Next returns the data rows in order. The errors are ParseCsv's, naming the
+/// file, line and column; an invalid UTF-8 byte is reported on the line it is found on (ParseCsv
+/// on text reports the first one in the text before any other error).
+class CsvReader {
+ public:
+  /// A file: InputError if it cannot be opened or is not a regular file (CheckInputFile).
+  CsvReader(const std::filesystem::path& path, const CsvOptions& options = {});
+  /// In-memory text, named `source` in messages; keeps every comment.
+  CsvReader(std::string text, std::string source, const CsvOptions& options = {});
+  ~CsvReader();
+  CsvReader(const CsvReader&) = delete;
+  CsvReader& operator=(const CsvReader&) = delete;
+
+  const std::string& source() const;
+  const std::vector<std::string>& header() const;
+  int header_line() const;
+  /// The '#' lines read so far (before and among the rows), at most kMaxCsvComments from a file.
+  const std::vector<std::string>& comments() const;
+  /// Index of a column; InputError "file: missing column 'x' (have: ...)" if absent.
+  std::size_t ColumnIndex(const std::string& name) const;
+  bool HasColumn(const std::string& name) const;
+
+  /// The next data row: header().size() values into `row` (NaN for a missing cell of a
+  /// missing_allowed column), its 1-based line into *line. False at the end of the text; then an
+  /// InputError for a table without data rows (unless allow_empty).
+  bool Next(double* row, int* line);
+  /// The next data row without parsing it: only the trimmed text of cell `column` (the row's cell
+  /// count is checked, the numbers are not); for a quick scan before the real pass.
+  bool NextCell(std::size_t column, std::string* cell, int* line);
+  long long rows() const;                 ///< data rows returned so far
+  unsigned long long bytes_read() const;  ///< of the text, for progress
+  unsigned long long total_bytes() const;  ///< the file's size (the text's)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 /// Parses CSV text. Rejects: text that is not UTF-8, no header, an empty or duplicated column

@@ -1,5 +1,7 @@
 #include "core/numbers.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -20,12 +22,31 @@ std::string Printf(const char* format, int precision, double x) {
 std::string MessageNumber(double x) { return FormatSignificant(x, 6); }
 
 std::string FormatNumber(double x) {
-  std::string s;
-  for (int digits = 6; digits <= 17; ++digits) {
-    s = FormatSignificant(x, digits);
-    if (std::strtod(s.c_str(), nullptr) == x) break;
+  // The fewest digits d >= 6 whose "%.*g" reads back as x. No d below the shortest round-trip
+  // representation's digit count can (it would be shorter), so the search starts there: one or
+  // two std::to_chars (printf's %g, exactly) instead of up to twelve printf and strtod.
+  if (!std::isfinite(x)) return FormatSignificant(x, 6);
+  // The significant digits of a number's text, without leading and trailing zeros.
+  const auto significant = [](const char* b, const char* e, char* out) {
+    char* o = out;
+    for (; b != e && *b != 'e'; ++b)
+      if (*b >= '0' && *b <= '9' && (o != out || *b != '0')) *o++ = *b;
+    while (o != out && o[-1] == '0') --o;
+    return static_cast<int>(o - out);
+  };
+  char shortest[64], digits[32], buf[64], printed[32];
+  const auto s = std::to_chars(shortest, shortest + sizeof shortest, x, std::chars_format::scientific);
+  const int n = significant(shortest, s.ptr, digits);
+  for (int d = std::max(6, n); d <= 17; ++d) {
+    const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, d);
+    // The same digits as the shortest representation: the same number, which reads back as x.
+    const int m = significant(buf, r.ptr, printed);
+    if (m == n && std::equal(digits, digits + n, printed)) return std::string(buf, r.ptr);
+    double back = 0;
+    std::from_chars(buf, r.ptr, back);
+    if (back == x || d == 17) return std::string(buf, r.ptr);
   }
-  return s;
+  return FormatSignificant(x, 17);
 }
 
 std::string FormatSignificant(double x, int digits) { return Printf("%.*g", digits, x); }

@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/run_program.h"
 
 namespace whirl {
 namespace {
@@ -245,6 +246,9 @@ std::string UnprovenStaging(const fs::path& s, const std::string& what) {
     const std::string entry = it->path().filename().string();
     if (entry == kStagingRecord || IsWhirlTemporary(entry)) continue;
     const auto f = record.files.find(entry);
+    if (f != record.files.end() && f->second == kProgramOutput &&
+        fs::is_regular_file(it->symlink_status()))
+      continue;  // named before whirl started the program that writes it
     if (f == record.files.end() || f->second.empty() || FileSha256(it->path()) != f->second)
       return QuotedPath(entry) + ", which whirl did not put there (or which changed since)";
   }
@@ -358,8 +362,14 @@ void RemoveStaleStaging(const fs::path& s) {
     record = ReadListing(s / kStagingRecord, s.string(), "whirl.output_dir.staging");
   } catch (const InputError&) {
   }
-  for (const auto& [name, hash] : record.files) RemoveProvenFile(s / name, hash);
   std::error_code ec;
+  for (const auto& [name, hash] : record.files) {
+    if (hash != kProgramOutput) {
+      RemoveProvenFile(s / name, hash);
+    } else if (fs::is_regular_file(fs::symlink_status(s / name, ec))) {
+      fs::remove(s / name, ec);  // UnprovenStaging accepted it as the program's
+    }
+  }
   std::vector<fs::path> temporaries;
   for (fs::directory_iterator it(s, ec), end; !ec && it != end; it.increment(ec))
     if (IsWhirlTemporary(it->path().filename().string()) &&
@@ -453,16 +463,22 @@ void OutputDir::Insert(const std::string& name, std::string contents) {
   files_.emplace_back(name, std::move(contents));
 }
 
-void OutputDir::Stage(const std::string& name, const std::string& contents, bool write) {
-  staged_[name] = Sha256Hex(contents);
+void OutputDir::WriteStagingRecord() const {
   Listing record;
   record.files = staged_;
-  // The record first: a run killed between the two leaves a recorded name without its file
-  // (harmless), never a file the next run cannot prove.
   WriteFileAtomic(staging_ / kStagingRecord,
                   ListingText(record, "whirl.output_dir.staging",
-                              "what whirl put into this staging folder, with SHA-256; a later "
-                              "run removes only these files once this run is gone"));
+                              "what whirl put into this staging folder, with SHA-256 (or " +
+                                  std::string(kProgramOutput) +
+                                  ": a file a program whirl ran was told to write); a later run "
+                                  "removes only these files once this run is gone"));
+}
+
+void OutputDir::Stage(const std::string& name, const std::string& contents, bool write) {
+  staged_[name] = Sha256Hex(contents);
+  // The record first: a run killed between the two leaves a recorded name without its file
+  // (harmless), never a file the next run cannot prove.
+  WriteStagingRecord();
   if (write) WriteFileAtomic(staging_ / name, contents);
 }
 
@@ -490,13 +506,49 @@ const fs::path& OutputDir::Staging() {
   return staging_;
 }
 
+int OutputDir::RunInStaging(const std::vector<std::string>& argv, const std::string& log,
+                            const std::vector<std::string>& outputs) {
+  const fs::path stage = fs::absolute(Staging());
+  for (const auto& name : outputs) {
+    if (!ValidEntryName(name))
+      throw InputError(what_ + ": " + QuotedPath(name) + " is not an entry name");
+    if (!staged_.count(name)) staged_[name] = kProgramOutput;
+  }
+  if (!ValidEntryName(log)) throw InputError(what_ + ": " + QuotedPath(log) + " is not an entry name");
+  if (!staged_.count(log)) staged_[log] = kProgramOutput;
+  WriteStagingRecord();
+  return RunProgram(argv, stage, stage / log);
+}
+
 void OutputDir::AddStaged(const std::string& name) {
   if (staging_.empty()) throw std::logic_error("OutputDir::AddStaged before Staging()");
   Insert(name, ReadTextFile(staging_ / name));
   Stage(name, files_.back().second, false);
 }
 
-std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, std::string>>& also) {
+bool OutputDir::AddProgramLog(const std::string& name) {
+  std::error_code ec;
+  if (staging_.empty() || !fs::is_regular_file(fs::symlink_status(staging_ / name, ec)))
+    return false;
+  AddStaged(name);
+  return true;
+}
+
+void OutputDir::AddReady(const std::string& name, const fs::path& ready) {
+  if (!ValidEntryName(name) || IsWhirlTemporary(name))
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": " + QuotedPath(name) +
+                     " is not a file name whirl may write there");
+  if (!names_.insert(name).second)
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": two outputs named " + QuotedPath(name));
+  const std::string hash = FileSha256(ready);
+  if (hash.empty())
+    throw InputError(what_ + " " + QuotedPath(dir_) + ": cannot read back " + QuotedPath(ready));
+  ready_.push_back({dir_ / name, ready});
+  ready_hashes_[name] = hash;
+}
+
+std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, std::string>>& also,
+                                        const std::vector<ReadyFile>& also_ready) {
   // The rule again, just before writing; `before` is what the directory provably holds of whirl's.
   const Proof before = Inspect(dir_, what_, std::set<std::string>(kept_.begin(), kept_.end()));
   Create();
@@ -505,6 +557,7 @@ std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, st
   Listing now;
   now.dirs.insert(kept_.begin(), kept_.end());
   for (const auto& [name, text] : files_) now.files[name] = Sha256Hex(text);
+  for (const auto& [name, hash] : ready_hashes_) now.files[name] = hash;
   Listing all = now;
   for (const auto& [name, hash] : before.listing.files)
     if (!now.files.count(name) && !now.dirs.count(name)) all.files[name] = hash;
@@ -521,7 +574,10 @@ std::vector<fs::path> OutputDir::Commit(const std::vector<std::pair<fs::path, st
   // Until the old files are gone the manifest lists them too, so a run killed in between
   // leaves a directory the next run accepts.
   batch.emplace_back(dir_ / kOutputManifest, ManifestText(all));
-  WriteFilesAtomic(batch);
+  std::vector<ReadyFile> ready = ready_;
+  for (const auto& r : ready_) written.push_back(r.path);
+  ready.insert(ready.end(), also_ready.begin(), also_ready.end());
+  WriteFilesAtomic(batch, ready);
   committed_ = true;
   std::error_code ec;
   if (!staging_.empty()) fs::remove_all(staging_, ec);

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/atomic_file.h"  // ReadyFile
+
 namespace whirl {
 
 /// The file in each output directory that lists what whirl wrote there: JSON, schema
@@ -22,6 +24,9 @@ inline constexpr const char* kOutputManifest = ".whirl-output.json";
 /// with their SHA-256 (schema "whirl.output_dir.staging"), so a later run can remove the folder
 /// of a killed run without removing anything else.
 inline constexpr const char* kStagingRecord = ".whirl-stage.json";
+/// The staging record's "hash" of a file a program run by whirl writes (OutputDir::RunInStaging):
+/// its content is not known in advance, its name is.
+inline constexpr const char* kProgramOutput = "program-output";
 
 /// The rule below in a few words, for --help texts of directory flags.
 inline constexpr const char* kOutputDirRule =
@@ -74,6 +79,11 @@ class OutputDir {
   /// A file of the output: `name` is one path component (no '/', not the manifest), given once.
   void Add(const std::string& name, std::string contents);
 
+  /// A file of the output already on disk, written without holding it (a long per-sample CSV:
+  /// StreamedFile with a target inside Staging(), then Finish()): `ready` is renamed into place
+  /// by Commit, never read into memory. Not copied into Staging() under `name`.
+  void AddReady(const std::string& name, const std::filesystem::path& ready);
+
   /// An entry written by its own OutputDir during this run (the demo's report/ sub-directory):
   /// listed in the manifest, never written by Commit.
   void Keep(const std::string& name);
@@ -86,22 +96,36 @@ class OutputDir {
   /// Adds the file `name` a program wrote into Staging() (binary safe).
   void AddStaged(const std::string& name);
 
+  /// Runs `argv` (e.g. gnuplot) in Staging() with its output and errors in the file `log`
+  /// there, and returns its exit status (RunProgram). Before it starts, `log` and `outputs` (the
+  /// files the program is told to write) are recorded as the program's in the staging record
+  /// (kProgramOutput instead of a hash): if this run is killed while the program runs, the next
+  /// run can prove those names are whirl's and remove them. Add what it wrote with AddStaged.
+  int RunInStaging(const std::vector<std::string>& argv, const std::string& log,
+                   const std::vector<std::string>& outputs);
+  /// Adds the log `name` of a RunInStaging program if it wrote one (false if not).
+  bool AddProgramLog(const std::string& name);
+
   /// Writes every added file, the manifest and `also` (files outside the directory, e.g. the
   /// --out JSON beside a --report) all-or-nothing; re-checks the rule first. Returns the paths
   /// of the added files.
   std::vector<std::filesystem::path> Commit(
-      const std::vector<std::pair<std::filesystem::path, std::string>>& also = {});
+      const std::vector<std::pair<std::filesystem::path, std::string>>& also = {},
+      const std::vector<ReadyFile>& also_ready = {});
 
  private:
   void Insert(const std::string& name, std::string contents);  // checks the name, keeps it
   // Records `name` with its hash in the staging folder's record (and writes it there if `write`).
   void Stage(const std::string& name, const std::string& contents, bool write);
+  void WriteStagingRecord() const;  // staged_ into the staging folder's kStagingRecord
 
   std::filesystem::path dir_;
   std::string what_;
   std::vector<std::pair<std::string, std::string>> files_;
   std::set<std::string> names_;  ///< of files_
   std::vector<std::string> kept_;
+  std::vector<ReadyFile> ready_;  ///< AddReady: the target inside the directory, the file
+  std::map<std::string, std::string> ready_hashes_;  ///< AddReady: name -> SHA-256
   std::filesystem::path staging_;
   std::map<std::string, std::string> staged_;  ///< name -> SHA-256 in the staging folder
   bool created_ = false, committed_ = false;

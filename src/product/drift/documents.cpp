@@ -198,24 +198,38 @@ std::string FormatModel(const DriftModel& m) {
   return o.str();
 }
 
-std::string PredictionCsv(const RunPrediction& p, const std::vector<std::string>& comments) {
-  std::vector<std::string> header{p.time_from_index ? "sample" : "time_min", "predicted_um",
+std::string PredictionCsvHeader(bool time_from_index, bool has_measured,
+                                const std::vector<std::string>& comments) {
+  std::vector<std::string> header{time_from_index ? "sample" : "time_min", "predicted_um",
                                   "compensation_um", "std_um"};
-  if (p.has_measured) {
+  if (has_measured) {
     header.push_back("measured_um");
     header.push_back("residual_um");
   }
-  std::vector<std::vector<double>> rows;
-  for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k) {
-    std::vector<double> r{p.time[static_cast<std::size_t>(k)], p.predicted_um(k),
-                          -p.predicted_um(k), p.std_um(k)};
-    if (p.has_measured) {
-      r.push_back(p.measured_um(k));
-      r.push_back(p.measured_um(k) - p.predicted_um(k));
-    }
-    rows.push_back(std::move(r));
-  }
-  return FormatCsv(header, rows, comments);
+  return FormatCsv(header, {}, comments);
+}
+
+void AppendPredictionRow(double time, double predicted, double std_um, const double* measured,
+                         std::string* out) {
+  const auto cell = [&](double v, char end) {
+    out->append(FormatNumber(v));
+    out->push_back(end);
+  };
+  cell(time, ',');
+  cell(predicted, ',');
+  cell(-predicted, ',');
+  if (!measured) return cell(std_um, '\n');
+  cell(std_um, ',');
+  cell(*measured, ',');
+  cell(*measured - predicted, '\n');
+}
+
+std::string PredictionCsv(const RunPrediction& p, const std::vector<std::string>& comments) {
+  std::string out = PredictionCsvHeader(p.time_from_index, p.has_measured, comments);
+  for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k)
+    AppendPredictionRow(p.time[static_cast<std::size_t>(k)], p.predicted_um(k), p.std_um(k),
+                        p.has_measured ? &p.measured_um(k) : nullptr, &out);
+  return out;
 }
 
 json ErrorStatsJson(const ErrorStats& s) {
@@ -226,19 +240,21 @@ json ErrorStatsJson(const ErrorStats& s) {
           {"max_abs_um", s.max_abs_um}};
 }
 
-json PredictionJson(const RunPrediction& p) {
+json PredictionJson(const PredictionSummary& p) {
   json j = {{"run", p.run},
-            {"samples", p.predicted_um.size()},
+            {"samples", p.samples},
             {"time_axis", p.time_from_index ? "sample index (no recorded time)" : "time_min"},
-            {"predicted_um_range", {p.predicted_um.minCoeff(), p.predicted_um.maxCoeff()}},
+            {"predicted_um_range", {p.predicted_min_um, p.predicted_max_um}},
             {"outside_training_range_samples", p.outside_range_samples},
             {"warnings", p.warnings}};
   if (p.has_measured) {
-    j["residual"] = ErrorStatsJson(ComputeErrorStats(p.measured_um - p.predicted_um));
-    j["no_compensation"] = ErrorStatsJson(ComputeErrorStats(p.measured_um));
+    j["residual"] = ErrorStatsJson(p.residual);
+    j["no_compensation"] = ErrorStatsJson(p.none);
   }
   return j;
 }
+
+json PredictionJson(const RunPrediction& p) { return PredictionJson(Summarize(p)); }
 
 json CrossRunJson(const CrossRunResult& r) {
   json runs = json::array();

@@ -11,6 +11,7 @@
 #include "drift/model.h"
 #include "drift/report.h"
 #include "drift/selection.h"
+#include "drift/stream.h"
 
 namespace whirl::drift {
 
@@ -26,8 +27,15 @@ std::string FormatModel(const DriftModel& m);
 /// Per sample: time_min (or sample), predicted_um, compensation_um (= -predicted), std_um, and
 /// measured_um, residual_um when the run has the error column.
 std::string PredictionCsv(const RunPrediction& p, const std::vector<std::string>& comments);
+/// The same CSV written row by row (a streamed run): the comments and header ...
+std::string PredictionCsvHeader(bool time_from_index, bool has_measured,
+                                const std::vector<std::string>& comments);
+/// ... and one row per sample (`measured` null when the run has no measured error).
+void AppendPredictionRow(double time, double predicted_um, double std_um, const double* measured_um,
+                         std::string* out);
 /// Summary of a prediction (statistics of the residual when measured, warnings).
 nlohmann::json PredictionJson(const RunPrediction& p);
+nlohmann::json PredictionJson(const PredictionSummary& p);
 
 nlohmann::json ErrorStatsJson(const ErrorStats& s);
 nlohmann::json CrossRunJson(const CrossRunResult& r);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "core/error.h"
@@ -79,6 +80,33 @@ ErrorStats ComputeErrorStats(const Eigen::VectorXd& r) {
   s.rmse_um = std::sqrt(r.squaredNorm() / n);
   s.std_um = std::sqrt((r.array() - r.mean()).square().sum() / n);
   s.max_abs_um = r.cwiseAbs().maxCoeff();
+  return s;
+}
+
+void ErrorStatsAccumulator::Merge(const ErrorStatsAccumulator& o) {
+  if (o.n_ == 0) return;
+  if (n_ == 0) {
+    *this = o;
+    return;
+  }
+  const double n = static_cast<double>(n_ + o.n_), d = o.mean_ - mean_;
+  m2_ += o.m2_ + d * d * static_cast<double>(n_) * static_cast<double>(o.n_) / n;
+  mean_ += d * static_cast<double>(o.n_) / n;
+  n_ += o.n_;
+  abs_ += o.abs_;
+  sq_ += o.sq_;
+  max_ = std::max(max_, o.max_);
+}
+
+ErrorStats ErrorStatsAccumulator::Stats() const {
+  ErrorStats s;
+  s.samples = static_cast<int>(std::min<long long>(n_, std::numeric_limits<int>::max()));
+  if (n_ == 0) return s;
+  const double n = static_cast<double>(n_);
+  s.mae_um = abs_ / n;
+  s.rmse_um = std::sqrt(sq_ / n);
+  s.std_um = std::sqrt(std::max(m2_, 0.0) / n);
+  s.max_abs_um = max_;
   return s;
 }
 

@@ -12,6 +12,8 @@
 //    [a Q, (a + b) Q); the model runs from row 0 (lags and reference start at the log's start, as
 //    on a machine that is never reset) and is scored on the test rows only.
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -29,6 +31,30 @@ struct ErrorStats {
   double max_abs_um = 0;  ///< max |r|
 };
 ErrorStats ComputeErrorStats(const Eigen::VectorXd& residual_um);
+
+/// ComputeErrorStats over residuals that arrive one at a time (a streamed run): sums of |r| and
+/// r^2, the maximum, and the mean and sum of squared deviations by Welford's update (Chan,
+/// Golub and LeVeque's merge for Merge), so the memory is fixed; equal to ComputeErrorStats up to
+/// rounding.
+class ErrorStatsAccumulator {
+ public:
+  void Add(double r) {
+    ++n_;
+    abs_ += std::abs(r);
+    sq_ += r * r;
+    max_ = std::max(max_, std::abs(r));
+    const double d = r - mean_;
+    mean_ += d / static_cast<double>(n_);
+    m2_ += d * (r - mean_);
+  }
+  void Merge(const ErrorStatsAccumulator& o);
+  long long count() const { return n_; }
+  ErrorStats Stats() const;
+
+ private:
+  long long n_ = 0;
+  double abs_ = 0, sq_ = 0, max_ = 0, mean_ = 0, m2_ = 0;
+};
 
 // Every figure below is on one error zero (FitOptions::zero, run_file.h ErrorZero): the models,
 // "no compensation" and the sensor-free baselines alike, so gains are comparable.

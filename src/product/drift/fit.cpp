@@ -19,12 +19,14 @@ struct Stacked {
   std::vector<int> fold;  // fold of each sample
   std::vector<int> run;   // run of each sample
   std::vector<double> elapsed;  // time since the run's start [min or samples]
+  double sampling_step = std::numeric_limits<double>::quiet_NaN();  // FitOptions::sampling_step
 };
 
 Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
               const std::vector<std::string>& sensors, const std::vector<std::string>& extras,
               const std::vector<double>& taus, int folds,
-              const std::vector<double>& elapsed_taus = {}) {
+              const std::vector<double>& elapsed_taus = {},
+              double sampling_step = std::numeric_limits<double>::quiet_NaN()) {
   std::vector<Eigen::MatrixXd> parts;
   Eigen::Index total = 0, cols = 0;
   for (const Run& r : runs) {
@@ -33,6 +35,7 @@ Stacked Stack(const std::vector<Run>& runs, const std::string& error_column,
     cols = parts.back().cols();
   }
   Stacked s;
+  s.sampling_step = sampling_step;
   s.x.resize(total, cols);
   s.y.resize(total);
   s.fold.resize(static_cast<std::size_t>(total));
@@ -146,7 +149,7 @@ WarmUpFit WarmUpOnRows(const Stacked& s, const std::vector<Eigen::Index>& idx, i
   }
   std::vector<Eigen::VectorXd> ev;
   for (const auto& v : e) ev.push_back(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
-  return FitWarmUp(t, ev, terms, with_x ? Rows(s.x, idx) : Eigen::MatrixXd());
+  return FitWarmUp(t, ev, terms, with_x ? Rows(s.x, idx) : Eigen::MatrixXd(), s.sampling_step);
 }
 
 Eigen::VectorXd PredictWarmUp(const WarmUpFit& f, const Stacked& s,
@@ -234,7 +237,32 @@ void FitNetwork(const Stacked& s, const FitOptions& o, DriftModel* m, std::strin
 // The given sensors without the dead and duplicate ones (selection.h convention 8).
 std::vector<std::string> UsableSensors(const std::vector<Run>& runs,
                                        const std::vector<std::string>& sensors,
+                                       const SelectionMoments* all_rows,
                                        std::vector<std::string>* warnings) {
+  if (all_rows != nullptr) {  // the moments of every row: the given sensors' part of them
+    SelectionMoments given;
+    const auto m = static_cast<Eigen::Index>(sensors.size());
+    given.rows = all_rows->rows;
+    given.mean.resize(m);
+    given.max_abs.resize(m);
+    given.cross.resize(m, m);
+    std::vector<int> at;
+    for (const auto& name : sensors) at.push_back(runs.front().SensorIndex(name));
+    for (Eigen::Index i = 0; i < m; ++i) {
+      given.mean(i) = all_rows->mean(at[static_cast<std::size_t>(i)]);
+      given.max_abs(i) = all_rows->max_abs(at[static_cast<std::size_t>(i)]);
+      for (Eigen::Index j = 0; j < m; ++j)
+        given.cross(i, j) =
+            all_rows->cross(at[static_cast<std::size_t>(i)], at[static_cast<std::size_t>(j)]);
+    }
+    for (const Run& r : runs)
+      for (const auto& name : sensors) r.SensorIndex(name);
+    const SensorScreen screen = ScreenSensors(given, sensors, RunSources(runs));
+    *warnings = screen.left_out;
+    std::vector<std::string> out;
+    for (const int i : screen.usable) out.push_back(sensors[static_cast<std::size_t>(i)]);
+    return out;
+  }
   Eigen::Index total = 0;
   for (const Run& r : runs) total += r.samples();
   Eigen::MatrixXd rises(total, static_cast<Eigen::Index>(sensors.size()));
@@ -306,6 +334,8 @@ void FitOptions::Validate() const {
     throw InputError("hidden " + std::to_string(hidden) + ": must be 1..20");
   if (restarts < 1 || restarts > 50)
     throw InputError("restarts " + std::to_string(restarts) + ": must be 1..50");
+  if (!(std::isnan(sampling_step) || (sampling_step > 0 && std::isfinite(sampling_step))))
+    throw InputError("sampling step " + MessageNumber(sampling_step) + ": must be > 0");
   if (max_train_samples < 20 || max_train_samples > 20000)
     throw InputError("max train samples " + std::to_string(max_train_samples) +
                      ": must be 20..20000");
@@ -314,11 +344,12 @@ void FitOptions::Validate() const {
 
 Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& error_column,
                               const FitOptions& o) {
+  const SelectionMoments* all = o.all_rows.get();
   if (o.selection.rule != ClassCountRule::kCrossValidated)
-    return SelectSensors(runs, error_column, o.selection);
+    return SelectSensors(runs, error_column, o.selection, all);
   SelectionOptions by_count = o.selection;
   by_count.rule = ClassCountRule::kLargestMargin;  // any rule that never throws: only the cuts
-  const Selection cuts = SelectSensors(runs, error_column, by_count);  // the partitions on offer
+  const Selection cuts = SelectSensors(runs, error_column, by_count, all);  // the cuts on offer
   by_count.rule = ClassCountRule::kFixed;
   std::vector<int> counts;
   for (const Partition& p : cuts.partitions)
@@ -332,7 +363,7 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
   ParallelFor(counts.size(), o.threads, [&](std::size_t i) {
     SelectionOptions fixed = by_count;
     fixed.fixed_classes = counts[i];
-    candidates[i] = SelectSensors(runs, error_column, fixed);
+    candidates[i] = SelectSensors(runs, error_column, fixed, all);
     try {
       rmse[i] = CrossValidatedRmse(
           Stack(runs, error_column, candidates[i].ChosenNames(), o.extra_inputs, {}, o.folds),
@@ -385,7 +416,7 @@ void ChooseSensors(const std::vector<Run>& runs, const std::string& error_column
     m.selection = "Miao et al. selection: " + rep->selection.message;
     rep->warnings = rep->selection.left_out;
   } else {
-    m.sensors = UsableSensors(runs, o.sensors, &rep->warnings);
+    m.sensors = UsableSensors(runs, o.sensors, o.all_rows.get(), &rep->warnings);
     m.selection = "given";
   }
 }
@@ -513,7 +544,7 @@ FitReport FitSensorModel(const std::vector<Run>& runs, const std::string& error_
 FitReport FitTimeModel(const std::vector<Run>& runs, const std::string& error_column,
                        const FitOptions& o, int terms) {
   FitReport rep = StartReport(runs, error_column, o, false);
-  const Stacked s = Stack(runs, error_column, {}, {}, {}, o.folds);
+  const Stacked s = Stack(runs, error_column, {}, {}, {}, o.folds, {}, o.sampling_step);
   std::vector<Eigen::Index> all(s.fold.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
   const WarmUpFit w = WarmUpOnRows(s, all, terms, false);
@@ -527,7 +558,8 @@ FitReport FitTimeModel(const std::vector<Run>& runs, const std::string& error_co
 FitReport FitSensorTimeModel(const std::vector<Run>& runs, const std::string& error_column,
                              const FitOptions& o, FitReport rep) {
   DriftModel& m = rep.model;
-  const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
+  const Stacked s = Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds,
+                          {}, o.sampling_step);
   std::vector<Eigen::Index> all(s.fold.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Eigen::Index>(i);
   const WarmUpFit w = WarmUpOnRows(s, all, 1, true);
@@ -548,7 +580,8 @@ std::string HowValidated(const std::vector<Run>& runs, const FitOptions& o) {
 FitReport FitCandidates(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& o) {
   const bool forward = o.forward_cv && runs.size() == 1;
-  const Stacked time_stack = Stack(runs, error_column, {}, {}, {}, o.folds);
+  const Stacked time_stack =
+      Stack(runs, error_column, {}, {}, {}, o.folds, {}, o.sampling_step);
   std::vector<CandidateScore> scores;
   auto score = [&](const std::string& name, int parameters, bool sensor_free, auto cv) {
     CandidateScore c;
@@ -579,7 +612,8 @@ FitReport FitCandidates(const std::vector<Run>& runs, const std::string& error_c
     sensors = FitSensorModel(runs, error_column, o);
     const DriftModel& m = sensors.model;
     const Stacked ss =
-        Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds);
+        Stack(runs, error_column, m.sensors, m.extra_inputs, m.time_constants, o.folds, {},
+              o.sampling_step);
     const int p = static_cast<int>(ss.x.cols()) + 1 + static_cast<int>(m.time_constants.size());
     if (want_sensors) score("sensors", p, false, [&] { return CrossValidateLinear(ss, forward); });
     if (want_mixed)

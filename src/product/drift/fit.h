@@ -8,6 +8,7 @@
 // computes; this header, how it is fitted.
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,12 @@ struct FitOptions {
   int max_train_samples = 3000;  ///< network: evenly thinned to at most this many samples
   nn::TrainOptions train;        ///< network: trainbr options (epochs default 1000)
   int threads = 0;               ///< cross-validation and restarts (0: all cores)
+  /// Set by FitFiles (drift/stream.h) when the runs are an evenly thinned sample of longer logs:
+  /// the logs' own sampling step [min, or samples] (the warm-up's shortest time constant is 2 of
+  /// it; NaN: the runs' median step), and the rises' moments over every row of the logs (the
+  /// selection's screen, similarity and F test; null: from the runs).
+  double sampling_step = std::numeric_limits<double>::quiet_NaN();
+  std::shared_ptr<const SelectionMoments> all_rows;
   void Validate() const;
 };
 

@@ -57,6 +57,16 @@ Eigen::MatrixXd ReadMatrix(const json& j, const char* key, Eigen::Index n,
 
 bool IsLinear(ModelKind k) { return k != ModelKind::kNetwork; }
 
+int FindColumn(const std::vector<std::string>& names, const std::string& name,
+               const std::string& source, const char* kind) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it != names.end()) return static_cast<int>(it - names.begin());
+  std::string have;
+  for (const auto& n : names) have += (have.empty() ? "" : ", ") + n;
+  throw InputError(source + ": no " + kind + " column '" + name + "' (have: " +
+                   (have.empty() ? "none" : have) + ")");
+}
+
 const char* const kElapsedInput = "elapsed";
 
 std::vector<Feature> MakeFeatures(const std::vector<std::string>& inputs,
@@ -427,68 +437,102 @@ Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& se
   return all;
 }
 
-RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode reference) {
+RunPredictor::RunPredictor(const DriftModel& model, bool time_from_index,
+                           const std::string& source, ReferenceMode reference)
+    : model_(&model), time_from_index_(time_from_index), reference_(reference) {
   model.Validate();
-  if (run.time_from_index != (model.time_unit == "sample"))
-    throw InputError(run.source + ": " +
-                     (run.time_from_index ? "has no recorded time" : "has a recorded time") +
+  if (time_from_index != (model.time_unit == "sample"))
+    throw InputError(source + ": " +
+                     (time_from_index ? "has no recorded time" : "has a recorded time") +
                      " but the model's time unit is '" + model.time_unit +
                      "': its lag time constants would be misread");
-  const Eigen::MatrixXd u = RawInputs(model, run);
-  Eigen::VectorXd ref = model.reference_C;
-  if (reference == ReferenceMode::kRunStart)
-    ref = u.row(0).head(static_cast<Eigen::Index>(model.sensors.size())).transpose();
-  DriftEvaluator ev(model, ref);
-  RunPrediction p;
-  p.run = run.name;
-  p.time = run.time_min;
-  p.time_from_index = run.time_from_index;
-  p.predicted_um.resize(run.samples());
-  p.std_um.resize(run.samples());
   // The input features' training ranges; the elapsed-time features (last) have their own test:
   // time beyond the longest training run.
-  const Eigen::Index ni = static_cast<Eigen::Index>(model.features.size() -
-                                                    model.elapsed_time_constants.size());
-  const double trained = TrainedElapsed(model);
-  int beyond = 0;
-  for (int k = 0; k < run.samples(); ++k) {
-    const double t = run.time_min[static_cast<std::size_t>(k)];
-    p.predicted_um(k) = ev.Step(t, u.row(k).transpose());
-    p.std_um(k) = ev.StdDev();
-    const Eigen::VectorXd f = ev.features().head(ni);
-    const double span = 1e-9;
-    if (((f - model.feature_max.head(ni)).array() > span).any() ||
-        ((model.feature_min.head(ni) - f).array() > span).any())
-      ++p.outside_range_samples;
-    beyond += t - run.time_min.front() > trained * (1 + 1e-9);
+  input_features_ =
+      static_cast<Eigen::Index>(model.features.size() - model.elapsed_time_constants.size());
+  trained_ = TrainedElapsed(model);
+}
+
+double RunPredictor::Step(double t, const Eigen::VectorXd& raw) {
+  const DriftModel& model = *model_;
+  if (!evaluator_) {
+    Eigen::VectorXd ref = model.reference_C;
+    if (reference_ == ReferenceMode::kRunStart)
+      ref = raw.head(static_cast<Eigen::Index>(model.sensors.size()));
+    evaluator_ = std::make_unique<DriftEvaluator>(model, ref);
+    first_time_ = t;
   }
-  p.beyond_trained_time_samples = beyond;
-  const auto& names = run.error_names;
-  if (std::find(names.begin(), names.end(), model.error_column) != names.end()) {
-    p.has_measured = true;
-    p.measured_um = ApplyErrorZero(run, model.zero).error_um.col(run.ErrorIndex(model.error_column));
-    if (model.zero.zero == ErrorZero::kAsLogged)
-      p.warnings.push_back(model.error_column +
-                           ": the model file predates the error zero (schema 1): errors as "
-                           "logged; refit for one zero for the model and its comparisons");
-  }
-  if (p.outside_range_samples > 0)
-    p.warnings.push_back(run.name + ": " + std::to_string(p.outside_range_samples) + " of " +
-                         std::to_string(run.samples()) +
-                         " samples have an input outside the model's training range "
-                         "(extrapolation)");
-  if (beyond > 0)
-    p.warnings.push_back(
-        run.name + ": " + std::to_string(beyond) + " of " + std::to_string(run.samples()) +
-        " samples lie beyond the longest training run (" + MessageNumber(trained) + " " +
+  const double predicted = evaluator_->Step(t, raw);
+  const Eigen::Index ni = input_features_;
+  const auto f = evaluator_->features().head(ni);
+  const double span = 1e-9;
+  if (((f - model.feature_max.head(ni)).array() > span).any() ||
+      ((model.feature_min.head(ni) - f).array() > span).any())
+    ++outside_;
+  beyond_ += t - first_time_ > trained_ * (1 + 1e-9);
+  return predicted;
+}
+
+std::vector<std::string> RunPredictor::Warnings(const std::string& run, long long samples,
+                                                bool has_measured) const {
+  const DriftModel& model = *model_;
+  std::vector<std::string> w;
+  if (has_measured && model.zero.zero == ErrorZero::kAsLogged)
+    w.push_back(model.error_column +
+                ": the model file predates the error zero (schema 1): errors as "
+                "logged; refit for one zero for the model and its comparisons");
+  if (outside_ > 0)
+    w.push_back(run + ": " + std::to_string(outside_) + " of " + std::to_string(samples) +
+                " samples have an input outside the model's training range "
+                "(extrapolation)");
+  if (beyond_ > 0)
+    w.push_back(
+        run + ": " + std::to_string(beyond_) + " of " + std::to_string(samples) +
+        " samples lie beyond the longest training run (" + MessageNumber(trained_) + " " +
         model.time_unit + " since its start): the elapsed-time warm-up is extrapolated there; it " +
         (model.SensorFree() && model.extra_inputs.empty()
              ? "approaches its plateau " + MessageNumber(WarmUpPlateau(model)) + " um"
              : "approaches its plateau (" + MessageNumber(WarmUpPlateau(model)) +
                    " um, the warm-up part)") +
         " and never passes it");
-  if (run.time_from_index)
-    p.warnings.push_back(run.name + ": no recorded time: the sample index is the time axis");
+  if (time_from_index_)
+    w.push_back(run + ": no recorded time: the sample index is the time axis");
+  return w;
+}
+
+InputColumns ModelInputColumns(const DriftModel& model,
+                               const std::vector<std::string>& sensor_names,
+                               const std::vector<std::string>& other_names,
+                               const std::string& source) {
+  InputColumns c;
+  for (const auto& s : model.sensors)
+    c.sensors.push_back(FindColumn(sensor_names, s, source, "temperature (_C)"));
+  for (const auto& e : model.extra_inputs)
+    c.extras.push_back(FindColumn(other_names, e, source, "input"));
+  return c;
+}
+
+RunPrediction PredictRun(const DriftModel& model, const Run& run, ReferenceMode reference) {
+  RunPredictor predictor(model, run.time_from_index, run.source, reference);
+  const Eigen::MatrixXd u = RawInputs(model, run);
+  RunPrediction p;
+  p.run = run.name;
+  p.time = run.time_min;
+  p.time_from_index = run.time_from_index;
+  p.predicted_um.resize(run.samples());
+  p.std_um.resize(run.samples());
+  for (int k = 0; k < run.samples(); ++k) {
+    p.predicted_um(k) = predictor.Step(run.time_min[static_cast<std::size_t>(k)], u.row(k).transpose());
+    p.std_um(k) = predictor.StdDev();
+  }
+  p.outside_range_samples = static_cast<int>(predictor.outside_range_samples());
+  p.beyond_trained_time_samples = static_cast<int>(predictor.beyond_trained_time_samples());
+  const auto& names = run.error_names;
+  if (std::find(names.begin(), names.end(), model.error_column) != names.end()) {
+    p.has_measured = true;
+    p.measured_um = ApplyErrorZero(run, model.zero).error_um.col(run.ErrorIndex(model.error_column));
+  }
+  p.warnings = predictor.Warnings(run.name, run.samples(), p.has_measured);
   return p;
 }
 

@@ -38,6 +38,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -148,6 +149,43 @@ Eigen::MatrixXd BuildFeatures(const Run& run, const std::vector<std::string>& se
                               const std::vector<double>& elapsed_time_constants = {});
 /// The elapsed-time features of a run: samples x taus, column j = 1 - exp(-(t - t0) / tau_j).
 Eigen::MatrixXd ElapsedFeatures(const std::vector<double>& t, const std::vector<double>& taus);
+
+/// PredictRun one sample at a time, for a run streamed from its file (the same evaluator, checks
+/// and warnings): Step takes a sample's time and raw inputs (model.sensors' temperatures [degC],
+/// then the extra inputs as logged) and returns the predicted error [um]; the first Step sets the
+/// run-start reference. Counts the samples outside the training range and beyond the trained time.
+class RunPredictor {
+ public:
+  /// InputError when the run's time axis (`time_from_index`) does not match the model's unit.
+  RunPredictor(const DriftModel& model, bool time_from_index, const std::string& source,
+               ReferenceMode reference = ReferenceMode::kRunStart);
+  double Step(double time, const Eigen::VectorXd& raw_inputs);
+  double StdDev() const { return evaluator_->StdDev(); }  ///< of the last Step [um]
+  long long outside_range_samples() const { return outside_; }
+  long long beyond_trained_time_samples() const { return beyond_; }
+  /// PredictRun's warnings for a run named `run` of `samples` samples (the error-zero warning
+  /// only when `has_measured`).
+  std::vector<std::string> Warnings(const std::string& run, long long samples,
+                                    bool has_measured) const;
+
+ private:
+  const DriftModel* model_;
+  bool time_from_index_;
+  ReferenceMode reference_;
+  std::unique_ptr<DriftEvaluator> evaluator_;
+  Eigen::Index input_features_ = 0;
+  double trained_ = 0, first_time_ = 0;
+  long long outside_ = 0, beyond_ = 0;
+};
+
+/// The columns of the model's raw inputs in a run's groups: model.sensors in the temperatures,
+/// the extra inputs in the other columns (InputError naming a missing one).
+struct InputColumns {
+  std::vector<int> sensors, extras;
+};
+InputColumns ModelInputColumns(const DriftModel& model, const std::vector<std::string>& sensor_names,
+                               const std::vector<std::string>& other_names,
+                               const std::string& source);
 
 struct RunPrediction {
   std::string run;

@@ -77,13 +77,17 @@
 // Output documents (CSV, JSON, text, HTML report): drift/monitor_report.h.
 #include <Eigen/Core>
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drift/evaluation.h"
 #include "drift/fit.h"
 #include "drift/model.h"
 #include "drift/run_file.h"
+#include "drift/stream.h"
 
 namespace whirl::drift {
 
@@ -163,10 +167,17 @@ struct BaselineResult {
 
 struct MonitorResult {
   std::string run, error_column, model_kind;
+  /// Per-sample series (time, measured_um, measurement_noise_um, each strategy's and baseline's
+  /// predicted_um): every sample for MonitorRun; empty for MonitorFile (its sink got them); the
+  /// samples `rows_kept` names when thinned for a plot (PlotRows in drift/monitor_report.h).
   std::vector<double> time;
+  std::vector<long long> rows_kept;        ///< empty: the series hold every sample
   bool time_from_index = false;
   Eigen::VectorXd measured_um;             ///< the logged error (without the added noise)
   Eigen::VectorXd measurement_noise_um;    ///< the draw added at each sample if measured
+  long long samples = 0;                   ///< rows of the run
+  double first_time = 0, last_time = 0;    ///< of the run [min; samples]
+  double score_first_time = 0, score_last_time = 0;  ///< of the first and last scored row
   int score_begin = 0, score_end = 0;      ///< scored rows [begin, end)
   double monitored_min = 0;                ///< t_end - start [min; samples]
   double threshold_um = 0;                 ///< the threshold in force
@@ -174,9 +185,26 @@ struct MonitorResult {
   std::vector<StrategyResult> strategies;  ///< static first, then options.rules
   std::vector<BaselineResult> baselines;   ///< sensor-free baselines (MonitorRun's argument)
   std::vector<std::string> warnings;
+  /// The scored residuals' running sums per name ("none", each rule, each baseline), so days can
+  /// be pooled without their samples (MonitorWeek).
+  std::vector<std::pair<std::string, ErrorStatsAccumulator>> scored;
   /// The lowest scored MAE among none, the strategies and the baselines.
   std::string Strongest() const;
 };
+
+/// One sample of a replay as it is produced (MonitorFile's sink: the timeline writer, a plot's
+/// decimation): the measured error on the model's zero without the noise, and each strategy's and
+/// baseline's prediction [um], in the result's order.
+struct MonitorSample {
+  long long rows = 0;                   ///< of the run (its scan)
+  double first_time = 0, last_time = 0;  ///< of the run
+  long long index = 0;
+  double time = 0;
+  double measured_um = 0;
+  std::vector<double> predicted_um;  ///< per strategy
+  std::vector<double> baseline_um;   ///< per baseline
+};
+using MonitorSink = std::function<void(const MonitorSample&)>;
 
 /// Replays `options` on `run` (which must have model.error_column). InputError for a network
 /// model (not linear in coefficients), a missing column, a time-unit mismatch or bad options.
@@ -186,6 +214,23 @@ struct MonitorResult {
 MonitorResult MonitorRun(const DriftModel& model, const Run& run, const MonitorOptions& options,
                          const std::vector<DriftModel>& baselines = {},
                          const std::vector<StrategyResult>* initial = nullptr);
+
+/// The strategies a replay reports, in order: static, then options.rules without repeats.
+std::vector<UpdateRule> ReplayedRules(const MonitorOptions& options);
+
+/// A baseline model replayed beside the rules, with the name its row takes.
+struct NamedBaseline {
+  std::string name;
+  DriftModel model;
+};
+/// MonitorRun on a run file streamed block by block (drift/stream.h): the same replay, events
+/// and scores in fixed memory; the result's per-sample series stay empty and `sink` (optional)
+/// receives every sample in order. Baselines by name ("time", "duty:<col>", "previous run").
+MonitorResult MonitorFile(const DriftModel& model, const std::filesystem::path& run,
+                          const MonitorOptions& options,
+                          const std::vector<NamedBaseline>& baselines = {},
+                          const std::vector<StrategyResult>* initial = nullptr,
+                          const MonitorSink& sink = {}, const StreamProgress& progress = {});
 
 /// A production week: the days replayed in order, each day's rules starting from the previous
 /// day's final coefficients and bayes covariance (the static row stays the given model), the
@@ -226,6 +271,14 @@ void CheckMonitorDays(std::size_t count);
 WeekResult MonitorWeek(const DriftModel& model, const std::vector<Run>& days,
                        const MonitorOptions& options,
                        const std::vector<Run>& first_time_training = {});
+/// MonitorWeek on day files streamed one at a time (MonitorFile per day; the previous day's refit
+/// and time-only fit by FitFiles): memory independent of the days' lengths and count. `sink`
+/// (optional) gets each day's samples with the day's index (0-based); the days' results keep no
+/// per-sample series.
+WeekResult MonitorWeekFiles(const DriftModel& model, const std::vector<std::filesystem::path>& days,
+                            const MonitorOptions& options,
+                            const std::function<void(std::size_t, const MonitorSample&)>& sink = {},
+                            const StreamProgress& progress = {});
 
 /// Features of every sample as the control computes them: samples x (1 + features), first
 /// column 1 (the design rows of the updates).

@@ -19,8 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string TimeName(const MonitorResult& r) { return r.time_from_index ? "sample" : "time_min"; }
-
 std::vector<std::string> WithComments(const std::vector<std::string>& c, const std::string& what) {
   std::vector<std::string> out{what};
   out.insert(out.end(), c.begin(), c.end());
@@ -46,18 +44,74 @@ nlohmann::json EventJson(const MonitorEvent& e) {
 
 }  // namespace
 
+std::string MonitorTimelineHeader(bool time_from_index, const std::vector<UpdateRule>& rules,
+                                  const std::vector<std::string>& comments, bool day_column) {
+  std::vector<std::string> header;
+  if (day_column) header.push_back("day");
+  header.push_back(time_from_index ? "sample" : "time_min");
+  header.push_back("measured_um");
+  for (UpdateRule u : rules) header.push_back(ToString(u) + "_um");
+  for (UpdateRule u : rules) header.push_back(ToString(u) + "_residual_um");
+  return FormatCsv(header, {}, comments);
+}
+
+void AppendTimelineRow(double time, double measured, const std::vector<double>& predicted,
+                       std::string* out, int day) {
+  const auto cell = [&](double v) {
+    if (!out->empty() && out->back() != '\n') out->push_back(',');
+    out->append(FormatNumber(v));
+  };
+  if (day > 0) cell(day);
+  cell(time);
+  cell(measured);
+  for (double p : predicted) cell(p);
+  for (double p : predicted) cell(measured - p);
+  out->push_back('\n');
+}
+
 std::string MonitorTimelineCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
-  std::vector<std::string> header{TimeName(r), "measured_um"};
-  for (const auto& s : r.strategies) header.push_back(ToString(s.rule) + "_um");
-  for (const auto& s : r.strategies) header.push_back(ToString(s.rule) + "_residual_um");
-  std::vector<std::vector<double>> rows;
+  std::vector<UpdateRule> rules;
+  for (const auto& s : r.strategies) rules.push_back(s.rule);
+  std::string out =
+      MonitorTimelineHeader(r.time_from_index, rules, WithComments(comments, "monitor timeline of " + r.run));
+  std::vector<double> predicted(r.strategies.size());
   for (Eigen::Index k = 0; k < r.measured_um.size(); ++k) {
-    std::vector<double> row{r.time[static_cast<std::size_t>(k)], r.measured_um(k)};
-    for (const auto& s : r.strategies) row.push_back(s.predicted_um(k));
-    for (const auto& s : r.strategies) row.push_back(r.measured_um(k) - s.predicted_um(k));
-    rows.push_back(std::move(row));
+    for (std::size_t i = 0; i < predicted.size(); ++i) predicted[i] = r.strategies[i].predicted_um(k);
+    AppendTimelineRow(r.time[static_cast<std::size_t>(k)], r.measured_um(k), predicted, &out);
   }
-  return FormatCsv(header, rows, WithComments(comments, "monitor timeline of " + r.run));
+  return out;
+}
+
+MonitorResult PlotRows(const MonitorResult& r, int columns) {
+  std::vector<std::vector<double>> series{
+      std::vector<double>(r.measured_um.data(), r.measured_um.data() + r.measured_um.size())};
+  for (const auto& st : r.strategies) {
+    series.emplace_back(st.predicted_um.data(), st.predicted_um.data() + st.predicted_um.size());
+    series.emplace_back(r.measured_um.size());
+    for (Eigen::Index k = 0; k < r.measured_um.size(); ++k)
+      series.back()[static_cast<std::size_t>(k)] = r.measured_um(k) - st.predicted_um(k);
+  }
+  const std::vector<std::size_t> keep = M4Rows(r.time, series, columns);
+  MonitorResult out = r;
+  const auto pick = [&](const Eigen::VectorXd& v) {
+    Eigen::VectorXd p(static_cast<Eigen::Index>(keep.size()));
+    for (std::size_t i = 0; i < keep.size(); ++i)
+      p(static_cast<Eigen::Index>(i)) = v(static_cast<Eigen::Index>(keep[i]));
+    return p;
+  };
+  out.time.clear();
+  out.rows_kept.clear();
+  for (std::size_t i : keep) {
+    out.time.push_back(r.time[i]);
+    out.rows_kept.push_back(static_cast<long long>(r.rows_kept.empty() ? i : r.rows_kept[i]));
+  }
+  out.measured_um = pick(r.measured_um);
+  if (r.measurement_noise_um.size() == r.measured_um.size())
+    out.measurement_noise_um = pick(r.measurement_noise_um);
+  for (auto& st : out.strategies) st.predicted_um = pick(st.predicted_um);
+  for (auto& b : out.baselines)
+    if (b.predicted_um.size() == r.measured_um.size()) b.predicted_um = pick(b.predicted_um);
+  return out;
 }
 
 std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
@@ -153,8 +207,8 @@ std::string FormatMonitor(const MonitorResult& r, const MonitorOptions& o) {
     << (idx ? " (no recorded time: intervals count samples; stop share not computed)" : "")
     << "\n";
   s << "scored rows [" << r.score_begin << ", " << r.score_end
-    << "): " << FormatDecimals(r.time[static_cast<std::size_t>(r.score_begin)] * to_h, 2) << " to "
-    << FormatDecimals(r.time[static_cast<std::size_t>(r.score_end - 1)] * to_h, 2) << " " << unit
+    << "): " << FormatDecimals(r.score_first_time * to_h, 2) << " to "
+    << FormatDecimals(r.score_last_time * to_h, 2) << " " << unit
     << "\n";
   s << "rule      MAE um  RMSE um  max um  checks  invalid  recal  stop min  stop %\n";
   char buf[200];
@@ -265,23 +319,71 @@ nlohmann::json WeekJson(const WeekResult& w, const MonitorOptions& o) {
 
 std::string WeekTimelineCsv(const WeekResult& w, const std::vector<std::string>& comments) {
   const MonitorResult& first = w.days.front();
-  std::vector<std::string> header{"day", TimeName(first), "measured_um"};
-  for (const auto& s : first.strategies) header.push_back(ToString(s.rule) + "_um");
-  for (const auto& s : first.strategies) header.push_back(ToString(s.rule) + "_residual_um");
+  std::vector<UpdateRule> rules;
+  for (const auto& s : first.strategies) rules.push_back(s.rule);
   std::vector<std::string> c = comments;
-  std::vector<std::vector<double>> rows;
+  for (std::size_t d = 0; d < w.days.size(); ++d)
+    c.push_back("day " + std::to_string(d + 1) + ": " + w.days[d].run);
+  std::string out = MonitorTimelineHeader(
+      first.time_from_index, rules, WithComments(c, "monitor timeline of a week, day by day"), true);
   for (std::size_t d = 0; d < w.days.size(); ++d) {
     const MonitorResult& r = w.days[d];
-    c.push_back("day " + std::to_string(d + 1) + ": " + r.run);
+    std::vector<double> predicted(r.strategies.size());
     for (Eigen::Index k = 0; k < r.measured_um.size(); ++k) {
-      std::vector<double> row{static_cast<double>(d + 1), r.time[static_cast<std::size_t>(k)],
-                              r.measured_um(k)};
-      for (const auto& s : r.strategies) row.push_back(s.predicted_um(k));
-      for (const auto& s : r.strategies) row.push_back(r.measured_um(k) - s.predicted_um(k));
-      rows.push_back(std::move(row));
+      for (std::size_t i = 0; i < predicted.size(); ++i)
+        predicted[i] = r.strategies[i].predicted_um(k);
+      AppendTimelineRow(r.time[static_cast<std::size_t>(k)], r.measured_um(k), predicted, &out,
+                        static_cast<int>(d + 1));
     }
   }
-  return FormatCsv(header, rows, WithComments(c, "monitor timeline of a week, day by day"));
+  return out;
+}
+
+TimelineSink::TimelineSink(const MonitorOptions& o, bool time_from_index,
+                           std::vector<std::string> header_comments,
+                           std::vector<StreamedFile*> files, int day, bool write_header)
+    : rules_(ReplayedRules(o)), time_from_index_(time_from_index),
+      comments_(std::move(header_comments)), files_(std::move(files)), day_(day),
+      header_(write_header) {}
+
+void TimelineSink::Flush() {
+  for (StreamedFile* f : files_) f->Append(text_);
+  text_.clear();
+}
+
+void TimelineSink::Add(const MonitorSample& s) {
+  if (s.index == 0) {
+    if (header_ && !files_.empty())
+      text_ = MonitorTimelineHeader(time_from_index_, rules_, comments_, day_ > 0);
+    plot_ = std::make_unique<M4Decimator>(static_cast<int>(1 + 2 * rules_.size()), s.first_time,
+                                          s.last_time);
+  }
+  if (!files_.empty()) {
+    AppendTimelineRow(s.time, s.measured_um, s.predicted_um, &text_, day_);
+    if (text_.size() >= (1u << 20)) Flush();
+  }
+  values_.assign(1, s.measured_um);
+  values_.insert(values_.end(), s.predicted_um.begin(), s.predicted_um.end());
+  for (double p : s.predicted_um) values_.push_back(s.measured_um - p);
+  plot_->Add(s.index, s.time, values_.data());
+}
+
+void TimelineSink::Finish(MonitorResult* r) {
+  Flush();
+  if (!plot_ || r == nullptr) return;
+  plot_->Finish();
+  const std::size_t n = plot_->rows().size(), q = rules_.size(), w = 1 + 2 * q;
+  r->rows_kept = plot_->rows();
+  r->time = plot_->x();
+  r->measured_um.resize(static_cast<Eigen::Index>(n));
+  for (auto& st : r->strategies) st.predicted_um.resize(static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* v = plot_->values().data() + i * w;
+    r->measured_um(static_cast<Eigen::Index>(i)) = v[0];
+    for (std::size_t j = 0; j < q && j < r->strategies.size(); ++j)
+      r->strategies[j].predicted_um(static_cast<Eigen::Index>(i)) = v[1 + j];
+  }
+  r->measurement_noise_um.resize(0);
 }
 
 std::string WeekEventsCsv(const WeekResult& w, const std::vector<std::string>& comments) {
@@ -318,7 +420,7 @@ std::string ChecksCsv(const MonitorResult& r) {
       if (e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement)
         marks << FormatNumber(e.time) << "," << FormatNumber(e.measured_um) << ","
               << (e.kind == MonitorEvent::Kind::kCheck && e.valid ? 0 : 1) << "\n";
-    marks << FormatNumber(r.time.front()) << ",0,-1\n\n\n";  // sentinel: no block is empty
+    marks << FormatNumber(r.first_time) << ",0,-1\n\n\n";  // sentinel: no block is empty
   }
   return marks.str();
 }
@@ -333,16 +435,16 @@ std::string MonitorGnuplot(const MonitorResult& r, const std::string& prefix = "
      << GnuplotString(prefix + "monitor.png") << "\n"
      << "set datafile separator ','\nset key outside right\nset grid\nset xlabel "
      << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset arrow from "
-     << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
+     << FormatNumber((r.last_time - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
      << ", graph 0 to "
-     << FormatNumber((r.time.back() - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
+     << FormatNumber((r.last_time - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
      << ", graph 1 nohead dt 2\nset multiplot layout 2,1\n"
      << "set ylabel 'thermal error [um]'\nset title "
      << GnuplotString(
             "run " + r.run + ": measured " + r.error_column +
             " and the models (dashed: monitoring starts; open: valid checks, filled: invalid "
             "checks and refit measurements)")
-     << "\nplot " << GnuplotString(prefix + "timeline.csv") << " using " << x
+     << "\nplot " << GnuplotString(prefix + "plot_timeline.csv") << " using " << x
      << ":2 with lines lc rgb 'black' lw 2 title 'measured'";
   for (std::size_t i = 0; i < q; ++i)
     gp << ", '' using " << x << ":" << i + 3 << " with lines lc " << i + 1 << " title "
@@ -354,7 +456,7 @@ std::string MonitorGnuplot(const MonitorResult& r, const std::string& prefix = "
        << ":($3==1?$2:1/0) with points pt 7 lc " << i + 1 << " notitle";
   gp << "\nset title 'residual (measured - model)'\nset ylabel 'residual [um]'\nplot ";
   for (std::size_t i = 0; i < q; ++i)
-    gp << (i ? ", " : "") << GnuplotString(prefix + "timeline.csv") << " using " << x << ":"
+    gp << (i ? ", " : "") << GnuplotString(prefix + "plot_timeline.csv") << " using " << x << ":"
        << i + 3 + q << " with lines lc "
        << i + 1 << " title " << GnuplotString(ToString(r.strategies[i].rule));
   gp << "\nunset multiplot\n";
@@ -371,16 +473,15 @@ std::string RenderMonitorPlot(const fs::path& dir, const std::string& gnuplot, O
   if (!ProgramSucceeds({gnuplot, "--version"})) {
     warnings->push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
   } else {
-    const fs::path stage = fs::absolute(files.Staging());  // gnuplot renders there
-    if (RunProgram({gnuplot, script}, stage, stage / (prefix + "gnuplot.log")) == 0 &&
+    const fs::path stage = files.Staging();  // gnuplot renders there
+    if (files.RunInStaging({gnuplot, script}, prefix + "gnuplot.log", {png}) == 0 &&
         fs::is_regular_file(stage / png, ec)) {
       files.AddStaged(png);
       img = "<img src='" + HtmlEscape(png) + "' alt='monitor timeline'>";
     } else {
       warnings->push_back("gnuplot failed on " + (dir / script).string() + " (see " + prefix +
                           "gnuplot.log)");
-      if (fs::is_regular_file(stage / (prefix + "gnuplot.log"), ec))
-        files.AddStaged(prefix + "gnuplot.log");
+      files.AddProgramLog(prefix + "gnuplot.log");
     }
   }
   return img;
@@ -404,19 +505,48 @@ std::string MonitorIndexHtml(const MonitorResult& r, const MonitorOptions& o,
 
 }  // namespace
 
+namespace {
+
+// plot_timeline.csv: the rows the plot needs (the series as given when already cut).
+std::string PlotTimelineCsv(const MonitorResult& r, const std::vector<std::string>& provenance) {
+  std::vector<std::string> c{"the rows of timeline.csv a plot needs (M4: first, last, minimum and "
+                             "maximum of every series per pixel column), " +
+                             std::to_string(r.rows_kept.empty() ? r.measured_um.size()
+                                                                : static_cast<Eigen::Index>(r.rows_kept.size())) +
+                             " of " + std::to_string(r.samples) + " rows"};
+  c.insert(c.end(), provenance.begin(), provenance.end());
+  return MonitorTimelineCsv(r.rows_kept.empty() ? PlotRows(r) : r, c);
+}
+
+}  // namespace
+
 MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult& r,
                                        const MonitorOptions& o,
                                        const std::vector<std::string>& provenance,
                                        const std::string& gnuplot, const AlsoWrite& also) {
   OutputDir files(dir, "report directory");
+  return WriteMonitorReport(files, r, o, provenance, gnuplot, also, {}, {});
+}
+
+MonitorReportResult WriteMonitorReport(OutputDir& files, const MonitorResult& r,
+                                       const MonitorOptions& o,
+                                       const std::vector<std::string>& provenance,
+                                       const std::string& gnuplot, const AlsoWrite& also,
+                                       const std::vector<ReadyFile>& also_ready,
+                                       const fs::path& timeline_ready) {
+  const fs::path& dir = files.path();
   MonitorReportResult out;
-  files.Add("timeline.csv", MonitorTimelineCsv(r, provenance));
+  if (timeline_ready.empty())
+    files.Add("timeline.csv", MonitorTimelineCsv(r, provenance));
+  else
+    files.AddReady("timeline.csv", timeline_ready);
+  files.Add("plot_timeline.csv", PlotTimelineCsv(r, provenance));
   files.Add("events.csv", MonitorEventsCsv(r, provenance));
   files.Add("checks.csv", ChecksCsv(r));
   files.Add("monitor.gp", MonitorGnuplot(r));
   const std::string img = RenderMonitorPlot(dir, gnuplot, files, &out.warnings);
   files.Add("index.html", MonitorIndexHtml(r, o, provenance, img, out.warnings));
-  files.Commit(also);
+  files.Commit(also, also_ready);
   out.index_html = dir / "index.html";
   return out;
 }
@@ -426,14 +556,32 @@ MonitorReportResult WriteWeekReport(const fs::path& dir, const WeekResult& w,
                                     const std::vector<std::string>& provenance,
                                     const std::string& gnuplot, const AlsoWrite& also) {
   OutputDir files(dir, "report directory");
+  return WriteWeekReport(files, w, o, provenance, gnuplot, also, {}, {}, {});
+}
+
+MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
+                                    const MonitorOptions& o,
+                                    const std::vector<std::string>& provenance,
+                                    const std::string& gnuplot, const AlsoWrite& also,
+                                    const std::vector<ReadyFile>& also_ready,
+                                    const std::vector<fs::path>& day_ready,
+                                    const fs::path& week_ready) {
+  const fs::path& dir = files.path();
   MonitorReportResult out;
-  files.Add("week_timeline.csv", WeekTimelineCsv(w, provenance));
+  if (week_ready.empty())
+    files.Add("week_timeline.csv", WeekTimelineCsv(w, provenance));
+  else
+    files.AddReady("week_timeline.csv", week_ready);
   files.Add("week_events.csv", WeekEventsCsv(w, provenance));
   std::ostringstream days;
   for (std::size_t d = 0; d < w.days.size(); ++d) {
     const MonitorResult& r = w.days[d];
     const std::string prefix = "day" + std::to_string(d + 1) + "_";
-    files.Add(prefix + "timeline.csv", MonitorTimelineCsv(r, provenance));
+    if (d < day_ready.size() && !day_ready[d].empty())
+      files.AddReady(prefix + "timeline.csv", day_ready[d]);
+    else
+      files.Add(prefix + "timeline.csv", MonitorTimelineCsv(r, provenance));
+    files.Add(prefix + "plot_timeline.csv", PlotTimelineCsv(r, provenance));
     files.Add(prefix + "events.csv", MonitorEventsCsv(r, provenance));
     files.Add(prefix + "checks.csv", ChecksCsv(r));
     files.Add(prefix + "monitor.gp", MonitorGnuplot(r, prefix));
@@ -455,7 +603,7 @@ MonitorReportResult WriteWeekReport(const fs::path& dir, const WeekResult& w,
   for (const auto& warn : out.warnings) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
   h << "</body></html>\n";
   files.Add("index.html", h.str());
-  files.Commit(also);
+  files.Commit(also, also_ready);
   out.index_html = dir / "index.html";
   return out;
 }

@@ -81,6 +81,72 @@ LinearFit FitLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
   return f;
 }
 
+StreamingLeastSquares::StreamingLeastSquares(int regressors)
+    : p_(regressors), r_(Eigen::MatrixXd::Zero(regressors + 2, regressors + 2)),
+      block_(4096, regressors + 2) {}
+
+void StreamingLeastSquares::Add(const Eigen::Ref<const Eigen::VectorXd>& x, double y) {
+  if (filled_ == block_.rows()) Flush();
+  block_(filled_, 0) = 1.0;
+  block_.row(filled_).segment(1, p_) = x.transpose();
+  block_(filled_, p_ + 1) = y;
+  finite_ = finite_ && x.allFinite() && std::isfinite(y);
+  ++filled_;
+  ++n_;
+}
+
+void StreamingLeastSquares::Flush() {
+  if (filled_ == 0) return;
+  const Eigen::Index c = p_ + 2, top = have_r_ ? c : 0;
+  Eigen::MatrixXd stack(top + filled_, c);
+  if (have_r_) stack.topRows(c) = r_;
+  stack.bottomRows(filled_) = block_.topRows(filled_);
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(stack);
+  const Eigen::Index k = std::min<Eigen::Index>(stack.rows(), c);
+  r_.setZero();
+  r_.topRows(k) = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  have_r_ = true;
+  filled_ = 0;
+}
+
+LinearFit StreamingLeastSquares::Fit() {
+  Flush();
+  const Eigen::Index p = p_;
+  if (n_ <= p + 1)
+    throw InputError("regression: " + std::to_string(n_) + " samples for " + std::to_string(p) +
+                     " regressors and an intercept: need more than " + std::to_string(p + 1));
+  if (!finite_) throw InputError("regression: a value is not finite");
+  const Eigen::MatrixXd a = r_.leftCols(p + 1);
+  const Eigen::VectorXd b = r_.col(p + 1);
+  const Solved s = Solve(a, b);
+  LinearFit f;
+  f.coefficients = s.b;
+  f.xtx_inverse = s.xtx_inverse;
+  const double rss = (b - a * s.b).squaredNorm();
+  const double tss = b.tail(p + 1).squaredNorm();  // below the intercept's row
+  f.samples = static_cast<int>(std::min<long long>(n_, std::numeric_limits<int>::max()));
+  f.degrees_of_freedom = static_cast<int>(std::min<long long>(n_ - p - 1,
+                                                              std::numeric_limits<int>::max()));
+  f.residual_std_um = std::sqrt(rss / static_cast<double>(n_ - p - 1));
+  f.covariance = f.residual_std_um * f.residual_std_um * s.xtx_inverse;
+  f.standard_errors = f.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  f.r_squared = tss <= 0 ? (rss <= 0 ? 1.0 : 0.0) : 1.0 - rss / tss;
+  // VIF_j from the centred block: column j of R_22 on the others (no intercept: centred).
+  const Eigen::MatrixXd r22 = r_.block(1, 1, p, p);
+  f.vif = Eigen::VectorXd::Ones(p);
+  for (Eigen::Index j = 0; j < p && p >= 2; ++j) {
+    Eigen::MatrixXd others(p, p - 1);
+    for (Eigen::Index k = 0, c = 0; k < p; ++k)
+      if (k != j) others.col(c++) = r22.col(k);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(others);
+    const double res = (r22.col(j) - others * qr.solve(r22.col(j))).squaredNorm();
+    const double tot = r22.col(j).squaredNorm();
+    const double r2 = tot <= 0 ? (res <= 0 ? 1.0 : 0.0) : 1.0 - res / tot;
+    f.vif(j) = r2 < 1 ? 1.0 / (1.0 - r2) : std::numeric_limits<double>::infinity();
+  }
+  return f;
+}
+
 Eigen::VectorXd LeastSquaresCoefficients(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
   const Eigen::MatrixXd x1 = WithIntercept(x);
   Eigen::VectorXd scale = x1.colwise().norm().transpose();
@@ -139,19 +205,108 @@ struct WarmUpData {
   Eigen::Index rows = 0;
 };
 
-// Stacked design [elapsed lags] of every run for time constants `taus`.
-Eigen::MatrixXd WarmUpDesign(const WarmUpData& d, const std::vector<double>& taus) {
-  const Eigen::Index c = d.fixed.cols();
-  Eigen::MatrixXd x(d.rows, c + static_cast<Eigen::Index>(taus.size()));
-  if (c > 0) x.leftCols(c) = d.fixed;
-  Eigen::Index at = 0;
-  for (const auto& t : d.t) {
-    for (std::size_t k = 0; k < t.size(); ++k, ++at)
-      for (std::size_t j = 0; j < taus.size(); ++j)
-        x(at, c + static_cast<Eigen::Index>(j)) = 1.0 - std::exp(-t[k] / taus[j]);
+// One elapsed-time column 1 - exp(-(t - t0) / tau) with the intercept and the fixed columns
+// projected out (Frisch-Waugh-Lovell: the gains' least squares on the projected columns is the
+// joint one): g_hat, its squared norm and its product with the projected error.
+struct Projected {
+  double tau = 0;
+  Eigen::VectorXd g;  // projected
+  double gg = 0, gy = 0, raw = 0;  // |g_hat|^2, g_hat' y_hat, |g|^2 (the rank test's scale)
+};
+
+// The warm-up's least squares for given time constants, fast: the span of [1 fixed] is
+// factored once (an orthonormal basis by rank-revealing QR of the unit-norm-scaled columns, the
+// threshold of LeastSquaresCoefficients), every time-constant column is projected on its
+// complement once, and a candidate's residual sum of squares follows from the projected
+// columns' products: O(rows) per new time constant instead of a QR of the whole design.
+class WarmUpLeastSquares {
+ public:
+  WarmUpLeastSquares(const WarmUpData& d, const Eigen::VectorXd& y) : d_(d), y_(y) {
+    Eigen::MatrixXd base(d.rows, 1 + d.fixed.cols());
+    base.col(0).setOnes();
+    if (d.fixed.cols() > 0) base.rightCols(d.fixed.cols()) = d.fixed;
+    Eigen::VectorXd scale = base.colwise().norm().transpose();
+    for (Eigen::Index j = 0; j < scale.size(); ++j)
+      if (!(scale(j) > 0)) scale(j) = 1;
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(base * scale.cwiseInverse().asDiagonal());
+    qr.setThreshold(1e-12);
+    q_ = qr.householderQ() * Eigen::MatrixXd::Identity(d.rows, qr.rank());
+    y_hat_ = y - q_ * (q_.transpose() * y);
+    yy_ = y_hat_.squaredNorm();
   }
-  return x;
-}
+
+  Projected Column(double tau) const {
+    Projected c;
+    c.tau = tau;
+    c.g.resize(d_.rows);
+    Eigen::Index at = 0;
+    for (const auto& t : d_.t)
+      for (const double v : t) c.g(at++) = 1.0 - std::exp(-v / tau);
+    c.raw = c.g.squaredNorm();
+    c.g -= q_ * (q_.transpose() * c.g);
+    c.gg = c.g.squaredNorm();
+    c.gy = c.g.dot(y_hat_);
+    return c;
+  }
+
+  // A column the rest of the design explains (|g_hat| below 1e-12 of |g|: the rank threshold).
+  static bool Degenerate(const Projected& c) { return !(c.gg > 1e-24 * c.raw); }
+
+  // Residual sum of squares and gains of one term.
+  double One(const Projected& a, double* gain) const {
+    *gain = Degenerate(a) ? 0.0 : a.gy / a.gg;
+    return std::max(yy_ - *gain * a.gy, 0.0);
+  }
+
+  // Residual sum of squares and gains of two terms, the gains held to one sign (FitWarmUp): with
+  // opposite signs, the better of each term alone (the other gain 0). `ab` = g_hat_a' g_hat_b.
+  double Two(const Projected& a, const Projected& b, double ab, double* ga, double* gb) const {
+    const double det = a.gg * b.gg - ab * ab;
+    if (!Degenerate(a) && !Degenerate(b) && det > 1e-12 * a.gg * b.gg) {
+      *ga = (b.gg * a.gy - ab * b.gy) / det;
+      *gb = (a.gg * b.gy - ab * a.gy) / det;
+      if (*ga * *gb >= 0) return std::max(yy_ - *ga * a.gy - *gb * b.gy, 0.0);
+    }
+    double only_a = 0, only_b = 0;
+    const double sa = One(a, &only_a), sb = One(b, &only_b);
+    // The first term alone wins only when strictly better (on a tie, the second).
+    if (sa < sb) {
+      *ga = only_a, *gb = 0.0;
+      return sa;
+    }
+    *ga = 0.0, *gb = only_b;
+    return sb;
+  }
+
+  // The coefficients b0, the fixed columns', then the gains, for time constants `cols` with
+  // gains `gains` (the fixed part by least squares on what the warm-up leaves).
+  Eigen::VectorXd Coefficients(const std::vector<const Projected*>& cols,
+                               const std::vector<double>& gains) const {
+    Eigen::VectorXd rest = y_;
+    for (std::size_t j = 0; j < cols.size(); ++j) {
+      if (gains[j] == 0.0) continue;
+      Eigen::Index at = 0;
+      for (const auto& t : d_.t)
+        for (const double v : t) rest(at++) -= gains[j] * (1.0 - std::exp(-v / cols[j]->tau));
+    }
+    const Eigen::VectorXd base = LeastSquaresCoefficients(d_.fixed.cols() > 0
+                                                              ? d_.fixed
+                                                              : Eigen::MatrixXd(d_.rows, 0),
+                                                          rest);
+    Eigen::VectorXd b(base.size() + static_cast<Eigen::Index>(cols.size()));
+    b.head(base.size()) = base;
+    for (std::size_t j = 0; j < cols.size(); ++j)
+      b(base.size() + static_cast<Eigen::Index>(j)) = gains[j];
+    return b;
+  }
+
+ private:
+  const WarmUpData& d_;
+  const Eigen::VectorXd& y_;
+  Eigen::MatrixXd q_;  // orthonormal basis of span [1 fixed]
+  Eigen::VectorXd y_hat_;
+  double yy_ = 0;
+};
 
 Eigen::VectorXd WarmUpTarget(const WarmUpData& d) {
   Eigen::VectorXd y(d.rows);
@@ -161,36 +316,6 @@ Eigen::VectorXd WarmUpTarget(const WarmUpData& d) {
     at += e.size();
   }
   return y;
-}
-
-// Least squares of y on [1 design(taus)]: the residual sum of squares, coefficients in *b.
-double LeastSquaresSse(const WarmUpData& d, const Eigen::VectorXd& y,
-                       const std::vector<double>& taus, Eigen::VectorXd* b) {
-  const Eigen::MatrixXd x = WarmUpDesign(d, taus);
-  *b = LeastSquaresCoefficients(x, y);
-  return (y - EvaluateLinear(*b, x)).squaredNorm();
-}
-
-// The projected residual sum of squares: the gains by least squares for these taus, the warm-up
-// gains held to one sign (FitWarmUp). Two gains of opposite sign: the optimum of the convex
-// problem on the closed orthants lies on their boundary, a gain of 0, so it is the better of each
-// term alone (the other's gain set to 0 in *b).
-double ProjectedSse(const WarmUpData& d, const Eigen::VectorXd& y, const std::vector<double>& taus,
-                    Eigen::VectorXd* b) {
-  const double sse = LeastSquaresSse(d, y, taus, b);
-  const Eigen::Index c = 1 + d.fixed.cols();
-  if (taus.size() != 2 || (*b)(c) * (*b)(c + 1) >= 0) return sse;
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t drop = 0; drop < 2; ++drop) {
-    Eigen::VectorXd one;
-    const double s = LeastSquaresSse(d, y, {taus[1 - drop]}, &one);
-    if (!(s < best)) continue;
-    best = s;
-    b->head(c) = one.head(c);
-    (*b)(c + static_cast<Eigen::Index>(1 - drop)) = one(c);
-    (*b)(c + static_cast<Eigen::Index>(drop)) = 0.0;
-  }
-  return best;
 }
 
 // Golden-section minimum of f over log tau in [lo, hi] (Kiefer, "Sequential minimax search for a
@@ -219,45 +344,67 @@ double LongestSpan(const WarmUpData& d) {
   return longest;
 }
 
-std::vector<double> LogGrid(const WarmUpData& d) {
-  std::vector<double> steps;
-  for (const auto& t : d.t)
-    for (std::size_t k = 1; k < t.size(); ++k) steps.push_back(t[k] - t[k - 1]);
-  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2),
-                   steps.end());
-  const double lo = 2 * steps[steps.size() / 2];
+std::vector<double> LogGrid(const WarmUpData& d, double sampling_step) {
+  double step = sampling_step;
+  if (!(step > 0)) {
+    std::vector<double> steps;
+    for (const auto& t : d.t)
+      for (std::size_t k = 1; k < t.size(); ++k) steps.push_back(t[k] - t[k - 1]);
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2),
+                     steps.end());
+    step = steps[steps.size() / 2];
+  }
+  const double lo = 2 * step;
   const double hi = std::max(kMaxWarmUpTauPerSpan * LongestSpan(d), lo);
   std::vector<double> grid(41);
   for (int i = 0; i < 41; ++i) grid[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, i / 40.0);
   return grid;
 }
 
-// Best grid point (one term) or pair with tau_2 >= 3 tau_1 (two terms), as grid indices.
-std::vector<std::size_t> GridSearch(const WarmUpData& d, const Eigen::VectorXd& y,
-                                    const std::vector<double>& grid, int terms) {
+// Best grid point (one term) or pair with tau_2 >= 3 tau_1 (two terms), as grid indices; `cols`
+// receives the grid's projected columns.
+std::vector<std::size_t> GridSearch(const WarmUpLeastSquares& ls, const std::vector<double>& grid,
+                                    int terms, std::vector<Projected>* cols) {
+  cols->clear();
+  for (double tau : grid) cols->push_back(ls.Column(tau));
   double best = std::numeric_limits<double>::infinity();
   std::vector<std::size_t> at;
-  Eigen::VectorXd b;
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    if (terms == 1) {
-      const double sse = ProjectedSse(d, y, {grid[i]}, &b);
+  if (terms == 1) {
+    for (std::size_t i = 0; i < grid.size(); ++i) {
+      double g = 0;
+      const double sse = ls.One((*cols)[i], &g);
       if (sse < best) best = sse, at = {i};
-      continue;
     }
+    return at;
+  }
+  Eigen::MatrixXd g(cols->front().g.size(), static_cast<Eigen::Index>(cols->size()));
+  for (std::size_t i = 0; i < cols->size(); ++i) g.col(static_cast<Eigen::Index>(i)) = (*cols)[i].g;
+  const Eigen::MatrixXd gram = g.transpose() * g;
+  for (std::size_t i = 0; i < grid.size(); ++i)
     for (std::size_t k = i + 1; k < grid.size(); ++k) {
       if (grid[k] < 3 * grid[i]) continue;
-      const double sse = ProjectedSse(d, y, {grid[i], grid[k]}, &b);
+      double a = 0, b = 0;
+      const double sse = ls.Two((*cols)[i], (*cols)[k],
+                                gram(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)),
+                                &a, &b);
       if (sse < best) best = sse, at = {i, k};
     }
-  }
   return at;
+}
+
+// The residual sum of squares and gains for time constants `cols` (one or two).
+double WarmUpSse(const WarmUpLeastSquares& ls, const std::vector<const Projected*>& cols,
+                 std::vector<double>* gains) {
+  gains->assign(cols.size(), 0.0);
+  if (cols.size() == 1) return ls.One(*cols[0], &(*gains)[0]);
+  return ls.Two(*cols[0], *cols[1], cols[0]->g.dot(cols[1]->g), &(*gains)[0], &(*gains)[1]);
 }
 
 }  // namespace
 
 WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
                     const std::vector<Eigen::VectorXd>& errors, int terms,
-                    const Eigen::MatrixXd& fixed) {
+                    const Eigen::MatrixXd& fixed, double sampling_step) {
   if (terms < 1 || terms > 2)
     throw InputError("warm-up model: " + std::to_string(terms) + " terms: must be 1 or 2");
   WarmUpData d{times, errors, fixed};
@@ -270,46 +417,55 @@ WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
   if (fixed.cols() > 0 && fixed.rows() != d.rows)
     throw InputError("warm-up model: the fixed columns need one row per sample");
   const Eigen::VectorXd y = WarmUpTarget(d);
-  const std::vector<double> grid = LogGrid(d);
-  const std::vector<std::size_t> at = GridSearch(d, y, grid, terms);
+  const WarmUpLeastSquares ls(d, y);
+  const std::vector<double> grid = LogGrid(d, sampling_step);
+  std::vector<Projected> grid_cols;
+  const std::vector<std::size_t> at = GridSearch(ls, grid, terms, &grid_cols);
   if (at.empty()) {  // two terms 3 apart do not fit between two sample steps and the span
-    WarmUpFit one = FitWarmUp(times, errors, 1, fixed);
+    WarmUpFit one = FitWarmUp(times, errors, 1, fixed, sampling_step);
     one.note = "the trained span is too short for two time constants: one term" +
                std::string(one.note.empty() ? "" : "; ") + one.note;
     return one;
   }
-  std::vector<double> taus;
-  for (std::size_t i : at) taus.push_back(grid[i]);
-  Eigen::VectorXd b;
-  for (std::size_t j = 0; j < taus.size(); ++j) {  // refine each tau between its neighbours
+  std::vector<Projected> cols;
+  for (std::size_t i : at) cols.push_back(grid_cols[i]);
+  grid_cols.clear();
+  std::vector<double> gains;
+  for (std::size_t j = 0; j < cols.size(); ++j) {  // refine each tau between its neighbours
     const std::size_t i = at[j];
     const double lo = grid[i > 0 ? i - 1 : 0], hi = grid[std::min(i + 1, grid.size() - 1)];
-    std::vector<double> trial = taus;
-    const double lower = j == 1 ? std::max(lo, 3 * taus[0]) : lo;
-    const double upper = j == 0 && taus.size() == 2 ? std::min(hi, taus[1] / 3) : hi;
+    const double lower = j == 1 ? std::max(lo, 3 * cols[0].tau) : lo;
+    const double upper = j == 0 && cols.size() == 2 ? std::min(hi, cols[1].tau / 3) : hi;
     if (!(upper > lower)) continue;
-    taus[j] = GoldenLog(
-        [&](double tau) {
-          trial[j] = tau;
-          return ProjectedSse(d, y, trial, &b);
+    std::vector<const Projected*> trial;
+    for (const Projected& c : cols) trial.push_back(&c);
+    Projected moving;
+    const double tau = GoldenLog(
+        [&](double v) {
+          moving = ls.Column(v);
+          trial[j] = &moving;
+          return WarmUpSse(ls, trial, &gains);
         },
         lower, upper);
+    cols[j] = ls.Column(tau);
   }
+  std::vector<const Projected*> chosen;
+  for (const Projected& c : cols) chosen.push_back(&c);
   WarmUpFit f;
   f.span = LongestSpan(d);
-  f.rmse_um = std::sqrt(ProjectedSse(d, y, taus, &f.coefficients) / static_cast<double>(d.rows));
-  const Eigen::Index c = 1 + fixed.cols();
+  f.rmse_um = std::sqrt(WarmUpSse(ls, chosen, &gains) / static_cast<double>(d.rows));
+  std::vector<double> taus;
+  for (const Projected& c : cols) taus.push_back(c.tau);
   std::vector<std::size_t> kept_at = at;
-  if (taus.size() == 2 && (f.coefficients(c) == 0.0 || f.coefficients(c + 1) == 0.0)) {
-    const std::size_t zero = f.coefficients(c) == 0.0 ? 0 : 1;  // the term held at 0: dropped
+  if (taus.size() == 2 && (gains[0] == 0.0 || gains[1] == 0.0)) {
+    const std::size_t zero = gains[0] == 0.0 ? 0 : 1;  // the term held at 0: dropped
     taus.erase(taus.begin() + static_cast<std::ptrdiff_t>(zero));
     kept_at.erase(kept_at.begin() + static_cast<std::ptrdiff_t>(zero));
-    Eigen::VectorXd kept(c + 1);
-    kept.head(c) = f.coefficients.head(c);
-    kept(c) = f.coefficients(c + 1 - static_cast<Eigen::Index>(zero));
-    f.coefficients = kept;
+    chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(zero));
+    gains.erase(gains.begin() + static_cast<std::ptrdiff_t>(zero));
     f.note = "two terms would need gains of opposite sign: one term kept";
   }
+  f.coefficients = ls.Coefficients(chosen, gains);
   f.time_constants = taus;
   if (kept_at.back() + 1 == grid.size() && grid.back() > grid.front()) {
     f.identified = false;

@@ -13,6 +13,7 @@
 // The posterior of b under a flat prior and Gaussian noise is N(b, Cov(b)), which the on-line
 // recalibration (drift/monitor.h) uses as its prior; xtx_inverse is kept for it unscaled.
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,31 @@ struct LinearFit {
 /// OLS of y (n) on the columns of x (n x p) with an intercept. InputError if n <= p + 1, a value
 /// is not finite or [1 X] is rank deficient (names the rank: collinear regressors).
 LinearFit FitLinear(const Eigen::MatrixXd& x, const Eigen::VectorXd& y);
+
+/// FitLinear on rows that arrive one at a time and are not kept (the final fit on every row of a
+/// long log, drift/stream.h FitFiles): the R factor of the QR decomposition of [1 X y] is updated
+/// every 4096 rows (Householder QR of the previous R stacked on the new rows), so memory is
+/// (p + 2)^2 whatever the row count, and the accuracy is the QR's, not the normal equations'.
+/// Fit() gives FitLinear's statistics: the coefficients by the same rank-checked column-pivoting
+/// QR (of R's first p + 1 columns, which have the norms of [1 X]), RSS as the squared residual of
+/// R's last column on them, TSS as that column's squared norm below the intercept's row, and the
+/// VIF from the block R_22 below and right of the intercept (R_22' R_22 = X_c' X_c, X centred).
+/// Equal to FitLinear on the same rows up to rounding; the same InputErrors.
+class StreamingLeastSquares {
+ public:
+  explicit StreamingLeastSquares(int regressors);
+  void Add(const Eigen::Ref<const Eigen::VectorXd>& x, double y);  ///< one row
+  LinearFit Fit();
+  long long samples() const { return n_; }
+
+ private:
+  void Flush();
+  int p_;
+  Eigen::MatrixXd r_, block_;
+  int filled_ = 0;
+  long long n_ = 0;
+  bool have_r_ = false, finite_ = true;
+};
 
 /// The minimum-norm least-squares coefficients (b0 first) of y on [1 x], also for a rank-deficient
 /// [1 x] (complete orthogonal decomposition of the unit-norm-scaled columns). For
@@ -87,8 +113,14 @@ inline constexpr double kMaxWarmUpTauPerSpan = 1.0;
 /// `times`: time since each run's start, t - t0 [min or samples], and `errors` [um], per run;
 /// `fixed`: extra regressors, one row per sample of the runs in order (0 columns: none).
 /// InputError when no run has 3 samples.
+/// `sampling_step` (optional): the sampling step of the logs the runs were thinned from
+/// (drift/stream.h FitFiles), which then sets the shortest tau instead of the runs' median step.
+/// Each candidate's least squares is computed on the time-constant columns with the intercept and
+/// the fixed columns projected out (Frisch-Waugh-Lovell), the span of those factored once: the
+/// same fit as a QR of the whole design up to rounding, in O(rows) per time constant tried.
 WarmUpFit FitWarmUp(const std::vector<std::vector<double>>& times,
                     const std::vector<Eigen::VectorXd>& errors, int terms,
-                    const Eigen::MatrixXd& fixed = Eigen::MatrixXd());
+                    const Eigen::MatrixXd& fixed = Eigen::MatrixXd(),
+                    double sampling_step = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace whirl::drift

@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
+#include "core/decimate.h"
 #include "core/error.h"
 #include "core/html_page.h"
 #include "core/numbers.h"
@@ -40,8 +41,8 @@ class ReportWriter {
                            kTerminal + "set output " + GnuplotString(png) + "\n" + body);
     if (have_gnuplot_) {
       // gnuplot never sees the output directory: it renders in the staging folder.
-      const fs::path stage = fs::absolute(out_.Staging());
-      const int rc = RunProgram({gnuplot_, stem + ".gp"}, stage, stage / "gnuplot.log");
+      const int rc = out_.RunInStaging({gnuplot_, stem + ".gp"}, "gnuplot.log", {png});
+      const fs::path stage = out_.Staging();
       std::error_code ec;
       if (rc == 0 && fs::is_regular_file(stage / png, ec) && fs::file_size(stage / png, ec) > 0) {
         out_.AddStaged(png);
@@ -53,11 +54,25 @@ class ReportWriter {
     }
     return "<p>(plot not rendered: " + HtmlEscape(stem) + ".gp)</p>";
   }
+  // A long per-sample CSV written to disk as it is formatted (never held whole): the
+  // prediction's rows through a 1 MiB buffer into the staging folder, renamed into place by Commit.
+  void PredictionFile(const std::string& name, const RunPrediction& p,
+                      const std::vector<std::string>& comments) {
+    StreamedFile file(fs::absolute(out_.Staging()) / name);
+    std::string rows = PredictionCsvHeader(p.time_from_index, p.has_measured, comments);
+    for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k) {
+      AppendPredictionRow(p.time[static_cast<std::size_t>(k)], p.predicted_um(k), p.std_um(k),
+                          p.has_measured ? &p.measured_um(k) : nullptr, &rows);
+      if (rows.size() < (1u << 20)) continue;
+      file.Append(rows);
+      rows.clear();
+    }
+    file.Append(rows);
+    out_.AddReady(name, file.Finish());
+  }
   const std::vector<std::string>& warnings() const { return result_.warnings; }
   DriftReportResult Finish(const std::string& html) {
-    std::error_code ec;
-    if (gnuplot_failed_ && fs::is_regular_file(out_.Staging() / "gnuplot.log", ec))
-      out_.AddStaged("gnuplot.log");
+    if (gnuplot_failed_) out_.AddProgramLog("gnuplot.log");
     File("index.html", html);
     result_.files = out_.Commit();
     result_.index_html = out_.path() / "index.html";
@@ -268,6 +283,27 @@ std::string BaselinesHtml(const std::vector<ReportBaseline>& cells,
   return h.str();
 }
 
+// The rows of a prediction a plot needs (core/decimate.h, M4 on predicted, measured and
+// residual): the CSV gnuplot reads, whatever the run's length.
+std::string PlotCsv(const RunPrediction& p, const std::vector<std::string>& comments) {
+  const auto n = static_cast<std::size_t>(p.predicted_um.size());
+  std::vector<std::vector<double>> series(p.has_measured ? 3 : 1, std::vector<double>(n));
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    series[0][k] = p.predicted_um(i);
+    if (!p.has_measured) continue;
+    series[1][k] = p.measured_um(i);
+    series[2][k] = p.measured_um(i) - p.predicted_um(i);
+  }
+  std::string out = PredictionCsvHeader(p.time_from_index, p.has_measured, comments);
+  for (const std::size_t k : M4Rows(p.time, series)) {
+    const auto i = static_cast<Eigen::Index>(k);
+    AppendPredictionRow(p.time[k], p.predicted_um(i), p.std_um(i),
+                        p.has_measured ? &p.measured_um(i) : nullptr, &out);
+  }
+  return out;
+}
+
 }  // namespace
 
 DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
@@ -291,25 +327,30 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   std::ostringstream plots;
   for (const RunPrediction& p : preds) {
     const std::string slug = Slug(p.run);
-    w.File(slug + "_prediction.csv",
-           PredictionCsv(p, Comments(provenance, "prediction of " + p.run)));
+    w.PredictionFile(slug + "_prediction.csv", p, Comments(provenance, "prediction of " + p.run));
     if (p.has_measured) {
       h << StatsRow(p.run + " (model)", ComputeErrorStats(p.measured_um - p.predicted_um))
         << StatsRow(p.run + " (no compensation)", ComputeErrorStats(p.measured_um));
     }
+    // gnuplot reads the plot's rows only (M4: at most a few thousand whatever the run's length).
+    const std::string plot_csv = slug + "_plot.csv";
+    w.File(plot_csv, PlotCsv(p, Comments(provenance, "rows of the plot of " + p.run +
+                                                         " (M4 decimation of the prediction "
+                                                         "per pixel column; all rows: " +
+                                                         slug + "_prediction.csv)")));
     const std::string x = p.time_from_index ? "sample" : "time [h]";
     const std::string xcol = p.time_from_index ? "1" : "($1/60)";
     std::ostringstream gp;
     gp << "set datafile separator ','\nset key top left\nset grid\nset xlabel " << GnuplotString(x)
        << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\nset title "
        << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column) << "\nplot "
-       << GnuplotString(slug + "_prediction.csv") << " using " << xcol
+       << GnuplotString(plot_csv) << " using " << xcol
        << ":2 with lines lw 2 title 'predicted'";
     if (p.has_measured)
       gp << ", '' using " << xcol << ":5 with lines lc rgb 'black' title 'measured'";
     gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
     if (p.has_measured)
-      gp << "plot " << GnuplotString(slug + "_prediction.csv") << " using " << xcol
+      gp << "plot " << GnuplotString(plot_csv) << " using " << xcol
          << ":6 with lines lc rgb 'red' title 'residual'\n";
     else
       gp << "plot 0 notitle\n";

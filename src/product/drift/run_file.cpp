@@ -13,34 +13,10 @@
 namespace whirl::drift {
 namespace {
 
-bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() > suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 std::string Join(const std::vector<std::string>& v) {
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
   return out.empty() ? "none" : out;
-}
-
-// The time column: time_s or time_min (not both); "" if none. Its cells may be missing (empty
-// or nan, CsvOptions::missing_allowed), every other cell keeps the reader's strict rules.
-std::string TimeColumn(const CsvTable& t) {
-  const bool s = t.HasColumn("time_s"), m = t.HasColumn("time_min");
-  if (s && m)
-    throw InputError(t.source + ":" + std::to_string(t.header_line) +
-                     ": two time columns ('time_s' and 'time_min'): give time_s or time_min, not "
-                     "both");
-  return s ? "time_s" : m ? "time_min" : "";
-}
-
-void CheckCellRange(const CsvTable& t, std::size_t row, std::size_t col, double lo, double hi,
-                const std::string& rule) {
-  const double v = t.rows[row][col];
-  if (v >= lo && v <= hi) return;
-  throw InputError(t.source + ":" + std::to_string(t.line_numbers[row]) + ": column '" +
-                   t.header[col] + "': value " + FormatNumber(v) + " " + rule);
 }
 
 int FindIndex(const std::vector<std::string>& names, const std::string& name,
@@ -143,90 +119,6 @@ Run ApplyErrorZero(const Run& run, const ZeroConvention& zero) {
 }
 
 Run ErrorsFromStart(const Run& run) { return ApplyErrorZero(run, {ErrorZero::kRunStart, 0.0}); }
-
-Run ParseRun(const std::string& text, const std::string& source, RunState state) {
-  CsvOptions csv;
-  csv.missing_allowed = {"time_s", "time_min"};
-  const CsvTable t = ParseCsv(text, source, csv);
-  const std::string time_column = TimeColumn(t);
-  if (t.rows.size() > static_cast<std::size_t>(kMaxRunSamples))
-    throw InputError(source + ": " + std::to_string(t.rows.size()) +
-                     " rows: a run file holds at most " + std::to_string(kMaxRunSamples) +
-                     " (split the log into runs)");
-  if (t.header.size() > static_cast<std::size_t>(kMaxRunColumns))
-    throw InputError(source + ": " + std::to_string(t.header.size()) +
-                     " columns: a run file holds at most " + std::to_string(kMaxRunColumns));
-  Run r;
-  r.source = source;
-  r.name = std::filesystem::path(source).stem().string();
-  r.state = state;
-  r.line_numbers = t.line_numbers;
-  std::vector<std::size_t> s_cols, e_cols, o_cols;
-  for (std::size_t c = 0; c < t.header.size(); ++c) {
-    const std::string& h = t.header[c];
-    if (h == time_column) continue;
-    if (EndsWith(h, "_C")) {
-      s_cols.push_back(c);
-      r.sensor_names.push_back(h);
-    } else if (EndsWith(h, "_um")) {
-      e_cols.push_back(c);
-      r.error_names.push_back(h);
-    } else {
-      o_cols.push_back(c);
-      r.other_names.push_back(h);
-    }
-  }
-  if (s_cols.empty())
-    throw InputError(source +
-                     ": no temperature column (a name ending in _C, degC) in the header (" +
-                     Join(t.header) + ")");
-  const std::size_t q = t.rows.size();
-  const auto n = static_cast<Eigen::Index>(q);
-  r.temperature_C.resize(n, static_cast<Eigen::Index>(s_cols.size()));
-  r.error_um.resize(n, static_cast<Eigen::Index>(e_cols.size()));
-  r.other.resize(n, static_cast<Eigen::Index>(o_cols.size()));
-  for (std::size_t i = 0; i < q; ++i) {
-    const auto k = static_cast<Eigen::Index>(i);
-    for (std::size_t j = 0; j < s_cols.size(); ++j) {
-      CheckCellRange(t, i, s_cols[j], kMinTemperatureC, kMaxTemperatureC,
-                 "is outside the plausible temperature range [-60, 400] degC");
-      r.temperature_C(k, static_cast<Eigen::Index>(j)) = t.rows[i][s_cols[j]];
-    }
-    for (std::size_t j = 0; j < e_cols.size(); ++j) {
-      CheckCellRange(t, i, e_cols[j], -kMaxAbsErrorUm, kMaxAbsErrorUm,
-                 "is outside the plausible thermal-error range +-100000 um");
-      r.error_um(k, static_cast<Eigen::Index>(j)) = t.rows[i][e_cols[j]];
-    }
-    for (std::size_t j = 0; j < o_cols.size(); ++j) {
-      CheckCellRange(t, i, o_cols[j], -kMaxAbsOtherValue, kMaxAbsOtherValue,
-                     "is outside +-1e15 (no input of a run is that large: a broken cell)");
-      r.other(k, static_cast<Eigen::Index>(j)) = t.rows[i][o_cols[j]];
-    }
-  }
-  bool missing = false;  // a time cell was empty or nan
-  if (!time_column.empty())
-    for (double v : t.Column(time_column)) missing = missing || std::isnan(v);
-  if (time_column.empty() || missing) {
-    r.time_from_index = true;
-    r.time_min.resize(q);
-    for (std::size_t i = 0; i < q; ++i) r.time_min[i] = static_cast<double>(i);
-  } else {
-    const std::size_t tc = t.ColumnIndex(time_column);
-    const double unit = time_column == "time_s" ? 60.0 : 1.0;
-    for (std::size_t i = 0; i < q; ++i)
-      CheckCellRange(t, i, tc, -kMaxRunTimeMin * unit, kMaxRunTimeMin * unit,
-                     "is outside +-1e8 min (+-6e9 s, 190 years: even a time since 1970 fits; a "
-                     "larger time is a broken cell)");
-    r.time_min = t.IncreasingColumn(time_column);
-    if (time_column == "time_s")
-      for (double& v : r.time_min) v /= 60.0;
-  }
-  return r;
-}
-
-Run ReadRun(const std::filesystem::path& path, RunState state) {
-  return ParseRun(ReadTextFile(path), path.string(), state);
-}
 
 std::string FormatRun(const Run& run, const std::vector<std::string>& comments) {
   std::vector<std::string> header;

@@ -14,18 +14,27 @@
 // Cells other than time must be finite numbers; '#' lines are comments (provenance), as in
 // core/csv.h. A run's state (idle or cutting, Miao et al.'s two conditions) is not in the file: it
 // comes from the command line (--idle / --cutting) or the caller.
-// Limits (resource and plausibility, stated in the messages): at most kMaxRunSamples rows and
-// kMaxRunColumns columns; temperatures within [-60, 400] degC; errors within +-100000 um; times
-// within +-kMaxRunTimeMin; other columns within +-kMaxAbsOtherValue.
+// Limits (resource and plausibility, stated in the messages): kMaxRunColumns columns;
+// temperatures within [-60, 400] degC; errors within +-100000 um; times within +-kMaxRunTimeMin (190
+// years); every other column within +-kMaxAbsOtherValue. Rows: a run held whole in memory (Run, ReadRun: drift
+// select, crossval, holdout, monitor --day, every library caller) has at most kMaxRunSamples; the
+// commands that stream a file (RunReader: drift fit, predict, monitor --run, split, report) keep
+// memory independent of its length and take up to kMaxStreamRows.
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace whirl::drift {
 
 inline constexpr int kMaxRunSamples = 2'000'000;
+/// Rows of a run file streamed (RunReader): 10^9, 31 years of 1-s samples; the streaming commands'
+/// memory does not grow with them (docs/security-and-limits.md).
+inline constexpr long long kMaxStreamRows = 1'000'000'000;
 inline constexpr int kMaxRunColumns = 512;
 inline constexpr double kMinTemperatureC = -60.0;
 inline constexpr double kMaxTemperatureC = 400.0;
@@ -124,6 +133,99 @@ inline constexpr int kMaxSplitRuns = 10000;
 /// first run also holds the rows before the first start. Names: "<run.name>_<k>" (k from 1).
 /// More than kMaxSplitRuns starts is an InputError naming the file, the column and the count.
 /// Memory: the runs together hold the log once (each Slice copies only its rows).
+/// SplitLogFile streams the same rule.
 std::vector<Run> SplitAtStarts(const Run& run, const std::string& column, double threshold = 0.0);
+
+// ---- Streaming: run files longer than memory (a year of a machine's log) --------------------
+
+/// A run file's columns sorted into the Run's groups (by name, as the header comment says).
+struct RunLayout {
+  std::string source, name;  ///< file name for messages; the run's name (file stem)
+  RunState state = RunState::kUnknown;
+  std::string time_column;  ///< "time_s", "time_min" or "" (none)
+  std::vector<std::string> sensor_names, error_names, other_names;
+  std::size_t time_index = 0;  ///< CSV column of the time (when time_column is set)
+  std::vector<std::size_t> sensor_columns, error_columns, other_columns;  ///< CSV columns
+  std::size_t columns = 0;  ///< all CSV columns
+  int SensorIndex(const std::string& name) const;  ///< InputError as Run::SensorIndex
+  int ErrorIndex(const std::string& name) const;
+  int OtherIndex(const std::string& name) const;
+};
+
+/// What a quick pass over a run file finds (only the time cells are read): the data rows, whether
+/// every row recorded its time, and the first, second-to-last and last time [min; the sample
+/// index when time_from_index]. The streaming commands scan first: a run's time axis (recorded or
+/// the sample index) must be known before the first lag is computed.
+struct RunScan {
+  long long rows = 0;
+  bool time_from_index = false;
+  double first_time = 0, penultimate_time = 0, last_time = 0;
+};
+RunScan ScanRun(const std::filesystem::path& path);
+
+/// A block of consecutive rows of a run (RunReader::Read): per group a rows x columns matrix.
+struct RunRows {
+  int count = 0;
+  long long first = 0;           ///< index of the block's first row in the run
+  std::vector<double> time_min;  ///< [min]; the row index with a sample-index time axis; NaN:
+                                 ///< a missing cell when the axis is not decided yet
+  Eigen::MatrixXd temperature_C, error_um, other;
+  std::vector<int> line_numbers;
+};
+
+/// A run file read block by block with ParseRun's rules and messages (core/csv.h's CsvReader
+/// underneath: memory independent of the file's length). The time axis: `time_from_index` true
+/// (the sample index), false (recorded; every cell must be present) or unset (not decided yet:
+/// missing cells read NaN and time_missing() says so; the strict increase of recorded times is
+/// checked at the end, only when no cell was missing, as ParseRun). Errors name file, line,
+/// column, value and rule; the end-of-file checks (no data rows, times not increasing, more than
+/// kMaxStreamRows rows) come from the Read that returns false.
+class RunReader {
+ public:
+  RunReader(const std::filesystem::path& path, RunState state,
+            std::optional<bool> time_from_index);
+  /// In-memory text named `source` (ParseRun).
+  RunReader(std::string text, const std::string& source, RunState state,
+            std::optional<bool> time_from_index);
+  ~RunReader();
+  RunReader(const RunReader&) = delete;
+  RunReader& operator=(const RunReader&) = delete;
+
+  const RunLayout& layout() const;
+  /// Up to `max_rows` next rows into *block (its matrices resized); false at the end of the file.
+  bool Read(RunRows* block, int max_rows = 4096);
+  long long rows() const;     ///< rows read so far
+  bool time_missing() const;  ///< a time cell was empty or nan (unset axis)
+  double fraction_read() const;  ///< of the file's bytes, for progress
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The run-file text of a layout's columns as FormatRun writes them: comments, header
+/// (time_min unless `time_from_index`, sensors, errors, others).
+std::string FormatRunHeader(const RunLayout& layout, bool time_from_index,
+                            const std::vector<std::string>& comments);
+/// Appends row k of a block in FormatRun's format (FormatNumber cells, '\n').
+void AppendRunRow(const RunRows& block, int k, bool time_from_index, std::string* out);
+
+/// One run written by SplitLogFile.
+struct SplitRun {
+  std::string name;
+  std::filesystem::path file;
+  long long samples = 0;
+  double start_min = 0, end_min = 0;  ///< first and last time [min; sample index without time]
+  int first_line = 0, last_line = 0;
+};
+/// SplitAtStarts on a log file streamed row by row (fixed memory): each run is written as
+/// <dir>/<Slug(name)>.csv as its rows arrive, through an OutputDir (all or nothing, `what` names
+/// the directory); the same runs and files as SplitAtStarts + WriteRuns. `progress` (optional)
+/// gets the rows read and the fraction of the file.
+std::vector<SplitRun> SplitLogFile(const std::filesystem::path& log, const std::string& column,
+                                   double threshold, const std::filesystem::path& dir,
+                                   const std::vector<std::string>& comments,
+                                   const std::string& what,
+                                   const std::function<void(long long, double)>& progress = {});
 
 }  // namespace whirl::drift

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "core/error.h"
@@ -250,20 +251,19 @@ Eigen::VectorXd GreyGrades(const Eigen::MatrixXd& series, const Eigen::VectorXd&
   return xi.colwise().mean().transpose();
 }
 
-Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& error,
-                        const std::vector<std::string>& sensor_names,
-                        const SelectionOptions& options) {
-  options.Validate();
-  const auto m = static_cast<int>(rises.cols());
-  if (m < 1 || rises.rows() < 3 || error.size() != rises.rows() ||
-      static_cast<int>(sensor_names.size()) != m)
-    throw InputError("sensor selection needs at least 1 sensor and 3 samples (have " +
-                     std::to_string(m) + " sensors, " + std::to_string(rises.rows()) + " samples)");
+namespace {
+
+// The selection from its parts (conventions 3-7): the similarity matrix, the F statistic of a
+// partition and the grades.
+Selection SelectWith(Eigen::MatrixXd similarity,
+                     const std::function<double(const std::vector<int>&)>& f_statistic,
+                     Eigen::VectorXd grades, const std::vector<std::string>& sensor_names,
+                     const SelectionOptions& options) {
+  const auto m = static_cast<int>(similarity.rows());
   Selection s;
   s.sensor_names = sensor_names;
-  s.similarity = SimilarityMatrix(rises);
+  s.similarity = std::move(similarity);
   s.equivalence = FuzzyEquivalence(s.similarity, &s.squarings);
-  const Eigen::MatrixXd z = ZScore(rises);
   for (double lambda : LambdaLevels(s.equivalence)) {
     Partition p;
     p.lambda = lambda;
@@ -271,12 +271,12 @@ Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& err
     p.classes = *std::max_element(p.labels.begin(), p.labels.end()) + 1;
     p.has_f = p.classes > 1 && p.classes < m;
     if (p.has_f) {
-      p.f = FStatistic(z, p.labels);
+      p.f = f_statistic(p.labels);
       p.f_critical = FCritical(p.classes - 1, m - p.classes, options.alpha);
     }
     s.partitions.push_back(std::move(p));
   }
-  s.grades = GreyGrades(rises, error, options.rho);
+  s.grades = std::move(grades);
   s.chosen_partition = ChoosePartition(s.partitions, options, &s.message);
   if (s.chosen_partition >= 0) {
     s.chosen =
@@ -292,6 +292,72 @@ Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& err
     s.chosen = order;
   }
   return s;
+}
+
+void CheckSelectionInputs(int m, Eigen::Index samples, bool sizes_agree) {
+  if (m < 1 || samples < 3 || !sizes_agree)
+    throw InputError("sensor selection needs at least 1 sensor and 3 samples (have " +
+                     std::to_string(m) + " sensors, " + std::to_string(samples) + " samples)");
+}
+
+}  // namespace
+
+Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& error,
+                        const std::vector<std::string>& sensor_names,
+                        const SelectionOptions& options) {
+  options.Validate();
+  const auto m = static_cast<int>(rises.cols());
+  CheckSelectionInputs(m, rises.rows(),
+                       error.size() == rises.rows() && static_cast<int>(sensor_names.size()) == m);
+  const Eigen::MatrixXd z = ZScore(rises);
+  return SelectWith(
+      SimilarityMatrix(rises), [&](const std::vector<int>& labels) { return FStatistic(z, labels); },
+      GreyGrades(rises, error, options.rho), sensor_names, options);
+}
+
+void SelectionMoments::Add(const Eigen::MatrixXd& x) {
+  if (x.rows() == 0) return;
+  const Eigen::VectorXd m = x.colwise().mean().transpose();
+  const Eigen::MatrixXd c = x.rowwise() - m.transpose();
+  const Eigen::MatrixXd cross_b = c.transpose() * c;
+  const Eigen::VectorXd max_b = x.cwiseAbs().colwise().maxCoeff().transpose();
+  if (rows == 0) {
+    rows = x.rows();
+    mean = m;
+    cross = cross_b;
+    max_abs = max_b;
+    return;
+  }
+  const double na = static_cast<double>(rows), nb = static_cast<double>(x.rows());
+  const Eigen::VectorXd d = m - mean;
+  cross += cross_b + d * d.transpose() * (na * nb / (na + nb));
+  mean += d * (nb / (na + nb));
+  max_abs = max_abs.cwiseMax(max_b);
+  rows += x.rows();
+}
+
+double FStatisticFromGram(const Eigen::MatrixXd& g, const std::vector<int>& labels) {
+  const auto m = static_cast<int>(g.rows());
+  const int r = *std::max_element(labels.begin(), labels.end()) + 1;
+  if (!(r > 1 && r < m))
+    throw InputError("F statistic needs 1 < r < m (r = " + std::to_string(r) +
+                     ", m = " + std::to_string(m) + ")");
+  // S(k, l) = sum of g over the members of classes k and l; n_k the class sizes.
+  Eigen::MatrixXd member = Eigen::MatrixXd::Zero(m, r);
+  for (int i = 0; i < m; ++i) member(i, labels[static_cast<std::size_t>(i)]) = 1;
+  const Eigen::MatrixXd sums = member.transpose() * g * member;
+  const Eigen::VectorXd n = member.colwise().sum().transpose();
+  const double all = sums.sum();
+  double between = 0, within = g.trace();
+  for (int k = 0; k < r; ++k) {
+    const double to_all = sums.row(k).sum();
+    // n_k |zbar_k - zbar|^2 = S_kk / n_k - 2 S_k. / m + n_k S.. / m^2
+    between += sums(k, k) / n(k) - 2 * to_all / m + n(k) * all / (static_cast<double>(m) * m);
+    within -= sums(k, k) / n(k);  // sum_i |z_i - zbar_k|^2 = sum_i g_ii - S_kk / n_k
+  }
+  const double num = between / (r - 1), den = within / (m - r);
+  if (den <= 0) return std::numeric_limits<double>::infinity();
+  return num / den;
 }
 
 void StackRuns(const std::vector<Run>& runs, const std::string& error_column,
@@ -315,14 +381,16 @@ void StackRuns(const std::vector<Run>& runs, const std::string& error_column,
   }
 }
 
-SensorScreen ScreenSensors(const Eigen::MatrixXd& rises, const std::vector<std::string>& names,
-                           const std::string& sources) {
-  const Eigen::MatrixXd c = rises.rowwise() - rises.colwise().mean();
-  const Eigen::MatrixXd gram = c.transpose() * c;  // centred cross products
+namespace {
+
+// Convention 8 from the centred cross products `gram` and each column's largest |rise|.
+SensorScreen ScreenFromGram(const Eigen::MatrixXd& gram, const Eigen::VectorXd& max_abs,
+                            long long rows, const std::vector<std::string>& names,
+                            const std::string& sources) {
   SensorScreen s;
-  for (Eigen::Index j = 0; j < rises.cols(); ++j) {
+  for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(names.size()); ++j) {
     const std::string& name = names[static_cast<std::size_t>(j)];
-    if (rises.rows() == 0 || rises.col(j).cwiseAbs().maxCoeff() == 0) {
+    if (rows == 0 || max_abs(j) == 0) {
       s.left_out.push_back(name + " is dead: its reading never moves in " + sources +
                            " (a stuck or disconnected sensor); left out");
       continue;
@@ -347,6 +415,27 @@ SensorScreen ScreenSensors(const Eigen::MatrixXd& rises, const std::vector<std::
   return s;
 }
 
+}  // namespace
+
+SensorScreen ScreenSensors(const Eigen::MatrixXd& rises, const std::vector<std::string>& names,
+                           const std::string& sources) {
+  const Eigen::MatrixXd c = rises.rowwise() - rises.colwise().mean();
+  const Eigen::MatrixXd gram = c.transpose() * c;  // centred cross products
+  const Eigen::VectorXd max_abs = rises.rows() == 0
+                                      ? Eigen::VectorXd::Zero(rises.cols())
+                                      : Eigen::VectorXd(rises.cwiseAbs().colwise().maxCoeff().transpose());
+  return ScreenFromGram(gram, max_abs, rises.rows(), names, sources);
+}
+
+SensorScreen ScreenSensors(const SelectionMoments& moments, const std::vector<std::string>& names,
+                           const std::string& sources) {
+  if (moments.rows == 0) {
+    const auto m = static_cast<Eigen::Index>(names.size());
+    return ScreenFromGram(Eigen::MatrixXd::Zero(m, m), Eigen::VectorXd::Zero(m), 0, names, sources);
+  }
+  return ScreenFromGram(moments.cross, moments.max_abs, moments.rows, names, sources);
+}
+
 std::string RunSources(const std::vector<Run>& runs) {
   std::string out;
   for (const Run& r : runs) out += (out.empty() ? "" : ", ") + r.source;
@@ -355,18 +444,47 @@ std::string RunSources(const std::vector<Run>& runs) {
 
 Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
                         const SelectionOptions& options) {
+  return SelectSensors(runs, error_column, options, nullptr);
+}
+
+Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
+                        const SelectionOptions& options, const SelectionMoments* all_rows) {
   Eigen::MatrixXd rises;
   Eigen::VectorXd error;
   StackRuns(runs, error_column, &rises, &error);
   const std::vector<std::string>& all = runs.front().sensor_names;
-  const SensorScreen screen = ScreenSensors(rises, all, RunSources(runs));
+  const SensorScreen screen = all_rows ? ScreenSensors(*all_rows, all, RunSources(runs))
+                                       : ScreenSensors(rises, all, RunSources(runs));
   Eigen::MatrixXd kept(rises.rows(), static_cast<Eigen::Index>(screen.usable.size()));
   std::vector<std::string> names;
   for (std::size_t k = 0; k < screen.usable.size(); ++k) {
     kept.col(static_cast<Eigen::Index>(k)) = rises.col(screen.usable[k]);
     names.push_back(all[static_cast<std::size_t>(screen.usable[k])]);
   }
-  Selection s = SelectSensors(kept, error, names, options);
+  Selection s;
+  if (all_rows == nullptr) {
+    s = SelectSensors(kept, error, names, options);
+  } else {  // the similarity and the F test from every row; the grades from the runs
+    options.Validate();
+    const auto m = static_cast<Eigen::Index>(names.size());
+    CheckSelectionInputs(static_cast<int>(m), all_rows->rows >= 3 ? kept.rows() : 0, true);
+    Eigen::MatrixXd cross(m, m);
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (Eigen::Index j = 0; j < m; ++j)
+        cross(i, j) = all_rows->cross(screen.usable[static_cast<std::size_t>(i)],
+                                      screen.usable[static_cast<std::size_t>(j)]);
+    Eigen::MatrixXd similarity = Eigen::MatrixXd::Identity(m, m), z = Eigen::MatrixXd::Zero(m, m);
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (Eigen::Index j = 0; j < m; ++j) {
+        const double norms = std::sqrt(cross(i, i) * cross(j, j));
+        if (!(norms > 0)) continue;
+        z(i, j) = cross(i, j) / norms;  // z_i' z_j / n: a constant sensor's z is 0
+        if (i != j) similarity(i, j) = std::min(1.0, std::abs(z(i, j)));
+      }
+    s = SelectWith(
+        similarity, [&](const std::vector<int>& labels) { return FStatisticFromGram(z, labels); },
+        GreyGrades(kept, error, options.rho), names, options);
+  }
   s.left_out = screen.left_out;
   return s;
 }

@@ -119,6 +119,21 @@ double FCritical(int d1, int d2, double alpha);
 Eigen::VectorXd GreyGrades(const Eigen::MatrixXd& series, const Eigen::VectorXd& error,
                            double rho = 0.5);
 
+/// Sums over the stacked rises of runs (convention 1) that are not held: the row count, the
+/// mean, the centred cross products sum (x - mean)(x - mean)' and each sensor's largest |rise|,
+/// merged block by block (Chan, Golub and LeVeque's pairwise update). They give the screen
+/// (convention 8: dead = largest |rise| 0, duplicates by the centred cross products, as
+/// ScreenSensors), the similarity r_ij (convention 2) and the F statistic (convention 5, through
+/// z_i' z_j = n r_ij signed) over every row of a long log (drift/stream.h FitFiles).
+struct SelectionMoments {
+  long long rows = 0;
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd cross;
+  Eigen::VectorXd max_abs;
+  /// Adds rows (samples x sensors) of rises.
+  void Add(const Eigen::MatrixXd& rises);
+};
+
 /// The whole selection on stacked rises and errors (samples x sensors, samples).
 Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& error,
                         const std::vector<std::string>& sensor_names,
@@ -127,6 +142,16 @@ Selection SelectSensors(const Eigen::MatrixXd& rises, const Eigen::VectorXd& err
 /// it or the runs' sensors differ.
 Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
                         const SelectionOptions& options = {});
+/// The same with the screen, the similarity and the F statistic from `all_rows` (the moments of
+/// every row of the logs `runs` were thinned from, sensors in runs' order) and the grey grades
+/// from `runs` (their min-max normalization too): what FitFiles runs on a thinned sample. Null:
+/// SelectSensors(runs, ...).
+Selection SelectSensors(const std::vector<Run>& runs, const std::string& error_column,
+                        const SelectionOptions& options, const SelectionMoments* all_rows);
+
+/// FStatistic from the columns' products z_i' z_j (`gram`, m x m) instead of the columns: the same
+/// F (between and within sums of squares are quadratic forms in the z_i).
+double FStatisticFromGram(const Eigen::MatrixXd& gram, const std::vector<int>& labels);
 
 /// 1 - |r| below which two rise series count as one (convention 8).
 inline constexpr double kDuplicateTolerance = 1e-12;
@@ -139,6 +164,9 @@ struct SensorScreen {
 /// InputError "<sources>: no usable temperature sensor: ..." when every column is left out
 /// (`sources` names the run files).
 SensorScreen ScreenSensors(const Eigen::MatrixXd& rises, const std::vector<std::string>& names,
+                           const std::string& sources);
+/// Convention 8 from moments (SelectionMoments) instead of the rises.
+SensorScreen ScreenSensors(const SelectionMoments& moments, const std::vector<std::string>& names,
                            const std::string& sources);
 
 /// "a.csv, b.csv": the files of the runs, for messages.

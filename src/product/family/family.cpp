@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <mutex>
 
 #include "core/error.h"
 #include "core/numbers.h"
@@ -100,8 +102,16 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
     return {loo.residual, loo.latent_variance};
   }
   if (folds == 0) {
-    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(m.gps[k]);
-    return {loo.residual, loo.latent_variance};
+    const gp::Gp& gp = m.gps[k];
+    const gp::LeaveOneOut loo = gp::LeaveOneOutGp(gp);
+    if (gp.rows.empty()) return {loo.residual, loo.latent_variance};
+    // A GP on a subset of the rows (GpOptions::max_rows): the other rows are held out already.
+    const gp::GpPrediction p = gp::PredictGp(gp, x);
+    h.r = y - p.mean;
+    h.v = p.latent_variance;
+    h.r(gp.rows) = loo.residual;
+    h.v(gp.rows) = loo.latent_variance;
+    return h;
   }
   const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
   KFoldResiduals(
@@ -117,7 +127,7 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
         }
         const gp::GpPrediction p = gp::PredictGp(
             cold_start ? gp::FitGp(x(Eigen::all, tr), y(tr), go)
-                 : gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta),
+                       : gp::FitGpFrom(x(Eigen::all, tr), y(tr), go, m.gps[k].theta),
             x(Eigen::all, te));
         *mean = p.mean;
         *latent = p.latent_variance;
@@ -152,7 +162,9 @@ std::string CalibrationText(int folds, bool two_sd) {
   return "per output the smallest noise variance at which +-1 sd (noise + latent variance) "
          "covers 68.27 % of the " +
          (folds == 0 ? std::string("closed-form leave-one-out residuals")
-                     : std::to_string(folds) + "-fold cross-validation residuals (refits)") +
+                     : std::to_string(folds) +
+                           "-fold cross-validation residuals (refits; a GP's hyperparameters "
+                           "refitted)") +
          (two_sd ? ", and +-1 sd 68.27 % and +-2 sd 95.45 % of the closed-form leave-one-out "
                    "residuals"
                  : "");
@@ -167,24 +179,24 @@ Eigen::RowVectorXd OriginalErrors(const FamilyModel& m, int k, const Eigen::RowV
   return e;
 }
 
-std::vector<gp::Gp> FitGps(const ProcessTable& t, const Candidate& c, const FitOptions& o) {
-  const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
-  gp::GpOptions go = o.gp;
-  go.kernel = c.kernel;
-  go.mean = c.mean;
-  go.isotropic = c.isotropic;
+// x: the used inputs, y: the targets, both transformed.
+std::vector<gp::Gp> FitGps(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, const Candidate& c,
+                           const FitOptions& o) {
+  const gp::GpOptions go = CandidateGpOptions(o, c);
   std::vector<gp::Gp> gps(static_cast<std::size_t>(y.rows()));
-  for (Eigen::Index k = 0; k < y.rows(); ++k) {
-    gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
-  }
+  for (Eigen::Index k = 0; k < y.rows(); ++k) gps[k] = gp::FitGp(x, y.row(k).transpose(), go);
   return gps;
 }
 
-std::vector<LinearModel> FitLinears(const ProcessTable& t) {
-  const Eigen::MatrixXd x = nn::InputMatrix(t.inputs), y = nn::TargetMatrix(t.targets);
+std::vector<LinearModel> FitLinears(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
   std::vector<LinearModel> fits;
   for (Eigen::Index k = 0; k < y.rows(); ++k) fits.push_back(FitLinear(x, y.row(k).transpose()));
   return fits;
+}
+
+// The used inputs of `table` through the model's transform (UsedInputCount() x rows).
+Eigen::MatrixXd ModelInputs(const FamilyModel& m, const std::vector<ProcessInputs>& inputs) {
+  return UsedInputRows(m.transform, TransformInputs(m.transform, nn::InputMatrix(inputs)));
 }
 
 // The inputs mapped through t, one row per input row.
@@ -214,7 +226,7 @@ Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<Process
       }
     return mean;
   }
-  const Eigen::MatrixXd x = nn::InputMatrix(z);
+  const Eigen::MatrixXd x = UsedInputRows(m.transform, nn::InputMatrix(z));
   for (int k = 0; k < Features::kCount && m.candidate.family == Family::kLinear; ++k) {
     const LinearPrediction p = PredictLinear(m.linears[k], x);
     mean.row(k) = p.mean.transpose();
@@ -257,28 +269,25 @@ void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions&
 }
 
 void CheckTable(const ProcessTable& table);
+void CheckRows(const ProcessTable& table, const Candidate& c, int inputs);
 
 // Folds of the held-out errors of linear and GP candidates: 0 = closed-form leave-one-out.
 int HeldOutFolds(const ChoiceOptions& o, int folds) { return o.closed_form_loo ? 0 : folds; }
-// The choice's held-out residuals are the calibration's when both use the same folds.
-bool ReusesCalibration(const ChoiceOptions& o, int folds) {
-  return HeldOutFolds(o, folds) == std::min(o.fit.calibration_folds, folds);
-}
 
 // Fits (or takes from `full`, the closed-form fits) each candidate that predicts an output
 // (chosen, or a positive stacking weight) on all rows, with calibration; fills models,
 // model_of_output and, for stacked outputs, weights.
 void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
                const std::array<Eigen::VectorXd, Features::kCount>& stack,
-               std::vector<FamilyModel>& full, Choice* choice) {
+               std::vector<FamilyModel>& full, const std::vector<char>& calibrated,
+               Choice* choice) {
   std::vector<int> fitted;
   auto model_of = [&](int c) {
     const auto it = std::find(fitted.begin(), fitted.end(), c);
     if (it != fitted.end()) return static_cast<int>(it - fitted.begin());
     fitted.push_back(c);
     if (options.candidates[c].family != Family::kNetwork) {
-      const int folds = std::min(options.folds, static_cast<int>(table.inputs.size()));
-      if (!ReusesCalibration(options, folds)) Calibrate(table, options.fit, &full[c]);
+      if (!calibrated[c]) Calibrate(table, options.fit, &full[c]);
       choice->models.push_back(std::move(full[c]));
     } else {
       choice->models.push_back(FitCandidate(table, options.candidates[c], options.fit, true));
@@ -304,6 +313,20 @@ void CheckTable(const ProcessTable& table) {
   if (table.inputs.size() < 4)
     throw InputError(table.source + ": " + std::to_string(table.inputs.size()) +
                      " training rows; choosing a model family needs at least 4");
+}
+
+void CheckRows(const ProcessTable& table, const Candidate& c, int inputs) {
+  const int rows = static_cast<int>(table.inputs.size()), need = MinimumRows(c, inputs);
+  if (rows >= need) return;
+  const std::string what =
+      c.family == Family::kLinear
+          ? "a linear fit in " + std::to_string(inputs) + " inputs (" + std::to_string(inputs + 1) +
+                " coefficients, and 2 rows to judge it)"
+          : c.family == Family::kGaussianProcess ? "its mean's coefficients and 2 rows to judge it"
+                                                 : "a network";
+  throw InputError(table.source + ": " + std::to_string(rows) + " training rows; " + c.Name() +
+                   " needs at least " + std::to_string(need) + " (" + what +
+                   "): add rows, or choose other candidates (--family)");
 }
 
 }  // namespace
@@ -354,42 +377,59 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
   CheckTable(table);
   FamilyModel m;
   m.candidate = candidate;
-  if (candidate.log) m.transform = LogWherePositive(table);
-  const ProcessTable t = TransformedTable(table, m.transform);
+  if (candidate.log)
+    m.transform = LogWherePositive(table);
+  else
+    LeaveOutConstantInputs(table, &m.transform);
+  CheckRows(table, candidate, m.transform.UsedInputCount());
   if (candidate.family == Family::kNetwork) {
-    m.network = FitNetwork(t, candidate, options, calibrate);
+    m.network = FitNetwork(TransformedTable(table, m.transform), candidate, options, calibrate);
     m.calibration = m.network.noise_calibration;
-  } else {
-    if (candidate.family == Family::kLinear)
-      m.linears = FitLinears(t);
-    else
-      m.gps = FitGps(t, candidate, options);
-    if (calibrate) Calibrate(table, options, &m);
+    return m;
   }
+  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
+  const Eigen::MatrixXd y = TransformTargets(m.transform, nn::TargetMatrix(table.targets));
+  if (candidate.family == Family::kLinear)
+    m.linears = FitLinears(x, y);
+  else
+    m.gps = FitGps(x, y, candidate, options);
+  if (calibrate) Calibrate(table, options, &m);
   return m;
 }
 
+int CalibrationFolds(const FitOptions& options, int rows, const FamilyModel& m) {
+  const int k = std::min(options.calibration_folds, rows);
+  if (k == 0 || m.candidate.family == Family::kNetwork) return k;
+  if (options.loo_calibration_rows > 0 && rows >= options.loo_calibration_rows) return 0;
+  // A GP on a subset of the rows: the rows it does not keep are held out already.
+  if (m.candidate.family == Family::kGaussianProcess && options.gp.max_rows > 0 &&
+      rows > options.gp.max_rows)
+    return 0;
+  const int smallest_training_split = rows - (rows + k - 1) / k;
+  return smallest_training_split >= MinimumRows(m.candidate, m.transform.UsedInputCount()) ? k : 0;
+}
+
 void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
-  const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd x = ModelInputs(*m, table.inputs);
   const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
+  const int folds = CalibrationFolds(options, static_cast<int>(table.inputs.size()), *m);
   for (int k = 0; k < Features::kCount; ++k) {
     const Eigen::VectorXd yk = y.row(k).transpose();
-    SetNoiseFrom(OutputHeldOut(*m, k, x, yk, options, options.calibration_folds),
-                 options.calibration_folds, options, x, yk, k, m);
+    SetNoiseFrom(OutputHeldOut(*m, k, x, yk, options, folds, true), folds, options, x, yk, k, m);
   }
-  m->calibration = CalibrationText(options.calibration_folds, options.calibrate_two_sd);
+  m->calibration = CalibrationText(folds, options.calibrate_two_sd);
 }
 
 Eigen::MatrixXd HeldOutErrors(const ProcessTable& table, const FitOptions& options, int folds,
-                              FamilyModel* m, bool calibrate) {
+                              FamilyModel* m, bool calibrate, bool cold = true) {
   if (m->candidate.family == Family::kNetwork)
     throw InputError("held-out errors of a fitted model: not available for " + m->candidate.Name());
-  const Eigen::MatrixXd x = TransformInputs(m->transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd x = ModelInputs(*m, table.inputs);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::MatrixXd y = TransformTargets(m->transform, t);
   Eigen::MatrixXd err(t.rows(), t.cols());
   for (int k = 0; k < Features::kCount; ++k) {
-    const HeldOut h = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds);
+    const HeldOut h = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds, cold);
     err.row(k) = OriginalErrors(*m, k, t.row(k), y.row(k).transpose(), h);
     if (calibrate) SetNoiseFrom(h, folds, options, x, y.row(k).transpose(), k, m);
   }
@@ -462,11 +502,13 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
   std::size_t best = 0;
   for (std::size_t c = 1; c < squared_errors.size(); ++c)
     if (squared_errors[c].mean() < squared_errors[best].mean()) best = c;
+  double simpler = std::numeric_limits<double>::infinity();  // lowest mean of those before c
   for (std::size_t c = 0; c < squared_errors.size(); ++c) {
     const Eigen::ArrayXd d = (squared_errors[c] - squared_errors[best]).array();
     const double n = static_cast<double>(d.size()), mean = d.mean();
     const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
-    if (mean <= se) return static_cast<int>(c);
+    if (mean <= se && squared_errors[c].mean() <= simpler) return static_cast<int>(c);
+    simpler = std::min(simpler, squared_errors[c].mean());
   }
   return static_cast<int>(best);
 }
@@ -494,14 +536,26 @@ double CoverageNoiseVariance(const Eigen::VectorXd& residual,
 void to_json(nlohmann::json& j, const CvRow& r) {
   j = {{"candidate", r.candidate.Name()},
        {"cv_rmse", std::vector<double>(r.cv_rmse.data(), r.cv_rmse.data() + r.cv_rmse.size())},
-       {"score", r.score},
-       {"fit_ms", r.fit_ms}};
+       {"score", r.score}};
+}
+
+std::string FamilyModel::OutputName(int k) const {
+  const std::string name = candidate.Name();
+  if (!candidate.log || transform.outputs.at(static_cast<std::size_t>(k)) == ColumnTransform::kLog)
+    return name;
+  return name + "-inputs";
+}
+
+int MinimumRows(const Candidate& c, int inputs) {
+  if (c.family == Family::kLinear) return inputs + 3;
+  if (c.family == Family::kGaussianProcess) return gp::MeanSize(c.mean, inputs) + 2;
+  return 4;
 }
 
 std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   std::vector<Candidate> c;
   for (const char* name : {"linear/log", "linear/identity", "gp-se-iso-constant/identity",
-                           "gp-matern52-constant/log", "gp-matern52-constant/identity"})
+                           "gp-matern52-linear/log", "gp-matern52-constant/identity"})
     c.push_back(ParseCandidate(name));
   return c;
 }
@@ -546,7 +600,7 @@ int LinearOnTheSameColumns(const ChoiceOptions& o, const Candidate& c) {
 // the held-out rows).
 Eigen::VectorXd RefitSquaredErrors(const FamilyModel& m, const ProcessTable& table,
                                    const FitOptions& o, int folds, int k) {
-  const Eigen::MatrixXd x = TransformInputs(m.transform, nn::InputMatrix(table.inputs));
+  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::VectorXd y = TransformTargets(m.transform, t).row(k).transpose();
   const HeldOut h = OutputHeldOut(m, k, x, y, o, folds, true);
@@ -629,19 +683,82 @@ int ChooseAmong(const std::vector<int>& kept, const std::vector<Eigen::MatrixXd>
 
 }  // namespace
 
-Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
+namespace {
+
+// `o` without its GP candidates on tables too small for their refits (ChoiceOptions::few_rows:
+// every training split of `folds` needs the rows of a linear fit in `inputs` inputs), unless they
+// are all there is; `note` says so.
+ChoiceOptions ActiveCandidates(const ChoiceOptions& o, int rows, int folds, int inputs,
+                               std::string* note) {
+  ChoiceOptions active = o;
+  const int split = rows - (rows + folds - 1) / folds, need = inputs + 3;
+  if (!o.closed_form_loo || rows >= o.few_rows || split >= need) return active;
+  active.candidates.clear();
+  for (const Candidate& c : o.candidates)
+    if (c.family != Family::kGaussianProcess) active.candidates.push_back(c);
+  if (active.candidates.empty() || active.candidates.size() == o.candidates.size()) return o;
+  *note = "at " + std::to_string(rows) + " rows the GP candidates sit out: a GP must beat the " +
+          "linear fits in " + std::to_string(folds) + "-fold refits, whose training splits of " +
+          std::to_string(split) + " rows are fewer than a linear fit in " +
+          std::to_string(inputs) + " inputs needs (" + std::to_string(need) + ")";
+  return active;
+}
+
+// Choice::warnings: the constant inputs left out, and the columns the log candidates keep raw.
+std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOptions& o,
+                                       const std::vector<int>& constant) {
+  std::vector<std::string> out;
+  for (int i : constant)
+    out.push_back(std::string(kInputColumns[i]) + " is constant (" +
+                  MessageNumber(table.inputs.front().ToArray()[i]) + " " + kInputUnits[i] +
+                  " in every row of " + table.source +
+                  "): left out of the model; its predictions do not depend on it, and other "
+                  "values of it are outside the training domain");
+  std::string logs, first;
+  for (const Candidate& c : o.candidates)
+    if (c.log) {
+      if (first.empty()) first = c.Name();
+      logs += (logs.empty() ? "" : ", ") + c.Name();
+    }
+  if (logs.empty()) return out;
+  for (const LogException& e : LogExceptions(table)) {
+    if (e.input && !LogWherePositive(table).input_used[e.column]) continue;
+    const std::string column = e.input ? kInputColumns[e.column] : kTargetColumns[e.column];
+    out.push_back(e.Describe(table) + ". The log candidates (" + logs + ") keep " + column +
+                  " on its raw scale" +
+                  (e.input ? "" : " (named " + first + "-inputs and so on: the log of the inputs only)") +
+                  "; check the row");
+  }
+  return out;
+}
+
+}  // namespace
+
+Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   CheckTable(table);
-  if (options.candidates.empty()) throw InputError("family choice: no candidates");
+  if (given.candidates.empty()) throw InputError("family choice: no candidates");
   const int rows = static_cast<int>(table.inputs.size());
-  const int folds = std::min(options.folds, rows), nc = static_cast<int>(options.candidates.size());
+  const int folds = std::min(given.folds, rows);
   if (folds < 2)
-    throw InputError("family choice: folds " + std::to_string(options.folds) + ": must be >= 2");
+    throw InputError("family choice: folds " + std::to_string(given.folds) + ": must be >= 2");
+  TableTransform used;
+  const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
+  std::string rows_note;
+  const ChoiceOptions options =
+      ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note);
+  const int nc = static_cast<int>(options.candidates.size());
   std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
                                    Eigen::MatrixXd(Features::kCount, rows));
   std::vector<double> ms(static_cast<std::size_t>(nc * folds));
   FitOptions fold_options = options.fit;
   fold_options.threads = 1;
+  for (const Candidate& c : options.candidates) CheckRows(table, c, used.UsedInputCount());
   std::vector<FamilyModel> full(static_cast<std::size_t>(nc));  // closed-form LOO fits
+  std::vector<char> calibrated(static_cast<std::size_t>(nc), 0);
+  std::mutex progress_mutex;
+  int done = 0;
+  int steps = 1;  // a network's folds, every other candidate's fit (with its held-out errors), the end
+  for (const Candidate& c : options.candidates) steps += c.family == Family::kNetwork ? folds : 1;
   ParallelFor(static_cast<std::size_t>(nc * folds), options.fit.threads, [&](std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
     const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
@@ -649,11 +766,20 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
       FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
     } else if (f == 0) {  // one full fit, its held-out errors (and calibration) from it
       full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
-      err[c] = HeldOutErrors(table, fold_options, HeldOutFolds(options, folds), &full[c],
-                             ReusesCalibration(options, folds));
+      const bool honest = options.closed_form_loo &&
+                          options.candidates[c].family == Family::kGaussianProcess &&
+                          rows < options.few_rows &&
+                          rows - (rows + folds - 1) / folds >=
+                              MinimumRows(options.candidates[c], used.UsedInputCount());
+      const int held_folds = honest ? folds : HeldOutFolds(options, folds);
+      calibrated[c] = held_folds == CalibrationFolds(options.fit, rows, full[c]);
+      err[c] = HeldOutErrors(table, fold_options, held_folds, &full[c], calibrated[c], true);
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (!options.progress || (f > 0 && options.candidates[c].family != Family::kNetwork)) return;
+    const std::lock_guard<std::mutex> lock(progress_mutex);
+    options.progress(++done, steps, options.candidates[c].Name());
   });
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::ArrayXd var =
@@ -695,7 +821,10 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options) {
       if (!choice.notes[k].empty()) choice.chosen[k] = lin;
     }
   }
-  FitChosen(table, options, stack, full, &choice);
+  FitChosen(table, options, stack, full, calibrated, &choice);
+  if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
+  choice.warnings = TableWarnings(table, options, constant);
+  choice.rows_note = rows_note;
   return choice;
 }
 
@@ -731,14 +860,15 @@ std::string Choice::Describe() const {
   for (int k = 0; k < Features::kCount; ++k) {
     s += (k ? ", " : "") + std::string(kTargetColumns[k]) + ": ";
     if (weights[k].empty()) {
-      s += table.at(chosen[k]).candidate.Name();
+      const bool fitted = static_cast<std::size_t>(model_of_output[k]) < models.size();
+      s += fitted ? models[model_of_output[k]].OutputName(k) : table.at(chosen[k]).candidate.Name();
       continue;
     }
     std::string terms;
     for (std::size_t j = 0; j < weights[k].size() && j < models.size(); ++j)
       if (weights[k][j] > 0)
         terms += (terms.empty() ? "" : " + ") + FormatFixed(weights[k][j], 2) + " " +
-                 models[j].candidate.Name();
+                 models[j].OutputName(k);
     s += terms;
   }
   return s;

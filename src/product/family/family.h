@@ -1,18 +1,22 @@
 #pragma once
-// The workpiece model as one of several families, chosen from the data by cross-validated error:
-// the trainbr network of nn/ (a fixed hidden size, or its evidence choice among sizes) and the
-// Gaussian process of gp/, each on identity or log columns (family/transform.h).
+// The workpiece model as one of several families, chosen from the data by held-out error: least
+// squares (on log columns a power law), the Gaussian process of gp/ and the trainbr network of
+// nn/ (a fixed hidden size, or its evidence choice among sizes), each on identity or log columns
+// (family/transform.h).
 //
-// Choice (ChooseFamily): K-fold cross-validation (row q held out in fold q % K, K = min(folds,
-// rows)); every candidate is refitted on each fold's training rows (its hyperparameters, weights,
-// scalings and transform ranges included, nothing from the held-out rows) and predicts the
-// held-out means; the score is
+// Choice (ChooseFamily), per output by default: every candidate's held-out predictions of every
+// row (ChoiceOptions::closed_form_loo: closed-form leave-one-out for linear fits, K-fold refits
+// for GPs below ChoiceOptions::few_rows rows and for networks, row q held out in fold q % K,
+// K = min(folds, rows), nothing fitted on the held-out rows), their squared errors, and
 //   score = sum over outputs k of mean_i (t_ik - mean_-i,k)^2 / var_k,
 // var_k = the population variance of output k over the whole table (both outputs weigh equally,
-// as in the network's normalized errors). The candidate with the lowest score (ties: the earlier)
-// is refitted on all rows with its noise calibration and returned with the table of scores.
-// Within the network family the hidden size may still be chosen by the evidence (MacKay 1992:
-// comparable only within one family); across families only cross-validated errors are compared.
+// as in the network's normalized errors). Per output the simplest candidate within one standard
+// error of the lowest error (ChoiceOptions::one_standard_error) is refitted on all rows with its
+// noise calibration and returned with the table of held-out errors. Within the network family
+// the hidden size may still be chosen by the evidence (MacKay 1992: comparable only within one
+// family); across families only held-out errors are compared. How the default was chosen, on a
+// benchmark of generator families split into a tuning and a confirmation part before tuning:
+// docs/workpiece-model.md.
 //
 // Predictive sd, per output, in the candidate's transformed space, then mapped back by the delta
 // method (family/transform.h):
@@ -29,6 +33,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -70,10 +75,15 @@ struct FitOptions {
   gp::GpOptions gp;             ///< the GP's options (kernel and mean come from the candidate)
   /// Noise calibration of linear and GP candidates: 0 = closed-form leave-one-out (for a GP at
   /// the full fit's hyperparameters); K > 0 = K-fold cross-validation (min(K, rows) folds, row
-  /// q held out in fold q % K; a GP refitted from the full fit's hyperparameters, one start),
-  /// the held-out residuals and latent variances in CoverageNoiseVariance (the network's rule,
-  /// nn/model.h). Why K-fold for both: leave-one-out residuals come from fits on n - 1 rows and
-  /// undercovered the simulator's hold-out tables (scripts/bench_peers.sh, 20 rows).
+  /// q held out in fold q % K; a GP's hyperparameters refitted from the fixed starting points of
+  /// gp::GpOptions, so that none has seen the held-out rows), the held-out residuals and latent
+  /// variances in CoverageNoiseVariance (the network's rule, nn/model.h). K-fold is used only
+  /// where every training split keeps MinimumRows rows (else leave-one-out: 8 and 9 rows for a
+  /// linear fit in 5 inputs) and below loo_calibration_rows; a GP on a subset of the rows
+  /// (gp::GpOptions::max_rows) is calibrated by the residuals of the rows it does not keep and
+  /// the leave-one-out of those it keeps. Why K-fold at few rows: leave-one-out residuals come
+  /// from fits on n - 1 rows and undercovered the simulator's hold-out tables
+  /// (scripts/bench_peers.sh, 20 rows).
   int calibration_folds = 5;
   /// true: the noise level is at least the one at which the closed-form leave-one-out residuals
   /// (and their latent variances) are covered 68.27 % at +-1 sd and 95.45 % at +-2 sd
@@ -86,6 +96,11 @@ struct FitOptions {
   /// of the 5-fold residuals covered 84-85 % at +-1 sd on Friedman's 20-row tables, this rule
   /// 69-74 % (scripts/bench_peers.sh, 20 seeds; docs/workpiece-model.md).
   bool calibrate_two_sd = true;
+  /// From this many rows on, linear and GP candidates are calibrated by the closed-form
+  /// leave-one-out alone (calibration_folds is used below it); 0 = never. At 70 rows and more
+  /// the leave-one-out residuals of a GP are close to those of refits (10 rows per
+  /// hyperparameter), and the refits cost a third of the fit time at 100 rows.
+  int loo_calibration_rows = 70;
   int threads = 1;  ///< core/parallel.h; the result is the same for any count
 };
 
@@ -99,11 +114,19 @@ struct FamilyModel {
   std::vector<gp::Gp> gps;
   std::vector<LinearModel> linears;
   std::string calibration;  ///< how the predictive sd was calibrated (provenance)
+  /// Name() of the candidate for output k, saying when a log candidate keeps the output on its raw
+  /// scale: "linear/log-inputs" (the log of the inputs only, LogExceptions).
+  std::string OutputName(int k) const;
 };
 
-/// Fits `candidate` on all rows of `table` (targets required, >= 4 rows); `calibrate` = false
-/// skips the noise calibration (the cross-validation folds need only means). InputError on bad
-/// tables.
+/// Fewest rows `c` can be fitted and judged on with `inputs` used inputs: a linear fit its
+/// 1 + inputs coefficients and 2 more (a residual degree of freedom after the leave-one-out), a
+/// GP its mean's coefficients and 2 more, a network 4.
+int MinimumRows(const Candidate& c, int inputs);
+
+/// Fits `candidate` on all rows of `table` (targets required, at least MinimumRows rows; the
+/// InputError counts the table's rows); `calibrate` = false skips the noise calibration (the
+/// cross-validation folds need only means). InputError on bad tables.
 FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
                          const FitOptions& options, bool calibrate = true);
 
@@ -140,8 +163,10 @@ Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
 
 /// ChoiceOptions::one_standard_error for one output: squared_errors[c] holds candidate c's
 /// squared held-out errors per row (candidates from the simplest); returns the first c with
-/// mean(d) <= sd(d) / sqrt(n), d = squared_errors[c] - squared_errors[b], b the lowest mean.
-/// InputError without candidates.
+/// mean(d) <= sd(d) / sqrt(n), d = squared_errors[c] - squared_errors[b], b the lowest mean,
+/// whose mean is not above that of a simpler candidate (a candidate worse than a simpler one is
+/// never preferred to it, even when its differences to b are noisier). InputError without
+/// candidates.
 int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors);
 
 /// How far apart two fits of output k are on the training rows, in sd of the output: the RMS over
@@ -181,63 +206,63 @@ struct ChoiceOptions {
   /// low (scripts/bench_peers.sh, simulator tables: the power law lost to a GP chosen by CV).
   /// Applies to per_output choices.
   bool one_standard_error = true;
-  /// Linear and GP candidates are fitted once on all rows; their held-out errors come from
-  ///   true (default): closed-form leave-one-out at the full fit (family/linear.h, exact;
-  ///     gp/gp.h, exact for the full fit's hyperparameters, which have seen the held-out row);
-  ///     the chosen candidates are then calibrated by FitOptions::calibration_folds;
-  ///   false: K-fold refits of that fit (a GP from its hyperparameters, one start; the held-out
-  ///     residuals also calibrate the noise when calibration_folds == folds).
+  /// Held-out errors of linear and GP candidates, each fitted once on all rows:
+  ///   true (default): linear candidates by their closed-form leave-one-out (family/linear.h,
+  ///     exact); GP candidates below few_rows by K-fold refits whose hyperparameters are
+  ///     refitted from gp::GpOptions' fixed starting points (none has seen the held-out rows),
+  ///     from few_rows on by their closed-form leave-one-out (gp/gp.h, exact for the full fit's
+  ///     hyperparameters, which have seen the held-out row);
+  ///   false: K-fold refits for both (a GP's hyperparameters refitted from the fixed starts).
   /// Networks are always refitted per fold (from their initialization).
-  /// Why leave-one-out (scripts/bench_peers.sh, 20 seeds, median test RMSE out1 / out2, K-fold
-  /// against leave-one-out): Friedman 20 rows 2.91 / 9.78 against 2.88 / 7.67, 100 rows
-  /// 0.805 / 2.42 against 0.805 / 2.47; simulator tables of 20 rows 1.056 / 2.89 against
-  /// 1.094 / 2.85, 100 rows 0.940 / 2.54 against 0.939 / 2.49; the shipped 20-row table
-  /// 1.107 / 3.064 against 1.039 / 3.064; and 3-4x less CPU (20 rows: 4.4 against 1.2 ms).
+  /// Why refits for GPs at few rows: a GP's closed-form leave-one-out error is exact only for
+  /// hyperparameters fitted with the held-out row (Cawley & Talbot, "On over-fitting in model
+  /// selection and subsequent selection bias in performance evaluation", JMLR 11, 2010); on the
+  /// tuning part of scripts/bench_peers.sh (20 rows) the default took GPs that lost to the power
+  /// law on power-law tables (+31 % median test RMSE for settle time) and the refits brought it
+  /// to the power law's (docs/workpiece-model.md).
   bool closed_form_loo = true;
+  /// Few rows for a GP: fewer than kRowsPerHyperparameter rows per hyperparameter of the ARD
+  /// kernel on the five inputs (7: 70 rows; the rule of thumb of 10, Harrell, "Regression
+  /// Modeling Strategies", 2nd ed., section 4.4). Below it GP held-out errors come from refits
+  /// (closed_form_loo); a table whose refit splits hold fewer rows than a linear fit needs
+  /// (5 inputs: 8 rows, so tables of 8 and 9 rows) leaves the GP candidates out, and
+  /// Choice::rows_note says so.
+  int few_rows = 70;
+  static constexpr int kRowsPerHyperparameter = 10;
   /// true: per output a convex combination of the candidates (ConvexStackWeights of their
   /// held-out predictions, original units) instead of one candidate; the one-standard-error rule
   /// is then not applied. Each candidate with a positive weight is refitted and calibrated on its
   /// own; the combination's sd is sqrt(sum_c w_c sd_c^2), an upper bound of the sd of
   /// sum_c w_c e_c for any correlation of the candidates' errors e_c (Minkowski, then Jensen).
+  /// Off by default: on the tuning part it made the power-law tables' settle time 37-99 % worse
+  /// (docs/workpiece-model.md).
   bool stack = false;
-  /// Practical equivalence at few rows (per-output choices without `stack`): if output k's choice
-  /// is a GP fitted with fewer than kRowsPerHyperparameter rows per hyperparameter
-  /// (FittedHyperparameters: 20 rows against 70 for an ARD kernel on 5 inputs) that spends more
-  /// degrees of freedom than the linear fit (gp::EffectiveDegreesOfFreedom above 1 + inputs: not
-  /// a shrunk linear fit but a bent one) on a fit that differs from the linear candidate's on the
-  /// same columns by less than equivalence_sd sd of the output (FitDifferenceInSd, both fitted on
-  /// all rows), the GP must earn its place honestly: refitted on `folds` folds (hyperparameters
-  /// refitted per fold from the fixed starting points of gp::GpOptions, so none has seen the
-  /// held-out rows), its held-out squared errors must beat those of the linear candidates' own
-  /// choice (the one-standard-error rule among them) by more than one standard error
+  /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
+  /// default since GP held-out errors at few rows come from refits, which it duplicates): if
+  /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
+  /// hyperparameter (FittedHyperparameters) that spends more degrees of freedom than the linear
+  /// fit (gp::EffectiveDegreesOfFreedom above 1 + inputs) on a fit that differs from the linear
+  /// candidate's on the same columns by less than equivalence_sd sd of the output
+  /// (FitDifferenceInSd), the GP, refitted on `folds` folds from the fixed starting points, must
+  /// beat the linear candidates' own choice by more than one standard error
   /// (SimplestWithinOneStandardError); else output k takes that linear candidate and
-  /// Choice::notes says why. The refits need 8 rows in every training split (smaller tables keep
-  /// their choice). 0 disables the rule.
-  /// Why: at 20 rows the closed-form leave-one-out error of a GP is exact only for
-  /// hyperparameters that were fitted with the held-out row (Cawley & Talbot, "On over-fitting in
-  /// model selection and subsequent selection bias in performance evaluation", JMLR 11, 2010):
-  /// on generated 20-row simulator tables it chose GPs that were power laws with a small bend and
-  /// lost to the power law on new rows. Only near-linear GPs are checked, because refits of 16
-  /// rows also penalize a GP that is right about a strong nonlinearity, and the checks cost
-  /// refits. Rows per parameter: the rule of thumb of 10 (Harrell, "Regression Modeling
-  /// Strategies", 2nd ed., section 4.4). Measured with scripts/bench_peers.sh and
-  /// tests/family/bend_probe.cpp (docs/workpiece-model.md, "Practical equivalence at few rows").
-  double equivalence_sd = 0.1;
-  static constexpr int kRowsPerHyperparameter = 10;
+  /// Choice::notes says why. The refits need 8 rows in every training split.
+  double equivalence_sd = 0;
   FitOptions fit;
+  /// Called from the fitting threads (one at a time) after each candidate's fit or fold and after
+  /// the final fits: `done` of `total` steps and what was just done. Empty: none.
+  std::function<void(int done, int total, const std::string& step)> progress;
   /// From the simplest (ChoiceOptions::one_standard_error): linear/log (the power law),
-  /// linear/identity, gp-se-iso-constant/identity (one length scale: 3 hyperparameters),
-  /// gp-matern52-constant/log, gp-matern52-constant/identity (ARD: 7). The isotropic GP on raw
-  /// columns (scripts/bench_peers.sh, 20 seeds, median test RMSE out1 / out2): Friedman 100 rows
-  /// 0.805 / 2.202 against 0.805 / 2.471, 20 rows 2.806 / 7.539 against 2.865 / 7.670, every
-  /// simulator median unchanged; the isotropic GP on log columns as well made the simulator's
-  /// 20-row tables worse (shipped table out1 1.106 against 1.039: its leave-one-out error beat
-  /// the power law's by more than one standard error, its test error did not). Measured with
-  /// scripts/bench_peers.sh (20 seeds, median test RMSE out1 / out2, without the one-standard-
-  /// error rule): adding the trainbr network (network-evidence/log) changed no median by more
-  /// than 1 % and costs 4-70 ms per fit; the squared-exponential kernel instead of Matern 5/2
-  /// was better on Friedman 100 rows (out2 2.24 against 2.47) and worse on the simulator's
-  /// 20-row tables (out2 3.11 against 2.85), both kernels together worse on those (3.11).
+  /// linear/identity, gp-se-iso-constant/identity (one length scale: 3 hyperparameters; only
+  /// below few_rows), gp-matern52-linear/log (a GP whose mean is a power law: it is the power
+  /// law when the data hold no more, R&W section 2.7), gp-matern52-constant/identity (ARD: 7
+  /// hyperparameters). Measured on the tuning part of scripts/bench_peers.sh (median test RMSE
+  /// against the best of the power law, GP-ARD and the networks; docs/workpiece-model.md): the
+  /// power-law mean instead of a constant one on log columns brought power-law tables of 100
+  /// rows from +15 % to the power law's own error; the trainbr network (network-evidence/
+  /// identity) as a sixth candidate was never chosen on the tuning part and cost 40-300 ms per
+  /// fit; a squared-exponential ARD kernel on raw columns, or a linear-mean GP on raw columns as
+  /// well, changed the medians by less than their spread between variants and cost time.
   static std::vector<Candidate> DefaultCandidates();
 };
 
@@ -252,13 +277,21 @@ struct Choice {
   /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight); empty: output
   /// k is models[model_of_output[k]] alone.
   std::array<std::vector<double>, Features::kCount> weights;
-  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none. Printed by `whirl train` (and in its --json), not stored in the model file.
+  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
+  /// Printed by `whirl train` (and in its --json), not stored in the model file.
   std::array<std::string, Features::kCount> notes;
+  /// What the choice did about the table that the user should know: inputs left out because they
+  /// are constant, columns a log candidate keeps on their raw scale (a value <= 0 or near zero,
+  /// LogExceptions). Printed by `whirl train` as warnings (and in its --json), not stored.
+  std::vector<std::string> warnings;
+  /// Why some candidates sat out (ChoiceOptions::few_rows); empty if none did. Printed by
+  /// `whirl train`, not stored.
+  std::string rows_note;
   std::string Describe()
       const;  ///< "max_elongation_um: linear/log, settle_time_s: gp-se-constant/log"
 };
-/// The choice of the header comment. InputError if the table has no targets or fewer than 4
-/// rows, or if there are no candidates.
+/// The choice of the header comment. InputError if the table has no targets or fewer rows than a
+/// candidate's MinimumRows (counting the table's rows), or if there are no candidates.
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
 /// Output k from models[model_of_output[k]] (mean and sd), or for a stacked output the weighted
 /// mean sum_j w_j mean_j and sd sqrt(sum_j w_j sd_j^2) (ChoiceOptions::stack).
@@ -271,7 +304,9 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
 // refactorized) and throws InputError naming the key and the rule.
 //   FamilyModel: {"candidate": Candidate::Name(), "transform", "calibration",
 //                 "linears" | "gps" | "network": one fit per output (a network: nn/model.h)}
-//   CvRow:       {"candidate", "cv_rmse" (per output, original units), "score", "fit_ms"}
+//   CvRow:       {"candidate", "cv_rmse" (per output, original units), "score"} (fit_ms is not
+//                stored, so that the same table and seed give the same file byte for byte; files
+//                of earlier versions that hold it load)
 //   Choice:      {"describe": Describe(), "table": [CvRow], "chosen", "model_of_output",
 //                 "models": [FamilyModel]}; the model of output k must be the candidate chosen
 //                 for it.

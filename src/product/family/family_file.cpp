@@ -13,35 +13,36 @@ namespace {
 
 using nlohmann::json;
 
-const json& Key(const json& j, const char* key, const std::string& what) {
-  if (!j.is_object() || !j.contains(key))
-    throw InputError(what + ": missing key '" + std::string(key) + "'");
-  return j.at(key);
-}
-
 template <typename T>
 std::vector<T> Fits(const json& j, const char* key, const std::string& what) {
-  const json& a = Key(j, key, what);
+  const json& a = RequireKey(j, key, what);
   if (!a.is_array() || a.size() != static_cast<std::size_t>(Features::kCount))
     throw InputError(what + ": '" + key + "' must hold one fit per output (" +
                      std::to_string(Features::kCount) + ")");
   std::vector<T> out;
-  for (const json& e : a) out.push_back(e.get<T>());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    try {
+      out.push_back(a[k].get<T>());
+    } catch (const InputError& e) {
+      throw InputError(what + ": '" + key + "'[" + std::to_string(k) + "] (" + kTargetColumns[k] +
+                       "): " + e.what());
+    }
+  }
   return out;
 }
 
-// Every per-output fit takes the five inputs.
+// Every per-output fit takes the inputs the transform uses.
 template <typename T>
-void CheckInputCount(const std::vector<T>& fits, const std::string& what) {
+void CheckInputCount(const std::vector<T>& fits, const TableTransform& t, const std::string& what) {
   for (const T& f : fits)
-    if (f.input_shift.size() != ProcessInputs::kCount)
+    if (f.input_shift.size() != t.UsedInputCount())
       throw InputError(what + ": a fit has " + std::to_string(f.input_shift.size()) +
-                       " inputs, expected " + std::to_string(ProcessInputs::kCount));
+                       " inputs, the transform uses " + std::to_string(t.UsedInputCount()));
 }
 
 std::array<int, Features::kCount> Indices(const json& j, const char* key, int count,
                                           const std::string& what) {
-  const json& a = Key(j, key, what);
+  const json& a = RequireKey(j, key, what);
   std::array<int, Features::kCount> out{};
   if (!a.is_array() || a.size() != out.size())
     throw InputError(what + ": '" + key + "' must hold one index per output");
@@ -67,43 +68,47 @@ void to_json(json& j, const FamilyModel& m) {
 
 void from_json(const json& j, FamilyModel& m) {
   const std::string what = "family model";
-  const json& name = Key(j, "candidate", what);
+  const json& name = RequireKey(j, "candidate", what);
   if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
   m.candidate = ParseCandidate(name.get<std::string>());
-  m.transform = Key(j, "transform", what).get<TableTransform>();
-  if (m.transform.IsIdentity() == m.candidate.log)
-    throw InputError(what + ": 'transform' disagrees with the candidate " + m.candidate.Name());
-  const json& calibration = Key(j, "calibration", what);
+  m.transform = RequireKey(j, "transform", what).get<TableTransform>();
+  if (!m.transform.IsIdentity() && !m.candidate.log)
+    throw InputError(what + ": 'transform' (" + m.transform.Describe() +
+                     ") disagrees with the candidate " + m.candidate.Name());
+  const json& calibration = RequireKey(j, "calibration", what);
   if (!calibration.is_string()) throw InputError(what + ": 'calibration' must be a string");
   m.calibration = calibration.get<std::string>();
   m.linears.clear();
   m.gps.clear();
   if (m.candidate.family == Family::kLinear) {
     m.linears = Fits<LinearModel>(j, "linears", what);
-    CheckInputCount(m.linears, what);
+    CheckInputCount(m.linears, m.transform, what);
   } else if (m.candidate.family == Family::kGaussianProcess) {
     m.gps = Fits<gp::Gp>(j, "gps", what);
-    CheckInputCount(m.gps, what);
+    CheckInputCount(m.gps, m.transform, what);
   } else {
-    m.network = Key(j, "network", what).get<nn::Model>();
+    m.network = RequireKey(j, "network", what).get<nn::Model>();
   }
 }
 
 void from_json(const json& j, CvRow& r) {
   const std::string what = "choice table row";
-  const json& name = Key(j, "candidate", what);
+  const json& name = RequireKey(j, "candidate", what);
   if (!name.is_string()) throw InputError(what + ": 'candidate' must be a string");
   r.candidate = ParseCandidate(name.get<std::string>());
-  const json& rmse = Key(j, "cv_rmse", what);
+  const json& rmse = RequireKey(j, "cv_rmse", what);
   if (!rmse.is_array() || rmse.size() != static_cast<std::size_t>(Features::kCount))
     throw InputError(what + ": 'cv_rmse' must hold one value per output");
   r.cv_rmse.resize(Features::kCount);
+  // Held-out RMSE in the output's units and a sum of MSE / variance: >= 0 and far below what
+  // overflows (a table's RMSE is at most the output's range, core/limits.h).
+  constexpr Range kErrorRange{0, 1e12, false, "", "a held-out error"};
   for (int k = 0; k < Features::kCount; ++k) {
-    if (!rmse[k].is_number()) throw InputError(what + ": 'cv_rmse' must hold numbers");
-    r.cv_rmse(k) = rmse[k].get<double>();
+    r.cv_rmse(k) = RequireFiniteValue(rmse[k], what + ": 'cv_rmse'[" + std::to_string(k) + "]");
+    CheckRange(r.cv_rmse(k), kErrorRange, "cv_rmse[" + std::to_string(k) + "]", what);
   }
-  r.score = RequireNumber(j, "score", what);
-  r.fit_ms = RequireNumber(j, "fit_ms", what);
+  r.score = RequireNumberIn(j, "score", kErrorRange, what);
+  if (j.contains("fit_ms")) r.fit_ms = RequireNumber(j, "fit_ms", what);
 }
 
 void to_json(json& j, const Choice& c) {
@@ -149,15 +154,22 @@ void ReadWeights(const json& j, const std::string& what, Choice* c) {
 
 void from_json(const json& j, Choice& c) {
   const std::string what = "family choice";
-  const json& table = Key(j, "table", what);
-  const json& models = Key(j, "models", what);
+  const json& table = RequireKey(j, "table", what);
+  const json& models = RequireKey(j, "models", what);
   if (!table.is_array() || table.empty() || !models.is_array() || models.empty() ||
       models.size() > std::max<std::size_t>(Features::kCount, table.size()))
     throw InputError(what + ": 'table' must be a non-empty array and 'models' hold 1 to " +
                      std::to_string(Features::kCount) + " models (a stack: up to one per row " +
                      "of 'table')");
   c.table = table.get<std::vector<CvRow>>();
-  c.models = models.get<std::vector<FamilyModel>>();
+  c.models.clear();
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    try {
+      c.models.push_back(models[i].get<FamilyModel>());
+    } catch (const InputError& e) {
+      throw InputError(what + ": 'models'[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
   c.chosen = Indices(j, "chosen", static_cast<int>(c.table.size()), what);
   c.model_of_output = Indices(j, "model_of_output", static_cast<int>(c.models.size()), what);
   for (int k = 0; k < Features::kCount; ++k) {

@@ -28,6 +28,19 @@ Eigen::VectorXd ToVector(const nlohmann::json& j, const char* key) {
   return ToVector(RequireKey(j, key, "linear model"), std::string("linear model: '") + key + "'");
 }
 
+// Rules of a linear fit's numbers in a file: wide enough for any fit of whirl's tables
+// (transformed units), narrow enough that no prediction overflows.
+constexpr Range kShiftRange{-1e7, 1e7, false, "", "a mean of transformed inputs"};
+constexpr Range kScaleRange{0, 1e7, true, "", "an sd of transformed inputs"};
+constexpr Range kCoefRange{-1e9, 1e9, false, "", "units of the transformed output"};
+constexpr Range kAtaInvRange{-1e9, 1e9, false, "", "(A'A)^-1 of standardized inputs"};
+constexpr Range kVarianceRange{0, 1e14, false, "", "units of the transformed output squared"};
+
+void CheckEach(const Eigen::VectorXd& v, const Range& range, const std::string& key) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    CheckRange(v(i), range, key + "[" + std::to_string(i) + "]", "linear model");
+}
+
 std::vector<double> ToStd(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
@@ -94,10 +107,13 @@ void from_json(const nlohmann::json& j, LinearModel& m) {
   m.input_scale = ToVector(j, "input_scale");
   m.coef = ToVector(j, "coef");
   const Eigen::Index p = m.coef.size();
-  if (m.input_scale.size() != m.input_shift.size() || p != m.input_shift.size() + 1 ||
-      !(m.input_scale.array() > 0).all())
+  if (m.input_scale.size() != m.input_shift.size() || p != m.input_shift.size() + 1 || p < 2)
     throw InputError(
-        "linear model: 'input_scale' (> 0) and 'coef' (inputs + 1) must match 'input_shift'");
+        "linear model: 'input_scale' (one per input) and 'coef' (inputs + 1) must match "
+        "'input_shift' (at least one input)");
+  CheckEach(m.input_shift, kShiftRange, "input_shift");
+  CheckEach(m.input_scale, kScaleRange, "input_scale");
+  CheckEach(m.coef, kCoefRange, "coef");
   if (!j.contains("ata_inv") || !j.at("ata_inv").is_array() ||
       j.at("ata_inv").size() != static_cast<std::size_t>(p))
     throw InputError("linear model: 'ata_inv' must hold " + std::to_string(p) + " rows");
@@ -107,13 +123,12 @@ void from_json(const nlohmann::json& j, LinearModel& m) {
         ToVector(j.at("ata_inv")[r], "linear model: 'ata_inv[" + std::to_string(r) + "]'");
     if (row.size() != p)
       throw InputError("linear model: 'ata_inv' rows must hold " + std::to_string(p) + " values");
+    CheckEach(row, kAtaInvRange, "ata_inv[" + std::to_string(r) + "]");
     m.ata_inv.row(r) = row.transpose();
   }
-  for (const char* key : {"fitted_noise_variance", "noise_variance"})
-    if (!j.contains(key) || !j.at(key).is_number() || !(j.at(key).get<double>() >= 0))
-      throw InputError(std::string("linear model: '") + key + "' must be a number >= 0");
-  m.fitted_noise_variance = j.at("fitted_noise_variance").get<double>();
-  m.noise_variance = j.at("noise_variance").get<double>();
+  m.fitted_noise_variance =
+      RequireNumberIn(j, "fitted_noise_variance", kVarianceRange, "linear model");
+  m.noise_variance = RequireNumberIn(j, "noise_variance", kVarianceRange, "linear model");
 }
 
 }  // namespace whirl::family

@@ -1,5 +1,7 @@
 #include "gp/gp.h"
 
+#include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -13,6 +15,29 @@ namespace {
 constexpr double kSqrt5 = 2.2360679774997896964;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// KernelMatrices for K(z, z): the element-wise functions of the squared distances r2 on the
+// lower triangle (column by column, vectorized), then mirrored.
+void SymmetricKernel(Kernel kernel, const Eigen::MatrixXd& r2, double sf2, Eigen::MatrixXd* kf,
+                     Eigen::MatrixXd* g) {
+  const Eigen::Index n = r2.cols();
+  kf->resize(n, n);
+  if (g) g->resize(n, n);
+  for (Eigen::Index q = 0; q < n; ++q) {
+    const Eigen::Index m = n - q;
+    const Eigen::ArrayXd s2 = r2.col(q).tail(m).array();
+    if (kernel == Kernel::kSquaredExponential) {
+      kf->col(q).tail(m) = (sf2 * (-0.5 * s2).exp()).matrix();
+      if (g) g->col(q).tail(m) = kf->col(q).tail(m);
+      continue;
+    }
+    const Eigen::ArrayXd r = s2.sqrt(), e = (-kSqrt5 * r).exp();
+    kf->col(q).tail(m) = (sf2 * (1.0 + kSqrt5 * r + (5.0 / 3.0) * s2) * e).matrix();
+    if (g) g->col(q).tail(m) = (sf2 * (5.0 / 3.0) * (1.0 + kSqrt5 * r) * e).matrix();
+  }
+  kf->triangularView<Eigen::StrictlyUpper>() = kf->transpose();
+  if (g) g->triangularView<Eigen::StrictlyUpper>() = g->transpose();
+}
+
 // Kernel values K_f(p, q) and, in g, the factor with dK_f/d ln l_i = g * (dz_i / l_i)^2.
 void KernelMatrices(Kernel kernel, const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                     const Eigen::VectorXd& length, double sf2, Eigen::MatrixXd* kf,
@@ -23,6 +48,7 @@ void KernelMatrices(Kernel kernel, const Eigen::MatrixXd& a, const Eigen::Matrix
       (-2.0 * as.transpose() * bs).colwise() + as.colwise().squaredNorm().transpose();
   r2.rowwise() += bs.colwise().squaredNorm();
   r2 = r2.cwiseMax(0.0);
+  if (&a == &b) return SymmetricKernel(kernel, r2, sf2, kf, g);
   if (kernel == Kernel::kSquaredExponential) {
     *kf = sf2 * (-0.5 * r2.array()).exp().matrix();
     if (g) *g = *kf;
@@ -69,12 +95,34 @@ bool Factor(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::Vec
   return f->alpha.allFinite();
 }
 
+// K^-1 from K = L L' in about 2n^3/3 flops: the triangular inverse X = L^-1 block column by
+// block column (column block j of X is zero above row j), then K^-1 = X' X by rank updates (row
+// block i of X is zero right of its diagonal block); solving with the identity takes 2n^3.
+Eigen::MatrixXd InverseFromCholesky(const Eigen::LLT<Eigen::MatrixXd>& chol) {
+  constexpr Eigen::Index kBlock = 32;
+  const Eigen::Index n = chol.rows();
+  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index j = 0; j < n; j += kBlock) {
+    const Eigen::Index b = std::min(kBlock, n - j), m = n - j;
+    auto block = x.block(j, j, m, b);
+    block.topRows(b).setIdentity();
+    chol.matrixLLT().bottomRightCorner(m, m).triangularView<Eigen::Lower>().solveInPlace(block);
+  }
+  Eigen::MatrixXd k_inv = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < n; i += kBlock) {
+    const Eigen::Index b = std::min(kBlock, n - i), c = i + b;
+    k_inv.topLeftCorner(c, c).selfadjointView<Eigen::Lower>().rankUpdate(
+        x.block(i, 0, b, c).transpose());
+  }
+  k_inv.triangularView<Eigen::StrictlyUpper>() = k_inv.transpose();
+  return k_inv;
+}
+
 // -tr(W dK/dtheta_j) / 2 for every j, W = alpha alpha' - K^-1 (R&W eq. 5.9).
 Eigen::VectorXd Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn2_dtheta,
                          const Factors& f) {
   const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
-  const Eigen::MatrixXd w =
-      f.alpha * f.alpha.transpose() - f.chol.solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::MatrixXd w = f.alpha * f.alpha.transpose() - InverseFromCholesky(f.chol);
   const Eigen::MatrixXd wg = w.cwiseProduct(f.g);
   Eigen::VectorXd grad(d + 2);
   for (int i = 0; i < d; ++i) {
@@ -120,25 +168,43 @@ Gp Standardized(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOpti
   return gp;
 }
 
-// Fixed starting points (length scale in standardized units, noise sd), signal sd 1.
-Eigen::VectorXd StartPoint(int index, int d) {
-  static const double kLength[kStartCount] = {1.0, 0.5, 2.0, 0.25};
-  static const double kNoise[kStartCount] = {0.1, 0.3, 0.03, 0.5};
-  Eigen::VectorXd theta(d + 2);
-  theta.head(d).setConstant(std::log(kLength[index] * std::sqrt(static_cast<double>(d))));
-  theta(d) = 0.0;
-  theta(d + 1) = std::log(kNoise[index]);
-  return theta;
+// Starting points (GpOptions::restarts): the first in standardized target units (signal sd 1,
+// noise sd 0.1, length scales sqrt(d)); the second scaled to what the mean's least-squares fit
+// leaves of the standardized targets (sd s: small where a power-law mean fits well): signal sd s,
+// noise sd 0.1 s, length scales 2 sqrt(d); then two more of the first kind.
+std::vector<Eigen::VectorXd> StartPoints(const Gp& gp, int count) {
+  static const double kLength[kStartCount] = {1.0, 2.0, 0.5, 0.25};
+  static const double kNoise[kStartCount] = {0.1, 0.1, 0.3, 0.5};
+  const int d = gp.InputCount();
+  const Eigen::MatrixXd h = Basis(gp.mean, gp.z);
+  const Eigen::VectorXd left = gp.u - h * h.colPivHouseholderQr().solve(gp.u);
+  const double s = std::sqrt(std::max(left.squaredNorm() / static_cast<double>(gp.u.size()), 1e-6));
+  std::vector<Eigen::VectorXd> starts;
+  for (int index = 0; index < count; ++index) {
+    const double scale = index == 1 ? s : 1.0;
+    Eigen::VectorXd theta(d + 2);
+    theta.head(d).setConstant(std::log(kLength[index] * std::sqrt(static_cast<double>(d))));
+    theta(d) = std::log(scale);
+    theta(d + 1) = std::log(kNoise[index] * scale);
+    starts.push_back(theta);
+  }
+  return starts;
 }
 
 // Minimizes NLML from each start; fills gp->theta with the best.
 void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp* gp,
               GpSummary* summary) {
-  const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
-    return NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t, gp->min_noise_variance,
-                                    grad);
-  };
   const int d = gp->InputCount();
+  const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
+    double v = NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t,
+                                        gp->min_noise_variance, grad);
+    if (o.length_prior_sd > 0 && std::isfinite(v)) {
+      const Eigen::ArrayXd dev = (t.head(d).array() - LengthPriorMean(d)) / o.length_prior_sd;
+      v += 0.5 * dev.square().sum();
+      if (grad) grad->head(d).array() += dev / o.length_prior_sd;
+    }
+    return v;
+  };
   // Isotropic: (ln l, ln s_f, ln s_n) <-> theta with d equal length scales.
   const auto expand = [d](const Eigen::VectorXd& t3) {
     Eigen::VectorXd t(d + 2);
@@ -157,13 +223,15 @@ void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp
   };
   GpSummary s;
   s.nlml = kInf;
-  for (const Eigen::VectorXd& start : starts) {
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    const Eigen::VectorXd& start = starts[i];
     Eigen::VectorXd t = start;
     if (o.isotropic) t = Eigen::Vector3d(start.head(d).mean(), start(d), start(d + 1));
-    const BfgsSummary b = MinimizeBfgs(o.isotropic ? f_iso : f, &t, o.bfgs);
+    const BfgsSummary b = MinimizeBfgs(o.isotropic ? f_iso : f, &t,
+                                       gp->u.size() < o.single_start_rows ? o.bfgs : o.bfgs_large);
     if (o.isotropic) t = expand(t);
     s.start_nlml.push_back(b.final_cost);
-    if (b.final_cost < s.nlml || gp->theta.size() == 0) {
+    if (b.final_cost < s.nlml || i == 0) {
       s.nlml = b.final_cost;
       s.optimizer = b;
       gp->theta = t;
@@ -172,12 +240,37 @@ void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp
   if (summary) *summary = s;
 }
 
+// m rows of n spread evenly by index: floor(j n / m), j = 0..m-1 (all rows if m <= 0 or m >= n).
+std::vector<int> EvenRows(int n, int m) {
+  std::vector<int> rows;
+  if (m <= 0 || m >= n) return rows;
+  for (int j = 0; j < m; ++j)
+    rows.push_back(static_cast<int>(static_cast<long long>(j) * n / m));
+  return rows;
+}
+
+// gp restricted to `rows` (its standardization kept).
+Gp RowsOf(const Gp& gp, const std::vector<int>& rows) {
+  Gp sub = gp;
+  sub.z = gp.z(Eigen::all, rows);
+  sub.u = gp.u(rows);
+  return sub;
+}
+
+// `starts` empty: StartPoints of the (subset of) standardized data.
 Gp FitFromStarts(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& o,
                  const std::vector<Eigen::VectorXd>& starts, GpSummary* summary) {
   o.Validate();
   ValidateData(x, y, o.mean);
+  const int n = static_cast<int>(y.size());
   Gp gp = Standardized(x, y, o);
-  Optimize(o, starts, &gp, summary);
+  gp.rows = EvenRows(n, o.max_rows);
+  if (!gp.rows.empty()) gp = RowsOf(gp, gp.rows);
+  const std::vector<int> hyper = EvenRows(static_cast<int>(gp.u.size()), o.hyperparameter_rows);
+  Gp sub = hyper.empty() ? gp : RowsOf(gp, hyper);
+  const int count = static_cast<int>(sub.u.size()) < o.single_start_rows ? o.restarts : 1;
+  Optimize(o, starts.empty() ? StartPoints(sub, count) : starts, &sub, summary);
+  gp.theta = sub.theta;
   gp.noise_variance = gp.SigmaN2();
   gp.Factorize();
   return gp;
@@ -191,6 +284,22 @@ Eigen::VectorXd ArrayToVector(const nlohmann::json& a, const std::string& name) 
 
 Eigen::VectorXd JsonVector(const nlohmann::json& j, const char* key) {
   return ArrayToVector(RequireKey(j, key, "gaussian process"), key);
+}
+
+// Rules of a GP file's numbers: wide enough for any fit of whirl's tables, narrow enough that
+// no prediction overflows (every value a fit writes is checked against them before it is saved).
+constexpr Range kShiftRange{-1e7, 1e7, false, "", "a mean of transformed inputs or outputs"};
+constexpr Range kScaleRange{0, 1e7, true, "", "an sd of transformed inputs or outputs"};
+constexpr Range kThetaRange{-30, 30, false, "",
+                            "the natural log of a length scale or sd, standardized units"};
+constexpr Range kNoiseRange{0, 1e4, false, "",
+                            "standardized target units: at most 100 times the training sd"};
+constexpr Range kMinNoiseRange{1e-12, 1, false, "", "standardized target units"};
+constexpr Range kStandardizedRange{-1e6, 1e6, false, "", "standardized units"};
+
+void CheckEach(const Eigen::VectorXd& v, const Range& range, const std::string& key) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    CheckRange(v(i), range, key + "[" + std::to_string(i) + "]", "gaussian process");
 }
 
 }  // namespace
@@ -211,12 +320,27 @@ Mean ParseMean(const std::string& s) {
 }
 
 void GpOptions::Validate() const {
+  if (single_start_rows < 0)
+    throw InputError("gaussian process single_start_rows " + std::to_string(single_start_rows) +
+                     ": must be >= 0");
   if (restarts < 1 || restarts > kStartCount)
     throw InputError("gaussian process restarts " + std::to_string(restarts) + ": must be in 1.." +
                      std::to_string(kStartCount));
+  if (!(length_prior_sd >= 0) || !std::isfinite(length_prior_sd))
+    throw InputError("gaussian process length_prior_sd " + MessageNumber(length_prior_sd) +
+                     ": must be finite and >= 0");
   if (!(min_noise_variance > 0) || !std::isfinite(min_noise_variance))
     throw InputError("gaussian process min_noise_variance " + MessageNumber(min_noise_variance) +
                      ": must be a finite number > 0");
+  if (max_rows < 0 || hyperparameter_rows < 0 || (max_rows > 0 && max_rows < 8) ||
+      (hyperparameter_rows > 0 && hyperparameter_rows < 8))
+    throw InputError("gaussian process max_rows " + std::to_string(max_rows) +
+                     " and hyperparameter_rows " + std::to_string(hyperparameter_rows) +
+                     ": each must be 0 (all rows) or at least 8");
+}
+
+double LengthPriorMean(int d) {
+  return std::sqrt(2.0) + 0.5 * std::log(static_cast<double>(d)) + 0.5 * std::log(12.0);
 }
 
 int MeanSize(Mean mean, int inputs) { return mean == Mean::kConstant ? 1 : 1 + inputs; }
@@ -258,10 +382,7 @@ std::string GpSummary::BriefReport() const {
 
 Gp FitGp(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
          GpSummary* summary) {
-  std::vector<Eigen::VectorXd> starts;
-  for (int i = 0; i < options.restarts; ++i)
-    starts.push_back(StartPoint(i, static_cast<int>(x.rows())));
-  return FitFromStarts(x, y, options, starts, summary);
+  return FitFromStarts(x, y, options, {}, summary);  // StartPoints
 }
 
 Gp FitGpFrom(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOptions& options,
@@ -302,8 +423,7 @@ GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x) {
 
 // The diagonal of P = K^-1 - K^-1 H (H' K^-1 H)^-1 H' K^-1 (the header's leave-one-out comment).
 Eigen::ArrayXd ProjectionDiagonal(const Gp& gp) {
-  const int n = static_cast<int>(gp.u.size());
-  const Eigen::MatrixXd k_inv = gp.chol.solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::MatrixXd k_inv = InverseFromCholesky(gp.chol);
   const Eigen::MatrixXd ah = gp.a_chol.matrixL().solve(gp.k_inv_h.transpose());  // m x n
   return k_inv.diagonal().array() - ah.colwise().squaredNorm().transpose().array();
 }
@@ -357,11 +477,17 @@ void from_json(const nlohmann::json& j, Gp& gp) {
   gp.min_noise_variance = RequireNumber(j, "min_noise_variance", what);
   gp.noise_variance = RequireNumber(j, "noise_variance", what);
   const auto d = gp.input_shift.size();
-  if (gp.input_scale.size() != d || gp.theta.size() != d + 2 || !(gp.input_scale.array() > 0).all())
-    throw InputError(what + ": input_scale (> 0) and theta (inputs + 2) must match input_shift");
-  if (!(gp.target_scale > 0) || !(gp.min_noise_variance > 0) || !(gp.noise_variance >= 0))
-    throw InputError(what +
-                     ": target_scale and min_noise_variance must be > 0, noise_variance >= 0");
+  if (gp.input_scale.size() != d || gp.theta.size() != d + 2 || d == 0)
+    throw InputError(what + ": 'input_scale' (one per input) and 'theta' (inputs + 2) must match "
+                            "'input_shift' (at least one input)");
+  CheckEach(gp.input_shift, kShiftRange, "input_shift");
+  CheckEach(gp.input_scale, kScaleRange, "input_scale");
+  CheckEach(gp.theta, kThetaRange, "theta");
+  CheckEach(gp.u, kStandardizedRange, "targets_standardized");
+  CheckRange(gp.target_shift, kShiftRange, "target_shift", what);
+  CheckRange(gp.target_scale, kScaleRange, "target_scale", what);
+  CheckRange(gp.min_noise_variance, kMinNoiseRange, "min_noise_variance", what);
+  CheckRange(gp.noise_variance, kNoiseRange, "noise_variance", what);
   if (!j.contains("inputs_standardized") || !j.at("inputs_standardized").is_array() ||
       j.at("inputs_standardized").size() != static_cast<std::size_t>(gp.u.size()))
     throw InputError(what + ": 'inputs_standardized' must hold one row per target");
@@ -370,6 +496,7 @@ void from_json(const nlohmann::json& j, Gp& gp) {
     const std::string name = "inputs_standardized[" + std::to_string(q) + "]";
     const Eigen::VectorXd row = ArrayToVector(j.at("inputs_standardized")[q], name);
     if (row.size() != d) throw InputError(what + ": '" + name + "' must hold one value per input");
+    CheckEach(row, kStandardizedRange, name);
     gp.z.col(q) = row;
   }
   gp.Factorize();

@@ -46,11 +46,12 @@ std::string ToString(Mean m);              ///< "constant", "linear"
 Kernel ParseKernel(const std::string& s);  ///< inverse; InputError otherwise
 Mean ParseMean(const std::string& s);      ///< inverse; InputError otherwise
 
-/// core/bfgs.h defaults with function_tolerance 1e-5 and gradient_tolerance 1e-4.
-inline BfgsOptions GpBfgsDefaults() {
+/// core/bfgs.h defaults with function_tolerance 1e-5 and gradient_tolerance 1e-4 (tables below
+/// GpOptions::single_start_rows), or 1e-4 and 1e-3 (larger tables).
+inline BfgsOptions GpBfgsDefaults(bool large = false) {
   BfgsOptions b;
-  b.function_tolerance = 1e-5;
-  b.gradient_tolerance = 1e-4;
+  b.function_tolerance = large ? 1e-4 : 1e-5;
+  b.gradient_tolerance = large ? 1e-3 : 1e-4;
   return b;
 }
 
@@ -62,23 +63,61 @@ struct GpOptions {
   /// (ln l, ln s_f, ln s_n), dNLML/d ln l = sum_i dNLML/d ln l_i; Gp::theta still holds d equal
   /// length scales, so predictions, leave-one-out and files are those of the ARD form.
   bool isotropic = false;
-  /// Starting points of the likelihood maximization (1..kStartCount), taken in this order from
-  /// a fixed list (no random numbers: the same table gives the same GP everywhere). One by
-  /// default: in scripts/bench_peers.sh (20 seeds each of Friedman and simulator tables, 20 and
-  /// 100 rows) a second start changed no median except Friedman 20 rows, where the chosen
-  /// models were worse with it (out1 2.94 against 2.88).
-  int restarts = 1;
+  /// Starting points of the likelihood maximization (1..kStartCount) for fits on fewer than
+  /// single_start_rows rows (one start from there on), from a fixed list (no random numbers: the
+  /// same table gives the same GP everywhere; the lowest objective wins): length scales sqrt(d),
+  /// signal sd 1 and noise sd 0.1 in standardized target units; then length scales 2 sqrt(d),
+  /// signal sd s and noise sd 0.1 s, s the sd that the mean's least-squares fit leaves of the
+  /// standardized targets (small where a power-law mean fits well); then (0.5 sqrt(d), 1, 0.3),
+  /// (0.25 sqrt(d), 1, 0.5). Why two below 70 rows: on the benchmark's tuning part each of the
+  /// first two starts alone fell into local optima the other avoided (the first missed the bend
+  /// of power laws bent in one input in refits of 16 rows, the second took noise for signal on
+  /// exact power laws); from 70 rows on one start changed no median and halves the time
+  /// (docs/workpiece-model.md).
+  int restarts = 2;
+  int single_start_rows = 70;
+  /// A log-normal prior on every length scale (the hyperparameters maximize the likelihood times
+  /// the prior: maximum a posteriori, R&W section 5.4.1's hierarchical view), the
+  /// dimension-scaled prior of Hvarfner, Hellsten & Nardi ("Vanilla Bayesian optimization
+  /// performs great in high dimensions", ICML 2024), ln l ~ N(sqrt(2) + ln(d) / 2, 3) for inputs
+  /// on the unit cube, moved to standardized inputs (a uniform input's range is sqrt(12) sd):
+  ///   ln l_i ~ N(LengthPriorMean(d), length_prior_sd^2),
+  ///   LengthPriorMean(d) = sqrt(2) + ln(d) / 2 + ln(sqrt(12))   (3.46 for 5 inputs).
+  /// It keeps a GP from short length scales (spurious bends) that a few rows cannot support.
+  /// length_prior_sd = 0: no prior (maximum likelihood). Why the prior: on the benchmark's tuning
+  /// part (scripts/bench_peers.sh --split tuning) it lowered the median test RMSE of the additive
+  /// and Friedman tables by 5-15 % at 20 and 100 rows (docs/workpiece-model.md).
+  double length_prior_sd = 1.7320508075688772;  // sqrt(3)
+  /// Subset of data for large tables (R&W section 8.3.2): a GP on at most max_rows rows of the
+  /// table, spread evenly by index (row floor(j n / m), j = 0..m-1), when it has more (0: every
+  /// row); the standardization still uses every row, and Gp::rows names the rows kept. One
+  /// likelihood evaluation costs O(rows^3) and the leave-one-out O(rows^3): 512 rows keep a fit
+  /// of 2,000 rows within the time of R brnn's (docs/workpiece-model.md, "Speed").
+  int max_rows = 512;
+  /// Hyperparameters from at most this many of the GP's rows (spread as above), the GP itself on
+  /// all of them (0: all rows). 128: tables of up to 128 rows are fitted in full, and 2,000
+  /// rows in about 0.5 s (below R brnn's 1 s). (20 rows per hyperparameter instead, 60 rows for
+  /// the isotropic kernel at 100 rows, made Friedman's second output at 100 rows 13 % worse on
+  /// the benchmark's tuning part.)
+  int hyperparameter_rows = 128;
   /// Floor added to s_n^2, standardized target units (keeps K well conditioned when the data
   /// are interpolated; 1e-6 = noise sd of 0.1 % of the target's sd).
   double min_noise_variance = 1e-6;
-  /// The optimizer's options; NLML is in nats, so a relative decrease of 1e-5 (about 2e-4 nats
-  /// at 20 rows) and max |dNLML/dtheta| <= 1e-4 are far below what changes a prediction
-  /// (scripts/bench_peers.sh, 20-row tables, 20 seeds: the same choices and medians within
-  /// 0.5 % as with 1e-7, and 20-25 % less CPU for the default choice).
+  /// The optimizer's options below single_start_rows rows (bfgs) and from there on
+  /// (bfgs_large). NLML is in nats, so a relative decrease of 1e-5 (about 2e-4 nats at 20 rows)
+  /// and max |dNLML/dtheta| <= 1e-4 are far below what changes a prediction (an earlier default,
+  /// 20-row tables: the same choices and medians within 0.5 % as with 1e-7, and 20-25 % less
+  /// CPU). From 70 rows 1e-4 and 1e-3 changed no median of the benchmark's tuning part at 100
+  /// rows by more than 0.5 % and save 15 % of the fit time; at 20 rows they moved single tables'
+  /// choices (docs/workpiece-model.md).
   BfgsOptions bfgs = GpBfgsDefaults();
+  BfgsOptions bfgs_large = GpBfgsDefaults(true);
   void Validate() const;  ///< InputError naming the option, its value and the rule
 };
 inline constexpr int kStartCount = 4;
+
+/// The mean of GpOptions' length-scale prior for d inputs (standardized, natural log).
+double LengthPriorMean(int d);
 
 /// Number of mean coefficients m for d inputs (1, or 1 + d).
 int MeanSize(Mean mean, int inputs);
@@ -100,6 +139,9 @@ struct Gp {
   double noise_variance = 0;  ///< of predictions, standardized target units
   Eigen::MatrixXd z;          ///< d x n standardized training inputs
   Eigen::VectorXd u;          ///< n standardized training targets
+  /// The rows of the training table the GP keeps (GpOptions::max_rows); empty: all rows, in order.
+  /// Set by FitGp, not stored in files.
+  std::vector<int> rows;
   // Derived by Factorize() from the fields above (not stored in files):
   Eigen::LLT<Eigen::MatrixXd> chol;    ///< K = L L'
   Eigen::MatrixXd k_inv_h;             ///< K^-1 H, n x m

@@ -145,6 +145,48 @@ std::uint64_t ReadSeed(const json& v, const std::string& where) {
   return v.get<std::uint64_t>();
 }
 
+// Largest magnitudes of a network file's numbers: far above any trainbr fit of whirl's tables,
+// far below the values that overflow a prediction.
+constexpr double kMaxWeight = 1e6;           // weights and biases (tansig inputs)
+constexpr double kMaxScalingValue = 1e7;     // input and target scalings, original units
+constexpr double kMaxNoiseNormalized = 1e4;  // noise variances, normalized targets in [-1, 1]
+constexpr double kMaxPosteriorCovariance = 1e12;
+
+// InputError "model '<key>[r][c]' = <x> breaks the rule: |x| <= <bound> (<why>)" for the first
+// entry of m beyond the bound, indexed as in the file ([i] for a vector).
+void CheckMagnitude(const Eigen::MatrixXd& m, double bound, const std::string& key,
+                    const char* why) {
+  for (Eigen::Index r = 0; r < m.rows(); ++r)
+    for (Eigen::Index c = 0; c < m.cols(); ++c) {
+      if (std::abs(m(r, c)) <= bound) continue;
+      const std::string at = m.cols() == 1 ? "[" + std::to_string(r) + "]"
+                                           : "[" + std::to_string(r) + "][" + std::to_string(c) + "]";
+      throw InputError("model '" + key + at + "' = " + MessageNumber(m(r, c)) +
+                       " breaks the rule: |x| <= " + MessageNumber(bound) + " (" + why + ")");
+    }
+}
+
+void CheckMagnitudes(const Model& m) {
+  for (int l = 0; l < m.network.LayerCount(); ++l) {
+    const std::string at = "layers[" + std::to_string(l) + "]";
+    CheckMagnitude(m.network.weights[l], kMaxWeight, at + ".weights", "a network weight");
+    CheckMagnitude(m.network.biases[l], kMaxWeight, at + ".biases", "a network bias");
+  }
+  for (const auto& [s, key] : {std::pair{&m.input_scaling, "input_scaling"},
+                               std::pair{&m.target_scaling, "target_scaling"}}) {
+    CheckMagnitude(s->xmin, kMaxScalingValue, std::string(key) + ".min", "original units");
+    CheckMagnitude(s->xmax, kMaxScalingValue, std::string(key) + ".max", "original units");
+  }
+  if (!(m.noise_variance <= kMaxNoiseNormalized))
+    throw InputError("model 'uncertainty.noise_variance_normalized' = " +
+                     MessageNumber(m.noise_variance) + " breaks the rule: |x| <= " +
+                     MessageNumber(kMaxNoiseNormalized) + " (normalized target units)");
+  CheckMagnitude(m.output_noise_variance, kMaxNoiseNormalized,
+                 "uncertainty.output_noise_variance_normalized", "normalized target units");
+  CheckMagnitude(m.posterior_covariance, kMaxPosteriorCovariance,
+                 "uncertainty.posterior_covariance", "normalized weight units");
+}
+
 // TrainSummary::ard_alpha: only with options.ard, one finite alpha > 0 per input and the rest.
 void ValidateArdAlpha(const Model& m) {
   const Eigen::VectorXd& a = m.training_summary.ard_alpha;
@@ -386,6 +428,7 @@ void Model::Validate() const {
         throw InputError("model 'uncertainty.posterior_covariance' is not symmetric at (" +
                          std::to_string(i) + ", " + std::to_string(k) + ")");
   }
+  CheckMagnitudes(*this);
   if (training_summary.parameter_count != N)
     throw InputError("model 'training_summary.parameter_count' = " +
                      std::to_string(training_summary.parameter_count) + ", layer_sizes give " +

@@ -75,11 +75,11 @@ bool Render(OutputDir& out, const SurfaceReportOptions& o, SurfaceReportResult& 
     r.warnings.push_back("gnuplot ('" + o.gnuplot_command + "') not found: map skipped");
     return false;
   }
-  const fs::path stage = fs::absolute(out.Staging());
-  const int rc = RunProgram({o.gnuplot_command, "map.gp"}, stage, stage / "gnuplot.log");
+  const int rc = out.RunInStaging({o.gnuplot_command, "map.gp"}, "gnuplot.log", {"map.png"});
+  const fs::path stage = out.Staging();
   std::error_code ec;
   if (rc != 0 || !fs::is_regular_file(stage / "map.png", ec)) {
-    if (fs::is_regular_file(stage / "gnuplot.log", ec)) out.AddStaged("gnuplot.log");
+    out.AddProgramLog("gnuplot.log");
     r.warnings.push_back("gnuplot failed (exit " + std::to_string(rc) +
                          "), see gnuplot.log: map skipped");
     return false;

@@ -1,12 +1,16 @@
 #include "workpiece/model.h"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <utility>
 
 #include "core/error.h"
 #include "core/json_file.h"
+#include "core/limits.h"
+#include "core/numbers.h"
 
 namespace whirl::workpiece {
 namespace {
@@ -66,19 +70,95 @@ WorkpieceModel FamilyFromJson(const json& j) {
   CheckVariables(j, "outputs", nn::ExpectedOutputs());
   WorkpieceModel m;
   m.kind = WorkpieceModel::Kind::kFamily;
-  if (!j.contains("domain")) throw InputError("missing key 'domain'");
-  m.domain_min = DomainVector(j.at("domain"), "min");
-  m.domain_max = DomainVector(j.at("domain"), "max");
+  const json& domain = RequireKey(j, "domain", "workpiece model");
+  m.domain_min = DomainVector(domain, "min");
+  m.domain_max = DomainVector(domain, "max");
   if (!(m.domain_min.array() <= m.domain_max.array()).all())
     throw InputError("'domain.min' must not exceed 'domain.max'");
-  if (!j.contains("training") || !j.at("training").is_object())
-    throw InputError("missing object 'training'");
-  m.training_data = RequireString(j.at("training"), "data", "workpiece model 'training'");
+  for (const auto& [v, key] : {std::pair{&m.domain_min, "domain.min"},
+                               std::pair{&m.domain_max, "domain.max"}}) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = (*v)(i);
+    CheckProcessInputs(ProcessInputs::FromArray(a), std::string("'") + key + "'");
+  }
+  const json& training = RequireObject(j, "training", "workpiece model");
+  m.training_data = RequireString(training, "data", "workpiece model 'training'");
   m.training_samples = static_cast<int>(
-      RequireInteger(j.at("training"), "samples", 4, 100000000, "workpiece model 'training'"));
-  if (!j.contains("choice")) throw InputError("missing key 'choice'");
-  m.choice = j.at("choice").get<family::Choice>();
+      RequireInteger(training, "samples", 4, 100000000, "workpiece model 'training'"));
+  m.choice = RequireKey(j, "choice", "workpiece model").get<family::Choice>();
   return m;
+}
+
+// Largest |mean| and sd a model may predict inside its training domain: 1000 times the output's
+// physical limit (core/limits.h).
+constexpr double kPredictionBound[Features::kCount] = {1e3 * kMaxElongationUm, 1e3 * kMaxSettleTimeS};
+
+// The corners and the centre of the training domain (33 processes).
+std::vector<ProcessInputs> DomainProbe(const WorkpieceModel& m) {
+  std::vector<ProcessInputs> probe;
+  for (int corner = 0; corner <= (1 << ProcessInputs::kCount); ++corner) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i)
+      a[i] = corner == (1 << ProcessInputs::kCount)
+                 ? 0.5 * (m.domain_min(i) + m.domain_max(i))
+                 : ((corner >> i) & 1 ? m.domain_max(i) : m.domain_min(i));
+    probe.push_back(ProcessInputs::FromArray(a));
+  }
+  return probe;
+}
+
+// InputError unless every mean and sd of `p` (one per process of DomainProbe) is finite, within
+// kPredictionBound and the sd >= 0; `what` names the model.
+void CheckProbe(const std::vector<Features>& mean, const std::vector<Features>& sd,
+                const std::string& what) {
+  for (std::size_t q = 0; q < mean.size(); ++q)
+    for (int k = 0; k < Features::kCount; ++k) {
+      const double m = mean[q].ToArray()[k], s = sd[q].ToArray()[k];
+      if (std::abs(m) <= kPredictionBound[k] && s >= 0 && s <= kPredictionBound[k]) continue;
+      throw InputError(what + " predicts " + kTargetColumns[k] + " = " + MessageNumber(m) +
+                       " +- " + MessageNumber(s) + " " + kTargetUnits[k] +
+                       " at the training domain's " +
+                       (q + 1 == mean.size() ? std::string("centre")
+                                             : "corner " + std::to_string(q + 1)) +
+                       "; a valid model predicts finite values within +-" +
+                       MessageNumber(kPredictionBound[k]) + " " + kTargetUnits[k] +
+                       " (1000 times the output's limit) with an sd >= 0 there");
+    }
+}
+
+// The predictions of a loaded model at DomainProbe, model by model: numbers that pass every field
+// rule of the file can still combine into nonsense.
+void CheckDomainPredictions(const WorkpieceModel& m) {
+  const std::vector<ProcessInputs> probe = DomainProbe(m);
+  std::vector<Features> mean, sd;
+  if (m.IsNetwork()) {
+    for (const nn::Prediction& p : nn::PredictBatch(m.network, probe)) {
+      mean.push_back(p.mean);
+      sd.push_back(p.stddev);
+    }
+    return CheckProbe(mean, sd, "the network");
+  }
+  for (std::size_t j = 0; j < m.choice.models.size(); ++j) {
+    mean.clear();
+    sd.clear();
+    for (const family::FamilyPrediction& p : family::PredictFamily(m.choice.models[j], probe)) {
+      mean.push_back(p.mean);
+      sd.push_back(p.stddev);
+    }
+    CheckProbe(mean, sd, "'choice.models'[" + std::to_string(j) + "] (" +
+                             m.choice.models[j].candidate.Name() + ")");
+  }
+}
+
+// InputError unless every mean and sd of `p` is finite (a damaged file or an overflow).
+void CheckFinite(const std::vector<Prediction>& p) {
+  for (std::size_t q = 0; q < p.size(); ++q)
+    for (int k = 0; k < Features::kCount; ++k)
+      if (!std::isfinite(p[q].mean.ToArray()[k]) || !std::isfinite(p[q].stddev.ToArray()[k]))
+        throw InputError("the model predicts " + std::string(kTargetColumns[k]) + " = " +
+                         MessageNumber(p[q].mean.ToArray()[k]) + " +- " +
+                         MessageNumber(p[q].stddev.ToArray()[k]) + " for process " +
+                         std::to_string(q + 1) + ": not a finite value (a damaged model file?)");
 }
 
 }  // namespace
@@ -118,7 +198,11 @@ WorkpieceModel FromChoice(family::Choice choice, const ProcessTable& table,
 
 std::vector<Prediction> PredictBatch(const WorkpieceModel& model,
                                      const std::vector<ProcessInputs>& inputs) {
-  if (model.IsNetwork()) return nn::PredictBatch(model.network, inputs);
+  if (model.IsNetwork()) {
+    std::vector<Prediction> out = nn::PredictBatch(model.network, inputs);
+    CheckFinite(out);
+    return out;
+  }
   const Eigen::MatrixXd x = nn::InputMatrix(inputs);
   if (!x.allFinite()) throw InputError("predict: an input is NaN or infinite");
   const std::vector<family::FamilyPrediction> f = family::PredictChoice(model.choice, inputs);
@@ -132,6 +216,7 @@ std::vector<Prediction> PredictBatch(const WorkpieceModel& model,
         out[q].outside_domain_fields.push_back(kInputColumns[i]);
       }
   }
+  CheckFinite(out);
   return out;
 }
 
@@ -162,18 +247,29 @@ WorkpieceModel LoadWorkpieceModel(const std::filesystem::path& path) {
         j.at(key) != WorkpieceModel::kFormat && j.at(key) != nn::Model::kFormat)
       throw InputError("model file '" + path.string() + "' is a " + DumpJson(j.at(key), -1) +
                        " file, not a workpiece model (whirl train writes one)");
-  if (!j.is_object() || !j.contains("format") || j.at("format") != WorkpieceModel::kFormat)
-    return FromNetwork(nn::LoadModel(path));  // names the file and the key on errors
   try {
-    return FamilyFromJson(j);
+    const bool family =
+        j.is_object() && j.contains("format") && j.at("format") == WorkpieceModel::kFormat;
+    // A network file: nn::LoadModel names the file and the key on errors.
+    const WorkpieceModel m = family ? FamilyFromJson(j) : FromNetwork(nn::LoadModel(path));
+    CheckDomainPredictions(m);
+    return m;
   } catch (const InputError& e) {
-    throw InputError("model file '" + path.string() + "': " + e.what());
+    const std::string prefix = "model file '" + path.string() + "': ";
+    const std::string what = e.what();
+    throw InputError(what.rfind(prefix, 0) == 0 ? what : prefix + what);
   } catch (const json::exception& e) {
     throw InputError("model file '" + path.string() + "': " + LibraryRule(e));
   }
 }
 
 void SaveWorkpieceModel(const std::filesystem::path& path, const WorkpieceModel& model) {
+  try {  // the rules a reader applies, so that every file written loads
+    CheckDomainPredictions(model);
+    if (!model.IsNetwork()) FamilyFromJson(FamilyJson(model));
+  } catch (const InputError& e) {
+    throw InputError("model file '" + path.string() + "' not written: " + e.what());
+  }
   if (model.IsNetwork()) {
     nn::SaveModel(path, model.network);
     return;
@@ -208,12 +304,14 @@ TransformFlag ParseTransformFlag(const std::string& s) {
 std::vector<family::Candidate> Candidates(FamilyFlag family, TransformFlag transform) {
   std::vector<family::Candidate> all;
   if (family == FamilyFlag::kAuto) all = family::ChoiceOptions::DefaultCandidates();
-  const char* body = family == FamilyFlag::kLinear            ? "linear"
-                     : family == FamilyFlag::kGaussianProcess ? "gp-matern52-constant"
-                                                              : "network-evidence";
+  const std::string body = family == FamilyFlag::kLinear            ? "linear"
+                           : family == FamilyFlag::kGaussianProcess ? "gp-matern52-"
+                                                                    : "network-evidence";
+  const bool gp = family == FamilyFlag::kGaussianProcess;  // a power-law mean on log columns
   if (family != FamilyFlag::kAuto)
     for (const char* t : {"/log", "/identity"})
-      all.push_back(family::ParseCandidate(std::string(body) + t));
+      all.push_back(family::ParseCandidate(
+          body + (gp ? (std::string(t) == "/log" ? "linear" : "constant") : "") + t));
   std::vector<family::Candidate> out;
   for (const family::Candidate& c : all)
     if (transform == TransformFlag::kAuto || c.log == (transform == TransformFlag::kLog))
@@ -226,11 +324,30 @@ WorkpieceModel TrainWorkpieceModel(const ProcessTable& table, const TrainOptions
                                    const nn::ModelProgress& progress) {
   if (options.family == FamilyFlag::kNetwork && options.transform == TransformFlag::kIdentity)
     return FromNetwork(nn::TrainModel(table, options.network, data_name, progress));
+  if (options.transform == TransformFlag::kLog) {
+    ProcessTable named = table;
+    named.source = data_name;
+    const std::vector<family::LogException> raw = family::LogExceptions(named);
+    if (!raw.empty())
+      throw InputError("--transform log: " + raw.front().Describe(named) +
+                       "; use --transform auto (the log candidates then keep that column on its "
+                       "raw scale and say so) or --transform identity, or correct the row");
+  }
   family::ChoiceOptions choice = options.choice;
   choice.candidates = Candidates(options.family, options.transform);
   ProcessTable named = table;
   named.source = data_name;
   return FromChoice(family::ChooseFamily(named, choice), table, data_name);
+}
+
+nlohmann::json ChoiceTableJson(const family::Choice& choice) {
+  json table = json::array();
+  for (const family::CvRow& r : choice.table) {
+    json row = r;
+    row["fit_ms"] = r.fit_ms;
+    table.push_back(row);
+  }
+  return table;
 }
 
 std::string FormatChoiceTable(const family::Choice& choice) {
@@ -249,6 +366,7 @@ std::string FormatChoiceTable(const family::Choice& choice) {
   }
   for (const std::string& note : choice.notes)
     if (!note.empty()) s += "  note: " + note + "\n";
+  if (!choice.rows_note.empty()) s += "  note: " + choice.rows_note + "\n";
   return s;
 }
 

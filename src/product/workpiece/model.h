@@ -95,9 +95,9 @@ struct TrainOptions {
 
 /// The candidates of a choice for the flags:
 ///   kAuto:            ChoiceOptions::DefaultCandidates() (power law, linear, isotropic GP,
-///                     GP Matern 5/2),
+///                     GP Matern 5/2 with a power-law mean on log columns, GP Matern 5/2),
 ///   kLinear:          linear/log, linear/identity,
-///   kGaussianProcess: gp-matern52-constant/log, gp-matern52-constant/identity,
+///   kGaussianProcess: gp-matern52-linear/log, gp-matern52-constant/identity,
 ///   kNetwork:         network-evidence/log, network-evidence/identity,
 /// keeping those of `transform` (kAuto: both). Listed from the simplest (one-standard-error
 /// rule, family/family.h).
@@ -115,5 +115,8 @@ WorkpieceModel TrainWorkpieceModel(const ProcessTable& table, const TrainOptions
 /// (um, s), the score and the fit time, and the chosen candidate of each output marked; then a
 /// "note:" line per output with family::Choice::notes.
 std::string FormatChoiceTable(const family::Choice& choice);
+/// The same table as JSON for `whirl train --json`: per candidate its name, cv_rmse, score and
+/// fit_ms (the fit time, which the model file does not store).
+nlohmann::json ChoiceTableJson(const family::Choice& choice);
 
 }  // namespace whirl::workpiece
