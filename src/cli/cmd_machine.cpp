@@ -95,7 +95,7 @@ machine::MachineConfig LoadMachine(const MachineCliOptions& o) {
 }
 
 void RunSensors(const MachineCliOptions& o) {
-  CheckOutputs({{"--machine", o.machine_path}}, {}, {{"--out-dir", o.out}});
+  CheckOutputs({{"--machine-thermal", o.machine_path}}, {}, {{"--out-dir", o.out}});
   const machine::MachineConfig config = LoadMachine(o);
   std::vector<drift::Run> runs;
   for (auto state : {drift::RunState::kIdle, drift::RunState::kCutting})
@@ -165,7 +165,7 @@ void RunScenarios(const MachineCliOptions& o, const std::vector<machine::Machine
 }
 
 void RunMachineEvaluate(const MachineCliOptions& o) {
-  CheckOutputs({{"--machine", o.machine_path},
+  CheckOutputs({{"--machine-thermal", o.machine_path},
                 {"--model", o.model_path},
                 {"--history", o.history},
                 {"--base-screw", o.base_screw},
@@ -226,9 +226,12 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
 }
 
 void CommonOptions(CLI::App* sub, MachineCliOptions* o) {
-  sub->add_option("--machine", o->machine_path,
-                  "machine thermal JSON (schema whirl.machine_thermal; default "
-                  "datasets/machines/whirling_thermal.json, built-in default if missing)");
+  // --machine is the 840D profile in plan and drift nc; here the simulator's thermal machine.
+  auto* thermal = sub->add_option("--machine-thermal", o->machine_path,
+                                  "the simulated machine's thermal JSON (schema "
+                                  "whirl.machine_thermal; default datasets/machines/"
+                                  "whirling_thermal.json, built-in default if missing)");
+  AddDeprecatedAlias(sub, thermal, "--machine");
   sub->add_flag("--machine-off", o->machine_off,
                 "switch every machine component off (m = 0: the workpiece-only truth)");
   sub->add_flag("--json", o->json, "machine output on stdout");
@@ -285,7 +288,8 @@ void RegisterMachine(CLI::App& app) {
       "Write virtual-sensor run files (drift format: <name>_C temperatures [degC], offset_um and\n"
       "zscrew_per_1000_um [um]) of one machine: idle warm-ups (ring turning, no cut, 180 min)\n"
       "and cutting runs (150 min); sample step from the machine JSON [min]. Fit them with\n"
-      "'whirl drift fit --runs DIR/cutting_*.csv --error offset_um'.");
+      "'whirl drift fit --cutting DIR/cutting_*.csv --error offset_um'; their sensors are the\n"
+      "analog inputs of datasets/machines/whirling_840d.json (drift nc --machine).");
   CommonOptions(s, o.get());
   auto* out_dir = s->add_option("--out-dir", o->out,
                                 std::string("output folder, all files or none: ") + kOutputDirRule)
@@ -331,7 +335,7 @@ void RegisterMachine(CLI::App& app) {
   e->add_option("--base-screw", o->base_screw, "screw whose blank and settings are shared");
   e->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV")
       ->check(CLI::ExistingFile);
-  o->legacy_only.push_back(e->get_option("--machine"));
+  o->legacy_only.push_back(e->get_option("--machine-thermal"));
   o->legacy_only.push_back(e->get_option("--machine-off"));
   o->legacy_only.push_back(e->add_option("--drift-model", o->drift_model,
                 "machine drift model kind: mlr (Miao et al.'s regression, default) or dynamic "

@@ -36,9 +36,9 @@ PY
 
 # Bad input: a typo in the machine file, a missing named file; nothing written.
 sed 's/"motor_tau_min"/"motor_tau_mn"/' "$S/datasets/machines/whirling_thermal.json" > "$D/bad.json"
-expect_fail "motor_tau_mn" "$W" machine sensors --machine "$D/bad.json" --out-dir "$D/none"
+expect_fail "motor_tau_mn" "$W" machine sensors --machine-thermal "$D/bad.json" --out-dir "$D/none"
 [ ! -e "$D/none" ] || fail "files written on bad input"
-expect_fail "missing.json" "$W" machine sensors --machine "$D/missing.json" --out-dir "$D/none"
+expect_fail "missing.json" "$W" machine sensors --machine-thermal "$D/missing.json" --out-dir "$D/none"
 
 # Combined 840D programs with the existing combined mode: the plan writes its K0 into
 # $AC_PARAM, the machine drift action (the offset model) is the single writer of SD43900.

@@ -45,17 +45,17 @@ expect_fail "nx \* ny = 40000.*10000" "$W" surface synth --nx 200 --ny 200 --out
 
 # --- Machine thermal files: schema required, every field in its physical range ---------------
 echo '{}' > empty.json
-expect_fail "empty.json.*'schema' must be" "$W" machine sensors --machine empty.json --out-dir m_out
+expect_fail "empty.json.*'schema' must be" "$W" machine sensors --machine-thermal empty.json --out-dir m_out
 for v in 99 '"1"' 1.5; do
   sed "s/\"schema_version\": 1,/\"schema_version\": $v,/" "$MACHINE" > "version_$v.json"
-  expect_fail "version_$v.json.*schema_version" "$W" machine sensors --machine "version_$v.json" --out-dir m_out
+  expect_fail "version_$v.json.*schema_version" "$W" machine sensors --machine-thermal "version_$v.json" --out-dir m_out
 done
 json_set "$MACHINE" spread.json "j['machine_spread'] = 1e308"
-expect_fail "spread.json.*machine_spread = 1e+308.*\[0, 1\]" "$W" machine sensors --machine spread.json --out-dir m_out
+expect_fail "spread.json.*machine_spread = 1e+308.*\[0, 1\]" "$W" machine sensors --machine-thermal spread.json --out-dir m_out
 json_set "$MACHINE" tau.json "j['sensors'][2]['tau_min'] = 1e308"
-expect_fail "tau.json.*sensor 'bed_middle' tau_min = 1e+308" "$W" machine evaluate --machine tau.json --machines 1 --screws 1
+expect_fail "tau.json.*sensor 'bed_middle' tau_min = 1e+308" "$W" machine evaluate --machine-thermal tau.json --machines 1 --screws 1
 json_set "$MACHINE" sign.json "j['head']['sign'] = 0.5"
-expect_fail "sign.json.*'sign'" "$W" machine sensors --machine sign.json --out-dir m_out
+expect_fail "sign.json.*'sign'" "$W" machine sensors --machine-thermal sign.json --out-dir m_out
 [ -e m_out ] && fail "machine wrote files from a bad machine file"
 
 # --- Drift model files: residual_std_um of +-1e308 gave std inf and a threshold of inf ---------
