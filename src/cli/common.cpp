@@ -23,6 +23,7 @@
 #include "core/numbers.h"
 #include "core/safe_text.h"
 #include "fit/arctan_curve.h"
+#include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
 
 namespace whirl::cli {
@@ -342,6 +343,43 @@ void CheckCommandWords(const CLI::App& app, int argc, char** argv) {
   }
 }
 
+// The option words of argv ("--name" or "--name=value") must each name an option of the command
+// they follow or of a command above it (hidden deprecated spellings included): an unknown one is
+// an error naming the word typed and the closest option the command's --help lists. Without this
+// CLI11 reports a missing required option first ("--data is required" for "--dta x.csv") or
+// "arguments were not expected" without a suggestion.
+void CheckOptionWords(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* current = &app;
+  int i = 1;
+  for (; i < argc; ++i) {  // the command words
+    const CLI::App* next = nullptr;
+    for (const CLI::App* sub : current->get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->check_name(argv[i])) next = sub;
+    if (next == nullptr) break;
+    current = next;
+    if (current->get_prefix_command() || current->get_allow_extras()) return;  // passed through
+  }
+  for (; i < argc; ++i) {
+    std::string word = argv[i];
+    if (word == "--") return;  // positional arguments follow
+    if (word.rfind("--", 0) != 0 || word.size() < 3) continue;
+    word = word.substr(0, word.find('='));
+    std::vector<std::string> listed;
+    bool known = false;
+    for (const CLI::App* a = current; a != nullptr && !known; a = a->get_parent())
+      for (const CLI::Option* o : a->get_options()) {
+        if (o->check_name(word)) known = true;
+        if (!o->get_group().empty())
+          for (const auto& n : o->get_lnames()) listed.push_back("--" + n);
+      }
+    if (known || listed.empty()) continue;
+    const std::string command = current == &app ? "whirl" : "whirl " + CommandPath(current);
+    throw CLI::ValidationError("unknown option '" + word + "' for '" + command +
+                               "'; did you mean '" + ClosestName(word, listed) + "'? ('" +
+                               command + " --help' lists its options)");
+  }
+}
+
 }  // namespace
 
 int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summaries) {
@@ -349,6 +387,7 @@ int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summari
   SetHelpRecursively(&app, std::make_shared<OneLineFormatter>(summaries));
   try {
     CheckCommandWords(app, argc, argv);
+    CheckOptionWords(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
@@ -385,6 +424,14 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
 void PrintJson(const nlohmann::json& j) { std::cout << DumpJson(j) << std::endl; }
 
 void Warn(const std::string& text) { std::cerr << "warning: " << text << std::endl; }
+
+void WarnIllustrativeProfile(const interp::MachineProfile& profile) {
+  if (!profile.Illustrative()) return;
+  Warn("machine profile " + profile.source + " is the shipped example (its name: \"" +
+       profile.name +
+       "\"): its axis, offsets, IDs, R parameters and alarms are illustrative, not your "
+       "machine's; replace every value and the name before these programs go onto a control");
+}
 
 Progress::Progress(std::string label, std::size_t total)
     : label_(std::move(label)), total_(total == 0 ? 1 : total), tty_(::isatty(2) != 0) {}
