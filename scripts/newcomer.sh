@@ -118,6 +118,9 @@ for needed in "whirl fit " "whirl train " "whirl plan " "whirl compare " "whirl 
   printf '%s\n' "${LINES[@]}" | grep -q "^$needed" || fail "the README's steps have no '$needed'"
 done
 
+grep -q "logs of \`whirl machine sensors\`.*whirling_840d.json" "$SRC/README.md" ||
+  fail "the README does not name the profile for logs of whirl machine sensors (whirling_840d.json)"
+
 ran=0
 # (A) The shipped example profile, logs of its own sensors.
 own_files "$D/a"
