@@ -44,7 +44,8 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
   const compare::ExperienceRule rule = compare::BuildExperienceRule(past);
   // Said on stdout (stderr under --json) and on the page: the baselines are only as good as
   // the screws they come from.
-  const std::string history = o.history + " (" + std::to_string(past.inputs.size()) + " past screws)";
+  const std::string history =
+      o.history + " (" + std::to_string(past.inputs.size()) + " past screws)";
   std::fprintf(o.json ? stderr : stdout, "history rules from: %s\n", history.c_str());
   const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
   compare::CompareOptions co;

@@ -343,40 +343,55 @@ void CheckCommandWords(const CLI::App& app, int argc, char** argv) {
   }
 }
 
-// The option words of argv ("--name" or "--name=value") must each name an option of the command
-// they follow or of a command above it (hidden deprecated spellings included): an unknown one is
-// an error naming the word typed and the closest option the command's --help lists. Without this
-// CLI11 reports a missing required option first ("--data is required" for "--dta x.csv") or
-// "arguments were not expected" without a suggestion.
-void CheckOptionWords(const CLI::App& app, int argc, char** argv) {
+// The command argv names: its command words from argv[1] on; `*first_option` is the first
+// argument after them.
+const CLI::App* CommandOf(const CLI::App& app, int argc, char** argv, int* first_option) {
   const CLI::App* current = &app;
   int i = 1;
-  for (; i < argc; ++i) {  // the command words
+  for (; i < argc; ++i) {
     const CLI::App* next = nullptr;
     for (const CLI::App* sub : current->get_subcommands([](const CLI::App*) { return true; }))
       if (sub->check_name(argv[i])) next = sub;
     if (next == nullptr) break;
     current = next;
-    if (current->get_prefix_command() || current->get_allow_extras()) return;  // passed through
   }
+  *first_option = i;
+  return current;
+}
+
+// Whether `flag` is an option of `command` or of a command above it (hidden deprecated
+// spellings included); `listed` gets the names their --help lists.
+bool KnownOption(const CLI::App* command, const std::string& flag,
+                 std::vector<std::string>* listed) {
+  for (const CLI::App* a = command; a != nullptr; a = a->get_parent())
+    for (const CLI::Option* o : a->get_options()) {
+      if (o->check_name(flag)) return true;
+      if (!o->get_group().empty())
+        for (const auto& n : o->get_lnames()) listed->push_back("--" + n);
+    }
+  return false;
+}
+
+// The option words of argv ("--name" or "--name=value") must each name an option of the command
+// they follow or of a command above it: an unknown one is an error naming the word typed and the
+// closest option the command's --help lists. Without this CLI11 reports a missing required
+// option first ("--data is required" for "--dta x.csv") or "arguments were not expected"
+// without a suggestion.
+void CheckOptionWords(const CLI::App& app, int argc, char** argv) {
+  int i = 0;
+  const CLI::App* command = CommandOf(app, argc, argv, &i);
+  if (command->get_prefix_command() || command->get_allow_extras()) return;  // passed through
   for (; i < argc; ++i) {
-    std::string word = argv[i];
-    if (word == "--") return;  // positional arguments follow
-    if (word.rfind("--", 0) != 0 || word.size() < 3) continue;
-    word = word.substr(0, word.find('='));
+    const std::string arg = argv[i];
+    if (arg == "--") return;  // positional arguments follow
+    if (arg.rfind("--", 0) != 0 || arg.size() < 3) continue;
+    const std::string flag = arg.substr(0, arg.find('='));
     std::vector<std::string> listed;
-    bool known = false;
-    for (const CLI::App* a = current; a != nullptr && !known; a = a->get_parent())
-      for (const CLI::Option* o : a->get_options()) {
-        if (o->check_name(word)) known = true;
-        if (!o->get_group().empty())
-          for (const auto& n : o->get_lnames()) listed.push_back("--" + n);
-      }
-    if (known || listed.empty()) continue;
-    const std::string command = current == &app ? "whirl" : "whirl " + CommandPath(current);
-    throw CLI::ValidationError("unknown option '" + word + "' for '" + command +
-                               "'; did you mean '" + ClosestName(word, listed) + "'? ('" +
-                               command + " --help' lists its options)");
+    if (KnownOption(command, flag, &listed) || listed.empty()) continue;
+    const std::string name = command == &app ? "whirl" : "whirl " + CommandPath(command);
+    throw CLI::ValidationError("unknown option '" + flag + "' for '" + name + "'; did you mean '" +
+                               ClosestName(flag, listed) + "'? ('" + name +
+                               " --help' lists its options)");
   }
 }
 
