@@ -11,7 +11,8 @@
     - every --help text (each command and group) names only what exists: a `whirl ...` command
       quoted in it is checked as above, every other --flag is an option of some command, and
       every path into the tree (datasets/, models/, docs/, src/, interp/, scripts/, tests/)
-      exists in the source tree (a glob must match a file).
+      exists in the source tree (a glob must match a file); so does every such path in a code
+      span of README.md and docs/*.md.
   --write: rewrites that table from the binary (after adding or renaming a flag).
 
 Usage: commands_doc.py --whirl build/whirl --src . (--check | --write)
@@ -220,6 +221,13 @@ def main():
             for problem in check_command(cmds, text):
                 failures.append(f"{os.path.relpath(page, a.src)}:{n}: {problem} (in '{text}')")
     failures += help_problems(cmds, a.src)
+    for page in pages:
+        for n, line in enumerate(open(page, encoding="utf-8"), 1):
+            for span in re.findall(r"`([^`]+)`", line):
+                for path in TREE_PATH.findall(span):
+                    if not glob.glob(os.path.join(a.src, path.rstrip("."))):
+                        failures.append(f"{os.path.relpath(page, a.src)}:{n}: names {path}, "
+                                        "which is not in the source tree")
     for f in failures:
         print("FAIL:", f)
     print(f"{checked} documented commands, {len(cmds.leaves())} commands in the table")
