@@ -53,7 +53,7 @@ std::string StrategyLabel(Strategy s) {
     case Strategy::kRegression:
       return "regression (log-linear features, 840D plan)";
     case Strategy::kModel:
-      return "model (network, 840D plan)";
+      return "model (workpiece model, 840D plan)";
     case Strategy::kClass:
       return "class (diameter-class means, 840D plan)";
     case Strategy::kTable:
