@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The figures models/README.md quotes are the binary's: the validation errors of the shipped model
 # and of the paper-sized 20-row model (trained as the README says) equal what `whirl predict`
-# prints; `whirl --help` does not call train "the network" (its default chooses a family).
+# prints; `whirl --help` does not call train "the network" nor `whirl evaluate --help` the model a
+# network (the default chooses a family).
 # args <whirl> <scratch dir> <source dir>
 set -u
 W="$1"; D="$2"; SRC="$3"
@@ -21,4 +22,6 @@ grep -qF "$big for the 500-row model against $small for the 20-row model" <<< "$
   fail "models/README.md does not quote '$big for the 500-row model against $small for the 20-row model'"
 "$W" --help > "$D/help.txt" || fail "whirl --help"
 grep -E "^ +train " "$D/help.txt" | grep -q "the network" && fail "whirl --help: train is not only the network"
+"$W" evaluate --help > "$D/evaluate.txt" || fail "whirl evaluate --help"
+grep -q "network" "$D/evaluate.txt" && fail "whirl evaluate --help calls the model a network"
 echo "ok: $big (500 rows), $small (20 rows)"
