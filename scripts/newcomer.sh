@@ -136,7 +136,7 @@ cp "$D/a/model.json" "$D/b/model.json" 2> /dev/null || fail "step A wrote no mod
 for line in "${LINES[@]}"; do
   case "$line" in
     "whirl drift "*) run "$D/b" "$line" ;;
-    "whirl plan "*--with-drift-action*) run "$D/b" "$line" --start-position-mm 0 ;;
+    "whirl plan "*--with-drift-action*) run "$D/b" "$line" --start-position-mm 5600 ;;  # as docs/machine.md
   esac
 done
 
