@@ -202,6 +202,7 @@ void RunDemo(const DemoOptions& o) {
   compare::ReportOptions ro;
   ro.plots = !o.no_plots;
   ro.control = control;
+  ro.history = train_path + " (" + std::to_string(history.inputs.size()) + " past screws)";
   ro.provenance = {"command: whirl demo --out-dir " + o.out_dir + " --seed " +
                        std::to_string(o.seed) + (o.retrain ? " --retrain" : ""),
                    "model: " + model_source, "history (traditional rule): " + train_path};

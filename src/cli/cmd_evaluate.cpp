@@ -258,7 +258,7 @@ void RegisterEvaluate(CLI::App& app) {
       "truth with its own seeded disturbances (MixSeed(--seed, index)). Prints one line per screw,\n"
       "then per strategy the median and worst accumulated lead error [um] within 1000 mm and over\n"
       "the thread and the share reaching ISO 3408-3 P3 and P5, the gain breakdown (curve shape,\n"
-      "five inputs, network) and the model's reductions against each baseline. --scenarios runs\n"
+      "five inputs, model) and the model's reductions against each baseline. --scenarios runs\n"
       "named truth scenarios instead. Uses --threads worker threads; results do not depend on the\n"
       "thread count.");
   sub->add_option("--model", o->model_path, "model file (default models/default.json)")
@@ -303,7 +303,7 @@ void RegisterEvaluate(CLI::App& app) {
                   "seed; prints the scenario x strategy table of median and worst accumulated "
                   "error [um] within 1000 mm and over the thread (src/lab/compare/scenarios.h)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
-                "evaluate the out-of-range scenario although the network extrapolates there");
+                "evaluate the out-of-range scenario although the model extrapolates there");
   sub->add_flag("--markdown", o->markdown, "--scenarios: print the table as Markdown");
   sub->add_flag("--json", o->json, "machine output: per-screw figures and the summary as JSON");
   sub->callback([o] { RunEvaluate(*o); });

@@ -28,6 +28,11 @@ void RunLeadReport(const LeadReportOptions& o) {
   const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, mo);
   const lead::IsoToleranceTable table = lead::ReadIsoToleranceTable(o.iso_table);
   const lead::IsoVerdict v = lead::EvaluateIsoClass(m, table);
+  if (!m.v_2pi_um)  // the class is then graded without one of its tolerances
+    Warn(std::string("v_2pi not evaluated (") +
+         (o.lead_mm > 0 ? "the samples are coarser than half a lead"
+                        : "give --lead-mm, the screw's lead") +
+         "): the ISO 3408-3 class is checked without it");
   if (o.json) {
     PrintJson({{"schema", "whirl.lead_report"},
                {"schema_version", 1},

@@ -85,6 +85,7 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
   bool have_start = false, have_offset = false;
   if (!o.machine_path.empty()) {
     const interp::MachineProfile m = interp::LoadMachineProfile(o.machine_path);
+    WarnIllustrativeProfile(m);
     if (o.with_drift_action)
       m.ApplyCombinedTo(p);
     else

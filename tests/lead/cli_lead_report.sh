@@ -17,7 +17,12 @@ assert abs(m["accumulated_1000_um"] - 10) < 1e-6 and abs(m["accumulated_total_um
 # l_u = 1000: P1 e_p 11 >= 10, v_up 9 >= 0: P1.
 assert j["iso"]["reached"] == "P1", j["iso"]
 PY
-"$whirl" lead-report --lead linear.csv | grep "ISO 3408-3 class reached: P1" > /dev/null
+"$whirl" lead-report --lead linear.csv --lead-mm 10 2> err.txt | grep "ISO 3408-3 class reached: P1" > /dev/null
+if grep -q "warning" err.txt; then echo "a warning with --lead-mm: $(cat err.txt)"; exit 1; fi
+# Without --lead-mm the class is graded without v_2pi: said on stderr (issue 44 item 8), and the
+# README's step 5 gives --lead-mm.
+"$whirl" lead-report --lead linear.csv 2> err.txt > /dev/null
+grep -q "^warning: v_2pi not evaluated (give --lead-mm" err.txt
 # Bad input: non-increasing position -> exit 1 with file:line in the message.
 printf 'position_mm,deviation_um\n0,0\n2,1\n1,2\n' > bad.csv
 if "$whirl" lead-report --lead bad.csv 2> err.txt; then echo "accepted a bad file"; exit 1; fi

@@ -144,10 +144,26 @@ TEST(FieldCausal, TheMonitoredValueAtSampleIDependsOnlyOnChecksAndSamplesUpToI) 
   EXPECT_EQ(full.updates, static_cast<int>(checks.size()) - 1);
   const HeldSamples trained = RunCausally(m.shop.sensors, log);
   EXPECT_NE(full.held.k0_um.back(), trained.k0_um.back()) << "the updates move K0";
+  // The samples where a look-ahead of one sample would show: the last one before each check,
+  // the one before it and the one at it; then 12 random ones over the day. A check within 1e-9
+  // min of a sample is taken at that sample (10-s steps summed in minutes round, e.g. to
+  // 749.99999999996 for 750).
+  const double same_time_min = 1e-9;
+  std::vector<int> samples;
+  for (const machine::Reading& r : checks) {
+    int j = 0;
+    while (j + 1 < raw.samples() &&
+           raw.time_min[static_cast<std::size_t>(j) + 1] < r.abs_min - same_time_min)
+      ++j;
+    for (int k : {j - 1, j, j + 1})
+      if (k >= 0 && k + 2 <= raw.samples()) samples.push_back(k);
+  }
+  ASSERT_GE(samples.size(), 6u);
   Rng rng(29);
+  for (int trial = 0; trial < 12; ++trial)
+    samples.push_back(static_cast<int>(rng.Uniform() * (raw.samples() - 2)));
   int changed_later = 0;
-  for (int trial = 0; trial < 12; ++trial) {
-    const int i = static_cast<int>(rng.Uniform() * (raw.samples() - 2));
+  for (const int i : samples) {
     drift::Run later = raw;
     for (int k = i + 1; k < later.samples(); ++k) {
       for (int s = 0; s < later.temperature_C.cols(); ++s) later.temperature_C(k, s) += 5;
@@ -155,7 +171,7 @@ TEST(FieldCausal, TheMonitoredValueAtSampleIDependsOnlyOnChecksAndSamplesUpToI) 
     }
     std::vector<machine::Reading> c = checks;
     for (machine::Reading& r : c)
-      if (r.abs_min > log.time_min[static_cast<std::size_t>(i)]) r.value_um += 30;
+      if (r.abs_min > log.time_min[static_cast<std::size_t>(i)] + same_time_min) r.value_um += 30;
     const MonitoredDay d = run(AverageSensors(later, 5), c);
     for (int k = 0; k <= i; ++k) {
       ASSERT_EQ(full.held.k0_um[static_cast<std::size_t>(k)], d.held.k0_um[static_cast<std::size_t>(k)])

@@ -95,7 +95,7 @@ CONSUMERS=(
   "curve|work|curve --model MODEL --screw $S"
   "plan|work|plan --model MODEL --screw $S --machine $P840 --nc PLAN.SPF --reset-nc PLAN_RESET.SPF --csv plan.csv"
   "plan_drift|work|plan --model MODEL --screw $S --machine $P840 --with-drift-action --nc PLAN.SPF --reset-nc PLAN_RESET.SPF"
-  "compare|work|compare --model MODEL --screw $S"
+  "compare|work|compare --model MODEL --screw $S --history $SRC/datasets/whirling_500.csv"
   "evaluate|work|evaluate --model MODEL --random 1 --no-validation"
   "crosscheck|work_network|crosscheck --model MODEL --data $TABLE"
   "export|work_network|export --model MODEL --torchscript model.pt"

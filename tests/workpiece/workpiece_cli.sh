@@ -32,7 +32,7 @@ grep -q "OUTSIDE" out.txt || fail "row not flagged outside"
   || fail "plan: $(cat err.txt)"
 "$whirl" curve --model fam.json --screw "$screw" --out curve.csv > /dev/null 2> err.txt \
   || fail "curve: $(cat err.txt)"
-"$whirl" compare --model fam.json --screw "$screw" --json > cmp.json 2> err.txt \
+"$whirl" compare --model fam.json --screw "$screw" --history "$src/datasets/whirling_500.csv" --json > cmp.json 2> err.txt \
   || fail "compare: $(cat err.txt)"
 grep -q '"model": "max_elongation_um: ' cmp.json || fail "compare does not name the model"
 grep -q '"model_vs_regression"' cmp.json || fail "compare lacks model vs regression"

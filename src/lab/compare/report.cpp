@@ -53,7 +53,7 @@ std::string StrategyLabel(Strategy s) {
     case Strategy::kRegression:
       return "regression (log-linear features, 840D plan)";
     case Strategy::kModel:
-      return "model (network, 840D plan)";
+      return "model (workpiece model, 840D plan)";
     case Strategy::kClass:
       return "class (diameter-class means, 840D plan)";
     case Strategy::kTable:
@@ -391,14 +391,17 @@ std::vector<plan::ControlLoad> ControlLoads(const std::vector<ScrewComparison>& 
 }
 
 // How to read the page; the strategies are listed from kStrategies.
-std::string HowToRead() {
+std::string HowToRead(const std::string& history) {
   std::string names;
   for (Strategy s : kStrategies) names += (names.empty() ? "" : "; ") + StrategyLabel(s);
   return "<h2>How to read this page</h2>\n<p>Each screw is cut in the simulator (the ground "
          "truth, with seeded disturbances the model never saw) once per strategy: " +
          HtmlEscape(names) +
          ". The curve-based strategies share the model's curve shape and 840D planning; the "
-         "history of past screws is the one the model was trained on. Travel deviation = actual "
+         "history rules (ramp, class, table, nearest, traditional, regression) use the past "
+         "screws of " +
+         HtmlEscape(history.empty() ? "the history named under the title" : history) +
+         ". Travel deviation = actual "
          "minus specified travel from the thread start after cooling; accumulated error within "
          "1000 mm = the largest max - min of the deviation within any 1000 mm of thread (the "
          "paper's figure), over the whole thread = max - min over the thread. e_a, v_u, v_300, "
@@ -416,7 +419,7 @@ std::string IndexHtml(const ReportOptions& options, const std::vector<std::strin
   html << HtmlPageBegin(options.title, options.provenance) << ControlBoxHtml(loads);
   for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
   for (const auto& w : warnings) html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
-  html << sections << HowToRead() << HtmlPageEnd();
+  html << sections << HowToRead(options.history) << HtmlPageEnd();
   return html.str();
 }
 

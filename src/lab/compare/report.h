@@ -48,6 +48,9 @@ struct ReportOptions {
   /// Missing entries: the box shows the plan's setting data and says that `whirl plan` writes
   /// the programs.
   std::vector<plan::ControlLoad> control;
+  /// Where the history rules' past screws come from (e.g. "table.csv (24 screws)"), stated in
+  /// "How to read this page"; empty: the page points to the lines under the title.
+  std::string history;
 };
 
 struct ReportResult {
