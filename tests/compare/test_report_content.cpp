@@ -149,8 +149,9 @@ TEST_F(ReportContent, LegendNamesTheModelsFamily) {
     WriteReport(dir, {c}, o);
     return ReadTextFile(dir / (Slug(c.screw.name) + ".gp"));
   };
-  EXPECT_NE(legend(*comparison_, "whirl_report_legend_network").find("'model (network, 840D plan)'"),
-            std::string::npos);
+  EXPECT_NE(
+      legend(*comparison_, "whirl_report_legend_network").find("'model (network, 840D plan)'"),
+      std::string::npos);
   ScrewComparison power = *comparison_;
   power.model_family = "power law";
   const std::string gp = legend(power, "whirl_report_legend_power");

@@ -127,7 +127,8 @@ std::string LeadPlot(const ScrewComparison& c, const std::string& slug, const st
   // The key below in two columns: room for its rows, the x label and the tick labels. gnuplot
   // overestimates the width of pngcairo's text, so two columns of the long labels ran past the
   // picture's right edge; "width -8" takes 8 characters off each column.
-  s << "set key below horizontal box maxcols 2 width -8\nset bmargin " << (c.outcomes.size() + 1) / 2 + 5
+  s << "set key below horizontal box maxcols 2 width -8\nset bmargin "
+    << (c.outcomes.size() + 1) / 2 + 5
     << "\nset output " << GnuplotString(png) << "\nset title "
     << GnuplotString(c.screw.name + ": " + title) << " noenhanced\n"
     << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"

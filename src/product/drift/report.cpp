@@ -345,7 +345,8 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
     // The line looks of core/plot_style.h; the key right of the data, the panels aligned.
     gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
        << GnuplotString(x) << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\n"
-       << "set title " << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column)
+       << "set title "
+       << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column)
        << "\nplot " << GnuplotString(plot_csv) << " using " << xcol
        << ":($2-$4):($2+$4) with filledcurves fs transparent solid 0.15 noborder lc rgb '"
        << FindSeriesStyle("prediction")->colour << "' title 'predicted +- 1 sd', '' using "
