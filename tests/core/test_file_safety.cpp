@@ -263,14 +263,18 @@ TEST(OutputDir, ADirectoryAtOneTargetWritesNothing) {
 
 // A run killed (no destructor, no Commit) while it staged files for a program: forked, so its
 // process is gone afterwards, like a kill -9.
-fs::path KilledRunsStaging(const fs::path& d) {
+// `staged` is what the run did before it was killed (default: staged map.gp, then added map.csv).
+fs::path KilledRunsStaging(const fs::path& d,
+                           const std::function<void(OutputDir&)>& staged = [](OutputDir& out) {
+                             out.Add("map.gp", "plot x");
+                             out.Staging();
+                             out.Add("map.csv", "1,2\n");
+                           }) {
   const pid_t child = ::fork();
   if (child == 0) {
     try {
       OutputDir out(d, "--out-dir");
-      out.Add("map.gp", "plot x");
-      out.Staging();
-      out.Add("map.csv", "1,2\n");
+      staged(out);
       ::_exit(0);  // no destructor: what a kill -9 leaves
     } catch (...) {
       ::_exit(1);
@@ -303,25 +307,11 @@ TEST(OutputDir, KilledRunsDebrisIsIgnoredAndRemoved) {
 TEST(OutputDir, AKilledProgramsNamedOutputsAreWhirlsAndNothingElse) {
   const fs::path d = Scratch("out_killed_program");
   const auto killed_while_program_ran = [&] {
-    const pid_t child = ::fork();
-    if (child == 0) {
-      try {
-        OutputDir out(d, "--out-dir");
-        out.Add("map.gp", "plot x");
-        out.RunInStaging({"/bin/sh", "-c", "printf png > map.png; echo started"}, "gnuplot.log",
-                         {"map.png"});
-        ::_exit(0);  // killed before AddStaged and Commit
-      } catch (...) {
-        ::_exit(1);
-      }
-    }
-    int status = 0;
-    ::waitpid(child, &status, 0);
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-    for (const auto& e : fs::directory_iterator(d))
-      if (e.path().filename().string().rfind(".whirl-stage-", 0) == 0) return e.path();
-    ADD_FAILURE() << "the killed run left no staging folder";
-    return fs::path{};
+    return KilledRunsStaging(d, [](OutputDir& out) {
+      out.Add("map.gp", "plot x");
+      out.RunInStaging({"/bin/sh", "-c", "printf png > map.png; echo started"}, "gnuplot.log",
+                       {"map.png"});
+    });
   };
   const fs::path stage = killed_while_program_ran();
   EXPECT_EQ(Entries(stage),
