@@ -421,6 +421,25 @@ GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x) {
   return p;
 }
 
+Eigen::MatrixXd PosteriorCovariance(const Gp& gp, const Eigen::MatrixXd& x) {
+  const int d = gp.InputCount();
+  if (x.rows() != d)
+    throw InputError("gaussian process: covariances need " + std::to_string(d) +
+                     " inputs, got " + std::to_string(x.rows()));
+  const Eigen::MatrixXd zs =
+      gp.input_scale.cwiseInverse().asDiagonal() * (x.colwise() - gp.input_shift);
+  const Eigen::VectorXd length = gp.theta.head(d).array().exp();
+  const double sf2 = std::exp(2.0 * gp.theta(d));
+  Eigen::MatrixXd ks, kss;
+  KernelMatrices(gp.kernel, gp.z, zs, length, sf2, &ks, nullptr);  // n x q
+  KernelMatrices(gp.kernel, zs, zs, length, sf2, &kss, nullptr);   // q x q
+  const Eigen::MatrixXd v = gp.chol.matrixL().solve(ks);
+  const Eigen::MatrixXd r = Basis(gp.mean, zs).transpose() - gp.k_inv_h.transpose() * ks;
+  const Eigen::MatrixXd ar = gp.a_chol.matrixL().solve(r);
+  const Eigen::MatrixXd c = kss - v.transpose() * v + ar.transpose() * ar;
+  return c * (gp.target_scale * gp.target_scale);
+}
+
 // The diagonal of P = K^-1 - K^-1 H (H' K^-1 H)^-1 H' K^-1 (the header's leave-one-out comment).
 Eigen::ArrayXd ProjectionDiagonal(const Gp& gp) {
   const Eigen::MatrixXd k_inv = InverseFromCholesky(gp.chol);

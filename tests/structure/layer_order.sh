@@ -12,7 +12,8 @@ LAYERS=(
   "fit family drift torch"     # curve fits (sim), model families (gp, nn), drift (nn), LibTorch (nn)
   "interp machine workpiece"   # 840D output (drift, fit), machine errors (drift, sim), the
                                # workpiece model (family, nn)
-  "ballbar surface compare"    # ball bar, worktable, strategy comparison (machine, interp, ...)
+  "ballbar surface compare design"  # ball bar, worktable, strategy comparison (machine, interp,
+                               # ...), which screws to measure (workpiece)
   "machine_eval"               # the machine evaluation (compare, machine)
   "cli"                        # the command line: parses and calls the library
 )
