@@ -26,6 +26,7 @@ Usage: python3 scripts/design_study.py --whirl build/whirl --problems simgen,pow
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -47,7 +48,13 @@ STRATEGIES = ["random", "lhs", "natural", "design"]
 def run(cmd):
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
-        sys.exit(f"design_study: {' '.join(cmd)} failed: {r.stderr}")
+        kept = ""
+        if "--data" in cmd:  # keep the table that failed to train for a bug report
+            kept = os.path.join(tempfile.gettempdir(), "design_study_failed_" + os.path.basename(
+                os.path.dirname(cmd[cmd.index("--data") + 1])) + ".csv")
+            shutil.copy(cmd[cmd.index("--data") + 1], kept)
+            kept = f" (table kept: {kept})"
+        sys.exit(f"design_study: {' '.join(cmd)} failed{kept}: {r.stderr}")
     return r.stdout
 
 

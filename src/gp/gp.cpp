@@ -271,6 +271,11 @@ Gp FitFromStarts(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOpt
   const int count = static_cast<int>(sub.u.size()) < o.single_start_rows ? o.restarts : 1;
   Optimize(o, starts.empty() ? StartPoints(sub, count) : starts, &sub, summary);
   gp.theta = sub.theta;
+  // A noise sd the likelihood drove to 0 (ln below -30: exp(-60) = 9e-27 standardized variance,
+  // far below min_noise_variance's 1e-12 floor) is written as -30, the rule a file's numbers
+  // must keep (kThetaRange below): the same predictions, and a model file that loads.
+  const Eigen::Index noise = gp.theta.size() - 1;
+  gp.theta(noise) = std::max(gp.theta(noise), -30.0);
   gp.noise_variance = gp.SigmaN2();
   gp.Factorize();
   return gp;
