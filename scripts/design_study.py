@@ -204,7 +204,7 @@ def plot(table, path, gnuplot="gnuplot"):
         cmds = [f"set terminal pngcairo size 1400,{420 * len(table)} font ',10'",
                 f"set output '{path}'", f"set multiplot layout {len(table)},2",
                 "set logscale y", "set xlabel 'measured screws N'", "set key top right",
-                "set grid"]
+                "set grid", "set termoption noenhanced"]
         for prob, rows in table.items():
             for k, out in enumerate(bp.TARGETS):
                 files = []
@@ -236,7 +236,17 @@ def main():
     ap.add_argument("--sim-cache", default=os.path.join(tempfile.gettempdir(), "whirl_design_sim"))
     ap.add_argument("--json", help="write every case's RMSE and the medians here")
     ap.add_argument("--plot", help="PNG of the medians (gnuplot)")
+    ap.add_argument("--from-json", help="print (and --plot) the medians of an earlier --json run")
     a = ap.parse_args()
+    if a.from_json:
+        saved = json.load(open(a.from_json))
+        table = {p: {s: {int(n): v for n, v in r.items()} for s, r in rows.items()}
+                 for p, rows in saved["medians"].items()}
+        print(f"criterion {saved['criterion']}, batch {saved['batch']}, seeds {saved['seeds']}")
+        print_markdown(table)
+        if a.plot:
+            plot(table, a.plot)
+        return
     os.makedirs(a.sim_cache, exist_ok=True)
     problems = a.problems.split(",")
     cases = [(p, s) for p in problems for s in seeds_of(a.seeds)]
