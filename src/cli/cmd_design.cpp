@@ -270,7 +270,7 @@ void RegisterDesign(CLI::App& app) {
   sub->add_option("--count", o->count, "number of screws to pick (first design: at least the "
                                        "power law's coefficients, 6)")
       ->required()
-      ->check(CLI::Range(1, 100000));
+      ->check(NumberIn(1, 100000));
   sub->add_option("--candidates", o->candidates_path, "candidate screws (CSV, five input columns)")
       ->check(CLI::ExistingFile);
   const std::array<const char*, ProcessInputs::kCount> what = {
@@ -280,8 +280,9 @@ void RegisterDesign(CLI::App& app) {
     sub->add_option(kDesignRangeFlags[j], o->ranges[j],
                     std::string(what[j]) + " (instead of --candidates; one value: fixed)");
   sub->add_option("--levels", o->levels,
-                  "grid levels per input over the ranges, log spacing (2..9)")
-      ->capture_default_str();
+                  "grid levels per input over the ranges, log spacing")
+      ->capture_default_str()
+      ->check(NumberIn(2, 9));
   sub->add_option("--criterion", o->criterion,
                   "first design: d (D-optimal: the power law's coefficients) or i (I-optimal: its "
                   "mean prediction variance over the candidates)")
