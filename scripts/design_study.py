@@ -124,13 +124,17 @@ class Evaluator:
         return bp.rmse(mean, self.truth).tolist()
 
 
-def designed(ev, criterion, batch):
-    """RMSE per size of the sequential design: FIRST by the first design, then batches."""
+def designed(ev, criterion, batch, first_lhs=None):
+    """RMSE per size of the sequential design: FIRST by the first design (or the Latin hypercube
+    picks `first_lhs`), then batches."""
     pool = os.path.join(ev.tmp, "pool.csv")
     bp.write_table(pool, ev.x)
-    out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
-                          "--criterion", criterion, "--json"]))
-    picked = [int(p["source"].split()[1]) - 2 for p in out["picks"]]  # line -> row (header line 1)
+    if first_lhs is not None:
+        picked = list(first_lhs)
+    else:
+        out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
+                              "--criterion", criterion, "--json"]))
+        picked = [int(p["source"].split()[1]) - 2 for p in out["picks"]]  # line -> row
     result = {}
     while True:
         model = ev.train(picked, "design")
@@ -160,7 +164,8 @@ def one_case(prob, seed, a, cache):
             res["random"] = {n: ev.rmse(ev.train(order[:n], "r")) for n in SIZES}
             res["lhs"] = {n: ev.rmse(ev.train(lhs_pick(x, n, rng), "l")) for n in SIZES}
             res["natural"] = {n: ev.rmse(ev.train(nat[:n], "n")) for n in SIZES}
-        res["design"] = designed(ev, a.criterion, a.batch)
+        first = lhs_pick(x, FIRST, np.random.default_rng([7, seed])) if a.first == "lhs" else None
+        res["design"] = designed(ev, a.criterion, a.batch, first)
         return prob, seed, res
 
 
@@ -230,7 +235,9 @@ def main():
     ap.add_argument("--problems", default="simgen,powerlaw")
     ap.add_argument("--seeds", default="1-10")
     ap.add_argument("--criterion", default="d", choices=["d", "i"])
-    ap.add_argument("--batch", type=int, default=4)
+    ap.add_argument("--batch", type=int, default=2)
+    ap.add_argument("--first", default="design", choices=["design", "lhs"],
+                    help="the design strategy's first 8 screws: whirl design, or a Latin hypercube")
     ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
     ap.add_argument("--design-only", action="store_true", help="only the design strategy")
     ap.add_argument("--sim-cache", default=os.path.join(tempfile.gettempdir(), "whirl_design_sim"))
