@@ -19,6 +19,10 @@ function(whirl_library folder)
   whirl_set_warnings(whirl_${folder})
   target_compile_options(whirl_${folder} PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})
   whirl_unity_build(whirl_${folder})
+  # A lab library's headers are found under src/lab (the product's under src/product, from core).
+  if(CMAKE_CURRENT_SOURCE_DIR MATCHES "/src/lab/")
+    target_include_directories(whirl_${folder} PUBLIC ${PROJECT_SOURCE_DIR}/src/lab)
+  endif()
 endfunction()
 
 # whirl_unity_build(<target>): compile the target's files in batches of WHIRL_UNITY_BATCH_SIZE, one

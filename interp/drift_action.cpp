@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/error.h"
 #include "core/numbers.h"
@@ -651,6 +652,62 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
   out += PlcRows("k0_mm", m, o, DriftControlCoefficients(m, o), kDecimalsDriftCoefficient);
   if (g)
     out += PlcRows("slope", *g, o, DriftSlopeCoefficients(*g, o), kDecimalsDriftSlopeCoefficient);
+  return out;
+}
+
+std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& m,
+                                                  const DriftActionOptions& o,
+                                                  const drift::DriftModel* g) {
+  o.Validate();
+  CheckModel(m);
+  if (g) CheckModel(*g);
+  const Slots s = MakeSlots(m, g, o.param_first);
+  const auto actions = static_cast<double>(ActionBodies(m, g, o, s).size());
+  const ControlLimits& c = o.control;
+  const double unstated = std::numeric_limits<double>::quiet_NaN();
+  auto stated = [&](int v) { return c.Stated() ? static_cast<double>(v) : unstated; };
+  const std::string program = " (" + o.program_name + ")";
+  std::vector<ControlRequirement> out;
+  const bool slope_mode = SlopeMode(o, g);
+  ControlRequirement type = MakeRequirement(
+      "MD32750 $MA_TEMP_COMP_TYPE", o.axis, RequirementRule::kBits, RequirementMerge::kUnion,
+      slope_mode ? 3.0 : 1.0, 0,
+      (slope_mode ? std::string("SD43900 and SD43910/SD43920") : "SD43900") + program);
+  out.push_back(type);
+  if (g) {
+    ControlRequirement velo =
+        MakeRequirement("MD32760 $MA_COMP_ADD_VELO_FACTOR", o.axis, RequirementRule::kAtLeast,
+                        RequirementMerge::kSum, DriftSlopeBound(*g, o), kDecimalsSd43910,
+                        "the machine slope's bound over the training ranges" + program);
+    out.push_back(velo);
+  }
+  ControlRequirement sync = MakeRequirement(
+      "MD28250 $MC_MM_NUM_SYNC_ELEMENTS", "", RequirementRule::kAtLeast, RequirementMerge::kSum,
+      actions, 0,
+      FormatFixed(actions, 0) + " static actions, IDS=" + std::to_string(o.sync_id_first) + ".." +
+          std::to_string(o.sync_id_first + static_cast<int>(actions) - 1) + " of the range " +
+          std::to_string(o.sync_id_first) + ".." + std::to_string(o.sync_id_last) +
+          " it cancels first" + program);
+  sync.stated = stated(c.sync_elements);
+  out.push_back(sync);
+  ControlRequirement ac =
+      MakeRequirement("MD28254 $MC_MM_NUM_AC_PARAM", "", RequirementRule::kAtLeast,
+                      RequirementMerge::kMax, static_cast<double>(s.last + 1), 0,
+                      "$AC_PARAM up to index " + std::to_string(s.last) + program);
+  ac.stated = stated(c.ac_params);
+  out.push_back(ac);
+  ControlRequirement ain = MakeRequirement(
+      "MD10300 $MN_FASTIO_ANA_NUM_INPUTS", "", RequirementRule::kAtLeast, RequirementMerge::kMax,
+      static_cast<double>(LargestAnalogIndex(m, g, o)), 0,
+      "analog inputs up to $A_INA[" + std::to_string(LargestAnalogIndex(m, g, o)) + "]" + program);
+  ain.stated = stated(c.analog_inputs);
+  out.push_back(ain);
+  const int r = o.save_r_first;
+  ControlRequirement rp =
+      MakeRequirement("MD28050 $MC_MM_NUM_R_PARAM", "", RequirementRule::kAtLeast,
+                      RequirementMerge::kMax, static_cast<double>(r + 5), 0,
+                      Rp(r) + ".." + Rp(r + 4) + ": setting data found, markers" + program);
+  out.push_back(rp);
   return out;
 }
 

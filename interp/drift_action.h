@@ -1,5 +1,5 @@
 #pragma once
-// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/drift, kinds mlr and
+// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/product/drift, kinds mlr and
 // dynamic) evaluated every interpolation cycle by static synchronized actions from the machine's
 // analog inputs, written into SD43900 $SA_TEMP_COMP_ABS_VALUE (the position-independent K0 that
 // Siemens designed for exactly this, Siemens K3), plus the same model as a PLC table.
@@ -46,7 +46,7 @@
 // run in ID order each cycle, so the plan's K0 is written before it is added (no cycle of lag).
 //
 // The machine's slope (optional second model, e.g. the Z feed screw growing from its fixed
-// bearing; machine/machine.h channel zscrew_per_1000_um). Its output g [um per 1000 mm] is the
+// bearing, trained on a lead-slope channel such as zscrew_per_1000_um). Its output g [um per 1000 mm] is the
 // growth of the error with the distance from the fixed end P_b (profile drift.slope):
 //   e(P) = e_K + g * sigma * (P - P_b) / 1000   [um along error_direction],
 // sigma = growth_direction (+1: the distance from the fixed end grows towards +axis). So the
@@ -70,6 +70,7 @@
 #include <vector>
 
 #include "drift/model.h"
+#include "interp/control_requirements.h"
 #include "interp/sinumerik.h"
 
 namespace whirl::interp {
@@ -187,8 +188,18 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
 
 /// The largest |S_m| the slope model gives over its training ranges (a box bound: |c_0| +
 /// sum |c_f| max(|min_f|, |max_f|)), mm/mm. The plan's slopes plus this must stay within MD32760
-/// (machine_eval/machine_nc.h checks it for the combined programs).
+/// (machine_report/machine_nc.h checks it for the combined programs).
 double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options);
+
+/// What the control must provide for the drift program (control_requirements.h), the same
+/// thresholds its header states: MD10300 >= the largest $A_INA index read, MD28254 >= the last
+/// $AC_PARAM slot + 1, MD28250 room for its static actions, MD32750 bit 0 (and bit 1 with a
+/// slope model that owns SD43910/SD43920) on the axis and, with a slope model, MD32760 >= its
+/// slope bound (DriftSlopeBound); each with the profile's value when options.control states it.
+/// InputError as FormatDriftNcProgram for a model it cannot write.
+std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& model,
+                                                  const DriftActionOptions& options,
+                                                  const drift::DriftModel* slope = nullptr);
 
 inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)
 inline constexpr int kDecimalsDriftSlopeCoefficient = 14;  ///< mm/mm per K: 1e-14 per K

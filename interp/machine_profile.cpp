@@ -258,6 +258,10 @@ void MachineProfile::Fill(PlanOptions& o) const {
   if (drift) o.drift_missing_alarm = drift->missing_alarm;
 }
 
+bool MachineProfile::Illustrative() const {
+  return name.find("illustrative values") != std::string::npos;
+}
+
 MachineProfile LoadMachineProfile(const std::filesystem::path& path) {
   const nlohmann::json j = ReadJsonFile(path);
   const std::string what = "machine profile '" + path.string() + "'";

@@ -112,6 +112,9 @@ struct MachineProfile {
   /// The drift action's options (axis, control_dk and the control's limits from the profile).
   /// InputError if absent. Validates the profile first.
   DriftActionOptions DriftOptions() const;
+  /// True while the name still says "illustrative values" (the shipped example_840d.json, copied
+  /// and not yet made the user's): plan and drift nc warn that its values are not a machine's.
+  bool Illustrative() const;
   std::string source;  ///< file name, for messages
 
  private:

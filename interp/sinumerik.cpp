@@ -809,4 +809,45 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
   return nc;
 }
 
+std::vector<ControlRequirement> PlanRequirements(const CompensationPlan& plan,
+                                                 const std::string& program) {
+  const PlanOptions& o = plan.options;
+  std::vector<ControlRequirement> out;
+  ControlRequirement type = MakeRequirement("MD32750 $MA_TEMP_COMP_TYPE", o.axis,
+                                            RequirementRule::kBits, RequirementMerge::kUnion, 3, 0,
+                                            "SD43900 and SD43910/SD43920 (" + program + ")");
+  out.push_back(type);
+  ControlRequirement velo = MakeRequirement(
+      "MD32760 $MA_COMP_ADD_VELO_FACTOR", o.axis, RequirementRule::kAtLeast, RequirementMerge::kSum,
+      plan.max_abs_slope, kDecimalsSd43910, "the largest |SD43910| of " + program);
+  out.push_back(velo);
+  const auto ids = static_cast<int>(SyncIdsNeeded(plan));
+  ControlRequirement sync = MakeRequirement(
+      "MD28250 $MC_MM_NUM_SYNC_ELEMENTS", "", RequirementRule::kAtLeast, RequirementMerge::kSum,
+      static_cast<double>(ids), 0,
+      std::to_string(ids) + " synchronized actions, IDs " + std::to_string(o.sync_id_first) + ".." +
+          std::to_string(o.sync_id_first + ids - 1) + " of the range " +
+          std::to_string(o.sync_id_first) + ".." + std::to_string(o.sync_id_last) +
+          " it cancels first (" + program + ")");
+  out.push_back(sync);
+  if (!SlopeHandedOver(o) && o.HasSaveR()) {
+    const int m = o.save_r_first;
+    ControlRequirement r = MakeRequirement(
+        "MD28050 $MC_MM_NUM_R_PARAM", "", RequirementRule::kAtLeast, RequirementMerge::kMax,
+        static_cast<double>(m + 4), 0,
+        R(m) + ".." + R(m + 3) + " (setting data found before the cut, marker; " + program + ")");
+    out.push_back(r);
+  }
+  int last = std::max(o.drift_alive_param, o.workpiece_k0_param);
+  if (SlopeHandedOver(o)) last = std::max(last, o.workpiece_slope_param + 1);
+  if (last >= 0) {
+    ControlRequirement ac =
+        MakeRequirement("MD28254 $MC_MM_NUM_AC_PARAM", "", RequirementRule::kAtLeast,
+                        RequirementMerge::kMax, static_cast<double>(last + 1), 0,
+                        "$AC_PARAM up to index " + std::to_string(last) + " (" + program + ")");
+    out.push_back(ac);
+  }
+  return out;
+}
+
 }  // namespace whirl::interp

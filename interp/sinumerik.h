@@ -27,6 +27,7 @@
 #include "core/numbers.h"  // FormatFixed: every value the control reads
 #include "fit/arctan_curve.h"
 #include "interp/breakpoints.h"
+#include "interp/control_requirements.h"
 
 namespace whirl::interp {
 
@@ -314,5 +315,13 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
 /// R<m+3> is 1, write back the saved SD43900/43910/43920 and clear the marker; M17. InputError if
 /// the IDs or (unless the slope is handed over) the R parameters are not set.
 std::string FormatNcResetProgram(const PlanOptions& options, const NcProgramInfo& info = {});
+
+/// What the control must provide for the plan's program (control_requirements.h), the same
+/// thresholds its header states: MD32750 bits 0 and 1 on the axis, MD32760 >= the largest
+/// |SD43910|, MD28250 room for its synchronized actions (one per segment and the restore) and,
+/// when it uses $AC_PARAM (the drift action's liveness slot, the hand-over slots), MD28254 >=
+/// the largest index + 1. `program` names the program in the uses.
+std::vector<ControlRequirement> PlanRequirements(const CompensationPlan& plan,
+                                                 const std::string& program);
 
 }  // namespace whirl::interp

@@ -6,7 +6,7 @@ Problem 1, "friedman" (generated; Friedman 1991, "Multivariate adaptive regressi
   out1 = 10 sin(pi x1 x2) + 20 (x3 - 0.5)^2 + 10 x4 + 5 x5 + N(0, 1^2)          (Friedman #1)
   out2 = 50 exp(-2 ((x1 - 0.5)^2 + (x3 - 0.5)^2)) + 30 x2 x5 + 20 sin(pi x4) + N(0, 3^2)
   (out1 -> max_elongation_um, out2 -> settle_time_s; the names only satisfy whirl's table format).
-  whirl's tables must hold physically plausible values (src/core/limits.h), so every method sees
+  whirl's tables must hold physically plausible values (src/product/core/limits.h), so every method sees
   the inputs mapped affinely to INPUT_LO + INPUT_SPAN * x and the targets (and the noise-free
   truth) shifted by +TARGET_OFFSET; whirl and the peers rescale inputs and targets affinely, so
   this changes neither the RMSE nor the coverage.
@@ -51,7 +51,7 @@ network: trainbr with R brnn's stopping rule, raw columns; R brnn itself is not 
   loglinear:   LinearRegression() of ln y on ln x per output (a power law in the five inputs,
                6 coefficients per output), predictions exp(.); the physics-shaped baseline
                (every input and both features are positive). Skipped (NaN) when a column is <= 0.
-The family library (src/family, src/gp; `--family-bench build/family_bench --family NAME=ARGS`)
+The family library (src/product/family, src/product/gp; `--family-bench build/family_bench --family NAME=ARGS`)
 is run in-process by the development driver tests/family/family_bench.cpp with ARGS (e.g.
 "--candidates gp-matern52-constant/log --no-cv"; NAME=default: the default choice); its
 fit_time_ms is the driver's wall time of the fit on one thread.

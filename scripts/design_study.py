@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Which screws to measure: test RMSE of the default `whirl train` model against the number of
-measured screws N for four ways of choosing them (docs/design.md, src/design/design.h).
+measured screws N for four ways of choosing them (docs/design.md, src/product/design/design.h).
 
 Per problem and seed: a candidate list ("pool", the screw types coming up) of POOL_ROWS screws with
 their noisy measured targets, and a test set with the noise-free truth. Every strategy picks its N

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Surface study: cubic polynomial vs B-spline on the documented synthetic fields
-# (src/surface/synthetic.h) over many noise seeds, through the command line only:
+# (src/lab/synthetic/surface.h) over many noise seeds, through the command line only:
 #   whirl surface synth --field F --noise-um S --seed k, then whirl surface compare --json,
 # and the 840D line of the noise-free smooth and bump fields. Prints, per setting, the mean
 # leave-one-out RMS of both methods on the common points, how often the B-spline is lower, how

@@ -5,7 +5,7 @@
 
 #include "ballbar/circle.h"
 #include "ballbar/drift.h"
-#include "ballbar/simulate.h"
+#include "synthetic/ballbar.h"
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "core/atomic_file.h"
@@ -171,14 +171,14 @@ void AddCircle(CLI::App& parent) {
 struct SimulateCmd {
   std::string out_dir;
   bool json = false;
-  ballbar::WarmupOptions o;
+  synthetic::WarmupOptions o;
 };
 
 void AddSimulate(CLI::App& parent) {
   auto c = std::make_shared<SimulateCmd>();
   auto* sub = parent.add_subcommand(
       "simulate",
-      "Writes the documented SIMULATED ball-bar measurement (src/ballbar/simulate.h): a spindle\n"
+      "Writes the documented SIMULATED ball-bar measurement (src/lab/synthetic/ballbar.h): a spindle\n"
       "warm-up (drift 2-10 um in X, Y and 20-60 um in Z, seeded) read with bar noise 0.1 um at\n"
       "0.1 um resolution and a warming bar (readings.csv, pivots.json, truth_drift.csv), circle\n"
       "traces with a planted scale mismatch, cyclic error and XZ parallelism, and a README.md.");
@@ -192,7 +192,7 @@ void AddSimulate(CLI::App& parent) {
   sub->add_flag("--json", c->json, "machine output: JSON on stdout");
   sub->callback([c] {
     CheckOutputs({}, {}, {{"--out-dir", c->out_dir}});
-    const nlohmann::json j = ballbar::WriteSimulatedMeasurement(c->out_dir, c->o);
+    const nlohmann::json j = synthetic::WriteSimulatedMeasurement(c->out_dir, c->o);
     if (c->json) return PrintJson(j);
     for (const auto& f : j["files"]) std::printf("wrote %s\n", f.get<std::string>().c_str());
   });

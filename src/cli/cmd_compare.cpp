@@ -11,7 +11,7 @@
 #include "core/output_dir.h"
 #include "core/process.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -24,7 +24,7 @@ struct CompareCliOptions {
   std::string report_dir;
   bool no_plots = false;
   bool no_disturbances = false;
-  std::string history = ProjectPath(kHistoryTable);
+  std::string history;
   std::string iso_table = ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv");
   double tolerance_um = interp::PlanOptions{}.tolerance_um;
   double md32760 = interp::kMd32760Default;
@@ -39,10 +39,15 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
                 {"--iso-table", o.iso_table}},
                {}, {{"--out-dir", o.report_dir}});
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
-  const sim::Screw screw = sim::ReadScrew(o.screw_path);
-  const compare::ExperienceRule rule =
-      compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
-  const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
+  const screw::Screw screw = screw::ReadScrew(o.screw_path);
+  const ProcessTable past = ReadProcessTable(o.history, /*require_targets=*/true);
+  const compare::ExperienceRule rule = compare::BuildExperienceRule(past);
+  // Said on stdout (stderr under --json) and on the page: the baselines are only as good as
+  // the screws they come from.
+  const std::string history =
+      o.history + " (" + std::to_string(past.inputs.size()) + " past screws)";
+  std::fprintf(o.json ? stderr : stdout, "history rules from: %s\n", history.c_str());
+  const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(o.iso_table);
   compare::CompareOptions co;
   co.seed = o.seed;
   co.disturbances_on = !o.no_disturbances;
@@ -57,6 +62,7 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
   if (!o.report_dir.empty()) {
     compare::ReportOptions ro;
     ro.plots = !o.no_plots;
+    ro.history = history;
     ro.provenance = {"command: " + command_line, "model: " + o.model_path, "screw: " + o.screw_path,
                      "history (traditional rule): " + o.history,
                      "truth seed: " + std::to_string(o.seed)};
@@ -125,10 +131,13 @@ void RegisterCompare(CLI::App& app) {
           std::string(kOutputDirRule));
   AddDeprecatedAlias(sub, report, "--report");
   sub->add_flag("--no-plots", o->no_plots, "with --out-dir: skip gnuplot (data and HTML only)");
+  // Required: a default would grade the user's model against screws the shop never cut.
   sub->add_option("--history", o->history,
-                  "past screws for the traditional rule: process table with targets "
-                  "(default: " +
-                      std::string(kHistoryTable) + ", the table models/default.json is trained on)")
+                  "past screws of the history rules (ramp, class, table, nearest, traditional, "
+                  "regression): a process table with targets, normally the table.csv your model "
+                  "was trained on (the shipped model's: " +
+                      std::string(kHistoryTable) + ")")
+      ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV (default: shipped)")
       ->check(CLI::ExistingFile);

@@ -1,4 +1,4 @@
-// whirl curve: the arctan elongation curve (src/fit/arctan_curve.h) from a model's prediction for a
+// whirl curve: the arctan elongation curve (src/product/fit/arctan_curve.h) from a model's prediction for a
 // screw, or from given features, sampled as CSV time_s,elongation_um.
 #include <cmath>
 #include <cstdio>
@@ -15,7 +15,7 @@
 #include "core/output_dir.h"
 #include "fit/arctan_curve.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -45,8 +45,8 @@ void Run(const CurveOptions& o) {
     if (o.source.model_path.empty() || o.source.screw_path.empty())
       throw InputError("curve: --model and --screw go together (got only " +
                        std::string(o.source.model_path.empty() ? "--screw" : "--model") + ")");
-    const sim::Screw screw = sim::ReadScrew(o.source.screw_path);
-    const sim::Kinematics kin = sim::ComputeKinematics(screw);
+    const screw::Screw screw = screw::ReadScrew(o.source.screw_path);
+    const screw::Kinematics kin = screw::ComputeKinematics(screw);
     const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.source.model_path);
     const workpiece::Prediction pred = workpiece::Predict(model, screw.process);
     GuardTrainingDomain(pred.outside_domain, pred.outside_domain_fields, o.source.screw_path,

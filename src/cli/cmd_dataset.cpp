@@ -1,4 +1,4 @@
-// whirl dataset: simulated process tables for training and validation (src/sim/dataset.h).
+// whirl dataset: simulated process tables for training and validation (src/lab/sim/dataset.h).
 #include <filesystem>
 #include <iostream>
 #include <sstream>

@@ -10,15 +10,18 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "compare/compare.h"
-#include "compare/plan_document.h"
+#include "plan/load.h"
+#include "plan/plan_document.h"
 #include "compare/report.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "interp/machine_profile.h"
-#include "machine_eval/machine_eval.h"  // step 7
+#include "machine/scenarios.h"
+#include "machine_eval/field_eval.h"  // step 7
+#include "machine_report/machine_report.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -34,32 +37,47 @@ struct DemoOptions {
   bool json = false;  ///< a JSON summary on stdout; the step lines go to stderr
 };
 
-// 7. The workpiece plan and a machine drift model on a machine that drifts (cmd_machine.cpp).
-// Returns the summary of step 7 for --json.
+// 7. The workpiece plan and the machine models a shop can train, on one machine of the field
+// world's production scenario (cmd_machine.cpp: whirl machine evaluate); the report of its first
+// test-day screw with the combined 840D programs of the network's plan and both_shop's sensor
+// model. Returns the summary of step 7 for --json.
 nlohmann::json RunDemoMachineStep(const std::filesystem::path& out,
                                   const workpiece::WorkpieceModel& model, std::uint64_t seed,
                                   std::FILE* say) {
-  machine_eval::MachineEvalOptions mo;
-  mo.machines = 1;
-  mo.screws_per_machine = 2;
-  mo.seed = seed;
-  mo.report_dir = (out / "machine_report").string();  // replaces the demo's earlier report
-  // The combined 840D programs of the report's screw, for the simulated machine's profile.
-  mo.profile = interp::LoadMachineProfile(ProjectPath("datasets/machines/whirling_840d.json"));
-  const machine_eval::MachineEvaluation e = machine_eval::EvaluateWithMachines(
-      sim::ReferenceScrew(), model,
+  machine_eval::FieldEvalOptions fo;
+  fo.machines = 1;
+  fo.seed = seed;
+  fo.calendar.test_days = 1;
+  fo.keep_report_screw = true;
+  const machine_eval::SeedsEvaluation e = machine_eval::EvaluateFieldOverSeeds(
+      machine::FindMachineScenario("production"), model,
       compare::BuildExperienceRule(ReadProcessTable(ProjectPath(kHistoryTable), true)),
-      compare::ReadIsoToleranceTable(
-          ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv")),
-      mo);
-  std::fprintf(
-      say,
-      "7. both halves on a drifting machine (whirl machine evaluate): %s\n%s   report: %s\n"
-      "   combined 840D programs (the drift action owns SD43900-43920; the plan hands its K0,\n"
-      "   slope and reference over): %s/WHIRL_DRIFT_COMP.SPF, WHIRL_TEMP_COMP.SPF, resets\n",
-      e.summary.message.c_str(), machine_eval::FormatMachineEvalTable(e, false).c_str(),
-      e.report_index.c_str(), mo.report_dir.c_str());
-  return {{"summary", e.summary.message}, {"report", e.report_index}, {"dir", mo.report_dir}};
+      lead::ReadIsoToleranceTable(ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv")),
+      fo, 1);
+  const machine_eval::MachineEvaluation& run = e.runs.front();
+  std::fprintf(say, "7. both halves on a drifting machine (whirl machine evaluate): %s\n%s",
+               run.summary.message.c_str(), machine_eval::FormatSeedsTable(e, false).c_str());
+  nlohmann::json j = {{"summary", run.summary.message}};
+  if (!run.report) {
+    Warn("step 7: no test-day screw was evaluated without error: no machine report");
+    return j;
+  }
+  // The combined 840D programs of the report's screw, for the simulated machine's profile.
+  const std::string dir = (out / "machine_report").string();  // replaces the earlier report
+  const interp::MachineProfile profile =
+      interp::LoadMachineProfile(ProjectPath("datasets/machines/whirling_840d.json"));
+  const machine_report::MachineReport r =
+      machine_report::WriteMachineScrewReport(dir, *run.report, &profile);
+  if (!r.programs_note.empty()) Warn(r.programs_note);
+  std::fprintf(say,
+               "   report: %s\n   combined 840D programs of what a shop can train (the network's "
+               "plan and both_shop's\n   sensor model; the drift action owns SD43900-43920, the "
+               "plan hands its K0, slope and\n   reference over): %s/WHIRL_DRIFT_COMP.SPF, "
+               "WHIRL_TEMP_COMP.SPF, resets\n",
+               r.index_html.c_str(), dir.c_str());
+  j["report"] = r.index_html;
+  j["dir"] = dir;
+  return j;
 }
 
 // The --json summary of one screw: prediction, plan files and each strategy's accumulated lead
@@ -119,8 +137,8 @@ void RunDemo(const DemoOptions& o) {
   }
 
   const std::string ref_path = ProjectPath("datasets/screws/reference_80x10x6000.json");
-  const sim::Screw reference = sim::ReadScrew(ref_path);  // a missing shipped file is an error
-  const sim::Screw new_type = compare::NewTypeScrew(reference);
+  const screw::Screw reference = screw::ReadScrew(ref_path);  // a missing shipped file is an error
+  const screw::Screw new_type = compare::NewTypeScrew(reference);
   const auto& n = new_type.process;
   std::fprintf(say,
                "2. screws: %s (shipped), and %s defined in code: reference blank with hardness "
@@ -130,7 +148,7 @@ void RunDemo(const DemoOptions& o) {
                n.pitch_mm, n.raceway_radius_mm, n.cutting_speed_m_min);
 
   const compare::ExperienceRule rule = compare::BuildExperienceRule(history);
-  const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(
+  const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(
       ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv"));
   compare::CompareOptions co;
   co.seed = o.seed;
@@ -139,10 +157,10 @@ void RunDemo(const DemoOptions& o) {
       interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile));
   profile.ApplyTo(co.plan);
   std::vector<compare::ScrewComparison> results;
-  std::vector<compare::ControlLoad> control;  // the report's "load onto the control" box
+  std::vector<plan::ControlLoad> control;  // the report's "load onto the control" box
   // The NC files' stems are their program names on the control (letters, digits, '_', at most
   // 24 characters: interp::CheckProgramName), so they cannot carry the screw's name.
-  const std::pair<const sim::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
+  const std::pair<const screw::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
                                                               {&new_type, "WHIRL_NEW_TYPE"}};
   for (const auto& [screw, program] : screws) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
@@ -157,17 +175,16 @@ void RunDemo(const DemoOptions& o) {
                  c.predicted_curve.shape_k, c.predicted_curve.time_exponent);
     const std::string provenance = "whirl demo, model " + model_source;
     const nlohmann::json plan_json =
-        compare::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
+        plan::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
                               {model_source, c.prediction, c.prediction.mean}, provenance);
     const std::vector<std::string> names = {slug + "_plan.json", slug + "_plan.csv",
                                             program + ".SPF", program + "_RESET.SPF"};
-    compare::WritePlanFiles(
+    plan::WritePlanFiles(
         {stage / names[0], stage / names[1], stage / names[2], stage / names[3]}, plan_json, c.plan,
         provenance, "whirl demo: model " + model_source + ", screw " + screw->name);
     for (const auto& name : names) files.AddStaged(name);
     // The report lives in report/, the files one level up.
-    control.push_back(compare::PlanFilesLoad("../", program, names[1], names[0],
-                                             ReadTextFile(stage / names[2]), &profile));
+    control.push_back(plan::PlanFilesLoad("../", program, names[1], names[0], c.plan, &profile));
     summary["screws"].push_back(DemoScrewJson(c, out, names));
     std::fprintf(say,
                  "4. %s: 840D plan %zu segments (max |SD43910| %.2e <= MD32760 %.2g), written to "
@@ -185,6 +202,7 @@ void RunDemo(const DemoOptions& o) {
   compare::ReportOptions ro;
   ro.plots = !o.no_plots;
   ro.control = control;
+  ro.history = train_path + " (" + std::to_string(history.inputs.size()) + " past screws)";
   ro.provenance = {"command: whirl demo --out-dir " + o.out_dir + " --seed " +
                        std::to_string(o.seed) + (o.retrain ? " --retrain" : ""),
                    "model: " + model_source, "history (traditional rule): " + train_path};
@@ -252,7 +270,7 @@ void RegisterDemo(CLI::App& app) {
   sub->add_flag("--retrain", o->retrain,
                 "train the model even if models/default.json exists, with `whirl train`'s\n"
                 "default (per output the power law, a linear fit or a Gaussian process, chosen\n"
-                "by cross-validated error; src/workpiece/model.h)");
+                "by cross-validated error; src/product/workpiece/model.h)");
   AddSeedOption(sub, &o->seed, "seed of the truth's disturbances (default 1)");
   sub->add_flag("--no-plots", o->no_plots, "skip gnuplot (report data and HTML only)");
   sub->add_flag("--json", o->json,

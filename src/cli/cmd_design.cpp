@@ -1,4 +1,4 @@
-// whirl design: which screws to measure (src/design/design.h): the first design for the power
+// whirl design: which screws to measure (src/product/design/design.h): the first design for the power
 // law on log inputs, or the next screws from a trained model's uncertainty, with the stop rule.
 #include <array>
 #include <cmath>
@@ -255,7 +255,7 @@ void RegisterDesign(CLI::App& app) {
   auto o = std::make_shared<DesignCliOptions>();
   auto* sub = app.add_subcommand(
       "design",
-      "Which screws to measure (src/design/design.h; evidence in docs/design.md).\n"
+      "Which screws to measure (src/product/design/design.h; evidence in docs/design.md).\n"
       "First design (no --model): the --count screws that best determine the power law of the\n"
       "five inputs (D- or I-optimal on log inputs), from --candidates CSV (the screw types the\n"
       "shop makes: columns hardness_hrc, diameter_mm, pitch_mm, raceway_radius_mm,\n"

@@ -1,5 +1,5 @@
 // whirl drift: machine thermal drift from temperature sensors (Miao et al.): sensitive points,
-// drift models, prediction, cross-run and hold-out evaluation, report (src/drift/).
+// drift models, prediction, cross-run and hold-out evaluation, report (src/product/drift/).
 #include <cmath>
 #include <cstdio>
 #include <limits>

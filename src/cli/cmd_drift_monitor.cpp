@@ -1,5 +1,5 @@
 // whirl drift monitor: replay of the on-line model check with a check bar and the recalibration
-// rules (Liu et al.'s check-bar patent) on a logged run (src/drift/monitor.h).
+// rules (Liu et al.'s check-bar patent) on a logged run (src/product/drift/monitor.h).
 #include <cstdio>
 #include <functional>
 #include <limits>

@@ -71,6 +71,7 @@ void Run(const DriftNcOptions& o) {
   if (!o.slope_model_path.empty()) slope = drift::ReadDriftModel(o.slope_model_path);
   const drift::DriftModel* g = slope ? &*slope : nullptr;
   const interp::MachineProfile machine = interp::LoadMachineProfile(o.machine_path);
+  WarnIllustrativeProfile(machine);
   interp::DriftActionOptions options = machine.DriftOptions();
   options.reference = interp::ParseDriftReference(o.reference);
   for (const std::string& text : o.inputs) {

@@ -13,7 +13,7 @@
 #include "fit/arctan_curve.h"
 #include "interp/sinumerik.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -90,8 +90,8 @@ void ReportOne(const EvaluateCliOptions& o, const compare::Evaluation& e) {
                   s.metrics[0].accumulated_1000_um, s.metrics[1].accumulated_1000_um,
                   s.metrics[2].accumulated_1000_um, s.metrics[3].accumulated_1000_um,
                   s.metrics[4].accumulated_1000_um);
-    std::snprintf(cls, sizeof cls, "%s / %s / %s", compare::ToString(s.iso[0]).c_str(),
-                  compare::ToString(s.iso[2]).c_str(), compare::ToString(s.iso[4]).c_str());
+    std::snprintf(cls, sizeof cls, "%s / %s / %s", lead::ToString(s.iso[0]).c_str(),
+                  lead::ToString(s.iso[2]).c_str(), lead::ToString(s.iso[4]).c_str());
     const auto& r = s.model_vs_traditional.accumulated_1000_pct;
     std::printf("%-40s | %-24s | %7.1f %%%s\n", acc, cls, r ? *r : 0.0,
                 s.outside_domain ? "  (outside training domain)" : "");
@@ -147,8 +147,8 @@ void ReportSeeds(const EvaluateCliOptions& o, const std::vector<compare::Evaluat
 
 // --scenarios: the sensitivity table (compare/scenarios.h).
 void RunScenarioTable(const EvaluateCliOptions& o, const workpiece::WorkpieceModel& model,
-                      const compare::ExperienceRule& rule, const compare::IsoToleranceTable& iso,
-                      const sim::Screw& base, const compare::EvaluateOptions& eo) {
+                      const compare::ExperienceRule& rule, const lead::IsoToleranceTable& iso,
+                      const screw::Screw& base, const compare::EvaluateOptions& eo) {
   compare::ScenarioOptions so;
   so.evaluate = eo;
   so.evaluate.seed = o.seed;
@@ -183,8 +183,8 @@ void RunEvaluate(const EvaluateCliOptions& o) {
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.model_path);
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
-  const compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(o.iso_table);
-  const sim::Screw base = sim::ReadScrew(o.base_screw);  // a missing file is an error
+  const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(o.iso_table);
+  const screw::Screw base = screw::ReadScrew(o.base_screw);  // a missing file is an error
   const ProcessTable validation =
       o.no_validation ? ProcessTable{} : ReadProcessTable(o.validation, false);
   if (o.no_validation && o.random == 0)
@@ -206,7 +206,7 @@ void RunEvaluate(const EvaluateCliOptions& o) {
   std::vector<compare::EvaluatedScrew> pooled;
   for (int k = 0; k < o.seeds; ++k) {
     const std::uint64_t seed = o.seed + static_cast<std::uint64_t>(k);
-    std::vector<sim::Screw> screws;
+    std::vector<screw::Screw> screws;
     if (!o.no_validation) screws = compare::ScrewsFromTable(base, validation, "validation");
     // The random screws draw from their own stream so adding validation rows does not change
     // them.
@@ -258,7 +258,7 @@ void RegisterEvaluate(CLI::App& app) {
       "truth with its own seeded disturbances (MixSeed(--seed, index)). Prints one line per screw,\n"
       "then per strategy the median and worst accumulated lead error [um] within 1000 mm and over\n"
       "the thread and the share reaching ISO 3408-3 P3 and P5, the gain breakdown (curve shape,\n"
-      "five inputs, network) and the model's reductions against each baseline. --scenarios runs\n"
+      "five inputs, model) and the model's reductions against each baseline. --scenarios runs\n"
       "named truth scenarios instead. Uses --threads worker threads; results do not depend on the\n"
       "thread count.");
   sub->add_option("--model", o->model_path, "model file (default models/default.json)")
@@ -301,9 +301,9 @@ void RegisterEvaluate(CLI::App& app) {
                   "the cut), steady-rest (60 W), out-of-range (D 40-125 mm, lead 5-20 mm, "
                   "120-250 m/min; needs --allow-extrapolation). --random screws per scenario and "
                   "seed; prints the scenario x strategy table of median and worst accumulated "
-                  "error [um] within 1000 mm and over the thread (src/compare/scenarios.h)");
+                  "error [um] within 1000 mm and over the thread (src/lab/compare/scenarios.h)");
   sub->add_flag("--allow-extrapolation", o->allow_extrapolation,
-                "evaluate the out-of-range scenario although the network extrapolates there");
+                "evaluate the out-of-range scenario although the model extrapolates there");
   sub->add_flag("--markdown", o->markdown, "--scenarios: print the table as Markdown");
   sub->add_flag("--json", o->json, "machine output: per-screw figures and the summary as JSON");
   sub->callback([o] { RunEvaluate(*o); });

@@ -1,6 +1,6 @@
 // whirl fit: features and fitted curve parameters of a measured (or simulated) elongation curve,
-// and the model comparison / shape calibration over simulated curves (src/fit/curve_fit.h,
-// src/compare/curve_study.h).
+// and the model comparison / shape calibration over simulated curves (src/product/fit/curve_fit.h,
+// src/lab/compare/curve_study.h).
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "fit/curve_fit.h"
-#include "sim/features.h"
+#include "fit/features.h"
 
 namespace whirl::cli {
 namespace {
@@ -45,7 +45,7 @@ nlohmann::json FitJson(const fit::CurveFit& f) {
 
 void RunCurve(const FitOptions& o) {
   const ElongationCurve record = ReadElongationCurve(o.curve_path, o.max_gap_factor);
-  const sim::SettleAnalysis settle = sim::AnalyzeSettle(record);
+  const fit::SettleAnalysis settle = fit::AnalyzeSettle(record);
   // The models describe the rise and the plateau it settles on; a long record's slow drift
   // (ambient, sensor) is not part of them, so they are fitted on [0, factor * t_s].
   ElongationCurve curve;
@@ -66,7 +66,8 @@ void RunCurve(const FitOptions& o) {
       Warn(fit::ToString(f.model) + " fit did not converge: " + f.summary.BriefReport());
   if (!settle.settled_before_tail)
     Warn("the curve does not settle before its tail window: the settle time is unreliable (" +
-         settle.message + ")");
+         settle.message + "); log the elongation for at least twice the settle time (30 min "
+         "from the start of the cut covers settle times up to 900 s)");
 
   if (o.json) {
     nlohmann::json models = nlohmann::json::array();
@@ -88,13 +89,17 @@ void RunCurve(const FitOptions& o) {
                  {"r_squared", shape.r_squared},
                  {"rms_residual_um", shape.rms_residual_um}}},
                {"models", models},
-               {"best_model", fit::ToString(fits[best].model)}});
+               {"best_model", fit::ToString(fits[best].model)},
+               {"table_row",  // what goes into table.csv: the features, not a free fit's L, t_s
+                {{"max_elongation_um", settle.features.max_elongation_um},
+                 {"settle_time_s", settle.features.settle_time_s}}}});
     return;
   }
   std::printf("curve %s: %zu samples, %.6g to %.6g s; models fitted on %.6g to %.6g s\n",
               o.curve_path.c_str(), record.size(), record.time_s.front(), record.time_s.back(),
               curve.time_s.front(), curve.time_s.back());
-  std::printf("features: max elongation %.4f um, settle time %.2f s (sim::AnalyzeSettle)\n",
+  std::printf("features: max elongation %.4f um, settle time %.2f s (settle criterion of "
+              "docs/methods.md; these two go into table.csv)\n",
               settle.features.max_elongation_um, settle.features.settle_time_s);
   std::printf(
       "arctan shape with these features fixed: k = %.4f, p = %.4f (R^2 %.6f, RMS %.4f um)\n",
@@ -109,6 +114,14 @@ void RunCurve(const FitOptions& o) {
                 f.r_squared, f.rms_residual_um, f.summary.Converged() ? "" : " (not converged)");
   }
   std::printf("best fit (smallest RMS residual): %s\n", fit::ToString(fits[best].model).c_str());
+  // The row the user adds: the features above (the free fits' L and t_s only describe the shape).
+  std::printf(
+      "table.csv row (the screw's five inputs, then the features; the free fits' L and t_s are "
+      "not table values):\n"
+      "hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min,"
+      "max_elongation_um,settle_time_s\n"
+      "<hrc>,<mm>,<mm>,<mm>,<m/min>,%.4f,%.2f\n",
+      settle.features.max_elongation_um, settle.features.settle_time_s);
 }
 
 void RunSimulated(const FitOptions& o) {
@@ -166,7 +179,8 @@ void RunSimulated(const FitOptions& o) {
       "  per curve: k %.4f to %.4f, p %.4f to %.4f; pooled shape on each curve: median R^2 "
       "%.6f, median RMS %.4f um\n"
       "  plain arctangent (p = 1), pooled: k = %.4f, median RMS %.4f um\n"
-      "  library defaults: kDefaultShapeK = %.4f, kDefaultTimeExponent = %.4f\n",
+      "  built-in defaults (--shape-k, --time-exponent of plan, curve, compare): k = %.4f, "
+      "p = %.4f\n",
       r.shape.shape_k, r.shape.time_exponent,
       r.shape.summary.Converged() ? "" : " (pooled fit not converged)", r.shape.min_shape_k,
       r.shape.max_shape_k, r.shape.min_time_exponent, r.shape.max_time_exponent,
@@ -190,10 +204,12 @@ void RegisterFit(CLI::App& app) {
       "fit",
       "Fit elongation-curve models to a measured or simulated curve and report its features.\n"
       "  --curve C.csv   columns time_s [s], elongation_um [um] ('#' comments allowed; gaps and\n"
-      "                  non-increasing time are errors). Reports the features (max elongation\n"
-      "                  [um], settle time [s]; sim::AnalyzeSettle criterion), the arctan shape\n"
-      "                  (k, p) with those features fixed, and three models with all parameters\n"
-      "                  free:\n"
+      "                  non-increasing time are errors; log at least twice the settle time,\n"
+      "                  e.g. 30 min from the start of the cut). Reports the features (max\n"
+      "                  elongation [um], settle time [s]; criterion in docs/methods.md) and\n"
+      "                  the table.csv row they make (these two, not a free fit's L and t_s),\n"
+      "                  the arctan shape (k, p) with those features fixed, and three models\n"
+      "                  with all parameters free:\n"
       "                    arctan   l = L atan(k (t/t_s)^p)/atan(k) up to t_s, L after\n"
       "                    parabola l = b t + (L - b t_s)(t/t_s)^2 up to t_s, L after\n"
       "                    sine     l = L sin(pi t/(2 t_s)) up to t_s, L after\n"
@@ -202,9 +218,8 @@ void RegisterFit(CLI::App& app) {
       "                  best as well (docs/results.md).\n"
       "  --simulated N   simulate N curves over the paper's training ranges, fit (k, p) with the\n"
       "                  simulator's features fixed (the pooled fit over the N curves = how\n"
-      "                  kDefaultShapeK and kDefaultTimeExponent are derived) and compare the "
-      "three\n"
-      "                  models (median R^2 / RMS, how often each is best).");
+      "                  the defaults of --shape-k and --time-exponent are derived) and compare\n"
+      "                  the three models (median R^2 / RMS, how often each is best).");
   auto* curve =
       sub->add_option("--curve", o->curve_path, "measured curve (CSV)")->check(CLI::ExistingFile);
   auto* simulated = sub->add_option("--simulated", o->simulated,

@@ -5,9 +5,9 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "compare/iso3408.h"
-#include "compare/lead.h"
-#include "compare/metrics.h"
+#include "lead/iso3408.h"
+#include "lead/lead.h"
+#include "lead/metrics.h"
 
 namespace whirl::cli {
 namespace {
@@ -21,13 +21,18 @@ struct LeadReportOptions {
 };
 
 void RunLeadReport(const LeadReportOptions& o) {
-  const compare::LeadDeviation lead = compare::ReadLeadDeviation(o.lead_csv);
-  compare::LeadMetricOptions mo;
+  const lead::LeadDeviation lead = lead::ReadLeadDeviation(o.lead_csv);
+  lead::LeadMetricOptions mo;
   mo.lead_mm = o.lead_mm;
   mo.end_margin_mm = o.end_margin_mm;
-  const compare::LeadMetrics m = compare::ComputeLeadMetrics(lead, mo);
-  const compare::IsoToleranceTable table = compare::ReadIsoToleranceTable(o.iso_table);
-  const compare::IsoVerdict v = compare::EvaluateIsoClass(m, table);
+  const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, mo);
+  const lead::IsoToleranceTable table = lead::ReadIsoToleranceTable(o.iso_table);
+  const lead::IsoVerdict v = lead::EvaluateIsoClass(m, table);
+  if (!m.v_2pi_um)  // the class is then graded without one of its tolerances
+    Warn(std::string("v_2pi not evaluated (") +
+         (o.lead_mm > 0 ? "the samples are coarser than half a lead"
+                        : "give --lead-mm, the screw's lead") +
+         "): the ISO 3408-3 class is checked without it");
   if (o.json) {
     PrintJson({{"schema", "whirl.lead_report"},
                {"schema_version", 1},
@@ -51,9 +56,9 @@ void RunLeadReport(const LeadReportOptions& o) {
   else
     std::printf("  v_2pi band within one revolution       not evaluated (%s)\n",
                 o.lead_mm > 0 ? "samples coarser than half a lead" : "give --lead-mm");
-  std::printf("ISO 3408-3 class reached: %s\n  %s\n", compare::ToString(v.reached).c_str(),
+  std::printf("ISO 3408-3 class reached: %s\n  %s\n", lead::ToString(v.reached).c_str(),
               v.message.c_str());
-  if (!v.table_cells_confirmed && v.reached != compare::IsoClass::kNone)
+  if (!v.table_cells_confirmed && v.reached != lead::IsoClass::kNone)
     std::printf(
         "  note: some tolerance cells behind this verdict are recalled, not confirmed "
         "(see %s)\n",

@@ -1,5 +1,5 @@
 // whirl machine truth: the field machine's uncompensated error per cut, split by source, for the
-// chosen scenarios (src/machine/magnitudes.h). A check of the simulated world, not an evaluation.
+// chosen scenarios (src/lab/machine/magnitudes.h). A check of the simulated world, not an evaluation.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -49,7 +49,6 @@ void RunMachineTruth(const MachineTruthOptions& o) {
   spec.test_days = o.test_days;
   spec.past_days = o.past_days;
   for (const auto& s : machine::SelectMachineScenarios(o.scenarios, "--scenarios")) {
-    if (s.world != machine::World::kField) continue;  // legacy: see 'whirl machine evaluate'
     std::fprintf(stderr, "scenario %s...\n", s.name.c_str());
     rows.push_back(machine::MeasureMagnitudes(machine::DefaultFieldMachine(), s, o.seed,
                                               o.machines, spec));
@@ -70,7 +69,7 @@ void RegisterMachineTruth(CLI::App* machine) {
       "Z axis), band width [um] within 1000 mm and over the thread, median / worst, and by start\n"
       "type (cold, warm, interrupted, long_pause). The truth side only: no model is trained.");
   t->add_option("--scenarios", o->scenarios,
-                "comma list of machine scenarios or 'all' (legacy is skipped; default all)");
+                "comma list of machine scenarios or 'all' (default all)");
   AddSeedOption(t, &o->seed, "seed of machines, calendars and halls (default 1)");
   t->add_option("--machines", o->machines, "machines (1..20, default 2)")->check(NumberIn(1, 20));
   t->add_option("--test-days", o->test_days, "production days in the test window (1..20, default 2)")

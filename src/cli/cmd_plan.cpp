@@ -8,7 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "compare/plan_document.h"
+#include "plan/plan_document.h"
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/numbers.h"
@@ -17,7 +17,7 @@
 #include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 
 namespace whirl::cli {
 namespace {
@@ -85,6 +85,7 @@ interp::PlanOptions ResolvePlanOptions(const PlanCliOptions& o) {
   bool have_start = false, have_offset = false;
   if (!o.machine_path.empty()) {
     const interp::MachineProfile m = interp::LoadMachineProfile(o.machine_path);
+    WarnIllustrativeProfile(m);
     if (o.with_drift_action)
       m.ApplyCombinedTo(p);
     else
@@ -136,10 +137,10 @@ void Run(const PlanCliOptions& o) {
   if (by_features == !o.source.model_path.empty())
     throw InputError("plan: give either --model M or --max-elongation-um L --settle-time-s T");
   const interp::PlanOptions options = ResolvePlanOptions(o);
-  const sim::Screw screw = sim::ReadScrew(o.source.screw_path);
-  const sim::Kinematics kin = sim::ComputeKinematics(screw);
+  const screw::Screw screw = screw::ReadScrew(o.source.screw_path);
+  const screw::Kinematics kin = screw::ComputeKinematics(screw);
 
-  compare::PlanSource plan_source;
+  plan::PlanSource plan_source;
   std::string source;
   if (!by_features) {
     const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(o.source.model_path);
@@ -161,8 +162,8 @@ void Run(const PlanCliOptions& o) {
   const interp::CompensationPlan plan =
       interp::BuildPlan(curve, kin.axial_feed_mm_s, screw.thread_length_mm, options);
   const std::string provenance = "whirl plan (" + source + "), " + curve.Describe();
-  const nlohmann::json j = compare::PlanDocument(plan, curve, screw, kin, plan_source, provenance);
-  compare::WritePlanFiles({o.out_path, o.csv_path, o.nc_path, o.reset_nc_path}, j, plan, provenance,
+  const nlohmann::json j = plan::PlanDocument(plan, curve, screw, kin, plan_source, provenance);
+  plan::WritePlanFiles({o.out_path, o.csv_path, o.nc_path, o.reset_nc_path}, j, plan, provenance,
                           curve.Describe() + " (" + source + ")");
 
   if (o.json) {

@@ -1,5 +1,5 @@
 // whirl predict: elongation features with standard deviations from a workpiece model
-// (src/workpiece/model.h; the figures in src/workpiece/prediction_report.h).
+// (src/product/workpiece/model.h; the figures in src/product/workpiece/prediction_report.h).
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -94,7 +94,7 @@ void RegisterPredict(CLI::App& app) {
       "Predict the two elongation features of hard whirling - maximum elongation of the\n"
       "unmachined section [um] and settle time [s] - each with a predictive standard deviation\n"
       "(noise plus model uncertainty: the network's Laplace approximation, or the chosen\n"
-      "family's, calibrated by cross-validation; src/workpiece/model.h).\n"
+      "family's, calibrated by cross-validation; src/product/workpiece/model.h).\n"
       "Inputs outside the training domain get a warning on stderr and a flag in the output.\n"
       "Give either --input CSV (columns hardness_hrc, diameter_mm, pitch_mm,\n"
       "raceway_radius_mm, cutting_speed_m_min; if max_elongation_um and settle_time_s are\n"

@@ -1,4 +1,4 @@
-// whirl simulate: the hard-whirling thermal simulator for one screw (src/sim/simulator.h).
+// whirl simulate: the hard-whirling thermal simulator for one screw (src/lab/sim/simulator.h).
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -10,7 +10,7 @@
 #include "core/limits.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 #include "sim/simulator.h"
 
 namespace whirl::cli {
@@ -27,8 +27,8 @@ struct SimulateOptions {
   bool json = false;
 };
 
-nlohmann::json ResultJson(const sim::Screw& screw, const sim::SimulationResult& r,
-                          const sim::SettleAnalysis& settle, const SimulateOptions& o) {
+nlohmann::json ResultJson(const screw::Screw& screw, const sim::SimulationResult& r,
+                          const fit::SettleAnalysis& settle, const SimulateOptions& o) {
   const auto& k = r.kinematics;
   nlohmann::json j;
   j["screw"] = screw;
@@ -72,7 +72,7 @@ nlohmann::json ResultJson(const sim::Screw& screw, const sim::SimulationResult& 
 
 void Run(const SimulateOptions& o) {
   CheckOutputs({{"--screw", o.screw_path}}, {{"--out", o.out_path}});
-  const sim::Screw screw = sim::ReadScrew(o.screw_path);
+  const screw::Screw screw = screw::ReadScrew(o.screw_path);
   sim::SimOptions options;
   options.duration_s = o.duration_s;
   options.cell_size_mm = o.cell_size_mm;
@@ -81,7 +81,7 @@ void Run(const SimulateOptions& o) {
   dist.enabled = !o.no_disturbances;
   dist.seed = o.seed;
   const sim::SimulationResult r = sim::Simulate(screw, options, dist);
-  const sim::SettleAnalysis settle = sim::AnalyzeSettle(r.curve, options.settle);
+  const fit::SettleAnalysis settle = fit::AnalyzeSettle(r.curve, options.settle);
   if (!settle.settled_before_tail)
     Warn("the curve has not settled before the last " +
          std::to_string(static_cast<int>(options.settle.tail_fraction * 100)) +
@@ -124,7 +124,7 @@ void RegisterSimulate(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "simulate",
       "Simulate the thermal elongation (um) of the unmachined section of a screw during hard\n"
-      "whirling (1D transient heat conduction with a moving source, src/sim/simulator.h) and\n"
+      "whirling (1D transient heat conduction with a moving source, src/lab/sim/simulator.h) and\n"
       "print its features: max_elongation_um (plateau) and settle_time_s.\n"
       "Disturbances (workpiece variation, ambient drift, +-0.5 um sensor noise) are ON unless\n"
       "--no-disturbances; they are seeded by --seed.\n"

@@ -1,6 +1,6 @@
 // whirl surface: thermal error over the worktable: synthetic fields, cubic polynomial or
 // B-spline surfaces, prediction at any position, the choice between the two, and the 840D line per
-// axis. The library is src/surface (its header surface/surface.h is the manual).
+// axis. The library is src/product/surface (its header surface/surface.h is the manual).
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -22,7 +22,7 @@
 #include "surface/line840d.h"
 #include "surface/report.h"
 #include "surface/surface.h"
-#include "surface/synthetic.h"
+#include "synthetic/surface.h"
 
 namespace whirl::cli {
 namespace {
@@ -32,7 +32,7 @@ using namespace whirl::surface;
 // --- synth -------------------------------------------------------------------------------------
 
 struct SynthCli {
-  SyntheticOptions synth;
+  synthetic::SyntheticOptions synth;
   std::string field = "smooth";
   std::string out;
   bool json = false;
@@ -40,10 +40,10 @@ struct SynthCli {
 
 void RunSynth(const SynthCli& o) {
   CheckOutputs({}, {{"--out", o.out}});
-  SyntheticOptions s = o.synth;
-  s.field = ParseSyntheticField(o.field);
-  const auto points = SyntheticPoints(s);
-  WriteFileAtomic(o.out, FormatPointsCsv(points, SyntheticProvenance(s)));
+  synthetic::SyntheticOptions s = o.synth;
+  s.field = synthetic::ParseSyntheticField(o.field);
+  const auto points = synthetic::SyntheticPoints(s);
+  WriteFileAtomic(o.out, FormatPointsCsv(points, synthetic::SyntheticProvenance(s)));
   if (o.json)
     PrintJson({{"schema", "whirl.surface_synth"},
                {"schema_version", 1},
@@ -61,7 +61,7 @@ void SetupSynth(CLI::App& parent) {
   auto* sub = parent.add_subcommand(
       "synth",
       "Write a documented synthetic thermal-error field as a points CSV (x_mm,y_mm,error_um).\n"
-      "No public whole-table measurements exist; formulas in src/surface/synthetic.h:\n"
+      "No public whole-table measurements exist; formulas in src/lab/synthetic/surface.h:\n"
       "  smooth: 10 + 10 s + 6 t + 4 s^2 + 3 s t - 2 t^2 + 5 s^3 + 2 s t^2 um, s = x/Lx, t = y/Ly\n"
       "  bump:   smooth + A exp(-r^2/(2 sigma^2)) at (0.7 Lx, 0.35 Ly), sigma = f Lx\n"
       "plus normal noise; the file's '#' lines record the field, options and seed.");
@@ -365,7 +365,7 @@ void RunPoints(const PointsCli& o) {
           (target.time_from_index ? " (sample index)" : " min"),
       "per-point models: " +
           std::string(o.sensors.empty() ? "Miao et al. selection + " : "given sensors, ") +
-          "MLR (src/drift), trained on " +
+          "MLR (src/product/drift), trained on " +
           (o.train.empty() ? o.run : std::to_string(o.train.size()) + " run(s)")};
   for (const auto& pc : points)
     fit.provenance.push_back(pc.column + ": " + notes.by_column[pc.column]);
@@ -392,7 +392,7 @@ void SetupPoints(CLI::App& parent) {
       "Per-point models, then a surface: each error column of a position-tagged run\n"
       "file (drift run format: time_s|time_min, *_C temperatures, *_um errors, each error\n"
       "column named <name>_x<X>_y<Y>_um with X, Y in mm, or placed by --manifest) gets its own\n"
-      "model from its sensitive temperatures (Miao et al.'s selection + MLR, src/drift) fitted on\n"
+      "model from its sensitive temperatures (Miao et al.'s selection + MLR, src/product/drift) fitted on\n"
       "--train runs (default: the run itself); the P predictions at --time-min become the points\n"
       "of a cubic or B-spline surface (as 'surface fit').");
   sub->add_option("--run", o->run, "run file to predict (CSV)")

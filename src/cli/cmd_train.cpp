@@ -1,7 +1,7 @@
-// whirl train: fit the workpiece model (src/workpiece/model.h) to a process table: by default the
-// family choice by cross-validated error (src/family/family.h), or the Bayesian-regularized network
-// (src/nn/trainbr.h); or sweep the network's hidden size with k-fold cross-validation
-// (src/nn/selection.h).
+// whirl train: fit the workpiece model (src/product/workpiece/model.h) to a process table: by default the
+// family choice by cross-validated error (src/product/family/family.h), or the Bayesian-regularized network
+// (src/product/nn/trainbr.h); or sweep the network's hidden size with k-fold cross-validation
+// (src/product/nn/selection.h).
 #include <unistd.h>
 
 #include <cerrno>
@@ -383,7 +383,7 @@ std::string TrainDescription() {
          "out; a zero or near-zero target keeps its column raw for the log candidates, with a\n"
          "warning. From 512 rows a GP keeps 512 rows spread over the table (the others judge\n"
          "it). The sd is calibrated to cover 68.27 % / 95.45 % of held-out residuals at +-1 /\n"
-         "+-2 sd (src/family/family.h). Prints the choice and the table of held-out errors; a\n"
+         "+-2 sd (src/product/family/family.h). Prints the choice and the table of held-out errors; a\n"
          "progress line every 2 s once a fit takes longer. The same table and seed give the\n"
          "same file byte for byte.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
@@ -447,13 +447,13 @@ void RegisterTrain(CLI::App& app) {
                 "automatic relevance determination: inputs the data do not support are\n"
                 "shrunk), kept only if it took a step and its log evidence is higher;\n"
                 "every size fit, restart and noise fold, and every fit of --hidden-sweep\n"
-                "(src/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
+                "(src/product/nn/trainbr.h TrainOptions::ard). With --stop-by-cv the folds\n"
                 "choose trainbr's epochs without ARD. Better from about 100 rows and for\n"
                 "settle time; docs/network.md");
   sub->add_flag("--stop-by-cv", o->stop_by_cv,
                 "stop at the epoch count with the lowest 5-fold cross-validation error\n"
                 "(measured in scripts/bench_peers.sh, not better than trainbr's own stopping;\n"
-                "src/nn/model.h Stopping)");
+                "src/product/nn/model.h Stopping)");
   sub->add_option("--change", o->change,
                   "R brnn's stopping rule: stop when the objective F = beta ssE + alpha ssX\n"
                   "(dimensionless, normalized targets) changed by less than this between each\n"

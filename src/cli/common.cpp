@@ -23,6 +23,7 @@
 #include "core/numbers.h"
 #include "core/safe_text.h"
 #include "fit/arctan_curve.h"
+#include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
 
 namespace whirl::cli {
@@ -342,6 +343,58 @@ void CheckCommandWords(const CLI::App& app, int argc, char** argv) {
   }
 }
 
+// The command argv names: its command words from argv[1] on; `*first_option` is the first
+// argument after them.
+const CLI::App* CommandOf(const CLI::App& app, int argc, char** argv, int* first_option) {
+  const CLI::App* current = &app;
+  int i = 1;
+  for (; i < argc; ++i) {
+    const CLI::App* next = nullptr;
+    for (const CLI::App* sub : current->get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->check_name(argv[i])) next = sub;
+    if (next == nullptr) break;
+    current = next;
+  }
+  *first_option = i;
+  return current;
+}
+
+// Whether `flag` is an option of `command` or of a command above it (hidden deprecated
+// spellings included); `listed` gets the names their --help lists.
+bool KnownOption(const CLI::App* command, const std::string& flag,
+                 std::vector<std::string>* listed) {
+  for (const CLI::App* a = command; a != nullptr; a = a->get_parent())
+    for (const CLI::Option* o : a->get_options()) {
+      if (o->check_name(flag)) return true;
+      if (!o->get_group().empty())
+        for (const auto& n : o->get_lnames()) listed->push_back("--" + n);
+    }
+  return false;
+}
+
+// The option words of argv ("--name" or "--name=value") must each name an option of the command
+// they follow or of a command above it: an unknown one is an error naming the word typed and the
+// closest option the command's --help lists. Without this CLI11 reports a missing required
+// option first ("--data is required" for "--dta x.csv") or "arguments were not expected"
+// without a suggestion.
+void CheckOptionWords(const CLI::App& app, int argc, char** argv) {
+  int i = 0;
+  const CLI::App* command = CommandOf(app, argc, argv, &i);
+  if (command->get_prefix_command() || command->get_allow_extras()) return;  // passed through
+  for (; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") return;  // positional arguments follow
+    if (arg.rfind("--", 0) != 0 || arg.size() < 3) continue;
+    const std::string flag = arg.substr(0, arg.find('='));
+    std::vector<std::string> listed;
+    if (KnownOption(command, flag, &listed) || listed.empty()) continue;
+    const std::string name = command == &app ? "whirl" : "whirl " + CommandPath(command);
+    throw CLI::ValidationError("unknown option '" + flag + "' for '" + name + "'; did you mean '" +
+                               ClosestName(flag, listed) + "'? ('" + name +
+                               " --help' lists its options)");
+  }
+}
+
 }  // namespace
 
 int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summaries) {
@@ -349,6 +402,7 @@ int RunApp(CLI::App& app, int argc, char** argv, const CommandSummaries& summari
   SetHelpRecursively(&app, std::make_shared<OneLineFormatter>(summaries));
   try {
     CheckCommandWords(app, argc, argv);
+    CheckOptionWords(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
@@ -385,6 +439,14 @@ void GuardTrainingDomain(bool outside_domain, const std::vector<std::string>& fi
 void PrintJson(const nlohmann::json& j) { std::cout << DumpJson(j) << std::endl; }
 
 void Warn(const std::string& text) { std::cerr << "warning: " << text << std::endl; }
+
+void WarnIllustrativeProfile(const interp::MachineProfile& profile) {
+  if (!profile.Illustrative()) return;
+  Warn("machine profile " + profile.source + " is the shipped example (its name: \"" +
+       profile.name +
+       "\"): its axis, offsets, IDs, R parameters and alarms are illustrative, not your "
+       "machine's; replace every value and the name before these programs go onto a control");
+}
 
 Progress::Progress(std::string label, std::size_t total)
     : label_(std::move(label)), total_(total == 0 ? 1 : total), tty_(::isatty(2) != 0) {}

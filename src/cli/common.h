@@ -19,6 +19,10 @@ class Option;
 class Validator;
 }
 
+namespace whirl::interp {
+struct MachineProfile;
+}  // namespace whirl::interp
+
 namespace whirl::cli {
 
 /// One line per command in a --help listing, keyed by the command's words below the program
@@ -128,6 +132,9 @@ void PrintJson(const nlohmann::json& j);
 
 /// Warning line on stderr: "warning: <text>".
 void Warn(const std::string& text);
+/// Warns when the machine profile is still the shipped illustrative example
+/// (its name says so): its offsets, IDs, R parameters and alarms are not the user's machine's.
+void WarnIllustrativeProfile(const interp::MachineProfile& profile);
 
 /// Progress bar on stderr. On a terminal it redraws one line; otherwise it prints a line at every
 /// 10 % so logs stay short. Finish() ends the line.

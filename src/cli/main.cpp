@@ -10,7 +10,7 @@ const whirl::cli::CommandSummaries kSummaries = {
     {"demo", "the whole workflow on the shipped files: model, 840D plans, comparison, report"},
     {"dataset", "simulate a process table (training rows) over the paper's ranges"},
     {"simulate", "simulate one screw's elongation [um] over time [s] and its two features"},
-    {"train", "train the network on a process table and write a model file"},
+    {"train", "train a workpiece model on a process table (family chosen by default) and write it"},
     {"predict", "max elongation [um] and settle time [s] of screws, with their sd"},
     {"design", "which screws to measure: first design, next screws, stop rule"},
     {"curve", "the arctangent elongation curve of a screw [um over s]"},
@@ -41,8 +41,8 @@ const whirl::cli::CommandSummaries kSummaries = {
     {"drift nc", "the live drift compensation on an 840D: NC program and PLC table"},
     {"drift monitor", "replay the on-line check-bar monitoring on a logged run"},
     {"machine", "simulated machine with its own thermal drift"},
-    {"machine sensors", "write virtual-sensor run files of a simulated machine"},
-    {"machine evaluate", "workpiece plan and drift model together on drifting machines"},
+    {"machine sensors", "write day logs of a simulated field machine (drift run files)"},
+    {"machine evaluate", "workpiece plan and shop-trained drift models on drifting machines"},
     {"machine truth", "uncompensated machine error per test-day cut, split by source"},
     {"crosscheck", "check the network against LibTorch (runs whirl-torch)"},
     {"export", "export a model as TorchScript (runs whirl-torch)"},
@@ -53,9 +53,10 @@ const whirl::cli::CommandSummaries kSummaries = {
 int main(int argc, char** argv) {
   CLI::App app{
       "whirl: thermal-elongation compensation for hard whirling of ball screws on SINUMERIK 840D.\n"
-      "Predict the elongation curve of the unmachined section with a Bayesian-regularized network\n"
-      "(or a regression), plan the 840D temperature-compensation setting data (SD43900/SD43910/\n"
-      "SD43920) and its NC programs, and compare the lead error against the alternatives.\n"
+      "Predict the elongation curve of the unmachined section with a workpiece model (power law,\n"
+      "linear fit, Gaussian process or Bayesian-regularized network, chosen on held-out error),\n"
+      "plan the 840D temperature-compensation setting data (SD43900/SD43910/SD43920) and its NC\n"
+      "programs, and compare the lead error against the alternatives.\n"
       "Run 'whirl <command> --help' for each command. Exit code 0 only on success; 1 on bad\n"
       "input or failure; 2 when a check ran and failed."};
   app.require_subcommand(1);

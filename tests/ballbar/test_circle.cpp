@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "ballbar/circle.h"
-#include "ballbar/simulate.h"
+#include "synthetic/ballbar.h"
 #include "core/error.h"
 
 namespace whirl::ballbar {
@@ -17,12 +17,12 @@ struct Values {
   double centre1 = 0, centre2 = 0, scale = 0, square = 0, cyc1 = 0, cyc2 = 0;
 };
 
-Values Planted(const CirclePlant& p) {
+Values Planted(const synthetic::CirclePlant& p) {
   return {p.centre_1_um,     p.centre_2_um, p.scale_1_um_per_m - p.scale_2_um_per_m,
           p.squareness_urad, p.cyclic_1_um, p.cyclic_2_um};
 }
 
-CircleOptions OptionsFor(const CirclePlant& p) {
+CircleOptions OptionsFor(const synthetic::CirclePlant& p) {
   CircleOptions o;
   o.plane = p.plane;
   o.radius_mm = p.radius_mm;
@@ -34,8 +34,8 @@ CircleOptions OptionsFor(const CirclePlant& p) {
 // The planted term within 2 %, the others near zero: within 4.5 of their standard errors (about
 // 300 such checks: P(any |z| > 4.5) ~ 0.2 % for pure noise) and those standard errors small
 // (at most 0.06 um, 1.5 um/m, 1.5 urad): no cross-talk beyond the noise.
-void ExpectRecovered(const CirclePlant& p, const std::string& label) {
-  const CircleDiagnostics d = FitCircle(SimulateCircle(p), OptionsFor(p));
+void ExpectRecovered(const synthetic::CirclePlant& p, const std::string& label) {
+  const CircleDiagnostics d = FitCircle(synthetic::SimulateCircle(p), OptionsFor(p));
   const Values want = Planted(p);
   const Values got{d.centre_offset_1_um, d.centre_offset_2_um,    d.scale_mismatch_um_per_m,
                    d.squareness_urad,    d.cyclic_amplitude_1_um, d.cyclic_amplitude_2_um};
@@ -66,7 +66,7 @@ TEST(Circle, EachPlantedErrorIsRecoveredWithin2PercentAndOthersStayNearZero) {
   for (Plane plane : {Plane::kXY, Plane::kXZ, Plane::kYZ})
     for (int term = 0; term < 6; ++term)
       for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-        CirclePlant p;
+        synthetic::CirclePlant p;
         p.plane = plane;
         p.samples = 2880;  // 0.125 deg steps (a ball bar samples far denser)
         p.radius_mm = 100 + 25 * seed;
@@ -103,11 +103,11 @@ TEST(Circle, EachPlantedErrorIsRecoveredWithin2PercentAndOthersStayNearZero) {
 }
 
 TEST(Circle, AllErrorsAtOnceAndCyclicPhase) {
-  CirclePlant p;
+  synthetic::CirclePlant p;
   p.centre_1_um = 5, p.centre_2_um = -3, p.scale_1_um_per_m = 20, p.scale_2_um_per_m = -10;
   p.squareness_urad = 25, p.cyclic_1_um = 1, p.cyclic_phase_1_deg = 45, p.cyclic_2_um = 0.8;
   p.cyclic_period_2_mm = 5, p.noise_sd_um = 0;
-  const CircleDiagnostics d = FitCircle(SimulateCircle(p), OptionsFor(p));
+  const CircleDiagnostics d = FitCircle(synthetic::SimulateCircle(p), OptionsFor(p));
   // Noise-free: only the first-order model error remains (errors^2 / R ~ 1e-3 um).
   EXPECT_NEAR(d.centre_offset_1_um, 5, 0.01);
   EXPECT_NEAR(d.centre_offset_2_um, -3, 0.01);
@@ -126,11 +126,11 @@ TEST(Circle, StandardErrorsMatchTheScatterOverSeeds) {
   double reported_scale = 0, reported_square = 0;
   const int n = 200;
   for (int s = 0; s < n; ++s) {
-    CirclePlant p;
+    synthetic::CirclePlant p;
     p.seed = 1000 + s;
     p.samples = 180;
     p.noise_sd_um = 0.3;
-    const CircleDiagnostics d = FitCircle(SimulateCircle(p), OptionsFor(p));
+    const CircleDiagnostics d = FitCircle(synthetic::SimulateCircle(p), OptionsFor(p));
     scale.push_back(d.scale_mismatch_um_per_m);
     square.push_back(d.squareness_urad);
     reported_scale += d.terms[3].sd / n;
@@ -147,9 +147,9 @@ TEST(Circle, StandardErrorsMatchTheScatterOverSeeds) {
 }
 
 TEST(Circle, TraceFileRoundTrip) {
-  CirclePlant p;
+  synthetic::CirclePlant p;
   p.samples = 64;
-  CircleTrace c = SimulateCircle(p);
+  CircleTrace c = synthetic::SimulateCircle(p);
   c.comments = {"made by a test"};
   const CircleTrace back = ParseCircleTrace(FormatCircleTrace(c), "t.csv");
   EXPECT_EQ(back.angle_deg, c.angle_deg);
@@ -158,15 +158,15 @@ TEST(Circle, TraceFileRoundTrip) {
 }
 
 TEST(Circle, TramCorrectsTheXzParallelism) {
-  CirclePlant p;
+  synthetic::CirclePlant p;
   p.plane = Plane::kXZ;
   p.squareness_urad = 40;
   CircleOptions o = OptionsFor(p);
   o.spindle_tram_urad = 15;
-  const CircleDiagnostics d = FitCircle(SimulateCircle(p), o);
+  const CircleDiagnostics d = FitCircle(synthetic::SimulateCircle(p), o);
   EXPECT_NEAR(d.parallelism_urad, d.squareness_urad - 15, 1e-12);
   o.plane = Plane::kXY;
-  EXPECT_THROW(FitCircle(SimulateCircle(p), o), InputError);
+  EXPECT_THROW(FitCircle(synthetic::SimulateCircle(p), o), InputError);
 }
 
 TEST(Circle, BadTracesAreClearErrors) {
@@ -186,9 +186,9 @@ TEST(Circle, BadTracesAreClearErrors) {
   CircleOptions longp;
   longp.radius_mm = 10;
   longp.cyclic_period_1_mm = 1000;  // mimics the centre offset over a 10 mm circle
-  CirclePlant p;
+  synthetic::CirclePlant p;
   p.radius_mm = 10;
-  ExpectInputError([&] { FitCircle(SimulateCircle(p), longp); }, "cyclic-period");
+  ExpectInputError([&] { FitCircle(synthetic::SimulateCircle(p), longp); }, "cyclic-period");
   EXPECT_THROW(ParsePlane("XX"), InputError);
   EXPECT_EQ(ParsePlane("xz"), Plane::kXZ);
 }

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "ballbar/drift.h"
-#include "ballbar/simulate.h"
+#include "synthetic/ballbar.h"
 #include "core/error.h"
 #include "support/eigen_near.h"
 
@@ -21,9 +21,9 @@ const double kReadingSdUm = std::sqrt(0.01 + 0.01 / 12);
 
 TEST(Simulation, PlantedDriftIsInTheIssuesRanges) {
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
-    WarmupOptions o;
+    synthetic::WarmupOptions o;
     o.seed = seed;
-    const WarmupSimulation s = SimulateWarmup(o);
+    const synthetic::WarmupSimulation s = synthetic::SimulateWarmup(o);
     for (int a = 0; a < 2; ++a) {
       EXPECT_GE(std::abs(s.final_drift_um(a)), 2);
       EXPECT_LE(std::abs(s.final_drift_um(a)), 10);
@@ -39,9 +39,9 @@ TEST(Drift, RecoversThePlantedDriftWithinItsStatedUncertainty) {
   // reading sd known and alpha exact, they must look like N(0, 1).
   std::vector<double> z;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-    WarmupOptions so;
+    synthetic::WarmupOptions so;
     so.seed = seed;
-    const WarmupSimulation s = SimulateWarmup(so);
+    const synthetic::WarmupSimulation s = synthetic::SimulateWarmup(so);
     DriftOptions o;
     o.bar_sd_um = kReadingSdUm;
     o.bar_alpha_sd_per_K = 0;
@@ -69,7 +69,7 @@ TEST(Drift, RecoversThePlantedDriftWithinItsStatedUncertainty) {
 
 TEST(Drift, DefaultOptionsAreConservativeOnTheDemo) {
   // The defaults (sd pooled from repeats, alpha sd 1e-6 /K): every block within 3 sd.
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   const DriftResult r = ComputeDrift(s.readings, s.pivots_mm);
   ASSERT_TRUE(r.pooled_bar_sd_um.has_value());
   EXPECT_GE(*r.pooled_bar_sd_um, 0.5 * kReadingSdUm);
@@ -82,9 +82,9 @@ TEST(Drift, DefaultOptionsAreConservativeOnTheDemo) {
 }
 
 TEST(Drift, BarExpansionCorrectionRemovesABiasOfSeveralSd) {
-  WarmupOptions so;
+  synthetic::WarmupOptions so;
   so.bar_rise_K = 3;
-  const WarmupSimulation s = SimulateWarmup(so);
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup(so);
   DriftOptions o;
   o.bar_sd_um = kReadingSdUm;
   o.bar_alpha_sd_per_K = 0;
@@ -103,7 +103,7 @@ TEST(Drift, BarExpansionCorrectionRemovesABiasOfSeveralSd) {
 }
 
 TEST(Drift, AlphaUncertaintyEntersTheSd) {
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   DriftOptions o;
   o.bar_sd_um = kReadingSdUm;
   o.bar_alpha_sd_per_K = 0;
@@ -123,7 +123,7 @@ TEST(Drift, LengthAveragingAgreesWithTheTripletAveragingOfEq18) {
   // triplets. Adding a third pivot-1 reading equal to the mean of its two keeps every pivot's mean
   // length but makes the counts unequal, so the block averages lengths instead. The two agree to
   // second order in the noise (sigma^2 / L ~ 1e-7 um here).
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   Readings r = s.readings;
   Readings extra = r;
   ASSERT_EQ(r.rows[6].pivot, 1);
@@ -145,10 +145,10 @@ TEST(Drift, LengthAveragingAgreesWithTheTripletAveragingOfEq18) {
 }
 
 TEST(Drift, NoiseFreeReadingsGiveTheTruthExactly) {
-  WarmupOptions clean;
+  synthetic::WarmupOptions clean;
   clean.bar_noise_sd_um = 0;
   clean.resolution_um = 0;
-  const WarmupSimulation c = SimulateWarmup(clean);
+  const synthetic::WarmupSimulation c = synthetic::SimulateWarmup(clean);
   DriftOptions o;
   o.bar_sd_um = 0.1;
   const DriftResult r = ComputeDrift(c.readings, c.pivots_mm, o);
@@ -159,7 +159,7 @@ TEST(Drift, NoiseFreeReadingsGiveTheTruthExactly) {
 }
 
 TEST(Drift, Sd43900IsMinusTheDriftInMmWithSubtract) {
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   DriftOptions o;
   const DriftResult sub = ComputeDrift(s.readings, s.pivots_mm, o);
   EXPECT_TRUE(test::AllNear(sub.sd43900_mm, -sub.blocks.back().drift_um / 1000, 1e-15));
@@ -170,7 +170,7 @@ TEST(Drift, Sd43900IsMinusTheDriftInMmWithSubtract) {
 }
 
 TEST(Drift, RunFileHasTheDriftModulesFormat) {
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   const DriftResult r = ComputeDrift(s.readings, s.pivots_mm);
   const std::string csv = FormatDriftCsv(r, {"provenance"});
   EXPECT_EQ(csv.rfind("# provenance\ntime_min,drift_x_um,drift_y_um,drift_z_um\n", 0), 0u) << csv;
@@ -183,7 +183,7 @@ TEST(Drift, RunFileHasTheDriftModulesFormat) {
 TEST(Drift, BlocksSplitWhereReadingsAreMoreThanTheGapApart) {
   // Same readings, stamped either per reading (0.25 min apart) or all at the block's time: the
   // same blocks and drift; a gap below the within-block spacing splits them (and then fails).
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   Readings same_time = s.readings;
   for (std::size_t i = 0; i < same_time.rows.size(); ++i)
     same_time.rows[i].time_min = s.readings.rows[i - i % 6].time_min;
@@ -208,7 +208,7 @@ TEST(Drift, BadReadingsNameFileLineAndRule) {
   ExpectInputError(
       [&] { ParseReadings("time_min,pivot,length_mm,bar_temperature_C\n0,1,150,99\n", "r.csv"); },
       "bar_temperature_C");
-  const WarmupSimulation s = SimulateWarmup({});
+  const synthetic::WarmupSimulation s = synthetic::SimulateWarmup({});
   ExpectInputError(
       [&] { ComputeDrift(ParseReadings(h + "0,1,150\n0,2,150\n", "r.csv"), s.pivots_mm); },
       "no reading of pivot 3");

@@ -1,4 +1,4 @@
-// The family library's fits (src/family, src/gp) on the simulator's tables, beside one trainbr fit
+// The family library's fits (src/product/family, src/product/gp) on the simulator's tables, beside one trainbr fit
 // and whirl's current default network fit in the same run, all on one thread:
 //   BM_FamilyDefault/rows:R/loo:L  ChooseFamily with the default candidates (the
 //                              cross-validated choice, then the chosen candidates' fits and

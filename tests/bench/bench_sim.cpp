@@ -8,7 +8,7 @@
 namespace {
 
 void BM_WholeReferenceScrew(benchmark::State& state) {
-  const whirl::sim::Screw screw = whirl::sim::ReferenceScrew();
+  const whirl::screw::Screw screw = whirl::screw::ReferenceScrew();
   whirl::sim::SimOptions options;  // duration_s = 0: the whole thread
   for (auto _ : state) benchmark::DoNotOptimize(whirl::sim::Simulate(screw, options));
   state.SetLabel("whole 5100 mm thread, 2 mm cells, 1 s steps");

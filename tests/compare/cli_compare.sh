@@ -6,7 +6,8 @@ whirl="$1"; scratch="$2"; src="$3"
 rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
 model="$src/models/default.json"; screw="$src/datasets/screws/reference_80x10x6000.json"
 if [[ ! -f "$model" || ! -f "$screw" ]]; then echo "shipped model or screw missing"; exit 1; fi
-"$whirl" compare --model "$model" --screw "$screw" --seed 2 --json --out-dir rep > cmp.json
+hist="$src/datasets/whirling_500.csv"
+"$whirl" compare --model "$model" --screw "$screw" --history "$hist" --seed 2 --json --out-dir rep > cmp.json
 python3 - <<'PY'
 import json
 j = json.load(open("cmp.json"))
@@ -21,10 +22,20 @@ for k in ("none", "ramp", "traditional", "regression", "model"):
 PY
 test -s rep/index.html && test -s rep/report.json && test -s rep/reference_80x10x6000_lead.csv
 if command -v gnuplot > /dev/null; then test -s rep/reference_80x10x6000_lead.png; fi
-"$whirl" compare --model "$model" --screw "$screw" | grep "ISO 3408-3 class reached" > /dev/null
+"$whirl" compare --model "$model" --screw "$screw" --history "$hist" | grep "ISO 3408-3 class reached" > /dev/null
+# The history rules' screws are the user's (issue 44 item 1): --history is required, and the table
+# given is named with its size on stdout and on the page (no silent shipped history).
+if "$whirl" compare --model "$model" --screw "$screw" 2> err.txt > /dev/null; then exit 1; fi
+grep -q -- "--history" err.txt
+head -31 "$hist" | grep -v '^#' > own.csv; rows=$(($(wc -l < own.csv) - 1))
+"$whirl" compare --model "$model" --screw "$screw" --history own.csv --no-plots --out-dir own > own.txt
+grep -q "^history rules from: own.csv ($rows past screws)" own.txt
+grep -q "past screws of own.csv ($rows past screws)" own/index.html
+grep -q "whirling_500" own/index.html && exit 1
+grep -q "model (network" own/index.html && exit 1  # the model is any family, not only a network
 # Bad screw file -> exit 1 naming the file.
 echo '{"schema_version": 1, "name": "x"}' > bad.json
-if "$whirl" compare --model "$model" --screw bad.json 2> err.txt; then exit 1; fi
+if "$whirl" compare --model "$model" --screw bad.json --history "$hist" 2> err.txt; then exit 1; fi
 grep -q "bad.json" err.txt
 "$whirl" evaluate --no-validation --random 4 --seed 5 --json > eval.json
 python3 - <<'PY'

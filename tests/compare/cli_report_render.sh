@@ -21,9 +21,11 @@ if [ -z "$browser" ]; then
 fi
 command -v gnuplot > /dev/null || { echo "SKIPPED: gnuplot missing, reports have no plots"; exit 77; }
 
-# The reports: workpiece (demo), machine (demo step 7), drift (on the demo's sensor log).
+# The reports: workpiece (demo), machine (demo step 7), drift (on a simulated machine's day log).
 (cd "$D" && "$W" demo --out-dir out > demo.txt 2>&1) || fail "demo: $(tail -5 "$D/demo.txt")"
-"$W" drift report --train-cutting "$D/out/machine_report/sensors.csv" --error offset_um \
+"$W" machine sensors --out-dir "$D/runs" --idle 0 --cutting 1 > /dev/null \
+  || fail "machine sensors"
+"$W" drift report --train-cutting "$D/runs/cutting_1.csv" --error offset_um \
   --out-dir "$D/drift" > "$D/drift.txt" 2>&1 || fail "drift report: $(tail -5 "$D/drift.txt")"
 
 # Writes probe.html beside a page: the page plus a script that, once everything has loaded,

@@ -65,7 +65,7 @@ TEST(Baselines, TraditionalUsesTheClassMeanPlateauAndSettleTime) {
 // Energy balance of the scenario knobs: tool wear adds w/2 of the cut's heat (linear rise), a
 // steady rest adds its power times the heating time.
 TEST(Baselines, ToolWearAndSteadyRestHeatFollowTheirClosedForms) {
-  const sim::Screw screw = sim::ReferenceScrew();
+  const screw::Screw screw = screw::ReferenceScrew();
   sim::SimOptions o;
   o.duration_s = 600;
   o.cell_size_mm = 4;
@@ -95,7 +95,7 @@ TEST(Baselines, ScenarioSelectionAndOutOfRangeScrews) {
   EXPECT_THROW(SelectScenarios("today,bogus"), InputError);
   const Scenario out = SelectScenarios("out-of-range").front();
   const InputRanges training;
-  for (const auto& s : ScenarioScrews(out, sim::ReferenceScrew(), 20, 9)) {
+  for (const auto& s : ScenarioScrews(out, screw::ReferenceScrew(), 20, 9)) {
     const auto& p = s.process;
     const bool outside = p.diameter_mm < training.min.diameter_mm ||
                          p.diameter_mm > training.max.diameter_mm ||

@@ -39,7 +39,7 @@ TEST(ComparePlan, ZeroElongationTruthAndZeroPredictionGiveZeroDeviation) {
   zero.settle_time_s = 250;
   const interp::CompensationPlan plan = interp::BuildPlan(zero, feed, length, {});
   const ElongationCurve truth = Sampled(zero, length / feed + 1, 1.0);
-  const LeadDeviation d = CutLeadDeviation(truth, PlanCompensation(plan, feed), feed, length, 10);
+  const lead::LeadDeviation d = CutLeadDeviation(truth, PlanCompensation(plan, feed), feed, length, 10);
   for (double v : d.deviation_um) ASSERT_NEAR(v, 0.0, 1e-12);
 }
 
@@ -63,10 +63,10 @@ TEST(ComparePlan, PlanOfTheTruthLeavesOnlyThePlanTolerance) {
       const double feed = 0.667, length = 5100;
       const interp::CompensationPlan plan = interp::BuildPlan(curve, feed, length, po);
       const ElongationCurve truth = Sampled(curve, length / feed + 1, 0.25);
-      const LeadDeviation d =
+      const lead::LeadDeviation d =
           CutLeadDeviation(truth, PlanCompensation(plan, feed), feed, length, 10);
-      const LeadDeviation none = CutLeadDeviation(truth, NoCompensation(), feed, length, 10);
-      const LeadMetrics m = ComputeLeadMetrics(d), n = ComputeLeadMetrics(none);
+      const lead::LeadDeviation none = CutLeadDeviation(truth, NoCompensation(), feed, length, 10);
+      const lead::LeadMetrics m = lead::ComputeLeadMetrics(d), n = lead::ComputeLeadMetrics(none);
       EXPECT_LE(m.accumulated_total_um, 2 * po.tolerance_um + 0.05)
           << "sign " << interp::ToString(sign) << " direction " << direction;
       EXPECT_NEAR(n.accumulated_total_um, 40.0, 1e-6);
@@ -74,7 +74,7 @@ TEST(ComparePlan, PlanOfTheTruthLeavesOnlyThePlanTolerance) {
 }
 
 TEST(Compare, ReductionsFollowTheirFormula) {
-  LeadMetrics a, b;
+  lead::LeadMetrics a, b;
   a.accumulated_1000_um = 3;
   b.accumulated_1000_um = 12;
   a.e_a_um = -2;
@@ -90,12 +90,12 @@ TEST(Compare, ReductionsFollowTheirFormula) {
 }
 
 TEST(Compare, RandomScrewsAreFeasibleInRangeAndReproducible) {
-  const auto a = RandomFeasibleScrews(sim::ReferenceScrew(), 30, 9);
-  const auto b = RandomFeasibleScrews(sim::ReferenceScrew(), 30, 9);
+  const auto a = RandomFeasibleScrews(screw::ReferenceScrew(), 30, 9);
+  const auto b = RandomFeasibleScrews(screw::ReferenceScrew(), 30, 9);
   ASSERT_EQ(a.size(), 30u);
   const InputRanges r;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_NO_THROW(sim::ValidateScrew(a[i]));
+    EXPECT_NO_THROW(screw::ValidateScrew(a[i]));
     const auto x = a[i].process.ToArray(), lo = r.min.ToArray(), hi = r.max.ToArray();
     for (int k = 0; k < ProcessInputs::kCount; ++k) {
       EXPECT_GE(x[k], lo[k]);
@@ -103,7 +103,7 @@ TEST(Compare, RandomScrewsAreFeasibleInRangeAndReproducible) {
     }
     EXPECT_EQ(a[i].process.diameter_mm, b[i].process.diameter_mm);
   }
-  EXPECT_NO_THROW(sim::ValidateScrew(NewTypeScrew(sim::ReferenceScrew())));
+  EXPECT_NO_THROW(screw::ValidateScrew(NewTypeScrew(screw::ReferenceScrew())));
 }
 
 class ShippedModel : public ::testing::Test {
@@ -120,11 +120,11 @@ class ShippedModel : public ::testing::Test {
 TEST_F(ShippedModel, ReferenceScrewComparisonIsConsistent) {
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(model_path_);
   const ExperienceRule rule = BuildExperienceRule(ReadProcessTable(history_path_, true));
-  const IsoToleranceTable iso =
-      ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
+  const lead::IsoToleranceTable iso =
+      lead::ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
   CompareOptions options;
   options.seed = 3;
-  const ScrewComparison c = CompareScrew(sim::ReferenceScrew(), model, rule, iso, options);
+  const ScrewComparison c = CompareScrew(screw::ReferenceScrew(), model, rule, iso, options);
   const auto& none = c.Outcome(Strategy::kNone);
   const auto& model_o = c.Outcome(Strategy::kModel);
   // The uncompensated lead error equals the truth's elongation change along the cut.

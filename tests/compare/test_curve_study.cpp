@@ -20,7 +20,7 @@ TEST(SimulatedFits, DefaultShapeIsNearThePooledFitOfFreshSimulations) {
   EXPECT_NEAR(r.shape.shape_k, fit::kDefaultShapeK, 0.1 * fit::kDefaultShapeK)
       << "re-derive the defaults with 'whirl fit --simulated 25' if the simulator changed";
   // The settle time is itself the least-squares t_s of this shape plus a drift
-  // (sim/features.h), so the calibration with the features fixed is partly circular and lands at
+  // (fit/features.h), so the calibration with the features fixed is partly circular and lands at
   // p = 0.91 (k = 4.61) on the window the features come from.
   EXPECT_NEAR(r.shape.time_exponent, fit::kDefaultTimeExponent, 0.04)
       << "re-derive the defaults with 'whirl fit --simulated 25' if the simulator changed";

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "compare/cut.h"
-#include "compare/metrics.h"
+#include "lead/metrics.h"
 #include "compare/traditional.h"
 #include "core/error.h"
 
@@ -24,7 +24,7 @@ ElongationCurve Curve(double duration_s, double step_s, const std::function<doub
 TEST(Cut, ZeroElongationAndNoCompensationGiveZeroDeviation) {
   const double feed = 1.1, length = 5100;
   const ElongationCurve zero = Curve(length / feed + 1, 0.5, [](double) { return 0.0; });
-  const LeadDeviation d = CutLeadDeviation(zero, NoCompensation(), feed, length, 10);
+  const lead::LeadDeviation d = CutLeadDeviation(zero, NoCompensation(), feed, length, 10);
   EXPECT_EQ(d.position_mm.front(), 0.0);
   EXPECT_EQ(d.position_mm.back(), length);
   for (double v : d.deviation_um) EXPECT_EQ(v, 0.0);
@@ -40,11 +40,11 @@ TEST(Cut, CompensationEqualToTheTruthGivesZeroDeviation) {
     const ElongationCurve truth = Curve(length / feed + 2, 0.25, e);
     // The compensation follows the truth's own samples (the same linear interpolation).
     auto c = [&](double t) { return InterpolateLinear(truth.time_s, truth.elongation_um, t); };
-    const LeadDeviation d = CutLeadDeviation(truth, c, feed, length, 10);
+    const lead::LeadDeviation d = CutLeadDeviation(truth, c, feed, length, 10);
     for (double v : d.deviation_um) ASSERT_NEAR(v, 0.0, 1e-9);
     // A constant compensation changes nothing against none.
-    const LeadDeviation none = CutLeadDeviation(truth, NoCompensation(), feed, length, 10);
-    const LeadDeviation offset = CutLeadDeviation(
+    const lead::LeadDeviation none = CutLeadDeviation(truth, NoCompensation(), feed, length, 10);
+    const lead::LeadDeviation offset = CutLeadDeviation(
         truth, [](double) { return 37.0; }, feed, length, 10);
     for (std::size_t i = 0; i < none.size(); ++i)
       ASSERT_NEAR(none.deviation_um[i], offset.deviation_um[i], 1e-9);
@@ -55,12 +55,12 @@ TEST(Cut, LinearGrowthGivesALinearLeadErrorWithEaEqualToTheGrowth) {
   // e(t) = g t: d(x) = g x / v, so e_a = g * l / v and the band widths vanish.
   const double feed = 0.8, length = 2000, g = 0.05;
   const ElongationCurve truth = Curve(length / feed, 1.0, [&](double t) { return g * t; });
-  const LeadDeviation d = CutLeadDeviation(truth, NoCompensation(), feed, length, 10);
+  const lead::LeadDeviation d = CutLeadDeviation(truth, NoCompensation(), feed, length, 10);
   for (std::size_t i = 0; i < d.size(); ++i)
     ASSERT_NEAR(d.deviation_um[i], g * d.position_mm[i] / feed, 1e-9);
-  LeadMetricOptions options;
+  lead::LeadMetricOptions options;
   options.lead_mm = 10;
-  const LeadMetrics m = ComputeLeadMetrics(d, options);
+  const lead::LeadMetrics m = lead::ComputeLeadMetrics(d, options);
   EXPECT_NEAR(m.e_a_um, g * length / feed, 1e-6);
   EXPECT_NEAR(m.v_u_um, 0, 1e-6);
   EXPECT_NEAR(m.accumulated_1000_um, g * 1000 / feed, 1e-6);
@@ -68,7 +68,7 @@ TEST(Cut, LinearGrowthGivesALinearLeadErrorWithEaEqualToTheGrowth) {
 
 TEST(Cut, SampleStepResolvesOneLead) {
   const ElongationCurve truth = Curve(1000, 1.0, [](double t) { return std::sqrt(t); });
-  const LeadDeviation d = CutLeadDeviation(truth, NoCompensation(), 1.0, 1000, 6);
+  const lead::LeadDeviation d = CutLeadDeviation(truth, NoCompensation(), 1.0, 1000, 6);
   for (std::size_t i = 1; i < d.size(); ++i)
     ASSERT_LE(d.position_mm[i] - d.position_mm[i - 1], 0.6 + 1e-12);
 }
@@ -141,7 +141,7 @@ TEST(ExperienceRule, ZeroElongationHistoryAndTruthGiveZeroDeviation) {
   for (auto& f : cold.targets) f.max_elongation_um = 0;
   const ExperienceRule rule = BuildExperienceRule(cold);
   const ElongationCurve zero = Curve(6000, 1.0, [](double) { return 0.0; });
-  const LeadDeviation d = CutLeadDeviation(
+  const lead::LeadDeviation d = CutLeadDeviation(
       zero, [&](double t) { return rule.CompensationUm(80, t); }, 1.0, 5100, 10);
   for (double v : d.deviation_um) EXPECT_EQ(v, 0.0);
 }

@@ -33,22 +33,19 @@ class ReportContent : public ::testing::Test {
         workpiece::LoadWorkpieceModel(kSource / "models/default.json");
     const ExperienceRule rule =
         BuildExperienceRule(ReadProcessTable(kSource / "datasets/whirling_train.csv", true));
-    const IsoToleranceTable iso =
-        ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
+    const lead::IsoToleranceTable iso =
+        lead::ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
     profile_ = new interp::MachineProfile(
         interp::LoadMachineProfile(kSource / "datasets/machines/example_840d.json"));
     CompareOptions options;
     options.seed = 4;
     profile_->ApplyTo(options.plan);
     comparison_ =
-        new ScrewComparison(CompareScrew(sim::ReferenceScrew(), model, rule, iso, options));
-    nc_ = new std::string(
-        interp::FormatNcProgram(comparison_->plan, {"WHIRL_T", "WHIRL_T_RESET", "t"}));
+        new ScrewComparison(CompareScrew(screw::ReferenceScrew(), model, rule, iso, options));
   }
   static void TearDownTestSuite() {
     delete comparison_;
     delete profile_;
-    delete nc_;
   }
   // The report of the comparison in a fresh directory (no plots: the scripts are still written).
   static fs::path Write(const std::string& name, const ReportOptions& options) {
@@ -61,28 +58,14 @@ class ReportContent : public ::testing::Test {
   }
   static ScrewComparison* comparison_;
   static interp::MachineProfile* profile_;
-  static std::string* nc_;
 };
 ScrewComparison* ReportContent::comparison_ = nullptr;
 interp::MachineProfile* ReportContent::profile_ = nullptr;
-std::string* ReportContent::nc_ = nullptr;
-
-TEST_F(ReportContent, NcPrerequisitesAreTheProgramsHeaderRequirements) {
-  // Independently: the comment lines before the first statement that state a requirement.
-  std::vector<std::string> expected;
-  std::istringstream in(*nc_);
-  for (std::string line; std::getline(in, line) && line.rfind(";", 0) == 0;)
-    if (line.rfind("; requires ", 0) == 0 || line.rfind("; uses ", 0) == 0)
-      expected.push_back(line.substr(2));
-  ASSERT_GE(expected.size(), 3u);  // MD32750, MD32760, MD28250, ... IDs and R parameters
-  EXPECT_EQ(NcPrerequisites(*nc_), expected);
-  // A "; requires" comment after the header is not a prerequisite of the program.
-  EXPECT_EQ(NcPrerequisites(*nc_ + "; requires nothing else\n"), expected);
-}
 
 TEST_F(ReportContent, ControlBoxComesFirstWithSettingDataFilesAndPrerequisites) {
   ReportOptions o;
-  o.control = {PlanFilesLoad("../", "WHIRL_T", "t_plan.csv", "t_plan.json", *nc_, profile_)};
+  o.control = {
+      plan::PlanFilesLoad("../", "WHIRL_T", "t_plan.csv", "t_plan.json", comparison_->plan, profile_)};
   const std::string html = ReadTextFile(Write("whirl_report_box", o) / "index.html");
   const std::size_t box = html.find("<section class='control'");
   const std::size_t box_end = html.find("</section>");
@@ -101,6 +84,15 @@ TEST_F(ReportContent, ControlBoxComesFirstWithSettingDataFilesAndPrerequisites) 
   for (const char* f : {"../WHIRL_T.SPF", "../WHIRL_T_RESET.SPF", "../t_plan.csv"})
     EXPECT_NE(b.find(std::string("href='") + f + "'"), std::string::npos) << f;
   EXPECT_NE(b.find("MD28254 " + std::to_string(profile_->control.ac_params)), std::string::npos);
+  // The machine data the program needs, from the plan's data, each datum once with its threshold.
+  for (const interp::ControlRequirement& r : interp::PlanRequirements(comparison_->plan, "WHIRL_T")) {
+    const std::string line = "<li>" + r.datum;
+    const std::size_t at = b.find(line);
+    EXPECT_NE(at, std::string::npos) << r.datum;
+    EXPECT_EQ(b.find(line, at + 1), std::string::npos) << r.datum << " listed twice";
+  }
+  EXPECT_NE(b.find("MD32750 $MA_TEMP_COMP_TYPE on axis Z: bits 0 and 1 set (= 3)"),
+            std::string::npos);
   EXPECT_NE(b.find("After an aborted cut"), std::string::npos);
   EXPECT_NE(b.find("WHIRL_T_RESET"), std::string::npos);
   // Without files the box still gives the setting data and says where the programs come from.

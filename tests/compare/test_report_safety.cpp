@@ -32,11 +32,11 @@ class ShippedModelReport : public ::testing::Test {
     ASSERT_TRUE(fs::exists(history)) << history << " not shipped";
     model_ = workpiece::LoadWorkpieceModel(model);
     rule_ = BuildExperienceRule(ReadProcessTable(history, true));
-    iso_ = ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
+    iso_ = lead::ReadIsoToleranceTable(kSource / "datasets/standards/iso3408_3_lead_tolerances.csv");
   }
   workpiece::WorkpieceModel model_;
   ExperienceRule rule_;
-  IsoToleranceTable iso_;
+  lead::IsoToleranceTable iso_;
 };
 
 TEST_F(ShippedModelReport, HostileScrewNamesRenderPlotsAndRunNothing) {
@@ -51,7 +51,7 @@ TEST_F(ShippedModelReport, HostileScrewNamesRenderPlotsAndRunNothing) {
       "<script>alert('x')</script>", "$(touch " + pwned.string() + ") ^_@{}"};
   CompareOptions options;
   options.seed = 5;
-  const ScrewComparison base = CompareScrew(sim::ReferenceScrew(), model_, rule_, iso_, options);
+  const ScrewComparison base = CompareScrew(screw::ReferenceScrew(), model_, rule_, iso_, options);
   std::vector<ScrewComparison> comparisons;
   for (const std::string& name : names) {
     comparisons.push_back(base);
@@ -82,7 +82,7 @@ TEST_F(ShippedModelReport, AFailingReportLeavesNoFileBehind) {
   fs::create_directories(dir / "index.html");  // the last file cannot be written
   CompareOptions options;
   options.seed = 2;
-  const ScrewComparison c = CompareScrew(sim::ReferenceScrew(), model_, rule_, iso_, options);
+  const ScrewComparison c = CompareScrew(screw::ReferenceScrew(), model_, rule_, iso_, options);
   ReportOptions ro;
   ro.plots = ProgramSucceeds({"gnuplot", "--version"});
   EXPECT_THROW(WriteReport(dir, {c}, ro), InputError);
@@ -105,7 +105,7 @@ TEST_F(ShippedModelReport, UnrenderedPlotLeavesNoOldFigure) {
   fs::remove_all(dir);
   CompareOptions options;
   options.seed = 3;
-  const ScrewComparison c = CompareScrew(sim::ReferenceScrew(), model_, rule_, iso_, options);
+  const ScrewComparison c = CompareScrew(screw::ReferenceScrew(), model_, rule_, iso_, options);
   ASSERT_TRUE(WriteReport(dir, {c}, {}).plots_rendered);
   std::size_t pngs = 0;
   for (const auto& e : fs::directory_iterator(dir)) pngs += e.path().extension() == ".png";
@@ -120,7 +120,7 @@ TEST_F(ShippedModelReport, UnrenderedPlotLeavesNoOldFigure) {
 }
 
 TEST_F(ShippedModelReport, EvaluateHandsAnyWorkerExceptionToTheCaller) {
-  const std::vector<sim::Screw> screws(4, sim::ReferenceScrew());
+  const std::vector<screw::Screw> screws(4, screw::ReferenceScrew());
   EvaluateOptions options;
   options.threads = 2;
   const auto throwing = [](std::size_t, std::size_t) { throw std::logic_error("not InputError"); };
@@ -128,11 +128,11 @@ TEST_F(ShippedModelReport, EvaluateHandsAnyWorkerExceptionToTheCaller) {
 }
 
 TEST_F(ShippedModelReport, EvaluateRecordsAnInfeasibleScrewAsFailed) {
-  sim::Screw bad = sim::ReferenceScrew();
+  screw::Screw bad = screw::ReferenceScrew();
   bad.process.diameter_mm = -80;  // CompareScrew validates the screw: an InputError
   EvaluateOptions options;
   options.threads = 2;
-  const Evaluation e = EvaluateScrews({sim::ReferenceScrew(), bad}, model_, rule_, iso_, options);
+  const Evaluation e = EvaluateScrews({screw::ReferenceScrew(), bad}, model_, rule_, iso_, options);
   ASSERT_EQ(e.screws.size(), 2u);
   EXPECT_TRUE(e.screws[0].ok);
   EXPECT_FALSE(e.screws[1].ok);

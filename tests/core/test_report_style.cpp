@@ -80,9 +80,9 @@ TEST(PlotStyle, GroupSeriesKeepsEveryNameOnceWithinTheLimitAndGroupsTogether) {
   EXPECT_THROW(GroupSeries({"a"}, 0), std::invalid_argument);
 }
 
-TEST(PlotStyle, GroupSeriesOfTheDefaultMachineSensors) {
-  // Worked by hand: the 13 sensors of machine::DefaultMachine, at most 8 per plot; the bed and head
-  // groups stay whole.
+TEST(PlotStyle, GroupSeriesOfThirteenMachineSensors) {
+  // Worked by hand: 13 machine sensors (those of the retired closed-form machine), at most 8 per
+  // plot; the bed and head groups stay whole.
   const std::vector<std::string> names = {
       "ambient_C",         "bed_headstock_C", "bed_middle_C",   "bed_tailstock_C", "head_motor_C",
       "head_bearing_C",    "head_housing_C",  "ring_gearbox_C", "coolant_tank_C",  "z_nut_C",

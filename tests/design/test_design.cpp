@@ -1,4 +1,4 @@
-// Tests of src/design: the first design against a known optimum and random subsets, the exact
+// Tests of src/product/design: the first design against a known optimum and random subsets, the exact
 // variance update against a refit, and the next screws' invariants on a trained model.
 #include <gtest/gtest.h>
 

@@ -7,7 +7,12 @@
       an option that command's --help lists: an old spelling (a hidden deprecated alias) or a
       removed flag fails;
     - the "every option" table of docs/commands.md lists each command with exactly the options
-      its --help lists.
+      its --help lists;
+    - every --help text (each command and group) names only what exists: a `whirl ...` command
+      quoted in it is checked as above, every other --flag is an option of some command, and
+      every path into the tree (datasets/, models/, docs/, src/, interp/, scripts/, tests/)
+      exists in the source tree (a glob must match a file); so does every such path in a code
+      span of README.md and docs/*.md.
   --write: rewrites that table from the binary (after adding or renaming a flag).
 
 Usage: commands_doc.py --whirl build/whirl --src . (--check | --write)
@@ -37,8 +42,18 @@ class Commands:
             r = subprocess.run([self.whirl, *words, "--help"], capture_output=True, text=True)
             if r.returncode != 0:
                 sys.exit(f"FAIL: whirl {' '.join(words)} --help: exit {r.returncode}: {r.stderr}")
-            self.cache[key] = parse_help(r.stdout)
+            self.cache[key] = (*parse_help(r.stdout), r.stdout)
         return self.cache[key]
+
+    def help_text(self, words):
+        return self.parsed(words)[2]
+
+    def nodes(self, words=()):
+        """Every command and group, the program first."""
+        out = [list(words)]
+        for s in self.subcommands(list(words)):
+            out += self.nodes((*words, s))
+        return out
 
     def subcommands(self, words):
         return self.parsed(words)[0]
@@ -129,6 +144,42 @@ def check_command(cmds, text):
     return [f"whirl {where}: no option {f}" for f in flags if f not in known]
 
 
+HELP_FLAG = re.compile(r"(?<![\w-])(--[a-zA-Z][a-zA-Z0-9-]*\*?)")
+TREE_PATH = re.compile(r"(?<![\w/.-])((?:datasets|models|docs|src|interp|scripts|tests)/[\w./*-]*[\w*])")
+QUOTED_COMMAND = re.compile(r"(?<![\w/-])whirl ((?:[a-z][a-z0-9-]* )*[a-z][a-z0-9-]*(?: [^'\"`()\n;]*)?)")
+
+
+def help_problems(cmds, src):
+    """What a --help text names that does not exist."""
+    every_flag = set()
+    for node in cmds.nodes():
+        every_flag.update(cmds.options(node))
+    problems = []
+    for node in cmds.nodes():
+        text = cmds.help_text(node)
+        where = "whirl " + " ".join(node + ["--help"])
+        body = text.split("\nOptions:", 1)
+        quoted = set()
+        for m in QUOTED_COMMAND.finditer(text):
+            command = "whirl " + m.group(1)
+            words = m.group(1).split()
+            if not words or words[0] not in cmds.subcommands([]):
+                continue  # "whirl: thermal ...", prose
+            quoted.update(FLAG.findall(m.group(1)))
+            problems += [f"{where}: '{command}': {p}" for p in check_command(cmds, command)]
+        for flag in HELP_FLAG.findall(text):
+            if flag.endswith("*"):  # "--train-*": some option starts so
+                if not any(f.startswith(flag[:-1]) for f in every_flag):
+                    problems.append(f"{where}: names {flag}, which no option matches")
+            elif flag not in every_flag and flag not in quoted:
+                problems.append(f"{where}: names {flag}, an option of no command")
+        for path in TREE_PATH.findall(text):
+            path = path.rstrip(".")
+            if not glob.glob(os.path.join(src, path)):
+                problems.append(f"{where}: names {path}, which is not in the source tree")
+    return problems
+
+
 def option_table(cmds):
     rows = ["| command | options |", "|---|---|"]
     for leaf in cmds.leaves():
@@ -169,6 +220,14 @@ def main():
             checked += 1
             for problem in check_command(cmds, text):
                 failures.append(f"{os.path.relpath(page, a.src)}:{n}: {problem} (in '{text}')")
+    failures += help_problems(cmds, a.src)
+    for page in pages:
+        for n, line in enumerate(open(page, encoding="utf-8"), 1):
+            for span in re.findall(r"`([^`]+)`", line):
+                for path in TREE_PATH.findall(span):
+                    if not glob.glob(os.path.join(a.src, path.rstrip("."))):
+                        failures.append(f"{os.path.relpath(page, a.src)}:{n}: names {path}, "
+                                        "which is not in the source tree")
     for f in failures:
         print("FAIL:", f)
     print(f"{checked} documented commands, {len(cmds.leaves())} commands in the table")

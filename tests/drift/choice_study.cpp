@@ -3,9 +3,10 @@
 // the better of `--candidates sensors` and `--candidates time` case by case (issue 38's measure).
 //   choice_study tuning [--seeds N]        the tuning set: tests/drift/planted_logs.h
 //   choice_study confirmation [--seeds N]  the confirmation set: other generators, the field
-//                                          machine (src/machine/field.h) on production days
-//                                          refitted daily and the closed-form machine's warm-up
-//                                          and cutting runs (src/machine/machine.h)
+//                                          machine (src/lab/machine/field.h) on production days
+//                                          refitted daily and its warm-up tests (the closed-form
+//                                          machine's warm-up runs of issue 38's confirmation
+//                                          left with that machine: docs/drift.md)
 //   [--margin M --consistency C --tolerance T]  a rule other than the default (tuning only)
 // Prints one line per case (MAE um of the default, sensors, time, the better of the two, the
 // default's ratio to it, the candidate chosen) and per scenario and overall: the summed MAE of
@@ -25,10 +26,8 @@
 #include "drift/planted_logs.h"
 #include "machine/field.h"
 #include "machine/instruments.h"
-#include "machine/machine.h"
 #include "machine/scenarios.h"
 #include "machine/truth.h"
-#include "machine_eval/machine_eval.h"
 
 namespace {
 
@@ -180,27 +179,6 @@ std::vector<planted::Case> ConfirmationCases(int seeds) {
         cases.push_back(std::move(c));
       }
     }
-  const machine::MachineConfig legacy = machine::DefaultMachine();
-  for (int k = 0; k < seeds; ++k) {
-    std::vector<Run> idle =
-        machine_eval::TrainingRuns(legacy, MixSeed(4139, static_cast<std::uint64_t>(k)), 6,
-                                   RunState::kIdle);
-    for (Run& r : idle) r.error_names[r.ErrorIndex("offset_um")] = "e_um";
-    planted::Case one;
-    one.scenario = "legacy warm-up x1";
-    one.train = {idle[0]};
-    planted::Case four;
-    four.scenario = "legacy warm-up x4";
-    four.train = {idle[0], idle[1], idle[2], idle[3]};
-    for (std::size_t i = 4; i < 6; ++i) {
-      one.test.push_back(idle[i]);
-      one.scored.emplace_back(0, idle[i].samples());
-    }
-    four.test = one.test;
-    four.scored = one.scored;
-    cases.push_back(std::move(one));
-    cases.push_back(std::move(four));
-  }
   return cases;
 }
 

@@ -56,6 +56,15 @@ for m in mlr dynamic network; do
 done
 "$W" drift fit --idle "$D/idle1.csv" --error err_um --json --out "$D/m.json" > "$D/fit.json" || fail "fit --json"
 grep -q '"coefficients"' "$D/fit.json" || fail "fit --json has no coefficients"
+# A production week (--day ...) writes what --out-dir, --timeline and --events name (issue 44
+# item 2: the multi-day replay exited 0 and wrote nothing).
+"$W" drift monitor --model "$D/mlr.json" --day "$D/idle2.csv" --day "$D/cut1.csv" --threshold-um 1 \
+  --out-dir "$D/week" --timeline "$D/week_t.csv" --events "$D/week_e.csv" > /dev/null \
+  2> "$D/week_err.txt" || fail "monitor --day: $(cat "$D/week_err.txt")"
+for f in "$D/week/index.html" "$D/week_t.csv" "$D/week_e.csv"; do
+  [ -s "$f" ] || fail "monitor --day did not write $f"
+done
+grep -v '^#' "$D/week_t.csv" | head -1 | grep -q "^day," || fail "week timeline has no day column"
 "$W" drift predict --model "$D/mlr.json" --run "$D/cut1.csv" --out "$D/pred.csv" > "$D/pred.txt" \
   2> "$D/pred_err.txt" || fail "predict"
 grep -q "^time_min,predicted_um,compensation_um,std_um,measured_um,residual_um" "$D/pred.csv" \

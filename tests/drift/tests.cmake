@@ -1,4 +1,4 @@
-# Tests of src/drift (run files, Miao et al.'s selection, drift models, evaluation) and its CLI.
+# Tests of src/product/drift (run files, Miao et al.'s selection, drift models, evaluation) and its CLI.
 whirl_add_gtest(test_drift
   SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/test_selection.cpp
@@ -24,9 +24,9 @@ whirl_add_cli_test(cli_fl_thermal_moonshot_full ${CMAKE_CURRENT_LIST_DIR}/cli_fl
 set_tests_properties(cli_fl_thermal_moonshot cli_fl_thermal_moonshot_full PROPERTIES SKIP_RETURN_CODE 77)
 set_property(TEST cli_fl_thermal_moonshot_full APPEND PROPERTY LABELS slow)
 # Development driver: the choice between the sensor and the elapsed-time models on planted logs
-# (tuning: tests/drift/planted_logs.h; confirmation: the field and closed-form machines).
+# (tuning: tests/drift/planted_logs.h; confirmation: the field machine).
 add_executable(choice_study ${CMAKE_CURRENT_LIST_DIR}/choice_study.cpp)
-target_link_libraries(choice_study PRIVATE whirl::machine_eval)
+target_link_libraries(choice_study PRIVATE whirl::machine)
 target_include_directories(choice_study PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 whirl_set_warnings(choice_study)
 target_compile_options(choice_study PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})

@@ -26,6 +26,21 @@ awk -v k="$k" 'BEGIN { exit !(k > 3.96 && k < 4.04) }' || fail "fitted k = $k, e
 p=$(tr -d ' \n' < "$D/fit.json" | grep -o '"time_exponent":[0-9.e+-]*' | head -1 | cut -d: -f2)
 awk -v p="$p" 'BEGIN { exit !(p > 0.79 && p < 0.81) }' || fail "fitted p = $p, expected 0.8"
 grep -q "p = 0.8" "$D/c.csv" || fail "curve CSV comment does not give p"
+# The row for table.csv is printed: the features (not a free fit's L, t_s), equal to the JSON's.
+python3 - "$D/fit.json" "$D/fit.txt" <<'PY' || fail "fit --curve: no table.csv row of the features: $(cat "$D/fit.txt")"
+import json, sys
+f = json.load(open(sys.argv[1]))["features"]
+lines = open(sys.argv[2]).read().splitlines()
+i = lines.index("hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min,max_elongation_um,settle_time_s")
+row = lines[i + 1].split(",")
+assert abs(float(row[5]) - f["max_elongation_um"]) < 1e-4 and abs(float(row[6]) - f["settle_time_s"]) < 1e-2, row
+assert "go into table.csv" in open(sys.argv[2]).read()
+PY
+grep -Eq "::|kDefault" "$D/help.txt" && fail "fit --help names internals: $(grep -E '::|kDefault' "$D/help.txt")"
+# A record too short for its settle time: the warning says how long to log.
+"$W" curve --max-elongation-um 30 --settle-time-s 250 --duration-s 300 --out "$D/short.csv" || fail "short curve"
+"$W" fit --curve "$D/short.csv" > /dev/null 2> "$D/short.err" || fail "fit short"
+grep -q "at least twice the settle time" "$D/short.err" || fail "short record: $(cat "$D/short.err")"
 expect_fail "time-exponent" "$W" curve --max-elongation-um 3 --settle-time-s 100 --time-exponent 1.2
 
 # Bad curves: a gap, non-increasing time, a missing file.

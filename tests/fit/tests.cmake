@@ -1,4 +1,4 @@
-# Tests of src/fit (LM solver, curve models) and the fit/curve command line.
+# Tests of src/product/fit (LM solver, curve models) and the fit/curve command line.
 whirl_add_gtest(test_fit
   SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/test_levenberg_marquardt.cpp

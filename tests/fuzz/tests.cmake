@@ -47,8 +47,8 @@ file(CONFIGURE OUTPUT ${CMAKE_CURRENT_BINARY_DIR}/fuzz_replay/corpus_harnesses.h
 add_executable(fuzz_corpus ${corpus_sources})
 target_include_directories(fuzz_corpus PRIVATE ${CMAKE_CURRENT_BINARY_DIR}/fuzz_replay
                            ${CMAKE_CURRENT_LIST_DIR} ${PROJECT_SOURCE_DIR})
-target_link_libraries(fuzz_corpus PRIVATE whirl::core whirl::sim whirl::nn whirl::workpiece
-                      whirl::drift whirl::interp whirl::ballbar whirl::surface whirl::compare)
+target_link_libraries(fuzz_corpus PRIVATE whirl::core whirl::screw whirl::lead whirl::nn
+                      whirl::workpiece whirl::drift whirl::interp whirl::ballbar whirl::surface)
 target_compile_options(fuzz_corpus PRIVATE ${WHIRL_TEST_OPTIMIZATION})
 whirl_set_warnings(fuzz_corpus)
 foreach(name IN LISTS WHIRL_FUZZ_HARNESSES)
@@ -63,7 +63,8 @@ if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
 endif()
 set(WHIRL_FUZZ_FLAGS -fsanitize=address,undefined -fno-sanitize-recover=undefined -g)
 set(fuzz_lib_sources)
-foreach(module core sim nn gp family workpiece fit drift interp machine ballbar surface compare)
+# Every loader a harness reaches is in the product (src/product, interp): no lab module.
+foreach(module core screw lead nn gp family workpiece fit drift interp plan ballbar surface)
   get_target_property(sources whirl_${module} SOURCES)
   get_target_property(dir whirl_${module} SOURCE_DIR)
   foreach(src IN LISTS sources)
@@ -75,7 +76,7 @@ foreach(module core sim nn gp family workpiece fit drift interp machine ballbar 
   endforeach()
 endforeach()
 add_library(whirl_fuzz_lib STATIC ${fuzz_lib_sources})
-target_include_directories(whirl_fuzz_lib PUBLIC ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR})
+target_include_directories(whirl_fuzz_lib PUBLIC ${PROJECT_SOURCE_DIR}/src/product ${PROJECT_SOURCE_DIR})
 target_link_libraries(whirl_fuzz_lib PUBLIC Eigen3::Eigen nlohmann_json::nlohmann_json Boost::headers)
 target_compile_features(whirl_fuzz_lib PUBLIC cxx_std_17)
 target_compile_options(whirl_fuzz_lib PRIVATE -fsanitize=fuzzer-no-link ${WHIRL_FUZZ_FLAGS})

@@ -17,7 +17,9 @@ awk 'BEGIN { print "# synthetic run for the smoke test"; print "time_min,t1_C,t2
 "$W" drift fit --run "$D/run.csv" --error ch1_um --sensors t1_C t2_C --out "$D/model.json" \
   > /dev/null || fail "drift fit"
 "$W" drift nc --model "$D/model.json" --machine "$M" --nc "$D/drift.spf" \
-  --reset-nc "$D/drift_reset.spf" --csv "$D/drift.csv" > "$D/out.txt" || fail "drift nc"
+  --reset-nc "$D/drift_reset.spf" --csv "$D/drift.csv" > "$D/out.txt" 2> "$D/nc.err" || fail "drift nc"
+grep -q "^warning: machine profile .*example_840d.json is the shipped example" "$D/nc.err" ||
+  fail "drift nc with the untouched example profile does not warn: $(cat "$D/nc.err")"
 for f in drift.spf drift_reset.spf drift.csv; do [ -s "$D/$f" ] || fail "$f not written"; done
 grep -q '^IDS=200 ' "$D/drift.spf" || fail "IDS range from the profile"
 grep -q 'A_INA\[1\]' "$D/drift.spf" || fail "analog input of t1_C"

@@ -14,7 +14,15 @@ grep -q -- "--save-r-first" "$D/help.txt" || fail "plan --help lacks --save-r-fi
 
 # From given features: all three outputs, consistent with each other.
 "$W" plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 --machine "$M" --out "$D/plan.json" \
-  --csv "$D/plan.csv" --nc "$D/plan.spf" --reset-nc "$D/reset.spf" > "$D/plan.txt" || fail "plan"
+  --csv "$D/plan.csv" --nc "$D/plan.spf" --reset-nc "$D/reset.spf" > "$D/plan.txt" 2> "$D/plan.err" || fail "plan"
+# The untouched example profile is named as illustrative (issue 44 item 5); a profile the user
+# made their own (renamed) is not.
+grep -q "^warning: machine profile .*example_840d.json is the shipped example" "$D/plan.err" ||
+  fail "plan with the untouched example profile does not warn: $(cat "$D/plan.err")"
+sed 's/"name": "[^"]*"/"name": "WM-7 hall 2"/' "$M" > "$D/own_profile.json"
+"$W" plan --screw "$S" --max-elongation-um 30 --settle-time-s 250 --machine "$D/own_profile.json" \
+  --out "$D/own_plan.json" > /dev/null 2> "$D/own.err" || fail "plan with an own profile"
+grep -q "warning" "$D/own.err" && fail "plan warns about an own profile: $(cat "$D/own.err")"
 for f in plan.json plan.csv plan.spf reset.spf; do [ -s "$D/$f" ] || fail "$f not written"; done
 grep -q '"schema": "whirl.plan"' "$D/plan.json" || fail "plan JSON schema"
 grep -q '"uniform_point_count"' "$D/plan.json" || fail "plan JSON uniform count"

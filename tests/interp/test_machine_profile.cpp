@@ -51,7 +51,7 @@ TEST(MachineProfile, ShippedProfilesLoadWithTheirDriftObjects) {
   EXPECT_EQ(w.drift->slope_fixed_end_mm, 5587.5);
   EXPECT_EQ(w.drift->slope_growth_direction, -1);
   EXPECT_EQ(w.drift->workpiece_slope_param, 97);
-  EXPECT_EQ(w.drift->inputs.size(), 13u);
+  EXPECT_EQ(w.drift->inputs.size(), 18u);  // 13 sensors, 5 duty signals
   const MachineProfile e =
       LoadMachineProfile(fs::path(WHIRL_SOURCE_DIR) / "datasets/machines/example_840d.json");
   ASSERT_TRUE(e.drift);
@@ -155,7 +155,7 @@ TEST(MachineProfile, CrossChecksAndBoundsAreRefusedByName) {
                 "fixed_end_position_mm");
   // The control's own limits: analog inputs (MD10300), $AC_PARAM (MD28254), elements (MD28250).
   ExpectRefused([](J& j) { j["control"]["md10300_analog_inputs"] = 8; }, "MD10300");
-  ExpectRefused([](J& j) { j["drift"]["analog_inputs"]["cabinet_C"]["index"] = 14; }, "MD10300");
+  ExpectRefused([](J& j) { j["drift"]["analog_inputs"]["cabinet_C"]["index"] = 19; }, "MD10300");
   ExpectRefused([](J& j) { j["control"]["md28254_ac_params"] = 250; }, "MD28254");
   ExpectRefused([](J& j) { j["control"]["md28250_sync_elements"] = 50; }, "MD28250");
   ExpectRefused([](J& j) { j["control"]["md10300_analog_inputs"] = 1000; }, "MD10300");

@@ -6,6 +6,7 @@ whirl_add_gtest(test_interp
     ${CMAKE_CURRENT_LIST_DIR}/test_nc_replay.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_drift_action.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_machine_profile.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_control_requirements.cpp
 )
 whirl_add_cli_test(cli_plan ${CMAKE_CURRENT_LIST_DIR}/cli_plan.sh)
 whirl_add_cli_test(cli_drift_nc ${CMAKE_CURRENT_LIST_DIR}/cli_drift_nc.sh)

@@ -1,4 +1,4 @@
-// The shop day (src/machine/day.h) and the calendar (scenarios.h): ordered events, cut lengths,
+// The shop day (src/lab/machine/day.h) and the calendar (scenarios.h): ordered events, cut lengths,
 // breaks, start types, disjoint day seeds.
 #include <gtest/gtest.h>
 
@@ -109,7 +109,8 @@ TEST(ShopDay, HistoryAndTestDaySeedsAreDisjoint) {
 }
 
 TEST(Scenarios, SelectionAndCalendar) {
-  EXPECT_EQ(SelectMachineScenarios("all").size(), 7u);
+  EXPECT_EQ(SelectMachineScenarios("all").size(), 6u);
+  EXPECT_THROW(SelectMachineScenarios("legacy"), InputError);  // the retired world
   EXPECT_EQ(SelectMachineScenarios("production,linear-scale").size(), 2u);
   try {
     SelectMachineScenarios("production,bogus");

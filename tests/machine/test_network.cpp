@@ -1,4 +1,4 @@
-// The exact thermal network and the field machine's error functional (src/machine/network.h,
+// The exact thermal network and the field machine's error functional (src/lab/machine/network.h,
 // field.h): closed forms, steady state, energy balance, the fin decay of the Z screw, the linear
 // scale taking the screw out of the loop.
 #include <gtest/gtest.h>

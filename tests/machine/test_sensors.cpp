@@ -1,4 +1,4 @@
-// Sensors of the field machine (src/machine/sensors.h): each reads its own location; noise,
+// Sensors of the field machine (src/lab/machine/sensors.h): each reads its own location; noise,
 // quantum and per-machine draws as documented.
 #include <gtest/gtest.h>
 

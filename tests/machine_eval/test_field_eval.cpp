@@ -14,7 +14,7 @@
 #include "machine_eval/field_eval.h"
 #include "machine_eval/field_history.h"
 #include "machine_eval/field_monitor.h"
-#include "machine_eval/seeds.h"
+#include "machine_eval/summary.h"
 #include "machine_eval/strategies.h"
 #include "machine_eval/trained_numbers.h"
 
@@ -144,10 +144,26 @@ TEST(FieldCausal, TheMonitoredValueAtSampleIDependsOnlyOnChecksAndSamplesUpToI) 
   EXPECT_EQ(full.updates, static_cast<int>(checks.size()) - 1);
   const HeldSamples trained = RunCausally(m.shop.sensors, log);
   EXPECT_NE(full.held.k0_um.back(), trained.k0_um.back()) << "the updates move K0";
+  // The samples where a look-ahead of one sample would show: the last one before each check,
+  // the one before it and the one at it; then 12 random ones over the day. A check within 1e-9
+  // min of a sample is taken at that sample (10-s steps summed in minutes round, e.g. to
+  // 749.99999999996 for 750).
+  const double same_time_min = 1e-9;
+  std::vector<int> samples;
+  for (const machine::Reading& r : checks) {
+    int j = 0;
+    while (j + 1 < raw.samples() &&
+           raw.time_min[static_cast<std::size_t>(j) + 1] < r.abs_min - same_time_min)
+      ++j;
+    for (int k : {j - 1, j, j + 1})
+      if (k >= 0 && k + 2 <= raw.samples()) samples.push_back(k);
+  }
+  ASSERT_GE(samples.size(), 6u);
   Rng rng(29);
+  for (int trial = 0; trial < 12; ++trial)
+    samples.push_back(static_cast<int>(rng.Uniform() * (raw.samples() - 2)));
   int changed_later = 0;
-  for (int trial = 0; trial < 12; ++trial) {
-    const int i = static_cast<int>(rng.Uniform() * (raw.samples() - 2));
+  for (const int i : samples) {
     drift::Run later = raw;
     for (int k = i + 1; k < later.samples(); ++k) {
       for (int s = 0; s < later.temperature_C.cols(); ++s) later.temperature_C(k, s) += 5;
@@ -155,7 +171,7 @@ TEST(FieldCausal, TheMonitoredValueAtSampleIDependsOnlyOnChecksAndSamplesUpToI) 
     }
     std::vector<machine::Reading> c = checks;
     for (machine::Reading& r : c)
-      if (r.abs_min > log.time_min[static_cast<std::size_t>(i)]) r.value_um += 30;
+      if (r.abs_min > log.time_min[static_cast<std::size_t>(i)] + same_time_min) r.value_um += 30;
     const MonitoredDay d = run(AverageSensors(later, 5), c);
     for (int k = 0; k <= i; ++k) {
       ASSERT_EQ(full.held.k0_um[static_cast<std::size_t>(k)], d.held.k0_um[static_cast<std::size_t>(k)])
@@ -291,7 +307,6 @@ TEST(FieldMonitor, RemovesMostOfAPersistentChangeTheSensorsDoNotSee) {
 SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_shop_seed_scale) {
   SeedsEvaluation e;
   e.scenario = "planted";
-  e.rows = FieldStrategies();
   for (int s = 0; s < 3; ++s) {
     e.seeds.push_back(static_cast<std::uint64_t>(s + 1));
     MachineEvaluation run;
@@ -310,13 +325,13 @@ SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_sho
   return e;
 }
 
-// T: headlines name the smallest thread median among the sensor-free rows of the table (rows
-// outside the table never), give the gain of both_shop with its per-seed range, and say plainly
-// whether the sensors beat it.
+// T: headlines name the smallest thread median among the sensor-free rows of the table (a
+// sensor row never), give the gain of both_shop with its per-seed range, and say plainly whether
+// the sensors beat it.
 TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
-  // none traditional workpiece machine both both_idle both_monitor class table nearest warmup
-  // schedule machine_shop both_shop lead_slope both_shop_monitor
-  std::vector<double> v = {60, 40, 30, 1, 1, 1, 1, 45, 42, 41, 25, 20, 18, 15, 28, 12};
+  // none traditional workpiece class table nearest warmup schedule lead_slope machine_shop
+  // both_shop both_shop_monitor
+  std::vector<double> v = {60, 40, 30, 45, 42, 41, 25, 20, 28, 18, 15, 12};
   ASSERT_EQ(v.size(), kMachineStrategyCount);
   SeedsEvaluation e = Planted(v, 1.0);
   auto h = MachineHeadlines(e);
@@ -343,19 +358,29 @@ TEST(FieldSeedsSummary, HeadlinesNameTheStrongestSensorFreeRowAndTheGain) {
   h = MachineHeadlines(e);
   EXPECT_NE(h[1].find("(per seed -68.8 .. +25.0 %"), std::string::npos) << h[1];
   EXPECT_NE(h[3].find("both_shop (sensors) does NOT beat"), std::string::npos) << h[3];
-  // A sensor-free row outside the table is never named; a sensor row never either.
-  v[static_cast<std::size_t>(MachineStrategy::kNearest)] = 10;
+  // A sensor row is never named, however small; a smaller sensor-free row is.
+  v[static_cast<std::size_t>(MachineStrategy::kMachineShop)] = 5;
   e = Planted(v, 1.0);
-  e.rows.erase(std::find(e.rows.begin(), e.rows.end(), MachineStrategy::kNearest));
   h = MachineHeadlines(e);
   EXPECT_NE(h[0].find("is schedule"), std::string::npos) << h[0];
-  e.rows = FieldStrategies();
+  v[static_cast<std::size_t>(MachineStrategy::kNearest)] = 10;
+  e = Planted(v, 1.0);
   h = MachineHeadlines(e);
   EXPECT_NE(h[0].find("is nearest"), std::string::npos) << h[0];
+  // One row per strategy of the one list, in its order; the retired legacy rows are gone.
   const std::string table = FormatSeedsTable(e, true);
-  EXPECT_EQ(table.find("| planted | both_idle |"), std::string::npos);
-  EXPECT_NE(table.find("| planted | both_shop |"), std::string::npos);
-  EXPECT_NE(table.find("| planted | both_shop_monitor |"), std::string::npos);
+  std::size_t at = 0;
+  for (MachineStrategy s : MachineStrategies()) {
+    const std::string row = "| planted | " + ToString(s) + " |";
+    const std::size_t found = table.find(row);
+    ASSERT_NE(found, std::string::npos) << row;
+    EXPECT_GT(found, at) << row << " out of order";
+    EXPECT_EQ(table.find(row, found + 1), std::string::npos) << row << " twice";
+    at = found;
+  }
+  for (const char* retired : {"both_idle", "both_monitor", "| planted | machine |",
+                              "| planted | both |"})
+    EXPECT_EQ(table.find(retired), std::string::npos) << retired;
 }
 
 }  // namespace
@@ -513,8 +538,8 @@ TEST(LeadSlope, RecoversAPlantedSlopeAndCancelsIt) {
   const workpiece::WorkpieceModel model = workpiece::LoadWorkpieceModel(root + "models/default.json");
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(root + "datasets/whirling_500.csv", true));
-  const compare::IsoToleranceTable iso =
-      compare::ReadIsoToleranceTable(root + "datasets/standards/iso3408_3_lead_tolerances.csv");
+  const lead::IsoToleranceTable iso =
+      lead::ReadIsoToleranceTable(root + "datasets/standards/iso3408_3_lead_tolerances.csv");
   const MachineEvaluation e = EvaluateFieldScenario(s, model, rule, iso, o);
   const auto lead = static_cast<std::size_t>(MachineStrategy::kLeadSlope);
   const auto wp = static_cast<std::size_t>(MachineStrategy::kWorkpiece);

@@ -1,108 +1,147 @@
-// The machine evaluation (machine_eval/machine_eval.h): with every machine component off each
-// strategy equals its workpiece-only counterpart of the strategy comparison exactly, and the
-// report of one screw keeps hostile names as text.
+// The machine evaluation (machine_eval/machine_eval.h, field_eval.h): on a field machine that
+// does not drift every workpiece row equals its counterpart of the workpiece-only strategy
+// comparison, and the report screw an evaluation keeps is its first screw with its own curves.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 
-#include "core/error.h"
 #include "core/process.h"
-#include "core/safe_text.h"
-#include "machine/machine.h"
-#include "machine_eval/machine_eval.h"
-#include "machine_eval/machine_report.h"
+#include "core/random.h"
+#include "machine/scenarios.h"
+#include "machine_eval/field_eval.h"
 #include "workpiece/model.h"
-#include "sim/screw.h"
-#include "support/scratch_dir.h"
 
 namespace whirl::machine_eval {
 namespace {
 
-struct Fixture {
+struct EvalFixture {
   workpiece::WorkpieceModel model =
       workpiece::LoadWorkpieceModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
   compare::ExperienceRule rule = compare::BuildExperienceRule(
       ReadProcessTable(std::string(WHIRL_SOURCE_DIR) + "/datasets/whirling_500.csv", true));
-  compare::IsoToleranceTable iso = compare::ReadIsoToleranceTable(
+  lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(
       std::string(WHIRL_SOURCE_DIR) + "/datasets/standards/iso3408_3_lead_tolerances.csv");
 };
 
-TEST(MachineEvaluation, EveryComponentOffEqualsTheWorkpieceOnlyComparisonExactly) {
-  Fixture f;
-  machine::MachineConfig off = machine::DefaultMachine();
-  off.DisableAll();
-  const machine::MachineDay day = machine::MachineDay::Draw(off, 2, 3);
-  const MachineModels none;  // nothing fitted when the machine does not drift
-  const sim::Screw screw = compare::RandomFeasibleScrews(sim::ReferenceScrew(), 1, 5).front();
-  compare::CompareOptions co;
-  co.seed = 9;
-  const MachineEvalScrew m = EvaluateScrewOnMachine(screw, f.model, f.rule, f.iso, day, none, co);
-  const compare::ScrewComparison c = compare::CompareScrew(screw, f.model, f.rule, f.iso, co);
-  auto same = [](const compare::LeadMetrics& a, const compare::LeadMetrics& b) {
-    EXPECT_EQ(a.accumulated_1000_um, b.accumulated_1000_um);
-    EXPECT_EQ(a.accumulated_total_um, b.accumulated_total_um);
-    EXPECT_EQ(a.e_a_um, b.e_a_um);
-    EXPECT_EQ(a.v_300_um, b.v_300_um);
-  };
-  same(m.metrics[0], c.Outcome(compare::Strategy::kNone).metrics);
-  same(m.metrics[1], c.Outcome(compare::Strategy::kTraditional).metrics);
-  same(m.metrics[2], c.Outcome(compare::Strategy::kModel).metrics);
-  same(m.metrics[3], c.Outcome(compare::Strategy::kNone).metrics);
-  same(m.metrics[4], c.Outcome(compare::Strategy::kModel).metrics);
-  EXPECT_EQ(m.source_total_um[1], 0.0);
-  EXPECT_EQ(m.source_total_um[2], 0.0);
-  EXPECT_EQ(m.source_total_um[3], 0.0);
-  // And with the machine on, the truth differs (the test above can fail).
-  const machine::MachineDay on = machine::MachineDay::Draw(machine::DefaultMachine(), 2, 3);
-  const MachineEvalScrew w = EvaluateScrewOnMachine(screw, f.model, f.rule, f.iso, on, none, co);
-  EXPECT_GT(std::abs(w.metrics[0].accumulated_total_um - m.metrics[0].accumulated_total_um), 1.0);
+// One machine, one warm-up test, one laser test, two past production days, one test day.
+FieldEvalOptions SmallEvaluation() {
+  FieldEvalOptions o;
+  o.machines = 1;
+  o.threads = 1;
+  o.calendar.warmup_speeds_m_min = {180};
+  o.calendar.past_days = 2;
+  o.calendar.test_days = 1;
+  return o;
 }
 
-}  // namespace
-}  // namespace whirl::machine_eval
+// A production scenario whose hall stays at 20 degC (no diurnal swing, noise, day offset, ramp or
+// door), on a machine without heat sources: nothing moves the machine.
+machine::MachineScenario StillHall() {
+  machine::MachineScenario s = machine::FindMachineScenario("production");
+  s.hall.amplitude_k = s.hall.ou_std_k = s.hall.day_offset_std_k = s.hall.ramp_std_k_per_h = 0;
+  s.hall.door_events_per_day = 0;
+  return s;
+}
 
-namespace whirl::machine_eval {
-namespace {
+machine::FieldMachineConfig NoHeat() {
+  machine::FieldMachineConfig c = machine::DefaultFieldMachine();
+  c.head.bearing_power = c.head.motor_power = c.head.belt_power = 0;
+  c.head.motor_cut_share = c.head.tool_heat_share = 0;
+  c.z.motor_hold_power = c.z.motor_power_per_100mm_min = 0;
+  c.z.bearing_torque_nm = c.z.nut_torque_nm = 0;
+  c.bed.chip_share = c.bed.headstock_power = 0;
+  return c;
+}
 
-TEST(MachineReport, HostileNamesStayText) {
-  const std::string hostile = "a'b\"c\\d\n<script>alert(1)</script>";
-  MachineEvalScrew r;
-  r.ok = true;
-  r.screw.name = hostile;
-  MachineScrewDetail d;
-  machine::MachineConfig c = machine::DefaultMachine();
-  d.log = machine::SimulateRun(machine::MachineDay::Draw(c, 1, 1),
-                               {"log", drift::RunState::kCutting, 20, 180, 1});
-  d.log.sensor_names.front() = hostile;  // past the machine file's name rule, to test escaping
-  c.sensors.front().name = hostile;
-  EXPECT_THROW(c.Validate("test"), InputError);
-  for (auto& l : d.leads) {
-    l.position_mm = {0, 1, 2};
-    l.deviation_um = {0, 0.5, 1};
+void ExpectSameMetrics(const lead::LeadMetrics& a, const lead::LeadMetrics& b, const char* what) {
+  EXPECT_NEAR(a.accumulated_1000_um, b.accumulated_1000_um, 1e-6) << what;
+  EXPECT_NEAR(a.accumulated_total_um, b.accumulated_total_um, 1e-6) << what;
+  EXPECT_NEAR(a.e_a_um, b.e_a_um, 1e-6) << what;
+  EXPECT_NEAR(a.v_300_um, b.v_300_um, 1e-6) << what;
+}
+
+// Nothing moves the machine: the rows none, traditional, workpiece, class, table and nearest of
+// every test-day cut equal the strategy comparison of the same screw, seed and hall (1e-6 um),
+// and the machine's sources are zero. With the default machine the same cuts differ (the test can
+// fail).
+TEST(MachineEvaluation, WithoutMachineDriftTheWorkpieceRowsAreTheWorkpieceComparison) {
+  const EvalFixture f;
+  FieldEvalOptions o = SmallEvaluation();
+  o.machine = NoHeat();
+  const machine::MachineScenario still = StillHall();
+  const MachineEvaluation e = EvaluateFieldScenario(still, f.model, f.rule, f.iso, o);
+  const machine::MachineWorld w =
+      machine::BuildMachineWorld(o.machine, still, o.seed, 0, o.calendar, o.timeline);
+  const machine::DayPlan& day = w.timeline.Day(0);
+  ASSERT_EQ(e.screws.size(), day.jobs.size());
+  ASSERT_FALSE(e.screws.empty());
+  using S = MachineStrategy;
+  using C = compare::Strategy;
+  const std::pair<S, C> rows[] = {{S::kNone, C::kNone},       {S::kTraditional, C::kTraditional},
+                                  {S::kWorkpiece, C::kModel}, {S::kClass, C::kClass},
+                                  {S::kTable, C::kTable},     {S::kNearest, C::kNearest}};
+  for (std::size_t j = 0; j < day.jobs.size(); ++j) {
+    const MachineEvalScrew& r = e.screws[j];
+    ASSERT_TRUE(r.ok) << r.error;
+    compare::CompareOptions co = o.compare;
+    co.seed = MixSeed(day.seed, 0x77700 + j);
+    co.disturbance.ambient_drift_fixed_k_per_h = 0;  // the still hall's slope over the cut
+    const compare::ScrewComparison c =
+        compare::CompareScrew(day.jobs[j].screw, f.model, f.rule, f.iso, co);
+    for (const auto& [mine, theirs] : rows)
+      ExpectSameMetrics(r.metrics[static_cast<std::size_t>(mine)], c.Outcome(theirs).metrics,
+                        ToString(mine).c_str());
+    EXPECT_NEAR(r.source_total_um[static_cast<std::size_t>(ErrorSource::kHead)], 0.0, 1e-6);
+    EXPECT_NEAR(r.source_total_um[static_cast<std::size_t>(ErrorSource::kZAxis)], 0.0, 1e-6);
   }
-  const std::filesystem::path dir = whirl::test::ScratchDir() /
-                                    ("whirl_machine_report_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  const std::string index = WriteMachineScrewReport(dir.string(), r, d, {hostile}, {});
-  std::ifstream in(index);
-  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(html.find("<script>"), std::string::npos);
-  EXPECT_NE(html.find("&lt;script&gt;"), std::string::npos);
-  std::ifstream gp(dir / "sensors.gp");
-  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
-  EXPECT_NE(script.find(GnuplotString(hostile)), std::string::npos);
-  EXPECT_NE(script.find("noenhanced"), std::string::npos);
-  // A second report replaces whirl's own; a file that is not whirl's refuses the folder and stays.
-  EXPECT_NO_THROW(WriteMachineScrewReport(dir.string(), r, d, {}, {}));
-  { std::ofstream(dir / "notes.txt") << "mine"; }
-  EXPECT_THROW(WriteMachineScrewReport(dir.string(), r, d, {}, {}), InputError);
-  EXPECT_TRUE(std::filesystem::exists(dir / "notes.txt"));
-  EXPECT_FALSE(std::filesystem::exists(dir.string() + ".partial"));
-  std::filesystem::remove_all(dir);
+  // The default machine in the same hall drifts: the same first cut leaves more uncompensated.
+  FieldEvalOptions heat = SmallEvaluation();
+  const MachineEvaluation h = EvaluateFieldScenario(still, f.model, f.rule, f.iso, heat);
+  ASSERT_FALSE(h.screws.empty());
+  ASSERT_TRUE(h.screws[0].ok);
+  EXPECT_GT(std::abs(h.screws[0].metrics[0].accumulated_total_um -
+                     e.screws[0].metrics[0].accumulated_total_um),
+            1.0);
+}
+
+// The report screw is the first test-day screw of machine 0 as the evaluation scored it: its
+// curves give its metrics, its log runs from the day's power-on past the end of its cut, its
+// drift models are the sensor model's channels with the training ranges; only on request, and
+// over seeds only in the first.
+TEST(MachineEvaluation, TheReportScrewIsTheFirstScrewWithItsOwnCurves) {
+  const EvalFixture f;
+  FieldEvalOptions o = SmallEvaluation();
+  o.keep_report_screw = true;
+  const SeedsEvaluation s = EvaluateFieldOverSeeds(machine::FindMachineScenario("production"),
+                                                   f.model, f.rule, f.iso, o, 2);
+  ASSERT_EQ(s.runs.size(), 2u);
+  EXPECT_FALSE(s.runs[1].report);  // asked for in the first seed only
+  const MachineEvaluation& e = s.runs[0];
+  ASSERT_TRUE(e.report);
+  const ReportScrew& r = *e.report;
+  ASSERT_TRUE(e.screws.front().ok);
+  EXPECT_EQ(r.result.machine, 0);
+  EXPECT_EQ(r.result.screw.name, e.screws.front().screw.name);
+  EXPECT_EQ(r.scenario, "production");
+  lead::LeadMetricOptions mo = o.compare.metrics;
+  mo.lead_mm = r.result.screw.process.pitch_mm;
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
+    const lead::LeadMetrics m = lead::ComputeLeadMetrics(r.leads[k], mo);
+    EXPECT_EQ(m.accumulated_total_um, e.screws.front().metrics[k].accumulated_total_um)
+        << ToString(static_cast<MachineStrategy>(k));
+  }
+  ASSERT_GT(r.log.samples(), 2);
+  EXPECT_EQ(r.log.other(0, r.log.OtherIndex("power_on")), 0.0);  // the power-on sample
+  EXPECT_GE(r.log.time_min.back(), r.cut_end_min);
+  EXPECT_LT(r.cut_start_min, r.cut_end_min);
+  EXPECT_GT(r.cut_start_min, r.log.time_min.front());
+  EXPECT_NEAR(r.cut_end_min - r.cut_start_min, r.kinematics.cutting_time_s / 60.0, 1e-9);
+  EXPECT_EQ(r.sensors, e.sensors.front());
+  EXPECT_EQ(r.sensors_choice, e.sensors_choice.front());
+  EXPECT_EQ(r.offset.features.size(), r.slope.features.size());
+  ASSERT_GT(r.offset.features.size(), 0u);
+  EXPECT_LT(r.offset.feature_max.maxCoeff(), 1e6);  // the training range, not unbounded
+  EXPECT_EQ(r.z_ref_mm, o.machine.z.fixed_end_mm);
 }
 
 }  // namespace

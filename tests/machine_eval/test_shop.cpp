@@ -1,72 +1,18 @@
-// Training from shop measurements and causal application (machine_eval/history.h,
-// machine_eval/strategies.h), the legacy evaluation's reproduction, and the seeds summary.
+// Training from shop measurements and causal application (machine_eval/shop_models.h,
+// machine_eval/strategies.h), and the seeds summary. That no truth reaches a trained model is
+// tested on the field world (test_field_eval.cpp, FieldTraining).
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <nlohmann/json.hpp>
 
-#include "core/process.h"
 #include "core/random.h"
-#include "drift/fit.h"
-#include "machine/machine.h"
-#include "machine_eval/history.h"
 #include "machine_eval/machine_eval.h"
-#include "machine_eval/seeds.h"
+#include "machine_eval/shop_models.h"
 #include "machine_eval/strategies.h"
-#include "machine_eval/trained_numbers.h"
-#include "workpiece/model.h"
-#include "sim/screw.h"
+#include "machine_eval/summary.h"
 
 namespace whirl::machine_eval {
 namespace {
-
-using testing_support::TrainedNumbers;
-
-std::string Source(const std::string& rel) { return std::string(WHIRL_SOURCE_DIR) + "/" + rel; }
-
-// The training runs of one legacy machine (idle, then cutting) with their speeds.
-struct Training {
-  std::vector<drift::Run> runs;
-  std::vector<double> speeds = {0, 0, 170, 190};
-};
-Training LegacyTraining(std::uint64_t machine_seed) {
-  const machine::MachineConfig c = machine::DefaultMachine();
-  Training t;
-  t.runs = TrainingRuns(c, machine_seed, 2, drift::RunState::kIdle);
-  const auto cutting = TrainingRuns(c, machine_seed, 2, drift::RunState::kCutting);
-  t.runs.insert(t.runs.end(), cutting.begin(), cutting.end());
-  return t;
-}
-
-nlohmann::json Trained(const ShopModels& s) {
-  return {TrainedNumbers(s.sensors), TrainedNumbers(s.warmup), TrainedNumbers(s.schedule)};
-}
-
-// No truth channel reaches a model: 20 um pulses added to the runs' exact error channels at the
-// minutes between the instruments' readings (probe every 10 min, laser every 20 min) change
-// nothing the shop models learn; the same pulses change the legacy models, which read the
-// channels every minute (the control that shows the pulses are large enough to matter).
-TEST(ShopTraining, PulsesInTheTruthBetweenReadingsChangeNothingTrained) {
-  const double z_fixed = machine::DefaultMachine().z_screw.fixed_end_mm;
-  const Training clean = LegacyTraining(MixSeed(1, 0x4d00));
-  Training pulsed = clean;
-  for (auto& run : pulsed.runs)
-    for (int k = 0; k < run.samples(); ++k)
-      if (std::fmod(run.time_min[static_cast<std::size_t>(k)], 10.0) != 0.0)
-        run.error_um.row(k).array() += 20.0 * ((k % 3) - 1);
-  const ShopProtocol p;
-  const drift::ShopRecord a = MeasureTrainingRuns(clean.runs, clean.speeds, z_fixed, p, 7);
-  const drift::ShopRecord b = MeasureTrainingRuns(pulsed.runs, pulsed.speeds, z_fixed, p, 7);
-  for (const auto& log : b.day_logs) EXPECT_TRUE(log.error_names.empty());
-  EXPECT_EQ(Trained(FitShopModels(a, z_fixed)).dump(), Trained(FitShopModels(b, z_fixed)).dump());
-  drift::FitOptions f;
-  f.threads = 1;
-  const std::vector<drift::Run> cut_clean(clean.runs.begin() + 2, clean.runs.end());
-  const std::vector<drift::Run> cut_pulsed(pulsed.runs.begin() + 2, pulsed.runs.end());
-  EXPECT_NE(drift::FitDriftModel(cut_clean, "offset_um", f).model.linear.coefficients(0),
-            drift::FitDriftModel(cut_pulsed, "offset_um", f).model.linear.coefficients(0));
-}
 
 // A model by hand: one sensor and power_on, one lag of 20 min, offset and slope coefficients.
 drift::JointDriftModel HandModel() {
@@ -98,7 +44,7 @@ drift::Run HandLog(int samples, std::uint64_t seed) {
 
 // A planted shop record whose drift follows the time since power-on alone, while four sensors
 // wander independently of it (they carry nothing): per day a log of 300 min (the control's duty
-// columns as ControlDayLog writes them), probe readings at z = 150 mm every 10 min, and on the
+// columns power_on, ring_on, cutting and ring_load_pct), probe readings at z = 150 mm every 10 min, and on the
 // first two days laser targets at 500, 3000 and 5500 mm; m = 20 w + 3 w (6400 - z) / 1000,
 // w = 1 - exp(-t / 40), 1 um noise, a zero per record.
 drift::ShopRecord SensorsCarryNothing(std::uint64_t seed, int days) {
@@ -147,7 +93,7 @@ drift::ShopRecord SensorsCarryNothing(std::uint64_t seed, int days) {
 TEST(ShopTraining, WhereSensorsCarryNothingTheSensorModelIsNotWorseThanWarmup) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const drift::ShopRecord rec = SensorsCarryNothing(seed, 6);
-    const ShopModels m = FitShopModels(rec, 6400);
+    const ShopModels m = FitShopModels(rec, 6400, {"ring_on", "cutting", "ring_load_pct"});
     EXPECT_LE(m.sensors.cv_rmse_um, m.warmup.cv_rmse_um + 1e-9) << "seed " << seed;
     // A new day of the same world: the error of each model's prediction at z = 1000 mm.
     const drift::ShopRecord test = SensorsCarryNothing(100 + seed, 1);
@@ -196,51 +142,14 @@ TEST(CausalApplication, TheValueBeforeSampleIPlusOneIgnoresLaterSamples) {
   }
 }
 
-// The legacy world reproduces the table of the program before this change: per screw, the rows
-// none, workpiece, machine, both, both_idle and both_monitor, and the old "traditional" (the
-// class means, now the row `class`) equal the reference written by that program
-// (`whirl machine evaluate --machines 2 --screws 2 --seed 1 --json` at main 9437d1a) within
-// relative 1e-9.
-TEST(LegacyWorld, ReproducesTheTableOfThePreviousProgram) {
-  std::ifstream in(Source("tests/machine_eval/data/legacy_eval_2x2_seed1.json"));
-  ASSERT_TRUE(in.good());
-  nlohmann::json ref;
-  in >> ref;
-  MachineEvalOptions o;
-  o.machine = machine::ReadMachine(Source("datasets/machines/whirling_thermal.json"));
-  o.machines = 2;
-  o.screws_per_machine = 2;
-  o.seed = 1;
-  const workpiece::WorkpieceModel model =
-      workpiece::LoadWorkpieceModel(Source("models/default.json"));
-  const compare::ExperienceRule rule =
-      compare::BuildExperienceRule(ReadProcessTable(Source("datasets/whirling_500.csv"), true));
-  const compare::IsoToleranceTable iso =
-      compare::ReadIsoToleranceTable(Source("datasets/standards/iso3408_3_lead_tolerances.csv"));
-  const MachineEvaluation e = EvaluateWithMachines(
-      sim::ReadScrew(Source("datasets/screws/reference_80x10x6000.json")), model, rule, iso, o);
-  nlohmann::json now = e;
-  ASSERT_EQ(ref["screws"].size(), now["screws"].size());
-  const std::vector<std::pair<std::string, std::string>> rows = {
-      {"none", "none"}, {"workpiece", "workpiece"}, {"machine", "machine"},
-      {"both", "both"}, {"both_idle", "both_idle"}, {"both_monitor", "both_monitor"},
-      {"traditional", "class"}};
-  for (std::size_t s = 0; s < now["screws"].size(); ++s)
-    for (const auto& [old_name, new_name] : rows)
-      for (const char* metric : {"accumulated_1000_um", "accumulated_total_um", "e_a_um"}) {
-        const double a = ref["screws"][s]["strategies"][old_name]["metrics"][metric];
-        const double b = now["screws"][s]["strategies"][new_name]["metrics"][metric];
-        EXPECT_NEAR(a, b, 1e-9 * (1 + std::abs(a))) << s << " " << new_name << " " << metric;
-      }
-}
-
 // The headline names the sensor-free row with the smallest pooled thread median (none excluded,
 // sensor rows never), and the per-seed medians bound the pooled one.
 TEST(SeedsSummary, StrongestSensorFreeIsTheSmallestThreadMedianWithoutSensors) {
   std::array<SeedStats, kMachineStrategyCount> s{};
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k) s[k].total_median_um = 50.0 - k;
   s[static_cast<std::size_t>(MachineStrategy::kNone)].total_median_um = 0.1;
-  EXPECT_EQ(StrongestSensorFree(s), MachineStrategy::kSchedule);  // 39: the smaller values are sensor rows
+  // 42: lead_slope, the last sensor-free row (the smaller values are sensor rows)
+  EXPECT_EQ(StrongestSensorFree(s), MachineStrategy::kLeadSlope);
   s[static_cast<std::size_t>(MachineStrategy::kTable)].total_median_um = 5;
   EXPECT_EQ(StrongestSensorFree(s), MachineStrategy::kTable);
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)

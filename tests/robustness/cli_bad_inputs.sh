@@ -15,7 +15,8 @@ t() { timeout 60 "$@"; }
 for L in 1e7 1e9; do
   sed "s/\"length_mm\": 6000.0/\"length_mm\": $L/" "$S" > "len_$L.json"
   expect_fail "at most 20000 mm" t "$W" simulate --screw "len_$L.json" --duration-s 10
-  expect_fail "at most 20000 mm" t "$W" compare --model "$M" --screw "len_$L.json"
+  expect_fail "at most 20000 mm" t "$W" compare --model "$M" --screw "len_$L.json" \
+    --history "$SRC/datasets/whirling_500.csv"
   expect_fail "at most 20000 mm" t "$W" evaluate --base-screw "len_$L.json" --random 1 --no-validation
 done
 # A cell size that would overflow the cell count, and one coarser than a third of the blank.

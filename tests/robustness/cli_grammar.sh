@@ -148,7 +148,8 @@ alias_case() {
   local words=() args=()
   while [ "$1" != -- ]; do words+=("$1"); shift; done; shift
   args=("$@")
-  "$W" "${words[@]}" --help | grep -qE -- "^ +${old}( |$)" && fail "whirl ${words[*]} --help lists $old"
+  "$W" "${words[@]}" --help > "$D/help.txt" || fail "whirl ${words[*]} --help exits non-zero"
+  grep -qE -- "^ +${old}( |$)" "$D/help.txt" && fail "whirl ${words[*]} --help lists $old"
   local with_new=() with_old=() a
   for a in "${args[@]}"; do
     with_new+=("${a//@FLAG@/$new}"); with_old+=("${a//@FLAG@/$old}")
@@ -206,8 +207,9 @@ done
 # Folders: the machine's sensor runs, the comparison and machine reports.
 alias_case --out --out-dir machine sensors -- @FLAG@ "$D/runs_@FLAG@" --idle 1 --cutting 0 --json
 alias_case --report --out-dir compare -- --model "$SRC/models/default.json" --screw "$S" --no-plots \
+  --history "$SRC/datasets/whirling_500.csv" \
   @FLAG@ "$D/compare_@FLAG@" --json
-alias_case --report --out-dir machine evaluate -- --machines 1 --screws 1 --train-runs 1 \
+alias_case --report --out-dir machine evaluate -- --machines 1 --test-days 1 --past-days 1 \
   @FLAG@ "$D/machine_@FLAG@" --json
 
 # drift: a run log with time and one without (its time is the sample index); the error follows
@@ -223,7 +225,8 @@ alias_case --lag-grid --lag-grid-min drift holdout -- --log "$D/drift.csv" --no-
   @FLAG@ 10,40 --json
 # --errors-from-start stood for --error-zero run-start (a flag for an option with its value).
 HO=(drift holdout --log "$D/drift.csv" --no-network --json)
-"$W" "${HO[@]}" --help | grep -q -- "--errors-from-start" && fail "holdout --help lists --errors-from-start"
+"$W" "${HO[@]}" --help > "$D/help.txt" || fail "holdout --help exits non-zero"
+grep -q -- "--errors-from-start" "$D/help.txt" && fail "holdout --help lists --errors-from-start"
 "$W" "${HO[@]}" --error-zero run-start > "$D/new.out" 2> "$D/new.err" || fail "holdout --error-zero"
 "$W" "${HO[@]}" --errors-from-start > "$D/old.out" 2> "$D/old.err" ||
   fail "holdout --errors-from-start refused: $(cat "$D/old.err")"
@@ -277,3 +280,13 @@ expect_fail "^error: --out (now --out-dir) '" "$W" machine sensors --out "$D/for
 expect_fail "^error: --out-dir '" "$W" machine sensors --out-dir "$D/foreign" --idle 1 --cutting 0
 grep -q "(now" "$D/err.txt" && fail "the current spelling is shown as an old one: $(cat "$D/err.txt")"
 echo "deprecated spellings: $aliases checked"
+
+# A mistyped flag is named with the closest option of its command, before any "X is required".
+expect_fail "^error: unknown option '--dta' for 'whirl train'; did you mean '--data'" \
+  "$W" train --dta "$D/x.csv" --out "$D/never.json"
+expect_fail "unknown option '--hiden' for 'whirl train'; did you mean '--hidden'" \
+  "$W" train --data "$D/x.csv" --hiden 4 --out "$D/never.json"
+expect_fail "unknown option '--out-dri' for 'whirl drift monitor'; did you mean '--out-dir'" \
+  "$W" drift monitor --model m.json --run r.csv --out-dri=x
+[ ! -e "$D/never.json" ] || fail "a mistyped flag wrote an output"
+echo "mistyped flags: named with the closest option"

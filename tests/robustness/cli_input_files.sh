@@ -11,7 +11,6 @@ source "$SRC/tests/support/cli_common.sh"
 # build gets wrong).
 if [ -n "${KEEP_GOING:-}" ]; then fail() { echo "FAIL: $*"; }; fi
 S="$SRC/datasets/screws/reference_80x10x6000.json"
-MACHINE="$SRC/datasets/machines/whirling_thermal.json"
 PROFILE="$SRC/datasets/machines/example_840d.json"
 # json_set <in> <out> <python expression on j>: a copy of a JSON file with one field changed.
 json_set() { python3 -c "import json,sys; j=json.load(open(sys.argv[1])); $3; json.dump(j, open(sys.argv[2], 'w'))" "$1" "$2" || fail "json_set $*"; }
@@ -43,20 +42,12 @@ expect_fail "\-\-x.*finite" "$W" surface predict --surface cubic.json --x-mm nan
 expect_fail "nx \* ny = 40000.*10000" "$W" surface synth --nx 200 --ny 200 --out big.csv
 [ -e big.csv ] && fail "synth wrote a points file that fit refuses"
 
-# --- Machine thermal files: schema required, every field in its physical range ---------------
+# --- The retired legacy machine file: refused, naming what replaced it; nothing written ------
 echo '{}' > empty.json
-expect_fail "empty.json.*'schema' must be" "$W" machine sensors --machine empty.json --out-dir m_out
-for v in 99 '"1"' 1.5; do
-  sed "s/\"schema_version\": 1,/\"schema_version\": $v,/" "$MACHINE" > "version_$v.json"
-  expect_fail "version_$v.json.*schema_version" "$W" machine sensors --machine "version_$v.json" --out-dir m_out
-done
-json_set "$MACHINE" spread.json "j['machine_spread'] = 1e308"
-expect_fail "spread.json.*machine_spread = 1e+308.*\[0, 1\]" "$W" machine sensors --machine spread.json --out-dir m_out
-json_set "$MACHINE" tau.json "j['sensors'][2]['tau_min'] = 1e308"
-expect_fail "tau.json.*sensor 'bed_middle' tau_min = 1e+308" "$W" machine evaluate --machine tau.json --machines 1 --screws 1
-json_set "$MACHINE" sign.json "j['head']['sign'] = 0.5"
-expect_fail "sign.json.*'sign'" "$W" machine sensors --machine sign.json --out-dir m_out
-[ -e m_out ] && fail "machine wrote files from a bad machine file"
+expect_fail "\-\-machine: applied to the legacy machine world, which was retired" \
+  "$W" machine sensors --machine empty.json --out-dir m_out
+expect_fail "\-\-machine: applied to the legacy machine world" "$W" machine evaluate --machine empty.json
+[ -e m_out ] && fail "machine wrote files after a retired flag"
 
 # --- Drift model files: residual_std_um of +-1e308 gave std inf and a threshold of inf ---------
 awk 'BEGIN { print "time_min,a_C,b_C,c_C,err_um,spindle_rpm";

@@ -21,6 +21,23 @@ PSLOPE="$SRC/datasets/machines/whirling_840d.json"
 
 # --- Producers ---------------------------------------------------------------------------------
 "$W" machine sensors --out-dir runs --idle 2 --cutting 2 > /dev/null || fail "machine sensors"
+# The field machine logs one displacement (offset_um); a slope model (drift nc --slope-model)
+# needs a lead-slope channel: zscrew_per_1000_um, made from the offset and the first sensor, so
+# that the mlr fit has something to follow (what is checked here is the file round trip).
+python3 - runs/cutting_1.csv runs/cutting_2.csv runs/idle_1.csv <<'EOF' || fail "slope channel"
+import sys
+for path in sys.argv[1:]:
+    lines = open(path).read().splitlines()
+    head = next(i for i, l in enumerate(lines) if l and not l.startswith("#"))
+    cols = lines[head].split(",")
+    off = cols.index("offset_um")
+    temp = next(i for i, c in enumerate(cols) if c.endswith("_C"))
+    out = lines[:head] + [lines[head] + ",zscrew_per_1000_um"]
+    for l in lines[head + 1:]:
+        c = l.split(",")
+        out.append(l + f",{0.3 * float(c[off]) + 0.5 * float(c[temp]):.4f}")
+    open(path, "w").write("\n".join(out) + "\n")
+EOF
 R=runs/cutting_1.csv
 fit() {  # fit <name> <error column> <drift fit options...>
   local name="$1" error="$2"; shift 2
@@ -78,7 +95,7 @@ CONSUMERS=(
   "curve|work|curve --model MODEL --screw $S"
   "plan|work|plan --model MODEL --screw $S --machine $P840 --nc PLAN.SPF --reset-nc PLAN_RESET.SPF --csv plan.csv"
   "plan_drift|work|plan --model MODEL --screw $S --machine $P840 --with-drift-action --nc PLAN.SPF --reset-nc PLAN_RESET.SPF"
-  "compare|work|compare --model MODEL --screw $S"
+  "compare|work|compare --model MODEL --screw $S --history $SRC/datasets/whirling_500.csv"
   "evaluate|work|evaluate --model MODEL --random 1 --no-validation"
   "crosscheck|work_network|crosscheck --model MODEL --data $TABLE"
   "export|work_network|export --model MODEL --torchscript model.pt"

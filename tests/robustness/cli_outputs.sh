@@ -111,8 +111,8 @@ dir_rule --out-dir "$W" ballbar simulate
 dir_rule --out-dir "$W" surface fit --points pts.csv --no-plots
 dir_rule --curves-dir "$W" dataset --count 1 --out table.csv
 dir_rule --out-dir "$W" compare --model "$SRC/models/default.json" \
-  --screw "$SRC/datasets/screws/reference_80x10x6000.json"
-dir_rule --out-dir "$W" machine evaluate --machines 1 --screws 1
+  --screw "$SRC/datasets/screws/reference_80x10x6000.json" --history "$SRC/datasets/whirling_500.csv"
+dir_rule --out-dir "$W" machine evaluate --machines 1 --test-days 1 --past-days 1
 dir_rule --out-dir "$W" demo --no-plots
 [ -e table.csv ] && fail "dataset wrote its table although --curves-dir was refused"
 # Run twice into the same directory: whirl's own output is replaced.

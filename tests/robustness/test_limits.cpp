@@ -11,8 +11,8 @@
 #include <string>
 
 #include "compare/compare.h"
-#include "compare/lead.h"
-#include "compare/metrics.h"
+#include "lead/lead.h"
+#include "lead/metrics.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_file.h"
@@ -20,7 +20,7 @@
 #include "core/process.h"
 #include "nn/model.h"
 #include "sim/dataset.h"
-#include "sim/screw.h"
+#include "screw/screw.h"
 #include "sim/simulator.h"
 #include "support/expect_error.h"
 #include "support/scratch_dir.h"
@@ -77,23 +77,23 @@ TEST(Limits, ProcessTableRowNamesFileAndLine) {
 }
 
 TEST(Limits, ScrewBlankLengthAndName) {
-  sim::Screw s = sim::ReferenceScrew();
+  screw::Screw s = screw::ReferenceScrew();
   s.length_mm = kMaxBlankLengthMm;
-  EXPECT_NO_THROW(sim::ValidateScrew(s));
+  EXPECT_NO_THROW(screw::ValidateScrew(s));
   for (double bad : {1e7, 1e9}) {
     s.length_mm = bad;
-    EXPECT_NE(ErrorOf([&] { sim::ValidateScrew(s); }).find("at most 20000 mm"), std::string::npos);
+    EXPECT_NE(ErrorOf([&] { screw::ValidateScrew(s); }).find("at most 20000 mm"), std::string::npos);
   }
   const fs::path d = Scratch("screw");
-  nlohmann::json j = sim::ReferenceScrew();
-  j["name"] = std::string(sim::kMaxScrewNameLength + 1, 'n');
+  nlohmann::json j = screw::ReferenceScrew();
+  j["name"] = std::string(screw::kMaxScrewNameLength + 1, 'n');
   WriteJsonFile(d / "s.json", j);
-  EXPECT_NE(ErrorOf([&] { sim::ReadScrew(d / "s.json"); }).find("'name' has 201"),
+  EXPECT_NE(ErrorOf([&] { screw::ReadScrew(d / "s.json"); }).find("'name' has 201"),
             std::string::npos);
 }
 
 TEST(Limits, SimulationCellsAndStepsAreBoundedBeforeAllocating) {
-  const sim::Screw s = sim::ReferenceScrew();  // 6000 mm blank
+  const screw::Screw s = screw::ReferenceScrew();  // 6000 mm blank
   sim::SimOptions o;
   o.duration_s = 10;
   for (double cell : {1e-300, 6000.0 / (sim::kMaxCells + 1), 2500.0, 1e300}) {
@@ -156,30 +156,30 @@ TEST(Limits, LeadMetricsStayFiniteWithinTheLimits) {
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(0, 1);
   for (int trial = 0; trial < 200; ++trial) {
-    compare::LeadDeviation lead;
-    const double spacing = compare::kMinLeadSpacingMm * std::pow(1e9, u(rng));
+    lead::LeadDeviation lead;
+    const double spacing = lead::kMinLeadSpacingMm * std::pow(1e9, u(rng));
     const double scale = std::pow(10.0, -320 + 326 * u(rng));  // subnormal .. the limit
     const int n = 2 + static_cast<int>(50 * u(rng));
-    double x = -compare::kMaxLeadPositionMm * u(rng) * 0.5;
-    for (int i = 0; i < n && x <= compare::kMaxLeadPositionMm; ++i, x += spacing) {
+    double x = -lead::kMaxLeadPositionMm * u(rng) * 0.5;
+    for (int i = 0; i < n && x <= lead::kMaxLeadPositionMm; ++i, x += spacing) {
       lead.position_mm.push_back(x);
-      lead.deviation_um.push_back(std::min(compare::kMaxLeadDeviationUm, scale) * (2 * u(rng) - 1));
+      lead.deviation_um.push_back(std::min(lead::kMaxLeadDeviationUm, scale) * (2 * u(rng) - 1));
     }
     if (lead.size() < 2) continue;
-    compare::LeadMetricOptions o;
+    lead::LeadMetricOptions o;
     o.lead_mm = u(rng) < 0.5 ? 10 : 0;
-    const compare::LeadMetrics m = compare::ComputeLeadMetrics(lead, o);
+    const lead::LeadMetrics m = lead::ComputeLeadMetrics(lead, o);
     for (double v : {m.e_a_um, m.v_u_um, m.v_300_um, m.accumulated_1000_um, m.accumulated_total_um,
                      m.mean_line_slope_um_per_m, m.mean_line_offset_um})
       ASSERT_TRUE(std::isfinite(v)) << "trial " << trial << " spacing " << spacing;
   }
-  compare::LeadDeviation far{{0, 1e307}, {0, 1}};
-  EXPECT_NE(ErrorOf([&] { compare::ComputeLeadMetrics(far); }).find("position_mm"),
+  lead::LeadDeviation far{{0, 1e307}, {0, 1}};
+  EXPECT_NE(ErrorOf([&] { lead::ComputeLeadMetrics(far); }).find("position_mm"),
             std::string::npos);
 }
 
 TEST(Limits, ReductionAgainstAVanishingBaselineIsAbsentNotInfinite) {
-  compare::LeadMetrics model, baseline;
+  lead::LeadMetrics model, baseline;
   model.accumulated_1000_um = 1;
   baseline.accumulated_1000_um = 1e-310;  // subnormal: 1 / 1e-310 overflows
   baseline.e_a_um = 2;

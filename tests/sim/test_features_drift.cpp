@@ -10,7 +10,7 @@
 
 #include "core/random.h"
 #include "sim/dataset.h"
-#include "sim/features.h"
+#include "fit/features.h"
 #include "sim/simulator.h"
 
 namespace whirl::sim {
@@ -38,7 +38,7 @@ DisturbanceOptions WorkpieceOnly(DisturbanceOptions d) {
 // `whirl simulate`'s defaults: the whole thread, drift std 0.2 K/h. The reference screw at seeds
 // 1-20 within 10 % of its undisturbed settle time (before: 2373-4883 s at seeds 1-5 against 295 s).
 TEST(FeaturesDrift, ReferenceScrewWholeThreadSeeds1To20) {
-  const Screw screw = ReferenceScrew();
+  const screw::Screw screw = screw::ReferenceScrew();
   const SimOptions sim;
   const Features undisturbed = Simulate(screw, sim, DisturbanceOptions{}).features;
   EXPECT_NEAR(undisturbed.settle_time_s, 295, 0.1 * 295);  // the old 2 % criterion's value
@@ -52,7 +52,7 @@ TEST(FeaturesDrift, ReferenceScrewWholeThreadSeeds1To20) {
     worst = std::max(worst, std::abs(e));
     EXPECT_LT(std::abs(e), 0.10) << "seed " << seed << ", drift "
                                  << r.disturbances.ambient_drift_k_per_h
-                                 << " K/h: " << AnalyzeSettle(r.curve).message;
+                                 << " K/h: " << fit::AnalyzeSettle(r.curve).message;
   }
   std::printf(
       "[ figures  ] reference screw, whole thread, seeds 1-20: undisturbed t_s %.0f s, "
@@ -74,13 +74,13 @@ TEST(FeaturesDrift, DisturbedCurvesGiveTheUndriftedFeatures) {
   std::vector<double> settle_err, max_err, settle, plateau;
   double max_drift = 0;
   for (int c = 0; c < kCases; ++c) {
-    Screw screw = ReferenceScrew();
+    screw::Screw screw = screw::ReferenceScrew();
     screw.process = points[c];
     sim.duration_s = c % 2 == 0 ? 1800.0 : 0.0;
     const DisturbanceOptions d = WithDrift(100 + c, 1.0 * (2 * rng.Uniform() - 1));
     const SimulationResult r = Simulate(screw, sim, d);
     const SimulationResult ref = Simulate(screw, sim, WorkpieceOnly(d));
-    const SettleAnalysis a = AnalyzeSettle(r.curve), b = AnalyzeSettle(ref.curve);
+    const fit::SettleAnalysis a = fit::AnalyzeSettle(r.curve), b = fit::AnalyzeSettle(ref.curve);
     const double e_s = std::abs(a.features.settle_time_s / b.features.settle_time_s - 1);
     const double e_m = std::abs(a.features.max_elongation_um / b.features.max_elongation_um - 1);
     settle_err.push_back(e_s);

@@ -9,8 +9,8 @@
 #include "core/error.h"
 #include "core/random.h"
 #include "sim/dataset.h"
-#include "sim/features.h"
-#include "sim/screw.h"
+#include "fit/features.h"
+#include "screw/screw.h"
 #include "sim/simulator.h"
 #include "support/scratch_dir.h"
 
@@ -36,7 +36,7 @@ double ClosedFormBox(double xi_m, double q_w, double w_m, double v, double a, do
 }
 
 TEST(Simulator, QuasiSteadyProfileMatchesMovingSourceFinSolution) {
-  Screw s = ReferenceScrew();
+  screw::Screw s = screw::ReferenceScrew();
   SimOptions o;
   o.duration_s = 3000;
   o.cell_size_mm = 1.0;
@@ -76,7 +76,7 @@ TEST(Simulator, HalvingCellAndStepChangesFeaturesLessThanHalfPercent) {
   SimOptions fine = coarse;
   fine.cell_size_mm /= 2;
   fine.time_step_s /= 2;
-  const Screw s = ReferenceScrew();
+  const screw::Screw s = screw::ReferenceScrew();
   const SimulationResult a = Simulate(s, coarse), b = Simulate(s, fine);
   EXPECT_NEAR(a.features.max_elongation_um, b.features.max_elongation_um,
               0.005 * b.features.max_elongation_um);
@@ -116,7 +116,7 @@ TEST(Simulator, NoHeatGivesNoElongation) {
   SimOptions o;
   o.duration_s = 300;
   o.heat_input_override_w = 0;
-  const SimulationResult r = Simulate(ReferenceScrew(), o);
+  const SimulationResult r = Simulate(screw::ReferenceScrew(), o);
   for (double e : r.elongation_noise_free_um) EXPECT_EQ(e, 0.0);
   EXPECT_EQ(r.summary.heat_in_j, 0.0);
 }
@@ -124,7 +124,7 @@ TEST(Simulator, NoHeatGivesNoElongation) {
 TEST(Simulator, ReferenceCurveHasThePapersShape) {
   SimOptions o;
   o.duration_s = 1200;
-  const SimulationResult r = Simulate(ReferenceScrew(), o);
+  const SimulationResult r = Simulate(screw::ReferenceScrew(), o);
   const double plateau = r.features.max_elongation_um;
   EXPECT_GT(plateau, 10);  // order of tens of um
   EXPECT_LT(plateau, 100);
@@ -145,13 +145,13 @@ TEST(Simulator, DisturbancesAreSeededAndSwitchable) {
   DisturbanceOptions d;
   d.enabled = true;
   d.seed = 5;
-  const SimulationResult a = Simulate(ReferenceScrew(), o, d), b = Simulate(ReferenceScrew(), o, d);
+  const SimulationResult a = Simulate(screw::ReferenceScrew(), o, d), b = Simulate(screw::ReferenceScrew(), o, d);
   EXPECT_EQ(a.curve.elongation_um, b.curve.elongation_um);
   d.seed = 6;
-  const SimulationResult c = Simulate(ReferenceScrew(), o, d);
+  const SimulationResult c = Simulate(screw::ReferenceScrew(), o, d);
   EXPECT_NE(a.curve.elongation_um, c.curve.elongation_um);
   d.measurement_noise = false;
-  const SimulationResult quiet = Simulate(ReferenceScrew(), o, d);
+  const SimulationResult quiet = Simulate(screw::ReferenceScrew(), o, d);
   EXPECT_EQ(quiet.curve.elongation_um, quiet.elongation_noise_free_um);
   // Noise level: residuals of the recorded curve about the truth have the configured std.
   double ss = 0;
@@ -160,7 +160,7 @@ TEST(Simulator, DisturbancesAreSeededAndSwitchable) {
     ss += e * e;
   }
   EXPECT_NEAR(std::sqrt(ss / c.curve.size()), 0.25, 0.05);
-  const SimulationResult off = Simulate(ReferenceScrew(), o, DisturbanceOptions{});
+  const SimulationResult off = Simulate(screw::ReferenceScrew(), o, DisturbanceOptions{});
   EXPECT_EQ(off.disturbances.heat_partition_factor, 1.0);
   EXPECT_EQ(off.curve.elongation_um, off.elongation_noise_free_um);
 }
@@ -174,11 +174,11 @@ TEST(Simulator, GivenAmbientRateReplacesOnlyTheDrawnOne) {
   d.enabled = true;
   d.seed = 11;
   d.measurement_noise = false;
-  const SimulationResult drawn = Simulate(ReferenceScrew(), o, d);
+  const SimulationResult drawn = Simulate(screw::ReferenceScrew(), o, d);
   d.ambient_drift_fixed_k_per_h = 0.8;
-  const SimulationResult warm = Simulate(ReferenceScrew(), o, d);
+  const SimulationResult warm = Simulate(screw::ReferenceScrew(), o, d);
   d.ambient_drift_fixed_k_per_h = -0.8;
-  const SimulationResult cool = Simulate(ReferenceScrew(), o, d);
+  const SimulationResult cool = Simulate(screw::ReferenceScrew(), o, d);
   EXPECT_EQ(warm.disturbances.ambient_drift_k_per_h, 0.8);
   EXPECT_EQ(warm.disturbances.heat_partition_factor, drawn.disturbances.heat_partition_factor);
   EXPECT_EQ(warm.disturbances.expansion_factor, drawn.disturbances.expansion_factor);
@@ -186,7 +186,7 @@ TEST(Simulator, GivenAmbientRateReplacesOnlyTheDrawnOne) {
 }
 
 TEST(ProcessModel, KinematicsClosedFormsForTheReferenceScrew) {
-  const Kinematics k = ComputeKinematics(ReferenceScrew());
+  const screw::Kinematics k = screw::ComputeKinematics(screw::ReferenceScrew());
   EXPECT_NEAR(k.ring_speed_rpm, 180000.0 / (kPi * 86.0), 1e-9);
   EXPECT_NEAR(k.ring_speed_rpm, 667, 1.5);  // the paper's ring speed
   EXPECT_NEAR(k.axial_feed_mm_min, 0.01 * 6 * k.ring_speed_rpm, 1e-12);
@@ -195,7 +195,7 @@ TEST(ProcessModel, KinematicsClosedFormsForTheReferenceScrew) {
   EXPECT_GT(k.cutting_time_s, 3600);  // hours of cutting
   EXPECT_NEAR(k.CutPositionMm(100), 5600 - 100 * k.axial_feed_mm_s, 1e-9);
   // Groove segment area against a numerical integral of the circular segment.
-  const GrooveGeometry g = k.groove;
+  const screw::GrooveGeometry g = k.groove;
   const double r = 3.7, h = g.depth_mm;
   double area = 0;
   const int n = 200000;
@@ -235,9 +235,9 @@ TEST(ProcessModel, ElongationMovesInPhysicallySensibleDirections) {
 TEST(Screw, JsonRoundTripAndClearErrors) {
   const std::filesystem::path dir = whirl::test::ScratchDir() / "whirl_sim_screw";
   std::filesystem::create_directories(dir);
-  const Screw ref = ReferenceScrew();
-  WriteScrew(dir / "ref.json", ref);
-  const Screw back = ReadScrew(dir / "ref.json");
+  const screw::Screw ref = screw::ReferenceScrew();
+  screw::WriteScrew(dir / "ref.json", ref);
+  const screw::Screw back = screw::ReadScrew(dir / "ref.json");
   EXPECT_EQ(back.process.ToArray(), ref.process.ToArray());
   EXPECT_EQ(back.length_mm, ref.length_mm);
   EXPECT_EQ(back.settings.tool_count, ref.settings.tool_count);
@@ -246,7 +246,7 @@ TEST(Screw, JsonRoundTripAndClearErrors) {
   nlohmann::json j = ref;
   const auto expect_error = [&](nlohmann::json bad, const std::string& needle) {
     try {
-      Screw s = bad.get<Screw>();
+      screw::Screw s = bad.get<screw::Screw>();
       ADD_FAILURE() << "accepted " << bad.dump();
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
@@ -281,7 +281,7 @@ TEST(Screw, JsonRoundTripAndClearErrors) {
 // user wrote, never surfacing later under a derived name ("axial_feed_mm_s = 0" from a tool-circle
 // margin, "thread_length_mm" from a thread start offset).
 TEST(Screw, EveryNumberOutOfRangeIsNamedAsWritten) {
-  const nlohmann::json ref = ReferenceScrew();
+  const nlohmann::json ref = screw::ReferenceScrew();
   const nlohmann::json flat = ref.flatten();
   int swept = 0;
   for (auto it = flat.begin(); it != flat.end(); ++it) {
@@ -292,7 +292,7 @@ TEST(Screw, EveryNumberOutOfRangeIsNamedAsWritten) {
       nlohmann::json bad = ref;
       bad[nlohmann::json::json_pointer(pointer)] = v;
       try {
-        (void)bad.get<Screw>();
+        (void)bad.get<screw::Screw>();
         ADD_FAILURE() << pointer << " = " << v << " accepted";
       } catch (const InputError& e) {
         const std::string m = e.what(), value = key + " = " + (v > 0 ? "1e+308" : "-1e+308");
@@ -307,7 +307,7 @@ TEST(Screw, EveryNumberOutOfRangeIsNamedAsWritten) {
   nlohmann::json margin = ref;
   margin["process"]["tool_circle_margin_mm"] = 1e308;
   try {
-    (void)margin.get<Screw>();
+    (void)margin.get<screw::Screw>();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("process.tool_circle_margin_mm = 1e+308 breaks the rule: "
                                          "must lie in (0, 100] mm"),
@@ -329,9 +329,9 @@ TEST(Features, SettleTimeOfSyntheticCurvesWithNoiseAndDrift) {
       c.elongation_um.push_back(plateau * (1 - std::exp(-t / tau)) + drift_um_per_s * t +
                                 0.25 * rng.Normal());
     }
-    SettleOptions band;  // a first-order rise: the 2 % band criterion, not the arctan shape
-    band.method = SettleMethod::kBand;
-    const SettleAnalysis a = AnalyzeSettle(c, band);
+    fit::SettleOptions band;  // a first-order rise: the 2 % band criterion, not the arctan shape
+    band.method = fit::SettleMethod::kBand;
+    const fit::SettleAnalysis a = fit::AnalyzeSettle(c, band);
     const double expected = tau * std::log(50.0);
     EXPECT_NEAR(a.features.settle_time_s, expected, 0.15 * expected + 15) << a.message;
     // The plateau where it is reached: the drift accumulated by then is included.
@@ -363,11 +363,11 @@ TEST(Features, DisturbedCurvesGiveTheUndriftedFeatures) {
     DisturbanceOptions workpiece_only = disturbed;
     workpiece_only.ambient_drift = false;
     workpiece_only.measurement_noise = false;
-    const Screw screw = RowScrew(points[c]);
+    const screw::Screw screw = RowScrew(points[c]);
     const SimulationResult r = Simulate(screw, sim, disturbed);
     const SimulationResult ref = Simulate(screw, sim, workpiece_only);
     ASSERT_EQ(r.disturbances.heat_partition_factor, ref.disturbances.heat_partition_factor);
-    const SettleAnalysis a = AnalyzeSettle(r.curve), b = AnalyzeSettle(ref.curve);
+    const fit::SettleAnalysis a = fit::AnalyzeSettle(r.curve), b = fit::AnalyzeSettle(ref.curve);
     const double e_s = std::abs(a.features.settle_time_s / b.features.settle_time_s - 1);
     const double e_m = std::abs(a.features.max_elongation_um / b.features.max_elongation_um - 1);
     settle_err.push_back(e_s);
@@ -395,20 +395,20 @@ TEST(Features, RejectsBadCurves) {
     c.time_s.push_back(i);
     c.elongation_um.push_back(i);
   }
-  EXPECT_THROW(ExtractFeatures(c), InputError);
+  EXPECT_THROW(fit::ExtractFeatures(c), InputError);
   for (int i = 5; i < 20; ++i) {
     c.time_s.push_back(i);
     c.elongation_um.push_back(i);
   }
   c.time_s[7] = 3;
-  EXPECT_THROW(ExtractFeatures(c), InputError);
+  EXPECT_THROW(fit::ExtractFeatures(c), InputError);
 }
 
 TEST(Dataset, DesignIsFeasibleInRangeAndIndependentOfThreads) {
   const auto points = DesignPoints(200, 9, DatasetOptions{}.ranges);
   ASSERT_EQ(points.size(), 200u);
   for (const auto& p : points) {
-    EXPECT_NO_THROW(ValidateScrew(RowScrew(p)));
+    EXPECT_NO_THROW(screw::ValidateScrew(RowScrew(p)));
     EXPECT_GE(p.hardness_hrc, 60);
     EXPECT_LE(p.cutting_speed_m_min, 210);
   }

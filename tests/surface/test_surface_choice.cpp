@@ -6,32 +6,32 @@
 #include "core/error.h"
 #include "surface/choice.h"
 #include "surface/line840d.h"
-#include "surface/synthetic.h"
+#include "synthetic/surface.h"
 
 namespace whirl::surface {
 namespace {
 
 TEST(Synthetic, SmoothFieldSpans10To40UmWithAllParts) {
-  SyntheticOptions o;
+  synthetic::SyntheticOptions o;
   o.noise_um = 0;
   double lo = 1e9, hi = -1e9;
-  for (const auto& p : SyntheticPoints(o))
+  for (const auto& p : synthetic::SyntheticPoints(o))
     lo = std::min(lo, p.error_um), hi = std::max(hi, p.error_um);
   EXPECT_DOUBLE_EQ(lo, 10);  // at (0, 0)
   EXPECT_DOUBLE_EQ(hi, 38);  // at (length_x, length_y): 10+10+6+4+3-2+5+2
   // The noise has the stated standard deviation.
-  SyntheticOptions n = o;
+  synthetic::SyntheticOptions n = o;
   n.noise_um = 1.5, n.nx = 60, n.ny = 60;
   double sum2 = 0;
-  const auto pts = SyntheticPoints(n);
-  for (const auto& p : pts) sum2 += std::pow(p.error_um - SyntheticErrorUm(n, p.x_mm, p.y_mm), 2);
+  const auto pts = synthetic::SyntheticPoints(n);
+  for (const auto& p : pts) sum2 += std::pow(p.error_um - synthetic::SyntheticErrorUm(n, p.x_mm, p.y_mm), 2);
   EXPECT_NEAR(std::sqrt(sum2 / pts.size()), 1.5, 0.1);
 }
 
 TEST(Choice, CubicFieldIsFittedExactlyAndNotFlagged) {
-  SyntheticOptions o;
+  synthetic::SyntheticOptions o;
   o.noise_um = 0;
-  const MethodComparison c = CompareMethods(SyntheticPoints(o));
+  const MethodComparison c = CompareMethods(synthetic::SyntheticPoints(o));
   ASSERT_TRUE(c.cubic_available && c.bspline_available);
   EXPECT_LT(c.cubic_loo.max_abs_um, 1e-9);
   EXPECT_FALSE(c.cubic_oscillates) << c.note;
@@ -40,19 +40,19 @@ TEST(Choice, CubicFieldIsFittedExactlyAndNotFlagged) {
 
 TEST(Choice, SmoothNoisyFieldPrefersTheCubic) {
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-    SyntheticOptions o;
+    synthetic::SyntheticOptions o;
     o.seed = seed;
-    const MethodComparison c = CompareMethods(SyntheticPoints(o));
+    const MethodComparison c = CompareMethods(synthetic::SyntheticPoints(o));
     EXPECT_EQ(c.recommended, Method::kCubic) << "seed " << seed << ": " << c.reason;
   }
 }
 
 TEST(Choice, OnTheBumpFieldTheBsplineLeaveOneOutIsLower) {
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-    SyntheticOptions o;
-    o.field = SyntheticField::kBump;
+    synthetic::SyntheticOptions o;
+    o.field = synthetic::SyntheticField::kBump;
     o.seed = seed;
-    const MethodComparison c = CompareMethods(SyntheticPoints(o));
+    const MethodComparison c = CompareMethods(synthetic::SyntheticPoints(o));
     EXPECT_LT(c.bspline_loo_common.rms_um, c.cubic_loo_common.rms_um) << "seed " << seed;
     EXPECT_EQ(c.recommended, Method::kBspline) << c.reason;
   }
@@ -75,8 +75,8 @@ TEST(Choice, RungeFieldRaisesTheOscillationNote) {
 }
 
 TEST(Choice, ScatteredPointsFallBackToTheCubic) {
-  SyntheticOptions o;
-  auto pts = SyntheticPoints(o);
+  synthetic::SyntheticOptions o;
+  auto pts = synthetic::SyntheticPoints(o);
   pts.pop_back();  // no longer a complete grid
   const MethodComparison c = CompareMethods(pts);
   EXPECT_FALSE(c.bspline_available);

@@ -11,7 +11,7 @@
 #include "surface/line840d.h"
 #include "surface/per_point.h"
 #include "surface/surface.h"
-#include "surface/synthetic.h"
+#include "synthetic/surface.h"
 
 namespace whirl::surface {
 namespace {
@@ -28,10 +28,10 @@ std::string ErrorOf(const json& j) {
 }
 
 json FittedFile(Method m) {
-  SyntheticOptions o;
+  synthetic::SyntheticOptions o;
   o.nx = 6;
   o.ny = 5;
-  return json::parse(SurfaceFitToJson(FitSurface(SyntheticPoints(o), {m, 3})).dump());
+  return json::parse(SurfaceFitToJson(FitSurface(synthetic::SyntheticPoints(o), {m, 3})).dump());
 }
 
 // Each number of the file, set to a value outside its range, is refused naming the field as the
@@ -101,18 +101,18 @@ TEST(SurfaceInputs, EvaluationsAreFiniteWithinTheRanges) {
 // A fitted surface passes the checks its file is read with (what fit writes, predict reads).
 TEST(SurfaceInputs, AFitPassesTheReadChecks) {
   for (Method m : {Method::kCubic, Method::kBspline}) {
-    SyntheticOptions o;
+    synthetic::SyntheticOptions o;
     o.nx = 100;
     o.ny = 100;  // 10000 points, the limit
     o.length_x_mm = kMaxCoordinateMm;
-    const SurfaceFit f = FitSurface(SyntheticPoints(o), {m, 1});
+    const SurfaceFit f = FitSurface(synthetic::SyntheticPoints(o), {m, 1});
     EXPECT_NO_THROW(CheckSurface(f.surface, "test"));
   }
 }
 
 TEST(SurfaceInputs, AxisNameIsAnNcIdentifier) {
-  SyntheticOptions o;
-  const Surface s = FitSurface(SyntheticPoints(o), {Method::kCubic, 3}).surface;
+  synthetic::SyntheticOptions o;
+  const Surface s = FitSurface(synthetic::SyntheticPoints(o), {Method::kCubic, 3}).surface;
   for (const char* bad :
        {"1", "_", "", "X Y", "1X", "X-1", "\xC3\x84", "XXXXXXXXXXXXXXXXXXXXXXXXXXXXXXXXX"}) {
     AxisLineOptions lo;
@@ -127,15 +127,15 @@ TEST(SurfaceInputs, AxisNameIsAnNcIdentifier) {
 }
 
 TEST(SurfaceInputs, SyntheticGridWithinThePointsLimit) {
-  SyntheticOptions o;
+  synthetic::SyntheticOptions o;
   o.nx = 200;
   o.ny = 200;
-  EXPECT_THROW(SyntheticPoints(o), InputError);
+  EXPECT_THROW(synthetic::SyntheticPoints(o), InputError);
   o.nx = 100;
   o.ny = 101;
-  EXPECT_THROW(SyntheticPoints(o), InputError);
+  EXPECT_THROW(synthetic::SyntheticPoints(o), InputError);
   o.ny = 100;
-  EXPECT_EQ(SyntheticPoints(o).size(), kMaxPoints);
+  EXPECT_EQ(synthetic::SyntheticPoints(o).size(), kMaxPoints);
 }
 
 TEST(SurfaceInputs, NearestSampleNeedsAFiniteTime) {

@@ -6,7 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/run_program.h"
 #include "surface/report.h"
-#include "surface/synthetic.h"
+#include "synthetic/surface.h"
 #include "support/scratch_dir.h"
 
 namespace whirl::surface {
@@ -17,8 +17,8 @@ namespace fs = std::filesystem;
 TEST(SurfaceReport, HostileTitleAndProvenanceStayText) {
   const fs::path dir = whirl::test::ScratchDir() / "whirl_surface_report_test";
   fs::remove_all(dir);
-  SyntheticOptions s;
-  const SurfaceFit fit = FitSurface(SyntheticPoints(s), {Method::kBspline, 3});
+  synthetic::SyntheticOptions s;
+  const SurfaceFit fit = FitSurface(synthetic::SyntheticPoints(s), {Method::kBspline, 3});
   const MethodComparison choice = CompareMethods(fit.points);
   SurfaceReportOptions o;
   o.title = "it's \\ a \"table\"\nset output '/tmp/pwned'\n<script>alert(1)</script>";

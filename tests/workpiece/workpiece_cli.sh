@@ -32,13 +32,13 @@ grep -q "OUTSIDE" out.txt || fail "row not flagged outside"
   || fail "plan: $(cat err.txt)"
 "$whirl" curve --model fam.json --screw "$screw" --out curve.csv > /dev/null 2> err.txt \
   || fail "curve: $(cat err.txt)"
-"$whirl" compare --model fam.json --screw "$screw" --json > cmp.json 2> err.txt \
+"$whirl" compare --model fam.json --screw "$screw" --history "$src/datasets/whirling_500.csv" --json > cmp.json 2> err.txt \
   || fail "compare: $(cat err.txt)"
 grep -q '"model": "max_elongation_um: ' cmp.json || fail "compare does not name the model"
 grep -q '"model_vs_regression"' cmp.json || fail "compare lacks model vs regression"
 
 # At 20 rows a GP must beat the power law in refits whose hyperparameters never saw the held-out
-# rows (src/family/family.h, ChoiceOptions::closed_form_loo). On this generated table (the
+# rows (src/product/family/family.h, ChoiceOptions::closed_form_loo). On this generated table (the
 # simulator's seed 120001) the GP on log columns beat the power law's leave-one-out error for
 # max elongation but not the refits: train takes the power law.
 "$whirl" dataset --count 20 --seed 120001 --out gen.csv > /dev/null 2> err.txt \

@@ -1,0 +1,77 @@
+#pragma once
+// The report a process engineer opens after a comparison: one HTML page (index.html, the shared
+// skeleton and stylesheet of core/html_page.h) that opens with the "load onto the control" box
+// (compare/control_box.h: setting data, programs, prerequisites, what to run after an abort), then
+// per screw the metrics of every strategy (kStrategies) with the ISO 3408-3 class reached and how
+// much less the model leaves, the elongation curve (simulated truth, the prediction with its
+// +-1 sd band, i.e. the arctangent curves of the features at mean -+ 1 sd, and each strategy's
+// compensation with the plan's compensation points), the lead deviation of every strategy along
+// the thread (whole thread, and the first 1000 mm where the transient lives), plus the CSV files
+// every plot comes from and report.json. Each strategy has one colour and dash in every plot
+// (core/plot_style.h).
+//
+// Plots: gnuplot (Debian package gnuplot-nox, pngcairo terminal, falling back to png). Why gnuplot:
+// it is a well-kept Debian package already installed by scripts/setup.sh, it needs no library
+// linked into whirl (the library stays free of plotting code paths at link time), the generated
+// .gp scripts stay in the report folder so anyone can re-plot or restyle from the CSVs, and PNG
+// embeds in any browser or mail. If gnuplot is missing at run time, the HTML, CSVs and scripts are
+// still written and ReportResult::warnings says the plots were skipped.
+// All-or-nothing: every file (CSVs, .gp scripts, PNGs rendered by gnuplot, report.json,
+// index.html) is collected by core/output_dir.h's OutputDir (gnuplot renders in its staging
+// folder) and committed at once; a failure leaves no new file and the previous report intact. The
+// directory follows OutputDir's rule: new, empty or a whirl output (never a symbolic link); files
+// of an earlier report that this one does not write are removed.
+// Safe with any screw name: names reach gnuplot only as GnuplotString literals (titles
+// `noenhanced`), the page only through HtmlEscape, file names only as Slug; gnuplot runs through
+// RunProgram (an argument vector, no shell), in the staging folder.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "compare/compare.h"
+#include "compare/control_box.h"
+
+namespace whirl::compare {
+
+struct ReportOptions {
+  std::string title = "whirl: lead error with and without thermal-elongation compensation";
+  /// Lines shown under the title and written as '#' comments into every CSV (command, seed, model).
+  std::vector<std::string> provenance;
+  /// Render PNGs with gnuplot (false: data, scripts and HTML only).
+  bool plots = true;
+  std::string gnuplot_command = "gnuplot";
+  /// Extra notes shown at the top of the page (e.g. how the new-type screw was defined).
+  std::vector<std::string> notes;
+  /// The "load onto the control" box, one entry per comparison in the same order (heading and
+  /// plan are taken from the comparison): the programs and PLC table written with the report
+  /// (links relative to `dir`), the prerequisites, the call order, what to run after an abort.
+  /// Missing entries: the box shows the plan's setting data and says that `whirl plan` writes
+  /// the programs.
+  std::vector<plan::ControlLoad> control;
+  /// Where the history rules' past screws come from (e.g. "table.csv (24 screws)"), stated in
+  /// "How to read this page"; empty: the page points to the lines under the title.
+  std::string history;
+};
+
+struct ReportResult {
+  std::filesystem::path index_html;
+  std::vector<std::filesystem::path> files;  ///< every file written
+  bool plots_rendered = false;
+  std::vector<std::string> warnings;  ///< e.g. "gnuplot not found: plots skipped"
+};
+
+/// Writes the report for one or more screws into `dir` (created if missing). InputError if the
+/// directory cannot be created or a file cannot be written; a failing gnuplot is a warning.
+ReportResult WriteReport(const std::filesystem::path& dir,
+                         const std::vector<ScrewComparison>& comparisons,
+                         const ReportOptions& options = {});
+
+/// Plain-text metrics table of one comparison (for the terminal): the metrics of every strategy,
+/// the ISO class reached and how much less the model leaves than each.
+std::string FormatComparisonTable(const ScrewComparison& c);
+
+/// File-name stem for a screw name: lower case letters, digits, '-' and '_' only, at most 64
+/// characters, never empty ("screw").
+std::string Slug(const std::string& name);
+
+}  // namespace whirl::compare

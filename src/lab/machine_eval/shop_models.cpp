@@ -1,0 +1,83 @@
+#include "machine_eval/shop_models.h"
+
+#include <cmath>
+#include <optional>
+#include <tuple>
+
+#include "core/error.h"
+#include "drift/monitor.h"
+
+namespace whirl::machine_eval {
+
+std::vector<std::string> ScheduleInputs() {
+  return {"ring_on", "cutting", "ring_load_pct", "z_speed_mm_min"};
+}
+
+ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
+                         const std::vector<std::string>& schedule_inputs) {
+  ShopModels m;
+  drift::JointFitOptions lagged;
+  lagged.require_lag = true;
+  drift::JointSpec warmup;
+  warmup.z_ref_mm = z_fixed_mm;
+  warmup.other_inputs = {"power_on"};
+  m.warmup = drift::FitJoint(record, warmup, lagged).model;
+  drift::JointSpec schedule;
+  schedule.z_ref_mm = z_fixed_mm;
+  schedule.other_inputs = schedule_inputs;
+  m.schedule = drift::FitJoint(record, schedule, lagged).model;
+  const bool schedule_base = m.schedule.cv_rmse_um <= m.warmup.cv_rmse_um;
+  const drift::JointDriftModel& base = schedule_base ? m.schedule : m.warmup;
+  std::vector<std::string> pool;
+  for (const auto& name : record.day_logs.front().sensor_names) pool.push_back(name);
+  drift::JointSpec alone;
+  alone.z_ref_mm = z_fixed_mm;
+  alone.sensor_pool = pool;
+  // No sensor lowers the CV below the constant: the candidate does not exist (the record itself
+  // passed the fits above, so this is the only InputError left).
+  std::optional<drift::JointDriftModel> sensors;
+  try {
+    sensors = drift::FitJoint(record, alone, {}).model;
+  } catch (const InputError&) {
+  }
+  // Sensors on top of the sensor-free rule: its inputs and lags, a sensor added only while the
+  // grouped CV falls.
+  drift::JointSpec on_top = alone;
+  on_top.other_inputs = base.other_inputs;
+  on_top.time_constants = base.time_constants;
+  drift::JointFitOptions keep_lags;
+  keep_lags.max_lags = static_cast<int>(base.time_constants.size());
+  const drift::JointDriftModel combined = drift::FitJoint(record, on_top, keep_lags).model;
+  const std::string base_name = schedule_base ? "schedule" : "warmup";
+  m.sensors = base;
+  m.sensors_choice = base_name;
+  if (sensors && sensors->cv_rmse_um < m.sensors.cv_rmse_um)
+    m.sensors = *sensors, m.sensors_choice = "sensors";
+  if (combined.cv_rmse_um < m.sensors.cv_rmse_um)
+    m.sensors = combined, m.sensors_choice = "sensors+" + base_name;
+  return m;
+}
+
+ShopControl ShopControlModels(const drift::JointDriftModel& model,
+                              const std::vector<drift::Run>& training_logs) {
+  ShopControl c;
+  std::tie(c.offset, c.slope) = drift::ToDriftModels(model);
+  const Eigen::Index p = model.features();
+  if (p == 0) return c;
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, 1e300), hi = -lo;
+  for (const drift::Run& log : training_logs) {
+    if (log.samples() == 0) continue;
+    const Eigen::MatrixXd x = drift::MonitorDesign(c.offset, log, drift::ReferenceMode::kRunStart);
+    lo = lo.cwiseMin(x.rightCols(p).colwise().minCoeff().transpose());
+    hi = hi.cwiseMax(x.rightCols(p).colwise().maxCoeff().transpose());
+  }
+  if (!(lo.array() <= hi.array()).all()) return c;
+  for (drift::DriftModel* m : {&c.offset, &c.slope}) {
+    m->feature_min = lo;
+    m->feature_max = hi;
+  }
+  c.ranged = true;
+  return c;
+}
+
+}  // namespace whirl::machine_eval

@@ -1,0 +1,54 @@
+#pragma once
+// The machine drift models a shop can train from what it measures (field_history.h: probe and
+// laser readings, the measured leads of past screws, set-up checks; never a truth channel), and
+// the sensor model in the form the 840D drift action applies.
+//
+// FitShopModels: every family with the same records and the same estimator (drift/joint.h):
+//   warmup    lags of power_on (the time since power-on);
+//   schedule  lags of the control's duty signals (ScheduleInputs: Brecher, Hirsch and Weck 2004,
+//             the control's own drive data);
+//   sensors   the candidate with the smallest grouped cross-validated RMSE (leave one calendar
+//             day out) among
+//     sensors             forward choice from all sensors, own lags;
+//     sensors+<rule>      the better sensor-free rule's inputs and lags, sensors added while the
+//                         CV falls by more than 1 %;
+//     <rule>              the better sensor-free rule itself (warmup or schedule by CV),
+//   so the sensor model is never worse than the sensor-free rules in cross-validation; a slope is
+//   learned only over the range the Z-spanning readings cover (JointFitOptions).
+// The day logs carry the sensors (<name>_C) and the control's duty signals a SINUMERIK 840D has
+// without wiring (power_on: 0 at the first row, the power-on sample; ring_on, cutting,
+// ring_load_pct, z_speed_mm_min; machine/instruments.h DayLog).
+#include <string>
+#include <vector>
+
+#include "drift/joint.h"
+#include "drift/measurements.h"
+#include "drift/model.h"
+#include "drift/run_file.h"
+
+namespace whirl::machine_eval {
+
+/// The control signals of the schedule rule: ring_on, cutting, ring_load_pct, z_speed_mm_min.
+std::vector<std::string> ScheduleInputs();
+
+struct ShopModels {
+  drift::JointDriftModel sensors, warmup, schedule;
+  std::string sensors_choice;  ///< which candidate the sensor model is (see above)
+};
+/// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing).
+ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
+                         const std::vector<std::string>& schedule_inputs = ScheduleInputs());
+
+/// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
+/// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on
+/// (drift::MonitorDesign with rises from each log's first row): the range the drift action's
+/// slope bound and the monitor's scaling read. `ranged` false: no feature or no log sample, the
+/// ranges stay as ToDriftModels leaves them (unbounded).
+struct ShopControl {
+  drift::DriftModel offset, slope;
+  bool ranged = false;
+};
+ShopControl ShopControlModels(const drift::JointDriftModel& model,
+                              const std::vector<drift::Run>& training_logs);
+
+}  // namespace whirl::machine_eval

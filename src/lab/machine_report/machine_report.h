@@ -1,0 +1,41 @@
+#pragma once
+// The report of one screw cut on a drifting machine, the manual of the machine_report module
+// (lab): written by the caller (`whirl machine evaluate --out-dir`, step 7 of `whirl demo`) from
+// the screw an evaluation kept (machine_eval.h ReportScrew; the evaluation itself writes
+// nothing). Its control log, the lead deviation per strategy, and the combined 840D programs
+// (machine_nc.h) of the models a shop can train: the workpiece plan of the network's curve and
+// the drift action of the sensor model both_shop applies (trained from probe, laser and lead
+// measurements only, never from the simulator's truth).
+#include <string>
+
+#include "interp/machine_profile.h"
+#include "machine_eval/machine_eval.h"
+
+namespace whirl::machine_report {
+
+struct MachineReport {
+  std::string index_html;  ///< the page written
+  bool programs = false;   ///< the combined programs were written beside it
+  /// Why the report holds no combined programs (no profile, or one that does not fit the
+  /// machine), or "".
+  std::string programs_note;
+};
+
+/// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a
+/// symbolic link; written all-or-nothing): sensors.csv/.png (the control's log of the screw's
+/// day from power-on to the cut's end in the drift run format, the temperatures in panels of at
+/// most 8 sensors, related ones together, the sensor model's sensors thick; degC over min since
+/// the day's 00:00), lead.csv/.png (lead deviation per strategy, um over mm from the thread start
+/// to its end, each strategy in its core/plot_style.h look), index.html (core/html_page.h) with
+/// the strategies' figures and the sensor model. Plots need gnuplot (skipped with a note
+/// otherwise). With a `profile` that fits the machine, the screw's combined 840D programs are
+/// written beside the figures and the page opens with the "load onto the control" box
+/// (plan/load.h data, compare/control_box.h): the plan's setting data, the five files, the
+/// machine data both programs need (each datum once), the call order and what to run after an
+/// abort; a profile that does not fit leaves them out with the note returned (the report
+/// stands). InputError for a screw whose evaluation failed.
+MachineReport WriteMachineScrewReport(const std::string& dir,
+                                      const machine_eval::ReportScrew& screw,
+                                      const interp::MachineProfile* profile);
+
+}  // namespace whirl::machine_report

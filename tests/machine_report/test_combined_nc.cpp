@@ -1,0 +1,197 @@
+// The combined 840D programs of a screw on the field machine (machine_report/machine_nc.h),
+// replayed as the control runs them (tests/interp/nc_replay.h) from the day's power-on, with the
+// control's log (its filtered temperatures and duty signals) on the analog inputs: at every
+// control sample the control applies the workpiece plan plus what the evaluation's both_shop
+// applies from that sample on (the sensor model a shop trained, drift/joint.h, run causally:
+// machine_eval/strategies.h, K0_k + G_k (z_ref - z) / 1000); while the axis waits before the
+// thread start, the machine line alone; the reset programs leave the control as found. The
+// analog inputs hold each sample's values over the interval that ends at it (the interval the
+// causal evaluator's lag step covers), so the two agree at the samples; between samples the
+// control moves on every cycle while both_shop holds the last sample.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/process.h"
+#include "drift/joint.h"
+#include "interp/nc_replay.h"
+#include "machine/scenarios.h"
+#include "machine_eval/field_eval.h"
+#include "machine_eval/strategies.h"
+#include "machine_report/machine_nc.h"
+#include "workpiece/model.h"
+
+namespace whirl::machine_report {
+namespace {
+
+constexpr double kReplayCycleMs = 100;  // the largest cycle the profile allows: 100 per sample
+
+std::string CombinedSource(const std::string& rel) {
+  return std::string(WHIRL_SOURCE_DIR) + "/" + rel;
+}
+
+// The first test-day screw of a constant-duty machine (one cut right after power-on) whose
+// screws have 400 mm of thread (about ten minutes of cut), with the models trained on its
+// history (one warm-up test, one laser test, two past days).
+const machine_eval::ReportScrew& ShortCut() {
+  static const machine_eval::ReportScrew* kept = [] {
+    machine::MachineScenario s = machine::FindMachineScenario("constant-duty");
+    s.jobs.base.thread_length_mm = 400;
+    machine_eval::FieldEvalOptions o;
+    o.machines = 1;
+    o.threads = 1;
+    o.seed = 2;
+    o.calendar.warmup_speeds_m_min = {180};
+    o.calendar.past_days = 2;
+    o.calendar.test_days = 1;
+    o.keep_report_screw = true;
+    const machine_eval::MachineEvaluation e = machine_eval::EvaluateFieldScenario(
+        s, workpiece::LoadWorkpieceModel(CombinedSource("models/default.json")),
+        compare::BuildExperienceRule(
+            ReadProcessTable(CombinedSource("datasets/whirling_500.csv"), true)),
+        lead::ReadIsoToleranceTable(
+            CombinedSource("datasets/standards/iso3408_3_lead_tolerances.csv")),
+        o);
+    if (!e.report) throw std::runtime_error("no report screw");
+    return new machine_eval::ReportScrew(*e.report);
+  }();
+  return *kept;
+}
+
+// The shipped profile with the replay's cycle (direction -1), or the same machine seen from an
+// axis that runs +Z towards the chuck (direction +1: program coordinate -z, the fixed bearing at
+// offset - z_fixed).
+interp::MachineProfile CombinedProfile(int direction, interp::ControlDk control_dk,
+                                       double z_fixed_mm) {
+  interp::MachineProfile p =
+      interp::LoadMachineProfile(CombinedSource("datasets/machines/whirling_840d.json"));
+  p.control_dk = control_dk;
+  p.drift->ipo_cycle_ms = kReplayCycleMs;
+  if (direction == 1) {
+    p.direction = 1;
+    p.drift->error_direction = 1;
+    p.drift->slope_growth_direction = 1;
+    p.drift->slope_fixed_end_mm = p.machine_offset_mm - z_fixed_mm;
+  }
+  return p;
+}
+
+CombinedPrograms Build(const machine_eval::ReportScrew& r, const interp::MachineProfile& p) {
+  return BuildCombinedPrograms(r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm,
+                               r.plan_options, r.offset, r.slope, r.z_ref_mm, p, "test curve",
+                               "test model");
+}
+
+void ReplayTheDay(int direction, interp::ControlDk control_dk) {
+  SCOPED_TRACE("direction " + std::to_string(direction) + ", control_dk " +
+               interp::ToString(control_dk));
+  const machine_eval::ReportScrew& r = ShortCut();
+  const drift::Run& log = r.log;
+  const CombinedPrograms p = Build(r, CombinedProfile(direction, control_dk, r.z_ref_mm));
+  const machine_eval::HeldSamples held = machine_eval::RunCausally(r.sensor_model, log);
+  const Eigen::MatrixXd raw = drift::JointRawInputs(r.sensor_model, log);
+  std::vector<std::string> inputs = r.sensor_model.sensors;
+  inputs.insert(inputs.end(), r.sensor_model.other_inputs.begin(),
+                r.sensor_model.other_inputs.end());
+  interp::replay::Replay replay;
+  replay.control.abs_value_mm = -0.0013;  // what the control holds before
+  replay.control.slope = 7e-6;
+  replay.control.ref_position_mm = 100.0;
+  auto set_inputs = [&](int k) {
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const auto it = p.drift.inputs.find(inputs[i]);
+      ASSERT_NE(it, p.drift.inputs.end()) << inputs[i];
+      replay.control.ain[it->second.index] =
+          (raw(k, static_cast<Eigen::Index>(i)) - it->second.offset) / it->second.scale;
+    }
+  };
+  const double feed = r.kinematics.axial_feed_mm_s, t_cut = r.kinematics.cutting_time_s;
+  const double z0 = r.kinematics.thread_start_position_mm;
+  const double park = interp::AxisPositionMm(p.plan.options, feed, -5.0 / feed);  // 5 mm before
+  auto axis_at = [&](double t_min) {  // where the axis is at log time t_min
+    const double t_s = (t_min - r.cut_start_min) * 60.0;
+    return t_s < 0 ? park : interp::AxisPositionMm(p.plan.options, feed, std::min(t_s, t_cut));
+  };
+  auto z_at = [&](double t_min) {  // the tool's distance from the chuck face
+    const double t_s = (t_min - r.cut_start_min) * 60.0;
+    return t_s < 0 ? z0 + 5.0 : z0 - feed * std::min(t_s, t_cut);
+  };
+  const double s = interp::SignFactor(p.plan.options.sign);
+  // Power-on: the drift action starts on the first sample; then the plan with the axis parked.
+  set_inputs(0);
+  replay.axis_mm = park;
+  ASSERT_TRUE(replay.RunProgram(p.drift_nc));
+  replay.Cycle(park);
+  ASSERT_TRUE(replay.RunProgram(p.plan_nc));
+  const int per_sample =
+      static_cast<int>(std::lround((log.time_min[1] - log.time_min[0]) * 60000.0 / kReplayCycleMs));
+  double worst_um = 0, worst_parked_um = 0, largest_machine_um = 0;
+  int cut_samples = 0;
+  for (int k = 1; k < log.samples(); ++k) {
+    const double t0 = log.time_min[static_cast<std::size_t>(k - 1)];
+    const double t1 = log.time_min[static_cast<std::size_t>(k)];
+    ASSERT_EQ(static_cast<int>(std::lround((t1 - t0) * 60000.0 / kReplayCycleMs)), per_sample);
+    set_inputs(k);
+    for (int c = 1; c <= per_sample; ++c) replay.Cycle(axis_at(t0 + (t1 - t0) * c / per_sample));
+    if (::testing::Test::HasFailure()) return;
+    const double pos = axis_at(t1);
+    const double machine_um =
+        held.k0_um[static_cast<std::size_t>(k)] +
+        held.slope_um_per_1000[static_cast<std::size_t>(k)] * (r.z_ref_mm - z_at(t1)) / 1000.0;
+    const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
+    largest_machine_um = std::max(largest_machine_um, std::abs(machine_um));
+    if (t1 < r.cut_start_min) {  // parked before the thread start: the machine line alone
+      worst_parked_um = std::max(worst_parked_um, std::abs(applied_um - machine_um));
+    } else if (t1 <= r.cut_end_min) {
+      ++cut_samples;
+      worst_um = std::max(
+          worst_um, std::abs(applied_um - machine_um - interp::AppliedCompensationUm(p.plan, pos)));
+    }
+  }
+  EXPECT_GT(cut_samples, 30);
+  EXPECT_LT(worst_um, 1e-3);
+  EXPECT_LT(worst_parked_um, 1e-3);
+  EXPECT_GT(largest_machine_um, 2.0);  // the machine part is not trivially zero
+  // The plan never writes a setting datum itself; after the cut and both resets the control
+  // holds what it held before.
+  EXPECT_EQ(p.plan_nc.find("SA_TEMP_COMP"), std::string::npos);
+  replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
+  replay.EndProgram();
+  ASSERT_TRUE(replay.RunProgram(p.plan_reset_nc));
+  ASSERT_TRUE(replay.RunProgram(p.drift_reset_nc));
+  EXPECT_TRUE(replay.actions.empty());
+  EXPECT_EQ(replay.control.abs_value_mm, -0.0013);
+  EXPECT_EQ(replay.control.slope, 7e-6);
+  EXPECT_EQ(replay.control.ref_position_mm, 100.0);
+}
+
+TEST(CombinedPrograms, ReplayAppliesPlanPlusTheShopTrainedModelAtEveryControlSample) {
+  ASSERT_GT(ShortCut().sensor_model.features(), 0);
+  for (int direction : {-1, 1})
+    for (auto control_dk : {interp::ControlDk::kAdded, interp::ControlDk::kSubtracted})
+      ReplayTheDay(direction, control_dk);
+}
+
+TEST(CombinedPrograms, ProfileThatDisagreesWithTheMachineIsRefused) {
+  const machine_eval::ReportScrew& r = ShortCut();
+  interp::MachineProfile profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  EXPECT_NO_THROW(Build(r, profile));
+  profile.drift->slope_fixed_end_mm += 10.0;  // the bearing is not where the machine has it
+  EXPECT_THROW(Build(r, profile), InputError);
+  profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  profile.drift->slope_growth_direction = 1;
+  EXPECT_THROW(Build(r, profile), InputError);
+  profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  profile.drift->workpiece_slope_param = -1;  // the plan would keep SD43910: two writers
+  EXPECT_THROW(Build(r, profile), InputError);
+  profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  for (const std::string& in : r.sensor_model.sensors) profile.drift->inputs.erase(in);
+  if (!r.sensor_model.sensors.empty()) {
+    EXPECT_THROW(Build(r, profile), InputError);
+  }
+}
+
+}  // namespace
+}  // namespace whirl::machine_report

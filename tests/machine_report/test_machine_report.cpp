@@ -1,0 +1,189 @@
+// The report of one screw (machine_report/machine_report.h), written from the screw a field
+// evaluation kept: every strategy has its own look in the one style table (core/plot_style.h),
+// the sensor plot has at most 8 lines per panel and every sensor once, the lead plot ends at the
+// thread's end, hostile names stay text, and the programs handed over are those of the models a
+// shop can train, with each machine datum listed once in the box.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "compare/compare.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/plot_style.h"
+#include "core/process.h"
+#include "core/safe_text.h"
+#include "interp/drift_action.h"
+#include "machine/scenarios.h"
+#include "machine_eval/field_eval.h"
+#include "machine_report/machine_report.h"
+#include "support/scratch_dir.h"
+#include "workpiece/model.h"
+
+namespace whirl::machine_report {
+namespace {
+
+using machine_eval::kMachineStrategyCount;
+using machine_eval::MachineStrategy;
+using machine_eval::ReportScrew;
+
+std::string ReportSource(const std::string& rel) {
+  return std::string(WHIRL_SOURCE_DIR) + "/" + rel;
+}
+
+// The first test-day screw of a small production world (one warm-up test, one laser test, two
+// past days, one test day), evaluated once for every test here.
+const ReportScrew& KeptScrew() {
+  static const ReportScrew* kept = [] {
+    machine_eval::FieldEvalOptions o;
+    o.machines = 1;
+    o.threads = 1;
+    o.calendar.warmup_speeds_m_min = {180};
+    o.calendar.past_days = 2;
+    o.calendar.test_days = 1;
+    o.keep_report_screw = true;
+    const workpiece::WorkpieceModel model =
+        workpiece::LoadWorkpieceModel(ReportSource("models/default.json"));
+    const compare::ExperienceRule rule = compare::BuildExperienceRule(
+        ReadProcessTable(ReportSource("datasets/whirling_500.csv"), true));
+    const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(
+        ReportSource("datasets/standards/iso3408_3_lead_tolerances.csv"));
+    const machine_eval::MachineEvaluation e = machine_eval::EvaluateFieldScenario(
+        machine::FindMachineScenario("production"), model, rule, iso, o);
+    if (!e.report) throw std::runtime_error("no report screw");
+    return new ReportScrew(*e.report);
+  }();
+  return *kept;
+}
+
+std::filesystem::path ReportDir(const std::string& name) {
+  const std::filesystem::path dir =
+      whirl::test::ScratchDir() / (name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+TEST(ReportStyle, EveryStrategyHasItsOwnEntryInTheStyleTable) {
+  for (compare::Strategy s : compare::kStrategies)
+    EXPECT_NE(FindSeriesStyle(compare::ToString(s)), nullptr)
+        << compare::ToString(s) << ": add it to core/plot_style.cpp";
+  for (MachineStrategy s : machine_eval::MachineStrategies()) {
+    const std::string name = machine_eval::ToString(s);
+    EXPECT_NE(FindSeriesStyle(name), nullptr) << name << ": add it to core/plot_style.cpp";
+  }
+}
+
+TEST(MachineReport, SensorPanelsHoldAtMostEightLinesAndLeadEndsAtTheThread) {
+  const ReportScrew& r = KeptScrew();
+  const std::size_t sensors = r.log.sensor_names.size();
+  ASSERT_GT(sensors, 8u);
+  const std::filesystem::path dir = ReportDir("whirl_machine_report_plots");
+  WriteMachineScrewReport(dir.string(), r, nullptr);
+  // sensors.gp: one plot command per panel; columns 2..sensors+1 once each.
+  std::istringstream gp(ReadTextFile(dir / "sensors.gp"));
+  std::multiset<std::string> columns;
+  int panels = 0;
+  for (std::string line; std::getline(gp, line);) {
+    if (line.rfind("plot ", 0) != 0) continue;
+    ++panels;
+    int lines = 0;
+    for (std::size_t at = line.find("using 1:"); at != std::string::npos;
+         at = line.find("using 1:", at + 1), ++lines)
+      columns.insert(line.substr(at + 8, line.find(' ', at + 8) - at - 8));
+    EXPECT_LE(lines, 8) << line;
+  }
+  EXPECT_GE(panels, static_cast<int>((sensors + 7) / 8));
+  EXPECT_EQ(columns.size(), sensors);
+  for (std::size_t s = 0; s < sensors; ++s) EXPECT_EQ(columns.count(std::to_string(s + 2)), 1u);
+  // lead.gp: x from the thread start to its end; every strategy in its style.
+  const std::string lead = ReadTextFile(dir / "lead.gp");
+  const double thread = r.result.screw.thread_length_mm;
+  EXPECT_NE(lead.find("set xrange [0:" + std::to_string(thread) + "]"), std::string::npos) << lead;
+  for (MachineStrategy s : machine_eval::MachineStrategies())
+    EXPECT_NE(lead.find(GnuplotWith(machine_eval::ToString(s))), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MachineReport, HostileNamesStayText) {
+  const std::string hostile = "a'b\"c\\d\n<script>alert(1)</script>";
+  ReportScrew r = KeptScrew();
+  r.result.screw.name = hostile;
+  r.log.sensor_names.front() = hostile;  // past the machine's name rule, to test escaping
+  r.sensors = {hostile};
+  const std::filesystem::path dir = ReportDir("whirl_machine_report_hostile");
+  const std::string index = WriteMachineScrewReport(dir.string(), r, nullptr).index_html;
+  const std::string html = ReadTextFile(index);
+  EXPECT_EQ(html.find("<script>"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;"), std::string::npos);
+  const std::string script = ReadTextFile(dir / "sensors.gp");
+  EXPECT_NE(script.find(GnuplotString(hostile)), std::string::npos);
+  EXPECT_NE(script.find("noenhanced"), std::string::npos);
+  // A second report replaces whirl's own; a file that is not whirl's refuses the folder and stays.
+  EXPECT_NO_THROW(WriteMachineScrewReport(dir.string(), r, nullptr));
+  WriteFileAtomic(dir / "notes.txt", "mine");
+  EXPECT_THROW(WriteMachineScrewReport(dir.string(), r, nullptr), InputError);
+  EXPECT_TRUE(std::filesystem::exists(dir / "notes.txt"));
+  EXPECT_FALSE(std::filesystem::exists(dir.string() + ".partial"));
+  std::filesystem::remove_all(dir);
+}
+
+// The threshold after `datum` on the header lines of an NC program ("; requires ...").
+int HeaderAtLeast(const std::string& nc, const std::string& datum) {
+  std::smatch m;
+  const std::regex re(datum + R"( \S+ >= (\d+))");
+  return std::regex_search(nc, m, re) ? std::stoi(m[1]) : -1;
+}
+
+// The programs handed over are those of the models a shop can train: the drift program is the
+// sensor model's (the report screw's offset and slope channels), not a model of the simulator's
+// truth; the box lists each machine datum once, MD28254 with the larger of the two programs'
+// thresholds. Without a profile the report stands without programs and says why.
+TEST(MachineReport, TheProgramsAreTheShopTrainedModelsAndTheBoxListsEachDatumOnce) {
+  const ReportScrew& r = KeptScrew();
+  const interp::MachineProfile profile =
+      interp::LoadMachineProfile(ReportSource("datasets/machines/whirling_840d.json"));
+  const std::filesystem::path dir = ReportDir("whirl_machine_report_programs");
+  const MachineReport written = WriteMachineScrewReport(dir.string(), r, &profile);
+  ASSERT_TRUE(written.programs) << written.programs_note;
+  const std::string drift_nc = ReadTextFile(dir / "WHIRL_DRIFT_COMP.SPF");
+  const std::string plan_nc = ReadTextFile(dir / "WHIRL_TEMP_COMP.SPF");
+  interp::DriftActionOptions d = profile.DriftOptions();
+  d.reference = interp::DriftReference::kStart;
+  auto statements = [](const std::string& nc) {  // the program without its comment lines
+    std::string out;
+    std::istringstream in(nc);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(";", 0) != 0) out += line + "\n";
+    return out;
+  };
+  EXPECT_EQ(statements(drift_nc),
+            statements(interp::FormatDriftNcProgram(r.offset, d, "", &r.slope)))
+      << "the drift program applies the sensor model's channels";
+  EXPECT_NE(drift_nc.find("trained only from shop measurements"), std::string::npos);
+  const std::string html = ReadTextFile(dir / "index.html");
+  for (const char* datum : {"MD10300", "MD28050", "MD28250", "MD28254", "MD32750", "MD32760"}) {
+    const std::size_t at = html.find(std::string("<li>") + datum);
+    EXPECT_NE(at, std::string::npos) << datum;
+    EXPECT_EQ(html.find(std::string("<li>") + datum, at + 1), std::string::npos)
+        << datum << " listed twice";
+  }
+  const int both = std::max(HeaderAtLeast(drift_nc, "MD28254"), HeaderAtLeast(plan_nc, "MD28254"));
+  ASSERT_GT(both, 0);
+  EXPECT_NE(HeaderAtLeast(drift_nc, "MD28254"), HeaderAtLeast(plan_nc, "MD28254"));
+  EXPECT_NE(html.find("<li>MD28254 $MC_MM_NUM_AC_PARAM &gt;= " + std::to_string(both) + ":"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
+  const MachineReport bare = WriteMachineScrewReport(dir.string(), r, nullptr);
+  EXPECT_FALSE(bare.programs);
+  EXPECT_NE(bare.programs_note.find("no machine profile"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "WHIRL_DRIFT_COMP.SPF"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace whirl::machine_report
