@@ -162,9 +162,9 @@ void RunDemo(const DemoOptions& o) {
   // 24 characters: interp::CheckProgramName), so they cannot carry the screw's name.
   const std::pair<const screw::Screw*, std::string> screws[] = {{&reference, "WHIRL_REFERENCE"},
                                                               {&new_type, "WHIRL_NEW_TYPE"}};
+  // Step 3 for every screw, then step 4 for every screw: the steps print in order.
   for (const auto& [screw, program] : screws) {
     compare::ScrewComparison c = compare::CompareScrew(*screw, model, rule, iso, co);
-    const std::string slug = compare::Slug(screw->name);
     const auto& p = c.prediction;
     std::fprintf(say,
                  "3. %s: predicted max elongation %.1f +- %.1f um, settle time %.0f +- %.0f s%s; "
@@ -173,6 +173,13 @@ void RunDemo(const DemoOptions& o) {
                  p.mean.settle_time_s, p.stddev.settle_time_s,
                  p.outside_domain ? " (outside the training domain)" : "",
                  c.predicted_curve.shape_k, c.predicted_curve.time_exponent);
+    results.push_back(std::move(c));
+  }
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const compare::ScrewComparison& c = results[i];
+    const screw::Screw* screw = screws[i].first;
+    const std::string& program = screws[i].second;
+    const std::string slug = compare::Slug(screw->name);
     const std::string provenance = "whirl demo, model " + model_source;
     const nlohmann::json plan_json =
         plan::PlanDocument(c.plan, c.predicted_curve, c.screw, c.kinematics,
@@ -192,7 +199,6 @@ void RunDemo(const DemoOptions& o) {
                  screw->name.c_str(), c.plan.segments.size(), c.plan.max_abs_slope,
                  c.plan.options.md32760, (out / slug).string().c_str(), program.c_str(),
                  program.c_str());
-    results.push_back(std::move(c));
   }
 
   files.Keep("report");
@@ -207,7 +213,7 @@ void RunDemo(const DemoOptions& o) {
                        std::to_string(o.seed) + (o.retrain ? " --retrain" : ""),
                    "model: " + model_source, "history (traditional rule): " + train_path};
   ro.notes = {
-      "The new-type screw is defined in code (compare::NewTypeScrew): the reference blank "
+      "The new-type screw is defined in the demo: the reference blank "
       "with hardness 61 HRC, diameter 63 mm, lead 12 mm, raceway radius 4.0 mm, cutting "
       "speed 200 m/min, a combination that is not a training row."};
   const compare::ReportResult report = compare::WriteReport(out / "report", results, ro);
@@ -231,11 +237,12 @@ void RunDemo(const DemoOptions& o) {
     std::fprintf(
         say,
         " %s: accumulated lead error within 1000 mm %.1f um (model), %.1f um (regression), "
-        "%.1f um (traditional), %.1f um (ramp), %.1f um (none); model %.0f %% less than "
-        "traditional;",
+        "%.1f um (traditional), %.1f um (ramp), %.1f um (none); model %s traditional;",
         c.screw.name.c_str(), um(compare::Strategy::kModel), um(compare::Strategy::kRegression),
         um(compare::Strategy::kTraditional), um(compare::Strategy::kRamp),
-        um(compare::Strategy::kNone), r.accumulated_1000_pct ? *r.accumulated_1000_pct : 0.0);
+        um(compare::Strategy::kNone),
+        compare::ReductionWords(r.accumulated_1000_pct ? *r.accumulated_1000_pct : 0.0, 0)
+            .c_str());
   }
   std::fprintf(say, " done in %.1f s\n", seconds);
   if (!o.json) return;

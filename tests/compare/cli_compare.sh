@@ -32,7 +32,7 @@ head -31 "$hist" | grep -v '^#' > own.csv; rows=$(($(wc -l < own.csv) - 1))
 grep -q "^history rules from: own.csv ($rows past screws)" own.txt
 grep -q "past screws of own.csv ($rows past screws)" own/index.html
 grep -q "whirling_500" own/index.html && exit 1
-grep -q "model (network" own/index.html && exit 1  # the model is any family, not only a network
+grep -q "model (network, 840D plan)" own/index.html || exit 1  # the legend names the model's own family (a network here)
 # Bad screw file -> exit 1 naming the file.
 echo '{"schema_version": 1, "name": "x"}' > bad.json
 if "$whirl" compare --model "$model" --screw bad.json --history "$hist" 2> err.txt; then exit 1; fi

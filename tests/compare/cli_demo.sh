@@ -5,7 +5,15 @@ whirl="$1"; scratch="$2"
 rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
 "$whirl" demo --out-dir out > demo.txt
 grep -q "summary:" demo.txt
-grep -q "% less" demo.txt
+grep -Eq "% (less|more) than traditional" demo.txt
+# A reduction is never negative in words ("model -5 % less"): a larger error says "more than".
+if grep -Eq -- "-[0-9.]+ % (less|more)" demo.txt; then echo "negative percentage in words"; exit 1; fi
+# The numbered steps print in order (not "3. 4. 3. 4.").
+steps=$(grep -oE "^[0-9]+\. " demo.txt | tr -d '. ' | tr '\n' ' ')
+sorted=$(grep -oE "^[0-9]+\. " demo.txt | tr -d '. ' | sort -n | tr '\n' ' ')
+[ "$steps" = "$sorted" ] || { echo "steps out of order: $steps"; exit 1; }
+# The report says what the new-type screw is, not the code's identifier.
+if grep -q "compare::" out/report/index.html; then echo "code identifier in the report"; exit 1; fi
 for f in reference_80x10x6000_plan.json reference_80x10x6000_plan.csv WHIRL_REFERENCE.SPF \
          new-type_63x12x6000_plan.json report/index.html report/report.json; do
   test -s "out/$f" || { echo "missing out/$f"; exit 1; }

@@ -89,6 +89,17 @@ TEST(Compare, ReductionsFollowTheirFormula) {
   EXPECT_DOUBLE_EQ(Stats({5, 1, 3}).worst_pct, 1);
 }
 
+// A larger error than the baseline's reads "more than", never "-5 % less than".
+TEST(Compare, ReductionWordsSayLessOrMore) {
+  lead::LeadMetrics model, traditional;
+  model.accumulated_1000_um = 10.5;
+  traditional.accumulated_1000_um = 10;
+  const double pct = *Reductions(model, traditional).accumulated_1000_pct;  // -5
+  EXPECT_EQ(ReductionWords(pct, 0), "5 % more than");
+  EXPECT_EQ(ReductionWords(75, 1), "75.0 % less than");
+  EXPECT_EQ(ReductionWords(0, 0), "0 % less than");
+}
+
 TEST(Compare, RandomScrewsAreFeasibleInRangeAndReproducible) {
   const auto a = RandomFeasibleScrews(screw::ReferenceScrew(), 30, 9);
   const auto b = RandomFeasibleScrews(screw::ReferenceScrew(), 30, 9);

@@ -95,10 +95,17 @@ TEST_F(ReportContent, ControlBoxComesFirstWithSettingDataFilesAndPrerequisites) 
             std::string::npos);
   EXPECT_NE(b.find("After an aborted cut"), std::string::npos);
   EXPECT_NE(b.find("WHIRL_T_RESET"), std::string::npos);
-  // Without files the box still gives the setting data and says where the programs come from.
+  // The demo's plan is placed on the machine's axis by its profile: positions in MCS.
+  EXPECT_NE(b.find("passes [mm, MCS]"), std::string::npos);
+  // Without files the box still gives the setting data and says where the programs come from;
+  // compare's plan has no machine profile: its positions count from the thread start, not MCS.
   const std::string bare = ReadTextFile(Write("whirl_report_bare", {}) / "index.html");
   EXPECT_NE(bare.find("writes no NC programs"), std::string::npos);
   EXPECT_NE(bare.find("SD43910 slope"), std::string::npos);
+  const std::string bare_box = bare.substr(0, bare.find("</section>"));
+  EXPECT_EQ(bare_box.find("MCS"), std::string::npos);
+  EXPECT_NE(bare_box.find("passes [mm from the thread start]"), std::string::npos);
+  EXPECT_NE(bare_box.find("SD43920 reference [mm from the thread start]"), std::string::npos);
 }
 
 TEST_F(ReportContent, EveryStrategyIsInTheDataAndThePlots) {
@@ -128,6 +135,29 @@ TEST_F(ReportContent, EveryStrategyIsInTheDataAndThePlots) {
   // The lead axis ends at the thread's end.
   EXPECT_NE(gp.find("set xrange [0:" + FormatNumber(c.screw.thread_length_mm) + "]"),
             std::string::npos);
+}
+
+// The legend names the model's real family: the shipped network as "network", a power law as
+// "power law" (never "network").
+TEST_F(ReportContent, LegendNamesTheModelsFamily) {
+  EXPECT_EQ(comparison_->model_family, "network");
+  const auto legend = [](const ScrewComparison& c, const std::string& name) {
+    const fs::path dir = whirl::test::ScratchDir() / name;
+    fs::remove_all(dir);
+    ReportOptions o;
+    o.plots = false;
+    WriteReport(dir, {c}, o);
+    return ReadTextFile(dir / (Slug(c.screw.name) + ".gp"));
+  };
+  EXPECT_NE(
+      legend(*comparison_, "whirl_report_legend_network").find("'model (network, 840D plan)'"),
+      std::string::npos);
+  ScrewComparison power = *comparison_;
+  power.model_family = "power law";
+  const std::string gp = legend(power, "whirl_report_legend_power");
+  EXPECT_NE(gp.find("'model (power law, 840D plan)'"), std::string::npos);
+  EXPECT_NE(gp.find("'compensation: model (power law, 840D plan)'"), std::string::npos);
+  EXPECT_EQ(gp.find("network"), std::string::npos);
 }
 
 TEST_F(ReportContent, PredictionBandContainsThePredictionAndWidensWithItsSd) {

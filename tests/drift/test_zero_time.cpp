@@ -3,6 +3,7 @@
 // the truth and where only a sensor explains the error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -151,6 +152,8 @@ TEST(Baselines, TimeOnlyIsTheTruth) {
   const HoldoutResult hr = Holdout(log, h);
   double time_mae = -1, mlr_mae = -1;
   for (const auto& row : hr.rows_out) {
+    const auto& methods = HoldoutMethods();  // the list the report's styles are checked against
+    EXPECT_NE(std::find(methods.begin(), methods.end(), row.method), methods.end()) << row.method;
     if (row.method == "time") time_mae = row.test.mae_um;
     if (row.method == "mlr") mlr_mae = row.test.mae_um;
   }

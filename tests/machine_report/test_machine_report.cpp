@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -17,6 +19,8 @@
 #include "core/error.h"
 #include "core/plot_style.h"
 #include "core/process.h"
+#include "drift/evaluation.h"
+#include "drift/monitor.h"
 #include "core/safe_text.h"
 #include "interp/drift_action.h"
 #include "machine/scenarios.h"
@@ -75,6 +79,31 @@ TEST(ReportStyle, EveryStrategyHasItsOwnEntryInTheStyleTable) {
   for (MachineStrategy s : machine_eval::MachineStrategies()) {
     const std::string name = machine_eval::ToString(s);
     EXPECT_NE(FindSeriesStyle(name), nullptr) << name << ": add it to core/plot_style.cpp";
+  }
+}
+
+// No two strategies of the workpiece and the machine comparison share a colour (the two lists
+// overlap and a name means one strategy in both), and no two names of the drift hold-out's
+// methods or the monitor's rules share one within their list; every name has its own entry.
+TEST(ReportStyle, NoTwoStrategiesShareAColour) {
+  std::vector<std::string> strategies;
+  for (compare::Strategy s : compare::kStrategies) strategies.push_back(compare::ToString(s));
+  for (MachineStrategy s : machine_eval::MachineStrategies())
+    if (std::find(strategies.begin(), strategies.end(), machine_eval::ToString(s)) ==
+        strategies.end())
+      strategies.push_back(machine_eval::ToString(s));
+  std::vector<std::string> rules;
+  for (drift::UpdateRule r : {drift::UpdateRule::kStatic, drift::UpdateRule::kPatent,
+                              drift::UpdateRule::kBayes, drift::UpdateRule::kOffset})
+    rules.push_back(drift::ToString(r));
+  for (const std::vector<std::string>& list : {strategies, drift::HoldoutMethods(), rules}) {
+    std::map<std::string_view, std::string> colour_of;
+    for (const std::string& name : list) {
+      const SeriesStyle* style = FindSeriesStyle(name);
+      ASSERT_NE(style, nullptr) << name << ": add it to core/plot_style.cpp";
+      const auto [it, added] = colour_of.emplace(style->colour, name);
+      EXPECT_TRUE(added) << name << " and " << it->second << " share " << style->colour;
+    }
   }
 }
 

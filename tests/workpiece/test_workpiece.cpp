@@ -222,6 +222,22 @@ TEST(WorkpieceModel, FileNumbersAreRangeCheckedAndPredictionsMustBeFinite) {
                    "output_noise_variance_normalized[1]' = 1e+308 breaks the rule");
 }
 
+// The legend's family words: the shipped network, a power law (linear/log), a GP.
+TEST(WorkpieceModel, FamilyLabelNamesTheChosenFamily) {
+  EXPECT_EQ(LoadWorkpieceModel(Shipped("models/default.json")).FamilyLabel(), "network");
+  const ProcessTable t = MakeTable(20, 0.05, 21);
+  TrainOptions power;
+  power.family = FamilyFlag::kLinear;
+  power.transform = TransformFlag::kLog;
+  const WorkpieceModel p = TrainWorkpieceModel(t, power, "generated.csv");
+  ASSERT_EQ(p.Describe(), "max_elongation_um: linear/log, settle_time_s: linear/log");
+  EXPECT_EQ(p.FamilyLabel(), "power law");
+  TrainOptions gp;
+  gp.family = FamilyFlag::kGaussianProcess;
+  gp.transform = TransformFlag::kIdentity;
+  EXPECT_EQ(TrainWorkpieceModel(t, gp, "generated.csv").FamilyLabel(), "Gaussian process");
+}
+
 TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
   const auto names = [](FamilyFlag f, TransformFlag t) {
     std::string s;

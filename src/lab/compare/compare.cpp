@@ -56,6 +56,10 @@ MetricReductions Reductions(const lead::LeadMetrics& s, const lead::LeadMetrics&
   return r;
 }
 
+std::string ReductionWords(double pct, int decimals) {
+  return FormatDecimals(std::abs(pct), decimals) + (pct < 0 ? " % more than" : " % less than");
+}
+
 const StrategyOutcome& ScrewComparison::Outcome(Strategy s) const {
   return outcomes[static_cast<std::size_t>(s)];
 }
@@ -69,8 +73,8 @@ std::string ScrewComparison::BriefReport() const {
     s += " " + ToString(o.strategy) + " " + FormatDecimals(o.metrics.accumulated_total_um, 1);
   s += " um";
   if (model_vs_traditional.accumulated_1000_pct)
-    s += " (model " + FormatDecimals(*model_vs_traditional.accumulated_1000_pct, 1) +
-         " % less than traditional within 1000 mm)";
+    s += " (model " + ReductionWords(*model_vs_traditional.accumulated_1000_pct, 1) +
+         " traditional within 1000 mm)";
   s += ", ISO class";
   for (const auto& o : outcomes) s += " " + ToString(o.strategy) + " " + ToString(o.iso.reached);
   return s;
@@ -186,6 +190,7 @@ ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::Workpie
   // Model: prediction -> arctangent curve -> 840D plan.
   c.prediction = workpiece::Predict(model, screw.process);
   c.model_description = model.Describe();
+  c.model_family = model.FamilyLabel();
   c.predicted_curve =
       fit::ArctanCurve::FromFeatures(c.prediction.mean, options.shape_k, options.time_exponent);
   c.predicted_curve.Validate("predicted curve of screw '" + screw.name + "'");

@@ -90,6 +90,9 @@ struct MetricReductions {
       accumulated_total_pct;
 };
 MetricReductions Reductions(const lead::LeadMetrics& strategy, const lead::LeadMetrics& baseline);
+/// A reduction in words, |pct| with `decimals` decimals: "12.3 % less than" (pct >= 0) or
+/// "5.0 % more than" (pct < 0: the strategy's error is larger than the baseline's).
+std::string ReductionWords(double pct, int decimals);
 
 struct ScrewComparison {
   screw::Screw screw;
@@ -103,6 +106,7 @@ struct ScrewComparison {
   Features truth_features;
   workpiece::Prediction prediction;  ///< model prediction for the screw's five inputs
   std::string model_description;     ///< workpiece::WorkpieceModel::Describe() of the model
+  std::string model_family;  ///< workpiece::WorkpieceModel::FamilyLabel(): "power law", ...
   fit::ArctanCurve predicted_curve;
   interp::CompensationPlan plan;
   ExperienceClass experience_class;  ///< the traditional rule's class of this screw

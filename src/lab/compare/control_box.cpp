@@ -11,11 +11,14 @@ namespace whirl::compare {
 namespace {
 
 // The plan's setting data, one row per segment, and the restoring row at the thread end.
-std::string SettingDataTable(const interp::CompensationPlan& plan) {
+// Positions in machine coordinates or, for a plan made without a machine profile, from the
+// thread start.
+std::string SettingDataTable(const interp::CompensationPlan& plan, bool machine_coordinates) {
+  const std::string unit = machine_coordinates ? "[mm, MCS]" : "[mm from the thread start]";
   std::ostringstream h;
   h << "<table><tr><th>segment</th><th>written when " << HtmlEscape(plan.options.axis)
-    << " passes [mm, MCS]</th><th>SD43900 K0 [mm]</th><th>SD43910 slope [-]</th>"
-       "<th>SD43920 reference [mm]</th></tr>\n";
+    << " passes " << unit << "</th><th>SD43900 K0 [mm]</th><th>SD43910 slope [-]</th>"
+    << "<th>SD43920 reference " << unit << "</th></tr>\n";
   for (std::size_t i = 0; i < plan.segments.size(); ++i) {
     const interp::CompensationSegment& s = plan.segments[i];
     h << "<tr><td>" << i + 1 << "</td><td>" << FormatFixed(s.p_a_mm, interp::kDecimalsPositionMm)
@@ -53,7 +56,7 @@ std::string LoadHtml(const plan::ControlLoad& load) {
   if (!load.call_order.empty()) h << "<p><b>Call:</b> " << HtmlEscape(load.call_order) << "</p>\n";
   h << "<p><b>Setting data the plan writes</b> (axis " << HtmlEscape(load.plan.options.axis)
     << ", sign " << interp::ToString(load.plan.options.sign) << "):</p>\n"
-    << SettingDataTable(load.plan);
+    << SettingDataTable(load.plan, load.machine_coordinates);
   if (!load.plan_note.empty()) h << "<p class='small'>" << HtmlEscape(load.plan_note) << "</p>\n";
   std::vector<std::string> needs;
   for (const interp::ControlRequirement& r : load.requirements) needs.push_back(ToString(r));

@@ -41,8 +41,9 @@ struct PlotFiles {
   std::string elongation, lead, lead_start;
 };
 
-// The legend's words for a strategy (the tables use the bare names).
-std::string StrategyLabel(Strategy s) {
+// The legend's words for a strategy (the tables use the bare names); `model_family` names the
+// model's family (workpiece::WorkpieceModel::FamilyLabel).
+std::string StrategyLabel(Strategy s, const std::string& model_family) {
   switch (s) {
     case Strategy::kNone:
       return "none (no compensation)";
@@ -53,7 +54,7 @@ std::string StrategyLabel(Strategy s) {
     case Strategy::kRegression:
       return "regression (log-linear features, 840D plan)";
     case Strategy::kModel:
-      return "model (workpiece model, 840D plan)";
+      return "model (" + model_family + ", 840D plan)";
     case Strategy::kClass:
       return "class (diameter-class means, 840D plan)";
     case Strategy::kTable:
@@ -112,7 +113,7 @@ std::string ElongationPlot(const ScrewComparison& c, const std::string& slug,
   int column = 6;
   for (Strategy st : CompensatingStrategies())
     s << ", \\\n  '' using 1:" << column++ << " " << GnuplotWith(ToString(st)) << " title "
-      << GnuplotString("compensation: " + StrategyLabel(st));
+      << GnuplotString("compensation: " + StrategyLabel(st, c.model_family));
   s << ", \\\n  " << GnuplotString(slug + "_points.csv")
     << " using 1:3 with points pt 7 ps 0.8 lc rgb '#000000' title 'SD43900/10/20 breakpoints "
        "(model plan)'\nset output\n";
@@ -123,8 +124,11 @@ std::string ElongationPlot(const ScrewComparison& c, const std::string& slug,
 std::string LeadPlot(const ScrewComparison& c, const std::string& slug, const std::string& png,
                      double x_end_mm, const std::string& title) {
   std::ostringstream s;
-  // The key below in two columns: room for its rows, the x label and the tick labels.
-  s << "set key below horizontal box maxcols 2\nset bmargin " << (c.outcomes.size() + 1) / 2 + 5
+  // The key below in two columns: room for its rows, the x label and the tick labels. gnuplot
+  // overestimates the width of pngcairo's text, so two columns of the long labels ran past the
+  // picture's right edge; "width -8" takes 8 characters off each column.
+  s << "set key below horizontal box maxcols 2 width -8\nset bmargin "
+    << (c.outcomes.size() + 1) / 2 + 5
     << "\nset output " << GnuplotString(png) << "\nset title "
     << GnuplotString(c.screw.name + ": " + title) << " noenhanced\n"
     << "set xlabel 'position from the thread start [mm]'\nset ylabel 'travel deviation [um]'\n"
@@ -132,7 +136,7 @@ std::string LeadPlot(const ScrewComparison& c, const std::string& slug, const st
   for (std::size_t k = 0; k < c.outcomes.size(); ++k)
     s << (k ? ", \\\n  '' " : GnuplotString(slug + "_lead.csv") + " ") << "using 1:" << k + 2 << " "
       << GnuplotWith(ToString(c.outcomes[k].strategy)) << " title "
-      << GnuplotString(StrategyLabel(c.outcomes[k].strategy));
+      << GnuplotString(StrategyLabel(c.outcomes[k].strategy, c.model_family));
   s << "\nset output\n";
   return s.str();
 }
@@ -380,8 +384,9 @@ std::vector<plan::ControlLoad> ControlLoads(const std::vector<ScrewComparison>& 
           "this command writes no NC programs; 'whirl plan' writes them for your machine (give "
           "it the model, the screw and the machine profile, see whirl plan --help).";
       load.plan_note =
-          "Setting data of this comparison's plan (positions from the plan options given here, "
-          "not from a machine profile): plan for your machine with 'whirl plan'.";
+          "Setting data of this comparison's plan (positions from the thread start, not placed "
+          "on a machine's axis by a machine profile): plan for your machine with 'whirl plan'.";
+      load.machine_coordinates = false;
     }
     load.heading = comparisons[i].screw.name;
     load.plan = comparisons[i].plan;
@@ -391,9 +396,10 @@ std::vector<plan::ControlLoad> ControlLoads(const std::vector<ScrewComparison>& 
 }
 
 // How to read the page; the strategies are listed from kStrategies.
-std::string HowToRead(const std::string& history) {
+std::string HowToRead(const std::string& history, const std::string& model_family) {
   std::string names;
-  for (Strategy s : kStrategies) names += (names.empty() ? "" : "; ") + StrategyLabel(s);
+  for (Strategy s : kStrategies)
+    names += (names.empty() ? "" : "; ") + StrategyLabel(s, model_family);
   return "<h2>How to read this page</h2>\n<p>Each screw is cut in the simulator (the ground "
          "truth, with seeded disturbances the model never saw) once per strategy: " +
          HtmlEscape(names) +
@@ -414,12 +420,13 @@ std::string HowToRead(const std::string& history) {
 // The page: title, provenance, the "load onto the control" box, notes, warnings, the screws'
 // sections, how to read it.
 std::string IndexHtml(const ReportOptions& options, const std::vector<std::string>& warnings,
-                      const std::vector<plan::ControlLoad>& loads, const std::string& sections) {
+                      const std::vector<plan::ControlLoad>& loads, const std::string& sections,
+                      const std::string& model_family) {
   std::ostringstream html;
   html << HtmlPageBegin(options.title, options.provenance) << ControlBoxHtml(loads);
   for (const auto& n : options.notes) html << "<p>" << HtmlEscape(n) << "</p>\n";
   for (const auto& w : warnings) html << "<p class='warn'>warning: " << HtmlEscape(w) << "</p>\n";
-  html << sections << HowToRead(options.history) << HtmlPageEnd();
+  html << sections << HowToRead(options.history, model_family) << HtmlPageEnd();
   return html.str();
 }
 
@@ -509,7 +516,8 @@ ReportResult WriteReport(const std::filesystem::path& dir,
                                  {"comparisons", report_json}};
   out.Add("report.json", JsonFileText(report));
   out.Add("index.html",
-          IndexHtml(options, result.warnings, ControlLoads(comparisons, options), body.str()));
+          IndexHtml(options, result.warnings, ControlLoads(comparisons, options), body.str(),
+                    comparisons.empty() ? "" : comparisons.front().model_family));
   result.files = out.Commit();
   result.index_html = dir / "index.html";
   return result;

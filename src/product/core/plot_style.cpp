@@ -8,33 +8,47 @@
 namespace whirl {
 
 const std::vector<SeriesStyle>& SeriesStyles() {
-  // "both" is drawn before its variants and thicker, so a variant that coincides with it (dotted,
-  // thin) shows on top of it instead of hiding it.
+  // Every strategy of the workpiece and the machine comparison has a colour of its own (Tableau
+  // 10 for the workpiece comparison, Tableau 20b's dark tones for the rows only the machine
+  // evaluation has); the drift methods and monitor rules reuse those colours with dash patterns
+  // no strategy has, distinct within their own report. "both_shop" is drawn thicker than its
+  // monitored variant, which carries open circles, so the two stay apart where they coincide.
   // One entry a line (clang-format off keeps it so, and a new strategy a one-line change).
   // clang-format off
   static const std::vector<SeriesStyle> kStyles = {
       {"measured",     "#000000", 1, 2.0},
       {"prediction",   "#1f77b4", 3, 1.5},
+      {"residual",     "#d62728", 1, 1.5},
+      // The strategies of the workpiece comparison (compare::kStrategies).
       {"none",         "#7f7f7f", 1, 2.0},
       {"ramp",         "#8c564b", 4, 2.0},
       {"traditional",  "#ff7f0e", 2, 2.0},
       {"regression",   "#9467bd", 5, 1.5, 4},
       {"model",        "#1f77b4", 1, 2.5},
-      {"workpiece",    "#1f77b4", 2, 2.0},
-      {"machine",      "#e377c2", 2, 2.0},
-      {"both",         "#2ca02c", 1, 3.5},
-      {"both_idle",    "#bcbd22", 4, 1.5},
-      {"both_monitor", "#d62728", 1, 1.0, 6},
-      // The history rules (traditional is the strongest of them) and the shop's machine rows.
-      {"class",        "#ff7f0e", 4, 1.5},
+      {"class",        "#bcbd22", 4, 1.5},
       {"table",        "#17becf", 1, 1.5},
-      {"nearest",      "#17becf", 2, 1.5},
-      {"warmup",       "#8c564b", 2, 1.5},
-      {"schedule",     "#e377c2", 4, 1.5},
-      {"machine_shop", "#e377c2", 1, 1.5},
-      {"both_shop",    "#2ca02c", 2, 2.5},
-      {"lead_slope",   "#8c564b", 5, 1.5},
-      {"both_shop_monitor", "#d62728", 2, 2.0}};
+      {"nearest",      "#e377c2", 2, 1.5},
+      // The rows only the machine evaluation has (machine_eval::MachineStrategies()).
+      {"workpiece",    "#393b79", 2, 2.0},
+      {"warmup",       "#b8860b", 2, 1.5},
+      {"schedule",     "#7b4173", 4, 1.5},
+      {"lead_slope",   "#637939", 5, 1.5},
+      {"machine_shop", "#843c39", 1, 1.5},
+      {"both_shop",    "#2ca02c", 1, 3.5},
+      {"both_shop_monitor", "#d62728", 2, 1.0, 6},
+      // The drift hold-out's methods (drift::HoldoutMethods(); "none" as above).
+      {"fit",          "#1f77b4", 2, 2.0},
+      {"time",         "#ff7f0e", 5, 1.5},
+      {"mlr_all",      "#9467bd", 1, 1.5},
+      {"mlr",          "#17becf", 2, 1.5},
+      {"dynamic",      "#2ca02c", 4, 1.5},
+      {"network",      "#e377c2", 1, 1.5},
+      {"dynamic_extra", "#8c564b", 2, 1.5},
+      // The drift monitor's update rules (drift::UpdateRule).
+      {"static",       "#7f7f7f", 2, 1.5},
+      {"patent",       "#ff7f0e", 1, 1.5},
+      {"bayes",        "#2ca02c", 2, 1.5},
+      {"offset",       "#9467bd", 4, 1.5}};
   // clang-format on
   return kStyles;
 }
@@ -56,6 +70,15 @@ std::string GnuplotWith(std::string_view name) {
   std::string with = buf;
   if (s->point) with += " pt " + std::to_string(s->point) + " ps 0.9 pn 40";
   return with;
+}
+
+std::string GnuplotKeyOutsideRight(double right_edge) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "set key outside right top Left reverse\nset lmargin at screen 0.08\n"
+                "set rmargin at screen %g\n",
+                right_edge);
+  return buf;
 }
 
 const std::vector<std::string_view>& SeriesPalette() {

@@ -1,11 +1,15 @@
 #pragma once
 // How every whirl plot draws a series: one colour, one dash pattern and one line width per
-// compensation strategy (and for the measured truth and the prediction), the same in the
-// workpiece report, the machine report and any later plot, so a dashed orange line always means
-// "traditional" and a solid blue one always "model". The table is the only place a strategy's
-// look is defined; tests/core checks that no two entries look alike and that every strategy of
-// compare::Strategy and machine_eval::MachineStrategy has an entry.
-// Colours: the Tableau 10 palette (as in matplotlib's "tab10"), black for measurements.
+// compensation strategy, drift method and monitor rule (and for the measured truth, the
+// prediction and the residual), the same in the workpiece report, the machine report, the drift
+// reports and the monitor report, so a dashed orange line always means "traditional" and a solid
+// blue one always "model". The table is the only place a series' look is defined; tests/core
+// checks that no two entries look alike; tests/machine_report checks that every name of every
+// evaluation's list (compare::kStrategies, machine_eval::MachineStrategies(),
+// drift::HoldoutMethods(), drift::UpdateRule) has an entry and that no two strategies of the
+// workpiece and machine comparisons, and no two names of one list, share a colour.
+// Colours: the Tableau 10 palette (as in matplotlib's "tab10") and the dark tones of Tableau 20b,
+// black for measurements.
 // Dash types are gnuplot's (1 solid, 2 dashed, 3 dotted, 4 dash-dot, 5 dash-dot-dot); point types
 // gnuplot's too (4 open square, 6 open circle).
 #include <cstddef>
@@ -21,15 +25,16 @@ struct SeriesStyle {
   int dash = 1;             ///< gnuplot dash type, 1..5
   double width = 2;         ///< line width, gnuplot units
   /// gnuplot point type marked at 40 places along the line (0: none): how a series that often
-  /// coincides with a thicker one (both_monitor with both, regression with model) stays visible
-  /// (a dash pattern vanishes on a line of many short segments).
+  /// coincides with a thicker one (both_shop_monitor with both_shop, regression with model) stays
+  /// visible (a dash pattern vanishes on a line of many short segments).
   int point = 0;
 };
 
-/// The table: measured (truth), prediction, then the strategies none, ramp, traditional,
-/// regression, model (the workpiece comparison), workpiece, machine, both, both_idle,
-/// both_monitor (the machine evaluation), the history rules class, table, nearest and the shop's
-/// machine rows warmup, schedule, machine_shop, both_shop, lead_slope.
+/// The table: measured (truth), prediction, residual, then the strategies none, ramp,
+/// traditional, regression, model, class, table, nearest (the workpiece comparison), the machine
+/// evaluation's own rows workpiece, warmup, schedule, lead_slope, machine_shop, both_shop,
+/// both_shop_monitor, the drift hold-out's methods fit, time, mlr_all, mlr, dynamic, network,
+/// dynamic_extra and the monitor's rules static, patent, bayes, offset.
 const std::vector<SeriesStyle>& SeriesStyles();
 
 /// The entry named `name`, or nullptr when the table has none.
@@ -39,6 +44,11 @@ const SeriesStyle* FindSeriesStyle(std::string_view name);
 /// type "with linespoints lc rgb '#d62728' lw 1 dt 1 pt 6 ps 0.9 pn 40" (pn: gnuplot >= 5.4). A
 /// name without an entry gets thin grey dots (visible, and obviously not one of the table's looks).
 std::string GnuplotWith(std::string_view name);
+
+/// gnuplot lines that put the key beside the plot, right of the data (never on it), with the
+/// plot area fixed from 8 % to `right_edge` of the picture's width so the panels of a multiplot
+/// line up whatever their keys' widths.
+std::string GnuplotKeyOutsideRight(double right_edge = 0.8);
 
 /// Eight well-separated colours for plots of many unnamed series (sensors), in order.
 const std::vector<std::string_view>& SeriesPalette();

@@ -54,6 +54,12 @@ std::string CrossRunGroup::Strongest() const {
   return best;
 }
 
+const std::vector<std::string>& HoldoutMethods() {
+  static const std::vector<std::string> kMethods = {"none",    "fit",     "time",   "mlr_all",
+                                                    "mlr",     "dynamic", "network", "dynamic_extra"};
+  return kMethods;
+}
+
 std::vector<std::pair<std::string, std::string>> HoldoutResult::Strongest() const {
   std::vector<std::pair<std::string, std::string>> out;
   std::map<std::string, const HoldoutRow*> best;

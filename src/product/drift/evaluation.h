@@ -137,6 +137,11 @@ struct HoldoutResult {
   std::vector<std::pair<std::string, std::string>> Strongest() const;  ///< (channel, method)
 };
 
+/// Every method a hold-out row can name (HoldoutOptions' list, in the order Holdout adds them):
+/// none, fit, time, mlr_all, mlr, dynamic, network, dynamic_extra. The report draws each in its
+/// look of core/plot_style.h.
+const std::vector<std::string>& HoldoutMethods();
+
 HoldoutResult Holdout(const Run& log, const HoldoutOptions& options,
                       const std::function<void(const std::string&)>& progress = {});
 

@@ -10,6 +10,7 @@
 #include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
+#include "core/plot_style.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
@@ -433,7 +434,7 @@ std::string MonitorGnuplot(const MonitorResult& r, const std::string& prefix = "
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1100,700 font 'Sans,10' noenhanced\nset output "
      << GnuplotString(prefix + "monitor.png") << "\n"
-     << "set datafile separator ','\nset key outside right\nset grid\nset xlabel "
+     << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
      << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset arrow from "
      << FormatNumber((r.last_time - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
      << ", graph 0 to "
@@ -445,20 +446,24 @@ std::string MonitorGnuplot(const MonitorResult& r, const std::string& prefix = "
             " and the models (dashed: monitoring starts; open: valid checks, filled: invalid "
             "checks and refit measurements)")
      << "\nplot " << GnuplotString(prefix + "plot_timeline.csv") << " using " << x
-     << ":2 with lines lc rgb 'black' lw 2 title 'measured'";
+     << ":2 " << GnuplotWith("measured") << " title 'measured'";
+  // Each rule in its look of core/plot_style.h, its checks in its colour.
+  const auto rule = [&r](std::size_t i) { return ToString(r.strategies[i].rule); };
+  const auto colour = [&rule](std::size_t i) {
+    const SeriesStyle* s = FindSeriesStyle(rule(i));
+    return "rgb '" + std::string(s ? s->colour : "#aaaaaa") + "'";
+  };
   for (std::size_t i = 0; i < q; ++i)
-    gp << ", '' using " << x << ":" << i + 3 << " with lines lc " << i + 1 << " title "
-       << GnuplotString(ToString(r.strategies[i].rule));
+    gp << ", '' using " << x << ":" << i + 3 << " " << GnuplotWith(rule(i)) << " title "
+       << GnuplotString(rule(i));
   for (std::size_t i = 1; i < q; ++i)
     gp << ", " << GnuplotString(prefix + "checks.csv") << " index " << i << " using " << x
-       << ":($3==0?$2:1/0) with points pt 6 lc "
-       << i + 1 << " notitle, '' index " << i << " using " << x
-       << ":($3==1?$2:1/0) with points pt 7 lc " << i + 1 << " notitle";
+       << ":($3==0?$2:1/0) with points pt 6 lc " << colour(i) << " notitle, '' index " << i
+       << " using " << x << ":($3==1?$2:1/0) with points pt 7 lc " << colour(i) << " notitle";
   gp << "\nset title 'residual (measured - model)'\nset ylabel 'residual [um]'\nplot ";
   for (std::size_t i = 0; i < q; ++i)
     gp << (i ? ", " : "") << GnuplotString(prefix + "plot_timeline.csv") << " using " << x << ":"
-       << i + 3 + q << " with lines lc "
-       << i + 1 << " title " << GnuplotString(ToString(r.strategies[i].rule));
+       << i + 3 + q << " " << GnuplotWith(rule(i)) << " title " << GnuplotString(rule(i));
   gp << "\nunset multiplot\n";
   return "# gnuplot script written by whirl; re-run: gnuplot " + prefix + "monitor.gp\n" + gp.str();
 }

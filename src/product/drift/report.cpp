@@ -11,6 +11,7 @@
 #include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
+#include "core/plot_style.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
@@ -341,17 +342,21 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
     const std::string x = p.time_from_index ? "sample" : "time [h]";
     const std::string xcol = p.time_from_index ? "1" : "($1/60)";
     std::ostringstream gp;
-    gp << "set datafile separator ','\nset key top left\nset grid\nset xlabel " << GnuplotString(x)
-       << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\nset title "
-       << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column) << "\nplot "
-       << GnuplotString(plot_csv) << " using " << xcol
-       << ":2 with lines lw 2 title 'predicted'";
+    // The line looks of core/plot_style.h; the key right of the data, the panels aligned.
+    gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
+       << GnuplotString(x) << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\n"
+       << "set title "
+       << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column)
+       << "\nplot " << GnuplotString(plot_csv) << " using " << xcol
+       << ":($2-$4):($2+$4) with filledcurves fs transparent solid 0.15 noborder lc rgb '"
+       << FindSeriesStyle("prediction")->colour << "' title 'predicted +- 1 sd', '' using "
+       << xcol << ":2 " << GnuplotWith("prediction") << " title 'predicted'";
     if (p.has_measured)
-      gp << ", '' using " << xcol << ":5 with lines lc rgb 'black' title 'measured'";
+      gp << ", '' using " << xcol << ":5 " << GnuplotWith("measured") << " title 'measured'";
     gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
     if (p.has_measured)
-      gp << "plot " << GnuplotString(plot_csv) << " using " << xcol
-         << ":6 with lines lc rgb 'red' title 'residual'\n";
+      gp << "plot " << GnuplotString(plot_csv) << " using " << xcol << ":6 "
+         << GnuplotWith("residual") << " title 'residual'\n";
     else
       gp << "plot 0 notitle\n";
     gp << "unset multiplot\n";
@@ -403,20 +408,22 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const 
     w.File(slug + "_holdout.csv",
            FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
     std::ostringstream gp;
-    gp << "set datafile separator ','\nset key outside right\nset grid\nset xlabel 'time [h]'\n"
+    // Each method in its look of core/plot_style.h; the key right of the data.
+    gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight()
+       << "set grid\nset xlabel 'time [h]'\n"
        << "set arrow from " << r.train_end_min / 60 << ", graph 0 to " << r.train_end_min / 60
        << ", graph 1 nohead dt 2\nset multiplot layout 2,1\nset ylabel 'error [um]'\nset title "
        << GnuplotString(ch + ": measured and predicted (dashed line: end of training)") << "\nplot "
-       << GnuplotString(slug + "_holdout.csv")
-       << " using ($1/60):2 with lines lc rgb 'black' lw 2 title 'measured'";
+       << GnuplotString(slug + "_holdout.csv") << " using ($1/60):2 " << GnuplotWith("measured")
+       << " title 'measured'";
     for (std::size_t c = 1; c < idx.size(); ++c)
-      gp << ", '' using ($1/60):" << c + 3 << " with lines lc " << c << " title "
-         << GnuplotString(r.rows_out[idx[c]].method);
-    gp << ", '' using ($1/60):2 with lines lc rgb 'black' lw 2 notitle";
+      gp << ", '' using ($1/60):" << c + 3 << " " << GnuplotWith(r.rows_out[idx[c]].method)
+         << " title " << GnuplotString(r.rows_out[idx[c]].method);
+    gp << ", '' using ($1/60):2 " << GnuplotWith("measured") << " notitle";  // on top
     gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\nplot ";
     for (std::size_t c = 1; c < idx.size(); ++c)
       gp << (c > 1 ? ", " : "") << GnuplotString(slug + "_holdout.csv") << " using ($1/60):($2-$"
-         << c + 3 << ") with lines lc " << c << " title "
+         << c + 3 << ") " << GnuplotWith(r.rows_out[idx[c]].method) << " title "
          << GnuplotString(r.rows_out[idx[c]].method);
     gp << "\nunset multiplot\n";
     h << "<h2>" << HtmlEscape(ch) << "</h2>\n"

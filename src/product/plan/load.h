@@ -20,6 +20,10 @@ namespace whirl::plan {
 struct ControlLoad {
   std::string heading;            ///< e.g. the screw's name
   interp::CompensationPlan plan;  ///< its setting data
+  /// Whether the plan's positions (trigger positions, SD43920) are machine coordinates (MCS: the
+  /// plan options or a machine profile placed the thread on the axis); false: millimetres from
+  /// the thread start (a plan made without a machine profile, as `compare` makes it).
+  bool machine_coordinates = true;
   /// Extra words under the setting-data table (e.g. "handed to the drift action via $AC_PARAM").
   std::string plan_note;
   /// (href relative to the report page, what it is), in the order of loading; empty: `no_files`.

@@ -171,6 +171,37 @@ std::string WorkpieceModel::Describe() const {
   return "network " + sizes;
 }
 
+namespace {
+
+std::string FamilyWords(const family::Candidate& c) {
+  switch (c.family) {
+    case family::Family::kLinear:
+      return c.log ? "power law" : "linear";
+    case family::Family::kNetwork:
+      return "network";
+    case family::Family::kGaussianProcess:
+      return "Gaussian process";
+  }
+  return c.Name();
+}
+
+}  // namespace
+
+std::string WorkpieceModel::FamilyLabel() const {
+  if (kind == Kind::kNetwork) return "network";
+  std::array<std::string, Features::kCount> words;
+  for (std::size_t k = 0; k < words.size(); ++k) {
+    const auto m = static_cast<std::size_t>(choice.model_of_output[k]);
+    if (!choice.weights[k].empty())
+      words[k] = "stack";
+    else if (m < choice.models.size())
+      words[k] = FamilyWords(choice.models[m].candidate);
+    else
+      words[k] = FamilyWords(choice.table.at(static_cast<std::size_t>(choice.chosen[k])).candidate);
+  }
+  return words[0] == words[1] ? words[0] : words[0] + " / " + words[1];
+}
+
 WorkpieceModel FromNetwork(nn::Model network) {
   WorkpieceModel m;
   m.kind = WorkpieceModel::Kind::kNetwork;

@@ -51,6 +51,10 @@ struct WorkpieceModel {
   bool IsNetwork() const { return kind == Kind::kNetwork; }
   /// "network 5-6-2" or "max_elongation_um: linear/log, settle_time_s: gp-matern52-constant/log".
   std::string Describe() const;
+  /// The model's family in words for a legend: "network", "power law" (linear/log), "linear",
+  /// "Gaussian process", "stack"; two outputs of different families "power law / Gaussian
+  /// process" (max elongation / settle time).
+  std::string FamilyLabel() const;
 };
 
 /// A network as a workpiece model (its domain and provenance copied).
