@@ -64,6 +64,9 @@ own_files() {
     > "$dir/curves/screw01.csv"
   # 24 screws measured over the years (rows of the shipped history, no comment lines).
   grep -v '^#' "$SRC/datasets/whirling_500.csv" | awk 'NR == 1 || (NR > 100 && NR <= 124)' > "$dir/table.csv"
+  # The screw types the shop makes (candidates for `whirl design`): the five inputs of 40 rows.
+  grep -v '^#' "$SRC/datasets/whirling_500.csv" | cut -d, -f1-5 | awk 'NR == 1 || (NR > 200 && NR <= 240)' \
+    > "$dir/types.csv"
   # Cutting logs every minute for 4 h: four of the profile's sensors and the check-bar offset.
   for r in 1 2 3; do
     awk -v r="$r" 'BEGIN { print "time_min,t1_C,t2_C,t3_C,t4_C,offset_um"

@@ -7,6 +7,7 @@ namespace whirl::cli {
 
 void RegisterTrain(CLI::App& app);       // cmd_train.cpp
 void RegisterPredict(CLI::App& app);     // cmd_predict.cpp
+void RegisterDesign(CLI::App& app);      // cmd_design.cpp
 void RegisterSimulate(CLI::App& app);    // cmd_simulate.cpp
 void RegisterDataset(CLI::App& app);     // cmd_dataset.cpp
 void RegisterCurve(CLI::App& app);       // cmd_curve.cpp

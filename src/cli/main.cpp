@@ -12,6 +12,7 @@ const whirl::cli::CommandSummaries kSummaries = {
     {"simulate", "simulate one screw's elongation [um] over time [s] and its two features"},
     {"train", "train a workpiece model on a process table (family chosen by default) and write it"},
     {"predict", "max elongation [um] and settle time [s] of screws, with their sd"},
+    {"design", "which screws to measure: first design, next screws, stop rule"},
     {"curve", "the arctangent elongation curve of a screw [um over s]"},
     {"fit", "fit curve models to a measured or simulated elongation curve"},
     {"plan", "SD43900/43910/43920 and the 840D programs for one screw"},
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   RegisterSimulate(app);
   RegisterTrain(app);
   RegisterPredict(app);
+  RegisterDesign(app);
   RegisterCurve(app);
   RegisterFit(app);
   RegisterPlan(app);

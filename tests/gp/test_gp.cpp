@@ -309,3 +309,32 @@ TEST(GpFit, SubsetsOfLargeTables) {
 
 }  // namespace
 }  // namespace whirl::gp
+
+namespace whirl::gp {
+namespace {
+
+// Data that the mean explains exactly drive the likelihood's noise sd towards 0 (a design's table of
+// 8-12 screws of the simulator did: ln s_n = -46.6, and 'whirl train' refused to write its own
+// model); the fit keeps ln s_n within the file's rule [-30, 30], so its model saves and loads.
+TEST(GpFit, ExactDataGiveASavableNoiseLevel) {
+  Eigen::MatrixXd x(2, 14);
+  Eigen::VectorXd y(14);
+  for (int i = 0; i < 14; ++i) {
+    x(0, i) = std::sin(0.9 * i), x(1, i) = std::cos(1.7 * i);
+    y(i) = 1 + 2 * x(0, i) - x(1, i);
+  }
+  GpOptions o;
+  o.mean = Mean::kLinear;
+  // From a start whose noise sd is already far below the floor, where the likelihood no longer
+  // moves it (its gradient vanishes there): the optimizer leaves it at ln s_n = -50.
+  Eigen::VectorXd start(4);
+  start << 0.5, 0.5, 0.0, -50.0;
+  const Gp g = FitGpFrom(x, y, o, start);
+  EXPECT_GE(g.theta(g.theta.size() - 1), -30.0);
+  nlohmann::json j = g;
+  Gp back;
+  EXPECT_NO_THROW(from_json(j, back));
+}
+
+}  // namespace
+}  // namespace whirl::gp

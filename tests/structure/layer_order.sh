@@ -21,7 +21,8 @@ PRODUCT_LAYERS=(
                                # fits and features (core only)
   "family drift"               # model families (gp, nn), drift (nn)
   "interp workpiece"           # 840D output (drift, fit), the workpiece model (family, nn)
-  "plan ballbar surface"       # plan files (interp, screw), ball bar (interp), worktable (drift, interp)
+  "plan ballbar surface design"  # plan files (interp, screw), ball bar (interp), worktable (drift,
+                               # interp), which screws to measure (workpiece)
 )
 LAB_LAYERS=(
   "sim torch synthetic"        # the simulator, the LibTorch cross-check (nn), synthetic ball-bar

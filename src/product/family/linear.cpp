@@ -81,6 +81,14 @@ LinearPrediction PredictLinear(const LinearModel& m, const Eigen::MatrixXd& x) {
   return p;
 }
 
+Eigen::MatrixXd LatentCovariance(const LinearModel& m, const Eigen::MatrixXd& x) {
+  if (x.rows() != m.input_shift.size())
+    throw InputError("linear model: covariances need " + std::to_string(m.input_shift.size()) +
+                     " inputs, got " + std::to_string(x.rows()));
+  const Eigen::MatrixXd a = Design(m, x);
+  return m.fitted_noise_variance * a * m.ata_inv * a.transpose();
+}
+
 LinearLeaveOneOut LeaveOneOutLinear(const LinearModel& m, const Eigen::MatrixXd& x,
                                     const Eigen::VectorXd& y) {
   const Eigen::MatrixXd a = Design(m, x);

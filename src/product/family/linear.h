@@ -35,6 +35,9 @@ struct LinearPrediction {
   Eigen::VectorXd latent_variance;  ///< s^2 a*' (A'A)^-1 a*
 };
 LinearPrediction PredictLinear(const LinearModel& m, const Eigen::MatrixXd& x);
+/// The latent covariance of the fit at x (d x q): s^2 A* (A'A)^-1 A*', q x q, units of y squared;
+/// its diagonal is PredictLinear's latent_variance.
+Eigen::MatrixXd LatentCovariance(const LinearModel& m, const Eigen::MatrixXd& x);
 
 /// Closed-form leave-one-out of the training rows (header comment), units of y.
 struct LinearLeaveOneOut {

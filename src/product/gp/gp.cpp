@@ -271,6 +271,11 @@ Gp FitFromStarts(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const GpOpt
   const int count = static_cast<int>(sub.u.size()) < o.single_start_rows ? o.restarts : 1;
   Optimize(o, starts.empty() ? StartPoints(sub, count) : starts, &sub, summary);
   gp.theta = sub.theta;
+  // A noise sd the likelihood drove to 0 (ln below -30: exp(-60) = 9e-27 standardized variance,
+  // far below min_noise_variance's 1e-12 floor) is written as -30, the rule a file's numbers
+  // must keep (kThetaRange below): the same predictions, and a model file that loads.
+  const Eigen::Index noise = gp.theta.size() - 1;
+  gp.theta(noise) = std::max(gp.theta(noise), -30.0);
   gp.noise_variance = gp.SigmaN2();
   gp.Factorize();
   return gp;
@@ -419,6 +424,25 @@ GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x) {
   p.latent_variance = (latent * gp.target_scale * gp.target_scale).matrix();
   p.noise_variance = gp.noise_variance * gp.target_scale * gp.target_scale;
   return p;
+}
+
+Eigen::MatrixXd PosteriorCovariance(const Gp& gp, const Eigen::MatrixXd& x) {
+  const int d = gp.InputCount();
+  if (x.rows() != d)
+    throw InputError("gaussian process: covariances need " + std::to_string(d) +
+                     " inputs, got " + std::to_string(x.rows()));
+  const Eigen::MatrixXd zs =
+      gp.input_scale.cwiseInverse().asDiagonal() * (x.colwise() - gp.input_shift);
+  const Eigen::VectorXd length = gp.theta.head(d).array().exp();
+  const double sf2 = std::exp(2.0 * gp.theta(d));
+  Eigen::MatrixXd ks, kss;
+  KernelMatrices(gp.kernel, gp.z, zs, length, sf2, &ks, nullptr);  // n x q
+  KernelMatrices(gp.kernel, zs, zs, length, sf2, &kss, nullptr);   // q x q
+  const Eigen::MatrixXd v = gp.chol.matrixL().solve(ks);
+  const Eigen::MatrixXd r = Basis(gp.mean, zs).transpose() - gp.k_inv_h.transpose() * ks;
+  const Eigen::MatrixXd ar = gp.a_chol.matrixL().solve(r);
+  const Eigen::MatrixXd c = kss - v.transpose() * v + ar.transpose() * ar;
+  return c * (gp.target_scale * gp.target_scale);
 }
 
 // The diagonal of P = K^-1 - K^-1 H (H' K^-1 H)^-1 H' K^-1 (the header's leave-one-out comment).

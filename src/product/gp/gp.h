@@ -179,6 +179,10 @@ struct GpPrediction {
   Eigen::VectorXd Stddev() const;   ///< sqrt(latent + noise)
 };
 GpPrediction PredictGp(const Gp& gp, const Eigen::MatrixXd& x);
+/// The latent posterior covariance of the function at x (d x q, original units), q x q in units
+/// of y squared, mean coefficients included (R&W eq. 2.41): its diagonal is
+/// PredictGp(gp, x).latent_variance. Used to ask what a new row would change (design/design.h).
+Eigen::MatrixXd PosteriorCovariance(const Gp& gp, const Eigen::MatrixXd& x);
 
 /// Closed-form leave-one-out of the training rows (header comment), units of y.
 struct LeaveOneOut {

@@ -1,0 +1,274 @@
+#!/usr/bin/python3
+"""Which screws to measure: test RMSE of the default `whirl train` model against the number of
+measured screws N for four ways of choosing them (docs/design.md, src/product/design/design.h).
+
+Per problem and seed: a candidate list ("pool", the screw types coming up) of POOL_ROWS screws with
+their noisy measured targets, and a test set with the noise-free truth. Every strategy picks its N
+screws from the pool (it can only measure what production makes), the default model is trained on
+them (`whirl train`, seed 1) and its test RMSE per output is measured against the truth:
+  random   the first N of a random order of the pool;
+  lhs      a Latin hypercube of N points over the pool's input box (McKay, Beckman & Conover 1979),
+           each matched to the nearest unused pool screw (inputs scaled to the box);
+  natural  the shop's natural order: production in campaigns of CAMPAIGN screws of one product
+           family (the pool split by the nearest of FAMILIES random centres), families in random
+           order;
+  design   `whirl design`: a first design of FIRST screws (--criterion), then batches of --batch
+           next screws from the model trained on the screws so far (`whirl design --model`).
+Problems: "simgen" (pool: `whirl dataset --count POOL_ROWS --seed 200000 + seed`, the simulator;
+test: datasets/whirling_500.csv, whose targets carry the simulator's scatter) and the generator
+families of scripts/bench_peers.py (pool: the family's training rows at POOL_ROWS; test: its 1000
+noise-free rows). `whirl train` refuses fewer than 8 rows, so N starts at 8 (N = 6 is reported as
+untrainable for every strategy).
+
+Usage: python3 scripts/design_study.py --whirl build/whirl --problems simgen,powerlaw \\
+         --seeds 1-10 --criterion d --batch 4 --json out.json [--plot out.png]
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_peers as bp  # noqa: E402
+
+POOL_ROWS = 200
+SIZES = [8, 12, 16, 20, 30]
+FIRST = 8
+CAMPAIGN = 5
+FAMILIES = 6
+STRATEGIES = ["random", "lhs", "natural", "design"]
+
+
+def run(cmd):
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        kept = ""
+        if "--data" in cmd:  # keep the table that failed to train for a bug report
+            kept = os.path.join(tempfile.gettempdir(), "design_study_failed_" + os.path.basename(
+                os.path.dirname(cmd[cmd.index("--data") + 1])) + ".csv")
+            shutil.copy(cmd[cmd.index("--data") + 1], kept)
+            kept = f" (table kept: {kept})"
+        sys.exit(f"design_study: {' '.join(cmd)} failed{kept}: {r.stderr}")
+    return r.stdout
+
+
+def problem(prob, seed, whirl, datasets, cache):
+    """(pool x, pool y, test x, test truth)."""
+    if prob == "simgen":
+        path = os.path.join(cache, f"pool_{seed}.csv")
+        if not os.path.exists(path):
+            run([whirl, "dataset", "--count", str(POOL_ROWS), "--seed", str(200000 + seed),
+                 "--out", path, "--threads", "1"])
+        x, y = bp.read_table(path)
+        xte, yte = bp.read_table(os.path.join(datasets, "whirling_500.csv"))
+        return x, y, xte, yte
+    x, y, xte, fte, _ = bp.generated(prob, POOL_ROWS, seed)
+    return x, y, xte, fte
+
+
+def unit(x, lo, hi):
+    return (x - lo) / np.where(hi > lo, hi - lo, 1.0)
+
+
+def lhs_pick(x, n, rng):
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    u = unit(x, lo, hi)
+    pts = (np.array([rng.permutation(n) for _ in range(x.shape[1])]).T + rng.uniform(size=(n, 5))) / n
+    used, out = set(), []
+    for p in pts:
+        d = ((u - p) ** 2).sum(axis=1)
+        for i in np.argsort(d):
+            if i not in used:
+                used.add(i)
+                out.append(int(i))
+                break
+    return out
+
+
+def natural_order(x, rng):
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    u = unit(x, lo, hi)
+    centres = rng.uniform(size=(FAMILIES, 5))
+    fam = np.argmin(((u[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
+    queues = {f: list(rng.permutation(np.flatnonzero(fam == f))) for f in range(FAMILIES)}
+    order = []
+    while len(order) < len(x):
+        live = [f for f in queues if queues[f]]
+        f = live[rng.integers(len(live))]
+        order += [int(i) for i in queues[f][:CAMPAIGN]]
+        queues[f] = queues[f][CAMPAIGN:]
+    return order
+
+
+class Evaluator:
+    def __init__(self, whirl, tmp, x, y, xte, truth):
+        self.whirl, self.tmp, self.x, self.y, self.truth = whirl, tmp, x, y, truth
+        self.test = os.path.join(tmp, "test.csv")
+        bp.write_table(self.test, xte)
+
+    def train(self, rows, name):
+        data, model = (os.path.join(self.tmp, f"{name}.{e}") for e in ("csv", "json"))
+        bp.write_table(data, self.x[rows], self.y[rows])
+        run([self.whirl, "train", "--data", data, "--out", model, "--seed", "1", "--threads", "1"])
+        return model
+
+    def rmse(self, model):
+        p = json.loads(run([self.whirl, "predict", "--model", model, "--input", self.test, "--json"]))
+        mean = np.array([[r["max_elongation_um"], r["settle_time_s"]] for r in p["predictions"]])
+        return bp.rmse(mean, self.truth).tolist()
+
+
+def designed(ev, criterion, batch, first_lhs=None):
+    """RMSE per size of the sequential design: FIRST by the first design (or the Latin hypercube
+    picks `first_lhs`), then batches."""
+    pool = os.path.join(ev.tmp, "pool.csv")
+    bp.write_table(pool, ev.x)
+    if first_lhs is not None:
+        picked = list(first_lhs)
+    else:
+        out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
+                              "--criterion", criterion, "--json"]))
+        picked = [int(p["source"].split()[1]) - 2 for p in out["picks"]]  # line -> row
+    result = {}
+    while True:
+        model = ev.train(picked, "design")
+        if len(picked) in SIZES:
+            result[len(picked)] = ev.rmse(model)
+        if len(picked) >= max(SIZES):
+            return result
+        nxt = min(s for s in SIZES if s > len(picked))
+        k = min(batch, nxt - len(picked))
+        left = [i for i in range(len(ev.x)) if i not in set(picked)]
+        cand = os.path.join(ev.tmp, "left.csv")
+        bp.write_table(cand, ev.x[left])
+        out = json.loads(run([ev.whirl, "design", "--model", model, "--candidates", cand,
+                              "--count", str(k), "--json"]))
+        picked += [left[int(p["source"].split()[1]) - 2] for p in out["picks"]]
+
+
+def one_case(prob, seed, a, cache):
+    with tempfile.TemporaryDirectory() as tmp:
+        x, y, xte, truth = problem(prob, seed, a.whirl, a.datasets, cache)
+        ev = Evaluator(a.whirl, tmp, x, y, xte, truth)
+        rng = np.random.default_rng([42, seed, len(prob)])
+        res = {}
+        if not a.design_only:
+            order = [int(i) for i in rng.permutation(len(x))]
+            nat = natural_order(x, rng)
+            res["random"] = {n: ev.rmse(ev.train(order[:n], "r")) for n in SIZES}
+            res["lhs"] = {n: ev.rmse(ev.train(lhs_pick(x, n, rng), "l")) for n in SIZES}
+            res["natural"] = {n: ev.rmse(ev.train(nat[:n], "n")) for n in SIZES}
+        first = lhs_pick(x, FIRST, np.random.default_rng([7, seed])) if a.first == "lhs" else None
+        res["design"] = designed(ev, a.criterion, a.batch, first)
+        return prob, seed, res
+
+
+def seeds_of(text):
+    lo, _, hi = text.partition("-")
+    return list(range(int(lo), int(hi or lo) + 1))
+
+
+def summarize(results, problems):
+    """Median over seeds of RMSE per output, per problem, strategy and size."""
+    table = {}
+    for prob in problems:
+        cases = [r for p, _, r in results if p == prob]
+        table[prob] = {}
+        for s in STRATEGIES:
+            if not all(s in r for r in cases):
+                continue
+            table[prob][s] = {n: np.median([r[s][n] for r in cases], axis=0).tolist()
+                              for n in SIZES}
+    return table
+
+
+def print_markdown(table):
+    for prob, rows in table.items():
+        for k, out in enumerate(bp.TARGETS):
+            print(f"\n{prob}, {out}: median test RMSE over seeds (N = {', '.join(map(str, SIZES))})\n")
+            print("| strategy | " + " | ".join(f"N={n}" for n in SIZES) + " |")
+            print("|---|" + "---|" * len(SIZES))
+            for s, r in rows.items():
+                print(f"| {s} | " + " | ".join(f"{r[n][k]:.4g}" for n in SIZES) + " |")
+            if "random" in rows and "design" in rows:
+                r20 = rows["random"][20][k]
+                reach = [n for n in SIZES if rows["design"][n][k] <= r20]
+                worse = [n for n in SIZES if rows["design"][n][k] > rows["random"][n][k]]
+                print(f"\ndesign reaches random@20 ({r20:.4g}) at N = {reach[0] if reach else 'never'}"
+                      f"; worse than random at N = {worse or 'none'}")
+
+
+def plot(table, path, gnuplot="gnuplot"):
+    with tempfile.TemporaryDirectory() as tmp:
+        cmds = [f"set terminal pngcairo size 1400,{420 * len(table)} font ',10'",
+                f"set output '{path}'", f"set multiplot layout {len(table)},2",
+                "set logscale y", "set xlabel 'measured screws N'", "set key top right",
+                "set grid", "set termoption noenhanced"]
+        for prob, rows in table.items():
+            for k, out in enumerate(bp.TARGETS):
+                files = []
+                for s, r in rows.items():
+                    f = os.path.join(tmp, f"{prob}_{k}_{s}.dat")
+                    with open(f, "w") as h:
+                        h.writelines(f"{n} {r[n][k]}\n" for n in SIZES)
+                    files.append((f, s))
+                cmds.append(f"set title '{prob}: {out} (median test RMSE)'")
+                cmds.append("plot " + ", ".join(f"'{f}' using 1:2 with linespoints title '{s}'"
+                                                 for f, s in files))
+        cmds.append("unset multiplot")
+        script = os.path.join(tmp, "p.gp")
+        with open(script, "w") as h:
+            h.write("\n".join(cmds) + "\n")
+        subprocess.run([gnuplot, script], check=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--whirl", default="build/whirl")
+    ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
+    ap.add_argument("--problems", default="simgen,powerlaw")
+    ap.add_argument("--seeds", default="1-10")
+    ap.add_argument("--criterion", default="d", choices=["d", "i"])
+    ap.add_argument("--batch", type=int, default=2)
+    ap.add_argument("--first", default="design", choices=["design", "lhs"],
+                    help="the design strategy's first 8 screws: whirl design, or a Latin hypercube")
+    ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
+    ap.add_argument("--design-only", action="store_true", help="only the design strategy")
+    ap.add_argument("--sim-cache", default=os.path.join(tempfile.gettempdir(), "whirl_design_sim"))
+    ap.add_argument("--json", help="write every case's RMSE and the medians here")
+    ap.add_argument("--plot", help="PNG of the medians (gnuplot)")
+    ap.add_argument("--from-json", help="print (and --plot) the medians of an earlier --json run")
+    a = ap.parse_args()
+    if a.from_json:
+        saved = json.load(open(a.from_json))
+        table = {p: {s: {int(n): v for n, v in r.items()} for s, r in rows.items()}
+                 for p, rows in saved["medians"].items()}
+        print(f"criterion {saved['criterion']}, batch {saved['batch']}, seeds {saved['seeds']}")
+        print_markdown(table)
+        if a.plot:
+            plot(table, a.plot)
+        return
+    os.makedirs(a.sim_cache, exist_ok=True)
+    problems = a.problems.split(",")
+    cases = [(p, s) for p in problems for s in seeds_of(a.seeds)]
+    with ThreadPoolExecutor(max_workers=min(a.jobs, 2)) as pool:
+        results = list(pool.map(lambda c: one_case(c[0], c[1], a, a.sim_cache), cases))
+    table = summarize(results, problems)
+    print(f"criterion {a.criterion}, batch {a.batch}, seeds {a.seeds}, pool {POOL_ROWS}")
+    print_markdown(table)
+    if a.json:
+        with open(a.json, "w") as h:
+            json.dump({"criterion": a.criterion, "batch": a.batch, "seeds": a.seeds,
+                       "cases": results, "medians": table}, h)
+    if a.plot:
+        plot(table, a.plot)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,306 @@
+// whirl design: which screws to measure (src/product/design/design.h): the first design for the power
+// law on log inputs, or the next screws from a trained model's uncertainty, with the stop rule.
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/numbers.h"
+#include "core/output_dir.h"
+#include "core/process.h"
+#include "design/design.h"
+#include "workpiece/model.h"
+
+namespace whirl::cli {
+namespace {
+
+struct DesignCliOptions {
+  std::string candidates_path, model_path, out_path;
+  std::array<std::string, ProcessInputs::kCount> ranges;
+  int count = 0, levels = 3;
+  std::string criterion = "d";
+  double tolerance_um = 0, tolerance_s = 0;
+  bool json = false;
+};
+
+const std::array<const char*, ProcessInputs::kCount> kDesignRangeFlags = {
+    "--hardness-hrc-range", "--diameter-mm-range", "--pitch-mm-range",
+    "--raceway-radius-mm-range", "--cutting-speed-m-min-range"};
+
+// "LO..HI" (or one value for an input the shop keeps fixed).
+std::pair<double, double> ParseDesignRange(const std::string& flag, const std::string& text) {
+  const auto dots = text.find("..");
+  const auto lo = ParseDecimal(dots == std::string::npos ? text : text.substr(0, dots));
+  const auto hi = dots == std::string::npos ? lo : ParseDecimal(text.substr(dots + 2));
+  if (!lo || !hi)
+    throw InputError(flag + " '" + text + "': expected LO..HI with two decimal numbers, e.g. 6..16");
+  return {*lo, *hi};
+}
+
+// The candidate list and where each came from ("line N" of the CSV, or "grid").
+struct DesignCandidates {
+  std::string source;
+  std::vector<ProcessInputs> inputs;
+  std::vector<int> lines;  // empty for a grid
+};
+
+DesignCandidates ReadDesignCandidates(const DesignCliOptions& o) {
+  DesignCandidates c;
+  std::string given, missing;
+  for (int j = 0; j < ProcessInputs::kCount; ++j)
+    (o.ranges[j].empty() ? missing : given) += std::string(" ") + kDesignRangeFlags[j];
+  if (!o.candidates_path.empty()) {
+    if (!given.empty())
+      throw InputError("design: give either --candidates CSV or the ranges, not both (got" +
+                       given + ")");
+    const ProcessTable t = ReadProcessTable(o.candidates_path, /*require_targets=*/false);
+    if (t.inputs.empty())
+      throw InputError(o.candidates_path + ": the candidate list is empty (a header and no rows)");
+    c.source = o.candidates_path;
+    c.inputs = t.inputs;
+    c.lines = t.line_numbers;
+    return c;
+  }
+  if (!missing.empty())
+    throw InputError("design: give --candidates CSV or all five ranges (missing:" + missing + ")");
+  design::InputRanges r;
+  for (int j = 0; j < ProcessInputs::kCount; ++j)
+    std::tie(r.lo[j], r.hi[j]) = ParseDesignRange(kDesignRangeFlags[j], o.ranges[j]);
+  r.Validate(kDesignRangeFlags);
+  c.inputs = design::GridCandidates(r, o.levels);
+  c.source = "grid of " + std::to_string(o.levels) + " levels per input (log spacing), " +
+             std::to_string(c.inputs.size()) + " candidates";
+  return c;
+}
+
+std::string WhereFrom(const DesignCandidates& c, int i) {
+  return c.lines.empty() ? "grid " + std::to_string(i + 1) : "line " + std::to_string(c.lines[i]);
+}
+
+nlohmann::json InputsJson(const ProcessInputs& x) {
+  nlohmann::json j;
+  const auto a = x.ToArray();
+  for (int i = 0; i < ProcessInputs::kCount; ++i) j[kInputColumns[i]] = a[i];
+  return j;
+}
+
+// The CSV of the picks (both modes): rank, where, five inputs, the sd columns, why.
+std::string DesignCsv(const DesignCandidates& c, const std::vector<design::Pick>& picks,
+                      bool next, const std::string& command) {
+  std::ostringstream s;
+  s << "# whirl design: " << command << "\n# candidates: " << c.source << "\n";
+  s << (next ? "# sd: predictive sd now and expected after measuring this screw and those ranked "
+               "before it (um, s)\n"
+             : "# sd_factor: sd of the power law's ln prediction at this screw in units of the "
+               "relative measurement scatter, before and after it (in the ranked order)\n");
+  s << "rank,source";
+  for (auto* col : kInputColumns) s << "," << col;
+  s << (next ? ",max_elongation_sd_now_um,max_elongation_sd_after_um,settle_time_sd_now_s,"
+               "settle_time_sd_after_s"
+             : ",sd_factor_before,sd_factor_after");
+  s << ",why\n";
+  for (std::size_t r = 0; r < picks.size(); ++r) {
+    const auto& p = picks[r];
+    s << r + 1 << "," << WhereFrom(c, p.candidate);
+    for (double v : c.inputs[p.candidate].ToArray()) s << "," << FormatNumber(v);
+    if (next)
+      s << "," << FormatNumber(p.sd_now[0]) << "," << FormatNumber(p.sd_after[0]) << ","
+        << FormatNumber(p.sd_now[1]) << "," << FormatNumber(p.sd_after[1]);
+    else
+      s << "," << (std::isfinite(p.sd_now[0]) ? FormatNumber(p.sd_now[0]) : "") << ","
+        << FormatNumber(p.sd_after[0]);
+    s << ",\"" << p.why << "\"\n";  // why: library text without quotes
+  }
+  return s.str();
+}
+
+std::string InputsText(const ProcessInputs& x) {
+  const auto a = x.ToArray();
+  std::string t;
+  for (int i = 0; i < ProcessInputs::kCount; ++i)
+    t += (i ? " " : "") + FormatSignificant(a[i], 4);
+  return t;
+}
+
+void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
+  const auto d = design::DesignPowerLaw(c.inputs, o.count, design::ParseCriterion(o.criterion));
+  const std::string csv = DesignCsv(c, d.picks, false, "first design, criterion " + o.criterion);
+  if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
+  if (o.json) {
+    nlohmann::json picks = nlohmann::json::array();
+    for (std::size_t r = 0; r < d.picks.size(); ++r) {
+      const auto& p = d.picks[r];
+      picks.push_back({{"rank", r + 1}, {"source", WhereFrom(c, p.candidate)},
+                       {"inputs", InputsJson(c.inputs[p.candidate])},
+                       {"sd_factor_before", std::isfinite(p.sd_now[0]) ? nlohmann::json(p.sd_now[0])
+                                                                       : nlohmann::json(nullptr)},
+                       {"sd_factor_after", p.sd_after[0]}, {"why", p.why}});
+    }
+    PrintJson({{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
+               {"candidate_count", c.inputs.size()}, {"coefficients", d.coefficients},
+               {"varying_inputs", d.inputs}, {"log_det_per_screw", d.log_det},
+               {"mean_sd_factor", d.mean_sd_factor}, {"max_sd_factor", d.max_sd_factor},
+               {"picks", picks}});
+    return;
+  }
+  std::cout << "first design (" << (o.criterion == "d" ? "D" : "I") << "-optimal for the power law "
+            << "on log inputs): " << o.count << " of " << c.inputs.size() << " candidates ("
+            << c.source << ")\n";
+  std::cout << "rank  source      " << JoinFields({kInputColumns.begin(), kInputColumns.end()})
+            << "\n";
+  for (std::size_t r = 0; r < d.picks.size(); ++r) {
+    const auto& p = d.picks[r];
+    std::printf("%4zu  %-10s  %s\n      why: %s\n", r + 1, WhereFrom(c, p.candidate).c_str(),
+                InputsText(c.inputs[p.candidate]).c_str(), p.why.c_str());
+  }
+  std::cout << "expected prediction sd of ln y over the candidates: mean "
+            << FormatSignificant(d.mean_sd_factor, 3) << ", max "
+            << FormatSignificant(d.max_sd_factor, 3)
+            << " times the relative measurement scatter (5 % scatter: mean "
+            << FormatSignificant(5 * d.mean_sd_factor, 3) << " %), if the power law holds\n";
+  if (o.count < 8)
+    std::cout << "note: 'whirl train' needs at least 8 rows; measure " << 8 - o.count
+              << " more (whirl design --model) before training\n";
+  if (!o.out_path.empty()) std::cout << "written: " << o.out_path << "\n";
+}
+
+void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
+  const auto model = workpiece::LoadWorkpieceModel(o.model_path);
+  design::StopRule rule;
+  rule.tolerance = {o.tolerance_um, o.tolerance_s};
+  design::NextDesign d;
+  try {
+    d = design::DesignNext(model, c.inputs, o.count, rule, c.lines);
+  } catch (const InputError& e) {
+    throw InputError("design --model " + o.model_path + " --candidates " + c.source + ": " +
+                     e.what());
+  }
+  const std::string csv = DesignCsv(c, d.picks, true, "next screws from " + o.model_path);
+  if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
+  if (o.json) {
+    nlohmann::json picks = nlohmann::json::array();
+    for (std::size_t r = 0; r < d.picks.size(); ++r) {
+      const auto& p = d.picks[r];
+      picks.push_back({{"rank", r + 1}, {"source", WhereFrom(c, p.candidate)},
+                       {"inputs", InputsJson(c.inputs[p.candidate])},
+                       {"max_elongation_sd_now_um", p.sd_now[0]},
+                       {"max_elongation_sd_after_um", p.sd_after[0]},
+                       {"settle_time_sd_now_s", p.sd_now[1]},
+                       {"settle_time_sd_after_s", p.sd_after[1]}, {"why", p.why}});
+    }
+    nlohmann::json j = {{"mode", "next"}, {"model", o.model_path},
+                        {"model_describe", model.Describe()}, {"candidates", c.source},
+                        {"candidate_count", c.inputs.size()}, {"picks", picks},
+                        {"rms_sd_now", {{"max_elongation_um", d.rms_sd_now[0]},
+                                        {"settle_time_s", d.rms_sd_now[1]}}},
+                        {"rms_sd_after", {{"max_elongation_um", d.rms_sd_after[0]},
+                                          {"settle_time_s", d.rms_sd_after[1]}}},
+                        {"rms_sd_floor", {{"max_elongation_um", d.rms_sd_floor[0]},
+                                          {"settle_time_s", d.rms_sd_floor[1]}}}};
+    if (!d.stop.empty())
+      j["stop"] = {{"decision", d.stop}, {"tolerance_um", o.tolerance_um},
+                   {"tolerance_s", o.tolerance_s}, {"reason", d.stop_reason},
+                   {"screws_to_tolerance", d.screws_to_tolerance}};
+    PrintJson(j);
+    return;
+  }
+  std::cout << "next screws (integrated variance reduction of " << model.Describe() << "): "
+            << o.count << " of " << c.inputs.size() << " candidates (" << c.source << ")\n";
+  std::cout << "rank  source      inputs (" << JoinFields({kInputColumns.begin(), kInputColumns.end()})
+            << ")\n      sd now -> after: max_elongation [um], settle_time [s]\n";
+  for (std::size_t r = 0; r < d.picks.size(); ++r) {
+    const auto& p = d.picks[r];
+    std::printf("%4zu  %-10s  %s\n      sd %s -> %s um, %s -> %s s\n      why: %s\n", r + 1,
+                WhereFrom(c, p.candidate).c_str(), InputsText(c.inputs[p.candidate]).c_str(),
+                FormatSignificant(p.sd_now[0], 3).c_str(), FormatSignificant(p.sd_after[0], 3).c_str(),
+                FormatSignificant(p.sd_now[1], 3).c_str(), FormatSignificant(p.sd_after[1], 3).c_str(),
+                p.why.c_str());
+  }
+  std::cout << "RMS predictive sd over the list: max_elongation " << FormatSignificant(d.rms_sd_now[0], 3)
+            << " -> " << FormatSignificant(d.rms_sd_after[0], 3) << " um (floor "
+            << FormatSignificant(d.rms_sd_floor[0], 3) << "), settle_time "
+            << FormatSignificant(d.rms_sd_now[1], 3) << " -> " << FormatSignificant(d.rms_sd_after[1], 3)
+            << " s (floor " << FormatSignificant(d.rms_sd_floor[1], 3) << ")\n";
+  if (!d.stop.empty()) std::cout << "stop rule: " << d.stop << ": " << d.stop_reason << "\n";
+  if (!o.out_path.empty()) std::cout << "written: " << o.out_path << "\n";
+}
+
+void RunDesign(const DesignCliOptions& o) {
+  CheckOutputs({{"--candidates", o.candidates_path}, {"--model", o.model_path}},
+               {{"--out", o.out_path}});
+  if (o.model_path.empty() && (o.tolerance_um > 0 || o.tolerance_s > 0))
+    throw InputError("design: --tolerance-um / --tolerance-s need --model (the stop rule judges a "
+                     "trained model's predictive sd)");
+  const DesignCandidates c = ReadDesignCandidates(o);
+  if (o.model_path.empty()) {
+    try {
+      RunFirstDesign(o, c);
+    } catch (const InputError& e) {
+      throw InputError(c.source + ": " + e.what());
+    }
+  } else {
+    RunNextScrews(o, c);
+  }
+}
+
+}  // namespace
+
+void RegisterDesign(CLI::App& app) {
+  auto o = std::make_shared<DesignCliOptions>();
+  auto* sub = app.add_subcommand(
+      "design",
+      "Which screws to measure (src/product/design/design.h; evidence in docs/design.md).\n"
+      "First design (no --model): the --count screws that best determine the power law of the\n"
+      "five inputs (D- or I-optimal on log inputs), from --candidates CSV (the screw types the\n"
+      "shop makes: columns hardness_hrc, diameter_mm, pitch_mm, raceway_radius_mm,\n"
+      "cutting_speed_m_min; other columns ignored) or from a grid over the five ranges.\n"
+      "Next screws (--model M.json from 'whirl train'): the --count candidates whose measurement\n"
+      "most reduces the model's predictive variance over the list (integrated variance\n"
+      "reduction, greedy batch), each with its predictive sd now and expected after.\n"
+      "Stop rule (--tolerance-um, --tolerance-s with --model): says whether the RMS predictive\n"
+      "sd over the list is within tolerance (measurements no longer pay), cannot get there\n"
+      "(the scatter alone is above it), or about how many more screws it takes.\n"
+      "Output: a text table with why each screw was picked; --json; --out FILE writes a CSV.");
+  sub->add_option("--count", o->count, "number of screws to pick (first design: at least the "
+                                       "power law's coefficients, 6)")
+      ->required()
+      ->check(NumberIn(1, 100000));
+  sub->add_option("--candidates", o->candidates_path, "candidate screws (CSV, five input columns)")
+      ->check(CLI::ExistingFile);
+  const std::array<const char*, ProcessInputs::kCount> what = {
+      "hardness range LO..HI [HRC]", "diameter range LO..HI [mm]", "pitch (lead) range LO..HI [mm]",
+      "raceway radius range LO..HI [mm]", "cutting speed range LO..HI [m/min]"};
+  for (int j = 0; j < ProcessInputs::kCount; ++j)
+    sub->add_option(kDesignRangeFlags[j], o->ranges[j],
+                    std::string(what[j]) + " (instead of --candidates; one value: fixed)");
+  sub->add_option("--levels", o->levels,
+                  "grid levels per input over the ranges, log spacing")
+      ->capture_default_str()
+      ->check(NumberIn(2, 9));
+  sub->add_option("--criterion", o->criterion,
+                  "first design: d (D-optimal: the power law's coefficients) or i (I-optimal: its "
+                  "mean prediction variance over the candidates)")
+      ->capture_default_str();
+  sub->add_option("--model", o->model_path,
+                  "trained family model ('whirl train' default): next screws instead of a first "
+                  "design")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--tolerance-um", o->tolerance_um,
+                  "stop rule: tolerated RMS predictive sd of max elongation over the list [um]")
+      ->check(PositiveNumber("um"));
+  sub->add_option("--tolerance-s", o->tolerance_s,
+                  "stop rule: tolerated RMS predictive sd of settle time over the list [s]")
+      ->check(PositiveNumber("s"));
+  sub->add_option("--out", o->out_path, "write the picked screws as CSV (rank, source line, "
+                                        "inputs, sd columns, why)");
+  sub->add_flag("--json", o->json, "machine output: JSON on stdout");
+  sub->callback([o] { RunDesign(*o); });
+}
+
+}  // namespace whirl::cli

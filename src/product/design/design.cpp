@@ -1,0 +1,469 @@
+// Designs for the workpiece model's training table (design.h).
+#include "design/design.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "core/error.h"
+#include "core/limits.h"
+#include "core/numbers.h"
+#include "family/family.h"
+#include "family/linear.h"
+#include "family/transform.h"
+#include "gp/gp.h"
+
+namespace whirl::design {
+namespace {
+
+// ---- First design: the power law on log inputs -----------------------------------------------
+
+// Rows f(x_c) = (1, standardized ln x_j of the varying inputs), candidates x coefficients.
+Eigen::MatrixXd PowerLawRows(const std::vector<ProcessInputs>& cands,
+                             std::vector<std::string>* names) {
+  const int n = static_cast<int>(cands.size());
+  Eigen::MatrixXd logs(n, ProcessInputs::kCount);
+  for (int c = 0; c < n; ++c) {
+    const auto a = cands[c].ToArray();
+    for (int j = 0; j < ProcessInputs::kCount; ++j) logs(c, j) = std::log(a[j]);
+  }
+  std::vector<int> used;
+  for (int j = 0; j < ProcessInputs::kCount; ++j) {
+    const double spread = logs.col(j).maxCoeff() - logs.col(j).minCoeff();
+    if (spread > 1e-12) used.push_back(j);
+  }
+  Eigen::MatrixXd f(n, 1 + static_cast<int>(used.size()));
+  f.col(0).setOnes();
+  for (std::size_t u = 0; u < used.size(); ++u) {
+    const Eigen::VectorXd v = logs.col(used[u]);
+    const double mean = v.mean();
+    const double sd = std::sqrt((v.array() - mean).square().mean());
+    f.col(1 + static_cast<int>(u)) = (v.array() - mean) / sd;
+    names->push_back(kInputColumns[used[u]]);
+  }
+  return f;
+}
+
+// The criterion (larger is better) of the rows `picked` of f; -inf when F'F is singular.
+double CriterionValue(const Eigen::MatrixXd& f, const std::vector<int>& picked, Criterion c,
+                 const Eigen::MatrixXd& w) {
+  const int p = static_cast<int>(f.cols());
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p, p);
+  for (int i : picked) m.noalias() += f.row(i).transpose() * f.row(i);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
+  const Eigen::VectorXd d = ldlt.vectorD();
+  if (ldlt.info() != Eigen::Success || d.minCoeff() <= 1e-10 * std::max(1.0, d.maxCoeff()))
+    return -std::numeric_limits<double>::infinity();
+  if (c == Criterion::kD) return d.array().log().sum();
+  return -(ldlt.solve(w)).trace();  // mean_c f_c' M^-1 f_c = tr(M^-1 W)
+}
+
+// Greedy start: each pick the candidate of largest f' (M + eps I)^-1 f (the D rule of Wynn).
+std::vector<int> GreedyStart(const Eigen::MatrixXd& f, int count) {
+  const int p = static_cast<int>(f.cols());
+  Eigen::MatrixXd m = 1e-6 * Eigen::MatrixXd::Identity(p, p);
+  std::vector<int> picked;
+  std::vector<char> taken(f.rows(), 0);
+  for (int k = 0; k < count; ++k) {
+    const Eigen::MatrixXd mi = m.inverse();
+    int best = -1;
+    double best_v = -1;
+    for (int c = 0; c < f.rows(); ++c) {
+      if (taken[c]) continue;
+      const double v = f.row(c) * mi * f.row(c).transpose();
+      if (v > best_v * (1 + 1e-12)) best_v = v, best = c;
+    }
+    taken[best] = 1;
+    picked.push_back(best);
+    m.noalias() += f.row(best).transpose() * f.row(best);
+  }
+  return picked;
+}
+
+// Fedorov exchanges until no swap improves the criterion (at most 50 passes).
+void Exchange(const Eigen::MatrixXd& f, Criterion c, const Eigen::MatrixXd& w,
+              std::vector<int>* picked) {
+  std::vector<char> taken(f.rows(), 0);
+  for (int i : *picked) taken[i] = 1;
+  double value = CriterionValue(f, *picked, c, w);
+  for (int pass = 0; pass < 50; ++pass) {
+    bool improved = false;
+    for (auto& slot : *picked) {
+      for (int cand = 0; cand < f.rows(); ++cand) {
+        if (taken[cand]) continue;
+        const int old = slot;
+        slot = cand;
+        const double v = CriterionValue(f, *picked, c, w);
+        if (v > value + 1e-9 * std::max(1.0, std::abs(value))) {
+          taken[old] = 0, taken[cand] = 1, value = v, improved = true;
+        } else {
+          slot = old;
+        }
+      }
+    }
+    if (!improved) break;
+  }
+}
+
+// The explaining order: each next screw has the highest variance factor given those before it.
+std::vector<Pick> ExplainingOrder(const Eigen::MatrixXd& f, const std::vector<int>& design) {
+  const int p = static_cast<int>(f.cols());
+  Eigen::MatrixXd m = 1e-9 * Eigen::MatrixXd::Identity(p, p);
+  std::vector<int> left = design;
+  std::vector<Pick> out;
+  while (!left.empty()) {
+    const Eigen::MatrixXd mi = m.inverse();
+    std::size_t best = 0;
+    double best_v = -1;
+    for (std::size_t i = 0; i < left.size(); ++i) {
+      const double v = f.row(left[i]) * mi * f.row(left[i]).transpose();
+      if (v > best_v * (1 + 1e-12)) best_v = v, best = i;
+    }
+    const int c = left[best];
+    left.erase(left.begin() + static_cast<long>(best));
+    Pick pick;
+    pick.candidate = c;
+    const bool first = static_cast<int>(out.size()) < p;
+    m.noalias() += f.row(c).transpose() * f.row(c);
+    const double after = f.row(c) * m.inverse() * f.row(c).transpose();
+    pick.sd_now = {first ? std::numeric_limits<double>::infinity() : std::sqrt(best_v), 0};
+    pick.sd_after = {std::sqrt(after), 0};
+    pick.why = first ? "one of the " + std::to_string(p) +
+                           " screws that determine the power law's coefficients (spread in the "
+                           "log inputs)"
+                     : "the power law's prediction is least known here given the screws before "
+                       "it: sd factor " + FormatSignificant(std::sqrt(best_v), 3) + " -> " +
+                           FormatSignificant(std::sqrt(after), 3);
+    out.push_back(pick);
+  }
+  return out;
+}
+
+// ---- Next screws: integrated variance reduction --------------------------------------------
+
+// One output's state over the candidates: latent covariance in the transformed space, the
+// delta method's factor, the calibrated prediction noise and the fitted noise of a new row.
+struct OutputState {
+  Eigen::MatrixXd cov;
+  Eigen::VectorXd g;
+  double prediction_noise = 0, measurement_noise = 0;
+  double weight = 1;  // 1 / mean predictive variance now (original units)
+  double Variance(int c) const { return g(c) * g(c) * (std::max(cov(c, c), 0.0) + prediction_noise); }
+  double Rms() const {
+    double s = 0;
+    for (Eigen::Index c = 0; c < g.size(); ++c) s += Variance(static_cast<int>(c));
+    return std::sqrt(s / static_cast<double>(g.size()));
+  }
+  double FloorRms() const {
+    return std::sqrt(g.array().square().mean() * prediction_noise);
+  }
+  double Reduction(int j) const {  // sum_c g_c^2 C[c,j]^2 / (C[j,j] + s^2)
+    const double denom = std::max(cov(j, j), 0.0) + measurement_noise;
+    if (denom <= 0) return 0;
+    return (g.array().square() * cov.col(j).array().square()).sum() / denom;
+  }
+  void Measure(int j) {
+    const double denom = std::max(cov(j, j), 0.0) + measurement_noise;
+    if (denom <= 0) return;
+    const Eigen::VectorXd col = cov.col(j);
+    cov.noalias() -= col * col.transpose() / denom;
+  }
+};
+
+void CheckUsedInputs(const family::FamilyModel& m, const workpiece::WorkpieceModel& model,
+                     const std::vector<ProcessInputs>& cands, const std::vector<int>& lines) {
+  for (int j = 0; j < ProcessInputs::kCount; ++j) {
+    if (m.transform.input_used[j]) continue;
+    const double trained = model.domain_min(j);
+    for (std::size_t c = 0; c < cands.size(); ++c) {
+      const double v = cands[c].ToArray()[j];
+      if (std::abs(v - trained) > 1e-9 * std::max(1.0, std::abs(trained)))
+        throw InputError(
+            std::string("the model leaves out ") + kInputColumns[j] + " (constant " +
+            FormatSignificant(trained, 6) + " in its training table '" + model.training_data +
+            "'), but " +
+            (lines.size() == cands.size() ? "line " + std::to_string(lines[c])
+                                          : "candidate " + std::to_string(c + 1)) +
+            " has " + kInputColumns[j] + " = " +
+            FormatSignificant(v, 6) + ": the model cannot say what that input changes; train it "
+            "on a table that varies " + kInputColumns[j] + " or keep the candidates at " +
+            FormatSignificant(trained, 6));
+    }
+  }
+}
+
+OutputState StateOf(const family::FamilyModel& m, int k, const Eigen::MatrixXd& x_used,
+                    const Eigen::VectorXd& mean_z) {
+  OutputState s;
+  const auto t = m.transform.outputs[k];
+  s.g.resize(mean_z.size());
+  for (Eigen::Index c = 0; c < mean_z.size(); ++c)
+    s.g(c) = family::InverseDerivative(t, mean_z(c));
+  if (m.candidate.family == family::Family::kLinear) {
+    const auto& lin = m.linears[k];
+    s.cov = family::LatentCovariance(lin, x_used);
+    s.prediction_noise = lin.noise_variance;
+    s.measurement_noise = lin.fitted_noise_variance;
+  } else {
+    const auto& gp = m.gps[k];
+    s.cov = gp::PosteriorCovariance(gp, x_used);
+    s.prediction_noise = gp.noise_variance * gp.target_scale * gp.target_scale;
+    s.measurement_noise = gp.SigmaN2() * gp.target_scale * gp.target_scale;
+  }
+  return s;
+}
+
+const family::FamilyModel& ModelOfOutput(const workpiece::WorkpieceModel& model, int k) {
+  if (model.IsNetwork())
+    throw InputError("the model (trained on '" + model.training_data +
+                     "') is a network (" + model.Describe() + "); the next screws need a family "
+                     "model: train one with 'whirl train' without --family network or "
+                     "--trainbr-matlab");
+  const auto& choice = model.choice;
+  if (!choice.weights[k].empty())
+    throw InputError(std::string("output ") + kTargetColumns[k] +
+                     " is a stacked combination; the next screws need one family per output "
+                     "(train without --stack)");
+  const auto& m = choice.models[choice.model_of_output[k]];
+  if (m.candidate.family == family::Family::kNetwork)
+    throw InputError(std::string("output ") + kTargetColumns[k] + " is " +
+                     m.OutputName(k) + "; the next screws need a linear or GP family");
+  return m;
+}
+
+std::array<OutputState, Features::kCount> States(const workpiece::WorkpieceModel& model,
+                                                 const std::vector<ProcessInputs>& cands,
+                                                 const std::vector<int>& lines) {
+  std::array<OutputState, Features::kCount> states;
+  Eigen::MatrixXd x(ProcessInputs::kCount, static_cast<Eigen::Index>(cands.size()));
+  for (std::size_t c = 0; c < cands.size(); ++c) {
+    const auto a = cands[c].ToArray();
+    for (int j = 0; j < ProcessInputs::kCount; ++j) x(j, static_cast<Eigen::Index>(c)) = a[j];
+  }
+  for (int k = 0; k < Features::kCount; ++k) {
+    const auto& m = ModelOfOutput(model, k);
+    CheckUsedInputs(m, model, cands, lines);
+    const Eigen::MatrixXd used =
+        family::UsedInputRows(m.transform, family::TransformInputs(m.transform, x));
+    Eigen::VectorXd mean_z;
+    if (m.candidate.family == family::Family::kLinear)
+      mean_z = family::PredictLinear(m.linears[k], used).mean;
+    else
+      mean_z = gp::PredictGp(m.gps[k], used).mean;
+    states[k] = StateOf(m, k, used, mean_z);
+  }
+  return states;
+}
+
+int BestCandidate(const std::array<OutputState, Features::kCount>& states,
+                  const std::vector<char>& taken, double* score) {
+  int best = -1;
+  *score = -1;
+  for (std::size_t j = 0; j < taken.size(); ++j) {
+    if (taken[j]) continue;
+    double s = 0;
+    for (const auto& st : states) s += st.weight * st.Reduction(static_cast<int>(j));
+    if (s > *score * (1 + 1e-12)) *score = s, best = static_cast<int>(j);
+  }
+  return best;
+}
+
+std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int j,
+                    double score, const workpiece::Prediction& now) {
+  std::string why = "largest expected reduction of the prediction variance over the list (" +
+                    FormatSignificant(100 * score / Features::kCount, 3) +
+                    " % of its mean, both outputs weighed equally)";
+  const double here = states[0].weight * states[0].Reduction(j);
+  const double there = states[1].weight * states[1].Reduction(j);
+  why += here >= there ? "; mostly for max elongation" : "; mostly for settle time";
+  if (now.outside_domain)
+    {
+    std::string fields;
+    for (const auto& f : now.outside_domain_fields) fields += (fields.empty() ? "" : ", ") + f;
+    why += "; outside the training domain in " + fields;
+  }
+  return why;
+}
+
+void ApplyStopRule(const StopRule& rule, std::array<OutputState, Features::kCount> states,
+                   std::vector<char> taken, NextDesign* d) {
+  if (!rule.Any()) return;
+  static const char* kUnit[] = {"um", "s"};
+  std::string reason;
+  bool enough = true, floor = false;
+  for (int k = 0; k < Features::kCount; ++k) {
+    if (rule.tolerance[k] <= 0) continue;
+    const std::string name = kTargetColumns[k];
+    const std::string tol = FormatSignificant(rule.tolerance[k], 3) + " " + kUnit[k];
+    if (d->rms_sd_floor[k] > rule.tolerance[k]) {
+      floor = true;
+      reason += name + ": the scatter alone (the floor of the predictive sd) is " +
+                FormatSignificant(d->rms_sd_floor[k], 3) + " " + kUnit[k] + ", above " + tol +
+                ": no number of screws reaches it with this model. ";
+    } else if (d->rms_sd_now[k] > rule.tolerance[k]) {
+      enough = false;
+      reason += name + ": RMS sd " + FormatSignificant(d->rms_sd_now[k], 3) + " " + kUnit[k] +
+                " above " + tol + ". ";
+    } else {
+      reason += name + ": RMS sd " + FormatSignificant(d->rms_sd_now[k], 3) + " " + kUnit[k] +
+                " within " + tol + ". ";
+    }
+  }
+  if (floor) {
+    d->stop = "floor";
+  } else if (enough) {
+    d->stop = "enough";
+    reason += "Further measurements no longer pay.";
+  } else {
+    d->stop = "continue";
+    const int limit = std::min<int>(kStopLookAhead, static_cast<int>(taken.size()));
+    for (int n = 1; n <= limit; ++n) {
+      double score = 0;
+      const int j = BestCandidate(states, taken, &score);
+      if (j < 0) break;
+      taken[j] = 1;
+      for (auto& st : states) st.Measure(j);
+      bool reached = true;
+      for (int k = 0; k < Features::kCount; ++k)
+        reached = reached && (rule.tolerance[k] <= 0 || states[k].Rms() <= rule.tolerance[k]);
+      if (reached) {
+        d->screws_to_tolerance = n;
+        break;
+      }
+    }
+    reason += d->screws_to_tolerance > 0
+                  ? "Expected within tolerance after about " +
+                        std::to_string(d->screws_to_tolerance) +
+                        " screws of this list (hyperparameters as now)."
+                  : "Not reached by " + std::to_string(limit) +
+                        " screws of this list with the model as it is.";
+  }
+  if (!reason.empty() && reason.back() == ' ') reason.pop_back();
+  d->stop_reason = reason;
+}
+
+}  // namespace
+
+Criterion ParseCriterion(const std::string& s) {
+  if (s == "d") return Criterion::kD;
+  if (s == "i") return Criterion::kI;
+  throw InputError("--criterion '" + s + "': expected 'd' (D-optimal) or 'i' (I-optimal)");
+}
+
+std::string ToString(Criterion c) { return c == Criterion::kD ? "d" : "i"; }
+
+void InputRanges::Validate(const std::array<const char*, ProcessInputs::kCount>& flags) const {
+  for (int j = 0; j < ProcessInputs::kCount; ++j) {
+    const std::string what = std::string(flags[j]) + " " + FormatSignificant(lo[j], 6) + ".." +
+                             FormatSignificant(hi[j], 6);
+    if (!std::isfinite(lo[j]) || !std::isfinite(hi[j]) || lo[j] <= 0)
+      throw InputError(what + ": bounds must be finite and positive (the power law takes logs)");
+    if (lo[j] > hi[j])
+      throw InputError(what + ": reversed range (the lower bound is above the upper bound)");
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = lo[i];
+    CheckProcessInputs(ProcessInputs::FromArray(a), "design ranges (lower bounds)");
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a[i] = hi[i];
+    CheckProcessInputs(ProcessInputs::FromArray(a), "design ranges (upper bounds)");
+  }
+}
+
+std::vector<ProcessInputs> GridCandidates(const InputRanges& r, int levels) {
+  if (levels < 2 || levels > 9)
+    throw InputError("--levels " + std::to_string(levels) + ": must lie in [2, 9]");
+  std::array<std::vector<double>, ProcessInputs::kCount> values;
+  for (int j = 0; j < ProcessInputs::kCount; ++j) {
+    const int n = r.lo[j] == r.hi[j] ? 1 : levels;
+    for (int i = 0; i < n; ++i) {
+      const double t = n == 1 ? 0.0 : static_cast<double>(i) / (n - 1);
+      const double v = std::exp(std::log(r.lo[j]) + t * (std::log(r.hi[j]) - std::log(r.lo[j])));
+      values[j].push_back(i == 0 ? r.lo[j] : i == n - 1 ? r.hi[j] : v);  // the bounds exactly
+    }
+  }
+  std::vector<ProcessInputs> out;
+  std::array<std::size_t, ProcessInputs::kCount> idx{};
+  while (true) {
+    std::array<double, ProcessInputs::kCount> a{};
+    for (int j = 0; j < ProcessInputs::kCount; ++j) a[j] = values[j][idx[j]];
+    out.push_back(ProcessInputs::FromArray(a));
+    int j = ProcessInputs::kCount - 1;
+    while (j >= 0 && ++idx[j] == values[j].size()) idx[j--] = 0;
+    if (j < 0) break;
+  }
+  return out;
+}
+
+PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count,
+                              Criterion criterion) {
+  if (cands.empty()) throw InputError("design: the candidate list is empty");
+  PowerLawDesign d;
+  d.criterion = criterion;
+  const Eigen::MatrixXd f = PowerLawRows(cands, &d.inputs);
+  d.coefficients = static_cast<int>(f.cols());
+  const int n = static_cast<int>(cands.size());
+  if (count < d.coefficients || count > n)
+    throw InputError("design --count " + std::to_string(count) + ": the power law in the " +
+                     std::to_string(d.inputs.size()) + " inputs that vary over the " +
+                     std::to_string(n) + " candidates has " + std::to_string(d.coefficients) +
+                     " coefficients; the count must lie in [" +
+                     std::to_string(d.coefficients) + ", " + std::to_string(n) + "]");
+  const Eigen::MatrixXd w = f.transpose() * f / static_cast<double>(n);
+  std::vector<int> picked = GreedyStart(f, count);
+  Exchange(f, criterion, w, &picked);
+  if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w)))
+    throw InputError("design: the candidates do not determine a power law (their log inputs "
+                     "are collinear); add candidates that vary the inputs independently");
+  d.picks = ExplainingOrder(f, picked);
+  d.log_det = CriterionValue(f, picked, Criterion::kD, w) - d.coefficients * std::log(count);
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(f.cols(), f.cols());
+  for (int i : picked) m.noalias() += f.row(i).transpose() * f.row(i);
+  const Eigen::MatrixXd mi = m.inverse();
+  double sum = 0, mx = 0;
+  for (int c = 0; c < n; ++c) {
+    const double v = std::sqrt(std::max(0.0, double(f.row(c) * mi * f.row(c).transpose())));
+    sum += v, mx = std::max(mx, v);
+  }
+  d.mean_sd_factor = sum / n;
+  d.max_sd_factor = mx;
+  return d;
+}
+
+NextDesign DesignNext(const workpiece::WorkpieceModel& model,
+                      const std::vector<ProcessInputs>& cands, int count, const StopRule& stop,
+                      const std::vector<int>& lines) {
+  if (cands.empty()) throw InputError("design: the candidate list is empty");
+  const int n = static_cast<int>(cands.size());
+  if (count < 1 || count > n)
+    throw InputError("design --count " + std::to_string(count) + ": must lie in [1, " +
+                     std::to_string(n) + "] (the candidates)");
+  auto states = States(model, cands, lines);
+  NextDesign d;
+  d.now = workpiece::PredictBatch(model, cands);
+  for (int k = 0; k < Features::kCount; ++k) {
+    d.rms_sd_now[k] = states[k].Rms();
+    d.rms_sd_floor[k] = states[k].FloorRms();
+    states[k].weight = d.rms_sd_now[k] > 0 ? 1.0 / (d.rms_sd_now[k] * d.rms_sd_now[k]) : 0.0;
+  }
+  const auto initial = states;
+  std::vector<char> taken(n, 0);
+  for (int i = 0; i < count; ++i) {
+    double score = 0;
+    const int j = BestCandidate(states, taken, &score);
+    Pick p;
+    p.candidate = j;
+    p.why = WhyNext(states, j, score / n, d.now[j]);
+    for (int k = 0; k < Features::kCount; ++k) p.sd_now[k] = std::sqrt(initial[k].Variance(j));
+    taken[j] = 1;
+    for (auto& st : states) st.Measure(j);
+    for (int k = 0; k < Features::kCount; ++k) p.sd_after[k] = std::sqrt(states[k].Variance(j));
+    d.picks.push_back(p);
+  }
+  for (int k = 0; k < Features::kCount; ++k) d.rms_sd_after[k] = states[k].Rms();
+  ApplyStopRule(stop, initial, std::vector<char>(n, 0), &d);
+  return d;
+}
+
+}  // namespace whirl::design

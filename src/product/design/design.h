@@ -1,0 +1,122 @@
+#pragma once
+// Which screws to measure: a design for the workpiece model's training table (`whirl design`).
+// Every measured screw costs an instrumented cut, cooling in the clamping and a lead
+// measurement; the design picks the screws that teach the model most.
+//
+// First design (DesignPowerLaw): no measurements yet. The model's physics is a power law in the
+// five inputs, ln y = b0 + sum_j b_j ln x_j: a linear model in f(x) = (1, ln x_1, .., ln x_5)
+// (inputs that do not vary over the candidates left out). Among the candidates (the screw types
+// the shop makes, or a grid over its ranges: GridCandidates) the design picks `count` distinct
+// screws that maximize
+//   D: ln det(F'F)                     (the power law's coefficients best determined), or
+//   I: -mean_c f(x_c)' (F'F)^-1 f(x_c) (the power law's prediction variance averaged over the
+//                                       candidates, i.e. over what the shop will predict),
+// F the design's rows f(x_i) on log inputs standardized over the candidates. Search: greedy
+// picks, then Fedorov exchanges (swap a picked screw for an unpicked one while the criterion
+// improves; Fedorov, "Theory of Optimal Experiments", 1972). Reported per screw in a pick order
+// that explains it: each screw is the one of highest power-law prediction variance given the
+// screws before it (the first 1 + inputs determine the coefficients). The expected prediction
+// sd over the candidates is given as a factor of the measurement scatter of ln y (relative
+// scatter): sd(ln y_hat(x)) = factor(x) * sd(scatter), factor = sqrt(f' (F'F)^-1 f).
+//
+// Next screws (DesignNext): a trained family model (workpiece/model.h, family/family.h) and the
+// candidates coming up. Per output k, the latent posterior covariance C_k of the chosen family
+// over the candidates (gp::PosteriorCovariance, family::LatentCovariance; in the output's
+// transformed space, mapped to original units by the delta method's factor g_c of
+// family/transform.h). Measuring candidate j (noise s_k^2: the model's fitted noise) lowers the
+// variance at c by g_c^2 C_k[c,j]^2 / (C_k[j,j] + s_k^2) (the exact update of a Gaussian process
+// or a linear fit at fixed hyperparameters; Rasmussen & Williams, "Gaussian Processes for Machine
+// Learning", 2006, eq. 2.19). Integrated variance reduction: the pick is the candidate of
+// largest
+//   sum_k sum_c g_c^2 C_k[c,j]^2 / (C_k[j,j] + s_k^2) / V_k,
+// V_k = the mean predictive variance of output k over the candidates now (both outputs weigh
+// equally); then C_k is updated as if it were measured, and the next pick follows (greedy
+// batch: the hyperparameters are not refitted, so a batch is as good as the first pick's model).
+// Predictive sd = sqrt(g^2 (latent + calibrated noise)) as `whirl predict` gives it; after a
+// measurement only the latent part shrinks: the calibrated noise is the floor no number of
+// screws goes below.
+//
+// Stop rule (StopRule): per output with a tolerance, the root mean square of the predictive sd
+// over the candidates (um, s). Measuring no longer pays when it is at or below the tolerance
+// ("enough"), or when the floor (the noise part alone) is above it ("floor": no number of screws
+// of this model reaches it; a better-fitting model or less scatter would); otherwise the report
+// estimates how many more screws of this list the greedy design needs to reach it (up to
+// kStopLookAhead). Evidence (designed against random, Latin hypercube and production-order
+// screws, simulator and generated families): docs/design.md.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/process.h"
+#include "workpiece/model.h"
+
+namespace whirl::design {
+
+enum class Criterion { kD, kI };
+Criterion ParseCriterion(const std::string& s);  ///< "d" | "i"; InputError otherwise
+std::string ToString(Criterion c);               ///< "d", "i"
+
+/// The shop's ranges of the five inputs (original units, kInputColumns order).
+struct InputRanges {
+  std::array<double, ProcessInputs::kCount> lo{}, hi{};
+  /// InputError naming the input's flag (`flags[i]`) when a bound is not finite, not positive
+  /// (the power law takes logs), lo > hi (reversed), or outside core/limits.h's range.
+  void Validate(const std::array<const char*, ProcessInputs::kCount>& flags) const;
+};
+
+/// `levels` values per input, spaced evenly in ln x from lo to hi (one value where lo == hi):
+/// up to levels^5 candidates, in lexicographic order. InputError if levels < 2 or > 9.
+std::vector<ProcessInputs> GridCandidates(const InputRanges& ranges, int levels);
+
+/// One screw of a design.
+struct Pick {
+  int candidate = 0;  ///< index into the candidate list
+  std::string why;    ///< one sentence
+  /// First design: the power-law sd factor at this screw before and after it was added (in the
+  /// explaining order). Next screws: per output, the predictive sd now and after this pick and
+  /// the ones before it (original units).
+  std::array<double, Features::kCount> sd_now{}, sd_after{};
+};
+
+struct PowerLawDesign {
+  Criterion criterion = Criterion::kD;
+  int coefficients = 0;             ///< 1 + inputs that vary over the candidates
+  std::vector<std::string> inputs;  ///< the varying inputs' columns
+  std::vector<Pick> picks;          ///< in the explaining order (header comment)
+  double log_det = 0;               ///< ln det(F'F / count), standardized log inputs
+  double mean_sd_factor = 0, max_sd_factor = 0;  ///< over the candidates (header comment)
+};
+
+/// The first design of the header comment: `count` distinct candidates. InputError if the list
+/// is empty, count < coefficients or count > candidates.
+PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& candidates, int count,
+                              Criterion criterion);
+
+struct StopRule {
+  /// Per output, the tolerance of the RMS predictive sd over the candidates (um, s); <= 0: none.
+  std::array<double, Features::kCount> tolerance{};
+  bool Any() const { return tolerance[0] > 0 || tolerance[1] > 0; }
+};
+inline constexpr int kStopLookAhead = 200;  ///< screws the stop rule's estimate looks ahead
+
+struct NextDesign {
+  std::vector<Pick> picks;  ///< in pick order
+  std::array<double, Features::kCount> rms_sd_now{}, rms_sd_after{}, rms_sd_floor{};
+  std::vector<workpiece::Prediction> now;  ///< per candidate, the model's prediction
+  /// Stop rule: "" (no tolerance), "enough", "floor", "continue" (more screws needed: about
+  /// screws_to_tolerance of this list, -1 if kStopLookAhead picks do not reach it).
+  std::string stop;
+  int screws_to_tolerance = -1;
+  std::string stop_reason;  ///< one or two sentences, with the figures
+};
+
+/// The next screws of the header comment: `count` distinct candidates (1 <= count <=
+/// candidates). InputError if the list is empty, the model is a network or a stacked choice
+/// ("whirl train" without --family network or --stack), or if it leaves out an input (constant
+/// in its training table) that the candidates vary (naming the input, its training value and the
+/// first candidate that differs: "line N" when `lines` gives the candidates' file lines).
+NextDesign DesignNext(const workpiece::WorkpieceModel& model,
+                      const std::vector<ProcessInputs>& candidates, int count,
+                      const StopRule& stop = {}, const std::vector<int>& lines = {});
+
+}  // namespace whirl::design
