@@ -148,6 +148,8 @@ struct RunLayout {
   std::vector<std::size_t> sensor_columns, error_columns, other_columns;  ///< CSV columns
   std::size_t columns = 0;  ///< all CSV columns
   int SensorIndex(const std::string& name) const;  ///< InputError as Run::SensorIndex
+  /// A Run with this layout's source, name, state and column names, and no samples yet.
+  Run EmptyRun() const;
   int ErrorIndex(const std::string& name) const;
   int OtherIndex(const std::string& name) const;
 };

@@ -81,6 +81,17 @@ int IndexIn(const std::vector<std::string>& names, const std::string& name,
 
 }  // namespace
 
+Run RunLayout::EmptyRun() const {
+  Run r;
+  r.source = source;
+  r.name = name;
+  r.state = state;
+  r.sensor_names = sensor_names;
+  r.error_names = error_names;
+  r.other_names = other_names;
+  return r;
+}
+
 int RunLayout::SensorIndex(const std::string& n) const {
   return IndexIn(sensor_names, n, source, "temperature (_C)");
 }
@@ -283,13 +294,7 @@ Run CollectRun(RunReader& reader) {
       for (Eigen::Index j = 0; j < b.other.cols(); ++j) others.push_back(b.other(k, j));
     }
   }
-  Run r;
-  r.source = l.source;
-  r.name = l.name;
-  r.state = l.state;
-  r.sensor_names = l.sensor_names;
-  r.error_names = l.error_names;
-  r.other_names = l.other_names;
+  Run r = l.EmptyRun();
   r.line_numbers = std::move(lines);
   const auto n = static_cast<Eigen::Index>(time.size());
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;

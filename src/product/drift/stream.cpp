@@ -140,13 +140,7 @@ struct SampledRun {
 
   // The sampled rows as a Run (times: the row index in the run without recorded time).
   Run ToRun() const {
-    Run r;
-    r.source = layout.source;
-    r.name = layout.name;
-    r.state = layout.state;
-    r.sensor_names = layout.sensor_names;
-    r.error_names = layout.error_names;
-    r.other_names = layout.other_names;
+    Run r = layout.EmptyRun();
     r.line_numbers = lines;
     r.time_from_index = time_from_index();
     r.time_min.resize(kept());
