@@ -219,7 +219,7 @@ drift::FitOptions ToFit(const ModelArgs& m, const SelectionArgs& s, bool time_fr
 }
 
 // FitFiles on the run files (streamed: any length), with LoadRuns' warning for runs without time
-// (`warn` false: the caller loads the same runs with LoadRuns, which warns).
+// (`warn` false: the caller warns for the same runs itself, as drift report does).
 drift::FitReport FitRunFiles(const RunInputs& in, const std::string& error, const ModelArgs& m,
                              const SelectionArgs& sel, RowProgress* progress, bool warn = true) {
   const std::vector<drift::RunFile> files = RunFiles(in);
@@ -559,7 +559,7 @@ void RegisterReport(CLI::App* drift_app) {
     SelectionArgs sel;
     ModelArgs model;
     std::string error, out_dir;
-    bool json = false;
+    bool json = false, progress = false;
   };
   auto o = std::make_shared<Opts>();
   auto* sub = drift_app->add_subcommand(
@@ -589,26 +589,34 @@ void RegisterReport(CLI::App* drift_app) {
   sub->add_flag("--json", o->json,
                 "machine output on stdout: the model, the selection and each run's residual "
                 "against no compensation [um]");
+  AddProgressFlag(sub, &o->progress);
   sub->callback([o] {
     std::vector<FlagPath> inputs = InputPaths(o->train, "train-"), more = InputPaths(o->runs);
     inputs.insert(inputs.end(), more.begin(), more.end());
     CheckOutputs(inputs, {}, {{"--out-dir", o->out_dir}});
     const bool shown = !o->runs.runs.empty() || !o->runs.idle.empty() || !o->runs.cutting.empty();
     // The model as drift fit makes it (streamed; a thinned search on long training runs).
+    RowProgress progress(o->progress, o->json);
     const drift::FitReport rep =
-        FitRunFiles(o->train, o->error, o->model, o->sel, nullptr, /*warn=*/shown);
-    const std::vector<drift::Run> runs = LoadRuns(shown ? o->runs : o->train);
+        FitRunFiles(o->train, o->error, o->model, o->sel, &progress, /*warn=*/shown);
     for (const auto& w : rep.warnings) Warn(w);
-    const auto r =
-        drift::WriteModelReport(o->out_dir, rep, runs, {"whirl drift report --error " + o->error});
+    // The runs shown are streamed too: each pass over a file is a block of rows at a time.
+    const std::vector<drift::RunFile> runs = RunFiles(shown ? o->runs : o->train);
+    const auto r = drift::WriteModelReport(o->out_dir, rep, runs,
+                                           {"whirl drift report --error " + o->error}, "gnuplot",
+                                           progress.Callback());
+    progress.Finish();
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      if (r.predictions[i].time_from_index)
+        Warn(runs[i].path.string() + ": no complete time column: the sample index is used as time");
     for (const auto& w : r.warnings) Warn(w);
     if (!o->json) {
       std::printf("report written to %s\n", r.index_html.string().c_str());
       return;
     }
     nlohmann::json predictions = nlohmann::json::array(), files = nlohmann::json::array();
-    for (const drift::Run& run : runs)
-      predictions.push_back(drift::PredictionJson(drift::PredictRun(rep.model, run)));
+    for (const drift::PredictionSummary& p : r.predictions)
+      predictions.push_back(drift::PredictionJson(p));
     for (const auto& f : r.files) files.push_back(f.string());
     nlohmann::json j = {{"schema", "whirl.drift_report"},
                         {"schema_version", 1},

@@ -164,6 +164,15 @@ import json, sys
 assert sum(r["samples"] for r in json.load(open(sys.argv[1]))["runs"]) == 20000
 EOF2
 "$W" drift report --train-run "$D/long.csv" --run "$D/long.csv" --error ch1_um \
-  --out-dir "$D/long_rep" > /dev/null 2>&1 || fail "report on the long log"
+  --out-dir "$D/long_rep" --json --progress > "$D/long_rep.json" 2> "$D/long_rep_err.txt" \
+  || fail "report on the long log: $(tail -3 "$D/long_rep_err.txt")"
 [ "$(grep -vc '^#' "$D/long_rep/long_plot.csv")" -lt 20001 ] || fail "the plot rows are not decimated"
+[ "$(grep -vc '^#' "$D/long_rep/long_prediction.csv")" = 20001 ] || fail "report: not every row in the CSV"
+python3 - "$D/long_rep.json" <<'EOF2' || fail "report --json --progress: $(head -c 300 "$D/long_rep.json")"
+import json, sys
+j = json.load(open(sys.argv[1]))  # stdout stays JSON with --progress
+assert j["runs"][0]["samples"] == 20000, j["runs"][0]
+b = j["baselines"]["runs"][0]
+assert b["time_only_mae_um"] is not None and b["model_mae_um"] is not None, b
+EOF2
 echo "ok"

@@ -5,14 +5,14 @@
 
 namespace whirl {
 
-M4Decimator::M4Decimator(int series, double x0, double x1, int columns)
-    : series_(std::max(0, series)), x0_(x0), x1_(x1), columns_(std::max(1, columns)),
+M4Decimator::M4Decimator(int series, double x0, double x1, int columns, int carried)
+    : series_(std::max(0, series)), width_(series_ + std::max(0, carried)), x0_(x0), x1_(x1), columns_(std::max(1, columns)),
       min_(static_cast<std::size_t>(series_)), max_(static_cast<std::size_t>(series_)) {}
 
 void M4Decimator::Consider(Candidate* c, long long row, double x, const double* values) {
   c->row = row;
   c->x = x;
-  c->values.assign(values, values + series_);
+  c->values.assign(values, values + width_);
 }
 
 void M4Decimator::Add(long long row, double x, const double* values) {

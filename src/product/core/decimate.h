@@ -19,13 +19,15 @@ inline constexpr int kPlotColumns = 1200;
 /// M4 decimation of rows that arrive in order of x (a streamed log), x within [x0, x1].
 class M4Decimator {
  public:
-  M4Decimator(int series, double x0, double x1, int columns = kPlotColumns);
-  /// Row `row` (its index in the table) at x with `series` values.
+  /// `carried` more values per row ride along with the kept rows (a prediction's standard
+  /// deviation beside its line) without choosing rows: the extremes are the `series`' only.
+  M4Decimator(int series, double x0, double x1, int columns = kPlotColumns, int carried = 0);
+  /// Row `row` (its index in the table) at x with `series` values, then the `carried` ones.
   void Add(long long row, double x, const double* values);
   /// Ends the last column; the kept rows' indices, in order.
   const std::vector<long long>& Finish();
   const std::vector<long long>& rows() const { return rows_; }
-  /// The kept rows' values, row-major (series values per kept row), and their x.
+  /// The kept rows' values, row-major (series then carried values per kept row), and their x.
   const std::vector<double>& values() const { return values_; }
   const std::vector<double>& x() const { return xs_; }
 
@@ -38,7 +40,7 @@ class M4Decimator {
   void Consider(Candidate* c, long long row, double x, const double* values);
   void Emit();
 
-  int series_;
+  int series_, width_;  // width_: series_ + carried values per row
   double x0_, x1_;
   int columns_;
   long long column_ = -1;

@@ -2,6 +2,8 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -55,22 +57,12 @@ class ReportWriter {
     }
     return "<p>(plot not rendered: " + HtmlEscape(stem) + ".gp)</p>";
   }
-  // A long per-sample CSV written to disk as it is formatted (never held whole): the
-  // prediction's rows through a 1 MiB buffer into the staging folder, renamed into place by Commit.
-  void PredictionFile(const std::string& name, const RunPrediction& p,
-                      const std::vector<std::string>& comments) {
-    StreamedFile file(fs::absolute(out_.Staging()) / name);
-    std::string rows = PredictionCsvHeader(p.time_from_index, p.has_measured, comments);
-    for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k) {
-      AppendPredictionRow(p.time[static_cast<std::size_t>(k)], p.predicted_um(k), p.std_um(k),
-                          p.has_measured ? &p.measured_um(k) : nullptr, &rows);
-      if (rows.size() < (1u << 20)) continue;
-      file.Append(rows);
-      rows.clear();
-    }
-    file.Append(rows);
-    out_.AddReady(name, file.Finish());
+  // A long per-sample CSV written to disk as it is formatted (never held whole): a file in the
+  // staging folder, handed to Commit by Ready.
+  std::unique_ptr<StreamedFile> Streamed(const std::string& name) {
+    return std::make_unique<StreamedFile>(fs::absolute(out_.Staging()) / name);
   }
+  void Ready(const std::string& name, StreamedFile* file) { out_.AddReady(name, file->Finish()); }
   const std::vector<std::string>& warnings() const { return result_.warnings; }
   DriftReportResult Finish(const std::string& html) {
     if (gnuplot_failed_) out_.AddProgramLog("gnuplot.log");
@@ -186,16 +178,109 @@ std::string StatsRow(const std::string& name, const ErrorStats& s) {
 }
 
 
+using SampleSink = std::function<void(const PredictedSample&)>;
+
+// The x range of a run's samples (its first and last time [min], or sample index) and its axis.
+struct RunAxis {
+  double first = 0, last = 0;
+  bool time_from_index = false;
+};
+
+// Where a model report's runs come from: files streamed block by block, or runs in memory. Per
+// run its name and time axis, its prediction under any model sample by sample, and fits on some
+// of the runs (the baselines' models).
+class ShownRuns {
+ public:
+  virtual ~ShownRuns() = default;
+  virtual std::size_t size() const = 0;
+  virtual const std::string& Name(std::size_t i) const = 0;
+  virtual RunAxis Axis(std::size_t i) const = 0;
+  // PredictRun's samples in order into `sink` (optional) and their summary.
+  virtual PredictionSummary Predict(const DriftModel& m, std::size_t i,
+                                    const SampleSink& sink) const = 0;
+  // The model drift fit makes on the runs `which` (InputError as FitDriftModel).
+  virtual DriftModel Fit(const std::vector<std::size_t>& which, const std::string& error,
+                         const FitOptions& o) const = 0;
+};
+
+class RunsInMemory final : public ShownRuns {
+ public:
+  explicit RunsInMemory(const std::vector<Run>& runs) : runs_(runs) {}
+  std::size_t size() const override { return runs_.size(); }
+  const std::string& Name(std::size_t i) const override { return runs_[i].name; }
+  RunAxis Axis(std::size_t i) const override {
+    const std::vector<double>& t = runs_[i].time_min;
+    return {t.empty() ? 0.0 : t.front(), t.empty() ? 0.0 : t.back(), runs_[i].time_from_index};
+  }
+  PredictionSummary Predict(const DriftModel& m, std::size_t i,
+                            const SampleSink& sink) const override {
+    const RunPrediction p = PredictRun(m, runs_[i]);
+    PredictedSample s;
+    s.has_measured = p.has_measured;
+    for (Eigen::Index k = 0; sink && k < p.predicted_um.size(); ++k) {
+      s.index = k;
+      s.time = p.time[static_cast<std::size_t>(k)];
+      s.predicted_um = p.predicted_um(k);
+      s.std_um = p.std_um(k);
+      if (p.has_measured) s.measured_um = p.measured_um(k);
+      sink(s);
+    }
+    return Summarize(p);
+  }
+  DriftModel Fit(const std::vector<std::size_t>& which, const std::string& error,
+                 const FitOptions& o) const override {
+    std::vector<Run> chosen;
+    for (const std::size_t i : which) chosen.push_back(runs_[i]);
+    return FitDriftModel(chosen, error, o).model;
+  }
+
+ private:
+  const std::vector<Run>& runs_;
+};
+
+// The runs as files: each scanned once (its rows and time axis), every pass streamed.
+class RunsInFiles final : public ShownRuns {
+ public:
+  RunsInFiles(const std::vector<RunFile>& files, const StreamProgress& progress)
+      : files_(files), progress_(progress) {
+    for (const RunFile& f : files) {
+      scans_.push_back(ScanRun(f.path));
+      names_.push_back(RunReader(f.path, f.state, scans_.back().time_from_index).layout().name);
+    }
+  }
+  std::size_t size() const override { return files_.size(); }
+  const std::string& Name(std::size_t i) const override { return names_[i]; }
+  RunAxis Axis(std::size_t i) const override {
+    return {scans_[i].first_time, scans_[i].last_time, scans_[i].time_from_index};
+  }
+  PredictionSummary Predict(const DriftModel& m, std::size_t i,
+                            const SampleSink& sink) const override {
+    return PredictFile(m, files_[i].path, ReferenceMode::kRunStart, sink, progress_, &scans_[i]);
+  }
+  DriftModel Fit(const std::vector<std::size_t>& which, const std::string& error,
+                 const FitOptions& o) const override {
+    std::vector<RunFile> chosen;
+    for (const std::size_t i : which) chosen.push_back(files_[i]);
+    return FitFiles(chosen, error, o, progress_).model;
+  }
+
+ private:
+  const std::vector<RunFile>& files_;
+  const StreamProgress& progress_;
+  std::vector<RunScan> scans_;
+  std::vector<std::string> names_;
+};
+
 // The model's training runs among the runs shown (all of them, in the model's order), or empty.
-std::vector<Run> TrainingRunsShown(const DriftModel& m, const std::vector<Run>& runs) {
-  std::vector<Run> found;
+std::vector<std::size_t> TrainingRunsShown(const DriftModel& m, const ShownRuns& runs) {
+  std::vector<std::size_t> found;
   for (const std::string& name : m.training_runs)
-    for (const Run& r : runs)
-      if (r.name == name) {
-        found.push_back(r);
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      if (runs.Name(i) == name) {
+        found.push_back(i);
         break;
       }
-  return found.size() == m.training_runs.size() ? found : std::vector<Run>{};
+  return found.size() == m.training_runs.size() ? found : std::vector<std::size_t>{};
 }
 
 constexpr const char* kBaselineNames[] = {"model", "none", "time only", kPreviousRunBaseline};
@@ -213,21 +298,24 @@ std::string Strongest(const ReportBaseline& c) {
   return best < 0 ? "" : kBaselineNames[best];
 }
 
-double BaselineMae(const DriftModel& b, const Run& run) {
-  const RunPrediction p = PredictRun(b, run);
-  return p.has_measured ? ComputeErrorStats(p.measured_um - p.predicted_um).mae_um : NAN;
+// A baseline's MAE on run i: one more pass, its samples never kept.
+double BaselineMae(const DriftModel& b, const ShownRuns& runs, std::size_t i) {
+  const PredictionSummary s = runs.Predict(b, i, {});
+  return s.has_measured ? s.residual.mae_um : NAN;
 }
 
-// Per run shown: the model against no compensation, a time-only warm-up fitted on the model's
-// training runs (first order in time since the run's start, drift/regression.h FitWarmUp), and
-// drift fit at its defaults redone on the previous run shown (drift/fit.h PreviousRunOptions). A baseline that cannot be fitted (the
-// training runs are not shown, too few samples) stays empty and the notes say why.
-std::vector<ReportBaseline> Baselines(const DriftModel& m, const std::vector<RunPrediction>& preds,
-                                     const std::vector<Run>& runs, std::vector<std::string>* notes) {
+// Per run shown: the model (its pass, `preds`) against no compensation, a time-only warm-up
+// fitted on the model's training runs (first order in time since the run's start,
+// drift/regression.h FitWarmUp), and drift fit at its defaults redone on the previous run shown
+// (drift/fit.h PreviousRunOptions). A baseline that cannot be fitted (the training runs are not
+// shown, too few samples) stays empty and the notes say why.
+std::vector<ReportBaseline> Baselines(const DriftModel& m,
+                                      const std::vector<PredictionSummary>& preds,
+                                      const ShownRuns& runs, std::vector<std::string>* notes) {
   std::vector<ReportBaseline> cells(runs.size());
   DriftModel time;
   bool have_time = false;
-  const std::vector<Run> training = TrainingRunsShown(m, runs);
+  const std::vector<std::size_t> training = TrainingRunsShown(m, runs);
   if (training.empty()) {
     notes->push_back("time only: not fitted (the model's training runs are not among the runs shown)");
   } else {
@@ -236,7 +324,7 @@ std::vector<ReportBaseline> Baselines(const DriftModel& m, const std::vector<Run
       t.kind = ModelKind::kMlr;
       t.candidates = Candidates::kTime;
       t.zero = m.zero;
-      time = FitDriftModel(training, m.error_column, t).model;
+      time = runs.Fit(training, m.error_column, t);
       have_time = true;
     } catch (const InputError& e) {
       notes->push_back(std::string("time only: not fitted: ") + e.what());
@@ -244,18 +332,18 @@ std::vector<ReportBaseline> Baselines(const DriftModel& m, const std::vector<Run
   }
   for (std::size_t i = 0; i < runs.size(); ++i) {
     ReportBaseline& c = cells[i];
-    c.run = runs[i].name;
+    c.run = runs.Name(i);
     if (!preds[i].has_measured) continue;
-    c.model_mae_um = ComputeErrorStats(preds[i].measured_um - preds[i].predicted_um).mae_um;
-    c.none_mae_um = ComputeErrorStats(preds[i].measured_um).mae_um;
-    if (have_time) c.time_only_mae_um = BaselineMae(time, runs[i]);
+    c.model_mae_um = preds[i].residual.mae_um;
+    c.none_mae_um = preds[i].none.mae_um;
+    if (have_time) c.time_only_mae_um = BaselineMae(time, runs, i);
     if (i > 0) {
       try {
         c.previous_run_mae_um = BaselineMae(
-            FitDriftModel({runs[i - 1]}, m.error_column, PreviousRunOptions(m)).model, runs[i]);
+            runs.Fit({i - 1}, m.error_column, PreviousRunOptions(m)), runs, i);
       } catch (const InputError& e) {
-        notes->push_back(std::string(kPreviousRunBaseline) + ": no refit on " + runs[i - 1].name +
-                         ": " + e.what());
+        notes->push_back(std::string(kPreviousRunBaseline) + ": no refit on " +
+                         runs.Name(i - 1) + ": " + e.what());
       }
     }
     c.strongest = Strongest(c);
@@ -284,35 +372,122 @@ std::string BaselinesHtml(const std::vector<ReportBaseline>& cells,
   return h.str();
 }
 
-// The rows of a prediction a plot needs (core/decimate.h, M4 on predicted, measured and
-// residual): the CSV gnuplot reads, whatever the run's length.
-std::string PlotCsv(const RunPrediction& p, const std::vector<std::string>& comments) {
-  const auto n = static_cast<std::size_t>(p.predicted_um.size());
-  std::vector<std::vector<double>> series(p.has_measured ? 3 : 1, std::vector<double>(n));
-  for (std::size_t k = 0; k < n; ++k) {
-    const auto i = static_cast<Eigen::Index>(k);
-    series[0][k] = p.predicted_um(i);
-    if (!p.has_measured) continue;
-    series[1][k] = p.measured_um(i);
-    series[2][k] = p.measured_um(i) - p.predicted_um(i);
+// The model's pass over one run: every sample goes into the per-sample CSV (written as it is
+// formatted, through a 1 MiB buffer) and into the plot's M4 decimation (core/decimate.h: the
+// extremes of predicted, measured and residual per pixel column, the std carried along), so
+// neither grows in memory with the run.
+class RunPass {
+ public:
+  RunPass(ReportWriter* w, const std::string& csv_name, const RunAxis& axis,
+          std::vector<std::string> comments)
+      : file_(w->Streamed(csv_name)), axis_(axis), comments_(std::move(comments)) {}
+
+  void Add(const PredictedSample& p) {
+    if (!plot_) Start(p.has_measured);
+    AppendPredictionRow(p.time, p.predicted_um, p.std_um,
+                        p.has_measured ? &p.measured_um : nullptr, &rows_);
+    if (rows_.size() >= (1u << 20)) {
+      file_->Append(rows_);
+      rows_.clear();
+    }
+    const std::array<double, 4> v =
+        p.has_measured
+            ? std::array<double, 4>{p.predicted_um, p.measured_um, p.measured_um - p.predicted_um,
+                                    p.std_um}
+            : std::array<double, 4>{p.predicted_um, p.std_um, 0, 0};
+    plot_->Add(p.index, p.time, v.data());
   }
-  std::string out = PredictionCsvHeader(p.time_from_index, p.has_measured, comments);
-  for (const std::size_t k : M4Rows(p.time, series)) {
-    const auto i = static_cast<Eigen::Index>(k);
-    AppendPredictionRow(p.time[k], p.predicted_um(i), p.std_um(i),
-                        p.has_measured ? &p.measured_um(i) : nullptr, &out);
+
+  // Ends the per-sample CSV (handed to the writer as `name`) and returns the plot's rows as CSV.
+  std::string Finish(ReportWriter* w, const std::string& name, bool has_measured,
+                     const std::vector<std::string>& plot_comments) {
+    if (!plot_) Start(has_measured);
+    file_->Append(rows_);
+    w->Ready(name, file_.get());
+    std::string out = PredictionCsvHeader(axis_.time_from_index, measured_, plot_comments);
+    plot_->Finish();
+    const std::vector<double>& x = plot_->x();
+    const std::vector<double>& v = plot_->values();
+    const std::size_t width = measured_ ? 4 : 2;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      const double* row = v.data() + k * width;
+      AppendPredictionRow(x[k], row[0], row[width - 1], measured_ ? row + 1 : nullptr, &out);
+    }
+    return out;
   }
-  return out;
+
+ private:
+  void Start(bool has_measured) {
+    measured_ = has_measured;
+    rows_ = PredictionCsvHeader(axis_.time_from_index, has_measured, comments_);
+    plot_ = std::make_unique<M4Decimator>(has_measured ? 3 : 1, axis_.first, axis_.last,
+                                          kPlotColumns, 1);
+  }
+
+  std::unique_ptr<StreamedFile> file_;
+  RunAxis axis_;
+  std::vector<std::string> comments_;
+  std::string rows_;
+  bool measured_ = false;
+  std::unique_ptr<M4Decimator> plot_;
+};
+
+// The gnuplot script of a run's plot: measured and predicted (+- 1 sd) over time, the residual.
+std::string RunPlotScript(const DriftModel& m, const PredictionSummary& p,
+                          const std::string& plot_csv) {
+  const std::string x = p.time_from_index ? "sample" : "time [h]";
+  const std::string xcol = p.time_from_index ? "1" : "($1/60)";
+  std::ostringstream gp;
+  // The line looks of core/plot_style.h; the key right of the data, the panels aligned.
+  gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
+     << GnuplotString(x) << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\n"
+     << "set title "
+     << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column)
+     << "\nplot " << GnuplotString(plot_csv) << " using " << xcol
+     << ":($2-$4):($2+$4) with filledcurves fs transparent solid 0.15 noborder lc rgb '"
+     << FindSeriesStyle("prediction")->colour << "' title 'predicted +- 1 sd', '' using "
+     << xcol << ":2 " << GnuplotWith("prediction") << " title 'predicted'";
+  if (p.has_measured)
+    gp << ", '' using " << xcol << ":5 " << GnuplotWith("measured") << " title 'measured'";
+  gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
+  if (p.has_measured)
+    gp << "plot " << GnuplotString(plot_csv) << " using " << xcol << ":6 "
+       << GnuplotWith("residual") << " title 'residual'\n";
+  else
+    gp << "plot 0 notitle\n";
+  gp << "unset multiplot\n";
+  return gp.str();
 }
 
-}  // namespace
+// Run i under the model, in one pass: its per-sample CSV, the plot's rows and script, the plot's
+// HTML into `plots`; returns the prediction's summary.
+PredictionSummary ShowRun(ReportWriter* w, const ShownRuns& runs, std::size_t i,
+                          const DriftModel& m, const std::vector<std::string>& provenance,
+                          std::ostringstream* plots) {
+  const std::string& name = runs.Name(i);
+  const std::string slug = Slug(name);
+  RunPass pass(w, slug + "_prediction.csv", runs.Axis(i),
+               Comments(provenance, "prediction of " + name));
+  const PredictionSummary p =
+      runs.Predict(m, i, [&pass](const PredictedSample& s) { pass.Add(s); });
+  // gnuplot reads the plot's rows only (M4: at most a few thousand whatever the run's length).
+  const std::string plot_csv = slug + "_plot.csv";
+  w->File(plot_csv, pass.Finish(w, slug + "_prediction.csv", p.has_measured,
+                                Comments(provenance, "rows of the plot of " + name +
+                                                         " (M4 decimation of the prediction "
+                                                         "per pixel column; all rows: " +
+                                                         slug + "_prediction.csv)")));
+  *plots << "<h3>" << HtmlEscape(p.run) << "</h3>\n";
+  for (const auto& warn : p.warnings) *plots << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
+  *plots << w->Plot(slug + "_prediction", RunPlotScript(m, p, plot_csv),
+                    "measured and predicted error of " + p.run)
+         << "\n";
+  return p;
+}
 
-DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
-                                   const std::vector<Run>& runs,
-                                   const std::vector<std::string>& provenance,
-                                   const std::string& gnuplot) {
-  std::vector<RunPrediction> preds;
-  for (const Run& r : runs) preds.push_back(PredictRun(fit.model, r));  // all inputs checked first
+DriftReportResult ModelReport(const fs::path& dir, const FitReport& fit, const ShownRuns& runs,
+                              const std::vector<std::string>& provenance,
+                              const std::string& gnuplot) {
   ReportWriter w(dir, gnuplot);
   const DriftModel& m = fit.model;
   std::ostringstream h;
@@ -326,44 +501,12 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
        "um</th>"
        "<th>std um</th><th>max um</th></tr>\n";
   std::ostringstream plots;
-  for (const RunPrediction& p : preds) {
-    const std::string slug = Slug(p.run);
-    w.PredictionFile(slug + "_prediction.csv", p, Comments(provenance, "prediction of " + p.run));
-    if (p.has_measured) {
-      h << StatsRow(p.run + " (model)", ComputeErrorStats(p.measured_um - p.predicted_um))
-        << StatsRow(p.run + " (no compensation)", ComputeErrorStats(p.measured_um));
-    }
-    // gnuplot reads the plot's rows only (M4: at most a few thousand whatever the run's length).
-    const std::string plot_csv = slug + "_plot.csv";
-    w.File(plot_csv, PlotCsv(p, Comments(provenance, "rows of the plot of " + p.run +
-                                                         " (M4 decimation of the prediction "
-                                                         "per pixel column; all rows: " +
-                                                         slug + "_prediction.csv)")));
-    const std::string x = p.time_from_index ? "sample" : "time [h]";
-    const std::string xcol = p.time_from_index ? "1" : "($1/60)";
-    std::ostringstream gp;
-    // The line looks of core/plot_style.h; the key right of the data, the panels aligned.
-    gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
-       << GnuplotString(x) << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\n"
-       << "set title "
-       << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column)
-       << "\nplot " << GnuplotString(plot_csv) << " using " << xcol
-       << ":($2-$4):($2+$4) with filledcurves fs transparent solid 0.15 noborder lc rgb '"
-       << FindSeriesStyle("prediction")->colour << "' title 'predicted +- 1 sd', '' using "
-       << xcol << ":2 " << GnuplotWith("prediction") << " title 'predicted'";
+  std::vector<PredictionSummary> preds;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const PredictionSummary& p = preds.emplace_back(ShowRun(&w, runs, i, m, provenance, &plots));
     if (p.has_measured)
-      gp << ", '' using " << xcol << ":5 " << GnuplotWith("measured") << " title 'measured'";
-    gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
-    if (p.has_measured)
-      gp << "plot " << GnuplotString(plot_csv) << " using " << xcol << ":6 "
-         << GnuplotWith("residual") << " title 'residual'\n";
-    else
-      gp << "plot 0 notitle\n";
-    gp << "unset multiplot\n";
-    plots << "<h3>" << HtmlEscape(p.run) << "</h3>\n";
-    for (const auto& warn : p.warnings) plots << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
-    plots << w.Plot(slug + "_prediction", gp.str(), "measured and predicted error of " + p.run)
-          << "\n";
+      h << StatsRow(p.run + " (model)", p.residual)
+        << StatsRow(p.run + " (no compensation)", p.none);
   }
   h << "</table>\n";
   std::vector<std::string> notes;
@@ -375,7 +518,24 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   DriftReportResult result = w.Finish(h.str());
   result.baselines = baselines;
   result.baseline_notes = notes;
+  result.predictions = std::move(preds);
   return result;
+}
+
+}  // namespace
+
+DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
+                                   const std::vector<Run>& runs,
+                                   const std::vector<std::string>& provenance,
+                                   const std::string& gnuplot) {
+  return ModelReport(dir, fit, RunsInMemory(runs), provenance, gnuplot);
+}
+
+DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
+                                   const std::vector<RunFile>& runs,
+                                   const std::vector<std::string>& provenance,
+                                   const std::string& gnuplot, const StreamProgress& progress) {
+  return ModelReport(dir, fit, RunsInFiles(runs, progress), provenance, gnuplot);
 }
 
 DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const HoldoutResult& r,

@@ -14,6 +14,7 @@
 #include "drift/evaluation.h"
 #include "drift/fit.h"
 #include "drift/model.h"
+#include "drift/stream.h"
 
 namespace whirl::drift {
 
@@ -35,15 +36,30 @@ struct DriftReportResult {
   std::vector<std::string> warnings;
   std::vector<ReportBaseline> baselines;    ///< model reports: one per run shown
   std::vector<std::string> baseline_notes;  ///< why a baseline is missing
+  std::vector<PredictionSummary> predictions;  ///< model reports: the model on each run shown
 };
 
 /// A fitted model (with its selection) applied to `runs`: the similarity matrix and lambda
 /// levels, the grades and the chosen sensors, the coefficients, and per run the measured and
-/// predicted error over time and the residual.
+/// predicted error over time and the residual. Per run the model's prediction is evaluated sample
+/// by sample into the per-sample CSV (written to disk as it is formatted), the plot's M4 rows
+/// (core/decimate.h) and the running statistics; each baseline is one more such pass with its own
+/// model (ReportBaseline), so the memory besides the runs given is independent of their length.
 DriftReportResult WriteModelReport(const std::filesystem::path& dir, const FitReport& fit,
                                    const std::vector<Run>& runs,
                                    const std::vector<std::string>& provenance,
                                    const std::string& gnuplot = "gnuplot");
+/// The same report on run files streamed block by block (drift/stream.h; any length): memory
+/// independent of the rows shown (a block of rows, the plots' decimated rows, running sums), plus
+/// the baselines' fits (FitFiles: the time-only warm-up on the training runs shown, drift fit's
+/// defaults on the previous run). Its statistics equal the in-memory report's up to rounding
+/// (ErrorStatsAccumulator); its models and plot rows are the same. `progress` (optional) hears
+/// every pass over a file.
+DriftReportResult WriteModelReport(const std::filesystem::path& dir, const FitReport& fit,
+                                   const std::vector<RunFile>& runs,
+                                   const std::vector<std::string>& provenance,
+                                   const std::string& gnuplot = "gnuplot",
+                                   const StreamProgress& progress = {});
 
 /// A hold-out evaluation: per channel the measured error and every method's prediction over the
 /// whole log prefix (train/test boundary marked) and the test residuals, with the table.

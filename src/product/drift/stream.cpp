@@ -33,8 +33,8 @@ PredictionSummary Summarize(const RunPrediction& p) {
 PredictionSummary PredictFile(const DriftModel& model, const std::filesystem::path& path,
                               ReferenceMode reference,
                               const std::function<void(const PredictedSample&)>& sink,
-                              const StreamProgress& progress) {
-  const RunScan scan = ScanRun(path);
+                              const StreamProgress& progress, const RunScan* scanned) {
+  const RunScan scan = scanned ? *scanned : ScanRun(path);
   RunReader reader(path, RunState::kUnknown, scan.time_from_index);
   const RunLayout& l = reader.layout();
   RunPredictor predictor(model, scan.time_from_index, l.source, reference);

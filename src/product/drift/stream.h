@@ -6,8 +6,10 @@
 //                                   outputs are written as the rows arrive);
 //   fit                             bounded: the evenly thinned sample of FitFiles (at most
 //                                   kSearchSampleCells cells) plus the final fit's running QR;
-//   report                          fit's, then predict's per run shown, plus the plot's
-//                                   decimated series (core/decimate.h: a few thousand points).
+//   report                          fit's, then predict's per pass over a run shown (the
+//                                   model's, one per baseline) plus the plot's decimated rows
+//                                   (core/decimate.h: a few thousand); the baselines' fits are
+//                                   fit's (drift/report.h).
 // Time axis: a streamed command first scans the file (ScanRun: the row count and whether every
 // row recorded its time), since the lags need the axis before the first row.
 #include <filesystem>
@@ -53,11 +55,12 @@ struct PredictedSample {
 
 /// PredictRun on a run file streamed block by block (fixed memory): the same samples, statistics
 /// and warnings. `sink` (optional) receives every sample in order (the CSV writer, a plot's
-/// decimation).
+/// decimation). `scan` (optional): the file's ScanRun, when the caller has it (several passes
+/// over one file scan it once).
 PredictionSummary PredictFile(const DriftModel& model, const std::filesystem::path& run,
                               ReferenceMode reference = ReferenceMode::kRunStart,
                               const std::function<void(const PredictedSample&)>& sink = {},
-                              const StreamProgress& progress = {});
+                              const StreamProgress& progress = {}, const RunScan* scan = nullptr);
 
 /// A run file named with its state, as the fit commands take them.
 struct RunFile {
