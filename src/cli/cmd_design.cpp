@@ -21,9 +21,9 @@ namespace whirl::cli {
 namespace {
 
 struct DesignCliOptions {
-  std::string candidates_path, model_path, out_path;
+  std::string candidates_path, model_path, out_path, measured_path;
   std::array<std::string, ProcessInputs::kCount> ranges;
-  int count = 0, levels = 3;
+  int count = 0, levels = 3, space_filling = 0;
   std::string criterion = "d";
   double tolerance_um = 0, tolerance_s = 0;
   bool json = false;
@@ -129,7 +129,8 @@ std::string InputsText(const ProcessInputs& x) {
 }
 
 void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
-  const auto d = design::DesignPowerLaw(c.inputs, o.count, design::ParseCriterion(o.criterion));
+  const auto d = design::DesignPowerLaw(c.inputs, o.count, design::ParseCriterion(o.criterion),
+                                        o.space_filling);
   const std::string csv = DesignCsv(c, d.picks, false, "first design, criterion " + o.criterion);
   if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
   if (o.json) {
@@ -145,6 +146,7 @@ void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
     PrintJson({{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
                {"candidate_count", c.inputs.size()}, {"coefficients", d.coefficients},
                {"varying_inputs", d.inputs}, {"log_det_per_screw", d.log_det},
+               {"space_filling", d.space_filling}, {"min_distance", d.min_distance},
                {"mean_sd_factor", d.mean_sd_factor}, {"max_sd_factor", d.max_sd_factor},
                {"picks", picks}});
     return;
@@ -174,9 +176,13 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
   const auto model = workpiece::LoadWorkpieceModel(o.model_path);
   design::StopRule rule;
   rule.tolerance = {o.tolerance_um, o.tolerance_s};
+  design::SpaceFilling fill;
+  fill.screws = o.space_filling;
+  if (!o.measured_path.empty())
+    fill.measured = ReadProcessTable(o.measured_path, /*require_targets=*/false).inputs;
   design::NextDesign d;
   try {
-    d = design::DesignNext(model, c.inputs, o.count, rule, c.lines);
+    d = design::DesignNext(model, c.inputs, o.count, rule, c.lines, fill);
   } catch (const InputError& e) {
     throw InputError("design --model " + o.model_path + " --candidates " + c.source + ": " +
                      e.what());
@@ -232,11 +238,14 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
 }
 
 void RunDesign(const DesignCliOptions& o) {
-  CheckOutputs({{"--candidates", o.candidates_path}, {"--model", o.model_path}},
+  CheckOutputs({{"--candidates", o.candidates_path}, {"--model", o.model_path},
+                {"--measured", o.measured_path}},
                {{"--out", o.out_path}});
   if (o.model_path.empty() && (o.tolerance_um > 0 || o.tolerance_s > 0))
     throw InputError("design: --tolerance-um / --tolerance-s need --model (the stop rule judges a "
                      "trained model's predictive sd)");
+  if (o.model_path.empty() && !o.measured_path.empty())
+    throw InputError("design: --measured needs --model (a first design has no measured screws)");
   const DesignCandidates c = ReadDesignCandidates(o);
   if (o.model_path.empty()) {
     try {
@@ -287,6 +296,16 @@ void RegisterDesign(CLI::App& app) {
                   "first design: d (D-optimal: the power law's coefficients) or i (I-optimal: its "
                   "mean prediction variance over the candidates)")
       ->capture_default_str();
+  sub->add_option("--space-filling", o->space_filling,
+                  "screws of --count chosen for space filling [screws]: each the candidate of "
+                  "largest distance (standardized log inputs) to the screws before it and, with "
+                  "--model, to the --measured ones; first design: after the optimal ones")
+      ->capture_default_str()
+      ->check(NumberIn(0, 100000));
+  sub->add_option("--measured", o->measured_path,
+                  "with --model: the screws measured so far (CSV, five input columns; e.g. the "
+                  "training table), needed by --space-filling")
+      ->check(CLI::ExistingFile);
   sub->add_option("--model", o->model_path,
                   "trained family model ('whirl train' default): next screws instead of a first "
                   "design")

@@ -61,7 +61,43 @@ for k in ("max_elongation_um", "settle_time_s"):
 assert d["stop"]["decision"] == "floor", d["stop"]
 PY
 
+# Space filling: the first design's last picks and a next batch's last pick say so; the next
+# mode keeps them away from the --measured screws (the training table here).
+"$whirl" design "${ranges[@]}" --count 8 --space-filling 2 --json > fill.json 2> err.txt \
+  || fail "design --space-filling: $(cat err.txt)"
+python3 - fill.json <<'PY2' || fail "fill.json: $(cat fill.json)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["space_filling"] == 2 and d["min_distance"] > 0
+assert [p["why"].startswith("space filling") for p in d["picks"]] == [False] * 6 + [True] * 2
+PY2
+"$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
+  --measured "$data" > out.txt 2> err.txt || fail "next --space-filling: $(cat err.txt)"
+grep -q "why: space filling" out.txt || fail "no space-filling pick: $(cat out.txt)"
+
+# A table on which one candidate's held-out error diverges (score about 5e16: 8 screws of the
+# "interacting" generator of scripts/bench_peers.py picked by a space-filling first design);
+# 'whirl train' once refused to write its own model (the reader capped the error at 1e12).
+cat > diverging.csv <<'CSV'
+hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min,max_elongation_um,settle_time_s
+50.762477742280424,20.27267384430763,5.299392587692616,5.317813643073528,249.0046025194891,23.950378153773762,12.019006595636997
+59.13457875206609,55.189232146018846,5.214686253513435,2.164271446872278,202.1488808251812,23.93438445183566,96.53466927644885
+42.388248445995444,53.4333287071961,5.227074433669532,5.267341509700547,116.97442586967277,23.88215216318723,33.202572027351735
+47.01507872773325,27.720727701534926,6.425275601729446,2.076261253180501,110.55471097449616,20.0071543838235,72.1238315345706
+58.8614760712245,46.50141013936262,13.00520532993242,5.052311958984523,130.3281629080634,29.623856593589178,51.91513764821854
+40.516918553369926,48.532146158975735,14.433769797439734,4.076705566326774,289.39621460534283,26.606376403732835,34.379201659697706
+44.48381934991297,21.463099627060885,11.475570867320155,2.237988049604183,275.57357860637967,21.044517838873926,20.53174790942123
+42.72766961115034,55.692046868241405,11.353671940415104,2.5196295573274234,106.44017749318631,20.495208861380203,37.03694626199615
+CSV
+"$whirl" train --data diverging.csv --out diverging.json --seed 1 --threads 1 > /dev/null \
+  2> err.txt || fail "train on a table with a diverging candidate: $(cat err.txt)"
+
 # Bad input: each error names what is wrong.
+expect_fail "needs --measured" "$whirl" design --model m.json --candidates cands.csv --count 2 \
+  --space-filling 1
+expect_fail "--measured needs --model" "$whirl" design "${ranges[@]}" --count 8 --measured "$data"
+expect_fail "count 8: the power law.*\[9, 243\]" "$whirl" design "${ranges[@]}" --count 8 \
+  --space-filling 3
 head -1 cands.csv > empty.csv
 expect_fail "empty.csv: table has no data rows" "$whirl" design --candidates empty.csv --count 6
 expect_fail "--pitch-mm-range 16..6: reversed range" "$whirl" design --hardness-hrc-range 60..65 \

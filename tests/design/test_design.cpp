@@ -117,6 +117,74 @@ TEST(Design, BadRequestsAreNamed) {
   EXPECT_THROW(ParseCriterion("a"), InputError);
 }
 
+// Standardized log inputs (each input: mean 0, sd 1 over `all`), rows = screws.
+Eigen::MatrixXd LogUnits(const std::vector<ProcessInputs>& all) {
+  Eigen::MatrixXd u(all.size(), 5);
+  for (std::size_t c = 0; c < all.size(); ++c)
+    for (int j = 0; j < 5; ++j) u(c, j) = std::log(all[c].ToArray()[j]);
+  for (int j = 0; j < 5; ++j) {
+    const double m = u.col(j).mean();
+    u.col(j) = (u.col(j).array() - m) / std::sqrt((u.col(j).array() - m).square().mean());
+  }
+  return u;
+}
+
+double Nearest(const Eigen::MatrixXd& u, int c, const std::vector<int>& from) {
+  double d = 1e300;
+  for (int i : from) d = std::min(d, (u.row(c) - u.row(i)).norm());
+  return d;
+}
+
+std::vector<ProcessInputs> RandomList(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<ProcessInputs> cands;
+  for (int i = 0; i < n; ++i)
+    cands.push_back(ProcessInputs::FromArray(
+        {60 + 5 * u(rng), 50 + 50 * u(rng), 6 + 10 * u(rng), 3 + 7 * u(rng), 150 + 60 * u(rng)}));
+  return cands;
+}
+
+TEST(Design, SpaceFillingPicksAreMaximinAfterTheOptimalOnes) {
+  std::mt19937 rng(11);
+  for (int t = 0; t < 10; ++t) {
+    const auto cands = RandomList(rng, 80);
+    const Eigen::MatrixXd u = LogUnits(cands);
+    const auto d = DesignPowerLaw(cands, 9, Criterion::kD, 3);
+    const auto optimal = DesignPowerLaw(cands, 6, Criterion::kD);
+    ASSERT_EQ(d.picks.size(), 9u);
+    std::vector<int> before;
+    for (int i = 0; i < 6; ++i) before.push_back(d.picks[i].candidate);
+    std::vector<int> opt;
+    for (const auto& p : optimal.picks) opt.push_back(p.candidate);
+    // The first picks are the D-optimal design of their count.
+    EXPECT_EQ(std::set<int>(before.begin(), before.end()), std::set<int>(opt.begin(), opt.end()));
+    // Each later pick is the candidate farthest from the picks before it (brute force).
+    for (int i = 6; i < 9; ++i) {
+      const int c = d.picks[i].candidate;
+      const double mine = Nearest(u, c, before);
+      for (int o = 0; o < static_cast<int>(cands.size()); ++o) {
+        if (std::find(before.begin(), before.end(), o) != before.end()) continue;
+        EXPECT_GE(mine, Nearest(u, o, before) - 1e-9) << "pick " << i << " candidate " << o;
+      }
+      EXPECT_EQ(d.picks[i].why.rfind("space filling", 0), 0u) << d.picks[i].why;
+      before.push_back(c);
+    }
+    EXPECT_EQ(std::set<int>(before.begin(), before.end()).size(), 9u);
+    // The reported maximin distance is the smallest pair distance of the design.
+    double pair = 1e300;
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < i; ++j) pair = std::min(pair, (u.row(before[i]) - u.row(before[j])).norm());
+    EXPECT_NEAR(d.min_distance, pair, 1e-9);
+  }
+}
+
+TEST(Design, SpaceFillingCountsAreChecked) {
+  const auto g = GridCandidates(PaperRanges(), 3);
+  EXPECT_NO_THROW(DesignPowerLaw(g, 8, Criterion::kD, 2));
+  EXPECT_THROW(DesignPowerLaw(g, 8, Criterion::kD, 3), InputError);  // 5 < 6 coefficients
+  EXPECT_THROW(DesignPowerLaw(g, 8, Criterion::kD, -1), InputError);
+}
+
 // A GP on 12 rows of a smooth function of 2 inputs.
 gp::Gp SmallGp() {
   Eigen::MatrixXd x(2, 12);
@@ -188,6 +256,41 @@ TEST(Design, NextScrewsLowerTheVarianceAndStopRuleDecides) {
   const NextDesign m = DesignNext(model, cands, 1, middle);
   EXPECT_EQ(m.stop, "continue");
   EXPECT_GE(m.screws_to_tolerance, 1);
+}
+
+TEST(Design, NextSpaceFillingPicksKeepAwayFromTheMeasured) {
+  const ProcessTable t = ReadProcessTable(WHIRL_SOURCE_DIR "/datasets/whirling_train.csv", true);
+  workpiece::TrainOptions o;
+  const auto model = workpiece::TrainWorkpieceModel(t, o, "whirling_train.csv");
+  const auto cands = GridCandidates(PaperRanges(), 3);
+  SpaceFilling fill;
+  fill.screws = 2;
+  fill.measured = t.inputs;
+  const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill);
+  const NextDesign plain = DesignNext(model, cands, 1);
+  ASSERT_EQ(d.picks.size(), 3u);
+  EXPECT_EQ(d.picks[0].candidate, plain.picks[0].candidate);  // the variance pick comes first
+  std::vector<ProcessInputs> all = cands;
+  all.insert(all.end(), t.inputs.begin(), t.inputs.end());
+  const Eigen::MatrixXd u = LogUnits(all);
+  std::vector<int> near;
+  for (std::size_t i = 0; i < t.inputs.size(); ++i) near.push_back(int(cands.size() + i));
+  near.push_back(d.picks[0].candidate);
+  for (int i = 1; i < 3; ++i) {
+    const int c = d.picks[i].candidate;
+    const double mine = Nearest(u, c, near);
+    for (int other = 0; other < static_cast<int>(cands.size()); ++other) {
+      if (std::find(near.begin(), near.end(), other) != near.end()) continue;
+      EXPECT_GE(mine, Nearest(u, other, near) - 1e-9) << "pick " << i << " vs " << other;
+    }
+    for (int k = 0; k < 2; ++k) EXPECT_LE(d.picks[i].sd_after[k], d.picks[i].sd_now[k] + 1e-12);
+    near.push_back(c);
+  }
+  SpaceFilling none;
+  none.screws = 1;
+  EXPECT_THROW(DesignNext(model, cands, 2, {}, {}, none), InputError);  // no --measured
+  fill.screws = 4;
+  EXPECT_THROW(DesignNext(model, cands, 3, {}, {}, fill), InputError);  // more than --count
 }
 
 }  // namespace

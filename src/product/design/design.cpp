@@ -142,6 +142,35 @@ std::vector<Pick> ExplainingOrder(const Eigen::MatrixXd& f, const std::vector<in
   return out;
 }
 
+// ---- Space filling: maximin picks --------------------------------------------------------------
+
+// The smallest distance from point c of `u` to the points `from` of `u` (rows), +inf if none.
+double NearestDistance(const Eigen::MatrixXd& u, int c, const std::vector<int>& from) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int i : from) d = std::min(d, (u.row(c) - u.row(i)).norm());
+  return d;
+}
+
+// The unpicked row of u (among the first `n` rows: the candidates) farthest from the rows
+// `near` (picked candidates and measured screws); ties to the lower index. -1 when all taken.
+int FarthestCandidate(const Eigen::MatrixXd& u, int n, const std::vector<char>& taken,
+                      const std::vector<int>& near, double* distance) {
+  int best = -1;
+  *distance = -1;
+  for (int c = 0; c < n; ++c) {
+    if (taken[c]) continue;
+    const double d = NearestDistance(u, c, near);
+    if (d > *distance * (1 + 1e-12)) *distance = d, best = c;
+  }
+  return best;
+}
+
+std::string WhySpaceFilling(double distance) {
+  return "space filling: the candidate farthest from the screws before it (distance " +
+         FormatSignificant(distance, 3) + " in standardized log inputs), so that the model's "
+         "cross-validation sees the inside of the range and a bend";
+}
+
 // ---- Next screws: integrated variance reduction --------------------------------------------
 
 // One output's state over the candidates: latent covariance in the transformed space, the
@@ -396,32 +425,80 @@ std::vector<ProcessInputs> GridCandidates(const InputRanges& r, int levels) {
   return out;
 }
 
+namespace {
+
+// The power-law sd factor sqrt(f_c' M^-1 f_c) of row c, M the information of `picked`.
+double SdFactor(const Eigen::MatrixXd& f, const std::vector<int>& picked, int c) {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(f.cols(), f.cols());
+  for (int i : picked) m.noalias() += f.row(i).transpose() * f.row(i);
+  return std::sqrt(std::max(0.0, double(f.row(c) * m.inverse() * f.row(c).transpose())));
+}
+
+// `k` more picks of the first design, each the candidate farthest (maximin) from those before.
+void AddSpaceFilling(const Eigen::MatrixXd& f, int k, std::vector<int>* picked,
+                     std::vector<Pick>* picks) {
+  const Eigen::MatrixXd u = f.rightCols(f.cols() - 1);
+  std::vector<char> taken(f.rows(), 0);
+  for (int i : *picked) taken[i] = 1;
+  for (int i = 0; i < k; ++i) {
+    double distance = 0;
+    const int c = FarthestCandidate(u, static_cast<int>(f.rows()), taken, *picked, &distance);
+    Pick pick;
+    pick.candidate = c;
+    pick.sd_now = {SdFactor(f, *picked, c), 0};
+    taken[c] = 1;
+    picked->push_back(c);
+    pick.sd_after = {SdFactor(f, *picked, c), 0};
+    pick.why = WhySpaceFilling(distance);
+    picks->push_back(pick);
+  }
+}
+
+// The smallest distance between two picks, standardized log inputs (f's columns after the 1).
+double MinPairDistance(const Eigen::MatrixXd& f, const std::vector<int>& picked) {
+  const Eigen::MatrixXd u = f.rightCols(f.cols() - 1);
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < picked.size(); ++i)
+    d = std::min(d, NearestDistance(u, picked[i], {picked.begin(), picked.begin() + long(i)}));
+  return d;
+}
+
+}  // namespace
+
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count,
-                              Criterion criterion) {
+                              Criterion criterion, int space_filling) {
   if (cands.empty()) throw InputError("design: the candidate list is empty");
   PowerLawDesign d;
   d.criterion = criterion;
+  d.space_filling = space_filling;
   const Eigen::MatrixXd f = PowerLawRows(cands, &d.inputs);
   d.coefficients = static_cast<int>(f.cols());
   const int n = static_cast<int>(cands.size());
-  if (count < d.coefficients || count > n)
+  if (space_filling < 0 || space_filling >= count)
+    throw InputError("design --space-filling " + std::to_string(space_filling) +
+                     ": must lie in [0, --count - 1]");
+  if (count - space_filling < d.coefficients || count > n)
     throw InputError("design --count " + std::to_string(count) + ": the power law in the " +
                      std::to_string(d.inputs.size()) + " inputs that vary over the " +
                      std::to_string(n) + " candidates has " + std::to_string(d.coefficients) +
                      " coefficients; the count must lie in [" +
-                     std::to_string(d.coefficients) + ", " + std::to_string(n) + "]");
+                     std::to_string(d.coefficients + space_filling) + ", " + std::to_string(n) +
+                     "] (the coefficients plus --space-filling " + std::to_string(space_filling) +
+                     ", at most the candidates)");
   const Eigen::MatrixXd w = f.transpose() * f / static_cast<double>(n);
-  std::vector<int> picked = GreedyStart(f, count);
+  std::vector<int> picked = GreedyStart(f, count - space_filling);
   Exchange(f, criterion, w, &picked);
   if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w)))
     throw InputError("design: the candidates do not determine a power law (their log inputs "
                      "are collinear); add candidates that vary the inputs independently");
   d.picks = ExplainingOrder(f, picked);
+  AddSpaceFilling(f, space_filling, &picked, &d.picks);
   d.log_det = CriterionValue(f, picked, Criterion::kD, w) - d.coefficients * std::log(count);
+  d.min_distance = MinPairDistance(f, picked);
+  double sum = 0, mx = 0;
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(f.cols(), f.cols());
   for (int i : picked) m.noalias() += f.row(i).transpose() * f.row(i);
   const Eigen::MatrixXd mi = m.inverse();
-  double sum = 0, mx = 0;
   for (int c = 0; c < n; ++c) {
     const double v = std::sqrt(std::max(0.0, double(f.row(c) * mi * f.row(c).transpose())));
     sum += v, mx = std::max(mx, v);
@@ -433,12 +510,19 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
 
 NextDesign DesignNext(const workpiece::WorkpieceModel& model,
                       const std::vector<ProcessInputs>& cands, int count, const StopRule& stop,
-                      const std::vector<int>& lines) {
+                      const std::vector<int>& lines, const SpaceFilling& fill) {
   if (cands.empty()) throw InputError("design: the candidate list is empty");
   const int n = static_cast<int>(cands.size());
   if (count < 1 || count > n)
     throw InputError("design --count " + std::to_string(count) + ": must lie in [1, " +
                      std::to_string(n) + "] (the candidates)");
+  if (fill.screws < 0 || fill.screws > count)
+    throw InputError("design --space-filling " + std::to_string(fill.screws) +
+                     ": must lie in [0, --count " + std::to_string(count) + "]");
+  if (fill.screws > 0 && fill.measured.empty())
+    throw InputError("design --space-filling " + std::to_string(fill.screws) +
+                     " with --model needs --measured (the screws measured so far, e.g. the "
+                     "model's training table): the space-filling picks keep away from them");
   auto states = States(model, cands, lines);
   NextDesign d;
   d.now = workpiece::PredictBatch(model, cands);
@@ -448,15 +532,29 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
     states[k].weight = d.rms_sd_now[k] > 0 ? 1.0 / (d.rms_sd_now[k] * d.rms_sd_now[k]) : 0.0;
   }
   const auto initial = states;
+  std::vector<ProcessInputs> all = cands;
+  all.insert(all.end(), fill.measured.begin(), fill.measured.end());
+  std::vector<std::string> names;
+  const Eigen::MatrixXd rows = PowerLawRows(all, &names);
+  const Eigen::MatrixXd u = rows.rightCols(rows.cols() - 1);
+  std::vector<int> near(fill.measured.size());
+  std::iota(near.begin(), near.end(), n);
   std::vector<char> taken(n, 0);
   for (int i = 0; i < count; ++i) {
-    double score = 0;
-    const int j = BestCandidate(states, taken, &score);
     Pick p;
-    p.candidate = j;
-    p.why = WhyNext(states, j, score / n, d.now[j]);
+    if (i >= count - fill.screws) {
+      double distance = 0;
+      p.candidate = FarthestCandidate(u, n, taken, near, &distance);
+      p.why = WhySpaceFilling(distance);
+    } else {
+      double score = 0;
+      p.candidate = BestCandidate(states, taken, &score);
+      p.why = WhyNext(states, p.candidate, score / n, d.now[p.candidate]);
+    }
+    const int j = p.candidate;
     for (int k = 0; k < Features::kCount; ++k) p.sd_now[k] = std::sqrt(initial[k].Variance(j));
     taken[j] = 1;
+    near.push_back(j);
     for (auto& st : states) st.Measure(j);
     for (int k = 0; k < Features::kCount; ++k) p.sd_after[k] = std::sqrt(states[k].Variance(j));
     d.picks.push_back(p);

@@ -19,6 +19,16 @@
 // sd over the candidates is given as a factor of the measurement scatter of ln y (relative
 // scatter): sd(ln y_hat(x)) = factor(x) * sd(scatter), factor = sqrt(f' (F'F)^-1 f).
 //
+// Space filling (`space_filling` screws of the count): the optimal design puts every screw at
+// the edges of the log-input box, where a power law is best determined but a bend inside the box
+// is invisible to the model's cross-validation. The last `space_filling` screws are therefore
+// picked one at a time as the candidate farthest (Euclidean, log inputs standardized over the
+// list) from the screws before it (greedy maximin; Johnson, Moore & Ylvisaker, "Minimax and
+// maximin distance designs", 1990), after count - space_filling optimal ones. In the next-screws
+// mode the same rule picks the batch's last `space_filling` screws, keeping away from the
+// screws measured so far (SpaceFilling::measured) and the batch's earlier picks; the variance
+// update still counts them as measured, so later variance picks do not repeat their region.
+//
 // Next screws (DesignNext): a trained family model (workpiece/model.h, family/family.h) and the
 // candidates coming up. Per output k, the latent posterior covariance C_k of the chosen family
 // over the candidates (gp::PosteriorCovariance, family::LatentCovariance; in the output's
@@ -83,14 +93,17 @@ struct PowerLawDesign {
   int coefficients = 0;             ///< 1 + inputs that vary over the candidates
   std::vector<std::string> inputs;  ///< the varying inputs' columns
   std::vector<Pick> picks;          ///< in the explaining order (header comment)
+  int space_filling = 0;            ///< the last picks chosen by maximin (header comment)
   double log_det = 0;               ///< ln det(F'F / count), standardized log inputs
+  double min_distance = 0;          ///< smallest distance between two picks (std. log inputs)
   double mean_sd_factor = 0, max_sd_factor = 0;  ///< over the candidates (header comment)
 };
 
-/// The first design of the header comment: `count` distinct candidates. InputError if the list
-/// is empty, count < coefficients or count > candidates.
+/// The first design of the header comment: `count` distinct candidates, the last
+/// `space_filling` of them by maximin. InputError if the list is empty, space_filling is outside
+/// [0, count - 1], count - space_filling < coefficients or count > candidates.
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& candidates, int count,
-                              Criterion criterion);
+                              Criterion criterion, int space_filling = 0);
 
 struct StopRule {
   /// Per output, the tolerance of the RMS predictive sd over the candidates (um, s); <= 0: none.
@@ -110,13 +123,20 @@ struct NextDesign {
   std::string stop_reason;  ///< one or two sentences, with the figures
 };
 
+/// The space-filling share of a next batch (header comment).
+struct SpaceFilling {
+  int screws = 0;                        ///< the batch's last picks chosen by maximin
+  std::vector<ProcessInputs> measured;   ///< the screws measured so far (needed if screws > 0)
+};
+
 /// The next screws of the header comment: `count` distinct candidates (1 <= count <=
-/// candidates). InputError if the list is empty, the model is a network or a stacked choice
+/// candidates), the last fill.screws (<= count; needs fill.measured) by maximin. InputError if the list is empty, the model is a network or a stacked choice
 /// ("whirl train" without --family network or --stack), or if it leaves out an input (constant
 /// in its training table) that the candidates vary (naming the input, its training value and the
 /// first candidate that differs: "line N" when `lines` gives the candidates' file lines).
 NextDesign DesignNext(const workpiece::WorkpieceModel& model,
                       const std::vector<ProcessInputs>& candidates, int count,
-                      const StopRule& stop = {}, const std::vector<int>& lines = {});
+                      const StopRule& stop = {}, const std::vector<int>& lines = {},
+                      const SpaceFilling& fill = {});
 
 }  // namespace whirl::design
