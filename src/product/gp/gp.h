@@ -142,10 +142,12 @@ struct Gp {
   /// The rows of the training table the GP keeps (GpOptions::max_rows); empty: all rows, in order.
   /// Set by FitGp, not stored in files.
   std::vector<int> rows;
-  // Derived by Factorize() from the fields above (not stored in files):
-  Eigen::LLT<Eigen::MatrixXd> chol;    ///< K = L L'
-  Eigen::MatrixXd k_inv_h;             ///< K^-1 H, n x m
-  Eigen::LLT<Eigen::MatrixXd> a_chol;  ///< H' K^-1 H = L_A L_A'
+  // Derived by Factorize() from the fields above (not stored in files). The factors start as
+  // factorizations of an empty matrix: Eigen's default LLT leaves its status unset, and copying a
+  // Gp before Factorize() (FitGp does) would read it (UBSan: invalid ComputationInfo).
+  Eigen::LLT<Eigen::MatrixXd> chol{Eigen::MatrixXd()};    ///< K = L L'
+  Eigen::MatrixXd k_inv_h;                                ///< K^-1 H, n x m
+  Eigen::LLT<Eigen::MatrixXd> a_chol{Eigen::MatrixXd()};  ///< H' K^-1 H = L_A L_A'
   Eigen::VectorXd b;                   ///< GLS mean coefficients
   Eigen::VectorXd alpha;               ///< K^-1 (u - H b)
 
