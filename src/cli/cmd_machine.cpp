@@ -172,9 +172,9 @@ void AddScenarioOptions(CLI::App* e, MachineCliOptions* o) {
                 "production days scored per machine (1..20, default 2)")
       ->check(NumberIn(1, 20));
   e->add_option("--past-days", o->past_days,
-                "history production days per machine whose screws' leads are measured (1..30, "
-                "default 5)")
-      ->check(NumberIn(1, 30));
+                "history production days per machine whose screws' leads are measured (1..40, "
+                "default 5; 40 = 8 weeks)")
+      ->check(NumberIn(1, 40));
   e->add_option("--check-every-min", o->check_every_min,
                 "probe reading of the check ring every [min] in the warm-up tests (1..120, "
                 "default 10)")
@@ -235,8 +235,10 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
       "--test-days production days are cut with every strategy: none, traditional (the\n"
       "strongest history rule), workpiece (the network's plan), class, table, nearest, warmup\n"
       "(time since power-on), schedule (the control's duty signals), lead_slope, machine_shop\n"
-      "(the sensor model alone), both_shop (plan + sensor model) and both_shop_monitor\n"
-      "(both_shop kept valid by the probe checks at the set-ups), every machine model applied\n"
+      "(the sensor model alone), both_shop (plan + sensor model), both_shop_monitor\n"
+      "(both_shop kept valid by the probe checks at the set-ups) and both_grey (plan + the\n"
+      "grey box: absolute temperatures, a slope intercept, the blank latched at the cut start,\n"
+      "physical priors), every machine model applied\n"
       "from past control samples only. Prints per scenario the median [range of per-seed\n"
       "medians] and worst accumulated lead error [um] within 1000 mm and over the thread,\n"
       "|e_a - c| [um], P3/P5 shares, and the headlines against the strongest sensor-free\n"

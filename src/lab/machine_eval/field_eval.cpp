@@ -266,7 +266,7 @@ void ValidateFieldOptions(const FieldEvalOptions& o) {
   range(o.machines, 1, 20, "machines");
   range(o.threads, 1, 64, "threads");
   range(o.calendar.test_days, 1, 20, "test days");
-  range(o.calendar.past_days, 1, 30, "past days");
+  range(o.calendar.past_days, 1, 40, "past days");
   o.machine.Validate("field machine '" + o.machine.name + "'");
 }
 
