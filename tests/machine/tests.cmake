@@ -1,5 +1,6 @@
 # Tests of src/lab/machine; the evaluation of both halves is tested in tests/machine_eval.
-whirl_add_gtest(test_machine SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_machine.cpp)
+whirl_add_gtest(test_machine SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_machine.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/test_blank.cpp)
 whirl_add_cli_test(cli_machine ${CMAKE_CURRENT_LIST_DIR}/cli_machine.sh)
 # scripts/grey_acceptance.sh: arguments only (the table takes minutes).
 whirl_add_cli_test(cli_grey_acceptance ${CMAKE_CURRENT_LIST_DIR}/cli_grey_acceptance.sh)
