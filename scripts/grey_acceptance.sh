@@ -65,13 +65,15 @@ for w in weeks:
         if sc in ("unconditioned-hall", "interrupted-starts"):
             crit = ">= 30 %, every seed (1 week)" if w == "1" else "-"
             ok = (gain >= 30 and won == n) if w == "1" else None
-        else:
+        elif sc in ("production", "duty-changes"):
             if w == "1":
                 crit, ok = "not worse (1 week)", gain >= 0
             elif w == "8":
                 crit, ok = ">= 30 % (8 weeks)", gain >= 30
             else:
                 crit, ok = "-", None
+        else:
+            crit, ok = "-", None
         holds = "-" if ok is None else ("yes" if ok else "NO")
         print(f"| {w} | {sc} | {best} {med:.1f} | {rows.get((sc, 'both_shop'), float('nan')):.1f} "
               f"| {rows.get((sc, 'both_grey'), float('nan')):.1f} | {gain:+.1f} % | {won} of {n} "

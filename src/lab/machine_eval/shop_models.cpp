@@ -1,5 +1,6 @@
 #include "machine_eval/shop_models.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <tuple>
@@ -55,7 +56,13 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
     m.sensors = *sensors, m.sensors_choice = "sensors";
   if (combined.cv_rmse_um < m.sensors.cv_rmse_um)
     m.sensors = combined, m.sensors_choice = "sensors+" + base_name;
-  m.grey = drift::FitGreyBox(record, FieldGreyBoxSpec(z_fixed_mm));
+  // The grey box needs the field machine's sensors (a record without them keeps it empty).
+  const drift::GreyBoxSpec grey = FieldGreyBoxSpec(z_fixed_mm);
+  const std::vector<std::string>& have = record.day_logs.front().sensor_names;
+  bool placed = true;
+  for (const std::string& s : grey.Inputs())
+    placed = placed && std::find(have.begin(), have.end(), s) != have.end();
+  if (placed) m.grey = drift::FitGreyBox(record, grey);
   return m;
 }
 

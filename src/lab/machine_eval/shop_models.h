@@ -35,7 +35,9 @@ std::vector<std::string> ScheduleInputs();
 struct ShopModels {
   drift::JointDriftModel sensors, warmup, schedule;
   std::string sensors_choice;  ///< which candidate the sensor model is (see above)
-  drift::GreyBoxModel grey;    ///< the grey box (FieldGreyBoxSpec), the both_grey row
+  /// The grey box (FieldGreyBoxSpec), the both_grey row; empty (no input, 0 everywhere) when
+  /// the record's logs lack one of its sensors.
+  drift::GreyBoxModel grey;
 };
 
 /// The grey box of the field machine (drift/grey_box.h), its sensors placed by the physics:

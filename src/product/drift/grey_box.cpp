@@ -28,6 +28,13 @@ void GreyBoxOptions::Validate() const {
                      ": must lie in (0, 1)");
 }
 
+std::vector<std::string> GreyBoxSpec::Inputs() const {
+  std::vector<std::string> in = offset_sensors;
+  in.insert(in.end(), slope_sensors.begin(), slope_sensors.end());
+  if (!blank_sensor.empty()) in.push_back(blank_sensor);
+  return in;
+}
+
 std::vector<std::string> GreyBoxModel::Inputs() const {
   std::vector<std::string> in = offset_sensors;
   in.insert(in.end(), slope_sensors.begin(), slope_sensors.end());
@@ -239,8 +246,7 @@ GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
   if (spec.offset_sensors.empty() && spec.slope_sensors.empty())
     throw InputError("grey box: no offset or slope sensor given");
   for (const Run& log : record.day_logs)
-    for (const auto& s : spec.offset_sensors.empty() ? spec.slope_sensors : spec.offset_sensors)
-      (void)log.SensorIndex(s);  // InputError naming the missing column
+    for (const auto& s : spec.Inputs()) (void)log.SensorIndex(s);  // InputError naming it
   double cv = 0;
   const grey_box_detail::Choice c = grey_box_detail::Choose(record, spec, options, &cv);
   const grey_box_detail::Design d = grey_box_detail::BuildDesign(record, spec, c, options.lead_share);

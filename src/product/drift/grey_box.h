@@ -51,6 +51,8 @@ struct GreyBoxSpec {
   std::map<std::string, double> offset_prior, slope_prior;
   /// g_b's prior, um per 1000 mm per K: -alpha_w x 1e6 (steel: -11.5).
   double blank_prior = -11.5;
+  /// Every sensor the spec reads: offset, slope, then the blank sensor (when set).
+  std::vector<std::string> Inputs() const;
 };
 
 struct GreyBoxOptions {
