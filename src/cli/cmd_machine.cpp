@@ -193,7 +193,7 @@ void AddScenarioOptions(CLI::App* e, MachineCliOptions* o) {
                 "one point of a past screw's measured lead per [min] of cutting time in the "
                 "training record (1..30, default 5)")
       ->check(NumberIn(1.0, 30.0));
-  e->add_option("--blank-h-w-m2k", o->blank_h_w_m2k,
+  e->add_option("--blank-h-w-m2-per-k", o->blank_h_w_m2k,
                 "each blank's thermal lag from its diameter, tau = rho c D / (4 h), with this "
                 "convection coefficient h [W/(m^2 K)] (0..100; default 0: every blank 45 min)")
       ->check(NumberIn(0.0, 100.0));
