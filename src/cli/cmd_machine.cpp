@@ -50,6 +50,7 @@ struct MachineCliOptions {
   int test_days = 2, past_days = 5;
   double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
   bool no_setup_checks = false;
+  double blank_h_w_m2k = 0, stock_offset_std_k = 0;
   std::vector<std::pair<std::string, CLI::Option*>> retired;  ///< legacy-world flags, hidden
 };
 
@@ -76,6 +77,8 @@ machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
   f.protocol.laser_every_min = o.laser_every_min;
   f.protocol.lead_sample_min = o.lead_sample_min;
   f.protocol.setup_checks = !o.no_setup_checks;
+  f.machine.blank_h_w_m2k = o.blank_h_w_m2k;
+  f.machine.stock_offset_std_k = o.stock_offset_std_k;
   return f;
 }
 
@@ -172,9 +175,9 @@ void AddScenarioOptions(CLI::App* e, MachineCliOptions* o) {
                 "production days scored per machine (1..20, default 2)")
       ->check(NumberIn(1, 20));
   e->add_option("--past-days", o->past_days,
-                "history production days per machine whose screws' leads are measured (1..30, "
-                "default 5)")
-      ->check(NumberIn(1, 30));
+                "history production days per machine whose screws' leads are measured (1..40, "
+                "default 5; 40 = 8 weeks)")
+      ->check(NumberIn(1, 40));
   e->add_option("--check-every-min", o->check_every_min,
                 "probe reading of the check ring every [min] in the warm-up tests (1..120, "
                 "default 10)")
@@ -190,6 +193,14 @@ void AddScenarioOptions(CLI::App* e, MachineCliOptions* o) {
                 "one point of a past screw's measured lead per [min] of cutting time in the "
                 "training record (1..30, default 5)")
       ->check(NumberIn(1.0, 30.0));
+  e->add_option("--blank-h-w-m2-per-k", o->blank_h_w_m2k,
+                "each blank's thermal lag from its diameter, tau = rho c D / (4 h), with this "
+                "convection coefficient h [W/(m^2 K)] (0..100; default 0: every blank 45 min)")
+      ->check(NumberIn(0.0, 100.0));
+  e->add_option("--stock-offset-std-k", o->stock_offset_std_k,
+                "stock from a store or the gate: each blank's temperature at the cut start is the "
+                "hall's lagged one plus N(0, this) [K] (0..10; default 0: stored in the hall)")
+      ->check(NumberIn(0.0, 10.0));
   e->add_flag("--no-setup-checks", o->no_setup_checks,
               "no probe reading of the check ring at power-on and at each set-up of the past "
               "production days");
@@ -235,8 +246,10 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
       "--test-days production days are cut with every strategy: none, traditional (the\n"
       "strongest history rule), workpiece (the network's plan), class, table, nearest, warmup\n"
       "(time since power-on), schedule (the control's duty signals), lead_slope, machine_shop\n"
-      "(the sensor model alone), both_shop (plan + sensor model) and both_shop_monitor\n"
-      "(both_shop kept valid by the probe checks at the set-ups), every machine model applied\n"
+      "(the sensor model alone), both_shop (plan + sensor model), both_shop_monitor\n"
+      "(both_shop kept valid by the probe checks at the set-ups) and both_grey (plan + the\n"
+      "grey box: absolute temperatures, a slope intercept, the blank latched at the cut start,\n"
+      "physical priors), every machine model applied\n"
       "from past control samples only. Prints per scenario the median [range of per-seed\n"
       "medians] and worst accumulated lead error [um] within 1000 mm and over the thread,\n"
       "|e_a - c| [um], P3/P5 shares, and the headlines against the strongest sensor-free\n"

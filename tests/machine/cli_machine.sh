@@ -100,7 +100,7 @@ s = j["scenarios"][0]
 assert s["scenario"] == "production"
 rows = list(s["strategies"])
 want = ["none", "traditional", "workpiece", "class", "table", "nearest", "warmup", "schedule",
-        "lead_slope", "machine_shop", "both_shop", "both_shop_monitor"]
+        "lead_slope", "machine_shop", "both_shop", "both_shop_monitor", "both_grey"]
 assert sorted(rows) == sorted(want), rows
 assert s["strategies"]["none"]["screws"] >= 1
 PY

@@ -75,6 +75,12 @@ void FieldMachineConfig::Validate(const std::string& where) const {
   if (head.sign != 1 && head.sign != -1) throw InputError(where + ": head.sign must be +1 or -1");
   for (double s : {capacity_spread, conductance_spread, length_spread, power_spread})
     if (!(s >= 0 && s <= 1)) throw InputError(where + ": spreads must be in [0, 1]");
+  if (!(blank_h_w_m2k >= 0 && blank_h_w_m2k <= 100))
+    throw InputError(where + ": blank_h_w_m2k = " + std::to_string(blank_h_w_m2k) +
+                     ": must be within 0..100 W/(m^2 K)");
+  if (!(stock_offset_std_k >= 0 && stock_offset_std_k <= 10))
+    throw InputError(where + ": stock_offset_std_k = " + std::to_string(stock_offset_std_k) +
+                     ": must be within 0..10 K");
 }
 
 FieldMachine::FieldMachine(const FieldMachineConfig& config, std::uint64_t machine_seed)

@@ -96,6 +96,14 @@ struct FieldMachineConfig {
   double steel_conductivity = 38, steel_density = 7810, steel_heat = 465;  ///< screw material
   double cabinet_base_c = 25, cabinet_hall_gain = 0.3;
   double blank_tau_min = 45;  ///< a blank stored in the hall follows it with this lag (truth.h)
+  /// > 0: each blank's own lag from its diameter instead of blank_tau_min, tau = rho c D / (4 h)
+  /// (a long steel cylinder losing heat through its mantle; rho, c = steel_density,
+  /// steel_heat; h in W/(m^2 K), 0..100; docs/machine-truth.md). 0: blank_tau_min (default).
+  double blank_h_w_m2k = 0;
+  /// Stock from a store or the gate: a blank's temperature at the cut start is the hall's
+  /// lagged temperature plus N(0, this) K drawn per screw (0..10; 0: stored in the hall, the
+  /// default).
+  double stock_offset_std_k = 0;
   double capacity_spread = 0.10;    ///< per machine: capacities x (1 + this N)
   double conductance_spread = 0.15; ///< per machine: conductances and source powers
   double length_spread = 0.10;      ///< per machine: the head's lengths L_j

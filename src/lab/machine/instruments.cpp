@@ -133,7 +133,7 @@ std::vector<Reading> MeasureLead(const MachineTimeline& timeline, const CutRef& 
   const double start = cut.day * 1440.0 + job.cut_start_min;
   Rng rng(seed);
   const double scale = options.scale_noise_um_per_m * rng.Normal();
-  const double blank_c = detail::BlankTemperatureC(timeline.data(), start);
+  const double blank_c = detail::CutBlankC(timeline.data(), plan, cut.job);
   auto total = [&](double x) {
     const double t_s = x / k.axial_feed_mm_s;
     const auto p = timeline.data().ErrorAt(start + t_s / 60, k.thread_start_position_mm - x);

@@ -21,7 +21,7 @@ CutMagnitude MeasureCut(const MachineTimeline& timeline, const CutRef& cut) {
   const Job& job = timeline.Day(cut.day).jobs[cut.job];
   const double start = cut.day * 1440.0 + job.cut_start_min;
   std::vector<double> x, head, z, total;
-  const double blank_c = detail::BlankTemperatureC(timeline.data(), start);
+  const double blank_c = detail::CutBlankC(timeline.data(), timeline.Day(cut.day), cut.job);
   const TruthSample at0 = TrueError(timeline, start, job.kinematics.thread_start_position_mm);
   for (double s = 0; s <= job.screw.thread_length_mm + 1e-9; s += 10) {
     const double t = start + s / job.kinematics.axial_feed_mm_min;

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/numbers.h"
+#include "core/random.h"
 #include "machine/timeline_data.h"
 #include "sim/physics.h"
 
@@ -176,8 +177,27 @@ detail::TimelineData::Parts detail::TimelineData::ErrorAt(double t, double z_mm)
   return {p.head_um, p.z_um, extra};
 }
 
-double detail::BlankTemperatureC(const TimelineData& d, double abs_min) {
-  const double tau = d.machine.config().blank_tau_min, step = tau / 20;
+double detail::BlankTauMin(const TimelineData& d, const DayPlan& plan, int job) {
+  const FieldMachineConfig& c = d.machine.config();
+  if (!(c.blank_h_w_m2k > 0)) return c.blank_tau_min;
+  const double diameter_m =
+      plan.jobs[static_cast<std::size_t>(job)].screw.process.diameter_mm / 1000.0;
+  return c.steel_density * c.steel_heat * diameter_m / (4 * c.blank_h_w_m2k) / 60.0;
+}
+
+double detail::CutBlankC(const TimelineData& d, const DayPlan& plan, int job) {
+  const double start = plan.day * 1440.0 + plan.jobs[static_cast<std::size_t>(job)].cut_start_min;
+  double c = BlankTemperatureC(d, start, BlankTauMin(d, plan, job));
+  const double sd = d.machine.config().stock_offset_std_k;
+  if (sd > 0) {
+    Rng rng(MixSeed(plan.seed, 0x73746f636bULL + static_cast<std::uint64_t>(job)));
+    c += sd * rng.Normal();
+  }
+  return c;
+}
+
+double detail::BlankTemperatureC(const TimelineData& d, double abs_min, double tau_min) {
+  const double tau = tau_min, step = tau / 20;
   double sum = 0, weight = 0;
   for (int i = 0; i < 160; ++i) {  // 8 tau, midpoint rule
     const double age = (i + 0.5) * step, w = std::exp(-age / tau);

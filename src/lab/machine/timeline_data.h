@@ -26,8 +26,14 @@ struct TimelineData {
 };
 
 /// Temperature of a blank stored in the hall at abs_min: the hall air through a first-order lag
-/// of FieldMachineConfig::blank_tau_min (convolution over the preceding 8 time constants).
-double BlankTemperatureC(const TimelineData& d, double abs_min);
+/// of tau_min (convolution over the preceding 8 time constants).
+double BlankTemperatureC(const TimelineData& d, double abs_min, double tau_min);
+/// The lag of the blank of job `job` of `plan`: FieldMachineConfig::blank_tau_min, or from its
+/// diameter rho c D / (4 h) when blank_h_w_m2k > 0 [min].
+double BlankTauMin(const TimelineData& d, const DayPlan& plan, int job);
+/// The blank's temperature at the cut start of job `job` of `plan`: BlankTemperatureC with its
+/// lag plus the stock offset N(0, stock_offset_std_k) of that screw (seeded by the day and job).
+double CutBlankC(const TimelineData& d, const DayPlan& plan, int job);
 /// The blank's part of the lead at 20 degC (Bryan 1990: only differential expansion against the
 /// 20 degC reference matters): the workpiece simulator measures its elongation from the blank's
 /// temperature T_0 at the cut start; measured at 20 degC a groove cut at z lies further towards

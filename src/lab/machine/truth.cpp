@@ -27,7 +27,7 @@ std::vector<TruthSample> TrueCutError(const MachineTimeline& timeline, const Cut
   const double start = cut.day * 1440.0 + job.cut_start_min;
   const double end = cut.day * 1440.0 + job.cut_end_min;
   const double step = timeline.options().control_sample_s / 60;
-  const double blank_c = detail::BlankTemperatureC(timeline.data(), start);
+  const double blank_c = detail::CutBlankC(timeline.data(), timeline.Day(cut.day), cut.job);
   std::vector<TruthSample> out;
   for (double t = start; t <= end + 1e-9; t += step) {
     const double z = job.kinematics.thread_start_position_mm -
@@ -59,7 +59,7 @@ CutHall HallDuringCut(const MachineTimeline& timeline, const CutRef& cut) {
   const Job& job = CutJob(timeline, cut);
   const double start = cut.day * 1440.0 + job.cut_start_min;
   const double end = cut.day * 1440.0 + job.cut_end_min;
-  return {detail::BlankTemperatureC(timeline.data(), start),
+  return {detail::CutBlankC(timeline.data(), timeline.Day(cut.day), cut.job),
           timeline.hall().SlopeKPerH(start, end)};
 }
 

@@ -112,7 +112,7 @@ ElongationCurve Add(ElongationCurve a, const ElongationCurve& b) {
 // The shop models held sample by sample over the day's control log: sensors, warmup, schedule,
 // and the sensor model kept valid by the day's set-up checks.
 struct DayHeld {
-  HeldSamples sensors, warmup, schedule, monitored;
+  HeldSamples sensors, warmup, schedule, monitored, grey;
 };
 
 // One test-day cut, every strategy; `report` (optional) receives its curves (the rest of the
@@ -163,7 +163,8 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
       Sum(workpiece, lead_slope),           // lead_slope
       shop,                                 // machine_shop
       Sum(workpiece, shop),                 // both_shop
-      Sum(workpiece, line(held.monitored))  // both_shop_monitor
+      Sum(workpiece, line(held.monitored)),  // both_shop_monitor
+      Sum(workpiece, line(held.grey))        // both_grey
   };
   detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out,
                           report ? &report->leads : nullptr);
@@ -226,7 +227,8 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
     DayHeld held = {RunCausally(models.shop.sensors, log),
                     RunCausally(models.shop.warmup, log),
                     RunCausally(models.shop.schedule, log),
-                    {}};
+                    {},
+                    RunCausally(models.shop.grey, log)};
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));
@@ -264,7 +266,7 @@ void ValidateFieldOptions(const FieldEvalOptions& o) {
   range(o.machines, 1, 20, "machines");
   range(o.threads, 1, 64, "threads");
   range(o.calendar.test_days, 1, 20, "test days");
-  range(o.calendar.past_days, 1, 30, "past days");
+  range(o.calendar.past_days, 1, 40, "past days");
   o.machine.Validate("field machine '" + o.machine.name + "'");
 }
 

@@ -54,6 +54,10 @@
 //                      is what the report's programs apply
 //   both_shop_monitor  both_shop with the offset channel updated on the test day from the probe
 //                      checks at its set-ups (field_monitor.h)
+//   both_grey          workpiece + the grey box (drift/grey_box.h: absolute temperatures, a slope
+//                      intercept, the blank's estimate latched at the cut start, physical priors;
+//                      shop_models.h FieldGreyBoxSpec), trained from the same shop records; the
+//                      report's 840D programs do not apply it yet (they apply both_shop)
 // Every machine model is applied causally (strategies.h). The truth of a cut: the workpiece truth
 // of compare::CompareScrew (the blank starts at the hall's temperature through its lag and
 // follows the hall over the cut) plus the machine's truth m(t, z) along the cut
@@ -96,16 +100,17 @@ enum class MachineStrategy {
   kLeadSlope,
   kMachineShop,
   kBothShop,
-  kBothShopMonitor
+  kBothShopMonitor,
+  kBothGrey
 };
-inline constexpr std::size_t kMachineStrategyCount = 12;
+inline constexpr std::size_t kMachineStrategyCount = 13;
 /// The strategies in table order (the header comment's list).
 std::array<MachineStrategy, kMachineStrategyCount> MachineStrategies();
 /// none, traditional, workpiece, class, table, nearest, warmup, schedule, lead_slope,
-/// machine_shop, both_shop, both_shop_monitor
+/// machine_shop, both_shop, both_shop_monitor, both_grey
 std::string ToString(MachineStrategy s);
 /// Whether a strategy's machine half uses temperature sensors (machine_shop, both_shop,
-/// both_shop_monitor); the others are sensor-free.
+/// both_shop_monitor, both_grey); the others are sensor-free.
 bool UsesSensors(MachineStrategy s);
 
 /// Sources of the uncompensated lead error (accumulated over the thread, um, each alone).

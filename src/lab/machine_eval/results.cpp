@@ -18,14 +18,15 @@ std::array<MachineStrategy, kMachineStrategyCount> MachineStrategies() {
 std::string ToString(MachineStrategy s) {
   static const char* kNames[] = {"none",       "traditional",  "workpiece", "class",
                                  "table",      "nearest",      "warmup",    "schedule",
-                                 "lead_slope", "machine_shop", "both_shop", "both_shop_monitor"};
+                                 "lead_slope", "machine_shop", "both_shop", "both_shop_monitor",
+                                 "both_grey"};
   static_assert(sizeof kNames / sizeof kNames[0] == kMachineStrategyCount);
   return kNames[static_cast<int>(s)];
 }
 
 bool UsesSensors(MachineStrategy s) {
   return s == MachineStrategy::kMachineShop || s == MachineStrategy::kBothShop ||
-         s == MachineStrategy::kBothShopMonitor;
+         s == MachineStrategy::kBothShopMonitor || s == MachineStrategy::kBothGrey;
 }
 
 std::string ToString(ErrorSource s) {

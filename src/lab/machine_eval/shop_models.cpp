@@ -1,5 +1,6 @@
 #include "machine_eval/shop_models.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <tuple>
@@ -55,7 +56,29 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
     m.sensors = *sensors, m.sensors_choice = "sensors";
   if (combined.cv_rmse_um < m.sensors.cv_rmse_um)
     m.sensors = combined, m.sensors_choice = "sensors+" + base_name;
+  // The grey box needs the field machine's sensors (a record without them keeps it empty).
+  const drift::GreyBoxSpec grey = FieldGreyBoxSpec(z_fixed_mm);
+  const std::vector<std::string>& have = record.day_logs.front().sensor_names;
+  bool placed = true;
+  for (const std::string& s : grey.Inputs())
+    placed = placed && std::find(have.begin(), have.end(), s) != have.end();
+  if (placed) m.grey = drift::FitGreyBox(record, grey);
   return m;
+}
+
+drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm) {
+  constexpr double kAlphaScrew = 11.5e-6, kAlphaBed = 10.5e-6, kAlphaBlank = 11.8e-6;
+  drift::GreyBoxSpec s;
+  s.offset_sensors = {"head_bearing_C", "head_housing_C", "bed_middle_C"};
+  s.slope_sensors = {"ambient_C", "z_nut_C"};
+  s.blank_sensor = "ambient_C";
+  s.z_ref_mm = z_ref_mm;
+  s.offset_prior = {{"bed_middle_C", -kAlphaBed * 1e3 * z_ref_mm},
+                    {"head_housing_C", kAlphaScrew * 1e6 * 0.15},
+                    {"head_bearing_C", kAlphaScrew * 1e6 * 0.03}};
+  s.slope_prior = {{"ambient_C", 0.5 * kAlphaScrew * 1e6}, {"z_nut_C", 0.5 * kAlphaScrew * 1e6}};
+  s.blank_prior = -kAlphaBlank * 1e6;
+  return s;
 }
 
 ShopControl ShopControlModels(const drift::JointDriftModel& model,

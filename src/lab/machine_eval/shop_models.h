@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "drift/grey_box.h"
 #include "drift/joint.h"
 #include "drift/measurements.h"
 #include "drift/model.h"
@@ -34,7 +35,20 @@ std::vector<std::string> ScheduleInputs();
 struct ShopModels {
   drift::JointDriftModel sensors, warmup, schedule;
   std::string sensors_choice;  ///< which candidate the sensor model is (see above)
+  /// The grey box (FieldGreyBoxSpec), the both_grey row; empty (no input, 0 everywhere) when
+  /// the record's logs lack one of its sensors.
+  drift::GreyBoxModel grey;
 };
+
+/// The grey box of the field machine (drift/grey_box.h), its sensors placed by the physics:
+/// offset from head_bearing, head_housing and bed_middle; slope from ambient and z_nut (the
+/// screw lies between the hall's air and its nut); the blank from ambient (stock stored in the
+/// hall). Priors (alpha x lengths; nominal values a shop reads off its drawings): bed_middle
+/// -alpha_b z_ref (the bed carries the fixed bearing away from the chuck), head_housing
+/// alpha_s (L_housing + L_carriage) = 0.15 m, head_bearing alpha_s 0.03 m; the screw's slope
+/// alpha_s 1e6 per 1000 mm split equally between ambient and z_nut; the blank -alpha_w 1e6.
+/// alpha_s = 11.5e-6, alpha_b = 10.5e-6, alpha_w = 11.8e-6 1/K.
+drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing).
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs());

@@ -23,14 +23,33 @@ HeldSamples RunCausally(const drift::JointDriftModel& model, const drift::Run& l
   return h;
 }
 
+HeldSamples RunCausally(const drift::GreyBoxModel& model, const drift::Run& log) {
+  HeldSamples h;
+  drift::GreyBoxEvaluator ev(model);
+  const Eigen::MatrixXd u = drift::GreyBoxRawInputs(model, log);
+  for (int k = 0; k < log.samples(); ++k) {
+    const double t = log.time_min[static_cast<std::size_t>(k)];
+    const drift::GreyBoxEvaluator::Output o = ev.Step(t, u.row(k).transpose());
+    h.time_min.push_back(t);
+    h.k0_um.push_back(o.k0_um);
+    h.slope_um_per_1000.push_back(o.slope_um_per_1000);
+    h.blank_slope_um_per_1000.push_back(ev.BlankSlope(o.blank_c));
+  }
+  return h;
+}
+
 compare::CompensationFunction CausalMachineLine(HeldSamples samples, double cut_start_min,
                                                 double z_ref_mm,
                                                 std::function<double(double)> z_of_t) {
-  return [samples = std::move(samples), cut_start_min, z_ref_mm,
+  const double blank = samples.blank_slope_um_per_1000.empty()
+                          ? 0.0
+                          : samples.blank_slope_um_per_1000[samples.IndexAt(cut_start_min)];
+  return [samples = std::move(samples), cut_start_min, z_ref_mm, blank,
           z_of_t = std::move(z_of_t)](double t_s) {
     if (samples.time_min.empty()) return 0.0;
     const std::size_t k = samples.IndexAt(cut_start_min + t_s / 60.0);
-    return samples.k0_um[k] + samples.slope_um_per_1000[k] * (z_ref_mm - z_of_t(t_s)) / 1000.0;
+    return samples.k0_um[k] +
+           (samples.slope_um_per_1000[k] + blank) * (z_ref_mm - z_of_t(t_s)) / 1000.0;
   };
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "compare/cut.h"
+#include "drift/grey_box.h"
 #include "drift/joint.h"
 #include "drift/run_file.h"
 
@@ -18,15 +19,22 @@ namespace whirl::machine_eval {
 /// value (the power-on state).
 struct HeldSamples {
   std::vector<double> time_min, k0_um, slope_um_per_1000;
+  /// The grey box's blank term g_b (B - 20) of each sample (drift/grey_box.h), latched at the
+  /// cut start and added to the slope for the whole cut; empty: no blank term.
+  std::vector<double> blank_slope_um_per_1000;
   /// Index of the latest sample with time <= t_min (0 before the first).
   std::size_t IndexAt(double t_min) const;
 };
 
 /// The model stepped through the log (the first row is the day's power-on).
 HeldSamples RunCausally(const drift::JointDriftModel& model, const drift::Run& log);
+/// The grey box stepped through the log, with its blank term per sample (latched at the cut
+/// start by CausalMachineLine).
+HeldSamples RunCausally(const drift::GreyBoxModel& model, const drift::Run& log);
 
 /// c_m(t_s), t_s from the cut start, which is at log time `cut_start_min`; z_of_t(t_s) the tool
-/// position [mm]. The samples are kept by the function.
+/// position [mm]; a blank term (grey box) is latched at the cut start's sample and added to the
+/// slope for the whole cut. The samples are kept by the function.
 compare::CompensationFunction CausalMachineLine(HeldSamples samples, double cut_start_min,
                                                 double z_ref_mm,
                                                 std::function<double(double)> z_of_t);

@@ -109,7 +109,7 @@ Gain GainOver(const SeedsEvaluation& e, const std::array<SeedStats, kMachineStra
   return g;
 }
 
-// The verdict of a "both" row (both_shop or both_shop_monitor) against a reference row.
+// The verdict of a "both" row (both_shop, both_shop_monitor or both_grey) against a reference row.
 std::string Verdict(const SeedsEvaluation& e, MachineStrategy x, const Gain& g, MachineStrategy ref,
                     const char* what) {
   char buf[400];
@@ -142,7 +142,8 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
                 e.scenario.c_str(), ToString(best).c_str(), s[b].total_median_um,
                 s[b].acc1000_median_um, s[b].screws, e.seeds.size());
   out.push_back(buf);
-  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor}) {
+  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor,
+                            MachineStrategy::kBothGrey}) {
     const Gain g = GainOver(e, s, static_cast<std::size_t>(x), b);
     std::snprintf(buf, sizeof buf,
                   "%s vs %s over the thread: %+.1f %% (per seed %+.1f .. %+.1f %%; positive = "
@@ -156,7 +157,8 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
               s[static_cast<std::size_t>(MachineStrategy::kWarmup)].total_median_um
           ? MachineStrategy::kSchedule
           : MachineStrategy::kWarmup;
-  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor}) {
+  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor,
+                            MachineStrategy::kBothGrey}) {
     const auto k = static_cast<std::size_t>(x);
     out.push_back(Verdict(e, x, GainOver(e, s, k, b), best, "the strongest sensor-free strategy"));
     if (rule != best)

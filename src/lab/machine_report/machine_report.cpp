@@ -86,12 +86,15 @@ std::string SensorScript(const drift::Run& log, const std::string& title,
 std::vector<std::vector<std::size_t>> LeadPanels() {
   using S = MachineStrategy;
   const auto at = [](S s) { return static_cast<std::size_t>(s); };
-  std::vector<std::vector<std::size_t>> panels(2);
+  std::vector<std::vector<std::size_t>> panels(3);
   for (S s : {S::kNone, S::kTraditional, S::kWorkpiece, S::kClass, S::kTable, S::kNearest})
     panels[0].push_back(at(s));
   for (S s : {S::kNone, S::kWorkpiece, S::kWarmup, S::kSchedule, S::kLeadSlope, S::kMachineShop,
               S::kBothShop, S::kBothShopMonitor})
     panels[1].push_back(at(s));
+  // The grey box beside the rows it is measured against.
+  for (S s : {S::kNone, S::kWorkpiece, S::kWarmup, S::kBothShop, S::kBothGrey})
+    panels[2].push_back(at(s));
   return panels;
 }
 

@@ -36,6 +36,7 @@ const std::vector<SeriesStyle>& SeriesStyles() {
       {"machine_shop", "#843c39", 1, 1.5},
       {"both_shop",    "#2ca02c", 1, 3.5},
       {"both_shop_monitor", "#d62728", 2, 1.0, 6},
+      {"both_grey",    "#e6550d", 1, 2.5},
       // The drift hold-out's methods (drift::HoldoutMethods(); "none" as above).
       {"fit",          "#1f77b4", 2, 2.0},
       {"time",         "#ff7f0e", 5, 1.5},

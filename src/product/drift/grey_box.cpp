@@ -1,0 +1,340 @@
+#include "drift/grey_box.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "core/error.h"
+#include "drift/model.h"
+
+namespace whirl::drift {
+
+void GreyBoxOptions::Validate() const {
+  auto positive = [](const std::vector<double>& v, const char* name) {
+    if (v.empty()) throw InputError(std::string("grey box: ") + name + " is empty");
+    for (double x : v)
+      if (!(x > 0) || !std::isfinite(x))
+        throw InputError(std::string("grey box: ") + name + " holds " + std::to_string(x) +
+                         ": each value must be finite and > 0");
+  };
+  positive(tau_grid, "tau_grid");
+  positive(blank_tau_grid, "blank_tau_grid");
+  positive(strength_grid, "strength_grid");
+  if (max_lags < 0 || max_lags > 4)
+    throw InputError("grey box: max_lags = " + std::to_string(max_lags) + ": must be within 0..4");
+  if (!(lead_share > 0 && lead_share < 1))
+    throw InputError("grey box: lead_share = " + std::to_string(lead_share) +
+                     ": must lie in (0, 1)");
+}
+
+std::vector<std::string> GreyBoxSpec::Inputs() const {
+  std::vector<std::string> in = offset_sensors;
+  in.insert(in.end(), slope_sensors.begin(), slope_sensors.end());
+  if (!blank_sensor.empty()) in.push_back(blank_sensor);
+  return in;
+}
+
+std::vector<std::string> GreyBoxModel::Inputs() const {
+  std::vector<std::string> in = offset_sensors;
+  in.insert(in.end(), slope_sensors.begin(), slope_sensors.end());
+  if (!blank_sensor.empty()) in.push_back(blank_sensor);
+  return in;
+}
+
+Eigen::MatrixXd AbsoluteFeatures(const Run& run, const std::vector<std::string>& sensors,
+                                 const std::vector<double>& taus) {
+  Eigen::MatrixXd f = BuildFeatures(run, sensors, {}, taus);
+  const auto per = static_cast<Eigen::Index>(1 + taus.size());
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    const double first = run.temperature_C(0, run.SensorIndex(sensors[i])) - 20.0;
+    f.middleCols(static_cast<Eigen::Index>(i) * per, per).array() += first;
+  }
+  return f;
+}
+
+namespace grey_box_detail {
+
+struct Choice {
+  std::vector<double> taus;
+  double blank_tau = 60;
+  double strength = 1e-2;
+};
+
+// The stacked, record-demeaned design: columns [phi_o | phi_s dz | dz | (B0 - 20) dz], dz =
+// (z_ref - z) / 1000; the prior of every column; weights (lead_share applied) and days.
+struct Design {
+  Eigen::MatrixXd x;
+  Eigen::VectorXd y, w, prior;
+  std::vector<int> day;
+  Eigen::Index po = 0, ps = 0;  ///< offset and slope feature counts
+};
+
+struct LogFeatures {
+  Eigen::MatrixXd off, slope;
+  Eigen::VectorXd blank_c;  ///< B(t) per sample (20 without a blank sensor)
+};
+
+LogFeatures FeaturesOf(const Run& log, const GreyBoxSpec& spec, const Choice& c) {
+  LogFeatures f;
+  f.off = AbsoluteFeatures(log, spec.offset_sensors, c.taus);
+  f.slope = AbsoluteFeatures(log, spec.slope_sensors, c.taus);
+  f.blank_c = Eigen::VectorXd::Constant(log.samples(), 20.0);
+  if (!spec.blank_sensor.empty())
+    f.blank_c = AbsoluteFeatures(log, {spec.blank_sensor}, {c.blank_tau}).col(1).array() + 20.0;
+  return f;
+}
+
+Eigen::VectorXd Priors(const std::vector<std::string>& inputs,
+                       const std::map<std::string, double>& prior, std::size_t taus) {
+  const auto per = static_cast<Eigen::Index>(1 + taus);
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(inputs.size()) * per);
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto it = prior.find(inputs[i]);
+    if (it != prior.end())
+      p.segment(static_cast<Eigen::Index>(i) * per, per).setConstant(it->second / per);
+  }
+  return p;
+}
+
+Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
+                   double lead_share) {
+  std::vector<LogFeatures> logs(rec.day_logs.size());
+  std::vector<bool> built(rec.day_logs.size(), false);
+  std::size_t n = 0;
+  for (const auto& r : rec.records) n += r.rows.size();
+  Design d;
+  d.po = static_cast<Eigen::Index>(spec.offset_sensors.size() * (1 + c.taus.size()));
+  d.ps = static_cast<Eigen::Index>(spec.slope_sensors.size() * (1 + c.taus.size()));
+  const Eigen::Index p = d.po + d.ps + 2;
+  d.x.resize(static_cast<Eigen::Index>(n), p);
+  d.y.resize(static_cast<Eigen::Index>(n));
+  d.w.resize(static_cast<Eigen::Index>(n));
+  double lead_w = 0, other_w = 0;
+  Eigen::Index row = 0;
+  for (const auto& r : rec.records) {
+    const auto l = static_cast<std::size_t>(r.log);
+    if (!built[l]) logs[l] = FeaturesOf(rec.day_logs[l], spec, c), built[l] = true;
+    const LogFeatures& f = logs[l];
+    const bool lead = r.kind == MeasurementRecord::Kind::kLead;
+    const double blank = lead && !r.rows.empty() ? f.blank_c(r.rows.front().sample) - 20.0 : 0.0;
+    const Eigen::Index begin = row;
+    for (const Measurement& m : r.rows) {
+      const double dz = (spec.z_ref_mm - m.z_mm) / 1000.0;
+      d.x.row(row) << f.off.row(m.sample), f.slope.row(m.sample) * dz, dz, blank * dz;
+      d.y(row) = m.value_um;
+      d.w(row) = 1.0 / (m.sigma_um * m.sigma_um);
+      (lead ? lead_w : other_w) += d.w(row);
+      d.day.push_back(r.day);
+      ++row;
+    }
+    const Eigen::Index len = row - begin;
+    if (len == 0) continue;
+    const auto wr = d.w.segment(begin, len);
+    const double sw = wr.sum();
+    const Eigen::RowVectorXd mx =
+        (d.x.middleRows(begin, len).array().colwise() * wr.array()).colwise().sum() / sw;
+    d.x.middleRows(begin, len).rowwise() -= mx;
+    d.y.segment(begin, len).array() -= wr.dot(d.y.segment(begin, len)) / sw;
+  }
+  // The leads' share of the weight (both kinds present), the total kept.
+  if (lead_w > 0 && other_w > 0) {
+    const double total = lead_w + other_w;
+    row = 0;
+    for (const auto& r : rec.records) {
+      const bool lead = r.kind == MeasurementRecord::Kind::kLead;
+      const double f = lead ? lead_share * total / lead_w : (1 - lead_share) * total / other_w;
+      for (std::size_t k = 0; k < r.rows.size(); ++k) d.w(row++) *= f;
+    }
+  }
+  d.prior.resize(p);
+  d.prior << Priors(spec.offset_sensors, spec.offset_prior, c.taus.size()),
+      Priors(spec.slope_sensors, spec.slope_prior, c.taus.size()), 0.0, spec.blank_prior;
+  return d;
+}
+
+// min sum w (y - x b)^2 + lambda sum_j s_j^2 (b_j - p_j)^2, lambda = strength sum w.
+Eigen::VectorXd Solve(const Design& d, const Eigen::VectorXd& w, double strength) {
+  const Eigen::Index k = d.x.cols();
+  const double sw = w.sum();
+  if (!(sw > 0)) return d.prior;
+  Eigen::VectorXd scale(k);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    scale(j) = std::sqrt(w.dot(d.x.col(j).cwiseAbs2()) / sw);
+    if (!(scale(j) > 1e-12)) scale(j) = 1.0;
+  }
+  const Eigen::MatrixXd xs = d.x * scale.cwiseInverse().asDiagonal();
+  Eigen::MatrixXd a = xs.transpose() * w.asDiagonal() * xs;
+  const double lambda = strength * sw;
+  a.diagonal().array() += lambda;
+  const Eigen::VectorXd rhs =
+      xs.transpose() * (w.asDiagonal() * d.y) + lambda * d.prior.cwiseProduct(scale);
+  return Eigen::LDLT<Eigen::MatrixXd>(a).solve(rhs).cwiseQuotient(scale);
+}
+
+// Leave one calendar day out (weighted RMS of the held-out residuals); one day: training RMS.
+double CvRmse(const Design& d, double strength) {
+  const std::set<int> days(d.day.begin(), d.day.end());
+  const auto n = d.x.rows();
+  if (days.size() < 2) {
+    const Eigen::VectorXd r = d.y - d.x * Solve(d, d.w, strength);
+    return std::sqrt(d.w.dot(r.cwiseAbs2()) / d.w.sum());
+  }
+  double num = 0, den = 0;
+  for (int day : days) {
+    Eigen::VectorXd wt = d.w;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (d.day[static_cast<std::size_t>(i)] == day) wt(i) = 0;
+    const Eigen::VectorXd b = Solve(d, wt, strength);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (d.day[static_cast<std::size_t>(i)] != day) continue;
+      const double r = d.y(i) - d.x.row(i).dot(b);
+      num += d.w(i) * r * r;
+      den += d.w(i);
+    }
+  }
+  return den > 0 ? std::sqrt(num / den) : 0.0;
+}
+
+double Score(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
+             const GreyBoxOptions& o) {
+  return CvRmse(BuildDesign(rec, spec, c, o.lead_share), c.strength);
+}
+
+// Lags greedy (accepted while the CV falls), then the blank's lag, then the strength.
+Choice Choose(const ShopRecord& rec, const GreyBoxSpec& spec, const GreyBoxOptions& o,
+              double* cv) {
+  Choice c;
+  c.blank_tau = o.blank_tau_grid[o.blank_tau_grid.size() / 2];
+  c.strength = o.strength_grid[o.strength_grid.size() / 2];
+  double current = Score(rec, spec, c, o);
+  while (static_cast<int>(c.taus.size()) < o.max_lags) {
+    double best = current, pick = 0;
+    for (double tau : o.tau_grid) {
+      if (std::find(c.taus.begin(), c.taus.end(), tau) != c.taus.end()) continue;
+      Choice t = c;
+      t.taus.push_back(tau);
+      std::sort(t.taus.begin(), t.taus.end());
+      const double e = Score(rec, spec, t, o);
+      if (e < best) best = e, pick = tau;
+    }
+    if (pick <= 0) break;
+    c.taus.push_back(pick);
+    std::sort(c.taus.begin(), c.taus.end());
+    current = best;
+  }
+  auto pick_best = [&](double Choice::*field, const std::vector<double>& grid) {
+    for (double v : grid) {
+      Choice t = c;
+      t.*field = v;
+      const double e = Score(rec, spec, t, o);
+      if (e < current) current = e, c = t;
+    }
+  };
+  if (!spec.blank_sensor.empty()) pick_best(&Choice::blank_tau, o.blank_tau_grid);
+  pick_best(&Choice::strength, o.strength_grid);
+  *cv = current;
+  return c;
+}
+
+}  // namespace grey_box_detail
+
+GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
+                        const GreyBoxOptions& options) {
+  record.Validate();
+  options.Validate();
+  if (spec.offset_sensors.empty() && spec.slope_sensors.empty())
+    throw InputError("grey box: no offset or slope sensor given");
+  for (const Run& log : record.day_logs)
+    for (const auto& s : spec.Inputs()) (void)log.SensorIndex(s);  // InputError naming it
+  double cv = 0;
+  const grey_box_detail::Choice c = grey_box_detail::Choose(record, spec, options, &cv);
+  const grey_box_detail::Design d = grey_box_detail::BuildDesign(record, spec, c, options.lead_share);
+  if (d.x.rows() <= d.x.cols())
+    throw InputError("grey box: " + std::to_string(d.x.rows()) + " readings for " +
+                     std::to_string(d.x.cols()) + " coefficients");
+  const Eigen::VectorXd b = grey_box_detail::Solve(d, d.w, c.strength);
+  GreyBoxModel m;
+  m.offset_sensors = spec.offset_sensors;
+  m.slope_sensors = spec.slope_sensors;
+  m.blank_sensor = spec.blank_sensor;
+  m.time_constants = c.taus;
+  m.z_ref_mm = spec.z_ref_mm;
+  m.a = b.head(d.po);
+  m.g = b.segment(d.po, d.ps);
+  m.slope_intercept_um_per_1000 = b(d.po + d.ps);
+  m.blank_tau_min = c.blank_tau;
+  m.blank_um_per_1000_per_k = spec.blank_sensor.empty() ? 0.0 : b(d.po + d.ps + 1);
+  m.prior_strength = c.strength;
+  m.cv_rmse_um = cv;
+  m.rows = static_cast<int>(d.x.rows());
+  return m;
+}
+
+std::vector<double> PredictGreyRecord(const GreyBoxModel& m, const ShopRecord& record,
+                                      const MeasurementRecord& r) {
+  const Run& log = record.day_logs.at(static_cast<std::size_t>(r.log));
+  GreyBoxEvaluator ev(m);
+  const Eigen::MatrixXd u = GreyBoxRawInputs(m, log);
+  std::vector<GreyBoxEvaluator::Output> out;
+  for (int k = 0; k < log.samples(); ++k)
+    out.push_back(ev.Step(log.time_min[static_cast<std::size_t>(k)], u.row(k).transpose()));
+  const bool lead = r.kind == MeasurementRecord::Kind::kLead && !r.rows.empty();
+  const double blank =
+      lead ? ev.BlankSlope(out[static_cast<std::size_t>(r.rows.front().sample)].blank_c) : 0.0;
+  std::vector<double> v;
+  for (const Measurement& x : r.rows) {
+    const auto& o = out[static_cast<std::size_t>(x.sample)];
+    v.push_back(o.k0_um + (o.slope_um_per_1000 + blank) * (m.z_ref_mm - x.z_mm) / 1000.0);
+  }
+  return v;
+}
+
+GreyBoxEvaluator::GreyBoxEvaluator(const GreyBoxModel& model) : model_(&model) {}
+
+GreyBoxEvaluator::Output GreyBoxEvaluator::Step(double time_min, const Eigen::VectorXd& raw) {
+  const GreyBoxModel& m = *model_;
+  const auto nt = static_cast<Eigen::Index>(m.time_constants.size());
+  const auto no = static_cast<Eigen::Index>(m.offset_sensors.size());
+  const auto ns = static_cast<Eigen::Index>(m.slope_sensors.size());
+  if (!started_) lag_ = Eigen::VectorXd::Zero((no + ns) * nt);
+  Eigen::VectorXd phi((no + ns) * (1 + nt));
+  for (Eigen::Index i = 0; i < no + ns; ++i) {
+    const double u = raw(i) - 20.0;
+    phi(i * (1 + nt)) = u;
+    for (Eigen::Index l = 0; l < nt; ++l) {
+      double& y = lag_(i * nt + l);
+      const double tau = m.time_constants[static_cast<std::size_t>(l)];
+      y = started_ ? y + (1.0 - std::exp(-(time_min - last_time_) / tau)) * (u - y) : u;
+      phi(i * (1 + nt) + 1 + l) = y;
+    }
+  }
+  if (!m.blank_sensor.empty()) {
+    const double u = raw(no + ns);
+    blank_ = started_
+                 ? blank_ + (1.0 - std::exp(-(time_min - last_time_) / m.blank_tau_min)) * (u - blank_)
+                 : u;
+  }
+  started_ = true;
+  last_time_ = time_min;
+  const Eigen::Index po = no * (1 + nt);
+  Output o;
+  o.k0_um = phi.head(po).dot(m.a);
+  o.slope_um_per_1000 = m.slope_intercept_um_per_1000 + phi.tail(ns * (1 + nt)).dot(m.g);
+  o.blank_c = blank_;
+  return o;
+}
+
+double GreyBoxEvaluator::BlankSlope(double latched_blank_c) const {
+  return model_->blank_um_per_1000_per_k * (latched_blank_c - 20.0);
+}
+
+Eigen::MatrixXd GreyBoxRawInputs(const GreyBoxModel& m, const Run& run) {
+  const std::vector<std::string> in = m.Inputs();
+  Eigen::MatrixXd u(run.samples(), static_cast<Eigen::Index>(in.size()));
+  for (std::size_t c = 0; c < in.size(); ++c)
+    u.col(static_cast<Eigen::Index>(c)) = run.temperature_C.col(run.SensorIndex(in[c]));
+  return u;
+}
+
+}  // namespace whirl::drift

@@ -1,0 +1,123 @@
+#pragma once
+// The grey-box machine drift estimator: the 840D form of drift/joint.h with the physics of a
+// screw-fed Z axis built in, fitted from the same shop measurements (drift/measurements.h):
+//
+//   K0(t)   = a' phi_o(t)                                                       [um]
+//   G(t)    = g0 + g' phi_s(t) + g_b (B(t_0) - 20)                      [um per 1000 mm]
+//   m_hat(t, z) = K0(t) + G(t) (z_ref - z) / 1000
+//
+// phi_o, phi_s: the offset sensors (head, bed) and the slope sensors (the screw's, the hall's)
+// as ABSOLUTE temperatures referred to 20 degC, T - 20 [K], each with its first-order lags of
+// the shared time constants (drift/model.h BuildFeatures' recursion, L_0 = u_0). The slope of a
+// screw-fed axis is alpha_s (T_screw - 20) - alpha_w (T_blank(t_0) - 20) (Bryan 1990: only
+// expansion against 20 degC matters), so a rise since power-on cannot carry it; the offset
+// enters the lead error only through its change during a cut, where absolute and rise agree.
+// g0: the slope intercept (what is left at 20 degC everywhere: a pitch error of the axis).
+// B(t): the blank's temperature estimate, the first-order lag (blank_tau_min) of blank_sensor
+// (the hall's air for stock stored in the hall); the control LATCHES it at the cut start t_0 and
+// holds it for the whole cut (the blank was clamped at that temperature; the workpiece is
+// measured at 20 degC). Only lead records see it (a probe or laser test cuts nothing): the
+// column is 0 on every other reading.
+// Fit: weighted least squares with one free constant per record (demeaned within each record,
+// as drift/joint.h), and a ridge TOWARDS the physical coefficients (alpha x lengths, the caller's
+// priors, spread equally over an input's static and lagged columns; g0 towards 0, g_b towards
+// blank_prior) instead of towards 0:
+//   min sum w (y - mu_r - x' b)^2 + lambda sum_j s_j^2 (b_j - p_j)^2,
+// s_j the weighted RMS of column j, lambda = strength x sum w. A column no reading moves keeps
+// its prior exactly; collinear sensors cannot trade large opposite coefficients (the penalty
+// grows with the square of each departure from the prior). Weights: 1 / sigma^2 within a kind;
+// the lead records together carry lead_share of the total weight (so hundreds of idle warm-up
+// and laser readings cannot drown the cuts). Choices by the grouped cross-validated RMSE (leave
+// one calendar day out, the same weights): the lags (greedy, at most max_lags from tau_grid), then
+// the blank's time constant from blank_tau_grid, then the strength from strength_grid. The
+// sensors are the caller's, physically placed (no greedy search among collinear sensors).
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "drift/measurements.h"
+#include "drift/run_file.h"
+
+namespace whirl::drift {
+
+struct GreyBoxSpec {
+  std::vector<std::string> offset_sensors;  ///< K0 inputs (head, bed), as the logs name them
+  std::vector<std::string> slope_sensors;   ///< slope inputs (screw, hall)
+  std::string blank_sensor;                 ///< the blank's estimate; "" = no blank term
+  double z_ref_mm = 6400;                   ///< slope reference (the Z screw's fixed bearing)
+  /// Physical priors, um per K of an input (spread equally over its static and lagged
+  /// columns); an input not named has prior 0. Offset: um per K; slope: um per 1000 mm per K.
+  std::map<std::string, double> offset_prior, slope_prior;
+  /// g_b's prior, um per 1000 mm per K: -alpha_w x 1e6 (steel: -11.5).
+  double blank_prior = -11.5;
+  /// Every sensor the spec reads: offset, slope, then the blank sensor (when set).
+  std::vector<std::string> Inputs() const;
+};
+
+struct GreyBoxOptions {
+  std::vector<double> tau_grid = {10, 20, 40, 80, 160, 320};  ///< min
+  int max_lags = 2;                                           ///< 0..4
+  std::vector<double> blank_tau_grid = {30, 60, 120, 240};    ///< min, each > 0
+  std::vector<double> strength_grid = {1e-3, 1e-2, 1e-1, 1};  ///< each > 0
+  double lead_share = 0.5;  ///< the lead records' share of the total weight, in (0, 1)
+  void Validate() const;    ///< InputError naming the field and the rule
+};
+
+struct GreyBoxModel {
+  std::vector<std::string> offset_sensors, slope_sensors;
+  std::string blank_sensor;
+  std::vector<double> time_constants;  ///< min, ascending
+  double z_ref_mm = 6400;
+  Eigen::VectorXd a;  ///< per offset feature (input-major: T - 20, then its lags), um per K
+  Eigen::VectorXd g;  ///< per slope feature, um per 1000 mm per K
+  double slope_intercept_um_per_1000 = 0;  ///< g0
+  double blank_tau_min = 60;               ///< B's lag
+  double blank_um_per_1000_per_k = 0;      ///< g_b
+  double prior_strength = 0;               ///< the chosen strength
+  double cv_rmse_um = 0;                   ///< grouped CV RMSE of the final choice
+  int rows = 0;
+  /// The raw inputs a control feeds the evaluator, in order: offset sensors, slope sensors,
+  /// then the blank sensor (when set).
+  std::vector<std::string> Inputs() const;
+};
+
+/// InputError: an invalid record, a missing column, no sensor, bad options, or fewer readings
+/// than unknowns.
+GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
+                        const GreyBoxOptions& options = {});
+
+/// m_hat of every row of a record (its own day log from its first row); a lead record latches
+/// B at its first reading (the cut start).
+std::vector<double> PredictGreyRecord(const GreyBoxModel& m, const ShopRecord& record,
+                                      const MeasurementRecord& r);
+
+/// The model sample by sample as the control runs it from power-on: K0, the slope without the
+/// blank term, and B (the blank estimate now, degC). At the cut start the control latches B;
+/// the slope of the cut is then slope_um_per_1000 + BlankSlope(latched B).
+class GreyBoxEvaluator {
+ public:
+  explicit GreyBoxEvaluator(const GreyBoxModel& model);
+  struct Output {
+    double k0_um = 0, slope_um_per_1000 = 0, blank_c = 20;
+  };
+  Output Step(double time_min, const Eigen::VectorXd& raw_inputs);
+  /// g_b (B_latched - 20), um per 1000 mm.
+  double BlankSlope(double latched_blank_c) const;
+
+ private:
+  const GreyBoxModel* model_;
+  Eigen::VectorXd lag_;
+  double blank_ = 20, last_time_ = 0;
+  bool started_ = false;
+};
+
+/// Raw inputs (GreyBoxModel::Inputs order) of every sample of a run; InputError if missing.
+Eigen::MatrixXd GreyBoxRawInputs(const GreyBoxModel& m, const Run& run);
+
+/// Features of `sensors` on a run as absolute temperatures referred to 20 degC, input-major
+/// with their lags (samples x sensors (1 + taus)).
+Eigen::MatrixXd AbsoluteFeatures(const Run& run, const std::vector<std::string>& sensors,
+                                 const std::vector<double>& taus);
+
+}  // namespace whirl::drift

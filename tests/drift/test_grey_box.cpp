@@ -1,0 +1,235 @@
+// The grey-box estimator of drift/grey_box.h on planted worlds whose truth is known: recovery of
+// every coefficient (offset, slope on absolute temperatures, slope intercept, the blank latched
+// at the cut start), the evaluator against the closed-form lag of a step, priors kept where no
+// reading sees a column, collinear sensors that cannot trade opposite coefficients, bad options.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.h"
+#include "core/random.h"
+#include "drift/grey_box.h"
+
+namespace whirl::drift {
+namespace grey_box_test {
+
+// A day log: a head sensor warming from the day's level, a screw sensor and the hall's air at
+// their own absolute levels (different per day: absolute temperature matters for the slope).
+Run DayLog(int day, int minutes, bool twin = false) {
+  Run r;
+  r.name = "day" + std::to_string(day);
+  r.sensor_names = {"head", "screw", "air"};
+  if (twin) r.sensor_names.push_back("screw_twin");
+  r.temperature_C.resize(minutes + 1, static_cast<Eigen::Index>(r.sensor_names.size()));
+  Rng rng(100 + static_cast<std::uint64_t>(day));
+  const double level = 17.0 + 1.7 * day - 0.45 * day * day;
+  for (int k = 0; k <= minutes; ++k) {
+    const double t = k;
+    r.time_min.push_back(t);
+    r.temperature_C(k, 0) = level + (3 + 0.5 * day) * (1 - std::exp(-t / (30.0 + 10 * day)));
+    r.temperature_C(k, 1) = level + 0.6 + 0.004 * t * (1 + day % 2) + 0.3 * std::sin(t / 50.0);
+    r.temperature_C(k, 2) = level - 0.3 + std::sin(t / (60.0 + 9 * day) + day);
+    if (twin) r.temperature_C(k, 3) = r.temperature_C(k, 1) + 0.02 * rng.Normal();
+  }
+  return r;
+}
+
+GreyBoxModel Truth() {
+  GreyBoxModel t;
+  t.offset_sensors = {"head"};
+  t.slope_sensors = {"screw"};
+  t.blank_sensor = "air";
+  t.time_constants = {40};
+  t.z_ref_mm = 6400;
+  t.a.resize(2);
+  t.a << 1.5, -2.5;
+  t.g.resize(2);
+  t.g << 7.0, 4.5;
+  t.slope_intercept_um_per_1000 = 3.0;
+  t.blank_tau_min = 60;
+  t.blank_um_per_1000_per_k = -11.8;
+  return t;
+}
+
+// Per day: a probe series at z = 150 mm, laser targets at 1000 and 4000 mm (one record each), and
+// two lead records (cuts from z = 5000 mm towards the chuck at 20 mm/min, starting at minutes
+// 60 and 200). Each record has an unknown zero; values = the truth, no noise.
+ShopRecord Planted(const GreyBoxModel& truth, bool leads, int days = 5) {
+  ShopRecord rec;
+  Rng rng(7);
+  for (int day = 0; day < days; ++day) {
+    rec.day_logs.push_back(DayLog(day, 360));
+    auto add = [&](MeasurementRecord r) {
+      const std::vector<double> m = PredictGreyRecord(truth, rec, r);
+      const double zero = 5.0 * rng.Normal();
+      for (std::size_t i = 0; i < r.rows.size(); ++i) r.rows[i].value_um = m[i] + zero;
+      rec.records.push_back(std::move(r));
+    };
+    for (double z : {150.0, 1000.0, 4000.0}) {
+      MeasurementRecord r;
+      r.kind = z == 150 ? MeasurementRecord::Kind::kProbe : MeasurementRecord::Kind::kLaser;
+      r.day = day;
+      r.log = day;
+      for (int k = 0; k <= 360; k += 10) r.rows.push_back({k, double(k), z, 0, 1.0});
+      add(r);
+    }
+    if (!leads) continue;
+    for (int start : {60, 200}) {
+      MeasurementRecord r;
+      r.kind = MeasurementRecord::Kind::kLead;
+      r.day = day;
+      r.log = day;
+      for (int k = 0; k <= 120; k += 5)
+        r.rows.push_back({start + k, double(start + k), 5000.0 - 20.0 * k, 0, 2.0});
+      add(r);
+    }
+  }
+  return rec;
+}
+
+GreyBoxSpec SpecOf(const GreyBoxModel& t) {
+  GreyBoxSpec s;
+  s.offset_sensors = t.offset_sensors;
+  s.slope_sensors = t.slope_sensors;
+  s.blank_sensor = t.blank_sensor;
+  s.z_ref_mm = t.z_ref_mm;
+  return s;
+}
+
+GreyBoxOptions Fixed(const GreyBoxModel& t, double strength) {
+  GreyBoxOptions o;
+  o.tau_grid = t.time_constants;
+  o.max_lags = 1;
+  o.blank_tau_grid = {t.blank_tau_min};
+  o.strength_grid = {strength};
+  return o;
+}
+
+TEST(GreyBox, RecoversEveryPlantedCoefficientIncludingTheLatchedBlank) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, true);
+  const GreyBoxModel m = FitGreyBox(rec, SpecOf(t), Fixed(t, 1e-10));
+  ASSERT_EQ(m.time_constants, t.time_constants);
+  for (Eigen::Index j = 0; j < 2; ++j) {
+    EXPECT_NEAR(m.a(j), t.a(j), 1e-3) << j;
+    EXPECT_NEAR(m.g(j), t.g(j), 1e-3) << j;
+  }
+  EXPECT_NEAR(m.slope_intercept_um_per_1000, t.slope_intercept_um_per_1000, 1e-3);
+  EXPECT_NEAR(m.blank_um_per_1000_per_k, t.blank_um_per_1000_per_k, 1e-3);
+  EXPECT_LT(m.cv_rmse_um, 1e-3);
+}
+
+TEST(GreyBox, TheSearchFindsThePlantedLagsAmongOthers) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, true);
+  GreyBoxOptions o;
+  o.tau_grid = {10, 40, 160};
+  o.max_lags = 1;
+  o.blank_tau_grid = {15, 240, 60};  // the search starts from the middle one
+  o.strength_grid = {1e-10, 1e-1};
+  const GreyBoxModel m = FitGreyBox(rec, SpecOf(t), o);
+  EXPECT_EQ(m.time_constants, std::vector<double>{40});
+  EXPECT_DOUBLE_EQ(m.blank_tau_min, 60);
+  EXPECT_DOUBLE_EQ(m.prior_strength, 1e-10);
+}
+
+// Without a lead record no reading sees the blank or the slope intercept: both keep their priors
+// exactly, whatever the strength.
+TEST(GreyBox, AColumnNoReadingSeesKeepsItsPrior) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, false);
+  GreyBoxSpec s = SpecOf(t);
+  s.blank_prior = -9.25;
+  for (double strength : {1e-6, 1.0}) {
+    const GreyBoxModel m = FitGreyBox(rec, s, Fixed(t, strength));
+    EXPECT_NEAR(m.blank_um_per_1000_per_k, -9.25, 1e-9);
+    EXPECT_NEAR(m.slope_intercept_um_per_1000, 0.0, 1e-9);
+  }
+}
+
+// A strong prior pulls towards the physical coefficients: with strength -> large the fitted
+// slope coefficients approach the prior (spread equally over the static and lagged columns).
+TEST(GreyBox, AStrongPriorHoldsThePhysicalCoefficients) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, true);
+  GreyBoxSpec s = SpecOf(t);
+  s.slope_prior = {{"screw", 11.5}};
+  const GreyBoxModel m = FitGreyBox(rec, s, Fixed(t, 1e6));
+  EXPECT_NEAR(m.g(0), 5.75, 1e-3);
+  EXPECT_NEAR(m.g(1), 5.75, 1e-3);
+  EXPECT_NEAR(m.blank_um_per_1000_per_k, s.blank_prior, 1e-3);
+}
+
+// Two sensors 0.02 K apart (noise) read the same screw: an unregularized fit trades large
+// opposite coefficients on them; the grey box's ridge towards the prior keeps both moderate and
+// their sum at the truth.
+TEST(GreyBox, CollinearSensorsCannotTradeOppositeCoefficients) {
+  const GreyBoxModel t = Truth();
+  ShopRecord rec = Planted(t, true);
+  for (int d = 0; d < static_cast<int>(rec.day_logs.size()); ++d) {
+    const drift::Run twin = DayLog(d, 360, true);
+    rec.day_logs[static_cast<std::size_t>(d)] = twin;
+  }
+  Rng rng(3);
+  for (auto& r : rec.records)
+    for (auto& x : r.rows) x.value_um += 0.3 * rng.Normal();
+  GreyBoxSpec s = SpecOf(t);
+  s.slope_sensors = {"screw", "screw_twin"};
+  const GreyBoxModel m = FitGreyBox(rec, s, Fixed(t, 1e-2));
+  const double sum = m.g.sum();
+  EXPECT_NEAR(sum, t.g.sum(), 0.15 * t.g.sum());
+  EXPECT_LT(m.g.cwiseAbs().maxCoeff(), t.g.sum());
+}
+
+// The evaluator's blank estimate is the exact first-order lag of a held step, and K0 / slope are
+// the closed forms of the static inputs.
+TEST(GreyBox, TheEvaluatorFollowsTheClosedFormLagOfAStep) {
+  GreyBoxModel m = Truth();
+  m.time_constants.clear();
+  m.a.resize(1);
+  m.a << 2.0;
+  m.g.resize(1);
+  m.g << 3.0;
+  GreyBoxEvaluator ev(m);
+  Eigen::VectorXd raw(3);
+  raw << 22.0, 21.0, 18.0;
+  ev.Step(0, raw);
+  raw << 23.0, 25.0, 24.0;
+  for (double t = 10; t <= 300; t += 10) {
+    const GreyBoxEvaluator::Output o = ev.Step(t, raw);
+    EXPECT_NEAR(o.blank_c, 24.0 - 6.0 * std::exp(-(t - 0) / m.blank_tau_min), 1e-12) << t;
+    EXPECT_NEAR(o.k0_um, 2.0 * 3.0, 1e-12);
+    EXPECT_NEAR(o.slope_um_per_1000, 3.0 + 3.0 * 5.0, 1e-12);
+    EXPECT_NEAR(ev.BlankSlope(o.blank_c), -11.8 * (o.blank_c - 20), 1e-12);
+  }
+}
+
+TEST(GreyBox, BadOptionsAndMissingColumnsAreNamed) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, false, 2);
+  GreyBoxOptions o = Fixed(t, 1e-2);
+  o.lead_share = 1.0;
+  EXPECT_THROW(
+      {
+        try {
+          FitGreyBox(rec, SpecOf(t), o);
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("lead_share"), std::string::npos);
+          throw;
+        }
+      },
+      InputError);
+  o = Fixed(t, 1e-2);
+  o.blank_tau_grid = {0};
+  EXPECT_THROW(FitGreyBox(rec, SpecOf(t), o), InputError);
+  GreyBoxSpec s = SpecOf(t);
+  s.slope_sensors = {"no_such_sensor"};
+  EXPECT_THROW(FitGreyBox(rec, s, Fixed(t, 1e-2)), InputError);
+  s = SpecOf(t);
+  s.offset_sensors.clear();
+  s.slope_sensors.clear();
+  EXPECT_THROW(FitGreyBox(rec, s, Fixed(t, 1e-2)), InputError);
+}
+
+}  // namespace grey_box_test
+}  // namespace whirl::drift
