@@ -1,4 +1,4 @@
-// What the workpiece report shows (compare/report.h, compare/control_box.h), checked against the
+// What the workpiece report shows (compare/report.h, plan/load.h LoadBox), checked against the
 // comparison it is written from: the "load onto the control" box first, with the plan's setting
 // data, the files and the programs' own prerequisites; every strategy in the data and the plots;
 // the prediction's +-1 sd band around the prediction; each baseline's own features.
@@ -10,7 +10,6 @@
 #include <string>
 
 #include "compare/compare.h"
-#include "compare/control_box.h"
 #include "compare/report.h"
 #include "core/atomic_file.h"
 #include "core/csv.h"
@@ -25,6 +24,15 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::kSource;
+
+// The gnuplot scripts of one screw's figures, one after the other (core/report_render.h writes
+// one per figure).
+std::string Scripts(const fs::path& dir, const std::string& slug) {
+  std::string gp;
+  for (const char* figure : {"_elongation.gp", "_lead.gp", "_lead_start.gp"})
+    gp += ReadTextFile(dir / (slug + figure));
+  return gp;
+}
 
 class ReportContent : public ::testing::Test {
  protected:
@@ -114,7 +122,7 @@ TEST_F(ReportContent, EveryStrategyIsInTheDataAndThePlots) {
   const std::string slug = Slug(c.screw.name);
   const CsvTable lead = ReadCsv(dir / (slug + "_lead.csv"));
   const CsvTable el = ReadCsv(dir / (slug + "_elongation.csv"));
-  const std::string gp = ReadTextFile(dir / (slug + ".gp"));
+  const std::string gp = Scripts(dir, slug);
   for (const auto& o : c.outcomes) {
     const std::vector<double> dev = lead.Column(ToString(o.strategy) + "_deviation_um");
     ASSERT_EQ(dev.size(), o.lead.size());
@@ -147,7 +155,7 @@ TEST_F(ReportContent, LegendNamesTheModelsFamily) {
     ReportOptions o;
     o.plots = false;
     WriteReport(dir, {c}, o);
-    return ReadTextFile(dir / (Slug(c.screw.name) + ".gp"));
+    return Scripts(dir, Slug(c.screw.name));
   };
   EXPECT_NE(
       legend(*comparison_, "whirl_report_legend_network").find("'model (network, 840D plan)'"),

@@ -120,6 +120,12 @@ struct ScrewComparison {
   /// Compensation applied at the truth's sample times, um, per strategy (kStrategies order).
   std::array<std::vector<double>, kStrategyCount> compensation_um;
   std::array<StrategyOutcome, kStrategyCount> outcomes;  ///< in kStrategies order
+  /// The +-1 sd band of the prediction: the arctangent curves of (L - sd_L, t_s + sd_t) and
+  /// (L + sd_L, t_s - sd_t), the two corners that move the whole curve down and up (t_s at least
+  /// 1 s, L at least 0), and the model's travel deviation had its plan been made from each (the
+  /// same 840D planning and cut; empty where a band curve has no plan, e.g. L - sd_L <= 0).
+  std::array<fit::ArctanCurve, 2> band_curves;
+  std::array<lead::LeadDeviation, 2> band_leads;
   MetricReductions model_vs_traditional, model_vs_none, traditional_vs_none, model_vs_regression,
       model_vs_ramp;
 

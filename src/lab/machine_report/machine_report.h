@@ -30,7 +30,7 @@ struct MachineReport {
 /// the strategies' figures and the sensor model. Plots need gnuplot (skipped with a note
 /// otherwise). With a `profile` that fits the machine, the screw's combined 840D programs are
 /// written beside the figures and the page opens with the "load onto the control" box
-/// (plan/load.h data, compare/control_box.h): the plan's setting data, the five files, the
+/// (plan/load.h LoadBox, rendered by core/report_render.h): the plan's setting data, the five files, the
 /// machine data both programs need (each datum once), the call order and what to run after an
 /// abort; a profile that does not fit leaves them out with the note returned (the report
 /// stands). InputError for a screw whose evaluation failed.

@@ -19,7 +19,11 @@ std::string_view ReportStylesheet() {
          ".control h2{border:none;margin-top:0.5em}\n"
          "pre,code{font-family:monospace;font-size:0.9em}\n"
          "pre{background:#f6f6f6;padding:6px;white-space:pre-wrap;overflow-wrap:anywhere}\n"
-         "img{max-width:100%;height:auto;border:1px solid #ddd;display:block;margin:0.5em 0}\n";
+         "img{max-width:100%;height:auto;border:1px solid #ddd;display:block;margin:0.5em 0}\n"
+         "figure{margin:0.8em 0}\n"
+         ".legend{list-style:none;padding:0;margin:0.2em 0 1em;columns:2 24em;font-size:0.9em}\n"
+         ".legend li{break-inside:avoid;margin:0.1em 0}"
+         ".legend svg{vertical-align:middle;margin-right:0.5em}\n";
 }
 
 std::string HtmlPageBegin(std::string_view title, const std::vector<std::string>& provenance) {
