@@ -144,9 +144,9 @@ std::string With(const Series& s, bool surface) {
     case SeriesKind::kBand:
       return "with filledcurves fs transparent solid 0.15 noborder " + lc;
     case SeriesKind::kPoints:
-      return nocontours + "with points pt 7 ps 0.8 " + lc;
+      return nocontours + "with points pt 7 ps 1.2 " + lc;
     case SeriesKind::kOpenPoints:
-      return nocontours + "with points pt 6 ps 1 " + lc;
+      return nocontours + "with points pt 6 ps 1.6 lw 1.5 " + lc;
     case SeriesKind::kLinePoints:
       return "with linespoints pt 5 lw 2 " + lc;
     case SeriesKind::kMap:
