@@ -69,11 +69,12 @@ struct Preformatted {
   std::string text;
 };
 
-/// One column of a data file as gnuplot reads it: `$index`, or `$index - $minus`, divided by
+/// One column of a data file as gnuplot reads it: `$index`, or `$index + $plus - $minus`, divided by
 /// `divide` (e.g. minutes to hours: 60); `only_if_column` > 0: only rows whose column holds
 /// `only_if_value` (others are left out).
 struct Column {
   int index = 1;
+  int plus = 0;
   int minus = 0;
   double divide = 1;
   int only_if_column = 0;
@@ -105,6 +106,9 @@ struct Series {
   bool right_axis = false;
   /// The legend's words ("" leaves the series out of the legend, e.g. markers of a rule's checks).
   std::string title;
+  /// Open circles at 40 places along a line: how a series that coincides with one drawn before
+  /// it stays visible (a dash pattern vanishes under another line).
+  bool markers = false;
 };
 
 struct Range {

@@ -97,6 +97,10 @@ namespace fs = std::filesystem;
 std::string ColumnText(const Column& c) {
   std::string e = "$" + std::to_string(c.index);
   bool plain = true;
+  if (c.plus > 0) {
+    e += "+$" + std::to_string(c.plus);
+    plain = false;
+  }
   if (c.minus > 0) {
     e += "-$" + std::to_string(c.minus);
     plain = false;
@@ -138,9 +142,13 @@ std::string With(const Series& s, bool surface) {
   const std::string lc = "lc rgb '" + Colour(s) + "'";
   const std::string nocontours = surface ? "nocontours " : "";
   switch (s.kind) {
-    case SeriesKind::kLine:
-      if (!s.style.empty()) return GnuplotWith(s.style);
-      return "with lines " + lc + " lw " + FormatNumber(s.width) + " dt 1";
+    case SeriesKind::kLine: {
+      std::string w = s.style.empty() ? "with lines " + lc + " lw " + FormatNumber(s.width) + " dt 1"
+                                      : GnuplotWith(s.style);
+      if (s.markers && w.rfind("with lines ", 0) == 0)
+        w = "with linespoints " + w.substr(11) + " pt 6 ps 1.2 pn 40";
+      return w;
+    }
     case SeriesKind::kBand:
       return "with filledcurves fs transparent solid 0.15 noborder " + lc;
     case SeriesKind::kPoints:
@@ -340,7 +348,8 @@ std::string LegendEntry(const Series& s) {
         << FormatNumber(std::max(1.0, width)) << "'";
       if (*DashArray(dash)) h << " stroke-dasharray='" << DashArray(dash) << "'";
       h << "/>";
-      if (point) h << "<circle cx='20' cy='6' r='3.5' stroke='" << colour << "' fill='none'/>";
+      if (point || s.markers)
+        h << "<circle cx='20' cy='6' r='3.5' stroke='" << colour << "' fill='none'/>";
   }
   h << "</svg>" << HtmlEscape(s.title) << "</li>\n";
   return h.str();
