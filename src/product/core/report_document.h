@@ -47,6 +47,9 @@ struct Cell {
   std::string text;
   int colspan = 1;
   bool left = false;  ///< left-aligned (numbers are right-aligned)
+  /// In a table of series (Table::series_rows): this row names no plotted series (a baseline
+  /// shown in the table only).
+  bool not_plotted = false;
 };
 
 struct Table {

@@ -289,7 +289,7 @@ std::string TableHtml(const Table& t) {
     for (std::size_t c = 0; c < t.rows[r].size(); ++c) {
       const Cell& cell = t.rows[r][c];
       h << "<td";
-      if (c == 0 && t.series_rows) h << " data-series='" << HtmlEscape(cell.text) << "'";
+      if (c == 0 && t.series_rows && !cell.not_plotted) h << " data-series='" << HtmlEscape(cell.text) << "'";
       if (cell.colspan > 1) h << " colspan='" << cell.colspan << "'";
       if (cell.left) h << " style='text-align:left'";
       h << ">" << HtmlEscape(cell.text) << "</td>";

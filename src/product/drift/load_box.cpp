@@ -23,7 +23,7 @@ report::Box DriftLoadBox(const std::string& model_kind, const std::string& error
   box.blocks.back().paragraph.spans.push_back(
       Text(" writes the live drift action (static synchronized actions that write SD43900 from "
            "the model every interpolation cycle), its reset program and the PLC table."));
-  if (model_kind == "network")
+  if (model_kind.rfind("network", 0) == 0)
     box.blocks.push_back(MakeBlock(report::Paragraph{
         {Text("This model is a network: drift nc takes models of kind mlr or dynamic only; fit "
               "one of those (whirl drift fit --kind mlr or dynamic) to compensate on the "

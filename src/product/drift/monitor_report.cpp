@@ -490,7 +490,9 @@ report::Table MonitorTable(const MonitorResult& r) {
     return std::vector<report::Cell>{FormatDecimals(s.mae_um, 2), FormatDecimals(s.rmse_um, 2),
                                      FormatDecimals(s.max_abs_um, 2)};
   };
-  std::vector<report::Cell> none{"none"};
+  report::Cell none_name("none (no compensation)");
+  none_name.not_plotted = true;
+  std::vector<report::Cell> none{none_name};
   for (auto& c : stats(r.none)) none.push_back(c);
   none.insert(none.end(), {"-", "-", "-", "-", "-"});
   t.rows.push_back(none);
@@ -505,7 +507,9 @@ report::Table MonitorTable(const MonitorResult& r) {
     t.rows.push_back(std::move(row));
   }
   for (const auto& b : r.baselines) {
-    std::vector<report::Cell> row{b.name + " (sensor-free)"};
+    report::Cell name(b.name + " (sensor-free, not drawn)");
+    name.not_plotted = true;
+    std::vector<report::Cell> row{name};
     for (auto& c : stats(b.score)) row.push_back(c);
     row.insert(row.end(), {"-", "-", "-", "-", "-"});
     t.rows.push_back(std::move(row));

@@ -487,7 +487,7 @@ report::Table HoldoutTable(const HoldoutResult& r) {
 // The method (among idx[0..c)) whose prediction equals idx[c]'s on every row, or "".
 std::string SameAs(const HoldoutResult& r, const std::vector<std::size_t>& idx, std::size_t c) {
   const Eigen::VectorXd& v = r.predictions[idx[c]].predicted_um;
-  for (std::size_t e = 1; e < c; ++e) {
+  for (std::size_t e = 0; e < c; ++e) {
     const Eigen::VectorXd& u = r.predictions[idx[e]].predicted_um;
     if (u.size() == v.size() && v.size() > 0 &&
         (u - v).cwiseAbs().maxCoeff() <= 1e-9 * (1 + v.cwiseAbs().maxCoeff()))
@@ -513,11 +513,11 @@ report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size
   }
   top.series.push_back({csv, -1, {Col(1, 60), Col(2)}, SeriesKind::kLine, "measured", "", 1.5,
                         false, "measured"});
-  for (std::size_t c = 1; c < idx.size(); ++c) {
+  for (std::size_t c = 0; c < idx.size(); ++c) {
     const std::string method = r.rows_out[idx[c]].method;
     const std::string same = SameAs(r, idx, c);
     const std::string title = method + (same.empty() ? "" : " (the same as " + same + ")");
-    report::Column residual = Col(2, 60);
+    report::Column residual = Col(2);
     residual.minus = static_cast<int>(c) + 3;
     report::Series line{csv, -1, {Col(1, 60), Col(static_cast<int>(c) + 3)}, SeriesKind::kLine,
                         method, "", 1.5, false, title};
@@ -536,6 +536,21 @@ report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size
   return f;
 }
 
+// The load box of the first channel's strongest method (the model drift fit would hand on).
+report::Box HoldoutBox(const HoldoutResult& r) {
+  const auto strongest = r.Strongest();
+  for (std::size_t i = 0; i < r.rows_out.size() && i < r.models.size(); ++i)
+    if (!strongest.empty() && r.rows_out[i].channel == strongest.front().first &&
+        r.rows_out[i].method == strongest.front().second) {
+      const DriftModel& m = r.models[i];
+      std::vector<std::string> inputs = m.sensors;
+      inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+      return DriftLoadBox(ToString(m.kind) + ", the strongest here: " + r.rows_out[i].method,
+                          r.rows_out[i].channel, inputs);
+    }
+  return DriftLoadBox("no model", r.rows_out.empty() ? "" : r.rows_out.front().channel, {});
+}
+
 }  // namespace
 
 DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const HoldoutResult& r,
@@ -549,7 +564,7 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const 
           FormatDecimals(r.train_end_min / 60, 1) + " h; test rows [" +
           std::to_string(r.train_end) + ", " + std::to_string(r.test_end) + ") to " +
           FormatDecimals(r.test_end_min / 60, 1) + " h. Models run from the log's first row.");
-  doc.Add(HoldoutTable(r));
+  doc.Add(HoldoutBox(r)).Add(HoldoutTable(r));
   for (const auto& warn : r.warnings) doc.Say(warn, report::Tone::kWarn);
   std::vector<std::string> channels;
   for (const auto& row : r.rows_out)
