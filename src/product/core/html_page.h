@@ -1,7 +1,8 @@
 #pragma once
 // The page every whirl report is: one stylesheet and one skeleton (doctype, charset, title,
 // heading, provenance), so the workpiece, machine, drift, monitor and surface reports look alike
-// and a change of style is made once. Everything user-supplied that reaches a page goes through
+// and a change of style is made once. Used by the one renderer (core/report_render.h); reports
+// build documents and never call these themselves. Everything user-supplied that reaches a page goes through
 // HtmlEscape (core/safe_text.h); these helpers escape their arguments themselves.
 #include <string>
 #include <string_view>
