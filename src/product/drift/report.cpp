@@ -499,9 +499,11 @@ std::string SameAs(const HoldoutResult& r, const std::vector<std::size_t>& idx, 
 // One channel's figure: measured and every method's prediction over the log prefix (the end of
 // training dashed), the residuals below. A method whose prediction equals an earlier one's is
 // drawn with open circles and its legend says so, so coinciding lines stay distinguishable.
+// `band`: the strongest method's +-1 sd band (time_min, low, high in <slug>_holdout_band.csv),
+// "" for none.
 report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size_t>& idx,
                              const std::string& ch, const std::string& csv,
-                             const std::string& slug) {
+                             const std::string& slug, const std::string& band) {
   report::Panel top, bottom;
   top.title = ch + ": measured and predicted (dashed line: end of training)";
   top.ylabel = "error [um]";
@@ -511,6 +513,9 @@ report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size
     p->xlabel = "time [h]";
     p->x_marks = {r.train_end_min / 60};
   }
+  if (!band.empty())
+    top.series.push_back({slug + "_holdout_band.csv", -1, {Col(1, 60), Col(2), Col(3)},
+                          SeriesKind::kBand, band, "", 1.5, false, band + " +- 1 sd"});
   top.series.push_back({csv, -1, {Col(1, 60), Col(2)}, SeriesKind::kLine, "measured", "", 1.5,
                         false, "measured"});
   for (std::size_t c = 0; c < idx.size(); ++c) {
@@ -534,6 +539,31 @@ report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size
   f.height_px = 640;
   f.panels = {top, bottom};
   return f;
+}
+
+// <slug>_holdout_band.csv: the channel's strongest method's prediction -+ its sd per row; returns
+// the method ("" when it has no sd, e.g. none).
+std::string AddBand(const HoldoutResult& r, const std::vector<std::size_t>& idx,
+                    const std::string& ch, const std::string& slug,
+                    const std::vector<std::string>& provenance, ReportWriter* w) {
+  for (const auto& [channel, method] : r.Strongest()) {
+    if (channel != ch) continue;
+    for (std::size_t i : idx) {
+      const RunPrediction& p = r.predictions[i];
+      if (r.rows_out[i].method != method || p.std_um.size() != p.predicted_um.size() ||
+          p.std_um.size() == 0 || p.std_um.maxCoeff() <= 0)
+        continue;
+      std::vector<std::vector<double>> rows;
+      for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k)
+        rows.push_back({p.time[static_cast<std::size_t>(k)], p.predicted_um(k) - p.std_um(k),
+                        p.predicted_um(k) + p.std_um(k)});
+      w->File(slug + "_holdout_band.csv",
+              FormatCsv({"time_min", method + "_minus_1sd_um", method + "_plus_1sd_um"}, rows,
+                        Comments(provenance, "+-1 sd band of " + method + " on " + ch)));
+      return method;
+    }
+  }
+  return "";
 }
 
 // The load box of the first channel's strongest method (the model drift fit would hand on).
@@ -585,7 +615,9 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const 
     const std::string slug = Slug(ch);
     w.File(slug + "_holdout.csv",
            FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
-    doc.Add(report::Heading{2, ch, ""}).Add(HoldoutFigure(r, idx, ch, slug + "_holdout.csv", slug));
+    const std::string band = AddBand(r, idx, ch, slug, provenance, &w);
+    doc.Add(report::Heading{2, ch, ""})
+        .Add(HoldoutFigure(r, idx, ch, slug + "_holdout.csv", slug, band));
   }
   return w.Finish(doc);
 }
