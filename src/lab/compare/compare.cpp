@@ -254,7 +254,7 @@ ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::Workpie
       PlannedCompensation(history_plans[1], feed),
       PlannedCompensation(history_plans[2], feed)};
   CutWithEveryStrategy(comp, screw, iso_table, options, &c);
-  CutWithBand(screw, options, &c);
+  if (options.band) CutWithBand(screw, options, &c);
   return c;
 }
 

@@ -70,15 +70,34 @@ Block MakeBlock(Box x) {
   return b;
 }
 
-Document& Document::Add(Heading h) { return blocks.push_back(MakeBlock(std::move(h))), *this; }
-Document& Document::Add(Paragraph p) { return blocks.push_back(MakeBlock(std::move(p))), *this; }
-Document& Document::Add(Table t) { return blocks.push_back(MakeBlock(std::move(t))), *this; }
-Document& Document::Add(List l) { return blocks.push_back(MakeBlock(std::move(l))), *this; }
-Document& Document::Add(Preformatted p) {
-  return blocks.push_back(MakeBlock(std::move(p))), *this;
+Document& Document::Add(Heading h) {
+  blocks.push_back(MakeBlock(std::move(h)));
+  return *this;
 }
-Document& Document::Add(Figure f) { return blocks.push_back(MakeBlock(std::move(f))), *this; }
-Document& Document::Add(Box b) { return blocks.push_back(MakeBlock(std::move(b))), *this; }
+Document& Document::Add(Paragraph p) {
+  blocks.push_back(MakeBlock(std::move(p)));
+  return *this;
+}
+Document& Document::Add(Table t) {
+  blocks.push_back(MakeBlock(std::move(t)));
+  return *this;
+}
+Document& Document::Add(List l) {
+  blocks.push_back(MakeBlock(std::move(l)));
+  return *this;
+}
+Document& Document::Add(Preformatted p) {
+  blocks.push_back(MakeBlock(std::move(p)));
+  return *this;
+}
+Document& Document::Add(Figure f) {
+  blocks.push_back(MakeBlock(std::move(f)));
+  return *this;
+}
+Document& Document::Add(Box b) {
+  blocks.push_back(MakeBlock(std::move(b)));
+  return *this;
+}
 Document& Document::Add(const std::vector<Block>& more) {
   blocks.insert(blocks.end(), more.begin(), more.end());
   return *this;

@@ -451,10 +451,23 @@ report::Figure MonitorFigure(const MonitorResult& r, const std::string& prefix) 
   for (std::size_t i = 0; i < q; ++i) {
     const std::string rule = ToString(r.strategies[i].rule);
     const int k = static_cast<int>(i);
-    top.series.push_back({timeline, -1, {Col(1, per), Col(k + 3)}, SeriesKind::kLine, rule, "", 1.5,
-                          false, rule});
-    bottom.series.push_back({timeline, -1, {Col(1, per), Col(k + 3 + static_cast<int>(q))},
-                             SeriesKind::kLine, rule, "", 1.5, false, rule});
+    // A rule that never left an earlier one's prediction is drawn with open circles and its
+    // legend says so: coinciding lines stay distinguishable.
+    std::string same;
+    const Eigen::VectorXd& v = r.strategies[i].predicted_um;
+    for (std::size_t e = 0; e < i && same.empty(); ++e) {
+      const Eigen::VectorXd& u = r.strategies[e].predicted_um;
+      if (u.size() == v.size() && v.size() > 0 &&
+          (u - v).cwiseAbs().maxCoeff() <= 1e-9 * (1 + v.cwiseAbs().maxCoeff()))
+        same = ToString(r.strategies[e].rule);
+    }
+    const std::string title = rule + (same.empty() ? "" : " (the same as " + same + ")");
+    report::Series line{timeline, -1, {Col(1, per), Col(k + 3)}, SeriesKind::kLine, rule, "", 1.5,
+                        false, title};
+    line.markers = !same.empty();
+    top.series.push_back(line);
+    line.columns = {Col(1, per), Col(k + 3 + static_cast<int>(q))};
+    bottom.series.push_back(line);
   }
   for (std::size_t i = 1; i < q; ++i) {
     const std::string rule = ToString(r.strategies[i].rule);
@@ -514,6 +527,32 @@ report::Table MonitorTable(const MonitorResult& r) {
     row.insert(row.end(), {"-", "-", "-", "-", "-"});
     t.rows.push_back(std::move(row));
   }
+  return t;
+}
+
+// The week: per row (none, the rules, the baselines) the MAE and RMSE over the days it covers,
+// and for the rules the measurements and stop time; the strongest over the week bold.
+report::Table WeekTable(const WeekResult& w) {
+  report::Table t;
+  t.series_rows = true;
+  t.header = {"row", "days", "MAE [um]", "RMSE [um]", "measurements", "stop [min]"};
+  const auto& rules = w.days.front().strategies;
+  for (const WeekRow& row : w.week) {
+    std::size_t rule = rules.size();
+    for (std::size_t i = 0; i < rules.size(); ++i)
+      if (ToString(rules[i].rule) == row.name) rule = i;
+    report::Cell name(row.name);
+    name.not_plotted = rule == rules.size();  // none and the baselines are not drawn
+    if (row.name == w.strongest) t.highlight.push_back(t.rows.size());
+    t.rows.push_back({name, std::to_string(row.days), FormatDecimals(row.score.mae_um, 2),
+                      FormatDecimals(row.score.rmse_um, 2),
+                      rule < rules.size() ? std::to_string(w.measurements[rule]) : "-",
+                      rule < rules.size() ? FormatDecimals(w.stop_min[rule], 0) : "-"});
+  }
+  t.caption = "Each rule carries its coefficients (and the bayes covariance) from day to day; "
+              "previous run = drift fit at its defaults redone on the previous day (the given "
+              "model on the first); time = sensor-free warm-up fitted on the previous day. Bold: "
+              "the strongest over the week (lowest MAE among the rows covering every day).";
   return t;
 }
 
@@ -644,7 +683,16 @@ MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
   doc.provenance = provenance;
   doc.Add(DriftLoadBox(w.days.front().model_kind, w.days.front().error_column, {}));
   doc.Add(report::Heading{2, "Week", ""});
-  doc.Add(report::Preformatted{FormatWeek(w, o)});
+  doc.Add(WeekTable(w));
+  for (const WeekPartial& p : w.partial) {
+    std::string days;
+    for (int d : p.days) days += (days.empty() ? "" : ", ") + w.days[static_cast<std::size_t>(d)].run;
+    doc.Say(p.name + " covers " + std::to_string(p.days.size()) + " of " +
+                std::to_string(w.days.size()) + " days (" + days + "): not ranked; over those days " +
+                p.name + " " + FormatDecimals(p.mae_um, 2) + " um, the strongest row covering every day " +
+                p.strongest + " " + FormatDecimals(p.strongest_mae_um, 2) + " um.",
+            report::Tone::kSmall);
+  }
   doc.Add(report::Paragraph{{report::Text("Data: "),
                              report::Link("week_timeline.csv", "week_timeline.csv"),
                              report::Text(" (every day, a day column first), "),
