@@ -1,4 +1,4 @@
-// The shared report page (core/html_page.h) and plot styles (core/plot_style.h): every entry of
+// The shared report page (core/report_render.h) and plot styles (core/plot_style.h): every entry of
 // the style table looks different from every other, the gnuplot style says what the table says,
 // GroupSeries keeps its promises over many random sensor lists, the page skeleton escapes
 // what it is given, and the one renderer (core/report_render.h) escapes every string of a
@@ -14,7 +14,6 @@
 #include <tuple>
 #include <vector>
 
-#include "core/html_page.h"
 #include "core/plot_style.h"
 #include "core/report_render.h"
 #include "core/safe_text.h"

@@ -26,7 +26,7 @@ struct MachineReport {
 /// day from power-on to the cut's end in the drift run format, the temperatures in panels of at
 /// most 8 sensors, related ones together, the sensor model's sensors thick; degC over min since
 /// the day's 00:00), lead.csv/.png (lead deviation per strategy, um over mm from the thread start
-/// to its end, each strategy in its core/plot_style.h look), index.html (core/html_page.h) with
+/// to its end, each strategy in its core/plot_style.h look), index.html (core/report_render.h) with
 /// the strategies' figures and the sensor model. Plots need gnuplot (skipped with a note
 /// otherwise). With a `profile` that fits the machine, the screw's combined 840D programs are
 /// written beside the figures and the page opens with the "load onto the control" box
