@@ -55,6 +55,7 @@ void RunCompare(const CompareCliOptions& o, const std::string& command_line) {
   co.plan.md32760 = o.md32760;
   co.shape_k = o.shape_k;
   co.time_exponent = o.time_exponent;
+  co.band = !o.report_dir.empty();  // the report's lead plots show the model's +-1 sd band
   const compare::ScrewComparison c = compare::CompareScrew(screw, model, rule, iso, co);
   if (c.prediction.outside_domain)
     Warn("screw '" + screw.name + "' lies outside the model's training domain (" +

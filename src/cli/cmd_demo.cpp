@@ -152,6 +152,7 @@ void RunDemo(const DemoOptions& o) {
       ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv"));
   compare::CompareOptions co;
   co.seed = o.seed;
+  co.band = true;  // the report's lead plots show the model's +-1 sd band
   // The example machine's facts (ID range, R parameters, offset): a real run names its own.
   const interp::MachineProfile profile =
       interp::LoadMachineProfile(ProjectPath(kDemoMachineProfile));

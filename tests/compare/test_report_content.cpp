@@ -1,4 +1,4 @@
-// What the workpiece report shows (compare/report.h, compare/control_box.h), checked against the
+// What the workpiece report shows (compare/report.h, plan/load.h LoadBox), checked against the
 // comparison it is written from: the "load onto the control" box first, with the plan's setting
 // data, the files and the programs' own prerequisites; every strategy in the data and the plots;
 // the prediction's +-1 sd band around the prediction; each baseline's own features.
@@ -10,7 +10,6 @@
 #include <string>
 
 #include "compare/compare.h"
-#include "compare/control_box.h"
 #include "compare/report.h"
 #include "core/atomic_file.h"
 #include "core/csv.h"
@@ -26,6 +25,15 @@ namespace fs = std::filesystem;
 
 using test::kSource;
 
+// The gnuplot scripts of one screw's figures, one after the other (core/report_render.h writes
+// one per figure).
+std::string Scripts(const fs::path& dir, const std::string& slug) {
+  std::string gp;
+  for (const char* figure : {"_elongation.gp", "_lead.gp", "_lead_start.gp"})
+    gp += ReadTextFile(dir / (slug + figure));
+  return gp;
+}
+
 class ReportContent : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -39,6 +47,7 @@ class ReportContent : public ::testing::Test {
         interp::LoadMachineProfile(kSource / "datasets/machines/example_840d.json"));
     CompareOptions options;
     options.seed = 4;
+    options.band = true;
     profile_->ApplyTo(options.plan);
     comparison_ =
         new ScrewComparison(CompareScrew(screw::ReferenceScrew(), model, rule, iso, options));
@@ -114,7 +123,7 @@ TEST_F(ReportContent, EveryStrategyIsInTheDataAndThePlots) {
   const std::string slug = Slug(c.screw.name);
   const CsvTable lead = ReadCsv(dir / (slug + "_lead.csv"));
   const CsvTable el = ReadCsv(dir / (slug + "_elongation.csv"));
-  const std::string gp = ReadTextFile(dir / (slug + ".gp"));
+  const std::string gp = Scripts(dir, slug);
   for (const auto& o : c.outcomes) {
     const std::vector<double> dev = lead.Column(ToString(o.strategy) + "_deviation_um");
     ASSERT_EQ(dev.size(), o.lead.size());
@@ -147,7 +156,7 @@ TEST_F(ReportContent, LegendNamesTheModelsFamily) {
     ReportOptions o;
     o.plots = false;
     WriteReport(dir, {c}, o);
-    return ReadTextFile(dir / (Slug(c.screw.name) + ".gp"));
+    return Scripts(dir, Slug(c.screw.name));
   };
   EXPECT_NE(
       legend(*comparison_, "whirl_report_legend_network").find("'model (network, 840D plan)'"),
@@ -175,6 +184,39 @@ TEST_F(ReportContent, PredictionBandContainsThePredictionAndWidensWithItsSd) {
   const double l = c.prediction.mean.max_elongation_um, sd = c.prediction.stddev.max_elongation_um;
   EXPECT_NEAR(lo.back(), std::max(0.0, l - sd), 1e-3);
   EXPECT_NEAR(hi.back(), l + sd, 1e-3);
+}
+
+// The model's +-1 sd band on the lead plots: a larger compensation leaves a smaller deviation
+// (d = [e(t) - c(t)] - [e(0) - c(0)], c(0) = 0), and the band curves lie below and above the
+// prediction, so the +1 sd plan's deviation lies below the model's and the -1 sd plan's above it,
+// up to the plans' chord tolerance (each within tolerance_um of its curve); the band CSV holds
+// them and both lead plots draw it.
+TEST_F(ReportContent, LeadBandBracketsTheModelUpToThePlansTolerance) {
+  const ScrewComparison& c = *comparison_;
+  const lead::LeadDeviation& model = c.Outcome(Strategy::kModel).lead;
+  const lead::LeadDeviation& low = c.band_leads[0];
+  const lead::LeadDeviation& high = c.band_leads[1];
+  ASSERT_EQ(low.size(), model.size());
+  ASSERT_EQ(high.size(), model.size());
+  const double tol = 2 * c.plan.options.tolerance_um;
+  double width = 0;
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    ASSERT_GE(low.deviation_um[i], model.deviation_um[i] - tol) << model.position_mm[i];
+    ASSERT_LE(high.deviation_um[i], model.deviation_um[i] + tol) << model.position_mm[i];
+    width = std::max(width, low.deviation_um[i] - high.deviation_um[i]);
+  }
+  EXPECT_GT(width, 0.1) << "the band has no width";
+  const fs::path dir = Write("whirl_report_lead_band", {});
+  const CsvTable band = ReadCsv(dir / (Slug(c.screw.name) + "_lead_band.csv"));
+  const auto lo = band.Column("model_minus_1sd_deviation_um");
+  ASSERT_EQ(lo.size(), low.size());
+  for (std::size_t i = 0; i < lo.size(); i += 97) EXPECT_NEAR(lo[i], low.deviation_um[i], 1e-6);
+  const std::string gp = Scripts(dir, Slug(c.screw.name));
+  std::size_t plotted = 0;
+  for (std::size_t at = gp.find("_lead_band.csv"); at != std::string::npos;
+       at = gp.find("_lead_band.csv", at + 1))
+    ++plotted;
+  EXPECT_EQ(plotted, 2u) << "the band in both lead plots";
 }
 
 TEST_F(ReportContent, EachBaselineShowsItsOwnFeaturesAndNoStaleProse) {

@@ -1,7 +1,9 @@
-// The shared report page (core/html_page.h) and plot styles (core/plot_style.h): every entry of
+// The shared report page (core/report_render.h) and plot styles (core/plot_style.h): every entry of
 // the style table looks different from every other, the gnuplot style says what the table says,
-// GroupSeries keeps its promises over many random sensor lists, and the page skeleton escapes
-// what it is given.
+// GroupSeries keeps its promises over many random sensor lists, the page skeleton escapes
+// what it is given, and the one renderer (core/report_render.h) escapes every string of a
+// document, draws each series in its look in the script and in the legend, and reads columns as
+// numbers.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,8 +14,9 @@
 #include <tuple>
 #include <vector>
 
-#include "core/html_page.h"
 #include "core/plot_style.h"
+#include "core/report_render.h"
+#include "core/safe_text.h"
 
 namespace whirl {
 namespace {
@@ -108,6 +111,94 @@ TEST(HtmlPage, SkeletonEscapesTitleProvenanceLinksAndImages) {
   // The one stylesheet is in the page, and it wraps long lines of preformatted text.
   EXPECT_NE(page.find(std::string(ReportStylesheet())), std::string::npos);
   EXPECT_NE(ReportStylesheet().find("white-space:pre-wrap"), std::string::npos);
+}
+
+// A document with hostile text everywhere: the page holds it as text only, the script as
+// single-quoted gnuplot strings only (a newline would end a command).
+TEST(ReportRender, EveryStringOfADocumentIsEscaped) {
+  const std::string hostile = "a'b\"c\\d\n<script>alert(1)</script>&";
+  report::Document doc;
+  doc.title = hostile;
+  doc.provenance = {hostile};
+  doc.Say(hostile, report::Tone::kWarn);
+  doc.Add(report::Paragraph{{report::Link(hostile, hostile), report::Code(hostile)}});
+  report::Table t;
+  t.header = {hostile};
+  t.rows = {{hostile}};
+  t.series_rows = true;
+  t.caption = hostile;
+  doc.Add(t).Add(report::Preformatted{hostile});
+  report::Panel p;
+  p.title = p.xlabel = p.ylabel = hostile;
+  p.tic_names = {hostile};
+  p.series.push_back({hostile, -1, {report::Col(1), report::Col(2)}, report::SeriesKind::kLine,
+                      "model", "", 1.5, false, hostile});
+  report::Figure f;
+  f.stem = "plot";
+  f.title = hostile;
+  f.panels = {p};
+  doc.Add(f);
+  const std::string html = report::RenderHtml(doc, {"plot"});
+  EXPECT_EQ(html.find("<script>"), std::string::npos);
+  EXPECT_EQ(html.find("a'b"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;alert(1)&lt;/script&gt;&amp;"), std::string::npos);
+  const std::string gp = report::GnuplotScript(f);
+  EXPECT_EQ(gp.find("\n<script>"), std::string::npos);
+  EXPECT_NE(gp.find("title " + GnuplotString(hostile)), std::string::npos) << gp;
+  EXPECT_NE(gp.find(GnuplotString(hostile) + " using 1:2 "), std::string::npos) << gp;
+  EXPECT_NE(gp.find("noenhanced"), std::string::npos);
+}
+
+// Each series is drawn in its look: the script's style is GnuplotWith, the legend's swatch the
+// same colour with data-series naming the look; an untitled series has no legend entry; a
+// missing picture gives a note and no legend.
+TEST(ReportRender, SeriesLookTheSameInScriptAndLegend) {
+  report::Figure f;
+  f.stem = "lead";
+  report::Panel p;
+  for (const char* s : {"none", "traditional", "model"})
+    p.series.push_back({"lead.csv", -1, {report::Col(1), report::Col(2)},
+                        report::SeriesKind::kLine, s, "", 1.5, false, std::string(s) + " words"});
+  p.series.push_back({"lead.csv", -1, {report::Col(1), report::Col(3)},
+                      report::SeriesKind::kPoints, "", "#123456", 1.5, false, ""});
+  f.panels = {p};
+  report::Document doc;
+  doc.Add(f);
+  const std::string gp = report::GnuplotScript(f);
+  const std::string html = report::RenderHtml(doc, {"lead"});
+  for (const char* s : {"none", "traditional", "model"}) {
+    EXPECT_NE(gp.find(GnuplotWith(s) + " title '" + s + " words'"), std::string::npos) << gp;
+    const std::string entry = std::string("data-series='") + s + "' data-colour='" +
+                              std::string(FindSeriesStyle(s)->colour) + "'";
+    EXPECT_NE(html.find(entry), std::string::npos) << html;
+  }
+  EXPECT_NE(gp.find("lc rgb '#123456' notitle"), std::string::npos) << gp;
+  EXPECT_EQ(html.find("#123456"), std::string::npos) << "an untitled series in the legend";
+  EXPECT_NE(gp.find("unset key"), std::string::npos);  // the legend is the page's
+  const std::string missing = report::RenderHtml(doc, {});
+  EXPECT_EQ(missing.find("class='legend'"), std::string::npos);
+  EXPECT_NE(missing.find("lead.png not rendered"), std::string::npos);
+}
+
+// Columns are numbers: $i, ($i+$p-$m)/d, and a filter on a column's value.
+TEST(ReportRender, ColumnsAreGnuplotExpressionsOfNumbers) {
+  report::Column c = report::Col(2, 60);
+  c.plus = 4;
+  c.minus = 5;
+  report::Column f = report::Col(2);
+  f.only_if_column = 3;
+  f.only_if_value = 1;
+  report::Panel p;
+  p.series.push_back({"d.csv", 2, {report::Col(1), c}, report::SeriesKind::kLine, "", "#000000",
+                      1, false, ""});
+  p.series.push_back({"d.csv", -1, {report::Col(1), f}, report::SeriesKind::kPoints, "",
+                      "#000000", 1, false, ""});
+  report::Figure fig;
+  fig.stem = "x";
+  fig.panels = {p};
+  const std::string gp = report::GnuplotScript(fig);
+  EXPECT_NE(gp.find("'d.csv' index 2 using 1:(($2+$4-$5)/60) "), std::string::npos) << gp;
+  EXPECT_NE(gp.find("'' using 1:($3==1?$2:1/0) "), std::string::npos) << gp;
 }
 
 }  // namespace

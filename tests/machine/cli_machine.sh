@@ -77,7 +77,7 @@ grep -q "^; model: .*trained only from shop measurements" "$D/report/WHIRL_DRIFT
 [ "$(grep -c "<li>MD28254" "$D/report/index.html")" = 1 ] || fail "MD28254 not listed once"
 [ "$(grep -c "<li>MD32750" "$D/report/index.html")" = 1 ] || fail "MD32750 not listed once"
 # The page quotes the drift action's output action: one IDS line, nothing after it (a label).
-grep -q "output:</p><pre>IDS=[0-9]* [^<]*</pre>" "$D/report/index.html" \
+grep -A1 "output:</p>$" "$D/report/index.html" | grep -q "^<pre>IDS=[0-9]* [^<]*</pre>$" \
   || fail "report: the drift action's output action is not one IDS line"
 # The screw's control log is a drift run file: a machine model evaluates on it.
 "$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \

@@ -17,6 +17,7 @@
 #include "compare/compare.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/plot_style.h"
 #include "core/process.h"
 #include "drift/evaluation.h"
@@ -132,7 +133,7 @@ TEST(MachineReport, SensorPanelsHoldAtMostEightLinesAndLeadEndsAtTheThread) {
   // lead.gp: x from the thread start to its end; every strategy in its style.
   const std::string lead = ReadTextFile(dir / "lead.gp");
   const double thread = r.result.screw.thread_length_mm;
-  EXPECT_NE(lead.find("set xrange [0:" + std::to_string(thread) + "]"), std::string::npos) << lead;
+  EXPECT_NE(lead.find("set xrange [0:" + FormatNumber(thread) + "]"), std::string::npos) << lead;
   for (MachineStrategy s : machine_eval::MachineStrategies())
     EXPECT_NE(lead.find(GnuplotWith(machine_eval::ToString(s))), std::string::npos);
   std::filesystem::remove_all(dir);

@@ -1,5 +1,6 @@
 #include "compare/compare.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -175,6 +176,35 @@ void CutWithEveryStrategy(const std::array<CompensationFunction, kStrategyCount>
   c->model_vs_ramp = vs(Strategy::kModel, Strategy::kRamp);
 }
 
+// The band of the prediction (ScrewComparison::band_curves) and the model's travel deviation
+// with a plan of each band curve.
+void CutWithBand(const screw::Screw& screw, const CompareOptions& options, ScrewComparison* c) {
+  const Features& m = c->prediction.mean;
+  const Features& sd = c->prediction.stddev;
+  const auto curve = [&options](double l_um, double t_s) {
+    return fit::ArctanCurve::FromFeatures({std::max(0.0, l_um), std::max(1.0, t_s)},
+                                          options.shape_k, options.time_exponent);
+  };
+  c->band_curves = {
+      curve(m.max_elongation_um - sd.max_elongation_um, m.settle_time_s + sd.settle_time_s),
+      curve(m.max_elongation_um + sd.max_elongation_um, m.settle_time_s - sd.settle_time_s)};
+  const double feed = c->kinematics.axial_feed_mm_s;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const fit::ArctanCurve& b = c->band_curves[k];
+    const Features f{b.max_elongation_um, b.settle_time_s};
+    try {
+      const interp::CompensationPlan plan =
+          BaselinePlan(f, "prediction band", screw, feed, options);
+      if (plan.segments.empty()) continue;
+      c->band_leads[k] = CutLeadDeviation(c->truth, PlannedCompensation(plan, feed), feed,
+                                          screw.thread_length_mm, screw.process.pitch_mm,
+                                          options.cut);
+    } catch (const InputError&) {
+      c->band_leads[k] = {};  // no plan of this band curve: the band is not drawn
+    }
+  }
+}
+
 }  // namespace
 
 ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
@@ -224,6 +254,7 @@ ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::Workpie
       PlannedCompensation(history_plans[1], feed),
       PlannedCompensation(history_plans[2], feed)};
   CutWithEveryStrategy(comp, screw, iso_table, options, &c);
+  if (options.band) CutWithBand(screw, options, &c);
   return c;
 }
 

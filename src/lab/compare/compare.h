@@ -73,6 +73,9 @@ struct CompareOptions {
   /// Metric options; lead_mm is set to the screw's lead.
   lead::LeadMetricOptions metrics;
   CutOptions cut;
+  /// Also cut the model's +-1 sd band (ScrewComparison::band_leads: two more plans and cuts, for
+  /// the report's lead plots; evaluations over many screws leave it off).
+  bool band = false;
 };
 
 struct StrategyOutcome {
@@ -120,6 +123,13 @@ struct ScrewComparison {
   /// Compensation applied at the truth's sample times, um, per strategy (kStrategies order).
   std::array<std::vector<double>, kStrategyCount> compensation_um;
   std::array<StrategyOutcome, kStrategyCount> outcomes;  ///< in kStrategies order
+  /// The +-1 sd band of the prediction: the arctangent curves of (L - sd_L, t_s + sd_t) and
+  /// (L + sd_L, t_s - sd_t), the two corners that move the whole curve down and up (t_s at least
+  /// 1 s, L at least 0), and the model's travel deviation had its plan been made from each (the
+  /// same 840D planning and cut; empty where a band curve has no plan, e.g. L - sd_L <= 0, or
+  /// without CompareOptions::band).
+  std::array<fit::ArctanCurve, 2> band_curves;
+  std::array<lead::LeadDeviation, 2> band_leads;
   MetricReductions model_vs_traditional, model_vs_none, traditional_vs_none, model_vs_regression,
       model_vs_ramp;
 

@@ -1,35 +1,30 @@
 #pragma once
-// The report a process engineer opens after a comparison: one HTML page (index.html, the shared
-// skeleton and stylesheet of core/html_page.h) that opens with the "load onto the control" box
-// (compare/control_box.h: setting data, programs, prerequisites, what to run after an abort), then
-// per screw the metrics of every strategy (kStrategies) with the ISO 3408-3 class reached and how
-// much less the model leaves, the elongation curve (simulated truth, the prediction with its
-// +-1 sd band, i.e. the arctangent curves of the features at mean -+ 1 sd, and each strategy's
-// compensation with the plan's compensation points), the lead deviation of every strategy along
-// the thread (whole thread, and the first 1000 mm where the transient lives), plus the CSV files
-// every plot comes from and report.json. Each strategy has one colour and dash in every plot
-// (core/plot_style.h).
+// The report a process engineer opens after a comparison, built as a report document
+// (core/report_document.h) and rendered by core/report_render.h: one page (index.html) that opens
+// with the "load onto the control" box (plan/load.h LoadBox: setting data, programs,
+// prerequisites, what to run after an abort), then per screw the metrics of every strategy
+// (kStrategies) with the ISO 3408-3 class reached and how much less the model leaves, the
+// elongation curve (simulated truth, the prediction with its +-1 sd band, i.e. the arctangent
+// curves of the features at mean -+ 1 sd, and each strategy's compensation with the plan's
+// compensation points), the travel deviation of every strategy along the thread (whole thread,
+// and the first 1000 mm where the transient lives) with the model's +-1 sd band (its deviation
+// had the plan been made from either band curve), plus the CSV files every plot comes from and
+// report.json. Each strategy has one colour and dash in every plot and legend (core/plot_style.h).
 //
-// Plots: gnuplot (Debian package gnuplot-nox, pngcairo terminal, falling back to png). Why gnuplot:
-// it is a well-kept Debian package already installed by scripts/setup.sh, it needs no library
-// linked into whirl (the library stays free of plotting code paths at link time), the generated
-// .gp scripts stay in the report folder so anyone can re-plot or restyle from the CSVs, and PNG
-// embeds in any browser or mail. If gnuplot is missing at run time, the HTML, CSVs and scripts are
-// still written and ReportResult::warnings says the plots were skipped.
-// All-or-nothing: every file (CSVs, .gp scripts, PNGs rendered by gnuplot, report.json,
-// index.html) is collected by core/output_dir.h's OutputDir (gnuplot renders in its staging
-// folder) and committed at once; a failure leaves no new file and the previous report intact. The
-// directory follows OutputDir's rule: new, empty or a whirl output (never a symbolic link); files
-// of an earlier report that this one does not write are removed.
-// Safe with any screw name: names reach gnuplot only as GnuplotString literals (titles
-// `noenhanced`), the page only through HtmlEscape, file names only as Slug; gnuplot runs through
-// RunProgram (an argument vector, no shell), in the staging folder.
+// Plots: gnuplot (Debian package gnuplot-nox), see core/report_render.h; without it the page,
+// the CSVs and the scripts are still written and ReportResult::warnings says the plots were
+// skipped. All-or-nothing: every file is collected by core/output_dir.h's OutputDir (gnuplot
+// renders in its staging folder) and committed at once; a failure leaves no new file and the
+// previous report intact. The directory follows OutputDir's rule: new, empty or a whirl output
+// (never a symbolic link); files of an earlier report that this one does not write are removed.
+// Safe with any screw name: the document holds plain text, the renderer escapes it; file names
+// are Slugs.
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "compare/compare.h"
-#include "compare/control_box.h"
+#include "plan/load.h"
 
 namespace whirl::compare {
 

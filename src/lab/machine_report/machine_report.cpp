@@ -1,7 +1,6 @@
 // Report of one screw cut on a drifting machine (machine_report.h): the "load onto the control"
-// box, lead deviation per strategy, sensor plots, how the programs share the setting data. User
-// strings (sensor and screw names) reach gnuplot only through GnuplotString (terminal noenhanced)
-// and HTML only through HtmlEscape; gnuplot runs through RunProgram with an argument vector.
+// box, lead deviation per strategy, sensor plots, how the programs share the setting data, built
+// as a report document and rendered by core/report_render.h (which escapes every string).
 #include "machine_report/machine_report.h"
 
 #include <algorithm>
@@ -10,15 +9,12 @@
 #include <optional>
 #include <sstream>
 
-#include "compare/control_box.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/plot_style.h"
-#include "core/run_program.h"
-#include "core/safe_text.h"
+#include "core/report_render.h"
 #include "machine_report/machine_nc.h"
 #include "plan/load.h"
 
@@ -30,11 +26,8 @@ using machine_eval::kMachineStrategyCount;
 using machine_eval::MachineStrategy;
 using machine_eval::ReportScrew;
 
-// The terminal of every plot: `height_px` tall (the sensor plot grows with its panels).
-std::string Terminal(int height_px) {
-  return "set terminal pngcairo size 1000," + std::to_string(height_px) +
-         " font 'Sans,10' noenhanced\n";
-}
+using report::Col;
+using report::SeriesKind;
 
 std::string LeadCsv(const ReportScrew& d) {
   std::ostringstream out;
@@ -56,28 +49,31 @@ constexpr int kPanelHeightPx = 300;
 
 // The sensor log in panels of at most kSensorsPerPanel lines, related sensors together
 // (core/plot_style.h GroupSeries); the machine models' chosen sensors drawn thick.
-std::string SensorScript(const drift::Run& log, const std::string& title,
-                         const std::vector<std::string>& chosen,
-                         const std::vector<std::vector<std::size_t>>& panels) {
-  std::string gp =
-      "set datafile separator ','\nset key outside right\nset grid\n"
-      "set ylabel 'temperature [degC]'\n"
-      "set lmargin at screen 0.08\nset rmargin at screen 0.76\nset multiplot layout " +
-      std::to_string(panels.size()) + ",1 title " + GnuplotString(title) + "\n";
-  for (std::size_t p = 0; p < panels.size(); ++p) {
-    gp += p + 1 == panels.size() ? "set xlabel 'time [min]'\n" : "unset xlabel\n";
-    gp += "plot ";
-    for (std::size_t j = 0; j < panels[p].size(); ++j) {
-      const std::string& name = log.sensor_names[panels[p][j]];
+report::Figure SensorFigure(const drift::Run& log, const std::string& title,
+                            const std::vector<std::string>& chosen) {
+  report::Figure f;
+  f.stem = "sensors";
+  f.alt = title;
+  f.title = title;
+  for (const auto& panel : GroupSeries(log.sensor_names, kSensorsPerPanel)) {
+    report::Panel p;
+    p.ylabel = "temperature [degC]";
+    for (std::size_t j = 0; j < panel.size(); ++j) {
+      const std::string& name = log.sensor_names[panel[j]];
       const bool model = std::find(chosen.begin(), chosen.end(), name) != chosen.end();
-      gp += (j ? ", " : "") + std::string("'sensors.csv' using 1:") +
-            std::to_string(panels[p][j] + 2) + " with lines lc rgb '" +
-            std::string(SeriesPalette()[j % SeriesPalette().size()]) + "' lw " +
-            (model ? "3.5" : "1.5") + " title " + GnuplotString(name);
+      report::Series s;
+      s.file = "sensors.csv";
+      s.columns = {Col(1), Col(static_cast<int>(panel[j]) + 2)};
+      s.colour = std::string(SeriesPalette()[j % SeriesPalette().size()]);
+      s.width = model ? 3.5 : 1.5;
+      s.title = name;
+      p.series.push_back(std::move(s));
     }
-    gp += "\n";
+    f.panels.push_back(std::move(p));
   }
-  return gp + "unset multiplot\n";
+  if (!f.panels.empty()) f.panels.back().xlabel = "time [min]";
+  f.height_px = 80 + kPanelHeightPx * static_cast<int>(std::max<std::size_t>(1, f.panels.size()));
+  return f;
 }
 
 // The strategies of each panel of the lead plot: the workpiece rows (none, the history rules,
@@ -99,50 +95,30 @@ std::vector<std::vector<std::size_t>> LeadPanels() {
 }
 
 // Every strategy in its colour and dash (core/plot_style.h), x from the thread start to its end.
-std::string LeadScript(const std::string& title, double thread_length_mm,
-                       const std::vector<std::vector<std::size_t>>& panels) {
-  std::string gp =
-      "set datafile separator ','\nset key outside right\nset grid\n"
-      "set xlabel 'position along the thread [mm]'\nset xrange [0:" +
-      std::to_string(thread_length_mm) +
-      "]\nset ylabel 'travel deviation [um]'\nset lmargin at screen 0.08\n"
-      "set rmargin at screen 0.8\nset multiplot layout " +
-      std::to_string(panels.size()) + ",1 title " + GnuplotString(title) + "\n";
-  for (const auto& panel : panels) {
-    gp += "plot ";
-    for (std::size_t j = 0; j < panel.size(); ++j) {
-      const std::string name = machine_eval::ToString(static_cast<MachineStrategy>(panel[j]));
-      gp += (j ? ", " : "") + std::string("'lead.csv' using 1:") + std::to_string(panel[j] + 2) +
-            " " + GnuplotWith(name) + " title " + GnuplotString(name);
+report::Figure LeadFigure(const std::string& title, double thread_length_mm) {
+  report::Figure f;
+  f.stem = "lead";
+  f.alt = title;
+  f.title = title;
+  for (const auto& panel : LeadPanels()) {
+    report::Panel p;
+    p.xlabel = "position along the thread [mm]";
+    p.ylabel = "travel deviation [um]";
+    p.x = {0, thread_length_mm};
+    for (std::size_t k : panel) {
+      const std::string name = machine_eval::ToString(static_cast<MachineStrategy>(k));
+      p.series.push_back({"lead.csv", -1, {Col(1), Col(static_cast<int>(k) + 2)}, SeriesKind::kLine,
+                          name, "", 1.5, false, name});
     }
-    gp += "\n";
+    f.panels.push_back(std::move(p));
   }
-  return gp + "unset multiplot\n";
-}
-
-// Adds <stem>.gp to the report and renders <stem>.png in its staging folder; returns the <img>
-// tag or a note.
-std::string Render(OutputDir& out, const std::string& stem, const std::string& body,
-                   int height_px = 480) {
-  out.Add(stem + ".gp",
-          Terminal(height_px) + "set output " + GnuplotString(stem + ".png") + "\n" + body);
-  if (!ProgramSucceeds({"gnuplot", "--version"}))
-    return "<p class='warn'>(gnuplot not found: " + HtmlEscape(stem) + ".gp not rendered)</p>";
-  const int rc = out.RunInStaging({"gnuplot", stem + ".gp"}, stem + ".log", {stem + ".png"});
-  const fs::path stage = out.Staging();
-  std::error_code ec;
-  if (rc != 0 || !fs::is_regular_file(stage / (stem + ".png"), ec)) {
-    if (fs::is_regular_file(stage / (stem + ".log"), ec)) out.AddStaged(stem + ".log");
-    return "<p class='warn'>(gnuplot failed on " + HtmlEscape(stem) + ".gp, see " +
-           HtmlEscape(stem) + ".log)</p>";
-  }
-  out.AddStaged(stem + ".png");
-  return HtmlImage(stem + ".png", stem);
+  f.height_px = 40 + 420 * static_cast<int>(f.panels.size());
+  return f;
 }
 
 std::string List(const std::vector<std::string>& names) {
   std::string s;
-  for (const auto& n : names) s += (s.empty() ? "" : ", ") + HtmlEscape(n);
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
   return s.empty() ? "(none: the model reads only the control's duty signals)" : s;
 }
 
@@ -154,8 +130,8 @@ std::string OutputAction(const std::string& drift_nc) {
   return drift_nc.substr(begin + 1, end == std::string::npos ? end : end - begin - 1);
 }
 
-// The "load onto the control" box of the combined programs (compare/control_box.h).
-std::string ControlBox(const std::string& screw_name, const CombinedPrograms& p) {
+// The "load onto the control" box of the combined programs (plan/load.h LoadBox).
+report::Box ControlBox(const std::string& screw_name, const CombinedPrograms& p) {
   plan::ControlLoad load;
   load.heading = screw_name;
   load.plan = p.plan;
@@ -184,63 +160,72 @@ std::string ControlBox(const std::string& screw_name, const CombinedPrograms& p)
       "again with WHIRL_TEMP_COMP. WHIRL_DRIFT_COMP refuses to start while a "
       "plan's compensation is active: call WHIRL_TEMP_COMP_RESET first.";
   load.requirements = p.requirements;
-  return compare::ControlBoxHtml({load});
+  return plan::LoadBox({load});
 }
 
-std::string ProgramsHtml(const CombinedPrograms* p, const std::string& note) {
-  if (!p) return note.empty() ? "" : "<p class='warn'>" + HtmlEscape(note) + "</p>";
-  const interp::DriftActionOptions& d = p->drift;
-  return "<h2>How the two programs share the setting data</h2><p>The workpiece plan (" +
-         std::to_string(p->plan.segments.size()) +
-         " segments of the network's curve) hands K0_w, S_w and P_w over; the machine drift action "
-         "(the sensor model's offset and slope channels, evaluated every interpolation cycle from "
-         "the analog inputs: sensors and the control's duty signals) writes SD43920 = P_w, SD43910 "
-         "= S_w + S_m, SD43900 = K0_w + K_m + S_m "
-         "(P_w - P_b), the fixed bearing at P_b = " +
-         FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:</p><pre>" +
-         HtmlEscape(OutputAction(p->drift_nc)) + "</pre>";
-}
-
-std::string StrategyTable(const machine_eval::MachineEvalScrew& r) {
-  std::string h =
-      "<table><tr><th>strategy</th><th>within 1000 mm [um]</th><th>over the thread "
-      "[um]</th><th>ISO 3408-3 class</th></tr>\n";
-  char buf[256];
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    std::snprintf(buf, sizeof buf, "<tr><td>%s</td><td>%.1f</td><td>%.1f</td><td>%s</td></tr>\n",
-                  machine_eval::ToString(static_cast<MachineStrategy>(k)).c_str(),
-                  r.metrics[k].accumulated_1000_um, r.metrics[k].accumulated_total_um,
-                  HtmlEscape(ToString(r.iso[k])).c_str());
-    h += buf;
+void AddPrograms(const CombinedPrograms* p, const std::string& note, report::Document* doc) {
+  if (!p) {
+    if (!note.empty()) doc->Say(note, report::Tone::kWarn);
+    return;
   }
-  std::snprintf(buf, sizeof buf,
-                "</table><p>Left after both_shop, over the thread: workpiece part %.1f um, "
-                "machine part %.1f um.</p>\n",
-                r.residual_workpiece_total_um, r.residual_machine_total_um);
-  return h + buf +
-         "<p class='small'>none: no compensation; traditional: the strongest history rule's plan "
-         "(class, table or nearest, chosen on the history); class, table, nearest: each history "
-         "rule's plan; workpiece: the network's plan alone. Machine models trained only from the "
-         "shop's probe, laser and lead measurements, applied from past control samples: warmup: "
-         "workpiece plus a time-since-power-on rule; schedule: workpiece plus a rule on the "
-         "control's duty signals; lead_slope: workpiece plus a pitch correction from measured past "
-         "screws; machine_shop: the sensor model alone; both_shop: workpiece plus the sensor model "
-         "(the programs above); both_shop_monitor: both_shop kept valid by the probe checks at the "
-         "set-ups.</p>\n";
+  const interp::DriftActionOptions& d = p->drift;
+  doc->Add(report::Heading{2, "How the two programs share the setting data", ""});
+  doc->Say("The workpiece plan (" + std::to_string(p->plan.segments.size()) +
+           " segments of the network's curve) hands K0_w, S_w and P_w over; the machine drift "
+           "action (the sensor model's offset and slope channels, evaluated every interpolation "
+           "cycle from the analog inputs: sensors and the control's duty signals) writes SD43920 "
+           "= P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b), the fixed bearing "
+           "at P_b = " +
+           FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:");
+  doc->Add(report::Preformatted{OutputAction(p->drift_nc)});
 }
 
-std::string Html(const ReportScrew& r, const std::string& sensor_img, const std::string& lead_img,
-                 const CombinedPrograms* programs, const std::string& programs_note) {
+report::Table StrategyTable(const machine_eval::MachineEvalScrew& r) {
+  report::Table t;
+  t.series_rows = true;
+  t.header = {"strategy", "within 1000 mm [um]", "over the thread [um]", "ISO 3408-3 class"};
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
+    t.rows.push_back({machine_eval::ToString(static_cast<MachineStrategy>(k)),
+                      FormatDecimals(r.metrics[k].accumulated_1000_um, 1),
+                      FormatDecimals(r.metrics[k].accumulated_total_um, 1), ToString(r.iso[k])});
+  return t;
+}
+
+void AddStrategyNotes(const machine_eval::MachineEvalScrew& r, report::Document* doc) {
+  doc->Say("Left after both_shop, over the thread: workpiece part " +
+           FormatDecimals(r.residual_workpiece_total_um, 1) + " um, machine part " +
+           FormatDecimals(r.residual_machine_total_um, 1) + " um.");
+  doc->Say(
+      "none: no compensation; traditional: the strongest history rule's plan (class, table or "
+      "nearest, chosen on the history); class, table, nearest: each history rule's plan; "
+      "workpiece: the network's plan alone. Machine models trained only from the shop's probe, "
+      "laser and lead measurements, applied from past control samples: warmup: workpiece plus a "
+      "time-since-power-on rule; schedule: workpiece plus a rule on the control's duty signals; "
+      "lead_slope: workpiece plus a pitch correction from measured past screws; machine_shop: "
+      "the sensor model alone; both_shop: workpiece plus the sensor model (the programs above); "
+      "both_shop_monitor: both_shop kept valid by the probe checks at the set-ups (drawn thin "
+      "with open circles: where it coincides with both_shop, both stay visible).",
+      report::Tone::kSmall);
+}
+
+report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
+                      const std::string& programs_note) {
   const machine_eval::MachineEvalScrew& x = r.result;
-  return HtmlPageBegin(x.screw.name + ": workpiece and machine drift in one cut (simulated)") +
-         (programs ? ControlBox(x.screw.name, *programs) : "") + "<p>Scenario " +
-         HtmlEscape(r.scenario) + ", machine " + std::to_string(x.machine) + ", test day " +
-         std::to_string(x.day) + ", start type " + HtmlEscape(x.start_type) +
-         ".</p><h2>Lead deviation per strategy</h2>" + StrategyTable(x) + lead_img +
-         "<h2>Sensors</h2><p>The sensor model (" + HtmlEscape(r.sensors_choice) +
-         ", trained from the shop's measurements) reads the sensors drawn thick: " +
-         List(r.sensors) + ".</p>" + sensor_img + ProgramsHtml(programs, programs_note) +
-         HtmlPageEnd();
+  report::Document doc;
+  doc.title = x.screw.name + ": workpiece and machine drift in one cut (simulated)";
+  if (programs) doc.Add(ControlBox(x.screw.name, *programs));
+  doc.Say("Scenario " + r.scenario + ", machine " + std::to_string(x.machine) + ", test day " +
+          std::to_string(x.day) + ", start type " + x.start_type + ".");
+  doc.Add(report::Heading{2, "Lead deviation per strategy", ""}).Add(StrategyTable(x));
+  AddStrategyNotes(x, &doc);
+  doc.Add(LeadFigure(x.screw.name + ": lead deviation", x.screw.thread_length_mm));
+  doc.Add(report::Heading{2, "Sensors", ""});
+  doc.Say("The sensor model (" + r.sensors_choice +
+          ", trained from the shop's measurements) reads the sensors drawn thick: " +
+          List(r.sensors) + ".");
+  doc.Add(SensorFigure(r.log, x.screw.name + ": sensors on the control", r.sensors));
+  AddPrograms(programs, programs_note, &doc);
+  return doc;
 }
 
 // The combined programs of the screw for the profile, or the note why there are none.
@@ -284,22 +269,11 @@ MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew&
                       "cut from " +
                           FormatFixed(screw.cut_start_min, 1) + " to " +
                           FormatFixed(screw.cut_end_min, 1) + " min"}));
-  const auto panels = GroupSeries(screw.log.sensor_names, kSensorsPerPanel);
-  const std::string sensor_img = Render(
-      out, "sensors",
-      SensorScript(screw.log, x.screw.name + ": sensors on the control", screw.sensors, panels),
-      80 + kPanelHeightPx * static_cast<int>(panels.size()));
   out.Add("lead.csv", LeadCsv(screw));
-  const auto lead_panels = LeadPanels();
-  const std::string lead_img =
-      Render(out, "lead",
-             LeadScript(x.screw.name + ": lead deviation", x.screw.thread_length_mm, lead_panels),
-             40 + 420 * static_cast<int>(lead_panels.size()));
   if (programs)
     for (const auto& [path, text] : CombinedProgramFiles("", *programs))
       out.Add(path.filename().string(), text);
-  out.Add("index.html",
-          Html(screw, sensor_img, lead_img, programs ? &*programs : nullptr, report.programs_note));
+  report::RenderReport(Page(screw, programs ? &*programs : nullptr, report.programs_note), out);
   out.Commit();
   report.index_html = (fs::path(dir) / "index.html").string();
   report.programs = programs.has_value();

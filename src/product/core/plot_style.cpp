@@ -73,15 +73,6 @@ std::string GnuplotWith(std::string_view name) {
   return with;
 }
 
-std::string GnuplotKeyOutsideRight(double right_edge) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf,
-                "set key outside right top Left reverse\nset lmargin at screen 0.08\n"
-                "set rmargin at screen %g\n",
-                right_edge);
-  return buf;
-}
-
 const std::vector<std::string_view>& SeriesPalette() {
   static const std::vector<std::string_view> kPalette = {
       "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf"};

@@ -45,11 +45,6 @@ const SeriesStyle* FindSeriesStyle(std::string_view name);
 /// name without an entry gets thin grey dots (visible, and obviously not one of the table's looks).
 std::string GnuplotWith(std::string_view name);
 
-/// gnuplot lines that put the key beside the plot, right of the data (never on it), with the
-/// plot area fixed from 8 % to `right_edge` of the picture's width so the panels of a multiplot
-/// line up whatever their keys' widths.
-std::string GnuplotKeyOutsideRight(double right_edge = 0.8);
-
 /// Eight well-separated colours for plots of many unnamed series (sensors), in order.
 const std::vector<std::string_view>& SeriesPalette();
 

@@ -47,8 +47,8 @@ std::string Classes(const Selection& s, const Partition& p) {
   return out;
 }
 
-// The unit of a feature's coefficient: rises and their lags um/K, elapsed-time terms um, other
-// inputs um per the unit their name ends in (spindle_rpm: um/rpm).
+}  // namespace
+
 std::string CoefficientUnit(const DriftModel& m, const Feature& f) {
   if (f.input == "elapsed") return "um";
   for (const auto& s : m.sensors)
@@ -58,8 +58,6 @@ std::string CoefficientUnit(const DriftModel& m, const Feature& f) {
     return "um/" + f.input.substr(cut + 1);
   return "um per unit of " + f.input;
 }
-
-}  // namespace
 
 json SelectionJson(const Selection& s) {
   json parts = json::array();

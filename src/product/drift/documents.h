@@ -23,6 +23,9 @@ std::string FormatSelection(const Selection& s);
 /// R^2, residual std, training runs, lag search.
 nlohmann::json ModelSummaryJson(const DriftModel& m);
 std::string FormatModel(const DriftModel& m);
+/// The unit of a feature's coefficient: rises and their lags um/K, elapsed-time terms um, other
+/// inputs um per the unit their name ends in (spindle_rpm: um/rpm).
+std::string CoefficientUnit(const DriftModel& m, const Feature& f);
 
 /// Per sample: time_min (or sample), predicted_um, compensation_um (= -predicted), std_um, and
 /// measured_um, residual_um when the run has the error column.

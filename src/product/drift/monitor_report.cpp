@@ -7,13 +7,13 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
-#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/plot_style.h"
-#include "core/run_program.h"
+#include "core/report_render.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
+#include "drift/load_box.h"
 
 namespace whirl::drift {
 namespace {
@@ -426,86 +426,180 @@ std::string ChecksCsv(const MonitorResult& r) {
   return marks.str();
 }
 
-// monitor.gp: the measured error and every rule's model over time, the checks as markers, and
-// the residuals below; `prefix` names the files of one day of a week ("" for one run).
-std::string MonitorGnuplot(const MonitorResult& r, const std::string& prefix = "") {
-  const std::string x = r.time_from_index ? "1" : "($1/60)";
-  const std::size_t q = r.strategies.size();
-  std::ostringstream gp;
-  gp << "set terminal pngcairo size 1100,700 font 'Sans,10' noenhanced\nset output "
-     << GnuplotString(prefix + "monitor.png") << "\n"
-     << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
-     << GnuplotString(r.time_from_index ? "sample" : "time [h]") << "\nset arrow from "
-     << FormatNumber((r.last_time - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
-     << ", graph 0 to "
-     << FormatNumber((r.last_time - r.monitored_min) / (r.time_from_index ? 1.0 : 60.0))
-     << ", graph 1 nohead dt 2\nset multiplot layout 2,1\n"
-     << "set ylabel 'thermal error [um]'\nset title "
-     << GnuplotString(
-            "run " + r.run + ": measured " + r.error_column +
-            " and the models (dashed: monitoring starts; open: valid checks, filled: invalid "
-            "checks and refit measurements)")
-     << "\nplot " << GnuplotString(prefix + "plot_timeline.csv") << " using " << x
-     << ":2 " << GnuplotWith("measured") << " title 'measured'";
-  // Each rule in its look of core/plot_style.h, its checks in its colour.
-  const auto rule = [&r](std::size_t i) { return ToString(r.strategies[i].rule); };
-  const auto colour = [&rule](std::size_t i) {
-    const SeriesStyle* s = FindSeriesStyle(rule(i));
-    return "rgb '" + std::string(s ? s->colour : "#aaaaaa") + "'";
-  };
-  for (std::size_t i = 0; i < q; ++i)
-    gp << ", '' using " << x << ":" << i + 3 << " " << GnuplotWith(rule(i)) << " title "
-       << GnuplotString(rule(i));
-  for (std::size_t i = 1; i < q; ++i)
-    gp << ", " << GnuplotString(prefix + "checks.csv") << " index " << i << " using " << x
-       << ":($3==0?$2:1/0) with points pt 6 lc " << colour(i) << " notitle, '' index " << i
-       << " using " << x << ":($3==1?$2:1/0) with points pt 7 lc " << colour(i) << " notitle";
-  gp << "\nset title 'residual (measured - model)'\nset ylabel 'residual [um]'\nplot ";
-  for (std::size_t i = 0; i < q; ++i)
-    gp << (i ? ", " : "") << GnuplotString(prefix + "plot_timeline.csv") << " using " << x << ":"
-       << i + 3 + q << " " << GnuplotWith(rule(i)) << " title " << GnuplotString(rule(i));
-  gp << "\nunset multiplot\n";
-  return "# gnuplot script written by whirl; re-run: gnuplot " + prefix + "monitor.gp\n" + gp.str();
-}
+using report::Col;
+using report::SeriesKind;
 
-// Renders monitor.gp in the staging folder of `files`; returns the page's image element (or the
-// note that it was not rendered), warnings say why not.
-std::string RenderMonitorPlot(const fs::path& dir, const std::string& gnuplot, OutputDir& files,
-                              std::vector<std::string>* warnings, const std::string& prefix = "") {
-  const std::string script = prefix + "monitor.gp", png = prefix + "monitor.png";
-  std::string img = "<p>(plot not rendered: " + HtmlEscape(script) + ")</p>";
-  std::error_code ec;
-  if (!ProgramSucceeds({gnuplot, "--version"})) {
-    warnings->push_back("'" + gnuplot + "' not found: plot skipped (install gnuplot-nox)");
-  } else {
-    const fs::path stage = files.Staging();  // gnuplot renders there
-    if (files.RunInStaging({gnuplot, script}, prefix + "gnuplot.log", {png}) == 0 &&
-        fs::is_regular_file(stage / png, ec)) {
-      files.AddStaged(png);
-      img = "<img src='" + HtmlEscape(png) + "' alt='monitor timeline'>";
-    } else {
-      warnings->push_back("gnuplot failed on " + (dir / script).string() + " (see " + prefix +
-                          "gnuplot.log)");
-      files.AddProgramLog(prefix + "gnuplot.log");
+// The monitor's figure (<prefix>monitor.gp/.png): the measured error and every rule's model over
+// time with its checks (open: valid, filled: invalid checks and refit measurements) and the
+// start of monitoring (dashed), and the residuals below. Each rule in its look of
+// core/plot_style.h, its checks in its colour; `prefix` names the files of one day of a week.
+report::Figure MonitorFigure(const MonitorResult& r, const std::string& prefix) {
+  const double per = r.time_from_index ? 1.0 : 60.0;
+  const std::size_t q = r.strategies.size();
+  const std::string timeline = prefix + "plot_timeline.csv", checks = prefix + "checks.csv";
+  report::Panel top, bottom;
+  top.title = "run " + r.run + ": measured " + r.error_column + " and the models";
+  top.ylabel = "thermal error [um]";
+  bottom.title = "residual (measured - model)";
+  bottom.ylabel = "residual [um]";
+  for (report::Panel* p : {&top, &bottom}) {
+    p->xlabel = r.time_from_index ? "sample" : "time [h]";
+    p->x_marks = {(r.last_time - r.monitored_min) / per};
+  }
+  top.series.push_back({timeline, -1, {Col(1, per), Col(2)}, SeriesKind::kLine, "measured", "", 1.5,
+                        false, "measured"});
+  for (std::size_t i = 0; i < q; ++i) {
+    const std::string rule = ToString(r.strategies[i].rule);
+    const int k = static_cast<int>(i);
+    // A rule that never left an earlier one's prediction is drawn with open circles and its
+    // legend says so: coinciding lines stay distinguishable.
+    std::string same;
+    const Eigen::VectorXd& v = r.strategies[i].predicted_um;
+    for (std::size_t e = 0; e < i && same.empty(); ++e) {
+      const Eigen::VectorXd& u = r.strategies[e].predicted_um;
+      if (u.size() == v.size() && v.size() > 0 &&
+          (u - v).cwiseAbs().maxCoeff() <= 1e-9 * (1 + v.cwiseAbs().maxCoeff()))
+        same = ToString(r.strategies[e].rule);
+    }
+    const std::string title = rule + (same.empty() ? "" : " (the same as " + same + ")");
+    report::Series line{timeline, -1, {Col(1, per), Col(k + 3)}, SeriesKind::kLine, rule, "", 1.5,
+                        false, title};
+    line.markers = !same.empty();
+    top.series.push_back(line);
+    line.columns = {Col(1, per), Col(k + 3 + static_cast<int>(q))};
+    bottom.series.push_back(line);
+  }
+  for (std::size_t i = 1; i < q; ++i) {
+    const std::string rule = ToString(r.strategies[i].rule);
+    for (const int invalid : {0, 1}) {
+      report::Column y = Col(2);
+      y.only_if_column = 3;
+      y.only_if_value = invalid;
+      report::Series s{checks, static_cast<int>(i), {Col(1, per), y},
+                       invalid ? SeriesKind::kPoints : SeriesKind::kOpenPoints, "", "", 1.5, false,
+                       ""};
+      const SeriesStyle* look = FindSeriesStyle(rule);
+      s.colour = look ? std::string(look->colour) : "#aaaaaa";
+      top.series.push_back(std::move(s));
     }
   }
-  return img;
+  report::Figure f;
+  f.stem = prefix + "monitor";
+  f.alt = "monitor timeline of " + r.run;
+  f.width_px = 1000;
+  f.height_px = 700;
+  f.panels = {top, bottom};
+  return f;
 }
 
-// index.html: provenance, the text report, the plot and the data files.
-std::string MonitorIndexHtml(const MonitorResult& r, const MonitorOptions& o,
-                             const std::vector<std::string>& provenance, const std::string& img,
-                             const std::vector<std::string>& warnings) {
-  std::ostringstream h;
-  h << HtmlPageBegin(  // the shared skeleton and stylesheet (core/html_page.h)
-      "whirl: on-line check and recalibration of " + r.error_column + " on " + r.run, provenance);
-  h << "<pre>" << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n"
-    << img << "\n"
-    << "<p>Data: <a href='timeline.csv'>timeline.csv</a>, <a href='events.csv'>events.csv</a> "
-       "(every check and update with its reason), <a href='monitor.gp'>monitor.gp</a>.</p>\n";
-  for (const auto& w : warnings) h << "<p><i>" << HtmlEscape(w) << "</i></p>\n";
-  h << "</body></html>\n";
-  return h.str();
+// The rules' table: MAE, RMSE and max per rule, no compensation and the sensor-free baselines,
+// with checks, invalid checks, recalibrations and stop time.
+report::Table MonitorTable(const MonitorResult& r) {
+  report::Table t;
+  t.series_rows = true;
+  t.header = {"rule", "MAE [um]", "RMSE [um]", "max [um]", "checks", "invalid", "recalibrations",
+              "stop [min]", "stop [%]"};
+  const auto stats = [](const ErrorStats& s) {
+    return std::vector<report::Cell>{FormatDecimals(s.mae_um, 2), FormatDecimals(s.rmse_um, 2),
+                                     FormatDecimals(s.max_abs_um, 2)};
+  };
+  report::Cell none_name("none (no compensation)");
+  none_name.not_plotted = true;
+  std::vector<report::Cell> none{none_name};
+  for (auto& c : stats(r.none)) none.push_back(c);
+  none.insert(none.end(), {"-", "-", "-", "-", "-"});
+  t.rows.push_back(none);
+  for (const auto& st : r.strategies) {
+    std::vector<report::Cell> row{ToString(st.rule)};
+    for (auto& c : stats(st.score)) row.push_back(c);
+    row.insert(row.end(),
+               {std::to_string(st.checks), std::to_string(st.invalid_checks),
+                std::to_string(st.recalibrations), FormatDecimals(st.stop_min, 1),
+                r.time_from_index ? std::string("-") : FormatDecimals(100.0 * st.stop_share, 2)});
+    if (ToString(st.rule) == r.Strongest()) t.highlight.push_back(t.rows.size());
+    t.rows.push_back(std::move(row));
+  }
+  for (const auto& b : r.baselines) {
+    report::Cell name(b.name + " (sensor-free, not drawn)");
+    name.not_plotted = true;
+    std::vector<report::Cell> row{name};
+    for (auto& c : stats(b.score)) row.push_back(c);
+    row.insert(row.end(), {"-", "-", "-", "-", "-"});
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+// The week: per row (none, the rules, the baselines) the MAE and RMSE over the days it covers,
+// and for the rules the measurements and stop time; the strongest over the week bold.
+report::Table WeekTable(const WeekResult& w) {
+  report::Table t;
+  t.series_rows = true;
+  t.header = {"row", "days", "MAE [um]", "RMSE [um]", "measurements", "stop [min]"};
+  const auto& rules = w.days.front().strategies;
+  for (const WeekRow& row : w.week) {
+    std::size_t rule = rules.size();
+    for (std::size_t i = 0; i < rules.size(); ++i)
+      if (ToString(rules[i].rule) == row.name) rule = i;
+    report::Cell name(row.name);
+    name.not_plotted = rule == rules.size();  // none and the baselines are not drawn
+    if (row.name == w.strongest) t.highlight.push_back(t.rows.size());
+    t.rows.push_back({name, std::to_string(row.days), FormatDecimals(row.score.mae_um, 2),
+                      FormatDecimals(row.score.rmse_um, 2),
+                      rule < rules.size() ? std::to_string(w.measurements[rule]) : "-",
+                      rule < rules.size() ? FormatDecimals(w.stop_min[rule], 0) : "-"});
+  }
+  t.caption = "Each rule carries its coefficients (and the bayes covariance) from day to day; "
+              "previous run = drift fit at its defaults redone on the previous day (the given "
+              "model on the first); time = sensor-free warm-up fitted on the previous day. Bold: "
+              "the strongest over the week (lowest MAE among the rows covering every day).";
+  return t;
+}
+
+// One run's part of the page: what was run, the table, the updates, the figure, the data.
+std::vector<report::Block> MonitorBlocks(const MonitorResult& r, const MonitorOptions& o,
+                                         const std::string& prefix) {
+  using report::MakeBlock;
+  const bool idx = r.time_from_index;
+  const double to_h = idx ? 1.0 : 1.0 / 60.0;
+  const std::string every = idx ? " samples" : " min", unit = idx ? " samples" : " h";
+  std::vector<report::Block> b;
+  b.push_back(MakeBlock(report::Paragraph{{report::Text(
+      "Run " + r.run + ", " + r.error_column + ", " + r.model_kind + " model; checks every " +
+      MessageNumber(o.check_every) + every + ", threshold " + FormatDecimals(r.threshold_um, 2) +
+      " um, " + std::to_string(o.refit_samples) + " refit measurements every " +
+      MessageNumber(o.refit_every) + every + ", " + MessageNumber(o.stop_min_per_measurement) +
+      " min stop each" +
+      (idx ? " (no recorded time: intervals count samples; stop share not computed)" : "") +
+      ". Scored rows [" + std::to_string(r.score_begin) + ", " + std::to_string(r.score_end) +
+      "): " + FormatDecimals(r.score_first_time * to_h, 2) + " to " +
+      FormatDecimals(r.score_last_time * to_h, 2) + unit + ". Strongest (lowest MAE, bold): " +
+      r.Strongest() + ".")}}));
+  b.push_back(MakeBlock(MonitorTable(r)));
+  report::List updates;
+  updates.tone = report::Tone::kSmall;
+  for (const auto& st : r.strategies)
+    for (const auto& e : st.events)
+      if (e.kind == MonitorEvent::Kind::kUpdate || e.kind == MonitorEvent::Kind::kSkipped)
+        updates.items.push_back({report::Bold(ToString(st.rule)),
+                                 report::Text(" at " + FormatDecimals(e.time * to_h, 2) + unit +
+                                              ": " + e.message)});
+  if (!updates.items.empty()) {
+    b.push_back(MakeBlock(report::Paragraph{{report::Text("Recalibrations:")}}));
+    b.push_back(MakeBlock(updates));
+  }
+  for (const auto& w : r.warnings)
+    b.push_back(MakeBlock(report::Paragraph{{report::Text("warning: " + w)}, report::Tone::kWarn}));
+  b.push_back(MakeBlock(MonitorFigure(r, prefix)));
+  b.push_back(MakeBlock(report::Paragraph{
+      {report::Text("The dashed vertical line: monitoring starts; open circles: valid checks, "
+                    "filled: invalid checks and refit measurements, in their rule's colour. Data: "),
+       report::Link(prefix + "timeline.csv", prefix + "timeline.csv"), report::Text(", "),
+       report::Link(prefix + "events.csv", prefix + "events.csv"),
+       report::Text(" (every check and update with its reason), "),
+       report::Link(prefix + "monitor.gp", prefix + "monitor.gp"), report::Text(".")},
+      report::Tone::kSmall}));
+  return b;
 }
 
 }  // namespace
@@ -548,9 +642,14 @@ MonitorReportResult WriteMonitorReport(OutputDir& files, const MonitorResult& r,
   files.Add("plot_timeline.csv", PlotTimelineCsv(r, provenance));
   files.Add("events.csv", MonitorEventsCsv(r, provenance));
   files.Add("checks.csv", ChecksCsv(r));
-  files.Add("monitor.gp", MonitorGnuplot(r));
-  const std::string img = RenderMonitorPlot(dir, gnuplot, files, &out.warnings);
-  files.Add("index.html", MonitorIndexHtml(r, o, provenance, img, out.warnings));
+  report::Document doc;
+  doc.title = "whirl: on-line check and recalibration of " + r.error_column + " on " + r.run;
+  doc.provenance = provenance;
+  doc.Add(DriftLoadBox(r.model_kind, r.error_column, {}));
+  doc.Add(MonitorBlocks(r, o, ""));
+  report::RenderOptions ro;
+  ro.gnuplot = gnuplot;
+  out.warnings = report::RenderReport(doc, files, ro).warnings;
   files.Commit(also, also_ready);
   out.index_html = dir / "index.html";
   return out;
@@ -578,7 +677,27 @@ MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
   else
     files.AddReady("week_timeline.csv", week_ready);
   files.Add("week_events.csv", WeekEventsCsv(w, provenance));
-  std::ostringstream days;
+  report::Document doc;
+  doc.title = "whirl: a production week of " + w.days.front().error_column + ", " +
+              std::to_string(w.days.size()) + " days";
+  doc.provenance = provenance;
+  doc.Add(DriftLoadBox(w.days.front().model_kind, w.days.front().error_column, {}));
+  doc.Add(report::Heading{2, "Week", ""});
+  doc.Add(WeekTable(w));
+  for (const WeekPartial& p : w.partial) {
+    std::string days;
+    for (int d : p.days) days += (days.empty() ? "" : ", ") + w.days[static_cast<std::size_t>(d)].run;
+    doc.Say(p.name + " covers " + std::to_string(p.days.size()) + " of " +
+                std::to_string(w.days.size()) + " days (" + days + "): not ranked; over those days " +
+                p.name + " " + FormatDecimals(p.mae_um, 2) + " um, the strongest row covering every day " +
+                p.strongest + " " + FormatDecimals(p.strongest_mae_um, 2) + " um.",
+            report::Tone::kSmall);
+  }
+  doc.Add(report::Paragraph{{report::Text("Data: "),
+                             report::Link("week_timeline.csv", "week_timeline.csv"),
+                             report::Text(" (every day, a day column first), "),
+                             report::Link("week_events.csv", "week_events.csv"), report::Text(".")},
+                            report::Tone::kSmall});
   for (std::size_t d = 0; d < w.days.size(); ++d) {
     const MonitorResult& r = w.days[d];
     const std::string prefix = "day" + std::to_string(d + 1) + "_";
@@ -589,25 +708,12 @@ MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
     files.Add(prefix + "plot_timeline.csv", PlotTimelineCsv(r, provenance));
     files.Add(prefix + "events.csv", MonitorEventsCsv(r, provenance));
     files.Add(prefix + "checks.csv", ChecksCsv(r));
-    files.Add(prefix + "monitor.gp", MonitorGnuplot(r, prefix));
-    const std::string img = RenderMonitorPlot(dir, gnuplot, files, &out.warnings, prefix);
-    days << "<h2>Day " << d + 1 << ": " << HtmlEscape(r.run) << "</h2>\n<pre>"
-         << HtmlEscape(FormatMonitor(r, o)) << "</pre>\n" << img << "\n<p>Data: <a href='"
-         << prefix << "timeline.csv'>" << prefix << "timeline.csv</a>, <a href='" << prefix
-         << "events.csv'>" << prefix << "events.csv</a>, <a href='" << prefix << "monitor.gp'>"
-         << prefix << "monitor.gp</a>.</p>\n";
+    doc.Add(report::Heading{2, "Day " + std::to_string(d + 1) + ": " + r.run, ""});
+    doc.Add(MonitorBlocks(r, o, prefix));
   }
-  std::ostringstream h;
-  h << HtmlPageBegin("whirl: a production week of " + w.days.front().error_column + ", " +
-                         std::to_string(w.days.size()) + " days",
-                     provenance);
-  h << "<h2>Week</h2>\n<pre>" << HtmlEscape(FormatWeek(w, o)) << "</pre>\n"
-    << "<p>Data: <a href='week_timeline.csv'>week_timeline.csv</a> (every day, a day column "
-       "first), <a href='week_events.csv'>week_events.csv</a>.</p>\n"
-    << days.str();
-  for (const auto& warn : out.warnings) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
-  h << "</body></html>\n";
-  files.Add("index.html", h.str());
+  report::RenderOptions ro;
+  ro.gnuplot = gnuplot;
+  out.warnings = report::RenderReport(doc, files, ro).warnings;
   files.Commit(also, also_ready);
   out.index_html = dir / "index.html";
   return out;

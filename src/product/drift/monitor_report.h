@@ -81,9 +81,10 @@ struct MonitorReportResult {
 /// Files written together with a report, outside its directory: (path, contents).
 using AlsoWrite = std::vector<std::pair<std::filesystem::path, std::string>>;
 
-/// HTML page with the table and a plot of measured and predicted error per rule with the checks
-/// and recalibrations marked, and the residuals (gnuplot via RunProgram; skipped with a warning
-/// when absent), beside the timeline and events CSV it is drawn from. `dir` follows the
+/// HTML page (a report document rendered by core/report_render.h): the "load onto the control"
+/// box (drift/load_box.h), the rules' table (the strongest bold), the recalibrations, and a plot
+/// of measured and predicted error per rule with the checks and recalibrations marked, and the
+/// residuals (gnuplot; skipped with a warning when absent), beside the timeline and events CSV it is drawn from. `dir` follows the
 /// output-directory rule of core/output_dir.h; the page, its files and `also` (e.g. the
 /// --timeline and --events files) are written all-or-nothing.
 MonitorReportResult WriteMonitorReport(const std::filesystem::path& dir, const MonitorResult& r,

@@ -1,5 +1,6 @@
 #include "drift/report.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -10,63 +11,36 @@
 #include "core/csv.h"
 #include "core/decimate.h"
 #include "core/error.h"
-#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/plot_style.h"
-#include "core/run_program.h"
+#include "core/report_render.h"
 #include "core/safe_text.h"
 #include "drift/documents.h"
+#include "drift/load_box.h"
 
 namespace whirl::drift {
 namespace {
 
 namespace fs = std::filesystem;
 
-const char* kTerminal = "set terminal pngcairo size 1000,480 font 'Sans,10' noenhanced\n";
-
-// Collects the files, renders the gnuplot scripts in the output directory's staging folder and
-// commits everything with index.html all-or-nothing (core/output_dir.h).
+// Collects the files and commits them with the rendered page all-or-nothing
+// (core/output_dir.h); the page and its figures are rendered by core/report_render.h.
 class ReportWriter {
  public:
   ReportWriter(const fs::path& dir, std::string gnuplot)
-      : out_(dir, "report directory"), gnuplot_(std::move(gnuplot)) {
-    have_gnuplot_ = ProgramSucceeds({gnuplot_, "--version"});
-    if (!have_gnuplot_)
-      result_.warnings.push_back("'" + gnuplot_ +
-                                 "' not found: plots skipped (install gnuplot-nox)");
-  }
+      : out_(dir, "report directory"), gnuplot_(std::move(gnuplot)) {}
   void File(const std::string& name, const std::string& text) { out_.Add(name, text); }
-  // Script `stem`.gp renders `stem`.png; returns the <img> tag (or a note when not rendered).
-  std::string Plot(const std::string& stem, const std::string& body, const std::string& alt) {
-    const std::string png = stem + ".png";
-    File(stem + ".gp", "# gnuplot script written by whirl; re-run with: gnuplot " + stem + ".gp\n" +
-                           kTerminal + "set output " + GnuplotString(png) + "\n" + body);
-    if (have_gnuplot_) {
-      // gnuplot never sees the output directory: it renders in the staging folder.
-      const int rc = out_.RunInStaging({gnuplot_, stem + ".gp"}, "gnuplot.log", {png});
-      const fs::path stage = out_.Staging();
-      std::error_code ec;
-      if (rc == 0 && fs::is_regular_file(stage / png, ec) && fs::file_size(stage / png, ec) > 0) {
-        out_.AddStaged(png);
-        return "<img src='" + HtmlEscape(png) + "' alt='" + HtmlEscape(alt) + "'>";
-      }
-      gnuplot_failed_ = true;
-      result_.warnings.push_back("gnuplot failed on " + (out_.path() / (stem + ".gp")).string() +
-                                 " (see gnuplot.log)");
-    }
-    return "<p>(plot not rendered: " + HtmlEscape(stem) + ".gp)</p>";
-  }
   // A long per-sample CSV written to disk as it is formatted (never held whole): a file in the
   // staging folder, handed to Commit by Ready.
   std::unique_ptr<StreamedFile> Streamed(const std::string& name) {
     return std::make_unique<StreamedFile>(fs::absolute(out_.Staging()) / name);
   }
   void Ready(const std::string& name, StreamedFile* file) { out_.AddReady(name, file->Finish()); }
-  const std::vector<std::string>& warnings() const { return result_.warnings; }
-  DriftReportResult Finish(const std::string& html) {
-    if (gnuplot_failed_) out_.AddProgramLog("gnuplot.log");
-    File("index.html", html);
+  DriftReportResult Finish(const report::Document& doc) {
+    report::RenderOptions o;
+    o.gnuplot = gnuplot_;
+    result_.warnings = report::RenderReport(doc, out_, o).warnings;
     result_.files = out_.Commit();
     result_.index_html = out_.path() / "index.html";
     return result_;
@@ -75,14 +49,8 @@ class ReportWriter {
  private:
   OutputDir out_;
   std::string gnuplot_;
-  bool have_gnuplot_ = false, gnuplot_failed_ = false;
   DriftReportResult result_;
 };
-
-// The shared skeleton and stylesheet of every report (core/html_page.h).
-std::string Head(const std::string& title, const std::vector<std::string>& provenance) {
-  return HtmlPageBegin(title, provenance);
-}
 
 std::vector<std::string> Comments(const std::vector<std::string>& provenance,
                                   const std::string& what) {
@@ -91,13 +59,87 @@ std::vector<std::string> Comments(const std::vector<std::string>& provenance,
   return c;
 }
 
-std::string SelectionHtml(const Selection& s) {
-  std::ostringstream h;
-  h << "<h2>Sensitive points (Miao et al.)</h2>\n<p>" << HtmlEscape(s.message)
-    << ". Chosen sensors: <b>";
-  for (const auto& n : s.ChosenNames()) h << HtmlEscape(n) << " ";
-  h << "</b></p>\n<table><tr><th>lambda</th><th>classes</th><th>F</th><th>F crit</th>"
-       "<th>significant</th><th style='text-align:left'>partition</th></tr>\n";
+using report::Cell;
+using report::Col;
+using report::SeriesKind;
+using report::Text;
+
+// The model: what it predicts from what, its zero and training, and its coefficients as a table.
+void AddModel(const DriftModel& m, report::Document* doc) {
+  std::vector<std::string> inputs = m.sensors;
+  inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+  if (!m.elapsed_time_constants.empty()) inputs.push_back("elapsed time");
+  std::string on;
+  for (const auto& i : inputs) on += (on.empty() ? "" : ", ") + i;
+  const auto numbers = [](const std::vector<double>& v) {
+    std::string out;
+    for (double x : v) out += (out.empty() ? "" : ", ") + MessageNumber(x);
+    return out;
+  };
+  std::string text = ToString(m.kind) + " model of " + m.error_column + " on " + on +
+                     ". Error zero: " + ToString(m.zero.zero) +
+                     (m.zero.zero == ErrorZero::kFixed
+                          ? " (gauge level " + FormatDecimals(m.zero.gauge_level_um, 3) + " um)"
+                          : std::string()) +
+                     "; sensors: " + m.selection + ".";
+  if (!m.time_constants.empty())
+    text += " Lag time constants: " + numbers(m.time_constants) + " " + m.time_unit + ".";
+  if (!m.elapsed_time_constants.empty())
+    text += " Elapsed-time constants: " + numbers(m.elapsed_time_constants) + " " + m.time_unit +
+            ".";
+  std::string runs;
+  for (const auto& r : m.training_runs) runs += (runs.empty() ? "" : ", ") + r;
+  text += " Training: R^2 " + FormatDecimals(m.r_squared, 4) + ", residual std " +
+          FormatDecimals(m.residual_std_um, 3) + " um, " + std::to_string(m.training_samples) +
+          " samples of " + runs + " (state " + ToString(m.state) + ").";
+  doc->Add(report::Heading{2, "Model", ""}).Say(text);
+  for (const auto& n : m.notes) doc->Say(n, report::Tone::kSmall);
+  if (m.kind == ModelKind::kNetwork) {
+    doc->Say("Network " + std::to_string(m.network.layer_sizes[0]) + "-" +
+             std::to_string(m.network.layer_sizes[1]) + "-1 (no coefficients to show).");
+    return;
+  }
+  report::Table t;
+  t.header = {"feature", "coefficient", "std error", "VIF"};
+  t.rows.push_back({"intercept [um]", FormatDecimals(m.linear.coefficients(0), 4),
+                    FormatDecimals(m.linear.standard_errors(0), 4), ""});
+  for (std::size_t i = 0; i < m.features.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    t.rows.push_back({m.features[i].Name(m.time_unit) + " [" + CoefficientUnit(m, m.features[i]) +
+                          "]",
+                      FormatDecimals(m.linear.coefficients(k + 1), 4),
+                      FormatDecimals(m.linear.standard_errors(k + 1), 4),
+                      FormatSignificant(m.linear.vif(k), 4)});
+  }
+  doc->Add(t);
+}
+
+// The candidates of the fit's choice (validation RMSE per candidate), as a table.
+void AddCandidates(const FitReport& fit, report::Document* doc) {
+  if (fit.candidates.empty()) return;
+  report::Table t;
+  t.header = {"candidate", "parameters", "validation RMSE [um]", "folds", "RMSE per fold [um]"};
+  for (const auto& c : fit.candidates) {
+    std::string folds;
+    for (double f : c.fold_rmse_um)
+      folds += (folds.empty() ? "" : " ") + FormatDecimalsOr(std::isfinite(f) ? f : NAN, 3, "-");
+    Cell per(folds);
+    per.left = true;
+    t.rows.push_back({c.name, std::to_string(c.parameters),
+                      FormatDecimalsOr(std::isfinite(c.cv_rmse_um) ? c.cv_rmse_um : NAN, 3, "-"),
+                      std::to_string(c.folds), per});
+  }
+  t.caption = "candidates (validation RMSE, the whole fit redone in every fold): " + fit.chosen;
+  doc->Add(t);
+}
+
+void AddSelection(const Selection& s, report::Document* doc) {
+  std::string chosen;
+  for (const auto& n : s.ChosenNames()) chosen += (chosen.empty() ? "" : ", ") + n;
+  doc->Add(report::Heading{2, "Sensitive points (Miao et al.)", ""});
+  doc->Add(report::Paragraph{{Text(s.message + ". Chosen sensors: "), report::Bold(chosen)}});
+  report::Table t;
+  t.header = {"lambda", "classes", "F", "F crit", "significant", "partition"};
   for (std::size_t i = 0; i < s.partitions.size(); ++i) {
     const Partition& p = s.partitions[i];
     std::string classes;
@@ -107,25 +149,31 @@ std::string SelectionHtml(const Selection& s) {
         if (p.labels[j] == k) classes += s.sensor_names[j] + " ";
       classes += "} ";
     }
-    const bool chosen = static_cast<int>(i) == s.chosen_partition;
-    h << "<tr" << (chosen ? " style='background:#dfd'" : "") << "><td>"
-      << FormatDecimals(p.lambda, 4) << "</td><td>" << p.classes << "</td><td>"
-      << (p.has_f ? FormatDecimals(p.f, 3) : "-") << "</td><td>"
-      << (p.has_f ? FormatDecimals(p.f_critical, 3) : "-") << "</td><td>"
-      << (p.has_f ? (p.significant() ? "yes" : "no") : "-") << "</td><td style='text-align:left'>"
-      << HtmlEscape(classes) << "</td></tr>\n";
+    if (static_cast<int>(i) == s.chosen_partition) t.highlight.push_back(t.rows.size());
+    Cell part(classes);
+    part.left = true;
+    t.rows.push_back({FormatDecimals(p.lambda, 4), std::to_string(p.classes),
+                      p.has_f ? FormatDecimals(p.f, 3) : "-",
+                      p.has_f ? FormatDecimals(p.f_critical, 3) : "-",
+                      p.has_f ? (p.significant() ? "yes" : "no") : "-", part});
   }
-  h << "</table>\n<p>Grey relational grades against the error (rho 0.5):</p><table><tr>";
-  for (const auto& n : s.sensor_names) h << "<th>" << HtmlEscape(n) << "</th>";
-  h << "</tr><tr>";
-  for (Eigen::Index i = 0; i < s.grades.size(); ++i)
-    h << "<td>" << FormatDecimals(s.grades(i), 4) << "</td>";
-  h << "</tr></table>\n";
-  return h.str();
+  t.caption = "The chosen partition in bold.";
+  doc->Add(t);
+  // One row per sensor (a column per sensor ran off the page).
+  report::Table g;
+  g.header = {"sensor", "grey relational grade against the error (rho 0.5)", "chosen"};
+  const std::vector<std::string> names = s.ChosenNames();
+  for (Eigen::Index i = 0; i < s.grades.size(); ++i) {
+    const std::string& n = s.sensor_names[static_cast<std::size_t>(i)];
+    const bool is = std::find(names.begin(), names.end(), n) != names.end();
+    if (is) g.highlight.push_back(g.rows.size());
+    g.rows.push_back({n, FormatDecimals(s.grades(i), 4), is ? "yes" : ""});
+  }
+  doc->Add(g);
 }
 
 // Similarity matrix and fuzzy equivalence as heat maps, with sensor names on the axes.
-std::string SimilarityPlot(ReportWriter* w, const Selection& s) {
+report::Figure SimilarityFigure(ReportWriter* w, const Selection& s) {
   std::ostringstream data;
   const Eigen::Index m = s.similarity.rows();
   for (Eigen::Index i = 0; i < m; ++i)
@@ -134,23 +182,27 @@ std::string SimilarityPlot(ReportWriter* w, const Selection& s) {
            << FormatNumber(s.equivalence(i, j)) << "\n";
   w->File("similarity.dat",
           "# i j similarity equivalence (sensor indices as in the tics)\n" + data.str());
-  std::string tics;
-  for (Eigen::Index i = 0; i < m; ++i)
-    tics += (i ? ", " : "") + GnuplotString(s.sensor_names[static_cast<std::size_t>(i)]) + " " +
-            std::to_string(i);
-  std::ostringstream gp;
-  gp << "set multiplot layout 1,2\nset size ratio -1\nset cbrange [0:1]\nset xtics (" << tics
-     << ") rotate by 90 right\nset bmargin 6\nset ytics (" << tics << ")\nset yrange [] reverse\n"
-     << "set title 'similarity |Pearson r| of the rises'\nplot 'similarity.dat' using 1:2:3 with "
-        "image notitle\n"
-     << "set title 'fuzzy equivalence (lambda levels)'\nplot 'similarity.dat' using 1:2:4 with "
-        "image notitle\n"
-     << "unset multiplot\n";
-  return w->Plot("similarity", gp.str(), "similarity and fuzzy equivalence matrices");
+  report::Figure f;
+  f.stem = "similarity";
+  f.alt = "similarity and fuzzy equivalence matrices";
+  f.columns = 2;
+  for (const auto& [title, column] :
+       {std::pair<const char*, int>{"similarity |Pearson r| of the rises", 3},
+        {"fuzzy equivalence (lambda levels)", 4}}) {
+    report::Panel p;
+    p.title = title;
+    p.equal_axes = true;
+    p.y_reversed = true;
+    p.tic_names = s.sensor_names;
+    p.series.push_back(
+        {"similarity.dat", -1, {Col(1), Col(2), Col(column)}, SeriesKind::kImage, "", "", 1.5, false, ""});
+    f.panels.push_back(std::move(p));
+  }
+  return f;
 }
 
 // The lambda-cuts as a step plot: class count against lambda, with F / F_crit where defined.
-std::string LevelsPlot(ReportWriter* w, const Selection& s) {
+report::Figure LevelsFigure(ReportWriter* w, const Selection& s) {
   std::vector<std::vector<double>> rows;
   for (const Partition& p : s.partitions)
     rows.push_back({p.lambda, static_cast<double>(p.classes),
@@ -160,21 +212,27 @@ std::string LevelsPlot(ReportWriter* w, const Selection& s) {
       FormatCsv(
           {"lambda", "classes", "f_over_f_critical"}, rows,
           {"lambda-cuts of the fuzzy equivalence matrix; -1: no F (r = 1 or m, or F infinite)"}));
-  std::ostringstream gp;
-  gp << "set datafile separator ','\nset grid\nset key top left\nset xlabel 'lambda'\n"
-     << "set ylabel 'classes r'\nset y2label 'F / F_crit'\nset y2tics\nset logscale y2\n"
-     << "set title 'lambda levels: classes and F test (F / F_crit > 1: significant)'\n"
-     << "plot 'lambda_levels.csv' using 1:2 with linespoints pt 5 lw 2 title 'classes at the cut', "
-     << "'' using 1:($3 > 0 ? $3 : 1/0) axes x1y2 with points pt 7 title 'F / F_crit', "
-     << "1 axes x1y2 with lines dt 2 lc rgb 'gray' notitle\n";
-  return w->Plot("lambda_levels", gp.str(), "class count and F test per lambda level");
+  report::Panel p;
+  p.title = "lambda levels: classes and F test (F / F_crit > 1: significant)";
+  p.xlabel = "lambda";
+  p.ylabel = "classes r";
+  p.y2label = "F / F_crit";
+  p.y2_log = true;
+  p.y2_marks = {1};
+  p.series.push_back({"lambda_levels.csv", -1, {Col(1), Col(2)}, SeriesKind::kLinePoints, "",
+                      "#1f77b4", 2, false, "classes at the cut"});
+  p.series.push_back({"lambda_levels.csv", -1, {Col(1), Col(3)}, SeriesKind::kPoints, "",
+                      "#d62728", 1.5, true, "F / F_crit (where defined)"});
+  report::Figure f;
+  f.stem = "lambda_levels";
+  f.alt = "class count and F test per lambda level";
+  f.panels = {p};
+  return f;
 }
 
-std::string StatsRow(const std::string& name, const ErrorStats& s) {
-  return "<tr><td style='text-align:left'>" + HtmlEscape(name) + "</td><td>" +
-         FormatDecimals(s.mae_um, 2) + "</td><td>" + FormatDecimals(s.rmse_um, 2) + "</td><td>" +
-         FormatDecimals(s.std_um, 2) + "</td><td>" + FormatDecimals(s.max_abs_um, 2) +
-         "</td></tr>\n";
+std::vector<Cell> StatsRow(const std::string& name, const ErrorStats& s) {
+  return {name, FormatDecimals(s.mae_um, 2), FormatDecimals(s.rmse_um, 2),
+          FormatDecimals(s.std_um, 2), FormatDecimals(s.max_abs_um, 2)};
 }
 
 
@@ -351,25 +409,25 @@ std::vector<ReportBaseline> Baselines(const DriftModel& m,
   return cells;
 }
 
-std::string BaselinesHtml(const std::vector<ReportBaseline>& cells,
-                          const std::vector<std::string>& notes) {
-  std::ostringstream h;
-  h << "<h2>Baselines</h2>\n<p>MAE um per run: the model, no compensation, a time-only warm-up "
-       "(first order in the time since the run's start, no sensor, fitted on the model's "
-       "training runs) and drift fit at its defaults redone on the previous run shown (the "
-       "model's kind, inputs and zero); the strongest "
-       "is named.</p>\n<table><tr><th style='text-align:left'>run</th><th>model</th><th>none</th>"
-       "<th>time only</th><th>previous run</th><th>strongest</th></tr>\n";
+void AddBaselines(const std::vector<ReportBaseline>& cells, const std::vector<std::string>& notes,
+                  report::Document* doc) {
+  doc->Add(report::Heading{2, "Baselines", ""});
+  doc->Say("MAE um per run: the model, no compensation, a time-only warm-up (first order in the "
+           "time since the run's start, no sensor, fitted on the model's training runs) and drift "
+           "fit at its defaults redone on the previous run shown (the model's kind, inputs and "
+           "zero); the strongest is named.");
+  report::Table t;
+  t.header = {"run", "model [um]", "none [um]", "time only [um]", "previous run [um]",
+              "strongest"};
   for (const ReportBaseline& c : cells) {
-    const std::array<double, 4> v = BaselineValues(c);
-    h << "<tr><td style='text-align:left'>" << HtmlEscape(c.run) << "</td>";
-    for (int k = 0; k < 4; ++k)
-      h << "<td>" << (std::isfinite(v[k]) ? FormatDecimals(v[k], 2) : "&ndash;") << "</td>";
-    h << "<td>" << (c.strongest.empty() ? "&ndash;" : c.strongest) << "</td></tr>\n";
+    std::vector<Cell> row{c.run};
+    for (double v : BaselineValues(c))
+      row.push_back(std::isfinite(v) ? FormatDecimals(v, 2) : "-");
+    row.push_back(c.strongest.empty() ? "-" : c.strongest);
+    t.rows.push_back(std::move(row));
   }
-  h << "</table>\n";
-  for (const auto& n : notes) h << "<p><i>" << HtmlEscape(n) << "</i></p>\n";
-  return h.str();
+  doc->Add(t);
+  for (const auto& n : notes) doc->Say(n, report::Tone::kSmall);
 }
 
 // The model's pass over one run: every sample goes into the per-sample CSV (written as it is
@@ -432,38 +490,42 @@ class RunPass {
   std::unique_ptr<M4Decimator> plot_;
 };
 
-// The gnuplot script of a run's plot: measured and predicted (+- 1 sd) over time, the residual.
-std::string RunPlotScript(const DriftModel& m, const PredictionSummary& p,
-                          const std::string& plot_csv) {
-  const std::string x = p.time_from_index ? "sample" : "time [h]";
-  const std::string xcol = p.time_from_index ? "1" : "($1/60)";
-  std::ostringstream gp;
-  // The line looks of core/plot_style.h; the key right of the data, the panels aligned.
-  gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight() << "set grid\nset xlabel "
-     << GnuplotString(x) << "\nset ylabel 'thermal error [um]'\nset multiplot layout 2,1\n"
-     << "set title "
-     << GnuplotString("run " + p.run + ": measured and predicted " + m.error_column)
-     << "\nplot " << GnuplotString(plot_csv) << " using " << xcol
-     << ":($2-$4):($2+$4) with filledcurves fs transparent solid 0.15 noborder lc rgb '"
-     << FindSeriesStyle("prediction")->colour << "' title 'predicted +- 1 sd', '' using "
-     << xcol << ":2 " << GnuplotWith("prediction") << " title 'predicted'";
-  if (p.has_measured)
-    gp << ", '' using " << xcol << ":5 " << GnuplotWith("measured") << " title 'measured'";
-  gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\n";
-  if (p.has_measured)
-    gp << "plot " << GnuplotString(plot_csv) << " using " << xcol << ":6 "
-       << GnuplotWith("residual") << " title 'residual'\n";
-  else
-    gp << "plot 0 notitle\n";
-  gp << "unset multiplot\n";
-  return gp.str();
+// The run's figure: measured and predicted error with the prediction's +-1 sd band, and the
+// residual below (columns of <slug>_plot.csv: PredictionCsvHeader).
+report::Figure RunFigure(const PredictionSummary& p, const std::string& plot_csv,
+                         const std::string& error_column, const std::string& slug) {
+  const double per = p.time_from_index ? 1.0 : 60.0;
+  report::Panel top, bottom;
+  top.title = "run " + p.run + ": measured and predicted " + error_column;
+  top.ylabel = "thermal error [um]";
+  bottom.title = "residual (measured - predicted)";
+  bottom.ylabel = "residual [um]";
+  for (report::Panel* x : {&top, &bottom}) x->xlabel = p.time_from_index ? "sample" : "time [h]";
+  report::Column low = Col(2), high = Col(2);
+  low.minus = 4;
+  high.plus = 4;
+  top.series.push_back({plot_csv, -1, {Col(1, per), low, high}, SeriesKind::kBand, "prediction", "",
+                        1.5, false, "predicted +- 1 sd"});
+  top.series.push_back({plot_csv, -1, {Col(1, per), Col(2)}, SeriesKind::kLine, "prediction", "",
+                        1.5, false, "predicted"});
+  if (p.has_measured) {
+    top.series.push_back({plot_csv, -1, {Col(1, per), Col(5)}, SeriesKind::kLine, "measured", "",
+                          1.5, false, "measured"});
+    bottom.series.push_back({plot_csv, -1, {Col(1, per), Col(6)}, SeriesKind::kLine, "residual",
+                             "", 1.5, false, "residual"});
+  }
+  report::Figure f;
+  f.stem = slug + "_prediction";
+  f.alt = "measured and predicted error of " + p.run;
+  f.panels = {top, bottom};
+  return f;
 }
 
-// Run i under the model, in one pass: its per-sample CSV, the plot's rows and script, the plot's
-// HTML into `plots`; returns the prediction's summary.
+// Run i under the model, in one pass: its per-sample CSV, the plot's rows, its heading, warnings
+// and figure into `plots`; returns the prediction's summary.
 PredictionSummary ShowRun(ReportWriter* w, const ShownRuns& runs, std::size_t i,
                           const DriftModel& m, const std::vector<std::string>& provenance,
-                          std::ostringstream* plots) {
+                          std::vector<report::Block>* plots) {
   const std::string& name = runs.Name(i);
   const std::string slug = Slug(name);
   RunPass pass(w, slug + "_prediction.csv", runs.Axis(i),
@@ -477,45 +539,48 @@ PredictionSummary ShowRun(ReportWriter* w, const ShownRuns& runs, std::size_t i,
                                                          " (M4 decimation of the prediction "
                                                          "per pixel column; all rows: " +
                                                          slug + "_prediction.csv)")));
-  *plots << "<h3>" << HtmlEscape(p.run) << "</h3>\n";
-  for (const auto& warn : p.warnings) *plots << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
-  *plots << w->Plot(slug + "_prediction", RunPlotScript(m, p, plot_csv),
-                    "measured and predicted error of " + p.run)
-         << "\n";
+  plots->push_back(report::MakeBlock(report::Heading{3, p.run, ""}));
+  for (const auto& warn : p.warnings)
+    plots->push_back(report::MakeBlock(report::Paragraph{{Text(warn)}, report::Tone::kWarn}));
+  plots->push_back(report::MakeBlock(RunFigure(p, plot_csv, m.error_column, slug)));
   return p;
 }
 
+// The model report of `runs`: the load box, the baselines (is the model worth loading?), the model
+// and its choice, then per run its statistics and figure. Each run is one pass under the model;
+// each baseline one more pass (Baselines).
 DriftReportResult ModelReport(const fs::path& dir, const FitReport& fit, const ShownRuns& runs,
                               const std::vector<std::string>& provenance,
                               const std::string& gnuplot) {
   ReportWriter w(dir, gnuplot);
   const DriftModel& m = fit.model;
-  std::ostringstream h;
-  h << Head("whirl: machine thermal drift of " + m.error_column, provenance);
-  h << "<h2>Model</h2>\n<pre>" << HtmlEscape(FormatModel(m)) << "</pre>\n";
-  if (!fit.candidates.empty()) h << "<pre>" << HtmlEscape(FormatCandidates(fit)) << "</pre>\n";
-  if (fit.selected)
-    h << SelectionHtml(fit.selection) << SimilarityPlot(&w, fit.selection) << "\n"
-      << LevelsPlot(&w, fit.selection) << "\n";
-  h << "<h2>Runs</h2>\n<table><tr><th style='text-align:left'>run</th><th>MAE um</th><th>RMSE "
-       "um</th>"
-       "<th>std um</th><th>max um</th></tr>\n";
-  std::ostringstream plots;
+  report::Table stats;
+  stats.header = {"run", "MAE [um]", "RMSE [um]", "std [um]", "max [um]"};
+  std::vector<report::Block> plots;
   std::vector<PredictionSummary> preds;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const PredictionSummary& p = preds.emplace_back(ShowRun(&w, runs, i, m, provenance, &plots));
-    if (p.has_measured)
-      h << StatsRow(p.run + " (model)", p.residual)
-        << StatsRow(p.run + " (no compensation)", p.none);
+    if (!p.has_measured) continue;
+    stats.rows.push_back(StatsRow(p.run + " (model)", p.residual));
+    stats.rows.push_back(StatsRow(p.run + " (no compensation)", p.none));
   }
-  h << "</table>\n";
+  report::Document doc;
+  doc.title = "whirl: machine thermal drift of " + m.error_column;
+  doc.provenance = provenance;
+  std::vector<std::string> inputs = m.sensors;
+  inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+  doc.Add(DriftLoadBox(ToString(m.kind), m.error_column, inputs));
   std::vector<std::string> notes;
   const std::vector<ReportBaseline> baselines = Baselines(m, preds, runs, &notes);
-  h << BaselinesHtml(baselines, notes);
-  h << plots.str();
-  for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
-  h << "</body></html>\n";
-  DriftReportResult result = w.Finish(h.str());
+  AddBaselines(baselines, notes, &doc);  // the summary first: is the model worth loading?
+  AddModel(m, &doc);
+  AddCandidates(fit, &doc);
+  if (fit.selected) {
+    AddSelection(fit.selection, &doc);
+    doc.Add(SimilarityFigure(&w, fit.selection)).Add(LevelsFigure(&w, fit.selection));
+  }
+  doc.Add(report::Heading{2, "Runs", ""}).Add(stats).Add(plots);
+  DriftReportResult result = w.Finish(doc);
   result.baselines = baselines;
   result.baseline_notes = notes;
   result.predictions = std::move(preds);
@@ -538,16 +603,154 @@ DriftReportResult WriteModelReport(const fs::path& dir, const FitReport& fit,
   return ModelReport(dir, fit, RunsInFiles(runs, progress), provenance, gnuplot);
 }
 
+namespace {
+
+// The hold-out's table: per channel and method the test and train errors and the inputs; the
+// strongest method of each channel bold.
+report::Table HoldoutTable(const HoldoutResult& r) {
+  report::Table t;
+  t.series_rows = true;
+  t.header = {"method", "channel", "test MAE [um]", "test RMSE [um]", "test max [um]",
+              "train MAE [um]", "inputs (lags)"};
+  const auto strongest = r.Strongest();
+  for (const auto& row : r.rows_out) {
+    std::string inputs;
+    if (row.inputs.size() > 6) {
+      inputs = std::to_string(row.inputs.size()) + " sensors";
+    } else {
+      for (const auto& i : row.inputs) inputs += (inputs.empty() ? "" : ", ") + i;
+    }
+    if (!row.time_constants.empty()) {
+      std::string lags;
+      for (double l : row.time_constants) lags += (lags.empty() ? "" : ", ") + MessageNumber(l);
+      inputs += " (" + lags + (r.time_from_index ? " samples)" : " min)");
+    }
+    for (const auto& [ch, method] : strongest)
+      if (ch == row.channel && method == row.method) t.highlight.push_back(t.rows.size());
+    Cell in(inputs);
+    in.left = true;
+    t.rows.push_back({row.method, row.channel, FormatDecimals(row.test.mae_um, 2),
+                      FormatDecimals(row.test.rmse_um, 2), FormatDecimals(row.test.max_abs_um, 2),
+                      FormatDecimals(row.train.mae_um, 2), in});
+  }
+  t.caption = "Errors from zero '" + ToString(r.zero.zero) +
+              "'; time = sensor-free warm-up in time since the log's start; bold: the strongest "
+              "(lowest test MAE) of each channel.";
+  return t;
+}
+
+// The method (among idx[0..c)) whose prediction equals idx[c]'s on every row, or "".
+std::string SameAs(const HoldoutResult& r, const std::vector<std::size_t>& idx, std::size_t c) {
+  const Eigen::VectorXd& v = r.predictions[idx[c]].predicted_um;
+  for (std::size_t e = 0; e < c; ++e) {
+    const Eigen::VectorXd& u = r.predictions[idx[e]].predicted_um;
+    if (u.size() == v.size() && v.size() > 0 &&
+        (u - v).cwiseAbs().maxCoeff() <= 1e-9 * (1 + v.cwiseAbs().maxCoeff()))
+      return r.rows_out[idx[e]].method;
+  }
+  return "";
+}
+
+// One channel's figure: measured and every method's prediction over the log prefix (the end of
+// training dashed), the residuals below. A method whose prediction equals an earlier one's is
+// drawn with open circles and its legend says so, so coinciding lines stay distinguishable.
+// `band`: the strongest method's +-1 sd band (time_min, low, high in <slug>_holdout_band.csv),
+// "" for none.
+report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size_t>& idx,
+                             const std::string& ch, const std::string& csv,
+                             const std::string& slug, const std::string& band) {
+  report::Panel top, bottom;
+  top.title = ch + ": measured and predicted (dashed line: end of training)";
+  top.ylabel = "error [um]";
+  bottom.title = "residual (measured - predicted)";
+  bottom.ylabel = "residual [um]";
+  for (report::Panel* p : {&top, &bottom}) {
+    p->xlabel = "time [h]";
+    p->x_marks = {r.train_end_min / 60};
+  }
+  if (!band.empty())
+    top.series.push_back({slug + "_holdout_band.csv", -1, {Col(1, 60), Col(2), Col(3)},
+                          SeriesKind::kBand, band, "", 1.5, false, band + " +- 1 sd"});
+  top.series.push_back({csv, -1, {Col(1, 60), Col(2)}, SeriesKind::kLine, "measured", "", 1.5,
+                        false, "measured"});
+  for (std::size_t c = 0; c < idx.size(); ++c) {
+    const std::string method = r.rows_out[idx[c]].method;
+    const std::string same = SameAs(r, idx, c);
+    const std::string title = method + (same.empty() ? "" : " (the same as " + same + ")");
+    report::Column residual = Col(2);
+    residual.minus = static_cast<int>(c) + 3;
+    report::Series line{csv, -1, {Col(1, 60), Col(static_cast<int>(c) + 3)}, SeriesKind::kLine,
+                        method, "", 1.5, false, title};
+    line.markers = !same.empty();
+    top.series.push_back(line);
+    line.columns = {Col(1, 60), residual};
+    bottom.series.push_back(line);
+  }
+  top.series.push_back(
+      {csv, -1, {Col(1, 60), Col(2)}, SeriesKind::kLine, "measured", "", 1.5, false, ""});  // on top
+  report::Figure f;
+  f.stem = slug + "_holdout";
+  f.alt = "hold-out of " + ch;
+  f.height_px = 640;
+  f.panels = {top, bottom};
+  return f;
+}
+
+// <slug>_holdout_band.csv: the channel's strongest method's prediction -+ its sd per row; returns
+// the method ("" when it has no sd, e.g. none).
+std::string AddBand(const HoldoutResult& r, const std::vector<std::size_t>& idx,
+                    const std::string& ch, const std::string& slug,
+                    const std::vector<std::string>& provenance, ReportWriter* w) {
+  for (const auto& [channel, method] : r.Strongest()) {
+    if (channel != ch) continue;
+    for (std::size_t i : idx) {
+      const RunPrediction& p = r.predictions[i];
+      if (r.rows_out[i].method != method || p.std_um.size() != p.predicted_um.size() ||
+          p.std_um.size() == 0 || p.std_um.maxCoeff() <= 0)
+        continue;
+      std::vector<std::vector<double>> rows;
+      for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k)
+        rows.push_back({p.time[static_cast<std::size_t>(k)], p.predicted_um(k) - p.std_um(k),
+                        p.predicted_um(k) + p.std_um(k)});
+      w->File(slug + "_holdout_band.csv",
+              FormatCsv({"time_min", method + "_minus_1sd_um", method + "_plus_1sd_um"}, rows,
+                        Comments(provenance, "+-1 sd band of " + method + " on " + ch)));
+      return method;
+    }
+  }
+  return "";
+}
+
+// The load box of the first channel's strongest method (the model drift fit would hand on).
+report::Box HoldoutBox(const HoldoutResult& r) {
+  const auto strongest = r.Strongest();
+  for (std::size_t i = 0; i < r.rows_out.size() && i < r.models.size(); ++i)
+    if (!strongest.empty() && r.rows_out[i].channel == strongest.front().first &&
+        r.rows_out[i].method == strongest.front().second) {
+      const DriftModel& m = r.models[i];
+      std::vector<std::string> inputs = m.sensors;
+      inputs.insert(inputs.end(), m.extra_inputs.begin(), m.extra_inputs.end());
+      return DriftLoadBox(ToString(m.kind) + ", the strongest here: " + r.rows_out[i].method,
+                          r.rows_out[i].channel, inputs);
+    }
+  return DriftLoadBox("no model", r.rows_out.empty() ? "" : r.rows_out.front().channel, {});
+}
+
+}  // namespace
+
 DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const HoldoutResult& r,
                                      const std::vector<std::string>& provenance,
                                      const std::string& gnuplot) {
   ReportWriter w(dir, gnuplot);
-  std::ostringstream h;
-  h << Head("whirl: chronological hold-out on " + log.name, provenance);
-  h << "<p>Train rows [0, " << r.train_end << ") to " << FormatDecimals(r.train_end_min / 60, 1)
-    << " h; test rows [" << r.train_end << ", " << r.test_end << ") to "
-    << FormatDecimals(r.test_end_min / 60, 1) << " h. Models run from the log's first row.</p>\n";
-  h << "<pre>" << HtmlEscape(FormatHoldout(r)) << "</pre>\n";
+  report::Document doc;
+  doc.title = "whirl: chronological hold-out on " + log.name;
+  doc.provenance = provenance;
+  doc.Say("Train rows [0, " + std::to_string(r.train_end) + ") to " +
+          FormatDecimals(r.train_end_min / 60, 1) + " h; test rows [" +
+          std::to_string(r.train_end) + ", " + std::to_string(r.test_end) + ") to " +
+          FormatDecimals(r.test_end_min / 60, 1) + " h. Models run from the log's first row.");
+  doc.Add(HoldoutBox(r)).Add(HoldoutTable(r));
+  for (const auto& warn : r.warnings) doc.Say(warn, report::Tone::kWarn);
   std::vector<std::string> channels;
   for (const auto& row : r.rows_out)
     if (channels.empty() || channels.back() != row.channel) channels.push_back(row.channel);
@@ -567,31 +770,11 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const 
     const std::string slug = Slug(ch);
     w.File(slug + "_holdout.csv",
            FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
-    std::ostringstream gp;
-    // Each method in its look of core/plot_style.h; the key right of the data.
-    gp << "set datafile separator ','\n" << GnuplotKeyOutsideRight()
-       << "set grid\nset xlabel 'time [h]'\n"
-       << "set arrow from " << r.train_end_min / 60 << ", graph 0 to " << r.train_end_min / 60
-       << ", graph 1 nohead dt 2\nset multiplot layout 2,1\nset ylabel 'error [um]'\nset title "
-       << GnuplotString(ch + ": measured and predicted (dashed line: end of training)") << "\nplot "
-       << GnuplotString(slug + "_holdout.csv") << " using ($1/60):2 " << GnuplotWith("measured")
-       << " title 'measured'";
-    for (std::size_t c = 1; c < idx.size(); ++c)
-      gp << ", '' using ($1/60):" << c + 3 << " " << GnuplotWith(r.rows_out[idx[c]].method)
-         << " title " << GnuplotString(r.rows_out[idx[c]].method);
-    gp << ", '' using ($1/60):2 " << GnuplotWith("measured") << " notitle";  // on top
-    gp << "\nset title 'residual (measured - predicted)'\nset ylabel 'residual [um]'\nplot ";
-    for (std::size_t c = 1; c < idx.size(); ++c)
-      gp << (c > 1 ? ", " : "") << GnuplotString(slug + "_holdout.csv") << " using ($1/60):($2-$"
-         << c + 3 << ") " << GnuplotWith(r.rows_out[idx[c]].method) << " title "
-         << GnuplotString(r.rows_out[idx[c]].method);
-    gp << "\nunset multiplot\n";
-    h << "<h2>" << HtmlEscape(ch) << "</h2>\n"
-      << w.Plot(slug + "_holdout", gp.str(), "hold-out of " + ch) << "\n";
+    const std::string band = AddBand(r, idx, ch, slug, provenance, &w);
+    doc.Add(report::Heading{2, ch, ""})
+        .Add(HoldoutFigure(r, idx, ch, slug + "_holdout.csv", slug, band));
   }
-  for (const auto& warn : w.warnings()) h << "<p><i>" << HtmlEscape(warn) << "</i></p>\n";
-  h << "</body></html>\n";
-  return w.Finish(h.str());
+  return w.Finish(doc);
 }
 
 }  // namespace whirl::drift

@@ -55,3 +55,91 @@ ControlLoad PlanFilesLoad(const std::string& prefix, const std::string& program,
 }
 
 }  // namespace whirl::plan
+
+namespace whirl::plan {
+namespace {
+
+using report::Cell;
+
+// The plan's setting data, one row per segment, and the restoring row at the thread end.
+report::Table SettingDataTable(const interp::CompensationPlan& plan, bool machine_coordinates) {
+  const std::string unit = machine_coordinates ? "[mm, MCS]" : "[mm from the thread start]";
+  report::Table t;
+  t.header = {"segment", "written when " + plan.options.axis + " passes " + unit,
+              "SD43900 K0 [mm]", "SD43910 slope [-]", "SD43920 reference " + unit};
+  for (std::size_t i = 0; i < plan.segments.size(); ++i) {
+    const interp::CompensationSegment& s = plan.segments[i];
+    t.rows.push_back({std::to_string(i + 1), FormatFixed(s.p_a_mm, interp::kDecimalsPositionMm),
+                      FormatFixed(s.sd43900_mm, interp::kDecimalsSd43900Mm),
+                      FormatFixed(s.sd43910, interp::kDecimalsSd43910),
+                      FormatFixed(s.sd43920_mm, interp::kDecimalsPositionMm)});
+  }
+  if (!plan.segments.empty()) {
+    Cell what("the values found before the cut are written back (thread end)");
+    what.colspan = 3;
+    what.left = true;
+    t.rows.push_back({"restore",
+                      FormatFixed(plan.segments.back().p_b_mm, interp::kDecimalsPositionMm), what});
+  }
+  return t;
+}
+
+std::vector<report::Block> LoadBlocks(const ControlLoad& load) {
+  using report::Bold;
+  using report::MakeBlock;
+  using report::Text;
+  std::vector<report::Block> b;
+  b.push_back(MakeBlock(report::Heading{3, load.heading, ""}));
+  report::Paragraph files{{Bold("Files onto the control:"), Text(" ")}, report::Tone::kNormal};
+  if (load.files.empty()) files.spans.push_back(Text(load.no_files));
+  for (std::size_t i = 0; i < load.files.size(); ++i) {
+    if (i) files.spans.push_back(Text("; "));
+    files.spans.push_back(report::Link(load.files[i].first, load.files[i].first));
+    files.spans.push_back(Text(" (" + load.files[i].second + ")"));
+  }
+  if (!load.files.empty()) files.spans.push_back(Text("."));
+  b.push_back(MakeBlock(files));
+  if (!load.call_order.empty())
+    b.push_back(MakeBlock(report::Paragraph{{Bold("Call:"), Text(" " + load.call_order)}}));
+  b.push_back(MakeBlock(report::Paragraph{
+      {Bold("Setting data the plan writes"),
+       Text(" (axis " + load.plan.options.axis + ", sign " +
+            interp::ToString(load.plan.options.sign) + "):")}}));
+  b.push_back(MakeBlock(SettingDataTable(load.plan, load.machine_coordinates)));
+  if (!load.plan_note.empty())
+    b.push_back(MakeBlock(report::Paragraph{{Text(load.plan_note)}, report::Tone::kSmall}));
+  report::List needs;
+  for (const interp::ControlRequirement& r : load.requirements)
+    needs.items.push_back({Text(interp::ToString(r))});
+  if (!load.profile_note.empty()) needs.items.push_back({Text(load.profile_note)});
+  if (!needs.items.empty()) {
+    b.push_back(MakeBlock(report::Paragraph{{Bold("Machine data the programs need"),
+                                             Text(" (check once on the control):")}}));
+    b.push_back(MakeBlock(needs));
+  }
+  if (!load.after_abort.empty())
+    b.push_back(
+        MakeBlock(report::Paragraph{{Bold("After an aborted cut:"), Text(" " + load.after_abort)}}));
+  return b;
+}
+
+}  // namespace
+
+report::Box LoadBox(const std::vector<ControlLoad>& loads) {
+  report::Box box;
+  box.id = "load";
+  box.blocks.push_back(report::MakeBlock(report::Heading{2, "Load onto the control", ""}));
+  box.blocks.push_back(report::MakeBlock(report::Paragraph{
+      {report::Text("What to take to the SINUMERIK 840D. The links open the files written with "
+                    "this report. The programs were not run on a real control here: check the "
+                    "sign once with a constant SD43900 test value and a dial gauge before the "
+                    "first cut.")},
+      report::Tone::kSmall}));
+  for (const ControlLoad& load : loads) {
+    const std::vector<report::Block> b = LoadBlocks(load);
+    box.blocks.insert(box.blocks.end(), b.begin(), b.end());
+  }
+  return box;
+}
+
+}  // namespace whirl::plan

@@ -1,16 +1,17 @@
 #pragma once
 // What a process engineer takes to the SINUMERIK 840D for one screw, as data ("load onto the
-// control"; a report renders it, the lab's compare/control_box.h for now): the setting data the
-// plan writes (SD43900 K0, SD43910 slope, SD43920 reference position, one row per segment,
-// written when the axis passes the row's trigger position), the files in the order of loading,
-// the machine data the programs need (each datum once, with the threshold the programs need
-// together: interp/control_requirements.h, built from the plan and the drift action's data, not
-// read back from the programs' text), what the machine profile states about the control, the
-// call order and what to run after an aborted cut.
+// control"; LoadBox makes it a box of a report document, core/report_render.h renders it): the
+// setting data the plan writes (SD43900 K0, SD43910 slope, SD43920 reference position, one row
+// per segment, written when the axis passes the row's trigger position), the files in the order
+// of loading, the machine data the programs need (each datum once, with the threshold the
+// programs need together: interp/control_requirements.h, built from the plan and the drift
+// action's data, not read back from the programs' text), what the machine profile states about
+// the control, the call order and what to run after an aborted cut.
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/report_document.h"
 #include "interp/control_requirements.h"
 #include "interp/machine_profile.h"
 #include "interp/sinumerik.h"
@@ -58,5 +59,12 @@ ControlLoad PlanFilesLoad(const std::string& prefix, const std::string& program,
                           const std::string& plc_csv, const std::string& plan_json,
                           const interp::CompensationPlan& plan,
                           const interp::MachineProfile* profile);
+
+/// The "load onto the control" box that opens the workpiece and the machine report (id "load"):
+/// per load its heading, the files (links), the call order, the setting data the plan writes
+/// (one row per segment and the restoring row; positions "[mm, MCS]" or "[mm from the thread
+/// start]" per ControlLoad::machine_coordinates), the machine data the programs need and what to
+/// run after an abort. Plain text throughout: the renderer escapes it.
+report::Box LoadBox(const std::vector<ControlLoad>& loads);
 
 }  // namespace whirl::plan

@@ -6,11 +6,9 @@
 #include "core/atomic_file.h"
 #include "core/csv.h"
 #include "core/error.h"
-#include "core/html_page.h"
 #include "core/numbers.h"
 #include "core/output_dir.h"
-#include "core/run_program.h"
-#include "core/safe_text.h"
+#include "core/report_render.h"
 
 namespace whirl::surface {
 namespace fs = std::filesystem;
@@ -43,134 +41,126 @@ std::string PointsData(const SurfaceFit& fit) {
   return s.str();
 }
 
-std::string MapScript(const SurfaceReportOptions& o, const std::string& terminal,
-                      const std::string& subtitle) {
-  std::ostringstream s;
-  s << "# gnuplot script written by whirl surface; re-run with: gnuplot map.gp\n"
-    << "set terminal " << terminal << "\n"
-    << "set output 'map.png'\n"
-    << "set title " << GnuplotString(o.title + ": " + subtitle) << " noenhanced\n"
-    << "set xlabel 'X [mm]'\nset ylabel 'Y [mm]'\nset cblabel 'thermal error [um]'\n"
-    << "set view map\nset size ratio -1\nset palette rgbformulae 33,13,10\n"
-    << "set contour base\nset cntrparam levels auto 12\nunset clabel\n"
-    << "unset key\n"
-    << "set datafile separator whitespace\n"
-    << "splot 'surface_grid.dat' using 1:2:3 with pm3d nocontours notitle, \\\n"
-    << "  '' using 1:2:3 nosurface with lines lc rgb '#202020' notitle, \\\n"
-    << "  'points.dat' using 1:2:3 nocontours with points pt 7 ps 1.3 "
-       "lc rgb 'black' notitle\n"
-    << "set output\n";
-  return s.str();
+using report::Cell;
+using report::Col;
+using report::SeriesKind;
+
+// The map: the surface as colours with contour lines, the measured points on top.
+report::Figure MapFigure(const SurfaceReportOptions& o, const std::string& subtitle) {
+  report::Panel p;
+  p.title = o.title + ": " + subtitle;
+  p.xlabel = "X [mm]";
+  p.ylabel = "Y [mm]";
+  p.cblabel = "thermal error [um]";
+  p.equal_axes = true;
+  p.series.push_back({"surface_grid.dat", -1, {Col(1), Col(2), Col(3)}, SeriesKind::kMap, "", "",
+                      1.5, false, ""});
+  p.series.push_back({"surface_grid.dat", -1, {Col(1), Col(2), Col(3)}, SeriesKind::kContour, "",
+                      "#202020", 1, false, "contour lines of the surface"});
+  p.series.push_back({"points.dat", -1, {Col(1), Col(2), Col(3)}, SeriesKind::kPoints, "",
+                      "#000000", 1.5, false, "measured points"});
+  report::Figure f;
+  f.stem = "map";
+  f.alt = "map of the thermal error over the table";
+  f.height_px = 700;
+  f.panels = {p};
+  return f;
 }
 
-std::string Terminal(const std::string& gnuplot) {
-  const bool cairo = ProgramSucceeds({gnuplot, "-e", "set terminal pngcairo"});
-  return cairo ? "pngcairo size 1000,700 font 'Sans,10' noenhanced"
-               : "png size 1000,700 noenhanced";
-}
-
-// Renders map.gp in the output directory's staging folder; adds map.png to the output.
-bool Render(OutputDir& out, const SurfaceReportOptions& o, SurfaceReportResult& r) {
-  if (!ProgramSucceeds({o.gnuplot_command, "--version"})) {
-    r.warnings.push_back("gnuplot ('" + o.gnuplot_command + "') not found: map skipped");
-    return false;
-  }
-  const int rc = out.RunInStaging({o.gnuplot_command, "map.gp"}, "gnuplot.log", {"map.png"});
-  const fs::path stage = out.Staging();
-  std::error_code ec;
-  if (rc != 0 || !fs::is_regular_file(stage / "map.png", ec)) {
-    out.AddProgramLog("gnuplot.log");
-    r.warnings.push_back("gnuplot failed (exit " + std::to_string(rc) +
-                         "), see gnuplot.log: map skipped");
-    return false;
-  }
-  out.AddStaged("map.png");
-  return true;
-}
-
-std::string SummaryHtml(const SurfaceFit& f) {
+report::Table SummaryTable(const SurfaceFit& f) {
   const ErrorStats res = StatsOf(f.residual_um), loo = StatsOf(f.loo_error_um);
-  std::ostringstream h;
-  h << "<table><tr><th>method</th><td>" << ToString(f.surface.method);
-  if (f.surface.method == Method::kBspline) h << ", degree " << f.surface.bspline.degree;
-  h << "</td></tr>\n<tr><th>points</th><td>" << f.points.size() << "</td></tr>\n"
-    << "<tr><th>condition number</th><td>" << FormatDecimalsOr(f.condition_number, 1, "-");
+  report::Table t;
+  std::string method = ToString(f.surface.method);
+  if (f.surface.method == Method::kBspline)
+    method += ", degree " + std::to_string(f.surface.bspline.degree);
+  std::string condition = FormatDecimalsOr(f.condition_number, 1, "-");
   if (f.surface.method == Method::kCubic)
-    h << " (normalized coordinates; " << FormatSignificant(f.condition_number_mm, 3)
-      << " in raw mm)";
-  h << "</td></tr>\n<tr><th>residual RMS / max</th><td>" << FormatDecimalsOr(res.rms_um, 3, "-")
-    << " / " << FormatDecimalsOr(res.max_abs_um, 3, "-") << " um</td></tr>\n"
-    << "<tr><th>leave-one-out RMS / max</th><td>" << FormatDecimalsOr(loo.rms_um, 3, "-") << " / "
-    << FormatDecimalsOr(loo.max_abs_um, 3, "-") << " um over " << loo.count
-    << " points</td></tr>\n</table>\n";
-  if (f.surface.method == Method::kCubic) {
-    const auto a = f.surface.cubic.CoefficientsMm();
-    h << "<p>dE = a0 + a1 X + a2 Y + a3 X&sup2; + a4 XY + a5 Y&sup2; + a6 X&sup3; + a7 X&sup2;Y + "
-         "a8 XY&sup2; + a9 Y&sup3; (um, X and Y in mm)</p>\n<table><tr>";
-    for (int k = 0; k < kCubicTerms; ++k) h << "<th>a" << k << "</th>";
-    h << "</tr><tr>";
-    for (int k = 0; k < kCubicTerms; ++k) {
-      h << "<td>" << FormatExponent(a[k], 4) << "</td>";
-    }
-    h << "</tr></table>\n";
+    condition += " (normalized coordinates; " + FormatSignificant(f.condition_number_mm, 3) +
+                 " in raw mm)";
+  const auto left = [](std::string text) {
+    Cell c(std::move(text));
+    c.left = true;
+    return c;
+  };
+  t.rows = {{"method", left(method)},
+            {"points", left(std::to_string(f.points.size()))},
+            {"condition number", left(condition)},
+            {"residual RMS / max", left(FormatDecimalsOr(res.rms_um, 3, "-") + " / " +
+                                        FormatDecimalsOr(res.max_abs_um, 3, "-") + " um")},
+            {"leave-one-out RMS / max",
+             left(FormatDecimalsOr(loo.rms_um, 3, "-") + " / " +
+                  FormatDecimalsOr(loo.max_abs_um, 3, "-") + " um over " +
+                  std::to_string(loo.count) + " points")}};
+  return t;
+}
+
+void AddCubic(const SurfaceFit& f, report::Document* doc) {
+  if (f.surface.method != Method::kCubic) return;
+  const auto a = f.surface.cubic.CoefficientsMm();
+  doc->Say("dE = a0 + a1 X + a2 Y + a3 X\u00b2 + a4 XY + a5 Y\u00b2 + a6 X\u00b3 + a7 X\u00b2Y + "
+           "a8 XY\u00b2 + a9 Y\u00b3 (um, X and Y in mm)");
+  report::Table t;
+  t.rows.emplace_back();
+  for (int k = 0; k < kCubicTerms; ++k) {
+    t.header.push_back("a" + std::to_string(k));
+    t.rows.back().push_back(FormatExponent(a[k], 4));
   }
-  return h.str();
+  doc->Add(t);
 }
 
-std::string LinesHtml(const std::vector<AxisLine>& lines) {
-  if (lines.empty()) return "";
-  std::ostringstream h;
-  h << "<h2>840D: the least-squares line per axis (what temperature compensation can apply)</h2>\n"
-       "<table><tr><th>axis</th><th>along</th><th>SD43900 [mm]</th><th>SD43910</th>"
-       "<th>SD43920 [mm]</th><th>error max / RMS [um]</th><th>left by the line max / RMS "
-       "[um]</th></tr>\n";
+void AddLines(const std::vector<AxisLine>& lines, report::Document* doc) {
+  if (lines.empty()) return;
+  doc->Add(report::Heading{
+      2, "840D: the least-squares line per axis (what temperature compensation can apply)", ""});
+  report::Table t;
+  t.header = {"axis", "along", "SD43900 [mm]", "SD43910", "SD43920 [mm]", "error max / RMS [um]",
+              "left by the line max / RMS [um]"};
   for (const auto& l : lines)
-    h << "<tr><td>" << HtmlEscape(l.options.axis) << "</td><td>" << l.options.along << "</td><td>"
-      << FormatDecimalsOr(l.sd43900_mm, 6, "-") << "</td><td>"
-      << FormatDecimalsOr(l.sd43910, 8, "-") << (l.slope_capped ? " (capped)" : "") << "</td><td>"
-      << FormatDecimalsOr(l.sd43920_mm, 4, "-") << "</td><td>"
-      << FormatDecimalsOr(l.error_max_abs_um, 2, "-") << " / "
-      << FormatDecimalsOr(l.error_rms_um, 2, "-") << "</td><td>"
-      << FormatDecimalsOr(l.uncorrected_max_abs_um, 2, "-") << " / "
-      << FormatDecimalsOr(l.uncorrected_rms_um, 2, "-") << "</td></tr>\n";
-  h << "</table>\n<p class='small'>sign " << interp::ToString(lines[0].options.sign)
-    << " (dK = s &middot; line / 1000, interp/sinumerik.h); check it on the machine.</p>\n";
-  return h.str();
+    t.rows.push_back({l.options.axis, std::string(1, l.options.along),
+                      FormatDecimalsOr(l.sd43900_mm, 6, "-"),
+                      FormatDecimalsOr(l.sd43910, 8, "-") + (l.slope_capped ? " (capped)" : ""),
+                      FormatDecimalsOr(l.sd43920_mm, 4, "-"),
+                      FormatDecimalsOr(l.error_max_abs_um, 2, "-") + " / " +
+                          FormatDecimalsOr(l.error_rms_um, 2, "-"),
+                      FormatDecimalsOr(l.uncorrected_max_abs_um, 2, "-") + " / " +
+                          FormatDecimalsOr(l.uncorrected_rms_um, 2, "-")});
+  t.caption = "sign " + interp::ToString(lines[0].options.sign) +
+              " (dK = s \u00b7 line / 1000, interp/sinumerik.h); check it on the machine.";
+  doc->Add(t);
 }
 
-std::string PointsHtml(const SurfaceFit& f) {
-  std::ostringstream h;
-  h << "<h2>Measured points</h2>\n<table><tr><th>#</th><th>x [mm]</th><th>y [mm]</th>"
-       "<th>error [um]</th><th>fitted [um]</th><th>residual [um]</th><th>leave-one-out "
-       "error [um]</th></tr>\n";
+report::Table PointsTable(const SurfaceFit& f) {
+  report::Table t;
+  t.header = {"#", "x [mm]", "y [mm]", "error [um]", "fitted [um]", "residual [um]",
+              "leave-one-out error [um]"};
   for (std::size_t k = 0; k < f.points.size(); ++k)
-    h << "<tr><td>" << k + 1 << "</td><td>" << FormatDecimalsOr(f.points[k].x_mm, 2, "-")
-      << "</td><td>" << FormatDecimalsOr(f.points[k].y_mm, 2, "-") << "</td><td>"
-      << FormatDecimalsOr(f.points[k].error_um, 3, "-") << "</td><td>"
-      << FormatDecimalsOr(f.fitted_um[k], 3, "-") << "</td><td>"
-      << FormatDecimalsOr(f.residual_um[k], 3, "-") << "</td><td>"
-      << FormatDecimalsOr(f.loo_error_um[k], 3, "-") << "</td></tr>\n";
-  h << "</table>\n";
-  return h.str();
+    t.rows.push_back({std::to_string(k + 1), FormatDecimalsOr(f.points[k].x_mm, 2, "-"),
+                      FormatDecimalsOr(f.points[k].y_mm, 2, "-"),
+                      FormatDecimalsOr(f.points[k].error_um, 3, "-"),
+                      FormatDecimalsOr(f.fitted_um[k], 3, "-"),
+                      FormatDecimalsOr(f.residual_um[k], 3, "-"),
+                      FormatDecimalsOr(f.loo_error_um[k], 3, "-")});
+  return t;
 }
 
-std::string PageHtml(const SurfaceFit& f, const MethodComparison* choice,
-                     const std::vector<AxisLine>& lines, const SurfaceReportOptions& o,
-                     bool have_map, const std::vector<std::string>& warnings) {
-  std::ostringstream h;
-  h << HtmlPageBegin(o.title, o.provenance);  // the shared skeleton (core/html_page.h)
-  for (const auto& w : warnings) h << "<p><b>warning:</b> " << HtmlEscape(w) << "</p>\n";
-  if (have_map)
-    h << "<p><img src='map.png' alt='map of the thermal error over the table' width='1000'></p>\n";
-  h << "<h2>Fit</h2>\n" << SummaryHtml(f);
-  if (choice)
-    h << "<h2>Cubic polynomial or B-spline</h2>\n<pre>" << HtmlEscape(FormatComparisonText(*choice))
-      << "</pre>\n";
-  h << LinesHtml(lines) << PointsHtml(f)
-    << "<p class='small'>Files: surface_grid.dat, points.csv, points.dat, map.gp (re-plot with "
-       "gnuplot "
-       "map.gp).</p>\n</body></html>\n";
-  return h.str();
+report::Document Page(const SurfaceFit& f, const MethodComparison* choice,
+                      const std::vector<AxisLine>& lines, const SurfaceReportOptions& o,
+                      bool map, const std::string& subtitle) {
+  report::Document doc;
+  doc.title = o.title;
+  doc.provenance = o.provenance;
+  if (map) doc.Add(MapFigure(o, subtitle));
+  doc.Add(report::Heading{2, "Fit", ""}).Add(SummaryTable(f));
+  AddCubic(f, &doc);
+  if (choice) {
+    doc.Add(report::Heading{2, "Cubic polynomial or B-spline", ""});
+    doc.Add(report::Preformatted{FormatComparisonText(*choice)});
+  }
+  AddLines(lines, &doc);
+  doc.Add(report::Heading{2, "Measured points", ""}).Add(PointsTable(f));
+  doc.Say("Files: surface_grid.dat, points.csv, points.dat, map.gp (re-plot with gnuplot map.gp).",
+          report::Tone::kSmall);
+  return doc;
 }
 
 }  // namespace
@@ -192,10 +182,16 @@ SurfaceReportResult WriteSurfaceReport(const fs::path& dir, const SurfaceFit& fi
   for (const auto& p : o.provenance) comments.push_back(" " + p);
   out.Add("points.csv", FormatPointsCsv(fit.points, comments));
   out.Add("points.dat", PointsData(fit));
-  out.Add("map.gp", MapScript(o, Terminal(o.gnuplot_command), subtitle));
-  if (o.plots && !flat) r.plot_rendered = Render(out, o, r);
-  if (flat) r.warnings.push_back("the points span no rectangle: map skipped");
-  out.Add("index.html", PageHtml(fit, choice, lines, o, r.plot_rendered, r.warnings));
+  std::vector<std::string> warnings;
+  if (flat) warnings.push_back("the points span no rectangle: map skipped");
+  report::RenderOptions ro;
+  ro.plots = o.plots;
+  ro.gnuplot = o.gnuplot_command;
+  const report::RenderResult rendered =
+      report::RenderReport(Page(fit, choice, lines, o, !flat, subtitle), out, ro, warnings);
+  r.plot_rendered = rendered.plots_rendered;
+  r.warnings = warnings;
+  r.warnings.insert(r.warnings.end(), rendered.warnings.begin(), rendered.warnings.end());
   r.files = out.Commit(o.also_write);
   r.index_html = dir / "index.html";
   return r;

@@ -1,0 +1,557 @@
+#include "core/report_render.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "core/numbers.h"
+#include "core/plot_style.h"
+#include "core/run_program.h"
+#include "core/safe_text.h"
+
+namespace whirl {
+
+std::string_view ReportStylesheet() {
+  return "body{font-family:sans-serif;max-width:1100px;margin:1.5em auto;padding:0 1em;color:#222;"
+         "line-height:1.4}\n"
+         "h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}\n"
+         "table{border-collapse:collapse;margin:0.6em 0;display:block;overflow-x:auto;"
+         "max-width:100%}\n"
+         "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right;vertical-align:top}\n"
+         "td:first-child,th:first-child{text-align:left}th{background:#eee}\n"
+         "tr.cls td{font-weight:bold}\n"
+         ".small{font-size:0.85em;color:#555}.warn{color:#a00}\n"
+         ".control{border:2px solid #2a6;background:#f3fbf5;padding:0.4em 1.2em 0.8em;"
+         "margin:1em 0;border-radius:6px}\n"
+         ".control h2{border:none;margin-top:0.5em}\n"
+         "pre,code{font-family:monospace;font-size:0.9em}\n"
+         "pre{background:#f6f6f6;padding:6px;white-space:pre-wrap;overflow-wrap:anywhere}\n"
+         "img{max-width:100%;height:auto;border:1px solid #ddd;display:block;margin:0.5em 0}\n"
+         "figure{margin:0.8em 0}\n"
+         ".legend{list-style:none;padding:0;margin:0.2em 0 1em;columns:2 24em;font-size:0.9em}\n"
+         ".legend li{break-inside:avoid;margin:0.1em 0}"
+         ".legend svg{vertical-align:middle;margin-right:0.5em}\n";
+}
+
+std::string HtmlPageBegin(std::string_view title, const std::vector<std::string>& provenance) {
+  std::string h =
+      "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
+      "<meta name='viewport' content='width=device-width, initial-scale=1'><title>" +
+      HtmlEscape(title) + "</title>\n<style>\n" + std::string(ReportStylesheet()) +
+      "</style></head><body>\n<h1>" + HtmlEscape(title) + "</h1>\n";
+  for (const auto& p : provenance) h += "<p class='small'>" + HtmlEscape(p) + "</p>\n";
+  return h;
+}
+
+std::string HtmlPageEnd() { return "</body></html>\n"; }
+
+std::string HtmlImage(std::string_view file, std::string_view alt) {
+  return "<img src='" + HtmlEscape(file) + "' alt='" + HtmlEscape(alt) + "'>";
+}
+
+std::string HtmlLink(std::string_view href, std::string_view text) {
+  return "<a href='" + HtmlEscape(href) + "'>" + HtmlEscape(text) + "</a>";
+}
+
+}  // namespace whirl
+
+namespace whirl::report {
+
+Span Text(std::string text) { return {Span::Kind::kText, std::move(text), {}}; }
+Span Bold(std::string text) { return {Span::Kind::kBold, std::move(text), {}}; }
+Span Code(std::string text) { return {Span::Kind::kCode, std::move(text), {}}; }
+Span Link(std::string href, std::string text) {
+  return {Span::Kind::kLink, std::move(text), std::move(href)};
+}
+Column Col(int index, double divide) {
+  Column c;
+  c.index = index;
+  c.divide = divide;
+  return c;
+}
+
+Block MakeBlock(Heading h) {
+  Block b;
+  b.kind = Block::Kind::kHeading;
+  b.heading = std::move(h);
+  return b;
+}
+Block MakeBlock(Paragraph p) {
+  Block b;
+  b.kind = Block::Kind::kParagraph;
+  b.paragraph = std::move(p);
+  return b;
+}
+Block MakeBlock(Table t) {
+  Block b;
+  b.kind = Block::Kind::kTable;
+  b.table = std::move(t);
+  return b;
+}
+Block MakeBlock(List l) {
+  Block b;
+  b.kind = Block::Kind::kList;
+  b.list = std::move(l);
+  return b;
+}
+Block MakeBlock(Preformatted p) {
+  Block b;
+  b.kind = Block::Kind::kPreformatted;
+  b.pre = std::move(p);
+  return b;
+}
+Block MakeBlock(Figure f) {
+  Block b;
+  b.kind = Block::Kind::kFigure;
+  b.figure = std::move(f);
+  return b;
+}
+Block MakeBlock(Box x) {
+  Block b;
+  b.kind = Block::Kind::kBox;
+  b.box = std::move(x);
+  return b;
+}
+
+Document& Document::Add(Heading h) {
+  blocks.push_back(MakeBlock(std::move(h)));
+  return *this;
+}
+Document& Document::Add(Paragraph p) {
+  blocks.push_back(MakeBlock(std::move(p)));
+  return *this;
+}
+Document& Document::Add(Table t) {
+  blocks.push_back(MakeBlock(std::move(t)));
+  return *this;
+}
+Document& Document::Add(List l) {
+  blocks.push_back(MakeBlock(std::move(l)));
+  return *this;
+}
+Document& Document::Add(Preformatted p) {
+  blocks.push_back(MakeBlock(std::move(p)));
+  return *this;
+}
+Document& Document::Add(Figure f) {
+  blocks.push_back(MakeBlock(std::move(f)));
+  return *this;
+}
+Document& Document::Add(Box b) {
+  blocks.push_back(MakeBlock(std::move(b)));
+  return *this;
+}
+Document& Document::Add(const std::vector<Block>& more) {
+  blocks.insert(blocks.end(), more.begin(), more.end());
+  return *this;
+}
+Document& Document::Say(std::string text, Tone tone) {
+  return Add(Paragraph{{Text(std::move(text))}, tone});
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- gnuplot -------------------------------------------------------------------------------
+
+// A column as gnuplot reads it: "3", "($1/60)", "($2-$5)", "($3==0?$2:1/0)".
+std::string ColumnText(const Column& c) {
+  std::string e = "$" + std::to_string(c.index);
+  bool plain = true;
+  if (c.plus > 0) {
+    e += "+$" + std::to_string(c.plus);
+    plain = false;
+  }
+  if (c.minus > 0) {
+    e += "-$" + std::to_string(c.minus);
+    plain = false;
+  }
+  if (c.divide != 1) {
+    e = "(" + e + ")/" + FormatNumber(c.divide);
+    plain = false;
+  }
+  if (c.only_if_column > 0) {
+    e = "$" + std::to_string(c.only_if_column) + "==" + FormatNumber(c.only_if_value) + "?" + e +
+        ":1/0";
+    plain = false;
+  }
+  return plain ? std::to_string(c.index) : "(" + e + ")";
+}
+
+std::string Using(const Series& s) {
+  std::string u;
+  for (const Column& c : s.columns) u += (u.empty() ? "" : ":") + ColumnText(c);
+  return u;
+}
+
+// The colour of a series: its look's, its own, or grey.
+std::string Colour(const Series& s) {
+  if (!s.style.empty()) {
+    const SeriesStyle* st = FindSeriesStyle(s.style);
+    return st ? std::string(st->colour) : "#aaaaaa";
+  }
+  return s.colour.empty() ? "#555555" : s.colour;
+}
+
+bool IsSurface(const Panel& p) {
+  for (const Series& s : p.series)
+    if (s.kind == SeriesKind::kMap || s.kind == SeriesKind::kContour) return true;
+  return false;
+}
+
+std::string With(const Series& s, bool surface) {
+  const std::string lc = "lc rgb '" + Colour(s) + "'";
+  const std::string nocontours = surface ? "nocontours " : "";
+  switch (s.kind) {
+    case SeriesKind::kLine: {
+      std::string w = s.style.empty() ? "with lines " + lc + " lw " + FormatNumber(s.width) + " dt 1"
+                                      : GnuplotWith(s.style);
+      if (s.markers && w.rfind("with lines ", 0) == 0)
+        w = "with linespoints " + w.substr(11) + " pt 6 ps 1.2 pn 40";
+      return w;
+    }
+    case SeriesKind::kBand:
+      return "with filledcurves fs transparent solid 0.15 noborder " + lc;
+    case SeriesKind::kPoints:
+      return nocontours + "with points pt 7 ps 1.2 " + lc;
+    case SeriesKind::kOpenPoints:
+      return nocontours + "with points pt 6 ps 1.6 lw 1.5 " + lc;
+    case SeriesKind::kLinePoints:
+      return "with linespoints pt 5 lw 2 " + lc;
+    case SeriesKind::kMap:
+      return "with pm3d nocontours";
+    case SeriesKind::kContour:
+      return "nosurface with lines lc rgb '#202020'";
+    case SeriesKind::kImage:
+      return "with image";
+  }
+  return "";
+}
+
+std::string RangeText(const Range& r) {
+  const auto end = [](double v) { return std::isfinite(v) ? FormatNumber(v) : std::string("*"); };
+  return "[" + end(r.low) + ":" + end(r.high) + "]";
+}
+
+std::string Tics(const std::vector<std::string>& names) {
+  std::string t;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    t += (i ? ", " : "") + GnuplotString(names[i]) + " " + std::to_string(i);
+  return "(" + t + ")";
+}
+
+// The settings of one panel, each set or reset so that a panel never inherits the last one's.
+std::string PanelSettings(const Panel& p, bool aligned) {
+  std::ostringstream s;
+  const bool surface = IsSurface(p);
+  s << "unset arrow\nset title " << GnuplotString(p.title) << "\nset xlabel "
+    << GnuplotString(p.xlabel) << "\nset ylabel " << GnuplotString(p.ylabel) << "\n";
+  if (p.y2label.empty())
+    s << "unset y2label\nunset y2tics\nset ytics mirror\n";
+  else
+    s << "set y2label " << GnuplotString(p.y2label) << "\nset y2tics\nset ytics nomirror\n";
+  s << (p.y2_log ? "set logscale y2\n" : "unset logscale y2\n");
+  s << "set xrange " << RangeText(p.x) << "\nset yrange " << RangeText(p.y)
+    << (p.y_reversed ? " reverse" : " noreverse") << "\n";
+  s << (p.equal_axes ? "set size ratio -1\n" : "set size noratio\n");
+  if (p.tic_names.empty())
+    s << "set xtics autofreq norotate\nset ytics autofreq\n";
+  else
+    s << "set xtics " << Tics(p.tic_names) << " rotate by 90 right\nset ytics "
+      << Tics(p.tic_names) << "\n";
+  if (!p.cblabel.empty()) s << "set cblabel " << GnuplotString(p.cblabel) << "\n";
+  if (aligned && !surface && !p.equal_axes)
+    s << "set lmargin at screen 0.08\nset rmargin at screen 0.95\n";
+  else
+    s << "unset lmargin\nunset rmargin\n";
+  for (double x : p.x_marks)
+    s << "set arrow from " << FormatNumber(x) << ", graph 0 to " << FormatNumber(x)
+      << ", graph 1 nohead dt 2 lc rgb '#555555'\n";
+  for (double y : p.y2_marks)
+    s << "set arrow from graph 0, second " << FormatNumber(y) << " to graph 1, second "
+      << FormatNumber(y) << " nohead dt 2 lc rgb 'gray'\n";
+  if (surface)
+    s << "set view map\nset palette rgbformulae 33,13,10\nset contour base\n"
+         "set cntrparam levels auto 12\nunset clabel\n";
+  // Whitespace data (maps, matrices) unless the panel reads CSV.
+  const bool csv = !p.series.empty() && p.series.front().file.size() > 4 &&
+                   p.series.front().file.substr(p.series.front().file.size() - 4) == ".csv";
+  s << (csv ? "set datafile separator ','\n" : "set datafile separator whitespace\n");
+  return s.str();
+}
+
+std::string PlotCommand(const Panel& p) {
+  const bool surface = IsSurface(p);
+  std::ostringstream s;
+  s << (surface ? "splot " : "plot ");
+  if (p.series.empty()) return s.str() + "1/0 notitle\n";
+  std::string last_file;
+  for (std::size_t i = 0; i < p.series.size(); ++i) {
+    const Series& x = p.series[i];
+    s << (i ? ", " : "") << (x.file == last_file ? "''" : GnuplotString(x.file));
+    last_file = x.file;
+    if (x.block >= 0) s << " index " << x.block;
+    s << " using " << Using(x) << (x.right_axis ? " axes x1y2" : "") << " " << With(x, surface)
+      << " " << (x.title.empty() ? "notitle" : "title " + GnuplotString(x.title));
+  }
+  return s.str() + "\n";
+}
+
+std::string Terminal(const std::string& gnuplot) {
+  return ProgramSucceeds({gnuplot, "-e", "set terminal pngcairo"}) ? "pngcairo" : "png";
+}
+
+// ---- HTML ----------------------------------------------------------------------------------
+
+std::string SpansHtml(const std::vector<Span>& spans) {
+  std::string h;
+  for (const Span& s : spans) switch (s.kind) {
+      case Span::Kind::kText:
+        h += HtmlEscape(s.text);
+        break;
+      case Span::Kind::kBold:
+        h += "<b>" + HtmlEscape(s.text) + "</b>";
+        break;
+      case Span::Kind::kCode:
+        h += "<code>" + HtmlEscape(s.text) + "</code>";
+        break;
+      case Span::Kind::kLink:
+        h += HtmlLink(s.href, s.text);
+        break;
+    }
+  return h;
+}
+
+const char* ToneClass(Tone t) {
+  switch (t) {
+    case Tone::kSmall:
+      return " class='small'";
+    case Tone::kWarn:
+      return " class='warn'";
+    case Tone::kNormal:
+      break;
+  }
+  return "";
+}
+
+std::string TableHtml(const Table& t) {
+  std::ostringstream h;
+  h << "<table" << (t.series_rows ? " class='series'" : "") << ">";
+  if (!t.header.empty()) {
+    h << "<tr>";
+    for (const auto& c : t.header) h << "<th>" << HtmlEscape(c) << "</th>";
+    h << "</tr>";
+  }
+  h << "\n";
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    bool bold = false;
+    for (std::size_t k : t.highlight) bold = bold || k == r;
+    h << "<tr" << (bold ? " class='cls'" : "") << ">";
+    for (std::size_t c = 0; c < t.rows[r].size(); ++c) {
+      const Cell& cell = t.rows[r][c];
+      h << "<td";
+      if (c == 0 && t.series_rows && !cell.not_plotted) h << " data-series='" << HtmlEscape(cell.text) << "'";
+      if (cell.colspan > 1) h << " colspan='" << cell.colspan << "'";
+      if (cell.left) h << " style='text-align:left'";
+      h << ">" << HtmlEscape(cell.text) << "</td>";
+    }
+    h << "</tr>\n";
+  }
+  h << "</table>\n";
+  if (!t.caption.empty()) h << "<p class='small'>" << HtmlEscape(t.caption) << "</p>\n";
+  return h.str();
+}
+
+// SVG dash arrays of gnuplot's dash types 1..5 at a line width of about 2.
+const char* DashArray(int dash) {
+  switch (dash) {
+    case 2:
+      return "8 4";
+    case 3:
+      return "2 3";
+    case 4:
+      return "8 3 2 3";
+    case 5:
+      return "8 3 2 3 2 3";
+    default:
+      return "";
+  }
+}
+
+// One legend entry: a swatch in the series' look and its words.
+std::string LegendEntry(const Series& s) {
+  const std::string colour = Colour(s);
+  int dash = 1;
+  double width = s.width;
+  int point = 0;
+  if (!s.style.empty()) {
+    const SeriesStyle* st = FindSeriesStyle(s.style);
+    dash = st ? st->dash : 3;
+    width = st ? st->width : 1.5;
+    point = st ? st->point : 0;
+  }
+  std::ostringstream h;
+  h << "<li";
+  if (!s.style.empty()) h << " data-series='" << HtmlEscape(s.style) << "'";
+  h << " data-colour='" << HtmlEscape(colour) << "'><svg width='40' height='12' aria-hidden='true'>";
+  switch (s.kind) {
+    case SeriesKind::kBand:
+      h << "<rect x='0' y='1' width='40' height='10' fill='" << colour
+        << "' fill-opacity='0.25'/>";
+      break;
+    case SeriesKind::kPoints:
+    case SeriesKind::kOpenPoints:
+      h << "<circle cx='20' cy='6' r='4' stroke='" << colour << "' fill='"
+        << (s.kind == SeriesKind::kPoints ? colour : "none") << "'/>";
+      break;
+    default:
+      h << "<line x1='0' y1='6' x2='40' y2='6' stroke='" << colour << "' stroke-width='"
+        << FormatNumber(std::max(1.0, width)) << "'";
+      if (*DashArray(dash)) h << " stroke-dasharray='" << DashArray(dash) << "'";
+      h << "/>";
+      if (point || s.markers)
+        h << "<circle cx='20' cy='6' r='3.5' stroke='" << colour << "' fill='none'/>";
+  }
+  h << "</svg>" << HtmlEscape(s.title) << "</li>\n";
+  return h.str();
+}
+
+std::string FigureHtml(const Figure& f, const std::set<std::string>& rendered) {
+  if (rendered.count(f.stem) == 0)
+    return "<p class='warn'>Plot " + HtmlEscape(f.stem) + ".png not rendered (see the warnings; " +
+           HtmlLink(f.stem + ".gp", f.stem + ".gp") + " draws it).</p>\n";
+  std::string legend;
+  std::set<std::string> seen;
+  for (const Panel& p : f.panels)
+    for (const Series& s : p.series)
+      if (!s.title.empty() && seen.insert(s.style + "\n" + s.title).second)
+        legend += LegendEntry(s);
+  return "<figure id='fig-" + HtmlEscape(f.stem) + "'>" + HtmlImage(f.stem + ".png", f.alt) +
+         (legend.empty() ? "" : "<ul class='legend'>\n" + legend + "</ul>") + "</figure>\n";
+}
+
+std::string BlocksHtml(const std::vector<Block>& blocks, const std::set<std::string>& rendered) {
+  std::string h;
+  for (const Block& b : blocks) switch (b.kind) {
+      case Block::Kind::kHeading: {
+        const std::string tag = b.heading.level >= 3 ? "h3" : "h2";
+        h += "<" + tag +
+             (b.heading.id.empty() ? "" : " id='" + HtmlEscape(b.heading.id) + "'") + ">" +
+             HtmlEscape(b.heading.text) + "</" + tag + ">\n";
+        break;
+      }
+      case Block::Kind::kParagraph:
+        h += std::string("<p") + ToneClass(b.paragraph.tone) + ">" +
+             SpansHtml(b.paragraph.spans) + "</p>\n";
+        break;
+      case Block::Kind::kTable:
+        h += TableHtml(b.table);
+        break;
+      case Block::Kind::kList:
+        h += std::string("<ul") + ToneClass(b.list.tone) + ">\n";
+        for (const auto& item : b.list.items) h += "<li>" + SpansHtml(item) + "</li>\n";
+        h += "</ul>\n";
+        break;
+      case Block::Kind::kPreformatted:
+        h += "<pre>" + HtmlEscape(b.pre.text) + "</pre>\n";
+        break;
+      case Block::Kind::kFigure:
+        h += FigureHtml(b.figure, rendered);
+        break;
+      case Block::Kind::kBox:
+        h += "<section class='control'" +
+             (b.box.id.empty() ? std::string() : " id='" + HtmlEscape(b.box.id) + "'") + ">\n" +
+             BlocksHtml(b.box.blocks, rendered) + "</section>\n";
+        break;
+    }
+  return h;
+}
+
+void CollectFigures(const std::vector<Block>& blocks, std::vector<const Figure*>* out) {
+  for (const Block& b : blocks) {
+    if (b.kind == Block::Kind::kFigure) out->push_back(&b.figure);
+    if (b.kind == Block::Kind::kBox) CollectFigures(b.box.blocks, out);
+  }
+}
+
+}  // namespace
+
+std::string GnuplotScript(const Figure& f, const std::string& terminal) {
+  std::ostringstream s;
+  const bool cairo = terminal == "pngcairo";
+  s << "# gnuplot script written by whirl; re-run with: gnuplot " << f.stem << ".gp\n"
+    << "# The report's page shows the legend; 'set key' before a plot draws it here too.\n"
+    << "set terminal " << terminal << " size " << f.width_px << "," << f.height_px
+    << (cairo ? " font 'Sans,10'" : "") << " noenhanced\nset output "
+    << GnuplotString(f.stem + ".png") << "\nset datafile commentschars '#'\nset grid\nunset key\n";
+  const bool multi = f.panels.size() > 1;
+  if (multi) {
+    const int cols = std::max(1, f.columns);
+    const int rows = static_cast<int>((f.panels.size() + cols - 1) / cols);
+    s << "set multiplot layout " << rows << "," << cols << " title " << GnuplotString(f.title)
+      << "\n";
+  }
+  for (const Panel& p : f.panels) {
+    Panel shown = p;
+    if (!multi && shown.title.empty()) shown.title = f.title;
+    s << PanelSettings(shown, f.columns <= 1) << PlotCommand(shown);
+  }
+  if (multi) s << "unset multiplot\n";
+  s << "set output\n";
+  return s.str();
+}
+
+std::vector<const Figure*> Figures(const Document& doc) {
+  std::vector<const Figure*> out;
+  CollectFigures(doc.blocks, &out);
+  return out;
+}
+
+std::string RenderHtml(const Document& doc, const std::set<std::string>& rendered,
+                       const std::vector<std::string>& warnings) {
+  std::string h = HtmlPageBegin(doc.title, doc.provenance);
+  for (const auto& w : warnings) h += "<p class='warn'>warning: " + HtmlEscape(w) + "</p>\n";
+  return h + BlocksHtml(doc.blocks, rendered) + HtmlPageEnd();
+}
+
+RenderResult RenderReport(const Document& doc, OutputDir& out, const RenderOptions& o,
+                          const std::vector<std::string>& warnings) {
+  RenderResult r;
+  const std::vector<const Figure*> figures = Figures(doc);
+  const bool gnuplot =
+      o.plots && !figures.empty() && !o.gnuplot.empty() && ProgramSucceeds({o.gnuplot, "--version"});
+  if (o.plots && !figures.empty() && !gnuplot)
+    r.warnings.push_back("'" + o.gnuplot +
+                         "' not found: plots skipped (install gnuplot-nox, e.g. scripts/setup.sh); "
+                         "the page, the data and the .gp scripts are written");
+  const std::string terminal = gnuplot ? Terminal(o.gnuplot) : "pngcairo";
+  std::set<std::string> rendered;
+  for (const Figure* f : figures) {
+    out.Add(f->stem + ".gp", GnuplotScript(*f, terminal));
+    if (!gnuplot) continue;
+    // gnuplot never sees the output directory: it renders in the staging folder.
+    const std::string png = f->stem + ".png", log = f->stem + ".gp.log";
+    const int rc = out.RunInStaging({o.gnuplot, f->stem + ".gp"}, log, {png});
+    std::error_code ec;
+    const fs::path staged = out.Staging() / png;
+    if (rc == 0 && fs::is_regular_file(staged, ec) && fs::file_size(staged, ec) > 0) {
+      out.AddStaged(png);
+      rendered.insert(f->stem);
+    } else {
+      out.AddProgramLog(log);
+      r.warnings.push_back("gnuplot failed on " + (out.path() / (f->stem + ".gp")).string() +
+                           " (exit " + std::to_string(rc) + ", see " + log + "): " + png +
+                           " not drawn");
+    }
+  }
+  r.plots_rendered = gnuplot && rendered.size() == figures.size();
+  std::vector<std::string> shown = warnings;
+  shown.insert(shown.end(), r.warnings.begin(), r.warnings.end());
+  out.Add(o.page, RenderHtml(doc, rendered, shown));
+  return r;
+}
+
+}  // namespace whirl::report
