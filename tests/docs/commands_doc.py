@@ -36,8 +36,17 @@ class Commands:
         self.whirl = whirl
         self.cache = {}
 
+    def without_torch(self, words):
+        """A command that runs whirl-torch, in a build without it (-DWHIRL_WITH_TORCH=OFF, e.g.
+        scripts/sanitize.sh): its --help is whirl-torch's, so it cannot be checked here."""
+        torch = os.path.join(os.path.dirname(os.path.abspath(self.whirl)), "whirl-torch")
+        return words[:1] in (["crosscheck"], ["export"]) and not os.access(torch, os.X_OK)
+
     def parsed(self, words):
         key = tuple(words)
+        if key not in self.cache and self.without_torch(list(words)):
+            print(f"skipped: whirl {' '.join(words)} (no whirl-torch in this build)")
+            self.cache[key] = ([], [], "")
         if key not in self.cache:
             r = subprocess.run([self.whirl, *words, "--help"], capture_output=True, text=True)
             if r.returncode != 0:
@@ -139,6 +148,8 @@ def check_command(cmds, text):
             known.update(cmds.options(path + [a]))
         where = " ".join(path) + " " + "|".join(alternatives)
     else:
+        if cmds.without_torch(path):
+            return []  # its options are whirl-torch's, not in this build
         known = set(cmds.options(path))
         where = " ".join(path) or "(top level)"
     return [f"whirl {where}: no option {f}" for f in flags if f not in known]
@@ -180,9 +191,14 @@ def help_problems(cmds, src):
     return problems
 
 
-def option_table(cmds):
+def option_table(cmds, old_table=""):
+    """The table from --help; a command without whirl-torch in this build keeps its old row."""
     rows = ["| command | options |", "|---|---|"]
     for leaf in cmds.leaves():
+        if cmds.without_torch(leaf):
+            start = f"| `whirl {' '.join(leaf)}` |"
+            rows += [r for r in old_table.splitlines() if r.startswith(start)]
+            continue
         opts = " ".join(f"`{o}`" for o in cmds.options(leaf) if o != "--help")
         rows.append(f"| `whirl {' '.join(leaf)}` | {opts} |")
     return "\n".join(rows)
@@ -203,8 +219,10 @@ def main():
         sys.exit(f"FAIL: {doc_path} lacks the markers of the every-option table")
     head, rest = doc.split(BEGIN, 1)
     old_table, tail = rest.split(END, 1)
-    table = option_table(cmds)
+    table = option_table(cmds, old_table)
     if a.write:
+        if cmds.without_torch(["crosscheck"]):
+            sys.exit("FAIL: --write needs a build with whirl-torch (-DWHIRL_WITH_TORCH=ON)")
         with open(doc_path, "w", encoding="utf-8") as f:
             f.write(head + BEGIN + "\n" + table + "\n" + END + tail)
         print(f"wrote the every-option table of {doc_path}")

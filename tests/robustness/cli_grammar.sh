@@ -99,6 +99,7 @@ check_listing() {  # check_listing <help text> <command words...>
 
 walk() {  # walk <command words...>
   local help sub subs
+  if without_torch "$@"; then echo "skipped: whirl $* (no whirl-torch in this build)"; return; fi
   help=$("$W" "$@" --help) || fail "whirl $* --help failed"
   subs=$(subcommands <<< "$help")
   if [ -z "$subs" ]; then check_command "$help" "$@"; return; fi

@@ -40,6 +40,7 @@ without_range() {
 
 walk() {  # walk <command words...>: checks the command's flags, then its subcommands'
   local flag sub line help
+  if without_torch "$@"; then echo "skipped: whirl $* (no whirl-torch in this build)"; return; fi
   help=$("$W" "$@" --help) || fail "whirl $* --help failed"
   while IFS= read -r line; do
     [ -n "$line" ] || continue

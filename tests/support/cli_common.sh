@@ -13,3 +13,7 @@ expect_jumps_to_end() {  # expect_jumps_to_end <file>: an NC program whose every
        END { exit (bad || n == 0) }' "$1" || fail "$1: a SETAL not followed by GOTOF WHIRL_END"
   [ "$(tail -n 2 "$1" | tr '\n' ' ')" = "WHIRL_END: M17 " ] || fail "$1: no WHIRL_END: before M17"
 }
+without_torch() {  # without_torch <command words...>: true for a command that runs whirl-torch in a
+  # build without it (-DWHIRL_WITH_TORCH=OFF, e.g. scripts/sanitize.sh): its --help is whirl-torch's
+  case "$1" in crosscheck | export) [ ! -x "$(dirname "$W")/whirl-torch" ] ;; *) return 1 ;; esac
+}
