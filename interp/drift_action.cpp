@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "core/safe_text.h"
+#include "drift/grey_box_io.h"
 
 namespace whirl::interp {
 namespace {
@@ -105,9 +106,12 @@ struct Slots {
   Layout offset, slope;
   int s_m = -1;  // $AC_PARAM holding S_m, -1 without a slope model
   int last = 0;
+  const BlankTerm* blank = nullptr;  // the grey box's blank term
+  int blank_flag = -1;               // B's init flag (B and its latch: options.blank_param)
 };
 
-Slots MakeSlots(const drift::DriftModel& m, const drift::DriftModel* g, int first) {
+Slots MakeSlots(const drift::DriftModel& m, const drift::DriftModel* g, int first,
+                const BlankTerm* blank = nullptr) {
   Slots s;
   s.alive = first;
   s.offset = MakeLayout(m, first + 1);
@@ -117,7 +121,17 @@ Slots MakeSlots(const drift::DriftModel& m, const drift::DriftModel* g, int firs
     s.s_m = s.slope.Last() + 1;
     s.last = s.s_m;
   }
+  if (blank) {
+    s.blank = blank;
+    s.blank_flag = s.last + 1;
+    s.last = s.blank_flag;
+  }
   return s;
+}
+
+// The highest $AC_PARAM index the program touches (its own slots, the blank latch).
+int LastSlotUsed(const DriftActionOptions& o, const Slots& s) {
+  return s.blank ? std::max(s.last, o.blank_param + 1) : s.last;
 }
 
 std::string Line(const std::string& text) {
@@ -203,6 +217,7 @@ std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
                        const DriftActionOptions& o, const Slots& s,
                        std::vector<std::string>* bodies) {
   const std::string ax = "[" + o.axis + "]";
+  const std::string mode = s.blank ? "3" : "2";
   std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient,
                           s.offset.sum, bodies);
   if (o.workpiece_k0_param >= 0) k0 += "+" + P(o.workpiece_k0_param);
@@ -222,7 +237,18 @@ std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
     ref = FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm);
   }
   return "DO $$SA_TEMP_COMP_SLOPE" + ax + "=" + slope + " $$SA_TEMP_COMP_REF_POSITION" + ax + "=" +
-         ref + " $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=2";
+         ref + " $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=" + mode;
+}
+
+// B, the blank estimate: once its input's value, then its lag every cycle, in
+// $AC_PARAM[blank_param] (the plan latches it into blank_param + 1 at the cut start).
+std::vector<std::string> BlankBodies(const DriftActionOptions& o, const Slots& s) {
+  const std::string b = P(o.blank_param);
+  const std::string reading = Reading(Input(o, s.blank->sensor));
+  return {"WHENEVER " + P(s.blank_flag) + "==0 DO " + b + "=" + reading + " " + P(s.blank_flag) +
+              "=1",
+          "DO " + b + "=" + b + Term(LagFactor(o, s.blank->tau_min), kDecimalsLagFactor) + "*(" +
+              reading + "-" + b + ")"};
 }
 
 // The static actions, in execution order.
@@ -232,8 +258,14 @@ std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::D
   if (g) {
     const std::vector<std::string> more = FeatureBodies(*g, o, s.slope);
     bodies.insert(bodies.end(), more.begin(), more.end());
-    const std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope,
-                                   kDecimalsDriftSlopeCoefficient, s.s_m, &bodies);
+    std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope,
+                             kDecimalsDriftSlopeCoefficient, s.s_m, &bodies);
+    if (s.blank) {
+      const std::vector<std::string> b = BlankBodies(o, s);
+      bodies.insert(bodies.end(), b.begin(), b.end());
+      s_m += Term(DriftBlankCoefficient(*s.blank, o), kDecimalsDriftSlopeCoefficient) + "*(" +
+             P(o.blank_param + 1) + Term(-kBlankNeutralC, 4) + ")";
+    }
     if (s_m != P(s.s_m)) bodies.push_back("DO " + P(s.s_m) + "=" + s_m);
   }
   const std::string output = OutputBody(m, g, o, s, &bodies);
@@ -299,7 +331,8 @@ void CheckSlotsBelowCount(const DriftActionOptions& o) {
   if (!o.control.Stated()) return;
   const int last = std::max({o.param_last < 0 ? o.param_first : o.param_last,
                              o.workpiece_k0_param,
-                             o.workpiece_slope_param < 0 ? -1 : o.workpiece_slope_param + 1});
+                             o.workpiece_slope_param < 0 ? -1 : o.workpiece_slope_param + 1,
+                             o.blank_param < 0 ? -1 : o.blank_param + 1});
   if (last >= o.control.ac_params)
     throw InputError("drift $AC_PARAM slot " + std::to_string(last) +
                      " does not exist: MD28254 $MC_MM_NUM_AC_PARAM is " +
@@ -351,6 +384,15 @@ void DriftActionOptions::Validate() const {
     throw InputError("drift workpiece_slope_param " + std::to_string(workpiece_slope_param) +
                      ": needs workpiece_k0_param (the plan hands over K0 and slope together), "
                      "must be within 0..9998, and its two slots must not hold workpiece_k0_param");
+  if (blank_param >= 0 &&
+      !(blank_param <= 9998 && workpiece_slope_param >= 0 &&
+        !RangesOverlap(blank_param, blank_param + 1, workpiece_k0_param, workpiece_k0_param) &&
+        !RangesOverlap(blank_param, blank_param + 1, workpiece_slope_param,
+                       workpiece_slope_param + 1)))
+    throw InputError("drift blank_param " + std::to_string(blank_param) +
+                     ": must be within 0..9998, needs workpiece_slope_param (the blank term is "
+                     "part of the slope this action owns) and its two slots must not hold a "
+                     "workpiece slot");
   if (save_r_first > 9995)
     throw InputError("drift save_r_first " + std::to_string(save_r_first) +
                      ": must be within 0..9995 (R<n>..R<n+4> are used)");
@@ -362,8 +404,26 @@ void DriftActionOptions::Validate() const {
   for (const auto& [name, a] : inputs) CheckAnalogInput(name, a, control);
 }
 
-int DriftParamCount(const drift::DriftModel& m, const drift::DriftModel* g) {
-  return MakeSlots(m, g, 0).last + 1;
+int DriftParamCount(const drift::DriftModel& m, const drift::DriftModel* g,
+                    const BlankTerm* blank) {
+  return MakeSlots(m, g, 0, blank).last + 1;
+}
+
+GreyBoxAction GreyBoxActionModels(const drift::GreyBoxModel& model) {
+  const drift::GreyBoxControl c = drift::GreyBoxControlModels(model);
+  GreyBoxAction a;
+  a.offset = c.offset;
+  a.slope = c.slope;
+  a.has_blank = !model.blank_sensor.empty();
+  if (a.has_blank)
+    a.blank = {model.blank_sensor, model.blank_tau_min, model.blank_um_per_1000_per_k,
+               model.blank_min_c, model.blank_max_c};
+  return a;
+}
+
+double DriftBlankCoefficient(const BlankTerm& b, const DriftActionOptions& o) {
+  return RoundTo(DriftSign(o) * o.slope_growth_direction * b.um_per_1000_per_k / 1e6,
+                 kDecimalsDriftSlopeCoefficient);
 }
 
 Eigen::VectorXd DriftControlCoefficients(const drift::DriftModel& m, const DriftActionOptions& o) {
@@ -384,9 +444,13 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& g, const DriftAc
   return c;
 }
 
-double DriftSlopeBound(const drift::DriftModel& g, const DriftActionOptions& o) {
+double DriftSlopeBound(const drift::DriftModel& g, const DriftActionOptions& o,
+                       const BlankTerm* blank) {
   const Eigen::VectorXd c = DriftSlopeCoefficients(g, o);
   double bound = std::abs(c(0));
+  if (blank)
+    bound += std::abs(DriftBlankCoefficient(*blank, o)) *
+             std::max(std::abs(blank->min_c - kBlankNeutralC), std::abs(blank->max_c - kBlankNeutralC));
   for (Eigen::Index f = 1; f < c.size(); ++f)
     bound +=
         std::abs(c(f)) * std::max(std::abs(g.feature_min(f - 1)), std::abs(g.feature_max(f - 1)));
@@ -395,7 +459,29 @@ double DriftSlopeBound(const drift::DriftModel& g, const DriftActionOptions& o) 
 
 namespace {
 
+void CheckBlank(const drift::DriftModel* g, const DriftActionOptions& o, const Slots& s) {
+  if (!s.blank) return;
+  if (!g)
+    throw InputError("drift action: the blank term is part of the slope: it needs a slope model");
+  if (o.blank_param < 0)
+    throw InputError(
+        "drift action: the grey box's blank term needs the profile's drift.blank_param (its "
+        "estimate B in $AC_PARAM[n], the value latched at the cut start in [n + 1])");
+  if (o.reference != DriftReference::kModel)
+    throw InputError(
+        "drift action: the grey box reads absolute temperatures (referred to 20 degC): "
+        "reference 'model', not 'start'");
+  if (!(s.blank->tau_min > 0) || !std::isfinite(s.blank->um_per_1000_per_k))
+    throw InputError("drift action: the blank term's tau_min must be > 0 and its coefficient "
+                     "finite");
+  if (RangesOverlap(o.blank_param, o.blank_param + 1, o.param_first, s.last))
+    throw InputError("drift action: blank_param " + std::to_string(o.blank_param) + ", + 1 " +
+                     "lie in the action's own $AC_PARAM slots " + std::to_string(o.param_first) +
+                     ".." + std::to_string(s.last));
+}
+
 void CheckSlope(const drift::DriftModel* g, const DriftActionOptions& o, const Slots& s) {
+  CheckBlank(g, o, s);
   if (g && !o.has_slope)
     throw InputError(
         "drift action: a slope model needs the profile's drift.slope object "
@@ -430,6 +516,9 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
           "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + Rp(r + 3) + "\n" + Rp(r + 4) + "=0\nENDIF\n";
   nc += P(s.alive) + "=0\n" + P(s.offset.flag) + "=0\n";
   if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
+  if (s.blank)  // B starts again; no blank term until a cut start latches one
+    nc += P(s.blank_flag) + "=0\n" + P(o.blank_param + 1) + "=" +
+          FormatFixed(kBlankNeutralC, 4) + "\n";
   if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
   if (o.workpiece_slope_param >= 0)  // no plan yet: slope 0 about the fixed end
     nc += P(o.workpiece_slope_param) + "=0\n" + P(o.workpiece_slope_param + 1) + "=" +
@@ -455,13 +544,28 @@ std::string ElapsedNote(const drift::DriftModel& m, const drift::DriftModel* g) 
          "training run the warm-up goes on to its plateau b0 + sum of its gains, never past it\n";
 }
 
+// The blank term: what the action computes and who latches it.
+std::string BlankNote(const DriftActionOptions& o, const Slots& s) {
+  if (!s.blank) return "";
+  const std::string b = P(o.blank_param), l = P(o.blank_param + 1);
+  return Line("; blank term (grey box): S_m also adds s * sigma * g_b (" + l + " - 20) / 1e6, g_b = " +
+              FormatFixed(s.blank->um_per_1000_per_k, 4) + " um per 1000 mm per K; " + b +
+              " = B, the lag " + FormatFixed(s.blank->tau_min, 3) + " min of " +
+              Text(s.blank->sensor) + " [degC], run every cycle") +
+         "; " + l + " = B latched at the cut start: the whirling plan (profile drift.blank_param) "
+         "copies " + b + " into it at the thread start and writes 20 back at the thread end; "
+         "without a plan the part program does: STOPRE, " + l + "=" + b +
+         " before the cut, " + l + "=20 after it (20: no blank term); this program sets it to 20\n";
+}
+
 // The largest $A_INA index the program reads.
 int LargestAnalogIndex(const drift::DriftModel& m, const drift::DriftModel* g,
-                       const DriftActionOptions& o) {
+                       const DriftActionOptions& o, const BlankTerm* blank) {
   int largest = 0;
   for (const std::string& name : Inputs(m)) largest = std::max(largest, Input(o, name).index);
   if (g)
     for (const std::string& name : Inputs(*g)) largest = std::max(largest, Input(o, name).index);
+  if (blank) largest = std::max(largest, Input(o, blank->sensor).index);
   return largest;
 }
 
@@ -472,10 +576,10 @@ std::string Prerequisites(const drift::DriftModel& m, const drift::DriftModel* g
   auto stated = [&](int v) {
     return c.Stated() ? " (profile: " + std::to_string(v) + ")" : std::string(" (not stated)");
   };
-  const int largest = LargestAnalogIndex(m, g, o);
+  const int largest = LargestAnalogIndex(m, g, o, s.blank);
   return "; requires MD10300 $MN_FASTIO_ANA_NUM_INPUTS >= " + std::to_string(largest) +
          (largest == 0 ? " (no analog input read)" : "") + stated(c.analog_inputs) +
-         ", MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(s.last + 1) +
+         ", MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(LastSlotUsed(o, s) + 1) +
          stated(c.ac_params) + ", MD28250 $MC_MM_NUM_SYNC_ELEMENTS room for " +
          std::to_string(actions) + " static actions" + stated(c.sync_elements) +
          "; no FCTDEF (MD28252) used\n";
@@ -488,8 +592,9 @@ void CheckSlotRange(const DriftActionOptions& o, const Slots& s) {
                      std::to_string(s.last) + "], the profile reserves " +
                      std::to_string(o.param_first) + ".." + std::to_string(o.param_last) +
                      " (drift.param_last): use fewer sensors or lags, or widen the range");
-  if (o.control.Stated() && s.last >= o.control.ac_params)
-    throw InputError("drift action needs $AC_PARAM up to index " + std::to_string(s.last) +
+  if (o.control.Stated() && LastSlotUsed(o, s) >= o.control.ac_params)
+    throw InputError("drift action needs $AC_PARAM up to index " +
+                     std::to_string(LastSlotUsed(o, s)) +
                      ", the control has " + std::to_string(o.control.ac_params) +
                      " (MD28254 $MC_MM_NUM_AC_PARAM)");
 }
@@ -512,7 +617,7 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
     nc += "; slope S_m = s * sigma * (g0 + sum g_f x_f) / 1e6 (sigma = " +
           std::to_string(o.slope_growth_direction) + ") about the fixed end " +
           FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
-          " mm (MCS); |S_m| <= " + FormatFixed(DriftSlopeBound(*g, o), kDecimalsSd43910) +
+          " mm (MCS); |S_m| <= " + FormatFixed(DriftSlopeBound(*g, o, s.blank), kDecimalsSd43910) +
           " over the training ranges: the plan's slopes plus this must stay within MD32760\n";
   const std::string saved = slope_mode
                                 ? Rp(r) + ".." + Rp(r + 4) + " (SD43900-43920 found, markers)"
@@ -522,8 +627,9 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
   nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
         std::to_string(o.param_first) + ".." + std::to_string(s.last) + "] (liveness $AC_PARAM[" +
-        std::to_string(s.alive) + "] = " + (SlopeMode(o, g) ? "2" : "1") + " while running), " +
-        saved + "\n";
+        std::to_string(s.alive) + "] = " + (s.blank ? "3" : SlopeMode(o, g) ? "2" : "1") +
+        " while running), " + saved + "\n";
+  nc += BlankNote(o, s);
   if (o.workpiece_k0_param >= 0)
     nc += "; adds the whirling plan's K0 from $AC_PARAM[" + std::to_string(o.workpiece_k0_param) +
           "]: this action is the only writer of SD43900 on axis " + o.axis + "\n";
@@ -542,11 +648,12 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
 }  // namespace
 
 std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOptions& o,
-                                 const std::string& model_source, const drift::DriftModel* g) {
+                                 const std::string& model_source, const drift::DriftModel* g,
+                                 const BlankTerm* blank) {
   o.Validate();
   CheckModel(m);
   if (g) CheckModel(*g);
-  const Slots s = MakeSlots(m, g, o.param_first);
+  const Slots s = MakeSlots(m, g, o.param_first, blank);
   CheckSlope(g, o, s);
   CheckSlotRange(o, s);
   const std::vector<std::string> bodies = ActionBodies(m, g, o, s);
@@ -620,10 +727,11 @@ std::string PlcRows(const std::string& output, const drift::DriftModel& m,
 }  // namespace
 
 std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptions& o,
-                              const drift::DriftModel* g) {
+                              const drift::DriftModel* g, const BlankTerm* blank) {
   o.Validate();
   if (g && !o.has_slope)
     throw InputError("drift PLC table: a slope model needs the profile's drift.slope object");
+  CheckBlank(g, o, MakeSlots(m, g, o.param_first, blank));
   std::string out;
   out +=
       "# whirl drift action as a PLC table: every cycle T = scale * AIN[ain_index] + offset; "
@@ -646,22 +754,36 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
            "K_m + S_m (P_w - fixed end))\n";
   else
     out += "# SD43900[" + o.axis + "] = K_m\n";
+  if (blank)
+    out += "# blank_latched (grey box): B <- B + a_per_cycle * (T - B) (B = T at start) every "
+           "cycle; at the cut start hold B for the whole cut; S_m += coefficient_per_unit * (B "
+           "held - reference_C); between cuts that term is 0\n";
   out +=
       "output,feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,"
       "coefficient_per_unit\n";
   out += PlcRows("k0_mm", m, o, DriftControlCoefficients(m, o), kDecimalsDriftCoefficient);
   if (g)
     out += PlcRows("slope", *g, o, DriftSlopeCoefficients(*g, o), kDecimalsDriftSlopeCoefficient);
+  if (blank) {
+    const AnalogInput& a = Input(o, blank->sensor);
+    out += "slope,blank_latched," + Cell(blank->sensor) + "," + std::to_string(a.index) + "," +
+           FormatFixed(a.scale, kDecimalsDriftCoefficient) + "," + FormatFixed(a.offset, 4) + "," +
+           FormatFixed(kBlankNeutralC, 4) + "," + FormatFixed(blank->tau_min, 3) + "," +
+           FormatFixed(LagFactor(o, blank->tau_min), kDecimalsLagFactor) + "," +
+           FormatFixed(DriftBlankCoefficient(*blank, o), kDecimalsDriftSlopeCoefficient) + "\n";
+  }
   return out;
 }
 
 std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& m,
                                                   const DriftActionOptions& o,
-                                                  const drift::DriftModel* g) {
+                                                  const drift::DriftModel* g,
+                                                  const BlankTerm* blank) {
   o.Validate();
   CheckModel(m);
   if (g) CheckModel(*g);
-  const Slots s = MakeSlots(m, g, o.param_first);
+  const Slots s = MakeSlots(m, g, o.param_first, blank);
+  CheckSlope(g, o, s);
   const auto actions = static_cast<double>(ActionBodies(m, g, o, s).size());
   const ControlLimits& c = o.control;
   const double unstated = std::numeric_limits<double>::quiet_NaN();
@@ -677,7 +799,7 @@ std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& m,
   if (g) {
     ControlRequirement velo =
         MakeRequirement("MD32760 $MA_COMP_ADD_VELO_FACTOR", o.axis, RequirementRule::kAtLeast,
-                        RequirementMerge::kSum, DriftSlopeBound(*g, o), kDecimalsSd43910,
+                        RequirementMerge::kSum, DriftSlopeBound(*g, o, blank), kDecimalsSd43910,
                         "the machine slope's bound over the training ranges" + program);
     out.push_back(velo);
   }
@@ -692,14 +814,15 @@ std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& m,
   out.push_back(sync);
   ControlRequirement ac =
       MakeRequirement("MD28254 $MC_MM_NUM_AC_PARAM", "", RequirementRule::kAtLeast,
-                      RequirementMerge::kMax, static_cast<double>(s.last + 1), 0,
-                      "$AC_PARAM up to index " + std::to_string(s.last) + program);
+                      RequirementMerge::kMax, static_cast<double>(LastSlotUsed(o, s) + 1), 0,
+                      "$AC_PARAM up to index " + std::to_string(LastSlotUsed(o, s)) + program);
   ac.stated = stated(c.ac_params);
   out.push_back(ac);
   ControlRequirement ain = MakeRequirement(
       "MD10300 $MN_FASTIO_ANA_NUM_INPUTS", "", RequirementRule::kAtLeast, RequirementMerge::kMax,
-      static_cast<double>(LargestAnalogIndex(m, g, o)), 0,
-      "analog inputs up to $A_INA[" + std::to_string(LargestAnalogIndex(m, g, o)) + "]" + program);
+      static_cast<double>(LargestAnalogIndex(m, g, o, blank)), 0,
+      "analog inputs up to $A_INA[" + std::to_string(LargestAnalogIndex(m, g, o, blank)) + "]" +
+          program);
   ain.stated = stated(c.analog_inputs);
   out.push_back(ain);
   const int r = o.save_r_first;

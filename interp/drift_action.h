@@ -25,15 +25,18 @@
 // +axis relative to the workpiece (what a dial gauge on the table reads along +axis).
 //
 // $AC_PARAM layout from param_first: the liveness slot (the last action writes the mode there
-// every cycle: 1 owns SD43900, 2 owns SD43900-43920; the plans clear it, dwell and read it back,
-// sinumerik.h), then one slot per model feature (input-major, as DriftModel::features), one
-// reference slot per sensor (reference "start") and an init flag, and for a model of more than 8
-// features a slot its sum is accumulated in, 8 terms per action (every program line must stay
-// within the control's 512 characters); with a slope model its slots follow likewise, then S_m.
+// every cycle: 1 owns SD43900, 2 owns SD43900-43920, 3 also reads the blank latch; the plans
+// clear it, dwell and read it back, sinumerik.h), then one slot per model feature (input-major,
+// as DriftModel::features), one reference slot per sensor (reference "start") and an init flag,
+// and for a model of more than 8 features a slot its sum is accumulated in, 8 terms per action
+// (every program line must stay within the control's 512 characters); with a slope model its
+// slots follow likewise, then S_m; with a blank term the init flag of B (B itself and its latch
+// are the profile's blank_param, + 1).
 // The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
 // Action order (IDs count up from sync_id_first; actions run in ID order every cycle):
 //   [start: capture T_ref once] -> rises u -> [elapsed updates] -> [once: L = u, x = 0, flag]
-//   -> [lag updates] -> [partial sums] -> SD43900.
+//   -> [lag updates] -> [partial sums] -> [slope model likewise, B's init and lag, S_m]
+//   -> SD43900 (-43920).
 //
 // One writer per setting datum. With a whirling plan on the same axis (whirl plan
 // --with-drift-action), the plan's actions write their K0 into $AC_PARAM[workpiece_k0_param]
@@ -59,6 +62,20 @@
 //   SD43920 = P_w,  SD43910 = S_w + S_m,  SD43900 = K0_w + K_m + S_m (P_w - P_b),
 // which equals the sum at every P; this action is then the only writer of all three.
 //
+// The grey box's blank term (drift/grey_box.h; BlankTerm below): the slope also carries
+// g_b (B(t_0) - 20), B the first-order lag (blank tau) of the blank sensor, LATCHED at the cut
+// start t_0. This action runs B every cycle into $AC_PARAM[blank_param] (profile
+// drift.blank_param), and S_m reads the latched value from $AC_PARAM[blank_param + 1]:
+//   S_m = s * sigma * (g0 + sum g_f x_f + g_b ($AC_PARAM[blank_param + 1] - 20)) / 1e6.
+// The workpiece plan (sinumerik.h PlanOptions::blank_param) copies [blank_param] into
+// [blank_param + 1] with its first segment at the thread start and writes 20 (no blank term)
+// back at the thread end, in its undo of an aborted run and in its reset program; this
+// program's preamble writes 20 there. Without a plan the part program latches it (the header
+// says how). The liveness mode is then 3 (owns SD43900-43920 and reads the latch): a plan that
+// does not latch refuses to start beside it (a blank term silently missing).
+// The grey box's inputs are absolute temperatures referred to 20 degC: GreyBoxActionModels gives
+// its offset and slope as two models with reference_C = 20, run with reference "model".
+//
 // The programs save what they find (R<n> SD43900, marker R<n+1>; with a slope R<n+2> SD43910,
 // R<n+3> SD43920, slope marker R<n+4>; n = save_r_first, R<n>..R<n+4> reserved) and the reset
 // program cancels the actions and restores them, so the control ends as it was found. A program
@@ -69,6 +86,7 @@
 #include <string>
 #include <vector>
 
+#include "drift/grey_box.h"
 #include "drift/model.h"
 #include "interp/control_requirements.h"
 #include "interp/sinumerik.h"
@@ -126,6 +144,10 @@ struct DriftActionOptions {
   /// >= 0: the plan's SD43910 in $AC_PARAM[n], its SD43920 in $AC_PARAM[n + 1] (this action owns
   /// SD43910/SD43920 too); needs workpiece_k0_param.
   int workpiece_slope_param = -1;
+  /// >= 0: the grey box's blank estimate B in $AC_PARAM[n] (this action writes it every cycle)
+  /// and its value latched at the cut start in $AC_PARAM[n + 1] (the plan writes it); outside
+  /// the action's own slots and the workpiece slots (profile drift.blank_param).
+  int blank_param = -1;
   bool has_slope = false;          ///< the profile's drift.slope object is present
   double slope_fixed_end_mm = 0;   ///< P_b: axis position (MCS) of the zero of the growth, mm
   int slope_growth_direction = 1;  ///< sigma: +1 distance from P_b grows towards +axis, or -1
@@ -149,20 +171,48 @@ struct DriftActionOptions {
   void Validate() const;
 };
 
+/// The neutral value of the latched blank slot [degC]: the blank term g_b (B - 20) is 0.
+inline constexpr double kBlankNeutralC = 20.0;
+
+/// The grey box's blank term of the slope (see the header comment): g_b (B_latched - 20) um per
+/// 1000 mm, B the first-order lag tau_min of `sensor` [degC]; min_c..max_c the range B took in
+/// training (the slope bound reads it).
+struct BlankTerm {
+  std::string sensor;
+  double tau_min = 60;
+  double um_per_1000_per_k = 0;
+  double min_c = 20, max_c = 20;
+};
+
+/// The grey box (drift/grey_box.h) as this action runs it: the offset (K0 um) and slope (um per
+/// 1000 mm, g0 its intercept) models with reference_C = 20 (drift/grey_box_io.h
+/// GreyBoxControlModels; run them with reference "model") and the blank term (none without a
+/// blank sensor). InputError for a model without an offset or a slope sensor.
+struct GreyBoxAction {
+  drift::DriftModel offset, slope;
+  bool has_blank = false;
+  BlankTerm blank;
+  const BlankTerm* Blank() const { return has_blank ? &blank : nullptr; }
+};
+GreyBoxAction GreyBoxActionModels(const drift::GreyBoxModel& model);
+
 /// How many $AC_PARAM slots the action uses for `model` (features, references, flag) and the
 /// optional slope model (its features, references, flag, and one slot for S_m).
-int DriftParamCount(const drift::DriftModel& model, const drift::DriftModel* slope = nullptr);
+int DriftParamCount(const drift::DriftModel& model, const drift::DriftModel* slope = nullptr,
+                    const BlankTerm* blank = nullptr);
 
 /// The NC program (subprogram, .SPF, ends in M17) that installs the static actions. `slope`
 /// (optional) is the machine's slope model (see the header comment). InputError for a network
 /// model, a dynamic model without a time unit of minutes, a missing analog input, an ID range or
 /// $AC_PARAM range (param_first..param_last, below MD28254) too small, a line longer than the
 /// control's 512 characters, a slope model without the profile's slope object, or a slope model
-/// with a plan that writes SD43910 itself (two writers). The header names the prerequisites:
-/// MD10300 for the analog inputs read, MD28254 for the slots, MD28250 for the actions.
+/// with a plan that writes SD43910 itself (two writers), a blank term without a slope model, the
+/// profile's blank_param or reference "model". The header names the prerequisites: MD10300 for
+/// the analog inputs read, MD28254 for the slots, MD28250 for the actions.
 std::string FormatDriftNcProgram(const drift::DriftModel& model, const DriftActionOptions& options,
                                  const std::string& model_source = "",
-                                 const drift::DriftModel* slope = nullptr);
+                                 const drift::DriftModel* slope = nullptr,
+                                 const BlankTerm* blank = nullptr);
 
 /// The program that cancels the drift action's IDs and restores the saved setting data (SD43900
 /// if R<n+1> = 1, SD43910/SD43920 if R<n+4> = 1).
@@ -171,10 +221,12 @@ std::string FormatDriftNcResetProgram(const DriftActionOptions& options);
 /// The same model(s) for a PLC: '#' comments with the formulas, then one row per feature:
 /// output,feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,coefficient_per_unit
 /// where output is "k0_mm" (the offset model; coefficient in mm per unit) or "slope" (the slope
-/// model: S_m, coefficient in mm/mm per unit), each beginning with a row "intercept". Fixed
-/// decimals.
+/// model: S_m, coefficient in mm/mm per unit), each beginning with a row "intercept", and with a
+/// blank term a last slope row "blank_latched" (its lag; the value at the cut start minus 20
+/// degC times the coefficient). Fixed decimals.
 std::string FormatDriftPlcCsv(const drift::DriftModel& model, const DriftActionOptions& options,
-                              const drift::DriftModel* slope = nullptr);
+                              const drift::DriftModel* slope = nullptr,
+                              const BlankTerm* blank = nullptr);
 
 /// The coefficients the control applies: c_0 = s * b0 / 1000 [mm], c_f = s * b_f / 1000
 /// [mm per unit], rounded to kDecimalsDriftCoefficient as printed.
@@ -189,7 +241,12 @@ Eigen::VectorXd DriftSlopeCoefficients(const drift::DriftModel& slope,
 /// The largest |S_m| the slope model gives over its training ranges (a box bound: |c_0| +
 /// sum |c_f| max(|min_f|, |max_f|)), mm/mm. The plan's slopes plus this must stay within MD32760
 /// (machine_report/machine_nc.h checks it for the combined programs).
-double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options);
+/// With a blank term, + |c_b| max(|min_c - 20|, |max_c - 20|).
+double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions& options,
+                       const BlankTerm* blank = nullptr);
+/// The blank term's coefficient the control applies: c_b = s * sigma * g_b / 1e6 (mm/mm per K),
+/// rounded to kDecimalsDriftSlopeCoefficient.
+double DriftBlankCoefficient(const BlankTerm& blank, const DriftActionOptions& options);
 
 /// What the control must provide for the drift program (control_requirements.h), the same
 /// thresholds its header states: MD10300 >= the largest $A_INA index read, MD28254 >= the last
@@ -199,7 +256,8 @@ double DriftSlopeBound(const drift::DriftModel& slope, const DriftActionOptions&
 /// InputError as FormatDriftNcProgram for a model it cannot write.
 std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& model,
                                                   const DriftActionOptions& options,
-                                                  const drift::DriftModel* slope = nullptr);
+                                                  const drift::DriftModel* slope = nullptr,
+                                                  const BlankTerm* blank = nullptr);
 
 inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)
 inline constexpr int kDecimalsDriftSlopeCoefficient = 14;  ///< mm/mm per K: 1e-14 per K

@@ -77,7 +77,8 @@ DriftActionOptions ReadDriftSection(const nlohmann::json& j, const std::string& 
   RejectUnknownKeys(j,
                     {"sync_id_first", "sync_id_last", "param_first", "param_last", "save_r_first",
                      "ipo_cycle_ms", "error_direction", "workpiece_k0_param",
-                     "workpiece_slope_param", "missing_alarm", "slope", "analog_inputs"},
+                     "workpiece_slope_param", "blank_param", "missing_alarm", "slope",
+                     "analog_inputs"},
                     w);
   DriftActionOptions d;
   d.sync_id_first = RequireInt(j, "sync_id_first", w);
@@ -93,6 +94,8 @@ DriftActionOptions ReadDriftSection(const nlohmann::json& j, const std::string& 
   if (j.contains("workpiece_slope_param"))
     d.workpiece_slope_param =
         static_cast<int>(RequireInteger(j, "workpiece_slope_param", 0, 9998, w));
+  if (j.contains("blank_param"))
+    d.blank_param = static_cast<int>(RequireInteger(j, "blank_param", 0, 9998, w));
   if (j.contains("missing_alarm")) d.missing_alarm = RequireInt(j, "missing_alarm", w);
   if (version >= 2 || j.contains("param_last")) {
     d.param_last = static_cast<int>(RequireInteger(j, "param_last", 0, 9999, w));
@@ -159,7 +162,9 @@ void CheckDriftAgainstPlan(const MachineProfile& m) {
        {std::pair{"drift.workpiece_k0_param", d.workpiece_k0_param},
         {"drift.workpiece_slope_param", d.workpiece_slope_param},
         {"drift.workpiece_slope_param + 1",
-         d.workpiece_slope_param < 0 ? -1 : d.workpiece_slope_param + 1}})
+         d.workpiece_slope_param < 0 ? -1 : d.workpiece_slope_param + 1},
+        {"drift.blank_param", d.blank_param},
+        {"drift.blank_param + 1", d.blank_param < 0 ? -1 : d.blank_param + 1}})
     if (slot >= 0 && Overlap(slot, slot, d.param_first, param_last))
       throw InputError(std::string(key) + " " + std::to_string(slot) +
                        " lies in the drift action's own $AC_PARAM slots drift.param_first.." +
@@ -215,6 +220,7 @@ void MachineProfile::ApplyCombinedTo(PlanOptions& o) const {
   ApplyTo(o);
   o.workpiece_k0_param = drift->workpiece_k0_param;
   o.workpiece_slope_param = drift->workpiece_slope_param;
+  o.blank_param = drift->blank_param;
 }
 
 DriftActionOptions MachineProfile::DriftOptions() const {

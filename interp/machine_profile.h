@@ -47,6 +47,9 @@
 //      "workpiece_k0_param": 99,  $AC_PARAM the whirling plan writes its K0 into when combined
 //      "workpiece_slope_param": 97, optional: the plan also hands its SD43910 (97) and SD43920
 //                                 (98) to the drift action, which then owns all three
+//      "blank_param": 95,         optional (needs workpiece_slope_param): the grey box's blank
+//                                 estimate B (95, the drift action writes it) and its value
+//                                 latched at the cut start (96, the plan writes it)
 //      "slope": {"fixed_end_position_mm": 5587.5, "growth_direction": -1},
 //                                 optional: the machine's slope model (drift nc --slope-model):
 //                                 MCS position of the zero of the growth (a feed screw's fixed

@@ -165,6 +165,14 @@ void PlanOptions::Validate() const {
                      std::to_string(workpiece_slope_param) +
                      " needs workpiece_k0_param >= 0 outside its two slots (" +
                      std::to_string(workpiece_k0_param) + ") and must be 0..9998");
+  if (blank_param >= 0 &&
+      !(workpiece_slope_param >= 0 && blank_param <= 9998 &&
+        (blank_param + 1 < workpiece_slope_param || blank_param > workpiece_slope_param + 1) &&
+        (blank_param + 1 < workpiece_k0_param || blank_param > workpiece_k0_param) &&
+        (blank_param + 1 < drift_alive_param || blank_param > drift_alive_param)))
+    throw InputError("blank latch: blank_param " + std::to_string(blank_param) +
+                     " needs workpiece_slope_param (the drift action owns the slope), must be "
+                     "0..9998 and its two slots must not hold a workpiece or liveness slot");
   if (!(save_r_first >= -1 && save_r_first <= 9996))
     throw InputError("save_r_first = " + std::to_string(save_r_first) +
                      ": must be within 0..9996 (R<n>..R<n+3> are used), or -1: not set");
@@ -271,6 +279,7 @@ void to_json(nlohmann::json& j, const PlanOptions& o) {
                      {"drift_alive_param", o.drift_alive_param},
                      {"drift_missing_alarm", o.drift_missing_alarm},
                      {"workpiece_slope_param", o.workpiece_slope_param},
+                     {"blank_param", o.blank_param},
                      {"start_alarm", o.start_alarm}};
 }
 
@@ -280,7 +289,7 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
       {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
        "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
        "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm", "workpiece_slope_param",
-       "drift_slope_marker_r", "drift_alive_param", "start_alarm"},
+       "drift_slope_marker_r", "drift_alive_param", "start_alarm", "blank_param"},
       "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
@@ -300,6 +309,7 @@ void from_json(const nlohmann::json& j, PlanOptions& o) {
   // drift_marker_r is read over: the check now looks at the running action, not an R marker).
   o.workpiece_slope_param = j.value("workpiece_slope_param", -1);
   o.drift_alive_param = j.value("drift_alive_param", -1);
+  o.blank_param = j.value("blank_param", -1);  // absent before the blank latch
   // Absent in plans written before the start check: its documented default.
   o.start_alarm = j.value("start_alarm", kDefaultStartAlarm);
   o.Validate();
@@ -506,6 +516,15 @@ bool Combined(const PlanOptions& o) { return o.workpiece_k0_param >= 0; }
 // The drift action owns SD43910/SD43920 too; the plan hands its slope and reference over.
 bool SlopeHandedOver(const PlanOptions& o) { return o.workpiece_slope_param >= 0; }
 std::string Param(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
+bool Latches(const PlanOptions& o) { return o.blank_param >= 0; }
+// The latch of the blank estimate at the thread start, and its neutral value (no blank term)
+// written back at the thread end; " <write>" appended to an action's writes, or "".
+std::string LatchWrite(const PlanOptions& o) {
+  return Latches(o) ? " " + Param(o.blank_param + 1) + "=" + Param(o.blank_param) : "";
+}
+std::string UnlatchWrite(const PlanOptions& o) {
+  return Latches(o) ? " " + Param(o.blank_param + 1) + "=" + FormatFixed(20.0, 4) : "";
+}
 
 // Where K0 goes: SD43900 itself, or (combined with the drift action) the $AC_PARAM the drift
 // action adds. prefix "$$" in a synchronized action (main run), "$" in the part program.
@@ -581,7 +600,8 @@ std::string UndoEarlierRun(const PlanOptions& o) {
   // Handed over: slope and K0 slots to 0 (slope first); the reference slot may stay, since with
   // both at 0 the plan adds nothing wherever its reference lies.
   if (SlopeHandedOver(o))
-    return SlopeTarget(o, "$") + "=0\n" + K0Target(o, "$") + "=0\n";
+    return SlopeTarget(o, "$") + "=0\n" + K0Target(o, "$") + "=0\n" +
+           (Latches(o) ? UnlatchWrite(o).substr(1) + "\n" : std::string());
   const int m = o.save_r_first;
   std::string writes = RestoreWrites(o);
   std::string slots;
@@ -600,7 +620,9 @@ std::string RequireDriftAction(const PlanOptions& o) {
   std::string out = alive + "=0\nG4 F0.1\nSTOPRE\n";  // a running action writes it again
   if (!Combined(o)) return out + CheckOrAlarm(alive + "==0", a + 1, "WHIRL_NO_DRIFT_ACTION");
   const std::string mode = SlopeHandedOver(o) ? "2" : "1";
-  return out + CheckOrAlarm(alive + "<>0", a, "WHIRL_DRIFT_ACTION_RUNS") +
+  // A plan that latches the blank also runs beside an action without a blank term (mode 2).
+  const std::string also = Latches(o) ? "IF " + alive + "==3 GOTOF WHIRL_DRIFT_MODE_OK\n" : "";
+  return out + CheckOrAlarm(alive + "<>0", a, "WHIRL_DRIFT_ACTION_RUNS") + also +
          CheckOrAlarm(alive + "==" + mode, a + 2, "WHIRL_DRIFT_MODE_OK");
 }
 
@@ -618,6 +640,7 @@ std::string RequireAxisBeforeStart(const CompensationPlan& plan) {
 std::string AcParamPrerequisite(const PlanOptions& o) {
   int last = std::max(o.drift_alive_param, o.workpiece_k0_param);
   if (SlopeHandedOver(o)) last = std::max(last, o.workpiece_slope_param + 1);
+  if (Latches(o)) last = std::max(last, o.blank_param + 1);
   if (last < 0) return "";
   return "; requires MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(last + 1) +
          " ($AC_PARAM up to index " + std::to_string(last) + ")\n";
@@ -714,6 +737,12 @@ std::string Header(const CompensationPlan& plan, const NcProgramInfo& info) {
     nc << "; slope handed over too: SD43910 goes to $AC_PARAM[" << o.workpiece_slope_param
        << "] and SD43920 to $AC_PARAM[" << o.workpiece_slope_param + 1
        << "]; the drift action adds the machine's slope and is the only writer of SD43900-43920\n";
+  if (Latches(o))
+    nc << "; blank latch: at the thread start the first segment copies the drift action's blank "
+          "estimate $AC_PARAM["
+       << o.blank_param << "] into $AC_PARAM[" << o.blank_param + 1
+       << "], which the drift action's slope reads for the whole cut; the thread end writes 20 "
+          "back (no blank term); accepts the drift action in mode 2 or 3\n";
   return nc.str();
 }
 
@@ -772,12 +801,13 @@ std::string FormatNcProgram(const CompensationPlan& plan, const NcProgramInfo& i
   for (std::size_t i = 0; i < plan.segments.size(); ++i, ++id) {
     const CompensationSegment& s = plan.segments[i];
     nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(s.sd43920_mm) +
-          " DO " + SdWrites(o, "$$", k0(s.sd43900_mm), slope(s.sd43910), pos(s.sd43920_mm)) + "\n";
+          " DO " + SdWrites(o, "$$", k0(s.sd43900_mm), slope(s.sd43910), pos(s.sd43920_mm)) +
+          (i == 0 ? LatchWrite(o) : std::string()) + "\n";
   }
   const int m = o.save_r_first;
   nc += "ID=" + std::to_string(id) + " WHEN $AA_IM[" + ax + "]" + cmp + pos(ThreadEndMm(plan)) +
         " DO " + SdWrites(o, "$$", RestoredK0(o, "$"), RestoredSlope(o, "$"), RestoredRef(o, "$")) +
-        (SlopeHandedOver(o) ? std::string() : " $" + R(m + 3) + "=0") + "\n";
+        (SlopeHandedOver(o) ? std::string() : " $" + R(m + 3) + "=0") + UnlatchWrite(o) + "\n";
   nc += std::string(kProgramEndLabel) + ":\nM17\n";
   return nc;
 }
@@ -797,8 +827,12 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
   if (SlopeHandedOver(o)) {  // only the plan's own $AC_PARAM slots: cleared unconditionally
     nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
           std::to_string(o.sync_id_last) + ", then sets the plan's K0, slope and reference in " +
-          "$AC_PARAM to 0 (the drift action owns SD43900-43920)\n";
-    return nc + CancelIds(o) + "STOPRE\n" + writes + "STOPRE\nM17\n";
+          "$AC_PARAM to 0 (the drift action owns SD43900-43920)" +
+          (Latches(o) ? " and the blank latch " + Param(o.blank_param + 1) + " to 20 (no blank term)"
+                      : std::string()) +
+          "\n";
+    return nc + CancelIds(o) + "STOPRE\n" + writes +
+           (Latches(o) ? UnlatchWrite(o).substr(1) + "\n" : std::string()) + "STOPRE\nM17\n";
   }
   nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + ", then, if " + R(m + 3) +
@@ -840,6 +874,7 @@ std::vector<ControlRequirement> PlanRequirements(const CompensationPlan& plan,
   }
   int last = std::max(o.drift_alive_param, o.workpiece_k0_param);
   if (SlopeHandedOver(o)) last = std::max(last, o.workpiece_slope_param + 1);
+  if (Latches(o)) last = std::max(last, o.blank_param + 1);
   if (last >= 0) {
     ControlRequirement ac =
         MakeRequirement("MD28254 $MC_MM_NUM_AC_PARAM", "", RequirementRule::kAtLeast,

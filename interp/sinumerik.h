@@ -174,6 +174,13 @@ struct PlanOptions {
   /// $AC_PARAM[workpiece_slope_param + 1], saves nothing, uses no R marker and resets its slots
   /// to 0 at the thread end.
   int workpiece_slope_param = -1;
+  /// -1: no blank latch. >= 0 (only with workpiece_slope_param): the drift action runs the grey
+  /// box's blank estimate B in $AC_PARAM[blank_param] (drift_action.h); the plan's first segment
+  /// copies it into $AC_PARAM[blank_param + 1] at the thread start (the latch the drift action's
+  /// slope reads for the whole cut) and the thread end, the undo of an aborted run and the reset
+  /// program write 20 there (no blank term). The plan then accepts the drift action in mode 2 or
+  /// 3; without it, mode 3 (an action that reads a latch) is refused.
+  int blank_param = -1;
   /// The drift action's liveness slot (the profile's drift.param_first; -1: the machine has no
   /// drift action): the running action writes its mode there every interpolation cycle (1 owns
   /// SD43900, 2 owns SD43900-43920). The plan clears the slot, dwells 0.1 s and reads it back, so

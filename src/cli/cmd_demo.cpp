@@ -39,8 +39,9 @@ struct DemoOptions {
 
 // 7. The workpiece plan and the machine models a shop can train, on one machine of the field
 // world's production scenario (cmd_machine.cpp: whirl machine evaluate); the report of its first
-// test-day screw with the combined 840D programs of the network's plan and both_shop's sensor
-// model. Returns the summary of step 7 for --json.
+// test-day screw with the combined 840D programs of the network's plan and the machine model the
+// evaluation picks among the shop-trainable ones (the grey box of both_grey or both_shop's sensor
+// model; machine_report.h). Returns the summary of step 7 for --json.
 nlohmann::json RunDemoMachineStep(const std::filesystem::path& out,
                                   const workpiece::WorkpieceModel& model, std::uint64_t seed,
                                   std::FILE* say) {
@@ -71,11 +72,15 @@ nlohmann::json RunDemoMachineStep(const std::filesystem::path& out,
   if (!r.programs_note.empty()) Warn(r.programs_note);
   std::fprintf(say,
                "   report: %s\n   combined 840D programs of what a shop can train (the network's "
-               "plan and both_shop's\n   sensor model; the drift action owns SD43900-43920, the "
-               "plan hands its K0, slope and\n   reference over): %s/WHIRL_DRIFT_COMP.SPF, "
-               "WHIRL_TEMP_COMP.SPF, resets\n",
-               r.index_html.c_str(), dir.c_str());
+               "plan and %s;\n   the drift action owns SD43900-43920, the plan hands its K0, "
+               "slope and\n   reference over): %s/WHIRL_DRIFT_COMP.SPF, WHIRL_TEMP_COMP.SPF, "
+               "resets\n   machine model: %s\n",
+               r.index_html.c_str(),
+               r.programs_grey ? "the grey box of both_grey" : "both_shop's sensor model",
+               dir.c_str(), r.programs_reason.c_str());
   j["report"] = r.index_html;
+  j["programs_model"] = r.programs_grey ? "both_grey" : "both_shop";
+  j["programs_reason"] = r.programs_reason;
   j["dir"] = dir;
   return j;
 }

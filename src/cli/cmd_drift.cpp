@@ -634,6 +634,7 @@ void RegisterReport(CLI::App* drift_app) {
 }  // namespace
 
 void RegisterDriftMonitor(CLI::App* drift_app);  // cmd_drift_monitor.cpp
+void RegisterDriftFitGrey(CLI::App* drift_app);  // cmd_drift_fit_grey.cpp
 void RegisterDrift(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "drift",
@@ -644,6 +645,7 @@ void RegisterDrift(CLI::App& app) {
   sub->require_subcommand(1);
   RegisterSelect(sub);
   RegisterFitModel(sub);
+  RegisterDriftFitGrey(sub);
   RegisterPredictDrift(sub);
   RegisterCrossval(sub);
   RegisterHoldout(sub);

@@ -13,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_dir.h"
+#include "drift/grey_box_io.h"
 #include "drift/model.h"
 #include "interp/drift_action.h"
 #include "interp/machine_profile.h"
@@ -21,7 +22,7 @@ namespace whirl::cli {
 namespace {
 
 struct DriftNcOptions {
-  std::string model_path, slope_model_path, machine_path, reference = "model";
+  std::string model_path, slope_model_path, grey_model_path, machine_path, reference = "model";
   std::vector<std::string> inputs;  // NAME=INDEX:SCALE:OFFSET
   std::string nc_path, reset_path, csv_path;
   bool json = false;
@@ -61,22 +62,60 @@ void CheckKnownInput(const std::string& text, const std::string& name,
                    "' (its inputs: " + known + ")");
 }
 
+// The models the action runs: a drift model (and slope model) or a grey box (its offset, slope
+// and blank term, drift/grey_box_io.h).
+struct DriftNcModels {
+  drift::DriftModel model;
+  std::optional<drift::DriftModel> slope;
+  std::optional<interp::GreyBoxAction> grey;
+  const drift::DriftModel* Slope() const { return slope ? &*slope : nullptr; }
+  const interp::BlankTerm* Blank() const { return grey ? grey->Blank() : nullptr; }
+};
+
+DriftNcModels ReadDriftNcModels(const DriftNcOptions& o) {
+  if (o.model_path.empty() == o.grey_model_path.empty())
+    throw InputError("give either --model (a drift model, with --slope-model optional) or "
+                     "--grey-model (a grey box: offset, slope and the latched blank)");
+  DriftNcModels m;
+  if (!o.grey_model_path.empty()) {
+    if (!o.slope_model_path.empty())
+      throw InputError("--slope-model with --grey-model: the grey box carries its own slope");
+    if (o.reference != "model")
+      throw InputError("--reference " + o.reference +
+                       " with --grey-model: the grey box reads absolute temperatures referred to "
+                       "20 degC (reference model)");
+    try {
+      m.grey = interp::GreyBoxActionModels(drift::ReadGreyBoxModel(o.grey_model_path));
+    } catch (const InputError& e) {
+      throw InputError("--grey-model '" + o.grey_model_path + "': " + e.what());
+    }
+    m.model = m.grey->offset;
+    m.slope = m.grey->slope;
+    return m;
+  }
+  m.model = drift::ReadDriftModel(o.model_path);
+  if (!o.slope_model_path.empty()) m.slope = drift::ReadDriftModel(o.slope_model_path);
+  return m;
+}
+
 void Run(const DriftNcOptions& o) {
   CheckOutputs({{"--model", o.model_path},
                 {"--slope-model", o.slope_model_path},
+                {"--grey-model", o.grey_model_path},
                 {"--machine", o.machine_path}},
                {{"--nc", o.nc_path}, {"--reset-nc", o.reset_path}, {"--csv", o.csv_path}});
-  const drift::DriftModel model = drift::ReadDriftModel(o.model_path);
-  std::optional<drift::DriftModel> slope;
-  if (!o.slope_model_path.empty()) slope = drift::ReadDriftModel(o.slope_model_path);
-  const drift::DriftModel* g = slope ? &*slope : nullptr;
+  const DriftNcModels models = ReadDriftNcModels(o);
+  const drift::DriftModel& model = models.model;
+  const drift::DriftModel* g = models.Slope();
+  const interp::BlankTerm* blank = models.Blank();
+  const std::string source = o.grey_model_path.empty() ? o.model_path : o.grey_model_path;
   const interp::MachineProfile machine = interp::LoadMachineProfile(o.machine_path);
   WarnIllustrativeProfile(machine);
   interp::DriftActionOptions options = machine.DriftOptions();
   options.reference = interp::ParseDriftReference(o.reference);
   for (const std::string& text : o.inputs) {
     const auto [name, a] = ParseInput(text);
-    CheckKnownInput(text, name, model, g);
+    if (!(blank && name == blank->sensor)) CheckKnownInput(text, name, model, g);
     options.inputs[name] = a;
     try {  // the profile's bounds and the control's analog input count (MD10300)
       options.Validate();
@@ -89,9 +128,9 @@ void Run(const DriftNcOptions& o) {
   if (!o.reset_path.empty())
     options.reset_program_name = interp::ProgramNameOf(o.reset_path, "--reset-nc");
   // Render everything first (a model the control cannot run fails here), then write all or none.
-  const std::string nc = interp::FormatDriftNcProgram(model, options, o.model_path, g);
+  const std::string nc = interp::FormatDriftNcProgram(model, options, source, g, blank);
   const std::string reset = interp::FormatDriftNcResetProgram(options);
-  const std::string csv = interp::FormatDriftPlcCsv(model, options, g);
+  const std::string csv = interp::FormatDriftPlcCsv(model, options, g, blank);
   std::vector<std::pair<std::filesystem::path, std::string>> files;
   if (!o.nc_path.empty()) files.emplace_back(o.nc_path, nc);
   if (!o.reset_path.empty()) files.emplace_back(o.reset_path, reset);
@@ -107,7 +146,16 @@ void Run(const DriftNcOptions& o) {
                     {"growth_direction", options.slope_growth_direction},
                     {"coefficients", std::vector<double>(cg.data(), cg.data() + cg.size())}};
     }
-    PrintJson({{"model", o.model_path},
+    nlohmann::json blank_json = nullptr;
+    if (blank)
+      blank_json = {{"sensor", blank->sensor},
+                    {"tau_min", blank->tau_min},
+                    {"coefficient_mm_per_mm_per_k", interp::DriftBlankCoefficient(*blank, options)},
+                    {"estimate_param", options.blank_param},
+                    {"latched_param", options.blank_param + 1}};
+    PrintJson({{"model", source},
+               {"grey_box", !o.grey_model_path.empty()},
+               {"blank", blank_json},
                {"axis", options.axis},
                {"coefficients_mm", std::vector<double>(c.data(), c.data() + c.size())},
                {"slope", slope_json},
@@ -134,6 +182,12 @@ void Run(const DriftNcOptions& o) {
                                    {o.reset_path, "NC reset program"},
                                    {o.csv_path, "PLC table"}})
     if (!path.empty()) std::printf("written: %s (%s)\n", path.c_str(), what);
+  if (blank)
+    std::printf("  blank term: lag %.1f min of %s in $AC_PARAM[%d], latched at the cut start in "
+                "$AC_PARAM[%d] (the whirling plan, or your part program: see the program's "
+                "header)\n",
+                blank->tau_min, blank->sensor.c_str(), options.blank_param,
+                options.blank_param + 1);
 }
 
 }  // namespace
@@ -160,10 +214,20 @@ void RegisterDriftNc(CLI::App* drift_app) {
       "time1, time2, sensors+time): the actions count the time since the program's start\n"
       "themselves, x = 1 - exp(-t / tau) by x <- x + a (1 - x) every cycle, so run the program\n"
       "when the machine starts. The reset program (--reset-nc) cancels the actions and\n"
-      "restores the setting data found. Files are .SPF subprograms (M17). Not verified on a\n"
-      "control: main-run write access to SD43900-43920.");
-  sub->add_option("--model", o->model_path, "drift model JSON (whirl drift fit)")
-      ->required()
+      "restores the setting data found. Files are .SPF subprograms (M17). With --grey-model\n"
+      "(whirl drift fit-grey) the action runs the grey box: K0 and the slope from absolute\n"
+      "temperatures (T - 20 degC) and their lags, the slope intercept, and the blank term\n"
+      "g_b (B - 20): B, a lag of the blank sensor, runs in $AC_PARAM[drift.blank_param] and\n"
+      "the whirling plan latches it into [blank_param + 1] at the thread start (back to 20\n"
+      "at the thread end). Not verified on a control: main-run write access to SD43900-43920.");
+  sub->add_option("--model", o->model_path,
+                  "drift model JSON (whirl drift fit); or --grey-model")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--grey-model", o->grey_model_path,
+                  "grey box model JSON (whirl drift fit-grey) instead of --model/--slope-model: "
+                  "K0 [um] from the offset sensors, the slope [um per 1000 mm] from the slope "
+                  "sensors, its intercept and the blank's estimate latched at the cut start "
+                  "(profile drift.slope and drift.blank_param; reference model: T - 20 degC)")
       ->check(CLI::ExistingFile);
   sub->add_option("--slope-model", o->slope_model_path,
                   "drift model JSON of the machine's slope, um per 1000 mm of distance from the "

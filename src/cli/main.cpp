@@ -33,6 +33,7 @@ const whirl::cli::CommandSummaries kSummaries = {
     {"drift", "machine thermal drift from temperature sensors"},
     {"drift select", "temperature-sensitive points: the sensors that explain an error"},
     {"drift fit", "fit a drift model of one error channel [um] and write it"},
+    {"drift fit-grey", "fit the grey-box machine estimator from a shop's measurement records"},
     {"drift predict", "evaluate a drift model on a run sample by sample"},
     {"drift crossval", "cross-run evaluation of the drift models"},
     {"drift holdout", "chronological hold-out on one long log"},

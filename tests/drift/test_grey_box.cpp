@@ -5,10 +5,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <functional>
 
 #include "core/error.h"
 #include "core/random.h"
+#include "core/atomic_file.h"
+#include "core/json_file.h"
 #include "drift/grey_box.h"
+#include "drift/grey_box_io.h"
+#include "drift/measurement_file.h"
+#include "support/expect_error.h"
+#include "support/scratch_dir.h"
 
 namespace whirl::drift {
 namespace grey_box_test {
@@ -229,6 +237,142 @@ TEST(GreyBox, BadOptionsAndMissingColumnsAreNamed) {
   s.offset_sensors.clear();
   s.slope_sensors.clear();
   EXPECT_THROW(FitGreyBox(rec, s, Fixed(t, 1e-2)), InputError);
+}
+
+// The files (drift/grey_box_io.h, drift/measurement_file.h): sensors named as run files name
+// them (<name>_C).
+ShopRecord Renamed(ShopRecord rec) {
+  for (Run& log : rec.day_logs)
+    for (std::string& n : log.sensor_names) n += "_C";
+  return rec;
+}
+
+GreyBoxSpec RenamedSpec(const GreyBoxModel& t) {
+  GreyBoxSpec s = SpecOf(t);
+  for (auto* list : {&s.offset_sensors, &s.slope_sensors})
+    for (std::string& n : *list) n += "_C";
+  s.blank_sensor += "_C";
+  return s;
+}
+
+void ExpectSameModel(const GreyBoxModel& a, const GreyBoxModel& b, double tol) {
+  EXPECT_EQ(a.offset_sensors, b.offset_sensors);
+  EXPECT_EQ(a.slope_sensors, b.slope_sensors);
+  EXPECT_EQ(a.blank_sensor, b.blank_sensor);
+  EXPECT_EQ(a.time_constants, b.time_constants);
+  EXPECT_EQ(a.z_ref_mm, b.z_ref_mm);
+  ASSERT_EQ(a.a.size(), b.a.size());
+  ASSERT_EQ(a.g.size(), b.g.size());
+  EXPECT_LE((a.a - b.a).cwiseAbs().maxCoeff(), tol);
+  EXPECT_LE((a.g - b.g).cwiseAbs().maxCoeff(), tol);
+  EXPECT_LE((a.offset_min - b.offset_min).cwiseAbs().maxCoeff(), tol);
+  EXPECT_LE((a.slope_max - b.slope_max).cwiseAbs().maxCoeff(), tol);
+  EXPECT_NEAR(a.slope_intercept_um_per_1000, b.slope_intercept_um_per_1000, tol);
+  EXPECT_NEAR(a.blank_um_per_1000_per_k, b.blank_um_per_1000_per_k, tol);
+  EXPECT_EQ(a.blank_tau_min, b.blank_tau_min);
+  EXPECT_NEAR(a.blank_min_c, b.blank_min_c, tol);
+  EXPECT_NEAR(a.blank_max_c, b.blank_max_c, tol);
+  EXPECT_NEAR(a.cv_rmse_um, b.cv_rmse_um, tol);
+  EXPECT_EQ(a.rows, b.rows);
+}
+
+TEST(GreyBoxFiles, TheModelFileRoundTripsExactlyAndPredictsTheSame) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, true);
+  GreyBoxModel m = FitGreyBox(rec, SpecOf(t), Fixed(t, 1e-2));
+  m.notes = {"fitted by a test"};
+  const auto path = test::ScratchDir() / "grey.json";
+  WriteGreyBoxModel(path, m);
+  const GreyBoxModel back = ReadGreyBoxModel(path);
+  ExpectSameModel(m, back, 0.0);
+  EXPECT_EQ(back.notes, m.notes);
+  for (const MeasurementRecord& r : rec.records)
+    EXPECT_EQ(PredictGreyRecord(back, rec, r), PredictGreyRecord(m, rec, r));
+  // The ranges are those of the evaluator on the logs: B stays within them.
+  EXPECT_LT(m.blank_min_c, m.blank_max_c);
+  EXPECT_GE((m.offset_max - m.offset_min).minCoeff(), 0.0);
+}
+
+TEST(GreyBoxFiles, FittedFromTheRecordsFileItIsTheModelOfTheRecordsInMemory) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Renamed(Planted(t, true, 3));
+  const auto dir = test::ScratchDir() / "records";
+  std::filesystem::create_directories(dir / "logs");
+  std::vector<std::string> paths;
+  for (std::size_t i = 0; i < rec.day_logs.size(); ++i) {
+    paths.push_back("logs/day" + std::to_string(i) + ".csv");
+    WriteFileAtomic(dir / paths.back(), FormatRun(rec.day_logs[i], {"planted day log"}));
+  }
+  WriteFileAtomic(dir / "records.json", FormatMeasurementRecords(rec, paths, "planted"));
+  const MeasurementFile f = ReadMeasurementRecords(dir / "records.json");
+  ASSERT_EQ(f.record.records.size(), rec.records.size());
+  for (std::size_t i = 0; i < rec.records.size(); ++i)
+    for (std::size_t k = 0; k < rec.records[i].rows.size(); ++k)
+      EXPECT_EQ(f.record.records[i].rows[k].sample, rec.records[i].rows[k].sample);
+  const GreyBoxOptions o = Fixed(t, 1e-2);
+  ExpectSameModel(FitGreyBox(f.record, RenamedSpec(t), o), FitGreyBox(rec, RenamedSpec(t), o),
+                  1e-6);
+}
+
+// A file with one field changed from a valid one: the error names the field and the rule.
+void ExpectBadModel(const std::function<void(nlohmann::json&)>& change, const std::string& what) {
+  GreyBoxModel m = FitGreyBox(Planted(Truth(), true, 2), SpecOf(Truth()), Fixed(Truth(), 1e-2));
+  nlohmann::json j = m;
+  change(j);
+  const auto path = test::ScratchDir() / "bad_grey.json";
+  WriteFileAtomic(path, j.dump());
+  ExpectInputError([&] { (void)ReadGreyBoxModel(path); }, what);
+}
+
+TEST(GreyBoxFiles, BadModelSpecAndRecordsFilesNameFileFieldAndRule) {
+  ExpectBadModel([](nlohmann::json& j) { j["offset_features"][0]["coefficient"] = 1e9; },
+                 "offset_features[0].coefficient = 1e+09 breaks the rule");
+  ExpectBadModel([](nlohmann::json& j) { j["slope_features"].erase(0); }, "'slope_features' has");
+  ExpectBadModel([](nlohmann::json& j) { j["blank"] = nullptr; }, "'blank' must be null exactly");
+  ExpectBadModel([](nlohmann::json& j) { j["time_constants_min"] = {-5}; }, "time_constants_min");
+  ExpectBadModel([](nlohmann::json& j) { j["z_ref_mm"] = 1e9; }, "z_ref_mm");
+  ExpectBadModel([](nlohmann::json& j) { j["format"] = "whirl-drift-model"; }, "not a grey box");
+  ExpectBadModel([](nlohmann::json& j) { j["blank"]["train_max_c"] = -900; }, "train_max_c");
+  ExpectBadModel([](nlohmann::json& j) { j["extra"] = 1; }, "extra");
+  // The path is named.
+  ExpectBadModel([](nlohmann::json& j) { j["fit"]["cv_rmse_um"] = -1; }, "bad_grey.json");
+  // Spec: a prior for a sensor not in its list would be ignored silently.
+  const auto spec = test::ScratchDir() / "spec.json";
+  const std::string good = R"({"format": "whirl-grey-box-spec", "schema_version": 1,
+    "offset_sensors": ["a_C"], "slope_sensors": ["b_C"], "blank_sensor": "c_C", "z_ref_mm": 6400,
+    "offset_prior_um_per_k": {"a_C": 1.5}, "blank_prior_um_per_1000_per_k": -11.8})";
+  WriteFileAtomic(spec, good);
+  EXPECT_EQ(ReadGreyBoxSpec(spec).offset_prior.at("a_C"), 1.5);
+  std::string bad = good;
+  bad.replace(bad.find("{\"a_C\": 1.5}"), 12, "{\"b_C\": 1.5}");
+  WriteFileAtomic(spec, bad);
+  ExpectInputError([&] { (void)ReadGreyBoxSpec(spec); }, "'offset_prior_um_per_k' names 'b_C'");
+  bad = good;
+  bad.replace(bad.find("[\"b_C\"]"), 7, "[\"a_C\", \"a_C\"]");
+  WriteFileAtomic(spec, bad);
+  ExpectInputError([&] { (void)ReadGreyBoxSpec(spec); }, "names 'a_C' twice");
+  // Records: a reading outside its log, a sigma of 0, arrays of different lengths, a log index
+  // out of range; each names the record and the field.
+  const ShopRecord rec = Renamed(Planted(Truth(), false, 1));
+  const auto dir = test::ScratchDir() / "bad_records";
+  std::filesystem::create_directories(dir);
+  WriteFileAtomic(dir / "day0.csv", FormatRun(rec.day_logs[0]));
+  const nlohmann::json valid = nlohmann::json::parse(FormatMeasurementRecords(rec, {"day0.csv"}, ""));
+  auto expect_bad = [&](const std::function<void(nlohmann::json&)>& change,
+                        const std::string& what) {
+    nlohmann::json j = valid;
+    change(j);
+    WriteFileAtomic(dir / "records.json", j.dump());
+    ExpectInputError([&] { (void)ReadMeasurementRecords(dir / "records.json"); }, what);
+  };
+  expect_bad([](nlohmann::json& j) { j["records"][1]["time_min"][2] = 999.0; },
+             "'records'[1] reading 2: time_min 999 lies outside its day log");
+  expect_bad([](nlohmann::json& j) { j["records"][0]["sigma_um"][0] = 0.0; },
+             "'records'[0] reading 0: sigma_um = 0 breaks the rule");
+  expect_bad([](nlohmann::json& j) { j["records"][0]["z_mm"].erase(0); }, "one value per reading");
+  expect_bad([](nlohmann::json& j) { j["records"][0]["log"] = 3; }, "'records'[0]: 'log'");
+  expect_bad([](nlohmann::json& j) { j["records"][0]["kind"] = "gauge"; }, "kind");
+  expect_bad([](nlohmann::json& j) { j["day_logs"] = {"missing.csv"}; }, "missing.csv");
 }
 
 }  // namespace grey_box_test

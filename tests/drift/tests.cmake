@@ -18,6 +18,9 @@ whirl_add_cli_test(cli_drift_frictions ${CMAKE_CURRENT_LIST_DIR}/cli_frictions.s
 # The joint estimator from shop measurements (drift/joint.h).
 whirl_add_gtest(test_drift_joint SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_joint.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_grey_box.cpp)
+# The grey box fitted from measurement records and written for the 840D (drift fit-grey,
+# drift nc --grey-model).
+whirl_add_cli_test(cli_fit_grey ${CMAKE_CURRENT_LIST_DIR}/cli_fit_grey.sh)
 # The FL_THERMAL target's settings chosen before the test window (needs ../shared; exit 77: skipped):
 # 3 settings in the default run, the script's whole grid of 8 under the label slow.
 whirl_add_cli_test(cli_fl_thermal_moonshot ${CMAKE_CURRENT_LIST_DIR}/cli_fl_moonshot.sh quick)

@@ -5,6 +5,7 @@ whirl_add_gtest(test_interp
     ${CMAKE_CURRENT_LIST_DIR}/test_sinumerik.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_nc_replay.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_drift_action.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_grey_action.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_machine_profile.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_control_requirements.cpp
 )

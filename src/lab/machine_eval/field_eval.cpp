@@ -208,6 +208,7 @@ void CompleteReport(const drift::Run& log, const FieldMachineModels& models, Rep
   r->sensors = models.shop.sensors.sensors;
   r->sensors_choice = models.shop.sensors_choice;
   r->z_ref_mm = models.z_ref_mm;
+  r->grey = models.shop.grey;
 }
 
 // Every test-day screw of one machine world; `report` (optional) receives the first screw that
@@ -333,6 +334,12 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
                                            [&](std::size_t done, std::size_t) {
                                              if (progress) progress(s * per + done, seeds * per);
                                            }));
+  }
+  // The report screw's programs: the model the evaluation picks (summary.h ProgramsStrategy).
+  if (!e.runs.empty() && e.runs.front().report) {
+    ReportScrew& r = *e.runs.front().report;
+    r.programs_strategy =
+        ProgramsStrategy(SummarizeOverSeeds(e), !r.grey.Inputs().empty(), &r.programs_reason);
   }
   return e;
 }

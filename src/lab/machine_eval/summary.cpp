@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "compare/evaluate.h"
+#include "core/numbers.h"
 
 namespace whirl::machine_eval {
 
@@ -83,6 +84,29 @@ MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategy
     if (best == 0 || s[k].total_median_um < s[best].total_median_um) best = k;
   }
   return static_cast<MachineStrategy>(best);
+}
+
+MachineStrategy ProgramsStrategy(const std::array<SeedStats, kMachineStrategyCount>& s,
+                                 bool grey_fitted, std::string* reason) {
+  const SeedStats& shop = s[static_cast<std::size_t>(MachineStrategy::kBothShop)];
+  const SeedStats& grey = s[static_cast<std::size_t>(MachineStrategy::kBothGrey)];
+  const std::string medians = " (thread medians over " + std::to_string(shop.screws) +
+                              " test screws, simulated: both_grey " +
+                              FormatDecimals(grey.total_median_um, 1) + " um, both_shop " +
+                              FormatDecimals(shop.total_median_um, 1) +
+                              " um; chosen on the test screws themselves)";
+  if (!grey_fitted) {
+    *reason = "both_shop: the grey box was not fitted (its sensors are not in the logs)";
+    return MachineStrategy::kBothShop;
+  }
+  if (grey.screws > 0 && grey.total_median_um < shop.total_median_um) {
+    *reason = "both_grey: the grey box leaves less lead error than both_shop's sensor model" +
+              medians;
+    return MachineStrategy::kBothGrey;
+  }
+  *reason = "both_shop: the grey box does not leave less lead error than both_shop's sensor "
+            "model" + medians;
+  return MachineStrategy::kBothShop;
 }
 
 namespace {

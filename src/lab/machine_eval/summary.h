@@ -37,6 +37,13 @@ std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvalu
 /// The strongest sensor-free strategy by pooled thread median (see the header comment).
 MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s);
 
+/// The shop-trainable strategy whose machine model the report's combined 840D programs apply
+/// (ReportScrew::programs_strategy): both_grey when the grey box was fitted (`grey_fitted`) and
+/// its pooled thread median is below both_shop's, else both_shop; `reason` says which medians
+/// decided (chosen on the evaluation's test screws, as the strongest sensor-free rule is).
+MachineStrategy ProgramsStrategy(const std::array<SeedStats, kMachineStrategyCount>& s,
+                                 bool grey_fitted, std::string* reason);
+
 /// Sentences: the strongest sensor-free rule and the gain 1 - median(x) / median(best) over the
 /// thread of both_shop and both_shop_monitor, with the per-seed range of the gain; then the
 /// verdicts, each naming the "both" row it judges: whether both_shop beats the strongest

@@ -33,21 +33,33 @@ void CheckAgainstMachine(const interp::MachineProfile& p, const interp::DriftAct
               "(z_fixed) sits at " + FormatFixed(fixed_end_mm, 4) + " mm (MCS)");
 }
 
-}  // namespace
+// The machine's models as the drift action runs them.
+struct MachineModels {
+  const drift::DriftModel& offset;
+  const drift::DriftModel& slope;
+  const interp::BlankTerm* blank;
+  interp::DriftReference reference;
+};
 
-CombinedPrograms BuildCombinedPrograms(
-    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
-    const interp::PlanOptions& plan_options, const drift::DriftModel& offset,
-    const drift::DriftModel& slope, double z_fixed_mm, const interp::MachineProfile& profile,
-    const std::string& curve_source, const std::string& model_source) {
+CombinedPrograms Build(const fit::ArctanCurve& curve, const screw::Kinematics& kinematics,
+                       double thread_length_mm, const interp::PlanOptions& plan_options,
+                       const MachineModels& machine, double z_fixed_mm,
+                       const interp::MachineProfile& profile, const std::string& curve_source,
+                       const std::string& model_source) {
+  const drift::DriftModel& offset = machine.offset;
+  const interp::BlankTerm* blank = machine.blank;
   CombinedPrograms out;
   interp::PlanOptions po = plan_options;
   profile.ApplyCombinedTo(po);
+  if (!blank) po.blank_param = -1;  // nothing to latch: the plan leaves the slots alone
   // Program zero at the chuck face, the program coordinate -direction * z: the cut runs towards
   // the chuck (z falls) in the direction of travel.
   po.start_position_mm = -po.direction * kinematics.thread_start_position_mm;
   out.drift = profile.DriftOptions();
-  out.drift.reference = interp::DriftReference::kStart;
+  out.drift.reference = machine.reference;
+  Require(!blank || out.drift.blank_param >= 0, profile, "drift.blank_param",
+          "missing: the grey box's blank estimate and its latch at the cut start need two "
+          "$AC_PARAM slots");
   const double z0 = kinematics.thread_start_position_mm;
   CheckAgainstMachine(
       profile, out.drift,
@@ -57,8 +69,8 @@ CombinedPrograms BuildCombinedPrograms(
   info.curve_source = curve_source;
   out.plan_nc = interp::FormatNcProgram(out.plan, info);
   out.plan_reset_nc = interp::FormatNcResetProgram(po, info);
-  const drift::DriftModel& g = slope;
-  const double bound = interp::DriftSlopeBound(g, out.drift);
+  const drift::DriftModel& g = machine.slope;
+  const double bound = interp::DriftSlopeBound(g, out.drift, blank);
   if (out.plan.max_abs_slope + bound > po.md32760)
     throw InputError("combined programs: the plan's largest slope " +
                      FormatFixed(out.plan.max_abs_slope, interp::kDecimalsSd43910) +
@@ -66,13 +78,38 @@ CombinedPrograms BuildCombinedPrograms(
                      FormatFixed(bound, interp::kDecimalsSd43910) +
                      " exceed MD32760 = " + FormatFixed(po.md32760, 4) + " (profile '" +
                      profile.source + "'): SD43910 could be capped mid-cut");
-  out.drift_nc = interp::FormatDriftNcProgram(offset, out.drift, model_source, &g);
+  out.drift_nc = interp::FormatDriftNcProgram(offset, out.drift, model_source, &g, blank);
   out.drift_reset_nc = interp::FormatDriftNcResetProgram(out.drift);
-  out.drift_plc_csv = interp::FormatDriftPlcCsv(offset, out.drift, &g);
+  out.drift_plc_csv = interp::FormatDriftPlcCsv(offset, out.drift, &g, blank);
   out.requirements = plan::WithProfileValues(
-      interp::MergeRequirements(interp::DriftRequirements(offset, out.drift, &g),
+      interp::MergeRequirements(interp::DriftRequirements(offset, out.drift, &g, blank),
                                 interp::PlanRequirements(out.plan, info.program_name)),
       profile);
+  return out;
+}
+
+}  // namespace
+
+CombinedPrograms BuildCombinedPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::DriftModel& offset,
+    const drift::DriftModel& slope, double z_fixed_mm, const interp::MachineProfile& profile,
+    const std::string& curve_source, const std::string& model_source) {
+  return Build(curve, kinematics, thread_length_mm, plan_options,
+               {offset, slope, nullptr, interp::DriftReference::kStart}, z_fixed_mm, profile,
+               curve_source, model_source);
+}
+
+CombinedPrograms BuildCombinedGreyPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::GreyBoxModel& grey,
+    const interp::MachineProfile& profile, const std::string& curve_source,
+    const std::string& model_source) {
+  const interp::GreyBoxAction a = interp::GreyBoxActionModels(grey);
+  CombinedPrograms out = Build(curve, kinematics, thread_length_mm, plan_options,
+                               {a.offset, a.slope, a.Blank(), interp::DriftReference::kModel},
+                               grey.z_ref_mm, profile, curve_source, model_source);
+  out.grey = true;
   return out;
 }
 

@@ -8,7 +8,9 @@
 //   the drift action writes SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m +
 //   S_m (P_w - P_b), K_m from the offset model, S_m from the slope model (um per 1000 mm) about
 //   the screw's fixed bearing P_b.
-// The drift models are what a shop can train: the sensor model of the evaluation's both_shop
+// The drift models are what a shop can train: the grey box of both_grey where the evaluation
+// picks it (BuildCombinedGreyPrograms: absolute temperatures, reference "model", the blank
+// latched by the plan at the thread start), else the sensor model of the evaluation's both_shop
 // (machine_eval/shop_models.h, from probe, laser and lead measurements only), its inputs the
 // sensors and the control's duty signals the profile maps to analog inputs. Its rises and lags
 // count from the day's power-on (drift/joint.h), so the drift action starts at power-on and runs
@@ -27,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include "drift/grey_box.h"
 #include "drift/model.h"
 #include "fit/arctan_curve.h"
 #include "interp/control_requirements.h"
@@ -45,6 +48,7 @@ struct CombinedPrograms {
   /// What the control must provide for both programs together, each datum once
   /// (interp::MergeRequirements of the plan's and the drift action's), with the profile's values.
   std::vector<interp::ControlRequirement> requirements;
+  bool grey = false;  ///< the drift action runs the grey box (BuildCombinedGreyPrograms)
 };
 
 /// Builds both programs. `plan_options` gives the tolerance and check step (the profile sets
@@ -58,6 +62,17 @@ CombinedPrograms BuildCombinedPrograms(
     const interp::PlanOptions& plan_options, const drift::DriftModel& offset,
     const drift::DriftModel& slope, double z_fixed_mm, const interp::MachineProfile& profile,
     const std::string& curve_source, const std::string& model_source);
+
+/// The same with the grey box (drift/grey_box.h) as the machine's models: its offset and slope
+/// (absolute temperatures, reference "model") and the blank estimate the plan latches at the
+/// thread start (interp/drift_action.h BlankTerm; profile drift.blank_param), about its own
+/// z_ref (the fixed bearing). InputError as above, or when the profile has no drift.blank_param
+/// for a grey box with a blank sensor.
+CombinedPrograms BuildCombinedGreyPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::GreyBoxModel& grey,
+    const interp::MachineProfile& profile, const std::string& curve_source,
+    const std::string& model_source);
 
 /// The files of the programs in `dir` (created if needed): WHIRL_TEMP_COMP.SPF,
 /// WHIRL_TEMP_COMP_RESET.SPF, WHIRL_DRIFT_COMP.SPF, WHIRL_DRIFT_COMP_RESET.SPF,

@@ -142,15 +142,24 @@ report::Box ControlBox(const std::string& screw_name, const CombinedPrograms& p)
       std::to_string(d.workpiece_k0_param) + "], [" + std::to_string(d.workpiece_slope_param) +
       "], [" + std::to_string(d.workpiece_slope_param + 1) +
       "], which adds the machine's drift every interpolation cycle and is the only "
-      "writer of SD43900-43920.";
+      "writer of SD43900-43920." +
+      (d.blank_param >= 0 && p.grey
+           ? " At the thread start it also latches the grey box's blank estimate $AC_PARAM[" +
+                 std::to_string(d.blank_param) + "] into [" + std::to_string(d.blank_param + 1) +
+                 "] for the cut (20 again at the thread end)."
+           : std::string());
   load.files = {{"WHIRL_DRIFT_COMP.SPF", "live machine-drift action"},
                 {"WHIRL_DRIFT_COMP_RESET.SPF", "stops it, restores the setting data"},
                 {"WHIRL_DRIFT_COMP_PLC.csv", "the drift action as a PLC table"},
                 {"WHIRL_TEMP_COMP.SPF", "workpiece plan"},
                 {"WHIRL_TEMP_COMP_RESET.SPF", "its reset program"}};
   load.call_order =
-      "WHIRL_DRIFT_COMP once at power-on (it keeps running all day; the model's rises count "
-      "from its start), then WHIRL_TEMP_COMP before each cutting block with the axis before "
+      std::string(p.grey ? "WHIRL_DRIFT_COMP once at power-on (it keeps running all day; the "
+                           "grey box reads absolute temperatures, its lags start from the first "
+                           "cycle)"
+                         : "WHIRL_DRIFT_COMP once at power-on (it keeps running all day; the "
+                           "model's rises count from its start)") +
+      ", then WHIRL_TEMP_COMP before each cutting block with the axis before "
       "the thread start; WHIRL_TEMP_COMP_RESET after the cutting block; "
       "WHIRL_DRIFT_COMP_RESET to stop the drift action.";
   load.after_abort =
@@ -163,17 +172,25 @@ report::Box ControlBox(const std::string& screw_name, const CombinedPrograms& p)
   return plan::LoadBox({load});
 }
 
-void AddPrograms(const CombinedPrograms* p, const std::string& note, report::Document* doc) {
+void AddPrograms(const CombinedPrograms* p, const std::string& note, const std::string& reason,
+                 report::Document* doc) {
   if (!p) {
     if (!note.empty()) doc->Say(note, report::Tone::kWarn);
     return;
   }
   const interp::DriftActionOptions& d = p->drift;
   doc->Add(report::Heading{2, "How the two programs share the setting data", ""});
+  doc->Say("Machine model of the programs: " + reason + ".");
+  if (!note.empty()) doc->Say(note, report::Tone::kWarn);
+  const std::string what =
+      p->grey ? "the grey box's offset and slope from absolute temperatures (T - 20 degC) and "
+                "their lags, the slope intercept, and the blank's estimate the plan latches at the "
+                "thread start; evaluated every interpolation cycle from the analog inputs"
+              : "the sensor model's offset and slope channels, evaluated every interpolation "
+                "cycle from the analog inputs: sensors and the control's duty signals";
   doc->Say("The workpiece plan (" + std::to_string(p->plan.segments.size()) +
            " segments of the network's curve) hands K0_w, S_w and P_w over; the machine drift "
-           "action (the sensor model's offset and slope channels, evaluated every interpolation "
-           "cycle from the analog inputs: sensors and the control's duty signals) writes SD43920 "
+           "action (" + what + ") writes SD43920 "
            "= P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b), the fixed bearing "
            "at P_b = " +
            FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:");
@@ -202,14 +219,16 @@ void AddStrategyNotes(const machine_eval::MachineEvalScrew& r, report::Document*
       "laser and lead measurements, applied from past control samples: warmup: workpiece plus a "
       "time-since-power-on rule; schedule: workpiece plus a rule on the control's duty signals; "
       "lead_slope: workpiece plus a pitch correction from measured past screws; machine_shop: "
-      "the sensor model alone; both_shop: workpiece plus the sensor model (the programs above); "
-      "both_shop_monitor: both_shop kept valid by the probe checks at the set-ups (drawn thin "
-      "with open circles: where it coincides with both_shop, both stay visible).",
+      "the sensor model alone; both_shop: workpiece plus the sensor model; both_shop_monitor: "
+      "both_shop kept valid by the probe checks at the set-ups (drawn thin with open circles: "
+      "where it coincides with both_shop, both stay visible); both_grey: workpiece plus the grey "
+      "box (absolute temperatures, a slope intercept, the blank latched at the cut start). The "
+      "programs above apply both_grey or both_shop, as said under them.",
       report::Tone::kSmall);
 }
 
 report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
-                      const std::string& programs_note) {
+                      const std::string& programs_note, const std::string& reason) {
   const machine_eval::MachineEvalScrew& x = r.result;
   report::Document doc;
   doc.title = x.screw.name + ": workpiece and machine drift in one cut (simulated)";
@@ -220,20 +239,41 @@ report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
   AddStrategyNotes(x, &doc);
   doc.Add(LeadFigure(x.screw.name + ": lead deviation", x.screw.thread_length_mm));
   doc.Add(report::Heading{2, "Sensors", ""});
-  doc.Say("The sensor model (" + r.sensors_choice +
-          ", trained from the shop's measurements) reads the sensors drawn thick: " +
-          List(r.sensors) + ".");
-  doc.Add(SensorFigure(r.log, x.screw.name + ": sensors on the control", r.sensors));
-  AddPrograms(programs, programs_note, &doc);
+  const bool grey = programs && programs->grey;
+  const std::vector<std::string> thick = grey ? r.grey.Inputs() : r.sensors;
+  doc.Say(grey ? "The grey box (both_grey, trained from the shop's measurements; the programs' "
+                 "model) reads the sensors drawn thick: " + List(thick) + "."
+               : "The sensor model (" + r.sensors_choice +
+                     ", trained from the shop's measurements) reads the sensors drawn thick: " +
+                     List(thick) + ".");
+  doc.Add(SensorFigure(r.log, x.screw.name + ": sensors on the control", thick));
+  AddPrograms(programs, programs_note, reason, &doc);
   return doc;
 }
 
-// The combined programs of the screw for the profile, or the note why there are none.
+// The combined programs of the screw for the profile, or the note why there are none: the grey
+// box's where the evaluation picked both_grey (ReportScrew::programs_strategy), else, or when
+// its programs cannot be written for the profile (said in the note), both_shop's.
 std::optional<CombinedPrograms> Programs(const ReportScrew& r,
-                                         const interp::MachineProfile* profile, std::string* note) {
+                                         const interp::MachineProfile* profile, std::string* note,
+                                         std::string* reason) {
+  *reason = r.programs_reason;
   if (!profile) {
     *note = "combined 840D programs not written: no machine profile given";
     return std::nullopt;
+  }
+  if (r.programs_strategy == MachineStrategy::kBothGrey) {
+    try {
+      return BuildCombinedGreyPrograms(
+          r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options,
+          r.grey, *profile, "network curve of screw " + r.result.screw.name,
+          "grey box (both_grey) trained only from shop measurements");
+    } catch (const InputError& err) {
+      *note = std::string("the grey box's programs could not be written (") + err.what() +
+              "): both_shop's instead";
+      *reason = "both_shop, as the grey box's programs could not be written; the evaluation had "
+                "picked " + r.programs_reason;
+    }
   }
   try {
     return BuildCombinedPrograms(
@@ -253,7 +293,8 @@ MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew&
   const machine_eval::MachineEvalScrew& x = screw.result;
   if (!x.ok) throw InputError("report of screw '" + x.screw.name + "': " + x.error);
   MachineReport report;
-  const std::optional<CombinedPrograms> programs = Programs(screw, profile, &report.programs_note);
+  const std::optional<CombinedPrograms> programs =
+      Programs(screw, profile, &report.programs_note, &report.programs_reason);
   OutputDir out(dir, "report directory");
   // The screw's day as the control logged it, in the drift run format, so `whirl drift predict
   // --run sensors.csv` evaluates a machine model on it.
@@ -273,10 +314,13 @@ MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew&
   if (programs)
     for (const auto& [path, text] : CombinedProgramFiles("", *programs))
       out.Add(path.filename().string(), text);
-  report::RenderReport(Page(screw, programs ? &*programs : nullptr, report.programs_note), out);
+  report::RenderReport(
+      Page(screw, programs ? &*programs : nullptr, report.programs_note, report.programs_reason),
+      out);
   out.Commit();
   report.index_html = (fs::path(dir) / "index.html").string();
   report.programs = programs.has_value();
+  report.programs_grey = programs && programs->grey;
   return report;
 }
 

@@ -4,8 +4,9 @@
 // the screw an evaluation kept (machine_eval.h ReportScrew; the evaluation itself writes
 // nothing). Its control log, the lead deviation per strategy, and the combined 840D programs
 // (machine_nc.h) of the models a shop can train: the workpiece plan of the network's curve and
-// the drift action of the sensor model both_shop applies (trained from probe, laser and lead
-// measurements only, never from the simulator's truth).
+// the drift action of the machine model the evaluation picks among the shop-trainable ones (the
+// grey box of both_grey, or the sensor model of both_shop; ReportScrew::programs_strategy),
+// trained from probe, laser and lead measurements only, never from the simulator's truth.
 #include <string>
 
 #include "interp/machine_profile.h"
@@ -19,6 +20,10 @@ struct MachineReport {
   /// Why the report holds no combined programs (no profile, or one that does not fit the
   /// machine), or "".
   std::string programs_note;
+  /// Which machine model the programs apply and why (ReportScrew::programs_reason, or the
+  /// fallback to both_shop when the grey box's programs cannot be written for the profile).
+  std::string programs_reason;
+  bool programs_grey = false;  ///< the programs apply the grey box (both_grey)
 };
 
 /// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a

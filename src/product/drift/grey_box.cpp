@@ -268,7 +268,36 @@ GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
   m.prior_strength = c.strength;
   m.cv_rmse_um = cv;
   m.rows = static_cast<int>(d.x.rows());
+  SetGreyBoxRanges(&m, record.day_logs);
   return m;
+}
+
+void SetGreyBoxRanges(GreyBoxModel* m, const std::vector<Run>& logs) {
+  const auto per = static_cast<Eigen::Index>(1 + m->time_constants.size());
+  const auto no = static_cast<Eigen::Index>(m->offset_sensors.size()) * per;
+  const auto ns = static_cast<Eigen::Index>(m->slope_sensors.size()) * per;
+  m->offset_min = m->offset_max = Eigen::VectorXd::Zero(no);
+  m->slope_min = m->slope_max = Eigen::VectorXd::Zero(ns);
+  m->blank_min_c = m->blank_max_c = 20;
+  bool first = true;
+  for (const Run& log : logs) {
+    if (log.samples() == 0) continue;
+    const Eigen::MatrixXd o = AbsoluteFeatures(log, m->offset_sensors, m->time_constants);
+    const Eigen::MatrixXd s = AbsoluteFeatures(log, m->slope_sensors, m->time_constants);
+    const Eigen::VectorXd omin = o.colwise().minCoeff(), omax = o.colwise().maxCoeff();
+    const Eigen::VectorXd smin = s.colwise().minCoeff(), smax = s.colwise().maxCoeff();
+    m->offset_min = first ? omin : m->offset_min.cwiseMin(omin);
+    m->offset_max = first ? omax : m->offset_max.cwiseMax(omax);
+    m->slope_min = first ? smin : m->slope_min.cwiseMin(smin);
+    m->slope_max = first ? smax : m->slope_max.cwiseMax(smax);
+    if (!m->blank_sensor.empty()) {
+      const Eigen::VectorXd b =
+          AbsoluteFeatures(log, {m->blank_sensor}, {m->blank_tau_min}).col(1).array() + 20.0;
+      m->blank_min_c = first ? b.minCoeff() : std::min(m->blank_min_c, b.minCoeff());
+      m->blank_max_c = first ? b.maxCoeff() : std::max(m->blank_max_c, b.maxCoeff());
+    }
+    first = false;
+  }
 }
 
 std::vector<double> PredictGreyRecord(const GreyBoxModel& m, const ShopRecord& record,

@@ -77,6 +77,12 @@ struct GreyBoxModel {
   double prior_strength = 0;               ///< the chosen strength
   double cv_rmse_um = 0;                   ///< grouped CV RMSE of the final choice
   int rows = 0;
+  /// Training range of each feature over the record's day logs, as GreyBoxEvaluator runs them
+  /// from each log's first row (SetGreyBoxRanges): phi_o and phi_s [K against 20 degC] and B
+  /// [degC]. The drift action's slope bound (interp/drift_action.h) reads them.
+  Eigen::VectorXd offset_min, offset_max, slope_min, slope_max;
+  double blank_min_c = 20, blank_max_c = 20;
+  std::vector<std::string> notes;  ///< provenance (the command line, the records)
   /// The raw inputs a control feeds the evaluator, in order: offset sensors, slope sensors,
   /// then the blank sensor (when set).
   std::vector<std::string> Inputs() const;
@@ -86,6 +92,10 @@ struct GreyBoxModel {
 /// than unknowns.
 GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
                         const GreyBoxOptions& options = {});
+
+/// Sets the model's training ranges from `logs` (each run from its first row); a model without
+/// a log keeps ranges of zero width at 0 K (B at 20 degC).
+void SetGreyBoxRanges(GreyBoxModel* m, const std::vector<Run>& logs);
 
 /// m_hat of every row of a record (its own day log from its first row); a lead record latches
 /// B at its first reading (the cut start).

@@ -1,0 +1,119 @@
+// whirl drift fit-grey: the grey-box machine estimator (drift/grey_box.h) fitted from a shop's
+// measurement records (drift/measurement_file.h) to the sensors and priors of a spec
+// (drift/grey_box_io.h), written as a grey box model file for `whirl drift nc --grey-model`.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "core/error.h"
+#include "core/numbers.h"
+#include "drift/grey_box.h"
+#include "drift/grey_box_io.h"
+#include "drift/measurement_file.h"
+
+namespace whirl::cli {
+namespace {
+
+struct FitGreyOptions {
+  std::string records, spec, out;
+  bool json = false;
+};
+
+std::string FitGreyCounts(const drift::ShopRecord& r) {
+  int counts[4] = {0, 0, 0, 0};
+  for (const auto& m : r.records) ++counts[static_cast<int>(m.kind)];
+  return std::to_string(counts[0]) + " probe, " + std::to_string(counts[1]) + " laser, " +
+         std::to_string(counts[2]) + " lead, " + std::to_string(counts[3]) +
+         " setup_check records on " + std::to_string(r.day_logs.size()) + " day logs";
+}
+
+void PrintFitGrey(const drift::GreyBoxModel& m) {
+  std::printf("grey box: lags %s min, blank lag %s min, prior strength %s, CV RMSE %.2f um over "
+              "%d readings\n",
+              m.time_constants.empty() ? "none" : [&] {
+                std::string s;
+                for (double t : m.time_constants) s += (s.empty() ? "" : ", ") + MessageNumber(t);
+                return s;
+              }().c_str(),
+              m.blank_sensor.empty() ? "-" : MessageNumber(m.blank_tau_min).c_str(),
+              MessageNumber(m.prior_strength).c_str(), m.cv_rmse_um, m.rows);
+  const auto per = 1 + m.time_constants.size();
+  for (std::size_t i = 0; i < m.offset_sensors.size(); ++i)
+    std::printf("  K0   %-20s %9.3f um/K (sum over its lags)\n", m.offset_sensors[i].c_str(),
+                m.a.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
+  std::printf("  G    intercept            %9.3f um per 1000 mm\n", m.slope_intercept_um_per_1000);
+  for (std::size_t i = 0; i < m.slope_sensors.size(); ++i)
+    std::printf("  G    %-20s %9.3f um per 1000 mm per K (sum over its lags)\n",
+                m.slope_sensors[i].c_str(),
+                m.g.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
+  if (!m.blank_sensor.empty())
+    std::printf("  G    blank (%s, latched) %9.3f um per 1000 mm per K\n", m.blank_sensor.c_str(),
+                m.blank_um_per_1000_per_k);
+}
+
+void RunFitGrey(const FitGreyOptions& o) {
+  CheckOutputs({{"--records", o.records}, {"--spec", o.spec}}, {{"--out", o.out}});
+  const drift::GreyBoxSpec spec = drift::ReadGreyBoxSpec(o.spec);
+  const drift::MeasurementFile records = drift::ReadMeasurementRecords(o.records);
+  drift::GreyBoxModel m;
+  try {
+    m = drift::FitGreyBox(records.record, spec);
+  } catch (const InputError& e) {
+    throw InputError("--records '" + o.records + "' with --spec '" + o.spec + "': " + e.what());
+  }
+  m.notes.push_back("whirl drift fit-grey --records " + o.records + " --spec " + o.spec);
+  m.notes.push_back(FitGreyCounts(records.record));
+  if (!records.description.empty()) m.notes.push_back("records: " + records.description);
+  drift::WriteGreyBoxModel(o.out, m);
+  if (o.json) {
+    PrintJson({{"schema", "whirl.drift_fit_grey"},
+               {"schema_version", 1},
+               {"model_file", o.out},
+               {"model", nlohmann::json(m)}});
+    return;
+  }
+  std::printf("%s\n", FitGreyCounts(records.record).c_str());
+  PrintFitGrey(m);
+  std::printf("model written to %s\n", o.out.c_str());
+}
+
+}  // namespace
+
+void RegisterDriftFitGrey(CLI::App* drift_app) {
+  auto o = std::make_shared<FitGreyOptions>();
+  auto* sub = drift_app->add_subcommand(
+      "fit-grey",
+      "Fit the grey-box machine drift estimator (the form the 840D applies) from a shop's\n"
+      "measurement records and write it as a grey box model file (JSON) for whirl drift nc\n"
+      "--grey-model:\n"
+      "  K0 = a' phi_o [um],  G = g0 + g' phi_s + g_b (B(t0) - 20) [um per 1000 mm],\n"
+      "  m(t, z) = K0 + G (z_ref - z) / 1000,\n"
+      "phi: the spec's offset and slope sensors as T - 20 [K] with first-order lags (at most 2\n"
+      "from 10-320 min by leave-one-day-out CV), g0 a slope intercept, B the blank's estimate\n"
+      "(a lag of the blank sensor, 30-240 min by CV) latched at the cut start (lead records\n"
+      "only). A ridge towards the spec's physical priors (alpha x lengths; strength 1e-3..1 by\n"
+      "CV); the lead records carry half of the total weight. The records (--records) are what a\n"
+      "shop measures: warm-up probe tests, laser tests, the measured leads of past screws and\n"
+      "the probe readings at set-ups, each on its day log (the control's sensor log, a drift\n"
+      "run file).");
+  sub->add_option("--records", o->records,
+                  "measurement records JSON (format whirl-measurement-records: day_logs = run "
+                  "files relative to it; records with kind probe|laser|lead|setup_check, day, "
+                  "log, time_min [min], z_mm [mm from the chuck face], value_um [um], sigma_um "
+                  "[um])")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--spec", o->spec,
+                  "grey box spec JSON (format whirl-grey-box-spec: offset_sensors, "
+                  "slope_sensors, blank_sensor, z_ref_mm [mm], priors in um per K and um per "
+                  "1000 mm per K; e.g. datasets/machines/field_grey_box_spec.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--out", o->out, "grey box model file to write (JSON)")->required();
+  sub->add_flag("--json", o->json, "machine output on stdout");
+  sub->callback([o] { RunFitGrey(*o); });
+}
+
+}  // namespace whirl::cli

@@ -1,0 +1,72 @@
+#pragma once
+// Files of the grey-box estimator (drift/grey_box.h): the model a shop fits (whirl drift
+// fit-grey) and hands to the control (whirl drift nc --grey-model), and the spec it is fitted to.
+//
+// Model file (JSON, "format": "whirl-grey-box-model", "schema_version": 1):
+//   offset_sensors, slope_sensors   column names of the day logs (<name>_C), in order
+//   blank_sensor                    the blank's estimate's input, "" for none
+//   time_constants_min              the shared lags, ascending, each in (0, 1e6] min
+//   z_ref_mm                        the slope's reference (the Z screw's fixed bearing), mm
+//   offset_features, slope_features one object per feature, input-major (T - 20, then its lags):
+//                                   name, input, tau_min (0: the input itself), coefficient
+//                                   (um per K; slope: um per 1000 mm per K, |c| <= 1e4), and its
+//                                   training range train_min_k, train_max_k [K against 20 degC]
+//   slope_intercept_um_per_1000     g0, |g0| <= 1e5 (0.1 mm/mm, the largest MD32760)
+//   blank                           null without a blank sensor, else {tau_min (0, 1e6],
+//                                   um_per_1000_per_k (|g_b| <= 1e4), train_min_c, train_max_c}
+//   fit                             {prior_strength >= 0, cv_rmse_um in [0, 1e6], rows >= 0}
+//   training                        {notes: provenance}
+// Every number is range-checked on reading; an error names the file, the field and the rule.
+//
+// Spec file (JSON, "format": "whirl-grey-box-spec", "schema_version": 1): the sensors a shop
+// placed and the physical priors it reads off its drawings:
+//   offset_sensors, slope_sensors, blank_sensor ("" for none), z_ref_mm,
+//   offset_prior_um_per_k {sensor: um per K}, slope_prior_um_per_1000_per_k {sensor: value},
+//   blank_prior_um_per_1000_per_k (-alpha_w x 1e6; steel -11.8).
+// A prior key that names no sensor of its list is an error (it would be ignored silently).
+// Shipped example for the simulated field machine: datasets/machines/field_grey_box_spec.json.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "drift/grey_box.h"
+#include "drift/model.h"
+
+namespace whirl::drift {
+
+inline constexpr const char* kGreyBoxFormat = "whirl-grey-box-model";
+inline constexpr int kGreyBoxSchemaVersion = 1;
+inline constexpr const char* kGreyBoxSpecFormat = "whirl-grey-box-spec";
+/// Largest |coefficient| of a feature (um per K, or um per 1000 mm per K): 100 x the growth of a
+/// 10 m steel bed per K (110 um/K); larger is a corrupt file.
+inline constexpr double kMaxGreyCoefficient = 1e4;
+/// Largest |slope intercept| [um per 1000 mm]: 0.1 mm/mm, the largest MD32760 (SD43910's cap).
+inline constexpr double kMaxGreyIntercept = 1e5;
+/// Largest |feature| of a training range [K against 20 degC].
+inline constexpr double kMaxGreyFeatureK = 1000;
+
+/// InputError naming the field and the rule: sizes, ascending lags, every range above.
+void ValidateGreyBox(const GreyBoxModel& m);
+
+void to_json(nlohmann::json& j, const GreyBoxModel& m);
+void from_json(const nlohmann::json& j, GreyBoxModel& m);
+/// InputError naming the file, the field and the rule.
+GreyBoxModel ReadGreyBoxModel(const std::filesystem::path& path);
+/// Validates, then writes atomically.
+void WriteGreyBoxModel(const std::filesystem::path& path, const GreyBoxModel& m);
+
+/// InputError naming the file, the field and the rule (a sensor named twice, a prior for a
+/// sensor not in its list, no offset or slope sensor).
+GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path);
+
+/// The grey box as the drift action's two linear models (interp/drift_action.h), evaluated with
+/// reference "model" at 20 degC, so each input is T - 20 with lags L_0 = u_0 (GreyBoxEvaluator):
+///   offset: sensors = offset_sensors, b0 = 0, b = a          [um]
+///   slope:  sensors = slope_sensors,  b0 = g0, b = g         [um per 1000 mm]
+/// with the grey box's training ranges. The blank term g_b (B_latched - 20) is not in them: the
+/// drift action adds it from the latched slot (interp::BlankTerm).
+struct GreyBoxControl {
+  DriftModel offset, slope;
+};
+GreyBoxControl GreyBoxControlModels(const GreyBoxModel& m);
+
+}  // namespace whirl::drift
