@@ -14,6 +14,7 @@
 #include "drift/grey_box.h"
 #include "fit/arctan_curve.h"
 #include "interp/drift_action.h"
+#include "interp/machine_profile.h"
 #include "interp/nc_replay.h"
 #include "interp/sinumerik.h"
 
@@ -356,6 +357,14 @@ TEST(GreyAction, BadInputsAreRefusedWithTheirReason) {
     if (q.datum.rfind("MD28254", 0) == 0) {
       EXPECT_EQ(q.value, 97.0);
     }
+  // The profile's slot pair: not in the drift action's own range, not a workpiece slot.
+  MachineProfile profile = LoadMachineProfile(std::string(WHIRL_SOURCE_DIR) +
+                                              "/datasets/machines/whirling_840d.json");
+  EXPECT_EQ(profile.drift->blank_param, 95);
+  profile.drift->blank_param = 100;
+  ExpectRefused([&] { profile.Validate(); }, "drift.blank_param 100 lies in the drift action's own");
+  profile.drift->blank_param = 96;
+  ExpectRefused([&] { profile.Validate(); }, "blank_param 96");
   // A grey box without an offset sensor cannot be a drift action.
   drift::GreyBoxModel no_offset = Model();
   no_offset.offset_sensors.clear();

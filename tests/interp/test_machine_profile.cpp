@@ -89,11 +89,13 @@ TEST(MachineProfile, PlanOptionsCarryTheLivenessCheckThroughTheJsonRoundTrip) {
   nlohmann::json j = combined;
   PlanOptions back = j.get<PlanOptions>();
   EXPECT_EQ(back.workpiece_slope_param, 97);
+  EXPECT_EQ(back.blank_param, 95);  // the grey box's blank latch (drift.blank_param)
   EXPECT_EQ(back.drift_alive_param, 100);
   EXPECT_EQ(back.drift_missing_alarm, combined.drift_missing_alarm);
   // A plan JSON from before the liveness check (drift_marker_r, no drift_alive_param) still loads.
   j.erase("drift_alive_param");
   j.erase("workpiece_slope_param");
+  j.erase("blank_param");
   j["workpiece_k0_param"] = -1;
   j["drift_marker_r"] = -1;
   EXPECT_NO_THROW(j.get<PlanOptions>());

@@ -301,6 +301,7 @@ TEST(NcReplay, EveryFailedStartCheckJumpsToTheEndAndChangesNothing) {
     const bool handover = combined.workpiece_slope_param >= 0;
     DriftActionOptions other = d;
     other.workpiece_slope_param = handover ? -1 : d.workpiece_k0_param - 2;  // the 2 slots below
+    if (handover) other.blank_param = -1;  // the blank latch belongs to the handed-over slope
     const std::string drift_expected = handover ? FormatDriftNcProgram(m, d, "", &g)
                                                 : FormatDriftNcProgram(m, d);
     const std::string drift_other_mode = FormatDriftNcProgram(m, other);

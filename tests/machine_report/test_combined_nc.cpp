@@ -174,6 +174,100 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheShopTrainedModelAtEveryControlSam
       ReplayTheDay(direction, control_dk);
 }
 
+// The grey box's combined programs over the same day: at every control sample the control
+// applies the plan plus what both_grey applies (machine_eval/strategies.h RunCausally on the grey
+// box: K0_k + (G_k + g_b (B_latched - 20)) (z_ref - z) / 1000), B latched by the plan at the
+// thread start and held for the cut; parked before it and after the cut, no blank term. The
+// control latches B of the cycle the axis reaches the thread start, the evaluation the last
+// control sample before it: the two agree within what B moves in one sample interval.
+TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
+  const machine_eval::ReportScrew& r = ShortCut();
+  ASSERT_FALSE(r.grey.blank_sensor.empty());
+  const CombinedPrograms p = BuildCombinedGreyPrograms(
+      r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options, r.grey,
+      CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm), "test curve", "test grey box");
+  ASSERT_TRUE(p.grey);
+  const drift::Run& log = r.log;
+  const machine_eval::HeldSamples held = machine_eval::RunCausally(r.grey, log);
+  const Eigen::MatrixXd raw = drift::GreyBoxRawInputs(r.grey, log);
+  const std::vector<std::string> inputs = r.grey.Inputs();
+  const int blank = p.drift.blank_param;
+  interp::replay::Replay replay;
+  replay.control.abs_value_mm = -0.0013;
+  replay.control.slope = 7e-6;
+  replay.control.ref_position_mm = 100.0;
+  auto set_inputs = [&](int k) {
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const interp::AnalogInput& a = p.drift.inputs.at(inputs[i]);
+      replay.control.ain[a.index] = (raw(k, static_cast<Eigen::Index>(i)) - a.offset) / a.scale;
+    }
+  };
+  const double feed = r.kinematics.axial_feed_mm_s, t_cut = r.kinematics.cutting_time_s;
+  const double z0 = r.kinematics.thread_start_position_mm;
+  const double park = interp::AxisPositionMm(p.plan.options, feed, -5.0 / feed);
+  auto t_of = [&](double t_min) { return (t_min - r.cut_start_min) * 60.0; };
+  auto axis_at = [&](double t_min) {
+    const double t_s = t_of(t_min);
+    return t_s < 0 ? park : interp::AxisPositionMm(p.plan.options, feed, std::min(t_s, t_cut));
+  };
+  auto z_at = [&](double t_min) {
+    const double t_s = t_of(t_min);
+    return t_s < 0 ? z0 + 5.0 : z0 - feed * std::min(t_s, t_cut);
+  };
+  const double s = interp::SignFactor(p.plan.options.sign);
+  set_inputs(0);
+  replay.axis_mm = park;
+  ASSERT_TRUE(replay.RunProgram(p.drift_nc));
+  replay.Cycle(park);
+  ASSERT_TRUE(replay.RunProgram(p.plan_nc));
+  const int per_sample =
+      static_cast<int>(std::lround((log.time_min[1] - log.time_min[0]) * 60000.0 / kReplayCycleMs));
+  const std::size_t at_start = held.IndexAt(r.cut_start_min);
+  const double g_b = r.grey.blank_um_per_1000_per_k;
+  double worst_um = 0, latched = NAN, b_moved = 0;
+  int cut_samples = 0;
+  for (int k = 1; k < log.samples(); ++k) {
+    const double t0 = log.time_min[static_cast<std::size_t>(k - 1)];
+    const double t1 = log.time_min[static_cast<std::size_t>(k)];
+    set_inputs(k);
+    for (int c = 1; c <= per_sample; ++c) replay.Cycle(axis_at(t0 + (t1 - t0) * c / per_sample));
+    if (::testing::Test::HasFailure()) return;
+    const auto uk = static_cast<std::size_t>(k);
+    const double pos = axis_at(t1);
+    const bool cutting = t_of(t1) >= 0 && t_of(t1) < t_cut;
+    const double latch = replay.control.ac_param[blank + 1];
+    if (cutting) {
+      if (std::isnan(latched)) latched = latch;
+      EXPECT_EQ(latch, latched) << "the latch moved during the cut, sample " << k;
+      b_moved = std::max(b_moved, std::abs(replay.control.ac_param[blank] - latched));
+    } else {
+      EXPECT_EQ(latch, interp::kBlankNeutralC) << "sample " << k;
+    }
+    const double g = held.slope_um_per_1000[uk] + (cutting ? g_b * (latch - 20.0) : 0.0);
+    const double machine_um = held.k0_um[uk] + g * (r.z_ref_mm - z_at(t1)) / 1000.0;
+    const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
+    const double plan_um = t_of(t1) >= 0 && t_of(t1) < t_cut
+                               ? interp::AppliedCompensationUm(p.plan, pos) : 0.0;
+    worst_um = std::max(worst_um, std::abs(applied_um - machine_um - plan_um));
+    cut_samples += cutting;
+  }
+  EXPECT_GT(cut_samples, 30);
+  EXPECT_LT(worst_um, 1e-3);
+  // The latched value is the evaluation's B at the cut start within what B moves in one sample.
+  const double b_eval = 20.0 + held.blank_slope_um_per_1000[at_start] / g_b;
+  EXPECT_LT(std::abs(latched - b_eval), 0.05) << latched << " vs " << b_eval;
+  EXPECT_GT(b_moved, 0.0);
+  replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
+  replay.EndProgram();
+  ASSERT_TRUE(replay.RunProgram(p.plan_reset_nc));
+  ASSERT_TRUE(replay.RunProgram(p.drift_reset_nc));
+  EXPECT_TRUE(replay.actions.empty());
+  EXPECT_EQ(replay.control.abs_value_mm, -0.0013);
+  EXPECT_EQ(replay.control.slope, 7e-6);
+  EXPECT_EQ(replay.control.ref_position_mm, 100.0);
+  EXPECT_EQ(replay.control.ac_param[blank + 1], interp::kBlankNeutralC);
+}
+
 TEST(CombinedPrograms, ProfileThatDisagreesWithTheMachineIsRefused) {
   const machine_eval::ReportScrew& r = ShortCut();
   interp::MachineProfile profile = CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);

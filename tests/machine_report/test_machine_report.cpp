@@ -215,5 +215,70 @@ TEST(MachineReport, TheProgramsAreTheShopTrainedModelsAndTheBoxListsEachDatumOnc
   std::filesystem::remove_all(dir);
 }
 
+// Where the evaluation picks both_grey, the programs are the grey box's: the drift program runs
+// its offset, slope and blank term (reference model), the plan latches the blank at the thread
+// start, and the page says which model and why; a profile without drift.blank_param falls back
+// to both_shop's programs and says so.
+TEST(MachineReport, WhereTheEvaluationPicksTheGreyBoxItsProgramsAreHandedOut) {
+  ReportScrew r = KeptScrew();
+  ASSERT_FALSE(r.grey.Inputs().empty());
+  r.programs_strategy = MachineStrategy::kBothGrey;
+  r.programs_reason = "both_grey: picked by the test";
+  const interp::MachineProfile profile =
+      interp::LoadMachineProfile(ReportSource("datasets/machines/whirling_840d.json"));
+  const std::filesystem::path dir = ReportDir("whirl_machine_report_grey");
+  const MachineReport written = WriteMachineScrewReport(dir.string(), r, &profile);
+  ASSERT_TRUE(written.programs) << written.programs_note;
+  EXPECT_TRUE(written.programs_grey);
+  EXPECT_EQ(written.programs_reason, "both_grey: picked by the test");
+  const std::string drift_nc = ReadTextFile(dir / "WHIRL_DRIFT_COMP.SPF");
+  const interp::GreyBoxAction a = interp::GreyBoxActionModels(r.grey);
+  interp::DriftActionOptions d = profile.DriftOptions();
+  d.reference = interp::DriftReference::kModel;
+  auto statements = [](const std::string& nc) {
+    std::string out;
+    std::istringstream in(nc);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(";", 0) != 0) out += line + "\n";
+    return out;
+  };
+  EXPECT_EQ(statements(drift_nc),
+            statements(interp::FormatDriftNcProgram(a.offset, d, "", &a.slope, a.Blank())));
+  EXPECT_NE(ReadTextFile(dir / "WHIRL_TEMP_COMP.SPF").find("$AC_PARAM[96]=$AC_PARAM[95]"),
+            std::string::npos);
+  EXPECT_NE(ReadTextFile(dir / "index.html").find("both_grey: picked by the test"),
+            std::string::npos);
+  interp::MachineProfile no_blank = profile;
+  no_blank.drift->blank_param = -1;
+  std::filesystem::remove_all(dir);
+  const MachineReport fallback = WriteMachineScrewReport(dir.string(), r, &no_blank);
+  ASSERT_TRUE(fallback.programs);
+  EXPECT_FALSE(fallback.programs_grey);
+  EXPECT_NE(fallback.programs_note.find("drift.blank_param"), std::string::npos)
+      << fallback.programs_note;
+  EXPECT_NE(fallback.programs_reason.find("both_shop"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// The choice between the two shop-trainable models with programs: the smaller pooled thread
+// median, both_shop on a tie or when the grey box was not fitted.
+TEST(MachineReport, TheProgramsModelIsTheOneWithTheSmallerThreadMedian) {
+  std::array<machine_eval::SeedStats, kMachineStrategyCount> s{};
+  auto& shop = s[static_cast<std::size_t>(MachineStrategy::kBothShop)];
+  auto& grey = s[static_cast<std::size_t>(MachineStrategy::kBothGrey)];
+  shop.screws = grey.screws = 12;
+  shop.total_median_um = 10.0;
+  grey.total_median_um = 8.0;
+  std::string why;
+  EXPECT_EQ(machine_eval::ProgramsStrategy(s, true, &why), MachineStrategy::kBothGrey);
+  EXPECT_NE(why.find("both_grey 8.0 um, both_shop 10.0 um"), std::string::npos) << why;
+  EXPECT_EQ(machine_eval::ProgramsStrategy(s, false, &why), MachineStrategy::kBothShop);
+  grey.total_median_um = 10.0;
+  EXPECT_EQ(machine_eval::ProgramsStrategy(s, true, &why), MachineStrategy::kBothShop);
+  grey.total_median_um = 12.0;
+  EXPECT_EQ(machine_eval::ProgramsStrategy(s, true, &why), MachineStrategy::kBothShop);
+  EXPECT_EQ(why.rfind("both_shop", 0), 0u) << why;
+}
+
 }  // namespace
 }  // namespace whirl::machine_report
