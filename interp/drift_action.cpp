@@ -245,10 +245,10 @@ std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
 std::vector<std::string> BlankBodies(const DriftActionOptions& o, const Slots& s) {
   const std::string b = P(o.blank_param);
   const std::string reading = Reading(Input(o, s.blank->sensor));
-  return {"WHENEVER " + P(s.blank_flag) + "==0 DO " + b + "=" + reading + " " + P(s.blank_flag) +
-              "=1",
-          "DO " + b + "=" + b + Term(LagFactor(o, s.blank->tau_min), kDecimalsLagFactor) + "*(" +
-              reading + "-" + b + ")"};
+  return {
+      "WHENEVER " + P(s.blank_flag) + "==0 DO " + b + "=" + reading + " " + P(s.blank_flag) + "=1",
+      "DO " + b + "=" + b + Term(LagFactor(o, s.blank->tau_min), kDecimalsLagFactor) + "*(" +
+          reading + "-" + b + ")"};
 }
 
 // The static actions, in execution order.
@@ -258,8 +258,8 @@ std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::D
   if (g) {
     const std::vector<std::string> more = FeatureBodies(*g, o, s.slope);
     bodies.insert(bodies.end(), more.begin(), more.end());
-    std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope,
-                             kDecimalsDriftSlopeCoefficient, s.s_m, &bodies);
+    std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope, kDecimalsDriftSlopeCoefficient,
+                             s.s_m, &bodies);
     if (s.blank) {
       const std::vector<std::string> b = BlankBodies(o, s);
       bodies.insert(bodies.end(), b.begin(), b.end());
@@ -329,8 +329,7 @@ void CheckAnalogInput(const std::string& name, const AnalogInput& a, const Contr
 // Every $AC_PARAM slot the options name lies below MD28254 (when stated).
 void CheckSlotsBelowCount(const DriftActionOptions& o) {
   if (!o.control.Stated()) return;
-  const int last = std::max({o.param_last < 0 ? o.param_first : o.param_last,
-                             o.workpiece_k0_param,
+  const int last = std::max({o.param_last < 0 ? o.param_first : o.param_last, o.workpiece_k0_param,
                              o.workpiece_slope_param < 0 ? -1 : o.workpiece_slope_param + 1,
                              o.blank_param < 0 ? -1 : o.blank_param + 1});
   if (last >= o.control.ac_params)
@@ -449,8 +448,9 @@ double DriftSlopeBound(const drift::DriftModel& g, const DriftActionOptions& o,
   const Eigen::VectorXd c = DriftSlopeCoefficients(g, o);
   double bound = std::abs(c(0));
   if (blank)
-    bound += std::abs(DriftBlankCoefficient(*blank, o)) *
-             std::max(std::abs(blank->min_c - kBlankNeutralC), std::abs(blank->max_c - kBlankNeutralC));
+    bound +=
+        std::abs(DriftBlankCoefficient(*blank, o)) *
+        std::max(std::abs(blank->min_c - kBlankNeutralC), std::abs(blank->max_c - kBlankNeutralC));
   for (Eigen::Index f = 1; f < c.size(); ++f)
     bound +=
         std::abs(c(f)) * std::max(std::abs(g.feature_min(f - 1)), std::abs(g.feature_max(f - 1)));
@@ -472,8 +472,7 @@ void CheckBlank(const drift::DriftModel* g, const DriftActionOptions& o, const S
         "drift action: the grey box reads absolute temperatures (referred to 20 degC): "
         "reference 'model', not 'start'");
   if (!(s.blank->tau_min > 0) || !std::isfinite(s.blank->um_per_1000_per_k))
-    throw InputError("drift action: the blank term's tau_min must be > 0 and its coefficient "
-                     "finite");
+    throw InputError("drift action: the blank term's tau_min must be > 0, its coefficient finite");
   if (RangesOverlap(o.blank_param, o.blank_param + 1, o.param_first, s.last))
     throw InputError("drift action: blank_param " + std::to_string(o.blank_param) + ", + 1 " +
                      "lie in the action's own $AC_PARAM slots " + std::to_string(o.param_first) +
@@ -517,8 +516,8 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
   nc += P(s.alive) + "=0\n" + P(s.offset.flag) + "=0\n";
   if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
   if (s.blank)  // B starts again; no blank term until a cut start latches one
-    nc += P(s.blank_flag) + "=0\n" + P(o.blank_param + 1) + "=" +
-          FormatFixed(kBlankNeutralC, 4) + "\n";
+    nc += P(s.blank_flag) + "=0\n" + P(o.blank_param + 1) + "=" + FormatFixed(kBlankNeutralC, 4) +
+          "\n";
   if (o.workpiece_k0_param >= 0) nc += P(o.workpiece_k0_param) + "=0\n";
   if (o.workpiece_slope_param >= 0)  // no plan yet: slope 0 about the fixed end
     nc += P(o.workpiece_slope_param) + "=0\n" + P(o.workpiece_slope_param + 1) + "=" +
@@ -548,14 +547,18 @@ std::string ElapsedNote(const drift::DriftModel& m, const drift::DriftModel* g) 
 std::string BlankNote(const DriftActionOptions& o, const Slots& s) {
   if (!s.blank) return "";
   const std::string b = P(o.blank_param), l = P(o.blank_param + 1);
-  return Line("; blank term (grey box): S_m also adds s * sigma * g_b (" + l + " - 20) / 1e6, g_b = " +
-              FormatFixed(s.blank->um_per_1000_per_k, 4) + " um per 1000 mm per K; " + b +
-              " = B, the lag " + FormatFixed(s.blank->tau_min, 3) + " min of " +
-              Text(s.blank->sensor) + " [degC], run every cycle") +
-         "; " + l + " = B latched at the cut start: the whirling plan (profile drift.blank_param) "
-         "copies " + b + " into it at the thread start and writes 20 back at the thread end; "
-         "without a plan the part program does: STOPRE, " + l + "=" + b +
-         " before the cut, " + l + "=20 after it (20: no blank term); this program sets it to 20\n";
+  return Line("; blank term (grey box): S_m also adds s * sigma * g_b (" + l +
+              " - 20) / 1e6, g_b = " + FormatFixed(s.blank->um_per_1000_per_k, 4) +
+              " um per 1000 mm per K; " + b + " = B, the lag " + FormatFixed(s.blank->tau_min, 3) +
+              " min of " + Text(s.blank->sensor) + " [degC], run every cycle") +
+         "; " + l +
+         " = B latched at the cut start: the whirling plan (profile drift.blank_param) "
+         "copies " +
+         b +
+         " into it at the thread start and writes 20 back at the thread end; "
+         "without a plan the part program does: STOPRE, " +
+         l + "=" + b + " before the cut, " + l +
+         "=20 after it (20: no blank term); this program sets it to 20\n";
 }
 
 // The largest $A_INA index the program reads.
@@ -594,9 +597,8 @@ void CheckSlotRange(const DriftActionOptions& o, const Slots& s) {
                      " (drift.param_last): use fewer sensors or lags, or widen the range");
   if (o.control.Stated() && LastSlotUsed(o, s) >= o.control.ac_params)
     throw InputError("drift action needs $AC_PARAM up to index " +
-                     std::to_string(LastSlotUsed(o, s)) +
-                     ", the control has " + std::to_string(o.control.ac_params) +
-                     " (MD28254 $MC_MM_NUM_AC_PARAM)");
+                     std::to_string(LastSlotUsed(o, s)) + ", the control has " +
+                     std::to_string(o.control.ac_params) + " (MD28254 $MC_MM_NUM_AC_PARAM)");
 }
 
 std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
@@ -627,7 +629,10 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
   nc += "; uses static actions IDS=" + std::to_string(o.sync_id_first) + ".." +
         std::to_string(o.sync_id_last) + " (cancelled first), $AC_PARAM[" +
         std::to_string(o.param_first) + ".." + std::to_string(s.last) + "] (liveness $AC_PARAM[" +
-        std::to_string(s.alive) + "] = " + (s.blank ? "3" : SlopeMode(o, g) ? "2" : "1") +
+        std::to_string(s.alive) + "] = " +
+        (s.blank           ? "3"
+         : SlopeMode(o, g) ? "2"
+                           : "1") +
         " while running), " + saved + "\n";
   nc += BlankNote(o, s);
   if (o.workpiece_k0_param >= 0)
@@ -755,9 +760,10 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
   else
     out += "# SD43900[" + o.axis + "] = K_m\n";
   if (blank)
-    out += "# blank_latched (grey box): B <- B + a_per_cycle * (T - B) (B = T at start) every "
-           "cycle; at the cut start hold B for the whole cut; S_m += coefficient_per_unit * (B "
-           "held - reference_C); between cuts that term is 0\n";
+    out +=
+        "# blank_latched (grey box): B <- B + a_per_cycle * (T - B) (B = T at start) every "
+        "cycle; at the cut start hold B for the whole cut; S_m += coefficient_per_unit * (B "
+        "held - reference_C); between cuts that term is 0\n";
   out +=
       "output,feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,"
       "coefficient_per_unit\n";

@@ -1,8 +1,8 @@
 #pragma once
-// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/product/drift, kinds mlr and
-// dynamic) evaluated every interpolation cycle by static synchronized actions from the machine's
-// analog inputs, written into SD43900 $SA_TEMP_COMP_ABS_VALUE (the position-independent K0 that
-// Siemens designed for exactly this, Siemens K3), plus the same model as a PLC table.
+// The live machine-drift compensation on a SINUMERIK 840D: a drift model (src/product/drift, kinds
+// mlr and dynamic) evaluated every interpolation cycle by static synchronized actions from the
+// machine's analog inputs, written into SD43900 $SA_TEMP_COMP_ABS_VALUE (the position-independent
+// K0 that Siemens designed for exactly this, Siemens K3), plus the same model as a PLC table.
 //
 // Inputs. Sensor i of the model reads T_i = scale_i * $A_INA[index_i] + offset_i [degC]; an extra
 // input (e.g. spindle_rpm) reads scale * $A_INA[index] + offset in its own unit. The mapping is a
@@ -49,8 +49,8 @@
 // run in ID order each cycle, so the plan's K0 is written before it is added (no cycle of lag).
 //
 // The machine's slope (optional second model, e.g. the Z feed screw growing from its fixed
-// bearing, trained on a lead-slope channel such as zscrew_per_1000_um). Its output g [um per 1000 mm] is the
-// growth of the error with the distance from the fixed end P_b (profile drift.slope):
+// bearing, trained on a lead-slope channel such as zscrew_per_1000_um). Its output g [um per 1000
+// mm] is the growth of the error with the distance from the fixed end P_b (profile drift.slope):
 //   e(P) = e_K + g * sigma * (P - P_b) / 1000   [um along error_direction],
 // sigma = growth_direction (+1: the distance from the fixed end grows towards +axis). So the
 // machine alone is dK_m(P) = K_m + S_m (P - P_b) with K_m = s e_K / 1000 mm and

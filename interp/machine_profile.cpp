@@ -74,12 +74,12 @@ DriftActionOptions ReadDriftSection(const nlohmann::json& j, const std::string& 
                                     int version) {
   const std::string w = what + ", object 'drift'";
   if (!j.is_object()) throw InputError(w + ": must be a JSON object");
-  RejectUnknownKeys(j,
-                    {"sync_id_first", "sync_id_last", "param_first", "param_last", "save_r_first",
-                     "ipo_cycle_ms", "error_direction", "workpiece_k0_param",
-                     "workpiece_slope_param", "blank_param", "missing_alarm", "slope",
-                     "analog_inputs"},
-                    w);
+  RejectUnknownKeys(
+      j,
+      {"sync_id_first", "sync_id_last", "param_first", "param_last", "save_r_first", "ipo_cycle_ms",
+       "error_direction", "workpiece_k0_param", "workpiece_slope_param", "blank_param",
+       "missing_alarm", "slope", "analog_inputs"},
+      w);
   DriftActionOptions d;
   d.sync_id_first = RequireInt(j, "sync_id_first", w);
   d.sync_id_last = RequireInt(j, "sync_id_last", w);

@@ -284,13 +284,17 @@ void to_json(nlohmann::json& j, const PlanOptions& o) {
 }
 
 void from_json(const nlohmann::json& j, PlanOptions& o) {
-  RejectUnknownKeys(
-      j,
-      {"tolerance_um", "axis", "start_position_mm", "direction", "machine_offset_mm", "sign",
-       "control_dk", "md32760", "check_step_s", "sync_id_first", "sync_id_last", "save_r_first",
-       "workpiece_k0_param", "drift_marker_r", "drift_missing_alarm", "workpiece_slope_param",
-       "drift_slope_marker_r", "drift_alive_param", "start_alarm", "blank_param"},
-      "plan settings");
+  RejectUnknownKeys(j, {"tolerance_um",         "axis",
+                        "start_position_mm",    "direction",
+                        "machine_offset_mm",    "sign",
+                        "control_dk",           "md32760",
+                        "check_step_s",         "sync_id_first",
+                        "sync_id_last",         "save_r_first",
+                        "workpiece_k0_param",   "drift_marker_r",
+                        "drift_missing_alarm",  "workpiece_slope_param",
+                        "drift_slope_marker_r", "drift_alive_param",
+                        "start_alarm",          "blank_param"},
+                    "plan settings");
   o.tolerance_um = j.at("tolerance_um").get<double>();
   o.axis = j.at("axis").get<std::string>();
   o.start_position_mm = j.at("start_position_mm").get<double>();
@@ -825,12 +829,13 @@ std::string FormatNcResetProgram(const PlanOptions& o, const NcProgramInfo& info
                    ax + " after an aborted " + info.program_name + " run\n";
   const std::string writes = RestoreWrites(o);
   if (SlopeHandedOver(o)) {  // only the plan's own $AC_PARAM slots: cleared unconditionally
-    nc += "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
-          std::to_string(o.sync_id_last) + ", then sets the plan's K0, slope and reference in " +
-          "$AC_PARAM to 0 (the drift action owns SD43900-43920)" +
-          (Latches(o) ? " and the blank latch " + Param(o.blank_param + 1) + " to 20 (no blank term)"
-                      : std::string()) +
-          "\n";
+    nc +=
+        "; cancels synchronized actions " + std::to_string(o.sync_id_first) + ".." +
+        std::to_string(o.sync_id_last) + ", then sets the plan's K0, slope and reference in " +
+        "$AC_PARAM to 0 (the drift action owns SD43900-43920)" +
+        (Latches(o) ? " and the blank latch " + Param(o.blank_param + 1) + " to 20 (no blank term)"
+                    : std::string()) +
+        "\n";
     return nc + CancelIds(o) + "STOPRE\n" + writes +
            (Latches(o) ? UnlatchWrite(o).substr(1) + "\n" : std::string()) + "STOPRE\nM17\n";
   }

@@ -41,13 +41,14 @@ void PrintFitGrey(const drift::GreyBoxModel& m) {
               MessageNumber(m.prior_strength).c_str(), m.cv_rmse_um, m.rows);
   const auto per = 1 + m.time_constants.size();
   for (std::size_t i = 0; i < m.offset_sensors.size(); ++i)
-    std::printf("  K0   %-20s %9.3f um/K (sum over its lags)\n", m.offset_sensors[i].c_str(),
-                m.a.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
+    std::printf(
+        "  K0   %-20s %9.3f um/K (sum over its lags)\n", m.offset_sensors[i].c_str(),
+        m.a.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
   std::printf("  G    intercept            %9.3f um per 1000 mm\n", m.slope_intercept_um_per_1000);
   for (std::size_t i = 0; i < m.slope_sensors.size(); ++i)
-    std::printf("  G    %-20s %9.3f um per 1000 mm per K (sum over its lags)\n",
-                m.slope_sensors[i].c_str(),
-                m.g.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
+    std::printf(
+        "  G    %-20s %9.3f um per 1000 mm per K (sum over its lags)\n", m.slope_sensors[i].c_str(),
+        m.g.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
   if (!m.blank_sensor.empty())
     std::printf("  G    blank (%s, latched) %9.3f um per 1000 mm per K\n", m.blank_sensor.c_str(),
                 m.blank_um_per_1000_per_k);

@@ -74,8 +74,9 @@ struct DriftNcModels {
 
 DriftNcModels ReadDriftNcModels(const DriftNcOptions& o) {
   if (o.model_path.empty() == o.grey_model_path.empty())
-    throw InputError("give either --model (a drift model, with --slope-model optional) or "
-                     "--grey-model (a grey box: offset, slope and the latched blank)");
+    throw InputError(
+        "give either --model (a drift model, with --slope-model optional) or "
+        "--grey-model (a grey box: offset, slope and the latched blank)");
   DriftNcModels m;
   if (!o.grey_model_path.empty()) {
     if (!o.slope_model_path.empty())
@@ -183,11 +184,11 @@ void Run(const DriftNcOptions& o) {
                                    {o.csv_path, "PLC table"}})
     if (!path.empty()) std::printf("written: %s (%s)\n", path.c_str(), what);
   if (blank)
-    std::printf("  blank term: lag %.1f min of %s in $AC_PARAM[%d], latched at the cut start in "
-                "$AC_PARAM[%d] (the whirling plan, or your part program: see the program's "
-                "header)\n",
-                blank->tau_min, blank->sensor.c_str(), options.blank_param,
-                options.blank_param + 1);
+    std::printf(
+        "  blank term: lag %.1f min of %s in $AC_PARAM[%d], latched at the cut start in "
+        "$AC_PARAM[%d] (the whirling plan, or your part program: see the program's "
+        "header)\n",
+        blank->tau_min, blank->sensor.c_str(), options.blank_param, options.blank_param + 1);
 }
 
 }  // namespace
@@ -220,8 +221,7 @@ void RegisterDriftNc(CLI::App* drift_app) {
       "g_b (B - 20): B, a lag of the blank sensor, runs in $AC_PARAM[drift.blank_param] and\n"
       "the whirling plan latches it into [blank_param + 1] at the thread start (back to 20\n"
       "at the thread end). Not verified on a control: main-run write access to SD43900-43920.");
-  sub->add_option("--model", o->model_path,
-                  "drift model JSON (whirl drift fit); or --grey-model")
+  sub->add_option("--model", o->model_path, "drift model JSON (whirl drift fit); or --grey-model")
       ->check(CLI::ExistingFile);
   sub->add_option("--grey-model", o->grey_model_path,
                   "grey box model JSON (whirl drift fit-grey) instead of --model/--slope-model: "

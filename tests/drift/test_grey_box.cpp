@@ -8,10 +8,10 @@
 #include <filesystem>
 #include <functional>
 
-#include "core/error.h"
-#include "core/random.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/json_file.h"
+#include "core/random.h"
 #include "drift/grey_box.h"
 #include "drift/grey_box_io.h"
 #include "drift/measurement_file.h"
@@ -357,7 +357,8 @@ TEST(GreyBoxFiles, BadModelSpecAndRecordsFilesNameFileFieldAndRule) {
   const auto dir = test::ScratchDir() / "bad_records";
   std::filesystem::create_directories(dir);
   WriteFileAtomic(dir / "day0.csv", FormatRun(rec.day_logs[0]));
-  const nlohmann::json valid = nlohmann::json::parse(FormatMeasurementRecords(rec, {"day0.csv"}, ""));
+  const nlohmann::json valid =
+      nlohmann::json::parse(FormatMeasurementRecords(rec, {"day0.csv"}, ""));
   auto expect_bad = [&](const std::function<void(nlohmann::json&)>& change,
                         const std::string& what) {
     nlohmann::json j = valid;

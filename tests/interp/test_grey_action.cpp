@@ -126,8 +126,8 @@ double ExpectedDkMm(const replay::Replay& r, const DriftActionOptions& o,
                     const drift::GreyBoxEvaluator& ev, const drift::GreyBoxEvaluator::Output& e,
                     double latched_c, double pos) {
   const double g = e.slope_um_per_1000 + ev.BlankSlope(latched_c);
-  const double machine = Sign(o) / 1000.0 *
-                         (e.k0_um + o.slope_growth_direction * g * (pos - kFixedEndMm) / 1000.0);
+  const double machine =
+      Sign(o) / 1000.0 * (e.k0_um + o.slope_growth_direction * g * (pos - kFixedEndMm) / 1000.0);
   const double workpiece = P(r, 99) + P(r, 97) * (pos - P(r, 98));
   return workpiece + machine;
 }
@@ -153,8 +153,8 @@ TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) 
   drift::GreyBoxEvaluator::Output e;
   auto step_reference = [&] { e = ev.Step(k * kCycleMs / 60000.0, Raw(now)), ++k; };
   SetInputs(r, d, now);
-  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope,
-                                                action.Blank())));
+  ASSERT_TRUE(
+      r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope, action.Blank())));
   EXPECT_EQ(P(r, 96), kBlankNeutralC);
   double worst_mm = 0;
   // A minute before the cut, axis parked: no blank term (the latch reads 20).
@@ -184,7 +184,7 @@ TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) 
     r.Cycle(pos);
     step_reference();
     const bool cutting = t_s < t_end;  // at the thread end the plan's restore has fired
-    if (k - 1 == cut_first) {  // the plan copied B of the cycle before
+    if (k - 1 == cut_first) {          // the plan copied B of the cycle before
       latched = b_before;
       latched_control = b_control_before;
       EXPECT_LT(std::abs(latched_control - latched), 1e-9);
@@ -194,14 +194,14 @@ TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) 
       b_min = std::min(b_min, e.blank_c);
       b_max = std::max(b_max, e.blank_c);
       worst_if_unlatched =
-          std::max(worst_if_unlatched, std::abs(r.control.DkMm(pos) -
-                                                ExpectedDkMm(r, d, ev, e, e.blank_c, pos)));
+          std::max(worst_if_unlatched,
+                   std::abs(r.control.DkMm(pos) - ExpectedDkMm(r, d, ev, e, e.blank_c, pos)));
     } else {
       EXPECT_EQ(P(r, 96), kBlankNeutralC) << "the thread end writes the latch back";
     }
-    worst_mm = std::max(worst_mm, std::abs(r.control.DkMm(pos) -
-                                           ExpectedDkMm(r, d, ev, e,
-                                                        cutting ? latched : kBlankNeutralC, pos)));
+    worst_mm = std::max(
+        worst_mm, std::abs(r.control.DkMm(pos) -
+                           ExpectedDkMm(r, d, ev, e, cutting ? latched : kBlankNeutralC, pos)));
     b_before = e.blank_c;
     b_control_before = P(r, 95);
   }
@@ -232,8 +232,8 @@ TEST(GreyAction, AnAbortedCutsLatchIsWrittenBack) {
     const double parked = AxisPositionMm(p, 2.0, 0.0) + 1.0;
     r.axis_mm = parked;
     SetInputs(r, d, Temperatures(0));
-    ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope,
-                                                  action.Blank())));
+    ASSERT_TRUE(
+        r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope, action.Blank())));
     ASSERT_TRUE(r.RunProgram(FormatNcProgram(plan)));
     for (int k = 0; k < 400; ++k) r.Cycle(AxisPositionMm(p, 2.0, 0.05 * k));  // into the cut
     ASSERT_NE(P(r, 96), kBlankNeutralC);
@@ -259,8 +259,8 @@ TEST(GreyAction, APlanThatDoesNotLatchRefusesAnActionThatReadsTheLatch) {
   replay::Replay r;
   r.axis_mm = AxisPositionMm(no_latch.options, 2.0, 0.0) + 1.0;
   SetInputs(r, d, Temperatures(0));
-  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope,
-                                                action.Blank())));
+  ASSERT_TRUE(
+      r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope, action.Blank())));
   EXPECT_FALSE(r.RunProgram(FormatNcProgram(no_latch)));
   EXPECT_EQ(r.control.alarm, no_latch.options.drift_missing_alarm + 2);
   EXPECT_TRUE(r.RunProgram(FormatNcProgram(latch)));
@@ -358,11 +358,12 @@ TEST(GreyAction, BadInputsAreRefusedWithTheirReason) {
       EXPECT_EQ(q.value, 97.0);
     }
   // The profile's slot pair: not in the drift action's own range, not a workpiece slot.
-  MachineProfile profile = LoadMachineProfile(std::string(WHIRL_SOURCE_DIR) +
-                                              "/datasets/machines/whirling_840d.json");
+  MachineProfile profile =
+      LoadMachineProfile(std::string(WHIRL_SOURCE_DIR) + "/datasets/machines/whirling_840d.json");
   EXPECT_EQ(profile.drift->blank_param, 95);
   profile.drift->blank_param = 100;
-  ExpectRefused([&] { profile.Validate(); }, "drift.blank_param 100 lies in the drift action's own");
+  ExpectRefused([&] { profile.Validate(); },
+                "drift.blank_param 100 lies in the drift action's own");
   profile.drift->blank_param = 96;
   ExpectRefused([&] { profile.Validate(); }, "blank_param 96");
   // A grey box without an offset sensor cannot be a drift action.

@@ -246,8 +246,8 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
     const double g = held.slope_um_per_1000[uk] + (cutting ? g_b * (latch - 20.0) : 0.0);
     const double machine_um = held.k0_um[uk] + g * (r.z_ref_mm - z_at(t1)) / 1000.0;
     const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
-    const double plan_um = t_of(t1) >= 0 && t_of(t1) < t_cut
-                               ? interp::AppliedCompensationUm(p.plan, pos) : 0.0;
+    const double plan_um =
+        t_of(t1) >= 0 && t_of(t1) < t_cut ? interp::AppliedCompensationUm(p.plan, pos) : 0.0;
     worst_um = std::max(worst_um, std::abs(applied_um - machine_um - plan_um));
     cut_samples += cutting;
   }

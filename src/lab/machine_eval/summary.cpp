@@ -100,12 +100,14 @@ MachineStrategy ProgramsStrategy(const std::array<SeedStats, kMachineStrategyCou
     return MachineStrategy::kBothShop;
   }
   if (grey.screws > 0 && grey.total_median_um < shop.total_median_um) {
-    *reason = "both_grey: the grey box leaves less lead error than both_shop's sensor model" +
-              medians;
+    *reason =
+        "both_grey: the grey box leaves less lead error than both_shop's sensor model" + medians;
     return MachineStrategy::kBothGrey;
   }
-  *reason = "both_shop: the grey box does not leave less lead error than both_shop's sensor "
-            "model" + medians;
+  *reason =
+      "both_shop: the grey box does not leave less lead error than both_shop's sensor "
+      "model" +
+      medians;
   return MachineStrategy::kBothShop;
 }
 

@@ -190,7 +190,9 @@ void AddPrograms(const CombinedPrograms* p, const std::string& note, const std::
                 "cycle from the analog inputs: sensors and the control's duty signals";
   doc->Say("The workpiece plan (" + std::to_string(p->plan.segments.size()) +
            " segments of the network's curve) hands K0_w, S_w and P_w over; the machine drift "
-           "action (" + what + ") writes SD43920 "
+           "action (" +
+           what +
+           ") writes SD43920 "
            "= P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b), the fixed bearing "
            "at P_b = " +
            FormatFixed(d.slope_fixed_end_mm, 4) + " mm (MCS). The drift action's output:");
@@ -242,7 +244,8 @@ report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
   const bool grey = programs && programs->grey;
   const std::vector<std::string> thick = grey ? r.grey.Inputs() : r.sensors;
   doc.Say(grey ? "The grey box (both_grey, trained from the shop's measurements; the programs' "
-                 "model) reads the sensors drawn thick: " + List(thick) + "."
+                 "model) reads the sensors drawn thick: " +
+                     List(thick) + "."
                : "The sensor model (" + r.sensors_choice +
                      ", trained from the shop's measurements) reads the sensors drawn thick: " +
                      List(thick) + ".");
@@ -264,15 +267,17 @@ std::optional<CombinedPrograms> Programs(const ReportScrew& r,
   }
   if (r.programs_strategy == MachineStrategy::kBothGrey) {
     try {
-      return BuildCombinedGreyPrograms(
-          r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options,
-          r.grey, *profile, "network curve of screw " + r.result.screw.name,
-          "grey box (both_grey) trained only from shop measurements");
+      return BuildCombinedGreyPrograms(r.predicted_curve, r.kinematics,
+                                       r.result.screw.thread_length_mm, r.plan_options, r.grey,
+                                       *profile, "network curve of screw " + r.result.screw.name,
+                                       "grey box (both_grey) trained only from shop measurements");
     } catch (const InputError& err) {
       *note = std::string("the grey box's programs could not be written (") + err.what() +
               "): both_shop's instead";
-      *reason = "both_shop, as the grey box's programs could not be written; the evaluation had "
-                "picked " + r.programs_reason;
+      *reason =
+          "both_shop, as the grey box's programs could not be written; the evaluation had "
+          "picked " +
+          r.programs_reason;
     }
   }
   try {

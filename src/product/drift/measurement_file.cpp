@@ -24,12 +24,12 @@ MeasurementRecord::Kind ParseKind(const std::string& k) {
 int SampleAt(const Run& log, double t, const std::string& where) {
   const std::vector<double>& time = log.time_min;
   if (time.empty() || t < time.front() || t > time.back())
-    throw InputError(where + ": time_min " + MessageNumber(t) + " lies outside its day log '" +
-                     log.source + "' (" +
-                     (time.empty() ? std::string("no rows")
-                                   : MessageNumber(time.front()) + ".." +
-                                         MessageNumber(time.back()) + " min") +
-                     ")");
+    throw InputError(
+        where + ": time_min " + MessageNumber(t) + " lies outside its day log '" + log.source +
+        "' (" +
+        (time.empty() ? std::string("no rows")
+                      : MessageNumber(time.front()) + ".." + MessageNumber(time.back()) + " min") +
+        ")");
   return static_cast<int>(std::upper_bound(time.begin(), time.end(), t) - time.begin()) - 1;
 }
 
@@ -41,16 +41,18 @@ MeasurementRecord ReadRecord(const json& r, const std::string& where,
   m.name = RequireString(r, "name", where);
   m.kind = ParseKind(RequireOneOf(r, "kind", {"probe", "laser", "lead", "setup_check"}, where));
   m.day = static_cast<int>(RequireInteger(r, "day", 0, 100000, where));
-  m.log = static_cast<int>(
-      RequireInteger(r, "log", 0, static_cast<long long>(logs.size()) - 1, where));
+  m.log =
+      static_cast<int>(RequireInteger(r, "log", 0, static_cast<long long>(logs.size()) - 1, where));
   const std::vector<double> t = RequireNumberArray(r, "time_min", where);
   const std::vector<double> z = RequireNumberArray(r, "z_mm", where);
   const std::vector<double> v = RequireNumberArray(r, "value_um", where);
   const std::vector<double> s = RequireNumberArray(r, "sigma_um", where);
   if (z.size() != t.size() || v.size() != t.size() || s.size() != t.size())
-    throw InputError(where + ": time_min, z_mm, value_um and sigma_um must have one value per "
-                     "reading (" + std::to_string(t.size()) + ", " + std::to_string(z.size()) +
-                     ", " + std::to_string(v.size()) + ", " + std::to_string(s.size()) + ")");
+    throw InputError(where +
+                     ": time_min, z_mm, value_um and sigma_um must have one value per "
+                     "reading (" +
+                     std::to_string(t.size()) + ", " + std::to_string(z.size()) + ", " +
+                     std::to_string(v.size()) + ", " + std::to_string(s.size()) + ")");
   const Run& log = logs[static_cast<std::size_t>(m.log)];
   for (std::size_t k = 0; k < t.size(); ++k) {
     const std::string at = where + " reading " + std::to_string(k);
