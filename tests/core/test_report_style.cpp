@@ -250,12 +250,15 @@ TEST(ReportRender, TextColumnsAndTheirHeadersAreLeftAligned) {
   report::Document doc;
   doc.Add(t);
   const std::string html = report::RenderHtml(doc, {});
-  const std::string left = "<th style='text-align:left'>";
-  EXPECT_NE(html.find(left + "ISO 3408-3 class</th>"), std::string::npos) << html;
-  EXPECT_NE(html.find("<td style='text-align:left'>T7</td>"), std::string::npos) << html;
-  EXPECT_NE(html.find("<th>within 1000 mm [um]</th>"), std::string::npos) << html;
-  EXPECT_NE(html.find("<td>-3.25</td>"), std::string::npos) << html;
-  EXPECT_NE(html.find("<th>note</th>"), std::string::npos) << html;  // nothing in it
+  // Column 3 of 4 is text: the table says so, the stylesheet left-aligns its cells and header.
+  EXPECT_NE(html.find("<table class='l3'>"), std::string::npos) << html;
+  EXPECT_NE(std::string(ReportStylesheet()).find(".l3 td:nth-child(3),.l3 th:nth-child(3)"),
+            std::string::npos);
+  report::Table numbers;
+  numbers.rows = {{"none", "12.5", "-"}};
+  report::Document plain;
+  plain.Add(numbers);
+  EXPECT_NE(report::RenderHtml(plain, {}).find("<table>"), std::string::npos);
 }
 
 // One sensor, one colour: the palette's colours differ, and the i-th series' colour is the

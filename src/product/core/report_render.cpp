@@ -22,6 +22,13 @@ std::string_view ReportStylesheet() {
          "max-width:100%}\n"
          "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right;vertical-align:top}\n"
          "td:first-child,th:first-child{text-align:left}th{background:#eee}\n"
+         // A text column k (names, classes; TextColumns) of a table of class lk, header too.
+         ".l2 td:nth-child(2),.l2 th:nth-child(2),.l3 td:nth-child(3),.l3 th:nth-child(3),"
+         ".l4 td:nth-child(4),.l4 th:nth-child(4),.l5 td:nth-child(5),.l5 th:nth-child(5),"
+         ".l6 td:nth-child(6),.l6 th:nth-child(6),.l7 td:nth-child(7),.l7 th:nth-child(7),"
+         ".l8 td:nth-child(8),.l8 th:nth-child(8),.l9 td:nth-child(9),.l9 th:nth-child(9),"
+         ".l10 td:nth-child(10),.l10 th:nth-child(10),.l11 td:nth-child(11),"
+         ".l11 th:nth-child(11),.l12 td:nth-child(12),.l12 th:nth-child(12){text-align:left}\n"
          "tr.cls td{font-weight:bold}\n"
          ".small{font-size:0.85em;color:#555}.warn{color:#a00}\n"
          ".control{border:2px solid #2a6;background:#f3fbf5;padding:0.4em 1.2em 0.8em;"
@@ -354,17 +361,22 @@ std::vector<bool> TextColumns(const Table& t) {
   return text;
 }
 
+// The table's classes: "series" (Table::series_rows) and "lk" for each text column k (1-based,
+// 2..12; the stylesheet left-aligns its cells and header; the first column is left anyway).
+std::string TableClasses(const Table& t) {
+  std::string c = t.series_rows ? "series" : "";
+  const std::vector<bool> text = TextColumns(t);
+  for (std::size_t k = 1; k < text.size() && k < 12; ++k)
+    if (text[k]) c += (c.empty() ? "l" : " l") + std::to_string(k + 1);
+  return c.empty() ? "" : " class='" + c + "'";
+}
+
 std::string TableHtml(const Table& t) {
   std::ostringstream h;
-  const std::vector<bool> text = TextColumns(t);
-  const auto align = [&text](std::size_t c) {
-    return c < text.size() && text[c] ? " style='text-align:left'" : "";
-  };
-  h << "<table" << (t.series_rows ? " class='series'" : "") << ">";
+  h << "<table" << TableClasses(t) << ">";
   if (!t.header.empty()) {
     h << "<tr>";
-    for (std::size_t c = 0; c < t.header.size(); ++c)
-      h << "<th" << align(c) << ">" << HtmlEscape(t.header[c]) << "</th>";
+    for (const auto& c : t.header) h << "<th>" << HtmlEscape(c) << "</th>";
     h << "</tr>";
   }
   h << "\n";
@@ -377,7 +389,7 @@ std::string TableHtml(const Table& t) {
       h << "<td";
       if (c == 0 && t.series_rows && !cell.not_plotted) h << " data-series='" << HtmlEscape(cell.text) << "'";
       if (cell.colspan > 1) h << " colspan='" << cell.colspan << "'";
-      if (cell.left || (c < text.size() && text[c])) h << " style='text-align:left'";
+      if (cell.left) h << " style='text-align:left'";
       h << ">" << HtmlEscape(cell.text) << "</td>";
     }
     h << "</tr>\n";
