@@ -2,6 +2,7 @@
 // law on log inputs, or the next screws from a trained model's uncertainty, with the stop rule.
 #include <array>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -90,6 +91,22 @@ nlohmann::json InputsJson(const ProcessInputs& x) {
   return j;
 }
 
+// The picks as JSON (both modes): rank, source, inputs, the mode's sd fields (`sd`), why.
+nlohmann::json PicksJson(const DesignCandidates& c, const std::vector<design::Pick>& picks,
+                         const std::function<void(const design::Pick&, nlohmann::json*)>& sd) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t r = 0; r < picks.size(); ++r) {
+    const design::Pick& p = picks[r];
+    nlohmann::json j = {{"rank", r + 1},
+                        {"source", WhereFrom(c, p.candidate)},
+                        {"inputs", InputsJson(c.inputs[p.candidate])},
+                        {"why", p.why}};
+    sd(p, &j);
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
 // The CSV of the picks (both modes): rank, where, five inputs, the sd columns, why.
 std::string DesignCsv(const DesignCandidates& c, const std::vector<design::Pick>& picks,
                       bool next, const std::string& command) {
@@ -134,15 +151,12 @@ void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
   const std::string csv = DesignCsv(c, d.picks, false, "first design, criterion " + o.criterion);
   if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
   if (o.json) {
-    nlohmann::json picks = nlohmann::json::array();
-    for (std::size_t r = 0; r < d.picks.size(); ++r) {
-      const auto& p = d.picks[r];
-      picks.push_back({{"rank", r + 1}, {"source", WhereFrom(c, p.candidate)},
-                       {"inputs", InputsJson(c.inputs[p.candidate])},
-                       {"sd_factor_before", std::isfinite(p.sd_now[0]) ? nlohmann::json(p.sd_now[0])
-                                                                       : nlohmann::json(nullptr)},
-                       {"sd_factor_after", p.sd_after[0]}, {"why", p.why}});
-    }
+    const nlohmann::json picks =
+        PicksJson(c, d.picks, [](const design::Pick& p, nlohmann::json* j) {
+          (*j)["sd_factor_before"] =
+              std::isfinite(p.sd_now[0]) ? nlohmann::json(p.sd_now[0]) : nlohmann::json(nullptr);
+          (*j)["sd_factor_after"] = p.sd_after[0];
+        });
     PrintJson({{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
                {"candidate_count", c.inputs.size()}, {"coefficients", d.coefficients},
                {"varying_inputs", d.inputs}, {"log_det_per_screw", d.log_det},
@@ -190,16 +204,13 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
   const std::string csv = DesignCsv(c, d.picks, true, "next screws from " + o.model_path);
   if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
   if (o.json) {
-    nlohmann::json picks = nlohmann::json::array();
-    for (std::size_t r = 0; r < d.picks.size(); ++r) {
-      const auto& p = d.picks[r];
-      picks.push_back({{"rank", r + 1}, {"source", WhereFrom(c, p.candidate)},
-                       {"inputs", InputsJson(c.inputs[p.candidate])},
-                       {"max_elongation_sd_now_um", p.sd_now[0]},
-                       {"max_elongation_sd_after_um", p.sd_after[0]},
-                       {"settle_time_sd_now_s", p.sd_now[1]},
-                       {"settle_time_sd_after_s", p.sd_after[1]}, {"why", p.why}});
-    }
+    const nlohmann::json picks =
+        PicksJson(c, d.picks, [](const design::Pick& p, nlohmann::json* j) {
+          (*j)["max_elongation_sd_now_um"] = p.sd_now[0];
+          (*j)["max_elongation_sd_after_um"] = p.sd_after[0];
+          (*j)["settle_time_sd_now_s"] = p.sd_now[1];
+          (*j)["settle_time_sd_after_s"] = p.sd_after[1];
+        });
     nlohmann::json j = {{"mode", "next"}, {"model", o.model_path},
                         {"model_describe", model.Describe()}, {"candidates", c.source},
                         {"candidate_count", c.inputs.size()}, {"picks", picks},

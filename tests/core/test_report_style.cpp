@@ -201,5 +201,75 @@ TEST(ReportRender, ColumnsAreGnuplotExpressionsOfNumbers) {
   EXPECT_NE(gp.find("'' using 1:($3==1?$2:1/0) "), std::string::npos) << gp;
 }
 
+// A band's edges are the prediction's column shifted by -sd and +sd; its legend entry says it
+// is a band (data-kind), the line's that it is a line.
+TEST(ReportRender, BandEdgesAreTheColumnShiftedBySd) {
+  report::Panel p;
+  p.series.push_back({"d.csv",
+                      -1,
+                      {report::Col(1, 60), report::Shifted(3, -1.5), report::Shifted(3, 2.25)},
+                      report::SeriesKind::kBand,
+                      "model",
+                      "",
+                      1.5,
+                      false,
+                      "model +- 1 sd"});
+  p.series.push_back({"d.csv",
+                      -1,
+                      {report::Col(1, 60), report::Col(3)},
+                      report::SeriesKind::kLine,
+                      "model",
+                      "",
+                      1.5,
+                      false,
+                      "model"});
+  report::Figure fig;
+  fig.stem = "x";
+  fig.panels = {p};
+  report::Document doc;
+  doc.Add(fig);
+  const std::string gp = report::GnuplotScript(fig);
+  EXPECT_NE(gp.find("'d.csv' using (($1)/60):($3-1.5):($3+2.25) with filledcurves"),
+            std::string::npos)
+      << gp;
+  const std::string html = report::RenderHtml(doc, {"x"});
+  EXPECT_NE(html.find("data-series='model' data-colour='#1f77b4' data-kind='band'"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("data-series='model' data-colour='#1f77b4' data-kind='line'"),
+            std::string::npos)
+      << html;
+}
+
+// The header of a text column is left-aligned like its cells; a column of numbers stays
+// right-aligned under its header.
+TEST(ReportRender, TextColumnsAndTheirHeadersAreLeftAligned) {
+  report::Table t;
+  t.header = {"strategy", "within 1000 mm [um]", "ISO 3408-3 class", "note"};
+  t.rows = {{"none", "12.5", "T7", "-"}, {"model", "-3.25", "P3", ""}};
+  report::Document doc;
+  doc.Add(t);
+  const std::string html = report::RenderHtml(doc, {});
+  // Column 3 of 4 is text: the table says so, the stylesheet left-aligns its cells and header.
+  EXPECT_NE(html.find("<table class='l3'>"), std::string::npos) << html;
+  EXPECT_NE(std::string(ReportStylesheet()).find(".l3 td:nth-child(3),.l3 th:nth-child(3)"),
+            std::string::npos);
+  report::Table numbers;
+  numbers.rows = {{"none", "12.5", "-"}};
+  report::Document plain;
+  plain.Add(numbers);
+  EXPECT_NE(report::RenderHtml(plain, {}).find("<table>"), std::string::npos);
+}
+
+// One sensor, one colour: the palette's colours differ, and the i-th series' colour is the
+// palette's i-th whichever panel it is drawn in.
+TEST(PlotStyle, PaletteColoursDifferAndFollowTheIndex) {
+  const auto& palette = SeriesPalette();
+  EXPECT_GE(palette.size(), 13u);  // the simulated machine's sensors, each its own
+  EXPECT_EQ(std::set<std::string_view>(palette.begin(), palette.end()).size(), palette.size());
+  for (std::size_t i = 0; i < 2 * palette.size(); ++i)
+    EXPECT_EQ(PaletteColour(i), palette[i % palette.size()]);
+}
+
 }  // namespace
 }  // namespace whirl

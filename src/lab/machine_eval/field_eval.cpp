@@ -1,6 +1,7 @@
 #include "machine_eval/field_eval.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -115,6 +116,41 @@ struct DayHeld {
   HeldSamples sensors, warmup, schedule, monitored, grey;
 };
 
+// ReportScrew::sd_um of a cut: each strategy's compensation sd from its training data only.
+std::array<double, kMachineStrategyCount> StrategySd(const compare::ScrewComparison& c,
+                                                     const FieldMachineModels& models,
+                                                     const compare::ExperienceRule& rule,
+                                                     double thread_length_mm) {
+  const auto both = [](double a, double b) { return std::hypot(a, b); };
+  const double net = c.prediction.stddev.max_elongation_um;
+  std::array<double, compare::kHistoryRuleCount> rules{};
+  for (std::size_t k = 0; k < rules.size(); ++k)
+    rules[k] = rule.has_choice ? rule.choice.loo_relative_error[k] *
+                                     std::abs(c.history_features[k].max_elongation_um)
+                               : 0.0;
+  double mean = 0, var = 0;
+  const auto& past = models.lead_slopes;
+  for (const PastLeadSlope& p : past) mean += p.slope_um_per_m / static_cast<double>(past.size());
+  for (const PastLeadSlope& p : past)
+    var += (p.slope_um_per_m - mean) * (p.slope_um_per_m - mean) /
+           static_cast<double>(std::max<std::size_t>(1, past.size() - 1));
+  const double slope = std::sqrt(var) * thread_length_mm / 1000.0;
+  const ShopModels& m = models.shop;
+  return {0.0,
+          rules[static_cast<std::size_t>(c.traditional_rule)],
+          net,
+          rules[0],
+          rules[1],
+          rules[2],
+          both(net, m.warmup.cv_rmse_um),
+          both(net, m.schedule.cv_rmse_um),
+          both(net, slope),
+          m.sensors.cv_rmse_um,
+          both(net, m.sensors.cv_rmse_um),
+          both(net, m.sensors.cv_rmse_um),
+          both(net, m.grey.cv_rmse_um)};
+}
+
 // One test-day cut, every strategy; `report` (optional) receives its curves (the rest of the
 // report screw is the caller's).
 MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, const DayHeld& held,
@@ -169,6 +205,7 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
   detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out,
                           report ? &report->leads : nullptr);
   if (report) {
+    report->sd_um = StrategySd(c, models, wp.rule, job.screw.thread_length_mm);
     report->predicted_curve = c.predicted_curve;
     report->kinematics = c.kinematics;
     report->plan_options = wp.options.plan;

@@ -151,6 +151,13 @@ struct ReportScrew {
   std::string scenario;
   MachineEvalScrew result;
   std::array<lead::LeadDeviation, kMachineStrategyCount> leads;  ///< per strategy
+  /// Per strategy: the sd of its compensation from its training data only, um (0 for none; the
+  /// report's +-1 sd bands): the network's predictive sd of the maximum elongation; a history
+  /// rule's leave-one-out mean relative error on the history times its plateau; warmup,
+  /// schedule, the sensor model (and the monitored one) and the grey box: their grouped CV RMSE
+  /// over the shop's records; lead_slope: the sd of the past screws' slopes over the thread;
+  /// a strategy of two halves: both in quadrature.
+  std::array<double, kMachineStrategyCount> sd_um{};
   /// The control's log of the screw's day (temperatures through the control's input filter, the
   /// duty signals) from power-on to two samples after the cut; time_min from the day's 00:00.
   drift::Run log;

@@ -4,6 +4,7 @@
 #include "machine_report/machine_report.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -64,7 +65,7 @@ report::Figure SensorFigure(const drift::Run& log, const std::string& title,
       report::Series s;
       s.file = "sensors.csv";
       s.columns = {Col(1), Col(static_cast<int>(panel[j]) + 2)};
-      s.colour = std::string(SeriesPalette()[j % SeriesPalette().size()]);
+      s.colour = std::string(PaletteColour(panel[j]));  // the sensor's own, in every panel
       s.width = model ? 3.5 : 1.5;
       s.title = name;
       p.series.push_back(std::move(s));
@@ -94,8 +95,10 @@ std::vector<std::vector<std::size_t>> LeadPanels() {
   return panels;
 }
 
-// Every strategy in its colour and dash (core/plot_style.h), x from the thread start to its end.
-report::Figure LeadFigure(const std::string& title, double thread_length_mm) {
+// Every strategy in its colour and dash (core/plot_style.h), x from the thread start to its end,
+// each compensated one with its +-1 sd band (`sd_um`: ReportScrew::sd_um) under the lines.
+report::Figure LeadFigure(const std::string& title, double thread_length_mm,
+                          const std::array<double, kMachineStrategyCount>& sd_um) {
   report::Figure f;
   f.stem = "lead";
   f.alt = title;
@@ -105,6 +108,14 @@ report::Figure LeadFigure(const std::string& title, double thread_length_mm) {
     p.xlabel = "position along the thread [mm]";
     p.ylabel = "travel deviation [um]";
     p.x = {0, thread_length_mm};
+    for (std::size_t k : panel) {
+      if (!(sd_um[k] > 0)) continue;
+      const std::string name = machine_eval::ToString(static_cast<MachineStrategy>(k));
+      const int c = static_cast<int>(k) + 2;
+      p.series.push_back(
+          report::SdBand("lead.csv", Col(1), c, sd_um[k], name,
+                         name + " +- 1 sd (" + FormatDecimals(sd_um[k], 1) + " um)"));
+    }
     for (std::size_t k : panel) {
       const std::string name = machine_eval::ToString(static_cast<MachineStrategy>(k));
       p.series.push_back({"lead.csv", -1, {Col(1), Col(static_cast<int>(k) + 2)}, SeriesKind::kLine,
@@ -199,14 +210,17 @@ void AddPrograms(const CombinedPrograms* p, const std::string& note, const std::
   doc->Add(report::Preformatted{OutputAction(p->drift_nc)});
 }
 
-report::Table StrategyTable(const machine_eval::MachineEvalScrew& r) {
+report::Table StrategyTable(const machine_eval::MachineEvalScrew& r,
+                            const std::array<double, kMachineStrategyCount>& sd_um) {
   report::Table t;
   t.series_rows = true;
-  t.header = {"strategy", "within 1000 mm [um]", "over the thread [um]", "ISO 3408-3 class"};
+  t.header = {"strategy", "within 1000 mm [um]", "over the thread [um]", "ISO 3408-3 class",
+              "band +-1 sd [um]"};
   for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
     t.rows.push_back({machine_eval::ToString(static_cast<MachineStrategy>(k)),
                       FormatDecimals(r.metrics[k].accumulated_1000_um, 1),
-                      FormatDecimals(r.metrics[k].accumulated_total_um, 1), ToString(r.iso[k])});
+                      FormatDecimals(r.metrics[k].accumulated_total_um, 1), ToString(r.iso[k]),
+                      sd_um[k] > 0 ? FormatDecimals(sd_um[k], 1) : "-"});
   return t;
 }
 
@@ -227,6 +241,15 @@ void AddStrategyNotes(const machine_eval::MachineEvalScrew& r, report::Document*
       "box (absolute temperatures, a slope intercept, the blank latched at the cut start). The "
       "programs above apply both_grey or both_shop, as said under them.",
       report::Tone::kSmall);
+  doc->Say(
+      "The shaded bands: each strategy's curve +- 1 sd of its compensation, the sd from its "
+      "training data only (never from the test days): the network's predictive sd of the "
+      "maximum elongation; a history rule's leave-one-out mean relative error on the history "
+      "times its plateau; warmup, schedule, the sensor model (also for both_shop_monitor) and "
+      "the grey box: their grouped CV RMSE over the shop's records; lead_slope: the sd of the "
+      "past screws' slopes over the thread; two halves in quadrature. It is the scale of how far "
+      "the compensation may be off, not an interval computed for this lead curve.",
+      report::Tone::kSmall);
 }
 
 report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
@@ -237,9 +260,9 @@ report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
   if (programs) doc.Add(ControlBox(x.screw.name, *programs));
   doc.Say("Scenario " + r.scenario + ", machine " + std::to_string(x.machine) + ", test day " +
           std::to_string(x.day) + ", start type " + x.start_type + ".");
-  doc.Add(report::Heading{2, "Lead deviation per strategy", ""}).Add(StrategyTable(x));
+  doc.Add(report::Heading{2, "Lead deviation per strategy", ""}).Add(StrategyTable(x, r.sd_um));
   AddStrategyNotes(x, &doc);
-  doc.Add(LeadFigure(x.screw.name + ": lead deviation", x.screw.thread_length_mm));
+  doc.Add(LeadFigure(x.screw.name + ": lead deviation", x.screw.thread_length_mm, r.sd_um));
   doc.Add(report::Heading{2, "Sensors", ""});
   const bool grey = programs && programs->grey;
   const std::vector<std::string> thick = grey ? r.grey.Inputs() : r.sensors;

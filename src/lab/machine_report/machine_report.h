@@ -29,15 +29,16 @@ struct MachineReport {
 /// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a
 /// symbolic link; written all-or-nothing): sensors.csv/.png (the control's log of the screw's
 /// day from power-on to the cut's end in the drift run format, the temperatures in panels of at
-/// most 8 sensors, related ones together, the sensor model's sensors thick; degC over min since
-/// the day's 00:00), lead.csv/.png (lead deviation per strategy, um over mm from the thread start
-/// to its end, each strategy in its core/plot_style.h look), index.html (core/report_render.h) with
+/// most 8 sensors, related ones together, each sensor in one colour in every panel, the sensor
+/// model's sensors thick; degC over min since the day's 00:00), lead.csv/.png (lead deviation per
+/// strategy, um over mm from the thread start to its end, each strategy in its core/plot_style.h
+/// look with its +-1 sd band, ReportScrew::sd_um), index.html (core/report_render.h) with
 /// the strategies' figures and the sensor model. Plots need gnuplot (skipped with a note
 /// otherwise). With a `profile` that fits the machine, the screw's combined 840D programs are
 /// written beside the figures and the page opens with the "load onto the control" box
-/// (plan/load.h LoadBox, rendered by core/report_render.h): the plan's setting data, the five files, the
-/// machine data both programs need (each datum once), the call order and what to run after an
-/// abort; a profile that does not fit leaves them out with the note returned (the report
+/// (plan/load.h LoadBox, rendered by core/report_render.h): the plan's setting data, the five
+/// files, the machine data both programs need (each datum once), the call order and what to run
+/// after an abort; a profile that does not fit leaves them out with the note returned (the report
 /// stands). InputError for a screw whose evaluation failed.
 MachineReport WriteMachineScrewReport(const std::string& dir,
                                       const machine_eval::ReportScrew& screw,

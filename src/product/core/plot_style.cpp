@@ -75,8 +75,13 @@ std::string GnuplotWith(std::string_view name) {
 
 const std::vector<std::string_view>& SeriesPalette() {
   static const std::vector<std::string_view> kPalette = {
-      "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+      "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+      "#bcbd22", "#17becf", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd"};
   return kPalette;
+}
+
+std::string_view PaletteColour(std::size_t index) {
+  return SeriesPalette()[index % SeriesPalette().size()];
 }
 
 std::vector<std::vector<std::size_t>> GroupSeries(const std::vector<std::string>& names,

@@ -45,8 +45,14 @@ const SeriesStyle* FindSeriesStyle(std::string_view name);
 /// name without an entry gets thin grey dots (visible, and obviously not one of the table's looks).
 std::string GnuplotWith(std::string_view name);
 
-/// Eight well-separated colours for plots of many unnamed series (sensors), in order.
+/// Sixteen well-separated colours for plots of many unnamed series (sensors), in order: Tableau
+/// 10, then six dark tones of Tableau 20b/c.
 const std::vector<std::string_view>& SeriesPalette();
+
+/// The colour of the `index`-th of a set of unnamed series (a sensor's column in its log): the
+/// palette's colour `index` (repeating only past its size), so one sensor has one colour in
+/// every panel and figure of a report.
+std::string_view PaletteColour(std::size_t index);
 
 /// Splits `names` into plots of at most `max_per_plot` series (>= 1), keeping related series
 /// together: names sharing the text before their first '_' ("bed_headstock_C", "bed_middle_C")

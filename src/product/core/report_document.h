@@ -72,18 +72,22 @@ struct Preformatted {
   std::string text;
 };
 
-/// One column of a data file as gnuplot reads it: `$index`, or `$index + $plus - $minus`, divided by
-/// `divide` (e.g. minutes to hours: 60); `only_if_column` > 0: only rows whose column holds
+/// One column of a data file as gnuplot reads it: `$index`, or `$index + $plus - $minus`, divided
+/// by `divide` (e.g. minutes to hours: 60), plus the constant `add` (e.g. a band's -sd or +sd
+/// around a prediction's column); `only_if_column` > 0: only rows whose column holds
 /// `only_if_value` (others are left out).
 struct Column {
   int index = 1;
   int plus = 0;
   int minus = 0;
   double divide = 1;
+  double add = 0;
   int only_if_column = 0;
   double only_if_value = 0;
 };
 Column Col(int index, double divide = 1);
+/// The column `index` plus the constant `add` (a band's edge: Shifted(k, -sd), Shifted(k, sd)).
+Column Shifted(int index, double add);
 
 enum class SeriesKind {
   kLine,        ///< a line in the look of `style` (core/plot_style.h)
@@ -113,6 +117,9 @@ struct Series {
   /// it stays visible (a dash pattern vanishes under another line).
   bool markers = false;
 };
+
+/// The +-`sd` band of the prediction in column `y` of `file` over `x`, in the look `style`.
+Series SdBand(std::string file, Column x, int y, double sd, std::string style, std::string title);
 
 struct Range {
   double low = NAN, high = NAN;  ///< NaN: chosen by gnuplot

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 
@@ -21,6 +22,13 @@ std::string_view ReportStylesheet() {
          "max-width:100%}\n"
          "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right;vertical-align:top}\n"
          "td:first-child,th:first-child{text-align:left}th{background:#eee}\n"
+         // A text column k (names, classes; TextColumns) of a table of class lk, header too.
+         ".l2 td:nth-child(2),.l2 th:nth-child(2),.l3 td:nth-child(3),.l3 th:nth-child(3),"
+         ".l4 td:nth-child(4),.l4 th:nth-child(4),.l5 td:nth-child(5),.l5 th:nth-child(5),"
+         ".l6 td:nth-child(6),.l6 th:nth-child(6),.l7 td:nth-child(7),.l7 th:nth-child(7),"
+         ".l8 td:nth-child(8),.l8 th:nth-child(8),.l9 td:nth-child(9),.l9 th:nth-child(9),"
+         ".l10 td:nth-child(10),.l10 th:nth-child(10),.l11 td:nth-child(11),"
+         ".l11 th:nth-child(11),.l12 td:nth-child(12),.l12 th:nth-child(12){text-align:left}\n"
          "tr.cls td{font-weight:bold}\n"
          ".small{font-size:0.85em;color:#555}.warn{color:#a00}\n"
          ".control{border:2px solid #2a6;background:#f3fbf5;padding:0.4em 1.2em 0.8em;"
@@ -71,78 +79,56 @@ Column Col(int index, double divide) {
   c.divide = divide;
   return c;
 }
+Column Shifted(int index, double add) {
+  Column c;
+  c.index = index;
+  c.add = add;
+  return c;
+}
+Series SdBand(std::string file, Column x, int y, double sd, std::string style, std::string title) {
+  Series s;
+  s.file = std::move(file);
+  s.columns = {x, Shifted(y, -sd), Shifted(y, sd)};
+  s.kind = SeriesKind::kBand;
+  s.style = std::move(style);
+  s.title = std::move(title);
+  return s;
+}
 
-Block MakeBlock(Heading h) {
+namespace {
+// A block of `kind` holding `value` in its member `field`.
+template <typename T>
+Block Made(Block::Kind kind, T Block::*field, T value) {
   Block b;
-  b.kind = Block::Kind::kHeading;
-  b.heading = std::move(h);
+  b.kind = kind;
+  b.*field = std::move(value);
   return b;
 }
+Document& Append(Document* doc, Block b) {
+  doc->blocks.push_back(std::move(b));
+  return *doc;
+}
+}  // namespace
+
+Block MakeBlock(Heading h) { return Made(Block::Kind::kHeading, &Block::heading, std::move(h)); }
 Block MakeBlock(Paragraph p) {
-  Block b;
-  b.kind = Block::Kind::kParagraph;
-  b.paragraph = std::move(p);
-  return b;
+  return Made(Block::Kind::kParagraph, &Block::paragraph, std::move(p));
 }
-Block MakeBlock(Table t) {
-  Block b;
-  b.kind = Block::Kind::kTable;
-  b.table = std::move(t);
-  return b;
-}
-Block MakeBlock(List l) {
-  Block b;
-  b.kind = Block::Kind::kList;
-  b.list = std::move(l);
-  return b;
-}
+Block MakeBlock(Table t) { return Made(Block::Kind::kTable, &Block::table, std::move(t)); }
+Block MakeBlock(List l) { return Made(Block::Kind::kList, &Block::list, std::move(l)); }
 Block MakeBlock(Preformatted p) {
-  Block b;
-  b.kind = Block::Kind::kPreformatted;
-  b.pre = std::move(p);
-  return b;
+  return Made(Block::Kind::kPreformatted, &Block::pre, std::move(p));
 }
-Block MakeBlock(Figure f) {
-  Block b;
-  b.kind = Block::Kind::kFigure;
-  b.figure = std::move(f);
-  return b;
-}
-Block MakeBlock(Box x) {
-  Block b;
-  b.kind = Block::Kind::kBox;
-  b.box = std::move(x);
-  return b;
-}
+Block MakeBlock(Figure f) { return Made(Block::Kind::kFigure, &Block::figure, std::move(f)); }
+Block MakeBlock(Box x) { return Made(Block::Kind::kBox, &Block::box, std::move(x)); }
 
-Document& Document::Add(Heading h) {
-  blocks.push_back(MakeBlock(std::move(h)));
-  return *this;
-}
-Document& Document::Add(Paragraph p) {
-  blocks.push_back(MakeBlock(std::move(p)));
-  return *this;
-}
-Document& Document::Add(Table t) {
-  blocks.push_back(MakeBlock(std::move(t)));
-  return *this;
-}
-Document& Document::Add(List l) {
-  blocks.push_back(MakeBlock(std::move(l)));
-  return *this;
-}
-Document& Document::Add(Preformatted p) {
-  blocks.push_back(MakeBlock(std::move(p)));
-  return *this;
-}
-Document& Document::Add(Figure f) {
-  blocks.push_back(MakeBlock(std::move(f)));
-  return *this;
-}
-Document& Document::Add(Box b) {
-  blocks.push_back(MakeBlock(std::move(b)));
-  return *this;
-}
+Document& Document::Add(Heading h) { return Append(this, MakeBlock(std::move(h))); }
+Document& Document::Add(Paragraph p) { return Append(this, MakeBlock(std::move(p))); }
+Document& Document::Add(Table t) { return Append(this, MakeBlock(std::move(t))); }
+Document& Document::Add(List l) { return Append(this, MakeBlock(std::move(l))); }
+Document& Document::Add(Preformatted p) { return Append(this, MakeBlock(std::move(p))); }
+Document& Document::Add(Figure f) { return Append(this, MakeBlock(std::move(f))); }
+Document& Document::Add(Box b) { return Append(this, MakeBlock(std::move(b))); }
 Document& Document::Add(const std::vector<Block>& more) {
   blocks.insert(blocks.end(), more.begin(), more.end());
   return *this;
@@ -171,6 +157,10 @@ std::string ColumnText(const Column& c) {
   }
   if (c.divide != 1) {
     e = "(" + e + ")/" + FormatNumber(c.divide);
+    plain = false;
+  }
+  if (c.add != 0) {
+    e += (c.add > 0 ? "+" : "-") + FormatNumber(std::abs(c.add));
     plain = false;
   }
   if (c.only_if_column > 0) {
@@ -202,7 +192,8 @@ bool IsSurface(const Panel& p) {
   return false;
 }
 
-std::string With(const Series& s, bool surface) {
+// `bands`: how many bands the panel shades; the more, the lighter each (overlaps stay readable).
+std::string With(const Series& s, bool surface, int bands) {
   const std::string lc = "lc rgb '" + Colour(s) + "'";
   const std::string nocontours = surface ? "nocontours " : "";
   switch (s.kind) {
@@ -214,7 +205,8 @@ std::string With(const Series& s, bool surface) {
       return w;
     }
     case SeriesKind::kBand:
-      return "with filledcurves fs transparent solid 0.15 noborder " + lc;
+      return "with filledcurves fs transparent solid " +
+             FormatNumber(bands <= 2 ? 0.15 : std::max(0.06, 0.3 / bands)) + " noborder " + lc;
     case SeriesKind::kPoints:
       return nocontours + "with points pt 7 ps 1.2 " + lc;
     case SeriesKind::kOpenPoints:
@@ -289,13 +281,17 @@ std::string PlotCommand(const Panel& p) {
   s << (surface ? "splot " : "plot ");
   if (p.series.empty()) return s.str() + "1/0 notitle\n";
   std::string last_file;
+  const auto bands =
+      static_cast<int>(std::count_if(p.series.begin(), p.series.end(),
+                                     [](const Series& x) { return x.kind == SeriesKind::kBand; }));
   for (std::size_t i = 0; i < p.series.size(); ++i) {
     const Series& x = p.series[i];
     s << (i ? ", " : "") << (x.file == last_file ? "''" : GnuplotString(x.file));
     last_file = x.file;
     if (x.block >= 0) s << " index " << x.block;
-    s << " using " << Using(x) << (x.right_axis ? " axes x1y2" : "") << " " << With(x, surface)
-      << " " << (x.title.empty() ? "notitle" : "title " + GnuplotString(x.title));
+    s << " using " << Using(x) << (x.right_axis ? " axes x1y2" : "") << " "
+      << With(x, surface, bands) << " "
+      << (x.title.empty() ? "notitle" : "title " + GnuplotString(x.title));
   }
   return s.str() + "\n";
 }
@@ -337,9 +333,47 @@ const char* ToneClass(Tone t) {
   return "";
 }
 
+// A cell that reads as a number ("3.2", "-5 %", "1e-3 um"); "" and "-" (nothing to show) do not.
+bool Numeric(const std::string& text) {
+  if (text.empty() || text == "-") return false;
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  return end != text.c_str();
+}
+
+// Per column: a text column (names, ISO classes, yes/no: some cell and no cell a number, or every
+// cell marked left) is left-aligned, its header too; numbers stay right-aligned under theirs.
+std::vector<bool> TextColumns(const Table& t) {
+  std::size_t n = t.header.size();
+  for (const auto& row : t.rows) n = std::max(n, row.size());
+  std::vector<bool> text(n, false);
+  for (std::size_t c = 0; c < n; ++c) {
+    bool any = false, number = false, left = true;
+    for (const auto& row : t.rows) {
+      if (c >= row.size() || row[c].colspan > 1) continue;
+      const std::string& x = row[c].text;
+      any = any || (!x.empty() && x != "-");
+      number = number || Numeric(x);
+      left = left && row[c].left;
+    }
+    text[c] = any && (!number || left);
+  }
+  return text;
+}
+
+// The table's classes: "series" (Table::series_rows) and "lk" for each text column k (1-based,
+// 2..12; the stylesheet left-aligns its cells and header; the first column is left anyway).
+std::string TableClasses(const Table& t) {
+  std::string c = t.series_rows ? "series" : "";
+  const std::vector<bool> text = TextColumns(t);
+  for (std::size_t k = 1; k < text.size() && k < 12; ++k)
+    if (text[k]) c += (c.empty() ? "l" : " l") + std::to_string(k + 1);
+  return c.empty() ? "" : " class='" + c + "'";
+}
+
 std::string TableHtml(const Table& t) {
   std::ostringstream h;
-  h << "<table" << (t.series_rows ? " class='series'" : "") << ">";
+  h << "<table" << TableClasses(t) << ">";
   if (!t.header.empty()) {
     h << "<tr>";
     for (const auto& c : t.header) h << "<th>" << HtmlEscape(c) << "</th>";
@@ -381,7 +415,21 @@ const char* DashArray(int dash) {
   }
 }
 
-// One legend entry: a swatch in the series' look and its words.
+// What a legend entry draws: "band" (a +-1 sd region), "points", or "line" (lines, maps).
+const char* LegendKind(SeriesKind k) {
+  switch (k) {
+    case SeriesKind::kBand:
+      return "band";
+    case SeriesKind::kPoints:
+    case SeriesKind::kOpenPoints:
+      return "points";
+    default:
+      return "line";
+  }
+}
+
+// One legend entry: a swatch in the series' look and its words, with data-series (the look),
+// data-colour and data-kind (LegendKind) for a test to read.
 std::string LegendEntry(const Series& s) {
   const std::string colour = Colour(s);
   int dash = 1;
@@ -396,7 +444,8 @@ std::string LegendEntry(const Series& s) {
   std::ostringstream h;
   h << "<li";
   if (!s.style.empty()) h << " data-series='" << HtmlEscape(s.style) << "'";
-  h << " data-colour='" << HtmlEscape(colour) << "'><svg width='40' height='12' aria-hidden='true'>";
+  h << " data-colour='" << HtmlEscape(colour) << "' data-kind='" << LegendKind(s.kind)
+    << "'><svg width='40' height='12' aria-hidden='true'>";
   switch (s.kind) {
     case SeriesKind::kBand:
       h << "<rect x='0' y='1' width='40' height='10' fill='" << colour

@@ -4,9 +4,9 @@
 // monitor and surface reports look alike and a change of style is made once), each figure as a
 // gnuplot script (<stem>.gp, kept beside its data so anyone can re-plot) rendered to <stem>.png
 // by gnuplot (pngcairo, falling back to png; run through OutputDir::RunInStaging, an argument
-// vector and no shell), and beside each picture
-// its legend in HTML: one entry per titled series, drawn in the series' look (core/plot_style.h)
-// with `data-series` (the look's key) and `data-colour` attributes a test can read. The pictures
+// vector and no shell), and beside each picture its legend in HTML: one entry per titled
+// series, drawn in the series' look (core/plot_style.h) with `data-series` (the look's key),
+// `data-colour` and `data-kind` (line, band, points) attributes a test can read. The pictures
 // carry no key of their own (it can neither cover the data nor be clipped); the scripts keep
 // every series' title, so `set key` in a script brings it back.
 // Safety: every string of the document reaches the page through HtmlEscape and the scripts

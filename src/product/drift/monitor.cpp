@@ -583,6 +583,7 @@ class Replayer {
     r.score_last_time = score_last_time_;
     r.monitored_min = last_time_ - start_time_;
     r.threshold_um = config_->threshold_um;
+    r.training_residual_std_um = model_.residual_std_um;
     r.none = none_.Stats();
     r.scored.emplace_back("none", none_);
     if (model_.zero.zero == ErrorZero::kAsLogged)

@@ -181,6 +181,9 @@ struct MonitorResult {
   int score_begin = 0, score_end = 0;      ///< scored rows [begin, end)
   double monitored_min = 0;                ///< t_end - start [min; samples]
   double threshold_um = 0;                 ///< the threshold in force
+  /// The model's training residual std (drift/model.h DriftModel::residual_std_um): the +-1 sd
+  /// band of every rule's prediction in the report.
+  double training_residual_std_um = 0;
   ErrorStats none;                         ///< no compensation over the scored rows
   std::vector<StrategyResult> strategies;  ///< static first, then options.rules
   std::vector<BaselineResult> baselines;   ///< sensor-free baselines (MonitorRun's argument)

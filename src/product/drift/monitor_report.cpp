@@ -446,6 +446,14 @@ report::Figure MonitorFigure(const MonitorResult& r, const std::string& prefix) 
     p->xlabel = r.time_from_index ? "sample" : "time [h]";
     p->x_marks = {(r.last_time - r.monitored_min) / per};
   }
+  // Each rule's +-1 sd band (the model's training residual std) under the lines.
+  const double sd = r.training_residual_std_um;
+  for (std::size_t i = 0; i < q && sd > 0; ++i) {
+    const std::string rule = ToString(r.strategies[i].rule);
+    const int k = static_cast<int>(i) + 3;
+    top.series.push_back(report::SdBand(timeline, Col(1, per), k, sd, rule,
+                                        rule + " +- 1 sd (" + FormatDecimals(sd, 2) + " um)"));
+  }
   top.series.push_back({timeline, -1, {Col(1, per), Col(2)}, SeriesKind::kLine, "measured", "", 1.5,
                         false, "measured"});
   for (std::size_t i = 0; i < q; ++i) {
@@ -556,25 +564,64 @@ report::Table WeekTable(const WeekResult& w) {
   return t;
 }
 
-// One run's part of the page: what was run, the table, the updates, the figure, the data.
+// What the monitor ran with: the model, the check interval, the threshold, the refits.
+std::string SettingsText(const MonitorResult& r, const MonitorOptions& o) {
+  const bool idx = r.time_from_index;
+  const std::string every = idx ? " samples" : " min";
+  return r.error_column + ", " + r.model_kind + " model; checks every " +
+         MessageNumber(o.check_every) + every + ", threshold " + FormatDecimals(r.threshold_um, 2) +
+         " um, " + std::to_string(o.refit_samples) + " refit measurements every " +
+         MessageNumber(o.refit_every) + every + ", " + MessageNumber(o.stop_min_per_measurement) +
+         " min stop each" +
+         (idx ? " (no recorded time: intervals count samples; stop share not computed)" : "");
+}
+
+// The scored part of a run: "6.00 to 14.50 h" (or samples).
+std::string ScoredSpan(const MonitorResult& r) {
+  const double to_h = r.time_from_index ? 1.0 : 1.0 / 60.0;
+  return FormatDecimals(r.score_first_time * to_h, 2) + " to " +
+         FormatDecimals(r.score_last_time * to_h, 2) + (r.time_from_index ? " samples" : " h");
+}
+
+// The week's days in one table: the scored span, the MAE of no compensation and of each rule,
+// the day's strongest row (rules and sensor-free baselines).
+report::Table DaysTable(const WeekResult& w) {
+  report::Table t;
+  t.header = {"day", "run", "scored", "none: MAE [um]"};
+  const std::size_t q = w.days.front().strategies.size();
+  for (const auto& st : w.days.front().strategies)
+    t.header.push_back(ToString(st.rule) + ": MAE [um]");
+  t.header.push_back("strongest");
+  for (std::size_t d = 0; d < w.days.size(); ++d) {
+    const MonitorResult& r = w.days[d];
+    std::vector<report::Cell> row = {std::to_string(d + 1), r.run, ScoredSpan(r),
+                                     FormatDecimals(r.none.mae_um, 2)};
+    for (std::size_t i = 0; i < q; ++i)
+      row.push_back(i < r.strategies.size() ? FormatDecimals(r.strategies[i].score.mae_um, 2)
+                                            : "-");
+    row.push_back(r.Strongest());
+    t.rows.push_back(std::move(row));
+  }
+  t.caption =
+      "MAE over each day's scored rows; strongest: the lowest MAE of the day among no "
+      "compensation, the rules and the sensor-free baselines (each day's table below).";
+  return t;
+}
+
+// One run's part of the page: what was run (`with_settings`: a week states them once above its
+// days), the table, the updates, the figure, the data.
 std::vector<report::Block> MonitorBlocks(const MonitorResult& r, const MonitorOptions& o,
-                                         const std::string& prefix) {
+                                         const std::string& prefix, bool with_settings = true) {
   using report::MakeBlock;
   const bool idx = r.time_from_index;
   const double to_h = idx ? 1.0 : 1.0 / 60.0;
-  const std::string every = idx ? " samples" : " min", unit = idx ? " samples" : " h";
+  const std::string unit = idx ? " samples" : " h";
   std::vector<report::Block> b;
-  b.push_back(MakeBlock(report::Paragraph{{report::Text(
-      "Run " + r.run + ", " + r.error_column + ", " + r.model_kind + " model; checks every " +
-      MessageNumber(o.check_every) + every + ", threshold " + FormatDecimals(r.threshold_um, 2) +
-      " um, " + std::to_string(o.refit_samples) + " refit measurements every " +
-      MessageNumber(o.refit_every) + every + ", " + MessageNumber(o.stop_min_per_measurement) +
-      " min stop each" +
-      (idx ? " (no recorded time: intervals count samples; stop share not computed)" : "") +
-      ". Scored rows [" + std::to_string(r.score_begin) + ", " + std::to_string(r.score_end) +
-      "): " + FormatDecimals(r.score_first_time * to_h, 2) + " to " +
-      FormatDecimals(r.score_last_time * to_h, 2) + unit + ". Strongest (lowest MAE, bold): " +
-      r.Strongest() + ".")}}));
+  if (with_settings)
+    b.push_back(MakeBlock(report::Paragraph{
+        {report::Text("Run " + r.run + ", " + SettingsText(r, o) + ". Scored rows [" +
+                      std::to_string(r.score_begin) + ", " + std::to_string(r.score_end) + "): " +
+                      ScoredSpan(r) + ". Strongest (lowest MAE, bold): " + r.Strongest() + ".")}}));
   b.push_back(MakeBlock(MonitorTable(r)));
   report::List updates;
   updates.tone = report::Tone::kSmall;
@@ -593,7 +640,11 @@ std::vector<report::Block> MonitorBlocks(const MonitorResult& r, const MonitorOp
   b.push_back(MakeBlock(MonitorFigure(r, prefix)));
   b.push_back(MakeBlock(report::Paragraph{
       {report::Text("The dashed vertical line: monitoring starts; open circles: valid checks, "
-                    "filled: invalid checks and refit measurements, in their rule's colour. Data: "),
+                    "filled: invalid checks and refit measurements, in their rule's colour; the "
+                    "shaded bands: each rule's prediction +- 1 sd, the sd the model's training "
+                    "residual std (" +
+                    FormatDecimals(r.training_residual_std_um, 2) +
+                    " um, from its training runs, not from this run). Data: "),
        report::Link(prefix + "timeline.csv", prefix + "timeline.csv"), report::Text(", "),
        report::Link(prefix + "events.csv", prefix + "events.csv"),
        report::Text(" (every check and update with its reason), "),
@@ -617,6 +668,33 @@ std::string PlotTimelineCsv(const MonitorResult& r, const std::vector<std::strin
   return MonitorTimelineCsv(r.rows_kept.empty() ? PlotRows(r) : r, c);
 }
 
+// The data of one run's part of the page, each file's name after `prefix`: its timeline (or
+// the one the caller streamed, `ready`), the plot's rows, the events, the checks.
+void AddRunFiles(OutputDir& files, const MonitorResult& r,
+                 const std::vector<std::string>& provenance, const std::string& prefix,
+                 const fs::path& ready) {
+  if (ready.empty())
+    files.Add(prefix + "timeline.csv", MonitorTimelineCsv(r, provenance));
+  else
+    files.AddReady(prefix + "timeline.csv", ready);
+  files.Add(prefix + "plot_timeline.csv", PlotTimelineCsv(r, provenance));
+  files.Add(prefix + "events.csv", MonitorEventsCsv(r, provenance));
+  files.Add(prefix + "checks.csv", ChecksCsv(r));
+}
+
+// Renders the page beside its data and commits the directory.
+MonitorReportResult RenderAndCommit(const report::Document& doc, OutputDir& files,
+                                    const std::string& gnuplot, const AlsoWrite& also,
+                                    const std::vector<ReadyFile>& also_ready) {
+  MonitorReportResult out;
+  report::RenderOptions ro;
+  ro.gnuplot = gnuplot;
+  out.warnings = report::RenderReport(doc, files, ro).warnings;
+  files.Commit(also, also_ready);
+  out.index_html = files.path() / "index.html";
+  return out;
+}
+
 }  // namespace
 
 MonitorReportResult WriteMonitorReport(const fs::path& dir, const MonitorResult& r,
@@ -633,26 +711,13 @@ MonitorReportResult WriteMonitorReport(OutputDir& files, const MonitorResult& r,
                                        const std::string& gnuplot, const AlsoWrite& also,
                                        const std::vector<ReadyFile>& also_ready,
                                        const fs::path& timeline_ready) {
-  const fs::path& dir = files.path();
-  MonitorReportResult out;
-  if (timeline_ready.empty())
-    files.Add("timeline.csv", MonitorTimelineCsv(r, provenance));
-  else
-    files.AddReady("timeline.csv", timeline_ready);
-  files.Add("plot_timeline.csv", PlotTimelineCsv(r, provenance));
-  files.Add("events.csv", MonitorEventsCsv(r, provenance));
-  files.Add("checks.csv", ChecksCsv(r));
+  AddRunFiles(files, r, provenance, "", timeline_ready);
   report::Document doc;
   doc.title = "whirl: on-line check and recalibration of " + r.error_column + " on " + r.run;
   doc.provenance = provenance;
   doc.Add(DriftLoadBox(r.model_kind, r.error_column, {}));
   doc.Add(MonitorBlocks(r, o, ""));
-  report::RenderOptions ro;
-  ro.gnuplot = gnuplot;
-  out.warnings = report::RenderReport(doc, files, ro).warnings;
-  files.Commit(also, also_ready);
-  out.index_html = dir / "index.html";
-  return out;
+  return RenderAndCommit(doc, files, gnuplot, also, also_ready);
 }
 
 MonitorReportResult WriteWeekReport(const fs::path& dir, const WeekResult& w,
@@ -663,15 +728,12 @@ MonitorReportResult WriteWeekReport(const fs::path& dir, const WeekResult& w,
   return WriteWeekReport(files, w, o, provenance, gnuplot, also, {}, {}, {});
 }
 
-MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
-                                    const MonitorOptions& o,
+MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w, const MonitorOptions& o,
                                     const std::vector<std::string>& provenance,
                                     const std::string& gnuplot, const AlsoWrite& also,
                                     const std::vector<ReadyFile>& also_ready,
                                     const std::vector<fs::path>& day_ready,
                                     const fs::path& week_ready) {
-  const fs::path& dir = files.path();
-  MonitorReportResult out;
   if (week_ready.empty())
     files.Add("week_timeline.csv", WeekTimelineCsv(w, provenance));
   else
@@ -693,6 +755,8 @@ MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
                 p.strongest + " " + FormatDecimals(p.strongest_mae_um, 2) + " um.",
             report::Tone::kSmall);
   }
+  doc.Say("Every day: " + SettingsText(w.days.front(), o) + ".");
+  doc.Add(report::Heading{3, "Days", ""}).Add(DaysTable(w));
   doc.Add(report::Paragraph{{report::Text("Data: "),
                              report::Link("week_timeline.csv", "week_timeline.csv"),
                              report::Text(" (every day, a day column first), "),
@@ -701,22 +765,11 @@ MonitorReportResult WriteWeekReport(OutputDir& files, const WeekResult& w,
   for (std::size_t d = 0; d < w.days.size(); ++d) {
     const MonitorResult& r = w.days[d];
     const std::string prefix = "day" + std::to_string(d + 1) + "_";
-    if (d < day_ready.size() && !day_ready[d].empty())
-      files.AddReady(prefix + "timeline.csv", day_ready[d]);
-    else
-      files.Add(prefix + "timeline.csv", MonitorTimelineCsv(r, provenance));
-    files.Add(prefix + "plot_timeline.csv", PlotTimelineCsv(r, provenance));
-    files.Add(prefix + "events.csv", MonitorEventsCsv(r, provenance));
-    files.Add(prefix + "checks.csv", ChecksCsv(r));
+    AddRunFiles(files, r, provenance, prefix, d < day_ready.size() ? day_ready[d] : fs::path());
     doc.Add(report::Heading{2, "Day " + std::to_string(d + 1) + ": " + r.run, ""});
-    doc.Add(MonitorBlocks(r, o, prefix));
+    doc.Add(MonitorBlocks(r, o, prefix, false));
   }
-  report::RenderOptions ro;
-  ro.gnuplot = gnuplot;
-  out.warnings = report::RenderReport(doc, files, ro).warnings;
-  files.Commit(also, also_ready);
-  out.index_html = dir / "index.html";
-  return out;
+  return RenderAndCommit(doc, files, gnuplot, also, also_ready);
 }
 
 }  // namespace whirl::drift

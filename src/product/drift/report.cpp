@@ -651,14 +651,19 @@ std::string SameAs(const HoldoutResult& r, const std::vector<std::size_t>& idx, 
   return "";
 }
 
+// A method's +-1 sd band in <slug>_holdout_band.csv: its name and the file's columns (low, high).
+struct Band {
+  std::string method;
+  int low = 0, high = 0;
+};
+
 // One channel's figure: measured and every method's prediction over the log prefix (the end of
-// training dashed), the residuals below. A method whose prediction equals an earlier one's is
-// drawn with open circles and its legend says so, so coinciding lines stay distinguishable.
-// `band`: the strongest method's +-1 sd band (time_min, low, high in <slug>_holdout_band.csv),
-// "" for none.
+// training dashed), each with its +-1 sd band (`bands`), the residuals below. A method whose
+// prediction equals an earlier one's is drawn with open circles and its legend says so, so
+// coinciding lines stay distinguishable.
 report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size_t>& idx,
-                             const std::string& ch, const std::string& csv,
-                             const std::string& slug, const std::string& band) {
+                             const std::string& ch, const std::string& csv, const std::string& slug,
+                             const std::vector<Band>& bands) {
   report::Panel top, bottom;
   top.title = ch + ": measured and predicted (dashed line: end of training)";
   top.ylabel = "error [um]";
@@ -668,9 +673,16 @@ report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size
     p->xlabel = "time [h]";
     p->x_marks = {r.train_end_min / 60};
   }
-  if (!band.empty())
-    top.series.push_back({slug + "_holdout_band.csv", -1, {Col(1, 60), Col(2), Col(3)},
-                          SeriesKind::kBand, band, "", 1.5, false, band + " +- 1 sd"});
+  for (const Band& b : bands)
+    top.series.push_back({slug + "_holdout_band.csv",
+                          -1,
+                          {Col(1, 60), Col(b.low), Col(b.high)},
+                          SeriesKind::kBand,
+                          b.method,
+                          "",
+                          1.5,
+                          false,
+                          b.method + " +- 1 sd"});
   top.series.push_back({csv, -1, {Col(1, 60), Col(2)}, SeriesKind::kLine, "measured", "", 1.5,
                         false, "measured"});
   for (std::size_t c = 0; c < idx.size(); ++c) {
@@ -696,29 +708,49 @@ report::Figure HoldoutFigure(const HoldoutResult& r, const std::vector<std::size
   return f;
 }
 
-// <slug>_holdout_band.csv: the channel's strongest method's prediction -+ its sd per row; returns
-// the method ("" when it has no sd, e.g. none).
-std::string AddBand(const HoldoutResult& r, const std::vector<std::size_t>& idx,
-                    const std::string& ch, const std::string& slug,
-                    const std::vector<std::string>& provenance, ReportWriter* w) {
-  for (const auto& [channel, method] : r.Strongest()) {
-    if (channel != ch) continue;
-    for (std::size_t i : idx) {
-      const RunPrediction& p = r.predictions[i];
-      if (r.rows_out[i].method != method || p.std_um.size() != p.predicted_um.size() ||
-          p.std_um.size() == 0 || p.std_um.maxCoeff() <= 0)
-        continue;
-      std::vector<std::vector<double>> rows;
-      for (Eigen::Index k = 0; k < p.predicted_um.size(); ++k)
-        rows.push_back({p.time[static_cast<std::size_t>(k)], p.predicted_um(k) - p.std_um(k),
-                        p.predicted_um(k) + p.std_um(k)});
-      w->File(slug + "_holdout_band.csv",
-              FormatCsv({"time_min", method + "_minus_1sd_um", method + "_plus_1sd_um"}, rows,
-                        Comments(provenance, "+-1 sd band of " + method + " on " + ch)));
-      return method;
-    }
+// <slug>_holdout_band.csv: every method's prediction -+ its sd per row (its predictive sd where
+// the model gives one, else its training residual std; none has no band); returns the bands.
+std::vector<Band> AddBands(const HoldoutResult& r, const std::vector<std::size_t>& idx,
+                           const std::string& ch, const std::string& slug,
+                           const std::vector<std::string>& provenance, ReportWriter* w) {
+  std::vector<Band> bands;
+  std::vector<std::string> header{"time_min"};
+  std::vector<Eigen::VectorXd> sd;
+  std::vector<std::size_t> shown;
+  for (std::size_t i : idx) {
+    const RunPrediction& p = r.predictions[i];
+    const std::string& method = r.rows_out[i].method;
+    Eigen::VectorXd s =
+        p.std_um.size() == p.predicted_um.size() && p.std_um.size() > 0 && p.std_um.maxCoeff() > 0
+            ? p.std_um
+            : Eigen::VectorXd::Constant(p.predicted_um.size(),
+                                        i < r.models.size() ? r.models[i].residual_std_um : 0.0);
+    if (method == "none" || s.size() == 0 || !(s.maxCoeff() > 0)) continue;
+    const int low = static_cast<int>(header.size()) + 1;
+    bands.push_back({method, low, low + 1});
+    header.push_back(method + "_minus_1sd_um");
+    header.push_back(method + "_plus_1sd_um");
+    sd.push_back(std::move(s));
+    shown.push_back(i);
   }
-  return "";
+  if (bands.empty()) return bands;
+  std::vector<std::vector<double>> rows;
+  const RunPrediction& first = r.predictions[shown.front()];
+  for (Eigen::Index k = 0; k < first.predicted_um.size(); ++k) {
+    std::vector<double> row{first.time[static_cast<std::size_t>(k)]};
+    for (std::size_t j = 0; j < shown.size(); ++j) {
+      const double y = r.predictions[shown[j]].predicted_um(k);
+      row.push_back(y - sd[j](k));
+      row.push_back(y + sd[j](k));
+    }
+    rows.push_back(std::move(row));
+  }
+  w->File(slug + "_holdout_band.csv",
+          FormatCsv(header, rows,
+                    Comments(provenance, "+-1 sd band of each method on " + ch +
+                                             " (its predictive sd, or its training residual "
+                                             "std where the model gives none)")));
+  return bands;
 }
 
 // The load box of the first channel's strongest method (the model drift fit would hand on).
@@ -770,9 +802,14 @@ DriftReportResult WriteHoldoutReport(const fs::path& dir, const Run& log, const 
     const std::string slug = Slug(ch);
     w.File(slug + "_holdout.csv",
            FormatCsv(header, rows, Comments(provenance, "hold-out of " + ch)));
-    const std::string band = AddBand(r, idx, ch, slug, provenance, &w);
+    const std::vector<Band> bands = AddBands(r, idx, ch, slug, provenance, &w);
     doc.Add(report::Heading{2, ch, ""})
-        .Add(HoldoutFigure(r, idx, ch, slug + "_holdout.csv", slug, band));
+        .Add(HoldoutFigure(r, idx, ch, slug + "_holdout.csv", slug, bands));
+    if (!bands.empty())
+      doc.Say(
+          "Shaded: each method's prediction +- 1 sd, the sd its model predicts where it gives "
+          "one, else its residual std on the training rows (never from the test rows).",
+          report::Tone::kSmall);
   }
   return w.Finish(doc);
 }

@@ -1,5 +1,6 @@
 #include "surface/report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -45,8 +46,11 @@ using report::Cell;
 using report::Col;
 using report::SeriesKind;
 
-// The map: the surface as colours with contour lines, the measured points on top.
-report::Figure MapFigure(const SurfaceReportOptions& o, const std::string& subtitle) {
+// The map: the surface as colours with contour lines, the measured points on top. The picture
+// takes the table's shape (`b`: one mm as long on X as on Y), so the map fills it: gnuplot keeps
+// about 320 px beside the map (Y labels, the colour box) and 180 px above and below it.
+report::Figure MapFigure(const SurfaceReportOptions& o, const std::string& subtitle,
+                         const Bounds& b) {
   report::Panel p;
   p.title = o.title + ": " + subtitle;
   p.xlabel = "X [mm]";
@@ -62,7 +66,12 @@ report::Figure MapFigure(const SurfaceReportOptions& o, const std::string& subti
   report::Figure f;
   f.stem = "map";
   f.alt = "map of the thermal error over the table";
-  f.height_px = 700;
+  const double dx = b.x_max_mm - b.x_min_mm, dy = b.y_max_mm - b.y_min_mm;
+  const double aspect = dx > 0 && dy > 0 ? dy / dx : 1.0;  // height / width of the map
+  constexpr double kBeside = 320, kAbove = 180, kMapWidth = 680, kMaxMapHeight = 720;
+  const double map_height = std::min(kMaxMapHeight, kMapWidth * aspect);
+  f.width_px = static_cast<int>(std::lround(kBeside + map_height / aspect));
+  f.height_px = static_cast<int>(std::lround(kAbove + std::max(200.0, map_height)));
   f.panels = {p};
   return f;
 }
@@ -149,7 +158,7 @@ report::Document Page(const SurfaceFit& f, const MethodComparison* choice,
   report::Document doc;
   doc.title = o.title;
   doc.provenance = o.provenance;
-  if (map) doc.Add(MapFigure(o, subtitle));
+  if (map) doc.Add(MapFigure(o, subtitle, f.surface.bounds));
   doc.Add(report::Heading{2, "Fit", ""}).Add(SummaryTable(f));
   AddCubic(f, &doc);
   if (choice) {
