@@ -15,7 +15,8 @@ namespace whirl::cli {
 struct FieldWorldFlags {
   double blank_h_w_m2k = 0, stock_offset_std_k = 0;
   double blank_contact_std_k = -1;  ///< < 0: no contact reading
-  double seasonal_amplitude_k = 0, seasonal_peak_day = 56;
+  double seasonal_amplitude_k = 0;
+  int seasonal_peak_day = 56;
   std::string test_shift_of;  ///< empty: the test days keep the scenario's day rules
 };
 
@@ -39,7 +40,7 @@ inline void AddFieldWorldOptions(CLI::App* e, FieldWorldFlags* w) {
   e->add_option("--seasonal-peak-day", w->seasonal_peak_day,
                 "the warmest day of the seasons [day; 0 = the first test day] (-400..400, "
                 "default 56)")
-      ->check(NumberIn(-400.0, 400.0));
+      ->check(NumberIn(-400, 400));
   e->add_option("--test-shift-of", w->test_shift_of,
                 "a shift-pattern change: the test days follow this scenario's day rules (shift "
                 "times, breaks, stops), the training weeks their own (default: no change)");
@@ -71,7 +72,7 @@ inline std::string FieldWorldCommandLine(const FieldWorldFlags& w) {
     s += " --blank-contact-std-k " + FormatNumber(w.blank_contact_std_k);
   if (w.seasonal_amplitude_k > 0)
     s += " --seasonal-amplitude-k " + FormatNumber(w.seasonal_amplitude_k) +
-         " --seasonal-peak-day " + FormatNumber(w.seasonal_peak_day);
+         " --seasonal-peak-day " + std::to_string(w.seasonal_peak_day);
   if (!w.test_shift_of.empty()) s += " --test-shift-of " + w.test_shift_of;
   return s;
 }
