@@ -124,5 +124,29 @@ TEST(FieldExport, BadRecordsAreRefusedNamingFileLineAndColumn) {
   }
 }
 
+// With a contact reading of each blank in the logs, the grey box latches that reading (no lag)
+// instead of the hall's lag; without it, ambient as before.
+TEST(FieldGreyContact, TheGreyBoxTakesTheContactReadingWhenTheLogsHoldIt) {
+  machine::CalendarSpec c;
+  c.warmup_speeds_m_min = {180};
+  c.past_days = 3;
+  c.test_days = 1;
+  machine::FieldMachineConfig m = machine::DefaultFieldMachine();
+  m.stock_offset_std_k = 3;
+  const auto scenario = machine::FindMachineScenario("production");
+  const machine::MachineWorld plain = machine::BuildMachineWorld(m, scenario, 5, 0, c);
+  m.blank_contact_std_k = 0.3;
+  const machine::MachineWorld read = machine::BuildMachineWorld(m, scenario, 5, 0, c);
+  const FieldProtocol p;
+  const double z_ref = read.timeline.machine().config().z.fixed_end_mm;
+  const ShopModels a = FitShopModels(FieldShopRecord(plain.timeline, p, nullptr, 11), z_ref);
+  const ShopModels b = FitShopModels(FieldShopRecord(read.timeline, p, nullptr, 11), z_ref);
+  EXPECT_EQ(a.grey.blank_sensor, "ambient_C");
+  EXPECT_EQ(b.grey.blank_sensor, kBlankContactSensor);
+  EXPECT_EQ(b.grey.blank_tau_min, kBlankContactTauMin);
+  // The lead records identify the blank's expansion near its physical -11.8 um per 1000 mm per K.
+  EXPECT_NEAR(b.grey.blank_um_per_1000_per_k, -11.8, 3.0);
+}
+
 }  // namespace
 }  // namespace whirl::machine_eval
