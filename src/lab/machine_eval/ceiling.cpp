@@ -102,9 +102,16 @@ CeilingModel FitCeiling(const std::vector<DesignRow>& rows, bool blank) {
   Eigen::VectorXd scale = X.colwise().norm().transpose();
   for (Eigen::Index j = 0; j < q; ++j) scale(j) = scale(j) > 0 ? scale(j) : 1;
   const Eigen::MatrixXd Xs = X * scale.cwiseInverse().asDiagonal();
-  Eigen::MatrixXd A = Xs.transpose() * Xs;
-  A.diagonal().array() += 1e-8 * A.trace() / static_cast<double>(q);
-  const Eigen::VectorXd beta = scale.cwiseInverse().asDiagonal() * A.ldlt().solve(Xs.transpose() * y);
+  // Ridge 1e-8 by an augmented least-squares problem solved by QR (the normal equations square
+  // the condition number of collinear temperature columns); the intercepts are not shrunk.
+  Eigen::MatrixXd ridge = 1e-4 * Eigen::MatrixXd::Identity(q, q);
+  ridge(0, 0) = ridge(1 + p, 1 + p) = 0;
+  Eigen::MatrixXd aug(n + q, q);
+  aug << Xs, ridge;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + q);
+  rhs.head(n) = y;
+  const Eigen::VectorXd beta =
+      scale.cwiseInverse().asDiagonal() * aug.colPivHouseholderQr().solve(rhs);
   CeilingModel m;
   m.blank = blank;
   m.a = beta.head(1 + p);

@@ -12,7 +12,7 @@
 //   m_hat(t, z) = a' [1, x(t)] + (g' [1, x(t)] + g_b (B - 20)) (z_ref - z) / 1000,
 // fitted by least squares to m along each training cut against the cut's first row (a lead holds
 // only what changes along its cut; the level at the cut start drops out, and with it a(0)), with a
-// ridge of 1e-8 on unit-norm columns, x one of the feature sets:
+// ridge of 1e-8 on unit-norm columns except the intercepts (solved by QR), x one of the sets:
 //   none        no feature (the intercepts only)
 //   time        first-order lags (20, 80, 320 min) of power_on (time since power-on)
 //   time+duty   + the same lags of ring_on, cutting, ring_load_pct, z_speed_mm_min
