@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/cmd_machine_world.h"
 #include "cli/common.h"
 #include "core/error.h"
 #include "core/output_dir.h"
@@ -50,7 +51,7 @@ struct MachineCliOptions {
   int test_days = 2, past_days = 5;
   double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
   bool no_setup_checks = false;
-  double blank_h_w_m2k = 0, stock_offset_std_k = 0;
+  FieldWorldFlags world;  ///< the world's optional parts (cmd_machine_world.h)
   std::vector<std::pair<std::string, CLI::Option*>> retired;  ///< legacy-world flags, hidden
 };
 
@@ -77,8 +78,6 @@ machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
   f.protocol.laser_every_min = o.laser_every_min;
   f.protocol.lead_sample_min = o.lead_sample_min;
   f.protocol.setup_checks = !o.no_setup_checks;
-  f.machine.blank_h_w_m2k = o.blank_h_w_m2k;
-  f.machine.stock_offset_std_k = o.stock_offset_std_k;
   return f;
 }
 
@@ -140,8 +139,9 @@ void RunMachineEvaluate(const MachineCliOptions& o) {
   const compare::ExperienceRule rule =
       compare::BuildExperienceRule(ReadProcessTable(o.history, /*require_targets=*/true));
   const lead::IsoToleranceTable iso = lead::ReadIsoToleranceTable(o.iso_table);
-  const auto scenarios = machine::SelectMachineScenarios(o.scenarios, "--scenarios");
+  auto scenarios = machine::SelectMachineScenarios(o.scenarios, "--scenarios");
   machine_eval::FieldEvalOptions f = FieldOptions(o);
+  ApplyFieldWorld(o.world, &f, &scenarios);
   f.keep_report_screw = !o.report.empty();
   Progress progress("machine evaluate", scenarios.size() * 1000);
   std::vector<machine_eval::SeedsEvaluation> all = machine_eval::EvaluateMachineScenarios(
@@ -193,14 +193,7 @@ void AddScenarioOptions(CLI::App* e, MachineCliOptions* o) {
                 "one point of a past screw's measured lead per [min] of cutting time in the "
                 "training record (1..30, default 5)")
       ->check(NumberIn(1.0, 30.0));
-  e->add_option("--blank-h-w-m2-per-k", o->blank_h_w_m2k,
-                "each blank's thermal lag from its diameter, tau = rho c D / (4 h), with this "
-                "convection coefficient h [W/(m^2 K)] (0..100; default 0: every blank 45 min)")
-      ->check(NumberIn(0.0, 100.0));
-  e->add_option("--stock-offset-std-k", o->stock_offset_std_k,
-                "stock from a store or the gate: each blank's temperature at the cut start is the "
-                "hall's lagged one plus N(0, this) [K] (0..10; default 0: stored in the hall)")
-      ->check(NumberIn(0.0, 10.0));
+  AddFieldWorldOptions(e, &o->world);
   e->add_flag("--no-setup-checks", o->no_setup_checks,
               "no probe reading of the check ring at power-on and at each set-up of the past "
               "production days");
@@ -313,6 +306,8 @@ void RegisterMachine(CLI::App& app) {
   RegisterSensors(m, o);
   RegisterEvaluate(m, o);
   RegisterMachineTruth(m);
+  RegisterMachineExport(m);
+  RegisterMachineCeiling(m);
 }
 
 }  // namespace whirl::cli

@@ -27,5 +27,7 @@ void RegisterDrift(CLI::App& app);       // cmd_drift.cpp
 void RegisterDriftNc(CLI::App* drift);   // cmd_drift_nc.cpp: whirl drift nc
 void RegisterMachine(CLI::App& app);     // cmd_machine.cpp
 void RegisterMachineTruth(CLI::App* machine);  // cmd_machine_truth.cpp: whirl machine truth
+void RegisterMachineExport(CLI::App* machine);  // cmd_machine_export.cpp: whirl machine export
+void RegisterMachineCeiling(CLI::App* machine);  // cmd_machine_ceiling.cpp: whirl machine ceiling
 
 }  // namespace whirl::cli

@@ -81,6 +81,9 @@ void FieldMachineConfig::Validate(const std::string& where) const {
   if (!(stock_offset_std_k >= 0 && stock_offset_std_k <= 10))
     throw InputError(where + ": stock_offset_std_k = " + std::to_string(stock_offset_std_k) +
                      ": must be within 0..10 K");
+  if (!(blank_contact_std_k < 0 || blank_contact_std_k <= 2))
+    throw InputError(where + ": blank_contact_std_k = " + std::to_string(blank_contact_std_k) +
+                     ": must be within 0..2 K (or negative: no contact reading)");
 }
 
 FieldMachine::FieldMachine(const FieldMachineConfig& config, std::uint64_t machine_seed)

@@ -104,6 +104,11 @@ struct FieldMachineConfig {
   /// lagged temperature plus N(0, this) K drawn per screw (0..10; 0: stored in the hall, the
   /// default).
   double stock_offset_std_k = 0;
+  /// A contact thermometer on each blank at clamping (the start of its set-up): < 0 none (the
+  /// default); 0..2: the reading, the blank's temperature then + N(0, this) K, is logged as the
+  /// sensor column blank_contact_C from the clamping until the next one (20 before the day's
+  /// first), instruments.h DayLog. A shop's surface probe reads to a few tenths of a K.
+  double blank_contact_std_k = -1;
   double capacity_spread = 0.10;    ///< per machine: capacities x (1 + this N)
   double conductance_spread = 0.15; ///< per machine: conductances and source powers
   double length_spread = 0.10;      ///< per machine: the head's lengths L_j

@@ -35,6 +35,10 @@ HallProfile::HallProfile(const HallOptions& options, int first_day, int last_day
   if (last_day < first_day) throw InputError("hall: last day before the first day");
   if (options.kind != "diurnal" && options.kind != "ramp")
     throw InputError("hall: kind '" + options.kind + "' must be 'diurnal' or 'ramp'");
+  if (!(options.seasonal_amplitude_k >= 0 && options.seasonal_amplitude_k <= 15) ||
+      !(std::abs(options.seasonal_peak_day) <= 1e6))
+    throw InputError("hall: seasonal amplitude " + FormatNumber(options.seasonal_amplitude_k) +
+                     " K must be within 0..15 and the peak day within +-1e6");
   Rng rng(seed);
   const int days = last_day - first_day + 2;  // one extra for the night after the last day
   for (int d = 0; d < days; ++d) {
@@ -66,6 +70,9 @@ double HallProfile::At(double abs_min) const {
   const double t0 = first_day_ * 1440.0;
   const double t = std::clamp(abs_min, t0, (last_day_ + 2) * 1440.0 - 1e-9);
   const double rel = t - t0;
+  const double season =
+      options_.seasonal_amplitude_k *
+      std::cos(2 * kPi * (t / 1440.0 - options_.seasonal_peak_day) / 365.25);
   if (options_.kind == "ramp") {
     const int d = static_cast<int>(std::floor(rel / 1440));
     const double clock = rel - d * 1440.0;
@@ -73,11 +80,11 @@ double HallProfile::At(double abs_min) const {
     auto day_value = [&](int i, double c) {
       return ramp_k_per_h_[i] * std::clamp(c - 360, 0.0, ramp_end - 360) / 60;
     };
-    if (clock >= 360 && clock <= 1320) return 20 + day_value(d, clock);
+    if (clock >= 360 && clock <= 1320) return 20 + season + day_value(d, clock);
     // Night: linear from the day's value at 22:00 back to 20 at 06:00.
     const double from = clock > 1320 ? day_value(d, 1320) : (d > 0 ? day_value(d - 1, 1320) : 0);
     const double into = clock > 1320 ? clock - 1320 : clock + 120;
-    return 20 + from * (1 - into / 480);
+    return 20 + season + from * (1 - into / 480);
   }
   const double clock = std::fmod(rel, 1440.0);
   const double u = rel / 1440 - 0.5;  // day centres at noon
@@ -92,7 +99,7 @@ double HallProfile::At(double abs_min) const {
   double doors = 0;
   for (const Door& door : doors_)
     if (abs_min >= door.start_abs_min && abs_min < door.end_abs_min) doors += options_.door_drop_k;
-  return 20 + offset + diurnal + ou + doors;
+  return 20 + season + offset + diurnal + ou + doors;
 }
 
 double HallProfile::SlopeKPerH(double a, double b) const {

@@ -8,6 +8,11 @@
 //     door_duration_min (at a uniform clock time in the shift).
 //   kind "ramp": T = 20 + r_d min(max(clock - 360, 0), ramp_hours 60) / 60 during the day, r_d ~
 //     N(0, ramp_std_k_per_h), back to 20 linearly between 22:00 and 06:00 of the next day.
+// Seasons (both kinds, off by default): + A_s cos(2 pi (abs_min / 1440 - peak_day) / 365.25), a
+//   year's swing of a hall whose conditioning holds the day but not the season (an estimate: an
+//   unconditioned hall in central Europe follows the outdoor monthly means of about +-9 K damped by
+//   the building; a conditioned one a few K); over a calendar of weeks it shifts the test window
+//   against the training weeks.
 // Conditioned hall: A 0.5 K, peak 15:00, ou_std 0.2 K, day offset std 0.3 K, no doors.
 // Unconditioned: A 2.5 K, ou_std 0.5 K, 1 door event per day of -1.5 K for 20 min.
 // Bryan 1990 names the environment a leading thermal error source; ISO 230-3 tests it (ETVE);
@@ -30,6 +35,8 @@ struct HallOptions {
   double door_duration_min = 20;
   double ramp_std_k_per_h = 0.3;
   double ramp_hours = 4;
+  double seasonal_amplitude_k = 0;  ///< A_s, K (0..15; 0: no seasons, the default)
+  double seasonal_peak_day = 56;    ///< the warmest day (day 0 = the first test day)
   static HallOptions Conditioned();
   static HallOptions Unconditioned();
   static HallOptions Ramp();

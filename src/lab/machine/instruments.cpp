@@ -1,5 +1,6 @@
 #include "machine/instruments.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -21,6 +22,27 @@ Eigen::RowVectorXd DutyRow(const DutyState& d, double rated_w, double clock, dou
       100.0 * d.drive_power_w / rated_w + (d.ring_on ? load_noise : 0.0), (d.cutting ? 1.0 : 0.0),
       d.z_speed_mm_min, d.z_position_mm, clock;
   return row;
+}
+
+// blank_contact_C of a day's rows (FieldMachineConfig::blank_contact_std_k): each job's blank read
+// at its clamping (its set-up's start; the cut start without a set-up), held until the next one.
+Eigen::VectorXd BlankContactColumn(const detail::TimelineData& data, const DayPlan& plan,
+                                   const std::vector<double>& abs_min) {
+  const double sd = data.machine.config().blank_contact_std_k;
+  std::vector<std::pair<double, double>> readings;  // (abs min, degC)
+  for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
+    double clamp = plan.jobs[static_cast<std::size_t>(j)].cut_start_min;
+    for (const ScheduleEvent& e : plan.events)
+      if (e.kind == EventKind::kSetup && e.job == j) clamp = std::min(clamp, e.start_min);
+    clamp += plan.day * 1440.0;
+    Rng rng(MixSeed(plan.seed, 0x636f6e74616374ULL + static_cast<std::uint64_t>(j)));
+    readings.push_back({clamp, detail::BlankAtC(data, plan, j, clamp) + sd * rng.Normal()});
+  }
+  Eigen::VectorXd col = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(abs_min.size()), 20.0);
+  for (std::size_t r = 0; r < abs_min.size(); ++r)
+    for (const auto& [t, c] : readings)
+      if (t <= abs_min[r] + 1e-9) col(static_cast<Eigen::Index>(r)) = c;
+  return col;
 }
 
 }  // namespace
@@ -65,6 +87,12 @@ drift::Run DayLog(const MachineTimeline& timeline, int day, const LogOptions& op
       run.other.row(r) = DutyRow(d, rated_w, data.abs_min[k] - day * 1440.0, noise);
       if (r == 0) run.other(r, 6) = data.duty[k].z_position_mm;
     }
+  }
+  if (options.sensors && data.machine.config().blank_contact_std_k >= 0) {
+    run.sensor_names.push_back("blank_contact_C");
+    run.temperature_C.conservativeResize(Eigen::NoChange, run.temperature_C.cols() + 1);
+    run.temperature_C.col(run.temperature_C.cols() - 1) =
+        BlankContactColumn(data, plan, run.time_min);
   }
   return run;
 }

@@ -10,6 +10,8 @@
 //               and other columns power_on, ring_on, ring_rpm, ring_load_pct (drive power /
 //               rated x 100 + N(0, 1)), cutting, z_speed_mm_min, z_position_mm, clock_min.
 //               The first row is at power-on with the duty columns at 0. time_min = abs_min.
+//               With FieldMachineConfig::blank_contact_std_k >= 0 also blank_contact_C: the
+//               contact thermometer's reading of the latest blank clamped (20 before the first).
 //   Probe       a check ring on the chuck read by a touch probe on the head at z_mm: m(t, z) +
 //               zero + N(0, sigma) (Renishaw OMP40-2: 1.0 um 2 sigma repeatability plus
 //               re-seating, estimate 1.0 um).

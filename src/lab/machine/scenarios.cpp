@@ -119,7 +119,8 @@ std::vector<DayPlan> PlanCalendar(const MachineScenario& scenario, std::uint64_t
   if (d > 0) throw InputError("calendar: history runs into the test window");
   d = 0;
   for (int i = 0; i < spec.test_days; ++i)
-    days.push_back(PlanDay(scenario.day, next_workday(), machine_seed, scenario.jobs, power_spread));
+    days.push_back(PlanDay(spec.test_day_options.value_or(scenario.day), next_workday(),
+                           machine_seed, scenario.jobs, power_spread));
   ClassifyStarts(days);
   return days;
 }

@@ -54,6 +54,10 @@ struct CalendarSpec {
   double laser_z_lo_mm = 500, laser_z_hi_mm = 5500;
   int past_days = 5;   ///< production days of the scenario before the test window
   int test_days = 2;   ///< production days from d = 0
+  /// A shift-pattern change between the training and the test weeks: the test days planned with
+  /// these day rules (shift times, breaks, stops; e.g. another scenario's) instead of the
+  /// scenario's; unset (the default): the scenario's.
+  std::optional<DayOptions> test_day_options;
 };
 
 /// The calendar of one machine (day plans with roles), seeded by the machine seed.

@@ -186,8 +186,12 @@ double detail::BlankTauMin(const TimelineData& d, const DayPlan& plan, int job) 
 }
 
 double detail::CutBlankC(const TimelineData& d, const DayPlan& plan, int job) {
-  const double start = plan.day * 1440.0 + plan.jobs[static_cast<std::size_t>(job)].cut_start_min;
-  double c = BlankTemperatureC(d, start, BlankTauMin(d, plan, job));
+  return BlankAtC(d, plan, job,
+                  plan.day * 1440.0 + plan.jobs[static_cast<std::size_t>(job)].cut_start_min);
+}
+
+double detail::BlankAtC(const TimelineData& d, const DayPlan& plan, int job, double abs_min) {
+  double c = BlankTemperatureC(d, abs_min, BlankTauMin(d, plan, job));
   const double sd = d.machine.config().stock_offset_std_k;
   if (sd > 0) {
     Rng rng(MixSeed(plan.seed, 0x73746f636bULL + static_cast<std::uint64_t>(job)));

@@ -34,6 +34,8 @@ double BlankTauMin(const TimelineData& d, const DayPlan& plan, int job);
 /// The blank's temperature at the cut start of job `job` of `plan`: BlankTemperatureC with its
 /// lag plus the stock offset N(0, stock_offset_std_k) of that screw (seeded by the day and job).
 double CutBlankC(const TimelineData& d, const DayPlan& plan, int job);
+/// The same blank at abs_min (its lag and stock offset; the contact reading's truth at clamping).
+double BlankAtC(const TimelineData& d, const DayPlan& plan, int job, double abs_min);
 /// The blank's part of the lead at 20 degC (Bryan 1990: only differential expansion against the
 /// 20 degC reference matters): the workpiece simulator measures its elongation from the blank's
 /// temperature T_0 at the cut start; measured at 20 degC a groove cut at z lies further towards

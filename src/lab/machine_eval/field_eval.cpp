@@ -61,7 +61,7 @@ compare::ScrewComparison CompareFieldCut(const MachineTimeline& tl, const CutRef
 
 // The history screws were cut with the workpiece plan and no machine compensation: (e - c_wp)(t).
 WorkpieceResidual HistoryResidual(const MachineTimeline& tl, const Workpiece& wp) {
-  return [&tl, &wp](const Job&, const CutRef& cut) -> std::function<double(double)> {
+  return [&tl, wp](const Job&, const CutRef& cut) -> std::function<double(double)> {
     try {
       const compare::ScrewComparison c = CompareFieldCut(tl, cut, wp);
       const compare::CompensationFunction plan =
@@ -310,6 +310,18 @@ void ValidateFieldOptions(const FieldEvalOptions& o) {
 
 }  // namespace
 
+std::uint64_t ShopRecordSeed(std::uint64_t machine_seed) {
+  return MixSeed(machine_seed, 0x73686f70);
+}
+
+WorkpieceResidual FieldHistoryResidual(const machine::MachineTimeline& timeline,
+                                       const workpiece::WorkpieceModel& model,
+                                       const compare::ExperienceRule& rule,
+                                       const lead::IsoToleranceTable& iso_table,
+                                       const compare::CompareOptions& options) {
+  return HistoryResidual(timeline, Workpiece{model, rule, iso_table, options});
+}
+
 MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario,
                                         const workpiece::WorkpieceModel& model,
                                         const compare::ExperienceRule& rule,
@@ -330,7 +342,7 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
                                        options.calendar, options.timeline);
         models[i] =
             TrainFieldMachine(world.timeline, options.protocol, HistoryResidual(world.timeline, wp),
-                              MixSeed(world.machine_seed, 0x73686f70));
+                              ShopRecordSeed(world.machine_seed));
         per[i] =
             EvaluateTestDays(world.timeline, models[i], options.protocol, wp, static_cast<int>(i),
                              i == 0 && options.keep_report_screw ? &report : nullptr);

@@ -64,6 +64,18 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
                                      const WorkpieceResidual& workpiece_residual,
                                      std::uint64_t seed);
 
+/// The seed of a machine's shop record (TrainFieldMachine's `seed` in the evaluation).
+std::uint64_t ShopRecordSeed(std::uint64_t machine_seed);
+
+/// The history screws' workpiece residual as the evaluation computes it (cut with the workpiece
+/// plan and no machine compensation; the blank at its start temperature, machine/truth.h
+/// HallDuringCut). Every reference must outlive the function.
+WorkpieceResidual FieldHistoryResidual(const machine::MachineTimeline& timeline,
+                                       const workpiece::WorkpieceModel& model,
+                                       const compare::ExperienceRule& rule,
+                                       const lead::IsoToleranceTable& iso_table,
+                                       const compare::CompareOptions& options);
+
 /// One seed of a field scenario: every test-day screw of every machine.
 MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario,
                                         const workpiece::WorkpieceModel& model,

@@ -57,21 +57,25 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   if (combined.cv_rmse_um < m.sensors.cv_rmse_um)
     m.sensors = combined, m.sensors_choice = "sensors+" + base_name;
   // The grey box needs the field machine's sensors (a record without them keeps it empty).
-  const drift::GreyBoxSpec grey = FieldGreyBoxSpec(z_fixed_mm);
   const std::vector<std::string>& have = record.day_logs.front().sensor_names;
+  const bool contact =
+      std::find(have.begin(), have.end(), kBlankContactSensor) != have.end();
+  const drift::GreyBoxSpec grey = FieldGreyBoxSpec(z_fixed_mm, contact);
   bool placed = true;
   for (const std::string& s : grey.Inputs())
     placed = placed && std::find(have.begin(), have.end(), s) != have.end();
-  if (placed) m.grey = drift::FitGreyBox(record, grey);
+  drift::GreyBoxOptions grey_options;
+  if (contact) grey_options.blank_tau_grid = {kBlankContactTauMin};  // a held reading: no lag
+  if (placed) m.grey = drift::FitGreyBox(record, grey, grey_options);
   return m;
 }
 
-drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm) {
+drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact) {
   constexpr double kAlphaScrew = 11.5e-6, kAlphaBed = 10.5e-6, kAlphaBlank = 11.8e-6;
   drift::GreyBoxSpec s;
   s.offset_sensors = {"head_bearing_C", "head_housing_C", "bed_middle_C"};
   s.slope_sensors = {"ambient_C", "z_nut_C"};
-  s.blank_sensor = "ambient_C";
+  s.blank_sensor = blank_contact ? kBlankContactSensor : "ambient_C";
   s.z_ref_mm = z_ref_mm;
   s.offset_prior = {{"bed_middle_C", -kAlphaBed * 1e3 * z_ref_mm},
                     {"head_housing_C", kAlphaScrew * 1e6 * 0.15},

@@ -48,7 +48,13 @@ struct ShopModels {
 /// alpha_s (L_housing + L_carriage) = 0.15 m, head_bearing alpha_s 0.03 m; the screw's slope
 /// alpha_s 1e6 per 1000 mm split equally between ambient and z_nut; the blank -alpha_w 1e6.
 /// alpha_s = 11.5e-6, alpha_b = 10.5e-6, alpha_w = 11.8e-6 1/K.
-drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm);
+/// With `blank_contact` (the logs hold kBlankContactSensor, machine/field.h blank_contact_std_k)
+/// the blank is that reading instead of ambient's lag: FitShopModels then fixes the blank's time
+/// constant at kBlankContactTauMin (a reading held since clamping needs no lag; the evaluator's
+/// lag only follows its steps).
+inline constexpr const char* kBlankContactSensor = "blank_contact_C";
+inline constexpr double kBlankContactTauMin = 0.5;
+drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact = false);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing).
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs());
