@@ -8,6 +8,7 @@
 #include "cli/cmd_machine_world.h"
 #include "cli/common.h"
 #include "core/error.h"
+#include "core/output_dir.h"
 #include "machine/scenarios.h"
 #include "machine_eval/ceiling.h"
 #include "workpiece/model.h"

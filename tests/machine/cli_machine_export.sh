@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Smoke test of 'whirl machine export' and 'whirl machine ceiling': the export's day logs are run
 # files 'whirl drift fit' and 'drift predict' accept, the truth is in files named as such, the
-# README says where the files came from; bad input is refused with exit 1 and nothing written;
-# the ceiling prints its table with every feature set and estimator.
+# README says where the files came from; 'drift fit-grey' fits from its records.json; bad input
+# is refused with exit 1 and nothing written; the ceiling prints its table with every feature set
+# and estimator.
 set -u
 W="$1"; D="$2"; S="$3"
 rm -rf "$D"; mkdir -p "$D"
@@ -12,7 +13,7 @@ source "$S/tests/support/cli_common.sh"
 grep -q "\[W/(m^2 K)\]" "$D/export_help.txt" || fail "export --help names no unit"
 "$W" machine export --out-dir "$D/x" --past-days 1 --test-days 1 --seed 3 \
   --blank-contact-std-k 0.3 > "$D/export.txt" || fail "machine export"
-for f in README.md days.csv records.csv cuts.csv truth_cuts.csv day+000_test.csv \
+for f in README.md days.csv records.csv records.json cuts.csv truth_cuts.csv day+000_test.csv \
   truth_day+000_test.csv; do
   [ -f "$D/x/$f" ] || fail "export: $f missing"
 done
@@ -30,6 +31,9 @@ hist=$(ls "$D/x"/day-*_history.csv | head -n 1)
 "$W" drift predict --model "$D/model.json" --run "$D/x/day+000_test.csv" --json > "$D/pred.json" \
   2> /dev/null || fail "drift predict on an exported test day"
 grep -q '"residual"' "$D/pred.json" || fail "prediction has no residual"
+"$W" drift fit-grey --records "$D/x/records.json" \
+  --spec "$S/datasets/machines/field_grey_box_spec.json" --out "$D/grey.json" > /dev/null \
+  2> "$D/grey_err.txt" || fail "drift fit-grey on the exported records: $(cat "$D/grey_err.txt")"
 # Writing again into its own folder works; bad input writes nothing.
 "$W" machine export --out-dir "$D/x" --past-days 1 --test-days 1 --seed 3 > /dev/null \
   || fail "export again into its own folder"

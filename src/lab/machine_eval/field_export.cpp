@@ -1,5 +1,6 @@
 #include "machine_eval/field_export.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -8,6 +9,7 @@
 #include "core/error.h"
 #include "core/numbers.h"
 #include "core/random.h"
+#include "drift/measurement_file.h"
 #include "machine/truth.h"
 
 namespace whirl::machine_eval {
@@ -164,6 +166,15 @@ void ReadRecords(const std::filesystem::path& path, const std::map<int, int>& lo
   }
 }
 
+// The record with its days counted from its first (a measurement-records file's days are >= 0;
+// the cross-validation groups by day, so a shift changes nothing).
+drift::ShopRecord FromDayZero(drift::ShopRecord record) {
+  int first = 0;
+  for (const drift::MeasurementRecord& r : record.records) first = std::min(first, r.day);
+  for (drift::MeasurementRecord& r : record.records) r.day -= first;
+  return record;
+}
+
 }  // namespace
 
 std::string ExportDayFile(int day, machine::DayRole role) {
@@ -183,6 +194,7 @@ std::vector<std::pair<std::string, std::string>> FieldExportFiles(
   std::vector<std::pair<std::string, std::string>> files;
   files.emplace_back("README.md", readme);
   std::vector<std::vector<double>> days;
+  std::vector<std::string> history_files;  // record.day_logs' files, in order
   std::size_t history = 0;
   for (const machine::DayPlan& plan : timeline.days()) {
     const drift::Run log =
@@ -191,6 +203,7 @@ std::vector<std::pair<std::string, std::string>> FieldExportFiles(
     const drift::Run with_ring =
         WithCheckRing(log, timeline, protocol, MixSeed(plan.seed, 0x636872696e67));
     const std::string name = ExportDayFile(plan.day, plan.role);
+    if (plan.day < 0) history_files.push_back(name);
     files.emplace_back(
         name, drift::FormatRun(
                   with_ring,
@@ -223,6 +236,11 @@ std::vector<std::pair<std::string, std::string>> FieldExportFiles(
                  "screw's measured lead, id = job; z_mm = the tool position), 3 setup_check",
                  "sample: row of the day's log (0 = first data row); time_min: absolute minutes; "
                  "sigma_um: the weight's standard deviation"}));
+  files.emplace_back("records.json", drift::FormatMeasurementRecords(
+                                         FromDayZero(record), history_files,
+                                         "the shop record of the simulated field machine (whirl "
+                                         "machine export; README.md), the same readings as "
+                                         "records.csv, for whirl drift fit-grey"));
   std::vector<std::vector<double>> cuts, truth;
   AddCuts(timeline, truth_range, &cuts, &truth);
   files.emplace_back(

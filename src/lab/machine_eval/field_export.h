@@ -19,6 +19,9 @@
 //                        1 laser, 2 lead, 3 setup_check), id (lead: job index; laser: target mm;
 //                        else 0), sample (row of the day's log), time_min, z_mm, value_um,
 //                        sigma_um; a record is a run of rows with the same (day, kind, id)
+//   records.json         the same readings as a whirl-measurement-records file
+//                        (drift/measurement_file.h) naming the history day logs, for
+//                        `whirl drift fit-grey`
 //   cuts.csv             every cut as the shop planned it: day, job, start type (0 cold, 1 warm,
 //                        2 interrupted, 3 long_pause), cut start and end [abs min], the screw
 //   truth_day<d>_<role>.csv  TRUTH at the log's times: hall_true_C, the machine's error at the
