@@ -39,9 +39,9 @@ struct DemoOptions {
 
 // 7. The workpiece plan and the machine models a shop can train, on one machine of the field
 // world's production scenario (cmd_machine.cpp: whirl machine evaluate); the report of its first
-// test-day screw with the combined 840D programs of the network's plan and the machine model the
-// evaluation picks among the shop-trainable ones (the grey box of both_grey or both_shop's sensor
-// model; machine_report.h). Returns the summary of step 7 for --json.
+// test-day screw with the combined 840D programs of the network's plan and a shop-trainable
+// machine model (the grey box of both_grey wherever it was fitted, else both_shop's sensor model;
+// machine_report.h). Returns the summary of step 7 for --json.
 nlohmann::json RunDemoMachineStep(const std::filesystem::path& out,
                                   const workpiece::WorkpieceModel& model, std::uint64_t seed,
                                   std::FILE* say) {

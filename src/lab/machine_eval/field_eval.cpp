@@ -384,7 +384,7 @@ SeedsEvaluation EvaluateFieldOverSeeds(const machine::MachineScenario& scenario,
                                              if (progress) progress(s * per + done, seeds * per);
                                            }));
   }
-  // The report screw's programs: the model the evaluation picks (summary.h ProgramsStrategy).
+  // The report screw's programs (summary.h ProgramsStrategy: the grey box where it was fitted).
   if (!e.runs.empty() && e.runs.front().report) {
     ReportScrew& r = *e.runs.front().report;
     r.programs_strategy =

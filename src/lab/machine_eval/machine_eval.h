@@ -57,7 +57,7 @@
 //   both_grey          workpiece + the grey box (drift/grey_box.h: absolute temperatures, a slope
 //                      intercept, the blank's estimate latched at the cut start, physical priors;
 //                      shop_models.h FieldGreyBoxSpec), trained from the same shop records; the
-//                      report's 840D programs apply it where the evaluation picks it
+//                      report's 840D programs apply it wherever it was fitted
 //                      (ReportScrew::programs_strategy)
 // Every machine model is applied causally (strategies.h). The truth of a cut: the workpiece truth
 // of compare::CompareScrew (the blank starts at the hall's temperature through its lag and
@@ -174,9 +174,9 @@ struct ReportScrew {
   std::string sensors_choice;        ///< which candidate it is (shop_models.h)
   double z_ref_mm = 0;               ///< the slope's reference: the Z screw's fixed bearing
   drift::GreyBoxModel grey;          ///< the grey box both_grey applies (no input: not fitted)
-  /// The machine model the report's combined 840D programs apply: kBothGrey where the
-  /// evaluation over seeds picks the grey box among the shop-trainable strategies with 840D
-  /// programs (ProgramsStrategy, summary.h), else kBothShop; and why.
+  /// The machine model the report's combined 840D programs apply: kBothGrey where the grey box
+  /// was fitted (ProgramsStrategy, summary.h: a rule fixed before the test days), else
+  /// kBothShop; and why.
   MachineStrategy programs_strategy = MachineStrategy::kBothShop;
   std::string programs_reason = "both_shop: no evaluation over seeds chose between the models";
 };

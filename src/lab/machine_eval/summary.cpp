@@ -94,21 +94,13 @@ MachineStrategy ProgramsStrategy(const std::array<SeedStats, kMachineStrategyCou
                               " test screws, simulated: both_grey " +
                               FormatDecimals(grey.total_median_um, 1) + " um, both_shop " +
                               FormatDecimals(shop.total_median_um, 1) +
-                              " um; chosen on the test screws themselves)";
+                              " um; for information: the rule does not look at them)";
   if (!grey_fitted) {
     *reason = "both_shop: the grey box was not fitted (its sensors are not in the logs)";
     return MachineStrategy::kBothShop;
   }
-  if (grey.screws > 0 && grey.total_median_um < shop.total_median_um) {
-    *reason =
-        "both_grey: the grey box leaves less lead error than both_shop's sensor model" + medians;
-    return MachineStrategy::kBothGrey;
-  }
-  *reason =
-      "both_shop: the grey box does not leave less lead error than both_shop's sensor "
-      "model" +
-      medians;
-  return MachineStrategy::kBothShop;
+  *reason = "both_grey: the grey box is the default wherever it can be fitted" + medians;
+  return MachineStrategy::kBothGrey;
 }
 
 namespace {

@@ -38,9 +38,10 @@ std::array<SeedStats, kMachineStrategyCount> SummarizeOverSeeds(const SeedsEvalu
 MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategyCount>& s);
 
 /// The shop-trainable strategy whose machine model the report's combined 840D programs apply
-/// (ReportScrew::programs_strategy): both_grey when the grey box was fitted (`grey_fitted`) and
-/// its pooled thread median is below both_shop's, else both_shop; `reason` says which medians
-/// decided (chosen on the evaluation's test screws, as the strongest sensor-free rule is).
+/// (ReportScrew::programs_strategy): both_grey whenever the grey box was fitted (`grey_fitted`),
+/// else both_shop. A rule fixed before any test day (the grey box left less than both_shop in
+/// every scenario of the documented evaluation), never a choice on the test screws: `reason`
+/// says which and gives both pooled thread medians on the test screws for information only.
 MachineStrategy ProgramsStrategy(const std::array<SeedStats, kMachineStrategyCount>& s,
                                  bool grey_fitted, std::string* reason);
 

@@ -4,8 +4,8 @@
 // the screw an evaluation kept (machine_eval.h ReportScrew; the evaluation itself writes
 // nothing). Its control log, the lead deviation per strategy, and the combined 840D programs
 // (machine_nc.h) of the models a shop can train: the workpiece plan of the network's curve and
-// the drift action of the machine model the evaluation picks among the shop-trainable ones (the
-// grey box of both_grey, or the sensor model of both_shop; ReportScrew::programs_strategy),
+// the drift action of a shop-trainable machine model (the grey box of both_grey wherever it was
+// fitted, else the sensor model of both_shop; ReportScrew::programs_strategy),
 // trained from probe, laser and lead measurements only, never from the simulator's truth.
 #include <string>
 
