@@ -40,7 +40,7 @@ MachineStrategy StrongestSensorFree(const std::array<SeedStats, kMachineStrategy
 /// The shop-trainable strategy whose machine model the report's combined 840D programs apply
 /// (ReportScrew::programs_strategy): both_grey whenever the grey box was fitted (`grey_fitted`),
 /// else both_shop. A rule fixed before any test day (the grey box left less than both_shop in
-/// every scenario of the documented evaluation), never a choice on the test screws: `reason`
+/// every scenario of the documented 1-week evaluation), never a choice on the test screws: `reason`
 /// says which and gives both pooled thread medians on the test screws for information only.
 MachineStrategy ProgramsStrategy(const std::array<SeedStats, kMachineStrategyCount>& s,
                                  bool grey_fitted, std::string* reason);
