@@ -336,6 +336,13 @@ TEST(GreyBoxFiles, BadModelSpecAndRecordsFilesNameFileFieldAndRule) {
   ExpectBadModel([](nlohmann::json& j) { j["extra"] = 1; }, "extra");
   // The path is named.
   ExpectBadModel([](nlohmann::json& j) { j["fit"]["cv_rmse_um"] = -1; }, "bad_grey.json");
+  // A grey box handed to a command that takes a drift model (drift predict, drift nc --model):
+  // the error says what the file is and which option takes it.
+  const auto grey = test::ScratchDir() / "grey_as_drift.json";
+  WriteFileAtomic(grey, nlohmann::json(FitGreyBox(Planted(Truth(), true, 2), SpecOf(Truth()),
+                                                  Fixed(Truth(), 1e-2)))
+                            .dump());
+  ExpectInputError([&] { (void)ReadDriftModel(grey); }, "drift nc --grey-model");
   // Spec: a prior for a sensor not in its list would be ignored silently.
   const auto spec = test::ScratchDir() / "spec.json";
   const std::string good = R"({"format": "whirl-grey-box-spec", "schema_version": 1,

@@ -12,6 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/process.h"
@@ -84,6 +87,74 @@ CombinedPrograms Build(const machine_eval::ReportScrew& r, const interp::Machine
                                "test model");
 }
 
+// One replayed day of a screw's combined programs: the control's analog inputs fed from the
+// log's raw inputs, the axis parked 5 mm before the thread start until the cut, then following
+// the plan's feed; power-on starts the drift action on the first sample, then the plan.
+struct DayReplay {
+  DayReplay(const machine_eval::ReportScrew& screw, const CombinedPrograms& programs,
+            Eigen::MatrixXd raw_inputs, std::vector<std::string> input_names)
+      : r(screw), p(programs), raw(std::move(raw_inputs)), inputs(std::move(input_names)),
+        feed(screw.kinematics.axial_feed_mm_s), t_cut(screw.kinematics.cutting_time_s),
+        z0(screw.kinematics.thread_start_position_mm),
+        park(interp::AxisPositionMm(programs.plan.options, feed, -5.0 / feed)) {
+    replay.control.abs_value_mm = -0.0013;  // what the control holds before
+    replay.control.slope = 7e-6;
+    replay.control.ref_position_mm = 100.0;
+  }
+  void SetInputs(int k) {
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const interp::AnalogInput& a = p.drift.inputs.at(inputs[i]);
+      replay.control.ain[a.index] = (raw(k, static_cast<Eigen::Index>(i)) - a.offset) / a.scale;
+    }
+  }
+  double CutTimeS(double t_min) const { return (t_min - r.cut_start_min) * 60.0; }
+  double AxisAt(double t_min) const {  // where the axis is at log time t_min
+    const double t_s = CutTimeS(t_min);
+    return t_s < 0 ? park : interp::AxisPositionMm(p.plan.options, feed, std::min(t_s, t_cut));
+  }
+  double ZAt(double t_min) const {  // the tool's distance from the chuck face
+    const double t_s = CutTimeS(t_min);
+    return t_s < 0 ? z0 + 5.0 : z0 - feed * std::min(t_s, t_cut);
+  }
+  void PowerOn() {
+    SetInputs(0);
+    replay.axis_mm = park;
+    ASSERT_TRUE(replay.RunProgram(p.drift_nc));
+    replay.Cycle(park);
+    ASSERT_TRUE(replay.RunProgram(p.plan_nc));
+  }
+  // Sample k-1 -> k: the inputs of sample k, one control cycle at a time.
+  void Advance(int k, int per_sample) {
+    const double t0 = r.log.time_min[static_cast<std::size_t>(k - 1)];
+    const double t1 = r.log.time_min[static_cast<std::size_t>(k)];
+    SetInputs(k);
+    for (int c = 1; c <= per_sample; ++c) replay.Cycle(AxisAt(t0 + (t1 - t0) * c / per_sample));
+  }
+  // After the cut: both reset programs; the control holds what it held before.
+  void EndAndReset() {
+    replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
+    replay.EndProgram();
+    ASSERT_TRUE(replay.RunProgram(p.plan_reset_nc));
+    ASSERT_TRUE(replay.RunProgram(p.drift_reset_nc));
+    EXPECT_TRUE(replay.actions.empty());
+    EXPECT_EQ(replay.control.abs_value_mm, -0.0013);
+    EXPECT_EQ(replay.control.slope, 7e-6);
+    EXPECT_EQ(replay.control.ref_position_mm, 100.0);
+  }
+
+  const machine_eval::ReportScrew& r;
+  const CombinedPrograms& p;
+  Eigen::MatrixXd raw;
+  std::vector<std::string> inputs;
+  double feed, t_cut, z0, park;
+  interp::replay::Replay replay;
+};
+
+int SamplesPerInterval(const drift::Run& log) {
+  return static_cast<int>(
+      std::lround((log.time_min[1] - log.time_min[0]) * 60000.0 / kReplayCycleMs));
+}
+
 void ReplayTheDay(int direction, interp::ControlDk control_dk) {
   SCOPED_TRACE("direction " + std::to_string(direction) + ", control_dk " +
                interp::ToString(control_dk));
@@ -91,56 +162,27 @@ void ReplayTheDay(int direction, interp::ControlDk control_dk) {
   const drift::Run& log = r.log;
   const CombinedPrograms p = Build(r, CombinedProfile(direction, control_dk, r.z_ref_mm));
   const machine_eval::HeldSamples held = machine_eval::RunCausally(r.sensor_model, log);
-  const Eigen::MatrixXd raw = drift::JointRawInputs(r.sensor_model, log);
   std::vector<std::string> inputs = r.sensor_model.sensors;
   inputs.insert(inputs.end(), r.sensor_model.other_inputs.begin(),
                 r.sensor_model.other_inputs.end());
-  interp::replay::Replay replay;
-  replay.control.abs_value_mm = -0.0013;  // what the control holds before
-  replay.control.slope = 7e-6;
-  replay.control.ref_position_mm = 100.0;
-  auto set_inputs = [&](int k) {
-    for (std::size_t i = 0; i < inputs.size(); ++i) {
-      const auto it = p.drift.inputs.find(inputs[i]);
-      ASSERT_NE(it, p.drift.inputs.end()) << inputs[i];
-      replay.control.ain[it->second.index] =
-          (raw(k, static_cast<Eigen::Index>(i)) - it->second.offset) / it->second.scale;
-    }
-  };
-  const double feed = r.kinematics.axial_feed_mm_s, t_cut = r.kinematics.cutting_time_s;
-  const double z0 = r.kinematics.thread_start_position_mm;
-  const double park = interp::AxisPositionMm(p.plan.options, feed, -5.0 / feed);  // 5 mm before
-  auto axis_at = [&](double t_min) {  // where the axis is at log time t_min
-    const double t_s = (t_min - r.cut_start_min) * 60.0;
-    return t_s < 0 ? park : interp::AxisPositionMm(p.plan.options, feed, std::min(t_s, t_cut));
-  };
-  auto z_at = [&](double t_min) {  // the tool's distance from the chuck face
-    const double t_s = (t_min - r.cut_start_min) * 60.0;
-    return t_s < 0 ? z0 + 5.0 : z0 - feed * std::min(t_s, t_cut);
-  };
+  DayReplay day(r, p, drift::JointRawInputs(r.sensor_model, log), inputs);
   const double s = interp::SignFactor(p.plan.options.sign);
-  // Power-on: the drift action starts on the first sample; then the plan with the axis parked.
-  set_inputs(0);
-  replay.axis_mm = park;
-  ASSERT_TRUE(replay.RunProgram(p.drift_nc));
-  replay.Cycle(park);
-  ASSERT_TRUE(replay.RunProgram(p.plan_nc));
-  const int per_sample =
-      static_cast<int>(std::lround((log.time_min[1] - log.time_min[0]) * 60000.0 / kReplayCycleMs));
+  day.PowerOn();
+  if (::testing::Test::HasFatalFailure()) return;
+  const int per_sample = SamplesPerInterval(log);
   double worst_um = 0, worst_parked_um = 0, largest_machine_um = 0;
   int cut_samples = 0;
   for (int k = 1; k < log.samples(); ++k) {
     const double t0 = log.time_min[static_cast<std::size_t>(k - 1)];
     const double t1 = log.time_min[static_cast<std::size_t>(k)];
     ASSERT_EQ(static_cast<int>(std::lround((t1 - t0) * 60000.0 / kReplayCycleMs)), per_sample);
-    set_inputs(k);
-    for (int c = 1; c <= per_sample; ++c) replay.Cycle(axis_at(t0 + (t1 - t0) * c / per_sample));
+    day.Advance(k, per_sample);
     if (::testing::Test::HasFailure()) return;
-    const double pos = axis_at(t1);
+    const double pos = day.AxisAt(t1);
     const double machine_um =
         held.k0_um[static_cast<std::size_t>(k)] +
-        held.slope_um_per_1000[static_cast<std::size_t>(k)] * (r.z_ref_mm - z_at(t1)) / 1000.0;
-    const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
+        held.slope_um_per_1000[static_cast<std::size_t>(k)] * (r.z_ref_mm - day.ZAt(t1)) / 1000.0;
+    const double applied_um = day.replay.control.DkMm(pos) * 1000.0 / s;
     largest_machine_um = std::max(largest_machine_um, std::abs(machine_um));
     if (t1 < r.cut_start_min) {  // parked before the thread start: the machine line alone
       worst_parked_um = std::max(worst_parked_um, std::abs(applied_um - machine_um));
@@ -157,14 +199,7 @@ void ReplayTheDay(int direction, interp::ControlDk control_dk) {
   // The plan never writes a setting datum itself; after the cut and both resets the control
   // holds what it held before.
   EXPECT_EQ(p.plan_nc.find("SA_TEMP_COMP"), std::string::npos);
-  replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
-  replay.EndProgram();
-  ASSERT_TRUE(replay.RunProgram(p.plan_reset_nc));
-  ASSERT_TRUE(replay.RunProgram(p.drift_reset_nc));
-  EXPECT_TRUE(replay.actions.empty());
-  EXPECT_EQ(replay.control.abs_value_mm, -0.0013);
-  EXPECT_EQ(replay.control.slope, 7e-6);
-  EXPECT_EQ(replay.control.ref_position_mm, 100.0);
+  day.EndAndReset();
 }
 
 TEST(CombinedPrograms, ReplayAppliesPlanPlusTheShopTrainedModelAtEveryControlSample) {
@@ -189,52 +224,24 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
   ASSERT_TRUE(p.grey);
   const drift::Run& log = r.log;
   const machine_eval::HeldSamples held = machine_eval::RunCausally(r.grey, log);
-  const Eigen::MatrixXd raw = drift::GreyBoxRawInputs(r.grey, log);
-  const std::vector<std::string> inputs = r.grey.Inputs();
   const int blank = p.drift.blank_param;
-  interp::replay::Replay replay;
-  replay.control.abs_value_mm = -0.0013;
-  replay.control.slope = 7e-6;
-  replay.control.ref_position_mm = 100.0;
-  auto set_inputs = [&](int k) {
-    for (std::size_t i = 0; i < inputs.size(); ++i) {
-      const interp::AnalogInput& a = p.drift.inputs.at(inputs[i]);
-      replay.control.ain[a.index] = (raw(k, static_cast<Eigen::Index>(i)) - a.offset) / a.scale;
-    }
-  };
-  const double feed = r.kinematics.axial_feed_mm_s, t_cut = r.kinematics.cutting_time_s;
-  const double z0 = r.kinematics.thread_start_position_mm;
-  const double park = interp::AxisPositionMm(p.plan.options, feed, -5.0 / feed);
-  auto t_of = [&](double t_min) { return (t_min - r.cut_start_min) * 60.0; };
-  auto axis_at = [&](double t_min) {
-    const double t_s = t_of(t_min);
-    return t_s < 0 ? park : interp::AxisPositionMm(p.plan.options, feed, std::min(t_s, t_cut));
-  };
-  auto z_at = [&](double t_min) {
-    const double t_s = t_of(t_min);
-    return t_s < 0 ? z0 + 5.0 : z0 - feed * std::min(t_s, t_cut);
-  };
+  DayReplay day(r, p, drift::GreyBoxRawInputs(r.grey, log), r.grey.Inputs());
+  interp::replay::Replay& replay = day.replay;
   const double s = interp::SignFactor(p.plan.options.sign);
-  set_inputs(0);
-  replay.axis_mm = park;
-  ASSERT_TRUE(replay.RunProgram(p.drift_nc));
-  replay.Cycle(park);
-  ASSERT_TRUE(replay.RunProgram(p.plan_nc));
-  const int per_sample =
-      static_cast<int>(std::lround((log.time_min[1] - log.time_min[0]) * 60000.0 / kReplayCycleMs));
+  day.PowerOn();
+  if (::testing::Test::HasFatalFailure()) return;
+  const int per_sample = SamplesPerInterval(log);
   const std::size_t at_start = held.IndexAt(r.cut_start_min);
   const double g_b = r.grey.blank_um_per_1000_per_k;
   double worst_um = 0, latched = NAN, b_moved = 0;
   int cut_samples = 0;
   for (int k = 1; k < log.samples(); ++k) {
-    const double t0 = log.time_min[static_cast<std::size_t>(k - 1)];
     const double t1 = log.time_min[static_cast<std::size_t>(k)];
-    set_inputs(k);
-    for (int c = 1; c <= per_sample; ++c) replay.Cycle(axis_at(t0 + (t1 - t0) * c / per_sample));
+    day.Advance(k, per_sample);
     if (::testing::Test::HasFailure()) return;
     const auto uk = static_cast<std::size_t>(k);
-    const double pos = axis_at(t1);
-    const bool cutting = t_of(t1) >= 0 && t_of(t1) < t_cut;
+    const double pos = day.AxisAt(t1);
+    const bool cutting = day.CutTimeS(t1) >= 0 && day.CutTimeS(t1) < day.t_cut;
     const double latch = replay.control.ac_param[blank + 1];
     if (cutting) {
       if (std::isnan(latched)) latched = latch;
@@ -244,10 +251,9 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
       EXPECT_EQ(latch, interp::kBlankNeutralC) << "sample " << k;
     }
     const double g = held.slope_um_per_1000[uk] + (cutting ? g_b * (latch - 20.0) : 0.0);
-    const double machine_um = held.k0_um[uk] + g * (r.z_ref_mm - z_at(t1)) / 1000.0;
+    const double machine_um = held.k0_um[uk] + g * (r.z_ref_mm - day.ZAt(t1)) / 1000.0;
     const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
-    const double plan_um =
-        t_of(t1) >= 0 && t_of(t1) < t_cut ? interp::AppliedCompensationUm(p.plan, pos) : 0.0;
+    const double plan_um = cutting ? interp::AppliedCompensationUm(p.plan, pos) : 0.0;
     worst_um = std::max(worst_um, std::abs(applied_um - machine_um - plan_um));
     cut_samples += cutting;
   }
@@ -257,14 +263,7 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
   const double b_eval = 20.0 + held.blank_slope_um_per_1000[at_start] / g_b;
   EXPECT_LT(std::abs(latched - b_eval), 0.05) << latched << " vs " << b_eval;
   EXPECT_GT(b_moved, 0.0);
-  replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
-  replay.EndProgram();
-  ASSERT_TRUE(replay.RunProgram(p.plan_reset_nc));
-  ASSERT_TRUE(replay.RunProgram(p.drift_reset_nc));
-  EXPECT_TRUE(replay.actions.empty());
-  EXPECT_EQ(replay.control.abs_value_mm, -0.0013);
-  EXPECT_EQ(replay.control.slope, 7e-6);
-  EXPECT_EQ(replay.control.ref_position_mm, 100.0);
+  day.EndAndReset();
   EXPECT_EQ(replay.control.ac_param[blank + 1], interp::kBlankNeutralC);
 }
 

@@ -11,6 +11,7 @@
 #include "core/limits.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
+#include "drift/grey_box_io.h"
 #include "nn/model.h"
 
 namespace whirl::drift {
@@ -240,6 +241,10 @@ void to_json(json& j, const DriftModel& m) {
 }
 
 void from_json(const json& j, DriftModel& m) {
+  if (j.is_object() && j.contains("format") && j["format"] == kGreyBoxFormat)
+    throw InputError(std::string("a grey-box model ('format' '") + kGreyBoxFormat +
+                     "', written by whirl drift fit-grey), not a drift model: put it on the "
+                     "control with whirl drift nc --grey-model FILE");
   if (!j.is_object() || !j.contains("format") || j["format"] != DriftModel::kFormat)
     throw InputError(std::string("not a drift model (its 'format' is not '") + DriftModel::kFormat +
                      "'; write one with whirl drift fit)");
