@@ -807,7 +807,8 @@ DriftModel BlendModels(const DriftModel& a, const DriftModel& b, double share,
 namespace {
 
 bool SameLinearModel(const DriftModel& a, const DriftModel& b) {
-  if (a.kind != b.kind || a.sensors != b.sensors || a.features.size() != b.features.size() ||
+  if (a.time_constants != b.time_constants || a.sensors != b.sensors ||
+      a.features.size() != b.features.size() ||
       a.elapsed_time_constants != b.elapsed_time_constants)
     return false;
   for (std::size_t i = 0; i < a.features.size(); ++i)
@@ -831,8 +832,14 @@ FitReport BlendWithDynamic(const std::vector<Run>& runs, const std::string& erro
   const FitReport b = FitCandidates(runs, error_column, od);
   const auto [name_a, why_a] = SplitChosen(a.chosen);
   const auto [name_b, why_b] = SplitChosen(b.chosen);
-  if (SameLinearModel(a.model, b.model)) {  // e.g. both chose the same time-only model
-    a.chosen += "; the dynamic kind chose the same model";
+  if (a.model.SensorFree() || b.model.SensorFree()) {  // a time-only choice is not blended
+    a.chosen += "; not blended with the dynamic kind's " + name_b +
+                (a.model.SensorFree() ? " (the mlr choice is time-only)" : " (time-only)");
+    a.model.notes.back() = a.chosen;
+    return a;
+  }
+  if (SameLinearModel(a.model, b.model)) {  // the lag search added no lag
+    a.chosen += "; the dynamic kind chose the same model (no lag)";
     a.model.notes.back() = a.chosen;
     return a;
   }
