@@ -151,7 +151,9 @@ void AddCandidatesOption(CLI::App* sub, ModelArgs* m, const std::string& what) {
                 "redone in every fold: leave one run out, or forward-chaining blocks of one run): "
                 "auto (default: sensors, time1, time2, and sensors+time with >= 3 runs; the "
                 "fewest parameters within 5 % of the lowest validation RMSE, and a time model "
-                "replaces the sensors only 20 % lower and lower in 3 of 4 folds), sensors, time "
+                "replaces the sensors only 20 % lower and lower in 3 of 4 folds; with --model "
+                "mlr and the selection, a sensor model chosen is blended 75 % / 25 % with the "
+                "one chosen by the same rule with lagged sensors (--model dynamic)), sensors, time "
                 "(first-order warm-up in time since the run start, 1 or 2 terms, each time "
                 "constant at most the longest training run, gains of one sign), time1, time2 or "
                 "sensors+time")

@@ -8,6 +8,8 @@
 //                                          machine's warm-up runs of issue 38's confirmation
 //                                          left with that machine: docs/drift.md)
 //   [--margin M --consistency C --tolerance T]  a rule other than the default (tuning only)
+//   [--dynamic-share S]  the default's share of the dynamic kind (FitOptions::dynamic_share;
+//                        0: the mlr choice alone, the rule before the second round)
 // Prints one line per case (MAE um of the default, sensors, time, the better of the two, the
 // default's ratio to it, the candidate chosen) and per scenario and overall: the summed MAE of
 // the default against the summed better-of, the worst ratio, and the cases above 1.25.
@@ -62,10 +64,13 @@ double TrainedSpan(const planted::Case& c) {
   return span;
 }
 
+double g_dynamic_share = FitOptions().dynamic_share;  // --dynamic-share
+
 Scores Score(const planted::Case& c, const ChoiceRule& rule, const std::string& error) {
   FitOptions f;
   f.threads = 1;
   f.choice = rule;
+  f.dynamic_share = g_dynamic_share;
   Scores s;
   const FitReport def = FitDriftModel(c.train, error, f);
   s.mae_default = Mae(def.model, c);
@@ -187,7 +192,7 @@ std::vector<planted::Case> ConfirmationCases(int seeds) {
 int main(int argc, char** argv) {
   if (argc < 2 || (std::strcmp(argv[1], "tuning") != 0 && std::strcmp(argv[1], "confirmation") != 0)) {
     std::fprintf(stderr, "usage: choice_study tuning|confirmation [--seeds N] [--margin M] "
-                         "[--consistency C] [--tolerance T] [--quiet]\n");
+                         "[--consistency C] [--tolerance T] [--dynamic-share S] [--quiet]\n");
     return 2;
   }
   const bool tuning = std::strcmp(argv[1], "tuning") == 0;
@@ -206,6 +211,7 @@ int main(int argc, char** argv) {
     else if (a == "--margin") rule.margin = v;
     else if (a == "--consistency") rule.consistency = v;
     else if (a == "--tolerance") rule.tolerance = v;
+    else if (a == "--dynamic-share") g_dynamic_share = v;
     else return 2;
   }
   const std::vector<planted::Case> cases = tuning ? TuningCases(seeds) : ConfirmationCases(seeds);

@@ -153,7 +153,10 @@ TEST(PlantedChoice, SpindleLogKeepsTheSensors) {
     Rng rng(200 + seed);
     const planted::Case c = planted::SpindleLong(rng);
     const FitReport rep = FitDriftModel(c.train, "e_um", FitOptions{});
-    EXPECT_EQ(rep.chosen.rfind("chosen: sensors:", 0), 0u) << rep.chosen;
+    // The mlr kind's choice is the sensors (alone, or blended with the dynamic kind's sensors).
+    EXPECT_EQ(rep.chosen.rfind("chosen: sensors", 0), 0u) << rep.chosen;
+    EXPECT_FALSE(rep.model.SensorFree()) << rep.chosen;
+    EXPECT_TRUE(rep.model.elapsed_time_constants.empty()) << rep.chosen;
   }
 }
 
@@ -227,6 +230,82 @@ TEST(WarmUpFitBounds, TimeConstantsAndGainSignsOnRandomRuns) {
   const WarmUpFit short_run = FitWarmUp({{0.0, 1.0, 2.0, 2.5}}, {Eigen::Vector4d(0, 1, 1.5, 1.6)}, 2);
   EXPECT_EQ(short_run.time_constants.size(), 1u);
   EXPECT_NE(short_run.note.find("too short for two"), std::string::npos) << short_run.note;
+}
+
+// BlendModels on planted runs: the blend's prediction is (1 - w) x a's + w x b's sample by
+// sample (a static and a lagged sensor model, a time model and a sensor model), w = 0 and 1
+// give a and b, and the coefficient covariance bounds the blend's variance from above:
+// x' C x >= ((1 - w) sd_a + w sd_b)^2 for every sample's features.
+TEST(BlendModels, PredictionIsTheBlendOfThePredictions) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Rng rng(500 + seed);
+    const planted::Case c = planted::DutySensor(rng);
+    FitOptions f;
+    f.candidates = Candidates::kSensors;
+    const DriftModel mlr = FitDriftModel(c.train, "e_um", f).model;
+    f.kind = ModelKind::kDynamic;
+    f.max_lags = 1;
+    const DriftModel dyn = FitDriftModel(c.train, "e_um", f).model;
+    f.kind = ModelKind::kMlr;
+    f.candidates = Candidates::kTime1;
+    const DriftModel time = FitDriftModel(c.train, "e_um", f).model;
+    ASSERT_FALSE(dyn.time_constants.empty());
+    for (const auto& [a, b] : {std::pair{&mlr, &dyn}, {&time, &dyn}, {&mlr, &time}}) {
+      for (double w : {0.0, 0.3, 1.0}) {
+        const DriftModel m = BlendModels(*a, *b, w, c.train);
+        EXPECT_NO_THROW(m.Validate());
+        const RunPrediction pm = PredictRun(m, c.test[0]);
+        const RunPrediction pa = PredictRun(*a, c.test[0]), pb = PredictRun(*b, c.test[0]);
+        const Eigen::VectorXd blend = (1 - w) * pa.predicted_um + w * pb.predicted_um;
+        EXPECT_LT((pm.predicted_um - blend).cwiseAbs().maxCoeff(), 1e-9 * (1 + blend.norm()));
+        auto var = [](const RunPrediction& p, const DriftModel& x, Eigen::Index k) {
+          return p.std_um(k) * p.std_um(k) - x.residual_std_um * x.residual_std_um;
+        };
+        for (Eigen::Index k = 0; k < pm.std_um.size(); k += 7) {
+          const double bound = (1 - w) * std::sqrt(std::max(0.0, var(pa, *a, k))) +
+                               w * std::sqrt(std::max(0.0, var(pb, *b, k)));
+          EXPECT_GE(var(pm, m, k), bound * bound * (1 - 1e-9) - 1e-12) << k;
+        }
+      }
+    }
+    EXPECT_THROW(BlendModels(mlr, dyn, 1.5, c.train), InputError);
+  }
+}
+
+// The default (candidates auto, kind mlr) is the mlr kind's choice blended with the dynamic
+// kind's at FitOptions::dynamic_share when both are sensor models; a time-only choice of the
+// mlr kind is kept as it is (time is the truth -> a time model, PlantedChoice.TimeIsTheTruth).
+TEST(BlendModels, DefaultIsTheBlendOfTheTwoKindsChoices) {
+  int blended = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    Rng rng(600 + seed);
+    const planted::Case c = planted::DutySensor(rng);
+    const FitReport def = FitDriftModel(c.train, "e_um", FitOptions{});
+    FitOptions f;
+    f.dynamic_share = 0;
+    const FitReport mlr = FitDriftModel(c.train, "e_um", f);
+    f.kind = ModelKind::kDynamic;
+    const FitReport dyn = FitDriftModel(c.train, "e_um", f);
+    ASSERT_FALSE(mlr.model.SensorFree());
+    // Blended only when the dynamic kind chose a sensor model with lags (else the same model).
+    const bool blend = !dyn.model.SensorFree() && !dyn.model.time_constants.empty();
+    EXPECT_EQ(def.blended, blend) << def.chosen;
+    blended += blend;
+    const double w = blend ? 0.25 : 0.0;
+    const Eigen::VectorXd expected = (1 - w) * PredictRun(mlr.model, c.test[0]).predicted_um +
+                                     w * PredictRun(dyn.model, c.test[0]).predicted_um;
+    const Eigen::VectorXd got = PredictRun(def.model, c.test[0]).predicted_um;
+    EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-9 * (1 + expected.norm()));
+    if (blend) {
+      EXPECT_NE(def.chosen.find("mlr: sensors"), std::string::npos) << def.chosen;
+      EXPECT_NE(def.chosen.find("dynamic: sensors"), std::string::npos) << def.chosen;
+    }
+  }
+  EXPECT_GE(blended, 1);
+  // dynamic_share out of range: an error naming it.
+  FitOptions bad;
+  bad.dynamic_share = -0.1;
+  EXPECT_THROW(bad.Validate(), InputError);
 }
 
 }  // namespace

@@ -336,6 +336,8 @@ void FitOptions::Validate() const {
     throw InputError("restarts " + std::to_string(restarts) + ": must be 1..50");
   if (!(std::isnan(sampling_step) || (sampling_step > 0 && std::isfinite(sampling_step))))
     throw InputError("sampling step " + MessageNumber(sampling_step) + ": must be > 0");
+  if (!(dynamic_share >= 0 && dynamic_share <= 1))
+    throw InputError("dynamic share " + MessageNumber(dynamic_share) + ": must be within 0..1");
   if (max_train_samples < 20 || max_train_samples > 20000)
     throw InputError("max train samples " + std::to_string(max_train_samples) +
                      ": must be 20..20000");
@@ -707,6 +709,163 @@ CandidateChoice ChooseCandidate(const std::vector<CandidateScore>& s, const Choi
   return c;
 }
 
+namespace {
+
+template <typename T>
+void AddMissing(const std::vector<T>& from, std::vector<T>* to) {
+  for (const T& v : from)
+    if (std::find(to->begin(), to->end(), v) == to->end()) to->push_back(v);
+}
+
+// The index of each of `s`'s coefficients (intercept first) in the union model `m`.
+std::vector<Eigen::Index> CoefficientIndex(const DriftModel& s, const DriftModel& m) {
+  std::vector<Eigen::Index> at{0};
+  for (const Feature& f : s.features) {
+    const auto it = std::find_if(m.features.begin(), m.features.end(), [&](const Feature& g) {
+      return g.input == f.input && g.tau == f.tau;
+    });
+    at.push_back(1 + (it - m.features.begin()));
+  }
+  return at;
+}
+
+void CheckBlendable(const DriftModel& a, const DriftModel& b, double share) {
+  if (!(share >= 0 && share <= 1))
+    throw InputError("blend share " + MessageNumber(share) + ": must be within 0..1");
+  for (const DriftModel* x : {&a, &b})
+    if (x->kind == ModelKind::kNetwork)
+      throw InputError("blend: a network model is not linear in its features");
+  if (a.error_column != b.error_column || a.time_unit != b.time_unit ||
+      a.zero.zero != b.zero.zero)
+    throw InputError("blend: the models differ in error column, time unit or error zero (" +
+                     a.error_column + ", " + b.error_column + ")");
+}
+
+// The union model's inputs, lag and elapsed-time constants and features (drift/model.h order).
+DriftModel UnionStructure(const DriftModel& a, const DriftModel& b) {
+  DriftModel m;
+  m.error_column = a.error_column;
+  m.time_unit = a.time_unit;
+  m.zero = a.zero;
+  m.sensors = a.sensors;
+  AddMissing(b.sensors, &m.sensors);
+  m.extra_inputs = a.extra_inputs;
+  AddMissing(b.extra_inputs, &m.extra_inputs);
+  m.time_constants = a.time_constants;
+  AddMissing(b.time_constants, &m.time_constants);
+  std::sort(m.time_constants.begin(), m.time_constants.end());
+  m.elapsed_time_constants = a.elapsed_time_constants;
+  AddMissing(b.elapsed_time_constants, &m.elapsed_time_constants);
+  std::sort(m.elapsed_time_constants.begin(), m.elapsed_time_constants.end());
+  m.kind = m.time_constants.empty() ? ModelKind::kMlr : ModelKind::kDynamic;
+  ListFeatures(&m);
+  for (double t : m.elapsed_time_constants) m.features.push_back({"elapsed", t});
+  m.selection = a.SensorFree() ? b.selection : a.selection;
+  return m;
+}
+
+}  // namespace
+
+DriftModel BlendModels(const DriftModel& a, const DriftModel& b, double share,
+                       const std::vector<Run>& runs) {
+  CheckBlendable(a, b, share);
+  DriftModel m = UnionStructure(a, b);
+  SetTrainingProvenance(runs, &m);
+  const auto p = static_cast<Eigen::Index>(m.features.size()) + 1;
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(p);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(p, p);
+  for (const auto& [s, w] : {std::pair<const DriftModel*, double>{&a, 1 - share}, {&b, share}}) {
+    const std::vector<Eigen::Index> at = CoefficientIndex(*s, m);
+    for (std::size_t i = 0; i < at.size(); ++i) {
+      c(at[i]) += w * s->linear.coefficients(static_cast<Eigen::Index>(i));
+      for (std::size_t j = 0; j < at.size(); ++j)
+        cov(at[i], at[j]) += w * s->linear.covariance(static_cast<Eigen::Index>(i),
+                                                      static_cast<Eigen::Index>(j));
+    }
+  }
+  const Stacked st = Stack(runs, m.error_column, m.sensors, m.extra_inputs, m.time_constants, 2,
+                           m.elapsed_time_constants);
+  m.feature_min = st.x.colwise().minCoeff().transpose();
+  m.feature_max = st.x.colwise().maxCoeff().transpose();
+  const Eigen::VectorXd res = st.y - EvaluateLinear(c, st.x);
+  LinearFit& f = m.linear;
+  f.coefficients = c;
+  f.covariance = cov;
+  f.standard_errors = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  f.samples = static_cast<int>(st.y.size());
+  f.degrees_of_freedom = std::max(1, f.samples - static_cast<int>(p));
+  f.residual_std_um = std::sqrt(res.squaredNorm() / f.degrees_of_freedom);
+  const double tss = (st.y.array() - st.y.mean()).square().sum();
+  f.r_squared = tss > 0 ? 1.0 - res.squaredNorm() / tss : 1.0;
+  f.xtx_inverse = f.residual_std_um > 0 ? Eigen::MatrixXd(cov / (f.residual_std_um * f.residual_std_um)) : cov;
+  f.vif = VarianceInflation(st.x);
+  m.residual_std_um = f.residual_std_um;
+  m.r_squared = f.r_squared;
+  return m;
+}
+
+namespace {
+
+bool SameLinearModel(const DriftModel& a, const DriftModel& b) {
+  if (a.time_constants != b.time_constants || a.sensors != b.sensors ||
+      a.features.size() != b.features.size() ||
+      a.elapsed_time_constants != b.elapsed_time_constants)
+    return false;
+  for (std::size_t i = 0; i < a.features.size(); ++i)
+    if (a.features[i].input != b.features[i].input || a.features[i].tau != b.features[i].tau)
+      return false;
+  return a.linear.coefficients.size() == b.linear.coefficients.size() &&
+         a.linear.coefficients == b.linear.coefficients;
+}
+
+// "chosen: NAME: why" -> NAME and why.
+std::pair<std::string, std::string> SplitChosen(const std::string& chosen) {
+  const std::size_t colon = chosen.find(':', 8);
+  return {chosen.substr(8, colon - 8), chosen.substr(colon + 2)};
+}
+
+// FitOptions::dynamic_share: the mlr kind's choice `a` blended with the dynamic kind's.
+FitReport BlendWithDynamic(const std::vector<Run>& runs, const std::string& error_column,
+                           const FitOptions& o, FitReport a) {
+  FitOptions od = o;
+  od.kind = ModelKind::kDynamic;
+  const FitReport b = FitCandidates(runs, error_column, od);
+  const auto [name_a, why_a] = SplitChosen(a.chosen);
+  const auto [name_b, why_b] = SplitChosen(b.chosen);
+  if (a.model.SensorFree() || b.model.SensorFree()) {  // a time-only choice is not blended
+    a.chosen += "; not blended with the dynamic kind's " + name_b +
+                (a.model.SensorFree() ? " (the mlr choice is time-only)" : " (time-only)");
+    a.model.notes.back() = a.chosen;
+    return a;
+  }
+  if (SameLinearModel(a.model, b.model)) {  // the lag search added no lag
+    a.chosen += "; the dynamic kind chose the same model (no lag)";
+    a.model.notes.back() = a.chosen;
+    return a;
+  }
+  FitReport rep = a;
+  rep.blended = true;
+  rep.model = BlendModels(a.model, b.model, o.dynamic_share, runs);
+  rep.lag_search = b.lag_search;
+  for (CandidateScore c : b.candidates)
+    if (!c.sensor_free) c.name = "dynamic " + c.name, rep.candidates.push_back(c);
+  const std::string pa = MessageNumber(100 * (1 - o.dynamic_share)) + " %";
+  const std::string pb = MessageNumber(100 * o.dynamic_share) + " %";
+  rep.chosen = "chosen: " + name_a + " " + pa + " + dynamic " + name_b + " " + pb +
+               ": the default blends the mlr kind's choice with the dynamic kind's (lagged "
+               "sensors shrunk towards the static model; docs/drift.md, issue 38). mlr: " +
+               name_a + ", " + why_a + ". dynamic: " + name_b + ", " + why_b;
+  rep.model.notes = {};
+  for (const std::string& n : a.model.notes)
+    if (n.rfind("chosen:", 0) != 0) rep.model.notes.push_back(n);
+  for (const std::string& n : b.model.notes)
+    if (n.rfind("chosen:", 0) != 0) rep.model.notes.push_back("dynamic kind: " + n);
+  rep.model.notes.push_back(rep.chosen);
+  return rep;
+}
+
+}  // namespace
+
 FitOptions PreviousRunOptions(const DriftModel& m) {
   FitOptions f;
   f.threads = 1;
@@ -730,6 +889,9 @@ FitReport FitDriftModel(const std::vector<Run>& raw_runs, const std::string& err
                            (o.candidates == Candidates::kAuto && !o.sensors.empty());
   FitReport rep = sensors_only ? FitSensorModel(runs, error_column, o)
                       : FitCandidates(runs, error_column, o);
+  if (!sensors_only && o.kind == ModelKind::kMlr && o.candidates == Candidates::kAuto &&
+      o.dynamic_share > 0)
+    rep = BlendWithDynamic(runs, error_column, o, std::move(rep));
   rep.model.zero = zero;
   return rep;
 }

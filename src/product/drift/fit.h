@@ -51,6 +51,12 @@ struct FitOptions {
   ZeroConvention zero;
   Candidates candidates = Candidates::kAuto;
   ChoiceRule choice;                 ///< among the candidates (ChooseCandidate)
+  /// Candidates auto with the mlr kind and the selection (no sensors given): the model written is
+  /// (1 - dynamic_share) x the mlr kind's choice + dynamic_share x the dynamic kind's choice (the
+  /// same candidates scored with lagged sensors; BlendModels), one linear model on the union of
+  /// their features: the lagged model shrunk towards the static one. 0: the mlr choice alone.
+  /// 0.25 was chosen on issue 38's second-round tuning set (docs/drift.md).
+  double dynamic_share = 0.25;
   std::vector<std::string> sensors;  ///< empty: Miao et al.'s selection (selection.h)
   SelectionOptions selection;
   std::vector<std::string> extra_inputs;  ///< other columns used as inputs
@@ -111,6 +117,9 @@ struct FitReport {
   DriftModel model;
   std::vector<CandidateScore> candidates;  ///< scored candidates (empty: one family asked for)
   std::string chosen;                      ///< the candidate fitted and why
+  /// A blend (FitOptions::dynamic_share): its coefficients come from the search's runs (FitFiles
+  /// does not refit it on every row of thinned logs).
+  bool blended = false;
   bool selected = false;                  ///< sensors came from the selection
   Selection selection;                    ///< when selected
   std::vector<LagSearchStep> lag_search;  ///< dynamic: accepted steps, static first
@@ -146,6 +155,19 @@ Selection SelectSensorsForFit(const std::vector<Run>& runs, const std::string& e
 /// no sensor is left, or when the regression is still rank-deficient (naming the features).
 FitReport FitDriftModel(const std::vector<Run>& runs, const std::string& error_column,
                         const FitOptions& options);
+
+/// (1 - share) x a + share x b as one linear model (kind mlr or dynamic) of a's error column: the
+/// union of the two models' sensors, extra inputs, lag and elapsed-time constants, each feature's
+/// coefficient the blend of the two (0 where a model lacks the feature), so its prediction is
+/// the blend of the two predictions sample by sample. On `runs` (the training runs, on the
+/// models' error zero): the feature ranges, residual std (n - p - 1 degrees of freedom), R^2 and
+/// VIF; the coefficient covariance is (1 - share) Cov_a + share Cov_b (both embedded in the
+/// union), an upper bound of the blend's whatever the two fits' correlation (the square of a
+/// convex combination of standard deviations is at most the combination of the variances).
+/// InputError unless both are linear kinds of the same error column, time unit and error zero,
+/// and 0 <= share <= 1.
+DriftModel BlendModels(const DriftModel& a, const DriftModel& b, double share,
+                       const std::vector<Run>& runs);
 
 /// The name of the "previous run" baseline in drift report and drift monitor --day.
 inline constexpr const char* kPreviousRunBaseline = "previous run";

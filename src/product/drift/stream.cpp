@@ -384,6 +384,13 @@ FitReport FitFiles(const std::vector<RunFile>& files, const std::string& error_c
   if (progress) progress("searching on the thinned sample", sampler.kept(), NAN);
   FitReport rep = FitDriftModel(runs, error_column, thinned);
   runs.clear();
+  if (rep.blended) {  // a blend of two fits is not one least-squares fit: kept as searched
+    rep.model.notes.push_back("a blend (drift/fit.h FitOptions::dynamic_share): coefficients, "
+                              "residual std, R^2 and ranges from the evenly thinned sample of " +
+                              std::to_string(sampler.kept()) + " of " +
+                              std::to_string(sampler.rows()) + " rows");
+    return rep;
+  }
   RefitOnAllRows(files, sampler.runs(), error_column, progress, &rep);
   rep.model.notes.push_back(
       "search (selection, candidates, time constants) on an evenly thinned sample: " +
