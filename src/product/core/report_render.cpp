@@ -236,14 +236,15 @@ std::string Tics(const std::vector<std::string>& names) {
 }
 
 // An x axis end chosen by gnuplot stays where the data end (gnuplot would extend it to the next
-// tic: a log ending at 520 min drawn to 540) in a panel of lines and bands; maps, matrices and
-// panels with markers (which the axis would cut in half) keep gnuplot's own choice. The panel's
-// settings clear it first ("set autoscale x"), so a panel never inherits it.
+// tic: a log ending at 520 min drawn to 540) in a panel that draws lines or bands (a log over
+// time; markers on it, e.g. checks, fall inside); maps, matrices and panels of markers only
+// (which the axis would cut in half at its ends) keep gnuplot's own choice. The panel's settings
+// clear it first ("set autoscale x"), so a panel never inherits it.
 std::string XAutoscaleFix(const Panel& p, bool surface) {
-  const bool markers = std::any_of(p.series.begin(), p.series.end(), [](const Series& x) {
-    return x.kind != SeriesKind::kLine && x.kind != SeriesKind::kBand;
+  const bool lines = std::any_of(p.series.begin(), p.series.end(), [](const Series& x) {
+    return x.kind == SeriesKind::kLine || x.kind == SeriesKind::kBand;
   });
-  if (surface || markers || p.equal_axes || !p.tic_names.empty()) return "";
+  if (surface || !lines || p.equal_axes || !p.tic_names.empty()) return "";
   const bool low = !std::isfinite(p.x.low), high = !std::isfinite(p.x.high);
   if (low && high) return "set autoscale xfix\n";
   if (low) return "set autoscale xfixmin\n";
