@@ -108,12 +108,9 @@ for series, c in colour.items():
     if c in shared: fail(f"{series} and {shared[c]} share the colour {c}")
     shared[c] = series
 # Every plotted prediction (a line in the look of a strategy, method or rule, or the model's
-# prediction) has its +-1 sd band, in the same look, in the same figure.
-# Not yet (issue 39): the workpiece comparison's baselines (the history rules, the ramp, the
-# regression) state no sd of their own; its model and prediction are held to the rule.
+# prediction) has its +-1 sd band, in the same look, in the same figure; only the truth, the
+# residual and none (no compensation, nothing predicted) have none.
 unbanded = {"measured", "residual", "none"}
-if name == "workpiece":
-    unbanded |= {"ramp", "traditional", "regression", "class", "table", "nearest"}
 for i, fig in enumerate(r["figures"]):
     banded = {s for s, kind in fig if kind == "band"}
     if "prediction" in banded: banded.add("model")  # the model's plan follows the prediction

@@ -2,6 +2,7 @@
 // (sim/simulator.h) against closed forms and hand-computed examples.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 
 #include "compare/history_rules.h"
@@ -186,6 +187,75 @@ TEST(HistoryRules, LeaveOneOutChoosesTheTableWhenItIsExact) {
     d.targets[r] = {d.inputs[r].diameter_mm < 63 ? 10.0 : 30.0, 300};
   for (auto& p : d.inputs) p.diameter_mm = p.diameter_mm < 63 ? 50 : 90;
   EXPECT_EQ(BuildExperienceRule(d).choice.chosen, HistoryRule::kClass);
+}
+
+// The ramp rule's leave-one-out score by hand on three screws: two of the 80 mm class
+// (10 um, 200 s; 14 um, 300 s) and one of the 50 mm class (20 um, 100 s). Without a screw the
+// ramp takes its class's other screw's plateau (the 50 mm screw, alone in its class, the mean of
+// the others) and the others' mean settle time as the ramp time:
+//   (|14 - 10| / 10 + |200 - 200| / 200) / 2 = 0.2
+//   (|10 - 14| / 14 + |150 - 300| / 300) / 2 = 11 / 28
+//   (|12 - 20| / 20 + |250 - 100| / 100) / 2 = 0.95
+TEST(HistoryRules, RampLeaveOneOutErrorByHand) {
+  ProcessTable h;
+  h.source = "hand";
+  h.inputs = {{62, 80, 10, 3.7, 180}, {62, 82, 10, 3.7, 180}, {62, 50, 10, 3.7, 180}};
+  h.targets = {{10, 200}, {14, 300}, {20, 100}};
+  const ExperienceRule rule = BuildExperienceRule(h);
+  EXPECT_NEAR(rule.ramp_loo_relative_error, (0.2 + 11.0 / 28 + 0.95) / 3, 1e-12);
+  EXPECT_NEAR(RampLeaveOneOutError(h, rule), rule.ramp_loo_relative_error, 0);
+  h.inputs.resize(1);
+  h.targets.resize(1);
+  EXPECT_THROW(RampLeaveOneOutError(h, rule), InputError);
+  EXPECT_TRUE(std::isnan(BuildExperienceRule(h).ramp_loo_relative_error));
+}
+
+// The regression's leave-one-out score against the closed form of least squares: the residual of
+// row i in a fit without it is e_i / (1 - h_ii) (e: the full fit's residual, h: the hat matrix),
+// here in the logs of both features. An exact power law scores 0; fewer than 8 rows: NaN.
+TEST(Baselines, RegressionLeaveOneOutErrorMatchesTheHatMatrixClosedForm) {
+  ProcessTable h;
+  h.source = "noisy power law";
+  Rng rng(5);
+  for (int i = 0; i < 25; ++i) {
+    const ProcessInputs p{60 + 5 * rng.Uniform(), 50 + 50 * rng.Uniform(), 6 + 10 * rng.Uniform(),
+                          3 + 7 * rng.Uniform(), 150 + 60 * rng.Uniform()};
+    h.inputs.push_back(p);
+    h.targets.push_back({0.3 * p.diameter_mm * std::exp(0.1 * rng.Normal()),
+                         9e5 / p.cutting_speed_m_min * std::exp(0.2 * rng.Normal())});
+  }
+  const int n = static_cast<int>(h.inputs.size()), p = ProcessInputs::kCount + 1;
+  Eigen::MatrixXd a(n, p), y(n, 2);
+  for (int r = 0; r < n; ++r) {
+    const auto x = h.inputs[r].ToArray();
+    a(r, 0) = 1;
+    for (int i = 0; i < ProcessInputs::kCount; ++i) a(r, i + 1) = std::log(x[i]);
+    y(r, 0) = std::log(h.targets[r].max_elongation_um);
+    y(r, 1) = std::log(h.targets[r].settle_time_s);
+  }
+  const Eigen::MatrixXd hat = a * (a.transpose() * a).inverse() * a.transpose();
+  const Eigen::MatrixXd e = y - hat * y;
+  double expected = 0;
+  for (int r = 0; r < n; ++r) {
+    const double lp = y(r, 0) - e(r, 0) / (1 - hat(r, r)), lt = y(r, 1) - e(r, 1) / (1 - hat(r, r));
+    expected += 0.5 * (std::abs(std::exp(lp) - h.targets[r].max_elongation_um) /
+                           h.targets[r].max_elongation_um +
+                       std::abs(std::exp(lt) - h.targets[r].settle_time_s) /
+                           h.targets[r].settle_time_s) /
+                n;
+  }
+  EXPECT_GT(expected, 0.02);
+  EXPECT_NEAR(RegressionLeaveOneOutError(h), expected, 1e-9);
+  EXPECT_NEAR(BuildExperienceRule(h).regression_loo_relative_error, expected, 1e-9);
+  for (std::size_t r = 0; r < h.inputs.size(); ++r)  // the same inputs, exact power-law targets
+    h.targets[r] = {0.3 * h.inputs[r].diameter_mm, 9e5 / h.inputs[r].cutting_speed_m_min};
+  EXPECT_NEAR(RegressionLeaveOneOutError(h), 0.0, 1e-9);
+  h.inputs.resize(7);
+  h.targets.resize(7);
+  EXPECT_TRUE(std::isnan(RegressionLeaveOneOutError(h)));
+  const ExperienceRule seven = BuildExperienceRule(h);
+  EXPECT_TRUE(seven.has_regression);  // 7 rows fit 6 coefficients, but leave none to spare
+  EXPECT_TRUE(std::isnan(seven.regression_loo_relative_error));
 }
 
 }  // namespace

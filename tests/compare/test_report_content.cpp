@@ -1,7 +1,8 @@
 // What the workpiece report shows (compare/report.h, plan/load.h LoadBox), checked against the
 // comparison it is written from: the "load onto the control" box first, with the plan's setting
 // data, the files and the programs' own prerequisites; every strategy in the data and the plots;
-// the prediction's +-1 sd band around the prediction; each baseline's own features.
+// the prediction's +-1 sd band around the prediction and each baseline's band from the history;
+// each baseline's own features.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -190,7 +191,7 @@ TEST_F(ReportContent, PredictionBandContainsThePredictionAndWidensWithItsSd) {
 // (d = [e(t) - c(t)] - [e(0) - c(0)], c(0) = 0), and the band curves lie below and above the
 // prediction, so the +1 sd plan's deviation lies below the model's and the -1 sd plan's above it,
 // up to the plans' chord tolerance (each within tolerance_um of its curve); the band CSV holds
-// them and both lead plots draw it.
+// them and both panels of both lead plots draw it.
 TEST_F(ReportContent, LeadBandBracketsTheModelUpToThePlansTolerance) {
   const ScrewComparison& c = *comparison_;
   const lead::LeadDeviation& model = c.Outcome(Strategy::kModel).lead;
@@ -216,7 +217,7 @@ TEST_F(ReportContent, LeadBandBracketsTheModelUpToThePlansTolerance) {
   for (std::size_t at = gp.find("_lead_band.csv"); at != std::string::npos;
        at = gp.find("_lead_band.csv", at + 1))
     ++plotted;
-  EXPECT_EQ(plotted, 2u) << "the band in both lead plots";
+  EXPECT_EQ(plotted, 4u) << "the band in both panels of both lead plots";
 }
 
 TEST_F(ReportContent, EachBaselineShowsItsOwnFeaturesAndNoStaleProse) {
@@ -235,6 +236,58 @@ TEST_F(ReportContent, EachBaselineShowsItsOwnFeaturesAndNoStaleProse) {
   EXPECT_NE(row("regression (").find(buf), std::string::npos) << row("regression (");
   EXPECT_EQ(html.find("three"), std::string::npos);
   EXPECT_EQ(html.find("traditional rule ("), std::string::npos);
+}
+
+// Every baseline's +-1 sd band comes from the history alone: its rule's leave-one-out error
+// (ExperienceRule) times its plateau for this screw (traditional: its rule's; the model: the
+// prediction's sd; none: no band); the elongation CSV holds each baseline's compensation times
+// 1 -+ that error, and both lead plots shade each baseline's curve -+ its sd.
+TEST_F(ReportContent, EachBaselineHasABandFromTheHistorysLeaveOneOutError) {
+  const ScrewComparison& c = *comparison_;
+  const ExperienceRule rule =
+      BuildExperienceRule(ReadProcessTable(kSource / "datasets/whirling_train.csv", true));
+  ASSERT_TRUE(rule.has_choice);
+  const auto sd = [&c](Strategy s) { return c.band_sd_um[static_cast<std::size_t>(s)]; };
+  const Strategy rules[] = {Strategy::kClass, Strategy::kTable, Strategy::kNearest};
+  for (std::size_t k = 0; k < kHistoryRuleCount; ++k)
+    EXPECT_DOUBLE_EQ(sd(rules[k]), rule.choice.loo_relative_error[k] *
+                                       c.history_features[k].max_elongation_um);
+  EXPECT_DOUBLE_EQ(sd(Strategy::kTraditional),
+                   sd(rules[static_cast<std::size_t>(c.traditional_rule)]));
+  EXPECT_DOUBLE_EQ(sd(Strategy::kRamp),
+                   rule.ramp_loo_relative_error * c.experience_class.plateau_um);
+  EXPECT_DOUBLE_EQ(sd(Strategy::kRegression), rule.regression_loo_relative_error *
+                                                  c.regression_features.max_elongation_um);
+  EXPECT_DOUBLE_EQ(sd(Strategy::kModel), c.prediction.stddev.max_elongation_um);
+  EXPECT_EQ(sd(Strategy::kNone), 0.0);
+  const fs::path dir = Write("whirl_report_baseline_bands", {});
+  const std::string slug = Slug(c.screw.name);
+  const CsvTable el = ReadCsv(dir / (slug + "_elongation.csv"));
+  const CsvTable lead = ReadCsv(dir / (slug + "_lead.csv"));
+  const std::string gp = ReadTextFile(dir / (slug + "_lead.gp")) +
+                         ReadTextFile(dir / (slug + "_lead_start.gp"));
+  for (Strategy s : kStrategies) {
+    if (s == Strategy::kNone || s == Strategy::kModel) continue;
+    const std::string name = ToString(s);
+    ASSERT_GT(sd(s), 0) << name;
+    const double rel = c.band_relative[static_cast<std::size_t>(s)];
+    const auto comp = el.Column(name + "_compensation_um");
+    const auto lo = el.Column(name + "_minus_1sd_um"), hi = el.Column(name + "_plus_1sd_um");
+    double widest = 0;
+    for (std::size_t i = 0; i < comp.size(); ++i) {
+      ASSERT_NEAR(lo[i], comp[i] * (1 - rel), 1e-6) << name;
+      ASSERT_NEAR(hi[i], comp[i] * (1 + rel), 1e-6) << name;
+      widest = std::max(widest, (hi[i] - lo[i]) / 2);
+    }
+    // On the plateau the half-width is the sd (the curve within the plan's tolerance of it).
+    EXPECT_NEAR(widest, sd(s), rel * c.plan.options.tolerance_um + 1e-9) << name;
+    const std::string col = std::to_string(lead.ColumnIndex(name + "_deviation_um") + 1);
+    const std::string band = "using 1:($" + col + "-" + FormatNumber(sd(s)) + "):($" + col + "+" +
+                             FormatNumber(sd(s)) + ")";
+    std::size_t n = 0;
+    for (std::size_t at = gp.find(band); at != std::string::npos; at = gp.find(band, at + 1)) ++n;
+    EXPECT_EQ(n, 2u) << name << ": its band in both lead plots";
+  }
 }
 
 }  // namespace

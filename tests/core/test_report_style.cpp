@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <random>
 #include <set>
@@ -239,6 +240,45 @@ TEST(ReportRender, BandEdgesAreTheColumnShiftedBySd) {
   EXPECT_NE(html.find("data-series='model' data-colour='#1f77b4' data-kind='line'"),
             std::string::npos)
       << html;
+}
+
+// An x axis left to gnuplot ends at the data (no extension to the next tic: a log ending at
+// 520 min is not drawn to 540), at the end left open only, also with markers on the lines; a
+// given range stays as given, and a map or a panel of markers only keeps gnuplot's choice; each
+// panel clears the last one's first.
+TEST(ReportRender, AnXAxisLeftToGnuplotEndsWhereTheDataEnd) {
+  const auto panel = [](report::Range x, bool equal_axes) {
+    report::Panel p;
+    p.x = x;
+    p.equal_axes = equal_axes;
+    report::Series s;
+    s.file = "d.csv";
+    s.columns = {report::Col(1), report::Col(2)};
+    p.series.push_back(s);
+    return p;
+  };
+  report::Figure fig;
+  fig.stem = "x";
+  report::Panel points = panel({}, false);
+  points.series.front().kind = report::SeriesKind::kLinePoints;
+  report::Panel checks = panel({}, false);  // a log with markers of checks on it
+  checks.series.push_back(checks.series.front());
+  checks.series.back().kind = report::SeriesKind::kOpenPoints;
+  fig.panels = {panel({}, false), panel({0, NAN}, false), panel({NAN, 5}, false),
+                panel({0, 100}, false), panel({}, true), points, checks};
+  const std::string gp = report::GnuplotScript(fig);
+  std::vector<std::string> settings;  // what follows each panel's "set xrange"
+  for (std::size_t at = gp.find("set autoscale x\nset xrange "); at != std::string::npos;
+       at = gp.find("set autoscale x\nset xrange ", at + 1))
+    settings.push_back(gp.substr(at, gp.find("set yrange", at) - at));
+  ASSERT_EQ(settings.size(), 7u) << gp;
+  EXPECT_EQ(settings[0], "set autoscale x\nset xrange [*:*]\nset autoscale xfix\n");
+  EXPECT_EQ(settings[1], "set autoscale x\nset xrange [0:*]\nset autoscale xfixmax\n");
+  EXPECT_EQ(settings[2], "set autoscale x\nset xrange [*:5]\nset autoscale xfixmin\n");
+  EXPECT_EQ(settings[3], "set autoscale x\nset xrange [0:100]\n");
+  EXPECT_EQ(settings[4], "set autoscale x\nset xrange [*:*]\n");
+  EXPECT_EQ(settings[5], "set autoscale x\nset xrange [*:*]\n");  // markers only: room
+  EXPECT_EQ(settings[6], "set autoscale x\nset xrange [*:*]\nset autoscale xfix\n");
 }
 
 // The header of a text column is left-aligned like its cells; a column of numbers stays

@@ -7,14 +7,18 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <functional>
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/random.h"
 #include "drift/fit.h"
 #include "drift/monitor.h"
+#include "drift/monitor_report.h"
+#include "core/numbers.h"
 
 namespace whirl::drift {
 namespace {
@@ -562,6 +566,62 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   const Eigen::MatrixXd x = MonitorDesign(m, MakeRun(q, 5), ReferenceMode::kRunStart);
   EXPECT_NEAR(check->predicted_um, x.row(check->sample).dot(first.final_coefficients), 1e-9);
   EXPECT_FALSE(changed.strongest.empty());
+}
+
+// The week on the terminal: one compact row per day under one header - day, samples, the MAE of
+// every row of the week in the week table's order (- where the day has none), the checking rules'
+// checks, invalid checks and stop minutes, the day's strongest, the run - not a sentence per day.
+TEST(MonitorWeek, TerminalShowsOneTableRowPerDay) {
+  Planted p;
+  const DriftModel m = FitOn(MakeRun(p, 1));
+  MonitorOptions o;
+  o.check_every = 100;
+  Planted q = p;
+  q.change_min = 0;
+  q.w_after = {1.6, 0.1, -0.4};
+  const WeekResult w = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5), MakeRun(p, 6)}, o);
+  const std::string text = FormatWeek(w, o);
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream lines(text);
+  bool in_table = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("  day  samples", 0) == 0) {
+      in_table = true;
+      continue;
+    }
+    if (!in_table || line.rfind("week ", 0) == 0) {
+      in_table = false;
+      continue;
+    }
+    std::istringstream words(line);
+    rows.emplace_back();
+    for (std::string word; words >> word;) rows.back().push_back(word);
+  }
+  ASSERT_EQ(rows.size(), w.days.size()) << text;
+  for (std::size_t d = 0; d < w.days.size(); ++d) {
+    const MonitorResult& day = w.days[d];
+    const std::vector<std::string>& r = rows[d];
+    ASSERT_GE(r.size(), 3 + w.week.size() + 3) << text;
+    EXPECT_EQ(r[0], std::to_string(d + 1));
+    EXPECT_EQ(r[1], std::to_string(day.samples));
+    EXPECT_EQ(r[2], FormatDecimals(day.none.mae_um, 2));
+    for (const StrategyResult& st : day.strategies) {
+      std::size_t k = 0;
+      while (k < w.week.size() && w.week[k].name != ToString(st.rule)) ++k;
+      ASSERT_LT(k, w.week.size());
+      EXPECT_EQ(r[2 + k], FormatDecimals(st.score.mae_um, 2)) << ToString(st.rule);
+    }
+    const std::size_t after = 2 + w.week.size();
+    EXPECT_EQ(r[after], std::to_string(Rule(day, UpdateRule::kPatent).checks));
+    std::vector<std::string> each;  // the checking rules' invalid checks, one when they agree
+    for (const StrategyResult& st : day.strategies)
+      if (st.rule != UpdateRule::kStatic) each.push_back(std::to_string(st.invalid_checks));
+    std::string invalid = each.front();
+    if (std::count(each.begin(), each.end(), each.front()) != static_cast<long>(each.size()))
+      for (std::size_t k = 1; k < each.size(); ++k) invalid += "/" + each[k];
+    EXPECT_EQ(r[after + 1], invalid) << text;
+    EXPECT_EQ(r.back(), day.run);
+  }
 }
 
 // Issue 45 item 7: --day had no bound (3,000 files were read); a replay takes at most a year of

@@ -1,10 +1,14 @@
-// The HTML page and gnuplot script of a surface fit: hostile user strings stay text.
+// The HTML page and gnuplot script of a surface fit: hostile user strings stay text; the cubic /
+// B-spline comparison is a table of its figures.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <tuple>
 
 #include "core/atomic_file.h"
+#include "core/numbers.h"
 #include "core/run_program.h"
+#include "core/safe_text.h"
 #include "surface/report.h"
 #include "synthetic/surface.h"
 #include "support/scratch_dir.h"
@@ -43,6 +47,41 @@ TEST(SurfaceReport, HostileTitleAndProvenanceStayText) {
     GTEST_SKIP() << "gnuplot not installed: page checked, map not rendered";
   }
   EXPECT_FALSE(fs::exists("/tmp/pwned"));
+  fs::remove_all(dir);
+}
+
+// The comparison of the two methods (choice.h) is a table, not preformatted text: one row per
+// method with its leave-one-out figures, the recommended one in bold, the reason below.
+TEST(SurfaceReport, MethodComparisonIsATableOfItsFigures) {
+  const fs::path dir = whirl::test::ScratchDir() / "whirl_surface_report_choice";
+  fs::remove_all(dir);
+  synthetic::SyntheticOptions s;
+  const SurfaceFit fit = FitSurface(synthetic::SyntheticPoints(s), {Method::kCubic, 3});
+  const MethodComparison c = CompareMethods(fit.points);
+  ASSERT_TRUE(c.cubic_available && c.bspline_available);
+  SurfaceReportOptions o;
+  o.plots = false;
+  const std::string html = ReadTextFile(WriteSurfaceReport(dir, fit, &c, {}, o).index_html);
+  EXPECT_EQ(html.find("<pre>"), std::string::npos) << html;
+  const auto row = [&html](const std::string& method) {
+    const std::size_t at = html.find("<td>" + method + "</td>");
+    if (at == std::string::npos) return std::string();
+    const std::size_t tr = html.rfind("<tr", at);
+    return html.substr(tr, html.find("</tr>", at) - tr);
+  };
+  const auto cell = [](double um) { return "<td>" + FormatDecimals(um, 3) + "</td>"; };
+  for (const auto& [name, all, common] :
+       {std::tuple{ToString(Method::kCubic), c.cubic_loo, c.cubic_loo_common},
+        std::tuple{ToString(Method::kBspline), c.bspline_loo, c.bspline_loo_common}}) {
+    const std::string r = row(name);
+    ASSERT_FALSE(r.empty()) << name;
+    EXPECT_NE(r.find("<td>" + std::to_string(all.count) + "</td>" + cell(all.rms_um) +
+                     cell(all.max_abs_um) + cell(common.rms_um) + cell(common.max_abs_um)),
+              std::string::npos)
+        << r;
+    EXPECT_EQ(r.rfind("<tr class='cls'>", 0) == 0, name == ToString(c.recommended)) << r;
+  }
+  EXPECT_NE(html.find(HtmlEscape(c.reason)), std::string::npos);
   fs::remove_all(dir);
 }
 

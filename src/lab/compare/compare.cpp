@@ -205,6 +205,30 @@ void CutWithBand(const screw::Screw& screw, const CompareOptions& options, Screw
   }
 }
 
+// ScrewComparison::band_sd_um and band_relative from the history's leave-one-out scores and the
+// prediction's sd (after the features are set).
+void SetBands(const ExperienceRule& rule, ScrewComparison* c) {
+  const auto loo = [&rule](HistoryRule h) {
+    return rule.has_choice ? rule.choice.loo_relative_error[static_cast<std::size_t>(h)] : NAN;
+  };
+  const double model_mean = c->prediction.mean.max_elongation_um;
+  const std::array<std::pair<double, double>, kStrategyCount> rel_plateau = {{
+      {0.0, 0.0},
+      {rule.ramp_loo_relative_error, c->experience_class.plateau_um},
+      {loo(c->traditional_rule), c->traditional_features.max_elongation_um},
+      {rule.regression_loo_relative_error, c->regression_features.max_elongation_um},
+      {model_mean > 0 ? c->prediction.stddev.max_elongation_um / model_mean : 0.0, model_mean},
+      {loo(HistoryRule::kClass), c->history_features[0].max_elongation_um},
+      {loo(HistoryRule::kTable), c->history_features[1].max_elongation_um},
+      {loo(HistoryRule::kNearest), c->history_features[2].max_elongation_um}}};
+  for (std::size_t k = 0; k < kStrategyCount; ++k) {
+    const auto [rel, plateau] = rel_plateau[k];
+    const bool known = std::isfinite(rel) && rel > 0 && plateau > 0;
+    c->band_relative[k] = known ? rel : 0.0;
+    c->band_sd_um[k] = known ? rel * plateau : 0.0;
+  }
+}
+
 }  // namespace
 
 ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::WorkpieceModel& model,
@@ -254,6 +278,7 @@ ScrewComparison CompareScrew(const screw::Screw& screw, const workpiece::Workpie
       PlannedCompensation(history_plans[1], feed),
       PlannedCompensation(history_plans[2], feed)};
   CutWithEveryStrategy(comp, screw, iso_table, options, &c);
+  SetBands(rule, &c);
   if (options.band) CutWithBand(screw, options, &c);
   return c;
 }
@@ -270,7 +295,10 @@ void to_json(nlohmann::json& j, const MetricReductions& r) {
 void to_json(nlohmann::json& j, const ScrewComparison& c) {
   nlohmann::json strategies = nlohmann::json::object();
   for (const auto& o : c.outcomes)
-    strategies[ToString(o.strategy)] = {{"metrics", o.metrics}, {"iso", o.iso}};
+    strategies[ToString(o.strategy)] = {
+        {"metrics", o.metrics},
+        {"iso", o.iso},
+        {"band_sd_um", c.band_sd_um[static_cast<std::size_t>(o.strategy)]}};
   nlohmann::json plan_summary = {{"segments", c.plan.segments.size()},
                                  {"points", c.plan.point_count},
                                  {"uniform_points_for_same_bound", c.plan.uniform_point_count},

@@ -123,6 +123,14 @@ struct ScrewComparison {
   /// Compensation applied at the truth's sample times, um, per strategy (kStrategies order).
   std::array<std::vector<double>, kStrategyCount> compensation_um;
   std::array<StrategyOutcome, kStrategyCount> outcomes;  ///< in kStrategies order
+  /// The +-1 sd of each strategy's compensation at its plateau, um (kStrategies order), from
+  /// training data only, never from this screw: a history rule (ramp, class, table, nearest;
+  /// traditional: its rule's; regression) its leave-one-out mean relative error on the past
+  /// screws (compare/history_rules.h's score, ExperienceRule) times its plateau; model: the
+  /// prediction's sd of the plateau; none: 0. `band_relative`: the same as a fraction of the
+  /// plateau. 0 where the error cannot be computed (e.g. a regression on fewer than 8 screws).
+  std::array<double, kStrategyCount> band_sd_um{};
+  std::array<double, kStrategyCount> band_relative{};
   /// The +-1 sd band of the prediction: the arctangent curves of (L - sd_L, t_s + sd_t) and
   /// (L + sd_L, t_s - sd_t), the two corners that move the whole curve down and up (t_s at least
   /// 1 s, L at least 0), and the model's travel deviation had its plan been made from each (the

@@ -46,12 +46,12 @@ Features Scaled(const Features& a, double f) {
   return {a.max_elongation_um * f, a.settle_time_s * f};
 }
 
-double RelativeError(const Features& p, const Features& t) {
+}  // namespace
+
+double LeaveOneOutRelativeError(const Features& p, const Features& t) {
   return 0.5 * (std::abs(p.max_elongation_um - t.max_elongation_um) / t.max_elongation_um +
                 std::abs(p.settle_time_s - t.settle_time_s) / t.settle_time_s);
 }
-
-}  // namespace
 
 int ExperienceTable::CellOf(const ProcessInputs& in) const {
   return 9 * ClassIndex(in.raceway_radius_mm, options.raceway_edges_mm) +
@@ -161,15 +161,36 @@ TraditionalChoice ChooseTraditional(const ProcessTable& history, const Experienc
     const int cell = without.CellOf(history.inputs[r]);
     without.sum[cell] = Add(without.sum[cell], t, -1.0);
     --without.count[cell];
-    out.loo_relative_error[0] += RelativeError(ClassLeaveOneOut(rule, history, r, all_sum), t);
-    out.loo_relative_error[1] += RelativeError(without.Predict(history.inputs[r]), t);
+    out.loo_relative_error[0] +=
+        LeaveOneOutRelativeError(ClassLeaveOneOut(rule, history, r, all_sum), t);
+    out.loo_relative_error[1] += LeaveOneOutRelativeError(without.Predict(history.inputs[r]), t);
     out.loo_relative_error[2] +=
-        RelativeError(nearest.Predict(history.inputs[r], 3, static_cast<int>(r)), t);
+        LeaveOneOutRelativeError(nearest.Predict(history.inputs[r], 3, static_cast<int>(r)), t);
   }
   for (double& e : out.loo_relative_error) e /= static_cast<double>(history.inputs.size());
   const auto best = std::min_element(out.loo_relative_error.begin(), out.loo_relative_error.end());
   out.chosen = static_cast<HistoryRule>(best - out.loo_relative_error.begin());
   return out;
+}
+
+double RampLeaveOneOutError(const ProcessTable& history, const ExperienceRule& rule) {
+  RequireHistory(history, "leave-one-out error of the ramp rule");
+  if (history.inputs.size() < 2)
+    throw InputError(history.source + ": the leave-one-out error of the ramp rule needs at least "
+                                      "2 past screws");
+  const Features all_sum = std::accumulate(history.targets.begin(), history.targets.end(),
+                                           Features{}, [](Features a, const Features& b) {
+                                             return Add(a, b);
+                                           });
+  const double others = static_cast<double>(history.inputs.size() - 1);
+  double sum = 0;
+  for (std::size_t r = 0; r < history.inputs.size(); ++r) {
+    const Features& t = history.targets[r];
+    const Features ramp{ClassLeaveOneOut(rule, history, r, all_sum).max_elongation_um,
+                        (all_sum.settle_time_s - t.settle_time_s) / others};
+    sum += LeaveOneOutRelativeError(ramp, t);
+  }
+  return sum / static_cast<double>(history.inputs.size());
 }
 
 }  // namespace whirl::compare

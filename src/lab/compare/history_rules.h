@@ -63,6 +63,10 @@ struct NearestScrews {
 /// InputError: no rows or no targets.
 NearestScrews BuildNearestScrews(const ProcessTable& history);
 
+/// The leave-one-out score of one prediction (header comment): the mean relative error of both
+/// features, (|P - P_r| / P_r + |T - T_r| / T_r) / 2, against the measured `truth`.
+double LeaveOneOutRelativeError(const Features& predicted, const Features& truth);
+
 struct TraditionalChoice {
   HistoryRule chosen = HistoryRule::kClass;
   std::array<double, kHistoryRuleCount> loo_relative_error{};  ///< HistoryRule order
@@ -73,5 +77,10 @@ struct ExperienceRule;
 /// screws, all built from `history`. InputError with fewer than 2 past screws.
 TraditionalChoice ChooseTraditional(const ProcessTable& history, const ExperienceRule& class_rule,
                                     const ExperienceTable& table, const NearestScrews& nearest);
+
+/// The same leave-one-out score of the ramp rule (compare/traditional.h: the class plateau
+/// without the screw, the machine's mean settle time without it as the ramp time). InputError
+/// with fewer than 2 past screws.
+double RampLeaveOneOutError(const ProcessTable& history, const ExperienceRule& class_rule);
 
 }  // namespace whirl::compare

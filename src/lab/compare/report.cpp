@@ -65,10 +65,36 @@ using report::Series;
 using report::SeriesKind;
 using report::Text;
 
-// The screw's data files: <slug>_elongation.csv (time, truth, prediction, its band, then each
-// compensating strategy's compensation, in CompensatingStrategies order: the columns the plot
-// script reads by number), the plan's compensation points and the travel deviation of each
-// strategy (CSV with `options.provenance` as comments).
+// The baselines whose compensation is drawn with a band of its own in the elongation plot (all
+// compensating strategies but the model, whose band is the prediction's): the band columns of
+// <slug>_elongation.csv, in this order.
+std::vector<Strategy> BandedBaselines() {
+  std::vector<Strategy> out;
+  for (Strategy s : CompensatingStrategies())
+    if (s != Strategy::kModel) out.push_back(s);
+  return out;
+}
+
+std::size_t At(Strategy s) { return static_cast<std::size_t>(s); }
+
+// Columns of <slug>_elongation.csv (gnuplot's numbers): time, truth, prediction, its band (4, 5),
+// each compensating strategy's compensation from 6 on, then each banded baseline's -1 sd and
+// +1 sd columns.
+int CompensationColumn(Strategy s) {
+  const auto all = CompensatingStrategies();
+  return 6 + static_cast<int>(std::find(all.begin(), all.end(), s) - all.begin());
+}
+int BandLowColumn(Strategy s) {
+  const auto banded = BandedBaselines();
+  return 6 + static_cast<int>(CompensatingStrategies().size()) +
+         2 * static_cast<int>(std::find(banded.begin(), banded.end(), s) - banded.begin());
+}
+
+// The screw's data files: <slug>_elongation.csv (the columns above), the plan's compensation
+// points and the travel deviation of each strategy (CSV with `options.provenance` as comments).
+// A baseline's elongation band is its compensation times 1 -+ its relative error
+// (ScrewComparison::band_relative): the rule's plateau off by its typical error, scaled along
+// the curve.
 void AddScrewData(const ScrewComparison& c, const std::string& slug, const ReportOptions& options,
                   OutputDir& out) {
   const fit::ArctanCurve& low = c.band_curves[0];
@@ -76,20 +102,31 @@ void AddScrewData(const ScrewComparison& c, const std::string& slug, const Repor
   std::vector<std::string> header{"time_s", "truth_elongation_um", "predicted_elongation_um",
                                   "predicted_minus_1sd_um", "predicted_plus_1sd_um"};
   for (Strategy st : CompensatingStrategies()) header.push_back(ToString(st) + "_compensation_um");
+  for (Strategy st : BandedBaselines()) {
+    header.push_back(ToString(st) + "_minus_1sd_um");
+    header.push_back(ToString(st) + "_plus_1sd_um");
+  }
   std::vector<std::vector<double>> rows;
   for (std::size_t i = 0; i < c.truth.size(); ++i) {
     const double t = c.truth.time_s[i];
     rows.push_back({t, c.truth.elongation_um[i], c.predicted_curve.ElongationUm(t),
                     low.ElongationUm(t), high.ElongationUm(t)});
     for (Strategy st : CompensatingStrategies())
-      rows.back().push_back(c.compensation_um[static_cast<std::size_t>(st)][i]);
+      rows.back().push_back(c.compensation_um[At(st)][i]);
+    for (Strategy st : BandedBaselines()) {
+      const double comp = c.compensation_um[At(st)][i], rel = c.band_relative[At(st)];
+      rows.back().push_back(comp * (1 - rel));
+      rows.back().push_back(comp * (1 + rel));
+    }
   }
-  out.Add(
-      slug + "_elongation.csv",
-      FormatCsv(header, rows,
-                Comments(options, "elongation of the unmachined section of screw '" + c.screw.name +
-                                      "', the prediction +- 1 sd (curves of "
-                                      "the features at +-1 sd) and the compensation applied")));
+  out.Add(slug + "_elongation.csv",
+          FormatCsv(header, rows,
+                    Comments(options,
+                             "elongation of the unmachined section of screw '" + c.screw.name +
+                                 "', the prediction +- 1 sd (curves of the features at +-1 sd), "
+                                 "the compensation applied, and each baseline's compensation "
+                                 "times 1 -+ its leave-one-out relative error on the past "
+                                 "screws")));
   out.Add(slug + "_points.csv",
           interp::FormatPointsCsv(
               c.plan, Comments(options,
@@ -130,63 +167,117 @@ bool AddBandData(const ScrewComparison& c, const std::string& slug, const Report
   return true;
 }
 
-// Elongation: the truth, the prediction with its band, each strategy's compensation, the plan's
-// points (columns of <slug>_elongation.csv: see AddScrewData).
+// The two panels of the workpiece plots: the model with the baselines a headline compares it
+// against (ramp, traditional, regression), then the three history rules traditional is chosen
+// from. Fewer bands per panel keep the lines readable.
+const std::vector<Strategy>& HeadlineBaselines() {
+  static const std::vector<Strategy> s{Strategy::kRamp, Strategy::kTraditional,
+                                       Strategy::kRegression};
+  return s;
+}
+const std::vector<Strategy>& HistoryRuleStrategies() {
+  static const std::vector<Strategy> s{Strategy::kClass, Strategy::kTable, Strategy::kNearest};
+  return s;
+}
+
+// A band's legend words: the strategy, its sd at the plateau.
+std::string BandTitle(Strategy s, const ScrewComparison& c) {
+  return ToString(s) + " +- 1 sd (" + FormatDecimals(c.band_sd_um[At(s)], 1) +
+         " um at the plateau)";
+}
+
+// Elongation: the truth, then per panel the baselines' compensation with their bands (columns of
+// <slug>_elongation.csv: see BandLowColumn); the first panel also the prediction with its band,
+// the model's compensation and the plan's points.
 report::Figure ElongationFigure(const ScrewComparison& c, const std::string& slug) {
   const double t_end = c.truth.time_s.back();
   const double settle = std::max(c.predicted_curve.settle_time_s, c.experience_ramp_time_s);
   const double t_zoom = std::min(t_end, std::max(60.0, 3.0 * settle));
-  report::Panel p;
-  p.title = c.screw.name + ": elongation of the unmachined section (first " +
-            FormatDecimals(t_zoom, 0) + " s of " + FormatDecimals(t_end, 0) + " s cutting time)";
-  p.xlabel = "cutting time t [s]";
-  p.ylabel = "elongation [um]";
-  p.x = {0, t_zoom};
-  p.y = {0, NAN};
   const std::string csv = slug + "_elongation.csv";
-  p.series.push_back({csv, -1, {Col(1), Col(4), Col(5)}, SeriesKind::kBand, "prediction", "", 1.5,
-                      false, "prediction +- 1 sd"});
-  p.series.push_back({csv, -1, {Col(1), Col(3)}, SeriesKind::kLine, "prediction", "", 1.5, false,
+  const auto panel = [&](const std::string& title, const std::vector<Strategy>& baselines) {
+    report::Panel p;
+    p.title = title;
+    p.ylabel = "elongation [um]";
+    p.x = {0, t_zoom};
+    p.y = {0, NAN};
+    for (Strategy st : baselines)
+      if (c.band_sd_um[At(st)] > 0)
+        p.series.push_back({csv, -1, {Col(1), Col(BandLowColumn(st)), Col(BandLowColumn(st) + 1)},
+                            SeriesKind::kBand, ToString(st), "", 1.5, false, BandTitle(st, c)});
+    p.series.push_back({csv, -1, {Col(1), Col(2)}, SeriesKind::kLine, "measured", "", 1.5, false,
+                        "simulated truth (disturbed)"});
+    for (Strategy st : baselines)
+      p.series.push_back({csv, -1, {Col(1), Col(CompensationColumn(st))}, SeriesKind::kLine,
+                          ToString(st), "", 1.5, false,
+                          "compensation: " + StrategyLabel(st, c.model_family)});
+    return p;
+  };
+  report::Panel a = panel(c.screw.name + ": elongation of the unmachined section (first " +
+                              FormatDecimals(t_zoom, 0) + " s of " + FormatDecimals(t_end, 0) +
+                              " s cutting time): the model and the headline baselines",
+                          HeadlineBaselines());
+  a.series.insert(a.series.begin(),
+                  {csv, -1, {Col(1), Col(4), Col(5)}, SeriesKind::kBand, "prediction", "", 1.5,
+                   false, "prediction +- 1 sd (curves of the features at -+1 sd)"});
+  a.series.push_back({csv, -1, {Col(1), Col(3)}, SeriesKind::kLine, "prediction", "", 1.5, false,
                       "predicted arctan curve (model)"});
-  p.series.push_back({csv, -1, {Col(1), Col(2)}, SeriesKind::kLine, "measured", "", 1.5, false,
-                      "simulated truth (disturbed)"});
-  int column = 6;
-  for (Strategy st : CompensatingStrategies())
-    p.series.push_back({csv, -1, {Col(1), Col(column++)}, SeriesKind::kLine, ToString(st), "", 1.5,
-                        false, "compensation: " + StrategyLabel(st, c.model_family)});
-  p.series.push_back({slug + "_points.csv", -1, {Col(1), Col(3)}, SeriesKind::kPoints, "",
+  a.series.push_back({csv, -1, {Col(1), Col(CompensationColumn(Strategy::kModel))},
+                      SeriesKind::kLine, ToString(Strategy::kModel), "", 1.5, false,
+                      "compensation: " + StrategyLabel(Strategy::kModel, c.model_family)});
+  a.series.push_back({slug + "_points.csv", -1, {Col(1), Col(3)}, SeriesKind::kPoints, "",
                       "#000000", 1.5, false, "SD43900/10/20 breakpoints (model plan)"});
+  report::Panel b = panel("the history rules traditional is chosen from", HistoryRuleStrategies());
+  b.xlabel = "cutting time t [s]";
   report::Figure f;
   f.stem = slug + "_elongation";
   f.alt = "elongation of " + c.screw.name;
-  f.height_px = 560;
-  f.panels = {p};
+  f.height_px = 900;
+  f.panels = {a, b};
   return f;
 }
 
-// Travel deviation of every strategy along the thread (x from 0 to `x_end_mm`), the model's
-// with its +-1 sd band when `band`.
+// Travel deviation along the thread (x from 0 to `x_end_mm`) in the two panels: none, the
+// model (with its +-1 sd band when `band`: plans of the prediction's band curves) and the
+// headline baselines; none, the model and the history rules. Each baseline with its +-1 sd
+// band (core/report_document.h SdBand: the curve -+ ScrewComparison::band_sd_um).
 report::Figure LeadFigure(const ScrewComparison& c, const std::string& slug,
                           const std::string& stem, double x_end_mm, const std::string& title,
                           bool band) {
-  report::Panel p;
-  p.title = c.screw.name + ": " + title;
-  p.xlabel = "position from the thread start [mm]";
-  p.ylabel = "travel deviation [um]";
-  p.x = {0, x_end_mm};
-  if (band)
-    p.series.push_back({slug + "_lead_band.csv", -1, {Col(1), Col(2), Col(3)}, SeriesKind::kBand,
-                        ToString(Strategy::kModel), "", 1.5, false,
-                        "model +- 1 sd (plans of the prediction's -1 sd and +1 sd curves)"});
-  for (std::size_t k = 0; k < c.outcomes.size(); ++k)
-    p.series.push_back({slug + "_lead.csv", -1, {Col(1), Col(static_cast<int>(k) + 2)},
-                        SeriesKind::kLine, ToString(c.outcomes[k].strategy), "", 1.5, false,
-                        StrategyLabel(c.outcomes[k].strategy, c.model_family)});
+  const std::string csv = slug + "_lead.csv";
+  const auto column = [&c](Strategy s) {
+    for (std::size_t k = 0; k < c.outcomes.size(); ++k)
+      if (c.outcomes[k].strategy == s) return static_cast<int>(k) + 2;
+    return 0;
+  };
+  const auto panel = [&](const std::string& what, const std::vector<Strategy>& baselines) {
+    report::Panel p;
+    p.title = what;
+    p.ylabel = "travel deviation [um]";
+    p.x = {0, x_end_mm};
+    if (band)
+      p.series.push_back({slug + "_lead_band.csv", -1, {Col(1), Col(2), Col(3)},
+                          SeriesKind::kBand, ToString(Strategy::kModel), "", 1.5, false,
+                          "model +- 1 sd (plans of the prediction's -1 sd and +1 sd curves)"});
+    for (Strategy st : baselines)
+      if (c.band_sd_um[At(st)] > 0)
+        p.series.push_back(report::SdBand(csv, Col(1), column(st), c.band_sd_um[At(st)],
+                                          ToString(st), BandTitle(st, c)));
+    std::vector<Strategy> lines{Strategy::kNone, Strategy::kModel};
+    lines.insert(lines.end(), baselines.begin(), baselines.end());
+    for (Strategy st : lines)
+      p.series.push_back({csv, -1, {Col(1), Col(column(st))}, SeriesKind::kLine, ToString(st),
+                          "", 1.5, false, StrategyLabel(st, c.model_family)});
+    return p;
+  };
+  report::Panel a = panel(c.screw.name + ": " + title + ": the model and the headline baselines",
+                          HeadlineBaselines());
+  report::Panel b = panel("the history rules traditional is chosen from", HistoryRuleStrategies());
+  b.xlabel = "position from the thread start [mm]";
   report::Figure f;
   f.stem = stem;
   f.alt = c.screw.name + ": " + title;
-  f.height_px = 520;
-  f.panels = {p};
+  f.height_px = 860;
+  f.panels = {a, b};
   return f;
 }
 
@@ -260,41 +351,54 @@ void AddInputs(const ScrewComparison& c, report::Document* doc) {
   }
 }
 
+// A strategy's +-1 sd band in words for the features table: "1.9 (11.8 % leave-one-out)".
+std::string BandCell(const ScrewComparison& c, Strategy s, const std::string& source) {
+  if (!(c.band_sd_um[At(s)] > 0)) return "- (no band: " + source + " unknown)";
+  return FormatDecimals(c.band_sd_um[At(s)], 1) + " (" +
+         FormatDecimals(100 * c.band_relative[At(s)], 1) + " % " + source + ")";
+}
+
 // The features each strategy works from: the truth's, the model's (+- 1 sd), the ramp's class
-// plateau and ramp time, the traditional rule's class means and the regression's.
+// plateau and ramp time, the traditional rule's class means and the regression's, each with the
+// +-1 sd of its plateau that its bands show (ScrewComparison::band_sd_um).
 report::Table FeaturesTable(const ScrewComparison& c) {
+  const std::string loo = "leave-one-out";
   report::Table t;
-  t.header = {"", "max elongation [um]", "settle time [s]"};
-  auto row = [&t](const std::string& what, const std::string& l, const std::string& s) {
-    t.rows.push_back({what, l, s});
-  };
+  t.header = {"", "max elongation [um]", "settle time [s]", "band +-1 sd at the plateau [um]"};
+  auto row = [&t](const std::string& what, const std::string& l, const std::string& s,
+                  const std::string& band) { t.rows.push_back({what, l, s, band}); };
   row("simulated truth (seed " + std::to_string(c.seed) + ", disturbances " +
           (c.disturbances_on ? "on" : "off") + ")",
       FormatDecimals(c.truth_features.max_elongation_um, 1),
-      FormatDecimals(c.truth_features.settle_time_s, 0));
+      FormatDecimals(c.truth_features.settle_time_s, 0), "");
   row("model prediction (+- 1 sd)",
       FormatDecimals(c.prediction.mean.max_elongation_um, 1) + " +- " +
           FormatDecimals(c.prediction.stddev.max_elongation_um, 1),
       FormatDecimals(c.prediction.mean.settle_time_s, 0) + " +- " +
-          FormatDecimals(c.prediction.stddev.settle_time_s, 0));
+          FormatDecimals(c.prediction.stddev.settle_time_s, 0),
+      BandCell(c, Strategy::kModel, "predictive sd"));
   const std::string cls = "class " + FormatDecimals(c.experience_class.nominal_diameter_mm, 0) +
                           " mm, " + std::to_string(c.experience_class.screws) + " past screws";
   row("ramp (" + cls + ")", FormatDecimals(c.experience_class.plateau_um, 1),
-      FormatDecimals(c.experience_ramp_time_s, 0) + " (linear ramp)");
+      FormatDecimals(c.experience_ramp_time_s, 0) + " (linear ramp)",
+      BandCell(c, Strategy::kRamp, loo));
   row("traditional (= " + ToString(c.traditional_rule) + ", chosen on the history)",
       FormatDecimals(c.traditional_features.max_elongation_um, 1),
-      FormatDecimals(c.traditional_features.settle_time_s, 0));
-  for (std::size_t k = 0; k < kHistoryRuleCount; ++k)
-    row(ToString(static_cast<HistoryRule>(k)) +
-            (k == 0 ? " (" + cls + ", means)" : std::string(" (history rule)")),
+      FormatDecimals(c.traditional_features.settle_time_s, 0),
+      BandCell(c, Strategy::kTraditional, loo));
+  for (std::size_t k = 0; k < kHistoryRuleCount; ++k) {  // HistoryRule order, as the panel's
+    const Strategy st = HistoryRuleStrategies()[k];
+    row(ToString(st) + (k == 0 ? " (" + cls + ", means)" : std::string(" (history rule)")),
         FormatDecimals(c.history_features[k].max_elongation_um, 1),
-        FormatDecimals(c.history_features[k].settle_time_s, 0));
+        FormatDecimals(c.history_features[k].settle_time_s, 0), BandCell(c, st, loo));
+  }
   if (c.regression_features.max_elongation_um > 0)
     row("regression (log-linear on the five inputs)",
         FormatDecimals(c.regression_features.max_elongation_um, 1),
-        FormatDecimals(c.regression_features.settle_time_s, 0));
+        FormatDecimals(c.regression_features.settle_time_s, 0),
+        BandCell(c, Strategy::kRegression, loo));
   else
-    row("regression", "-", "- (the history has no regression: equals none)");
+    row("regression", "-", "- (the history has no regression: equals none)", "");
   return t;
 }
 
@@ -387,8 +491,22 @@ void AddHowToRead(const std::string& history, const std::string& model_family,
            "cooling; accumulated error within 1000 mm = the largest max - min of the deviation "
            "within any 1000 mm of thread (the paper's figure), over the whole thread = max - min "
            "over the thread. e_a, v_u, v_300, v_2pi as ISO 3408-3 (about the least-squares mean "
-           "travel line). The band around model: its travel deviation had the plan been made "
-           "from the prediction's -1 sd and +1 sd curves.");
+           "travel line).");
+  doc->Add(report::Heading{3, "The shaded +-1 sd bands", ""});
+  doc->Say(
+      "Every plotted prediction has a band computed from training data only (the past screws "
+      "and the model's training), never from the screw being cut. model: in the elongation plot "
+      "the arctangent curves of the predicted features at -+1 sd (the network's predictive sd); "
+      "in the travel-deviation plots the model's deviation had the plan been made from either "
+      "curve. ramp, traditional, regression, class, table, nearest: the rule's leave-one-out "
+      "mean relative error on the past screws (each past screw predicted by the rule built "
+      "without it, the error of plateau and settle time averaged: the score traditional is "
+      "chosen by; the regression refitted without each screw; traditional takes its rule's) "
+      "times the rule's plateau for this screw (the table of features gives both). In the "
+      "elongation plot the band is the compensation times 1 -+ that error, in the "
+      "travel-deviation plots the curve -+ that many um. It is the scale of how far the "
+      "compensation may be off, not an interval computed for this lead curve; none compensates "
+      "nothing and has no band. The same definitions as the machine report's bands.");
   doc->Say("ISO 3408-3 caveat: only some tolerance cells are confirmed by a source (Steinmeyer, "
            "HIWIN catalogue); the others are recalled values "
            "(datasets/standards/iso3408_3_lead_tolerances.csv). Treat the class as indicative.",

@@ -7,9 +7,17 @@
 // elongation curve (simulated truth, the prediction with its +-1 sd band, i.e. the arctangent
 // curves of the features at mean -+ 1 sd, and each strategy's compensation with the plan's
 // compensation points), the travel deviation of every strategy along the thread (whole thread,
-// and the first 1000 mm where the transient lives) with the model's +-1 sd band (its deviation
-// had the plan been made from either band curve), plus the CSV files every plot comes from and
-// report.json. Each strategy has one colour and dash in every plot and legend (core/plot_style.h).
+// and the first 1000 mm where the transient lives), each plot in two panels (the model with
+// ramp, traditional and regression; the model with the history rules class, table, nearest),
+// plus the CSV files every plot comes from and report.json. Each strategy has one colour and
+// dash in every plot and legend (core/plot_style.h).
+// Every plotted prediction has its +-1 sd band, from training data only (never from the screw
+// being cut; ScrewComparison::band_sd_um): the model's is the prediction's (elongation: the band
+// curves; travel deviation: the deviation had the plan been made from either band curve); a
+// baseline's (ramp, traditional, regression, class, table, nearest) is its rule's leave-one-out
+// mean relative error on the past screws times its plateau: its compensation times 1 -+ that
+// error in the elongation plot, its curve -+ that many um in the travel-deviation plots
+// (core/report_document.h SdBand, as the machine report's bands).
 //
 // Plots: gnuplot (Debian package gnuplot-nox), see core/report_render.h; without it the page,
 // the CSVs and the scripts are still written and ReportResult::warnings says the plots were

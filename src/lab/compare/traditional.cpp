@@ -93,6 +93,24 @@ LogLinearFeatures FitLogLinear(const ProcessTable& history) {
   return f;
 }
 
+double RegressionLeaveOneOutError(const ProcessTable& history) {
+  const std::size_t n = history.inputs.size();
+  if (n < ProcessInputs::kCount + 3 || history.targets.size() != n) return NAN;
+  double sum = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    ProcessTable others;
+    others.source = history.source;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i == r) continue;
+      others.inputs.push_back(history.inputs[i]);
+      others.targets.push_back(history.targets[i]);
+    }
+    sum += LeaveOneOutRelativeError(FitLogLinear(others).Predict(history.inputs[r]),
+                                    history.targets[r]);
+  }
+  return sum / static_cast<double>(n);
+}
+
 ExperienceRule BuildExperienceRule(const ProcessTable& history,
                                    const ExperienceRuleOptions& options) {
   if (history.inputs.empty())
@@ -149,12 +167,15 @@ ExperienceRule BuildExperienceRule(const ProcessTable& history,
   if (history.inputs.size() >= 2) {
     rule.choice = ChooseTraditional(history, rule, rule.table, rule.nearest);
     rule.has_choice = true;
+    rule.ramp_loo_relative_error = RampLeaveOneOutError(history, rule);
   }
   try {
     rule.regression = FitLogLinear(history);
     rule.has_regression = true;
+    // Without one screw the design can turn singular (a value only that screw has): no score.
+    rule.regression_loo_relative_error = RegressionLeaveOneOutError(history);
   } catch (const InputError& e) {
-    rule.regression_error = e.what();
+    if (!rule.has_regression) rule.regression_error = e.what();
   }
   return rule;
 }
@@ -180,6 +201,10 @@ void to_json(nlohmann::json& j, const ExperienceRule& rule) {
     j["traditional"] = {{"chosen", ToString(rule.choice.chosen)},
                         {"leave_one_out_mean_relative_error", loo}};
   }
+  if (std::isfinite(rule.ramp_loo_relative_error))
+    j["ramp_leave_one_out_mean_relative_error"] = rule.ramp_loo_relative_error;
+  if (std::isfinite(rule.regression_loo_relative_error))
+    j["regression_leave_one_out_mean_relative_error"] = rule.regression_loo_relative_error;
   if (rule.has_regression) {
     nlohmann::json reg = nlohmann::json::object();
     for (int k = 0; k < 2; ++k) reg[kTargetColumns[k]] = rule.regression.coef[k];

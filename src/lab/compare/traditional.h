@@ -37,6 +37,7 @@
 //                form the physics suggests: L ~ q / v_f, t_s ~ a / v_f^2); it is what a process
 //                engineer with a spreadsheet would fit before training a network.
 #include <array>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -71,6 +72,10 @@ struct LogLinearFeatures {
 /// input or target, or a singular design, e.g. a constant column).
 LogLinearFeatures FitLogLinear(const ProcessTable& history);
 
+/// The leave-one-out score (compare/history_rules.h) of the regression: each past screw predicted
+/// by the fit of the others. NaN with fewer than 8 past screws (7 left for 6 coefficients).
+double RegressionLeaveOneOutError(const ProcessTable& history);
+
 struct ExperienceRule {
   std::vector<ExperienceClass> classes;
   double ramp_time_s = 0;         ///< T, s
@@ -89,6 +94,12 @@ struct ExperienceRule {
   NearestScrews nearest;
   TraditionalChoice choice;
   bool has_choice = false;
+  /// The same leave-one-out score (compare/history_rules.h) of the ramp rule and of the
+  /// regression (refitted without each past screw): what the report's +-1 sd bands of ramp and
+  /// regression are made from. NaN when it cannot be computed (ramp: fewer than 2 past screws;
+  /// regression: no regression, or fewer than 8 past screws).
+  double ramp_loo_relative_error = NAN;
+  double regression_loo_relative_error = NAN;
   /// Features of one history rule for a screw.
   Features HistoryFeatures(HistoryRule r, const ProcessInputs& inputs) const;
   /// Features of the strongest history rule (choice.chosen): the headline "traditional".

@@ -235,6 +235,23 @@ std::string Tics(const std::vector<std::string>& names) {
   return "(" + t + ")";
 }
 
+// An x axis end chosen by gnuplot stays where the data end (gnuplot would extend it to the next
+// tic: a log ending at 520 min drawn to 540) in a panel that draws lines or bands (a log over
+// time; markers on it, e.g. checks, fall inside); maps, matrices and panels of markers only
+// (which the axis would cut in half at its ends) keep gnuplot's own choice. The panel's settings
+// clear it first ("set autoscale x"), so a panel never inherits it.
+std::string XAutoscaleFix(const Panel& p, bool surface) {
+  const bool lines = std::any_of(p.series.begin(), p.series.end(), [](const Series& x) {
+    return x.kind == SeriesKind::kLine || x.kind == SeriesKind::kBand;
+  });
+  if (surface || !lines || p.equal_axes || !p.tic_names.empty()) return "";
+  const bool low = !std::isfinite(p.x.low), high = !std::isfinite(p.x.high);
+  if (low && high) return "set autoscale xfix\n";
+  if (low) return "set autoscale xfixmin\n";
+  if (high) return "set autoscale xfixmax\n";
+  return "";
+}
+
 // The settings of one panel, each set or reset so that a panel never inherits the last one's.
 std::string PanelSettings(const Panel& p, bool aligned) {
   std::ostringstream s;
@@ -246,8 +263,8 @@ std::string PanelSettings(const Panel& p, bool aligned) {
   else
     s << "set y2label " << GnuplotString(p.y2label) << "\nset y2tics\nset ytics nomirror\n";
   s << (p.y2_log ? "set logscale y2\n" : "unset logscale y2\n");
-  s << "set xrange " << RangeText(p.x) << "\nset yrange " << RangeText(p.y)
-    << (p.y_reversed ? " reverse" : " noreverse") << "\n";
+  s << "set autoscale x\nset xrange " << RangeText(p.x) << "\n" << XAutoscaleFix(p, surface)
+    << "set yrange " << RangeText(p.y) << (p.y_reversed ? " reverse" : " noreverse") << "\n";
   s << (p.equal_axes ? "set size ratio -1\n" : "set size noratio\n");
   if (p.tic_names.empty())
     s << "set xtics autofreq norotate\nset ytics autofreq\n";

@@ -8,7 +8,9 @@
 // series, drawn in the series' look (core/plot_style.h) with `data-series` (the look's key),
 // `data-colour` and `data-kind` (line, band, points) attributes a test can read. The pictures
 // carry no key of their own (it can neither cover the data nor be clipped); the scripts keep
-// every series' title, so `set key` in a script brings it back.
+// every series' title, so `set key` in a script brings it back. An x axis a panel leaves to
+// gnuplot ends where its lines end (not at the next tic); a map or a panel of markers only keeps
+// gnuplot's choice.
 // Safety: every string of the document reaches the page through HtmlEscape and the scripts
 // through GnuplotString (noenhanced); file names and hrefs are escaped as attributes; the columns
 // are numbers. Without gnuplot (or with plots off), the page, data and scripts are still written

@@ -1,7 +1,10 @@
 // Output documents of the monitor: timeline and events CSV, JSON, text table, HTML page.
 #include "drift/monitor_report.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <functional>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -250,6 +253,67 @@ std::string DayNames(const WeekResult& w, const std::vector<int>& which) {
   return out;
 }
 
+// One day's MAE [um] of the week's row `name` (none, a rule, a baseline), NaN where the day has
+// no such row (the time baseline on the first day).
+double DayMae(const MonitorResult& d, const std::string& name) {
+  if (name == "none") return d.none.mae_um;
+  for (const auto& st : d.strategies)
+    if (ToString(st.rule) == name) return st.score.mae_um;
+  for (const auto& b : d.baselines)
+    if (b.name == name) return b.score.mae_um;
+  return NAN;
+}
+
+// "4" when every checking rule (all but static) has the same value, else "4/5/4" in their order.
+std::string PerRule(const MonitorResult& d,
+                    const std::function<std::string(const StrategyResult&)>& f) {
+  std::vector<std::string> v;
+  for (const auto& st : d.strategies)
+    if (st.rule != UpdateRule::kStatic) v.push_back(f(st));
+  if (v.empty()) return "-";
+  if (std::all_of(v.begin(), v.end(), [&v](const std::string& x) { return x == v.front(); }))
+    return v.front();
+  std::string out;
+  for (const auto& x : v) out += (out.empty() ? "" : "/") + x;
+  return out;
+}
+
+// The days as one table: day, samples, the MAE [um] of every row of the week (none, the rules,
+// the baselines), the checking rules' checks, invalid checks and stop minutes, the day's
+// strongest, the run; the variable-width columns last.
+std::string DayTable(const WeekResult& w) {
+  std::vector<std::string> names;
+  for (const WeekRow& row : w.week) names.push_back(row.name);
+  std::string rules;
+  for (const auto& st : w.days.front().strategies)
+    if (st.rule != UpdateRule::kStatic) rules += (rules.empty() ? "" : "/") + ToString(st.rule);
+  std::ostringstream s;
+  s << "per day, MAE [um] of each row (" << kPreviousRunBaseline
+    << ": drift fit at its defaults redone on the previous day, the given model on the first;\n"
+       "time: sensor-free warm-up fitted on the previous day; -: not run that day), then the "
+       "checks, invalid checks\nand stop [min] of the checking rules "
+    << rules << " (one number when they agree, else each in that order):\n";
+  const auto width = [](const std::string& name) { return std::max<std::size_t>(7, name.size()); };
+  const auto checks = [](const StrategyResult& r) { return std::to_string(r.checks); };
+  const auto invalid = [](const StrategyResult& r) { return std::to_string(r.invalid_checks); };
+  const auto stop = [](const StrategyResult& r) { return FormatDecimals(r.stop_min, 0); };
+  s << "  day  samples";
+  for (const auto& n : names) s << "  " << PadLeft(n, width(n));
+  s << "  checks  invalid  stop min  strongest     run\n";
+  for (std::size_t i = 0; i < w.days.size(); ++i) {
+    const MonitorResult& d = w.days[i];
+    s << "  " << PadLeft(std::to_string(i + 1), 3) << "  " << PadLeft(std::to_string(d.samples), 7);
+    for (const auto& n : names)
+      s << "  " << PadLeft(FormatDecimalsOr(DayMae(d, n), 2, "-"), width(n));
+    const std::string strongest = d.Strongest();
+    s << "  " << PadLeft(PerRule(d, checks), 6) << "  " << PadLeft(PerRule(d, invalid), 7) << "  "
+      << PadLeft(PerRule(d, stop), 8) << "  " << strongest
+      << std::string(strongest.size() < 12 ? 12 - strongest.size() : 1, ' ') << "  " << d.run
+      << "\n";
+  }
+  return s.str();
+}
+
 }  // namespace
 
 std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
@@ -260,17 +324,7 @@ std::string FormatWeek(const WeekResult& w, const MonitorOptions& o) {
     << " from each day's start, " << o.refit_samples
     << " refit measurements; each rule carries its coefficients (and the bayes covariance) "
        "from day to day\n";
-  s << "MAE um per day (" << kPreviousRunBaseline
-    << " = drift fit at its defaults redone on the previous day, the given model on the first; time = "
-       "sensor-free warm-up fitted on the previous day)\n";
-  for (const auto& d : w.days) {
-    s << "  " << d.run << ": none " << FormatDecimals(d.none.mae_um, 2);
-    for (const auto& st : d.strategies)
-      s << ", " << ToString(st.rule) << " " << FormatDecimals(st.score.mae_um, 2) << " (" << st.checks
-        << " checks, " << FormatDecimals(st.stop_min, 0) << " min)";
-    for (const auto& b : d.baselines) s << ", " << b.name << " " << FormatDecimals(b.score.mae_um, 2);
-    s << "; strongest " << d.Strongest() << "\n";
-  }
+  s << DayTable(w);
   s << "week           days  MAE um  RMSE um  measurements  stop min\n";
   for (const WeekRow& row : w.week) {
     char buf[160];

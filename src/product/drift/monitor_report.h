@@ -62,9 +62,10 @@ class TimelineSink {
 /// threshold_um, valid, message.
 std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments);
 nlohmann::json MonitorJson(const MonitorResult& r, const MonitorOptions& o);
-/// The week: per day the table of none, each rule and the baselines (MAE [um]), checks and stop
-/// minutes; then the week's MAE / RMSE per row, measurements and stop time totalled, and the
-/// strongest. JSON schema whirl.drift_monitor_week v1.
+/// The week: a table of one row per day (day, samples, the MAE [um] of none, each rule and the
+/// baselines, the checking rules' checks, invalid checks and stop minutes - one number when they
+/// agree -, the day's strongest, the run); then the week's MAE / RMSE per row, measurements and
+/// stop time totalled, and the strongest. JSON schema whirl.drift_monitor_week v1.
 std::string FormatWeek(const WeekResult& w, const MonitorOptions& o);
 nlohmann::json WeekJson(const WeekResult& w, const MonitorOptions& o);
 /// The week's timeline: every day's MonitorTimelineCsv rows with a first column `day` (1, 2, ...;

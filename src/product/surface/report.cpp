@@ -138,6 +138,41 @@ void AddLines(const std::vector<AxisLine>& lines, report::Document* doc) {
   doc->Add(t);
 }
 
+// The cubic / B-spline comparison (choice.h) as a table: each method's leave-one-out error over
+// its points and over the points both define, the cubic's edge / inside split and overshoot; the
+// recommended method's row in bold, the reason and the oscillation note below.
+report::Table ComparisonTable(const MethodComparison& c) {
+  report::Table t;
+  t.header = {"method", "points", "LOO RMS [um]", "LOO max [um]", "common points: RMS [um]",
+              "common points: max [um]", "edges / inside: RMS [um]", "overshoot [um]"};
+  const auto um = [](double x) { return FormatDecimalsOr(x, 3, "-"); };
+  const auto row = [&](Method m, bool ok, const std::string& refusal, const ErrorStats& all,
+                       const ErrorStats& common) {
+    if (ok && m == c.recommended) t.highlight.push_back(t.rows.size());
+    if (!ok) {
+      report::Cell why("not available (" + refusal + ")");
+      why.colspan = 7;
+      why.left = true;
+      t.rows.push_back({ToString(m), why});
+      return;
+    }
+    const bool cubic = m == Method::kCubic;
+    t.rows.push_back({ToString(m), std::to_string(all.count), um(all.rms_um), um(all.max_abs_um),
+                      um(common.rms_um), um(common.max_abs_um),
+                      cubic ? um(c.cubic_loo_edge.rms_um) + " / " + um(c.cubic_loo_interior.rms_um)
+                            : "-",
+                      cubic ? um(c.cubic_overshoot_um) : "-"});
+  };
+  row(Method::kCubic, c.cubic_available, c.cubic_refusal, c.cubic_loo, c.cubic_loo_common);
+  row(Method::kBspline, c.bspline_available, c.bspline_refusal, c.bspline_loo,
+      c.bspline_loo_common);
+  t.caption = "Leave-one-out (LOO) error: measured - prediction without the point (the B-spline "
+              "leaves out its row or column); common points: where both are defined; overshoot: "
+              "how far the cubic leaves the measured range over the box. Recommended: " +
+              c.reason + (c.note.empty() ? std::string() : "; note: " + c.note) + ".";
+  return t;
+}
+
 report::Table PointsTable(const SurfaceFit& f) {
   report::Table t;
   t.header = {"#", "x [mm]", "y [mm]", "error [um]", "fitted [um]", "residual [um]",
@@ -163,7 +198,7 @@ report::Document Page(const SurfaceFit& f, const MethodComparison* choice,
   AddCubic(f, &doc);
   if (choice) {
     doc.Add(report::Heading{2, "Cubic polynomial or B-spline", ""});
-    doc.Add(report::Preformatted{FormatComparisonText(*choice)});
+    doc.Add(ComparisonTable(*choice));
   }
   AddLines(lines, &doc);
   doc.Add(report::Heading{2, "Measured points", ""}).Add(PointsTable(f));

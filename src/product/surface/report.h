@@ -2,7 +2,8 @@
 // The page a process engineer opens after fitting a surface: one HTML file (index.html) with a
 // colour map of the surface over the measured rectangle, contour lines, the measured points on
 // top, the fit summary (method, condition number, residual and leave-one-out error), the choice
-// between cubic and B-spline with its note, the 840D line per axis and the per-point table.
+// between cubic and B-spline as a table with its reason and note, the 840D line per axis and the
+// per-point table.
 //
 // Plot: gnuplot (Debian gnuplot-nox, pngcairo terminal, png when cairo is missing), run through
 // core/run_program.h with an argument vector (never a shell); every user string that reaches the
