@@ -34,7 +34,7 @@ set(corpus_rows "")
 foreach(name IN LISTS WHIRL_FUZZ_HARNESSES)
   set(wrapper ${CMAKE_CURRENT_BINARY_DIR}/fuzz_replay/corpus_${name}.cpp)
   file(CONFIGURE OUTPUT ${wrapper} CONTENT
-       "#define LLVMFuzzerTestOneInput WhirlFuzz_${name}\n#include \"${CMAKE_CURRENT_LIST_DIR}/fuzz_${name}.cpp\"\n")
+       "#define LLVMFuzzerTestOneInput WhirlFuzz_${name}\n#include \"${CMAKE_CURRENT_LIST_DIR}/fuzz_${name}.cpp\"\n#undef LLVMFuzzerTestOneInput\n")
   list(APPEND corpus_sources ${wrapper})
   string(APPEND corpus_table
          "extern \"C\" int WhirlFuzz_${name}(const std::uint8_t*, std::size_t);\n")
@@ -51,6 +51,9 @@ target_link_libraries(fuzz_corpus PRIVATE whirl::core whirl::screw whirl::lead w
                       whirl::workpiece whirl::drift whirl::interp whirl::ballbar whirl::surface)
 target_compile_options(fuzz_corpus PRIVATE ${WHIRL_TEST_OPTIMIZATION})
 whirl_set_warnings(fuzz_corpus)
+# One unity batch (each wrapper undefines its entry-point name again): the 15 files took 22 s of
+# CPU one by one, most of it parsing the same headers (docs/development.md, "Build time").
+whirl_unity_build(fuzz_corpus)
 foreach(name IN LISTS WHIRL_FUZZ_HARNESSES)
   add_test(NAME corpus_${name}
            COMMAND fuzz_corpus ${name} ${seeds_${name}} ${CMAKE_CURRENT_LIST_DIR}/corpus/${name})

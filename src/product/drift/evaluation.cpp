@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/error.h"
+#include "core/numbers.h"
 #include "core/parallel.h"
 
 namespace whirl::drift {
