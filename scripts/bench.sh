@@ -6,7 +6,6 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build.sh
 BUILD_DIR="${WHIRL_BUILD_DIR:-build}"
-cmake --build "$BUILD_DIR" --target bench -j "$(nproc)"  # not in the default build
 filter="${1:-.}"
 for b in "$BUILD_DIR"/bench/bench_*; do
   echo "== $(basename "$b")"
