@@ -120,10 +120,12 @@ void AddDynamicOptions(CLI::App* sub, ModelArgs* m) {
                   "dynamic: at most this many time constants (1..4, default 2)")
       ->check(NumberIn(1, 4));
   sub->add_option("--folds", m->folds,
-                  "dynamic: cross-validation blocks of a single training run (2..20, default 5)")
+                  "cross-validation blocks of a single training run, for the lag search and the "
+                  "choice among --candidates (2..20, default 5)")
       ->check(NumberIn(2, 20));
   sub->add_flag("--leave-block-out", m->shuffle_cv,
-                "dynamic: leave-one-block-out instead of forward-chaining blocks");
+                "leave-one-block-out instead of forward-chaining blocks (lag search and "
+                "candidates)");
 }
 
 // --error-zero (old spelling --errors-from-start: run-start), --gauge-level-um (every command
