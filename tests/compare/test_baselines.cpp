@@ -47,12 +47,18 @@ TEST(Baselines, LogLinearRegressionRecoversAnExactPowerLaw) {
   EXPECT_THROW(FitLogLinear(h), InputError);  // 5 rows < 6 coefficients
 }
 
-// Hand-computed class means: two 80 mm screws and one 50 mm screw.
-TEST(Baselines, TraditionalUsesTheClassMeanPlateauAndSettleTime) {
+// Two 80 mm screws and one 50 mm screw, targets small enough to compute by hand.
+ProcessTable HandTable() {
   ProcessTable h;
   h.source = "hand";
   h.inputs = {{62, 80, 10, 3.7, 180}, {62, 82, 10, 3.7, 180}, {62, 50, 10, 3.7, 180}};
   h.targets = {{10, 200}, {14, 300}, {20, 100}};
+  return h;
+}
+
+// Hand-computed class means: two 80 mm screws and one 50 mm screw.
+TEST(Baselines, TraditionalUsesTheClassMeanPlateauAndSettleTime) {
+  const ProcessTable h = HandTable();
   const ExperienceRule r = BuildExperienceRule(h);
   EXPECT_DOUBLE_EQ(r.ClassFeatures(80).max_elongation_um, 12);
   EXPECT_DOUBLE_EQ(r.ClassFeatures(80).settle_time_s, 250);
@@ -197,10 +203,7 @@ TEST(HistoryRules, LeaveOneOutChoosesTheTableWhenItIsExact) {
 //   (|10 - 14| / 14 + |150 - 300| / 300) / 2 = 11 / 28
 //   (|12 - 20| / 20 + |250 - 100| / 100) / 2 = 0.95
 TEST(HistoryRules, RampLeaveOneOutErrorByHand) {
-  ProcessTable h;
-  h.source = "hand";
-  h.inputs = {{62, 80, 10, 3.7, 180}, {62, 82, 10, 3.7, 180}, {62, 50, 10, 3.7, 180}};
-  h.targets = {{10, 200}, {14, 300}, {20, 100}};
+  ProcessTable h = HandTable();
   const ExperienceRule rule = BuildExperienceRule(h);
   EXPECT_NEAR(rule.ramp_loo_relative_error, (0.2 + 11.0 / 28 + 0.95) / 3, 1e-12);
   EXPECT_NEAR(RampLeaveOneOutError(h, rule), rule.ramp_loo_relative_error, 0);

@@ -131,6 +131,15 @@ NearestScrews BuildNearestScrews(const ProcessTable& history) {
 
 namespace {
 
+// The sum of the past screws' targets, for a leave-one-out score `what` (at least 2 screws).
+Features LeaveOneOutTargetSum(const ProcessTable& history, const char* what) {
+  RequireHistory(history, what);
+  if (history.inputs.size() < 2)
+    throw InputError(history.source + ": the " + what + " needs at least 2 past screws");
+  return std::accumulate(history.targets.begin(), history.targets.end(), Features{},
+                         [](Features a, const Features& b) { return Add(a, b); });
+}
+
 // Leave-one-out features of row r by the class rule: the class means without the row, the mean
 // of all other screws for a class left empty.
 Features ClassLeaveOneOut(const ExperienceRule& rule, const ProcessTable& h, std::size_t r,
@@ -146,14 +155,8 @@ Features ClassLeaveOneOut(const ExperienceRule& rule, const ProcessTable& h, std
 
 TraditionalChoice ChooseTraditional(const ProcessTable& history, const ExperienceRule& rule,
                                     const ExperienceTable& table, const NearestScrews& nearest) {
-  RequireHistory(history, "choice of the traditional rule");
-  if (history.inputs.size() < 2)
-    throw InputError(history.source + ": the leave-one-out choice of the traditional rule needs "
-                                      "at least 2 past screws");
-  const Features all_sum = std::accumulate(history.targets.begin(), history.targets.end(),
-                                           Features{}, [](Features a, const Features& b) {
-                                             return Add(a, b);
-                                           });
+  const Features all_sum =
+      LeaveOneOutTargetSum(history, "leave-one-out choice of the traditional rule");
   TraditionalChoice out;
   for (std::size_t r = 0; r < history.inputs.size(); ++r) {
     const Features& t = history.targets[r];
@@ -174,14 +177,7 @@ TraditionalChoice ChooseTraditional(const ProcessTable& history, const Experienc
 }
 
 double RampLeaveOneOutError(const ProcessTable& history, const ExperienceRule& rule) {
-  RequireHistory(history, "leave-one-out error of the ramp rule");
-  if (history.inputs.size() < 2)
-    throw InputError(history.source + ": the leave-one-out error of the ramp rule needs at least "
-                                      "2 past screws");
-  const Features all_sum = std::accumulate(history.targets.begin(), history.targets.end(),
-                                           Features{}, [](Features a, const Features& b) {
-                                             return Add(a, b);
-                                           });
+  const Features all_sum = LeaveOneOutTargetSum(history, "leave-one-out error of the ramp rule");
   const double others = static_cast<double>(history.inputs.size() - 1);
   double sum = 0;
   for (std::size_t r = 0; r < history.inputs.size(); ++r) {
