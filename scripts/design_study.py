@@ -124,17 +124,22 @@ class Evaluator:
         return bp.rmse(mean, self.truth).tolist()
 
 
-def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0):
+def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, variance=None,
+             inside=()):
     """RMSE per size of the sequential design: FIRST by the first design (or the Latin hypercube
-    picks `first_lhs`), then batches; fill_first / fill_next: `whirl design --space-filling`."""
+    picks `first_lhs`), then batches; fill_first / fill_next: `whirl design --space-filling`;
+    variance: extra `whirl design` arguments of the next screws (--variance ..., None: defaults;
+    the hyperparameters go to the first design too); inside: the first design's `--inside K`."""
     pool = os.path.join(ev.tmp, "pool.csv")
     bp.write_table(pool, ev.x)
     if first_lhs is not None:
         picked = list(first_lhs)
     else:
+        hyper = [a for f, v in zip(variance[::2], variance[1::2]) if f != "--variance"
+                 for a in (f, v)] if variance else []
         out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
                               "--criterion", criterion, "--space-filling", str(fill_first),
-                              "--json"]))
+                              "--json"] + hyper + inside))
         picked = [int(p["source"].split()[1]) - 2 for p in out["picks"]]  # line -> row
     result = {}
     while True:
@@ -153,7 +158,7 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0):
         fill = min(fill_next, k)
         out = json.loads(run([ev.whirl, "design", "--model", model, "--candidates", cand,
                               "--count", str(k), "--space-filling", str(fill), "--measured",
-                              measured, "--json"]))
+                              measured, "--json"] + (variance or [])))
         picked += [left[int(p["source"].split()[1]) - 2] for p in out["picks"]]
 
 
@@ -170,8 +175,20 @@ def one_case(prob, seed, a, cache):
             res["lhs"] = {n: ev.rmse(ev.train(lhs_pick(x, n, rng), "l")) for n in SIZES}
             res["natural"] = {n: ev.rmse(ev.train(nat[:n], "n")) for n in SIZES}
         first = lhs_pick(x, FIRST, np.random.default_rng([7, seed])) if a.first == "lhs" else None
-        res["design"] = designed(ev, a.criterion, a.batch, first, a.fill_first, a.fill_next)
+        res["design"] = designed(ev, a.criterion, a.batch, first, a.fill_first, a.fill_next,
+                                 variance_args(a),
+                                 [] if a.inside is None else ["--inside", str(a.inside)])
         return prob, seed, res
+
+
+def variance_args(a):
+    """The next screws' `whirl design` options given to the study (none: the defaults)."""
+    out = []
+    for flag, v in (("--variance", a.variance), ("--departure-ratio", a.departure_ratio),
+                    ("--length-scale", a.length_scale)):
+        if v is not None:
+            out += [flag, str(v)]
+    return out
 
 
 def seeds_of(text):
@@ -281,6 +298,11 @@ def main():
                     help="whirl design --space-filling of the first design [screws]")
     ap.add_argument("--fill-next", type=int, default=0,
                     help="whirl design --space-filling of every next batch [screws]")
+    ap.add_argument("--variance", help="whirl design --variance of the next screws (default: "
+                    "whirl design's)")
+    ap.add_argument("--departure-ratio", type=float, help="whirl design --departure-ratio")
+    ap.add_argument("--length-scale", type=float, help="whirl design --length-scale")
+    ap.add_argument("--inside", type=int, help="whirl design --inside of the first design")
     ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
     ap.add_argument("--design-only", action="store_true", help="only the design strategy")
     ap.add_argument("--sim-cache", default=os.path.join(tempfile.gettempdir(), "whirl_design_sim"))
@@ -312,13 +334,18 @@ def main():
                       for k in STRATEGIES if k != "design"})
     table = summarize(results, problems)
     print(f"criterion {a.criterion}, batch {a.batch}, space filling {a.fill_first} (first) / "
-          f"{a.fill_next} (next), seeds {a.seeds}, pool {POOL_ROWS}")
+          f"{a.fill_next} (next), inside {a.inside}, next screws "
+          f"{' '.join(variance_args(a)) or 'defaults'}, "
+          f"seeds {a.seeds}, pool {POOL_ROWS}")
     print_markdown(table)
     score(table)
     if a.json:
         with open(a.json, "w") as h:
             json.dump({"criterion": a.criterion, "batch": a.batch, "seeds": a.seeds,
                        "fill_first": a.fill_first, "fill_next": a.fill_next,
+                       "next_screws": variance_args(a) or "whirl design defaults",
+                       "inside": a.inside,
+                       "command": " ".join(sys.argv),
                        "cases": results, "medians": table}, h)
     if a.plot:
         plot(table, a.plot)

@@ -24,8 +24,10 @@ namespace {
 struct DesignCliOptions {
   std::string candidates_path, model_path, out_path, measured_path;
   std::array<std::string, ProcessInputs::kCount> ranges;
-  int count = 0, levels = 3, space_filling = 0;
-  std::string criterion = "d";
+  int count = 0, levels = 3, space_filling = 0, inside = 0;
+  std::string criterion = "d", variance = design::ToString(design::NextRule{}.model);
+  double departure_ratio = design::NextRule{}.departure_ratio;
+  double length_scale = design::NextRule{}.length_scale;
   double tolerance_um = 0, tolerance_s = 0;
   bool json = false;
 };
@@ -145,9 +147,17 @@ std::string InputsText(const ProcessInputs& x) {
   return t;
 }
 
+design::NextRule RuleOf(const DesignCliOptions& o) {
+  design::NextRule rule;
+  rule.model = design::ParseNextModel(o.variance);
+  rule.departure_ratio = o.departure_ratio;
+  rule.length_scale = o.length_scale;
+  return rule;
+}
+
 void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
   const auto d = design::DesignPowerLaw(c.inputs, o.count, design::ParseCriterion(o.criterion),
-                                        o.space_filling);
+                                        o.space_filling, o.inside, RuleOf(o));
   const std::string csv = DesignCsv(c, d.picks, false, "first design, criterion " + o.criterion);
   if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
   if (o.json) {
@@ -160,7 +170,8 @@ void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
     PrintJson({{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
                {"candidate_count", c.inputs.size()}, {"coefficients", d.coefficients},
                {"varying_inputs", d.inputs}, {"log_det_per_screw", d.log_det},
-               {"space_filling", d.space_filling}, {"min_distance", d.min_distance},
+               {"space_filling", d.space_filling}, {"inside", d.inside},
+               {"min_distance", d.min_distance},
                {"mean_sd_factor", d.mean_sd_factor}, {"max_sd_factor", d.max_sd_factor},
                {"picks", picks}});
     return;
@@ -196,7 +207,7 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
     fill.measured = ReadProcessTable(o.measured_path, /*require_targets=*/false).inputs;
   design::NextDesign d;
   try {
-    d = design::DesignNext(model, c.inputs, o.count, rule, c.lines, fill);
+    d = design::DesignNext(model, c.inputs, o.count, rule, c.lines, fill, RuleOf(o));
   } catch (const InputError& e) {
     throw InputError("design --model " + o.model_path + " --candidates " + c.source + ": " +
                      e.what());
@@ -211,7 +222,7 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
           (*j)["settle_time_sd_now_s"] = p.sd_now[1];
           (*j)["settle_time_sd_after_s"] = p.sd_after[1];
         });
-    nlohmann::json j = {{"mode", "next"}, {"model", o.model_path},
+    nlohmann::json j = {{"mode", "next"}, {"model", o.model_path}, {"variance", o.variance},
                         {"model_describe", model.Describe()}, {"candidates", c.source},
                         {"candidate_count", c.inputs.size()}, {"picks", picks},
                         {"rms_sd_now", {{"max_elongation_um", d.rms_sd_now[0]},
@@ -227,7 +238,8 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
     PrintJson(j);
     return;
   }
-  std::cout << "next screws (integrated variance reduction of " << model.Describe() << "): "
+  std::cout << "next screws (integrated variance reduction, --variance " << o.variance
+            << "; model " << model.Describe() << "): "
             << o.count << " of " << c.inputs.size() << " candidates (" << c.source << ")\n";
   std::cout << "rank  source      inputs (" << JoinFields({kInputColumns.begin(), kInputColumns.end()})
             << ")\n      sd now -> after: max_elongation [um], settle_time [s]\n";
@@ -255,6 +267,13 @@ void RunDesign(const DesignCliOptions& o) {
   if (o.model_path.empty() && (o.tolerance_um > 0 || o.tolerance_s > 0))
     throw InputError("design: --tolerance-um / --tolerance-s need --model (the stop rule judges a "
                      "trained model's predictive sd)");
+  const design::NextRule defaults;
+  if (o.model_path.empty() && o.variance != design::ToString(defaults.model))
+    throw InputError("design: --variance needs --model (it chooses the next screws; a first "
+                     "design is D- or I-optimal, --criterion, with --inside screws by power-gp)");
+  if (!o.model_path.empty() && o.inside > 0)
+    throw InputError("design: --inside is a first design's (without --model); the next screws "
+                     "follow --variance");
   if (o.model_path.empty() && !o.measured_path.empty())
     throw InputError("design: --measured needs --model (a first design has no measured screws)");
   const DesignCandidates c = ReadDesignCandidates(o);
@@ -313,10 +332,32 @@ void RegisterDesign(CLI::App& app) {
                   "--model, to the --measured ones; first design: after the optimal ones")
       ->capture_default_str()
       ->check(NumberIn(0, 100000));
+  sub->add_option("--inside", o->inside,
+                  "first design: screws of --count picked after the optimal ones by the "
+                  "power-gp variance (see --variance) given those before, so that the first "
+                  "table sees inside the range [screws]")
+      ->capture_default_str()
+      ->check(NumberIn(0, 100000));
   sub->add_option("--measured", o->measured_path,
                   "with --model: the screws measured so far (CSV, five input columns; e.g. the "
-                  "training table), needed by --space-filling")
+                  "training table), needed by --variance power-gp | sum and --space-filling")
       ->check(CLI::ExistingFile);
+  sub->add_option("--variance", o->variance,
+                  "next screws: whose variance the picks reduce: power-gp (a GP on the "
+                  "standardized log inputs whose mean is the power law: the power law plus a "
+                  "smooth departure, given the --measured screws; needs --measured), chosen (the "
+                  "model's chosen family's own variance) or sum (both, weighed equally)")
+      ->capture_default_str();
+  sub->add_option("--departure-ratio", o->departure_ratio,
+                  "power-gp (and --inside): the departure's sd over the measurement scatter's "
+                  "sd [1]")
+      ->capture_default_str()
+      ->check(PositiveNumber("1"));
+  sub->add_option("--length-scale", o->length_scale,
+                  "power-gp (and --inside): the departure's length scale in log inputs "
+                  "standardized over the list and the measured screws [sd]")
+      ->capture_default_str()
+      ->check(PositiveNumber("sd"));
   sub->add_option("--model", o->model_path,
                   "trained family model ('whirl train' default): next screws instead of a first "
                   "design")

@@ -44,11 +44,11 @@ PY
 # Next screws from a trained model: sd after <= sd now; the stop rule in three cases.
 "$whirl" train --data "$data" --out m.json > /dev/null 2> err.txt || fail "train: $(cat err.txt)"
 "$whirl" design --model m.json --candidates cands.csv --count 3 --tolerance-um 1000 \
-  --tolerance-s 1000 --out next.csv > out.txt 2> err.txt || fail "next screws: $(cat err.txt)"
+  --tolerance-s 1000 --measured "$data" --out next.csv > out.txt 2> err.txt || fail "next screws: $(cat err.txt)"
 grep -q "stop rule: enough" out.txt || fail "huge tolerance is not 'enough': $(cat out.txt)"
 [ "$(grep -vc '^#' next.csv)" -eq 4 ] || fail "next.csv does not hold 3 screws"
 "$whirl" design --model m.json --candidates cands.csv --count 3 --tolerance-um 0.001 --json \
-  > next.json 2> err.txt || fail "next --json: $(cat err.txt)"
+  --measured "$data" > next.json 2> err.txt || fail "next --json: $(cat err.txt)"
 python3 - next.json <<'PY' || fail "next.json: $(cat next.json)"
 import json, sys
 d = json.load(open(sys.argv[1]))
@@ -59,7 +59,14 @@ for p in d["picks"]:
 for k in ("max_elongation_um", "settle_time_s"):
     assert d["rms_sd_after"][k] <= d["rms_sd_now"][k] + 1e-12
 assert d["stop"]["decision"] == "floor", d["stop"]
+assert d["variance"] == "power-gp" and all("smooth departure" in p["why"] for p in d["picks"])
 PY
+# The chosen family's own variance needs no measured screws.
+"$whirl" design --model m.json --candidates cands.csv --count 2 --variance chosen > out.txt \
+  2> err.txt || fail "next --variance chosen: $(cat err.txt)"
+grep -q "both outputs weighed equally" out.txt || fail "--variance chosen: $(cat out.txt)"
+"$whirl" design --model m.json --candidates cands.csv --count 2 --variance sum --measured "$data" \
+  --departure-ratio 4 --length-scale 1.5 > out.txt 2> err.txt || fail "next --variance sum: $(cat err.txt)"
 
 # Space filling: the first design's last picks and a next batch's last pick say so; the next
 # mode keeps them away from the --measured screws (the training table here).
@@ -71,6 +78,15 @@ d = json.load(open(sys.argv[1]))
 assert d["space_filling"] == 2 and d["min_distance"] > 0
 assert [p["why"].startswith("space filling") for p in d["picks"]] == [False] * 6 + [True] * 2
 PY2
+# --inside: the first design's last picks by the power-GP variance, after the optimal ones.
+"$whirl" design "${ranges[@]}" --count 8 --inside 2 --json > inside.json 2> err.txt \
+  || fail "design --inside: $(cat err.txt)"
+python3 - inside.json <<'PY3' || fail "inside.json: $(cat inside.json)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["inside"] == 2 and len({p["source"] for p in d["picks"]}) == 8
+assert [p["why"].startswith("inside the range") for p in d["picks"]] == [False] * 6 + [True] * 2
+PY3
 "$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
   --measured "$data" > out.txt 2> err.txt || fail "next --space-filling: $(cat err.txt)"
 grep -q "why: space filling" out.txt || fail "no space-filling pick: $(cat out.txt)"
@@ -92,10 +108,59 @@ CSV
 "$whirl" train --data diverging.csv --out diverging.json --seed 1 --threads 1 > /dev/null \
   2> err.txt || fail "train on a table with a diverging candidate: $(cat err.txt)"
 
+# A table on which a linear-mean GP's signal sd went to 0 (ln s_f = -30.09, screws of a generator
+# family picked by a design); 'whirl train' refused to write its own model (the reader's rule
+# for theta is [-30, 30]; the fit now keeps every theta inside it).
+cat > flat_signal.csv <<'CSV'
+hardness_hrc,diameter_mm,pitch_mm,raceway_radius_mm,cutting_speed_m_min,max_elongation_um,settle_time_s
+44.820223841618,21.84380203351935,5.172132662632464,2.052772439709822,104.55123350776283,2.6748269998136633,10.336663826122512
+40.930823829510516,21.01376327687321,14.85707049994499,5.5499166188922935,126.27307252588102,12.963641830805269,75.99454398077675
+47.46308272435349,26.161212249615314,14.789244988442526,2.06858796590763,282.52666046937895,3.7463451102561636,35.6830133284755
+56.10378197807478,27.767904672299014,5.084950098436273,4.508092787897646,292.92456433336787,18.591620807025702,29.896266964870627
+40.221474276958354,49.49546051470753,5.920599076994457,4.43018528122208,241.69919330103394,21.000284972924227,27.9741677828575
+51.788707889314836,58.826746980760625,12.594185113045413,4.0467436799173235,105.85355343089032,5.41686901685158,38.856670547791744
+57.64385979446725,44.99487639488713,10.147922089131384,4.050245345042011,239.06373940830588,10.193030319514289,52.33212674169291
+42.19406069890861,52.567499791119054,9.425238442921966,2.1625029373321203,228.92607437476008,4.440807403338631,23.208556378050446
+43.96551035546757,44.48250427068454,14.061816705560616,5.869728090286157,258.85567660312654,25.08851460093017,69.29391687122703
+57.10352919809678,26.687692304944516,12.688696844273377,5.580845474166322,212.64671185219257,14.629417215106939,95.83152783284017
+59.07607877554808,52.07420760994302,8.69454265195266,5.350904458612353,134.76380920848246,10.540419595840419,51.300819189744026
+58.63941288759287,41.27477263757803,11.701566181632895,2.2094649039469223,290.93071645962294,3.6010039707730734,29.796945512012396
+49.0380393556034,50.49389510717869,5.241160760949918,5.658484329753448,245.82507365102933,27.664475132359332,28.50054720876982
+43.07325560589677,27.053939644188688,7.37970397781673,5.885505419013839,276.0567544962387,33.448698568645796,68.76682297012105
+41.74681397130884,58.98055974030417,12.50461442355445,5.498877322297539,128.89867695304054,13.203243592553903,54.117379963187354
+47.22827894172951,51.11230160511491,6.513617608762444,4.7570495379169575,188.62070010423594,16.682341147344626,31.55810568224105
+43.27598024273469,51.71246059138447,10.682177677665669,5.395060024324094,276.563441224245,24.518288157142834,79.89646249432255
+43.266596778029566,21.561767402285724,13.009465804279092,4.686190214593528,197.2765845097672,13.155381592397069,76.38351607098632
+54.82307258613912,22.36626665603989,14.475391598486503,4.722617046683018,188.25558147806498,9.569374487501046,65.25720351774542
+40.544378394328895,49.32363239224266,9.42861182149095,5.461647038294258,242.18065310550733,24.174963559085636,59.413027890293684
+50.77834320663391,24.013561307654754,5.056918271163406,5.184365424100732,239.00641257475635,23.605279419379045,35.83869022403813
+58.508824375948045,44.79972372696825,14.369900457302233,5.162705088874805,264.57775032058953,14.525971934031121,72.21309185383055
+55.63109638656643,22.54818712368507,11.79708549694469,5.631915222031477,123.86392693018213,10.28642889681809,68.75733969191671
+58.05177013441271,38.88876050582453,7.463524001089793,4.5744718038810355,101.53792660223131,6.712550063904874,36.89753366609553
+53.927023364568136,54.58814848219507,13.548127553537604,5.399249139267029,171.0865508745476,12.428742925121796,56.43508910571521
+40.14802170094009,53.92258715736244,7.848201168378276,2.46568898971532,233.56797757935098,6.444386007415326,21.34966645133891
+CSV
+"$whirl" train --data flat_signal.csv --out flat_signal.json --seed 1 --threads 1 > /dev/null \
+  2> err.txt || fail "train on a table whose GP signal sd goes to 0: $(cat err.txt)"
+
 # Bad input: each error names what is wrong.
 expect_fail "needs --measured" "$whirl" design --model m.json --candidates cands.csv --count 2 \
   --space-filling 1
 expect_fail "--measured needs --model" "$whirl" design "${ranges[@]}" --count 8 --measured "$data"
+expect_fail "power-gp needs --measured" "$whirl" design --model m.json --candidates cands.csv \
+  --count 2
+expect_fail "--variance 'gp': expected 'power-gp'" "$whirl" design --model m.json \
+  --candidates cands.csv --count 2 --variance gp --measured "$data"
+expect_fail "departure-ratio" "$whirl" design --model m.json --candidates cands.csv --count 2 \
+  --measured "$data" --departure-ratio 0
+expect_fail "--variance needs --model" "$whirl" design "${ranges[@]}" --count 8 --variance sum
+expect_fail "--inside is a first design" "$whirl" design --model m.json --candidates cands.csv \
+  --count 2 --measured "$data" --inside 1
+expect_fail "count 8: the power law.*plus --inside 3" "$whirl" design "${ranges[@]}" --count 8 \
+  --inside 3
+head -6 cands.csv > five.csv
+expect_fail "at least 6 measured screws" "$whirl" design --model m.json --candidates cands.csv \
+  --count 2 --measured five.csv
 expect_fail "count 8: the power law.*\[9, 243\]" "$whirl" design "${ranges[@]}" --count 8 \
   --space-filling 3
 head -1 cands.csv > empty.csv
@@ -112,9 +177,9 @@ expect_fail "cutting_speed_m_min" "$whirl" design --candidates nospeed.csv --cou
 awk -F, 'BEGIN { OFS = "," } NR == 1 { print; next } { $1 = 62; print }' cands.csv > const.csv
 "$whirl" train --data const.csv --out const.json > /dev/null 2> err.txt || fail "train const: $(cat err.txt)"
 expect_fail "leaves out hardness_hrc (constant 62 in its training table .const.csv.), but line 2 has hardness_hrc" "$whirl" design --model const.json \
-  --candidates cands.csv --count 2
+  --candidates cands.csv --count 2 --measured "$data"
 expect_fail "is a network" "$whirl" design --model "$src/models/default.json" \
-  --candidates cands.csv --count 2
+  --candidates cands.csv --count 2 --measured "$data"
 expect_fail "need --model" "$whirl" design "${ranges[@]}" --count 8 --tolerance-um 1
 expect_fail "tolerance-um" "$whirl" design --model m.json --candidates cands.csv --count 2 \
   --tolerance-um -1

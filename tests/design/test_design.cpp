@@ -236,7 +236,9 @@ TEST(Design, NextScrewsLowerTheVarianceAndStopRuleDecides) {
   workpiece::TrainOptions o;
   const auto model = workpiece::TrainWorkpieceModel(t, o, "whirling_train.csv");
   const auto cands = GridCandidates(PaperRanges(), 2);
-  const NextDesign d = DesignNext(model, cands, 4);
+  SpaceFilling measured;  // the default rule (power-gp) is conditioned on the measured screws
+  measured.measured = t.inputs;
+  const NextDesign d = DesignNext(model, cands, 4, {}, {}, measured);
   ASSERT_EQ(d.picks.size(), 4u);
   std::set<int> seen;
   for (const auto& p : d.picks) {
@@ -251,9 +253,9 @@ TEST(Design, NextScrewsLowerTheVarianceAndStopRuleDecides) {
   loose.tolerance = {1e4, 1e4};
   tight.tolerance = {d.rms_sd_floor[0] / 2, 0};
   middle.tolerance = {(d.rms_sd_now[0] + d.rms_sd_floor[0]) / 2, 0};
-  EXPECT_EQ(DesignNext(model, cands, 1, loose).stop, "enough");
-  EXPECT_EQ(DesignNext(model, cands, 1, tight).stop, "floor");
-  const NextDesign m = DesignNext(model, cands, 1, middle);
+  EXPECT_EQ(DesignNext(model, cands, 1, loose, {}, measured).stop, "enough");
+  EXPECT_EQ(DesignNext(model, cands, 1, tight, {}, measured).stop, "floor");
+  const NextDesign m = DesignNext(model, cands, 1, middle, {}, measured);
   EXPECT_EQ(m.stop, "continue");
   EXPECT_GE(m.screws_to_tolerance, 1);
 }
@@ -267,7 +269,9 @@ TEST(Design, NextSpaceFillingPicksKeepAwayFromTheMeasured) {
   fill.screws = 2;
   fill.measured = t.inputs;
   const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill);
-  const NextDesign plain = DesignNext(model, cands, 1);
+  SpaceFilling measured;
+  measured.measured = t.inputs;
+  const NextDesign plain = DesignNext(model, cands, 1, {}, {}, measured);
   ASSERT_EQ(d.picks.size(), 3u);
   EXPECT_EQ(d.picks[0].candidate, plain.picks[0].candidate);  // the variance pick comes first
   std::vector<ProcessInputs> all = cands;
@@ -291,6 +295,146 @@ TEST(Design, NextSpaceFillingPicksKeepAwayFromTheMeasured) {
   EXPECT_THROW(DesignNext(model, cands, 2, {}, {}, none), InputError);  // no --measured
   fill.screws = 4;
   EXPECT_THROW(DesignNext(model, cands, 3, {}, {}, fill), InputError);  // more than --count
+}
+
+// The mean posterior variance over `cands` of the power-GP rule's GP (design.h, NextRule), built
+// here from scratch and refitted with the rows `measured` (standardized log inputs u, rows).
+double PowerGpMeanVariance(const Eigen::MatrixXd& u, int n, const std::vector<int>& measured,
+                           const NextRule& rule) {
+  gp::Gp g;
+  g.kernel = gp::Kernel::kMatern52;
+  g.mean = gp::Mean::kLinear;
+  const int d = static_cast<int>(u.cols());
+  g.input_shift = Eigen::VectorXd::Zero(d);
+  g.input_scale = Eigen::VectorXd::Ones(d);
+  g.theta = Eigen::VectorXd::Zero(d + 2);
+  g.theta.head(d).setConstant(std::log(rule.length_scale));
+  g.theta(d) = std::log(rule.departure_ratio);
+  g.z.resize(d, static_cast<Eigen::Index>(measured.size()));
+  for (std::size_t i = 0; i < measured.size(); ++i) g.z.col(long(i)) = u.row(measured[i]).transpose();
+  g.u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(measured.size()));
+  g.Factorize();
+  return gp::PosteriorCovariance(g, u.topRows(n).transpose()).diagonal().mean();
+}
+
+workpiece::WorkpieceModel TrainedModel() {
+  const ProcessTable t = ReadProcessTable(WHIRL_SOURCE_DIR "/datasets/whirling_train.csv", true);
+  workpiece::TrainOptions o;
+  return workpiece::TrainWorkpieceModel(t, o, "whirling_train.csv");
+}
+
+TEST(Design, PowerGpPicksTheLargestVarianceReductionByRefit) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(5);
+  for (int t = 0; t < 5; ++t) {
+    const auto cands = RandomList(rng, 40);
+    const auto measured = RandomList(rng, 9);
+    SpaceFilling fill;
+    fill.measured = measured;
+    const NextRule rule;  // the default: power-gp
+    const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill, rule);
+    ASSERT_EQ(d.picks.size(), 3u);
+    // Deterministic, distinct, inside the list.
+    const NextDesign again = DesignNext(model, cands, 3, {}, {}, fill, rule);
+    std::set<int> seen;
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(d.picks[i].candidate, again.picks[i].candidate);
+      EXPECT_GE(d.picks[i].candidate, 0);
+      EXPECT_LT(d.picks[i].candidate, 40);
+      EXPECT_TRUE(seen.insert(d.picks[i].candidate).second);
+      EXPECT_NE(d.picks[i].why.find("smooth departure"), std::string::npos) << d.picks[i].why;
+    }
+    // Each pick is the candidate whose measurement, refitted from scratch, leaves the lowest
+    // mean variance over the list given the measured screws and the picks before it.
+    std::vector<ProcessInputs> all = cands;
+    all.insert(all.end(), measured.begin(), measured.end());
+    const Eigen::MatrixXd u = LogUnits(all);
+    std::vector<int> rows;
+    for (int i = 0; i < 9; ++i) rows.push_back(40 + i);
+    for (const auto& p : d.picks) {
+      std::vector<int> with = rows;
+      with.push_back(p.candidate);
+      const double mine = PowerGpMeanVariance(u, 40, with, rule);
+      for (int c = 0; c < 40; ++c) {
+        if (std::find(rows.begin(), rows.end(), c) != rows.end()) continue;
+        with.back() = c;
+        EXPECT_LE(mine, PowerGpMeanVariance(u, 40, with, rule) + 1e-9) << "candidate " << c;
+      }
+      rows.push_back(p.candidate);
+    }
+  }
+}
+
+TEST(Design, PowerGpLooksInsideTheMeasuredCorners) {
+  // Two inputs vary over a 3 x 3 grid in log steps; the four corners are measured: the power
+  // law is determined there, a departure is least known at the centre, which is also nearest
+  // to every other candidate, so the first pick is the centre (by symmetry, hand-checkable).
+  const auto model = TrainedModel();
+  std::vector<ProcessInputs> grid;
+  for (double dia : {50.0, std::sqrt(50.0 * 100.0), 100.0})
+    for (double pitch : {6.0, std::sqrt(6.0 * 16.0), 16.0})
+      grid.push_back(ProcessInputs::FromArray({62, dia, pitch, 5, 180}));
+  SpaceFilling fill;
+  std::vector<ProcessInputs> cands;
+  for (int i : {0, 2, 6, 8}) fill.measured.push_back(grid[i]);
+  for (int i : {1, 3, 4, 5, 7}) cands.push_back(grid[i]);  // the centre is cands[2]
+  const NextDesign d = DesignNext(model, cands, 2, {}, {}, fill);
+  EXPECT_EQ(d.picks[0].candidate, 2);
+  // The chosen family's rule (the power law on this table) has its least variance at the
+  // centre and picks an edge.
+  NextRule chosen;
+  chosen.model = NextRule::Model::kChosen;
+  EXPECT_NE(DesignNext(model, cands, 1, {}, {}, fill, chosen).picks[0].candidate, 2);
+}
+
+TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(8);
+  const auto cands = RandomList(rng, 20);
+  SpaceFilling fill;
+  EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill), InputError);  // none measured
+  fill.measured = RandomList(rng, 5);  // 5 inputs: 6 needed (the power law's coefficients)
+  try {
+    DesignNext(model, cands, 1, {}, {}, fill);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("at least 6 measured screws"), std::string::npos)
+        << e.what();
+  }
+  fill.measured = RandomList(rng, 6);
+  EXPECT_NO_THROW(DesignNext(model, cands, 1, {}, {}, fill));
+  EXPECT_EQ(ParseNextModel("sum"), NextRule::Model::kSum);
+  EXPECT_THROW(ParseNextModel("gp"), InputError);
+}
+
+TEST(Design, InsidePicksReduceThePowerGpVarianceMostAfterTheOptimalOnes) {
+  std::mt19937 rng(21);
+  for (int t = 0; t < 5; ++t) {
+    const auto cands = RandomList(rng, 60);
+    const auto d = DesignPowerLaw(cands, 8, Criterion::kD, 0, 2);
+    const auto optimal = DesignPowerLaw(cands, 6, Criterion::kD);
+    ASSERT_EQ(d.picks.size(), 8u);
+    std::vector<int> before, opt;
+    for (int i = 0; i < 6; ++i) before.push_back(d.picks[i].candidate);
+    for (const auto& p : optimal.picks) opt.push_back(p.candidate);
+    EXPECT_EQ(std::set<int>(before.begin(), before.end()), std::set<int>(opt.begin(), opt.end()));
+    const Eigen::MatrixXd u = LogUnits(cands);
+    for (int i = 6; i < 8; ++i) {
+      std::vector<int> with = before;
+      with.push_back(d.picks[i].candidate);
+      const double mine = PowerGpMeanVariance(u, 60, with, NextRule{});
+      for (int c = 0; c < 60; ++c) {
+        if (std::find(before.begin(), before.end(), c) != before.end()) continue;
+        with.back() = c;
+        EXPECT_LE(mine, PowerGpMeanVariance(u, 60, with, NextRule{}) + 1e-9) << "candidate " << c;
+      }
+      EXPECT_EQ(d.picks[i].why.rfind("inside the range", 0), 0u) << d.picks[i].why;
+      before.push_back(d.picks[i].candidate);
+    }
+    EXPECT_EQ(std::set<int>(before.begin(), before.end()).size(), 8u);
+  }
+  EXPECT_THROW(DesignPowerLaw(RandomList(rng, 30), 8, Criterion::kD, 0, 3), InputError);
+  EXPECT_THROW(DesignPowerLaw(RandomList(rng, 30), 8, Criterion::kD, 0, -1), InputError);
 }
 
 }  // namespace

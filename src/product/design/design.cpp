@@ -287,8 +287,43 @@ std::array<OutputState, Features::kCount> States(const workpiece::WorkpieceModel
   return states;
 }
 
-int BestCandidate(const std::array<OutputState, Features::kCount>& states,
-                  const std::vector<char>& taken, double* score) {
+// The power-GP rule's state (design.h, NextRule): the posterior covariance over the candidates
+// (rows 0..n-1 of u, standardized log inputs) of a GP with a power-law mean (flat prior on its
+// coefficients), an isotropic Matern 5/2 departure of sd rule.departure_ratio and length
+// rule.length_scale, conditioned on the measured screws (rows n.. of u) with scatter sd 1.
+// Targets do not enter a GP's covariance, so none are needed.
+OutputState PowerGpState(const Eigen::MatrixXd& u, int n, const NextRule& rule) {
+  const int d = static_cast<int>(u.cols());
+  const int m = static_cast<int>(u.rows()) - n;
+  if (m < d + 1)
+    throw InputError("the power-GP rule needs at least " + std::to_string(d + 1) +
+                     " measured screws (--measured: the power law's coefficients), got " +
+                     std::to_string(m));
+  gp::Gp g;
+  g.kernel = gp::Kernel::kMatern52;
+  g.mean = gp::Mean::kLinear;
+  g.input_shift = Eigen::VectorXd::Zero(d);
+  g.input_scale = Eigen::VectorXd::Ones(d);
+  g.theta = Eigen::VectorXd::Zero(d + 2);
+  g.theta.head(d).setConstant(std::log(rule.length_scale));
+  g.theta(d) = std::log(rule.departure_ratio);
+  g.z = u.bottomRows(m).transpose();
+  g.u = Eigen::VectorXd::Zero(m);
+  try {
+    g.Factorize();
+  } catch (const InputError&) {
+    throw InputError("the measured screws (--measured) do not determine a power law (their log "
+                     "inputs are collinear); the power-GP rule needs them spread in every input");
+  }
+  OutputState s;
+  s.cov = gp::PosteriorCovariance(g, u.topRows(n).transpose());
+  s.g = Eigen::VectorXd::Ones(n);
+  s.measurement_noise = g.SigmaN2();
+  return s;
+}
+
+template <class States>
+int BestCandidate(const States& states, const std::vector<char>& taken, double* score) {
   int best = -1;
   *score = -1;
   for (std::size_t j = 0; j < taken.size(); ++j) {
@@ -300,16 +335,27 @@ int BestCandidate(const std::array<OutputState, Features::kCount>& states,
   return best;
 }
 
-std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int j,
-                    double score, const workpiece::Prediction& now) {
-  std::string why = "largest expected reduction of the prediction variance over the list (" +
-                    FormatSignificant(100 * score / Features::kCount, 3) +
-                    " % of its mean, both outputs weighed equally)";
-  const double here = states[0].weight * states[0].Reduction(j);
-  const double there = states[1].weight * states[1].Reduction(j);
-  why += here >= there ? "; mostly for max elongation" : "; mostly for settle time";
-  if (now.outside_domain)
-    {
+// Why the pick j of the variance rule was made; `share` = its reduction as a fraction of the
+// criterion's mean variance over the list (design.h: each variance weighed by its mean).
+std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int j, double share,
+                    NextRule::Model model, const workpiece::Prediction& now) {
+  const std::string pct = FormatSignificant(100 * share, 3) + " % of its mean";
+  std::string why;
+  if (model == NextRule::Model::kPowerGp) {
+    why = "largest expected reduction of the prediction variance over the list of a power law "
+          "with a smooth departure (a GP on the log inputs, given the measured screws): " + pct;
+  } else {
+    why = "largest expected reduction of the prediction variance over the list (" + pct +
+          (model == NextRule::Model::kSum
+               ? "; the chosen family's, both outputs, and a power law with a smooth departure's "
+                 "weighed equally)"
+               : ", both outputs weighed equally)");
+    const double here = states[0].weight * states[0].Reduction(j);
+    const double there = states[1].weight * states[1].Reduction(j);
+    why += here >= there ? "; for the chosen family mostly max elongation"
+                         : "; for the chosen family mostly settle time";
+  }
+  if (now.outside_domain) {
     std::string fields;
     for (const auto& f : now.outside_domain_fields) fields += (fields.empty() ? "" : ", ") + f;
     why += "; outside the training domain in " + fields;
@@ -384,6 +430,19 @@ Criterion ParseCriterion(const std::string& s) {
 
 std::string ToString(Criterion c) { return c == Criterion::kD ? "d" : "i"; }
 
+NextRule::Model ParseNextModel(const std::string& s) {
+  if (s == "power-gp") return NextRule::Model::kPowerGp;
+  if (s == "chosen") return NextRule::Model::kChosen;
+  if (s == "sum") return NextRule::Model::kSum;
+  throw InputError("--variance '" + s + "': expected 'power-gp' (a GP with a power-law mean on "
+                   "the log inputs), 'chosen' (the chosen family's) or 'sum' (both)");
+}
+
+std::string ToString(NextRule::Model m) {
+  return m == NextRule::Model::kPowerGp ? "power-gp" : m == NextRule::Model::kChosen ? "chosen"
+                                                                                     : "sum";
+}
+
 void InputRanges::Validate(const std::array<const char*, ProcessInputs::kCount>& flags) const {
   for (int j = 0; j < ProcessInputs::kCount; ++j) {
     const std::string what = std::string(flags[j]) + " " + FormatSignificant(lo[j], 6) + ".." +
@@ -454,6 +513,37 @@ void AddSpaceFilling(const Eigen::MatrixXd& f, int k, std::vector<int>* picked,
   }
 }
 
+// `k` more picks of the first design, each of largest integrated variance reduction under the
+// power-GP rule (NextRule) given the picks before it.
+void AddPowerGpPicks(const Eigen::MatrixXd& f, int k, const NextRule& rule,
+                     std::vector<int>* picked, std::vector<Pick>* picks) {
+  if (k == 0) return;
+  const int n = static_cast<int>(f.rows());
+  const Eigen::MatrixXd u = f.rightCols(f.cols() - 1);
+  Eigen::MatrixXd all(n + static_cast<int>(picked->size()), u.cols());
+  all.topRows(n) = u;
+  for (std::size_t i = 0; i < picked->size(); ++i) all.row(n + long(i)) = u.row((*picked)[i]);
+  std::array<OutputState, 1> state = {PowerGpState(all, n, rule)};
+  state[0].weight = 1.0 / std::max(state[0].cov.diagonal().mean(), 1e-300);
+  std::vector<char> taken(n, 0);
+  for (int i : *picked) taken[i] = 1;
+  for (int i = 0; i < k; ++i) {
+    double score = 0;
+    const int c = BestCandidate(state, taken, &score);
+    Pick pick;
+    pick.candidate = c;
+    pick.sd_now = {SdFactor(f, *picked, c), 0};
+    taken[c] = 1;
+    picked->push_back(c);
+    state[0].Measure(c);
+    pick.sd_after = {SdFactor(f, *picked, c), 0};
+    pick.why = "inside the range: largest expected reduction of the prediction variance over the "
+               "list of a power law with a smooth departure given the screws before it (" +
+               FormatSignificant(100 * score / n, 3) + " % of its mean)";
+    picks->push_back(pick);
+  }
+}
+
 // The smallest distance between two picks, standardized log inputs (f's columns after the 1).
 double MinPairDistance(const Eigen::MatrixXd& f, const std::vector<int>& picked) {
   const Eigen::MatrixXd u = f.rightCols(f.cols() - 1);
@@ -466,7 +556,8 @@ double MinPairDistance(const Eigen::MatrixXd& f, const std::vector<int>& picked)
 }  // namespace
 
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count,
-                              Criterion criterion, int space_filling) {
+                              Criterion criterion, int space_filling, int inside,
+                              const NextRule& rule) {
   if (cands.empty()) throw InputError("design: the candidate list is empty");
   PowerLawDesign d;
   d.criterion = criterion;
@@ -477,21 +568,27 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
   if (space_filling < 0 || space_filling >= count)
     throw InputError("design --space-filling " + std::to_string(space_filling) +
                      ": must lie in [0, --count - 1]");
-  if (count - space_filling < d.coefficients || count > n)
+  if (inside < 0 || inside + space_filling >= count)
+    throw InputError("design --inside " + std::to_string(inside) +
+                     ": must lie in [0, --count - --space-filling - 1]");
+  if (count - space_filling - inside < d.coefficients || count > n)
     throw InputError("design --count " + std::to_string(count) + ": the power law in the " +
                      std::to_string(d.inputs.size()) + " inputs that vary over the " +
                      std::to_string(n) + " candidates has " + std::to_string(d.coefficients) +
                      " coefficients; the count must lie in [" +
-                     std::to_string(d.coefficients + space_filling) + ", " + std::to_string(n) +
-                     "] (the coefficients plus --space-filling " + std::to_string(space_filling) +
+                     std::to_string(d.coefficients + space_filling + inside) + ", " +
+                     std::to_string(n) + "] (the coefficients plus --space-filling " +
+                     std::to_string(space_filling) + " plus --inside " + std::to_string(inside) +
                      ", at most the candidates)");
   const Eigen::MatrixXd w = f.transpose() * f / static_cast<double>(n);
-  std::vector<int> picked = GreedyStart(f, count - space_filling);
+  std::vector<int> picked = GreedyStart(f, count - space_filling - inside);
   Exchange(f, criterion, w, &picked);
   if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w)))
     throw InputError("design: the candidates do not determine a power law (their log inputs "
                      "are collinear); add candidates that vary the inputs independently");
   d.picks = ExplainingOrder(f, picked);
+  AddPowerGpPicks(f, inside, rule, &picked, &d.picks);
+  d.inside = inside;
   AddSpaceFilling(f, space_filling, &picked, &d.picks);
   d.log_det = CriterionValue(f, picked, Criterion::kD, w) - d.coefficients * std::log(count);
   d.min_distance = MinPairDistance(f, picked);
@@ -508,11 +605,28 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
   return d;
 }
 
-NextDesign DesignNext(const workpiece::WorkpieceModel& model,
-                      const std::vector<ProcessInputs>& cands, int count, const StopRule& stop,
-                      const std::vector<int>& lines, const SpaceFilling& fill) {
-  if (cands.empty()) throw InputError("design: the candidate list is empty");
-  const int n = static_cast<int>(cands.size());
+namespace {
+
+// The states the picks are made with (design.h, NextRule), each weighed by its mean variance
+// over the list; *units = the number of variances of equal weight (for WhyNext's share).
+std::vector<OutputState> CriterionStates(const std::array<OutputState, Features::kCount>& model,
+                                         const Eigen::MatrixXd& u, int n, const NextRule& rule,
+                                         double* units) {
+  std::vector<OutputState> out;
+  if (rule.model != NextRule::Model::kPowerGp) out.assign(model.begin(), model.end());
+  *units = static_cast<double>(out.size());
+  if (rule.model != NextRule::Model::kChosen) {
+    OutputState s = PowerGpState(u, n, rule);
+    const double mean = s.cov.diagonal().mean();
+    const double share = rule.model == NextRule::Model::kSum ? Features::kCount : 1.0;
+    s.weight = mean > 0 ? share / mean : 0.0;
+    *units += share;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+void CheckNextArguments(int n, int count, const SpaceFilling& fill, const NextRule& rule) {
   if (count < 1 || count > n)
     throw InputError("design --count " + std::to_string(count) + ": must lie in [1, " +
                      std::to_string(n) + "] (the candidates)");
@@ -523,6 +637,24 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
     throw InputError("design --space-filling " + std::to_string(fill.screws) +
                      " with --model needs --measured (the screws measured so far, e.g. the "
                      "model's training table): the space-filling picks keep away from them");
+  if (rule.model != NextRule::Model::kChosen && fill.measured.empty())
+    throw InputError("design --variance " + ToString(rule.model) + " needs --measured (the "
+                     "screws measured so far, e.g. the model's training table): the power law "
+                     "with a departure is conditioned on them ('--variance chosen' does without)");
+  if (!(rule.departure_ratio > 0) || !(rule.length_scale > 0) ||
+      !std::isfinite(rule.departure_ratio) || !std::isfinite(rule.length_scale))
+    throw InputError("design: --departure-ratio and --length-scale must be finite and positive");
+}
+
+}  // namespace
+
+NextDesign DesignNext(const workpiece::WorkpieceModel& model,
+                      const std::vector<ProcessInputs>& cands, int count, const StopRule& stop,
+                      const std::vector<int>& lines, const SpaceFilling& fill,
+                      const NextRule& rule) {
+  if (cands.empty()) throw InputError("design: the candidate list is empty");
+  const int n = static_cast<int>(cands.size());
+  CheckNextArguments(n, count, fill, rule);
   auto states = States(model, cands, lines);
   NextDesign d;
   d.now = workpiece::PredictBatch(model, cands);
@@ -537,6 +669,8 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
   std::vector<std::string> names;
   const Eigen::MatrixXd rows = PowerLawRows(all, &names);
   const Eigen::MatrixXd u = rows.rightCols(rows.cols() - 1);
+  double units = 0;
+  auto crit = CriterionStates(states, u, n, rule, &units);
   std::vector<int> near(fill.measured.size());
   std::iota(near.begin(), near.end(), n);
   std::vector<char> taken(n, 0);
@@ -548,14 +682,15 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
       p.why = WhySpaceFilling(distance);
     } else {
       double score = 0;
-      p.candidate = BestCandidate(states, taken, &score);
-      p.why = WhyNext(states, p.candidate, score / n, d.now[p.candidate]);
+      p.candidate = BestCandidate(crit, taken, &score);
+      p.why = WhyNext(states, p.candidate, score / n / units, rule.model, d.now[p.candidate]);
     }
     const int j = p.candidate;
     for (int k = 0; k < Features::kCount; ++k) p.sd_now[k] = std::sqrt(initial[k].Variance(j));
     taken[j] = 1;
     near.push_back(j);
     for (auto& st : states) st.Measure(j);
+    for (auto& st : crit) st.Measure(j);
     for (int k = 0; k < Features::kCount; ++k) p.sd_after[k] = std::sqrt(states[k].Variance(j));
     d.picks.push_back(p);
   }

@@ -46,6 +46,23 @@
 // measurement only the latent part shrinks: the calibrated noise is the floor no number of
 // screws goes below.
 //
+// Next screws' rule (NextRule: whose variance the integrated variance reduction above is computed
+// with). kChosen: the chosen family's own covariance, as above. Where the power law is chosen
+// (the default model's choice at few rows) that variance is the linear fit's, largest at the
+// edges of the log-input box, so the next screws go to the edges again and a bend inside the box
+// stays unseen (docs/design.md, first and second attempts). kPowerGp: the covariance over the
+// candidates of a Gaussian process on the log inputs (standardized over list and measured
+// screws) whose mean is the power law with a flat prior on its coefficients (universal kriging;
+// R&W section 2.7; the `gp-matern52-linear/log` family of `whirl train`), plus an isotropic
+// Matern 5/2 departure of sd departure_ratio times the scatter and length length_scale,
+// conditioned on the screws measured so far (SpaceFilling::measured; at least 1 + inputs + 1).
+// Its variance is the power law's where the departure is known and grows away from the measured
+// screws, so the picks mix the power law's edges with the inside, weighted by where the list's
+// screws are; targets do not enter a GP's covariance, so the rule needs the measured screws'
+// inputs only, and its hyperparameters are fixed (a fit to 8-20 rows would follow their noise).
+// kSum: both criteria, each weighed by its mean variance over the list. The reported sd now and
+// after are always the trained model's.
+//
 // Stop rule (StopRule): per output with a tolerance, the root mean square of the predictive sd
 // over the candidates (um, s). Measuring no longer pays when it is at or below the tolerance
 // ("enough"), or when the floor (the noise part alone) is above it ("floor": no number of screws
@@ -88,22 +105,43 @@ struct Pick {
   std::array<double, Features::kCount> sd_now{}, sd_after{};
 };
 
+/// Which variance the next screws' integrated variance reduction is computed with (header
+/// comment, "Next screws' rule").
+struct NextRule {
+  enum class Model {
+    kPowerGp,  ///< a GP on the standardized log inputs with a power-law mean (the default)
+    kChosen,   ///< the chosen family's own posterior covariance (the rule of the first attempts)
+    kSum,      ///< both, each normalized by its mean variance over the list
+  };
+  Model model = Model::kPowerGp;
+  /// kPowerGp / kSum: the departure's signal sd over the measurement scatter's sd, and its
+  /// (isotropic Matern 5/2) length scale in log inputs standardized over list and measured.
+  double departure_ratio = 2.0;
+  double length_scale = 2.23606797749979;  // sqrt(5)
+};
+NextRule::Model ParseNextModel(const std::string& s);  ///< "power-gp" | "chosen" | "sum"
+std::string ToString(NextRule::Model m);
+
 struct PowerLawDesign {
   Criterion criterion = Criterion::kD;
   int coefficients = 0;             ///< 1 + inputs that vary over the candidates
   std::vector<std::string> inputs;  ///< the varying inputs' columns
   std::vector<Pick> picks;          ///< in the explaining order (header comment)
   int space_filling = 0;            ///< the last picks chosen by maximin (header comment)
+  int inside = 0;  ///< picks before those by the power-GP rule given the optimal ones (NextRule)
   double log_det = 0;               ///< ln det(F'F / count), standardized log inputs
   double min_distance = 0;          ///< smallest distance between two picks (std. log inputs)
   double mean_sd_factor = 0, max_sd_factor = 0;  ///< over the candidates (header comment)
 };
 
-/// The first design of the header comment: `count` distinct candidates, the last
-/// `space_filling` of them by maximin. InputError if the list is empty, space_filling is outside
-/// [0, count - 1], count - space_filling < coefficients or count > candidates.
+/// The first design of the header comment: `count` distinct candidates: count - inside -
+/// space_filling optimal ones, then `inside` by the power-GP rule's integrated variance reduction
+/// (NextRule::kPowerGp at `rule`'s hyperparameters) given those before, then `space_filling` by
+/// maximin. InputError if the list is empty, inside or space_filling is negative, their sum is
+/// not below count, count - inside - space_filling < coefficients or count > candidates.
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& candidates, int count,
-                              Criterion criterion, int space_filling = 0);
+                              Criterion criterion, int space_filling = 0, int inside = 0,
+                              const NextRule& rule = {});
 
 struct StopRule {
   /// Per output, the tolerance of the RMS predictive sd over the candidates (um, s); <= 0: none.
@@ -126,17 +164,20 @@ struct NextDesign {
 /// The space-filling share of a next batch (header comment).
 struct SpaceFilling {
   int screws = 0;                        ///< the batch's last picks chosen by maximin
-  std::vector<ProcessInputs> measured;   ///< the screws measured so far (needed if screws > 0)
+  /// The screws measured so far: needed if screws > 0 and by NextRule's kPowerGp and kSum.
+  std::vector<ProcessInputs> measured;
 };
 
 /// The next screws of the header comment: `count` distinct candidates (1 <= count <=
-/// candidates), the last fill.screws (<= count; needs fill.measured) by maximin. InputError if the list is empty, the model is a network or a stacked choice
-/// ("whirl train" without --family network or --stack), or if it leaves out an input (constant
+/// candidates) by `rule`, the last fill.screws (<= count; needs fill.measured) by maximin.
+/// InputError if the list is empty, the model is a network or a stacked choice ("whirl train"
+/// without --family network or --stack), if `rule` needs measured screws and fill.measured holds
+/// too few (or collinear ones), or if the model leaves out an input (constant
 /// in its training table) that the candidates vary (naming the input, its training value and the
 /// first candidate that differs: "line N" when `lines` gives the candidates' file lines).
 NextDesign DesignNext(const workpiece::WorkpieceModel& model,
                       const std::vector<ProcessInputs>& candidates, int count,
                       const StopRule& stop = {}, const std::vector<int>& lines = {},
-                      const SpaceFilling& fill = {});
+                      const SpaceFilling& fill = {}, const NextRule& rule = {});
 
 }  // namespace whirl::design
