@@ -24,7 +24,7 @@ namespace {
 struct DesignCliOptions {
   std::string candidates_path, model_path, out_path, measured_path;
   std::array<std::string, ProcessInputs::kCount> ranges;
-  int count = 0, levels = 3, space_filling = 0, inside = 0;
+  int count = 0, levels = 3, space_filling = 0, inside = design::kInsideAuto;
   std::string criterion = "d", variance = design::ToString(design::NextRule{}.model);
   double departure_ratio = design::NextRule{}.departure_ratio;
   double length_scale = design::NextRule{}.length_scale;
@@ -177,8 +177,12 @@ void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
     return;
   }
   std::cout << "first design (" << (o.criterion == "d" ? "D" : "I") << "-optimal for the power law "
-            << "on log inputs): " << o.count << " of " << c.inputs.size() << " candidates ("
-            << c.source << ")\n";
+            << "on log inputs"
+            << (d.inside > 0 ? ", the last " + std::to_string(d.inside) +
+                                   " of them inside the range by the power-gp variance"
+                             : std::string())
+            << "): " << o.count << " of " << c.inputs.size() << " candidates (" << c.source
+            << ")\n";
   std::cout << "rank  source      " << JoinFields({kInputColumns.begin(), kInputColumns.end()})
             << "\n";
   for (std::size_t r = 0; r < d.picks.size(); ++r) {
@@ -271,7 +275,7 @@ void RunDesign(const DesignCliOptions& o) {
   if (o.model_path.empty() && o.variance != design::ToString(defaults.model))
     throw InputError("design: --variance needs --model (it chooses the next screws; a first "
                      "design is D- or I-optimal, --criterion, with --inside screws by power-gp)");
-  if (!o.model_path.empty() && o.inside > 0)
+  if (!o.model_path.empty() && o.inside != design::kInsideAuto)
     throw InputError("design: --inside is a first design's (without --model); the next screws "
                      "follow --variance");
   if (o.model_path.empty() && !o.measured_path.empty())
@@ -296,12 +300,18 @@ void RegisterDesign(CLI::App& app) {
       "design",
       "Which screws to measure (src/product/design/design.h; evidence in docs/design.md).\n"
       "First design (no --model): the --count screws that best determine the power law of the\n"
-      "five inputs (D- or I-optimal on log inputs), from --candidates CSV (the screw types the\n"
+      "five inputs (D- or I-optimal on log inputs), the last --inside (2) of them where a\n"
+      "smooth departure from it is least known, from --candidates CSV (the screw types the\n"
       "shop makes: columns hardness_hrc, diameter_mm, pitch_mm, raceway_radius_mm,\n"
       "cutting_speed_m_min; other columns ignored) or from a grid over the five ranges.\n"
-      "Next screws (--model M.json from 'whirl train'): the --count candidates whose measurement\n"
-      "most reduces the model's predictive variance over the list (integrated variance\n"
-      "reduction, greedy batch), each with its predictive sd now and expected after.\n"
+      "Next screws (--model M.json from 'whirl train', --measured TABLE.csv: the screws measured\n"
+      "so far): the --count candidates whose measurement most reduces the prediction variance\n"
+      "over the list (integrated variance reduction, greedy batch) of a power law with a smooth\n"
+      "departure (--variance power-gp: a GP on the log inputs whose mean is the power law, the\n"
+      "departure's sd --departure-ratio times the scatter, length --length-scale), each with\n"
+      "the model's predictive sd now and expected after. Why not the model's own variance\n"
+      "(--variance chosen): where the power law is chosen it sends every screw to the edges of\n"
+      "the range, and random screws beat it where the truth bends (docs/design.md).\n"
       "Stop rule (--tolerance-um, --tolerance-s with --model): says whether the RMS predictive\n"
       "sd over the list is within tolerance (measurements no longer pay), cannot get there\n"
       "(the scatter alone is above it), or about how many more screws it takes.\n"
@@ -335,8 +345,8 @@ void RegisterDesign(CLI::App& app) {
   sub->add_option("--inside", o->inside,
                   "first design: screws of --count picked after the optimal ones by the "
                   "power-gp variance (see --variance) given those before, so that the first "
-                  "table sees inside the range [screws]")
-      ->capture_default_str()
+                  "table sees inside the range [screws] (default: 2, fewer where --count leaves "
+                  "no room beyond the power law's coefficients)")
       ->check(NumberIn(0, 100000));
   sub->add_option("--measured", o->measured_path,
                   "with --model: the screws measured so far (CSV, five input columns; e.g. the "

@@ -434,7 +434,14 @@ TEST(Design, InsidePicksReduceThePowerGpVarianceMostAfterTheOptimalOnes) {
     EXPECT_EQ(std::set<int>(before.begin(), before.end()).size(), 8u);
   }
   EXPECT_THROW(DesignPowerLaw(RandomList(rng, 30), 8, Criterion::kD, 0, 3), InputError);
-  EXPECT_THROW(DesignPowerLaw(RandomList(rng, 30), 8, Criterion::kD, 0, -1), InputError);
+  EXPECT_THROW(DesignPowerLaw(RandomList(rng, 30), 8, Criterion::kD, 0, -2), InputError);
+  // kInsideAuto (whirl design's default): up to kDefaultInside, within the room the count leaves.
+  const auto list = RandomList(rng, 30);
+  EXPECT_EQ(DesignPowerLaw(list, 8, Criterion::kD, 0, kInsideAuto).inside, 2);
+  EXPECT_EQ(DesignPowerLaw(list, 12, Criterion::kD, 0, kInsideAuto).inside, 2);
+  EXPECT_EQ(DesignPowerLaw(list, 7, Criterion::kD, 0, kInsideAuto).inside, 1);
+  EXPECT_EQ(DesignPowerLaw(list, 6, Criterion::kD, 0, kInsideAuto).inside, 0);
+  EXPECT_EQ(DesignPowerLaw(list, 8, Criterion::kD, 1, kInsideAuto).inside, 1);
 }
 
 }  // namespace

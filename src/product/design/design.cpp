@@ -568,6 +568,8 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
   if (space_filling < 0 || space_filling >= count)
     throw InputError("design --space-filling " + std::to_string(space_filling) +
                      ": must lie in [0, --count - 1]");
+  if (inside == kInsideAuto)
+    inside = std::clamp(count - space_filling - d.coefficients, 0, kDefaultInside);
   if (inside < 0 || inside + space_filling >= count)
     throw InputError("design --inside " + std::to_string(inside) +
                      ": must lie in [0, --count - --space-filling - 1]");

@@ -116,7 +116,7 @@ struct NextRule {
   Model model = Model::kPowerGp;
   /// kPowerGp / kSum: the departure's signal sd over the measurement scatter's sd, and its
   /// (isotropic Matern 5/2) length scale in log inputs standardized over list and measured.
-  double departure_ratio = 2.0;
+  double departure_ratio = 4.0;
   double length_scale = 2.23606797749979;  // sqrt(5)
 };
 NextRule::Model ParseNextModel(const std::string& s);  ///< "power-gp" | "chosen" | "sum"
@@ -134,10 +134,17 @@ struct PowerLawDesign {
   double mean_sd_factor = 0, max_sd_factor = 0;  ///< over the candidates (header comment)
 };
 
+/// `whirl design`'s first design: inside = kInsideAuto picks min(kDefaultInside, count -
+/// space_filling - coefficients) inside screws (none where the count leaves no room beyond the
+/// power law's coefficients). Chosen on the third attempt's tuning part (docs/design.md).
+inline constexpr int kInsideAuto = -1;
+inline constexpr int kDefaultInside = 2;
+
 /// The first design of the header comment: `count` distinct candidates: count - inside -
 /// space_filling optimal ones, then `inside` by the power-GP rule's integrated variance reduction
 /// (NextRule::kPowerGp at `rule`'s hyperparameters) given those before, then `space_filling` by
-/// maximin. InputError if the list is empty, inside or space_filling is negative, their sum is
+/// maximin (inside = kInsideAuto: see there). InputError if the list is empty, inside or
+/// space_filling is negative, their sum is
 /// not below count, count - inside - space_filling < coefficients or count > candidates.
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& candidates, int count,
                               Criterion criterion, int space_filling = 0, int inside = 0,
