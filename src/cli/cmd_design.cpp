@@ -360,9 +360,9 @@ void RegisterDesign(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--departure-ratio", o->departure_ratio,
                   "power-gp (and --inside): the departure's sd over the measurement scatter's "
-                  "sd [1]")
+                  "sd [ratio]")
       ->capture_default_str()
-      ->check(PositiveNumber("1"));
+      ->check(PositiveNumber());
   sub->add_option("--length-scale", o->length_scale,
                   "power-gp (and --inside): the departure's length scale in log inputs "
                   "standardized over the list and the measured screws [sd]")
