@@ -261,6 +261,11 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
             << FormatSignificant(d.rms_sd_now[1], 3) << " -> " << FormatSignificant(d.rms_sd_after[1], 3)
             << " s (floor " << FormatSignificant(d.rms_sd_floor[1], 3) << ")\n";
   if (!d.stop.empty()) std::cout << "stop rule: " << d.stop << ": " << d.stop_reason << "\n";
+  if (!fill.measured.empty() &&
+      static_cast<int>(fill.measured.size()) != model.training_samples)
+    std::cout << "note: --measured " << o.measured_path << " holds " << fill.measured.size()
+              << " screws, the model was trained on " << model.training_samples
+              << " rows: are they the same table?\n";
   if (!o.out_path.empty()) std::cout << "written: " << o.out_path << "\n";
 }
 

@@ -61,6 +61,15 @@ for k in ("max_elongation_um", "settle_time_s"):
 assert d["stop"]["decision"] == "floor", d["stop"]
 assert d["variance"] == "power-gp" and all("smooth departure" in p["why"] for p in d["picks"])
 PY
+# A --measured table that is not the model's training table gets a note.
+head -9 cands.csv > nine.csv
+"$whirl" design --model m.json --candidates cands.csv --count 2 --measured nine.csv > out.txt \
+  2> err.txt || fail "next with 8 measured: $(cat err.txt)"
+grep -q "note: --measured nine.csv holds 8 screws, the model was trained on 20 rows" out.txt \
+  || fail "no note on a --measured table unlike the training table: $(cat out.txt)"
+"$whirl" design --model m.json --candidates cands.csv --count 2 --measured "$data" > out.txt \
+  2> err.txt || fail "next: $(cat err.txt)"
+grep -q "note: --measured" out.txt && fail "a note on the training table itself: $(cat out.txt)"
 # The chosen family's own variance needs no measured screws.
 "$whirl" design --model m.json --candidates cands.csv --count 2 --variance chosen > out.txt \
   2> err.txt || fail "next --variance chosen: $(cat err.txt)"
