@@ -1,8 +1,8 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--joint] [--loo|--kfold] [--no-1se] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
-//                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--threads N]
+//                [--joint] [--loo|--kfold] [--no-1se] [--leave-first-se Z] [--leave-first-se-large Z] [--leave-first-blocks M] [--leave-first-row-share S] [--lowest-gp|--no-lowest-gp] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
+//                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
 //                [--few-rows N] [--gp-length-prior-sd SD] [--gp-max-rows N]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
@@ -56,6 +56,18 @@ Args Parse(int argc, char** argv) {
       a.choice.fit.calibrate_two_sd = false;
     else if (k == "--equivalence-sd")
       a.choice.equivalence_sd = std::stod(value());
+    else if (k == "--leave-first-se")
+      a.choice.leave_first_se = std::stod(value());
+    else if (k == "--leave-first-se-large")
+      a.choice.leave_first_se_large = std::stod(value());
+    else if (k == "--leave-first-row-share")
+      a.choice.leave_first_row_share = std::stod(value());
+    else if (k == "--leave-first-blocks")
+      a.choice.leave_first_blocks = std::stoi(value());
+    else if (k == "--lowest-gp")
+      a.choice.lowest_gp = true;
+    else if (k == "--no-lowest-gp")
+      a.choice.lowest_gp = false;
     else if (k == "--no-1se")
       a.choice.one_standard_error = false;
     else if (k == "--gp-ftol")
@@ -84,6 +96,8 @@ Args Parse(int argc, char** argv) {
       a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")
       a.choice.fit.gp.restarts = std::stoi(value());
+    else if (k == "--gp-single-start-rows")
+      a.choice.fit.gp.single_start_rows = std::stoi(value());
     else if (k == "--threads")
       a.choice.fit.threads = std::stoi(value());
     else

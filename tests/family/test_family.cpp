@@ -195,6 +195,74 @@ TEST(FamilyChoice, OneStandardErrorRuleOnHandComputedCases) {
   ExpectInputError([] { SimplestWithinOneStandardError({}); }, "no candidates");
 }
 
+TEST(FamilyChoice, LeavingTheFirstCandidateOnHandComputedCases) {
+  Eigen::VectorXd first(4), other(4);
+  first << 4, 0, 4, 0;
+  other << 1, 1, 1, 1;  // d = (3, -1, 3, -1): mean 1, sd sqrt(16 / 3), se 1.1547
+  EXPECT_TRUE(BeatsFirst(first, other, 0.5, 0, 4));   // 1 > 0.577
+  EXPECT_FALSE(BeatsFirst(first, other, 1.0, 0, 4));  // 1 <= 1.155
+  EXPECT_TRUE(BeatsFirst(first, other, 0.5, 1, 2));   // blocks (6, -2): one positive
+  EXPECT_FALSE(BeatsFirst(first, other, 0.5, 2, 2));  // not two
+  EXPECT_TRUE(BeatsFirst(first, other, 0.5, 9, 1));   // one block: its sum 4 > 0
+  EXPECT_FALSE(BeatsFirst(other, first, 0.0, 0, 4));  // a higher mean never beats
+  EXPECT_FALSE(BeatsFirst(first, first, 0.0, 0, 4));  // nor an equal one
+  ExpectInputError([&] { BeatsFirst(first, Eigen::VectorXd(3), 1, 0, 4); }, "equal sizes");
+  ExpectInputError([&] { BeatsFirst(first, other, 1, 0, 0); }, "blocks >= 1");
+}
+
+// ChoiceOptions::leave_first_se: on 20-row power-law tables with 8 % noise the
+// one-standard-error rule alone leaves the power law on some tables (a GP or the raw linear fit
+// wins the 5-fold refits by chance); the default leaves it on fewer.
+TEST(FamilyChoice, ThePowerLawIsLeftOnlyForACandidateThatBeatsItClearly) {
+  ChoiceOptions off;
+  off.leave_first_se = 0;
+  int left_off = 0, left_default = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    const ProcessTable t = MakeTable(20, 0.08, seed);
+    const Choice a = ChooseFamily(t, off), b = ChooseFamily(t, ChoiceOptions{});
+    for (int k = 0; k < 2; ++k) {
+      left_off += a.table[a.chosen[k]].candidate.Name() != "linear/log";
+      left_default += b.table[b.chosen[k]].candidate.Name() != "linear/log";
+    }
+  }
+  EXPECT_GT(left_off, 0);  // the planted case exists
+  EXPECT_LT(left_default, left_off);
+}
+
+// ChoiceOptions::lowest_gp: a chosen GP is the GP with the lowest held-out error of its output
+// (the one-standard-error rule alone may take a simpler GP within one standard error of it).
+TEST(FamilyChoice, AChosenGpIsTheLowestGp) {
+  ChoiceOptions on, off;
+  on.leave_first_se = off.leave_first_se = 0;  // every GP takes part
+  off.lowest_gp = false;
+  ASSERT_TRUE(on.lowest_gp);
+  int violations_off = 0, gps = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed)
+    for (const bool curved : {false, true}) {
+      const ProcessTable t = curved ? MakeTable(24, 0.05, seed, true)
+                                    : test::MakeBentTable(24, 0.03, 0.5, seed);
+      for (const bool lowest : {true, false}) {
+        const Choice c = ChooseFamily(t, lowest ? on : off);
+        for (int k = 0; k < 2; ++k) {
+          const CvRow& chosen = c.table[c.chosen[k]];
+          if (chosen.candidate.family != Family::kGaussianProcess) continue;
+          bool lowest_gp = true;
+          for (const CvRow& r : c.table)
+            if (r.candidate.family == Family::kGaussianProcess && r.cv_rmse(k) < chosen.cv_rmse(k))
+              lowest_gp = false;
+          if (lowest) {
+            ++gps;
+            EXPECT_TRUE(lowest_gp) << "seed " << seed << " output " << k << ": " << c.Describe();
+          } else {
+            violations_off += !lowest_gp;
+          }
+        }
+      }
+    }
+  EXPECT_GT(gps, 5);
+  EXPECT_GT(violations_off, 0);  // the rule changes something on these tables
+}
+
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
   r << 1, -2, 3, 4;
@@ -282,6 +350,8 @@ ChoiceOptions EquivalenceOptions(double sd) {
   ChoiceOptions o;
   o.equivalence_sd = sd;
   o.few_rows = 0;  // GP held-out errors by their closed-form leave-one-out
+  o.leave_first_se = o.leave_first_se_large = 0;  // the rule under test alone
+  o.leave_first_row_share = 0;
   return o;
 }
 
@@ -343,7 +413,10 @@ TEST(FamilyEquivalence, ARealBendAboveTheNoiseKeepsItsGp) {
     }
     EXPECT_LT(e_c, e_p) << "seed " << seed;
   }
-  EXPECT_GE(gp, 8) << "rule " << rule;
+  // The default's leave_first_se (2 standard errors to leave the power law at 20 rows) keeps the
+  // power law on some of these tables, where the GP beats it by 1-2 standard errors only: the
+  // price of not leaving it on power laws without a bend (docs/workpiece-model.md).
+  EXPECT_GE(gp, rule ? 8 : 6) << "rule " << rule;
   }
 }
 

@@ -248,7 +248,7 @@ TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
   EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-linear/log ");
   EXPECT_EQ(names(FamilyFlag::kNetwork, TransformFlag::kLog), "network-evidence/log ");
   EXPECT_EQ(names(FamilyFlag::kAuto, TransformFlag::kIdentity),
-            "linear/identity gp-se-iso-constant/identity gp-matern52-constant/identity ");
+            "linear/identity gp-matern52-constant/identity gp-se-constant/identity ");
   ExpectInputError([] { ParseFamilyFlag("svm"); }, "--family 'svm'");
   ExpectInputError([] { ParseTransformFlag("sqrt"); }, "--transform 'sqrt'");
 }

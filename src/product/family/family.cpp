@@ -497,6 +497,23 @@ Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
   return best;
 }
 
+bool BeatsFirst(const Eigen::VectorXd& first, const Eigen::VectorXd& other, double z, int wins,
+                int blocks, double row_share) {
+  if (first.size() != other.size() || first.size() == 0 || blocks < 1)
+    throw InputError("leaving the first candidate: " + std::to_string(first.size()) + " and " +
+                     std::to_string(other.size()) + " squared errors in " +
+                     std::to_string(blocks) + " blocks; need equal sizes > 0 and blocks >= 1");
+  const Eigen::ArrayXd d = (first - other).array();
+  const double n = static_cast<double>(d.size()), mean = d.mean();
+  const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
+  if (!(mean > z * se) || mean <= 0) return false;
+  const int b = std::min<int>(blocks, static_cast<int>(d.size()));
+  Eigen::ArrayXd block = Eigen::ArrayXd::Zero(b);
+  for (Eigen::Index q = 0; q < d.size(); ++q) block(q % b) += d(q);
+  return (block > 0).count() >= std::min(wins, b) &&
+         static_cast<double>((d > 0).count()) >= row_share * n;
+}
+
 int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_errors) {
   if (squared_errors.empty()) throw InputError("one-standard-error rule: no candidates");
   std::size_t best = 0;
@@ -554,8 +571,8 @@ int MinimumRows(const Candidate& c, int inputs) {
 
 std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   std::vector<Candidate> c;
-  for (const char* name : {"linear/log", "linear/identity", "gp-se-iso-constant/identity",
-                           "gp-matern52-linear/log", "gp-matern52-constant/identity"})
+  for (const char* name : {"linear/log", "linear/identity", "gp-matern52-linear/log",
+                           "gp-matern52-constant/identity", "gp-se-constant/identity"})
     c.push_back(ParseCandidate(name));
   return c;
 }
@@ -668,10 +685,38 @@ std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
                       std::sqrt(e_lin.mean()));
 }
 
+// ChoiceOptions::lowest_gp: `kept` without its GP candidates except the one with the lowest
+// held-out error of output k (the first of equal ones), which keeps its place.
+std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
+                                     const std::vector<Eigen::MatrixXd>& err,
+                                     const ChoiceOptions& o, int k) {
+  int best = -1;
+  for (int c : kept)
+    if (o.candidates[c].family == Family::kGaussianProcess &&
+        (best < 0 || err[c].row(k).squaredNorm() < err[best].row(k).squaredNorm()))
+      best = c;
+  std::vector<int> out;
+  for (int c : kept)
+    if (o.candidates[c].family != Family::kGaussianProcess || c == best) out.push_back(c);
+  return out;
+}
+
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the
-// lowest error).
-int ChooseAmong(const std::vector<int>& kept, const std::vector<Eigen::MatrixXd>& err,
+// lowest error), after ChoiceOptions::leave_first_se and leave_first_blocks have removed those
+// that do not beat the first of `kept` clearly enough.
+int ChooseAmong(const std::vector<int>& given, const std::vector<Eigen::MatrixXd>& err,
                 const ChoiceOptions& o, int k) {
+  const double z = err.front().cols() < o.few_rows ? o.leave_first_se : o.leave_first_se_large;
+  const bool all = !o.one_standard_error ||
+                   (z <= 0 && o.leave_first_blocks <= 0 && o.leave_first_row_share <= 0);
+  std::vector<int> kept;
+  for (int c : given)
+    if (kept.empty() || all ||
+        BeatsFirst(err[given.front()].row(k).array().square().matrix(),
+                   err[c].row(k).array().square().matrix(), z, o.leave_first_blocks, o.folds,
+                   o.leave_first_row_share))
+      kept.push_back(c);
+  if (o.lowest_gp) kept = WithTheLowestGpOnly(kept, err, o, k);
   std::vector<Eigen::VectorXd> sq;
   for (int c : kept) sq.push_back(err[c].row(k).array().square().matrix());
   if (o.one_standard_error) return kept[SimplestWithinOneStandardError(sq)];
