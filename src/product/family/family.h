@@ -10,9 +10,13 @@
 // K = min(folds, rows), nothing fitted on the held-out rows), their squared errors, and
 //   score = sum over outputs k of mean_i (t_ik - mean_-i,k)^2 / var_k,
 // var_k = the population variance of output k over the whole table (both outputs weigh equally,
-// as in the network's normalized errors). Per output the simplest candidate within one standard
-// error of the lowest error (ChoiceOptions::one_standard_error) is refitted on all rows with its
-// noise calibration and returned with the table of held-out errors. Within the network family
+// as in the network's normalized errors). Per output, in three steps: a candidate after the first
+// (the power law in the default list) takes part only if its squared held-out errors beat the
+// first's by more than ChoiceOptions::leave_first_se standard errors of the paired differences
+// (leave_first_se_large from ChoiceOptions::few_rows rows; BeatsFirst); of the GPs only the one
+// with the lowest held-out error takes part (ChoiceOptions::lowest_gp); of those, the simplest
+// within one standard error of the lowest error (ChoiceOptions::one_standard_error) is refitted
+// on all rows with its noise calibration and returned with the table of held-out errors. Within the network family
 // the hidden size may still be chosen by the evidence (MacKay 1992: comparable only within one
 // family); across families only held-out errors are compared. How the default was chosen, on a
 // benchmark of generator families split into a tuning and a confirmation part before tuning:
