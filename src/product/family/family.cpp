@@ -497,6 +497,21 @@ Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
   return best;
 }
 
+namespace {
+
+// The mean of paired differences d (row by row, two candidates' squared held-out errors) and its
+// standard error (sample sd / sqrt(n)): the comparison behind BeatsFirst and the
+// one-standard-error rule.
+struct MeanAndSe {
+  double mean, se;
+};
+MeanAndSe OfDifferences(const Eigen::ArrayXd& d) {
+  const double n = static_cast<double>(d.size()), mean = d.mean();
+  return {mean, std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n)};
+}
+
+}  // namespace
+
 bool BeatsFirst(const Eigen::VectorXd& first, const Eigen::VectorXd& other, double z, int wins,
                 int blocks, double row_share) {
   if (first.size() != other.size() || first.size() == 0 || blocks < 1)
@@ -504,8 +519,8 @@ bool BeatsFirst(const Eigen::VectorXd& first, const Eigen::VectorXd& other, doub
                      std::to_string(other.size()) + " squared errors in " +
                      std::to_string(blocks) + " blocks; need equal sizes > 0 and blocks >= 1");
   const Eigen::ArrayXd d = (first - other).array();
-  const double n = static_cast<double>(d.size()), mean = d.mean();
-  const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
+  const double n = static_cast<double>(d.size());
+  const auto [mean, se] = OfDifferences(d);
   if (!(mean > z * se) || mean <= 0) return false;
   const int b = std::min<int>(blocks, static_cast<int>(d.size()));
   Eigen::ArrayXd block = Eigen::ArrayXd::Zero(b);
@@ -521,9 +536,7 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
     if (squared_errors[c].mean() < squared_errors[best].mean()) best = c;
   double simpler = std::numeric_limits<double>::infinity();  // lowest mean of those before c
   for (std::size_t c = 0; c < squared_errors.size(); ++c) {
-    const Eigen::ArrayXd d = (squared_errors[c] - squared_errors[best]).array();
-    const double n = static_cast<double>(d.size()), mean = d.mean();
-    const double se = std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n);
+    const auto [mean, se] = OfDifferences((squared_errors[c] - squared_errors[best]).array());
     if (mean <= se && squared_errors[c].mean() <= simpler) return static_cast<int>(c);
     simpler = std::min(simpler, squared_errors[c].mean());
   }
