@@ -67,30 +67,49 @@ Eigen::MatrixXd Basis(Mean mean, const Eigen::MatrixXd& z) {
   return h;
 }
 
-// Everything NLML and its gradient need at one theta; false if K or H'K^-1H is not PD.
+// Everything NLML and its gradient need at one theta, and the buffers they are computed in: one
+// Factors serves every evaluation of a fit (same z), so that no n x n matrix is allocated per
+// evaluation (at 100 rows a fresh one per step made the C library grow and trim its heap at
+// every evaluation: a third of the fit's CPU time, docs/workpiece-model.md "Speed").
 struct Factors {
-  Eigen::MatrixXd kf, g;
+  Eigen::MatrixXd h;              // the basis H of z (set by the first Factor)
+  Eigen::MatrixXd scaled, r2;     // z / l per input; squared scaled distances
+  Eigen::MatrixXd kf, g, k;       // K_f, the gradient's factor of K_f, K = K_f + sigma_n^2 I
   Eigen::LLT<Eigen::MatrixXd> chol, a_chol;
   Eigen::MatrixXd k_inv_h;
   Eigen::VectorXd b, alpha, r;
+  Eigen::MatrixXd l_inv, k_inv, w, wg;  // Gradient: L^-1, K^-1, alpha alpha' - K^-1, w .* g
 };
+
+// KernelMatrices(kernel, z, z, ...) into f->kf (and f->g) through f's buffers.
+void OwnKernel(Kernel kernel, const Eigen::MatrixXd& z, const Eigen::VectorXd& length, double sf2,
+               bool with_g, Factors* f) {
+  f->scaled.noalias() = length.cwiseInverse().asDiagonal() * z;
+  f->r2.noalias() = -2.0 * f->scaled.transpose() * f->scaled;
+  f->r2.colwise() += f->scaled.colwise().squaredNorm().transpose();
+  f->r2.rowwise() += f->scaled.colwise().squaredNorm();
+  f->r2 = f->r2.cwiseMax(0.0);
+  SymmetricKernel(kernel, f->r2, sf2, &f->kf, with_g ? &f->g : nullptr);
+}
+
+// Fills f at theta; false if K or H'K^-1H is not PD.
 bool Factor(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::VectorXd& u,
             const Eigen::VectorXd& theta, double noise2, bool with_g, Factors* f) {
   const int d = static_cast<int>(z.rows());
   const Eigen::VectorXd length = theta.head(d).array().exp();
   const double sf2 = std::exp(2.0 * theta(d));
   if (!length.allFinite() || !std::isfinite(sf2) || !std::isfinite(noise2)) return false;
-  KernelMatrices(kernel, z, z, length, sf2, &f->kf, with_g ? &f->g : nullptr);
-  Eigen::MatrixXd k = f->kf;
-  k.diagonal().array() += noise2;
-  f->chol.compute(k);
+  OwnKernel(kernel, z, length, sf2, with_g, f);
+  f->k = f->kf;
+  f->k.diagonal().array() += noise2;
+  f->chol.compute(f->k);
   if (f->chol.info() != Eigen::Success) return false;
-  const Eigen::MatrixXd h = Basis(mean, z);
-  f->k_inv_h = f->chol.solve(h);
-  f->a_chol.compute(h.transpose() * f->k_inv_h);
+  if (f->h.rows() != z.cols()) f->h = Basis(mean, z);
+  f->k_inv_h = f->chol.solve(f->h);
+  f->a_chol.compute(f->h.transpose() * f->k_inv_h);
   if (f->a_chol.info() != Eigen::Success) return false;
   f->b = f->a_chol.solve(f->k_inv_h.transpose() * u);
-  f->r = u - h * f->b;
+  f->r = u - f->h * f->b;
   f->alpha = f->chol.solve(f->r);
   return f->alpha.allFinite();
 }
@@ -98,33 +117,46 @@ bool Factor(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::Vec
 // K^-1 from K = L L' in about 2n^3/3 flops: the triangular inverse X = L^-1 block column by
 // block column (column block j of X is zero above row j), then K^-1 = X' X by rank updates (row
 // block i of X is zero right of its diagonal block); solving with the identity takes 2n^3.
-Eigen::MatrixXd InverseFromCholesky(const Eigen::LLT<Eigen::MatrixXd>& chol) {
+// x: the buffer of L^-1.
+void InverseFromCholesky(const Eigen::LLT<Eigen::MatrixXd>& chol, Eigen::MatrixXd* x,
+                         Eigen::MatrixXd* k_inv) {
   constexpr Eigen::Index kBlock = 32;
   const Eigen::Index n = chol.rows();
-  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, n);
+  x->setZero(n, n);
   for (Eigen::Index j = 0; j < n; j += kBlock) {
     const Eigen::Index b = std::min(kBlock, n - j), m = n - j;
-    auto block = x.block(j, j, m, b);
+    auto block = x->block(j, j, m, b);
     block.topRows(b).setIdentity();
     chol.matrixLLT().bottomRightCorner(m, m).triangularView<Eigen::Lower>().solveInPlace(block);
   }
-  Eigen::MatrixXd k_inv = Eigen::MatrixXd::Zero(n, n);
+  k_inv->setZero(n, n);
   for (Eigen::Index i = 0; i < n; i += kBlock) {
     const Eigen::Index b = std::min(kBlock, n - i), c = i + b;
-    k_inv.topLeftCorner(c, c).selfadjointView<Eigen::Lower>().rankUpdate(
-        x.block(i, 0, b, c).transpose());
+    k_inv->topLeftCorner(c, c).selfadjointView<Eigen::Lower>().rankUpdate(
+        x->block(i, 0, b, c).transpose());
   }
-  k_inv.triangularView<Eigen::StrictlyUpper>() = k_inv.transpose();
+  k_inv->triangularView<Eigen::StrictlyUpper>() = k_inv->transpose();
+}
+
+Eigen::MatrixXd InverseFromCholesky(const Eigen::LLT<Eigen::MatrixXd>& chol) {
+  Eigen::MatrixXd x, k_inv;
+  InverseFromCholesky(chol, &x, &k_inv);
   return k_inv;
 }
 
 // -tr(W dK/dtheta_j) / 2 for every j, W = alpha alpha' - K^-1 (R&W eq. 5.9).
-Eigen::VectorXd Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn2_dtheta,
-                         const Factors& f) {
+void Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn2_dtheta,
+              Factors* factors, Eigen::VectorXd* gradient) {
   const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
-  const Eigen::MatrixXd w = f.alpha * f.alpha.transpose() - InverseFromCholesky(f.chol);
-  const Eigen::MatrixXd wg = w.cwiseProduct(f.g);
-  Eigen::VectorXd grad(d + 2);
+  Factors& f = *factors;
+  InverseFromCholesky(f.chol, &f.l_inv, &f.k_inv);
+  f.w.noalias() = f.alpha * f.alpha.transpose();
+  f.w -= f.k_inv;
+  f.wg = f.w.cwiseProduct(f.g);
+  const Eigen::MatrixXd& w = f.w;
+  const Eigen::MatrixXd& wg = f.wg;
+  Eigen::VectorXd& grad = *gradient;
+  grad.resize(d + 2);
   for (int i = 0; i < d; ++i) {
     const Eigen::ArrayXd zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
     double s = 0;
@@ -133,7 +165,22 @@ Eigen::VectorXd Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta,
   }
   grad(d) = -w.cwiseProduct(f.kf).sum();
   grad(d + 1) = -0.5 * w.trace() * dsn2_dtheta;
-  return grad;
+}
+
+// NegLogMarginalLikelihood in the buffers f (of earlier evaluations on the same z, or empty).
+double Nlml(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::VectorXd& u,
+            const Eigen::VectorXd& theta, double min_noise_variance, Eigen::VectorXd* gradient,
+            Factors* f) {
+  const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
+  const double sn2_free = std::exp(2.0 * theta(d + 1));
+  if (!Factor(kernel, mean, z, u, theta, sn2_free + min_noise_variance, gradient != nullptr, f)) {
+    if (gradient) gradient->setConstant(theta.size(), kInf);
+    return kInf;
+  }
+  const double log_det_half = f->chol.matrixLLT().diagonal().array().log().sum();
+  const double nlml = 0.5 * f->r.dot(f->alpha) + log_det_half + 0.5 * n * std::log(2.0 * kPi);
+  if (gradient) Gradient(z, theta, 2.0 * sn2_free, f, gradient);
+  return nlml;
 }
 
 void ValidateData(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, Mean mean) {
@@ -195,9 +242,9 @@ std::vector<Eigen::VectorXd> StartPoints(const Gp& gp, int count) {
 void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp* gp,
               GpSummary* summary) {
   const int d = gp->InputCount();
+  Factors buffers;
   const SmoothObjective f = [&](const Eigen::VectorXd& t, Eigen::VectorXd* grad) {
-    double v = NegLogMarginalLikelihood(gp->kernel, gp->mean, gp->z, gp->u, t,
-                                        gp->min_noise_variance, grad);
+    double v = Nlml(gp->kernel, gp->mean, gp->z, gp->u, t, gp->min_noise_variance, grad, &buffers);
     if (o.length_prior_sd > 0 && std::isfinite(v)) {
       const Eigen::ArrayXd dev = (t.head(d).array() - LengthPriorMean(d)) / o.length_prior_sd;
       v += 0.5 * dev.square().sum();
@@ -356,17 +403,8 @@ int MeanSize(Mean mean, int inputs) { return mean == Mean::kConstant ? 1 : 1 + i
 double NegLogMarginalLikelihood(Kernel kernel, Mean mean, const Eigen::MatrixXd& z,
                                 const Eigen::VectorXd& u, const Eigen::VectorXd& theta,
                                 double min_noise_variance, Eigen::VectorXd* gradient) {
-  const int d = static_cast<int>(z.rows()), n = static_cast<int>(z.cols());
-  const double sn2_free = std::exp(2.0 * theta(d + 1));
   Factors f;
-  if (!Factor(kernel, mean, z, u, theta, sn2_free + min_noise_variance, gradient != nullptr, &f)) {
-    if (gradient) gradient->setConstant(theta.size(), kInf);
-    return kInf;
-  }
-  const double log_det_half = f.chol.matrixLLT().diagonal().array().log().sum();
-  const double nlml = 0.5 * f.r.dot(f.alpha) + log_det_half + 0.5 * n * std::log(2.0 * kPi);
-  if (gradient) *gradient = Gradient(z, theta, 2.0 * sn2_free, f);
-  return nlml;
+  return Nlml(kernel, mean, z, u, theta, min_noise_variance, gradient, &f);
 }
 
 double Gp::SigmaN2() const { return std::exp(2.0 * theta(InputCount() + 1)) + min_noise_variance; }
