@@ -372,8 +372,10 @@ Candidate ParseCandidate(const std::string& name) {
   throw InputError(bad);
 }
 
-FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
-                         const FitOptions& options, bool calibrate) {
+namespace {
+
+// `candidate` with its transform of `table`, nothing fitted yet (FitCandidate's first step).
+FamilyModel Unfitted(const ProcessTable& table, const Candidate& candidate) {
   CheckTable(table);
   FamilyModel m;
   m.candidate = candidate;
@@ -382,17 +384,30 @@ FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
   else
     LeaveOutConstantInputs(table, &m.transform);
   CheckRows(table, candidate, m.transform.UsedInputCount());
+  return m;
+}
+
+// The fits of a linear or GP model m from Unfitted, on all rows of `table`.
+void FitOwnColumns(const ProcessTable& table, const FitOptions& options, FamilyModel* m) {
+  const Eigen::MatrixXd x = ModelInputs(*m, table.inputs);
+  const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
+  if (m->candidate.family == Family::kLinear)
+    m->linears = FitLinears(x, y);
+  else
+    m->gps = FitGps(x, y, m->candidate, options);
+}
+
+}  // namespace
+
+FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
+                         const FitOptions& options, bool calibrate) {
+  FamilyModel m = Unfitted(table, candidate);
   if (candidate.family == Family::kNetwork) {
     m.network = FitNetwork(TransformedTable(table, m.transform), candidate, options, calibrate);
     m.calibration = m.network.noise_calibration;
     return m;
   }
-  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
-  const Eigen::MatrixXd y = TransformTargets(m.transform, nn::TargetMatrix(table.targets));
-  if (candidate.family == Family::kLinear)
-    m.linears = FitLinears(x, y);
-  else
-    m.gps = FitGps(x, y, candidate, options);
+  FitOwnColumns(table, options, &m);
   if (calibrate) Calibrate(table, options, &m);
   return m;
 }
@@ -420,20 +435,42 @@ void Calibrate(const ProcessTable& table, const FitOptions& options, FamilyModel
   m->calibration = CalibrationText(folds, options.calibrate_two_sd);
 }
 
+namespace {
+
+using HeldOuts = std::array<HeldOut, Features::kCount>;
+
+// The noise calibration of m (fitted on `table`) from its held-out residuals h of `folds`.
+void CalibrateFrom(const ProcessTable& table, const FitOptions& options, int folds,
+                   const HeldOuts& h, FamilyModel* m) {
+  const Eigen::MatrixXd x = ModelInputs(*m, table.inputs);
+  const Eigen::MatrixXd y = TransformTargets(m->transform, nn::TargetMatrix(table.targets));
+  for (int k = 0; k < Features::kCount; ++k)
+    SetNoiseFrom(h[k], folds, options, x, y.row(k).transpose(), k, m);
+  m->calibration = CalibrationText(folds, options.calibrate_two_sd);
+}
+
+}  // namespace
+
+// Held-out errors (original units) of m's `folds` (0: closed form; K-fold refits from the fixed
+// starting points with `cold`, from the full fit's hyperparameters otherwise: these need m
+// fitted, the others only its transform), with m's calibration from them (`calibrate`); the
+// residuals in `kept` if non-null.
 Eigen::MatrixXd HeldOutErrors(const ProcessTable& table, const FitOptions& options, int folds,
-                              FamilyModel* m, bool calibrate, bool cold = true) {
+                              FamilyModel* m, bool calibrate, bool cold = true,
+                              HeldOuts* kept = nullptr) {
   if (m->candidate.family == Family::kNetwork)
     throw InputError("held-out errors of a fitted model: not available for " + m->candidate.Name());
   const Eigen::MatrixXd x = ModelInputs(*m, table.inputs);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::MatrixXd y = TransformTargets(m->transform, t);
   Eigen::MatrixXd err(t.rows(), t.cols());
+  HeldOuts h;
   for (int k = 0; k < Features::kCount; ++k) {
-    const HeldOut h = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds, cold);
-    err.row(k) = OriginalErrors(*m, k, t.row(k), y.row(k).transpose(), h);
-    if (calibrate) SetNoiseFrom(h, folds, options, x, y.row(k).transpose(), k, m);
+    h[k] = OutputHeldOut(*m, k, x, y.row(k).transpose(), options, folds, cold);
+    err.row(k) = OriginalErrors(*m, k, t.row(k), y.row(k).transpose(), h[k]);
   }
-  if (calibrate) m->calibration = CalibrationText(folds, options.calibrate_two_sd);
+  if (calibrate) CalibrateFrom(table, options, folds, h, m);
+  if (kept) *kept = std::move(h);
   return err;
 }
 
@@ -682,8 +719,10 @@ std::string SetAsideNote(const ChoiceOptions& o, const FamilyModel& gp, int lin,
 // ChoiceOptions::equivalence_sd for output k: the reason to set the chosen candidate c aside for
 // the linear candidates' choice `lin` (empty: keep c). The refits need every training split to
 // hold at least kLinearCoefficients + 2 rows (FitLinear); below that the choice stays.
+// `refit_err`: c's held-out errors (2 x rows) of these refits if ChooseFamily has them already.
 std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
-                        const std::vector<FamilyModel>& full, int c, int lin, int k) {
+                        const std::vector<FamilyModel>& full, int c, int lin, int k,
+                        const Eigen::MatrixXd* refit_err) {
   NearLinearGp n;
   if (!IsNearLinearGp(table, o, full, c, k, &n)) return "";
   const int rows = static_cast<int>(table.inputs.size());
@@ -692,7 +731,8 @@ std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
   FitOptions fo = o.fit;
   fo.threads = 1;
   const Eigen::VectorXd e_lin = RefitSquaredErrors(full[lin], table, fo, folds, k);
-  const Eigen::VectorXd e_gp = RefitSquaredErrors(full[c], table, fo, folds, k);
+  const Eigen::VectorXd e_gp = refit_err ? refit_err->row(k).array().square().matrix().transpose()
+                                         : RefitSquaredErrors(full[c], table, fo, folds, k);
   if (SimplestWithinOneStandardError({e_lin, e_gp}) == 1) return "";
   return SetAsideNote(o, full[c], lin, k, rows, n, folds, std::sqrt(e_gp.mean()),
                       std::sqrt(e_lin.mean()));
@@ -813,6 +853,10 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   for (const Candidate& c : options.candidates) CheckRows(table, c, used.UsedInputCount());
   std::vector<FamilyModel> full(static_cast<std::size_t>(nc));  // closed-form LOO fits
   std::vector<char> calibrated(static_cast<std::size_t>(nc), 0);
+  // A GP judged by K-fold refits from fixed starting points needs no full fit for its held-out
+  // errors: it is fitted (and calibrated from `held`) only when it is chosen (Complete below).
+  std::vector<char> refitted(static_cast<std::size_t>(nc), 0), pending = refitted;
+  std::vector<HeldOuts> held(static_cast<std::size_t>(nc));
   std::mutex progress_mutex;
   int done = 0;
   int steps = 1;  // a network's folds, every other candidate's fit (with its held-out errors), the end
@@ -823,7 +867,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     if (options.candidates[c].family == Family::kNetwork) {
       FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
     } else if (f == 0) {  // one full fit, its held-out errors (and calibration) from it
-      full[c] = FitCandidate(table, options.candidates[c], fold_options, false);
+      full[c] = Unfitted(table, options.candidates[c]);
       const bool honest = options.closed_form_loo &&
                           options.candidates[c].family == Family::kGaussianProcess &&
                           rows < options.few_rows &&
@@ -831,7 +875,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
                               MinimumRows(options.candidates[c], used.UsedInputCount());
       const int held_folds = honest ? folds : HeldOutFolds(options, folds);
       calibrated[c] = held_folds == CalibrationFolds(options.fit, rows, full[c]);
-      err[c] = HeldOutErrors(table, fold_options, held_folds, &full[c], calibrated[c], true);
+      refitted[c] = held_folds > 0;
+      pending[c] = refitted[c] && options.candidates[c].family == Family::kGaussianProcess;
+      if (!pending[c]) FitOwnColumns(table, fold_options, &full[c]);
+      err[c] = HeldOutErrors(table, fold_options, held_folds, &full[c], calibrated[c] && !pending[c],
+                             true, &held[c]);
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -857,6 +905,15 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
         choice.chosen[k] = c;
     }
   }
+  const auto complete = [&](int c) {  // the full fit of a pending GP, calibrated as above
+    if (!pending[c]) return;
+    const auto start = std::chrono::steady_clock::now();
+    FitOwnColumns(table, fold_options, &full[c]);
+    if (calibrated[c]) CalibrateFrom(table, fold_options, folds, held[c], &full[c]);
+    pending[c] = 0;
+    choice.table[c].fit_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
   std::array<Eigen::VectorXd, Features::kCount> stack;
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
@@ -874,10 +931,17 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       }
       choice.chosen[k] = ChooseAmong(all, err, options, k);
       if (linear.empty()) continue;
-      const int lin = ChooseAmong(linear, err, options, k);
-      choice.notes[k] = WhySetAside(table, options, full, choice.chosen[k], lin, k);
+      const int lin = ChooseAmong(linear, err, options, k), c = choice.chosen[k];
+      complete(c);
+      choice.notes[k] =
+          WhySetAside(table, options, full, c, lin, k, refitted[c] ? &err[c] : nullptr);
       if (!choice.notes[k].empty()) choice.chosen[k] = lin;
     }
+  }
+  for (int k = 0; k < Features::kCount; ++k) {
+    complete(choice.chosen[k]);
+    for (Eigen::Index c = 0; c < stack[k].size(); ++c)
+      if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
   FitChosen(table, options, stack, full, calibrated, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
