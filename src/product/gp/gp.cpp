@@ -22,15 +22,18 @@ void SymmetricKernel(Kernel kernel, const Eigen::MatrixXd& r2, double sf2, Eigen
   const Eigen::Index n = r2.cols();
   kf->resize(n, n);
   if (g) g->resize(n, n);
+  Eigen::ArrayXd s2_all(n), r_all(n), e_all(n);  // one column's terms, from index 0 (aligned)
   for (Eigen::Index q = 0; q < n; ++q) {
     const Eigen::Index m = n - q;
-    const Eigen::ArrayXd s2 = r2.col(q).tail(m).array();
+    auto s2 = s2_all.head(m), r = r_all.head(m), e = e_all.head(m);
+    s2 = r2.col(q).tail(m).array();
     if (kernel == Kernel::kSquaredExponential) {
       kf->col(q).tail(m) = (sf2 * (-0.5 * s2).exp()).matrix();
       if (g) g->col(q).tail(m) = kf->col(q).tail(m);
       continue;
     }
-    const Eigen::ArrayXd r = s2.sqrt(), e = (-kSqrt5 * r).exp();
+    r = s2.sqrt();
+    e = (-kSqrt5 * r).exp();
     kf->col(q).tail(m) = (sf2 * (1.0 + kSqrt5 * r + (5.0 / 3.0) * s2) * e).matrix();
     if (g) g->col(q).tail(m) = (sf2 * (5.0 / 3.0) * (1.0 + kSqrt5 * r) * e).matrix();
   }
@@ -79,6 +82,7 @@ struct Factors {
   Eigen::MatrixXd k_inv_h;
   Eigen::VectorXd b, alpha, r;
   Eigen::MatrixXd l_inv, k_inv, w, wg;  // Gradient: L^-1, K^-1, alpha alpha' - K^-1, w .* g
+  Eigen::ArrayXd zi;                     // Gradient: one input's row
 };
 
 // KernelMatrices(kernel, z, z, ...) into f->kf (and f->g) through f's buffers.
@@ -158,7 +162,8 @@ void Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn
   Eigen::VectorXd& grad = *gradient;
   grad.resize(d + 2);
   for (int i = 0; i < d; ++i) {
-    const Eigen::ArrayXd zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
+    Eigen::ArrayXd& zi = f.zi;
+    zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
     double s = 0;
     for (int q = 0; q < n; ++q) s += (wg.col(q).array() * (zi - zi(q)).square()).sum();
     grad(i) = -0.5 * s * std::exp(-2.0 * theta(i));
