@@ -278,6 +278,28 @@ TEST(GpFit, LengthPriorIsStationaryInThePosterior) {
   }
 }
 
+// The fit evaluates the likelihood many times in buffers it reuses; the value it reports for the
+// chosen start is a fresh evaluation's at the hyperparameters it returns (plus the length prior).
+TEST(GpFit, ReportedObjectiveIsAFreshEvaluationAtTheFittedPoint) {
+  for (const int n : {16, 45, 90})
+    for (Kernel k : kKernels)
+      for (Mean m : kMeans) {
+        const Data data = MakeData(3, n, 0.1, 17 + n);
+        GpOptions o;
+        o.kernel = k;
+        o.mean = m;
+        GpSummary s;
+        const Gp gp = FitGp(data.x, data.y, o, &s);
+        ASSERT_TRUE((gp.theta.array().abs() < 30).all());
+        const Eigen::ArrayXd dev =
+            (gp.theta.head(3).array() - LengthPriorMean(3)) / o.length_prior_sd;
+        const double fresh =
+            NegLogMarginalLikelihood(k, m, gp.z, gp.u, gp.theta, gp.min_noise_variance, nullptr) +
+            0.5 * dev.square().sum();
+        EXPECT_EQ(s.nlml, fresh) << "n " << n << ", " << ToString(k) << ", " << ToString(m);
+      }
+}
+
 // GpOptions::max_rows keeps every ceil-spread row of a large table (and no other), and
 // hyperparameter_rows fits the hyperparameters on a subset while the GP keeps all its rows.
 TEST(GpFit, SubsetsOfLargeTables) {
