@@ -273,16 +273,33 @@ def paired_t(d):
     return d.mean(), se, d.mean() / se if se > 0 else float("nan")
 
 
-def log_ratios(cases, a, b, outputs=(0, 1)):
-    """Per case (problem, seed): the mean over `outputs` and SIZES of ln(RMSE_a / RMSE_b); a and
-    b: (cases, strategy)."""
+def log_ratios(cases, a, b, outputs=(0, 1), sizes=SIZES):
+    """Per case (problem, seed): the mean over `outputs` and `sizes` of ln(RMSE_a / RMSE_b); a
+    and b: (cases, strategy)."""
     (ca, sa), (cb, sb) = a, b
     out = {}
     for key in ca:
         if key in cb and sa in ca[key] and sb in cb[key]:
             out[key] = np.mean([np.log(ca[key][sa][n][k] / cb[key][sb][n][k])
-                                for n in SIZES for k in outputs])
+                                for n in sizes for k in outputs])
     return out
+
+
+def print_paired_cells(cases):
+    """Design against random per problem, output and N: the paired ratio exp(mean log-ratio)
+    over the seeds and its t (the acceptance's "never worse than random at any N")."""
+    print("\npaired, design / random per cell: ratio (t) at N = " + ", ".join(map(str, SIZES)))
+    for prob in dict.fromkeys(p for p, _ in cases):
+        one = {key: c for key, c in cases.items() if key[0] == prob}
+        for k, out in enumerate(bp.TARGETS):
+            cells = []
+            for n in SIZES:
+                d = log_ratios(one, (one, "design"), (one, "random"), (k,), (n,))
+                if not d:
+                    return
+                m, _, t = paired_t(list(d.values()))
+                cells.append(f"{np.exp(m):.3f} ({t:+.1f})")
+            print(f"  {prob}, {out}: " + ", ".join(cells))
 
 
 def print_paired(d, title):
@@ -305,6 +322,7 @@ def paired_report(results, base=None):
     for k, out in enumerate(bp.TARGETS):
         print_paired(log_ratios(cases, (cases, "design"), (cases, "random"), (k,)),
                      f"paired, design / random, {out}")
+    print_paired_cells(cases)
     if base:
         other = cases_of(json.load(open(base))["cases"])
         print_paired(log_ratios(cases, (cases, "design"), (other, "design")),
