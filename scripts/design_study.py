@@ -304,7 +304,9 @@ def print_paired_cells(cases):
 
 def print_paired(d, title):
     """The fourth attempt's paired statistic (docs/design.md): mean, se and t of the per-case
-    log-ratios, the sign count, and per problem."""
+    log-ratios, the sign count, and per problem (nothing without cases: --design-only)."""
+    if not d:
+        return
     mean, se, t = paired_t(list(d.values()))
     below = sum(v < 0 for v in d.values())
     nonzero = sum(v != 0 for v in d.values())

@@ -121,7 +121,8 @@ struct NextRule {
   Model model = Model::kPowerGp;
   /// kPowerGp / kSum: the departure's signal sd over the measurement scatter's sd, and its
   /// (isotropic Matern 5/2) length scale in log inputs standardized over list and measured.
-  /// The defaults (and kPowerGp) were chosen on the third attempt's tuning part (docs/design.md).
+  /// The defaults (and kPowerGp) were chosen on the third attempt's tuning part and kept by the
+  /// fourth attempt's paired comparison with kChosen, kAuto and kSum (docs/design.md).
   double departure_ratio = 4.0;
   double length_scale = 2.23606797749979;  // sqrt(5)
 };
