@@ -288,6 +288,8 @@ def log_ratios(cases, a, b, outputs=(0, 1), sizes=SIZES):
 def print_paired_cells(cases):
     """Design against random per problem, output and N: the paired ratio exp(mean log-ratio)
     over the seeds and its t (the acceptance's "never worse than random at any N")."""
+    if not all("random" in c and "design" in c for c in cases.values()):
+        return
     print("\npaired, design / random per cell: ratio (t) at N = " + ", ".join(map(str, SIZES)))
     for prob in dict.fromkeys(p for p, _ in cases):
         one = {key: c for key, c in cases.items() if key[0] == prob}
@@ -295,8 +297,6 @@ def print_paired_cells(cases):
             cells = []
             for n in SIZES:
                 d = log_ratios(one, (one, "design"), (one, "random"), (k,), (n,))
-                if not d:
-                    return
                 m, _, t = paired_t(list(d.values()))
                 cells.append(f"{np.exp(m):.3f} ({t:+.1f})")
             print(f"  {prob}, {out}: " + ", ".join(cells))
