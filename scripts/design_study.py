@@ -260,6 +260,77 @@ def score(table):
               f"design / random {np.exp(np.mean(np.log(ratios))):.4f}")
 
 
+def cases_of(results):
+    """{(problem, seed): {strategy: {N: [rmse per output]}}} with integer N (also from --json)."""
+    return {(p, s): {k: {int(n): v for n, v in r.items()} for k, r in res.items()}
+            for p, s, res in results}
+
+
+def paired_t(d):
+    """(mean, standard error, t = mean / se) of paired differences d."""
+    d = np.asarray(d, dtype=float)
+    se = d.std(ddof=1) / np.sqrt(len(d)) if len(d) > 1 else float("nan")
+    return d.mean(), se, d.mean() / se if se > 0 else float("nan")
+
+
+def log_ratios(cases, a, b, outputs=(0, 1), sizes=SIZES):
+    """Per case (problem, seed): the mean over `outputs` and `sizes` of ln(RMSE_a / RMSE_b); a
+    and b: (cases, strategy)."""
+    (ca, sa), (cb, sb) = a, b
+    out = {}
+    for key in ca:
+        if key in cb and sa in ca[key] and sb in cb[key]:
+            out[key] = np.mean([np.log(ca[key][sa][n][k] / cb[key][sb][n][k])
+                                for n in sizes for k in outputs])
+    return out
+
+
+def print_paired_cells(cases):
+    """Design against random per problem, output and N: the paired ratio exp(mean log-ratio)
+    over the seeds and its t (the acceptance's "never worse than random at any N")."""
+    if not all("random" in c and "design" in c for c in cases.values()):
+        return
+    print("\npaired, design / random per cell: ratio (t) at N = " + ", ".join(map(str, SIZES)))
+    for prob in dict.fromkeys(p for p, _ in cases):
+        one = {key: c for key, c in cases.items() if key[0] == prob}
+        for k, out in enumerate(bp.TARGETS):
+            cells = []
+            for n in SIZES:
+                d = log_ratios(one, (one, "design"), (one, "random"), (k,), (n,))
+                m, _, t = paired_t(list(d.values()))
+                cells.append(f"{np.exp(m):.3f} ({t:+.1f})")
+            print(f"  {prob}, {out}: " + ", ".join(cells))
+
+
+def print_paired(d, title):
+    """The fourth attempt's paired statistic (docs/design.md): mean, se and t of the per-case
+    log-ratios, the sign count, and per problem (nothing without cases: --design-only)."""
+    if not d:
+        return
+    mean, se, t = paired_t(list(d.values()))
+    below = sum(v < 0 for v in d.values())
+    nonzero = sum(v != 0 for v in d.values())
+    print(f"\n{title}: {len(d)} cases, mean log-ratio {mean:+.4f} (ratio {np.exp(mean):.3f}), "
+          f"se {se:.4f}, t {t:+.2f}; lower in {below} of {nonzero} cases with a difference")
+    for prob in dict.fromkeys(p for p, _ in d):
+        m, e, tp = paired_t([v for (p, _), v in d.items() if p == prob])
+        print(f"  {prob}: mean {m:+.4f} (ratio {np.exp(m):.3f}), se {e:.4f}, t {tp:+.2f}")
+
+
+def paired_report(results, base=None):
+    """Design against random per output, and (base: an earlier --json run) this run's design
+    against the base run's design on the same cases."""
+    cases = cases_of(results)
+    for k, out in enumerate(bp.TARGETS):
+        print_paired(log_ratios(cases, (cases, "design"), (cases, "random"), (k,)),
+                     f"paired, design / random, {out}")
+    print_paired_cells(cases)
+    if base:
+        other = cases_of(json.load(open(base))["cases"])
+        print_paired(log_ratios(cases, (cases, "design"), (other, "design")),
+                     f"paired, this design / the design of {base}, both outputs")
+
+
 def plot(table, path, gnuplot="gnuplot"):
     with tempfile.TemporaryDirectory() as tmp:
         cmds = [f"set terminal pngcairo size 1400,{420 * len(table)} font ',10'",
@@ -311,6 +382,9 @@ def main():
     ap.add_argument("--json", help="write every case's RMSE and the medians here")
     ap.add_argument("--plot", help="PNG of the medians (gnuplot)")
     ap.add_argument("--from-json", help="print (and --plot) the medians of an earlier --json run")
+    ap.add_argument("--paired-with", help="an earlier --json run of the same problems and seeds: "
+                    "the paired log-ratio of this run's design against its design (docs/design.md, "
+                    "fourth attempt)")
     a = ap.parse_args()
     if a.from_json:
         saved = json.load(open(a.from_json))
@@ -319,6 +393,7 @@ def main():
         print(f"criterion {saved['criterion']}, batch {saved['batch']}, seeds {saved['seeds']}")
         print_markdown(table)
         score(table)
+        paired_report(saved["cases"], a.paired_with)
         if a.plot:
             plot(table, a.plot)
         return
@@ -347,6 +422,7 @@ def main():
                        "inside": a.inside,
                        "command": " ".join(sys.argv),
                        "cases": results, "medians": table}, h)
+    paired_report(results, a.paired_with)
     if a.plot:
         plot(table, a.plot)
 

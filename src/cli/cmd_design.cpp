@@ -355,13 +355,15 @@ void RegisterDesign(CLI::App& app) {
       ->check(NumberIn(0, 100000));
   sub->add_option("--measured", o->measured_path,
                   "with --model: the screws measured so far (CSV, five input columns; e.g. the "
-                  "training table), needed by --variance power-gp | sum and --space-filling")
+                  "training table), needed by --variance power-gp | sum | auto and --space-filling")
       ->check(CLI::ExistingFile);
   sub->add_option("--variance", o->variance,
                   "next screws: whose variance the picks reduce: power-gp (a GP on the "
                   "standardized log inputs whose mean is the power law: the power law plus a "
                   "smooth departure, given the --measured screws; needs --measured), chosen (the "
-                  "model's chosen family's own variance) or sum (both, weighed equally)")
+                  "model's chosen family's own variance), sum (both, weighed equally) or auto (per "
+                  "output the chosen family's where cross-validation chose a GP, else power-gp; "
+                  "needs --measured)")
       ->capture_default_str();
   sub->add_option("--departure-ratio", o->departure_ratio,
                   "power-gp (and --inside): the departure's sd over the measurement scatter's "

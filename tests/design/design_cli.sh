@@ -76,6 +76,17 @@ grep -q "note: --measured" out.txt && fail "a note on the training table itself:
 grep -q "both outputs weighed equally" out.txt || fail "--variance chosen: $(cat out.txt)"
 "$whirl" design --model m.json --candidates cands.csv --count 2 --variance sum --measured "$data" \
   --departure-ratio 4 --length-scale 1.5 > out.txt 2> err.txt || fail "next --variance sum: $(cat err.txt)"
+# --variance auto: per output the chosen GP's variance or, where a linear fit is chosen, power-gp.
+"$whirl" train --data "$data" --out m_gp.json --family gp --transform log > /dev/null 2> err.txt \
+  || fail "train --family gp: $(cat err.txt)"
+"$whirl" design --model m_gp.json --candidates cands.csv --count 2 --variance auto \
+  --measured "$data" > out.txt 2> err.txt || fail "next --variance auto: $(cat err.txt)"
+grep -q "both outputs weighed equally" out.txt || fail "--variance auto on GPs: $(cat out.txt)"
+"$whirl" train --data "$data" --out m_lin.json --family linear --transform log > /dev/null \
+  2> err.txt || fail "train --family linear: $(cat err.txt)"
+"$whirl" design --model m_lin.json --candidates cands.csv --count 2 --variance auto \
+  --measured "$data" > out.txt 2> err.txt || fail "next --variance auto: $(cat err.txt)"
+grep -q "smooth departure" out.txt || fail "--variance auto on power laws: $(cat out.txt)"
 
 # Space filling: the first design's last picks and a next batch's last pick say so; the next
 # mode keeps them away from the --measured screws (the training table here).
@@ -158,6 +169,8 @@ expect_fail "needs --measured" "$whirl" design --model m.json --candidates cands
 expect_fail "--measured needs --model" "$whirl" design "${ranges[@]}" --count 8 --measured "$data"
 expect_fail "power-gp needs --measured" "$whirl" design --model m.json --candidates cands.csv \
   --count 2
+expect_fail "auto needs --measured" "$whirl" design --model m.json --candidates cands.csv \
+  --count 2 --variance auto
 expect_fail "--variance 'gp': expected 'power-gp'" "$whirl" design --model m.json \
   --candidates cands.csv --count 2 --variance gp --measured "$data"
 expect_fail "departure-ratio" "$whirl" design --model m.json --candidates cands.csv --count 2 \

@@ -407,6 +407,41 @@ TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
   EXPECT_THROW(ParseNextModel("gp"), InputError);
 }
 
+// --variance auto follows cross-validation per output: a model whose outputs are both linear
+// (the power law) picks as power-gp, one whose outputs are both GPs as the chosen family's.
+std::vector<int> PickedBy(const workpiece::WorkpieceModel& model,
+                          const std::vector<ProcessInputs>& cands, const SpaceFilling& fill,
+                          NextRule::Model m) {
+  NextRule rule;
+  rule.model = m;
+  std::vector<int> out;
+  for (const auto& p : DesignNext(model, cands, 4, {}, {}, fill, rule).picks)
+    out.push_back(p.candidate);
+  return out;
+}
+
+TEST(Design, AutoVarianceFollowsTheChosenFamilyPerOutput) {
+  const ProcessTable t = ReadProcessTable(WHIRL_SOURCE_DIR "/datasets/whirling_train.csv", true);
+  std::mt19937 rng(21);
+  const auto cands = RandomList(rng, 60);
+  SpaceFilling fill;
+  fill.measured = t.inputs;
+  using M = NextRule::Model;
+  for (const auto flag : {workpiece::FamilyFlag::kLinear, workpiece::FamilyFlag::kGaussianProcess}) {
+    workpiece::TrainOptions o;
+    o.family = flag;
+    o.transform = workpiece::TransformFlag::kLog;
+    const auto model = workpiece::TrainWorkpieceModel(t, o, "whirling_train.csv");
+    const auto power_gp = PickedBy(model, cands, fill, M::kPowerGp);
+    const auto chosen = PickedBy(model, cands, fill, M::kChosen);
+    ASSERT_NE(power_gp, chosen);  // else the check below could not tell the rules apart
+    EXPECT_EQ(PickedBy(model, cands, fill, M::kAuto),
+              flag == workpiece::FamilyFlag::kLinear ? power_gp : chosen);
+  }
+  EXPECT_EQ(ParseNextModel("auto"), M::kAuto);
+  EXPECT_EQ(ToString(M::kAuto), "auto");
+}
+
 TEST(Design, InsidePicksReduceThePowerGpVarianceMostAfterTheOptimalOnes) {
   std::mt19937 rng(21);
   for (int t = 0; t < 5; ++t) {

@@ -338,10 +338,17 @@ int BestCandidate(const States& states, const std::vector<char>& taken, double* 
 // Why the pick j of the variance rule was made; `share` = its reduction as a fraction of the
 // criterion's mean variance over the list (design.h: each variance weighed by its mean).
 std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int j, double share,
-                    NextRule::Model model, const workpiece::Prediction& now) {
+                    NextRule::Model model, const std::array<bool, Features::kCount>& gp_chosen,
+                    const workpiece::Prediction& now) {
   const std::string pct = FormatSignificant(100 * share, 3) + " % of its mean";
   std::string why;
-  if (model == NextRule::Model::kPowerGp) {
+  if (model == NextRule::Model::kAuto && gp_chosen[0] != gp_chosen[1]) {
+    why = "largest expected reduction of the prediction variance over the list (" + pct +
+          "; for " + kTargetColumns[gp_chosen[0] ? 0 : 1] + " the chosen GP's, for " +
+          kTargetColumns[gp_chosen[0] ? 1 : 0] +
+          ", whose chosen family is linear, a power law with a smooth departure's)";
+  } else if (model == NextRule::Model::kPowerGp ||
+             (model == NextRule::Model::kAuto && !gp_chosen[0])) {
     why = "largest expected reduction of the prediction variance over the list of a power law "
           "with a smooth departure (a GP on the log inputs, given the measured screws): " + pct;
   } else {
@@ -434,13 +441,20 @@ NextRule::Model ParseNextModel(const std::string& s) {
   if (s == "power-gp") return NextRule::Model::kPowerGp;
   if (s == "chosen") return NextRule::Model::kChosen;
   if (s == "sum") return NextRule::Model::kSum;
+  if (s == "auto") return NextRule::Model::kAuto;
   throw InputError("--variance '" + s + "': expected 'power-gp' (a GP with a power-law mean on "
-                   "the log inputs), 'chosen' (the chosen family's) or 'sum' (both)");
+                   "the log inputs), 'chosen' (the chosen family's), 'sum' (both) or 'auto' (per "
+                   "output the chosen GP's where cross-validation chose a GP, else power-gp)");
 }
 
 std::string ToString(NextRule::Model m) {
-  return m == NextRule::Model::kPowerGp ? "power-gp" : m == NextRule::Model::kChosen ? "chosen"
-                                                                                     : "sum";
+  switch (m) {
+    case NextRule::Model::kPowerGp: return "power-gp";
+    case NextRule::Model::kChosen: return "chosen";
+    case NextRule::Model::kSum: return "sum";
+    case NextRule::Model::kAuto: break;
+  }
+  return "auto";
 }
 
 void InputRanges::Validate(const std::array<const char*, ProcessInputs::kCount>& flags) const {
@@ -611,16 +625,31 @@ namespace {
 
 // The states the picks are made with (design.h, NextRule), each weighed by its mean variance
 // over the list; *units = the number of variances of equal weight (for WhyNext's share).
+// gp_chosen[k]: cross-validation chose a GP for output k (NextRule::kAuto).
 std::vector<OutputState> CriterionStates(const std::array<OutputState, Features::kCount>& model,
+                                         const std::array<bool, Features::kCount>& gp_chosen,
                                          const Eigen::MatrixXd& u, int n, const NextRule& rule,
                                          double* units) {
   std::vector<OutputState> out;
-  if (rule.model != NextRule::Model::kPowerGp) out.assign(model.begin(), model.end());
+  int linear_outputs = 0;
+  for (int k = 0; k < Features::kCount; ++k) {
+    const bool own = rule.model == NextRule::Model::kChosen ||
+                     rule.model == NextRule::Model::kSum ||
+                     (rule.model == NextRule::Model::kAuto && gp_chosen[k]);
+    if (own) out.push_back(model[k]);
+    linear_outputs += !gp_chosen[k];
+  }
   *units = static_cast<double>(out.size());
-  if (rule.model != NextRule::Model::kChosen) {
+  const bool power_gp = rule.model == NextRule::Model::kPowerGp ||
+                        rule.model == NextRule::Model::kSum ||
+                        (rule.model == NextRule::Model::kAuto && linear_outputs > 0);
+  if (power_gp) {
     OutputState s = PowerGpState(u, n, rule);
     const double mean = s.cov.diagonal().mean();
-    const double share = rule.model == NextRule::Model::kSum ? Features::kCount : 1.0;
+    // kAuto: the power-GP stands in for each output whose chosen family is linear.
+    const double share = rule.model == NextRule::Model::kSum    ? Features::kCount
+                         : rule.model == NextRule::Model::kAuto ? linear_outputs
+                                                                : 1.0;
     s.weight = mean > 0 ? share / mean : 0.0;
     *units += share;
     out.push_back(std::move(s));
@@ -672,7 +701,10 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
   const Eigen::MatrixXd rows = PowerLawRows(all, &names);
   const Eigen::MatrixXd u = rows.rightCols(rows.cols() - 1);
   double units = 0;
-  auto crit = CriterionStates(states, u, n, rule, &units);
+  std::array<bool, Features::kCount> gp_chosen{};
+  for (int k = 0; k < Features::kCount; ++k)
+    gp_chosen[k] = ModelOfOutput(model, k).candidate.family == family::Family::kGaussianProcess;
+  auto crit = CriterionStates(states, gp_chosen, u, n, rule, &units);
   std::vector<int> near(fill.measured.size());
   std::iota(near.begin(), near.end(), n);
   std::vector<char> taken(n, 0);
@@ -685,7 +717,8 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
     } else {
       double score = 0;
       p.candidate = BestCandidate(crit, taken, &score);
-      p.why = WhyNext(states, p.candidate, score / n / units, rule.model, d.now[p.candidate]);
+      p.why = WhyNext(states, p.candidate, score / n / units, rule.model, gp_chosen,
+                      d.now[p.candidate]);
     }
     const int j = p.candidate;
     for (int k = 0; k < Features::kCount; ++k) p.sd_now[k] = std::sqrt(initial[k].Variance(j));
