@@ -2,8 +2,11 @@
 # The grey box (both_grey, drift/grey_box.h) against the strongest sensor-free rule of each field
 # scenario, per length of the shop's history, in the project's simulator only (issue 41's
 # acceptance): thread medians over the seeds, 4 machines, 3 test days each.
-# Usage: scripts/grey_acceptance.sh [--weeks "1 2 4 8"] [--seeds 5] [--threads 2]
-#                                   [--scenarios production,duty-changes,...] [--out-dir DIR]
+# Usage: scripts/grey_acceptance.sh [--weeks "1 2 4 8"] [--seeds 5] [--first-seed 1]
+#                                   [--threads 2] [--scenarios production,duty-changes,...]
+#                                   [--out-dir DIR]
+# Seeds S..S+N-1 with S = --first-seed (default 1) and N = --seeds (1..20): a confirmation run
+# takes seeds no tuning run has used (e.g. --first-seed 101).
 # A week is 5 production days of history (--past-days 5 x weeks; at most 8 weeks = 40 days). Writes DIR/weeks_<w>.md (the evaluation's
 # Markdown) and prints one table: per weeks and scenario the strongest sensor-free row and its
 # thread median, both_shop, both_grey, the gain of both_grey (1 - grey / sensor-free), the seeds
@@ -14,6 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
 seeds=5
+first_seed=1
 threads=2
 scenarios="production,duty-changes,interrupted-starts,unconditioned-hall"
 out_dir=""
@@ -21,13 +25,19 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --weeks) weeks="$2"; shift 2 ;;
     --seeds) seeds="$2"; shift 2 ;;
+    --first-seed) first_seed="$2"; shift 2 ;;
     --threads) threads="$2"; shift 2 ;;
     --scenarios) scenarios="$2"; shift 2 ;;
     --out-dir) out_dir="$2"; shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+[[ "$first_seed" =~ ^[1-9][0-9]{0,8}$ ]] ||
+  { echo "grey_acceptance.sh: --first-seed holds '$first_seed': must be an integer 1..999999999" >&2
+    exit 2; }
+[[ "$seeds" =~ ^[1-9][0-9]?$ ]] && [ "$seeds" -le 20 ] ||
+  { echo "grey_acceptance.sh: --seeds holds '$seeds': must be an integer 1..20" >&2; exit 2; }
 for w in $weeks; do
   case "$w" in
     [1-8]) ;;
@@ -40,7 +50,7 @@ whirl="${WHIRL_BUILD_DIR:-build}/whirl"
 [ -n "$out_dir" ] || out_dir="$(mktemp -d)"
 mkdir -p "$out_dir"
 for w in $weeks; do
-  "$whirl" machine evaluate --scenarios "$scenarios" --seeds "$seeds" --machines 4 \
+  "$whirl" machine evaluate --scenarios "$scenarios" --seed "$first_seed" --seeds "$seeds" --machines 4 \
     --test-days 3 --past-days $((5 * w)) --threads "$threads" --markdown \
     > "$out_dir/weeks_$w.md" 2> "$out_dir/weeks_$w.log"
 done
@@ -79,4 +89,4 @@ for w in weeks:
               f"| {rows.get((sc, 'both_grey'), float('nan')):.1f} | {gain:+.1f} % | {won} of {n} "
               f"| {crit} | {holds} |")
 PY
-echo "(simulator only; the evaluations' tables: $out_dir)"
+echo "(simulator only; seeds $first_seed..$((first_seed + seeds - 1)); the evaluations' tables: $out_dir)"
