@@ -371,7 +371,7 @@ void RegisterDesign(CLI::App& app) {
                   "next screws: whose variance the picks reduce: power-gp (a GP on the "
                   "standardized log inputs whose mean is the power law: the power law plus a "
                   "smooth departure, given the --measured screws; needs --measured), chosen (the "
-                  "model's chosen family's own variance), sum (both, weighed equally) or auto (per "
+                  "model's chosen family's own variance), sum (both, weighed equally), auto (per "
                   "output the chosen family's where cross-validation chose a GP, else power-gp; "
                   "needs --measured) or switch (per output the chosen family's while the power "
                   "law fits the --measured screws' targets, power-gp once they depart from it: "
@@ -389,8 +389,8 @@ void RegisterDesign(CLI::App& app) {
       ->capture_default_str()
       ->check(PositiveNumber("sd"));
   sub->add_option("--switch-ratio", o->switch_ratio,
-                  "--variance switch: an output departs from the power law when the power law's "
-                  "leave-one-out RMSE over the power-gp's exceeds this [ratio]")
+                  "with --variance switch: an output departs from the power law when the power "
+                  "law's leave-one-out RMSE over the power-gp's exceeds this [ratio]")
       ->capture_default_str()
       ->check(PositiveNumber());
   sub->add_option("--model", o->model_path,

@@ -59,7 +59,8 @@ for p in d["picks"]:
 for k in ("max_elongation_um", "settle_time_s"):
     assert d["rms_sd_after"][k] <= d["rms_sd_now"][k] + 1e-12
 assert d["stop"]["decision"] == "floor", d["stop"]
-assert d["variance"] == "power-gp" and all("smooth departure" in p["why"] for p in d["picks"])
+assert d["variance"] == "switch" and "lack_of_fit_ratio" in d, d  # the default
+assert all("leave-one-out error ratio" in p["why"] for p in d["picks"])
 PY
 # A --measured table that is not the model's training table gets a note.
 head -9 cands.csv > nine.csv
@@ -187,8 +188,10 @@ CSV
 expect_fail "needs --measured" "$whirl" design --model m.json --candidates cands.csv --count 2 \
   --space-filling 1
 expect_fail "--measured needs --model" "$whirl" design "${ranges[@]}" --count 8 --measured "$data"
-expect_fail "power-gp needs --measured" "$whirl" design --model m.json --candidates cands.csv \
+expect_fail "switch needs --measured" "$whirl" design --model m.json --candidates cands.csv \
   --count 2
+expect_fail "power-gp needs --measured" "$whirl" design --model m.json --candidates cands.csv \
+  --count 2 --variance power-gp
 expect_fail "auto needs --measured" "$whirl" design --model m.json --candidates cands.csv \
   --count 2 --variance auto
 cut -d, -f1-5 cands.csv > inputs_only.csv

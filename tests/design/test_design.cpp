@@ -236,8 +236,9 @@ TEST(Design, NextScrewsLowerTheVarianceAndStopRuleDecides) {
   workpiece::TrainOptions o;
   const auto model = workpiece::TrainWorkpieceModel(t, o, "whirling_train.csv");
   const auto cands = GridCandidates(PaperRanges(), 2);
-  SpaceFilling measured;  // the default rule (power-gp) is conditioned on the measured screws
+  SpaceFilling measured;  // the default rule (switch) judges the measured screws and targets
   measured.measured = t.inputs;
+  measured.measured_targets = t.targets;
   const NextDesign d = DesignNext(model, cands, 4, {}, {}, measured);
   ASSERT_EQ(d.picks.size(), 4u);
   std::set<int> seen;
@@ -268,9 +269,11 @@ TEST(Design, NextSpaceFillingPicksKeepAwayFromTheMeasured) {
   SpaceFilling fill;
   fill.screws = 2;
   fill.measured = t.inputs;
+  fill.measured_targets = t.targets;
   const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill);
   SpaceFilling measured;
   measured.measured = t.inputs;
+  measured.measured_targets = t.targets;
   const NextDesign plain = DesignNext(model, cands, 1, {}, {}, measured);
   ASSERT_EQ(d.picks.size(), 3u);
   EXPECT_EQ(d.picks[0].candidate, plain.picks[0].candidate);  // the variance pick comes first
@@ -331,7 +334,8 @@ TEST(Design, PowerGpPicksTheLargestVarianceReductionByRefit) {
     const auto measured = RandomList(rng, 9);
     SpaceFilling fill;
     fill.measured = measured;
-    const NextRule rule;  // the default: power-gp
+    NextRule rule;
+    rule.model = NextRule::Model::kPowerGp;
     const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill, rule);
     ASSERT_EQ(d.picks.size(), 3u);
     // Deterministic, distinct, inside the list.
@@ -378,33 +382,15 @@ TEST(Design, PowerGpLooksInsideTheMeasuredCorners) {
   std::vector<ProcessInputs> cands;
   for (int i : {0, 2, 6, 8}) fill.measured.push_back(grid[i]);
   for (int i : {1, 3, 4, 5, 7}) cands.push_back(grid[i]);  // the centre is cands[2]
-  const NextDesign d = DesignNext(model, cands, 2, {}, {}, fill);
+  NextRule power_gp;
+  power_gp.model = NextRule::Model::kPowerGp;
+  const NextDesign d = DesignNext(model, cands, 2, {}, {}, fill, power_gp);
   EXPECT_EQ(d.picks[0].candidate, 2);
   // The chosen family's rule (the power law on this table) has its least variance at the
   // centre and picks an edge.
   NextRule chosen;
   chosen.model = NextRule::Model::kChosen;
   EXPECT_NE(DesignNext(model, cands, 1, {}, {}, fill, chosen).picks[0].candidate, 2);
-}
-
-TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
-  const auto model = TrainedModel();
-  std::mt19937 rng(8);
-  const auto cands = RandomList(rng, 20);
-  SpaceFilling fill;
-  EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill), InputError);  // none measured
-  fill.measured = RandomList(rng, 5);  // 5 inputs: 6 needed (the power law's coefficients)
-  try {
-    DesignNext(model, cands, 1, {}, {}, fill);
-    ADD_FAILURE() << "expected an InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("at least 6 measured screws"), std::string::npos)
-        << e.what();
-  }
-  fill.measured = RandomList(rng, 6);
-  EXPECT_NO_THROW(DesignNext(model, cands, 1, {}, {}, fill));
-  EXPECT_EQ(ParseNextModel("sum"), NextRule::Model::kSum);
-  EXPECT_THROW(ParseNextModel("gp"), InputError);
 }
 
 // --variance auto follows cross-validation per output: a model whose outputs are both linear
@@ -652,6 +638,33 @@ TEST(Design, SwitchNeedsTheMeasuredTargets) {
   EXPECT_EQ(ParseNextModel("switch"), NextRule::Model::kSwitch);
   EXPECT_EQ(ToString(NextRule::Model::kSwitch), "switch");
   EXPECT_EQ(ToString(NextRule::Model::kAuto), "auto");
+}
+
+TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(8);
+  const auto cands = RandomList(rng, 20);
+  NextRule power_gp;
+  power_gp.model = NextRule::Model::kPowerGp;
+  for (const NextRule& rule : {power_gp, NextRule{}}) {  // NextRule{}: the default, switch
+    SpaceFilling fill;
+    EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule), InputError);  // none measured
+    fill.measured = RandomList(rng, 5);  // 5 inputs: 6 needed (the power law's coefficients)
+    fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);
+    try {
+      DesignNext(model, cands, 1, {}, {}, fill, rule);
+      ADD_FAILURE() << "expected an InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("at least 6 measured screws"), std::string::npos)
+          << e.what();
+    }
+    fill.measured = RandomList(rng, 6);
+    fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);
+    EXPECT_NO_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule));
+  }
+  EXPECT_EQ(NextRule{}.model, NextRule::Model::kSwitch);
+  EXPECT_EQ(ParseNextModel("sum"), NextRule::Model::kSum);
+  EXPECT_THROW(ParseNextModel("gp"), InputError);
 }
 
 }  // namespace

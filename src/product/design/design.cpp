@@ -672,10 +672,10 @@ namespace {
 // Per output, whether the rule uses the chosen family's own variance (design.h, NextRule);
 // gp_chosen[k]: cross-validation chose a GP for output k (kAuto); departure[k]: the measured
 // screws depart from the power law (kSwitch).
-std::array<bool, Features::kCount> OwnVariance(const NextRule& rule,
-                                               const std::array<bool, Features::kCount>& gp_chosen,
-                                               const std::array<bool, Features::kCount>& departure) {
-  std::array<bool, Features::kCount> own{};
+using OutputFlags = std::array<bool, Features::kCount>;
+OutputFlags OwnVariance(const NextRule& rule, const OutputFlags& gp_chosen,
+                        const OutputFlags& departure) {
+  OutputFlags own{};
   for (int k = 0; k < Features::kCount; ++k) {
     switch (rule.model) {
       case NextRule::Model::kChosen:
