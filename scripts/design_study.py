@@ -135,8 +135,8 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
     if first_lhs is not None:
         picked = list(first_lhs)
     else:
-        hyper = [a for f, v in zip(variance[::2], variance[1::2]) if f != "--variance"
-                 for a in (f, v)] if variance else []
+        hyper = [a for f, v in zip(variance[::2], variance[1::2])
+                 if f not in ("--variance", "--switch-ratio") for a in (f, v)] if variance else []
         out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
                               "--criterion", criterion, "--space-filling", str(fill_first),
                               "--json"] + hyper + inside))
@@ -154,7 +154,7 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
         cand = os.path.join(ev.tmp, "left.csv")
         bp.write_table(cand, ev.x[left])
         measured = os.path.join(ev.tmp, "measured.csv")
-        bp.write_table(measured, ev.x[picked])
+        bp.write_table(measured, ev.x[picked], ev.y[picked])  # targets: --variance switch
         fill = min(fill_next, k)
         out = json.loads(run([ev.whirl, "design", "--model", model, "--candidates", cand,
                               "--count", str(k), "--space-filling", str(fill), "--measured",
@@ -185,7 +185,7 @@ def variance_args(a):
     """The next screws' `whirl design` options given to the study (none: the defaults)."""
     out = []
     for flag, v in (("--variance", a.variance), ("--departure-ratio", a.departure_ratio),
-                    ("--length-scale", a.length_scale)):
+                    ("--length-scale", a.length_scale), ("--switch-ratio", a.switch_ratio)):
         if v is not None:
             out += [flag, str(v)]
     return out
@@ -373,6 +373,7 @@ def main():
                     "whirl design's)")
     ap.add_argument("--departure-ratio", type=float, help="whirl design --departure-ratio")
     ap.add_argument("--length-scale", type=float, help="whirl design --length-scale")
+    ap.add_argument("--switch-ratio", type=float, help="whirl design --switch-ratio")
     ap.add_argument("--inside", type=int, help="whirl design --inside of the first design")
     ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
     ap.add_argument("--design-only", action="store_true", help="only the design strategy")

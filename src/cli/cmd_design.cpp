@@ -28,6 +28,7 @@ struct DesignCliOptions {
   std::string criterion = "d", variance = design::ToString(design::NextRule{}.model);
   double departure_ratio = design::NextRule{}.departure_ratio;
   double length_scale = design::NextRule{}.length_scale;
+  double switch_ratio = design::NextRule{}.switch_ratio;
   double tolerance_um = 0, tolerance_s = 0;
   bool json = false;
 };
@@ -152,6 +153,7 @@ design::NextRule RuleOf(const DesignCliOptions& o) {
   rule.model = design::ParseNextModel(o.variance);
   rule.departure_ratio = o.departure_ratio;
   rule.length_scale = o.length_scale;
+  rule.switch_ratio = o.switch_ratio;
   return rule;
 }
 
@@ -207,8 +209,11 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
   rule.tolerance = {o.tolerance_um, o.tolerance_s};
   design::SpaceFilling fill;
   fill.screws = o.space_filling;
-  if (!o.measured_path.empty())
-    fill.measured = ReadProcessTable(o.measured_path, /*require_targets=*/false).inputs;
+  if (!o.measured_path.empty()) {
+    ProcessTable measured = ReadProcessTable(o.measured_path, /*require_targets=*/false);
+    fill.measured = std::move(measured.inputs);
+    fill.measured_targets = std::move(measured.targets);  // empty without target columns
+  }
   design::NextDesign d;
   try {
     d = design::DesignNext(model, c.inputs, o.count, rule, c.lines, fill, RuleOf(o));
@@ -235,6 +240,9 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
                                           {"settle_time_s", d.rms_sd_after[1]}}},
                         {"rms_sd_floor", {{"max_elongation_um", d.rms_sd_floor[0]},
                                           {"settle_time_s", d.rms_sd_floor[1]}}}};
+    if (o.variance == "switch")
+      j["lack_of_fit_ratio"] = {{"max_elongation_um", d.lack_of_fit_ratio[0]},
+                                {"settle_time_s", d.lack_of_fit_ratio[1]}};
     if (!d.stop.empty())
       j["stop"] = {{"decision", d.stop}, {"tolerance_um", o.tolerance_um},
                    {"tolerance_s", o.tolerance_s}, {"reason", d.stop_reason},
@@ -310,13 +318,15 @@ void RegisterDesign(CLI::App& app) {
       "shop makes: columns hardness_hrc, diameter_mm, pitch_mm, raceway_radius_mm,\n"
       "cutting_speed_m_min; other columns ignored) or from a grid over the five ranges.\n"
       "Next screws (--model M.json from 'whirl train', --measured TABLE.csv: the screws measured\n"
-      "so far): the --count candidates whose measurement most reduces the prediction variance\n"
-      "over the list (integrated variance reduction, greedy batch) of a power law with a smooth\n"
+      "so far, with their targets): the --count candidates whose measurement most reduces the\n"
+      "prediction variance over the list (integrated variance reduction, greedy batch). Whose\n"
+      "variance (--variance switch, the default): per output, the model's own while the power\n"
+      "law fits the measured screws (its leave-one-out error at most --switch-ratio times that\n"
+      "of a power law with a smooth departure), else that of the power law with a smooth\n"
       "departure (--variance power-gp: a GP on the log inputs whose mean is the power law, the\n"
-      "departure's sd --departure-ratio times the scatter, length --length-scale), each with\n"
-      "the model's predictive sd now and expected after. Why not the model's own variance\n"
-      "(--variance chosen): where the power law is chosen it sends every screw to the edges of\n"
-      "the range, and random screws beat it where the truth bends (docs/design.md).\n"
+      "departure's sd --departure-ratio times the scatter, length --length-scale), which also\n"
+      "looks inside the range, where the model's own power law sends every screw to its edges\n"
+      "(docs/design.md). Each pick with the model's predictive sd now and expected after.\n"
       "Stop rule (--tolerance-um, --tolerance-s with --model): says whether the RMS predictive\n"
       "sd over the list is within tolerance (measurements no longer pay), cannot get there\n"
       "(the scatter alone is above it), or about how many more screws it takes.\n"
@@ -355,15 +365,20 @@ void RegisterDesign(CLI::App& app) {
       ->check(NumberIn(0, 100000));
   sub->add_option("--measured", o->measured_path,
                   "with --model: the screws measured so far (CSV, five input columns; e.g. the "
-                  "training table), needed by --variance power-gp | sum | auto and --space-filling")
+                  "training table), needed by --variance power-gp | sum | auto | switch and "
+                  "--space-filling; --variance switch also needs its target columns "
+                  "max_elongation_um and settle_time_s")
       ->check(CLI::ExistingFile);
   sub->add_option("--variance", o->variance,
                   "next screws: whose variance the picks reduce: power-gp (a GP on the "
                   "standardized log inputs whose mean is the power law: the power law plus a "
                   "smooth departure, given the --measured screws; needs --measured), chosen (the "
-                  "model's chosen family's own variance), sum (both, weighed equally) or auto (per "
+                  "model's chosen family's own variance), sum (both, weighed equally), auto (per "
                   "output the chosen family's where cross-validation chose a GP, else power-gp; "
-                  "needs --measured)")
+                  "needs --measured) or switch (per output the chosen family's while the power "
+                  "law fits the --measured screws' targets, power-gp once they depart from it: "
+                  "the power law's leave-one-out RMSE of ln y over the power-gp's above "
+                  "--switch-ratio)")
       ->capture_default_str();
   sub->add_option("--departure-ratio", o->departure_ratio,
                   "power-gp (and --inside): the departure's sd over the measurement scatter's "
@@ -375,6 +390,11 @@ void RegisterDesign(CLI::App& app) {
                   "standardized over the list and the measured screws [sd]")
       ->capture_default_str()
       ->check(PositiveNumber("sd"));
+  sub->add_option("--switch-ratio", o->switch_ratio,
+                  "with --variance switch: an output departs from the power law when the power "
+                  "law's leave-one-out RMSE over the power-gp's exceeds this [ratio]")
+      ->capture_default_str()
+      ->check(PositiveNumber());
   sub->add_option("--model", o->model_path,
                   "trained family model ('whirl train' default): next screws instead of a first "
                   "design")

@@ -59,7 +59,8 @@ for p in d["picks"]:
 for k in ("max_elongation_um", "settle_time_s"):
     assert d["rms_sd_after"][k] <= d["rms_sd_now"][k] + 1e-12
 assert d["stop"]["decision"] == "floor", d["stop"]
-assert d["variance"] == "power-gp" and all("smooth departure" in p["why"] for p in d["picks"])
+assert d["variance"] == "switch" and "lack_of_fit_ratio" in d, d  # the default
+assert all("leave-one-out error ratio" in p["why"] for p in d["picks"])
 PY
 # A --measured table that is not the model's training table gets a note.
 head -9 cands.csv > nine.csv
@@ -87,6 +88,26 @@ grep -q "both outputs weighed equally" out.txt || fail "--variance auto on GPs: 
 "$whirl" design --model m_lin.json --candidates cands.csv --count 2 --variance auto \
   --measured "$data" > out.txt 2> err.txt || fail "next --variance auto: $(cat err.txt)"
 grep -q "smooth departure" out.txt || fail "--variance auto on power laws: $(cat out.txt)"
+# --variance switch: per output the chosen family's variance while the power law fits the
+# --measured screws' targets, power-gp once they depart from it; --switch-ratio decides.
+"$whirl" design --model m.json --candidates cands.csv --count 2 --variance switch \
+  --measured "$data" --json > switch.json 2> err.txt || fail "next --variance switch: $(cat err.txt)"
+python3 - switch.json <<'PY' || fail "--variance switch JSON: $(cat switch.json)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+r = d["lack_of_fit_ratio"]
+assert d["variance"] == "switch" and len(d["picks"]) == 2
+assert all(v > 0 for v in r.values()), r
+PY
+for limit in 1e-6 1e6; do
+  "$whirl" design --model m.json --candidates cands.csv --count 1 --variance switch \
+    --measured "$data" --switch-ratio $limit > "switch_$limit.txt" 2> err.txt \
+    || fail "next --variance switch --switch-ratio $limit: $(cat err.txt)"
+done
+[ "$(grep -o 'depart from the power law' switch_1e-6.txt | wc -l)" -eq 2 ] \
+  || fail "--switch-ratio 1e-6: both outputs should depart: $(cat switch_1e-6.txt)"
+[ "$(grep -o 'the power law fits' switch_1e6.txt | wc -l)" -eq 2 ] \
+  || fail "--switch-ratio 1e6: both outputs should fit: $(cat switch_1e6.txt)"
 
 # Space filling: the first design's last picks and a next batch's last pick say so; the next
 # mode keeps them away from the --measured screws (the training table here).
@@ -167,10 +188,17 @@ CSV
 expect_fail "needs --measured" "$whirl" design --model m.json --candidates cands.csv --count 2 \
   --space-filling 1
 expect_fail "--measured needs --model" "$whirl" design "${ranges[@]}" --count 8 --measured "$data"
-expect_fail "power-gp needs --measured" "$whirl" design --model m.json --candidates cands.csv \
+expect_fail "switch needs --measured" "$whirl" design --model m.json --candidates cands.csv \
   --count 2
+expect_fail "power-gp needs --measured" "$whirl" design --model m.json --candidates cands.csv \
+  --count 2 --variance power-gp
 expect_fail "auto needs --measured" "$whirl" design --model m.json --candidates cands.csv \
   --count 2 --variance auto
+cut -d, -f1-5 cands.csv > inputs_only.csv
+expect_fail "switch needs the measured screws' targets" "$whirl" design --model m.json \
+  --candidates cands.csv --count 2 --variance switch --measured inputs_only.csv
+expect_fail "switch-ratio" "$whirl" design --model m.json --candidates cands.csv --count 2 \
+  --variance switch --measured "$data" --switch-ratio 0
 expect_fail "--variance 'gp': expected 'power-gp'" "$whirl" design --model m.json \
   --candidates cands.csv --count 2 --variance gp --measured "$data"
 expect_fail "departure-ratio" "$whirl" design --model m.json --candidates cands.csv --count 2 \

@@ -236,8 +236,9 @@ TEST(Design, NextScrewsLowerTheVarianceAndStopRuleDecides) {
   workpiece::TrainOptions o;
   const auto model = workpiece::TrainWorkpieceModel(t, o, "whirling_train.csv");
   const auto cands = GridCandidates(PaperRanges(), 2);
-  SpaceFilling measured;  // the default rule (power-gp) is conditioned on the measured screws
+  SpaceFilling measured;  // the default rule (switch) judges the measured screws and targets
   measured.measured = t.inputs;
+  measured.measured_targets = t.targets;
   const NextDesign d = DesignNext(model, cands, 4, {}, {}, measured);
   ASSERT_EQ(d.picks.size(), 4u);
   std::set<int> seen;
@@ -268,9 +269,11 @@ TEST(Design, NextSpaceFillingPicksKeepAwayFromTheMeasured) {
   SpaceFilling fill;
   fill.screws = 2;
   fill.measured = t.inputs;
+  fill.measured_targets = t.targets;
   const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill);
   SpaceFilling measured;
   measured.measured = t.inputs;
+  measured.measured_targets = t.targets;
   const NextDesign plain = DesignNext(model, cands, 1, {}, {}, measured);
   ASSERT_EQ(d.picks.size(), 3u);
   EXPECT_EQ(d.picks[0].candidate, plain.picks[0].candidate);  // the variance pick comes first
@@ -331,7 +334,8 @@ TEST(Design, PowerGpPicksTheLargestVarianceReductionByRefit) {
     const auto measured = RandomList(rng, 9);
     SpaceFilling fill;
     fill.measured = measured;
-    const NextRule rule;  // the default: power-gp
+    NextRule rule;
+    rule.model = NextRule::Model::kPowerGp;
     const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill, rule);
     ASSERT_EQ(d.picks.size(), 3u);
     // Deterministic, distinct, inside the list.
@@ -378,33 +382,15 @@ TEST(Design, PowerGpLooksInsideTheMeasuredCorners) {
   std::vector<ProcessInputs> cands;
   for (int i : {0, 2, 6, 8}) fill.measured.push_back(grid[i]);
   for (int i : {1, 3, 4, 5, 7}) cands.push_back(grid[i]);  // the centre is cands[2]
-  const NextDesign d = DesignNext(model, cands, 2, {}, {}, fill);
+  NextRule power_gp;
+  power_gp.model = NextRule::Model::kPowerGp;
+  const NextDesign d = DesignNext(model, cands, 2, {}, {}, fill, power_gp);
   EXPECT_EQ(d.picks[0].candidate, 2);
   // The chosen family's rule (the power law on this table) has its least variance at the
   // centre and picks an edge.
   NextRule chosen;
   chosen.model = NextRule::Model::kChosen;
   EXPECT_NE(DesignNext(model, cands, 1, {}, {}, fill, chosen).picks[0].candidate, 2);
-}
-
-TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
-  const auto model = TrainedModel();
-  std::mt19937 rng(8);
-  const auto cands = RandomList(rng, 20);
-  SpaceFilling fill;
-  EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill), InputError);  // none measured
-  fill.measured = RandomList(rng, 5);  // 5 inputs: 6 needed (the power law's coefficients)
-  try {
-    DesignNext(model, cands, 1, {}, {}, fill);
-    ADD_FAILURE() << "expected an InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("at least 6 measured screws"), std::string::npos)
-        << e.what();
-  }
-  fill.measured = RandomList(rng, 6);
-  EXPECT_NO_THROW(DesignNext(model, cands, 1, {}, {}, fill));
-  EXPECT_EQ(ParseNextModel("sum"), NextRule::Model::kSum);
-  EXPECT_THROW(ParseNextModel("gp"), InputError);
 }
 
 // --variance auto follows cross-validation per output: a model whose outputs are both linear
@@ -477,6 +463,208 @@ TEST(Design, InsidePicksReduceThePowerGpVarianceMostAfterTheOptimalOnes) {
   EXPECT_EQ(DesignPowerLaw(list, 7, Criterion::kD, 0, kInsideAuto).inside, 1);
   EXPECT_EQ(DesignPowerLaw(list, 6, Criterion::kD, 0, kInsideAuto).inside, 0);
   EXPECT_EQ(DesignPowerLaw(list, 8, Criterion::kD, 1, kInsideAuto).inside, 1);
+}
+
+// --variance switch (design.h, NextRule::kSwitch). The leave-one-out residual of screw i, refitted
+// from scratch on the other screws: the power law by least squares, the power-GP by its
+// posterior mean (universal kriging, the same hyperparameters).
+double RefitResidual(const Eigen::MatrixXd& z, const Eigen::VectorXd& y, int i, bool power_gp,
+                     const NextRule& rule) {
+  const int m = static_cast<int>(z.rows()), d = static_cast<int>(z.cols());
+  Eigen::MatrixXd zr(m - 1, d);
+  Eigen::VectorXd yr(m - 1);
+  for (int r = 0, q = 0; r < m; ++r)
+    if (r != i) zr.row(q) = z.row(r), yr(q++) = y(r);
+  if (!power_gp) {
+    Eigen::MatrixXd h(m - 1, d + 1);
+    h << Eigen::VectorXd::Ones(m - 1), zr;
+    const Eigen::VectorXd b = h.colPivHouseholderQr().solve(yr);
+    return y(i) - (b(0) + z.row(i).dot(b.tail(d)));
+  }
+  gp::Gp g;
+  g.kernel = gp::Kernel::kMatern52;
+  g.mean = gp::Mean::kLinear;
+  g.input_shift = Eigen::VectorXd::Zero(d);
+  g.input_scale = Eigen::VectorXd::Ones(d);
+  g.theta = Eigen::VectorXd::Zero(d + 2);
+  g.theta.head(d).setConstant(std::log(rule.length_scale));
+  g.theta(d) = std::log(rule.departure_ratio);
+  g.z = zr.transpose();
+  g.u = yr;
+  g.Factorize();
+  return y(i) - gp::PredictGp(g, z.row(i).transpose()).mean(0);
+}
+
+// ln y of a power law in the standardized log inputs z, plus a smooth bump of size `bump`
+// around the centre and noise of sd `noise`.
+Eigen::VectorXd LogTargets(const Eigen::MatrixXd& z, double bump, double noise, std::mt19937& rng) {
+  std::normal_distribution<double> e(0, 1);
+  Eigen::VectorXd y(z.rows());
+  for (Eigen::Index i = 0; i < z.rows(); ++i)
+    y(i) = 3 + 0.5 * z(i, 0) - 0.3 * z(i, 1) + 0.2 * z(i, 2) +
+           bump * std::exp(-z.row(i).squaredNorm() / 2) + noise * e(rng);
+  return y;
+}
+
+TEST(Design, SwitchLackOfFitMatchesLeaveOneOutRefits) {
+  std::mt19937 rng(31);
+  std::normal_distribution<double> e(0, 1);
+  const NextRule rule;
+  for (int t = 0; t < 4; ++t) {
+    Eigen::MatrixXd z(12 + 4 * t, 5);
+    for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = e(rng);
+    const Eigen::VectorXd y = LogTargets(z, 0.3 * t, 0.05, rng);
+    double s0 = 0, s1 = 0;
+    for (int i = 0; i < z.rows(); ++i) {
+      s0 += std::pow(RefitResidual(z, y, i, false, rule), 2);
+      s1 += std::pow(RefitResidual(z, y, i, true, rule), 2);
+    }
+    const LackOfFit f = PowerLawLackOfFit(z, y, rule);
+    EXPECT_EQ(f.rows, z.rows());
+    EXPECT_NEAR(f.power_law_rmse, std::sqrt(s0 / z.rows()), 1e-6 * f.power_law_rmse);
+    // The closed form carries gp::Gp's noise floor (1e-6 of the scatter's variance).
+    EXPECT_NEAR(f.power_gp_rmse, std::sqrt(s1 / z.rows()), 1e-5 * f.power_gp_rmse);
+    EXPECT_NEAR(f.ratio, f.power_law_rmse / f.power_gp_rmse, 1e-12);
+  }
+}
+
+TEST(Design, SwitchLackOfFitSeesTheDepartureNotTheNoise) {
+  std::mt19937 rng(32);
+  std::normal_distribution<double> e(0, 1);
+  // A power law with scatter: the departure mostly follows noise and predicts worse (the ratio
+  // scatters around 0.9 at 30 screws, above 1 about one time in five); a bump of 1 (a factor e
+  // at the centre) with 3 % scatter: the power law misses it every time.
+  int above_null = 0;
+  for (int t = 0; t < 20; ++t) {
+    Eigen::MatrixXd z(30, 5);
+    for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = e(rng);
+    above_null += PowerLawLackOfFit(z, LogTargets(z, 0, t % 2 ? 0.03 : 0.15, rng), {}).ratio > 1;
+    EXPECT_GT(PowerLawLackOfFit(z, LogTargets(z, 1.0, 0.03, rng), {}).ratio, 1.25) << t;
+  }
+  EXPECT_LE(above_null, 8);
+  // Six screws, five inputs: every leverage is 1, nothing is left out: no evidence.
+  Eigen::MatrixXd z(6, 5);
+  for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = e(rng);
+  const LackOfFit none = PowerLawLackOfFit(z, LogTargets(z, 1.0, 0.03, rng), {});
+  EXPECT_EQ(none.rows, 0);
+  EXPECT_EQ(none.ratio, 0.0);
+  EXPECT_THROW(PowerLawLackOfFit(z.topRows(5), Eigen::VectorXd::Ones(5), {}), InputError);
+}
+
+// Targets of `measured` with ln y = the power law of LogTargets (+ bump) on their own
+// standardized log inputs, both outputs alike (levels of the simulator's: 20 um, 100 s).
+std::vector<Features> MeasuredTargets(const std::vector<ProcessInputs>& measured, double bump,
+                                      std::mt19937& rng) {
+  const Eigen::MatrixXd z = LogUnits(measured);
+  const Eigen::VectorXd y = LogTargets(z, bump, 0.03, rng);
+  std::vector<Features> out;
+  for (Eigen::Index i = 0; i < z.rows(); ++i)
+    out.push_back(Features::FromArray({std::exp(y(i) - 3) * 20, std::exp(y(i) - 3) * 100}));
+  return out;
+}
+
+TEST(Design, SwitchUsesTheChosenVarianceWhileThePowerLawFits) {
+  const auto model = TrainedModel();  // the power law on both outputs
+  std::mt19937 rng(33);
+  using M = NextRule::Model;
+  int fits = 0, departs = 0;
+  for (int t = 0; t < 6; ++t) {
+    const auto cands = RandomList(rng, 50);
+    SpaceFilling fill;
+    fill.measured = RandomList(rng, 30);
+    const auto power_gp = PickedBy(model, cands, fill, M::kPowerGp);
+    const auto chosen = PickedBy(model, cands, fill, M::kChosen);
+    ASSERT_NE(power_gp, chosen);  // else the checks below could not tell the rules apart
+    fill.measured_targets = MeasuredTargets(fill.measured, t % 2 ? 1.0 : 0.0, rng);
+    NextRule rule;
+    rule.model = M::kSwitch;
+    const NextDesign d = DesignNext(model, cands, 4, {}, {}, fill, rule);
+    std::vector<int> picked;
+    for (const auto& p : d.picks) picked.push_back(p.candidate);
+    // Both outputs share ln y up to a constant: one ratio, one side of the threshold; it is
+    // the lack of fit on the measured screws' rows of the log inputs standardized over list
+    // and measured screws.
+    std::vector<ProcessInputs> all = cands;
+    all.insert(all.end(), fill.measured.begin(), fill.measured.end());
+    Eigen::VectorXd ln_y(30);
+    for (int i = 0; i < 30; ++i) ln_y(i) = std::log(fill.measured_targets[i].ToArray()[0]);
+    const double ratio = PowerLawLackOfFit(LogUnits(all).bottomRows(30), ln_y, rule).ratio;
+    EXPECT_NEAR(d.lack_of_fit_ratio[0], ratio, 1e-9 * ratio);
+    EXPECT_NEAR(d.lack_of_fit_ratio[1], ratio, 1e-9 * ratio);
+    const bool departure = ratio > rule.switch_ratio;
+    EXPECT_EQ(picked, departure ? power_gp : chosen) << "ratio " << ratio;
+    if (t % 2) {
+      EXPECT_TRUE(departure) << "a bump of 1, ratio " << ratio;
+    }
+    fits += !departure, departs += departure;
+    EXPECT_NE(d.picks[0].why.find(departure ? "depart from the power law" : "power law fits"),
+              std::string::npos) << d.picks[0].why;
+    // The threshold decides: far above every ratio, the chosen family's; far below, power-gp.
+    rule.switch_ratio = 1e9;
+    std::vector<int> high, low;
+    for (const auto& p : DesignNext(model, cands, 4, {}, {}, fill, rule).picks)
+      high.push_back(p.candidate);
+    rule.switch_ratio = 1e-9;
+    for (const auto& p : DesignNext(model, cands, 4, {}, {}, fill, rule).picks)
+      low.push_back(p.candidate);
+    EXPECT_EQ(high, chosen);
+    EXPECT_EQ(low, power_gp);
+  }
+  EXPECT_GE(fits, 1);  // both sides seen
+  EXPECT_GE(departs, 3);
+}
+
+TEST(Design, SwitchNeedsTheMeasuredTargets) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(34);
+  const auto cands = RandomList(rng, 20);
+  SpaceFilling fill;
+  fill.measured = RandomList(rng, 10);
+  NextRule rule;
+  rule.model = NextRule::Model::kSwitch;
+  try {
+    DesignNext(model, cands, 1, {}, {}, fill, rule);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("targets"), std::string::npos) << e.what();
+  }
+  fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);
+  EXPECT_NO_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule));
+  fill.measured_targets[3] = Features::FromArray({0.0, 100.0});
+  EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule), InputError);
+  rule.switch_ratio = 0;
+  fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);
+  EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule), InputError);
+  EXPECT_EQ(ParseNextModel("switch"), NextRule::Model::kSwitch);
+  EXPECT_EQ(ToString(NextRule::Model::kSwitch), "switch");
+  EXPECT_EQ(ToString(NextRule::Model::kAuto), "auto");
+}
+
+TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(8);
+  const auto cands = RandomList(rng, 20);
+  NextRule power_gp;
+  power_gp.model = NextRule::Model::kPowerGp;
+  for (const NextRule& rule : {power_gp, NextRule{}}) {  // NextRule{}: the default, switch
+    SpaceFilling fill;
+    EXPECT_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule), InputError);  // none measured
+    fill.measured = RandomList(rng, 5);  // 5 inputs: 6 needed (the power law's coefficients)
+    fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);
+    try {
+      DesignNext(model, cands, 1, {}, {}, fill, rule);
+      ADD_FAILURE() << "expected an InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("at least 6 measured screws"), std::string::npos)
+          << e.what();
+    }
+    fill.measured = RandomList(rng, 6);
+    fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);
+    EXPECT_NO_THROW(DesignNext(model, cands, 1, {}, {}, fill, rule));
+  }
+  EXPECT_EQ(NextRule{}.model, NextRule::Model::kSwitch);
+  EXPECT_EQ(ParseNextModel("sum"), NextRule::Model::kSum);
+  EXPECT_THROW(ParseNextModel("gp"), InputError);
 }
 
 }  // namespace

@@ -292,13 +292,12 @@ std::array<OutputState, Features::kCount> States(const workpiece::WorkpieceModel
 // coefficients), an isotropic Matern 5/2 departure of sd rule.departure_ratio and length
 // rule.length_scale, conditioned on the measured screws (rows n.. of u) with scatter sd 1.
 // Targets do not enter a GP's covariance, so none are needed.
-OutputState PowerGpState(const Eigen::MatrixXd& u, int n, const NextRule& rule) {
-  const int d = static_cast<int>(u.cols());
-  const int m = static_cast<int>(u.rows()) - n;
-  if (m < d + 1)
-    throw InputError("the power-GP rule needs at least " + std::to_string(d + 1) +
-                     " measured screws (--measured: the power law's coefficients), got " +
-                     std::to_string(m));
+// The power-GP of NextRule on the screws z (d x m, standardized log inputs) with targets y (m):
+// power-law mean, flat prior on its coefficients, Matern 5/2 departure of sd `ratio` (scatter sd
+// 1) and length rule.length_scale. InputError (collinear screws) from Factorize.
+gp::Gp PowerGp(const Eigen::MatrixXd& z, const Eigen::VectorXd& y, double ratio,
+               const NextRule& rule) {
+  const int d = static_cast<int>(z.rows());
   gp::Gp g;
   g.kernel = gp::Kernel::kMatern52;
   g.mean = gp::Mean::kLinear;
@@ -306,14 +305,40 @@ OutputState PowerGpState(const Eigen::MatrixXd& u, int n, const NextRule& rule) 
   g.input_scale = Eigen::VectorXd::Ones(d);
   g.theta = Eigen::VectorXd::Zero(d + 2);
   g.theta.head(d).setConstant(std::log(rule.length_scale));
-  g.theta(d) = std::log(rule.departure_ratio);
-  g.z = u.bottomRows(m).transpose();
-  g.u = Eigen::VectorXd::Zero(m);
+  g.theta(d) = std::log(ratio);
+  g.z = z;
+  g.u = y;
+  g.Factorize();
+  return g;
+}
+
+int CheckMeasuredCount(int m, int d) {
+  if (m < d + 1)
+    throw InputError("the power-GP rule needs at least " + std::to_string(d + 1) +
+                     " measured screws (--measured: the power law's coefficients), got " +
+                     std::to_string(m));
+  return m;
+}
+
+// P_ii at or below which a screw's leave-one-out is undetermined (PowerLawLackOfFit; the scatter's
+// variance is 1, so the power law alone has P_ii = 1 - leverage).
+constexpr double kUndetermined = 1e-9;
+
+// The departure's sd of "the power law alone" in PowerLawLackOfFit: K = I up to 1e-12.
+constexpr double kPowerLawOnlyRatio = 1e-6;
+
+const char* kCollinear =
+    "the measured screws (--measured) do not determine a power law (their log inputs are "
+    "collinear); the power-GP rule needs them spread in every input";
+
+OutputState PowerGpState(const Eigen::MatrixXd& u, int n, const NextRule& rule) {
+  const int d = static_cast<int>(u.cols());
+  const int m = CheckMeasuredCount(static_cast<int>(u.rows()) - n, d);
+  gp::Gp g;
   try {
-    g.Factorize();
+    g = PowerGp(u.bottomRows(m).transpose(), Eigen::VectorXd::Zero(m), rule.departure_ratio, rule);
   } catch (const InputError&) {
-    throw InputError("the measured screws (--measured) do not determine a power law (their log "
-                     "inputs are collinear); the power-GP rule needs them spread in every input");
+    throw InputError(kCollinear);
   }
   OutputState s;
   s.cov = gp::PosteriorCovariance(g, u.topRows(n).transpose());
@@ -337,12 +362,29 @@ int BestCandidate(const States& states, const std::vector<char>& taken, double* 
 
 // Why the pick j of the variance rule was made; `share` = its reduction as a fraction of the
 // criterion's mean variance over the list (design.h: each variance weighed by its mean).
+// own[k]: output k's variance is the chosen family's (NextRule); lack_of_fit: kSwitch's ratios.
 std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int j, double share,
-                    NextRule::Model model, const std::array<bool, Features::kCount>& gp_chosen,
+                    const NextRule& rule, const std::array<bool, Features::kCount>& own,
+                    const std::array<double, Features::kCount>& lack_of_fit,
                     const workpiece::Prediction& now) {
+  const NextRule::Model model = rule.model;
+  const std::array<bool, Features::kCount>& gp_chosen = own;  // kAuto: own where a GP is chosen
   const std::string pct = FormatSignificant(100 * share, 3) + " % of its mean";
   std::string why;
-  if (model == NextRule::Model::kAuto && gp_chosen[0] != gp_chosen[1]) {
+  if (model == NextRule::Model::kSwitch) {
+    why = "largest expected reduction of the prediction variance over the list (" + pct + "; ";
+    const std::string limit = FormatSignificant(rule.switch_ratio, 3);
+    for (int k = 0; k < Features::kCount; ++k) {
+      const std::string ratio = FormatSignificant(lack_of_fit[k], 3);
+      why += std::string(k ? "; " : "") + kTargetColumns[k] +
+             (own[k] ? ": the power law fits its measured screws (leave-one-out error ratio " +
+                           ratio + " <= " + limit + "), the chosen family's variance"
+                     : ": its measured screws depart from the power law (leave-one-out error "
+                       "ratio " + ratio + " > " + limit + "), a power law with a smooth "
+                       "departure's variance");
+    }
+    why += ")";
+  } else if (model == NextRule::Model::kAuto && gp_chosen[0] != gp_chosen[1]) {
     why = "largest expected reduction of the prediction variance over the list (" + pct +
           "; for " + kTargetColumns[gp_chosen[0] ? 0 : 1] + " the chosen GP's, for " +
           kTargetColumns[gp_chosen[0] ? 1 : 0] +
@@ -442,9 +484,12 @@ NextRule::Model ParseNextModel(const std::string& s) {
   if (s == "chosen") return NextRule::Model::kChosen;
   if (s == "sum") return NextRule::Model::kSum;
   if (s == "auto") return NextRule::Model::kAuto;
+  if (s == "switch") return NextRule::Model::kSwitch;
   throw InputError("--variance '" + s + "': expected 'power-gp' (a GP with a power-law mean on "
-                   "the log inputs), 'chosen' (the chosen family's), 'sum' (both) or 'auto' (per "
-                   "output the chosen GP's where cross-validation chose a GP, else power-gp)");
+                   "the log inputs), 'chosen' (the chosen family's), 'sum' (both), 'auto' (per "
+                   "output the chosen GP's where cross-validation chose a GP, else power-gp) or "
+                   "'switch' (per output the chosen family's while the power law fits the "
+                   "measured screws, else power-gp)");
 }
 
 std::string ToString(NextRule::Model m) {
@@ -452,9 +497,10 @@ std::string ToString(NextRule::Model m) {
     case NextRule::Model::kPowerGp: return "power-gp";
     case NextRule::Model::kChosen: return "chosen";
     case NextRule::Model::kSum: return "sum";
-    case NextRule::Model::kAuto: break;
+    case NextRule::Model::kAuto: return "auto";
+    case NextRule::Model::kSwitch: break;
   }
-  return "auto";
+  return "switch";
 }
 
 void InputRanges::Validate(const std::array<const char*, ProcessInputs::kCount>& flags) const {
@@ -623,36 +669,70 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
 
 namespace {
 
+// Per output, whether the rule uses the chosen family's own variance (design.h, NextRule);
+// gp_chosen[k]: cross-validation chose a GP for output k (kAuto); departure[k]: the measured
+// screws depart from the power law (kSwitch).
+using OutputFlags = std::array<bool, Features::kCount>;
+OutputFlags OwnVariance(const NextRule& rule, const OutputFlags& gp_chosen,
+                        const OutputFlags& departure) {
+  OutputFlags own{};
+  for (int k = 0; k < Features::kCount; ++k) {
+    switch (rule.model) {
+      case NextRule::Model::kChosen:
+      case NextRule::Model::kSum: own[k] = true; break;
+      case NextRule::Model::kPowerGp: own[k] = false; break;
+      case NextRule::Model::kAuto: own[k] = gp_chosen[k]; break;
+      case NextRule::Model::kSwitch: own[k] = !departure[k]; break;
+    }
+  }
+  return own;
+}
+
 // The states the picks are made with (design.h, NextRule), each weighed by its mean variance
 // over the list; *units = the number of variances of equal weight (for WhyNext's share).
-// gp_chosen[k]: cross-validation chose a GP for output k (NextRule::kAuto).
 std::vector<OutputState> CriterionStates(const std::array<OutputState, Features::kCount>& model,
-                                         const std::array<bool, Features::kCount>& gp_chosen,
+                                         const std::array<bool, Features::kCount>& own,
                                          const Eigen::MatrixXd& u, int n, const NextRule& rule,
                                          double* units) {
   std::vector<OutputState> out;
-  int linear_outputs = 0;
+  int power_gp_outputs = 0;
   for (int k = 0; k < Features::kCount; ++k) {
-    const bool own = rule.model == NextRule::Model::kChosen ||
-                     rule.model == NextRule::Model::kSum ||
-                     (rule.model == NextRule::Model::kAuto && gp_chosen[k]);
-    if (own) out.push_back(model[k]);
-    linear_outputs += !gp_chosen[k];
+    if (own[k]) out.push_back(model[k]);
+    power_gp_outputs += !own[k];
   }
   *units = static_cast<double>(out.size());
-  const bool power_gp = rule.model == NextRule::Model::kPowerGp ||
-                        rule.model == NextRule::Model::kSum ||
-                        (rule.model == NextRule::Model::kAuto && linear_outputs > 0);
-  if (power_gp) {
+  const bool sum = rule.model == NextRule::Model::kSum;
+  if (sum || power_gp_outputs > 0) {
     OutputState s = PowerGpState(u, n, rule);
     const double mean = s.cov.diagonal().mean();
-    // kAuto: the power-GP stands in for each output whose chosen family is linear.
-    const double share = rule.model == NextRule::Model::kSum    ? Features::kCount
-                         : rule.model == NextRule::Model::kAuto ? linear_outputs
-                                                                : 1.0;
+    // kAuto, kSwitch: the power-GP stands in for each output that does not use its own.
+    const double share = sum                                    ? Features::kCount
+                         : rule.model == NextRule::Model::kPowerGp ? 1.0
+                                                                   : power_gp_outputs;
     s.weight = mean > 0 ? share / mean : 0.0;
     *units += share;
     out.push_back(std::move(s));
+  }
+  return out;
+}
+
+// kSwitch's figures per output from the measured screws' rows z of u and their targets.
+std::array<LackOfFit, Features::kCount> MeasuredLackOfFit(const Eigen::MatrixXd& z,
+                                                          const std::vector<Features>& targets,
+                                                          const NextRule& rule) {
+  std::array<LackOfFit, Features::kCount> out;
+  const Eigen::Index m = z.rows();
+  for (int k = 0; k < Features::kCount; ++k) {
+    Eigen::VectorXd ln_y(m);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const double y = targets[static_cast<std::size_t>(i)].ToArray()[k];
+      if (!(y > 0) || !std::isfinite(y))
+        throw InputError("design --variance switch: measured screw " + std::to_string(i + 1) +
+                         " has " + kTargetColumns[k] + " = " + FormatSignificant(y, 6) +
+                         "; the power law's fit needs positive targets");
+      ln_y(i) = std::log(y);
+    }
+    out[k] = PowerLawLackOfFit(z, ln_y, rule);
   }
   return out;
 }
@@ -675,9 +755,56 @@ void CheckNextArguments(int n, int count, const SpaceFilling& fill, const NextRu
   if (!(rule.departure_ratio > 0) || !(rule.length_scale > 0) ||
       !std::isfinite(rule.departure_ratio) || !std::isfinite(rule.length_scale))
     throw InputError("design: --departure-ratio and --length-scale must be finite and positive");
+  if (!(rule.switch_ratio > 0) || !std::isfinite(rule.switch_ratio))
+    throw InputError("design: --switch-ratio must be finite and positive");
+  if (rule.model == NextRule::Model::kSwitch &&
+      fill.measured_targets.size() != fill.measured.size())
+    throw InputError("design --variance switch needs the measured screws' targets (--measured "
+                     "with the columns " + std::string(kTargetColumns[0]) + " and " +
+                     kTargetColumns[1] + ", e.g. the model's training table): it judges the "
+                     "power law's fit to them");
 }
 
 }  // namespace
+
+LackOfFit PowerLawLackOfFit(const Eigen::MatrixXd& z, const Eigen::VectorXd& ln_y,
+                            const NextRule& rule) {
+  const int m = CheckMeasuredCount(static_cast<int>(z.rows()), static_cast<int>(z.cols()));
+  if (ln_y.size() != m) throw InputError("design: lack of fit: screws and targets differ in count");
+  LackOfFit f;
+  const double mean = ln_y.mean();
+  const double sd = std::sqrt((ln_y.array() - mean).square().mean());
+  if (!(sd > 0)) return f;  // constant targets: the power law fits exactly
+  const Eigen::VectorXd y = (ln_y.array() - mean) / sd;
+  std::array<gp::LeaveOneOut, 2> loo;
+  std::array<Eigen::ArrayXd, 2> p;  // P_ii
+  std::array<double, 2> ratios = {kPowerLawOnlyRatio, rule.departure_ratio};
+  for (int v = 0; v < 2; ++v) {
+    gp::Gp g;
+    try {
+      g = PowerGp(z.transpose(), y, ratios[v], rule);
+    } catch (const InputError&) {
+      throw InputError(kCollinear);
+    }
+    loo[v] = gp::LeaveOneOutGp(g);
+    p[v] = 1.0 / (loo[v].latent_variance.array() + g.SigmaN2());
+  }
+  double sum0 = 0, sum1 = 0;
+  for (int i = 0; i < m; ++i) {
+    bool ok = true;
+    for (int v = 0; v < 2; ++v)
+      ok = ok && p[v](i) > kUndetermined && std::isfinite(loo[v].residual(i));
+    if (!ok) continue;
+    ++f.rows;
+    sum0 += loo[0].residual(i) * loo[0].residual(i);
+    sum1 += loo[1].residual(i) * loo[1].residual(i);
+  }
+  if (f.rows < 2) return f;
+  f.power_law_rmse = sd * std::sqrt(sum0 / f.rows);
+  f.power_gp_rmse = sd * std::sqrt(sum1 / f.rows);
+  f.ratio = f.power_gp_rmse > 0 ? f.power_law_rmse / f.power_gp_rmse : 0.0;
+  return f;
+}
 
 NextDesign DesignNext(const workpiece::WorkpieceModel& model,
                       const std::vector<ProcessInputs>& cands, int count, const StopRule& stop,
@@ -701,10 +828,18 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
   const Eigen::MatrixXd rows = PowerLawRows(all, &names);
   const Eigen::MatrixXd u = rows.rightCols(rows.cols() - 1);
   double units = 0;
-  std::array<bool, Features::kCount> gp_chosen{};
+  std::array<bool, Features::kCount> gp_chosen{}, departure{};
   for (int k = 0; k < Features::kCount; ++k)
     gp_chosen[k] = ModelOfOutput(model, k).candidate.family == family::Family::kGaussianProcess;
-  auto crit = CriterionStates(states, gp_chosen, u, n, rule, &units);
+  if (rule.model == NextRule::Model::kSwitch) {
+    const auto fits = MeasuredLackOfFit(u.bottomRows(u.rows() - n), fill.measured_targets, rule);
+    for (int k = 0; k < Features::kCount; ++k) {
+      d.lack_of_fit_ratio[k] = fits[k].ratio;
+      departure[k] = fits[k].ratio > rule.switch_ratio;
+    }
+  }
+  const auto own = OwnVariance(rule, gp_chosen, departure);
+  auto crit = CriterionStates(states, own, u, n, rule, &units);
   std::vector<int> near(fill.measured.size());
   std::iota(near.begin(), near.end(), n);
   std::vector<char> taken(n, 0);
@@ -717,7 +852,7 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
     } else {
       double score = 0;
       p.candidate = BestCandidate(crit, taken, &score);
-      p.why = WhyNext(states, p.candidate, score / n / units, rule.model, gp_chosen,
+      p.why = WhyNext(states, p.candidate, score / n / units, rule, own, d.lack_of_fit_ratio,
                       d.now[p.candidate]);
     }
     const int j = p.candidate;

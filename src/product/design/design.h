@@ -64,8 +64,12 @@
 // chosen family's own covariance where cross-validation chose a Gaussian process for it (the
 // measured screws showed a departure from the power law, and that GP's fitted hyperparameters
 // know its size and length), the power-GP's where it chose a linear fit (the departure is still
-// a prior guess); each output weighs equally. The reported sd now and after are always the
-// trained model's.
+// a prior guess); each output weighs equally. kSwitch: per output, the chosen family's own
+// covariance while the power law fits the measured screws, the power-GP's once they depart from
+// it (PowerLawLackOfFit: the power law's leave-one-out error over the power-GP's, both with the
+// power law's coefficients integrated out, above switch_ratio); each output weighs equally. It
+// needs the measured screws' targets. The reported sd now and after are always the trained
+// model's.
 //
 // Stop rule (StopRule): per output with a tolerance, the root mean square of the predictive sd
 // over the candidates (um, s). Measuring no longer pays when it is at or below the tolerance
@@ -74,6 +78,7 @@
 // estimates how many more screws of this list the greedy design needs to reach it (up to
 // kStopLookAhead). Evidence (designed against random, Latin hypercube and production-order
 // screws, simulator and generated families): docs/design.md.
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
@@ -113,20 +118,28 @@ struct Pick {
 /// comment, "Next screws' rule").
 struct NextRule {
   enum class Model {
-    kPowerGp,  ///< a GP on the standardized log inputs with a power-law mean (the default)
+    kPowerGp,  ///< a GP on the standardized log inputs with a power-law mean
     kChosen,   ///< the chosen family's own posterior covariance (the rule of the first attempts)
     kSum,      ///< both, each normalized by its mean variance over the list
     kAuto,     ///< per output: the chosen GP's where cross-validation chose a GP, else kPowerGp
+    kSwitch,   ///< per output: kChosen's while the power law fits the measured screws, else
+               ///< kPowerGp (the default)
   };
-  Model model = Model::kPowerGp;
+  /// The default kSwitch at switch_ratio 1.25 was chosen on the fifth attempt's tuning part
+  /// (docs/design.md) over kPowerGp, the default before it.
+  Model model = Model::kSwitch;
   /// kPowerGp / kSum: the departure's signal sd over the measurement scatter's sd, and its
   /// (isotropic Matern 5/2) length scale in log inputs standardized over list and measured.
   /// The defaults (and kPowerGp) were chosen on the third attempt's tuning part and kept by the
   /// fourth attempt's paired comparison with kChosen, kAuto and kSum (docs/design.md).
   double departure_ratio = 4.0;
   double length_scale = 2.23606797749979;  // sqrt(5)
+  /// kSwitch: an output departs from the power law when PowerLawLackOfFit's ratio exceeds this
+  /// (chosen among 0.8, 1.0 and 1.25 on the fifth attempt's tuning part, docs/design.md).
+  double switch_ratio = 1.25;
 };
-NextRule::Model ParseNextModel(const std::string& s);  ///< "power-gp" | "chosen" | "sum" | "auto"
+/// "power-gp" | "chosen" | "sum" | "auto" | "switch"; InputError otherwise
+NextRule::Model ParseNextModel(const std::string& s);
 std::string ToString(NextRule::Model m);
 
 struct PowerLawDesign {
@@ -173,14 +186,34 @@ struct NextDesign {
   std::string stop;
   int screws_to_tolerance = -1;
   std::string stop_reason;  ///< one or two sentences, with the figures
+  /// kSwitch: per output, PowerLawLackOfFit's ratio on the measured screws (else 0).
+  std::array<double, Features::kCount> lack_of_fit_ratio{};
 };
 
 /// The space-filling share of a next batch (header comment).
 struct SpaceFilling {
   int screws = 0;                        ///< the batch's last picks chosen by maximin
-  /// The screws measured so far: needed if screws > 0 and by NextRule's kPowerGp and kSum.
+  /// The screws measured so far: needed if screws > 0 and by every NextRule but kChosen.
   std::vector<ProcessInputs> measured;
+  /// Their measured targets, row-aligned with `measured`: needed by NextRule's kSwitch.
+  std::vector<Features> measured_targets;
 };
+
+/// How well the power law fits the measured screws (NextRule's kSwitch). z: the screws' log
+/// inputs (one row per screw, standardized as the power-GP rule's), ln_y: their log targets.
+/// Leave-one-out residuals in closed form ((P y)_i / P_ii, the power law's coefficients under a
+/// flat prior; gp::LeaveOneOutGp) of the power law alone and of the power-GP (NextRule's
+/// departure_ratio and length_scale; scatter variance 1); screws whose leave-one-out is
+/// undetermined (P_ii <= 1e-9 in either, e.g. leverage 1) are left out of both.
+struct LackOfFit {
+  double power_law_rmse = 0;  ///< leave-one-out RMSE of ln y, the power law alone
+  double power_gp_rmse = 0;   ///< the same, the power-GP
+  double ratio = 0;  ///< power_law_rmse / power_gp_rmse; 0 when fewer than 2 screws are determined
+  int rows = 0;      ///< screws whose leave-one-out is determined
+};
+/// InputError if z holds fewer than 1 + columns rows, or collinear ones.
+LackOfFit PowerLawLackOfFit(const Eigen::MatrixXd& z, const Eigen::VectorXd& ln_y,
+                            const NextRule& rule);
 
 /// The next screws of the header comment: `count` distinct candidates (1 <= count <=
 /// candidates) by `rule`, the last fill.screws (<= count; needs fill.measured) by maximin.
