@@ -287,11 +287,6 @@ std::array<OutputState, Features::kCount> States(const workpiece::WorkpieceModel
   return states;
 }
 
-// The power-GP rule's state (design.h, NextRule): the posterior covariance over the candidates
-// (rows 0..n-1 of u, standardized log inputs) of a GP with a power-law mean (flat prior on its
-// coefficients), an isotropic Matern 5/2 departure of sd rule.departure_ratio and length
-// rule.length_scale, conditioned on the measured screws (rows n.. of u) with scatter sd 1.
-// Targets do not enter a GP's covariance, so none are needed.
 // The power-GP of NextRule on the screws z (d x m, standardized log inputs) with targets y (m):
 // power-law mean, flat prior on its coefficients, Matern 5/2 departure of sd `ratio` (scatter sd
 // 1) and length rule.length_scale. InputError (collinear screws) from Factorize.
@@ -331,6 +326,11 @@ const char* kCollinear =
     "the measured screws (--measured) do not determine a power law (their log inputs are "
     "collinear); the power-GP rule needs them spread in every input";
 
+// The power-GP rule's state (design.h, NextRule): the posterior covariance over the candidates
+// (rows 0..n-1 of u, standardized log inputs) of a GP with a power-law mean (flat prior on its
+// coefficients), an isotropic Matern 5/2 departure of sd rule.departure_ratio and length
+// rule.length_scale, conditioned on the measured screws (rows n.. of u) with scatter sd 1.
+// Targets do not enter a GP's covariance, so none are needed.
 OutputState PowerGpState(const Eigen::MatrixXd& u, int n, const NextRule& rule) {
   const int d = static_cast<int>(u.cols());
   const int m = CheckMeasuredCount(static_cast<int>(u.rows()) - n, d);
