@@ -136,7 +136,8 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
         picked = list(first_lhs)
     else:
         hyper = [a for f, v in zip(variance[::2], variance[1::2])
-                 if f not in ("--variance", "--switch-ratio") for a in (f, v)] if variance else []
+                 if f not in ("--variance", "--switch-ratio", "--space-filling-when")
+                 for a in (f, v)] if variance else []
         out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
                               "--criterion", criterion, "--space-filling", str(fill_first),
                               "--json"] + hyper + inside))
@@ -185,7 +186,9 @@ def variance_args(a):
     """The next screws' `whirl design` options given to the study (none: the defaults)."""
     out = []
     for flag, v in (("--variance", a.variance), ("--departure-ratio", a.departure_ratio),
-                    ("--length-scale", a.length_scale), ("--switch-ratio", a.switch_ratio)):
+                    ("--length-scale", a.length_scale), ("--switch-ratio", a.switch_ratio),
+                    ("--space-filling-rule", a.fill_rule),
+                    ("--space-filling-when", a.fill_when)):
         if v is not None:
             out += [flag, str(v)]
     return out
@@ -374,6 +377,10 @@ def main():
     ap.add_argument("--departure-ratio", type=float, help="whirl design --departure-ratio")
     ap.add_argument("--length-scale", type=float, help="whirl design --length-scale")
     ap.add_argument("--switch-ratio", type=float, help="whirl design --switch-ratio")
+    ap.add_argument("--fill-rule", choices=["maximin", "coverage"],
+                    help="whirl design --space-filling-rule (with --fill-first / --fill-next)")
+    ap.add_argument("--fill-when", choices=["always", "departure"],
+                    help="whirl design --space-filling-when of every next batch")
     ap.add_argument("--inside", type=int, help="whirl design --inside of the first design")
     ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
     ap.add_argument("--design-only", action="store_true", help="only the design strategy")

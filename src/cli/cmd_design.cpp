@@ -26,6 +26,8 @@ struct DesignCliOptions {
   std::array<std::string, ProcessInputs::kCount> ranges;
   int count = 0, levels = 3, space_filling = 0, inside = design::kInsideAuto;
   std::string criterion = "d", variance = design::ToString(design::NextRule{}.model);
+  std::string fill_rule = design::ToString(design::SpaceFilling{}.rule);
+  std::string fill_when = design::ToString(design::SpaceFilling{}.when);
   double departure_ratio = design::NextRule{}.departure_ratio;
   double length_scale = design::NextRule{}.length_scale;
   double switch_ratio = design::NextRule{}.switch_ratio;
@@ -159,7 +161,8 @@ design::NextRule RuleOf(const DesignCliOptions& o) {
 
 void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
   const auto d = design::DesignPowerLaw(c.inputs, o.count, design::ParseCriterion(o.criterion),
-                                        o.space_filling, o.inside, RuleOf(o));
+                                        o.space_filling, o.inside, RuleOf(o),
+                                        design::ParseFillRule(o.fill_rule));
   const std::string csv = DesignCsv(c, d.picks, false, "first design, criterion " + o.criterion);
   if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
   if (o.json) {
@@ -172,7 +175,8 @@ void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
     PrintJson({{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
                {"candidate_count", c.inputs.size()}, {"coefficients", d.coefficients},
                {"varying_inputs", d.inputs}, {"log_det_per_screw", d.log_det},
-               {"space_filling", d.space_filling}, {"inside", d.inside},
+               {"space_filling", d.space_filling}, {"space_filling_rule", o.fill_rule},
+               {"inside", d.inside},
                {"min_distance", d.min_distance},
                {"mean_sd_factor", d.mean_sd_factor}, {"max_sd_factor", d.max_sd_factor},
                {"picks", picks}});
@@ -209,6 +213,8 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
   rule.tolerance = {o.tolerance_um, o.tolerance_s};
   design::SpaceFilling fill;
   fill.screws = o.space_filling;
+  fill.rule = design::ParseFillRule(o.fill_rule);
+  fill.when = design::ParseFillWhen(o.fill_when);
   if (!o.measured_path.empty()) {
     ProcessTable measured = ReadProcessTable(o.measured_path, /*require_targets=*/false);
     fill.measured = std::move(measured.inputs);
@@ -234,6 +240,7 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
     nlohmann::json j = {{"mode", "next"}, {"model", o.model_path}, {"variance", o.variance},
                         {"model_describe", model.Describe()}, {"candidates", c.source},
                         {"candidate_count", c.inputs.size()}, {"picks", picks},
+                        {"space_filling", d.space_filling}, {"space_filling_rule", o.fill_rule},
                         {"rms_sd_now", {{"max_elongation_um", d.rms_sd_now[0]},
                                         {"settle_time_s", d.rms_sd_now[1]}}},
                         {"rms_sd_after", {{"max_elongation_um", d.rms_sd_after[0]},
@@ -281,6 +288,8 @@ void RunDesign(const DesignCliOptions& o) {
   CheckOutputs({{"--candidates", o.candidates_path}, {"--model", o.model_path},
                 {"--measured", o.measured_path}},
                {{"--out", o.out_path}});
+  design::ParseFillRule(o.fill_rule);  // bad spellings before any file is read
+  design::ParseFillWhen(o.fill_when);
   if (o.model_path.empty() && (o.tolerance_um > 0 || o.tolerance_s > 0))
     throw InputError("design: --tolerance-um / --tolerance-s need --model (the stop rule judges a "
                      "trained model's predictive sd)");
@@ -291,6 +300,9 @@ void RunDesign(const DesignCliOptions& o) {
   if (!o.model_path.empty() && o.inside != design::kInsideAuto)
     throw InputError("design: --inside is a first design's (without --model); the next screws "
                      "follow --variance");
+  if (o.model_path.empty() && o.fill_when != design::ToString(design::SpaceFilling{}.when))
+    throw InputError("design: --space-filling-when needs --model (a first design's space-filling "
+                     "screws are always its last ones)");
   if (o.model_path.empty() && !o.measured_path.empty())
     throw InputError("design: --measured needs --model (a first design has no measured screws)");
   const DesignCandidates c = ReadDesignCandidates(o);
@@ -357,6 +369,17 @@ void RegisterDesign(CLI::App& app) {
                   "--model, to the --measured ones; first design: after the optimal ones")
       ->capture_default_str()
       ->check(NumberIn(0, 100000));
+  sub->add_option("--space-filling-rule", o->fill_rule,
+                  "how --space-filling picks: maximin (the candidate farthest from the screws "
+                  "before it: the edges of the range) or coverage (the candidate that most "
+                  "lowers the mean distance from the list's screws to their nearest measured "
+                  "one: where the list is dense, a hedge against a model that is wrong)")
+      ->capture_default_str();
+  sub->add_option("--space-filling-when", o->fill_when,
+                  "with --model: always, or departure (a batch holds its --space-filling screws "
+                  "only where --variance switch finds a departure from the power law on an "
+                  "output)")
+      ->capture_default_str();
   sub->add_option("--inside", o->inside,
                   "first design: screws of --count picked after the optimal ones by the "
                   "power-gp variance (see --variance) given those before, so that the first "

@@ -131,6 +131,27 @@ PY3
 "$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
   --measured "$data" > out.txt 2> err.txt || fail "next --space-filling: $(cat err.txt)"
 grep -q "why: space filling" out.txt || fail "no space-filling pick: $(cat out.txt)"
+# Coverage picks in both modes; --space-filling-when departure follows the switch's verdict.
+"$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
+  --space-filling-rule coverage --measured "$data" --json > cover.json 2> err.txt \
+  || fail "next --space-filling-rule coverage: $(cat err.txt)"
+"$whirl" design "${ranges[@]}" --count 8 --space-filling 2 --space-filling-rule coverage \
+  --json > cover_first.json 2> err.txt || fail "first --space-filling-rule coverage: $(cat err.txt)"
+for limit in 1e-6 1e6; do
+  "$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
+    --space-filling-rule coverage --space-filling-when departure --switch-ratio $limit \
+    --measured "$data" --json > "when_$limit.json" 2> err.txt \
+    || fail "next --space-filling-when departure --switch-ratio $limit: $(cat err.txt)"
+done
+python3 - cover.json cover_first.json when_1e-6.json when_1e6.json <<'PY3' || fail "coverage: $(cat cover.json when_1e6.json)"
+import json, sys
+nxt, first, departs, fits = (json.load(open(f)) for f in sys.argv[1:])
+assert nxt["space_filling"] == 1 and nxt["space_filling_rule"] == "coverage"
+assert nxt["picks"][1]["why"].startswith("coverage") and not nxt["picks"][0]["why"].startswith("coverage")
+assert [p["why"].startswith("coverage") for p in first["picks"]] == [False] * 6 + [True] * 2
+assert departs["space_filling"] == 1 and departs["picks"][1]["why"].startswith("coverage")
+assert fits["space_filling"] == 0 and not any(p["why"].startswith("coverage") for p in fits["picks"])
+PY3
 
 # A table on which one candidate's held-out error diverges (score about 5e16: 8 screws of the
 # "interacting" generator of scripts/bench_peers.py picked by a space-filling first design);
@@ -203,6 +224,13 @@ expect_fail "--variance 'gp': expected 'power-gp'" "$whirl" design --model m.jso
   --candidates cands.csv --count 2 --variance gp --measured "$data"
 expect_fail "departure-ratio" "$whirl" design --model m.json --candidates cands.csv --count 2 \
   --measured "$data" --departure-ratio 0
+expect_fail "--space-filling-rule 'far': expected 'maximin'" "$whirl" design "${ranges[@]}" \
+  --count 8 --space-filling 1 --space-filling-rule far
+expect_fail "--space-filling-when needs --model" "$whirl" design "${ranges[@]}" --count 8 \
+  --space-filling 1 --space-filling-when departure
+expect_fail "--space-filling-when departure needs --variance switch" "$whirl" design \
+  --model m.json --candidates cands.csv --count 2 --space-filling 1 --variance power-gp \
+  --space-filling-when departure --measured "$data"
 expect_fail "--variance needs --model" "$whirl" design "${ranges[@]}" --count 8 --variance sum
 expect_fail "--inside is a first design" "$whirl" design --model m.json --candidates cands.csv \
   --count 2 --measured "$data" --inside 1

@@ -667,5 +667,119 @@ TEST(Design, PowerGpNeedsEnoughMeasuredScrews) {
   EXPECT_THROW(ParseNextModel("gp"), InputError);
 }
 
+// The mean over the list (rows 0..n-1 of u) of each row's distance to its nearest row of `from`.
+double MeanNearest(const Eigen::MatrixXd& u, int n, const std::vector<int>& from) {
+  double s = 0;
+  for (int i = 0; i < n; ++i) s += Nearest(u, i, from);
+  return s / n;
+}
+
+// Each coverage pick lowers the list's mean distance to its nearest screw the most (brute force
+// over the unpicked candidates), and is not the maximin pick (which goes to the edges).
+void ExpectCoveragePicks(const Eigen::MatrixXd& u, int n, const std::vector<Pick>& picks,
+                         std::size_t first, std::vector<int> near, int* differs) {
+  for (std::size_t i = first; i < picks.size(); ++i) {
+    const int c = picks[i].candidate;
+    std::vector<int> with = near;
+    with.push_back(c);
+    const double mine = MeanNearest(u, n, with);
+    int farthest = -1;
+    double far = -1;
+    for (int o = 0; o < n; ++o) {
+      if (std::find(near.begin(), near.end(), o) != near.end()) continue;
+      with.back() = o;
+      EXPECT_LE(mine, MeanNearest(u, n, with) + 1e-12) << "pick " << i << " candidate " << o;
+      if (Nearest(u, o, near) > far) far = Nearest(u, o, near), farthest = o;
+    }
+    *differs += farthest != c;
+    EXPECT_EQ(picks[i].why.rfind("coverage", 0), 0u) << picks[i].why;
+    EXPECT_LT(mine, MeanNearest(u, n, near));
+    near.push_back(c);
+  }
+}
+
+TEST(Design, CoveragePicksLowerTheMeanDistanceToTheNearestScrewMost) {
+  std::mt19937 rng(41);
+  int differs = 0;
+  for (int t = 0; t < 6; ++t) {
+    const auto cands = RandomList(rng, 70);
+    const Eigen::MatrixXd u = LogUnits(cands);
+    const auto d = DesignPowerLaw(cands, 9, Criterion::kD, 3, 0, {}, FillRule::kCoverage);
+    const auto optimal = DesignPowerLaw(cands, 6, Criterion::kD);
+    ASSERT_EQ(d.picks.size(), 9u);
+    std::vector<int> before;
+    for (int i = 0; i < 6; ++i) before.push_back(d.picks[i].candidate);
+    std::vector<int> opt;
+    for (const auto& p : optimal.picks) opt.push_back(p.candidate);
+    EXPECT_EQ(std::set<int>(before.begin(), before.end()), std::set<int>(opt.begin(), opt.end()));
+    ExpectCoveragePicks(u, 70, d.picks, 6, before, &differs);
+  }
+  EXPECT_GE(differs, 3);  // coverage is not maximin under another name
+}
+
+TEST(Design, NextCoveragePicksKeepNearTheListAwayFromTheMeasured) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(42);
+  int differs = 0;
+  for (int t = 0; t < 4; ++t) {
+    const auto cands = RandomList(rng, 60);
+    SpaceFilling fill;
+    fill.screws = 2;
+    fill.rule = FillRule::kCoverage;
+    fill.measured = RandomList(rng, 12);
+    fill.measured_targets = MeasuredTargets(fill.measured, 0.0, rng);
+    const NextDesign d = DesignNext(model, cands, 3, {}, {}, fill);
+    ASSERT_EQ(d.picks.size(), 3u);
+    EXPECT_EQ(d.space_filling, 2);
+    std::vector<ProcessInputs> all = cands;
+    all.insert(all.end(), fill.measured.begin(), fill.measured.end());
+    std::vector<int> near;
+    for (int i = 0; i < 12; ++i) near.push_back(60 + i);
+    near.push_back(d.picks[0].candidate);
+    ExpectCoveragePicks(LogUnits(all), 60, d.picks, 1, near, &differs);
+    for (const auto& p : d.picks)
+      for (int k = 0; k < 2; ++k) EXPECT_LE(p.sd_after[k], p.sd_now[k] + 1e-12);
+  }
+  EXPECT_GE(differs, 2);
+}
+
+TEST(Design, SpaceFillingWhenDepartureFollowsTheSwitch) {
+  const auto model = TrainedModel();
+  std::mt19937 rng(43);
+  int with = 0, without = 0;
+  for (int t = 0; t < 4; ++t) {
+    const auto cands = RandomList(rng, 50);
+    SpaceFilling fill;
+    fill.measured = RandomList(rng, 30);
+    fill.measured_targets = MeasuredTargets(fill.measured, t % 2 ? 1.0 : 0.0, rng);
+    const NextDesign plain = DesignNext(model, cands, 2, {}, {}, fill);
+    fill.screws = 1;
+    fill.rule = FillRule::kCoverage;
+    const NextDesign always = DesignNext(model, cands, 2, {}, {}, fill);
+    fill.when = SpaceFilling::When::kDeparture;
+    const NextDesign d = DesignNext(model, cands, 2, {}, {}, fill);
+    const bool departure = std::max(d.lack_of_fit_ratio[0], d.lack_of_fit_ratio[1]) >
+                           NextRule{}.switch_ratio;
+    EXPECT_EQ(d.space_filling, departure ? 1 : 0);
+    EXPECT_EQ(always.space_filling, 1);
+    const NextDesign& same = departure ? always : plain;
+    for (int i = 0; i < 2; ++i) EXPECT_EQ(d.picks[i].candidate, same.picks[i].candidate);
+    with += departure, without += !departure;
+  }
+  EXPECT_GE(with, 1);  // both sides seen
+  EXPECT_GE(without, 1);
+  SpaceFilling fill;
+  fill.screws = 1;
+  fill.when = SpaceFilling::When::kDeparture;
+  fill.measured = RandomList(rng, 12);
+  NextRule power_gp;
+  power_gp.model = NextRule::Model::kPowerGp;
+  EXPECT_THROW(DesignNext(model, RandomList(rng, 20), 2, {}, {}, fill, power_gp), InputError);
+  EXPECT_EQ(ParseFillRule("coverage"), FillRule::kCoverage);
+  EXPECT_EQ(ToString(ParseFillWhen("departure")), "departure");
+  EXPECT_THROW(ParseFillRule("random"), InputError);
+  EXPECT_THROW(ParseFillWhen("never"), InputError);
+}
+
 }  // namespace
 }  // namespace whirl::design

@@ -165,10 +165,61 @@ int FarthestCandidate(const Eigen::MatrixXd& u, int n, const std::vector<char>& 
   return best;
 }
 
+// The unpicked row of u (among the first `n` rows: the candidates) whose pick most lowers the
+// mean over the list (at most kCoverageRows rows, every k-th) of each row's distance to its
+// nearest row of `near`; *before / *after: that mean now and after the pick (design.h,
+// FillRule::kCoverage). Ties to the lower index; -1 when all taken.
+int CoverageCandidate(const Eigen::MatrixXd& u, int n, const std::vector<char>& taken,
+                      const std::vector<int>& near, double* before, double* after) {
+  const int step = (n + kCoverageRows - 1) / kCoverageRows;
+  std::vector<int> rows;
+  for (int i = 0; i < n; i += step) rows.push_back(i);
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd z(m, u.cols());
+  Eigen::VectorXd nearest(m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    z.row(r) = u.row(rows[static_cast<std::size_t>(r)]);
+    nearest(r) = NearestDistance(u, rows[static_cast<std::size_t>(r)], near);
+  }
+  int best = -1;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < n; ++c) {
+    if (taken[c]) continue;
+    const Eigen::VectorXd to_c = (z.rowwise() - u.row(c)).rowwise().norm();
+    const double sum = to_c.cwiseMin(nearest).sum();
+    if (sum < best_sum * (1 - 1e-12)) best_sum = sum, best = c;
+  }
+  *before = nearest.mean();
+  *after = best_sum / static_cast<double>(m);
+  return best;
+}
+
+std::string WhyCoverage(double before, double after) {
+  return "coverage: the candidate that most lowers the mean distance from the list's screws to "
+         "their nearest measured one (" + FormatSignificant(before, 3) + " -> " +
+         FormatSignificant(after, 3) + " in standardized log inputs), so that where the model is "
+         "wrong in a way its variance does not know, a screw was measured nearby";
+}
+
 std::string WhySpaceFilling(double distance) {
   return "space filling: the candidate farthest from the screws before it (distance " +
          FormatSignificant(distance, 3) + " in standardized log inputs), so that the model's "
          "cross-validation sees the inside of the range and a bend";
+}
+
+// One space-filling pick by `rule` among the first n rows of u, away from `near`, and its why.
+int FillCandidate(FillRule rule, const Eigen::MatrixXd& u, int n, const std::vector<char>& taken,
+                  const std::vector<int>& near, std::string* why) {
+  if (rule == FillRule::kCoverage) {
+    double before = 0, after = 0;
+    const int c = CoverageCandidate(u, n, taken, near, &before, &after);
+    *why = WhyCoverage(before, after);
+    return c;
+  }
+  double distance = 0;
+  const int c = FarthestCandidate(u, n, taken, near, &distance);
+  *why = WhySpaceFilling(distance);
+  return c;
 }
 
 // ---- Next screws: integrated variance reduction --------------------------------------------
@@ -503,6 +554,27 @@ std::string ToString(NextRule::Model m) {
   return "switch";
 }
 
+FillRule ParseFillRule(const std::string& s) {
+  if (s == "maximin") return FillRule::kMaximin;
+  if (s == "coverage") return FillRule::kCoverage;
+  throw InputError("--space-filling-rule '" + s + "': expected 'maximin' (farthest from the "
+                   "screws before it) or 'coverage' (most lowers the mean distance from the "
+                   "list to its nearest screw)");
+}
+
+std::string ToString(FillRule r) { return r == FillRule::kCoverage ? "coverage" : "maximin"; }
+
+SpaceFilling::When ParseFillWhen(const std::string& s) {
+  if (s == "always") return SpaceFilling::When::kAlways;
+  if (s == "departure") return SpaceFilling::When::kDeparture;
+  throw InputError("--space-filling-when '" + s + "': expected 'always' or 'departure' (only "
+                   "where --variance switch finds a departure from the power law)");
+}
+
+std::string ToString(SpaceFilling::When w) {
+  return w == SpaceFilling::When::kDeparture ? "departure" : "always";
+}
+
 void InputRanges::Validate(const std::array<const char*, ProcessInputs::kCount>& flags) const {
   for (int j = 0; j < ProcessInputs::kCount; ++j) {
     const std::string what = std::string(flags[j]) + " " + FormatSignificant(lo[j], 6) + ".." +
@@ -553,22 +625,20 @@ double SdFactor(const Eigen::MatrixXd& f, const std::vector<int>& picked, int c)
   return std::sqrt(std::max(0.0, double(f.row(c) * m.inverse() * f.row(c).transpose())));
 }
 
-// `k` more picks of the first design, each the candidate farthest (maximin) from those before.
-void AddSpaceFilling(const Eigen::MatrixXd& f, int k, std::vector<int>* picked,
+// `k` more picks of the first design, each by `rule` (maximin or coverage) given those before.
+void AddSpaceFilling(const Eigen::MatrixXd& f, int k, FillRule rule, std::vector<int>* picked,
                      std::vector<Pick>* picks) {
   const Eigen::MatrixXd u = f.rightCols(f.cols() - 1);
   std::vector<char> taken(f.rows(), 0);
   for (int i : *picked) taken[i] = 1;
   for (int i = 0; i < k; ++i) {
-    double distance = 0;
-    const int c = FarthestCandidate(u, static_cast<int>(f.rows()), taken, *picked, &distance);
     Pick pick;
+    const int c = FillCandidate(rule, u, static_cast<int>(f.rows()), taken, *picked, &pick.why);
     pick.candidate = c;
     pick.sd_now = {SdFactor(f, *picked, c), 0};
     taken[c] = 1;
     picked->push_back(c);
     pick.sd_after = {SdFactor(f, *picked, c), 0};
-    pick.why = WhySpaceFilling(distance);
     picks->push_back(pick);
   }
 }
@@ -617,7 +687,7 @@ double MinPairDistance(const Eigen::MatrixXd& f, const std::vector<int>& picked)
 
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count,
                               Criterion criterion, int space_filling, int inside,
-                              const NextRule& rule) {
+                              const NextRule& rule, FillRule fill) {
   if (cands.empty()) throw InputError("design: the candidate list is empty");
   PowerLawDesign d;
   d.criterion = criterion;
@@ -651,7 +721,7 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
   d.picks = ExplainingOrder(f, picked);
   AddPowerGpPicks(f, inside, rule, &picked, &d.picks);
   d.inside = inside;
-  AddSpaceFilling(f, space_filling, &picked, &d.picks);
+  AddSpaceFilling(f, space_filling, fill, &picked, &d.picks);
   d.log_det = CriterionValue(f, picked, Criterion::kD, w) - d.coefficients * std::log(count);
   d.min_distance = MinPairDistance(f, picked);
   double sum = 0, mx = 0;
@@ -757,6 +827,9 @@ void CheckNextArguments(int n, int count, const SpaceFilling& fill, const NextRu
     throw InputError("design: --departure-ratio and --length-scale must be finite and positive");
   if (!(rule.switch_ratio > 0) || !std::isfinite(rule.switch_ratio))
     throw InputError("design: --switch-ratio must be finite and positive");
+  if (fill.when == SpaceFilling::When::kDeparture && rule.model != NextRule::Model::kSwitch)
+    throw InputError("design --space-filling-when departure needs --variance switch (its lack of "
+                     "fit says where the measured screws depart from the power law)");
   if (rule.model == NextRule::Model::kSwitch &&
       fill.measured_targets.size() != fill.measured.size())
     throw InputError("design --variance switch needs the measured screws' targets (--measured "
@@ -838,6 +911,9 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
       departure[k] = fits[k].ratio > rule.switch_ratio;
     }
   }
+  d.space_filling = fill.when == SpaceFilling::When::kDeparture && !departure[0] && !departure[1]
+                        ? 0
+                        : fill.screws;
   const auto own = OwnVariance(rule, gp_chosen, departure);
   auto crit = CriterionStates(states, own, u, n, rule, &units);
   std::vector<int> near(fill.measured.size());
@@ -845,10 +921,8 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
   std::vector<char> taken(n, 0);
   for (int i = 0; i < count; ++i) {
     Pick p;
-    if (i >= count - fill.screws) {
-      double distance = 0;
-      p.candidate = FarthestCandidate(u, n, taken, near, &distance);
-      p.why = WhySpaceFilling(distance);
+    if (i >= count - d.space_filling) {
+      p.candidate = FillCandidate(fill.rule, u, n, taken, near, &p.why);
     } else {
       double score = 0;
       p.candidate = BestCandidate(crit, taken, &score);

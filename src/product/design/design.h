@@ -28,6 +28,14 @@
 // mode the same rule picks the batch's last `space_filling` screws, keeping away from the
 // screws measured so far (SpaceFilling::measured) and the batch's earlier picks; the variance
 // update still counts them as measured, so later variance picks do not repeat their region.
+// Maximin (FillRule::kMaximin) in a box goes to its edges again. Coverage (FillRule::kCoverage)
+// instead picks the candidate that most lowers the mean over the list of the distance from each
+// candidate to its nearest screw before it (a greedy p-median; over at most kCoverageRows
+// candidates, every k-th, where the list is longer): where the model is wrong in a way its
+// variance does not know, its error at a candidate grows with that distance (at most L times it
+// for a misfit of Lipschitz constant L), so the mean bounds the integrated error, and the
+// screws go where the list's screws are, as random ones do, but spread (a hedge against model
+// bias; Box & Draper, "A basis for the selection of a response surface design", 1959).
 //
 // Next screws (DesignNext): a trained family model (workpiece/model.h, family/family.h) and the
 // candidates coming up. Per output k, the latent posterior covariance C_k of the chosen family
@@ -91,6 +99,13 @@ namespace whirl::design {
 enum class Criterion { kD, kI };
 Criterion ParseCriterion(const std::string& s);  ///< "d" | "i"; InputError otherwise
 std::string ToString(Criterion c);               ///< "d", "i"
+
+/// How a space-filling pick is chosen (header comment, "Space filling"): kMaximin, the
+/// candidate farthest from the screws before it; kCoverage, the candidate that most lowers the
+/// mean over the list of the distance to the nearest screw before it.
+enum class FillRule { kMaximin, kCoverage };
+FillRule ParseFillRule(const std::string& s);  ///< "maximin" | "coverage"; InputError otherwise
+std::string ToString(FillRule r);
 
 /// The shop's ranges of the five inputs (original units, kInputColumns order).
 struct InputRanges {
@@ -168,7 +183,7 @@ inline constexpr int kDefaultInside = 2;
 /// not below count, count - inside - space_filling < coefficients or count > candidates.
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& candidates, int count,
                               Criterion criterion, int space_filling = 0, int inside = 0,
-                              const NextRule& rule = {});
+                              const NextRule& rule = {}, FillRule fill = FillRule::kMaximin);
 
 struct StopRule {
   /// Per output, the tolerance of the RMS predictive sd over the candidates (um, s); <= 0: none.
@@ -188,16 +203,30 @@ struct NextDesign {
   std::string stop_reason;  ///< one or two sentences, with the figures
   /// kSwitch: per output, PowerLawLackOfFit's ratio on the measured screws (else 0).
   std::array<double, Features::kCount> lack_of_fit_ratio{};
+  /// The batch's space-filling picks (SpaceFilling::screws, or 0 where SpaceFilling::when is
+  /// kDeparture and no output departs).
+  int space_filling = 0;
 };
 
 /// The space-filling share of a next batch (header comment).
 struct SpaceFilling {
-  int screws = 0;                        ///< the batch's last picks chosen by maximin
+  int screws = 0;                        ///< the batch's last picks chosen by `rule`
+  FillRule rule = FillRule::kMaximin;
+  /// When the batch holds its space-filling picks: kAlways, or kDeparture: only where NextRule's
+  /// kSwitch finds a departure from the power law on at least one output (else the whole batch
+  /// follows the variance rule; needs kSwitch).
+  enum class When { kAlways, kDeparture };
+  When when = When::kAlways;
   /// The screws measured so far: needed if screws > 0 and by every NextRule but kChosen.
   std::vector<ProcessInputs> measured;
   /// Their measured targets, row-aligned with `measured`: needed by NextRule's kSwitch.
   std::vector<Features> measured_targets;
 };
+
+inline constexpr int kCoverageRows = 2000;  ///< list rows the coverage mean runs over, at most
+/// "always" | "departure"; InputError otherwise
+SpaceFilling::When ParseFillWhen(const std::string& s);
+std::string ToString(SpaceFilling::When w);
 
 /// How well the power law fits the measured screws (NextRule's kSwitch). z: the screws' log
 /// inputs (one row per screw, standardized as the power-GP rule's), ln_y: their log targets.
