@@ -36,6 +36,9 @@
 // for a misfit of Lipschitz constant L), so the mean bounds the integrated error, and the
 // screws go where the list's screws are, as random ones do, but spread (a hedge against model
 // bias; Box & Draper, "A basis for the selection of a response surface design", 1959).
+// SpaceFilling::When::kDeparture keeps a batch's space-filling picks only where NextRule's
+// kSwitch finds a departure. Neither is the default: a coverage share of every batch, or of the
+// batches with a departure, did not beat the plain switch (docs/design.md, sixth attempt).
 //
 // Next screws (DesignNext): a trained family model (workpiece/model.h, family/family.h) and the
 // candidates coming up. Per output k, the latent posterior covariance C_k of the chosen family
