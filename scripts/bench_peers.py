@@ -313,13 +313,16 @@ GENERATORS = {
 # The first two attempts' confirmation parts (seeds 1001-1020 here; 2001-2010 and 3001-3012 in the
 # design study of docs/design.md) are spent; the third attempt (docs/workpiece-model.md, "Third
 # attempt: split") tunes on all eight families on seeds 1-20 and confirms once on seeds 4001-4020
-# plus three families added for it (saturating, powerlaw_step, hetero).
+# plus three families added for it (saturating, powerlaw_step, hetero). The fourth attempt tunes on
+# seeds 1-20 and 4001-4020 and confirms once on seeds 10001-10020 of the eleven families
+# ("confirmation4"; 10001-10010 at 100 rows).
 EIGHT = "powerlaw,bent,friedman,additive,simgen,friedman23,interacting,powerlaw_noisy"
 SPLITS = {
     "tuning": {"problems": "powerlaw,bent,friedman,additive,simgen", "first_seed": 1},
     "confirmation": {"problems": EIGHT, "first_seed": 1001},
     "tuning3": {"problems": EIGHT, "first_seed": 1},
     "confirmation3": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 4001},
+    "confirmation4": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 10001},
 }
 
 
