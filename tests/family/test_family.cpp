@@ -628,6 +628,40 @@ TEST(FamilyStacking, CoverageScaleOnHandComputedCases) {
                    "every sd > 0");
 }
 
+// Weight of linear/log (the power law) in output k of a choice: 1 or 0 for an unstacked output.
+double PowerLawWeight(const Choice& c, int k) {
+  if (c.weights[k].empty())
+    return c.table[c.chosen[k]].candidate.Name() == "linear/log" ? 1.0 : 0.0;
+  for (std::size_t j = 0; j < c.models.size(); ++j)
+    if (c.models[j].candidate.Name() == "linear/log") return c.weights[k][j];
+  return 0.0;
+}
+
+TEST(FamilyStacking, PowerLawTablesKeepThePowerLawUnderTheShrunkStack) {
+  // 20-row power laws with 3 % noise: the shrunk stack (ChoiceOptions::stack with its gate and
+  // shrinkage) leaves the power law's weight at 1 on at least 3 in 4 outputs and on more than
+  // twice as many as the unshrunk stack of every candidate (the first attempt's failure on
+  // power-law tables).
+  ChoiceOptions shrunk, plain;
+  shrunk.stack = plain.stack = true;
+  plain.stack_full_se = -1;
+  plain.stack_gate_se = 0;
+  plain.lowest_gp = false;
+  int whole_shrunk = 0, whole_plain = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const ProcessTable t = MakeTable(20, 0.03, seed);
+    const Choice a = ChooseFamily(t, shrunk), b = ChooseFamily(t, plain);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_GE(a.weights[k].empty() ? 0.0 : *std::min_element(a.weights[k].begin(),
+                                                               a.weights[k].end()), 0.0);
+      whole_shrunk += PowerLawWeight(a, k) >= 0.99;
+      whole_plain += PowerLawWeight(b, k) >= 0.99;
+    }
+  }
+  EXPECT_GE(whole_shrunk, 30) << "of 40 outputs (3 in 4); the unshrunk stack " << whole_plain;
+  EXPECT_LT(2 * whole_plain, whole_shrunk);
+}
+
 TEST(FamilyStacking, StackedChoicePredictsTheWeightedMeanAndRoundTrips) {
   const ProcessTable train = MakeTable(20, 0.05, 31, true), test = MakeTable(30, 0.0, 32, true);
   ChoiceOptions o;
@@ -639,8 +673,10 @@ TEST(FamilyStacking, StackedChoicePredictsTheWeightedMeanAndRoundTrips) {
   o.lowest_gp = false;
   const Choice c = ChooseFamily(train, o);
   ASSERT_GE(c.models.size(), 2u) << "no combination: the test would be moot; " << c.Describe();
+  ASSERT_FALSE(c.weights[0].empty() && c.weights[1].empty()) << "no stack: " << c.Describe();
   const std::vector<FamilyPrediction> p = PredictChoice(c, test.inputs);
   for (int k = 0; k < 2; ++k) {
+    if (c.weights[k].empty()) continue;  // one candidate alone (FamilyChoice tests)
     ASSERT_EQ(c.weights[k].size(), c.models.size()) << c.Describe();
     double sum = 0;
     for (const double w : c.weights[k]) sum += w;
@@ -665,10 +701,11 @@ TEST(FamilyStacking, StackedChoicePredictsTheWeightedMeanAndRoundTrips) {
       EXPECT_EQ(pb[q].stddev.ToArray()[k], p[q].stddev.ToArray()[k]);
     }
   nlohmann::json scale = c;
-  scale["sd_scale"][1] = 5.0;
-  ExpectInputError([&] { scale.get<Choice>(); }, "'sd_scale' of settle_time_s");
+  scale["sd_scale"][0] = 5.0;
+  ExpectInputError([&] { scale.get<Choice>(); }, "'sd_scale' of max_elongation_um");
   nlohmann::json bad = c;
-  bad["weights"][0][0] = bad["weights"][0][0].get<double>() + 0.5;
+  const int stacked = c.weights[0].empty() ? 1 : 0;
+  bad["weights"][stacked][0] = bad["weights"][stacked][0].get<double>() + 0.5;
   ExpectInputError([&] { bad.get<Choice>(); }, "must sum to 1");
 }
 
