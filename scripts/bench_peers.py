@@ -71,6 +71,8 @@ The summary at the end compares each whirl method's median test RMSE per output 
 median of the --acceptance-peers (default loglinear, gp_ard, mlp_default, mlp_cv, brnn_whirl: the
 power law, GP-ARD and the networks) and lists its +-1 / +-2 sd coverage.
 
+Pooled summary of earlier runs (the fourth attempt's tuning part spans seed ranges and sizes):
+  bench_peers.py --whirl build/whirl --from-json a.json b.json ... [--markdown]
 Usage: bench_peers.py --whirl build/whirl [--split tuning|confirmation] [--seeds 20]
        [--first-seed 1] [--sizes 20,100] [--problems friedman,simulator,simgen,...]
        [--variant NAME=ARGS ...] [--no-default] [--family-bench PATH --family NAME=ARGS ...]
@@ -313,13 +315,16 @@ GENERATORS = {
 # The first two attempts' confirmation parts (seeds 1001-1020 here; 2001-2010 and 3001-3012 in the
 # design study of docs/design.md) are spent; the third attempt (docs/workpiece-model.md, "Third
 # attempt: split") tunes on all eight families on seeds 1-20 and confirms once on seeds 4001-4020
-# plus three families added for it (saturating, powerlaw_step, hetero).
+# plus three families added for it (saturating, powerlaw_step, hetero). The fourth attempt tunes on
+# seeds 1-20 and 4001-4020 and confirms once on seeds 10001-10020 of the eleven families
+# ("confirmation4"; 10001-10010 at 100 rows).
 EIGHT = "powerlaw,bent,friedman,additive,simgen,friedman23,interacting,powerlaw_noisy"
 SPLITS = {
     "tuning": {"problems": "powerlaw,bent,friedman,additive,simgen", "first_seed": 1},
     "confirmation": {"problems": EIGHT, "first_seed": 1001},
     "tuning3": {"problems": EIGHT, "first_seed": 1},
     "confirmation3": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 4001},
+    "confirmation4": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 10001},
 }
 
 
@@ -544,7 +549,13 @@ def main():
     ap.add_argument("--markdown", action="store_true",
                     help="print the summary (the last table) as a Markdown table")
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
+    ap.add_argument("--from-json", nargs="+", metavar="FILE",
+                    help="run nothing: pool the --json files of earlier runs per problem and size "
+                         "(seeds of every file) and print the summary with its counts")
     a = ap.parse_args()
+    if a.from_json:
+        pooled_summary(a.from_json, [p for p in a.acceptance_peers.split(",") if p], a.markdown)
+        return
     split = SPLITS.get(a.split, {})
     problems = a.problems or split.get("problems", "friedman,simulator")
     first_seed = a.first_seed if a.first_seed is not None else split.get("first_seed", 1)
@@ -649,6 +660,39 @@ def report(results, prob, n, variants, peers):
           "time = median fit time (time2: whirl --threads 2); flat = seeds on which whirl train warned "
           "that the network is nearly flat (nn::FlatOutputs: it ignores the inputs)")
     sys.stdout.flush()
+
+
+def pooled_summary(files, accept, markdown):
+    """--from-json: the summary of the runs in `files` pooled per (problem, rows), every whirl
+    method found in all of them, and per method the count of medians more than 1 % behind the
+    best acceptance peer, the sum of those percentages and the (problem, rows, output) cells whose
+    mean coverage is outside 60-76 % (+-1 sd) or 90-98 % (+-2 sd)."""
+    runs = {}
+    for path in files:
+        with open(path) as f:
+            for r in json.load(f):
+                key = (r["problem"], r["rows"], r["seed"])
+                runs.setdefault(key, {"problem": r["problem"], "rows": r["rows"], "seed": r["seed"],
+                                      "methods": {}})["methods"].update(r["methods"])
+    results = list(runs.values())
+    cases = sorted({(r["problem"], r["rows"]) for r in results}, key=lambda c: (c[1], c[0]))
+    methods = [m for m in sorted({m for r in results for m in r["methods"]})
+               if all(m in r["methods"] and "cover1" in r["methods"][m] and "chosen" in
+                      r["methods"][m] for r in results)]
+    summary(results, cases, methods, accept, markdown)
+    for m in methods:
+        fails, total, cover = 0, 0.0, 0
+        for prob, n in cases:
+            rs = [r for r in results if r["problem"] == prob and r["rows"] == n]
+            med = lambda p, k: float(np.median([r["methods"][p]["rmse"][k] for r in rs]))
+            for k in (0, 1):
+                pct = 100 * (med(m, k) / min(med(p, k) for p in accept) - 1)
+                fails, total = fails + (pct > 1), total + (pct if pct > 1 else 0)
+                c1 = 100 * np.mean([r["methods"][m]["cover1"][k] for r in rs])
+                c2 = 100 * np.mean([r["methods"][m]["cover2"][k] for r in rs])
+                cover += not (60 <= c1 <= 76 and 90 <= c2 <= 98)
+        print(f"{m}: {fails} of {2 * len(cases)} medians more than 1 % behind the best peer, sum "
+              f"{total:.0f} %; coverage outside the bands on {cover} cells")
 
 
 def summary(results, cases, methods, accept, markdown=False):

@@ -2,7 +2,7 @@
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
 //                [--joint] [--loo|--kfold] [--no-1se] [--leave-first-se Z] [--leave-first-se-large Z] [--leave-first-blocks M] [--leave-first-row-share S] [--lowest-gp|--no-lowest-gp] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
-//                [--stack] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
+//                [--stack|--no-stack] [--stack-se START FULL] [--stack-se-large START FULL] [--stack-gate-se Z Z_LARGE] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
 //                [--few-rows N] [--gp-length-prior-sd SD] [--gp-max-rows N]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
@@ -50,6 +50,18 @@ Args Parse(int argc, char** argv) {
       a.choice.closed_form_loo = false;
     else if (k == "--stack")
       a.choice.stack = true;
+    else if (k == "--no-stack")
+      a.choice.stack = false;
+    else if (k == "--stack-se") {
+      a.choice.stack_start_se = std::stod(value());
+      a.choice.stack_full_se = std::stod(value());
+    } else if (k == "--stack-gate-se") {
+      a.choice.stack_gate_se = std::stod(value());
+      a.choice.stack_gate_se_large = std::stod(value());
+    } else if (k == "--stack-se-large") {
+      a.choice.stack_start_se_large = std::stod(value());
+      a.choice.stack_full_se_large = std::stod(value());
+    }
     else if (k == "--two-sd")
       a.choice.fit.calibrate_two_sd = true;
     else if (k == "--one-sd")

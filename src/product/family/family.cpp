@@ -504,25 +504,30 @@ Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
     throw InputError("stacking weights: " + std::to_string(n) + " x " + std::to_string(nc) +
                      " predictions and " + std::to_string(target.size()) +
                      " targets; need rows > 0, 1 to 12 candidates, one target per row");
+  // With sum w = 1, target - predictions w = errors w: the problem in the candidates' errors,
+  // scaled to their largest, is far better conditioned than in the predictions (which share
+  // the target's level: a Friedman #2 output of about 1000 lost every support set to rounding).
+  Eigen::MatrixXd e = (-predictions).colwise() + target;
+  const double scale = e.cwiseAbs().maxCoeff();
+  if (scale > 0) e /= scale;
+  const Eigen::MatrixXd gram = e.transpose() * e;
   Eigen::VectorXd best = Eigen::VectorXd::Unit(nc, 0);
-  double best_sse = (target - predictions.col(0)).squaredNorm();
+  double best_sse = gram(0, 0);
   int best_size = 1;
   for (unsigned mask = 1; mask < (1u << nc); ++mask) {
     std::vector<Eigen::Index> on;
     for (Eigen::Index c = 0; c < nc; ++c)
       if (mask & (1u << c)) on.push_back(c);
     const Eigen::Index m = static_cast<Eigen::Index>(on.size());
-    const Eigen::MatrixXd p = predictions(Eigen::all, on);
-    Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(m + 1, m + 1);  // [P'P 1; 1' 0]
-    kkt.topLeftCorner(m, m) = p.transpose() * p;
+    Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(m + 1, m + 1);  // [E'E 1; 1' 0]
+    kkt.topLeftCorner(m, m) = gram(on, on);
     kkt.topRightCorner(m, 1).setOnes();
     kkt.bottomLeftCorner(1, m).setOnes();
-    Eigen::VectorXd rhs(m + 1);
-    rhs << p.transpose() * target, 1.0;
-    const Eigen::VectorXd sol = kkt.completeOrthogonalDecomposition().solve(rhs);
-    const Eigen::VectorXd w = sol.head(m);
-    if (!w.allFinite() || (w.array() < 0).any() || std::abs(w.sum() - 1.0) > 1e-9) continue;
-    const double sse = (target - p * w).squaredNorm();
+    const Eigen::VectorXd rhs = Eigen::VectorXd::Unit(m + 1, m);
+    Eigen::VectorXd w = kkt.completeOrthogonalDecomposition().solve(rhs).head(m);
+    if (!w.allFinite() || (w.array() < 0).any() || std::abs(w.sum() - 1.0) > 1e-6) continue;
+    w /= w.sum();
+    const double sse = w.dot(gram(on, on) * w);
     const double tol = 1e-12 * std::max(best_sse, 1e-300);
     if (sse < best_sse - tol || (sse <= best_sse + tol && m < best_size)) {
       best.setZero();
@@ -536,12 +541,49 @@ Eigen::VectorXd ConvexStackWeights(const Eigen::MatrixXd& predictions,
 
 namespace {
 
-// The mean of paired differences d (row by row, two candidates' squared held-out errors) and its
-// standard error (sample sd / sqrt(n)): the comparison behind BeatsFirst and the
-// one-standard-error rule.
+// Mean and standard error of paired differences (below).
 struct MeanAndSe {
   double mean, se;
 };
+MeanAndSe OfDifferences(const Eigen::ArrayXd& d);
+
+}  // namespace
+
+ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::VectorXd& target,
+                               int folds, double start_se, double full_se) {
+  ShrunkStack out;
+  const Eigen::VectorXd all = ConvexStackWeights(predictions, target);
+  const Eigen::Index n = predictions.rows();
+  if (folds < 2) throw InputError("stacking weights: " + std::to_string(folds) + " folds; need >= 2");
+  const int k = static_cast<int>(std::min<Eigen::Index>(folds, n));
+  Eigen::VectorXd stacked(n);
+  for (int f = 0; f < k && n >= 2; ++f) {
+    std::vector<Eigen::Index> train, held;
+    for (Eigen::Index q = 0; q < n; ++q) (q % k == f ? held : train).push_back(q);
+    const Eigen::VectorXd w = ConvexStackWeights(predictions(train, Eigen::all), target(train));
+    stacked(held) = predictions(held, Eigen::all) * w;
+  }
+  if (n < 2) stacked = predictions * all;
+  const Eigen::ArrayXd d = (target - predictions.col(0)).array().square() -
+                           (target - stacked).array().square();
+  const MeanAndSe m = OfDifferences(d);
+  out.z = m.se > 0 ? m.mean / m.se : (m.mean > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+  if (full_se < 0)
+    out.share = 1;
+  else if (full_se <= start_se)
+    out.share = out.z > start_se ? 1 : 0;
+  else
+    out.share = std::clamp((out.z - start_se) / (full_se - start_se), 0.0, 1.0);
+  out.weights = out.share * all;
+  out.weights(0) += 1 - out.share;
+  return out;
+}
+
+namespace {
+
+// The mean of paired differences d (row by row, two candidates' squared held-out errors) and its
+// standard error (sample sd / sqrt(n)): the comparison behind BeatsFirst and the
+// one-standard-error rule.
 MeanAndSe OfDifferences(const Eigen::ArrayXd& d) {
   const double n = static_cast<double>(d.size()), mean = d.mean();
   return {mean, std::sqrt((d - mean).square().sum() / std::max(n - 1.0, 1.0) / n)};
@@ -578,6 +620,22 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
     simpler = std::min(simpler, squared_errors[c].mean());
   }
   return static_cast<int>(best);
+}
+
+double CoverageScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd, bool two_sd) {
+  if (residual.size() == 0 || residual.size() != sd.size() || !(sd.array() > 0).all())
+    throw InputError("sd scale: " + std::to_string(residual.size()) + " residuals and " +
+                     std::to_string(sd.size()) + " sd; need equal sizes > 0 and every sd > 0");
+  std::vector<double> ratio(static_cast<std::size_t>(residual.size()));
+  for (Eigen::Index i = 0; i < residual.size(); ++i)
+    ratio[static_cast<std::size_t>(i)] = std::abs(residual(i)) / sd(i);
+  std::sort(ratio.begin(), ratio.end());
+  const auto at = [&](double share) {  // the smallest ratio covering `share` of the rows
+    const double n = static_cast<double>(ratio.size());
+    const auto q = static_cast<std::size_t>(std::ceil(share * n - 1e-9));
+    return ratio[std::clamp<std::size_t>(q, 1, ratio.size()) - 1];
+  };
+  return std::clamp(two_sd ? std::max(at(kOneSigma), at(kTwoSigma) / 2) : at(kOneSigma), 0.25, 4.0);
 }
 
 double CoverageNoiseVariance(const Eigen::VectorXd& residual,
@@ -832,6 +890,57 @@ std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOp
 
 }  // namespace
 
+namespace {
+
+// ChoiceOptions::stack for output k of targets t (outputs x rows): the shrunk stacking weights
+// of every candidate (ShrunkStackWeights of their held-out predictions t - err), 0 for those
+// that stack_gate_se or lowest_gp leave out.
+Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
+                            const ChoiceOptions& o, int k, int folds) {
+  const int nc = static_cast<int>(err.size());
+  const bool large = t.cols() >= o.few_rows;
+  const double gate = large ? o.stack_gate_se_large : o.stack_gate_se;
+  const auto squared = [&](int c) -> Eigen::VectorXd {
+    return err[c].row(k).array().square().matrix().transpose();
+  };
+  std::vector<int> in = {0};
+  for (int c = 1; c < nc; ++c)
+    if (gate <= 0 || BeatsFirst(squared(0), squared(c), gate, 0, folds)) in.push_back(c);
+  if (o.lowest_gp) in = WithTheLowestGpOnly(in, err, o, k);
+  Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()));
+  for (std::size_t j = 0; j < in.size(); ++j)
+    p.col(static_cast<Eigen::Index>(j)) = (t.row(k) - err[in[j]].row(k)).transpose();
+  const Eigen::VectorXd w =
+      ShrunkStackWeights(p, t.row(k).transpose(), folds,
+                         large ? o.stack_start_se_large : o.stack_start_se,
+                         large ? o.stack_full_se_large : o.stack_full_se)
+          .weights;
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(nc);
+  for (std::size_t j = 0; j < in.size(); ++j) out(in[j]) = w(static_cast<Eigen::Index>(j));
+  return out;
+}
+
+// Choice::sd_scale of the stacked outputs: CoverageScale of the combination's held-out residuals
+// sum_c w_c err_c (original units) against its sd at the training rows.
+void ScaleStackedSd(const ProcessTable& table,
+                    const std::array<Eigen::VectorXd, Features::kCount>& stack,
+                    const std::vector<Eigen::MatrixXd>& err, Choice* choice) {
+  if (std::all_of(stack.begin(), stack.end(), [](const auto& w) { return w.size() == 0; })) return;
+  const std::vector<FamilyPrediction> p = PredictChoice(*choice, table.inputs);
+  for (int k = 0; k < Features::kCount; ++k) {
+    if (stack[k].size() == 0) continue;
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(p.size()));
+    for (Eigen::Index c = 0; c < stack[k].size(); ++c)
+      if (stack[k](c) > 0) r += stack[k](c) * err[static_cast<std::size_t>(c)].row(k).transpose();
+    Eigen::VectorXd sd(r.size());
+    for (std::size_t q = 0; q < p.size(); ++q)
+      sd(static_cast<Eigen::Index>(q)) = std::max(p[q].stddev.ToArray()[k], 1e-300);
+    choice->sd_scale[k] = std::min(CoverageScale(r, sd, false), 1.0);
+  }
+}
+
+}  // namespace
+
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   CheckTable(table);
   if (given.candidates.empty()) throw InputError("family choice: no candidates");
@@ -919,12 +1028,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<Eigen::VectorXd, Features::kCount> stack;
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      Eigen::MatrixXd p(rows, nc);
-      for (int c = 0; c < nc; ++c) p.col(c) = (t.row(k) - err[c].row(k)).transpose();
-      stack[k] = ConvexStackWeights(p, t.row(k).transpose());
+      stack[k] = OutputStack(t, err, options, k, folds);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
+      if ((stack[k].array() > 0).count() == 1) stack[k].resize(0);  // one candidate: no stack
     } else {
       std::vector<int> all(static_cast<std::size_t>(nc)), linear;
       for (int c = 0; c < nc; ++c) {
@@ -946,6 +1054,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
   FitChosen(table, options, stack, full, calibrated, &choice);
+  ScaleStackedSd(table, stack, err, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
   choice.warnings = TableWarnings(table, options, constant);
   choice.rows_note = rows_note;
@@ -966,13 +1075,12 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
         sd[k] = p.stddev.ToArray()[k];
         continue;
       }
-      double var = 0;
       for (std::size_t j = 0; j < per_model.size(); ++j) {
-        const double w = choice.weights[k][j], s = per_model[j][q].stddev.ToArray()[k];
+        const double w = choice.weights[k][j];
         mean[k] += w * per_model[j][q].mean.ToArray()[k];
-        var += w * s * s;
+        sd[k] += w * per_model[j][q].stddev.ToArray()[k];
       }
-      sd[k] = std::sqrt(var);
+      sd[k] *= choice.sd_scale[k];
     }
     out[q] = {Features::FromArray(mean), Features::FromArray(sd)};
   }

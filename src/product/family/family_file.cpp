@@ -119,8 +119,10 @@ void to_json(json& j, const Choice& c) {
        {"chosen", c.chosen},
        {"model_of_output", c.model_of_output},
        {"models", c.models}};
-  if (std::any_of(c.weights.begin(), c.weights.end(), [](const auto& w) { return !w.empty(); }))
+  if (std::any_of(c.weights.begin(), c.weights.end(), [](const auto& w) { return !w.empty(); })) {
     j["weights"] = c.weights;
+    j["sd_scale"] = c.sd_scale;
+  }
 }
 
 namespace {
@@ -149,6 +151,17 @@ void ReadWeights(const json& j, const std::string& what, Choice* c) {
     const auto top = std::max_element(c->weights[k].begin(), c->weights[k].end());
     if (*top != c->weights[k][c->model_of_output[k]])
       throw InputError(at + ": the largest weight must be on the model of 'model_of_output'");
+  }
+  // Choice::sd_scale (optional; files of earlier versions have none: 1), CoverageScale's range.
+  if (!j.contains("sd_scale")) return;
+  const json& s = j.at("sd_scale");
+  if (!s.is_array() || s.size() != static_cast<std::size_t>(Features::kCount))
+    throw InputError(what + ": 'sd_scale' must hold one number per output");
+  for (int k = 0; k < Features::kCount; ++k) {
+    if (!s[k].is_number() || !(s[k].get<double>() >= 0.25 && s[k].get<double>() <= 4.0))
+      throw InputError(what + ": 'sd_scale' of " + kTargetColumns[k] +
+                       " must be a number in [0.25, 4]");
+    c->sd_scale[k] = s[k].get<double>();
   }
 }
 }  // namespace
