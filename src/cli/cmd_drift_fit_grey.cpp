@@ -121,7 +121,9 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
   sub->add_option("--spec", o->spec,
                   "grey box spec JSON (format whirl-grey-box-spec: offset_sensors, "
                   "slope_sensors, blank_sensor, z_ref_mm [mm], priors in um per K and um per "
-                  "1000 mm per K; e.g. datasets/machines/field_grey_box_spec.json)")
+                  "1000 mm per K; optional offset_duty, slope_duty: control signals of the day "
+                  "logs, as logged, with the same lags, prior 0; e.g. "
+                  "datasets/machines/field_grey_box_spec.json)")
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "grey box model file to write (JSON)")->required();

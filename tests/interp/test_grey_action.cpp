@@ -326,7 +326,9 @@ TEST(GreyAction, HandComputedSmallExample) {
   const GreyBoxAction a = GreyBoxActionModels(m);
   const DriftActionOptions d = Options();
   replay::Replay r;
-  SetInputs(r, d, {25.0, 22.0, 18.0});
+  Inputs hand;
+  hand << 25.0, 22.0, 18.0, 0.0, 0.0;
+  SetInputs(r, d, hand);
   ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(a.offset, d, "", &a.slope, a.Blank())));
   for (int k = 0; k < 10; ++k) r.Cycle(0.0);
   EXPECT_NEAR(r.control.slope, -11e-6, 1e-13);

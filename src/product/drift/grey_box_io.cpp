@@ -198,8 +198,6 @@ void to_json(json& j, const GreyBoxModel& m) {
        {"offset_sensors", m.offset_sensors},
        {"slope_sensors", m.slope_sensors},
        {"blank_sensor", m.blank_sensor},
-       {"offset_duty", m.offset_duty},
-       {"slope_duty", m.slope_duty},
        {"time_constants_min", m.time_constants},
        {"z_ref_mm", m.z_ref_mm},
        {"offset_features",
@@ -212,6 +210,9 @@ void to_json(json& j, const GreyBoxModel& m) {
        {"fit",
         {{"prior_strength", m.prior_strength}, {"cv_rmse_um", m.cv_rmse_um}, {"rows", m.rows}}},
        {"training", {{"notes", m.notes}}}};
+  // Written only when used: a model without duty inputs is the file it was before they existed.
+  if (!m.offset_duty.empty()) j["offset_duty"] = m.offset_duty;
+  if (!m.slope_duty.empty()) j["slope_duty"] = m.slope_duty;
 }
 
 void from_json(const json& j, GreyBoxModel& m) {
