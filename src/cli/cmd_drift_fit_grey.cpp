@@ -44,11 +44,23 @@ void PrintFitGrey(const drift::GreyBoxModel& m) {
     std::printf(
         "  K0   %-20s %9.3f um/K (sum over its lags)\n", m.offset_sensors[i].c_str(),
         m.a.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
+  for (std::size_t i = 0; i < m.offset_duty.size(); ++i)
+    std::printf("  K0   %-20s %9.3f um per unit (duty input, sum over its lags)\n",
+                m.offset_duty[i].c_str(),
+                m.a.segment(static_cast<Eigen::Index>((m.offset_sensors.size() + i) * per),
+                            static_cast<Eigen::Index>(per))
+                    .sum());
   std::printf("  G    intercept            %9.3f um per 1000 mm\n", m.slope_intercept_um_per_1000);
   for (std::size_t i = 0; i < m.slope_sensors.size(); ++i)
     std::printf(
         "  G    %-20s %9.3f um per 1000 mm per K (sum over its lags)\n", m.slope_sensors[i].c_str(),
         m.g.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
+  for (std::size_t i = 0; i < m.slope_duty.size(); ++i)
+    std::printf("  G    %-20s %9.3f um per 1000 mm per unit (duty input, sum over its lags)\n",
+                m.slope_duty[i].c_str(),
+                m.g.segment(static_cast<Eigen::Index>((m.slope_sensors.size() + i) * per),
+                            static_cast<Eigen::Index>(per))
+                    .sum());
   if (!m.blank_sensor.empty())
     std::printf("  G    blank (%s, latched) %9.3f um per 1000 mm per K\n", m.blank_sensor.c_str(),
                 m.blank_um_per_1000_per_k);
@@ -109,7 +121,9 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
   sub->add_option("--spec", o->spec,
                   "grey box spec JSON (format whirl-grey-box-spec: offset_sensors, "
                   "slope_sensors, blank_sensor, z_ref_mm [mm], priors in um per K and um per "
-                  "1000 mm per K; e.g. datasets/machines/field_grey_box_spec.json)")
+                  "1000 mm per K; optional offset_duty, slope_duty: control signals of the day "
+                  "logs, as logged, with the same lags, prior 0; e.g. "
+                  "datasets/machines/field_grey_box_spec.json)")
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "grey box model file to write (JSON)")->required();

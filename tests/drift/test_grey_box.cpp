@@ -62,11 +62,28 @@ GreyBoxModel Truth() {
 // Per day: a probe series at z = 150 mm, laser targets at 1000 and 4000 mm (one record each), and
 // two lead records (cuts from z = 5000 mm towards the chuck at 20 mm/min, starting at minutes
 // 60 and 200). Each record has an unknown zero; values = the truth, no noise.
-ShopRecord Planted(const GreyBoxModel& truth, bool leads, int days = 5) {
+// With duty: the log also carries the control's signals (other columns, as logged): a load in
+// percent that steps with the cuts and a Z speed in mm/min during them.
+Run DutyDayLog(int day, int minutes) {
+  Run r = DayLog(day, minutes);
+  r.other_names = {"load_pct", "speed_mm_min"};
+  r.other.resize(minutes + 1, 2);
+  for (int k = 0; k <= minutes; ++k) {
+    const bool cut = (k >= 60 && k <= 180) || (k >= 200 && k <= 320);
+    r.other(k, 0) = cut ? 20.0 + 15.0 * ((day + k / 60) % 3) : 2.0;
+    r.other(k, 1) = cut ? 20.0 + 5.0 * (day % 2) : 0.0;
+  }
+  return r;
+}
+
+ShopRecord Planted(const GreyBoxModel& truth, bool leads, int days = 5,
+                   const std::function<Run(int, int)>& day_log = [](int d, int m) {
+                     return DayLog(d, m);
+                   }) {
   ShopRecord rec;
   Rng rng(7);
   for (int day = 0; day < days; ++day) {
-    rec.day_logs.push_back(DayLog(day, 360));
+    rec.day_logs.push_back(day_log(day, 360));
     auto add = [&](MeasurementRecord r) {
       const std::vector<double> m = PredictGreyRecord(truth, rec, r);
       const double zero = 5.0 * rng.Normal();
@@ -95,10 +112,24 @@ ShopRecord Planted(const GreyBoxModel& truth, bool leads, int days = 5) {
   return rec;
 }
 
+// The truth with a duty input on each channel: the load heats the head, the speed the screw.
+GreyBoxModel DutyTruth() {
+  GreyBoxModel t = Truth();
+  t.offset_duty = {"load_pct"};
+  t.slope_duty = {"speed_mm_min"};
+  t.a.resize(4);
+  t.a << 1.5, -2.5, 0.08, 0.05;
+  t.g.resize(4);
+  t.g << 7.0, 4.5, -0.02, 0.06;
+  return t;
+}
+
 GreyBoxSpec SpecOf(const GreyBoxModel& t) {
   GreyBoxSpec s;
   s.offset_sensors = t.offset_sensors;
   s.slope_sensors = t.slope_sensors;
+  s.offset_duty = t.offset_duty;
+  s.slope_duty = t.slope_duty;
   s.blank_sensor = t.blank_sensor;
   s.z_ref_mm = t.z_ref_mm;
   return s;
@@ -125,6 +156,34 @@ TEST(GreyBox, RecoversEveryPlantedCoefficientIncludingTheLatchedBlank) {
   EXPECT_NEAR(m.slope_intercept_um_per_1000, t.slope_intercept_um_per_1000, 1e-3);
   EXPECT_NEAR(m.blank_um_per_1000_per_k, t.blank_um_per_1000_per_k, 1e-3);
   EXPECT_LT(m.cv_rmse_um, 1e-3);
+}
+
+// Duty inputs (the control's signals as logged, with the same lags) are recovered beside the
+// temperatures, and a fit without them cannot explain the same readings.
+TEST(GreyBox, RecoversPlantedDutyInputsOnBothChannels) {
+  const GreyBoxModel t = DutyTruth();
+  const ShopRecord rec = Planted(t, true, 5, DutyDayLog);
+  const GreyBoxModel m = FitGreyBox(rec, SpecOf(t), Fixed(t, 1e-10));
+  ASSERT_EQ(m.a.size(), 4);
+  ASSERT_EQ(m.g.size(), 4);
+  EXPECT_EQ(m.offset_duty, t.offset_duty);
+  EXPECT_EQ(m.slope_duty, t.slope_duty);
+  for (Eigen::Index j = 0; j < 4; ++j) {
+    EXPECT_NEAR(m.a(j), t.a(j), 1e-3) << j;
+    EXPECT_NEAR(m.g(j), t.g(j), 1e-3) << j;
+  }
+  EXPECT_NEAR(m.blank_um_per_1000_per_k, t.blank_um_per_1000_per_k, 1e-3);
+  EXPECT_LT(m.cv_rmse_um, 1e-3);
+  for (const MeasurementRecord& r : rec.records) {
+    const std::vector<double> p = PredictGreyRecord(m, rec, r), q = PredictGreyRecord(t, rec, r);
+    for (std::size_t i = 0; i < p.size(); ++i) EXPECT_NEAR(p[i], q[i], 1e-3);
+  }
+  const GreyBoxModel without = FitGreyBox(rec, SpecOf(Truth()), Fixed(t, 1e-10));
+  EXPECT_GT(without.cv_rmse_um, 0.1);
+  // A duty input the logs lack is named.
+  GreyBoxSpec s = SpecOf(t);
+  s.slope_duty = {"no_such_signal"};
+  ExpectInputError([&] { FitGreyBox(rec, s, Fixed(t, 1e-2)); }, "no_such_signal");
 }
 
 TEST(GreyBox, TheSearchFindsThePlantedLagsAmongOthers) {
@@ -259,6 +318,8 @@ void ExpectSameModel(const GreyBoxModel& a, const GreyBoxModel& b, double tol) {
   EXPECT_EQ(a.offset_sensors, b.offset_sensors);
   EXPECT_EQ(a.slope_sensors, b.slope_sensors);
   EXPECT_EQ(a.blank_sensor, b.blank_sensor);
+  EXPECT_EQ(a.offset_duty, b.offset_duty);
+  EXPECT_EQ(a.slope_duty, b.slope_duty);
   EXPECT_EQ(a.time_constants, b.time_constants);
   EXPECT_EQ(a.z_ref_mm, b.z_ref_mm);
   ASSERT_EQ(a.a.size(), b.a.size());
@@ -291,6 +352,27 @@ TEST(GreyBoxFiles, TheModelFileRoundTripsExactlyAndPredictsTheSame) {
   // The ranges are those of the evaluator on the logs: B stays within them.
   EXPECT_LT(m.blank_min_c, m.blank_max_c);
   EXPECT_GE((m.offset_max - m.offset_min).minCoeff(), 0.0);
+}
+
+TEST(GreyBoxFiles, AModelWithDutyInputsRoundTripsExactly) {
+  const GreyBoxModel t = DutyTruth();
+  const ShopRecord rec = Planted(t, true, 5, DutyDayLog);
+  const GreyBoxModel m = FitGreyBox(rec, SpecOf(t), Fixed(t, 1e-2));
+  const auto path = test::ScratchDir() / "grey_duty.json";
+  WriteGreyBoxModel(path, m);
+  const GreyBoxModel back = ReadGreyBoxModel(path);
+  ExpectSameModel(m, back, 0.0);
+  for (const MeasurementRecord& r : rec.records)
+    EXPECT_EQ(PredictGreyRecord(back, rec, r), PredictGreyRecord(m, rec, r));
+  // The duty feature's range is that of the signal as logged (2..50 %), not against 20 degC.
+  EXPECT_DOUBLE_EQ(m.offset_min(2), 2.0);
+  EXPECT_DOUBLE_EQ(m.offset_max(2), 50.0);
+  // A file whose duty feature names the wrong input is refused with the rule.
+  nlohmann::json j = ReadJsonFile(path);
+  j["offset_features"][2]["input"] = "head_C";
+  const auto bad = test::ScratchDir() / "grey_duty_bad.json";
+  WriteJsonFile(bad, j);
+  ExpectInputError([&] { ReadGreyBoxModel(bad); }, "then each duty input");
 }
 
 TEST(GreyBoxFiles, FittedFromTheRecordsFileItIsTheModelOfTheRecordsInMemory) {

@@ -26,7 +26,9 @@ constexpr double kFixedEndMm = 5587.5;  // P_b (MCS): z_ref = 6400 mm with the p
 
 // Offset from t1, t2; slope from t2, t3; the blank from t3. Lags of 0.02 and 0.1 min and a blank
 // lag of 0.05 min: a few hundred cycles of 50 ms, so every recursion is exercised.
-drift::GreyBoxModel Model() {
+// With `duty`: also a load (percent) on the offset and a speed (mm/min) on the slope, as logged
+// with the same lags (the duty inputs of drift/grey_box.h).
+drift::GreyBoxModel Model(bool duty = false) {
   drift::GreyBoxModel m;
   m.offset_sensors = {"t1_C", "t2_C"};
   m.slope_sensors = {"t2_C", "t3_C"};
@@ -44,6 +46,18 @@ drift::GreyBoxModel Model() {
   m.offset_max = m.slope_max = Eigen::VectorXd::Constant(6, 20.0);
   m.blank_min_c = 10;
   m.blank_max_c = 35;
+  if (duty) {
+    m.offset_duty = {"load_pct"};
+    m.slope_duty = {"speed_mm_min"};
+    m.a.conservativeResize(9);
+    m.a.tail(3) << 0.05, 0.12, -0.03;
+    m.g.conservativeResize(9);
+    m.g.tail(3) << 0.02, -0.01, 0.04;
+    for (Eigen::VectorXd* v : {&m.offset_min, &m.slope_min})
+      v->conservativeResize(9), v->tail(3).setConstant(0.0);
+    for (Eigen::VectorXd* v : {&m.offset_max, &m.slope_max})
+      v->conservativeResize(9), v->tail(3).setConstant(200.0);
+  }
   return m;
 }
 
@@ -68,6 +82,8 @@ DriftActionOptions Options() {
   o.inputs["t1_C"] = {3, 0.1, -20.0};
   o.inputs["t2_C"] = {7, 0.05, 0.0};
   o.inputs["t3_C"] = {9, 0.0625, 0.0};
+  o.inputs["load_pct"] = {17, 0.1, 0.0};
+  o.inputs["speed_mm_min"] = {18, 1.0, 0.0};
   return o;
 }
 
@@ -88,26 +104,35 @@ PlanOptions Plan(const DriftActionOptions& d, bool latch) {
   return p;
 }
 
-// Temperatures at cycle k [degC]: t1 warms, t2 creeps, t3 (the hall) falls by several K over the
-// cut, so B moves by more than a K while the latched value must not.
-Eigen::Vector3d Temperatures(int k) {
+// Inputs at cycle k: t1 warms, t2 creeps, t3 (the hall) falls by several K over the cut, so B
+// moves by more than a K while the latched value must not [degC]; the load [%] steps every 40 s,
+// the speed [mm/min] ramps.
+using Inputs = Eigen::Matrix<double, 5, 1>;
+Inputs Temperatures(int k) {
   const double t_s = k * kCycleMs / 1000.0;
-  return {25.0 + 6.0 * (1 - std::exp(-t_s / 20.0)), 26.0 + 0.08 * t_s,
-          23.0 - 4.0 * (1 - std::exp(-t_s / 200.0)) + 0.3 * std::sin(t_s / 7.0)};
+  Inputs u;
+  u << 25.0 + 6.0 * (1 - std::exp(-t_s / 20.0)), 26.0 + 0.08 * t_s,
+      23.0 - 4.0 * (1 - std::exp(-t_s / 200.0)) + 0.3 * std::sin(t_s / 7.0),
+      20.0 + 30.0 * (static_cast<int>(t_s / 40.0) % 3), 50.0 + 0.5 * t_s;
+  return u;
 }
 
-void SetInputs(replay::Replay& r, const DriftActionOptions& o, const Eigen::Vector3d& t) {
-  const char* names[] = {"t1_C", "t2_C", "t3_C"};
-  for (int i = 0; i < 3; ++i) {
+void SetInputs(replay::Replay& r, const DriftActionOptions& o, const Inputs& t) {
+  const char* names[] = {"t1_C", "t2_C", "t3_C", "load_pct", "speed_mm_min"};
+  for (int i = 0; i < 5; ++i) {
     const AnalogInput& a = o.inputs.at(names[i]);
     r.control.ain[a.index] = (t(i) - a.offset) / a.scale;
   }
 }
 
-// The raw inputs the evaluator takes (GreyBoxModel::Inputs order: t1, t2 | t2, t3 | t3).
-Eigen::VectorXd Raw(const Eigen::Vector3d& t) {
-  Eigen::VectorXd u(5);
-  u << t(0), t(1), t(1), t(2), t(2);
+// The raw inputs the evaluator takes (GreyBoxRawInputs' order: t1, t2 | t2, t3 | t3, then the
+// duty inputs load | speed).
+Eigen::VectorXd Raw(const Inputs& t, bool duty = false) {
+  Eigen::VectorXd u(duty ? 7 : 5);
+  if (duty)
+    u << t(0), t(1), t(1), t(2), t(2), t(3), t(4);
+  else
+    u << t(0), t(1), t(1), t(2), t(2);
   return u;
 }
 
@@ -132,8 +157,8 @@ double ExpectedDkMm(const replay::Replay& r, const DriftActionOptions& o,
   return workpiece + machine;
 }
 
-TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) {
-  const drift::GreyBoxModel model = Model();
+void FollowsTheEvaluator(bool duty) {
+  const drift::GreyBoxModel model = Model(duty);
   const GreyBoxAction action = GreyBoxActionModels(model);
   const DriftActionOptions d = Options();
   const PlanOptions p = Plan(d, true);
@@ -149,9 +174,9 @@ TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) 
   r.axis_mm = parked;
   drift::GreyBoxEvaluator ev(model);
   int k = 0;
-  Eigen::Vector3d now = Temperatures(0);
+  Inputs now = Temperatures(0);
   drift::GreyBoxEvaluator::Output e;
-  auto step_reference = [&] { e = ev.Step(k * kCycleMs / 60000.0, Raw(now)), ++k; };
+  auto step_reference = [&] { e = ev.Step(k * kCycleMs / 60000.0, Raw(now, duty)), ++k; };
   SetInputs(r, d, now);
   ASSERT_TRUE(
       r.RunProgram(FormatDriftNcProgram(action.offset, d, "", &action.slope, action.Blank())));
@@ -218,6 +243,14 @@ TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) 
   EXPECT_EQ(r.control.ref_position_mm, 12.0);
   EXPECT_TRUE(r.actions.empty());
 }
+
+TEST(GreyAction, TheControlFollowsTheEvaluatorAndHoldsTheLatchedBlankForTheCut) {
+  FollowsTheEvaluator(false);
+}
+
+// Duty inputs (the ring's load on K0, the Z speed on the slope) are read as logged, without a
+// reference, through their own lags: the control still equals the evaluator every cycle.
+TEST(GreyAction, DutyInputsAreEvaluatedAsFitted) { FollowsTheEvaluator(true); }
 
 // An aborted cut leaves the latch set: the plan's next call (its undo) and its reset program
 // write 20 back before anything else, so the approach applies no blank term.
@@ -293,7 +326,9 @@ TEST(GreyAction, HandComputedSmallExample) {
   const GreyBoxAction a = GreyBoxActionModels(m);
   const DriftActionOptions d = Options();
   replay::Replay r;
-  SetInputs(r, d, {25.0, 22.0, 18.0});
+  Inputs hand;
+  hand << 25.0, 22.0, 18.0, 0.0, 0.0;
+  SetInputs(r, d, hand);
   ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram(a.offset, d, "", &a.slope, a.Blank())));
   for (int k = 0; k < 10; ++k) r.Cycle(0.0);
   EXPECT_NEAR(r.control.slope, -11e-6, 1e-13);

@@ -34,6 +34,20 @@ grep -q '"residual"' "$D/pred.json" || fail "prediction has no residual"
 "$W" drift fit-grey --records "$D/x/records.json" \
   --spec "$S/datasets/machines/field_grey_box_spec.json" --out "$D/grey.json" > /dev/null \
   2> "$D/grey_err.txt" || fail "drift fit-grey on the exported records: $(cat "$D/grey_err.txt")"
+# The same with duty inputs (the control's signals of the exported logs): fitted and printed; a
+# duty input the logs lack is named.
+sed 's/"blank_sensor": "ambient_C",/"blank_sensor": "ambient_C", "offset_duty": ["ring_load_pct"], "slope_duty": ["z_speed_mm_min"],/' \
+  "$S/datasets/machines/field_grey_box_spec.json" > "$D/spec_duty.json"
+grep -q offset_duty "$D/spec_duty.json" || fail "the duty spec was not made"
+"$W" drift fit-grey --records "$D/x/records.json" --spec "$D/spec_duty.json" \
+  --out "$D/grey_duty.json" > "$D/grey_duty.txt" 2> "$D/grey_err.txt" \
+  || fail "drift fit-grey with duty inputs: $(cat "$D/grey_err.txt")"
+grep -q "ring_load_pct .*duty input" "$D/grey_duty.txt" || fail "fit-grey prints no duty input"
+grep -q '"slope_duty"' "$D/grey_duty.json" || fail "the model file has no slope_duty"
+sed 's/z_speed_mm_min/z_speeed/' "$D/spec_duty.json" > "$D/spec_bad.json"
+expect_fail "z_speeed" "$W" drift fit-grey --records "$D/x/records.json" \
+  --spec "$D/spec_bad.json" --out "$D/grey_bad.json"
+[ ! -e "$D/grey_bad.json" ] || fail "fit-grey wrote a model on bad input"
 # Writing again into its own folder works; bad input writes nothing.
 "$W" machine export --out-dir "$D/x" --past-days 1 --test-days 1 --seed 3 > /dev/null \
   || fail "export again into its own folder"

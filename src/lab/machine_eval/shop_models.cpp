@@ -64,6 +64,9 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   bool placed = true;
   for (const std::string& s : grey.Inputs())
     placed = placed && std::find(have.begin(), have.end(), s) != have.end();
+  const std::vector<std::string>& other = record.day_logs.front().other_names;
+  for (const std::string& s : grey.DutyInputs())
+    placed = placed && std::find(other.begin(), other.end(), s) != other.end();
   drift::GreyBoxOptions grey_options;
   if (contact) grey_options.blank_tau_grid = {kBlankContactTauMin};  // a held reading: no lag
   if (placed) m.grey = drift::FitGreyBox(record, grey, grey_options);

@@ -35,6 +35,18 @@ std::vector<std::string> GreyBoxSpec::Inputs() const {
   return in;
 }
 
+std::vector<std::string> GreyBoxSpec::DutyInputs() const {
+  std::vector<std::string> in = offset_duty;
+  in.insert(in.end(), slope_duty.begin(), slope_duty.end());
+  return in;
+}
+
+std::vector<std::string> GreyBoxModel::DutyInputs() const {
+  std::vector<std::string> in = offset_duty;
+  in.insert(in.end(), slope_duty.begin(), slope_duty.end());
+  return in;
+}
+
 std::vector<std::string> GreyBoxModel::Inputs() const {
   std::vector<std::string> in = offset_sensors;
   in.insert(in.end(), slope_sensors.begin(), slope_sensors.end());
@@ -50,6 +62,17 @@ Eigen::MatrixXd AbsoluteFeatures(const Run& run, const std::vector<std::string>&
     const double first = run.temperature_C(0, run.SensorIndex(sensors[i])) - 20.0;
     f.middleCols(static_cast<Eigen::Index>(i) * per, per).array() += first;
   }
+  return f;
+}
+
+Eigen::MatrixXd GreyChannelFeatures(const Run& run, const std::vector<std::string>& sensors,
+                                    const std::vector<std::string>& duty,
+                                    const std::vector<double>& taus) {
+  const Eigen::MatrixXd t = AbsoluteFeatures(run, sensors, taus);
+  if (duty.empty()) return t;
+  const Eigen::MatrixXd d = BuildFeatures(run, {}, duty, taus);
+  Eigen::MatrixXd f(t.rows(), t.cols() + d.cols());
+  f << t, d;
   return f;
 }
 
@@ -77,8 +100,8 @@ struct LogFeatures {
 
 LogFeatures FeaturesOf(const Run& log, const GreyBoxSpec& spec, const Choice& c) {
   LogFeatures f;
-  f.off = AbsoluteFeatures(log, spec.offset_sensors, c.taus);
-  f.slope = AbsoluteFeatures(log, spec.slope_sensors, c.taus);
+  f.off = GreyChannelFeatures(log, spec.offset_sensors, spec.offset_duty, c.taus);
+  f.slope = GreyChannelFeatures(log, spec.slope_sensors, spec.slope_duty, c.taus);
   f.blank_c = Eigen::VectorXd::Constant(log.samples(), 20.0);
   if (!spec.blank_sensor.empty())
     f.blank_c = AbsoluteFeatures(log, {spec.blank_sensor}, {c.blank_tau}).col(1).array() + 20.0;
@@ -104,8 +127,9 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
   std::size_t n = 0;
   for (const auto& r : rec.records) n += r.rows.size();
   Design d;
-  d.po = static_cast<Eigen::Index>(spec.offset_sensors.size() * (1 + c.taus.size()));
-  d.ps = static_cast<Eigen::Index>(spec.slope_sensors.size() * (1 + c.taus.size()));
+  const std::size_t per = 1 + c.taus.size();
+  d.po = static_cast<Eigen::Index>((spec.offset_sensors.size() + spec.offset_duty.size()) * per);
+  d.ps = static_cast<Eigen::Index>((spec.slope_sensors.size() + spec.slope_duty.size()) * per);
   const Eigen::Index p = d.po + d.ps + 2;
   d.x.resize(static_cast<Eigen::Index>(n), p);
   d.y.resize(static_cast<Eigen::Index>(n));
@@ -148,8 +172,12 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
     }
   }
   d.prior.resize(p);
+  const auto duty_cols = [&](const std::vector<std::string>& duty) {
+    return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(duty.size() * per));
+  };
   d.prior << Priors(spec.offset_sensors, spec.offset_prior, c.taus.size()),
-      Priors(spec.slope_sensors, spec.slope_prior, c.taus.size()), 0.0, spec.blank_prior;
+      duty_cols(spec.offset_duty), Priors(spec.slope_sensors, spec.slope_prior, c.taus.size()),
+      duty_cols(spec.slope_duty), 0.0, spec.blank_prior;
   return d;
 }
 
@@ -245,8 +273,10 @@ GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
   options.Validate();
   if (spec.offset_sensors.empty() && spec.slope_sensors.empty())
     throw InputError("grey box: no offset or slope sensor given");
-  for (const Run& log : record.day_logs)
+  for (const Run& log : record.day_logs) {
     for (const auto& s : spec.Inputs()) (void)log.SensorIndex(s);  // InputError naming it
+    for (const auto& s : spec.DutyInputs()) (void)log.OtherIndex(s);
+  }
   double cv = 0;
   const grey_box_detail::Choice c = grey_box_detail::Choose(record, spec, options, &cv);
   const grey_box_detail::Design d = grey_box_detail::BuildDesign(record, spec, c, options.lead_share);
@@ -258,6 +288,8 @@ GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
   m.offset_sensors = spec.offset_sensors;
   m.slope_sensors = spec.slope_sensors;
   m.blank_sensor = spec.blank_sensor;
+  m.offset_duty = spec.offset_duty;
+  m.slope_duty = spec.slope_duty;
   m.time_constants = c.taus;
   m.z_ref_mm = spec.z_ref_mm;
   m.a = b.head(d.po);
@@ -274,16 +306,18 @@ GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
 
 void SetGreyBoxRanges(GreyBoxModel* m, const std::vector<Run>& logs) {
   const auto per = static_cast<Eigen::Index>(1 + m->time_constants.size());
-  const auto no = static_cast<Eigen::Index>(m->offset_sensors.size()) * per;
-  const auto ns = static_cast<Eigen::Index>(m->slope_sensors.size()) * per;
+  const auto no = static_cast<Eigen::Index>(m->offset_sensors.size() + m->offset_duty.size()) * per;
+  const auto ns = static_cast<Eigen::Index>(m->slope_sensors.size() + m->slope_duty.size()) * per;
   m->offset_min = m->offset_max = Eigen::VectorXd::Zero(no);
   m->slope_min = m->slope_max = Eigen::VectorXd::Zero(ns);
   m->blank_min_c = m->blank_max_c = 20;
   bool first = true;
   for (const Run& log : logs) {
     if (log.samples() == 0) continue;
-    const Eigen::MatrixXd o = AbsoluteFeatures(log, m->offset_sensors, m->time_constants);
-    const Eigen::MatrixXd s = AbsoluteFeatures(log, m->slope_sensors, m->time_constants);
+    const Eigen::MatrixXd o =
+        GreyChannelFeatures(log, m->offset_sensors, m->offset_duty, m->time_constants);
+    const Eigen::MatrixXd s =
+        GreyChannelFeatures(log, m->slope_sensors, m->slope_duty, m->time_constants);
     const Eigen::VectorXd omin = o.colwise().minCoeff(), omax = o.colwise().maxCoeff();
     const Eigen::VectorXd smin = s.colwise().minCoeff(), smax = s.colwise().maxCoeff();
     m->offset_min = first ? omin : m->offset_min.cwiseMin(omin);
@@ -324,12 +358,23 @@ GreyBoxEvaluator::GreyBoxEvaluator(const GreyBoxModel& model) : model_(&model) {
 GreyBoxEvaluator::Output GreyBoxEvaluator::Step(double time_min, const Eigen::VectorXd& raw) {
   const GreyBoxModel& m = *model_;
   const auto nt = static_cast<Eigen::Index>(m.time_constants.size());
-  const auto no = static_cast<Eigen::Index>(m.offset_sensors.size());
-  const auto ns = static_cast<Eigen::Index>(m.slope_sensors.size());
+  const auto nos = static_cast<Eigen::Index>(m.offset_sensors.size());
+  const auto nss = static_cast<Eigen::Index>(m.slope_sensors.size());
+  const auto nod = static_cast<Eigen::Index>(m.offset_duty.size());
+  const auto nsd = static_cast<Eigen::Index>(m.slope_duty.size());
+  const Eigen::Index no = nos + nod, ns = nss + nsd, nb = m.blank_sensor.empty() ? 0 : 1;
+  // Channel order [offset sensors | offset duty | slope sensors | slope duty]; raw order
+  // [offset sensors | slope sensors | blank | offset duty | slope duty].
+  auto raw_of = [&](Eigen::Index i) {
+    if (i < nos) return raw(i) - 20.0;
+    if (i < no) return raw(nos + nss + nb + (i - nos));
+    if (i < no + nss) return raw(nos + (i - no)) - 20.0;
+    return raw(nos + nss + nb + nod + (i - no - nss));
+  };
   if (!started_) lag_ = Eigen::VectorXd::Zero((no + ns) * nt);
   Eigen::VectorXd phi((no + ns) * (1 + nt));
   for (Eigen::Index i = 0; i < no + ns; ++i) {
-    const double u = raw(i) - 20.0;
+    const double u = raw_of(i);
     phi(i * (1 + nt)) = u;
     for (Eigen::Index l = 0; l < nt; ++l) {
       double& y = lag_(i * nt + l);
@@ -339,7 +384,7 @@ GreyBoxEvaluator::Output GreyBoxEvaluator::Step(double time_min, const Eigen::Ve
     }
   }
   if (!m.blank_sensor.empty()) {
-    const double u = raw(no + ns);
+    const double u = raw(nos + nss);
     blank_ = started_
                  ? blank_ + (1.0 - std::exp(-(time_min - last_time_) / m.blank_tau_min)) * (u - blank_)
                  : u;
@@ -359,10 +404,11 @@ double GreyBoxEvaluator::BlankSlope(double latched_blank_c) const {
 }
 
 Eigen::MatrixXd GreyBoxRawInputs(const GreyBoxModel& m, const Run& run) {
-  const std::vector<std::string> in = m.Inputs();
-  Eigen::MatrixXd u(run.samples(), static_cast<Eigen::Index>(in.size()));
-  for (std::size_t c = 0; c < in.size(); ++c)
-    u.col(static_cast<Eigen::Index>(c)) = run.temperature_C.col(run.SensorIndex(in[c]));
+  const std::vector<std::string> in = m.Inputs(), duty = m.DutyInputs();
+  Eigen::MatrixXd u(run.samples(), static_cast<Eigen::Index>(in.size() + duty.size()));
+  Eigen::Index c = 0;
+  for (const std::string& s : in) u.col(c++) = run.temperature_C.col(run.SensorIndex(s));
+  for (const std::string& s : duty) u.col(c++) = run.other.col(run.OtherIndex(s));
   return u;
 }
 

@@ -31,6 +31,10 @@
 // one calendar day out, the same weights): the lags (greedy, at most max_lags from tau_grid), then
 // the blank's time constant from blank_tau_grid, then the strength from strength_grid. The
 // sensors are the caller's, physically placed (no greedy search among collinear sensors).
+// Duty inputs (optional): control signals as logged (the day log's other columns, e.g. the ring
+// drive's load on the offset, the Z speed on the slope), each with the same lags, appended after
+// the temperatures of their channel (phi_o = [temperatures | duty], likewise phi_s), prior 0:
+// the heat a source puts in now, which a sensor away from it sees only later.
 #include <Eigen/Core>
 #include <map>
 #include <string>
@@ -45,6 +49,8 @@ struct GreyBoxSpec {
   std::vector<std::string> offset_sensors;  ///< K0 inputs (head, bed), as the logs name them
   std::vector<std::string> slope_sensors;   ///< slope inputs (screw, hall)
   std::string blank_sensor;                 ///< the blank's estimate; "" = no blank term
+  /// Duty inputs of K0 and of the slope: other columns of the logs, as logged, prior 0.
+  std::vector<std::string> offset_duty, slope_duty;
   double z_ref_mm = 6400;                   ///< slope reference (the Z screw's fixed bearing)
   /// Physical priors, um per K of an input (spread equally over its static and lagged
   /// columns); an input not named has prior 0. Offset: um per K; slope: um per 1000 mm per K.
@@ -53,6 +59,8 @@ struct GreyBoxSpec {
   double blank_prior = -11.5;
   /// Every sensor the spec reads: offset, slope, then the blank sensor (when set).
   std::vector<std::string> Inputs() const;
+  /// The duty inputs it reads: offset_duty, then slope_duty.
+  std::vector<std::string> DutyInputs() const;
 };
 
 struct GreyBoxOptions {
@@ -67,10 +75,13 @@ struct GreyBoxOptions {
 struct GreyBoxModel {
   std::vector<std::string> offset_sensors, slope_sensors;
   std::string blank_sensor;
+  std::vector<std::string> offset_duty, slope_duty;  ///< as logged (other columns), after the sensors
   std::vector<double> time_constants;  ///< min, ascending
   double z_ref_mm = 6400;
-  Eigen::VectorXd a;  ///< per offset feature (input-major: T - 20, then its lags), um per K
-  Eigen::VectorXd g;  ///< per slope feature, um per 1000 mm per K
+  /// Per offset feature (input-major: each sensor's T - 20, then its lags; then each duty
+  /// input as logged and its lags), um per K (um per unit of a duty input).
+  Eigen::VectorXd a;
+  Eigen::VectorXd g;  ///< per slope feature (the same order), um per 1000 mm per K (per unit)
   double slope_intercept_um_per_1000 = 0;  ///< g0
   double blank_tau_min = 60;               ///< B's lag
   double blank_um_per_1000_per_k = 0;      ///< g_b
@@ -83,9 +94,11 @@ struct GreyBoxModel {
   Eigen::VectorXd offset_min, offset_max, slope_min, slope_max;
   double blank_min_c = 20, blank_max_c = 20;
   std::vector<std::string> notes;  ///< provenance (the command line, the records)
-  /// The raw inputs a control feeds the evaluator, in order: offset sensors, slope sensors,
+  /// The temperatures a control feeds the evaluator, in order: offset sensors, slope sensors,
   /// then the blank sensor (when set).
   std::vector<std::string> Inputs() const;
+  /// The duty inputs it feeds after them: offset_duty, then slope_duty.
+  std::vector<std::string> DutyInputs() const;
 };
 
 /// InputError: an invalid record, a missing column, no sensor, bad options, or fewer readings
@@ -122,12 +135,19 @@ class GreyBoxEvaluator {
   bool started_ = false;
 };
 
-/// Raw inputs (GreyBoxModel::Inputs order) of every sample of a run; InputError if missing.
+/// Raw inputs of every sample of a run: Inputs() (temperatures, degC), then DutyInputs() (as
+/// logged); InputError if one is missing.
 Eigen::MatrixXd GreyBoxRawInputs(const GreyBoxModel& m, const Run& run);
 
 /// Features of `sensors` on a run as absolute temperatures referred to 20 degC, input-major
 /// with their lags (samples x sensors (1 + taus)).
 Eigen::MatrixXd AbsoluteFeatures(const Run& run, const std::vector<std::string>& sensors,
                                  const std::vector<double>& taus);
+
+/// One channel's features: AbsoluteFeatures of `sensors`, then `duty` as logged with the same
+/// lags (samples x (sensors + duty)(1 + taus)).
+Eigen::MatrixXd GreyChannelFeatures(const Run& run, const std::vector<std::string>& sensors,
+                                    const std::vector<std::string>& duty,
+                                    const std::vector<double>& taus);
 
 }  // namespace whirl::drift

@@ -16,18 +16,29 @@ using nlohmann::json;
 
 const char* const kWhat = "grey box model";
 
-std::string FeatureName(const std::string& input, double tau) {
-  return tau == 0 ? input + "-20" : "lag" + MessageNumber(tau) + "min(" + input + "-20)";
+// A sensor's feature is T - 20; a duty input's the input as logged.
+std::string FeatureName(const std::string& input, double tau, bool duty) {
+  const std::string u = duty ? input : input + "-20";
+  return tau == 0 ? u : "lag" + MessageNumber(tau) + "min(" + u + ")";
 }
 
-json Features(const std::vector<std::string>& inputs, const std::vector<double>& taus,
-              const Eigen::VectorXd& c, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) {
+std::vector<std::string> Joined(std::vector<std::string> sensors,
+                                const std::vector<std::string>& duty) {
+  sensors.insert(sensors.end(), duty.begin(), duty.end());
+  return sensors;
+}
+
+json Features(const std::vector<std::string>& sensors, const std::vector<std::string>& duty,
+              const std::vector<double>& taus, const Eigen::VectorXd& c, const Eigen::VectorXd& lo,
+              const Eigen::VectorXd& hi) {
   json out = json::array();
   Eigen::Index k = 0;
-  for (const std::string& in : inputs)
+  const std::vector<std::string> inputs = Joined(sensors, duty);
+  for (std::size_t i = 0; i < inputs.size(); ++i)
     for (std::size_t l = 0; l <= taus.size(); ++l, ++k) {
+      const std::string& in = inputs[i];
       const double tau = l == 0 ? 0.0 : taus[l - 1];
-      out.push_back({{"name", FeatureName(in, tau)},
+      out.push_back({{"name", FeatureName(in, tau, i >= sensors.size())},
                      {"input", in},
                      {"tau_min", tau},
                      {"coefficient", c(k)},
@@ -59,7 +70,8 @@ void ReadFeatures(const json& j, const char* key, const std::vector<std::string>
     const double tau = l == 0 ? 0.0 : taus[l - 1];
     if (RequireString(x, "input", w) != input || RequireNumber(x, "tau_min", w) != tau)
       throw InputError(w + ": must be input '" + input + "' with tau_min " + MessageNumber(tau) +
-                       " (input-major: each sensor's T - 20, then its lags)");
+                       " (input-major: each sensor's T - 20, then its lags; then each duty "
+                       "input and its lags)");
     const auto i = static_cast<Eigen::Index>(k);
     (*c)(i) = RequireNumber(x, "coefficient", w);
     (*lo)(i) = RequireNumber(x, "train_min_k", w);
@@ -76,15 +88,20 @@ void CheckNames(const std::vector<std::string>& names, const char* field, const 
   }
 }
 
+// The first `temperatures` features are temperatures (K against 20 degC); the rest duty inputs in
+// their own unit.
 void CheckCoefficients(const Eigen::VectorXd& c, const Eigen::VectorXd& lo,
-                       const Eigen::VectorXd& hi, const char* field, const char* unit) {
+                       const Eigen::VectorXd& hi, Eigen::Index temperatures, const char* field,
+                       const char* unit) {
   for (Eigen::Index k = 0; k < c.size(); ++k) {
     const std::string f = std::string(field) + "[" + std::to_string(k) + "]";
+    const bool duty = k >= temperatures;
+    const double bound = duty ? kMaxGreyDutyValue : kMaxGreyFeatureK;
+    const char* u = duty ? "the input's unit" : "K";
     CheckRange(c(k), {-kMaxGreyCoefficient, kMaxGreyCoefficient, false, unit}, f + ".coefficient",
                kWhat);
-    CheckRange(lo(k), {-kMaxGreyFeatureK, kMaxGreyFeatureK, false, "K"}, f + ".train_min_k", kWhat);
-    CheckRange(hi(k), {lo(k), kMaxGreyFeatureK, false, "K", "at least train_min_k"},
-               f + ".train_max_k", kWhat);
+    CheckRange(lo(k), {-bound, bound, false, u}, f + ".train_min_k", kWhat);
+    CheckRange(hi(k), {lo(k), bound, false, u, "at least train_min_k"}, f + ".train_max_k", kWhat);
   }
 }
 
@@ -123,19 +140,27 @@ void ValidateGreyBox(const GreyBoxModel& m) {
     throw InputError(w + ": no offset or slope sensor");
   CheckNames(m.offset_sensors, "offset_sensors", w);
   CheckNames(m.slope_sensors, "slope_sensors", w);
+  CheckNames(Joined(m.offset_sensors, m.offset_duty), "offset_sensors and offset_duty", w);
+  CheckNames(Joined(m.slope_sensors, m.slope_duty), "slope_sensors and slope_duty", w);
   CheckTimeConstants(m.time_constants);
   CheckRange(m.z_ref_mm, kAxisPositionRange, "z_ref_mm", w);
   const auto per = static_cast<Eigen::Index>(1 + m.time_constants.size());
-  const auto no = static_cast<Eigen::Index>(m.offset_sensors.size()) * per;
-  const auto ns = static_cast<Eigen::Index>(m.slope_sensors.size()) * per;
+  const auto no = static_cast<Eigen::Index>(m.offset_sensors.size() + m.offset_duty.size()) * per;
+  const auto ns = static_cast<Eigen::Index>(m.slope_sensors.size() + m.slope_duty.size()) * per;
   if (m.a.size() != no || m.offset_min.size() != no || m.offset_max.size() != no)
     throw InputError(w + ": 'offset_features' must hold " + std::to_string(no) +
-                     " coefficients and ranges (offset sensors x (1 + time constants))");
+                     " coefficients and ranges ((offset sensors + offset duty inputs) x (1 + time "
+                     "constants))");
   if (m.g.size() != ns || m.slope_min.size() != ns || m.slope_max.size() != ns)
     throw InputError(w + ": 'slope_features' must hold " + std::to_string(ns) +
-                     " coefficients and ranges (slope sensors x (1 + time constants))");
-  CheckCoefficients(m.a, m.offset_min, m.offset_max, "offset_features", "um per K");
-  CheckCoefficients(m.g, m.slope_min, m.slope_max, "slope_features", "um per 1000 mm per K");
+                     " coefficients and ranges ((slope sensors + slope duty inputs) x (1 + time "
+                     "constants))");
+  CheckCoefficients(m.a, m.offset_min, m.offset_max,
+                    static_cast<Eigen::Index>(m.offset_sensors.size()) * per, "offset_features",
+                    "um per K");
+  CheckCoefficients(m.g, m.slope_min, m.slope_max,
+                    static_cast<Eigen::Index>(m.slope_sensors.size()) * per, "slope_features",
+                    "um per 1000 mm per K");
   CheckRange(m.slope_intercept_um_per_1000,
              {-kMaxGreyIntercept, kMaxGreyIntercept, false, "um per 1000 mm"},
              "slope_intercept_um_per_1000", w);
@@ -176,14 +201,18 @@ void to_json(json& j, const GreyBoxModel& m) {
        {"time_constants_min", m.time_constants},
        {"z_ref_mm", m.z_ref_mm},
        {"offset_features",
-        Features(m.offset_sensors, m.time_constants, m.a, m.offset_min, m.offset_max)},
-       {"slope_features",
-        Features(m.slope_sensors, m.time_constants, m.g, m.slope_min, m.slope_max)},
+        Features(m.offset_sensors, m.offset_duty, m.time_constants, m.a, m.offset_min,
+                 m.offset_max)},
+       {"slope_features", Features(m.slope_sensors, m.slope_duty, m.time_constants, m.g,
+                                   m.slope_min, m.slope_max)},
        {"slope_intercept_um_per_1000", m.slope_intercept_um_per_1000},
        {"blank", blank},
        {"fit",
         {{"prior_strength", m.prior_strength}, {"cv_rmse_um", m.cv_rmse_um}, {"rows", m.rows}}},
        {"training", {{"notes", m.notes}}}};
+  // Written only when used: a model without duty inputs is the file it was before they existed.
+  if (!m.offset_duty.empty()) j["offset_duty"] = m.offset_duty;
+  if (!m.slope_duty.empty()) j["slope_duty"] = m.slope_duty;
 }
 
 void from_json(const json& j, GreyBoxModel& m) {
@@ -192,7 +221,8 @@ void from_json(const json& j, GreyBoxModel& m) {
                      "'; write one with whirl drift fit-grey)");
   RejectUnknownKeys(j,
                     {"format", "schema_version", "model", "offset_sensors", "slope_sensors",
-                     "blank_sensor", "time_constants_min", "z_ref_mm", "offset_features",
+                     "blank_sensor", "offset_duty", "slope_duty", "time_constants_min",
+                     "z_ref_mm", "offset_features",
                      "slope_features", "slope_intercept_um_per_1000", "blank", "fit", "training"},
                     kWhat);
   RequireSchema(j, kGreyBoxFormat, kGreyBoxSchemaVersion, kWhat, "format");
@@ -200,13 +230,15 @@ void from_json(const json& j, GreyBoxModel& m) {
   m.offset_sensors = RequireStrings(j, "offset_sensors", kWhat, 1000);
   m.slope_sensors = RequireStrings(j, "slope_sensors", kWhat, 1000);
   m.blank_sensor = RequireString(j, "blank_sensor", kWhat);
+  if (j.contains("offset_duty")) m.offset_duty = RequireStrings(j, "offset_duty", kWhat, 1000);
+  if (j.contains("slope_duty")) m.slope_duty = RequireStrings(j, "slope_duty", kWhat, 1000);
   m.time_constants = RequireNumberArray(j, "time_constants_min", kWhat, 100);
   CheckTimeConstants(m.time_constants);  // before the features are matched against them
   m.z_ref_mm = RequireNumber(j, "z_ref_mm", kWhat);
-  ReadFeatures(j, "offset_features", m.offset_sensors, m.time_constants, &m.a, &m.offset_min,
-               &m.offset_max);
-  ReadFeatures(j, "slope_features", m.slope_sensors, m.time_constants, &m.g, &m.slope_min,
-               &m.slope_max);
+  ReadFeatures(j, "offset_features", Joined(m.offset_sensors, m.offset_duty), m.time_constants,
+               &m.a, &m.offset_min, &m.offset_max);
+  ReadFeatures(j, "slope_features", Joined(m.slope_sensors, m.slope_duty), m.time_constants, &m.g,
+               &m.slope_min, &m.slope_max);
   m.slope_intercept_um_per_1000 = RequireNumber(j, "slope_intercept_um_per_1000", kWhat);
   const json& b = RequireKey(j, "blank", kWhat);
   if (m.blank_sensor.empty() != b.is_null())
@@ -252,7 +284,8 @@ GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path) {
     throw InputError(w + ": its 'format' must be '" + kGreyBoxSpecFormat + "'");
   RejectUnknownKeys(j,
                     {"format", "schema_version", "description", "offset_sensors", "slope_sensors",
-                     "blank_sensor", "z_ref_mm", "offset_prior_um_per_k",
+                     "blank_sensor", "offset_duty", "slope_duty", "z_ref_mm",
+                     "offset_prior_um_per_k",
                      "slope_prior_um_per_1000_per_k", "blank_prior_um_per_1000_per_k"},
                     w);
   RequireSchema(j, kGreyBoxSpecFormat, 1, w, "format");
@@ -262,6 +295,10 @@ GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path) {
   s.blank_sensor = RequireString(j, "blank_sensor", w);
   CheckNames(s.offset_sensors, "offset_sensors", w);
   CheckNames(s.slope_sensors, "slope_sensors", w);
+  if (j.contains("offset_duty")) s.offset_duty = RequireStrings(j, "offset_duty", w, 1000);
+  if (j.contains("slope_duty")) s.slope_duty = RequireStrings(j, "slope_duty", w, 1000);
+  CheckNames(Joined(s.offset_sensors, s.offset_duty), "offset_sensors and offset_duty", w);
+  CheckNames(Joined(s.slope_sensors, s.slope_duty), "slope_sensors and slope_duty", w);
   if (s.offset_sensors.empty() && s.slope_sensors.empty())
     throw InputError(w + ": no offset or slope sensor");
   s.z_ref_mm = RequireNumberIn(j, "z_ref_mm", kAxisPositionRange, w);
@@ -276,15 +313,17 @@ GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path) {
 namespace {
 
 DriftModel Channel(const std::string& column, const std::vector<std::string>& sensors,
-                   const std::vector<double>& taus, double intercept, const Eigen::VectorXd& b,
-                   const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) {
+                   const std::vector<std::string>& duty, const std::vector<double>& taus,
+                   double intercept, const Eigen::VectorXd& b, const Eigen::VectorXd& lo,
+                   const Eigen::VectorXd& hi) {
   DriftModel d;
   d.kind = taus.empty() ? ModelKind::kMlr : ModelKind::kDynamic;
   d.error_column = column;
   d.sensors = sensors;
   d.reference_C = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 20.0);
+  d.extra_inputs = duty;  // as logged: the action's u = value, no reference
   d.time_constants = taus;
-  for (const std::string& s : sensors) {
+  for (const std::string& s : Joined(sensors, duty)) {
     d.features.push_back({s, 0.0});
     for (double t : taus) d.features.push_back({s, t});
   }
@@ -312,9 +351,9 @@ GreyBoxControl GreyBoxControlModels(const GreyBoxModel& m) {
         "sensor (SD43910); this model has " +
         std::to_string(m.offset_sensors.size()) + " and " + std::to_string(m.slope_sensors.size()));
   GreyBoxControl c;
-  c.offset = Channel("grey_k0_um", m.offset_sensors, m.time_constants, 0.0, m.a, m.offset_min,
-                     m.offset_max);
-  c.slope = Channel("grey_slope_per_1000_um", m.slope_sensors, m.time_constants,
+  c.offset = Channel("grey_k0_um", m.offset_sensors, m.offset_duty, m.time_constants, 0.0, m.a,
+                     m.offset_min, m.offset_max);
+  c.slope = Channel("grey_slope_per_1000_um", m.slope_sensors, m.slope_duty, m.time_constants,
                     m.slope_intercept_um_per_1000, m.g, m.slope_min, m.slope_max);
   return c;
 }

@@ -5,12 +5,15 @@
 // Model file (JSON, "format": "whirl-grey-box-model", "schema_version": 1):
 //   offset_sensors, slope_sensors   column names of the day logs (<name>_C), in order
 //   blank_sensor                    the blank's estimate's input, "" for none
+//   offset_duty, slope_duty         optional: duty inputs (other columns of the logs, as logged,
+//                                   e.g. ring_load_pct), after the sensors of their channel
 //   time_constants_min              the shared lags, ascending, each in (0, 1e6] min
 //   z_ref_mm                        the slope's reference (the Z screw's fixed bearing), mm
 //   offset_features, slope_features one object per feature, input-major (T - 20, then its lags):
 //                                   name, input, tau_min (0: the input itself), coefficient
 //                                   (um per K; slope: um per 1000 mm per K, |c| <= 1e4), and its
-//                                   training range train_min_k, train_max_k [K against 20 degC]
+//                                   training range train_min_k, train_max_k [K against 20 degC;
+//                                   a duty input's own unit]; then each duty input and its lags
 //   slope_intercept_um_per_1000     g0, |g0| <= 1e5 (0.1 mm/mm, the largest MD32760)
 //   blank                           null without a blank sensor, else {tau_min (0, 1e6],
 //                                   um_per_1000_per_k (|g_b| <= 1e4), train_min_c, train_max_c}
@@ -20,7 +23,8 @@
 //
 // Spec file (JSON, "format": "whirl-grey-box-spec", "schema_version": 1): the sensors a shop
 // placed and the physical priors it reads off its drawings:
-//   offset_sensors, slope_sensors, blank_sensor ("" for none), z_ref_mm,
+//   offset_sensors, slope_sensors, blank_sensor ("" for none), optional offset_duty and
+//   slope_duty (duty inputs, prior 0), z_ref_mm,
 //   offset_prior_um_per_k {sensor: um per K}, slope_prior_um_per_1000_per_k {sensor: value},
 //   blank_prior_um_per_1000_per_k (-alpha_w x 1e6; steel -11.8).
 // A prior key that names no sensor of its list is an error (it would be ignored silently).
@@ -43,6 +47,9 @@ inline constexpr double kMaxGreyCoefficient = 1e4;
 inline constexpr double kMaxGreyIntercept = 1e5;
 /// Largest |feature| of a training range [K against 20 degC].
 inline constexpr double kMaxGreyFeatureK = 1000;
+/// Largest |value| of a duty input's training range, in its own unit (a feed in mm/min or a
+/// speed in 1/min stays far below; beyond it is a corrupt file).
+inline constexpr double kMaxGreyDutyValue = 1e6;
 
 /// InputError naming the field and the rule: sizes, ascending lags, every range above.
 void ValidateGreyBox(const GreyBoxModel& m);
