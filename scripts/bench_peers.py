@@ -646,7 +646,7 @@ def report(results, prob, n, variants, peers):
         line = f"{m:<14} {med('rmse', m, 0):9.3f} {med('rmse', m, 1):9.3f}"
         cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
                                    for k in (0, 1))
-        if m in peers:
+        if m in peers or not peers:  # no peers run (--peers ""): no wins
             line += f" {'':>6} {'':>6}"
         else:
             wins = [sum(r["methods"][m]["rmse"][k] < min(r["methods"][p]["rmse"][k] for p in peers)
