@@ -73,6 +73,8 @@ power law, GP-ARD and the networks) and lists its +-1 / +-2 sd coverage.
 
 Pooled summary of earlier runs (the fourth attempt's tuning part spans seed ranges and sizes):
   bench_peers.py --whirl build/whirl --from-json a.json b.json ... [--markdown]
+Paired decision of two whirl methods on the same tables (the fifth attempt's rule):
+  bench_peers.py --whirl build/whirl --from-json a.json ... --paired default stack
 Usage: bench_peers.py --whirl build/whirl [--split tuning|confirmation] [--seeds 20]
        [--first-seed 1] [--sizes 20,100] [--problems friedman,simulator,simgen,...]
        [--variant NAME=ARGS ...] [--no-default] [--family-bench PATH --family NAME=ARGS ...]
@@ -325,6 +327,9 @@ SPLITS = {
     "tuning3": {"problems": EIGHT, "first_seed": 1},
     "confirmation3": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 4001},
     "confirmation4": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 10001},
+    # The fifth attempt's decision (stack against the default, no tuning): 11001-11020 at 20 rows,
+    # 11001-11010 at 100 rows.
+    "decision5": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 11001},
 }
 
 
@@ -552,7 +557,16 @@ def main():
     ap.add_argument("--from-json", nargs="+", metavar="FILE",
                     help="run nothing: pool the --json files of earlier runs per problem and size "
                          "(seeds of every file) and print the summary with its counts")
+    ap.add_argument("--paired", nargs=2, metavar=("BASE", "CAND"),
+                    help="with --from-json: the paired decision of CAND against BASE (d = ln of the "
+                         "RMSE ratio per table and output, paired t, coverage cells, per-family "
+                         "median ratios; docs/workpiece-model.md, fifth attempt)")
     a = ap.parse_args()
+    if a.paired and not a.from_json:
+        sys.exit("bench_peers: --paired needs --from-json")
+    if a.paired:
+        paired_decision(a.from_json, *a.paired)
+        return
     if a.from_json:
         pooled_summary(a.from_json, [p for p in a.acceptance_peers.split(",") if p], a.markdown)
         return
@@ -632,7 +646,7 @@ def report(results, prob, n, variants, peers):
         line = f"{m:<14} {med('rmse', m, 0):9.3f} {med('rmse', m, 1):9.3f}"
         cov = lambda key: "/".join(f"{100 * np.mean([r['methods'][m][key][k] for r in rs]):.0f}"
                                    for k in (0, 1))
-        if m in peers:
+        if m in peers or not peers:  # no peers run (--peers ""): no wins
             line += f" {'':>6} {'':>6}"
         else:
             wins = [sum(r["methods"][m]["rmse"][k] < min(r["methods"][p]["rmse"][k] for p in peers)
@@ -667,14 +681,7 @@ def pooled_summary(files, accept, markdown):
     method found in all of them, and per method the count of medians more than 1 % behind the
     best acceptance peer, the sum of those percentages and the (problem, rows, output) cells whose
     mean coverage is outside 60-76 % (+-1 sd) or 90-98 % (+-2 sd)."""
-    runs = {}
-    for path in files:
-        with open(path) as f:
-            for r in json.load(f):
-                key = (r["problem"], r["rows"], r["seed"])
-                runs.setdefault(key, {"problem": r["problem"], "rows": r["rows"], "seed": r["seed"],
-                                      "methods": {}})["methods"].update(r["methods"])
-    results = list(runs.values())
+    results = load_runs(files)
     cases = sorted({(r["problem"], r["rows"]) for r in results}, key=lambda c: (c[1], c[0]))
     methods = [m for m in sorted({m for r in results for m in r["methods"]})
                if all(m in r["methods"] and "cover1" in r["methods"][m] and "chosen" in
@@ -693,6 +700,84 @@ def pooled_summary(files, accept, markdown):
                 cover += not (60 <= c1 <= 76 and 90 <= c2 <= 98)
         print(f"{m}: {fails} of {2 * len(cases)} medians more than 1 % behind the best peer, sum "
               f"{total:.0f} %; coverage outside the bands on {cover} cells")
+
+
+def load_runs(files):
+    """The records of --json files, one per (problem, rows, seed), methods merged."""
+    runs = {}
+    for path in files:
+        with open(path) as f:
+            for r in json.load(f):
+                key = (r["problem"], r["rows"], r["seed"])
+                runs.setdefault(key, {"problem": r["problem"], "rows": r["rows"], "seed": r["seed"],
+                                      "methods": {}})["methods"].update(r["methods"])
+    return list(runs.values())
+
+
+def coverage_cells_out(rs, m):
+    """(problem, rows, output) cells whose mean +-1 / +-2 sd coverage of method m is outside
+    60-76 % / 90-98 %."""
+    out = []
+    for prob, n in sorted({(r["problem"], r["rows"]) for r in rs}):
+        cell = [r for r in rs if r["problem"] == prob and r["rows"] == n]
+        for k in (0, 1):
+            c1 = 100 * np.mean([r["methods"][m]["cover1"][k] for r in cell])
+            c2 = 100 * np.mean([r["methods"][m]["cover2"][k] for r in cell])
+            if not (60 <= c1 <= 76 and 90 <= c2 <= 98):
+                out.append(f"{prob} {n} out{k + 1} {c1:.1f}/{c2:.1f}")
+    return out
+
+
+def paired_t(d):
+    d = np.asarray(d, dtype=float)
+    sd = float(np.std(d, ddof=1)) if len(d) > 1 else math.nan
+    return float(np.mean(d)), (float(np.mean(d)) / (sd / math.sqrt(len(d))) if sd > 0 else 0.0)
+
+
+def paired_decision(files, base, cand):
+    """The fifth attempt's rule (docs/workpiece-model.md), fixed before its run: per (problem,
+    rows, seed, output) d = ln(RMSE_cand / RMSE_base); adopt iff mean(d) < 0 with paired t <= -2,
+    no more coverage cells outside the bands than base, and no problem's median RMSE ratio above
+    1.03. A failed fit (NaN) of either method fails the rule."""
+    rs = load_runs(files)
+    d, fam, failed_fits = [], {}, 0
+    for r in rs:
+        for k in (0, 1):
+            b, c = r["methods"][base]["rmse"][k], r["methods"][cand]["rmse"][k]
+            if not (math.isfinite(b) and math.isfinite(c) and b > 0 and c > 0):
+                failed_fits += 1
+                continue
+            d.append(math.log(c / b))
+            fam.setdefault(r["problem"], []).append(d[-1])
+    identical = sum(x == 0.0 for x in d)
+    same_choice = sum(r["methods"][base].get("chosen") == r["methods"][cand].get("chosen") for r in rs)
+    mean, t = paired_t(d)
+    print(f"paired decision, {cand} against {base}: {len(d)} cases (problem, rows, seed, output) "
+          f"of {len(rs)} tables; {identical} cases with identical RMSE (d = 0); {same_choice} tables "
+          f"with the same chosen description; {failed_fits} failed fits")
+    print(f"mean d {mean:+.4f} (geometric mean ratio {math.exp(mean):.4f}), paired t {t:+.2f}")
+    print("| problem | cases | d = 0 | median ratio | mean d | t | cases better / worse |")
+    print("|---|---|---|---|---|---|---|")
+    worst = 0.0
+    for prob in sorted(fam):
+        x = fam[prob]
+        fm, ft = paired_t(x)
+        ratio = math.exp(float(np.median(x)))
+        worst = max(worst, ratio)
+        print(f"| {prob} | {len(x)} | {sum(v == 0.0 for v in x)} | {ratio:.4f} | {fm:+.4f} | "
+              f"{ft:+.2f} | {sum(v < 0 for v in x)} / {sum(v > 0 for v in x)} |")
+    cells = {m: coverage_cells_out(rs, m) for m in (base, cand)}
+    for m in (base, cand):
+        print(f"{m}: coverage outside 60-76 / 90-98 % on {len(cells[m])} of {4 * len(fam) if fam else 0} "
+              f"cells: " + "; ".join(cells[m]))
+    checks = {"mean d < 0 and t <= -2.0": mean < 0 and t <= -2.0,
+              f"coverage cells {len(cells[cand])} <= {len(cells[base])}":
+                  len(cells[cand]) <= len(cells[base]),
+              f"largest problem median ratio {worst:.4f} <= 1.03": worst <= 1.03,
+              "no failed fit": failed_fits == 0}
+    for what, ok in checks.items():
+        print(f"{'holds' if ok else 'FAILS'}: {what}")
+    print(f"decision: {'ADOPT ' + cand if all(checks.values()) else 'keep ' + base}")
 
 
 def summary(results, cases, methods, accept, markdown=False):

@@ -48,6 +48,7 @@ struct TrainCliOptions {
   bool json = false;
   std::string family;     // empty: not given
   std::string transform;  // empty: not given
+  std::string choice = "stack";  // --choice: stack (ChoiceOptions::stack) or hard
   std::string network_flags;  // the network-only flags given, " --hidden --ard"
 };
 
@@ -214,6 +215,7 @@ workpiece::TrainOptions WorkpieceOptions(const TrainCliOptions& o) {
                      "they exclude --transform " + o.transform +
                      " (a network on log columns is a family candidate with its defaults)");
   if (network) w.network = ModelOptions(o);
+  w.choice.stack = o.choice == "stack";
   w.choice.fit.seed = o.seed;
   w.choice.fit.threads = o.threads;
   return w;
@@ -301,7 +303,10 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::T
                                : "closed-form leave-one-out for GPs, " +
                                      std::to_string(c.folds) + "-fold refits for networks")
                     : std::to_string(c.folds) + "-fold refits")
-            << ")" << (c.one_standard_error ? ", the simplest within one standard error" : "")
+            << ")"
+            << (c.stack ? ", combined with weights shrunk toward the power law"
+                : c.one_standard_error ? ", the simplest within one standard error"
+                                       : "")
             << "; held-out RMSE in um and s, score = sum of MSE / variance:\n"
             << workpiece::FormatChoiceTable(model.choice);
   std::cout << "  sd: " << model.choice.models.front().calibration << "\n";
@@ -371,20 +376,25 @@ void Run(const TrainCliOptions& o) {
 // The subcommand's description in --help: what it trains, the default, the table's columns.
 std::string TrainDescription() {
   return "Train the workpiece model on a process table and write a model file (JSON).\n"
-         "Default (no model options): per output one of the power law (least squares on log\n"
-         "columns), a linear fit, a GP with a power-law mean on log columns and two ARD GPs on\n"
-         "raw columns (Matern 5/2, squared exponential): a candidate takes part only if its\n"
-         "held-out error beats the power law's by 2 standard errors (2.5 from 70 rows), and only\n"
-         "the GP with the lowest held-out error; then the simplest within one standard error of\n"
-         "the lowest. Held-out errors: closed-form leave-one-out for the linear fits; for GPs\n"
-         "below 70 rows 5-fold refits with their hyperparameters refitted (none has seen the\n"
-         "held-out rows), from 70 rows their closed-form leave-one-out. GP length scales have a\n"
+         "Default (no model options): per output a convex combination (stack) of the power law\n"
+         "(least squares on log columns), a linear fit, a GP with a power-law mean on log\n"
+         "columns and two ARD GPs on raw columns (Matern 5/2, squared exponential): a candidate\n"
+         "enters only if its held-out error beats the power law's by 1 standard error (1.5 from\n"
+         "70 rows), and only the GP with the lowest held-out error; weights minimize the\n"
+         "held-out error, shrunk toward the power law until the combination's nested held-out\n"
+         "error beats it by 1-2 standard errors (1.5-2.5 from 70 rows). --choice hard: one\n"
+         "candidate per output instead, the simplest within one standard error of the lowest,\n"
+         "a candidate leaving the power law only by 2 standard errors (2.5 from 70 rows).\n"
+         "Held-out errors: closed-form leave-one-out for the linear fits; for GPs below 70 rows\n"
+         "5-fold refits with their hyperparameters refitted (none has seen the held-out rows),\n"
+         "from 70 rows their closed-form leave-one-out. GP length scales have a\n"
          "log-normal prior that keeps few rows from bending a fit. Tables of 8 and 9 rows: the\n"
          "linear fits only (a note says why); fewer than 8 rows are refused. A constant input\n"
          "is named and left out; a zero or near-zero target keeps its column raw for the log\n"
          "candidates, with a warning. From 512 rows a GP keeps 512 rows spread over the table (the others judge\n"
          "it). The sd is calibrated to cover 68.27 % / 95.45 % of held-out residuals at +-1 /\n"
-         "+-2 sd (src/product/family/family.h). Prints the choice and the table of held-out errors; a\n"
+         "+-2 sd; a combination's sd is the weighted sum of its candidates' sd, scaled down to\n"
+         "cover 68.27 % of its own held-out residuals (src/product/family/family.h). Prints the choice and the table of held-out errors; a\n"
          "progress line every 2 s once a fit takes longer. The same table and seed give the\n"
          "same file byte for byte.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
@@ -482,6 +492,14 @@ void RegisterTrain(CLI::App& app) {
                   "columns; auto: both, chosen by cross-validated error. Default auto, for\n"
                   "--family network identity")
       ->check(CLI::IsMember({"auto", "log", "identity"}));
+  sub->add_option("--choice", o->choice,
+                  "stack (default): per output a convex combination of the candidates' held-out\n"
+                  "predictions, shrunk toward the power law (all weight on it until the\n"
+                  "combination beats it clearly); hard: one candidate per output (the\n"
+                  "simplest within one standard error, a candidate leaving the power law only\n"
+                  "by 2 standard errors; the default of earlier versions)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"stack", "hard"}));
   out->excludes(sweep);
   // The flags that only the network has (they imply --family network).
   std::vector<CLI::Option*> network_options;

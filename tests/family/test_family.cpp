@@ -30,6 +30,7 @@ TEST(FamilyChoice, FindsThePowerLawAndItsTableIsConsistent) {
   ChoiceOptions o;
   o.candidates = {ParseCandidate("linear/identity"), ParseCandidate("linear/log"),
                   ParseCandidate("network-h6/identity")};
+  o.stack = false;               // the hard choice (whirl train --choice hard)
   o.one_standard_error = false;  // the plain lowest error (tested alone below)
   o.closed_form_loo = false;     // 5-fold refits for every candidate
   for (const bool per_output : {false, true}) {
@@ -244,12 +245,13 @@ TEST(FamilyChoice, LeavingTheFirstCandidateOnHandComputedCases) {
 // one-standard-error rule alone leaves the power law on some tables (a GP or the raw linear fit
 // wins the 5-fold refits by chance); the default leaves it on fewer.
 TEST(FamilyChoice, ThePowerLawIsLeftOnlyForACandidateThatBeatsItClearly) {
-  ChoiceOptions off;
+  ChoiceOptions off, hard;  // the hard choice (the rule under test is not the stack's)
+  off.stack = hard.stack = false;
   off.leave_first_se = 0;
   int left_off = 0, left_default = 0;
   for (unsigned seed = 1; seed <= 30; ++seed) {
     const ProcessTable t = MakeTable(20, 0.08, seed);
-    const Choice a = ChooseFamily(t, off), b = ChooseFamily(t, ChoiceOptions{});
+    const Choice a = ChooseFamily(t, off), b = ChooseFamily(t, hard);
     for (int k = 0; k < 2; ++k) {
       left_off += a.table[a.chosen[k]].candidate.Name() != "linear/log";
       left_default += b.table[b.chosen[k]].candidate.Name() != "linear/log";
@@ -378,6 +380,7 @@ ProcessTable BentTable(double noise, double bend, unsigned seed) {
 // nothing; these tests switch it on, with the closed-form leave-one-out of GPs it was made for.)
 ChoiceOptions EquivalenceOptions(double sd) {
   ChoiceOptions o;
+  o.stack = false;  // the rule is the hard choice's (ChoiceOptions::equivalence_sd)
   o.equivalence_sd = sd;
   o.few_rows = 0;  // GP held-out errors by their closed-form leave-one-out
   o.leave_first_se = o.leave_first_se_large = 0;  // the rule under test alone
@@ -425,6 +428,7 @@ TEST(FamilyEquivalence, ARealBendAboveTheNoiseKeepsItsGp) {
   for (const bool rule : {true, false}) {
   // With the rule (and leave-one-out errors) and with the default (refits at few rows).
   ChoiceOptions o = rule ? EquivalenceOptions(0.1) : ChoiceOptions{};
+  o.stack = false;  // the hard choice's rules (whirl train --choice hard)
   int gp = 0;
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const Choice c = ChooseFamily(BentTable(0.003, 0.5, seed), o);

@@ -14,6 +14,7 @@ screw="$src/datasets/screws/reference_80x10x6000.json"
 
 # The default: a family choice, its table on stdout, a schema-3 file.
 "$whirl" train --data "$data" --out fam.json > out.txt 2> err.txt || fail "train: $(cat err.txt)"
+cp out.txt fam_out.txt
 grep -q "max_elongation_um: .*settle_time_s: " out.txt || fail "train does not say what it chose"
 grep -q "linear/log" out.txt || fail "train lacks the CV table: $(cat out.txt)"
 grep -q "<- " out.txt || fail "the CV table does not mark the choice"
@@ -104,6 +105,13 @@ expect_fail "noise_variance = 1e+308 breaks the rule" "$whirl" predict --model n
 grep -q "max_elongation_um: linear/log, settle_time_s: linear/log" out.txt \
   || fail "--family linear --transform log did not give the power law: $(cat out.txt)"
 expect_fail "--family" "$whirl" train --data "$data" --out x.json --family svm
+# The default combines the candidates (the stack); --choice hard takes one per output.
+grep -q "combined with weights shrunk toward the power law" fam_out.txt \
+  || fail "the default is not the stack: $(cat fam_out.txt)"
+"$whirl" train --data "$data" --out hard.json --choice hard > out.txt 2> err.txt \
+  || fail "--choice hard: $(cat err.txt)"
+grep -q "the simplest within one standard error" out.txt || fail "--choice hard: $(cat out.txt)"
+expect_fail "--choice" "$whirl" train --data "$data" --out x.json --choice soft
 expect_fail "--hidden" "$whirl" train --data "$data" --out x.json --family gp --hidden 4
 expect_fail "--transform" "$whirl" train --data "$data" --out x.json --trainbr-matlab --transform log
 [ ! -e x.json ] || fail "a refused train wrote a file"

@@ -276,12 +276,14 @@ struct ChoiceOptions {
   /// The candidates that enter: the first, those that beat it by more than stack_gate_se
   /// standard errors (BeatsFirst), and of the GPs with lowest_gp only the lowest; the weights are
   /// shrunk toward the first (ShrunkStackWeights, stack_start_se / stack_full_se).
-  /// Off by default: the unshrunk stack made power-law tables worse on the first attempt's
-  /// tuning part; with the shrinkage, the gate and the settings below it had as many medians
-  /// more than 1 % behind the best peer as the hard choice on the fourth attempt's tuning part
-  /// (a lower sum of those percentages, fewer coverage misses), which the decision rule fixed
-  /// in advance does not accept (docs/workpiece-model.md, "Fourth attempt").
-  bool stack = false;
+  /// The default since the fifth attempt (docs/workpiece-model.md, "Fifth attempt"): on fresh
+  /// seeds of the eleven generator families of scripts/bench_peers.py, with the settings below
+  /// unchanged from the fourth attempt, its test RMSE was lower than the hard choice's (mean
+  /// ln ratio -0.035, paired t -5.2 over 660 table outputs, 477 of them identical) with fewer
+  /// coverage cells outside the bands (6 against 9 of 44). false: the hard choice (one
+  /// candidate per output by the one-standard-error rule and leave_first_se; `whirl train
+  /// --choice hard`), the default before.
+  bool stack = true;
   /// ChoiceOptions::stack shrunk toward the first candidate (ShrunkStackWeights): the stack
   /// gets no weight while its nested held-out errors beat the first's by at most stack_start_se
   /// standard errors, all of it from stack_full_se on (the _large pair from few_rows rows, where
