@@ -39,28 +39,22 @@ void PrintFitGrey(const drift::GreyBoxModel& m) {
               }().c_str(),
               m.blank_sensor.empty() ? "-" : MessageNumber(m.blank_tau_min).c_str(),
               MessageNumber(m.prior_strength).c_str(), m.cv_rmse_um, m.rows);
-  const auto per = 1 + m.time_constants.size();
-  for (std::size_t i = 0; i < m.offset_sensors.size(); ++i)
-    std::printf(
-        "  K0   %-20s %9.3f um/K (sum over its lags)\n", m.offset_sensors[i].c_str(),
-        m.a.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
-  for (std::size_t i = 0; i < m.offset_duty.size(); ++i)
-    std::printf("  K0   %-20s %9.3f um per unit (duty input, sum over its lags)\n",
-                m.offset_duty[i].c_str(),
-                m.a.segment(static_cast<Eigen::Index>((m.offset_sensors.size() + i) * per),
-                            static_cast<Eigen::Index>(per))
-                    .sum());
+  const auto per = static_cast<Eigen::Index>(1 + m.time_constants.size());
+  // One line per input: its coefficients summed over its lags (each input's lags are stored
+  // together; `first` is the position of names[0] among the part's inputs).
+  const auto print_sums = [per](const char* part, const std::vector<std::string>& names,
+                                const Eigen::VectorXd& coef, std::size_t first, const char* what) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      std::printf("  %-4s %-20s %9.3f %s\n", part, names[i].c_str(),
+                  coef.segment(static_cast<Eigen::Index>(first + i) * per, per).sum(), what);
+  };
+  print_sums("K0", m.offset_sensors, m.a, 0, "um/K (sum over its lags)");
+  print_sums("K0", m.offset_duty, m.a, m.offset_sensors.size(),
+             "um per unit (duty input, sum over its lags)");
   std::printf("  G    intercept            %9.3f um per 1000 mm\n", m.slope_intercept_um_per_1000);
-  for (std::size_t i = 0; i < m.slope_sensors.size(); ++i)
-    std::printf(
-        "  G    %-20s %9.3f um per 1000 mm per K (sum over its lags)\n", m.slope_sensors[i].c_str(),
-        m.g.segment(static_cast<Eigen::Index>(i * per), static_cast<Eigen::Index>(per)).sum());
-  for (std::size_t i = 0; i < m.slope_duty.size(); ++i)
-    std::printf("  G    %-20s %9.3f um per 1000 mm per unit (duty input, sum over its lags)\n",
-                m.slope_duty[i].c_str(),
-                m.g.segment(static_cast<Eigen::Index>((m.slope_sensors.size() + i) * per),
-                            static_cast<Eigen::Index>(per))
-                    .sum());
+  print_sums("G", m.slope_sensors, m.g, 0, "um per 1000 mm per K (sum over its lags)");
+  print_sums("G", m.slope_duty, m.g, m.slope_sensors.size(),
+             "um per 1000 mm per unit (duty input, sum over its lags)");
   if (!m.blank_sensor.empty())
     std::printf("  G    blank (%s, latched) %9.3f um per 1000 mm per K\n", m.blank_sensor.c_str(),
                 m.blank_um_per_1000_per_k);
