@@ -144,20 +144,27 @@ std::vector<ProcessInputs> RandomList(std::mt19937& rng, int n) {
   return cands;
 }
 
+// The first `optimal` picks of a design `d` over `cands` (as candidate indices), checked to be the
+// D-optimal design of their count.
+std::vector<int> FirstPicksAreDOptimal(const std::vector<ProcessInputs>& cands,
+                                       const PowerLawDesign& d, int optimal) {
+  std::vector<int> before;
+  for (int i = 0; i < optimal; ++i) before.push_back(d.picks[i].candidate);
+  std::vector<int> opt;
+  for (const auto& p : DesignPowerLaw(cands, optimal, Criterion::kD).picks)
+    opt.push_back(p.candidate);
+  EXPECT_EQ(std::set<int>(before.begin(), before.end()), std::set<int>(opt.begin(), opt.end()));
+  return before;
+}
+
 TEST(Design, SpaceFillingPicksAreMaximinAfterTheOptimalOnes) {
   std::mt19937 rng(11);
   for (int t = 0; t < 10; ++t) {
     const auto cands = RandomList(rng, 80);
     const Eigen::MatrixXd u = LogUnits(cands);
     const auto d = DesignPowerLaw(cands, 9, Criterion::kD, 3);
-    const auto optimal = DesignPowerLaw(cands, 6, Criterion::kD);
     ASSERT_EQ(d.picks.size(), 9u);
-    std::vector<int> before;
-    for (int i = 0; i < 6; ++i) before.push_back(d.picks[i].candidate);
-    std::vector<int> opt;
-    for (const auto& p : optimal.picks) opt.push_back(p.candidate);
-    // The first picks are the D-optimal design of their count.
-    EXPECT_EQ(std::set<int>(before.begin(), before.end()), std::set<int>(opt.begin(), opt.end()));
+    std::vector<int> before = FirstPicksAreDOptimal(cands, d, 6);
     // Each later pick is the candidate farthest from the picks before it (brute force).
     for (int i = 6; i < 9; ++i) {
       const int c = d.picks[i].candidate;
@@ -705,13 +712,8 @@ TEST(Design, CoveragePicksLowerTheMeanDistanceToTheNearestScrewMost) {
     const auto cands = RandomList(rng, 70);
     const Eigen::MatrixXd u = LogUnits(cands);
     const auto d = DesignPowerLaw(cands, 9, Criterion::kD, 3, 0, {}, FillRule::kCoverage);
-    const auto optimal = DesignPowerLaw(cands, 6, Criterion::kD);
     ASSERT_EQ(d.picks.size(), 9u);
-    std::vector<int> before;
-    for (int i = 0; i < 6; ++i) before.push_back(d.picks[i].candidate);
-    std::vector<int> opt;
-    for (const auto& p : optimal.picks) opt.push_back(p.candidate);
-    EXPECT_EQ(std::set<int>(before.begin(), before.end()), std::set<int>(opt.begin(), opt.end()));
+    const std::vector<int> before = FirstPicksAreDOptimal(cands, d, 6);
     ExpectCoveragePicks(u, 70, d.picks, 6, before, &differs);
   }
   EXPECT_GE(differs, 3);  // coverage is not maximin under another name

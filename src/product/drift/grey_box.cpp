@@ -35,16 +35,20 @@ std::vector<std::string> GreyBoxSpec::Inputs() const {
   return in;
 }
 
+namespace {
+std::vector<std::string> Concatenated(std::vector<std::string> a,
+                                      const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+}  // namespace
+
 std::vector<std::string> GreyBoxSpec::DutyInputs() const {
-  std::vector<std::string> in = offset_duty;
-  in.insert(in.end(), slope_duty.begin(), slope_duty.end());
-  return in;
+  return Concatenated(offset_duty, slope_duty);
 }
 
 std::vector<std::string> GreyBoxModel::DutyInputs() const {
-  std::vector<std::string> in = offset_duty;
-  in.insert(in.end(), slope_duty.begin(), slope_duty.end());
-  return in;
+  return Concatenated(offset_duty, slope_duty);
 }
 
 std::vector<std::string> GreyBoxModel::Inputs() const {
