@@ -276,6 +276,13 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
             << FormatSignificant(d.rms_sd_now[1], 3) << " -> " << FormatSignificant(d.rms_sd_after[1], 3)
             << " s (floor " << FormatSignificant(d.rms_sd_floor[1], 3) << ")\n";
   if (!d.stop.empty()) std::cout << "stop rule: " << d.stop << ": " << d.stop_reason << "\n";
+  if (fill.screws > 0 && d.space_filling == 0)
+    std::cout << "note: --space-filling-when departure: no departure from the power law (lack-of-fit "
+                 "ratio max_elongation "
+              << FormatSignificant(d.lack_of_fit_ratio[0], 3) << ", settle_time "
+              << FormatSignificant(d.lack_of_fit_ratio[1], 3) << ", both <= --switch-ratio "
+              << FormatSignificant(RuleOf(o).switch_ratio, 3) << "): the " << fill.screws
+              << " space-filling pick(s) were made by variance instead\n";
   if (!fill.measured.empty() &&
       static_cast<int>(fill.measured.size()) != model.training_samples)
     std::cout << "note: --measured " << o.measured_path << " holds " << fill.measured.size()

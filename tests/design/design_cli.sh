@@ -143,6 +143,11 @@ for limit in 1e-6 1e6; do
     --measured "$data" --json > "when_$limit.json" 2> err.txt \
     || fail "next --space-filling-when departure --switch-ratio $limit: $(cat err.txt)"
 done
+"$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
+  --space-filling-when departure --switch-ratio 1e6 --measured "$data" > when_text.txt 2> err.txt \
+  || fail "next --space-filling-when departure (text): $(cat err.txt)"
+grep -q "no departure from the power law.*the 1 space-filling pick(s) were made by variance" \
+  when_text.txt || fail "departure dropping the fill picks is not said: $(cat when_text.txt)"
 python3 - cover.json cover_first.json when_1e-6.json when_1e6.json <<'PY3' || fail "coverage: $(cat cover.json when_1e6.json)"
 import json, sys
 nxt, first, departs, fits = (json.load(open(f)) for f in sys.argv[1:])
