@@ -786,7 +786,9 @@ using DayScores = std::vector<ErrorStatsAccumulator>;
 void CollectScored(const MonitorResult& r, std::size_t d, std::size_t days,
                    std::vector<std::pair<std::string, DayScores>>* week) {
   for (const auto& [name, acc] : r.scored) {
-    auto it = std::find_if(week->begin(), week->end(), [&](const auto& p) { return p.first == name; });
+    // C++17 cannot capture a structured binding (clang rejects it): an init-capture.
+    auto it = std::find_if(week->begin(), week->end(),
+                           [&n = name](const auto& p) { return p.first == n; });
     if (it == week->end()) it = week->insert(week->end(), {name, DayScores(days)});
     it->second[d] = acc;
   }
