@@ -188,6 +188,14 @@ ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::
 double CoverageScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd,
                      bool two_sd = true);
 
+/// Choice::sd_scale of a stacked output: min(1, max(q1, q2 / 2)), q1 the smallest factor at
+/// which kappa sd_i >= |r_i| for at least 68.27 % of the rows, q2 the smallest at which
+/// kappa sd_i >= |r_i| for at least `two_share` of them (two_share = 0: q1 alone), clamped to
+/// [0.25, 1]. The sd is only ever narrowed: the candidates' own sd is calibrated already, and
+/// a combination errs less than its parts. InputError as CoverageScale, or if two_share is
+/// outside [0, 1].
+double StackSdScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd, double two_share);
+
 /// ChoiceOptions::one_standard_error for one output: squared_errors[c] holds candidate c's
 /// squared held-out errors per row (candidates from the simplest); returns the first c with
 /// mean(d) <= sd(d) / sqrt(n), d = squared_errors[c] - squared_errors[b], b the lowest mean,
@@ -264,6 +272,11 @@ struct ChoiceOptions {
   /// Choice::rows_note says so.
   int few_rows = 70;
   static constexpr int kRowsPerHyperparameter = 10;
+  /// Network candidates sit out of tables with more rows than this (0: never), and
+  /// Choice::rows_note says so: their fold refits, final fit and noise folds grow with the rows
+  /// (trainbr) and the default's fit time must stay within R brnn's (docs/workpiece-model.md,
+  /// "Speed").
+  int network_max_rows = 500;
   /// true: per output a convex combination of the candidates (ConvexStackWeights of their
   /// held-out predictions, original units) instead of one candidate; the one-standard-error rule
   /// is then not applied. Each candidate with a positive weight is refitted and calibrated on its
@@ -276,13 +289,10 @@ struct ChoiceOptions {
   /// The candidates that enter: the first, those that beat it by more than stack_gate_se
   /// standard errors (BeatsFirst), and of the GPs with lowest_gp only the lowest; the weights are
   /// shrunk toward the first (ShrunkStackWeights, stack_start_se / stack_full_se).
-  /// The default since the fifth attempt (docs/workpiece-model.md, "Fifth attempt"): on fresh
-  /// seeds of the eleven generator families of scripts/bench_peers.py, with the settings below
-  /// unchanged from the fourth attempt, its test RMSE was lower than the hard choice's (mean
-  /// ln ratio -0.035, paired t -5.2 over 660 table outputs, 477 of them identical) with fewer
-  /// coverage cells outside the bands (6 against 9 of 44). false: the hard choice (one
-  /// candidate per output by the one-standard-error rule and leave_first_se; `whirl train
-  /// --choice hard`), the default before.
+  /// The default since the fifth attempt (docs/workpiece-model.md, "Fifth attempt": on fresh
+  /// seeds its test RMSE was lower than the hard choice's with fewer coverage cells outside the
+  /// bands). false: the hard choice (one candidate per output by the one-standard-error rule and
+  /// leave_first_se; `whirl train --choice hard`), the default before.
   bool stack = true;
   /// ChoiceOptions::stack shrunk toward the first candidate (ShrunkStackWeights): the stack
   /// gets no weight while its nested held-out errors beat the first's by at most stack_start_se
@@ -294,6 +304,18 @@ struct ChoiceOptions {
   /// squared held-out errors beat the first's by more than stack_gate_se standard errors
   /// (stack_gate_se_large from few_rows rows; BeatsFirst, no blocks); 0: every candidate enters.
   double stack_gate_se = 1.0, stack_gate_se_large = 1.5;
+  /// ChoiceOptions::stack: true: an output that one candidate takes whole gets Choice::sd_scale
+  /// too (a weight of 1 on that candidate), so that its sd is rescaled as a combination's;
+  /// false: its own sd, unscaled (Choice::weights empty).
+  /// ChoiceOptions::stack: the +-2 sd share of the held-out residuals that Choice::sd_scale must
+  /// keep covered (StackSdScale); 0: the +-1 sd share alone.
+  /// Why both (the sixth attempt, docs/workpiece-model.md): each candidate's own calibration
+  /// covers every held-out residual of a 20-row table at +-2 sd, and with heavy-tailed residuals
+  /// its +-1 sd then covered more than 76 % of new rows; narrowing the sd to the combination's
+  /// held-out +-1 sd share alone let +-2 sd fall below 90 %; keeping 95 % of the residuals (19
+  /// of 20) within +-2 sd holds both.
+  bool stack_scale_single = true;
+  double stack_sd_two_share = 0.95;
   /// Leaving the first candidate (the power law, by default): per output, a later candidate
   /// takes part in the choice only if its squared held-out errors beat the first's by more than
   /// leave_first_se standard errors of the paired differences (leave_first_se_large from
@@ -331,16 +353,13 @@ struct ChoiceOptions {
   std::function<void(int done, int total, const std::string& step)> progress;
   /// From the simplest (ChoiceOptions::one_standard_error): linear/log (the power law),
   /// linear/identity, gp-matern52-linear/log (a GP whose mean is a power law: it is the power
-  /// law when the data hold no more, R&W section 2.7), gp-matern52-constant/identity and
+  /// law when the data hold no more, R&W section 2.7), gp-matern52-constant/identity,
   /// gp-se-constant/identity (ARD: 7 hyperparameters; with lowest_gp only the GP with the lower
-  /// held-out error takes part). Measured on the tuning parts of scripts/bench_peers.py (median
-  /// test RMSE against the best of the power law, GP-ARD and the networks;
-  /// docs/workpiece-model.md): the power-law mean instead of a constant one on log columns
-  /// brought power-law tables of 100 rows from +15 % to the power law's own error; the
-  /// squared-exponential ARD GP (third attempt) brought Friedman #2 at 100 rows from +47 % to
-  /// +8 % with lowest_gp, and took the isotropic GP's place at about the same time; the trainbr
-  /// network (network-evidence/identity) as a further candidate was never chosen and cost
-  /// 40-300 ms per fit.
+  /// held-out error takes part) and network-h2/identity (trainbr with 2 tanh units on the raw
+  /// columns, R brnn's stopping rule: a logistic or saturating response in a direction of the
+  /// inputs is one unit of it; up to network_max_rows rows). Why each, with the figures measured
+  /// on the tuning parts of scripts/bench_peers.py: docs/workpiece-model.md (the power-law mean
+  /// and the squared-exponential GP: "Third attempt"; the network: "Sixth attempt").
   static std::vector<Candidate> DefaultCandidates();
 };
 
@@ -352,12 +371,13 @@ struct Choice {
   std::vector<FamilyModel> models;
   std::array<int, Features::kCount> model_of_output{};
   /// Stacked outputs (ChoiceOptions::stack): weights[k][j] = weight of models[j] in output k
-  /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight); empty: output
-  /// k is models[model_of_output[k]] alone.
+  /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight; a single
+  /// weight of 1 with ChoiceOptions::stack_scale_single); empty: output k is
+  /// models[model_of_output[k]] alone.
   std::array<std::vector<double>, Features::kCount> weights;
-  /// Stacked outputs: the factor on the combination's sd sum_j w_j sd_j, the +-1 sd
-  /// CoverageScale (two_sd false) of the combination's held-out residuals against that sd at
-  /// the training rows, at most 1 (the sum is an upper bound); 1 otherwise.
+  /// Stacked outputs: the factor on the combination's sd sum_j w_j sd_j, StackSdScale of the
+  /// combination's held-out residuals against that sd at the training rows (at most 1: the sum
+  /// is an upper bound); 1 otherwise.
   std::array<double, Features::kCount> sd_scale{1.0, 1.0};
   /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
   /// Printed by `whirl train` (and in its --json), not stored in the model file.
