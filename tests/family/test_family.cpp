@@ -650,27 +650,40 @@ TEST(FamilyStacking, StackSdScaleOnHandComputedCases) {
 }
 
 TEST(FamilyStacking, ScaleSingleRescalesTheSdOfAWholeCandidateAndKeepsItsMean) {
-  // stack_scale_single: an output one candidate takes whole is written as a weight of 1 with an
-  // sd_scale in [0.25, 1]; its means are those of the choice without the option, its sd that
-  // sd times the scale.
-  const ProcessTable train = MakeTable(20, 0.03, 7), test = MakeTable(10, 0.0, 8);
-  ChoiceOptions plain, single;  // single: the default
-  plain.stack_scale_single = false;
-  const Choice a = ChooseFamily(train, plain), b = ChooseFamily(train, single);
-  const std::vector<FamilyPrediction> pa = PredictChoice(a, test.inputs),
-                                      pb = PredictChoice(b, test.inputs);
-  for (int k = 0; k < 2; ++k) {
-    ASSERT_FALSE(b.weights[k].empty()) << b.Describe();
-    EXPECT_GE(b.sd_scale[k], 0.25);
-    EXPECT_LE(b.sd_scale[k], 1.0);
-    const double scale = a.weights[k].empty() ? b.sd_scale[k] : b.sd_scale[k] / a.sd_scale[k];
-    for (std::size_t q = 0; q < test.inputs.size(); ++q) {
-      EXPECT_NEAR(pb[q].mean.ToArray()[k], pa[q].mean.ToArray()[k],
-                  1e-12 * std::abs(pa[q].mean.ToArray()[k]));
-      EXPECT_NEAR(pb[q].stddev.ToArray()[k], scale * pa[q].stddev.ToArray()[k],
-                  1e-9 * pa[q].stddev.ToArray()[k]);
+  // stack_scale_single (the default): an output one candidate takes whole keeps no weights and
+  // gets an sd_scale in [0.25, 1]; its means are those of the choice without the option, its sd
+  // that sd times the scale, also after a round trip through the file. On 20-row power laws the
+  // candidates' own calibration (every leave-one-out residual within +-2 sd) leaves room: some
+  // scale is below 1.
+  int narrowed = 0;
+  for (unsigned seed = 7; seed < 12; ++seed) {
+    const ProcessTable train = MakeTable(20, 0.03, seed), test = MakeTable(10, 0.0, seed + 50);
+    ChoiceOptions plain, single;  // single: the default
+    plain.stack_scale_single = false;
+    const Choice a = ChooseFamily(train, plain), b = ChooseFamily(train, single);
+    const Choice back = nlohmann::json(b).get<Choice>();
+    const std::vector<FamilyPrediction> pa = PredictChoice(a, test.inputs),
+                                        pb = PredictChoice(b, test.inputs),
+                                        pback = PredictChoice(back, test.inputs);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_EQ(a.weights[k].empty(), b.weights[k].empty()) << b.Describe();
+      EXPECT_GE(b.sd_scale[k], 0.25);
+      EXPECT_LE(b.sd_scale[k], 1.0);
+      if (!a.weights[k].empty()) {
+        EXPECT_EQ(a.sd_scale[k], b.sd_scale[k]);  // a combination: scaled either way
+        continue;
+      }
+      EXPECT_EQ(a.sd_scale[k], 1.0);
+      narrowed += b.sd_scale[k] < 0.999;
+      for (std::size_t q = 0; q < test.inputs.size(); ++q) {
+        EXPECT_EQ(pb[q].mean.ToArray()[k], pa[q].mean.ToArray()[k]);
+        EXPECT_NEAR(pb[q].stddev.ToArray()[k], b.sd_scale[k] * pa[q].stddev.ToArray()[k],
+                    1e-12 * pa[q].stddev.ToArray()[k]);
+        EXPECT_EQ(pback[q].stddev.ToArray()[k], pb[q].stddev.ToArray()[k]);
+      }
     }
   }
+  EXPECT_GE(narrowed, 1) << "of the single-candidate outputs of 5 tables";
 }
 
 // A logistic step of 20 um in the direction of three inputs (the sixth attempt's reason for the

@@ -957,16 +957,21 @@ Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::M
   return out;
 }
 
-// Choice::sd_scale of the stacked outputs: CoverageScale of the combination's held-out residuals
-// sum_c w_c err_c (original units) against its sd at the training rows.
+// Choice::sd_scale of the stacked outputs (and with stack_scale_single of those one candidate
+// takes whole): StackSdScale of the output's held-out residuals sum_c w_c err_c (original units)
+// against its sd at the training rows.
 void ScaleStackedSd(const ProcessTable& table, const ChoiceOptions& options,
                     const std::array<Eigen::VectorXd, Features::kCount>& stack,
                     const std::vector<Eigen::MatrixXd>& err, Choice* choice) {
-  if (std::all_of(stack.begin(), stack.end(), [](const auto& w) { return w.size() == 0; })) return;
+  const auto scaled = [&](int k) {
+    return stack[k].size() > 0 || (options.stack && options.stack_scale_single);
+  };
+  if (!scaled(0) && !scaled(1)) return;
   const std::vector<FamilyPrediction> p = PredictChoice(*choice, table.inputs);
   for (int k = 0; k < Features::kCount; ++k) {
-    if (stack[k].size() == 0) continue;
+    if (!scaled(k)) continue;
     Eigen::VectorXd r = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(p.size()));
+    if (stack[k].size() == 0) r = err[static_cast<std::size_t>(choice->chosen[k])].row(k).transpose();
     for (Eigen::Index c = 0; c < stack[k].size(); ++c)
       if (stack[k](c) > 0) r += stack[k](c) * err[static_cast<std::size_t>(c)].row(k).transpose();
     Eigen::VectorXd sd(r.size());
@@ -1069,8 +1074,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
-      if ((stack[k].array() > 0).count() == 1 && !options.stack_scale_single)
-        stack[k].resize(0);  // one candidate: no stack
+      if ((stack[k].array() > 0).count() == 1) stack[k].resize(0);  // one candidate: no stack
     } else {
       std::vector<int> all(static_cast<std::size_t>(nc)), linear;
       for (int c = 0; c < nc; ++c) {
@@ -1110,7 +1114,7 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
       if (choice.weights[k].empty()) {
         const FamilyPrediction& p = per_model[choice.model_of_output[k]][q];
         mean[k] = p.mean.ToArray()[k];
-        sd[k] = p.stddev.ToArray()[k];
+        sd[k] = choice.sd_scale[k] * p.stddev.ToArray()[k];
         continue;
       }
       for (std::size_t j = 0; j < per_model.size(); ++j) {

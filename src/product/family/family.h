@@ -304,9 +304,9 @@ struct ChoiceOptions {
   /// squared held-out errors beat the first's by more than stack_gate_se standard errors
   /// (stack_gate_se_large from few_rows rows; BeatsFirst, no blocks); 0: every candidate enters.
   double stack_gate_se = 1.0, stack_gate_se_large = 1.5;
-  /// ChoiceOptions::stack: true: an output that one candidate takes whole gets Choice::sd_scale
-  /// too (a weight of 1 on that candidate), so that its sd is rescaled as a combination's;
-  /// false: its own sd, unscaled (Choice::weights empty).
+  /// ChoiceOptions::stack: true: an output that one candidate takes whole (Choice::weights
+  /// empty) gets a Choice::sd_scale too, from that candidate's held-out residuals, as a
+  /// combination's; false: its own sd, unscaled.
   /// ChoiceOptions::stack: the +-2 sd share of the held-out residuals that Choice::sd_scale must
   /// keep covered (StackSdScale); 0: the +-1 sd share alone.
   /// Why both (the sixth attempt, docs/workpiece-model.md): each candidate's own calibration
@@ -371,13 +371,14 @@ struct Choice {
   std::vector<FamilyModel> models;
   std::array<int, Features::kCount> model_of_output{};
   /// Stacked outputs (ChoiceOptions::stack): weights[k][j] = weight of models[j] in output k
-  /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight; a single
-  /// weight of 1 with ChoiceOptions::stack_scale_single); empty: output k is
-  /// models[model_of_output[k]] alone.
+  /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight); empty: output
+  /// k is models[model_of_output[k]] alone (its sd times sd_scale[k]).
   std::array<std::vector<double>, Features::kCount> weights;
   /// Stacked outputs: the factor on the combination's sd sum_j w_j sd_j, StackSdScale of the
   /// combination's held-out residuals against that sd at the training rows (at most 1: the sum
-  /// is an upper bound); 1 otherwise.
+  /// is an upper bound); with ChoiceOptions::stack_scale_single also the factor on a single
+  /// candidate's sd (its own held-out residuals); 1 otherwise. Stored in the model file when a
+  /// weight is or a factor is not 1.
   std::array<double, Features::kCount> sd_scale{1.0, 1.0};
   /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
   /// Printed by `whirl train` (and in its --json), not stored in the model file.
@@ -395,8 +396,9 @@ struct Choice {
 /// The choice of the header comment. InputError if the table has no targets or fewer rows than a
 /// candidate's MinimumRows (counting the table's rows), or if there are no candidates.
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
-/// Output k from models[model_of_output[k]] (mean and sd), or for a stacked output the weighted
-/// mean sum_j w_j mean_j and sd sd_scale[k] sum_j w_j sd_j (ChoiceOptions::stack).
+/// Output k from models[model_of_output[k]] (mean, and sd times sd_scale[k]), or for a stacked
+/// output the weighted mean sum_j w_j mean_j and sd sd_scale[k] sum_j w_j sd_j
+/// (ChoiceOptions::stack).
 std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
                                             const std::vector<ProcessInputs>& inputs);
 
