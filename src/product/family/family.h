@@ -93,12 +93,10 @@ struct FitOptions {
   /// (and their latent variances) are covered 68.27 % at +-1 sd and 95.45 % at +-2 sd
   /// (CoverageNoiseVariance with two_sd), besides the +-1 sd level of calibration_folds; false:
   /// the +-1 sd level alone. Why: a +-2 sd band is read as a 95 % interval, and with the +-1 sd
-  /// rule alone it covered 79 % of the hold-out rows of the shipped 20-row simulator table and
-  /// 88 % on generated 20-row tables (residuals with heavier tails than a normal's). Why the
-  /// leave-one-out residuals for the tail: at 20 rows 95.45 % means every row, and the K-fold
-  /// refits (16 rows) have occasional bad folds that a maximum follows: requiring both shares
-  /// of the 5-fold residuals covered 84-85 % at +-1 sd on Friedman's 20-row tables, this rule
-  /// 69-74 % (scripts/bench_peers.sh, 20 seeds; docs/workpiece-model.md).
+  /// rule alone it covered too few hold-out rows at +-2 sd on 20-row tables (residuals with
+  /// heavier tails than a normal's). Why the leave-one-out residuals for the tail: at 20 rows
+  /// 95.45 % means every row, and the K-fold refits (16 rows) have occasional bad folds that a
+  /// maximum follows, which made +-1 sd far too wide (figures: docs/workpiece-model.md).
   bool calibrate_two_sd = true;
   /// From this many rows on, linear and GP candidates are calibrated by the closed-form
   /// leave-one-out alone (calibration_folds is used below it); 0 = never. At 70 rows and more
@@ -261,8 +259,8 @@ struct ChoiceOptions {
   /// hyperparameters fitted with the held-out row (Cawley & Talbot, "On over-fitting in model
   /// selection and subsequent selection bias in performance evaluation", JMLR 11, 2010); on the
   /// tuning part of scripts/bench_peers.sh (20 rows) the default took GPs that lost to the power
-  /// law on power-law tables (+31 % median test RMSE for settle time) and the refits brought it
-  /// to the power law's (docs/workpiece-model.md).
+  /// law on power-law tables and the refits brought it to the power law's
+  /// (docs/workpiece-model.md).
   bool closed_form_loo = true;
   /// Few rows for a GP: fewer than kRowsPerHyperparameter rows per hyperparameter of the ARD
   /// kernel on the five inputs (7: 70 rows; the rule of thumb of 10, Harrell, "Regression
@@ -284,8 +282,8 @@ struct ChoiceOptions {
   /// errors e_c are fully correlated, and an upper bound for any correlation, Minkowski: the
   /// noise of a new row, most of each sd, is common to every candidate) times Choice::sd_scale,
   /// the CoverageScale of the combination's held-out residuals. (sqrt(sum_c w_c sd_c^2), the
-  /// looser bound of earlier versions, covered 77-82 % of the tuning part's test rows at +-1 sd
-  /// on bent and stepped power laws.)
+  /// looser bound of earlier versions, covered too many of the tuning part's test rows at +-1 sd
+  /// on bent and stepped power laws; docs/workpiece-model.md.)
   /// The candidates that enter: the first, those that beat it by more than stack_gate_se
   /// standard errors (BeatsFirst), and of the GPs with lowest_gp only the lowest; the weights are
   /// shrunk toward the first (ShrunkStackWeights, stack_start_se / stack_full_se).
@@ -309,11 +307,11 @@ struct ChoiceOptions {
   /// combination's; false: its own sd, unscaled.
   /// ChoiceOptions::stack: the +-2 sd share of the held-out residuals that Choice::sd_scale must
   /// keep covered (StackSdScale); 0: the +-1 sd share alone.
-  /// Why both (the sixth attempt, docs/workpiece-model.md): each candidate's own calibration
-  /// covers every held-out residual of a 20-row table at +-2 sd, and with heavy-tailed residuals
-  /// its +-1 sd then covered more than 76 % of new rows; narrowing the sd to the combination's
-  /// held-out +-1 sd share alone let +-2 sd fall below 90 %; keeping 95 % of the residuals (19
-  /// of 20) within +-2 sd holds both.
+  /// Why both (the sixth attempt, figures in docs/workpiece-model.md): each candidate's own
+  /// calibration covers every held-out residual of a 20-row table at +-2 sd, and with
+  /// heavy-tailed residuals its +-1 sd then covered more new rows than the 60-76 % band;
+  /// narrowing the sd to the held-out +-1 sd share alone let +-2 sd fall below 90 %; keeping 95 %
+  /// of the residuals (19 of 20) within +-2 sd holds both.
   bool stack_scale_single = true;
   double stack_sd_two_share = 0.95;
   /// Leaving the first candidate (the power law, by default): per output, a later candidate
@@ -324,8 +322,7 @@ struct ChoiceOptions {
   /// takes part (the one-standard-error rule alone).
   /// Defaults (2 and 2.5, no blocks) chosen on the third attempt's tuning part of
   /// scripts/bench_peers.py: with 0 (the one-standard-error rule alone) a GP or the raw linear
-  /// fit won the held-out comparison on power-law tables and lost on new rows (+7 to +15 %
-  /// median test RMSE); the larger margin from few_rows on answers the optimism of a GP's
+  /// fit won the held-out comparison on power-law tables and lost on new rows; the larger margin from few_rows on answers the optimism of a GP's
   /// closed-form leave-one-out, whose hyperparameters have seen the held-out row
   /// (docs/workpiece-model.md, "Third attempt").
   double leave_first_se = 2.0;
