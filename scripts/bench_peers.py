@@ -32,7 +32,8 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   powerlaw_noisy, which no setting was tuned on. Settings are chosen on the tuning part only; the
   confirmation part is run once, at the end (docs/workpiece-model.md reports both). That
   confirmation is spent; the third attempt's split: "tuning3" = the eight families on seeds 1-20,
-  "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero.
+  "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
+  later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -330,6 +331,9 @@ SPLITS = {
     # The fifth attempt's decision (stack against the default, no tuning): 11001-11020 at 20 rows,
     # 11001-11010 at 100 rows.
     "decision5": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 11001},
+    # The sixth attempt's confirmation (tuning on 1-20, 4001-, 10001-, 11001-): 12001-12020 at 20
+    # rows, 12001-12010 at 100 rows.
+    "confirmation6": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 12001},
 }
 
 
@@ -561,11 +565,16 @@ def main():
                     help="with --from-json: the paired decision of CAND against BASE (d = ln of the "
                          "RMSE ratio per table and output, paired t, coverage cells, per-family "
                          "median ratios; docs/workpiece-model.md, fifth attempt)")
+    ap.add_argument("--rule", choices=["fifth", "sixth"], default="fifth",
+                    help="with --paired: the fifth attempt's rule (no family median ratio above "
+                         "1.03) or the sixth's (no family geometric mean ratio above 1.02; a "
+                         "candidate that changes only the sd needs identical RMSE and strictly "
+                         "fewer coverage cells); docs/workpiece-model.md")
     a = ap.parse_args()
     if a.paired and not a.from_json:
         sys.exit("bench_peers: --paired needs --from-json")
     if a.paired:
-        paired_decision(a.from_json, *a.paired)
+        paired_decision(a.from_json, *a.paired, sixth=a.rule == "sixth")
         return
     if a.from_json:
         pooled_summary(a.from_json, [p for p in a.acceptance_peers.split(",") if p], a.markdown)
@@ -734,11 +743,14 @@ def paired_t(d):
     return float(np.mean(d)), (float(np.mean(d)) / (sd / math.sqrt(len(d))) if sd > 0 else 0.0)
 
 
-def paired_decision(files, base, cand):
+def paired_decision(files, base, cand, sixth=False):
     """The fifth attempt's rule (docs/workpiece-model.md), fixed before its run: per (problem,
     rows, seed, output) d = ln(RMSE_cand / RMSE_base); adopt iff mean(d) < 0 with paired t <= -2,
     no more coverage cells outside the bands than base, and no problem's median RMSE ratio above
-    1.03. A failed fit (NaN) of either method fails the rule."""
+    1.03. A failed fit (NaN) of either method fails the rule. sixth: the sixth attempt's rule
+    (section "Sixth attempt: split"): no problem's geometric mean ratio exp(mean d) above 1.02
+    instead of the median; if every case has d = 0 (only the sd changed), strictly fewer coverage
+    cells instead of the t test."""
     rs = load_runs(files)
     d, fam, failed_fits = [], {}, 0
     for r in rs:
@@ -758,12 +770,12 @@ def paired_decision(files, base, cand):
     print(f"mean d {mean:+.4f} (geometric mean ratio {math.exp(mean):.4f}), paired t {t:+.2f}")
     print("| problem | cases | d = 0 | median ratio | mean d | t | cases better / worse |")
     print("|---|---|---|---|---|---|---|")
-    worst = 0.0
+    worst, worst_gm = 0.0, 0.0
     for prob in sorted(fam):
         x = fam[prob]
         fm, ft = paired_t(x)
         ratio = math.exp(float(np.median(x)))
-        worst = max(worst, ratio)
+        worst, worst_gm = max(worst, ratio), max(worst_gm, math.exp(fm))
         print(f"| {prob} | {len(x)} | {sum(v == 0.0 for v in x)} | {ratio:.4f} | {fm:+.4f} | "
               f"{ft:+.2f} | {sum(v < 0 for v in x)} / {sum(v > 0 for v in x)} |")
     cells = {m: coverage_cells_out(rs, m) for m in (base, cand)}
@@ -775,6 +787,15 @@ def paired_decision(files, base, cand):
                   len(cells[cand]) <= len(cells[base]),
               f"largest problem median ratio {worst:.4f} <= 1.03": worst <= 1.03,
               "no failed fit": failed_fits == 0}
+    if sixth:
+        sd_only = identical == len(d) and failed_fits == 0
+        checks = {("sd only: every case d = 0" if sd_only else "mean d < 0 and t <= -2.0"):
+                      sd_only or (mean < 0 and t <= -2.0),
+                  f"coverage cells {len(cells[cand])} {'<' if sd_only else '<='} {len(cells[base])}":
+                      len(cells[cand]) < len(cells[base]) if sd_only
+                      else len(cells[cand]) <= len(cells[base]),
+                  f"largest problem geometric mean ratio {worst_gm:.4f} <= 1.02": worst_gm <= 1.02,
+                  "no failed fit": failed_fits == 0}
     for what, ok in checks.items():
         print(f"{'holds' if ok else 'FAILS'}: {what}")
     print(f"decision: {'ADOPT ' + cand if all(checks.values()) else 'keep ' + base}")

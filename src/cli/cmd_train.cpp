@@ -378,7 +378,8 @@ std::string TrainDescription() {
   return "Train the workpiece model on a process table and write a model file (JSON).\n"
          "Default (no model options): per output a convex combination (stack) of the power law\n"
          "(least squares on log columns), a linear fit, a GP with a power-law mean on log\n"
-         "columns and two ARD GPs on raw columns (Matern 5/2, squared exponential): a candidate\n"
+         "columns, two ARD GPs on raw columns (Matern 5/2, squared exponential) and up to 500\n"
+         "rows a trainbr network with 2 tanh units on raw columns (5 fold refits): a candidate\n"
          "enters only if its held-out error beats the power law's by 1 standard error (1.5 from\n"
          "70 rows), and only the GP with the lowest held-out error; weights minimize the\n"
          "held-out error, shrunk toward the power law until the combination's nested held-out\n"
@@ -393,8 +394,9 @@ std::string TrainDescription() {
          "is named and left out; a zero or near-zero target keeps its column raw for the log\n"
          "candidates, with a warning. From 512 rows a GP keeps 512 rows spread over the\n"
          "table (the others judge it). The sd is calibrated to cover 68.27 % / 95.45 % of\n"
-         "held-out residuals at +-1 / +-2 sd; a combination's sd is the weighted sum of its\n"
-         "candidates' sd, scaled down to cover 68.27 % of its own held-out residuals.\n"
+         "held-out residuals at +-1 / +-2 sd; the output's sd (the weighted sum of its\n"
+         "candidates' sd) is then scaled down to cover 68.27 % of its own held-out residuals\n"
+         "at +-1 sd, as long as +-2 sd still covers 95 % of them.\n"
          "Prints the choice and the table of held-out errors; a progress line every 2 s once\n"
          "a fit takes longer. The same table and seed give the same file byte for byte.\n"
          "--family network|gp|linear|auto and --transform log|identity|auto restrict it.\n"
@@ -489,8 +491,8 @@ void RegisterTrain(CLI::App& app) {
   sub->add_option("--transform", o->transform,
                   "log: every strictly positive column (all inputs and targets of a valid\n"
                   "table) on a log scale (a linear fit becomes a power law); identity: raw\n"
-                  "columns; auto: both, chosen by cross-validated error. Default auto, for\n"
-                  "--family network identity")
+                  "columns; auto: both, chosen by cross-validated error. Default auto\n"
+                  "(identity with --family network)")
       ->check(CLI::IsMember({"auto", "log", "identity"}));
   sub->add_option("--choice", o->choice,
                   "stack (default): per output a convex combination of the candidates' held-out\n"

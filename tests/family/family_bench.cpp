@@ -62,6 +62,14 @@ Args Parse(int argc, char** argv) {
       a.choice.stack_start_se_large = std::stod(value());
       a.choice.stack_full_se_large = std::stod(value());
     }
+    else if (k == "--stack-scale-single")
+      a.choice.stack_scale_single = true;
+    else if (k == "--no-stack-scale-single")
+      a.choice.stack_scale_single = false;
+    else if (k == "--network-max-rows")
+      a.choice.network_max_rows = std::stoi(value());
+    else if (k == "--stack-sd-two-share")
+      a.choice.stack_sd_two_share = std::stod(value());
     else if (k == "--two-sd")
       a.choice.fit.calibrate_two_sd = true;
     else if (k == "--one-sd")

@@ -127,7 +127,8 @@ TEST(WorkpieceModel, DeltaMethodSdMatchesFiniteDifferencesOfTheBackMapping) {
       const double slope = (std::exp(mz + h) - std::exp(mz - h)) / (2 * h);
       const Prediction p = Predict(m, test.inputs[q]);
       EXPECT_NEAR(p.mean.ToArray()[k], std::exp(mz), 1e-12 * std::exp(mz));
-      EXPECT_NEAR(p.stddev.ToArray()[k], slope * sz, 1e-6 * slope * sz);
+      const double scale = m.choice.sd_scale[k];  // ChoiceOptions::stack_scale_single
+      EXPECT_NEAR(p.stddev.ToArray()[k], scale * slope * sz, 1e-6 * scale * slope * sz);
     }
   }
 }
@@ -248,7 +249,8 @@ TEST(WorkpieceTraining, FlagsSelectTheCandidates) {
   EXPECT_EQ(names(FamilyFlag::kGaussianProcess, TransformFlag::kLog), "gp-matern52-linear/log ");
   EXPECT_EQ(names(FamilyFlag::kNetwork, TransformFlag::kLog), "network-evidence/log ");
   EXPECT_EQ(names(FamilyFlag::kAuto, TransformFlag::kIdentity),
-            "linear/identity gp-matern52-constant/identity gp-se-constant/identity ");
+            "linear/identity gp-matern52-constant/identity gp-se-constant/identity "
+            "network-h2/identity ");
   ExpectInputError([] { ParseFamilyFlag("svm"); }, "--family 'svm'");
   ExpectInputError([] { ParseTransformFlag("sqrt"); }, "--transform 'sqrt'");
 }

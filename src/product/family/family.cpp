@@ -622,20 +622,44 @@ int SimplestWithinOneStandardError(const std::vector<Eigen::VectorXd>& squared_e
   return static_cast<int>(best);
 }
 
-double CoverageScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd, bool two_sd) {
-  if (residual.size() == 0 || residual.size() != sd.size() || !(sd.array() > 0).all())
-    throw InputError("sd scale: " + std::to_string(residual.size()) + " residuals and " +
-                     std::to_string(sd.size()) + " sd; need equal sizes > 0 and every sd > 0");
-  std::vector<double> ratio(static_cast<std::size_t>(residual.size()));
-  for (Eigen::Index i = 0; i < residual.size(); ++i)
-    ratio[static_cast<std::size_t>(i)] = std::abs(residual(i)) / sd(i);
-  std::sort(ratio.begin(), ratio.end());
-  const auto at = [&](double share) {  // the smallest ratio covering `share` of the rows
-    const double n = static_cast<double>(ratio.size());
+namespace {
+
+// The smallest factor kappa at which kappa sd_i >= |r_i| for at least `share` of the rows.
+class ScaleQuantiles {
+ public:
+  ScaleQuantiles(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd) {
+    if (residual.size() == 0 || residual.size() != sd.size() || !(sd.array() > 0).all())
+      throw InputError("sd scale: " + std::to_string(residual.size()) + " residuals and " +
+                       std::to_string(sd.size()) + " sd; need equal sizes > 0 and every sd > 0");
+    for (Eigen::Index i = 0; i < residual.size(); ++i)
+      ratio_.push_back(std::abs(residual(i)) / sd(i));
+    std::sort(ratio_.begin(), ratio_.end());
+  }
+  double At(double share) const {
+    const double n = static_cast<double>(ratio_.size());
     const auto q = static_cast<std::size_t>(std::ceil(share * n - 1e-9));
-    return ratio[std::clamp<std::size_t>(q, 1, ratio.size()) - 1];
-  };
-  return std::clamp(two_sd ? std::max(at(kOneSigma), at(kTwoSigma) / 2) : at(kOneSigma), 0.25, 4.0);
+    return ratio_[std::clamp<std::size_t>(q, 1, ratio_.size()) - 1];
+  }
+
+ private:
+  std::vector<double> ratio_;
+};
+
+}  // namespace
+
+double CoverageScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd, bool two_sd) {
+  const ScaleQuantiles at(residual, sd);
+  return std::clamp(two_sd ? std::max(at.At(kOneSigma), at.At(kTwoSigma) / 2) : at.At(kOneSigma),
+                    0.25, 4.0);
+}
+
+double StackSdScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd, double two_share) {
+  if (!(two_share >= 0 && two_share <= 1))
+    throw InputError("sd scale: the +-2 sd share " + MessageNumber(two_share) +
+                     " must lie in [0, 1]");
+  const ScaleQuantiles at(residual, sd);
+  const double one = at.At(kOneSigma);
+  return std::clamp(two_share > 0 ? std::max(one, at.At(two_share) / 2) : one, 0.25, 1.0);
 }
 
 double CoverageNoiseVariance(const Eigen::VectorXd& residual,
@@ -680,7 +704,8 @@ int MinimumRows(const Candidate& c, int inputs) {
 std::vector<Candidate> ChoiceOptions::DefaultCandidates() {
   std::vector<Candidate> c;
   for (const char* name : {"linear/log", "linear/identity", "gp-matern52-linear/log",
-                           "gp-matern52-constant/identity", "gp-se-constant/identity"})
+                           "gp-matern52-constant/identity", "gp-se-constant/identity",
+                           "network-h2/identity"})
     c.push_back(ParseCandidate(name));
   return c;
 }
@@ -844,16 +869,28 @@ namespace {
 // `o` without its GP candidates on tables too small for their refits (ChoiceOptions::few_rows:
 // every training split of `folds` needs the rows of a linear fit in `inputs` inputs), unless they
 // are all there is; `note` says so.
-ChoiceOptions ActiveCandidates(const ChoiceOptions& o, int rows, int folds, int inputs,
+ChoiceOptions ActiveCandidates(const ChoiceOptions& given, int rows, int folds, int inputs,
                                std::string* note) {
+  ChoiceOptions o = given;
+  if (o.network_max_rows > 0 && rows > o.network_max_rows) {
+    o.candidates.clear();
+    for (const Candidate& c : given.candidates)
+      if (c.family != Family::kNetwork) o.candidates.push_back(c);
+    if (o.candidates.empty()) return given;
+    if (o.candidates.size() < given.candidates.size())
+      *note = "above " + std::to_string(o.network_max_rows) +
+              " rows the network candidates sit out (their refits would exceed the fit time "
+              "budget)";
+  }
   ChoiceOptions active = o;
   const int split = rows - (rows + folds - 1) / folds, need = inputs + 3;
   if (!o.closed_form_loo || rows >= o.few_rows || split >= need) return active;
   active.candidates.clear();
   for (const Candidate& c : o.candidates)
-    if (c.family != Family::kGaussianProcess) active.candidates.push_back(c);
+    if (c.family == Family::kLinear) active.candidates.push_back(c);
   if (active.candidates.empty() || active.candidates.size() == o.candidates.size()) return o;
-  *note = "at " + std::to_string(rows) + " rows the GP candidates sit out: a GP must beat the " +
+  *note = "at " + std::to_string(rows) + " rows the GP candidates sit out (and any network): " +
+          "a GP must beat the " +
           "linear fits in " + std::to_string(folds) + "-fold refits, whose training splits of " +
           std::to_string(split) + " rows are fewer than a linear fit in " +
           std::to_string(inputs) + " inputs needs (" + std::to_string(need) + ")";
@@ -920,22 +957,27 @@ Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::M
   return out;
 }
 
-// Choice::sd_scale of the stacked outputs: CoverageScale of the combination's held-out residuals
-// sum_c w_c err_c (original units) against its sd at the training rows.
-void ScaleStackedSd(const ProcessTable& table,
+// Choice::sd_scale of the stacked outputs (and with stack_scale_single of those one candidate
+// takes whole): StackSdScale of the output's held-out residuals sum_c w_c err_c (original units)
+// against its sd at the training rows.
+void ScaleStackedSd(const ProcessTable& table, const ChoiceOptions& options,
                     const std::array<Eigen::VectorXd, Features::kCount>& stack,
                     const std::vector<Eigen::MatrixXd>& err, Choice* choice) {
-  if (std::all_of(stack.begin(), stack.end(), [](const auto& w) { return w.size() == 0; })) return;
+  const auto scaled = [&](int k) {
+    return stack[k].size() > 0 || (options.stack && options.stack_scale_single);
+  };
+  if (!scaled(0) && !scaled(1)) return;
   const std::vector<FamilyPrediction> p = PredictChoice(*choice, table.inputs);
   for (int k = 0; k < Features::kCount; ++k) {
-    if (stack[k].size() == 0) continue;
+    if (!scaled(k)) continue;
     Eigen::VectorXd r = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(p.size()));
+    if (stack[k].size() == 0) r = err[static_cast<std::size_t>(choice->chosen[k])].row(k).transpose();
     for (Eigen::Index c = 0; c < stack[k].size(); ++c)
       if (stack[k](c) > 0) r += stack[k](c) * err[static_cast<std::size_t>(c)].row(k).transpose();
     Eigen::VectorXd sd(r.size());
     for (std::size_t q = 0; q < p.size(); ++q)
       sd(static_cast<Eigen::Index>(q)) = std::max(p[q].stddev.ToArray()[k], 1e-300);
-    choice->sd_scale[k] = std::min(CoverageScale(r, sd, false), 1.0);
+    choice->sd_scale[k] = StackSdScale(r, sd, options.stack_sd_two_share);
   }
 }
 
@@ -1054,7 +1096,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
   FitChosen(table, options, stack, full, calibrated, &choice);
-  ScaleStackedSd(table, stack, err, &choice);
+  ScaleStackedSd(table, options, stack, err, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
   choice.warnings = TableWarnings(table, options, constant);
   choice.rows_note = rows_note;
@@ -1072,7 +1114,7 @@ std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
       if (choice.weights[k].empty()) {
         const FamilyPrediction& p = per_model[choice.model_of_output[k]][q];
         mean[k] = p.mean.ToArray()[k];
-        sd[k] = p.stddev.ToArray()[k];
+        sd[k] = choice.sd_scale[k] * p.stddev.ToArray()[k];
         continue;
       }
       for (std::size_t j = 0; j < per_model.size(); ++j) {
@@ -1097,10 +1139,12 @@ std::string Choice::Describe() const {
       continue;
     }
     std::string terms;
+    const bool whole = std::count_if(weights[k].begin(), weights[k].end(),
+                                     [](double w) { return w > 0; }) == 1;
     for (std::size_t j = 0; j < weights[k].size() && j < models.size(); ++j)
-      if (weights[k][j] > 0)
-        terms += (terms.empty() ? "" : " + ") + FormatFixed(weights[k][j], 2) + " " +
-                 models[j].OutputName(k);
+      if (weights[k][j] > 0)  // one candidate with all the weight: its name alone
+        terms += (terms.empty() ? "" : " + ") +
+                 (whole ? "" : FormatFixed(weights[k][j], 2) + " ") + models[j].OutputName(k);
     s += terms;
   }
   return s;

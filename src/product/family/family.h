@@ -93,12 +93,10 @@ struct FitOptions {
   /// (and their latent variances) are covered 68.27 % at +-1 sd and 95.45 % at +-2 sd
   /// (CoverageNoiseVariance with two_sd), besides the +-1 sd level of calibration_folds; false:
   /// the +-1 sd level alone. Why: a +-2 sd band is read as a 95 % interval, and with the +-1 sd
-  /// rule alone it covered 79 % of the hold-out rows of the shipped 20-row simulator table and
-  /// 88 % on generated 20-row tables (residuals with heavier tails than a normal's). Why the
-  /// leave-one-out residuals for the tail: at 20 rows 95.45 % means every row, and the K-fold
-  /// refits (16 rows) have occasional bad folds that a maximum follows: requiring both shares
-  /// of the 5-fold residuals covered 84-85 % at +-1 sd on Friedman's 20-row tables, this rule
-  /// 69-74 % (scripts/bench_peers.sh, 20 seeds; docs/workpiece-model.md).
+  /// rule alone it covered too few hold-out rows at +-2 sd on 20-row tables (residuals with
+  /// heavier tails than a normal's). Why the leave-one-out residuals for the tail: at 20 rows
+  /// 95.45 % means every row, and the K-fold refits (16 rows) have occasional bad folds that a
+  /// maximum follows, which made +-1 sd far too wide (figures: docs/workpiece-model.md).
   bool calibrate_two_sd = true;
   /// From this many rows on, linear and GP candidates are calibrated by the closed-form
   /// leave-one-out alone (calibration_folds is used below it); 0 = never. At 70 rows and more
@@ -188,6 +186,14 @@ ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::
 double CoverageScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd,
                      bool two_sd = true);
 
+/// Choice::sd_scale of a stacked output: min(1, max(q1, q2 / 2)), q1 the smallest factor at
+/// which kappa sd_i >= |r_i| for at least 68.27 % of the rows, q2 the smallest at which
+/// kappa sd_i >= |r_i| for at least `two_share` of them (two_share = 0: q1 alone), clamped to
+/// [0.25, 1]. The sd is only ever narrowed: the candidates' own sd is calibrated already, and
+/// a combination errs less than its parts. InputError as CoverageScale, or if two_share is
+/// outside [0, 1].
+double StackSdScale(const Eigen::VectorXd& residual, const Eigen::VectorXd& sd, double two_share);
+
 /// ChoiceOptions::one_standard_error for one output: squared_errors[c] holds candidate c's
 /// squared held-out errors per row (candidates from the simplest); returns the first c with
 /// mean(d) <= sd(d) / sqrt(n), d = squared_errors[c] - squared_errors[b], b the lowest mean,
@@ -253,8 +259,8 @@ struct ChoiceOptions {
   /// hyperparameters fitted with the held-out row (Cawley & Talbot, "On over-fitting in model
   /// selection and subsequent selection bias in performance evaluation", JMLR 11, 2010); on the
   /// tuning part of scripts/bench_peers.sh (20 rows) the default took GPs that lost to the power
-  /// law on power-law tables (+31 % median test RMSE for settle time) and the refits brought it
-  /// to the power law's (docs/workpiece-model.md).
+  /// law on power-law tables and the refits brought it to the power law's
+  /// (docs/workpiece-model.md).
   bool closed_form_loo = true;
   /// Few rows for a GP: fewer than kRowsPerHyperparameter rows per hyperparameter of the ARD
   /// kernel on the five inputs (7: 70 rows; the rule of thumb of 10, Harrell, "Regression
@@ -264,6 +270,11 @@ struct ChoiceOptions {
   /// Choice::rows_note says so.
   int few_rows = 70;
   static constexpr int kRowsPerHyperparameter = 10;
+  /// Network candidates sit out of tables with more rows than this (0: never), and
+  /// Choice::rows_note says so: their fold refits, final fit and noise folds grow with the rows
+  /// (trainbr) and the default's fit time must stay within R brnn's (docs/workpiece-model.md,
+  /// "Speed").
+  int network_max_rows = 500;
   /// true: per output a convex combination of the candidates (ConvexStackWeights of their
   /// held-out predictions, original units) instead of one candidate; the one-standard-error rule
   /// is then not applied. Each candidate with a positive weight is refitted and calibrated on its
@@ -271,18 +282,15 @@ struct ChoiceOptions {
   /// errors e_c are fully correlated, and an upper bound for any correlation, Minkowski: the
   /// noise of a new row, most of each sd, is common to every candidate) times Choice::sd_scale,
   /// the CoverageScale of the combination's held-out residuals. (sqrt(sum_c w_c sd_c^2), the
-  /// looser bound of earlier versions, covered 77-82 % of the tuning part's test rows at +-1 sd
-  /// on bent and stepped power laws.)
+  /// looser bound of earlier versions, covered too many of the tuning part's test rows at +-1 sd
+  /// on bent and stepped power laws; docs/workpiece-model.md.)
   /// The candidates that enter: the first, those that beat it by more than stack_gate_se
   /// standard errors (BeatsFirst), and of the GPs with lowest_gp only the lowest; the weights are
   /// shrunk toward the first (ShrunkStackWeights, stack_start_se / stack_full_se).
-  /// The default since the fifth attempt (docs/workpiece-model.md, "Fifth attempt"): on fresh
-  /// seeds of the eleven generator families of scripts/bench_peers.py, with the settings below
-  /// unchanged from the fourth attempt, its test RMSE was lower than the hard choice's (mean
-  /// ln ratio -0.035, paired t -5.2 over 660 table outputs, 477 of them identical) with fewer
-  /// coverage cells outside the bands (6 against 9 of 44). false: the hard choice (one
-  /// candidate per output by the one-standard-error rule and leave_first_se; `whirl train
-  /// --choice hard`), the default before.
+  /// The default since the fifth attempt (docs/workpiece-model.md, "Fifth attempt": on fresh
+  /// seeds its test RMSE was lower than the hard choice's with fewer coverage cells outside the
+  /// bands). false: the hard choice (one candidate per output by the one-standard-error rule and
+  /// leave_first_se; `whirl train --choice hard`), the default before.
   bool stack = true;
   /// ChoiceOptions::stack shrunk toward the first candidate (ShrunkStackWeights): the stack
   /// gets no weight while its nested held-out errors beat the first's by at most stack_start_se
@@ -294,6 +302,18 @@ struct ChoiceOptions {
   /// squared held-out errors beat the first's by more than stack_gate_se standard errors
   /// (stack_gate_se_large from few_rows rows; BeatsFirst, no blocks); 0: every candidate enters.
   double stack_gate_se = 1.0, stack_gate_se_large = 1.5;
+  /// ChoiceOptions::stack: true: an output that one candidate takes whole (Choice::weights
+  /// empty) gets a Choice::sd_scale too, from that candidate's held-out residuals, as a
+  /// combination's; false: its own sd, unscaled.
+  /// ChoiceOptions::stack: the +-2 sd share of the held-out residuals that Choice::sd_scale must
+  /// keep covered (StackSdScale); 0: the +-1 sd share alone.
+  /// Why both (the sixth attempt, figures in docs/workpiece-model.md): each candidate's own
+  /// calibration covers every held-out residual of a 20-row table at +-2 sd, and with
+  /// heavy-tailed residuals its +-1 sd then covered more new rows than the 60-76 % band;
+  /// narrowing the sd to the held-out +-1 sd share alone let +-2 sd fall below 90 %; keeping 95 %
+  /// of the residuals (19 of 20) within +-2 sd holds both.
+  bool stack_scale_single = true;
+  double stack_sd_two_share = 0.95;
   /// Leaving the first candidate (the power law, by default): per output, a later candidate
   /// takes part in the choice only if its squared held-out errors beat the first's by more than
   /// leave_first_se standard errors of the paired differences (leave_first_se_large from
@@ -302,8 +322,7 @@ struct ChoiceOptions {
   /// takes part (the one-standard-error rule alone).
   /// Defaults (2 and 2.5, no blocks) chosen on the third attempt's tuning part of
   /// scripts/bench_peers.py: with 0 (the one-standard-error rule alone) a GP or the raw linear
-  /// fit won the held-out comparison on power-law tables and lost on new rows (+7 to +15 %
-  /// median test RMSE); the larger margin from few_rows on answers the optimism of a GP's
+  /// fit won the held-out comparison on power-law tables and lost on new rows; the larger margin from few_rows on answers the optimism of a GP's
   /// closed-form leave-one-out, whose hyperparameters have seen the held-out row
   /// (docs/workpiece-model.md, "Third attempt").
   double leave_first_se = 2.0;
@@ -331,16 +350,13 @@ struct ChoiceOptions {
   std::function<void(int done, int total, const std::string& step)> progress;
   /// From the simplest (ChoiceOptions::one_standard_error): linear/log (the power law),
   /// linear/identity, gp-matern52-linear/log (a GP whose mean is a power law: it is the power
-  /// law when the data hold no more, R&W section 2.7), gp-matern52-constant/identity and
+  /// law when the data hold no more, R&W section 2.7), gp-matern52-constant/identity,
   /// gp-se-constant/identity (ARD: 7 hyperparameters; with lowest_gp only the GP with the lower
-  /// held-out error takes part). Measured on the tuning parts of scripts/bench_peers.py (median
-  /// test RMSE against the best of the power law, GP-ARD and the networks;
-  /// docs/workpiece-model.md): the power-law mean instead of a constant one on log columns
-  /// brought power-law tables of 100 rows from +15 % to the power law's own error; the
-  /// squared-exponential ARD GP (third attempt) brought Friedman #2 at 100 rows from +47 % to
-  /// +8 % with lowest_gp, and took the isotropic GP's place at about the same time; the trainbr
-  /// network (network-evidence/identity) as a further candidate was never chosen and cost
-  /// 40-300 ms per fit.
+  /// held-out error takes part) and network-h2/identity (trainbr with 2 tanh units on the raw
+  /// columns, R brnn's stopping rule: a logistic or saturating response in a direction of the
+  /// inputs is one unit of it; up to network_max_rows rows). Why each, with the figures measured
+  /// on the tuning parts of scripts/bench_peers.py: docs/workpiece-model.md (the power-law mean
+  /// and the squared-exponential GP: "Third attempt"; the network: "Sixth attempt").
   static std::vector<Candidate> DefaultCandidates();
 };
 
@@ -353,11 +369,13 @@ struct Choice {
   std::array<int, Features::kCount> model_of_output{};
   /// Stacked outputs (ChoiceOptions::stack): weights[k][j] = weight of models[j] in output k
   /// (>= 0, sum 1; model_of_output[k] and chosen[k] then name the largest weight); empty: output
-  /// k is models[model_of_output[k]] alone.
+  /// k is models[model_of_output[k]] alone (its sd times sd_scale[k]).
   std::array<std::vector<double>, Features::kCount> weights;
-  /// Stacked outputs: the factor on the combination's sd sum_j w_j sd_j, the +-1 sd
-  /// CoverageScale (two_sd false) of the combination's held-out residuals against that sd at
-  /// the training rows, at most 1 (the sum is an upper bound); 1 otherwise.
+  /// Stacked outputs: the factor on the combination's sd sum_j w_j sd_j, StackSdScale of the
+  /// combination's held-out residuals against that sd at the training rows (at most 1: the sum
+  /// is an upper bound); with ChoiceOptions::stack_scale_single also the factor on a single
+  /// candidate's sd (its own held-out residuals); 1 otherwise. Stored in the model file when a
+  /// weight is or a factor is not 1.
   std::array<double, Features::kCount> sd_scale{1.0, 1.0};
   /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
   /// Printed by `whirl train` (and in its --json), not stored in the model file.
@@ -375,8 +393,9 @@ struct Choice {
 /// The choice of the header comment. InputError if the table has no targets or fewer rows than a
 /// candidate's MinimumRows (counting the table's rows), or if there are no candidates.
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& options);
-/// Output k from models[model_of_output[k]] (mean and sd), or for a stacked output the weighted
-/// mean sum_j w_j mean_j and sd sd_scale[k] sum_j w_j sd_j (ChoiceOptions::stack).
+/// Output k from models[model_of_output[k]] (mean, and sd times sd_scale[k]), or for a stacked
+/// output the weighted mean sum_j w_j mean_j and sd sd_scale[k] sum_j w_j sd_j
+/// (ChoiceOptions::stack).
 std::vector<FamilyPrediction> PredictChoice(const Choice& choice,
                                             const std::vector<ProcessInputs>& inputs);
 

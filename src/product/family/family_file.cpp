@@ -119,10 +119,11 @@ void to_json(json& j, const Choice& c) {
        {"chosen", c.chosen},
        {"model_of_output", c.model_of_output},
        {"models", c.models}};
-  if (std::any_of(c.weights.begin(), c.weights.end(), [](const auto& w) { return !w.empty(); })) {
+  if (std::any_of(c.weights.begin(), c.weights.end(), [](const auto& w) { return !w.empty(); }))
     j["weights"] = c.weights;
+  if (j.contains("weights") ||
+      std::any_of(c.sd_scale.begin(), c.sd_scale.end(), [](double s) { return s != 1.0; }))
     j["sd_scale"] = c.sd_scale;
-  }
 }
 
 namespace {
@@ -152,7 +153,10 @@ void ReadWeights(const json& j, const std::string& what, Choice* c) {
     if (*top != c->weights[k][c->model_of_output[k]])
       throw InputError(at + ": the largest weight must be on the model of 'model_of_output'");
   }
-  // Choice::sd_scale (optional; files of earlier versions have none: 1), CoverageScale's range.
+}
+
+// Choice::sd_scale (optional; files of earlier versions have none: 1), CoverageScale's range.
+void ReadSdScale(const json& j, const std::string& what, Choice* c) {
   if (!j.contains("sd_scale")) return;
   const json& s = j.at("sd_scale");
   if (!s.is_array() || s.size() != static_cast<std::size_t>(Features::kCount))
@@ -195,6 +199,7 @@ void from_json(const json& j, Choice& c) {
                        " but 'chosen' names " + chosen);
   }
   ReadWeights(j, what, &c);
+  ReadSdScale(j, what, &c);
 }
 
 }  // namespace whirl::family

@@ -98,8 +98,8 @@ struct TrainOptions {
 };
 
 /// The candidates of a choice for the flags:
-///   kAuto:            ChoiceOptions::DefaultCandidates() (power law, linear, isotropic GP,
-///                     GP Matern 5/2 with a power-law mean on log columns, GP Matern 5/2),
+///   kAuto:            ChoiceOptions::DefaultCandidates() (power law, linear, a GP with a
+///                     power-law mean on log columns, two ARD GPs, a 2-unit network),
 ///   kLinear:          linear/log, linear/identity,
 ///   kGaussianProcess: gp-matern52-linear/log, gp-matern52-constant/identity,
 ///   kNetwork:         network-evidence/log, network-evidence/identity,
