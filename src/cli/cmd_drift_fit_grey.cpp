@@ -18,6 +18,7 @@ namespace {
 
 struct FitGreyOptions {
   std::string records, spec, out;
+  std::string validation = "forward-leads";
   bool json = false;
 };
 
@@ -30,8 +31,8 @@ std::string FitGreyCounts(const drift::ShopRecord& r) {
 }
 
 void PrintFitGrey(const drift::GreyBoxModel& m) {
-  std::printf("grey box: lags %s min, blank lag %s min, prior strength %s, CV RMSE %.2f um over "
-              "%d readings\n",
+  std::printf("grey box: lags %s min, blank lag %s min, prior strength %s, validation RMSE %.2f "
+              "um, %d readings\n",
               m.time_constants.empty() ? "none" : [&] {
                 std::string s;
                 for (double t : m.time_constants) s += (s.empty() ? "" : ", ") + MessageNumber(t);
@@ -64,13 +65,16 @@ void RunFitGrey(const FitGreyOptions& o) {
   CheckOutputs({{"--records", o.records}, {"--spec", o.spec}}, {{"--out", o.out}});
   const drift::GreyBoxSpec spec = drift::ReadGreyBoxSpec(o.spec);
   const drift::MeasurementFile records = drift::ReadMeasurementRecords(o.records);
+  drift::GreyBoxOptions options;
+  if (o.validation == "forward-leads") options.validation = drift::GreyValidation::kForwardLeads;
   drift::GreyBoxModel m;
   try {
-    m = drift::FitGreyBox(records.record, spec);
+    m = drift::FitGreyBox(records.record, spec, options);
   } catch (const InputError& e) {
     throw InputError("--records '" + o.records + "' with --spec '" + o.spec + "': " + e.what());
   }
-  m.notes.push_back("whirl drift fit-grey --records " + o.records + " --spec " + o.spec);
+  m.notes.push_back("whirl drift fit-grey --records " + o.records + " --spec " + o.spec +
+                    " --validation " + o.validation);
   m.notes.push_back(FitGreyCounts(records.record));
   if (!records.description.empty()) m.notes.push_back("records: " + records.description);
   drift::WriteGreyBoxModel(o.out, m);
@@ -98,10 +102,10 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
       "  K0 = a' phi_o [um],  G = g0 + g' phi_s + g_b (B(t0) - 20) [um per 1000 mm],\n"
       "  m(t, z) = K0 + G (z_ref - z) / 1000,\n"
       "phi: the spec's offset and slope sensors as T - 20 [K] with first-order lags (at most 2\n"
-      "from 10-320 min by leave-one-day-out CV), g0 a slope intercept, B the blank's estimate\n"
-      "(a lag of the blank sensor, 30-240 min by CV) latched at the cut start (lead records\n"
-      "only). A ridge towards the spec's physical priors (alpha x lengths; strength 1e-3..1 by\n"
-      "CV); the lead records carry half of the total weight. The records (--records) are what a\n"
+      "from 10-320 min, chosen by --validation), g0 a slope intercept, B the blank's estimate\n"
+      "(a lag of the blank sensor, 30-240 min) latched at the cut start (lead records only). A\n"
+      "ridge towards the spec's physical priors (alpha x lengths; strength 1e-3..1); the lead\n"
+      "records carry half of the total weight. The records (--records) are what a\n"
       "shop measures: warm-up probe tests, laser tests, the measured leads of past screws and\n"
       "the probe readings at set-ups, each on its day log (the control's sensor log, a drift\n"
       "run file).");
@@ -121,6 +125,13 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "grey box model file to write (JSON)")->required();
+  sub->add_option("--validation", o->validation,
+                  "how the lags, the blank's lag and the prior's strength are chosen: "
+                  "forward-leads (default: for each of the last 10 days with a measured lead, "
+                  "fitted on the days before it, the RMS of that day's lead residuals [um]; "
+                  "leave-one-day-out while fewer than 20 days hold a lead) or leave-one-day-out "
+                  "(the grouped CV RMSE over every record, one calendar day held out at a time)")
+      ->check(CLI::IsMember({"forward-leads", "leave-one-day-out"}));
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] { RunFitGrey(*o); });
 }

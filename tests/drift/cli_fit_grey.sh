@@ -58,6 +58,13 @@ grep -q "1 probe\|3 probe" "$D/fit.txt" || fail "fit-grey does not count the rec
 "$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey2.json" --json \
   > "$D/fit.json" || fail "drift fit-grey --json"
 grep -q '"schema": "whirl.drift_fit_grey"' "$D/fit.json" || fail "fit-grey --json schema"
+grep -q 'validation RMSE' "$D/fit.txt" || fail "fit-grey does not say how it chose: $(cat "$D/fit.txt")"
+grep -q -- '--validation forward-leads' "$D/grey.json" || fail "the model's notes lack the validation"
+"$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey_lodo.json" \
+  --validation leave-one-day-out > "$D/fit_lodo.txt" || fail "drift fit-grey --validation leave-one-day-out"
+grep -q -- '--validation leave-one-day-out' "$D/grey_lodo.json" || fail "leave-one-day-out not noted"
+expect_fail "validation" "$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" \
+  --out "$D/none.json" --validation forward
 # The planted blank coefficient comes back near -11.8 (the prior is -11.8 too: check the sign
 # and size only) and the intercept near 3.
 awk '/"um_per_1000_per_k"/ { gsub(/[^-0-9.e]/, "", $2); v = $2 + 0; ok = (v < -5 && v > -20) }

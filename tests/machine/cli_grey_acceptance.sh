@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Smoke test of scripts/grey_acceptance.sh (issue 41's acceptance table): --help, bad arguments
+# Smoke test of scripts/grey_acceptance.sh (issue 41's acceptance table) and of
+# scripts/grey_residuals.py (a planted evaluation, below): --help, bad arguments
 # refused with exit 2 and a message naming the argument, and the evaluation's --past-days range
 # (1..40: 8 weeks) enforced with a clear error. The table itself takes minutes (not run here).
 set -u
@@ -28,4 +29,29 @@ WHIRL_BUILD_DIR="$D/fake" bash "$G" --first-seed 101 --seeds 3 --weeks "1 8" --o
 grep -q -- "--past-days 40 " "$D/args.txt" || fail "8 weeks: $(cat "$D/args.txt")"
 grep -q "seeds 101..103" "$D/out.txt" || fail "the seeds are not reported: $(cat "$D/out.txt")"
 expect_fail "past-days" "$W" machine evaluate --past-days 41 --machines 1 --test-days 1
+# scripts/grey_residuals.py on a planted evaluation of two screws (hand-computed figures): slope
+# part |b| x l_u = 2 um/m x 3 m = 6 and 1 x 3 = 3, median 4.5; the hindsight choice min(grey, sf)
+# per screw 4 and 5, median 4.5; the 30 % line 0.7 x median(8, 10) = 6.3.
+R="$S/scripts/grey_residuals.py"
+python3 - "$D/planted.json" <<'PY'
+import json, sys
+def m(total, b, band):
+    return {"metrics": {"accumulated_total_um": total, "mean_line_slope_um_per_m": b,
+                        "useful_travel_mm": 3000, "v_u_um": band, "accumulated_1000_um": 1}}
+screws = []
+for grey, b, sf, start in ((4, 2, 8, "cold"), (6, -1, 5, "warm")):
+    screws.append({"ok": True, "start_type": start, "residual_workpiece_total_um": 3,
+                   "strategies": {"both_grey": m(grey, b, 2), "both_shop": m(7, 0, 1),
+                                  "warmup": m(sf, 0, 1), "workpiece": m(12, 3, 4)}})
+screws[1]["strategies"]["warmup"]["metrics"]["accumulated_total_um"] = 10
+json.dump({"scenarios": [{"scenario": "production", "seeds": [1], "strongest_sensor_free": "warmup",
+                          "runs": [{"screws": screws}]}]}, open(sys.argv[1], "w"))
+PY
+python3 "$R" "$D/planted.json" > "$D/res.txt" 2> "$D/err.txt" || fail "grey_residuals: $(cat "$D/err.txt")"
+grep -Eq "^  both_grey +5.00 +4.50 +2.00 +\+0.50 +1.50" "$D/res.txt" || fail "medians: $(cat "$D/res.txt")"
+grep -q "30 % line 6.30; better of both_grey and warmup per screw (hindsight) 5.00" "$D/res.txt" ||
+  fail "hindsight: $(cat "$D/res.txt")"
+echo "not json" > "$D/bad.json"
+python3 "$R" "$D/bad.json" > "$D/out.txt" 2> "$D/err.txt" && fail "a bad file was accepted"
+grep -q "bad.json" "$D/err.txt" || fail "the bad file is not named: $(cat "$D/err.txt")"
 echo "cli_grey_acceptance: ok"

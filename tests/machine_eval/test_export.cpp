@@ -124,6 +124,32 @@ TEST(FieldExport, BadRecordsAreRefusedNamingFileLineAndColumn) {
   }
 }
 
+// The field's grey box makes its choices (lags, the blank's lag, the strength) by forward chaining
+// on the leads once the history holds 2 x 10 days of them (FieldGreyBoxOptions; the fourth round
+// of issue 41), and FitShopModels fits it so: on a 4-day record with forward_days = 2 the
+// field's options give FitGreyBox's forward-chained model, not the leave-one-day-out one.
+TEST(FieldGreyBox, ItsChoicesAreByForwardChainingOnTheLeads) {
+  const drift::GreyBoxOptions field = FieldGreyBoxOptions();
+  EXPECT_EQ(field.validation, drift::GreyValidation::kForwardLeads);
+  EXPECT_EQ(field.forward_days, 10);
+  machine::CalendarSpec c;
+  c.warmup_speeds_m_min = {180};
+  c.past_days = 4;
+  c.test_days = 1;
+  const machine::MachineWorld w = machine::BuildMachineWorld(
+      machine::DefaultFieldMachine(), machine::FindMachineScenario("production"), 5, 0, c);
+  const drift::ShopRecord rec = FieldShopRecord(w.timeline, FieldProtocol{}, nullptr, 11);
+  const double z_ref = w.timeline.machine().config().z.fixed_end_mm;
+  drift::GreyBoxOptions forward = field;
+  forward.forward_days = 2;
+  drift::GreyBoxOptions lodo = forward;
+  lodo.validation = drift::GreyValidation::kLeaveOneDayOut;
+  EXPECT_NE(GreyNumbers(drift::FitGreyBox(rec, FieldGreyBoxSpec(z_ref), lodo)).dump(),
+            GreyNumbers(drift::FitGreyBox(rec, FieldGreyBoxSpec(z_ref), forward)).dump());
+  EXPECT_EQ(GreyNumbers(FitShopModels(rec, z_ref).grey).dump(),
+            GreyNumbers(drift::FitGreyBox(rec, FieldGreyBoxSpec(z_ref), field)).dump());
+}
+
 // With a contact reading of each blank in the logs, the grey box latches that reading (no lag)
 // instead of the hall's lag; without it, ambient as before.
 TEST(FieldGreyContact, TheGreyBoxTakesTheContactReadingWhenTheLogsHoldIt) {

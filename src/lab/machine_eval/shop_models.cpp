@@ -67,9 +67,7 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   const std::vector<std::string>& other = record.day_logs.front().other_names;
   for (const std::string& s : grey.DutyInputs())
     placed = placed && std::find(other.begin(), other.end(), s) != other.end();
-  drift::GreyBoxOptions grey_options;
-  if (contact) grey_options.blank_tau_grid = {kBlankContactTauMin};  // a held reading: no lag
-  if (placed) m.grey = drift::FitGreyBox(record, grey, grey_options);
+  if (placed) m.grey = drift::FitGreyBox(record, grey, FieldGreyBoxOptions(contact));
   return m;
 }
 
@@ -86,6 +84,13 @@ drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact) {
   s.slope_prior = {{"ambient_C", 0.5 * kAlphaScrew * 1e6}, {"z_nut_C", 0.5 * kAlphaScrew * 1e6}};
   s.blank_prior = -kAlphaBlank * 1e6;
   return s;
+}
+
+drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact) {
+  drift::GreyBoxOptions o;
+  o.validation = drift::GreyValidation::kForwardLeads;
+  if (blank_contact) o.blank_tau_grid = {kBlankContactTauMin};  // a held reading: no lag
+  return o;
 }
 
 ShopControl ShopControlModels(const drift::JointDriftModel& model,

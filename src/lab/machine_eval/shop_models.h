@@ -55,6 +55,11 @@ struct ShopModels {
 inline constexpr const char* kBlankContactSensor = "blank_contact_C";
 inline constexpr double kBlankContactTauMin = 0.5;
 drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact = false);
+/// The grey box's fit options in the field: drift::GreyBoxOptions' grids, its choices by forward
+/// chaining on the leads (GreyValidation::kForwardLeads: the fourth round of issue 41,
+/// docs/machine-evaluation.md); with `blank_contact` the blank's time constant fixed at
+/// kBlankContactTauMin.
+drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing).
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs());

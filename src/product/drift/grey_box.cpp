@@ -23,6 +23,9 @@ void GreyBoxOptions::Validate() const {
   positive(strength_grid, "strength_grid");
   if (max_lags < 0 || max_lags > 4)
     throw InputError("grey box: max_lags = " + std::to_string(max_lags) + ": must be within 0..4");
+  if (forward_days < 2 || forward_days > 100)
+    throw InputError("grey box: forward_days = " + std::to_string(forward_days) +
+                     ": must be within 2..100");
   if (!(lead_share > 0 && lead_share < 1))
     throw InputError("grey box: lead_share = " + std::to_string(lead_share) +
                      ": must lie in (0, 1)");
@@ -94,6 +97,7 @@ struct Design {
   Eigen::MatrixXd x;
   Eigen::VectorXd y, w, prior;
   std::vector<int> day;
+  std::vector<bool> lead;       ///< the row is a lead reading
   Eigen::Index po = 0, ps = 0;  ///< offset and slope feature counts
 };
 
@@ -154,6 +158,7 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
       d.w(row) = 1.0 / (m.sigma_um * m.sigma_um);
       (lead ? lead_w : other_w) += d.w(row);
       d.day.push_back(r.day);
+      d.lead.push_back(lead);
       ++row;
     }
     const Eigen::Index len = row - begin;
@@ -228,9 +233,41 @@ double CvRmse(const Design& d, double strength) {
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
+// Forward chaining on the leads: each of the last `days` days with a lead reading, fitted on
+// the rows of the earlier days; NaN when fewer than 2 x `days` days hold a lead.
+double ForwardLeadRmse(const Design& d, double strength, int days) {
+  std::set<int> lead_days;
+  for (std::size_t i = 0; i < d.day.size(); ++i)
+    if (d.lead[i]) lead_days.insert(d.day[i]);
+  if (lead_days.size() < 2 * static_cast<std::size_t>(days)) return std::nan("");
+  std::vector<int> chosen(lead_days.begin(), lead_days.end());
+  chosen.erase(chosen.begin(), chosen.end() - days);
+  const auto n = d.x.rows();
+  double num = 0, den = 0;
+  for (int day : chosen) {
+    Eigen::VectorXd wt = d.w;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (d.day[static_cast<std::size_t>(i)] >= day) wt(i) = 0;
+    const Eigen::VectorXd b = Solve(d, wt, strength);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (d.day[k] != day || !d.lead[k]) continue;
+      const double r = d.y(i) - d.x.row(i).dot(b);
+      num += d.w(i) * r * r;
+      den += d.w(i);
+    }
+  }
+  return den > 0 ? std::sqrt(num / den) : std::nan("");
+}
+
 double Score(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
              const GreyBoxOptions& o) {
-  return CvRmse(BuildDesign(rec, spec, c, o.lead_share), c.strength);
+  const Design d = BuildDesign(rec, spec, c, o.lead_share);
+  if (o.validation == GreyValidation::kForwardLeads) {
+    const double e = ForwardLeadRmse(d, c.strength, o.forward_days);
+    if (std::isfinite(e)) return e;
+  }
+  return CvRmse(d, c.strength);
 }
 
 // Lags greedy (accepted while the CV falls), then the blank's lag, then the strength.

@@ -28,8 +28,9 @@
 // grows with the square of each departure from the prior). Weights: 1 / sigma^2 within a kind;
 // the lead records together carry lead_share of the total weight (so hundreds of idle warm-up
 // and laser readings cannot drown the cuts). Choices by the grouped cross-validated RMSE (leave
-// one calendar day out, the same weights): the lags (greedy, at most max_lags from tau_grid), then
-// the blank's time constant from blank_tau_grid, then the strength from strength_grid. The
+// one calendar day out, the same weights; or forward chaining on the leads, GreyValidation): the
+// lags (greedy, at most max_lags from tau_grid), then the blank's time constant from
+// blank_tau_grid, then the strength from strength_grid. The
 // sensors are the caller's, physically placed (no greedy search among collinear sensors).
 // Duty inputs (optional): control signals as logged (the day log's other columns, e.g. the ring
 // drive's load on the offset, the Z speed on the slope), each with the same lags, appended after
@@ -63,12 +64,25 @@ struct GreyBoxSpec {
   std::vector<std::string> DutyInputs() const;
 };
 
+/// How FitGreyBox scores a choice (lags, blank lag, strength):
+///   kLeaveOneDayOut  the grouped CV RMSE over every record, one calendar day held out at a time;
+///   kForwardLeads    forward chaining on the lead records: for each of the last forward_days
+///                    days that hold a lead, fitted on the records of the days before it only,
+///                    the weighted RMS of that day's lead residuals (what the shop's next screws
+///                    see: a model trained on the past, scored on the leads of the day after).
+///                    Only where the record holds at least 2 x forward_days days with a lead
+///                    (each validation fit then has at least forward_days of them); a shorter
+///                    history is scored by kLeaveOneDayOut.
+enum class GreyValidation { kLeaveOneDayOut, kForwardLeads };
+
 struct GreyBoxOptions {
   std::vector<double> tau_grid = {10, 20, 40, 80, 160, 320};  ///< min
   int max_lags = 2;                                           ///< 0..4
   std::vector<double> blank_tau_grid = {30, 60, 120, 240};    ///< min, each > 0
   std::vector<double> strength_grid = {1e-3, 1e-2, 1e-1, 1};  ///< each > 0
   double lead_share = 0.5;  ///< the lead records' share of the total weight, in (0, 1)
+  GreyValidation validation = GreyValidation::kLeaveOneDayOut;
+  int forward_days = 10;    ///< kForwardLeads: validation days, 2..100
   void Validate() const;    ///< InputError naming the field and the rule
 };
 
@@ -86,7 +100,7 @@ struct GreyBoxModel {
   double blank_tau_min = 60;               ///< B's lag
   double blank_um_per_1000_per_k = 0;      ///< g_b
   double prior_strength = 0;               ///< the chosen strength
-  double cv_rmse_um = 0;                   ///< grouped CV RMSE of the final choice
+  double cv_rmse_um = 0;  ///< validation RMSE of the final choice (GreyBoxOptions::validation)
   int rows = 0;
   /// Training range of each feature over the record's day logs, as GreyBoxEvaluator runs them
   /// from each log's first row (SetGreyBoxRanges): phi_o and phi_s [K against 20 degC] and B
