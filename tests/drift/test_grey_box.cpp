@@ -76,6 +76,13 @@ Run DutyDayLog(int day, int minutes) {
   return r;
 }
 
+// Measurement noise of sd `sd_um` on every planted reading (its own generator, `seed`).
+void AddNoise(ShopRecord* rec, double sd_um, std::uint64_t seed) {
+  Rng rng(seed);
+  for (auto& r : rec->records)
+    for (auto& x : r.rows) x.value_um += sd_um * rng.Normal();
+}
+
 ShopRecord Planted(const GreyBoxModel& truth, bool leads, int days = 5,
                    const std::function<Run(int, int)>& day_log = [](int d, int m) {
                      return DayLog(d, m);
@@ -237,9 +244,7 @@ TEST(GreyBox, CollinearSensorsCannotTradeOppositeCoefficients) {
     const drift::Run twin = DayLog(d, 360, true);
     rec.day_logs[static_cast<std::size_t>(d)] = twin;
   }
-  Rng rng(3);
-  for (auto& r : rec.records)
-    for (auto& x : r.rows) x.value_um += 0.3 * rng.Normal();
+  AddNoise(&rec, 0.3, 3);
   GreyBoxSpec s = SpecOf(t);
   s.slope_sensors = {"screw", "screw_twin"};
   const GreyBoxModel m = FitGreyBox(rec, s, Fixed(t, 1e-2));
@@ -279,9 +284,7 @@ TEST(GreyBox, TheEvaluatorFollowsTheClosedFormLagOfAStep) {
 TEST(GreyBox, ForwardValidationScoresTheLeadsOfEachDayFromTheDaysBefore) {
   const GreyBoxModel t = Truth();
   ShopRecord rec = Planted(t, true, 6);
-  Rng rng(11);
-  for (auto& r : rec.records)
-    for (auto& x : r.rows) x.value_um += 0.5 * rng.Normal();
+  AddNoise(&rec, 0.5, 11);
   GreyBoxOptions o = Fixed(t, 1e-2);
   o.validation = GreyValidation::kForwardLeads;
   o.forward_days = 3;
@@ -317,9 +320,7 @@ TEST(GreyBox, ForwardValidationScoresTheLeadsOfEachDayFromTheDaysBefore) {
 TEST(GreyBox, ForwardValidationNeedsTwiceItsDaysOfLeadsElseItIsLeaveOneDayOut) {
   const GreyBoxModel t = Truth();
   ShopRecord leads = Planted(t, true, 6);
-  Rng rng(5);
-  for (auto& r : leads.records)
-    for (auto& x : r.rows) x.value_um += 0.5 * rng.Normal();
+  AddNoise(&leads, 0.5, 5);
   for (const auto& [rec, days] : {std::pair{Planted(t, false, 4), 2}, std::pair{leads, 4}}) {
     GreyBoxOptions o;
     o.tau_grid = {10, 40, 160};
