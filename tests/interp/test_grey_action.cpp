@@ -183,7 +183,7 @@ void FollowsTheEvaluator(bool duty) {
   EXPECT_EQ(P(r, 96), kBlankNeutralC);
   double worst_mm = 0;
   // A minute before the cut, axis parked: no blank term (the latch reads 20).
-  for (; k < 1200;) {
+  while (k < 1200) {  // step_reference() advances k
     now = Temperatures(k);
     SetInputs(r, d, now);
     r.Cycle(parked);
