@@ -290,6 +290,8 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::T
                {"rows_note", model.choice.rows_note},
                {"warnings", model.choice.warnings},
                {"calibration", model.choice.models.front().calibration},
+               {"sd_scale", {{"max_elongation_um", model.choice.sd_scale[0]},
+                             {"settle_time_s", model.choice.sd_scale[1]}}},
                {"fit_time_ms", fit_ms}});
     return;
   }
@@ -310,6 +312,17 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::T
             << "; held-out RMSE in um and s, score = sum of MSE / variance:\n"
             << workpiece::FormatChoiceTable(model.choice);
   std::cout << "  sd: " << model.choice.models.front().calibration << "\n";
+  const auto& scale = model.choice.sd_scale;
+  if (scale[0] != 1.0 || scale[1] != 1.0)
+    std::cout << "  sd then narrowed per output (max_elongation_um x" << FormatSignificant(scale[0], 3)
+              << ", settle_time_s x" << FormatSignificant(scale[1], 3)
+              << "): the smallest factor, at most 1, at which +-1 sd covers 68.27 % of the held-out "
+                 "residuals"
+              << (c.stack_sd_two_share > 0
+                      ? " while +-2 sd still covers " +
+                            FormatSignificant(100 * c.stack_sd_two_share, 3) + " %"
+                      : std::string())
+              << "\n";
   std::cout << "  fit time " << FormatSignificant(fit_ms, 4) << " ms (choice, refits, calibration)\n";
 }
 

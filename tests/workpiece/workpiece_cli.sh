@@ -20,6 +20,25 @@ grep -q "linear/log" out.txt || fail "train lacks the CV table: $(cat out.txt)"
 grep -q "<- " out.txt || fail "the CV table does not mark the choice"
 grep -q '"format": "whirl-workpiece-model"' fam.json || fail "not a workpiece model file"
 grep -q '"schema_version": 3' fam.json || fail "not schema 3"
+# The sd factors it reports (--json, and a text line when one is not 1) are the file's.
+"$whirl" train --data "$data" --out fam_j.json --json > train.json 2> err.txt \
+  || fail "train --json: $(cat err.txt)"
+python3 - train.json fam_j.json fam_out.txt <<'PY3' || fail "sd_scale: $(cat train.json)"
+import json, sys
+said, model, text = json.load(open(sys.argv[1])), json.load(open(sys.argv[2])), open(sys.argv[3]).read()
+def find(j):
+    if isinstance(j, dict):
+        if "sd_scale" in j and isinstance(j["sd_scale"], list): return j["sd_scale"]
+        for v in j.values():
+            r = find(v)
+            if r is not None: return r
+    return None
+stored = find(model) or [1.0, 1.0]
+printed = [said["sd_scale"]["max_elongation_um"], said["sd_scale"]["settle_time_s"]]
+assert printed == stored, (printed, stored)
+assert all(0.25 <= f <= 1 for f in printed), printed
+assert ("sd then narrowed per output" in text) == (printed != [1.0, 1.0]), text
+PY3
 
 # It predicts with sd and the domain guard, plans and compares.
 "$whirl" predict --model fam.json --input "$src/datasets/whirling_validation.csv" --json \
