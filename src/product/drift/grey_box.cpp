@@ -209,27 +209,35 @@ Eigen::VectorXd Solve(const Design& d, const Eigen::VectorXd& w, double strength
   return Eigen::LDLT<Eigen::MatrixXd>(a).solve(rhs).cwiseQuotient(scale);
 }
 
+// Adds to *num and *den the weighted squared residuals of the rows `scored` picks, the fit
+// trained on the rows `trained` picks (the held-out part of one cross-validation fold).
+template <class Trained, class Scored>
+void AddHeldOut(const Design& d, double strength, Trained trained, Scored scored, double* num,
+                double* den) {
+  const auto n = d.x.rows();
+  Eigen::VectorXd wt = d.w;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!trained(static_cast<std::size_t>(i))) wt(i) = 0;
+  const Eigen::VectorXd b = Solve(d, wt, strength);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!scored(static_cast<std::size_t>(i))) continue;
+    const double r = d.y(i) - d.x.row(i).dot(b);
+    *num += d.w(i) * r * r;
+    *den += d.w(i);
+  }
+}
+
 // Leave one calendar day out (weighted RMS of the held-out residuals); one day: training RMS.
 double CvRmse(const Design& d, double strength) {
   const std::set<int> days(d.day.begin(), d.day.end());
-  const auto n = d.x.rows();
   if (days.size() < 2) {
     const Eigen::VectorXd r = d.y - d.x * Solve(d, d.w, strength);
     return std::sqrt(d.w.dot(r.cwiseAbs2()) / d.w.sum());
   }
   double num = 0, den = 0;
-  for (int day : days) {
-    Eigen::VectorXd wt = d.w;
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (d.day[static_cast<std::size_t>(i)] == day) wt(i) = 0;
-    const Eigen::VectorXd b = Solve(d, wt, strength);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (d.day[static_cast<std::size_t>(i)] != day) continue;
-      const double r = d.y(i) - d.x.row(i).dot(b);
-      num += d.w(i) * r * r;
-      den += d.w(i);
-    }
-  }
+  for (int day : days)
+    AddHeldOut(d, strength, [&](std::size_t i) { return d.day[i] != day; },
+               [&](std::size_t i) { return d.day[i] == day; }, &num, &den);
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
@@ -242,21 +250,10 @@ double ForwardLeadRmse(const Design& d, double strength, int days) {
   if (lead_days.size() < 2 * static_cast<std::size_t>(days)) return std::nan("");
   std::vector<int> chosen(lead_days.begin(), lead_days.end());
   chosen.erase(chosen.begin(), chosen.end() - days);
-  const auto n = d.x.rows();
   double num = 0, den = 0;
-  for (int day : chosen) {
-    Eigen::VectorXd wt = d.w;
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (d.day[static_cast<std::size_t>(i)] >= day) wt(i) = 0;
-    const Eigen::VectorXd b = Solve(d, wt, strength);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      if (d.day[k] != day || !d.lead[k]) continue;
-      const double r = d.y(i) - d.x.row(i).dot(b);
-      num += d.w(i) * r * r;
-      den += d.w(i);
-    }
-  }
+  for (int day : chosen)
+    AddHeldOut(d, strength, [&](std::size_t i) { return d.day[i] < day; },
+               [&](std::size_t i) { return d.day[i] == day && d.lead[i]; }, &num, &den);
   return den > 0 ? std::sqrt(num / den) : std::nan("");
 }
 
