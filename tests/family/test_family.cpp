@@ -295,6 +295,55 @@ TEST(FamilyChoice, AChosenGpIsTheLowestGp) {
   EXPECT_GT(violations_off, 0);  // the rule changes something on these tables
 }
 
+// GP candidates with a positive stacking weight in output k, as indices into c.table.
+std::vector<int> WeightedGps(const Choice& c, int k) {
+  std::vector<int> out;
+  for (std::size_t j = 0; j < c.models.size(); ++j) {
+    const bool weighted = c.weights[k].empty() ? static_cast<int>(j) == c.model_of_output[k]
+                                               : c.weights[k][j] > 0;
+    if (!weighted || c.models[j].candidate.family != Family::kGaussianProcess) continue;
+    for (std::size_t r = 0; r < c.table.size(); ++r)
+      if (c.table[r].candidate.Name() == c.models[j].candidate.Name())
+        out.push_back(static_cast<int>(r));
+  }
+  return out;
+}
+
+// ChoiceOptions::lowest_gp_per_scale: below few_rows every stacked GP is the lowest of its column
+// scale (at most one on log columns, one on raw columns; with every candidate past the gate), and
+// on some tables a GP of each scale gets weight, which lowest_gp alone never allows; from few_rows
+// rows the choice is the one without it.
+TEST(FamilyChoice, LowestGpPerScaleStacksTheLowestGpOfEachColumnScale) {
+  ChoiceOptions per_scale, lowest;
+  per_scale.stack_gate_se = lowest.stack_gate_se = 0;  // every candidate past the gate
+  per_scale.lowest_gp_per_scale = true;
+  ASSERT_FALSE(lowest.lowest_gp_per_scale);
+  int two_scales = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const ProcessTable t = test::MakeBentTable(24, 0.03, 0.5, seed);
+    const Choice a = ChooseFamily(t, per_scale), b = ChooseFamily(t, lowest);
+    for (int k = 0; k < 2; ++k) {
+      const std::vector<int> gps = WeightedGps(a, k);
+      EXPECT_LE(WeightedGps(b, k).size(), 1u) << b.Describe();
+      std::array<int, 2> per = {0, 0};
+      for (int g : gps) {
+        ++per[a.table[g].candidate.log];
+        for (const CvRow& r : a.table)
+          if (r.candidate.family == Family::kGaussianProcess &&
+              r.candidate.log == a.table[g].candidate.log)
+            EXPECT_GE(r.cv_rmse(k), a.table[g].cv_rmse(k)) << "seed " << seed << ": "
+                                                           << a.Describe();
+      }
+      EXPECT_LE(per[0], 1);
+      EXPECT_LE(per[1], 1);
+      two_scales += per[0] == 1 && per[1] == 1;
+    }
+  }
+  EXPECT_GT(two_scales, 0);  // the option changes something on these tables
+  const ProcessTable large = test::MakeBentTable(per_scale.few_rows, 0.03, 0.5, 1);
+  EXPECT_EQ(ChooseFamily(large, per_scale).Describe(), ChooseFamily(large, lowest).Describe());
+}
+
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
   r << 1, -2, 3, 4;

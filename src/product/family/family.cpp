@@ -822,18 +822,23 @@ std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
 }
 
 // ChoiceOptions::lowest_gp: `kept` without its GP candidates except the one with the lowest
-// held-out error of output k (the first of equal ones), which keeps its place.
+// held-out error of output k (the first of equal ones), which keeps its place; with
+// lowest_gp_per_scale below few_rows rows one such GP per column scale (Candidate::log).
 std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
                                      const std::vector<Eigen::MatrixXd>& err,
                                      const ChoiceOptions& o, int k) {
-  int best = -1;
-  for (int c : kept)
+  const bool per_scale = o.lowest_gp_per_scale && err.front().cols() < o.few_rows;
+  std::array<int, 2> best = {-1, -1};  // [log]; one slot without per_scale
+  for (int c : kept) {
+    int& b = best[per_scale && o.candidates[c].log ? 1 : 0];
     if (o.candidates[c].family == Family::kGaussianProcess &&
-        (best < 0 || err[c].row(k).squaredNorm() < err[best].row(k).squaredNorm()))
-      best = c;
+        (b < 0 || err[c].row(k).squaredNorm() < err[b].row(k).squaredNorm()))
+      b = c;
+  }
   std::vector<int> out;
   for (int c : kept)
-    if (o.candidates[c].family != Family::kGaussianProcess || c == best) out.push_back(c);
+    if (o.candidates[c].family != Family::kGaussianProcess || c == best[0] || c == best[1])
+      out.push_back(c);
   return out;
 }
 
