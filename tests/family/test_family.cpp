@@ -317,7 +317,7 @@ TEST(FamilyChoice, LowestGpPerScaleStacksTheLowestGpOfEachColumnScale) {
   ChoiceOptions per_scale, lowest;
   per_scale.stack_gate_se = lowest.stack_gate_se = 0;  // every candidate past the gate
   per_scale.lowest_gp_per_scale = true;
-  ASSERT_FALSE(lowest.lowest_gp_per_scale);
+  lowest.lowest_gp_per_scale = false;
   int two_scales = 0;
   for (unsigned seed = 1; seed <= 8; ++seed) {
     const ProcessTable t = test::MakeBentTable(24, 0.03, 0.5, seed);
