@@ -136,7 +136,8 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
         picked = list(first_lhs)
     else:
         hyper = [a for f, v in zip(variance[::2], variance[1::2])
-                 if f not in ("--variance", "--switch-ratio", "--space-filling-when")
+                 if f not in ("--variance", "--switch-ratio", "--space-filling-when",
+                              "--departure-evidence")
                  for a in (f, v)] if variance else []
         out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
                               "--criterion", criterion, "--space-filling", str(fill_first),
@@ -188,7 +189,8 @@ def variance_args(a):
     for flag, v in (("--variance", a.variance), ("--departure-ratio", a.departure_ratio),
                     ("--length-scale", a.length_scale), ("--switch-ratio", a.switch_ratio),
                     ("--space-filling-rule", a.fill_rule),
-                    ("--space-filling-when", a.fill_when)):
+                    ("--space-filling-when", a.fill_when),
+                    ("--departure-evidence", a.departure_evidence)):
         if v is not None:
             out += [flag, str(v)]
     return out
@@ -381,6 +383,8 @@ def main():
                     help="whirl design --space-filling-rule (with --fill-first / --fill-next)")
     ap.add_argument("--fill-when", choices=["always", "departure"],
                     help="whirl design --space-filling-when of every next batch")
+    ap.add_argument("--departure-evidence", choices=["lack-of-fit", "choice"],
+                    help="whirl design --departure-evidence of every next batch")
     ap.add_argument("--inside", type=int, help="whirl design --inside of the first design")
     ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
     ap.add_argument("--design-only", action="store_true", help="only the design strategy")
