@@ -307,6 +307,23 @@ def print_paired_cells(cases):
             print(f"  {prob}, {out}: " + ", ".join(cells))
 
 
+def print_twelve_against_twenty(cases):
+    """The sixth attempt's suggested paired criterion for "with at most 12 designed screws the
+    accuracy of 20 random screws": per problem and output, exp of the mean over seeds of
+    ln(RMSE_design(12) / RMSE_random(20)) and its t (a ratio <= 1 reaches it)."""
+    if not all("random" in c and "design" in c for c in cases.values()):
+        return
+    print("\npaired, design at 12 / random at 20 per problem and output: ratio (t)")
+    for prob in dict.fromkeys(p for p, _ in cases):
+        cells = []
+        for k, out in enumerate(bp.TARGETS):
+            d = [np.log(c["design"][12][k] / c["random"][20][k])
+                 for key, c in cases.items() if key[0] == prob]
+            m, _, t = paired_t(d)
+            cells.append(f"{out} {np.exp(m):.3f} ({t:+.1f})")
+        print(f"  {prob}: " + ", ".join(cells))
+
+
 def print_paired(d, title):
     """The fourth attempt's paired statistic (docs/design.md): mean, se and t of the per-case
     log-ratios, the sign count, and per problem (nothing without cases: --design-only)."""
@@ -330,6 +347,7 @@ def paired_report(results, base=None):
         print_paired(log_ratios(cases, (cases, "design"), (cases, "random"), (k,)),
                      f"paired, design / random, {out}")
     print_paired_cells(cases)
+    print_twelve_against_twenty(cases)
     if base:
         other = cases_of(json.load(open(base))["cases"])
         print_paired(log_ratios(cases, (cases, "design"), (other, "design")),
