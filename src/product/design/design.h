@@ -83,9 +83,10 @@
 // screws are; targets do not enter a GP's covariance, so the rule needs the measured screws'
 // inputs only, and its hyperparameters are fixed (a fit to 8-20 rows would follow their noise).
 // kSum: both criteria, each weighed by its mean variance over the list. kAuto: per output, the
-// chosen family's own covariance where cross-validation chose a Gaussian process for it (the
-// measured screws showed a departure from the power law, and that GP's fitted hyperparameters
-// know its size and length), the power-GP's where it chose a linear fit (the departure is still
+// chosen family's own covariance where cross-validation chose a Gaussian process for it (for a
+// stacked output: its candidate of largest weight is one; the measured screws showed a
+// departure from the power law, and that GP's fitted hyperparameters know its size and
+// length), the power-GP's where it chose a linear fit (the departure is still
 // a prior guess); each output weighs equally. kSwitch: per output, the chosen family's own
 // covariance while the power law fits the measured screws, the power-GP's once they depart from
 // it (PowerLawLackOfFit: the power law's leave-one-out error over the power-GP's, both with the
@@ -171,7 +172,8 @@ struct NextRule {
   /// not keeping the power law alone for the output (another candidate, or a stack with weight
   /// beyond the power law: its held-out comparison, gated and shrunk toward the power law,
   /// found a better fit), a test that also sees departures a smooth isotropic GP does not
-  /// follow (seventh attempt, docs/design.md).
+  /// follow. Not the default: on the seventh attempt's tuning part it gained on the additive
+  /// family only and did not pass the declared rule (docs/design.md).
   enum class Evidence { kLackOfFit, kChoice };
   Evidence evidence = Evidence::kLackOfFit;
 };
