@@ -136,7 +136,8 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
         picked = list(first_lhs)
     else:
         hyper = [a for f, v in zip(variance[::2], variance[1::2])
-                 if f not in ("--variance", "--switch-ratio", "--space-filling-when")
+                 if f not in ("--variance", "--switch-ratio", "--space-filling-when",
+                              "--departure-evidence")
                  for a in (f, v)] if variance else []
         out = json.loads(run([ev.whirl, "design", "--candidates", pool, "--count", str(FIRST),
                               "--criterion", criterion, "--space-filling", str(fill_first),
@@ -188,7 +189,8 @@ def variance_args(a):
     for flag, v in (("--variance", a.variance), ("--departure-ratio", a.departure_ratio),
                     ("--length-scale", a.length_scale), ("--switch-ratio", a.switch_ratio),
                     ("--space-filling-rule", a.fill_rule),
-                    ("--space-filling-when", a.fill_when)):
+                    ("--space-filling-when", a.fill_when),
+                    ("--departure-evidence", a.departure_evidence)):
         if v is not None:
             out += [flag, str(v)]
     return out
@@ -305,6 +307,23 @@ def print_paired_cells(cases):
             print(f"  {prob}, {out}: " + ", ".join(cells))
 
 
+def print_twelve_against_twenty(cases):
+    """The sixth attempt's suggested paired criterion for "with at most 12 designed screws the
+    accuracy of 20 random screws": per problem and output, exp of the mean over seeds of
+    ln(RMSE_design(12) / RMSE_random(20)) and its t (a ratio <= 1 reaches it)."""
+    if not all("random" in c and "design" in c for c in cases.values()):
+        return
+    print("\npaired, design at 12 / random at 20 per problem and output: ratio (t)")
+    for prob in dict.fromkeys(p for p, _ in cases):
+        cells = []
+        for k, out in enumerate(bp.TARGETS):
+            d = [np.log(c["design"][12][k] / c["random"][20][k])
+                 for key, c in cases.items() if key[0] == prob]
+            m, _, t = paired_t(d)
+            cells.append(f"{out} {np.exp(m):.3f} ({t:+.1f})")
+        print(f"  {prob}: " + ", ".join(cells))
+
+
 def print_paired(d, title):
     """The fourth attempt's paired statistic (docs/design.md): mean, se and t of the per-case
     log-ratios, the sign count, and per problem (nothing without cases: --design-only)."""
@@ -328,6 +347,7 @@ def paired_report(results, base=None):
         print_paired(log_ratios(cases, (cases, "design"), (cases, "random"), (k,)),
                      f"paired, design / random, {out}")
     print_paired_cells(cases)
+    print_twelve_against_twenty(cases)
     if base:
         other = cases_of(json.load(open(base))["cases"])
         print_paired(log_ratios(cases, (cases, "design"), (other, "design")),
@@ -381,6 +401,8 @@ def main():
                     help="whirl design --space-filling-rule (with --fill-first / --fill-next)")
     ap.add_argument("--fill-when", choices=["always", "departure"],
                     help="whirl design --space-filling-when of every next batch")
+    ap.add_argument("--departure-evidence", choices=["lack-of-fit", "choice"],
+                    help="whirl design --departure-evidence of every next batch")
     ap.add_argument("--inside", type=int, help="whirl design --inside of the first design")
     ap.add_argument("--jobs", type=int, default=2, help="parallel cases (at most 2 on shared machines)")
     ap.add_argument("--design-only", action="store_true", help="only the design strategy")

@@ -31,6 +31,7 @@ struct DesignCliOptions {
   double departure_ratio = design::NextRule{}.departure_ratio;
   double length_scale = design::NextRule{}.length_scale;
   double switch_ratio = design::NextRule{}.switch_ratio;
+  std::string evidence = design::ToString(design::NextRule{}.evidence);
   double tolerance_um = 0, tolerance_s = 0;
   bool json = false;
 };
@@ -156,6 +157,7 @@ design::NextRule RuleOf(const DesignCliOptions& o) {
   rule.departure_ratio = o.departure_ratio;
   rule.length_scale = o.length_scale;
   rule.switch_ratio = o.switch_ratio;
+  rule.evidence = design::ParseEvidence(o.evidence);
   return rule;
 }
 
@@ -248,8 +250,12 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
                         {"rms_sd_floor", {{"max_elongation_um", d.rms_sd_floor[0]},
                                           {"settle_time_s", d.rms_sd_floor[1]}}}};
     if (design::ParseNextModel(o.variance) == design::NextRule::Model::kSwitch)
+    {
       j["lack_of_fit_ratio"] = {{"max_elongation_um", d.lack_of_fit_ratio[0]},
                                 {"settle_time_s", d.lack_of_fit_ratio[1]}};
+      j["departure"] = {{"max_elongation_um", d.departure[0]}, {"settle_time_s", d.departure[1]}};
+      j["departure_evidence"] = o.evidence;
+    }
     if (!d.stop.empty())
       j["stop"] = {{"decision", d.stop}, {"tolerance_um", o.tolerance_um},
                    {"tolerance_s", o.tolerance_s}, {"reason", d.stop_reason},
@@ -297,6 +303,7 @@ void RunDesign(const DesignCliOptions& o) {
                {{"--out", o.out_path}});
   design::ParseFillRule(o.fill_rule);  // bad spellings before any file is read
   design::ParseFillWhen(o.fill_when);
+  design::ParseEvidence(o.evidence);
   if (o.model_path.empty() && (o.tolerance_um > 0 || o.tolerance_s > 0))
     throw InputError("design: --tolerance-um / --tolerance-s need --model (the stop rule judges a "
                      "trained model's predictive sd)");
@@ -307,6 +314,9 @@ void RunDesign(const DesignCliOptions& o) {
   if (!o.model_path.empty() && o.inside != design::kInsideAuto)
     throw InputError("design: --inside is a first design's (without --model); the next screws "
                      "follow --variance");
+  if (o.model_path.empty() && o.evidence != design::ToString(defaults.evidence))
+    throw InputError("design: --departure-evidence needs --model (it judges a trained model's "
+                     "choice and the measured screws)");
   if (o.model_path.empty() && o.fill_when != design::ToString(design::SpaceFilling{}.when))
     throw InputError("design: --space-filling-when needs --model (a first design's space-filling "
                      "screws are always its last ones)");
@@ -425,6 +435,11 @@ void RegisterDesign(CLI::App& app) {
                   "law's leave-one-out RMSE over the power-gp's exceeds this [ratio]")
       ->capture_default_str()
       ->check(PositiveNumber());
+  sub->add_option("--departure-evidence", o->evidence,
+                  "with --variance switch: what shows a departure from the power law: "
+                  "lack-of-fit (--switch-ratio alone) or choice (that, or the model's choice not "
+                  "keeping the power law alone for the output)")
+      ->capture_default_str();
   sub->add_option("--model", o->model_path,
                   "trained family model ('whirl train' default): next screws instead of a first "
                   "design")

@@ -108,6 +108,23 @@ done
   || fail "--switch-ratio 1e-6: both outputs should depart: $(cat switch_1e-6.txt)"
 [ "$(grep -o 'the power law fits' switch_1e6.txt | wc -l)" -eq 2 ] \
   || fail "--switch-ratio 1e6: both outputs should fit: $(cat switch_1e6.txt)"
+# --departure-evidence choice: also a departure where the model's choice left the power law
+# (linear on raw columns here, m_raw.json); the JSON says which outputs depart.
+"$whirl" train --data "$data" --out m_raw.json --family linear --transform identity > /dev/null \
+  2> err.txt || fail "train --family linear --transform identity: $(cat err.txt)"
+for evidence in lack-of-fit choice; do
+  "$whirl" design --model m_raw.json --candidates cands.csv --count 1 --measured "$data" \
+    --switch-ratio 1e6 --departure-evidence $evidence --json > "evidence_$evidence.json" \
+    2> err.txt || fail "next --departure-evidence $evidence: $(cat err.txt)"
+done
+python3 - evidence_lack-of-fit.json evidence_choice.json <<'PY' || fail "--departure-evidence JSON"
+import json, sys
+lack, choice = (json.load(open(f)) for f in sys.argv[1:])
+assert lack["departure_evidence"] == "lack-of-fit" and choice["departure_evidence"] == "choice"
+assert not any(lack["departure"].values()), lack["departure"]
+assert all(choice["departure"].values()), choice["departure"]
+assert "choice left the power law" in choice["picks"][0]["why"], choice["picks"][0]["why"]
+PY
 
 # Space filling: the first design's last picks and a next batch's last pick say so; the next
 # mode keeps them away from the --measured screws (the training table here).
@@ -237,6 +254,12 @@ expect_fail "--space-filling-when departure needs --variance switch" "$whirl" de
   --model m.json --candidates cands.csv --count 2 --space-filling 1 --variance power-gp \
   --space-filling-when departure --measured "$data"
 expect_fail "--variance needs --model" "$whirl" design "${ranges[@]}" --count 8 --variance sum
+expect_fail "--departure-evidence needs --model" "$whirl" design "${ranges[@]}" --count 8 \
+  --departure-evidence choice
+expect_fail "--departure-evidence 'fit': expected 'lack-of-fit'" "$whirl" design --model m.json \
+  --candidates cands.csv --count 2 --measured "$data" --departure-evidence fit
+expect_fail "--departure-evidence choice needs --variance switch" "$whirl" design --model m.json \
+  --candidates cands.csv --count 2 --measured "$data" --variance power-gp --departure-evidence choice
 expect_fail "--inside is a first design" "$whirl" design --model m.json --candidates cands.csv \
   --count 2 --measured "$data" --inside 1
 expect_fail "count 8: the power law.*plus --inside 3" "$whirl" design "${ranges[@]}" --count 8 \

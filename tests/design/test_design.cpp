@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/process.h"
 #include "design/design.h"
+#include "family/family.h"
 #include "family/linear.h"
 #include "gp/gp.h"
 #include "workpiece/model.h"
@@ -781,6 +782,179 @@ TEST(Design, SpaceFillingWhenDepartureFollowsTheSwitch) {
   EXPECT_EQ(ToString(ParseFillWhen("departure")), "departure");
   EXPECT_THROW(ParseFillRule("random"), InputError);
   EXPECT_THROW(ParseFillWhen("never"), InputError);
+}
+
+// ---- The design follows the default model: sd_scale, stacked outputs, network candidates ------
+
+ProcessTable TrainTable() {
+  return ReadProcessTable(WHIRL_SOURCE_DIR "/datasets/whirling_train.csv", true);
+}
+
+// A family model of the named candidates fitted on the training table: output k is models
+// [of[k]] alone (weights empty), or the stack `weights[k]` where given; sd factors `scale`.
+workpiece::WorkpieceModel HandChoice(const std::vector<std::string>& names,
+                                     std::array<int, 2> of,
+                                     std::array<std::vector<double>, 2> weights,
+                                     std::array<double, 2> scale) {
+  const ProcessTable t = TrainTable();
+  family::Choice c;
+  for (const auto& n : names)
+    c.models.push_back(family::FitCandidate(t, family::ParseCandidate(n), family::FitOptions{}));
+  c.model_of_output = of;
+  c.chosen = of;
+  c.weights = std::move(weights);
+  c.sd_scale = scale;
+  return workpiece::FromChoice(std::move(c), t, "whirling_train.csv");
+}
+
+std::vector<int> Candidates(const NextDesign& d) {
+  std::vector<int> out;
+  for (const auto& p : d.picks) out.push_back(p.candidate);
+  return out;
+}
+
+TEST(Design, SdScaleScalesEverySdAndTheStopRuleNotThePicks) {
+  std::mt19937 rng(71);
+  const auto cands = RandomList(rng, 40);
+  SpaceFilling fill;  // the default rule (switch) with the training table as measured screws
+  const ProcessTable t = TrainTable();
+  fill.measured = t.inputs;
+  fill.measured_targets = t.targets;
+  const auto plain = HandChoice({"linear/log", "gp-matern52-constant/identity"}, {0, 1}, {},
+                                {1.0, 1.0});
+  auto scaled = plain;
+  scaled.choice.sd_scale = {0.5, 0.8};  // family::Choice::sd_scale of a calibrated choice
+  const NextDesign a = DesignNext(plain, cands, 3, {}, {}, fill);
+  const NextDesign b = DesignNext(scaled, cands, 3, {}, {}, fill);
+  EXPECT_EQ(Candidates(a), Candidates(b));
+  const std::array<double, 2> s = {0.5, 0.8};
+  const auto predicted = workpiece::PredictBatch(scaled, cands);
+  for (std::size_t i = 0; i < a.picks.size(); ++i)
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(b.picks[i].sd_now[k], s[k] * a.picks[i].sd_now[k], 1e-12 * a.picks[i].sd_now[k]);
+      EXPECT_NEAR(b.picks[i].sd_after[k], s[k] * a.picks[i].sd_after[k],
+                  1e-12 * a.picks[i].sd_after[k]);
+      // The sd now is the one `whirl predict` gives (sd_scale included).
+      EXPECT_NEAR(b.picks[i].sd_now[k], predicted[b.picks[i].candidate].stddev.ToArray()[k],
+                  1e-9 * b.picks[i].sd_now[k]);
+    }
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_NEAR(b.rms_sd_now[k], s[k] * a.rms_sd_now[k], 1e-12 * a.rms_sd_now[k]);
+    EXPECT_NEAR(b.rms_sd_after[k], s[k] * a.rms_sd_after[k], 1e-12 * a.rms_sd_after[k]);
+    EXPECT_NEAR(b.rms_sd_floor[k], s[k] * a.rms_sd_floor[k], 1e-12 * a.rms_sd_floor[k]);
+  }
+  // A tolerance between the scaled and the unscaled RMS sd: enough for the scaled model only.
+  StopRule between;
+  between.tolerance = {0.7 * a.rms_sd_now[0], 0};
+  ASSERT_LE(a.rms_sd_floor[0] * 0.5, between.tolerance[0]);
+  EXPECT_EQ(DesignNext(scaled, cands, 1, between, {}, fill).stop, "enough");
+  EXPECT_NE(DesignNext(plain, cands, 1, between, {}, fill).stop, "enough");
+}
+
+TEST(Design, StackedOutputsTakeTheModelsCombinedSd) {
+  std::mt19937 rng(72);
+  const auto cands = RandomList(rng, 30);
+  SpaceFilling fill;
+  fill.measured = TrainTable().inputs;
+  NextRule chosen;
+  chosen.model = NextRule::Model::kChosen;
+  const std::vector<std::string> names = {"linear/log", "gp-matern52-constant/identity"};
+  const auto stack = HandChoice(names, {1, 1}, {std::vector<double>{0.3, 0.7}, {0.6, 0.4}},
+                                {0.8, 0.9});
+  const NextDesign d = DesignNext(stack, cands, 3, {}, {}, fill, chosen);
+  ASSERT_EQ(d.picks.size(), 3u);
+  // By hand: sd = sd_scale (w_1 sd_1 + w_2 sd_2) with each candidate's own predictive sd.
+  const auto p0 = family::PredictFamily(stack.choice.models[0], cands);
+  const auto p1 = family::PredictFamily(stack.choice.models[1], cands);
+  const std::array<std::array<double, 2>, 2> w = {{{0.3, 0.7}, {0.6, 0.4}}};
+  const std::array<double, 2> s = {0.8, 0.9};
+  for (const auto& p : d.picks)
+    for (int k = 0; k < 2; ++k) {
+      const double hand = s[k] * (w[k][0] * p0[p.candidate].stddev.ToArray()[k] +
+                                  w[k][1] * p1[p.candidate].stddev.ToArray()[k]);
+      EXPECT_NEAR(p.sd_now[k], hand, 1e-9 * hand);
+      EXPECT_LE(p.sd_after[k], p.sd_now[k] + 1e-12);
+    }
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_LT(d.rms_sd_after[k], d.rms_sd_now[k]);
+    EXPECT_LE(d.rms_sd_floor[k], d.rms_sd_after[k] + 1e-12);
+  }
+  // A stack whose weight is all on one candidate is that candidate (same picks, same sds).
+  const auto whole = HandChoice(names, {0, 0}, {std::vector<double>{1.0, 0.0}, {1.0, 0.0}},
+                                {0.8, 0.9});
+  const auto alone = HandChoice(names, {0, 0}, {}, {0.8, 0.9});
+  const NextDesign dw = DesignNext(whole, cands, 3, {}, {}, fill, chosen);
+  const NextDesign da = DesignNext(alone, cands, 3, {}, {}, fill, chosen);
+  EXPECT_EQ(Candidates(dw), Candidates(da));
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(dw.rms_sd_after[k], da.rms_sd_after[k], 1e-9);
+}
+
+TEST(Design, NetworkCandidatesTakeTheirLaplaceCovariance) {
+  std::mt19937 rng(73);
+  const auto cands = RandomList(rng, 30);
+  SpaceFilling fill;
+  fill.measured = TrainTable().inputs;
+  NextRule chosen;
+  chosen.model = NextRule::Model::kChosen;
+  const auto net = HandChoice({"network-h2/identity"}, {0, 0}, {}, {1.0, 1.0});
+  const NextDesign d = DesignNext(net, cands, 4, {}, {}, fill, chosen);
+  ASSERT_EQ(d.picks.size(), 4u);
+  // The covariance's diagonal plus the calibrated noise is nn's own predictive variance.
+  const auto p = family::PredictFamily(net.choice.models[0], cands);
+  std::set<int> seen;
+  for (const auto& pick : d.picks) {
+    EXPECT_TRUE(seen.insert(pick.candidate).second);
+    for (int k = 0; k < 2; ++k) {
+      const double own = p[pick.candidate].stddev.ToArray()[k];
+      EXPECT_NEAR(pick.sd_now[k], own, 1e-9 * own);
+      EXPECT_LE(pick.sd_after[k], pick.sd_now[k] + 1e-12);
+    }
+  }
+  for (int k = 0; k < 2; ++k) EXPECT_LE(d.rms_sd_after[k], d.rms_sd_now[k]);
+  // The first pick lowers the summed variance most: no other candidate measured alone does
+  // better (the first pick of a greedy batch is the exact optimum of one screw).
+  const NextDesign first = DesignNext(net, cands, 1, {}, {}, fill, chosen);
+  EXPECT_EQ(first.picks[0].candidate, d.picks[0].candidate);
+}
+
+TEST(Design, ChoiceEvidenceSwitchesWhereTheModelLeftThePowerLaw) {
+  std::mt19937 rng(74);
+  const auto cands = RandomList(rng, 40);
+  SpaceFilling fill;
+  fill.measured = RandomList(rng, 20);
+  fill.measured_targets = MeasuredTargets(fill.measured, 0, rng);  // a power law: no lack of fit
+  NextRule lack, choice, power_gp;
+  lack.switch_ratio = choice.switch_ratio = 1e9;  // the lack of fit never departs
+  choice.evidence = NextRule::Evidence::kChoice;
+  power_gp.model = NextRule::Model::kPowerGp;
+  // Linear on raw columns for both outputs: the choice left the power law; power-gp's picks.
+  const auto raw = HandChoice({"linear/identity"}, {0, 0}, {}, {1.0, 1.0});
+  const NextDesign c = DesignNext(raw, cands, 3, {}, {}, fill, choice);
+  EXPECT_TRUE(c.choice_departure[0] && c.choice_departure[1]);
+  EXPECT_TRUE(c.departure[0] && c.departure[1]);
+  EXPECT_EQ(Candidates(c), Candidates(DesignNext(raw, cands, 3, {}, {}, fill, power_gp)));
+  EXPECT_NE(c.picks[0].why.find("choice left the power law"), std::string::npos) << c.picks[0].why;
+  const NextDesign l = DesignNext(raw, cands, 3, {}, {}, fill, lack);
+  EXPECT_FALSE(l.departure[0] || l.departure[1] || l.choice_departure[0]);
+  // The power law on both outputs: the choice adds nothing.
+  const auto power = HandChoice({"linear/log"}, {0, 0}, {}, {1.0, 1.0});
+  const NextDesign pc = DesignNext(power, cands, 3, {}, {}, fill, choice);
+  EXPECT_FALSE(pc.choice_departure[0] || pc.choice_departure[1]);
+  EXPECT_EQ(Candidates(pc), Candidates(DesignNext(power, cands, 3, {}, {}, fill, lack)));
+  // A stack with weight beyond the power law departs; the power law taking it whole does not.
+  const std::vector<std::string> names = {"linear/log", "linear/identity"};
+  const auto mixed = HandChoice(names, {0, 0}, {std::vector<double>{0.5, 0.5}, {1.0, 0.0}},
+                                {1.0, 1.0});
+  const NextDesign m = DesignNext(mixed, cands, 2, {}, {}, fill, choice);
+  EXPECT_TRUE(m.choice_departure[0]);
+  EXPECT_FALSE(m.choice_departure[1]);
+  // Only with the switch; spellings.
+  NextRule bad = choice;
+  bad.model = NextRule::Model::kChosen;
+  EXPECT_THROW(DesignNext(raw, cands, 1, {}, {}, fill, bad), InputError);
+  EXPECT_EQ(ParseEvidence("choice"), NextRule::Evidence::kChoice);
+  EXPECT_EQ(ToString(NextRule::Evidence::kLackOfFit), "lack-of-fit");
+  EXPECT_THROW(ParseEvidence("ratio"), InputError);
 }
 
 }  // namespace

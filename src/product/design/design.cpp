@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -15,6 +16,7 @@
 #include "family/linear.h"
 #include "family/transform.h"
 #include "gp/gp.h"
+#include "nn/network.h"
 
 namespace whirl::design {
 namespace {
@@ -224,34 +226,84 @@ int FillCandidate(FillRule rule, const Eigen::MatrixXd& u, int n, const std::vec
 
 // ---- Next screws: integrated variance reduction --------------------------------------------
 
-// One output's state over the candidates: latent covariance in the transformed space, the
-// delta method's factor, the calibrated prediction noise and the fitted noise of a new row.
-struct OutputState {
+// One candidate model's output over the candidates: latent covariance in the transformed space,
+// the delta method's factor, the calibrated prediction noise and the fitted noise of a new row.
+struct MemberState {
   Eigen::MatrixXd cov;
   Eigen::VectorXd g;
   double prediction_noise = 0, measurement_noise = 0;
-  double weight = 1;  // 1 / mean predictive variance now (original units)
   double Variance(int c) const { return g(c) * g(c) * (std::max(cov(c, c), 0.0) + prediction_noise); }
-  double Rms() const {
-    double s = 0;
-    for (Eigen::Index c = 0; c < g.size(); ++c) s += Variance(static_cast<int>(c));
-    return std::sqrt(s / static_cast<double>(g.size()));
-  }
-  double FloorRms() const {
-    return std::sqrt(g.array().square().mean() * prediction_noise);
+  double Denominator(int j) const { return std::max(cov(j, j), 0.0) + measurement_noise; }
+  double VarianceAfter(int c, int j) const {  // at c once j is measured
+    const double denom = Denominator(j);
+    const double drop = denom > 0 ? cov(c, j) * cov(c, j) / denom : 0.0;
+    return g(c) * g(c) * (std::max(cov(c, c) - drop, 0.0) + prediction_noise);
   }
   double Reduction(int j) const {  // sum_c g_c^2 C[c,j]^2 / (C[j,j] + s^2)
-    const double denom = std::max(cov(j, j), 0.0) + measurement_noise;
+    const double denom = Denominator(j);
     if (denom <= 0) return 0;
     return (g.array().square() * cov.col(j).array().square()).sum() / denom;
   }
   void Measure(int j) {
-    const double denom = std::max(cov(j, j), 0.0) + measurement_noise;
+    const double denom = Denominator(j);
     if (denom <= 0) return;
     const Eigen::VectorXd col = cov.col(j);
     cov.noalias() -= col * col.transpose() / denom;
   }
 };
+
+// One output's state over the candidates as the model predicts it (family::PredictChoice): the
+// sd is scale * sum_m share_m sd_m over the members (one member with share 1 where a candidate
+// takes the output whole; scale = Choice::sd_scale). The criterion's weight: 1 / mean predictive
+// variance now (original units).
+struct OutputState {
+  std::vector<MemberState> members;
+  std::vector<double> shares;
+  double scale = 1;
+  double weight = 1;
+  double Sd(int c, int measured = -1) const {
+    double s = 0;
+    for (std::size_t m = 0; m < members.size(); ++m)
+      s += shares[m] * std::sqrt(measured < 0 ? members[m].Variance(c)
+                                              : members[m].VarianceAfter(c, measured));
+    return scale * s;
+  }
+  double Variance(int c) const { return Sd(c) * Sd(c); }
+  int Size() const { return static_cast<int>(members.front().g.size()); }
+  double Rms() const {
+    double s = 0;
+    for (int c = 0; c < Size(); ++c) s += Variance(c);
+    return std::sqrt(s / Size());
+  }
+  double FloorRms() const {  // the sd with every latent variance at 0
+    double s = 0;
+    for (int c = 0; c < Size(); ++c) {
+      double sd = 0;
+      for (std::size_t m = 0; m < members.size(); ++m)
+        sd += shares[m] * std::abs(members[m].g(c)) * std::sqrt(members[m].prediction_noise);
+      s += scale * scale * sd * sd;
+    }
+    return std::sqrt(s / Size());
+  }
+  // sum_c (variance now - variance once j is measured); one member: its closed form times
+  // scale^2 (the latent covariance and the noise of a Gaussian model scaled alike).
+  double Reduction(int j) const {
+    if (members.size() == 1) return scale * scale * members.front().Reduction(j);
+    double s = 0;
+    for (int c = 0; c < Size(); ++c) s += Variance(c) - Sd(c, j) * Sd(c, j);
+    return s;
+  }
+  void Measure(int j) {
+    for (auto& m : members) m.Measure(j);
+  }
+};
+
+OutputState Single(MemberState m) {
+  OutputState s;
+  s.members.push_back(std::move(m));
+  s.shares = {1.0};
+  return s;
+}
 
 void CheckUsedInputs(const family::FamilyModel& m, const workpiece::WorkpieceModel& model,
                      const std::vector<ProcessInputs>& cands, const std::vector<int>& lines) {
@@ -275,48 +327,88 @@ void CheckUsedInputs(const family::FamilyModel& m, const workpiece::WorkpieceMod
   }
 }
 
-OutputState StateOf(const family::FamilyModel& m, int k, const Eigen::MatrixXd& x_used,
-                    const Eigen::VectorXd& mean_z) {
-  OutputState s;
-  const auto t = m.transform.outputs[k];
-  s.g.resize(mean_z.size());
-  for (Eigen::Index c = 0; c < mean_z.size(); ++c)
-    s.g(c) = family::InverseDerivative(t, mean_z(c));
-  if (m.candidate.family == family::Family::kLinear) {
+// A network's output k over the rows z (all five transformed inputs, one column per candidate):
+// its mean and the Laplace covariance g_k(x_c)' A^-1 g_k(x_j) of nn/model.h, both in the
+// transformed output's units (the mapminmax half range); prediction noise the calibrated
+// sigma_k^2, the noise of a new row trainbr's 1 / (2 beta), the level its posterior assumes.
+MemberState NetworkState(const nn::Model& net, int k, const Eigen::MatrixXd& z,
+                         Eigen::VectorXd* mean_z) {
+  if (net.posterior_covariance.size() == 0)
+    throw InputError("design: the network of output " + std::string(kTargetColumns[k]) +
+                     " has no posterior covariance (trained without regularization)");
+  nn::ForwardCache cache;
+  net.network.Forward(net.input_scaling.Apply(z), &cache);
+  *mean_z = net.target_scaling.Reverse(cache.output()).row(k).transpose();
+  Eigen::MatrixXd jac;
+  nn::ErrorJacobian(net.network, cache, &jac);  // rows q * S + k, = -dy/dw
+  const int outputs = net.network.OutputCount();
+  Eigen::MatrixXd gk(z.cols(), jac.cols());
+  for (Eigen::Index q = 0; q < z.cols(); ++q) gk.row(q) = jac.row(q * outputs + k);
+  const double half = net.target_scaling.HalfRange()(k), half2 = half * half;
+  MemberState s;
+  s.cov = half2 * (gk * net.posterior_covariance * gk.transpose());
+  s.prediction_noise = half2 * net.output_noise_variance(k);
+  s.measurement_noise = half2 * net.noise_variance;
+  return s;
+}
+
+// Member m's output k over the candidates x (original units, one column per candidate).
+MemberState StateOf(const family::FamilyModel& m, int k, const Eigen::MatrixXd& x) {
+  const Eigen::MatrixXd z = family::TransformInputs(m.transform, x);
+  const Eigen::MatrixXd used = family::UsedInputRows(m.transform, z);
+  MemberState s;
+  Eigen::VectorXd mean_z;
+  if (m.candidate.family == family::Family::kNetwork) {
+    s = NetworkState(m.network, k, z, &mean_z);
+  } else if (m.candidate.family == family::Family::kLinear) {
     const auto& lin = m.linears[k];
-    s.cov = family::LatentCovariance(lin, x_used);
+    mean_z = family::PredictLinear(lin, used).mean;
+    s.cov = family::LatentCovariance(lin, used);
     s.prediction_noise = lin.noise_variance;
     s.measurement_noise = lin.fitted_noise_variance;
   } else {
     const auto& gp = m.gps[k];
-    s.cov = gp::PosteriorCovariance(gp, x_used);
+    mean_z = gp::PredictGp(gp, used).mean;
+    s.cov = gp::PosteriorCovariance(gp, used);
     s.prediction_noise = gp.noise_variance * gp.target_scale * gp.target_scale;
     s.measurement_noise = gp.SigmaN2() * gp.target_scale * gp.target_scale;
   }
+  const auto t = m.transform.outputs[k];
+  s.g.resize(mean_z.size());
+  for (Eigen::Index c = 0; c < mean_z.size(); ++c)
+    s.g(c) = family::InverseDerivative(t, mean_z(c));
   return s;
 }
 
-const family::FamilyModel& ModelOfOutput(const workpiece::WorkpieceModel& model, int k) {
+// The choice of a family model (a network model: InputError).
+const family::Choice& ChoiceOf(const workpiece::WorkpieceModel& model) {
   if (model.IsNetwork())
     throw InputError("the model (trained on '" + model.training_data +
                      "') is a network (" + model.Describe() + "); the next screws need a family "
                      "model: train one with 'whirl train' without --family network or "
                      "--trainbr-matlab");
-  const auto& choice = model.choice;
-  if (!choice.weights[k].empty())
-    throw InputError(std::string("output ") + kTargetColumns[k] +
-                     " is a stacked combination; the next screws need one family per output "
-                     "(train without --stack)");
+  return model.choice;
+}
+
+// Whether the choice predicts output k by the power law alone (linear/log on a log output).
+bool PowerLawAlone(const family::Choice& choice, int k) {
+  int parts = 0;
+  for (double w : choice.weights[k]) parts += w > 0;
   const auto& m = choice.models[choice.model_of_output[k]];
-  if (m.candidate.family == family::Family::kNetwork)
-    throw InputError(std::string("output ") + kTargetColumns[k] + " is " +
-                     m.OutputName(k) + "; the next screws need a linear or GP family");
-  return m;
+  return parts <= 1 && m.candidate.family == family::Family::kLinear && m.candidate.log &&
+         m.OutputName(k) == m.candidate.Name();
+}
+
+// The candidate that predicts output k, or of a stacked output the one of largest weight.
+const family::FamilyModel& ModelOfOutput(const workpiece::WorkpieceModel& model, int k) {
+  const auto& choice = ChoiceOf(model);
+  return choice.models[choice.model_of_output[k]];
 }
 
 std::array<OutputState, Features::kCount> States(const workpiece::WorkpieceModel& model,
                                                  const std::vector<ProcessInputs>& cands,
                                                  const std::vector<int>& lines) {
+  const auto& choice = ChoiceOf(model);
   std::array<OutputState, Features::kCount> states;
   Eigen::MatrixXd x(ProcessInputs::kCount, static_cast<Eigen::Index>(cands.size()));
   for (std::size_t c = 0; c < cands.size(); ++c) {
@@ -324,16 +416,17 @@ std::array<OutputState, Features::kCount> States(const workpiece::WorkpieceModel
     for (int j = 0; j < ProcessInputs::kCount; ++j) x(j, static_cast<Eigen::Index>(c)) = a[j];
   }
   for (int k = 0; k < Features::kCount; ++k) {
-    const auto& m = ModelOfOutput(model, k);
-    CheckUsedInputs(m, model, cands, lines);
-    const Eigen::MatrixXd used =
-        family::UsedInputRows(m.transform, family::TransformInputs(m.transform, x));
-    Eigen::VectorXd mean_z;
-    if (m.candidate.family == family::Family::kLinear)
-      mean_z = family::PredictLinear(m.linears[k], used).mean;
-    else
-      mean_z = gp::PredictGp(m.gps[k], used).mean;
-    states[k] = StateOf(m, k, used, mean_z);
+    std::vector<std::pair<int, double>> parts;  // (model, weight)
+    if (choice.weights[k].empty()) parts.push_back({choice.model_of_output[k], 1.0});
+    for (std::size_t j = 0; j < choice.weights[k].size(); ++j)
+      if (choice.weights[k][j] > 0) parts.push_back({static_cast<int>(j), choice.weights[k][j]});
+    for (const auto& [j, w] : parts) {
+      const auto& m = choice.models[static_cast<std::size_t>(j)];
+      CheckUsedInputs(m, model, cands, lines);
+      states[k].members.push_back(StateOf(m, k, x));
+      states[k].shares.push_back(w);
+    }
+    states[k].scale = choice.sd_scale[k];
   }
   return states;
 }
@@ -391,11 +484,11 @@ OutputState PowerGpState(const Eigen::MatrixXd& u, int n, const NextRule& rule) 
   } catch (const InputError&) {
     throw InputError(kCollinear);
   }
-  OutputState s;
+  MemberState s;
   s.cov = gp::PosteriorCovariance(g, u.topRows(n).transpose());
   s.g = Eigen::VectorXd::Ones(n);
   s.measurement_noise = g.SigmaN2();
-  return s;
+  return Single(std::move(s));
 }
 
 template <class States>
@@ -416,8 +509,8 @@ int BestCandidate(const States& states, const std::vector<char>& taken, double* 
 // own[k]: output k's variance is the chosen family's (NextRule); lack_of_fit: kSwitch's ratios.
 std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int j, double share,
                     const NextRule& rule, const std::array<bool, Features::kCount>& own,
-                    const std::array<double, Features::kCount>& lack_of_fit,
-                    const workpiece::Prediction& now) {
+                    const NextDesign& d, const workpiece::Prediction& now) {
+  const std::array<double, Features::kCount>& lack_of_fit = d.lack_of_fit_ratio;
   const NextRule::Model model = rule.model;
   const std::array<bool, Features::kCount>& gp_chosen = own;  // kAuto: own where a GP is chosen
   const std::string pct = FormatSignificant(100 * share, 3) + " % of its mean";
@@ -430,9 +523,13 @@ std::string WhyNext(const std::array<OutputState, Features::kCount>& states, int
       why += std::string(k ? "; " : "") + kTargetColumns[k] +
              (own[k] ? ": the power law fits its measured screws (leave-one-out error ratio " +
                            ratio + " <= " + limit + "), the chosen family's variance"
-                     : ": its measured screws depart from the power law (leave-one-out error "
-                       "ratio " + ratio + " > " + limit + "), a power law with a smooth "
-                       "departure's variance");
+              : lack_of_fit[k] > rule.switch_ratio
+                  ? ": its measured screws depart from the power law (leave-one-out error "
+                    "ratio " + ratio + " > " + limit + "), a power law with a smooth "
+                    "departure's variance"
+                  : ": the model's choice left the power law (leave-one-out error ratio " +
+                        ratio + " <= " + limit + "), a power law with a smooth departure's "
+                        "variance");
     }
     why += ")";
   } else if (model == NextRule::Model::kAuto && gp_chosen[0] != gp_chosen[1]) {
@@ -554,6 +651,18 @@ std::string ToString(NextRule::Model m) {
   return "switch";
 }
 
+NextRule::Evidence ParseEvidence(const std::string& s) {
+  if (s == "lack-of-fit") return NextRule::Evidence::kLackOfFit;
+  if (s == "choice") return NextRule::Evidence::kChoice;
+  throw InputError("--departure-evidence '" + s + "': expected 'lack-of-fit' (the power law's "
+                   "leave-one-out error over the power-gp's above --switch-ratio) or 'choice' "
+                   "(that, or the model's choice not keeping the power law alone)");
+}
+
+std::string ToString(NextRule::Evidence e) {
+  return e == NextRule::Evidence::kChoice ? "choice" : "lack-of-fit";
+}
+
 FillRule ParseFillRule(const std::string& s) {
   if (s == "maximin") return FillRule::kMaximin;
   if (s == "coverage") return FillRule::kCoverage;
@@ -654,7 +763,7 @@ void AddPowerGpPicks(const Eigen::MatrixXd& f, int k, const NextRule& rule,
   all.topRows(n) = u;
   for (std::size_t i = 0; i < picked->size(); ++i) all.row(n + long(i)) = u.row((*picked)[i]);
   std::array<OutputState, 1> state = {PowerGpState(all, n, rule)};
-  state[0].weight = 1.0 / std::max(state[0].cov.diagonal().mean(), 1e-300);
+  state[0].weight = 1.0 / std::max(state[0].members[0].cov.diagonal().mean(), 1e-300);
   std::vector<char> taken(n, 0);
   for (int i : *picked) taken[i] = 1;
   for (int i = 0; i < k; ++i) {
@@ -774,7 +883,7 @@ std::vector<OutputState> CriterionStates(const std::array<OutputState, Features:
   const bool sum = rule.model == NextRule::Model::kSum;
   if (sum || power_gp_outputs > 0) {
     OutputState s = PowerGpState(u, n, rule);
-    const double mean = s.cov.diagonal().mean();
+    const double mean = s.members[0].cov.diagonal().mean();
     // kAuto, kSwitch: the power-GP stands in for each output that does not use its own.
     const double share = sum                                    ? Features::kCount
                          : rule.model == NextRule::Model::kPowerGp ? 1.0
@@ -827,6 +936,9 @@ void CheckNextArguments(int n, int count, const SpaceFilling& fill, const NextRu
     throw InputError("design: --departure-ratio and --length-scale must be finite and positive");
   if (!(rule.switch_ratio > 0) || !std::isfinite(rule.switch_ratio))
     throw InputError("design: --switch-ratio must be finite and positive");
+  if (rule.evidence == NextRule::Evidence::kChoice && rule.model != NextRule::Model::kSwitch)
+    throw InputError("design --departure-evidence choice needs --variance switch (it says when "
+                     "the switch takes the power law with a smooth departure's variance)");
   if (fill.when == SpaceFilling::When::kDeparture && rule.model != NextRule::Model::kSwitch)
     throw InputError("design --space-filling-when departure needs --variance switch (its lack of "
                      "fit says where the measured screws depart from the power law)");
@@ -908,8 +1020,11 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
     const auto fits = MeasuredLackOfFit(u.bottomRows(u.rows() - n), fill.measured_targets, rule);
     for (int k = 0; k < Features::kCount; ++k) {
       d.lack_of_fit_ratio[k] = fits[k].ratio;
-      departure[k] = fits[k].ratio > rule.switch_ratio;
+      d.choice_departure[k] = rule.evidence == NextRule::Evidence::kChoice &&
+                              !PowerLawAlone(model.choice, k);
+      departure[k] = fits[k].ratio > rule.switch_ratio || d.choice_departure[k];
     }
+    d.departure = departure;
   }
   d.space_filling = fill.when == SpaceFilling::When::kDeparture && !departure[0] && !departure[1]
                         ? 0
@@ -926,8 +1041,7 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
     } else {
       double score = 0;
       p.candidate = BestCandidate(crit, taken, &score);
-      p.why = WhyNext(states, p.candidate, score / n / units, rule, own, d.lack_of_fit_ratio,
-                      d.now[p.candidate]);
+      p.why = WhyNext(states, p.candidate, score / n / units, rule, own, d, d.now[p.candidate]);
     }
     const int j = p.candidate;
     for (int k = 0; k < Features::kCount; ++k) p.sd_now[k] = std::sqrt(initial[k].Variance(j));
