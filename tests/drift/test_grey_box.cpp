@@ -365,6 +365,70 @@ TEST(GreyBox, ForwardValidationFindsThePlantedLagsAndTheBlanksLag) {
   EXPECT_LT(m.cv_rmse_um, 1e-3);
 }
 
+// A world whose bodies follow their sensors only through a lag (instant coefficients 0): with
+// the temperatures through their lags only (instant_offset_inputs / instant_slope_inputs false)
+// the fit recovers every planted lag coefficient, keeps each instant coefficient at 0 exactly,
+// and predicts every reading as the truth does; a sensor's noise on its instant reading then
+// cannot reach the compensation at once.
+GreyBoxModel LaggedTruth() {
+  GreyBoxModel t = Truth();
+  t.a << 0.0, -4.0;
+  t.g << 0.0, 11.5;
+  return t;
+}
+
+TEST(GreyBox, LagsOnlyRecoversALaggedWorldWithInstantCoefficientsExactlyZero) {
+  const GreyBoxModel t = LaggedTruth();
+  const ShopRecord rec = Planted(t, true);
+  GreyBoxOptions o = Fixed(t, 1e-10);
+  o.instant_offset_inputs = o.instant_slope_inputs = false;
+  const GreyBoxModel m = FitGreyBox(rec, SpecOf(t), o);
+  ASSERT_EQ(m.time_constants, t.time_constants);
+  EXPECT_EQ(m.a(0), 0.0);
+  EXPECT_EQ(m.g(0), 0.0);
+  EXPECT_NEAR(m.a(1), -4.0, 1e-3);
+  EXPECT_NEAR(m.g(1), 11.5, 1e-3);
+  EXPECT_NEAR(m.slope_intercept_um_per_1000, t.slope_intercept_um_per_1000, 1e-3);
+  EXPECT_NEAR(m.blank_um_per_1000_per_k, t.blank_um_per_1000_per_k, 1e-3);
+  EXPECT_LT(m.cv_rmse_um, 1e-3);
+  for (const MeasurementRecord& r : rec.records) {
+    const std::vector<double> p = PredictGreyRecord(m, rec, r), q = PredictGreyRecord(t, rec, r);
+    for (std::size_t i = 0; i < p.size(); ++i) EXPECT_NEAR(p[i], q[i], 1e-3);
+  }
+  // The planted world of the other tests moves the instant columns: lags alone cannot fit it.
+  const ShopRecord instant = Planted(Truth(), true);
+  EXPECT_GT(FitGreyBox(instant, SpecOf(t), o).cv_rmse_um, 0.1);
+}
+
+// Without the instant column an input's prior goes to its lags alone (here one lag: the whole
+// prior), on the channel switched off only; with no lag to hold it the instant column stays and
+// the fit is the default fit exactly. (The lagged world makes the lag the better choice of the
+// search even when a strong prior holds every coefficient.)
+TEST(GreyBox, LagsOnlyPutsThePriorOnTheLagsAndNeedsALag) {
+  const GreyBoxModel t = LaggedTruth();
+  const ShopRecord rec = Planted(t, true);
+  GreyBoxSpec s = SpecOf(t);
+  s.offset_prior = {{"head", -4.0}};
+  s.slope_prior = {{"screw", 11.5}};
+  GreyBoxOptions o = Fixed(t, 1e6);
+  o.instant_slope_inputs = false;
+  const GreyBoxModel m = FitGreyBox(rec, s, o);
+  ASSERT_EQ(m.time_constants, t.time_constants);
+  EXPECT_NEAR(m.a(0), -2.0, 1e-3);  // offset: instant and lag share the prior, as by default
+  EXPECT_NEAR(m.a(1), -2.0, 1e-3);
+  EXPECT_EQ(m.g(0), 0.0);
+  EXPECT_NEAR(m.g(1), 11.5, 1e-3);
+  GreyBoxOptions none = Fixed(t, 1e-2);
+  none.max_lags = 0;
+  const GreyBoxModel plain = FitGreyBox(rec, s, none);
+  none.instant_offset_inputs = none.instant_slope_inputs = false;
+  const GreyBoxModel lagless = FitGreyBox(rec, s, none);
+  ASSERT_TRUE(lagless.time_constants.empty());
+  EXPECT_EQ(lagless.a, plain.a);
+  EXPECT_EQ(lagless.g, plain.g);
+  EXPECT_NE(lagless.a(0), 0.0);
+}
+
 TEST(GreyBox, BadOptionsAndMissingColumnsAreNamed) {
   const GreyBoxModel t = Truth();
   const ShopRecord rec = Planted(t, false, 2);

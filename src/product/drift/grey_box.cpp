@@ -106,30 +106,54 @@ struct LogFeatures {
   Eigen::VectorXd blank_c;  ///< B(t) per sample (20 without a blank sensor)
 };
 
-LogFeatures FeaturesOf(const Run& log, const GreyBoxSpec& spec, const Choice& c) {
+// Which inputs keep their instant column (the options; none is dropped without a lag).
+struct Instant {
+  bool offset = true, slope = true;
+};
+
+Instant InstantOf(const GreyBoxOptions& o, const Choice& c) {
+  const bool lags = !c.taus.empty();
+  return {o.instant_offset_inputs || !lags, o.instant_slope_inputs || !lags};
+}
+
+// Zeroes the instant column of each of the first `inputs` inputs (their lags kept).
+void DropInstant(Eigen::MatrixXd* f, std::size_t inputs, std::size_t taus) {
+  for (std::size_t i = 0; i < inputs; ++i) f->col(static_cast<Eigen::Index>(i * (1 + taus))).setZero();
+}
+
+LogFeatures FeaturesOf(const Run& log, const GreyBoxSpec& spec, const Choice& c,
+                       const Instant& instant) {
   LogFeatures f;
   f.off = GreyChannelFeatures(log, spec.offset_sensors, spec.offset_duty, c.taus);
   f.slope = GreyChannelFeatures(log, spec.slope_sensors, spec.slope_duty, c.taus);
+  if (!instant.offset) DropInstant(&f.off, spec.offset_sensors.size(), c.taus.size());
+  if (!instant.slope) DropInstant(&f.slope, spec.slope_sensors.size(), c.taus.size());
   f.blank_c = Eigen::VectorXd::Constant(log.samples(), 20.0);
   if (!spec.blank_sensor.empty())
     f.blank_c = AbsoluteFeatures(log, {spec.blank_sensor}, {c.blank_tau}).col(1).array() + 20.0;
   return f;
 }
 
+// Each input's prior spread equally over its columns, or over its lags only (`instant` false).
 Eigen::VectorXd Priors(const std::vector<std::string>& inputs,
-                       const std::map<std::string, double>& prior, std::size_t taus) {
+                       const std::map<std::string, double>& prior, std::size_t taus,
+                       bool instant) {
   const auto per = static_cast<Eigen::Index>(1 + taus);
+  const Eigen::Index skip = instant ? 0 : 1;
   Eigen::VectorXd p = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(inputs.size()) * per);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto it = prior.find(inputs[i]);
     if (it != prior.end())
-      p.segment(static_cast<Eigen::Index>(i) * per, per).setConstant(it->second / per);
+      p.segment(static_cast<Eigen::Index>(i) * per + skip, per - skip)
+          .setConstant(it->second / static_cast<double>(per - skip));
   }
   return p;
 }
 
 Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
-                   double lead_share) {
+                   const GreyBoxOptions& o) {
+  const double lead_share = o.lead_share;
+  const Instant instant = InstantOf(o, c);
   std::vector<LogFeatures> logs(rec.day_logs.size());
   std::vector<bool> built(rec.day_logs.size(), false);
   std::size_t n = 0;
@@ -146,7 +170,7 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
   Eigen::Index row = 0;
   for (const auto& r : rec.records) {
     const auto l = static_cast<std::size_t>(r.log);
-    if (!built[l]) logs[l] = FeaturesOf(rec.day_logs[l], spec, c), built[l] = true;
+    if (!built[l]) logs[l] = FeaturesOf(rec.day_logs[l], spec, c, instant), built[l] = true;
     const LogFeatures& f = logs[l];
     const bool lead = r.kind == MeasurementRecord::Kind::kLead;
     const double blank = lead && !r.rows.empty() ? f.blank_c(r.rows.front().sample) - 20.0 : 0.0;
@@ -184,8 +208,9 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
   const auto duty_cols = [&](const std::vector<std::string>& duty) {
     return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(duty.size() * per));
   };
-  d.prior << Priors(spec.offset_sensors, spec.offset_prior, c.taus.size()),
-      duty_cols(spec.offset_duty), Priors(spec.slope_sensors, spec.slope_prior, c.taus.size()),
+  d.prior << Priors(spec.offset_sensors, spec.offset_prior, c.taus.size(), instant.offset),
+      duty_cols(spec.offset_duty),
+      Priors(spec.slope_sensors, spec.slope_prior, c.taus.size(), instant.slope),
       duty_cols(spec.slope_duty), 0.0, spec.blank_prior;
   return d;
 }
@@ -259,7 +284,7 @@ double ForwardLeadRmse(const Design& d, double strength, int days) {
 
 double Score(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
              const GreyBoxOptions& o) {
-  const Design d = BuildDesign(rec, spec, c, o.lead_share);
+  const Design d = BuildDesign(rec, spec, c, o);
   if (o.validation == GreyValidation::kForwardLeads) {
     const double e = ForwardLeadRmse(d, c.strength, o.forward_days);
     if (std::isfinite(e)) return e;
@@ -317,7 +342,7 @@ GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
   }
   double cv = 0;
   const grey_box_detail::Choice c = grey_box_detail::Choose(record, spec, options, &cv);
-  const grey_box_detail::Design d = grey_box_detail::BuildDesign(record, spec, c, options.lead_share);
+  const grey_box_detail::Design d = grey_box_detail::BuildDesign(record, spec, c, options);
   if (d.x.rows() <= d.x.cols())
     throw InputError("grey box: " + std::to_string(d.x.rows()) + " readings for " +
                      std::to_string(d.x.cols()) + " coefficients");

@@ -83,6 +83,11 @@ struct GreyBoxOptions {
   double lead_share = 0.5;  ///< the lead records' share of the total weight, in (0, 1)
   GreyValidation validation = GreyValidation::kLeaveOneDayOut;
   int forward_days = 10;    ///< kForwardLeads: validation days, 2..100
+  /// false: the channel's temperatures enter through their lags only (each input's prior spread
+  /// over its lagged columns, the instant column's coefficient 0): no body whose growth makes the
+  /// error follows a reading at once, and the instant column carries the reading's noise into
+  /// the compensation. With no lag chosen the instant columns stay. Duty inputs are not affected.
+  bool instant_offset_inputs = true, instant_slope_inputs = true;
   void Validate() const;    ///< InputError naming the field and the rule
 };
 
