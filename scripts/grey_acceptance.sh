@@ -77,7 +77,7 @@ for w in weeks:
             ok = (gain >= 30 and won == n) if w == "1" else None
         elif sc in ("production", "duty-changes"):
             if w == "1":
-                crit, ok = "not worse (1 week)", gain >= 0
+                crit, ok = "not worse, every seed (1 week)", gain >= 0 and won == n
             elif w == "8":
                 crit, ok = ">= 30 % (8 weeks)", gain >= 30
             else:
