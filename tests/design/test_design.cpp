@@ -790,6 +790,20 @@ ProcessTable TrainTable() {
   return ReadProcessTable(WHIRL_SOURCE_DIR "/datasets/whirling_train.csv", true);
 }
 
+// The next-screws rule that follows the model's own choice per output.
+NextRule ChosenRule() {
+  NextRule rule;
+  rule.model = NextRule::Model::kChosen;
+  return rule;
+}
+
+// Space filling that counts the training table as measured.
+SpaceFilling TrainFill() {
+  SpaceFilling fill;
+  fill.measured = TrainTable().inputs;
+  return fill;
+}
+
 // A family model of the named candidates fitted on the training table: output k is models
 // [of[k]] alone (weights empty), or the stack `weights[k]` where given; sd factors `scale`.
 workpiece::WorkpieceModel HandChoice(const std::vector<std::string>& names,
@@ -854,10 +868,8 @@ TEST(Design, SdScaleScalesEverySdAndTheStopRuleNotThePicks) {
 TEST(Design, StackedOutputsTakeTheModelsCombinedSd) {
   std::mt19937 rng(72);
   const auto cands = RandomList(rng, 30);
-  SpaceFilling fill;
-  fill.measured = TrainTable().inputs;
-  NextRule chosen;
-  chosen.model = NextRule::Model::kChosen;
+  const SpaceFilling fill = TrainFill();
+  const NextRule chosen = ChosenRule();
   const std::vector<std::string> names = {"linear/log", "gp-matern52-constant/identity"};
   const auto stack = HandChoice(names, {1, 1}, {std::vector<double>{0.3, 0.7}, {0.6, 0.4}},
                                 {0.8, 0.9});
@@ -892,10 +904,8 @@ TEST(Design, StackedOutputsTakeTheModelsCombinedSd) {
 TEST(Design, NetworkCandidatesTakeTheirLaplaceCovariance) {
   std::mt19937 rng(73);
   const auto cands = RandomList(rng, 30);
-  SpaceFilling fill;
-  fill.measured = TrainTable().inputs;
-  NextRule chosen;
-  chosen.model = NextRule::Model::kChosen;
+  const SpaceFilling fill = TrainFill();
+  const NextRule chosen = ChosenRule();
   const auto net = HandChoice({"network-h2/identity"}, {0, 0}, {}, {1.0, 1.0});
   const NextDesign d = DesignNext(net, cands, 4, {}, {}, fill, chosen);
   ASSERT_EQ(d.picks.size(), 4u);
