@@ -4,7 +4,7 @@
 # acceptance): thread medians over the seeds, 4 machines, 3 test days each.
 # Usage: scripts/grey_acceptance.sh [--weeks "1 2 4 8"] [--seeds 5] [--first-seed 1]
 #                                   [--threads 2] [--scenarios production,duty-changes,...]
-#                                   [--out-dir DIR]
+#                                   [--out-dir DIR] [--slope-through-lags-only]
 # Seeds S..S+N-1 with S = --first-seed (default 1) and N = --seeds (1..20): a confirmation run
 # takes seeds no tuning run has used (e.g. --first-seed 101).
 # A week is 5 production days of history (--past-days 5 x weeks; at most 8 weeks = 40 days). Writes DIR/weeks_<w>.md (the evaluation's
@@ -12,7 +12,8 @@
 # thread median, both_shop, both_grey, the gain of both_grey (1 - grey / sensor-free), the seeds
 # in which it left less, and the criterion of issue 41 (30 % and every seed for
 # unconditioned-hall and interrupted-starts after 1 week; for production and duty-changes never
-# worse after 1 week and 30 % after 8).
+# worse after 1 week and 30 % after 8). --slope-through-lags-only: both_grey with its slope sensors
+# through their lags only (whirl machine evaluate's flag; an opt-in candidate, off by default).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -21,6 +22,7 @@ first_seed=1
 threads=2
 scenarios="production,duty-changes,interrupted-starts,unconditioned-hall"
 out_dir=""
+candidate=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --weeks) weeks="$2"; shift 2 ;;
@@ -29,6 +31,7 @@ while [ $# -gt 0 ]; do
     --threads) threads="$2"; shift 2 ;;
     --scenarios) scenarios="$2"; shift 2 ;;
     --out-dir) out_dir="$2"; shift 2 ;;
+    --slope-through-lags-only) candidate=(--slope-through-lags-only); shift ;;
     -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -52,6 +55,7 @@ mkdir -p "$out_dir"
 for w in $weeks; do
   "$whirl" machine evaluate --scenarios "$scenarios" --seed "$first_seed" --seeds "$seeds" --machines 4 \
     --test-days 3 --past-days $((5 * w)) --threads "$threads" --markdown \
+    ${candidate[@]+"${candidate[@]}"} \
     > "$out_dir/weeks_$w.md" 2> "$out_dir/weeks_$w.log"
 done
 python3 - "$out_dir" $weeks <<'PY'
@@ -89,4 +93,4 @@ for w in weeks:
               f"| {rows.get((sc, 'both_grey'), float('nan')):.1f} | {gain:+.1f} % | {won} of {n} "
               f"| {crit} | {holds} |")
 PY
-echo "(simulator only; seeds $first_seed..$((first_seed + seeds - 1)); the evaluations' tables: $out_dir)"
+echo "(simulator only; seeds $first_seed..$((first_seed + seeds - 1))${candidate[@]+; both_grey with ${candidate[*]}}; the evaluations' tables: $out_dir)"

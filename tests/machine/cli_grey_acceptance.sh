@@ -28,6 +28,14 @@ WHIRL_BUILD_DIR="$D/fake" bash "$G" --first-seed 101 --seeds 3 --weeks "1 8" --o
 [ "$(grep -c -- "--seed 101 --seeds 3 " "$D/args.txt")" -eq 2 ] || fail "seeds: $(cat "$D/args.txt")"
 grep -q -- "--past-days 40 " "$D/args.txt" || fail "8 weeks: $(cat "$D/args.txt")"
 grep -q "seeds 101..103" "$D/out.txt" || fail "the seeds are not reported: $(cat "$D/out.txt")"
+grep -q -- "--slope-through-lags-only" "$D/args.txt" "$D/out.txt" && fail "the candidate without asking"
+# --slope-through-lags-only reaches every evaluation and the table says so.
+rm -f "$D/args.txt"
+WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --slope-through-lags-only --out-dir "$D/c" \
+  > "$D/out.txt" 2> "$D/err.txt" || fail "candidate run: $(cat "$D/err.txt")"
+[ "$(grep -c -- "--markdown --slope-through-lags-only" "$D/args.txt")" -eq 2 ] ||
+  fail "the candidate's flag: $(cat "$D/args.txt")"
+grep -q "both_grey with --slope-through-lags-only" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
 expect_fail "past-days" "$W" machine evaluate --past-days 41 --machines 1 --test-days 1
 # scripts/grey_residuals.py on a planted evaluation of two screws (hand-computed figures): slope
 # part |b| x l_u = 2 um/m x 3 m = 6 and 1 x 3 = 3, median 4.5; the hindsight choice min(grey, sf)

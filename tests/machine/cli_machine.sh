@@ -104,4 +104,17 @@ want = ["none", "traditional", "workpiece", "class", "table", "nearest", "warmup
 assert sorted(rows) == sorted(want), rows
 assert s["strategies"]["none"]["screws"] >= 1
 PY
+# --slope-through-lags-only (issue 41's opt-in candidate) reaches both_grey only: every other
+# row of the same run comes out equal.
+grep -q -- "--slope-through-lags-only" "$D/evaluate_help.txt" || fail "--help lacks --slope-through-lags-only"
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --slope-through-lags-only > "$D/field_lags.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --slope-through-lags-only: $(cat "$D/field_err.txt")"
+python3 - "$D/field.json" "$D/field_lags.json" <<'PY' || fail "--slope-through-lags-only moved another row"
+import json, sys
+a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
+assert sorted(a) == sorted(b), (sorted(a), sorted(b))
+for name in a:
+    assert name == "both_grey" or a[name] == b[name], name
+PY
 echo "cli_machine: ok"

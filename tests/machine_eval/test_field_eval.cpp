@@ -68,6 +68,37 @@ TEST(FieldTraining, HiddenTruthOfTheTestWindowChangesNothingTrained) {
 
 // The record holds only instrument readings: probe, laser, lead and set-up check records of days
 // before 0, each row a sample of its own day log, no error channel in any log.
+// The opt-in candidate of issue 41's sixth round (FieldProtocol::grey_slope_lags_only, the CLI's
+// --slope-through-lags-only): both_grey's slope sensors enter through their lags only, so the
+// instant coefficient of each is exactly 0 once a lag is chosen, while the offset keeps its
+// instant columns; by default the instant slope columns carry weight. The other models do not
+// read the option: they come out equal.
+TEST(FieldTraining, SlopeThroughLagsOnlyZeroesTheGreyBoxsInstantSlopeColumnsOnly) {
+  const drift::GreyBoxOptions o = FieldGreyBoxOptions(false, true);
+  EXPECT_FALSE(o.instant_slope_inputs);
+  EXPECT_TRUE(o.instant_offset_inputs);
+  EXPECT_TRUE(FieldGreyBoxOptions().instant_slope_inputs);
+  const machine::MachineWorld w = SmallWorld({});
+  FieldProtocol p;
+  const FieldMachineModels plain = TrainFieldMachine(w.timeline, p, nullptr, 7);
+  p.grey_slope_lags_only = true;
+  const FieldMachineModels lagged = TrainFieldMachine(w.timeline, p, nullptr, 7);
+  EXPECT_EQ(Trained(plain).dump(), Trained(lagged).dump());
+  auto instant = [](const drift::GreyBoxModel& m, const Eigen::VectorXd& c, std::size_t inputs) {
+    double sum = 0;
+    for (std::size_t i = 0; i < inputs; ++i)
+      sum += std::abs(c(static_cast<Eigen::Index>(i * (1 + m.time_constants.size()))));
+    return sum;
+  };
+  const drift::GreyBoxModel& g = lagged.shop.grey;
+  ASSERT_EQ(g.slope_sensors.size(), 2u);
+  ASSERT_FALSE(g.time_constants.empty());
+  EXPECT_EQ(instant(g, g.g, g.slope_sensors.size()), 0.0);
+  EXPECT_GT(instant(g, g.a, g.offset_sensors.size()), 0.0);
+  const drift::GreyBoxModel& d = plain.shop.grey;
+  EXPECT_GT(instant(d, d.g, d.slope_sensors.size()), 0.0);
+}
+
 TEST(FieldTraining, TheRecordHasOnlyReadingsOfHistoryDays) {
   const machine::MachineWorld w = SmallWorld({});
   const drift::ShopRecord r = FieldShopRecord(w.timeline, FieldProtocol{}, nullptr, 5);

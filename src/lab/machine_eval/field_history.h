@@ -49,6 +49,9 @@ struct FieldProtocol {
   /// threshold_um, prior_scale and estimate_drift are read, and bayes in rules switches the
   /// update on (rules without bayes: the row is both_shop).
   drift::MonitorOptions monitor;
+  /// both_grey's slope sensors through their lags only (FieldGreyBoxOptions' `slope_lags_only`):
+  /// an opt-in candidate of issue 41 (docs/machine-evaluation.md, sixth round), off by default.
+  bool grey_slope_lags_only = false;
 };
 
 /// The temperature columns of `log` replaced by their mean over the rows with time in

@@ -15,7 +15,8 @@ std::vector<std::string> ScheduleInputs() {
 }
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
-                         const std::vector<std::string>& schedule_inputs) {
+                         const std::vector<std::string>& schedule_inputs,
+                         bool grey_slope_lags_only) {
   ShopModels m;
   drift::JointFitOptions lagged;
   lagged.require_lag = true;
@@ -67,7 +68,8 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   const std::vector<std::string>& other = record.day_logs.front().other_names;
   for (const std::string& s : grey.DutyInputs())
     placed = placed && std::find(other.begin(), other.end(), s) != other.end();
-  if (placed) m.grey = drift::FitGreyBox(record, grey, FieldGreyBoxOptions(contact));
+  if (placed)
+    m.grey = drift::FitGreyBox(record, grey, FieldGreyBoxOptions(contact, grey_slope_lags_only));
   return m;
 }
 
@@ -86,9 +88,10 @@ drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact) {
   return s;
 }
 
-drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact) {
+drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact, bool slope_lags_only) {
   drift::GreyBoxOptions o;
   o.validation = drift::GreyValidation::kForwardLeads;
+  o.instant_slope_inputs = !slope_lags_only;
   if (blank_contact) o.blank_tau_grid = {kBlankContactTauMin};  // a held reading: no lag
   return o;
 }

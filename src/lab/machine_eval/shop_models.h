@@ -58,11 +58,14 @@ drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact = false)
 /// The grey box's fit options in the field: drift::GreyBoxOptions' grids, its choices by forward
 /// chaining on the leads (GreyValidation::kForwardLeads: the fourth round of issue 41,
 /// docs/machine-evaluation.md); with `blank_contact` the blank's time constant fixed at
-/// kBlankContactTauMin.
-drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false);
-/// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing).
+/// kBlankContactTauMin; with `slope_lags_only` the slope sensors enter through their lags only
+/// (GreyBoxOptions::instant_slope_inputs false; the offset's as read), an opt-in candidate.
+drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false, bool slope_lags_only = false);
+/// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
+/// FieldGreyBoxOptions' `slope_lags_only` for the grey box.
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
-                         const std::vector<std::string>& schedule_inputs = ScheduleInputs());
+                         const std::vector<std::string>& schedule_inputs = ScheduleInputs(),
+                         bool grey_slope_lags_only = false);
 
 /// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
 /// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on
