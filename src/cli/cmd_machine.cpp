@@ -289,8 +289,8 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
   e->add_flag("--markdown", o->markdown, "print the table as Markdown");
   e->add_flag("--slope-through-lags-only", o->slope_through_lags_only,
               "both_grey's slope sensors (ambient, z_nut) through their lags only, the offset's "
-              "as read: an opt-in candidate of issue 41 (docs/machine-evaluation.md, sixth "
-              "round), off by default");
+              "as read: an opt-in variant, off by default, that lost on its tuning seeds "
+              "(docs/machine-evaluation.md, sixth round)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

@@ -50,7 +50,7 @@ struct FieldProtocol {
   /// update on (rules without bayes: the row is both_shop).
   drift::MonitorOptions monitor;
   /// both_grey's slope sensors through their lags only (FieldGreyBoxOptions' `slope_lags_only`):
-  /// an opt-in candidate of issue 41 (docs/machine-evaluation.md, sixth round), off by default.
+  /// an opt-in variant, off by default (docs/machine-evaluation.md, sixth round).
   bool grey_slope_lags_only = false;
 };
 
