@@ -249,8 +249,7 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
                                           {"settle_time_s", d.rms_sd_after[1]}}},
                         {"rms_sd_floor", {{"max_elongation_um", d.rms_sd_floor[0]},
                                           {"settle_time_s", d.rms_sd_floor[1]}}}};
-    if (design::ParseNextModel(o.variance) == design::NextRule::Model::kSwitch)
-    {
+    if (design::ParseNextModel(o.variance) == design::NextRule::Model::kSwitch) {
       j["lack_of_fit_ratio"] = {{"max_elongation_um", d.lack_of_fit_ratio[0]},
                                 {"settle_time_s", d.lack_of_fit_ratio[1]}};
       j["departure"] = {{"max_elongation_um", d.departure[0]}, {"settle_time_s", d.departure[1]}};

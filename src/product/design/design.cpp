@@ -268,7 +268,10 @@ struct OutputState {
                                               : members[m].VarianceAfter(c, measured));
     return scale * s;
   }
-  double Variance(int c) const { return Sd(c) * Sd(c); }
+  double Variance(int c) const {
+    const double sd = Sd(c);
+    return sd * sd;
+  }
   int Size() const { return static_cast<int>(members.front().g.size()); }
   double Rms() const {
     double s = 0;
@@ -290,7 +293,10 @@ struct OutputState {
   double Reduction(int j) const {
     if (members.size() == 1) return scale * scale * members.front().Reduction(j);
     double s = 0;
-    for (int c = 0; c < Size(); ++c) s += Variance(c) - Sd(c, j) * Sd(c, j);
+    for (int c = 0; c < Size(); ++c) {
+      const double after = Sd(c, j);
+      s += Variance(c) - after * after;
+    }
     return s;
   }
   void Measure(int j) {
@@ -1013,7 +1019,7 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
   const Eigen::MatrixXd rows = PowerLawRows(all, &names);
   const Eigen::MatrixXd u = rows.rightCols(rows.cols() - 1);
   double units = 0;
-  std::array<bool, Features::kCount> gp_chosen{}, departure{};
+  std::array<bool, Features::kCount> gp_chosen{};
   for (int k = 0; k < Features::kCount; ++k)
     gp_chosen[k] = ModelOfOutput(model, k).candidate.family == family::Family::kGaussianProcess;
   if (rule.model == NextRule::Model::kSwitch) {
@@ -1022,14 +1028,12 @@ NextDesign DesignNext(const workpiece::WorkpieceModel& model,
       d.lack_of_fit_ratio[k] = fits[k].ratio;
       d.choice_departure[k] = rule.evidence == NextRule::Evidence::kChoice &&
                               !PowerLawAlone(model.choice, k);
-      departure[k] = fits[k].ratio > rule.switch_ratio || d.choice_departure[k];
+      d.departure[k] = fits[k].ratio > rule.switch_ratio || d.choice_departure[k];
     }
-    d.departure = departure;
   }
-  d.space_filling = fill.when == SpaceFilling::When::kDeparture && !departure[0] && !departure[1]
-                        ? 0
-                        : fill.screws;
-  const auto own = OwnVariance(rule, gp_chosen, departure);
+  const bool departs = d.departure[0] || d.departure[1];
+  d.space_filling = fill.when == SpaceFilling::When::kDeparture && !departs ? 0 : fill.screws;
+  const auto own = OwnVariance(rule, gp_chosen, d.departure);
   auto crit = CriterionStates(states, own, u, n, rule, &units);
   std::vector<int> near(fill.measured.size());
   std::iota(near.begin(), near.end(), n);
