@@ -5,6 +5,7 @@
 # Usage: scripts/grey_acceptance.sh [--weeks "1 2 4 8"] [--seeds 5] [--first-seed 1]
 #                                   [--threads 2] [--scenarios production,duty-changes,...]
 #                                   [--out-dir DIR] [--slope-through-lags-only]
+#                                   [--offset-candidates]
 # Seeds S..S+N-1 with S = --first-seed (default 1) and N = --seeds (1..20): a confirmation run
 # takes seeds no tuning run has used (e.g. --first-seed 101).
 # A week is 5 production days of history (--past-days 5 x weeks; at most 8 weeks = 40 days). Writes DIR/weeks_<w>.md (the evaluation's
@@ -14,6 +15,9 @@
 # unconditioned-hall and interrupted-starts after 1 week; for production and duty-changes never
 # worse after 1 week and 30 % after 8). --slope-through-lags-only: both_grey with its slope sensors
 # through their lags only (whirl machine evaluate's flag; an opt-in candidate, off by default).
+# --offset-candidates: the evaluation's opt-in rows too (grey_warmup_k0, grey_mean_k0: both_grey's
+# slope with warmup's offset or the mean of both offsets), judged like both_grey, one table row
+# each beside both_grey's, with the per-seed range of the gain.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -23,6 +27,7 @@ threads=2
 scenarios="production,duty-changes,interrupted-starts,unconditioned-hall"
 out_dir=""
 candidate=()
+rows="both_grey"
 while [ $# -gt 0 ]; do
   case "$1" in
     --weeks) weeks="$2"; shift 2 ;;
@@ -31,8 +36,10 @@ while [ $# -gt 0 ]; do
     --threads) threads="$2"; shift 2 ;;
     --scenarios) scenarios="$2"; shift 2 ;;
     --out-dir) out_dir="$2"; shift 2 ;;
-    --slope-through-lags-only) candidate=(--slope-through-lags-only); shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    --slope-through-lags-only) candidate+=(--slope-through-lags-only); shift ;;
+    --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
+                         shift ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -58,39 +65,59 @@ for w in $weeks; do
     ${candidate[@]+"${candidate[@]}"} \
     > "$out_dir/weeks_$w.md" 2> "$out_dir/weeks_$w.log"
 done
-python3 - "$out_dir" $weeks <<'PY'
+python3 - "$out_dir" "$rows" $weeks <<'PY'
 import re, sys
-out_dir, weeks = sys.argv[1], sys.argv[2:]
-print("| weeks | scenario | strongest sensor-free (thread median um) | both_shop um | both_grey um "
-      "| gain of both_grey | seeds better | criterion | holds |")
-print("|---|---|---|---|---|---|---|---|---|")
+out_dir, judged, weeks = sys.argv[1], sys.argv[2].split(","), sys.argv[3:]
+several = len(judged) > 1
+if several:
+    print("| weeks | scenario | row | strongest sensor-free (thread median um) | both_shop um | row um "
+          "| gain of the row (per seed) | seeds better | criterion | holds |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+else:
+    print("| weeks | scenario | strongest sensor-free (thread median um) | both_shop um | both_grey um "
+          "| gain of both_grey | seeds better | criterion | holds |")
+    print("|---|---|---|---|---|---|---|---|---|")
+def criterion(sc, w, gain, won, n):
+    if sc in ("unconditioned-hall", "interrupted-starts"):
+        return (">= 30 %, every seed (1 week)", gain >= 30 and won == n) if w == "1" else ("-", None)
+    if sc in ("production", "duty-changes"):
+        if w == "1":
+            return "not worse, every seed (1 week)", gain >= 0 and won == n
+        if w == "8":
+            return ">= 30 % (8 weeks)", gain >= 30
+    return "-", None
 for w in weeks:
     text = open(f"{out_dir}/weeks_{w}.md").read()
     rows = {}
-    for m in re.finditer(r"^\| ([a-z-]+) \| ([a-z_]+) \| [^|]+ \| [^|]+ \| ([0-9.]+) \[", text, re.M):
+    for m in re.finditer(r"^\| ([a-z-]+) \| ([a-z0-9_]+) \| [^|]+ \| [^|]+ \| ([0-9.]+) \[", text, re.M):
         rows[(m.group(1), m.group(2))] = float(m.group(3))
     for m in re.finditer(r"^- ([a-z-]+): the strongest sensor-free strategy is ([a-z_]+) "
                          r"\(thread median ([0-9.]+) um", text, re.M):
         sc, best, med = m.group(1), m.group(2), float(m.group(3))
-        v = re.search(rf"^- {sc}: both_grey \(sensors\) (?:beats|does NOT beat) the strongest "
-                      r"sensor-free strategy [a-z_]+ over the thread (?:by )?\(?([-+0-9.]+) %"
-                      r"(?:;)? ?\(?better in (\d+) of (\d+) seeds\)", text, re.M)
-        gain, won, n = float(v.group(1)), int(v.group(2)), int(v.group(3))
-        if sc in ("unconditioned-hall", "interrupted-starts"):
-            crit = ">= 30 %, every seed (1 week)" if w == "1" else "-"
-            ok = (gain >= 30 and won == n) if w == "1" else None
-        elif sc in ("production", "duty-changes"):
-            if w == "1":
-                crit, ok = "not worse, every seed (1 week)", gain >= 0 and won == n
-            elif w == "8":
-                crit, ok = ">= 30 % (8 weeks)", gain >= 30
-            else:
-                crit, ok = "-", None
-        else:
-            crit, ok = "-", None
-        holds = "-" if ok is None else ("yes" if ok else "NO")
-        print(f"| {w} | {sc} | {best} {med:.1f} | {rows.get((sc, 'both_shop'), float('nan')):.1f} "
-              f"| {rows.get((sc, 'both_grey'), float('nan')):.1f} | {gain:+.1f} % | {won} of {n} "
-              f"| {crit} | {holds} |")
+        for row in judged:
+            v = re.search(rf"^- {sc}: {row} \(sensors\) (?:beats|does NOT beat) the strongest "
+                          r"sensor-free strategy [a-z_]+ over the thread (?:by )?\(?([-+0-9.]+) %"
+                          r"(?:;)? ?\(?better in (\d+) of (\d+) seeds\)", text, re.M)
+            gain, won, n = float(v.group(1)), int(v.group(2)), int(v.group(3))
+            crit, ok = criterion(sc, w, gain, won, n)
+            holds = "-" if ok is None else ("yes" if ok else "NO")
+            shop = rows.get((sc, 'both_shop'), float('nan'))
+            value = rows.get((sc, row), float('nan'))
+            if not several:
+                print(f"| {w} | {sc} | {best} {med:.1f} | {shop:.1f} | {value:.1f} | {gain:+.1f} % "
+                      f"| {won} of {n} | {crit} | {holds} |")
+                continue
+            p = re.search(rf"^- {row} vs [a-z_]+ over the thread: [-+0-9.]+ % \(per seed "
+                          r"([-+0-9.]+) \.\. ([-+0-9.]+) %", text, re.M)
+            spread = f" ({p.group(1)} .. {p.group(2)})" if p else ""
+            print(f"| {w} | {sc} | {row} | {best} {med:.1f} | {shop:.1f} | {value:.1f} "
+                  f"| {gain:+.1f} %{spread} | {won} of {n} | {crit} | {holds} |")
 PY
-echo "(simulator only; seeds $first_seed..$((first_seed + seeds - 1))${candidate[@]+; both_grey with ${candidate[*]}}; the evaluations' tables: $out_dir)"
+note=""
+for c in ${candidate[@]+"${candidate[@]}"}; do
+  case "$c" in
+    --slope-through-lags-only) note+="; both_grey with $c" ;;
+    --offset-candidates) note+="; the opt-in rows of $c" ;;
+  esac
+done
+echo "(simulator only; seeds $first_seed..$((first_seed + seeds - 1))$note; the evaluations' tables: $out_dir)"

@@ -50,7 +50,7 @@ struct MachineCliOptions {
   std::string scenarios = "production";
   int test_days = 2, past_days = 5;
   double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
-  bool no_setup_checks = false, slope_through_lags_only = false;
+  bool no_setup_checks = false, slope_through_lags_only = false, offset_candidates = false;
   FieldWorldFlags world;  ///< the world's optional parts (cmd_machine_world.h)
   std::vector<std::pair<std::string, CLI::Option*>> retired;  ///< legacy-world flags, hidden
 };
@@ -79,6 +79,7 @@ machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
   f.protocol.lead_sample_min = o.lead_sample_min;
   f.protocol.setup_checks = !o.no_setup_checks;
   f.protocol.grey_slope_lags_only = o.slope_through_lags_only;
+  f.protocol.offset_candidates = o.offset_candidates;
   return f;
 }
 
@@ -291,6 +292,10 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "both_grey's slope sensors (ambient, z_nut) through their lags only, the offset's "
               "as read: an opt-in variant, off by default, that lost on its tuning seeds "
               "(docs/machine-evaluation.md, sixth round)");
+  e->add_flag("--offset-candidates", o->offset_candidates,
+              "two more rows after the table's, computed in the same run: both_grey's slope with "
+              "warmup's offset K0 (grey_warmup_k0) and with the mean of both offsets "
+              "(grey_mean_k0); opt-in, off by default (docs/machine-evaluation.md, seventh round)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

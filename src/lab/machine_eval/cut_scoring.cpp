@@ -1,5 +1,7 @@
 #include "machine_eval/cut_scoring.h"
 
+#include <utility>
+
 #include "core/error.h"
 #include "lead/lead.h"
 
@@ -42,22 +44,28 @@ compare::CompensationFunction Sum(compare::CompensationFunction a,
   return [a, b](double t) { return a(t) + b(t); };
 }
 
+void ScoreOne(const ElongationCurve& truth, const compare::CompensationFunction& compensation,
+              double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
+              const lead::IsoToleranceTable& iso_table, lead::LeadMetrics* metrics,
+              lead::IsoClass* iso, lead::LeadDeviation* lead) {
+  lead::LeadMetricOptions mo = options.metrics;
+  mo.lead_mm = screw.process.pitch_mm;
+  lead::LeadDeviation l = compare::CutLeadDeviation(
+      truth, compensation, feed_mm_s, screw.thread_length_mm, screw.process.pitch_mm, options.cut);
+  *metrics = lead::ComputeLeadMetrics(l, mo);
+  *iso = lead::EvaluateIsoClass(*metrics, iso_table).reached;
+  if (lead) *lead = std::move(l);
+}
+
 void ScoreStrategies(
     const ElongationCurve& truth,
     const std::array<compare::CompensationFunction, kMachineStrategyCount>& compensations,
     double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
     const lead::IsoToleranceTable& iso_table, MachineEvalScrew* out,
     std::array<lead::LeadDeviation, kMachineStrategyCount>* leads) {
-  lead::LeadMetricOptions mo = options.metrics;
-  mo.lead_mm = screw.process.pitch_mm;
-  for (std::size_t k = 0; k < kMachineStrategyCount; ++k) {
-    const lead::LeadDeviation lead =
-        compare::CutLeadDeviation(truth, compensations[k], feed_mm_s, screw.thread_length_mm,
-                                  screw.process.pitch_mm, options.cut);
-    out->metrics[k] = lead::ComputeLeadMetrics(lead, mo);
-    if (leads) (*leads)[k] = lead;
-    out->iso[k] = lead::EvaluateIsoClass(out->metrics[k], iso_table).reached;
-  }
+  for (std::size_t k = 0; k < kMachineStrategyCount; ++k)
+    ScoreOne(truth, compensations[k], feed_mm_s, screw, options, iso_table, &out->metrics[k],
+             &out->iso[k], leads ? &(*leads)[k] : nullptr);
 }
 
 }  // namespace whirl::machine_eval::detail

@@ -27,6 +27,12 @@ compare::CompensationFunction Planned(const interp::CompensationPlan& plan, doub
 
 compare::CompensationFunction Sum(compare::CompensationFunction a, compare::CompensationFunction b);
 
+/// Metrics and ISO class of one compensation on the truth; `lead` (optional) keeps the lead.
+void ScoreOne(const ElongationCurve& truth, const compare::CompensationFunction& compensation,
+              double feed_mm_s, const screw::Screw& screw, const compare::CompareOptions& options,
+              const lead::IsoToleranceTable& iso_table, lead::LeadMetrics* metrics,
+              lead::IsoClass* iso, lead::LeadDeviation* lead = nullptr);
+
 /// Metrics and ISO class of every strategy on the truth; `leads` (optional) keeps the leads.
 void ScoreStrategies(
     const ElongationCurve& truth,

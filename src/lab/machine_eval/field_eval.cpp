@@ -111,9 +111,11 @@ ElongationCurve Add(ElongationCurve a, const ElongationCurve& b) {
 }
 
 // The shop models held sample by sample over the day's control log: sensors, warmup, schedule,
-// and the sensor model kept valid by the day's set-up checks.
+// the sensor model kept valid by the day's set-up checks, the grey box, and the opt-in rows
+// (OffsetCandidate order; empty unless asked for).
 struct DayHeld {
   HeldSamples sensors, warmup, schedule, monitored, grey;
+  std::vector<HeldSamples> candidates;
 };
 
 // ReportScrew::sd_um of a cut: each strategy's compensation sd from its training data only.
@@ -204,6 +206,12 @@ MachineEvalScrew EvaluateFieldCut(const MachineTimeline& tl, const CutRef& cut, 
   };
   detail::ScoreStrategies(truth, comp, feed, job.screw, wp.options, wp.iso, &out,
                           report ? &report->leads : nullptr);
+  const std::size_t n = held.candidates.size();
+  out.candidate_metrics.resize(n);
+  out.candidate_iso.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    detail::ScoreOne(truth, Sum(workpiece, line(held.candidates[i])), feed, job.screw, wp.options,
+                     wp.iso, &out.candidate_metrics[i], &out.candidate_iso[i]);
   if (report) {
     report->sd_um = StrategySd(c, models, wp.rule, job.screw.thread_length_mm);
     report->predicted_curve = c.predicted_curve;
@@ -266,7 +274,11 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
                     RunCausally(models.shop.warmup, log),
                     RunCausally(models.shop.schedule, log),
                     {},
-                    RunCausally(models.shop.grey, log)};
+                    RunCausally(models.shop.grey, log),
+                    {}};
+    for (std::size_t c = 0; protocol.offset_candidates && c < kOffsetCandidateCount; ++c)
+      held.candidates.push_back(WithOffsetOf(
+          held.grey, held.warmup, WarmupOffsetShare(static_cast<OffsetCandidate>(c))));
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));

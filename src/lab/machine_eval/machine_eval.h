@@ -115,6 +115,16 @@ std::string ToString(MachineStrategy s);
 /// both_shop_monitor, both_grey); the others are sensor-free.
 bool UsesSensors(MachineStrategy s);
 
+/// Opt-in rows (issue 41, seventh round; FieldProtocol::offset_candidates), after the table's
+/// rows: the workpiece plan + both_grey's slope (with its latched blank term) and another offset
+/// K0(t): `warmup`'s (grey_warmup_k0) or the mean of warmup's and the grey box's
+/// (grey_mean_k0). Both use sensors (the slope); never the strongest sensor-free row.
+enum class OffsetCandidate { kGreyWarmupOffset, kGreyMeanOffset };
+inline constexpr std::size_t kOffsetCandidateCount = 2;
+std::string ToString(OffsetCandidate c);  ///< grey_warmup_k0, grey_mean_k0
+/// warmup's share of the candidate's K0 (1 and 0.5; the grey box's share is 1 minus it).
+double WarmupOffsetShare(OffsetCandidate c);
+
 /// Sources of the uncompensated lead error (accumulated over the thread, um, each alone).
 enum class ErrorSource { kWorkpiece, kHead, kZAxis };
 inline constexpr std::size_t kErrorSourceCount = 3;
@@ -135,6 +145,9 @@ struct MachineEvalScrew {
   std::array<double, kErrorSourceCount> source_total_um{};
   /// both_shop: accumulated error over the thread of the workpiece and machine residuals, um.
   double residual_workpiece_total_um = 0, residual_machine_total_um = 0;
+  /// The opt-in rows (OffsetCandidate order); empty unless asked for.
+  std::vector<lead::LeadMetrics> candidate_metrics;
+  std::vector<lead::IsoClass> candidate_iso;
 };
 
 struct MachineEvalSummary {

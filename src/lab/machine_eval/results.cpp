@@ -29,6 +29,14 @@ bool UsesSensors(MachineStrategy s) {
          s == MachineStrategy::kBothShopMonitor || s == MachineStrategy::kBothGrey;
 }
 
+std::string ToString(OffsetCandidate c) {
+  return c == OffsetCandidate::kGreyWarmupOffset ? "grey_warmup_k0" : "grey_mean_k0";
+}
+
+double WarmupOffsetShare(OffsetCandidate c) {
+  return c == OffsetCandidate::kGreyWarmupOffset ? 1.0 : 0.5;
+}
+
 std::string ToString(ErrorSource s) {
   static const char* kNames[] = {"workpiece", "head", "z_axis"};
   return kNames[static_cast<int>(s)];
@@ -94,6 +102,9 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
         x["strategies"][ToString(st)] = {{"metrics", r.metrics[k]},
                                          {"iso_class", ToString(r.iso[k])}};
       }
+      for (std::size_t c = 0; c < r.candidate_metrics.size(); ++c)
+        x["strategies"][ToString(static_cast<OffsetCandidate>(c))] = {
+            {"metrics", r.candidate_metrics[c]}, {"iso_class", ToString(r.candidate_iso[c])}};
       x["day"] = r.day;
       x["start_type"] = r.start_type;
       x["residual_workpiece_total_um"] = r.residual_workpiece_total_um;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/error.h"
+
 namespace whirl::machine_eval {
 
 std::size_t HeldSamples::IndexAt(double t_min) const {
@@ -36,6 +38,18 @@ HeldSamples RunCausally(const drift::GreyBoxModel& model, const drift::Run& log)
     h.blank_slope_um_per_1000.push_back(ev.BlankSlope(o.blank_c));
   }
   return h;
+}
+
+HeldSamples WithOffsetOf(HeldSamples slope_model, const HeldSamples& offset_model, double share) {
+  if (slope_model.time_min != offset_model.time_min)
+    throw InputError("WithOffsetOf: the two models were not stepped through the same log (" +
+                     std::to_string(slope_model.time_min.size()) + " and " +
+                     std::to_string(offset_model.time_min.size()) + " samples)");
+  for (std::size_t k = 0; k < slope_model.k0_um.size(); ++k)
+    slope_model.k0_um[k] = share == 1.0 ? offset_model.k0_um[k]
+                                        : (1.0 - share) * slope_model.k0_um[k] +
+                                              share * offset_model.k0_um[k];
+  return slope_model;
 }
 
 compare::CompensationFunction CausalMachineLine(HeldSamples samples, double cut_start_min,

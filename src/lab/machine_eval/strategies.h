@@ -32,6 +32,11 @@ HeldSamples RunCausally(const drift::JointDriftModel& model, const drift::Run& l
 /// start by CausalMachineLine).
 HeldSamples RunCausally(const drift::GreyBoxModel& model, const drift::Run& log);
 
+/// `slope_model`'s samples (slope and blank term) with the offset K0 = (1 - share) x its own +
+/// share x `offset_model`'s, sample by sample (share 1: offset_model's K0 exactly). Both must be
+/// stepped through the same log (InputError when their sample times differ).
+HeldSamples WithOffsetOf(HeldSamples slope_model, const HeldSamples& offset_model, double share);
+
 /// c_m(t_s), t_s from the cut start, which is at log time `cut_start_min`; z_of_t(t_s) the tool
 /// position [mm]; a blank term (grey box) is latched at the cut start's sample and added to the
 /// slope for the whole cut. The samples are kept by the function.

@@ -26,6 +26,29 @@ bool ReachesP(lead::IsoClass c, int p) {
   return c == IsoClass::kP1 || c == IsoClass::kP3 || (p == 5 && c == IsoClass::kP5);
 }
 
+// Row k of a screw: the table's strategies, then the opt-in rows (OffsetCandidate order).
+const lead::LeadMetrics& MetricsOf(const MachineEvalScrew& r, std::size_t k) {
+  return k < kMachineStrategyCount ? r.metrics[k] : r.candidate_metrics[k - kMachineStrategyCount];
+}
+lead::IsoClass IsoOf(const MachineEvalScrew& r, std::size_t k) {
+  return k < kMachineStrategyCount ? r.iso[k] : r.candidate_iso[k - kMachineStrategyCount];
+}
+
+// The row's name (k as in MetricsOf).
+std::string RowName(std::size_t k) {
+  return k < kMachineStrategyCount
+             ? ToString(static_cast<MachineStrategy>(k))
+             : ToString(static_cast<OffsetCandidate>(k - kMachineStrategyCount));
+}
+
+// The opt-in rows the evaluation holds (those of its first screw evaluated without error).
+std::size_t CandidateRows(const SeedsEvaluation& e) {
+  for (const MachineEvaluation& run : e.runs)
+    for (const MachineEvalScrew& r : run.screws)
+      if (r.ok) return r.candidate_metrics.size();
+  return 0;
+}
+
 SeedStats StatsOf(const SeedsEvaluation& e, std::size_t k) {
   SeedStats s;
   std::vector<double> acc, tot, ea, seed_acc, seed_tot;
@@ -34,11 +57,12 @@ SeedStats StatsOf(const SeedsEvaluation& e, std::size_t k) {
     std::vector<double> a, t;
     for (const MachineEvalScrew& r : run.screws) {
       if (!r.ok) continue;
-      a.push_back(std::abs(r.metrics[k].accumulated_1000_um));
-      t.push_back(std::abs(r.metrics[k].accumulated_total_um));
-      ea.push_back(std::abs(r.metrics[k].e_a_um - e.travel_c_um));
-      p3 += ReachesP(r.iso[k], 3);
-      p5 += ReachesP(r.iso[k], 5);
+      const lead::LeadMetrics& m = MetricsOf(r, k);
+      a.push_back(std::abs(m.accumulated_1000_um));
+      t.push_back(std::abs(m.accumulated_total_um));
+      ea.push_back(std::abs(m.e_a_um - e.travel_c_um));
+      p3 += ReachesP(IsoOf(r, k), 3);
+      p5 += ReachesP(IsoOf(r, k), 5);
     }
     seed_acc.push_back(Median(a));
     seed_tot.push_back(Median(t));
@@ -60,11 +84,11 @@ SeedStats StatsOf(const SeedsEvaluation& e, std::size_t k) {
   return s;
 }
 
-// Median over the screws of one seed's run of the thread error of strategy k.
+// Median over the screws of one seed's run of the thread error of row k.
 double SeedMedian(const MachineEvaluation& run, std::size_t k) {
   std::vector<double> t;
   for (const auto& r : run.screws)
-    if (r.ok) t.push_back(std::abs(r.metrics[k].accumulated_total_um));
+    if (r.ok) t.push_back(std::abs(MetricsOf(r, k).accumulated_total_um));
   return Median(t);
 }
 
@@ -115,6 +139,7 @@ struct Gain {
   }
 };
 
+// Row k (as in MetricsOf) against the table's row ref.
 Gain GainOver(const SeedsEvaluation& e, const std::array<SeedStats, kMachineStrategyCount>& s,
               std::size_t k, std::size_t ref) {
   Gain g;
@@ -122,26 +147,26 @@ Gain GainOver(const SeedsEvaluation& e, const std::array<SeedStats, kMachineStra
     const double r = SeedMedian(run, ref);
     if (r > 1e-9) g.per_seed.push_back(100.0 * (1.0 - SeedMedian(run, k) / r));
   }
-  if (s[ref].total_median_um > 1e-9)
-    g.pooled = 100.0 * (1.0 - s[k].total_median_um / s[ref].total_median_um);
+  const double x = k < kMachineStrategyCount ? s[k].total_median_um : StatsOf(e, k).total_median_um;
+  if (s[ref].total_median_um > 1e-9) g.pooled = 100.0 * (1.0 - x / s[ref].total_median_um);
   return g;
 }
 
 // The verdict of a "both" row (both_shop, both_shop_monitor or both_grey) against a reference row.
-std::string Verdict(const SeedsEvaluation& e, MachineStrategy x, const Gain& g, MachineStrategy ref,
+std::string Verdict(const SeedsEvaluation& e, std::size_t x, const Gain& g, MachineStrategy ref,
                     const char* what) {
   char buf[400];
   if (g.pooled > 0)
     std::snprintf(buf, sizeof buf,
                   "%s: %s (sensors) beats %s %s over the thread by %.1f %% (better in %d of %zu "
                   "seeds)",
-                  e.scenario.c_str(), ToString(x).c_str(), what, ToString(ref).c_str(), g.pooled,
+                  e.scenario.c_str(), RowName(x).c_str(), what, ToString(ref).c_str(), g.pooled,
                   g.seeds_won(), g.per_seed.size());
   else
     std::snprintf(buf, sizeof buf,
                   "%s: %s (sensors) does NOT beat %s %s over the thread (%+.1f %%; better in %d "
                   "of %zu seeds)",
-                  e.scenario.c_str(), ToString(x).c_str(), what, ToString(ref).c_str(), g.pooled,
+                  e.scenario.c_str(), RowName(x).c_str(), what, ToString(ref).c_str(), g.pooled,
                   g.seeds_won(), g.per_seed.size());
   return buf;
 }
@@ -160,14 +185,18 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
                 e.scenario.c_str(), ToString(best).c_str(), s[b].total_median_um,
                 s[b].acc1000_median_um, s[b].screws, e.seeds.size());
   out.push_back(buf);
+  std::vector<std::size_t> rows;
   for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor,
-                            MachineStrategy::kBothGrey}) {
-    const Gain g = GainOver(e, s, static_cast<std::size_t>(x), b);
+                            MachineStrategy::kBothGrey})
+    rows.push_back(static_cast<std::size_t>(x));
+  for (std::size_t c = 0; c < CandidateRows(e); ++c) rows.push_back(kMachineStrategyCount + c);
+  for (std::size_t k : rows) {
+    const Gain g = GainOver(e, s, k, b);
     std::snprintf(buf, sizeof buf,
                   "%s vs %s over the thread: %+.1f %% (per seed %+.1f .. %+.1f %%; positive = "
                   "%s leaves less)",
-                  ToString(x).c_str(), ToString(best).c_str(), g.pooled, Min(g.per_seed),
-                  Max(g.per_seed), ToString(x).c_str());
+                  RowName(k).c_str(), ToString(best).c_str(), g.pooled, Min(g.per_seed),
+                  Max(g.per_seed), RowName(k).c_str());
     out.push_back(buf);
   }
   const MachineStrategy rule =
@@ -175,12 +204,10 @@ std::vector<std::string> MachineHeadlines(const SeedsEvaluation& e) {
               s[static_cast<std::size_t>(MachineStrategy::kWarmup)].total_median_um
           ? MachineStrategy::kSchedule
           : MachineStrategy::kWarmup;
-  for (MachineStrategy x : {MachineStrategy::kBothShop, MachineStrategy::kBothShopMonitor,
-                            MachineStrategy::kBothGrey}) {
-    const auto k = static_cast<std::size_t>(x);
-    out.push_back(Verdict(e, x, GainOver(e, s, k, b), best, "the strongest sensor-free strategy"));
+  for (std::size_t k : rows) {
+    out.push_back(Verdict(e, k, GainOver(e, s, k, b), best, "the strongest sensor-free strategy"));
     if (rule != best)
-      out.push_back(Verdict(e, x, GainOver(e, s, k, static_cast<std::size_t>(rule)), rule,
+      out.push_back(Verdict(e, k, GainOver(e, s, k, static_cast<std::size_t>(rule)), rule,
                             "the better sensor-free machine rule"));
   }
   return out;
@@ -241,14 +268,14 @@ std::string TableRows(const SeedsEvaluation& e, bool markdown) {
   const auto s = SummarizeOverSeeds(e);
   std::string out;
   char buf[400];
-  for (MachineStrategy st : MachineStrategies()) {
-    const SeedStats& x = s[static_cast<std::size_t>(st)];
+  for (std::size_t k = 0; k < kMachineStrategyCount + CandidateRows(e); ++k) {
+    const SeedStats x = k < kMachineStrategyCount ? s[k] : StatsOf(e, k);
     const char* fmt = markdown
                           ? "| %s | %s | %.1f [%.1f-%.1f] | %.1f | %.1f [%.1f-%.1f] | %.1f | %.1f "
                             "| %.2f / %.2f |\n"
                           : "%-19s %-17s %6.1f [%5.1f-%5.1f] %6.1f %7.1f [%5.1f-%5.1f] %6.1f "
                             "%6.1f  %.2f/%.2f\n";
-    std::snprintf(buf, sizeof buf, fmt, e.scenario.c_str(), ToString(st).c_str(),
+    std::snprintf(buf, sizeof buf, fmt, e.scenario.c_str(), RowName(k).c_str(),
                   x.acc1000_median_um, x.acc1000_seed_min_um, x.acc1000_seed_max_um,
                   x.acc1000_worst_um, x.total_median_um, x.total_seed_min_um, x.total_seed_max_um,
                   x.total_worst_um, x.e_a_minus_c_median_um, x.share_p3, x.share_p5);
@@ -284,13 +311,13 @@ std::string FormatScenarioTables(const std::vector<SeedsEvaluation>& e, bool mar
 void to_json(nlohmann::json& j, const SeedsEvaluation& e) {
   const auto s = SummarizeOverSeeds(e);
   nlohmann::json strategies = nlohmann::json::object();
-  for (MachineStrategy st : MachineStrategies()) {
-    const auto k = static_cast<std::size_t>(st);
-    const SeedStats& x = s[k];
+  for (std::size_t k = 0; k < kMachineStrategyCount + CandidateRows(e); ++k) {
+    const SeedStats x = k < kMachineStrategyCount ? s[k] : StatsOf(e, k);
     std::vector<double> per_seed;
     for (const auto& run : e.runs) per_seed.push_back(SeedMedian(run, k));
-    strategies[ToString(static_cast<MachineStrategy>(k))] = {
-        {"uses_sensors", UsesSensors(static_cast<MachineStrategy>(k))},
+    strategies[RowName(k)] = {
+        {"uses_sensors",
+         k >= kMachineStrategyCount || UsesSensors(static_cast<MachineStrategy>(k))},
         {"accumulated_1000_median_um", x.acc1000_median_um},
         {"accumulated_1000_worst_um", x.acc1000_worst_um},
         {"accumulated_1000_seed_median_range_um", {x.acc1000_seed_min_um, x.acc1000_seed_max_um}},

@@ -6,7 +6,8 @@
 // c) and the P3/P5 shares beside. Headlines name the strongest sensor-free strategy (the smallest
 // pooled thread median among every row whose machine half uses no temperature sensor, `none`
 // excluded; chosen on the test screws themselves, which can only flatter it) and the gain of the
-// sensor strategies over it.
+// sensor strategies over it. An evaluation whose screws hold the opt-in rows (machine_eval.h
+// OffsetCandidate) gives them after the table's rows, in the tables, the headlines and the JSON.
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
