@@ -36,6 +36,14 @@ WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --slope-through-lags-only --ou
 [ "$(grep -c -- "--markdown --slope-through-lags-only" "$D/args.txt")" -eq 2 ] ||
   fail "the candidate's flag: $(cat "$D/args.txt")"
 grep -q "both_grey with --slope-through-lags-only" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
+# --offset-candidates reaches every evaluation and the table says so.
+rm -f "$D/args.txt"
+WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --offset-candidates --out-dir "$D/k" \
+  > "$D/out.txt" 2> "$D/err.txt" || fail "offset candidates run: $(cat "$D/err.txt")"
+[ "$(grep -c -- "--markdown --offset-candidates" "$D/args.txt")" -eq 2 ] ||
+  fail "the rows' flag: $(cat "$D/args.txt")"
+grep -q "the opt-in rows of --offset-candidates" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
+grep -q "| weeks | scenario | row |" "$D/out.txt" || fail "no row column: $(cat "$D/out.txt")"
 expect_fail "past-days" "$W" machine evaluate --past-days 41 --machines 1 --test-days 1
 # scripts/grey_residuals.py on a planted evaluation of two screws (hand-computed figures): slope
 # part |b| x l_u = 2 um/m x 3 m = 6 and 1 x 3 = 3, median 4.5; the hindsight choice min(grey, sf)

@@ -117,4 +117,19 @@ assert sorted(a) == sorted(b), (sorted(a), sorted(b))
 for name in a:
     assert name == "both_grey" or a[name] == b[name], name
 PY
+# --offset-candidates (issue 41's seventh round) adds the two opt-in rows, sensor rows, after
+# the table's, in the same run: every other row comes out equal.
+grep -q -- "--offset-candidates" "$D/evaluate_help.txt" || fail "--help lacks --offset-candidates"
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --offset-candidates > "$D/field_k0.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --offset-candidates: $(cat "$D/field_err.txt")"
+python3 - "$D/field.json" "$D/field_k0.json" <<'PY' || fail "--offset-candidates: rows wrong"
+import json, sys
+a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
+assert sorted(b) == sorted(list(a) + ["grey_warmup_k0", "grey_mean_k0"]), sorted(b)
+for name in a:
+    assert a[name] == b[name], name
+for name in ("grey_warmup_k0", "grey_mean_k0"):
+    assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
+PY
 echo "cli_machine: ok"

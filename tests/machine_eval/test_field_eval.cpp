@@ -356,6 +356,43 @@ SeedsEvaluation Planted(const std::vector<double>& per_strategy, double both_sho
   return e;
 }
 
+// The opt-in rows (OffsetCandidate) come after the table's rows, once each, with a gain line and
+// a verdict each after the three "both" rows' (hand-computed: 12 and 8 against schedule's 20 in
+// every seed, +40 and +60 %); an evaluation without them has none.
+TEST(FieldSeedsSummary, OffsetCandidateRowsFollowTheTableWhenPresent) {
+  const std::vector<double> v = {60, 40, 30, 45, 42, 41, 25, 20, 28, 18, 15, 12, 10};
+  SeedsEvaluation e = Planted(v, 1.0);
+  EXPECT_EQ(FormatSeedsTable(e, true).find("grey_"), std::string::npos);
+  for (std::size_t s = 0; s < e.runs.size(); ++s)
+    for (MachineEvalScrew& r : e.runs[s].screws) {
+      r.candidate_metrics.resize(kOffsetCandidateCount);
+      r.candidate_iso.resize(kOffsetCandidateCount);
+      r.candidate_metrics[0].accumulated_total_um = 12 * (1 + 0.1 * static_cast<double>(s));
+      r.candidate_metrics[1].accumulated_total_um = 8 * (1 + 0.1 * static_cast<double>(s));
+    }
+  const auto h = MachineHeadlines(e);
+  ASSERT_EQ(h.size(), 11u);
+  EXPECT_NE(h[4].find("grey_warmup_k0 vs schedule over the thread: +40.0 % (per seed +40.0 .. "
+                      "+40.0"),
+            std::string::npos)
+      << h[4];
+  EXPECT_NE(h[5].find("grey_mean_k0 vs schedule over the thread: +60.0 %"), std::string::npos)
+      << h[5];
+  EXPECT_NE(h[9].find("grey_warmup_k0 (sensors) beats the strongest sensor-free strategy schedule "
+                      "over the thread by 40.0 % (better in 3 of 3 seeds)"),
+            std::string::npos)
+      << h[9];
+  const std::string table = FormatSeedsTable(e, true);
+  const std::size_t grey = table.find("| planted | both_grey |");
+  const std::size_t hybrid = table.find("| planted | grey_warmup_k0 | 0.0 [0.0-0.0] | 0.0 | 13.2 "
+                                        "[12.0-14.4] | 14.4 |");
+  const std::size_t mean = table.find("| planted | grey_mean_k0 |");
+  ASSERT_NE(hybrid, std::string::npos) << table;
+  EXPECT_LT(grey, hybrid);
+  EXPECT_LT(hybrid, mean);
+  EXPECT_NE(mean, std::string::npos);
+}
+
 // T: headlines name the smallest thread median among the sensor-free rows of the table (a
 // sensor row never), give the gain of both_shop with its per-seed range, and say plainly whether
 // the sensors beat it.

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "core/error.h"
 #include "core/random.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/shop_models.h"
@@ -140,6 +141,28 @@ TEST(CausalApplication, TheValueBeforeSampleIPlusOneIgnoresLaterSamples) {
     }
     EXPECT_NE(c(t_next_s), d(t_next_s)) << "the change shows from sample i + 1 on";
   }
+}
+
+// The seventh round's rows (WithOffsetOf): with warmup's share 1 the held offset is warmup's
+// exactly while the slope and the blank term stay the grey box's; share 0.5 gives the midpoint.
+// On the line, hand-computed: at z = z_ref only K0 acts; 60 mm from it the grey box's slope and
+// its blank term latched at the cut start. Models stepped through different logs are refused.
+TEST(CausalApplication, WithOffsetOfTakesTheOffsetAndKeepsTheSlope) {
+  const HeldSamples grey{{0, 1, 2}, {5, 6, 7}, {10, 11, 12}, {0.5, 0.6, 0.7}};
+  const HeldSamples warm{{0, 1, 2}, {-1, 2.5, 3}, {99, 98, 97}, {}};
+  const HeldSamples h = WithOffsetOf(grey, warm, 1.0);
+  EXPECT_EQ(h.k0_um, warm.k0_um);
+  EXPECT_EQ(h.slope_um_per_1000, grey.slope_um_per_1000);
+  EXPECT_EQ(h.blank_slope_um_per_1000, grey.blank_slope_um_per_1000);
+  EXPECT_EQ(WithOffsetOf(grey, warm, 0.5).k0_um, (std::vector<double>{2, 4.25, 5}));
+  // Cut start at 0.5 min (sample 0: blank term 0.5 latched), z(t) = 6400 - 1 mm/s x t.
+  const compare::CompensationFunction c =
+      CausalMachineLine(h, 0.5, 6400, [](double t_s) { return 6400 - t_s; });
+  EXPECT_DOUBLE_EQ(c(0), -1.0);                         // warmup's K0 of sample 0
+  EXPECT_DOUBLE_EQ(c(60), 2.5 + (11 + 0.5) * 60 / 1000.0);  // sample 1: 3.19 um
+  HeldSamples other = warm;
+  other.time_min[2] = 3;
+  EXPECT_THROW(WithOffsetOf(grey, other, 1.0), InputError);
 }
 
 // The headline names the sensor-free row with the smallest pooled thread median (none excluded,
