@@ -107,8 +107,9 @@ for w in weeks:
                 print(f"| {w} | {sc} | {best} {med:.1f} | {shop:.1f} | {value:.1f} | {gain:+.1f} % "
                       f"| {won} of {n} | {crit} | {holds} |")
                 continue
-            p = re.search(rf"^- {row} vs [a-z_]+ over the thread: [-+0-9.]+ % \(per seed "
-                          r"([-+0-9.]+) \.\. ([-+0-9.]+) %", text, re.M)
+            # the gain lines name no scenario: the first after this scenario's headline is its own
+            p = re.compile(rf"^- {row} vs [a-z_]+ over the thread: [-+0-9.]+ % \(per seed "
+                           r"([-+0-9.]+) \.\. ([-+0-9.]+) %", re.M).search(text, m.end())
             spread = f" ({p.group(1)} .. {p.group(2)})" if p else ""
             print(f"| {w} | {sc} | {row} | {best} {med:.1f} | {shop:.1f} | {value:.1f} "
                   f"| {gain:+.1f} %{spread} | {won} of {n} | {crit} | {holds} |")

@@ -44,6 +44,30 @@ WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --offset-candidates --out-dir 
   fail "the rows' flag: $(cat "$D/args.txt")"
 grep -q "the opt-in rows of --offset-candidates" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
 grep -q "| weeks | scenario | row |" "$D/out.txt" || fail "no row column: $(cat "$D/out.txt")"
+# Each scenario's row gets its own per-seed range (the gain lines name no scenario): a stand-in
+# prints two planted scenario blocks whose ranges differ.
+python3 - "$D/planted.md" <<'PY'
+import sys
+rows = ("both_grey", "grey_warmup_k0", "grey_mean_k0")
+out = []
+for sc, lo in (("production", 1), ("duty-changes", 5)):
+    out += [f"| {sc} | {r} | 1.0 [1.0-1.0] | 1.0 | {8 + i}.0 [7.0-9.0] | 9 | 1 | 1 / 1 |"
+            for i, r in enumerate(rows)]
+for sc, lo in (("production", 1), ("duty-changes", 5)):
+    out.append(f"- {sc}: the strongest sensor-free strategy is warmup (thread median 10.0 um, x")
+    out += [f"- {r} vs warmup over the thread: +{20 - i}.0 % (per seed +{lo}.0 .. +{lo + i}.5 %; x"
+            for i, r in enumerate(rows)]
+    out += [f"- {sc}: {r} (sensors) beats the strongest sensor-free strategy warmup over the "
+            f"thread by {20 - i}.0 % (better in 5 of 5 seeds)" for i, r in enumerate(rows)]
+open(sys.argv[1], "w").write("\n".join(out) + "\n")
+PY
+printf '#!/usr/bin/env bash\ncat "%s/planted.md"\n' "$D" > "$D/fake/whirl"
+WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks 8 --offset-candidates --out-dir "$D/p" \
+  > "$D/out.txt" 2> "$D/err.txt" || fail "planted run: $(cat "$D/err.txt")"
+grep -q "| 8 | production | grey_mean_k0 | warmup 10.0 | nan | 10.0 | +18.0 % (+1.0 .. +3.5) | 5 of 5 |" \
+  "$D/out.txt" || fail "production's range: $(cat "$D/out.txt")"
+grep -q "| 8 | duty-changes | grey_warmup_k0 | warmup 10.0 | nan | 9.0 | +19.0 % (+5.0 .. +6.5) | 5 of 5 |" \
+  "$D/out.txt" || fail "duty-changes' range: $(cat "$D/out.txt")"
 expect_fail "past-days" "$W" machine evaluate --past-days 41 --machines 1 --test-days 1
 # scripts/grey_residuals.py on a planted evaluation of two screws (hand-computed figures): slope
 # part |b| x l_u = 2 um/m x 3 m = 6 and 1 x 3 = 3, median 4.5; the hindsight choice min(grey, sf)
