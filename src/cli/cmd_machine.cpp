@@ -295,7 +295,8 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
   e->add_flag("--offset-candidates", o->offset_candidates,
               "two more rows after the table's, computed in the same run: both_grey's slope with "
               "warmup's offset K0 (grey_warmup_k0) and with the mean of both offsets "
-              "(grey_mean_k0); opt-in, off by default (docs/machine-evaluation.md, seventh round)");
+              "(grey_mean_k0); opt-in, off by default; both lost on their tuning seeds "
+              "(docs/machine-evaluation.md, seventh round)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});
