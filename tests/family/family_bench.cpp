@@ -3,7 +3,8 @@
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
 //                [--joint] [--loo|--kfold] [--no-1se] [--leave-first-se Z] [--leave-first-se-large Z] [--leave-first-blocks M] [--leave-first-row-share S] [--lowest-gp|--no-lowest-gp] [--lowest-gp-per-scale|--no-lowest-gp-per-scale] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
 //                [--stack|--no-stack] [--stack-se START FULL] [--stack-se-large START FULL] [--stack-gate-se Z Z_LARGE] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
-//                [--few-rows N] [--gp-length-prior-sd SD] [--gp-max-rows N]
+//                [--few-rows N] [--refit-lowest-gp-rows N] [--refit-iterations N] [--refit-folds K]
+//                [--gp-length-prior-sd SD] [--gp-max-rows N]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
@@ -116,6 +117,12 @@ Args Parse(int argc, char** argv) {
       a.choice.fit.loo_calibration_rows = std::stoi(value());
     else if (k == "--few-rows")
       a.choice.few_rows = std::stoi(value());
+    else if (k == "--refit-lowest-gp-rows")
+      a.choice.refit_lowest_gp_rows = std::stoi(value());
+    else if (k == "--refit-iterations")
+      a.choice.refit_iterations = std::stoi(value());
+    else if (k == "--refit-folds")
+      a.choice.refit_folds = std::stoi(value());
     else if (k == "--gp-length-prior-sd")
       a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")

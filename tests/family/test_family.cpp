@@ -344,6 +344,28 @@ TEST(FamilyChoice, LowestGpPerScaleStacksTheLowestGpOfEachColumnScale) {
   EXPECT_EQ(ChooseFamily(large, per_scale).Describe(), ChooseFamily(large, lowest).Describe());
 }
 
+// ChoiceOptions::refit_lowest_gp_rows: per output the GP with the lowest closed-form
+// leave-one-out error keeps the held-out errors that refitting every GP gives it (the same
+// folds, fixed starts), the other GP keeps its closed-form leave-one-out errors, and no GP but
+// the refitted one gets weight.
+TEST(FamilyChoice, RefitLowestGpJudgesOnlyTheLowestGpByRefits) {
+  ChoiceOptions loo, every, lowest;
+  for (ChoiceOptions* o : {&loo, &every, &lowest})
+    o->candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-linear/log"),
+                     ParseCandidate("gp-matern52-constant/identity")};
+  every.few_rows = lowest.few_rows = 101;
+  lowest.refit_lowest_gp_rows = 70;
+  const ProcessTable t = test::MakeBentTable(100, 0.03, 0.5, 2);
+  const Choice a = ChooseFamily(t, loo), b = ChooseFamily(t, every), c = ChooseFamily(t, lowest);
+  for (int k = 0; k < 2; ++k) {
+    const int g = a.table[1].cv_rmse(k) <= a.table[2].cv_rmse(k) ? 1 : 2, other = 3 - g;
+    EXPECT_NEAR(c.table[g].cv_rmse(k), b.table[g].cv_rmse(k), 1e-9 * b.table[g].cv_rmse(k));
+    EXPECT_NE(c.table[g].cv_rmse(k), a.table[g].cv_rmse(k));
+    EXPECT_EQ(c.table[other].cv_rmse(k), a.table[other].cv_rmse(k));
+    for (int w : WeightedGps(c, k)) EXPECT_EQ(w, g) << c.Describe();
+  }
+}
+
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
   r << 1, -2, 3, 4;

@@ -745,16 +745,19 @@ int LinearOnTheSameColumns(const ChoiceOptions& o, const Candidate& c) {
   return -1;
 }
 
-// Squared held-out errors of output k (original units) from K-fold refits of m (row q held out
-// in fold q % K; a GP from GpOptions' fixed starting points, so that no hyperparameter has seen
-// the held-out rows).
-Eigen::VectorXd RefitSquaredErrors(const FamilyModel& m, const ProcessTable& table,
-                                   const FitOptions& o, int folds, int k) {
+// Held-out errors of output k (original units) from K-fold refits of m (row q held out in fold
+// q % K; a GP from GpOptions' fixed starting points with `cold`, so that no hyperparameter has
+// seen the held-out rows, else from m's hyperparameters).
+Eigen::RowVectorXd RefitErrors(const FamilyModel& m, const ProcessTable& table, const FitOptions& o,
+                               int folds, int k, bool cold = true) {
   const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::VectorXd y = TransformTargets(m.transform, t).row(k).transpose();
-  const HeldOut h = OutputHeldOut(m, k, x, y, o, folds, true);
-  return OriginalErrors(m, k, t.row(k), y, h).array().square().matrix().transpose();
+  return OriginalErrors(m, k, t.row(k), y, OutputHeldOut(m, k, x, y, o, folds, cold));
+}
+Eigen::VectorXd RefitSquaredErrors(const FamilyModel& m, const ProcessTable& table,
+                                   const FitOptions& o, int folds, int k) {
+  return RefitErrors(m, table, o, folds, k).array().square().matrix().transpose();
 }
 
 // A chosen GP that ChoiceOptions::equivalence_sd checks: few rows per hyperparameter, more degrees
@@ -842,11 +845,28 @@ std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
   return out;
 }
 
+// `kept` without its GP candidates but `only` (ChoiceOptions::refit_lowest_gp_rows: the one GP
+// judged by refits; the others' held-out errors are their closed-form leave-one-out's).
+std::vector<int> WithOneGp(const std::vector<int>& kept, const ChoiceOptions& o, int only) {
+  std::vector<int> out;
+  for (int c : kept)
+    if (o.candidates[c].family != Family::kGaussianProcess || c == only) out.push_back(c);
+  return out;
+}
+
+// ChoiceOptions::lowest_gp (or the one refitted GP `only` if >= 0) applied to `kept`.
+std::vector<int> GpsThatTakePart(const std::vector<int>& kept,
+                                 const std::vector<Eigen::MatrixXd>& err, const ChoiceOptions& o,
+                                 int k, int only) {
+  if (only >= 0) return WithOneGp(kept, o, only);
+  return o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k) : kept;
+}
+
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the
 // lowest error), after ChoiceOptions::leave_first_se and leave_first_blocks have removed those
-// that do not beat the first of `kept` clearly enough.
+// that do not beat the first of `kept` clearly enough; `only`: GpsThatTakePart.
 int ChooseAmong(const std::vector<int>& given, const std::vector<Eigen::MatrixXd>& err,
-                const ChoiceOptions& o, int k) {
+                const ChoiceOptions& o, int k, int only = -1) {
   const double z = err.front().cols() < o.few_rows ? o.leave_first_se : o.leave_first_se_large;
   const bool all = !o.one_standard_error ||
                    (z <= 0 && o.leave_first_blocks <= 0 && o.leave_first_row_share <= 0);
@@ -857,7 +877,7 @@ int ChooseAmong(const std::vector<int>& given, const std::vector<Eigen::MatrixXd
                    err[c].row(k).array().square().matrix(), z, o.leave_first_blocks, o.folds,
                    o.leave_first_row_share))
       kept.push_back(c);
-  if (o.lowest_gp) kept = WithTheLowestGpOnly(kept, err, o, k);
+  kept = GpsThatTakePart(kept, err, o, k, only);
   std::vector<Eigen::VectorXd> sq;
   for (int c : kept) sq.push_back(err[c].row(k).array().square().matrix());
   if (o.one_standard_error) return kept[SimplestWithinOneStandardError(sq)];
@@ -936,9 +956,9 @@ namespace {
 
 // ChoiceOptions::stack for output k of targets t (outputs x rows): the shrunk stacking weights
 // of every candidate (ShrunkStackWeights of their held-out predictions t - err), 0 for those
-// that stack_gate_se or lowest_gp leave out.
+// that stack_gate_se or lowest_gp leave out (`only`: GpsThatTakePart).
 Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
-                            const ChoiceOptions& o, int k, int folds) {
+                            const ChoiceOptions& o, int k, int folds, int only) {
   const int nc = static_cast<int>(err.size());
   const bool large = t.cols() >= o.few_rows;
   const double gate = large ? o.stack_gate_se_large : o.stack_gate_se;
@@ -948,7 +968,7 @@ Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::M
   std::vector<int> in = {0};
   for (int c = 1; c < nc; ++c)
     if (gate <= 0 || BeatsFirst(squared(0), squared(c), gate, 0, folds)) in.push_back(c);
-  if (o.lowest_gp) in = WithTheLowestGpOnly(in, err, o, k);
+  in = GpsThatTakePart(in, err, o, k, only);
   Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()));
   for (std::size_t j = 0; j < in.size(); ++j)
     p.col(static_cast<Eigen::Index>(j)) = (t.row(k) - err[in[j]].row(k)).transpose();
@@ -984,6 +1004,43 @@ void ScaleStackedSd(const ProcessTable& table, const ChoiceOptions& options,
       sd(static_cast<Eigen::Index>(q)) = std::max(p[q].stddev.ToArray()[k], 1e-300);
     choice->sd_scale[k] = StackSdScale(r, sd, options.stack_sd_two_share);
   }
+}
+
+// ChoiceOptions::refit_lowest_gp_rows applies to a table of `rows` rows.
+bool RefitsLowestGpOnly(const ChoiceOptions& o, int rows) {
+  return o.closed_form_loo && o.refit_lowest_gp_rows > 0 && rows >= o.refit_lowest_gp_rows &&
+         rows < o.few_rows;
+}
+
+// ChoiceOptions::refit_lowest_gp_rows: per output k the GP candidate of `full` (fitted on all
+// rows) with the lowest closed-form leave-one-out error in `err`, its row k of `err` replaced by
+// the errors of refits on ChoiceOptions::refit_folds folds (0: `folds`); returns it per output
+// (-1: no GP candidate).
+std::array<int, Features::kCount> RefitLowestGp(const ProcessTable& table, const ChoiceOptions& o,
+                                                int folds, const std::vector<FamilyModel>& full,
+                                                std::vector<Eigen::MatrixXd>* err) {
+  std::array<int, Features::kCount> only;
+  only.fill(-1);
+  FitOptions fo = o.fit;
+  fo.threads = 1;
+  // The refits take the optimizer settings of the whole table (one start from single_start_rows)
+  // even where fewer folds leave fewer rows in a training split.
+  if (static_cast<int>(table.inputs.size()) >= fo.gp.single_start_rows) fo.gp.single_start_rows = 0;
+  fo.gp.bfgs.max_iterations = fo.gp.bfgs_large.max_iterations =
+      o.refit_iterations > 0 ? o.refit_iterations : fo.gp.bfgs.max_iterations;
+  for (int k = 0; k < Features::kCount; ++k)
+    for (std::size_t c = 0; c < o.candidates.size(); ++c)
+      if (o.candidates[c].family == Family::kGaussianProcess &&
+          (only[k] < 0 || (*err)[c].row(k).squaredNorm() < (*err)[only[k]].row(k).squaredNorm()))
+        only[k] = static_cast<int>(c);
+  ParallelFor(Features::kCount, o.fit.threads, [&](std::size_t k) {
+    const int c = only[k];
+    if (c >= 0)
+      (*err)[c].row(static_cast<Eigen::Index>(k)) =
+          RefitErrors(full[c], table, fo, o.refit_folds > 0 ? o.refit_folds : folds,
+                      static_cast<int>(k), o.refit_iterations <= 0);
+  });
+  return only;
 }
 
 }  // namespace
@@ -1027,7 +1084,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       full[c] = Unfitted(table, options.candidates[c]);
       const bool honest = options.closed_form_loo &&
                           options.candidates[c].family == Family::kGaussianProcess &&
-                          rows < options.few_rows &&
+                          rows < options.few_rows && !RefitsLowestGpOnly(options, rows) &&
                           rows - (rows + folds - 1) / folds >=
                               MinimumRows(options.candidates[c], used.UsedInputCount());
       const int held_folds = honest ? folds : HeldOutFolds(options, folds);
@@ -1045,6 +1102,9 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     const std::lock_guard<std::mutex> lock(progress_mutex);
     options.progress(++done, steps, options.candidates[c].Name());
   });
+  std::array<int, Features::kCount> only;
+  only.fill(-1);
+  if (RefitsLowestGpOnly(options, rows)) only = RefitLowestGp(table, options, folds, full, &err);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   const Eigen::ArrayXd var =
       ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows).array().max(1e-300);
@@ -1075,7 +1135,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<Eigen::VectorXd, Features::kCount> stack;
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      stack[k] = OutputStack(t, err, options, k, folds);
+      stack[k] = OutputStack(t, err, options, k, folds, only[k]);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
@@ -1086,7 +1146,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
         all[c] = c;
         if (options.candidates[c].family == Family::kLinear) linear.push_back(c);
       }
-      choice.chosen[k] = ChooseAmong(all, err, options, k);
+      choice.chosen[k] = ChooseAmong(all, err, options, k, only[k]);
       if (linear.empty()) continue;
       const int lin = ChooseAmong(linear, err, options, k), c = choice.chosen[k];
       complete(c);
