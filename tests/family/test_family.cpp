@@ -330,9 +330,10 @@ TEST(FamilyChoice, LowestGpPerScaleStacksTheLowestGpOfEachColumnScale) {
         ++per[a.table[g].candidate.log];
         for (const CvRow& r : a.table)
           if (r.candidate.family == Family::kGaussianProcess &&
-              r.candidate.log == a.table[g].candidate.log)
+              r.candidate.log == a.table[g].candidate.log) {
             EXPECT_GE(r.cv_rmse(k), a.table[g].cv_rmse(k)) << "seed " << seed << ": "
                                                            << a.Describe();
+          }
       }
       EXPECT_LE(per[0], 1);
       EXPECT_LE(per[1], 1);
