@@ -6,6 +6,8 @@ random ones at 12 and 20 (the study's own random order), each trained as the stu
   a power law alone on the same rows (`--family linear --transform log`);
   both trained on the generator's noise-free truth at the same rows (generator families only:
   what is left is bias, not scatter; None where `whirl train` refuses the table);
+  the default model's RMSE also on the test rows inside the box (no coordinate in its outer
+  10 % at either end) and on the others;
   the rows' geometry on log inputs scaled to the list's box, u in [0, 1]: mean |2u - 1|, the
   share of coordinates in the outer 10 % at either end, rows with none there ("inside"), the
   smallest distance between two rows and the rows closer than 0.1 to another.
@@ -40,7 +42,9 @@ def truth_pool(prob, seed):
 
 
 def fit(a, tmp, x, y, extra=()):
-    """(choice summary, test RMSE per output) of `whirl train` on (x, y); None if it refuses."""
+    """(choice summary, test RMSE per output) of `whirl train` on (x, y); None if it refuses.
+    The RMSE is {"all", "inside", "edge"}: over every test row, the rows with no coordinate in
+    the outer 10 % of the list's box (log inputs), and the others."""
     data, model = os.path.join(tmp, "t.csv"), os.path.join(tmp, "m.json")
     bp.write_table(data, x, y)
     r = subprocess.run([a.whirl, "train", "--data", data, "--out", model, "--seed", "1",
@@ -50,12 +54,20 @@ def fit(a, tmp, x, y, extra=()):
     p = json.loads(ds.run([a.whirl, "predict", "--model", model, "--input",
                            os.path.join(tmp, "test.csv"), "--json"]))
     mean = np.array([[q["max_elongation_um"], q["settle_time_s"]] for q in p["predictions"]])
-    return json.loads(r.stdout), bp.rmse(mean, a.truth_of[tmp]).tolist()
+    truth, inside = a.truth_of[tmp]
+    return json.loads(r.stdout), {"all": bp.rmse(mean, truth).tolist(),
+                                  "inside": bp.rmse(mean[inside], truth[inside]).tolist(),
+                                  "edge": bp.rmse(mean[~inside], truth[~inside]).tolist()}
+
+
+def scaled(x, pool):
+    """x's log inputs scaled to the box of pool's, u in [0, 1] inside it."""
+    lo, hi = np.log(pool.min(0)), np.log(pool.max(0))
+    return (np.log(x) - lo) / np.where(hi > lo, hi - lo, 1.0)
 
 
 def geometry(x, rows):
-    lo, hi = np.log(x.min(0)), np.log(x.max(0))
-    u = (np.log(x[rows]) - lo) / np.where(hi > lo, hi - lo, 1.0)
+    u = scaled(x[rows], x)
     edge = np.abs(u - 0.5) * 2  # 1 at a face of the box
     d = np.sqrt(((u[:, None] - u[None]) ** 2).sum(-1))
     d[np.diag_indices(len(rows))] = np.inf
@@ -73,16 +85,22 @@ def case(a, prob, seed, picks):
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         bp.write_table(os.path.join(tmp, "test.csv"), xte)
-        a.truth_of[tmp] = truth
+        a.truth_of[tmp] = truth, (np.abs(scaled(xte, x) - 0.5) * 2).max(1) < 0.8
         for tab, rows in rows_of.items():
             t, rmse = fit(a, tmp, x[rows], y[rows])
-            r = {"rmse": rmse, "chosen": t["chosen"], "geometry": geometry(x, rows),
-                 "rmse_power_law": fit(a, tmp, x[rows], y[rows], POWER_LAW)[1]}
+            r = {"rmse": rmse["all"], "rmse_inside": rmse["inside"], "rmse_edge": rmse["edge"],
+                 "chosen": t["chosen"], "geometry": geometry(x, rows),
+                 "rmse_power_law": overall(fit(a, tmp, x[rows], y[rows], POWER_LAW)[1])}
             if f is not None:
-                r["rmse_noise_free"] = fit(a, tmp, x[rows], f[rows])[1]
-                r["rmse_noise_free_power_law"] = fit(a, tmp, x[rows], f[rows], POWER_LAW)[1]
+                r["rmse_noise_free"] = overall(fit(a, tmp, x[rows], f[rows])[1])
+                r["rmse_noise_free_power_law"] = overall(
+                    fit(a, tmp, x[rows], f[rows], POWER_LAW)[1])
             out[tab] = r
     return prob, seed, out
+
+
+def overall(rmse):
+    return rmse and rmse["all"]
 
 
 def kind(chosen, k):
@@ -103,8 +121,8 @@ def summary(res):
             print(f"\n{prob}, {out}: geometric mean test RMSE over {len(cases)} seeds")
             for tab in TABLES:
                 cells = []
-                for key in ("rmse", "rmse_power_law", "rmse_noise_free",
-                            "rmse_noise_free_power_law"):
+                for key in ("rmse", "rmse_inside", "rmse_edge", "rmse_power_law",
+                            "rmse_noise_free", "rmse_noise_free_power_law"):
                     if key in cases[0][tab]:
                         v = geometric_mean([c[tab][key] and c[tab][key][k] for c in cases])
                         cells.append(f"{key} {v:.3g}")
