@@ -43,6 +43,7 @@ FIRST = 8
 CAMPAIGN = 5
 FAMILIES = 6
 STRATEGIES = ["random", "lhs", "natural", "design"]
+PICKS = {}  # "problem/seed" -> the design's pool rows in the order picked (--json: design_picks)
 
 
 def run(cmd):
@@ -125,11 +126,12 @@ class Evaluator:
 
 
 def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, variance=None,
-             inside=()):
+             inside=(), picks=None):
     """RMSE per size of the sequential design: FIRST by the first design (or the Latin hypercube
     picks `first_lhs`), then batches; fill_first / fill_next: `whirl design --space-filling`;
     variance: extra `whirl design` arguments of the next screws (--variance ..., None: defaults;
-    the hyperparameters go to the first design too); inside: the first design's `--inside K`."""
+    the hyperparameters go to the first design too); inside: the first design's `--inside K`;
+    picks: a list that receives the pool rows picked, in order."""
     pool = os.path.join(ev.tmp, "pool.csv")
     bp.write_table(pool, ev.x)
     if first_lhs is not None:
@@ -149,6 +151,8 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
         if len(picked) in SIZES:
             result[len(picked)] = ev.rmse(model)
         if len(picked) >= max(SIZES):
+            if picks is not None:
+                picks += picked
             return result
         nxt = min(s for s in SIZES if s > len(picked))
         k = min(batch, nxt - len(picked))
@@ -179,7 +183,8 @@ def one_case(prob, seed, a, cache):
         first = lhs_pick(x, FIRST, np.random.default_rng([7, seed])) if a.first == "lhs" else None
         res["design"] = designed(ev, a.criterion, a.batch, first, a.fill_first, a.fill_next,
                                  variance_args(a),
-                                 [] if a.inside is None else ["--inside", str(a.inside)])
+                                 [] if a.inside is None else ["--inside", str(a.inside)],
+                                 PICKS.setdefault(f"{prob}/{seed}", []))
         return prob, seed, res
 
 
@@ -451,7 +456,7 @@ def main():
                        "next_screws": variance_args(a) or "whirl design defaults",
                        "inside": a.inside,
                        "command": " ".join(sys.argv),
-                       "cases": results, "medians": table}, h)
+                       "cases": results, "medians": table, "design_picks": PICKS}, h)
     paired_report(results, a.paired_with)
     if a.plot:
         plot(table, a.plot)
