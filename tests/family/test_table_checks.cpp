@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include "family/family.h"
+#include "family/transform.h"
+#include "nn/model.h"
 #include "support/expect_error.h"
 #include "support/power_law_table.h"
 
@@ -91,6 +93,29 @@ TEST(ConstantInputs, AreNamedAndLeftOut) {
       << c.warnings[0];
   const ProcessTable varied = MakeTable(30, 0.04, 3, true);
   EXPECT_TRUE(ChooseFamily(varied, o).warnings.empty());
+}
+
+// A target that is the same in every row (a clipped or rounded measurement): named in a warning,
+// left out of the score (over its zero variance any candidate's MSE was a number beyond the
+// model file's range, and the file was refused), and the model predicts that value.
+TEST(ConstantTargets, AreNamedLeftOutOfTheScoreAndPredicted) {
+  ProcessTable t = MakeTable(20, 0.04, 5);
+  for (Features& f : t.targets) f.settle_time_s = 50;
+  EXPECT_EQ(ConstantTargets(t), std::vector<int>{1});
+  EXPECT_TRUE(ConstantTargets(MakeTable(20, 0.04, 5)).empty());
+  const Choice c = ChooseFamily(t, ChoiceOptions{});
+  const Eigen::MatrixXd x = nn::TargetMatrix(t.targets);
+  const double var0 = (x.row(0).array() - x.row(0).mean()).square().mean();
+  for (const CvRow& r : c.table)  // the score is the elongation's MSE / variance alone
+    EXPECT_NEAR(r.score, r.cv_rmse(0) * r.cv_rmse(0) / var0, 1e-9 * (1 + r.score)) << r.candidate.Name();
+  bool named = false;
+  for (const std::string& w : c.warnings)
+    named |= w.rfind("settle_time_s is the same (50 s) in every row of generated.csv", 0) == 0;
+  EXPECT_TRUE(named) << ::testing::PrintToString(c.warnings);
+  Choice back;
+  ASSERT_NO_THROW(back = nlohmann::json(c).get<Choice>());  // the model file's range checks
+  for (const FamilyPrediction& q : PredictChoice(back, MakeTable(10, 0.0, 77).inputs))
+    EXPECT_NEAR(q.mean.settle_time_s, 50.0, 1e-6) << "a constant target predicted elsewhere";
 }
 
 // A 0 in max_elongation_um: the log candidates keep that output raw, say so in a warning and in

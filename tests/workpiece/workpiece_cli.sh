@@ -101,6 +101,12 @@ grep -q "warning: hardness_hrc is constant (61 HRC in every row of odd.csv): lef
   || fail "no warning on the constant input: $(cat err.txt)"
 grep -q "warning: max_elongation_um = 0 um (odd.csv line 7): a log scale needs values > 0" err.txt \
   || fail "no warning on the zero target: $(cat err.txt)"
+# A target the same in every row (a clipped measurement) trains, named in a warning.
+awk -F, 'BEGIN { OFS = "," } /^#/ { next } NR == 1 || !h { h = 1; for (i = 1; i <= NF; i++) c[$i] = i; print; next }
+  { $c["settle_time_s"] = 50; print }' "$data" > flat.csv
+"$whirl" train --data flat.csv --out flat.json > /dev/null 2> err.txt || fail "flat target: $(cat err.txt)"
+grep -q "warning: settle_time_s is the same (50 s) in every row of flat.csv" err.txt \
+  || fail "no warning on the constant target: $(cat err.txt)"
 "$whirl" train --data odd.csv --out odd.json --json > out.json 2> err.txt || fail "odd --json"
 grep -q '"warnings": \[' out.json || fail "--json lacks the warnings: $(cat out.json)"
 expect_fail "--transform log: max_elongation_um = 0 um (odd.csv line 7)" \

@@ -932,6 +932,13 @@ std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOp
                   " in every row of " + table.source +
                   "): left out of the model; its predictions do not depend on it, and other "
                   "values of it are outside the training domain");
+  for (int k : ConstantTargets(table))
+    out.push_back(std::string(kTargetColumns[k]) + " is the same (" +
+                  MessageNumber(table.targets.front().ToArray()[k]) + " " + kTargetUnits[k] +
+                  ") in every row of " +
+                  table.source + ": there is nothing to learn for it, every candidate predicts "
+                  "about that value and the choice for it rests on no evidence; check the column "
+                  "(a clipped or rounded measurement?)");
   std::string logs, first;
   for (const Candidate& c : o.candidates)
     if (c.log) {
@@ -1106,15 +1113,18 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   only.fill(-1);
   if (RefitsLowestGpOnly(options, rows)) only = RefitLowestGp(table, options, folds, full, &err);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
-  const Eigen::ArrayXd var =
-      ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows).array().max(1e-300);
+  // An output whose targets are all equal has nothing to choose on: it stays out of the score
+  // (its MSE over a zero variance would only be a huge number; TableWarnings names it).
+  Eigen::ArrayXd weight = ((t.colwise() - t.rowwise().mean()).rowwise().squaredNorm() / rows)
+                              .array().max(1e-300).inverse();
+  for (int k : ConstantTargets(table)) weight(k) = 0;
   Choice choice;
   for (int c = 0; c < nc; ++c) {
     CvRow r;
     r.candidate = options.candidates[c];
     const Eigen::ArrayXd mse = err[c].array().square().rowwise().mean();
     r.cv_rmse = mse.sqrt().matrix();
-    r.score = (mse / var).sum();
+    r.score = (mse * weight).sum();
     for (int f = 0; f < folds; ++f) r.fit_ms += ms[c * folds + f];
     choice.table.push_back(r);
     for (int k = 0; k < Features::kCount; ++k) {

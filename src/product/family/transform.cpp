@@ -119,20 +119,37 @@ std::vector<LogException> LogExceptions(const ProcessTable& table) {
   return out;
 }
 
+namespace {
+
+// Column `i` of `rows` (ProcessInputs or Features) has all values equal: relative spread <= 1e-12.
+template <typename Row>
+bool ColumnIsConstant(const std::vector<Row>& rows, int i) {
+  double lo = rows.front().ToArray()[i], hi = lo;
+  for (const Row& r : rows) {
+    lo = std::min(lo, r.ToArray()[i]);
+    hi = std::max(hi, r.ToArray()[i]);
+  }
+  return hi - lo <= 1e-12 * std::max({std::abs(lo), std::abs(hi), 1e-300});
+}
+
+}  // namespace
+
 std::vector<int> LeaveOutConstantInputs(const ProcessTable& table, TableTransform* t) {
   std::vector<int> out;
   if (table.inputs.empty()) return out;
-  for (int i = 0; i < ProcessInputs::kCount; ++i) {
-    double lo = table.inputs[0].ToArray()[i], hi = lo;
-    for (const ProcessInputs& p : table.inputs) {
-      lo = std::min(lo, p.ToArray()[i]);
-      hi = std::max(hi, p.ToArray()[i]);
-    }
-    if (hi - lo <= 1e-12 * std::max({std::abs(lo), std::abs(hi), 1e-300})) {
+  for (int i = 0; i < ProcessInputs::kCount; ++i)
+    if (ColumnIsConstant(table.inputs, i)) {
       t->input_used[i] = false;
       out.push_back(i);
     }
-  }
+  return out;
+}
+
+std::vector<int> ConstantTargets(const ProcessTable& table) {
+  std::vector<int> out;
+  if (table.targets.empty()) return out;
+  for (int k = 0; k < Features::kCount; ++k)
+    if (ColumnIsConstant(table.targets, k)) out.push_back(k);
   return out;
 }
 

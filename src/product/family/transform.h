@@ -70,6 +70,10 @@ TableTransform LogWherePositive(const ProcessTable& table);
 /// out of `t`, and returns their indices.
 std::vector<int> LeaveOutConstantInputs(const ProcessTable& table, TableTransform* t);
 
+/// The target columns of `table` whose values are all equal (the same rule): nothing to learn
+/// there; the choice leaves them out of its score (ChooseFamily) and `whirl train` warns.
+std::vector<int> ConstantTargets(const ProcessTable& table);
+
 /// z = g(x) for one value; InputError naming `column` if kLog and x <= 0 or x is not finite.
 double Forward(ColumnTransform t, double x, const char* column);
 /// g^-1(z).
