@@ -34,7 +34,7 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   confirmation is spent; the third attempt's split: "tuning3" = the eight families on seeds 1-20,
   "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
-  "confirmation7" (13001-), "confirmation8" (14001-).
+  "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -341,6 +341,8 @@ SPLITS = {
     # The eighth attempt's confirmation (tuning on 1-20, 4001-, 10001-, 11001-, 12001-, 13001-):
     # 14001-14010 at 100 rows (14001-14020 at 20 rows if a change touches 20-row tables).
     "confirmation8": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 14001},
+    # The ninth attempt's confirmation (tuning part the eighth's): 15001-15010 at 100 rows.
+    "confirmation9": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 15001},
 }
 
 
