@@ -4,6 +4,7 @@
 //                [--joint] [--loo|--kfold] [--no-1se] [--leave-first-se Z] [--leave-first-se-large Z] [--leave-first-blocks M] [--leave-first-row-share S] [--lowest-gp|--no-lowest-gp] [--lowest-gp-per-scale|--no-lowest-gp-per-scale] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
 //                [--stack|--no-stack] [--stack-se START FULL] [--stack-se-large START FULL] [--stack-gate-se Z Z_LARGE] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
 //                [--few-rows N] [--refit-lowest-gp-rows N] [--refit-iterations N] [--refit-folds K]
+//                [--refit-hyper-rows N] [--refit-ftol F] [--refit-gtol G]
 //                [--gp-length-prior-sd SD] [--gp-max-rows N]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
@@ -121,6 +122,12 @@ Args Parse(int argc, char** argv) {
       a.choice.refit_lowest_gp_rows = std::stoi(value());
     else if (k == "--refit-iterations")
       a.choice.refit_iterations = std::stoi(value());
+    else if (k == "--refit-ftol")
+      a.choice.refit_function_tolerance = std::stod(value());
+    else if (k == "--refit-gtol")
+      a.choice.refit_gradient_tolerance = std::stod(value());
+    else if (k == "--refit-hyper-rows")
+      a.choice.refit_hyperparameter_rows = std::stoi(value());
     else if (k == "--refit-folds")
       a.choice.refit_folds = std::stoi(value());
     else if (k == "--gp-length-prior-sd")

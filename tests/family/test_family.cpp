@@ -367,6 +367,46 @@ TEST(FamilyChoice, RefitLowestGpJudgesOnlyTheLowestGpByRefits) {
   }
 }
 
+// ChoiceOptions::refit_hyperparameter_rows: a subset of every row of the refits is the choice
+// without it, bit for bit; a smaller one (or looser refit tolerances) changes the GP's held-out
+// errors (its refits) and neither the linear fit's errors nor the GP fitted on the whole table
+// (GpOptions' own settings); below single_start_rows rows it changes nothing.
+TEST(FamilyChoice, RefitHyperparameterRowsSubsetsOnlyTheRefits) {
+  ChoiceOptions every, all_rows, subset, loose;
+  for (ChoiceOptions* o : {&every, &all_rows, &subset, &loose}) {
+    o->candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-linear/log")};
+    o->few_rows = 101;
+    o->stack_gate_se = o->stack_gate_se_large = 0;  // the GP gets weight
+  }
+  all_rows.refit_hyperparameter_rows = 100;
+  subset.refit_hyperparameter_rows = 40;
+  loose.refit_function_tolerance = 0.1;
+  loose.refit_gradient_tolerance = 1;
+  const ProcessTable t = test::MakeBentTable(100, 0.03, 0.5, 2);
+  const Choice a = ChooseFamily(t, every), b = ChooseFamily(t, all_rows);
+  EXPECT_EQ(b.Describe(), a.Describe());
+  for (int k = 0; k < 2; ++k) EXPECT_EQ(b.table[1].cv_rmse(k), a.table[1].cv_rmse(k));
+  for (const ChoiceOptions* o : {&subset, &loose}) {
+    const Choice c = ChooseFamily(t, *o);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_EQ(c.table[0].cv_rmse(k), a.table[0].cv_rmse(k));
+      EXPECT_NE(c.table[1].cv_rmse(k), a.table[1].cv_rmse(k));
+    }
+    int gps = 0;
+    for (const FamilyModel& m : c.models)
+      for (const FamilyModel& n : a.models) {
+        if (m.gps.empty() || m.candidate.Name() != n.candidate.Name()) continue;
+        for (std::size_t k = 0; k < m.gps.size(); ++k, ++gps)
+          EXPECT_EQ(m.gps[k].theta, n.gps[k].theta) << "output " << k;
+      }
+    EXPECT_GT(gps, 0) << c.Describe();
+  }
+  const ProcessTable small = test::MakeBentTable(24, 0.03, 0.5, 2);
+  const Choice d = ChooseFamily(small, every), e = ChooseFamily(small, subset);
+  EXPECT_EQ(e.Describe(), d.Describe());
+  for (int k = 0; k < 2; ++k) EXPECT_EQ(e.table[1].cv_rmse(k), d.table[1].cv_rmse(k));
+}
+
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
   r << 1, -2, 3, 4;

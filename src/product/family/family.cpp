@@ -1013,6 +1013,26 @@ void ScaleStackedSd(const ProcessTable& table, const ChoiceOptions& options,
   }
 }
 
+// `fit` for the GP refits of ChooseFamily on a table of `rows` rows
+// (ChoiceOptions::refit_hyperparameter_rows, refit_function_tolerance, refit_gradient_tolerance):
+// the refits' optimizer tolerances, and hyperparameters from that subset of each refit's
+// rows, from one start (single_start_rows lowered to the subset's size, so that the subset takes
+// the optimizer settings of the whole table).
+FitOptions RefitOptions(const ChoiceOptions& o, FitOptions fit, int rows) {
+  gp::GpOptions& gp = fit.gp;
+  if (rows < gp.single_start_rows || rows >= o.few_rows) return fit;
+  for (BfgsOptions* b : {&gp.bfgs, &gp.bfgs_large}) {
+    if (o.refit_function_tolerance > 0) b->function_tolerance = o.refit_function_tolerance;
+    if (o.refit_gradient_tolerance > 0) b->gradient_tolerance = o.refit_gradient_tolerance;
+  }
+  const int subset = o.refit_hyperparameter_rows;
+  if (subset <= 0) return fit;
+  gp.hyperparameter_rows =
+      gp.hyperparameter_rows > 0 ? std::min(gp.hyperparameter_rows, subset) : subset;
+  gp.single_start_rows = std::min(gp.single_start_rows, gp.hyperparameter_rows);
+  return fit;
+}
+
 // ChoiceOptions::refit_lowest_gp_rows applies to a table of `rows` rows.
 bool RefitsLowestGpOnly(const ChoiceOptions& o, int rows) {
   return o.closed_form_loo && o.refit_lowest_gp_rows > 0 && rows >= o.refit_lowest_gp_rows &&
@@ -1070,6 +1090,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::vector<double> ms(static_cast<std::size_t>(nc * folds));
   FitOptions fold_options = options.fit;
   fold_options.threads = 1;
+  const FitOptions refit_options = RefitOptions(options, fold_options, rows);
   for (const Candidate& c : options.candidates) CheckRows(table, c, used.UsedInputCount());
   std::vector<FamilyModel> full(static_cast<std::size_t>(nc));  // closed-form LOO fits
   std::vector<char> calibrated(static_cast<std::size_t>(nc), 0);
@@ -1100,8 +1121,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       pending[c] = refitted[c] && options.candidates[c].family == Family::kGaussianProcess;
       if (!pending[c]) FitOwnColumns(table, fold_options, &full[c]);
       const bool calibrate_now = calibrated[c] && !pending[c];
-      err[c] = HeldOutErrors(table, fold_options, held_folds, &full[c], calibrate_now, true,
-                             &held[c]);
+      err[c] = HeldOutErrors(table, pending[c] ? refit_options : fold_options, held_folds,
+                             &full[c], calibrate_now, true, &held[c]);
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

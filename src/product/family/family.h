@@ -283,6 +283,20 @@ struct ChoiceOptions {
   int refit_lowest_gp_rows = 0;
   int refit_iterations = 0;
   int refit_folds = 0;
+  /// Subset of data for the hyperparameters of the GP refits (R&W section 8.3.2) on tables of
+  /// at least fit.gp.single_start_rows rows below few_rows (0: GpOptions' own
+  /// hyperparameter_rows; not the refits of refit_lowest_gp_rows): each K-fold refit that judges
+  /// a GP takes its hyperparameters from at most this many of its rows
+  /// (GpOptions::hyperparameter_rows, spread evenly) from one start, and its held-out
+  /// predictions from all of them; the GP fitted on the whole table (once chosen) keeps
+  /// GpOptions' settings. Opt-in: with few_rows 101, meant to pay for judging every
+  /// GP at 100 rows by K-fold refits, it made the 100-row test RMSE worse on the tuning part at
+  /// every subset within the time budget (docs/workpiece-model.md, "Ninth attempt").
+  int refit_hyperparameter_rows = 0;
+  /// The optimizer's tolerances for those refits (0: GpOptions' own; BfgsOptions'
+  /// function_tolerance and gradient_tolerance, on the same tables as refit_hyperparameter_rows).
+  /// Opt-in for the same reason (the same section).
+  double refit_function_tolerance = 0, refit_gradient_tolerance = 0;
   /// Network candidates sit out of tables with more rows than this (0: never), and
   /// Choice::rows_note says so: their fold refits, final fit and noise folds grow with the rows
   /// (trainbr) and the default's fit time must stay within R brnn's (docs/workpiece-model.md,
