@@ -2,7 +2,7 @@
 # Builds the libFuzzer harnesses of every loader with clang (ASan + UBSan) in build-fuzz and runs
 # each for SECONDS (default 60) over its seeds and its committed corpus (tests/fuzz/corpus/<h>);
 # a crash, sanitizer report, leak, hang, an exception other than InputError or a refusal that
-# names no rule stops with the reproducer path. New inputs go to build-fuzz/tests/fuzz_corpus/<h>.
+# names no rule stops with the reproducer path. New inputs go to build-fuzz/tests/fuzz_scratch/<h>.
 # Needs clang (Debian 'clang'; not part of scripts/setup.sh, the default test run does not need
 # it: it replays the committed corpora as the CTests corpus_<h>).
 # Usage: scripts/fuzz.sh [SECONDS] [HARNESS...]   e.g. scripts/fuzz.sh 300 model screw
@@ -37,7 +37,7 @@ seeds_of() {  # the shipped files of the harness's kind (read only; new inputs g
   esac
 }
 for h in "${HARNESSES[@]}"; do
-  scratch="$BUILD/tests/fuzz_corpus/$h"; corpus="tests/fuzz/corpus/$h"
+  scratch="$BUILD/tests/fuzz_scratch/$h"; corpus="tests/fuzz/corpus/$h"
   mkdir -p "$scratch" "$corpus"
   if [ "$MODE" = merge ]; then
     # Only inputs that reach code the seeds and the committed corpus do not reach: the base (seeds

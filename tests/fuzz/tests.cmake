@@ -91,7 +91,7 @@ foreach(name IN LISTS WHIRL_FUZZ_HARNESSES)
   target_compile_options(fuzz_${name} PRIVATE -fsanitize=fuzzer ${WHIRL_FUZZ_FLAGS})
   target_link_options(fuzz_${name} PRIVATE -fsanitize=fuzzer)
   set_target_properties(fuzz_${name} PROPERTIES EXCLUDE_FROM_ALL ON)
-  set(scratch ${CMAKE_CURRENT_BINARY_DIR}/fuzz_corpus/${name})
+  set(scratch ${CMAKE_CURRENT_BINARY_DIR}/fuzz_scratch/${name})
   file(MAKE_DIRECTORY ${scratch})
   # New inputs go into the first (scratch) directory; the seeds and the corpus are only read.
   add_test(NAME fuzz_${name}
