@@ -34,7 +34,8 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   confirmation is spent; the third attempt's split: "tuning3" = the eight families on seeds 1-20,
   "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
-  "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-).
+  "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-),
+  "confirmation10" (16001-).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -343,6 +344,9 @@ SPLITS = {
     "confirmation8": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 14001},
     # The ninth attempt's confirmation (tuning part the eighth's): 15001-15010 at 100 rows.
     "confirmation9": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 15001},
+    # The tenth attempt's confirmation (tuning part the eighth's plus 20-row seeds 1-20, 4001-,
+    # 10001-13001): 16001-16010 at 20 and at 100 rows.
+    "confirmation10": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 16001},
 }
 
 

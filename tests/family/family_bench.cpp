@@ -5,7 +5,7 @@
 //                [--stack|--no-stack] [--stack-se START FULL] [--stack-se-large START FULL] [--stack-gate-se Z Z_LARGE] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
 //                [--few-rows N] [--refit-lowest-gp-rows N] [--refit-iterations N] [--refit-folds K]
 //                [--refit-hyper-rows N] [--refit-ftol F] [--refit-gtol G]
-//                [--gp-length-prior-sd SD] [--gp-max-rows N]
+//                [--gp-length-prior-sd SD] [--gp-max-rows N] [--gp-loo-penalty F]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
@@ -130,6 +130,8 @@ Args Parse(int argc, char** argv) {
       a.choice.refit_hyperparameter_rows = std::stoi(value());
     else if (k == "--refit-folds")
       a.choice.refit_folds = std::stoi(value());
+    else if (k == "--gp-loo-penalty")
+      a.choice.gp_loo_hyperparameter_penalty = std::stod(value());
     else if (k == "--gp-length-prior-sd")
       a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")

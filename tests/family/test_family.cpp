@@ -407,6 +407,40 @@ TEST(FamilyChoice, RefitHyperparameterRowsSubsetsOnlyTheRefits) {
   for (int k = 0; k < 2; ++k) EXPECT_EQ(e.table[1].cv_rmse(k), d.table[1].cv_rmse(k));
 }
 
+TEST(FamilyChoice, GpLooHyperparameterPenaltyScalesOnlyTheGpsLeaveOneOut) {
+  ChoiceOptions plain, penalized;
+  for (ChoiceOptions* o : {&plain, &penalized})
+    o->candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-se-constant/identity"),
+                     ParseCandidate("gp-se-iso-constant/identity")};
+  penalized.gp_loo_hyperparameter_penalty = 2;
+  const ProcessTable t = test::MakeBentTable(100, 0.03, 0.5, 2);
+  const Choice a = ChooseFamily(t, plain), b = ChooseFamily(t, penalized);
+  // 100 rows, five inputs: the ARD GP fits 5 length scales + signal + noise sd, the isotropic 3.
+  const double ard = std::sqrt(1 + 2.0 * 7 / 100), iso = std::sqrt(1 + 2.0 * 3 / 100);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(b.table[0].cv_rmse(k), a.table[0].cv_rmse(k));
+    EXPECT_NEAR(b.table[1].cv_rmse(k), ard * a.table[1].cv_rmse(k), 1e-12 * a.table[1].cv_rmse(k));
+    EXPECT_NEAR(b.table[2].cv_rmse(k), iso * a.table[2].cv_rmse(k), 1e-12 * a.table[2].cv_rmse(k));
+  }
+  // The GPs themselves and their calibration do not change.
+  int gps = 0;
+  for (const FamilyModel& m : b.models)
+    for (const FamilyModel& n : a.models) {
+      if (m.gps.empty() || m.candidate.Name() != n.candidate.Name()) continue;
+      for (std::size_t k = 0; k < m.gps.size(); ++k, ++gps) {
+        EXPECT_EQ(m.gps[k].theta, n.gps[k].theta);
+        EXPECT_EQ(m.gps[k].noise_variance, n.gps[k].noise_variance);
+      }
+    }
+  EXPECT_GT(gps, 0) << a.Describe() << " / " << b.Describe();
+  // Below few_rows the GPs are judged by refits: nothing is scaled.
+  const ProcessTable small = test::MakeBentTable(30, 0.03, 0.5, 2);
+  const Choice c = ChooseFamily(small, plain), d = ChooseFamily(small, penalized);
+  EXPECT_EQ(d.Describe(), c.Describe());
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 2; ++k) EXPECT_EQ(d.table[j].cv_rmse(k), c.table[j].cv_rmse(k));
+}
+
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
   r << 1, -2, 3, 4;

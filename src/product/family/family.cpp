@@ -1070,6 +1070,32 @@ std::array<int, Features::kCount> RefitLowestGp(const ProcessTable& table, const
   return only;
 }
 
+// ChoiceOptions::gp_loo_hyperparameter_penalty: `err` with the rows of the GP candidates judged
+// by their closed-form leave-one-out (not `refitted`) scaled; the other candidates' unchanged.
+std::vector<Eigen::MatrixXd> JudgedErrors(const std::vector<Eigen::MatrixXd>& err,
+                                          const std::vector<FamilyModel>& full,
+                                          const std::vector<char>& refitted,
+                                          const ChoiceOptions& o) {
+  std::vector<Eigen::MatrixXd> out = err;
+  if (o.gp_loo_hyperparameter_penalty <= 0) return out;
+  for (std::size_t c = 0; c < err.size(); ++c) {
+    if (o.candidates[c].family != Family::kGaussianProcess || refitted[c]) continue;
+    for (std::size_t k = 0; k < full[c].gps.size(); ++k) {
+      const gp::Gp& g = full[c].gps[k];
+      const double n = g.rows.empty() ? static_cast<double>(err[c].cols())
+                                      : static_cast<double>(g.rows.size());
+      const double lengths =
+          o.candidates[c].isotropic ? 1.0 : static_cast<double>(g.theta.size()) - 2;
+      const double p = lengths + 2;  // and the signal and noise sd
+      const double f = std::sqrt(1 + o.gp_loo_hyperparameter_penalty * p / n);
+      const auto kk = static_cast<Eigen::Index>(k);
+      if (g.rows.empty()) out[c].row(kk) *= f;
+      for (int r : g.rows) out[c](kk, r) *= f;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
@@ -1133,6 +1159,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<int, Features::kCount> only;
   only.fill(-1);
   if (RefitsLowestGpOnly(options, rows)) only = RefitLowestGp(table, options, folds, full, &err);
+  const std::vector<Eigen::MatrixXd> judged = JudgedErrors(err, full, refitted, options);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   // An output whose targets are all equal has nothing to choose on: it stays out of the score
   // (its MSE over a zero variance would only be a huge number; TableWarnings names it).
@@ -1143,7 +1170,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   for (int c = 0; c < nc; ++c) {
     CvRow r;
     r.candidate = options.candidates[c];
-    const Eigen::ArrayXd mse = err[c].array().square().rowwise().mean();
+    const Eigen::ArrayXd mse = judged[c].array().square().rowwise().mean();
     r.cv_rmse = mse.sqrt().matrix();
     r.score = (mse * weight).sum();
     for (int f = 0; f < folds; ++f) r.fit_ms += ms[c * folds + f];
@@ -1166,7 +1193,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<Eigen::VectorXd, Features::kCount> stack;
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      stack[k] = OutputStack(t, err, options, k, folds, only[k]);
+      stack[k] = OutputStack(t, judged, options, k, folds, only[k]);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
@@ -1177,9 +1204,9 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
         all[c] = c;
         if (options.candidates[c].family == Family::kLinear) linear.push_back(c);
       }
-      choice.chosen[k] = ChooseAmong(all, err, options, k, only[k]);
+      choice.chosen[k] = ChooseAmong(all, judged, options, k, only[k]);
       if (linear.empty()) continue;
-      const int lin = ChooseAmong(linear, err, options, k), c = choice.chosen[k];
+      const int lin = ChooseAmong(linear, judged, options, k), c = choice.chosen[k];
       complete(c);
       choice.notes[k] =
           WhySetAside(table, options, full, c, lin, k, refitted[c] ? &err[c] : nullptr);

@@ -331,6 +331,18 @@ struct ChoiceOptions {
   /// squared held-out errors beat the first's by more than stack_gate_se standard errors
   /// (stack_gate_se_large from few_rows rows; BeatsFirst, no blocks); 0: every candidate enters.
   double stack_gate_se = 1.0, stack_gate_se_large = 1.5;
+  /// The held-out errors of each GP candidate judged by its closed-form leave-one-out (from
+  /// few_rows rows), as the choice sees them (Choice::table, the stack's gate, weights and
+  /// shrinkage, the hard choice), times sqrt(1 + gp_loo_hyperparameter_penalty p / n): p the GP's
+  /// fitted hyperparameters (d length scales, or 1 if isotropic, plus the signal and noise sd),
+  /// n the rows of its leave-one-out; 0: unscaled. The calibration and the stack's sd scale keep
+  /// the unscaled errors. Why: that leave-one-out is exact for fixed hyperparameters, and these
+  /// were fitted with the held-out row (Cawley & Talbot, JMLR 11, 2010); 2 is the in-sample
+  /// optimism of p maximum-likelihood parameters, 2 sigma^2 p / n (Mallows' Cp, Akaike's AIC;
+  /// Efron, "The estimation of prediction error: covariance penalties and cross-validation",
+  /// JASA 2004), with sigma^2 about the leave-one-out MSE. Opt-in (docs/workpiece-model.md,
+  /// "Tenth attempt").
+  double gp_loo_hyperparameter_penalty = 0;
   /// ChoiceOptions::stack: true: an output that one candidate takes whole (Choice::weights
   /// empty) gets a Choice::sd_scale too, from that candidate's held-out residuals, as a
   /// combination's; false: its own sd, unscaled.
