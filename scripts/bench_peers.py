@@ -35,7 +35,7 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
   "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-),
-  "confirmation10" (16001-).
+  "confirmation10" (16001-), "confirmation11" (17001-).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -347,6 +347,8 @@ SPLITS = {
     # The tenth attempt's confirmation (tuning part the eighth's plus 20-row seeds 1-20, 4001-,
     # 10001-13001): 16001-16010 at 20 and at 100 rows.
     "confirmation10": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 16001},
+    # The eleventh attempt's confirmation (tuning part the tenth's): 17001-17010 at 20 and 100 rows.
+    "confirmation11": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 17001},
 }
 
 

@@ -1,7 +1,7 @@
 // Development driver (not installed, not a test): fits the family choice or one candidate on a
 // training table and predicts a test table, printing JSON for scripts/bench_peers.py.
 //   family_bench --train T.csv --test X.csv [--candidates default|NAME,NAME...] [--no-cv]
-//                [--joint] [--loo|--kfold] [--no-1se] [--leave-first-se Z] [--leave-first-se-large Z] [--leave-first-blocks M] [--leave-first-row-share S] [--lowest-gp|--no-lowest-gp] [--lowest-gp-per-scale|--no-lowest-gp-per-scale] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
+//                [--joint] [--loo|--kfold] [--no-1se] [--leave-first-se Z] [--leave-first-se-large Z] [--leave-first-blocks M] [--leave-first-row-share S] [--lowest-gp|--no-lowest-gp] [--lowest-gp-per-scale|--no-lowest-gp-per-scale] [--lowest-gp-per-scale-large] [--equivalence-sd SD] [--gp-ftol F] [--gp-gtol G] [--gp-large-ftol F] [--gp-large-gtol G] [--calibration-folds K]
 //                [--stack|--no-stack] [--stack-se START FULL] [--stack-se-large START FULL] [--stack-gate-se Z Z_LARGE] [--two-sd|--one-sd] [--seed N] [--folds K] [--gp-restarts R] [--gp-single-start-rows N] [--threads N]
 //                [--few-rows N] [--refit-lowest-gp-rows N] [--refit-iterations N] [--refit-folds K]
 //                [--refit-hyper-rows N] [--refit-ftol F] [--refit-gtol G]
@@ -94,6 +94,8 @@ Args Parse(int argc, char** argv) {
       a.choice.lowest_gp_per_scale = true;
     else if (k == "--no-lowest-gp-per-scale")
       a.choice.lowest_gp_per_scale = false;
+    else if (k == "--lowest-gp-per-scale-large")
+      a.choice.lowest_gp_per_scale_large = true;
     else if (k == "--no-1se")
       a.choice.one_standard_error = false;
     else if (k == "--gp-ftol")

@@ -345,6 +345,61 @@ TEST(FamilyChoice, LowestGpPerScaleStacksTheLowestGpOfEachColumnScale) {
   EXPECT_EQ(ChooseFamily(large, per_scale).Describe(), ChooseFamily(large, lowest).Describe());
 }
 
+// ChoiceOptions::lowest_gp_per_scale_large: below few_rows the choice is the default's, bit for
+// bit (and the default has it off). From few_rows rows the lowest GP of each column scale takes
+// part (GpsThatTakePart, the same list for the stack and the hard choice): in the stack (every
+// candidate past the gate, unshrunk) every weighted GP is the lowest of its scale, at most one
+// per scale; in the hard choice (one-standard-error rule, simplest first, the log-column GP
+// listed before the raw-column ones) a log-column GP within one standard error of a lower
+// raw-column GP is chosen on some tables, which the default, with the lowest GP of all alone,
+// never allows.
+TEST(FamilyChoice, LowestGpPerScaleLargeLetsTheLowestGpOfEachScaleTakePartFromFewRows) {
+  ChoiceOptions per_scale, lowest;
+  EXPECT_FALSE(lowest.lowest_gp_per_scale_large);
+  per_scale.lowest_gp_per_scale_large = true;
+  const ProcessTable small = test::MakeBentTable(24, 0.03, 0.5, 1);
+  EXPECT_EQ(ChooseFamily(small, per_scale).Describe(), ChooseFamily(small, lowest).Describe());
+  for (ChoiceOptions* o : {&per_scale, &lowest}) {
+    o->candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-linear/log"),
+                     ParseCandidate("gp-matern52-constant/identity"),
+                     ParseCandidate("gp-se-constant/identity")};
+    o->stack_gate_se_large = 0;                             // every candidate past the gate
+    o->stack_start_se_large = o->stack_full_se_large = -1;  // the unshrunk stack
+    o->leave_first_se_large = 0;                            // the hard choice: every candidate
+  }
+  ChoiceOptions hard_per_scale = per_scale, hard_lowest = lowest;
+  hard_per_scale.stack = hard_lowest.stack = false;
+  const auto is_gp = [](const CvRow& r) { return r.candidate.family == Family::kGaussianProcess; };
+  int log_within_one_se = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    const int rows = per_scale.few_rows + 10 * (seed % 2);
+    const ProcessTable t = seed > 6 ? test::MakeTable(rows, 0.15, seed, true)
+                                    : test::MakeBentTable(rows, 0.15, 0.5, seed);
+    const Choice a = ChooseFamily(t, per_scale);
+    for (int k = 0; k < 2; ++k) {
+      std::array<int, 2> per = {0, 0};
+      for (int g : WeightedGps(a, k)) {
+        ++per[a.table[g].candidate.log];
+        for (const CvRow& r : a.table)
+          if (is_gp(r) && r.candidate.log == a.table[g].candidate.log) {
+            EXPECT_GE(r.cv_rmse(k), a.table[g].cv_rmse(k))
+                << "seed " << seed << ": " << a.Describe();
+          }
+      }
+      EXPECT_LE(per[0], 1);
+      EXPECT_LE(per[1], 1);
+    }
+    const Choice h = ChooseFamily(t, hard_per_scale), d = ChooseFamily(t, hard_lowest);
+    for (int k = 0; k < 2; ++k) {
+      const CvRow &ch = h.table[h.chosen[k]], &cd = d.table[d.chosen[k]];
+      for (const CvRow& r : d.table)  // the default: only the lowest GP of all takes part
+        if (is_gp(cd) && is_gp(r)) EXPECT_GE(r.cv_rmse(k), cd.cv_rmse(k)) << d.Describe();
+      log_within_one_se += is_gp(ch) && ch.candidate.log && is_gp(cd) && !cd.candidate.log;
+    }
+  }
+  EXPECT_GT(log_within_one_se, 0);  // the option changes the list on these tables
+}
+
 // ChoiceOptions::refit_lowest_gp_rows: per output the GP with the lowest closed-form
 // leave-one-out error keeps the held-out errors that refitting every GP gives it (the same
 // folds, fixed starts), the other GP keeps its closed-form leave-one-out errors, and no GP but

@@ -826,11 +826,13 @@ std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
 
 // ChoiceOptions::lowest_gp: `kept` without its GP candidates except the one with the lowest
 // held-out error of output k (the first of equal ones), which keeps its place; with
-// lowest_gp_per_scale below few_rows rows one such GP per column scale (Candidate::log).
+// lowest_gp_per_scale below few_rows rows (lowest_gp_per_scale_large from few_rows on) one such
+// GP per column scale (Candidate::log).
 std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
                                      const std::vector<Eigen::MatrixXd>& err,
                                      const ChoiceOptions& o, int k) {
-  const bool per_scale = o.lowest_gp_per_scale && err.front().cols() < o.few_rows;
+  const bool per_scale = err.front().cols() < o.few_rows ? o.lowest_gp_per_scale
+                                                         : o.lowest_gp_per_scale_large;
   std::array<int, 2> best = {-1, -1};  // [log]; one slot without per_scale
   for (int c : kept) {
     int& b = best[per_scale && o.candidates[c].log ? 1 : 0];

@@ -381,6 +381,12 @@ struct ChoiceOptions {
   /// (docs/workpiece-model.md, "Seventh attempt": on the tuning part alone it lowered the 20-row
   /// test RMSE, and with the shrinkage 0.5-1.5 did not hold on the confirmation part).
   bool lowest_gp_per_scale = false;
+  /// The same per-scale rule from few_rows rows on (GPs judged by their closed-form
+  /// leave-one-out); below few_rows lowest_gp_per_scale alone decides. Why: at 100 rows the
+  /// log-column GP, whose leave-one-out is the most optimistic of the GPs, took the one slot on
+  /// tables where the raw-column GP alone predicted better (docs/workpiece-model.md, "Tenth
+  /// attempt: diagnosis"). Opt-in (the same document, "Eleventh attempt").
+  bool lowest_gp_per_scale_large = false;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
