@@ -31,6 +31,11 @@
 // screws where a bend would show (mid-levels) only as far as that prior makes it pay. tau -> 0
 // gives the D-optimal design of the power law; tau = 1 is the paper's default. Same search as D
 // and I. The first design's automatic `inside` is 0 with it (the hedge is the criterion's).
+// Not the default: on lists of continuous inputs it sees a square through one mid-level
+// coordinate and keeps the other coordinates at the edges, so it puts hardly any screw inside
+// the box, and neither squares nor squares+interactions at tau = 1 beat the D-optimal design
+// with 2 inside picks on the ninth attempt's tuning part (docs/design.md). The next screws have
+// its analogue already: kPowerGp is a power law with a prior on a smooth departure.
 //
 // Space filling (`space_filling` screws of the count): the optimal design puts every screw at
 // the edges of the log-input box, where a power law is best determined but a bend inside the box
