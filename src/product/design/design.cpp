@@ -866,8 +866,10 @@ std::vector<int> OptimalPicks(const Eigen::MatrixXd& f, int count, Criterion cri
   }
   std::vector<int> picked = GreedyStart(x, count, prior);
   Exchange(x, criterion, w, prior, &picked);
-  if (criterion == Criterion::kBayesD) d->bayes_log_det = CriterionValue(x, picked, criterion, w, prior);
-  if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w, Eigen::VectorXd::Zero(f.cols()))))
+  if (criterion == Criterion::kBayesD)
+    d->bayes_log_det = CriterionValue(x, picked, criterion, w, prior);
+  const Eigen::VectorXd none = Eigen::VectorXd::Zero(f.cols());
+  if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w, none)))
     throw InputError("design: the candidates do not determine a power law (their log inputs "
                      "are collinear); add candidates that vary the inputs independently");
   d->picks = ExplainingOrder(f, picked);
