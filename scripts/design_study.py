@@ -130,7 +130,8 @@ def designed(ev, criterion, batch, first_lhs=None, fill_first=0, fill_next=0, va
     """RMSE per size of the sequential design: FIRST by the first design (or the Latin hypercube
     picks `first_lhs`), then batches; fill_first / fill_next: `whirl design --space-filling`;
     variance: extra `whirl design` arguments of the next screws (--variance ..., None: defaults;
-    the hyperparameters go to the first design too); inside: the first design's `--inside K`;
+    the hyperparameters go to the first design too); inside: the first design's own options
+    (`--inside K`, `--potential-terms`, `--tau`);
     picks: a list that receives the pool rows picked, in order."""
     pool = os.path.join(ev.tmp, "pool.csv")
     bp.write_table(pool, ev.x)
@@ -183,9 +184,19 @@ def one_case(prob, seed, a, cache):
         first = lhs_pick(x, FIRST, np.random.default_rng([7, seed])) if a.first == "lhs" else None
         res["design"] = designed(ev, a.criterion, a.batch, first, a.fill_first, a.fill_next,
                                  variance_args(a),
-                                 [] if a.inside is None else ["--inside", str(a.inside)],
+                                 first_design_args(a),
                                  PICKS.setdefault(f"{prob}/{seed}", []))
         return prob, seed, res
+
+
+def first_design_args(a):
+    """The first design's own `whirl design` options given to the study (none: the defaults)."""
+    out = []
+    for flag, v in (("--inside", a.inside), ("--potential-terms", a.potential_terms),
+                    ("--tau", a.tau)):
+        if v is not None:
+            out += [flag, str(v)]
+    return out
 
 
 def variance_args(a):
@@ -389,7 +400,10 @@ def main():
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     ap.add_argument("--problems", default="simgen,powerlaw")
     ap.add_argument("--seeds", default="1-10")
-    ap.add_argument("--criterion", default="d", choices=["d", "i"])
+    ap.add_argument("--criterion", default="d", choices=["d", "i", "bayes-d"])
+    ap.add_argument("--potential-terms", choices=["squares", "squares+interactions"],
+                    help="whirl design --potential-terms of the first design (--criterion bayes-d)")
+    ap.add_argument("--tau", type=float, help="whirl design --tau of the first design (bayes-d)")
     ap.add_argument("--batch", type=int, default=2)
     ap.add_argument("--first", default="design", choices=["design", "lhs"],
                     help="the design strategy's first 8 screws: whirl design, or a Latin hypercube")
@@ -444,7 +458,8 @@ def main():
                       for k in STRATEGIES if k != "design"})
     table = summarize(results, problems)
     print(f"criterion {a.criterion}, batch {a.batch}, space filling {a.fill_first} (first) / "
-          f"{a.fill_next} (next), inside {a.inside}, next screws "
+          f"{a.fill_next} (next), first design {' '.join(first_design_args(a)) or 'defaults'}, "
+          f"next screws "
           f"{' '.join(variance_args(a)) or 'defaults'}, "
           f"seeds {a.seeds}, pool {POOL_ROWS}")
     print_markdown(table)
@@ -454,7 +469,7 @@ def main():
             json.dump({"criterion": a.criterion, "batch": a.batch, "seeds": a.seeds,
                        "fill_first": a.fill_first, "fill_next": a.fill_next,
                        "next_screws": variance_args(a) or "whirl design defaults",
-                       "inside": a.inside,
+                       "inside": a.inside, "first_design": first_design_args(a),
                        "command": " ".join(sys.argv),
                        "cases": results, "medians": table, "design_picks": PICKS}, h)
     paired_report(results, a.paired_with)

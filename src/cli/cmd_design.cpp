@@ -26,6 +26,8 @@ struct DesignCliOptions {
   std::array<std::string, ProcessInputs::kCount> ranges;
   int count = 0, levels = 3, space_filling = 0, inside = design::kInsideAuto;
   std::string criterion = "d", variance = design::ToString(design::NextRule{}.model);
+  std::string potential_terms = design::ToString(design::BayesPrior{}.terms);
+  double tau = design::BayesPrior{}.tau;
   std::string fill_rule = design::ToString(design::SpaceFilling{}.rule);
   std::string fill_when = design::ToString(design::SpaceFilling{}.when);
   double departure_ratio = design::NextRule{}.departure_ratio;
@@ -161,10 +163,19 @@ design::NextRule RuleOf(const DesignCliOptions& o) {
   return rule;
 }
 
+// The first design's criterion as the text report names it.
+std::string CriterionText(const DesignCliOptions& o) {
+  if (o.criterion == "d") return "D-optimal";
+  if (o.criterion == "i") return "I-optimal";
+  return "Bayesian D-optimal, potential terms " + o.potential_terms + ", tau " +
+         FormatSignificant(o.tau, 3) + ",";
+}
+
 void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
+  const design::BayesPrior bayes{design::ParsePotentialTerms(o.potential_terms), o.tau};
   const auto d = design::DesignPowerLaw(c.inputs, o.count, design::ParseCriterion(o.criterion),
                                         o.space_filling, o.inside, RuleOf(o),
-                                        design::ParseFillRule(o.fill_rule));
+                                        design::ParseFillRule(o.fill_rule), bayes);
   const std::string csv = DesignCsv(c, d.picks, false, "first design, criterion " + o.criterion);
   if (!o.out_path.empty()) WriteFileAtomic(o.out_path, csv);
   if (o.json) {
@@ -174,17 +185,24 @@ void RunFirstDesign(const DesignCliOptions& o, const DesignCandidates& c) {
               std::isfinite(p.sd_now[0]) ? nlohmann::json(p.sd_now[0]) : nlohmann::json(nullptr);
           (*j)["sd_factor_after"] = p.sd_after[0];
         });
-    PrintJson({{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
+    nlohmann::json out = {{"mode", "first"}, {"criterion", o.criterion}, {"candidates", c.source},
                {"candidate_count", c.inputs.size()}, {"coefficients", d.coefficients},
                {"varying_inputs", d.inputs}, {"log_det_per_screw", d.log_det},
                {"space_filling", d.space_filling}, {"space_filling_rule", o.fill_rule},
                {"inside", d.inside},
                {"min_distance", d.min_distance},
                {"mean_sd_factor", d.mean_sd_factor}, {"max_sd_factor", d.max_sd_factor},
-               {"picks", picks}});
+               {"picks", picks}};
+    if (d.criterion == design::Criterion::kBayesD) {
+      out["potential_terms"] = o.potential_terms;
+      out["potential_columns"] = d.potential_terms;
+      out["tau"] = o.tau;
+      out["bayes_log_det"] = d.bayes_log_det;
+    }
+    PrintJson(out);
     return;
   }
-  std::cout << "first design (" << (o.criterion == "d" ? "D" : "I") << "-optimal for the power law "
+  std::cout << "first design (" << CriterionText(o) << " for the power law "
             << "on log inputs"
             << (d.inside > 0 ? ", the last " + std::to_string(d.inside) +
                                    " of them inside the range by the power-gp variance"
@@ -296,6 +314,17 @@ void RunNextScrews(const DesignCliOptions& o, const DesignCandidates& c) {
   if (!o.out_path.empty()) std::cout << "written: " << o.out_path << "\n";
 }
 
+// --criterion bayes-d is a first design's; --potential-terms and --tau are its alone.
+void CheckBayesOptions(const DesignCliOptions& o) {
+  const design::BayesPrior defaults;
+  const bool bayes = design::ParseCriterion(o.criterion) == design::Criterion::kBayesD;
+  if (bayes && !o.model_path.empty())
+    throw InputError("design: --criterion bayes-d is a first design's (without --model); the "
+                     "next screws follow --variance");
+  if (!bayes && (o.potential_terms != design::ToString(defaults.terms) || o.tau != defaults.tau))
+    throw InputError("design: --potential-terms and --tau need --criterion bayes-d");
+}
+
 void RunDesign(const DesignCliOptions& o) {
   CheckOutputs({{"--candidates", o.candidates_path}, {"--model", o.model_path},
                 {"--measured", o.measured_path}},
@@ -303,6 +332,8 @@ void RunDesign(const DesignCliOptions& o) {
   design::ParseFillRule(o.fill_rule);  // bad spellings before any file is read
   design::ParseFillWhen(o.fill_when);
   design::ParseEvidence(o.evidence);
+  design::ParsePotentialTerms(o.potential_terms);
+  CheckBayesOptions(o);
   if (o.model_path.empty() && (o.tolerance_um > 0 || o.tolerance_s > 0))
     throw InputError("design: --tolerance-um / --tolerance-s need --model (the stop rule judges a "
                      "trained model's predictive sd)");
@@ -342,7 +373,8 @@ void RegisterDesign(CLI::App& app) {
       "Which screws to measure (src/product/design/design.h; evidence in docs/design.md).\n"
       "First design (no --model): the --count screws that best determine the power law of the\n"
       "five inputs (D- or I-optimal on log inputs), the last --inside (2) of them where a\n"
-      "smooth departure from it is least known, from --candidates CSV (the screw types the\n"
+      "smooth departure from it is least known (--criterion bayes-d instead: Bayesian\n"
+      "D-optimal, a prior on squared log inputs), from --candidates CSV (the screw types the\n"
       "shop makes: columns hardness_hrc, diameter_mm, pitch_mm, raceway_radius_mm,\n"
       "cutting_speed_m_min; other columns ignored) or from a grid over the five ranges.\n"
       "Next screws (--model M.json from 'whirl train', --measured TABLE.csv: the screws measured\n"
@@ -376,9 +408,20 @@ void RegisterDesign(CLI::App& app) {
       ->capture_default_str()
       ->check(NumberIn(2, 9));
   sub->add_option("--criterion", o->criterion,
-                  "first design: d (D-optimal: the power law's coefficients) or i (I-optimal: its "
-                  "mean prediction variance over the candidates)")
+                  "first design: d (D-optimal: the power law's coefficients), i (I-optimal: its "
+                  "mean prediction variance over the candidates) or bayes-d (Bayesian "
+                  "D-optimal, DuMouchel & Jones: also hedges against the --potential-terms "
+                  "bending the power law; --inside 0 by default)")
       ->capture_default_str();
+  sub->add_option("--potential-terms", o->potential_terms,
+                  "with --criterion bayes-d: squares (of the centred log inputs) or "
+                  "squares+interactions (also their pairwise products)")
+      ->capture_default_str();
+  sub->add_option("--tau", o->tau,
+                  "with --criterion bayes-d: the potential terms' prior sd in units of the "
+                  "measurement scatter [ratio] (toward 0: the D-optimal design)")
+      ->capture_default_str()
+      ->check(PositiveNumber());
   sub->add_option("--space-filling", o->space_filling,
                   "screws of --count chosen for space filling [screws]: each the candidate of "
                   "largest distance (standardized log inputs) to the screws before it and, with "
@@ -400,7 +443,7 @@ void RegisterDesign(CLI::App& app) {
                   "first design: screws of --count picked after the optimal ones by the "
                   "power-gp variance (see --variance) given those before, so that the first "
                   "table sees inside the range [screws] (default: 2, fewer where --count leaves "
-                  "no room beyond the power law's coefficients)")
+                  "no room beyond the power law's coefficients; 0 with --criterion bayes-d)")
       ->check(NumberIn(0, 100000));
   sub->add_option("--measured", o->measured_path,
                   "with --model: the screws measured so far (CSV, five input columns; e.g. the "

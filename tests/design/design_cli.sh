@@ -145,6 +145,20 @@ d = json.load(open(sys.argv[1]))
 assert d["inside"] == 2 and len({p["source"] for p in d["picks"]}) == 8
 assert [p["why"].startswith("inside the range") for p in d["picks"]] == [False] * 6 + [True] * 2
 PY3
+# --criterion bayes-d: no inside picks by default, picks beyond the coefficients say why, and the
+# prior's figures in the JSON.
+"$whirl" design "${ranges[@]}" --count 10 --criterion bayes-d --potential-terms \
+  squares+interactions --tau 1 --json > bayes.json 2> err.txt || fail "bayes-d: $(cat err.txt)"
+python3 - bayes.json <<'PY4' || fail "bayes.json: $(cat bayes.json)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["criterion"] == "bayes-d" and d["inside"] == 0 and d["potential_columns"] == 15
+assert len({p["source"] for p in d["picks"]}) == 10 and d["bayes_log_det"] > 0
+assert [p["why"].startswith("Bayesian D-optimal") for p in d["picks"]] == [False] * 6 + [True] * 4
+PY4
+"$whirl" design "${ranges[@]}" --count 8 --criterion bayes-d > out.txt 2> err.txt \
+  || fail "bayes-d text: $(cat err.txt)"
+grep -q "Bayesian D-optimal, potential terms squares, tau 1" out.txt || fail "bayes-d: $(cat out.txt)"
 "$whirl" design --model m.json --candidates cands.csv --count 2 --space-filling 1 \
   --measured "$data" > out.txt 2> err.txt || fail "next --space-filling: $(cat err.txt)"
 grep -q "why: space filling" out.txt || fail "no space-filling pick: $(cat out.txt)"
@@ -260,6 +274,12 @@ expect_fail "--departure-evidence 'fit': expected 'lack-of-fit'" "$whirl" design
   --candidates cands.csv --count 2 --measured "$data" --departure-evidence fit
 expect_fail "--departure-evidence choice needs --variance switch" "$whirl" design --model m.json \
   --candidates cands.csv --count 2 --measured "$data" --variance power-gp --departure-evidence choice
+expect_fail "--potential-terms and --tau need --criterion bayes-d" "$whirl" design "${ranges[@]}" \
+  --count 8 --tau 2
+expect_fail "--criterion bayes-d is a first design" "$whirl" design --model m.json \
+  --candidates cands.csv --count 2 --measured "$data" --criterion bayes-d
+expect_fail "--potential-terms 'cubes': expected" "$whirl" design "${ranges[@]}" --count 8 \
+  --criterion bayes-d --potential-terms cubes
 expect_fail "--inside is a first design" "$whirl" design --model m.json --candidates cands.csv \
   --count 2 --measured "$data" --inside 1
 expect_fail "count 8: the power law.*plus --inside 3" "$whirl" design "${ranges[@]}" --count 8 \

@@ -967,5 +967,107 @@ TEST(Design, ChoiceEvidenceSwitchesWhereTheModelLeftThePowerLaw) {
   EXPECT_THROW(ParseEvidence("ratio"), InputError);
 }
 
+
+// ---- Bayesian D (DuMouchel & Jones 1994) ------------------------------------------------------
+
+std::set<int> PickSet(const PowerLawDesign& d) {
+  std::set<int> s;
+  for (const auto& p : d.picks) s.insert(p.candidate);
+  return s;
+}
+
+// One input varies: ln(diameter / 50 mm) = t in {-1, -0.5, 0, 0.5, 1}, 3 screws. Primary terms
+// (1, z), z = t / sqrt(0.5) (standardized); the potential square z^2 is symmetric, so orthogonal
+// to z; its residual on 1 is prop. to t^2 - 0.5, range-scaled to q = (1, -0.5, -1, -0.5, 1).
+// For t = {-1, 0, 1}: X'X = [[3, 0, 1], [0, 4, 0], [1, 0, 3]], det 32, and det(F'F) = 12; for
+// t = {-1, +-0.5, 1}: det(X'X) = 18, det(F'F) = 13 (the D-optimal ones). With the prior k =
+// 1 / tau^2 on q, det(X'X + k e e') = det(X'X) + k det(F'F): 32 + 12 k against 18 + 13 k, so the
+// mid-level screw wins while k < 14 (tau > 0.267): at tau = 1, ln det = ln 44.
+std::vector<ProcessInputs> FiveDiameters() {
+  std::vector<ProcessInputs> c;
+  for (double t : {-1.0, -0.5, 0.0, 0.5, 1.0})
+    c.push_back(ProcessInputs::FromArray({62, 50 * std::exp(t), 10, 5, 180}));
+  return c;
+}
+
+TEST(Design, BayesDTakesTheMidLevelByHand) {
+  const auto c = FiveDiameters();
+  const auto b = DesignPowerLaw(c, 3, Criterion::kBayesD, 0, kInsideAuto, {}, FillRule::kMaximin,
+                                {BayesPrior::Terms::kSquares, 1.0});
+  EXPECT_EQ(PickSet(b), (std::set<int>{0, 2, 4}));
+  EXPECT_NEAR(b.bayes_log_det, std::log(44.0), 1e-9);
+  EXPECT_EQ(b.potential_terms, 1);
+  EXPECT_EQ(b.inside, 0);  // the automatic --inside is 0 with bayes-d
+  // Interactions need two varying inputs: none here, the same design.
+  const auto bi = DesignPowerLaw(c, 3, Criterion::kBayesD, 0, 0, {}, FillRule::kMaximin,
+                                 {BayesPrior::Terms::kSquaresInteractions, 1.0});
+  EXPECT_EQ(PickSet(bi), PickSet(b));
+  const auto d = PickSet(DesignPowerLaw(c, 3, Criterion::kD, 0, 0));
+  EXPECT_TRUE(d == (std::set<int>{0, 1, 4}) || d == (std::set<int>{0, 3, 4}));
+  // Past k = 14 (tau = 0.2: k = 25) the D-optimal screws win: 18 + 13 k = 343 > 32 + 12 k = 332.
+  const auto small = DesignPowerLaw(c, 3, Criterion::kBayesD, 0, 0, {}, FillRule::kMaximin,
+                                    {BayesPrior::Terms::kSquares, 0.2});
+  EXPECT_EQ(PickSet(small).count(2), 0u);
+  EXPECT_NEAR(small.bayes_log_det, std::log(343.0), 1e-9);
+}
+
+TEST(Design, BayesDWithTinyTauIsTheDOptimalDesign) {
+  std::mt19937 rng(11);
+  const auto cands = RandomList(rng, 60);
+  for (auto terms : {BayesPrior::Terms::kSquares, BayesPrior::Terms::kSquaresInteractions})
+    for (int count : {6, 8, 12}) {
+      const auto d = DesignPowerLaw(cands, count, Criterion::kD, 0, 0);
+      const auto b = DesignPowerLaw(cands, count, Criterion::kBayesD, 0, 0, {},
+                                    FillRule::kMaximin, {terms, 1e-3});
+      EXPECT_EQ(PickSet(b), PickSet(d)) << "count " << count;
+      EXPECT_NEAR(b.log_det, d.log_det, 1e-9);
+    }
+}
+
+TEST(Design, BayesDRespectsTheListAndTheRanges) {
+  const auto r = PaperRanges();
+  const auto g3 = GridCandidates(r, 3);
+  for (auto terms : {BayesPrior::Terms::kSquares, BayesPrior::Terms::kSquaresInteractions}) {
+    const auto b = DesignPowerLaw(g3, 12, Criterion::kBayesD, 0, kInsideAuto, {},
+                                  FillRule::kMaximin, {terms, 1.0});
+    ASSERT_EQ(PickSet(b).size(), 12u);
+    EXPECT_EQ(b.potential_terms, terms == BayesPrior::Terms::kSquares ? 5 : 15);
+    int mid = 0;  // coordinates at the grid's middle level, where a bend shows
+    for (int c : PickSet(b)) {
+      ASSERT_GE(c, 0);
+      ASSERT_LT(c, static_cast<int>(g3.size()));
+      const auto a = g3[c].ToArray();
+      for (int j = 0; j < 5; ++j) {
+        EXPECT_GE(a[j], r.lo[j]);
+        EXPECT_LE(a[j], r.hi[j]);
+        mid += a[j] != r.lo[j] && a[j] != r.hi[j];
+      }
+    }
+    EXPECT_GT(mid, 0);
+    // A squared log input takes one value over two levels: no potential square survives; the
+    // design is then the D-optimal one (squares) or spends the prior on the 10 interactions.
+    const auto g2 = GridCandidates(r, 2);
+    const auto b2 = DesignPowerLaw(g2, 8, Criterion::kBayesD, 0, 0, {}, FillRule::kMaximin,
+                                   {terms, 1.0});
+    EXPECT_EQ(b2.potential_terms, terms == BayesPrior::Terms::kSquares ? 0 : 10);
+  }
+  const auto d = DesignPowerLaw(g3, 12, Criterion::kD, 0, 0);  // the D design: corners only
+  for (int c : PickSet(d))
+    for (int j = 0; j < 5; ++j)
+      EXPECT_TRUE(g3[c].ToArray()[j] == r.lo[j] || g3[c].ToArray()[j] == r.hi[j]);
+}
+
+TEST(Design, BayesDBadRequestsAreNamed) {
+  const auto c = FiveDiameters();
+  for (double tau : {0.0, -1.0, std::nan("")})
+    EXPECT_THROW(DesignPowerLaw(c, 3, Criterion::kBayesD, 0, 0, {}, FillRule::kMaximin,
+                                {BayesPrior::Terms::kSquares, tau}),
+                 InputError);
+  EXPECT_THROW(ParsePotentialTerms("cubes"), InputError);
+  EXPECT_EQ(ParseCriterion("bayes-d"), Criterion::kBayesD);
+  EXPECT_EQ(ToString(ParsePotentialTerms("squares+interactions")), "squares+interactions");
+  EXPECT_THROW(DesignPowerLaw(c, 1, Criterion::kBayesD), InputError);  // below 2 coefficients
+}
+
 }  // namespace
 }  // namespace whirl::design

@@ -29,6 +29,7 @@ DIMENSIONLESS=(
   --score-rows            # shares of a run's rows
   --threshold             # drift split: in the unit of the --at column, whatever it is
   --train --test          # drift holdout: shares of the rows
+  --tau                   # design: the potential terms' prior sd over the scatter's (the paper's tau)
 )
 # Flags not yet renamed, each "<command> <flag>" ("<command> --json": no --json yet): skipped by
 # the walk until renamed. Empty: every command follows the grammar.

@@ -49,24 +49,49 @@ Eigen::MatrixXd PowerLawRows(const std::vector<ProcessInputs>& cands,
   return f;
 }
 
-// The criterion (larger is better) of the rows `picked` of f; -inf when F'F is singular.
+// The Bayesian D design's potential columns (design.h, "Bayesian D") over the candidates:
+// squares (and pairwise products) of f's standardized log inputs, each the residual of its
+// least-squares regression on f's columns, scaled to a range of 2; columns without range left out.
+Eigen::MatrixXd PotentialColumns(const Eigen::MatrixXd& f, BayesPrior::Terms terms) {
+  const Eigen::MatrixXd u = f.rightCols(f.cols() - 1);
+  std::vector<Eigen::VectorXd> raw;
+  for (Eigen::Index i = 0; i < u.cols(); ++i) raw.push_back(u.col(i).array().square());
+  if (terms == BayesPrior::Terms::kSquaresInteractions)
+    for (Eigen::Index i = 0; i < u.cols(); ++i)
+      for (Eigen::Index j = i + 1; j < u.cols(); ++j)
+        raw.push_back(u.col(i).cwiseProduct(u.col(j)));
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(f);
+  std::vector<Eigen::VectorXd> kept;
+  for (const auto& z : raw) {
+    const Eigen::VectorXd r = z - f * qr.solve(z);
+    const double range = r.maxCoeff() - r.minCoeff();
+    if (range > 1e-9 * std::max(1.0, z.cwiseAbs().maxCoeff())) kept.push_back(2.0 * r / range);
+  }
+  Eigen::MatrixXd out(f.rows(), static_cast<Eigen::Index>(kept.size()));
+  for (std::size_t k = 0; k < kept.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = kept[k];
+  return out;
+}
+
+// The criterion (larger is better) of the rows `picked` of f, the diagonal `prior` added to
+// F'F (zeros but for Criterion::kBayesD, which is then D's); -inf when that is singular.
 double CriterionValue(const Eigen::MatrixXd& f, const std::vector<int>& picked, Criterion c,
-                 const Eigen::MatrixXd& w) {
-  const int p = static_cast<int>(f.cols());
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p, p);
+                      const Eigen::MatrixXd& w, const Eigen::VectorXd& prior) {
+  Eigen::MatrixXd m = prior.asDiagonal();
   for (int i : picked) m.noalias() += f.row(i).transpose() * f.row(i);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
   const Eigen::VectorXd d = ldlt.vectorD();
   if (ldlt.info() != Eigen::Success || d.minCoeff() <= 1e-10 * std::max(1.0, d.maxCoeff()))
     return -std::numeric_limits<double>::infinity();
-  if (c == Criterion::kD) return d.array().log().sum();
+  if (c != Criterion::kI) return d.array().log().sum();
   return -(ldlt.solve(w)).trace();  // mean_c f_c' M^-1 f_c = tr(M^-1 W)
 }
 
-// Greedy start: each pick the candidate of largest f' (M + eps I)^-1 f (the D rule of Wynn).
-std::vector<int> GreedyStart(const Eigen::MatrixXd& f, int count) {
+// Greedy start: each pick the candidate of largest f' (M + prior + eps I)^-1 f (the D rule of
+// Wynn).
+std::vector<int> GreedyStart(const Eigen::MatrixXd& f, int count, const Eigen::VectorXd& prior) {
   const int p = static_cast<int>(f.cols());
   Eigen::MatrixXd m = 1e-6 * Eigen::MatrixXd::Identity(p, p);
+  m.diagonal() += prior;
   std::vector<int> picked;
   std::vector<char> taken(f.rows(), 0);
   for (int k = 0; k < count; ++k) {
@@ -87,10 +112,10 @@ std::vector<int> GreedyStart(const Eigen::MatrixXd& f, int count) {
 
 // Fedorov exchanges until no swap improves the criterion (at most 50 passes).
 void Exchange(const Eigen::MatrixXd& f, Criterion c, const Eigen::MatrixXd& w,
-              std::vector<int>* picked) {
+              const Eigen::VectorXd& prior, std::vector<int>* picked) {
   std::vector<char> taken(f.rows(), 0);
   for (int i : *picked) taken[i] = 1;
-  double value = CriterionValue(f, *picked, c, w);
+  double value = CriterionValue(f, *picked, c, w, prior);
   for (int pass = 0; pass < 50; ++pass) {
     bool improved = false;
     for (auto& slot : *picked) {
@@ -98,7 +123,7 @@ void Exchange(const Eigen::MatrixXd& f, Criterion c, const Eigen::MatrixXd& w,
         if (taken[cand]) continue;
         const int old = slot;
         slot = cand;
-        const double v = CriterionValue(f, *picked, c, w);
+        const double v = CriterionValue(f, *picked, c, w, prior);
         if (v > value + 1e-9 * std::max(1.0, std::abs(value))) {
           taken[old] = 0, taken[cand] = 1, value = v, improved = true;
         } else {
@@ -628,10 +653,25 @@ void ApplyStopRule(const StopRule& rule, std::array<OutputState, Features::kCoun
 Criterion ParseCriterion(const std::string& s) {
   if (s == "d") return Criterion::kD;
   if (s == "i") return Criterion::kI;
-  throw InputError("--criterion '" + s + "': expected 'd' (D-optimal) or 'i' (I-optimal)");
+  if (s == "bayes-d") return Criterion::kBayesD;
+  throw InputError("--criterion '" + s + "': expected 'd' (D-optimal), 'i' (I-optimal) or "
+                   "'bayes-d' (Bayesian D-optimal with potential terms)");
 }
 
-std::string ToString(Criterion c) { return c == Criterion::kD ? "d" : "i"; }
+std::string ToString(Criterion c) {
+  return c == Criterion::kD ? "d" : c == Criterion::kI ? "i" : "bayes-d";
+}
+
+BayesPrior::Terms ParsePotentialTerms(const std::string& s) {
+  if (s == "squares") return BayesPrior::Terms::kSquares;
+  if (s == "squares+interactions") return BayesPrior::Terms::kSquaresInteractions;
+  throw InputError("--potential-terms '" + s + "': expected 'squares' or "
+                   "'squares+interactions'");
+}
+
+std::string ToString(BayesPrior::Terms t) {
+  return t == BayesPrior::Terms::kSquares ? "squares" : "squares+interactions";
+}
 
 NextRule::Model ParseNextModel(const std::string& s) {
   if (s == "power-gp") return NextRule::Model::kPowerGp;
@@ -798,11 +838,52 @@ double MinPairDistance(const Eigen::MatrixXd& f, const std::vector<int>& picked)
   return d;
 }
 
+std::string WhyBayes(const Pick& p, const BayesPrior& bayes) {
+  return "Bayesian D-optimal (DuMouchel & Jones 1994; potential terms " + ToString(bayes.terms) +
+         ", tau " + FormatSignificant(bayes.tau, 3) + "): a bend of the power law in the log "
+         "inputs would show here; power-law sd factor " + FormatSignificant(p.sd_now[0], 3) +
+         " -> " + FormatSignificant(p.sd_after[0], 3);
+}
+
+// The optimal part of the first design: `count` picks of f by the criterion (greedy start, then
+// exchanges; kBayesD on f with its potential columns and their prior, design.h), in the
+// explaining order; sets d's bayes_log_det and potential_terms for kBayesD.
+std::vector<int> OptimalPicks(const Eigen::MatrixXd& f, int count, Criterion criterion,
+                              const BayesPrior& bayes, PowerLawDesign* d) {
+  const Eigen::MatrixXd w = f.transpose() * f / static_cast<double>(f.rows());
+  Eigen::MatrixXd x = f;
+  Eigen::VectorXd prior = Eigen::VectorXd::Zero(f.cols());
+  if (criterion == Criterion::kBayesD) {
+    if (!(bayes.tau > 0) || !std::isfinite(bayes.tau))
+      throw InputError("design --tau " + FormatSignificant(bayes.tau, 6) +
+                       ": must be positive and finite (the potential terms' prior sd)");
+    const Eigen::MatrixXd z = PotentialColumns(f, bayes.terms);
+    x.conservativeResize(Eigen::NoChange, f.cols() + z.cols());
+    x.rightCols(z.cols()) = z;
+    prior = Eigen::VectorXd::Zero(x.cols());
+    prior.tail(z.cols()).setConstant(1.0 / (bayes.tau * bayes.tau));
+    d->potential_terms = static_cast<int>(z.cols());
+  }
+  std::vector<int> picked = GreedyStart(x, count, prior);
+  Exchange(x, criterion, w, prior, &picked);
+  if (criterion == Criterion::kBayesD)
+    d->bayes_log_det = CriterionValue(x, picked, criterion, w, prior);
+  const Eigen::VectorXd none = Eigen::VectorXd::Zero(f.cols());
+  if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w, none)))
+    throw InputError("design: the candidates do not determine a power law (their log inputs "
+                     "are collinear); add candidates that vary the inputs independently");
+  d->picks = ExplainingOrder(f, picked);
+  if (criterion == Criterion::kBayesD)
+    for (std::size_t i = static_cast<std::size_t>(f.cols()); i < d->picks.size(); ++i)
+      d->picks[i].why = WhyBayes(d->picks[i], bayes);
+  return picked;
+}
+
 }  // namespace
 
 PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count,
                               Criterion criterion, int space_filling, int inside,
-                              const NextRule& rule, FillRule fill) {
+                              const NextRule& rule, FillRule fill, const BayesPrior& bayes) {
   if (cands.empty()) throw InputError("design: the candidate list is empty");
   PowerLawDesign d;
   d.criterion = criterion;
@@ -814,7 +895,9 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
     throw InputError("design --space-filling " + std::to_string(space_filling) +
                      ": must lie in [0, --count - 1]");
   if (inside == kInsideAuto)
-    inside = std::clamp(count - space_filling - d.coefficients, 0, kDefaultInside);
+    inside = criterion == Criterion::kBayesD
+                 ? 0
+                 : std::clamp(count - space_filling - d.coefficients, 0, kDefaultInside);
   if (inside < 0 || inside + space_filling >= count)
     throw InputError("design --inside " + std::to_string(inside) +
                      ": must lie in [0, --count - --space-filling - 1]");
@@ -827,17 +910,13 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
                      std::to_string(n) + "] (the coefficients plus --space-filling " +
                      std::to_string(space_filling) + " plus --inside " + std::to_string(inside) +
                      ", at most the candidates)");
-  const Eigen::MatrixXd w = f.transpose() * f / static_cast<double>(n);
-  std::vector<int> picked = GreedyStart(f, count - space_filling - inside);
-  Exchange(f, criterion, w, &picked);
-  if (!std::isfinite(CriterionValue(f, picked, Criterion::kD, w)))
-    throw InputError("design: the candidates do not determine a power law (their log inputs "
-                     "are collinear); add candidates that vary the inputs independently");
-  d.picks = ExplainingOrder(f, picked);
+  std::vector<int> picked = OptimalPicks(f, count - space_filling - inside, criterion, bayes, &d);
   AddPowerGpPicks(f, inside, rule, &picked, &d.picks);
   d.inside = inside;
   AddSpaceFilling(f, space_filling, fill, &picked, &d.picks);
-  d.log_det = CriterionValue(f, picked, Criterion::kD, w) - d.coefficients * std::log(count);
+  const Eigen::VectorXd none = Eigen::VectorXd::Zero(f.cols());
+  d.log_det = CriterionValue(f, picked, Criterion::kD, Eigen::MatrixXd(), none) -
+              d.coefficients * std::log(count);
   d.min_distance = MinPairDistance(f, picked);
   double sum = 0, mx = 0;
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(f.cols(), f.cols());
