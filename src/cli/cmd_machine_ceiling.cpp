@@ -34,9 +34,13 @@ nlohmann::json CeilingJson(const std::vector<machine_eval::CeilingScenario>& row
   for (const auto& r : rows) {
     nlohmann::json cuts = nlohmann::json::array();
     for (const auto& c : r.cuts)
-      cuts.push_back({{"machine", c.machine}, {"day", c.day}, {"job", c.job},
-                      {"ceiling_um", c.ceiling_um}, {"estimator_um", c.estimator_um},
-                      {"grey_um", c.grey_um}, {"blank_error_k", c.blank_error_k}});
+      cuts.push_back({{"machine", c.machine},
+                      {"day", c.day},
+                      {"job", c.job},
+                      {"ceiling_um", c.ceiling_um},
+                      {"estimator_um", c.estimator_um},
+                      {"grey_um", c.grey_um},
+                      {"blank_error_k", c.blank_error_k}});
     j.push_back({{"scenario", r.scenario},
                  {"seeds", r.seeds},
                  {"ceiling_median_um", r.ceiling_median_um},

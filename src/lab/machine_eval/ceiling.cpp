@@ -278,7 +278,8 @@ drift::ShopRecord TruthRecord(const machine::MachineTimeline& tl, const FieldPro
       for (const machine::TruthSample& s : TruthOf(tl, {plan.day, j}).m) {
         if (s.abs_min + 1e-9 < next) continue;
         next = s.abs_min + step_min;
-        const auto it = std::upper_bound(log.time_min.begin(), log.time_min.end(), s.abs_min + 1e-9);
+        const auto it =
+            std::upper_bound(log.time_min.begin(), log.time_min.end(), s.abs_min + 1e-9);
         const int k = std::max(0, static_cast<int>(it - log.time_min.begin()) - 1);
         r.rows.push_back({k, s.abs_min, s.z_mm, s.total_um(), 1.0});
       }
@@ -292,7 +293,8 @@ drift::ShopRecord TruthRecord(const machine::MachineTimeline& tl, const FieldPro
 drift::ShopRecord LastDays(drift::ShopRecord rec, int keep) {
   std::set<int> days;
   for (const auto& r : rec.records) days.insert(r.day);
-  std::set<int> kept(std::prev(days.end(), std::min<std::ptrdiff_t>(keep, days.size())), days.end());
+  std::set<int> kept(std::prev(days.end(), std::min<std::ptrdiff_t>(keep, days.size())),
+                     days.end());
   std::vector<drift::MeasurementRecord> out;
   for (auto& r : rec.records)
     if (kept.count(r.day)) out.push_back(std::move(r));
@@ -326,8 +328,8 @@ double LatchedBlankC(const drift::GreyBoxModel& m, const drift::Run& log, double
   drift::GreyBoxEvaluator ev(m);
   const Eigen::MatrixXd u = drift::GreyBoxRawInputs(m, log);
   double b = 20;
-  for (int k = 0; k < log.samples() && log.time_min[static_cast<std::size_t>(k)] <= start_min + 1e-9;
-       ++k)
+  for (int k = 0;
+       k < log.samples() && log.time_min[static_cast<std::size_t>(k)] <= start_min + 1e-9; ++k)
     b = ev.Step(log.time_min[static_cast<std::size_t>(k)], u.row(k).transpose()).blank_c;
   return b;
 }
@@ -335,8 +337,8 @@ double LatchedBlankC(const drift::GreyBoxModel& m, const drift::Run& log, double
 std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
                                        const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
-                                       const lead::IsoToleranceTable& iso,
-                                       const CeilingOptions& o, std::uint64_t seed, int index) {
+                                       const lead::IsoToleranceTable& iso, const CeilingOptions& o,
+                                       std::uint64_t seed, int index) {
   const FieldEvalOptions& f = o.field;
   const machine::MachineWorld w =
       machine::BuildMachineWorld(f.machine, scenario, seed, index, f.calendar, f.timeline);
@@ -347,13 +349,13 @@ std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
   for (int s = 0; s < kSets; ++s)
     models.push_back(FitCeiling(rows[static_cast<std::size_t>(s)], s == kBlank || s == kContact));
   const bool contact = f.machine.blank_contact_std_k >= 0;
-  const ShopModels shop = TrainShop(tl, f.protocol,
-                                    FieldHistoryResidual(tl, model, rule, iso, f.compare),
-                                    w.machine_seed, o.estimator_past_days, z_ref);
+  const ShopModels shop =
+      TrainShop(tl, f.protocol, FieldHistoryResidual(tl, model, rule, iso, f.compare),
+                w.machine_seed, o.estimator_past_days, z_ref);
   const std::vector<drift::GreyBoxModel> grey =
-      o.grey_structure ? GreyOnTruth(TruthRecord(tl, f.protocol, o.row_step_min), z_ref,
-                                     o.estimator_past_days)
-                       : std::vector<drift::GreyBoxModel>{};
+      o.grey_structure
+          ? GreyOnTruth(TruthRecord(tl, f.protocol, o.row_step_min), z_ref, o.estimator_past_days)
+          : std::vector<drift::GreyBoxModel>{};
   std::vector<CeilingCut> out;
   for (const machine::DayPlan& plan : tl.days()) {
     if (plan.day < 0) continue;
@@ -479,7 +481,8 @@ CeilingScenario EvaluateCeiling(const machine::MachineScenario& scenario,
     std::sort(v.begin(), v.end());
     out.blank_error_median_k.push_back(CeilingMedian(v));
     out.blank_error_p95_k.push_back(
-        v.empty() ? std::nan("") : v[std::min(v.size() - 1, static_cast<std::size_t>(0.95 * v.size()))]);
+        v.empty() ? std::nan("")
+                  : v[std::min(v.size() - 1, static_cast<std::size_t>(0.95 * v.size()))]);
   }
   return out;
 }
@@ -496,15 +499,17 @@ std::string FormatCeilingTable(const std::vector<CeilingScenario>& rows) {
   for (const CeilingScenario& r : rows) {
     s += "| " + r.scenario + " | " + std::to_string(r.cuts.size()) + " |";
     auto cell = [&](double v) {
-      if (std::isfinite(v)) std::snprintf(buf, sizeof buf, " %.1f |", v);
-      else std::snprintf(buf, sizeof buf, " - |");
+      if (std::isfinite(v))
+        std::snprintf(buf, sizeof buf, " %.1f |", v);
+      else
+        std::snprintf(buf, sizeof buf, " - |");
       s += buf;
     };
     for (double v : r.ceiling_median_um) cell(v);
     for (double v : r.estimator_median_um) cell(v);
-    std::snprintf(buf, sizeof buf, " %.1f |\n",
-                  std::min({r.estimator_median_um[0], r.estimator_median_um[1],
-                            r.estimator_median_um[2]}));
+    std::snprintf(
+        buf, sizeof buf, " %.1f |\n",
+        std::min({r.estimator_median_um[0], r.estimator_median_um[1], r.estimator_median_um[2]}));
     s += buf;
   }
   return s;

@@ -113,8 +113,8 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
                                          {"iso_class", ToString(r.iso[k])}};
       }
       for (std::size_t c = 0; c < r.candidate_metrics.size(); ++c)
-        x["strategies"][OptInRowName(c)] = {
-            {"metrics", r.candidate_metrics[c]}, {"iso_class", ToString(r.candidate_iso[c])}};
+        x["strategies"][OptInRowName(c)] = {{"metrics", r.candidate_metrics[c]},
+                                            {"iso_class", ToString(r.candidate_iso[c])}};
       x["day"] = r.day;
       x["start_type"] = r.start_type;
       x["residual_workpiece_total_um"] = r.residual_workpiece_total_um;

@@ -16,8 +16,8 @@ std::vector<std::string> ScheduleInputs() {
 }
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
-                         const std::vector<std::string>& schedule_inputs,
-                         bool grey_slope_lags_only, bool grey_candidates) {
+                         const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
+                         bool grey_candidates) {
   ShopModels m;
   drift::JointFitOptions lagged;
   lagged.require_lag = true;

@@ -36,9 +36,8 @@ lead::IsoClass IsoOf(const MachineEvalScrew& r, std::size_t k) {
 
 // The row's name (k as in MetricsOf).
 std::string RowName(std::size_t k) {
-  return k < kMachineStrategyCount
-             ? ToString(static_cast<MachineStrategy>(k))
-             : OptInRowName(k - kMachineStrategyCount);
+  return k < kMachineStrategyCount ? ToString(static_cast<MachineStrategy>(k))
+                                   : OptInRowName(k - kMachineStrategyCount);
 }
 
 // The opt-in rows the evaluation holds (those of its first screw evaluated without error).
