@@ -302,6 +302,7 @@ TEST(GreyCandidates, TheLeadShareOf90PercentFollowsTheLeadsWhereTheProbeDisagree
   const std::vector<std::string> sensors = FieldLikeLog(0).sensor_names;
   const GreyCandidateFit heavy = FieldGreyCandidate(1, 6400, false, sensors);
   EXPECT_EQ(heavy.options.lead_share, 0.9);
+  EXPECT_EQ(FieldGreyBoxOptions().lead_share, 0.9);  // adopted in the eighth round
   EXPECT_EQ(heavy.spec.offset_sensors, FieldGreyBoxSpec(6400).offset_sensors);
   for (double extra : {0.0, 3.0}) {
     const drift::ShopRecord train = MotorRecord(0, 8, 0, extra), test = MotorRecord(20, 3, 0, 0);
