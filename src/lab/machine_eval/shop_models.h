@@ -73,7 +73,8 @@ drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false, bool slope
 ///                         0.6 um less);
 ///   1 grey_lead_share_90  the field grey box with the lead records carrying 0.9 of the weight
 ///                         instead of 0.5 (the training data: on 5 days the shop's records leave
-///                         1.0-2.5 um more than the truth's cuts, which hold leads only).
+///                         1.0-4.7 um more than the truth's cuts, which hold leads only); adopted
+///                         as drift::GreyBoxOptions' default in that round, so now both_grey.
 struct GreyCandidateFit {
   drift::GreyBoxSpec spec;
   drift::GreyBoxOptions options;
