@@ -5,7 +5,7 @@
 # Usage: scripts/grey_acceptance.sh [--weeks "1 2 4 8"] [--seeds 5] [--first-seed 1]
 #                                   [--threads 2] [--scenarios production,duty-changes,...]
 #                                   [--out-dir DIR] [--slope-through-lags-only]
-#                                   [--offset-candidates]
+#                                   [--offset-candidates] [--grey-candidates]
 # Seeds S..S+N-1 with S = --first-seed (default 1) and N = --seeds (1..20): a confirmation run
 # takes seeds no tuning run has used (e.g. --first-seed 101).
 # A week is 5 production days of history (--past-days 5 x weeks; at most 8 weeks = 40 days). Writes DIR/weeks_<w>.md (the evaluation's
@@ -18,6 +18,8 @@
 # --offset-candidates: the evaluation's opt-in rows too (grey_warmup_k0, grey_mean_k0: both_grey's
 # slope with warmup's offset or the mean of both offsets), judged like both_grey, one table row
 # each beside both_grey's, with the per-seed range of the gain.
+# --grey-candidates: the eighth round's opt-in rows (grey_all_sensors: every sensor on both
+# channels; grey_lead_share_90: the leads carry 0.9 of the weight), judged and tabled the same way.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -39,7 +41,9 @@ while [ $# -gt 0 ]; do
     --slope-through-lags-only) candidate+=(--slope-through-lags-only); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_lead_share_90"
+                       shift ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -118,7 +122,7 @@ note=""
 for c in ${candidate[@]+"${candidate[@]}"}; do
   case "$c" in
     --slope-through-lags-only) note+="; both_grey with $c" ;;
-    --offset-candidates) note+="; the opt-in rows of $c" ;;
+    --offset-candidates|--grey-candidates) note+="; the opt-in rows of $c" ;;
   esac
 done
 echo "(simulator only; seeds $first_seed..$((first_seed + seeds - 1))$note; the evaluations' tables: $out_dir)"

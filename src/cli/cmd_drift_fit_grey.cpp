@@ -105,7 +105,7 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
       "from 10-320 min, chosen by --validation), g0 a slope intercept, B the blank's estimate\n"
       "(a lag of the blank sensor, 30-240 min) latched at the cut start (lead records only). A\n"
       "ridge towards the spec's physical priors (alpha x lengths; strength 1e-3..1); the lead\n"
-      "records carry half of the total weight. The records (--records) are what a\n"
+      "records carry 0.9 of the total weight. The records (--records) are what a\n"
       "shop measures: warm-up probe tests, laser tests, the measured leads of past screws and\n"
       "the probe readings at set-ups, each on its day log (the control's sensor log, a drift\n"
       "run file).");

@@ -50,7 +50,8 @@ struct MachineCliOptions {
   std::string scenarios = "production";
   int test_days = 2, past_days = 5;
   double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
-  bool no_setup_checks = false, slope_through_lags_only = false, offset_candidates = false;
+  bool no_setup_checks = false, slope_through_lags_only = false, offset_candidates = false,
+       grey_candidates = false;
   FieldWorldFlags world;  ///< the world's optional parts (cmd_machine_world.h)
   std::vector<std::pair<std::string, CLI::Option*>> retired;  ///< legacy-world flags, hidden
 };
@@ -80,6 +81,7 @@ machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
   f.protocol.setup_checks = !o.no_setup_checks;
   f.protocol.grey_slope_lags_only = o.slope_through_lags_only;
   f.protocol.offset_candidates = o.offset_candidates;
+  f.protocol.grey_candidates = o.grey_candidates;
   return f;
 }
 
@@ -297,6 +299,12 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "warmup's offset K0 (grey_warmup_k0) and with the mean of both offsets "
               "(grey_mean_k0); opt-in, off by default; both lost on their tuning seeds "
               "(docs/machine-evaluation.md, seventh round)");
+  e->add_flag("--grey-candidates", o->grey_candidates,
+              "the eighth round's opt-in rows after the table's (with the --offset-candidates "
+              "rows), computed in the same run: grey boxes of another structure fitted from the "
+              "same records (grey_all_sensors: every sensor on both channels; grey_lead_share_90: "
+              "the lead records carry 0.9 of the weight); "
+              "off by default (docs/machine-evaluation.md, eighth round)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

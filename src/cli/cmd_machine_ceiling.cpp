@@ -26,7 +26,7 @@ struct MachineCeilingOptions {
   std::string model_path = ProjectPath("models/default.json");
   std::string history = ProjectPath(kHistoryTable);
   std::string iso_table = ProjectPath("datasets/standards/iso3408_3_lead_tolerances.csv");
-  bool json = false;
+  bool json = false, grey_structure = false;
 };
 
 nlohmann::json CeilingJson(const std::vector<machine_eval::CeilingScenario>& rows) {
@@ -34,18 +34,28 @@ nlohmann::json CeilingJson(const std::vector<machine_eval::CeilingScenario>& row
   for (const auto& r : rows) {
     nlohmann::json cuts = nlohmann::json::array();
     for (const auto& c : r.cuts)
-      cuts.push_back({{"machine", c.machine}, {"day", c.day}, {"job", c.job},
-                      {"ceiling_um", c.ceiling_um}, {"estimator_um", c.estimator_um}});
+      cuts.push_back({{"machine", c.machine},
+                      {"day", c.day},
+                      {"job", c.job},
+                      {"ceiling_um", c.ceiling_um},
+                      {"estimator_um", c.estimator_um},
+                      {"grey_um", c.grey_um},
+                      {"blank_error_k", c.blank_error_k}});
     j.push_back({{"scenario", r.scenario},
                  {"seeds", r.seeds},
                  {"ceiling_median_um", r.ceiling_median_um},
                  {"estimator_median_um", r.estimator_median_um},
+                 {"grey_median_um", r.grey_median_um},
+                 {"blank_error_median_k", r.blank_error_median_k},
+                 {"blank_error_p95_k", r.blank_error_p95_k},
                  {"cuts", cuts}});
   }
   return {{"schema", "whirl.machine_ceiling"},
           {"schema_version", 1},
           {"feature_sets", machine_eval::CeilingFeatureSets()},
           {"estimators", machine_eval::CeilingEstimators()},
+          {"grey_columns", machine_eval::CeilingGreyColumns()},
+          {"blank_models", machine_eval::CeilingBlankModels()},
           {"scenarios", j}};
 }
 
@@ -69,6 +79,7 @@ void RunMachineCeiling(const MachineCeilingOptions& o) {
   ApplyFieldWorld(o.world, &c.field, &scenarios);
   c.estimator_past_days = o.estimator_past_days;
   c.row_step_min = o.row_step_min;
+  c.grey_structure = o.grey_structure;
   std::vector<machine_eval::CeilingScenario> rows;
   Progress progress("machine ceiling", scenarios.size() * 1000);
   for (std::size_t i = 0; i < scenarios.size(); ++i)
@@ -82,6 +93,8 @@ void RunMachineCeiling(const MachineCeilingOptions& o) {
     return;
   }
   std::printf("%s", machine_eval::FormatCeilingTable(rows).c_str());
+  if (o.grey_structure)
+    std::printf("\n%s", machine_eval::FormatGreyStructureTable(rows).c_str());
 }
 
 }  // namespace
@@ -127,6 +140,11 @@ void RegisterMachineCeiling(CLI::App* machine) {
       ->check(CLI::ExistingFile);
   s->add_option("--iso-table", o->iso_table, "ISO 3408-3 tolerance table CSV")
       ->check(CLI::ExistingFile);
+  s->add_flag("--grey-structure", o->grey_structure,
+             "also the grey box's own structure trained on the exact truth (its sensors, lags, "
+             "priors; with the true blank; with every sensor; on the last --estimator-past-days), "
+             "a second table with the gaps of the shop's grey box to the ceiling and the error of "
+             "its latched blank estimate [K]");
   s->add_flag("--json", o->json, "machine output on stdout: every cut's figures [um]");
   s->callback([o] { RunMachineCeiling(*o); });
 }

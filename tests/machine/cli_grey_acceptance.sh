@@ -44,6 +44,13 @@ WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --offset-candidates --out-dir 
   fail "the rows' flag: $(cat "$D/args.txt")"
 grep -q "the opt-in rows of --offset-candidates" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
 grep -q "| weeks | scenario | row |" "$D/out.txt" || fail "no row column: $(cat "$D/out.txt")"
+# --grey-candidates (the eighth round) likewise.
+rm -f "$D/args.txt"
+WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --grey-candidates --out-dir "$D/g" \
+  > "$D/out.txt" 2> "$D/err.txt" || fail "grey candidates run: $(cat "$D/err.txt")"
+[ "$(grep -c -- "--markdown --grey-candidates" "$D/args.txt")" -eq 2 ] ||
+  fail "the rows' flag: $(cat "$D/args.txt")"
+grep -q "the opt-in rows of --grey-candidates" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
 # Each scenario's row gets its own per-seed range (the gain lines name no scenario): a stand-in
 # prints two planted scenario blocks whose ranges differ.
 python3 - "$D/planted.md" <<'PY'

@@ -132,4 +132,19 @@ for name in a:
 for name in ("grey_warmup_k0", "grey_mean_k0"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 PY
+# --grey-candidates (the eighth round) adds its two rows after the seventh round's, in the same
+# run: every other row, the seventh round's included, comes out equal.
+grep -q -- "--grey-candidates" "$D/evaluate_help.txt" || fail "--help lacks --grey-candidates"
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --grey-candidates > "$D/field_gc.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --grey-candidates: $(cat "$D/field_err.txt")"
+python3 - "$D/field_k0.json" "$D/field_gc.json" <<'PY' || fail "--grey-candidates: rows wrong"
+import json, sys
+a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
+assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_lead_share_90"]), sorted(b)
+for name in a:
+    assert a[name] == b[name], name
+for name in ("grey_all_sensors", "grey_lead_share_90"):
+    assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
+PY
 echo "cli_machine: ok"

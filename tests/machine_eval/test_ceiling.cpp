@@ -13,7 +13,7 @@
 namespace whirl::machine_eval {
 namespace {
 
-CeilingScenario SmallCeiling(double planted_um_per_1000) {
+CeilingScenario SmallCeiling(double planted_um_per_1000, bool grey_structure = false) {
   static const workpiece::WorkpieceModel model =
       workpiece::LoadWorkpieceModel(std::string(WHIRL_SOURCE_DIR) + "/models/default.json");
   static const compare::ExperienceRule rule = compare::BuildExperienceRule(
@@ -28,6 +28,7 @@ CeilingScenario SmallCeiling(double planted_um_per_1000) {
   o.field.calendar.test_days = 1;
   o.estimator_past_days = 2;
   o.row_step_min = 2;
+  o.grey_structure = grey_structure;
   const double z_ref = o.field.machine.z.fixed_end_mm;
   if (planted_um_per_1000 != 0)
     o.field.timeline.extra_error_um = [=](double, double z_mm) {
@@ -51,6 +52,39 @@ TEST(Ceiling, APlantedConstantSlopeIsLearnedByEveryFeatureSet) {
     grown += b.estimator_um[0] - a.estimator_um[0];  // uncompensated
   }
   EXPECT_GT(grown / plain.cuts.size(), 5.0);  // the plant is large where nothing learns it
+}
+
+// The grey structure (grey_structure): the grey box reading the true blank column latches the
+// blank's true temperature at every cut start exactly; the field grey box's estimate (a lag of
+// the hall's sensor) is finite and not exact; every grey column is scored on every cut. (A
+// planted constant slope is not learned exactly here: the ridge pulls g0 towards 0 with a
+// strength chosen by CV, unlike the ceiling's free intercepts.)
+TEST(Ceiling, TheGreyStructureLatchesTheTrueBlankExactly) {
+  const CeilingScenario plain = SmallCeiling(0, true);
+  ASSERT_GE(plain.cuts.size(), 3u);
+  ASSERT_EQ(plain.grey_median_um.size(), CeilingGreyColumns().size());
+  double estimate_off = 0;
+  for (std::size_t i = 0; i < plain.cuts.size(); ++i) {
+    const CeilingCut& a = plain.cuts[i];
+    ASSERT_EQ(a.grey_um.size(), CeilingGreyColumns().size());
+    ASSERT_EQ(a.blank_error_k.size(), CeilingBlankModels().size());
+    EXPECT_NEAR(a.blank_error_k[2], 0.0, 1e-9) << "cut " << i;
+    for (std::size_t m = 0; m < 2; ++m) ASSERT_TRUE(std::isfinite(a.blank_error_k[m]));
+    estimate_off = std::max(estimate_off, std::abs(a.blank_error_k[1]));
+    for (double g : a.grey_um) EXPECT_TRUE(std::isfinite(g) && g >= 0) << "cut " << i;
+  }
+  EXPECT_GT(estimate_off, 0.01);  // a lag of the hall's sensor is not the blank's truth
+  // Without the option nothing of it is computed and the other columns are the same.
+  const CeilingScenario off = SmallCeiling(0);
+  ASSERT_EQ(off.cuts.size(), plain.cuts.size());
+  EXPECT_TRUE(off.grey_median_um.empty());
+  for (std::size_t i = 0; i < off.cuts.size(); ++i) {
+    EXPECT_TRUE(off.cuts[i].grey_um.empty());
+    EXPECT_EQ(off.cuts[i].ceiling_um.size(), plain.cuts[i].ceiling_um.size());
+    for (std::size_t s = 0; s + 1 < off.cuts[i].ceiling_um.size(); ++s)
+      EXPECT_EQ(off.cuts[i].ceiling_um[s], plain.cuts[i].ceiling_um[s]);
+    EXPECT_EQ(off.cuts[i].estimator_um, plain.cuts[i].estimator_um);
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "machine/instruments.h"
 #include "machine/truth.h"
 #include "machine_eval/cut_scoring.h"
+#include "machine_eval/shop_models.h"
 #include "machine_eval/strategies.h"
 
 namespace whirl::machine_eval {
@@ -229,11 +230,115 @@ ShopModels TrainShop(const machine::MachineTimeline& tl, const FieldProtocol& p,
   return FitShopModels(rec, z_ref, ScheduleInputs());
 }
 
+constexpr const char* kTrueBlankColumn = "blank_true_C";
+constexpr double kExactLatchTauMin = 1e-3;  // a lag that follows its input within one sample
+
+// The log with a column of the blank's TRUE temperature at the start of the next cut (of the
+// day's cuts the first starting at or after the sample; the last one's after it): a grey box
+// reading it through a lag of kExactLatchTauMin latches the exact value at each cut start.
+drift::Run WithTrueBlank(drift::Run log, const machine::MachineTimeline& tl, int day) {
+  const machine::DayPlan& plan = tl.Day(day);
+  std::vector<std::pair<double, double>> starts;  // (abs min, degC), in cut-start order
+  for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j)
+    starts.push_back({day * 1440.0 + plan.jobs[static_cast<std::size_t>(j)].cut_start_min,
+                      machine::HallDuringCut(tl, {day, j}).start_c});
+  std::sort(starts.begin(), starts.end());
+  Eigen::VectorXd col = Eigen::VectorXd::Constant(log.samples(), 20.0);
+  for (int k = 0; k < log.samples(); ++k) {
+    const double t = log.time_min[static_cast<std::size_t>(k)];
+    for (const auto& [start, c] : starts) {
+      col(k) = c;
+      if (start >= t - 1e-9) break;
+    }
+  }
+  log.sensor_names.push_back(kTrueBlankColumn);
+  log.temperature_C.conservativeResize(Eigen::NoChange, log.temperature_C.cols() + 1);
+  log.temperature_C.col(log.temperature_C.cols() - 1) = col;
+  return log;
+}
+
+// The exact truth as a shop record: one lead record per cut of every past production day (a
+// reading m(t, z) every step_min along the cut, sigma 1 um), on the ceiling's control logs with
+// the true blank column (WithTrueBlank).
+drift::ShopRecord TruthRecord(const machine::MachineTimeline& tl, const FieldProtocol& p,
+                              double step_min) {
+  drift::ShopRecord rec;
+  for (const machine::DayPlan& plan : tl.days()) {
+    if (plan.day >= 0 || plan.role != machine::DayRole::kHistory) continue;
+    const int li = static_cast<int>(rec.day_logs.size());
+    rec.day_logs.push_back(WithTrueBlank(CeilingLog(tl, plan.day, p), tl, plan.day));
+    const drift::Run& log = rec.day_logs.back();
+    for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
+      drift::MeasurementRecord r;
+      r.kind = drift::MeasurementRecord::Kind::kLead;
+      r.day = plan.day;
+      r.log = li;
+      r.name = "day" + std::to_string(plan.day) + "_truth_" + std::to_string(j);
+      double next = -1e300;
+      for (const machine::TruthSample& s : TruthOf(tl, {plan.day, j}).m) {
+        if (s.abs_min + 1e-9 < next) continue;
+        next = s.abs_min + step_min;
+        const auto it =
+            std::upper_bound(log.time_min.begin(), log.time_min.end(), s.abs_min + 1e-9);
+        const int k = std::max(0, static_cast<int>(it - log.time_min.begin()) - 1);
+        r.rows.push_back({k, s.abs_min, s.z_mm, s.total_um(), 1.0});
+      }
+      if (r.rows.size() > 1) rec.records.push_back(std::move(r));
+    }
+  }
+  return rec;
+}
+
+// The record's last `keep` days (records and their logs kept as they are).
+drift::ShopRecord LastDays(drift::ShopRecord rec, int keep) {
+  std::set<int> days;
+  for (const auto& r : rec.records) days.insert(r.day);
+  std::set<int> kept(std::prev(days.end(), std::min<std::ptrdiff_t>(keep, days.size())),
+                     days.end());
+  std::vector<drift::MeasurementRecord> out;
+  for (auto& r : rec.records)
+    if (kept.count(r.day)) out.push_back(std::move(r));
+  rec.records = std::move(out);
+  return rec;
+}
+
+// The grey boxes of CeilingGreyColumns, trained on the truth record.
+std::vector<drift::GreyBoxModel> GreyOnTruth(const drift::ShopRecord& truth, double z_ref,
+                                             int last_days) {
+  const drift::GreyBoxSpec field = FieldGreyBoxSpec(z_ref, false);
+  const drift::GreyBoxOptions options = FieldGreyBoxOptions(false, false);
+  drift::GreyBoxSpec exact = field;
+  exact.blank_sensor = kTrueBlankColumn;
+  drift::GreyBoxOptions exact_options = options;
+  exact_options.blank_tau_grid = {kExactLatchTauMin};
+  drift::GreyBoxSpec all = field;
+  all.offset_sensors.clear();
+  for (const std::string& s : truth.day_logs.front().sensor_names)
+    if (s != kTrueBlankColumn && s != kContactColumn) all.offset_sensors.push_back(s);
+  all.slope_sensors = all.offset_sensors;
+  return {drift::FitGreyBox(truth, field, options), drift::FitGreyBox(truth, exact, exact_options),
+          drift::FitGreyBox(truth, all, options),
+          drift::FitGreyBox(LastDays(truth, last_days), field, options)};
+}
+
+// The grey box's blank estimate B [degC] latched at the cut start (its evaluator run from the
+// log's first row to the latest sample at or before the start); NaN for a model with no input.
+double LatchedBlankC(const drift::GreyBoxModel& m, const drift::Run& log, double start_min) {
+  if (m.Inputs().empty()) return std::nan("");
+  drift::GreyBoxEvaluator ev(m);
+  const Eigen::MatrixXd u = drift::GreyBoxRawInputs(m, log);
+  double b = 20;
+  for (int k = 0;
+       k < log.samples() && log.time_min[static_cast<std::size_t>(k)] <= start_min + 1e-9; ++k)
+    b = ev.Step(log.time_min[static_cast<std::size_t>(k)], u.row(k).transpose()).blank_c;
+  return b;
+}
+
 std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
                                        const workpiece::WorkpieceModel& model,
                                        const compare::ExperienceRule& rule,
-                                       const lead::IsoToleranceTable& iso,
-                                       const CeilingOptions& o, std::uint64_t seed, int index) {
+                                       const lead::IsoToleranceTable& iso, const CeilingOptions& o,
+                                       std::uint64_t seed, int index) {
   const FieldEvalOptions& f = o.field;
   const machine::MachineWorld w =
       machine::BuildMachineWorld(f.machine, scenario, seed, index, f.calendar, f.timeline);
@@ -244,9 +349,13 @@ std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
   for (int s = 0; s < kSets; ++s)
     models.push_back(FitCeiling(rows[static_cast<std::size_t>(s)], s == kBlank || s == kContact));
   const bool contact = f.machine.blank_contact_std_k >= 0;
-  const ShopModels shop = TrainShop(tl, f.protocol,
-                                    FieldHistoryResidual(tl, model, rule, iso, f.compare),
-                                    w.machine_seed, o.estimator_past_days, z_ref);
+  const ShopModels shop =
+      TrainShop(tl, f.protocol, FieldHistoryResidual(tl, model, rule, iso, f.compare),
+                w.machine_seed, o.estimator_past_days, z_ref);
+  const std::vector<drift::GreyBoxModel> grey =
+      o.grey_structure
+          ? GreyOnTruth(TruthRecord(tl, f.protocol, o.row_step_min), z_ref, o.estimator_past_days)
+          : std::vector<drift::GreyBoxModel>{};
   std::vector<CeilingCut> out;
   for (const machine::DayPlan& plan : tl.days()) {
     if (plan.day < 0) continue;
@@ -255,6 +364,9 @@ std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
     for (int s = 0; s < kSets; ++s) feats.push_back(CeilingFeatures(s, log));
     const HeldSamples est[] = {RunCausally(shop.warmup, log), RunCausally(shop.schedule, log),
                                RunCausally(shop.sensors, log), RunCausally(shop.grey, log)};
+    const drift::Run blank_log = o.grey_structure ? WithTrueBlank(log, tl, plan.day) : log;
+    std::vector<HeldSamples> grey_held;
+    for (const drift::GreyBoxModel& g : grey) grey_held.push_back(RunCausally(g, blank_log));
     for (int j = 0; j < static_cast<int>(plan.jobs.size()); ++j) {
       const machine::Job& job = plan.jobs[static_cast<std::size_t>(j)];
       const CutTruth c = TruthOf(tl, {plan.day, j});
@@ -265,7 +377,7 @@ std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
       auto total = [&](const compare::CompensationFunction& comp) {
         return detail::TotalOf(c.curve, comp, k.axial_feed_mm_s, job.screw, f.compare);
       };
-      CeilingCut cut{index, plan.day, j, {}, {}};
+      CeilingCut cut{index, plan.day, j, {}, {}, {}, {}};
       try {
         for (int s = 0; s < kSets; ++s)
           cut.ceiling_um.push_back(
@@ -278,6 +390,11 @@ std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
         cut.estimator_um.push_back(total(compare::NoCompensation()));
         for (const HeldSamples& h : est)
           cut.estimator_um.push_back(total(CausalMachineLine(h, c.start_min, z_ref, z_of_t)));
+        for (const HeldSamples& h : grey_held)
+          cut.grey_um.push_back(total(CausalMachineLine(h, c.start_min, z_ref, z_of_t)));
+        if (o.grey_structure)
+          for (const drift::GreyBoxModel* g : {&shop.grey, &grey[0], &grey[1]})
+            cut.blank_error_k.push_back(LatchedBlankC(*g, blank_log, c.start_min) - c.blank_c);
       } catch (const InputError&) {
         continue;  // a cut the lead metrics cannot score (too short a thread)
       }
@@ -302,6 +419,12 @@ double CeilingMedian(std::vector<double> all) {
 std::vector<std::string> CeilingFeatureSets() {
   return {"none", "time", "time+duty", "joint", "absolute", "+blank", "+contact"};
 }
+
+std::vector<std::string> CeilingGreyColumns() {
+  return {"grey truth", "grey truth blank", "grey truth all", "grey truth last"};
+}
+
+std::vector<std::string> CeilingBlankModels() { return {"shop", "truth", "truth blank"}; }
 
 std::vector<std::string> CeilingEstimators() {
   return {"uncompensated", "warmup", "schedule", "sensors", "grey"};
@@ -345,6 +468,22 @@ CeilingScenario EvaluateCeiling(const machine::MachineScenario& scenario,
     for (const CeilingCut& c : out.cuts) v.push_back(c.estimator_um[j]);
     out.estimator_median_um.push_back(CeilingMedian(v));
   }
+  if (!o.grey_structure) return out;
+  for (std::size_t j = 0; j < CeilingGreyColumns().size(); ++j) {
+    std::vector<double> v;
+    for (const CeilingCut& c : out.cuts) v.push_back(c.grey_um[j]);
+    out.grey_median_um.push_back(CeilingMedian(v));
+  }
+  for (std::size_t j = 0; j < CeilingBlankModels().size(); ++j) {
+    std::vector<double> v;
+    for (const CeilingCut& c : out.cuts)
+      if (std::isfinite(c.blank_error_k[j])) v.push_back(std::abs(c.blank_error_k[j]));
+    std::sort(v.begin(), v.end());
+    out.blank_error_median_k.push_back(CeilingMedian(v));
+    out.blank_error_p95_k.push_back(
+        v.empty() ? std::nan("")
+                  : v[std::min(v.size() - 1, static_cast<std::size_t>(0.95 * v.size()))]);
+  }
   return out;
 }
 
@@ -360,16 +499,52 @@ std::string FormatCeilingTable(const std::vector<CeilingScenario>& rows) {
   for (const CeilingScenario& r : rows) {
     s += "| " + r.scenario + " | " + std::to_string(r.cuts.size()) + " |";
     auto cell = [&](double v) {
-      if (std::isfinite(v)) std::snprintf(buf, sizeof buf, " %.1f |", v);
-      else std::snprintf(buf, sizeof buf, " - |");
+      if (std::isfinite(v))
+        std::snprintf(buf, sizeof buf, " %.1f |", v);
+      else
+        std::snprintf(buf, sizeof buf, " - |");
       s += buf;
     };
     for (double v : r.ceiling_median_um) cell(v);
     for (double v : r.estimator_median_um) cell(v);
-    std::snprintf(buf, sizeof buf, " %.1f |\n",
-                  std::min({r.estimator_median_um[0], r.estimator_median_um[1],
-                            r.estimator_median_um[2]}));
+    std::snprintf(
+        buf, sizeof buf, " %.1f |\n",
+        std::min({r.estimator_median_um[0], r.estimator_median_um[1], r.estimator_median_um[2]}));
     s += buf;
+  }
+  return s;
+}
+
+std::string FormatGreyStructureTable(const std::vector<CeilingScenario>& rows) {
+  std::string s = "| scenario | cuts | absolute | +blank |";
+  for (const auto& c : CeilingGreyColumns()) s += " " + c + " |";
+  s += " grey (shop) | structure gap | data gap |";
+  for (const auto& b : CeilingBlankModels()) s += " |B - true| " + b + " (K) |";
+  s += "\n|---|---|";
+  for (std::size_t i = 0; i < CeilingGreyColumns().size() + CeilingBlankModels().size() + 5; ++i)
+    s += "---|";
+  s += "\n";
+  char buf[64];
+  const std::size_t absolute = 4, blank = 5, shop_grey = 4;  // CeilingFeatureSets / Estimators
+  for (const CeilingScenario& r : rows) {
+    if (r.grey_median_um.empty()) continue;
+    s += "| " + r.scenario + " | " + std::to_string(r.cuts.size()) + " |";
+    auto cell = [&](double v) {
+      std::snprintf(buf, sizeof buf, std::isfinite(v) ? " %.1f |" : " - |", v);
+      s += buf;
+    };
+    cell(r.ceiling_median_um[absolute]);
+    cell(r.ceiling_median_um[blank]);
+    for (double v : r.grey_median_um) cell(v);
+    cell(r.estimator_median_um[shop_grey]);
+    cell(r.grey_median_um[0] - r.ceiling_median_um[absolute]);
+    cell(r.estimator_median_um[shop_grey] - r.grey_median_um[0]);
+    for (std::size_t j = 0; j < r.blank_error_median_k.size(); ++j) {
+      std::snprintf(buf, sizeof buf, " %.2f / %.2f |", r.blank_error_median_k[j],
+                    r.blank_error_p95_k[j]);
+      s += buf;
+    }
+    s += "\n";
   }
   return s;
 }

@@ -28,6 +28,14 @@
 // Beside it the shop's models of the same machine (field_eval.h TrainFieldMachine on the shop
 // record of the last estimator_past_days production days and the calendar's tests): warmup,
 // schedule, sensors (both_shop's machine half) and grey (both_grey's), scored the same way.
+// With grey_structure (opt-in; docs/machine-evaluation.md "Eighth round: diagnosis") the grey
+// box's own structure (drift/grey_box.h FitGreyBox with shop_models.h FieldGreyBoxSpec and
+// FieldGreyBoxOptions) is also trained on the exact truth, a lead record per past cut with one
+// reading per row_step_min (the value m(t, z), sigma 1 um, no probe or laser record), on the
+// control logs the ceiling trains on (CeilingGreyColumns): so the gap of the shop's grey box to
+// the ceiling splits into its structure (grey on truth against absolute / +blank) and its
+// training data (grey on the shop's records against grey on truth). Beside it the error of each
+// grey box's blank estimate B latched at the cut start against the blank's true temperature.
 #include <string>
 #include <vector>
 
@@ -43,13 +51,28 @@ struct CeilingOptions {
   FieldEvalOptions field;       ///< machines, seed, calendar (past_days = the ceiling's days)
   int estimator_past_days = 5;  ///< the shop's models: the last this many past days (1..past_days)
   double row_step_min = 1;      ///< training rows along a past cut, min (0.1..30)
+  bool grey_structure = false;  ///< also CeilingGreyColumns and the blank errors (header comment)
 };
+
+/// The grey-structure columns (grey_structure), each the grey box trained on the exact truth:
+///   grey truth         the field grey box (its sensors, lags, blank as ambient's lag, priors,
+///                      forward-chaining choices) on every past day's cuts;
+///   grey truth blank   the same with B the blank's TRUE temperature at the cut start (a log
+///                      column of it, read through a lag of 1e-3 min: latched exactly);
+///   grey truth all     every sensor of the log on both channels, the extra ones with a prior 0;
+///   grey truth last    the field grey box on the last estimator_past_days days only.
+std::vector<std::string> CeilingGreyColumns();
+/// The grey boxes whose latched blank estimate is compared with the truth: shop (both_grey's,
+/// the shop's records), truth (grey truth), truth blank (grey truth blank: 0 by construction).
+std::vector<std::string> CeilingBlankModels();
 
 /// Per cut of one scenario and seed: the accumulated lead error of the machine half [um] per
 /// feature set (CeilingFeatureSets order) and per estimator (CeilingEstimators order).
 struct CeilingCut {
   int machine = 0, day = 0, job = 0;
   std::vector<double> ceiling_um, estimator_um;
+  std::vector<double> grey_um;        ///< CeilingGreyColumns order (empty without grey_structure)
+  std::vector<double> blank_error_k;  ///< CeilingBlankModels order: B latched - true [K]
 };
 
 struct CeilingScenario {
@@ -58,6 +81,9 @@ struct CeilingScenario {
   std::vector<CeilingCut> cuts;
   /// Medians over every cut of every seed.
   std::vector<double> ceiling_median_um, estimator_median_um;
+  std::vector<double> grey_median_um;  ///< CeilingGreyColumns (grey_structure)
+  /// Per CeilingBlankModels: the median and the 95th percentile of |B latched - true| [K].
+  std::vector<double> blank_error_median_k, blank_error_p95_k;
 };
 
 /// One scenario over seeds field.seed .. + seeds - 1 (1..20). Needs the workpiece model for the
@@ -71,5 +97,10 @@ CeilingScenario EvaluateCeiling(const machine::MachineScenario& scenario,
 
 /// The Markdown table: per scenario the ceiling's medians and the estimators' [um].
 std::string FormatCeilingTable(const std::vector<CeilingScenario>& rows);
+
+/// The grey-structure table (rows evaluated with grey_structure): per scenario absolute, +blank,
+/// the grey columns, the shop's grey, the two gaps (structure: grey truth - absolute; training
+/// data: the shop's grey - grey truth) [um], and the blank errors [K] (median / 95 %).
+std::string FormatGreyStructureTable(const std::vector<CeilingScenario>& rows);
 
 }  // namespace whirl::machine_eval

@@ -23,7 +23,8 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
   const drift::ShopRecord record =
       FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
-  m.shop = FitShopModels(record, m.z_ref_mm, ScheduleInputs(), protocol.grey_slope_lags_only);
+  m.shop = FitShopModels(record, m.z_ref_mm, ScheduleInputs(), protocol.grey_slope_lags_only,
+                         protocol.grey_candidates);
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.control = ShopControlModels(m.shop.sensors, record.day_logs);
   m.records = static_cast<int>(record.records.size());
@@ -112,7 +113,7 @@ ElongationCurve Add(ElongationCurve a, const ElongationCurve& b) {
 
 // The shop models held sample by sample over the day's control log: sensors, warmup, schedule,
 // the sensor model kept valid by the day's set-up checks, the grey box, and the opt-in rows
-// (OffsetCandidate order; empty unless asked for).
+// (OptInRowName order; empty unless asked for).
 struct DayHeld {
   HeldSamples sensors, warmup, schedule, monitored, grey;
   std::vector<HeldSamples> candidates;
@@ -276,9 +277,12 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
                     {},
                     RunCausally(models.shop.grey, log),
                     {}};
-    for (std::size_t c = 0; protocol.offset_candidates && c < kOffsetCandidateCount; ++c)
+    const bool opt_in = protocol.offset_candidates || protocol.grey_candidates;
+    for (std::size_t c = 0; opt_in && c < kOffsetCandidateCount; ++c)
       held.candidates.push_back(WithOffsetOf(
           held.grey, held.warmup, WarmupOffsetShare(static_cast<OffsetCandidate>(c))));
+    for (const drift::GreyBoxModel& g : models.shop.grey_candidates)
+      held.candidates.push_back(RunCausally(g, log));
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));

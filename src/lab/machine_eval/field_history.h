@@ -55,6 +55,10 @@ struct FieldProtocol {
   /// Score the opt-in rows of OffsetCandidate (machine_eval.h) as well: both_grey's slope with
   /// warmup's offset, or with the mean of both offsets (docs/machine-evaluation.md, seventh round).
   bool offset_candidates = false;
+  /// Score the opt-in rows of GreyCandidate (machine_eval.h) as well, after the OffsetCandidate
+  /// rows (computed with them): grey boxes of another structure (docs/machine-evaluation.md,
+  /// eighth round).
+  bool grey_candidates = false;
 };
 
 /// The temperature columns of `log` replaced by their mean over the rows with time in

@@ -125,6 +125,17 @@ std::string ToString(OffsetCandidate c);  ///< grey_warmup_k0, grey_mean_k0
 /// warmup's share of the candidate's K0 (1 and 0.5; the grey box's share is 1 minus it).
 double WarmupOffsetShare(OffsetCandidate c);
 
+/// Opt-in rows of the eighth round (issue 41; FieldProtocol::grey_candidates), after the
+/// OffsetCandidate rows (which come with them): the workpiece plan + a grey box fitted from the
+/// same shop records as both_grey with another structure or weighting (shop_models.h
+/// FieldGreyCandidate).
+/// Both use sensors; never the strongest sensor-free row.
+enum class GreyCandidate { kAllSensors, kLeadShare90 };
+inline constexpr std::size_t kGreyCandidateCount = 2;
+std::string ToString(GreyCandidate c);  ///< grey_all_sensors, grey_lead_share_90
+/// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
+std::string OptInRowName(std::size_t k);
+
 /// Sources of the uncompensated lead error (accumulated over the thread, um, each alone).
 enum class ErrorSource { kWorkpiece, kHead, kZAxis };
 inline constexpr std::size_t kErrorSourceCount = 3;
@@ -145,7 +156,7 @@ struct MachineEvalScrew {
   std::array<double, kErrorSourceCount> source_total_um{};
   /// both_shop: accumulated error over the thread of the workpiece and machine residuals, um.
   double residual_workpiece_total_um = 0, residual_machine_total_um = 0;
-  /// The opt-in rows (OffsetCandidate order); empty unless asked for.
+  /// The opt-in rows (OptInRowName order); empty unless asked for.
   std::vector<lead::LeadMetrics> candidate_metrics;
   std::vector<lead::IsoClass> candidate_iso;
 };

@@ -37,6 +37,16 @@ double WarmupOffsetShare(OffsetCandidate c) {
   return c == OffsetCandidate::kGreyWarmupOffset ? 1.0 : 0.5;
 }
 
+std::string ToString(GreyCandidate c) {
+  return c == GreyCandidate::kAllSensors ? "grey_all_sensors" : "grey_lead_share_90";
+}
+
+std::string OptInRowName(std::size_t k) {
+  return k < kOffsetCandidateCount
+             ? ToString(static_cast<OffsetCandidate>(k))
+             : ToString(static_cast<GreyCandidate>(k - kOffsetCandidateCount));
+}
+
 std::string ToString(ErrorSource s) {
   static const char* kNames[] = {"workpiece", "head", "z_axis"};
   return kNames[static_cast<int>(s)];
@@ -103,8 +113,8 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
                                          {"iso_class", ToString(r.iso[k])}};
       }
       for (std::size_t c = 0; c < r.candidate_metrics.size(); ++c)
-        x["strategies"][ToString(static_cast<OffsetCandidate>(c))] = {
-            {"metrics", r.candidate_metrics[c]}, {"iso_class", ToString(r.candidate_iso[c])}};
+        x["strategies"][OptInRowName(c)] = {{"metrics", r.candidate_metrics[c]},
+                                            {"iso_class", ToString(r.candidate_iso[c])}};
       x["day"] = r.day;
       x["start_type"] = r.start_type;
       x["residual_workpiece_total_um"] = r.residual_workpiece_total_um;

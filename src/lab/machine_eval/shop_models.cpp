@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "drift/monitor.h"
+#include "machine_eval/machine_eval.h"
 
 namespace whirl::machine_eval {
 
@@ -15,8 +16,8 @@ std::vector<std::string> ScheduleInputs() {
 }
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
-                         const std::vector<std::string>& schedule_inputs,
-                         bool grey_slope_lags_only) {
+                         const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
+                         bool grey_candidates) {
   ShopModels m;
   drift::JointFitOptions lagged;
   lagged.require_lag = true;
@@ -68,9 +69,27 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   const std::vector<std::string>& other = record.day_logs.front().other_names;
   for (const std::string& s : grey.DutyInputs())
     placed = placed && std::find(other.begin(), other.end(), s) != other.end();
-  if (placed)
-    m.grey = drift::FitGreyBox(record, grey, FieldGreyBoxOptions(contact, grey_slope_lags_only));
+  if (!placed) return m;
+  m.grey = drift::FitGreyBox(record, grey, FieldGreyBoxOptions(contact, grey_slope_lags_only));
+  for (int c = 0; grey_candidates && c < static_cast<int>(kGreyCandidateCount); ++c) {
+    const GreyCandidateFit f = FieldGreyCandidate(c, z_fixed_mm, contact, have);
+    m.grey_candidates.push_back(drift::FitGreyBox(record, f.spec, f.options));
+  }
   return m;
+}
+
+GreyCandidateFit FieldGreyCandidate(int candidate, double z_ref_mm, bool blank_contact,
+                                    const std::vector<std::string>& sensors) {
+  GreyCandidateFit f{FieldGreyBoxSpec(z_ref_mm, blank_contact), FieldGreyBoxOptions(blank_contact)};
+  if (candidate == 0) {
+    f.spec.offset_sensors.clear();
+    for (const std::string& s : sensors)
+      if (s != kBlankContactSensor) f.spec.offset_sensors.push_back(s);
+    f.spec.slope_sensors = f.spec.offset_sensors;
+  } else {
+    f.options.lead_share = 0.9;
+  }
+  return f;
 }
 
 drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact) {

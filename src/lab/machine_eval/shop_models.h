@@ -38,6 +38,9 @@ struct ShopModels {
   /// The grey box (FieldGreyBoxSpec), the both_grey row; empty (no input, 0 everywhere) when
   /// the record's logs lack one of its sensors.
   drift::GreyBoxModel grey;
+  /// The eighth round's opt-in grey boxes (GreyCandidate order, FieldGreyCandidate), fitted
+  /// only when asked for and where the grey box is.
+  std::vector<drift::GreyBoxModel> grey_candidates;
 };
 
 /// The grey box of the field machine (drift/grey_box.h), its sensors placed by the physics:
@@ -61,11 +64,29 @@ drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact = false)
 /// kBlankContactTauMin; with `slope_lags_only` the slope sensors enter through their lags only
 /// (GreyBoxOptions::instant_slope_inputs false; the offset's as read), an opt-in candidate.
 drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false, bool slope_lags_only = false);
+/// The eighth round's opt-in grey boxes (machine_eval.h GreyCandidate; docs/machine-evaluation.md
+/// "Eighth round: split"), from the field grey box's spec and options (`sensors`: the record's
+/// temperature sensors):
+///   0 grey_all_sensors    every sensor on both channels; the field spec's priors, the others 0
+///                         (the structure: the grey box's structure trained on the exact truth
+///                         leaves 1.4 um more than the ceiling's 13 sensors, with every sensor
+///                         0.6 um less);
+///   1 grey_lead_share_90  the field grey box with the lead records carrying 0.9 of the weight
+///                         instead of 0.5 (the training data: on 5 days the shop's records leave
+///                         1.0-4.7 um more than the truth's cuts, which hold leads only); adopted
+///                         as drift::GreyBoxOptions' default in that round, so now both_grey.
+struct GreyCandidateFit {
+  drift::GreyBoxSpec spec;
+  drift::GreyBoxOptions options;
+};
+GreyCandidateFit FieldGreyCandidate(int candidate, double z_ref_mm, bool blank_contact,
+                                    const std::vector<std::string>& sensors);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
-/// FieldGreyBoxOptions' `slope_lags_only` for the grey box.
+/// FieldGreyBoxOptions' `slope_lags_only` for the grey box; `grey_candidates`: also fit
+/// ShopModels::grey_candidates.
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs(),
-                         bool grey_slope_lags_only = false);
+                         bool grey_slope_lags_only = false, bool grey_candidates = false);
 
 /// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
 /// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on

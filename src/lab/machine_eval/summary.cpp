@@ -26,7 +26,7 @@ bool ReachesP(lead::IsoClass c, int p) {
   return c == IsoClass::kP1 || c == IsoClass::kP3 || (p == 5 && c == IsoClass::kP5);
 }
 
-// Row k of a screw: the table's strategies, then the opt-in rows (OffsetCandidate order).
+// Row k of a screw: the table's strategies, then the opt-in rows (OptInRowName order).
 const lead::LeadMetrics& MetricsOf(const MachineEvalScrew& r, std::size_t k) {
   return k < kMachineStrategyCount ? r.metrics[k] : r.candidate_metrics[k - kMachineStrategyCount];
 }
@@ -36,9 +36,8 @@ lead::IsoClass IsoOf(const MachineEvalScrew& r, std::size_t k) {
 
 // The row's name (k as in MetricsOf).
 std::string RowName(std::size_t k) {
-  return k < kMachineStrategyCount
-             ? ToString(static_cast<MachineStrategy>(k))
-             : ToString(static_cast<OffsetCandidate>(k - kMachineStrategyCount));
+  return k < kMachineStrategyCount ? ToString(static_cast<MachineStrategy>(k))
+                                   : OptInRowName(k - kMachineStrategyCount);
 }
 
 // The opt-in rows the evaluation holds (those of its first screw evaluated without error).
