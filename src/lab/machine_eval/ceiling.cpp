@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/stats.h"
 #include "core/random.h"
 #include "machine/instruments.h"
 #include "machine/truth.h"
@@ -404,14 +405,24 @@ std::vector<CeilingCut> CeilingMachine(const machine::MachineScenario& scenario,
   return out;
 }
 
-double CeilingMedian(std::vector<double> all) {
+/// The median of the finite values (NaN if there are none).
+double CeilingMedian(const std::vector<double>& all) {
   std::vector<double> v;
   for (double x : all)
     if (std::isfinite(x)) v.push_back(x);
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return v.empty() ? std::nan("") : Median(std::move(v));
+}
+
+/// Per column j < columns: the median over the cuts of (cut.*field)[j].
+std::vector<double> ColumnMedians(const std::vector<CeilingCut>& cuts,
+                                  std::vector<double> CeilingCut::*field, std::size_t columns) {
+  std::vector<double> out;
+  for (std::size_t j = 0; j < columns; ++j) {
+    std::vector<double> v;
+    for (const CeilingCut& c : cuts) v.push_back((c.*field)[j]);
+    out.push_back(CeilingMedian(v));
+  }
+  return out;
 }
 
 }  // namespace
@@ -458,22 +469,12 @@ CeilingScenario EvaluateCeiling(const machine::MachineScenario& scenario,
         });
     for (auto& p : per) out.cuts.insert(out.cuts.end(), p.begin(), p.end());
   }
-  for (std::size_t j = 0; j < CeilingFeatureSets().size(); ++j) {
-    std::vector<double> v;
-    for (const CeilingCut& c : out.cuts) v.push_back(c.ceiling_um[j]);
-    out.ceiling_median_um.push_back(CeilingMedian(v));
-  }
-  for (std::size_t j = 0; j < CeilingEstimators().size(); ++j) {
-    std::vector<double> v;
-    for (const CeilingCut& c : out.cuts) v.push_back(c.estimator_um[j]);
-    out.estimator_median_um.push_back(CeilingMedian(v));
-  }
+  out.ceiling_median_um =
+      ColumnMedians(out.cuts, &CeilingCut::ceiling_um, CeilingFeatureSets().size());
+  out.estimator_median_um =
+      ColumnMedians(out.cuts, &CeilingCut::estimator_um, CeilingEstimators().size());
   if (!o.grey_structure) return out;
-  for (std::size_t j = 0; j < CeilingGreyColumns().size(); ++j) {
-    std::vector<double> v;
-    for (const CeilingCut& c : out.cuts) v.push_back(c.grey_um[j]);
-    out.grey_median_um.push_back(CeilingMedian(v));
-  }
+  out.grey_median_um = ColumnMedians(out.cuts, &CeilingCut::grey_um, CeilingGreyColumns().size());
   for (std::size_t j = 0; j < CeilingBlankModels().size(); ++j) {
     std::vector<double> v;
     for (const CeilingCut& c : out.cuts)
