@@ -6,13 +6,14 @@
 //                [--few-rows N] [--refit-lowest-gp-rows N] [--refit-iterations N] [--refit-folds K]
 //                [--refit-hyper-rows N] [--refit-ftol F] [--refit-gtol G]
 //                [--gp-length-prior-sd SD] [--gp-max-rows N] [--gp-loo-penalty F]
-//                [--gp-hyper-rows N] [--loo-calibration-rows N]
+//                [--gp-hyper-rows N] [--loo-calibration-rows N] [--gp-slot-large held-out|evidence|bic]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
 #include <ctime>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "core/error.h"
@@ -134,7 +135,15 @@ Args Parse(int argc, char** argv) {
       a.choice.refit_folds = std::stoi(value());
     else if (k == "--gp-loo-penalty")
       a.choice.gp_loo_hyperparameter_penalty = std::stod(value());
-    else if (k == "--gp-length-prior-sd")
+    else if (k == "--gp-slot-large") {
+      const std::string v = value();
+      using whirl::family::GpSlot;
+      if (v != "held-out" && v != "evidence" && v != "bic")
+        throw std::invalid_argument("--gp-slot-large " + v + ": must be held-out, evidence or bic");
+      a.choice.gp_slot_large = v == "evidence" ? GpSlot::kEvidence
+                               : v == "bic"    ? GpSlot::kBic
+                                               : GpSlot::kHeldOut;
+    } else if (k == "--gp-length-prior-sd")
       a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")
       a.choice.fit.gp.restarts = std::stoi(value());

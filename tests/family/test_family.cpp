@@ -496,6 +496,110 @@ TEST(FamilyChoice, GpLooHyperparameterPenaltyScalesOnlyTheGpsLeaveOneOut) {
     for (int k = 0; k < 2; ++k) EXPECT_EQ(d.table[j].cv_rmse(k), c.table[j].cv_rmse(k));
 }
 
+// ln N(w | H b, s^2 K) over the rows of g (squared-exponential kernel), w in the units of the
+// GP's column (ln y or y), b by generalized least squares of w, K of g's fitted hyperparameters
+// on its standardized inputs, s its target scale; dense inverse and LU determinant.
+double DenseLogDensity(const gp::Gp& g, const Eigen::VectorXd& w) {
+  const int d = g.InputCount(), n = static_cast<int>(w.size());
+  Eigen::MatrixXd k(n, n);
+  for (int p = 0; p < n; ++p)
+    for (int q = 0; q < n; ++q)
+      k(p, q) =
+          std::exp(2 * g.theta(d)) *
+          std::exp(
+              -0.5 *
+              ((g.z.col(p) - g.z.col(q)).array() / g.theta.head(d).array().exp()).square().sum());
+  k.diagonal().array() += g.SigmaN2();
+  k *= g.target_scale * g.target_scale;
+  Eigen::MatrixXd h(n, gp::MeanSize(g.mean, d));
+  h.col(0).setOnes();
+  if (g.mean == gp::Mean::kLinear) h.rightCols(d) = g.z.transpose();
+  const Eigen::MatrixXd ki = k.inverse();
+  const Eigen::VectorXd r = w - h * ((h.transpose() * ki * h).inverse() * h.transpose() * ki * w);
+  return -0.5 * r.dot(ki * r) - 0.5 * std::log(k.fullPivLu().determinant()) -
+         0.5 * n * std::log(2 * 3.14159265358979323846);
+}
+
+// GpLogEvidence: the GP's Gaussian density of its column (ln y or y) written out in the column's
+// own units, minus sum ln y for a GP of ln y (the Jacobian of the log transform); and so the
+// same shift for a GP of ln y and one of y when the targets change units.
+TEST(FamilyGpEvidence, IsTheDensityOfTheTargetsWithTheJacobianOfTheLog) {
+  const ProcessTable t = MakeTable(16, 0.05, 3, true);
+  ProcessTable milli = t;  // the targets in units 1000 times smaller
+  for (Features& f : milli.targets)
+    f = Features::FromArray({1000 * f.ToArray()[0], 1000 * f.ToArray()[1]});
+  for (const char* name : {"gp-se-constant/log", "gp-se-linear/log", "gp-se-constant/identity"}) {
+    const Candidate c = ParseCandidate(name);
+    const FamilyModel m = FitCandidate(t, c, {}, false);
+    const FamilyModel m1000 = FitCandidate(milli, c, {}, false);
+    for (int k = 0; k < 2; ++k) {
+      Eigen::VectorXd w(static_cast<Eigen::Index>(t.targets.size()));
+      double sum_log_y = 0;
+      for (std::size_t i = 0; i < t.targets.size(); ++i) {
+        const double y = t.targets[i].ToArray()[k];
+        w(static_cast<Eigen::Index>(i)) = c.log ? std::log(y) : y;
+        sum_log_y += std::log(y);
+      }
+      const double expected = DenseLogDensity(m.gps[k], w) - (c.log ? sum_log_y : 0.0);
+      EXPECT_NEAR(GpLogEvidence(m, k), expected, 1e-7 * std::abs(expected)) << name << " " << k;
+      // y -> 1000 y: every density of y divides by 1000 per row.
+      const double n = static_cast<double>(w.size());
+      EXPECT_NEAR(GpLogEvidence(m1000, k) - GpLogEvidence(m, k), -n * std::log(1000.0), 1e-3)
+          << name << " " << k;
+    }
+  }
+  ExpectInputError([&] { GpLogEvidence(FitCandidate(t, ParseCandidate("linear/log"), {}), 0); },
+                   "holds no GP");
+}
+
+// ChoiceOptions::gp_slot_large: off (the default) and below few_rows the choice is the default's
+// bit for bit; from few_rows the one GP that takes part is the GP of highest GpLogEvidence
+// (kBic: minus (q / 2) ln n), and on some of these tables that is not the GP of lowest
+// held-out error.
+TEST(FamilyChoice, GpSlotLargeGivesTheSlotToTheHighestEvidenceFromFewRows) {
+  ChoiceOptions held;
+  EXPECT_EQ(held.gp_slot_large, GpSlot::kHeldOut);
+  const ProcessTable small = test::MakeBentTable(30, 0.03, 0.5, 1);
+  ChoiceOptions evidence = held;
+  evidence.gp_slot_large = GpSlot::kEvidence;
+  const Choice s0 = ChooseFamily(small, held), s1 = ChooseFamily(small, evidence);
+  EXPECT_EQ(nlohmann::json(s1).dump(), nlohmann::json(s0).dump());
+  held.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-linear/log"),
+                     ParseCandidate("gp-matern52-constant/identity"),
+                     ParseCandidate("gp-se-constant/identity")};
+  held.stack_gate_se_large = 0;                               // every candidate past the gate
+  held.stack_start_se_large = held.stack_full_se_large = -1;  // the unshrunk stack
+  int differs = 0;
+  for (const GpSlot slot : {GpSlot::kEvidence, GpSlot::kBic})
+    for (unsigned seed = 1; seed <= 6; ++seed) {
+      const ProcessTable t = seed > 3 ? test::MakeTable(held.few_rows, 0.15, seed, true)
+                                      : test::MakeBentTable(held.few_rows, 0.15, 0.5, seed);
+      ChoiceOptions o = held;
+      o.gp_slot_large = slot;
+      const Choice a = ChooseFamily(t, o), b = ChooseFamily(t, held);
+      for (int k = 0; k < 2; ++k) {
+        int best = -1, lowest = -1;
+        double best_ev = 0;
+        for (std::size_t c = 1; c < o.candidates.size(); ++c) {
+          const FamilyModel m = FitCandidate(t, o.candidates[c], o.fit, false);
+          const double n = static_cast<double>(m.gps[k].u.size());
+          const double q = 7 + gp::MeanSize(m.gps[k].mean, 5);  // 5 lengths, signal, noise
+          const double ev =
+              GpLogEvidence(m, k) - (slot == GpSlot::kBic ? 0.5 * q * std::log(n) : 0);
+          if (best < 0 || ev > best_ev) best = static_cast<int>(c), best_ev = ev;
+          if (lowest < 0 || a.table[c].cv_rmse(k) < a.table[lowest].cv_rmse(k))
+            lowest = static_cast<int>(c);
+        }
+        for (int g : WeightedGps(a, k))
+          EXPECT_EQ(g, best) << "seed " << seed << ": " << a.Describe();
+        for (int g : WeightedGps(b, k))
+          EXPECT_EQ(g, lowest) << "seed " << seed << ": " << b.Describe();
+        differs += best != lowest;
+      }
+    }
+  EXPECT_GT(differs, 0);  // the option changes the slot on these tables
+}
+
 TEST(FamilyCalibration, CoverageNoiseOnHandComputedCases) {
   Eigen::VectorXd r(4), v = Eigen::VectorXd::Zero(4);
   r << 1, -2, 3, 4;

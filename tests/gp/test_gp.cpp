@@ -72,6 +72,20 @@ TEST(GpLikelihood, EqualsTheDenseFormula) {
           << ToString(k) << " " << ToString(m);
 }
 
+TEST(GpLikelihood, FittedLogMarginalLikelihoodIsMinusTheDenseFormula) {
+  const Data data = MakeData(3, 20, 0.1, 4);
+  for (Kernel k : kKernels)
+    for (Mean m : kMeans) {
+      GpOptions o;
+      o.kernel = k;
+      o.mean = m;
+      const Gp gp = FitGp(data.x, data.y, o);
+      EXPECT_NEAR(LogMarginalLikelihood(gp),
+                  -DenseNlml(k, m, gp.z, gp.u, gp.theta, gp.min_noise_variance), 1e-8)
+          << ToString(k) << " " << ToString(m);
+    }
+}
+
 TEST(GpLikelihood, GradientMatchesCentralDifferences) {
   for (unsigned seed = 1; seed <= 5; ++seed) {
     const Data data = MakeData(4, 15, 0.2, seed);

@@ -735,6 +735,18 @@ int FittedHyperparameters(const Candidate& c) {
   return (c.isotropic ? 1 : ProcessInputs::kCount) + 2;
 }
 
+double GpLogEvidence(const FamilyModel& m, int k) {
+  if (k < 0 || static_cast<std::size_t>(k) >= m.gps.size())
+    throw InputError("GP evidence: " + m.candidate.Name() + " holds no GP for output " +
+                     std::to_string(k));
+  const gp::Gp& g = m.gps[static_cast<std::size_t>(k)];
+  const double n = static_cast<double>(g.u.size());
+  double e = gp::LogMarginalLikelihood(g) - n * std::log(g.target_scale);
+  if (m.transform.outputs[k] == ColumnTransform::kLog)  // sum_i ln y_i, ln y_i = shift + s u_i
+    e -= n * g.target_shift + g.target_scale * g.u.sum();
+  return e;
+}
+
 namespace {
 
 // The linear candidate on the columns of candidate c (-1 if there is none).
@@ -824,13 +836,39 @@ std::string WhySetAside(const ProcessTable& table, const ChoiceOptions& o,
                       std::sqrt(e_lin.mean()));
 }
 
+// `kept` without its GP candidates but `only` (ChoiceOptions::refit_lowest_gp_rows: the one GP
+// judged by refits; the others' held-out errors are their closed-form leave-one-out's).
+std::vector<int> WithOneGp(const std::vector<int>& kept, const ChoiceOptions& o, int only) {
+  std::vector<int> out;
+  for (int c : kept)
+    if (o.candidates[c].family != Family::kGaussianProcess || c == only) out.push_back(c);
+  return out;
+}
+
+// ChoiceOptions::gp_slot_large: per candidate and output the GP's GpLogEvidence (kBic: minus
+// (q / 2) ln n), -infinity for other candidates; empty where the held-out errors give the slot.
+using GpEvidence = std::vector<std::array<double, Features::kCount>>;
+
+// The GP candidate of highest evidence of output k among all of `o` (the first of equal ones;
+// -1 if none).
+int HighestEvidenceGp(const ChoiceOptions& o, const GpEvidence& ev, int k) {
+  int best = -1;
+  for (std::size_t c = 0; c < o.candidates.size(); ++c)
+    if (o.candidates[c].family == Family::kGaussianProcess &&
+        (best < 0 || ev[c][k] > ev[static_cast<std::size_t>(best)][k]))
+      best = static_cast<int>(c);
+  return best;
+}
+
 // ChoiceOptions::lowest_gp: `kept` without its GP candidates except the one with the lowest
 // held-out error of output k (the first of equal ones), which keeps its place; with
 // lowest_gp_per_scale below few_rows rows (lowest_gp_per_scale_large from few_rows on) one such
-// GP per column scale (Candidate::log).
+// GP per column scale (Candidate::log); with `ev` (ChoiceOptions::gp_slot_large) the GP of
+// highest evidence among all GP candidates instead, if it is in `kept`.
 std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
                                      const std::vector<Eigen::MatrixXd>& err,
-                                     const ChoiceOptions& o, int k) {
+                                     const ChoiceOptions& o, int k, const GpEvidence& ev) {
+  if (!ev.empty()) return WithOneGp(kept, o, HighestEvidenceGp(o, ev, k));
   const bool per_scale = err.front().cols() < o.few_rows ? o.lowest_gp_per_scale
                                                          : o.lowest_gp_per_scale_large;
   std::array<int, 2> best = {-1, -1};  // [log]; one slot without per_scale
@@ -847,28 +885,19 @@ std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
   return out;
 }
 
-// `kept` without its GP candidates but `only` (ChoiceOptions::refit_lowest_gp_rows: the one GP
-// judged by refits; the others' held-out errors are their closed-form leave-one-out's).
-std::vector<int> WithOneGp(const std::vector<int>& kept, const ChoiceOptions& o, int only) {
-  std::vector<int> out;
-  for (int c : kept)
-    if (o.candidates[c].family != Family::kGaussianProcess || c == only) out.push_back(c);
-  return out;
-}
-
 // ChoiceOptions::lowest_gp (or the one refitted GP `only` if >= 0) applied to `kept`.
 std::vector<int> GpsThatTakePart(const std::vector<int>& kept,
                                  const std::vector<Eigen::MatrixXd>& err, const ChoiceOptions& o,
-                                 int k, int only) {
+                                 int k, int only, const GpEvidence& ev) {
   if (only >= 0) return WithOneGp(kept, o, only);
-  return o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k) : kept;
+  return o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k, ev) : kept;
 }
 
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the
 // lowest error), after ChoiceOptions::leave_first_se and leave_first_blocks have removed those
-// that do not beat the first of `kept` clearly enough; `only`: GpsThatTakePart.
+// that do not beat the first of `kept` clearly enough; `only`, `ev`: GpsThatTakePart.
 int ChooseAmong(const std::vector<int>& given, const std::vector<Eigen::MatrixXd>& err,
-                const ChoiceOptions& o, int k, int only = -1) {
+                const ChoiceOptions& o, int k, int only = -1, const GpEvidence& ev = {}) {
   const double z = err.front().cols() < o.few_rows ? o.leave_first_se : o.leave_first_se_large;
   const bool all = !o.one_standard_error ||
                    (z <= 0 && o.leave_first_blocks <= 0 && o.leave_first_row_share <= 0);
@@ -879,7 +908,7 @@ int ChooseAmong(const std::vector<int>& given, const std::vector<Eigen::MatrixXd
                    err[c].row(k).array().square().matrix(), z, o.leave_first_blocks, o.folds,
                    o.leave_first_row_share))
       kept.push_back(c);
-  kept = GpsThatTakePart(kept, err, o, k, only);
+  kept = GpsThatTakePart(kept, err, o, k, only, ev);
   std::vector<Eigen::VectorXd> sq;
   for (int c : kept) sq.push_back(err[c].row(k).array().square().matrix());
   if (o.one_standard_error) return kept[SimplestWithinOneStandardError(sq)];
@@ -965,9 +994,10 @@ namespace {
 
 // ChoiceOptions::stack for output k of targets t (outputs x rows): the shrunk stacking weights
 // of every candidate (ShrunkStackWeights of their held-out predictions t - err), 0 for those
-// that stack_gate_se or lowest_gp leave out (`only`: GpsThatTakePart).
+// that stack_gate_se or lowest_gp leave out (`only`, `ev`: GpsThatTakePart).
 Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
-                            const ChoiceOptions& o, int k, int folds, int only) {
+                            const ChoiceOptions& o, int k, int folds, int only,
+                            const GpEvidence& ev) {
   const int nc = static_cast<int>(err.size());
   const bool large = t.cols() >= o.few_rows;
   const double gate = large ? o.stack_gate_se_large : o.stack_gate_se;
@@ -977,7 +1007,7 @@ Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::M
   std::vector<int> in = {0};
   for (int c = 1; c < nc; ++c)
     if (gate <= 0 || BeatsFirst(squared(0), squared(c), gate, 0, folds)) in.push_back(c);
-  in = GpsThatTakePart(in, err, o, k, only);
+  in = GpsThatTakePart(in, err, o, k, only, ev);
   Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()));
   for (std::size_t j = 0; j < in.size(); ++j)
     p.col(static_cast<Eigen::Index>(j)) = (t.row(k) - err[in[j]].row(k)).transpose();
@@ -1098,6 +1128,27 @@ std::vector<Eigen::MatrixXd> JudgedErrors(const std::vector<Eigen::MatrixXd>& er
   return out;
 }
 
+// ChoiceOptions::gp_slot_large on a table of `rows` rows: GpEvidence of the GP candidates of
+// `full` (fitted on all rows from few_rows on); empty where the held-out errors give the slot.
+GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows) {
+  if (o.gp_slot_large == GpSlot::kHeldOut || rows < o.few_rows) return {};
+  GpEvidence ev(full.size());
+  for (std::size_t c = 0; c < full.size(); ++c)
+    for (int k = 0; k < Features::kCount; ++k) {
+      ev[c][k] = -std::numeric_limits<double>::infinity();
+      if (o.candidates[c].family != Family::kGaussianProcess ||
+          static_cast<std::size_t>(k) >= full[c].gps.size())
+        continue;
+      const gp::Gp& g = full[c].gps[static_cast<std::size_t>(k)];
+      const int d = g.InputCount();
+      const double q = (o.candidates[c].isotropic ? 1 : d) + 2 + gp::MeanSize(g.mean, d);
+      ev[c][k] = GpLogEvidence(full[c], k);
+      if (o.gp_slot_large == GpSlot::kBic)
+        ev[c][k] -= 0.5 * q * std::log(static_cast<double>(g.u.size()));
+    }
+  return ev;
+}
+
 }  // namespace
 
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
@@ -1162,6 +1213,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   only.fill(-1);
   if (RefitsLowestGpOnly(options, rows)) only = RefitLowestGp(table, options, folds, full, &err);
   const std::vector<Eigen::MatrixXd> judged = JudgedErrors(err, full, refitted, options);
+  const GpEvidence ev = SlotEvidence(options, full, rows);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   // An output whose targets are all equal has nothing to choose on: it stays out of the score
   // (its MSE over a zero variance would only be a huge number; TableWarnings names it).
@@ -1195,7 +1247,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<Eigen::VectorXd, Features::kCount> stack;
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      stack[k] = OutputStack(t, judged, options, k, folds, only[k]);
+      stack[k] = OutputStack(t, judged, options, k, folds, only[k], ev);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
@@ -1206,7 +1258,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
         all[c] = c;
         if (options.candidates[c].family == Family::kLinear) linear.push_back(c);
       }
-      choice.chosen[k] = ChooseAmong(all, judged, options, k, only[k]);
+      choice.chosen[k] = ChooseAmong(all, judged, options, k, only[k], ev);
       if (linear.empty()) continue;
       const int lin = ChooseAmong(linear, judged, options, k), c = choice.chosen[k];
       complete(c);

@@ -221,7 +221,23 @@ double FitDifferenceInSd(const FamilyModel& a, const FamilyModel& b, const Proce
 /// if isotropic), the signal sd and the noise sd; 0 for other families.
 int FittedHyperparameters(const Candidate& c);
 
-/// One row of the choice table.
+/// ln p(y) of output k's GP in `m` at its fitted hyperparameters, as a density of the output in
+/// its original units (the log marginal likelihood made comparable between a GP of ln y and a
+/// GP of y): gp::LogMarginalLikelihood (of the standardized targets u) - n ln s - [log output]
+/// sum_i ln y_i, n the GP's rows, s its target_scale (u = (z - shift) / s, z = ln y or y), and
+/// ln y_i = shift + s u_i; the last sum is the Jacobian of the log transform. InputError if `m`
+/// holds no GP for output k.
+double GpLogEvidence(const FamilyModel& m, int k);
+
+/// ChoiceOptions::gp_slot_large: how the one GP slot of lowest_gp is given from few_rows rows.
+enum class GpSlot {
+  kHeldOut,   ///< the GP of lowest held-out error (the default)
+  kEvidence,  ///< the GP of highest GpLogEvidence
+  kBic,       ///< the GP of highest GpLogEvidence - (q / 2) ln n, q = FittedHyperparameters +
+              ///< mean coefficients (Schwarz's BIC)
+};
+
+/// One row of the choice table./// One row of the choice table.
 struct CvRow {
   Candidate candidate;
   Eigen::VectorXd cv_rmse;  ///< per output, original units
@@ -387,6 +403,15 @@ struct ChoiceOptions {
   /// tables where the raw-column GP alone predicted better (docs/workpiece-model.md, "Tenth
   /// attempt: diagnosis"). Opt-in (the same document, "Eleventh attempt").
   bool lowest_gp_per_scale_large = false;
+  /// With lowest_gp, from few_rows rows (GPs judged by their closed-form leave-one-out): which
+  /// GP takes the one slot per output (GpSlot; kHeldOut: the lowest held-out error, as below
+  /// few_rows). kEvidence and kBic rank every GP candidate by GpLogEvidence (kBic: minus
+  /// (q / 2) ln n) and keep the highest; it still has to pass the gate (stack_gate_se_large,
+  /// leave_first_se_large) to enter; it overrides lowest_gp_per_scale_large. Why: the GPs'
+  /// closed-form leave-one-out is optimistic, most for the log-column GP, which took the slot on
+  /// tables where a raw-column GP predicted better; the marginal likelihood does not use the
+  /// leave-one-out (docs/workpiece-model.md, "Twelfth attempt").
+  GpSlot gp_slot_large = GpSlot::kHeldOut;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per

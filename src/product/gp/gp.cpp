@@ -521,6 +521,13 @@ double EffectiveDegreesOfFreedom(const Gp& gp) {
   return static_cast<double>(gp.u.size()) - gp.SigmaN2() * ProjectionDiagonal(gp).sum();
 }
 
+double LogMarginalLikelihood(const Gp& gp) {
+  const Eigen::VectorXd r = gp.u - Basis(gp.mean, gp.z) * gp.b;
+  const double log_det_half = gp.chol.matrixLLT().diagonal().array().log().sum();
+  return -(0.5 * r.dot(gp.alpha) + log_det_half +
+           0.5 * static_cast<double>(gp.u.size()) * std::log(2.0 * kPi));
+}
+
 LeaveOneOut LeaveOneOutGp(const Gp& gp) {
   const Eigen::ArrayXd p_diag = ProjectionDiagonal(gp);
   LeaveOneOut loo;

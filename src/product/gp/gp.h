@@ -200,6 +200,12 @@ LeaveOneOut LeaveOneOutGp(const Gp& gp);
 /// between the mean's coefficient count m (the kernel adds nothing) and n (interpolation).
 double EffectiveDegreesOfFreedom(const Gp& gp);
 
+/// -NLML at the fitted hyperparameters (header comment, R&W eq. 2.30: the mean coefficients
+/// profiled by GLS, no length-scale prior), from the stored factors: the log density of the
+/// standardized targets u of the GP's rows. As a density of y in its units subtract
+/// u.size() ln target_scale (family/family.h: GpLogEvidence).
+double LogMarginalLikelihood(const Gp& gp);
+
 /// JSON of the fields above the "Derived" line; from_json validates sizes and finiteness
 /// (InputError naming the key) and calls Factorize().
 void to_json(nlohmann::json& j, const Gp& gp);
