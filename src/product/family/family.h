@@ -411,7 +411,7 @@ struct ChoiceOptions {
   /// closed-form leave-one-out is optimistic, most for the log-column GP, which took the slot on
   /// tables where a raw-column GP predicted better; the marginal likelihood does not use the
   /// leave-one-out (docs/workpiece-model.md, "Twelfth attempt").
-  GpSlot gp_slot_large = GpSlot::kHeldOut;
+  GpSlot gp_slot_large = GpSlot::kBic;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
