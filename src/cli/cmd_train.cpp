@@ -264,6 +264,15 @@ class SlowFitProgress {
 };
 
 // A family choice: train, save and print what was chosen with the CV table.
+// How the one GP that takes part is chosen (ChoiceOptions::gp_slot_large), for the table's
+// summary line; empty where the held-out errors choose it.
+std::string GpSlotNote(const family::ChoiceOptions& c, bool few) {
+  if (few || !c.lowest_gp || c.gp_slot_large == family::GpSlot::kHeldOut) return "";
+  return std::string("; of the GPs only the one of highest ") +
+         (c.gp_slot_large == family::GpSlot::kBic ? "BIC" : "log marginal likelihood") +
+         " (as a density of the output in its units) takes part";
+}
+
 void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::TrainOptions w) {
   const auto start = std::chrono::steady_clock::now();
   workpiece::WorkpieceModel model;
@@ -305,7 +314,7 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::T
                                : "closed-form leave-one-out for GPs, " +
                                      std::to_string(c.folds) + "-fold refits for networks")
                     : std::to_string(c.folds) + "-fold refits")
-            << ")"
+            << ")" << GpSlotNote(c, few)
             << (c.stack ? ", combined with weights shrunk toward the power law"
                 : c.one_standard_error ? ", the simplest within one standard error"
                                        : "")

@@ -14,7 +14,8 @@
 // (the power law in the default list) takes part only if its squared held-out errors beat the
 // first's by more than ChoiceOptions::leave_first_se standard errors of the paired differences
 // (leave_first_se_large from ChoiceOptions::few_rows rows; BeatsFirst); of the GPs only the one
-// with the lowest held-out error takes part (ChoiceOptions::lowest_gp); of those, the simplest
+// with the lowest held-out error takes part (ChoiceOptions::lowest_gp; from few_rows rows the one
+// of highest BIC of its marginal likelihood, ChoiceOptions::gp_slot_large); of those, the simplest
 // within one standard error of the lowest error (ChoiceOptions::one_standard_error) is refitted
 // on all rows with its noise calibration and returned with the table of held-out errors. Within the network family
 // the hidden size may still be chosen by the evidence (MacKay 1992: comparable only within one
@@ -231,10 +232,10 @@ double GpLogEvidence(const FamilyModel& m, int k);
 
 /// ChoiceOptions::gp_slot_large: how the one GP slot of lowest_gp is given from few_rows rows.
 enum class GpSlot {
-  kHeldOut,   ///< the GP of lowest held-out error (the default)
+  kHeldOut,   ///< the GP of lowest held-out error (the default before the twelfth attempt)
   kEvidence,  ///< the GP of highest GpLogEvidence
-  kBic,       ///< the GP of highest GpLogEvidence - (q / 2) ln n, q = FittedHyperparameters +
-              ///< mean coefficients (Schwarz's BIC)
+  kBic,       ///< the GP of highest GpLogEvidence - (q / 2) ln n, q = its hyperparameters +
+              ///< mean coefficients (Schwarz's BIC); the default
 };
 
 /// One row of the choice table./// One row of the choice table.
@@ -410,7 +411,9 @@ struct ChoiceOptions {
   /// leave_first_se_large) to enter; it overrides lowest_gp_per_scale_large. Why: the GPs'
   /// closed-form leave-one-out is optimistic, most for the log-column GP, which took the slot on
   /// tables where a raw-column GP predicted better; the marginal likelihood does not use the
-  /// leave-one-out (docs/workpiece-model.md, "Twelfth attempt").
+  /// leave-one-out. kBic met the rule on a tuning and a confirmation part; kEvidence, which
+  /// does not count the power-law mean's five extra maximized coefficients, gave the slot to
+  /// the log-column GP still more often and lost (docs/workpiece-model.md, "Twelfth attempt").
   GpSlot gp_slot_large = GpSlot::kBic;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
