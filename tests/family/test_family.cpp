@@ -357,6 +357,8 @@ TEST(FamilyChoice, LowestGpPerScaleLargeLetsTheLowestGpOfEachScaleTakePartFromFe
   ChoiceOptions per_scale, lowest;
   EXPECT_FALSE(lowest.lowest_gp_per_scale_large);
   per_scale.lowest_gp_per_scale_large = true;
+  // The held-out slot, which the per-scale rule refines (gp_slot_large overrides it).
+  per_scale.gp_slot_large = lowest.gp_slot_large = GpSlot::kHeldOut;
   const ProcessTable small = test::MakeBentTable(24, 0.03, 0.5, 1);
   EXPECT_EQ(ChooseFamily(small, per_scale).Describe(), ChooseFamily(small, lowest).Describe());
   for (ChoiceOptions* o : {&per_scale, &lowest}) {
@@ -552,18 +554,21 @@ TEST(FamilyGpEvidence, IsTheDensityOfTheTargetsWithTheJacobianOfTheLog) {
                    "holds no GP");
 }
 
-// ChoiceOptions::gp_slot_large: off (the default) and below few_rows the choice is the default's
-// bit for bit; from few_rows the one GP that takes part is the GP of highest GpLogEvidence
-// (kBic: minus (q / 2) ln n), and on some of these tables that is not the GP of lowest
-// held-out error.
+// ChoiceOptions::gp_slot_large (kBic by default): below few_rows the choice is that of the
+// held-out slot bit for bit, for every rule; from few_rows the one GP that takes part is the GP
+// of highest GpLogEvidence (kBic: minus (q / 2) ln n), and on some of these tables that is not
+// the GP of lowest held-out error (kHeldOut, the default before).
 TEST(FamilyChoice, GpSlotLargeGivesTheSlotToTheHighestEvidenceFromFewRows) {
+  EXPECT_EQ(ChoiceOptions().gp_slot_large, GpSlot::kBic);
   ChoiceOptions held;
-  EXPECT_EQ(held.gp_slot_large, GpSlot::kHeldOut);
+  held.gp_slot_large = GpSlot::kHeldOut;
   const ProcessTable small = test::MakeBentTable(30, 0.03, 0.5, 1);
-  ChoiceOptions evidence = held;
-  evidence.gp_slot_large = GpSlot::kEvidence;
-  const Choice s0 = ChooseFamily(small, held), s1 = ChooseFamily(small, evidence);
-  EXPECT_EQ(nlohmann::json(s1).dump(), nlohmann::json(s0).dump());
+  const Choice s0 = ChooseFamily(small, held);
+  for (const GpSlot slot : {GpSlot::kEvidence, GpSlot::kBic}) {
+    ChoiceOptions o = held;
+    o.gp_slot_large = slot;
+    EXPECT_EQ(nlohmann::json(ChooseFamily(small, o)).dump(), nlohmann::json(s0).dump());
+  }
   held.candidates = {ParseCandidate("linear/log"), ParseCandidate("gp-matern52-linear/log"),
                      ParseCandidate("gp-matern52-constant/identity"),
                      ParseCandidate("gp-se-constant/identity")};
