@@ -18,8 +18,9 @@
 # --offset-candidates: the evaluation's opt-in rows too (grey_warmup_k0, grey_mean_k0: both_grey's
 # slope with warmup's offset or the mean of both offsets), judged like both_grey, one table row
 # each beside both_grey's, with the per-seed range of the gain.
-# --grey-candidates: the eighth round's opt-in rows (grey_all_sensors: every sensor on both
-# channels; grey_lead_share_90: the leads carry 0.9 of the weight), judged and tabled the same way.
+# --grey-candidates: the opt-in grey rows (grey_all_sensors: every sensor on both channels;
+# grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two lead
+# days), judged and tabled the same way.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -41,9 +42,9 @@ while [ $# -gt 0 ]; do
     --slope-through-lags-only) candidate+=(--slope-through-lags-only); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
-    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_lead_share_90"
+    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_guarded"
                        shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -300,11 +300,11 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "(grey_mean_k0); opt-in, off by default; both lost on their tuning seeds "
               "(docs/machine-evaluation.md, seventh round)");
   e->add_flag("--grey-candidates", o->grey_candidates,
-              "the eighth round's opt-in rows after the table's (with the --offset-candidates "
-              "rows), computed in the same run: grey boxes of another structure fitted from the "
-              "same records (grey_all_sensors: every sensor on both channels; grey_lead_share_90: "
-              "the lead records carry 0.9 of the weight); "
-              "off by default (docs/machine-evaluation.md, eighth round)");
+              "the opt-in grey rows after the table's (with the --offset-candidates rows), "
+              "computed in the same run from the same records: grey_all_sensors (the grey box "
+              "with every sensor on both channels) and grey_guarded (both_grey's model or the "
+              "sensor-free base rule, whichever predicted the shop's own last two lead days "
+              "better); off by default (docs/machine-evaluation.md, eighth and ninth rounds)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

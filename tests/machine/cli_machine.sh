@@ -132,19 +132,26 @@ for name in a:
 for name in ("grey_warmup_k0", "grey_mean_k0"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 PY
-# --grey-candidates (the eighth round) adds its two rows after the seventh round's, in the same
-# run: every other row, the seventh round's included, comes out equal.
+# --grey-candidates (the eighth and ninth rounds) adds its two rows after the seventh round's, in
+# the same run: every other row, the seventh round's included, comes out equal; grey_guarded is
+# the row of the model it chose (grey_guarded_choice per machine) to the digit.
 grep -q -- "--grey-candidates" "$D/evaluate_help.txt" || fail "--help lacks --grey-candidates"
 "$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
   --grey-candidates > "$D/field_gc.json" 2> "$D/field_err.txt" ||
   fail "field evaluate --grey-candidates: $(cat "$D/field_err.txt")"
 python3 - "$D/field_k0.json" "$D/field_gc.json" <<'PY' || fail "--grey-candidates: rows wrong"
 import json, sys
-a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
-assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_lead_share_90"]), sorted(b)
+a = json.load(open(sys.argv[1]))["scenarios"][0]["strategies"]
+gc = json.load(open(sys.argv[2]))["scenarios"][0]
+b = gc["strategies"]
+assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_guarded"]), sorted(b)
 for name in a:
     assert a[name] == b[name], name
-for name in ("grey_all_sensors", "grey_lead_share_90"):
+for name in ("grey_all_sensors", "grey_guarded"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
+chosen = gc["runs"][0]["grey_guarded_choice"]
+assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), chosen
+for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
+    assert b["grey_guarded"][key] == a[chosen[0]][key], (key, chosen)
 PY
 echo "cli_machine: ok"

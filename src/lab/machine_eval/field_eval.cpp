@@ -283,6 +283,11 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
           held.grey, held.warmup, WarmupOffsetShare(static_cast<OffsetCandidate>(c))));
     for (const drift::GreyBoxModel& g : models.shop.grey_candidates)
       held.candidates.push_back(RunCausally(g, log));
+    const ShopModels& shop = models.shop;
+    if (shop.guard.chosen)
+      held.candidates.push_back(shop.guard.keep_grey   ? held.grey
+                                : shop.rule_is_schedule ? held.schedule
+                                                        : held.warmup);
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));
@@ -368,6 +373,11 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
   for (std::size_t i = 0; i < n; ++i) {
     e.sensors.push_back(models[i].shop.sensors.sensors);
     e.sensors_choice.push_back(models[i].shop.sensors_choice);
+    const ShopModels& shop = models[i].shop;
+    if (shop.guard.chosen)
+      e.guard_choice.push_back(shop.guard.keep_grey      ? "both_grey"
+                               : shop.rule_is_schedule ? "schedule"
+                                                       : "warmup");
     e.screws.insert(e.screws.end(), per[i].begin(), per[i].end());
   }
   e.summary = SummarizeMachineEval(e.screws);

@@ -125,14 +125,15 @@ std::string ToString(OffsetCandidate c);  ///< grey_warmup_k0, grey_mean_k0
 /// warmup's share of the candidate's K0 (1 and 0.5; the grey box's share is 1 minus it).
 double WarmupOffsetShare(OffsetCandidate c);
 
-/// Opt-in rows of the eighth round (issue 41; FieldProtocol::grey_candidates), after the
-/// OffsetCandidate rows (which come with them): the workpiece plan + a grey box fitted from the
-/// same shop records as both_grey with another structure or weighting (shop_models.h
-/// FieldGreyCandidate).
-/// Both use sensors; never the strongest sensor-free row.
-enum class GreyCandidate { kAllSensors, kLeadShare90 };
+/// Opt-in rows of the eighth and ninth rounds (issue 41; FieldProtocol::grey_candidates), after
+/// the OffsetCandidate rows (which come with them), from the same shop records as both_grey:
+/// the workpiece plan + the grey box of every sensor (grey_all_sensors, shop_models.h
+/// FieldGreyCandidate), or + both_grey's grey box or the sensor-free base rule (warmup or
+/// schedule), whichever the shop's own last lead days favour (grey_guarded, GuardGreyBox).
+/// Both count as using sensors; never the strongest sensor-free row.
+enum class GreyCandidate { kAllSensors, kGuarded };
 inline constexpr std::size_t kGreyCandidateCount = 2;
-std::string ToString(GreyCandidate c);  ///< grey_all_sensors, grey_lead_share_90
+std::string ToString(GreyCandidate c);  ///< grey_all_sensors, grey_guarded
 /// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
 std::string OptInRowName(std::size_t k);
 
@@ -209,6 +210,9 @@ struct MachineEvaluation {
   /// Per machine: the sensor model's sensors and which candidate it is (shop_models.h).
   std::vector<std::vector<std::string>> sensors;
   std::vector<std::string> sensors_choice;
+  /// Per machine, when the opt-in grey rows were asked for: what grey_guarded applies
+  /// ("both_grey", "warmup" or "schedule"; shop_models.h GuardGreyBox); else empty.
+  std::vector<std::string> guard_choice;
   std::vector<MachineEvalScrew> screws;
   MachineEvalSummary summary;
   std::optional<ReportScrew> report;  ///< when asked for (FieldEvalOptions::keep_report_screw)

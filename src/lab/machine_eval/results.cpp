@@ -38,7 +38,7 @@ double WarmupOffsetShare(OffsetCandidate c) {
 }
 
 std::string ToString(GreyCandidate c) {
-  return c == GreyCandidate::kAllSensors ? "grey_all_sensors" : "grey_lead_share_90";
+  return c == GreyCandidate::kAllSensors ? "grey_all_sensors" : "grey_guarded";
 }
 
 std::string OptInRowName(std::size_t k) {
@@ -133,6 +133,7 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
          {"message", s.message}}},
        {"sensor_model_sensors", e.sensors},
        {"sensor_model_choice", e.sensors_choice},
+       {"grey_guarded_choice", e.guard_choice},
        {"screws", screws}};
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <tuple>
+#include <utility>
 
 #include "core/error.h"
 #include "drift/monitor.h"
@@ -15,21 +16,101 @@ std::vector<std::string> ScheduleInputs() {
   return {"ring_on", "cutting", "ring_load_pct", "z_speed_mm_min"};
 }
 
+namespace {
+
+// A sensor-free rule's spec: control signals as logged, at least one lag (RuleOptions).
+drift::JointSpec RuleSpec(double z_ref_mm, std::vector<std::string> inputs) {
+  drift::JointSpec s;
+  s.z_ref_mm = z_ref_mm;
+  s.other_inputs = std::move(inputs);
+  return s;
+}
+
+drift::JointFitOptions RuleOptions() {
+  drift::JointFitOptions o;
+  o.require_lag = true;
+  return o;
+}
+
+// The records of the days before `day` (every day log kept: records index them).
+drift::ShopRecord Before(const drift::ShopRecord& record, int day) {
+  drift::ShopRecord r;
+  r.day_logs = record.day_logs;
+  for (const drift::MeasurementRecord& m : record.records)
+    if (m.day < day) r.records.push_back(m);
+  return r;
+}
+
+// Sum over a lead record of w (e - e_bar)^2 (w = 1 / sigma^2, e the residual, e_bar its weighted
+// mean over the record), and the sum of w.
+std::pair<double, double> DemeanedSquares(const drift::MeasurementRecord& r,
+                                          const std::vector<double>& predicted) {
+  double sw = 0, swe = 0;
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    const double w = 1 / (r.rows[i].sigma_um * r.rows[i].sigma_um);
+    sw += w, swe += w * (r.rows[i].value_um - predicted[i]);
+  }
+  double ss = 0;
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    const double e = r.rows[i].value_um - predicted[i] - swe / sw;
+    ss += e * e / (r.rows[i].sigma_um * r.rows[i].sigma_um);
+  }
+  return {ss, sw};
+}
+
+}  // namespace
+
+GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpec& grey,
+                        const drift::GreyBoxOptions& grey_options, const drift::JointSpec& rule,
+                        const drift::JointFitOptions& rule_options, int held_days) {
+  std::vector<int> lead_days;
+  for (const drift::MeasurementRecord& r : record.records)
+    if (r.kind == drift::MeasurementRecord::Kind::kLead) lead_days.push_back(r.day);
+  std::sort(lead_days.begin(), lead_days.end());
+  lead_days.erase(std::unique(lead_days.begin(), lead_days.end()), lead_days.end());
+  if (held_days < 1)
+    throw InputError("grey guard: held_days = " + std::to_string(held_days) + ": must be >= 1");
+  const std::size_t held = static_cast<std::size_t>(held_days);
+  const std::size_t first = lead_days.size() > held ? lead_days.size() - held : 0;
+  double grey_ss = 0, rule_ss = 0, sw = 0;
+  GuardScore g;
+  for (std::size_t k = first; k < lead_days.size(); ++k) {
+    const drift::ShopRecord past = Before(record, lead_days[k]);
+    if (past.records.empty()) continue;
+    drift::GreyBoxModel gm;
+    drift::JointDriftModel rm;
+    try {
+      gm = drift::FitGreyBox(past, grey, grey_options);
+      rm = drift::FitJoint(past, rule, rule_options).model;
+    } catch (const InputError&) {
+      continue;  // too few readings before this day: not scored
+    }
+    for (const drift::MeasurementRecord& r : record.records) {
+      if (r.kind != drift::MeasurementRecord::Kind::kLead || r.day != lead_days[k]) continue;
+      const auto [gs, w] = DemeanedSquares(r, drift::PredictGreyRecord(gm, record, r));
+      grey_ss += gs, sw += w;
+      rule_ss += DemeanedSquares(r, drift::PredictRecord(rm, record, r)).first;
+    }
+    ++g.days;
+  }
+  if (g.days == 0 || sw <= 0) return g;
+  g.grey_rms_um = std::sqrt(grey_ss / sw);
+  g.rule_rms_um = std::sqrt(rule_ss / sw);
+  g.keep_grey = g.grey_rms_um <= g.rule_rms_um;
+  return g;
+}
+
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
                          bool grey_candidates) {
   ShopModels m;
-  drift::JointFitOptions lagged;
-  lagged.require_lag = true;
-  drift::JointSpec warmup;
-  warmup.z_ref_mm = z_fixed_mm;
-  warmup.other_inputs = {"power_on"};
+  const drift::JointFitOptions lagged = RuleOptions();
+  const drift::JointSpec warmup = RuleSpec(z_fixed_mm, {"power_on"}),
+                         schedule = RuleSpec(z_fixed_mm, schedule_inputs);
   m.warmup = drift::FitJoint(record, warmup, lagged).model;
-  drift::JointSpec schedule;
-  schedule.z_ref_mm = z_fixed_mm;
-  schedule.other_inputs = schedule_inputs;
   m.schedule = drift::FitJoint(record, schedule, lagged).model;
   const bool schedule_base = m.schedule.cv_rmse_um <= m.warmup.cv_rmse_um;
+  m.rule_is_schedule = schedule_base;
   const drift::JointDriftModel& base = schedule_base ? m.schedule : m.warmup;
   std::vector<std::string> pool;
   for (const auto& name : record.day_logs.front().sensor_names) pool.push_back(name);
@@ -70,25 +151,24 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   for (const std::string& s : grey.DutyInputs())
     placed = placed && std::find(other.begin(), other.end(), s) != other.end();
   if (!placed) return m;
-  m.grey = drift::FitGreyBox(record, grey, FieldGreyBoxOptions(contact, grey_slope_lags_only));
-  for (int c = 0; grey_candidates && c < static_cast<int>(kGreyCandidateCount); ++c) {
-    const GreyCandidateFit f = FieldGreyCandidate(c, z_fixed_mm, contact, have);
-    m.grey_candidates.push_back(drift::FitGreyBox(record, f.spec, f.options));
-  }
+  const drift::GreyBoxOptions grey_options = FieldGreyBoxOptions(contact, grey_slope_lags_only);
+  m.grey = drift::FitGreyBox(record, grey, grey_options);
+  if (!grey_candidates) return m;
+  const GreyCandidateFit all = FieldGreyCandidate(z_fixed_mm, contact, have);
+  m.grey_candidates.push_back(drift::FitGreyBox(record, all.spec, all.options));
+  const GuardScore g =
+      GuardGreyBox(record, grey, grey_options, schedule_base ? schedule : warmup, lagged);
+  m.guard = {true, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
   return m;
 }
 
-GreyCandidateFit FieldGreyCandidate(int candidate, double z_ref_mm, bool blank_contact,
+GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
                                     const std::vector<std::string>& sensors) {
   GreyCandidateFit f{FieldGreyBoxSpec(z_ref_mm, blank_contact), FieldGreyBoxOptions(blank_contact)};
-  if (candidate == 0) {
-    f.spec.offset_sensors.clear();
-    for (const std::string& s : sensors)
-      if (s != kBlankContactSensor) f.spec.offset_sensors.push_back(s);
-    f.spec.slope_sensors = f.spec.offset_sensors;
-  } else {
-    f.options.lead_share = 0.9;
-  }
+  f.spec.offset_sensors.clear();
+  for (const std::string& s : sensors)
+    if (s != kBlankContactSensor) f.spec.offset_sensors.push_back(s);
+  f.spec.slope_sensors = f.spec.offset_sensors;
   return f;
 }
 

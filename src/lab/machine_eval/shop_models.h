@@ -38,9 +38,16 @@ struct ShopModels {
   /// The grey box (FieldGreyBoxSpec), the both_grey row; empty (no input, 0 everywhere) when
   /// the record's logs lack one of its sensors.
   drift::GreyBoxModel grey;
-  /// The eighth round's opt-in grey boxes (GreyCandidate order, FieldGreyCandidate), fitted
-  /// only when asked for and where the grey box is.
+  /// The opt-in grey boxes (grey_all_sensors: FieldGreyCandidate), fitted only when asked for
+  /// and where the grey box is.
   std::vector<drift::GreyBoxModel> grey_candidates;
+  bool rule_is_schedule = false;  ///< the sensor-free base (schedule, else warmup) by its CV
+  /// The ninth round's guard (grey_guarded: GuardGreyBox), chosen only when the opt-in grey
+  /// boxes are asked for and the grey box is; keep_grey: both_grey's model, else the base rule.
+  struct Guard {
+    bool chosen = false, keep_grey = true;
+    double grey_rms_um = 0, rule_rms_um = 0;
+  } guard;
 };
 
 /// The grey box of the field machine (drift/grey_box.h), its sensors placed by the physics:
@@ -64,23 +71,35 @@ drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact = false)
 /// kBlankContactTauMin; with `slope_lags_only` the slope sensors enter through their lags only
 /// (GreyBoxOptions::instant_slope_inputs false; the offset's as read), an opt-in candidate.
 drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false, bool slope_lags_only = false);
-/// The eighth round's opt-in grey boxes (machine_eval.h GreyCandidate; docs/machine-evaluation.md
-/// "Eighth round: split"), from the field grey box's spec and options (`sensors`: the record's
-/// temperature sensors):
-///   0 grey_all_sensors    every sensor on both channels; the field spec's priors, the others 0
-///                         (the structure: the grey box's structure trained on the exact truth
-///                         leaves 1.4 um more than the ceiling's 13 sensors, with every sensor
-///                         0.6 um less);
-///   1 grey_lead_share_90  the field grey box with the lead records carrying 0.9 of the weight
-///                         instead of 0.5 (the training data: on 5 days the shop's records leave
-///                         1.0-4.7 um more than the truth's cuts, which hold leads only); adopted
-///                         as drift::GreyBoxOptions' default in that round, so now both_grey.
+/// The opt-in grey box of every sensor (grey_all_sensors, machine_eval.h GreyCandidate;
+/// docs/machine-evaluation.md "Eighth round: split"), from the field grey box's spec and options
+/// (`sensors`: the record's temperature sensors): every sensor on both channels, the field spec's
+/// priors, the others 0 (the grey box's structure trained on the exact truth leaves 1.4 um more
+/// than the ceiling's 13 sensors, with every sensor 0.6 um less). (The eighth round's other row,
+/// the leads carrying 0.9 of the weight, became drift::GreyBoxOptions' default.)
 struct GreyCandidateFit {
   drift::GreyBoxSpec spec;
   drift::GreyBoxOptions options;
 };
-GreyCandidateFit FieldGreyCandidate(int candidate, double z_ref_mm, bool blank_contact,
+GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
                                     const std::vector<std::string>& sensors);
+
+/// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split"): the
+/// grey box or a sensor-free rule, chosen on the shop's own record in time order. For each of
+/// the last `held_days` calendar days that hold a lead record, both are fitted on the records of
+/// the days before it only and that day's leads predicted; the score is the weighted
+/// (1 / sigma^2) RMS of the lead residuals, each lead record's about its own weighted mean (a
+/// lead is known up to a constant), pooled over the days. keep_grey: the grey box's score is at
+/// most the rule's, or no day could be scored (a fit failed or no earlier day): the grey box
+/// stays. Only the record's past enters; the caller applies the family fitted on all of it.
+struct GuardScore {
+  bool keep_grey = true;
+  double grey_rms_um = 0, rule_rms_um = 0;  ///< 0 when no day was scored
+  int days = 0;                             ///< days scored
+};
+GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpec& grey,
+                        const drift::GreyBoxOptions& grey_options, const drift::JointSpec& rule,
+                        const drift::JointFitOptions& rule_options, int held_days = 2);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
 /// FieldGreyBoxOptions' `slope_lags_only` for the grey box; `grey_candidates`: also fit
 /// ShopModels::grey_candidates.

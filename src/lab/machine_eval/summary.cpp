@@ -248,6 +248,13 @@ std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e) {
     line += buf;
   }
   out.push_back(line);
+  std::size_t machines = 0, grey = 0;
+  for (const auto& run : e.runs)
+    for (const std::string& c : run.guard_choice) machines++, grey += c == "both_grey";
+  if (machines)
+    out.push_back(e.scenario + ": grey_guarded applies both_grey's model on " +
+                  std::to_string(grey) + " of " + std::to_string(machines) +
+                  " machines, the sensor-free rule on the others");
   return out;
 }
 
