@@ -72,14 +72,19 @@ TEST(GpLikelihood, EqualsTheDenseFormula) {
           << ToString(k) << " " << ToString(m);
 }
 
+// A GP fitted to the data with the given kernel and mean, every other option the default.
+Gp FitWith(const Data& data, Kernel k, Mean m) {
+  GpOptions o;
+  o.kernel = k;
+  o.mean = m;
+  return FitGp(data.x, data.y, o);
+}
+
 TEST(GpLikelihood, FittedLogMarginalLikelihoodIsMinusTheDenseFormula) {
   const Data data = MakeData(3, 20, 0.1, 4);
   for (Kernel k : kKernels)
     for (Mean m : kMeans) {
-      GpOptions o;
-      o.kernel = k;
-      o.mean = m;
-      const Gp gp = FitGp(data.x, data.y, o);
+      const Gp gp = FitWith(data, k, m);
       EXPECT_NEAR(LogMarginalLikelihood(gp),
                   -DenseNlml(k, m, gp.z, gp.u, gp.theta, gp.min_noise_variance), 1e-8)
           << ToString(k) << " " << ToString(m);
@@ -113,10 +118,7 @@ TEST(GpLeaveOneOut, EqualsRefitsWithoutEachRow) {
   const Data data = MakeData(3, 14, 0.2, 7);
   for (Kernel k : kKernels)
     for (Mean m : kMeans) {
-      GpOptions o;
-      o.kernel = k;
-      o.mean = m;
-      const Gp gp = FitGp(data.x, data.y, o);
+      const Gp gp = FitWith(data, k, m);
       const LeaveOneOut loo = LeaveOneOutGp(gp);
       for (int i = 0; i < 14; ++i) {
         Gp without = gp;  // same hyperparameters and standardization, row i removed
