@@ -1,0 +1,148 @@
+"""The thirteenth attempt's diagnosis at 20 rows (docs/workpiece-model.md, "Thirteenth attempt:
+diagnosis at 20 rows"): from bench_peers.py --json files holding, per table, the default
+("default") and each candidate alone (family_bench --candidates NAME --no-cv: linlog, linid,
+gplog, gpm52, gpse, net), and on some tables the peers:
+  1. per failing cell, the median's % above the best peer's median (tables with peers) and each
+     candidate's geometric mean ratio of test RMSE to the default's (all tables); "oracle" the
+     per-table best candidate in hindsight;
+  2. which candidates the default gives weight to;
+  3. coverage: +-1 / +-2 sd, the spread of the test residuals and of the held-out residuals
+     (the candidates' cv_rmse the choice saw) against the sd;
+  4. single-candidate choices against the same candidate alone, and selection optimism.
+Usage: choice_diagnosis.py d_1_20.json d_4001_20.json ..."""
+import json
+import math
+import sys
+
+import numpy as np
+
+ACCEPT = ["loglinear", "gp_ard", "mlp_default", "mlp_cv", "brnn_whirl"]
+CANDS = ["linlog", "linid", "gplog", "gpm52", "gpse", "net"]
+recs = [r for f in sys.argv[1:] for r in json.load(open(f))]
+ok = lambda r, m: m in r["methods"] and "rmse" in r["methods"][m]
+RMSE_CELLS = [("powerlaw", 1), ("friedman", 0), ("friedman", 1), ("additive", 0), ("additive", 1),
+              ("friedman23", 0), ("friedman23", 1), ("powerlaw_noisy", 0), ("hetero", 1)]
+COV_CELLS = [("friedman", 1), ("hetero", 1), ("saturating", 1), ("simgen", 0), ("simgen", 1)]
+
+
+def rmse(r, m, k):
+    return r["methods"][m]["rmse"][k]
+
+
+def pct(a, b):
+    return 100 * (a / b - 1)
+
+
+print("| cell | best peer, tuning seeds with peers (n) | default | "
+      + " | ".join(CANDS) + " | oracle |")
+print("|" + "---|" * (4 + len(CANDS)))
+for fam, k in RMSE_CELLS:
+    rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+    wp = [r for r in rs if all(ok(r, p) for p in ACCEPT)]
+    med = {p: np.median([rmse(r, p, k) for r in wp]) for p in ACCEPT}
+    best = min(med, key=med.get)
+    cells = []
+    for m in ["default"] + CANDS:
+        mp = pct(np.median([rmse(r, m, k) for r in wp]), med[best])
+        g = math.exp(np.mean([math.log(rmse(r, m, k) / rmse(r, "default", k)) for r in rs]))
+        cells.append(f"{mp:+.1f} %" if m == "default" else f"{mp:+.1f} % / {g:.2f}")
+    orc = [min(rmse(r, m, k) for m in CANDS) for r in rs]
+    og = math.exp(np.mean([math.log(o / rmse(r, "default", k)) for o, r in zip(orc, rs)]))
+    om = pct(np.median([min(rmse(r, m, k) for m in CANDS) for r in wp]), med[best])
+    print(f"| {fam} out{k+1} | {best} {med[best]:.4g} ({len(wp)}) | "
+          + " | ".join(cells) + f" | {om:+.1f} % / {og:.2f} ({len(rs)}) |")
+
+# which candidates the default gives weight to, per cell (share of tables where it appears)
+print()
+for fam, k in RMSE_CELLS + COV_CELLS:
+    rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+    outname = ["max_elongation_um", "settle_time_s"][k]
+    cnt = {}
+    for r in rs:
+        desc = [p for p in r["methods"]["default"]["chosen"].split(", ") if p.startswith(outname)][0]
+        for part in desc.split(": ", 1)[1].split(" + "):
+            name = part.split(" ")[-1]
+            cnt[name] = cnt.get(name, 0) + 1
+    print(f"{fam} out{k+1} ({len(rs)} tables): " + ", ".join(f"{n} {c}" for n, c in
+                                                         sorted(cnt.items(), key=lambda x: -x[1])))
+
+# coverage: test residual spread / sd, held-out RMSE / sd, per method
+print()
+NAMES = {"linlog": "linear/log", "linid": "linear/identity", "gplog": "gp-matern52-linear/log",
+         "gpm52": "gp-matern52-constant/identity", "gpse": "gp-se-constant/identity",
+         "net": "network-h2/identity"}
+print("| cell | method | cov +-1 / +-2 sd | 10-table blocks +-1 sd min-max | test resid / sd | held-out / sd | test resid / held-out |")
+print("|---|---|---|---|---|---|---|")
+for fam, k in COV_CELLS:
+    rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+    for m in ["default"] + CANDS:
+        mm = [r["methods"][m] for r in rs]
+        c1 = 100 * np.mean([x["cover1"][k] for x in mm]); c2 = 100 * np.mean([x["cover2"][k] for x in mm])
+        tr = math.exp(np.mean([math.log(x["resid_rms"][k] / x["sd_rms"][k]) for x in mm]))
+        if m == "default":
+            ho = [min(v[k] for v in r["methods"]["default"]["cv_rmse"].values()) for r in rs]
+        else:
+            ho = [r["methods"]["default"]["cv_rmse"].get(NAMES[m], [math.nan, math.nan])[k] for r in rs]
+        hs = math.exp(np.nanmean([math.log(h / x["sd_rms"][k]) for h, x in zip(ho, mm)]))
+        th = math.exp(np.nanmean([math.log(x["resid_rms"][k] / h) for h, x in zip(ho, mm)]))
+        blocks = {}
+        for r, x in zip(rs, mm):
+            blocks.setdefault((r["seed"] - 1) // 10, []).append(x["cover1"][k])
+        bm = [100 * np.mean(v) for v in blocks.values() if len(v) == 10]
+        print(f"| {fam} out{k+1} ({len(rs)}) | {m} | {c1:.0f} / {c2:.0f} | {min(bm):.0f}-{max(bm):.0f} ({len(bm)}) | {tr:.2f} | {hs:.2f} | {th:.2f} |")
+
+# Single-candidate choices: the default's sd (after its narrowing to the held-out residuals)
+# against the same candidate fitted alone (its own calibration, no narrowing), all families.
+print()
+INV = {v: k for k, v in NAMES.items()}
+rows = {}
+low = []
+for r in recs:
+    if not ok(r, "default"):
+        continue
+    for k, outname in enumerate(["max_elongation_um", "settle_time_s"]):
+        desc = [p for p in r["methods"]["default"]["chosen"].split(", ") if p.startswith(outname)][0]
+        c = desc.split(": ", 1)[1]
+        d = r["methods"]["default"]
+        if d["cover1"][k] < 0.45:
+            low.append((r["problem"], r["seed"], k + 1, d["cover1"][k], c))
+        if " " in c or INV.get(c) is None:
+            kind = "stack"
+            rows.setdefault(kind, []).append((d["cover1"][k], d["cover2"][k], math.nan, d["resid_rms"][k] / d["sd_rms"][k]))
+            continue
+        a = r["methods"][INV[c]]
+        kind = "single " + c
+        rows.setdefault(kind, []).append((d["cover1"][k], d["cover2"][k], d["sd_rms"][k] / a["sd_rms"][k],
+                                          d["resid_rms"][k] / d["sd_rms"][k], a["cover1"][k], a["cover2"][k]))
+print("| the default's choice for an output (all tuning tables, 8 families) | outputs | cov +-1 / +-2 sd | sd / the candidate alone's sd | test resid / sd | the candidate alone: cov +-1 / +-2 |")
+print("|---|---|---|---|---|---|")
+for kind, v in sorted(rows.items(), key=lambda x: -len(x[1])):
+    v = np.array([list(t) + [math.nan] * (6 - len(t)) for t in v])
+    print(f"| {kind} | {len(v)} | {100*np.mean(v[:,0]):.0f} / {100*np.mean(v[:,1]):.0f} | "
+          f"{math.exp(np.nanmean(np.log(v[:,2]))) if kind != 'stack' else float('nan'):.2f} | "
+          f"{math.exp(np.mean(np.log(v[:,3]))):.2f} | "
+          + (f"{100*np.nanmean(v[:,4]):.0f} / {100*np.nanmean(v[:,5]):.0f} |" if kind != "stack" else "- |"))
+print(f"\noutputs with +-1 sd coverage below 45 % ({len(low)}):")
+for t in low:
+    print(" ", t[0], t[1], f"out{t[2]}", f"{100*t[3]:.0f} %", t[4])
+
+# Selection optimism: a candidate's test residual spread over its held-out RMSE, on the outputs
+# where the default chose it alone, against all outputs (the same candidate fitted alone).
+print()
+print("| candidate | test resid / held-out: chosen alone (n) | all tables (n) |")
+print("|---|---|---|")
+for m, name in NAMES.items():
+    ch, al = [], []
+    for r in recs:
+        if not ok(r, "default") or not ok(r, m):
+            continue
+        for k, outname in enumerate(["max_elongation_um", "settle_time_s"]):
+            h = r["methods"]["default"]["cv_rmse"].get(name)
+            if not h:
+                continue
+            v = math.log(r["methods"][m]["resid_rms"][k] / h[k])
+            al.append(v)
+            desc = [p for p in r["methods"]["default"]["chosen"].split(", ") if p.startswith(outname)][0]
+            if desc.split(": ", 1)[1] == name:
+                ch.append(v)
+    print(f"| {name} | {math.exp(np.mean(ch)) if ch else float('nan'):.2f} ({len(ch)}) | {math.exp(np.mean(al)):.2f} ({len(al)}) |")
