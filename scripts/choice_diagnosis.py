@@ -1,3 +1,4 @@
+#!/usr/bin/python3
 """The thirteenth attempt's diagnosis at 20 rows (docs/workpiece-model.md, "Thirteenth attempt:
 diagnosis at 20 rows"): from bench_peers.py --json files holding, per table, the default
 ("default") and each candidate alone (family_bench --candidates NAME --no-cv: linlog, linid,
@@ -9,7 +10,7 @@ gplog, gpm52, gpse, net), and on some tables the peers:
   3. coverage: +-1 / +-2 sd, the spread of the test residuals and of the held-out residuals
      (the candidates' cv_rmse the choice saw) against the sd;
   4. single-candidate choices against the same candidate alone, and selection optimism.
-Usage: choice_diagnosis.py d_1_20.json d_4001_20.json ..."""
+Usage: scripts/choice_diagnosis.py d_1_20.json d_4001_20.json ..."""
 import json
 import math
 import sys
