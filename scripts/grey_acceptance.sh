@@ -19,8 +19,9 @@
 # slope with warmup's offset or the mean of both offsets), judged like both_grey, one table row
 # each beside both_grey's, with the per-seed range of the gain.
 # --grey-candidates: the opt-in grey rows (grey_all_sensors: every sensor on both channels;
-# grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two lead
-# days), judged and tabled the same way.
+# grey_sensors_by_days: grey_all_sensors' model from 20 lead days in the record, both_grey's
+# before; grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two
+# lead days), judged and tabled the same way.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -42,9 +43,9 @@ while [ $# -gt 0 ]; do
     --slope-through-lags-only) candidate+=(--slope-through-lags-only); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
-    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_guarded"
+    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_guarded"
                        shift ;;
-    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

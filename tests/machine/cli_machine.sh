@@ -132,9 +132,10 @@ for name in a:
 for name in ("grey_warmup_k0", "grey_mean_k0"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 PY
-# --grey-candidates (the eighth and ninth rounds) adds its two rows after the seventh round's, in
-# the same run: every other row, the seventh round's included, comes out equal; grey_guarded is
-# the row of the model it chose (grey_guarded_choice per machine) to the digit.
+# --grey-candidates (the eighth to tenth rounds) adds its three rows after the seventh round's,
+# in the same run: every other row, the seventh round's included, comes out equal; grey_guarded
+# is the row of the model it chose (grey_guarded_choice per machine) to the digit, and
+# grey_sensors_by_days both_grey's (one past day: fewer than 20 lead days).
 grep -q -- "--grey-candidates" "$D/evaluate_help.txt" || fail "--help lacks --grey-candidates"
 "$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
   --grey-candidates > "$D/field_gc.json" 2> "$D/field_err.txt" ||
@@ -144,14 +145,16 @@ import json, sys
 a = json.load(open(sys.argv[1]))["scenarios"][0]["strategies"]
 gc = json.load(open(sys.argv[2]))["scenarios"][0]
 b = gc["strategies"]
-assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_guarded"]), sorted(b)
+assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_sensors_by_days",
+                                      "grey_guarded"]), sorted(b)
 for name in a:
     assert a[name] == b[name], name
-for name in ("grey_all_sensors", "grey_guarded"):
+for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_guarded"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 chosen = gc["runs"][0]["grey_guarded_choice"]
 assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), chosen
 for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
     assert b["grey_guarded"][key] == a[chosen[0]][key], (key, chosen)
+    assert b["grey_sensors_by_days"][key] == a["both_grey"][key], key
 PY
 echo "cli_machine: ok"

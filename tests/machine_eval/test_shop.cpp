@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/random.h"
+#include "drift/grey_box_io.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/shop_models.h"
 #include "machine_eval/strategies.h"
@@ -318,6 +319,44 @@ TEST(GreyCandidates, TheLeadShareOf90PercentFollowsTheLeadsWhereTheProbeDisagree
       EXPECT_LT(c, 0.8 * f) << "candidate " << c << " um, field " << f << " um";
     }
   }
+}
+
+// grey_sensors_by_days (the tenth round) follows the record's length: on a planted record of 19
+// lead days (below 2 x forward_days = 20) it is both_grey's model bit for bit, on one of 20
+// grey_all_sensors' bit for bit (every field of the model, as written to a file); the two models
+// differ on both records (z_motor_C moves the slope), so the test sees which one was taken.
+TEST(GreyCandidates, SensorsByDaysTakeEverySensorFromTwentyLeadDays) {
+  EXPECT_EQ(FieldGreyBoxOptions().forward_days, 10);
+  for (int days : {19, 20}) {
+    const drift::ShopRecord rec = MotorRecord(0, days);
+    ASSERT_EQ(drift::LeadDays(rec).size(), static_cast<std::size_t>(days));
+    EXPECT_EQ(EverySensorByDays(rec, FieldGreyBoxOptions()), days >= 20);
+    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true);
+    ASSERT_EQ(m.grey_candidates.size(), 2u);
+    const nlohmann::json grey = m.grey, all = m.grey_candidates[0],
+                         by_days = m.grey_candidates[1];
+    EXPECT_NE(grey, all) << days << " days";
+    EXPECT_EQ(by_days, days >= 20 ? all : grey) << days << " days";
+  }
+}
+
+// LeadDays counts the calendar days with a lead reading: not a probe-only day, not a lead
+// record without rows; ScoresForward needs kForwardLeads and 2 x forward_days of them.
+TEST(GreyCandidates, LeadDaysCountOnlyDaysWithALeadReading) {
+  drift::ShopRecord rec = MotorRecord(0, 4);
+  for (drift::MeasurementRecord& r : rec.records)
+    if (r.day == 1 && r.kind == drift::MeasurementRecord::Kind::kLead) r.rows.clear();
+  for (drift::MeasurementRecord& r : rec.records)
+    if (r.day == 2 && r.kind == drift::MeasurementRecord::Kind::kLead)
+      r.kind = drift::MeasurementRecord::Kind::kProbe;
+  EXPECT_EQ(drift::LeadDays(rec), (std::vector<int>{0, 3}));
+  drift::GreyBoxOptions o = FieldGreyBoxOptions();
+  o.forward_days = 2;
+  EXPECT_FALSE(drift::ScoresForward(rec, o));
+  o.forward_days = 1;  // 2 lead days = 2 x 1: scores (the fit validates forward_days, not this)
+  EXPECT_TRUE(drift::ScoresForward(rec, o));
+  o.validation = drift::GreyValidation::kLeaveOneDayOut;
+  EXPECT_FALSE(drift::ScoresForward(rec, o));
 }
 
 // The leads of a world where only the time since power-on moves the machine (the sensors of

@@ -125,15 +125,18 @@ std::string ToString(OffsetCandidate c);  ///< grey_warmup_k0, grey_mean_k0
 /// warmup's share of the candidate's K0 (1 and 0.5; the grey box's share is 1 minus it).
 double WarmupOffsetShare(OffsetCandidate c);
 
-/// Opt-in rows of the eighth and ninth rounds (issue 41; FieldProtocol::grey_candidates), after
+/// Opt-in rows of the eighth to tenth rounds (issue 41; FieldProtocol::grey_candidates), after
 /// the OffsetCandidate rows (which come with them), from the same shop records as both_grey:
 /// the workpiece plan + the grey box of every sensor (grey_all_sensors, shop_models.h
-/// FieldGreyCandidate), or + both_grey's grey box or the sensor-free base rule (warmup or
-/// schedule), whichever the shop's own last lead days favour (grey_guarded, GuardGreyBox).
-/// Both count as using sensors; never the strongest sensor-free row.
-enum class GreyCandidate { kAllSensors, kGuarded };
-inline constexpr std::size_t kGreyCandidateCount = 2;
-std::string ToString(GreyCandidate c);  ///< grey_all_sensors, grey_guarded
+/// FieldGreyCandidate); + that grey box once the record holds 2 x forward_days lead days,
+/// both_grey's before (grey_sensors_by_days, shop_models.h EverySensorByDays); or + both_grey's
+/// grey box or the sensor-free base rule (warmup or schedule), whichever the shop's own last
+/// lead days favour (grey_guarded, GuardGreyBox). All count as using sensors; never the
+/// strongest sensor-free row.
+enum class GreyCandidate { kAllSensors, kSensorsByDays, kGuarded };
+inline constexpr std::size_t kGreyCandidateCount = 3;
+/// grey_all_sensors, grey_sensors_by_days, grey_guarded
+std::string ToString(GreyCandidate c);
 /// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
 std::string OptInRowName(std::size_t k);
 

@@ -38,7 +38,8 @@ double WarmupOffsetShare(OffsetCandidate c) {
 }
 
 std::string ToString(GreyCandidate c) {
-  return c == GreyCandidate::kAllSensors ? "grey_all_sensors" : "grey_guarded";
+  static const char* kNames[] = {"grey_all_sensors", "grey_sensors_by_days", "grey_guarded"};
+  return kNames[static_cast<int>(c)];
 }
 
 std::string OptInRowName(std::size_t k) {

@@ -156,6 +156,9 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   if (!grey_candidates) return m;
   const GreyCandidateFit all = FieldGreyCandidate(z_fixed_mm, contact, have);
   m.grey_candidates.push_back(drift::FitGreyBox(record, all.spec, all.options));
+  drift::GreyBoxModel by_days = EverySensorByDays(record, grey_options) ? m.grey_candidates[0]
+                                                                        : m.grey;
+  m.grey_candidates.push_back(std::move(by_days));
   const GuardScore g =
       GuardGreyBox(record, grey, grey_options, schedule_base ? schedule : warmup, lagged);
   m.guard = {true, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
@@ -170,6 +173,10 @@ GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
     if (s != kBlankContactSensor) f.spec.offset_sensors.push_back(s);
   f.spec.slope_sensors = f.spec.offset_sensors;
   return f;
+}
+
+bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOptions& options) {
+  return drift::ScoresForward(record, options);
 }
 
 drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact) {

@@ -38,8 +38,9 @@ struct ShopModels {
   /// The grey box (FieldGreyBoxSpec), the both_grey row; empty (no input, 0 everywhere) when
   /// the record's logs lack one of its sensors.
   drift::GreyBoxModel grey;
-  /// The opt-in grey boxes (grey_all_sensors: FieldGreyCandidate), fitted only when asked for
-  /// and where the grey box is.
+  /// The opt-in grey boxes, fitted only when asked for and where the grey box is, in
+  /// GreyCandidate's order: grey_all_sensors (FieldGreyCandidate), grey_sensors_by_days (a copy
+  /// of that model or of `grey`, by EverySensorByDays).
   std::vector<drift::GreyBoxModel> grey_candidates;
   bool rule_is_schedule = false;  ///< the sensor-free base (schedule, else warmup) by its CV
   /// The ninth round's guard (grey_guarded: GuardGreyBox), chosen only when the opt-in grey
@@ -83,6 +84,11 @@ struct GreyCandidateFit {
 };
 GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
                                     const std::vector<std::string>& sensors);
+/// The tenth round's row (grey_sensors_by_days; docs/machine-evaluation.md "Tenth round:
+/// split"): every sensor (FieldGreyCandidate) once the record holds enough lead days for the
+/// grey box's forward chaining (drift::ScoresForward: 2 x forward_days), the field grey box's
+/// five sensors before (every sensor pays on a short record and gains on a long one).
+bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOptions& options);
 
 /// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split"): the
 /// grey box or a sensor-free rule, chosen on the shop's own record in time order. For each of

@@ -266,14 +266,9 @@ double CvRmse(const Design& d, double strength) {
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
-// Forward chaining on the leads: each of the last `days` days with a lead reading, fitted on
-// the rows of the earlier days; NaN when fewer than 2 x `days` days hold a lead.
-double ForwardLeadRmse(const Design& d, double strength, int days) {
-  std::set<int> lead_days;
-  for (std::size_t i = 0; i < d.day.size(); ++i)
-    if (d.lead[i]) lead_days.insert(d.day[i]);
-  if (lead_days.size() < 2 * static_cast<std::size_t>(days)) return std::nan("");
-  std::vector<int> chosen(lead_days.begin(), lead_days.end());
+// Forward chaining on the leads: each of the last `days` of `lead_days` (LeadDays, at least
+// `days` of them), fitted on the rows of the earlier days; NaN when no lead row is scored.
+double ForwardLeadRmse(const Design& d, double strength, std::vector<int> chosen, int days) {
   chosen.erase(chosen.begin(), chosen.end() - days);
   double num = 0, den = 0;
   for (int day : chosen)
@@ -285,8 +280,8 @@ double ForwardLeadRmse(const Design& d, double strength, int days) {
 double Score(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
              const GreyBoxOptions& o) {
   const Design d = BuildDesign(rec, spec, c, o);
-  if (o.validation == GreyValidation::kForwardLeads) {
-    const double e = ForwardLeadRmse(d, c.strength, o.forward_days);
+  if (ScoresForward(rec, o)) {
+    const double e = ForwardLeadRmse(d, c.strength, LeadDays(rec), o.forward_days);
     if (std::isfinite(e)) return e;
   }
   return CvRmse(d, c.strength);
@@ -329,6 +324,18 @@ Choice Choose(const ShopRecord& rec, const GreyBoxSpec& spec, const GreyBoxOptio
 }
 
 }  // namespace grey_box_detail
+
+std::vector<int> LeadDays(const ShopRecord& record) {
+  std::set<int> days;
+  for (const MeasurementRecord& r : record.records)
+    if (r.kind == MeasurementRecord::Kind::kLead && !r.rows.empty()) days.insert(r.day);
+  return {days.begin(), days.end()};
+}
+
+bool ScoresForward(const ShopRecord& record, const GreyBoxOptions& options) {
+  return options.validation == GreyValidation::kForwardLeads &&
+         LeadDays(record).size() >= 2 * static_cast<std::size_t>(options.forward_days);
+}
 
 GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
                         const GreyBoxOptions& options) {

@@ -122,6 +122,12 @@ struct GreyBoxModel {
   std::vector<std::string> DutyInputs() const;
 };
 
+/// The calendar days that hold a lead reading (a lead record with a row), ascending.
+std::vector<int> LeadDays(const ShopRecord& record);
+/// Whether FitGreyBox scores its choices by forward chaining on `record`: kForwardLeads and at
+/// least 2 x forward_days lead days (LeadDays); else leave one day out.
+bool ScoresForward(const ShopRecord& record, const GreyBoxOptions& options);
+
 /// InputError: an invalid record, a missing column, no sensor, bad options, or fewer readings
 /// than unknowns.
 GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,
