@@ -730,9 +730,9 @@ double FitDifferenceInSd(const FamilyModel& a, const FamilyModel& b, const Proce
   return spread > 0 ? std::sqrt(d.squaredNorm() / static_cast<double>(d.size())) / spread : 0.0;
 }
 
-int FittedHyperparameters(const Candidate& c) {
+int FittedHyperparameters(const Candidate& c, int inputs) {
   if (c.family != Family::kGaussianProcess) return 0;
-  return (c.isotropic ? 1 : ProcessInputs::kCount) + 2;
+  return (c.isotropic ? 1 : inputs) + 2;
 }
 
 double GpLogEvidence(const FamilyModel& m, int k) {
@@ -1141,7 +1141,7 @@ GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& 
         continue;
       const gp::Gp& g = full[c].gps[static_cast<std::size_t>(k)];
       const int d = g.InputCount();
-      const double q = (o.candidates[c].isotropic ? 1 : d) + 2 + gp::MeanSize(g.mean, d);
+      const double q = FittedHyperparameters(o.candidates[c], d) + gp::MeanSize(g.mean, d);
       ev[c][k] = GpLogEvidence(full[c], k);
       if (o.gp_slot_large == GpSlot::kBic)
         ev[c][k] -= 0.5 * q * std::log(static_cast<double>(g.u.size()));

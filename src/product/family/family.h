@@ -218,9 +218,10 @@ bool BeatsFirst(const Eigen::VectorXd& first, const Eigen::VectorXd& other, doub
 double FitDifferenceInSd(const FamilyModel& a, const FamilyModel& b, const ProcessTable& table,
                          int k);
 
-/// Hyperparameters a GP candidate fits by maximum likelihood: one length scale per input (one
-/// if isotropic), the signal sd and the noise sd; 0 for other families.
-int FittedHyperparameters(const Candidate& c);
+/// Hyperparameters a GP candidate fits by maximum likelihood on `inputs` input columns: one
+/// length scale per input (one if isotropic), the signal sd and the noise sd; 0 for other
+/// families.
+int FittedHyperparameters(const Candidate& c, int inputs = ProcessInputs::kCount);
 
 /// ln p(y) of output k's GP in `m` at its fitted hyperparameters, as a density of the output in
 /// its original units (the log marginal likelihood made comparable between a GP of ln y and a
