@@ -63,11 +63,7 @@ std::pair<double, double> DemeanedSquares(const drift::MeasurementRecord& r,
 GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpec& grey,
                         const drift::GreyBoxOptions& grey_options, const drift::JointSpec& rule,
                         const drift::JointFitOptions& rule_options, int held_days) {
-  std::vector<int> lead_days;
-  for (const drift::MeasurementRecord& r : record.records)
-    if (r.kind == drift::MeasurementRecord::Kind::kLead) lead_days.push_back(r.day);
-  std::sort(lead_days.begin(), lead_days.end());
-  lead_days.erase(std::unique(lead_days.begin(), lead_days.end()), lead_days.end());
+  const std::vector<int> lead_days = drift::LeadDays(record);
   if (held_days < 1)
     throw InputError("grey guard: held_days = " + std::to_string(held_days) + ": must be >= 1");
   const std::size_t held = static_cast<std::size_t>(held_days);
