@@ -29,28 +29,18 @@ WHIRL_BUILD_DIR="$D/fake" bash "$G" --first-seed 101 --seeds 3 --weeks "1 8" --o
 grep -q -- "--past-days 40 " "$D/args.txt" || fail "8 weeks: $(cat "$D/args.txt")"
 grep -q "seeds 101..103" "$D/out.txt" || fail "the seeds are not reported: $(cat "$D/out.txt")"
 grep -q -- "--slope-through-lags-only" "$D/args.txt" "$D/out.txt" && fail "the candidate without asking"
-# --slope-through-lags-only reaches every evaluation and the table says so.
-rm -f "$D/args.txt"
-WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --slope-through-lags-only --out-dir "$D/c" \
-  > "$D/out.txt" 2> "$D/err.txt" || fail "candidate run: $(cat "$D/err.txt")"
-[ "$(grep -c -- "--markdown --slope-through-lags-only" "$D/args.txt")" -eq 2 ] ||
-  fail "the candidate's flag: $(cat "$D/args.txt")"
-grep -q "both_grey with --slope-through-lags-only" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
-# --offset-candidates reaches every evaluation and the table says so.
-rm -f "$D/args.txt"
-WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --offset-candidates --out-dir "$D/k" \
-  > "$D/out.txt" 2> "$D/err.txt" || fail "offset candidates run: $(cat "$D/err.txt")"
-[ "$(grep -c -- "--markdown --offset-candidates" "$D/args.txt")" -eq 2 ] ||
-  fail "the rows' flag: $(cat "$D/args.txt")"
-grep -q "the opt-in rows of --offset-candidates" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
+# An opt-in flag ($1) reaches both weeks' evaluations (out-dir $D/$2) and the table says so ($3).
+flag_reaches_every_evaluation() {
+  rm -f "$D/args.txt"
+  WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" "$1" --out-dir "$D/$2" \
+    > "$D/out.txt" 2> "$D/err.txt" || fail "$1 run: $(cat "$D/err.txt")"
+  [ "$(grep -c -- "--markdown $1" "$D/args.txt")" -eq 2 ] || fail "$1: $(cat "$D/args.txt")"
+  grep -q -- "$3" "$D/out.txt" || fail "$1 not reported: $(cat "$D/out.txt")"
+}
+flag_reaches_every_evaluation --slope-through-lags-only c "both_grey with --slope-through-lags-only"
+flag_reaches_every_evaluation --offset-candidates k "the opt-in rows of --offset-candidates"
 grep -q "| weeks | scenario | row |" "$D/out.txt" || fail "no row column: $(cat "$D/out.txt")"
-# --grey-candidates (the eighth round) likewise.
-rm -f "$D/args.txt"
-WHIRL_BUILD_DIR="$D/fake" bash "$G" --weeks "1 8" --grey-candidates --out-dir "$D/g" \
-  > "$D/out.txt" 2> "$D/err.txt" || fail "grey candidates run: $(cat "$D/err.txt")"
-[ "$(grep -c -- "--markdown --grey-candidates" "$D/args.txt")" -eq 2 ] ||
-  fail "the rows' flag: $(cat "$D/args.txt")"
-grep -q "the opt-in rows of --grey-candidates" "$D/out.txt" || fail "not reported: $(cat "$D/out.txt")"
+flag_reaches_every_evaluation --grey-candidates g "the opt-in rows of --grey-candidates"
 # Each scenario's row gets its own per-seed range (the gain lines name no scenario): a stand-in
 # prints two planted scenario blocks whose ranges differ.
 python3 - "$D/planted.md" <<'PY'
