@@ -488,6 +488,17 @@ CeilingScenario EvaluateCeiling(const machine::MachineScenario& scenario,
   return out;
 }
 
+namespace {
+
+// One table cell of a median in um: " 4.2 |", or " - |" where there is none.
+std::string TableCell(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, std::isfinite(v) ? " %.1f |" : " - |", v);
+  return buf;
+}
+
+}  // namespace
+
 std::string FormatCeilingTable(const std::vector<CeilingScenario>& rows) {
   std::string s = "| scenario | cuts |";
   for (const auto& c : CeilingFeatureSets()) s += " " + c + " |";
@@ -499,13 +510,7 @@ std::string FormatCeilingTable(const std::vector<CeilingScenario>& rows) {
   char buf[32];
   for (const CeilingScenario& r : rows) {
     s += "| " + r.scenario + " | " + std::to_string(r.cuts.size()) + " |";
-    auto cell = [&](double v) {
-      if (std::isfinite(v))
-        std::snprintf(buf, sizeof buf, " %.1f |", v);
-      else
-        std::snprintf(buf, sizeof buf, " - |");
-      s += buf;
-    };
+    auto cell = [&](double v) { s += TableCell(v); };
     for (double v : r.ceiling_median_um) cell(v);
     for (double v : r.estimator_median_um) cell(v);
     std::snprintf(
@@ -530,10 +535,7 @@ std::string FormatGreyStructureTable(const std::vector<CeilingScenario>& rows) {
   for (const CeilingScenario& r : rows) {
     if (r.grey_median_um.empty()) continue;
     s += "| " + r.scenario + " | " + std::to_string(r.cuts.size()) + " |";
-    auto cell = [&](double v) {
-      std::snprintf(buf, sizeof buf, std::isfinite(v) ? " %.1f |" : " - |", v);
-      s += buf;
-    };
+    auto cell = [&](double v) { s += TableCell(v); };
     cell(r.ceiling_median_um[absolute]);
     cell(r.ceiling_median_um[blank]);
     for (double v : r.grey_median_um) cell(v);
