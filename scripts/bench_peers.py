@@ -98,17 +98,24 @@ import tempfile
 import time
 
 import numpy as np
-import sklearn
-from sklearn.compose import TransformedTargetRegressor
-from sklearn.linear_model import LinearRegression, RidgeCV
-from sklearn.exceptions import ConvergenceWarning
-from sklearn.gaussian_process import GaussianProcessRegressor
-from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
-from sklearn.model_selection import GridSearchCV, KFold
-from sklearn.neural_network import MLPRegressor
-from sklearn.pipeline import make_pipeline
-from sklearn.preprocessing import StandardScaler
 import warnings
+
+# scikit-learn only for its peers (Debian python3-sklearn, scripts/setup.sh with
+# WHIRL_SETUP_BENCH_PEERS=1): whirl's own methods, --peers "" or brnn_whirl, --from-json and the
+# scripts that import this file (design_study.py, ...) run without it.
+try:
+    import sklearn
+    from sklearn.compose import TransformedTargetRegressor
+    from sklearn.linear_model import LinearRegression, RidgeCV
+    from sklearn.exceptions import ConvergenceWarning
+    from sklearn.gaussian_process import GaussianProcessRegressor
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+    from sklearn.model_selection import GridSearchCV, KFold
+    from sklearn.neural_network import MLPRegressor
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+except ImportError:
+    sklearn = None
 
 INPUTS = ["hardness_hrc", "diameter_mm", "pitch_mm", "raceway_radius_mm", "cutting_speed_m_min"]
 TARGETS = ["max_elongation_um", "settle_time_s"]
@@ -612,6 +619,10 @@ def main():
     if families and not a.family_bench:
         sys.exit("bench_peers: --family needs --family-bench")
     peers = [p for p in a.peers.split(",") if p]
+    if sklearn is None and any(p != "brnn_whirl" for p in peers):
+        sys.exit(f"bench_peers: the peers {', '.join(p for p in peers if p != 'brnn_whirl')} need "
+                 "scikit-learn (python3-sklearn: WHIRL_SETUP_BENCH_PEERS=1 scripts/setup.sh); "
+                 "--peers '' or brnn_whirl runs without it")
     cases = []
     for prob in problems.split(","):
         sizes = [20] if prob == "simulator" else [int(s) for s in a.sizes.split(",")]
@@ -716,6 +727,10 @@ def pooled_summary(files, accept, markdown):
     best acceptance peer, the sum of those percentages and the (problem, rows, output) cells whose
     mean coverage is outside 60-76 % (+-1 sd) or 90-98 % (+-2 sd)."""
     results = load_runs(files)
+    accept = [p for p in accept if results and all(p in r["methods"] for r in results)]
+    if not accept:
+        sys.exit(f"bench_peers: --from-json: no acceptance peer (--acceptance-peers) was run on "
+                 f"every table of {' '.join(files)}; --paired compares two whirl methods")
     cases = sorted({(r["problem"], r["rows"]) for r in results}, key=lambda c: (c[1], c[0]))
     methods = [m for m in sorted({m for r in results for m in r["methods"]})
                if all(m in r["methods"] and "cover1" in r["methods"][m] and "chosen" in
@@ -775,8 +790,17 @@ def paired_decision(files, base, cand, sixth=False):
     1.03. A failed fit (NaN) of either method fails the rule. sixth: the sixth attempt's rule
     (section "Sixth attempt: split"): no problem's geometric mean ratio exp(mean d) above 1.02
     instead of the median; if every case has d = 0 (only the sd changed), strictly fewer coverage
-    cells instead of the t test."""
+    cells instead of the t test. Both rules: "no change" when the two methods' RMSE, sd and
+    coverage are equal on every table (nothing to decide; base stays)."""
     rs = load_runs(files)
+    if not rs:
+        sys.exit(f"bench_peers: --paired: no tables in {' '.join(files)}")
+    for r in rs:
+        for m in (base, cand):
+            if "rmse" not in r["methods"].get(m, {}):
+                sys.exit(f"bench_peers: --paired: method '{m}' missing in {r['problem']}, "
+                         f"{r['rows']} rows, seed {r['seed']} of {' '.join(files)} (methods there: "
+                         f"{', '.join(sorted(r['methods']))})")
     d, fam, failed_fits = [], {}, 0
     for r in rs:
         for k in (0, 1):
@@ -823,6 +847,11 @@ def paired_decision(files, base, cand, sixth=False):
                   "no failed fit": failed_fits == 0}
     for what, ok in checks.items():
         print(f"{'holds' if ok else 'FAILS'}: {what}")
+    if all(r["methods"][cand].get(key) == r["methods"][base].get(key) for r in rs
+           for key in ("rmse", "sd_rms", "cover1", "cover2", "cover1_truth", "cover2_truth")):
+        print(f"decision: no change ({cand} has {base}'s RMSE, sd and coverage on every table; "
+              f"keep {base})")
+        return
     print(f"decision: {'ADOPT ' + cand if all(checks.values()) else 'keep ' + base}")
 
 
