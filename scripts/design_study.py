@@ -212,23 +212,40 @@ def variance_args(a):
     return out
 
 
+# A replaced generator seed s (negative target in its candidate list) becomes the first of
+# s + k * REPLACEMENT_STRIDE (k = 1, 2, ...) whose list has none: seeds of --seeds stay below the
+# stride, so ranges that do not overlap get disjoint seeds, replacements included.
+REPLACEMENT_STRIDE = 1_000_000
+
+
 def seeds_of(text):
+    """The seeds of --seeds "LO-HI" or "S" (1 <= LO <= HI < REPLACEMENT_STRIDE)."""
     lo, _, hi = text.partition("-")
-    return list(range(int(lo), int(hi or lo) + 1))
+    try:
+        seeds = list(range(int(lo), int(hi or lo) + 1))
+    except ValueError:
+        sys.exit(f"design_study: --seeds '{text}': expected LO-HI or one seed (integers)")
+    if not seeds or seeds[0] < 1 or seeds[-1] >= REPLACEMENT_STRIDE:
+        sys.exit(f"design_study: --seeds '{text}': expected 1 <= LO <= HI < {REPLACEMENT_STRIDE}")
+    return seeds
 
 
 def usable_seeds(prob, seeds):
-    """`seeds`, where a generator seed whose candidate list holds a negative target (which
-    `whirl train` refuses) is replaced by the next seed after the range that does not (the rule
-    of docs/design.md, fixed before the second attempt's tuning)."""
+    """`seeds`, where a generator seed s whose candidate list holds a negative target (which
+    `whirl train` refuses) is replaced by the first s + k REPLACEMENT_STRIDE, k = 1, 2, ..., that
+    does not (docs/design.md; before 2026-11-30 by the next seed after the range that does not,
+    which the next range of seeds also used)."""
     if prob == "simgen":
         return seeds
-    ok = lambda s: (bp.generated(prob, POOL_ROWS, s)[1] >= 0).all()  # noqa: E731
-    out, nxt = [s for s in seeds if ok(s)], max(seeds) + 1
-    while len(out) < len(seeds):
-        if ok(nxt):
-            out.append(nxt)
-        nxt += 1
+    out = []
+    for s in seeds:
+        r = s
+        while not (bp.generated(prob, POOL_ROWS, r)[1] >= 0).all():
+            r += REPLACEMENT_STRIDE
+        if r != s:
+            print(f"design_study: {prob} seed {s} replaced by {r} (a negative target in its "
+                  "candidate list)", file=sys.stderr)
+        out.append(r)
     return out
 
 
