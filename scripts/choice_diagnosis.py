@@ -10,6 +10,9 @@ gplog, gpm52, gpse, net), and on some tables the peers:
   3. coverage: +-1 / +-2 sd, the spread of the test residuals and of the held-out residuals
      (the candidates' cv_rmse the choice saw) against the sd;
   4. single-candidate choices against the same candidate alone, and selection optimism.
+A cell whose family no file holds is left out; without tables that hold every peer the peer
+columns read "-"; the +-1 sd coverage of 10-table blocks needs seeds of one block (1-10, 11-20,
+...) all present ("-" otherwise).
 Usage: scripts/choice_diagnosis.py d_1_20.json d_4001_20.json ..."""
 import json
 import math
@@ -19,7 +22,12 @@ import numpy as np
 
 ACCEPT = ["loglinear", "gp_ard", "mlp_default", "mlp_cv", "brnn_whirl"]
 CANDS = ["linlog", "linid", "gplog", "gpm52", "gpse", "net"]
-recs = [r for f in sys.argv[1:] for r in json.load(open(f))]
+if len(sys.argv) < 2:
+    sys.exit(__doc__)
+try:
+    recs = [r for f in sys.argv[1:] for r in json.load(open(f))]
+except (OSError, ValueError) as e:
+    sys.exit(f"choice_diagnosis.py: not a bench_peers.py --json file: {e}")
 ok = lambda r, m: m in r["methods"] and "rmse" in r["methods"][m]
 RMSE_CELLS = [("powerlaw", 1), ("friedman", 0), ("friedman", 1), ("additive", 0), ("additive", 1),
               ("friedman23", 0), ("friedman23", 1), ("powerlaw_noisy", 0), ("hetero", 1)]
@@ -39,24 +47,29 @@ print("| cell | best peer, tuning seeds with peers (n) | default | "
 print("|" + "---|" * (4 + len(CANDS)))
 for fam, k in RMSE_CELLS:
     rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+    if not rs:
+        continue
     wp = [r for r in rs if all(ok(r, p) for p in ACCEPT)]
-    med = {p: np.median([rmse(r, p, k) for r in wp]) for p in ACCEPT}
-    best = min(med, key=med.get)
+    med = {p: np.median([rmse(r, p, k) for r in wp]) for p in ACCEPT} if wp else {}
+    best = min(med, key=med.get) if wp else None
+    above = lambda v: f"{pct(np.median(v), med[best]):+.1f} %" if wp else "-"  # noqa: E731
     cells = []
     for m in ["default"] + CANDS:
-        mp = pct(np.median([rmse(r, m, k) for r in wp]), med[best])
+        mp = above([rmse(r, m, k) for r in wp])
         g = math.exp(np.mean([math.log(rmse(r, m, k) / rmse(r, "default", k)) for r in rs]))
-        cells.append(f"{mp:+.1f} %" if m == "default" else f"{mp:+.1f} % / {g:.2f}")
+        cells.append(mp if m == "default" else f"{mp} / {g:.2f}")
     orc = [min(rmse(r, m, k) for m in CANDS) for r in rs]
     og = math.exp(np.mean([math.log(o / rmse(r, "default", k)) for o, r in zip(orc, rs)]))
-    om = pct(np.median([min(rmse(r, m, k) for m in CANDS) for r in wp]), med[best])
-    print(f"| {fam} out{k+1} | {best} {med[best]:.4g} ({len(wp)}) | "
-          + " | ".join(cells) + f" | {om:+.1f} % / {og:.2f} ({len(rs)}) |")
+    om = above([min(rmse(r, m, k) for m in CANDS) for r in wp])
+    peer = f"{best} {med[best]:.4g} ({len(wp)})" if wp else "- (0)"
+    print(f"| {fam} out{k+1} | {peer} | " + " | ".join(cells) + f" | {om} / {og:.2f} ({len(rs)}) |")
 
 # which candidates the default gives weight to, per cell (share of tables where it appears)
 print()
-for fam, k in RMSE_CELLS + COV_CELLS:
+for fam, k in dict.fromkeys(RMSE_CELLS + COV_CELLS):  # friedman out2 is in both
     rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+    if not rs:
+        continue
     outname = ["max_elongation_um", "settle_time_s"][k]
     cnt = {}
     for r in rs:
@@ -76,6 +89,8 @@ print("| cell | method | cov +-1 / +-2 sd | 10-table blocks +-1 sd min-max | tes
 print("|---|---|---|---|---|---|---|")
 for fam, k in COV_CELLS:
     rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+    if not rs:
+        continue
     for m in ["default"] + CANDS:
         mm = [r["methods"][m] for r in rs]
         c1 = 100 * np.mean([x["cover1"][k] for x in mm]); c2 = 100 * np.mean([x["cover2"][k] for x in mm])
@@ -90,7 +105,8 @@ for fam, k in COV_CELLS:
         for r, x in zip(rs, mm):
             blocks.setdefault((r["seed"] - 1) // 10, []).append(x["cover1"][k])
         bm = [100 * np.mean(v) for v in blocks.values() if len(v) == 10]
-        print(f"| {fam} out{k+1} ({len(rs)}) | {m} | {c1:.0f} / {c2:.0f} | {min(bm):.0f}-{max(bm):.0f} ({len(bm)}) | {tr:.2f} | {hs:.2f} | {th:.2f} |")
+        span = f"{min(bm):.0f}-{max(bm):.0f}" if bm else "-"
+        print(f"| {fam} out{k+1} ({len(rs)}) | {m} | {c1:.0f} / {c2:.0f} | {span} ({len(bm)}) | {tr:.2f} | {hs:.2f} | {th:.2f} |")
 
 # Single-candidate choices: the default's sd (after its narrowing to the held-out residuals)
 # against the same candidate fitted alone (its own calibration, no narrowing), all families.
