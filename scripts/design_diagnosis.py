@@ -145,10 +145,14 @@ def main():
     ap.add_argument("--problems", help="only these (comma-separated)")
     a = ap.parse_args()
     a.truth_of = {}
-    base = json.load(open(a.run))
     keep = a.problems.split(",") if a.problems else None
-    todo = [(p, s, base["design_picks"][f"{p}/{s}"]) for p, s, _ in base["cases"]
-            if keep is None or p in keep]
+    try:
+        base = json.load(open(a.run))
+        todo = [(p, s, base["design_picks"][f"{p}/{s}"]) for p, s, _ in base["cases"]
+                if keep is None or p in keep]
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        sys.exit(f"design_diagnosis: {a.run}: not a design_study.py --json run with design_picks "
+                 f"({type(e).__name__}: {e})")
     with ThreadPoolExecutor(2) as ex:
         res = list(ex.map(lambda c: case(a, *c), todo))
     json.dump(res, open(a.out, "w"))

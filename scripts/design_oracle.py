@@ -264,9 +264,13 @@ def main():
                     "--progress file)")
     a = ap.parse_args()
     if a.from_json:
-        text = open(a.from_json).read()
-        res = (json.loads(text)["cases"] if text.startswith("{") else
-               [json.loads(line) for line in text.splitlines() if line.strip()])
+        try:
+            text = open(a.from_json).read()
+            res = (json.loads(text)["cases"] if text.startswith("{") else
+                   [json.loads(line) for line in text.splitlines() if line.strip()])
+        except (OSError, ValueError, KeyError) as e:
+            sys.exit(f"design_oracle: {a.from_json}: not a --json run or --progress file "
+                     f"({type(e).__name__}: {e})")
         summary(res)
         if a.fresh_noise:
             got = fresh_noise(a, res)

@@ -10,6 +10,7 @@ packages=(
   gnuplot-nox fonts-liberation   # report plots (pngcairo needs a font; a Recommends of gnuplot-nox)
   libboost-dev                   # Boost.Math (header-only): F-distribution quantile of the drift selection
   python3                        # the command-line tests read JSON outputs with it
+  python3-numpy                  # the lab's scripts (scripts/*.py) and their tests (tests/lab)
   # tests/compare/cli_report_render.sh renders every report in it (skipped without). Measured on
   # Debian 12: 10 packages, about 280 MB installed, 35 s to download and install; the test takes
   # about 15 s (most of it the demo that writes the reports).

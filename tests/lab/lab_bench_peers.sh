@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# scripts/bench_peers.py: the paired decision (--from-json --paired, --rule fifth|sixth) on planted
+# runs with hand-computed figures; a tiny run through build/whirl and build/family_bench (2 problems
+# x 1 size x 2 seeds, no scikit-learn peer): its JSON's records, fields and counts, and two
+# identical whirl settings paired give every d = 0 and "no change"; bad arguments exit non-zero
+# with a message.
+# Usage (CTest): lab_bench_peers.sh <whirl> <scratch dir> <source dir> <family_bench>
+set -uo pipefail
+W="$1"; D="$2"; S="$3"; FB="$4"
+rm -rf "$D"; mkdir -p "$D"; cd "$D"
+source "$S/tests/lab/lab_common.sh"
+BP=("$PY" "$S/scripts/bench_peers.py" --whirl "$W")
+
+# Planted runs. rec <problem> <seed> <rmse a> <rmse b> [<cover1 a>]: methods a and b on one
+# table, coverage inside the bands (+-1 sd 68 %, +-2 sd 95 %) unless <cover1 a> is given.
+"$PY" - <<'PY' || fail "could not write the planted runs"
+import json
+def rec(prob, seed, ra, rb, cover1_a=0.68):
+    m = lambda r, c1: {"rmse": r, "cover1": [c1, c1], "cover2": [0.95, 0.95], "sd_rms": [1.0, 1.0]}
+    return {"problem": prob, "rows": 20, "seed": seed,
+            "methods": {"a": m(ra, cover1_a), "b": m(rb, 0.68)}}
+# d = ln(b / a) per (table, output): ln 0.5, ln 0.25, ln 0.5, 0, i.e. -L, -2L, -L, 0 (L = ln 2):
+# mean -L = -0.6931 (geometric mean ratio 0.5), sd L sqrt(2/3), t = -L / (sd / 2) = -sqrt(6)
+# = -2.45; median of d -L (ratio 0.5000); 3 cases lower, 0 higher, one d = 0.
+better = [rec("p", 1, [1.0, 1.0], [0.5, 0.25]), rec("p", 2, [1.0, 1.0], [0.5, 1.0])]
+json.dump(better, open("better.json", "w"))
+# plus problem q where b is 5 % worse on every case: q's median ratio 1.05 > 1.03, its geometric
+# mean 1.05 > 1.02 (both rules keep a)
+json.dump(better + [rec("q", 1, [2.0, 4.0], [2.1, 4.2]), rec("q", 2, [1.0, 3.0], [1.05, 3.15])],
+          open("worse_q.json", "w"))
+# b has a's RMSE everywhere and only its sd changed: a's +-1 sd coverage 50 % (outside the band)
+# on both outputs of p, b's 68 %: the sixth rule's "sd only" path adopts b (2 cells -> 0), the
+# fifth rule keeps a (mean d = 0 is not < 0)
+json.dump([rec("p", 1, [1.0, 2.0], [1.0, 2.0], 0.5), rec("p", 2, [3.0, 4.0], [3.0, 4.0], 0.5)],
+          open("sd_only.json", "w"))
+PY
+for rule in fifth sixth; do
+  "${BP[@]}" --from-json better.json --paired a b --rule $rule > better_$rule.txt 2> err.txt \
+    || fail "--paired on better.json ($rule): $(cat err.txt)"
+  grep -qF "4 cases (problem, rows, seed, output) of 2 tables; 1 cases with identical RMSE (d = 0)" \
+    better_$rule.txt || fail "better.json ($rule): counts: $(cat better_$rule.txt)"
+  grep -qF "mean d -0.6931 (geometric mean ratio 0.5000), paired t -2.45" better_$rule.txt \
+    || fail "better.json ($rule): not the hand-computed mean d and t: $(cat better_$rule.txt)"
+  grep -qF "| p | 4 | 1 | 0.5000 | -0.6931 | -2.45 | 3 / 0 |" better_$rule.txt \
+    || fail "better.json ($rule): not the hand-computed row of p: $(cat better_$rule.txt)"
+  grep -qx "decision: ADOPT b" better_$rule.txt || fail "better.json ($rule): $(cat better_$rule.txt)"
+  "${BP[@]}" --from-json worse_q.json --paired a b --rule $rule > worse_$rule.txt 2> err.txt \
+    || fail "--paired on worse_q.json ($rule): $(cat err.txt)"
+  grep -qx "decision: keep a" worse_$rule.txt || fail "worse_q.json ($rule): $(cat worse_$rule.txt)"
+done
+grep -qF "| q | 4 | 0 | 1.0500 | +0.0488 |" worse_fifth.txt || fail "q's row: $(cat worse_fifth.txt)"
+grep -qF "FAILS: largest problem median ratio 1.0500 <= 1.03" worse_fifth.txt \
+  || fail "fifth rule, q: $(cat worse_fifth.txt)"
+grep -qF "FAILS: largest problem geometric mean ratio 1.0500 <= 1.02" worse_sixth.txt \
+  || fail "sixth rule, q: $(cat worse_sixth.txt)"
+"${BP[@]}" --from-json sd_only.json --paired a b --rule sixth > sd6.txt 2> err.txt || fail "$(cat err.txt)"
+grep -qF "holds: sd only: every case d = 0" sd6.txt && grep -qF "holds: coverage cells 0 < 2" sd6.txt \
+  && grep -qx "decision: ADOPT b" sd6.txt || fail "sixth rule, sd only: $(cat sd6.txt)"
+"${BP[@]}" --from-json sd_only.json --paired a b --rule fifth > sd5.txt 2> err.txt || fail "$(cat err.txt)"
+grep -qx "decision: keep a" sd5.txt || fail "fifth rule, sd only: $(cat sd5.txt)"
+
+# A tiny run: 2 problems x 20 rows x seeds 1-2; whirl's default, the same settings again ("twin")
+# and the family library's default choice through family_bench ("fam"); no peer.
+"${BP[@]}" --problems powerlaw,friedman --sizes 20 --seeds 2 --first-seed 1 --peers "" \
+  --variant twin= --family-bench "$FB" --family fam= --json run.json > run.txt 2> err.txt \
+  || fail "the tiny run: $(cat err.txt)"
+check_py "run.json" '
+import json, math, sys
+runs = json.load(open("run.json"))
+keys = sorted((r["problem"], r["rows"], r["seed"]) for r in runs)
+assert keys == [(p, 20, s) for p in ("friedman", "powerlaw") for s in (1, 2)], keys
+for r in runs:
+    assert set(r["methods"]) == {"whirl", "twin", "fam"}, r["methods"].keys()
+    for name, m in r["methods"].items():
+        assert "failed" not in m, (name, m)
+        for key in ("rmse", "sd_rms", "resid_rms", "cover1", "cover2", "cover1_truth", "cover2_truth"):
+            assert len(m[key]) == 2 and all(math.isfinite(v) for v in m[key]), (name, key, m[key])
+        assert all(v > 0 for v in m["rmse"] + m["sd_rms"]), (name, m)
+        assert all(0 <= v <= 1 for k in ("cover1", "cover2") for v in m[k]), (name, m)
+        assert all(c1 <= c2 for c1, c2 in zip(m["cover1"], m["cover2"])), (name, m)
+        assert isinstance(m["chosen"], str) and m["chosen"] and m["time_ms"] >= 0, (name, m)
+    assert "time2_ms" in r["methods"]["whirl"]  # the --threads 2 rerun predicted identically
+'
+for p in powerlaw friedman; do
+  grep -qF "$p, 20 training rows, 2 seeds (1-2;" run.txt || fail "no report of $p: $(cat run.txt)"
+done
+"${BP[@]}" --from-json run.json --paired whirl twin > twin.txt 2> err.txt || fail "$(cat err.txt)"
+grep -qF "8 cases (problem, rows, seed, output) of 4 tables; 8 cases with identical RMSE (d = 0)" \
+  twin.txt && grep -qF "mean d +0.0000" twin.txt \
+  && grep -qx "decision: no change (twin has whirl's RMSE, sd and coverage on every table; keep whirl)" \
+  twin.txt || fail "two identical settings paired: $(cat twin.txt)"
+
+# Bad arguments: a non-zero exit and a message.
+expect_usage_error "needs --from-json" "${BP[@]}" --paired a b
+expect_usage_error "invalid choice" "${BP[@]}" --from-json better.json --paired a b --rule seventh
+expect_usage_error "method 'nosuch' missing in p, 20 rows, seed 1" \
+  "${BP[@]}" --from-json better.json --paired a nosuch
+expect_usage_error "need scikit-learn" "${BP[@]}" --problems powerlaw --seeds 1 --peers gp_ard
+expect_usage_error "--family needs --family-bench" "${BP[@]}" --problems powerlaw --family x=
+expect_usage_error "no acceptance peer" "${BP[@]}" --from-json run.json
+echo "lab_bench_peers: passed ($PY)"
