@@ -246,6 +246,7 @@ def main():
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     ap.add_argument("--sim-cache", default=os.path.join(tempfile.gettempdir(), "whirl_design_sim"))
     ap.add_argument("--seeds", default="9901-9910")
+    ap.add_argument("--seed-rule", default="stride", choices=ds.SEED_RULES, help=ds.SEED_RULE_HELP)
     ap.add_argument("--cases", default="bent:0,additive:0,additive:1,interacting:1,simgen:1,"
                     "powerlaw:1", help="problem:output (0 max elongation, 1 settle time)")
     ap.add_argument("--greedy", type=int, default=24, help="tries per forward step 9-12")
@@ -282,7 +283,7 @@ def main():
     ds.SIZES = [8, 12]  # the study's design loop, stopped at 12 screws
     os.makedirs(a.sim_cache, exist_ok=True)
     specs = [(p, int(k)) for p, k in (c.split(":") for c in a.cases.split(","))]
-    seeds = {p: ds.usable_seeds(p, ds.seeds_of(a.seeds)) for p, _ in specs}
+    seeds = {p: ds.usable_seeds(p, ds.seeds_of(a.seeds), a.seed_rule) for p, _ in specs}
     todo = [(p, k, seeds[p][i]) for i in range(len(ds.seeds_of(a.seeds))) for p, k in specs]
     with ThreadPoolExecutor(min(a.jobs, 2)) as ex:
         res = list(ex.map(lambda c: case(a, *c), todo))

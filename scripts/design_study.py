@@ -216,6 +216,10 @@ def variance_args(a):
 # s + k * REPLACEMENT_STRIDE (k = 1, 2, ...) whose list has none: seeds of --seeds stay below the
 # stride, so ranges that do not overlap get disjoint seeds, replacements included.
 REPLACEMENT_STRIDE = 1_000_000
+SEED_RULES = ["stride", "next-after-range"]
+SEED_RULE_HELP = ("how a seed whose candidate list holds a negative target is replaced: 'stride' "
+                  "(s + k x 1,000,000) or 'next-after-range' (the rule of the figures published "
+                  "in docs/design.md before 2026-11-30; reproduces them)")
 
 
 def seeds_of(text):
@@ -230,17 +234,27 @@ def seeds_of(text):
     return seeds
 
 
-def usable_seeds(prob, seeds):
+def usable_seeds(prob, seeds, rule="stride"):
     """`seeds`, where a generator seed s whose candidate list holds a negative target (which
-    `whirl train` refuses) is replaced by the first s + k REPLACEMENT_STRIDE, k = 1, 2, ..., that
-    does not (docs/design.md; before 2026-11-30 by the next seed after the range that does not,
-    which the next range of seeds also used)."""
+    `whirl train` refuses) is replaced. rule "stride" (the default since 2026-11-30): by the first
+    s + k REPLACEMENT_STRIDE, k = 1, 2, ..., that does not, so that ranges that do not overlap
+    share no seed. rule "next-after-range": by the next seed after the range that does not (the
+    rule every figure of docs/design.md was made with; the next range of seeds also uses it), kept
+    so that those figures' commands reproduce them."""
     if prob == "simgen":
         return seeds
+    ok = lambda s: (bp.generated(prob, POOL_ROWS, s)[1] >= 0).all()  # noqa: E731
+    if rule == "next-after-range":
+        out, nxt = [s for s in seeds if ok(s)], max(seeds) + 1
+        while len(out) < len(seeds):
+            if ok(nxt):
+                out.append(nxt)
+            nxt += 1
+        return out
     out = []
     for s in seeds:
         r = s
-        while not (bp.generated(prob, POOL_ROWS, r)[1] >= 0).all():
+        while not ok(r):
             r += REPLACEMENT_STRIDE
         if r != s:
             print(f"design_study: {prob} seed {s} replaced by {r} (a negative target in its "
@@ -417,6 +431,7 @@ def main():
     ap.add_argument("--datasets", default=os.path.join(os.path.dirname(__file__), "..", "datasets"))
     ap.add_argument("--problems", default="simgen,powerlaw")
     ap.add_argument("--seeds", default="1-10")
+    ap.add_argument("--seed-rule", default="stride", choices=SEED_RULES, help=SEED_RULE_HELP)
     ap.add_argument("--criterion", default="d", choices=["d", "i", "bayes-d"])
     ap.add_argument("--potential-terms", choices=["squares", "squares+interactions"],
                     help="whirl design --potential-terms of the first design (--criterion bayes-d)")
@@ -465,7 +480,7 @@ def main():
         return
     os.makedirs(a.sim_cache, exist_ok=True)
     problems = a.problems.split(",")
-    cases = [(p, s) for p in problems for s in usable_seeds(p, seeds_of(a.seeds))]
+    cases = [(p, s) for p in problems for s in usable_seeds(p, seeds_of(a.seeds), a.seed_rule)]
     with ThreadPoolExecutor(max_workers=min(a.jobs, 2)) as pool:
         results = list(pool.map(lambda c: one_case(c[0], c[1], a, a.sim_cache), cases))
     if a.random_from:

@@ -38,6 +38,20 @@ for prob, lo, n in (("additive", 1, 10), ("additive", 3001, 10), ("additive", 1,
 assert replaced > 0, "no range of the test holds a seed to replace: the test cannot fail"
 '
 
+# The legacy rule (--seed-rule next-after-range), kept so that docs/design.md's published commands
+# reproduce their figures: the range's usable seeds in order, then the first usable seeds after the
+# range; additive 1-10 (seed 2 unusable) ends with 11, which the range 11-20 uses as well.
+check_py "the legacy seed rule" '
+import bench_peers as bp, design_study as ds
+ok = lambda s: (bp.generated("additive", ds.POOL_ROWS, s)[1] >= 0).all()
+assert not ok(2) and ok(11), "additive seed 2 usable or 11 not: the hand-made case moved"
+legacy = ds.usable_seeds("additive", list(range(1, 11)), "next-after-range")
+assert legacy == [1] + list(range(3, 12)), legacy
+assert 11 in ds.usable_seeds("additive", list(range(11, 21)), "next-after-range")
+assert ds.usable_seeds("powerlaw", list(range(1, 11)), "next-after-range") == \
+    ds.usable_seeds("powerlaw", list(range(1, 11))), "the rules differ where nothing is replaced"
+'
+
 # A tiny study: one generator problem, seeds 1-2 (additive 2 is replaced), all four strategies.
 "$PY" "$S/scripts/design_study.py" --whirl "$W" --problems additive --seeds 1-2 --jobs 1 \
   --sim-cache "$D/sim" --json study.json > study.txt 2> err.txt || fail "design_study: $(cat err.txt)"
