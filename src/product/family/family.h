@@ -440,7 +440,10 @@ struct ChoiceOptions {
   /// partitions); the sd keeps partition 0's residuals. 1: one partition. Why: the 20-row choice
   /// errs both ways (GPs let in on power laws, the power law kept on non-linear tables), the
   /// variance of one partition's held-out errors (docs/workpiece-model.md, "Thirteenth attempt:
-  /// diagnosis at 20 rows"). Opt-in ("Fourteenth attempt").
+  /// diagnosis at 20 rows"). Opt-in: with 2 partitions it did not lower the 20-row test RMSE on
+  /// the fourteenth attempt's tuning part (lower on power laws, higher on Friedman #1 and
+  /// saturating tables) and doubles the 20-row fit time (docs/workpiece-model.md, "Fourteenth
+  /// attempt").
   int fold_partitions = 1;
   /// Selection-aware sd below few_rows rows (stack only): an output whose stack gives one GP
   /// candidate judged by refits a weight of at least fresh_sd_weight gets that GP's noise level
@@ -448,7 +451,9 @@ struct ChoiceOptions {
   /// of fold partition fold_partitions, which the choice did not use (refits from the fixed
   /// starting points). Why: a GP chosen alone at 20 rows is chosen where its refit errors
   /// happened to be low, and its sd calibrated on those same residuals covered too few test rows
-  /// (test residuals 1.26 times its held-out RMSE; the same section). Opt-in (the same document,
+  /// (test residuals 1.26 times its held-out RMSE; the same section). Opt-in: on the outputs it
+  /// acts on it brought the tuning part's coverage into the bands, and the rule, written for the
+  /// pooled cells (none outside the bands before), could not register it (docs/workpiece-model.md,
   /// "Fourteenth attempt").
   bool fresh_partition_sd = false;
   double fresh_sd_weight = 0.8;
