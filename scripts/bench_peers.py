@@ -35,7 +35,7 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
   "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-),
-  "confirmation10" (16001-), "confirmation11" (17001-), "confirmation13" (18001-, reserved).
+  "confirmation10" (16001-), "confirmation11" (17001-), "confirmation13" (18001-, spent by the fourteenth attempt).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
