@@ -1228,15 +1228,27 @@ std::vector<Eigen::MatrixXd> RmsOverPartitions(const PartitionErrs& parts) {
   return out;
 }
 
+}  // namespace
+
+std::string FreshPartitionText(int k, int partition, int folds, double weight) {
+  return std::string("for ") + kTargetColumns[k] + " (stack weight " +
+         FormatSignificant(weight, 3) + ") the " + std::to_string(folds) +
+         "-fold cross-validation residuals of fold partition " + std::to_string(partition) +
+         " (rows permuted from the fit seed), which the choice did not use: a selection-aware sd";
+}
+
+namespace {
+
 // ChoiceOptions::fresh_partition_sd for output k: if its top candidate `g` (stack weight
 // `weight`) is a GP judged by refits and calibrated from them (`fresh`) with weight >=
 // fresh_sd_weight, its noise level from its held-out residuals of fold partition `partition`
-// (refits from the fixed starts), and row k of sd_err[g] their errors in original units.
-void FreshPartitionSd(const ProcessTable& table, const ChoiceOptions& o, FitOptions fo, int folds,
+// (refits from the fixed starts), row k of sd_err[g] their errors in original units, and its
+// calibration text says so; true if it did.
+bool FreshPartitionSd(const ProcessTable& table, const ChoiceOptions& o, FitOptions fo, int folds,
                       int partition, int g, double weight, const std::vector<char>& fresh, int k,
                       std::vector<FamilyModel>* full, std::vector<Eigen::MatrixXd>* sd_err) {
   if (o.candidates[g].family != Family::kGaussianProcess || !fresh[g] || weight < o.fresh_sd_weight)
-    return;
+    return false;
   fo.fold_partition = partition;
   FamilyModel& m = (*full)[g];
   const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
@@ -1246,6 +1258,8 @@ void FreshPartitionSd(const ProcessTable& table, const ChoiceOptions& o, FitOpti
   const HeldOut h = OutputHeldOut(m, k, x, yk, fo, folds, true);
   (*sd_err)[g].row(k) = OriginalErrors(m, k, t.row(k), yk, h);
   SetNoiseFrom(h, folds, fo, x, yk, k, &m);
+  m.calibration += "; " + FreshPartitionText(k, partition, folds, weight);
+  return true;
 }
 
 }  // namespace
@@ -1384,8 +1398,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     const int g = choice.chosen[k];
     std::vector<char> fresh(calibrated.size());
     for (std::size_t c = 0; c < fresh.size(); ++c) fresh[c] = calibrated[c] && refitted[c];
-    FreshPartitionSd(table, options, refit_options, folds, partitions, g,
-                     stack[k].size() == 0 ? 1.0 : stack[k](g), fresh, k, &full, &sd_err);
+    const double weight = stack[k].size() == 0 ? 1.0 : stack[k](g);
+    if (FreshPartitionSd(table, options, refit_options, folds, partitions, g, weight, fresh, k,
+                         &full, &sd_err))
+      choice.notes[k] = options.candidates[g].Name() + ": its sd " +
+                        FreshPartitionText(k, partitions, folds, weight);
   }
   FitChosen(table, options, stack, full, calibrated, &choice);
   ScaleStackedSd(table, options, stack, sd_err, &choice);

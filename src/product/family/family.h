@@ -110,6 +110,10 @@ struct FitOptions {
   int fold_partition = 0;
 };
 
+/// What ChoiceOptions::fresh_partition_sd appends to a GP's calibration text when it took output
+/// k's sd (stack weight `weight`) from the `folds`-fold refit residuals of fold `partition`.
+std::string FreshPartitionText(int k, int partition, int folds, double weight);
+
 /// Fold of each of `rows` rows among min(folds, rows) folds: partition 0 puts row q in fold
 /// q % folds; partition p >= 1 puts it in fold pos(q) % folds, pos(q) its position in a
 /// permutation of the rows drawn by Fisher-Yates from Rng(MixSeed(seed, p)) (core/random.h), so
@@ -455,6 +459,8 @@ struct ChoiceOptions {
   /// acts on it brought the tuning part's coverage into the bands, and the rule, written for the
   /// pooled cells (none outside the bands before), could not register it (docs/workpiece-model.md,
   /// "Fourteenth attempt").
+  /// The GP's calibration text (FamilyModel::calibration, in the model file) then ends with
+  /// FreshPartitionText of each such output, and Choice::notes[k] names the GP and says it.
   bool fresh_partition_sd = false;
   double fresh_sd_weight = 0.8;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
@@ -501,7 +507,8 @@ struct Choice {
   /// candidate's sd (its own held-out residuals); 1 otherwise. Stored in the model file when a
   /// weight is or a factor is not 1.
   std::array<double, Features::kCount> sd_scale{1.0, 1.0};
-  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
+  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why, or the GP whose sd
+  /// ChoiceOptions::fresh_partition_sd took from another fold partition; empty if none.
   /// Printed by `whirl train` (and in its --json), not stored in the model file.
   std::array<std::string, Features::kCount> notes;
   /// What the choice did about the table that the user should know: inputs left out because they
