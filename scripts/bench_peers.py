@@ -36,7 +36,7 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
   "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-),
   "confirmation10" (16001-), "confirmation11" (17001-), "confirmation13" (18001-, spent by the fourteenth attempt),
-  "confirmation15" (19001-, the fifteenth attempt's, 20 rows).
+  "confirmation15" (19001-, 20 rows, spent by the fifteenth attempt).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -356,7 +356,7 @@ SPLITS = {
     # confirmation: 18001-18010 at 20 and 100 rows; only the peers have been run on it.
     "confirmation13": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 18001},
     # The fifteenth attempt's confirmation (an sd-only change; tuning part the fourteenth's 920
-    # tables): 19001-19020 at 20 rows.
+    # tables): 19001-19020 at 20 rows; spent (C failed its rule, no default changed).
     "confirmation15": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 19001},
 }
 

@@ -458,7 +458,8 @@ struct ChoiceOptions {
   /// (test residuals 1.26 times its held-out RMSE; the same section). Opt-in: on the outputs it
   /// acts on it brought the tuning part's coverage into the bands, and the rule, written for the
   /// pooled cells (none outside the bands before), could not register it (docs/workpiece-model.md,
-  /// "Fourteenth attempt").
+  /// "Fourteenth attempt"); on fresh tables it left as many cells of 10 tables outside the bands
+  /// as the default, two brought inside and two pushed too wide ("Fifteenth attempt").
   /// The GP's calibration text (FamilyModel::calibration, in the model file) then ends with
   /// FreshPartitionText of each such output, and Choice::notes[k] names the GP and says it.
   bool fresh_partition_sd = false;
