@@ -35,7 +35,8 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
   "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-),
-  "confirmation10" (16001-), "confirmation11" (17001-), "confirmation13" (18001-, reserved).
+  "confirmation10" (16001-), "confirmation11" (17001-), "confirmation13" (18001-, spent by the fourteenth attempt),
+  "confirmation15" (19001-, 20 rows, spent by the fifteenth attempt).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -78,6 +79,8 @@ Pooled summary of earlier runs (the fourth attempt's tuning part spans seed rang
   bench_peers.py --whirl build/whirl --from-json a.json b.json ... [--markdown]
 Paired decision of two whirl methods on the same tables (the fifth attempt's rule):
   bench_peers.py --whirl build/whirl --from-json a.json ... --paired default stack
+  (--rule sixth or fifteenth: those attempts' rules; fifteenth is for a change of the sd alone
+  and counts coverage cells of 10-table blocks)
 Usage: bench_peers.py --whirl build/whirl [--split tuning|confirmation] [--seeds 20]
        [--first-seed 1] [--sizes 20,100] [--problems friedman,simulator,simgen,...]
        [--variant NAME=ARGS ...] [--no-default] [--family-bench PATH --family NAME=ARGS ...]
@@ -359,6 +362,9 @@ SPLITS = {
     # Reserved by the thirteenth attempt (a diagnosis, no default change) for the next attempt's
     # confirmation: 18001-18010 at 20 and 100 rows; only the peers have been run on it.
     "confirmation13": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 18001},
+    # The fifteenth attempt's confirmation (an sd-only change; tuning part the fourteenth's 920
+    # tables): 19001-19020 at 20 rows; spent (C failed its rule, no default changed).
+    "confirmation15": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 19001},
 }
 
 
@@ -597,16 +603,21 @@ def main():
                     help="with --from-json: the paired decision of CAND against BASE (d = ln of the "
                          "RMSE ratio per table and output, paired t, coverage cells, per-family "
                          "median ratios; docs/workpiece-model.md, fifth attempt)")
-    ap.add_argument("--rule", choices=["fifth", "sixth"], default="fifth",
+    ap.add_argument("--rule", choices=["fifth", "sixth", "fifteenth"], default="fifth",
                     help="with --paired: the fifth attempt's rule (no family median ratio above "
                          "1.03) or the sixth's (no family geometric mean ratio above 1.02; a "
                          "candidate that changes only the sd needs identical RMSE and strictly "
-                         "fewer coverage cells); docs/workpiece-model.md")
+                         "fewer coverage cells) or the fifteenth's (sd only: identical RMSE, "
+                         "strictly fewer cells of 10-table blocks, pooled cells not more, no "
+                         "pooled +-1 sd coverage leaving its band); docs/workpiece-model.md")
     a = ap.parse_args()
     if a.paired and not a.from_json:
         sys.exit("bench_peers: --paired needs --from-json")
     if a.paired:
-        paired_decision(a.from_json, *a.paired, sixth=a.rule == "sixth")
+        if a.rule == "fifteenth":
+            sd_only_decision(a.from_json, *a.paired)
+        else:
+            paired_decision(a.from_json, *a.paired, sixth=a.rule == "sixth")
         return
     if a.from_json:
         pooled_summary(a.from_json, [p for p in a.acceptance_peers.split(",") if p], a.markdown)
@@ -775,6 +786,74 @@ def coverage_cells_out(rs, m):
             if not (60 <= c1 <= 76 and 90 <= c2 <= 98):
                 out.append(f"{prob} {n} out{k + 1} {c1:.1f}/{c2:.1f}")
     return out
+
+
+def in_bands(c1, c2):
+    """Mean +-1 / +-2 sd coverage (%) inside 60-76 % / 90-98 %."""
+    return 60 <= c1 <= 76 and 90 <= c2 <= 98
+
+
+def coverage_of(cell, m, k):
+    """Mean +-1 and +-2 sd coverage (%) of method m, output k, over the records of a cell."""
+    return (100 * np.mean([r["methods"][m]["cover1"][k] for r in cell]),
+            100 * np.mean([r["methods"][m]["cover2"][k] for r in cell]))
+
+
+def sd_only_decision(files, base, cand, block=10):
+    """The fifteenth attempt's rule for a change of the sd alone (docs/workpiece-model.md,
+    "Fifteenth attempt: split"): (a) every case's RMSE identical; (b') strictly fewer (problem,
+    rows, output, block of `block` consecutive seeds) cells outside 60-76 / 90-98 % than base, and
+    pooled (problem, rows, output) cells outside not more; (c) no pooled cell whose +-1 sd
+    coverage is inside 60-76 % for base outside it for cand; (d) no failed fit."""
+    rs = load_runs(files)
+    cases = [(r, k) for r in rs for k in (0, 1)]
+    failed = sum(not all(math.isfinite(r["methods"][m]["rmse"][k]) and r["methods"][m]["rmse"][k] > 0
+                         for m in (base, cand)) for r, k in cases)
+    differ = sum(r["methods"][base]["rmse"][k] != r["methods"][cand]["rmse"][k] for r, k in cases)
+    touched = [(r, k) for r, k in cases
+               if r["methods"][base]["sd_rms"][k] != r["methods"][cand]["sd_rms"][k]]
+    groups = {"block": {}, "pooled": {}}
+    for r in rs:
+        groups["pooled"].setdefault((r["problem"], r["rows"]), []).append(r)
+        groups["block"].setdefault((r["problem"], r["rows"], (r["seed"] - 1) // block), []).append(r)
+    out = {g: {m: [] for m in (base, cand)} for g in groups}
+    for g, cells in groups.items():
+        for key in sorted(cells):
+            for k in (0, 1):
+                for m in (base, cand):
+                    c1, c2 = coverage_of(cells[key], m, k)
+                    if not in_bands(c1, c2):
+                        out[g][m].append(" ".join(map(str, key)) + f" out{k + 1} {c1:.1f}/{c2:.1f}")
+    left = []
+    for key, cell in sorted(groups["pooled"].items()):
+        for k in (0, 1):
+            b1, c1 = coverage_of(cell, base, k)[0], coverage_of(cell, cand, k)[0]
+            if 60 <= b1 <= 76 and not 60 <= c1 <= 76:
+                left.append(f"{key[0]} {key[1]} out{k + 1} {b1:.1f} -> {c1:.1f}")
+    print(f"sd-only decision, {cand} against {base}: {len(cases)} cases of {len(rs)} tables; "
+          f"{differ} with another RMSE; {len(touched)} outputs with another sd; {failed} failed fits")
+    if touched:
+        for m in (base, cand):
+            c1 = 100 * np.mean([r["methods"][m]["cover1"][k] for r, k in touched])
+            c2 = 100 * np.mean([r["methods"][m]["cover2"][k] for r, k in touched])
+            low = sum(r["methods"][m]["cover1"][k] < 0.45 for r, k in touched)
+            print(f"  {m} on those outputs: +-1 / +-2 sd coverage {c1:.0f} / {c2:.0f} %, "
+                  f"{low} below 45 % at +-1 sd")
+    for g in groups:
+        n = 2 * len(groups[g])
+        for m in (base, cand):
+            print(f"{m}: {g} cells outside 60-76 / 90-98 %: {len(out[g][m])} of {n}: "
+                  + "; ".join(out[g][m]))
+    nb, nc = len(out["block"][base]), len(out["block"][cand])
+    pb, pc = len(out["pooled"][base]), len(out["pooled"][cand])
+    checks = {"(a) every case's RMSE identical": differ == 0 and failed == 0,
+              f"(b') block cells {nc} < {nb} and pooled cells {pc} <= {pb}": nc < nb and pc <= pb,
+              "(c) no pooled +-1 sd coverage leaves 60-76 %" + (": " + "; ".join(left) if left else ""):
+                  not left,
+              "(d) no failed fit": failed == 0}
+    for what, ok in checks.items():
+        print(f"{'holds' if ok else 'FAILS'}: {what}")
+    print(f"decision (speed rule (e) apart): {'ADOPT ' + cand if all(checks.values()) else 'keep ' + base}")
 
 
 def paired_t(d):

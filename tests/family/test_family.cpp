@@ -1157,5 +1157,170 @@ TEST(FamilyCandidates, NamesRoundTripAndBadInput) {
   ExpectInputError([&] { ChooseFamily(no_targets, {}); }, "target columns");
 }
 
+
+TEST(FamilyFolds, EveryPartitionHoldsEachRowOutOnceInFoldsOfTheSameSizes) {
+  for (const int rows : {8, 20, 23, 69}) {
+    const std::vector<int> first = FoldOfRows(rows, 5, 0, 1);
+    std::vector<int> sizes(5, 0);
+    for (int q = 0; q < rows; ++q) {
+      ASSERT_EQ(first[q], q % 5);  // partition 0: the folds of the choice before partitions
+      ++sizes[first[q]];
+    }
+    for (int p = 1; p <= 3; ++p) {
+      const std::vector<int> fold = FoldOfRows(rows, 5, p, 1);
+      ASSERT_EQ(fold.size(), static_cast<std::size_t>(rows));
+      std::vector<int> count(5, 0);
+      for (int f : fold) {
+        ASSERT_GE(f, 0);
+        ASSERT_LT(f, 5);
+        ++count[f];
+      }
+      EXPECT_EQ(count, sizes) << rows << " rows, partition " << p;
+      EXPECT_EQ(fold, FoldOfRows(rows, 5, p, 1));  // the same seed, the same partition
+      if (rows >= 20) {
+        EXPECT_NE(fold, first);
+        EXPECT_NE(fold, FoldOfRows(rows, 5, p, 2));
+        EXPECT_NE(fold, FoldOfRows(rows, 5, p + 1, 1));
+      }
+    }
+  }
+  EXPECT_EQ(FoldOfRows(3, 5, 1, 1).size(), 3u);  // min(folds, rows) folds: one row each
+  std::vector<int> three = FoldOfRows(3, 5, 1, 1);
+  std::sort(three.begin(), three.end());
+  EXPECT_EQ(three, (std::vector<int>{0, 1, 2}));
+  ExpectInputError([] { FoldOfRows(0, 5, 0, 1); }, "need rows >= 1");
+  ExpectInputError([] { FoldOfRows(20, 5, -1, 1); }, "partition >= 0");
+}
+
+TEST(FamilyStacking, PartitionsOfIdenticalBlocksGiveTheWeightsOfOne) {
+  // Two partitions whose held-out predictions are the same: the stacked rows are duplicates, so
+  // the weights (least squares over both blocks), the nested folds and the mean of the
+  // per-row differences are those of one partition.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n01;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 12 + trial;
+    Eigen::MatrixXd p(n, 3);
+    Eigen::VectorXd t(n);
+    for (int i = 0; i < n; ++i) {
+      t(i) = n01(rng);
+      for (int c = 0; c < 3; ++c) p(i, c) = t(i) + (0.2 + 0.3 * c) * n01(rng);
+    }
+    const ShrunkStack one = ShrunkStackWeights(p, t, 5, 1.0, 2.0);
+    const ShrunkStack two =
+        ShrunkStackWeights(p.replicate(2, 1), t.replicate(2, 1), 5, 1.0, 2.0, 2);
+    EXPECT_TRUE(two.weights.isApprox(one.weights, 1e-9)) << trial;
+    EXPECT_NEAR(two.z, one.z, 1e-9 * (1 + std::abs(one.z))) << trial;
+  }
+  Eigen::MatrixXd p = Eigen::MatrixXd::Ones(11, 2);
+  ExpectInputError([&] { ShrunkStackWeights(p, Eigen::VectorXd::Ones(11), 5, 1.0, 2.0, 2); },
+                   "need equal blocks");
+}
+
+ChoiceOptions RepeatedAndFresh(int partitions, bool fresh) {
+  ChoiceOptions o;
+  o.fold_partitions = partitions;
+  o.fresh_partition_sd = fresh;
+  return o;
+}
+
+TEST(FamilyChoice, FoldPartitionsAndFreshSdLeaveEightRowsAndFromFewRowsAsTheyAre) {
+  // The linear fits alone (8 and 9 rows) and every table from few_rows (70) rows: the file of
+  // the default choice byte for byte.
+  for (const ProcessTable& t : {MakeTable(8, 0.05, 3), MakeTable(9, 0.05, 4),
+                                test::MakeBentTable(70, 0.05, 0.5, 2), MakeTable(70, 0.05, 5, true)})
+    for (const ChoiceOptions& o : {RepeatedAndFresh(2, true), RepeatedAndFresh(3, false),
+                                   RepeatedAndFresh(1, true)})
+      EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(),
+                nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump())
+          << t.inputs.size() << " rows";
+  // One partition without the fresh sd is the choice of the default (partition 0 is q % K,
+  // the previous folds: FamilyFolds above).
+  const ProcessTable t = MakeTable(20, 0.05, 6, true);
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, RepeatedAndFresh(1, false))).dump(),
+            nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump());
+}
+
+TEST(FamilyChoice, FoldPartitionsGiveTheSameFileTwiceAndChangeTheChoiceAtFewRows) {
+  int differs = 0;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const ProcessTable t = seed == 1 ? LogisticTable(20, 0.5, seed) : MakeTable(20, 0.05, seed, true);
+    ChoiceOptions o = RepeatedAndFresh(2, true);
+    const std::string a = nlohmann::json(ChooseFamily(t, o)).dump();
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), a);
+    o.fit.threads = 2;
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), a);
+    differs += a != nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump();
+  }
+  EXPECT_GT(differs, 0);  // the held-out errors of a second partition enter the choice
+}
+
+TEST(FamilyChoice, FreshPartitionSdChangesOnlyTheSdOfOutputsOneGpTakes) {
+  // C on the default choice: the same means everywhere; the sd of an output whose stack weighs
+  // one GP at least fresh_sd_weight may change, every other output's sd stays.
+  int changed = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const ProcessTable t = MakeTable(20, 0.02, seed, true), test = MakeTable(50, 0, seed + 40, true);
+    const Choice a = ChooseFamily(t, ChoiceOptions{}), b = ChooseFamily(t, RepeatedAndFresh(1, true));
+    ASSERT_EQ(a.Describe(), b.Describe());
+    const std::vector<FamilyPrediction> pa = PredictChoice(a, test.inputs),
+                                        pb = PredictChoice(b, test.inputs);
+    for (int k = 0; k < 2; ++k) {
+      bool gp_takes = false;
+      for (std::size_t j = 0; j < a.models.size(); ++j) {
+        const double w = a.weights[k].empty() ? (a.model_of_output[k] == static_cast<int>(j))
+                                              : a.weights[k][j];
+        gp_takes |= a.models[j].candidate.family == Family::kGaussianProcess && w >= 0.8;
+      }
+      bool sd_differs = false;
+      for (std::size_t q = 0; q < pa.size(); ++q) {
+        ASSERT_EQ(pa[q].mean.ToArray()[k], pb[q].mean.ToArray()[k]);
+        sd_differs |= pa[q].stddev.ToArray()[k] != pb[q].stddev.ToArray()[k];
+      }
+      EXPECT_TRUE(gp_takes || !sd_differs) << "seed " << seed << ": " << a.Describe();
+      changed += sd_differs;
+    }
+  }
+  EXPECT_GT(changed, 0);
+}
+
+TEST(FamilyChoice, FreshPartitionSdSaysInTheCalibrationWhichGpAndPartition) {
+  // Where C took an output's sd from fold partition 1, the GP's calibration text (stored in the
+  // model file) is the default's with "; " FreshPartitionText of that output appended, the
+  // output's note names the GP and says the same; every other model's text is the default's.
+  // Two runs and two threads give the same file.
+  int said = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const ProcessTable t = MakeTable(20, 0.02, seed, true);
+    const ChoiceOptions off = RepeatedAndFresh(1, false);
+    ChoiceOptions on = RepeatedAndFresh(1, true);
+    const Choice a = ChooseFamily(t, off), b = ChooseFamily(t, on);
+    ASSERT_EQ(a.models.size(), b.models.size());
+    std::vector<std::string> expected;
+    for (const FamilyModel& m : a.models) expected.push_back(m.calibration);
+    for (int k = 0; k < 2; ++k) {
+      if (b.notes[k].empty()) continue;
+      const int j = b.model_of_output[k];
+      const FamilyModel& m = b.models[j];
+      EXPECT_EQ(m.candidate.family, Family::kGaussianProcess) << b.notes[k];
+      const double weight = b.weights[k].empty() ? 1.0 : b.weights[k][j];
+      EXPECT_GE(weight, on.fresh_sd_weight);
+      const std::string text = FreshPartitionText(k, 1, on.folds, weight);
+      EXPECT_EQ(b.notes[k], m.candidate.Name() + ": its sd " + text);
+      EXPECT_NE(text.find(std::string("for ") + kTargetColumns[k]), std::string::npos) << text;
+      EXPECT_NE(text.find("fold partition 1 "), std::string::npos) << text;
+      expected[j] += "; " + text;
+      ++said;
+    }
+    for (std::size_t j = 0; j < b.models.size(); ++j)
+      EXPECT_EQ(b.models[j].calibration, expected[j]) << "seed " << seed;
+    const std::string file = nlohmann::json(b).dump();
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, on)).dump(), file);
+    on.fit.threads = 2;
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, on)).dump(), file);
+  }
+  EXPECT_GT(said, 0);
+}
+
 }  // namespace
 }  // namespace whirl::family

@@ -7,10 +7,12 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <numeric>
 
 #include "core/error.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
+#include "core/random.h"
 
 namespace whirl::family {
 namespace {
@@ -56,17 +58,19 @@ nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions
 }
 
 // Held-out residuals r and latent variances v (units of y) of K-fold refits, row q held out in
-// fold q % K; fit_predict(train rows, held-out rows, &mean, &latent variance).
+// fold FoldOfRows(...)[q] of o.fold_partition; fit_predict(train rows, held-out rows, &mean,
+// &latent variance).
 using FoldFitPredict = std::function<void(const Eigen::VectorXi&, const Eigen::VectorXi&,
                                           Eigen::VectorXd*, Eigen::VectorXd*)>;
-void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FoldFitPredict& fit_predict,
-                    Eigen::VectorXd* r, Eigen::VectorXd* v) {
+void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FitOptions& o,
+                    const FoldFitPredict& fit_predict, Eigen::VectorXd* r, Eigen::VectorXd* v) {
   const int n = static_cast<int>(y.size()), k = std::min(folds, n);
+  const std::vector<int> fold_of = FoldOfRows(n, k, o.fold_partition, o.seed);
   r->resize(n);
   v->resize(n);
   for (int f = 0; f < k; ++f) {
     std::vector<int> tr, te;
-    for (int q = 0; q < n; ++q) (q % k == f ? te : tr).push_back(q);
+    for (int q = 0; q < n; ++q) (fold_of[q] == f ? te : tr).push_back(q);
     const Eigen::VectorXi tri =
         Eigen::Map<Eigen::VectorXi>(tr.data(), static_cast<Eigen::Index>(tr.size()));
     const Eigen::VectorXi tei =
@@ -115,7 +119,7 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
   }
   const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
   KFoldResiduals(
-      y, folds,
+      y, folds, o,
       [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te, Eigen::VectorXd* mean,
           Eigen::VectorXd* latent) {
         if (linear) {
@@ -241,11 +245,12 @@ Eigen::MatrixXd TransformedMeans(const FamilyModel& m, const std::vector<Process
   return mean;
 }
 
-ProcessTable Rows(const ProcessTable& table, int folds, int fold, bool held_out) {
+ProcessTable Rows(const ProcessTable& table, const std::vector<int>& fold_of, int fold,
+                  bool held_out) {
   ProcessTable out;
   out.source = table.source;
   for (std::size_t i = 0; i < table.inputs.size(); ++i)
-    if ((static_cast<int>(i) % folds == fold) == held_out) {
+    if ((fold_of[i] == fold) == held_out) {
       out.inputs.push_back(table.inputs[i]);
       out.targets.push_back(table.targets[i]);
     }
@@ -255,11 +260,14 @@ ProcessTable Rows(const ProcessTable& table, int folds, int fold, bool held_out)
 // Held-out errors (2 x rows, original units) of one candidate's fold fit.
 void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
                 int fold, Eigen::MatrixXd* err) {
-  const ProcessTable train = Rows(table, folds, fold, false), held = Rows(table, folds, fold, true);
+  const std::vector<int> fold_of =
+      FoldOfRows(static_cast<int>(table.inputs.size()), folds, o.fold_partition, o.seed);
+  const ProcessTable train = Rows(table, fold_of, fold, false),
+                     held = Rows(table, fold_of, fold, true);
   const FamilyModel m = FitCandidate(train, c, o, false);
   const std::vector<FamilyPrediction> p = PredictFamily(m, held.inputs);
   for (std::size_t i = 0, row = 0; row < table.inputs.size(); ++row) {
-    if (static_cast<int>(row) % folds != fold) continue;
+    if (fold_of[row] != fold) continue;
     for (int k = 0; k < Features::kCount; ++k) {
       (*err)(k, static_cast<Eigen::Index>(row)) =
           held.targets[i].ToArray()[k] - p[i].mean.ToArray()[k];
@@ -330,6 +338,23 @@ void CheckRows(const ProcessTable& table, const Candidate& c, int inputs) {
 }
 
 }  // namespace
+
+std::vector<int> FoldOfRows(int rows, int folds, int partition, std::uint64_t seed) {
+  if (rows < 1 || folds < 1 || partition < 0)
+    throw InputError("fold partition: " + std::to_string(rows) + " rows, " +
+                     std::to_string(folds) + " folds, partition " + std::to_string(partition) +
+                     "; need rows >= 1, folds >= 1 and partition >= 0");
+  const int k = std::min(folds, rows);
+  std::vector<int> order(static_cast<std::size_t>(rows)), fold(order.size());  // order[pos] = row
+  std::iota(order.begin(), order.end(), 0);
+  if (partition > 0) {
+    Rng rng(MixSeed(seed, static_cast<std::uint64_t>(partition)));
+    for (int i = rows - 1; i > 0; --i)  // Fisher-Yates
+      std::swap(order[i], order[std::min(i, static_cast<int>(rng.Uniform() * (i + 1)))]);
+  }
+  for (int pos = 0; pos < rows; ++pos) fold[order[pos]] = pos % k;
+  return fold;
+}
 
 std::string Candidate::Name() const {
   const std::string t = log ? "/log" : "/identity";
@@ -550,22 +575,29 @@ MeanAndSe OfDifferences(const Eigen::ArrayXd& d);
 }  // namespace
 
 ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::VectorXd& target,
-                               int folds, double start_se, double full_se) {
+                               int folds, double start_se, double full_se, int partitions) {
   ShrunkStack out;
   const Eigen::VectorXd all = ConvexStackWeights(predictions, target);
-  const Eigen::Index n = predictions.rows();
+  const Eigen::Index total = predictions.rows();
   if (folds < 2) throw InputError("stacking weights: " + std::to_string(folds) + " folds; need >= 2");
+  if (partitions < 1 || total % partitions != 0)
+    throw InputError("stacking weights: " + std::to_string(total) + " rows in " +
+                     std::to_string(partitions) + " partitions; need equal blocks");
+  const Eigen::Index n = total / partitions;
   const int k = static_cast<int>(std::min<Eigen::Index>(folds, n));
-  Eigen::VectorXd stacked(n);
+  Eigen::VectorXd stacked(total);
   for (int f = 0; f < k && n >= 2; ++f) {
     std::vector<Eigen::Index> train, held;
-    for (Eigen::Index q = 0; q < n; ++q) (q % k == f ? held : train).push_back(q);
+    for (Eigen::Index q = 0; q < total; ++q) ((q % n) % k == f ? held : train).push_back(q);
     const Eigen::VectorXd w = ConvexStackWeights(predictions(train, Eigen::all), target(train));
     stacked(held) = predictions(held, Eigen::all) * w;
   }
   if (n < 2) stacked = predictions * all;
-  const Eigen::ArrayXd d = (target - predictions.col(0)).array().square() -
-                           (target - stacked).array().square();
+  const Eigen::ArrayXd each = (target - predictions.col(0)).array().square() -
+                              (target - stacked).array().square();
+  Eigen::ArrayXd d = each.head(n);
+  for (int p = 1; p < partitions; ++p) d += each.segment(p * n, n);
+  if (partitions > 1) d /= partitions;
   const MeanAndSe m = OfDifferences(d);
   out.z = m.se > 0 ? m.mean / m.se : (m.mean > 0 ? std::numeric_limits<double>::infinity() : 0.0);
   if (full_se < 0)
@@ -992,12 +1024,16 @@ std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOp
 
 namespace {
 
+// Held-out errors per fold partition and candidate (ChoiceOptions::fold_partitions).
+using PartitionErrs = std::vector<std::vector<Eigen::MatrixXd>>;
+
 // ChoiceOptions::stack for output k of targets t (outputs x rows): the shrunk stacking weights
-// of every candidate (ShrunkStackWeights of their held-out predictions t - err), 0 for those
-// that stack_gate_se or lowest_gp leave out (`only`, `ev`: GpsThatTakePart).
+// of every candidate (ShrunkStackWeights of their held-out predictions t - err, or with more than
+// one of `parts` of every partition's), 0 for those that stack_gate_se or lowest_gp leave out
+// (`only`, `ev`: GpsThatTakePart).
 Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
-                            const ChoiceOptions& o, int k, int folds, int only,
-                            const GpEvidence& ev) {
+                            const PartitionErrs& parts, const ChoiceOptions& o, int k, int folds,
+                            int only, const GpEvidence& ev) {
   const int nc = static_cast<int>(err.size());
   const bool large = t.cols() >= o.few_rows;
   const double gate = large ? o.stack_gate_se_large : o.stack_gate_se;
@@ -1008,13 +1044,18 @@ Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::M
   for (int c = 1; c < nc; ++c)
     if (gate <= 0 || BeatsFirst(squared(0), squared(c), gate, 0, folds)) in.push_back(c);
   in = GpsThatTakePart(in, err, o, k, only, ev);
-  Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()));
-  for (std::size_t j = 0; j < in.size(); ++j)
-    p.col(static_cast<Eigen::Index>(j)) = (t.row(k) - err[in[j]].row(k)).transpose();
+  const int np = std::max<int>(1, static_cast<int>(parts.size()));
+  const Eigen::Index n = t.cols();
+  Eigen::MatrixXd p(n * np, static_cast<Eigen::Index>(in.size()));
+  for (int b = 0; b < np; ++b)
+    for (std::size_t j = 0; j < in.size(); ++j) {
+      const Eigen::MatrixXd& e = np > 1 ? parts[b][in[j]] : err[in[j]];
+      p.block(b * n, static_cast<Eigen::Index>(j), n, 1) = (t.row(k) - e.row(k)).transpose();
+    }
   const Eigen::VectorXd w =
-      ShrunkStackWeights(p, t.row(k).transpose(), folds,
+      ShrunkStackWeights(p, t.row(k).transpose().replicate(np, 1), folds,
                          large ? o.stack_start_se_large : o.stack_start_se,
-                         large ? o.stack_full_se_large : o.stack_full_se)
+                         large ? o.stack_full_se_large : o.stack_full_se, np)
           .weights;
   Eigen::VectorXd out = Eigen::VectorXd::Zero(nc);
   for (std::size_t j = 0; j < in.size(); ++j) out(in[j]) = w(static_cast<Eigen::Index>(j));
@@ -1149,6 +1190,78 @@ GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& 
   return ev;
 }
 
+// ChoiceOptions::fold_partitions: per fold partition 0 .. partitions-1 the held-out errors
+// (original units) of every candidate; those judged by refits (networks, `refitted`; a pending
+// GP with `refit_options`) refitted on partitions from 1 on, the others' (closed-form) err's.
+PartitionErrs PartitionErrors(const ProcessTable& table, const ChoiceOptions& o,
+                              const FitOptions& fold_options, const FitOptions& refit_options,
+                              int folds, const std::vector<Eigen::MatrixXd>& err,
+                              const std::vector<char>& refitted, const std::vector<char>& pending,
+                              int partitions) {
+  const int nc = static_cast<int>(err.size());
+  PartitionErrs parts(static_cast<std::size_t>(partitions), err);
+  ParallelFor(static_cast<std::size_t>((partitions - 1) * nc * folds), o.fit.threads,
+              [&](std::size_t i) {
+                const int p = 1 + static_cast<int>(i) / (nc * folds);
+                const int c = static_cast<int>(i) / folds % nc, f = static_cast<int>(i) % folds;
+                const Candidate& cand = o.candidates[c];
+                FitOptions fo = pending[c] ? refit_options : fold_options;
+                fo.fold_partition = p;
+                if (cand.family == Family::kNetwork) {
+                  FoldErrors(table, cand, fo, folds, f, &parts[p][c]);
+                } else if (refitted[c] && f == 0) {
+                  FamilyModel m = Unfitted(table, cand);
+                  parts[p][c] = HeldOutErrors(table, fo, folds, &m, false, true);
+                }
+              });
+  return parts;
+}
+
+// Per candidate and row, the root of the mean over the partitions of the squared held-out errors.
+std::vector<Eigen::MatrixXd> RmsOverPartitions(const PartitionErrs& parts) {
+  std::vector<Eigen::MatrixXd> out = parts.front();
+  for (std::size_t c = 0; c < out.size(); ++c) {
+    Eigen::ArrayXXd sum = parts[0][c].array().square();
+    for (std::size_t p = 1; p < parts.size(); ++p) sum += parts[p][c].array().square();
+    out[c] = (sum / static_cast<double>(parts.size())).sqrt().matrix();
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string FreshPartitionText(int k, int partition, int folds, double weight) {
+  return std::string("for ") + kTargetColumns[k] + " (stack weight " +
+         FormatSignificant(weight, 3) + ") the " + std::to_string(folds) +
+         "-fold cross-validation residuals of fold partition " + std::to_string(partition) +
+         " (rows permuted from the fit seed), which the choice did not use: a selection-aware sd";
+}
+
+namespace {
+
+// ChoiceOptions::fresh_partition_sd for output k: if its top candidate `g` (stack weight
+// `weight`) is a GP judged by refits and calibrated from them (`fresh`) with weight >=
+// fresh_sd_weight, its noise level from its held-out residuals of fold partition `partition`
+// (refits from the fixed starts), row k of sd_err[g] their errors in original units, and its
+// calibration text says so; true if it did.
+bool FreshPartitionSd(const ProcessTable& table, const ChoiceOptions& o, FitOptions fo, int folds,
+                      int partition, int g, double weight, const std::vector<char>& fresh, int k,
+                      std::vector<FamilyModel>* full, std::vector<Eigen::MatrixXd>* sd_err) {
+  if (o.candidates[g].family != Family::kGaussianProcess || !fresh[g] || weight < o.fresh_sd_weight)
+    return false;
+  fo.fold_partition = partition;
+  FamilyModel& m = (*full)[g];
+  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
+  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
+  const Eigen::MatrixXd y = TransformTargets(m.transform, t);
+  const Eigen::VectorXd yk = y.row(k).transpose();
+  const HeldOut h = OutputHeldOut(m, k, x, yk, fo, folds, true);
+  (*sd_err)[g].row(k) = OriginalErrors(m, k, t.row(k), yk, h);
+  SetNoiseFrom(h, folds, fo, x, yk, k, &m);
+  m.calibration += "; " + FreshPartitionText(k, partition, folds, weight);
+  return true;
+}
+
 }  // namespace
 
 Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
@@ -1212,7 +1325,13 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<int, Features::kCount> only;
   only.fill(-1);
   if (RefitsLowestGpOnly(options, rows)) only = RefitLowestGp(table, options, folds, full, &err);
-  const std::vector<Eigen::MatrixXd> judged = JudgedErrors(err, full, refitted, options);
+  const int partitions = rows < options.few_rows ? std::max(1, options.fold_partitions) : 1;
+  PartitionErrs parts;
+  if (partitions > 1)
+    parts = PartitionErrors(table, options, fold_options, refit_options, folds, err, refitted,
+                            pending, partitions);
+  const std::vector<Eigen::MatrixXd> judged =
+      JudgedErrors(partitions > 1 ? RmsOverPartitions(parts) : err, full, refitted, options);
   const GpEvidence ev = SlotEvidence(options, full, rows);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   // An output whose targets are all equal has nothing to choose on: it stays out of the score
@@ -1247,7 +1366,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<Eigen::VectorXd, Features::kCount> stack;
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      stack[k] = OutputStack(t, judged, options, k, folds, only[k], ev);
+      stack[k] = OutputStack(t, judged, parts, options, k, folds, only[k], ev);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
@@ -1272,8 +1391,21 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     for (Eigen::Index c = 0; c < stack[k].size(); ++c)
       if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
+  std::vector<Eigen::MatrixXd> sd_err = err;  // ChoiceOptions::fresh_partition_sd
+  for (int k = 0; k < Features::kCount && options.fresh_partition_sd && options.stack &&
+                  options.per_output && rows < options.few_rows;
+       ++k) {
+    const int g = choice.chosen[k];
+    std::vector<char> fresh(calibrated.size());
+    for (std::size_t c = 0; c < fresh.size(); ++c) fresh[c] = calibrated[c] && refitted[c];
+    const double weight = stack[k].size() == 0 ? 1.0 : stack[k](g);
+    if (FreshPartitionSd(table, options, refit_options, folds, partitions, g, weight, fresh, k,
+                         &full, &sd_err))
+      choice.notes[k] = options.candidates[g].Name() + ": its sd " +
+                        FreshPartitionText(k, partitions, folds, weight);
+  }
   FitChosen(table, options, stack, full, calibrated, &choice);
-  ScaleStackedSd(table, options, stack, err, &choice);
+  ScaleStackedSd(table, options, stack, sd_err, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
   choice.warnings = TableWarnings(table, options, constant);
   choice.rows_note = rows_note;

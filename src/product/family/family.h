@@ -105,7 +105,21 @@ struct FitOptions {
   /// hyperparameter), and the refits cost a third of the fit time at 100 rows.
   int loo_calibration_rows = 70;
   int threads = 1;  ///< core/parallel.h; the result is the same for any count
+  /// The fold partition of every K-fold refit (calibration_folds, the choice's refits): row q is
+  /// held out in fold FoldOfRows(rows, K, fold_partition, seed)[q]; 0 = fold q % K.
+  int fold_partition = 0;
 };
+
+/// What ChoiceOptions::fresh_partition_sd appends to a GP's calibration text when it took output
+/// k's sd (stack weight `weight`) from the `folds`-fold refit residuals of fold `partition`.
+std::string FreshPartitionText(int k, int partition, int folds, double weight);
+
+/// Fold of each of `rows` rows among min(folds, rows) folds: partition 0 puts row q in fold
+/// q % folds; partition p >= 1 puts it in fold pos(q) % folds, pos(q) its position in a
+/// permutation of the rows drawn by Fisher-Yates from Rng(MixSeed(seed, p)) (core/random.h), so
+/// that the same seed gives the same partitions. Every partition holds each row out once, in
+/// folds of the sizes of partition 0. InputError if rows < 1, folds < 1 or partition < 0.
+std::vector<int> FoldOfRows(int rows, int folds, int partition, std::uint64_t seed);
 
 /// A fitted candidate: the network (Family::kNetwork, in the transformed space), one least-squares
 /// fit per output (Family::kLinear) or one GP per output (Family::kGaussianProcess), x and y in
@@ -177,8 +191,13 @@ struct ShrunkStack {
   double z = 0;             ///< the stack's lead over the first candidate, in standard errors
   double share = 0;         ///< a
 };
+/// partitions > 1 (ChoiceOptions::fold_partitions): predictions and target hold the n rows
+/// `partitions` times (block p: fold partition p's held-out predictions); the weights minimize
+/// the squared error over all blocks, the nested folds go by row (row q of every block in fold
+/// q % folds), and the comparison with the first candidate takes per row the mean over blocks
+/// of the squared-error differences. InputError also if the rows are not partitions blocks.
 ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::VectorXd& target,
-                               int folds, double start_se, double full_se);
+                               int folds, double start_se, double full_se, int partitions = 1);
 
 /// kappa > 0: the smallest factor at which kappa sd_i >= |r_i| for at least 68.27 % of the rows
 /// and 2 kappa sd_i >= |r_i| for at least 95.45 % (the rule of CoverageNoiseVariance with
@@ -416,6 +435,35 @@ struct ChoiceOptions {
   /// does not count the power-law mean's five extra maximized coefficients, gave the slot to
   /// the log-column GP still more often and lost (docs/workpiece-model.md, "Twelfth attempt").
   GpSlot gp_slot_large = GpSlot::kBic;
+  /// Repeated K-fold below few_rows rows: the candidates judged by K-fold refits (GPs below
+  /// few_rows, networks) are refitted on this many fold partitions (FitOptions::fold_partition
+  /// 0 .. P-1; the linear fits' closed-form leave-one-out is the same in every one). Per row and
+  /// output the choice (gate, GP slot, hard choice, Choice::table) takes the mean over the
+  /// partitions of each candidate's squared held-out error, and the stacking weights minimize
+  /// the squared error summed over the partitions' held-out predictions (ShrunkStackWeights with
+  /// partitions); the sd keeps partition 0's residuals. 1: one partition. Why: the 20-row choice
+  /// errs both ways (GPs let in on power laws, the power law kept on non-linear tables), the
+  /// variance of one partition's held-out errors (docs/workpiece-model.md, "Thirteenth attempt:
+  /// diagnosis at 20 rows"). Opt-in: with 2 partitions it did not lower the 20-row test RMSE on
+  /// the fourteenth attempt's tuning part (lower on power laws, higher on Friedman #1 and
+  /// saturating tables) and doubles the 20-row fit time (docs/workpiece-model.md, "Fourteenth
+  /// attempt").
+  int fold_partitions = 1;
+  /// Selection-aware sd below few_rows rows (stack only): an output whose stack gives one GP
+  /// candidate judged by refits a weight of at least fresh_sd_weight gets that GP's noise level
+  /// (its calibration rule) and the output's Choice::sd_scale from the GP's held-out residuals
+  /// of fold partition fold_partitions, which the choice did not use (refits from the fixed
+  /// starting points). Why: a GP chosen alone at 20 rows is chosen where its refit errors
+  /// happened to be low, and its sd calibrated on those same residuals covered too few test rows
+  /// (test residuals 1.26 times its held-out RMSE; the same section). Opt-in: on the outputs it
+  /// acts on it brought the tuning part's coverage into the bands, and the rule, written for the
+  /// pooled cells (none outside the bands before), could not register it (docs/workpiece-model.md,
+  /// "Fourteenth attempt"); on fresh tables it left as many cells of 10 tables outside the bands
+  /// as the default, two brought inside and two pushed too wide ("Fifteenth attempt").
+  /// The GP's calibration text (FamilyModel::calibration, in the model file) then ends with
+  /// FreshPartitionText of each such output, and Choice::notes[k] names the GP and says it.
+  bool fresh_partition_sd = false;
+  double fresh_sd_weight = 0.8;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
@@ -460,7 +508,8 @@ struct Choice {
   /// candidate's sd (its own held-out residuals); 1 otherwise. Stored in the model file when a
   /// weight is or a factor is not 1.
   std::array<double, Features::kCount> sd_scale{1.0, 1.0};
-  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
+  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why, or the GP whose sd
+  /// ChoiceOptions::fresh_partition_sd took from another fold partition; empty if none.
   /// Printed by `whirl train` (and in its --json), not stored in the model file.
   std::array<std::string, Features::kCount> notes;
   /// What the choice did about the table that the user should know: inputs left out because they
