@@ -395,7 +395,9 @@ TEST(FamilyChoice, LowestGpPerScaleLargeLetsTheLowestGpOfEachScaleTakePartFromFe
     for (int k = 0; k < 2; ++k) {
       const CvRow &ch = h.table[h.chosen[k]], &cd = d.table[d.chosen[k]];
       for (const CvRow& r : d.table)  // the default: only the lowest GP of all takes part
-        if (is_gp(cd) && is_gp(r)) EXPECT_GE(r.cv_rmse(k), cd.cv_rmse(k)) << d.Describe();
+        if (is_gp(cd) && is_gp(r)) {
+          EXPECT_GE(r.cv_rmse(k), cd.cv_rmse(k)) << d.Describe();
+        }
       log_within_one_se += is_gp(ch) && ch.candidate.log && is_gp(cd) && !cd.candidate.log;
     }
   }
