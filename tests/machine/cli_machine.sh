@@ -117,6 +117,18 @@ assert sorted(a) == sorted(b), (sorted(a), sorted(b))
 for name in a:
     assert name == "both_grey" or a[name] == b[name], name
 PY
+# --grey-five-sensors (the grey box before the eleventh round) changes nothing on a record of
+# fewer than 20 lead days (one past day): every row, both_grey's included, comes out equal
+# (tests/machine_eval/test_shop.cpp plants the long record where it does change both_grey).
+grep -q -- "--grey-five-sensors" "$D/evaluate_help.txt" || fail "--help lacks --grey-five-sensors"
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --grey-five-sensors > "$D/field_five.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --grey-five-sensors: $(cat "$D/field_err.txt")"
+python3 - "$D/field.json" "$D/field_five.json" <<'PY' || fail "--grey-five-sensors moved a row"
+import json, sys
+a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
+assert a == b, sorted(k for k in a if a[k] != b.get(k))
+PY
 # --offset-candidates (issue 41's seventh round) adds the two opt-in rows, sensor rows, after
 # the table's, in the same run: every other row comes out equal.
 grep -q -- "--offset-candidates" "$D/evaluate_help.txt" || fail "--help lacks --offset-candidates"
