@@ -270,7 +270,8 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
       "write the report of the first scenario's first test-day screw (machine 0, first seed) "
       "into this directory: its control log [degC over min], the sensor model's sensors, lead "
       "deviation per strategy [um over mm] and the combined 840D programs for --profile of the "
-      "models a shop can train (the network's plan and both_shop's sensor model) (" +
+      "models a shop can train (the network's plan and the grey box of both_grey wherever it "
+      "was fitted, else both_shop's sensor model) (" +
           std::string(kOutputDirRule) + ")");
   AddDeprecatedAlias(e, report, "--report");
   e->add_option("--profile", o->profile,
