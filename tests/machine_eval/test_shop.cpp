@@ -445,5 +445,29 @@ TEST(GreyGuard, ScoresEachHeldDayFromTheDaysBeforeItOnly) {
   EXPECT_TRUE(one.keep_grey);
 }
 
+// grey_guarded scores the model it applies (both_grey's): on a record of 20 lead days the
+// every-sensor grey box's guard score, on 19 days and with grey_five_sensors the five sensors'.
+// The two specs' scores differ on both records, so the test sees which one was scored.
+TEST(GreyGuard, ScoresTheGreyBoxItApplies) {
+  for (int days : {19, 20}) {
+    const drift::ShopRecord rec = MotorRecord(0, days);
+    const GreyCandidateFit all =
+        FieldGreyCandidate(6400, false, rec.day_logs.front().sensor_names);
+    const GuardScore every = GuardGreyBox(rec, all.spec, FieldGreyBoxOptions(), WarmupSpec(),
+                                          WarmupOptions()),
+                     five = GuardGreyBox(rec, FieldGreyBoxSpec(6400), FieldGreyBoxOptions(),
+                                         WarmupSpec(), WarmupOptions());
+    ASSERT_EQ(every.days, 2);
+    EXPECT_NE(every.grey_rms_um, five.grey_rms_um) << days << " days";
+    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true),
+                     old = FitShopModels(rec, 6400, {"power_on"}, false, true, true);
+    ASSERT_TRUE(m.guard.chosen);
+    EXPECT_EQ(m.guard.grey_rms_um, (days >= 20 ? every : five).grey_rms_um) << days << " days";
+    EXPECT_EQ(m.guard.keep_grey, (days >= 20 ? every : five).keep_grey) << days << " days";
+    EXPECT_EQ(old.guard.grey_rms_um, five.grey_rms_um) << days << " days";
+    EXPECT_EQ(m.guard.rule_rms_um, five.rule_rms_um) << days << " days";
+  }
+}
+
 }  // namespace
 }  // namespace whirl::machine_eval

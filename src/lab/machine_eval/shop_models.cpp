@@ -152,15 +152,17 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   const GreyCandidateFit all = FieldGreyCandidate(z_fixed_mm, contact, have);
   const bool long_record = EverySensorByDays(record, grey_options);
   const bool every = long_record && !grey_five_sensors;
-  m.grey = drift::FitGreyBox(record, every ? all.spec : grey, grey_options);
+  const drift::GreyBoxSpec& applied = every ? all.spec : grey;  // both_grey's sensors
+  m.grey = drift::FitGreyBox(record, applied, grey_options);
   if (!grey_candidates) return m;
   const bool same = every && !grey_slope_lags_only;  // then m.grey is grey_all_sensors' model
   m.grey_candidates.push_back(same ? m.grey : drift::FitGreyBox(record, all.spec, all.options));
   // A short record's m.grey is the five sensors' model, with or without grey_five_sensors.
   drift::GreyBoxModel by_days = long_record ? m.grey_candidates[0] : m.grey;
   m.grey_candidates.push_back(std::move(by_days));
+  // The guard scores the model it would apply: both_grey's (its sensors, its options).
   const GuardScore g =
-      GuardGreyBox(record, grey, grey_options, schedule_base ? schedule : warmup, lagged);
+      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
   m.guard = {true, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
   return m;
 }
