@@ -142,51 +142,83 @@ std::string Line(const std::string& text) {
   return text + "\n";
 }
 
-// The actions that turn one model's inputs into its features (rises, lags), in execution order.
+// The longest action body: a program line is "IDS=<id> " (at most 8 characters) and the body.
+constexpr std::size_t kMaxActionBody = kMaxNcLine - sizeof("IDS=255 ") + 1;
+
+// Assignments packed into as few actions as their lines allow, in order: `head` ("DO" or
+// "WHENEVER <condition> DO") and then the assignments, each body within kMaxActionBody (one
+// assignment longer than that stays alone, and Line refuses it). A synchronized action's DO
+// part holds several actions (Siemens, SINUMERIK 840D sl Synchronized Actions Function Manual,
+// "Definition of a synchronized action": DO <action 1 ... n>); the callers pack only assignments
+// that do not read each other, so what each computes does not depend on their order in the line.
+std::vector<std::string> Packed(const std::string& head, const std::vector<std::string>& items) {
+  std::vector<std::string> bodies;
+  std::string body;
+  for (const std::string& item : items) {
+    if (!body.empty() && body.size() + 1 + item.size() > kMaxActionBody) {
+      bodies.push_back(body);
+      body.clear();
+    }
+    body += (body.empty() ? head : std::string()) + " " + item;
+  }
+  if (!body.empty()) bodies.push_back(body);
+  return bodies;
+}
+
+void Append(std::vector<std::string>* to, const std::vector<std::string>& more) {
+  to->insert(to->end(), more.begin(), more.end());
+}
+
+// The actions that turn one model's inputs into its features (rises, lags), in execution order:
+// [the references, once] -> the rises -> [the elapsed-time updates] -> once: each lag from its
+// input, each elapsed-time feature 0, then the init flag (in the last of these actions, so each
+// of them still sees the flag 0 in the start's cycle) -> the lag updates. Each step's
+// assignments are packed (Packed): none reads another of the same step.
 std::vector<std::string> FeatureBodies(const drift::DriftModel& m, const DriftActionOptions& o,
                                        const Layout& l) {
   const std::vector<std::string> in = Inputs(m);
   const int ns = static_cast<int>(m.sensors.size());
+  const std::string once = "WHENEVER " + P(l.flag) + "==0 DO";
   std::vector<std::string> bodies;
-  std::string init_ref;
   if (o.reference == DriftReference::kStart && ns > 0) {
-    for (int i = 0; i < ns; ++i) init_ref += " " + P(l.ref + i) + "=" + Reading(Input(o, in[i]));
-    bodies.push_back("WHENEVER " + P(l.flag) + "==0 DO" + init_ref);
+    std::vector<std::string> refs;
+    for (int i = 0; i < ns; ++i) refs.push_back(P(l.ref + i) + "=" + Reading(Input(o, in[i])));
+    Append(&bodies, Packed(once, refs));
   }
+  std::vector<std::string> rises;
   for (int i = 0; i < static_cast<int>(in.size()); ++i) {
     std::string ref;
     if (i < ns)
       ref = o.reference == DriftReference::kStart ? "-" + P(l.ref + i) : Term(-m.reference_C(i), 4);
-    bodies.push_back("DO " + P(l.features + i * l.per) + "=" + Reading(Input(o, in[i])) + ref);
+    rises.push_back(P(l.features + i * l.per) + "=" + Reading(Input(o, in[i])) + ref);
   }
-  if (l.elapsed_count > 0) {  // the lag of a unit step at the start: the time since the start
-    std::string upd = "DO";    // (before the init below, so the start's cycle holds x = 0)
-    for (int j = 0; j < l.elapsed_count; ++j) {
-      const std::string y = P(l.elapsed + j);
-      upd += " " + y + "=" + y +
-             Term(LagFactor(o, m.elapsed_time_constants[static_cast<std::size_t>(j)]),
-                  kDecimalsLagFactor) +
-             "*(1-" + y + ")";
-    }
-    bodies.push_back(upd);
+  Append(&bodies, Packed("DO", rises));
+  std::vector<std::string> elapsed;  // the lag of a unit step at the start: the time since it
+  for (int j = 0; j < l.elapsed_count; ++j) {  // (before the init below: the start's cycle x = 0)
+    const std::string y = P(l.elapsed + j);
+    elapsed.push_back(y + "=" + y +
+                      Term(LagFactor(o, m.elapsed_time_constants[static_cast<std::size_t>(j)]),
+                           kDecimalsLagFactor) +
+                      "*(1-" + y + ")");
   }
-  // Once, at the start: each lag from its input's value, each elapsed-time feature from 0.
-  std::string init = "WHENEVER " + P(l.flag) + "==0 DO";
+  Append(&bodies, Packed("DO", elapsed));
+  std::vector<std::string> init;
   for (int i = 0; i < static_cast<int>(in.size()); ++i)
     for (int k = 1; k < l.per; ++k)
-      init += " " + P(l.features + i * l.per + k) + "=" + P(l.features + i * l.per);
-  for (int j = 0; j < l.elapsed_count; ++j) init += " " + P(l.elapsed + j) + "=0";
-  bodies.push_back(init + " " + P(l.flag) + "=1");
+      init.push_back(P(l.features + i * l.per + k) + "=" + P(l.features + i * l.per));
+  for (int j = 0; j < l.elapsed_count; ++j) init.push_back(P(l.elapsed + j) + "=0");
+  init.push_back(P(l.flag) + "=1");
+  Append(&bodies, Packed(once, init));
+  std::vector<std::string> lags;
   for (int i = 0; l.per > 1 && i < static_cast<int>(in.size()); ++i) {
-    std::string upd = "DO";
     const std::string u = P(l.features + i * l.per);
     for (int k = 1; k < l.per; ++k) {
       const std::string y = P(l.features + i * l.per + k);
-      upd += " " + y + "=" + y + Term(LagFactor(o, m.time_constants[k - 1]), kDecimalsLagFactor) +
-             "*(" + u + "-" + y + ")";
+      lags.push_back(y + "=" + y + Term(LagFactor(o, m.time_constants[k - 1]), kDecimalsLagFactor) +
+                     "*(" + u + "-" + y + ")");
     }
-    bodies.push_back(upd);
   }
+  Append(&bodies, Packed("DO", lags));
   return bodies;
 }
 
@@ -256,13 +288,11 @@ std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::D
                                       const DriftActionOptions& o, const Slots& s) {
   std::vector<std::string> bodies = FeatureBodies(m, o, s.offset);
   if (g) {
-    const std::vector<std::string> more = FeatureBodies(*g, o, s.slope);
-    bodies.insert(bodies.end(), more.begin(), more.end());
+    Append(&bodies, FeatureBodies(*g, o, s.slope));
     std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope, kDecimalsDriftSlopeCoefficient,
                              s.s_m, &bodies);
     if (s.blank) {
-      const std::vector<std::string> b = BlankBodies(o, s);
-      bodies.insert(bodies.end(), b.begin(), b.end());
+      Append(&bodies, BlankBodies(o, s));
       s_m += Term(DriftBlankCoefficient(*s.blank, o), kDecimalsDriftSlopeCoefficient) + "*(" +
              P(o.blank_param + 1) + Term(-kBlankNeutralC, 4) + ")";
     }

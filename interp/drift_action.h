@@ -37,6 +37,12 @@
 //   [start: capture T_ref once] -> rises u -> [elapsed updates] -> [once: L = u, x = 0, flag]
 //   -> [lag updates] -> [partial sums] -> [slope model likewise, B's init and lag, S_m]
 //   -> SD43900 (-43920).
+// Each bracket's assignments of all inputs share actions, as many per action as the line holds
+// (a DO part holds several actions: Siemens, SINUMERIK 840D sl Synchronized Actions function
+// manual; none of them reads another of the same step), so the IDS count grows with the line
+// length of the model, not with one action per input: the field's every-sensor grey box (13
+// sensors on both channels, 2 lags, the blank) takes 32 IDs. With the once-step over several
+// actions the flag is set in the last of them.
 //
 // One writer per setting datum. With a whirling plan on the same axis (whirl plan
 // --with-drift-action), the plan's actions write their K0 into $AC_PARAM[workpiece_k0_param]

@@ -6,6 +6,7 @@
 #                                   [--threads 2] [--scenarios production,duty-changes,...]
 #                                   [--out-dir DIR] [--slope-through-lags-only]
 #                                   [--offset-candidates] [--grey-candidates]
+#                                   [--grey-five-sensors]
 # Seeds S..S+N-1 with S = --first-seed (default 1) and N = --seeds (1..20): a confirmation run
 # takes seeds no tuning run has used (e.g. --first-seed 101).
 # A week is 5 production days of history (--past-days 5 x weeks; at most 8 weeks = 40 days). Writes DIR/weeks_<w>.md (the evaluation's
@@ -22,6 +23,8 @@
 # grey_sensors_by_days: grey_all_sensors' model from 20 lead days in the record, both_grey's
 # before; grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two
 # lead days), judged and tabled the same way.
+# --grey-five-sensors: both_grey with its five physical sensors on every record (the model before
+# the eleventh round, which takes every sensor from 20 lead days on), so older figures reproduce.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -41,11 +44,12 @@ while [ $# -gt 0 ]; do
     --scenarios) scenarios="$2"; shift 2 ;;
     --out-dir) out_dir="$2"; shift 2 ;;
     --slope-through-lags-only) candidate+=(--slope-through-lags-only); shift ;;
+    --grey-five-sensors) candidate+=(--grey-five-sensors); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
     --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_guarded"
                        shift ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -123,7 +127,7 @@ PY
 note=""
 for c in ${candidate[@]+"${candidate[@]}"}; do
   case "$c" in
-    --slope-through-lags-only) note+="; both_grey with $c" ;;
+    --slope-through-lags-only|--grey-five-sensors) note+="; both_grey with $c" ;;
     --offset-candidates|--grey-candidates) note+="; the opt-in rows of $c" ;;
   esac
 done

@@ -51,7 +51,7 @@ struct MachineCliOptions {
   int test_days = 2, past_days = 5;
   double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
   bool no_setup_checks = false, slope_through_lags_only = false, offset_candidates = false,
-       grey_candidates = false;
+       grey_candidates = false, grey_five_sensors = false;
   FieldWorldFlags world;  ///< the world's optional parts (cmd_machine_world.h)
   std::vector<std::pair<std::string, CLI::Option*>> retired;  ///< legacy-world flags, hidden
 };
@@ -82,6 +82,7 @@ machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
   f.protocol.grey_slope_lags_only = o.slope_through_lags_only;
   f.protocol.offset_candidates = o.offset_candidates;
   f.protocol.grey_candidates = o.grey_candidates;
+  f.protocol.grey_five_sensors = o.grey_five_sensors;
   return f;
 }
 
@@ -269,7 +270,8 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
       "write the report of the first scenario's first test-day screw (machine 0, first seed) "
       "into this directory: its control log [degC over min], the sensor model's sensors, lead "
       "deviation per strategy [um over mm] and the combined 840D programs for --profile of the "
-      "models a shop can train (the network's plan and both_shop's sensor model) (" +
+      "models a shop can train (the network's plan and the grey box of both_grey wherever it "
+      "was fitted, else both_shop's sensor model) (" +
           std::string(kOutputDirRule) + ")");
   AddDeprecatedAlias(e, report, "--report");
   e->add_option("--profile", o->profile,
@@ -294,6 +296,11 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "both_grey's slope sensors (ambient, z_nut) through their lags only, the offset's "
               "as read: an opt-in variant, off by default, that lost on its tuning seeds "
               "(docs/machine-evaluation.md, sixth round)");
+  e->add_flag("--grey-five-sensors", o->grey_five_sensors,
+              "both_grey with its five physical sensors on every record: the model before the "
+              "eleventh round, which takes every sensor once the record holds 20 lead days; "
+              "opt-in, so that older figures reproduce (docs/machine-evaluation.md, eleventh "
+              "round)");
   e->add_flag("--offset-candidates", o->offset_candidates,
               "two more rows after the table's, computed in the same run: both_grey's slope with "
               "warmup's offset K0 (grey_warmup_k0) and with the mean of both offsets "

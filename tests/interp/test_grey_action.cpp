@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "core/error.h"
@@ -355,6 +356,79 @@ void ExpectRefused(const std::function<void()>& f, const std::string& needle) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
   }
+}
+
+// A grey box as large as the field's every-sensor one (13 sensors on both channels, 2 lags, the
+// blank term; no plan, so the latch stays neutral and the workpiece slots 0): its rises, lag starts and lag updates are
+// packed several to an action and over several actions each (every line within the control's
+// 512 characters); the control still equals the evaluator every cycle, K0 and slope.
+TEST(GreyAction, ALargeGreyBoxPackedIntoFewActionsFollowsTheEvaluator) {
+  constexpr int kSensors = 13;
+  drift::GreyBoxModel m;
+  for (int i = 0; i < kSensors; ++i) m.offset_sensors.push_back("s" + std::to_string(i) + "_C");
+  m.slope_sensors = m.offset_sensors;
+  m.blank_sensor = m.offset_sensors[0];
+  m.time_constants = {0.02, 0.1};
+  const int n = kSensors * 3;
+  m.a.resize(n);
+  m.g.resize(n);
+  for (int j = 0; j < n; ++j) m.a(j) = 0.6 * std::sin(j + 1.0), m.g(j) = 0.4 * std::cos(j + 0.5);
+  m.slope_intercept_um_per_1000 = 1.5;
+  m.blank_tau_min = 0.05;
+  m.blank_um_per_1000_per_k = -11.8;
+  m.offset_min = m.slope_min = Eigen::VectorXd::Constant(n, -20.0);
+  m.offset_max = m.slope_max = Eigen::VectorXd::Constant(n, 20.0);
+  const GreyBoxAction action = GreyBoxActionModels(m);
+  DriftActionOptions d = Options();
+  for (int i = 0; i < kSensors; ++i) d.inputs[m.offset_sensors[i]] = {i + 1, 0.0625, 0.0};
+  const std::string nc =
+      FormatDriftNcProgram(action.offset, d, "", &action.slope, action.Blank());
+  // One action per input's rise and per input's lags would need 2 x 13 x 2 alone.
+  int ids = 0, packed_rises = 0, lag_starts = 0;
+  std::istringstream in(nc);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("IDS=", 0) != 0) continue;
+    ++ids;
+    std::size_t reads = 0;
+    for (std::size_t at = line.find("$A_INA["); at != std::string::npos;
+         at = line.find("$A_INA[", at + 1))
+      ++reads;
+    packed_rises += reads > 1;
+    lag_starts += line.find("WHENEVER") != std::string::npos;
+    EXPECT_LE(line.size(), 512u);
+  }
+  EXPECT_LE(ids, d.sync_id_last - d.sync_id_first + 1);
+  EXPECT_GE(packed_rises, 2);
+  EXPECT_GE(lag_starts, 5);  // per channel: the lags' start over 2 actions; B's own
+  replay::Replay r;
+  const double parked = 4000.0;
+  drift::GreyBoxEvaluator ev(m);
+  auto temperature = [](int i, double t_s) {
+    return 18.0 + i + 4.0 * (1 - std::exp(-t_s / (10.0 + 3 * i))) + 0.3 * std::sin(t_s / (3.0 + i));
+  };
+  Eigen::VectorXd raw(2 * kSensors + 1);
+  auto set = [&](int k) {
+    const double t_s = k * kCycleMs / 1000.0;
+    for (int i = 0; i < kSensors; ++i) {
+      const double t = temperature(i, t_s);
+      r.control.ain[i + 1] = t / 0.0625;
+      raw(i) = raw(kSensors + i) = t;
+    }
+    raw(2 * kSensors) = raw(0);
+  };
+  set(0);
+  ASSERT_TRUE(r.RunProgram(nc));
+  double worst_mm = 0, largest_mm = 0;
+  for (int k = 0; k < 1500; ++k) {
+    set(k);
+    r.Cycle(parked);
+    const drift::GreyBoxEvaluator::Output e = ev.Step(k * kCycleMs / 60000.0, raw);
+    const double expected = ExpectedDkMm(r, d, ev, e, kBlankNeutralC, parked);
+    worst_mm = std::max(worst_mm, std::abs(r.control.DkMm(parked) - expected));
+    largest_mm = std::max(largest_mm, std::abs(expected));
+  }
+  EXPECT_LT(worst_mm, 1e-8);
+  EXPECT_GT(largest_mm, 1e-3);  // the comparison sees a model that moves
 }
 
 TEST(GreyAction, BadInputsAreRefusedWithTheirReason) {

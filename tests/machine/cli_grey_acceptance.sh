@@ -41,6 +41,7 @@ flag_reaches_every_evaluation --slope-through-lags-only c "both_grey with --slop
 flag_reaches_every_evaluation --offset-candidates k "the opt-in rows of --offset-candidates"
 grep -q "| weeks | scenario | row |" "$D/out.txt" || fail "no row column: $(cat "$D/out.txt")"
 flag_reaches_every_evaluation --grey-candidates g "the opt-in rows of --grey-candidates"
+flag_reaches_every_evaluation --grey-five-sensors f "both_grey with --grey-five-sensors"
 # Each scenario's row gets its own per-seed range (the gain lines name no scenario): a stand-in
 # prints two planted scenario blocks whose ranges differ.
 python3 - "$D/planted.md" <<'PY'

@@ -79,6 +79,18 @@ grep -q "^; model: .*trained only from shop measurements" "$D/report/WHIRL_DRIFT
 # The page quotes the drift action's output action: one IDS line, nothing after it (a label).
 grep -A1 "output:</p>$" "$D/report/index.html" | grep -q "^<pre>IDS=[0-9]* [^<]*</pre>$" \
   || fail "report: the drift action's output action is not one IDS line"
+# On a record of 20 production days (>= 20 lead days: both_grey takes every sensor) the report's
+# programs are the grey box's, every sensor on both channels, written with no warning: the default
+# profile's drift IDs hold its drift action (issue 41; the largest such action is checked in
+# tests/machine_report/test_machine_report.cpp).
+"$W" machine evaluate --scenarios production --machines 1 --test-days 1 --past-days 20 --seed 7 \
+  --out-dir "$D/report_long" > /dev/null 2> "$D/report_long_err.txt" ||
+  fail "evaluate --out-dir on 20 days: $(cat "$D/report_long_err.txt")"
+grep -q "warning" "$D/report_long_err.txt" && fail "20 days: $(cat "$D/report_long_err.txt")"
+grep -q "^; model: .* from 13 sensors, file grey box (both_grey)" \
+  "$D/report_long/WHIRL_DRIFT_COMP.SPF" || fail "20 days: the drift program is not both_grey's"
+grep -q "^; slope model: .* from 13 sensors$" "$D/report_long/WHIRL_DRIFT_COMP.SPF" ||
+  fail "20 days: the drift program's slope is not every sensor's"
 # The screw's control log is a drift run file: a machine model evaluates on it.
 "$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \
   2>/dev/null || fail "drift predict on the screw's log"
@@ -116,6 +128,18 @@ a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
 assert sorted(a) == sorted(b), (sorted(a), sorted(b))
 for name in a:
     assert name == "both_grey" or a[name] == b[name], name
+PY
+# --grey-five-sensors (the grey box before the eleventh round) changes nothing on a record of
+# fewer than 20 lead days (one past day): every row, both_grey's included, comes out equal
+# (tests/machine_eval/test_shop.cpp plants the long record where it does change both_grey).
+grep -q -- "--grey-five-sensors" "$D/evaluate_help.txt" || fail "--help lacks --grey-five-sensors"
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --grey-five-sensors > "$D/field_five.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --grey-five-sensors: $(cat "$D/field_err.txt")"
+python3 - "$D/field.json" "$D/field_five.json" <<'PY' || fail "--grey-five-sensors moved a row"
+import json, sys
+a, b = (json.load(open(f))["scenarios"][0]["strategies"] for f in sys.argv[1:])
+assert a == b, sorted(k for k in a if a[k] != b.get(k))
 PY
 # --offset-candidates (issue 41's seventh round) adds the two opt-in rows, sensor rows, after
 # the table's, in the same run: every other row comes out equal.

@@ -321,22 +321,35 @@ TEST(GreyCandidates, TheLeadShareOf90PercentFollowsTheLeadsWhereTheProbeDisagree
   }
 }
 
-// grey_sensors_by_days (the tenth round) follows the record's length: on a planted record of 19
-// lead days (below 2 x forward_days = 20) it is both_grey's model bit for bit, on one of 20
-// grey_all_sensors' bit for bit (every field of the model, as written to a file); the two models
-// differ on both records (z_motor_C moves the slope), so the test sees which one was taken.
-TEST(GreyCandidates, SensorsByDaysTakeEverySensorFromTwentyLeadDays) {
+// The field grey box (both_grey) follows the record's length since the eleventh round, as the
+// tenth round's grey_sensors_by_days did: on a planted record of 19 lead days (below
+// 2 x forward_days = 20) it is the five physical sensors' model (FieldGreyBoxSpec) bit for bit,
+// on one of 20 the every-sensor model (FieldGreyCandidate) bit for bit (every field of the
+// model, as written to a file); with grey_five_sensors it is the five sensors' model on both (the
+// model before the eleventh round: old figures reproduce). The opt-in rows keep their models:
+// grey_all_sensors every sensor, grey_sensors_by_days the default's. The two models differ on
+// both records (z_motor_C moves the slope), so the test sees which one was taken.
+TEST(GreyCandidates, TheFieldGreyBoxTakesEverySensorFromTwentyLeadDays) {
   EXPECT_EQ(FieldGreyBoxOptions().forward_days, 10);
   for (int days : {19, 20}) {
     const drift::ShopRecord rec = MotorRecord(0, days);
     ASSERT_EQ(drift::LeadDays(rec).size(), static_cast<std::size_t>(days));
     EXPECT_EQ(EverySensorByDays(rec, FieldGreyBoxOptions()), days >= 20);
-    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true);
-    ASSERT_EQ(m.grey_candidates.size(), 2u);
-    const nlohmann::json grey = m.grey, all = m.grey_candidates[0],
-                         by_days = m.grey_candidates[1];
-    EXPECT_NE(grey, all) << days << " days";
-    EXPECT_EQ(by_days, days >= 20 ? all : grey) << days << " days";
+    const GreyCandidateFit all =
+        FieldGreyCandidate(6400, false, rec.day_logs.front().sensor_names);
+    const nlohmann::json five = drift::FitGreyBox(rec, FieldGreyBoxSpec(6400),
+                                                  FieldGreyBoxOptions()),
+                         every = drift::FitGreyBox(rec, all.spec, all.options);
+    EXPECT_NE(five, every) << days << " days";
+    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true),
+                     old = FitShopModels(rec, 6400, {"power_on"}, false, true, true);
+    EXPECT_EQ(nlohmann::json(m.grey), days >= 20 ? every : five) << days << " days";
+    EXPECT_EQ(nlohmann::json(old.grey), five) << days << " days";
+    for (const ShopModels* s : {&m, &old}) {
+      ASSERT_EQ(s->grey_candidates.size(), 2u);
+      EXPECT_EQ(nlohmann::json(s->grey_candidates[0]), every) << days << " days";
+      EXPECT_EQ(nlohmann::json(s->grey_candidates[1]), days >= 20 ? every : five) << days;
+    }
   }
 }
 
@@ -430,6 +443,30 @@ TEST(GreyGuard, ScoresEachHeldDayFromTheDaysBeforeItOnly) {
                                       FieldGreyBoxOptions(), WarmupSpec(), WarmupOptions());
   EXPECT_EQ(one.days, 0);
   EXPECT_TRUE(one.keep_grey);
+}
+
+// grey_guarded scores the model it applies (both_grey's): on a record of 20 lead days the
+// every-sensor grey box's guard score, on 19 days and with grey_five_sensors the five sensors'.
+// The two specs' scores differ on both records, so the test sees which one was scored.
+TEST(GreyGuard, ScoresTheGreyBoxItApplies) {
+  for (int days : {19, 20}) {
+    const drift::ShopRecord rec = MotorRecord(0, days);
+    const GreyCandidateFit all =
+        FieldGreyCandidate(6400, false, rec.day_logs.front().sensor_names);
+    const GuardScore every = GuardGreyBox(rec, all.spec, FieldGreyBoxOptions(), WarmupSpec(),
+                                          WarmupOptions()),
+                     five = GuardGreyBox(rec, FieldGreyBoxSpec(6400), FieldGreyBoxOptions(),
+                                         WarmupSpec(), WarmupOptions());
+    ASSERT_EQ(every.days, 2);
+    EXPECT_NE(every.grey_rms_um, five.grey_rms_um) << days << " days";
+    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true),
+                     old = FitShopModels(rec, 6400, {"power_on"}, false, true, true);
+    ASSERT_TRUE(m.guard.chosen);
+    EXPECT_EQ(m.guard.grey_rms_um, (days >= 20 ? every : five).grey_rms_um) << days << " days";
+    EXPECT_EQ(m.guard.keep_grey, (days >= 20 ? every : five).keep_grey) << days << " days";
+    EXPECT_EQ(old.guard.grey_rms_um, five.grey_rms_um) << days << " days";
+    EXPECT_EQ(m.guard.rule_rms_um, five.rule_rms_um) << days << " days";
+  }
 }
 
 }  // namespace

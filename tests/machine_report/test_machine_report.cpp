@@ -25,7 +25,9 @@
 #include "core/safe_text.h"
 #include "interp/drift_action.h"
 #include "machine/scenarios.h"
+#include "machine/sensors.h"
 #include "machine_eval/field_eval.h"
+#include "machine_eval/shop_models.h"
 #include "machine_report/machine_report.h"
 #include "support/scratch_dir.h"
 #include "workpiece/model.h"
@@ -277,6 +279,64 @@ TEST(MachineReport, TheProgramsModelIsTheGreyBoxWhereverItWasFitted) {
   grey.total_median_um = 12.0;  // worse on the test screws: the rule does not look
   EXPECT_EQ(machine_eval::ProgramsStrategy(s, true, &why), MachineStrategy::kBothGrey);
   EXPECT_NE(why.find("both_grey 12.0 um, both_shop 10.0 um"), std::string::npos) << why;
+}
+
+// The largest drift action the default field grey box can produce fits the default profile: every
+// sensor of the field machine (machine::DefaultSensorSpecs, as its logs name them) on both
+// channels (FieldGreyCandidate, the model both_grey takes on a long record), as many lags as the
+// fit may choose (FieldGreyBoxOptions().max_lags) at the longest time constants of its grid, and
+// the blank term. The generator's own counts (DriftRequirements: MD28250's static actions, the
+// last $AC_PARAM) against the profile's drift IDs, parameter range and control limits, and the
+// program is written (IDs, slots and every line within the control's 512 characters).
+TEST(MachineReport, TheDefaultProfileHoldsTheLargestFieldGreyBoxDriftAction) {
+  const interp::MachineProfile profile =
+      interp::LoadMachineProfile(ReportSource("datasets/machines/whirling_840d.json"));
+  std::vector<std::string> sensors;
+  for (const machine::FieldSensorSpec& s : machine::DefaultSensorSpecs())
+    sensors.push_back(s.name + "_C");
+  ASSERT_EQ(sensors.size(), 13u);
+  const machine_eval::GreyCandidateFit all =
+      machine_eval::FieldGreyCandidate(6400, false, sensors);
+  ASSERT_EQ(all.spec.offset_sensors, sensors);
+  ASSERT_EQ(all.spec.slope_sensors, sensors);
+  const drift::GreyBoxOptions fit = machine_eval::FieldGreyBoxOptions();
+  ASSERT_GE(fit.max_lags, 1);
+  ASSERT_GE(fit.tau_grid.size(), static_cast<std::size_t>(fit.max_lags));
+  drift::GreyBoxModel m;
+  m.offset_sensors = all.spec.offset_sensors;
+  m.slope_sensors = all.spec.slope_sensors;
+  m.blank_sensor = all.spec.blank_sensor;
+  ASSERT_FALSE(m.blank_sensor.empty());
+  m.time_constants.assign(fit.tau_grid.end() - fit.max_lags, fit.tau_grid.end());
+  const Eigen::Index n = static_cast<Eigen::Index>(sensors.size()) * (1 + fit.max_lags);
+  m.a = Eigen::VectorXd::Constant(n, -0.0123);
+  m.g = Eigen::VectorXd::Constant(n, 0.0045);
+  m.slope_intercept_um_per_1000 = 1.5;
+  m.blank_um_per_1000_per_k = -11.8;
+  m.offset_min = m.slope_min = Eigen::VectorXd::Constant(n, -5.0);
+  m.offset_max = m.slope_max = Eigen::VectorXd::Constant(n, 15.0);
+  m.blank_min_c = 15, m.blank_max_c = 30;
+  const interp::GreyBoxAction a = interp::GreyBoxActionModels(m);
+  interp::DriftActionOptions d = profile.DriftOptions();
+  d.reference = interp::DriftReference::kModel;
+  double actions = -1, last_slot = -1;
+  for (const interp::ControlRequirement& r :
+       interp::DriftRequirements(a.offset, d, &a.slope, a.Blank())) {
+    if (r.datum.rfind("MD28250", 0) == 0) actions = r.value;
+    if (r.datum.rfind("MD28254", 0) == 0) last_slot = r.value - 1;
+  }
+  EXPECT_LE(actions, d.sync_id_last - d.sync_id_first + 1);
+  EXPECT_LE(actions, d.control.sync_elements);
+  EXPECT_LE(last_slot, d.param_last);
+  EXPECT_LT(last_slot, d.control.ac_params);
+  // The action's slots hold every feature of both channels (13 x 3 each): the model is this big.
+  EXPECT_GT(last_slot, d.param_first + 2 * n);
+  std::string nc;
+  ASSERT_NO_THROW(nc = interp::FormatDriftNcProgram(a.offset, d, "", &a.slope, a.Blank()));
+  EXPECT_NE(nc.find("IDS=" + std::to_string(d.sync_id_first + static_cast<int>(actions) - 1) + " "),
+            std::string::npos);
+  EXPECT_EQ(nc.find("IDS=" + std::to_string(d.sync_id_first + static_cast<int>(actions)) + " "),
+            std::string::npos);
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
       FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
   m.shop = FitShopModels(record, m.z_ref_mm, ScheduleInputs(), protocol.grey_slope_lags_only,
-                         protocol.grey_candidates);
+                         protocol.grey_candidates, protocol.grey_five_sensors);
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.control = ShopControlModels(m.shop.sensors, record.day_logs);
   m.records = static_cast<int>(record.records.size());

@@ -52,6 +52,9 @@ struct FieldProtocol {
   /// both_grey's slope sensors through their lags only (FieldGreyBoxOptions' `slope_lags_only`):
   /// an opt-in variant, off by default (docs/machine-evaluation.md, sixth round).
   bool grey_slope_lags_only = false;
+  /// both_grey with the field grey box's five physical sensors on a long record too (the model
+  /// before the eleventh round, so that older figures reproduce): an opt-in, off by default.
+  bool grey_five_sensors = false;
   /// Score the opt-in rows of OffsetCandidate (machine_eval.h) as well: both_grey's slope with
   /// warmup's offset, or with the mean of both offsets (docs/machine-evaluation.md, seventh round).
   bool offset_candidates = false;

@@ -98,7 +98,7 @@ GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpe
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
-                         bool grey_candidates) {
+                         bool grey_candidates, bool grey_five_sensors) {
   ShopModels m;
   const drift::JointFitOptions lagged = RuleOptions();
   const drift::JointSpec warmup = RuleSpec(z_fixed_mm, {"power_on"}),
@@ -148,15 +148,21 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
     placed = placed && std::find(other.begin(), other.end(), s) != other.end();
   if (!placed) return m;
   const drift::GreyBoxOptions grey_options = FieldGreyBoxOptions(contact, grey_slope_lags_only);
-  m.grey = drift::FitGreyBox(record, grey, grey_options);
-  if (!grey_candidates) return m;
+  // Every sensor once the record is long (the eleventh round's default), else the five.
   const GreyCandidateFit all = FieldGreyCandidate(z_fixed_mm, contact, have);
-  m.grey_candidates.push_back(drift::FitGreyBox(record, all.spec, all.options));
-  drift::GreyBoxModel by_days = EverySensorByDays(record, grey_options) ? m.grey_candidates[0]
-                                                                        : m.grey;
+  const bool long_record = EverySensorByDays(record, grey_options);
+  const bool every = long_record && !grey_five_sensors;
+  const drift::GreyBoxSpec& applied = every ? all.spec : grey;  // both_grey's sensors
+  m.grey = drift::FitGreyBox(record, applied, grey_options);
+  if (!grey_candidates) return m;
+  const bool same = every && !grey_slope_lags_only;  // then m.grey is grey_all_sensors' model
+  m.grey_candidates.push_back(same ? m.grey : drift::FitGreyBox(record, all.spec, all.options));
+  // A short record's m.grey is the five sensors' model, with or without grey_five_sensors.
+  drift::GreyBoxModel by_days = long_record ? m.grey_candidates[0] : m.grey;
   m.grey_candidates.push_back(std::move(by_days));
+  // The guard scores the model it would apply: both_grey's (its sensors, its options).
   const GuardScore g =
-      GuardGreyBox(record, grey, grey_options, schedule_base ? schedule : warmup, lagged);
+      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
   m.guard = {true, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
   return m;
 }

@@ -35,8 +35,11 @@ std::vector<std::string> ScheduleInputs();
 struct ShopModels {
   drift::JointDriftModel sensors, warmup, schedule;
   std::string sensors_choice;  ///< which candidate the sensor model is (see above)
-  /// The grey box (FieldGreyBoxSpec), the both_grey row; empty (no input, 0 everywhere) when
-  /// the record's logs lack one of its sensors.
+  /// The grey box, the both_grey row: FieldGreyBoxSpec's five physical sensors while the record
+  /// holds fewer than 20 lead days (EverySensorByDays), every sensor (FieldGreyCandidate's spec)
+  /// from then on (the eleventh round, docs/machine-evaluation.md; FitShopModels'
+  /// grey_five_sensors keeps the five always); empty (no input, 0 everywhere) when the record's
+  /// logs lack one of the five.
   drift::GreyBoxModel grey;
   /// The opt-in grey boxes, fitted only when asked for and where the grey box is, in
   /// GreyCandidate's order: grey_all_sensors (FieldGreyCandidate), grey_sensors_by_days (a copy
@@ -85,9 +88,10 @@ struct GreyCandidateFit {
 GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
                                     const std::vector<std::string>& sensors);
 /// The tenth round's row (grey_sensors_by_days; docs/machine-evaluation.md "Tenth round:
-/// split"): every sensor (FieldGreyCandidate) once the record holds enough lead days for the
-/// grey box's forward chaining (drift::ScoresForward: 2 x forward_days), the field grey box's
-/// five sensors before (every sensor pays on a short record and gains on a long one).
+/// split"), the field grey box's default since the eleventh round: every sensor
+/// (FieldGreyCandidate) once the record holds enough lead days for the grey box's forward
+/// chaining (drift::ScoresForward: 2 x forward_days), the field grey box's five sensors before
+/// (every sensor pays on a short record and gains on a long one).
 bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOptions& options);
 
 /// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split"): the
@@ -108,10 +112,12 @@ GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpe
                         const drift::JointFitOptions& rule_options, int held_days = 2);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
 /// FieldGreyBoxOptions' `slope_lags_only` for the grey box; `grey_candidates`: also fit
-/// ShopModels::grey_candidates.
+/// ShopModels::grey_candidates; `grey_five_sensors`: the grey box keeps FieldGreyBoxSpec's five
+/// sensors on a long record too (the model before the eleventh round, an opt-in).
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs(),
-                         bool grey_slope_lags_only = false, bool grey_candidates = false);
+                         bool grey_slope_lags_only = false, bool grey_candidates = false,
+                         bool grey_five_sensors = false);
 
 /// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
 /// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on
