@@ -365,6 +365,9 @@ SPLITS = {
     # The fifteenth attempt's confirmation (an sd-only change; tuning part the fourteenth's 920
     # tables): 19001-19020 at 20 rows; spent (C failed its rule, no default changed).
     "confirmation15": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 19001},
+    # The sixteenth attempt's confirmation (E, an evidence-based 20-row choice; tuning part the
+    # fourteenth's 920 tables): 20001-20010 at 20 rows.
+    "confirmation16": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 20001},
 }
 
 
