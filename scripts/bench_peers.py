@@ -79,7 +79,7 @@ Pooled summary of earlier runs (the fourth attempt's tuning part spans seed rang
   bench_peers.py --whirl build/whirl --from-json a.json b.json ... [--markdown]
 Paired decision of two whirl methods on the same tables (the fifth attempt's rule):
   bench_peers.py --whirl build/whirl --from-json a.json ... --paired default stack
-  (--rule sixth or fifteenth: those attempts' rules; fifteenth is for a change of the sd alone
+  (--rule sixth, fifteenth or sixteenth: those attempts' rules; fifteenth is for a change of the sd alone
   and counts coverage cells of 10-table blocks)
 Usage: bench_peers.py --whirl build/whirl [--split tuning|confirmation] [--seeds 20]
        [--first-seed 1] [--sizes 20,100] [--problems friedman,simulator,simgen,...]
@@ -606,13 +606,14 @@ def main():
                     help="with --from-json: the paired decision of CAND against BASE (d = ln of the "
                          "RMSE ratio per table and output, paired t, coverage cells, per-family "
                          "median ratios; docs/workpiece-model.md, fifth attempt)")
-    ap.add_argument("--rule", choices=["fifth", "sixth", "fifteenth"], default="fifth",
+    ap.add_argument("--rule", choices=["fifth", "sixth", "fifteenth", "sixteenth"], default="fifth",
                     help="with --paired: the fifth attempt's rule (no family median ratio above "
                          "1.03) or the sixth's (no family geometric mean ratio above 1.02; a "
                          "candidate that changes only the sd needs identical RMSE and strictly "
                          "fewer coverage cells) or the fifteenth's (sd only: identical RMSE, "
                          "strictly fewer cells of 10-table blocks, pooled cells not more, no "
-                         "pooled +-1 sd coverage leaving its band); docs/workpiece-model.md")
+                         "pooled +-1 sd coverage leaving its band) or the sixteenth's (the sixth's "
+                         "with coverage cells of 10-table blocks); docs/workpiece-model.md")
     a = ap.parse_args()
     if a.paired and not a.from_json:
         sys.exit("bench_peers: --paired needs --from-json")
@@ -620,7 +621,8 @@ def main():
         if a.rule == "fifteenth":
             sd_only_decision(a.from_json, *a.paired)
         else:
-            paired_decision(a.from_json, *a.paired, sixth=a.rule == "sixth")
+            paired_decision(a.from_json, *a.paired, sixth=a.rule in ("sixth", "sixteenth"),
+                            block=10 if a.rule == "sixteenth" else 0)
         return
     if a.from_json:
         pooled_summary(a.from_json, [p for p in a.acceptance_peers.split(",") if p], a.markdown)
@@ -777,17 +779,18 @@ def load_runs(files):
     return list(runs.values())
 
 
-def coverage_cells_out(rs, m):
+def coverage_cells_out(rs, m, block=0):
     """(problem, rows, output) cells whose mean +-1 / +-2 sd coverage of method m is outside
-    60-76 % / 90-98 %."""
+    60-76 % / 90-98 %; block > 0: cells of `block` consecutive seeds ((seed - 1) // block) each."""
     out = []
-    for prob, n in sorted({(r["problem"], r["rows"]) for r in rs}):
-        cell = [r for r in rs if r["problem"] == prob and r["rows"] == n]
+    group = lambda r: (r["problem"], r["rows"], (r["seed"] - 1) // block if block else 0)
+    for key in sorted({group(r) for r in rs}):
+        cell = [r for r in rs if group(r) == key]
         for k in (0, 1):
-            c1 = 100 * np.mean([r["methods"][m]["cover1"][k] for r in cell])
-            c2 = 100 * np.mean([r["methods"][m]["cover2"][k] for r in cell])
-            if not (60 <= c1 <= 76 and 90 <= c2 <= 98):
-                out.append(f"{prob} {n} out{k + 1} {c1:.1f}/{c2:.1f}")
+            c1, c2 = coverage_of(cell, m, k)
+            if not in_bands(c1, c2):
+                name = f"{key[0]} {key[1]}" + (f" seeds {key[2] * block + 1}-" if block else "")
+                out.append(f"{name} out{k + 1} {c1:.1f}/{c2:.1f}")
     return out
 
 
@@ -865,7 +868,7 @@ def paired_t(d):
     return float(np.mean(d)), (float(np.mean(d)) / (sd / math.sqrt(len(d))) if sd > 0 else 0.0)
 
 
-def paired_decision(files, base, cand, sixth=False):
+def paired_decision(files, base, cand, sixth=False, block=0):
     """The fifth attempt's rule (docs/workpiece-model.md), fixed before its run: per (problem,
     rows, seed, output) d = ln(RMSE_cand / RMSE_base); adopt iff mean(d) < 0 with paired t <= -2,
     no more coverage cells outside the bands than base, and no problem's median RMSE ratio above
@@ -873,7 +876,8 @@ def paired_decision(files, base, cand, sixth=False):
     (section "Sixth attempt: split"): no problem's geometric mean ratio exp(mean d) above 1.02
     instead of the median; if every case has d = 0 (only the sd changed), strictly fewer coverage
     cells instead of the t test. Both rules: "no change" when the two methods' RMSE, sd and
-    coverage are equal on every table (nothing to decide; base stays)."""
+    coverage are equal on every table (nothing to decide; base stays). block > 0: the sixteenth
+    attempt's rule, the sixth's with coverage cells of `block` consecutive seeds."""
     rs = load_runs(files)
     if not rs:
         sys.exit(f"bench_peers: --paired: no tables in {' '.join(files)}")
@@ -909,9 +913,10 @@ def paired_decision(files, base, cand, sixth=False):
         worst, worst_gm = max(worst, ratio), max(worst_gm, math.exp(fm))
         print(f"| {prob} | {len(x)} | {sum(v == 0.0 for v in x)} | {ratio:.4f} | {fm:+.4f} | "
               f"{ft:+.2f} | {sum(v < 0 for v in x)} / {sum(v > 0 for v in x)} |")
-    cells = {m: coverage_cells_out(rs, m) for m in (base, cand)}
+    cells = {m: coverage_cells_out(rs, m, block) for m in (base, cand)}
+    ncells = 2 * len({(r["problem"], r["rows"], (r["seed"] - 1) // block if block else 0) for r in rs})
     for m in (base, cand):
-        print(f"{m}: coverage outside 60-76 / 90-98 % on {len(cells[m])} of {4 * len(fam) if fam else 0} "
+        print(f"{m}: coverage outside 60-76 / 90-98 % on {len(cells[m])} of {ncells} "
               f"cells: " + "; ".join(cells[m]))
     checks = {"mean d < 0 and t <= -2.0": mean < 0 and t <= -2.0,
               f"coverage cells {len(cells[cand])} <= {len(cells[base])}":
