@@ -8,6 +8,7 @@
 //                [--gp-length-prior-sd SD] [--gp-max-rows N] [--gp-loo-penalty F]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N] [--gp-slot-large held-out|evidence|bic]
 //                [--fold-partitions P] [--fresh-partition-sd] [--fresh-sd-weight W]
+//                [--anchor-small first|bic|bic-weights]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -150,6 +151,15 @@ Args Parse(int argc, char** argv) {
       a.choice.fresh_partition_sd = true;
     else if (k == "--fresh-sd-weight")
       a.choice.fresh_sd_weight = std::stod(value());
+    else if (k == "--anchor-small") {
+      const std::string v = value();
+      using whirl::family::Anchor;
+      if (v != "first" && v != "bic" && v != "bic-weights")
+        throw std::invalid_argument("--anchor-small " + v + ": must be first, bic or bic-weights");
+      a.choice.anchor_small = v == "bic" ? Anchor::kBic
+                              : v == "bic-weights" ? Anchor::kBicWeights
+                                                   : Anchor::kFirst;
+    }
     else if (k == "--gp-length-prior-sd")
       a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")

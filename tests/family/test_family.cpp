@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
+#include <utility>
 
 #include "family/family.h"
 #include "support/expect_error.h"
@@ -1322,6 +1324,159 @@ TEST(FamilyChoice, FreshPartitionSdSaysInTheCalibrationWhichGpAndPartition) {
     EXPECT_EQ(nlohmann::json(ChooseFamily(t, on)).dump(), file);
   }
   EXPECT_GT(said, 0);
+}
+
+// LinearLogEvidence: the sum over the rows of the log-normal density of y (normal for a raw
+// output) at the fit's medians and the maximum-likelihood variance (mean squared residual of the
+// output column), written out from the predictions; that variance maximizes it, and y -> 1000 y
+// lowers it by n ln 1000.
+TEST(FamilyLinearEvidence, IsTheLogNormalDensityOfTheTargetsAtTheLeastSquaresFit) {
+  const ProcessTable t = MakeTable(16, 0.05, 3, true);
+  ProcessTable milli = t;
+  for (Features& f : milli.targets)
+    f = Features::FromArray({1000 * f.ToArray()[0], 1000 * f.ToArray()[1]});
+  for (const char* name : {"linear/log", "linear/identity"}) {
+    const Candidate c = ParseCandidate(name);
+    const FamilyModel m = FitCandidate(t, c, {}, false);
+    const std::vector<FamilyPrediction> p = PredictFamily(m, t.inputs);
+    for (int k = 0; k < 2; ++k) {
+      const auto density = [&](double variance_factor) {
+        double rss = 0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          const double y = t.targets[i].ToArray()[k], mu = p[i].mean.ToArray()[k];
+          rss += c.log ? std::pow(std::log(y) - std::log(mu), 2) : std::pow(y - mu, 2);
+        }
+        const double v = variance_factor * rss / static_cast<double>(p.size());
+        double sum = 0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          const double y = t.targets[i].ToArray()[k], mu = p[i].mean.ToArray()[k];
+          const double r = c.log ? std::log(y) - std::log(mu) : y - mu;
+          sum += -0.5 * std::log(2 * 3.14159265358979323846 * v) - r * r / (2 * v) -
+                 (c.log ? std::log(y) : 0.0);
+        }
+        return sum;
+      };
+      const double e = LinearLogEvidence(m, t, k);
+      EXPECT_NEAR(e, density(1), 1e-9 * std::abs(e)) << name << " " << k;
+      EXPECT_LT(density(1.01), e) << name << " " << k;
+      EXPECT_LT(density(0.99), e) << name << " " << k;
+      const double n = static_cast<double>(t.targets.size());
+      EXPECT_NEAR(LinearLogEvidence(FitCandidate(milli, c, {}, false), milli, k) - e,
+                  -n * std::log(1000.0), 1e-6)
+          << name << " " << k;
+    }
+  }
+  ExpectInputError(
+      [&] { LinearLogEvidence(FitCandidate(t, ParseCandidate("gp-se-constant/log"), {}), t, 0); },
+      "holds no linear fit");
+}
+
+ChoiceOptions Anchored(Anchor a) {
+  ChoiceOptions o;
+  o.anchor_small = a;
+  return o;
+}
+
+// The BIC of the power law and the highest BIC of the GPs of output k of `t`, written out from
+// fits of each candidate (LinearLogEvidence, GpLogEvidence) and q: 1 + 5 coefficients + the noise
+// for the power law; 5 lengths, signal, noise and the mean's coefficients for a GP. `gp`: the GP's
+// index in o.candidates.
+std::pair<double, double> PowerLawAndGpBic(const ProcessTable& t, const ChoiceOptions& o, int k,
+                                           int* gp) {
+  const double n = static_cast<double>(t.inputs.size());
+  const double power_law =
+      LinearLogEvidence(FitCandidate(t, o.candidates[0], o.fit, false), t, k) - 3.5 * std::log(n);
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t c = 1; c < o.candidates.size(); ++c) {
+    if (o.candidates[c].family != Family::kGaussianProcess) continue;
+    const FamilyModel m = FitCandidate(t, o.candidates[c], o.fit, false);
+    const double q = 7 + gp::MeanSize(m.gps[k].mean, 5);
+    const double b = GpLogEvidence(m, k) - 0.5 * q * std::log(n);
+    if (b > best) best = b, *gp = static_cast<int>(c);
+  }
+  return {power_law, best};
+}
+
+// ChoiceOptions::anchor_small = kBic at 20 rows: per output the power law takes part and no GP
+// when its BIC is the higher, else the GP of highest BIC and not the power law (BIC computed here
+// from each candidate's own fit); clean power laws keep the power law on every output, the
+// smooth non-power law of MakeTable(curved) gives a GP weight on most.
+TEST(FamilyAnchor, BicAnchorIsThePowerLawOrTheGpOfHigherBic) {
+  const ChoiceOptions o = Anchored(Anchor::kBic);
+  int power_law_kept = 0, gp_taken = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const bool curved = seed > 4;
+    const ProcessTable t = MakeTable(20, 0.03, seed, curved);
+    const Choice c = ChooseFamily(t, o);
+    for (int k = 0; k < 2; ++k) {
+      int g = -1;
+      const auto [power_law, gp] = PowerLawAndGpBic(t, o, k, &g);
+      const std::vector<int> gps = WeightedGps(c, k);
+      if (gp > power_law) {
+        EXPECT_EQ(PowerLawWeight(c, k), 0.0) << "seed " << seed << ": " << c.Describe();
+        EXPECT_EQ(gps, std::vector<int>{g}) << "seed " << seed << ": " << c.Describe();
+      } else {
+        EXPECT_TRUE(gps.empty()) << "seed " << seed << ": " << c.Describe();
+      }
+      power_law_kept += !curved && PowerLawWeight(c, k) > 0 && gps.empty();
+      gp_taken += curved && !gps.empty();
+    }
+  }
+  EXPECT_EQ(power_law_kept, 8) << "of 8 power-law outputs";
+  EXPECT_GE(gp_taken, 6) << "of 8 curved outputs";
+}
+
+// kBicWeights: where both the power law and the GP of highest BIC have weight, their ratio is
+// exp(BIC difference) (both scaled by the anchor's stack weight); where one of them has none, the
+// BIC difference puts its weight below 0.001.
+TEST(FamilyAnchor, BicWeightsSplitTheAnchorByExpBic) {
+  const ChoiceOptions o = Anchored(Anchor::kBicWeights);
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const ProcessTable t = seed > 3 ? MakeTable(20, 0.3, seed, true) : MakeTable(20, 0.1, seed);
+    const Choice c = ChooseFamily(t, o);
+    for (int k = 0; k < 2; ++k) {
+      int g = -1;
+      const auto [power_law, gp] = PowerLawAndGpBic(t, o, k, &g);
+      const double wp = PowerLawWeight(c, k);
+      double wg = 0;
+      for (std::size_t j = 0; j < c.models.size(); ++j)
+        if (c.models[j].candidate.Name() == o.candidates[g].Name())
+          wg = c.weights[k].empty() ? (c.model_of_output[k] == static_cast<int>(j) ? 1.0 : 0.0)
+                                    : c.weights[k][j];
+      if (wp > 0 && wg > 0)
+        EXPECT_NEAR(std::log(wg / wp), gp - power_law, 1e-6) << "seed " << seed;
+      else if (wg > 0)
+        EXPECT_GT(gp - power_law, std::log(999.0)) << "seed " << seed << ": " << c.Describe();
+      else if (wp > 0)
+        EXPECT_LT(gp - power_law, -std::log(999.0)) << "seed " << seed << ": " << c.Describe();
+    }
+  }
+}
+
+// Both anchors change nothing on 8- and 9-row tables (linear fits only) and from few_rows (70)
+// rows (the file of the default byte for byte); at 20 rows the same file twice and with two
+// threads, and another file than the default's on some of these tables; kFirst is the default.
+TEST(FamilyAnchor, LeavesEightRowsAndFromFewRowsAsTheyAreAndGivesTheSameFileTwice) {
+  EXPECT_EQ(ChoiceOptions().anchor_small, Anchor::kFirst);
+  for (const ProcessTable& t : {MakeTable(8, 0.05, 3), MakeTable(9, 0.05, 4),
+                                test::MakeBentTable(70, 0.05, 0.5, 2), MakeTable(70, 0.05, 5, true)})
+    for (const Anchor a : {Anchor::kBic, Anchor::kBicWeights})
+      EXPECT_EQ(nlohmann::json(ChooseFamily(t, Anchored(a))).dump(),
+                nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump())
+          << t.inputs.size() << " rows";
+  int differs = 0;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const ProcessTable t = seed == 1 ? LogisticTable(20, 0.5, seed) : MakeTable(20, 0.05, seed, true);
+    for (const Anchor a : {Anchor::kBic, Anchor::kBicWeights}) {
+      ChoiceOptions o = Anchored(a);
+      const std::string file = nlohmann::json(ChooseFamily(t, o)).dump();
+      EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+      o.fit.threads = 2;
+      EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+      differs += file != nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump();
+    }
+  }
+  EXPECT_GT(differs, 0);
 }
 
 }  // namespace

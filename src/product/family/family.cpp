@@ -779,6 +779,20 @@ double GpLogEvidence(const FamilyModel& m, int k) {
   return e;
 }
 
+double LinearLogEvidence(const FamilyModel& m, const ProcessTable& table, int k) {
+  if (k < 0 || static_cast<std::size_t>(k) >= m.linears.size())
+    throw InputError("linear evidence: " + m.candidate.Name() + " holds no linear fit for output " +
+                     std::to_string(k));
+  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
+  const Eigen::VectorXd y =
+      TransformTargets(m.transform, nn::TargetMatrix(table.targets)).row(k).transpose();
+  const double rss = (y - PredictLinear(m.linears[k], x).mean).squaredNorm();
+  const double n = static_cast<double>(y.size());
+  double e = -0.5 * n * (std::log(2 * kPi * rss / n) + 1);
+  if (m.transform.outputs[k] == ColumnTransform::kLog) e -= y.sum();  // sum_i ln y_i
+  return e;
+}
+
 namespace {
 
 // The linear candidate on the columns of candidate c (-1 if there is none).
@@ -1169,10 +1183,9 @@ std::vector<Eigen::MatrixXd> JudgedErrors(const std::vector<Eigen::MatrixXd>& er
   return out;
 }
 
-// ChoiceOptions::gp_slot_large on a table of `rows` rows: GpEvidence of the GP candidates of
-// `full` (fitted on all rows from few_rows on); empty where the held-out errors give the slot.
-GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows) {
-  if (o.gp_slot_large == GpSlot::kHeldOut || rows < o.few_rows) return {};
+// Per candidate and output the GpLogEvidence of the GPs of `full` (kBic: minus (q / 2) ln n, q
+// their hyperparameters and mean coefficients), -infinity for the other candidates.
+GpEvidence GpEvidenceOf(const ChoiceOptions& o, const std::vector<FamilyModel>& full, GpSlot slot) {
   GpEvidence ev(full.size());
   for (std::size_t c = 0; c < full.size(); ++c)
     for (int k = 0; k < Features::kCount; ++k) {
@@ -1184,10 +1197,75 @@ GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& 
       const int d = g.InputCount();
       const double q = FittedHyperparameters(o.candidates[c], d) + gp::MeanSize(g.mean, d);
       ev[c][k] = GpLogEvidence(full[c], k);
-      if (o.gp_slot_large == GpSlot::kBic)
+      if (slot == GpSlot::kBic)
         ev[c][k] -= 0.5 * q * std::log(static_cast<double>(g.u.size()));
     }
   return ev;
+}
+
+// ChoiceOptions::gp_slot_large on a table of `rows` rows: GpEvidence of the GP candidates of
+// `full` (fitted on all rows from few_rows on); empty where the held-out errors give the slot.
+GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows) {
+  if (o.gp_slot_large == GpSlot::kHeldOut || rows < o.few_rows) return {};
+  return GpEvidenceOf(o, full, o.gp_slot_large);
+}
+
+// ChoiceOptions::anchor_small applies to a table of `rows` rows (with `partitions` fold
+// partitions): the stack below few_rows, a linear fit first, and a GP candidate among `o`'s.
+bool AnchorApplies(const ChoiceOptions& o, int rows, int partitions) {
+  if (o.anchor_small == Anchor::kFirst || !o.stack || !o.per_output || rows >= o.few_rows ||
+      partitions > 1 || o.candidates.front().family != Family::kLinear)
+    return false;
+  return std::any_of(o.candidates.begin(), o.candidates.end(),
+                     [](const Candidate& c) { return c.family == Family::kGaussianProcess; });
+}
+
+// ChoiceOptions::anchor_small for output k: the anchor's weights over the candidates (sum 1):
+// the first candidate (the power law) and the GP of highest BIC in `gp_bic` by their BIC.
+Eigen::VectorXd AnchorWeights(const ChoiceOptions& o, const std::vector<FamilyModel>& full,
+                              const ProcessTable& table, const GpEvidence& gp_bic, int k) {
+  const double n = static_cast<double>(table.inputs.size());
+  const double q = static_cast<double>(full.front().linears[k].coef.size()) + 1;  // and the noise
+  const double power_law = LinearLogEvidence(full.front(), table, k) - 0.5 * q * std::log(n);
+  const int g = HighestEvidenceGp(o, gp_bic, k);
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(full.size()));
+  double wg = gp_bic[g][k] > power_law ? 1.0 : 0.0;
+  if (o.anchor_small == Anchor::kBicWeights) {
+    wg = 1 / (1 + std::exp(power_law - gp_bic[g][k]));
+    wg = wg < 1e-3 ? 0.0 : wg > 1 - 1e-3 ? 1.0 : wg;
+  }
+  a(g) = wg;
+  a(0) = 1 - wg;
+  return a;
+}
+
+// ChoiceOptions::anchor_small for output k of targets t: the shrunk stack (ShrunkStackWeights)
+// of the anchor `a` (AnchorWeights; its held-out prediction the a-weighted one of its parts) and
+// the candidates that are neither the first nor a GP and beat the anchor's squared held-out
+// errors by stack_gate_se standard errors; the anchor's weight split by a.
+Eigen::VectorXd AnchoredStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
+                              const ChoiceOptions& o, int k, int folds, const Eigen::VectorXd& a) {
+  Eigen::RowVectorXd anchor = Eigen::RowVectorXd::Zero(t.cols());
+  for (Eigen::Index c = 0; c < a.size(); ++c)
+    if (a(c) > 0) anchor += a(c) * err[static_cast<std::size_t>(c)].row(k);
+  const auto squared = [](const Eigen::RowVectorXd& e) -> Eigen::VectorXd {
+    return e.array().square().matrix().transpose();
+  };
+  std::vector<int> in;
+  for (std::size_t c = 1; c < err.size(); ++c)
+    if (o.candidates[c].family != Family::kGaussianProcess &&
+        (o.stack_gate_se <= 0 ||
+         BeatsFirst(squared(anchor), squared(err[c].row(k)), o.stack_gate_se, 0, folds)))
+      in.push_back(static_cast<int>(c));
+  Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()) + 1);
+  p.col(0) = (t.row(k) - anchor).transpose();
+  for (std::size_t j = 0; j < in.size(); ++j)
+    p.col(static_cast<Eigen::Index>(j) + 1) = (t.row(k) - err[in[j]].row(k)).transpose();
+  const Eigen::VectorXd w =
+      ShrunkStackWeights(p, t.row(k).transpose(), folds, o.stack_start_se, o.stack_full_se).weights;
+  Eigen::VectorXd out = w(0) * a;
+  for (std::size_t j = 0; j < in.size(); ++j) out(in[j]) += w(static_cast<Eigen::Index>(j) + 1);
+  return out;
 }
 
 // ChoiceOptions::fold_partitions: per fold partition 0 .. partitions-1 the held-out errors
@@ -1364,9 +1442,17 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
   std::array<Eigen::VectorXd, Features::kCount> stack;
+  const bool anchored = AnchorApplies(options, rows, partitions);
+  GpEvidence gp_bic;
+  if (anchored) {  // ChoiceOptions::anchor_small: every GP fitted on all rows for its BIC
+    for (int c = 0; c < nc; ++c) complete(c);
+    gp_bic = GpEvidenceOf(options, full, GpSlot::kBic);
+  }
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      stack[k] = OutputStack(t, judged, parts, options, k, folds, only[k], ev);
+      stack[k] = anchored ? AnchoredStack(t, judged, options, k, folds,
+                                          AnchorWeights(options, full, table, gp_bic, k))
+                          : OutputStack(t, judged, parts, options, k, folds, only[k], ev);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);

@@ -250,6 +250,21 @@ int FittedHyperparameters(const Candidate& c, int inputs = ProcessInputs::kCount
 /// holds no GP for output k.
 double GpLogEvidence(const FamilyModel& m, int k);
 
+/// ln p(y) of output k's least-squares fit in the linear candidate `m` (fitted on `table`) as a
+/// Gaussian linear model of its output column at the maximum-likelihood noise RSS / n, written
+/// as a density of the output in its original units: -(n / 2) (ln(2 pi RSS / n) + 1) - [log
+/// output] sum_i ln y_i (the Jacobian of the log transform, as in GpLogEvidence), n the table's
+/// rows, RSS the residual sum of squares in the output column (ln y or y). InputError if `m`
+/// holds no linear fit for output k.
+double LinearLogEvidence(const FamilyModel& m, const ProcessTable& table, int k);
+
+/// ChoiceOptions::anchor_small: what the stack below few_rows rows is shrunk toward.
+enum class Anchor {
+  kFirst,       ///< the first candidate (the power law), the others past the held-out gate
+  kBic,         ///< the power law or the GP of highest BIC, whichever has the higher BIC
+  kBicWeights,  ///< their BIC-weighted average
+};
+
 /// ChoiceOptions::gp_slot_large: how the one GP slot of lowest_gp is given from few_rows rows.
 enum class GpSlot {
   kHeldOut,   ///< the GP of lowest held-out error (the default before the twelfth attempt)
@@ -464,6 +479,21 @@ struct ChoiceOptions {
   /// FreshPartitionText of each such output, and Choice::notes[k] names the GP and says it.
   bool fresh_partition_sd = false;
   double fresh_sd_weight = 0.8;
+  /// The stack's anchor below few_rows rows (per output; only where the first candidate is a
+  /// linear fit, GP candidates take part and fold_partitions is 1): kBic compares the BIC of the
+  /// power law (LinearLogEvidence - (q / 2) ln n, q = its coefficients + the noise) with the
+  /// highest BIC of the GPs (GpLogEvidence as gp_slot_large's kBic, every GP fitted on all rows
+  /// for it); the higher is the anchor and the other takes no part (so do the other GPs). The
+  /// remaining candidates (linear/identity, the network) enter if their held-out errors beat the
+  /// anchor's by stack_gate_se standard errors, and the stacking weights are shrunk toward the
+  /// anchor (stack_start_se, stack_full_se). kBicWeights: the anchor is the average of the power
+  /// law and that GP with the weights exp(BIC) / sum exp(BIC) (a weight below 0.001 is 0), its
+  /// stack weight split by them. kFirst: the stack of `stack` (the power law first, every
+  /// candidate gated by held-out errors). Why: the 20-row held-out errors (5-fold refits on 16
+  /// rows) let GPs in on power laws and kept the power law on bent tables, a variance
+  /// (docs/workpiece-model.md, "Thirteenth attempt: diagnosis at 20 rows"); the evidence does
+  /// not use them ("Sixteenth attempt").
+  Anchor anchor_small = Anchor::kFirst;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
