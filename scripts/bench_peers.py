@@ -366,7 +366,8 @@ SPLITS = {
     # tables): 19001-19020 at 20 rows; spent (C failed its rule, no default changed).
     "confirmation15": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 19001},
     # The sixteenth attempt's confirmation (E, an evidence-based 20-row choice; tuning part the
-    # fourteenth's 920 tables): 20001-20010 at 20 rows.
+    # fourteenth's 920 tables): 20001-20010 at 20 rows. Unused (E failed its tuning part) and
+    # reserved; only the peers have been run on it.
     "confirmation16": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 20001},
 }
 
