@@ -1443,12 +1443,13 @@ TEST(FamilyAnchor, BicWeightsSplitTheAnchorByExpBic) {
         if (c.models[j].candidate.Name() == o.candidates[g].Name())
           wg = c.weights[k].empty() ? (c.model_of_output[k] == static_cast<int>(j) ? 1.0 : 0.0)
                                     : c.weights[k][j];
-      if (wp > 0 && wg > 0)
+      if (wp > 0 && wg > 0) {
         EXPECT_NEAR(std::log(wg / wp), gp - power_law, 1e-6) << "seed " << seed;
-      else if (wg > 0)
+      } else if (wg > 0) {
         EXPECT_GT(gp - power_law, std::log(999.0)) << "seed " << seed << ": " << c.Describe();
-      else if (wp > 0)
+      } else if (wp > 0) {
         EXPECT_LT(gp - power_law, -std::log(999.0)) << "seed " << seed << ": " << c.Describe();
+      }
     }
   }
 }
