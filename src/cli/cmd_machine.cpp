@@ -310,10 +310,11 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "the opt-in grey rows after the table's (with the --offset-candidates rows), "
               "computed in the same run from the same records: grey_all_sensors (the grey box "
               "with every sensor on both channels), grey_sensors_by_days (grey_all_sensors' "
-              "model once the record holds 20 lead days, both_grey's before) and grey_guarded "
-              "(both_grey's model or the sensor-free base rule, whichever predicted the shop's "
-              "own last two lead days better); off by default (docs/machine-evaluation.md, "
-              "eighth to tenth rounds)");
+              "model once the record holds 20 lead days, both_grey's before), grey_short_prior "
+              "(both_grey with the prior strength fixed at 1 while the record holds fewer than "
+              "20 lead days) and grey_guarded (both_grey's model or the sensor-free base rule, "
+              "whichever predicted the shop's own last two lead days better); off by default "
+              "(docs/machine-evaluation.md, eighth to twelfth rounds)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

@@ -458,6 +458,11 @@ TEST(GreyBox, BadOptionsAndMissingColumnsAreNamed) {
   o = Fixed(t, 1e-2);
   o.blank_tau_grid = {0};
   EXPECT_THROW(FitGreyBox(rec, SpecOf(t), o), InputError);
+  for (double bad : {0.0, -1.0, std::nan("")}) {
+    o = Fixed(t, 1e-2);
+    o.short_record_strength_grid = {bad};
+    ExpectInputError([&] { FitGreyBox(rec, SpecOf(t), o); }, "short_record_strength_grid holds");
+  }
   GreyBoxSpec s = SpecOf(t);
   s.slope_sensors = {"no_such_sensor"};
   EXPECT_THROW(FitGreyBox(rec, s, Fixed(t, 1e-2)), InputError);

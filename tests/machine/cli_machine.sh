@@ -170,11 +170,17 @@ a = json.load(open(sys.argv[1]))["scenarios"][0]["strategies"]
 gc = json.load(open(sys.argv[2]))["scenarios"][0]
 b = gc["strategies"]
 assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_sensors_by_days",
-                                      "grey_guarded"]), sorted(b)
+                                      "grey_short_prior", "grey_guarded"]), sorted(b)
 for name in a:
     assert a[name] == b[name], name
-for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_guarded"):
+for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_short_prior", "grey_guarded"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
+# grey_fit: what both_grey's fit chose on the machine (one past day: one lead day), from its grids.
+fit = gc["runs"][0]["grey_fit"]
+assert len(fit) == 1 and fit[0]["lead_days"] == 1, fit
+assert fit[0]["prior_strength"] in (1e-3, 1e-2, 1e-1, 1.0), fit
+assert fit[0]["blank_tau_min"] in (30, 60, 120, 240), fit
+assert all(t in (10, 20, 40, 80, 160, 320) for t in fit[0]["time_constants_min"]), fit
 chosen = gc["runs"][0]["grey_guarded_choice"]
 assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), chosen
 for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):

@@ -3,6 +3,7 @@
 // tested on the field world (test_field_eval.cpp, FieldTraining).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -346,11 +347,50 @@ TEST(GreyCandidates, TheFieldGreyBoxTakesEverySensorFromTwentyLeadDays) {
     EXPECT_EQ(nlohmann::json(m.grey), days >= 20 ? every : five) << days << " days";
     EXPECT_EQ(nlohmann::json(old.grey), five) << days << " days";
     for (const ShopModels* s : {&m, &old}) {
-      ASSERT_EQ(s->grey_candidates.size(), 2u);
+      ASSERT_EQ(s->grey_candidates.size(), 3u);
       EXPECT_EQ(nlohmann::json(s->grey_candidates[0]), every) << days << " days";
       EXPECT_EQ(nlohmann::json(s->grey_candidates[1]), days >= 20 ? every : five) << days;
     }
   }
+}
+
+// The twelfth round's candidate (grey_short_prior) acts only on a short record: below
+// 2 x forward_days = 20 lead days the strength comes from short_record_strength_grid (a value
+// the default grid lacks, 7, is the one chosen; ShortRecordStrongPrior fixes 1), from 20 lead
+// days on the option changes nothing, bit for bit (every field of the model as written to a
+// file), so the 4- and 8-week figures cannot move. The row is that fit of both_grey's spec below
+// 20 lead days and both_grey's model itself from 20 on.
+TEST(GreyCandidates, TheShortRecordStrengthActsOnlyBelowTwentyLeadDays) {
+  const drift::GreyBoxOptions field = FieldGreyBoxOptions();
+  EXPECT_TRUE(field.short_record_strength_grid.empty());  // off unless asked for
+  EXPECT_EQ(ShortRecordStrongPrior(field).short_record_strength_grid, std::vector<double>{1.0});
+  drift::GreyBoxOptions seven = field;
+  seven.short_record_strength_grid = {7.0};
+  ASSERT_EQ(std::count(field.strength_grid.begin(), field.strength_grid.end(), 7.0), 0);
+  for (int days : {19, 20}) {
+    const drift::ShopRecord rec = MotorRecord(0, days);
+    ASSERT_EQ(drift::LeadDays(rec).size(), static_cast<std::size_t>(days));
+    EXPECT_EQ(&drift::StrengthGrid(rec, seven),
+              days < 20 ? &seven.short_record_strength_grid : &seven.strength_grid);
+    const drift::GreyBoxSpec spec = FieldGreyBoxSpec(6400);
+    const drift::GreyBoxModel plain = drift::FitGreyBox(rec, spec, field),
+                              strong = drift::FitGreyBox(rec, spec, seven),
+                              one = drift::FitGreyBox(rec, spec, ShortRecordStrongPrior(field));
+    if (days < 20) {
+      EXPECT_EQ(strong.prior_strength, 7.0);
+      EXPECT_EQ(one.prior_strength, 1.0);
+      EXPECT_NE(nlohmann::json(strong), nlohmann::json(plain));
+    } else {
+      EXPECT_EQ(nlohmann::json(strong), nlohmann::json(plain));
+      EXPECT_EQ(nlohmann::json(one), nlohmann::json(plain));
+    }
+    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true);
+    ASSERT_EQ(m.grey_candidates.size(), 3u);
+    EXPECT_EQ(nlohmann::json(m.grey_candidates[2]), nlohmann::json(days < 20 ? one : m.grey))
+        << days << " days";
+  }
+  EXPECT_EQ(ToString(GreyCandidate::kShortPrior), "grey_short_prior");
+  EXPECT_EQ(OptInRowName(kOffsetCandidateCount + kGreyCandidateCount - 1), "grey_guarded");
 }
 
 // LeadDays counts the calendar days with a lead reading: not a probe-only day, not a lead

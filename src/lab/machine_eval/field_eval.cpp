@@ -28,6 +28,7 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.control = ShopControlModels(m.shop.sensors, record.day_logs);
   m.records = static_cast<int>(record.records.size());
+  m.lead_days = static_cast<int>(drift::LeadDays(record).size());
   for (const auto& r : record.records) m.readings += static_cast<int>(r.rows.size());
   return m;
 }
@@ -378,6 +379,9 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
       e.guard_choice.push_back(shop.guard.keep_grey      ? "both_grey"
                                : shop.rule_is_schedule ? "schedule"
                                                        : "warmup");
+    e.grey_fit.push_back({shop.grey.prior_strength, shop.grey.blank_tau_min,
+                          shop.grey.cv_rmse_um, shop.grey.time_constants,
+                          models[i].lead_days});
     e.screws.insert(e.screws.end(), per[i].begin(), per[i].end());
   }
   e.summary = SummarizeMachineEval(e.screws);

@@ -51,6 +51,7 @@ struct FieldEvalOptions {
 struct FieldMachineModels {
   ShopModels shop;
   int records = 0, readings = 0;
+  int lead_days = 0;                       ///< calendar days with a lead record (drift::LeadDays)
   double z_ref_mm = 0;                     ///< reference of the slope (the Z screw's fixed bearing)
   std::vector<PastLeadSlope> lead_slopes;  ///< the lead-slope rule's past screws
   ProbeMonitor monitor;  ///< both_shop_monitor: the sensor model's offset channel and its ranges

@@ -131,11 +131,13 @@ double WarmupOffsetShare(OffsetCandidate c);
 /// FieldGreyCandidate); + that grey box once the record holds 2 x forward_days lead days,
 /// both_grey's before (grey_sensors_by_days, shop_models.h EverySensorByDays); or + both_grey's
 /// grey box or the sensor-free base rule (warmup or schedule), whichever the shop's own last
-/// lead days favour (grey_guarded, GuardGreyBox). All count as using sensors; never the
+/// lead days favour (grey_guarded, GuardGreyBox); the twelfth round's both_grey with the prior
+/// strength fixed at 1 below 2 x forward_days lead days (grey_short_prior, shop_models.h
+/// ShortRecordStrongPrior), before grey_guarded. All count as using sensors; never the
 /// strongest sensor-free row.
-enum class GreyCandidate { kAllSensors, kSensorsByDays, kGuarded };
-inline constexpr std::size_t kGreyCandidateCount = 3;
-/// grey_all_sensors, grey_sensors_by_days, grey_guarded
+enum class GreyCandidate { kAllSensors, kSensorsByDays, kShortPrior, kGuarded };
+inline constexpr std::size_t kGreyCandidateCount = 4;
+/// grey_all_sensors, grey_sensors_by_days, grey_short_prior, grey_guarded
 std::string ToString(GreyCandidate c);
 /// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
 std::string OptInRowName(std::size_t k);
@@ -216,6 +218,15 @@ struct MachineEvaluation {
   /// Per machine, when the opt-in grey rows were asked for: what grey_guarded applies
   /// ("both_grey", "warmup" or "schedule"; shop_models.h GuardGreyBox); else empty.
   std::vector<std::string> guard_choice;
+  /// Per machine, what the grey box's fit chose (drift::GreyBoxModel): the prior strength, the
+  /// lags' time constants [min], the blank's [min], the validation RMSE [um], and the record's
+  /// lead days (drift::LeadDays); strength 0 and no lag where no grey box was fitted.
+  struct GreyFit {
+    double prior_strength = 0, blank_tau_min = 0, cv_rmse_um = 0;
+    std::vector<double> time_constants_min;
+    int lead_days = 0;
+  };
+  std::vector<GreyFit> grey_fit;
   std::vector<MachineEvalScrew> screws;
   MachineEvalSummary summary;
   std::optional<ReportScrew> report;  ///< when asked for (FieldEvalOptions::keep_report_screw)

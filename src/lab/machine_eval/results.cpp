@@ -38,7 +38,8 @@ double WarmupOffsetShare(OffsetCandidate c) {
 }
 
 std::string ToString(GreyCandidate c) {
-  static const char* kNames[] = {"grey_all_sensors", "grey_sensors_by_days", "grey_guarded"};
+  static const char* kNames[] = {"grey_all_sensors", "grey_sensors_by_days", "grey_short_prior",
+                                 "grey_guarded"};
   return kNames[static_cast<int>(c)];
 }
 
@@ -123,6 +124,13 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
     }
     screws.push_back(x);
   }
+  nlohmann::json grey_fit = nlohmann::json::array();
+  for (const auto& g : e.grey_fit)
+    grey_fit.push_back({{"prior_strength", g.prior_strength},
+                        {"time_constants_min", g.time_constants_min},
+                        {"blank_tau_min", g.blank_tau_min},
+                        {"cv_rmse_um", g.cv_rmse_um},
+                        {"lead_days", g.lead_days}});
   j = {{"schema", "whirl.machine_evaluate_run"},
        {"schema_version", 1},
        {"summary",
@@ -135,6 +143,7 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
        {"sensor_model_sensors", e.sensors},
        {"sensor_model_choice", e.sensors_choice},
        {"grey_guarded_choice", e.guard_choice},
+       {"grey_fit", grey_fit},
        {"screws", screws}};
 }
 

@@ -160,6 +160,11 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   // A short record's m.grey is the five sensors' model, with or without grey_five_sensors.
   drift::GreyBoxModel by_days = long_record ? m.grey_candidates[0] : m.grey;
   m.grey_candidates.push_back(std::move(by_days));
+  // The twelfth round's row: both_grey's model, the strength fixed at 1 on a short record (on a
+  // long one the option does nothing: both_grey's model itself).
+  m.grey_candidates.push_back(
+      long_record ? m.grey
+                  : drift::FitGreyBox(record, applied, ShortRecordStrongPrior(grey_options)));
   // The guard scores the model it would apply: both_grey's (its sensors, its options).
   const GuardScore g =
       GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
@@ -175,6 +180,11 @@ GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
     if (s != kBlankContactSensor) f.spec.offset_sensors.push_back(s);
   f.spec.slope_sensors = f.spec.offset_sensors;
   return f;
+}
+
+drift::GreyBoxOptions ShortRecordStrongPrior(drift::GreyBoxOptions options) {
+  options.short_record_strength_grid = {1.0};
+  return options;
 }
 
 bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOptions& options) {

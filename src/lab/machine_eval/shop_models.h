@@ -43,7 +43,8 @@ struct ShopModels {
   drift::GreyBoxModel grey;
   /// The opt-in grey boxes, fitted only when asked for and where the grey box is, in
   /// GreyCandidate's order: grey_all_sensors (FieldGreyCandidate), grey_sensors_by_days (a copy
-  /// of that model or of `grey`, by EverySensorByDays).
+  /// of that model or of `grey`, by EverySensorByDays), grey_short_prior (`grey`'s spec and
+  /// options with ShortRecordStrongPrior; a copy of `grey` on a long record).
   std::vector<drift::GreyBoxModel> grey_candidates;
   bool rule_is_schedule = false;  ///< the sensor-free base (schedule, else warmup) by its CV
   /// The ninth round's guard (grey_guarded: GuardGreyBox), chosen only when the opt-in grey
@@ -93,6 +94,12 @@ GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
 /// chaining (drift::ScoresForward: 2 x forward_days), the field grey box's five sensors before
 /// (every sensor pays on a short record and gains on a long one).
 bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOptions& options);
+/// The twelfth round's row (grey_short_prior; docs/machine-evaluation.md "Twelfth round:
+/// split"): `options` with the prior strength fixed at 1 while the record holds fewer than
+/// 2 x forward_days lead days (drift::GreyBoxOptions::short_record_strength_grid = {1}: the
+/// physical prior weighs as much as the data where 5 held-out days cannot choose a strength);
+/// unchanged from 2 x forward_days lead days on.
+drift::GreyBoxOptions ShortRecordStrongPrior(drift::GreyBoxOptions options);
 
 /// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split"): the
 /// grey box or a sensor-free rule, chosen on the shop's own record in time order. For each of

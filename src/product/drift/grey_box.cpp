@@ -21,6 +21,8 @@ void GreyBoxOptions::Validate() const {
   positive(tau_grid, "tau_grid");
   positive(blank_tau_grid, "blank_tau_grid");
   positive(strength_grid, "strength_grid");
+  if (!short_record_strength_grid.empty())
+    positive(short_record_strength_grid, "short_record_strength_grid");
   if (max_lags < 0 || max_lags > 4)
     throw InputError("grey box: max_lags = " + std::to_string(max_lags) + ": must be within 0..4");
   if (forward_days < 2 || forward_days > 100)
@@ -291,8 +293,9 @@ double Score(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
 Choice Choose(const ShopRecord& rec, const GreyBoxSpec& spec, const GreyBoxOptions& o,
               double* cv) {
   Choice c;
+  const std::vector<double>& strengths = StrengthGrid(rec, o);
   c.blank_tau = o.blank_tau_grid[o.blank_tau_grid.size() / 2];
-  c.strength = o.strength_grid[o.strength_grid.size() / 2];
+  c.strength = strengths[strengths.size() / 2];
   double current = Score(rec, spec, c, o);
   while (static_cast<int>(c.taus.size()) < o.max_lags) {
     double best = current, pick = 0;
@@ -318,7 +321,7 @@ Choice Choose(const ShopRecord& rec, const GreyBoxSpec& spec, const GreyBoxOptio
     }
   };
   if (!spec.blank_sensor.empty()) pick_best(&Choice::blank_tau, o.blank_tau_grid);
-  pick_best(&Choice::strength, o.strength_grid);
+  pick_best(&Choice::strength, strengths);
   *cv = current;
   return c;
 }
@@ -335,6 +338,14 @@ std::vector<int> LeadDays(const ShopRecord& record) {
 bool ScoresForward(const ShopRecord& record, const GreyBoxOptions& options) {
   return options.validation == GreyValidation::kForwardLeads &&
          LeadDays(record).size() >= 2 * static_cast<std::size_t>(options.forward_days);
+}
+
+const std::vector<double>& StrengthGrid(const ShopRecord& record, const GreyBoxOptions& options) {
+  const bool short_record =
+      LeadDays(record).size() < 2 * static_cast<std::size_t>(options.forward_days);
+  return short_record && !options.short_record_strength_grid.empty()
+             ? options.short_record_strength_grid
+             : options.strength_grid;
 }
 
 GreyBoxModel FitGreyBox(const ShopRecord& record, const GreyBoxSpec& spec,

@@ -90,6 +90,11 @@ struct GreyBoxOptions {
   /// error follows a reading at once, and the instant column carries the reading's noise into
   /// the compensation. With no lag chosen the instant columns stay. Duty inputs are not affected.
   bool instant_offset_inputs = true, instant_slope_inputs = true;
+  /// On a record with fewer than 2 x forward_days lead days (LeadDays; whatever the
+  /// validation), the strength is chosen from this grid instead of strength_grid (each > 0);
+  /// empty: strength_grid on every record. {1}: the physics weighs as much as the data where 5
+  /// held-out days cannot choose (issue 41's twelfth round, docs/machine-evaluation.md).
+  std::vector<double> short_record_strength_grid;
   void Validate() const;    ///< InputError naming the field and the rule
 };
 
@@ -127,6 +132,9 @@ std::vector<int> LeadDays(const ShopRecord& record);
 /// Whether FitGreyBox scores its choices by forward chaining on `record`: kForwardLeads and at
 /// least 2 x forward_days lead days (LeadDays); else leave one day out.
 bool ScoresForward(const ShopRecord& record, const GreyBoxOptions& options);
+/// The strengths FitGreyBox chooses from on `record`: short_record_strength_grid when it is set
+/// and the record holds fewer than 2 x forward_days lead days, else strength_grid.
+const std::vector<double>& StrengthGrid(const ShopRecord& record, const GreyBoxOptions& options);
 
 /// InputError: an invalid record, a missing column, no sensor, bad options, or fewer readings
 /// than unknowns.
