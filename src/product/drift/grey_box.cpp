@@ -335,15 +335,16 @@ std::vector<int> LeadDays(const ShopRecord& record) {
   return {days.begin(), days.end()};
 }
 
+bool LongRecord(const ShopRecord& record, const GreyBoxOptions& options) {
+  return LeadDays(record).size() >= 2 * static_cast<std::size_t>(options.forward_days);
+}
+
 bool ScoresForward(const ShopRecord& record, const GreyBoxOptions& options) {
-  return options.validation == GreyValidation::kForwardLeads &&
-         LeadDays(record).size() >= 2 * static_cast<std::size_t>(options.forward_days);
+  return options.validation == GreyValidation::kForwardLeads && LongRecord(record, options);
 }
 
 const std::vector<double>& StrengthGrid(const ShopRecord& record, const GreyBoxOptions& options) {
-  const bool short_record =
-      LeadDays(record).size() < 2 * static_cast<std::size_t>(options.forward_days);
-  return short_record && !options.short_record_strength_grid.empty()
+  return !LongRecord(record, options) && !options.short_record_strength_grid.empty()
              ? options.short_record_strength_grid
              : options.strength_grid;
 }

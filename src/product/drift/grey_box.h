@@ -129,8 +129,11 @@ struct GreyBoxModel {
 
 /// The calendar days that hold a lead reading (a lead record with a row), ascending.
 std::vector<int> LeadDays(const ShopRecord& record);
-/// Whether FitGreyBox scores its choices by forward chaining on `record`: kForwardLeads and at
-/// least 2 x forward_days lead days (LeadDays); else leave one day out.
+/// Whether `record` holds at least 2 x forward_days lead days (LeadDays): long enough for
+/// forward chaining, and where short_record_strength_grid no longer applies.
+bool LongRecord(const ShopRecord& record, const GreyBoxOptions& options);
+/// Whether FitGreyBox scores its choices by forward chaining on `record`: kForwardLeads and a
+/// LongRecord; else leave one day out.
 bool ScoresForward(const ShopRecord& record, const GreyBoxOptions& options);
 /// The strengths FitGreyBox chooses from on `record`: short_record_strength_grid when it is set
 /// and the record holds fewer than 2 x forward_days lead days, else strength_grid.
