@@ -8,7 +8,7 @@
 //                [--gp-length-prior-sd SD] [--gp-max-rows N] [--gp-loo-penalty F]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N] [--gp-slot-large held-out|evidence|bic]
 //                [--fold-partitions P] [--fresh-partition-sd] [--fresh-sd-weight W]
-//                [--anchor-small first|bic|bic-weights]
+//                [--anchor-small first|bic|bic-weights] [--same-scale-gp-bic] [--gp-noise-prior-small]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -151,6 +151,10 @@ Args Parse(int argc, char** argv) {
       a.choice.fresh_partition_sd = true;
     else if (k == "--fresh-sd-weight")
       a.choice.fresh_sd_weight = std::stod(value());
+    else if (k == "--same-scale-gp-bic")
+      a.choice.same_scale_gp_bic = true;
+    else if (k == "--gp-noise-prior-small")
+      a.choice.gp_noise_prior_small = true;
     else if (k == "--anchor-small") {
       const std::string v = value();
       using whirl::family::Anchor;

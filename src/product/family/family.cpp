@@ -906,19 +906,40 @@ int HighestEvidenceGp(const ChoiceOptions& o, const GpEvidence& ev, int k) {
   return best;
 }
 
+// ChoiceOptions::same_scale_gp_bic: `kept` without the GP candidates of output k whose BIC in
+// `ev` is below that of another GP candidate of `o` on the same column scale (Candidate::log; of
+// equal ones the first stays).
+std::vector<int> WithTheHighestBicPerScale(const std::vector<int>& kept, const ChoiceOptions& o,
+                                           const GpEvidence& ev, int k) {
+  const auto is_gp = [&](std::size_t c) {
+    return o.candidates[c].family == Family::kGaussianProcess;
+  };
+  std::vector<int> out;
+  for (int c : kept) {
+    const std::size_t u = static_cast<std::size_t>(c);
+    bool beaten = false;
+    for (std::size_t b = 0; b < o.candidates.size() && is_gp(u); ++b)
+      beaten = beaten || (b != u && is_gp(b) && o.candidates[b].log == o.candidates[u].log &&
+                          (ev[b][k] > ev[u][k] || (ev[b][k] == ev[u][k] && b < u)));
+    if (!beaten) out.push_back(c);
+  }
+  return out;
+}
+
 // ChoiceOptions::lowest_gp: `kept` without its GP candidates except the one with the lowest
 // held-out error of output k (the first of equal ones), which keeps its place; with
 // lowest_gp_per_scale below few_rows rows (lowest_gp_per_scale_large from few_rows on) one such
-// GP per column scale (Candidate::log); with `ev` (ChoiceOptions::gp_slot_large) the GP of
-// highest evidence among all GP candidates instead, if it is in `kept`.
+// GP per column scale (Candidate::log); with `ev` from few_rows rows (ChoiceOptions::gp_slot_large)
+// the GP of highest evidence among all GP candidates instead, if it is in `kept`; with `ev` below
+// few_rows (ChoiceOptions::same_scale_gp_bic) the lowest among WithTheHighestBicPerScale.
 std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
                                      const std::vector<Eigen::MatrixXd>& err,
                                      const ChoiceOptions& o, int k, const GpEvidence& ev) {
-  if (!ev.empty()) return WithOneGp(kept, o, HighestEvidenceGp(o, ev, k));
-  const bool per_scale = err.front().cols() < o.few_rows ? o.lowest_gp_per_scale
-                                                         : o.lowest_gp_per_scale_large;
+  const bool small = err.front().cols() < o.few_rows;
+  if (!ev.empty() && !small) return WithOneGp(kept, o, HighestEvidenceGp(o, ev, k));
+  const bool per_scale = small ? o.lowest_gp_per_scale : o.lowest_gp_per_scale_large;
   std::array<int, 2> best = {-1, -1};  // [log]; one slot without per_scale
-  for (int c : kept) {
+  for (int c : ev.empty() ? kept : WithTheHighestBicPerScale(kept, o, ev, k)) {
     int& b = best[per_scale && o.candidates[c].log ? 1 : 0];
     if (o.candidates[c].family == Family::kGaussianProcess &&
         (b < 0 || err[c].row(k).squaredNorm() < err[b].row(k).squaredNorm()))
@@ -997,6 +1018,14 @@ ChoiceOptions ActiveCandidates(const ChoiceOptions& given, int rows, int folds, 
           std::to_string(split) + " rows are fewer than a linear fit in " +
           std::to_string(inputs) + " inputs needs (" + std::to_string(need) + ")";
   return active;
+}
+
+// ChoiceOptions::gp_noise_prior_small: below few_rows rows the GPs' noise prior (sd 1 unless
+// fit.gp gives one).
+ChoiceOptions WithSmallTableNoisePrior(ChoiceOptions o, int rows) {
+  if (o.gp_noise_prior_small && rows < o.few_rows && o.fit.gp.noise_prior_sd == 0)
+    o.fit.gp.noise_prior_sd = 1;
+  return o;
 }
 
 // Choice::warnings: the constant inputs left out, and the columns the log candidates keep raw.
@@ -1205,8 +1234,25 @@ GpEvidence GpEvidenceOf(const ChoiceOptions& o, const std::vector<FamilyModel>& 
 
 // ChoiceOptions::gp_slot_large on a table of `rows` rows: GpEvidence of the GP candidates of
 // `full` (fitted on all rows from few_rows on); empty where the held-out errors give the slot.
-GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows) {
-  if (o.gp_slot_large == GpSlot::kHeldOut || rows < o.few_rows) return {};
+// Below few_rows: with ChoiceOptions::same_scale_gp_bic (and lowest_gp) the BIC of the GPs that
+// share a column scale with another GP candidate (fitted on all rows: `complete`), -infinity for
+// the others (GpEvidenceOf of an unfitted GP).
+GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows,
+                        const std::function<void(int)>& complete) {
+  if (rows < o.few_rows) {
+    if (!o.same_scale_gp_bic || !o.lowest_gp) return {};
+    const int nc = static_cast<int>(o.candidates.size());
+    for (int c = 0; c < nc; ++c)
+      for (int b = 0; b < nc; ++b)
+        if (b != c && o.candidates[c].family == Family::kGaussianProcess &&
+            o.candidates[b].family == Family::kGaussianProcess &&
+            o.candidates[b].log == o.candidates[c].log) {
+          complete(c);
+          break;
+        }
+    return GpEvidenceOf(o, full, GpSlot::kBic);
+  }
+  if (o.gp_slot_large == GpSlot::kHeldOut) return {};
   return GpEvidenceOf(o, full, o.gp_slot_large);
 }
 
@@ -1352,8 +1398,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   TableTransform used;
   const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
   std::string rows_note;
-  const ChoiceOptions options =
-      ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note);
+  const ChoiceOptions options = WithSmallTableNoisePrior(
+      ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note), rows);
   const int nc = static_cast<int>(options.candidates.size());
   std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
                                    Eigen::MatrixXd(Features::kCount, rows));
@@ -1410,7 +1456,6 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
                             pending, partitions);
   const std::vector<Eigen::MatrixXd> judged =
       JudgedErrors(partitions > 1 ? RmsOverPartitions(parts) : err, full, refitted, options);
-  const GpEvidence ev = SlotEvidence(options, full, rows);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   // An output whose targets are all equal has nothing to choose on: it stays out of the score
   // (its MSE over a zero variance would only be a huge number; TableWarnings names it).
@@ -1441,6 +1486,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     choice.table[c].fit_ms +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
+  const GpEvidence ev = SlotEvidence(options, full, rows, complete);
   std::array<Eigen::VectorXd, Features::kCount> stack;
   const bool anchored = AnchorApplies(options, rows, partitions);
   GpEvidence gp_bic;

@@ -496,6 +496,24 @@ struct ChoiceOptions {
   /// tuning part, most on non-linear families, where the power law's log-normal density
   /// outranked a raw-column GP whose mean predicted better ("Sixteenth attempt").
   Anchor anchor_small = Anchor::kFirst;
+  /// With lowest_gp, below few_rows rows (GPs judged by K-fold refits): of the GP candidates on
+  /// the same column scale (Candidate::log; by default the two on raw columns, Matern 5/2 and
+  /// squared-exponential) only the one of highest BIC (GpLogEvidence - (q / 2) ln n, each fitted
+  /// on all rows for it, as gp_slot_large's kBic) takes part; a GP alone on its scale takes part
+  /// as now. The gate against the first candidate, the one GP slot (lowest held-out error, or one
+  /// per scale with lowest_gp_per_scale) and the weights then go by held-out errors as without
+  /// it. Why: the 20-row slot was the lowest of three noisy 5-fold refit errors, a minimum that
+  /// is optimistic (docs/workpiece-model.md, "Thirteenth attempt: diagnosis at 20 rows"); two GPs
+  /// of one column scale are densities of the same output with the same noise model, which BIC
+  /// may rank, unlike a log-normal and a Gaussian one ("Sixteenth attempt"). Opt-in
+  /// (docs/workpiece-model.md, "Seventeenth attempt").
+  bool same_scale_gp_bic = false;
+  /// Below few_rows rows: every GP fit of the choice (refits and fits on all rows) maximizes its
+  /// likelihood times gp::GpOptions' noise prior, ln s_n^2 ~ N(-4, 1) in standardized target
+  /// units (noise_prior_sd 1 unless fit.gp sets one), so that 20 rows cannot make a GP take noise
+  /// for signal; from few_rows rows fit.gp as given. Opt-in (docs/workpiece-model.md,
+  /// "Seventeenth attempt").
+  bool gp_noise_prior_small = false;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
