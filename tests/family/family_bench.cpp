@@ -8,7 +8,8 @@
 //                [--gp-length-prior-sd SD] [--gp-max-rows N] [--gp-loo-penalty F]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N] [--gp-slot-large held-out|evidence|bic]
 //                [--fold-partitions P] [--fresh-partition-sd] [--fresh-sd-weight W]
-//                [--anchor-small first|bic|bic-weights] [--same-scale-gp-bic] [--gp-noise-prior-small]
+//                [--anchor-small first|bic|bic-weights] [--same-scale-gp-bic]
+//                [--gp-noise-prior-small]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>

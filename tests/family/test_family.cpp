@@ -1480,5 +1480,94 @@ TEST(FamilyAnchor, LeavesEightRowsAndFromFewRowsAsTheyAreAndGivesTheSameFileTwic
   EXPECT_GT(differs, 0);
 }
 
+ChoiceOptions NoisePriorSmall() {
+  ChoiceOptions o;
+  o.gp_noise_prior_small = true;
+  return o;
+}
+
+// ChoiceOptions::gp_noise_prior_small changes nothing on 8- and 9-row tables (no GP) and from
+// few_rows (70) rows (the file of the default byte for byte); it is off by default.
+TEST(FamilyNoisePrior, LeavesEightRowsAndFromFewRowsAsTheyAre) {
+  EXPECT_FALSE(ChoiceOptions().gp_noise_prior_small);
+  EXPECT_EQ(ChoiceOptions().fit.gp.noise_prior_sd, 0.0);
+  for (const ProcessTable& t : {MakeTable(8, 0.05, 3), MakeTable(9, 0.05, 4),
+                                test::MakeBentTable(70, 0.05, 0.5, 2),
+                                MakeTable(70, 0.05, 5, true)})
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, NoisePriorSmall())).dump(),
+              nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump())
+        << t.inputs.size() << " rows";
+}
+
+// At 20 rows every GP of the choice is the fit of its candidate with gp::GpOptions' noise prior
+// (sd 1, mean -4) on all rows, hyperparameters bit for bit, and not the fit without it; the same
+// file twice and with two threads, another file than the default's on some of these tables.
+TEST(FamilyNoisePrior, GpsBelowFewRowsAreFittedWithTheNoisePrior) {
+  FitOptions with_prior;
+  with_prior.gp.noise_prior_sd = 1;
+  int gps = 0, differs = 0;
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    const ProcessTable t =
+        seed == 1 ? LogisticTable(20, 0.5, seed) : MakeTable(20, 0.03, seed, true);
+    ChoiceOptions o = NoisePriorSmall();
+    const Choice c = ChooseFamily(t, o);
+    for (const FamilyModel& m : c.models) {
+      if (m.candidate.family != Family::kGaussianProcess) continue;
+      const FamilyModel prior = FitCandidate(t, m.candidate, with_prior, false),
+                        none = FitCandidate(t, m.candidate, FitOptions{}, false);
+      ASSERT_EQ(m.gps.size(), prior.gps.size());
+      for (std::size_t k = 0; k < m.gps.size(); ++k) {
+        EXPECT_EQ(m.gps[k].theta, prior.gps[k].theta) << m.candidate.Name() << " output " << k;
+        EXPECT_NE(m.gps[k].theta, none.gps[k].theta) << m.candidate.Name() << " output " << k;
+        ++gps;
+      }
+    }
+    const std::string file = nlohmann::json(c).dump();
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+    o.fit.threads = 2;
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+    differs += file != nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump();
+  }
+  EXPECT_GT(gps, 0) << "no GP in the choices: the test cannot fail";
+  EXPECT_GT(differs, 0);
+}
+
+// ChoiceOptions::same_scale_gp_bic at 20 rows: of the two raw-column GPs at most the one of
+// higher BIC (GpLogEvidence - (q / 2) ln n of each fitted on all rows, written out here) has
+// weight in an output; nothing changes on 8-9 rows and from few_rows rows.
+TEST(FamilySameScaleBic, OnlyTheRawGpOfHigherBicTakesPart) {
+  ChoiceOptions o;
+  o.same_scale_gp_bic = true;
+  for (const ProcessTable& t : {MakeTable(8, 0.05, 3), test::MakeBentTable(70, 0.05, 0.5, 2)})
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(),
+              nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump());
+  const Candidate m52 = ParseCandidate("gp-matern52-constant/identity"),
+                  se = ParseCandidate("gp-se-constant/identity");
+  int raw_weighted = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const ProcessTable t =
+        seed <= 2 ? LogisticTable(20, 0.5, seed) : MakeTable(20, 0.1, seed, true);
+    const Choice c = ChooseFamily(t, o);
+    const FamilyModel fm = FitCandidate(t, m52, o.fit, false),
+                      fs = FitCandidate(t, se, o.fit, false);
+    for (int k = 0; k < 2; ++k) {
+      const double n = 20, q = 7 + 1;  // 5 lengths, signal, noise; the constant mean
+      const bool m52_higher = GpLogEvidence(fm, k) - 0.5 * q * std::log(n) >=
+                              GpLogEvidence(fs, k) - 0.5 * q * std::log(n);
+      for (std::size_t j = 0; j < c.models.size(); ++j) {
+        const double w = c.weights[k].empty()
+                             ? (c.model_of_output[k] == static_cast<int>(j) ? 1.0 : 0.0)
+                             : c.weights[k][j];
+        const std::string name = c.models[j].candidate.Name();
+        if (w <= 0 || (name != m52.Name() && name != se.Name())) continue;
+        EXPECT_EQ(name, m52_higher ? m52.Name() : se.Name())
+            << "seed " << seed << ": " << c.Describe();
+        ++raw_weighted;
+      }
+    }
+  }
+  EXPECT_GT(raw_weighted, 0) << "no raw-column GP with weight: the test cannot fail";
+}
+
 }  // namespace
 }  // namespace whirl::family
