@@ -215,9 +215,15 @@ void SetupPredict(CLI::App& parent) {
   sub->add_option("--surface", o->surface, "surface JSON from 'whirl surface fit'")
       ->required()
       ->check(CLI::ExistingFile);
-  AddDeprecatedAlias(sub, sub->add_option("--x-mm", o->x, "table X, mm")->check(FiniteNumber("mm")),
+  AddDeprecatedAlias(sub,
+                     sub->add_option("--x-mm", o->x,
+                                     "table X, mm (with --y-mm, instead of --input)")
+                         ->check(FiniteNumber("mm")),
                      "--x");
-  AddDeprecatedAlias(sub, sub->add_option("--y-mm", o->y, "table Y, mm")->check(FiniteNumber("mm")),
+  AddDeprecatedAlias(sub,
+                     sub->add_option("--y-mm", o->y,
+                                     "table Y, mm (with --x-mm, instead of --input)")
+                         ->check(FiniteNumber("mm")),
                      "--y");
   sub->add_option("--input", o->input, "CSV of positions x_mm,y_mm (at most 10000 rows)")
       ->check(CLI::ExistingFile);
