@@ -41,6 +41,11 @@ grep -Eq "::|kDefault" "$D/help.txt" && fail "fit --help names internals: $(grep
 "$W" curve --max-elongation-um 30 --settle-time-s 250 --duration-s 300 --out "$D/short.csv" || fail "short curve"
 "$W" fit --curve "$D/short.csv" > /dev/null 2> "$D/short.err" || fail "fit short"
 grep -q "at least twice the settle time" "$D/short.err" || fail "short record: $(cat "$D/short.err")"
+# Its numbers are message numbers (6 significant digits, core/numbers.h MessageNumber), not a
+# file's round-trip digits (L = 15.77392385154572 um).
+grep -Eq "[0-9]{7}" "$D/short.err" && fail "short record: round-trip digits in the warning: $(cat "$D/short.err")"
+"$W" fit --curve "$D/short.csv" --json > "$D/short.json" 2> /dev/null || fail "fit short --json"
+grep -Eq '"criterion": "[^"]*[0-9]{7}' "$D/short.json" && fail "round-trip digits in the criterion: $(grep criterion "$D/short.json")"
 expect_fail "time-exponent" "$W" curve --max-elongation-um 3 --settle-time-s 100 --time-exponent 1.2
 
 # Bad curves: a gap, non-increasing time, a missing file.
