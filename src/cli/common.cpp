@@ -352,8 +352,7 @@ void SetHelpRecursively(CLI::App* app, const std::shared_ptr<CLI::FormatterBase>
   // where the shipped files come from (and how to point at them).
   if (app->get_footer().empty())
     app->footer("Documentation: " + CommandDocsPage(app) +
-                " (terms, methods, figures); every flag: docs/commands.md.\n" +
-                kShippedFilesHelp);
+                " (terms, methods, figures); every flag: docs/commands.md.\n" + kShippedFilesHelp);
   for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; }))
     SetHelpRecursively(sub, formatter);
 }
