@@ -76,8 +76,11 @@ void RegisterDataset(CLI::App& app) {
       "speed 150-210 m/min), feasible screws only, each simulated on the reference blank and\n"
       "reduced to max_elongation_um (um) and settle_time_s (s). Disturbances ON unless\n"
       "--no-disturbances. Progress on stderr.");
-  sub->add_option("--count", opts->count, "number of rows")->check(NumberIn(1, 100000));
-  AddSeedOption(sub, &opts->seed, "seed of the design shift and of the disturbances");
+  sub->add_option("--count", opts->count, "number of rows")
+      ->check(NumberIn(1, 100000))
+      ->capture_default_str();
+  AddSeedOption(sub, &opts->seed, "seed of the design shift and of the disturbances")
+      ->capture_default_str();
   sub->add_option("--out", opts->out_path, "output CSV (inputs, then targets), written atomically")
       ->required();
   sub->add_option("--curves-dir", opts->curves_dir,
@@ -85,8 +88,11 @@ void RegisterDataset(CLI::App& app) {
                   "with the table all-or-nothing (" +
                       std::string(kOutputDirRule) + ")");
   sub->add_option("--window-s", opts->window_s, "simulated time per row in s")
-      ->check(PositiveNumber());
-  sub->add_option("--threads", opts->threads, "worker threads")->check(NumberIn(1, 64));
+      ->check(PositiveNumber())
+      ->capture_default_str();
+  sub->add_option("--threads", opts->threads, "worker threads")
+      ->check(NumberIn(1, 64))
+      ->capture_default_str();
   sub->add_flag("--no-disturbances", opts->no_disturbances,
                 "pure physics (no noise, no variation)");
   sub->add_flag("--json", opts->json,

@@ -487,10 +487,12 @@ void RegisterDesign(CLI::App& app) {
                   "design")
       ->check(CLI::ExistingFile);
   sub->add_option("--tolerance-um", o->tolerance_um,
-                  "stop rule: tolerated RMS predictive sd of max elongation over the list [um]")
+                  "stop rule: tolerated RMS predictive sd of max elongation over the list [um] "
+                  "(default: no stop rule for it)")
       ->check(PositiveNumber("um"));
   sub->add_option("--tolerance-s", o->tolerance_s,
-                  "stop rule: tolerated RMS predictive sd of settle time over the list [s]")
+                  "stop rule: tolerated RMS predictive sd of settle time over the list [s] "
+                  "(default: no stop rule for it)")
       ->check(PositiveNumber("s"));
   sub->add_option("--out", o->out_path, "write the picked screws as CSV (rank, source line, "
                                         "inputs, sd columns, why)");

@@ -293,7 +293,7 @@ void RegisterEvaluate(CLI::App& app) {
   sub->add_option("--require-median-pct", o->require_median_pct,
                   "fail (exit 2) if the median reduction of the accumulated error within 1000 mm "
                   "against traditional is below this, or if any screw's comparison failed, "
-                  "percent (target: 85)")
+                  "percent (target: 85; default: no check)")
       ->check(FiniteNumber("%"));
   sub->add_option("--scenarios", o->scenarios,
                   "named truth scenarios, comma-separated or 'all': today, heat-spread (heat "

@@ -44,7 +44,15 @@ nlohmann::json FitJson(const fit::CurveFit& f) {
 }
 
 void RunCurve(const FitOptions& o) {
-  const ElongationCurve record = ReadElongationCurve(o.curve_path, o.max_gap_factor);
+  ElongationCurve record = ReadElongationCurve(o.curve_path, o.max_gap_factor);
+  // Time 0 is the start of the cut: the features count from the first sample (fit/features.h),
+  // and so do the models (a logger's clock would shift their time axis).
+  const double t0 = record.time_s.front();
+  if (t0 != 0) {
+    for (double& t : record.time_s) t -= t0;
+    Warn(o.curve_path + ": time starts at " + MessageNumber(t0) +
+         " s: the first sample is taken as the start of the cut (time 0)");
+  }
   const fit::SettleAnalysis settle = fit::AnalyzeSettle(record);
   // The models describe the rise and the plateau it settles on; a long record's slow drift
   // (ambient, sensor) is not part of them, so they are fitted on [0, factor * t_s].
@@ -96,8 +104,8 @@ void RunCurve(const FitOptions& o) {
     return;
   }
   std::printf("curve %s: %zu samples, %.6g to %.6g s; models fitted on %.6g to %.6g s\n",
-              o.curve_path.c_str(), record.size(), record.time_s.front(), record.time_s.back(),
-              curve.time_s.front(), curve.time_s.back());
+              o.curve_path.c_str(), record.size(), t0 + record.time_s.front(),
+              t0 + record.time_s.back(), curve.time_s.front(), curve.time_s.back());
   std::printf("features: max elongation %.4f um, settle time %.2f s (settle criterion of "
               "docs/methods.md; these two go into table.csv)\n",
               settle.features.max_elongation_um, settle.features.settle_time_s);

@@ -271,7 +271,9 @@ void RegisterPlan(CLI::App& app) {
       ->check(NumberIn(1, 255));
   sub->add_option("--sync-id-last", o->sync_id_last,
                   "last synchronized-action ID whirl may use (1-255); the programs CANCEL the "
-                  "whole range first, so it must be the range the machine builder reserved")
+                  "whole range first, so it must be the range the machine builder reserved; no "
+                  "default: from the profile, or required with --sync-id-first for "
+                  "--nc/--reset-nc without one")
       ->check(NumberIn(1, 255));
   auto* save_r = sub->add_option("--save-r-first", o->save_r_first,
                                  "R<n>..R<n+3> keep the setting data found before the cut and a "

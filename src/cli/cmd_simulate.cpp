@@ -144,14 +144,17 @@ void RegisterSimulate(CLI::App& app) {
                   "write the recorded curve as CSV time_s,elongation_um (s, um), atomically");
   sub->add_option("--duration-s", opts->duration_s,
                   "simulated cutting time in s; 0 = the whole thread (hours)")
-      ->check(NonNegativeNumber());
+      ->check(NonNegativeNumber())
+      ->capture_default_str();
   sub->add_flag("--no-disturbances", opts->no_disturbances,
                 "pure physics: no workpiece variation, ambient drift or measurement noise");
   AddSeedOption(sub, &opts->seed, "seed of the disturbances (default 1)");
   sub->add_option("--cell-size-mm", opts->cell_size_mm, "finite-volume cell size in mm")
-      ->check(PositiveNumber());
+      ->check(PositiveNumber())
+      ->capture_default_str();
   sub->add_option("--time-step-s", opts->time_step_s, "BDF2 time step in s")
-      ->check(PositiveNumber());
+      ->check(PositiveNumber())
+      ->capture_default_str();
   sub->add_flag("--json", opts->json, "print the result as JSON on stdout");
   sub->callback([opts] { Run(*opts); });
 }

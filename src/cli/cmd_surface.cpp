@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -215,10 +216,16 @@ void SetupPredict(CLI::App& parent) {
   sub->add_option("--surface", o->surface, "surface JSON from 'whirl surface fit'")
       ->required()
       ->check(CLI::ExistingFile);
-  AddDeprecatedAlias(sub, sub->add_option("--x-mm", o->x, "table X, mm")->check(FiniteNumber("mm")),
-                     "--x");
-  AddDeprecatedAlias(sub, sub->add_option("--y-mm", o->y, "table Y, mm")->check(FiniteNumber("mm")),
-                     "--y");
+  AddDeprecatedAlias(
+      sub,
+      sub->add_option("--x-mm", o->x, "table X, mm (with --y-mm, instead of --input)")
+          ->check(NumberIn(kAxisPositionRange)),
+      "--x");
+  AddDeprecatedAlias(
+      sub,
+      sub->add_option("--y-mm", o->y, "table Y, mm (with --x-mm, instead of --input)")
+          ->check(NumberIn(kAxisPositionRange)),
+      "--y");
   sub->add_option("--input", o->input, "CSV of positions x_mm,y_mm (at most 10000 rows)")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", o->out, "CSV to write: x_mm,y_mm,error_um");
@@ -258,13 +265,13 @@ void SetupCompare(CLI::App& parent) {
       ->check(NumberIn(1, kMaxDegree));
   sub->add_option("--edge-ratio", o->choice.edge_ratio,
                   "edge / interior LOO RMS that flags oscillation (> 1, default 1.5)")
-      ->check(FiniteNumber());
+      ->check(NumberIn(Range{1, std::numeric_limits<double>::max(), true}));
   sub->add_option("--overshoot-fraction", o->choice.overshoot_fraction,
                   "overshoot / measured range that flags oscillation (> 0, default 0.1)")
-      ->check(FiniteNumber());
+      ->check(PositiveNumber());
   sub->add_option("--min-excess-um", o->choice.min_excess_um,
                   "smallest excess that flags oscillation, um (default 0.5)")
-      ->check(FiniteNumber("um"));
+      ->check(NonNegativeNumber("um"));
   sub->add_flag("--json", o->json, "machine output: JSON on stdout");
   sub->callback([o] { RunCompare(*o); });
 }
@@ -316,10 +323,10 @@ void SetupLine(CLI::App& parent) {
       ->check(FiniteNumber());
   sub->add_option("--ref-position-mm", o->ref_mm,
                   "reference position P0 in surface coordinates, mm (default: travel start)")
-      ->check(FiniteNumber());
+      ->check(NumberIn(kAxisPositionRange));
   sub->add_option("--machine-offset-mm", o->line.machine_offset_mm,
                   "MCS position of the surface's coordinate origin on this axis, mm (default 0)")
-      ->check(FiniteNumber());
+      ->check(NumberIn(kAxisPositionRange));
   sub->add_option("--sign", o->sign, "subtract (dK = -line, default) | add")
       ->check(CLI::IsMember({"subtract", "add"}));
   sub->add_option("--md32760", o->line.md32760,

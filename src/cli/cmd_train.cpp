@@ -23,6 +23,7 @@
 #include "core/numbers.h"
 #include "core/output_dir.h"
 #include "core/process.h"
+#include "family/transform.h"
 #include "nn/model.h"
 #include "nn/selection.h"
 #include "workpiece/model.h"
@@ -335,9 +336,22 @@ void RunFamily(const TrainCliOptions& o, const ProcessTable& table, workpiece::T
   std::cout << "  fit time " << FormatSignificant(fit_ms, 4) << " ms (choice, refits, calibration)\n";
 }
 
+// Refuses a table whose rows are all one screw type (every input equal in every row): no model
+// can learn how the inputs act from it, and a fit would claim certainty it does not have.
+void RequireVaryingInputs(const ProcessTable& table) {
+  family::TableTransform used;
+  if (family::LeaveOutConstantInputs(table, &used).size() < ProcessInputs::kCount) return;
+  throw InputError(table.source + ": every input is the same in every row (" +
+                   std::to_string(table.inputs.size()) +
+                   " rows of one screw type): a workpiece model learns how the five inputs act "
+                   "from screws that differ in them; add measured screws of other types "
+                   "('whirl design' says which)");
+}
+
 void Run(const TrainCliOptions& o) {
   CheckOutputs({{"--data", o.data_path}}, {{"--out", o.out_path}});
   const ProcessTable table = ReadProcessTable(o.data_path, /*require_targets=*/true);
+  RequireVaryingInputs(table);
   if (!o.hidden_sweep.empty()) {
     RunSweep(o, table);
     return;

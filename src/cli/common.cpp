@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -310,10 +311,48 @@ class OneLineFormatter : public CLI::Formatter {
   CommandSummaries summaries_;
 };
 
+// The docs page that explains a command's terms, methods and figures: its command path, else
+// its first word, else the index.
+std::string CommandDocsPage(const CLI::App* app) {
+  static const std::map<std::string, std::string> pages = {
+      {"demo", "README.md"},
+      {"dataset", "simulator.md"},
+      {"simulate", "simulator.md"},
+      {"train", "workpiece-model.md"},
+      {"predict", "workpiece-model.md"},
+      {"design", "design.md"},
+      {"curve", "methods.md"},
+      {"fit", "methods.md"},
+      {"plan", "840d.md"},
+      {"compare", "results.md"},
+      {"evaluate", "results.md"},
+      {"lead-report", "methods.md"},
+      {"ballbar", "ballbar.md"},
+      {"surface", "surface.md"},
+      {"drift", "drift-sensors.md"},
+      {"drift split", "drift.md"},
+      {"drift fit-grey", "machine-evaluation.md"},
+      {"drift nc", "840d.md"},
+      {"machine", "machine.md"},
+      {"machine truth", "machine-truth.md"},
+      {"machine evaluate", "machine-evaluation.md"},
+      {"machine export", "machine-evaluation.md"},
+      {"machine ceiling", "machine-evaluation.md"},
+      {"crosscheck", "network.md"},
+      {"export", "network.md"}};
+  const std::string path = CommandPath(app);
+  auto it = pages.find(path);
+  if (it == pages.end()) it = pages.find(path.substr(0, path.find(' ')));
+  return "docs/" + (it != pages.end() ? it->second : std::string("README.md"));
+}
+
 void SetHelpRecursively(CLI::App* app, const std::shared_ptr<CLI::FormatterBase>& formatter) {
   app->formatter(formatter);
-  // Every --help says where the shipped files come from (and how to point at them).
-  if (app->get_footer().empty()) app->footer(kShippedFilesHelp);
+  // Every --help names the page that explains the command (in whirl's source tree) and says
+  // where the shipped files come from (and how to point at them).
+  if (app->get_footer().empty())
+    app->footer("Documentation: " + CommandDocsPage(app) +
+                " (terms, methods, figures); every flag: docs/commands.md.\n" + kShippedFilesHelp);
   for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; }))
     SetHelpRecursively(sub, formatter);
 }

@@ -3,7 +3,13 @@
 set -euo pipefail
 whirl="$1"; scratch="$2"
 rm -rf "$scratch"; mkdir -p "$scratch"; cd "$scratch"
+t0=$(date +%s.%N)
 "$whirl" demo --out-dir out > demo.txt
+wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
+# "done in X s" is the whole run: it stopped the clock before step 7 (about 2 of 6 s).
+done_s=$(grep -oE "done in [0-9.]+ s" demo.txt | grep -oE "[0-9.]+")
+awk -v d="$done_s" -v w="$wall" 'BEGIN { exit !(d >= 0.8 * w - 0.5 && d <= w + 0.1) }' \
+  || { echo "done in $done_s s, but the run took $wall s"; exit 1; }
 grep -q "summary:" demo.txt
 grep -Eq "% (less|more) than traditional" demo.txt
 # A reduction is never negative in words ("model -5 % less"): a larger error says "more than".

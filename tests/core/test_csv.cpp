@@ -42,6 +42,20 @@ TEST(Csv, ErrorsNameFileLineAndColumn) {
   EXPECT_NE(CsvErrorOf("a,b\n1,\n").find("empty cell"), std::string::npos);
 }
 
+// A spreadsheet's semicolon or tab export (a decimal comma locale): named as such at the header,
+// not as "column 1 ('a;b'): '1;2' is not a number".
+TEST(Csv, SemicolonOrTabSeparatedFilesAreNamedAtTheHeader) {
+  for (const std::string text : {"a;b\n1;2\n", "a;b\n1;2,5\n", "a\tb\n1\t2\n"}) {
+    const std::string e = CsvErrorOf(text);
+    EXPECT_NE(e.find("t.csv:1: the header is one column"), std::string::npos) << e;
+    EXPECT_NE(e.find("comma-separated"), std::string::npos) << e;
+  }
+  const std::string semicolon = CsvErrorOf("a;b\n1;2\n");
+  EXPECT_NE(semicolon.find("';'"), std::string::npos) << semicolon;
+  // One named column is still one column.
+  EXPECT_NE(CsvErrorOf("a\nx\n").find("'x' is not a number"), std::string::npos);
+}
+
 TEST(Csv, FormatNumberRoundTripsRandomDoubles) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);

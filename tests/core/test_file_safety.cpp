@@ -226,6 +226,8 @@ TEST(OutputDir, EmptyDirectoryIsAcceptedAForeignFileRefusedByName) {
   WriteFileAtomic(other / "thesis.tex", "mine");
   const std::string e2 = ErrorOf([&] { OutputDir out(other, "--out-dir"); });
   EXPECT_TRUE(Has(e2, "thesis.tex") && Has(e2, "did not write")) << e2;
+  // One sentence: "holds 'thesis.tex', which whirl did not write (...)", not "... write it".
+  EXPECT_TRUE(Has(e2, "which whirl did not write (")) << e2;
   EXPECT_EQ(ReadTextFile(other / "thesis.tex"), "mine");
 }
 

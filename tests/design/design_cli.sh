@@ -289,6 +289,11 @@ expect_fail "at least 6 measured screws" "$whirl" design --model m.json --candid
   --count 2 --measured five.csv
 expect_fail "count 8: the power law.*\[9, 243\]" "$whirl" design "${ranges[@]}" --count 8 \
   --space-filling 3
+# Fewer candidates than the design needs: says so (it said "the count must lie in [8, 3]").
+head -4 cands.csv > three.csv
+expect_fail "the 3 candidates are too few: .* needs 8 different candidates" "$whirl" design \
+  --candidates three.csv --count 8
+grep -q "\[8, 3\]" err.txt && fail "an empty range in the message: $(cat err.txt)"
 head -1 cands.csv > empty.csv
 expect_fail "empty.csv: table has no data rows" "$whirl" design --candidates empty.csv --count 6
 expect_fail "--pitch-mm-range 16..6: reversed range" "$whirl" design --hardness-hrc-range 60..65 \

@@ -37,10 +37,29 @@ assert abs(float(row[5]) - f["max_elongation_um"]) < 1e-4 and abs(float(row[6]) 
 assert "go into table.csv" in open(sys.argv[2]).read()
 PY
 grep -Eq "::|kDefault" "$D/help.txt" && fail "fit --help names internals: $(grep -E '::|kDefault' "$D/help.txt")"
+# A logger's clock (time 1000 s at the start of the cut): the features count from the first
+# sample, and so do the models (they were fitted on absolute time: R^2 below 0).
+awk -F, -v OFS=, '/^#/ || /^time_s/ { print; next } { print $1 + 1000, $2 }' "$D/c.csv" > "$D/clock.csv"
+"$W" fit --curve "$D/clock.csv" --json > "$D/clock.json" 2> "$D/clock.err" || fail "fit clock: $(cat "$D/clock.err")"
+grep -q "time starts at 1000 s" "$D/clock.err" || fail "clock: no warning: $(cat "$D/clock.err")"
+python3 - "$D/fit.json" "$D/clock.json" <<'PY' || fail "clock.csv: the fits differ from c.csv's"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["features"]["settle_time_s"] == b["features"]["settle_time_s"], (a["features"], b["features"])
+assert b["shape_with_features_fixed"]["r_squared"] > 0.99, b["shape_with_features_fixed"]
+arctan = lambda j: next(m for m in j["models"] if m["model"] == "arctan")
+assert b["fit_window_s"][0] == 0, b["fit_window_s"]
+assert abs(arctan(a)["r_squared"] - arctan(b)["r_squared"]) < 1e-6, (arctan(a), arctan(b))
+PY
 # A record too short for its settle time: the warning says how long to log.
 "$W" curve --max-elongation-um 30 --settle-time-s 250 --duration-s 300 --out "$D/short.csv" || fail "short curve"
 "$W" fit --curve "$D/short.csv" > /dev/null 2> "$D/short.err" || fail "fit short"
 grep -q "at least twice the settle time" "$D/short.err" || fail "short record: $(cat "$D/short.err")"
+# Its numbers are message numbers (6 significant digits, core/numbers.h MessageNumber), not a
+# file's round-trip digits (L = 15.77392385154572 um).
+grep -Eq "[0-9]{7}" "$D/short.err" && fail "short record: round-trip digits in the warning: $(cat "$D/short.err")"
+"$W" fit --curve "$D/short.csv" --json > "$D/short.json" 2> /dev/null || fail "fit short --json"
+grep -Eq '"criterion": "[^"]*[0-9]{7}' "$D/short.json" && fail "round-trip digits in the criterion: $(grep criterion "$D/short.json")"
 expect_fail "time-exponent" "$W" curve --max-elongation-um 3 --settle-time-s 100 --time-exponent 1.2
 
 # Bad curves: a gap, non-increasing time, a missing file.

@@ -98,10 +98,21 @@ check_listing() {  # check_listing <help text> <command words...>
     bad "whirl $* --help: $lines lines for $listed subcommands (one line per command)"
 }
 
+# Every --help names the docs page that explains the command's terms (fuzzy equivalence,
+# lambda-cuts, grey grade, ...), and the page exists.
+check_docs_page() {  # check_docs_page <help text> <command words...>
+  local help="$1"; shift
+  local page
+  page=$(grep -oE "Documentation: docs/[A-Za-z0-9-]+\.md" <<< "$help" | head -1 | sed 's/^Documentation: //')
+  if [ -z "$page" ]; then bad "whirl $* --help names no docs page ('Documentation: docs/...')"
+  elif [ ! -f "$SRC/$page" ]; then bad "whirl $* --help names $page, which does not exist"; fi
+}
+
 walk() {  # walk <command words...>
   local help sub subs
   if without_torch "$@"; then echo "skipped: whirl $* (no whirl-torch in this build)"; return; fi
   help=$("$W" "$@" --help) || fail "whirl $* --help failed"
+  check_docs_page "$help" "$@"
   subs=$(subcommands <<< "$help")
   if [ -z "$subs" ]; then check_command "$help" "$@"; return; fi
   check_listing "$help" "$@"
@@ -110,6 +121,7 @@ walk() {  # walk <command words...>
 
 top=$("$W" --help) || fail "whirl --help failed"
 check_listing "$top"
+check_docs_page "$top"
 for sub in $(subcommands <<< "$top"); do walk "$sub"; done
 [ "$checked_commands" -gt 30 ] || fail "only $checked_commands commands found: has --help changed?"
 [ "$checked_flags" -gt 50 ] || fail "only $checked_flags decimal flags found: has --help changed?"

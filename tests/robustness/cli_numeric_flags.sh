@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Every numeric flag of every subcommand refuses nan, inf, 1e999 and -inf (exit 1, the flag named
-# on stderr) and shows its range in --help (the one validator of numeric flags, cli/common.h
+# on stderr) and shows its range and its default (or that it has none) in --help (the one validator of numeric flags, cli/common.h
 # NumberIn, or a list of allowed values): args <whirl> <scratch dir> <source dir>. The flags are
 # found by walking --help (an option whose type is FLOAT, INT or UINT), so a new flag or
 # subcommand is covered without touching this test. KEEP_GOING=1 lists every failure instead of
@@ -38,6 +38,18 @@ without_range() {
     grep -vE -- '(FLOAT|INT|UINT):([[({]|>=? |finite)'
 }
 
+# Numeric options of a --help text on stdin (the option line joined with its continuation lines)
+# that show no default: neither CLI11's "=value" after the range, nor the word "default" (or "no
+# default"), nor REQUIRED / "required", nor "instead of" or "Excludes:" another flag. A user reads
+# what the command does without the flag from its help.
+without_default() {
+  awk '/^ +(-[a-zA-Z],)?--[a-z0-9-]+ / { if (o != "") print o; o = $0; next }
+       /^                    +[^ ]/ && o != "" { o = o " " $0; next } { if (o != "") print o; o = "" }
+       END { if (o != "") print o }' |
+    grep -E -- '^ +(-[a-zA-Z],)?--[a-z0-9-]+ +(FLOAT|INT|UINT)([: ]|$)' |
+    grep -vE -- '[^ ]=[^ ]|[Dd]efault|REQUIRED|required|instead of|Excludes:' | sed -E 's/ +/ /g'
+}
+
 walk() {  # walk <command words...>: checks the command's flags, then its subcommands'
   local flag sub line help
   if without_torch "$@"; then echo "skipped: whirl $* (no whirl-torch in this build)"; return; fi
@@ -48,6 +60,12 @@ walk() {  # walk <command words...>: checks the command's flags, then its subcom
     failures=$((failures + 1))
     [ "${KEEP_GOING:-0}" = 1 ] || exit 1
   done <<< "$(without_range <<< "$help")"
+  while IFS= read -r line; do
+    [ -n "$line" ] || continue
+    echo "FAIL: whirl $*: no default in --help: $line"
+    failures=$((failures + 1))
+    [ "${KEEP_GOING:-0}" = 1 ] || exit 1
+  done <<< "$(without_default <<< "$help")"
   for flag in $(numeric_flags <<< "$help"); do
     check_flag "$flag" "$@"
     checked=$((checked + 1))

@@ -46,6 +46,23 @@ import json; c = json.load(open('cmp.json'))
 assert c['recommended'] == 'bspline', c['reason']
 assert c['bspline']['loo_common']['rms_um'] < c['cubic']['loo_common']['rms_um']
 " || fail "bump comparison"
+# compare's thresholds: refused by the flag's name with the rule --help shows (the help said
+# "finite" and the message named the field, "overshoot_fraction -1 must be > 0").
+expect_fail "\-\-edge-ratio: 1 breaks the rule: .*> 1" "$whirl" surface compare --points bump.csv --edge-ratio 1
+expect_fail "\-\-overshoot-fraction: -1 breaks the rule: .*> 0" "$whirl" surface compare --points bump.csv \
+  --overshoot-fraction -1
+expect_fail "\-\-min-excess-um: -5 breaks the rule: .*>= 0" "$whirl" surface compare --points bump.csv \
+  --min-excess-um -5
+# Positions: the axis range of 'plan' (+-100000 mm), by the flag's name.
+"$whirl" surface fit --points bump.csv --out bump_fit.json > /dev/null || fail "fit bump"
+for flag in --ref-position-mm --machine-offset-mm; do
+  expect_fail "\\$flag: 1e300 breaks the rule: .*\[-100000, 100000\] mm" "$whirl" surface line \
+    --surface bump_fit.json "$flag" 1e300
+done
+expect_fail "\-\-x-mm: 1e300 breaks the rule" "$whirl" surface predict --surface bump_fit.json \
+  --x-mm 1e300 --y-mm 0
+"$whirl" surface compare --help | grep -A1 -- "--edge-ratio" | grep -q "FLOAT:> 1" \
+  || fail "compare --help: no range of --edge-ratio: $("$whirl" surface compare --help | grep -A1 -- --edge-ratio)"
 
 # 840D line of an exactly linear field: nothing left uncorrected, slope = -0.02 um/mm / 1000.
 printf 'x_mm,y_mm,error_um\n' > plane.csv

@@ -91,6 +91,17 @@ for n in 8 9; do
 done
 expect_fail "rows7.csv: 7 training rows; linear/log needs at least 8" \
   "$whirl" train --data rows7.csv --out x.json
+# One screw type in every row (every input constant): refused by name, for the family choice
+# and the network alike (the choice failed on an internal field, 'inputs_used'; the network
+# wrote a model with a predictive sd of 0 s); no file left behind.
+awk -F, 'BEGIN { OFS = "," } /^#/ { next } NR == 1 || !h { h = 1; print; next } !r { r = $0 }
+  { split(r, a, ","); for (i = 1; i <= 5; i++) $i = a[i]; print }' "$data" > one_type.csv
+expect_fail "one_type.csv: every input is the same in every row" "$whirl" train --data one_type.csv \
+  --out one.json
+grep -q "inputs_used" err.txt && fail "an internal field in the message: $(cat err.txt)"
+expect_fail "one_type.csv: every input is the same in every row" "$whirl" train --data one_type.csv \
+  --out one.json --family network
+[ -e one.json ] && fail "a refused train wrote one.json"
 
 # A constant input is named and left out; a zero target keeps its column raw with a warning, and
 # --transform log refuses it.

@@ -63,8 +63,16 @@ bool IsAscii(std::string_view s) {
   return any < 0x80;
 }
 
-// Column names of the header row: none empty, none twice.
+// Column names of the header row: none empty, none twice, and not one name holding a ';' or a
+// tab (a spreadsheet's export in a decimal-comma locale).
 std::vector<std::string> HeaderNames(std::vector<std::string> cells, const std::string& where) {
+  if (cells.size() == 1)
+    for (const char sep : {';', '\t'})
+      if (cells[0].find(sep) != std::string::npos)
+        throw InputError(where + ": the header is one column holding " +
+                         (sep == ';' ? std::string("';'") : std::string("tabs")) +
+                         ": whirl reads comma-separated files (',' between columns, '.' as the "
+                         "decimal point); save the table as CSV with commas");
   std::set<std::string> seen;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (cells[c].empty())

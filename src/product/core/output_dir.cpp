@@ -296,7 +296,7 @@ std::string Unproven(const fs::path& dir, const std::string& entry, const Listin
   if (list.dirs.count(entry) > 0)
     return "is listed as whirl's directory but is " + KindName(st) + " without a whirl manifest";
   return listed ? "is not among the files whirl wrote there"
-                : "whirl did not write it (the directory has no " + std::string(kOutputManifest) +
+                : "whirl did not write (the directory has no " + std::string(kOutputManifest) +
                       ")";
 }
 

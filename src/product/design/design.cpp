@@ -901,6 +901,16 @@ PowerLawDesign DesignPowerLaw(const std::vector<ProcessInputs>& cands, int count
   if (inside < 0 || inside + space_filling >= count)
     throw InputError("design --inside " + std::to_string(inside) +
                      ": must lie in [0, --count - --space-filling - 1]");
+  const int needed = d.coefficients + space_filling + inside;
+  if (needed > n)
+    throw InputError("design --count " + std::to_string(count) + ": the " + std::to_string(n) +
+                     " candidates are too few: the power law in the " +
+                     std::to_string(d.inputs.size()) + " inputs that vary over them has " +
+                     std::to_string(d.coefficients) + " coefficients, and the design needs " +
+                     std::to_string(needed) +
+                     " different candidates (the coefficients plus --space-filling " +
+                     std::to_string(space_filling) + " plus --inside " + std::to_string(inside) +
+                     "); give more candidate screws");
   if (count - space_filling - inside < d.coefficients || count > n)
     throw InputError("design --count " + std::to_string(count) + ": the power law in the " +
                      std::to_string(d.inputs.size()) + " inputs that vary over the " +

@@ -150,16 +150,16 @@ BandExit LastBandExit(const std::vector<double>& u, const std::vector<double>& y
 // SettleAnalysis::message: the plateau, the fit and the band that decided the settle time.
 std::string DescribeSettle(const SettleAnalysis& a, const SettleOptions& options) {
   std::ostringstream msg;
-  msg << "plateau " << FormatNumber(a.features.max_elongation_um)
+  msg << "plateau " << MessageNumber(a.features.max_elongation_um)
       << " um at the settle time (fit of"
       << " plateau + degree-" << options.drift_degree << " drift from "
-      << FormatNumber(a.fit_start_s) << " s, " << a.iterations << " passes; drift "
-      << FormatNumber(a.drift_at_settle_um) << " um at the settle time, "
-      << FormatNumber(a.drift_at_end_um) << " um at the end), band +-" << FormatNumber(a.band_um)
+      << MessageNumber(a.fit_start_s) << " s, " << a.iterations << " passes; drift "
+      << MessageNumber(a.drift_at_settle_um) << " um at the settle time, "
+      << MessageNumber(a.drift_at_end_um) << " um at the end), band +-" << MessageNumber(a.band_um)
       << " um = max(" << options.tolerance_rel << " x plateau, " << options.noise_sigma_multiplier
-      << " x noise " << FormatNumber(a.noise_std_um) << " um / sqrt(samples in "
+      << " x noise " << MessageNumber(a.noise_std_um) << " um / sqrt(samples in "
       << options.smoothing_window_s << " s)); detrended smoothed curve stays in the band from "
-      << FormatNumber(a.features.settle_time_s) << " s"
+      << MessageNumber(a.features.settle_time_s) << " s"
       << (a.settled_before_tail ? "" : " (NOT before the tail window: record too short)");
   return msg.str();
 }
@@ -300,12 +300,12 @@ SettleAnalysis AnalyzeByShape(const ElongationCurve& c, const SettleOptions& o) 
   a.iterations = 1;
   a.settled_before_tail = f.settle_s < (1.0 - o.tail_fraction) * span;
   std::ostringstream msg;
-  msg << "least-squares fit over " << FormatNumber(span) << " s of L atan(" << o.shape_k
+  msg << "least-squares fit over " << MessageNumber(span) << " s of L atan(" << o.shape_k
       << " (t/t_s)^" << o.time_exponent << ")/atan(" << o.shape_k
-      << ") + drift c2 u^2 + c3 u^3: L = " << FormatNumber(f.plateau)
-      << " um, t_s = " << FormatNumber(f.settle_s) << " s, drift "
-      << FormatNumber(a.drift_at_settle_um) << " um at t_s, " << FormatNumber(a.drift_at_end_um)
-      << " um at the end, residual rms " << FormatNumber(f.rms) << " um"
+      << ") + drift c2 u^2 + c3 u^3: L = " << MessageNumber(f.plateau)
+      << " um, t_s = " << MessageNumber(f.settle_s) << " s, drift "
+      << MessageNumber(a.drift_at_settle_um) << " um at t_s, " << MessageNumber(a.drift_at_end_um)
+      << " um at the end, residual rms " << MessageNumber(f.rms) << " um"
       << (a.settled_before_tail ? "" : " (t_s NOT before the last part of the record: too short)");
   a.message = msg.str();
   return a;
