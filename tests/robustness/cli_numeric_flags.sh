@@ -50,22 +50,22 @@ without_default() {
     grep -vE -- '[^ ]=[^ ]|[Dd]efault|REQUIRED|required|instead of|Excludes:' | sed -E 's/ +/ /g'
 }
 
+report_lines() {  # report_lines WHAT: one failure per non-empty line on stdin
+  local line
+  while IFS= read -r line; do
+    [ -n "$line" ] || continue
+    echo "FAIL: $1: $line"
+    failures=$((failures + 1))
+    [ "${KEEP_GOING:-0}" = 1 ] || exit 1
+  done
+}
+
 walk() {  # walk <command words...>: checks the command's flags, then its subcommands'
-  local flag sub line help
+  local flag sub help
   if without_torch "$@"; then echo "skipped: whirl $* (no whirl-torch in this build)"; return; fi
   help=$("$W" "$@" --help) || fail "whirl $* --help failed"
-  while IFS= read -r line; do
-    [ -n "$line" ] || continue
-    echo "FAIL: whirl $*: no range in --help: $line"
-    failures=$((failures + 1))
-    [ "${KEEP_GOING:-0}" = 1 ] || exit 1
-  done <<< "$(without_range <<< "$help")"
-  while IFS= read -r line; do
-    [ -n "$line" ] || continue
-    echo "FAIL: whirl $*: no default in --help: $line"
-    failures=$((failures + 1))
-    [ "${KEEP_GOING:-0}" = 1 ] || exit 1
-  done <<< "$(without_default <<< "$help")"
+  report_lines "whirl $*: no range in --help" <<< "$(without_range <<< "$help")"
+  report_lines "whirl $*: no default in --help" <<< "$(without_default <<< "$help")"
   for flag in $(numeric_flags <<< "$help"); do
     check_flag "$flag" "$@"
     checked=$((checked + 1))
