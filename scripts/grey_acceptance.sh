@@ -22,6 +22,8 @@
 # --grey-candidates: the opt-in grey rows (grey_all_sensors: every sensor on both channels;
 # grey_sensors_by_days: grey_all_sensors' model from 20 lead days in the record, both_grey's
 # before; grey_short_prior: both_grey with the prior strength fixed at 1 below 20 lead days;
+# grey_short_offset_as_read / grey_short_offset_one_lag: both_grey with the offset sensors as read
+# / through the shortest chosen lag below 20 lead days;
 # grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two lead
 # days), judged and tabled the same way.
 # --grey-five-sensors: both_grey with its five physical sensors on every record (the model before
@@ -48,9 +50,9 @@ while [ $# -gt 0 ]; do
     --grey-five-sensors) candidate+=(--grey-five-sensors); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
-    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_short_prior,grey_guarded"
+    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_short_prior,grey_short_offset_as_read,grey_short_offset_one_lag,grey_guarded"
                        shift ;;
-    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -312,9 +312,12 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "with every sensor on both channels), grey_sensors_by_days (grey_all_sensors' "
               "model once the record holds 20 lead days, both_grey's before), grey_short_prior "
               "(both_grey with the prior strength fixed at 1 while the record holds fewer than "
-              "20 lead days) and grey_guarded (both_grey's model or the sensor-free base rule, "
-              "whichever predicted the shop's own last two lead days better); off by default "
-              "(docs/machine-evaluation.md, eighth to twelfth rounds)");
+              "20 lead days), grey_short_offset_as_read and grey_short_offset_one_lag "
+              "(both_grey with the offset sensors as read, or through the shortest chosen lag, "
+              "while the record holds fewer than 20 lead days) and grey_guarded (both_grey's "
+              "model or the sensor-free base rule, whichever predicted the shop's own last two "
+              "lead days better); off by default (docs/machine-evaluation.md, eighth to "
+              "thirteenth rounds)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

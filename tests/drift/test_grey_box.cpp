@@ -437,6 +437,66 @@ TEST(GreyBox, LagsOnlyPutsThePriorOnTheLagsAndNeedsALag) {
   EXPECT_NE(lagless.a(0), 0.0);
 }
 
+// short_record_offset_lags (issue 41's thirteenth round): on a record with fewer than
+// 2 x forward_days lead days the offset sensors keep their instant column and the first `lags`
+// of the chosen lags. The planted truth needs its 40-min lag (the slope and the offset both
+// follow lags), so the lag is chosen either way; with the offset as read its lag coefficient is
+// exactly 0 (the evaluator and the 840D programs run the model as it is), the slope keeps its
+// lag and the offset's missing lag shows in the validation error. Keeping one lag of one chosen
+// changes nothing; from 2 x forward_days lead days (forward_days 2: 5 lead days of 4 needed)
+// the option changes nothing, bit for bit.
+TEST(GreyBox, ShortRecordOffsetLagsDropTheOffsetLagsOnlyOnAShortRecord) {
+  const GreyBoxModel t = Truth();
+  const ShopRecord rec = Planted(t, true);
+  ASSERT_EQ(LeadDays(rec).size(), 5u);
+  GreyBoxOptions o = Fixed(t, 1e-10);
+  EXPECT_EQ(o.short_record_offset_lags, -1);  // off by default
+  const GreyBoxModel plain = FitGreyBox(rec, SpecOf(t), o);
+  ASSERT_EQ(plain.time_constants, t.time_constants);
+  GreyBoxOptions read = o, one = o;
+  read.short_record_offset_lags = 0;
+  one.short_record_offset_lags = 1;
+  const GreyBoxModel m = FitGreyBox(rec, SpecOf(t), read);
+  ASSERT_EQ(m.time_constants, t.time_constants);
+  EXPECT_EQ(m.a(1), 0.0);
+  EXPECT_NE(m.a(0), 0.0);
+  EXPECT_NE(m.g(1), 0.0);
+  EXPECT_GT(m.cv_rmse_um, plain.cv_rmse_um + 1e-3);
+  EXPECT_EQ(nlohmann::json(FitGreyBox(rec, SpecOf(t), one)), nlohmann::json(plain));
+  for (GreyBoxOptions* x : {&o, &read}) x->forward_days = 2;
+  ASSERT_TRUE(LongRecord(rec, read));
+  EXPECT_EQ(nlohmann::json(FitGreyBox(rec, SpecOf(t), read)),
+            nlohmann::json(FitGreyBox(rec, SpecOf(t), o)));
+}
+
+// Where the prior rules (strength 1e9) each coefficient is its prior, spread equally over an
+// input's columns: with the offset as read the whole prior of the offset sensor (6 um/K) sits on
+// its instant column, its lag's coefficient 0; with the lag it is 3 and 3. The slope's prior is
+// spread over both of its columns in both fits. (The planted truth is the priors spread over
+// both columns, so the lag is chosen at this strength too.)
+TEST(GreyBox, TheOffsetAsReadCarriesItsWholePriorOnTheInstantColumn) {
+  GreyBoxModel t = Truth();
+  t.a << 3.0, 3.0;
+  t.g << 5.75, 5.75;
+  const ShopRecord rec = Planted(t, true);
+  GreyBoxSpec spec = SpecOf(t);
+  spec.offset_prior = {{"head", 6.0}};
+  spec.slope_prior = {{"screw", 11.5}};
+  GreyBoxOptions o = Fixed(t, 1e9);
+  const GreyBoxModel every = FitGreyBox(rec, spec, o);
+  o.short_record_offset_lags = 0;
+  const GreyBoxModel read = FitGreyBox(rec, spec, o);
+  for (const GreyBoxModel* m : {&every, &read}) {
+    ASSERT_EQ(m->time_constants, t.time_constants) << "no lag chosen: the test could not fail";
+    EXPECT_NEAR(m->g(0), 5.75, 1e-5);
+    EXPECT_NEAR(m->g(1), 5.75, 1e-5);
+  }
+  EXPECT_NEAR(every.a(0), 3.0, 1e-5);
+  EXPECT_NEAR(every.a(1), 3.0, 1e-5);
+  EXPECT_NEAR(read.a(0), 6.0, 1e-5);
+  EXPECT_EQ(read.a(1), 0.0);
+}
+
 TEST(GreyBox, BadOptionsAndMissingColumnsAreNamed) {
   const GreyBoxModel t = Truth();
   const ShopRecord rec = Planted(t, false, 2);
@@ -462,6 +522,12 @@ TEST(GreyBox, BadOptionsAndMissingColumnsAreNamed) {
     o = Fixed(t, 1e-2);
     o.short_record_strength_grid = {bad};
     ExpectInputError([&] { FitGreyBox(rec, SpecOf(t), o); }, "short_record_strength_grid holds");
+  }
+  for (int bad : {-2, 5}) {
+    o = Fixed(t, 1e-2);
+    o.short_record_offset_lags = bad;
+    ExpectInputError([&] { FitGreyBox(rec, SpecOf(t), o); },
+                     "short_record_offset_lags = " + std::to_string(bad) + ": must be -1");
   }
   GreyBoxSpec s = SpecOf(t);
   s.slope_sensors = {"no_such_sensor"};

@@ -170,10 +170,12 @@ a = json.load(open(sys.argv[1]))["scenarios"][0]["strategies"]
 gc = json.load(open(sys.argv[2]))["scenarios"][0]
 b = gc["strategies"]
 assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_sensors_by_days",
-                                      "grey_short_prior", "grey_guarded"]), sorted(b)
+                                      "grey_short_prior", "grey_short_offset_as_read",
+                                      "grey_short_offset_one_lag", "grey_guarded"]), sorted(b)
 for name in a:
     assert a[name] == b[name], name
-for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_short_prior", "grey_guarded"):
+for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_short_prior",
+             "grey_short_offset_as_read", "grey_short_offset_one_lag", "grey_guarded"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 # grey_fit: what both_grey's fit chose on the machine (one past day: one lead day), from its grids.
 fit = gc["runs"][0]["grey_fit"]

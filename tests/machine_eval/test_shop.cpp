@@ -224,11 +224,27 @@ drift::GreyBoxModel MotorTruth(double motor_um_per_1000_per_k = 25) {
   return t;
 }
 
+// MotorTruth with one lag (40 min) on every input, each coefficient on the instant column,
+// except z_nut_C's, which acts through the lag only and at 5 times its prior (its 40-min wave,
+// seen late, is then a large part of the slope).
+drift::GreyBoxModel NutLagTruth(double motor_um_per_1000_per_k) {
+  drift::GreyBoxModel t = MotorTruth(motor_um_per_1000_per_k);
+  t.time_constants = {40};
+  const Eigen::VectorXd a = t.a, g = t.g;
+  t.a = Eigen::VectorXd::Zero(6);
+  t.g = Eigen::VectorXd::Zero(6);
+  for (int j = 0; j < 3; ++j) t.a(2 * j) = a(j), t.g(2 * j) = g(j);
+  t.g(2) = 0, t.g(3) = 5 * g(1);
+  return t;
+}
+
 // probe_extra_um_per_k: the probe readings also grow with head_bearing_C - 20 by this much (a
 // law of the idle test that the cuts do not follow, e.g. the probe's own bracket).
+// nut_lag: the planted slope follows z_nut_C through a 40-min lag (NutLagTruth).
 drift::ShopRecord MotorRecord(int first_day, int days, double motor_um_per_1000_per_k = 25,
-                              double probe_extra_um_per_k = 0) {
-  const drift::GreyBoxModel truth = MotorTruth(motor_um_per_1000_per_k);
+                              double probe_extra_um_per_k = 0, bool nut_lag = false) {
+  const drift::GreyBoxModel truth =
+      nut_lag ? NutLagTruth(motor_um_per_1000_per_k) : MotorTruth(motor_um_per_1000_per_k);
   drift::ShopRecord rec;
   Rng rng(5);
   for (int d = first_day; d < first_day + days; ++d) {
@@ -347,7 +363,7 @@ TEST(GreyCandidates, TheFieldGreyBoxTakesEverySensorFromTwentyLeadDays) {
     EXPECT_EQ(nlohmann::json(m.grey), days >= 20 ? every : five) << days << " days";
     EXPECT_EQ(nlohmann::json(old.grey), five) << days << " days";
     for (const ShopModels* s : {&m, &old}) {
-      ASSERT_EQ(s->grey_candidates.size(), 3u);
+      ASSERT_EQ(s->grey_candidates.size(), 5u);
       EXPECT_EQ(nlohmann::json(s->grey_candidates[0]), every) << days << " days";
       EXPECT_EQ(nlohmann::json(s->grey_candidates[1]), days >= 20 ? every : five) << days;
     }
@@ -385,12 +401,58 @@ TEST(GreyCandidates, TheShortRecordStrengthActsOnlyBelowTwentyLeadDays) {
       EXPECT_EQ(nlohmann::json(one), nlohmann::json(plain));
     }
     const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true);
-    ASSERT_EQ(m.grey_candidates.size(), 3u);
+    ASSERT_EQ(m.grey_candidates.size(), 5u);
     EXPECT_EQ(nlohmann::json(m.grey_candidates[2]), nlohmann::json(days < 20 ? one : m.grey))
         << days << " days";
   }
   EXPECT_EQ(ToString(GreyCandidate::kShortPrior), "grey_short_prior");
   EXPECT_EQ(OptInRowName(kOffsetCandidateCount + kGreyCandidateCount - 1), "grey_guarded");
+}
+
+// The thirteenth round's rows (grey_short_offset_as_read, grey_short_offset_one_lag) act only on
+// a short record: below 2 x forward_days = 20 lead days the offset sensors keep their instant
+// column and the first `lags` of the chosen lags, the other lag columns' coefficients are exactly
+// 0 (the evaluator and the 840D programs then run the model as it is) while the slope channel
+// keeps its lags; from 20 lead days on the option changes nothing, bit for bit, so the 4- and
+// 8-week figures cannot move. The rows are those fits below 20 lead days, both_grey's model from
+// 20 on. The record's slope follows z_nut_C through a 40-min lag, so lags are chosen.
+TEST(GreyCandidates, TheShortRecordOffsetLagsActOnlyBelowTwentyLeadDays) {
+  const drift::GreyBoxOptions field = FieldGreyBoxOptions();
+  EXPECT_EQ(field.short_record_offset_lags, -1);  // off unless asked for
+  EXPECT_EQ(ShortRecordOffsetLags(field, 1).short_record_offset_lags, 1);
+  const drift::GreyBoxSpec spec = FieldGreyBoxSpec(6400);
+  for (int days : {19, 20}) {
+    const drift::ShopRecord rec = MotorRecord(0, days, 0, 0, /*nut_lag=*/true);
+    ASSERT_EQ(drift::LeadDays(rec).size(), static_cast<std::size_t>(days));
+    const drift::GreyBoxModel plain = drift::FitGreyBox(rec, spec, field);
+    const ShopModels m = FitShopModels(rec, 6400, {"power_on"}, false, true);
+    ASSERT_EQ(m.grey_candidates.size(), 5u);
+    for (int lags : {0, 1}) {
+      const drift::GreyBoxModel cut =
+          drift::FitGreyBox(rec, spec, ShortRecordOffsetLags(field, lags));
+      EXPECT_EQ(nlohmann::json(m.grey_candidates[3 + static_cast<std::size_t>(lags)]),
+                nlohmann::json(days < 20 ? cut : m.grey))
+          << days << " days";
+      if (days >= 20) {
+        EXPECT_EQ(nlohmann::json(cut), nlohmann::json(plain)) << lags;
+        continue;
+      }
+      const auto taus = static_cast<int>(cut.time_constants.size());
+      ASSERT_GE(taus, 1) << "no lag chosen: the test could not fail";
+      for (int i = 0; i < 3; ++i) {  // offset sensors: instant, then the lags
+        EXPECT_NE(cut.a(i * (1 + taus)), 0.0) << i;
+        for (int l = 1; l <= taus; ++l)
+          EXPECT_EQ(cut.a(i * (1 + taus) + l) == 0.0, l > lags) << lags << " " << i << " " << l;
+      }
+      for (int l = 1; l <= taus; ++l) EXPECT_NE(cut.g(l), 0.0) << l;  // the slope keeps its lags
+      if (lags < taus)
+        EXPECT_NE(nlohmann::json(cut), nlohmann::json(plain)) << lags;
+      else  // every chosen lag kept: nothing to drop
+        EXPECT_EQ(nlohmann::json(cut), nlohmann::json(plain)) << lags;
+    }
+  }
+  EXPECT_EQ(ToString(GreyCandidate::kShortOffsetAsRead), "grey_short_offset_as_read");
+  EXPECT_EQ(ToString(GreyCandidate::kShortOffsetOneLag), "grey_short_offset_one_lag");
 }
 
 // LeadDays counts the calendar days with a lead reading: not a probe-only day, not a lead

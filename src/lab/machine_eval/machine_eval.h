@@ -133,11 +133,21 @@ double WarmupOffsetShare(OffsetCandidate c);
 /// grey box or the sensor-free base rule (warmup or schedule), whichever the shop's own last
 /// lead days favour (grey_guarded, GuardGreyBox); the twelfth round's both_grey with the prior
 /// strength fixed at 1 below 2 x forward_days lead days (grey_short_prior, shop_models.h
-/// ShortRecordStrongPrior), before grey_guarded. All count as using sensors; never the
-/// strongest sensor-free row.
-enum class GreyCandidate { kAllSensors, kSensorsByDays, kShortPrior, kGuarded };
-inline constexpr std::size_t kGreyCandidateCount = 4;
-/// grey_all_sensors, grey_sensors_by_days, grey_short_prior, grey_guarded
+/// ShortRecordStrongPrior); the thirteenth round's both_grey with the offset sensors as read
+/// (grey_short_offset_as_read) or through the shortest chosen lag (grey_short_offset_one_lag)
+/// below 2 x forward_days lead days (shop_models.h ShortRecordOffsetLags), before grey_guarded.
+/// All count as using sensors; never the strongest sensor-free row.
+enum class GreyCandidate {
+  kAllSensors,
+  kSensorsByDays,
+  kShortPrior,
+  kShortOffsetAsRead,
+  kShortOffsetOneLag,
+  kGuarded
+};
+inline constexpr std::size_t kGreyCandidateCount = 6;
+/// grey_all_sensors, grey_sensors_by_days, grey_short_prior, grey_short_offset_as_read,
+/// grey_short_offset_one_lag, grey_guarded
 std::string ToString(GreyCandidate c);
 /// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
 std::string OptInRowName(std::size_t k);

@@ -38,8 +38,9 @@ double WarmupOffsetShare(OffsetCandidate c) {
 }
 
 std::string ToString(GreyCandidate c) {
-  static const char* kNames[] = {"grey_all_sensors", "grey_sensors_by_days", "grey_short_prior",
-                                 "grey_guarded"};
+  static const char* kNames[] = {"grey_all_sensors",          "grey_sensors_by_days",
+                                 "grey_short_prior",          "grey_short_offset_as_read",
+                                 "grey_short_offset_one_lag", "grey_guarded"};
   return kNames[static_cast<int>(c)];
 }
 

@@ -165,6 +165,11 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   m.grey_candidates.push_back(
       long_record ? m.grey
                   : drift::FitGreyBox(record, applied, ShortRecordStrongPrior(grey_options)));
+  // The thirteenth round's rows: the offset sensors as read, or through the shortest lag.
+  for (int lags : {0, 1})
+    m.grey_candidates.push_back(
+        long_record ? m.grey
+                    : drift::FitGreyBox(record, applied, ShortRecordOffsetLags(grey_options, lags)));
   // The guard scores the model it would apply: both_grey's (its sensors, its options).
   const GuardScore g =
       GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
@@ -184,6 +189,11 @@ GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
 
 drift::GreyBoxOptions ShortRecordStrongPrior(drift::GreyBoxOptions options) {
   options.short_record_strength_grid = {1.0};
+  return options;
+}
+
+drift::GreyBoxOptions ShortRecordOffsetLags(drift::GreyBoxOptions options, int lags) {
+  options.short_record_offset_lags = lags;
   return options;
 }
 

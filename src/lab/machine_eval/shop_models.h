@@ -44,7 +44,9 @@ struct ShopModels {
   /// The opt-in grey boxes, fitted only when asked for and where the grey box is, in
   /// GreyCandidate's order: grey_all_sensors (FieldGreyCandidate), grey_sensors_by_days (a copy
   /// of that model or of `grey`, by EverySensorByDays), grey_short_prior (`grey`'s spec and
-  /// options with ShortRecordStrongPrior; a copy of `grey` on a long record).
+  /// options with ShortRecordStrongPrior; a copy of `grey` on a long record),
+  /// grey_short_offset_as_read and grey_short_offset_one_lag (`grey`'s spec and options with
+  /// ShortRecordOffsetLags 0 and 1; copies of `grey` on a long record).
   std::vector<drift::GreyBoxModel> grey_candidates;
   bool rule_is_schedule = false;  ///< the sensor-free base (schedule, else warmup) by its CV
   /// The ninth round's guard (grey_guarded: GuardGreyBox), chosen only when the opt-in grey
@@ -100,6 +102,12 @@ bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOpti
 /// physical prior weighs as much as the data where 5 held-out days cannot choose a strength);
 /// unchanged from 2 x forward_days lead days on.
 drift::GreyBoxOptions ShortRecordStrongPrior(drift::GreyBoxOptions options);
+/// The thirteenth round's rows (grey_short_offset_as_read, grey_short_offset_one_lag;
+/// docs/machine-evaluation.md "Thirteenth round: split"): `options` with the offset sensors
+/// keeping only the first `lags` of the chosen lags (0: as read) while the record holds fewer
+/// than 2 x forward_days lead days (drift::GreyBoxOptions::short_record_offset_lags: on 5 lead
+/// days lags of the slow bed bend K0 along a cut); unchanged from 2 x forward_days lead days on.
+drift::GreyBoxOptions ShortRecordOffsetLags(drift::GreyBoxOptions options, int lags);
 
 /// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split"): the
 /// grey box or a sensor-free rule, chosen on the shop's own record in time order. For each of

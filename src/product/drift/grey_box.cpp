@@ -23,6 +23,9 @@ void GreyBoxOptions::Validate() const {
   positive(strength_grid, "strength_grid");
   if (!short_record_strength_grid.empty())
     positive(short_record_strength_grid, "short_record_strength_grid");
+  if (short_record_offset_lags < -1 || short_record_offset_lags > 4)
+    throw InputError("grey box: short_record_offset_lags = " +
+                     std::to_string(short_record_offset_lags) + ": must be -1 (off) or 0..4");
   if (max_lags < 0 || max_lags > 4)
     throw InputError("grey box: max_lags = " + std::to_string(max_lags) + ": must be within 0..4");
   if (forward_days < 2 || forward_days > 100)
@@ -108,46 +111,60 @@ struct LogFeatures {
   Eigen::VectorXd blank_c;  ///< B(t) per sample (20 without a blank sensor)
 };
 
-// Which inputs keep their instant column (the options; none is dropped without a lag).
-struct Instant {
-  bool offset = true, slope = true;
+// Which columns of each sensor a channel keeps (per input: the instant column, then one per
+// lag), by the options and the record's length; none is dropped without a lag.
+struct Columns {
+  std::vector<bool> offset, slope;
 };
 
-Instant InstantOf(const GreyBoxOptions& o, const Choice& c) {
-  const bool lags = !c.taus.empty();
-  return {o.instant_offset_inputs || !lags, o.instant_slope_inputs || !lags};
+std::vector<bool> KeptColumns(std::size_t taus, bool instant, std::size_t lags) {
+  std::vector<bool> keep(1 + taus, false);
+  keep[0] = instant || lags == 0;
+  for (std::size_t l = 0; l < std::min(lags, taus); ++l) keep[1 + l] = true;
+  return keep;
 }
 
-// Zeroes the instant column of each of the first `inputs` inputs (their lags kept).
-void DropInstant(Eigen::MatrixXd* f, std::size_t inputs, std::size_t taus) {
-  for (std::size_t i = 0; i < inputs; ++i) f->col(static_cast<Eigen::Index>(i * (1 + taus))).setZero();
+Columns ColumnsOf(const GreyBoxOptions& o, const Choice& c, bool long_record) {
+  const std::size_t taus = c.taus.size();
+  const bool cut = o.short_record_offset_lags >= 0 && !long_record;
+  const std::size_t offset_lags =
+      cut ? std::min(taus, static_cast<std::size_t>(o.short_record_offset_lags)) : taus;
+  return {KeptColumns(taus, o.instant_offset_inputs, offset_lags),
+          KeptColumns(taus, o.instant_slope_inputs, taus)};
+}
+
+// Zeroes the columns `keep` drops of each of the first `inputs` inputs.
+void ZeroDropped(Eigen::MatrixXd* f, std::size_t inputs, const std::vector<bool>& keep) {
+  for (std::size_t i = 0; i < inputs; ++i)
+    for (std::size_t k = 0; k < keep.size(); ++k)
+      if (!keep[k]) f->col(static_cast<Eigen::Index>(i * keep.size() + k)).setZero();
 }
 
 LogFeatures FeaturesOf(const Run& log, const GreyBoxSpec& spec, const Choice& c,
-                       const Instant& instant) {
+                       const Columns& cols) {
   LogFeatures f;
   f.off = GreyChannelFeatures(log, spec.offset_sensors, spec.offset_duty, c.taus);
   f.slope = GreyChannelFeatures(log, spec.slope_sensors, spec.slope_duty, c.taus);
-  if (!instant.offset) DropInstant(&f.off, spec.offset_sensors.size(), c.taus.size());
-  if (!instant.slope) DropInstant(&f.slope, spec.slope_sensors.size(), c.taus.size());
+  ZeroDropped(&f.off, spec.offset_sensors.size(), cols.offset);
+  ZeroDropped(&f.slope, spec.slope_sensors.size(), cols.slope);
   f.blank_c = Eigen::VectorXd::Constant(log.samples(), 20.0);
   if (!spec.blank_sensor.empty())
     f.blank_c = AbsoluteFeatures(log, {spec.blank_sensor}, {c.blank_tau}).col(1).array() + 20.0;
   return f;
 }
 
-// Each input's prior spread equally over its columns, or over its lags only (`instant` false).
+// Each input's prior spread equally over the columns `keep` holds.
 Eigen::VectorXd Priors(const std::vector<std::string>& inputs,
-                       const std::map<std::string, double>& prior, std::size_t taus,
-                       bool instant) {
-  const auto per = static_cast<Eigen::Index>(1 + taus);
-  const Eigen::Index skip = instant ? 0 : 1;
+                       const std::map<std::string, double>& prior, const std::vector<bool>& keep) {
+  const auto per = static_cast<Eigen::Index>(keep.size());
+  const auto kept = static_cast<double>(std::count(keep.begin(), keep.end(), true));
   Eigen::VectorXd p = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(inputs.size()) * per);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto it = prior.find(inputs[i]);
-    if (it != prior.end())
-      p.segment(static_cast<Eigen::Index>(i) * per + skip, per - skip)
-          .setConstant(it->second / static_cast<double>(per - skip));
+    if (it == prior.end()) continue;
+    for (Eigen::Index k = 0; k < per; ++k)
+      if (keep[static_cast<std::size_t>(k)])
+        p(static_cast<Eigen::Index>(i) * per + k) = it->second / kept;
   }
   return p;
 }
@@ -155,7 +172,7 @@ Eigen::VectorXd Priors(const std::vector<std::string>& inputs,
 Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice& c,
                    const GreyBoxOptions& o) {
   const double lead_share = o.lead_share;
-  const Instant instant = InstantOf(o, c);
+  const Columns cols = ColumnsOf(o, c, LongRecord(rec, o));
   std::vector<LogFeatures> logs(rec.day_logs.size());
   std::vector<bool> built(rec.day_logs.size(), false);
   std::size_t n = 0;
@@ -172,7 +189,7 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
   Eigen::Index row = 0;
   for (const auto& r : rec.records) {
     const auto l = static_cast<std::size_t>(r.log);
-    if (!built[l]) logs[l] = FeaturesOf(rec.day_logs[l], spec, c, instant), built[l] = true;
+    if (!built[l]) logs[l] = FeaturesOf(rec.day_logs[l], spec, c, cols), built[l] = true;
     const LogFeatures& f = logs[l];
     const bool lead = r.kind == MeasurementRecord::Kind::kLead;
     const double blank = lead && !r.rows.empty() ? f.blank_c(r.rows.front().sample) - 20.0 : 0.0;
@@ -210,9 +227,8 @@ Design BuildDesign(const ShopRecord& rec, const GreyBoxSpec& spec, const Choice&
   const auto duty_cols = [&](const std::vector<std::string>& duty) {
     return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(duty.size() * per));
   };
-  d.prior << Priors(spec.offset_sensors, spec.offset_prior, c.taus.size(), instant.offset),
-      duty_cols(spec.offset_duty),
-      Priors(spec.slope_sensors, spec.slope_prior, c.taus.size(), instant.slope),
+  d.prior << Priors(spec.offset_sensors, spec.offset_prior, cols.offset),
+      duty_cols(spec.offset_duty), Priors(spec.slope_sensors, spec.slope_prior, cols.slope),
       duty_cols(spec.slope_duty), 0.0, spec.blank_prior;
   return d;
 }

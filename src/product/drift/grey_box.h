@@ -95,6 +95,13 @@ struct GreyBoxOptions {
   /// empty: strength_grid on every record. {1}: the physics weighs as much as the data where 5
   /// held-out days cannot choose (issue 41's twelfth round, docs/machine-evaluation.md).
   std::vector<double> short_record_strength_grid;
+  /// On a record with fewer than 2 x forward_days lead days: the offset sensors keep their
+  /// instant column and only the first this many of the chosen lags (the shortest); the others'
+  /// columns are 0 with a prior of 0, so their coefficients are exactly 0 and the evaluator and
+  /// the 840D programs run the model as it is. -1: every chosen lag (off), else 0..4. Duty
+  /// inputs and the slope channel are not affected. 0: the offset as read (issue 41's thirteenth
+  /// round, docs/machine-evaluation.md: on 5 lead days lags of the slow bed bend K0 along a cut).
+  int short_record_offset_lags = -1;
   void Validate() const;    ///< InputError naming the field and the rule
 };
 
@@ -130,7 +137,8 @@ struct GreyBoxModel {
 /// The calendar days that hold a lead reading (a lead record with a row), ascending.
 std::vector<int> LeadDays(const ShopRecord& record);
 /// Whether `record` holds at least 2 x forward_days lead days (LeadDays): long enough for
-/// forward chaining, and where short_record_strength_grid no longer applies.
+/// forward chaining, and where short_record_strength_grid and short_record_offset_lags no
+/// longer apply.
 bool LongRecord(const ShopRecord& record, const GreyBoxOptions& options);
 /// Whether FitGreyBox scores its choices by forward chaining on `record`: kForwardLeads and a
 /// LongRecord; else leave one day out.
