@@ -123,15 +123,21 @@ def seventeenth(files):
 
 def cells_of(files):
     """{(problem, rows, output k): arrays} of the merged records: cur (N,), peers (N, 5),
-    cover (N, 2) in % (+-1, +-2 sd), seeds (N,)."""
+    cover (N, 2) in % (+-1, +-2 sd), seeds (N,). A table on which a method has no finite RMSE (a
+    failed fit, a table whirl refuses) is left out of both its cells and named on stderr."""
     cells = {}
     for r in load_runs(files):
+        m = r["methods"]
+        missing = [x for x in METHODS if "rmse" not in m.get(x, {})]
+        if missing:
+            sys.exit(f"median_rule_noise: {r['problem']}, {r['rows']} rows, seed {r['seed']}: "
+                     f"no {', '.join(missing)} in {' '.join(files)}")
+        bad = [x for x in METHODS if not all(math.isfinite(v) and v > 0 for v in m[x]["rmse"])]
+        if bad:
+            print(f"median_rule_noise: left out {r['problem']}, {r['rows']} rows, seed {r['seed']}: "
+                  f"no finite RMSE of {', '.join(bad)}", file=sys.stderr)
+            continue
         for k in (0, 1):
-            m = r["methods"]
-            missing = [x for x in METHODS if "rmse" not in m.get(x, {})]
-            if missing:
-                sys.exit(f"median_rule_noise: {r['problem']}, {r['rows']} rows, seed {r['seed']}: "
-                         f"no {', '.join(missing)} in {' '.join(files)}")
             c = cells.setdefault((r["problem"], r["rows"], k), {"cur": [], "peers": [], "cover": [],
                                                                "seeds": []})
             c["cur"].append(m["current"]["rmse"][k])

@@ -3,6 +3,7 @@
 # behind the best peer on every table is "behind" (ratio 1.050 in every bootstrap draw), one equal
 # to it "within" (1.000); coverage 68 / 95 % on every table "inside", 50 / 80 % "outside", +-1 sd
 # 0 % and 100 % on alternate tables (mean 50 %, bootstrap interval about 26-74 %) "undecided";
+# a table with a failed fit is left out (named on stderr);
 # the twin of the best peer is the best peer itself where the default's ratio is the same on every
 # table, so the noise floor is 0. Bad arguments exit non-zero with a message.
 # Usage (CTest): lab_median_rule_noise.sh <whirl> <scratch dir> <source dir>
@@ -24,12 +25,15 @@ def rec(prob, seed, factor, c1, c2):
 runs = [rec("p", s, 1.05, 0.68, 0.95) for s in range(1, 13)]
 runs += [rec("q", s, 1.0, 0.50, 0.80) for s in range(1, 13)]
 runs += [rec("r", s, 1.0, float(s % 2), 0.95) for s in range(1, 13)]
-json.dump(runs[:20], open("a.json", "w")); json.dump(runs[20:], open("b.json", "w"))
+failed = rec("p", 13, 1.05, 0.68, 0.95); failed["methods"]["current"]["rmse"] = [float("nan")] * 2
+json.dump(runs[:20], open("a.json", "w")); json.dump(runs[20:] + [failed], open("b.json", "w"))
 bad = runs[:1]; del bad[0]["methods"]["gp_ard"]
 json.dump(bad, open("bad.json", "w"))
 PY
 "${MR[@]}" --verdicts --draws 500 --twins 20 a.json b.json > v.txt 2> err.txt \
   || fail "--verdicts on the planted runs: $(cat err.txt)"
+grep -qF "left out p, 20 rows, seed 13: no finite RMSE of current" err.txt \
+  || fail "a failed table is not named: $(cat err.txt)"
 for k in 1 2; do
   grep -qF "| p | 20 | out$k | 12 | loglinear " v.txt && \
     grep -F "| p | 20 | out$k |" v.txt | grep -qF "| 1.050 | 1.050-1.050 | behind | 68.0 (68.0-68.0) | 95.0 (95.0-95.0) | inside |" \
