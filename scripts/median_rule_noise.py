@@ -247,6 +247,9 @@ def verdicts(files, draws, twins, twin_draws=1000, seed=40):
           + "; ".join(point_out))
     print(f"point rule on the first 10 seeds: {first10[0]} medians behind, {first10[1]} coverage "
           "cells outside")
+    names = [f"{k[0]} {k[1]} out{k[2] + 1}" for k in sorted(cells, key=lambda k: (k[1], k[0], k[2]))]
+    print("twin judged 'behind', share of twins per cell (cells above 0): " + "; ".join(
+        f"{nm} {float(np.mean(b)):.2f}" for nm, b in zip(names, floor_behind) if np.any(b)))
     counts = np.sum(np.asarray(floor_behind), axis=0)
     print(f"noise floor (twin of the best peer) at N tables: (i) point rule {sum(floor_point):.1f} "
           f"of {nc} cells expected behind; (ii) verdict 'behind' {float(np.mean(counts)):.2f} "
