@@ -36,7 +36,8 @@ The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additi
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
   "confirmation7" (13001-), "confirmation8" (14001-), "confirmation9" (15001-),
   "confirmation10" (16001-), "confirmation11" (17001-), "confirmation13" (18001-, spent by the fourteenth attempt),
-  "confirmation15" (19001-, 20 rows, spent by the fifteenth attempt).
+  "confirmation15" (19001-, 20 rows, spent by the fifteenth attempt), "confirmation16" (20001-,
+  20 rows, reserved), "acceptance40" (21001-21040, the acceptance measured at N tables per cell).
 
 Peers (scikit-learn, Debian python3-sklearn; inputs and targets standardized, one network for
 both outputs as whirl), and brnn_whirl, whirl's own brnn-equivalent network (whirl train --family
@@ -369,6 +370,9 @@ SPLITS = {
     # fourteenth's 920 tables): 20001-20010 at 20 rows. Unused (E failed its tuning part) and
     # reserved; only the peers have been run on it.
     "confirmation16": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 20001},
+    # The acceptance measured at N tables per cell (a measurement of the default, no tuning):
+    # 21001-21040 at 20 and 100 rows, run in blocks of 5 seeds (--first-seed, --seeds).
+    "acceptance40": {"problems": EIGHT + ",saturating,powerlaw_step,hetero", "first_seed": 21001},
 }
 
 

@@ -9,3 +9,4 @@ whirl_add_cli_test(lab_choice_diagnosis ${CMAKE_CURRENT_LIST_DIR}/lab_choice_dia
                    $<TARGET_FILE:family_bench>)
 whirl_add_cli_test(lab_design_study ${CMAKE_CURRENT_LIST_DIR}/lab_design_study.sh)
 whirl_add_cli_test(lab_grey_residuals ${CMAKE_CURRENT_LIST_DIR}/lab_grey_residuals.sh)
+whirl_add_cli_test(lab_median_rule_noise ${CMAKE_CURRENT_LIST_DIR}/lab_median_rule_noise.sh)
