@@ -14,16 +14,17 @@ namespace {
 
 constexpr std::size_t kMaxNcLine = 512;
 
-// Text from files the user supplies (a model's column names, a path) in a comment line or a CSV
-// cell: control characters (a newline would start a new NC block) and ',' become spaces.
+// Text from files the user supplies (a model's column names, a path) in a comment line:
+// control characters (a newline would start a new NC block) and ',' become spaces.
 std::string Text(std::string t) {
   for (char& ch : t)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f || ch == ',') ch = ' ';
   return t;
 }
 
-// Text in a cell of its own in the PLC table: also no formula when opened in a spreadsheet.
-std::string Cell(const std::string& t) { return SpreadsheetCell(Text(t)); }
+// Text in a cell of its own in the PLC table: the name as it is, quoted by RFC 4180 where it
+// holds ',', '"', CR or LF, and no formula when opened in a spreadsheet (CsvTextCell).
+std::string Cell(const std::string& t) { return CsvTextCell(t); }
 
 std::string P(int n) { return "$AC_PARAM[" + std::to_string(n) + "]"; }
 std::string Rp(int n) { return "R" + std::to_string(n); }

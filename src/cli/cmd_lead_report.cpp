@@ -22,6 +22,7 @@ struct LeadReportOptions {
 
 void RunLeadReport(const LeadReportOptions& o) {
   const lead::LeadDeviation lead = lead::ReadLeadDeviation(o.lead_csv);
+  lead::CheckEndMargin(lead, o.end_margin_mm, "--end-margin-mm");  // named by its flag
   lead::LeadMetricOptions mo;
   mo.lead_mm = o.lead_mm;
   mo.end_margin_mm = o.end_margin_mm;
@@ -89,7 +90,7 @@ void RegisterLeadReport(CLI::App& app) {
       ->check(NonNegativeNumber());
   sub->add_option("--end-margin-mm", o->end_margin_mm,
                   "excess travel l_e left out at each end, mm: l_u = length - 2 l_e (default 0)")
-      ->check(NonNegativeNumber());
+      ->check(NonNegativeNumber("mm"));
   sub->add_option("--iso-table", o->iso_table,
                   "ISO 3408-3 tolerance table CSV (default: the shipped "
                   "datasets/standards/iso3408_3_lead_tolerances.csv)")

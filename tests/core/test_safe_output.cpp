@@ -14,6 +14,7 @@
 #include "core/parallel.h"
 #include "core/run_program.h"
 #include "core/safe_text.h"
+#include "support/rfc4180.h"
 #include "support/scratch_dir.h"
 
 namespace whirl {
@@ -129,6 +130,42 @@ TEST(SafeText, SpreadsheetCellNeverStartsAFormula) {
       ASSERT_EQ(cell, "'" + text) << "trial " << trial;
     } else {
       ASSERT_EQ(cell, text) << "trial " << trial;
+    }
+  }
+}
+
+// RFC 4180 section 2, rules 5-7, by hand: quotes only where needed, '"' doubled, the guard first.
+TEST(SafeText, CsvTextCellQuotesByRfc4180) {
+  EXPECT_EQ(CsvTextCell("t1_C"), "t1_C");
+  EXPECT_EQ(CsvTextCell(""), "");
+  EXPECT_EQ(CsvTextCell("a,b"), "\"a,b\"");
+  EXPECT_EQ(CsvTextCell("say \"hi\""), "\"say \"\"hi\"\"\"");
+  EXPECT_EQ(CsvTextCell("a\nb"), "\"a\nb\"");
+  EXPECT_EQ(CsvTextCell("a\rb"), "\"a\rb\"");
+  EXPECT_EQ(CsvTextCell("=1+2"), "'=1+2");
+  EXPECT_EQ(CsvTextCell("=A1,\"x\""), "\"'=A1,\"\"x\"\"\"");
+}
+
+// Property over random strings: a row of CsvTextCell cells read by an RFC 4180 reader gives one
+// record with the cells' texts (each after the guard's apostrophe when it looked like a formula).
+TEST(SafeText, CsvTextCellsReadBackByRfc4180) {
+  std::mt19937_64 rng(20261130);
+  const std::string alphabet = "=+-@\t\r\n'a1 ,\"";
+  std::uniform_int_distribution<std::size_t> pick(0, alphabet.size() - 1), length(0, 6);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::vector<std::string> texts(3);
+    std::string row;
+    for (std::size_t i = 0; i < texts.size(); ++i) {
+      texts[i].assign(length(rng), '\0');
+      for (char& c : texts[i]) c = alphabet[pick(rng)];
+      row += (i ? "," : "") + CsvTextCell(texts[i]);
+    }
+    const auto records = test::ParseRfc4180(row + "\r\n");
+    ASSERT_EQ(records.size(), 1u) << "trial " << trial;
+    ASSERT_EQ(records[0].size(), texts.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < texts.size(); ++i) {
+      ASSERT_EQ(records[0][i], SpreadsheetCell(texts[i])) << "trial " << trial;
+      ASSERT_FALSE(LooksLikeFormula(records[0][i])) << "trial " << trial;
     }
   }
 }

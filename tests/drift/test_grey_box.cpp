@@ -646,6 +646,72 @@ void ExpectBadModel(const std::function<void(nlohmann::json&)>& change, const st
   ExpectInputError([&] { (void)ReadGreyBoxModel(path); }, what);
 }
 
+// Values no machine can hold (a fixed bearing behind the chuck face, temperatures a run file
+// refuses, below absolute zero): each is refused with the file, the field, the value and the rule;
+// the same file with every such value at its limit reads back and writes back unchanged.
+TEST(GreyBoxFiles, PhysicallyImpossibleValuesAreRefusedAndTheLimitsRoundTrip) {
+  const GreyBoxModel fitted =
+      FitGreyBox(Planted(Truth(), true, 2), SpecOf(Truth()), Fixed(Truth(), 1e-2));
+  const nlohmann::json valid = fitted;
+  const auto path = test::ScratchDir() / "impossible_grey.json";
+  struct Case {
+    std::vector<std::string> where;  // JSON path
+    double value;
+    std::vector<std::string> fragments;  // of the message, each
+  };
+  const std::vector<Case> hostile = {
+      {{"z_ref_mm"}, -5, {"z_ref_mm = -5 breaks the rule: must lie in (0, 100000] mm"}},
+      {{"z_ref_mm"}, 0, {"z_ref_mm = 0 breaks the rule: must lie in (0, 100000] mm"}},
+      {{"offset_features", "0", "train_min_k"}, -293.15,
+       {"offset_features[0].train_min_k = -293.15 breaks the rule: must lie in [-80, 380] K"}},
+      {{"slope_features", "1", "train_max_k"}, 380.5,
+       {"slope_features[1].train_max_k = 380.5 breaks the rule: must lie in [",
+        "380] K (at least train_min_k)"}},
+      {{"blank", "train_min_c"}, -61,
+       {"blank.train_min_c = -61 breaks the rule: must lie in [-60, 400] degC"}},
+      {{"blank", "train_max_c"}, 1000,
+       {"blank.train_max_c = 1000 breaks the rule", "400] degC (at least train_min_c)"}}};
+  auto at = [](nlohmann::json& j, const std::vector<std::string>& where) -> nlohmann::json& {
+    nlohmann::json* x = &j;
+    for (const std::string& k : where)
+      x = x->is_array() ? &(*x)[std::stoul(k)] : &(*x)[k];
+    return *x;
+  };
+  for (const Case& c : hostile) {
+    nlohmann::json j = valid;
+    at(j, c.where) = c.value;
+    WriteFileAtomic(path, j.dump());
+    const std::string error = whirl::ErrorOf([&] { (void)ReadGreyBoxModel(path); });
+    EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+    for (const std::string& f : c.fragments) EXPECT_NE(error.find(f), std::string::npos) << error;
+  }
+  // Every such value at its limit: read, written and read again, the same file.
+  nlohmann::json limits = valid;
+  limits["z_ref_mm"] = 100000.0;
+  limits["offset_features"][0]["train_min_k"] = -80.0;
+  limits["slope_features"][1]["train_max_k"] = 380.0;
+  limits["blank"]["train_min_c"] = -60.0;
+  limits["blank"]["train_max_c"] = 400.0;
+  WriteFileAtomic(path, limits.dump());
+  const GreyBoxModel read = ReadGreyBoxModel(path);
+  EXPECT_EQ(read.z_ref_mm, 100000.0);
+  EXPECT_EQ(read.offset_min(0), -80.0);
+  EXPECT_EQ(read.blank_max_c, 400.0);
+  const auto again = test::ScratchDir() / "impossible_grey_again.json";
+  WriteGreyBoxModel(again, read);
+  EXPECT_EQ(nlohmann::json(ReadGreyBoxModel(again)), limits);
+  // The spec the model is fitted to: the same rule for its z_ref_mm, naming the file.
+  const auto spec = test::ScratchDir() / "impossible_spec.json";
+  WriteFileAtomic(spec, R"({"format": "whirl-grey-box-spec", "schema_version": 1,
+    "offset_sensors": ["a_C"], "slope_sensors": ["b_C"], "blank_sensor": "", "z_ref_mm": -5,
+    "blank_prior_um_per_1000_per_k": -11.8})");
+  const std::string error = whirl::ErrorOf([&] { (void)ReadGreyBoxSpec(spec); });
+  EXPECT_NE(error.find(spec.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("z_ref_mm = -5 breaks the rule: must lie in (0, 100000] mm"),
+            std::string::npos)
+      << error;
+}
+
 TEST(GreyBoxFiles, BadModelSpecAndRecordsFilesNameFileFieldAndRule) {
   ExpectBadModel([](nlohmann::json& j) { j["offset_features"][0]["coefficient"] = 1e9; },
                  "offset_features[0].coefficient = 1e+09 breaks the rule");

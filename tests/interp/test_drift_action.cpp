@@ -19,6 +19,7 @@
 #include "interp/drift_action.h"
 #include "interp/nc_replay.h"
 #include "interp/sinumerik.h"
+#include "support/rfc4180.h"
 
 namespace whirl::interp {
 namespace {
@@ -667,6 +668,32 @@ TEST(DriftAction, HostileNamesStayInsideCommentsAndCells) {
     if (line.empty() || line[0] == '#') continue;
     EXPECT_EQ(std::count(line.begin(), line.end(), ','), 9) << line;
   }
+}
+
+// Sensor names holding '"', ',', a line break or a formula start: every data row of the PLC table
+// read by RFC 4180 has the header's 10 cells, and the input cell gives the name back (after the
+// spreadsheet guard's apostrophe), so a '"' never sits inside an unquoted cell.
+TEST(DriftAction, PlcTableCellsFollowRfc4180) {
+  const std::vector<std::string> names = {"t\"1\" C", "=t2,C\r\nx"};
+  drift::DriftModel m = HandModel(false, {1.0, 2.0, -3.0});
+  m.sensors = names;
+  for (std::size_t i = 0; i < names.size(); ++i) m.features[i].input = names[i];
+  m.Validate();
+  DriftActionOptions o = Options(ControlDk::kAdded, 1, DriftReference::kModel);
+  o.inputs = {{names[0], {3, 0.1, -20.0}}, {names[1], {7, 0.05, 0.0}}};
+  std::string table;
+  std::istringstream text(FormatDriftPlcCsv(m, o));
+  for (std::string line; std::getline(text, line);)
+    if (line.empty() || line[0] != '#') table += line + "\n";
+  const auto records = test::ParseRfc4180(table);
+  ASSERT_EQ(records.size(), 4u) << table;  // header, the intercept, one row per sensor
+  std::vector<std::string> inputs;
+  for (const auto& r : records) {
+    ASSERT_EQ(r.size(), 10u) << table;
+    inputs.push_back(r[2]);
+  }
+  EXPECT_EQ(inputs[2], names[0]);
+  EXPECT_EQ(inputs[3], "'" + names[1]);
 }
 
 TEST(DriftAction, GoldenProgramAndPlcTable) {

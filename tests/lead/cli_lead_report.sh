@@ -30,4 +30,24 @@ grep -q "bad.csv:4" err.txt
 # Missing file: parse-time validator, non-zero exit.
 if "$whirl" lead-report --lead missing.csv 2> /dev/null; then exit 1; fi
 "$whirl" lead-report --help | grep "deviation_um" > /dev/null
+# --end-margin-mm that leaves fewer than 2 samples of the 1000 mm curve (1 mm apart): the error
+# names the flag (not the library's field end_margin_mm), the value in mm, the rule and the
+# useful travel it leaves (1000 - 2 x 500 = 0 mm, 1000 - 2 x 600 = -200 mm); a negative value is
+# refused at the flag with its unit.
+for margin in 500:0:1 600:-200:0; do
+  IFS=: read -r m lu n <<< "$margin"
+  if "$whirl" lead-report --lead linear.csv --end-margin-mm "$m" 2> err.txt > /dev/null; then
+    echo "accepted --end-margin-mm $m"; exit 1
+  fi
+  grep -q -- "--end-margin-mm: $m mm breaks the rule: .*at least 2 samples" err.txt ||
+    { echo "--end-margin-mm $m: $(cat err.txt)"; exit 1; }
+  grep -q "leaves l_u = $lu mm holding $n sample" err.txt ||
+    { echo "--end-margin-mm $m, no travel left: $(cat err.txt)"; exit 1; }
+  if grep -q "end_margin_mm" err.txt; then echo "names the field: $(cat err.txt)"; exit 1; fi
+done
+if "$whirl" lead-report --lead linear.csv --end-margin-mm -5 2> err.txt > /dev/null; then
+  echo "accepted a negative margin"; exit 1
+fi
+grep -q -- "--end-margin-mm: -5 breaks the rule: .* mm" err.txt ||
+  { echo "--end-margin-mm -5: $(cat err.txt)"; exit 1; }
 echo OK

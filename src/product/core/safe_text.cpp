@@ -150,6 +150,14 @@ std::string SpreadsheetCell(std::string_view text) {
   return LooksLikeFormula(text) ? "'" + std::string(text) : std::string(text);
 }
 
+std::string CsvTextCell(std::string_view text) {
+  const std::string cell = SpreadsheetCell(text);
+  if (cell.find_first_of(",\"\r\n") == std::string::npos) return cell;
+  std::string out = "\"";
+  for (const char ch : cell) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
 std::string SpreadsheetLine(std::string_view line) {
   std::string out;
   std::size_t start = 0;

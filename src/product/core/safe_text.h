@@ -47,6 +47,13 @@ bool LooksLikeFormula(std::string_view text);
 /// "-Z_um" survives a write and a read.
 std::string SpreadsheetCell(std::string_view text);
 
+/// One CSV cell of user text (a name, a message) in a row of a CSV file (RFC 4180, "Common
+/// Format and MIME Type for CSV Files", section 2): first SpreadsheetCell's formula guard, then a
+/// cell holding ',', '"', CR or LF is enclosed in double quotes with each '"' doubled; any other
+/// cell is written as it is. A reader by RFC 4180 gets the text back (after the guard's
+/// apostrophe), with one cell per cell, one record per row.
+std::string CsvTextCell(std::string_view text);
+
 /// A whole CSV line holding user text (a '#' comment, a header), made inert for spreadsheets, which
 /// split it at every comma: control characters become spaces, and each comma-separated cell whose
 /// first non-blank character starts a formula gets an apostrophe before that character, unless the

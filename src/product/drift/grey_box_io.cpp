@@ -95,13 +95,14 @@ void CheckCoefficients(const Eigen::VectorXd& c, const Eigen::VectorXd& lo,
                        const char* unit) {
   for (Eigen::Index k = 0; k < c.size(); ++k) {
     const std::string f = std::string(field) + "[" + std::to_string(k) + "]";
-    const bool duty = k >= temperatures;
-    const double bound = duty ? kMaxGreyDutyValue : kMaxGreyFeatureK;
-    const char* u = duty ? "the input's unit" : "K";
+    const Range range = k >= temperatures
+                            ? Range{-kMaxGreyDutyValue, kMaxGreyDutyValue, false, "the input's unit"}
+                            : kGreyFeatureRangeK;
     CheckRange(c(k), {-kMaxGreyCoefficient, kMaxGreyCoefficient, false, unit}, f + ".coefficient",
                kWhat);
-    CheckRange(lo(k), {-bound, bound, false, u}, f + ".train_min_k", kWhat);
-    CheckRange(hi(k), {lo(k), bound, false, u, "at least train_min_k"}, f + ".train_max_k", kWhat);
+    CheckRange(lo(k), range, f + ".train_min_k", kWhat);
+    CheckRange(hi(k), {lo(k), range.max, false, range.unit, "at least train_min_k"},
+               f + ".train_max_k", kWhat);
   }
 }
 
@@ -143,7 +144,7 @@ void ValidateGreyBox(const GreyBoxModel& m) {
   CheckNames(Joined(m.offset_sensors, m.offset_duty), "offset_sensors and offset_duty", w);
   CheckNames(Joined(m.slope_sensors, m.slope_duty), "slope_sensors and slope_duty", w);
   CheckTimeConstants(m.time_constants);
-  CheckRange(m.z_ref_mm, kAxisPositionRange, "z_ref_mm", w);
+  CheckRange(m.z_ref_mm, kGreyZRefRange, "z_ref_mm", w);
   const auto per = static_cast<Eigen::Index>(1 + m.time_constants.size());
   const auto no = static_cast<Eigen::Index>(m.offset_sensors.size() + m.offset_duty.size()) * per;
   const auto ns = static_cast<Eigen::Index>(m.slope_sensors.size() + m.slope_duty.size()) * per;
@@ -169,10 +170,9 @@ void ValidateGreyBox(const GreyBoxModel& m) {
     CheckRange(m.blank_um_per_1000_per_k,
                {-kMaxGreyCoefficient, kMaxGreyCoefficient, false, "um per 1000 mm per K"},
                "blank.um_per_1000_per_k", w);
-    CheckRange(m.blank_min_c, {20 - kMaxGreyFeatureK, 20 + kMaxGreyFeatureK, false, "degC"},
-               "blank.train_min_c", w);
+    CheckRange(m.blank_min_c, kGreyBlankRangeC, "blank.train_min_c", w);
     CheckRange(m.blank_max_c,
-               {m.blank_min_c, 20 + kMaxGreyFeatureK, false, "degC", "at least train_min_c"},
+               {m.blank_min_c, kGreyBlankRangeC.max, false, "degC", "at least train_min_c"},
                "blank.train_max_c", w);
   } else if (m.blank_um_per_1000_per_k != 0) {
     throw InputError(w + ": a blank coefficient without a blank sensor");
@@ -301,7 +301,7 @@ GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path) {
   CheckNames(Joined(s.slope_sensors, s.slope_duty), "slope_sensors and slope_duty", w);
   if (s.offset_sensors.empty() && s.slope_sensors.empty())
     throw InputError(w + ": no offset or slope sensor");
-  s.z_ref_mm = RequireNumberIn(j, "z_ref_mm", kAxisPositionRange, w);
+  s.z_ref_mm = RequireNumberIn(j, "z_ref_mm", kGreyZRefRange, w);
   s.offset_prior = ReadPriors(j, "offset_prior_um_per_k", s.offset_sensors, w);
   s.slope_prior = ReadPriors(j, "slope_prior_um_per_1000_per_k", s.slope_sensors, w);
   s.blank_prior = RequireNumberIn(

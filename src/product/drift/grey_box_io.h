@@ -9,14 +9,17 @@
 //                                   e.g. ring_load_pct), after the sensors of their channel
 //   time_constants_min              the shared lags, ascending, each in (0, 1e6] min
 //   z_ref_mm                        the slope's reference (the Z screw's fixed bearing), mm
+//                                   from the chuck face, in (0, 1e5] (kGreyZRefRange)
 //   offset_features, slope_features one object per feature, input-major (T - 20, then its lags):
 //                                   name, input, tau_min (0: the input itself), coefficient
 //                                   (um per K; slope: um per 1000 mm per K, |c| <= 1e4), and its
-//                                   training range train_min_k, train_max_k [K against 20 degC;
-//                                   a duty input's own unit]; then each duty input and its lags
+//                                   training range train_min_k, train_max_k [K against 20 degC,
+//                                   within kGreyFeatureRangeK; a duty input's own unit]; then each
+//                                   duty input and its lags
 //   slope_intercept_um_per_1000     g0, |g0| <= 1e5 (0.1 mm/mm, the largest MD32760)
 //   blank                           null without a blank sensor, else {tau_min (0, 1e6],
-//                                   um_per_1000_per_k (|g_b| <= 1e4), train_min_c, train_max_c}
+//                                   um_per_1000_per_k (|g_b| <= 1e4), train_min_c, train_max_c
+//                                   within kGreyBlankRangeC}
 //   fit                             {prior_strength >= 0, cv_rmse_um in [0, 1e6], rows >= 0}
 //   training                        {notes: provenance}
 // Every number is range-checked on reading; an error names the file, the field and the rule.
@@ -24,7 +27,7 @@
 // Spec file (JSON, "format": "whirl-grey-box-spec", "schema_version": 1): the sensors a shop
 // placed and the physical priors it reads off its drawings:
 //   offset_sensors, slope_sensors, blank_sensor ("" for none), optional offset_duty and
-//   slope_duty (duty inputs, prior 0), z_ref_mm,
+//   slope_duty (duty inputs, prior 0), z_ref_mm (kGreyZRefRange),
 //   offset_prior_um_per_k {sensor: um per K}, slope_prior_um_per_1000_per_k {sensor: value},
 //   blank_prior_um_per_1000_per_k (-alpha_w x 1e6; steel -11.8).
 // A prior key that names no sensor of its list is an error (it would be ignored silently).
@@ -32,6 +35,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "core/limits.h"
 #include "drift/grey_box.h"
 #include "drift/model.h"
 
@@ -45,8 +49,17 @@ inline constexpr const char* kGreyBoxSpecFormat = "whirl-grey-box-spec";
 inline constexpr double kMaxGreyCoefficient = 1e4;
 /// Largest |slope intercept| [um per 1000 mm]: 0.1 mm/mm, the largest MD32760 (SD43910's cap).
 inline constexpr double kMaxGreyIntercept = 1e5;
-/// Largest |feature| of a training range [K against 20 degC].
-inline constexpr double kMaxGreyFeatureK = 1000;
+/// A temperature feature's training range [K against 20 degC]: T - 20 and its lags (averages of
+/// T - 20) for a T that a run file accepts (drift/run_file.h, kMinTemperatureC..kMaxTemperatureC).
+inline constexpr Range kGreyFeatureRangeK{kMinTemperatureC - 20, kMaxTemperatureC - 20, false, "K",
+                                          "T - 20 degC for T a run file accepts"};
+/// The blank's training range [degC]: a lag of a sensor's T, so within what a run file accepts.
+inline constexpr Range kGreyBlankRangeC{kMinTemperatureC, kMaxTemperatureC, false, "degC",
+                                        "a temperature a run file accepts"};
+/// z_ref_mm [mm from the chuck face, the readings' z_mm]: the Z screw's fixed bearing lies on the
+/// bed, beyond the chuck face (z = 0), as the field machine's z.fixed_end_mm (lab/machine/field.h).
+inline constexpr Range kGreyZRefRange{0, kMaxAxisPositionMm, true, "mm",
+                                      "the fixed bearing lies on the bed, beyond the chuck face"};
 /// Largest |value| of a duty input's training range, in its own unit (a feed in mm/min or a
 /// speed in 1/min stays far below; beyond it is a corrupt file).
 inline constexpr double kMaxGreyDutyValue = 1e6;

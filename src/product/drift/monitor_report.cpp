@@ -127,9 +127,6 @@ std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::stri
     << "measured_um,predicted_um,threshold_um,valid,message\n";
   for (const auto& s : r.strategies)
     for (const auto& e : s.events) {
-      std::string msg = e.message;
-      for (char& ch : msg)
-        if (ch == '"' || ch == '\n' || ch == ',') ch = ch == ',' ? ';' : '\'';
       const bool measured =
           e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement;
       o << ToString(s.rule) << "," << ToString(e.kind) << "," << e.sample << ","
@@ -137,7 +134,7 @@ std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::stri
         << FormatNumber(e.predicted_um) << ","
         << (e.kind == MonitorEvent::Kind::kCheck ? FormatNumber(e.threshold_um) : "") << ","
         << (e.kind == MonitorEvent::Kind::kCheck ? (e.valid ? "1" : "0") : "") << ","
-        << SpreadsheetCell(msg) << "\n";
+        << CsvTextCell(e.message) << "\n";
     }
   return o.str();
 }
@@ -456,7 +453,7 @@ std::string WeekEventsCsv(const WeekResult& w, const std::vector<std::string>& c
         if (d == 0) o << "day," << line << "\n";
         continue;
       }
-      o << SpreadsheetCell(w.days[d].run) << "," << line << "\n";
+      o << CsvTextCell(w.days[d].run) << "," << line << "\n";
     }
   }
   return o.str();

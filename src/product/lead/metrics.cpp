@@ -8,11 +8,35 @@
 
 namespace whirl::lead {
 
+namespace {
+
+// Tolerance of the ends of l_u against rounding of x0 + m and x_end - m, mm.
+double EndEps(const LeadDeviation& lead) {
+  return 1e-9 * std::max(1.0, std::abs(lead.position_mm.back()));
+}
+
+}  // namespace
+
+void CheckEndMargin(const LeadDeviation& lead, double end_margin_mm, const std::string& name) {
+  const std::string rule = name + ": " + FormatNumber(end_margin_mm) +
+                           " mm breaks the rule: a finite excess travel l_e >= 0 mm at each end "
+                           "that leaves at least 2 samples in the useful travel l_u = length - 2 l_e";
+  if (!(end_margin_mm >= 0) || !std::isfinite(end_margin_mm)) throw InputError(rule);
+  const double start = lead.position_mm.front() + end_margin_mm;
+  const double end = lead.position_mm.back() - end_margin_mm;
+  const double eps = EndEps(lead);
+  std::size_t n = 0;
+  for (const double x : lead.position_mm) n += (x >= start - eps && x <= end + eps) ? 1 : 0;
+  if (n < 2)
+    throw InputError(rule + "; on the curve [" + FormatNumber(lead.position_mm.front()) + ", " +
+                     FormatNumber(lead.position_mm.back()) + "] mm it leaves l_u = " +
+                     FormatNumber(end - start) + " mm holding " + std::to_string(n) +
+                     " sample(s)");
+}
+
 LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOptions& options) {
   ValidateLeadDeviation(lead, "lead-deviation curve");
-  if (!(options.end_margin_mm >= 0) || !std::isfinite(options.end_margin_mm))
-    throw InputError("end_margin_mm = " + FormatNumber(options.end_margin_mm) +
-                     ": must be finite and >= 0");
+  CheckEndMargin(lead, options.end_margin_mm, "end_margin_mm");
   if (!(options.lead_mm >= 0) || !std::isfinite(options.lead_mm))
     throw InputError("lead_mm = " + FormatNumber(options.lead_mm) +
                      ": must be finite and >= 0 (0 = unknown)");
@@ -22,7 +46,7 @@ LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOption
                      ": windows must be > 0");
   const double start = lead.position_mm.front() + options.end_margin_mm;
   const double end = lead.position_mm.back() - options.end_margin_mm;
-  const double eps = 1e-9 * std::max(1.0, std::abs(lead.position_mm.back()));
+  const double eps = EndEps(lead);
   std::vector<double> x, d;
   for (std::size_t i = 0; i < lead.size(); ++i) {
     if (lead.position_mm[i] >= start - eps && lead.position_mm[i] <= end + eps) {
@@ -30,11 +54,6 @@ LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOption
       d.push_back(lead.deviation_um[i]);
     }
   }
-  if (x.size() < 2)
-    throw InputError("end_margin_mm = " + FormatNumber(options.end_margin_mm) + " leaves " +
-                     std::to_string(x.size()) + " sample(s) of the curve [" +
-                     FormatNumber(lead.position_mm.front()) + ", " +
-                     FormatNumber(lead.position_mm.back()) + "] mm; need at least 2");
 
   LeadMetrics m;
   m.samples = x.size();

@@ -58,6 +58,13 @@ struct LeadMetrics {
 /// a negative margin, a margin that leaves fewer than 2 samples, or non-positive windows.
 LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOptions& options = {});
 
+/// The end margin's rule: a finite `end_margin_mm` >= 0 that leaves at least 2 samples of the
+/// curve in l_u = [x0 + m, x_end - m]. InputError otherwise, naming `name` (the field
+/// "end_margin_mm", or the flag that set it), the value in mm, the rule and the travel l_u it
+/// leaves. ComputeLeadMetrics checks it with the field's name; a command checks it first with its
+/// flag's.
+void CheckEndMargin(const LeadDeviation& lead, double end_margin_mm, const std::string& name);
+
 /// Band width over sliding windows (core/window_range.h), used for v_300, v_2pi and the 1000 mm
 /// figure.
 using whirl::MaxWindowRange;
