@@ -660,8 +660,9 @@ TEST(GreyBoxFiles, PhysicallyImpossibleValuesAreRefusedAndTheLimitsRoundTrip) {
     std::vector<std::string> fragments;  // of the message, each
   };
   const std::vector<Case> hostile = {
-      {{"z_ref_mm"}, -5, {"z_ref_mm = -5 breaks the rule: must lie in (0, 100000] mm"}},
-      {{"z_ref_mm"}, 0, {"z_ref_mm = 0 breaks the rule: must lie in (0, 100000] mm"}},
+      {{"z_ref_mm"},
+       -100001,
+       {"z_ref_mm = -100001 breaks the rule: must lie in [-100000, 100000] mm"}},
       {{"offset_features", "0", "train_min_k"}, -293.15,
        {"offset_features[0].train_min_k = -293.15 breaks the rule: must lie in [-80, 380] K"}},
       {{"slope_features", "1", "train_max_k"}, 380.5,
@@ -687,14 +688,14 @@ TEST(GreyBoxFiles, PhysicallyImpossibleValuesAreRefusedAndTheLimitsRoundTrip) {
   }
   // Every such value at its limit: read, written and read again, the same file.
   nlohmann::json limits = valid;
-  limits["z_ref_mm"] = 100000.0;
+  limits["z_ref_mm"] = -100000.0;  // a fixed bearing behind the chuck face is negative
   limits["offset_features"][0]["train_min_k"] = -80.0;
   limits["slope_features"][1]["train_max_k"] = 380.0;
   limits["blank"]["train_min_c"] = -60.0;
   limits["blank"]["train_max_c"] = 400.0;
   WriteFileAtomic(path, limits.dump());
   const GreyBoxModel read = ReadGreyBoxModel(path);
-  EXPECT_EQ(read.z_ref_mm, 100000.0);
+  EXPECT_EQ(read.z_ref_mm, -100000.0);
   EXPECT_EQ(read.offset_min(0), -80.0);
   EXPECT_EQ(read.blank_max_c, 400.0);
   const auto again = test::ScratchDir() / "impossible_grey_again.json";
@@ -703,11 +704,11 @@ TEST(GreyBoxFiles, PhysicallyImpossibleValuesAreRefusedAndTheLimitsRoundTrip) {
   // The spec the model is fitted to: the same rule for its z_ref_mm, naming the file.
   const auto spec = test::ScratchDir() / "impossible_spec.json";
   WriteFileAtomic(spec, R"({"format": "whirl-grey-box-spec", "schema_version": 1,
-    "offset_sensors": ["a_C"], "slope_sensors": ["b_C"], "blank_sensor": "", "z_ref_mm": -5,
+    "offset_sensors": ["a_C"], "slope_sensors": ["b_C"], "blank_sensor": "", "z_ref_mm": 2e5,
     "blank_prior_um_per_1000_per_k": -11.8})");
   const std::string error = whirl::ErrorOf([&] { (void)ReadGreyBoxSpec(spec); });
   EXPECT_NE(error.find(spec.string()), std::string::npos) << error;
-  EXPECT_NE(error.find("z_ref_mm = -5 breaks the rule: must lie in (0, 100000] mm"),
+  EXPECT_NE(error.find("z_ref_mm = 200000 breaks the rule: must lie in [-100000, 100000] mm"),
             std::string::npos)
       << error;
 }

@@ -144,7 +144,7 @@ void ValidateGreyBox(const GreyBoxModel& m) {
   CheckNames(Joined(m.offset_sensors, m.offset_duty), "offset_sensors and offset_duty", w);
   CheckNames(Joined(m.slope_sensors, m.slope_duty), "slope_sensors and slope_duty", w);
   CheckTimeConstants(m.time_constants);
-  CheckRange(m.z_ref_mm, kGreyZRefRange, "z_ref_mm", w);
+  CheckRange(m.z_ref_mm, kAxisPositionRange, "z_ref_mm", w);
   const auto per = static_cast<Eigen::Index>(1 + m.time_constants.size());
   const auto no = static_cast<Eigen::Index>(m.offset_sensors.size() + m.offset_duty.size()) * per;
   const auto ns = static_cast<Eigen::Index>(m.slope_sensors.size() + m.slope_duty.size()) * per;
@@ -301,7 +301,7 @@ GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path) {
   CheckNames(Joined(s.slope_sensors, s.slope_duty), "slope_sensors and slope_duty", w);
   if (s.offset_sensors.empty() && s.slope_sensors.empty())
     throw InputError(w + ": no offset or slope sensor");
-  s.z_ref_mm = RequireNumberIn(j, "z_ref_mm", kGreyZRefRange, w);
+  s.z_ref_mm = RequireNumberIn(j, "z_ref_mm", kAxisPositionRange, w);
   s.offset_prior = ReadPriors(j, "offset_prior_um_per_k", s.offset_sensors, w);
   s.slope_prior = ReadPriors(j, "slope_prior_um_per_1000_per_k", s.slope_sensors, w);
   s.blank_prior = RequireNumberIn(

@@ -9,7 +9,8 @@
 //                                   e.g. ring_load_pct), after the sensors of their channel
 //   time_constants_min              the shared lags, ascending, each in (0, 1e6] min
 //   z_ref_mm                        the slope's reference (the Z screw's fixed bearing), mm
-//                                   from the chuck face, in (0, 1e5] (kGreyZRefRange)
+//                                   in the readings' z, within +-1e5 (kAxisPositionRange; a
+//                                   bearing behind the chuck face is negative)
 //   offset_features, slope_features one object per feature, input-major (T - 20, then its lags):
 //                                   name, input, tau_min (0: the input itself), coefficient
 //                                   (um per K; slope: um per 1000 mm per K, |c| <= 1e4), and its
@@ -27,7 +28,7 @@
 // Spec file (JSON, "format": "whirl-grey-box-spec", "schema_version": 1): the sensors a shop
 // placed and the physical priors it reads off its drawings:
 //   offset_sensors, slope_sensors, blank_sensor ("" for none), optional offset_duty and
-//   slope_duty (duty inputs, prior 0), z_ref_mm (kGreyZRefRange),
+//   slope_duty (duty inputs, prior 0), z_ref_mm (kAxisPositionRange),
 //   offset_prior_um_per_k {sensor: um per K}, slope_prior_um_per_1000_per_k {sensor: value},
 //   blank_prior_um_per_1000_per_k (-alpha_w x 1e6; steel -11.8).
 // A prior key that names no sensor of its list is an error (it would be ignored silently).
@@ -56,10 +57,6 @@ inline constexpr Range kGreyFeatureRangeK{kMinTemperatureC - 20, kMaxTemperature
 /// The blank's training range [degC]: a lag of a sensor's T, so within what a run file accepts.
 inline constexpr Range kGreyBlankRangeC{kMinTemperatureC, kMaxTemperatureC, false, "degC",
                                         "a temperature a run file accepts"};
-/// z_ref_mm [mm from the chuck face, the readings' z_mm]: the Z screw's fixed bearing lies on the
-/// bed, beyond the chuck face (z = 0), as the field machine's z.fixed_end_mm (lab/machine/field.h).
-inline constexpr Range kGreyZRefRange{0, kMaxAxisPositionMm, true, "mm",
-                                      "the fixed bearing lies on the bed, beyond the chuck face"};
 /// Largest |value| of a duty input's training range, in its own unit (a feed in mm/min or a
 /// speed in 1/min stays far below; beyond it is a corrupt file).
 inline constexpr double kMaxGreyDutyValue = 1e6;
