@@ -13,7 +13,10 @@ gplog, gpm52, gpse, net), and on some tables the peers:
 A cell whose family no file holds is left out; without tables that hold every peer the peer
 columns read "-"; the +-1 sd coverage of 10-table blocks needs seeds of one block (1-10, 11-20,
 ...) all present ("-" otherwise).
-Usage: scripts/choice_diagnosis.py d_1_20.json d_4001_20.json ..."""
+--cells FAMILY/ROWS/OUT,... (e.g. friedman23/20/out1): these cells instead, each on its tables of
+ROWS rows only, in every section (the 40-table diagnosis of the acceptance's five cells behind,
+section "Where the five cells lose").
+Usage: scripts/choice_diagnosis.py [--cells FAMILY/ROWS/OUT,...] d_1_20.json d_4001_20.json ..."""
 import json
 import math
 import sys
@@ -22,16 +25,39 @@ import numpy as np
 
 ACCEPT = ["loglinear", "gp_ard", "mlp_default", "mlp_cv", "brnn_whirl"]
 CANDS = ["linlog", "linid", "gplog", "gpm52", "gpse", "net"]
-if len(sys.argv) < 2:
+args = sys.argv[1:]
+CELL_SPEC = None
+if args[:1] == ["--cells"]:
+    if len(args) < 2:
+        sys.exit(__doc__)
+    try:
+        CELL_SPEC = [(f, int(n), {"out1": 0, "out2": 1}[o]) for f, n, o in
+                     (c.split("/") for c in args[1].split(","))]
+    except (ValueError, KeyError):
+        sys.exit(f"choice_diagnosis.py: --cells {args[1]}: each cell must be FAMILY/ROWS/out1|out2")
+    args = args[2:]
+if not args:
     sys.exit(__doc__)
 try:
-    recs = [r for f in sys.argv[1:] for r in json.load(open(f))]
+    recs = [r for f in args for r in json.load(open(f))]
 except (OSError, ValueError) as e:
     sys.exit(f"choice_diagnosis.py: not a bench_peers.py --json file: {e}")
 ok = lambda r, m: m in r["methods"] and "rmse" in r["methods"][m]
 RMSE_CELLS = [("powerlaw", 1), ("friedman", 0), ("friedman", 1), ("additive", 0), ("additive", 1),
               ("friedman23", 0), ("friedman23", 1), ("powerlaw_noisy", 0), ("hetero", 1)]
 COV_CELLS = [("friedman", 1), ("hetero", 1), ("saturating", 1), ("simgen", 0), ("simgen", 1)]
+if CELL_SPEC:  # (family, output, rows): the cell's tables of those rows only
+    RMSE_CELLS = COV_CELLS = [(f, k, n) for f, n, k in CELL_SPEC]
+
+
+def cell_recs(cell):
+    """The tables of a cell (family, output[, rows]) that hold the default."""
+    return [r for r in recs if r["problem"] == cell[0] and ok(r, "default")
+            and (len(cell) < 3 or r["rows"] == cell[2])]
+
+
+def label(cell):
+    return f"{cell[0]} {cell[2]} rows out{cell[1] + 1}" if len(cell) > 2 else f"{cell[0]} out{cell[1] + 1}"
 
 
 def rmse(r, m, k):
@@ -42,11 +68,12 @@ def pct(a, b):
     return 100 * (a / b - 1)
 
 
-print("| cell | best peer, tuning seeds with peers (n) | default | "
+print(f"| cell | best peer, {'' if CELL_SPEC else 'tuning '}seeds with peers (n) | default | "
       + " | ".join(CANDS) + " | oracle |")
 print("|" + "---|" * (4 + len(CANDS)))
-for fam, k in RMSE_CELLS:
-    rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+for cell in RMSE_CELLS:
+    k = cell[1]
+    rs = cell_recs(cell)
     if not rs:
         continue
     wp = [r for r in rs if all(ok(r, p) for p in ACCEPT)]
@@ -62,12 +89,13 @@ for fam, k in RMSE_CELLS:
     og = math.exp(np.mean([math.log(o / rmse(r, "default", k)) for o, r in zip(orc, rs)]))
     om = above([min(rmse(r, m, k) for m in CANDS) for r in wp])
     peer = f"{best} {med[best]:.4g} ({len(wp)})" if wp else "- (0)"
-    print(f"| {fam} out{k+1} | {peer} | " + " | ".join(cells) + f" | {om} / {og:.2f} ({len(rs)}) |")
+    print(f"| {label(cell)} | {peer} | " + " | ".join(cells) + f" | {om} / {og:.2f} ({len(rs)}) |")
 
 # which candidates the default gives weight to, per cell (share of tables where it appears)
 print()
-for fam, k in dict.fromkeys(RMSE_CELLS + COV_CELLS):  # friedman out2 is in both
-    rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+for cell in dict.fromkeys(RMSE_CELLS + COV_CELLS):  # friedman out2 is in both
+    k = cell[1]
+    rs = cell_recs(cell)
     if not rs:
         continue
     outname = ["max_elongation_um", "settle_time_s"][k]
@@ -77,7 +105,7 @@ for fam, k in dict.fromkeys(RMSE_CELLS + COV_CELLS):  # friedman out2 is in both
         for part in desc.split(": ", 1)[1].split(" + "):
             name = part.split(" ")[-1]
             cnt[name] = cnt.get(name, 0) + 1
-    print(f"{fam} out{k+1} ({len(rs)} tables): " + ", ".join(f"{n} {c}" for n, c in
+    print(f"{label(cell)} ({len(rs)} tables): " + ", ".join(f"{n} {c}" for n, c in
                                                          sorted(cnt.items(), key=lambda x: -x[1])))
 
 # coverage: test residual spread / sd, held-out RMSE / sd, per method
@@ -87,8 +115,9 @@ NAMES = {"linlog": "linear/log", "linid": "linear/identity", "gplog": "gp-matern
          "net": "network-h2/identity"}
 print("| cell | method | cov +-1 / +-2 sd | 10-table blocks +-1 sd min-max | test resid / sd | held-out / sd | test resid / held-out |")
 print("|---|---|---|---|---|---|---|")
-for fam, k in COV_CELLS:
-    rs = [r for r in recs if r["problem"] == fam and ok(r, "default")]
+for cell in COV_CELLS:
+    k = cell[1]
+    rs = cell_recs(cell)
     if not rs:
         continue
     for m in ["default"] + CANDS:
@@ -106,7 +135,7 @@ for fam, k in COV_CELLS:
             blocks.setdefault((r["seed"] - 1) // 10, []).append(x["cover1"][k])
         bm = [100 * np.mean(v) for v in blocks.values() if len(v) == 10]
         span = f"{min(bm):.0f}-{max(bm):.0f}" if bm else "-"
-        print(f"| {fam} out{k+1} ({len(rs)}) | {m} | {c1:.0f} / {c2:.0f} | {span} ({len(bm)}) | {tr:.2f} | {hs:.2f} | {th:.2f} |")
+        print(f"| {label(cell)} ({len(rs)}) | {m} | {c1:.0f} / {c2:.0f} | {span} ({len(bm)}) | {tr:.2f} | {hs:.2f} | {th:.2f} |")
 
 # Single-candidate choices: the default's sd (after its narrowing to the held-out residuals)
 # against the same candidate fitted alone (its own calibration, no narrowing), all families.
@@ -131,7 +160,7 @@ for r in recs:
         kind = "single " + c
         rows.setdefault(kind, []).append((d["cover1"][k], d["cover2"][k], d["sd_rms"][k] / a["sd_rms"][k],
                                           d["resid_rms"][k] / d["sd_rms"][k], a["cover1"][k], a["cover2"][k]))
-print("| the default's choice for an output (all tuning tables, 8 families) | outputs | cov +-1 / +-2 sd | sd / the candidate alone's sd | test resid / sd | the candidate alone: cov +-1 / +-2 |")
+print(f"| the default's choice for an output ({'all tables of the files' if CELL_SPEC else 'all tuning tables, 8 families'}) | outputs | cov +-1 / +-2 sd | sd / the candidate alone's sd | test resid / sd | the candidate alone: cov +-1 / +-2 |")
 print("|---|---|---|---|---|---|")
 for kind, v in sorted(rows.items(), key=lambda x: -len(x[1])):
     v = np.array([list(t) + [math.nan] * (6 - len(t)) for t in v])

@@ -4,8 +4,8 @@
 # docs/workpiece-model.md's thirteenth attempt runs it, no scikit-learn peer): one row per cell
 # whose family was run, the header's columns, the tables counted, the hindsight oracle never
 # above a candidate, every output counted once; with planted peers (each the default's RMSE
-# doubled) the default's median is -50.0 % of the best peer's; bad arguments exit non-zero with a
-# message.
+# doubled) the default's median is -50.0 % of the best peer's; --cells keeps the cells named, on
+# their rows; bad arguments exit non-zero with a message.
 # Usage (CTest): lab_choice_diagnosis.sh <whirl> <scratch dir> <source dir> <family_bench>
 set -uo pipefail
 W="$1"; D="$2"; S="$3"; FB="$4"
@@ -70,7 +70,27 @@ PY
 [ "$(grep -c '^| \(powerlaw\|friedman\) out[12] | [a-z_]* [0-9.e+-]* (2) | -50.0 % |' peers.txt)" = 3 ] \
   || fail "planted peers: the default is not -50.0 % of the best peer in 3 cells: $(cat peers.txt)"
 
+# --cells: only the cells named, on their tables of those rows; a cell without tables (powerlaw
+# at 100 rows: none were run) is left out, in the RMSE and the coverage sections alike.
+"${CD[@]}" --cells friedman/20/out1,powerlaw/100/out2 run.json > cells.txt 2> err.txt \
+  || fail "choice_diagnosis --cells: $(cat err.txt)"
+check_py "cells.txt" '
+lines = open("cells.txt").read().splitlines()
+cols = lambda l: [c.strip() for c in l.strip().strip("|").split("|")]
+rmse = [l for l in lines if l.startswith("| friedman") and cols(l)[0].endswith("out1")]
+assert [cols(l)[0] for l in rmse] == ["friedman 20 rows out1"], lines
+ratios = [float(x.split("/")[1]) for x in cols(rmse[0])[3:9]]
+assert float(cols(rmse[0])[9].split("/")[1].split("(")[0]) <= min(ratios), rmse
+assert cols(rmse[0])[9].endswith("(2)"), rmse
+cover = [l for l in lines if l.startswith("| friedman 20 rows out1 (2) |")]
+assert [cols(l)[1] for l in cover] == ["default", "linlog", "linid", "gplog", "gpm52", "gpse", "net"], lines
+assert [l for l in lines if " tables): " in l] == [l for l in lines if l.startswith("friedman 20 rows out1 (2 tables): ")], lines
+assert not any("powerlaw" in l and "rows out" in l for l in lines), lines
+'
+
 # Bad arguments.
 expect_usage_error "Usage: scripts/choice_diagnosis.py" "${CD[@]}"
+expect_usage_error "each cell must be FAMILY/ROWS/out1" "${CD[@]}" --cells friedman/20/out3 run.json
+expect_usage_error "Usage: scripts/choice_diagnosis.py" "${CD[@]}" --cells friedman/20/out1
 expect_usage_error "not a bench_peers.py --json file" "${CD[@]}" nosuch.json
 echo "lab_choice_diagnosis: passed ($PY)"
