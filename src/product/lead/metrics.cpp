@@ -10,28 +10,33 @@ namespace whirl::lead {
 
 namespace {
 
-// Tolerance of the ends of l_u against rounding of x0 + m and x_end - m, mm.
-double EndEps(const LeadDeviation& lead) {
-  return 1e-9 * std::max(1.0, std::abs(lead.position_mm.back()));
-}
+// Whether a position lies in the useful travel l_u = [x0 + m, x_end - m] of a margin m, with a
+// tolerance against the rounding of its ends.
+struct UsefulTravel {
+  UsefulTravel(const LeadDeviation& lead, double end_margin_mm)
+      : start(lead.position_mm.front() + end_margin_mm),
+        end(lead.position_mm.back() - end_margin_mm),
+        eps(1e-9 * std::max(1.0, std::abs(lead.position_mm.back()))) {}
+  bool Holds(double x) const { return x >= start - eps && x <= end + eps; }
+  double start, end, eps;
+};
 
 }  // namespace
 
 void CheckEndMargin(const LeadDeviation& lead, double end_margin_mm, const std::string& name) {
-  const std::string rule = name + ": " + FormatNumber(end_margin_mm) +
-                           " mm breaks the rule: a finite excess travel l_e >= 0 mm at each end "
-                           "that leaves at least 2 samples in the useful travel l_u = length - 2 l_e";
+  const std::string rule =
+      name + ": " + FormatNumber(end_margin_mm) +
+      " mm breaks the rule: a finite excess travel l_e >= 0 mm at each end "
+      "that leaves at least 2 samples in the useful travel l_u = length - 2 l_e";
   if (!(end_margin_mm >= 0) || !std::isfinite(end_margin_mm)) throw InputError(rule);
-  const double start = lead.position_mm.front() + end_margin_mm;
-  const double end = lead.position_mm.back() - end_margin_mm;
-  const double eps = EndEps(lead);
-  std::size_t n = 0;
-  for (const double x : lead.position_mm) n += (x >= start - eps && x <= end + eps) ? 1 : 0;
+  const UsefulTravel lu(lead, end_margin_mm);
+  const auto n = static_cast<std::size_t>(std::count_if(
+      lead.position_mm.begin(), lead.position_mm.end(), [&](double x) { return lu.Holds(x); }));
   if (n < 2)
     throw InputError(rule + "; on the curve [" + FormatNumber(lead.position_mm.front()) + ", " +
-                     FormatNumber(lead.position_mm.back()) + "] mm it leaves l_u = " +
-                     FormatNumber(end - start) + " mm holding " + std::to_string(n) +
-                     " sample(s)");
+                     FormatNumber(lead.position_mm.back()) +
+                     "] mm it leaves l_u = " + FormatNumber(lu.end - lu.start) + " mm holding " +
+                     std::to_string(n) + " sample(s)");
 }
 
 LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOptions& options) {
@@ -44,12 +49,10 @@ LeadMetrics ComputeLeadMetrics(const LeadDeviation& lead, const LeadMetricOption
     throw InputError("window_300_mm = " + FormatNumber(options.window_300_mm) +
                      ", window_1000_mm = " + FormatNumber(options.window_1000_mm) +
                      ": windows must be > 0");
-  const double start = lead.position_mm.front() + options.end_margin_mm;
-  const double end = lead.position_mm.back() - options.end_margin_mm;
-  const double eps = EndEps(lead);
+  const UsefulTravel lu(lead, options.end_margin_mm);
   std::vector<double> x, d;
   for (std::size_t i = 0; i < lead.size(); ++i) {
-    if (lead.position_mm[i] >= start - eps && lead.position_mm[i] <= end + eps) {
+    if (lu.Holds(lead.position_mm[i])) {
       x.push_back(lead.position_mm[i]);
       d.push_back(lead.deviation_um[i]);
     }
