@@ -31,7 +31,8 @@ const char* kRunFilesHelp =
     "Run files: CSV, header row; time_s [s] or time_min [min] (empty/nan cells: the sample\n"
     "index is used and said so); temperatures <name>_C [degC]; errors <name>_um [um]; other\n"
     "columns (e.g. spindle_rpm) are optional inputs. At most 2,000,000 rows, 512 columns.\n"
-    "UTF-8 text (a leading byte-order mark is skipped); decimal numbers only.\n";
+    "UTF-8 text (a leading byte-order mark is skipped); decimal numbers only; names and cells\n"
+    "may be in double quotes (RFC 4180, as a spreadsheet's \"quote all text cells\" export).\n";
 
 const std::string kDeadSensorsHelp =
     "A sensor whose reading never moves (stuck, disconnected) or moves exactly as another (the\n"

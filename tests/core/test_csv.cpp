@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <regex>
 
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/process.h"
+#include "core/safe_text.h"
+#include "support/rfc4180.h"
 
 namespace whirl {
 namespace {
@@ -182,6 +186,201 @@ TEST(Csv, FormatThenParseIsIdentity) {
   std::vector<std::vector<double>> rows = {{1.0 / 3, 2e-300}, {-7, 1e10}};
   const CsvTable t = ParseCsv(FormatCsv({"x", "y"}, rows, {"c"}), "m");
   EXPECT_EQ(t.rows, rows);
+}
+
+// A spreadsheet's "save as CSV" with "quote all text cells": RFC 4180 quoted names and cells;
+// "" in quotes is one '"'; a quoted number follows its column's number rules; blanks around the
+// quotes are not part of the cell, blanks inside a quoted name are.
+TEST(Csv, QuotedNamesAndCellsByRfc4180) {
+  const CsvTable t = ParseCsv(
+      "\xEF\xBB\xBF\"hardness_hrc\",\"diameter_mm\"\r\n\"58.5\",20\r\n 61 , \"-2e1\" \r\n", "t.csv");
+  EXPECT_EQ(t.header, (std::vector<std::string>{"hardness_hrc", "diameter_mm"}));
+  EXPECT_EQ(t.rows, (std::vector<std::vector<double>>{{58.5, 20}, {61, -20}}));
+  EXPECT_EQ(t.line_numbers, (std::vector<int>{2, 3}));
+  EXPECT_EQ(ParseCsv("\"say \"\"hi\"\"\",\" b \",\"c,d\"\n1,2,3\n", "t.csv").header,
+            (std::vector<std::string>{"say \"hi\"", " b ", "c,d"}));
+  EXPECT_NE(CsvErrorOf("a,b\n1,\"x\"\n").find("t.csv:2: column 2 ('b'): 'x' is not a number"),
+            std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,\"\"\n").find("t.csv:2: column 2 ('b'): empty cell"),
+            std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,\"0x1p3\"\n").find("not a decimal number"), std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,b\n1,\"2,3\"\n").find("'2,3' is not a number"), std::string::npos)
+      << "a quoted comma is no separator";
+  EXPECT_NE(CsvErrorOf("a,b\n\"1\",\"2\",3\n").find("t.csv:2: expected 2 cells, found 3"),
+            std::string::npos);
+  CsvOptions o;
+  o.missing_allowed = {"time_s"};
+  const CsvTable m = ParseCsv("\"time_s\",\"a\"\n\"\",1\n\"nan\",2\n", "t.csv", o);
+  EXPECT_TRUE(std::isnan(m.rows[0][0]) && std::isnan(m.rows[1][0]));
+  EXPECT_EQ(m.rows[1][1], 2);
+}
+
+// What RFC 4180 does not allow is refused naming the file, line, column, character and the rule.
+TEST(Csv, QuotesRfc4180RefusesAreNamed) {
+  const std::string stray = CsvErrorOf("a,b\"c\n1,2\n");
+  EXPECT_NE(stray.find("t.csv:1: column 2, character 4: a '\"' inside a cell that does not start "
+                       "with one (RFC 4180: a cell holding ',', '\"' or a line break is enclosed "
+                       "in double quotes, each '\"' in it doubled)"),
+            std::string::npos)
+      << stray;
+  EXPECT_NE(CsvErrorOf("a,b\n1,2\"\n").find("t.csv:2: column 2, character 4: a '\"' inside"),
+            std::string::npos);
+  EXPECT_NE(CsvErrorOf("\"a\"x,b\n1,2\n")
+                .find("t.csv:1: column 1, character 4: text after the closing '\"'"),
+            std::string::npos);
+  EXPECT_NE(CsvErrorOf("a,\"b\" \"c\"\n1,2\n").find("t.csv:1: column 2, character 7: text after"),
+            std::string::npos);
+  const std::string open = CsvErrorOf("a,b\n1,\"2\n3,4\n");
+  EXPECT_NE(open.find("t.csv:2: column 2, character 3: the '\"' opening this cell is never closed"),
+            std::string::npos)
+      << open;
+  EXPECT_NE(CsvErrorOf("x\xC3\xA9,\"b,c\",d\xFF\n1,2,3\n")
+                .find("t.csv:1: column 3, character 11: byte 0xFF is not UTF-8"),
+            std::string::npos)
+      << "the column counts cells, not commas: " << CsvErrorOf("x\xC3\xA9,\"b,c\",d\xFF\n1,2,3\n");
+}
+
+// A quoted cell may hold line breaks: the record goes on, line numbers stay the file's, and a
+// '#' comment line holding a '"' is still one line.
+TEST(Csv, LineBreaksInsideQuotesKeepFileLines) {
+  const std::string text = "# say \"hi\n\"a\nb\",\"c\r\n\r\nd\"\n# note\n1,2\n3,x\n";
+  const std::string e = CsvErrorOf(text);
+  EXPECT_NE(e.find("t.csv:8: column 2 ('c\r\n\r\nd'): 'x' is not a number"), std::string::npos) << e;
+  const CsvTable t = ParseCsv(text.substr(0, text.size() - 4), "t.csv");
+  EXPECT_EQ(t.header, (std::vector<std::string>{"a\nb", "c\r\n\r\nd"}));
+  EXPECT_EQ(t.header_line, 2);
+  EXPECT_EQ(t.line_numbers, (std::vector<int>{7}));
+  EXPECT_EQ(t.comments, (std::vector<std::string>{"say \"hi", "note"}));
+  EXPECT_NE(CsvErrorOf("\"a\n\nx\",b\n1,2\n3\n").find("t.csv:5: expected 2 cells"),
+            std::string::npos);
+}
+
+// A decimal-comma spreadsheet's export with quoted text is still named at the header; a quoted
+// ';' is a character of a name.
+TEST(Csv, QuotedSemicolonExportIsNamedAtTheHeader) {
+  const std::string e = CsvErrorOf("\"a\";\"b\"\n1;2\n");
+  EXPECT_NE(e.find("t.csv:1: the header is one column holding ';'"), std::string::npos) << e;
+  EXPECT_EQ(ParseCsv("\"a;b\"\n1\n", "t.csv").header, (std::vector<std::string>{"a;b"}));
+}
+
+// Column names that need quoting, by hand: written quoted (the formula guard inside the quotes),
+// each read back as it was.
+TEST(Csv, NamesNeedingQuotesAreWrittenQuotedAndReadBack) {
+  const std::vector<std::string> names = {"a,b", "say \"hi\"", " lead", "trail ", "x\ny",
+                                          "=1+2", "'=x", "#n", "p;q", " =cmd"};
+  const std::string text = FormatCsv(names, {{1, 2, 3, 4, 5, 6, 7, 8, 9, 10}});
+  EXPECT_EQ(text.substr(0, text.find("\n1,")),
+            "\"a,b\",\"say \"\"hi\"\"\",\" lead\",\"trail \",\"x\ny\",'=1+2,''=x,\"#n\",\"p;q\","
+            "' =cmd");
+  const CsvTable t = ParseCsv(text, "m");
+  EXPECT_EQ(t.header, names);
+  EXPECT_EQ(t.rows.at(0).at(9), 10);
+}
+
+// Random names over the characters that matter (separators, quotes, blanks, line breaks, formula
+// starts, '#', the text marker, UTF-8): every table whirl writes reads back with its names and
+// numbers (from text; every 25th from a file too), and its header is one RFC 4180 record (an
+// independent reader) of the guarded names.
+TEST(Csv, RandomNamesRoundTrip) {
+  const std::vector<std::string> alphabet = {"=", "+", "-", "@", "\t", "\r", "\n", "'", "a", "1",
+                                             " ", ",", "\"", ";", "#", "\xC2\xB5", "\r\n"};
+  std::mt19937_64 rng(20261130);
+  std::uniform_int_distribution<std::size_t> pick(0, alphabet.size() - 1), length(1, 6),
+      columns(1, 4);
+  const auto file = std::filesystem::temp_directory_path() / "whirl_csv_names.csv";
+  for (int trial = 0; trial < 5000; ++trial) {
+    std::vector<std::string> names;
+    while (names.size() < columns(rng)) {
+      std::string n;
+      for (std::size_t k = length(rng); k > 0; --k) n += alphabet[pick(rng)];
+      if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+    }
+    const std::vector<std::vector<double>> rows = {std::vector<double>(names.size(), trial),
+                                                   std::vector<double>(names.size(), -0.5)};
+    const std::string text = FormatCsv(names, rows, {"c \"" + names[0]});
+    const CsvTable t = ParseCsv(text, "m");
+    ASSERT_EQ(t.header, names) << "trial " << trial << ": " << text;
+    ASSERT_EQ(t.rows, rows) << "trial " << trial;
+    if (trial % 25 == 0) {  // a file reader holds a 1 MiB buffer: every 25th table
+      std::ofstream(file, std::ios::binary | std::ios::trunc) << text;
+      CsvReader reader(file);
+      ASSERT_EQ(reader.header(), names) << "trial " << trial;
+    }
+    const auto records = test::ParseRfc4180(text.substr(text.find('\n') + 1));
+    ASSERT_EQ(records.size(), 3u) << "trial " << trial;
+    for (std::size_t i = 0; i < names.size(); ++i)
+      ASSERT_EQ(records[0][i], SpreadsheetCell(names[i])) << "trial " << trial;
+  }
+  std::filesystem::remove(file);
+}
+
+// The file reader's first chunk (1 MiB) ends before, at or after the line break inside a quoted
+// cell: the rows before it and the refusal of that cell (a number cannot hold a line break) are
+// ParseCsv's on the whole text, on the file's line.
+TEST(Csv, QuotedRecordsAcrossChunksReadAsTheWholeText) {
+  std::string rows = "\"t\nime_s\",\"v\"\n";
+  for (int i = 0; rows.size() < (1u << 20) - 64; ++i)
+    rows += (i % 3 ? "\"" + std::to_string(i) + "\"" : std::to_string(i)) + ", \" " +
+            FormatNumber(0.25 * i) + " \"\n";
+  const auto file = std::filesystem::temp_directory_path() / "whirl_csv_chunks.csv";
+  for (std::size_t k = 0; k < 12; ++k) {
+    // a comment line that puts the '\n' inside "1\n2" at byte 2^20 - 6 + k of the file
+    const std::string pad((1u << 20) - rows.size() - 12 + k, ' ');
+    const std::string text = rows + "#" + pad + "\n5,\"1\n2\"\n6,7\n";
+    ASSERT_EQ(text.find("1\n2"), (1u << 20) - 6 + k - 1);
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << text;
+    const std::string whole = CsvErrorOf(text);
+    const auto line = 1 + std::count(text.begin(), text.begin() + text.find("5,\"1"), '\n');
+    EXPECT_NE(whole.find(":" + std::to_string(line) + ": column 2 ('v'): '1\n2' is not a number"),
+              std::string::npos)
+        << whole;
+    const CsvTable before = ParseCsv(rows, "t.csv");
+    CsvReader reader(file);
+    EXPECT_EQ(reader.header(), (std::vector<std::string>{"t\nime_s", "v"}));
+    double row[2];
+    int row_line = 0;
+    std::size_t n = 0;
+    try {
+      for (; reader.Next(row, &row_line); ++n) {
+        ASSERT_LT(n, before.rows.size());
+        ASSERT_EQ(row_line, before.line_numbers[n]);
+        ASSERT_EQ(row[0], before.rows[n][0]);
+        ASSERT_EQ(row[1], before.rows[n][1]);
+      }
+      ADD_FAILURE() << "no error, k = " << k;
+    } catch (const InputError& e) {
+      EXPECT_EQ(n, before.rows.size());
+      const std::string message = e.what();
+      EXPECT_EQ(message.substr(message.find(':')), whole.substr(whole.find(':'))) << k;
+    }
+  }
+  std::filesystem::remove(file);
+}
+
+// A quote never closed in a long file stops the reader at its memory bound (kMaxCsvLineBytes),
+// naming where the quote opened, instead of reading the file into one record.
+TEST(Csv, UnclosedQuoteStopsAtTheMemoryBound) {
+  const auto file = std::filesystem::temp_directory_path() / "whirl_csv_unclosed.csv";
+  {
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out << "a,b\n1,2\n3,\"4\n";
+    const std::string rows(1 << 20, '\n');
+    for (std::size_t written = 0; written <= kMaxCsvLineBytes; written += rows.size()) out << rows;
+  }
+  CsvReader reader(file);
+  double row[2];
+  int line = 0;
+  ASSERT_TRUE(reader.Next(row, &line));
+  try {
+    reader.Next(row, &line);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":3: column 2, character 3: the '\"' opening this cell "
+                                         "is not closed within 16 MiB"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(file);
 }
 
 }  // namespace

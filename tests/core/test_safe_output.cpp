@@ -115,8 +115,9 @@ TEST(SafeText, TerminalTextIsAlwaysInertAndKeepsInertText) {
   }
 }
 
-// Property over random byte strings: a spreadsheet cell never starts like a formula, text that
-// does not is unchanged, and one that does keeps its text after the apostrophe.
+// Property over random strings: a spreadsheet cell never starts a formula, not even after its
+// leading spaces and apostrophes; text that does not is unchanged, one that does keeps its text
+// after the apostrophe; SpreadsheetText gives the text back.
 TEST(SafeText, SpreadsheetCellNeverStartsAFormula) {
   std::mt19937_64 rng(20261126);
   const std::string alphabet = "=+-@\t\r'a1 ,\"";
@@ -126,12 +127,18 @@ TEST(SafeText, SpreadsheetCellNeverStartsAFormula) {
     for (char& c : text) c = alphabet[pick(rng)];
     const std::string cell = SpreadsheetCell(text);
     ASSERT_FALSE(LooksLikeFormula(cell)) << "trial " << trial;
-    if (!text.empty() && std::string("=+-@\t\r").find(text[0]) != std::string::npos) {
-      ASSERT_EQ(cell, "'" + text) << "trial " << trial;
-    } else {
-      ASSERT_EQ(cell, text) << "trial " << trial;
+    const std::size_t first = text.find_first_not_of("' ");
+    const bool formula = first != std::string::npos &&
+                         std::string("=+-@\t\r").find(text[first]) != std::string::npos;
+    ASSERT_EQ(cell, formula ? "'" + text : text) << "trial " << trial;
+    const std::size_t shown = cell.find_first_not_of(' ');
+    if (shown != std::string::npos) {
+      ASSERT_FALSE(LooksLikeFormula(cell.substr(shown))) << "trial " << trial;
     }
+    ASSERT_EQ(SpreadsheetText(cell), text) << "trial " << trial;
   }
+  EXPECT_EQ(SpreadsheetCell("'=x"), "''=x") << "the marker itself is not mistaken for text";
+  EXPECT_EQ(SpreadsheetText("'abc"), "'abc");
 }
 
 // RFC 4180 section 2, rules 5-7, by hand: quotes only where needed, '"' doubled, the guard first.
@@ -144,6 +151,15 @@ TEST(SafeText, CsvTextCellQuotesByRfc4180) {
   EXPECT_EQ(CsvTextCell("a\rb"), "\"a\rb\"");
   EXPECT_EQ(CsvTextCell("=1+2"), "'=1+2");
   EXPECT_EQ(CsvTextCell("=A1,\"x\""), "\"'=A1,\"\"x\"\"\"");
+  // Beyond the RFC's must: blanks at an end (readers trim them), ';' and tab (a decimal-comma
+  // spreadsheet's separators), a leading '#' (a comment line as a row's first cell).
+  EXPECT_EQ(CsvTextCell(" a"), "\" a\"");
+  EXPECT_EQ(CsvTextCell("a "), "\"a \"");
+  EXPECT_EQ(CsvTextCell("a;b"), "\"a;b\"");
+  EXPECT_EQ(CsvTextCell("a\tb"), "\"a\tb\"");
+  EXPECT_EQ(CsvTextCell("#a"), "\"#a\"");
+  EXPECT_EQ(CsvTextCell("a#"), "a#");
+  EXPECT_EQ(CsvTextCell(" =1"), "' =1");
 }
 
 // Property over random strings: a row of CsvTextCell cells read by an RFC 4180 reader gives one

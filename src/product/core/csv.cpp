@@ -29,30 +29,98 @@ std::string_view Trim(std::string_view s) {
   return s;
 }
 
-// The cells of a line: every ',' ends one (a trailing ',' leaves an empty last cell), each trimmed.
-std::vector<std::string> SplitCells(std::string_view line) {
+// The RFC 4180 rule quoted in every refusal of a quote.
+constexpr const char* kQuoteRule =
+    "(RFC 4180: a cell holding ',', '\"' or a line break is enclosed in double quotes, each '\"' "
+    "in it doubled)";
+
+// 1 + the commas of `text` outside double quotes (each '"' opens or closes a quoted cell; "" in
+// one closes and reopens it): the CSV column of the byte after `text`.
+std::size_t ColumnAfter(std::string_view text) {
+  std::size_t column = 1;
+  bool quoted = false;
+  for (const char ch : text) {
+    if (ch == '"') quoted = !quoted;
+    column += !quoted && ch == ',';
+  }
+  return column;
+}
+
+// "source:line: column c, character k" of byte `offset` of a record starting on `first_line`
+// (the text before it is UTF-8): the file line it is on, its CSV column, its character there.
+std::string Place(std::string_view record, std::size_t offset, int first_line,
+                  const std::string& source) {
+  const std::string_view before = record.substr(0, offset);
+  const std::size_t newline = before.rfind('\n');
+  const std::string_view on_line =
+      newline == std::string_view::npos ? before : before.substr(newline + 1);
+  std::size_t character = 1;  // code points before the byte on its line
+  for (const char ch : on_line) character += (static_cast<unsigned char>(ch) & 0xC0) != 0x80;
+  const auto line = first_line + std::count(before.begin(), before.end(), '\n');
+  return source + ":" + std::to_string(line) + ": column " + std::to_string(ColumnAfter(before)) +
+         ", character " + std::to_string(character);
+}
+
+// The text of a quoted cell whose '"' is at record[open], "" read as one '"'; *after is the
+// index after its closing '"'. False when the cell is not closed.
+bool QuotedCell(std::string_view record, std::size_t open, std::string* cell, std::size_t* after) {
+  cell->clear();
+  for (std::size_t i = open + 1; i < record.size(); ++i) {
+    if (record[i] != '"') {
+      *cell += record[i];
+    } else if (i + 1 < record.size() && record[i + 1] == '"') {
+      *cell += '"';
+      ++i;
+    } else {
+      *after = i + 1;
+      return true;
+    }
+  }
+  return false;
+}
+
+// The cells of a record by RFC 4180 (section 2, rules 4-7): every ',' outside quotes ends one (a
+// trailing ',' leaves an empty last cell); a cell in double quotes (blanks around them ignored)
+// keeps its text as it is, ',' and line breaks included, "" read as '"'; any other cell is
+// trimmed. A '"' inside an unquoted cell, text after a closing quote and a quote never closed
+// are InputErrors naming the file, line, column, character and the rule.
+std::vector<std::string> SplitCells(std::string_view record, int first_line,
+                                    const std::string& source) {
   std::vector<std::string> cells;
-  for (;;) {
-    const std::size_t comma = line.find(',');
-    cells.emplace_back(Trim(line.substr(0, comma)));
-    if (comma == std::string_view::npos) return cells;
-    line.remove_prefix(comma + 1);
+  const auto refuse = [&](std::size_t at, const char* what) {
+    throw InputError(Place(record, at, first_line, source) + ": " + what + " " + kQuoteRule);
+  };
+  for (std::size_t i = 0;;) {
+    std::size_t start = i;
+    while (start < record.size() && IsBlank(record[start])) ++start;
+    std::size_t stop = 0;
+    if (start < record.size() && record[start] == '"') {
+      cells.emplace_back();
+      if (!QuotedCell(record, start, &cells.back(), &stop))
+        refuse(start, "the '\"' opening this cell is never closed");
+      while (stop < record.size() && IsBlank(record[stop])) ++stop;
+      if (stop < record.size() && record[stop] != ',')
+        refuse(stop, "text after the closing '\"' of a quoted cell");
+    } else {
+      stop = std::min(record.find(',', i), record.size());
+      const std::string_view cell = record.substr(i, stop - i);
+      if (cell.find('"') != std::string_view::npos)
+        refuse(i + cell.find('"'), "a '\"' inside a cell that does not start with one");
+      cells.emplace_back(Trim(cell));
+    }
+    if (stop >= record.size()) return cells;
+    i = stop + 1;
   }
 }
 
-// InputError at the first byte of `line` that is not UTF-8: line, CSV column and character
-// position; nothing when the line is UTF-8.
-void CheckUtf8Line(std::string_view line, int line_no, const std::string& source) {
-  const std::size_t bad = InvalidUtf8Offset(line);
+// InputError at the first byte of a record (starting on file line `first_line`) that is not
+// UTF-8: its line, CSV column and character position; nothing when the record is UTF-8.
+void CheckUtf8(std::string_view record, int first_line, const std::string& source) {
+  const std::size_t bad = InvalidUtf8Offset(record);
   if (bad == std::string_view::npos) return;
-  const std::string_view before = line.substr(0, bad);
-  const auto column = 1 + std::count(before.begin(), before.end(), ',');
-  std::size_t character = 1;  // code points before the bad byte (the line before it is UTF-8)
-  for (const char ch : before) character += (static_cast<unsigned char>(ch) & 0xC0) != 0x80;
   char byte[8];
-  std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(line[bad]));
-  throw InputError(source + ":" + std::to_string(line_no) + ": column " + std::to_string(column) +
-                   ", character " + std::to_string(character) + ": byte " + byte +
+  std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(record[bad]));
+  throw InputError(Place(record, bad, first_line, source) + ": byte " + byte +
                    " is not UTF-8 (save the file as UTF-8 text)");
 }
 
@@ -63,24 +131,33 @@ bool IsAscii(std::string_view s) {
   return any < 0x80;
 }
 
-// Column names of the header row: none empty, none twice, and not one name holding a ';' or a
-// tab (a spreadsheet's export in a decimal-comma locale).
+// A header row without a ',' outside quotes but with a ';' or a tab there: a spreadsheet's export
+// in a decimal-comma locale, named as such (not as one column called "a;b").
+void CheckSeparator(std::string_view record, const std::string& where) {
+  bool quoted = false;
+  char separator = 0;
+  for (const char ch : Trim(record)) {
+    if (ch == '"') quoted = !quoted;
+    if (quoted) continue;
+    if (ch == ',') return;
+    if ((ch == ';' || ch == '\t') && separator == 0) separator = ch;
+  }
+  if (separator != 0)
+    throw InputError(where + ": the header is one column holding " +
+                     (separator == ';' ? std::string("';'") : std::string("tabs")) +
+                     ": whirl reads comma-separated files (',' between columns, '.' as the "
+                     "decimal point); save the table as CSV with commas");
+}
+
+// Column names of the header row: none empty, none twice. The spreadsheet text marker whirl
+// writes before a formula-like name (SpreadsheetCell) is not part of the name, as in a
+// spreadsheet (SpreadsheetText).
 std::vector<std::string> HeaderNames(std::vector<std::string> cells, const std::string& where) {
-  if (cells.size() == 1)
-    for (const char sep : {';', '\t'})
-      if (cells[0].find(sep) != std::string::npos)
-        throw InputError(where + ": the header is one column holding " +
-                         (sep == ';' ? std::string("';'") : std::string("tabs")) +
-                         ": whirl reads comma-separated files (',' between columns, '.' as the "
-                         "decimal point); save the table as CSV with commas");
   std::set<std::string> seen;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (cells[c].empty())
       throw InputError(where + ": column " + std::to_string(c + 1) + " has an empty name");
-    // The spreadsheet text marker whirl writes before a formula-like name
-    // (SpreadsheetCell) is not part of the name, as in a spreadsheet.
-    if (cells[c].size() > 1 && cells[c][0] == '\'' && LooksLikeFormula(cells[c].substr(1)))
-      cells[c].erase(0, 1);
+    cells[c] = SpreadsheetText(cells[c]);
     if (!seen.insert(cells[c]).second)
       throw InputError(where + ": duplicated column '" + cells[c] + "'");
   }
@@ -141,9 +218,37 @@ bool FastDecimal(std::string_view cell, double* v) {
 
 constexpr std::size_t kChunkBytes = 1u << 20;
 
+// Whether a record goes on past a line break: RFC 4180 lets a quoted cell hold one. The scan of
+// the record so far, resumed line by line; a stray '"' counts as text here (SplitCells refuses
+// it when the record is parsed).
+struct QuoteScan {
+  enum State { kCellStart, kUnquoted, kQuoted, kQuoteInQuoted } state = kCellStart;
+  std::size_t opened = 0;  // offset of the '"' that opened the last quoted cell
+
+  // Scans record[from, end): true when it ends inside a quoted cell.
+  bool Open(std::string_view record, std::size_t from) {
+    for (std::size_t i = from; i < record.size(); ++i) {
+      const char ch = record[i];
+      if (state == kCellStart && ch == '"') {
+        state = kQuoted;
+        opened = i;
+      } else if (state == kCellStart) {
+        state = ch == ',' || IsBlank(ch) ? kCellStart : kUnquoted;
+      } else if (state == kUnquoted) {
+        state = ch == ',' ? kCellStart : kUnquoted;
+      } else if (state == kQuoted) {
+        state = ch == '"' ? kQuoteInQuoted : kQuoted;
+      } else {  // after a '"' in a quoted cell: "" goes on, anything else closed it
+        state = ch == '"' ? kQuoted : ch == ',' ? kCellStart : kUnquoted;
+      }
+    }
+    return state == kQuoted;
+  }
+};
+
 }  // namespace
 
-// The reader's state: the text (read in chunks from a file, or held), the line scanner and the
+// The reader's state: the text (read in chunks from a file, or held), the record scanner and the
 // header.
 struct CsvReader::Impl {
   std::string source;
@@ -153,7 +258,10 @@ struct CsvReader::Impl {
   std::size_t pos = 0, end = 0;
   bool eof = false, first_line = true;
   unsigned long long consumed = 0, total = 0;
-  int line_no = 0;
+  std::size_t quote_from = std::string::npos, quote_at = 0, quote_end = 0;  // QuoteFrom's memo
+  int line_no = 0;             // file lines read so far
+  int record_line = 0;         // the first file line of the last record
+  bool record_quoted = false;  // the last record holds a '"'
   std::size_t comment_cap = std::numeric_limits<std::size_t>::max();
   std::vector<std::string> header, comments;
   std::vector<bool> may_miss;
@@ -168,14 +276,12 @@ struct CsvReader::Impl {
   // Reads more text into the buffer; false at the end of the file.
   bool Fill() {
     if (eof) return false;
-    if (pos > 0) {  // the unscanned rest (a partial line) to the front
+    if (pos > 0) {  // the unscanned rest (a partial record) to the front
       std::memmove(buf.data(), buf.data() + pos, end - pos);
       end -= pos;
       pos = 0;
+      quote_from = std::string::npos;
     }
-    if (end > kMaxCsvLineBytes)  // the buffer holds the current line alone
-      throw InputError(source + ":" + std::to_string(line_no + 1) + ": a line longer than " +
-                       std::to_string(kMaxCsvLineBytes >> 20) + " MiB (not a CSV table?)");
     if (buf.size() - end < kChunkBytes) buf.resize(end + kChunkBytes);  // grows, never shrinks
     for (;;) {
       const ssize_t n = ::read(fd, buf.data() + end, buf.size() - end);
@@ -187,78 +293,133 @@ struct CsvReader::Impl {
     }
   }
 
-  // The next line without its '\n' (and a final '\r'); false at the end of the text.
-  bool NextLine(std::string_view* line) {
-    for (;;) {
-      const char* b = buf.data() + pos;
-      const void* nl = std::memchr(b, '\n', end - pos);
-      if (nl != nullptr || (eof || fd < 0)) {
-        const std::size_t len = nl ? static_cast<const char*>(nl) - b : end - pos;
-        if (!nl && len == 0) return false;
-        *line = std::string_view(b, len);
-        pos += len + (nl ? 1 : 0);
-        consumed += len + (nl ? 1 : 0);
-        ++line_no;
-        if (first_line) {  // a UTF-8 byte-order mark is not part of the first line
-          first_line = false;
-          if (line->substr(0, 3) == "\xEF\xBB\xBF") line->remove_prefix(3);
-        }
-        if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
-        return true;
-      }
-      Fill();
+  // A UTF-8 byte-order mark at the start of the text is skipped (spreadsheets write one), so it
+  // can neither hide the first column's name nor turn a first '#' line into the header.
+  void SkipByteOrderMark() {
+    first_line = false;
+    while (end - pos < 3 && Fill()) {
+    }
+    if (std::string_view(buf.data() + pos, end - pos).substr(0, 3) == "\xEF\xBB\xBF") {
+      pos += 3;
+      consumed += 3;
     }
   }
 
-  // The next line that is not blank, a comment or (once) the header; false at the end.
-  bool NextDataLine(std::string_view* line) {
-    while (NextLine(line)) {
-      if (!IsAscii(*line)) CheckUtf8Line(*line, line_no, source);
-      const std::string_view trimmed = Trim(*line);
-      if (trimmed.empty()) continue;
-      if (trimmed[0] == '#') {
-        if (comments.size() < comment_cap) comments.emplace_back(Trim(trimmed.substr(1)));
+  // The buffer index of the first '"' in buf[at, end), or `end` if none; memoized, so that a
+  // text without quotes costs one memchr per chunk, not one per line.
+  std::size_t QuoteFrom(std::size_t at) {
+    if (at < quote_from || at > quote_at || (quote_at == quote_end && quote_end < end)) {
+      const void* q = std::memchr(buf.data() + at, '"', end - at);
+      quote_from = at;
+      quote_end = end;
+      quote_at = q ? static_cast<std::size_t>(static_cast<const char*>(q) - buf.data()) : end;
+    }
+    return quote_at;
+  }
+
+  // True when the line record[from, end) (record at buf[pos]) leaves the record inside a quoted
+  // cell, so that the record goes on after the line break. A '#' comment line never does.
+  bool Continues(std::string_view record, std::size_t from, QuoteScan* scan) {
+    if (from == 0) {
+      record_quoted = QuoteFrom(pos) < pos + record.size();
+      if (!record_quoted) return false;
+      const std::string_view trimmed = Trim(record);
+      if (!trimmed.empty() && trimmed[0] == '#') return false;
+    }
+    return scan->Open(record, from);
+  }
+
+  // The buffer holds kMaxCsvLineBytes of one record that has not ended: the memory bound.
+  [[noreturn]] void TooLong(std::string_view record, std::size_t from, QuoteScan* scan) const {
+    const std::string mib = std::to_string(kMaxCsvLineBytes >> 20) + " MiB";
+    if (from > 0 && scan->Open(record, from))
+      throw InputError(Place(record, scan->opened, line_no + 1, source) +
+                       ": the '\"' opening this cell is not closed within " + mib + " " +
+                       kQuoteRule);
+    throw InputError(source + ":" + std::to_string(line_no + 1) + ": a line longer than " + mib +
+                     " (not a CSV table?)");
+  }
+
+  // The next record without its line break (and a '\r' before it): one line, or several when a
+  // quoted cell holds line breaks; false at the end of the text.
+  bool NextRecord(std::string_view* record) {
+    if (first_line) SkipByteOrderMark();
+    QuoteScan scan;
+    std::size_t from = 0;  // the record's lines before `from` end inside a quoted cell
+    for (;;) {
+      const char* b = buf.data() + pos;
+      const std::size_t avail = end - pos;
+      const void* nl = std::memchr(b + from, '\n', avail - from);
+      if (nl == nullptr && !eof && fd >= 0) {
+        if (avail > kMaxCsvLineBytes) TooLong(std::string_view(b, avail), from, &scan);
+        Fill();
         continue;
       }
-      if (header_line == 0) {
-        ReadHeader(*line);
+      const std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - b) : avail;
+      if (nl != nullptr && Continues(std::string_view(b, len), from, &scan)) {
+        from = len + 1;
         continue;
       }
+      if (nl == nullptr && len == 0) return false;
+      *record = std::string_view(b, len);
+      if (nl == nullptr && from == 0) record_quoted = QuoteFrom(pos) < pos + len;
+      pos += len + (nl ? 1 : 0);
+      consumed += len + (nl ? 1 : 0);
+      record_line = line_no + 1;
+      line_no = record_line +
+                static_cast<int>(from > 0 ? std::count(record->begin(), record->end(), '\n') : 0);
+      if (!record->empty() && record->back() == '\r') record->remove_suffix(1);
       return true;
     }
+  }
+
+  // Checks a record's UTF-8; true when it is blank or a '#' comment (kept in `comments`).
+  bool Skip(std::string_view record) {
+    if (!IsAscii(record)) CheckUtf8(record, record_line, source);
+    const std::string_view trimmed = Trim(record);
+    if (!trimmed.empty() && trimmed[0] != '#') return false;
+    if (!trimmed.empty() && comments.size() < comment_cap)
+      comments.emplace_back(Trim(trimmed.substr(1)));
+    return true;
+  }
+
+  // The next record that is not blank or a comment; false at the end.
+  bool NextDataRecord(std::string_view* record) {
+    while (NextRecord(record))
+      if (!Skip(*record)) return true;
     return false;
   }
 
-  void ReadHeader(std::string_view line) {
-    header = HeaderNames(SplitCells(line), source + ":" + std::to_string(line_no));
-    header_line = line_no;
+  void ReadHeader(std::string_view record) {
+    header_line = record_line;
+    const std::string where = source + ":" + std::to_string(record_line);
+    CheckSeparator(record, where);
+    header = HeaderNames(SplitCells(record, record_line, source), where);
     for (const auto& h : header)
       may_miss.push_back(std::find(options.missing_allowed.begin(), options.missing_allowed.end(),
                                    h) != options.missing_allowed.end());
   }
 
+  // Up to the header: blank and comment lines, then the header row itself.
   void Start() {
-    std::string_view line;
-    // Up to the header: blank and comment lines, then the header row itself.
-    while (header_line == 0 && NextLine(&line)) {
-      if (!IsAscii(line)) CheckUtf8Line(line, line_no, source);
-      const std::string_view trimmed = Trim(line);
-      if (trimmed.empty()) continue;
-      if (trimmed[0] == '#') {
-        if (comments.size() < comment_cap) comments.emplace_back(Trim(trimmed.substr(1)));
-        continue;
-      }
-      ReadHeader(line);
-    }
+    std::string_view record;
+    while (header_line == 0 && NextRecord(&record))
+      if (!Skip(record)) ReadHeader(record);
     if (header_line == 0) throw InputError(source + ": empty file (no header row)");
   }
 
   // The cell count of a data row must be the header's.
-  void CheckCellCount(std::string_view line) const {
-    const auto cells = 1 + static_cast<std::size_t>(std::count(line.begin(), line.end(), ','));
+  void CheckCellCount(std::size_t cells) const {
     if (cells != header.size())
-      throw InputError(source + ":" + std::to_string(line_no) + ": expected " +
+      throw InputError(source + ":" + std::to_string(record_line) + ": expected " +
                        std::to_string(header.size()) + " cells, found " + std::to_string(cells));
+  }
+
+  // The cells of a record with quotes (SplitCells), as many as the header's.
+  std::vector<std::string> QuotedCells(std::string_view record) const {
+    std::vector<std::string> cells = SplitCells(record, record_line, source);
+    CheckCellCount(cells.size());
+    return cells;
   }
 
   // End of the text: a table without rows is refused unless allowed.
@@ -269,19 +430,39 @@ struct CsvReader::Impl {
     return false;
   }
 
-  void ParseRow(std::string_view line, double* row) const {
-    for (std::size_t c = 0; c < header.size(); ++c) {
-      const std::size_t comma = line.find(',');
-      const std::string_view cell = Trim(line.substr(0, comma));
-      line.remove_prefix(comma == std::string_view::npos ? line.size() : comma + 1);
-      if (may_miss[c] && IsMissing(cell)) {
-        row[c] = NAN;
-      } else if (!FastDecimal(cell, &row[c])) {
-        row[c] = CellNumber(std::string(cell), source + ":" + std::to_string(line_no) +
-                                                   ": column " + std::to_string(c + 1) + " ('" +
-                                                   header[c] + "')");
-      }
+  // Cell c of a data row (trimmed; a quoted cell's text) by the number rules of its column.
+  void ParseCell(std::size_t c, std::string_view cell, double* row) const {
+    if (may_miss[c] && IsMissing(cell)) {
+      row[c] = NAN;
+    } else if (!FastDecimal(cell, &row[c])) {
+      row[c] = CellNumber(std::string(cell), source + ":" + std::to_string(record_line) +
+                                                 ": column " + std::to_string(c + 1) + " ('" +
+                                                 header[c] + "')");
     }
+  }
+
+  // A data record into row[0, header.size()): a record without quotes (the common one) is cut
+  // at its commas in place, one with quotes goes through SplitCells.
+  void ParseRow(std::string_view record, double* row) const {
+    if (record_quoted) {
+      const std::vector<std::string> cells = QuotedCells(record);
+      for (std::size_t c = 0; c < header.size(); ++c) ParseCell(c, Trim(cells[c]), row);
+      return;
+    }
+    CheckCellCount(1 + static_cast<std::size_t>(std::count(record.begin(), record.end(), ',')));
+    for (std::size_t c = 0; c < header.size(); ++c) {
+      const std::size_t comma = record.find(',');
+      ParseCell(c, Trim(record.substr(0, comma)), row);
+      record.remove_prefix(comma == std::string_view::npos ? record.size() : comma + 1);
+    }
+  }
+
+  // The trimmed text of cell `column` of a data record (its cell count checked).
+  std::string CellText(std::string_view record, std::size_t column) const {
+    if (record_quoted) return std::string(Trim(QuotedCells(record)[column]));
+    CheckCellCount(1 + static_cast<std::size_t>(std::count(record.begin(), record.end(), ',')));
+    for (std::size_t c = 0; c < column; ++c) record.remove_prefix(record.find(',') + 1);
+    return std::string(Trim(record.substr(0, record.find(','))));
   }
 };
 
@@ -332,22 +513,19 @@ bool CsvReader::HasColumn(const std::string& name) const {
 }
 
 bool CsvReader::Next(double* row, int* line) {
-  std::string_view text;
-  if (!impl_->NextDataLine(&text)) return impl_->Finish();
-  impl_->CheckCellCount(text);
-  impl_->ParseRow(text, row);
-  *line = impl_->line_no;
+  std::string_view record;
+  if (!impl_->NextDataRecord(&record)) return impl_->Finish();
+  impl_->ParseRow(record, row);
+  *line = impl_->record_line;
   ++impl_->rows;
   return true;
 }
 
 bool CsvReader::NextCell(std::size_t column, std::string* cell, int* line) {
-  std::string_view text;
-  if (!impl_->NextDataLine(&text)) return impl_->Finish();
-  impl_->CheckCellCount(text);
-  for (std::size_t c = 0; c < column; ++c) text.remove_prefix(text.find(',') + 1);
-  cell->assign(Trim(text.substr(0, text.find(','))));
-  *line = impl_->line_no;
+  std::string_view record;
+  if (!impl_->NextDataRecord(&record)) return impl_->Finish();
+  *cell = impl_->CellText(record, column);
+  *line = impl_->record_line;
   ++impl_->rows;
   return true;
 }
@@ -394,8 +572,7 @@ CsvTable ParseCsv(const std::string& text, const std::string& source, const CsvO
       const std::size_t newline = bad == 0 ? std::string_view::npos : body.rfind('\n', bad - 1);
       const std::size_t start = newline == std::string_view::npos ? 0 : newline + 1;
       const auto line = 1 + std::count(body.begin(), body.begin() + static_cast<std::ptrdiff_t>(start), '\n');
-      CheckUtf8Line(body.substr(start, body.find('\n', bad) - start), static_cast<int>(line),
-                    source);
+      CheckUtf8(body.substr(start, body.find('\n', bad) - start), static_cast<int>(line), source);
     }
   }
   CsvReader reader(text, source, options);
@@ -434,12 +611,12 @@ std::string FormatCsv(const std::vector<std::string>& header,
                       const std::vector<std::vector<double>>& rows,
                       const std::vector<std::string>& comments) {
   std::string out;
-  // Comments and header carry user text (names, paths): one line each (a newline in a name must
-  // not start a data row) and inert in a spreadsheet (SpreadsheetLine).
+  // Comments and column names carry user text (names, paths), inert in a spreadsheet: a comment is
+  // one line (SpreadsheetLine), a name one cell by RFC 4180 (CsvTextCell), which the reader above
+  // gives back as it was.
   for (const auto& c : comments) out += "# " + SpreadsheetLine(c) + "\n";
-  std::string names;
-  for (std::size_t i = 0; i < header.size(); ++i) names += (i ? "," : "") + header[i];
-  out += SpreadsheetLine(names) + "\n";
+  for (std::size_t i = 0; i < header.size(); ++i) out += (i ? "," : "") + CsvTextCell(header[i]);
+  out += "\n";
   for (const auto& r : rows) {
     for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "," : "") + FormatNumber(r[i]);
     out += "\n";

@@ -9,6 +9,15 @@
 // line, the column and the character position.
 // Numbers: decimal only, [+-]digits[.digits][(e|E)[+-]digits] (also ".5" and "5."); hexadecimal
 // floats (0x1p3), "inf", "nan" and every other form strtod would take are refused.
+// Quotes: RFC 4180 ("Common Format and MIME Type for CSV Files", section 2), as a spreadsheet's
+// "quote all text cells" export writes: a name or cell in double quotes (blanks around them
+// dropped) keeps its text as it is, ',' and line breaks included, "" read as one '"'; a quoted
+// number follows its column's number rules. A '"' inside an unquoted cell, text after a closing
+// quote and a quote never closed are refused (file, line, column, character, the rule). A record
+// whose quoted cell holds line breaks spans those file lines; line numbers are the file's (a
+// row's is the line it starts on). A column name keeps the blanks inside its quotes, and loses
+// the spreadsheet text marker whirl writes before a formula-like name (SpreadsheetText).
+// FormatCsv writes every name through CsvTextCell, so every table it writes reads back.
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -47,13 +56,16 @@ struct CsvOptions {
 
 /// Comment lines a CsvReader on a file keeps (the first ones: a logger may write many).
 inline constexpr std::size_t kMaxCsvComments = 1000;
-/// Longest line a CsvReader takes [bytes] (a run file of 512 columns needs about 15 kB).
+/// Longest record a CsvReader takes [bytes] (a run file of 512 columns needs about 15 kB): a line,
+/// or the lines of a quoted cell holding line breaks (an unclosed quote stops here).
 inline constexpr std::size_t kMaxCsvLineBytes = 16u << 20;
 
 /// A CSV text read row by row by the rules of this header, for files too long to hold (a
 /// machine's log of millions of rows): a file is read in chunks of 1 MiB and each row parsed once
 /// into the caller's buffer, so memory does not grow with the file. The constructor reads up to
-/// the header row; Next returns the data rows in order. The errors are ParseCsv's, naming the
+/// the header row; Next returns the data rows in order. A record without '"' (the common one) is
+/// cut at its commas in place; one with quotes goes through the RFC 4180 rules above. The errors
+/// are ParseCsv's, naming the
 /// file, line and column; an invalid UTF-8 byte is reported on the line it is found on (ParseCsv
 /// on text reports the first one in the text before any other error).
 class CsvReader {
@@ -92,7 +104,8 @@ class CsvReader {
 };
 
 /// Parses CSV text. Rejects: text that is not UTF-8, no header, an empty or duplicated column
-/// name, a row with the wrong number of cells, a cell that is not a complete decimal number, NaN
+/// name, a quote against RFC 4180, a row with the wrong number of cells, a cell that is not a
+/// complete decimal number, NaN
 /// or infinity (outside options.missing_allowed), and (unless options.allow_empty) a table with
 /// no data row. `source` names the text in error messages.
 CsvTable ParseCsv(const std::string& text, const std::string& source, const CsvOptions& options);
@@ -105,7 +118,8 @@ CsvTable ReadCsv(const std::filesystem::path& path, bool allow_empty = false);
 /// command-line number); nullopt otherwise ("0x1p3", "nan", "1e999", "1,5", "").
 std::optional<double> ParseDecimal(const std::string& text);
 
-/// Builds CSV text: optional '#' comment lines, a header, and rows (formatted by FormatNumber).
+/// Builds CSV text: optional '#' comment lines (SpreadsheetLine), a header of CsvTextCell names
+/// (quoted where needed, formula-guarded) and rows (formatted by FormatNumber).
 std::string FormatCsv(const std::vector<std::string>& header,
                       const std::vector<std::vector<double>>& rows,
                       const std::vector<std::string>& comments = {});

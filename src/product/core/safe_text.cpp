@@ -146,13 +146,39 @@ bool LooksLikeFormula(std::string_view text) {
   return c == '=' || c == '+' || c == '-' || c == '@' || c == '\t' || c == '\r';
 }
 
+namespace {
+
+// SpreadsheetCell's rule: the text after its leading apostrophes and spaces looks like a formula.
+// Prepending an apostrophe keeps the answer, so SpreadsheetText can undo the marker.
+bool NeedsTextMarker(std::string_view text) {
+  const std::size_t first = text.find_first_not_of("' ");
+  return first != std::string_view::npos && LooksLikeFormula(text.substr(first));
+}
+
+// A cell that CsvTextCell encloses in quotes: RFC 4180's ',', '"', CR and LF; a blank at either
+// end (a reader trims unquoted cells); ';' and tab (a spreadsheet in a decimal-comma locale
+// splits there); a leading '#' (a comment line when it is a row's first cell) or byte-order mark.
+bool NeedsQuotes(std::string_view cell) {
+  if (cell.empty()) return false;
+  return cell.find_first_of(",\"\r\n;\t") != std::string_view::npos || cell.front() == ' ' ||
+         cell.back() == ' ' || cell.front() == '#' || cell.substr(0, 3) == "\xEF\xBB\xBF";
+}
+
+}  // namespace
+
 std::string SpreadsheetCell(std::string_view text) {
-  return LooksLikeFormula(text) ? "'" + std::string(text) : std::string(text);
+  return NeedsTextMarker(text) ? "'" + std::string(text) : std::string(text);
+}
+
+std::string SpreadsheetText(std::string_view cell) {
+  if (!cell.empty() && cell.front() == '\'' && NeedsTextMarker(cell.substr(1)))
+    cell.remove_prefix(1);
+  return std::string(cell);
 }
 
 std::string CsvTextCell(std::string_view text) {
   const std::string cell = SpreadsheetCell(text);
-  if (cell.find_first_of(",\"\r\n") == std::string::npos) return cell;
+  if (!NeedsQuotes(cell)) return cell;
   std::string out = "\"";
   for (const char ch : cell) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
   return out + "\"";

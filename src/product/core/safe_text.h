@@ -41,17 +41,23 @@ std::size_t InvalidUtf8Offset(std::string_view text);
 /// '=', '+', '-', '@', a tab or a carriage return (OWASP "CSV injection").
 bool LooksLikeFormula(std::string_view text);
 
-/// A CSV cell from user text that a spreadsheet shows as text: a cell that LooksLikeFormula gets a
-/// leading apostrophe (spreadsheets show the rest as typed, without the apostrophe); anything else
-/// is unchanged. whirl's CSV reader drops that apostrophe again (core/csv.h), so a column such as
-/// "-Z_um" survives a write and a read.
+/// A CSV cell from user text that a spreadsheet shows as text: a cell that would start a formula
+/// once its leading apostrophes and spaces are passed over (LooksLikeFormula) gets a leading
+/// apostrophe, the spreadsheet's text marker (spreadsheets show the rest as typed, without the
+/// apostrophe); anything else is unchanged. SpreadsheetText undoes it exactly, which whirl's CSV
+/// reader does for column names (core/csv.h), so "-Z_um" or "'=x" survives a write and a read.
 std::string SpreadsheetCell(std::string_view text);
 
-/// One CSV cell of user text (a name, a message) in a row of a CSV file (RFC 4180, "Common
+/// The text of a cell SpreadsheetCell wrote: its leading apostrophe dropped when SpreadsheetCell
+/// would have added it (SpreadsheetText(SpreadsheetCell(t)) == t for every t).
+std::string SpreadsheetText(std::string_view cell);
+
+/// One CSV cell of user text (a name, a message, a column name) in a CSV file (RFC 4180, "Common
 /// Format and MIME Type for CSV Files", section 2): first SpreadsheetCell's formula guard, then a
-/// cell holding ',', '"', CR or LF is enclosed in double quotes with each '"' doubled; any other
-/// cell is written as it is. A reader by RFC 4180 gets the text back (after the guard's
-/// apostrophe), with one cell per cell, one record per row.
+/// cell holding ',', '"', CR, LF, ';' or a tab, or starting with '#', or with a space at either
+/// end, is enclosed in double quotes with each '"' doubled; any other cell is written as it is.
+/// A reader by RFC 4180 gets the text back (after the guard's apostrophe), with one cell per
+/// cell, one record per row; whirl's reader (core/csv.h) gets the text itself back.
 std::string CsvTextCell(std::string_view text);
 
 /// A whole CSV line holding user text (a '#' comment, a header), made inert for spreadsheets, which
