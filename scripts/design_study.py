@@ -214,8 +214,9 @@ def variance_args(a):
 
 # A replaced generator seed s (negative target in its candidate list) becomes the first of
 # s + k * REPLACEMENT_STRIDE (k = 1, 2, ...) whose list has none: seeds of --seeds stay below the
-# stride, so ranges that do not overlap get disjoint seeds, replacements included.
-REPLACEMENT_STRIDE = 1_000_000
+# stride, so ranges that do not overlap get disjoint seeds, replacements included (the rule
+# scripts/bench_peers.py applies to its tables).
+REPLACEMENT_STRIDE = bp.REPLACEMENT_STRIDE
 SEED_RULES = ["stride", "next-after-range"]
 SEED_RULE_HELP = ("how a seed whose candidate list holds a negative target is replaced: 'stride' "
                   "(s + k x 1,000,000) or 'next-after-range' (the rule of the figures published "
@@ -253,9 +254,7 @@ def usable_seeds(prob, seeds, rule="stride"):
         return out
     out = []
     for s in seeds:
-        r = s
-        while not ok(r):
-            r += REPLACEMENT_STRIDE
+        r = bp.replacement_seed(ok, s)
         if r != s:
             print(f"design_study: {prob} seed {s} replaced by {r} (a negative target in its "
                   "candidate list)", file=sys.stderr)

@@ -2,7 +2,8 @@
 # scripts/bench_peers.py: the paired decision (--from-json --paired, --rule fifth|sixth) on planted
 # runs with hand-computed figures; a tiny run through build/whirl and build/family_bench (2 problems
 # x 1 size x 2 seeds, no scikit-learn peer): its JSON's records, fields and counts, and two
-# identical whirl settings paired give every d = 0 and "no change"; bad arguments exit non-zero
+# identical whirl settings paired give every d = 0 and "no change"; a planted table with a
+# non-positive target is replaced by seed + k x 1,000,000 and counted; bad arguments exit non-zero
 # with a message.
 # Usage (CTest): lab_bench_peers.sh <whirl> <scratch dir> <source dir> <family_bench>
 set -uo pipefail
@@ -89,6 +90,43 @@ grep -qF "8 cases (problem, rows, seed, output) of 4 tables; 8 cases with identi
   twin.txt && grep -qF "mean d +0.0000" twin.txt \
   && grep -qx "decision: no change (twin has whirl's RMSE, sd and coverage on every table; keep whirl)" \
   twin.txt || fail "two identical settings paired: $(cat twin.txt)"
+
+# A planted table with a non-positive target (which whirl train, brnn_whirl and loglinear refuse):
+# powerlaw 20 rows seed 2 gets a negative settle time, its first replacement 1000002 a zero
+# elongation, so seed 2 is run as 2000002 (s + 2 x 1,000,000), said on stderr, counted in the
+# report and kept as "replaces" in the JSON; seed 1 is run as drawn. replacement_seed by hand:
+# the first of 1, 1000001, 2000001 divisible by 3 is 2000001.
+"$PY" - "$S/scripts" "$W" > planted.txt 2> planted_err.txt <<'PY' || fail "planted run: $(cat planted_err.txt)"
+import sys
+sys.path.insert(0, sys.argv[1])
+import bench_peers as bp
+assert bp.replacement_seed(lambda s: s % 3 == 0, 1) == 2000001
+drawn = bp.problem_data
+def planted(prob, n, seed, *rest):
+    xtr, ytr, xte, fte, yte = drawn(prob, n, seed, *rest)
+    ytr = ytr.copy()
+    if seed == 2:
+        ytr[5, 1] = -1.0
+    if seed == 1000002:
+        ytr[0, 0] = 0.0
+    return xtr, ytr, xte, fte, yte
+bp.problem_data = planted
+sys.argv = ["bench_peers.py", "--whirl", sys.argv[2], "--problems", "powerlaw", "--sizes", "20",
+            "--seeds", "2", "--first-seed", "1", "--peers", "", "--no-threads2", "--json",
+            "planted.json"]
+bp.main()
+PY
+check_py "planted.json" '
+import json
+runs = json.load(open("planted.json"))
+assert [(r["seed"], r.get("replaces")) for r in runs] == [(1, None), (2000002, 2)], runs
+assert all("failed" not in m for r in runs for m in r["methods"].values()), runs
+'
+grep -qF "bench_peers: powerlaw 20 rows seed 2 replaced by 2000002 (a training target <= 0)" \
+  planted_err.txt || fail "no replacement message: $(cat planted_err.txt)"
+grep -qF "powerlaw, 20 training rows, 2 seeds (1-2;" planted.txt \
+  && grep -qF "1 of 2 seeds replaced (a training target <= 0): 2 by 2000002" planted.txt \
+  || fail "the report does not count the replacement: $(cat planted.txt)"
 
 # Bad arguments: a non-zero exit and a message.
 expect_usage_error "needs --from-json" "${BP[@]}" --paired a b
