@@ -25,7 +25,9 @@
 # grey_short_offset_as_read / grey_short_offset_one_lag: both_grey with the offset sensors as read
 # / through the shortest chosen lag below 20 lead days;
 # grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two lead
-# days), judged and tabled the same way.
+# days; grey_short_mix / grey_short_mix_fixed: below 20 lead days the line w both_grey + (1 - w)
+# the base rule, w from those two lead days clamped to [0.5, 1] / fixed at 0.75), judged and
+# tabled the same way.
 # --grey-five-sensors: both_grey with its five physical sensors on every record (the model before
 # the eleventh round, which takes every sensor from 20 lead days on), so older figures reproduce.
 set -euo pipefail
@@ -50,7 +52,7 @@ while [ $# -gt 0 ]; do
     --grey-five-sensors) candidate+=(--grey-five-sensors); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
-    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_short_prior,grey_short_offset_as_read,grey_short_offset_one_lag,grey_guarded"
+    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_short_prior,grey_short_offset_as_read,grey_short_offset_one_lag,grey_guarded,grey_short_mix,grey_short_mix_fixed"
                        shift ;;
     -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;

@@ -316,8 +316,10 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "(both_grey with the offset sensors as read, or through the shortest chosen lag, "
               "while the record holds fewer than 20 lead days) and grey_guarded (both_grey's "
               "model or the sensor-free base rule, whichever predicted the shop's own last two "
-              "lead days better); off by default (docs/machine-evaluation.md, eighth to "
-              "thirteenth rounds)");
+              "lead days better), grey_short_mix and grey_short_mix_fixed (while the record "
+              "holds fewer than 20 lead days the line w both_grey + (1 - w) the base rule, w "
+              "from the same two lead days, at least 0.5, or fixed at 0.75); off by default "
+              "(docs/machine-evaluation.md, eighth to fourteenth rounds)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

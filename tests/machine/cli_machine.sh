@@ -156,7 +156,7 @@ for name in a:
 for name in ("grey_warmup_k0", "grey_mean_k0"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 PY
-# --grey-candidates (the eighth to tenth rounds) adds its three rows after the seventh round's,
+# --grey-candidates (the eighth to fourteenth rounds) adds its rows after the seventh round's,
 # in the same run: every other row, the seventh round's included, comes out equal; grey_guarded
 # is the row of the model it chose (grey_guarded_choice per machine) to the digit, and
 # grey_sensors_by_days both_grey's (one past day: fewer than 20 lead days).
@@ -171,11 +171,13 @@ gc = json.load(open(sys.argv[2]))["scenarios"][0]
 b = gc["strategies"]
 assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_sensors_by_days",
                                       "grey_short_prior", "grey_short_offset_as_read",
-                                      "grey_short_offset_one_lag", "grey_guarded"]), sorted(b)
+                                      "grey_short_offset_one_lag", "grey_guarded",
+                                      "grey_short_mix", "grey_short_mix_fixed"]), sorted(b)
 for name in a:
     assert a[name] == b[name], name
 for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_short_prior",
-             "grey_short_offset_as_read", "grey_short_offset_one_lag", "grey_guarded"):
+             "grey_short_offset_as_read", "grey_short_offset_one_lag", "grey_guarded",
+             "grey_short_mix", "grey_short_mix_fixed"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 # grey_fit: what both_grey's fit chose on the machine (one past day: one lead day), from its grids.
 fit = gc["runs"][0]["grey_fit"]
@@ -188,5 +190,10 @@ assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), ch
 for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
     assert b["grey_guarded"][key] == a[chosen[0]][key], (key, chosen)
     assert b["grey_sensors_by_days"][key] == a["both_grey"][key], key
+# grey_short_mix (the fourteenth round): one lead day leaves no earlier day to score, so the grey
+# box's weight is 1 and the row is both_grey's to the digit.
+assert gc["runs"][0]["grey_short_mix_weight"] == [1.0], gc["runs"][0]["grey_short_mix_weight"]
+for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
+    assert b["grey_short_mix"][key] == a["both_grey"][key], key
 PY
 echo "cli_machine: ok"

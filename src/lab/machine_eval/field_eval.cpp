@@ -285,10 +285,12 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
     for (const drift::GreyBoxModel& g : models.shop.grey_candidates)
       held.candidates.push_back(RunCausally(g, log));
     const ShopModels& shop = models.shop;
-    if (shop.guard.chosen)
-      held.candidates.push_back(shop.guard.keep_grey   ? held.grey
-                                : shop.rule_is_schedule ? held.schedule
-                                                        : held.warmup);
+    if (shop.guard.chosen) {
+      const HeldSamples& rule = shop.rule_is_schedule ? held.schedule : held.warmup;
+      held.candidates.push_back(shop.guard.keep_grey ? held.grey : rule);
+      for (double w : {shop.mix.fitted_weight, shop.mix.fixed_weight})
+        held.candidates.push_back(MixedLines(held.grey, rule, w));
+    }
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));
@@ -379,6 +381,7 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
       e.guard_choice.push_back(shop.guard.keep_grey      ? "both_grey"
                                : shop.rule_is_schedule ? "schedule"
                                                        : "warmup");
+    if (shop.guard.chosen) e.short_mix_weight.push_back(shop.mix.fitted_weight);
     e.grey_fit.push_back({shop.grey.prior_strength, shop.grey.blank_tau_min,
                           shop.grey.cv_rmse_um, shop.grey.time_constants,
                           models[i].lead_days});

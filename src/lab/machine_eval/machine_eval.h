@@ -135,19 +135,24 @@ double WarmupOffsetShare(OffsetCandidate c);
 /// strength fixed at 1 below 2 x forward_days lead days (grey_short_prior, shop_models.h
 /// ShortRecordStrongPrior); the thirteenth round's both_grey with the offset sensors as read
 /// (grey_short_offset_as_read) or through the shortest chosen lag (grey_short_offset_one_lag)
-/// below 2 x forward_days lead days (shop_models.h ShortRecordOffsetLags), before grey_guarded.
-/// All count as using sensors; never the strongest sensor-free row.
+/// below 2 x forward_days lead days (shop_models.h ShortRecordOffsetLags), before grey_guarded;
+/// after it the fourteenth round's line w both_grey + (1 - w) base rule below 2 x forward_days
+/// lead days, w from the guard's held days (grey_short_mix) or fixed (grey_short_mix_fixed;
+/// shop_models.h ShortMixWeights). All count as using sensors; never the strongest sensor-free
+/// row.
 enum class GreyCandidate {
   kAllSensors,
   kSensorsByDays,
   kShortPrior,
   kShortOffsetAsRead,
   kShortOffsetOneLag,
-  kGuarded
+  kGuarded,
+  kShortMix,
+  kShortMixFixed
 };
-inline constexpr std::size_t kGreyCandidateCount = 6;
+inline constexpr std::size_t kGreyCandidateCount = 8;
 /// grey_all_sensors, grey_sensors_by_days, grey_short_prior, grey_short_offset_as_read,
-/// grey_short_offset_one_lag, grey_guarded
+/// grey_short_offset_one_lag, grey_guarded, grey_short_mix, grey_short_mix_fixed
 std::string ToString(GreyCandidate c);
 /// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
 std::string OptInRowName(std::size_t k);
@@ -228,6 +233,9 @@ struct MachineEvaluation {
   /// Per machine, when the opt-in grey rows were asked for: what grey_guarded applies
   /// ("both_grey", "warmup" or "schedule"; shop_models.h GuardGreyBox); else empty.
   std::vector<std::string> guard_choice;
+  /// Per machine, when the opt-in grey rows were asked for: grey_short_mix's weight w of the
+  /// grey box (shop_models.h ShortMixWeights); else empty.
+  std::vector<double> short_mix_weight;
   /// Per machine, what the grey box's fit chose (drift::GreyBoxModel): the prior strength, the
   /// lags' time constants [min], the blank's [min], the validation RMSE [um], and the record's
   /// lead days (drift::LeadDays); strength 0 and no lag where no grey box was fitted.
