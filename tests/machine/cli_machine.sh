@@ -190,10 +190,12 @@ assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), ch
 for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
     assert b["grey_guarded"][key] == a[chosen[0]][key], (key, chosen)
     assert b["grey_sensors_by_days"][key] == a["both_grey"][key], key
-# grey_short_mix (the fourteenth round): one lead day leaves no earlier day to score, so the grey
-# box's weight is 1 and the row is both_grey's to the digit.
-assert gc["runs"][0]["grey_short_mix_weight"] == [1.0], gc["runs"][0]["grey_short_mix_weight"]
-for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
-    assert b["grey_short_mix"][key] == a["both_grey"][key], key
+# grey_short_mix (the fourteenth round): the grey box's weight per machine, within [0.5, 1]; at 1
+# the row is both_grey's to the digit.
+mix = gc["runs"][0]["grey_short_mix_weight"]
+assert len(mix) == 1 and 0.5 <= mix[0] <= 1, mix
+if mix[0] == 1:
+    for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
+        assert b["grey_short_mix"][key] == a["both_grey"][key], key
 PY
 echo "cli_machine: ok"
