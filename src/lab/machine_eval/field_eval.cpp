@@ -27,6 +27,9 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
                          protocol.grey_candidates, protocol.grey_five_sensors);
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.control = ShopControlModels(m.shop.sensors, record.day_logs);
+  if (m.shop.guard.chosen)
+    m.mix_rule_control = ShopControlModels(
+        m.shop.rule_is_schedule ? m.shop.schedule : m.shop.warmup, record.day_logs);
   m.records = static_cast<int>(record.records.size());
   m.lead_days = static_cast<int>(drift::LeadDays(record).size());
   for (const auto& r : record.records) m.readings += static_cast<int>(r.rows.size());
@@ -256,6 +259,14 @@ void CompleteReport(const drift::Run& log, const FieldMachineModels& models, Rep
   r->sensors_choice = models.shop.sensors_choice;
   r->z_ref_mm = models.z_ref_mm;
   r->grey = models.shop.grey;
+  const ShopModels& shop = models.shop;
+  r->mix_computed = shop.guard.chosen;
+  if (!r->mix_computed) return;
+  r->mix_weight = shop.mix.fitted_weight;
+  r->mix_rule_name = shop.rule_is_schedule ? "schedule" : "warmup";
+  r->mix_rule = shop.rule_is_schedule ? shop.schedule : shop.warmup;
+  r->mix_rule_offset = models.mix_rule_control.offset;
+  r->mix_rule_slope = models.mix_rule_control.slope;
 }
 
 // Every test-day screw of one machine world; `report` (optional) receives the first screw that

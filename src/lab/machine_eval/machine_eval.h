@@ -219,6 +219,15 @@ struct ReportScrew {
   std::string sensors_choice;        ///< which candidate it is (shop_models.h)
   double z_ref_mm = 0;               ///< the slope's reference: the Z screw's fixed bearing
   drift::GreyBoxModel grey;          ///< the grey box both_grey applies (no input: not fitted)
+  /// grey_short_mix where its row was computed (the opt-in grey rows, the guard chosen): the
+  /// grey box's weight w (shop_models.h ShortMixWeights; 1: the grey box's line), the base rule
+  /// it is mixed with (warmup or schedule, `mix_rule_name`) and that rule as the drift action's
+  /// offset and slope models (ShopControlModels); mix_computed false otherwise.
+  bool mix_computed = false;
+  double mix_weight = 1;
+  std::string mix_rule_name;
+  drift::JointDriftModel mix_rule;
+  drift::DriftModel mix_rule_offset, mix_rule_slope;
   /// The machine model the report's combined 840D programs apply: kBothGrey where the grey box
   /// was fitted (ProgramsStrategy, summary.h: a rule fixed before the test days), else
   /// kBothShop; and why.
