@@ -130,6 +130,7 @@ void WriteReport(const MachineCliOptions& o, const machine_eval::SeedsEvaluation
   const machine_report::MachineReport r =
       machine_report::WriteMachineScrewReport(o.report, *report, &profile);
   if (!r.programs_note.empty()) Warn(r.programs_note);
+  if (!r.mix_note.empty()) Warn(r.mix_note);
   std::fprintf(stderr, "report written to %s\n", r.index_html.c_str());
 }
 

@@ -91,6 +91,28 @@ grep -q "^; model: .* from 13 sensors, file grey box (both_grey)" \
   "$D/report_long/WHIRL_DRIFT_COMP.SPF" || fail "20 days: the drift program is not both_grey's"
 grep -q "^; slope model: .* from 13 sensors$" "$D/report_long/WHIRL_DRIFT_COMP.SPF" ||
   fail "20 days: the drift program's slope is not every sensor's"
+# With --grey-candidates the report also holds grey_short_mix's drift action (the fourteenth
+# round), beside the grey box's plan: on 5 past days of duty changes (seed 3: the fitted weight
+# below 1) the mixed line of the grey box and the sensor-free rule, its PLC rows tagged by
+# component and weight, written with no warning (the largest such action against the default
+# profile: tests/machine_report/test_machine_report.cpp).
+"$W" machine evaluate --scenarios duty-changes --machines 1 --test-days 1 --past-days 5 --seed 3 \
+  --grey-candidates --out-dir "$D/report_mix" > /dev/null 2> "$D/report_mix_err.txt" ||
+  fail "evaluate --grey-candidates --out-dir: $(cat "$D/report_mix_err.txt")"
+grep -q "warning" "$D/report_mix_err.txt" && fail "mix: $(cat "$D/report_mix_err.txt")"
+for f in WHIRL_DRIFT_MIX.SPF WHIRL_DRIFT_MIX_RESET.SPF WHIRL_DRIFT_MIX_PLC.csv; do
+  [ -f "$D/report_mix/$f" ] || fail "report lacks $f"
+done
+grep -q "^; mixed line of 2 components" "$D/report_mix/WHIRL_DRIFT_MIX.SPF" ||
+  fail "mix: the drift program is not a mixed line"
+grep -q "^; component 2, w = 0\.[0-9]*: model dynamic of k0_um from 0 sensors" \
+  "$D/report_mix/WHIRL_DRIFT_MIX.SPF" || fail "mix: the rule's component is missing"
+grep -q "^component,weight,output,feature," "$D/report_mix/WHIRL_DRIFT_MIX_PLC.csv" &&
+  grep -q "^2,0\.[0-9]*,k0_mm,intercept," "$D/report_mix/WHIRL_DRIFT_MIX_PLC.csv" ||
+  fail "mix: the PLC rows are not tagged by component and weight"
+cmp -s "$D/report_mix/WHIRL_DRIFT_COMP_RESET.SPF" "$D/report_mix/WHIRL_DRIFT_MIX_RESET.SPF" &&
+  fail "mix: the reset program does not carry its own name"
+grep -q "grey_short_mix on the control" "$D/report_mix/index.html" || fail "mix: page lacks it"
 # The screw's control log is a drift run file: a machine model evaluates on it.
 "$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \
   2>/dev/null || fail "drift predict on the screw's log"

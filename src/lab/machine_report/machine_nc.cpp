@@ -142,6 +142,14 @@ CombinedPrograms BuildCombinedMixPrograms(
   return out;
 }
 
+std::vector<std::pair<std::filesystem::path, std::string>> MixDriftProgramFiles(
+    const std::filesystem::path& dir, const CombinedPrograms& mix) {
+  const std::string name = kMixDriftProgramName;
+  return {{dir / (name + ".SPF"), mix.drift_nc},
+          {dir / (std::string(kMixDriftResetProgramName) + ".SPF"), mix.drift_reset_nc},
+          {dir / (name + "_PLC.csv"), mix.drift_plc_csv}};
+}
+
 std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(
     const std::filesystem::path& dir, const CombinedPrograms& p) {
   return {{dir / "WHIRL_TEMP_COMP.SPF", p.plan_nc},

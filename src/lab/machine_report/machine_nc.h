@@ -90,6 +90,14 @@ CombinedPrograms BuildCombinedMixPrograms(
     double grey_weight, const interp::MachineProfile& profile, const std::string& curve_source,
     const std::string& model_source);
 
+/// grey_short_mix's drift action in a report (machine_report.h): it runs in place of
+/// WHIRL_DRIFT_COMP with the grey box's plan (the same IDs and slots), under these names.
+inline constexpr const char* kMixDriftProgramName = "WHIRL_DRIFT_MIX";
+inline constexpr const char* kMixDriftResetProgramName = "WHIRL_DRIFT_MIX_RESET";
+/// Its files in `dir`: WHIRL_DRIFT_MIX.SPF, WHIRL_DRIFT_MIX_RESET.SPF, WHIRL_DRIFT_MIX_PLC.csv.
+std::vector<std::pair<std::filesystem::path, std::string>> MixDriftProgramFiles(
+    const std::filesystem::path& dir, const CombinedPrograms& mix);
+
 /// The files of the programs in `dir` (created if needed): WHIRL_TEMP_COMP.SPF,
 /// WHIRL_TEMP_COMP_RESET.SPF, WHIRL_DRIFT_COMP.SPF, WHIRL_DRIFT_COMP_RESET.SPF,
 /// WHIRL_DRIFT_COMP_PLC.csv, as (path, text) pairs for core's WriteFilesAtomic.
