@@ -72,7 +72,8 @@ grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/DRIFT.SPF" || fail "drift action does not w
 for f in WHIRL_TEMP_COMP.SPF WHIRL_DRIFT_COMP.SPF WHIRL_DRIFT_COMP_RESET.SPF index.html; do
   [ -f "$D/report/$f" ] || fail "report lacks $f"
 done
-grep -q "^; model: .*trained only from shop measurements" "$D/report/WHIRL_DRIFT_COMP.SPF" \
+grep -q "^; \(model\|mixed line of 2 components\): .*trained only from shop measurements" \
+  "$D/report/WHIRL_DRIFT_COMP.SPF" \
   || fail "the report's drift program is not the shop-trained model's"
 [ "$(grep -c "<li>MD28254" "$D/report/index.html")" = 1 ] || fail "MD28254 not listed once"
 [ "$(grep -c "<li>MD32750" "$D/report/index.html")" = 1 ] || fail "MD32750 not listed once"
@@ -91,13 +92,22 @@ grep -q "^; model: .* from 13 sensors, file grey box (both_grey)" \
   "$D/report_long/WHIRL_DRIFT_COMP.SPF" || fail "20 days: the drift program is not both_grey's"
 grep -q "^; slope model: .* from 13 sensors$" "$D/report_long/WHIRL_DRIFT_COMP.SPF" ||
   fail "20 days: the drift program's slope is not every sensor's"
-# With --grey-candidates the report also holds grey_short_mix's drift action (the fourteenth
-# round), beside the grey box's plan: on 5 past days of duty changes (seed 3: the fitted weight
-# below 1) the mixed line of the grey box and the sensor-free rule, its PLC rows tagged by
-# component and weight, written with no warning (the largest such action against the default
-# profile: tests/machine_report/test_machine_report.cpp).
+# Since the fourteenth round's adoption both_grey's programs on a short record are the
+# grey_short_mix line's: on 5 past days of duty changes (seed 3: the fitted weight below 1) the
+# report's drift action is the mixed line of the grey box and the sensor-free rule. With
+# --grey-without-short-mix --grey-candidates the programs are the grey box's and the mix's drift
+# action is written beside them (WHIRL_DRIFT_MIX), its PLC rows tagged by component and weight,
+# with no warning (the largest such action against the default profile:
+# tests/machine_report/test_machine_report.cpp).
 "$W" machine evaluate --scenarios duty-changes --machines 1 --test-days 1 --past-days 5 --seed 3 \
-  --grey-candidates --out-dir "$D/report_mix" > /dev/null 2> "$D/report_mix_err.txt" ||
+  --out-dir "$D/report_mix_default" > /dev/null 2> "$D/report_mix_default_err.txt" ||
+  fail "evaluate --out-dir (mix default): $(cat "$D/report_mix_default_err.txt")"
+grep -q "^; mixed line of 2 components: .*file grey box (both_grey) mixed with" \
+  "$D/report_mix_default/WHIRL_DRIFT_COMP.SPF" || fail "default: both_grey's program is not the mix"
+[ -f "$D/report_mix_default/WHIRL_DRIFT_MIX.SPF" ] && fail "default: a second mix program"
+"$W" machine evaluate --scenarios duty-changes --machines 1 --test-days 1 --past-days 5 --seed 3 \
+  --grey-without-short-mix --grey-candidates --out-dir "$D/report_mix" > /dev/null \
+  2> "$D/report_mix_err.txt" ||
   fail "evaluate --grey-candidates --out-dir: $(cat "$D/report_mix_err.txt")"
 grep -q "warning" "$D/report_mix_err.txt" && fail "mix: $(cat "$D/report_mix_err.txt")"
 for f in WHIRL_DRIFT_MIX.SPF WHIRL_DRIFT_MIX_RESET.SPF WHIRL_DRIFT_MIX_PLC.csv; do
@@ -209,15 +219,35 @@ assert fit[0]["blank_tau_min"] in (30, 60, 120, 240), fit
 assert all(t in (10, 20, 40, 80, 160, 320) for t in fit[0]["time_constants_min"]), fit
 chosen = gc["runs"][0]["grey_guarded_choice"]
 assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), chosen
+# The grey box's line alone is grey_sensors_by_days' (one past day: fewer than 20 lead days);
+# since the fourteenth round's adoption both_grey is grey_short_mix's line, to the digit.
+keep = {"both_grey": "grey_sensors_by_days"}
 for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
-    assert b["grey_guarded"][key] == a[chosen[0]][key], (key, chosen)
-    assert b["grey_sensors_by_days"][key] == a["both_grey"][key], key
-# grey_short_mix (the fourteenth round): the grey box's weight per machine, within [0.5, 1]; at 1
-# the row is both_grey's to the digit.
+    assert b["grey_guarded"][key] == b[keep.get(chosen[0], chosen[0])][key], (key, chosen)
+    assert b["grey_short_mix"][key] == a["both_grey"][key], key
+# grey_short_mix (the fourteenth round): the grey box's weight per machine, within [0.5, 1].
 mix = gc["runs"][0]["grey_short_mix_weight"]
 assert len(mix) == 1 and 0.5 <= mix[0] <= 1, mix
-if mix[0] == 1:
-    for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
-        assert b["grey_short_mix"][key] == a["both_grey"][key], key
+PY
+# --grey-without-short-mix (the opt-out): both_grey is the grey box's line alone again
+# (grey_sensors_by_days' row, the default before the adoption), every other row as with the
+# default, the mix's weight the same.
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --grey-candidates --grey-without-short-mix > "$D/field_gc_out.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --grey-without-short-mix: $(cat "$D/field_err.txt")"
+python3 - "$D/field_gc.json" "$D/field_gc_out.json" <<'PY' || fail "--grey-without-short-mix wrong"
+import json, sys
+gc = json.load(open(sys.argv[1]))["scenarios"][0]
+out = json.load(open(sys.argv[2]))["scenarios"][0]
+a, b = gc["strategies"], out["strategies"]
+assert sorted(a) == sorted(b)
+for name in a:
+    if name != "both_grey":
+        assert a[name] == b[name], name
+for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
+    assert b["both_grey"][key] == b["grey_sensors_by_days"][key], key
+assert gc["runs"][0]["grey_short_mix_weight"] == out["runs"][0]["grey_short_mix_weight"]
+if gc["runs"][0]["grey_short_mix_weight"][0] < 1:
+    assert a["both_grey"] != b["both_grey"], "the mix must move both_grey below w = 1"
 PY
 echo "cli_machine: ok"

@@ -227,6 +227,15 @@ TEST(MachineReport, WhereTheProgramsModelIsTheGreyBoxItsProgramsAreHandedOut) {
   ASSERT_FALSE(r.grey.Inputs().empty());
   r.programs_strategy = MachineStrategy::kBothGrey;
   r.programs_reason = "both_grey: picked by the test";
+  // The default since the fourteenth round: both_grey applies grey_short_mix's line on a short
+  // record, and its programs are the mix's (here with w = 0.6, so both components show).
+  ASSERT_TRUE(r.mix_computed && r.mix_applied);
+  const ReportScrew mixed = [&] {
+    ReportScrew m = r;
+    m.mix_weight = 0.6;
+    return m;
+  }();
+  r.mix_applied = false;  // the grey box's line alone (--grey-without-short-mix)
   const interp::MachineProfile profile =
       interp::LoadMachineProfile(ReportSource("datasets/machines/whirling_840d.json"));
   const std::filesystem::path dir = ReportDir("whirl_machine_report_grey");
@@ -260,6 +269,15 @@ TEST(MachineReport, WhereTheProgramsModelIsTheGreyBoxItsProgramsAreHandedOut) {
   EXPECT_NE(fallback.programs_note.find("drift.blank_param"), std::string::npos)
       << fallback.programs_note;
   EXPECT_NE(fallback.programs_reason.find("both_shop"), std::string::npos);
+  std::filesystem::remove_all(dir);
+  const MachineReport mix = WriteMachineScrewReport(dir.string(), mixed, &profile);
+  ASSERT_TRUE(mix.programs && mix.programs_grey) << mix.programs_note;
+  EXPECT_FALSE(mix.mix_programs);  // the programs themselves: no second drift action
+  EXPECT_EQ(statements(ReadTextFile(dir / "WHIRL_DRIFT_COMP.SPF")),
+            statements(interp::FormatDriftNcProgram(
+                {{&a.offset, &a.slope, a.Blank(), 0.6},
+                 {&mixed.mix_rule_offset, &mixed.mix_rule_slope, nullptr, 0.4}},
+                d)));
   std::filesystem::remove_all(dir);
 }
 

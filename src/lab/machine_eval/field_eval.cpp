@@ -24,10 +24,11 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
       FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
   m.shop = FitShopModels(record, m.z_ref_mm, ScheduleInputs(), protocol.grey_slope_lags_only,
-                         protocol.grey_candidates, protocol.grey_five_sensors);
+                         protocol.grey_candidates, protocol.grey_five_sensors,
+                         protocol.grey_short_mix);
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.control = ShopControlModels(m.shop.sensors, record.day_logs);
-  if (m.shop.guard.chosen)
+  if (m.shop.mix.computed)
     m.mix_rule_control = ShopControlModels(
         m.shop.rule_is_schedule ? m.shop.schedule : m.shop.warmup, record.day_logs);
   m.records = static_cast<int>(record.records.size());
@@ -260,7 +261,8 @@ void CompleteReport(const drift::Run& log, const FieldMachineModels& models, Rep
   r->z_ref_mm = models.z_ref_mm;
   r->grey = models.shop.grey;
   const ShopModels& shop = models.shop;
-  r->mix_computed = shop.guard.chosen;
+  r->mix_computed = shop.mix.computed;
+  r->mix_applied = shop.mix.applied;
   if (!r->mix_computed) return;
   r->mix_weight = shop.mix.fitted_weight;
   r->mix_rule_name = shop.rule_is_schedule ? "schedule" : "warmup";
@@ -302,6 +304,9 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
       for (double w : {shop.mix.fitted_weight, shop.mix.fixed_weight})
         held.candidates.push_back(MixedLines(held.grey, rule, w));
     }
+    if (shop.mix.applied)  // both_grey's line is grey_short_mix's (after the rows built on the box)
+      held.grey = MixedLines(held.grey, shop.rule_is_schedule ? held.schedule : held.warmup,
+                             shop.mix.fitted_weight);
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));

@@ -224,6 +224,7 @@ struct ReportScrew {
   /// it is mixed with (warmup or schedule, `mix_rule_name`) and that rule as the drift action's
   /// offset and slope models (ShopControlModels); mix_computed false otherwise.
   bool mix_computed = false;
+  bool mix_applied = false;  ///< both_grey applies the mix (FieldProtocol::grey_short_mix)
   double mix_weight = 1;
   std::string mix_rule_name;
   drift::JointDriftModel mix_rule;

@@ -115,7 +115,7 @@ ShopModels::Mix ShortMixWeights(bool long_record, const GuardScore& guard) {
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
-                         bool grey_candidates, bool grey_five_sensors) {
+                         bool grey_candidates, bool grey_five_sensors, bool grey_short_mix) {
   ShopModels m;
   const drift::JointFitOptions lagged = RuleOptions();
   const drift::JointSpec warmup = RuleSpec(z_fixed_mm, {"power_on"}),
@@ -171,6 +171,15 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   const bool every = long_record && !grey_five_sensors;
   const drift::GreyBoxSpec& applied = every ? all.spec : grey;  // both_grey's sensors
   m.grey = drift::FitGreyBox(record, applied, grey_options);
+  if (!grey_candidates && !grey_short_mix) return m;
+  // The guard scores the model it would apply: both_grey's (its sensors, its options); its
+  // combination weight is the fourteenth round's mix.
+  const GuardScore g =
+      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
+  m.guard = {grey_candidates, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
+  m.mix = ShortMixWeights(long_record, g);
+  m.mix.computed = true;
+  m.mix.applied = grey_short_mix;
   if (!grey_candidates) return m;
   const bool same = every && !grey_slope_lags_only;  // then m.grey is grey_all_sensors' model
   m.grey_candidates.push_back(same ? m.grey : drift::FitGreyBox(record, all.spec, all.options));
@@ -187,11 +196,6 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
     m.grey_candidates.push_back(
         long_record ? m.grey
                     : drift::FitGreyBox(record, applied, ShortRecordOffsetLags(grey_options, lags)));
-  // The guard scores the model it would apply: both_grey's (its sensors, its options).
-  const GuardScore g =
-      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
-  m.guard = {true, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
-  m.mix = ShortMixWeights(long_record, g);  // the fourteenth round's rows
   return m;
 }
 

@@ -58,8 +58,12 @@ struct ShopModels {
   /// The fourteenth round's mixes (grey_short_mix, grey_short_mix_fixed: ShortMixWeights), set
   /// with the guard: the grey box's share w of the line w grey + (1 - w) base rule; 1 (both_grey's
   /// line itself) on a record of 2 x forward_days lead days and more.
+  /// computed: the weights were fitted (the opt-in rows, or the default's mix); applied:
+  /// both_grey's line is the grey_short_mix line (FitShopModels' grey_short_mix, the field
+  /// default since the fourteenth round's adoption; 1 on a long record: the grey box's line).
   struct Mix {
     double fitted_weight = 1, fixed_weight = 1;
+    bool computed = false, applied = false;
   } mix;
 };
 
@@ -146,11 +150,14 @@ ShopModels::Mix ShortMixWeights(bool long_record, const GuardScore& guard);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
 /// FieldGreyBoxOptions' `slope_lags_only` for the grey box; `grey_candidates`: also fit
 /// ShopModels::grey_candidates; `grey_five_sensors`: the grey box keeps FieldGreyBoxSpec's five
-/// sensors on a long record too (the model before the eleventh round, an opt-in).
+/// sensors on a long record too (the model before the eleventh round, an opt-in);
+/// `grey_short_mix`: fit the mix's weights and let both_grey apply the grey_short_mix line
+/// (ShopModels::Mix::applied; FieldProtocol's default, false here for the callers that fit the
+/// grey box alone).
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs(),
                          bool grey_slope_lags_only = false, bool grey_candidates = false,
-                         bool grey_five_sensors = false);
+                         bool grey_five_sensors = false, bool grey_short_mix = false);
 
 /// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
 /// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on

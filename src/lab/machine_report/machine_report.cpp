@@ -290,6 +290,14 @@ std::optional<CombinedPrograms> Programs(const ReportScrew& r,
   }
   if (r.programs_strategy == MachineStrategy::kBothGrey) {
     try {
+      if (r.mix_applied)  // both_grey's line is grey_short_mix's (w = 1: the grey box's)
+        return BuildCombinedMixPrograms(
+            r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options,
+            r.grey, r.mix_rule_offset, r.mix_rule_slope, r.mix_weight, *profile,
+            "network curve of screw " + r.result.screw.name,
+            "grey box (both_grey) mixed with " + r.mix_rule_name +
+                " (w = " + FormatFixed(r.mix_weight, 2) +
+                ") trained only from shop measurements");
       return BuildCombinedGreyPrograms(r.predicted_curve, r.kinematics,
                                        r.result.screw.thread_length_mm, r.plan_options, r.grey,
                                        *profile, "network curve of screw " + r.result.screw.name,
@@ -319,7 +327,7 @@ std::optional<CombinedPrograms> Programs(const ReportScrew& r,
 std::optional<CombinedPrograms> MixPrograms(const ReportScrew& r,
                                             const interp::MachineProfile* profile,
                                             const CombinedPrograms* programs, std::string* note) {
-  if (!r.mix_computed || !profile) return std::nullopt;
+  if (!r.mix_computed || r.mix_applied || !profile) return std::nullopt;  // applied: the programs
   if (!programs || !programs->grey) {
     *note =
         "grey_short_mix's drift action not written: the report's programs are not the grey "
