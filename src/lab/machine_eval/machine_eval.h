@@ -56,8 +56,11 @@
 //                      checks at its set-ups (field_monitor.h)
 //   both_grey          workpiece + the grey box (drift/grey_box.h: absolute temperatures, a slope
 //                      intercept, the blank's estimate latched at the cut start, physical priors;
-//                      shop_models.h FieldGreyBoxSpec), trained from the same shop records; the
-//                      report's 840D programs apply it wherever it was fitted
+//                      shop_models.h FieldGreyBoxSpec), trained from the same shop records;
+//                      below 2 x forward_days lead days mixed with the sensor-free base rule,
+//                      w grey + (1 - w) rule (grey_short_mix's line, FieldProtocol::
+//                      grey_short_mix, the default since the fourteenth round); the report's
+//                      840D programs apply it wherever it was fitted
 //                      (ReportScrew::programs_strategy)
 // Every machine model is applied causally (strategies.h). The truth of a cut: the workpiece truth
 // of compare::CompareScrew (the blank starts at the hall's temperature through its lag and
@@ -136,7 +139,7 @@ double WarmupOffsetShare(OffsetCandidate c);
 /// ShortRecordStrongPrior); the thirteenth round's both_grey with the offset sensors as read
 /// (grey_short_offset_as_read) or through the shortest chosen lag (grey_short_offset_one_lag)
 /// below 2 x forward_days lead days (shop_models.h ShortRecordOffsetLags), before grey_guarded;
-/// after it the fourteenth round's line w both_grey + (1 - w) base rule below 2 x forward_days
+/// after it the fourteenth round's line w grey box + (1 - w) base rule below 2 x forward_days
 /// lead days, w from the guard's held days (grey_short_mix) or fixed (grey_short_mix_fixed;
 /// shop_models.h ShortMixWeights). All count as using sensors; never the strongest sensor-free
 /// row.
