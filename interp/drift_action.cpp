@@ -101,33 +101,84 @@ Layout MakeLayout(const drift::DriftModel& m, int first) {
   return l;
 }
 
-// Slots of one program: liveness, the offset model's, then the slope model's and S_m.
+// One component as the program runs it: its models, weight and slots.
+struct Part {
+  const drift::DriftModel* m = nullptr;  // the offset (K0) model
+  const drift::DriftModel* g = nullptr;  // the slope model, or none
+  const BlankTerm* blank = nullptr;
+  double weight = 1;
+  Layout offset, slope;
+  int s_m = -1;  // its S_j (one component: the program's S_m), -1 without a slope model
+  int k0 = -1;   // its K_j, only with more than one component
+};
+
+// Slots of one program: liveness, per component the offset model's, the slope model's and its
+// S_j (and, mixed, its K_j), then (mixed) the program's S_m, then the blank's flag.
 struct Slots {
   int alive = 0;
-  Layout offset, slope;
+  std::vector<Part> parts;
   int s_m = -1;  // $AC_PARAM holding S_m, -1 without a slope model
   int last = 0;
   const BlankTerm* blank = nullptr;  // the grey box's blank term
   int blank_flag = -1;               // B's init flag (B and its latch: options.blank_param)
+  bool Mixed() const { return parts.size() > 1; }
 };
 
-Slots MakeSlots(const drift::DriftModel& m, const drift::DriftModel* g, int first,
-                const BlankTerm* blank = nullptr) {
+void CheckComponents(const std::vector<DriftComponent>& c) {
+  if (c.empty()) throw InputError("drift action: no model to run (no component)");
+  double sum = 0;
+  int blanks = 0;
+  for (std::size_t j = 0; j < c.size(); ++j) {
+    const std::string which = "drift action: component " + std::to_string(j + 1);
+    if (!c[j].offset) throw InputError(which + " has no offset (K0) model");
+    if (!(c[j].weight > 0 && c[j].weight <= 1))
+      throw InputError(which + "'s weight " + MessageNumber(c[j].weight) +
+                       " must be within (0, 1]");
+    sum += c[j].weight;
+    blanks += c[j].blank ? 1 : 0;
+  }
+  if (std::abs(sum - 1.0) > 1e-9)
+    throw InputError("drift action: the components' weights sum to " + MessageNumber(sum) +
+                     ", not 1 (a mixed line is a weighted mean of the components' lines)");
+  if (blanks > 1)
+    throw InputError("drift action: " + std::to_string(blanks) +
+                     " components carry a blank term; the profile's blank_param holds one");
+}
+
+Slots MakeSlots(const std::vector<DriftComponent>& c, int first) {
+  CheckComponents(c);
   Slots s;
   s.alive = first;
-  s.offset = MakeLayout(m, first + 1);
-  s.last = s.offset.Last();
-  if (g) {
-    s.slope = MakeLayout(*g, s.last + 1);
-    s.s_m = s.slope.Last() + 1;
-    s.last = s.s_m;
+  int next = first + 1;
+  const bool mixed = c.size() > 1;
+  for (const DriftComponent& dc : c) {
+    Part p{dc.offset, dc.slope, dc.blank, dc.weight, {}, {}, -1, -1};
+    p.offset = MakeLayout(*p.m, next);
+    next = p.offset.Last() + 1;
+    if (p.g) {
+      p.slope = MakeLayout(*p.g, next);
+      p.s_m = p.slope.Last() + 1;
+      next = p.s_m + 1;
+    }
+    if (mixed) p.k0 = p.offset.sum >= 0 ? p.offset.sum : next++;
+    if (p.blank) s.blank = p.blank;
+    s.parts.push_back(p);
   }
-  if (blank) {
-    s.blank = blank;
+  if (!mixed)
+    s.s_m = s.parts[0].s_m;
+  else if (std::any_of(c.begin(), c.end(), [](const DriftComponent& dc) { return dc.slope; }))
+    s.s_m = next++;
+  s.last = next - 1;
+  if (s.blank) {
     s.blank_flag = s.last + 1;
     s.last = s.blank_flag;
   }
   return s;
+}
+
+std::vector<DriftComponent> One(const drift::DriftModel& m, const drift::DriftModel* g,
+                                const BlankTerm* blank) {
+  return {DriftComponent{&m, g, blank, 1.0}};
 }
 
 // The highest $AC_PARAM index the program touches (its own slots, the blank latch).
@@ -240,28 +291,39 @@ std::string Linear(const Eigen::VectorXd& c, const Layout& l, int decimals, int 
   return out;
 }
 
-bool SlopeMode(const DriftActionOptions& o, const drift::DriftModel* g) {
-  return g != nullptr || o.workpiece_slope_param >= 0;
+bool SlopeMode(const DriftActionOptions& o, const Slots& s) {
+  return s.s_m >= 0 || o.workpiece_slope_param >= 0;
+}
+
+// sum_j w_j $AC_PARAM[slot_j] over the components with such a slot.
+std::string Weighted(const Slots& s, int Part::*slot) {
+  std::string out;
+  for (const Part& p : s.parts)
+    if (p.*slot >= 0)
+      out += (out.empty() ? "" : "+") + FormatFixed(p.weight, kDecimalsDriftWeight) + "*" +
+             P(p.*slot);
+  return out;
 }
 
 // The setting-data writes (see the header comment for the composition); partial sums of a
 // long model are appended to `bodies` first.
-std::string OutputBody(const drift::DriftModel& m, const drift::DriftModel* g,
-                       const DriftActionOptions& o, const Slots& s,
+std::string OutputBody(const DriftActionOptions& o, const Slots& s,
                        std::vector<std::string>* bodies) {
   const std::string ax = "[" + o.axis + "]";
   const std::string mode = s.blank ? "3" : "2";
-  std::string k0 = Linear(DriftControlCoefficients(m, o), s.offset, kDecimalsDriftCoefficient,
-                          s.offset.sum, bodies);
+  const Part& one = s.parts[0];
+  std::string k0 = s.Mixed() ? Weighted(s, &Part::k0)
+                             : Linear(DriftControlCoefficients(*one.m, o), one.offset,
+                                      kDecimalsDriftCoefficient, one.offset.sum, bodies);
   if (o.workpiece_k0_param >= 0) k0 += "+" + P(o.workpiece_k0_param);
-  if (!SlopeMode(o, g))
+  if (!SlopeMode(o, s))
     return "DO $$SA_TEMP_COMP_ABS_VALUE" + ax + "=" + k0 + " " + P(s.alive) + "=1";
   std::string slope, ref;
   if (o.workpiece_slope_param >= 0) {
     const std::string p_w = P(o.workpiece_slope_param + 1);
     slope = P(o.workpiece_slope_param);
     ref = p_w;
-    if (g) {
+    if (s.s_m >= 0) {
       slope = P(s.s_m) + "+" + slope;
       k0 += "+" + P(s.s_m) + "*(" + p_w + Term(-o.slope_fixed_end_mm, kDecimalsPositionMm) + ")";
     }
@@ -284,22 +346,34 @@ std::vector<std::string> BlankBodies(const DriftActionOptions& o, const Slots& s
           reading + "-" + b + ")"};
 }
 
-// The static actions, in execution order.
-std::vector<std::string> ActionBodies(const drift::DriftModel& m, const drift::DriftModel* g,
-                                      const DriftActionOptions& o, const Slots& s) {
-  std::vector<std::string> bodies = FeatureBodies(m, o, s.offset);
-  if (g) {
-    Append(&bodies, FeatureBodies(*g, o, s.slope));
-    std::string s_m = Linear(DriftSlopeCoefficients(*g, o), s.slope, kDecimalsDriftSlopeCoefficient,
-                             s.s_m, &bodies);
-    if (s.blank) {
-      Append(&bodies, BlankBodies(o, s));
-      s_m += Term(DriftBlankCoefficient(*s.blank, o), kDecimalsDriftSlopeCoefficient) + "*(" +
+// One component's actions: its features, its slope S_j (with its blank term) and, mixed, its
+// K_j accumulated in its own slot.
+void PartBodies(const Part& p, const DriftActionOptions& o, const Slots& s,
+                std::vector<std::string>* bodies) {
+  Append(bodies, FeatureBodies(*p.m, o, p.offset));
+  if (p.g) {
+    Append(bodies, FeatureBodies(*p.g, o, p.slope));
+    std::string s_m = Linear(DriftSlopeCoefficients(*p.g, o), p.slope,
+                             kDecimalsDriftSlopeCoefficient, p.s_m, bodies);
+    if (p.blank) {
+      Append(bodies, BlankBodies(o, s));
+      s_m += Term(DriftBlankCoefficient(*p.blank, o), kDecimalsDriftSlopeCoefficient) + "*(" +
              P(o.blank_param + 1) + Term(-kBlankNeutralC, 4) + ")";
     }
-    if (s_m != P(s.s_m)) bodies.push_back("DO " + P(s.s_m) + "=" + s_m);
+    if (s_m != P(p.s_m)) bodies->push_back("DO " + P(p.s_m) + "=" + s_m);
   }
-  const std::string output = OutputBody(m, g, o, s, &bodies);
+  if (p.k0 < 0) return;  // one component: K_m is written with the output
+  const std::string k0 =
+      Linear(DriftControlCoefficients(*p.m, o), p.offset, kDecimalsDriftCoefficient, p.k0, bodies);
+  if (k0 != P(p.k0)) bodies->push_back("DO " + P(p.k0) + "=" + k0);
+}
+
+// The static actions, in execution order.
+std::vector<std::string> ActionBodies(const DriftActionOptions& o, const Slots& s) {
+  std::vector<std::string> bodies;
+  for (const Part& p : s.parts) PartBodies(p, o, s, &bodies);
+  if (s.Mixed() && s.s_m >= 0) bodies.push_back("DO " + P(s.s_m) + "=" + Weighted(s, &Part::s_m));
+  const std::string output = OutputBody(o, s, &bodies);
   bodies.push_back(output);
   return bodies;
 }
@@ -436,7 +510,7 @@ void DriftActionOptions::Validate() const {
 
 int DriftParamCount(const drift::DriftModel& m, const drift::DriftModel* g,
                     const BlankTerm* blank) {
-  return MakeSlots(m, g, 0, blank).last + 1;
+  return MakeSlots(One(m, g, blank), 0).last + 1;
 }
 
 GreyBoxAction GreyBoxActionModels(const drift::GreyBoxModel& model) {
@@ -490,9 +564,14 @@ double DriftSlopeBound(const drift::DriftModel& g, const DriftActionOptions& o,
 
 namespace {
 
-void CheckBlank(const drift::DriftModel* g, const DriftActionOptions& o, const Slots& s) {
+bool BlankWithoutSlope(const Slots& s) {
+  return std::any_of(s.parts.begin(), s.parts.end(),
+                     [](const Part& p) { return p.blank && !p.g; });
+}
+
+void CheckBlank(const DriftActionOptions& o, const Slots& s) {
   if (!s.blank) return;
-  if (!g)
+  if (BlankWithoutSlope(s))
     throw InputError("drift action: the blank term is part of the slope: it needs a slope model");
   if (o.blank_param < 0)
     throw InputError(
@@ -510,8 +589,9 @@ void CheckBlank(const drift::DriftModel* g, const DriftActionOptions& o, const S
                      ".." + std::to_string(s.last));
 }
 
-void CheckSlope(const drift::DriftModel* g, const DriftActionOptions& o, const Slots& s) {
-  CheckBlank(g, o, s);
+void CheckSlope(const DriftActionOptions& o, const Slots& s) {
+  CheckBlank(o, s);
+  const bool g = s.s_m >= 0;
   if (g && !o.has_slope)
     throw InputError(
         "drift action: a slope model needs the profile's drift.slope object "
@@ -544,8 +624,11 @@ std::string Preamble(const DriftActionOptions& o, bool slope_mode, const Slots& 
   else  // an aborted slope run left its slope behind: give the found one back
     nc += "IF " + Rp(r + 4) + "==1\n$SA_TEMP_COMP_SLOPE" + ax + "=" + Rp(r + 2) +
           "\n$SA_TEMP_COMP_REF_POSITION" + ax + "=" + Rp(r + 3) + "\n" + Rp(r + 4) + "=0\nENDIF\n";
-  nc += P(s.alive) + "=0\n" + P(s.offset.flag) + "=0\n";
-  if (s.s_m >= 0) nc += P(s.slope.flag) + "=0\n";
+  nc += P(s.alive) + "=0\n";
+  for (const Part& p : s.parts) {
+    nc += P(p.offset.flag) + "=0\n";
+    if (p.g) nc += P(p.slope.flag) + "=0\n";
+  }
   if (s.blank)  // B starts again; no blank term until a cut start latches one
     nc += P(s.blank_flag) + "=0\n" + P(o.blank_param + 1) + "=" + FormatFixed(kBlankNeutralC, 4) +
           "\n";
@@ -566,8 +649,12 @@ std::string ModelLine(const std::string& what, const drift::DriftModel& m) {
 }
 
 // The elapsed-time features: what the control counts and from when.
-std::string ElapsedNote(const drift::DriftModel& m, const drift::DriftModel* g) {
-  if (m.elapsed_time_constants.empty() && (!g || g->elapsed_time_constants.empty())) return "";
+std::string ElapsedNote(const Slots& s) {
+  if (std::none_of(s.parts.begin(), s.parts.end(), [](const Part& p) {
+        return !p.m->elapsed_time_constants.empty() ||
+               (p.g && !p.g->elapsed_time_constants.empty());
+      }))
+    return "";
   return "; elapsed time is counted here from this program's start (run it when the machine "
          "starts, as the model's training runs started): x = 1 - exp(-t / tau) by the recursion "
          "x <- x + a (1 - x), x = 0 at the start, every interpolation cycle; beyond the longest "
@@ -593,24 +680,25 @@ std::string BlankNote(const DriftActionOptions& o, const Slots& s) {
 }
 
 // The largest $A_INA index the program reads.
-int LargestAnalogIndex(const drift::DriftModel& m, const drift::DriftModel* g,
-                       const DriftActionOptions& o, const BlankTerm* blank) {
+int LargestAnalogIndex(const DriftActionOptions& o, const Slots& s) {
   int largest = 0;
-  for (const std::string& name : Inputs(m)) largest = std::max(largest, Input(o, name).index);
-  if (g)
-    for (const std::string& name : Inputs(*g)) largest = std::max(largest, Input(o, name).index);
-  if (blank) largest = std::max(largest, Input(o, blank->sensor).index);
+  for (const Part& p : s.parts) {
+    for (const std::string& name : Inputs(*p.m)) largest = std::max(largest, Input(o, name).index);
+    if (p.g)
+      for (const std::string& name : Inputs(*p.g))
+        largest = std::max(largest, Input(o, name).index);
+  }
+  if (s.blank) largest = std::max(largest, Input(o, s.blank->sensor).index);
   return largest;
 }
 
 // The control's limits the program depends on, with the values the profile states.
-std::string Prerequisites(const drift::DriftModel& m, const drift::DriftModel* g,
-                          const DriftActionOptions& o, const Slots& s, std::size_t actions) {
+std::string Prerequisites(const DriftActionOptions& o, const Slots& s, std::size_t actions) {
   const ControlLimits& c = o.control;
   auto stated = [&](int v) {
     return c.Stated() ? " (profile: " + std::to_string(v) + ")" : std::string(" (not stated)");
   };
-  const int largest = LargestAnalogIndex(m, g, o, s.blank);
+  const int largest = LargestAnalogIndex(o, s);
   return "; requires MD10300 $MN_FASTIO_ANA_NUM_INPUTS >= " + std::to_string(largest) +
          (largest == 0 ? " (no analog input read)" : "") + stated(c.analog_inputs) +
          ", MD28254 $MC_MM_NUM_AC_PARAM >= " + std::to_string(LastSlotUsed(o, s) + 1) +
@@ -632,25 +720,54 @@ void CheckSlotRange(const DriftActionOptions& o, const Slots& s) {
                      std::to_string(o.control.ac_params) + " (MD28254 $MC_MM_NUM_AC_PARAM)");
 }
 
-std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
-                   const DriftActionOptions& o, const std::string& model_source, const Slots& s,
+// A mixed line's slope bound: sum_j w_j times component j's (one component: its own).
+double SlopeBound(const DriftActionOptions& o, const Slots& s) {
+  double bound = 0;
+  for (const Part& p : s.parts)
+    if (p.g) bound += p.weight * DriftSlopeBound(*p.g, o, p.blank);
+  return bound;
+}
+
+// The model lines: one model, or each component with its weight and slots.
+std::string ModelLines(const std::string& model_source, const Slots& s) {
+  const std::string source = model_source.empty() ? std::string() : ", file " + Text(model_source);
+  if (!s.Mixed()) {
+    const Part& p = s.parts[0];
+    return Line(ModelLine("; model: ", *p.m) + source) +
+           (p.g ? Line(ModelLine("; slope model: ", *p.g)) : std::string());
+  }
+  std::string nc = Line("; mixed line of " + std::to_string(s.parts.size()) +
+                        " components: K_m = sum_j w_j K_j, S_m = sum_j w_j S_j" + source);
+  for (std::size_t j = 0; j < s.parts.size(); ++j) {
+    const Part& p = s.parts[j];
+    const std::string c = "; component " + std::to_string(j + 1) + ", w = " +
+                          FormatFixed(p.weight, kDecimalsDriftWeight) + ": ";
+    nc += Line(ModelLine(c + "model ", *p.m) + ", K_j in " + P(p.k0));
+    if (p.g)
+      nc += Line(ModelLine(c + "slope model ", *p.g) + ", S_j in " + P(p.s_m) +
+                 (p.blank ? " (with the blank term)" : ""));
+  }
+  return nc;
+}
+
+std::string Header(const DriftActionOptions& o, const std::string& model_source, const Slots& s,
                    std::size_t actions) {
   const int r = o.save_r_first;
-  const bool slope_mode = SlopeMode(o, g);
+  const bool slope_mode = SlopeMode(o, s);
+  const std::string j = s.Mixed() ? "_j" : "";
   std::string nc = "; " + o.program_name +
                    ": SINUMERIK 840D live machine-drift compensation of axis " + o.axis + "\n";
-  nc += Line(ModelLine("; model: ", m) +
-             (model_source.empty() ? std::string() : ", file " + Text(model_source)));
-  if (g) nc += Line(ModelLine("; slope model: ", *g));
-  nc += "; SD43900 = s * (b0 + sum b_f x_f) / 1000 mm, s = " + FormatFixed(DriftSign(o), 0) +
-        " (control_dk " + ToString(o.control_dk) + ", error_direction " +
-        std::to_string(o.error_direction) + "); reference " + ToString(o.reference) +
-        "; interpolation cycle " + FormatFixed(o.ipo_cycle_ms, 3) + " ms\n";
-  if (g)
-    nc += "; slope S_m = s * sigma * (g0 + sum g_f x_f) / 1e6 (sigma = " +
+  nc += ModelLines(model_source, s);
+  nc += std::string(s.Mixed() ? "; K_j" : "; SD43900") + " = s * (b0 + sum b_f x_f) / 1000 mm, s = " +
+        FormatFixed(DriftSign(o), 0) + " (control_dk " + ToString(o.control_dk) +
+        ", error_direction " + std::to_string(o.error_direction) + "); reference " +
+        ToString(o.reference) + "; interpolation cycle " + FormatFixed(o.ipo_cycle_ms, 3) +
+        " ms\n";
+  if (s.s_m >= 0)
+    nc += "; slope S" + (s.Mixed() ? j : "_m") + " = s * sigma * (g0 + sum g_f x_f) / 1e6 (sigma = " +
           std::to_string(o.slope_growth_direction) + ") about the fixed end " +
           FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
-          " mm (MCS); |S_m| <= " + FormatFixed(DriftSlopeBound(*g, o, s.blank), kDecimalsSd43910) +
+          " mm (MCS); |S_m| <= " + FormatFixed(SlopeBound(o, s), kDecimalsSd43910) +
           " over the training ranges: the plan's slopes plus this must stay within MD32760\n";
   const std::string saved = slope_mode
                                 ? Rp(r) + ".." + Rp(r + 4) + " (SD43900-43920 found, markers)"
@@ -662,7 +779,7 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
         std::to_string(o.param_first) + ".." + std::to_string(s.last) + "] (liveness $AC_PARAM[" +
         std::to_string(s.alive) + "] = " +
         (s.blank           ? "3"
-         : SlopeMode(o, g) ? "2"
+         : SlopeMode(o, s) ? "2"
                            : "1") +
         " while running), " + saved + "\n";
   nc += BlankNote(o, s);
@@ -674,11 +791,27 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
           std::to_string(o.workpiece_slope_param) + "], [" +
           std::to_string(o.workpiece_slope_param + 1) +
           "]: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + K_m + S_m (P_w - P_b)\n";
-  nc += ElapsedNote(m, g);
+  nc += ElapsedNote(s);
   nc += "; requires MD32750 $MA_TEMP_COMP_TYPE bit 0" +
         std::string(slope_mode ? " and bit 1" : "") + " for axis " + o.axis + "; stop it with " +
         o.reset_program_name + " (restores what it found)\n";
-  return nc + Prerequisites(m, g, o, s, actions);
+  return nc + Prerequisites(o, s, actions);
+}
+
+}  // namespace
+
+namespace {
+
+// The program's slots after the checks every writer makes (options, models, slope and blank).
+Slots CheckedSlots(const std::vector<DriftComponent>& c, const DriftActionOptions& o) {
+  o.Validate();
+  for (const DriftComponent& dc : c) {
+    if (dc.offset) CheckModel(*dc.offset);
+    if (dc.slope) CheckModel(*dc.slope);
+  }
+  const Slots s = MakeSlots(c, o.param_first);
+  CheckSlope(o, s);
+  return s;
 }
 
 }  // namespace
@@ -686,26 +819,27 @@ std::string Header(const drift::DriftModel& m, const drift::DriftModel* g,
 std::string FormatDriftNcProgram(const drift::DriftModel& m, const DriftActionOptions& o,
                                  const std::string& model_source, const drift::DriftModel* g,
                                  const BlankTerm* blank) {
-  o.Validate();
-  CheckModel(m);
-  if (g) CheckModel(*g);
-  const Slots s = MakeSlots(m, g, o.param_first, blank);
-  CheckSlope(g, o, s);
+  return FormatDriftNcProgram(One(m, g, blank), o, model_source);
+}
+
+std::string FormatDriftNcProgram(const std::vector<DriftComponent>& c,
+                                 const DriftActionOptions& o, const std::string& model_source) {
+  const Slots s = CheckedSlots(c, o);
   CheckSlotRange(o, s);
-  const std::vector<std::string> bodies = ActionBodies(m, g, o, s);
+  const std::vector<std::string> bodies = ActionBodies(o, s);
   const int available = o.sync_id_last - o.sync_id_first + 1;
   if (static_cast<int>(bodies.size()) > available)
     throw InputError("drift action needs " + std::to_string(bodies.size()) +
                      " synchronized-action IDs, the range " + std::to_string(o.sync_id_first) +
                      ".." + std::to_string(o.sync_id_last) + " has " + std::to_string(available));
-  std::string nc = Header(m, g, o, model_source, s, bodies.size());
+  std::string nc = Header(o, model_source, s, bodies.size());
   const bool check = o.plan_marker_r >= 0;
   if (check)  // a plan's own compensation is still on the control: reset it first
     nc += "; after the alarm the program jumps to " + std::string(kProgramEndLabel) +
           " and cancels, saves and writes nothing, whatever the alarm's response\n" +
           CheckOrAlarm(Rp(o.plan_marker_r) + "<>1", o.missing_alarm + 3, "WHIRL_NO_PLAN_ACTIVE");
   nc += CancelRange(o.sync_id_first, o.sync_id_last) + "STOPRE\n";
-  nc += Preamble(o, SlopeMode(o, g), s) + "STOPRE\n";
+  nc += Preamble(o, SlopeMode(o, s), s) + "STOPRE\n";
   for (std::size_t k = 0; k < bodies.size(); ++k)
     nc += Line("IDS=" + std::to_string(o.sync_id_first + static_cast<int>(k)) + " " + bodies[k]);
   if (check) nc += std::string(kProgramEndLabel) + ":\n";
@@ -762,12 +896,85 @@ std::string PlcRows(const std::string& output, const drift::DriftModel& m,
 
 }  // namespace
 
+namespace {
+
+// The blank term's PLC row (a last slope row of its component).
+std::string BlankRow(const BlankTerm& blank, const DriftActionOptions& o) {
+  const AnalogInput& a = Input(o, blank.sensor);
+  return "slope,blank_latched," + Cell(blank.sensor) + "," + std::to_string(a.index) + "," +
+         FormatFixed(a.scale, kDecimalsDriftCoefficient) + "," + FormatFixed(a.offset, 4) + "," +
+         FormatFixed(kBlankNeutralC, 4) + "," + FormatFixed(blank.tau_min, 3) + "," +
+         FormatFixed(LagFactor(o, blank.tau_min), kDecimalsLagFactor) + "," +
+         FormatFixed(DriftBlankCoefficient(blank, o), kDecimalsDriftSlopeCoefficient) + "\n";
+}
+
+// One component's rows: k0_mm, slope, the blank term.
+std::string PartRows(const Part& p, const DriftActionOptions& o) {
+  std::string out =
+      PlcRows("k0_mm", *p.m, o, DriftControlCoefficients(*p.m, o), kDecimalsDriftCoefficient);
+  if (p.g)
+    out += PlcRows("slope", *p.g, o, DriftSlopeCoefficients(*p.g, o),
+                   kDecimalsDriftSlopeCoefficient);
+  if (p.blank) out += BlankRow(*p.blank, o);
+  return out;
+}
+
+// Every line of `rows` with `prefix` in front.
+std::string Prefixed(const std::string& rows, const std::string& prefix) {
+  std::string out;
+  for (std::size_t at = 0, end; at < rows.size(); at = end + 1) {
+    end = rows.find('\n', at);
+    out += prefix + rows.substr(at, end - at + 1);
+  }
+  return out;
+}
+
+// The PLC table's comment on the models: one model, or the mixed line's components.
+std::string PlcModelComment(const DriftActionOptions& o, const Slots& s) {
+  const std::string sign = "sign applied (s = " + FormatFixed(DriftSign(o), 0) +
+                           "); interpolation cycle " + FormatFixed(o.ipo_cycle_ms, 3) + " ms\n";
+  const std::string sd =
+      "SD43910[" + o.axis + "] = S_m, SD43920 = " +
+      FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
+      " mm, SD43900 = K_m (with a plan: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + "
+      "K_m + S_m (P_w - fixed end))\n";
+  if (!s.Mixed()) {
+    const Part& p = s.parts[0];
+    std::string out = "# model " + drift::ToString(p.m->kind) + " of " + Text(p.m->error_column) +
+                      "; " + sign;
+    if (p.g)
+      return out + "# slope model " + drift::ToString(p.g->kind) + " of " +
+             Text(p.g->error_column) + ": S_m (mm/mm) = sum of the slope rows likewise; " + sd;
+    return out + "# SD43900[" + o.axis + "] = K_m\n";
+  }
+  std::string out = "# mixed line of " + std::to_string(s.parts.size()) +
+                    " components (columns component, weight): K_m = sum of weight * each "
+                    "component's k0_mm sum, S_m (mm/mm) = sum of weight * each component's slope "
+                    "sum; " + sign;
+  for (std::size_t j = 0; j < s.parts.size(); ++j) {
+    const Part& p = s.parts[j];
+    out += "# component " + std::to_string(j + 1) + ": model " + drift::ToString(p.m->kind) +
+           " of " + Text(p.m->error_column) +
+           (p.g ? "; slope model " + drift::ToString(p.g->kind) + " of " + Text(p.g->error_column)
+                : std::string()) +
+           "\n";
+  }
+  return out + "# " + (s.s_m >= 0 ? sd : "SD43900[" + o.axis + "] = K_m\n");
+}
+
+}  // namespace
+
 std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptions& o,
                               const drift::DriftModel* g, const BlankTerm* blank) {
+  return FormatDriftPlcCsv(One(m, g, blank), o);
+}
+
+std::string FormatDriftPlcCsv(const std::vector<DriftComponent>& c, const DriftActionOptions& o) {
   o.Validate();
-  if (g && !o.has_slope)
+  const Slots s = MakeSlots(c, o.param_first);
+  if (s.s_m >= 0 && !o.has_slope)
     throw InputError("drift PLC table: a slope model needs the profile's drift.slope object");
-  CheckBlank(g, o, MakeSlots(m, g, o.param_first, blank));
+  CheckBlank(o, s);
   std::string out;
   out +=
       "# whirl drift action as a PLC table: every cycle T = scale * AIN[ain_index] + offset; "
@@ -775,40 +982,28 @@ std::string FormatDriftPlcCsv(const drift::DriftModel& m, const DriftActionOptio
   out +=
       "# lagged features L <- L + a_per_cycle * (u - L) (L = u at start); K_m (mm) = sum of "
       "the k0_mm rows' coefficient_per_unit * feature value, intercept included\n";
-  if (!m.elapsed_time_constants.empty() || (g && !g->elapsed_time_constants.empty()))
+  if (std::any_of(s.parts.begin(), s.parts.end(), [](const Part& p) {
+        return !p.m->elapsed_time_constants.empty() ||
+               (p.g && !p.g->elapsed_time_constants.empty());
+      }))
     out +=
         "# input 'elapsed' (no analog input): time since the start counted by the PLC, "
         "L <- L + a_per_cycle * (1 - L) (L = 0 at start) = 1 - exp(-t / tau_min)\n";
-  out += "# model " + drift::ToString(m.kind) + " of " + Text(m.error_column) +
-         "; sign applied (s = " + FormatFixed(DriftSign(o), 0) + "); interpolation cycle " +
-         FormatFixed(o.ipo_cycle_ms, 3) + " ms\n";
-  if (g)
-    out += "# slope model " + drift::ToString(g->kind) + " of " + Text(g->error_column) +
-           ": S_m (mm/mm) = sum of the slope rows likewise; SD43910[" + o.axis +
-           "] = S_m, SD43920 = " + FormatFixed(o.slope_fixed_end_mm, kDecimalsPositionMm) +
-           " mm, SD43900 = K_m (with a plan: SD43920 = P_w, SD43910 = S_w + S_m, SD43900 = K0_w + "
-           "K_m + S_m (P_w - fixed end))\n";
-  else
-    out += "# SD43900[" + o.axis + "] = K_m\n";
-  if (blank)
+  out += PlcModelComment(o, s);
+  if (s.blank)
     out +=
         "# blank_latched (grey box): B <- B + a_per_cycle * (T - B) (B = T at start) every "
         "cycle; at the cut start hold B for the whole cut; S_m += coefficient_per_unit * (B "
         "held - reference_C); between cuts that term is 0\n";
-  out +=
+  const std::string columns =
       "output,feature,input,ain_index,scale,offset,reference_C,tau_min,a_per_cycle,"
       "coefficient_per_unit\n";
-  out += PlcRows("k0_mm", m, o, DriftControlCoefficients(m, o), kDecimalsDriftCoefficient);
-  if (g)
-    out += PlcRows("slope", *g, o, DriftSlopeCoefficients(*g, o), kDecimalsDriftSlopeCoefficient);
-  if (blank) {
-    const AnalogInput& a = Input(o, blank->sensor);
-    out += "slope,blank_latched," + Cell(blank->sensor) + "," + std::to_string(a.index) + "," +
-           FormatFixed(a.scale, kDecimalsDriftCoefficient) + "," + FormatFixed(a.offset, 4) + "," +
-           FormatFixed(kBlankNeutralC, 4) + "," + FormatFixed(blank->tau_min, 3) + "," +
-           FormatFixed(LagFactor(o, blank->tau_min), kDecimalsLagFactor) + "," +
-           FormatFixed(DriftBlankCoefficient(*blank, o), kDecimalsDriftSlopeCoefficient) + "\n";
-  }
+  if (!s.Mixed()) return out + columns + PartRows(s.parts[0], o);
+  out += "component,weight," + columns;
+  for (std::size_t j = 0; j < s.parts.size(); ++j)
+    out += Prefixed(PartRows(s.parts[j], o),
+                    std::to_string(j + 1) + "," +
+                        FormatFixed(s.parts[j].weight, kDecimalsDriftWeight) + ",");
   return out;
 }
 
@@ -816,27 +1011,32 @@ std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& m,
                                                   const DriftActionOptions& o,
                                                   const drift::DriftModel* g,
                                                   const BlankTerm* blank) {
-  o.Validate();
-  CheckModel(m);
-  if (g) CheckModel(*g);
-  const Slots s = MakeSlots(m, g, o.param_first, blank);
-  CheckSlope(g, o, s);
-  const auto actions = static_cast<double>(ActionBodies(m, g, o, s).size());
+  return DriftRequirements(One(m, g, blank), o);
+}
+
+double DriftSlopeBound(const std::vector<DriftComponent>& c, const DriftActionOptions& o) {
+  return SlopeBound(o, MakeSlots(c, o.param_first));
+}
+
+std::vector<ControlRequirement> DriftRequirements(const std::vector<DriftComponent>& components,
+                                                  const DriftActionOptions& o) {
+  const Slots s = CheckedSlots(components, o);
+  const auto actions = static_cast<double>(ActionBodies(o, s).size());
   const ControlLimits& c = o.control;
   const double unstated = std::numeric_limits<double>::quiet_NaN();
   auto stated = [&](int v) { return c.Stated() ? static_cast<double>(v) : unstated; };
   const std::string program = " (" + o.program_name + ")";
   std::vector<ControlRequirement> out;
-  const bool slope_mode = SlopeMode(o, g);
+  const bool slope_mode = SlopeMode(o, s);
   ControlRequirement type = MakeRequirement(
       "MD32750 $MA_TEMP_COMP_TYPE", o.axis, RequirementRule::kBits, RequirementMerge::kUnion,
       slope_mode ? 3.0 : 1.0, 0,
       (slope_mode ? std::string("SD43900 and SD43910/SD43920") : "SD43900") + program);
   out.push_back(type);
-  if (g) {
+  if (s.s_m >= 0) {
     ControlRequirement velo =
         MakeRequirement("MD32760 $MA_COMP_ADD_VELO_FACTOR", o.axis, RequirementRule::kAtLeast,
-                        RequirementMerge::kSum, DriftSlopeBound(*g, o, blank), kDecimalsSd43910,
+                        RequirementMerge::kSum, SlopeBound(o, s), kDecimalsSd43910,
                         "the machine slope's bound over the training ranges" + program);
     out.push_back(velo);
   }
@@ -857,8 +1057,8 @@ std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& m,
   out.push_back(ac);
   ControlRequirement ain = MakeRequirement(
       "MD10300 $MN_FASTIO_ANA_NUM_INPUTS", "", RequirementRule::kAtLeast, RequirementMerge::kMax,
-      static_cast<double>(LargestAnalogIndex(m, g, o, blank)), 0,
-      "analog inputs up to $A_INA[" + std::to_string(LargestAnalogIndex(m, g, o, blank)) + "]" +
+      static_cast<double>(LargestAnalogIndex(o, s)), 0,
+      "analog inputs up to $A_INA[" + std::to_string(LargestAnalogIndex(o, s)) + "]" +
           program);
   ain.stated = stated(c.analog_inputs);
   out.push_back(ain);

@@ -33,6 +33,11 @@
 // slots follow likewise, then S_m; with a blank term the init flag of B (B itself and its latch
 // are the profile's blank_param, + 1).
 // The machine must provide them (MD28254 $MC_MM_NUM_AC_PARAM).
+// A mixed line (DriftComponent, e.g. the grey box with weight w and a sensor-free rule with
+// 1 - w) has, after the liveness slot, per component its offset model's slots, its slope
+// model's and its S_j, and its K_j (the offset's partial-sum slot where it has one), then the
+// program's S_m = sum_j w_j S_j, then the blank's flag; each component's actions run as for one
+// model, its K_j summed into its own slot, then S_m, then the output with K_m = sum_j w_j K_j.
 // Action order (IDs count up from sync_id_first; actions run in ID order every cycle):
 //   [start: capture T_ref once] -> rises u -> [elapsed updates] -> [once: L = u, x = 0, flag]
 //   -> [lag updates] -> [partial sums] -> [slope model likewise, B's init and lag, S_m]
@@ -202,6 +207,24 @@ struct GreyBoxAction {
 };
 GreyBoxAction GreyBoxActionModels(const drift::GreyBoxModel& model);
 
+/// One component of a mixed drift action (docs/machine-evaluation.md "Fourteenth round:
+/// adoption"): the line sum_j w_j c_j, c_j the component's own line (K0 from `offset`, the slope
+/// from `slope` with its `blank` term), each component with its own inputs, lags, reference
+/// slots and init flags. Its K_j and S_j are accumulated in slots of their own every cycle and
+///   SD43900 K_m = sum_j w_j K_j,  S_m = sum_j w_j S_j  (a component without a slope adds 0),
+/// then composed with a plan's slots as for one model; the blank term belongs to its component's
+/// S_j, so it is weighted by that w_j. Every component runs with the options' reference: mix a
+/// model with sensors referred to `reference_C` (the grey box, reference "model") only with
+/// models without sensors (the sensor-free rules warmup and schedule). One component of weight 1
+/// is the single-model program (byte for byte). At most one component carries a blank term;
+/// weights within (0, 1], summing to 1 (within 1e-9).
+struct DriftComponent {
+  const drift::DriftModel* offset = nullptr;
+  const drift::DriftModel* slope = nullptr;
+  const BlankTerm* blank = nullptr;
+  double weight = 1;
+};
+
 /// How many $AC_PARAM slots the action uses for `model` (features, references, flag) and the
 /// optional slope model (its features, references, flag, and one slot for S_m).
 int DriftParamCount(const drift::DriftModel& model, const drift::DriftModel* slope = nullptr,
@@ -220,6 +243,14 @@ std::string FormatDriftNcProgram(const drift::DriftModel& model, const DriftActi
                                  const drift::DriftModel* slope = nullptr,
                                  const BlankTerm* blank = nullptr);
 
+/// The same for a mixed line (DriftComponent): the header names each component and its weight,
+/// the model lines, IDs, slots and the control's prerequisites count every component.
+/// InputError as above, and for no component, a weight outside (0, 1] or weights not summing
+/// to 1, more than one blank term, or a component without an offset model.
+std::string FormatDriftNcProgram(const std::vector<DriftComponent>& components,
+                                 const DriftActionOptions& options,
+                                 const std::string& model_source = "");
+
 /// The program that cancels the drift action's IDs and restores the saved setting data (SD43900
 /// if R<n+1> = 1, SD43910/SD43920 if R<n+4> = 1).
 std::string FormatDriftNcResetProgram(const DriftActionOptions& options);
@@ -233,6 +264,12 @@ std::string FormatDriftNcResetProgram(const DriftActionOptions& options);
 std::string FormatDriftPlcCsv(const drift::DriftModel& model, const DriftActionOptions& options,
                               const drift::DriftModel* slope = nullptr,
                               const BlankTerm* blank = nullptr);
+
+/// The same for a mixed line: with more than one component every row is tagged by its
+/// component (1-based) and weight in two leading columns component,weight, and the comment says
+/// K_m = sum of weight * each component's k0_mm sum (S_m likewise).
+std::string FormatDriftPlcCsv(const std::vector<DriftComponent>& components,
+                              const DriftActionOptions& options);
 
 /// The coefficients the control applies: c_0 = s * b0 / 1000 [mm], c_f = s * b_f / 1000
 /// [mm per unit], rounded to kDecimalsDriftCoefficient as printed.
@@ -265,6 +302,15 @@ std::vector<ControlRequirement> DriftRequirements(const drift::DriftModel& model
                                                   const drift::DriftModel* slope = nullptr,
                                                   const BlankTerm* blank = nullptr);
 
+/// The same for a mixed line (DriftComponent); MD32760 against sum_j w_j times each
+/// component's slope bound.
+std::vector<ControlRequirement> DriftRequirements(const std::vector<DriftComponent>& components,
+                                                  const DriftActionOptions& options);
+/// A mixed line's slope bound: sum_j w_j DriftSlopeBound of component j (0 without a slope).
+double DriftSlopeBound(const std::vector<DriftComponent>& components,
+                       const DriftActionOptions& options);
+
+inline constexpr int kDecimalsDriftWeight = 10;            ///< a component's weight w_j
 inline constexpr int kDecimalsDriftCoefficient = 10;       ///< mm per K (or per input unit)
 inline constexpr int kDecimalsDriftSlopeCoefficient = 14;  ///< mm/mm per K: 1e-14 per K
 inline constexpr int kDecimalsLagFactor = 15;              ///< a = 1 - exp(-T_ipo / tau)

@@ -6,7 +6,7 @@
 #                                   [--threads 2] [--scenarios production,duty-changes,...]
 #                                   [--out-dir DIR] [--slope-through-lags-only]
 #                                   [--offset-candidates] [--grey-candidates]
-#                                   [--grey-five-sensors]
+#                                   [--grey-five-sensors] [--grey-without-short-mix]
 # Seeds S..S+N-1 with S = --first-seed (default 1) and N = --seeds (1..20): a confirmation run
 # takes seeds no tuning run has used (e.g. --first-seed 101).
 # A week is 5 production days of history (--past-days 5 x weeks; at most 8 weeks = 40 days). Writes DIR/weeks_<w>.md (the evaluation's
@@ -25,9 +25,13 @@
 # grey_short_offset_as_read / grey_short_offset_one_lag: both_grey with the offset sensors as read
 # / through the shortest chosen lag below 20 lead days;
 # grey_guarded: both_grey or the sensor-free base rule, chosen on the shop's own last two lead
-# days), judged and tabled the same way.
+# days; grey_short_mix / grey_short_mix_fixed: below 20 lead days the line w both_grey + (1 - w)
+# the base rule, w from those two lead days clamped to [0.5, 1] / fixed at 0.75), judged and
+# tabled the same way.
 # --grey-five-sensors: both_grey with its five physical sensors on every record (the model before
 # the eleventh round, which takes every sensor from 20 lead days on), so older figures reproduce.
+# --grey-without-short-mix: both_grey as the grey box's line alone below 20 lead days (the default
+# before the fourteenth round's adoption of grey_short_mix), so older figures reproduce.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weeks="1"
@@ -48,9 +52,10 @@ while [ $# -gt 0 ]; do
     --out-dir) out_dir="$2"; shift 2 ;;
     --slope-through-lags-only) candidate+=(--slope-through-lags-only); shift ;;
     --grey-five-sensors) candidate+=(--grey-five-sensors); shift ;;
+    --grey-without-short-mix) candidate+=(--grey-without-short-mix); shift ;;
     --offset-candidates) candidate+=(--offset-candidates); rows="both_grey,grey_warmup_k0,grey_mean_k0"
                          shift ;;
-    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_short_prior,grey_short_offset_as_read,grey_short_offset_one_lag,grey_guarded"
+    --grey-candidates) candidate+=(--grey-candidates); rows="both_grey,grey_all_sensors,grey_sensors_by_days,grey_short_prior,grey_short_offset_as_read,grey_short_offset_one_lag,grey_guarded,grey_short_mix,grey_short_mix_fixed"
                        shift ;;
     -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) echo "grey_acceptance.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -130,7 +135,8 @@ PY
 note=""
 for c in ${candidate[@]+"${candidate[@]}"}; do
   case "$c" in
-    --slope-through-lags-only|--grey-five-sensors) note+="; both_grey with $c" ;;
+    --slope-through-lags-only|--grey-five-sensors|--grey-without-short-mix)
+      note+="; both_grey with $c" ;;
     --offset-candidates|--grey-candidates) note+="; the opt-in rows of $c" ;;
   esac
 done

@@ -51,7 +51,7 @@ struct MachineCliOptions {
   int test_days = 2, past_days = 5;
   double check_every_min = 10, probe_noise_um = 1.0, laser_every_min = 20, lead_sample_min = 5;
   bool no_setup_checks = false, slope_through_lags_only = false, offset_candidates = false,
-       grey_candidates = false, grey_five_sensors = false;
+       grey_candidates = false, grey_five_sensors = false, grey_without_short_mix = false;
   FieldWorldFlags world;  ///< the world's optional parts (cmd_machine_world.h)
   std::vector<std::pair<std::string, CLI::Option*>> retired;  ///< legacy-world flags, hidden
 };
@@ -83,6 +83,7 @@ machine_eval::FieldEvalOptions FieldOptions(const MachineCliOptions& o) {
   f.protocol.offset_candidates = o.offset_candidates;
   f.protocol.grey_candidates = o.grey_candidates;
   f.protocol.grey_five_sensors = o.grey_five_sensors;
+  f.protocol.grey_short_mix = !o.grey_without_short_mix;
   return f;
 }
 
@@ -130,6 +131,7 @@ void WriteReport(const MachineCliOptions& o, const machine_eval::SeedsEvaluation
   const machine_report::MachineReport r =
       machine_report::WriteMachineScrewReport(o.report, *report, &profile);
   if (!r.programs_note.empty()) Warn(r.programs_note);
+  if (!r.mix_note.empty()) Warn(r.mix_note);
   std::fprintf(stderr, "report written to %s\n", r.index_html.c_str());
 }
 
@@ -301,6 +303,12 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "eleventh round, which takes every sensor once the record holds 20 lead days; "
               "opt-in, so that older figures reproduce (docs/machine-evaluation.md, eleventh "
               "round)");
+  e->add_flag("--grey-without-short-mix", o->grey_without_short_mix,
+              "both_grey as the grey box's line alone on a record of fewer than 20 lead days: "
+              "the default before the fourteenth round, which mixes it with the sensor-free "
+              "base rule there (w grey + (1 - w) rule, w from the shop's last two lead days "
+              "within [0.5, 1]); opt-out, so that older figures reproduce bit for bit "
+              "(docs/machine-evaluation.md, fourteenth round)");
   e->add_flag("--offset-candidates", o->offset_candidates,
               "two more rows after the table's, computed in the same run: both_grey's slope with "
               "warmup's offset K0 (grey_warmup_k0) and with the mean of both offsets "
@@ -316,8 +324,10 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "(both_grey with the offset sensors as read, or through the shortest chosen lag, "
               "while the record holds fewer than 20 lead days) and grey_guarded (both_grey's "
               "model or the sensor-free base rule, whichever predicted the shop's own last two "
-              "lead days better); off by default (docs/machine-evaluation.md, eighth to "
-              "thirteenth rounds)");
+              "lead days better), grey_short_mix and grey_short_mix_fixed (while the record "
+              "holds fewer than 20 lead days the line w both_grey + (1 - w) the base rule, w "
+              "from the same two lead days, at least 0.5, or fixed at 0.75); off by default "
+              "(docs/machine-evaluation.md, eighth to fourteenth rounds)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

@@ -569,6 +569,134 @@ TEST(DriftAction, OffsetOnlyProgramGivesBackAnAbandonedSlope) {
   EXPECT_EQ(r.control.ref_position_mm, -5.0);
 }
 
+// A mixed line (DriftComponent: docs/machine-evaluation.md "Fourteenth round: adoption"), by
+// hand: two static models at u = (1, 1) K, e_A = 1 + 2 - 1 = 2 um and e_B = 4 + 0.5 + 0.5 = 5 um,
+// weights 0.25 / 0.75: SD43900 = s (0.5 + 3.75) / 1000 = 0.00425 mm (s = +1: subtracted, +1).
+TEST(DriftAction, MixedLineByHand) {
+  const drift::DriftModel a = HandModel(false, {1.0, 2.0, -1.0});
+  const drift::DriftModel b = HandModel(false, {4.0, 0.5, 0.5});
+  const DriftActionOptions o = Options(ControlDk::kSubtracted, 1, DriftReference::kModel);
+  replay::Replay r;
+  SetInputs(r, o, Eigen::Vector2d(25.5, 27.25));  // the references 24.5, 26.25 plus 1 K
+  ASSERT_TRUE(r.RunProgram(FormatDriftNcProgram({{&a, nullptr, nullptr, 0.25},
+                                                 {&b, nullptr, nullptr, 0.75}}, o)));
+  r.Cycle(0.0);
+  EXPECT_NEAR(r.control.abs_value_mm, 0.00425, 1e-12);
+}
+
+// Two components, each with its own lags and slope model (one of them without a slope), weights
+// 0.3 / 0.7: the control applies s/1000 (sum_j w_j e_K,j + sigma (sum_j w_j e_g,j) (P - P_b) /
+// 1000) at every position, every cycle, each e from the component's own DriftEvaluator. The
+// header's counts are the program's: IDs, the last slot, every line within 512 characters.
+TEST(DriftAction, MixedLineIsTheWeightedSumOfItsComponentsLines) {
+  std::mt19937 rng(1841);
+  for (bool second_slope : {true, false})
+    for (auto control : {ControlDk::kAdded, ControlDk::kSubtracted}) {
+      const drift::DriftModel m1 = HandModel(true, rng), g1 = SlopeModel();
+      const drift::DriftModel m2 = HandModel(false, rng);
+      const drift::DriftModel g2 = HandModel(true, {0.3, -2.0, 1.0, 0.5, 4.0, -1.5, 2.5});
+      const double w = 0.3;
+      const DriftActionOptions o = SlopeOptions(control, -1, -1);
+      const std::vector<DriftComponent> parts = {
+          {&m1, &g1, nullptr, w}, {&m2, second_slope ? &g2 : nullptr, nullptr, 1 - w}};
+      const std::string nc = FormatDriftNcProgram(parts, o);
+      replay::Replay r;
+      SetInputs(r, o, Temperatures(0));
+      ASSERT_TRUE(r.RunProgram(nc)) << nc;
+      drift::DriftEvaluator k1(m1, m1.reference_C), s1(g1, g1.reference_C),
+          k2(m2, m2.reference_C), s2(g2, g2.reference_C);
+      double worst_mm = 0, second_mm = 0;
+      for (int k = 0; k < 1200; ++k) {
+        SetInputs(r, o, Temperatures(k));
+        r.Cycle(0.0);
+        const double t = k * kCycleMs / 60000.0;
+        const Eigen::Vector2d u = Temperatures(k);
+        const double e_k1 = k1.Step(t, u), e_g1 = s1.Step(t, u), e_k2 = k2.Step(t, u);
+        const double e_g2 = second_slope ? s2.Step(t, u) : 0.0;
+        for (double p : {-812.5, 2500.0, 5587.5, 6400.0}) {
+          const double line = (w * e_k1 + (1 - w) * e_k2) -
+                              (w * e_g1 + (1 - w) * e_g2) * (p - 5587.5) / 1000.0;  // sigma -1
+          const double first = e_k1 - e_g1 * (p - 5587.5) / 1000.0;
+          worst_mm = std::max(worst_mm, std::abs(r.control.DkMm(p) - Sign(o) * line / 1000.0));
+          second_mm = std::max(second_mm, std::abs(line - first) / 1000.0);
+        }
+      }
+      EXPECT_LT(worst_mm, 1e-8) << nc;
+      EXPECT_GT(second_mm, 1e-4) << "the second component must move the line";
+      // The counts the header and the requirements state are the program's own.
+      int ids = 0, largest_slot = -1;
+      std::istringstream lines(nc);
+      for (std::string line; std::getline(lines, line);) {
+        EXPECT_LE(line.size(), 512u) << line;
+        ids += line.rfind("IDS=", 0) == 0;
+        for (std::size_t at = line.find("$AC_PARAM["); at != std::string::npos;
+             at = line.find("$AC_PARAM[", at + 1))
+          if (line[0] != ';') largest_slot = std::max(largest_slot, std::stoi(line.substr(at + 10)));
+      }
+      double actions = -1, slots = -1;
+      for (const ControlRequirement& q : DriftRequirements(parts, o)) {
+        if (q.datum.rfind("MD28250", 0) == 0) actions = q.value;
+        if (q.datum.rfind("MD28254", 0) == 0) slots = q.value;
+      }
+      EXPECT_EQ(actions, ids);
+      EXPECT_EQ(slots, largest_slot + 1);
+      EXPECT_NE(nc.find("room for " + std::to_string(ids) + " static actions"), std::string::npos);
+      EXPECT_NE(nc.find("; component 2, w = 0.7000000000: model "), std::string::npos);
+      ASSERT_FALSE(HasFailure());
+    }
+}
+
+// One component of weight 1 is the single-model program, byte for byte (NC, PLC table,
+// requirements); a mixed PLC table tags every row by component and weight.
+TEST(DriftAction, OneComponentIsTheSingleModelProgram) {
+  std::mt19937 rng(1842);
+  const drift::DriftModel m = HandModel(true, rng), g = SlopeModel();
+  const DriftActionOptions o = SlopeOptions(ControlDk::kAdded, 1, 1);
+  EXPECT_EQ(FormatDriftNcProgram({{&m, &g, nullptr, 1.0}}, o, "src"),
+            FormatDriftNcProgram(m, o, "src", &g));
+  EXPECT_EQ(FormatDriftPlcCsv({{&m, &g, nullptr, 1.0}}, o), FormatDriftPlcCsv(m, o, &g));
+  EXPECT_EQ(DriftSlopeBound({{&m, &g, nullptr, 1.0}}, o), DriftSlopeBound(g, o));
+  const drift::DriftModel m2 = HandModel(false, rng);
+  const std::string csv = FormatDriftPlcCsv({{&m, &g, nullptr, 0.6}, {&m2, nullptr, nullptr, 0.4}}, o);
+  std::istringstream lines(csv);
+  int rows1 = 0, rows2 = 0;
+  bool header = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (!header) {
+      EXPECT_EQ(line.rfind("component,weight,output,feature,", 0), 0u) << line;
+      header = true;
+      continue;
+    }
+    rows1 += line.rfind("1,0.6000000000,", 0) == 0;
+    rows2 += line.rfind("2,0.4000000000,k0_mm,", 0) == 0;
+  }
+  EXPECT_EQ(rows1, 7 + 3);  // component 1: intercept and 6 features, the slope's 1 and 2
+  EXPECT_EQ(rows2, 3);      // component 2: intercept and 2 features, no slope
+  EXPECT_NEAR(DriftSlopeBound({{&m, &g, nullptr, 0.6}, {&m2, nullptr, nullptr, 0.4}}, o),
+              0.6 * DriftSlopeBound(g, o), 1e-15);
+}
+
+TEST(DriftAction, MixedLinesThatCannotBeRunAreRefused) {
+  std::mt19937 rng(1843);
+  const drift::DriftModel m = HandModel(true, rng), g = SlopeModel();
+  const DriftActionOptions o = SlopeOptions(ControlDk::kAdded, 1, 1);
+  const BlankTerm blank{"t2_C", 1.0, -11.8, 15, 30};
+  using Parts = std::vector<DriftComponent>;
+  EXPECT_THROW(FormatDriftNcProgram(Parts{}, o), InputError);
+  EXPECT_THROW(FormatDriftNcProgram(Parts{{&m, &g, nullptr, 0.5}, {&m, &g, nullptr, 0.4}}, o),
+               InputError);  // weights sum to 0.9
+  EXPECT_THROW(FormatDriftNcProgram(Parts{{&m, &g, nullptr, 1.0}, {&m, &g, nullptr, 0.0}}, o),
+               InputError);  // weight 0
+  EXPECT_THROW(FormatDriftNcProgram(Parts{{nullptr, &g, nullptr, 0.5}, {&m, &g, nullptr, 0.5}}, o),
+               InputError);  // no offset model
+  EXPECT_THROW(FormatDriftNcProgram(Parts{{&m, &g, &blank, 0.5}, {&m, &g, &blank, 0.5}}, o),
+               InputError);  // two blank terms, one blank_param
+  EXPECT_THROW(FormatDriftPlcCsv(Parts{{&m, &g, nullptr, 0.5}, {&m, &g, nullptr, 0.4}}, o),
+               InputError);
+  EXPECT_NO_THROW(FormatDriftNcProgram(Parts{{&m, &g, nullptr, 0.5}, {&m, &g, nullptr, 0.5}}, o));
+}
+
 TEST(DriftAction, RefusesWhatTheControlCannotRun) {
   std::mt19937 rng(1806);
   drift::DriftModel m = HandModel(true, rng);

@@ -72,7 +72,8 @@ grep -q 'SA_TEMP_COMP_ABS_VALUE' "$D/DRIFT.SPF" || fail "drift action does not w
 for f in WHIRL_TEMP_COMP.SPF WHIRL_DRIFT_COMP.SPF WHIRL_DRIFT_COMP_RESET.SPF index.html; do
   [ -f "$D/report/$f" ] || fail "report lacks $f"
 done
-grep -q "^; model: .*trained only from shop measurements" "$D/report/WHIRL_DRIFT_COMP.SPF" \
+grep -q "^; \(model\|mixed line of 2 components\): .*trained only from shop measurements" \
+  "$D/report/WHIRL_DRIFT_COMP.SPF" \
   || fail "the report's drift program is not the shop-trained model's"
 [ "$(grep -c "<li>MD28254" "$D/report/index.html")" = 1 ] || fail "MD28254 not listed once"
 [ "$(grep -c "<li>MD32750" "$D/report/index.html")" = 1 ] || fail "MD32750 not listed once"
@@ -91,6 +92,37 @@ grep -q "^; model: .* from 13 sensors, file grey box (both_grey)" \
   "$D/report_long/WHIRL_DRIFT_COMP.SPF" || fail "20 days: the drift program is not both_grey's"
 grep -q "^; slope model: .* from 13 sensors$" "$D/report_long/WHIRL_DRIFT_COMP.SPF" ||
   fail "20 days: the drift program's slope is not every sensor's"
+# Since the fourteenth round's adoption both_grey's programs on a short record are the
+# grey_short_mix line's: on 5 past days of duty changes (seed 3: the fitted weight below 1) the
+# report's drift action is the mixed line of the grey box and the sensor-free rule. With
+# --grey-without-short-mix --grey-candidates the programs are the grey box's and the mix's drift
+# action is written beside them (WHIRL_DRIFT_MIX), its PLC rows tagged by component and weight,
+# with no warning (the largest such action against the default profile:
+# tests/machine_report/test_machine_report.cpp).
+"$W" machine evaluate --scenarios duty-changes --machines 1 --test-days 1 --past-days 5 --seed 3 \
+  --out-dir "$D/report_mix_default" > /dev/null 2> "$D/report_mix_default_err.txt" ||
+  fail "evaluate --out-dir (mix default): $(cat "$D/report_mix_default_err.txt")"
+grep -q "^; mixed line of 2 components: .*file grey box (both_grey) mixed with" \
+  "$D/report_mix_default/WHIRL_DRIFT_COMP.SPF" || fail "default: both_grey's program is not the mix"
+[ -f "$D/report_mix_default/WHIRL_DRIFT_MIX.SPF" ] && fail "default: a second mix program"
+"$W" machine evaluate --scenarios duty-changes --machines 1 --test-days 1 --past-days 5 --seed 3 \
+  --grey-without-short-mix --grey-candidates --out-dir "$D/report_mix" > /dev/null \
+  2> "$D/report_mix_err.txt" ||
+  fail "evaluate --grey-candidates --out-dir: $(cat "$D/report_mix_err.txt")"
+grep -q "warning" "$D/report_mix_err.txt" && fail "mix: $(cat "$D/report_mix_err.txt")"
+for f in WHIRL_DRIFT_MIX.SPF WHIRL_DRIFT_MIX_RESET.SPF WHIRL_DRIFT_MIX_PLC.csv; do
+  [ -f "$D/report_mix/$f" ] || fail "report lacks $f"
+done
+grep -q "^; mixed line of 2 components" "$D/report_mix/WHIRL_DRIFT_MIX.SPF" ||
+  fail "mix: the drift program is not a mixed line"
+grep -q "^; component 2, w = 0\.[0-9]*: model dynamic of k0_um from 0 sensors" \
+  "$D/report_mix/WHIRL_DRIFT_MIX.SPF" || fail "mix: the rule's component is missing"
+grep -q "^component,weight,output,feature," "$D/report_mix/WHIRL_DRIFT_MIX_PLC.csv" &&
+  grep -q "^2,0\.[0-9]*,k0_mm,intercept," "$D/report_mix/WHIRL_DRIFT_MIX_PLC.csv" ||
+  fail "mix: the PLC rows are not tagged by component and weight"
+cmp -s "$D/report_mix/WHIRL_DRIFT_COMP_RESET.SPF" "$D/report_mix/WHIRL_DRIFT_MIX_RESET.SPF" &&
+  fail "mix: the reset program does not carry its own name"
+grep -q "grey_short_mix on the control" "$D/report_mix/index.html" || fail "mix: page lacks it"
 # The screw's control log is a drift run file: a machine model evaluates on it.
 "$W" drift predict --model "$D/offset.json" --run "$D/report/sensors.csv" --json > "$D/pred2.json" \
   2>/dev/null || fail "drift predict on the screw's log"
@@ -156,7 +188,7 @@ for name in a:
 for name in ("grey_warmup_k0", "grey_mean_k0"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 PY
-# --grey-candidates (the eighth to tenth rounds) adds its three rows after the seventh round's,
+# --grey-candidates (the eighth to fourteenth rounds) adds its rows after the seventh round's,
 # in the same run: every other row, the seventh round's included, comes out equal; grey_guarded
 # is the row of the model it chose (grey_guarded_choice per machine) to the digit, and
 # grey_sensors_by_days both_grey's (one past day: fewer than 20 lead days).
@@ -171,11 +203,13 @@ gc = json.load(open(sys.argv[2]))["scenarios"][0]
 b = gc["strategies"]
 assert sorted(b) == sorted(list(a) + ["grey_all_sensors", "grey_sensors_by_days",
                                       "grey_short_prior", "grey_short_offset_as_read",
-                                      "grey_short_offset_one_lag", "grey_guarded"]), sorted(b)
+                                      "grey_short_offset_one_lag", "grey_guarded",
+                                      "grey_short_mix", "grey_short_mix_fixed"]), sorted(b)
 for name in a:
     assert a[name] == b[name], name
 for name in ("grey_all_sensors", "grey_sensors_by_days", "grey_short_prior",
-             "grey_short_offset_as_read", "grey_short_offset_one_lag", "grey_guarded"):
+             "grey_short_offset_as_read", "grey_short_offset_one_lag", "grey_guarded",
+             "grey_short_mix", "grey_short_mix_fixed"):
     assert b[name]["uses_sensors"] and b[name]["screws"] == a["both_grey"]["screws"], name
 # grey_fit: what both_grey's fit chose on the machine (one past day: one lead day), from its grids.
 fit = gc["runs"][0]["grey_fit"]
@@ -185,8 +219,35 @@ assert fit[0]["blank_tau_min"] in (30, 60, 120, 240), fit
 assert all(t in (10, 20, 40, 80, 160, 320) for t in fit[0]["time_constants_min"]), fit
 chosen = gc["runs"][0]["grey_guarded_choice"]
 assert len(chosen) == 1 and chosen[0] in ("both_grey", "warmup", "schedule"), chosen
+# The grey box's line alone is grey_sensors_by_days' (one past day: fewer than 20 lead days);
+# since the fourteenth round's adoption both_grey is grey_short_mix's line, to the digit.
+keep = {"both_grey": "grey_sensors_by_days"}
 for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
-    assert b["grey_guarded"][key] == a[chosen[0]][key], (key, chosen)
-    assert b["grey_sensors_by_days"][key] == a["both_grey"][key], key
+    assert b["grey_guarded"][key] == b[keep.get(chosen[0], chosen[0])][key], (key, chosen)
+    assert b["grey_short_mix"][key] == a["both_grey"][key], key
+# grey_short_mix (the fourteenth round): the grey box's weight per machine, within [0.5, 1].
+mix = gc["runs"][0]["grey_short_mix_weight"]
+assert len(mix) == 1 and 0.5 <= mix[0] <= 1, mix
+PY
+# --grey-without-short-mix (the opt-out): both_grey is the grey box's line alone again
+# (grey_sensors_by_days' row, the default before the adoption), every other row as with the
+# default, the mix's weight the same.
+"$W" machine evaluate --scenarios production --machines 1 --past-days 1 --test-days 1 --json \
+  --grey-candidates --grey-without-short-mix > "$D/field_gc_out.json" 2> "$D/field_err.txt" ||
+  fail "field evaluate --grey-without-short-mix: $(cat "$D/field_err.txt")"
+python3 - "$D/field_gc.json" "$D/field_gc_out.json" <<'PY' || fail "--grey-without-short-mix wrong"
+import json, sys
+gc = json.load(open(sys.argv[1]))["scenarios"][0]
+out = json.load(open(sys.argv[2]))["scenarios"][0]
+a, b = gc["strategies"], out["strategies"]
+assert sorted(a) == sorted(b)
+for name in a:
+    if name != "both_grey":
+        assert a[name] == b[name], name
+for key in ("accumulated_total_median_um", "accumulated_1000_median_um", "share_reaching_p5"):
+    assert b["both_grey"][key] == b["grey_sensors_by_days"][key], key
+assert gc["runs"][0]["grey_short_mix_weight"] == out["runs"][0]["grey_short_mix_weight"]
+if gc["runs"][0]["grey_short_mix_weight"][0] < 1:
+    assert a["both_grey"] != b["both_grey"], "the mix must move both_grey below w = 1"
 PY
 echo "cli_machine: ok"

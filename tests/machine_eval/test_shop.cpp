@@ -167,6 +167,39 @@ TEST(CausalApplication, WithOffsetOfTakesTheOffsetAndKeepsTheSlope) {
   EXPECT_THROW(WithOffsetOf(grey, other, 1.0), InputError);
 }
 
+// The fourteenth round's rows (MixedLines): the line w x grey's + (1 - w) x the rule's, every part
+// of it (K0, slope, the blank term, which the rule lacks: 0), so each model's K0 and slope stay
+// together; w 1 is the grey box's samples exactly (the rows are both_grey's from 20 lead days).
+// On the line, hand-computed with w = 0.75: sample 0's K0 0.75 x 5 + 0.25 x (-1) = 3.5; at 60 s
+// sample 1: K0 0.75 x 6 + 0.25 x 2.5 = 5.125, slope 0.75 x 11 + 0.25 x 98 = 32.75, the blank
+// term latched at the cut start 0.75 x 0.5 = 0.375. Other logs and weights outside [0, 1] are
+// refused.
+TEST(CausalApplication, MixedLinesMixesEachModelsWholeLine) {
+  const HeldSamples grey{{0, 1, 2}, {5, 6, 7}, {10, 11, 12}, {0.5, 0.6, 0.7}};
+  const HeldSamples warm{{0, 1, 2}, {-1, 2.5, 3}, {99, 98, 97}, {}};
+  const HeldSamples same = MixedLines(grey, warm, 1.0);
+  EXPECT_EQ(same.k0_um, grey.k0_um);
+  EXPECT_EQ(same.slope_um_per_1000, grey.slope_um_per_1000);
+  EXPECT_EQ(same.blank_slope_um_per_1000, grey.blank_slope_um_per_1000);
+  const HeldSamples h = MixedLines(grey, warm, 0.5);
+  EXPECT_EQ(h.k0_um, (std::vector<double>{2, 4.25, 5}));
+  EXPECT_EQ(h.slope_um_per_1000, (std::vector<double>{54.5, 54.5, 54.5}));
+  EXPECT_EQ(h.blank_slope_um_per_1000, (std::vector<double>{0.25, 0.3, 0.35}));
+  const HeldSamples rule_only = MixedLines(grey, warm, 0.0);
+  EXPECT_EQ(rule_only.k0_um, warm.k0_um);
+  EXPECT_EQ(rule_only.slope_um_per_1000, warm.slope_um_per_1000);
+  EXPECT_EQ(rule_only.blank_slope_um_per_1000, (std::vector<double>{0, 0, 0}));
+  const compare::CompensationFunction c = CausalMachineLine(
+      MixedLines(grey, warm, 0.75), 0.5, 6400, [](double t_s) { return 6400 - t_s; });
+  EXPECT_DOUBLE_EQ(c(0), 3.5);
+  EXPECT_DOUBLE_EQ(c(60), 5.125 + (32.75 + 0.375) * 60 / 1000.0);
+  HeldSamples other = warm;
+  other.time_min[2] = 3;
+  EXPECT_THROW(MixedLines(grey, other, 0.5), InputError);
+  EXPECT_THROW(MixedLines(grey, warm, 1.5), InputError);
+  EXPECT_THROW(MixedLines(grey, warm, -0.1), InputError);
+}
+
 // The headline names the sensor-free row with the smallest pooled thread median (none excluded,
 // sensor rows never), and the per-seed medians bound the pooled one.
 TEST(SeedsSummary, StrongestSensorFreeIsTheSmallestThreadMedianWithoutSensors) {
@@ -406,7 +439,8 @@ TEST(GreyCandidates, TheShortRecordStrengthActsOnlyBelowTwentyLeadDays) {
         << days << " days";
   }
   EXPECT_EQ(ToString(GreyCandidate::kShortPrior), "grey_short_prior");
-  EXPECT_EQ(OptInRowName(kOffsetCandidateCount + kGreyCandidateCount - 1), "grey_guarded");
+  EXPECT_EQ(OptInRowName(kOffsetCandidateCount + kGreyCandidateCount - 3), "grey_guarded");
+  EXPECT_EQ(OptInRowName(kOffsetCandidateCount + kGreyCandidateCount - 1), "grey_short_mix_fixed");
 }
 
 // The thirteenth round's rows (grey_short_offset_as_read, grey_short_offset_one_lag) act only on
@@ -545,6 +579,33 @@ TEST(GreyGuard, ScoresEachHeldDayFromTheDaysBeforeItOnly) {
                                       FieldGreyBoxOptions(), WarmupSpec(), WarmupOptions());
   EXPECT_EQ(one.days, 0);
   EXPECT_TRUE(one.keep_grey);
+  EXPECT_EQ(one.combination_weight, 1.0);
+}
+
+// grey_short_mix (the fourteenth round) takes the least-squares weight of the grey box on the
+// guard's held days: near 1 where the leads follow the field grey box's law (the sensors carry
+// the truth), below the floor where they follow the time since power-on alone (the sensors carry
+// nothing), where ShortMixWeights then keeps the floor 0.5: the grey box is never dropped. On a
+// long record both weights are 1 (both_grey's line), on a short one the fixed row's is 0.75.
+TEST(GreyMix, TheCombinationWeightFollowsWhichFamilyCarriesTheLeads) {
+  const GuardScore truth = GuardGreyBox(MotorRecord(0, 8, 0), FieldGreyBoxSpec(6400),
+                                        FieldGreyBoxOptions(), WarmupSpec(), WarmupOptions());
+  EXPECT_NEAR(truth.combination_weight, 1.0, 0.1);
+  const GuardScore clock = GuardGreyBox(ClockRecord(0, 8), FieldGreyBoxSpec(6400),
+                                        FieldGreyBoxOptions(), WarmupSpec(), WarmupOptions());
+  EXPECT_LT(clock.combination_weight, kShortMixFloor);
+  const ShopModels::Mix short_clock = ShortMixWeights(false, clock);
+  EXPECT_EQ(short_clock.fitted_weight, kShortMixFloor);
+  EXPECT_EQ(short_clock.fixed_weight, 0.75);
+  EXPECT_EQ(ShortMixWeights(false, truth).fitted_weight,
+            std::min(1.0, truth.combination_weight));
+  for (const GuardScore& g : {truth, clock}) {
+    const ShopModels::Mix long_record = ShortMixWeights(true, g);
+    EXPECT_EQ(long_record.fitted_weight, 1.0);
+    EXPECT_EQ(long_record.fixed_weight, 1.0);
+  }
+  EXPECT_EQ(ToString(GreyCandidate::kShortMix), "grey_short_mix");
+  EXPECT_EQ(ToString(GreyCandidate::kShortMixFixed), "grey_short_mix_fixed");
 }
 
 // grey_guarded scores the model it applies (both_grey's): on a record of 20 lead days the
@@ -568,6 +629,13 @@ TEST(GreyGuard, ScoresTheGreyBoxItApplies) {
     EXPECT_EQ(m.guard.keep_grey, (days >= 20 ? every : five).keep_grey) << days << " days";
     EXPECT_EQ(old.guard.grey_rms_um, five.grey_rms_um) << days << " days";
     EXPECT_EQ(m.guard.rule_rms_um, five.rule_rms_um) << days << " days";
+    // The fourteenth round's weights act only below 20 lead days (from the same guard score).
+    const ShopModels::Mix expect = ShortMixWeights(days >= 20, days >= 20 ? every : five);
+    EXPECT_EQ(m.mix.fitted_weight, expect.fitted_weight) << days << " days";
+    EXPECT_EQ(m.mix.fixed_weight, days >= 20 ? 1.0 : kShortMixFixedWeight) << days << " days";
+    if (days >= 20) {
+      EXPECT_EQ(m.mix.fitted_weight, 1.0);
+    }
   }
 }
 

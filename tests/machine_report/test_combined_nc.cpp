@@ -18,6 +18,7 @@
 
 #include "core/error.h"
 #include "core/process.h"
+#include "drift/grey_box.h"
 #include "drift/joint.h"
 #include "interp/nc_replay.h"
 #include "machine/scenarios.h"
@@ -50,6 +51,7 @@ const machine_eval::ReportScrew& ShortCut() {
     o.calendar.past_days = 2;
     o.calendar.test_days = 1;
     o.keep_report_screw = true;
+    o.protocol.grey_candidates = true;  // the mix's rule and weight (grey_short_mix)
     const machine_eval::MachineEvaluation e = machine_eval::EvaluateFieldScenario(
         s, workpiece::LoadWorkpieceModel(CombinedSource("models/default.json")),
         compare::BuildExperienceRule(
@@ -265,6 +267,95 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
   EXPECT_GT(b_moved, 0.0);
   day.EndAndReset();
   EXPECT_EQ(replay.control.ac_param[blank + 1], interp::kBlankNeutralC);
+}
+
+// grey_short_mix's combined programs over the same day (the fourteenth round): at every control
+// sample the control applies the plan plus the evaluator's mixed line (machine_eval/strategies.h
+// MixedLines of the grey box and the base rule, both run causally): K0 and slope each
+// w grey + (1 - w) rule, the grey box's blank term latched by the plan times w. A weight of
+// 0.7 (the fitted one may be 1 on this short record, where the mix is the grey box's line, a
+// case checked byte for byte below); the rule's part must show (else a program that dropped it
+// would pass).
+TEST(CombinedPrograms, ReplayAppliesPlanPlusTheMixedLineOfTheGreyBoxAndTheRule) {
+  const machine_eval::ReportScrew& r = ShortCut();
+  ASSERT_TRUE(r.mix_computed);
+  ASSERT_FALSE(r.grey.blank_sensor.empty());
+  ASSERT_TRUE(r.mix_rule.sensors.empty());
+  ASSERT_GT(r.mix_rule.features(), 0);
+  const double w = 0.7;
+  const interp::MachineProfile profile =
+      CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  const CombinedPrograms p = BuildCombinedMixPrograms(
+      r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options, r.grey,
+      r.mix_rule_offset, r.mix_rule_slope, w, profile, "test curve", "test mix");
+  ASSERT_TRUE(p.mixed);
+  const drift::Run& log = r.log;
+  const machine_eval::HeldSamples grey = machine_eval::RunCausally(r.grey, log);
+  const machine_eval::HeldSamples held =
+      machine_eval::MixedLines(grey, machine_eval::RunCausally(r.mix_rule, log), w);
+  const Eigen::MatrixXd grey_raw = drift::GreyBoxRawInputs(r.grey, log);
+  const Eigen::MatrixXd rule_raw = drift::JointRawInputs(r.mix_rule, log);
+  Eigen::MatrixXd raw(log.samples(), grey_raw.cols() + rule_raw.cols());
+  raw << grey_raw, rule_raw;
+  std::vector<std::string> inputs = r.grey.Inputs();
+  inputs.insert(inputs.end(), r.mix_rule.other_inputs.begin(), r.mix_rule.other_inputs.end());
+  const int blank = p.drift.blank_param;
+  DayReplay day(r, p, raw, inputs);
+  interp::replay::Replay& replay = day.replay;
+  const double s = interp::SignFactor(p.plan.options.sign);
+  day.PowerOn();
+  if (::testing::Test::HasFatalFailure()) return;
+  const int per_sample = SamplesPerInterval(log);
+  const double g_b = r.grey.blank_um_per_1000_per_k;
+  double worst_um = 0, rule_part_um = 0;
+  int cut_samples = 0;
+  for (int k = 1; k < log.samples(); ++k) {
+    const double t1 = log.time_min[static_cast<std::size_t>(k)];
+    day.Advance(k, per_sample);
+    if (::testing::Test::HasFailure()) return;
+    const auto uk = static_cast<std::size_t>(k);
+    const double pos = day.AxisAt(t1);
+    const bool cutting = day.CutTimeS(t1) >= 0 && day.CutTimeS(t1) < day.t_cut;
+    const double latch = replay.control.ac_param[blank + 1];
+    const double blank_um = cutting ? w * g_b * (latch - 20.0) : 0.0;
+    const double arm = (r.z_ref_mm - day.ZAt(t1)) / 1000.0;
+    const double machine_um = held.k0_um[uk] + (held.slope_um_per_1000[uk] + blank_um) * arm;
+    const double grey_um = grey.k0_um[uk] + (grey.slope_um_per_1000[uk] + blank_um / w) * arm;
+    const double applied_um = replay.control.DkMm(pos) * 1000.0 / s;
+    const double plan_um = cutting ? interp::AppliedCompensationUm(p.plan, pos) : 0.0;
+    worst_um = std::max(worst_um, std::abs(applied_um - machine_um - plan_um));
+    rule_part_um = std::max(rule_part_um, std::abs(machine_um - grey_um));
+    cut_samples += cutting;
+  }
+  EXPECT_GT(cut_samples, 30);
+  // Coefficients and weights print to 1e-10 mm (1e-4 nm): the replay agrees far below a nm.
+  EXPECT_LT(worst_um, 1e-4);
+  EXPECT_GT(rule_part_um, 0.1) << "the rule's 1 - w share must move the line";
+  day.EndAndReset();
+}
+
+// w = 1 (a long record, or the guard's weight clamped to 1): the grey box's programs, byte for
+// byte; a rule reading sensors, or a weight outside (0, 1], is refused.
+TEST(CombinedPrograms, TheMixOfWeightOneIsTheGreyBoxsProgramsAndBadMixesAreRefused) {
+  const machine_eval::ReportScrew& r = ShortCut();
+  const interp::MachineProfile profile =
+      CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  auto mix = [&](double w, const drift::DriftModel& offset, const drift::DriftModel& slope) {
+    return BuildCombinedMixPrograms(r.predicted_curve, r.kinematics,
+                                    r.result.screw.thread_length_mm, r.plan_options, r.grey,
+                                    offset, slope, w, profile, "c", "m");
+  };
+  const CombinedPrograms grey = BuildCombinedGreyPrograms(
+      r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options, r.grey,
+      profile, "c", "m");
+  const CombinedPrograms one = mix(1.0, r.mix_rule_offset, r.mix_rule_slope);
+  EXPECT_FALSE(one.mixed);
+  EXPECT_EQ(one.drift_nc, grey.drift_nc);
+  EXPECT_EQ(one.drift_plc_csv, grey.drift_plc_csv);
+  EXPECT_THROW(mix(0.0, r.mix_rule_offset, r.mix_rule_slope), InputError);
+  EXPECT_THROW(mix(1.2, r.mix_rule_offset, r.mix_rule_slope), InputError);
+  ASSERT_FALSE(r.sensor_model.sensors.empty());
+  EXPECT_THROW(mix(0.7, r.offset, r.slope), InputError);  // both_shop's: sensors from power-on
 }
 
 TEST(CombinedPrograms, ProfileThatDisagreesWithTheMachineIsRefused) {

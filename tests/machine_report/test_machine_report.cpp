@@ -21,6 +21,7 @@
 #include "core/plot_style.h"
 #include "core/process.h"
 #include "drift/evaluation.h"
+#include "drift/joint.h"
 #include "drift/monitor.h"
 #include "core/safe_text.h"
 #include "interp/drift_action.h"
@@ -226,6 +227,15 @@ TEST(MachineReport, WhereTheProgramsModelIsTheGreyBoxItsProgramsAreHandedOut) {
   ASSERT_FALSE(r.grey.Inputs().empty());
   r.programs_strategy = MachineStrategy::kBothGrey;
   r.programs_reason = "both_grey: picked by the test";
+  // The default since the fourteenth round: both_grey applies grey_short_mix's line on a short
+  // record, and its programs are the mix's (here with w = 0.6, so both components show).
+  ASSERT_TRUE(r.mix_computed && r.mix_applied);
+  const ReportScrew mixed = [&] {
+    ReportScrew m = r;
+    m.mix_weight = 0.6;
+    return m;
+  }();
+  r.mix_applied = false;  // the grey box's line alone (--grey-without-short-mix)
   const interp::MachineProfile profile =
       interp::LoadMachineProfile(ReportSource("datasets/machines/whirling_840d.json"));
   const std::filesystem::path dir = ReportDir("whirl_machine_report_grey");
@@ -259,6 +269,15 @@ TEST(MachineReport, WhereTheProgramsModelIsTheGreyBoxItsProgramsAreHandedOut) {
   EXPECT_NE(fallback.programs_note.find("drift.blank_param"), std::string::npos)
       << fallback.programs_note;
   EXPECT_NE(fallback.programs_reason.find("both_shop"), std::string::npos);
+  std::filesystem::remove_all(dir);
+  const MachineReport mix = WriteMachineScrewReport(dir.string(), mixed, &profile);
+  ASSERT_TRUE(mix.programs && mix.programs_grey) << mix.programs_note;
+  EXPECT_FALSE(mix.mix_programs);  // the programs themselves: no second drift action
+  EXPECT_EQ(statements(ReadTextFile(dir / "WHIRL_DRIFT_COMP.SPF")),
+            statements(interp::FormatDriftNcProgram(
+                {{&a.offset, &a.slope, a.Blank(), 0.6},
+                 {&mixed.mix_rule_offset, &mixed.mix_rule_slope, nullptr, 0.4}},
+                d)));
   std::filesystem::remove_all(dir);
 }
 
@@ -337,6 +356,76 @@ TEST(MachineReport, TheDefaultProfileHoldsTheLargestFieldGreyBoxDriftAction) {
             std::string::npos);
   EXPECT_EQ(nc.find("IDS=" + std::to_string(d.sync_id_first + static_cast<int>(actions)) + " "),
             std::string::npos);
+}
+
+// The largest grey_short_mix drift action the field can ask for (the mix acts below 20 lead days,
+// where the grey box has FieldGreyBoxSpec's five sensors; from 20 lead days on w = 1 and the
+// programs are the grey box's, checked above): the five-sensor grey box with the most lags its fit
+// allows, mixed with the larger sensor-free rule, schedule (every duty signal with the most lags
+// drift::JointFitOptions allows), fits the default profile's IDs and slots by the generator's
+// own counts, and the program is written.
+TEST(MachineReport, TheDefaultProfileHoldsTheLargestShortMixDriftAction) {
+  const interp::MachineProfile profile =
+      interp::LoadMachineProfile(ReportSource("datasets/machines/whirling_840d.json"));
+  const drift::GreyBoxSpec spec = machine_eval::FieldGreyBoxSpec(6400);
+  const drift::GreyBoxOptions fit = machine_eval::FieldGreyBoxOptions();
+  ASSERT_EQ(spec.offset_sensors.size() + spec.slope_sensors.size(), 5u);
+  drift::GreyBoxModel m;
+  m.offset_sensors = spec.offset_sensors;
+  m.slope_sensors = spec.slope_sensors;
+  m.blank_sensor = spec.blank_sensor;
+  ASSERT_FALSE(m.blank_sensor.empty());
+  m.time_constants.assign(fit.tau_grid.end() - fit.max_lags, fit.tau_grid.end());
+  const auto per = static_cast<Eigen::Index>(1 + fit.max_lags);
+  const Eigen::Index n_k = static_cast<Eigen::Index>(m.offset_sensors.size()) * per;
+  const Eigen::Index n_g = static_cast<Eigen::Index>(m.slope_sensors.size()) * per;
+  m.a = Eigen::VectorXd::Constant(n_k, -0.0123);
+  m.g = Eigen::VectorXd::Constant(n_g, 0.0045);
+  m.slope_intercept_um_per_1000 = 1.5;
+  m.blank_um_per_1000_per_k = -11.8;
+  m.offset_min = Eigen::VectorXd::Constant(n_k, -5.0);
+  m.offset_max = Eigen::VectorXd::Constant(n_k, 15.0);
+  m.slope_min = Eigen::VectorXd::Constant(n_g, -5.0);
+  m.slope_max = Eigen::VectorXd::Constant(n_g, 15.0);
+  m.blank_min_c = 15, m.blank_max_c = 30;
+  const interp::GreyBoxAction a = interp::GreyBoxActionModels(m);
+  drift::JointDriftModel rule;
+  rule.other_inputs = machine_eval::ScheduleInputs();
+  const drift::JointFitOptions joint;
+  rule.time_constants.assign(joint.tau_grid.end() - joint.max_lags, joint.tau_grid.end());
+  const auto n_r =
+      static_cast<Eigen::Index>(rule.other_inputs.size()) * (1 + joint.max_lags);
+  rule.a = Eigen::VectorXd::Constant(n_r, 0.031);
+  rule.g = Eigen::VectorXd::Constant(n_r, -0.0007);
+  auto [rule_k, rule_g] = drift::ToDriftModels(rule);
+  for (drift::DriftModel* d : {&rule_k, &rule_g}) {
+    d->feature_min = Eigen::VectorXd::Constant(n_r, 0.0);
+    d->feature_max = Eigen::VectorXd::Constant(n_r, 200.0);
+  }
+  interp::DriftActionOptions d = profile.DriftOptions();
+  d.reference = interp::DriftReference::kModel;
+  const std::vector<interp::DriftComponent> parts = {
+      {&a.offset, &a.slope, a.Blank(), machine_eval::kShortMixFloor},
+      {&rule_k, &rule_g, nullptr, 1 - machine_eval::kShortMixFloor}};
+  double actions = -1, last_slot = -1, single = -1;
+  for (const interp::ControlRequirement& r : interp::DriftRequirements(parts, d)) {
+    if (r.datum.rfind("MD28250", 0) == 0) actions = r.value;
+    if (r.datum.rfind("MD28254", 0) == 0) last_slot = r.value - 1;
+  }
+  for (const interp::ControlRequirement& r :
+       interp::DriftRequirements(a.offset, d, &a.slope, a.Blank()))
+    if (r.datum.rfind("MD28250", 0) == 0) single = r.value;
+  EXPECT_GT(actions, single + 6) << "the rule's actions are counted";
+  EXPECT_LE(actions, d.sync_id_last - d.sync_id_first + 1);
+  EXPECT_LE(actions, d.control.sync_elements);
+  EXPECT_LE(last_slot, d.param_last);
+  EXPECT_LT(last_slot, d.control.ac_params);
+  EXPECT_GT(last_slot, d.param_first + n_k + n_g + 2 * n_r);  // every feature has its slot
+  std::string nc;
+  ASSERT_NO_THROW(nc = interp::FormatDriftNcProgram(parts, d));
+  const int last_id = d.sync_id_first + static_cast<int>(actions) - 1;
+  EXPECT_NE(nc.find("IDS=" + std::to_string(last_id) + " "), std::string::npos);
+  EXPECT_EQ(nc.find("IDS=" + std::to_string(last_id + 1) + " "), std::string::npos);
 }
 
 }  // namespace

@@ -24,9 +24,13 @@ FieldMachineModels TrainFieldMachine(const machine::MachineTimeline& timeline,
       FieldShopRecord(timeline, protocol, workpiece_residual, seed, &m.lead_slopes);
   m.z_ref_mm = timeline.machine().config().z.fixed_end_mm;
   m.shop = FitShopModels(record, m.z_ref_mm, ScheduleInputs(), protocol.grey_slope_lags_only,
-                         protocol.grey_candidates, protocol.grey_five_sensors);
+                         protocol.grey_candidates, protocol.grey_five_sensors,
+                         protocol.grey_short_mix);
   m.monitor = MakeProbeMonitor(m.shop.sensors, record.day_logs);
   m.control = ShopControlModels(m.shop.sensors, record.day_logs);
+  if (m.shop.mix.computed)
+    m.mix_rule_control = ShopControlModels(
+        m.shop.rule_is_schedule ? m.shop.schedule : m.shop.warmup, record.day_logs);
   m.records = static_cast<int>(record.records.size());
   m.lead_days = static_cast<int>(drift::LeadDays(record).size());
   for (const auto& r : record.records) m.readings += static_cast<int>(r.rows.size());
@@ -256,6 +260,15 @@ void CompleteReport(const drift::Run& log, const FieldMachineModels& models, Rep
   r->sensors_choice = models.shop.sensors_choice;
   r->z_ref_mm = models.z_ref_mm;
   r->grey = models.shop.grey;
+  const ShopModels& shop = models.shop;
+  r->mix_computed = shop.mix.computed;
+  r->mix_applied = shop.mix.applied;
+  if (!r->mix_computed) return;
+  r->mix_weight = shop.mix.fitted_weight;
+  r->mix_rule_name = shop.rule_is_schedule ? "schedule" : "warmup";
+  r->mix_rule = shop.rule_is_schedule ? shop.schedule : shop.warmup;
+  r->mix_rule_offset = models.mix_rule_control.offset;
+  r->mix_rule_slope = models.mix_rule_control.slope;
 }
 
 // Every test-day screw of one machine world; `report` (optional) receives the first screw that
@@ -285,10 +298,15 @@ std::vector<MachineEvalScrew> EvaluateTestDays(const MachineTimeline& tl,
     for (const drift::GreyBoxModel& g : models.shop.grey_candidates)
       held.candidates.push_back(RunCausally(g, log));
     const ShopModels& shop = models.shop;
-    if (shop.guard.chosen)
-      held.candidates.push_back(shop.guard.keep_grey   ? held.grey
-                                : shop.rule_is_schedule ? held.schedule
-                                                        : held.warmup);
+    if (shop.guard.chosen) {
+      const HeldSamples& rule = shop.rule_is_schedule ? held.schedule : held.warmup;
+      held.candidates.push_back(shop.guard.keep_grey ? held.grey : rule);
+      for (double w : {shop.mix.fitted_weight, shop.mix.fixed_weight})
+        held.candidates.push_back(MixedLines(held.grey, rule, w));
+    }
+    if (shop.mix.applied)  // both_grey's line is grey_short_mix's (after the rows built on the box)
+      held.grey = MixedLines(held.grey, shop.rule_is_schedule ? held.schedule : held.warmup,
+                             shop.mix.fitted_weight);
     const std::vector<machine::Reading> checks =
         machine::ProbeReadings(tl, SetupCheckTimes(plan), protocol.probe_z_mm,
                                protocol.probe_sigma_um, MixSeed(plan.seed, 0x6d6f6e));
@@ -379,6 +397,7 @@ MachineEvaluation EvaluateFieldScenario(const machine::MachineScenario& scenario
       e.guard_choice.push_back(shop.guard.keep_grey      ? "both_grey"
                                : shop.rule_is_schedule ? "schedule"
                                                        : "warmup");
+    if (shop.guard.chosen) e.short_mix_weight.push_back(shop.mix.fitted_weight);
     e.grey_fit.push_back({shop.grey.prior_strength, shop.grey.blank_tau_min,
                           shop.grey.cv_rmse_um, shop.grey.time_constants,
                           models[i].lead_days});

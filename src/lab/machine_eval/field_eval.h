@@ -57,6 +57,9 @@ struct FieldMachineModels {
   ProbeMonitor monitor;  ///< both_shop_monitor: the sensor model's offset channel and its ranges
   /// The sensor model as the drift action's offset and slope models (shop_models.h).
   ShopControl control;
+  /// The base rule grey_short_mix mixes in (schedule or warmup: ShopModels::rule_is_schedule)
+  /// as the drift action's models; only where the guard was chosen (the opt-in grey rows).
+  ShopControl mix_rule_control;
 };
 
 /// The models of one machine world from its shop record (field_history.h) only.

@@ -62,6 +62,11 @@ struct FieldProtocol {
   /// rows (computed with them): grey boxes of another structure (docs/machine-evaluation.md,
   /// eighth round).
   bool grey_candidates = false;
+  /// both_grey applies the fourteenth round's grey_short_mix line below 20 lead days (the field
+  /// default since its adoption, docs/machine-evaluation.md "Fourteenth round: adoption");
+  /// false: the grey box's line alone, the figures before it bit for bit
+  /// (--grey-without-short-mix).
+  bool grey_short_mix = true;
 };
 
 /// The temperature columns of `log` replaced by their mean over the rows with time in

@@ -56,8 +56,11 @@
 //                      checks at its set-ups (field_monitor.h)
 //   both_grey          workpiece + the grey box (drift/grey_box.h: absolute temperatures, a slope
 //                      intercept, the blank's estimate latched at the cut start, physical priors;
-//                      shop_models.h FieldGreyBoxSpec), trained from the same shop records; the
-//                      report's 840D programs apply it wherever it was fitted
+//                      shop_models.h FieldGreyBoxSpec), trained from the same shop records;
+//                      below 2 x forward_days lead days mixed with the sensor-free base rule,
+//                      w grey + (1 - w) rule (grey_short_mix's line, FieldProtocol::
+//                      grey_short_mix, the default since the fourteenth round); the report's
+//                      840D programs apply it wherever it was fitted
 //                      (ReportScrew::programs_strategy)
 // Every machine model is applied causally (strategies.h). The truth of a cut: the workpiece truth
 // of compare::CompareScrew (the blank starts at the hall's temperature through its lag and
@@ -135,19 +138,24 @@ double WarmupOffsetShare(OffsetCandidate c);
 /// strength fixed at 1 below 2 x forward_days lead days (grey_short_prior, shop_models.h
 /// ShortRecordStrongPrior); the thirteenth round's both_grey with the offset sensors as read
 /// (grey_short_offset_as_read) or through the shortest chosen lag (grey_short_offset_one_lag)
-/// below 2 x forward_days lead days (shop_models.h ShortRecordOffsetLags), before grey_guarded.
-/// All count as using sensors; never the strongest sensor-free row.
+/// below 2 x forward_days lead days (shop_models.h ShortRecordOffsetLags), before grey_guarded;
+/// after it the fourteenth round's line w grey box + (1 - w) base rule below 2 x forward_days
+/// lead days, w from the guard's held days (grey_short_mix) or fixed (grey_short_mix_fixed;
+/// shop_models.h ShortMixWeights). All count as using sensors; never the strongest sensor-free
+/// row.
 enum class GreyCandidate {
   kAllSensors,
   kSensorsByDays,
   kShortPrior,
   kShortOffsetAsRead,
   kShortOffsetOneLag,
-  kGuarded
+  kGuarded,
+  kShortMix,
+  kShortMixFixed
 };
-inline constexpr std::size_t kGreyCandidateCount = 6;
+inline constexpr std::size_t kGreyCandidateCount = 8;
 /// grey_all_sensors, grey_sensors_by_days, grey_short_prior, grey_short_offset_as_read,
-/// grey_short_offset_one_lag, grey_guarded
+/// grey_short_offset_one_lag, grey_guarded, grey_short_mix, grey_short_mix_fixed
 std::string ToString(GreyCandidate c);
 /// The name of opt-in row k (OffsetCandidate rows, then GreyCandidate rows).
 std::string OptInRowName(std::size_t k);
@@ -214,6 +222,16 @@ struct ReportScrew {
   std::string sensors_choice;        ///< which candidate it is (shop_models.h)
   double z_ref_mm = 0;               ///< the slope's reference: the Z screw's fixed bearing
   drift::GreyBoxModel grey;          ///< the grey box both_grey applies (no input: not fitted)
+  /// grey_short_mix where its row was computed (the opt-in grey rows, the guard chosen): the
+  /// grey box's weight w (shop_models.h ShortMixWeights; 1: the grey box's line), the base rule
+  /// it is mixed with (warmup or schedule, `mix_rule_name`) and that rule as the drift action's
+  /// offset and slope models (ShopControlModels); mix_computed false otherwise.
+  bool mix_computed = false;
+  bool mix_applied = false;  ///< both_grey applies the mix (FieldProtocol::grey_short_mix)
+  double mix_weight = 1;
+  std::string mix_rule_name;
+  drift::JointDriftModel mix_rule;
+  drift::DriftModel mix_rule_offset, mix_rule_slope;
   /// The machine model the report's combined 840D programs apply: kBothGrey where the grey box
   /// was fitted (ProgramsStrategy, summary.h: a rule fixed before the test days), else
   /// kBothShop; and why.
@@ -228,6 +246,9 @@ struct MachineEvaluation {
   /// Per machine, when the opt-in grey rows were asked for: what grey_guarded applies
   /// ("both_grey", "warmup" or "schedule"; shop_models.h GuardGreyBox); else empty.
   std::vector<std::string> guard_choice;
+  /// Per machine, when the opt-in grey rows were asked for: grey_short_mix's weight w of the
+  /// grey box (shop_models.h ShortMixWeights); else empty.
+  std::vector<double> short_mix_weight;
   /// Per machine, what the grey box's fit chose (drift::GreyBoxModel): the prior strength, the
   /// lags' time constants [min], the blank's [min], the validation RMSE [um], and the record's
   /// lead days (drift::LeadDays); strength 0 and no lag where no grey box was fitted.

@@ -38,9 +38,15 @@ double WarmupOffsetShare(OffsetCandidate c) {
 }
 
 std::string ToString(GreyCandidate c) {
-  static const char* kNames[] = {"grey_all_sensors",          "grey_sensors_by_days",
-                                 "grey_short_prior",          "grey_short_offset_as_read",
-                                 "grey_short_offset_one_lag", "grey_guarded"};
+  static const char* kNames[] = {"grey_all_sensors",
+                                 "grey_sensors_by_days",
+                                 "grey_short_prior",
+                                 "grey_short_offset_as_read",
+                                 "grey_short_offset_one_lag",
+                                 "grey_guarded",
+                                 "grey_short_mix",
+                                 "grey_short_mix_fixed"};
+  static_assert(sizeof kNames / sizeof kNames[0] == kGreyCandidateCount);
   return kNames[static_cast<int>(c)];
 }
 
@@ -144,6 +150,7 @@ void to_json(nlohmann::json& j, const MachineEvaluation& e) {
        {"sensor_model_sensors", e.sensors},
        {"sensor_model_choice", e.sensors_choice},
        {"grey_guarded_choice", e.guard_choice},
+       {"grey_short_mix_weight", e.short_mix_weight},
        {"grey_fit", grey_fit},
        {"screws", screws}};
 }

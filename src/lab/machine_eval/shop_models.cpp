@@ -41,22 +41,33 @@ drift::ShopRecord Before(const drift::ShopRecord& record, int day) {
   return r;
 }
 
-// Sum over a lead record of w (e - e_bar)^2 (w = 1 / sigma^2, e the residual, e_bar its weighted
-// mean over the record), and the sum of w.
-std::pair<double, double> DemeanedSquares(const drift::MeasurementRecord& r,
-                                          const std::vector<double>& predicted) {
+// A lead record's residuals about their weighted mean (w = 1 / sigma^2: a lead is known up to a
+// constant), each scaled by 1 / sigma (so a sum of squares is the weighted one), and the sum of w.
+std::pair<std::vector<double>, double> Demeaned(const drift::MeasurementRecord& r,
+                                                const std::vector<double>& predicted) {
   double sw = 0, swe = 0;
   for (std::size_t i = 0; i < r.rows.size(); ++i) {
     const double w = 1 / (r.rows[i].sigma_um * r.rows[i].sigma_um);
     sw += w, swe += w * (r.rows[i].value_um - predicted[i]);
   }
-  double ss = 0;
-  for (std::size_t i = 0; i < r.rows.size(); ++i) {
-    const double e = r.rows[i].value_um - predicted[i] - swe / sw;
-    ss += e * e / (r.rows[i].sigma_um * r.rows[i].sigma_um);
-  }
-  return {ss, sw};
+  std::vector<double> e(r.rows.size());
+  for (std::size_t i = 0; i < r.rows.size(); ++i)
+    e[i] = (r.rows[i].value_um - predicted[i] - swe / sw) / r.rows[i].sigma_um;
+  return {std::move(e), sw};
 }
+
+// The pooled sums the guard and the combination weight need, over the scored lead records.
+struct PooledResiduals {
+  double grey_ss = 0, rule_ss = 0, sw = 0;
+  double cross = 0, spread = 0;  ///< sum e_r (e_r - e_g), sum (e_r - e_g)^2
+  void Add(const std::vector<double>& grey, const std::vector<double>& rule) {
+    for (std::size_t i = 0; i < grey.size(); ++i) {
+      const double d = rule[i] - grey[i];
+      grey_ss += grey[i] * grey[i], rule_ss += rule[i] * rule[i];
+      cross += rule[i] * d, spread += d * d;
+    }
+  }
+};
 
 }  // namespace
 
@@ -68,7 +79,7 @@ GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpe
     throw InputError("grey guard: held_days = " + std::to_string(held_days) + ": must be >= 1");
   const std::size_t held = static_cast<std::size_t>(held_days);
   const std::size_t first = lead_days.size() > held ? lead_days.size() - held : 0;
-  double grey_ss = 0, rule_ss = 0, sw = 0;
+  PooledResiduals p;
   GuardScore g;
   for (std::size_t k = first; k < lead_days.size(); ++k) {
     const drift::ShopRecord past = Before(record, lead_days[k]);
@@ -83,22 +94,28 @@ GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpe
     }
     for (const drift::MeasurementRecord& r : record.records) {
       if (r.kind != drift::MeasurementRecord::Kind::kLead || r.day != lead_days[k]) continue;
-      const auto [gs, w] = DemeanedSquares(r, drift::PredictGreyRecord(gm, record, r));
-      grey_ss += gs, sw += w;
-      rule_ss += DemeanedSquares(r, drift::PredictRecord(rm, record, r)).first;
+      const auto [grey_e, w] = Demeaned(r, drift::PredictGreyRecord(gm, record, r));
+      p.Add(grey_e, Demeaned(r, drift::PredictRecord(rm, record, r)).first);
+      p.sw += w;
     }
     ++g.days;
   }
-  if (g.days == 0 || sw <= 0) return g;
-  g.grey_rms_um = std::sqrt(grey_ss / sw);
-  g.rule_rms_um = std::sqrt(rule_ss / sw);
+  if (g.days == 0 || p.sw <= 0) return g;
+  g.grey_rms_um = std::sqrt(p.grey_ss / p.sw);
+  g.rule_rms_um = std::sqrt(p.rule_ss / p.sw);
   g.keep_grey = g.grey_rms_um <= g.rule_rms_um;
+  if (p.spread > 0) g.combination_weight = p.cross / p.spread;
   return g;
+}
+
+ShopModels::Mix ShortMixWeights(bool long_record, const GuardScore& guard) {
+  if (long_record) return {};
+  return {std::clamp(guard.combination_weight, kShortMixFloor, 1.0), kShortMixFixedWeight};
 }
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
-                         bool grey_candidates, bool grey_five_sensors) {
+                         bool grey_candidates, bool grey_five_sensors, bool grey_short_mix) {
   ShopModels m;
   const drift::JointFitOptions lagged = RuleOptions();
   const drift::JointSpec warmup = RuleSpec(z_fixed_mm, {"power_on"}),
@@ -154,6 +171,15 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   const bool every = long_record && !grey_five_sensors;
   const drift::GreyBoxSpec& applied = every ? all.spec : grey;  // both_grey's sensors
   m.grey = drift::FitGreyBox(record, applied, grey_options);
+  if (!grey_candidates && !grey_short_mix) return m;
+  // The guard scores the model it would apply: both_grey's (its sensors, its options); its
+  // combination weight is the fourteenth round's mix.
+  const GuardScore g =
+      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
+  m.guard = {grey_candidates, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
+  m.mix = ShortMixWeights(long_record, g);
+  m.mix.computed = true;
+  m.mix.applied = grey_short_mix;
   if (!grey_candidates) return m;
   const bool same = every && !grey_slope_lags_only;  // then m.grey is grey_all_sensors' model
   m.grey_candidates.push_back(same ? m.grey : drift::FitGreyBox(record, all.spec, all.options));
@@ -170,10 +196,6 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
     m.grey_candidates.push_back(
         long_record ? m.grey
                     : drift::FitGreyBox(record, applied, ShortRecordOffsetLags(grey_options, lags)));
-  // The guard scores the model it would apply: both_grey's (its sensors, its options).
-  const GuardScore g =
-      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
-  m.guard = {true, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
   return m;
 }
 

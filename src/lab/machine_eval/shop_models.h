@@ -55,6 +55,16 @@ struct ShopModels {
     bool chosen = false, keep_grey = true;
     double grey_rms_um = 0, rule_rms_um = 0;
   } guard;
+  /// The fourteenth round's mixes (grey_short_mix, grey_short_mix_fixed: ShortMixWeights), set
+  /// with the guard: the grey box's share w of the line w grey + (1 - w) base rule; 1 (both_grey's
+  /// line itself) on a record of 2 x forward_days lead days and more.
+  /// computed: the weights were fitted (the opt-in rows, or the default's mix); applied:
+  /// both_grey's line is the grey_short_mix line (FitShopModels' grey_short_mix, the field
+  /// default since the fourteenth round's adoption; 1 on a long record: the grey box's line).
+  struct Mix {
+    double fitted_weight = 1, fixed_weight = 1;
+    bool computed = false, applied = false;
+  } mix;
 };
 
 /// The grey box of the field machine (drift/grey_box.h), its sensors placed by the physics:
@@ -117,22 +127,37 @@ drift::GreyBoxOptions ShortRecordOffsetLags(drift::GreyBoxOptions options, int l
 /// lead is known up to a constant), pooled over the days. keep_grey: the grey box's score is at
 /// most the rule's, or no day could be scored (a fit failed or no earlier day): the grey box
 /// stays. Only the record's past enters; the caller applies the family fitted on all of it.
+/// combination_weight: the least-squares weight w of the grey box in w grey + (1 - w) rule on
+/// the same pooled demeaned residuals, sum s e_r (e_r - e_g) / sum s (e_r - e_g)^2 (Bates and
+/// Granger 1969, "The combination of forecasts"), unclamped; 1 when no day was scored or the two
+/// families' residuals are equal.
 struct GuardScore {
   bool keep_grey = true;
   double grey_rms_um = 0, rule_rms_um = 0;  ///< 0 when no day was scored
   int days = 0;                             ///< days scored
+  double combination_weight = 1;
 };
 GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpec& grey,
                         const drift::GreyBoxOptions& grey_options, const drift::JointSpec& rule,
                         const drift::JointFitOptions& rule_options, int held_days = 2);
+/// The fourteenth round's rows (docs/machine-evaluation.md "Fourteenth round: split"): the grey
+/// box's share w of the machine line w grey + (1 - w) base rule while the record holds fewer than
+/// 2 x forward_days lead days (drift::ScoresForward false), 1 from then on. grey_short_mix: the
+/// guard's combination weight clamped to [kShortMixFloor, 1] (the grey box is never dropped, so
+/// a wrong judge costs at most half the gap); grey_short_mix_fixed: kShortMixFixedWeight.
+inline constexpr double kShortMixFloor = 0.5, kShortMixFixedWeight = 0.75;
+ShopModels::Mix ShortMixWeights(bool long_record, const GuardScore& guard);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
 /// FieldGreyBoxOptions' `slope_lags_only` for the grey box; `grey_candidates`: also fit
 /// ShopModels::grey_candidates; `grey_five_sensors`: the grey box keeps FieldGreyBoxSpec's five
-/// sensors on a long record too (the model before the eleventh round, an opt-in).
+/// sensors on a long record too (the model before the eleventh round, an opt-in);
+/// `grey_short_mix`: fit the mix's weights and let both_grey apply the grey_short_mix line
+/// (ShopModels::Mix::applied; FieldProtocol's default, false here for the callers that fit the
+/// grey box alone).
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs = ScheduleInputs(),
                          bool grey_slope_lags_only = false, bool grey_candidates = false,
-                         bool grey_five_sensors = false);
+                         bool grey_five_sensors = false, bool grey_short_mix = false);
 
 /// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
 /// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on

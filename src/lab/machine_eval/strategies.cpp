@@ -52,6 +52,29 @@ HeldSamples WithOffsetOf(HeldSamples slope_model, const HeldSamples& offset_mode
   return slope_model;
 }
 
+HeldSamples MixedLines(HeldSamples grey, const HeldSamples& rule, double w) {
+  if (!(w >= 0 && w <= 1))
+    throw InputError("MixedLines: the grey box's weight " + std::to_string(w) +
+                     " is outside [0, 1]");
+  if (grey.time_min != rule.time_min)
+    throw InputError("MixedLines: the two models were not stepped through the same log (" +
+                     std::to_string(grey.time_min.size()) + " and " +
+                     std::to_string(rule.time_min.size()) + " samples)");
+  if (w == 1.0) return grey;
+  const auto mix = [w](double g, double r) { return w * g + (1.0 - w) * r; };
+  for (std::size_t k = 0; k < grey.k0_um.size(); ++k) {
+    grey.k0_um[k] = mix(grey.k0_um[k], rule.k0_um[k]);
+    grey.slope_um_per_1000[k] = mix(grey.slope_um_per_1000[k], rule.slope_um_per_1000[k]);
+  }
+  if (grey.blank_slope_um_per_1000.empty() && !rule.blank_slope_um_per_1000.empty())
+    grey.blank_slope_um_per_1000.assign(grey.time_min.size(), 0.0);
+  for (std::size_t k = 0; k < grey.blank_slope_um_per_1000.size(); ++k)
+    grey.blank_slope_um_per_1000[k] =
+        mix(grey.blank_slope_um_per_1000[k],
+            rule.blank_slope_um_per_1000.empty() ? 0.0 : rule.blank_slope_um_per_1000[k]);
+  return grey;
+}
+
 compare::CompensationFunction CausalMachineLine(HeldSamples samples, double cut_start_min,
                                                 double z_ref_mm,
                                                 std::function<double(double)> z_of_t) {

@@ -37,6 +37,12 @@ HeldSamples RunCausally(const drift::GreyBoxModel& model, const drift::Run& log)
 /// stepped through the same log (InputError when their sample times differ).
 HeldSamples WithOffsetOf(HeldSamples slope_model, const HeldSamples& offset_model, double share);
 
+/// The line w x `grey`'s + (1 - w) x `rule`'s, sample by sample: K0, slope and the blank term
+/// (latched at the cut start; `rule` without one counts 0) each mixed, so each model's K0 and
+/// slope stay together (w 1: `grey` exactly). Both must be stepped through the same log
+/// (InputError when their sample times differ); w outside [0, 1] is an InputError.
+HeldSamples MixedLines(HeldSamples grey, const HeldSamples& rule, double w);
+
 /// c_m(t_s), t_s from the cut start, which is at log time `cut_start_min`; z_of_t(t_s) the tool
 /// position [mm]; a blank term (grey box) is latched at the cut start's sample and added to the
 /// slope for the whole cut. The samples are kept by the function.

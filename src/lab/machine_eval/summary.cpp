@@ -6,6 +6,7 @@
 
 #include "compare/evaluate.h"
 #include "core/numbers.h"
+#include "machine_eval/shop_models.h"
 
 namespace whirl::machine_eval {
 
@@ -255,6 +256,19 @@ std::vector<std::string> ScenarioNotes(const SeedsEvaluation& e) {
     out.push_back(e.scenario + ": grey_guarded applies both_grey's model on " +
                   std::to_string(grey) + " of " + std::to_string(machines) +
                   " machines, the sensor-free rule on the others");
+  std::vector<double> w;
+  for (const auto& run : e.runs)
+    w.insert(w.end(), run.short_mix_weight.begin(), run.short_mix_weight.end());
+  if (!w.empty()) {
+    char buf[160];
+    std::snprintf(
+        buf, sizeof buf,
+        ": grey_short_mix's weight of the grey box: median %.2f (%.2f .. %.2f), at "
+        "the floor on %zu of %zu machines",
+        Median(w), *std::min_element(w.begin(), w.end()), *std::max_element(w.begin(), w.end()),
+        static_cast<std::size_t>(std::count(w.begin(), w.end(), kShortMixFloor)), w.size());
+    out.push_back(e.scenario + buf);
+  }
   return out;
 }
 

@@ -33,12 +33,16 @@ void CheckAgainstMachine(const interp::MachineProfile& p, const interp::DriftAct
               "(z_fixed) sits at " + FormatFixed(fixed_end_mm, 4) + " mm (MCS)");
 }
 
-// The machine's models as the drift action runs them.
+// The machine's models as the drift action runs them: one model, or the components of a mixed
+// line (interp::DriftComponent), each with a slope model.
 struct MachineModels {
-  const drift::DriftModel& offset;
-  const drift::DriftModel& slope;
-  const interp::BlankTerm* blank;
+  std::vector<interp::DriftComponent> parts;
   interp::DriftReference reference;
+  const interp::BlankTerm* Blank() const {
+    for (const interp::DriftComponent& c : parts)
+      if (c.blank) return c.blank;
+    return nullptr;
+  }
 };
 
 CombinedPrograms Build(const fit::ArctanCurve& curve, const screw::Kinematics& kinematics,
@@ -46,8 +50,7 @@ CombinedPrograms Build(const fit::ArctanCurve& curve, const screw::Kinematics& k
                        const MachineModels& machine, double z_fixed_mm,
                        const interp::MachineProfile& profile, const std::string& curve_source,
                        const std::string& model_source) {
-  const drift::DriftModel& offset = machine.offset;
-  const interp::BlankTerm* blank = machine.blank;
+  const interp::BlankTerm* blank = machine.Blank();
   CombinedPrograms out;
   interp::PlanOptions po = plan_options;
   profile.ApplyCombinedTo(po);
@@ -69,8 +72,7 @@ CombinedPrograms Build(const fit::ArctanCurve& curve, const screw::Kinematics& k
   info.curve_source = curve_source;
   out.plan_nc = interp::FormatNcProgram(out.plan, info);
   out.plan_reset_nc = interp::FormatNcResetProgram(po, info);
-  const drift::DriftModel& g = machine.slope;
-  const double bound = interp::DriftSlopeBound(g, out.drift, blank);
+  const double bound = interp::DriftSlopeBound(machine.parts, out.drift);
   if (out.plan.max_abs_slope + bound > po.md32760)
     throw InputError("combined programs: the plan's largest slope " +
                      FormatFixed(out.plan.max_abs_slope, interp::kDecimalsSd43910) +
@@ -78,11 +80,11 @@ CombinedPrograms Build(const fit::ArctanCurve& curve, const screw::Kinematics& k
                      FormatFixed(bound, interp::kDecimalsSd43910) +
                      " exceed MD32760 = " + FormatFixed(po.md32760, 4) + " (profile '" +
                      profile.source + "'): SD43910 could be capped mid-cut");
-  out.drift_nc = interp::FormatDriftNcProgram(offset, out.drift, model_source, &g, blank);
+  out.drift_nc = interp::FormatDriftNcProgram(machine.parts, out.drift, model_source);
   out.drift_reset_nc = interp::FormatDriftNcResetProgram(out.drift);
-  out.drift_plc_csv = interp::FormatDriftPlcCsv(offset, out.drift, &g, blank);
+  out.drift_plc_csv = interp::FormatDriftPlcCsv(machine.parts, out.drift);
   out.requirements = plan::WithProfileValues(
-      interp::MergeRequirements(interp::DriftRequirements(offset, out.drift, &g, blank),
+      interp::MergeRequirements(interp::DriftRequirements(machine.parts, out.drift),
                                 interp::PlanRequirements(out.plan, info.program_name)),
       profile);
   return out;
@@ -96,7 +98,8 @@ CombinedPrograms BuildCombinedPrograms(
     const drift::DriftModel& slope, double z_fixed_mm, const interp::MachineProfile& profile,
     const std::string& curve_source, const std::string& model_source) {
   return Build(curve, kinematics, thread_length_mm, plan_options,
-               {offset, slope, nullptr, interp::DriftReference::kStart}, z_fixed_mm, profile,
+               {{{&offset, &slope, nullptr, 1.0}}, interp::DriftReference::kStart}, z_fixed_mm,
+               profile,
                curve_source, model_source);
 }
 
@@ -107,10 +110,44 @@ CombinedPrograms BuildCombinedGreyPrograms(
     const std::string& model_source) {
   const interp::GreyBoxAction a = interp::GreyBoxActionModels(grey);
   CombinedPrograms out = Build(curve, kinematics, thread_length_mm, plan_options,
-                               {a.offset, a.slope, a.Blank(), interp::DriftReference::kModel},
+                               {{{&a.offset, &a.slope, a.Blank(), 1.0}},
+                                interp::DriftReference::kModel},
                                grey.z_ref_mm, profile, curve_source, model_source);
   out.grey = true;
   return out;
+}
+
+CombinedPrograms BuildCombinedMixPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::GreyBoxModel& grey,
+    const drift::DriftModel& rule_offset, const drift::DriftModel& rule_slope,
+    double grey_weight, const interp::MachineProfile& profile, const std::string& curve_source,
+    const std::string& model_source) {
+  if (grey_weight == 1.0)  // MixedLines' w = 1: the grey box's line itself
+    return BuildCombinedGreyPrograms(curve, kinematics, thread_length_mm, plan_options, grey,
+                                     profile, curve_source, model_source);
+  if (!rule_offset.sensors.empty() || !rule_slope.sensors.empty())
+    throw InputError(
+        "mixed drift action: the rule's models read sensors (rises from power-on), the grey "
+        "box's absolute temperatures; the program runs one reference: mix the grey box only "
+        "with a sensor-free rule (warmup, schedule)");
+  const interp::GreyBoxAction a = interp::GreyBoxActionModels(grey);
+  CombinedPrograms out = Build(curve, kinematics, thread_length_mm, plan_options,
+                               {{{&a.offset, &a.slope, a.Blank(), grey_weight},
+                                 {&rule_offset, &rule_slope, nullptr, 1.0 - grey_weight}},
+                                interp::DriftReference::kModel},
+                               grey.z_ref_mm, profile, curve_source, model_source);
+  out.grey = true;
+  out.mixed = true;
+  return out;
+}
+
+std::vector<std::pair<std::filesystem::path, std::string>> MixDriftProgramFiles(
+    const std::filesystem::path& dir, const CombinedPrograms& mix) {
+  const std::string name = kMixDriftProgramName;
+  return {{dir / (name + ".SPF"), mix.drift_nc},
+          {dir / (std::string(kMixDriftResetProgramName) + ".SPF"), mix.drift_reset_nc},
+          {dir / (name + "_PLC.csv"), mix.drift_plc_csv}};
 }
 
 std::vector<std::pair<std::filesystem::path, std::string>> CombinedProgramFiles(

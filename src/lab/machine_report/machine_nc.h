@@ -49,6 +49,7 @@ struct CombinedPrograms {
   /// (interp::MergeRequirements of the plan's and the drift action's), with the profile's values.
   std::vector<interp::ControlRequirement> requirements;
   bool grey = false;  ///< the drift action runs the grey box (BuildCombinedGreyPrograms)
+  bool mixed = false;  ///< ... mixed with a sensor-free rule (BuildCombinedMixPrograms)
 };
 
 /// Builds both programs. `plan_options` gives the tolerance and check step (the profile sets
@@ -73,6 +74,29 @@ CombinedPrograms BuildCombinedGreyPrograms(
     const interp::PlanOptions& plan_options, const drift::GreyBoxModel& grey,
     const interp::MachineProfile& profile, const std::string& curve_source,
     const std::string& model_source);
+
+/// The fourteenth round's grey_short_mix (docs/machine-evaluation.md "Fourteenth round:
+/// adoption"; machine_eval/strategies.h MixedLines): the machine line w grey + (1 - w) rule, the
+/// drift action as two components (interp::DriftComponent): the grey box with weight w (its
+/// K0, slope and latched blank term) and the sensor-free base rule's offset and slope models
+/// (drift/joint.h ToDriftModels with their training ranges, machine_eval::ShopControlModels)
+/// with 1 - w, all run with reference "model" (the rule has no sensor: its duty inputs are read
+/// as they are). w = 1: BuildCombinedGreyPrograms itself. InputError as above, for a w outside
+/// (0, 1] or a rule that reads sensors.
+CombinedPrograms BuildCombinedMixPrograms(
+    const fit::ArctanCurve& curve, const screw::Kinematics& kinematics, double thread_length_mm,
+    const interp::PlanOptions& plan_options, const drift::GreyBoxModel& grey,
+    const drift::DriftModel& rule_offset, const drift::DriftModel& rule_slope,
+    double grey_weight, const interp::MachineProfile& profile, const std::string& curve_source,
+    const std::string& model_source);
+
+/// grey_short_mix's drift action in a report (machine_report.h): it runs in place of
+/// WHIRL_DRIFT_COMP with the grey box's plan (the same IDs and slots), under these names.
+inline constexpr const char* kMixDriftProgramName = "WHIRL_DRIFT_MIX";
+inline constexpr const char* kMixDriftResetProgramName = "WHIRL_DRIFT_MIX_RESET";
+/// Its files in `dir`: WHIRL_DRIFT_MIX.SPF, WHIRL_DRIFT_MIX_RESET.SPF, WHIRL_DRIFT_MIX_PLC.csv.
+std::vector<std::pair<std::filesystem::path, std::string>> MixDriftProgramFiles(
+    const std::filesystem::path& dir, const CombinedPrograms& mix);
 
 /// The files of the programs in `dir` (created if needed): WHIRL_TEMP_COMP.SPF,
 /// WHIRL_TEMP_COMP_RESET.SPF, WHIRL_DRIFT_COMP.SPF, WHIRL_DRIFT_COMP_RESET.SPF,

@@ -290,6 +290,14 @@ std::optional<CombinedPrograms> Programs(const ReportScrew& r,
   }
   if (r.programs_strategy == MachineStrategy::kBothGrey) {
     try {
+      if (r.mix_applied)  // both_grey's line is grey_short_mix's (w = 1: the grey box's)
+        return BuildCombinedMixPrograms(
+            r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options,
+            r.grey, r.mix_rule_offset, r.mix_rule_slope, r.mix_weight, *profile,
+            "network curve of screw " + r.result.screw.name,
+            "grey box (both_grey) mixed with " + r.mix_rule_name +
+                " (w = " + FormatFixed(r.mix_weight, 2) +
+                ") trained only from shop measurements");
       return BuildCombinedGreyPrograms(r.predicted_curve, r.kinematics,
                                        r.result.screw.thread_length_mm, r.plan_options, r.grey,
                                        *profile, "network curve of screw " + r.result.screw.name,
@@ -314,6 +322,49 @@ std::optional<CombinedPrograms> Programs(const ReportScrew& r,
   }
 }
 
+// grey_short_mix's drift action (the fourteenth round) where its row was computed, beside the
+// grey box's plan (the plan that latches the blank), or the note why not.
+std::optional<CombinedPrograms> MixPrograms(const ReportScrew& r,
+                                            const interp::MachineProfile* profile,
+                                            const CombinedPrograms* programs, std::string* note) {
+  if (!r.mix_computed || r.mix_applied || !profile) return std::nullopt;  // applied: the programs
+  if (!programs || !programs->grey) {
+    *note =
+        "grey_short_mix's drift action not written: the report's programs are not the grey "
+        "box's (the mix runs beside the grey box's plan, which latches the blank)";
+    return std::nullopt;
+  }
+  interp::MachineProfile p = *profile;
+  p.drift->program_name = kMixDriftProgramName;
+  p.drift->reset_program_name = kMixDriftResetProgramName;
+  try {
+    return BuildCombinedMixPrograms(
+        r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options, r.grey,
+        r.mix_rule_offset, r.mix_rule_slope, r.mix_weight, p,
+        "network curve of screw " + r.result.screw.name,
+        "grey_short_mix (the grey box and " + r.mix_rule_name +
+            ") trained only from shop measurements");
+  } catch (const InputError& err) {
+    *note = std::string("grey_short_mix's drift action could not be written (") + err.what() + ")";
+    return std::nullopt;
+  }
+}
+
+// The page's paragraph on the mix's drift action: its weight, files and what it needs.
+void AddMixPrograms(const ReportScrew& r, const CombinedPrograms& mix, report::Document* doc) {
+  std::string needs;
+  for (const interp::ControlRequirement& q : mix.requirements)
+    if (q.datum.rfind("MD28250", 0) == 0 || q.datum.rfind("MD28254", 0) == 0)
+      needs += (needs.empty() ? "" : "; ") + q.datum + " >= " + FormatFixed(q.value, 0);
+  doc->Add(report::Heading{2, "grey_short_mix on the control (opt-in row)", ""});
+  doc->Say("The line w grey box + (1 - w) " + r.mix_rule_name + ", w = " +
+           FormatFixed(r.mix_weight, 2) + (mix.mixed ? "" : " (the grey box's line itself)") +
+           ": " + kMixDriftProgramName + ".SPF (reset " + kMixDriftResetProgramName +
+           ".SPF, PLC table " + kMixDriftProgramName +
+           "_PLC.csv) runs in place of WHIRL_DRIFT_COMP.SPF with the same plan, IDs and slots. " +
+           "Both programs together: " + needs + ".");
+}
+
 }  // namespace
 
 MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew& screw,
@@ -323,6 +374,8 @@ MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew&
   MachineReport report;
   const std::optional<CombinedPrograms> programs =
       Programs(screw, profile, &report.programs_note, &report.programs_reason);
+  const std::optional<CombinedPrograms> mix =
+      MixPrograms(screw, profile, programs ? &*programs : nullptr, &report.mix_note);
   OutputDir out(dir, "report directory");
   // The screw's day as the control logged it, in the drift run format, so `whirl drift predict
   // --run sensors.csv` evaluates a machine model on it.
@@ -342,13 +395,18 @@ MachineReport WriteMachineScrewReport(const std::string& dir, const ReportScrew&
   if (programs)
     for (const auto& [path, text] : CombinedProgramFiles("", *programs))
       out.Add(path.filename().string(), text);
-  report::RenderReport(
-      Page(screw, programs ? &*programs : nullptr, report.programs_note, report.programs_reason),
-      out);
+  if (mix)
+    for (const auto& [path, text] : MixDriftProgramFiles("", *mix))
+      out.Add(path.filename().string(), text);
+  report::Document page =
+      Page(screw, programs ? &*programs : nullptr, report.programs_note, report.programs_reason);
+  if (mix) AddMixPrograms(screw, *mix, &page);
+  report::RenderReport(page, out);
   out.Commit();
   report.index_html = (fs::path(dir) / "index.html").string();
   report.programs = programs.has_value();
   report.programs_grey = programs && programs->grey;
+  report.mix_programs = mix.has_value();
   return report;
 }
 

@@ -24,6 +24,11 @@ struct MachineReport {
   /// fallback to both_shop when the grey box's programs cannot be written for the profile).
   std::string programs_reason;
   bool programs_grey = false;  ///< the programs apply the grey box (both_grey)
+  /// grey_short_mix's drift action (machine_nc.h MixDriftProgramFiles) was written beside them:
+  /// where its row was computed (the opt-in grey rows) and the programs are the grey box's; else
+  /// mix_note says why not (empty where the row was not computed).
+  bool mix_programs = false;
+  std::string mix_note;
 };
 
 /// Report of one screw in `dir` (core/output_dir.h's rule: new, empty or a whirl output, never a
@@ -39,7 +44,10 @@ struct MachineReport {
 /// (plan/load.h LoadBox, rendered by core/report_render.h): the plan's setting data, the five
 /// files, the machine data both programs need (each datum once), the call order and what to run
 /// after an abort; a profile that does not fit leaves them out with the note returned (the report
-/// stands). InputError for a screw whose evaluation failed.
+/// stands). Where grey_short_mix's row was computed (ReportScrew::mix_computed) and the programs
+/// are the grey box's, its drift action is written too (machine_nc.h MixDriftProgramFiles: it
+/// replaces WHIRL_DRIFT_COMP with the same plan) with a paragraph on the page; else mix_note.
+/// InputError for a screw whose evaluation failed.
 MachineReport WriteMachineScrewReport(const std::string& dir,
                                       const machine_eval::ReportScrew& screw,
                                       const interp::MachineProfile* profile);
