@@ -1569,5 +1569,97 @@ TEST(FamilySameScaleBic, OnlyTheRawGpOfHigherBicTakesPart) {
   EXPECT_GT(raw_weighted, 0) << "no raw-column GP with weight: the test cannot fail";
 }
 
+ChoiceOptions LinearRefitsSmall() {
+  ChoiceOptions o;
+  o.linear_refits_small = true;
+  return o;
+}
+
+// ChoiceOptions::linear_refits_small: below few_rows the linear candidates' held-out errors are
+// those of K-fold refits (row q held out in fold q % K), each refit a least-squares fit of its
+// training rows predicting its held-out rows in original units; off by default (the closed-form
+// leave-one-out, FamilyChoice.ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits).
+TEST(FamilyLinearRefitsSmall, LinearErrorsAreThoseOfFiveFoldRefits) {
+  EXPECT_FALSE(ChoiceOptions().linear_refits_small);
+  const ProcessTable table = MakeTable(20, 0.05, 23, true);
+  for (const char* name : {"linear/log", "linear/identity"}) {
+    double sq[2] = {0, 0};
+    for (int f = 0; f < 5; ++f) {
+      ProcessTable train, held;
+      for (int q = 0; q < 20; ++q) {
+        ProcessTable& to = q % 5 == f ? held : train;
+        to.inputs.push_back(table.inputs[q]);
+        to.targets.push_back(table.targets[q]);
+      }
+      const FamilyModel m = FitCandidate(train, ParseCandidate(name), {}, false);
+      const std::vector<FamilyPrediction> p = PredictFamily(m, held.inputs);
+      for (std::size_t i = 0; i < p.size(); ++i)
+        for (int k = 0; k < 2; ++k) {
+          const double e = held.targets[i].ToArray()[k] - p[i].mean.ToArray()[k];
+          sq[k] += e * e / 20;
+        }
+    }
+    ChoiceOptions o = LinearRefitsSmall();
+    o.candidates = {ParseCandidate(name), ParseCandidate("gp-se-constant/identity")};
+    const Choice c = ChooseFamily(table, o);
+    o.linear_refits_small = false;
+    const Choice loo = ChooseFamily(table, o);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(c.table[0].cv_rmse(k), std::sqrt(sq[k]), 1e-9 * std::sqrt(sq[k])) << name;
+      EXPECT_GT(std::abs(loo.table[0].cv_rmse(k) - c.table[0].cv_rmse(k)), 1e-6 * std::sqrt(sq[k]))
+          << name << ": the leave-one-out is not the refits'";
+      EXPECT_EQ(c.table[1].cv_rmse(k), loo.table[1].cv_rmse(k)) << "the GP's refits unchanged";
+    }
+  }
+}
+
+// Nothing changes on 8- and 9-row tables (refit splits too small for a linear fit: the
+// leave-one-out stays) and from few_rows (70) rows: the choice's file byte for byte.
+TEST(FamilyLinearRefitsSmall, LeavesEightRowsAndFromFewRowsAsTheyAre) {
+  for (const ProcessTable& t : {MakeTable(8, 0.05, 3), MakeTable(9, 0.05, 4),
+                                test::MakeBentTable(70, 0.05, 0.5, 2),
+                                MakeTable(70, 0.05, 5, true)})
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, LinearRefitsSmall())).dump(),
+              nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump())
+        << t.inputs.size() << " rows";
+}
+
+// The same table and options give the same file byte for byte, with one thread or two.
+TEST(FamilyLinearRefitsSmall, SameFileTwiceAndWithTwoThreads) {
+  const ProcessTable t = MakeTable(20, 0.05, 29, true);
+  ChoiceOptions o = LinearRefitsSmall();
+  o.se_restarts_small = 4;
+  const std::string file = nlohmann::json(ChooseFamily(t, o)).dump();
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+  o.fit.threads = 2;
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+}
+
+// ChoiceOptions::se_restarts_small: below few_rows the squared-exponential GPs are fitted from
+// that many fixed starts (the same as fit.gp.restarts = 4 for a GP-SE alone), the Matern GPs as
+// before; from few_rows rows nothing changes.
+TEST(FamilySeRestartsSmall, OnlyTheSquaredExponentialGpsBelowFewRows) {
+  EXPECT_EQ(ChoiceOptions().se_restarts_small, 0);
+  const ProcessTable t = MakeTable(20, 0.05, 31, true);
+  ChoiceOptions se, four, m52, m52_four;
+  se.candidates = four.candidates = {ParseCandidate("linear/log"),
+                                     ParseCandidate("gp-se-constant/identity")};
+  m52.candidates = m52_four.candidates = {ParseCandidate("linear/log"),
+                                          ParseCandidate("gp-matern52-constant/identity")};
+  four.fit.gp.restarts = 4;
+  const std::string two_starts = nlohmann::json(ChooseFamily(t, se)).dump();
+  const std::string four_starts = nlohmann::json(ChooseFamily(t, four)).dump();
+  ASSERT_NE(two_starts, four_starts) << "a table on which the starts matter";
+  se.se_restarts_small = m52_four.se_restarts_small = 4;
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, se)).dump(), four_starts);
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, m52_four)).dump(),
+            nlohmann::json(ChooseFamily(t, m52)).dump());
+  ChoiceOptions large;
+  large.se_restarts_small = 4;
+  const ProcessTable t70 = MakeTable(70, 0.05, 5, true);
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t70, large)).dump(),
+            nlohmann::json(ChooseFamily(t70, ChoiceOptions{})).dump());
+}
+
 }  // namespace
 }  // namespace whirl::family

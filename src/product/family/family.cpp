@@ -87,6 +87,7 @@ gp::GpOptions CandidateGpOptions(const FitOptions& o, const Candidate& c) {
   go.kernel = c.kernel;
   go.mean = c.mean;
   go.isotropic = c.isotropic;
+  if (o.se_restarts > 0 && c.kernel == gp::Kernel::kSquaredExponential) go.restarts = o.se_restarts;
   return go;
 }
 
@@ -1020,11 +1021,12 @@ ChoiceOptions ActiveCandidates(const ChoiceOptions& given, int rows, int folds, 
   return active;
 }
 
-// ChoiceOptions::gp_noise_prior_small: below few_rows rows the GPs' noise prior (sd 1 unless
-// fit.gp gives one).
-ChoiceOptions WithSmallTableNoisePrior(ChoiceOptions o, int rows) {
-  if (o.gp_noise_prior_small && rows < o.few_rows && o.fit.gp.noise_prior_sd == 0)
-    o.fit.gp.noise_prior_sd = 1;
+// The fit options of the choice below few_rows rows: ChoiceOptions::gp_noise_prior_small (the
+// GPs' noise prior, sd 1 unless fit.gp gives one) and se_restarts_small.
+ChoiceOptions WithSmallTableFitOptions(ChoiceOptions o, int rows) {
+  if (rows >= o.few_rows) return o;
+  if (o.gp_noise_prior_small && o.fit.gp.noise_prior_sd == 0) o.fit.gp.noise_prior_sd = 1;
+  if (o.se_restarts_small > 0) o.fit.se_restarts = o.se_restarts_small;
   return o;
 }
 
@@ -1398,7 +1400,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   TableTransform used;
   const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
   std::string rows_note;
-  const ChoiceOptions options = WithSmallTableNoisePrior(
+  const ChoiceOptions options = WithSmallTableFitOptions(
       ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note), rows);
   const int nc = static_cast<int>(options.candidates.size());
   std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
@@ -1426,9 +1428,12 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
     } else if (f == 0) {  // held-out errors (and calibration) of the full fit or of refits
       full[c] = Unfitted(table, options.candidates[c]);
-      const bool honest = options.closed_form_loo &&
-                          options.candidates[c].family == Family::kGaussianProcess &&
-                          rows < options.few_rows && !RefitsLowestGpOnly(options, rows) &&
+      const Family family = options.candidates[c].family;
+      const bool refit_small =
+          family == Family::kGaussianProcess
+              ? !RefitsLowestGpOnly(options, rows)
+              : family == Family::kLinear && options.linear_refits_small;
+      const bool honest = options.closed_form_loo && refit_small && rows < options.few_rows &&
                           rows - (rows + folds - 1) / folds >=
                               MinimumRows(options.candidates[c], used.UsedInputCount());
       const int held_folds = honest ? folds : HeldOutFolds(options, folds);

@@ -108,6 +108,10 @@ struct FitOptions {
   /// The fold partition of every K-fold refit (calibration_folds, the choice's refits): row q is
   /// held out in fold FoldOfRows(rows, K, fold_partition, seed)[q]; 0 = fold q % K.
   int fold_partition = 0;
+  /// GP candidates with the squared-exponential kernel: this many of gp::GpOptions' fixed
+  /// starting points instead of gp.restarts (0: gp.restarts), where gp.restarts applies (below
+  /// gp.single_start_rows). Set by ChoiceOptions::se_restarts_small.
+  int se_restarts = 0;
 };
 
 /// What ChoiceOptions::fresh_partition_sd appends to a GP's calibration text when it took output
@@ -517,6 +521,24 @@ struct ChoiceOptions {
   /// not which outputs a GP takes part in; pooled, ratio 0.996 with paired t -1.98, short of the
   /// rule's -2.0 (docs/workpiece-model.md, "Seventeenth attempt: tuning part").
   bool gp_noise_prior_small = false;
+  /// Below few_rows rows: the linear candidates' held-out errors in the choice (the gate, the
+  /// stacking weights and shrinkage, the stack's sd scale, the hard choice, Choice::table) come
+  /// from the same K-fold refits (row q in fold q % K) as the GPs' instead of their closed-form
+  /// leave-one-out, where every training split keeps MinimumRows rows (so not on 8 and 9 rows);
+  /// from few_rows rows nothing changes. Why: with closed_form_loo the gate compared the power
+  /// law's leave-one-out (fits on n - 1 rows) with GP refits on (K - 1) / K of the rows; at 20
+  /// rows the power law's own 5-fold error is about 1.06 times its leave-one-out, a handicap of
+  /// the GPs that kept the power law alone on non-linear tables (docs/workpiece-model.md, "Where
+  /// the five cells lose"). Unlike closed_form_loo = false it leaves the GPs' closed-form
+  /// leave-one-out from few_rows rows as it is. Opt-in (docs/workpiece-model.md, "Eighteenth
+  /// attempt").
+  bool linear_refits_small = false;
+  /// Below few_rows rows: GP candidates with the squared-exponential kernel are fitted (refits
+  /// and fits on all rows) from this many of gp::GpOptions' fixed starting points
+  /// (FitOptions::se_restarts; 0: fit.gp.restarts, 2). Opt-in (docs/workpiece-model.md,
+  /// "Eighteenth attempt": with four starts GP-SE raw alone reached scikit-learn's GP-ARD on
+  /// Friedman #2/#3 at 20 rows in the diagnosis of spent seeds).
+  int se_restarts_small = 0;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
