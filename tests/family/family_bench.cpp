@@ -9,7 +9,7 @@
 //                [--gp-hyper-rows N] [--loo-calibration-rows N] [--gp-slot-large held-out|evidence|bic]
 //                [--fold-partitions P] [--fresh-partition-sd] [--fresh-sd-weight W]
 //                [--anchor-small first|bic|bic-weights] [--same-scale-gp-bic]
-//                [--gp-noise-prior-small] [--linear-refits-small] [--se-restarts-small R]
+//                [--gp-noise-prior-small] [--linear-refits-small [--linear-refits-small-keep-sd]] [--se-restarts-small R]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -158,6 +158,8 @@ Args Parse(int argc, char** argv) {
       a.choice.gp_noise_prior_small = true;
     else if (k == "--linear-refits-small")
       a.choice.linear_refits_small = true;
+    else if (k == "--linear-refits-small-keep-sd")
+      a.choice.linear_refits_small_keep_sd = true;
     else if (k == "--se-restarts-small")
       a.choice.se_restarts_small = std::stoi(value());
     else if (k == "--anchor-small") {

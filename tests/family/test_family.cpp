@@ -1618,10 +1618,14 @@ TEST(FamilyLinearRefitsSmall, LinearErrorsAreThoseOfFiveFoldRefits) {
 TEST(FamilyLinearRefitsSmall, LeavesEightRowsAndFromFewRowsAsTheyAre) {
   for (const ProcessTable& t : {MakeTable(8, 0.05, 3), MakeTable(9, 0.05, 4),
                                 test::MakeBentTable(70, 0.05, 0.5, 2),
-                                MakeTable(70, 0.05, 5, true)})
-    EXPECT_EQ(nlohmann::json(ChooseFamily(t, LinearRefitsSmall())).dump(),
-              nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump())
+                                MakeTable(70, 0.05, 5, true)}) {
+    ChoiceOptions keep = LinearRefitsSmall();
+    keep.linear_refits_small_keep_sd = true;
+    const std::string file = nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump();
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, LinearRefitsSmall())).dump(), file)
         << t.inputs.size() << " rows";
+    EXPECT_EQ(nlohmann::json(ChooseFamily(t, keep)).dump(), file) << t.inputs.size() << " rows";
+  }
 }
 
 // The same table and options give the same file byte for byte, with one thread or two.
@@ -1659,6 +1663,26 @@ TEST(FamilySeRestartsSmall, OnlyTheSquaredExponentialGpsBelowFewRows) {
   const ProcessTable t70 = MakeTable(70, 0.05, 5, true);
   EXPECT_EQ(nlohmann::json(ChooseFamily(t70, large)).dump(),
             nlohmann::json(ChooseFamily(t70, ChoiceOptions{})).dump());
+}
+
+// ChoiceOptions::linear_refits_small_keep_sd: on a power law that every variant gives to the
+// power law alone, the model and its sd scale are the default's (leave-one-out residuals), and
+// without it the sd scale comes from the refits' residuals (another value).
+TEST(FamilyLinearRefitsSmall, KeepSdLeavesThePowerLawsSdAsItIs) {
+  const ProcessTable t = MakeTable(20, 0.05, 37);
+  ChoiceOptions refit = LinearRefitsSmall(), keep = LinearRefitsSmall();
+  keep.linear_refits_small_keep_sd = true;
+  const Choice d = ChooseFamily(t, ChoiceOptions{}), r = ChooseFamily(t, refit),
+               k = ChooseFamily(t, keep);
+  for (int out = 0; out < 2; ++out) {
+    ASSERT_EQ(d.table[d.chosen[out]].candidate.Name(), "linear/log") << d.Describe();
+    ASSERT_TRUE(d.weights[out].empty() && r.weights[out].empty() && k.weights[out].empty());
+    ASSERT_EQ(k.table[k.chosen[out]].candidate.Name(), "linear/log") << k.Describe();
+    EXPECT_EQ(k.sd_scale[out], d.sd_scale[out]);
+    EXPECT_NE(r.sd_scale[out], d.sd_scale[out]);
+    EXPECT_NE(k.table[0].cv_rmse(out), d.table[0].cv_rmse(out)) << "the choice saw the refits";
+  }
+  EXPECT_EQ(nlohmann::json(k.models).dump(), nlohmann::json(d.models).dump());
 }
 
 }  // namespace

@@ -1417,6 +1417,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   // below); at 20 rows most GPs are not, and their full fits took a sixth of the choice's time.
   std::vector<char> refitted(static_cast<std::size_t>(nc), 0), pending = refitted;
   std::vector<HeldOuts> held(static_cast<std::size_t>(nc));
+  std::vector<Eigen::MatrixXd> loo_err(static_cast<std::size_t>(nc));  // linear_refits_small_keep_sd
   std::mutex progress_mutex;
   int done = 0;
   int steps = 1;  // a network's folds, every other candidate's fit (with its held-out errors), the end
@@ -1444,6 +1445,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       const bool calibrate_now = calibrated[c] && !pending[c];
       err[c] = HeldOutErrors(table, pending[c] ? refit_options : fold_options, held_folds,
                              &full[c], calibrate_now, true, &held[c]);
+      if (honest && family == Family::kLinear && options.linear_refits_small_keep_sd)
+        loo_err[c] = HeldOutErrors(table, fold_options, 0, &full[c], false);
     }
     ms[i] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -1529,6 +1532,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
   std::vector<Eigen::MatrixXd> sd_err = err;  // ChoiceOptions::fresh_partition_sd
+  for (int c = 0; c < nc; ++c)
+    if (loo_err[c].size() > 0) sd_err[c] = loo_err[c];  // linear_refits_small_keep_sd
   for (int k = 0; k < Features::kCount && options.fresh_partition_sd && options.stack &&
                   options.per_output && rows < options.few_rows;
        ++k) {

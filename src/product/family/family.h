@@ -533,6 +533,13 @@ struct ChoiceOptions {
   /// leave-one-out from few_rows rows as it is. Opt-in (docs/workpiece-model.md, "Eighteenth
   /// attempt").
   bool linear_refits_small = false;
+  /// With linear_refits_small: the stack's sd scale (Choice::sd_scale, from the held-out
+  /// residuals of the candidates it weighs) takes the linear candidates' closed-form
+  /// leave-one-out residuals, as without it, so that only the choice changes; false: their
+  /// refit residuals. Why: on the eighteenth attempt's screen the refit residuals (larger than
+  /// the leave-one-out's) widened the power law's sd (docs/workpiece-model.md, "Eighteenth
+  /// attempt: split").
+  bool linear_refits_small_keep_sd = false;
   /// Below few_rows rows: GP candidates with the squared-exponential kernel are fitted (refits
   /// and fits on all rows) from this many of gp::GpOptions' fixed starting points
   /// (FitOptions::se_restarts; 0: fit.gp.restarts, 2). Opt-in (docs/workpiece-model.md,
