@@ -10,6 +10,7 @@
 //                [--fold-partitions P] [--fresh-partition-sd] [--fresh-sd-weight W]
 //                [--anchor-small first|bic|bic-weights] [--same-scale-gp-bic]
 //                [--gp-noise-prior-small] [--linear-refits-small [--linear-refits-small-keep-sd]] [--se-restarts-small R]
+//                [--length-prior-off-large none|raw|all]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -162,6 +163,15 @@ Args Parse(int argc, char** argv) {
       a.choice.linear_refits_small_keep_sd = true;
     else if (k == "--se-restarts-small")
       a.choice.se_restarts_small = std::stoi(value());
+    else if (k == "--length-prior-off-large") {
+      const std::string v = value();
+      using whirl::family::LengthPriorOff;
+      if (v != "none" && v != "raw" && v != "all")
+        throw std::invalid_argument("--length-prior-off-large " + v + ": must be none, raw or all");
+      a.choice.length_prior_off_large = v == "all"   ? LengthPriorOff::kAll
+                                        : v == "raw" ? LengthPriorOff::kRaw
+                                                     : LengthPriorOff::kNone;
+    }
     else if (k == "--anchor-small") {
       const std::string v = value();
       using whirl::family::Anchor;

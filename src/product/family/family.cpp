@@ -88,6 +88,9 @@ gp::GpOptions CandidateGpOptions(const FitOptions& o, const Candidate& c) {
   go.mean = c.mean;
   go.isotropic = c.isotropic;
   if (o.se_restarts > 0 && c.kernel == gp::Kernel::kSquaredExponential) go.restarts = o.se_restarts;
+  if (o.length_prior_off == LengthPriorOff::kAll ||
+      (o.length_prior_off == LengthPriorOff::kRaw && !c.log))
+    go.length_prior_sd = 0;
   return go;
 }
 
@@ -1021,10 +1024,15 @@ ChoiceOptions ActiveCandidates(const ChoiceOptions& given, int rows, int folds, 
   return active;
 }
 
-// The fit options of the choice below few_rows rows: ChoiceOptions::gp_noise_prior_small (the
-// GPs' noise prior, sd 1 unless fit.gp gives one) and se_restarts_small.
-ChoiceOptions WithSmallTableFitOptions(ChoiceOptions o, int rows) {
-  if (rows >= o.few_rows) return o;
+// The fit options of the choice by table size: from few_rows rows ChoiceOptions::
+// length_prior_off_large; below it gp_noise_prior_small (the GPs' noise prior, sd 1 unless fit.gp
+// gives one) and se_restarts_small.
+ChoiceOptions WithRowsFitOptions(ChoiceOptions o, int rows) {
+  if (rows >= o.few_rows) {
+    if (o.length_prior_off_large != LengthPriorOff::kNone)
+      o.fit.length_prior_off = o.length_prior_off_large;
+    return o;
+  }
   if (o.gp_noise_prior_small && o.fit.gp.noise_prior_sd == 0) o.fit.gp.noise_prior_sd = 1;
   if (o.se_restarts_small > 0) o.fit.se_restarts = o.se_restarts_small;
   return o;
@@ -1400,7 +1408,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   TableTransform used;
   const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
   std::string rows_note;
-  const ChoiceOptions options = WithSmallTableFitOptions(
+  const ChoiceOptions options = WithRowsFitOptions(
       ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note), rows);
   const int nc = static_cast<int>(options.candidates.size());
   std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
