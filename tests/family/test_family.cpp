@@ -1685,5 +1685,69 @@ TEST(FamilyLinearRefitsSmall, KeepSdLeavesThePowerLawsSdAsItIs) {
   EXPECT_EQ(nlohmann::json(k.models).dump(), nlohmann::json(d.models).dump());
 }
 
+// FitOptions::length_prior_off: kAll fits every GP as with gp.length_prior_sd = 0 (maximum
+// likelihood), kRaw only the raw-column GPs (the log-column GP with its power-law mean keeps the
+// prior); the hyperparameters compared exactly.
+TEST(FamilyLengthPriorOff, WhichGpsAreFittedWithoutThePrior) {
+  EXPECT_EQ(FitOptions().length_prior_off, LengthPriorOff::kNone);
+  EXPECT_EQ(ChoiceOptions().length_prior_off_large, LengthPriorOff::kNone);
+  const ProcessTable t = test::MakeBentTable(70, 0.05, 0.5, 2);
+  FitOptions none, all, raw, ml;
+  all.length_prior_off = LengthPriorOff::kAll;
+  raw.length_prior_off = LengthPriorOff::kRaw;
+  ml.gp.length_prior_sd = 0;
+  for (const char* name : {"gp-se-constant/identity", "gp-matern52-linear/log"}) {
+    const Candidate c = ParseCandidate(name);
+    const FamilyModel with = FitCandidate(t, c, none, false), without = FitCandidate(t, c, ml, false);
+    ASSERT_NE(with.gps[0].theta, without.gps[0].theta) << name << ": the prior matters here";
+    EXPECT_EQ(FitCandidate(t, c, all, false).gps[0].theta, without.gps[0].theta) << name;
+    EXPECT_EQ(FitCandidate(t, c, raw, false).gps[0].theta, c.log ? with.gps[0].theta
+                                                                 : without.gps[0].theta) << name;
+  }
+}
+
+// ChoiceOptions::length_prior_off_large: from few_rows (70) rows the choice is the one with the
+// prior off on the GPs named (the file byte for byte); below it (20 and 69 rows, on which the
+// prior changes the choice's file) the default's byte for byte.
+TEST(FamilyLengthPriorOff, FromFewRowsOnlyAndOnlyTheGpsNamed) {
+  const std::vector<Candidate> raw_gp = {ParseCandidate("linear/log"),
+                                         ParseCandidate("gp-se-constant/identity")},
+                               log_gp = {ParseCandidate("linear/log"),
+                                         ParseCandidate("gp-matern52-linear/log")};
+  auto file = [](const ProcessTable& t, const std::vector<Candidate>& cands, LengthPriorOff off,
+                 double prior_sd) {
+    ChoiceOptions o;
+    o.candidates = cands;
+    o.length_prior_off_large = off;
+    o.fit.gp.length_prior_sd = prior_sd;
+    return nlohmann::json(ChooseFamily(t, o)).dump();
+  };
+  const double sd = gp::GpOptions().length_prior_sd;
+  for (int rows : {20, 69, 70}) {
+    const ProcessTable t = test::MakeBentTable(rows, 0.05, 0.5, 2);
+    for (const auto* cands : {&raw_gp, &log_gp}) {
+      const std::string with = file(t, *cands, LengthPriorOff::kNone, sd),
+                        without = file(t, *cands, LengthPriorOff::kNone, 0);
+      ASSERT_NE(with, without) << rows << " rows: a table on which the prior matters";
+      const bool large = rows >= ChoiceOptions().few_rows;
+      EXPECT_EQ(file(t, *cands, LengthPriorOff::kAll, sd), large ? without : with) << rows;
+      EXPECT_EQ(file(t, *cands, LengthPriorOff::kRaw, sd),
+                large && cands == &raw_gp ? without : with) << rows;
+    }
+  }
+}
+
+// The same table and options give the same file byte for byte, with one thread or two.
+TEST(FamilyLengthPriorOff, SameFileTwiceAndWithTwoThreads) {
+  const ProcessTable t = MakeTable(70, 0.05, 5, true);
+  ChoiceOptions o;
+  o.length_prior_off_large = LengthPriorOff::kAll;
+  const std::string file = nlohmann::json(ChooseFamily(t, o)).dump();
+  EXPECT_NE(file, nlohmann::json(ChooseFamily(t, ChoiceOptions{})).dump());
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+  o.fit.threads = 2;
+  EXPECT_EQ(nlohmann::json(ChooseFamily(t, o)).dump(), file);
+}
+
 }  // namespace
 }  // namespace whirl::family
