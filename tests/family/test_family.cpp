@@ -1161,5 +1161,36 @@ TEST(FamilyCandidates, NamesRoundTripAndBadInput) {
   ExpectInputError([&] { ChooseFamily(no_targets, {}); }, "target columns");
 }
 
+// The GP slot from few_rows rows (gp_slot_large: the GP of highest BIC among all GPs) may go to a
+// GP the gate dropped; with GP candidates only (`whirl train --family gp`) nothing was left, and
+// the choice threw ("stacking weights: 70 x 0 predictions", or with the hard choice
+// "one-standard-error rule: no candidates"). Now the first candidate, which the gate measured
+// the others against, takes part alone: such an output is the first GP's, as if it were the
+// only candidate (means and sd identical).
+TEST(FamilyChoice, GpOnlyCandidatesKeepTheFirstWhenTheGateDropsTheSlotsGp) {
+  const ProcessTable table = test::MakeFriedman23Table(70, 1);
+  ChoiceOptions o, first_only;
+  o.candidates = {ParseCandidate("gp-matern52-linear/log"),
+                  ParseCandidate("gp-matern52-constant/identity")};
+  first_only.candidates = {o.candidates.front()};
+  ASSERT_GE(table.inputs.size(), static_cast<std::size_t>(o.few_rows));
+  for (bool stack : {true, false}) {
+    o.stack = first_only.stack = stack;
+    const Choice c = ChooseFamily(table, o), alone = ChooseFamily(table, first_only);
+    const std::vector<FamilyPrediction> p = PredictChoice(c, table.inputs),
+                                        q = PredictChoice(alone, table.inputs);
+    int first_alone = 0;
+    for (int k = 0; k < 2; ++k) {
+      if (c.chosen[k] != 0 || !c.weights[k].empty()) continue;
+      ++first_alone;
+      for (std::size_t r = 0; r < p.size(); ++r) {
+        EXPECT_EQ(p[r].mean.ToArray()[k], q[r].mean.ToArray()[k]) << "stack " << stack;
+        EXPECT_EQ(p[r].stddev.ToArray()[k], q[r].stddev.ToArray()[k]) << "stack " << stack;
+      }
+    }
+    EXPECT_GE(first_alone, 1) << "stack " << stack << ": " << c.Describe();
+  }
+}
+
 }  // namespace
 }  // namespace whirl::family

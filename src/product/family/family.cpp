@@ -897,12 +897,19 @@ std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
   return out;
 }
 
-// ChoiceOptions::lowest_gp (or the one refitted GP `only` if >= 0) applied to `kept`.
+// ChoiceOptions::lowest_gp (or the one refitted GP `only` if >= 0) applied to `kept`, whose first
+// is the candidate the gate measured the others against. If that leaves none (every candidate
+// kept is a GP, as with `whirl train --family gp`, and the slot's GP is one the gate dropped:
+// gp_slot_large and `only` pick among all GPs), the first of `kept` takes part alone, as the
+// first candidate does in the default list when the slot's GP is dropped.
 std::vector<int> GpsThatTakePart(const std::vector<int>& kept,
                                  const std::vector<Eigen::MatrixXd>& err, const ChoiceOptions& o,
                                  int k, int only, const GpEvidence& ev) {
-  if (only >= 0) return WithOneGp(kept, o, only);
-  return o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k, ev) : kept;
+  std::vector<int> out = only >= 0     ? WithOneGp(kept, o, only)
+                         : o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k, ev)
+                                       : kept;
+  if (out.empty() && !kept.empty()) out.push_back(kept.front());
+  return out;
 }
 
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the

@@ -409,7 +409,8 @@ struct ChoiceOptions {
   /// GP takes the one slot per output (GpSlot; kHeldOut: the lowest held-out error, as below
   /// few_rows). kEvidence and kBic rank every GP candidate by GpLogEvidence (kBic: minus
   /// (q / 2) ln n) and keep the highest; it still has to pass the gate (stack_gate_se_large,
-  /// leave_first_se_large) to enter; it overrides lowest_gp_per_scale_large. Why: the GPs'
+  /// leave_first_se_large) to enter (if it does not and every candidate that did is a GP, the
+  /// first candidate takes part alone); it overrides lowest_gp_per_scale_large. Why: the GPs'
   /// closed-form leave-one-out is optimistic, most for the log-column GP, which took the slot on
   /// tables where a raw-column GP predicted better; the marginal likelihood does not use the
   /// leave-one-out. kBic met the rule on a tuning and a confirmation part; kEvidence, which
