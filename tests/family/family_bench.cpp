@@ -7,9 +7,6 @@
 //                [--refit-hyper-rows N] [--refit-ftol F] [--refit-gtol G]
 //                [--gp-length-prior-sd SD] [--gp-max-rows N] [--gp-loo-penalty F]
 //                [--gp-hyper-rows N] [--loo-calibration-rows N] [--gp-slot-large held-out|evidence|bic]
-//                [--fold-partitions P] [--fresh-partition-sd] [--fresh-sd-weight W]
-//                [--anchor-small first|bic|bic-weights] [--same-scale-gp-bic]
-//                [--gp-noise-prior-small]
 // Output: {"chosen", "cv_table", "fit_time_ms" (wall), "fit_cpu_ms" (process CPU), "predictions":
 // [{"mean": [e, s], "sd": [e, s]}, ...]}. Bad arguments: message on stderr, exit 2.
 #include <chrono>
@@ -146,26 +143,7 @@ Args Parse(int argc, char** argv) {
       a.choice.gp_slot_large = v == "evidence" ? GpSlot::kEvidence
                                : v == "bic"    ? GpSlot::kBic
                                                : GpSlot::kHeldOut;
-    } else if (k == "--fold-partitions")
-      a.choice.fold_partitions = std::stoi(value());
-    else if (k == "--fresh-partition-sd")
-      a.choice.fresh_partition_sd = true;
-    else if (k == "--fresh-sd-weight")
-      a.choice.fresh_sd_weight = std::stod(value());
-    else if (k == "--same-scale-gp-bic")
-      a.choice.same_scale_gp_bic = true;
-    else if (k == "--gp-noise-prior-small")
-      a.choice.gp_noise_prior_small = true;
-    else if (k == "--anchor-small") {
-      const std::string v = value();
-      using whirl::family::Anchor;
-      if (v != "first" && v != "bic" && v != "bic-weights")
-        throw std::invalid_argument("--anchor-small " + v + ": must be first, bic or bic-weights");
-      a.choice.anchor_small = v == "bic" ? Anchor::kBic
-                              : v == "bic-weights" ? Anchor::kBicWeights
-                                                   : Anchor::kFirst;
-    }
-    else if (k == "--gp-length-prior-sd")
+    } else if (k == "--gp-length-prior-sd")
       a.choice.fit.gp.length_prior_sd = std::stod(value());
     else if (k == "--gp-restarts")
       a.choice.fit.gp.restarts = std::stoi(value());

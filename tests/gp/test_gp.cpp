@@ -294,39 +294,6 @@ TEST(GpFit, LengthPriorIsStationaryInThePosterior) {
   }
 }
 
-// GpOptions::noise_prior_sd: at the fitted point the likelihood's gradient in ln s_n balances the
-// prior's, dNLML/d ln s_n = -2 (2 ln s_n - mean) / sd^2 (ln s_n^2 = 2 ln s_n), the signal's is 0;
-// on noise-free data the fit without it drives the noise toward 0 and the prior keeps ln s_n^2
-// nearer its mean.
-TEST(GpFit, NoisePriorIsStationaryInThePosterior) {
-  for (const double noise : {0.0, 0.1}) {
-    const Data data = MakeData(3, 20, noise, 13);
-    for (Kernel k : kKernels) {
-      GpOptions o;
-      o.kernel = k;
-      o.noise_prior_sd = 1;
-      o.bfgs.gradient_tolerance = 1e-8;
-      o.bfgs.function_tolerance = 1e-14;
-      const Gp map = FitGp(data.x, data.y, o);
-      Eigen::VectorXd g;
-      NegLogMarginalLikelihood(k, map.mean, map.z, map.u, map.theta, map.min_noise_variance, &g);
-      EXPECT_NEAR(g(4), -2 * (2 * map.theta(4) - o.noise_prior_mean) / 1.0, 1e-4)
-          << "kernel " << ToString(k) << ", noise " << noise;
-      EXPECT_NEAR(g(3), 0.0, 1e-4);
-      o.noise_prior_sd = 0;
-      const Gp ml = FitGp(data.x, data.y, o);
-      EXPECT_LT(std::abs(2 * map.theta(4) + 4), std::abs(2 * ml.theta(4) + 4))
-          << "kernel " << ToString(k) << ", noise " << noise;
-    }
-  }
-  GpOptions bad;
-  bad.noise_prior_sd = -1;
-  ExpectInputError([&] { bad.Validate(); }, "noise_prior_sd -1");
-  bad.noise_prior_sd = 1;
-  bad.noise_prior_mean = std::nan("");
-  ExpectInputError([&] { bad.Validate(); }, "noise_prior_mean");
-}
-
 // The fit evaluates the likelihood many times in buffers it reuses; the value it reports for the
 // chosen start is a fresh evaluation's at the hyperparameters it returns (plus the length prior).
 TEST(GpFit, ReportedObjectiveIsAFreshEvaluationAtTheFittedPoint) {

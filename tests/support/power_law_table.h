@@ -1,5 +1,6 @@
 #pragma once
 // Generated process tables for the model tests (family/, workpiece/).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
@@ -40,6 +41,34 @@ inline ProcessTable MakeBentTable(int rows, double noise_sd, double bend, unsign
   for (std::size_t q = 0; q < t.targets.size(); ++q)
     t.targets[q].max_elongation_um *=
         std::exp(bend * std::pow(std::log(t.inputs[q].raceway_radius_mm / 6), 2));
+  return t;
+}
+
+// Friedman #2 (max elongation) and #3 (settle time) (Friedman, "Multivariate adaptive regression
+// splines", 1991; Breiman, "Bagging predictors", 1996) on u_1..u_4 of u ~ U[0, 1]^5 (u_5 does not
+// matter), the inputs MakeTable's ranges: x1 = 100 u1, x2 = 40 pi + 520 pi u2, x3 = u3,
+// x4 = 1 + 10 u4, g = x2 x3 - 1 / (x2 x4); f2 = sqrt(x1^2 + g^2) + 500, f3 = 100 atan(g / x1)
+// + 200, noise sd a third of each function's sd (125 and 31), as scripts/bench_peers.py's
+// friedman23 family.
+inline ProcessTable MakeFriedman23Table(int rows, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::normal_distribution<double> n01;
+  const double lo[5] = {60, 50, 6, 3, 150}, span[5] = {5, 50, 10, 7, 60};
+  const double pi = std::acos(-1.0);
+  ProcessTable t;
+  t.source = "friedman23.csv";
+  for (int q = 0; q < rows; ++q) {
+    std::array<double, 5> u{}, x{};
+    for (int i = 0; i < 5; ++i) u[i] = u01(rng);
+    for (int i = 0; i < 5; ++i) x[i] = lo[i] + span[i] * u[i];
+    const double x1 = 100 * u[0], x2 = 40 * pi + 520 * pi * u[1], x3 = u[2], x4 = 1 + 10 * u[3];
+    const double g = x2 * x3 - 1 / (x2 * x4);
+    const double f2 = std::sqrt(x1 * x1 + g * g) + 500;
+    const double f3 = 100 * std::atan(g / std::max(x1, 1e-9)) + 200;
+    t.inputs.push_back(ProcessInputs::FromArray(x));
+    t.targets.push_back(Features::FromArray({f2 + 125 * n01(rng), f3 + 31 * n01(rng)}));
+  }
   return t;
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,8 +13,8 @@
 #include "core/json_file.h"
 #include "support/expect_error.h"
 #include "support/power_law_table.h"
-#include "workpiece/model.h"
 #include "support/scratch_dir.h"
+#include "workpiece/model.h"
 
 namespace whirl::workpiece {
 namespace {
@@ -269,6 +270,44 @@ TEST(WorkpieceTraining, ChosenNeverWorseInCvThanThePowerLawOnPowerLawTables) {
       EXPECT_LE(c.table[c.chosen[k]].cv_rmse(k), power_law->cv_rmse(k) * (1 + 1e-12))
           << "seed " << seed << ": " << c.Describe();
   }
+}
+
+// Property: every --family flag, with the stack and the hard choice, on random tables of 8, 20,
+// 69, 70 and 100 rows (below, at and above ChoiceOptions::few_rows; power laws, smooth non-power
+// laws, Friedman #2/#3), gives a model with finite predictions at its training rows or an
+// InputError that names the table; never an error of the choice's internals (such as
+// "stacking weights: 100 x 0 predictions" of --family gp on Friedman #2/#3 tables).
+TEST(WorkpieceTraining, EveryFamilyFlagGivesAModelOrAnErrorNamingTheTable) {
+  const std::string name = "random_table.csv";
+  int models = 0;
+  for (unsigned seed = 1; seed <= 15; ++seed) {
+    const int rows = std::array<int, 5>{8, 20, 69, 70, 100}[seed % 5];
+    const ProcessTable table = seed % 3 == 0   ? test::MakeFriedman23Table(rows, seed)
+                               : seed % 3 == 1 ? MakeTable(rows, 0.05, seed, true)
+                                               : MakeTable(rows, 0.1, seed);
+    for (FamilyFlag f : {FamilyFlag::kAuto, FamilyFlag::kNetwork, FamilyFlag::kGaussianProcess,
+                         FamilyFlag::kLinear})
+      for (bool stack : {true, false}) {
+        TrainOptions o;
+        o.family = f;
+        o.choice.stack = stack;
+        const std::string what = "seed " + std::to_string(seed) + ", " + std::to_string(rows) +
+                                 " rows, family " + std::to_string(static_cast<int>(f)) +
+                                 (stack ? ", stack" : ", hard");
+        try {
+          const WorkpieceModel m = TrainWorkpieceModel(table, o, name);
+          for (const Prediction& p : PredictBatch(m, table.inputs))
+            for (double v : {p.mean.max_elongation_um, p.mean.settle_time_s,
+                             p.stddev.max_elongation_um, p.stddev.settle_time_s})
+              ASSERT_TRUE(std::isfinite(v)) << what;
+          ++models;
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find(name), std::string::npos)
+              << what << ": " << e.what();
+        }
+      }
+  }
+  EXPECT_GE(models, 100) << "of 120 trainings";
 }
 
 }  // namespace

@@ -7,12 +7,10 @@
 #include <functional>
 #include <limits>
 #include <mutex>
-#include <numeric>
 
 #include "core/error.h"
 #include "core/numbers.h"
 #include "core/parallel.h"
-#include "core/random.h"
 
 namespace whirl::family {
 namespace {
@@ -57,15 +55,22 @@ nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions
   return nn::TrainModel(t, m, t.source);
 }
 
+// Fold of each of `rows` rows among min(folds, rows) folds: row q in fold q % min(folds, rows).
+std::vector<int> FoldOfRows(int rows, int folds) {
+  const int k = std::min(folds, rows);
+  std::vector<int> fold(static_cast<std::size_t>(rows));
+  for (int q = 0; q < rows; ++q) fold[static_cast<std::size_t>(q)] = q % k;
+  return fold;
+}
+
 // Held-out residuals r and latent variances v (units of y) of K-fold refits, row q held out in
-// fold FoldOfRows(...)[q] of o.fold_partition; fit_predict(train rows, held-out rows, &mean,
-// &latent variance).
+// fold q % K; fit_predict(train rows, held-out rows, &mean, &latent variance).
 using FoldFitPredict = std::function<void(const Eigen::VectorXi&, const Eigen::VectorXi&,
                                           Eigen::VectorXd*, Eigen::VectorXd*)>;
-void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FitOptions& o,
-                    const FoldFitPredict& fit_predict, Eigen::VectorXd* r, Eigen::VectorXd* v) {
+void KFoldResiduals(const Eigen::VectorXd& y, int folds, const FoldFitPredict& fit_predict,
+                    Eigen::VectorXd* r, Eigen::VectorXd* v) {
   const int n = static_cast<int>(y.size()), k = std::min(folds, n);
-  const std::vector<int> fold_of = FoldOfRows(n, k, o.fold_partition, o.seed);
+  const std::vector<int> fold_of = FoldOfRows(n, k);
   r->resize(n);
   v->resize(n);
   for (int f = 0; f < k; ++f) {
@@ -119,7 +124,7 @@ HeldOut OutputHeldOut(const FamilyModel& m, int k, const Eigen::MatrixXd& x,
   }
   const gp::GpOptions go = CandidateGpOptions(o, m.candidate);
   KFoldResiduals(
-      y, folds, o,
+      y, folds,
       [&](const Eigen::VectorXi& tr, const Eigen::VectorXi& te, Eigen::VectorXd* mean,
           Eigen::VectorXd* latent) {
         if (linear) {
@@ -260,8 +265,7 @@ ProcessTable Rows(const ProcessTable& table, const std::vector<int>& fold_of, in
 // Held-out errors (2 x rows, original units) of one candidate's fold fit.
 void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
                 int fold, Eigen::MatrixXd* err) {
-  const std::vector<int> fold_of =
-      FoldOfRows(static_cast<int>(table.inputs.size()), folds, o.fold_partition, o.seed);
+  const std::vector<int> fold_of = FoldOfRows(static_cast<int>(table.inputs.size()), folds);
   const ProcessTable train = Rows(table, fold_of, fold, false),
                      held = Rows(table, fold_of, fold, true);
   const FamilyModel m = FitCandidate(train, c, o, false);
@@ -338,23 +342,6 @@ void CheckRows(const ProcessTable& table, const Candidate& c, int inputs) {
 }
 
 }  // namespace
-
-std::vector<int> FoldOfRows(int rows, int folds, int partition, std::uint64_t seed) {
-  if (rows < 1 || folds < 1 || partition < 0)
-    throw InputError("fold partition: " + std::to_string(rows) + " rows, " +
-                     std::to_string(folds) + " folds, partition " + std::to_string(partition) +
-                     "; need rows >= 1, folds >= 1 and partition >= 0");
-  const int k = std::min(folds, rows);
-  std::vector<int> order(static_cast<std::size_t>(rows)), fold(order.size());  // order[pos] = row
-  std::iota(order.begin(), order.end(), 0);
-  if (partition > 0) {
-    Rng rng(MixSeed(seed, static_cast<std::uint64_t>(partition)));
-    for (int i = rows - 1; i > 0; --i)  // Fisher-Yates
-      std::swap(order[i], order[std::min(i, static_cast<int>(rng.Uniform() * (i + 1)))]);
-  }
-  for (int pos = 0; pos < rows; ++pos) fold[order[pos]] = pos % k;
-  return fold;
-}
 
 std::string Candidate::Name() const {
   const std::string t = log ? "/log" : "/identity";
@@ -575,29 +562,22 @@ MeanAndSe OfDifferences(const Eigen::ArrayXd& d);
 }  // namespace
 
 ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::VectorXd& target,
-                               int folds, double start_se, double full_se, int partitions) {
+                               int folds, double start_se, double full_se) {
   ShrunkStack out;
   const Eigen::VectorXd all = ConvexStackWeights(predictions, target);
-  const Eigen::Index total = predictions.rows();
+  const Eigen::Index n = predictions.rows();
   if (folds < 2) throw InputError("stacking weights: " + std::to_string(folds) + " folds; need >= 2");
-  if (partitions < 1 || total % partitions != 0)
-    throw InputError("stacking weights: " + std::to_string(total) + " rows in " +
-                     std::to_string(partitions) + " partitions; need equal blocks");
-  const Eigen::Index n = total / partitions;
   const int k = static_cast<int>(std::min<Eigen::Index>(folds, n));
-  Eigen::VectorXd stacked(total);
+  Eigen::VectorXd stacked(n);
   for (int f = 0; f < k && n >= 2; ++f) {
     std::vector<Eigen::Index> train, held;
-    for (Eigen::Index q = 0; q < total; ++q) ((q % n) % k == f ? held : train).push_back(q);
+    for (Eigen::Index q = 0; q < n; ++q) (q % k == f ? held : train).push_back(q);
     const Eigen::VectorXd w = ConvexStackWeights(predictions(train, Eigen::all), target(train));
     stacked(held) = predictions(held, Eigen::all) * w;
   }
   if (n < 2) stacked = predictions * all;
-  const Eigen::ArrayXd each = (target - predictions.col(0)).array().square() -
-                              (target - stacked).array().square();
-  Eigen::ArrayXd d = each.head(n);
-  for (int p = 1; p < partitions; ++p) d += each.segment(p * n, n);
-  if (partitions > 1) d /= partitions;
+  const Eigen::ArrayXd d = (target - predictions.col(0)).array().square() -
+                           (target - stacked).array().square();
   const MeanAndSe m = OfDifferences(d);
   out.z = m.se > 0 ? m.mean / m.se : (m.mean > 0 ? std::numeric_limits<double>::infinity() : 0.0);
   if (full_se < 0)
@@ -779,20 +759,6 @@ double GpLogEvidence(const FamilyModel& m, int k) {
   return e;
 }
 
-double LinearLogEvidence(const FamilyModel& m, const ProcessTable& table, int k) {
-  if (k < 0 || static_cast<std::size_t>(k) >= m.linears.size())
-    throw InputError("linear evidence: " + m.candidate.Name() + " holds no linear fit for output " +
-                     std::to_string(k));
-  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
-  const Eigen::VectorXd y =
-      TransformTargets(m.transform, nn::TargetMatrix(table.targets)).row(k).transpose();
-  const double rss = (y - PredictLinear(m.linears[k], x).mean).squaredNorm();
-  const double n = static_cast<double>(y.size());
-  double e = -0.5 * n * (std::log(2 * kPi * rss / n) + 1);
-  if (m.transform.outputs[k] == ColumnTransform::kLog) e -= y.sum();  // sum_i ln y_i
-  return e;
-}
-
 namespace {
 
 // The linear candidate on the columns of candidate c (-1 if there is none).
@@ -906,32 +872,11 @@ int HighestEvidenceGp(const ChoiceOptions& o, const GpEvidence& ev, int k) {
   return best;
 }
 
-// ChoiceOptions::same_scale_gp_bic: `kept` without the GP candidates of output k whose BIC in
-// `ev` is below that of another GP candidate of `o` on the same column scale (Candidate::log; of
-// equal ones the first stays).
-std::vector<int> WithTheHighestBicPerScale(const std::vector<int>& kept, const ChoiceOptions& o,
-                                           const GpEvidence& ev, int k) {
-  const auto is_gp = [&](std::size_t c) {
-    return o.candidates[c].family == Family::kGaussianProcess;
-  };
-  std::vector<int> out;
-  for (int c : kept) {
-    const std::size_t u = static_cast<std::size_t>(c);
-    bool beaten = false;
-    for (std::size_t b = 0; b < o.candidates.size() && is_gp(u); ++b)
-      beaten = beaten || (b != u && is_gp(b) && o.candidates[b].log == o.candidates[u].log &&
-                          (ev[b][k] > ev[u][k] || (ev[b][k] == ev[u][k] && b < u)));
-    if (!beaten) out.push_back(c);
-  }
-  return out;
-}
-
 // ChoiceOptions::lowest_gp: `kept` without its GP candidates except the one with the lowest
 // held-out error of output k (the first of equal ones), which keeps its place; with
 // lowest_gp_per_scale below few_rows rows (lowest_gp_per_scale_large from few_rows on) one such
 // GP per column scale (Candidate::log); with `ev` from few_rows rows (ChoiceOptions::gp_slot_large)
-// the GP of highest evidence among all GP candidates instead, if it is in `kept`; with `ev` below
-// few_rows (ChoiceOptions::same_scale_gp_bic) the lowest among WithTheHighestBicPerScale.
+// the GP of highest evidence among all GP candidates instead, if it is in `kept`.
 std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
                                      const std::vector<Eigen::MatrixXd>& err,
                                      const ChoiceOptions& o, int k, const GpEvidence& ev) {
@@ -939,7 +884,7 @@ std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
   if (!ev.empty() && !small) return WithOneGp(kept, o, HighestEvidenceGp(o, ev, k));
   const bool per_scale = small ? o.lowest_gp_per_scale : o.lowest_gp_per_scale_large;
   std::array<int, 2> best = {-1, -1};  // [log]; one slot without per_scale
-  for (int c : ev.empty() ? kept : WithTheHighestBicPerScale(kept, o, ev, k)) {
+  for (int c : kept) {
     int& b = best[per_scale && o.candidates[c].log ? 1 : 0];
     if (o.candidates[c].family == Family::kGaussianProcess &&
         (b < 0 || err[c].row(k).squaredNorm() < err[b].row(k).squaredNorm()))
@@ -952,12 +897,19 @@ std::vector<int> WithTheLowestGpOnly(const std::vector<int>& kept,
   return out;
 }
 
-// ChoiceOptions::lowest_gp (or the one refitted GP `only` if >= 0) applied to `kept`.
+// ChoiceOptions::lowest_gp (or the one refitted GP `only` if >= 0) applied to `kept`, whose first
+// is the candidate the gate measured the others against. If that leaves none (every candidate
+// kept is a GP, as with `whirl train --family gp`, and the slot's GP is one the gate dropped:
+// gp_slot_large and `only` pick among all GPs), the first of `kept` takes part alone, as the
+// first candidate does in the default list when the slot's GP is dropped.
 std::vector<int> GpsThatTakePart(const std::vector<int>& kept,
                                  const std::vector<Eigen::MatrixXd>& err, const ChoiceOptions& o,
                                  int k, int only, const GpEvidence& ev) {
-  if (only >= 0) return WithOneGp(kept, o, only);
-  return o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k, ev) : kept;
+  std::vector<int> out = only >= 0     ? WithOneGp(kept, o, only)
+                         : o.lowest_gp ? WithTheLowestGpOnly(kept, err, o, k, ev)
+                                       : kept;
+  if (out.empty() && !kept.empty()) out.push_back(kept.front());
+  return out;
 }
 
 // Output k's choice among the candidates `kept` (ChoiceOptions::one_standard_error, or the
@@ -1020,14 +972,6 @@ ChoiceOptions ActiveCandidates(const ChoiceOptions& given, int rows, int folds, 
   return active;
 }
 
-// ChoiceOptions::gp_noise_prior_small: below few_rows rows the GPs' noise prior (sd 1 unless
-// fit.gp gives one).
-ChoiceOptions WithSmallTableNoisePrior(ChoiceOptions o, int rows) {
-  if (o.gp_noise_prior_small && rows < o.few_rows && o.fit.gp.noise_prior_sd == 0)
-    o.fit.gp.noise_prior_sd = 1;
-  return o;
-}
-
 // Choice::warnings: the constant inputs left out, and the columns the log candidates keep raw.
 std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOptions& o,
                                        const std::vector<int>& constant) {
@@ -1067,16 +1011,12 @@ std::vector<std::string> TableWarnings(const ProcessTable& table, const ChoiceOp
 
 namespace {
 
-// Held-out errors per fold partition and candidate (ChoiceOptions::fold_partitions).
-using PartitionErrs = std::vector<std::vector<Eigen::MatrixXd>>;
-
 // ChoiceOptions::stack for output k of targets t (outputs x rows): the shrunk stacking weights
-// of every candidate (ShrunkStackWeights of their held-out predictions t - err, or with more than
-// one of `parts` of every partition's), 0 for those that stack_gate_se or lowest_gp leave out
-// (`only`, `ev`: GpsThatTakePart).
+// of every candidate (ShrunkStackWeights of their held-out predictions t - err), 0 for those
+// that stack_gate_se or lowest_gp leave out (`only`, `ev`: GpsThatTakePart).
 Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
-                            const PartitionErrs& parts, const ChoiceOptions& o, int k, int folds,
-                            int only, const GpEvidence& ev) {
+                            const ChoiceOptions& o, int k, int folds, int only,
+                            const GpEvidence& ev) {
   const int nc = static_cast<int>(err.size());
   const bool large = t.cols() >= o.few_rows;
   const double gate = large ? o.stack_gate_se_large : o.stack_gate_se;
@@ -1087,18 +1027,13 @@ Eigen::VectorXd OutputStack(const Eigen::MatrixXd& t, const std::vector<Eigen::M
   for (int c = 1; c < nc; ++c)
     if (gate <= 0 || BeatsFirst(squared(0), squared(c), gate, 0, folds)) in.push_back(c);
   in = GpsThatTakePart(in, err, o, k, only, ev);
-  const int np = std::max<int>(1, static_cast<int>(parts.size()));
-  const Eigen::Index n = t.cols();
-  Eigen::MatrixXd p(n * np, static_cast<Eigen::Index>(in.size()));
-  for (int b = 0; b < np; ++b)
-    for (std::size_t j = 0; j < in.size(); ++j) {
-      const Eigen::MatrixXd& e = np > 1 ? parts[b][in[j]] : err[in[j]];
-      p.block(b * n, static_cast<Eigen::Index>(j), n, 1) = (t.row(k) - e.row(k)).transpose();
-    }
+  Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()));
+  for (std::size_t j = 0; j < in.size(); ++j)
+    p.col(static_cast<Eigen::Index>(j)) = (t.row(k) - err[in[j]].row(k)).transpose();
   const Eigen::VectorXd w =
-      ShrunkStackWeights(p, t.row(k).transpose().replicate(np, 1), folds,
+      ShrunkStackWeights(p, t.row(k).transpose(), folds,
                          large ? o.stack_start_se_large : o.stack_start_se,
-                         large ? o.stack_full_se_large : o.stack_full_se, np)
+                         large ? o.stack_full_se_large : o.stack_full_se)
           .weights;
   Eigen::VectorXd out = Eigen::VectorXd::Zero(nc);
   for (std::size_t j = 0; j < in.size(); ++j) out(in[j]) = w(static_cast<Eigen::Index>(j));
@@ -1233,157 +1168,11 @@ GpEvidence GpEvidenceOf(const ChoiceOptions& o, const std::vector<FamilyModel>& 
 }
 
 // ChoiceOptions::gp_slot_large on a table of `rows` rows: GpEvidence of the GP candidates of
-// `full` (fitted on all rows from few_rows on); empty where the held-out errors give the slot.
-// Below few_rows: with ChoiceOptions::same_scale_gp_bic (and lowest_gp) the BIC of the GPs that
-// share a column scale with another GP candidate (fitted on all rows: `complete`), -infinity for
-// the others (GpEvidenceOf of an unfitted GP).
-GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows,
-                        const std::function<void(int)>& complete) {
-  if (rows < o.few_rows) {
-    if (!o.same_scale_gp_bic || !o.lowest_gp) return {};
-    const int nc = static_cast<int>(o.candidates.size());
-    for (int c = 0; c < nc; ++c)
-      for (int b = 0; b < nc; ++b)
-        if (b != c && o.candidates[c].family == Family::kGaussianProcess &&
-            o.candidates[b].family == Family::kGaussianProcess &&
-            o.candidates[b].log == o.candidates[c].log) {
-          complete(c);
-          break;
-        }
-    return GpEvidenceOf(o, full, GpSlot::kBic);
-  }
-  if (o.gp_slot_large == GpSlot::kHeldOut) return {};
+// `full` (fitted on all rows from few_rows on); empty where the held-out errors give the slot
+// (below few_rows, or kHeldOut).
+GpEvidence SlotEvidence(const ChoiceOptions& o, const std::vector<FamilyModel>& full, int rows) {
+  if (rows < o.few_rows || o.gp_slot_large == GpSlot::kHeldOut) return {};
   return GpEvidenceOf(o, full, o.gp_slot_large);
-}
-
-// ChoiceOptions::anchor_small applies to a table of `rows` rows (with `partitions` fold
-// partitions): the stack below few_rows, a linear fit first, and a GP candidate among `o`'s.
-bool AnchorApplies(const ChoiceOptions& o, int rows, int partitions) {
-  if (o.anchor_small == Anchor::kFirst || !o.stack || !o.per_output || rows >= o.few_rows ||
-      partitions > 1 || o.candidates.front().family != Family::kLinear)
-    return false;
-  return std::any_of(o.candidates.begin(), o.candidates.end(),
-                     [](const Candidate& c) { return c.family == Family::kGaussianProcess; });
-}
-
-// ChoiceOptions::anchor_small for output k: the anchor's weights over the candidates (sum 1):
-// the first candidate (the power law) and the GP of highest BIC in `gp_bic` by their BIC.
-Eigen::VectorXd AnchorWeights(const ChoiceOptions& o, const std::vector<FamilyModel>& full,
-                              const ProcessTable& table, const GpEvidence& gp_bic, int k) {
-  const double n = static_cast<double>(table.inputs.size());
-  const double q = static_cast<double>(full.front().linears[k].coef.size()) + 1;  // and the noise
-  const double power_law = LinearLogEvidence(full.front(), table, k) - 0.5 * q * std::log(n);
-  const int g = HighestEvidenceGp(o, gp_bic, k);
-  Eigen::VectorXd a = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(full.size()));
-  double wg = gp_bic[g][k] > power_law ? 1.0 : 0.0;
-  if (o.anchor_small == Anchor::kBicWeights) {
-    wg = 1 / (1 + std::exp(power_law - gp_bic[g][k]));
-    wg = wg < 1e-3 ? 0.0 : wg > 1 - 1e-3 ? 1.0 : wg;
-  }
-  a(g) = wg;
-  a(0) = 1 - wg;
-  return a;
-}
-
-// ChoiceOptions::anchor_small for output k of targets t: the shrunk stack (ShrunkStackWeights)
-// of the anchor `a` (AnchorWeights; its held-out prediction the a-weighted one of its parts) and
-// the candidates that are neither the first nor a GP and beat the anchor's squared held-out
-// errors by stack_gate_se standard errors; the anchor's weight split by a.
-Eigen::VectorXd AnchoredStack(const Eigen::MatrixXd& t, const std::vector<Eigen::MatrixXd>& err,
-                              const ChoiceOptions& o, int k, int folds, const Eigen::VectorXd& a) {
-  Eigen::RowVectorXd anchor = Eigen::RowVectorXd::Zero(t.cols());
-  for (Eigen::Index c = 0; c < a.size(); ++c)
-    if (a(c) > 0) anchor += a(c) * err[static_cast<std::size_t>(c)].row(k);
-  const auto squared = [](const Eigen::RowVectorXd& e) -> Eigen::VectorXd {
-    return e.array().square().matrix().transpose();
-  };
-  std::vector<int> in;
-  for (std::size_t c = 1; c < err.size(); ++c)
-    if (o.candidates[c].family != Family::kGaussianProcess &&
-        (o.stack_gate_se <= 0 ||
-         BeatsFirst(squared(anchor), squared(err[c].row(k)), o.stack_gate_se, 0, folds)))
-      in.push_back(static_cast<int>(c));
-  Eigen::MatrixXd p(t.cols(), static_cast<Eigen::Index>(in.size()) + 1);
-  p.col(0) = (t.row(k) - anchor).transpose();
-  for (std::size_t j = 0; j < in.size(); ++j)
-    p.col(static_cast<Eigen::Index>(j) + 1) = (t.row(k) - err[in[j]].row(k)).transpose();
-  const Eigen::VectorXd w =
-      ShrunkStackWeights(p, t.row(k).transpose(), folds, o.stack_start_se, o.stack_full_se).weights;
-  Eigen::VectorXd out = w(0) * a;
-  for (std::size_t j = 0; j < in.size(); ++j) out(in[j]) += w(static_cast<Eigen::Index>(j) + 1);
-  return out;
-}
-
-// ChoiceOptions::fold_partitions: per fold partition 0 .. partitions-1 the held-out errors
-// (original units) of every candidate; those judged by refits (networks, `refitted`; a pending
-// GP with `refit_options`) refitted on partitions from 1 on, the others' (closed-form) err's.
-PartitionErrs PartitionErrors(const ProcessTable& table, const ChoiceOptions& o,
-                              const FitOptions& fold_options, const FitOptions& refit_options,
-                              int folds, const std::vector<Eigen::MatrixXd>& err,
-                              const std::vector<char>& refitted, const std::vector<char>& pending,
-                              int partitions) {
-  const int nc = static_cast<int>(err.size());
-  PartitionErrs parts(static_cast<std::size_t>(partitions), err);
-  ParallelFor(static_cast<std::size_t>((partitions - 1) * nc * folds), o.fit.threads,
-              [&](std::size_t i) {
-                const int p = 1 + static_cast<int>(i) / (nc * folds);
-                const int c = static_cast<int>(i) / folds % nc, f = static_cast<int>(i) % folds;
-                const Candidate& cand = o.candidates[c];
-                FitOptions fo = pending[c] ? refit_options : fold_options;
-                fo.fold_partition = p;
-                if (cand.family == Family::kNetwork) {
-                  FoldErrors(table, cand, fo, folds, f, &parts[p][c]);
-                } else if (refitted[c] && f == 0) {
-                  FamilyModel m = Unfitted(table, cand);
-                  parts[p][c] = HeldOutErrors(table, fo, folds, &m, false, true);
-                }
-              });
-  return parts;
-}
-
-// Per candidate and row, the root of the mean over the partitions of the squared held-out errors.
-std::vector<Eigen::MatrixXd> RmsOverPartitions(const PartitionErrs& parts) {
-  std::vector<Eigen::MatrixXd> out = parts.front();
-  for (std::size_t c = 0; c < out.size(); ++c) {
-    Eigen::ArrayXXd sum = parts[0][c].array().square();
-    for (std::size_t p = 1; p < parts.size(); ++p) sum += parts[p][c].array().square();
-    out[c] = (sum / static_cast<double>(parts.size())).sqrt().matrix();
-  }
-  return out;
-}
-
-}  // namespace
-
-std::string FreshPartitionText(int k, int partition, int folds, double weight) {
-  return std::string("for ") + kTargetColumns[k] + " (stack weight " +
-         FormatSignificant(weight, 3) + ") the " + std::to_string(folds) +
-         "-fold cross-validation residuals of fold partition " + std::to_string(partition) +
-         " (rows permuted from the fit seed), which the choice did not use: a selection-aware sd";
-}
-
-namespace {
-
-// ChoiceOptions::fresh_partition_sd for output k: if its top candidate `g` (stack weight
-// `weight`) is a GP judged by refits and calibrated from them (`fresh`) with weight >=
-// fresh_sd_weight, its noise level from its held-out residuals of fold partition `partition`
-// (refits from the fixed starts), row k of sd_err[g] their errors in original units, and its
-// calibration text says so; true if it did.
-bool FreshPartitionSd(const ProcessTable& table, const ChoiceOptions& o, FitOptions fo, int folds,
-                      int partition, int g, double weight, const std::vector<char>& fresh, int k,
-                      std::vector<FamilyModel>* full, std::vector<Eigen::MatrixXd>* sd_err) {
-  if (o.candidates[g].family != Family::kGaussianProcess || !fresh[g] || weight < o.fresh_sd_weight)
-    return false;
-  fo.fold_partition = partition;
-  FamilyModel& m = (*full)[g];
-  const Eigen::MatrixXd x = ModelInputs(m, table.inputs);
-  const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
-  const Eigen::MatrixXd y = TransformTargets(m.transform, t);
-  const Eigen::VectorXd yk = y.row(k).transpose();
-  const HeldOut h = OutputHeldOut(m, k, x, yk, fo, folds, true);
-  (*sd_err)[g].row(k) = OriginalErrors(m, k, t.row(k), yk, h);
-  SetNoiseFrom(h, folds, fo, x, yk, k, &m);
-  m.calibration += "; " + FreshPartitionText(k, partition, folds, weight);
-  return true;
 }
 
 }  // namespace
@@ -1398,8 +1187,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   TableTransform used;
   const std::vector<int> constant = LeaveOutConstantInputs(table, &used);
   std::string rows_note;
-  const ChoiceOptions options = WithSmallTableNoisePrior(
-      ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note), rows);
+  const ChoiceOptions options =
+      ActiveCandidates(given, rows, folds, used.UsedInputCount(), &rows_note);
   const int nc = static_cast<int>(options.candidates.size());
   std::vector<Eigen::MatrixXd> err(static_cast<std::size_t>(nc),
                                    Eigen::MatrixXd(Features::kCount, rows));
@@ -1426,9 +1215,9 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
       FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
     } else if (f == 0) {  // held-out errors (and calibration) of the full fit or of refits
       full[c] = Unfitted(table, options.candidates[c]);
-      const bool honest = options.closed_form_loo &&
-                          options.candidates[c].family == Family::kGaussianProcess &&
-                          rows < options.few_rows && !RefitsLowestGpOnly(options, rows) &&
+      const bool refit_small = options.candidates[c].family == Family::kGaussianProcess &&
+                               !RefitsLowestGpOnly(options, rows);
+      const bool honest = options.closed_form_loo && refit_small && rows < options.few_rows &&
                           rows - (rows + folds - 1) / folds >=
                               MinimumRows(options.candidates[c], used.UsedInputCount());
       const int held_folds = honest ? folds : HeldOutFolds(options, folds);
@@ -1449,13 +1238,7 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   std::array<int, Features::kCount> only;
   only.fill(-1);
   if (RefitsLowestGpOnly(options, rows)) only = RefitLowestGp(table, options, folds, full, &err);
-  const int partitions = rows < options.few_rows ? std::max(1, options.fold_partitions) : 1;
-  PartitionErrs parts;
-  if (partitions > 1)
-    parts = PartitionErrors(table, options, fold_options, refit_options, folds, err, refitted,
-                            pending, partitions);
-  const std::vector<Eigen::MatrixXd> judged =
-      JudgedErrors(partitions > 1 ? RmsOverPartitions(parts) : err, full, refitted, options);
+  const std::vector<Eigen::MatrixXd> judged = JudgedErrors(err, full, refitted, options);
   const Eigen::MatrixXd t = nn::TargetMatrix(table.targets);
   // An output whose targets are all equal has nothing to choose on: it stays out of the score
   // (its MSE over a zero variance would only be a huge number; TableWarnings names it).
@@ -1486,19 +1269,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     choice.table[c].fit_ms +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
-  const GpEvidence ev = SlotEvidence(options, full, rows, complete);
+  const GpEvidence ev = SlotEvidence(options, full, rows);
   std::array<Eigen::VectorXd, Features::kCount> stack;
-  const bool anchored = AnchorApplies(options, rows, partitions);
-  GpEvidence gp_bic;
-  if (anchored) {  // ChoiceOptions::anchor_small: every GP fitted on all rows for its BIC
-    for (int c = 0; c < nc; ++c) complete(c);
-    gp_bic = GpEvidenceOf(options, full, GpSlot::kBic);
-  }
   for (int k = 0; k < Features::kCount && options.per_output; ++k) {
     if (options.stack) {
-      stack[k] = anchored ? AnchoredStack(t, judged, options, k, folds,
-                                          AnchorWeights(options, full, table, gp_bic, k))
-                          : OutputStack(t, judged, parts, options, k, folds, only[k], ev);
+      stack[k] = OutputStack(t, judged, options, k, folds, only[k], ev);
       Eigen::Index top = 0;
       stack[k].maxCoeff(&top);
       choice.chosen[k] = static_cast<int>(top);
@@ -1523,21 +1298,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     for (Eigen::Index c = 0; c < stack[k].size(); ++c)
       if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
-  std::vector<Eigen::MatrixXd> sd_err = err;  // ChoiceOptions::fresh_partition_sd
-  for (int k = 0; k < Features::kCount && options.fresh_partition_sd && options.stack &&
-                  options.per_output && rows < options.few_rows;
-       ++k) {
-    const int g = choice.chosen[k];
-    std::vector<char> fresh(calibrated.size());
-    for (std::size_t c = 0; c < fresh.size(); ++c) fresh[c] = calibrated[c] && refitted[c];
-    const double weight = stack[k].size() == 0 ? 1.0 : stack[k](g);
-    if (FreshPartitionSd(table, options, refit_options, folds, partitions, g, weight, fresh, k,
-                         &full, &sd_err))
-      choice.notes[k] = options.candidates[g].Name() + ": its sd " +
-                        FreshPartitionText(k, partitions, folds, weight);
-  }
   FitChosen(table, options, stack, full, calibrated, &choice);
-  ScaleStackedSd(table, options, stack, sd_err, &choice);
+  ScaleStackedSd(table, options, stack, err, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
   choice.warnings = TableWarnings(table, options, constant);
   choice.rows_note = rows_note;

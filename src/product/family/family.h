@@ -105,21 +105,7 @@ struct FitOptions {
   /// hyperparameter), and the refits cost a third of the fit time at 100 rows.
   int loo_calibration_rows = 70;
   int threads = 1;  ///< core/parallel.h; the result is the same for any count
-  /// The fold partition of every K-fold refit (calibration_folds, the choice's refits): row q is
-  /// held out in fold FoldOfRows(rows, K, fold_partition, seed)[q]; 0 = fold q % K.
-  int fold_partition = 0;
 };
-
-/// What ChoiceOptions::fresh_partition_sd appends to a GP's calibration text when it took output
-/// k's sd (stack weight `weight`) from the `folds`-fold refit residuals of fold `partition`.
-std::string FreshPartitionText(int k, int partition, int folds, double weight);
-
-/// Fold of each of `rows` rows among min(folds, rows) folds: partition 0 puts row q in fold
-/// q % folds; partition p >= 1 puts it in fold pos(q) % folds, pos(q) its position in a
-/// permutation of the rows drawn by Fisher-Yates from Rng(MixSeed(seed, p)) (core/random.h), so
-/// that the same seed gives the same partitions. Every partition holds each row out once, in
-/// folds of the sizes of partition 0. InputError if rows < 1, folds < 1 or partition < 0.
-std::vector<int> FoldOfRows(int rows, int folds, int partition, std::uint64_t seed);
 
 /// A fitted candidate: the network (Family::kNetwork, in the transformed space), one least-squares
 /// fit per output (Family::kLinear) or one GP per output (Family::kGaussianProcess), x and y in
@@ -191,13 +177,8 @@ struct ShrunkStack {
   double z = 0;             ///< the stack's lead over the first candidate, in standard errors
   double share = 0;         ///< a
 };
-/// partitions > 1 (ChoiceOptions::fold_partitions): predictions and target hold the n rows
-/// `partitions` times (block p: fold partition p's held-out predictions); the weights minimize
-/// the squared error over all blocks, the nested folds go by row (row q of every block in fold
-/// q % folds), and the comparison with the first candidate takes per row the mean over blocks
-/// of the squared-error differences. InputError also if the rows are not partitions blocks.
 ShrunkStack ShrunkStackWeights(const Eigen::MatrixXd& predictions, const Eigen::VectorXd& target,
-                               int folds, double start_se, double full_se, int partitions = 1);
+                               int folds, double start_se, double full_se);
 
 /// kappa > 0: the smallest factor at which kappa sd_i >= |r_i| for at least 68.27 % of the rows
 /// and 2 kappa sd_i >= |r_i| for at least 95.45 % (the rule of CoverageNoiseVariance with
@@ -249,21 +230,6 @@ int FittedHyperparameters(const Candidate& c, int inputs = ProcessInputs::kCount
 /// ln y_i = shift + s u_i; the last sum is the Jacobian of the log transform. InputError if `m`
 /// holds no GP for output k.
 double GpLogEvidence(const FamilyModel& m, int k);
-
-/// ln p(y) of output k's least-squares fit in the linear candidate `m` (fitted on `table`) as a
-/// Gaussian linear model of its output column at the maximum-likelihood noise RSS / n, written
-/// as a density of the output in its original units: -(n / 2) (ln(2 pi RSS / n) + 1) - [log
-/// output] sum_i ln y_i (the Jacobian of the log transform, as in GpLogEvidence), n the table's
-/// rows, RSS the residual sum of squares in the output column (ln y or y). InputError if `m`
-/// holds no linear fit for output k.
-double LinearLogEvidence(const FamilyModel& m, const ProcessTable& table, int k);
-
-/// ChoiceOptions::anchor_small: what the stack below few_rows rows is shrunk toward.
-enum class Anchor {
-  kFirst,       ///< the first candidate (the power law), the others past the held-out gate
-  kBic,         ///< the power law or the GP of highest BIC, whichever has the higher BIC
-  kBicWeights,  ///< their BIC-weighted average
-};
 
 /// ChoiceOptions::gp_slot_large: how the one GP slot of lowest_gp is given from few_rows rows.
 enum class GpSlot {
@@ -443,80 +409,14 @@ struct ChoiceOptions {
   /// GP takes the one slot per output (GpSlot; kHeldOut: the lowest held-out error, as below
   /// few_rows). kEvidence and kBic rank every GP candidate by GpLogEvidence (kBic: minus
   /// (q / 2) ln n) and keep the highest; it still has to pass the gate (stack_gate_se_large,
-  /// leave_first_se_large) to enter; it overrides lowest_gp_per_scale_large. Why: the GPs'
+  /// leave_first_se_large) to enter (if it does not and every candidate that did is a GP, the
+  /// first candidate takes part alone); it overrides lowest_gp_per_scale_large. Why: the GPs'
   /// closed-form leave-one-out is optimistic, most for the log-column GP, which took the slot on
   /// tables where a raw-column GP predicted better; the marginal likelihood does not use the
   /// leave-one-out. kBic met the rule on a tuning and a confirmation part; kEvidence, which
   /// does not count the power-law mean's five extra maximized coefficients, gave the slot to
   /// the log-column GP still more often and lost (docs/workpiece-model.md, "Twelfth attempt").
   GpSlot gp_slot_large = GpSlot::kBic;
-  /// Repeated K-fold below few_rows rows: the candidates judged by K-fold refits (GPs below
-  /// few_rows, networks) are refitted on this many fold partitions (FitOptions::fold_partition
-  /// 0 .. P-1; the linear fits' closed-form leave-one-out is the same in every one). Per row and
-  /// output the choice (gate, GP slot, hard choice, Choice::table) takes the mean over the
-  /// partitions of each candidate's squared held-out error, and the stacking weights minimize
-  /// the squared error summed over the partitions' held-out predictions (ShrunkStackWeights with
-  /// partitions); the sd keeps partition 0's residuals. 1: one partition. Why: the 20-row choice
-  /// errs both ways (GPs let in on power laws, the power law kept on non-linear tables), the
-  /// variance of one partition's held-out errors (docs/workpiece-model.md, "Thirteenth attempt:
-  /// diagnosis at 20 rows"). Opt-in: with 2 partitions it did not lower the 20-row test RMSE on
-  /// the fourteenth attempt's tuning part (lower on power laws, higher on Friedman #1 and
-  /// saturating tables) and doubles the 20-row fit time (docs/workpiece-model.md, "Fourteenth
-  /// attempt").
-  int fold_partitions = 1;
-  /// Selection-aware sd below few_rows rows (stack only): an output whose stack gives one GP
-  /// candidate judged by refits a weight of at least fresh_sd_weight gets that GP's noise level
-  /// (its calibration rule) and the output's Choice::sd_scale from the GP's held-out residuals
-  /// of fold partition fold_partitions, which the choice did not use (refits from the fixed
-  /// starting points). Why: a GP chosen alone at 20 rows is chosen where its refit errors
-  /// happened to be low, and its sd calibrated on those same residuals covered too few test rows
-  /// (test residuals 1.26 times its held-out RMSE; the same section). Opt-in: on the outputs it
-  /// acts on it brought the tuning part's coverage into the bands, and the rule, written for the
-  /// pooled cells (none outside the bands before), could not register it (docs/workpiece-model.md,
-  /// "Fourteenth attempt"); on fresh tables it left as many cells of 10 tables outside the bands
-  /// as the default, two brought inside and two pushed too wide ("Fifteenth attempt").
-  /// The GP's calibration text (FamilyModel::calibration, in the model file) then ends with
-  /// FreshPartitionText of each such output, and Choice::notes[k] names the GP and says it.
-  bool fresh_partition_sd = false;
-  double fresh_sd_weight = 0.8;
-  /// The stack's anchor below few_rows rows (per output; only where the first candidate is a
-  /// linear fit, GP candidates take part and fold_partitions is 1): kBic compares the BIC of the
-  /// power law (LinearLogEvidence - (q / 2) ln n, q = its coefficients + the noise) with the
-  /// highest BIC of the GPs (GpLogEvidence as gp_slot_large's kBic, every GP fitted on all rows
-  /// for it); the higher is the anchor and the other takes no part (so do the other GPs). The
-  /// remaining candidates (linear/identity, the network) enter if their held-out errors beat the
-  /// anchor's by stack_gate_se standard errors, and the stacking weights are shrunk toward the
-  /// anchor (stack_start_se, stack_full_se). kBicWeights: the anchor is the average of the power
-  /// law and that GP with the weights exp(BIC) / sum exp(BIC) (a weight below 0.001 is 0), its
-  /// stack weight split by them. kFirst: the stack of `stack` (the power law first, every
-  /// candidate gated by held-out errors). Why: the 20-row held-out errors (5-fold refits on 16
-  /// rows) let GPs in on power laws and kept the power law on bent tables, a variance
-  /// (docs/workpiece-model.md, "Thirteenth attempt: diagnosis at 20 rows"); the evidence does
-  /// not use them. Opt-in: both anchors raised the 20-row test RMSE on the sixteenth attempt's
-  /// tuning part, most on non-linear families, where the power law's log-normal density
-  /// outranked a raw-column GP whose mean predicted better ("Sixteenth attempt").
-  Anchor anchor_small = Anchor::kFirst;
-  /// With lowest_gp, below few_rows rows (GPs judged by K-fold refits): of the GP candidates on
-  /// the same column scale (Candidate::log; by default the two on raw columns, Matern 5/2 and
-  /// squared-exponential) only the one of highest BIC (GpLogEvidence - (q / 2) ln n, each fitted
-  /// on all rows for it, as gp_slot_large's kBic) takes part; a GP alone on its scale takes part
-  /// as now. The gate against the first candidate, the one GP slot (lowest held-out error, or one
-  /// per scale with lowest_gp_per_scale) and the weights then go by held-out errors as without
-  /// it. Why: the 20-row slot was the lowest of three noisy 5-fold refit errors, a minimum that
-  /// is optimistic (docs/workpiece-model.md, "Thirteenth attempt: diagnosis at 20 rows"); two GPs
-  /// of one column scale are densities of the same output with the same noise model, which BIC
-  /// may rank, unlike a log-normal and a Gaussian one ("Sixteenth attempt"). Opt-in: screened
-  /// on one range of the seventeenth attempt's tuning part only, where it raised the 20-row test
-  /// RMSE (ratio 1.003, additive 1.028; docs/workpiece-model.md, "Seventeenth attempt: split").
-  bool same_scale_gp_bic = false;
-  /// Below few_rows rows: every GP fit of the choice (refits and fits on all rows) maximizes its
-  /// likelihood times gp::GpOptions' noise prior, ln s_n^2 ~ N(-4, 1) in standardized target
-  /// units (noise_prior_sd 1 unless fit.gp sets one), so that 20 rows cannot make a GP take noise
-  /// for signal; from few_rows rows fit.gp as given. Opt-in: on the seventeenth attempt's tuning
-  /// part it lowered the 20-row test RMSE of the outputs whose stack weighs a GP (about 2 %) and
-  /// not which outputs a GP takes part in; pooled, ratio 0.996 with paired t -1.98, short of the
-  /// rule's -2.0 (docs/workpiece-model.md, "Seventeenth attempt: tuning part").
-  bool gp_noise_prior_small = false;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
   /// output k's choice is a GP fitted with fewer than kRowsPerHyperparameter rows per
@@ -561,8 +461,7 @@ struct Choice {
   /// candidate's sd (its own held-out residuals); 1 otherwise. Stored in the model file when a
   /// weight is or a factor is not 1.
   std::array<double, Features::kCount> sd_scale{1.0, 1.0};
-  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why, or the GP whose sd
-  /// ChoiceOptions::fresh_partition_sd took from another fold partition; empty if none.
+  /// Per output, the GP that ChoiceOptions::equivalence_sd set aside and why; empty if none.
   /// Printed by `whirl train` (and in its --json), not stored in the model file.
   std::array<std::string, Features::kCount> notes;
   /// What the choice did about the table that the user should know: inputs left out because they

@@ -274,11 +274,6 @@ void Optimize(const GpOptions& o, const std::vector<Eigen::VectorXd>& starts, Gp
       v += 0.5 * dev.square().sum();
       if (grad) grad->head(d).array() += dev / o.length_prior_sd;
     }
-    if (o.noise_prior_sd > 0 && std::isfinite(v)) {  // ln s_n^2 = 2 theta(d + 1)
-      const double dev = (2 * t(d + 1) - o.noise_prior_mean) / o.noise_prior_sd;
-      v += 0.5 * dev * dev;
-      if (grad) (*grad)(d + 1) += 2 * dev / o.noise_prior_sd;
-    }
     return v;
   };
   // Isotropic: (ln l, ln s_f, ln s_n) <-> theta with d equal length scales.
@@ -413,10 +408,6 @@ void GpOptions::Validate() const {
   if (!(length_prior_sd >= 0) || !std::isfinite(length_prior_sd))
     throw InputError("gaussian process length_prior_sd " + MessageNumber(length_prior_sd) +
                      ": must be finite and >= 0");
-  if (!(noise_prior_sd >= 0) || !std::isfinite(noise_prior_sd) || !std::isfinite(noise_prior_mean))
-    throw InputError("gaussian process noise_prior_sd " + MessageNumber(noise_prior_sd) +
-                     " and noise_prior_mean " + MessageNumber(noise_prior_mean) +
-                     ": the sd must be finite and >= 0, the mean finite");
   if (!(min_noise_variance > 0) || !std::isfinite(min_noise_variance))
     throw InputError("gaussian process min_noise_variance " + MessageNumber(min_noise_variance) +
                      ": must be a finite number > 0");

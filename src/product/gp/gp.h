@@ -88,15 +88,6 @@ struct GpOptions {
   /// part (scripts/bench_peers.sh --split tuning) it lowered the median test RMSE of the additive
   /// and Friedman tables by 5-15 % at 20 and 100 rows (docs/workpiece-model.md).
   double length_prior_sd = 1.7320508075688772;  // sqrt(3)
-  /// A log-normal prior on the noise variance in standardized target units (s_n^2, without
-  /// min_noise_variance), the one BoTorch pairs with the length-scale prior above (Hvarfner,
-  /// Hellsten & Nardi, ICML 2024; BoTorch's Gaussian likelihood with a log-normal prior):
-  ///   ln s_n^2 ~ N(noise_prior_mean, noise_prior_sd^2), (-4, 1): noise sd 0.14 of the target's.
-  /// noise_prior_sd = 0 (the default): no prior. It keeps a fit on few rows from explaining the
-  /// noise by short length scales and a noise level near zero (opt-in: family::ChoiceOptions::
-  /// gp_noise_prior_small, docs/workpiece-model.md, "Seventeenth attempt").
-  double noise_prior_sd = 0;
-  double noise_prior_mean = -4;
   /// Subset of data for large tables (R&W section 8.3.2): a GP on at most max_rows rows of the
   /// table, spread evenly by index (row floor(j n / m), j = 0..m-1), when it has more (0: every
   /// row); the standardization still uses every row, and Gp::rows names the rows kept. One
