@@ -513,6 +513,20 @@ int DriftParamCount(const drift::DriftModel& m, const drift::DriftModel* g,
   return MakeSlots(One(m, g, blank), 0).last + 1;
 }
 
+std::vector<DriftComponent> GreyMixComponents(const GreyBoxAction& grey,
+                                              const drift::DriftModel& rule_offset,
+                                              const drift::DriftModel& rule_slope,
+                                              double grey_weight) {
+  if (grey_weight == 1.0) return {{&grey.offset, &grey.slope, grey.Blank(), 1.0}};
+  if (!rule_offset.sensors.empty() || !rule_slope.sensors.empty())
+    throw InputError(
+        "mixed drift action: the rule's models read sensors (rises from power-on), the grey "
+        "box's absolute temperatures; the program runs one reference: mix the grey box only "
+        "with a sensor-free rule (warmup, schedule)");
+  return {{&grey.offset, &grey.slope, grey.Blank(), grey_weight},
+          {&rule_offset, &rule_slope, nullptr, 1.0 - grey_weight}};
+}
+
 GreyBoxAction GreyBoxActionModels(const drift::GreyBoxModel& model) {
   const drift::GreyBoxControl c = drift::GreyBoxControlModels(model);
   GreyBoxAction a;

@@ -225,6 +225,16 @@ struct DriftComponent {
   double weight = 1;
 };
 
+/// The fourteenth round's mix as the action's components (docs/machine-evaluation.md
+/// "Fourteenth round: adoption"; drift/grey_mix.h): the grey box (offset, slope and blank term)
+/// with `grey_weight` and a sensor-free rule's offset and slope models with 1 - w; the grey box
+/// alone for w = 1. The components point into `grey` and the rule's models. InputError for a rule
+/// that reads sensors (the program runs one reference, the grey box's: reference "model").
+std::vector<DriftComponent> GreyMixComponents(const GreyBoxAction& grey,
+                                              const drift::DriftModel& rule_offset,
+                                              const drift::DriftModel& rule_slope,
+                                              double grey_weight);
+
 /// How many $AC_PARAM slots the action uses for `model` (features, references, flag) and the
 /// optional slope model (its features, references, flag, and one slot for S_m).
 int DriftParamCount(const drift::DriftModel& model, const drift::DriftModel* slope = nullptr,

@@ -3,6 +3,7 @@
 // (drift/grey_box_io.h), written as a grey box model file for `whirl drift nc --grey-model`.
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "cli/commands.h"
@@ -11,6 +12,7 @@
 #include "core/numbers.h"
 #include "drift/grey_box.h"
 #include "drift/grey_box_io.h"
+#include "drift/grey_mix.h"
 #include "drift/measurement_file.h"
 
 namespace whirl::cli {
@@ -19,7 +21,7 @@ namespace {
 struct FitGreyOptions {
   std::string records, spec, out;
   std::string validation = "forward-leads";
-  bool json = false;
+  bool json = false, grey_alone = false;
 };
 
 std::string FitGreyCounts(const drift::ShopRecord& r) {
@@ -61,32 +63,82 @@ void PrintFitGrey(const drift::GreyBoxModel& m) {
                 m.blank_um_per_1000_per_k);
 }
 
+// The mix part (drift/grey_mix.h) for a record of fewer than 2 x forward_days lead days, unless
+// --grey-alone; the note line says w and why.
+std::optional<drift::GreyBoxMix> FitGreyMixPart(const FitGreyOptions& o,
+                                                const drift::MeasurementFile& records,
+                                                const drift::GreyBoxSpec& spec,
+                                                const drift::GreyBoxOptions& options,
+                                                std::string* note) {
+  const int days = static_cast<int>(drift::LeadDays(records.record).size());
+  const std::string held = std::to_string(days) + " lead days";
+  const std::string limit = std::to_string(2 * options.forward_days);
+  if (o.grey_alone) {
+    *note = "grey box alone (--grey-alone); the records hold " + held;
+    return std::nullopt;
+  }
+  if (drift::LongRecord(records.record, options)) {
+    *note = "grey box alone: the records hold " + held + " (>= " + limit + ")";
+    return std::nullopt;
+  }
+  drift::GreyMix mix;
+  try {
+    drift::RequireRuleColumns(records.record, records.log_paths);
+    mix = drift::FitGreyMix(records.record, spec, options);
+  } catch (const InputError& e) {
+    throw InputError("--records '" + o.records + "': " + e.what() +
+                     "; log them, or give --grey-alone for the grey box alone");
+  }
+  const drift::GuardScore& g = mix.guard;
+  const std::string why = "the records hold " + held + " (< " + limit +
+                          "); the guard's combination weight " +
+                          FormatFixed(g.combination_weight, 3) + " on the last " +
+                          std::to_string(g.days) + " lead days (grey box RMS " +
+                          FormatFixed(g.grey_rms_um, 2) + " um, " + mix.rules.BaseName() +
+                          " rule " + FormatFixed(g.rule_rms_um, 2) + " um) clamped to [" +
+                          FormatFixed(drift::kShortMixFloor, 1) + ", 1]";
+  std::optional<drift::GreyBoxMix> part = drift::GreyBoxMixPart(mix, records.record);
+  *note = part ? "mix: w = " + FormatFixed(mix.weight, 3) + " grey box + " +
+                     FormatFixed(1 - mix.weight, 3) + " " + mix.rules.BaseName() + " rule: " + why
+               : "grey box alone (w = 1): " + why;
+  return part;
+}
+
 void RunFitGrey(const FitGreyOptions& o) {
   CheckOutputs({{"--records", o.records}, {"--spec", o.spec}}, {{"--out", o.out}});
   const drift::GreyBoxSpec spec = drift::ReadGreyBoxSpec(o.spec);
   const drift::MeasurementFile records = drift::ReadMeasurementRecords(o.records);
   drift::GreyBoxOptions options;
   if (o.validation == "forward-leads") options.validation = drift::GreyValidation::kForwardLeads;
-  drift::GreyBoxModel m;
+  drift::GreyBoxFile file;
+  drift::GreyBoxModel& m = file.model;
   try {
     m = drift::FitGreyBox(records.record, spec, options);
   } catch (const InputError& e) {
     throw InputError("--records '" + o.records + "' with --spec '" + o.spec + "': " + e.what());
   }
+  std::string mix_note;
+  file.mix = FitGreyMixPart(o, records, spec, options, &mix_note);
   m.notes.push_back("whirl drift fit-grey --records " + o.records + " --spec " + o.spec +
-                    " --validation " + o.validation);
+                    " --validation " + o.validation + (o.grey_alone ? " --grey-alone" : ""));
   m.notes.push_back(FitGreyCounts(records.record));
   if (!records.description.empty()) m.notes.push_back("records: " + records.description);
-  drift::WriteGreyBoxModel(o.out, m);
+  m.notes.push_back(mix_note);
+  drift::WriteGreyBoxFile(o.out, file);
   if (o.json) {
+    nlohmann::json mix_json = nullptr;
+    if (file.mix) mix_json = {{"weight", file.mix->weight}, {"rule", file.mix->rule}};
     PrintJson({{"schema", "whirl.drift_fit_grey"},
                {"schema_version", 1},
                {"model_file", o.out},
-               {"model", nlohmann::json(m)}});
+               {"model", nlohmann::json(m)},
+               {"mix", mix_json},
+               {"mix_note", mix_note}});
     return;
   }
   std::printf("%s\n", FitGreyCounts(records.record).c_str());
   PrintFitGrey(m);
+  std::printf("%s\n", mix_note.c_str());
   std::printf("model written to %s\n", o.out.c_str());
 }
 
@@ -108,7 +160,13 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
       "records carry 0.9 of the total weight. The records (--records) are what a\n"
       "shop measures: warm-up probe tests, laser tests, the measured leads of past screws and\n"
       "the probe readings at set-ups, each on its day log (the control's sensor log, a drift\n"
-      "run file).");
+      "run file). Where the records hold fewer than 20 days with a lead, the file also carries\n"
+      "the mix the control then runs (docs/drift.md): w grey box + (1 - w) the better\n"
+      "sensor-free rule by its grouped CV (warmup: lags of power_on, the time since power-on\n"
+      "[min]; schedule: lags of ring_on, cutting, ring_load_pct [%], z_speed_mm_min [mm/min],\n"
+      "columns the day logs must hold), w the least-squares combination weight of the two\n"
+      "families' lead residuals on the last 2 lead days (each fitted on the days before it),\n"
+      "clamped to [0.5, 1]; --grey-alone writes the grey box alone.");
   sub->add_option("--records", o->records,
                   "measurement records JSON (format whirl-measurement-records: day_logs = run "
                   "files relative to it; records with kind probe|laser|lead|setup_check, day, "
@@ -132,6 +190,10 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
                   "leave-one-day-out while fewer than 20 days hold a lead) or leave-one-day-out "
                   "(the grouped CV RMSE over every record, one calendar day held out at a time)")
       ->check(CLI::IsMember({"forward-leads", "leave-one-day-out"}));
+  sub->add_flag("--grey-alone", o->grey_alone,
+                "write the grey box alone, also where the records hold fewer than 20 lead days "
+                "(2 x the forward-chaining days; default there: the mix w grey box + (1 - w) "
+                "sensor-free rule, see above)");
   sub->add_flag("--json", o->json, "machine output on stdout");
   sub->callback([o] { RunFitGrey(*o); });
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli/commands.h"
@@ -14,6 +15,7 @@
 #include "core/error.h"
 #include "core/output_dir.h"
 #include "drift/grey_box_io.h"
+#include "drift/grey_mix.h"
 #include "drift/model.h"
 #include "interp/drift_action.h"
 #include "interp/machine_profile.h"
@@ -44,13 +46,13 @@ std::pair<std::string, interp::AnalogInput> ParseInput(const std::string& text) 
 
 // An --input for a name the models do not read would be silently ignored: refused.
 void CheckKnownInput(const std::string& text, const std::string& name,
-                     const drift::DriftModel& model, const drift::DriftModel* slope) {
+                     const std::vector<const drift::DriftModel*>& models) {
   if (name == "elapsed")
     throw InputError("--input '" + text +
                      "': elapsed time is counted by the control itself from the program's "
                      "start (interp/drift_action.h); it reads no analog input");
   std::string known;
-  for (const drift::DriftModel* m : {&model, slope}) {
+  for (const drift::DriftModel* m : models) {
     if (!m) continue;
     for (const auto* list : {&m->sensors, &m->extra_inputs})
       for (const std::string& input : *list) {
@@ -68,7 +70,13 @@ struct DriftNcModels {
   drift::DriftModel model;
   std::optional<drift::DriftModel> slope;
   std::optional<interp::GreyBoxAction> grey;
+  std::optional<drift::GreyBoxMix> mix;  ///< fit-grey's mix part (drift/grey_box_io.h)
   const drift::DriftModel* Slope() const { return slope ? &*slope : nullptr; }
+  /// The mixed line's components (pointing into this object): the grey box with w and the rule
+  /// with 1 - w (the same as the lab report's, interp::GreyMixComponents).
+  std::vector<interp::DriftComponent> MixComponents() const {
+    return interp::GreyMixComponents(*grey, mix->rule_offset, mix->rule_slope, mix->weight);
+  }
   const interp::BlankTerm* Blank() const { return grey ? grey->Blank() : nullptr; }
 };
 
@@ -86,7 +94,9 @@ DriftNcModels ReadDriftNcModels(const DriftNcOptions& o) {
                        " with --grey-model: the grey box reads absolute temperatures referred to "
                        "20 degC (reference model)");
     try {
-      m.grey = interp::GreyBoxActionModels(drift::ReadGreyBoxModel(o.grey_model_path));
+      drift::GreyBoxFile file = drift::ReadGreyBoxFile(o.grey_model_path);
+      m.grey = interp::GreyBoxActionModels(file.model);
+      m.mix = std::move(file.mix);
     } catch (const InputError& e) {
       throw InputError("--grey-model '" + o.grey_model_path + "': " + e.what());
     }
@@ -116,7 +126,11 @@ void Run(const DriftNcOptions& o) {
   options.reference = interp::ParseDriftReference(o.reference);
   for (const std::string& text : o.inputs) {
     const auto [name, a] = ParseInput(text);
-    if (!(blank && name == blank->sensor)) CheckKnownInput(text, name, model, g);
+    if (!(blank && name == blank->sensor)) {
+      std::vector<const drift::DriftModel*> read = {&model, g};
+      if (models.mix) read.insert(read.end(), {&models.mix->rule_offset, &models.mix->rule_slope});
+      CheckKnownInput(text, name, read);
+    }
     options.inputs[name] = a;
     try {  // the profile's bounds and the control's analog input count (MD10300)
       options.Validate();
@@ -129,9 +143,12 @@ void Run(const DriftNcOptions& o) {
   if (!o.reset_path.empty())
     options.reset_program_name = interp::ProgramNameOf(o.reset_path, "--reset-nc");
   // Render everything first (a model the control cannot run fails here), then write all or none.
-  const std::string nc = interp::FormatDriftNcProgram(model, options, source, g, blank);
+  const std::string nc =
+      models.mix ? interp::FormatDriftNcProgram(models.MixComponents(), options, source)
+                 : interp::FormatDriftNcProgram(model, options, source, g, blank);
   const std::string reset = interp::FormatDriftNcResetProgram(options);
-  const std::string csv = interp::FormatDriftPlcCsv(model, options, g, blank);
+  const std::string csv = models.mix ? interp::FormatDriftPlcCsv(models.MixComponents(), options)
+                                     : interp::FormatDriftPlcCsv(model, options, g, blank);
   std::vector<std::pair<std::filesystem::path, std::string>> files;
   if (!o.nc_path.empty()) files.emplace_back(o.nc_path, nc);
   if (!o.reset_path.empty()) files.emplace_back(o.reset_path, reset);
@@ -154,8 +171,14 @@ void Run(const DriftNcOptions& o) {
                     {"coefficient_mm_per_mm_per_k", interp::DriftBlankCoefficient(*blank, options)},
                     {"estimate_param", options.blank_param},
                     {"latched_param", options.blank_param + 1}};
+    nlohmann::json mix_json = nullptr;
+    if (models.mix)
+      mix_json = {{"grey_weight", models.mix->weight},
+                  {"rule", models.mix->rule},
+                  {"rule_weight", 1 - models.mix->weight}};
     PrintJson({{"model", source},
                {"grey_box", !o.grey_model_path.empty()},
+               {"mix", mix_json},
                {"blank", blank_json},
                {"axis", options.axis},
                {"coefficients_mm", std::vector<double>(c.data(), c.data() + c.size())},
@@ -183,6 +206,11 @@ void Run(const DriftNcOptions& o) {
                                    {o.reset_path, "NC reset program"},
                                    {o.csv_path, "PLC table"}})
     if (!path.empty()) std::printf("written: %s (%s)\n", path.c_str(), what);
+  if (models.mix)
+    std::printf(
+        "  mixed line (the model file's mix part, whirl drift fit-grey): %.3f x the grey box + "
+        "%.3f x the %s rule (its K0 and slope; control signals as logged)\n",
+        models.mix->weight, 1 - models.mix->weight, models.mix->rule.c_str());
   if (blank)
     std::printf(
         "  blank term: lag %.1f min of %s in $AC_PARAM[%d], latched at the cut start in "
@@ -220,7 +248,10 @@ void RegisterDriftNc(CLI::App* drift_app) {
       "temperatures (T - 20 degC) and their lags, the slope intercept, and the blank term\n"
       "g_b (B - 20): B, a lag of the blank sensor, runs in $AC_PARAM[drift.blank_param] and\n"
       "the whirling plan latches it into [blank_param + 1] at the thread start (back to 20\n"
-      "at the thread end). Not verified on a control: main-run write access to SD43900-43920.");
+      "at the thread end). A grey box file with a mix part (fit-grey on fewer than 20 lead\n"
+      "days) gives the mixed line K_m = w K_grey + (1 - w) K_rule, S_m likewise, each\n"
+      "component with its own slots (the rule's control signals need analog inputs).\n"
+      "Not verified on a control: main-run write access to SD43900-43920.");
   sub->add_option("--model", o->model_path, "drift model JSON (whirl drift fit); or --grey-model")
       ->check(CLI::ExistingFile);
   sub->add_option("--grey-model", o->grey_model_path,

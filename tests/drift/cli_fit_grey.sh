@@ -50,21 +50,28 @@ awk 'function t(day, k, i) { hall = 17 + 2 * day + 2.5 * sin(k / 150 + day)
        }
        printf "\n]}\n" }' > "$D/records.json"
 
-"$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey.json" \
+# 3 lead days (< 20): the mix with a sensor-free rule needs the control's signals, which these
+# logs lack: refused, naming the log and the column; --grey-alone writes the grey box alone.
+expect_fail "day log 'logs/day0.csv' has no column 'power_on'" "$W" drift fit-grey \
+  --records "$D/records.json" --spec "$SPEC" --out "$D/none.json"
+grep -q -- "--grey-alone" "$D/err.txt" || fail "the refusal does not name --grey-alone"
+"$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey.json" --grey-alone \
   > "$D/fit.txt" 2> "$D/fit.err" || fail "drift fit-grey: $(cat "$D/fit.err")"
+grep -q "grey box alone (--grey-alone)" "$D/fit.txt" || fail "no note on --grey-alone: $(cat "$D/fit.txt")"
+grep -q '"schema_version": 1' "$D/grey.json" || fail "a grey box alone is not schema_version 1"
 [ -s "$D/grey.json" ] || fail "grey box model not written"
 grep -q '"format": "whirl-grey-box-model"' "$D/grey.json" || fail "grey box model format"
 grep -q "1 probe\|3 probe" "$D/fit.txt" || fail "fit-grey does not count the records: $(cat "$D/fit.txt")"
-"$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey2.json" --json \
+"$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey2.json" --json --grey-alone \
   > "$D/fit.json" || fail "drift fit-grey --json"
 grep -q '"schema": "whirl.drift_fit_grey"' "$D/fit.json" || fail "fit-grey --json schema"
 grep -q 'validation RMSE' "$D/fit.txt" || fail "fit-grey does not say how it chose: $(cat "$D/fit.txt")"
 grep -q -- '--validation forward-leads' "$D/grey.json" || fail "the model's notes lack the validation"
 "$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" --out "$D/grey_lodo.json" \
-  --validation leave-one-day-out > "$D/fit_lodo.txt" || fail "drift fit-grey --validation leave-one-day-out"
+  --grey-alone --validation leave-one-day-out > "$D/fit_lodo.txt" || fail "drift fit-grey --validation leave-one-day-out"
 grep -q -- '--validation leave-one-day-out' "$D/grey_lodo.json" || fail "leave-one-day-out not noted"
 expect_fail "validation" "$W" drift fit-grey --records "$D/records.json" --spec "$SPEC" \
-  --out "$D/none.json" --validation forward
+  --out "$D/none.json" --validation forward --grey-alone
 # The planted blank coefficient comes back near -11.8 (the prior is -11.8 too: check the sign
 # and size only) and the intercept near 3.
 awk '/"um_per_1000_per_k"/ { gsub(/[^-0-9.e]/, "", $2); v = $2 + 0; ok = (v < -5 && v > -20) }
@@ -103,12 +110,48 @@ expect_fail "ambient_C" "$W" drift nc --grey-model "$D/grey.json" --machine "$D/
 expect_fail "not a grey box model" "$W" drift nc --grey-model "$SPEC" --machine "$PROFILE"
 sed 's/"z_nut_C": 5.75/"z_screw_C": 5.75/' "$SPEC" > "$D/bad_spec.json"
 expect_fail "names 'z_screw_C'" "$W" drift fit-grey --records "$D/records.json" \
-  --spec "$D/bad_spec.json" --out "$D/none.json"
+  --spec "$D/bad_spec.json" --out "$D/none.json" --grey-alone
 sed 's/"time_min": \[0,/"time_min": [-5,/' "$D/records.json" > "$D/bad_records.json"
 expect_fail "reading 0: time_min -5 lies outside" "$W" drift fit-grey \
-  --records "$D/bad_records.json" --spec "$SPEC" --out "$D/none.json"
+  --records "$D/bad_records.json" --spec "$SPEC" --out "$D/none.json" --grey-alone
 sed 's/"ambient_C"/"hall_C"/g' "$SPEC" > "$D/hall_spec.json"
 expect_fail "hall_C" "$W" drift fit-grey --records "$D/records.json" --spec "$D/hall_spec.json" \
-  --out "$D/none.json"
+  --out "$D/none.json" --grey-alone
 [ -e "$D/none.json" ] && fail "a failed drift fit-grey wrote a file"
+# The mix: the same logs with the control's signals (power_on 0 at the first row, then 1; the
+# ring and the cut during the leads) and leads that also carry a drift with the time since
+# power-on the sensors do not see (9 um per 1000 mm times 1 - exp(-t / 100 min), a lag the rule
+# has): fit-grey writes the mix part (schema_version 2) and says w; drift nc runs the mixed line.
+mkdir -p "$D/mix/logs"
+for day in 0 1 2; do
+  awk -F, -v OFS=, 'NR == 1 { print; next }
+    NR == 2 { print $0 ",power_on,ring_on,cutting,ring_load_pct,z_speed_mm_min"; next }
+    { k = $1; cut = (k >= 150 && k <= 270) || (k >= 300 && k <= 420)
+      print $0 "," (k > 0) "," (k >= 140 && k <= 430) "," cut "," 40 * cut "," 30 * cut }' \
+    "$D/logs/day$day.csv" > "$D/mix/logs/day$day.csv"
+done
+awk '/"kind": "lead"/ { match($0, /"time_min": \[[^]]*\]/); split(substr($0, RSTART + 13, RLENGTH - 14), tm, ",")
+       match($0, /"z_mm": \[[^]]*\]/); split(substr($0, RSTART + 9, RLENGTH - 10), zz, ",")
+       match($0, /"value_um": \[[^]]*\]/); n = split(substr($0, RSTART + 13, RLENGTH - 14), v, ",")
+       s = ""; for (i = 1; i <= n; i++) s = s (i > 1 ? "," : "") (v[i] + 9 * (1 - exp(-tm[i] / 100)) * (6400 - zz[i]) / 1000)
+       sub(/"value_um": \[[^]]*\]/, "\"value_um\": [" s "]") }
+     { print }' "$D/records.json" > "$D/mix/records.json"
+"$W" drift fit-grey --records "$D/mix/records.json" --spec "$SPEC" --out "$D/mix/grey.json" \
+  > "$D/mix/fit.txt" 2> "$D/mix/fit.err" || fail "drift fit-grey (mix): $(cat "$D/mix/fit.err")"
+grep -q "^mix: w = 0\.[5-9][0-9]* grey box + 0\.[0-9]* \(warmup\|schedule\) rule: the records hold 3 lead days (< 20)" \
+  "$D/mix/fit.txt" || fail "no mix note: $(cat "$D/mix/fit.txt")"
+grep -q '"schema_version": 2' "$D/mix/grey.json" || fail "the mix file is not schema_version 2"
+"$W" drift nc --grey-model "$D/mix/grey.json" --machine "$PROFILE" --nc "$D/mix/MIX_COMP.SPF" \
+  --reset-nc "$D/mix/MIX_RESET.SPF" --csv "$D/mix/mix_plc.csv" > "$D/mix/nc.txt" \
+  || fail "drift nc --grey-model (mix)"
+grep -q "mixed line" "$D/mix/nc.txt" || fail "drift nc does not say it runs the mix: $(cat "$D/mix/nc.txt")"
+grep -q '^component,weight,' "$D/mix/mix_plc.csv" || fail "the PLC table has no component column"
+grep -q '\$A_INA\[14\]' "$D/mix/MIX_COMP.SPF" || fail "the mixed program does not read power_on's input"
+expect_jumps_to_end "$D/mix/MIX_COMP.SPF"
+"$W" drift nc --grey-model "$D/mix/grey.json" --machine "$PROFILE" --json > "$D/mix/nc.json" \
+  || fail "drift nc --grey-model --json (mix)"
+grep -q '"rule_weight"' "$D/mix/nc.json" || fail "drift nc --json lacks the mix"
+"$W" drift fit-grey --records "$D/mix/records.json" --spec "$SPEC" --out "$D/mix/alone.json" \
+  --grey-alone > /dev/null || fail "drift fit-grey --grey-alone (mix records)"
+grep -q '"schema_version": 1' "$D/mix/alone.json" || fail "--grey-alone wrote a mix"
 echo "cli_fit_grey: ok"

@@ -5,10 +5,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <optional>
 
 #include "core/error.h"
 #include "core/random.h"
+#include "core/json_file.h"
 #include "drift/grey_box_io.h"
+#include "drift/grey_mix.h"
+#include "support/expect_error.h"
+#include "support/scratch_dir.h"
 #include "machine_eval/machine_eval.h"
 #include "machine_eval/shop_models.h"
 #include "machine_eval/strategies.h"
@@ -637,6 +643,115 @@ TEST(GreyGuard, ScoresTheGreyBoxItApplies) {
       EXPECT_EQ(m.mix.fitted_weight, 1.0);
     }
   }
+}
+
+// A record whose leads follow both families: MotorRecord's sensor law (no motor term) plus `share` of
+// ClockRecord's time since power-on (8 um and 6 um per 1000 mm times 1 - exp(-t / 60 min)).
+drift::ShopRecord BlendRecord(int days, double share) {
+  drift::ShopRecord rec = MotorRecord(0, days, 0);
+  for (drift::MeasurementRecord& r : rec.records)
+    for (drift::Measurement& m : r.rows) {
+      const double rise = 1 - std::exp(-m.time_min / 60);
+      m.value_um += share * (8 * rise + 6 * rise * (6400 - m.z_mm) / 1000);
+    }
+  return rec;
+}
+
+// The shop's path (drift/grey_mix.h FitGreyMix, what whirl drift fit-grey runs) gives the lab's
+// grey_short_mix on the same record: the same base rule and the same w where the sensors carry
+// the leads (w near 1), where the clock does (w at the floor) and where both do (blends; at least
+// one w strictly between the floor and 1, so the clamp hides no difference). From 20 lead days on
+// neither mixes.
+TEST(GreyMix, TheShopsMixIsTheLabsOnTheSameRecord) {
+  std::vector<double> weights;
+  std::vector<drift::ShopRecord> records = {MotorRecord(0, 8, 0), ClockRecord(0, 8)};
+  for (double share : {0.5, 0.2, 0.1, 0.05}) records.push_back(BlendRecord(8, share));
+  for (const drift::ShopRecord& rec : records) {
+    const ShopModels lab = FitShopModels(rec, 6400, {"power_on"}, false, false, false, true);
+    const drift::GreyMix shop =
+        drift::FitGreyMix(rec, FieldGreyBoxSpec(6400), FieldGreyBoxOptions(), {"power_on"});
+    ASSERT_TRUE(shop.applies);
+    ASSERT_TRUE(lab.mix.applied);
+    EXPECT_EQ(shop.weight, lab.mix.fitted_weight);
+    EXPECT_EQ(shop.rules.is_schedule, lab.rule_is_schedule);
+    EXPECT_EQ(shop.rules.Base().cv_rmse_um,
+              (lab.rule_is_schedule ? lab.schedule : lab.warmup).cv_rmse_um);
+    EXPECT_EQ(shop.guard.days, 2);
+    weights.push_back(shop.weight);
+  }
+  EXPECT_GT(weights[0], 0.9);
+  EXPECT_EQ(weights[1], kShortMixFloor);
+  EXPECT_TRUE(std::any_of(weights.begin() + 2, weights.end(),
+                          [](double w) { return w > kShortMixFloor && w < 1.0; }))
+      << "no blend gave a weight strictly inside (0.5, 1): " << ::testing::PrintToString(weights);
+  const drift::GreyMix long_record =
+      drift::FitGreyMix(MotorRecord(0, 20), FieldGreyBoxSpec(6400), FieldGreyBoxOptions());
+  EXPECT_FALSE(long_record.applies);
+  EXPECT_EQ(long_record.weight, 1.0);
+}
+
+// The model file's mix part (drift/grey_box_io.h): written as schema_version 2, read back to the
+// number; the rule's models are the lab's (ShopControlModels over the record's day logs). A
+// version 1 file with a mix, a version 2 file without one, a weight outside [0.5, 1), another
+// rule or a rule reading sensors are refused with the field's name.
+TEST(GreyMix, TheModelFilesMixPartRoundTripsAndBadPartsAreRefused) {
+  const drift::ShopRecord rec = ClockRecord(0, 8);
+  const drift::GreyBoxOptions options = FieldGreyBoxOptions();
+  const drift::GreyMix mix = drift::FitGreyMix(rec, FieldGreyBoxSpec(6400), options, {"power_on"});
+  drift::GreyBoxFile file{drift::FitGreyBox(rec, FieldGreyBoxSpec(6400), options),
+                          drift::GreyBoxMixPart(mix, rec)};
+  ASSERT_TRUE(file.mix);
+  EXPECT_EQ(file.mix->weight, kShortMixFloor);
+  const ShopControl lab = ShopControlModels(mix.rules.Base(), rec.day_logs);
+  EXPECT_EQ(file.mix->rule_offset.linear.coefficients, lab.offset.linear.coefficients);
+  EXPECT_EQ(file.mix->rule_slope.linear.coefficients, lab.slope.linear.coefficients);
+  EXPECT_EQ(file.mix->rule_offset.feature_max, lab.offset.feature_max);
+  const auto dir = test::ScratchDir() / "grey_mix_file";
+  std::filesystem::create_directories(dir);
+  drift::WriteGreyBoxFile(dir / "mix.json", file);
+  const drift::GreyBoxFile back = drift::ReadGreyBoxFile(dir / "mix.json");
+  ASSERT_TRUE(back.mix);
+  EXPECT_EQ(back.mix->weight, file.mix->weight);
+  EXPECT_EQ(back.mix->rule, mix.rules.BaseName());
+  EXPECT_EQ(back.mix->guard.combination_weight, mix.guard.combination_weight);
+  EXPECT_EQ(nlohmann::json(back.mix->rule_offset), nlohmann::json(file.mix->rule_offset));
+  EXPECT_EQ(nlohmann::json(back.mix->rule_slope), nlohmann::json(file.mix->rule_slope));
+  EXPECT_EQ(nlohmann::json(back.model), nlohmann::json(file.model));
+  const nlohmann::json j = ReadJsonFile(dir / "mix.json");
+  EXPECT_EQ(j["schema_version"], 2);
+  // Without the mix: version 1, the file as before.
+  drift::WriteGreyBoxFile(dir / "alone.json", {file.model, std::nullopt});
+  EXPECT_EQ(ReadJsonFile(dir / "alone.json")["schema_version"], 1);
+  EXPECT_FALSE(drift::ReadGreyBoxFile(dir / "alone.json").mix);
+  const auto refused = [&](nlohmann::json bad, const std::string& what) {
+    const auto path = dir / "bad.json";
+    WriteJsonFile(path, bad);
+    const std::string error = ErrorOf([&] { (void)drift::ReadGreyBoxFile(path); });
+    EXPECT_NE(error.find(what), std::string::npos) << error;
+    EXPECT_NE(error.find("bad.json"), std::string::npos) << error;
+  };
+  nlohmann::json v1 = j;
+  v1["schema_version"] = 1;
+  refused(v1, "schema_version");
+  nlohmann::json no_mix = j;
+  no_mix.erase("mix");
+  refused(no_mix, "schema_version");
+  for (double w : {1.0, 0.4}) {
+    nlohmann::json bad = j;
+    bad["mix"]["weight"] = w;
+    refused(bad, "'weight'");
+  }
+  nlohmann::json rule = j;
+  rule["mix"]["rule"] = "sensors";
+  refused(rule, "warmup or schedule");
+  nlohmann::json sensors = j;
+  const drift::ShopRecord motor = MotorRecord(0, 8, 0);  // the sensors carry it: a sensor model
+  drift::DriftModel sensor_model =
+      ShopControlModels(FitShopModels(motor, 6400, {"power_on"}).sensors, motor.day_logs).offset;
+  ASSERT_FALSE(sensor_model.sensors.empty());
+  sensor_model.linear.vif = Eigen::VectorXd::Ones(sensor_model.linear.coefficients.size() - 1);
+  sensors["mix"]["rule_offset"] = nlohmann::json(sensor_model);
+  refused(sensors, "sensor-free");
 }
 
 }  // namespace

@@ -19,12 +19,14 @@
 #include "core/error.h"
 #include "core/process.h"
 #include "drift/grey_box.h"
+#include "drift/grey_box_io.h"
 #include "drift/joint.h"
 #include "interp/nc_replay.h"
 #include "machine/scenarios.h"
 #include "machine_eval/field_eval.h"
 #include "machine_eval/strategies.h"
 #include "machine_report/machine_nc.h"
+#include "support/scratch_dir.h"
 #include "workpiece/model.h"
 
 namespace whirl::machine_report {
@@ -332,6 +334,44 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheMixedLineOfTheGreyBoxAndTheRule) 
   EXPECT_LT(worst_um, 1e-4);
   EXPECT_GT(rule_part_um, 0.1) << "the rule's 1 - w share must move the line";
   day.EndAndReset();
+}
+
+// The shop's path gives the lab report's program: the grey box and the rule written to a model
+// file's mix part (drift/grey_box_io.h, what whirl drift fit-grey writes), read back and run as
+// whirl drift nc runs it (interp::GreyMixComponents with the profile's drift options, reference
+// model) give the drift program and the PLC table of BuildCombinedMixPrograms, byte for byte.
+TEST(CombinedPrograms, TheShopsMixFileGivesTheLabReportsMixProgram) {
+  const machine_eval::ReportScrew& r = ShortCut();
+  const double w = 0.7;
+  const interp::MachineProfile profile =
+      CombinedProfile(-1, interp::ControlDk::kAdded, r.z_ref_mm);
+  const CombinedPrograms lab = BuildCombinedMixPrograms(
+      r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options, r.grey,
+      r.mix_rule_offset, r.mix_rule_slope, w, profile, "test curve", "test mix");
+  drift::GreyBoxMix part;
+  part.weight = w;
+  part.rule = r.mix_rule_name;
+  part.rule_offset = r.mix_rule_offset;
+  part.rule_slope = r.mix_rule_slope;
+  const auto path = test::ScratchDir() / "shop_mix.json";
+  drift::WriteGreyBoxFile(path, {r.grey, part});
+  const drift::GreyBoxFile file = drift::ReadGreyBoxFile(path);
+  ASSERT_TRUE(file.mix);
+  const interp::GreyBoxAction grey = interp::GreyBoxActionModels(file.model);
+  const std::vector<interp::DriftComponent> parts = interp::GreyMixComponents(
+      grey, file.mix->rule_offset, file.mix->rule_slope, file.mix->weight);
+  ASSERT_EQ(parts.size(), 2u);
+  interp::DriftActionOptions options = profile.DriftOptions();
+  options.reference = interp::DriftReference::kModel;
+  EXPECT_EQ(interp::FormatDriftNcProgram(parts, options, "test mix"), lab.drift_nc);
+  EXPECT_EQ(interp::FormatDriftPlcCsv(parts, options), lab.drift_plc_csv);
+  EXPECT_EQ(interp::FormatDriftNcResetProgram(options), lab.drift_reset_nc);
+  // The rule's 1 - w share shows in the program (a file that lost it would differ).
+  EXPECT_NE(lab.drift_nc, BuildCombinedGreyPrograms(r.predicted_curve, r.kinematics,
+                                                    r.result.screw.thread_length_mm,
+                                                    r.plan_options, r.grey, profile,
+                                                    "test curve", "test mix")
+                              .drift_nc);
 }
 
 // w = 1 (a long record, or the guard's weight clamped to 1): the grey box's programs, byte for

@@ -7,122 +7,23 @@
 #include <utility>
 
 #include "core/error.h"
-#include "drift/monitor.h"
 #include "machine_eval/machine_eval.h"
 
 namespace whirl::machine_eval {
 
-std::vector<std::string> ScheduleInputs() {
-  return {"ring_on", "cutting", "ring_load_pct", "z_speed_mm_min"};
-}
-
-namespace {
-
-// A sensor-free rule's spec: control signals as logged, at least one lag (RuleOptions).
-drift::JointSpec RuleSpec(double z_ref_mm, std::vector<std::string> inputs) {
-  drift::JointSpec s;
-  s.z_ref_mm = z_ref_mm;
-  s.other_inputs = std::move(inputs);
-  return s;
-}
-
-drift::JointFitOptions RuleOptions() {
-  drift::JointFitOptions o;
-  o.require_lag = true;
-  return o;
-}
-
-// The records of the days before `day` (every day log kept: records index them).
-drift::ShopRecord Before(const drift::ShopRecord& record, int day) {
-  drift::ShopRecord r;
-  r.day_logs = record.day_logs;
-  for (const drift::MeasurementRecord& m : record.records)
-    if (m.day < day) r.records.push_back(m);
-  return r;
-}
-
-// A lead record's residuals about their weighted mean (w = 1 / sigma^2: a lead is known up to a
-// constant), each scaled by 1 / sigma (so a sum of squares is the weighted one), and the sum of w.
-std::pair<std::vector<double>, double> Demeaned(const drift::MeasurementRecord& r,
-                                                const std::vector<double>& predicted) {
-  double sw = 0, swe = 0;
-  for (std::size_t i = 0; i < r.rows.size(); ++i) {
-    const double w = 1 / (r.rows[i].sigma_um * r.rows[i].sigma_um);
-    sw += w, swe += w * (r.rows[i].value_um - predicted[i]);
-  }
-  std::vector<double> e(r.rows.size());
-  for (std::size_t i = 0; i < r.rows.size(); ++i)
-    e[i] = (r.rows[i].value_um - predicted[i] - swe / sw) / r.rows[i].sigma_um;
-  return {std::move(e), sw};
-}
-
-// The pooled sums the guard and the combination weight need, over the scored lead records.
-struct PooledResiduals {
-  double grey_ss = 0, rule_ss = 0, sw = 0;
-  double cross = 0, spread = 0;  ///< sum e_r (e_r - e_g), sum (e_r - e_g)^2
-  void Add(const std::vector<double>& grey, const std::vector<double>& rule) {
-    for (std::size_t i = 0; i < grey.size(); ++i) {
-      const double d = rule[i] - grey[i];
-      grey_ss += grey[i] * grey[i], rule_ss += rule[i] * rule[i];
-      cross += rule[i] * d, spread += d * d;
-    }
-  }
-};
-
-}  // namespace
-
-GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpec& grey,
-                        const drift::GreyBoxOptions& grey_options, const drift::JointSpec& rule,
-                        const drift::JointFitOptions& rule_options, int held_days) {
-  const std::vector<int> lead_days = drift::LeadDays(record);
-  if (held_days < 1)
-    throw InputError("grey guard: held_days = " + std::to_string(held_days) + ": must be >= 1");
-  const std::size_t held = static_cast<std::size_t>(held_days);
-  const std::size_t first = lead_days.size() > held ? lead_days.size() - held : 0;
-  PooledResiduals p;
-  GuardScore g;
-  for (std::size_t k = first; k < lead_days.size(); ++k) {
-    const drift::ShopRecord past = Before(record, lead_days[k]);
-    if (past.records.empty()) continue;
-    drift::GreyBoxModel gm;
-    drift::JointDriftModel rm;
-    try {
-      gm = drift::FitGreyBox(past, grey, grey_options);
-      rm = drift::FitJoint(past, rule, rule_options).model;
-    } catch (const InputError&) {
-      continue;  // too few readings before this day: not scored
-    }
-    for (const drift::MeasurementRecord& r : record.records) {
-      if (r.kind != drift::MeasurementRecord::Kind::kLead || r.day != lead_days[k]) continue;
-      const auto [grey_e, w] = Demeaned(r, drift::PredictGreyRecord(gm, record, r));
-      p.Add(grey_e, Demeaned(r, drift::PredictRecord(rm, record, r)).first);
-      p.sw += w;
-    }
-    ++g.days;
-  }
-  if (g.days == 0 || p.sw <= 0) return g;
-  g.grey_rms_um = std::sqrt(p.grey_ss / p.sw);
-  g.rule_rms_um = std::sqrt(p.rule_ss / p.sw);
-  g.keep_grey = g.grey_rms_um <= g.rule_rms_um;
-  if (p.spread > 0) g.combination_weight = p.cross / p.spread;
-  return g;
-}
-
 ShopModels::Mix ShortMixWeights(bool long_record, const GuardScore& guard) {
   if (long_record) return {};
-  return {std::clamp(guard.combination_weight, kShortMixFloor, 1.0), kShortMixFixedWeight};
+  return {drift::ShortMixWeight(false, guard), kShortMixFixedWeight};
 }
 
 ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          const std::vector<std::string>& schedule_inputs, bool grey_slope_lags_only,
                          bool grey_candidates, bool grey_five_sensors, bool grey_short_mix) {
   ShopModels m;
-  const drift::JointFitOptions lagged = RuleOptions();
-  const drift::JointSpec warmup = RuleSpec(z_fixed_mm, {"power_on"}),
-                         schedule = RuleSpec(z_fixed_mm, schedule_inputs);
-  m.warmup = drift::FitJoint(record, warmup, lagged).model;
-  m.schedule = drift::FitJoint(record, schedule, lagged).model;
-  const bool schedule_base = m.schedule.cv_rmse_um <= m.warmup.cv_rmse_um;
+  const drift::BaseRules rules = drift::FitBaseRules(record, z_fixed_mm, schedule_inputs);
+  m.warmup = rules.warmup;
+  m.schedule = rules.schedule;
+  const bool schedule_base = rules.is_schedule;
   m.rule_is_schedule = schedule_base;
   const drift::JointDriftModel& base = schedule_base ? m.schedule : m.warmup;
   std::vector<std::string> pool;
@@ -174,8 +75,12 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   if (!grey_candidates && !grey_short_mix) return m;
   // The guard scores the model it would apply: both_grey's (its sensors, its options); its
   // combination weight is the fourteenth round's mix.
-  const GuardScore g =
-      GuardGreyBox(record, applied, grey_options, schedule_base ? schedule : warmup, lagged);
+  const GuardScore g = drift::GuardGreyBox(
+      record, applied, grey_options,
+      drift::SensorFreeRuleSpec(z_fixed_mm, schedule_base ? schedule_inputs
+                                                          : std::vector<std::string>{
+                                                                drift::kWarmupInput}),
+      drift::SensorFreeRuleOptions());
   m.guard = {grey_candidates, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
   m.mix = ShortMixWeights(long_record, g);
   m.mix.computed = true;
@@ -244,28 +149,6 @@ drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact, bool slope_lags_on
   o.instant_slope_inputs = !slope_lags_only;
   if (blank_contact) o.blank_tau_grid = {kBlankContactTauMin};  // a held reading: no lag
   return o;
-}
-
-ShopControl ShopControlModels(const drift::JointDriftModel& model,
-                              const std::vector<drift::Run>& training_logs) {
-  ShopControl c;
-  std::tie(c.offset, c.slope) = drift::ToDriftModels(model);
-  const Eigen::Index p = model.features();
-  if (p == 0) return c;
-  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, 1e300), hi = -lo;
-  for (const drift::Run& log : training_logs) {
-    if (log.samples() == 0) continue;
-    const Eigen::MatrixXd x = drift::MonitorDesign(c.offset, log, drift::ReferenceMode::kRunStart);
-    lo = lo.cwiseMin(x.rightCols(p).colwise().minCoeff().transpose());
-    hi = hi.cwiseMax(x.rightCols(p).colwise().maxCoeff().transpose());
-  }
-  if (!(lo.array() <= hi.array()).all()) return c;
-  for (drift::DriftModel* m : {&c.offset, &c.slope}) {
-    m->feature_min = lo;
-    m->feature_max = hi;
-  }
-  c.ranged = true;
-  return c;
 }
 
 }  // namespace whirl::machine_eval

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "drift/grey_box.h"
+#include "drift/grey_mix.h"
 #include "drift/joint.h"
 #include "drift/measurements.h"
 #include "drift/model.h"
@@ -29,8 +30,8 @@
 
 namespace whirl::machine_eval {
 
-/// The control signals of the schedule rule: ring_on, cutting, ring_load_pct, z_speed_mm_min.
-std::vector<std::string> ScheduleInputs();
+/// The control signals of the schedule rule (drift/grey_mix.h, the product's: one list).
+using drift::ScheduleInputs;
 
 struct ShopModels {
   drift::JointDriftModel sensors, warmup, schedule;
@@ -119,33 +120,17 @@ drift::GreyBoxOptions ShortRecordStrongPrior(drift::GreyBoxOptions options);
 /// days lags of the slow bed bend K0 along a cut); unchanged from 2 x forward_days lead days on.
 drift::GreyBoxOptions ShortRecordOffsetLags(drift::GreyBoxOptions options, int lags);
 
-/// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split"): the
-/// grey box or a sensor-free rule, chosen on the shop's own record in time order. For each of
-/// the last `held_days` calendar days that hold a lead record, both are fitted on the records of
-/// the days before it only and that day's leads predicted; the score is the weighted
-/// (1 / sigma^2) RMS of the lead residuals, each lead record's about its own weighted mean (a
-/// lead is known up to a constant), pooled over the days. keep_grey: the grey box's score is at
-/// most the rule's, or no day could be scored (a fit failed or no earlier day): the grey box
-/// stays. Only the record's past enters; the caller applies the family fitted on all of it.
-/// combination_weight: the least-squares weight w of the grey box in w grey + (1 - w) rule on
-/// the same pooled demeaned residuals, sum s e_r (e_r - e_g) / sum s (e_r - e_g)^2 (Bates and
-/// Granger 1969, "The combination of forecasts"), unclamped; 1 when no day was scored or the two
-/// families' residuals are equal.
-struct GuardScore {
-  bool keep_grey = true;
-  double grey_rms_um = 0, rule_rms_um = 0;  ///< 0 when no day was scored
-  int days = 0;                             ///< days scored
-  double combination_weight = 1;
-};
-GuardScore GuardGreyBox(const drift::ShopRecord& record, const drift::GreyBoxSpec& grey,
-                        const drift::GreyBoxOptions& grey_options, const drift::JointSpec& rule,
-                        const drift::JointFitOptions& rule_options, int held_days = 2);
+/// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split") and
+/// its combination weight: the product's (drift/grey_mix.h), which whirl drift fit-grey runs too.
+using drift::GuardGreyBox;
+using drift::GuardScore;
 /// The fourteenth round's rows (docs/machine-evaluation.md "Fourteenth round: split"): the grey
 /// box's share w of the machine line w grey + (1 - w) base rule while the record holds fewer than
-/// 2 x forward_days lead days (drift::ScoresForward false), 1 from then on. grey_short_mix: the
-/// guard's combination weight clamped to [kShortMixFloor, 1] (the grey box is never dropped, so
-/// a wrong judge costs at most half the gap); grey_short_mix_fixed: kShortMixFixedWeight.
-inline constexpr double kShortMixFloor = 0.5, kShortMixFixedWeight = 0.75;
+/// 2 x forward_days lead days (drift::ScoresForward false), 1 from then on. grey_short_mix:
+/// drift::ShortMixWeight, the guard's combination weight clamped to [kShortMixFloor, 1] (the
+/// product's, the field default); grey_short_mix_fixed: kShortMixFixedWeight.
+using drift::kShortMixFloor;
+inline constexpr double kShortMixFixedWeight = 0.75;
 ShopModels::Mix ShortMixWeights(bool long_record, const GuardScore& guard);
 /// `z_fixed_mm`: the slope's reference (the Z screw's fixed bearing); `grey_slope_lags_only`:
 /// FieldGreyBoxOptions' `slope_lags_only` for the grey box; `grey_candidates`: also fit
@@ -159,16 +144,9 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
                          bool grey_slope_lags_only = false, bool grey_candidates = false,
                          bool grey_five_sensors = false, bool grey_short_mix = false);
 
-/// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
-/// (drift/joint.h ToDriftModels), with the features' range over the day logs it was trained on
-/// (drift::MonitorDesign with rises from each log's first row): the range the drift action's
-/// slope bound and the monitor's scaling read. `ranged` false: no feature or no log sample, the
-/// ranges stay as ToDriftModels leaves them (unbounded).
-struct ShopControl {
-  drift::DriftModel offset, slope;
-  bool ranged = false;
-};
-ShopControl ShopControlModels(const drift::JointDriftModel& model,
-                              const std::vector<drift::Run>& training_logs);
+/// A joint model's drift action models with their training ranges: the product's
+/// (drift/grey_mix.h), which whirl drift fit-grey writes for the mix's rule.
+using drift::ShopControl;
+using drift::ShopControlModels;
 
 }  // namespace whirl::machine_eval

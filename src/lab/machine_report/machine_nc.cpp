@@ -126,17 +126,12 @@ CombinedPrograms BuildCombinedMixPrograms(
   if (grey_weight == 1.0)  // MixedLines' w = 1: the grey box's line itself
     return BuildCombinedGreyPrograms(curve, kinematics, thread_length_mm, plan_options, grey,
                                      profile, curve_source, model_source);
-  if (!rule_offset.sensors.empty() || !rule_slope.sensors.empty())
-    throw InputError(
-        "mixed drift action: the rule's models read sensors (rises from power-on), the grey "
-        "box's absolute temperatures; the program runs one reference: mix the grey box only "
-        "with a sensor-free rule (warmup, schedule)");
   const interp::GreyBoxAction a = interp::GreyBoxActionModels(grey);
-  CombinedPrograms out = Build(curve, kinematics, thread_length_mm, plan_options,
-                               {{{&a.offset, &a.slope, a.Blank(), grey_weight},
-                                 {&rule_offset, &rule_slope, nullptr, 1.0 - grey_weight}},
-                                interp::DriftReference::kModel},
-                               grey.z_ref_mm, profile, curve_source, model_source);
+  CombinedPrograms out = Build(
+      curve, kinematics, thread_length_mm, plan_options,
+      {interp::GreyMixComponents(a, rule_offset, rule_slope, grey_weight),
+       interp::DriftReference::kModel},
+      grey.z_ref_mm, profile, curve_source, model_source);
   out.grey = true;
   out.mixed = true;
   return out;

@@ -223,9 +223,13 @@ void from_json(const json& j, GreyBoxModel& m) {
                     {"format", "schema_version", "model", "offset_sensors", "slope_sensors",
                      "blank_sensor", "offset_duty", "slope_duty", "time_constants_min",
                      "z_ref_mm", "offset_features",
-                     "slope_features", "slope_intercept_um_per_1000", "blank", "fit", "training"},
+                     "slope_features", "slope_intercept_um_per_1000", "blank", "fit", "training",
+                     "mix"},
                     kWhat);
-  RequireSchema(j, kGreyBoxFormat, kGreyBoxSchemaVersion, kWhat, "format");
+  // Version 2 exactly when the mix part is there (ReadGreyBoxFile reads it).
+  RequireSchema(j, kGreyBoxFormat,
+                j.contains("mix") ? kGreyBoxMixSchemaVersion : kGreyBoxSchemaVersion, kWhat,
+                "format");
   m = GreyBoxModel{};
   m.offset_sensors = RequireStrings(j, "offset_sensors", kWhat, 1000);
   m.slope_sensors = RequireStrings(j, "slope_sensors", kWhat, 1000);
@@ -275,6 +279,108 @@ GreyBoxModel ReadGreyBoxModel(const std::filesystem::path& path) {
 void WriteGreyBoxModel(const std::filesystem::path& path, const GreyBoxModel& m) {
   ValidateGreyBox(m);
   WriteJsonFile(path, json(m));
+}
+
+namespace {
+
+constexpr const char* kMixWhat = "grey box model 'mix'";
+
+void ValidateMix(const GreyBoxMix& x) {
+  if (!(x.weight >= kShortMixFloor && x.weight < 1))
+    throw InputError(std::string(kMixWhat) + " 'weight' = " + std::to_string(x.weight) +
+                     ": must lie within [" + std::to_string(kShortMixFloor) +
+                     ", 1) (w = 1 is the grey box alone: no mix part)");
+  if (x.rule != "warmup" && x.rule != "schedule")
+    throw InputError(std::string(kMixWhat) + " 'rule' = '" + x.rule +
+                     "': must be warmup or schedule");
+  for (const auto& [key, m] : {std::pair{"rule_offset", &x.rule_offset}, {"rule_slope", &x.rule_slope}}) {
+    if (!m->sensors.empty())
+      throw InputError(std::string(kMixWhat) + " '" + key +
+                       "': reads sensors; the mix runs with the grey box's reference (absolute "
+                       "temperatures), so its rule must be sensor-free (warmup, schedule)");
+    m->Validate();
+  }
+}
+
+// The joint fit (drift/joint.h ToDriftModels) computes no variance inflation; a drift model file
+// carries one per feature: 1, as GreyBoxControlModels writes.
+DriftModel WithVif(DriftModel d) {
+  const Eigen::Index nf = d.linear.coefficients.size() - 1;
+  if (nf >= 0 && d.linear.vif.size() != nf) d.linear.vif = Eigen::VectorXd::Ones(nf);
+  return d;
+}
+
+json MixJson(const GreyBoxMix& x) {
+  return {{"weight", x.weight},
+          {"rule", x.rule},
+          {"rule_offset", json(WithVif(x.rule_offset))},
+          {"rule_slope", json(WithVif(x.rule_slope))},
+          {"guard",
+           {{"days", x.guard.days},
+            {"grey_rms_um", x.guard.grey_rms_um},
+            {"rule_rms_um", x.guard.rule_rms_um},
+            {"combination_weight", x.guard.combination_weight}}}};
+}
+
+GreyBoxMix MixOf(const json& j) {
+  const std::string w = kMixWhat;
+  RejectUnknownKeys(j, {"weight", "rule", "rule_offset", "rule_slope", "guard"}, w);
+  GreyBoxMix x;
+  x.weight = RequireNumber(j, "weight", w);
+  x.rule = RequireString(j, "rule", w);
+  for (const auto& [key, m] : {std::pair{"rule_offset", &x.rule_offset}, {"rule_slope", &x.rule_slope}}) {
+    try {
+      *m = RequireObject(j, key, w).get<DriftModel>();
+    } catch (const InputError& e) {
+      throw InputError(w + " '" + key + "': " + e.what());
+    }
+  }
+  const std::string wg = w + " 'guard'";
+  const json& g = RequireObject(j, "guard", w);
+  RejectUnknownKeys(g, {"days", "grey_rms_um", "rule_rms_um", "combination_weight"}, wg);
+  x.guard.days = static_cast<int>(RequireInteger(g, "days", 0, 1000000, wg));
+  x.guard.grey_rms_um = RequireNumber(g, "grey_rms_um", wg);
+  x.guard.rule_rms_um = RequireNumber(g, "rule_rms_um", wg);
+  x.guard.combination_weight = RequireNumber(g, "combination_weight", wg);
+  ValidateMix(x);
+  return x;
+}
+
+}  // namespace
+
+std::optional<GreyBoxMix> GreyBoxMixPart(const GreyMix& mix, const ShopRecord& record) {
+  if (!mix.applies || mix.weight == 1.0) return std::nullopt;
+  GreyBoxMix x;
+  x.weight = mix.weight;
+  x.rule = mix.rules.BaseName();
+  const ShopControl c = ShopControlModels(mix.rules.Base(), record.day_logs);
+  x.rule_offset = c.offset;
+  x.rule_slope = c.slope;
+  for (DriftModel* d : {&x.rule_offset, &x.rule_slope}) *d = WithVif(*d);
+  x.guard = mix.guard;
+  return x;
+}
+
+GreyBoxFile ReadGreyBoxFile(const std::filesystem::path& path) {
+  const json j = ReadJsonFile(path);
+  try {
+    GreyBoxFile f{j.get<GreyBoxModel>(), std::nullopt};
+    if (j.contains("mix")) f.mix = MixOf(j["mix"]);
+    return f;
+  } catch (const InputError& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
+}
+
+void WriteGreyBoxFile(const std::filesystem::path& path, const GreyBoxFile& f) {
+  ValidateGreyBox(f.model);
+  json j(f.model);
+  if (f.mix) {
+    ValidateMix(*f.mix);
+    j["schema_version"] = kGreyBoxMixSchemaVersion;
+    j["mix"] = MixJson(*f.mix);
+  }
+  WriteJsonFile(path, j);
 }
 
 GreyBoxSpec ReadGreyBoxSpec(const std::filesystem::path& path) {

@@ -23,6 +23,15 @@
 //                                   within kGreyBlankRangeC}
 //   fit                             {prior_strength >= 0, cv_rmse_um in [0, 1e6], rows >= 0}
 //   training                        {notes: provenance}
+//   mix                             only in schema_version 2 (and required there): the short
+//                                   record's mix (drift/grey_mix.h) the control runs,
+//                                   w grey + (1 - w) rule: {weight (the grey box's w, within
+//                                   [kShortMixFloor, 1)), rule ("warmup" | "schedule"),
+//                                   rule_offset, rule_slope (the rule's drift models,
+//                                   whirl-drift-model objects: K0 um, slope um per 1000 mm),
+//                                   guard {days, grey_rms_um, rule_rms_um, combination_weight}}
+// A file without the mix is schema_version 1 (the file as before the mix); a reader that knows
+// only version 1 refuses a version 2 file rather than run the grey box alone.
 // Every number is range-checked on reading; an error names the file, the field and the rule.
 //
 // Spec file (JSON, "format": "whirl-grey-box-spec", "schema_version": 1): the sensors a shop
@@ -34,16 +43,20 @@
 // A prior key that names no sensor of its list is an error (it would be ignored silently).
 // Shipped example for the simulated field machine: datasets/machines/field_grey_box_spec.json.
 #include <filesystem>
+#include <optional>
+#include <string>
 #include <nlohmann/json.hpp>
 
 #include "core/limits.h"
 #include "drift/grey_box.h"
+#include "drift/grey_mix.h"
 #include "drift/model.h"
 
 namespace whirl::drift {
 
 inline constexpr const char* kGreyBoxFormat = "whirl-grey-box-model";
 inline constexpr int kGreyBoxSchemaVersion = 1;
+inline constexpr int kGreyBoxMixSchemaVersion = 2;  ///< a file with the mix part
 inline constexpr const char* kGreyBoxSpecFormat = "whirl-grey-box-spec";
 /// Largest |coefficient| of a feature (um per K, or um per 1000 mm per K): 100 x the growth of a
 /// 10 m steel bed per K (110 um/K); larger is a corrupt file.
@@ -66,10 +79,33 @@ void ValidateGreyBox(const GreyBoxModel& m);
 
 void to_json(nlohmann::json& j, const GreyBoxModel& m);
 void from_json(const nlohmann::json& j, GreyBoxModel& m);
-/// InputError naming the file, the field and the rule.
+/// InputError naming the file, the field and the rule. The grey box part only (a mix part is
+/// read and checked, then left out: ReadGreyBoxFile keeps it).
 GreyBoxModel ReadGreyBoxModel(const std::filesystem::path& path);
-/// Validates, then writes atomically.
+/// Validates, then writes atomically (schema_version 1, no mix).
 void WriteGreyBoxModel(const std::filesystem::path& path, const GreyBoxModel& m);
+
+/// The model file's optional mix part (see above; drift/grey_mix.h FitGreyMix).
+struct GreyBoxMix {
+  double weight = 1;  ///< the grey box's share w
+  std::string rule;   ///< "warmup" or "schedule"
+  DriftModel rule_offset, rule_slope;
+  GuardScore guard;
+};
+struct GreyBoxFile {
+  GreyBoxModel model;
+  std::optional<GreyBoxMix> mix;
+};
+/// The mix part for the grey box fitted on `record`: FitGreyMix's rule as drift models with its
+/// training ranges (ShopControlModels over the record's day logs); nullopt on a long record or
+/// where w = 1 (the grey box's line itself).
+std::optional<GreyBoxMix> GreyBoxMixPart(const GreyMix& mix, const ShopRecord& record);
+/// InputError naming the file, the field and the rule: the grey box as ReadGreyBoxModel, the
+/// mix's weight within [kShortMixFloor, 1), a rule other than warmup or schedule, rule models
+/// that read sensors (the mix runs one reference: the grey box's absolute temperatures).
+GreyBoxFile ReadGreyBoxFile(const std::filesystem::path& path);
+/// Validates, then writes atomically: schema_version 2 with the mix, else 1.
+void WriteGreyBoxFile(const std::filesystem::path& path, const GreyBoxFile& f);
 
 /// InputError naming the file, the field and the rule (a sensor named twice, a prior for a
 /// sensor not in its list, no offset or slope sensor).
