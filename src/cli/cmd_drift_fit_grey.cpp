@@ -161,12 +161,12 @@ void RegisterDriftFitGrey(CLI::App* drift_app) {
       "shop measures: warm-up probe tests, laser tests, the measured leads of past screws and\n"
       "the probe readings at set-ups, each on its day log (the control's sensor log, a drift\n"
       "run file). Where the records hold fewer than 20 days with a lead, the file also carries\n"
-      "the mix the control then runs (docs/drift.md): w grey box + (1 - w) the better\n"
-      "sensor-free rule by its grouped CV (warmup: lags of power_on, the time since power-on\n"
-      "[min]; schedule: lags of ring_on, cutting, ring_load_pct [%], z_speed_mm_min [mm/min],\n"
-      "columns the day logs must hold), w the least-squares combination weight of the two\n"
-      "families' lead residuals on the last 2 lead days (each fitted on the days before it),\n"
-      "clamped to [0.5, 1]; --grey-alone writes the grey box alone.");
+      "the mix the control then runs (docs/840d.md): w grey box + (1 - w) the better\n"
+      "sensor-free rule by its grouped CV (warmup: lags of power_on, 0 at the power-on row,\n"
+      "then 1; schedule: lags of ring_on, cutting (0/1), ring_load_pct [%], z_speed_mm_min\n"
+      "[mm/min]; columns the day logs must hold), w the least-squares combination weight of\n"
+      "the two families' lead residuals on the last 2 lead days (each fitted on the days\n"
+      "before it), clamped to [0.5, 1]; --grey-alone writes the grey box alone.");
   sub->add_option("--records", o->records,
                   "measurement records JSON (format whirl-measurement-records: day_logs = run "
                   "files relative to it; records with kind probe|laser|lead|setup_check, day, "

@@ -77,9 +77,9 @@ ShopModels FitShopModels(const drift::ShopRecord& record, double z_fixed_mm,
   // combination weight is the fourteenth round's mix.
   const GuardScore g = drift::GuardGreyBox(
       record, applied, grey_options,
-      drift::SensorFreeRuleSpec(z_fixed_mm, schedule_base ? schedule_inputs
-                                                          : std::vector<std::string>{
-                                                                drift::kWarmupInput}),
+      drift::SensorFreeRuleSpec(z_fixed_mm, schedule_base
+                                                ? schedule_inputs
+                                                : std::vector<std::string>{drift::kWarmupInput}),
       drift::SensorFreeRuleOptions());
   m.guard = {grey_candidates, g.keep_grey, g.grey_rms_um, g.rule_rms_um};
   m.mix = ShortMixWeights(long_record, g);

@@ -136,19 +136,18 @@ void RequireRuleColumns(const ShopRecord& record, const std::vector<std::string>
   }
 }
 
-GreyMix FitGreyMix(const ShopRecord& record, const GreyBoxSpec& spec,
-                   const GreyBoxOptions& options,
+GreyMix FitGreyMix(const ShopRecord& record, const GreyBoxSpec& spec, const GreyBoxOptions& options,
                    const std::vector<std::string>& schedule_inputs) {
   GreyMix m;
   if (LongRecord(record, options)) return m;
   m.applies = true;
   m.rules = FitBaseRules(record, spec.z_ref_mm, schedule_inputs);
-  m.guard = GuardGreyBox(record, spec, options,
-                         SensorFreeRuleSpec(spec.z_ref_mm, m.rules.is_schedule
-                                                               ? schedule_inputs
-                                                               : std::vector<std::string>{
-                                                                     kWarmupInput}),
-                         SensorFreeRuleOptions());
+  m.guard =
+      GuardGreyBox(record, spec, options,
+                   SensorFreeRuleSpec(spec.z_ref_mm, m.rules.is_schedule
+                                                         ? schedule_inputs
+                                                         : std::vector<std::string>{kWarmupInput}),
+                   SensorFreeRuleOptions());
   m.weight = ShortMixWeight(false, m.guard);
   return m;
 }

@@ -83,8 +83,7 @@ struct GreyMix {
   GuardScore guard;
   double weight = 1;
 };
-GreyMix FitGreyMix(const ShopRecord& record, const GreyBoxSpec& spec,
-                   const GreyBoxOptions& options,
+GreyMix FitGreyMix(const ShopRecord& record, const GreyBoxSpec& spec, const GreyBoxOptions& options,
                    const std::vector<std::string>& schedule_inputs = ScheduleInputs());
 
 /// A joint model's offset (K0) and slope (per 1000 mm) channels as the drift action's models
