@@ -134,6 +134,17 @@ struct DayReplay {
     SetInputs(k);
     for (int c = 1; c <= per_sample; ++c) replay.Cycle(AxisAt(t0 + (t1 - t0) * c / per_sample));
   }
+  // One step of a replay loop: Advance to sample k, then where the day is at that sample.
+  struct Sample {
+    std::size_t k;
+    double t_min, pos_mm;
+    bool cutting;
+  };
+  Sample Step(int k, int per_sample) {
+    Advance(k, per_sample);
+    const double t = r.log.time_min[static_cast<std::size_t>(k)];
+    return {static_cast<std::size_t>(k), t, AxisAt(t), CutTimeS(t) >= 0 && CutTimeS(t) < t_cut};
+  }
   // After the cut: both reset programs; the control holds what it held before.
   void EndAndReset() {
     replay.Cycle(interp::AxisPositionMm(p.plan.options, feed, t_cut) - 1.0);
@@ -240,12 +251,8 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheGreyBoxWithTheLatchedBlank) {
   double worst_um = 0, latched = NAN, b_moved = 0;
   int cut_samples = 0;
   for (int k = 1; k < log.samples(); ++k) {
-    const double t1 = log.time_min[static_cast<std::size_t>(k)];
-    day.Advance(k, per_sample);
+    const auto [uk, t1, pos, cutting] = day.Step(k, per_sample);
     if (::testing::Test::HasFailure()) return;
-    const auto uk = static_cast<std::size_t>(k);
-    const double pos = day.AxisAt(t1);
-    const bool cutting = day.CutTimeS(t1) >= 0 && day.CutTimeS(t1) < day.t_cut;
     const double latch = replay.control.ac_param[blank + 1];
     if (cutting) {
       if (std::isnan(latched)) latched = latch;
@@ -312,12 +319,8 @@ TEST(CombinedPrograms, ReplayAppliesPlanPlusTheMixedLineOfTheGreyBoxAndTheRule) 
   double worst_um = 0, rule_part_um = 0;
   int cut_samples = 0;
   for (int k = 1; k < log.samples(); ++k) {
-    const double t1 = log.time_min[static_cast<std::size_t>(k)];
-    day.Advance(k, per_sample);
+    const auto [uk, t1, pos, cutting] = day.Step(k, per_sample);
     if (::testing::Test::HasFailure()) return;
-    const auto uk = static_cast<std::size_t>(k);
-    const double pos = day.AxisAt(t1);
-    const bool cutting = day.CutTimeS(t1) >= 0 && day.CutTimeS(t1) < day.t_cut;
     const double latch = replay.control.ac_param[blank + 1];
     const double blank_um = cutting ? w * g_b * (latch - 20.0) : 0.0;
     const double arm = (r.z_ref_mm - day.ZAt(t1)) / 1000.0;
