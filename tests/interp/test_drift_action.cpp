@@ -796,6 +796,18 @@ TEST(DriftAction, HostileNamesStayInsideCommentsAndCells) {
     if (line.empty() || line[0] == '#') continue;
     EXPECT_EQ(std::count(line.begin(), line.end(), ','), 9) << line;
   }
+  // A mixed line names its file in the header's first line too (ModelLines' mix branch).
+  const drift::DriftModel b = HandModel(false, rng);
+  const std::vector<DriftComponent> parts = {{&m, nullptr, nullptr, 0.5},
+                                             {&b, nullptr, nullptr, 0.5}};
+  replay::Replay mixed;
+  ASSERT_TRUE(mixed.RunProgram(FormatDriftNcProgram(parts, o, "mix\nM30\n.json")));
+  EXPECT_EQ(mixed.control.slope, 0.0);
+  std::istringstream mixed_csv(FormatDriftPlcCsv(parts, o));
+  while (std::getline(mixed_csv, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 11) << line;  // + component, weight
+  }
 }
 
 // Sensor names holding '"', ',', a line break or a formula start: every data row of the PLC table
