@@ -29,6 +29,15 @@ head -1 out/WHIRL_REFERENCE.SPF | grep -q "^; WHIRL_REFERENCE: " || { echo "head
 grep -q "call WHIRL_REFERENCE_RESET after" out/WHIRL_REFERENCE.SPF || { echo "reset program not named"; exit 1; }
 test -s out/machine_report/index.html || { echo "missing machine report"; exit 1; }
 grep -q "both halves on a drifting machine" demo.txt
+# A drift program whose short-record mix weighs the grey box 1 is the grey box's own (one
+# component): its header must not call it mixed (it said "mixed with warmup (w = 1.00)").
+for spf in out/machine_report/WHIRL_DRIFT_*.SPF; do
+  if grep -q "^; mixed line of" "$spf"; then
+    grep -q "(w = 1\.00)" "$spf" && { echo "$spf: a mixed line with w = 1.00"; exit 1; }
+  else
+    grep -q "mixed with" "$spf" && { echo "$spf: one component called mixed"; exit 1; }
+  fi
+done
 # Again into the same directory: the demo replaces its own output (core/output_dir.h).
 "$whirl" demo --out-dir out --no-plots > demo2.txt
 grep -q "summary:" demo2.txt

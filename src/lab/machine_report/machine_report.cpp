@@ -277,6 +277,16 @@ report::Document Page(const ReportScrew& r, const CombinedPrograms* programs,
   return doc;
 }
 
+// The combined program's model line for a mixed both_grey screw: at w = 1 the program is the grey
+// box's own (GreyMixComponents), so the header does not call it mixed.
+std::string MixDescription(const ReportScrew& r) {
+  if (r.mix_weight == 1.0)
+    return "grey box (both_grey) alone (the short-record mix weighs " + r.mix_rule_name +
+           " 0) trained only from shop measurements";
+  return "grey box (both_grey) mixed with " + r.mix_rule_name + " (w = " +
+         FormatFixed(r.mix_weight, 2) + ") trained only from shop measurements";
+}
+
 // The combined programs of the screw for the profile, or the note why there are none: the grey
 // box's where the evaluation picked both_grey (ReportScrew::programs_strategy), else, or when
 // its programs cannot be written for the profile (said in the note), both_shop's.
@@ -295,9 +305,7 @@ std::optional<CombinedPrograms> Programs(const ReportScrew& r,
             r.predicted_curve, r.kinematics, r.result.screw.thread_length_mm, r.plan_options,
             r.grey, r.mix_rule_offset, r.mix_rule_slope, r.mix_weight, *profile,
             "network curve of screw " + r.result.screw.name,
-            "grey box (both_grey) mixed with " + r.mix_rule_name +
-                " (w = " + FormatFixed(r.mix_weight, 2) +
-                ") trained only from shop measurements");
+            MixDescription(r));
       return BuildCombinedGreyPrograms(r.predicted_curve, r.kinematics,
                                        r.result.screw.thread_length_mm, r.plan_options, r.grey,
                                        *profile, "network curve of screw " + r.result.screw.name,
