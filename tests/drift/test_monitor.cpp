@@ -19,6 +19,7 @@
 #include "drift/monitor.h"
 #include "drift/monitor_report.h"
 #include "core/numbers.h"
+#include "support/rfc4180.h"
 
 namespace whirl::drift {
 namespace {
@@ -566,6 +567,46 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   const Eigen::MatrixXd x = MonitorDesign(m, MakeRun(q, 5), ReferenceMode::kRunStart);
   EXPECT_NEAR(check->predicted_um, x.row(check->sample).dot(first.final_coefficients), 1e-9);
   EXPECT_FALSE(changed.strongest.empty());
+}
+
+// The week's events table is every day's events under one header with the day in front, built
+// row by row: a day named with a comma, a quote and a line break and a message holding a line
+// break stay one cell each (an RFC 4180 reader written apart from whirl's reads them back).
+TEST(MonitorWeek, EventsTableKeepsQuotedNamesAndMessagesWhole) {
+  Planted p;
+  const DriftModel m = FitOn(MakeRun(p, 1));
+  MonitorOptions o;
+  o.check_every = 100;
+  Planted q = p;
+  q.change_min = 0;
+  q.w_after = {1.6, 0.1, -0.4};
+  WeekResult w = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5)}, o);
+  w.days[0].run = "day, \"one\"\nof two";
+  const std::string message = "reason, with a comma\nand a second line";
+  std::size_t events = 0;
+  for (auto& day : w.days)
+    for (auto& st : day.strategies)
+      for (auto& e : st.events) {
+        e.message = message;
+        ++events;
+      }
+  ASSERT_GT(events, 0u);
+  std::string csv = WeekEventsCsv(w, {"a comment"});
+  while (csv.rfind("#", 0) == 0) csv.erase(0, csv.find('\n') + 1);
+  const auto records = test::ParseRfc4180(csv);
+  ASSERT_EQ(records.size(), 1 + events);
+  const std::vector<std::string>& header = records.front();
+  EXPECT_EQ(header.front(), "day");
+  EXPECT_EQ(header.back(), "message");
+  std::size_t row = 1;
+  for (const auto& day : w.days)
+    for (const auto& st : day.strategies)
+      for (std::size_t k = 0; k < st.events.size(); ++k, ++row) {
+        ASSERT_EQ(records[row].size(), header.size()) << row;
+        EXPECT_EQ(records[row].front(), day.run) << row;
+        EXPECT_EQ(records[row][1], ToString(st.rule)) << row;
+        EXPECT_EQ(records[row].back(), message) << row;
+      }
 }
 
 // The week on the terminal: one compact row per day under one header - day, samples, the MAE of

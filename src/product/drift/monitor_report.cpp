@@ -118,24 +118,39 @@ MonitorResult PlotRows(const MonitorResult& r, int columns) {
   return out;
 }
 
-std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
-  std::ostringstream o;
-  for (const auto& c : WithComments(comments, "monitor events of " + r.run))
-    o << "# " << SpreadsheetLine(c) << "\n";
-  // Without recorded time the time axis is the sample index: one column, not two.
-  o << "rule,kind,sample," << (r.time_from_index ? "" : "time_min,")
-    << "measured_um,predicted_um,threshold_um,valid,message\n";
+namespace {
+
+// The events table's column names; without recorded time the time axis is the sample index: one
+// column, not two.
+std::string EventsHeader(const MonitorResult& r) {
+  return std::string("rule,kind,sample,") + (r.time_from_index ? "" : "time_min,") +
+         "measured_um,predicted_um,threshold_um,valid,message\n";
+}
+
+// The events table's rows, each after `prefix` (the week's day cell). Built row by row rather
+// than by splitting a finished table at line ends, which would cut a quoted message in two.
+void EventRows(const MonitorResult& r, const std::string& prefix, std::ostream& o) {
   for (const auto& s : r.strategies)
     for (const auto& e : s.events) {
       const bool measured =
           e.kind == MonitorEvent::Kind::kCheck || e.kind == MonitorEvent::Kind::kRefitMeasurement;
-      o << ToString(s.rule) << "," << ToString(e.kind) << "," << e.sample << ","
-        << (r.time_from_index ? "" : FormatNumber(e.time) + ",") << (measured ? FormatNumber(e.measured_um) : "") << ","
-        << FormatNumber(e.predicted_um) << ","
-        << (e.kind == MonitorEvent::Kind::kCheck ? FormatNumber(e.threshold_um) : "") << ","
-        << (e.kind == MonitorEvent::Kind::kCheck ? (e.valid ? "1" : "0") : "") << ","
-        << CsvTextCell(e.message) << "\n";
+      const bool check = e.kind == MonitorEvent::Kind::kCheck;
+      o << prefix << ToString(s.rule) << "," << ToString(e.kind) << "," << e.sample << ","
+        << (r.time_from_index ? "" : FormatNumber(e.time) + ",")
+        << (measured ? FormatNumber(e.measured_um) : "") << "," << FormatNumber(e.predicted_um)
+        << "," << (check ? FormatNumber(e.threshold_um) : "") << ","
+        << (check ? (e.valid ? "1" : "0") : "") << "," << CsvTextCell(e.message) << "\n";
     }
+}
+
+}  // namespace
+
+std::string MonitorEventsCsv(const MonitorResult& r, const std::vector<std::string>& comments) {
+  std::ostringstream o;
+  for (const auto& c : WithComments(comments, "monitor events of " + r.run))
+    o << "# " << SpreadsheetLine(c) << "\n";
+  o << EventsHeader(r);
+  EventRows(r, "", o);
   return o.str();
 }
 
@@ -442,20 +457,8 @@ std::string WeekEventsCsv(const WeekResult& w, const std::vector<std::string>& c
   std::ostringstream o;
   for (const auto& c : WithComments(comments, "monitor events of a week, day by day"))
     o << "# " << SpreadsheetLine(c) << "\n";
-  for (std::size_t d = 0; d < w.days.size(); ++d) {
-    std::istringstream day(MonitorEventsCsv(w.days[d], {}));
-    std::string line;
-    bool header = false;
-    while (std::getline(day, line)) {
-      if (line.rfind("#", 0) == 0) continue;
-      if (!header) {  // the column names once, with the day in front
-        header = true;
-        if (d == 0) o << "day," << line << "\n";
-        continue;
-      }
-      o << CsvTextCell(w.days[d].run) << "," << line << "\n";
-    }
-  }
+  if (!w.days.empty()) o << "day," << EventsHeader(w.days.front());  // the column names once
+  for (const auto& day : w.days) EventRows(day, CsvTextCell(day.run) + ",", o);
   return o.str();
 }
 
