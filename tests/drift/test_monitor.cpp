@@ -569,18 +569,29 @@ TEST(MonitorWeek, CarriesStateAndTotals) {
   EXPECT_FALSE(changed.strongest.empty());
 }
 
+// A week of three days checked every 100 samples by a model fitted on a planted run: two days on
+// a changed machine, then one like the training run.
+struct ChangedWeekCase {
+  MonitorOptions o;
+  WeekResult w;
+};
+ChangedWeekCase ChangedWeek() {
+  Planted p;
+  const DriftModel m = FitOn(MakeRun(p, 1));
+  ChangedWeekCase c;
+  c.o.check_every = 100;
+  Planted q = p;
+  q.change_min = 0;
+  q.w_after = {1.6, 0.1, -0.4};
+  c.w = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5), MakeRun(p, 6)}, c.o);
+  return c;
+}
+
 // The week's events table is every day's events under one header with the day in front, built
 // row by row: a day named with a comma, a quote and a line break and a message holding a line
 // break stay one cell each (an RFC 4180 reader written apart from whirl's reads them back).
 TEST(MonitorWeek, EventsTableKeepsQuotedNamesAndMessagesWhole) {
-  Planted p;
-  const DriftModel m = FitOn(MakeRun(p, 1));
-  MonitorOptions o;
-  o.check_every = 100;
-  Planted q = p;
-  q.change_min = 0;
-  q.w_after = {1.6, 0.1, -0.4};
-  WeekResult w = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5)}, o);
+  WeekResult w = ChangedWeek().w;
   w.days[0].run = "day, \"one\"\nof two";
   const std::string message = "reason, with a comma\nand a second line";
   std::size_t events = 0;
@@ -613,14 +624,9 @@ TEST(MonitorWeek, EventsTableKeepsQuotedNamesAndMessagesWhole) {
 // every row of the week in the week table's order (- where the day has none), the checking rules'
 // checks, invalid checks and stop minutes, the day's strongest, the run - not a sentence per day.
 TEST(MonitorWeek, TerminalShowsOneTableRowPerDay) {
-  Planted p;
-  const DriftModel m = FitOn(MakeRun(p, 1));
-  MonitorOptions o;
-  o.check_every = 100;
-  Planted q = p;
-  q.change_min = 0;
-  q.w_after = {1.6, 0.1, -0.4};
-  const WeekResult w = MonitorWeek(m, {MakeRun(q, 4), MakeRun(q, 5), MakeRun(p, 6)}, o);
+  const ChangedWeekCase c = ChangedWeek();
+  const WeekResult& w = c.w;
+  const MonitorOptions& o = c.o;
   const std::string text = FormatWeek(w, o);
   std::vector<std::vector<std::string>> rows;
   std::istringstream lines(text);
