@@ -30,7 +30,7 @@ Generator families (GENERATORS; each function documented where it is defined): "
 The suite's split (SPLITS, --split): "tuning" = powerlaw, bent, friedman, additive, simgen with
   seeds 1-20; "confirmation" = the same five on seeds 1001-1020 plus friedman23, interacting and
   powerlaw_noisy, which no setting was tuned on. Settings are chosen on the tuning part only; the
-  confirmation part is run once, at the end (docs/workpiece-model.md reports both). That
+  confirmation part is run once, at the end (docs/workpiece-history.md reports both). That
   confirmation is spent; the third attempt's split: "tuning3" = the eight families on seeds 1-20,
   "confirmation3" = the eight on seeds 4001-4020 plus saturating, powerlaw_step and hetero;
   later attempts: "confirmation4" (10001-), "decision5" (11001-), "confirmation6" (12001-),
@@ -329,11 +329,11 @@ GENERATORS = {
     "hetero": (9, hetero_params, hetero_sample, "smooth and power law, noise sd growing with an input"),
 }
 
-# The split of the suite, fixed before any setting was tuned on it (docs/workpiece-model.md):
+# The split of the suite, fixed before any setting was tuned on it (docs/workpiece-history.md):
 # settings are tuned on "tuning" only; "confirmation" (fresh seeds of the tuning families, three
 # generator families never used for tuning, the simulator on fresh seeds) is run once at the end.
 # The first two attempts' confirmation parts (seeds 1001-1020 here; 2001-2010 and 3001-3012 in the
-# design study of docs/design.md) are spent; the third attempt (docs/workpiece-model.md, "Third
+# design study of docs/design.md) are spent; the third attempt (docs/workpiece-history.md, "Third
 # attempt: split") tunes on all eight families on seeds 1-20 and confirms once on seeds 4001-4020
 # plus three families added for it (saturating, powerlaw_step, hetero). The fourth attempt tunes on
 # seeds 1-20 and 4001-4020 and confirms once on seeds 10001-10020 of the eleven families
@@ -640,7 +640,7 @@ def main():
     ap.add_argument("--paired", nargs=2, metavar=("BASE", "CAND"),
                     help="with --from-json: the paired decision of CAND against BASE (d = ln of the "
                          "RMSE ratio per table and output, paired t, coverage cells, per-family "
-                         "median ratios; docs/workpiece-model.md, fifth attempt)")
+                         "median ratios; docs/workpiece-history.md, fifth attempt)")
     ap.add_argument("--rule", choices=["fifth", "sixth", "fifteenth", "sixteenth"], default="fifth",
                     help="with --paired: the fifth attempt's rule (no family median ratio above "
                          "1.03) or the sixth's (no family geometric mean ratio above 1.02; a "
@@ -648,7 +648,7 @@ def main():
                          "fewer coverage cells) or the fifteenth's (sd only: identical RMSE, "
                          "strictly fewer cells of 10-table blocks, pooled cells not more, no "
                          "pooled +-1 sd coverage leaving its band) or the sixteenth's (the sixth's "
-                         "with coverage cells of 10-table blocks); docs/workpiece-model.md")
+                         "with coverage cells of 10-table blocks); docs/workpiece-history.md")
     a = ap.parse_args()
     if a.paired and not a.from_json:
         sys.exit("bench_peers: --paired needs --from-json")
@@ -851,7 +851,7 @@ def coverage_of(cell, m, k):
 
 
 def sd_only_decision(files, base, cand, block=10):
-    """The fifteenth attempt's rule for a change of the sd alone (docs/workpiece-model.md,
+    """The fifteenth attempt's rule for a change of the sd alone (docs/workpiece-history.md,
     "Fifteenth attempt: split"): (a) every case's RMSE identical; (b') strictly fewer (problem,
     rows, output, block of `block` consecutive seeds) cells outside 60-76 / 90-98 % than base, and
     pooled (problem, rows, output) cells outside not more; (c) no pooled cell whose +-1 sd
@@ -914,7 +914,7 @@ def paired_t(d):
 
 
 def paired_decision(files, base, cand, sixth=False, block=0):
-    """The fifth attempt's rule (docs/workpiece-model.md), fixed before its run: per (problem,
+    """The fifth attempt's rule (docs/workpiece-history.md), fixed before its run: per (problem,
     rows, seed, output) d = ln(RMSE_cand / RMSE_base); adopt iff mean(d) < 0 with paired t <= -2,
     no more coverage cells outside the bands than base, and no problem's median RMSE ratio above
     1.03. A failed fit (NaN) of either method fails the rule. sixth: the sixth attempt's rule

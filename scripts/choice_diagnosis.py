@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The thirteenth attempt's diagnosis at 20 rows (docs/workpiece-model.md, "Thirteenth attempt:
+"""The thirteenth attempt's diagnosis at 20 rows (docs/workpiece-history.md, "Thirteenth attempt:
 diagnosis at 20 rows"): from bench_peers.py --json files holding, per table, the default
 ("default") and each candidate alone (family_bench --candidates NAME --no-cv: linlog, linid,
 gplog, gpm52, gpse, net), and on some tables the peers:

@@ -8,13 +8,13 @@ usage: median_rule_noise.py RUN.json [RUN.json ...]
 mlp_default, mlp_cv, brnn_whirl on the same tables; with --verdicts the records of one table in
 several files are merged).
 
-Without --verdicts (docs/workpiece-model.md, "Seventeenth attempt: how noisy is the 1 % rule at
+Without --verdicts (docs/workpiece-history.md, "Seventeenth attempt: how noisy is the 1 % rule at
 10 tables"): per (family, output) cell it draws 10 of the cell's tables many times and counts how
 often each method's median is more than 1 % above the lowest median of the other peers, and the
 same for a twin of the cell's best peer (its RMSE times the default's centred per-table log
 ratio: equal to the best peer in median).
 
---verdicts (docs/workpiece-model.md, "Acceptance measured at N tables per cell: split"): per
+--verdicts (docs/workpiece-history.md, "Acceptance measured at N tables per cell: split"): per
 (family, rows, output) cell of N tables, R = the default's median / the lowest peer median, with a
 90 % interval from a paired bootstrap over the cell's tables (the best peer recomputed in each
 draw): "behind" if its lower end > 1.01, "within" if its upper end <= 1.01, else "undecided"; the

@@ -297,23 +297,23 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
   e->add_flag("--slope-through-lags-only", o->slope_through_lags_only,
               "both_grey's slope sensors (ambient, z_nut) through their lags only, the offset's "
               "as read: an opt-in variant, off by default, that lost on its tuning seeds "
-              "(docs/machine-evaluation.md, sixth round)");
+              "(docs/machine-history.md, sixth round)");
   e->add_flag("--grey-five-sensors", o->grey_five_sensors,
               "both_grey with its five physical sensors on every record: the model before the "
               "eleventh round, which takes every sensor once the record holds 20 lead days; "
-              "opt-in, so that older figures reproduce (docs/machine-evaluation.md, eleventh "
+              "opt-in, so that older figures reproduce (docs/machine-history.md, eleventh "
               "round)");
   e->add_flag("--grey-without-short-mix", o->grey_without_short_mix,
               "both_grey as the grey box's line alone on a record of fewer than 20 lead days: "
               "the default before the fourteenth round, which mixes it with the sensor-free "
               "base rule there (w grey + (1 - w) rule, w from the shop's last two lead days "
               "within [0.5, 1]); opt-out, so that older figures reproduce bit for bit "
-              "(docs/machine-evaluation.md, fourteenth round)");
+              "(docs/machine-history.md, fourteenth round)");
   e->add_flag("--offset-candidates", o->offset_candidates,
               "two more rows after the table's, computed in the same run: both_grey's slope with "
               "warmup's offset K0 (grey_warmup_k0) and with the mean of both offsets "
               "(grey_mean_k0); opt-in, off by default; both lost on their tuning seeds "
-              "(docs/machine-evaluation.md, seventh round)");
+              "(docs/machine-history.md, seventh round)");
   e->add_flag("--grey-candidates", o->grey_candidates,
               "the opt-in grey rows after the table's (with the --offset-candidates rows), "
               "computed in the same run from the same records: grey_all_sensors (the grey box "
@@ -327,7 +327,7 @@ void RegisterEvaluate(CLI::App* m, const std::shared_ptr<MachineCliOptions>& o) 
               "lead days better), grey_short_mix and grey_short_mix_fixed (while the record "
               "holds fewer than 20 lead days the line w both_grey + (1 - w) the base rule, w "
               "from the same two lead days, at least 0.5, or fixed at 0.75); off by default "
-              "(docs/machine-evaluation.md, eighth to fourteenth rounds)");
+              "(docs/machine-history.md, eighth to fourteenth rounds)");
   AddRetired(e, o.get(),
              {"--screws", "--train-runs", "--machine", "--machine-off", "--drift-model",
               "--monitor-every-min", "--base-screw", "--alpha", "--classes", "--max-sensors"});

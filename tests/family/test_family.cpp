@@ -763,7 +763,7 @@ TEST(FamilyEquivalence, ARealBendAboveTheNoiseKeepsItsGp) {
   }
   // The default's leave_first_se (2 standard errors to leave the power law at 20 rows) keeps the
   // power law on some of these tables, where the GP beats it by 1-2 standard errors only: the
-  // price of not leaving it on power laws without a bend (docs/workpiece-model.md).
+  // price of not leaving it on power laws without a bend (docs/workpiece-history.md).
   EXPECT_GE(gp, rule ? 8 : 6) << "rule " << rule;
   }
 }

@@ -10,7 +10,7 @@ add_executable(family_bench ${CMAKE_CURRENT_LIST_DIR}/family_bench.cpp)
 target_link_libraries(family_bench PRIVATE whirl::family)
 whirl_set_warnings(family_bench)
 target_compile_options(family_bench PRIVATE ${WHIRL_LIBRARY_OPTIMIZATION})
-# Development driver: the practical-equivalence rule on bent power laws (docs/workpiece-model.md).
+# Development driver: the practical-equivalence rule on bent power laws (docs/workpiece-history.md).
 add_executable(bend_probe ${CMAKE_CURRENT_LIST_DIR}/bend_probe.cpp)
 target_link_libraries(bend_probe PRIVATE whirl::family)
 target_include_directories(bend_probe PRIVATE ${PROJECT_SOURCE_DIR}/tests)

@@ -569,7 +569,7 @@ TEST(DriftAction, OffsetOnlyProgramGivesBackAnAbandonedSlope) {
   EXPECT_EQ(r.control.ref_position_mm, -5.0);
 }
 
-// A mixed line (DriftComponent: docs/machine-evaluation.md "Fourteenth round: adoption"), by
+// A mixed line (DriftComponent: docs/machine-history.md "Fourteenth round: adoption"), by
 // hand: two static models at u = (1, 1) K, e_A = 1 + 2 - 1 = 2 um and e_B = 4 + 0.5 + 0.5 = 5 um,
 // weights 0.25 / 0.75: SD43900 = s (0.5 + 3.75) / 1000 = 0.00425 mm (s = +1: subtracted, +1).
 TEST(DriftAction, MixedLineByHand) {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # scripts/choice_diagnosis.py on a tiny bench_peers.py run (powerlaw and friedman, 20 rows, seeds
 # 1-2; the family library's default and its six candidates alone through build/family_bench, as
-# docs/workpiece-model.md's thirteenth attempt runs it, no scikit-learn peer): one row per cell
+# docs/workpiece-history.md's thirteenth attempt runs it, no scikit-learn peer): one row per cell
 # whose family was run, the header's columns, the tables counted, the hindsight oracle never
 # above a candidate, every output counted once; with planted peers (each the default's RMSE
 # doubled) the default's median is -50.0 % of the best peer's; --cells keeps the cells named, on

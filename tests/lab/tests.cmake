@@ -1,5 +1,6 @@
-# The lab's Python scripts (scripts/*.py: the published comparisons of docs/workpiece-model.md,
-# docs/design.md and docs/machine-evaluation.md), each run end to end on a tiny case through
+# The lab's Python scripts (scripts/*.py: the published comparisons of docs/workpiece-model.md
+# and docs/workpiece-history.md, docs/design.md, docs/machine-evaluation.md and
+# docs/machine-history.md), each run end to end on a tiny case through
 # build/whirl and build/tests/family_bench, their outputs checked for invariants and planted inputs
 # for hand-computed figures (labels lab, cli; in the default run). lab_common.sh finds a python
 # with numpy and fails when there is none; scikit-learn stays hidden, as on CI.

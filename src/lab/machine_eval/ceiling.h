@@ -28,7 +28,7 @@
 // Beside it the shop's models of the same machine (field_eval.h TrainFieldMachine on the shop
 // record of the last estimator_past_days production days and the calendar's tests): warmup,
 // schedule, sensors (both_shop's machine half) and grey (both_grey's), scored the same way.
-// With grey_structure (opt-in; docs/machine-evaluation.md "Eighth round: diagnosis") the grey
+// With grey_structure (opt-in; docs/machine-history.md "Eighth round: diagnosis") the grey
 // box's own structure (drift/grey_box.h FitGreyBox with shop_models.h FieldGreyBoxSpec and
 // FieldGreyBoxOptions) is also trained on the exact truth, a lead record per past cut with one
 // reading per row_step_min (the value m(t, z), sigma 1 um, no probe or laser record), on the

@@ -50,20 +50,20 @@ struct FieldProtocol {
   /// update on (rules without bayes: the row is both_shop).
   drift::MonitorOptions monitor;
   /// both_grey's slope sensors through their lags only (FieldGreyBoxOptions' `slope_lags_only`):
-  /// an opt-in variant, off by default (docs/machine-evaluation.md, sixth round).
+  /// an opt-in variant, off by default (docs/machine-history.md, sixth round).
   bool grey_slope_lags_only = false;
   /// both_grey with the field grey box's five physical sensors on a long record too (the model
   /// before the eleventh round, so that older figures reproduce): an opt-in, off by default.
   bool grey_five_sensors = false;
   /// Score the opt-in rows of OffsetCandidate (machine_eval.h) as well: both_grey's slope with
-  /// warmup's offset, or with the mean of both offsets (docs/machine-evaluation.md, seventh round).
+  /// warmup's offset, or with the mean of both offsets (docs/machine-history.md, seventh round).
   bool offset_candidates = false;
   /// Score the opt-in rows of GreyCandidate (machine_eval.h) as well, after the OffsetCandidate
-  /// rows (computed with them): grey boxes of another structure (docs/machine-evaluation.md,
+  /// rows (computed with them): grey boxes of another structure (docs/machine-history.md,
   /// eighth round).
   bool grey_candidates = false;
   /// both_grey applies the fourteenth round's grey_short_mix line below 20 lead days (the field
-  /// default since its adoption, docs/machine-evaluation.md "Fourteenth round: adoption");
+  /// default since its adoption, docs/machine-history.md "Fourteenth round: adoption");
   /// false: the grey box's line alone, the figures before it bit for bit
   /// (--grey-without-short-mix).
   bool grey_short_mix = true;

@@ -38,7 +38,7 @@ struct ShopModels {
   std::string sensors_choice;  ///< which candidate the sensor model is (see above)
   /// The grey box, the both_grey row: FieldGreyBoxSpec's five physical sensors while the record
   /// holds fewer than 20 lead days (EverySensorByDays), every sensor (FieldGreyCandidate's spec)
-  /// from then on (the eleventh round, docs/machine-evaluation.md; FitShopModels'
+  /// from then on (the eleventh round, docs/machine-history.md; FitShopModels'
   /// grey_five_sensors keeps the five always); empty (no input, 0 everywhere) when the record's
   /// logs lack one of the five.
   drift::GreyBoxModel grey;
@@ -85,12 +85,12 @@ inline constexpr double kBlankContactTauMin = 0.5;
 drift::GreyBoxSpec FieldGreyBoxSpec(double z_ref_mm, bool blank_contact = false);
 /// The grey box's fit options in the field: drift::GreyBoxOptions' grids, its choices by forward
 /// chaining on the leads (GreyValidation::kForwardLeads: the fourth round of issue 41,
-/// docs/machine-evaluation.md); with `blank_contact` the blank's time constant fixed at
+/// docs/machine-history.md); with `blank_contact` the blank's time constant fixed at
 /// kBlankContactTauMin; with `slope_lags_only` the slope sensors enter through their lags only
 /// (GreyBoxOptions::instant_slope_inputs false; the offset's as read), an opt-in candidate.
 drift::GreyBoxOptions FieldGreyBoxOptions(bool blank_contact = false, bool slope_lags_only = false);
 /// The opt-in grey box of every sensor (grey_all_sensors, machine_eval.h GreyCandidate;
-/// docs/machine-evaluation.md "Eighth round: split"), from the field grey box's spec and options
+/// docs/machine-history.md "Eighth round: split"), from the field grey box's spec and options
 /// (`sensors`: the record's temperature sensors): every sensor on both channels, the field spec's
 /// priors, the others 0 (the grey box's structure trained on the exact truth leaves 1.4 um more
 /// than the ceiling's 13 sensors, with every sensor 0.6 um less). (The eighth round's other row,
@@ -101,30 +101,30 @@ struct GreyCandidateFit {
 };
 GreyCandidateFit FieldGreyCandidate(double z_ref_mm, bool blank_contact,
                                     const std::vector<std::string>& sensors);
-/// The tenth round's row (grey_sensors_by_days; docs/machine-evaluation.md "Tenth round:
+/// The tenth round's row (grey_sensors_by_days; docs/machine-history.md "Tenth round:
 /// split"), the field grey box's default since the eleventh round: every sensor
 /// (FieldGreyCandidate) once the record holds enough lead days for the grey box's forward
 /// chaining (drift::ScoresForward: 2 x forward_days), the field grey box's five sensors before
 /// (every sensor pays on a short record and gains on a long one).
 bool EverySensorByDays(const drift::ShopRecord& record, const drift::GreyBoxOptions& options);
-/// The twelfth round's row (grey_short_prior; docs/machine-evaluation.md "Twelfth round:
+/// The twelfth round's row (grey_short_prior; docs/machine-history.md "Twelfth round:
 /// split"): `options` with the prior strength fixed at 1 while the record holds fewer than
 /// 2 x forward_days lead days (drift::GreyBoxOptions::short_record_strength_grid = {1}: the
 /// physical prior weighs as much as the data where 5 held-out days cannot choose a strength);
 /// unchanged from 2 x forward_days lead days on.
 drift::GreyBoxOptions ShortRecordStrongPrior(drift::GreyBoxOptions options);
 /// The thirteenth round's rows (grey_short_offset_as_read, grey_short_offset_one_lag;
-/// docs/machine-evaluation.md "Thirteenth round: split"): `options` with the offset sensors
+/// docs/machine-history.md "Thirteenth round: split"): `options` with the offset sensors
 /// keeping only the first `lags` of the chosen lags (0: as read) while the record holds fewer
 /// than 2 x forward_days lead days (drift::GreyBoxOptions::short_record_offset_lags: on 5 lead
 /// days lags of the slow bed bend K0 along a cut); unchanged from 2 x forward_days lead days on.
 drift::GreyBoxOptions ShortRecordOffsetLags(drift::GreyBoxOptions options, int lags);
 
-/// The ninth round's guard (grey_guarded; docs/machine-evaluation.md "Ninth round: split") and
+/// The ninth round's guard (grey_guarded; docs/machine-history.md "Ninth round: split") and
 /// its combination weight: the product's (drift/grey_mix.h), which whirl drift fit-grey runs too.
 using drift::GuardGreyBox;
 using drift::GuardScore;
-/// The fourteenth round's rows (docs/machine-evaluation.md "Fourteenth round: split"): the grey
+/// The fourteenth round's rows (docs/machine-history.md "Fourteenth round: split"): the grey
 /// box's share w of the machine line w grey + (1 - w) base rule while the record holds fewer than
 /// 2 x forward_days lead days (drift::ScoresForward false), 1 from then on. grey_short_mix:
 /// drift::ShortMixWeight, the guard's combination weight clamped to [kShortMixFloor, 1] (the

@@ -75,7 +75,7 @@ CombinedPrograms BuildCombinedGreyPrograms(
     const interp::MachineProfile& profile, const std::string& curve_source,
     const std::string& model_source);
 
-/// The fourteenth round's grey_short_mix (docs/machine-evaluation.md "Fourteenth round:
+/// The fourteenth round's grey_short_mix (docs/machine-history.md "Fourteenth round:
 /// adoption"; machine_eval/strategies.h MixedLines): the machine line w grey + (1 - w) rule, the
 /// drift action as two components (interp::DriftComponent): the grey box with weight w (its
 /// K0, slope and latched blank term) and the sensor-free base rule's offset and slope models

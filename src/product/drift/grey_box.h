@@ -81,7 +81,7 @@ struct GreyBoxOptions {
   std::vector<double> blank_tau_grid = {30, 60, 120, 240};    ///< min, each > 0
   std::vector<double> strength_grid = {1e-3, 1e-2, 1e-1, 1};  ///< each > 0
   /// The lead records' share of the total weight, in (0, 1): 0.9 since issue 41's eighth round
-  /// (docs/machine-evaluation.md; the leads are what a cut's error is; 0.5 before).
+  /// (docs/machine-history.md; the leads are what a cut's error is; 0.5 before).
   double lead_share = 0.9;
   GreyValidation validation = GreyValidation::kLeaveOneDayOut;
   int forward_days = 10;    ///< kForwardLeads: validation days, 2..100
@@ -93,14 +93,14 @@ struct GreyBoxOptions {
   /// On a record with fewer than 2 x forward_days lead days (LeadDays; whatever the
   /// validation), the strength is chosen from this grid instead of strength_grid (each > 0);
   /// empty: strength_grid on every record. {1}: the physics weighs as much as the data where 5
-  /// held-out days cannot choose (issue 41's twelfth round, docs/machine-evaluation.md).
+  /// held-out days cannot choose (issue 41's twelfth round, docs/machine-history.md).
   std::vector<double> short_record_strength_grid;
   /// On a record with fewer than 2 x forward_days lead days: the offset sensors keep their
   /// instant column and only the first this many of the chosen lags (the shortest); the others'
   /// columns are 0 with a prior of 0, so their coefficients are exactly 0 and the evaluator and
   /// the 840D programs run the model as it is. -1: every chosen lag (off), else 0..4. Duty
   /// inputs and the slope channel are not affected. 0: the offset as read (issue 41's thirteenth
-  /// round, docs/machine-evaluation.md: on 5 lead days lags of the slow bed bend K0 along a cut).
+  /// round, docs/machine-history.md: on 5 lead days lags of the slow bed bend K0 along a cut).
   int short_record_offset_lags = -1;
   void Validate() const;    ///< InputError naming the field and the rule
 };

@@ -1,5 +1,5 @@
 #pragma once
-// The grey box's mix with a sensor-free rule on a short record (docs/machine-evaluation.md
+// The grey box's mix with a sensor-free rule on a short record (docs/machine-history.md
 // "Fourteenth round"; the field default since its adoption): while the shop's record holds fewer
 // than 2 x forward_days lead days (ScoresForward false: 20 with GreyBoxOptions' defaults) the
 // machine line is w grey + (1 - w) base rule, the base rule the better sensor-free rule by its
@@ -39,7 +39,7 @@ struct BaseRules {
 BaseRules FitBaseRules(const ShopRecord& record, double z_ref_mm,
                        const std::vector<std::string>& schedule_inputs = ScheduleInputs());
 
-/// The ninth round's guard (docs/machine-evaluation.md "Ninth round: split"): the grey box or a
+/// The ninth round's guard (docs/machine-history.md "Ninth round: split"): the grey box or a
 /// sensor-free rule, chosen on the shop's own record in time order. For each of the last
 /// `held_days` calendar days that hold a lead record, both are fitted on the records of the days
 /// before it only and that day's leads predicted; the score is the weighted (1 / sigma^2) RMS of

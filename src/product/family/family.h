@@ -97,7 +97,7 @@ struct FitOptions {
   /// rule alone it covered too few hold-out rows at +-2 sd on 20-row tables (residuals with
   /// heavier tails than a normal's). Why the leave-one-out residuals for the tail: at 20 rows
   /// 95.45 % means every row, and the K-fold refits (16 rows) have occasional bad folds that a
-  /// maximum follows, which made +-1 sd far too wide (figures: docs/workpiece-model.md).
+  /// maximum follows, which made +-1 sd far too wide (figures: docs/workpiece-history.md).
   bool calibrate_two_sd = true;
   /// From this many rows on, linear and GP candidates are calibrated by the closed-form
   /// leave-one-out alone (calibration_folds is used below it); 0 = never. At 70 rows and more
@@ -278,7 +278,7 @@ struct ChoiceOptions {
   /// selection and subsequent selection bias in performance evaluation", JMLR 11, 2010); on the
   /// tuning part of scripts/bench_peers.sh (20 rows) the default took GPs that lost to the power
   /// law on power-law tables and the refits brought it to the power law's
-  /// (docs/workpiece-model.md).
+  /// (docs/workpiece-history.md).
   bool closed_form_loo = true;
   /// Few rows for a GP: fewer than kRowsPerHyperparameter rows per hyperparameter of the ARD
   /// kernel on the five inputs (7: 70 rows; the rule of thumb of 10, Harrell, "Regression
@@ -296,7 +296,7 @@ struct ChoiceOptions {
   /// at most this many optimizer iterations (0: from GpOptions' fixed starting points, run to
   /// convergence); refit_folds > 0: that many folds for them (0: `folds`). Opt-in: with
   /// few_rows 101 and 2 or 4 warm iterations it lowered the 100-row test RMSE on the tuning part
-  /// within the speed budget, and not on the confirmation part (docs/workpiece-model.md, "Eighth
+  /// within the speed budget, and not on the confirmation part (docs/workpiece-history.md, "Eighth
   /// attempt"); refitting every GP from the fixed starts costs three times the budget.
   int refit_lowest_gp_rows = 0;
   int refit_iterations = 0;
@@ -309,7 +309,7 @@ struct ChoiceOptions {
   /// predictions from all of them; the GP fitted on the whole table (once chosen) keeps
   /// GpOptions' settings. Opt-in: with few_rows 101, meant to pay for judging every
   /// GP at 100 rows by K-fold refits, it made the 100-row test RMSE worse on the tuning part at
-  /// every subset within the time budget (docs/workpiece-model.md, "Ninth attempt").
+  /// every subset within the time budget (docs/workpiece-history.md, "Ninth attempt").
   int refit_hyperparameter_rows = 0;
   /// The optimizer's tolerances for those refits (0: GpOptions' own; BfgsOptions'
   /// function_tolerance and gradient_tolerance, on the same tables as refit_hyperparameter_rows).
@@ -328,11 +328,11 @@ struct ChoiceOptions {
   /// noise of a new row, most of each sd, is common to every candidate) times Choice::sd_scale,
   /// the CoverageScale of the combination's held-out residuals. (sqrt(sum_c w_c sd_c^2), the
   /// looser bound of earlier versions, covered too many of the tuning part's test rows at +-1 sd
-  /// on bent and stepped power laws; docs/workpiece-model.md.)
+  /// on bent and stepped power laws; docs/workpiece-history.md.)
   /// The candidates that enter: the first, those that beat it by more than stack_gate_se
   /// standard errors (BeatsFirst), and of the GPs with lowest_gp only the lowest; the weights are
   /// shrunk toward the first (ShrunkStackWeights, stack_start_se / stack_full_se).
-  /// The default since the fifth attempt (docs/workpiece-model.md, "Fifth attempt": on fresh
+  /// The default since the fifth attempt (docs/workpiece-history.md, "Fifth attempt": on fresh
   /// seeds its test RMSE was lower than the hard choice's with fewer coverage cells outside the
   /// bands). false: the hard choice (one candidate per output by the one-standard-error rule and
   /// leave_first_se; `whirl train --choice hard`), the default before.
@@ -342,7 +342,7 @@ struct ChoiceOptions {
   /// standard errors, all of it from stack_full_se on (the _large pair from few_rows rows, where
   /// GPs are judged by their closed-form leave-one-out); stack_full_se < 0: the unshrunk stack.
   /// (0.5 and 1.5 with lowest_gp_per_scale met the rule on the seventh attempt's tuning part and
-  /// not on its confirmation part: docs/workpiece-model.md, "Seventh attempt".)
+  /// not on its confirmation part: docs/workpiece-history.md, "Seventh attempt".)
   double stack_start_se = 1.0, stack_full_se = 2.0;
   double stack_start_se_large = 1.5, stack_full_se_large = 2.5;
   /// ChoiceOptions::stack: a candidate after the first enters the combination only if its own
@@ -358,7 +358,7 @@ struct ChoiceOptions {
   /// were fitted with the held-out row (Cawley & Talbot, JMLR 11, 2010); 2 is the in-sample
   /// optimism of p maximum-likelihood parameters, 2 sigma^2 p / n (Mallows' Cp, Akaike's AIC;
   /// Efron, "The estimation of prediction error: covariance penalties and cross-validation",
-  /// JASA 2004), with sigma^2 about the leave-one-out MSE. Opt-in (docs/workpiece-model.md,
+  /// JASA 2004), with sigma^2 about the leave-one-out MSE. Opt-in (docs/workpiece-history.md,
   /// "Tenth attempt").
   double gp_loo_hyperparameter_penalty = 0;
   /// ChoiceOptions::stack: true: an output that one candidate takes whole (Choice::weights
@@ -366,7 +366,7 @@ struct ChoiceOptions {
   /// combination's; false: its own sd, unscaled.
   /// ChoiceOptions::stack: the +-2 sd share of the held-out residuals that Choice::sd_scale must
   /// keep covered (StackSdScale); 0: the +-1 sd share alone.
-  /// Why both (the sixth attempt, figures in docs/workpiece-model.md): each candidate's own
+  /// Why both (the sixth attempt, figures in docs/workpiece-history.md): each candidate's own
   /// calibration covers every held-out residual of a 20-row table at +-2 sd, and with
   /// heavy-tailed residuals its +-1 sd then covered more new rows than the 60-76 % band;
   /// narrowing the sd to the held-out +-1 sd share alone let +-2 sd fall below 90 %; keeping 95 %
@@ -383,7 +383,7 @@ struct ChoiceOptions {
   /// scripts/bench_peers.py: with 0 (the one-standard-error rule alone) a GP or the raw linear
   /// fit won the held-out comparison on power-law tables and lost on new rows; the larger margin from few_rows on answers the optimism of a GP's
   /// closed-form leave-one-out, whose hyperparameters have seen the held-out row
-  /// (docs/workpiece-model.md, "Third attempt").
+  /// (docs/workpiece-history.md, "Third attempt").
   double leave_first_se = 2.0;
   double leave_first_se_large = 2.5;
   int leave_first_blocks = 0;
@@ -396,13 +396,13 @@ struct ChoiceOptions {
   /// column scale (one on log columns, one on raw columns) takes part instead of the lowest of
   /// all, and the stacking weights choose between them. From few_rows rows on (closed-form
   /// leave-one-out) the lowest of all, as without it. Opt-in: not the default
-  /// (docs/workpiece-model.md, "Seventh attempt": on the tuning part alone it lowered the 20-row
+  /// (docs/workpiece-history.md, "Seventh attempt": on the tuning part alone it lowered the 20-row
   /// test RMSE, and with the shrinkage 0.5-1.5 did not hold on the confirmation part).
   bool lowest_gp_per_scale = false;
   /// The same per-scale rule from few_rows rows on (GPs judged by their closed-form
   /// leave-one-out); below few_rows lowest_gp_per_scale alone decides. Why: at 100 rows the
   /// log-column GP, whose leave-one-out is the most optimistic of the GPs, took the one slot on
-  /// tables where the raw-column GP alone predicted better (docs/workpiece-model.md, "Tenth
+  /// tables where the raw-column GP alone predicted better (docs/workpiece-history.md, "Tenth
   /// attempt: diagnosis"). Opt-in (the same document, "Eleventh attempt").
   bool lowest_gp_per_scale_large = false;
   /// With lowest_gp, from few_rows rows (GPs judged by their closed-form leave-one-out): which
@@ -415,7 +415,7 @@ struct ChoiceOptions {
   /// tables where a raw-column GP predicted better; the marginal likelihood does not use the
   /// leave-one-out. kBic met the rule on a tuning and a confirmation part; kEvidence, which
   /// does not count the power-law mean's five extra maximized coefficients, gave the slot to
-  /// the log-column GP still more often and lost (docs/workpiece-model.md, "Twelfth attempt").
+  /// the log-column GP still more often and lost (docs/workpiece-history.md, "Twelfth attempt").
   GpSlot gp_slot_large = GpSlot::kBic;
   /// Practical equivalence at few rows (per-output choices without `stack`; 0 disables it, the
   /// default since GP held-out errors at few rows come from refits, which it duplicates): if
@@ -439,7 +439,7 @@ struct ChoiceOptions {
   /// held-out error takes part) and network-h2/identity (trainbr with 2 tanh units on the raw
   /// columns, R brnn's stopping rule: a logistic or saturating response in a direction of the
   /// inputs is one unit of it; up to network_max_rows rows). Why each, with the figures measured
-  /// on the tuning parts of scripts/bench_peers.py: docs/workpiece-model.md (the power-law mean
+  /// on the tuning parts of scripts/bench_peers.py: docs/workpiece-history.md (the power-law mean
   /// and the squared-exponential GP: "Third attempt"; the network: "Sixth attempt").
   static std::vector<Candidate> DefaultCandidates();
 };

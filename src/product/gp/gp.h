@@ -73,7 +73,7 @@ struct GpOptions {
   /// first two starts alone fell into local optima the other avoided (the first missed the bend
   /// of power laws bent in one input in refits of 16 rows, the second took noise for signal on
   /// exact power laws); from 70 rows on one start changed no median and halves the time
-  /// (docs/workpiece-model.md).
+  /// (docs/workpiece-history.md).
   int restarts = 2;
   int single_start_rows = 70;
   /// A log-normal prior on every length scale (the hyperparameters maximize the likelihood times
@@ -86,7 +86,7 @@ struct GpOptions {
   /// It keeps a GP from short length scales (spurious bends) that a few rows cannot support.
   /// length_prior_sd = 0: no prior (maximum likelihood). Why the prior: on the benchmark's tuning
   /// part (scripts/bench_peers.sh --split tuning) it lowered the median test RMSE of the additive
-  /// and Friedman tables by 5-15 % at 20 and 100 rows (docs/workpiece-model.md).
+  /// and Friedman tables by 5-15 % at 20 and 100 rows (docs/workpiece-history.md).
   double length_prior_sd = 1.7320508075688772;  // sqrt(3)
   /// Subset of data for large tables (R&W section 8.3.2): a GP on at most max_rows rows of the
   /// table, spread evenly by index (row floor(j n / m), j = 0..m-1), when it has more (0: every
@@ -109,7 +109,7 @@ struct GpOptions {
   /// 20-row tables: the same choices and medians within 0.5 % as with 1e-7, and 20-25 % less
   /// CPU). From 70 rows 1e-4 and 1e-3 changed no median of the benchmark's tuning part at 100
   /// rows by more than 0.5 % and save 15 % of the fit time; at 20 rows they moved single tables'
-  /// choices (docs/workpiece-model.md).
+  /// choices (docs/workpiece-history.md).
   BfgsOptions bfgs = GpBfgsDefaults();
   BfgsOptions bfgs_large = GpBfgsDefaults(true);
   void Validate() const;  ///< InputError naming the option, its value and the rule
