@@ -61,6 +61,14 @@ network: trainbr with R brnn's stopping rule, raw columns; R brnn itself is not 
   loglinear:   LinearRegression() of ln y on ln x per output (a power law in the five inputs,
                6 coefficients per output), predictions exp(.); the physics-shaped baseline
                (every input and both features are positive). Skipped (NaN) when a column is <= 0.
+  cv_peers:    what a careful user would do without whirl: per output the one of loglinear,
+               gp_ard, mlp_default and brnn_whirl with the lowest 5-fold cross-validated MSE on
+               the training table (folds shuffled by the table's seed, the same for every
+               candidate), refitted on all rows: the chosen peer's own record (read from or
+               added to the peer cache), "cv_chosen" names it per output, "cv_mse" keeps every
+               candidate's CV MSE. Coverage NaN where the chosen peer gives no sd (loglinear,
+               mlp_default). mlp_cv is not a candidate (its grid search inside 5 folds costs
+               250 network fits per table).
 The family library (src/product/family, src/product/gp; `--family-bench build/family_bench --family NAME=ARGS`)
 is run in-process by the development driver tests/family/family_bench.cpp with ARGS (e.g.
 "--candidates gp-matern52-constant/log --no-cv"; NAME=default: the default choice); its
@@ -519,6 +527,45 @@ def fit_sklearn(kind, xtr, ytr, xte, seed):
     return model.predict(xte), 1000 * (time.perf_counter() - start), None
 
 
+def fit_peer(p, whirl, xtr, ytr, xte, seed, tmp):
+    """One peer fitted on (xtr, ytr), predicting xte: (prediction, fit ms, predictive sd or None)."""
+    if p == "brnn_whirl":
+        return brnn_equivalent(whirl, xtr, ytr, xte, seed, tmp)
+    return fit_sklearn(p, xtr, ytr, xte, seed)
+
+
+# cv_peers' candidates: the acceptance peers a careful user can cross-validate at these costs
+# (mlp_cv left out: its grid search inside each of 5 folds would cost 5 x 10 x 5 network fits).
+CV_PEERS = ("loglinear", "gp_ard", "mlp_default", "brnn_whirl")
+CV_FOLDS = 5
+
+
+def cv_mse(p, whirl, xtr, ytr, seed, tmp):
+    """Peer p's 5-fold cross-validated MSE per output on the training table (folds shuffled by
+    the table's seed: the same folds for every peer); inf where a fold's fit fails."""
+    sq = np.zeros(ytr.shape[1])
+    for fit, held in KFold(CV_FOLDS, shuffle=True, random_state=seed).split(xtr):
+        try:
+            pred = fit_peer(p, whirl, xtr[fit], ytr[fit], xtr[held], seed, tmp)[0]
+        except (subprocess.CalledProcessError, ValueError):
+            return [math.inf] * ytr.shape[1]
+        sq += np.sum((pred - ytr[held]) ** 2, axis=0)
+    return [float(v) if math.isfinite(v) else math.inf for v in sq / len(ytr)]
+
+
+def cv_peers(fitted, cv, cv_ms):
+    """Peer "cv_peers": per output the candidate with the lowest cross-validated MSE (cv: name ->
+    MSE per output), refitted on all rows, i.e. that peer's own record (fitted: name -> record);
+    coverage NaN on an output whose chosen peer gives no sd (loglinear, mlp_default). time_ms:
+    the cross-validation's wall time cv_ms plus the candidates' fits on all rows."""
+    chosen = [min(CV_PEERS, key=lambda p: (cv[p][k], CV_PEERS.index(p))) for k in (0, 1)]
+    rec = {"rmse": [fitted[c]["rmse"][k] for k, c in enumerate(chosen)], "cv_chosen": chosen,
+           "cv_mse": cv, "time_ms": cv_ms + sum(fitted[p]["time_ms"] for p in CV_PEERS)}
+    for key in ("sd_rms", "resid_rms", "cover1", "cover2", "cover1_truth", "cover2_truth"):
+        rec[key] = [fitted[c][key][k] if key in fitted[c] else math.nan for k, c in enumerate(chosen)]
+    return rec
+
+
 def run_family(driver, args, xtr, ytr, xte, tmp):
     """The family library through tests/family/family_bench.cpp: (mean, sd, fit ms, info)."""
     train, test = os.path.join(tmp, "ftrain.csv"), os.path.join(tmp, "ftest.csv")
@@ -707,23 +754,9 @@ def main():
                                                 **info, **coverage(mean, sd, yte, fte)}
                     except subprocess.CalledProcessError as e:
                         rec["methods"][name] = failed(e)
+                table = (prob, n, seed, xtr, ytr, xte, fte, yte)
                 for p in peers:
-                    key = f"{prob}/{n}/{seed}/{p}/" + (
-                        "whirl" if p == "brnn_whirl" else f"sklearn-{sklearn.__version__}")
-                    if key not in cache:
-                        try:
-                            if p == "brnn_whirl":
-                                pred, ms, sd = brnn_equivalent(a.whirl, xtr, ytr, xte, seed, tmp)
-                            else:
-                                pred, ms, sd = fit_sklearn(p, xtr, ytr, xte, seed)
-                            cache[key] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
-                            if sd is not None:
-                                cache[key].update(coverage(pred, sd, yte, fte))
-                        except (subprocess.CalledProcessError, ValueError) as e:
-                            cache[key] = failed(e)
-                        if a.peer_cache:
-                            save_peer_cache(a.peer_cache, key, cache[key])
-                    rec["methods"][p] = cache[key]
+                    rec["methods"][p] = peer_record(p, table, a.whirl, tmp, cache, a.peer_cache)
                 results.append(rec)
                 print(f"{prob} {n} rows seed {seed}: " + ", ".join(
                     f"{k} {v['rmse'][0]:.3g}/{v['rmse'][1]:.3g}" for k, v in rec["methods"].items()),
@@ -734,6 +767,31 @@ def main():
     if a.json:
         with open(a.json, "w") as f:
             json.dump(results, f, indent=1)
+
+
+def peer_record(p, table, whirl, tmp, cache, cache_path):
+    """Peer p's record on a table (prob, rows, seed, xtr, ytr, xte, fte, yte), from the peer cache
+    or fitted and added to it; cv_peers fits (or reads) its candidates first."""
+    prob, n, seed, xtr, ytr, xte, fte, yte = table
+    key = f"{prob}/{n}/{seed}/{p}/" + {"brnn_whirl": "whirl", "cv_peers": "cv5-whirl-"}.get(p, "") + (
+        "" if p == "brnn_whirl" else f"sklearn-{sklearn.__version__}")
+    if key not in cache:
+        try:
+            if p == "cv_peers":
+                fitted = {c: peer_record(c, table, whirl, tmp, cache, cache_path) for c in CV_PEERS}
+                start = time.perf_counter()
+                cv = {c: cv_mse(c, whirl, xtr, ytr, seed, tmp) for c in CV_PEERS}
+                cache[key] = cv_peers(fitted, cv, 1000 * (time.perf_counter() - start))
+            else:
+                pred, ms, sd = fit_peer(p, whirl, xtr, ytr, xte, seed, tmp)
+                cache[key] = {"rmse": rmse(pred, fte).tolist(), "time_ms": ms}
+                if sd is not None:
+                    cache[key].update(coverage(pred, sd, yte, fte))
+        except (subprocess.CalledProcessError, ValueError) as e:
+            cache[key] = failed(e)
+        if cache_path:
+            save_peer_cache(cache_path, key, cache[key])
+    return cache[key]
 
 
 def report(results, prob, n, variants, peers):

@@ -3,7 +3,8 @@
 verdicts per cell with intervals.
 
 usage: median_rule_noise.py RUN.json [RUN.json ...]
-       median_rule_noise.py --verdicts [--draws B] [--twins T] RUN.json [RUN.json ...]
+       median_rule_noise.py --verdicts [--draws B] [--twins T] [--method NAME] [--against NAME]
+                            RUN.json [RUN.json ...]
 (bench_peers.py --json files holding the default as "current" and the peers loglinear, gp_ard,
 mlp_default, mlp_cv, brnn_whirl on the same tables; with --verdicts the records of one table in
 several files are merged).
@@ -23,7 +24,13 @@ intervals lie inside 60-76 / 90-98 %, "outside" if either lies entirely outside 
 "undecided"; and the noise floor at N tables, for a twin of each cell's best peer (equal to it in
 median, as dispersed per table as the default): (i) cells whose twin median is more than 1 %
 above the lowest peer median on N tables drawn with replacement, (ii) cells the verdict calls
-"behind" for the twin."""
+"behind" for the twin.
+--method NAME judges another method of the runs the same way (default "current", whirl's default;
+e.g. cv_peers, or a peer, which is then judged against the best of the OTHER peers); --against
+NAME judges it against that one method instead of the best peer (docs/workpiece-choice-limits.md).
+Coverage uses the tables on which the judged method has one (a peer without an sd: NaN or none);
+a cell without any says "n/a". Where the method's records name its choice per output
+("cv_chosen", bench_peers.py's cv_peers) the choices are counted per cell."""
 import argparse, json, math, os, random, statistics, sys
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -121,30 +128,35 @@ def seventeenth(files):
         v.sort(); print(f"  {m}: {v[100]} / {v[1000]} / {v[1900]} (mean {sum(v)/len(v):.1f})")
 
 
-def cells_of(files):
-    """{(problem, rows, output k): arrays} of the merged records: cur (N,), peers (N, 5),
-    cover (N, 2) in % (+-1, +-2 sd), seeds (N,). A table on which a method has no finite RMSE (a
-    failed fit, a table whirl refuses) is left out of both its cells and named on stderr."""
+def cells_of(files, method="current", peers=PEERS):
+    """{(problem, rows, output k): arrays} of the merged records: cur (N,) the judged method's RMSE,
+    peers (N, len(peers)), cover (N, 2) in % (+-1, +-2 sd; NaN where the method has none), seeds
+    (N,), chosen (N,) the method's "cv_chosen" if it has one. A table on which a method has no
+    finite RMSE (a failed fit, a table whirl refuses) is left out of both its cells and named on
+    stderr."""
     cells = {}
+    methods = [method] + list(peers)
     for r in load_runs(files):
         m = r["methods"]
-        missing = [x for x in METHODS if "rmse" not in m.get(x, {})]
+        missing = [x for x in methods if "rmse" not in m.get(x, {})]
         if missing:
             sys.exit(f"median_rule_noise: {r['problem']}, {r['rows']} rows, seed {r['seed']}: "
                      f"no {', '.join(missing)} in {' '.join(files)}")
-        bad = [x for x in METHODS if not all(math.isfinite(v) and v > 0 for v in m[x]["rmse"])]
+        bad = [x for x in methods if not all(math.isfinite(v) and v > 0 for v in m[x]["rmse"])]
         if bad:
             print(f"median_rule_noise: left out {r['problem']}, {r['rows']} rows, seed {r['seed']}: "
                   f"no finite RMSE of {', '.join(bad)}", file=sys.stderr)
             continue
         for k in (0, 1):
             c = cells.setdefault((r["problem"], r["rows"], k), {"cur": [], "peers": [], "cover": [],
-                                                               "seeds": []})
-            c["cur"].append(m["current"]["rmse"][k])
-            c["peers"].append([m[p]["rmse"][k] for p in PEERS])
-            c["cover"].append([100 * m["current"]["cover1"][k], 100 * m["current"]["cover2"][k]])
+                                                               "seeds": [], "chosen": []})
+            c["cur"].append(m[method]["rmse"][k])
+            c["peers"].append([m[p]["rmse"][k] for p in peers])
+            c["cover"].append([100 * m[method].get(b, [math.nan] * 2)[k] for b in ("cover1", "cover2")])
             c["seeds"].append(r["seed"])
-    return {key: {f: np.asarray(v, dtype=float) for f, v in c.items()} for key, c in cells.items()}
+            c["chosen"].append(m[method].get("cv_chosen", [""] * 2)[k])
+    return {key: {f: np.asarray(v, dtype=object if f == "chosen" else float) for f, v in c.items()}
+            for key, c in cells.items()}
 
 
 def median_verdict(lo, hi):
@@ -193,10 +205,42 @@ def twin_floor(c, rng, draws, twins):
     return point, behind
 
 
-def verdicts(files, draws, twins, twin_draws=1000, seed=40):
-    """Per-cell verdicts (median ratio, coverage) and the twin noise floor; prints Markdown."""
-    cells = cells_of(files)
+def coverage_cell(cover, idx, rng):
+    """The judged method's mean +-1 / +-2 sd coverage of a cell over the tables that have one,
+    their 90 % intervals (the bootstrap draws idx, or draws among those tables when some have
+    none) and the verdict; (None, None, "n/a", 0) without any."""
+    ok = np.isfinite(cover).all(axis=1)
+    if not ok.any():
+        return None, None, "n/a", 0
+    if not ok.all():
+        idx = np.flatnonzero(ok)[rng.integers(0, ok.sum(), size=(idx.shape[0], ok.sum()))]
+    ci = [interval(cover[idx, b].mean(axis=1)) for b in (0, 1)]
+    cv = coverage_verdict(*(band_verdict(*ci[b], BANDS[b]) for b in (0, 1)))
+    return cover[ok].mean(axis=0), ci, cv, int(ok.sum())
+
+
+def choices(cells):
+    """A Markdown table of how often the judged method chose each name per cell (cv_chosen)."""
+    names = sorted({x for c in cells.values() for x in c["chosen"] if x})
+    if not names:
+        return
+    print("\n| problem | rows | out | " + " | ".join(names) + " |")
+    print("|---|---|---|" + "---|" * len(names))
+    for key in sorted(cells, key=lambda k: (k[1], k[0], k[2])):
+        ch = list(cells[key]["chosen"])
+        print(f"| {key[0]} | {key[1]} | out{key[2] + 1} | " +
+              " | ".join(str(ch.count(x)) for x in names) + " |")
+
+
+def verdicts(files, draws, twins, twin_draws=1000, seed=40, method="current", against=None):
+    """Per-cell verdicts (median ratio, coverage) and the twin noise floor of `method` against
+    the best of the peers (without itself) or against the one method `against`; prints Markdown."""
+    peers = [against] if against else [p for p in PEERS if p != method]
+    cells = cells_of(files, method, peers)
     rng = np.random.default_rng(seed)
+    if method != "current" or against:
+        print(f"{method} judged against {'the best of ' if len(peers) > 1 else ''}"
+              f"{', '.join(peers)}\n")
     print("| problem | rows | out | N | best peer (median) | ratio | 90 % interval | verdict | "
           "+-1 sd % (90 %) | +-2 sd % (90 %) | coverage |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
@@ -212,28 +256,30 @@ def verdicts(files, draws, twins, twin_draws=1000, seed=40):
         ratio = float(np.median(c["cur"]) / med[best])
         lo, hi = interval(ratio_draws(c["cur"], c["peers"], idx))
         mv = median_verdict(lo, hi)
-        cov = c["cover"].mean(axis=0)
-        ci = [interval(c["cover"][idx, b].mean(axis=1)) for b in (0, 1)]
-        cv = coverage_verdict(*(band_verdict(*ci[b], BANDS[b]) for b in (0, 1)))
-        for what, v in (("median", mv), ("coverage", cv)):
+        cov, ci, cv, n_cov = coverage_cell(c["cover"], idx, rng)
+        for what, v in (("median", mv), ("coverage", cv.split(" (")[0])):
             count.setdefault((what, key[1], v), []).append(f"{key[0]} out{key[2] + 1}")
         if ratio > TOL:
             point_behind.append(f"{key[0]} {key[1]} out{key[2] + 1} {100 * (ratio - 1):+.1f} %")
-        if not in_bands(*cov):
+        if cov is not None and not in_bands(*cov):
             point_out.append(f"{key[0]} {key[1]} out{key[2] + 1} {cov[0]:.1f}/{cov[1]:.1f}")
         ten = c["seeds"] < c["seeds"].min() + 10
         first10[0] += np.median(c["cur"][ten]) > TOL * np.median(c["peers"][ten], axis=0).min()
-        first10[1] += not in_bands(*c["cover"][ten].mean(axis=0))
+        ten_cov = c["cover"][ten & np.isfinite(c["cover"]).all(axis=1)]
+        first10[1] += len(ten_cov) > 0 and not in_bands(*ten_cov.mean(axis=0))
         p, b = twin_floor(c, rng, min(draws, twin_draws), twins)
         floor_point.append(p); floor_behind.append(b)
-        print(f"| {key[0]} | {key[1]} | out{key[2] + 1} | {n} | {PEERS[best]} {med[best]:.4g} | "
-              f"{ratio:.3f} | {lo:.3f}-{hi:.3f} | {mv} | {cov[0]:.1f} ({ci[0][0]:.1f}-{ci[0][1]:.1f}) | "
-              f"{cov[1]:.1f} ({ci[1][0]:.1f}-{ci[1][1]:.1f}) | {cv} |")
+        cover = " | ".join(f"{cov[b]:.1f} ({ci[b][0]:.1f}-{ci[b][1]:.1f})" for b in (0, 1)) \
+            if cov is not None else "- | -"
+        cv += f" ({n_cov} of {n} with an sd)" if 0 < n_cov < n else ""
+        print(f"| {key[0]} | {key[1]} | out{key[2] + 1} | {n} | {peers[best]} {med[best]:.4g} | "
+              f"{ratio:.3f} | {lo:.3f}-{hi:.3f} | {mv} | {cover} | {cv} |")
     nc = len(cells)
     print(f"\n{nc} cells; bootstrap {draws} draws, 90 % percentile intervals; twins {twins} per cell, "
           f"{min(draws, twin_draws)} draws each")
+    no_sd = ("n/a",) if any(k[0] == "coverage" and k[2] == "n/a" for k in count) else ()
     for what, vs in (("median", ("behind", "within", "undecided")),
-                     ("coverage", ("inside", "outside", "undecided"))):
+                     ("coverage", ("inside", "outside", "undecided") + no_sd)):
         for rows in sorted({k[1] for k in cells}):
             print(f"{what} {rows} rows: " + "; ".join(
                 f"{v} {len(count.get((what, rows, v), []))}" +
@@ -256,6 +302,7 @@ def verdicts(files, draws, twins, twin_draws=1000, seed=40):
           f"expected (count per set of twins 5th / 50th / 95th percentile "
           f"{np.percentile(counts, 5):.0f} / {np.percentile(counts, 50):.0f} / "
           f"{np.percentile(counts, 95):.0f})")
+    choices(cells)
 
 
 def main():
@@ -265,14 +312,23 @@ def main():
                     help="per-cell verdicts with bootstrap intervals and the twin noise floor")
     ap.add_argument("--draws", type=int, default=2000, help="bootstrap draws per cell (--verdicts)")
     ap.add_argument("--twins", type=int, default=200, help="twins per cell for the floor (ii)")
+    ap.add_argument("--method", default="current",
+                    help="the method judged (--verdicts; default current, whirl's default); a peer "
+                         "is judged against the best of the other peers")
+    ap.add_argument("--against", metavar="NAME",
+                    help="judge --method against this one method instead of the best peer")
     a = ap.parse_args()
+    if (a.method != "current" or a.against) and not a.verdicts:
+        sys.exit("median_rule_noise: --method and --against need --verdicts")
+    if a.against == a.method:
+        sys.exit(f"median_rule_noise: --against {a.against} is the judged method itself")
     for f in a.runs:
         if not os.path.exists(f):
             sys.exit(f"median_rule_noise: {f}: no such file")
     if a.draws < 20 or a.twins < 1:
         sys.exit("median_rule_noise: --draws needs at least 20 and --twins at least 1")
     if a.verdicts:
-        verdicts(a.runs, a.draws, a.twins)
+        verdicts(a.runs, a.draws, a.twins, method=a.method, against=a.against)
     else:
         seventeenth(a.runs)
 

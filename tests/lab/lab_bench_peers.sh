@@ -4,7 +4,7 @@
 # x 1 size x 2 seeds, no scikit-learn peer): its JSON's records, fields and counts, and two
 # identical whirl settings paired give every d = 0 and "no change"; a planted table with a
 # non-positive target is replaced by seed + k x 1,000,000 and counted; bad arguments exit non-zero
-# with a message.
+# with a message; cv_peers' choice on planted cross-validation errors.
 # Usage (CTest): lab_bench_peers.sh <whirl> <scratch dir> <source dir> <family_bench>
 set -uo pipefail
 W="$1"; D="$2"; S="$3"; FB="$4"
@@ -129,6 +129,27 @@ grep -qF "powerlaw, 20 training rows, 2 seeds (1-2;" planted.txt \
   || fail "the report does not count the replacement: $(cat planted.txt)"
 
 # Bad arguments: a non-zero exit and a message.
+# cv_peers' choice (docs/workpiece-choice-limits.md) on planted CV errors: per output the candidate
+# with the lowest CV MSE, its own record (RMSE, coverage; NaN where it has no sd), ties in the
+# order loglinear, gp_ard, mlp_default, brnn_whirl; a failed candidate (inf) is never chosen
+check_py "cv_peers' choice" '
+import math, sys
+sys.path.insert(0, sys.argv[1])
+from bench_peers import cv_peers
+sd = lambda c: {"cover1": [c, c], "cover2": [0.9, 0.9], "sd_rms": [1.0, 1.0], "resid_rms": [1.0, 1.0],
+                "cover1_truth": [c, c], "cover2_truth": [c, c]}
+fitted = {"loglinear": {"rmse": [1.0, 10.0], "time_ms": 1.0},
+          "gp_ard": {"rmse": [2.0, 20.0], "time_ms": 2.0, **sd(0.6)},
+          "mlp_default": {"rmse": [3.0, 30.0], "time_ms": 3.0},
+          "brnn_whirl": {"rmse": [4.0, 40.0], "time_ms": 4.0, **sd(0.7)}}
+cv = {"loglinear": [0.5, 9.0], "gp_ard": [0.7, 3.0], "mlp_default": [0.9, 3.0], "brnn_whirl": [math.inf, 5.0]}
+r = cv_peers(fitted, cv, 5.0)
+assert r["cv_chosen"] == ["loglinear", "gp_ard"], r
+assert r["rmse"] == [1.0, 20.0] and r["time_ms"] == 15.0, r
+assert math.isnan(r["cover1"][0]) and r["cover1"][1] == 0.6 and r["cover2"][1] == 0.9, r
+cv["loglinear"] = [math.inf, math.inf]
+assert cv_peers(fitted, cv, 5.0)["cv_chosen"] == ["gp_ard", "gp_ard"]
+' "$S/scripts"
 expect_usage_error "needs --from-json" "${BP[@]}" --paired a b
 expect_usage_error "invalid choice" "${BP[@]}" --from-json better.json --paired a b --rule seventh
 expect_usage_error "method 'nosuch' missing in p, 20 rows, seed 1" \
