@@ -9,6 +9,11 @@
 //                              the model's domain). The speed targets (issue 40): at most R
 //                              brnn's time for both outputs, taken as 20 ms at 20 rows, 45 ms at
 //                              100 rows and 1 s at 2,000 rows (brnn is not packaged for Debian);
+//   BM_WorkpieceGenerated/F/rows:R  the same on a generated table of family F of
+//                              scripts/bench_peers.py (friedman23, additive, interacting,
+//                              powerlaw_noisy: the families whose `whirl train` took longer than
+//                              the speed targets), seed 1001, R = 20 or 100 rows: committed in
+//                              tests/bench/data/F_R.csv, written by scripts/bench_tables.py;
 //   BM_FamilyCandidate/rows:R/candidate:C   FitCandidate of DefaultCandidates()[C] (with its
 //                              calibration; no choice);
 //   BM_TrainbrSingleFit/rows:R one nn::TrainModel of 5-6-2 with R brnn's stopping rule, no size
@@ -71,6 +76,28 @@ BENCHMARK(BM_WorkpieceDefault)
     ->Arg(100)
     ->Arg(500)
     ->Arg(2000)
+    ->Unit(benchmark::kMillisecond);
+
+// Arguments: family (index in kGeneratedFamilies), rows.
+const char* const kGeneratedFamilies[] = {"friedman23", "additive", "interacting", "powerlaw_noisy"};
+
+void BM_WorkpieceGenerated(benchmark::State& state) {
+  const std::string family = kGeneratedFamilies[state.range(0)];
+  const std::string rows = std::to_string(state.range(1));
+  const whirl::ProcessTable table = whirl::ReadProcessTable(
+      std::string(WHIRL_SOURCE_DIR) + "/tests/bench/data/" + family + "_" + rows + ".csv", true);
+  state.SetLabel(family + "/rows:" + rows);
+  whirl::workpiece::TrainOptions o;
+  o.choice.fit.threads = 1;
+  for (auto _ : state) {
+    const whirl::workpiece::WorkpieceModel m =
+        whirl::workpiece::TrainWorkpieceModel(table, o, "bench");
+    benchmark::DoNotOptimize(m.domain_max);
+  }
+}
+BENCHMARK(BM_WorkpieceGenerated)
+    ->ArgNames({"family", "rows"})
+    ->ArgsProduct({{0, 1, 2, 3}, {20, 100}})
     ->Unit(benchmark::kMillisecond);
 
 void BM_FamilyCandidate(benchmark::State& state) {
