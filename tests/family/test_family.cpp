@@ -9,6 +9,7 @@
 #include <random>
 #include <utility>
 
+#include "core/csv.h"
 #include "family/family.h"
 #include "support/expect_error.h"
 #include "support/power_law_table.h"
@@ -162,6 +163,36 @@ TEST(FamilyChoice, EveryChosenModelOfTheDefaultIsItsCandidatesOwnCalibratedFit) 
       }
     }
   EXPECT_GT(gps, 0);  // the tables choose a GP somewhere
+}
+
+TEST(FamilyChoice, ANetworkThatTakesPartIsItsCandidatesOwnCalibratedFit) {
+  // A network that takes part is calibrated from the choice's own refits (family.cpp,
+  // FitNetwork's fold_fits) instead of refitting them: the model is bit for bit FitCandidate's.
+  // On this generated Friedman #2/#3 table of 100 rows (scripts/bench_tables.py) the default
+  // stacks the network into both outputs.
+  const ProcessTable t = ReadProcessTable(
+      std::string(WHIRL_SOURCE_DIR) + "/tests/bench/data/friedman23_100.csv", true);
+  ChoiceOptions o;
+  o.fit.threads = 1;
+  const Choice c = ChooseFamily(t, o);
+  const ProcessTable test = MakeTable(30, 0.0, 42, true);
+  int networks = 0;
+  for (const FamilyModel& m : c.models) {
+    if (m.candidate.family != Family::kNetwork) continue;
+    ++networks;
+    const FamilyModel fresh = FitCandidate(t, m.candidate, o.fit);
+    EXPECT_EQ(m.calibration, fresh.calibration);
+    for (int k = 0; k < 2; ++k)
+      EXPECT_EQ(m.network.output_noise_variance(k), fresh.network.output_noise_variance(k)) << k;
+    const std::vector<FamilyPrediction> a = PredictFamily(m, test.inputs);
+    const std::vector<FamilyPrediction> b = PredictFamily(fresh, test.inputs);
+    for (std::size_t q = 0; q < a.size(); ++q)
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_EQ(a[q].mean.ToArray()[k], b[q].mean.ToArray()[k]);
+        EXPECT_EQ(a[q].stddev.ToArray()[k], b[q].stddev.ToArray()[k]);
+      }
+  }
+  EXPECT_EQ(networks, 1);
 }
 
 TEST(FamilyChoice, ClosedFormLeaveOneOutEqualsRefitsInOriginalUnits) {

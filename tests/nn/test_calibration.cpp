@@ -4,11 +4,14 @@
 // errors for both outputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "core/csv.h"
+#include "core/error.h"
 #include "nn/model.h"
 #include "sim/dataset.h"
 
@@ -63,6 +66,48 @@ void ExpectCalibrated(const char* name, const Model& m) {
       "%.1f %% (settle time), +-2 sigma %.1f %% / %.1f %%\n",
       name, HoldOut().inputs.size(), 100 * c.one[0], 100 * c.one[1], 100 * c.two[0],
       100 * c.two[1]);
+}
+
+// Given fold fits (family/family.cpp hands over the choice's refits of a network) are used as
+// they are: the fold fits CalibrateOutputNoise would train give its own calibration bit for bit;
+// other fits give another; a count other than the folds' is refused.
+TEST(Calibration, GivenFoldFitsAreUsedInsteadOfRefits) {
+  const ProcessTable t = ReadProcessTable(kData / "whirling_train.csv", true);
+  ModelTrainOptions o = DefaultTrainingOptions();
+  o.hidden_candidates.clear();
+  o.hidden_by_evidence = false;
+  o.hidden_sizes = {2};
+  o.threads = 1;
+  o.noise_folds = 0;
+  Model refitted = TrainModel(t, o, "t");
+  Model given = refitted, other = refitted;
+  constexpr int kFolds = 5;
+  CalibrateOutputNoise(t, o, kFolds, &refitted);
+  ModelTrainOptions fold_options = o;  // as CalibrateOutputNoise's comment on fold_models says
+  fold_options.restarts = std::min(o.restarts, 3);
+  fold_options.stopping = Stopping::kTrainbrMatlab;
+  fold_options.train = refitted.train_options;
+  std::vector<Model> folds;
+  for (int f = 0; f < kFolds; ++f) {
+    ProcessTable train;
+    for (std::size_t i = 0; i < t.inputs.size(); ++i)
+      if (static_cast<int>(i) % kFolds != f) {
+        train.inputs.push_back(t.inputs[i]);
+        train.targets.push_back(t.targets[i]);
+      }
+    folds.push_back(TrainModel(train, fold_options, "fold"));
+  }
+  CalibrateOutputNoise(t, o, kFolds, &given, &folds);
+  for (int k = 0; k < 2; ++k)
+    EXPECT_EQ(given.output_noise_variance(k), refitted.output_noise_variance(k)) << k;
+  EXPECT_EQ(given.noise_calibration, refitted.noise_calibration);
+  // The fit on all rows in place of every fold fit: its residuals on rows it was trained on.
+  const std::vector<Model> all_rows(kFolds, TrainModel(t, o, "t"));
+  CalibrateOutputNoise(t, o, kFolds, &other, &all_rows);
+  EXPECT_TRUE(other.output_noise_variance(0) != refitted.output_noise_variance(0) ||
+              other.output_noise_variance(1) != refitted.output_noise_variance(1));
+  folds.pop_back();
+  EXPECT_THROW(CalibrateOutputNoise(t, o, kFolds, &other, &folds), InputError);
 }
 
 // As `whirl train --data datasets/whirling_train.csv --seed 1 --restarts 10`.

@@ -39,8 +39,13 @@ ProcessTable TransformedTable(const ProcessTable& table, const TableTransform& t
   return out;
 }
 
+// `fold_fits`: the choice's refits of the candidate (ChooseFamily), one per fold of row q in fold
+// q % folds, on `t`'s transform; with `calibrate` they are the calibration's own fold fits when
+// nn::CalibrateOutputNoise would train them with the same options on the same folds (it trains
+// with min(restarts, 3) restarts and trainbr's own stopping; a size by evidence is chosen per fold
+// in the refits, not in the calibration), and are then taken instead of refitted: the same model.
 nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions& o,
-                     bool calibrate) {
+                     bool calibrate, const std::vector<nn::Model>* fold_fits = nullptr) {
   nn::ModelTrainOptions m = nn::DefaultTrainingOptions();
   m.seed = o.seed;
   m.restarts = o.network_restarts;
@@ -52,7 +57,17 @@ nn::Model FitNetwork(const ProcessTable& t, const Candidate& c, const FitOptions
     m.hidden_sizes = nn::HiddenLayers(c.hidden);
     if (c.hidden == 0) m.restarts = 1;
   }
-  return nn::TrainModel(t, m, t.source);
+  const int rows = static_cast<int>(t.inputs.size()), folds = std::min(m.noise_folds, rows);
+  const bool reuse = fold_fits && calibrate && rows >= 4 && folds >= 2 &&
+                     fold_fits->size() == static_cast<std::size_t>(folds) &&
+                     c.hidden != Candidate::kHiddenByEvidence && m.restarts <= 3 &&
+                     m.stopping == nn::Stopping::kTrainbrMatlab;
+  if (!reuse) return nn::TrainModel(t, m, t.source);
+  nn::ModelTrainOptions uncalibrated = m;
+  uncalibrated.noise_folds = 0;
+  nn::Model model = nn::TrainModel(t, uncalibrated, t.source);
+  nn::CalibrateOutputNoise(t, m, folds, &model, fold_fits);  // as TrainModel would with m
+  return model;
 }
 
 // Fold of each of `rows` rows among min(folds, rows) folds: row q in fold q % min(folds, rows).
@@ -262,13 +277,17 @@ ProcessTable Rows(const ProcessTable& table, const std::vector<int>& fold_of, in
   return out;
 }
 
-// Held-out errors (2 x rows, original units) of one candidate's fold fit.
-void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
-                int fold, Eigen::MatrixXd* err) {
+FamilyModel Unfitted(const ProcessTable& table, const Candidate& candidate);
+
+// Held-out errors (2 x rows, original units) of one candidate's fold fit; a network fold fit is
+// moved into `network` (true) when its transform is the whole table's, so that it is a fold fit
+// of the table's network (FitNetwork's fold_fits).
+bool FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions& o, int folds,
+                int fold, Eigen::MatrixXd* err, nn::Model* network) {
   const std::vector<int> fold_of = FoldOfRows(static_cast<int>(table.inputs.size()), folds);
   const ProcessTable train = Rows(table, fold_of, fold, false),
                      held = Rows(table, fold_of, fold, true);
-  const FamilyModel m = FitCandidate(train, c, o, false);
+  FamilyModel m = FitCandidate(train, c, o, false);
   const std::vector<FamilyPrediction> p = PredictFamily(m, held.inputs);
   for (std::size_t i = 0, row = 0; row < table.inputs.size(); ++row) {
     if (fold_of[row] != fold) continue;
@@ -278,6 +297,13 @@ void FoldErrors(const ProcessTable& table, const Candidate& c, const FitOptions&
     }
     ++i;
   }
+  if (c.family != Family::kNetwork) return false;
+  const TableTransform whole = Unfitted(table, c).transform;
+  if (m.transform.inputs != whole.inputs || m.transform.outputs != whole.outputs ||
+      m.transform.input_used != whole.input_used)
+    return false;
+  *network = std::move(m.network);
+  return true;
 }
 
 void CheckTable(const ProcessTable& table);
@@ -287,12 +313,13 @@ void CheckRows(const ProcessTable& table, const Candidate& c, int inputs);
 int HeldOutFolds(const ChoiceOptions& o, int folds) { return o.closed_form_loo ? 0 : folds; }
 
 // Fits (or takes from `full`, the closed-form fits) each candidate that predicts an output
-// (chosen, or a positive stacking weight) on all rows, with calibration; fills models,
-// model_of_output and, for stacked outputs, weights.
+// (chosen, or a positive stacking weight) on all rows, with calibration (a network's from its
+// fold fits in `fold_networks`, if any: FitNetwork); fills models, model_of_output and, for
+// stacked outputs, weights.
 void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
                const std::array<Eigen::VectorXd, Features::kCount>& stack,
                std::vector<FamilyModel>& full, const std::vector<char>& calibrated,
-               Choice* choice) {
+               const std::vector<std::vector<nn::Model>>& fold_networks, Choice* choice) {
   std::vector<int> fitted;
   auto model_of = [&](int c) {
     const auto it = std::find(fitted.begin(), fitted.end(), c);
@@ -302,7 +329,12 @@ void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
       if (!calibrated[c]) Calibrate(table, options.fit, &full[c]);
       choice->models.push_back(std::move(full[c]));
     } else {
-      choice->models.push_back(FitCandidate(table, options.candidates[c], options.fit, true));
+      FamilyModel m = Unfitted(table, options.candidates[c]);
+      const std::vector<nn::Model>& folds = fold_networks[static_cast<std::size_t>(c)];
+      m.network = FitNetwork(TransformedTable(table, m.transform), m.candidate, options.fit, true,
+                             folds.empty() ? nullptr : &folds);
+      m.calibration = m.network.noise_calibration;
+      choice->models.push_back(std::move(m));
     }
     return static_cast<int>(fitted.size()) - 1;
   };
@@ -1204,6 +1236,13 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
   // below); at 20 rows most GPs are not, and their full fits took a sixth of the choice's time.
   std::vector<char> refitted(static_cast<std::size_t>(nc), 0), pending = refitted;
   std::vector<HeldOuts> held(static_cast<std::size_t>(nc));
+  // A network's refits, kept as its calibration's fold fits (FitNetwork); emptied below unless
+  // every fold's was kept.
+  std::vector<std::vector<nn::Model>> fold_networks(static_cast<std::size_t>(nc));
+  std::vector<char> fold_kept(static_cast<std::size_t>(nc * folds), 0);
+  for (int c = 0; c < nc; ++c)
+    if (options.candidates[c].family == Family::kNetwork)
+      fold_networks[static_cast<std::size_t>(c)].resize(static_cast<std::size_t>(folds));
   std::mutex progress_mutex;
   int done = 0;
   int steps = 1;  // a network's folds, every other candidate's fit (with its held-out errors), the end
@@ -1212,7 +1251,8 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     const auto start = std::chrono::steady_clock::now();
     const int c = static_cast<int>(i) / folds, f = static_cast<int>(i) % folds;
     if (options.candidates[c].family == Family::kNetwork) {
-      FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c]);
+      fold_kept[i] = FoldErrors(table, options.candidates[c], fold_options, folds, f, &err[c],
+                                &fold_networks[static_cast<std::size_t>(c)][f]);
     } else if (f == 0) {  // held-out errors (and calibration) of the full fit or of refits
       full[c] = Unfitted(table, options.candidates[c]);
       const bool refit_small = options.candidates[c].family == Family::kGaussianProcess &&
@@ -1298,7 +1338,11 @@ Choice ChooseFamily(const ProcessTable& table, const ChoiceOptions& given) {
     for (Eigen::Index c = 0; c < stack[k].size(); ++c)
       if (stack[k](c) > 0) complete(static_cast<int>(c));
   }
-  FitChosen(table, options, stack, full, calibrated, &choice);
+  for (int c = 0; c < nc; ++c)
+    for (int f = 0; f < folds; ++f)
+      if (!fold_kept[static_cast<std::size_t>(c * folds + f)])
+        fold_networks[static_cast<std::size_t>(c)].clear();
+  FitChosen(table, options, stack, full, calibrated, fold_networks, &choice);
   ScaleStackedSd(table, options, stack, err, &choice);
   if (options.progress) options.progress(steps, steps, "final fits and sd calibration");
   choice.warnings = TableWarnings(table, options, constant);

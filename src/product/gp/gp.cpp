@@ -78,12 +78,17 @@ struct Factors {
   Eigen::MatrixXd h;              // the basis H of z (set by the first Factor)
   Eigen::MatrixXd scaled, r2;     // z / l per input; squared scaled distances
   Eigen::RowVectorXd sq;          // squared norms of the columns of `scaled`
-  Eigen::MatrixXd kf, g, k;       // K_f, the gradient's factor of K_f, K = K_f + sigma_n^2 I
+  Eigen::MatrixXd kf, g;          // K_f, the gradient's factor of K_f (Matern)
   Eigen::LLT<Eigen::MatrixXd> chol, a_chol;
   Eigen::MatrixXd k_inv_h;
   Eigen::VectorXd b, alpha, r;
   Eigen::MatrixXd l_inv, k_inv, w, wg;  // Gradient: L^-1, K^-1, alpha alpha' - K^-1, w .* g
-  Eigen::ArrayXd zi;                     // Gradient: one input's row
+  Eigen::VectorXd kf_diagonal;           // K_f's diagonal while K = K_f + sigma_n^2 I is factored
+  bool g_is_kf = false;                  // squared exponential: the gradient's factor is K_f
+  // Gradient, up to kCachedDifferenceRows rows: per input i the squared differences
+  // (z_ip - z_iq)^2, n x n, computed at the first gradient of the fit (they depend on z only).
+  std::vector<Eigen::MatrixXd> dz2;
+  Eigen::ArrayXd zi;  // Gradient from more rows: one input's row
 };
 
 // KernelMatrices(kernel, z, z, ...) into f->kf (and f->g) through f's buffers. The squared
@@ -112,7 +117,8 @@ void OwnKernel(Kernel kernel, const Eigen::MatrixXd& z, const Eigen::VectorXd& l
         f->r2(p, q) = r2 < 0.0 ? 0.0 : r2;
       }
   }
-  SymmetricKernel(kernel, f->r2, sf2, &f->kf, with_g ? &f->g : nullptr);
+  f->g_is_kf = kernel == Kernel::kSquaredExponential;  // SymmetricKernel's g would copy K_f
+  SymmetricKernel(kernel, f->r2, sf2, &f->kf, with_g && !f->g_is_kf ? &f->g : nullptr);
 }
 
 // Fills f at theta; false if K or H'K^-1H is not PD.
@@ -123,9 +129,12 @@ bool Factor(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::Vec
   const double sf2 = std::exp(2.0 * theta(d));
   if (!length.allFinite() || !std::isfinite(sf2) || !std::isfinite(noise2)) return false;
   OwnKernel(kernel, z, length, sf2, with_g, f);
-  f->k = f->kf;
-  f->k.diagonal().array() += noise2;
-  f->chol.compute(f->k);
+  // K = K_f + sigma_n^2 I factored from K_f's own buffer (LLT copies it), K_f's diagonal restored
+  // after: the same values as a copy of K_f plus sigma_n^2, without an n x n copy per evaluation.
+  f->kf_diagonal = f->kf.diagonal();
+  f->kf.diagonal().array() += noise2;
+  f->chol.compute(f->kf);
+  f->kf.diagonal() = f->kf_diagonal;
   if (f->chol.info() != Eigen::Success) return false;
   if (f->h.rows() != z.cols()) f->h = Basis(mean, z);
   f->k_inv_h = f->chol.solve(f->h);
@@ -167,6 +176,11 @@ Eigen::MatrixXd InverseFromCholesky(const Eigen::LLT<Eigen::MatrixXd>& chol) {
   return k_inv;
 }
 
+// Gradient keeps the squared input differences up to this many rows (the refits of tables below
+// 70 rows: 16 rows at 20; 4 % less CPU there); from 100 rows their d n^2 values cost more to
+// read than to recompute (1-2 % more CPU at 100 rows, docs/workpiece-model.md "Speed").
+constexpr int kCachedDifferenceRows = 64;
+
 // -tr(W dK/dtheta_j) / 2 for every j, W = alpha alpha' - K^-1 (R&W eq. 5.9).
 void Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn2_dtheta,
               Factors* factors, Eigen::VectorXd* gradient) {
@@ -175,16 +189,30 @@ void Gradient(const Eigen::MatrixXd& z, const Eigen::VectorXd& theta, double dsn
   InverseFromCholesky(f.chol, &f.l_inv, &f.k_inv);
   f.w.noalias() = f.alpha * f.alpha.transpose();
   f.w -= f.k_inv;
-  f.wg = f.w.cwiseProduct(f.g);
+  f.wg = f.w.cwiseProduct(f.g_is_kf ? f.kf : f.g);
   const Eigen::MatrixXd& w = f.w;
   const Eigen::MatrixXd& wg = f.wg;
   Eigen::VectorXd& grad = *gradient;
   grad.resize(d + 2);
+  const bool cached = n <= kCachedDifferenceRows;
+  if (cached && (f.dz2.size() != static_cast<std::size_t>(d) || f.dz2[0].cols() != n)) {
+    f.dz2.assign(static_cast<std::size_t>(d), Eigen::MatrixXd(n, n));
+    for (int i = 0; i < d; ++i) {
+      const Eigen::ArrayXd zi = z.row(i).transpose();
+      for (int q = 0; q < n; ++q) f.dz2[i].col(q) = (zi - zi(q)).square().matrix();
+    }
+  }
+  // Both branches sum the same products in the same order (the squares are exact either way).
   for (int i = 0; i < d; ++i) {
-    Eigen::ArrayXd& zi = f.zi;
-    zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
     double s = 0;
-    for (int q = 0; q < n; ++q) s += (wg.col(q).array() * (zi - zi(q)).square()).sum();
+    if (cached) {
+      const Eigen::MatrixXd& dz2 = f.dz2[static_cast<std::size_t>(i)];
+      for (int q = 0; q < n; ++q) s += (wg.col(q).array() * dz2.col(q).array()).sum();
+    } else {
+      Eigen::ArrayXd& zi = f.zi;
+      zi = z.row(i).transpose();  // contiguous: the inner loop vectorizes
+      for (int q = 0; q < n; ++q) s += (wg.col(q).array() * (zi - zi(q)).square()).sum();
+    }
     grad(i) = -0.5 * s * std::exp(-2.0 * theta(i));
   }
   grad(d) = -w.cwiseProduct(f.kf).sum();

@@ -232,9 +232,12 @@ int ChooseEpochsByCrossValidation(const ProcessTable& table, const ModelTrainOpt
 // Calibration of the predictive sd (model_calibration.cpp).
 /// Sets model->output_noise_variance and noise_calibration by K-fold cross-validation on the
 /// table the model was trained on (see the header comment). InputError if folds < 2 or the table
-/// has fewer rows than folds.
+/// has fewer rows than folds. `fold_models`, if given (one per fold), are the fold fits already
+/// made: TrainModel of the rows outside fold f (row q in fold q % folds) with the fold options
+/// this function sets (the family choice's refits of a network, family/family.cpp); they are used
+/// instead of refitting, and the caller answers for their being those fits.
 void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& options, int folds,
-                          Model* model);
+                          Model* model, const std::vector<Model>* fold_models = nullptr);
 
 // Tables as matrices (model_predict.cpp).
 /// Inputs (5 x Q) and targets (2 x Q) of a table, original units.

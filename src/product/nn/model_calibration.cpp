@@ -34,11 +34,14 @@ double NoiseForCoverage(const std::vector<double>& r2, const std::vector<double>
 }  // namespace
 
 void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& options, int folds,
-                          Model* model) {
+                          Model* model, const std::vector<Model>* fold_models) {
   const int rows = static_cast<int>(table.inputs.size());
   if (folds < 2 || rows < folds)
     throw InputError("noise calibration: " + std::to_string(folds) + " folds for " +
                      std::to_string(rows) + " rows; needs 2 <= folds <= rows");
+  if (fold_models && fold_models->size() != static_cast<std::size_t>(folds))
+    throw InputError("noise calibration: " + std::to_string(fold_models->size()) +
+                     " fold models for " + std::to_string(folds) + " folds");
   ModelTrainOptions fold_options = options;
   fold_options.noise_folds = 0;
   fold_options.restarts = std::min(options.restarts, 3);
@@ -59,7 +62,9 @@ void CalibrateOutputNoise(const ProcessTable& table, const ModelTrainOptions& op
       t.inputs.push_back(table.inputs[i]);
       t.targets.push_back(table.targets[i]);
     }
-    const Model fm = TrainModel(train, fold_options, "fold");
+    Model trained;
+    if (!fold_models) trained = TrainModel(train, fold_options, "fold");
+    const Model& fm = fold_models ? (*fold_models)[fi] : trained;
     const std::vector<Prediction> p = PredictBatch(fm, held.inputs);
     const Eigen::VectorXd fold_half = fm.target_scaling.HalfRange();
     for (std::size_t i = 0; i < held.inputs.size(); ++i) {
