@@ -70,6 +70,22 @@ Eigen::MatrixXd Basis(Mean mean, const Eigen::MatrixXd& z) {
   return h;
 }
 
+// Eigen's LLT of K = K_f + sigma_n^2 I, computed as LLT::compute does (Eigen 3.4: the same
+// blocked in-place factorization of the lower triangle, so the same bits) but from K_f and the
+// noise directly into the factor's own buffer, and without the L1 norm compute() takes for
+// rcond() (never called here): one n x n pass and copy fewer per likelihood evaluation.
+class KernelCholesky : public Eigen::LLT<Eigen::MatrixXd> {
+ public:
+  void Compute(const Eigen::MatrixXd& kf, double noise2) {
+    m_matrix = kf;
+    m_matrix.diagonal().array() += noise2;
+    m_l1_norm = std::numeric_limits<double>::quiet_NaN();  // not computed
+    m_isInitialized = true;
+    const bool ok = Eigen::internal::llt_inplace<double, Eigen::Lower>::blocked(m_matrix) == -1;
+    m_info = ok ? Eigen::Success : Eigen::NumericalIssue;
+  }
+};
+
 // Everything NLML and its gradient need at one theta, and the buffers they are computed in: one
 // Factors serves every evaluation of a fit (same z), so that no n x n matrix is allocated per
 // evaluation (at 100 rows a fresh one per step made the C library grow and trim its heap at
@@ -79,11 +95,11 @@ struct Factors {
   Eigen::MatrixXd scaled, r2;     // z / l per input; squared scaled distances
   Eigen::RowVectorXd sq;          // squared norms of the columns of `scaled`
   Eigen::MatrixXd kf, g;          // K_f, the gradient's factor of K_f (Matern)
-  Eigen::LLT<Eigen::MatrixXd> chol, a_chol;
+  KernelCholesky chol;
+  Eigen::LLT<Eigen::MatrixXd> a_chol;
   Eigen::MatrixXd k_inv_h;
   Eigen::VectorXd b, alpha, r;
   Eigen::MatrixXd l_inv, k_inv, w, wg;  // Gradient: L^-1, K^-1, alpha alpha' - K^-1, w .* g
-  Eigen::VectorXd kf_diagonal;           // K_f's diagonal while K = K_f + sigma_n^2 I is factored
   bool g_is_kf = false;                  // squared exponential: the gradient's factor is K_f
   // Gradient, up to kCachedDifferenceRows rows: per input i the squared differences
   // (z_ip - z_iq)^2, n x n, computed at the first gradient of the fit (they depend on z only).
@@ -129,12 +145,7 @@ bool Factor(Kernel kernel, Mean mean, const Eigen::MatrixXd& z, const Eigen::Vec
   const double sf2 = std::exp(2.0 * theta(d));
   if (!length.allFinite() || !std::isfinite(sf2) || !std::isfinite(noise2)) return false;
   OwnKernel(kernel, z, length, sf2, with_g, f);
-  // K = K_f + sigma_n^2 I factored from K_f's own buffer (LLT copies it), K_f's diagonal restored
-  // after: the same values as a copy of K_f plus sigma_n^2, without an n x n copy per evaluation.
-  f->kf_diagonal = f->kf.diagonal();
-  f->kf.diagonal().array() += noise2;
-  f->chol.compute(f->kf);
-  f->kf.diagonal() = f->kf_diagonal;
+  f->chol.Compute(f->kf, noise2);
   if (f->chol.info() != Eigen::Success) return false;
   if (f->h.rows() != z.cols()) f->h = Basis(mean, z);
   f->k_inv_h = f->chol.solve(f->h);
