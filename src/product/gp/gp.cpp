@@ -188,8 +188,8 @@ Eigen::MatrixXd InverseFromCholesky(const Eigen::LLT<Eigen::MatrixXd>& chol) {
 }
 
 // Gradient keeps the squared input differences up to this many rows (the refits of tables below
-// 70 rows: 16 rows at 20; 4 % less CPU there); from 100 rows their d n^2 values cost more to
-// read than to recompute (1-2 % more CPU at 100 rows, docs/workpiece-model.md "Speed").
+// 70 rows: 16 rows at 20, where it saves CPU); from 100 rows their d n^2 values cost more to read
+// than to recompute (measured in docs/workpiece-model.md, "Speed", fifth round).
 constexpr int kCachedDifferenceRows = 64;
 
 // -tr(W dK/dtheta_j) / 2 for every j, W = alpha alpha' - K^-1 (R&W eq. 5.9).
