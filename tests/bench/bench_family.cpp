@@ -60,8 +60,8 @@ BENCHMARK(BM_FamilyDefault)
     ->ArgsProduct({{20, 100}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 
-void BM_WorkpieceDefault(benchmark::State& state) {
-  const whirl::ProcessTable table = Table(static_cast<int>(state.range(0)));
+// The default `whirl train` fit of `table` on one thread, once per iteration.
+void TimeDefaultFit(benchmark::State& state, const whirl::ProcessTable& table) {
   whirl::workpiece::TrainOptions o;
   o.choice.fit.threads = 1;
   for (auto _ : state) {
@@ -69,6 +69,10 @@ void BM_WorkpieceDefault(benchmark::State& state) {
         whirl::workpiece::TrainWorkpieceModel(table, o, "bench");
     benchmark::DoNotOptimize(m.domain_max);
   }
+}
+
+void BM_WorkpieceDefault(benchmark::State& state) {
+  TimeDefaultFit(state, Table(static_cast<int>(state.range(0))));
 }
 BENCHMARK(BM_WorkpieceDefault)
     ->ArgName("rows")
@@ -87,13 +91,7 @@ void BM_WorkpieceGenerated(benchmark::State& state) {
   const whirl::ProcessTable table = whirl::ReadProcessTable(
       std::string(WHIRL_SOURCE_DIR) + "/tests/bench/data/" + family + "_" + rows + ".csv", true);
   state.SetLabel(family + "/rows:" + rows);
-  whirl::workpiece::TrainOptions o;
-  o.choice.fit.threads = 1;
-  for (auto _ : state) {
-    const whirl::workpiece::WorkpieceModel m =
-        whirl::workpiece::TrainWorkpieceModel(table, o, "bench");
-    benchmark::DoNotOptimize(m.domain_max);
-  }
+  TimeDefaultFit(state, table);
 }
 BENCHMARK(BM_WorkpieceGenerated)
     ->ArgNames({"family", "rows"})
