@@ -74,6 +74,9 @@ Eigen::MatrixXd Basis(Mean mean, const Eigen::MatrixXd& z) {
 // blocked in-place factorization of the lower triangle, so the same bits) but from K_f and the
 // noise directly into the factor's own buffer, and without the L1 norm compute() takes for
 // rcond() (never called here): one n x n pass and copy fewer per likelihood evaluation.
+// It reads LLT's protected members and Eigen::internal, written against Eigen 3.4 (Debian 12's);
+// any other Eigen takes the public path (one copy more, the same factorization).
+#if EIGEN_VERSION_AT_LEAST(3, 4, 0) && !EIGEN_VERSION_AT_LEAST(3, 4, 90)
 class KernelCholesky : public Eigen::LLT<Eigen::MatrixXd> {
  public:
   void Compute(const Eigen::MatrixXd& kf, double noise2) {
@@ -85,6 +88,19 @@ class KernelCholesky : public Eigen::LLT<Eigen::MatrixXd> {
     m_info = ok ? Eigen::Success : Eigen::NumericalIssue;
   }
 };
+#else
+class KernelCholesky : public Eigen::LLT<Eigen::MatrixXd> {
+ public:
+  void Compute(const Eigen::MatrixXd& kf, double noise2) {
+    k_ = kf;
+    k_.diagonal().array() += noise2;
+    compute(k_);
+  }
+
+ private:
+  Eigen::MatrixXd k_;
+};
+#endif
 
 // Everything NLML and its gradient need at one theta, and the buffers they are computed in: one
 // Factors serves every evaluation of a fit (same z), so that no n x n matrix is allocated per
