@@ -279,6 +279,17 @@ ProcessTable Rows(const ProcessTable& table, const std::vector<int>& fold_of, in
 
 FamilyModel Unfitted(const ProcessTable& table, const Candidate& candidate);
 
+// A network candidate fitted on all rows of `table` (FitNetwork; `fold_fits` as there).
+FamilyModel NetworkCandidate(const ProcessTable& table, const Candidate& candidate,
+                             const FitOptions& options, bool calibrate,
+                             const std::vector<nn::Model>* fold_fits) {
+  FamilyModel m = Unfitted(table, candidate);
+  m.network = FitNetwork(TransformedTable(table, m.transform), candidate, options, calibrate,
+                         fold_fits);
+  m.calibration = m.network.noise_calibration;
+  return m;
+}
+
 // Held-out errors (2 x rows, original units) of one candidate's fold fit; a network fold fit is
 // moved into `network` (true) when its transform is the whole table's, so that it is a fold fit
 // of the table's network (FitNetwork's fold_fits).
@@ -329,12 +340,9 @@ void FitChosen(const ProcessTable& table, const ChoiceOptions& options,
       if (!calibrated[c]) Calibrate(table, options.fit, &full[c]);
       choice->models.push_back(std::move(full[c]));
     } else {
-      FamilyModel m = Unfitted(table, options.candidates[c]);
       const std::vector<nn::Model>& folds = fold_networks[static_cast<std::size_t>(c)];
-      m.network = FitNetwork(TransformedTable(table, m.transform), m.candidate, options.fit, true,
-                             folds.empty() ? nullptr : &folds);
-      m.calibration = m.network.noise_calibration;
-      choice->models.push_back(std::move(m));
+      choice->models.push_back(NetworkCandidate(table, options.candidates[c], options.fit, true,
+                                                folds.empty() ? nullptr : &folds));
     }
     return static_cast<int>(fitted.size()) - 1;
   };
@@ -445,12 +453,9 @@ void FitOwnColumns(const ProcessTable& table, const FitOptions& options, FamilyM
 
 FamilyModel FitCandidate(const ProcessTable& table, const Candidate& candidate,
                          const FitOptions& options, bool calibrate) {
+  if (candidate.family == Family::kNetwork)
+    return NetworkCandidate(table, candidate, options, calibrate, nullptr);
   FamilyModel m = Unfitted(table, candidate);
-  if (candidate.family == Family::kNetwork) {
-    m.network = FitNetwork(TransformedTable(table, m.transform), candidate, options, calibrate);
-    m.calibration = m.network.noise_calibration;
-    return m;
-  }
   FitOwnColumns(table, options, &m);
   if (calibrate) Calibrate(table, options, &m);
   return m;
